@@ -1,0 +1,43 @@
+/* accel.h - Embree 3 scene built from the scene IR: triangles and meshes as
+ * Embree triangle geometry, analytic shapes as user geometry, reused meshes
+ * as instances. */
+#ifndef PT_ACCEL_H
+#define PT_ACCEL_H
+#include "diag.h"
+#include "scene.h"
+
+typedef struct accel accel;
+
+typedef struct {
+    double t;                     /* ray parameter (dir need not be unit) */
+    vec3 p;                       /* world hit point */
+    vec3 ng;                      /* world geometric normal, unit, NOT flipped to face the ray */
+    vec3 ns;                      /* world shading normal (smooth triangles/meshes), unit, same side as ng */
+    double u, v;                  /* surface parameters (barycentrics for triangles) */
+    const scene_object *obj;      /* the leaf object hit */
+    const scene_texture *texture; /* effective texture (per-triangle mesh textures resolved) */
+    unsigned prim;                /* primitive index within the object (triangle index for meshes) */
+} accel_hit;
+
+typedef struct {
+    long geometries, instances, triangles, user_prims, unsupported;
+    double build_seconds;
+} accel_stats;
+
+/* Build. Unsupported shapes are skipped with one warning each in `d`. */
+accel *accel_build(const scene *s, int threads, diag *d, pt_status *status);
+void accel_free(accel *a);
+/* Nearest hit with t in (tmin, tmax); returns 1 on hit. Objects flagged
+ * no_image are skipped when `primary` is set, no_reflection when `reflected`. */
+int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, accel_hit *hit);
+/* Any hit in (tmin, tmax) by an object that casts shadows (not no_shadow). */
+int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax);
+/* World bounds of finite geometry (infinite planes excluded) and a scene
+ * scale (bounding-box diagonal) for epsilons. */
+void accel_bounds(const accel *a, vec3 *lo, vec3 *hi);
+double accel_scale(const accel *a);
+accel_stats accel_get_stats(const accel *a);
+/* The underlying RTCScene (as void*), for benchmarks that drive Embree directly. */
+void *accel_rtc_scene(const accel *a);
+
+#endif

@@ -1,0 +1,66 @@
+/* pool.c - minimal parallel-for on pthreads with an atomic work counter. */
+#include "pool.h"
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+typedef struct {
+    pool_job job;
+    void *ctx;
+    int n;
+    atomic_int next;
+} pool_state;
+
+typedef struct {
+    pool_state *st;
+    int thread;
+} worker_arg;
+
+static void *worker(void *p)
+{
+    worker_arg *w = p;
+    for (;;) {
+        int i = atomic_fetch_add(&w->st->next, 1);
+        if (i >= w->st->n) break;
+        w->st->job(w->st->ctx, i, w->thread);
+    }
+    return NULL;
+}
+
+int pool_default_threads(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n > 0 ? (int)n : 1;
+}
+
+void pool_run(int threads, int n, pool_job job, void *ctx)
+{
+    if (threads <= 0) threads = pool_default_threads();
+    if (threads > n) threads = n;
+    pool_state st = {job, ctx, n, 0};
+    if (threads <= 1) {
+        for (int i = 0; i < n; i++) job(ctx, i, 0);
+        return;
+    }
+    pthread_t *tid = malloc(sizeof(pthread_t) * (size_t)threads);
+    worker_arg *args = malloc(sizeof(worker_arg) * (size_t)threads);
+    if (!tid || !args) {
+        free(tid); free(args);
+        for (int i = 0; i < n; i++) job(ctx, i, 0);
+        return;
+    }
+    int started = 0;
+    for (int t = 1; t < threads; t++) {
+        args[t].st = &st;
+        args[t].thread = t;
+        if (pthread_create(&tid[t], NULL, worker, &args[t]) == 0) started = t;
+        else break;
+    }
+    args[0].st = &st;
+    args[0].thread = 0;
+    worker(&args[0]);
+    for (int t = 1; t <= started; t++) pthread_join(tid[t], NULL);
+    free(tid);
+    free(args);
+}

@@ -1,0 +1,12 @@
+/* pool.h - run a job function over indices [0, n) on T threads (dynamic scheduling). */
+#ifndef PT_POOL_H
+#define PT_POOL_H
+
+typedef void (*pool_job)(void *ctx, int index, int thread);
+
+/* Calls job(ctx, i, thread) for every i in [0, n); returns when all are done.
+ * threads <= 0 means the number of online CPUs. */
+void pool_run(int threads, int n, pool_job job, void *ctx);
+int pool_default_threads(void);
+
+#endif

@@ -1,0 +1,202 @@
+/* scene.c - scene IR construction helpers and POV-Ray 3.7 defaults. */
+#include "scene.h"
+#include <stdlib.h>
+#include <string.h>
+
+void scene_default_finish(scene_finish *f)
+{
+    /* POV-Ray 3.7 reference, section "Finish": ambient 0.1, diffuse 0.6,
+     * brilliance 1, phong_size 40, roughness 0.05, falloff/exponent 1. */
+    memset(f, 0, sizeof *f);
+    f->ambient = (rgb){0.1, 0.1, 0.1};
+    f->diffuse = 0.6;
+    f->brilliance = 1.0;
+    f->phong_size = 40.0;
+    f->roughness = 0.05;
+    f->reflection_falloff = 1.0;
+    f->reflection_exponent = 1.0;
+}
+
+void scene_default_pigment(scene_pigment *p)
+{
+    /* Default pigment is black (POV-Ray 3.7 reference, "Pigment"). */
+    memset(p, 0, sizeof *p);
+    p->kind = PIGMENT_SOLID;
+    p->transform = xform_identity();
+}
+
+void scene_default_interior(scene_interior *i)
+{
+    memset(i, 0, sizeof *i);
+    i->ior = 1.0;
+    i->dispersion = 1.0;
+    i->fade_power = 0.0;
+}
+
+void scene_default_camera(scene_camera *c)
+{
+    /* POV-Ray 3.7 defaults: location <0,0,0>, direction <0,0,1>, up <0,1,0>,
+     * right <1.33,0,0>, sky <0,1,0>. */
+    memset(c, 0, sizeof *c);
+    c->kind = CAMERA_PERSPECTIVE;
+    c->direction = v3(0, 0, 1);
+    c->up = v3(0, 1, 0);
+    c->right = v3(1.33, 0, 0);
+    c->sky = v3(0, 1, 0);
+    c->look_at = v3(0, 0, 1);
+    c->blur_samples = 0;
+}
+
+void scene_default_light(scene_light *l)
+{
+    /* spotlight defaults: radius 30, falloff 45, tightness 0 (3.7 docs). */
+    memset(l, 0, sizeof *l);
+    l->kind = LIGHT_POINT;
+    l->colour = (rgb){1, 1, 1};
+    l->point_at = v3(0, 0, 1);
+    l->radius = 30.0;
+    l->falloff = 45.0;
+    l->tightness = 0.0;
+    l->adaptive = -1;
+    l->fade_power = 0.0;
+    l->media_interaction = 1;
+    l->media_attenuation = 0;
+}
+
+void scene_default_global(scene_global *g)
+{
+    memset(g, 0, sizeof *g);
+    g->ambient_light = (rgb){1, 1, 1};
+    g->max_trace_level = 5;
+    g->adc_bailout = 1.0 / 255.0;
+    g->noise_generator = 2;
+    scene_radiosity *r = &g->radiosity;
+    /* radiosity defaults, POV-Ray 3.7 reference "Radiosity". */
+    r->count = 35;
+    r->recursion_limit = 2;
+    r->error_bound = 1.8;
+    r->pretrace_start = 0.08;
+    r->pretrace_end = 0.04;
+    r->nearest_count = 5;
+    r->brightness = 1.0;
+    r->gray_threshold = 0.0;
+    r->low_error_factor = 0.5;
+    r->minimum_reuse = 0.015;
+}
+
+scene *scene_new(void)
+{
+    scene *s = calloc(1, sizeof *s);
+    if (!s) return NULL;
+    s->mem = arena_new();
+    if (!s->mem) { free(s); return NULL; }
+    scene_default_global(&s->global);
+    scene_default_camera(&s->camera);
+    scene_default_pigment(&s->default_texture.pigment);
+    scene_default_finish(&s->default_texture.finish);
+    s->default_texture.transform = xform_identity();
+    return s;
+}
+
+void scene_free(scene *s)
+{
+    if (!s) return;
+    arena_free(s->mem);
+    free(s->objects);
+    free(s->lights);
+    free(s);
+}
+
+scene_object *scene_new_object(scene *s, shape_kind kind, src_loc loc)
+{
+    scene_object *o = arena_alloc(s->mem, sizeof *o);
+    if (!o) return NULL;
+    o->kind = kind;
+    o->loc = loc;
+    o->transform = xform_identity();
+    return o;
+}
+
+scene_texture *scene_new_texture(scene *s)
+{
+    scene_texture *t = arena_alloc(s->mem, sizeof *t);
+    if (!t) return NULL;
+    *t = s->default_texture;
+    t->next = NULL;
+    return t;
+}
+
+scene_mesh *scene_new_mesh(scene *s) { return arena_alloc(s->mem, sizeof(scene_mesh)); }
+
+pt_status scene_add_object(scene *s, scene_object *o)
+{
+    if (s->nobjects == s->cap_objects) {
+        int nc = s->cap_objects ? s->cap_objects * 2 : 64;
+        scene_object **n = realloc(s->objects, sizeof(*n) * (size_t)nc);
+        if (!n) return PT_ERR_NOMEM;
+        s->objects = n;
+        s->cap_objects = nc;
+    }
+    s->objects[s->nobjects++] = o;
+    return PT_OK;
+}
+
+pt_status scene_add_light(scene *s, const scene_light *l)
+{
+    if (s->nlights == s->cap_lights) {
+        int nc = s->cap_lights ? s->cap_lights * 2 : 16;
+        scene_light *n = realloc(s->lights, sizeof(*n) * (size_t)nc);
+        if (!n) return PT_ERR_NOMEM;
+        s->lights = n;
+        s->cap_lights = nc;
+    }
+    s->lights[s->nlights++] = *l;
+    return PT_OK;
+}
+
+static void count_object(const scene_object *o, scene_counts *c)
+{
+    switch (o->kind) {
+    case SHAPE_UNION: case SHAPE_MERGE: case SHAPE_INTERSECTION: case SHAPE_DIFFERENCE:
+        c->csg++;
+        for (int i = 0; i < o->u.csg.nkids; i++) count_object(o->u.csg.kids[i], c);
+        return;
+    case SHAPE_TRIANGLE: case SHAPE_SMOOTH_TRIANGLE:
+        c->triangles++;
+        break;
+    case SHAPE_MESH:
+        c->meshes++;
+        if (o->u.mesh.mesh) c->triangles += o->u.mesh.mesh->ntris;
+        break;
+    case SHAPE_UNSUPPORTED:
+        c->unsupported++;
+        break;
+    default:
+        break;
+    }
+    c->objects++;
+}
+
+scene_counts scene_count(const scene *s)
+{
+    scene_counts c;
+    memset(&c, 0, sizeof c);
+    for (int i = 0; i < s->nobjects; i++) count_object(s->objects[i], &c);
+    c.lights = s->nlights;
+    return c;
+}
+
+void scene_camera_ray(const scene_camera *c, double px, double py, int w, int h, vec3 *org, vec3 *dir)
+{
+    /* POV-Ray: screen x runs -0.5..0.5 left to right along `right`, y runs
+     * 0.5..-0.5 top to bottom along `up`. */
+    double sx = px / w - 0.5;
+    double sy = 0.5 - py / h;
+    if (c->kind == CAMERA_ORTHOGRAPHIC) {
+        *org = v3_add(c->location, v3_add(v3_scale(c->right, sx), v3_scale(c->up, sy)));
+        *dir = v3_norm(c->direction);
+        return;
+    }
+    *org = c->location;
+    *dir = v3_norm(v3_add(c->direction, v3_add(v3_scale(c->right, sx), v3_scale(c->up, sy))));
+}

@@ -1,0 +1,269 @@
+/* scene.h - the scene IR: plain records the parser fills and every renderer
+ * reads. Nothing here knows about tokens or about Embree. All memory belongs
+ * to the scene's arena; pointers between records stay valid for its life.
+ *
+ * Conventions (POV-Ray's): left-handed world, y up, colours are linear
+ * (assumed_gamma 1.0 is the only working space we model; see DESIGN.md). */
+#ifndef PT_SCENE_H
+#define PT_SCENE_H
+#include <stddef.h>
+#include "arena.h"
+#include "diag.h"
+#include "vec.h"
+#include "xform.h"
+
+/* Colour with POV-Ray's filter and transmit channels. */
+typedef struct { double r, g, b, f, t; } colour5;
+typedef struct { double r, g, b; } rgb;
+
+/* ---------------------------------------------------------------- pigment */
+typedef enum {
+    PIGMENT_SOLID = 0,
+    PIGMENT_OTHER /* a pattern the renderer does not evaluate yet: uses `colour` */
+} pigment_kind;
+
+typedef struct {
+    pigment_kind kind;
+    colour5 colour;      /* solid colour (also the fallback for patterns) */
+    const char *pattern; /* pattern keyword for PIGMENT_OTHER, else NULL */
+    xform transform;     /* pattern space -> object space */
+} scene_pigment;
+
+/* ---------------------------------------------------------------- finish */
+typedef struct {
+    rgb ambient;          /* default 0.1 (POV-Ray 3.7 docs, finish) */
+    rgb emission;         /* default 0 */
+    double diffuse;       /* default 0.6 */
+    double diffuse_back;  /* "diffuse a, b": backside value, default 0 */
+    double brilliance;    /* default 1 */
+    double crand;         /* default 0 */
+    double phong;         /* default 0 */
+    double phong_size;    /* default 40 */
+    double specular;      /* default 0 */
+    double roughness;     /* default 0.05 */
+    double metallic;      /* highlight metallic, default 0 */
+    rgb reflection_min;   /* reflection {min, max}; plain "reflection c" sets both */
+    rgb reflection_max;
+    double reflection_falloff;  /* default 1 */
+    double reflection_exponent; /* default 1 */
+    double reflection_metallic; /* default 0 */
+    int fresnel;                /* reflection { fresnel on } */
+    int conserve_energy;
+} scene_finish;
+
+/* ---------------------------------------------------------------- interior */
+typedef struct {
+    double ior;           /* default 1 */
+    double dispersion;    /* default 1 */
+    double fade_distance; /* 0 = off */
+    double fade_power;
+    rgb fade_colour;
+    int caustics_set;
+} scene_interior;
+
+/* A texture: one pigment, finish and (later) normal. Layered textures are a
+ * list linked through `next`, the first entry on top. */
+typedef struct scene_texture {
+    scene_pigment pigment;
+    scene_finish finish;
+    int has_normal;            /* a normal{} block was given (not evaluated yet) */
+    xform transform;           /* texture transform (applied after the object's) */
+    struct scene_texture *next;
+    src_loc loc;
+} scene_texture;
+
+/* ---------------------------------------------------------------- meshes */
+/* Triangle data shared between objects (a declared mesh used many times is
+ * one scene_mesh referenced by several objects: accel instances it). */
+typedef struct scene_mesh {
+    int nverts, nnormals, nuvs, ntris;
+    float (*verts)[3];
+    float (*normals)[3];   /* may be NULL */
+    float (*uvs)[2];       /* may be NULL */
+    int (*tris)[3];        /* vertex indices */
+    int (*tri_normals)[3]; /* normal indices, NULL if none */
+    int *tri_texture;      /* index into `textures` per triangle, NULL = object texture */
+    int ntextures;
+    const scene_texture **textures;
+    int uses;              /* number of objects that reference it */
+    src_loc loc;
+} scene_mesh;
+
+/* ---------------------------------------------------------------- objects */
+typedef enum {
+    SHAPE_SPHERE,
+    SHAPE_BOX,
+    SHAPE_PLANE,
+    SHAPE_TRIANGLE,
+    SHAPE_SMOOTH_TRIANGLE,
+    SHAPE_MESH,
+    SHAPE_UNION,
+    SHAPE_MERGE,
+    SHAPE_INTERSECTION,
+    SHAPE_DIFFERENCE,
+    SHAPE_CYLINDER,
+    SHAPE_CONE,
+    SHAPE_DISC,
+    SHAPE_TORUS,
+    SHAPE_UNSUPPORTED /* parsed, not renderable yet: `name` says which */
+} shape_kind;
+
+enum {
+    OBJ_NO_SHADOW = 1u << 0,
+    OBJ_NO_IMAGE = 1u << 1,
+    OBJ_NO_REFLECTION = 1u << 2,
+    OBJ_INVERSE = 1u << 3,
+    OBJ_HOLLOW = 1u << 4,
+    OBJ_DOUBLE_ILLUMINATE = 1u << 5,
+    OBJ_OPEN = 1u << 6,
+    OBJ_STURM = 1u << 7,
+    OBJ_NO_RADIOSITY = 1u << 8
+};
+
+typedef struct scene_object scene_object;
+struct scene_object {
+    shape_kind kind;
+    const char *name;       /* keyword that made it ("sphere", "lathe", ...) */
+    src_loc loc;
+    xform transform;        /* object -> world (already composed with parents) */
+    const scene_texture *texture;   /* NULL = default texture */
+    const scene_texture *interior_texture;
+    const scene_interior *interior; /* NULL = default interior */
+    unsigned flags;
+    union {
+        struct { vec3 centre; double radius; } sphere;
+        struct { vec3 c1, c2; } box;            /* c1 <= c2 component-wise */
+        struct { vec3 normal; double offset; } plane; /* points p with n.p = offset */
+        struct { vec3 v[3]; vec3 n[3]; } triangle;   /* n used for smooth_triangle */
+        struct { const scene_mesh *mesh; int inside_vector_set; vec3 inside_vector; } mesh;
+        struct { scene_object **kids; int nkids; } csg;
+        struct { vec3 base, cap; double base_radius, cap_radius; } cone; /* cylinder: equal radii */
+        struct { vec3 centre, normal; double radius, hole_radius; } disc;
+        struct { double major, minor; } torus;
+    } u;
+};
+
+/* ---------------------------------------------------------------- lights */
+typedef enum { LIGHT_POINT, LIGHT_SPOT, LIGHT_CYLINDER, LIGHT_PARALLEL } light_kind;
+
+typedef struct {
+    light_kind kind;
+    src_loc loc;
+    vec3 position;
+    rgb colour;
+    vec3 point_at;          /* spot, cylinder, parallel; default <0,0,1> */
+    double radius, falloff, tightness; /* degrees for spot; defaults 30, 45, 0 (3.7 docs) */
+    int parallel;           /* `parallel` keyword on a point/spot light */
+    /* area light */
+    int area;
+    vec3 axis1, axis2;
+    int size1, size2;
+    int adaptive;           /* adaptive level, -1 if not given */
+    int jitter, circular, orient;
+    int area_illumination;
+    /* attenuation */
+    double fade_distance;   /* 0 = no fading */
+    double fade_power;
+    int shadowless;
+    int media_interaction, media_attenuation;
+    const scene_object *looks_like;
+} scene_light;
+
+/* ---------------------------------------------------------------- camera */
+typedef enum {
+    CAMERA_PERSPECTIVE, CAMERA_ORTHOGRAPHIC, CAMERA_FISHEYE, CAMERA_ULTRA_WIDE_ANGLE,
+    CAMERA_OMNIMAX, CAMERA_PANORAMIC, CAMERA_CYLINDER, CAMERA_SPHERICAL
+} camera_kind;
+
+typedef struct {
+    camera_kind kind;
+    int cylinder_type;
+    src_loc loc;
+    /* Final vectors after look_at, angle, sky and transforms, as POV-Ray
+     * computes them while parsing: a primary ray through normalised screen
+     * coordinates (sx, sy) in [-0.5, 0.5] is direction + sx*right + sy*up. */
+    vec3 location, direction, up, right, sky, look_at;
+    double angle;           /* horizontal field of view in degrees, 0 = unset */
+    double aperture;        /* focal blur, 0 = off */
+    int blur_samples;
+    vec3 focal_point;
+} scene_camera;
+
+/* ---------------------------------------------------------------- global settings */
+typedef struct {
+    int enabled;            /* a radiosity{} block was present */
+    int count;              /* default 35 */
+    int recursion_limit;    /* default 2 */
+    double error_bound;     /* default 1.8 */
+    double pretrace_start, pretrace_end; /* 0.08, 0.04 */
+    int nearest_count;      /* default 5 */
+    double brightness;      /* default 1 */
+    double gray_threshold;
+    double low_error_factor;
+    double minimum_reuse;
+    int always_sample;
+    int normal, media;
+} scene_radiosity;
+
+typedef struct {
+    double assumed_gamma;   /* 0 = not given */
+    rgb ambient_light;      /* default <1,1,1> */
+    int max_trace_level;    /* default 5 */
+    double adc_bailout;     /* default 1/255 */
+    int max_intersections;
+    scene_radiosity radiosity;
+    int photons;            /* a photons{} block was present */
+    double photons_spacing;
+    int photons_count;
+    double irid_wavelength[3];
+    int noise_generator;    /* default 2 */
+} scene_global;
+
+/* ---------------------------------------------------------------- the scene */
+typedef struct {
+    arena *mem;
+    scene_global global;
+    scene_camera camera;
+    int camera_set;
+    colour5 background;     /* default black */
+    int nobjects, cap_objects;
+    scene_object **objects; /* top-level objects */
+    int nlights, cap_lights;
+    scene_light *lights;
+    scene_texture default_texture;
+    int version_major, version_minor; /* from #version; 0 if absent */
+    int nfiles;             /* files read (scene + includes) */
+    double clock;
+} scene;
+
+scene *scene_new(void);
+void scene_free(scene *s);
+/* Defaults as POV-Ray 3.7 documents them. */
+void scene_default_finish(scene_finish *f);
+void scene_default_pigment(scene_pigment *p);
+void scene_default_camera(scene_camera *c);
+void scene_default_light(scene_light *l);
+void scene_default_global(scene_global *g);
+void scene_default_interior(scene_interior *i);
+scene_object *scene_new_object(scene *s, shape_kind kind, src_loc loc);
+scene_texture *scene_new_texture(scene *s);
+scene_mesh *scene_new_mesh(scene *s);
+pt_status scene_add_object(scene *s, scene_object *o);
+pt_status scene_add_light(scene *s, const scene_light *l);
+
+/* Counting helpers for `partray parse` and stats. */
+typedef struct {
+    long objects;     /* leaf objects (CSG children counted) */
+    long csg;         /* CSG nodes */
+    long triangles;   /* triangle + mesh triangles */
+    long meshes;
+    long lights;
+    long unsupported;
+} scene_counts;
+scene_counts scene_count(const scene *s);
+
+/* Camera ray for pixel position (px, py) in [0,w)x[0,h), pixel centres at .5;
+ * perspective and orthographic only for now. Direction is normalised. */
+void scene_camera_ray(const scene_camera *c, double px, double py, int w, int h, vec3 *org, vec3 *dir);
+
+#endif

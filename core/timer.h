@@ -1,0 +1,11 @@
+/* timer.h - monotonic wall clock in seconds. */
+#ifndef PT_TIMER_H
+#define PT_TIMER_H
+#include <time.h>
+static inline double timer_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+#endif

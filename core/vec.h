@@ -1,0 +1,43 @@
+/* vec.h - 3-component double vectors, all inline. */
+#ifndef PT_VEC_H
+#define PT_VEC_H
+#include <math.h>
+
+typedef struct { double x, y, z; } vec3;
+
+static inline vec3 v3(double x, double y, double z) { vec3 r = {x, y, z}; return r; }
+static inline vec3 v3s(double s) { return v3(s, s, s); }
+static inline vec3 v3_add(vec3 a, vec3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline vec3 v3_sub(vec3 a, vec3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline vec3 v3_mul(vec3 a, vec3 b) { return v3(a.x * b.x, a.y * b.y, a.z * b.z); }
+static inline vec3 v3_scale(vec3 a, double s) { return v3(a.x * s, a.y * s, a.z * s); }
+static inline vec3 v3_madd(vec3 a, vec3 b, double s) { return v3(a.x + b.x * s, a.y + b.y * s, a.z + b.z * s); }
+static inline vec3 v3_neg(vec3 a) { return v3(-a.x, -a.y, -a.z); }
+static inline double v3_dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline vec3 v3_cross(vec3 a, vec3 b)
+{
+    return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static inline double v3_len2(vec3 a) { return v3_dot(a, a); }
+static inline double v3_len(vec3 a) { return sqrt(v3_dot(a, a)); }
+static inline vec3 v3_norm(vec3 a)
+{
+    double l = v3_len(a);
+    return l > 0.0 ? v3_scale(a, 1.0 / l) : a;
+}
+static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fmin(a.x, b.x), fmin(a.y, b.y), fmin(a.z, b.z)); }
+static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z)); }
+static inline double v3_maxc(vec3 a) { return fmax(a.x, fmax(a.y, a.z)); }
+static inline double v3_idx(vec3 a, int i) { return i == 0 ? a.x : (i == 1 ? a.y : a.z); }
+static inline int v3_finite(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+/* Build an orthonormal basis (t, b) around unit vector n (Duff et al. 2017). */
+static inline void v3_basis(vec3 n, vec3 *t, vec3 *b)
+{
+    double s = copysign(1.0, n.z);
+    double a = -1.0 / (s + n.z);
+    double c = n.x * n.y * a;
+    *t = v3(1.0 + s * n.x * n.x * a, s * c, -s * n.x);
+    *b = v3(c, s + n.y * n.y * a, -n.y);
+}
+
+#endif

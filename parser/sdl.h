@@ -1,0 +1,31 @@
+/* sdl.h - POV-Ray 3.7 scene description language -> scene IR (core/scene.h).
+ * The parser builds IR only; it never creates render objects. */
+#ifndef PT_SDL_H
+#define PT_SDL_H
+#include "diag.h"
+#include "scene.h"
+
+typedef struct {
+    const char *const *lib_paths; /* extra include directories (-L), searched in order */
+    int nlib_paths;
+    int no_default_lib;           /* 1: do not add /usr/share/povray-3.7/include */
+    const char *const *defines;   /* "NAME=VALUE" (-D): declared before parsing; VALUE a float or a string */
+    int ndefines;
+    double clock;                 /* value of `clock`, default 0 */
+    int image_width, image_height;/* values of image_width/image_height */
+    long max_loop_iterations;     /* per #while/#for loop, 0 = default (10,000,000) */
+    int max_include_depth;        /* 0 = default (64) */
+    int max_macro_depth;          /* 0 = default (256) */
+} sdl_options;
+
+void sdl_default_options(sdl_options *o);
+
+/* Parse a file. On success *out holds a new scene (caller frees with
+ * scene_free). On error, messages with locations and the include/macro chain
+ * are in `d`, *out is NULL and the status says why (PT_ERR_SYNTAX, PT_ERR_IO,
+ * PT_ERR_LIMIT...). Warnings (e.g. unsupported features) go to `d` too. */
+pt_status sdl_parse_file(const char *path, const sdl_options *opt, scene **out, diag *d);
+/* Same, from a string in memory; `name` is used in locations. */
+pt_status sdl_parse_string(const char *name, const char *text, const sdl_options *opt, scene **out, diag *d);
+
+#endif

@@ -1,0 +1,45 @@
+/* shade.h - Whitted integrator with POV-Ray 3.7's lighting model: camera
+ * rays, direct light from every light type (with area-light sampling),
+ * shadows, reflection, antialiasing; multithreaded over tiles. An optional
+ * hook supplies the indirect diffuse term (GI modes plug in there). */
+#ifndef PT_SHADE_H
+#define PT_SHADE_H
+#include <stdint.h>
+#include "accel.h"
+#include "diag.h"
+#include "framebuffer.h"
+#include "scene.h"
+
+/* Irradiance-like indirect term at a diffuse hit: returns the incoming
+ * indirect radiance weighting that multiplies pigment*diffuse (POV-Ray's
+ * radiosity "ambient" replacement). `n` faces the viewer. */
+typedef rgb (*shade_indirect_fn)(void *ctx, const accel_hit *hit, vec3 n, int thread);
+
+typedef struct {
+    int width, height;
+    int threads;            /* <=0: all cores */
+    uint64_t seed;
+    int antialias;          /* 0 off, 1 POV-Ray +A adaptive (method 1), 2 fixed supersampling */
+    double aa_threshold;    /* +A0.3 -> 0.3 */
+    int aa_depth;           /* +R, default 3 */
+    int spp;                /* fixed supersampling: samples per pixel (n x n grid rounded) */
+    int max_trace_level;    /* 0 = scene's global_settings value */
+    int use_ambient;        /* 1: add finish ambient * ambient_light (no GI); 0: GI supplies it */
+    shade_indirect_fn indirect;
+    void *indirect_ctx;
+    volatile int *cancel;   /* set non-zero to stop early (SIGINT) */
+} shade_settings;
+
+typedef struct {
+    long primary_rays, shadow_rays, secondary_rays;
+    long discarded_samples;  /* NaN/Inf samples replaced by 0 */
+    long unsupported;        /* hits on things the shader cannot evaluate */
+    double seconds;
+} shade_stats;
+
+void shade_default_settings(shade_settings *s);
+pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s, framebuffer *fb, shade_stats *st, diag *d);
+/* Radiance along one ray (for tests and other integrators). */
+rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 org, vec3 dir, int thread, uint64_t *rng_state);
+
+#endif
