@@ -29,7 +29,7 @@ long fb_sanitize(framebuffer *fb)
     size_t total = (size_t)fb->width * (size_t)fb->height * 3u;
     for (size_t i = 0; i < total; i++) {
         float v = fb->rgb[i];
-        if (!isfinite(v) || v < 0.0f) { fb->rgb[i] = 0.0f; n++; }
+        if (!isfinite(v)) { fb->rgb[i] = 0.0f; n++; }
     }
     return n;
 }

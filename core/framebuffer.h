@@ -12,7 +12,8 @@ typedef struct {
 framebuffer *fb_new(int width, int height);
 void fb_free(framebuffer *fb);
 static inline float *fb_px(framebuffer *fb, int x, int y) { return fb->rgb + ((size_t)y * (size_t)fb->width + (size_t)x) * 3u; }
-/* Replace NaN/Inf by 0 (and negatives by 0); returns how many values were fixed. */
+/* Replace NaN/Inf by 0; returns how many values were fixed. Negative values
+ * (POV-Ray allows negative lights) are kept. */
 long fb_sanitize(framebuffer *fb);
 double fb_mean(const framebuffer *fb, int channel); /* channel -1 = mean of rgb */
 

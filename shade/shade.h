@@ -8,6 +8,7 @@
 #include "accel.h"
 #include "diag.h"
 #include "framebuffer.h"
+#include "rng.h"
 #include "scene.h"
 
 /* Irradiance-like indirect term at a diffuse hit: returns the incoming
@@ -40,6 +41,9 @@ typedef struct {
 void shade_default_settings(shade_settings *s);
 pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s, framebuffer *fb, shade_stats *st, diag *d);
 /* Radiance along one ray (for tests and other integrators). */
-rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 org, vec3 dir, int thread, uint64_t *rng_state);
+rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 org, vec3 dir, int thread, rng *r);
+/* POV-Ray's colour distance used for antialiasing decisions: sum of the
+ * absolute channel differences. */
+double shade_colour_distance(rgb a, rgb b);
 
 #endif

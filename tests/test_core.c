@@ -94,8 +94,8 @@ static void test_fb_sanitize(void **st)
     fb->rgb[1] = INFINITY;
     fb->rgb[2] = -1.0f;
     fb->rgb[3] = 0.5f;
-    assert_int_equal(fb_sanitize(fb), 3);
-    assert_true(fb->rgb[0] == 0.0f && fb->rgb[3] == 0.5f);
+    assert_int_equal(fb_sanitize(fb), 2);
+    assert_true(fb->rgb[0] == 0.0f && fb->rgb[1] == 0.0f && fb->rgb[2] == -1.0f && fb->rgb[3] == 0.5f);
     assert_true(fabs(fb_mean(fb, 0) - 0.25) < 1e-12);
     fb_free(fb);
     assert_null(fb_new(0, 5));

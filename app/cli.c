@@ -1,0 +1,200 @@
+/* cli.c - option parsing for `partray render`.
+ *
+ * POV-Ray style switches accepted (POV-Ray 3.7 reference, "Command-line
+ * options"): +Wn +Hn (size), +Ofile (output), +Ifile (input), +A[t] / -A
+ * (antialiasing with threshold t, default 0.3), +Rn (AA depth), +Lpath
+ * (library path), +FE/+FN (format, implied by the output name here), +WTn
+ * (work threads), +Kc (clock). Switches that only concern POV-Ray's display
+ * or its own files (+D, -D, +P, +V, +J...) are accepted and ignored. */
+#include "cli.h"
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int parse_int(const char *s, int *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (errno || end == s || *end || v < -2147483647L || v > 2147483647L) return 0;
+    *out = (int)v;
+    return 1;
+}
+
+static int parse_double(const char *s, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || end == s || *end) return 0;
+    *out = v;
+    return 1;
+}
+
+static int add_list(const char **list, int *n, const char *v)
+{
+    if (*n >= CLI_MAX_LIST) return 0;
+    list[(*n)++] = v;
+    return 1;
+}
+
+static int add_output(cli_render *o, const char *v)
+{
+    if (o->noutputs >= 8) return 0;
+    o->outputs[o->noutputs++] = v;
+    return 1;
+}
+
+/* One POV-Ray style switch: "+W640", "-A", "+A0.3", "+Oout.png"... */
+static int pov_switch(const char *arg, cli_render *o, char *err, int errlen)
+{
+    int on = arg[0] == '+';
+    const char *k = arg + 1;
+    char c = (char)(k[0] >= 'a' && k[0] <= 'z' ? k[0] - 32 : k[0]);
+    const char *v = k + 1;
+    switch (c) {
+    case 'W':
+        if ((v[0] == 'T' || v[0] == 't') && parse_int(v + 1, &o->threads)) return 0;
+        if (parse_int(v, &o->width) && o->width > 0) return 0;
+        break;
+    case 'H':
+        if (parse_int(v, &o->height) && o->height > 0) return 0;
+        break;
+    case 'A':
+        o->antialias = on;
+        if (*v && !parse_double(v, &o->aa_threshold)) break;
+        return 0;
+    case 'R':
+        if (parse_int(v, &o->aa_depth) && o->aa_depth >= 1 && o->aa_depth <= 9) return 0;
+        break;
+    case 'O':
+        if (*v && add_output(o, v)) return 0;
+        break;
+    case 'I':
+        if (*v) { o->scene = v; return 0; }
+        break;
+    case 'L':
+        if (*v && add_list(o->libs, &o->nlibs, v)) return 0;
+        break;
+    case 'F': case 'D': case 'P': case 'V': case 'J': case 'X': case 'Q': case 'K': case 'G': case 'B': case 'C':
+        return 0; /* format (from the file name), display, pause, verbose, jitter...: ignored */
+    default:
+        break;
+    }
+    snprintf(err, (size_t)errlen, "bad or unknown option '%s'", arg);
+    return 2;
+}
+
+static int has_value(const char *opt, const char *next, char *err, int errlen)
+{
+    if (next) return 1;
+    snprintf(err, (size_t)errlen, "option '%s' needs a value", opt);
+    return 0;
+}
+
+static int parse_size(const char *v, cli_render *o)
+{
+    int w, h;
+    char x;
+    if (sscanf(v, "%d%c%d", &w, &x, &h) != 3 || (x != 'x' && x != 'X') || w <= 0 || h <= 0 || w > 65536 || h > 65536)
+        return 0;
+    o->width = w;
+    o->height = h;
+    return 1;
+}
+
+int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen)
+{
+    memset(o, 0, sizeof *o);
+    o->aa_threshold = 0.3;
+    o->aa_depth = 3;
+    o->spp = 1;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        const char *next = i + 1 < argc ? argv[i + 1] : NULL;
+        if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (!add_output(o, next)) { snprintf(err, (size_t)errlen, "too many outputs"); return 2; }
+            i++;
+        } else if (strcmp(a, "--size") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (!parse_size(next, o)) { snprintf(err, (size_t)errlen, "--size wants WxH, got '%s'", next); return 2; }
+            i++;
+        } else if (strcmp(a, "--gi") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            o->gi = next;
+            i++;
+        } else if (strcmp(a, "--spp") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (!parse_int(next, &o->spp) || o->spp < 1) { snprintf(err, (size_t)errlen, "--spp wants a positive integer"); return 2; }
+            i++;
+        } else if (strcmp(a, "--threads") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (!parse_int(next, &o->threads) || o->threads < 0) { snprintf(err, (size_t)errlen, "--threads wants a non-negative integer"); return 2; }
+            i++;
+        } else if (strcmp(a, "--seed") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            char *end;
+            errno = 0;
+            unsigned long long s = strtoull(next, &end, 10);
+            if (errno || *end || end == next) { snprintf(err, (size_t)errlen, "--seed wants an integer"); return 2; }
+            o->seed = s;
+            i++;
+        } else if (strcmp(a, "--stats") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            o->stats = next;
+            i++;
+        } else if (strcmp(a, "--float") == 0) {
+            o->exr_float = 1;
+        } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
+            o->quiet = 1;
+        } else if (strcmp(a, "--max-loop") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            int v;
+            if (!parse_int(next, &v) || v < 1) { snprintf(err, (size_t)errlen, "--max-loop wants a positive integer"); return 2; }
+            o->max_loop = v;
+            i++;
+        } else if (strcmp(a, "--max-include-depth") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (!parse_int(next, &o->max_include_depth) || o->max_include_depth < 1) { snprintf(err, (size_t)errlen, "bad --max-include-depth"); return 2; }
+            i++;
+        } else if (strcmp(a, "--max-macro-depth") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (!parse_int(next, &o->max_macro_depth) || o->max_macro_depth < 1) { snprintf(err, (size_t)errlen, "bad --max-macro-depth"); return 2; }
+            i++;
+        } else if (strncmp(a, "-D", 2) == 0 && a[2]) {
+            if (!strchr(a + 2, '=') || !add_list(o->defines, &o->ndefines, a + 2)) {
+                snprintf(err, (size_t)errlen, "-D wants NAME=VALUE, got '%s'", a + 2);
+                return 2;
+            }
+        } else if (strcmp(a, "-D") == 0 && next && strchr(next, '=')) {
+            if (!add_list(o->defines, &o->ndefines, next)) { snprintf(err, (size_t)errlen, "too many -D"); return 2; }
+            i++;
+        } else if (strcmp(a, "-D") == 0) {
+            /* POV-Ray's "display off" switch: nothing to do */
+        } else if (strcmp(a, "-L") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (!add_list(o->libs, &o->nlibs, next)) { snprintf(err, (size_t)errlen, "too many -L"); return 2; }
+            i++;
+        } else if (strncmp(a, "-L", 2) == 0 && a[2] && a[1] == 'L') {
+            if (!add_list(o->libs, &o->nlibs, a + 2)) { snprintf(err, (size_t)errlen, "too many -L"); return 2; }
+        } else if ((a[0] == '+' || a[0] == '-') && a[1] && a[1] != '-') {
+            int rc = pov_switch(a, o, err, errlen);
+            if (rc) return rc;
+        } else if (a[0] == '-' && a[1]) {
+            snprintf(err, (size_t)errlen, "unknown option '%s'", a);
+            return 2;
+        } else if (!o->scene) {
+            o->scene = a;
+        } else {
+            snprintf(err, (size_t)errlen, "unexpected argument '%s' (scene already given as '%s')", a, o->scene);
+            return 2;
+        }
+    }
+    if (!o->scene) {
+        snprintf(err, (size_t)errlen, "no scene file given");
+        return 2;
+    }
+    return 0;
+}

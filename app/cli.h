@@ -1,0 +1,36 @@
+/* cli.h - command-line parsing for `partray render` (GNU-style and POV-Ray
+ * style options), kept apart from main.c so it can be unit-tested. */
+#ifndef PT_CLI_H
+#define PT_CLI_H
+#include <stdint.h>
+
+#define CLI_MAX_LIST 64
+
+typedef struct {
+    const char *scene;
+    const char *outputs[8];
+    int noutputs;
+    int width, height;      /* 0 = default (POV-Ray's 320x240 unless the scene says) */
+    const char *gi;         /* NULL = from the scene */
+    int spp;
+    int threads;
+    uint64_t seed;
+    const char *stats;
+    const char *defines[CLI_MAX_LIST];
+    int ndefines;
+    const char *libs[CLI_MAX_LIST];
+    int nlibs;
+    int antialias;          /* 0 off, 1 +A adaptive */
+    double aa_threshold;
+    int aa_depth;
+    int exr_float;
+    int quiet;
+    long max_loop;
+    int max_include_depth, max_macro_depth;
+} cli_render;
+
+/* Parses argv (after the subcommand). Returns 0 on success, otherwise writes
+ * a message into err and returns 2 (usage). */
+int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen);
+
+#endif

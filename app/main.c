@@ -1,0 +1,348 @@
+/* main.c - the `partray` command: render, parse, compare, view.
+ * Exit codes (DESIGN.md): 0 ok, 1 scene error, 2 usage, 3 I/O, 130 interrupted. */
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "accel.h"
+#include "cli.h"
+#include "cmd_compare.h"
+#include "diag.h"
+#include "framebuffer.h"
+#include "gi.h"
+#include "img_io.h"
+#include "pool.h"
+#include "scene.h"
+#include "sdl.h"
+#include "shade.h"
+#include "stats_json.h"
+#include "timer.h"
+
+#ifndef PARTRAY_VERSION
+#define PARTRAY_VERSION "0.0.0"
+#endif
+
+enum { EXIT_OK = 0, EXIT_SCENE = 1, EXIT_USAGE = 2, EXIT_IO = 3, EXIT_INTERRUPTED = 130 };
+
+static volatile int g_cancel = 0;
+
+static void on_sigint(int sig)
+{
+    (void)sig;
+    g_cancel = 1;
+}
+
+static const char *usage_text =
+    "usage:\n"
+    "  partray render SCENE.pov [-o OUT.exr|.png|.pfm]... [--size WxH] [--gi MODE] [--spp N]\n"
+    "                 [--threads N] [--seed N] [--stats FILE.json] [-D NAME=VALUE] [-L DIR]\n"
+    "                 [--float] [--max-loop N] [--max-include-depth N] [--max-macro-depth N]\n"
+    "                 [+W640 +H480 +A0.3 +R3 +Oout.png +Iscene.pov +Ldir ...]\n"
+    "  partray parse SCENE.pov [-D NAME=VALUE] [-L DIR]\n"
+    "  partray compare REF TEST [--heatmap OUT.png] [--json]\n"
+    "  partray view SCENE.pov\n"
+    "  partray --help | --version\n"
+    "\n"
+    "GI modes: none (direct light + Whitted), particle, pmfg, path.\n"
+    "Without --gi a scene with radiosity{} asks for particle GI, otherwise none.\n"
+    "Exit codes: 0 ok, 1 scene error, 2 usage, 3 I/O, 130 interrupted.\n";
+
+/* Print every message in d to stderr; returns the number of errors. */
+static int print_diags(const diag *d, int quiet)
+{
+    for (int i = 0; i < diag_count(d); i++) {
+        const diag_msg *m = diag_get(d, i);
+        if (quiet && m->severity != DIAG_ERROR) continue;
+        char *s = diag_format(m);
+        if (s) {
+            fprintf(stderr, "%s\n", s);
+            free(s);
+        }
+    }
+    return diag_errors(d);
+}
+
+static int status_exit(pt_status st)
+{
+    switch (st) {
+    case PT_OK: return EXIT_OK;
+    case PT_ERR_IO: return EXIT_IO;
+    case PT_ERR_USAGE: return EXIT_USAGE;
+    default: return EXIT_SCENE;
+    }
+}
+
+static void fill_sdl_options(sdl_options *so, const cli_render *o)
+{
+    sdl_default_options(so);
+    so->lib_paths = o->libs;
+    so->nlib_paths = o->nlibs;
+    so->defines = o->defines;
+    so->ndefines = o->ndefines;
+    so->image_width = o->width > 0 ? o->width : 320;
+    so->image_height = o->height > 0 ? o->height : 240;
+    if (o->max_loop > 0) so->max_loop_iterations = o->max_loop;
+    if (o->max_include_depth > 0) so->max_include_depth = o->max_include_depth;
+    if (o->max_macro_depth > 0) so->max_macro_depth = o->max_macro_depth;
+}
+
+static int cmd_parse(int argc, char **argv)
+{
+    cli_render o;
+    char err[512];
+    if (cli_parse_render(argc, argv, &o, err, sizeof err)) {
+        fprintf(stderr, "partray parse: %s\n%s", err, usage_text);
+        return EXIT_USAGE;
+    }
+    sdl_options so;
+    fill_sdl_options(&so, &o);
+    diag *d = diag_new();
+    scene *sc = NULL;
+    double t0 = timer_now();
+    pt_status st = sdl_parse_file(o.scene, &so, &sc, d);
+    double t1 = timer_now();
+    print_diags(d, 0);
+    if (st != PT_OK) {
+        diag_free(d);
+        return status_exit(st);
+    }
+    scene_counts c = scene_count(sc);
+    printf("%s: %ld objects (%ld CSG nodes), %ld lights, %ld triangles in %ld meshes, %ld unsupported, %d files, %.3f s\n",
+           o.scene, c.objects, c.csg, c.lights, c.triangles, c.meshes, c.unsupported, sc->nfiles, t1 - t0);
+    scene_free(sc);
+    diag_free(d);
+    return EXIT_OK;
+}
+
+/* "out.png" -> "out.partial.png" */
+static char *partial_name(const char *path)
+{
+    size_t n = strlen(path);
+    char *s = malloc(n + 16);
+    if (!s) return NULL;
+    const char *dot = strrchr(path, '.');
+    const char *slash = strrchr(path, '/');
+    if (!dot || (slash && dot < slash)) {
+        snprintf(s, n + 16, "%s.partial", path);
+    } else {
+        size_t stem = (size_t)(dot - path);
+        memcpy(s, path, stem);
+        snprintf(s + stem, n + 16 - stem, ".partial%s", dot);
+    }
+    return s;
+}
+
+static char *default_output(const char *scene_path)
+{
+    const char *base = strrchr(scene_path, '/');
+    base = base ? base + 1 : scene_path;
+    size_t n = strlen(base);
+    char *s = malloc(n + 8);
+    if (!s) return NULL;
+    memcpy(s, base, n + 1);
+    char *dot = strrchr(s, '.');
+    if (dot) *dot = 0;
+    strcat(s, ".png");
+    return s;
+}
+
+static int cmd_render(int argc, char **argv)
+{
+    double t_start = timer_now();
+    cli_render o;
+    char err[512];
+    if (cli_parse_render(argc, argv, &o, err, sizeof err)) {
+        fprintf(stderr, "partray render: %s\n%s", err, usage_text);
+        return EXIT_USAGE;
+    }
+    for (int i = 0; i < o.noutputs; i++) {
+        if (img_format_from_path(o.outputs[i]) == IMG_FMT_UNKNOWN) {
+            fprintf(stderr, "partray render: output '%s': unknown format (use .exr, .png or .pfm)\n", o.outputs[i]);
+            return EXIT_USAGE;
+        }
+    }
+    int gi = GI_NONE;
+    if (o.gi) {
+        gi = gi_mode_parse(o.gi);
+        if (gi < 0) {
+            fprintf(stderr, "partray render: unknown --gi mode '%s' (none, particle, pmfg, path)\n", o.gi);
+            return EXIT_USAGE;
+        }
+    }
+    char *default_out = NULL;
+    if (o.noutputs == 0) {
+        default_out = default_output(o.scene);
+        o.outputs[o.noutputs++] = default_out;
+    }
+
+    sdl_options so;
+    fill_sdl_options(&so, &o);
+    diag *d = diag_new();
+    scene *sc = NULL;
+    double t0 = timer_now();
+    pt_status st = sdl_parse_file(o.scene, &so, &sc, d);
+    double t_parse = timer_now() - t0;
+    if (st != PT_OK) {
+        print_diags(d, 0);
+        diag_free(d);
+        free(default_out);
+        return status_exit(st);
+    }
+    if (!o.gi && sc->global.radiosity.enabled) gi = GI_PARTICLE;
+    const char *gi_used = gi_mode_name(gi);
+    if (gi != GI_NONE) {
+        diag_report(d, DIAG_WARNING, (src_loc){0}, NULL,
+                    "GI mode '%s' is not built yet; rendering direct light + Whitted (--gi none)%s",
+                    gi_mode_name(gi), o.gi ? "" : " although the scene has radiosity{}");
+        gi = GI_NONE;
+        gi_used = "none";
+    }
+
+    int threads = o.threads > 0 ? o.threads : pool_default_threads();
+    t0 = timer_now();
+    accel *acc = accel_build(sc, threads, d, &st);
+    double t_accel = timer_now() - t0;
+    if (!acc || st != PT_OK) {
+        print_diags(d, 0);
+        scene_free(sc);
+        diag_free(d);
+        free(default_out);
+        return status_exit(st == PT_OK ? PT_ERR_DEVICE : st);
+    }
+
+    shade_settings ss;
+    shade_default_settings(&ss);
+    ss.width = o.width > 0 ? o.width : 320;
+    ss.height = o.height > 0 ? o.height : 240;
+    ss.threads = threads;
+    ss.seed = o.seed;
+    ss.antialias = o.antialias ? 1 : (o.spp > 1 ? 2 : 0);
+    ss.aa_threshold = o.aa_threshold;
+    ss.aa_depth = o.aa_depth;
+    ss.spp = o.spp;
+    ss.use_ambient = 1;
+    ss.cancel = &g_cancel;
+    framebuffer *fb = fb_new(ss.width, ss.height);
+    shade_stats sst;
+    memset(&sst, 0, sizeof sst);
+    signal(SIGINT, on_sigint);
+    t0 = timer_now();
+    st = fb ? shade_render(sc, acc, &ss, fb, &sst, d) : PT_ERR_NOMEM;
+    double t_render = timer_now() - t0;
+    print_diags(d, o.quiet);
+
+    int rc = EXIT_OK;
+    img_write_opts wo;
+    img_default_write_opts(&wo);
+    wo.exr_float = o.exr_float;
+    char tbuf[64];
+    snprintf(tbuf, sizeof tbuf, "%.3f", t_render);
+    const char *keys[] = {"partray:scene", "partray:gi", "partray:version", "partray:render_seconds"};
+    const char *vals[] = {o.scene, gi_used, PARTRAY_VERSION, tbuf};
+    wo.meta_keys = keys;
+    wo.meta_values = vals;
+    wo.nmeta = 4;
+    if (st == PT_OK && g_cancel) {
+        /* Interrupted: keep what was rendered under a clearly partial name. */
+        for (int i = 0; i < o.noutputs; i++) {
+            char *pn = partial_name(o.outputs[i]);
+            diag *wd = diag_new();
+            if (pn && img_write(pn, fb, &wo, wd) == PT_OK) fprintf(stderr, "partray: interrupted; partial image in %s\n", pn);
+            print_diags(wd, 0);
+            diag_free(wd);
+            free(pn);
+        }
+        rc = EXIT_INTERRUPTED;
+    } else if (st != PT_OK) {
+        rc = status_exit(st);
+    } else {
+        for (int i = 0; i < o.noutputs && rc == EXIT_OK; i++) {
+            diag *wd = diag_new();
+            pt_status ws = img_write(o.outputs[i], fb, &wo, wd);
+            print_diags(wd, 0);
+            diag_free(wd);
+            if (ws != PT_OK) rc = status_exit(ws);
+        }
+    }
+    double t_total = timer_now() - t_start;
+    if (o.stats && rc == EXIT_OK) {
+        accel_stats as = accel_get_stats(acc);
+        scene_counts cnt = scene_count(sc);
+        stats_json js;
+        stats_begin(&js);
+        stats_obj_begin(&js, "timings");
+        stats_num(&js, "parse", t_parse);
+        stats_num(&js, "accel", t_accel);
+        stats_num(&js, "gi_geometry", 0.0);
+        stats_num(&js, "gi_lighting", 0.0);
+        stats_num(&js, "render", t_render);
+        stats_num(&js, "total", t_total);
+        stats_obj_end(&js);
+        stats_int(&js, "rays", sst.primary_rays + sst.shadow_rays + sst.secondary_rays);
+        stats_int(&js, "primary_rays", sst.primary_rays);
+        stats_int(&js, "shadow_rays", sst.shadow_rays);
+        stats_int(&js, "secondary_rays", sst.secondary_rays);
+        stats_int(&js, "discarded_samples", sst.discarded_samples);
+        stats_int(&js, "width", ss.width);
+        stats_int(&js, "height", ss.height);
+        stats_int(&js, "threads", threads);
+        stats_str(&js, "gi", gi_used);
+        stats_str(&js, "gi_requested", o.gi ? o.gi : (sc->global.radiosity.enabled ? "particle" : "none"));
+        stats_str(&js, "scene", o.scene);
+        stats_obj_begin(&js, "scene_counts");
+        stats_int(&js, "objects", cnt.objects);
+        stats_int(&js, "lights", cnt.lights);
+        stats_int(&js, "triangles", cnt.triangles);
+        stats_int(&js, "unsupported", cnt.unsupported);
+        stats_obj_end(&js);
+        stats_obj_begin(&js, "accel");
+        stats_int(&js, "geometries", as.geometries);
+        stats_int(&js, "instances", as.instances);
+        stats_int(&js, "triangles", as.triangles);
+        stats_int(&js, "user_prims", as.user_prims);
+        stats_obj_end(&js);
+        int ok = stats_write(&js, o.stats);
+        if (!ok) {
+            fprintf(stderr, "partray: cannot write stats file '%s'\n", o.stats);
+            rc = EXIT_IO;
+        }
+    }
+    if (!o.quiet && rc == EXIT_OK)
+        fprintf(stderr, "partray: %dx%d, gi %s, parse %.3f s, accel %.3f s, render %.3f s, %.2f Mrays/s\n", ss.width,
+                ss.height, gi_used, t_parse, t_accel, t_render,
+                t_render > 0 ? (sst.primary_rays + sst.shadow_rays + sst.secondary_rays) / t_render * 1e-6 : 0.0);
+    fb_free(fb);
+    accel_free(acc);
+    scene_free(sc);
+    diag_free(d);
+    free(default_out);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fputs(usage_text, stderr);
+        return EXIT_USAGE;
+    }
+    const char *cmd = argv[1];
+    if (strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0 || strcmp(cmd, "help") == 0) {
+        fputs(usage_text, stdout);
+        return EXIT_OK;
+    }
+    if (strcmp(cmd, "--version") == 0) {
+        printf("partray %s\n", PARTRAY_VERSION);
+        return EXIT_OK;
+    }
+    if (strcmp(cmd, "render") == 0) return cmd_render(argc - 2, argv + 2);
+    if (strcmp(cmd, "parse") == 0) return cmd_parse(argc - 2, argv + 2);
+    if (strcmp(cmd, "compare") == 0) return cmd_compare(argc - 2, argv + 2);
+    if (strcmp(cmd, "view") == 0) {
+        fprintf(stderr, "partray view: the interactive viewer is not built yet\n");
+        return EXIT_USAGE;
+    }
+    /* POV-Ray habit: `partray scene.pov +W..` means render. */
+    if (strstr(cmd, ".pov") || cmd[0] == '+') return cmd_render(argc - 1, argv + 1);
+    fprintf(stderr, "partray: unknown command '%s'\n%s", cmd, usage_text);
+    return EXIT_USAGE;
+}

@@ -1,0 +1,664 @@
+/* shade.c - Whitted ray tracing with POV-Ray 3.7's classic lighting model.
+ *
+ * What is modelled, following the POV-Ray 3.7 reference manual (sections
+ * "Finish", "Light Source", "Anti-Aliasing Options") and the behaviour of
+ * POV-Ray 3.7's renderer as read from its sources (semantics only):
+ *  - colour = pigment * (emission + ambient * ambient_light)   [ambient only without GI]
+ *           + sum over lights of diffuse, phong and specular terms
+ *           + reflection * reflected ray + transmitted ray (filter/transmit, ior)
+ *  - diffuse:  diffuse * |cos i|^brilliance * pigment * light
+ *  - phong:    phong * cos(R, L)^phong_size * light (R = mirror of the eye ray)
+ *  - specular: specular * cos(H, N)^(1/roughness) * light (H = half vector)
+ *  - metallic highlight tint: POV-Ray's empirical Fresnel curve
+ *    F(x) = 0.014567225/(x-1.12)^2 - 0.011612903, x = angle/(pi/2).
+ *  - light attenuation: spotlight cos^tightness with a cubic falloff between
+ *    cos(radius) and cos(falloff); cylinder lights; fade
+ *    2/(1+(d/fade_distance)^fade_power).
+ *  - area lights: the intensity (spot, fade, cosine) is taken from the light's
+ *    centre; shadows are the average visibility over the size1 x size2 grid,
+ *    sampled adaptively as POV-Ray does (corners first, subdivide while the
+ *    corner values differ by more than 0.1 or the level is below `adaptive`),
+ *    each grid point jittered by up to half a cell when `jitter` is set.
+ *    `area_illumination on` evaluates the shading per grid point instead.
+ *  - antialiasing (+A, method 1): one ray through each pixel centre; a pixel
+ *    whose gamma-encoded colour differs from its left or upper neighbour by
+ *    at least the threshold is supersampled with depth x depth jittered rays,
+ *    averaged with the first sample.
+ */
+#include "shade.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "pool.h"
+#include "timer.h"
+
+#define SHADE_MAX_THREADS 256
+#define TILE 16
+
+typedef struct {
+    long primary, shadow, secondary, discarded, unsupported;
+    char pad[64];
+} thread_stats;
+
+typedef struct {
+    const scene *sc;
+    const accel *a;
+    const shade_settings *s;
+    double eps;          /* scene-scaled distance epsilon */
+    int max_level;
+    thread_stats *ts;
+    framebuffer *fb;
+    unsigned char *flag; /* per pixel: needs supersampling */
+    int tiles_x, tiles_y;
+} render_ctx;
+
+static inline rgb rgb_make(double r, double g, double b) { rgb c = {r, g, b}; return c; }
+static inline rgb rgb_add(rgb a, rgb b) { return rgb_make(a.r + b.r, a.g + b.g, a.b + b.b); }
+static inline rgb rgb_mul(rgb a, rgb b) { return rgb_make(a.r * b.r, a.g * b.g, a.b * b.b); }
+static inline rgb rgb_scale(rgb a, double s) { return rgb_make(a.r * s, a.g * s, a.b * s); }
+static inline double rgb_max(rgb a) { return fmax(a.r, fmax(a.g, a.b)); }
+static inline int rgb_near_zero(rgb a) { return fabs(a.r) < 1e-10 && fabs(a.g) < 1e-10 && fabs(a.b) < 1e-10; }
+/* POV-Ray's greyscale weights (0.297, 0.589, 0.114). */
+static inline double rgb_grey(rgb a) { return 0.297 * a.r + 0.589 * a.g + 0.114 * a.b; }
+
+double shade_colour_distance(rgb a, rgb b) { return fabs(a.r - b.r) + fabs(a.g - b.g) + fabs(a.b - b.b); }
+
+void shade_default_settings(shade_settings *s)
+{
+    memset(s, 0, sizeof *s);
+    s->width = 320;
+    s->height = 240;
+    s->threads = 0;
+    s->seed = 0;
+    s->antialias = 0;
+    s->aa_threshold = 0.3; /* POV-Ray's +A default threshold */
+    s->aa_depth = 3;       /* +R default 3 */
+    s->spp = 1;
+    s->use_ambient = 1;
+}
+
+/* ------------------------------------------------------------------ lights */
+
+/* cubic_spline(low, high, x): 0 below low, 1 above high, smooth in between
+ * (3 - 2t) t^2 -- POV-Ray's spotlight falloff curve. */
+static double cubic_step(double low, double high, double x)
+{
+    if (x <= low) return 0.0;
+    if (x >= high) return 1.0;
+    double t = (x - low) / (high - low);
+    return (3.0 - 2.0 * t) * t * t;
+}
+
+/* Angle- and distance-based attenuation of `l` seen from `p` along unit `dir`
+ * (towards the light) at distance `depth`. */
+static double light_attenuation(const scene_light *l, vec3 p, vec3 dir, double depth)
+{
+    double att = 1.0;
+    if (l->kind == LIGHT_SPOT) {
+        vec3 axis = v3_norm(v3_sub(l->point_at, l->position));
+        double c = -v3_dot(dir, axis);
+        if (c <= 0.0) return 0.0;
+        double cos_radius = cos(l->radius * M_PI / 180.0);
+        double cos_falloff = cos(l->falloff * M_PI / 180.0);
+        att = l->tightness != 0.0 ? pow(c, l->tightness) : 1.0;
+        if (cos_radius > 0.0 && c < cos_radius) att *= cubic_step(cos_falloff, cos_radius, c);
+    } else if (l->kind == LIGHT_CYLINDER) {
+        /* radius and falloff are distances from the axis for cylinder lights */
+        vec3 axis = v3_norm(v3_sub(l->point_at, l->position));
+        vec3 v1 = v3_sub(p, l->position);
+        double k = v3_dot(v1, axis);
+        if (k <= 0.0) return 0.0;
+        double len = v3_len(v3_sub(v1, v3_scale(axis, k)));
+        if (len >= l->falloff) return 0.0;
+        double d = 1.0 - len / l->falloff;
+        att = l->tightness != 0.0 ? pow(d, l->tightness) : 1.0;
+        if (l->radius > 0.0 && len > l->radius) att *= cubic_step(0.0, 1.0 - l->radius / l->falloff, d);
+    }
+    if (att > 0.0 && l->fade_power > 0.0) {
+        if (fabs(l->fade_distance) >= 1e-10)
+            att *= 2.0 / (1.0 + pow(depth / l->fade_distance, l->fade_power));
+        else
+            att *= pow(depth, -l->fade_power);
+    }
+    return att;
+}
+
+/* Direction from p towards the light point `centre` (which may be a jittered
+ * grid point) and the distance to it, with POV-Ray's handling of cylinder
+ * and parallel lights. */
+static void light_ray(const scene_light *l, vec3 centre, vec3 p, vec3 *dir, double *depth)
+{
+    if (l->kind == LIGHT_CYLINDER) {
+        vec3 d = v3_sub(centre, l->point_at);
+        double dl = v3_len(d);
+        *dir = v3_scale(d, 1.0 / dl);
+        *depth = v3_dot(v3_sub(centre, p), *dir);
+    } else {
+        vec3 d = v3_sub(centre, p);
+        *depth = v3_len(d);
+        *dir = *depth > 0 ? v3_scale(d, 1.0 / *depth) : v3(0, 1, 0);
+    }
+    if (l->parallel || l->kind == LIGHT_PARALLEL) {
+        vec3 axis = v3_norm(v3_sub(centre, l->point_at));
+        double a = v3_dot(axis, *dir);
+        *depth *= a;
+        *dir = axis;
+    }
+}
+
+static int shadow_blocked(render_ctx *c, int thread, vec3 p, vec3 dir, double depth)
+{
+    c->ts[thread].shadow++;
+    double tmax = depth - fmax(c->eps, depth * 1e-6);
+    if (tmax <= c->eps) return 0;
+    return accel_occluded(c->a, p, dir, c->eps, tmax);
+}
+
+/* Offset of grid point (u, v) on an area light (POV-Ray's layout: points span
+ * -axis/2 .. +axis/2; jitter moves each by up to half a cell). */
+static vec3 area_point(const scene_light *l, vec3 ax1, vec3 ax2, int u, int v, rng *r)
+{
+    double ju = u, jv = v;
+    if (l->jitter) {
+        ju += rng_f64(r) - 0.5;
+        jv += rng_f64(r) - 0.5;
+    }
+    if (l->circular && l->size1 > 1 && l->size2 > 1) {
+        ju = ju / (l->size1 - 1) - 0.5 + 0.001;
+        jv = jv / (l->size2 - 1) - 0.5 + 0.001;
+        double sf = fmax(fabs(ju), fabs(jv)) / sqrt(ju * ju + jv * jv);
+        return v3_add(v3_scale(ax1, ju * sf), v3_scale(ax2, jv * sf));
+    }
+    vec3 o = v3(0, 0, 0);
+    if (l->size1 > 1) o = v3_add(o, v3_scale(ax1, ju / (l->size1 - 1) - 0.5));
+    if (l->size2 > 1) o = v3_add(o, v3_scale(ax2, jv / (l->size2 - 1) - 0.5));
+    return o;
+}
+
+/* Visibility (0..1) of the rectangle [u1,u2]x[v1,v2] of the grid, adaptively. */
+typedef struct {
+    render_ctx *c;
+    const scene_light *l;
+    vec3 p, ax1, ax2;
+    double *grid; /* size1*size2, <0 = not sampled */
+    rng *r;
+    int thread;
+} area_job;
+
+static double area_sample(area_job *j, int u, int v)
+{
+    double *g = &j->grid[u * j->l->size2 + v];
+    if (*g >= 0.0) return *g;
+    vec3 centre = v3_add(j->l->position, area_point(j->l, j->ax1, j->ax2, u, v, j->r));
+    vec3 dir;
+    double depth;
+    light_ray(j->l, centre, j->p, &dir, &depth);
+    *g = shadow_blocked(j->c, j->thread, j->p, dir, depth) ? 0.0 : 1.0;
+    return *g;
+}
+
+static double area_subset(area_job *j, int u1, int v1, int u2, int v2, int level)
+{
+    double s[4] = {area_sample(j, u1, v1), area_sample(j, u2, v1), area_sample(j, u1, v2), area_sample(j, u2, v2)};
+    if (u2 - u1 > 1 || v2 - v1 > 1) {
+        /* ColourDistance on grey visibilities: |a-b| summed over 3 channels. */
+        int differ = 3.0 * fabs(s[0] - s[1]) > 0.1 || 3.0 * fabs(s[1] - s[3]) > 0.1 ||
+                     3.0 * fabs(s[3] - s[2]) > 0.1 || 3.0 * fabs(s[2] - s[0]) > 0.1;
+        if (level < j->l->adaptive || differ) {
+            int um0 = (int)floor((u1 + u2) / 2.0), um1 = (int)ceil((u1 + u2) / 2.0);
+            int vm0 = (int)floor((v1 + v2) / 2.0), vm1 = (int)ceil((v1 + v2) / 2.0);
+            s[0] = area_subset(j, u1, v1, um0, vm0, level + 1);
+            s[1] = area_subset(j, um1, v1, u2, vm0, level + 1);
+            s[2] = area_subset(j, u1, vm1, um0, v2, level + 1);
+            s[3] = area_subset(j, um1, vm1, u2, v2, level + 1);
+        }
+    }
+    return 0.25 * (s[0] + s[1] + s[2] + s[3]);
+}
+
+static double area_visibility(render_ctx *c, int thread, const scene_light *l, vec3 p, rng *r)
+{
+    double stack_grid[256];
+    int n = l->size1 * l->size2;
+    double *grid = n <= 256 ? stack_grid : malloc(sizeof(double) * (size_t)n);
+    if (!grid) return 1.0;
+    for (int i = 0; i < n; i++) grid[i] = -1.0;
+    area_job j = {c, l, p, l->axis1, l->axis2, grid, r, thread};
+    if (l->orient) {
+        vec3 dir;
+        double depth;
+        light_ray(l, l->position, p, &dir, &depth);
+        double len = v3_len(l->axis1);
+        vec3 helper = fabs(fabs(dir.z) - 1.0) < 0.01 ? v3(0, 1, 0) : v3(0, 0, 1);
+        j.ax1 = v3_scale(v3_norm(v3_cross(dir, helper)), len);
+        j.ax2 = v3_scale(v3_norm(v3_cross(dir, v3_norm(j.ax1))), len);
+    }
+    double vis = area_subset(&j, 0, 0, l->size1 - 1, l->size2 - 1, 0);
+    if (grid != stack_grid) free(grid);
+    return vis;
+}
+
+/* --------------------------------------------------------------- BRDF terms */
+
+static void metallic_tint(rgb *cs, double metallic, rgb pigment, double cos_angle)
+{
+    if (metallic == 0.0) return;
+    double x = fabs(acos(fmax(-1.0, fmin(1.0, cos_angle)))) / (M_PI / 2.0);
+    double f = 0.014567225 / ((x - 1.12) * (x - 1.12)) - 0.011612903;
+    f = fmin(1.0, fmax(0.0, f));
+    double k = metallic * (1.0 - f);
+    cs->r *= 1.0 + k * (pigment.r - 1.0);
+    cs->g *= 1.0 + k * (pigment.g - 1.0);
+    cs->b *= 1.0 + k * (pigment.b - 1.0);
+}
+
+typedef struct {
+    const scene_finish *f;
+    rgb pigment;
+    vec3 n;       /* shading normal facing the viewer */
+    vec3 eye;     /* incoming ray direction, unit */
+    double att;   /* opacity of the layer */
+    rng *r;
+} surface;
+
+/* Diffuse + highlights of one light of colour `lc` arriving along unit `l`. */
+static rgb light_terms(const surface *s, vec3 l, rgb lc, int backside)
+{
+    const scene_finish *f = s->f;
+    rgb out = {0, 0, 0};
+    double diffuse = backside ? f->diffuse_back : f->diffuse;
+    if (diffuse > 0.0) {
+        double ci = v3_dot(s->n, l);
+        double intensity = f->brilliance != 1.0 ? pow(fabs(ci), f->brilliance) : fabs(ci);
+        intensity *= diffuse * s->att;
+        if (f->crand > 0.0) intensity -= rng_f64(s->r) * f->crand;
+        out = rgb_add(out, rgb_scale(rgb_mul(s->pigment, lc), intensity));
+    }
+    if (backside) return out;
+    if (f->phong > 0.0) {
+        vec3 refl = v3_madd(s->eye, s->n, -2.0 * v3_dot(s->eye, s->n));
+        double ca = v3_dot(refl, l);
+        if (ca > 0.0 && (f->phong_size < 60 || ca > 0.0008)) {
+            double intensity = f->phong * pow(ca, f->phong_size);
+            rgb cs = {1, 1, 1};
+            metallic_tint(&cs, f->metallic, s->pigment, v3_dot(s->n, l));
+            out = rgb_add(out, rgb_scale(rgb_mul(lc, cs), intensity));
+        }
+    }
+    if (f->specular > 0.0) {
+        vec3 h = v3_scale(v3_sub(l, s->eye), 0.5);
+        double hl = v3_len(h);
+        if (hl > 0.0) {
+            double ca = v3_dot(h, s->n) / hl;
+            if (ca > 0.0) {
+                /* POV-Ray stores 1/roughness as the exponent. */
+                double rough = f->roughness > 0.0 ? f->roughness : 0.05;
+                double intensity = f->specular * pow(ca, 1.0 / rough);
+                rgb cs = {1, 1, 1};
+                metallic_tint(&cs, f->metallic, s->pigment, v3_dot(h, l) / hl);
+                out = rgb_add(out, rgb_scale(rgb_mul(lc, cs), intensity));
+            }
+        }
+    }
+    return out;
+}
+
+static rgb direct_light(render_ctx *c, int thread, const surface *s, const accel_hit *h, vec3 p, rng *r)
+{
+    rgb total = {0, 0, 0};
+    int double_illum = (h->obj->flags & OBJ_DOUBLE_ILLUMINATE) != 0;
+    for (int i = 0; i < c->sc->nlights; i++) {
+        const scene_light *l = &c->sc->lights[i];
+        vec3 dir;
+        double depth;
+        light_ray(l, l->position, p, &dir, &depth);
+        int full_area = l->area && l->area_illumination && l->size1 * l->size2 > 0;
+        double att = full_area ? 1.0 : light_attenuation(l, p, dir, depth);
+        rgb lc = rgb_scale(l->colour, att);
+        if (rgb_near_zero(lc)) continue;
+        int backside = 0;
+        if (!double_illum && !full_area && v3_dot(s->n, dir) < 1e-10) {
+            if (s->f->diffuse_back != 0.0) backside = 1;
+            else continue;
+        }
+        if (full_area) {
+            /* area_illumination: shade every grid point on its own. */
+            int n = l->size1 * l->size2;
+            rgb sample_lc = rgb_scale(l->colour, 1.0 / n);
+            for (int v = 0; v < l->size2; v++) {
+                for (int u = 0; u < l->size1; u++) {
+                    vec3 q = v3_add(l->position, area_point(l, l->axis1, l->axis2, u, v, r));
+                    vec3 d2;
+                    double dep2;
+                    light_ray(l, q, p, &d2, &dep2);
+                    rgb slc = rgb_scale(sample_lc, light_attenuation(l, p, d2, dep2));
+                    int back2 = 0;
+                    if (!double_illum && v3_dot(s->n, d2) < 1e-10) {
+                        if (s->f->diffuse_back != 0.0) back2 = 1;
+                        else continue;
+                    }
+                    if (!l->shadowless && shadow_blocked(c, thread, p, d2, dep2)) continue;
+                    total = rgb_add(total, light_terms(s, d2, slc, back2));
+                }
+            }
+            continue;
+        }
+        if (!l->shadowless) {
+            double vis;
+            if (l->area && l->size1 * l->size2 > 1)
+                vis = area_visibility(c, thread, l, p, r);
+            else
+                vis = shadow_blocked(c, thread, p, dir, depth) ? 0.0 : 1.0;
+            if (vis <= 0.0) continue;
+            lc = rgb_scale(lc, vis);
+        }
+        total = rgb_add(total, light_terms(s, dir, lc, backside));
+    }
+    return total;
+}
+
+/* ------------------------------------------------------------------ tracing */
+
+static rgb background(const scene *sc) { return rgb_make(sc->background.r, sc->background.g, sc->background.b); }
+
+/* Fresnel reflectance for unpolarised light, relative ior n (the standard
+ * dielectric formula in the form POV-Ray documents for `fresnel`). */
+static double fresnel_r(double cos_i, double n)
+{
+    double g2 = n * n + cos_i * cos_i - 1.0;
+    if (g2 <= 0.0) return 1.0;
+    double g = sqrt(g2);
+    double q1 = (g - cos_i) / (g + cos_i);
+    double q2 = (cos_i * (g + cos_i) - 1.0) / (cos_i * (g - cos_i) + 1.0);
+    double f = 0.5 * q1 * q1 * (1.0 + q2 * q2);
+    return fmin(1.0, fmax(0.0, f));
+}
+
+static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, double ior_outside, rng *r);
+
+static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, int level, double weight, rng *r)
+{
+    const scene *sc = c->sc;
+    const scene_texture *tex = h->texture ? h->texture : &sc->default_texture;
+    const scene_finish *f = &tex->finish;
+    const scene_pigment *pg = &tex->pigment;
+    if (pg->kind != PIGMENT_SOLID) c->ts[thread].unsupported++;
+    rgb pig = {pg->colour.r, pg->colour.g, pg->colour.b};
+    double filt = pg->colour.f, transm = pg->colour.t;
+
+    /* Normals: face the viewer (POV-Ray flips the normal towards the ray). */
+    vec3 ng = h->ng, n = h->ns;
+    int entering = v3_dot(dir, ng) < 0.0;
+    if (v3_dot(dir, n) > 0.0) n = v3_neg(n);
+    if (!entering) ng = v3_neg(ng);
+    /* Offset the hit point off the surface, on the viewer's side. */
+    vec3 p = v3_madd(h->p, ng, c->eps);
+
+    rgb trans_colour = {filt * pig.r + transm, filt * pig.g + transm, filt * pig.b + transm};
+    double opacity = 1.0 - fmin(1.0, fmax(0.0, rgb_grey(trans_colour)));
+
+    surface s = {f, pig, n, dir, opacity, r};
+    rgb col = f->emission;
+    if (c->s->use_ambient) col = rgb_add(col, rgb_mul(f->ambient, sc->global.ambient_light));
+    col = rgb_scale(rgb_mul(pig, col), opacity);
+    if (c->s->indirect && f->diffuse > 0.0) {
+        rgb ind = c->s->indirect(c->s->indirect_ctx, h, n, thread);
+        col = rgb_add(col, rgb_scale(rgb_mul(pig, ind), f->diffuse * opacity));
+    }
+    if (f->diffuse != 0.0 || f->diffuse_back != 0.0 || f->phong != 0.0 || f->specular != 0.0)
+        col = rgb_add(col, direct_light(c, thread, &s, h, p, r));
+
+    double cos_i = -v3_dot(dir, n);
+    const scene_interior *in = h->obj->interior;
+    double rel_ior = 1.0;
+    if (in && in->ior > 0.0) rel_ior = entering ? in->ior : 1.0 / in->ior;
+
+    /* Reflection (ComputeReflectivity semantics: falloff blend or fresnel). */
+    rgb rmax = f->reflection_max, rmin = f->reflection_min;
+    if (rgb_max(rmax) > 0.0 || rgb_max(rmin) > 0.0) {
+        rgb refl;
+        if (f->fresnel) {
+            double fr = fresnel_r(cos_i, rel_ior);
+            refl = rgb_add(rgb_scale(rmax, fr), rgb_scale(rmin, 1.0 - fr));
+        } else {
+            double frac = fabs(f->reflection_falloff - 1.0) > 1e-10 ? pow(1.0 - cos_i, f->reflection_falloff) : 1.0 - cos_i;
+            refl = rgb_add(rgb_scale(rmax, frac), rgb_scale(rmin, 1.0 - frac));
+        }
+        metallic_tint(&refl, f->reflection_metallic, pig, cos_i);
+        double w = weight * rgb_max(refl);
+        if (w > sc->global.adc_bailout) {
+            vec3 rd = v3_madd(dir, n, 2.0 * cos_i);
+            c->ts[thread].secondary++;
+            rgb rc = trace_ray(c, thread, p, rd, level + 1, w, 1.0, r);
+            if (f->reflection_exponent != 1.0) {
+                rc.r = pow(fmax(rc.r, 0.0), f->reflection_exponent);
+                rc.g = pow(fmax(rc.g, 0.0), f->reflection_exponent);
+                rc.b = pow(fmax(rc.b, 0.0), f->reflection_exponent);
+            }
+            col = rgb_add(col, rgb_mul(refl, rc));
+        }
+    }
+
+    /* Transmission: straight through, or refracted when an ior is given. */
+    double tw = weight * rgb_max(trans_colour);
+    if (rgb_max(trans_colour) > 0.0 && tw > sc->global.adc_bailout) {
+        vec3 q = v3_madd(h->p, ng, -c->eps);
+        vec3 td = dir;
+        if (fabs(rel_ior - 1.0) > 1e-9) {
+            double eta = 1.0 / rel_ior;
+            double k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+            if (k < 0.0) {
+                /* total internal reflection: all of the transmitted part reflects */
+                vec3 rd = v3_madd(dir, n, 2.0 * cos_i);
+                c->ts[thread].secondary++;
+                rgb rc = trace_ray(c, thread, p, rd, level + 1, tw, 1.0, r);
+                return rgb_add(col, rgb_mul(trans_colour, rc));
+            }
+            td = v3_norm(v3_add(v3_scale(dir, eta), v3_scale(n, eta * cos_i - sqrt(k))));
+        }
+        c->ts[thread].secondary++;
+        rgb tc = trace_ray(c, thread, q, td, level + 1, tw, 1.0, r);
+        col = rgb_add(col, rgb_mul(trans_colour, tc));
+    }
+    return col;
+}
+
+static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, double ior_outside, rng *r)
+{
+    (void)ior_outside;
+    if (level > c->max_level) return rgb_make(0, 0, 0);
+    accel_hit h;
+    if (!accel_intersect(c->a, org, dir, c->eps, INFINITY, &h)) return background(c->sc);
+    return shade_hit(c, thread, &h, dir, level, weight, r);
+}
+
+static double scene_eps(const accel *a)
+{
+    /* Distance epsilon: a fixed fraction of the scene's extent, so that tiny
+     * and huge scenes behave alike (single-precision Embree hits carry a
+     * relative error near 1e-7 of the coordinates). */
+    double s = accel_scale(a);
+    if (!(s > 0.0) || !isfinite(s)) s = 1.0;
+    return s * 1e-6;
+}
+
+rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 org, vec3 dir, int thread, rng *r)
+{
+    thread_stats ts[1];
+    memset(ts, 0, sizeof ts);
+    render_ctx c = {sc, a, s, scene_eps(a), s->max_trace_level > 0 ? s->max_trace_level : sc->global.max_trace_level, ts, NULL, NULL, 0, 0};
+    return trace_ray(&c, 0, org, v3_norm(dir), 1, 1.0, 1.0, r);
+}
+
+/* --------------------------------------------------------------- the image */
+
+static uint64_t mix64(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+static void pixel_rng(rng *r, uint64_t seed, int x, int y, int pass)
+{
+    rng_seed(r, mix64(seed * 0x9e3779b97f4a7c15ULL + (uint64_t)pass), ((uint64_t)y << 32) | (uint64_t)x);
+}
+
+static rgb sample(render_ctx *c, int thread, double px, double py, rng *r)
+{
+    vec3 org, dir;
+    scene_camera_ray(&c->sc->camera, px, py, c->s->width, c->s->height, &org, &dir);
+    c->ts[thread].primary++;
+    rgb v = trace_ray(c, thread, org, dir, 1, 1.0, 1.0, r);
+    if (!isfinite(v.r) || !isfinite(v.g) || !isfinite(v.b)) {
+        c->ts[thread].discarded++;
+        return rgb_make(0, 0, 0);
+    }
+    return v;
+}
+
+static void tile_bounds(const render_ctx *c, int tile, int *x0, int *y0, int *x1, int *y1)
+{
+    int tx = tile % c->tiles_x, ty = tile / c->tiles_x;
+    *x0 = tx * TILE;
+    *y0 = ty * TILE;
+    *x1 = *x0 + TILE < c->s->width ? *x0 + TILE : c->s->width;
+    *y1 = *y0 + TILE < c->s->height ? *y0 + TILE : c->s->height;
+}
+
+/* Pass 1: one ray per pixel centre (or a fixed n x n stratified grid). */
+static void tile_first_pass(void *ctx, int tile, int thread)
+{
+    render_ctx *c = ctx;
+    if (c->s->cancel && *c->s->cancel) return;
+    int x0, y0, x1, y1;
+    tile_bounds(c, tile, &x0, &y0, &x1, &y1);
+    int n = 1;
+    if (c->s->antialias == 2) {
+        n = (int)floor(sqrt((double)(c->s->spp > 1 ? c->s->spp : 1)) + 0.5);
+        if (n < 1) n = 1;
+    }
+    for (int y = y0; y < y1; y++) {
+        for (int x = x0; x < x1; x++) {
+            rng r;
+            pixel_rng(&r, c->s->seed, x, y, 0);
+            rgb acc = {0, 0, 0};
+            if (n == 1) {
+                acc = sample(c, thread, x + 0.5, y + 0.5, &r);
+            } else {
+                for (int j = 0; j < n; j++)
+                    for (int i = 0; i < n; i++)
+                        acc = rgb_add(acc, sample(c, thread, x + (i + rng_f64(&r)) / n, y + (j + rng_f64(&r)) / n, &r));
+                acc = rgb_scale(acc, 1.0 / (n * n));
+            }
+            float *px = fb_px(c->fb, x, y);
+            px[0] = (float)acc.r;
+            px[1] = (float)acc.g;
+            px[2] = (float)acc.b;
+        }
+    }
+}
+
+/* POV-Ray compares gamma-encoded, clipped colours for antialiasing. */
+static rgb aa_encode(const float *px)
+{
+    rgb c;
+    double v[3];
+    for (int i = 0; i < 3; i++) {
+        double l = fmin(1.0, fmax(0.0, px[i]));
+        v[i] = l <= 0.0031308 ? 12.92 * l : 1.055 * pow(l, 1.0 / 2.4) - 0.055;
+    }
+    c.r = v[0]; c.g = v[1]; c.b = v[2];
+    return c;
+}
+
+static void tile_supersample(void *ctx, int tile, int thread)
+{
+    render_ctx *c = ctx;
+    if (c->s->cancel && *c->s->cancel) return;
+    int x0, y0, x1, y1;
+    tile_bounds(c, tile, &x0, &y0, &x1, &y1);
+    int d = c->s->aa_depth > 0 ? c->s->aa_depth : 3;
+    double step = 1.0 / d;
+    for (int y = y0; y < y1; y++) {
+        for (int x = x0; x < x1; x++) {
+            if (!c->flag[(size_t)y * c->s->width + x]) continue;
+            rng r;
+            pixel_rng(&r, c->s->seed, x, y, 1);
+            float *px = fb_px(c->fb, x, y);
+            rgb acc = {px[0], px[1], px[2]};
+            for (int j = 0; j < d; j++) {
+                for (int i = 0; i < d; i++) {
+                    /* jittered grid: POV-Ray's default jitter 1.0 scaled by 1/depth */
+                    double sx = x + (i + 0.5) * step + (rng_f64(&r) - 0.5) * step;
+                    double sy = y + (j + 0.5) * step + (rng_f64(&r) - 0.5) * step;
+                    acc = rgb_add(acc, sample(c, thread, sx, sy, &r));
+                }
+            }
+            acc = rgb_scale(acc, 1.0 / (d * d + 1));
+            px[0] = (float)acc.r;
+            px[1] = (float)acc.g;
+            px[2] = (float)acc.b;
+        }
+    }
+}
+
+pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s, framebuffer *fb, shade_stats *st, diag *d)
+{
+    double t0 = timer_now();
+    if (!sc || !a || !s || !fb || fb->width != s->width || fb->height != s->height) {
+        diag_report(d, DIAG_ERROR, (src_loc){0}, NULL, "shade_render: bad arguments");
+        return PT_ERR_INTERNAL;
+    }
+    thread_stats *ts = calloc(SHADE_MAX_THREADS, sizeof *ts);
+    if (!ts) return PT_ERR_NOMEM;
+    int threads = s->threads > 0 ? s->threads : pool_default_threads();
+    if (threads > SHADE_MAX_THREADS) threads = SHADE_MAX_THREADS;
+    render_ctx c;
+    memset(&c, 0, sizeof c);
+    c.sc = sc;
+    c.a = a;
+    c.s = s;
+    c.eps = scene_eps(a);
+    c.max_level = s->max_trace_level > 0 ? s->max_trace_level : sc->global.max_trace_level;
+    if (c.max_level < 1) c.max_level = 1;
+    c.ts = ts;
+    c.fb = fb;
+    c.tiles_x = (s->width + TILE - 1) / TILE;
+    c.tiles_y = (s->height + TILE - 1) / TILE;
+    int ntiles = c.tiles_x * c.tiles_y;
+
+    pool_run(threads, ntiles, tile_first_pass, &c);
+
+    if (s->antialias == 1 && !(s->cancel && *s->cancel)) {
+        c.flag = calloc((size_t)s->width * (size_t)s->height, 1);
+        if (!c.flag) { free(ts); return PT_ERR_NOMEM; }
+        for (int y = 0; y < s->height; y++) {
+            for (int x = 0; x < s->width; x++) {
+                rgb cur = aa_encode(fb_px(fb, x, y));
+                if (x > 0 && shade_colour_distance(aa_encode(fb_px(fb, x - 1, y)), cur) >= s->aa_threshold)
+                    c.flag[(size_t)y * s->width + x] = c.flag[(size_t)y * s->width + x - 1] = 1;
+                if (y > 0 && shade_colour_distance(aa_encode(fb_px(fb, x, y - 1)), cur) >= s->aa_threshold)
+                    c.flag[(size_t)y * s->width + x] = c.flag[(size_t)(y - 1) * s->width + x] = 1;
+            }
+        }
+        pool_run(threads, ntiles, tile_supersample, &c);
+        free(c.flag);
+    }
+
+    long fixed = fb_sanitize(fb);
+    if (st) {
+        memset(st, 0, sizeof *st);
+        for (int i = 0; i < SHADE_MAX_THREADS; i++) {
+            st->primary_rays += ts[i].primary;
+            st->shadow_rays += ts[i].shadow;
+            st->secondary_rays += ts[i].secondary;
+            st->discarded_samples += ts[i].discarded;
+            st->unsupported += ts[i].unsupported;
+        }
+        st->discarded_samples += fixed;
+        st->seconds = timer_now() - t0;
+    }
+    free(ts);
+    return PT_OK;
+}
