@@ -1,0 +1,183 @@
+/* test_cli.c - the partray command end to end: exit codes, located errors,
+ * no output file on failure, --stats keys, POV-Ray style options. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include "img_io.h"
+
+static char tmpdir[256];
+static char out_text[65536];
+
+/* Run a shell command, capture stdout+stderr into out_text, return exit code. */
+static int run_capture(const char *cmd)
+{
+    char full[4096];
+    snprintf(full, sizeof full, "%s 2>&1", cmd);
+    FILE *p = popen(full, "r");
+    if (!p) return -1;
+    size_t n = fread(out_text, 1, sizeof out_text - 1, p);
+    out_text[n] = 0;
+    int rc = pclose(p);
+    return WEXITSTATUS(rc);
+}
+
+static void write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+static int exists(const char *path)
+{
+    struct stat sb;
+    return stat(path, &sb) == 0;
+}
+
+/* Render SCENE_TEXT; expect exit `code`, `needle` in the output and no file. */
+static void expect_failure(const char *scene_text, int code, const char *needle)
+{
+    char scene[512], out[512], cmd[2048];
+    snprintf(scene, sizeof scene, "%s/bad.pov", tmpdir);
+    snprintf(out, sizeof out, "%s/bad.png", tmpdir);
+    remove(out);
+    if (scene_text) write_file(scene, scene_text);
+    else remove(scene);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' -o '%s' --size 16x16", PARTRAY_BIN, scene, out);
+    int rc = run_capture(cmd);
+    printf("exit %d: %s", rc, out_text);
+    assert_int_equal(rc, code);
+    assert_non_null(strstr(out_text, needle));
+    assert_false(exists(out));
+}
+
+static void test_missing_file(void **st)
+{
+    (void)st;
+    char needle[600];
+    snprintf(needle, sizeof needle, "%s/bad.pov", tmpdir);
+    expect_failure(NULL, 3, needle);
+}
+
+static void test_unknown_keyword(void **st)
+{
+    (void)st;
+    char needle[600];
+    snprintf(needle, sizeof needle, "%s/bad.pov:3:1: error:", tmpdir);
+    expect_failure("// a scene\nsphere { 0, 1 }\nspehre { 0, 1 }\n", 1, needle);
+}
+
+static void test_unterminated_block(void **st)
+{
+    (void)st;
+    char needle[600];
+    snprintf(needle, sizeof needle, "%s/bad.pov:", tmpdir);
+    expect_failure("camera { location -5*z look_at 0 }\nsphere { 0, 1\n  pigment { rgb 1 }\n", 1, needle);
+    assert_non_null(strstr(out_text, "error:"));
+}
+
+static void test_include_chain(void **st)
+{
+    (void)st;
+    char inc[512];
+    snprintf(inc, sizeof inc, "%s/inc_bad.inc", tmpdir);
+    write_file(inc, "#declare A = 1;\nbogus_word\n");
+    char needle[600];
+    snprintf(needle, sizeof needle, "%s/inc_bad.inc:2:1: error:", tmpdir);
+    expect_failure("#include \"inc_bad.inc\"\n", 1, needle);
+    assert_non_null(strstr(out_text, "bad.pov:1"));
+}
+
+static void test_usage(void **st)
+{
+    (void)st;
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "'%s' render", PARTRAY_BIN);
+    assert_int_equal(run_capture(cmd), 2);
+    snprintf(cmd, sizeof cmd, "'%s' render x.pov --size 12", PARTRAY_BIN);
+    assert_int_equal(run_capture(cmd), 2);
+    snprintf(cmd, sizeof cmd, "'%s' frobnicate", PARTRAY_BIN);
+    assert_int_equal(run_capture(cmd), 2);
+    snprintf(cmd, sizeof cmd, "'%s' --version", PARTRAY_BIN);
+    assert_int_equal(run_capture(cmd), 0);
+    assert_non_null(strstr(out_text, "partray "));
+    snprintf(cmd, sizeof cmd, "'%s' --help", PARTRAY_BIN);
+    assert_int_equal(run_capture(cmd), 0);
+    assert_non_null(strstr(out_text, "partray render"));
+}
+
+/* A white diffuse plane under a point light straight above: the pixel in the
+ * image centre sees radiance L = diffuse * I * cos(0) = 0.5 * 1 * 1 (POV-Ray's
+ * lights do not fall off with distance unless fade is given). Checks -D, the
+ * +W/+H/+O options, every output format and the --stats keys. */
+static void test_render_outputs_and_stats(void **st)
+{
+    (void)st;
+    char scene[512], cmd[4096], stats[512];
+    snprintf(scene, sizeof scene, "%s/plane.pov", tmpdir);
+    write_file(scene,
+               "#version 3.7;\n"
+               "global_settings { assumed_gamma 1.0 }\n"
+               "camera { orthographic location <0, 5, 0> look_at <0, 0, 0> right x*2 up z*2 }\n"
+               "light_source { <0, 10, 0> color rgb Power }\n"
+               "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 0.5 } }\n");
+    snprintf(stats, sizeof stats, "%s/stats.json", tmpdir);
+    snprintf(cmd, sizeof cmd,
+             "'%s' render '%s' -D Power=1 +W32 +H24 +O%s/a.pfm -o %s/a.exr -o %s/a.png --stats '%s' --seed 3 --threads 2",
+             PARTRAY_BIN, scene, tmpdir, tmpdir, tmpdir, stats);
+    int rc = run_capture(cmd);
+    printf("%s", out_text);
+    assert_int_equal(rc, 0);
+    const char *exts[] = {"pfm", "exr", "png"};
+    for (int i = 0; i < 3; i++) {
+        char path[512];
+        snprintf(path, sizeof path, "%s/a.%s", tmpdir, exts[i]);
+        framebuffer *fb = NULL;
+        assert_int_equal(img_read(path, 0, &fb, NULL), PT_OK);
+        assert_int_equal(fb->width, 32);
+        assert_int_equal(fb->height, 24);
+        double v = fb_px(fb, 16, 12)[1];
+        printf("%s centre value %.5f (expect 0.5)\n", exts[i], v);
+        assert_true(fabs(v - 0.5) < (i == 2 ? 0.004 : 1e-3));
+        fb_free(fb);
+    }
+    FILE *f = fopen(stats, "rb");
+    assert_non_null(f);
+    size_t n = fread(out_text, 1, sizeof out_text - 1, f);
+    out_text[n] = 0;
+    fclose(f);
+    const char *keys[] = {"\"timings\"", "\"parse\"", "\"accel\"", "\"gi_geometry\"", "\"gi_lighting\"", "\"render\"",
+                          "\"total\"", "\"rays\"", "\"width\": 32", "\"height\": 24", "\"gi\": \"none\""};
+    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) {
+        if (!strstr(out_text, keys[i])) fail_msg("stats lacks %s:\n%s", keys[i], out_text);
+    }
+}
+
+int main(void)
+{
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/partray-cli-XXXXXX");
+    if (!mkdtemp(tmpdir)) return 1;
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_missing_file),
+        cmocka_unit_test(test_unknown_keyword),
+        cmocka_unit_test(test_unterminated_block),
+        cmocka_unit_test(test_include_chain),
+        cmocka_unit_test(test_usage),
+        cmocka_unit_test(test_render_outputs_and_stats),
+    };
+    int rc = cmocka_run_group_tests(tests, NULL, NULL);
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+    if (rc == 0) run_capture(cmd);
+    return rc;
+}
