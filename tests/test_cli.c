@@ -128,7 +128,7 @@ static void test_render_outputs_and_stats(void **st)
     write_file(scene,
                "#version 3.7;\n"
                "global_settings { assumed_gamma 1.0 }\n"
-               "camera { orthographic location <0, 5, 0> look_at <0, 0, 0> right x*2 up z*2 }\n"
+               "camera { orthographic location <0, 5, 0> direction -y right x*2 up z*2 }\n"
                "light_source { <0, 10, 0> color rgb Power }\n"
                "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 0.5 } }\n");
     snprintf(stats, sizeof stats, "%s/stats.json", tmpdir);
