@@ -6,6 +6,11 @@
 #include "diag.h"
 #include "framebuffer.h"
 
+/* Readers refuse images larger than this (a guard against corrupt headers);
+ * writers refuse framebuffers beyond it too. */
+#define IMG_MAX_SIDE 65536
+#define IMG_MAX_PIXELS (1ull << 28)
+
 typedef enum { IMG_FMT_UNKNOWN, IMG_FMT_EXR, IMG_FMT_PNG, IMG_FMT_PFM } img_format;
 
 typedef struct {

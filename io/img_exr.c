@@ -1,0 +1,461 @@
+/* img_exr.c - OpenEXR reading and writing with the OpenEXRCore C API only.
+ *
+ * The library is driven through its chunk interface ("Reading and Writing
+ * Image Files with the C-language API", openexr.com): a context is started
+ * with custom positioned read/write callbacks on a file descriptor we own,
+ * then every scanline block (or tile) is encoded/decoded by an
+ * exr_encode_pipeline_t / exr_decode_pipeline_t, which also converts between
+ * the file's half/float/uint samples and our float buffers.
+ *
+ * Library error messages go to an error handler that keeps the first one in
+ * a thread-local buffer (the handler may run while the context's mutex is
+ * held, so it must not call back into the library, e.g. exr_get_user_data). */
+#include "img_exr.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <openexr.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* Largest finite half: (2 - 2^-10) * 2^15 (IEEE 754-2008 binary16). */
+#define HALF_MAX 65504.0f
+
+static _Thread_local char exr_msg[512];
+
+static void on_error(exr_const_context_t ctxt, exr_result_t code, const char *msg)
+{
+    (void)ctxt;
+    if (exr_msg[0]) return; /* keep the first, most specific message */
+    snprintf(exr_msg, sizeof exr_msg, "%s", msg ? msg : exr_get_default_error_message(code));
+}
+
+static void report(diag *d, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+static void report(diag *d, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    src_loc none = {NULL, 0, 0};
+    diag_vreport(d, DIAG_ERROR, none, NULL, fmt, ap);
+    va_end(ap);
+}
+
+/* The reason for a failed library call: errno text for I/O failures in our
+ * callbacks, otherwise the library's message (or its generic one). */
+typedef struct {
+    int fd;
+    int err; /* errno of the first failed read/write, 0 if none */
+} exr_stream;
+
+static const char *reason(const exr_stream *s, exr_result_t rv)
+{
+    if (s->err) return strerror(s->err);
+    if (exr_msg[0]) return exr_msg;
+    return exr_get_default_error_message(rv);
+}
+
+static int64_t on_read(exr_const_context_t ctxt, void *ud, void *buf, uint64_t sz, uint64_t off,
+                       exr_stream_error_func_ptr_t error_cb)
+{
+    exr_stream *s = ud;
+    unsigned char *p = buf;
+    uint64_t done = 0;
+    while (done < sz) {
+        ssize_t r = pread(s->fd, p + done, (size_t)(sz - done), (off_t)(off + done));
+        if (r < 0) {
+            if (errno == EINTR) continue;
+            if (!s->err) s->err = errno;
+            if (error_cb) error_cb(ctxt, EXR_ERR_READ_IO, "read failed: %s", strerror(errno));
+            return -1;
+        }
+        if (r == 0) break; /* end of file: the library reports the short read */
+        done += (uint64_t)r;
+    }
+    return (int64_t)done;
+}
+
+static int64_t on_size(exr_const_context_t ctxt, void *ud)
+{
+    (void)ctxt;
+    exr_stream *s = ud;
+    struct stat st;
+    if (fstat(s->fd, &st) != 0) return -1;
+    return (int64_t)st.st_size;
+}
+
+static int64_t on_write(exr_const_context_t ctxt, void *ud, const void *buf, uint64_t sz, uint64_t off,
+                        exr_stream_error_func_ptr_t error_cb)
+{
+    exr_stream *s = ud;
+    const unsigned char *p = buf;
+    uint64_t done = 0;
+    while (done < sz) {
+        ssize_t w = pwrite(s->fd, p + done, (size_t)(sz - done), (off_t)(off + done));
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) {
+            if (!s->err) s->err = w < 0 ? errno : EIO;
+            if (error_cb) error_cb(ctxt, EXR_ERR_WRITE_IO, "write failed: %s", strerror(s->err));
+            return -1;
+        }
+        done += (uint64_t)w;
+    }
+    return (int64_t)done;
+}
+
+/* CIE 1931 xy chromaticities of the primaries and white point.
+ * Rec. ITU-R BT.709-6 item 1.4 (also the sRGB primaries, IEC 61966-2-1),
+ * white D65; ACES AP1 (SMPTE ST 2065-1 / Academy S-2014-004), white ~D60. */
+static const exr_attr_chromaticities_t primaries_table[] = {
+    [IMG_PRIMARIES_REC709] = {0.640f, 0.330f, 0.300f, 0.600f, 0.150f, 0.060f, 0.3127f, 0.3290f},
+    [IMG_PRIMARIES_ACESCG] = {0.713f, 0.293f, 0.165f, 0.830f, 0.128f, 0.044f, 0.32168f, 0.33767f},
+};
+
+static exr_compression_t compression_of(int c)
+{
+    switch (c) {
+    case 0: return EXR_COMPRESSION_NONE;
+    case 2: return EXR_COMPRESSION_PIZ;
+    default: return EXR_COMPRESSION_ZIP;
+    }
+}
+
+pt_status img_exr_write(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
+                        img_primaries prim, diag *d)
+{
+    exr_msg[0] = '\0';
+    exr_stream s = {fd, 0};
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = on_error;
+    init.user_data = &s;
+    init.write_fn = on_write;
+
+    const int w = fb->width, h = fb->height;
+    const int nch = fb->alpha ? 4 : 3;
+    const int use_float = o && o->exr_float;
+    const exr_pixel_type_t ptype = use_float ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF;
+    if ((unsigned)prim >= sizeof primaries_table / sizeof primaries_table[0]) prim = IMG_PRIMARIES_REC709;
+
+    exr_context_t ctx = NULL;
+    exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
+    int enc_init = 0;
+    float *buf = NULL;
+    const char *what = "cannot start EXR file";
+    int part = 0;
+    exr_result_t rv = exr_start_write(&ctx, name, EXR_WRITE_FILE_DIRECTLY, &init);
+    if (rv != EXR_ERR_SUCCESS) goto fail;
+
+    what = "cannot set up EXR header";
+    rv = exr_add_part(ctx, NULL, EXR_STORAGE_SCANLINE, &part);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_initialize_required_attr_simple(ctx, part, w, h, compression_of(o ? o->exr_compression : 1));
+    /* Channel order in the file is alphabetical whatever the add order. */
+    static const char *const names[4] = {"R", "G", "B", "A"};
+    for (int c = 0; c < nch && rv == EXR_ERR_SUCCESS; c++)
+        rv = exr_add_channel(ctx, part, names[c], ptype, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_attr_set_chromaticities(ctx, part, "chromaticities", &primaries_table[prim]);
+    if (rv != EXR_ERR_SUCCESS) goto fail;
+    for (int i = 0; o && i < o->nmeta; i++) {
+        const char *k = o->meta_keys[i], *v = o->meta_values[i];
+        if (!k || !*k || !v) continue;
+        rv = exr_attr_set_string(ctx, part, k, v);
+        if (rv != EXR_ERR_SUCCESS) {
+            exr_finish(&ctx);
+            report(d, "cannot write '%s': cannot set EXR attribute '%s': %s", name, k, reason(&s, rv));
+            return PT_ERR_IO;
+        }
+    }
+    what = "cannot write EXR header";
+    rv = exr_write_header(ctx);
+    if (rv != EXR_ERR_SUCCESS) goto fail;
+
+    int32_t lpc = 1;
+    what = "cannot write EXR data";
+    rv = exr_get_scanlines_per_chunk(ctx, part, &lpc);
+    if (rv != EXR_ERR_SUCCESS) goto fail;
+    if (lpc < 1) lpc = 1;
+    /* One block of sanitized, interleaved R,G,B[,A] floats. */
+    buf = malloc(sizeof(float) * (size_t)w * (size_t)lpc * (size_t)nch);
+    if (!buf) {
+        exr_finish(&ctx);
+        report(d, "cannot write '%s': out of memory", name);
+        return PT_ERR_NOMEM;
+    }
+    const float lim = use_float ? INFINITY : HALF_MAX;
+    for (int y0 = 0; y0 < h; y0 += lpc) {
+        exr_chunk_info_t ci;
+        rv = exr_write_scanline_chunk_info(ctx, part, y0, &ci);
+        if (rv != EXR_ERR_SUCCESS) goto fail;
+        for (int y = 0; y < ci.height; y++) {
+            const float *src = fb->rgb + (size_t)(y0 + y) * (size_t)w * 3u;
+            const float *asrc = fb->alpha ? fb->alpha + (size_t)(y0 + y) * (size_t)w : NULL;
+            float *dst = buf + (size_t)y * (size_t)w * (size_t)nch;
+            for (int x = 0; x < w; x++) {
+                for (int c = 0; c < nch; c++) {
+                    float v = c < 3 ? src[x * 3 + c] : asrc[x];
+                    if (!isfinite(v)) v = 0.0f;
+                    if (v > lim) v = lim;
+                    if (v < -lim) v = -lim;
+                    dst[x * nch + c] = v;
+                }
+            }
+        }
+        rv = enc_init ? exr_encoding_update(ctx, part, &ci, &enc) : exr_encoding_initialize(ctx, part, &ci, &enc);
+        if (rv != EXR_ERR_SUCCESS) goto fail;
+        for (int c = 0; c < enc.channel_count; c++) {
+            exr_coding_channel_info_t *ec = &enc.channels[c];
+            int slot = 0;
+            while (slot < nch && strcmp(ec->channel_name, names[slot]) != 0) slot++;
+            if (slot == nch) slot = 0; /* cannot happen: we declared exactly these */
+            ec->user_data_type = EXR_PIXEL_FLOAT;
+            ec->user_bytes_per_element = 4;
+            ec->user_pixel_stride = (int32_t)(sizeof(float) * (size_t)nch);
+            ec->user_line_stride = (int32_t)(sizeof(float) * (size_t)nch * (size_t)w);
+            ec->encode_from_ptr = (const uint8_t *)(buf + slot);
+        }
+        if (!enc_init) {
+            enc_init = 1;
+            rv = exr_encoding_choose_default_routines(ctx, part, &enc);
+            if (rv != EXR_ERR_SUCCESS) goto fail;
+        }
+        rv = exr_encoding_run(ctx, part, &enc);
+        if (rv != EXR_ERR_SUCCESS) goto fail;
+    }
+    exr_encoding_destroy(ctx, &enc);
+    enc_init = 0;
+    free(buf);
+    buf = NULL;
+    what = "cannot finish EXR file";
+    rv = exr_finish(&ctx);
+    if (rv != EXR_ERR_SUCCESS || s.err) {
+        report(d, "cannot write '%s': %s: %s", name, what, reason(&s, rv));
+        return PT_ERR_IO;
+    }
+    return PT_OK;
+
+fail:
+    if (enc_init) exr_encoding_destroy(ctx, &enc);
+    free(buf);
+    if (ctx) exr_finish(&ctx);
+    report(d, "cannot write '%s': %s: %s", name, what, reason(&s, rv));
+    return PT_ERR_IO;
+}
+
+/* ---- reading ---------------------------------------------------------- */
+
+enum { SLOT_R, SLOT_G, SLOT_B, SLOT_A, SLOT_Y, NSLOTS };
+
+/* Point the decoder's channels at their places in fb for the block whose
+ * top-left pixel is (x0, y0) in image coordinates. */
+static void bind_channels(exr_decode_pipeline_t *dec, framebuffer *fb, float *grey, int x0, int y0, int use_y)
+{
+    const size_t w = (size_t)fb->width;
+    for (int c = 0; c < dec->channel_count; c++) {
+        exr_coding_channel_info_t *dc = &dec->channels[c];
+        const char *n = dc->channel_name;
+        uint8_t *ptr = NULL;
+        int32_t pstride = 0, lstride = 0;
+        if (dc->x_samples == 1 && dc->y_samples == 1 && n && n[0] && !n[1]) {
+            int slot = -1;
+            switch (n[0]) {
+            case 'R': slot = use_y ? -1 : SLOT_R; break;
+            case 'G': slot = use_y ? -1 : SLOT_G; break;
+            case 'B': slot = use_y ? -1 : SLOT_B; break;
+            case 'A': slot = fb->alpha ? SLOT_A : -1; break;
+            case 'Y': slot = use_y ? SLOT_Y : -1; break;
+            default: break;
+            }
+            size_t pix = (size_t)y0 * w + (size_t)x0;
+            if (slot >= SLOT_R && slot <= SLOT_B) {
+                ptr = (uint8_t *)(fb->rgb + pix * 3u + (size_t)slot);
+                pstride = (int32_t)(3 * sizeof(float));
+                lstride = (int32_t)(w * 3u * sizeof(float));
+            } else if (slot == SLOT_A || slot == SLOT_Y) {
+                ptr = (uint8_t *)((slot == SLOT_A ? fb->alpha : grey) + pix);
+                pstride = (int32_t)sizeof(float);
+                lstride = (int32_t)(w * sizeof(float));
+            }
+        }
+        dc->decode_to_ptr = ptr;
+        dc->user_pixel_stride = pstride;
+        dc->user_line_stride = lstride;
+        dc->user_data_type = EXR_PIXEL_FLOAT;
+        dc->user_bytes_per_element = 4;
+    }
+}
+
+/* Decode one chunk described by ci into fb at (x0, y0). */
+static exr_result_t decode_chunk(exr_context_t ctx, const exr_chunk_info_t *ci, exr_decode_pipeline_t *dec,
+                                 int *dec_init, framebuffer *fb, float *grey, int x0, int y0, int use_y)
+{
+    exr_result_t rv = *dec_init ? exr_decoding_update(ctx, 0, ci, dec) : exr_decoding_initialize(ctx, 0, ci, dec);
+    if (rv != EXR_ERR_SUCCESS) return rv;
+    bind_channels(dec, fb, grey, x0, y0, use_y);
+    if (!*dec_init) {
+        *dec_init = 1;
+        rv = exr_decoding_choose_default_routines(ctx, 0, dec);
+        if (rv != EXR_ERR_SUCCESS) return rv;
+    }
+    return exr_decoding_run(ctx, 0, dec);
+}
+
+pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
+{
+    *out = NULL;
+    exr_msg[0] = '\0';
+    exr_stream s = {-1, 0};
+    s.fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (s.fd < 0) {
+        report(d, "cannot read '%s': %s", path, strerror(errno));
+        return PT_ERR_IO;
+    }
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = on_error;
+    init.user_data = &s;
+    init.read_fn = on_read;
+    init.size_fn = on_size;
+    init.max_image_width = IMG_MAX_SIDE;
+    init.max_image_height = IMG_MAX_SIDE;
+    /* A damaged chunk table is an error, not something to guess around. */
+    init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
+
+    pt_status st = PT_ERR_IO;
+    exr_context_t ctx = NULL;
+    exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
+    int dec_init = 0;
+    framebuffer *fb = NULL;
+    float *grey = NULL;
+    const char *what = "not a readable EXR file";
+
+    exr_result_t rv = exr_start_read(&ctx, path, &init);
+    if (rv != EXR_ERR_SUCCESS) goto libfail;
+
+    exr_storage_t storage;
+    what = "cannot read EXR header";
+    rv = exr_get_storage(ctx, 0, &storage);
+    if (rv != EXR_ERR_SUCCESS) goto libfail;
+    if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED) {
+        report(d, "cannot read '%s': deep EXR images are not supported", path);
+        goto done;
+    }
+    exr_attr_box2i_t dw;
+    rv = exr_get_data_window(ctx, 0, &dw);
+    if (rv != EXR_ERR_SUCCESS) goto libfail;
+    int64_t w64 = (int64_t)dw.max.x - dw.min.x + 1, h64 = (int64_t)dw.max.y - dw.min.y + 1;
+    if (w64 <= 0 || h64 <= 0 || w64 > IMG_MAX_SIDE || h64 > IMG_MAX_SIDE ||
+        (uint64_t)w64 * (uint64_t)h64 > IMG_MAX_PIXELS) {
+        report(d, "cannot read '%s': image size %lldx%lld is empty or exceeds the limit (%d per side, %llu pixels)",
+               path, (long long)w64, (long long)h64, IMG_MAX_SIDE, (unsigned long long)IMG_MAX_PIXELS);
+        goto done;
+    }
+    const int w = (int)w64, h = (int)h64;
+
+    const exr_attr_chlist_t *chl = NULL;
+    rv = exr_get_channels(ctx, 0, &chl);
+    if (rv != EXR_ERR_SUCCESS) goto libfail;
+    int have[NSLOTS] = {0};
+    for (int i = 0; i < chl->num_channels; i++) {
+        const exr_attr_chlist_entry_t *e = &chl->entries[i];
+        const char *n = e->name.str;
+        if (e->name.length != 1 || !n) continue;
+        int slot = n[0] == 'R' ? SLOT_R : n[0] == 'G' ? SLOT_G : n[0] == 'B' ? SLOT_B : n[0] == 'A' ? SLOT_A
+                 : n[0] == 'Y' ? SLOT_Y : -1;
+        if (slot < 0) continue;
+        if (e->x_sampling != 1 || e->y_sampling != 1) {
+            if (slot == SLOT_Y || slot == SLOT_A) continue; /* reported below if it matters */
+            report(d, "cannot read '%s': subsampled channel '%s' is not supported", path, n);
+            goto done;
+        }
+        have[slot] = 1;
+    }
+    const int use_y = !have[SLOT_R] && !have[SLOT_G] && !have[SLOT_B] && have[SLOT_Y];
+    if (!have[SLOT_R] && !have[SLOT_G] && !have[SLOT_B] && !have[SLOT_Y]) {
+        report(d, "cannot read '%s': no R, G, B or Y channel (of %d channels)", path, chl->num_channels);
+        goto done;
+    }
+    fb = fb_new(w, h);
+    if (fb && have[SLOT_A]) fb->alpha = calloc((size_t)w * (size_t)h, sizeof(float));
+    if (fb && use_y) grey = calloc((size_t)w * (size_t)h, sizeof(float));
+    if (!fb || (have[SLOT_A] && !fb->alpha) || (use_y && !grey)) {
+        report(d, "cannot read '%s': out of memory for %dx%d image", path, w, h);
+        st = PT_ERR_NOMEM;
+        goto done;
+    }
+
+    what = "cannot read EXR pixels";
+    if (storage == EXR_STORAGE_SCANLINE) {
+        int32_t lpc = 1;
+        rv = exr_get_scanlines_per_chunk(ctx, 0, &lpc);
+        if (rv != EXR_ERR_SUCCESS) goto libfail;
+        if (lpc < 1) lpc = 1;
+        for (int64_t y = dw.min.y; y <= dw.max.y; y += lpc) {
+            exr_chunk_info_t ci;
+            rv = exr_read_scanline_chunk_info(ctx, 0, (int)y, &ci);
+            if (rv != EXR_ERR_SUCCESS) goto libfail;
+            int row = ci.start_y - dw.min.y;
+            if (row < 0 || row + ci.height > h || ci.width != w) {
+                report(d, "cannot read '%s': inconsistent scanline block at y=%d", path, ci.start_y);
+                goto done;
+            }
+            rv = decode_chunk(ctx, &ci, &dec, &dec_init, fb, grey, 0, row, use_y);
+            if (rv != EXR_ERR_SUCCESS) goto libfail;
+        }
+    } else {
+        uint32_t tw = 0, th = 0;
+        exr_tile_level_mode_t lm;
+        exr_tile_round_mode_t rm;
+        rv = exr_get_tile_descriptor(ctx, 0, &tw, &th, &lm, &rm);
+        if (rv != EXR_ERR_SUCCESS) goto libfail;
+        int32_t lw = 0, lh = 0;
+        rv = exr_get_level_sizes(ctx, 0, 0, 0, &lw, &lh);
+        if (rv != EXR_ERR_SUCCESS) goto libfail;
+        if (tw == 0 || th == 0 || lw != w || lh != h) {
+            report(d, "cannot read '%s': inconsistent tile description", path);
+            goto done;
+        }
+        int ntx = (int)(((uint32_t)w + tw - 1) / tw), nty = (int)(((uint32_t)h + th - 1) / th);
+        for (int ty = 0; ty < nty; ty++) {
+            for (int tx = 0; tx < ntx; tx++) {
+                exr_chunk_info_t ci;
+                rv = exr_read_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &ci);
+                if (rv != EXR_ERR_SUCCESS) goto libfail;
+                int x0 = tx * (int)tw, y0 = ty * (int)th;
+                if (ci.width <= 0 || ci.height <= 0 || x0 + ci.width > w || y0 + ci.height > h) {
+                    report(d, "cannot read '%s': inconsistent tile (%d,%d)", path, tx, ty);
+                    goto done;
+                }
+                rv = decode_chunk(ctx, &ci, &dec, &dec_init, fb, grey, x0, y0, use_y);
+                if (rv != EXR_ERR_SUCCESS) goto libfail;
+            }
+        }
+    }
+    if (use_y) {
+        size_t n = (size_t)w * (size_t)h;
+        for (size_t i = 0; i < n; i++) fb->rgb[i * 3] = fb->rgb[i * 3 + 1] = fb->rgb[i * 3 + 2] = grey[i];
+    }
+    st = PT_OK;
+    *out = fb;
+    fb = NULL;
+    goto done;
+
+libfail:
+    report(d, "cannot read '%s': %s: %s", path, what, reason(&s, rv));
+    st = PT_ERR_IO;
+done:
+    if (dec_init) exr_decoding_destroy(ctx, &dec);
+    if (ctx) exr_finish(&ctx);
+    close(s.fd);
+    free(grey);
+    fb_free(fb);
+    return st;
+}

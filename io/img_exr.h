@@ -1,0 +1,24 @@
+/* img_exr.h - OpenEXR files through the OpenEXRCore C API. */
+#ifndef PT_IMG_EXR_H
+#define PT_IMG_EXR_H
+#include "img_io.h"
+
+/* Colour primaries written to the `chromaticities` header attribute.
+ * img_write uses REC709 (= sRGB primaries, D65 white). ACEScg needs only a
+ * `primaries` field in img_write_opts that img_write passes through here. */
+typedef enum { IMG_PRIMARIES_REC709 = 0, IMG_PRIMARIES_ACESCG } img_primaries;
+
+/* Write `fb` as a single-part scanline EXR to the open file `fd` (positioned
+ * writes; the caller closes it). `name` is only used in messages. Channels
+ * R,G,B (+A when fb->alpha) as half (default) or float (o->exr_float);
+ * non-finite values are written as 0 and, for half channels, finite values
+ * are clamped to +-65504 (the largest half) so no Inf ever reaches the file. */
+pt_status img_exr_write(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
+                        img_primaries prim, diag *d);
+
+/* Read part 0 of a scanline or tiled EXR (level 0 of a mip/rip-mapped file).
+ * R,G,B (half/float/uint, missing ones are 0) or, without any of those, Y as
+ * grey; A into fb->alpha when present. The data window becomes the image. */
+pt_status img_exr_read(const char *path, framebuffer **out, diag *d);
+
+#endif

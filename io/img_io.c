@@ -1,0 +1,222 @@
+/* img_io.c - image file dispatch, crash-safe writing, sRGB transfer functions.
+ *
+ * Writing: the encoder for the format chosen by the file extension writes to
+ * `<dir>/.<name>.tmp-<pid>` in the destination directory; only when every
+ * byte has been written, synced and the file closed is it renamed over
+ * `path` (rename(2) is atomic within one file system). On any failure the
+ * temporary file is removed, so no partial file ever appears under `path`.
+ *
+ * Reading: the format is chosen by the file's magic bytes (EXR, PNG, PFM),
+ * not by its extension.
+ *
+ * Values that are not finite (NaN, +-Inf) are written as 0 by every
+ * encoder; callers need not sanitize first. */
+#include "img_io.h"
+#include "img_exr.h"
+#include "img_pfm.h"
+#include "img_png.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <unistd.h>
+
+/* IEC 61966-2-1:1999 (sRGB), section 5.2 (encoding) and 5.3 (decoding):
+ *   V = 12.92 L                   for L <= 0.0031308
+ *   V = 1.055 L^(1/2.4) - 0.055   otherwise
+ * The standard's decoding knee is V = 0.04045; the two pieces of the curve do
+ * not meet exactly with these rounded constants (the power piece at
+ * L = 0.0031308 gives 0.0404499075, the linear piece 0.040449936). We decode
+ * with the knee placed at 12.92 * 0.0031308 = 0.040449936, the image of the
+ * encoding knee, so that encode(decode(V)) == V for every V and
+ * decode(encode(L)) == L for every L outside (0.0031308, 0.0031308022], a
+ * window in which the standard's own curve is not invertible. The results
+ * differ from the 0.04045 knee by less than 3e-9 and only for V in
+ * (0.040449936, 0.04045]. */
+#define SRGB_LIN_KNEE 0.0031308
+#define SRGB_ENC_KNEE (12.92 * SRGB_LIN_KNEE)
+
+double img_srgb_encode(double linear)
+{
+    if (linear <= SRGB_LIN_KNEE) return 12.92 * linear;
+    return 1.055 * pow(linear, 1.0 / 2.4) - 0.055;
+}
+
+double img_srgb_decode(double encoded)
+{
+    if (encoded <= SRGB_ENC_KNEE) return encoded / 12.92;
+    return pow((encoded + 0.055) / 1.055, 2.4);
+}
+
+void img_default_write_opts(img_write_opts *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof *o);
+    o->exr_float = 0;
+    o->exr_compression = 1; /* zip */
+    o->png_16bit = 0;
+}
+
+img_format img_format_from_path(const char *path)
+{
+    if (!path) return IMG_FMT_UNKNOWN;
+    const char *slash = strrchr(path, '/');
+    const char *base = slash ? slash + 1 : path;
+    const char *dot = strrchr(base, '.');
+    if (!dot || dot == base) return IMG_FMT_UNKNOWN;
+    if (strcasecmp(dot, ".exr") == 0) return IMG_FMT_EXR;
+    if (strcasecmp(dot, ".png") == 0) return IMG_FMT_PNG;
+    if (strcasecmp(dot, ".pfm") == 0) return IMG_FMT_PFM;
+    return IMG_FMT_UNKNOWN;
+}
+
+static void report(diag *d, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+static void report(diag *d, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    src_loc none = {NULL, 0, 0};
+    diag_vreport(d, DIAG_ERROR, none, NULL, fmt, ap);
+    va_end(ap);
+}
+
+/* "<dir>/.<name>.tmp-<pid>" for `path`; malloc'd, NULL when out of memory. */
+static char *temp_path_for(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    size_t dirlen = slash ? (size_t)(slash - path) + 1 : 0;
+    const char *base = path + dirlen;
+    char pidbuf[32];
+    snprintf(pidbuf, sizeof pidbuf, "%ld", (long)getpid());
+    size_t n = dirlen + 1 + strlen(base) + 5 + strlen(pidbuf) + 1;
+    char *t = malloc(n);
+    if (!t) return NULL;
+    memcpy(t, path, dirlen);
+    snprintf(t + dirlen, n - dirlen, ".%s.tmp-%s", base, pidbuf);
+    return t;
+}
+
+static int valid_fb(const framebuffer *fb)
+{
+    return fb && fb->rgb && fb->width > 0 && fb->height > 0 && fb->width <= IMG_MAX_SIDE &&
+           fb->height <= IMG_MAX_SIDE && (uint64_t)fb->width * (uint64_t)fb->height <= IMG_MAX_PIXELS;
+}
+
+pt_status img_write(const char *path, const framebuffer *fb, const img_write_opts *o, diag *d)
+{
+    img_write_opts defaults;
+    if (!o) {
+        img_default_write_opts(&defaults);
+        o = &defaults;
+    }
+    if (!path || !*path) {
+        report(d, "cannot write image: empty output path");
+        return PT_ERR_USAGE;
+    }
+    img_format fmt = img_format_from_path(path);
+    if (fmt == IMG_FMT_UNKNOWN) {
+        report(d, "cannot write '%s': unknown image extension (expected .exr, .png or .pfm)", path);
+        return PT_ERR_USAGE;
+    }
+    if (!valid_fb(fb)) {
+        report(d, "cannot write '%s': invalid framebuffer", path);
+        return PT_ERR_USAGE;
+    }
+    if (fmt == IMG_FMT_EXR && (o->exr_compression < 0 || o->exr_compression > 2)) {
+        report(d, "cannot write '%s': unknown EXR compression %d (0 none, 1 zip, 2 piz)", path,
+               o->exr_compression);
+        return PT_ERR_USAGE;
+    }
+    if (o->nmeta < 0 || (o->nmeta > 0 && (!o->meta_keys || !o->meta_values))) {
+        report(d, "cannot write '%s': inconsistent metadata arguments", path);
+        return PT_ERR_USAGE;
+    }
+
+    char *tmp = temp_path_for(path);
+    if (!tmp) {
+        report(d, "cannot write '%s': out of memory", path);
+        return PT_ERR_NOMEM;
+    }
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0 && errno == EEXIST) {
+        /* A stale temporary from an earlier process with the same pid. */
+        unlink(tmp);
+        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    }
+    if (fd < 0) {
+        report(d, "cannot write '%s': cannot create temporary file '%s': %s", path, tmp, strerror(errno));
+        free(tmp);
+        return PT_ERR_IO;
+    }
+
+    pt_status st;
+    switch (fmt) {
+    case IMG_FMT_EXR: st = img_exr_write(fd, path, fb, o, IMG_PRIMARIES_REC709, d); break;
+    case IMG_FMT_PNG: st = img_png_write(fd, path, fb, o, d); break;
+    default: st = img_pfm_write(fd, path, fb, d); break;
+    }
+
+    if (st == PT_OK && fsync(fd) != 0 && errno != EINVAL && errno != EROFS) {
+        report(d, "cannot write '%s': %s", path, strerror(errno));
+        st = PT_ERR_IO;
+    }
+    if (close(fd) != 0 && st == PT_OK) {
+        report(d, "cannot write '%s': %s", path, strerror(errno));
+        st = PT_ERR_IO;
+    }
+    if (st == PT_OK && rename(tmp, path) != 0) {
+        report(d, "cannot write '%s': cannot rename '%s' to it: %s", path, tmp, strerror(errno));
+        st = PT_ERR_IO;
+    }
+    if (st != PT_OK) unlink(tmp);
+    free(tmp);
+    return st;
+}
+
+pt_status img_read(const char *path, int png_raw, framebuffer **out, diag *d)
+{
+    if (!out) return PT_ERR_USAGE;
+    *out = NULL;
+    if (!path || !*path) {
+        report(d, "cannot read image: empty path");
+        return PT_ERR_USAGE;
+    }
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        report(d, "cannot read '%s': %s", path, strerror(errno));
+        return PT_ERR_IO;
+    }
+    unsigned char magic[8] = {0};
+    size_t n = fread(magic, 1, sizeof magic, f);
+    int rerr = ferror(f);
+    int saved = errno;
+    fclose(f);
+    if (rerr) {
+        report(d, "cannot read '%s': %s", path, strerror(saved));
+        return PT_ERR_IO;
+    }
+    /* OpenEXR file layout: magic number 20000630 as a little-endian int. */
+    static const unsigned char exr_magic[4] = {0x76, 0x2f, 0x31, 0x01};
+    /* PNG specification, section 5.2: the 8-byte signature. */
+    static const unsigned char png_magic[8] = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a};
+    if (n >= 4 && memcmp(magic, exr_magic, 4) == 0) return img_exr_read(path, out, d);
+    if (n >= 8 && memcmp(magic, png_magic, 8) == 0) return img_png_read(path, png_raw, out, d);
+    if (n >= 3 && magic[0] == 'P' && (magic[1] == 'F' || magic[1] == 'f') &&
+        (magic[2] == '\n' || magic[2] == '\r' || magic[2] == ' ' || magic[2] == '\t'))
+        return img_pfm_read(path, out, d);
+    if (n == 0)
+        report(d, "cannot read '%s': file is empty", path);
+    else
+        report(d, "cannot read '%s': not an EXR, PNG or PFM file (unrecognized magic bytes)", path);
+    return PT_ERR_IO;
+}

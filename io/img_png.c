@@ -1,0 +1,260 @@
+/* img_png.c - PNG reading and writing through libpng (1.6 API).
+ *
+ * libpng reports errors by calling the error callback, which must not
+ * return; ours records the message and long-jumps back with png_longjmp()
+ * to the setjmp(png_jmpbuf()) point of the running call (libpng manual,
+ * section "Setting up error handling"). Warnings are dropped: nothing in
+ * here prints. Multi-byte samples are big-endian in the file (PNG spec,
+ * section 7.1) and are packed/unpacked by hand, so no byte-swap transform
+ * is needed. */
+#include "img_png.h"
+
+#include <errno.h>
+#include <math.h>
+#include <png.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+typedef struct {
+    int fd;        /* write target */
+    int err;       /* errno of a failed write, 0 otherwise */
+    char msg[256]; /* last libpng error message */
+} png_ctx;
+
+static void report(diag *d, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+static void report(diag *d, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    src_loc none = {NULL, 0, 0};
+    diag_vreport(d, DIAG_ERROR, none, NULL, fmt, ap);
+    va_end(ap);
+}
+
+static void on_error(png_structp png, png_const_charp msg)
+{
+    png_ctx *c = png_get_error_ptr(png);
+    if (c) snprintf(c->msg, sizeof c->msg, "%s", msg ? msg : "unknown libpng error");
+    png_longjmp(png, 1);
+}
+
+static void on_warning(png_structp png, png_const_charp msg)
+{
+    (void)png;
+    (void)msg;
+}
+
+static void on_write(png_structp png, png_bytep data, png_size_t len)
+{
+    png_ctx *c = png_get_io_ptr(png);
+    while (len > 0) {
+        ssize_t w = write(c->fd, data, len);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) {
+            c->err = w < 0 ? errno : EIO;
+            png_error(png, "write failed");
+        }
+        data += w;
+        len -= (size_t)w;
+    }
+}
+
+static void on_flush(png_structp png) { (void)png; }
+
+/* Linear value -> code in [0, maxcode]: sRGB-encode, clamp to [0,1], round
+ * to nearest (half-way cases up). Non-finite values give 0. */
+static unsigned encode_code(float v, double maxcode)
+{
+    if (!isfinite(v) || v <= 0.0f) return 0;
+    double e = img_srgb_encode((double)v);
+    if (e >= 1.0) return (unsigned)maxcode;
+    return (unsigned)floor(e * maxcode + 0.5);
+}
+
+static unsigned alpha_code(float v, double maxcode)
+{
+    if (!isfinite(v) || v <= 0.0f) return 0;
+    if (v >= 1.0f) return (unsigned)maxcode;
+    return (unsigned)floor((double)v * maxcode + 0.5);
+}
+
+pt_status img_png_write(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
+                        diag *d)
+{
+    png_ctx ctx = {fd, 0, {0}};
+    const int bits = o && o->png_16bit ? 16 : 8;
+    const int ch = fb->alpha ? 4 : 3;
+    const double maxcode = bits == 16 ? 65535.0 : 255.0;
+    const size_t rowbytes = (size_t)fb->width * (size_t)ch * (size_t)(bits / 8);
+    unsigned char *row = malloc(rowbytes);
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &ctx, on_error, on_warning);
+    png_infop info = png ? png_create_info_struct(png) : NULL;
+    if (!row || !png || !info) {
+        if (png) png_destroy_write_struct(&png, info ? &info : NULL);
+        free(row);
+        report(d, "cannot write '%s': out of memory", name);
+        return PT_ERR_NOMEM;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        free(row);
+        if (ctx.err)
+            report(d, "cannot write '%s': %s", name, strerror(ctx.err));
+        else
+            report(d, "cannot write '%s': PNG error: %s", name, ctx.msg);
+        return PT_ERR_IO;
+    }
+    png_set_write_fn(png, &ctx, on_write, on_flush);
+    png_set_IHDR(png, info, (png_uint_32)fb->width, (png_uint_32)fb->height, bits,
+                 ch == 4 ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    /* sRGB chunk (perceptual rendering intent) plus the gAMA and cHRM values
+     * the PNG spec (section 11.3.3.5) recommends alongside it. */
+    png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    png_write_info(png, info);
+    for (int y = 0; y < fb->height; y++) {
+        const float *src = fb->rgb + (size_t)y * (size_t)fb->width * 3u;
+        const float *asrc = fb->alpha ? fb->alpha + (size_t)y * (size_t)fb->width : NULL;
+        unsigned char *p = row;
+        for (int x = 0; x < fb->width; x++) {
+            unsigned codes[4];
+            for (int k = 0; k < 3; k++) codes[k] = encode_code(src[x * 3 + k], maxcode);
+            if (asrc) codes[3] = alpha_code(asrc[x], maxcode);
+            for (int k = 0; k < ch; k++) {
+                if (bits == 16) {
+                    *p++ = (unsigned char)(codes[k] >> 8);
+                    *p++ = (unsigned char)(codes[k] & 0xffu);
+                } else {
+                    *p++ = (unsigned char)codes[k];
+                }
+            }
+        }
+        png_write_row(png, row);
+    }
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    free(row);
+    return PT_OK;
+}
+
+pt_status img_png_read(const char *path, int raw, framebuffer **out, diag *d)
+{
+    *out = NULL;
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        report(d, "cannot read '%s': %s", path, strerror(errno));
+        return PT_ERR_IO;
+    }
+    png_ctx ctx = {-1, 0, {0}};
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &ctx, on_error, on_warning);
+    png_infop info = png ? png_create_info_struct(png) : NULL;
+    if (!png || !info) {
+        if (png) png_destroy_read_struct(&png, info ? &info : NULL, NULL);
+        fclose(f);
+        report(d, "cannot read '%s': out of memory", path);
+        return PT_ERR_NOMEM;
+    }
+    /* Assigned after setjmp and used after a longjmp: must be volatile
+     * (C11 7.13.2.1p3). */
+    unsigned char *volatile image = NULL;
+    png_bytep *volatile rows = NULL;
+    framebuffer *volatile fb = NULL;
+    volatile pt_status fail = PT_ERR_IO;
+    volatile int reported = 0;
+    if (setjmp(png_jmpbuf(png))) {
+        if (reported)
+            ;
+        else if (fail == PT_ERR_NOMEM)
+            report(d, "cannot read '%s': out of memory", path);
+        else
+            report(d, "cannot read '%s': PNG error: %s", path, ctx.msg[0] ? ctx.msg : "unknown error");
+        png_destroy_read_struct(&png, &info, NULL);
+        free(image);
+        free(rows);
+        fb_free(fb);
+        fclose(f);
+        return fail;
+    }
+    png_init_io(png, f);
+    png_set_user_limits(png, IMG_MAX_SIDE, IMG_MAX_SIDE);
+    png_read_info(png, info);
+
+    png_uint_32 w, h;
+    int bit_depth, color_type, interlace;
+    png_get_IHDR(png, info, &w, &h, &bit_depth, &color_type, &interlace, NULL, NULL);
+    if ((uint64_t)w * (uint64_t)h > IMG_MAX_PIXELS) {
+        report(d, "cannot read '%s': image size %ux%u exceeds the limit (%llu pixels)", path, (unsigned)w,
+               (unsigned)h, (unsigned long long)IMG_MAX_PIXELS);
+        reported = 1;
+        png_longjmp(png, 1);
+    }
+    /* Normalize everything to 8- or 16-bit RGB or RGBA. */
+    if (color_type == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
+    if (color_type == PNG_COLOR_TYPE_GRAY && bit_depth < 8) png_set_expand_gray_1_2_4_to_8(png);
+    if (png_get_valid(png, info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(png);
+    if (color_type == PNG_COLOR_TYPE_GRAY || color_type == PNG_COLOR_TYPE_GRAY_ALPHA) png_set_gray_to_rgb(png);
+    if (interlace != PNG_INTERLACE_NONE) png_set_interlace_handling(png);
+    png_read_update_info(png, info);
+
+    const int ch = png_get_channels(png, info);
+    const int bits = png_get_bit_depth(png, info);
+    const size_t rowbytes = png_get_rowbytes(png, info);
+    if ((ch != 3 && ch != 4) || (bits != 8 && bits != 16) || rowbytes < (size_t)w * (size_t)ch * (size_t)(bits / 8)) {
+        snprintf(ctx.msg, sizeof ctx.msg, "unexpected layout after transforms (%d channels, %d bits)", ch, bits);
+        png_longjmp(png, 1);
+    }
+    fail = PT_ERR_NOMEM;
+    image = malloc(rowbytes * (size_t)h);
+    rows = malloc(sizeof(png_bytep) * (size_t)h);
+    fb = fb_new((int)w, (int)h);
+    if (!image || !rows || !fb) png_longjmp(png, 1);
+    if (ch == 4) {
+        fb->alpha = malloc(sizeof(float) * (size_t)w * (size_t)h);
+        if (!fb->alpha) png_longjmp(png, 1);
+    }
+    fail = PT_ERR_IO;
+    for (png_uint_32 y = 0; y < h; y++) rows[y] = image + (size_t)y * rowbytes;
+    png_read_image(png, rows);
+    png_read_end(png, NULL); /* also catches a file cut after the image data */
+
+    const double maxcode = bits == 16 ? 65535.0 : 255.0;
+    float lut8[256];
+    if (bits == 8)
+        for (int i = 0; i < 256; i++) lut8[i] = raw ? (float)(i / 255.0) : (float)img_srgb_decode(i / 255.0);
+    for (png_uint_32 y = 0; y < h; y++) {
+        const unsigned char *p = rows[y];
+        float *dst = fb_px(fb, 0, (int)y);
+        float *adst = fb->alpha ? fb->alpha + (size_t)y * (size_t)w : NULL;
+        for (png_uint_32 x = 0; x < w; x++) {
+            for (int k = 0; k < ch; k++) {
+                unsigned code;
+                if (bits == 16) {
+                    code = (unsigned)p[0] << 8 | p[1];
+                    p += 2;
+                } else {
+                    code = *p++;
+                }
+                if (k == 3)
+                    adst[x] = (float)(code / maxcode);
+                else if (bits == 8)
+                    dst[x * 3 + (png_uint_32)k] = lut8[code];
+                else
+                    dst[x * 3 + (png_uint_32)k] = (float)(raw ? code / maxcode : img_srgb_decode(code / maxcode));
+            }
+        }
+    }
+    png_destroy_read_struct(&png, &info, NULL);
+    free(image);
+    free(rows);
+    fclose(f);
+    *out = fb;
+    return PT_OK;
+}
