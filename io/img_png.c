@@ -69,6 +69,19 @@ static void on_write(png_structp png, png_bytep data, png_size_t len)
 
 static void on_flush(png_structp png) { (void)png; }
 
+/* Like libpng's default stdio reader, but says why a read came up short. */
+static void on_read(png_structp png, png_bytep data, png_size_t len)
+{
+    FILE *f = png_get_io_ptr(png);
+    if (fread(data, 1, len, f) == len) return;
+    if (ferror(f)) {
+        png_ctx *c = png_get_error_ptr(png);
+        if (c) c->err = errno ? errno : EIO;
+        png_error(png, "read failed");
+    }
+    png_error(png, "unexpected end of file (truncated PNG)");
+}
+
 /* Linear value -> code in [0, maxcode]: sRGB-encode, clamp to [0,1], round
  * to nearest (half-way cases up). Non-finite values give 0. */
 static unsigned encode_code(float v, double maxcode)
@@ -174,6 +187,8 @@ pt_status img_png_read(const char *path, int raw, framebuffer **out, diag *d)
             ;
         else if (fail == PT_ERR_NOMEM)
             report(d, "cannot read '%s': out of memory", path);
+        else if (ctx.err)
+            report(d, "cannot read '%s': %s", path, strerror(ctx.err));
         else
             report(d, "cannot read '%s': PNG error: %s", path, ctx.msg[0] ? ctx.msg : "unknown error");
         png_destroy_read_struct(&png, &info, NULL);
@@ -183,7 +198,7 @@ pt_status img_png_read(const char *path, int raw, framebuffer **out, diag *d)
         fclose(f);
         return fail;
     }
-    png_init_io(png, f);
+    png_set_read_fn(png, f, on_read);
     png_set_user_limits(png, IMG_MAX_SIDE, IMG_MAX_SIDE);
     png_read_info(png, info);
 
