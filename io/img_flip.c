@@ -406,8 +406,8 @@ pt_status img_flip_ldr(const framebuffer *ref, const framebuffer *test,
     /* The sRGB transfer function (IEC 61966-2-1) on clamped values. */
     for (size_t i = 0; i < n; i++) {
         double a = ref->rgb[i], b = test->rgb[i];
-        a = isnan(a) ? 0.0 : (a < 0.0 ? 0.0 : (a > 1.0 ? 1.0 : a));
-        b = isnan(b) ? 0.0 : (b < 0.0 ? 0.0 : (b > 1.0 ? 1.0 : b));
+        a = !isfinite(a) ? 0.0 : (a < 0.0 ? 0.0 : (a > 1.0 ? 1.0 : a));
+        b = !isfinite(b) ? 0.0 : (b < 0.0 ? 0.0 : (b > 1.0 ? 1.0 : b));
         lin[i] = (float)srgb_decode(a);
         lin[n + i] = (float)srgb_decode(b);
     }
@@ -442,8 +442,10 @@ pt_status img_flip_exposures(const framebuffer *ref, double *start, double *stop
     }
     double ymax = -INFINITY;
     for (size_t i = 0; i < n; i++) {
-        double y = luminance(ref->rgb + 3 * i);
-        if (!isfinite(y)) y = 0.0;
+        const float *px = ref->rgb + 3 * i;
+        float c[3] = {isfinite(px[0]) ? px[0] : 0.0f, isfinite(px[1]) ? px[1] : 0.0f,
+                      isfinite(px[2]) ? px[2] : 0.0f};
+        double y = luminance(c);
         lum[i] = y;
         if (y > ymax) ymax = y;
     }
@@ -534,11 +536,12 @@ pt_status img_flip_hdr(const framebuffer *ref, const framebuffer *test,
             const float *src = im ? test->rgb : ref->rgb;
             float *dst = im ? lt : lr;
             for (size_t i = 0; i < 3 * n; i++) {
-                double x = (double)src[i] * m;
-                if (isnan(x)) x = 0.0;
+                /* Negative values count as 0: the rational tone curve
+                 * is meant for x >= 0 (it turns x = -1 into 1.34). */
+                double x = isfinite(src[i]) && src[i] > 0.0f ? (double)src[i] * m : 0.0;
                 double y = (aces_c[0] * x * x + aces_c[1] * x + aces_c[2]) /
                            (aces_c[3] * x * x + aces_c[4] * x + aces_c[5]);
-                if (isnan(y)) y = 1.0; /* +inf input */
+                if (!isfinite(y)) y = 1.0; /* overflow of a huge value */
                 dst[i] = (float)(y < 0.0 ? 0.0 : (y > 1.0 ? 1.0 : y));
             }
         }

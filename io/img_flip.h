@@ -8,7 +8,7 @@
  * The error map holds one value in [0,1] per pixel (0 = no perceived
  * difference). Pooled values follow the authors' tool: the mean, and the
  * "weighted median" (each error weighted by itself; see
- * img_flip_weighted_percentile). */
+ * img_flip_weighted_percentile). Non-finite input values count as 0. */
 #ifndef PT_IMG_FLIP_H
 #define PT_IMG_FLIP_H
 #include <stddef.h>
@@ -39,7 +39,8 @@ void img_flip_default_params(img_flip_params *p);
 pt_status img_flip_ldr(const framebuffer *ref, const framebuffer *test,
                        const img_flip_params *p, float *err, diag *d);
 
-/* HDR-FLIP. `ref` and `test` hold scene-linear values. The exposure range
+/* HDR-FLIP. `ref` and `test` hold scene-linear values (negatives count as 0,
+ * before the tone curve). The exposure range
  * is taken from `p` or computed from the reference; the values used are
  * written back into *p. */
 pt_status img_flip_hdr(const framebuffer *ref, const framebuffer *test,
