@@ -27,8 +27,17 @@ typedef struct {
 /* Build. Unsupported shapes are skipped with one warning each in `d`. */
 accel *accel_build(const scene *s, int threads, diag *d, pt_status *status);
 void accel_free(accel *a);
-/* Nearest hit with t in (tmin, tmax); returns 1 on hit. Objects flagged
- * no_image are skipped when `primary` is set, no_reflection when `reflected`. */
+/* The scene must outlive the accel: hits point into it (hit->obj, and
+ * hit->texture, which is &s->default_texture for untextured objects).
+ * Textures and no_shadow/no_image/no_reflection/no_radiosity are inherited
+ * from CSG parents when the leaf has none of its own.
+ *
+ * Self-intersection rule: every query uses an effective tmin of
+ * max(tmin, accel_epsilon(a, org, dir)), i.e. 1e-6 * (accel_scale + max|org_i|)
+ * / |dir|, so a ray leaving a surface does not hit it again at t ~ 0.
+ * Thread-safe: any number of threads may query one accel concurrently. */
+/* Nearest hit with t in (tmin, tmax); returns 1 on hit. (no_image and
+ * no_reflection are not applied here yet: callers see them in hit->obj->flags.) */
 int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, accel_hit *hit);
 /* Any hit in (tmin, tmax) by an object that casts shadows (not no_shadow). */
 int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax);
@@ -39,5 +48,7 @@ double accel_scale(const accel *a);
 accel_stats accel_get_stats(const accel *a);
 /* The underlying RTCScene (as void*), for benchmarks that drive Embree directly. */
 void *accel_rtc_scene(const accel *a);
+/* The smallest ray parameter queries accept (see the self-intersection rule). */
+double accel_epsilon(const accel *a, vec3 org, vec3 dir);
 
 #endif

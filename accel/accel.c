@@ -1,0 +1,965 @@
+/* accel.c - the Embree 3 scene built from the scene IR.
+ *
+ * Layout of the Embree scene (the root RTCScene):
+ *   - up to two triangle geometries holding every triangle, smooth_triangle
+ *     and once-used mesh, flattened into world space (float vertices): one for
+ *     objects that cast shadows, one for no_shadow objects. A per-primitive
+ *     table leads back to the leaf object and the triangle index within it.
+ *   - one user geometry (RTC_GEOMETRY_TYPE_USER) whose primitives are the
+ *     analytic shapes (accel_shapes.c), intersected exactly in double precision.
+ *   - one instance geometry per object that references a shared mesh: a mesh
+ *     used by more than one object is built once as its own RTCScene in
+ *     object space and placed with the object's transform.
+ *
+ * no_shadow: accel_occluded must ignore such objects. We use Embree's
+ * occlusion filter callbacks (rtcSetGeometryOccludedFilterFunction): the
+ * no_shadow triangle geometry rejects every occlusion candidate; a shared
+ * mesh with at least one no_shadow instance rejects candidates whose instance
+ * is no_shadow (hit instID); user geometry checks the flag in its own occluded
+ * callback. Intersection queries run no filter at all, and geometries without
+ * no_shadow objects carry no filter, so the common path pays nothing. (Ray
+ * masks would also do, but they are an optional Embree build feature.)
+ *
+ * Epsilon rule (self-intersection): a ray's effective tmin is
+ *   max(tmin, ACCEL_EPS_REL * (accel_scale + max|org_i|) / |dir|)
+ * i.e. a distance of 1e-6 of the scene diagonal plus 1e-6 of the origin's
+ * magnitude. Embree intersects triangles in single precision with the origin
+ * rounded to float (relative error 6e-8), so spurious re-hits of the surface
+ * a ray starts on lie within a few float ulps of the origin's magnitude; the
+ * rule keeps a margin of about 16 ulps and scales with the scene, so the same
+ * scene scaled by 1e-4 or 1e5 behaves identically. Analytic shapes are
+ * intersected in double precision from the caller's double ray (passed to
+ * the callbacks through an extended intersect context), triangle hit
+ * distances are refined in double against the triangle's plane.
+ *
+ * Infinite planes: user geometry needs finite bounds. A plane is clipped to a
+ * cube centred on the scene's extent E (finite geometry, camera location,
+ * light positions) with half-size PLANE_EXTENT_FACTOR * max(diag(E),
+ * distance from E's centre to the plane). Beyond 1e4 scene sizes the plane
+ * subtends less than 1e-4 rad seen from inside the scene, below a pixel at
+ * any usual resolution, and the bounds stay well inside float range so the
+ * BVH is not degraded (the plane sits near the root of the user-geometry BVH
+ * and triangles live in their own BVH). Hits outside the cube are rejected,
+ * so the answer does not depend on how the BVH culls. */
+#include "accel.h"
+#include <embree3/rtcore.h>
+#include <float.h>
+#include <stdatomic.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "accel_shapes.h"
+#include "timer.h"
+
+#define ACCEL_EPS_REL 1e-6
+#define PLANE_EXTENT_FACTOR 1e4
+#define MAX_CSG_DEPTH 512
+
+enum { GEOM_NONE = 0, GEOM_TRI, GEOM_USER, GEOM_INSTANCE };
+enum { INHERITED_FLAGS = OBJ_NO_SHADOW | OBJ_NO_IMAGE | OBJ_NO_REFLECTION | OBJ_NO_RADIOSITY };
+
+typedef struct {
+    const scene_object *obj;
+    const scene_texture *texture; /* effective, never NULL */
+    unsigned flags;               /* effective: CSG parents' no_* flags included */
+    double wind;                  /* -1 when the transform mirrors, else 1 */
+    int group;                    /* shared-mesh group, -1 if none */
+} accel_leaf;
+
+typedef struct { unsigned leaf, local; } tri_ref;
+
+typedef struct {
+    float *v;       /* xyz per vertex (build time only) */
+    size_t nv, capv;
+    unsigned *idx;  /* 3 per triangle (build time only) */
+    tri_ref *refs;  /* per triangle (kept) */
+    size_t nt, capi, capr;
+} tri_batch;
+
+typedef struct { int kind; unsigned idx; } geom_info;
+
+typedef struct {
+    const scene_mesh *mesh;
+    RTCScene scene;
+    int any_no_shadow;
+} mesh_group;
+
+struct accel {
+    RTCDevice dev;
+    RTCScene root;
+    const scene *s;
+    accel_leaf *leaves;
+    int nleaves, capleaves;
+    tri_batch tri[2]; /* 0: casts shadows, 1: no_shadow */
+    accel_shape *shapes;
+    unsigned *shape_leaf;
+    int nshapes, capshapes;
+    mesh_group *groups;
+    int ngroups;
+    geom_info *ginfo;
+    unsigned nginfo;
+    vec3 lo, hi;
+    double scale;
+    accel_stats stats;
+    atomic_int err;
+    char errmsg[512];
+};
+
+/* Our intersect context: Embree passes the context pointer unchanged to the
+ * user-geometry callbacks (documented for RTCIntersectContext), which lets
+ * them use the caller's double ray. The callbacks recognise it by comparing
+ * with a thread-local pointer, so a plain context (bare Embree use, as in the
+ * benchmark) falls back to the float ray safely. */
+typedef struct {
+    struct RTCIntersectContext rtc; /* first member */
+    vec3 org, dir;
+    double tmin;
+    double ut;               /* last accepted user-geometry hit */
+    int upart;
+    unsigned uprim;
+    int uhit;
+} accel_query;
+
+static _Thread_local accel_query *tls_query;
+
+/* Embree's SoA ray/hit packets (rtcore_ray.h: RTCRayN/RTCHitN layout; the
+ * accessors there are C++ only). Ray fields: org 0-2, tnear 3, dir 4-6, time
+ * 7, tfar 8, mask 9, id 10, flags 11; hit fields: Ng 0-2, u 3, v 4, primID 5,
+ * geomID 6, instID 7. A RTCRayHitN holds the ray then the hit at 12*N. */
+#define SOA_F(p, N, i, k) (((float *)(p))[(size_t)(k) * (N) + (i)])
+#define SOA_U(p, N, i, k) (((unsigned *)(p))[(size_t)(k) * (N) + (i)])
+
+/* ------------------------------------------------------------ errors */
+
+static void on_embree_error(void *user, enum RTCError code, const char *str)
+{
+    accel *a = user;
+    int expected = 0;
+    if (atomic_compare_exchange_strong(&a->err, &expected, (int)code ? (int)code : -1))
+        snprintf(a->errmsg, sizeof a->errmsg, "%s", str ? str : "unknown error");
+}
+
+static const char *rtc_error_name(enum RTCError e)
+{
+    switch (e) {
+    case RTC_ERROR_NONE: return "no error";
+    case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
+    case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
+    case RTC_ERROR_CANCELLED: return "cancelled";
+    default: return "unknown error";
+    }
+}
+
+/* Non-zero when Embree reported an error; records it in `d`. */
+static int embree_failed(accel *a, diag *d, const char *stage)
+{
+    enum RTCError e = rtcGetDeviceError(a->dev);
+    int cb = atomic_load(&a->err);
+    if (e == RTC_ERROR_NONE && cb == 0) return 0;
+    src_loc nowhere = {0};
+    diag_report(d, DIAG_ERROR, nowhere, NULL, "Embree failed while %s: %s%s%s", stage,
+                rtc_error_name(e != RTC_ERROR_NONE ? e : (enum RTCError)cb), cb ? ": " : "", cb ? a->errmsg : "");
+    return 1;
+}
+
+/* ------------------------------------------------------------ build helpers */
+
+static int grow(void **p, size_t *cap, size_t need, size_t elem)
+{
+    if (need <= *cap) return 1;
+    size_t nc = *cap ? *cap : 64;
+    while (nc < need) nc *= 2;
+    void *n = realloc(*p, nc * elem);
+    if (!n) return 0;
+    *p = n;
+    *cap = nc;
+    return 1;
+}
+
+static int add_leaf(accel *a, const scene_object *o, const scene_texture *tex, unsigned flags)
+{
+    if (a->nleaves == a->capleaves) {
+        size_t cap = (size_t)a->capleaves;
+        if (!grow((void **)&a->leaves, &cap, (size_t)a->nleaves + 1, sizeof(accel_leaf))) return -1;
+        a->capleaves = (int)cap;
+    }
+    accel_leaf *l = &a->leaves[a->nleaves];
+    l->obj = o;
+    l->texture = tex ? tex : &a->s->default_texture;
+    l->flags = flags;
+    const double(*m)[4] = o->transform.m;
+    double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                 m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    l->wind = det < 0.0 ? -1.0 : 1.0;
+    l->group = -1;
+    return a->nleaves++;
+}
+
+static pt_status collect(accel *a, diag *d, const scene_object *o, const scene_texture *ptex, unsigned pflags,
+                         int depth)
+{
+    if (!o) return PT_OK;
+    const scene_texture *tex = o->texture ? o->texture : ptex;
+    unsigned flags = o->flags | (pflags & INHERITED_FLAGS);
+    switch (o->kind) {
+    case SHAPE_INTERSECTION:
+    case SHAPE_DIFFERENCE:
+        diag_warn_once(d, o->loc, "CSG intersection/difference is not evaluated yet: their parts are rendered as a union");
+        /* fall through */
+    case SHAPE_UNION:
+    case SHAPE_MERGE:
+        if (depth >= MAX_CSG_DEPTH) {
+            diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", MAX_CSG_DEPTH);
+            return PT_ERR_LIMIT;
+        }
+        for (int i = 0; i < o->u.csg.nkids; i++) {
+            pt_status st = collect(a, d, o->u.csg.kids[i], tex, flags, depth + 1);
+            if (st != PT_OK) return st;
+        }
+        return PT_OK;
+    case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_PLANE: case SHAPE_TRIANGLE: case SHAPE_SMOOTH_TRIANGLE:
+    case SHAPE_MESH: case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC: case SHAPE_TORUS:
+        return add_leaf(a, o, tex, flags) < 0 ? PT_ERR_NOMEM : PT_OK;
+    case SHAPE_UNSUPPORTED:
+    default:
+        a->stats.unsupported++;
+        diag_warn_once(d, o->loc, "%s is not rendered yet", o->name ? o->name : "this shape");
+        return PT_OK;
+    }
+}
+
+static void bounds_add(vec3 *lo, vec3 *hi, vec3 p)
+{
+    if (!v3_finite(p)) return;
+    *lo = v3_min(*lo, p);
+    *hi = v3_max(*hi, p);
+}
+
+static int batch_add_vertex(tri_batch *b, vec3 p)
+{
+    if (!grow((void **)&b->v, &b->capv, (b->nv + 1) * 3, sizeof(float))) return 0;
+    b->v[b->nv * 3 + 0] = (float)p.x;
+    b->v[b->nv * 3 + 1] = (float)p.y;
+    b->v[b->nv * 3 + 2] = (float)p.z;
+    b->nv++;
+    return 1;
+}
+
+static int batch_add_tri(tri_batch *b, unsigned i0, unsigned i1, unsigned i2, unsigned leaf, unsigned local)
+{
+    if (!grow((void **)&b->idx, &b->capi, (b->nt + 1) * 3, sizeof(unsigned))) return 0;
+    if (!grow((void **)&b->refs, &b->capr, b->nt + 1, sizeof(tri_ref))) return 0;
+    b->idx[b->nt * 3 + 0] = i0;
+    b->idx[b->nt * 3 + 1] = i1;
+    b->idx[b->nt * 3 + 2] = i2;
+    b->refs[b->nt].leaf = leaf;
+    b->refs[b->nt].local = local;
+    b->nt++;
+    return 1;
+}
+
+static int mesh_tri_ok(const scene_mesh *m, int t)
+{
+    const int *v = m->tris[t];
+    return v[0] >= 0 && v[0] < m->nverts && v[1] >= 0 && v[1] < m->nverts && v[2] >= 0 && v[2] < m->nverts;
+}
+
+static vec3 mesh_vert(const scene_mesh *m, int i)
+{
+    return v3(m->verts[i][0], m->verts[i][1], m->verts[i][2]);
+}
+
+static int set_ginfo(accel *a, unsigned id, int kind, unsigned idx)
+{
+    if (id == RTC_INVALID_GEOMETRY_ID) return 0;
+    if (id >= a->nginfo) {
+        unsigned nn = a->nginfo ? a->nginfo : 16;
+        while (nn <= id) nn *= 2;
+        geom_info *g = realloc(a->ginfo, nn * sizeof *g);
+        if (!g) return 0;
+        memset(g + a->nginfo, 0, (nn - a->nginfo) * sizeof *g);
+        a->ginfo = g;
+        a->nginfo = nn;
+    }
+    a->ginfo[id].kind = kind;
+    a->ginfo[id].idx = idx;
+    return 1;
+}
+
+/* ------------------------------------------------------------ callbacks */
+
+static void user_bounds(const struct RTCBoundsFunctionArguments *args)
+{
+    const accel *a = args->geometryUserPtr;
+    const accel_shape *sh = &a->shapes[args->primID];
+    vec3 lo = sh->lo, hi = sh->hi;
+    double ext = v3_maxc(v3_sub(hi, lo));
+    float out[6];
+    for (int i = 0; i < 3; i++) {
+        double l = v3_idx(lo, i), h = v3_idx(hi, i);
+        double pad = 1e-6 * (fabs(l) + fabs(h) + ext);
+        out[i] = nextafterf((float)(l - pad), -INFINITY);
+        out[3 + i] = nextafterf((float)(h + pad), INFINITY);
+    }
+    struct RTCBounds *b = args->bounds_o;
+    b->lower_x = out[0]; b->lower_y = out[1]; b->lower_z = out[2];
+    b->upper_x = out[3]; b->upper_y = out[4]; b->upper_z = out[5];
+}
+
+static void user_intersect(const struct RTCIntersectFunctionNArguments *args)
+{
+    const accel *a = args->geometryUserPtr;
+    const accel_shape *sh = &a->shapes[args->primID];
+    accel_query *q = tls_query;
+    unsigned N = args->N;
+    int exact = q && (void *)q == (void *)args->context && N == 1;
+    void *ray = args->rayhit;
+    float *hit = (float *)args->rayhit + 12 * (size_t)N;
+    for (unsigned i = 0; i < N; i++) {
+        if (args->valid[i] != -1) continue;
+        float tfar = SOA_F(ray, N, i, 8);
+        vec3 o, d;
+        double tmin;
+        if (exact) {
+            o = q->org;
+            d = q->dir;
+            tmin = q->tmin;
+        } else {
+            o = v3(SOA_F(ray, N, i, 0), SOA_F(ray, N, i, 1), SOA_F(ray, N, i, 2));
+            d = v3(SOA_F(ray, N, i, 4), SOA_F(ray, N, i, 5), SOA_F(ray, N, i, 6));
+            tmin = SOA_F(ray, N, i, 3);
+        }
+        accel_shape_hit h;
+        if (!accel_shape_intersect(sh, o, d, tmin, (double)tfar, &h)) continue;
+        SOA_F(ray, N, i, 8) = (float)h.t;
+        vec3 ng = v3(0, 0, 0);
+        double u = 0, v = 0;
+        if (exact) {
+            q->ut = h.t;
+            q->upart = h.part;
+            q->uprim = args->primID;
+            q->uhit = 1;
+        } else {
+            accel_shape_surface(sh, v3_madd(o, d, h.t), h.part, &ng, &u, &v);
+        }
+        SOA_F(hit, N, i, 0) = (float)ng.x;
+        SOA_F(hit, N, i, 1) = (float)ng.y;
+        SOA_F(hit, N, i, 2) = (float)ng.z;
+        SOA_F(hit, N, i, 3) = (float)u;
+        SOA_F(hit, N, i, 4) = (float)v;
+        SOA_U(hit, N, i, 5) = args->primID;
+        SOA_U(hit, N, i, 6) = args->geomID;
+        SOA_U(hit, N, i, 7) = args->context->instID[0];
+    }
+}
+
+static void user_occluded(const struct RTCOccludedFunctionNArguments *args)
+{
+    const accel *a = args->geometryUserPtr;
+    if (a->leaves[a->shape_leaf[args->primID]].flags & OBJ_NO_SHADOW) return;
+    const accel_shape *sh = &a->shapes[args->primID];
+    accel_query *q = tls_query;
+    unsigned N = args->N;
+    int exact = q && (void *)q == (void *)args->context && N == 1;
+    void *ray = args->ray;
+    for (unsigned i = 0; i < N; i++) {
+        if (args->valid[i] != -1) continue;
+        vec3 o, d;
+        double tmin;
+        if (exact) {
+            o = q->org;
+            d = q->dir;
+            tmin = q->tmin;
+        } else {
+            o = v3(SOA_F(ray, N, i, 0), SOA_F(ray, N, i, 1), SOA_F(ray, N, i, 2));
+            d = v3(SOA_F(ray, N, i, 4), SOA_F(ray, N, i, 5), SOA_F(ray, N, i, 6));
+            tmin = SOA_F(ray, N, i, 3);
+        }
+        accel_shape_hit h;
+        if (accel_shape_intersect(sh, o, d, tmin, (double)SOA_F(ray, N, i, 8), &h)) SOA_F(ray, N, i, 8) = -INFINITY;
+    }
+}
+
+/* Occlusion filter of the no_shadow triangle geometry: nothing there occludes. */
+static void filter_reject_all(const struct RTCFilterFunctionNArguments *args)
+{
+    for (unsigned i = 0; i < args->N; i++) args->valid[i] = 0;
+}
+
+/* Occlusion filter of a shared mesh with some no_shadow instances. */
+static void filter_instance_no_shadow(const struct RTCFilterFunctionNArguments *args)
+{
+    const accel *a = args->geometryUserPtr;
+    unsigned N = args->N;
+    for (unsigned i = 0; i < N; i++) {
+        if (args->valid[i] == 0) continue;
+        unsigned inst = SOA_U(args->hit, N, i, 7);
+        if (inst < a->nginfo && a->ginfo[inst].kind == GEOM_INSTANCE &&
+            (a->leaves[a->ginfo[inst].idx].flags & OBJ_NO_SHADOW))
+            args->valid[i] = 0;
+    }
+}
+
+/* ------------------------------------------------------------ geometry */
+
+static pt_status add_flat_triangles(accel *a, diag *d, int li)
+{
+    const accel_leaf *l = &a->leaves[li];
+    const scene_object *o = l->obj;
+    tri_batch *b = &a->tri[(l->flags & OBJ_NO_SHADOW) ? 1 : 0];
+    const xform *x = &o->transform;
+    if (o->kind == SHAPE_TRIANGLE || o->kind == SHAPE_SMOOTH_TRIANGLE) {
+        unsigned base = (unsigned)b->nv;
+        for (int k = 0; k < 3; k++) {
+            vec3 p = xform_point(x, o->u.triangle.v[k]);
+            bounds_add(&a->lo, &a->hi, p);
+            if (!batch_add_vertex(b, p)) return PT_ERR_NOMEM;
+        }
+        if (!batch_add_tri(b, base, base + 1, base + 2, (unsigned)li, 0)) return PT_ERR_NOMEM;
+        a->stats.triangles++;
+        return PT_OK;
+    }
+    const scene_mesh *m = o->u.mesh.mesh;
+    unsigned base = (unsigned)b->nv;
+    for (int i = 0; i < m->nverts; i++) {
+        vec3 p = xform_point(x, mesh_vert(m, i));
+        bounds_add(&a->lo, &a->hi, p);
+        if (!batch_add_vertex(b, p)) return PT_ERR_NOMEM;
+    }
+    for (int t = 0; t < m->ntris; t++) {
+        int ok = mesh_tri_ok(m, t);
+        if (!ok) diag_warn_once(d, m->loc, "mesh triangle with a vertex index out of range ignored");
+        const int *v = m->tris[t];
+        if (!batch_add_tri(b, base + (unsigned)(ok ? v[0] : 0), base + (unsigned)(ok ? v[1] : 0),
+                           base + (unsigned)(ok ? v[2] : 0), (unsigned)li, (unsigned)t))
+            return PT_ERR_NOMEM;
+    }
+    a->stats.triangles += m->ntris;
+    return PT_OK;
+}
+
+static RTCGeometry new_triangle_geometry(accel *a, const float *v, size_t nv, const unsigned *idx, size_t nt)
+{
+    RTCGeometry g = rtcNewGeometry(a->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (!g) return NULL;
+    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv);
+    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt);
+    if (!vb || !ib) {
+        rtcReleaseGeometry(g);
+        return NULL;
+    }
+    memcpy(vb, v, nv * 3 * sizeof(float));
+    memcpy(ib, idx, nt * 3 * sizeof(unsigned));
+    return g;
+}
+
+static pt_status build_batches(accel *a)
+{
+    for (int k = 0; k < 2; k++) {
+        tri_batch *b = &a->tri[k];
+        if (b->nt == 0) continue;
+        RTCGeometry g = new_triangle_geometry(a, b->v, b->nv, b->idx, b->nt);
+        if (!g) return PT_ERR_DEVICE;
+        if (k == 1) rtcSetGeometryOccludedFilterFunction(g, filter_reject_all);
+        rtcCommitGeometry(g);
+        unsigned id = rtcAttachGeometry(a->root, g);
+        rtcReleaseGeometry(g);
+        if (!set_ginfo(a, id, GEOM_TRI, (unsigned)k)) return PT_ERR_DEVICE;
+        a->stats.geometries++;
+        free(b->v);
+        free(b->idx);
+        b->v = NULL;
+        b->idx = NULL;
+    }
+    return PT_OK;
+}
+
+static int cmp_mesh_leaf(const void *pa, const void *pb)
+{
+    const uintptr_t *x = pa, *y = pb;
+    if (x[0] != y[0]) return x[0] < y[0] ? -1 : 1;
+    return x[1] < y[1] ? -1 : (x[1] > y[1]);
+}
+
+static void xform_to_float(const xform *x, float out[12])
+{
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 4; c++) out[r * 4 + c] = (float)x->m[r][c];
+}
+
+/* Shared meshes: one RTCScene each, one instance per referencing object. */
+static pt_status build_mesh_group(accel *a, diag *d, mesh_group *gr, const int *leaves, int n)
+{
+    const scene_mesh *m = gr->mesh;
+    float *v = malloc((size_t)m->nverts * 3 * sizeof(float) + 1);
+    unsigned *idx = malloc((size_t)m->ntris * 3 * sizeof(unsigned) + 1);
+    if (!v || !idx) { free(v); free(idx); return PT_ERR_NOMEM; }
+    vec3 mlo = v3s(INFINITY), mhi = v3s(-INFINITY);
+    for (int i = 0; i < m->nverts; i++) {
+        for (int k = 0; k < 3; k++) v[i * 3 + k] = m->verts[i][k];
+        bounds_add(&mlo, &mhi, mesh_vert(m, i));
+    }
+    for (int t = 0; t < m->ntris; t++) {
+        int ok = mesh_tri_ok(m, t);
+        if (!ok) diag_warn_once(d, m->loc, "mesh triangle with a vertex index out of range ignored");
+        for (int k = 0; k < 3; k++) idx[t * 3 + k] = ok ? (unsigned)m->tris[t][k] : 0u;
+    }
+    gr->scene = rtcNewScene(a->dev);
+    RTCGeometry g = gr->scene ? new_triangle_geometry(a, v, (size_t)m->nverts, idx, (size_t)m->ntris) : NULL;
+    free(v);
+    free(idx);
+    if (!g) return PT_ERR_DEVICE;
+    rtcSetSceneFlags(gr->scene, RTC_SCENE_FLAG_ROBUST);
+    for (int i = 0; i < n; i++)
+        if (a->leaves[leaves[i]].flags & OBJ_NO_SHADOW) gr->any_no_shadow = 1;
+    if (gr->any_no_shadow) {
+        rtcSetGeometryUserData(g, a);
+        rtcSetGeometryOccludedFilterFunction(g, filter_instance_no_shadow);
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(gr->scene, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(gr->scene);
+    a->stats.geometries++;
+    a->stats.triangles += m->ntris;
+    for (int i = 0; i < n; i++) {
+        const scene_object *o = a->leaves[leaves[i]].obj;
+        RTCGeometry inst = rtcNewGeometry(a->dev, RTC_GEOMETRY_TYPE_INSTANCE);
+        if (!inst) return PT_ERR_DEVICE;
+        rtcSetGeometryInstancedScene(inst, gr->scene);
+        rtcSetGeometryTimeStepCount(inst, 1);
+        float xf[12];
+        xform_to_float(&o->transform, xf);
+        rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, xf);
+        rtcCommitGeometry(inst);
+        unsigned id = rtcAttachGeometry(a->root, inst);
+        rtcReleaseGeometry(inst);
+        if (!set_ginfo(a, id, GEOM_INSTANCE, (unsigned)leaves[i])) return PT_ERR_DEVICE;
+        a->stats.instances++;
+        if (mlo.x <= mhi.x)
+            for (int c = 0; c < 8; c++) {
+                vec3 p = v3(c & 1 ? mhi.x : mlo.x, c & 2 ? mhi.y : mlo.y, c & 4 ? mhi.z : mlo.z);
+                bounds_add(&a->lo, &a->hi, xform_point(&o->transform, p));
+            }
+    }
+    return PT_OK;
+}
+
+static pt_status build_meshes(accel *a, diag *d)
+{
+    int n = 0;
+    for (int i = 0; i < a->nleaves; i++) {
+        const scene_object *o = a->leaves[i].obj;
+        if (o->kind == SHAPE_MESH && o->u.mesh.mesh && o->u.mesh.mesh->ntris > 0 && o->u.mesh.mesh->verts &&
+            o->u.mesh.mesh->tris)
+            n++;
+    }
+    if (n == 0) return PT_OK;
+    uintptr_t *refs = malloc((size_t)n * 2 * sizeof *refs);
+    int *lv = malloc((size_t)n * sizeof *lv);
+    a->groups = calloc((size_t)n, sizeof *a->groups);
+    if (!refs || !lv || !a->groups) { free(refs); free(lv); return PT_ERR_NOMEM; }
+    n = 0;
+    for (int i = 0; i < a->nleaves; i++) {
+        const scene_object *o = a->leaves[i].obj;
+        if (o->kind == SHAPE_MESH && o->u.mesh.mesh && o->u.mesh.mesh->ntris > 0 && o->u.mesh.mesh->verts &&
+            o->u.mesh.mesh->tris) {
+            refs[2 * n] = (uintptr_t)o->u.mesh.mesh;
+            refs[2 * n + 1] = (uintptr_t)i;
+            n++;
+        }
+    }
+    qsort(refs, (size_t)n, 2 * sizeof *refs, cmp_mesh_leaf);
+    pt_status st = PT_OK;
+    for (int i = 0; i < n && st == PT_OK;) {
+        int j = i;
+        while (j < n && refs[2 * j] == refs[2 * i]) j++;
+        const scene_mesh *m = (const scene_mesh *)refs[2 * i];
+        if (j - i > 1 || m->uses > 1) {
+            for (int k = i; k < j; k++) lv[k - i] = (int)refs[2 * k + 1];
+            mesh_group *gr = &a->groups[a->ngroups];
+            gr->mesh = m;
+            for (int k = 0; k < j - i; k++) a->leaves[lv[k]].group = a->ngroups;
+            a->ngroups++;
+            st = build_mesh_group(a, d, gr, lv, j - i);
+        } else {
+            st = add_flat_triangles(a, d, (int)refs[2 * i + 1]);
+        }
+        i = j;
+    }
+    free(refs);
+    free(lv);
+    return st;
+}
+
+static pt_status build_shapes(accel *a, diag *d)
+{
+    int n = 0;
+    for (int i = 0; i < a->nleaves; i++) {
+        shape_kind k = a->leaves[i].obj->kind;
+        if (k != SHAPE_TRIANGLE && k != SHAPE_SMOOTH_TRIANGLE && k != SHAPE_MESH) n++;
+    }
+    if (n == 0) return PT_OK;
+    a->shapes = malloc((size_t)n * sizeof *a->shapes);
+    a->shape_leaf = malloc((size_t)n * sizeof *a->shape_leaf);
+    if (!a->shapes || !a->shape_leaf) return PT_ERR_NOMEM;
+    for (int i = 0; i < a->nleaves; i++) {
+        const scene_object *o = a->leaves[i].obj;
+        if (o->kind == SHAPE_TRIANGLE || o->kind == SHAPE_SMOOTH_TRIANGLE || o->kind == SHAPE_MESH) continue;
+        accel_shape *sh = &a->shapes[a->nshapes];
+        if (accel_shape_init(sh, o) != 0) {
+            diag_warn_once(d, o->loc, "degenerate %s ignored (zero size, singular transform or non-finite numbers)",
+                           o->name ? o->name : "shape");
+            continue;
+        }
+        a->shape_leaf[a->nshapes++] = (unsigned)i;
+        if (o->kind != SHAPE_PLANE) {
+            bounds_add(&a->lo, &a->hi, sh->lo);
+            bounds_add(&a->lo, &a->hi, sh->hi);
+        }
+    }
+    return PT_OK;
+}
+
+/* Clip boxes for planes (see the comment at the top) and the scene scale. */
+static void finish_bounds(accel *a)
+{
+    const scene *s = a->s;
+    vec3 elo = a->lo, ehi = a->hi;
+    if (s->camera_set) bounds_add(&elo, &ehi, s->camera.location);
+    for (int i = 0; i < s->nlights; i++) bounds_add(&elo, &ehi, s->lights[i].position);
+    int have_e = elo.x <= ehi.x;
+    vec3 c = have_e ? v3_scale(v3_add(elo, ehi), 0.5) : v3s(0.0);
+    double diag_e = have_e ? v3_len(v3_sub(ehi, elo)) : 0.0;
+    double far_plane = 0.0;
+    for (int i = 0; i < a->nshapes; i++) {
+        accel_shape *sh = &a->shapes[i];
+        if (sh->kind != SHAPE_PLANE) continue;
+        vec3 nw = sh->identity ? sh->g.plane.n : v3_norm(xform_normal(&sh->x, sh->g.plane.n));
+        vec3 p0 = v3_scale(sh->g.plane.n, sh->g.plane.d);
+        if (!sh->identity) p0 = xform_point(&sh->x, p0);
+        double dist = fabs(v3_dot(v3_sub(c, p0), nw));
+        if (!isfinite(dist)) dist = 0.0;
+        double hsz = PLANE_EXTENT_FACTOR * fmax(diag_e, dist);
+        if (!(hsz > 0.0)) hsz = PLANE_EXTENT_FACTOR;
+        accel_shape_clip_plane(sh, v3_sub(c, v3s(hsz)), v3_add(c, v3s(hsz)));
+        far_plane = fmax(far_plane, dist);
+    }
+    if (a->lo.x <= a->hi.x) {
+        a->scale = v3_len(v3_sub(a->hi, a->lo));
+    } else {
+        a->lo = a->hi = v3s(0.0);
+        a->scale = 0.0;
+    }
+    if (!(a->scale > 0.0) || !isfinite(a->scale)) a->scale = diag_e;
+    if (!(a->scale > 0.0) || !isfinite(a->scale)) a->scale = far_plane;
+    if (!(a->scale > 0.0) || !isfinite(a->scale)) a->scale = 1.0;
+}
+
+static pt_status build_user_geometry(accel *a)
+{
+    if (a->nshapes == 0) return PT_OK;
+    RTCGeometry g = rtcNewGeometry(a->dev, RTC_GEOMETRY_TYPE_USER);
+    if (!g) return PT_ERR_DEVICE;
+    rtcSetGeometryUserPrimitiveCount(g, (unsigned)a->nshapes);
+    rtcSetGeometryUserData(g, a);
+    rtcSetGeometryBoundsFunction(g, user_bounds, a);
+    rtcSetGeometryIntersectFunction(g, user_intersect);
+    rtcSetGeometryOccludedFunction(g, user_occluded);
+    rtcCommitGeometry(g);
+    unsigned id = rtcAttachGeometry(a->root, g);
+    rtcReleaseGeometry(g);
+    if (!set_ginfo(a, id, GEOM_USER, 0)) return PT_ERR_DEVICE;
+    a->stats.geometries++;
+    a->stats.user_prims = a->nshapes;
+    return PT_OK;
+}
+
+/* ------------------------------------------------------------ public */
+
+accel *accel_build(const scene *s, int threads, diag *d, pt_status *status)
+{
+    double t0 = timer_now();
+    pt_status st = PT_OK;
+    src_loc nowhere = {0};
+    accel *a = calloc(1, sizeof *a);
+    if (!a) {
+        diag_report(d, DIAG_ERROR, nowhere, NULL, "out of memory while building the Embree scene");
+        if (status) *status = PT_ERR_NOMEM;
+        return NULL;
+    }
+    a->s = s;
+    a->lo = v3s(INFINITY);
+    a->hi = v3s(-INFINITY);
+    if (!s) {
+        diag_report(d, DIAG_ERROR, nowhere, NULL, "accel_build: no scene");
+        st = PT_ERR_INTERNAL;
+        goto fail;
+    }
+    char cfg[64] = "";
+    if (threads > 0) snprintf(cfg, sizeof cfg, "threads=%d", threads);
+    a->dev = rtcNewDevice(cfg[0] ? cfg : NULL);
+    if (!a->dev) {
+        diag_report(d, DIAG_ERROR, nowhere, NULL, "Embree device could not be created: %s",
+                    rtc_error_name(rtcGetDeviceError(NULL)));
+        st = PT_ERR_DEVICE;
+        goto fail;
+    }
+    rtcSetDeviceErrorFunction(a->dev, on_embree_error, a);
+    if (!rtcGetDeviceProperty(a->dev, RTC_DEVICE_PROPERTY_USER_GEOMETRY_SUPPORTED)) {
+        diag_report(d, DIAG_ERROR, nowhere, NULL, "this Embree library was built without user geometry support");
+        st = PT_ERR_DEVICE;
+        goto fail;
+    }
+    int filters = (int)rtcGetDeviceProperty(a->dev, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED);
+    a->root = rtcNewScene(a->dev);
+    if (!a->root) {
+        st = PT_ERR_DEVICE;
+        goto fail;
+    }
+    rtcSetSceneFlags(a->root, RTC_SCENE_FLAG_ROBUST);
+
+    for (int i = 0; i < s->nobjects && st == PT_OK; i++) st = collect(a, d, s->objects[i], NULL, 0u, 0);
+    if (st == PT_OK && !filters)
+        for (int i = 0; i < a->nleaves; i++)
+            if ((a->leaves[i].flags & OBJ_NO_SHADOW) && (a->leaves[i].obj->kind == SHAPE_TRIANGLE ||
+                a->leaves[i].obj->kind == SHAPE_SMOOTH_TRIANGLE || a->leaves[i].obj->kind == SHAPE_MESH))
+                diag_warn_once(d, a->leaves[i].obj->loc,
+                               "no_shadow on triangles/meshes is ignored: Embree was built without filter functions");
+    for (int i = 0; i < a->nleaves && st == PT_OK; i++) {
+        shape_kind k = a->leaves[i].obj->kind;
+        if (k == SHAPE_TRIANGLE || k == SHAPE_SMOOTH_TRIANGLE) st = add_flat_triangles(a, d, i);
+    }
+    if (st == PT_OK) st = build_meshes(a, d);
+    if (st == PT_OK) st = build_shapes(a, d);
+    if (st == PT_OK) finish_bounds(a);
+    if (st == PT_OK) st = build_batches(a);
+    if (st == PT_OK) st = build_user_geometry(a);
+    if (st == PT_OK) rtcCommitScene(a->root);
+    if (embree_failed(a, d, "building the scene")) {
+        st = PT_ERR_DEVICE;
+        goto fail;
+    }
+    if (st != PT_OK) {
+        if (st == PT_ERR_NOMEM)
+            diag_report(d, DIAG_ERROR, nowhere, NULL, "out of memory while building the Embree scene");
+        else if (st != PT_ERR_LIMIT)
+            diag_report(d, DIAG_ERROR, nowhere, NULL, "Embree scene build failed (%s)", pt_status_name(st));
+        goto fail;
+    }
+    a->stats.build_seconds = timer_now() - t0;
+    if (status) *status = PT_OK;
+    return a;
+
+fail:
+    accel_free(a);
+    if (status) *status = st;
+    return NULL;
+}
+
+void accel_free(accel *a)
+{
+    if (!a) return;
+    if (a->root) rtcReleaseScene(a->root);
+    for (int i = 0; i < a->ngroups; i++)
+        if (a->groups[i].scene) rtcReleaseScene(a->groups[i].scene);
+    if (a->dev) rtcReleaseDevice(a->dev);
+    for (int k = 0; k < 2; k++) {
+        free(a->tri[k].v);
+        free(a->tri[k].idx);
+        free(a->tri[k].refs);
+    }
+    free(a->leaves);
+    free(a->shapes);
+    free(a->shape_leaf);
+    free(a->groups);
+    free(a->ginfo);
+    free(a);
+}
+
+double accel_epsilon(const accel *a, vec3 org, vec3 dir)
+{
+    double m = fmax(fabs(org.x), fmax(fabs(org.y), fabs(org.z)));
+    double l = v3_len(dir);
+    double s = a ? a->scale : 1.0;
+    if (!(l > 0.0) || !isfinite(m)) return INFINITY;
+    return ACCEL_EPS_REL * (s + m) / l;
+}
+
+static int ray_ok(vec3 org, vec3 dir) { return v3_finite(org) && v3_finite(dir) && v3_len2(dir) > 0.0; }
+
+static void fill_rtc_ray(struct RTCRay *r, vec3 org, vec3 dir, double tmin, double tmax)
+{
+    r->org_x = (float)org.x;
+    r->org_y = (float)org.y;
+    r->org_z = (float)org.z;
+    r->dir_x = (float)dir.x;
+    r->dir_y = (float)dir.y;
+    r->dir_z = (float)dir.z;
+    r->tnear = (float)tmin;
+    r->tfar = tmax >= (double)FLT_MAX ? INFINITY : (float)tmax;
+    r->time = 0.0f;
+    r->mask = 0xFFFFFFFFu;
+    r->id = 0;
+    r->flags = 0;
+}
+
+/* Triangle data in object space for a hit on leaf `l`, triangle `local`. */
+static void fill_triangle(const accel *a, const accel_leaf *l, unsigned local, double bu, double bv, double t_emb,
+                          vec3 org, vec3 dir, accel_hit *hit)
+{
+    const scene_object *o = l->obj;
+    const xform *x = &o->transform;
+    vec3 p[3], n[3];
+    int smooth = 0;
+    const scene_texture *tex = l->texture;
+    if (o->kind == SHAPE_MESH) {
+        const scene_mesh *m = o->u.mesh.mesh;
+        int ok = (int)local < m->ntris && mesh_tri_ok(m, (int)local);
+        const int *tv = m->tris[ok ? local : 0];
+        for (int k = 0; k < 3; k++) p[k] = ok ? mesh_vert(m, tv[k]) : v3s(0.0);
+        if (ok && m->normals) {
+            const int *tn = m->tri_normals ? m->tri_normals[local] : (m->nnormals == m->nverts ? tv : NULL);
+            if (tn && tn[0] >= 0 && tn[0] < m->nnormals && tn[1] >= 0 && tn[1] < m->nnormals && tn[2] >= 0 &&
+                tn[2] < m->nnormals) {
+                for (int k = 0; k < 3; k++) n[k] = v3(m->normals[tn[k]][0], m->normals[tn[k]][1], m->normals[tn[k]][2]);
+                smooth = 1;
+            }
+        }
+        if (m->tri_texture && (int)local < m->ntris) {
+            int ti = m->tri_texture[local];
+            if (ti >= 0 && ti < m->ntextures && m->textures && m->textures[ti]) tex = m->textures[ti];
+        }
+    } else {
+        for (int k = 0; k < 3; k++) p[k] = o->u.triangle.v[k];
+        if (o->kind == SHAPE_SMOOTH_TRIANGLE) {
+            for (int k = 0; k < 3; k++) n[k] = o->u.triangle.n[k];
+            smooth = 1;
+        }
+    }
+    vec3 nobj = v3_cross(v3_sub(p[1], p[0]), v3_sub(p[2], p[0]));
+    vec3 ng = v3_scale(xform_normal(x, nobj), l->wind);
+    double t = t_emb;
+    /* refine the float distance against the triangle's plane, in double */
+    double den = v3_dot(dir, ng), lng = v3_len(ng);
+    if (fabs(den) > 1e-6 * lng * v3_len(dir)) {
+        double tr = v3_dot(v3_sub(xform_point(x, p[0]), org), ng) / den;
+        if (isfinite(tr) && fabs(tr - t_emb) <= 1e-4 * fabs(t_emb)) t = tr;
+    }
+    if (lng > 0.0 && isfinite(lng)) ng = v3_scale(ng, 1.0 / lng);
+    else ng = v3_norm(v3_neg(dir));
+    vec3 ns = ng;
+    if (smooth) {
+        double w = 1.0 - bu - bv;
+        vec3 sn = v3_add(v3_add(v3_scale(n[0], w), v3_scale(n[1], bu)), v3_scale(n[2], bv));
+        sn = xform_normal(x, sn);
+        double ls = v3_len(sn);
+        if (ls > 0.0 && isfinite(ls)) {
+            ns = v3_scale(sn, 1.0 / ls);
+            if (v3_dot(ns, ng) < 0.0) ns = v3_neg(ns);
+        }
+    }
+    hit->t = t;
+    hit->p = v3_madd(org, dir, t);
+    hit->ng = ng;
+    hit->ns = ns;
+    hit->u = bu;
+    hit->v = bv;
+    hit->obj = o;
+    hit->texture = tex;
+    hit->prim = local;
+}
+
+int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, accel_hit *hit)
+{
+    if (!a || !ray_ok(org, dir)) return 0;
+    double t0 = fmax(tmin, accel_epsilon(a, org, dir));
+    if (!(tmax > t0)) return 0;
+    accel_query q;
+    rtcInitIntersectContext(&q.rtc);
+    q.org = org;
+    q.dir = dir;
+    q.tmin = t0;
+    q.uhit = 0;
+    q.ut = 0.0;
+    q.upart = 0;
+    q.uprim = 0;
+    struct RTCRayHit rh;
+    fill_rtc_ray(&rh.ray, org, dir, t0, tmax);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    accel_query *saved = tls_query;
+    tls_query = &q;
+    rtcIntersect1(a->root, &q.rtc, &rh);
+    tls_query = saved;
+    unsigned gid = rh.hit.geomID, inst = rh.hit.instID[0], prim = rh.hit.primID;
+    if (gid == RTC_INVALID_GEOMETRY_ID) return 0;
+    if (inst != RTC_INVALID_GEOMETRY_ID) {
+        if (inst >= a->nginfo || a->ginfo[inst].kind != GEOM_INSTANCE) return 0;
+        fill_triangle(a, &a->leaves[a->ginfo[inst].idx], prim, rh.hit.u, rh.hit.v, rh.ray.tfar, org, dir, hit);
+    } else if (gid < a->nginfo && a->ginfo[gid].kind == GEOM_TRI) {
+        const tri_ref *r = &a->tri[a->ginfo[gid].idx].refs[prim];
+        fill_triangle(a, &a->leaves[r->leaf], r->local, rh.hit.u, rh.hit.v, rh.ray.tfar, org, dir, hit);
+    } else if (gid < a->nginfo && a->ginfo[gid].kind == GEOM_USER && prim < (unsigned)a->nshapes) {
+        const accel_shape *sh = &a->shapes[prim];
+        accel_shape_hit h;
+        if (q.uhit && q.uprim == prim) {
+            h.t = q.ut;
+            h.part = q.upart;
+        } else if (!accel_shape_intersect(sh, org, dir, t0, tmax, &h)) {
+            return 0;
+        }
+        const accel_leaf *l = &a->leaves[a->shape_leaf[prim]];
+        hit->t = h.t;
+        hit->p = v3_madd(org, dir, h.t);
+        accel_shape_surface(sh, hit->p, h.part, &hit->ng, &hit->u, &hit->v);
+        hit->ns = hit->ng;
+        hit->obj = l->obj;
+        hit->texture = l->texture;
+        hit->prim = (unsigned)h.part;
+    } else {
+        return 0;
+    }
+    return isfinite(hit->t) && v3_finite(hit->p);
+}
+
+int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax)
+{
+    if (!a || !ray_ok(org, dir)) return 0;
+    double t0 = fmax(tmin, accel_epsilon(a, org, dir));
+    if (!(tmax > t0)) return 0;
+    accel_query q;
+    rtcInitIntersectContext(&q.rtc);
+    q.org = org;
+    q.dir = dir;
+    q.tmin = t0;
+    q.uhit = 0;
+    struct RTCRay r;
+    fill_rtc_ray(&r, org, dir, t0, tmax);
+    accel_query *saved = tls_query;
+    tls_query = &q;
+    rtcOccluded1(a->root, &q.rtc, &r);
+    tls_query = saved;
+    return r.tfar == -INFINITY;
+}
+
+void accel_bounds(const accel *a, vec3 *lo, vec3 *hi)
+{
+    if (lo) *lo = a ? a->lo : v3s(0.0);
+    if (hi) *hi = a ? a->hi : v3s(0.0);
+}
+
+double accel_scale(const accel *a) { return a ? a->scale : 1.0; }
+
+accel_stats accel_get_stats(const accel *a)
+{
+    accel_stats s;
+    memset(&s, 0, sizeof s);
+    return a ? a->stats : s;
+}
+
+void *accel_rtc_scene(const accel *a) { return a ? (void *)a->root : NULL; }

@@ -1,0 +1,555 @@
+/* accel_shapes.c - double-precision intersection of analytic shapes.
+ *
+ * Quadratics are solved in the cancellation-free form (roots q/a and c/q with
+ * q = -(b + sign(b) sqrt(disc)), Press et al., Numerical Recipes 5.6). For the
+ * sphere the discriminant is formed from the ray's perpendicular offset from
+ * the centre, which keeps it accurate for distant origins (Haines et al.,
+ * "Precision Improvements for Ray/Sphere Intersection", Ray Tracing Gems 2019).
+ * The torus quartic is solved by isolating roots between the roots of its
+ * derivatives, each bracket holding at most one root of a monotonic function
+ * (the approach of Yuksel, "High-Performance Polynomial Root Finding for
+ * Graphics", HPG 2022), after moving the ray origin to the torus' bounding
+ * box and scaling the torus to unit size, so coefficients stay O(1). */
+#include "accel_shapes.h"
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+#define TWO_PI 6.283185307179586476925
+
+/* ------------------------------------------------------------ polynomials */
+
+static double poly_eval(const double *c, int n, double x)
+{
+    double f = c[n];
+    for (int i = n - 1; i >= 0; i--) f = f * x + c[i];
+    return f;
+}
+
+/* f monotonic on [lo, hi] with f(lo) and f(hi) of opposite signs: Newton
+ * steps kept inside a shrinking bracket, falling back to bisection. */
+static double poly_refine(const double *c, int n, double lo, double hi, double flo)
+{
+    double width = hi - lo;
+    double x = 0.5 * (lo + hi);
+    for (int it = 0; it < 100; it++) {
+        double f = c[n], df = 0.0;
+        for (int i = n - 1; i >= 0; i--) {
+            df = df * x + f;
+            f = f * x + c[i];
+        }
+        if (f == 0.0) return x;
+        if ((f < 0.0) == (flo < 0.0)) lo = x; else hi = x;
+        double xn = (df != 0.0) ? x - f / df : 0.5 * (lo + hi);
+        if (!(xn > lo && xn < hi)) xn = 0.5 * (lo + hi);
+        double step = fabs(xn - x);
+        x = xn;
+        if (step <= 1e-15 * (fabs(x) + width) || hi - lo <= 1e-15 * (fabs(x) + width)) break;
+    }
+    return x;
+}
+
+static int add_root(double *roots, int nr, double r)
+{
+    if (nr > 0 && r <= roots[nr - 1]) return nr; /* duplicate at a bracket end */
+    roots[nr] = r;
+    return nr + 1;
+}
+
+int accel_poly_roots(const double *c, int n, double a, double b, double *roots)
+{
+    while (n > 0 && c[n] == 0.0) n--;
+    if (n <= 0 || !(a <= b)) return 0;
+    if (n == 1) {
+        double r = -c[0] / c[1];
+        if (r >= a && r <= b) { roots[0] = r; return 1; }
+        return 0;
+    }
+    if (n == 2) {
+        double A = c[2], B = c[1], C = c[0];
+        double disc = B * B - 4.0 * A * C;
+        if (disc < 0.0) return 0;
+        double q = -0.5 * (B + copysign(sqrt(disc), B));
+        double r0 = q / A, r1 = (q != 0.0) ? C / q : r0;
+        if (r0 > r1) { double t = r0; r0 = r1; r1 = t; }
+        int nr = 0;
+        if (r0 >= a && r0 <= b) roots[nr++] = r0;
+        if (r1 >= a && r1 <= b && (nr == 0 || r1 > roots[0])) roots[nr++] = r1;
+        return nr;
+    }
+    /* Critical points split [a, b] into monotonic brackets. */
+    double d[4], crit[4], xs[6];
+    for (int i = 0; i < n; i++) d[i] = (double)(i + 1) * c[i + 1];
+    int nc = accel_poly_roots(d, n - 1, a, b, crit);
+    xs[0] = a;
+    for (int i = 0; i < nc; i++) xs[i + 1] = crit[i];
+    xs[nc + 1] = b;
+    int nr = 0;
+    double f0 = poly_eval(c, n, a);
+    if (f0 == 0.0) nr = add_root(roots, nr, a);
+    for (int j = 0; j <= nc; j++) {
+        double x0 = xs[j], x1 = xs[j + 1];
+        double f1 = poly_eval(c, n, x1);
+        if (f1 == 0.0)
+            nr = add_root(roots, nr, x1);
+        else if (f0 != 0.0 && (f0 < 0.0) != (f1 < 0.0) && x1 > x0)
+            nr = add_root(roots, nr, poly_refine(c, n, x0, x1, f0));
+        f0 = f1;
+    }
+    return nr;
+}
+
+/* Real roots of a t^2 + 2 b t + c = 0 (note the half b), ascending. */
+static int quad_half(double a, double b, double c, double *t0, double *t1)
+{
+    if (a == 0.0) {
+        if (b == 0.0) return 0;
+        *t0 = *t1 = -c / (2.0 * b);
+        return 1;
+    }
+    double disc = b * b - a * c;
+    if (disc < 0.0) return 0;
+    double q = -(b + copysign(sqrt(disc), b));
+    double r0 = q / a, r1 = (q != 0.0) ? c / q : r0;
+    if (r0 > r1) { double t = r0; r0 = r1; r1 = t; }
+    *t0 = r0;
+    *t1 = r1;
+    return 2;
+}
+
+/* ------------------------------------------------------------ setup */
+
+static double det3(const double m[3][4])
+{
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+         - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+         + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+
+static void world_bounds(accel_shape *sh, vec3 lo, vec3 hi)
+{
+    vec3 wl = v3s(INFINITY), wh = v3s(-INFINITY);
+    for (int i = 0; i < 8; i++) {
+        vec3 p = v3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+        vec3 q = sh->identity ? p : xform_point(&sh->x, p);
+        wl = v3_min(wl, q);
+        wh = v3_max(wh, q);
+    }
+    sh->lo = wl;
+    sh->hi = wh;
+}
+
+/* Half extents of a disc of radius r with unit axis n, per coordinate. */
+static vec3 disc_extent(vec3 n, double r)
+{
+    return v3(r * sqrt(fmax(0.0, 1.0 - n.x * n.x)), r * sqrt(fmax(0.0, 1.0 - n.y * n.y)),
+              r * sqrt(fmax(0.0, 1.0 - n.z * n.z)));
+}
+
+static int finite_d(double x) { return isfinite(x); }
+
+int accel_shape_init(accel_shape *sh, const scene_object *o)
+{
+    memset(sh, 0, sizeof *sh);
+    sh->kind = o->kind;
+    sh->x = o->transform;
+    double det = det3(o->transform.m);
+    if (!isfinite(det) || det == 0.0) return -1;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 4; j++)
+            if (!isfinite(o->transform.m[i][j]) || !isfinite(o->transform.inv[i][j])) return -1;
+    sh->identity = xform_is_identity(&o->transform);
+    sh->open = (o->flags & OBJ_OPEN) != 0;
+    vec3 lo, hi;
+    switch (o->kind) {
+    case SHAPE_SPHERE: {
+        double r = fabs(o->u.sphere.radius);
+        vec3 c = o->u.sphere.centre;
+        if (!(r > 0.0) || !finite_d(r) || !v3_finite(c)) return -1;
+        sh->g.sphere.c = c;
+        sh->g.sphere.r = r;
+        lo = v3_sub(c, v3s(r));
+        hi = v3_add(c, v3s(r));
+        break;
+    }
+    case SHAPE_BOX: {
+        vec3 a = o->u.box.c1, b = o->u.box.c2;
+        if (!v3_finite(a) || !v3_finite(b)) return -1;
+        lo = sh->g.box.lo = v3_min(a, b);
+        hi = sh->g.box.hi = v3_max(a, b);
+        break;
+    }
+    case SHAPE_PLANE: {
+        vec3 n = o->u.plane.normal;
+        double l = v3_len(n);
+        if (!(l > 0.0) || !finite_d(l) || !finite_d(o->u.plane.offset)) return -1;
+        sh->g.plane.n = v3_scale(n, 1.0 / l);
+        sh->g.plane.d = o->u.plane.offset / l;
+        /* bounds come from accel_shape_clip_plane */
+        sh->lo = v3s(-1.0);
+        sh->hi = v3s(1.0);
+        return 0;
+    }
+    case SHAPE_CYLINDER:
+    case SHAPE_CONE: {
+        vec3 b = o->u.cone.base, c = o->u.cone.cap;
+        double r0 = fabs(o->u.cone.base_radius);
+        double r1 = fabs(o->u.cone.cap_radius);
+        if (o->kind == SHAPE_CYLINDER) { /* the IR gives equal radii; take whichever is set */
+            r0 = r0 > 0.0 ? r0 : r1;
+            r1 = r0;
+        }
+        vec3 ax = v3_sub(c, b);
+        double h = v3_len(ax);
+        if (!v3_finite(b) || !v3_finite(c) || !(h > 0.0) || !finite_d(h) || !finite_d(r0) || !finite_d(r1) ||
+            (r0 == 0.0 && r1 == 0.0))
+            return -1;
+        vec3 w = v3_scale(ax, 1.0 / h), u, v;
+        v3_basis(w, &u, &v);
+        sh->g.cone.base = b;
+        sh->g.cone.u = u;
+        sh->g.cone.v = v;
+        sh->g.cone.w = w;
+        sh->g.cone.h = h;
+        sh->g.cone.r0 = r0;
+        sh->g.cone.r1 = r1;
+        sh->g.cone.k = (r1 - r0) / h;
+        vec3 e0 = disc_extent(w, r0), e1 = disc_extent(w, r1);
+        lo = v3_min(v3_sub(b, e0), v3_sub(c, e1));
+        hi = v3_max(v3_add(b, e0), v3_add(c, e1));
+        break;
+    }
+    case SHAPE_DISC: {
+        vec3 c = o->u.disc.centre, n = o->u.disc.normal;
+        double l = v3_len(n), r = fabs(o->u.disc.radius), hr = fabs(o->u.disc.hole_radius);
+        if (!v3_finite(c) || !(l > 0.0) || !finite_d(l) || !(r > 0.0) || !finite_d(r) || !finite_d(hr))
+            return -1;
+        n = v3_scale(n, 1.0 / l);
+        sh->g.disc.c = c;
+        sh->g.disc.n = n;
+        sh->g.disc.r2 = r * r;
+        sh->g.disc.h2 = hr * hr;
+        vec3 e = disc_extent(n, r);
+        lo = v3_sub(c, e);
+        hi = v3_add(c, e);
+        break;
+    }
+    case SHAPE_TORUS: {
+        double R = fabs(o->u.torus.major), r = fabs(o->u.torus.minor);
+        if (!(R > 0.0) || !(r > 0.0) || !finite_d(R) || !finite_d(r)) return -1;
+        sh->g.torus.R = R;
+        sh->g.torus.r = r;
+        lo = v3(-(R + r), -r, -(R + r));
+        hi = v3(R + r, r, R + r);
+        break;
+    }
+    default:
+        return -1;
+    }
+    world_bounds(sh, lo, hi);
+    if (!v3_finite(sh->lo) || !v3_finite(sh->hi)) return -1;
+    return 0;
+}
+
+void accel_shape_clip_plane(accel_shape *sh, vec3 lo, vec3 hi)
+{
+    sh->clipped = 1;
+    sh->clip_lo = lo;
+    sh->clip_hi = hi;
+    sh->lo = lo;
+    sh->hi = hi;
+    /* An axis-aligned plane touches only a slice of the box. */
+    vec3 nw = v3_norm(sh->identity ? sh->g.plane.n : xform_normal(&sh->x, sh->g.plane.n));
+    vec3 p0 = v3_scale(sh->g.plane.n, sh->g.plane.d);
+    if (!sh->identity) p0 = xform_point(&sh->x, p0);
+    double a[3] = {fabs(nw.x), fabs(nw.y), fabs(nw.z)};
+    for (int i = 0; i < 3; i++) {
+        if (a[i] > 1.0 - 1e-15 && a[(i + 1) % 3] < 1e-15 && a[(i + 2) % 3] < 1e-15) {
+            double c = v3_idx(p0, i);
+            if (i == 0) sh->lo.x = sh->hi.x = c;
+            if (i == 1) sh->lo.y = sh->hi.y = c;
+            if (i == 2) sh->lo.z = sh->hi.z = c;
+        }
+    }
+}
+
+/* ------------------------------------------------------------ intersection */
+
+static int in_range(double t, double tmin, double tmax) { return t > tmin && t < tmax; }
+
+static int hit_sphere(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *h)
+{
+    vec3 oc = v3_sub(o, sh->g.sphere.c);
+    double r = sh->g.sphere.r;
+    double a = v3_dot(d, d);
+    double b = v3_dot(oc, d);
+    vec3 l = v3_madd(oc, d, -b / a); /* offset of the closest approach */
+    double disc = a * (r * r - v3_dot(l, l));
+    if (disc < 0.0) return 0;
+    double c = v3_dot(oc, oc) - r * r;
+    double q = -(b + copysign(sqrt(disc), b));
+    double t0 = q / a, t1 = (q != 0.0) ? c / q : t0;
+    if (t0 > t1) { double t = t0; t0 = t1; t1 = t; }
+    if (in_range(t0, tmin, tmax)) { h->t = t0; h->part = 0; return 1; }
+    if (in_range(t1, tmin, tmax)) { h->t = t1; h->part = 0; return 1; }
+    return 0;
+}
+
+/* Slab test; entry/exit with the face each happens on. */
+static int slabs(vec3 o, vec3 d, vec3 lo, vec3 hi, double *tn, int *fn, double *tf, int *ff)
+{
+    double t0 = -INFINITY, t1 = INFINITY;
+    int f0 = -1, f1 = -1;
+    for (int i = 0; i < 3; i++) {
+        double oi = v3_idx(o, i), di = v3_idx(d, i), l = v3_idx(lo, i), u = v3_idx(hi, i);
+        double inv = 1.0 / di;
+        if (di == 0.0 || !isfinite(inv)) {
+            if (oi < l || oi > u) return 0;
+            continue;
+        }
+        double ta = (l - oi) * inv, tb = (u - oi) * inv;
+        int fa = 2 * i, fb = 2 * i + 1;
+        if (ta > tb) {
+            double t = ta; ta = tb; tb = t;
+            int f = fa; fa = fb; fb = f;
+        }
+        if (ta > t0) { t0 = ta; f0 = fa; }
+        if (tb < t1) { t1 = tb; f1 = fb; }
+    }
+    if (!(t0 <= t1) || f0 < 0) return 0;
+    *tn = t0; *fn = f0; *tf = t1; *ff = f1;
+    return 1;
+}
+
+static int hit_box(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *h)
+{
+    double t0, t1;
+    int f0, f1;
+    if (!slabs(o, d, sh->g.box.lo, sh->g.box.hi, &t0, &f0, &t1, &f1)) return 0;
+    if (in_range(t0, tmin, tmax)) { h->t = t0; h->part = f0; return 1; }
+    if (in_range(t1, tmin, tmax)) { h->t = t1; h->part = f1; return 1; }
+    return 0;
+}
+
+static int in_box(vec3 p, vec3 lo, vec3 hi)
+{
+    return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
+}
+
+static int hit_plane(const accel_shape *sh, vec3 o, vec3 d, vec3 worg, vec3 wdir, double tmin, double tmax,
+                     accel_shape_hit *h)
+{
+    double den = v3_dot(sh->g.plane.n, d);
+    if (den == 0.0) return 0;
+    double t = (sh->g.plane.d - v3_dot(sh->g.plane.n, o)) / den;
+    if (!in_range(t, tmin, tmax)) return 0;
+    if (sh->clipped && !in_box(v3_madd(worg, wdir, t), sh->clip_lo, sh->clip_hi)) return 0;
+    h->t = t;
+    h->part = 0;
+    return 1;
+}
+
+static int hit_cone(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *h)
+{
+    vec3 rel = v3_sub(o, sh->g.cone.base);
+    double ox = v3_dot(rel, sh->g.cone.u), oy = v3_dot(rel, sh->g.cone.v), oz = v3_dot(rel, sh->g.cone.w);
+    double dx = v3_dot(d, sh->g.cone.u), dy = v3_dot(d, sh->g.cone.v), dz = v3_dot(d, sh->g.cone.w);
+    double H = sh->g.cone.h, k = sh->g.cone.k, r0 = sh->g.cone.r0;
+    double best = INFINITY;
+    int part = -1;
+    /* side: x^2 + y^2 = (r0 + k z)^2 for z in [0, H] */
+    double Ro = r0 + k * oz;
+    double a = dx * dx + dy * dy - k * k * dz * dz;
+    double b = ox * dx + oy * dy - k * Ro * dz;
+    double c = ox * ox + oy * oy - Ro * Ro;
+    double ts[2];
+    int n = quad_half(a, b, c, &ts[0], &ts[1]);
+    for (int i = 0; i < n; i++) {
+        double t = ts[i];
+        if (!in_range(t, tmin, tmax) || t >= best) continue;
+        double z = oz + t * dz;
+        if (z < 0.0 || z > H) continue;
+        best = t;
+        part = ACCEL_PART_CONE_SIDE;
+    }
+    if (!sh->open && dz != 0.0) {
+        for (int e = 0; e < 2; e++) {
+            double zc = e ? H : 0.0, rc = e ? sh->g.cone.r1 : r0;
+            if (rc <= 0.0) continue;
+            double t = (zc - oz) / dz;
+            if (!in_range(t, tmin, tmax) || t >= best) continue;
+            double x = ox + t * dx, y = oy + t * dy;
+            if (x * x + y * y > rc * rc) continue;
+            best = t;
+            part = e ? ACCEL_PART_CONE_CAP : ACCEL_PART_CONE_BASE;
+        }
+    }
+    if (part < 0) return 0;
+    h->t = best;
+    h->part = part;
+    return 1;
+}
+
+static int hit_disc(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *h)
+{
+    double den = v3_dot(sh->g.disc.n, d);
+    if (den == 0.0) return 0;
+    double t = v3_dot(sh->g.disc.n, v3_sub(sh->g.disc.c, o)) / den;
+    if (!in_range(t, tmin, tmax)) return 0;
+    double r2 = v3_len2(v3_sub(v3_madd(o, d, t), sh->g.disc.c));
+    if (r2 > sh->g.disc.r2 || r2 < sh->g.disc.h2) return 0;
+    h->t = t;
+    h->part = 0;
+    return 1;
+}
+
+static int hit_torus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *h)
+{
+    double s = v3_len(d);
+    if (!(s > 0.0) || !isfinite(s)) return 0;
+    double R = sh->g.torus.R, r = sh->g.torus.r;
+    double k = 1.0 / (R + r);
+    double sk = s * k;               /* tau = t * sk: distance in unit-torus space */
+    vec3 e = v3_scale(d, 1.0 / s);
+    vec3 o1 = v3_scale(o, k);
+    double R1 = R * k, r1 = r * k;   /* R1 + r1 = 1 */
+    double ta = tmin * sk, tb = tmax * sk;
+    double b0, b1;
+    int f0, f1;
+    if (!slabs(o1, e, v3(-1.0, -r1, -1.0), v3(1.0, r1, 1.0), &b0, &f0, &b1, &f1)) return 0;
+    double lo = fmax(ta, b0), hi = fmin(tb, b1);
+    if (!(lo < hi)) return 0;
+    vec3 q = v3_madd(o1, e, lo);
+    double G = v3_dot(q, q) + R1 * R1 - r1 * r1, f = v3_dot(q, e);
+    double A = e.x * e.x + e.z * e.z, B = q.x * e.x + q.z * e.z, C = q.x * q.x + q.z * q.z;
+    double c[5];
+    c[4] = 1.0;
+    c[3] = 4.0 * f;
+    c[2] = 4.0 * f * f + 2.0 * G - 4.0 * R1 * R1 * A;
+    c[1] = 4.0 * f * G - 8.0 * R1 * R1 * B;
+    c[0] = G * G - 4.0 * R1 * R1 * C;
+    double roots[4];
+    int n = accel_poly_roots(c, 4, 0.0, hi - lo, roots);
+    for (int i = 0; i < n; i++) {
+        double tau = lo + roots[i];
+        if (tau > ta && tau < tb) {
+            double t = tau / sk;
+            if (!in_range(t, tmin, tmax)) continue;
+            h->t = t;
+            h->part = 0;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+int accel_shape_intersect(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
+                          accel_shape_hit *h)
+{
+    vec3 o = org, d = dir;
+    if (!sh->identity) {
+        o = xform_inv_point(&sh->x, org);
+        d = xform_inv_vector(&sh->x, dir);
+    }
+    if (v3_len2(d) == 0.0) return 0;
+    switch (sh->kind) {
+    case SHAPE_SPHERE: return hit_sphere(sh, o, d, tmin, tmax, h);
+    case SHAPE_BOX: return hit_box(sh, o, d, tmin, tmax, h);
+    case SHAPE_PLANE: return hit_plane(sh, o, d, org, dir, tmin, tmax, h);
+    case SHAPE_CYLINDER:
+    case SHAPE_CONE: return hit_cone(sh, o, d, tmin, tmax, h);
+    case SHAPE_DISC: return hit_disc(sh, o, d, tmin, tmax, h);
+    case SHAPE_TORUS: return hit_torus(sh, o, d, tmin, tmax, h);
+    default: return 0;
+    }
+}
+
+/* ------------------------------------------------------------ surface data */
+
+static double wrap01(double a)
+{
+    double u = a / TWO_PI;
+    if (u < 0.0) u += 1.0;
+    return (u >= 1.0 || !isfinite(u)) ? 0.0 : u;
+}
+
+static double clamp01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : (isfinite(x) ? x : 0.0)); }
+
+void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, double *u, double *v)
+{
+    vec3 po = sh->identity ? p : xform_inv_point(&sh->x, p);
+    vec3 n = v3(0, 1, 0);
+    double su = 0.0, sv = 0.0;
+    switch (sh->kind) {
+    case SHAPE_SPHERE: {
+        n = v3_sub(po, sh->g.sphere.c);
+        vec3 un = v3_norm(n);
+        su = wrap01(atan2(un.z, un.x));
+        sv = clamp01(1.0 - acos(fmax(-1.0, fmin(1.0, un.y))) / (TWO_PI * 0.5));
+        break;
+    }
+    case SHAPE_BOX: {
+        int axis = part / 2;
+        double s = (part & 1) ? 1.0 : -1.0;
+        n = v3(axis == 0 ? s : 0.0, axis == 1 ? s : 0.0, axis == 2 ? s : 0.0);
+        vec3 ext = v3_sub(sh->g.box.hi, sh->g.box.lo);
+        vec3 f = v3_sub(po, sh->g.box.lo);
+        double fx = ext.x > 0 ? f.x / ext.x : 0, fy = ext.y > 0 ? f.y / ext.y : 0, fz = ext.z > 0 ? f.z / ext.z : 0;
+        su = clamp01(axis == 0 ? fz : fx);
+        sv = clamp01(axis == 1 ? fz : fy);
+        break;
+    }
+    case SHAPE_PLANE:
+        n = sh->g.plane.n;
+        break;
+    case SHAPE_CYLINDER:
+    case SHAPE_CONE: {
+        vec3 rel = v3_sub(po, sh->g.cone.base);
+        double x = v3_dot(rel, sh->g.cone.u), y = v3_dot(rel, sh->g.cone.v), z = v3_dot(rel, sh->g.cone.w);
+        su = wrap01(atan2(y, x));
+        if (part == ACCEL_PART_CONE_BASE) {
+            n = v3_neg(sh->g.cone.w);
+            sv = sh->g.cone.r0 > 0 ? clamp01(sqrt(x * x + y * y) / sh->g.cone.r0) : 0.0;
+        } else if (part == ACCEL_PART_CONE_CAP) {
+            n = sh->g.cone.w;
+            sv = sh->g.cone.r1 > 0 ? clamp01(sqrt(x * x + y * y) / sh->g.cone.r1) : 0.0;
+        } else {
+            double k = sh->g.cone.k, rz = sh->g.cone.r0 + k * z;
+            n = v3_add(v3_add(v3_scale(sh->g.cone.u, x), v3_scale(sh->g.cone.v, y)), v3_scale(sh->g.cone.w, -k * rz));
+            if (!(v3_len2(n) > 0.0)) n = v3_scale(sh->g.cone.w, k <= 0.0 ? 1.0 : -1.0); /* apex */
+            sv = clamp01(z / sh->g.cone.h);
+        }
+        break;
+    }
+    case SHAPE_DISC: {
+        n = sh->g.disc.n;
+        vec3 t, b, rel = v3_sub(po, sh->g.disc.c);
+        v3_basis(n, &t, &b);
+        su = wrap01(atan2(v3_dot(rel, b), v3_dot(rel, t)));
+        sv = clamp01(sqrt(v3_len2(rel) / sh->g.disc.r2));
+        break;
+    }
+    case SHAPE_TORUS: {
+        double R = sh->g.torus.R;
+        double rho = sqrt(po.x * po.x + po.z * po.z);
+        if (rho > 0.0) {
+            vec3 core = v3(po.x * R / rho, 0.0, po.z * R / rho);
+            n = v3_sub(po, core);
+        } else {
+            n = v3(0.0, po.y >= 0.0 ? 1.0 : -1.0, 0.0);
+        }
+        su = wrap01(atan2(po.z, po.x));
+        sv = wrap01(atan2(po.y, rho - R));
+        break;
+    }
+    default:
+        break;
+    }
+    vec3 nw = sh->identity ? n : xform_normal(&sh->x, n);
+    double l = v3_len(nw);
+    if (l > 0.0 && isfinite(l)) nw = v3_scale(nw, 1.0 / l);
+    else nw = v3(0.0, 1.0, 0.0);
+    *ng = nw;
+    *u = su;
+    *v = sv;
+}

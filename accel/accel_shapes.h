@@ -1,0 +1,63 @@
+/* accel_shapes.h - exact double-precision ray intersection with the analytic
+ * POV-Ray shapes (sphere, box, plane, cylinder, cone, disc, torus). Pure math:
+ * no Embree here; accel.c wraps these as Embree user geometry.
+ *
+ * Every shape is intersected in its object space: the world ray is mapped by
+ * the object's `inv` (direction not renormalised, so t is the same parameter
+ * in both spaces) and normals go back with the inverse transpose. */
+#ifndef PT_ACCEL_SHAPES_H
+#define PT_ACCEL_SHAPES_H
+#include "scene.h"
+
+/* Parts reported in accel_shape_hit.part (and accel_hit.prim). */
+enum {
+    ACCEL_PART_BOX_NX = 0, ACCEL_PART_BOX_PX, ACCEL_PART_BOX_NY,
+    ACCEL_PART_BOX_PY, ACCEL_PART_BOX_NZ, ACCEL_PART_BOX_PZ,
+    ACCEL_PART_CONE_SIDE = 0, ACCEL_PART_CONE_BASE = 1, ACCEL_PART_CONE_CAP = 2
+};
+
+typedef struct {
+    shape_kind kind;
+    int identity;      /* transform is the identity: skip the ray mapping */
+    int open;          /* cone/cylinder without end caps */
+    int clipped;       /* plane: hits outside [clip_lo, clip_hi] are rejected */
+    xform x;           /* object -> world */
+    union {
+        struct { vec3 c; double r; } sphere;
+        struct { vec3 lo, hi; } box;
+        struct { vec3 n; double d; } plane;      /* unit n, n.p = d */
+        struct { vec3 base, u, v, w; double h, r0, r1, k; } cone; /* frame: w along the axis */
+        struct { vec3 c, n; double r2, h2; } disc; /* unit n, squared radii */
+        struct { double R, r; } torus;           /* in the xz plane, axis y */
+    } g;
+    vec3 lo, hi;       /* world bounds (planes: the clip box) */
+    vec3 clip_lo, clip_hi;
+} accel_shape;
+
+typedef struct {
+    double t;
+    int part;
+} accel_shape_hit;
+
+/* Fill `sh` from a leaf object of an analytic kind. Returns 0 on success, -1
+ * when the object is degenerate (zero radius, singular transform, non-finite
+ * numbers) and should be skipped. World bounds are computed for finite shapes;
+ * planes get them from accel_shape_clip_plane. */
+int accel_shape_init(accel_shape *sh, const scene_object *o);
+/* Planes are infinite: limit one to the world box [lo, hi] (see accel.c for
+ * how that box is chosen) and set its bounds to the part of the box it can
+ * touch. */
+void accel_shape_clip_plane(accel_shape *sh, vec3 lo, vec3 hi);
+/* Nearest intersection with t in (tmin, tmax) of the world ray org + t*dir.
+ * Returns 1 and fills `h` on a hit. Never produces NaN for finite input. */
+int accel_shape_intersect(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
+                          accel_shape_hit *h);
+/* Surface data at world point p (on the shape, `part` from the hit): unit
+ * outward world normal and natural surface parameters in [0,1]. */
+void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, double *u, double *v);
+
+/* Real roots of c[0] + c[1] x + ... + c[n] x^n (n <= 4) inside [a, b], in
+ * ascending order; returns their number. Exposed for the unit tests. */
+int accel_poly_roots(const double *c, int n, double a, double b, double *roots);
+
+#endif
