@@ -15,6 +15,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -825,6 +827,42 @@ static void test_write_errors(void **state)
     fb_free(fb);
 }
 
+/* A write that fails half way (file size limit: EFBIG) leaves neither the
+ * destination nor the temporary file behind, for every format. */
+static void test_write_fails_midway(void **state)
+{
+    tmpdir *t = *state;
+    framebuffer *fb = varied_fb(200, 200, 0);
+    struct rlimit old, lim;
+    assert_int_equal(getrlimit(RLIMIT_FSIZE, &old), 0);
+    void (*oldsig)(int) = signal(SIGXFSZ, SIG_IGN);
+    lim = old;
+    lim.rlim_cur = 20000;
+    assert_int_equal(setrlimit(RLIMIT_FSIZE, &lim), 0);
+    static const char *names[] = {"big.exr", "big.png", "big.pfm"};
+    diag *d = diag_new();
+    for (int i = 0; i < 3; i++) {
+        img_write_opts o;
+        img_default_write_opts(&o);
+        o.exr_float = 1;
+        o.exr_compression = 0;
+        o.png_16bit = 1;
+        const char *p = tpath(t, names[i]);
+        int before = diag_errors(d);
+        pt_status st = img_write(p, fb, &o, d);
+        assert_int_equal(st, PT_ERR_IO);
+        assert_true(diag_errors(d) > before);
+        assert_true(diag_has(d, p));
+        assert_true(diag_has(d, "File too large"));
+        assert_false(file_exists(p));
+        assert_int_equal(count_entries(t->dir), 0);
+    }
+    assert_int_equal(setrlimit(RLIMIT_FSIZE, &old), 0);
+    signal(SIGXFSZ, oldsig);
+    diag_free(d);
+    fb_free(fb);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -846,6 +884,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_pfm_read_grey_big_endian, setup_dir, teardown_dir),
         cmocka_unit_test_setup_teardown(test_bad_files, setup_dir, teardown_dir),
         cmocka_unit_test_setup_teardown(test_write_errors, setup_dir, teardown_dir),
+        cmocka_unit_test_setup_teardown(test_write_fails_midway, setup_dir, teardown_dir),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
