@@ -114,11 +114,20 @@ static int64_t on_write(exr_const_context_t ctxt, void *ud, const void *buf, uin
 
 /* CIE 1931 xy chromaticities of the primaries and white point.
  * Rec. ITU-R BT.709-6 item 1.4 (also the sRGB primaries, IEC 61966-2-1),
- * white D65; ACES AP1 (SMPTE ST 2065-1 / Academy S-2014-004), white ~D60. */
+ * white D65; ACES AP1 (SMPTE ST 2065-1 / Academy S-2014-004), white ~D60;
+ * ACES AP0 (SMPTE ST 2065-1), the same white. */
 static const exr_attr_chromaticities_t primaries_table[] = {
     [IMG_PRIMARIES_REC709] = {0.640f, 0.330f, 0.300f, 0.600f, 0.150f, 0.060f, 0.3127f, 0.3290f},
     [IMG_PRIMARIES_ACESCG] = {0.713f, 0.293f, 0.165f, 0.830f, 0.128f, 0.044f, 0.32168f, 0.33767f},
+    [IMG_PRIMARIES_ACES2065_1] = {0.7347f, 0.2653f, 0.0f, 1.0f, 0.0001f, -0.0770f, 0.32168f, 0.33767f},
 };
+
+void img_exr_primaries(img_primaries prim, float xy[8])
+{
+    const exr_attr_chromaticities_t *c = &primaries_table[prim];
+    const float v[8] = {c->red_x, c->red_y, c->green_x, c->green_y, c->blue_x, c->blue_y, c->white_x, c->white_y};
+    memcpy(xy, v, sizeof v);
+}
 
 static exr_compression_t compression_of(int c)
 {
@@ -132,6 +141,14 @@ static exr_compression_t compression_of(int c)
 pt_status img_exr_write(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
                         img_primaries prim, diag *d)
 {
+    float xy[8];
+    img_exr_primaries(prim, xy);
+    return img_exr_write_xy(fd, name, fb, o, xy, d);
+}
+
+pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
+                           const float *xy, diag *d)
+{
     exr_msg[0] = '\0';
     exr_stream s = {fd, 0};
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
@@ -143,7 +160,6 @@ pt_status img_exr_write(int fd, const char *name, const framebuffer *fb, const i
     const int nch = fb->alpha ? 4 : 3;
     const int use_float = o && o->exr_float;
     const exr_pixel_type_t ptype = use_float ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF;
-    if ((unsigned)prim >= sizeof primaries_table / sizeof primaries_table[0]) prim = IMG_PRIMARIES_REC709;
 
     exr_context_t ctx = NULL;
     exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
@@ -162,8 +178,10 @@ pt_status img_exr_write(int fd, const char *name, const framebuffer *fb, const i
     static const char *const names[4] = {"R", "G", "B", "A"};
     for (int c = 0; c < nch && rv == EXR_ERR_SUCCESS; c++)
         rv = exr_add_channel(ctx, part, names[c], ptype, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
-    if (rv == EXR_ERR_SUCCESS)
-        rv = exr_attr_set_chromaticities(ctx, part, "chromaticities", &primaries_table[prim]);
+    if (rv == EXR_ERR_SUCCESS && xy) {
+        const exr_attr_chromaticities_t chr = {xy[0], xy[1], xy[2], xy[3], xy[4], xy[5], xy[6], xy[7]};
+        rv = exr_attr_set_chromaticities(ctx, part, "chromaticities", &chr);
+    }
     if (rv != EXR_ERR_SUCCESS) goto fail;
     for (int i = 0; o && i < o->nmeta; i++) {
         const char *k = o->meta_keys[i], *v = o->meta_values[i];
@@ -364,15 +382,18 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
     rv = exr_get_channels(ctx, 0, &chl);
     if (rv != EXR_ERR_SUCCESS) goto libfail;
     int have[NSLOTS] = {0};
+    int chroma = 0, sub_y = 0;
     for (int i = 0; i < chl->num_channels; i++) {
         const exr_attr_chlist_entry_t *e = &chl->entries[i];
         const char *n = e->name.str;
+        if (n && (strcmp(n, "RY") == 0 || strcmp(n, "BY") == 0)) chroma = 1;
         if (e->name.length != 1 || !n) continue;
         int slot = n[0] == 'R' ? SLOT_R : n[0] == 'G' ? SLOT_G : n[0] == 'B' ? SLOT_B : n[0] == 'A' ? SLOT_A
                  : n[0] == 'Y' ? SLOT_Y : -1;
         if (slot < 0) continue;
         if (e->x_sampling != 1 || e->y_sampling != 1) {
-            if (slot == SLOT_Y || slot == SLOT_A) continue; /* reported below if it matters */
+            if (slot == SLOT_Y) sub_y = 1;
+            if (slot == SLOT_Y || slot == SLOT_A) continue; /* Y: reported below if it matters */
             report(d, "cannot read '%s': subsampled channel '%s' is not supported", path, n);
             goto done;
         }
@@ -380,8 +401,15 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
     }
     const int use_y = !have[SLOT_R] && !have[SLOT_G] && !have[SLOT_B] && have[SLOT_Y];
     if (!have[SLOT_R] && !have[SLOT_G] && !have[SLOT_B] && !have[SLOT_Y]) {
-        report(d, "cannot read '%s': no R, G, B or Y channel (of %d channels)", path, chl->num_channels);
+        if (sub_y)
+            report(d, "cannot read '%s': subsampled luminance channel 'Y' is not supported", path);
+        else
+            report(d, "cannot read '%s': no R, G, B or Y channel (of %d channels)", path, chl->num_channels);
         goto done;
+    }
+    if (use_y && chroma) {
+        src_loc none = {NULL, 0, 0};
+        diag_warn_once(d, none, "'%s': luminance/chroma EXR read as greyscale (RY/BY ignored)", path);
     }
     fb = fb_new(w, h);
     if (fb && have[SLOT_A]) fb->alpha = calloc((size_t)w * (size_t)h, sizeof(float));

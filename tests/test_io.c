@@ -316,6 +316,19 @@ static void test_exr_metadata(void **state)
     assert_int_equal(chl->num_channels, 3);
     assert_int_equal(chl->entries[0].pixel_type, EXR_PIXEL_HALF);
     exr_finish(&ctx);
+
+    /* A key that names a required attribute of another type cannot be set:
+     * an I/O error, and nothing is left behind. */
+    const char *badk[] = {"compression"};
+    const char *badv[] = {"zip"};
+    o.meta_keys = badk;
+    o.meta_values = badv;
+    o.nmeta = 1;
+    const char *q = tpath(t, "bad.exr");
+    assert_int_equal(img_write(q, fb, &o, d), PT_ERR_IO);
+    assert_true(diag_has(d, "compression"));
+    assert_false(file_exists(q));
+    assert_int_equal(count_entries(t->dir), 1);
     diag_free(d);
     fb_free(fb);
 }
@@ -427,6 +440,7 @@ static void test_exr_read_y_only(void **state)
     framebuffer *in = NULL;
     diag *d = diag_new();
     assert_int_equal(img_read(p, 0, &in, d), PT_OK);
+    assert_int_equal(diag_count(d), 0);
     assert_int_equal(in->width, 21);
     assert_int_equal(in->height, 19);
     for (int y = 0; y < 19; y++)
@@ -543,6 +557,26 @@ static void test_png_codes(void **state)
     assert_int_equal(code[8], 124); /* 0.484529 * 255 = 123.55 */
     assert_int_equal(code[9], 10);  /* 0.0404499 * 255 = 10.31 */
     fb_free(in);
+    /* The file carries an sRGB chunk with perceptual intent (0) and the
+     * matching gAMA (1/2.2 -> 45455); chunk = length, type, data, CRC. */
+    FILE *f = fopen(p, "rb");
+    assert_non_null(f);
+    unsigned char buf[4096];
+    size_t n = fread(buf, 1, sizeof buf, f);
+    fclose(f);
+    int found_srgb = 0, found_gama = 0;
+    for (size_t i = 8; i + 12 <= n;) {
+        uint32_t len = (uint32_t)buf[i] << 24 | (uint32_t)buf[i + 1] << 16 | (uint32_t)buf[i + 2] << 8 | buf[i + 3];
+        const unsigned char *ty = buf + i + 4, *data = buf + i + 8;
+        if (!memcmp(ty, "sRGB", 4) && len == 1 && data[0] == 0) found_srgb = 1;
+        if (!memcmp(ty, "gAMA", 4) && len == 4 &&
+            ((uint32_t)data[0] << 24 | (uint32_t)data[1] << 16 | (uint32_t)data[2] << 8 | data[3]) == 45455)
+            found_gama = 1;
+        if (!memcmp(ty, "IDAT", 4)) break;
+        i += 12 + len;
+    }
+    assert_true(found_srgb);
+    assert_true(found_gama);
     diag_free(d);
     fb_free(fb);
 }
