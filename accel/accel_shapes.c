@@ -416,7 +416,12 @@ static int hit_torus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
     double ta = tmin * sk, tb = tmax * sk;
     double b0, b1;
     int f0, f1;
-    if (!slabs(o1, e, v3(-1.0, -r1, -1.0), v3(1.0, r1, 1.0), &b0, &f0, &b1, &f1)) return 0;
+    /* The box is padded so that no root sits exactly on a bracket end (the
+     * tube touches the tight box, and a root at sigma = 0 could be lost to
+     * rounding in the sign test). */
+    const double pad = 0.01;
+    if (!slabs(o1, e, v3(-1.0 - pad, -r1 - pad, -1.0 - pad), v3(1.0 + pad, r1 + pad, 1.0 + pad), &b0, &f0, &b1, &f1))
+        return 0;
     double lo = fmax(ta, b0), hi = fmin(tb, b1);
     if (!(lo < hi)) return 0;
     vec3 q = v3_madd(o1, e, lo);

@@ -1,0 +1,1004 @@
+/* test_accel.c - Embree scene build and ray queries against closed-form
+ * answers: every analytic shape, triangles, meshes and instances, grazing
+ * rays, self-intersection, scale invariance, no_shadow, mesh textures.
+ * Tolerances: distances 1e-9 relative for analytic shapes (double precision
+ * end to end), 1e-6 relative for triangles (refined from Embree's float hit),
+ * normals 1e-9 (analytic) / 1e-6 (triangles). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <embree3/rtcore.h>
+#include "accel.h"
+#include "accel_shapes.h"
+#include "diag.h"
+#include "pool.h"
+#include "rng.h"
+#include "scene.h"
+
+static const src_loc here = {"test.pov", 1, 1};
+
+static void assert_near(double a, double b, double tol)
+{
+    if (!(fabs(a - b) <= tol)) fail_msg("got %.17g, expected %.17g (tol %g)", a, b, tol);
+}
+
+static void assert_vec(vec3 a, vec3 b, double tol)
+{
+    if (!(fabs(a.x - b.x) <= tol && fabs(a.y - b.y) <= tol && fabs(a.z - b.z) <= tol))
+        fail_msg("got <%.12g,%.12g,%.12g>, expected <%.12g,%.12g,%.12g> (tol %g)", a.x, a.y, a.z, b.x, b.y, b.z, tol);
+}
+
+static void assert_hit_sane(const accel_hit *h)
+{
+    assert_true(isfinite(h->t));
+    assert_true(v3_finite(h->p));
+    assert_true(v3_finite(h->ng));
+    assert_true(v3_finite(h->ns));
+    assert_near(v3_len(h->ng), 1.0, 1e-9);
+    assert_near(v3_len(h->ns), 1.0, 1e-9);
+    assert_true(v3_dot(h->ng, h->ns) >= 0.0);
+    assert_true(isfinite(h->u) && isfinite(h->v));
+    assert_non_null(h->obj);
+    assert_non_null(h->texture);
+}
+
+static scene_object *add_obj(scene *s, shape_kind k)
+{
+    scene_object *o = scene_new_object(s, k, here);
+    assert_non_null(o);
+    assert_int_equal(scene_add_object(s, o), PT_OK);
+    return o;
+}
+
+static scene_object *sphere(scene *s, vec3 c, double r)
+{
+    scene_object *o = add_obj(s, SHAPE_SPHERE);
+    o->name = "sphere";
+    o->u.sphere.centre = c;
+    o->u.sphere.radius = r;
+    return o;
+}
+
+static scene_object *box(scene *s, vec3 a, vec3 b)
+{
+    scene_object *o = add_obj(s, SHAPE_BOX);
+    o->name = "box";
+    o->u.box.c1 = a;
+    o->u.box.c2 = b;
+    return o;
+}
+
+static scene_object *triangle(scene *s, vec3 a, vec3 b, vec3 c)
+{
+    scene_object *o = add_obj(s, SHAPE_TRIANGLE);
+    o->name = "triangle";
+    o->u.triangle.v[0] = a;
+    o->u.triangle.v[1] = b;
+    o->u.triangle.v[2] = c;
+    return o;
+}
+
+static accel *build(const scene *s, diag *d)
+{
+    pt_status st = PT_ERR_INTERNAL;
+    accel *a = accel_build(s, 2, d, &st);
+    if (st != PT_OK) {
+        for (int i = 0; i < diag_count(d); i++) {
+            char *m = diag_format(diag_get(d, i));
+            print_error("%s\n", m);
+            free(m);
+        }
+    }
+    assert_int_equal(st, PT_OK);
+    assert_non_null(a);
+    return a;
+}
+
+/* Hit with tolerance checks on distance and normal. */
+static void expect_hit(const accel *a, vec3 org, vec3 dir, double t, vec3 n, double ttol, double ntol, accel_hit *out)
+{
+    accel_hit h;
+    if (!accel_intersect(a, org, dir, 0.0, INFINITY, &h))
+        fail_msg("expected a hit at t=%g from <%g,%g,%g>", t, org.x, org.y, org.z);
+    assert_hit_sane(&h);
+    assert_near(h.t, t, ttol * fmax(1.0, fabs(t)));
+    assert_vec(h.ng, n, ntol);
+    assert_vec(h.p, v3_madd(org, dir, h.t), 1e-12 * (1.0 + v3_len(h.p)));
+    if (out) *out = h;
+}
+
+static void expect_miss(const accel *a, vec3 org, vec3 dir)
+{
+    accel_hit h;
+    if (accel_intersect(a, org, dir, 0.0, INFINITY, &h))
+        fail_msg("expected a miss from <%g,%g,%g> dir <%g,%g,%g>, got t=%g", org.x, org.y, org.z, dir.x, dir.y,
+                 dir.z, h.t);
+}
+
+/* ------------------------------------------------------------ shapes */
+
+static void test_sphere(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    scene_object *o = sphere(s, v3(0, 0, 5), 1);
+    /* a second, transformed sphere: unit sphere scaled by 2 then moved to x=10 */
+    scene_object *o2 = sphere(s, v3(0, 0, 0), 1);
+    o2->transform = xform_then(xform_scale(v3(2, 2, 2)), xform_translate(v3(10, 0, 0)));
+    accel *a = build(s, d);
+    accel_hit h;
+    /* from outside along the axis */
+    expect_hit(a, v3(0, 0, 0), v3(0, 0, 1), 4.0, v3(0, 0, -1), 1e-12, 1e-12, &h);
+    assert_ptr_equal(h.obj, o);
+    assert_ptr_equal(h.texture, &s->default_texture);
+    /* off axis: x = 0.6 gives z = 5 - 0.8 */
+    expect_hit(a, v3(0.6, 0, 0), v3(0, 0, 1), 4.2, v3(0.6, 0, -0.8), 1e-12, 1e-12, NULL);
+    /* unnormalised direction: t is the ray parameter */
+    expect_hit(a, v3(0, 0, 0), v3(0, 0, 2), 2.0, v3(0, 0, -1), 1e-12, 1e-12, NULL);
+    /* from inside (the centre): exit point, outward normal (not flipped) */
+    expect_hit(a, v3(0, 0, 5), v3(1, 0, 0), 1.0, v3(1, 0, 0), 1e-12, 1e-12, NULL);
+    expect_hit(a, v3(0, 0, 5), v3(0, -1, 0), 1.0, v3(0, -1, 0), 1e-12, 1e-12, NULL);
+    /* transformed sphere: radius 2 at x=10 */
+    expect_hit(a, v3(10, 0, -10), v3(0, 0, 1), 8.0, v3(0, 0, -1), 1e-12, 1e-12, &h);
+    assert_ptr_equal(h.obj, o2);
+    expect_hit(a, v3(10, 10, 0), v3(0, -1, 0), 8.0, v3(0, 1, 0), 1e-12, 1e-12, NULL);
+    /* tmax cuts the hit off, tmin skips the first one */
+    assert_false(accel_intersect(a, v3(0, 0, 0), v3(0, 0, 1), 0.0, 3.9, &h));
+    assert_true(accel_intersect(a, v3(0, 0, 0), v3(0, 0, 1), 4.5, INFINITY, &h));
+    assert_near(h.t, 6.0, 1e-12);
+    assert_vec(h.ng, v3(0, 0, 1), 1e-12);
+    expect_miss(a, v3(0, 2, 0), v3(0, 0, 1));
+    accel_stats stt = accel_get_stats(a);
+    assert_int_equal(stt.user_prims, 2);
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+static void test_box_faces(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    box(s, v3(-1, -2, -3), v3(1, 2, 3));
+    accel *a = build(s, d);
+    accel_hit h;
+    expect_hit(a, v3(-10, 0.5, 0.5), v3(1, 0, 0), 9.0, v3(-1, 0, 0), 1e-12, 0, &h);
+    assert_int_equal(h.prim, ACCEL_PART_BOX_NX);
+    expect_hit(a, v3(10, 0.5, 0.5), v3(-1, 0, 0), 9.0, v3(1, 0, 0), 1e-12, 0, &h);
+    assert_int_equal(h.prim, ACCEL_PART_BOX_PX);
+    expect_hit(a, v3(0.5, -10, 0.5), v3(0, 1, 0), 8.0, v3(0, -1, 0), 1e-12, 0, NULL);
+    expect_hit(a, v3(0.5, 10, 0.5), v3(0, -1, 0), 8.0, v3(0, 1, 0), 1e-12, 0, NULL);
+    expect_hit(a, v3(0.5, 0.5, -10), v3(0, 0, 1), 7.0, v3(0, 0, -1), 1e-12, 0, NULL);
+    expect_hit(a, v3(0.5, 0.5, 10), v3(0, 0, -1), 7.0, v3(0, 0, 1), 1e-12, 0, NULL);
+    /* diagonal entry through the +y face */
+    expect_hit(a, v3(0, 4, 0), v3(0.1, -1, 0.1), 2.0, v3(0, 1, 0), 1e-12, 0, NULL);
+    /* from inside: the exit face */
+    expect_hit(a, v3(0, 0, 0), v3(0, 0, 1), 3.0, v3(0, 0, 1), 1e-12, 0, NULL);
+    expect_hit(a, v3(0, 0, 0), v3(-1, 0, 0), 1.0, v3(-1, 0, 0), 1e-12, 0, NULL);
+    /* parallel to a slab, outside it: miss (no 0*inf NaN) */
+    expect_miss(a, v3(-10, 5, 0), v3(1, 0, 0));
+    /* rotated box: rotate 90 about z maps the x half-size 1 onto y */
+    scene *s2 = scene_new();
+    scene_object *o = box(s2, v3(-1, -2, -3), v3(1, 2, 3));
+    o->transform = xform_rotate(v3(0, 0, 90));
+    accel *a2 = build(s2, d);
+    expect_hit(a2, v3(0, 10, 0), v3(0, -1, 0), 9.0, v3(0, 1, 0), 1e-12, 1e-12, NULL);
+    expect_hit(a2, v3(10, 0, 0), v3(-1, 0, 0), 8.0, v3(1, 0, 0), 1e-12, 1e-12, NULL);
+    accel_free(a2);
+    scene_free(s2);
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+static void test_plane(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    scene_object *p = add_obj(s, SHAPE_PLANE);
+    p->u.plane.normal = v3(0, 1, 0);
+    p->u.plane.offset = 1.0; /* y = 1 */
+    sphere(s, v3(0, 5, 0), 0.5);
+    accel *a = build(s, d);
+    /* both sides: normal is the plane's, not flipped */
+    expect_hit(a, v3(3, -3, 0), v3(0, 1, 0), 4.0, v3(0, 1, 0), 1e-12, 0, NULL);
+    expect_hit(a, v3(3, 3, 0), v3(0, -1, 0), 2.0, v3(0, 1, 0), 1e-12, 0, NULL);
+    expect_hit(a, v3(0, 3, 0), v3(1, -1, 0), 2.0, v3(0, 1, 0), 1e-12, 0, NULL);
+    /* parallel: miss */
+    expect_miss(a, v3(0, 3, 0), v3(1, 0, 0));
+    /* a far hit, 1000 scene sizes away, at a grazing angle */
+    double sc = accel_scale(a);
+    vec3 dir = v3(1, -2.0 / (1000.0 * sc), 0);
+    expect_hit(a, v3(0, 3, 0), dir, 1000.0 * sc, v3(0, 1, 0), 1e-9, 0, NULL);
+    /* bounds exclude the plane: they are the sphere's */
+    vec3 lo, hi;
+    accel_bounds(a, &lo, &hi);
+    assert_vec(lo, v3(-0.5, 4.5, -0.5), 1e-12);
+    assert_vec(hi, v3(0.5, 5.5, 0.5), 1e-12);
+    assert_near(accel_scale(a), sqrt(3.0), 1e-12);
+    accel_free(a);
+    /* a rotated, non-normalised plane: normal <0,2,0>, offset 2 -> y = 1, then rotate 90 about z -> x = -1 */
+    scene *s2 = scene_new();
+    p = add_obj(s2, SHAPE_PLANE);
+    p->u.plane.normal = v3(0, 2, 0);
+    p->u.plane.offset = 2.0;
+    p->transform = xform_rotate(v3(0, 0, 90));
+    a = build(s2, d);
+    expect_hit(a, v3(5, 0.3, 0.2), v3(-1, 0, 0), 6.0, v3(-1, 0, 0), 1e-12, 1e-12, NULL);
+    expect_hit(a, v3(-5, 0.3, 0.2), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12, NULL);
+    accel_free(a);
+    scene_free(s2);
+    diag_free(d);
+    scene_free(s);
+}
+
+static void test_triangles(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    scene_object *t = triangle(s, v3(0, 0, 5), v3(1, 0, 5), v3(0, 1, 5));
+    scene_object *sm = add_obj(s, SHAPE_SMOOTH_TRIANGLE);
+    sm->u.triangle.v[0] = v3(10, 0, 5);
+    sm->u.triangle.v[1] = v3(11, 0, 5);
+    sm->u.triangle.v[2] = v3(10, 1, 5);
+    sm->u.triangle.n[0] = v3(0, 0, 1);
+    sm->u.triangle.n[1] = v3(1, 0, 1);
+    sm->u.triangle.n[2] = v3(0, 1, 1);
+    /* a transformed triangle: scaled by 2 and mirrored in x (winding follows world) */
+    scene_object *tm = triangle(s, v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0));
+    tm->transform = xform_then(xform_scale(v3(-2, 2, 2)), xform_translate(v3(-10, 0, 7)));
+    scene_texture *tex = scene_new_texture(s);
+    t->texture = tex;
+    accel *a = build(s, d);
+    accel_hit h;
+    expect_hit(a, v3(0.25, 0.25, 0), v3(0, 0, 1), 5.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
+    assert_ptr_equal(h.obj, t);
+    assert_ptr_equal(h.texture, tex);
+    assert_near(h.u, 0.25, 1e-6);
+    assert_near(h.v, 0.25, 1e-6);
+    assert_vec(h.ns, h.ng, 1e-12);
+    /* back side: same normal */
+    expect_hit(a, v3(0.25, 0.25, 9), v3(0, 0, -1), 4.0, v3(0, 0, 1), 1e-6, 1e-6, NULL);
+    /* smooth: at barycentrics (u,v) = (0.5, 0.25) normal = .25 n0 + .5 n1 + .25 n2 */
+    expect_hit(a, v3(10.5, 0.25, 0), v3(0, 0, 1), 5.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
+    assert_ptr_equal(h.obj, sm);
+    assert_vec(h.ns, v3_norm(v3(0.5, 0.25, 1.0)), 1e-6);
+    /* mirrored: world vertices (-10,0,7), (-12,0,7), (-10,2,7): cross gives -z */
+    expect_hit(a, v3(-10.5, 0.5, 0), v3(0, 0, 1), 7.0, v3(0, 0, -1), 1e-6, 1e-6, &h);
+    assert_ptr_equal(h.obj, tm);
+    expect_miss(a, v3(0.75, 0.75, 0), v3(0, 0, 1));
+    accel_stats stt = accel_get_stats(a);
+    assert_int_equal(stt.triangles, 3);
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+/* A unit square in the xy plane (z = 0) made of two triangles, with
+ * per-vertex normals tilted and per-triangle textures. */
+static scene_mesh *quad_mesh(scene *s, const scene_texture *t0, const scene_texture *t1)
+{
+    scene_mesh *m = scene_new_mesh(s);
+    m->nverts = 4;
+    m->ntris = 2;
+    m->verts = arena_alloc(s->mem, sizeof(float[3]) * 4);
+    m->tris = arena_alloc(s->mem, sizeof(int[3]) * 2);
+    float v[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    memcpy(m->verts, v, sizeof v);
+    int tr[2][3] = {{0, 1, 2}, {0, 2, 3}};
+    memcpy(m->tris, tr, sizeof tr);
+    if (t0) {
+        m->ntextures = 2;
+        m->textures = arena_alloc(s->mem, sizeof(scene_texture *) * 2);
+        m->textures[0] = t0;
+        m->textures[1] = t1;
+        m->tri_texture = arena_alloc(s->mem, sizeof(int) * 2);
+        m->tri_texture[0] = 0;
+        m->tri_texture[1] = 1;
+    }
+    return m;
+}
+
+static scene_object *mesh_obj(scene *s, const scene_mesh *m, xform x)
+{
+    scene_object *o = add_obj(s, SHAPE_MESH);
+    o->name = "mesh";
+    o->u.mesh.mesh = m;
+    o->transform = x;
+    ((scene_mesh *)m)->uses++;
+    return o;
+}
+
+static void test_mesh_instances(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    scene_mesh *m = quad_mesh(s, NULL, NULL);
+    /* first instance at z = 5; second scaled by 2 at z = 10 */
+    scene_object *i1 = mesh_obj(s, m, xform_translate(v3(0, 0, 5)));
+    scene_object *i2 = mesh_obj(s, m, xform_then(xform_scale(v3(2, 2, 2)), xform_translate(v3(0, 0, 10))));
+    /* a single-use mesh: flattened */
+    scene_mesh *m2 = quad_mesh(s, NULL, NULL);
+    scene_object *f = mesh_obj(s, m2, xform_then(xform_rotate(v3(90, 0, 0)), xform_translate(v3(0, 20, 0))));
+    accel *a = build(s, d);
+    accel_stats stt = accel_get_stats(a);
+    assert_int_equal(stt.instances, 2);
+    assert_int_equal(stt.triangles, 4); /* shared mesh once + flattened */
+    accel_hit h;
+    /* (0.25, 0.75) lies in the second triangle of the first instance */
+    expect_hit(a, v3(0.25, 0.75, -1), v3(0, 0, 1), 6.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
+    assert_ptr_equal(h.obj, i1);
+    assert_int_equal(h.prim, 1);
+    assert_true(accel_intersect(a, v3(0.25, 0.75, -1), v3(0, 0, 1), 6.5, INFINITY, &h));
+    assert_hit_sane(&h);
+    assert_ptr_equal(h.obj, i2);
+    assert_near(h.t, 11.0, 1e-6 * 11);
+    assert_vec(h.ng, v3(0, 0, 1), 1e-6);
+    /* only the scaled instance covers x = 1.5 */
+    expect_hit(a, v3(1.5, 0.5, -1), v3(0, 0, 1), 11.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
+    assert_ptr_equal(h.obj, i2);
+    assert_int_equal(h.prim, 0);
+    /* flattened mesh: rotate 90 about x takes the xy square to xz at y = 20 (z in [0,1]); +z normal goes to -y */
+    expect_hit(a, v3(0.5, 30, 0.5), v3(0, -1, 0), 10.0, v3(0, -1, 0), 1e-6, 1e-6, &h);
+    assert_ptr_equal(h.obj, f);
+    vec3 lo, hi;
+    accel_bounds(a, &lo, &hi);
+    assert_vec(lo, v3(0, 0, 0), 1e-6);
+    assert_vec(hi, v3(2, 20, 10), 1e-6);
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+static void test_mesh_textures_normals(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    scene_texture *t0 = scene_new_texture(s), *t1 = scene_new_texture(s), *to = scene_new_texture(s);
+    scene_mesh *m = quad_mesh(s, t0, t1);
+    /* normals: one per vertex, tilted */
+    m->nnormals = 4;
+    m->normals = arena_alloc(s->mem, sizeof(float[3]) * 4);
+    float n[4][3] = {{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    memcpy(m->normals, n, sizeof n);
+    m->tri_normals = arena_alloc(s->mem, sizeof(int[3]) * 2);
+    int tn[2][3] = {{0, 1, 2}, {0, 2, 3}};
+    memcpy(m->tri_normals, tn, sizeof tn);
+    /* used twice (instanced) and once more as a separate single-use copy */
+    scene_object *a1 = mesh_obj(s, m, xform_translate(v3(0, 0, 5)));
+    a1->texture = to;
+    mesh_obj(s, m, xform_translate(v3(5, 0, 5)));
+    scene_mesh *m2 = quad_mesh(s, t0, t1);
+    m2->tri_texture[1] = 7; /* out of range: falls back to the object's texture */
+    scene_object *b = mesh_obj(s, m2, xform_translate(v3(10, 0, 5)));
+    b->texture = to;
+    accel *a = build(s, d);
+    accel_hit h;
+    expect_hit(a, v3(0.75, 0.25, 0), v3(0, 0, 1), 5.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
+    assert_ptr_equal(h.texture, t0);
+    /* shading normal: barycentrics u=0.5 (v1), v=0.25 (v2): .25 n0 + .5 n1 + .25 n2 */
+    assert_vec(h.ns, v3_norm(v3(0.75, 0.25, 1.0)), 1e-6);
+    expect_hit(a, v3(0.25, 0.75, 0), v3(0, 0, 1), 5.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
+    assert_ptr_equal(h.texture, t1);
+    expect_hit(a, v3(5.25, 0.75, 0), v3(0, 0, 1), 5.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
+    assert_ptr_equal(h.texture, t1);
+    expect_hit(a, v3(10.75, 0.25, 0), v3(0, 0, 1), 5.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
+    assert_ptr_equal(h.texture, t0);
+    expect_hit(a, v3(10.25, 0.75, 0), v3(0, 0, 1), 5.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
+    assert_ptr_equal(h.texture, to);
+    assert_int_equal(accel_get_stats(a).instances, 2);
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+static scene_object *cone(scene *s, shape_kind k, vec3 b, double rb, vec3 c, double rc)
+{
+    scene_object *o = add_obj(s, k);
+    o->name = k == SHAPE_CONE ? "cone" : "cylinder";
+    o->u.cone.base = b;
+    o->u.cone.cap = c;
+    o->u.cone.base_radius = rb;
+    o->u.cone.cap_radius = rc;
+    return o;
+}
+
+static void test_cylinder_cone(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    cone(s, SHAPE_CYLINDER, v3(0, 0, 0), 1, v3(0, 2, 0), 1);
+    scene_object *op = cone(s, SHAPE_CYLINDER, v3(10, 0, 0), 1, v3(10, 2, 0), 1);
+    op->flags |= OBJ_OPEN;
+    cone(s, SHAPE_CONE, v3(20, 0, 0), 1, v3(20, 2, 0), 0);
+    /* a truncated cone along x, radii 1 -> 2 */
+    cone(s, SHAPE_CONE, v3(30, 0, 0), 1, v3(34, 0, 0), 2);
+    accel *a = build(s, d);
+    accel_hit h;
+    expect_hit(a, v3(-5, 1, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12, &h);
+    assert_int_equal(h.prim, ACCEL_PART_CONE_SIDE);
+    expect_hit(a, v3(0.5, 5, 0), v3(0, -1, 0), 3.0, v3(0, 1, 0), 1e-12, 1e-12, &h);
+    assert_int_equal(h.prim, ACCEL_PART_CONE_CAP);
+    expect_hit(a, v3(0.5, -5, 0), v3(0, 1, 0), 5.0, v3(0, -1, 0), 1e-12, 1e-12, &h);
+    assert_int_equal(h.prim, ACCEL_PART_CONE_BASE);
+    /* from inside: the side at the exit */
+    expect_hit(a, v3(0, 1, 0), v3(0, 0, 1), 1.0, v3(0, 0, 1), 1e-12, 1e-12, NULL);
+    /* diagonal through side and cap: from (0,1,-3) towards (0,3,1)... enters side at z=-1, y=1.5 */
+    expect_hit(a, v3(0, 1, -3), v3(0, 0.25, 1), 2.0, v3(0, 0, -1), 1e-12, 1e-12, NULL);
+    /* open cylinder: down the axis misses; from inside through the open end: hits nothing */
+    expect_miss(a, v3(10, 5, 0), v3(0, -1, 0));
+    expect_hit(a, v3(10, 1, 0), v3(1, 0, 0), 1.0, v3(1, 0, 0), 1e-12, 1e-12, NULL);
+    /* cone apex up: at y = 1 the radius is 0.5; normal (-2,1,0)/sqrt5 */
+    expect_hit(a, v3(15, 1, 0), v3(1, 0, 0), 4.5, v3_norm(v3(-2, 1, 0)), 1e-12, 1e-12, NULL);
+    expect_hit(a, v3(20.25, -5, 0), v3(0, 1, 0), 5.0, v3(0, -1, 0), 1e-12, 1e-12, NULL);
+    /* truncated cone along x: at x = 32 radius 1.5; normal (-1/4, 1, 0) normalised */
+    expect_hit(a, v3(32, 5, 0), v3(0, -1, 0), 3.5, v3_norm(v3(-0.25, 1, 0)), 1e-12, 1e-12, NULL);
+    expect_hit(a, v3(40, 1.5, 0), v3(-1, 0, 0), 6.0, v3(1, 0, 0), 1e-12, 1e-12, NULL);
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+static void test_disc(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    scene_object *o = add_obj(s, SHAPE_DISC);
+    o->name = "disc";
+    o->u.disc.centre = v3(0, 0, 3);
+    o->u.disc.normal = v3(0, 0, 2);
+    o->u.disc.radius = 2;
+    o->u.disc.hole_radius = 0.5;
+    accel *a = build(s, d);
+    expect_hit(a, v3(1, 0, 0), v3(0, 0, 1), 3.0, v3(0, 0, 1), 1e-12, 1e-12, NULL);
+    expect_hit(a, v3(0, -1.5, 6), v3(0, 0, -1), 3.0, v3(0, 0, 1), 1e-12, 1e-12, NULL);
+    expect_miss(a, v3(0.2, 0, 0), v3(0, 0, 1)); /* hole */
+    expect_miss(a, v3(2.5, 0, 0), v3(0, 0, 1)); /* outside */
+    expect_miss(a, v3(0, 0, 0), v3(1, 0, 0));   /* parallel */
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+static void test_torus(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    scene_object *o = add_obj(s, SHAPE_TORUS);
+    o->name = "torus";
+    o->u.torus.major = 2;
+    o->u.torus.minor = 0.5;
+    /* a second torus, rotated to stand in the xy plane, moved to z = 10 */
+    scene_object *o2 = add_obj(s, SHAPE_TORUS);
+    o2->u.torus.major = 2;
+    o2->u.torus.minor = 0.5;
+    o2->transform = xform_then(xform_rotate(v3(90, 0, 0)), xform_translate(v3(0, 0, 10)));
+    accel *a = build(s, d);
+    accel_hit h;
+    expect_hit(a, v3(-5, 0, 0), v3(1, 0, 0), 2.5, v3(-1, 0, 0), 1e-10, 1e-10, NULL);
+    assert_true(accel_intersect(a, v3(-5, 0, 0), v3(1, 0, 0), 3.0, INFINITY, &h));
+    assert_near(h.t, 3.5, 1e-10);
+    assert_vec(h.ng, v3(1, 0, 0), 1e-10);
+    assert_true(accel_intersect(a, v3(-5, 0, 0), v3(1, 0, 0), 4.0, INFINITY, &h));
+    assert_near(h.t, 6.5, 1e-10);
+    assert_true(accel_intersect(a, v3(-5, 0, 0), v3(1, 0, 0), 7.0, INFINITY, &h));
+    assert_near(h.t, 7.5, 1e-10);
+    assert_false(accel_intersect(a, v3(-5, 0, 0), v3(1, 0, 0), 8.0, INFINITY, &h));
+    /* from above onto the tube */
+    expect_hit(a, v3(2, 5, 0), v3(0, -1, 0), 4.5, v3(0, 1, 0), 1e-10, 1e-10, NULL);
+    /* 45 degrees onto the tube top at x = z = sqrt2 */
+    double c = sqrt(2.0);
+    expect_hit(a, v3(c, 3, c), v3(0, -1, 0), 2.5, v3(0, 1, 0), 1e-10, 1e-10, NULL);
+    /* through the hole: miss */
+    expect_miss(a, v3(0, 5, 0), v3(0, -1, 0));
+    /* rotated torus: axis along z at z = 10; ray along -z at x = 2 hits the tube top (z = 10.5) */
+    expect_hit(a, v3(2, 0, 20), v3(0, 0, -1), 9.5, v3(0, 0, 1), 1e-10, 1e-10, &h);
+    assert_ptr_equal(h.obj, o2);
+    /* tangent rays along y = 0.5 (touching the tube top): no NaN, consistent */
+    for (int i = -4; i <= 4; i++) {
+        double y = 0.5 + i * 1e-9;
+        int hit = accel_intersect(a, v3(-5, y, 0), v3(1, 0, 0), 0.0, INFINITY, &h);
+        if (hit) assert_hit_sane(&h);
+        if (i > 0) assert_false(hit);
+        if (i < 0) assert_true(hit);
+    }
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+static void test_poly_roots(void **st)
+{
+    (void)st;
+    /* (x-1)(x-2)(x-3)(x-4) = x^4 - 10x^3 + 35x^2 - 50x + 24 */
+    double c[5] = {24, -50, 35, -10, 1}, r[4];
+    int n = accel_poly_roots(c, 4, 0.0, 5.0, r);
+    assert_int_equal(n, 4);
+    for (int i = 0; i < 4; i++) assert_near(r[i], i + 1.0, 1e-12);
+    assert_int_equal(accel_poly_roots(c, 4, 1.5, 3.5, r), 2);
+    assert_near(r[0], 2.0, 1e-12);
+    /* (x^2 + 1)(x^2 + 2): no real roots */
+    double c2[5] = {2, 0, 3, 0, 1};
+    assert_int_equal(accel_poly_roots(c2, 4, -10, 10, r), 0);
+    /* close roots 1 and 1 + 1e-6 */
+    double e = 1e-6;
+    double c3[3] = {1 + e, -(2 + e), 1};
+    double c4[5] = {0, 0, c3[0], c3[1], c3[2]}; /* x^2 (x-1)(x-1-e) */
+    n = accel_poly_roots(c4, 4, 0.5, 2.0, r);
+    assert_int_equal(n, 2);
+    assert_near(r[0], 1.0, 1e-9);
+    assert_near(r[1], 1.0 + e, 1e-9);
+}
+
+/* ------------------------------------------------------------ robustness */
+
+static void test_grazing_sphere(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    sphere(s, v3(0, 0, 0), 1);
+    accel *a = build(s, d);
+    accel_hit h;
+    /* exactly tangent: a hit must be at t = 5 with a sane normal */
+    if (accel_intersect(a, v3(1, 0, -5), v3(0, 0, 1), 0.0, INFINITY, &h)) {
+        assert_hit_sane(&h);
+        assert_near(h.t, 5.0, 1e-6);
+    }
+    /* offsets around the tangent: hit inside, miss outside, never NaN */
+    int prev = 1;
+    for (int i = -20; i <= 20; i++) {
+        double x = 1.0 + i * 1e-13;
+        int hit = accel_intersect(a, v3(x, 0, -5), v3(0, 0, 1), 0.0, INFINITY, &h);
+        if (hit) assert_hit_sane(&h);
+        if (i < -2) assert_true(hit);
+        if (i > 2) assert_false(hit);
+        assert_true(hit <= prev); /* monotonic: once missing, stays missing */
+        prev = hit;
+        assert_int_equal(accel_occluded(a, v3(x, 0, -5), v3(0, 0, 1), 0.0, INFINITY), hit);
+    }
+    /* degenerate rays: no hit, no crash */
+    assert_false(accel_intersect(a, v3(0, 0, -5), v3(0, 0, 0), 0.0, INFINITY, &h));
+    assert_false(accel_intersect(a, v3(NAN, 0, -5), v3(0, 0, 1), 0.0, INFINITY, &h));
+    assert_false(accel_intersect(a, v3(0, 0, -5), v3(0, INFINITY, 1), 0.0, INFINITY, &h));
+    assert_false(accel_intersect(a, v3(0, 0, -5), v3(0, 0, 1), 0.0, NAN, &h));
+    assert_false(accel_occluded(a, v3(0, 0, -5), v3(0, 0, 0), 0.0, INFINITY));
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+/* For every kind: hit it, then leave the surface along directions on the
+ * outer side (no self-hit), and into the solid (no hit at t ~ 0). */
+static void test_no_self_hit(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    sphere(s, v3(0, 0, 0), 1);
+    box(s, v3(4, -1, -1), v3(6, 1, 1));
+    cone(s, SHAPE_CYLINDER, v3(10, -1, 0), 1, v3(10, 1, 0), 1);
+    cone(s, SHAPE_CONE, v3(15, -1, 0), 1, v3(15, 1, 0), 0.2);
+    scene_object *t = add_obj(s, SHAPE_TORUS);
+    t->u.torus.major = 1;
+    t->u.torus.minor = 0.4;
+    t->transform = xform_then(xform_rotate(v3(90, 0, 0)), xform_translate(v3(20, 0, 0)));
+    scene_object *dc = add_obj(s, SHAPE_DISC);
+    dc->u.disc.centre = v3(25, 0, 0);
+    dc->u.disc.normal = v3(0, 0, 1);
+    dc->u.disc.radius = 1;
+    triangle(s, v3(29, -1, 0), v3(31, -1, 0), v3(30, 1, 0));
+    scene_mesh *m = quad_mesh(s, NULL, NULL);
+    mesh_obj(s, m, xform_translate(v3(34, 0, 0)));
+    mesh_obj(s, m, xform_translate(v3(38, 0, 0)));
+    accel *a = build(s, d);
+    double xs[] = {0, 5, 10, 15, 20.0 + 1.0, 25.3, 30, 34.5, 38.5};
+    double ys[] = {0.1, 0.2, 0.3, 0.1, 0.0, 0.2, 0.0, 0.5, 0.5};
+    rng r;
+    rng_seed(&r, 7, 1);
+    for (int k = 0; k < (int)(sizeof xs / sizeof xs[0]); k++) {
+        vec3 org = v3(xs[k] + 0.05, ys[k], -10);
+        accel_hit h;
+        assert_true(accel_intersect(a, org, v3(0, 0.001, 1), 0.0, INFINITY, &h));
+        assert_hit_sane(&h);
+        vec3 n = v3_dot(h.ng, v3(0, 0.001, 1)) < 0 ? h.ng : v3_neg(h.ng); /* towards the ray origin */
+        for (int j = 0; j < 200; j++) {
+            vec3 t, b;
+            v3_basis(n, &t, &b);
+            double phi = 6.283185307179586 * rng_f64(&r);
+            double ct = 0.02 + 0.98 * rng_f64(&r); /* at least ~1 degree above the tangent plane */
+            double stt = sqrt(1 - ct * ct);
+            vec3 dir = v3_add(v3_scale(n, ct), v3_add(v3_scale(t, stt * cos(phi)), v3_scale(b, stt * sin(phi))));
+            accel_hit h2;
+            if (accel_intersect(a, h.p, dir, 0.0, INFINITY, &h2)) {
+                /* the only thing allowed is another part of a non-convex shape, far away */
+                if (h2.obj == h.obj && h2.t < 1e-3)
+                    fail_msg("self-hit on object %d at t=%g (n.d=%g)", k, h2.t, ct);
+            }
+            if (accel_occluded(a, h.p, dir, 0.0, 1e-3)) fail_msg("self-occlusion on object %d", k);
+        }
+    }
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+/* The same scene at three scales: distances scale exactly (relative error < 1e-5). */
+static scene *scaled_scene(double k)
+{
+    scene *s = scene_new();
+    sphere(s, v3(0, 0, 5 * k), 1 * k);
+    box(s, v3(3 * k, -1 * k, 4 * k), v3(5 * k, 1 * k, 6 * k));
+    triangle(s, v3(-4 * k, -1 * k, 5 * k), v3(-2 * k, -1 * k, 6 * k), v3(-3 * k, 1 * k, 5.5 * k));
+    cone(s, SHAPE_CYLINDER, v3(8 * k, -1 * k, 5 * k), 1 * k, v3(8 * k, 1 * k, 5 * k), 1 * k);
+    scene_object *t = add_obj(s, SHAPE_TORUS);
+    t->u.torus.major = 1 * k;
+    t->u.torus.minor = 0.25 * k;
+    t->transform = xform_then(xform_rotate(v3(70, 0, 0)), xform_translate(v3(-8 * k, 0, 5 * k)));
+    scene_mesh *m = quad_mesh(s, NULL, NULL);
+    mesh_obj(s, m, xform_then(xform_scale(v3s(2 * k)), xform_translate(v3(11 * k, -1 * k, 6 * k))));
+    mesh_obj(s, m, xform_then(xform_scale(v3s(2 * k)), xform_translate(v3(14 * k, -1 * k, 7 * k))));
+    scene_object *p = add_obj(s, SHAPE_PLANE);
+    p->u.plane.normal = v3(0, 0, 1);
+    p->u.plane.offset = 20 * k;
+    return s;
+}
+
+static void test_scales(void **st)
+{
+    (void)st;
+    double scales[3] = {1e-4, 1.0, 1e5};
+    double ref[64];
+    int nref = 0;
+    diag *d = diag_new();
+    for (int si = 0; si < 3; si++) {
+        double k = scales[si];
+        scene *s = scaled_scene(k);
+        accel *a = build(s, d);
+        assert_near(accel_scale(a) / k, accel_scale(a) / k, 0); /* finite */
+        int n = 0;
+        for (int ix = 0; ix < 32; ix++) {
+            double x = -9.5 + ix * (25.0 / 31.0);
+            vec3 org = v3(0.1 * k, 0.13 * k, -3 * k);
+            vec3 tgt = v3(x * k, 0.2 * k, 5 * k);
+            vec3 dir = v3_norm(v3_sub(tgt, org));
+            accel_hit h;
+            int hit = accel_intersect(a, org, dir, 0.0, INFINITY, &h);
+            assert_true(hit); /* everything ends on the back plane at worst */
+            assert_hit_sane(&h);
+            double tn = h.t / k;
+            if (si == 0) {
+                ref[n] = tn;
+            } else if (fabs(tn - ref[n]) > 1e-5 * ref[n]) {
+                fail_msg("scale %g ray %d: t/k = %.12g, at scale 1e-4: %.12g", k, ix, tn, ref[n]);
+            }
+            n++;
+        }
+        nref = n;
+        accel_free(a);
+        scene_free(s);
+    }
+    assert_int_equal(nref, 32);
+    diag_free(d);
+}
+
+static void test_no_shadow(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    /* blockers between z = 0 and z = 10 at different x */
+    scene_object *sp = sphere(s, v3(0, 0, 5), 1);
+    sp->flags |= OBJ_NO_SHADOW;
+    scene_object *tr = triangle(s, v3(2, -1, 5), v3(4, -1, 5), v3(3, 1, 5));
+    tr->flags |= OBJ_NO_SHADOW;
+    triangle(s, v3(5, -1, 5), v3(7, -1, 5), v3(6, 1, 5)); /* casts shadows */
+    scene_mesh *m = quad_mesh(s, NULL, NULL);
+    scene_object *mi = mesh_obj(s, m, xform_translate(v3(8, -0.5, 5)));
+    mi->flags |= OBJ_NO_SHADOW;
+    mesh_obj(s, m, xform_translate(v3(10, -0.5, 5))); /* casts shadows */
+    /* a union flagged no_shadow: its child box inherits it */
+    scene_object *u = add_obj(s, SHAPE_UNION);
+    u->flags |= OBJ_NO_SHADOW;
+    scene_object *kid = scene_new_object(s, SHAPE_BOX, here);
+    kid->u.box.c1 = v3(12, -1, 4);
+    kid->u.box.c2 = v3(13, 1, 6);
+    u->u.csg.kids = arena_alloc(s->mem, sizeof(scene_object *));
+    u->u.csg.kids[0] = kid;
+    u->u.csg.nkids = 1;
+    sphere(s, v3(15, 0, 5), 1); /* casts shadows */
+    accel *a = build(s, d);
+    double x[7] = {0, 3, 6, 8.5, 10.5, 12.5, 15};
+    int occl[7] = {0, 0, 1, 0, 1, 0, 1};
+    for (int i = 0; i < 7; i++) {
+        vec3 org = v3(x[i], 0, 0), dir = v3(0, 0, 1);
+        accel_hit h;
+        assert_true(accel_intersect(a, org, dir, 0.0, 10.0, &h)); /* visible to camera rays */
+        assert_int_equal(accel_occluded(a, org, dir, 0.0, 10.0), occl[i]);
+        /* the bare Embree scene honours it too (filters live in the scene) */
+    }
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+static void test_warnings_csg(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    for (int i = 0; i < 2; i++) {
+        scene_object *o = add_obj(s, SHAPE_UNSUPPORTED);
+        o->name = "lathe";
+    }
+    scene_object *o = add_obj(s, SHAPE_UNSUPPORTED);
+    o->name = "sor";
+    scene_texture *tx = scene_new_texture(s);
+    for (int i = 0; i < 2; i++) {
+        scene_object *df = add_obj(s, SHAPE_DIFFERENCE);
+        df->texture = tx;
+        df->u.csg.kids = arena_alloc(s->mem, 2 * sizeof(scene_object *));
+        df->u.csg.nkids = 2;
+        for (int k = 0; k < 2; k++) {
+            scene_object *c = scene_new_object(s, SHAPE_SPHERE, here);
+            c->u.sphere.centre = v3(10 * i + 3 * k, 0, 5);
+            c->u.sphere.radius = 1;
+            df->u.csg.kids[k] = c;
+        }
+    }
+    accel *a = build(s, d);
+    int lathe = 0, sor = 0, csg = 0;
+    for (int i = 0; i < diag_count(d); i++) {
+        const diag_msg *m = diag_get(d, i);
+        assert_int_equal(m->severity, DIAG_WARNING);
+        if (strstr(m->text, "lathe is not rendered yet")) lathe++;
+        if (strstr(m->text, "sor is not rendered yet")) sor++;
+        if (strstr(m->text, "CSG intersection/difference is not evaluated yet")) csg++;
+    }
+    assert_int_equal(lathe, 1);
+    assert_int_equal(sor, 1);
+    assert_int_equal(csg, 1);
+    assert_int_equal(accel_get_stats(a).unsupported, 3);
+    /* the difference's children render (as a union) with the parent's texture */
+    accel_hit h;
+    expect_hit(a, v3(13, 0, 0), v3(0, 0, 1), 4.0, v3(0, 0, -1), 1e-12, 1e-12, &h);
+    assert_ptr_equal(h.texture, tx);
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+static void test_empty_and_errors(void **st)
+{
+    (void)st;
+    diag *d = diag_new();
+    scene *s = scene_new();
+    accel *a = build(s, d);
+    accel_hit h;
+    assert_false(accel_intersect(a, v3(0, 0, 0), v3(0, 0, 1), 0.0, INFINITY, &h));
+    assert_false(accel_occluded(a, v3(0, 0, 0), v3(0, 0, 1), 0.0, INFINITY));
+    assert_near(accel_scale(a), 1.0, 0);
+    accel_free(a);
+    /* degenerate objects are skipped with a warning */
+    sphere(s, v3(0, 0, 0), 0);
+    scene_object *o = sphere(s, v3(0, 0, 0), 1);
+    o->transform = xform_scale(v3(1, 0, 1));
+    triangle(s, v3(0, 0, 0), v3(1, 0, 0), v3(2, 0, 0)); /* collinear: never hit */
+    a = build(s, d);
+    assert_false(accel_intersect(a, v3(0.5, 0, -1), v3(0, 0, 1), 0.0, INFINITY, &h));
+    assert_true(diag_count(d) >= 1);
+    accel_free(a);
+    scene_free(s);
+    pt_status stt = PT_OK;
+    assert_null(accel_build(NULL, 1, d, &stt));
+    assert_int_not_equal(stt, PT_OK);
+    accel_free(NULL);
+    diag_free(d);
+}
+
+/* Random rays through a mixed scene: hits are sane and agree with occlusion. */
+static void test_random_rays(void **st)
+{
+    (void)st;
+    scene *s = scaled_scene(1.0);
+    diag *d = diag_new();
+    accel *a = build(s, d);
+    rng r;
+    rng_seed(&r, 42, 3);
+    for (int i = 0; i < 20000; i++) {
+        vec3 org = v3(30 * rng_f64(&r) - 12, 6 * rng_f64(&r) - 3, 30 * rng_f64(&r) - 8);
+        vec3 dir = v3(rng_f64(&r) - 0.5, rng_f64(&r) - 0.5, rng_f64(&r) - 0.5);
+        accel_hit h;
+        int hit = accel_intersect(a, org, dir, 0.0, INFINITY, &h);
+        if (hit) {
+            assert_hit_sane(&h);
+            assert_true(h.t > 0.0);
+            assert_true(accel_occluded(a, org, dir, 0.0, h.t * 1.001));
+        }
+        assert_int_equal(accel_occluded(a, org, dir, 0.0, INFINITY), hit);
+    }
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+/* Torus against brute force: signed distance to the tube sampled along the
+ * ray; the reported hit must be on the surface and no sign change may come
+ * before it. */
+static double torus_sdf(vec3 p, double R, double r)
+{
+    double rho = sqrt(p.x * p.x + p.z * p.z) - R;
+    return sqrt(rho * rho + p.y * p.y) - r;
+}
+
+static void test_torus_brute(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    scene_object *o = add_obj(s, SHAPE_TORUS);
+    o->u.torus.major = 1.0;
+    o->u.torus.minor = 0.3;
+    accel *a = build(s, d);
+    rng r;
+    rng_seed(&r, 5, 9);
+    int hits = 0;
+    for (int i = 0; i < 3000; i++) {
+        vec3 org = v3(4 * rng_f64(&r) - 2, 2 * rng_f64(&r) - 1, 4 * rng_f64(&r) - 2);
+        vec3 tgt = v3(2.6 * rng_f64(&r) - 1.3, 0.6 * rng_f64(&r) - 0.3, 2.6 * rng_f64(&r) - 1.3);
+        vec3 dir = v3_norm(v3_sub(tgt, org));
+        accel_hit h;
+        int hit = accel_intersect(a, org, dir, 0.0, 10.0, &h);
+        double tend = hit ? h.t : 10.0;
+        if (hit) {
+            hits++;
+            assert_hit_sane(&h);
+            assert_near(torus_sdf(h.p, 1.0, 0.3), 0.0, 1e-9);
+            /* outward normal: moving along it increases the distance */
+            assert_true(torus_sdf(v3_madd(h.p, h.ng, 1e-4), 1.0, 0.3) > 0.0);
+        }
+        /* no crossing before tend (steps of 1e-3, skipping the ends) */
+        double eps = 1e-6;
+        double f0 = torus_sdf(v3_madd(org, dir, eps), 1.0, 0.3);
+        for (double t = eps + 1e-3; t < tend - 1e-6; t += 1e-3) {
+            double f1 = torus_sdf(v3_madd(org, dir, t), 1.0, 0.3);
+            if ((f0 < 0) != (f1 < 0) && fabs(f1) > 1e-7 && fabs(f0) > 1e-7)
+                fail_msg("ray %d: surface crossed at t~%g before the reported %s %g", i, t, hit ? "hit" : "end", tend);
+            f0 = f1;
+        }
+    }
+    print_message("torus: %d of 3000 rays hit\n", hits);
+    assert_true(hits > 500);
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+/* The bare Embree scene (plain context: float rays in the user callbacks)
+ * agrees with accel_intersect to float precision, no_shadow included. */
+static void test_bare_embree(void **st)
+{
+    (void)st;
+    scene *s = scaled_scene(1.0);
+    scene_object *ns = sphere(s, v3(0, 0, 2), 0.5);
+    ns->flags |= OBJ_NO_SHADOW;
+    diag *d = diag_new();
+    accel *a = build(s, d);
+    RTCScene rs = (RTCScene)accel_rtc_scene(a);
+    assert_non_null(rs);
+    rng r;
+    rng_seed(&r, 11, 2);
+    for (int i = 0; i < 2000; i++) {
+        vec3 org = v3(0.1, 0.13, -3);
+        vec3 dir = v3_norm(v3(25 * rng_f64(&r) - 12, 3 * rng_f64(&r) - 1.5, 8));
+        double eps = accel_epsilon(a, org, dir);
+        accel_hit h;
+        int hit = accel_intersect(a, org, dir, 0.0, INFINITY, &h);
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        struct RTCRayHit rh;
+        memset(&rh, 0, sizeof rh);
+        rh.ray.org_x = (float)org.x; rh.ray.org_y = (float)org.y; rh.ray.org_z = (float)org.z;
+        rh.ray.dir_x = (float)dir.x; rh.ray.dir_y = (float)dir.y; rh.ray.dir_z = (float)dir.z;
+        rh.ray.tnear = (float)eps;
+        rh.ray.tfar = INFINITY;
+        rh.ray.mask = 0xFFFFFFFFu;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(rs, &ctx, &rh);
+        int bare = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        assert_int_equal(bare, hit);
+        if (hit) assert_near(rh.ray.tfar, h.t, 1e-5 * h.t);
+        /* occlusion: the bare query must skip the no_shadow sphere as well */
+        struct RTCRay ray = rh.ray;
+        ray.tfar = INFINITY;
+        rtcOccluded1(rs, &ctx, &ray);
+        assert_int_equal(ray.tfar == -INFINITY, accel_occluded(a, org, dir, 0.0, INFINITY));
+    }
+    vec3 org = v3(0, 0, 0), dir = v3(0, 0, 1);
+    assert_true(accel_occluded(a, org, dir, 0.0, INFINITY)); /* the box behind */
+    assert_false(accel_occluded(a, org, dir, 0.0, 3.0));     /* only the no_shadow sphere */
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+typedef struct {
+    const accel *a;
+    double *t;
+    int n;
+} par_ctx;
+
+static void par_job(void *ctx, int i, int thread)
+{
+    (void)thread;
+    par_ctx *c = ctx;
+    rng r;
+    rng_seed(&r, 99, (uint64_t)i);
+    for (int k = 0; k < 100; k++) {
+        vec3 org = v3(30 * rng_f64(&r) - 12, 6 * rng_f64(&r) - 3, 30 * rng_f64(&r) - 8);
+        vec3 dir = v3(rng_f64(&r) - 0.5, rng_f64(&r) - 0.5, rng_f64(&r) - 0.5);
+        accel_hit h;
+        c->t[i * 100 + k] = accel_intersect(c->a, org, dir, 0.0, INFINITY, &h) ? h.t : -1.0;
+    }
+}
+
+static void test_threads(void **st)
+{
+    (void)st;
+    scene *s = scaled_scene(1.0);
+    diag *d = diag_new();
+    accel *a = build(s, d);
+    int n = 200;
+    double *t1 = malloc(sizeof(double) * (size_t)n * 100), *t4 = malloc(sizeof(double) * (size_t)n * 100);
+    par_ctx c1 = {a, t1, n}, c4 = {a, t4, n};
+    pool_run(1, n, par_job, &c1);
+    pool_run(4, n, par_job, &c4);
+    assert_memory_equal(t1, t4, sizeof(double) * (size_t)n * 100);
+    free(t1);
+    free(t4);
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_sphere),
+        cmocka_unit_test(test_box_faces),
+        cmocka_unit_test(test_plane),
+        cmocka_unit_test(test_triangles),
+        cmocka_unit_test(test_mesh_instances),
+        cmocka_unit_test(test_mesh_textures_normals),
+        cmocka_unit_test(test_cylinder_cone),
+        cmocka_unit_test(test_disc),
+        cmocka_unit_test(test_torus),
+        cmocka_unit_test(test_poly_roots),
+        cmocka_unit_test(test_grazing_sphere),
+        cmocka_unit_test(test_no_self_hit),
+        cmocka_unit_test(test_scales),
+        cmocka_unit_test(test_no_shadow),
+        cmocka_unit_test(test_warnings_csg),
+        cmocka_unit_test(test_empty_and_errors),
+        cmocka_unit_test(test_random_rays),
+        cmocka_unit_test(test_torus_brute),
+        cmocka_unit_test(test_bare_embree),
+        cmocka_unit_test(test_threads),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
