@@ -1,47 +1,56 @@
-/* img_flip.c - LDR-FLIP (HPG 2020) and HDR-FLIP (EG 2021), written from the
- * papers. Equation references: "[L]" = the LDR paper, "[H]" = the HDR paper.
+/* img_flip.c - LDR-FLIP and HDR-FLIP, written from the papers:
+ *  [L] Andersson et al., "FLIP: A Difference Evaluator for Alternating
+ *      Images", HPG 2020 (PACMCGIT 3(2), 15:1-15:23);
+ *  [H] Andersson et al., "Visualizing Errors in Rendered High Dynamic Range
+ *      Images", Eurographics 2021 short paper.
+ * Where the papers leave a detail open (kernel radii and normalisation, edge
+ * handling, the median used for the exposure range, the weighted median),
+ * we follow the authors' published tool, so that our numbers match its
+ * output; ../shared/flip/README.md lists the values we reproduce.
  *
- * Outline of LDR-FLIP for a reference R and test T, both linear RGB in [0,1]:
- *  colour pipeline [L, Sec. 4.1-4.2]
- *   1. linear RGB -> XYZ -> YyCxCz (the opponent space of Johnson and Fairchild:
- *      a "linearised" CIELAB, Y' = 116 Y/Yn - 16, Cx = 500 (X/Xn - Y/Yn),
- *      Cz = 200 (Y/Yn - Z/Zn)).
- *   2. each channel is filtered with the spatial version of its contrast
+ * LDR-FLIP for a reference R and a test T, both linear RGB in [0,1]:
+ *  Colour pipeline [L]:
+ *   1. linear RGB -> XYZ -> YyCxCz, the opponent space of Johnson and
+ *      Fairchild (a "linearised" CIELAB: Y' = 116 Y/Yn - 16,
+ *      Cx = 500 (X/Xn - Y/Yn), Cz = 200 (Y/Yn - Z/Zn)).
+ *   2. Each channel is filtered with the spatial form of its contrast
  *      sensitivity function, a sum of Gaussians
  *        h(x) = a1 sqrt(pi/b1) exp(-pi^2 x^2/b1) + a2 sqrt(pi/b2) exp(-pi^2 x^2/b2)
- *      with x in degrees of visual angle (x = pixels / ppd); the 2-D kernel
- *      uses x^2 -> x^2 + y^2 and is normalised to unit sum. Constants
+ *      with x in degrees of visual angle (pixels / ppd); the 2-D kernel uses
+ *      x^2 -> x^2 + y^2 and is normalised to unit sum. Constants
  *      (achromatic, red-green, blue-yellow):
  *        a1 = 1, 1, 34.1   b1 = 0.0047, 0.0053, 0.04
  *        a2 = 0, 0, 13.5   b2 = 1e-5,  1e-5,   0.025
- *      Kernel radius: ceil(3 sigma_max ppd) with sigma = sqrt(b / (2 pi^2)).
- *   3. back to linear RGB, clamped to [0,1]; then CIELAB with the Hunt
- *      adjustment a' = 0.01 L a, b' = 0.01 L b [L, Eq. 3].
- *   4. HyAB distance |dL| + sqrt(da^2 + db^2) [L, Eq. 4], raised to qc = 0.7,
- *      remapped to [0,1] with pc = 0.4, pt = 0.95 and cmax = the distance
- *      (^qc) between Hunt-adjusted pure green and pure blue [L, Eq. 5].
- *  feature pipeline [L, Sec. 4.3]
- *   5. on the achromatic channel normalised to [0,1], edges and points are
+ *      Kernel radius: ceil(3 sigma_max ppd), sigma = sqrt(b / (2 pi^2)).
+ *   3. Back to linear RGB, clamped to [0,1]; then CIELAB and the Hunt
+ *      adjustment a' = 0.01 L a, b' = 0.01 L b.
+ *   4. HyAB distance |dL| + sqrt(da^2 + db^2), raised to qc = 0.7 and
+ *      remapped to [0,1] with pc = 0.4, pt = 0.95; cmax is the distance (^qc)
+ *      between Hunt-adjusted pure green and pure blue.
+ *  Feature pipeline [L]:
+ *   5. On the achromatic channel normalised to [0,1], edges and points are
  *      found with the first and second derivatives of a Gaussian of standard
  *      deviation sigma = 0.5 w ppd pixels, w = 0.082 degrees, radius
- *      ceil(3 sigma). The Gaussian is normalised to unit sum; the positive and
- *      negative lobes of each derivative to +1 and -1. Edge and point
- *      strengths are the lengths of the (x, y) responses.
- *   6. feature difference dF = (max(|dEdge|, |dPoint|) / sqrt(2))^qf, qf = 0.5.
- *  7. FLIP = dC^(1 - dF) [L, Eq. 6].
- * Borders repeat the edge pixel. All kernels are separable products of 1-D
- * kernels (the blue-yellow one is a sum of two separable Gaussians), which
+ *      ceil(3 sigma). The Gaussian is normalised to unit sum, the positive
+ *      and negative lobes of each derivative to +1 and -1. Edge and point
+ *      strengths are the lengths of the (x, y) response vectors.
+ *   6. Feature difference dF = (max(|dEdge|, |dPoint|) / sqrt(2))^qf, qf = 0.5.
+ *  7. FLIP = dC^(1 - dF).
+ * Borders repeat the edge pixel. All kernels are applied as products of 1-D
+ * kernels (the blue-yellow one as a sum of two separable Gaussians), which
  * gives the same result as the 2-D kernels.
  *
- * HDR-FLIP [H, Sec. 3]: the linear inputs are exposure-compensated by 2^c for
- * c from the start to the stop exposure in n equal steps, tone mapped with
- * the ACES filmic curve (Narkowicz's fit with the 0.6 pre-exposure folded in)
- * and clamped, LDR-FLIP is evaluated for each, and the per-pixel maximum is
- * the HDR-FLIP value. */
+ * HDR-FLIP [H]: the linear inputs are scaled by 2^c for exposures c from the
+ * start to the stop exposure in n equal steps, tone mapped with the ACES
+ * filmic curve (Narkowicz's fit with the 0.6 pre-exposure folded in) and
+ * clamped; LDR-FLIP is evaluated for each exposure, and the per-pixel
+ * maximum is the HDR-FLIP value. */
 #include "img_flip.h"
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include "pool.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -54,7 +63,7 @@
 #define FLIP_W 0.082
 #define FLIP_QF 0.5
 
-/* CSF sum-of-Gaussians constants [L, Sec. 4.1]: index 0 achromatic,
+/* CSF sum-of-Gaussians constants [L]: index 0 achromatic,
  * 1 red-green, 2 blue-yellow. */
 static const double csf_a1[3] = {1.0, 1.0, 34.1};
 static const double csf_b1[3] = {0.0047, 0.0053, 0.04};
@@ -62,7 +71,7 @@ static const double csf_a2[3] = {0.0, 0.0, 13.5};
 static const double csf_b2[3] = {1e-5, 1e-5, 0.025};
 
 /* ACES filmic fit t(x) = (c0 x^2 + c1 x) / (c3 x^2 + c4 x + c5), with the
- * usual 0.6 pre-exposure multiplied into the coefficients [H, Sec. 3]. */
+ * usual 0.6 pre-exposure multiplied into the coefficients [H]. */
 static const double aces_c[6] = {0.6 * 0.6 * 2.51, 0.6 * 0.03, 0.0,
                                  0.6 * 0.6 * 2.43, 0.6 * 0.59, 0.14};
 
@@ -78,7 +87,7 @@ static const double rgb2xyz[3][3] = {
 typedef struct {
     double xyz2rgb[3][3];
     double white[3];
-    double cmax, pccmax;  /* colour remapping [L, Eq. 5] */
+    double cmax, pccmax;  /* colour-difference remapping [L] */
 } flip_consts;
 
 static void lab_from_linear(const flip_consts *k, const double rgb[3], double lab[3])
@@ -95,14 +104,14 @@ static void lab_from_linear(const flip_consts *k, const double rgb[3], double la
     lab[2] = 200.0 * (f[1] - f[2]);
 }
 
-/* Hunt adjustment [L, Eq. 3]. */
+/* Hunt adjustment [L]: chroma scaled by 0.01 L. */
 static void hunt(double lab[3])
 {
     lab[1] *= 0.01 * lab[0];
     lab[2] *= 0.01 * lab[0];
 }
 
-/* HyAB [L, Eq. 4]. */
+/* HyAB distance [L]: city-block in L, Euclidean in (a, b). */
 static double hyab(const double p[3], const double q[3])
 {
     double da = p[1] - q[1], db = p[2] - q[2];
@@ -151,49 +160,117 @@ void img_flip_default_params(img_flip_params *p)
     p->nexposures = 0;
 }
 
-/* ---- separable filtering with edge clamping ---- */
+/* ---- separable filtering with edge clamping, rows in parallel ---- */
 
-/* One 1-D pass along x (dir 0) or y (dir 1) of `src` (w*h) into `dst`;
- * `acc` is scratch for w doubles. */
-static void conv1d(const float *src, float *dst, double *acc, int w, int h,
-                   const double *k, int r, int dir)
+#define ROWS_PER_JOB 16
+
+typedef struct {
+    int w, h, nthreads, padw;
+    double *acc; /* nthreads * w */
+    float *pad;  /* nthreads * padw */
+} conv_ctx;
+
+typedef struct {
+    const conv_ctx *c;
+    const float *src;
+    float *dst;
+    const double *k;
+    int r, dir;
+} conv_job;
+
+/* Rows [16 index, 16 index + 16) of a 1-D pass along x (dir 0) or y (dir 1).
+ * Both directions run tap by tap over a whole row (the inner loop is a plain
+ * multiply-add over x), the x pass on a copy of the row padded with its edge
+ * values. */
+static void conv_rows(void *ctx, int index, int thread)
 {
-    if (dir == 0) {
-        for (int y = 0; y < h; y++) {
-            const float *row = src + (size_t)y * (size_t)w;
-            float *out = dst + (size_t)y * (size_t)w;
-            for (int x = 0; x < w; x++) {
-                double s = 0.0;
-                for (int i = -r; i <= r; i++) {
-                    int xx = x + i;
-                    xx = xx < 0 ? 0 : (xx >= w ? w - 1 : xx);
-                    s += k[i + r] * row[xx];
-                }
-                out[x] = (float)s;
+    const conv_job *j = ctx;
+    int w = j->c->w, h = j->c->h, r = j->r;
+    double *acc = j->c->acc + (size_t)thread * (size_t)w;
+    float *pad = j->c->pad + (size_t)thread * (size_t)j->c->padw;
+    int y1 = (index + 1) * ROWS_PER_JOB;
+    if (y1 > h) y1 = h;
+    for (int y = index * ROWS_PER_JOB; y < y1; y++) {
+        for (int x = 0; x < w; x++) acc[x] = 0.0;
+        if (j->dir == 0) {
+            const float *row = j->src + (size_t)y * (size_t)w;
+            for (int i = 0; i < r; i++) {
+                pad[i] = row[0];
+                pad[r + w + i] = row[w - 1];
+            }
+            memcpy(pad + r, row, (size_t)w * sizeof *pad);
+            for (int i = 0; i <= 2 * r; i++) {
+                double kv = j->k[i];
+                const float *p = pad + i;
+                for (int x = 0; x < w; x++) acc[x] += kv * p[x];
+            }
+        } else {
+            for (int i = -r; i <= r; i++) {
+                int yy = y + i;
+                yy = yy < 0 ? 0 : (yy >= h ? h - 1 : yy);
+                const float *row = j->src + (size_t)yy * (size_t)w;
+                double kv = j->k[i + r];
+                for (int x = 0; x < w; x++) acc[x] += kv * row[x];
             }
         }
-        return;
-    }
-    for (int y = 0; y < h; y++) {
-        for (int x = 0; x < w; x++) acc[x] = 0.0;
-        for (int i = -r; i <= r; i++) {
-            int yy = y + i;
-            yy = yy < 0 ? 0 : (yy >= h ? h - 1 : yy);
-            const float *row = src + (size_t)yy * (size_t)w;
-            double kv = k[i + r];
-            for (int x = 0; x < w; x++) acc[x] += kv * row[x];
-        }
-        float *out = dst + (size_t)y * (size_t)w;
+        float *out = j->dst + (size_t)y * (size_t)w;
         for (int x = 0; x < w; x++) out[x] = (float)acc[x];
     }
 }
 
-/* 2-D separable convolution: kx along x, then ky along y. */
-static void conv2d(const float *src, float *dst, float *tmp, double *acc, int w, int h,
+/* One 1-D pass of kernel k (2r + 1 taps) over src (w*h) into dst. */
+static void conv1d(const conv_ctx *c, const float *src, float *dst, const double *k, int r, int dir)
+{
+    conv_job j = {c, src, dst, k, r, dir};
+    pool_run(c->nthreads, (c->h + ROWS_PER_JOB - 1) / ROWS_PER_JOB, conv_rows, &j);
+}
+
+/* 2-D separable convolution: kx along x into tmp, then ky along y. */
+static void conv2d(const conv_ctx *c, const float *src, float *dst, float *tmp,
                    const double *kx, const double *ky, int r)
 {
-    conv1d(src, tmp, acc, w, h, kx, r, 0);
-    conv1d(tmp, dst, acc, w, h, ky, r, 1);
+    conv1d(c, src, tmp, kx, r, 0);
+    conv1d(c, tmp, dst, ky, r, 1);
+}
+
+/* The colour difference of the filtered images and the final FLIP value,
+ * for a block of rows. */
+typedef struct {
+    const flip_consts *k;
+    float *(*P)[3];
+    const float *fdiff;
+    float *err;
+    int w, h;
+} color_job;
+
+static void color_rows(void *ctx, int index, int thread)
+{
+    const color_job *j = ctx;
+    const flip_consts *k = j->k;
+    int y1 = (index + 1) * ROWS_PER_JOB;
+    if (y1 > j->h) y1 = j->h;
+    size_t i0 = (size_t)index * ROWS_PER_JOB * (size_t)j->w, i1 = (size_t)y1 * (size_t)j->w;
+    for (size_t i = i0; i < i1; i++) {
+        double lab[2][3];
+        for (int im = 0; im < 2; im++) {
+            double yy = ((double)j->P[im][0][i] + 16.0) / 116.0;
+            double xyz[3] = {(yy + j->P[im][1][i] / 500.0) * k->white[0], yy * k->white[1],
+                             (yy - j->P[im][2][i] / 200.0) * k->white[2]};
+            double rgb[3];
+            for (int r = 0; r < 3; r++) {
+                double v = k->xyz2rgb[r][0] * xyz[0] + k->xyz2rgb[r][1] * xyz[1] + k->xyz2rgb[r][2] * xyz[2];
+                rgb[r] = v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+            }
+            lab_from_linear(k, rgb, lab[im]);
+            hunt(lab[im]);
+        }
+        double dc = pow(hyab(lab[0], lab[1]), FLIP_QC);
+        if (dc < k->pccmax)
+            dc *= FLIP_PT / k->pccmax;
+        else
+            dc = FLIP_PT + (dc - k->pccmax) / (k->cmax - k->pccmax) * (1.0 - FLIP_PT);
+        j->err[i] = (float)pow(dc, 1.0 - (double)j->fdiff[i]);
+    }
 }
 
 /* ---- LDR-FLIP on linear RGB in [0,1] ---- */
@@ -205,7 +282,7 @@ static pt_status flip_ldr_linear(const float *ref, const float *test, int w, int
     consts_init(&k);
     size_t n = (size_t)w * (size_t)h;
 
-    /* Spatial CSF kernels [L, Sec. 4.1]. */
+    /* Spatial CSF kernels [L]. */
     double bmax = 0.0;
     for (int c = 0; c < 3; c++) {
         if (csf_b1[c] > bmax) bmax = csf_b1[c];
@@ -213,7 +290,7 @@ static pt_status flip_ldr_linear(const float *ref, const float *test, int w, int
     }
     int rs = (int)ceil(3.0 * sqrt(bmax / (2.0 * M_PI * M_PI)) * ppd);
     int ns = 2 * rs + 1;
-    /* Feature kernels [L, Sec. 4.3]. */
+    /* Feature kernels [L]. */
     double sd = 0.5 * FLIP_W * ppd;
     int rf = (int)ceil(3.0 * sd);
     int nf = 2 * rf + 1;
@@ -222,11 +299,18 @@ static pt_status flip_ldr_linear(const float *ref, const float *test, int w, int
     /* planes: 3 YCxCz per image (6), filtered temp, scratch, and 2 feature
      * responses per image and direction handled in-place below. */
     float *buf = malloc(n * 12 * sizeof(float));
-    double *acc = malloc((size_t)w * sizeof(double));
-    if (!ks || !buf || !acc) {
+    conv_ctx cc;
+    cc.w = w;
+    cc.h = h;
+    cc.nthreads = pool_default_threads();
+    cc.padw = w + 2 * (rs > rf ? rs : rf);
+    cc.acc = malloc((size_t)cc.nthreads * (size_t)w * sizeof(double));
+    cc.pad = malloc((size_t)cc.nthreads * (size_t)cc.padw * sizeof(float));
+    if (!ks || !buf || !cc.acc || !cc.pad) {
         free(ks);
         free(buf);
-        free(acc);
+        free(cc.acc);
+        free(cc.pad);
         diag_report(d, DIAG_ERROR, (src_loc){0}, NULL, "FLIP: out of memory for a %dx%d image", w, h);
         return PT_ERR_NOMEM;
     }
@@ -308,63 +392,44 @@ static pt_status flip_ldr_linear(const float *ref, const float *test, int w, int
         for (size_t i = 0; i < n; i++) yn[i] = (float)(((double)P[im][0][i] + 16.0) / 116.0);
         float *edge = im ? F1 : E, *point = im ? F2 : Q;
         /* x-derivative responses */
-        conv2d(yn, edge, T, acc, w, h, kdg, kg, rf);   /* d/dx: derivative along x, Gaussian along y */
-        conv2d(yn, point, T, acc, w, h, kddg, kg, rf);
+        conv2d(&cc, yn, edge, T, kdg, kg, rf); /* derivative along x, Gaussian along y */
+        conv2d(&cc, yn, point, T, kddg, kg, rf);
         /* y-derivative responses: Gaussian along x into T, then each
          * derivative along y, using `err` (not yet written) as scratch. */
         float *dy = err;
-        conv1d(yn, T, acc, w, h, kg, rf, 0);            /* Gaussian along x */
-        conv1d(T, dy, acc, w, h, kdg, rf, 1);           /* derivative along y */
-        for (size_t i = 0; i < n; i++) edge[i] = (float)hypot(edge[i], dy[i]);
-        conv1d(T, dy, acc, w, h, kddg, rf, 1);
-        for (size_t i = 0; i < n; i++) point[i] = (float)hypot(point[i], dy[i]);
+        conv1d(&cc, yn, T, kg, rf, 0); /* Gaussian along x */
+        conv1d(&cc, T, dy, kdg, rf, 1); /* derivative along y */
+        for (size_t i = 0; i < n; i++) edge[i] = sqrtf(edge[i] * edge[i] + dy[i] * dy[i]);
+        conv1d(&cc, T, dy, kddg, rf, 1);
+        for (size_t i = 0; i < n; i++) point[i] = sqrtf(point[i] * point[i] + dy[i] * dy[i]);
     }
     /* Feature difference into E. */
     for (size_t i = 0; i < n; i++) {
         double de = fabs((double)E[i] - F1[i]);
         double dp = fabs((double)Q[i] - F2[i]);
         double m = de > dp ? de : dp;
-        E[i] = (float)pow(m / sqrt(2.0), FLIP_QF);
+        E[i] = (float)pow(m / sqrt(2.0), FLIP_QF); /* qf = 0.5 */
     }
 
     /* 2. Spatial filtering of YCxCz, in place per plane. */
     for (int im = 0; im < 2; im++) {
-        conv2d(P[im][0], F1, T, acc, w, h, kY, kY, rs);
+        conv2d(&cc, P[im][0], F1, T, kY, kY, rs);
         memcpy(P[im][0], F1, n * sizeof(float));
-        conv2d(P[im][1], F1, T, acc, w, h, kCx, kCx, rs);
+        conv2d(&cc, P[im][1], F1, T, kCx, kCx, rs);
         memcpy(P[im][1], F1, n * sizeof(float));
-        conv2d(P[im][2], F1, T, acc, w, h, kCz1, kCz1, rs);
-        conv2d(P[im][2], F2, T, acc, w, h, kCz2, kCz2, rs);
+        conv2d(&cc, P[im][2], F1, T, kCz1, kCz1, rs);
+        conv2d(&cc, P[im][2], F2, T, kCz2, kCz2, rs);
         for (size_t i = 0; i < n; i++) P[im][2][i] = F1[i] + F2[i];
     }
 
     /* 3-4, 7. Colour difference and final error. */
-    for (size_t i = 0; i < n; i++) {
-        double lab[2][3];
-        for (int im = 0; im < 2; im++) {
-            double yy = ((double)P[im][0][i] + 16.0) / 116.0;
-            double xyz[3] = {(yy + P[im][1][i] / 500.0) * k.white[0], yy * k.white[1],
-                             (yy - P[im][2][i] / 200.0) * k.white[2]};
-            double rgb[3];
-            for (int r = 0; r < 3; r++) {
-                double v = k.xyz2rgb[r][0] * xyz[0] + k.xyz2rgb[r][1] * xyz[1] + k.xyz2rgb[r][2] * xyz[2];
-                rgb[r] = v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
-            }
-            lab_from_linear(&k, rgb, lab[im]);
-            hunt(lab[im]);
-        }
-        double dc = pow(hyab(lab[0], lab[1]), FLIP_QC);
-        if (dc < k.pccmax)
-            dc *= FLIP_PT / k.pccmax;
-        else
-            dc = FLIP_PT + (dc - k.pccmax) / (k.cmax - k.pccmax) * (1.0 - FLIP_PT);
-        double df = E[i];
-        err[i] = (float)pow(dc, 1.0 - df);
-    }
+    color_job cj = {&k, P, E, err, w, h};
+    pool_run(cc.nthreads, (h + ROWS_PER_JOB - 1) / ROWS_PER_JOB, color_rows, &cj);
 
     free(ks);
     free(buf);
-    free(acc);
+    free(cc.acc);
+    free(cc.pad);
     return PT_OK;
 }
 
@@ -564,19 +629,65 @@ double img_flip_mean(const float *err, size_t n)
     return s / (double)n;
 }
 
-static int cmp_float(const void *a, const void *b)
+/* Order-preserving map of a float onto an unsigned key. */
+static uint32_t float_key(float f)
 {
-    float x = *(const float *)a, y = *(const float *)b;
-    return (x > y) - (x < y);
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
+}
+
+static float key_float(uint32_t u)
+{
+    u = (u & 0x80000000u) ? (u & 0x7fffffffu) : ~u;
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+}
+
+/* Sorts n floats ascending (non-finite values count as 0): two 16-bit LSD
+ * radix passes over the keys. Returns a malloc'd array or NULL. */
+static float *sorted_copy(const float *v, size_t n)
+{
+    uint32_t *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
+    size_t *cnt = malloc(65536 * sizeof *cnt);
+    if (!a || !b || !cnt) {
+        free(a);
+        free(b);
+        free(cnt);
+        return NULL;
+    }
+    for (size_t i = 0; i < n; i++) a[i] = float_key(isfinite(v[i]) ? v[i] : 0.0f);
+    for (int pass = 0; pass < 2; pass++) {
+        int sh = 16 * pass;
+        memset(cnt, 0, 65536 * sizeof *cnt);
+        for (size_t i = 0; i < n; i++) cnt[(a[i] >> sh) & 0xffffu]++;
+        size_t sum = 0;
+        for (size_t j = 0; j < 65536; j++) {
+            size_t c = cnt[j];
+            cnt[j] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < n; i++) b[cnt[(a[i] >> sh) & 0xffffu]++] = a[i];
+        uint32_t *t = a;
+        a = b;
+        b = t;
+    }
+    free(cnt);
+    free(b);
+    /* Convert in place (same size); memcpy keeps this free of type punning. */
+    for (size_t i = 0; i < n; i++) {
+        float f = key_float(a[i]);
+        memcpy(&a[i], &f, sizeof f);
+    }
+    return (float *)(void *)a;
 }
 
 double img_flip_weighted_percentile(const float *err, size_t n, double q)
 {
     if (!n) return 0.0;
-    float *v = malloc(n * sizeof *v);
+    float *v = sorted_copy(err, n);
     if (!v) return NAN;
-    memcpy(v, err, n * sizeof *v);
-    qsort(v, n, sizeof *v, cmp_float);
     double total = 0.0;
     for (size_t i = 0; i < n; i++) total += v[i];
     double run = 0.0, res = 0.0;

@@ -46,7 +46,7 @@ pt_status img_flip_ldr(const framebuffer *ref, const framebuffer *test,
 pt_status img_flip_hdr(const framebuffer *ref, const framebuffer *test,
                        img_flip_params *p, float *err, diag *d);
 
-/* HDR-FLIP's automatic exposure range (EG 2021, Sec. 3): with t(x) the ACES
+/* HDR-FLIP's automatic exposure range (EG 2021): with t(x) the ACES
  * tone curve, start = log2(x85 / Ymax) and stop = log2(x85 / Ymedian), where
  * t(x85) = 0.85 and Y is the reference's luminance; n = max(2, ceil(stop -
  * start)). A reference with median luminance 0 gets stop = start + 1.

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "img_flip.h"
+#include "pool.h"
 
 static double fin(float v)
 {
@@ -92,45 +93,62 @@ pt_status img_psnr(const framebuffer *ref, const framebuffer *test, double *psnr
 #define SSIM_SIGMA 1.5
 #define SSIM_RADIUS 5 /* 11x11 window */
 
-/* Mean SSIM of one channel over the valid window positions. */
-static double ssim_channel(const framebuffer *ref, const framebuffer *test, int c,
-                           const double *k, int r, double *planes)
+/* SSIM is computed in bands of output rows, one job per (channel, band),
+ * each with its own scratch; band sums are added in a fixed order, so the
+ * result does not depend on the thread count. */
+#define SSIM_BAND 32
+
+typedef struct {
+    const framebuffer *ref, *test;
+    const double *k;
+    int r, ow, oh, nbands, nthreads;
+    double *scratch;   /* per thread: 5 * w (row products) + 5 * ow * (SSIM_BAND + 2r) */
+    size_t per_thread; /* doubles per thread */
+    double *band_sum;  /* 3 * nbands */
+} ssim_job;
+
+static void ssim_band(void *ctx, int index, int thread)
 {
-    int w = ref->width, h = ref->height;
-    int ow = w - 2 * r, oh = h - 2 * r;
-    size_t n = (size_t)w * (size_t)h;
-    /* Five input planes x, y, xx, yy, xy; horizontal pass gives ow x h,
-     * vertical pass then ow x oh for each statistic. */
-    double *in = planes;                    /* 5 * n */
-    double *hp = planes + 5 * n;            /* 5 * ow * h */
-    for (size_t i = 0; i < n; i++) {
-        double x = clamp01(fin(ref->rgb[3 * i + (size_t)c]));
-        double y = clamp01(fin(test->rgb[3 * i + (size_t)c]));
-        in[i] = x;
-        in[n + i] = y;
-        in[2 * n + i] = x * x;
-        in[3 * n + i] = y * y;
-        in[4 * n + i] = x * y;
-    }
-    size_t hn = (size_t)ow * (size_t)h;
-    for (int p = 0; p < 5; p++)
-        for (int yy = 0; yy < h; yy++)
-            for (int xx = 0; xx < ow; xx++) {
-                const double *row = in + (size_t)p * n + (size_t)yy * (size_t)w + (size_t)xx;
-                double s = 0.0;
-                for (int i = 0; i <= 2 * r; i++) s += k[i] * row[i];
-                hp[(size_t)p * hn + (size_t)yy * (size_t)ow + (size_t)xx] = s;
+    const ssim_job *j = ctx;
+    int c = index / j->nbands, band = index % j->nbands;
+    int w = j->ref->width, r = j->r, ow = j->ow, taps = 2 * r + 1;
+    int oy0 = band * SSIM_BAND, oy1 = oy0 + SSIM_BAND;
+    if (oy1 > j->oh) oy1 = j->oh;
+    int rows = oy1 - oy0 + 2 * r; /* input rows oy0 .. oy1 + 2r - 1 */
+    double *prod = j->scratch + (size_t)thread * j->per_thread; /* 5 * w */
+    double *hp = prod + 5 * (size_t)w;                           /* 5 planes of ow * rows */
+    size_t plane = (size_t)ow * (size_t)rows;
+    for (int ry = 0; ry < rows; ry++) {
+        int y = oy0 + ry;
+        for (int x = 0; x < w; x++) {
+            size_t o = ((size_t)y * (size_t)w + (size_t)x) * 3u + (size_t)c;
+            double a = clamp01(fin(j->ref->rgb[o])), b = clamp01(fin(j->test->rgb[o]));
+            prod[x] = a;
+            prod[w + x] = b;
+            prod[2 * w + x] = a * a;
+            prod[3 * w + x] = b * b;
+            prod[4 * w + x] = a * b;
+        }
+        for (int p = 0; p < 5; p++) {
+            double *out = hp + (size_t)p * plane + (size_t)ry * (size_t)ow;
+            const double *in = prod + (size_t)p * (size_t)w;
+            for (int x = 0; x < ow; x++) out[x] = 0.0;
+            for (int i = 0; i < taps; i++) {
+                double kv = j->k[i];
+                for (int x = 0; x < ow; x++) out[x] += kv * in[x + i];
             }
+        }
+    }
     const double c1 = (SSIM_K1 * SSIM_L) * (SSIM_K1 * SSIM_L);
     const double c2 = (SSIM_K2 * SSIM_L) * (SSIM_K2 * SSIM_L);
     double total = 0.0;
-    for (int yy = 0; yy < oh; yy++)
-        for (int xx = 0; xx < ow; xx++) {
+    for (int oy = 0; oy < oy1 - oy0; oy++)
+        for (int x = 0; x < ow; x++) {
             double m[5];
             for (int p = 0; p < 5; p++) {
+                const double *col = hp + (size_t)p * plane + (size_t)oy * (size_t)ow + (size_t)x;
                 double s = 0.0;
-                for (int i = 0; i <= 2 * r; i++)
-                    s += k[i] * hp[(size_t)p * hn + (size_t)(yy + i) * (size_t)ow + (size_t)xx];
+                for (int i = 0; i < taps; i++) s += j->k[i] * col[(size_t)i * (size_t)ow];
                 m[p] = s;
             }
             double mx = m[0], my = m[1];
@@ -138,7 +156,7 @@ static double ssim_channel(const framebuffer *ref, const framebuffer *test, int 
             total += ((2.0 * mx * my + c1) * (2.0 * cxy + c2)) /
                      ((mx * mx + my * my + c1) * (vx + vy + c2));
         }
-    return total / ((double)ow * (double)oh);
+    j->band_sum[index] = total;
 }
 
 pt_status img_ssim(const framebuffer *ref, const framebuffer *test, double *ssim, double ch[3], diag *d)
@@ -155,19 +173,36 @@ pt_status img_ssim(const framebuffer *ref, const framebuffer *test, double *ssim
         ks += k[i + r];
     }
     for (int i = 0; i <= 2 * r; i++) k[i] /= ks;
-    size_t n = (size_t)w * (size_t)h;
-    size_t hn = (size_t)(w - 2 * r) * (size_t)h;
-    double *planes = malloc((5 * n + 5 * hn) * sizeof *planes);
-    if (!planes) {
+
+    ssim_job j;
+    j.ref = ref;
+    j.test = test;
+    j.k = k;
+    j.r = r;
+    j.ow = w - 2 * r;
+    j.oh = h - 2 * r;
+    j.nbands = (j.oh + SSIM_BAND - 1) / SSIM_BAND;
+    j.nthreads = pool_default_threads();
+    if (j.nthreads > 3 * j.nbands) j.nthreads = 3 * j.nbands;
+    j.per_thread = 5 * (size_t)w + 5 * (size_t)j.ow * (size_t)(SSIM_BAND + 2 * r);
+    j.scratch = malloc((size_t)j.nthreads * j.per_thread * sizeof(double));
+    j.band_sum = malloc(3 * (size_t)j.nbands * sizeof(double));
+    if (!j.scratch || !j.band_sum) {
+        free(j.scratch);
+        free(j.band_sum);
         diag_report(d, DIAG_ERROR, (src_loc){0}, NULL, "SSIM: out of memory");
         return PT_ERR_NOMEM;
     }
+    pool_run(j.nthreads, 3 * j.nbands, ssim_band, &j);
     double v[3], sum = 0.0;
     for (int c = 0; c < 3; c++) {
-        v[c] = ssim_channel(ref, test, c, k, r, planes);
+        double t = 0.0;
+        for (int b = 0; b < j.nbands; b++) t += j.band_sum[c * j.nbands + b];
+        v[c] = t / ((double)j.ow * (double)j.oh);
         sum += v[c];
     }
-    free(planes);
+    free(j.scratch);
+    free(j.band_sum);
     if (ssim) *ssim = sum / 3.0;
     if (ch)
         for (int c = 0; c < 3; c++) ch[c] = v[c];

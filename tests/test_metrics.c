@@ -250,8 +250,8 @@ static void test_flip_identical(void **st)
 }
 
 /* Uniform black against uniform white: no features, so FLIP is the remapped
- * colour difference alone [L, Eq. 5]. Black is L* = 0, white L* = 100 with
- * a* = b* = 0, so HyAB = 100. cmax is the HyAB distance between
+ * colour difference alone (LDR-FLIP paper). Black is L* = 0, white L* = 100
+ * with a* = b* = 0, so HyAB = 100. cmax is the HyAB distance between
  * Hunt-adjusted sRGB green and blue, computed here from the textbook sRGB
  * matrix (4 decimals) and CIELAB formulas. */
 static void lab_of(double r, double g, double b, double lab[3])
