@@ -124,6 +124,7 @@ static const exr_attr_chromaticities_t primaries_table[] = {
 
 void img_exr_primaries(img_primaries prim, float xy[8])
 {
+    if ((unsigned)prim >= sizeof primaries_table / sizeof primaries_table[0]) prim = IMG_PRIMARIES_REC709;
     const exr_attr_chromaticities_t *c = &primaries_table[prim];
     const float v[8] = {c->red_x, c->red_y, c->green_x, c->green_y, c->blue_x, c->blue_y, c->white_x, c->white_y};
     memcpy(xy, v, sizeof v);

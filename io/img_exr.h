@@ -4,9 +4,13 @@
 #include "img_io.h"
 
 /* Colour primaries written to the `chromaticities` header attribute.
- * img_write uses REC709 (= sRGB primaries, D65 white). ACEScg needs only a
- * `primaries` field in img_write_opts that img_write passes through here. */
-typedef enum { IMG_PRIMARIES_REC709 = 0, IMG_PRIMARIES_ACESCG } img_primaries;
+ * img_write uses REC709 (= sRGB primaries, D65 white) unless
+ * img_write_opts.working_space names another space; then the values come
+ * from img_ocio_chromaticities (which uses this table for the ACES spaces). */
+typedef enum { IMG_PRIMARIES_REC709 = 0, IMG_PRIMARIES_ACESCG, IMG_PRIMARIES_ACES2065_1 } img_primaries;
+
+/* The chromaticities of `prim` as rx ry gx gy bx by wx wy (CIE 1931 xy). */
+void img_exr_primaries(img_primaries prim, float xy[8]);
 
 /* Write `fb` as a single-part scanline EXR to the open file `fd` (positioned
  * writes; the caller closes it). `name` is only used in messages. Channels
@@ -15,6 +19,11 @@ typedef enum { IMG_PRIMARIES_REC709 = 0, IMG_PRIMARIES_ACESCG } img_primaries;
  * are clamped to +-65504 (the largest half) so no Inf ever reaches the file. */
 pt_status img_exr_write(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
                         img_primaries prim, diag *d);
+
+/* As img_exr_write with the chromaticities given as rx ry gx gy bx by wx wy;
+ * xy == NULL writes no chromaticities attribute. */
+pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
+                           const float *xy, diag *d);
 
 /* Read part 0 of a scanline or tiled EXR (level 0 of a mip/rip-mapped file).
  * R,G,B (half/float/uint, missing ones are 0) or, without any of those, Y as

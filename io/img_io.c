@@ -13,6 +13,7 @@
  * encoder; callers need not sanitize first. */
 #include "img_io.h"
 #include "img_exr.h"
+#include "img_ocio.h"
 #include "img_pfm.h"
 #include "img_png.h"
 
@@ -112,6 +113,95 @@ static int valid_fb(const framebuffer *fb)
            fb->height <= IMG_MAX_SIDE && (uint64_t)fb->width * (uint64_t)fb->height <= IMG_MAX_PIXELS;
 }
 
+/* What colour management does to one write: the values to encode (fb, or
+ * a converted copy), the EXR chromaticities, the PNG encoding and chunks. */
+typedef struct {
+    framebuffer *copy; /* owned RGB copy (alpha borrowed from fb), or NULL */
+    float xy[8];       /* EXR chromaticities */
+    int have_xy;       /* 0: write no chromaticities attribute */
+    int png_display;   /* 1: copy holds display-encoded values */
+    img_png_tag tag;
+} colour_plan;
+
+static void plan_free(colour_plan *p)
+{
+    if (p->copy) p->copy->alpha = NULL; /* borrowed */
+    fb_free(p->copy);
+    p->copy = NULL;
+}
+
+static pt_status plan_colour(const char *path, img_format fmt, const framebuffer *fb, const img_write_opts *o,
+                             colour_plan *p, diag *d)
+{
+    memset(p, 0, sizeof *p);
+    img_exr_primaries(IMG_PRIMARIES_REC709, p->xy);
+    p->have_xy = 1;
+    p->tag = IMG_PNG_TAG_SRGB;
+    if (fmt == IMG_FMT_PNG && (!isfinite(o->exposure) || fabs(o->exposure) > 64.0)) {
+        report(d, "cannot write '%s': exposure %g stops is out of range (finite, at most 64 either way)", path,
+               o->exposure);
+        return PT_ERR_USAGE;
+    }
+    const int need_ocio = (fmt == IMG_FMT_EXR && (o->working_space || o->fb_space)) ||
+                          (fmt == IMG_FMT_PNG && (o->display || o->view || o->look));
+    const int scale = fmt == IMG_FMT_PNG && o->exposure != 0.0;
+    if (!need_ocio && !scale) return PT_OK;
+
+    const char *fbs = o->fb_space ? o->fb_space : IMG_OCIO_RENDER_SPACE;
+    const char *ws = o->working_space ? o->working_space : fbs;
+    img_ocio *oc = o->ocio, *owned = NULL;
+    pt_status st = PT_OK;
+    if (need_ocio && !oc) {
+        st = img_ocio_open(o->ocio_config, &owned, d);
+        if (st != PT_OK) return st;
+        oc = owned;
+    }
+    /* Names first, so a typo fails before any pixel work. */
+    if (need_ocio && fmt == IMG_FMT_EXR) st = img_ocio_check(oc, ws, NULL, NULL, NULL, d);
+    if (need_ocio && st == PT_OK) st = img_ocio_check(oc, fbs, NULL, NULL, NULL, d);
+    if (need_ocio && fmt == IMG_FMT_PNG && st == PT_OK)
+        st = img_ocio_check(oc, NULL, o->display, o->view, o->look, d);
+    const int convert = fmt == IMG_FMT_PNG || strcmp(fbs, ws) != 0;
+    if (st == PT_OK && convert) {
+        p->copy = fb_new(fb->width, fb->height);
+        if (!p->copy) {
+            report(d, "cannot write '%s': out of memory", path);
+            st = PT_ERR_NOMEM;
+        } else {
+            memcpy(p->copy->rgb, fb->rgb, sizeof(float) * 3u * (size_t)fb->width * (size_t)fb->height);
+            p->copy->alpha = fb->alpha;
+        }
+    }
+    if (st == PT_OK && !need_ocio) {
+        /* Exposure alone on the plain sRGB path. */
+        const float k = (float)exp2(o->exposure);
+        const size_t n = 3u * (size_t)fb->width * (size_t)fb->height;
+        for (size_t i = 0; i < n; i++) p->copy->rgb[i] *= k;
+    } else if (st == PT_OK && fmt == IMG_FMT_EXR) {
+        if (convert) st = img_ocio_convert(oc, p->copy, fbs, ws, d);
+        if (st == PT_OK) p->have_xy = img_ocio_chromaticities(oc, ws, p->xy, d);
+    } else if (st == PT_OK) {
+        st = img_ocio_apply(oc, p->copy, fbs, o->display, o->view, o->look, o->exposure, d);
+        p->png_display = 1;
+        switch (img_ocio_display_kind(oc, o->display, o->view)) {
+        case IMG_DISPLAY_SRGB: p->tag = IMG_PNG_TAG_SRGB; break;
+        case IMG_DISPLAY_REC1886: p->tag = IMG_PNG_TAG_REC1886; break;
+        case IMG_DISPLAY_DATA: p->tag = IMG_PNG_TAG_NONE; break;
+        default: {
+            p->tag = IMG_PNG_TAG_NONE;
+            src_loc none = {NULL, 0, 0};
+            diag_report(d, DIAG_WARNING, none, NULL,
+                        "'%s': display '%s' is neither sRGB nor Rec.1886; the PNG gets no colour chunks", path,
+                        o->display ? o->display : img_ocio_default_display(oc));
+            break;
+        }
+        }
+    }
+    img_ocio_close(owned);
+    if (st != PT_OK) plan_free(p);
+    return st;
+}
+
 pt_status img_write(const char *path, const framebuffer *fb, const img_write_opts *o, diag *d)
 {
     img_write_opts defaults;
@@ -142,8 +232,14 @@ pt_status img_write(const char *path, const framebuffer *fb, const img_write_opt
         return PT_ERR_USAGE;
     }
 
+    colour_plan plan;
+    pt_status cst = plan_colour(path, fmt, fb, o, &plan, d);
+    if (cst != PT_OK) return cst;
+    const framebuffer *out = plan.copy ? plan.copy : fb;
+
     char *tmp = temp_path_for(path);
     if (!tmp) {
+        plan_free(&plan);
         report(d, "cannot write '%s': out of memory", path);
         return PT_ERR_NOMEM;
     }
@@ -156,15 +252,19 @@ pt_status img_write(const char *path, const framebuffer *fb, const img_write_opt
     if (fd < 0) {
         report(d, "cannot write '%s': cannot create temporary file '%s': %s", path, tmp, strerror(errno));
         free(tmp);
+        plan_free(&plan);
         return PT_ERR_IO;
     }
 
     pt_status st;
     switch (fmt) {
-    case IMG_FMT_EXR: st = img_exr_write(fd, path, fb, o, IMG_PRIMARIES_REC709, d); break;
-    case IMG_FMT_PNG: st = img_png_write(fd, path, fb, o, d); break;
+    case IMG_FMT_EXR: st = img_exr_write_xy(fd, path, out, o, plan.have_xy ? plan.xy : NULL, d); break;
+    case IMG_FMT_PNG:
+        st = plan.png_display ? img_png_write_display(fd, path, out, o, plan.tag, d) : img_png_write(fd, path, out, o, d);
+        break;
     default: st = img_pfm_write(fd, path, fb, d); break;
     }
+    plan_free(&plan);
 
     if (st == PT_OK && fsync(fd) != 0 && errno != EINVAL && errno != EROFS) {
         report(d, "cannot write '%s': %s", path, strerror(errno));

@@ -21,11 +21,31 @@ typedef struct {
     const char *const *meta_keys;
     const char *const *meta_values;
     int nmeta;
+
+    /* Colour management through OpenColorIO (io/img_ocio.h). With all of
+     * these NULL/0 (the default) no OCIO config is loaded: a PNG is the plain
+     * sRGB encoding of the linear values (as POV-Ray writes it) and an EXR
+     * holds the values as given, tagged with Rec.709 chromaticities. */
+    struct img_ocio *ocio;     /* an open config to use; NULL = open ocio_config */
+    const char *ocio_config;   /* config file; NULL = $OCIO if set, else the built-in one */
+    const char *fb_space;      /* colour space of fb's values; NULL = "Linear Rec.709 (sRGB)" */
+    /* EXR: the scene-linear space written; fb is converted into it and the
+     * chromaticities attribute describes it. NULL = fb_space. */
+    const char *working_space;
+    /* PNG: any of display/view/look set = encode through OCIO's
+     * DisplayViewTransform (NULL display/view = the config's defaults:
+     * sRGB / Standard), with colour chunks for that display: sRGB display
+     * -> sRGB chunk; Rec.1886 -> gAMA 1/2.4 + Rec.709 cHRM; Raw view or an
+     * unrecognised display -> none. Ignored for EXR and PFM. */
+    const char *display, *view, *look;
+    double exposure;           /* PNG only: values x 2^exposure before the view or the sRGB encoding */
 } img_write_opts;
 
 void img_default_write_opts(img_write_opts *o);
 img_format img_format_from_path(const char *path);
-/* PNG: linear values are encoded with the sRGB transfer function (IEC 61966-2-1). */
+/* PNG: linear values are encoded with the sRGB transfer function (IEC 61966-2-1)
+ * unless a display/view/look is set (see img_write_opts). PFM: values as given.
+ * Colour-management name errors are PT_ERR_USAGE, found before any file is made. */
 pt_status img_write(const char *path, const framebuffer *fb, const img_write_opts *o, diag *d);
 /* Reads EXR (R,G,B channels, half or float), PFM, PNG (8/16 bit; sRGB decoded
  * to linear unless `png_raw` is set, then values are code/max). */

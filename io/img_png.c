@@ -92,6 +92,14 @@ static unsigned encode_code(float v, double maxcode)
     return (unsigned)floor(e * maxcode + 0.5);
 }
 
+/* Display-encoded value -> code: clamp to [0,1], round to nearest. */
+static unsigned display_code(float v, double maxcode)
+{
+    if (!isfinite(v) || v <= 0.0f) return 0;
+    if (v >= 1.0f) return (unsigned)maxcode;
+    return (unsigned)floor((double)v * maxcode + 0.5);
+}
+
 static unsigned alpha_code(float v, double maxcode)
 {
     if (!isfinite(v) || v <= 0.0f) return 0;
@@ -99,8 +107,24 @@ static unsigned alpha_code(float v, double maxcode)
     return (unsigned)floor((double)v * maxcode + 0.5);
 }
 
+static pt_status write_png(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
+                           int encoded, img_png_tag tag, diag *d);
+
 pt_status img_png_write(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
                         diag *d)
+{
+    return write_png(fd, name, fb, o, 0, IMG_PNG_TAG_SRGB, d);
+}
+
+pt_status img_png_write_display(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
+                                img_png_tag tag, diag *d)
+{
+    return write_png(fd, name, fb, o, 1, tag, d);
+}
+
+/* `encoded`: fb holds display-encoded values (no transfer function here). */
+static pt_status write_png(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
+                           int encoded, img_png_tag tag, diag *d)
 {
     png_ctx ctx = {fd, 0, {0}};
     const int bits = o && o->png_16bit ? 16 : 8;
@@ -129,9 +153,18 @@ pt_status img_png_write(int fd, const char *name, const framebuffer *fb, const i
     png_set_IHDR(png, info, (png_uint_32)fb->width, (png_uint_32)fb->height, bits,
                  ch == 4 ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-    /* sRGB chunk (perceptual rendering intent) plus the gAMA and cHRM values
-     * the PNG spec (section 11.3.3.5) recommends alongside it. */
-    png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    if (tag == IMG_PNG_TAG_SRGB) {
+        /* sRGB chunk (perceptual rendering intent) plus the gAMA and cHRM
+         * values the PNG spec (section 11.3.3.5) recommends alongside it. */
+        png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    } else if (tag == IMG_PNG_TAG_REC1886) {
+        /* BT.1886 with zero black level is a pure 2.4 power law: gAMA holds
+         * the encoding exponent 1/2.4 (x 100000, PNG spec 11.3.3.2), cHRM the
+         * BT.709-6 primaries and D65 white (x 100000, 11.3.3.1). No sRGB or
+         * iCCP chunk. */
+        png_set_gAMA_fixed(png, info, 41667);
+        png_set_cHRM_fixed(png, info, 31270, 32900, 64000, 33000, 30000, 60000, 15000, 6000);
+    }
     png_write_info(png, info);
     for (int y = 0; y < fb->height; y++) {
         const float *src = fb->rgb + (size_t)y * (size_t)fb->width * 3u;
@@ -139,7 +172,8 @@ pt_status img_png_write(int fd, const char *name, const framebuffer *fb, const i
         unsigned char *p = row;
         for (int x = 0; x < fb->width; x++) {
             unsigned codes[4];
-            for (int k = 0; k < 3; k++) codes[k] = encode_code(src[x * 3 + k], maxcode);
+            for (int k = 0; k < 3; k++)
+                codes[k] = encoded ? display_code(src[x * 3 + k], maxcode) : encode_code(src[x * 3 + k], maxcode);
             if (asrc) codes[3] = alpha_code(asrc[x], maxcode);
             for (int k = 0; k < ch; k++) {
                 if (bits == 16) {

@@ -12,6 +12,19 @@
 pt_status img_png_write(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
                         diag *d);
 
+/* Colour chunks of a PNG holding display-encoded values. */
+typedef enum {
+    IMG_PNG_TAG_SRGB,    /* sRGB chunk (+ the gAMA/cHRM fallbacks): an sRGB display */
+    IMG_PNG_TAG_REC1886, /* gAMA 1/2.4 and Rec.709/D65 cHRM, no sRGB chunk: a BT.1886 display */
+    IMG_PNG_TAG_NONE     /* no colour chunks (data, or a display we cannot describe) */
+} img_png_tag;
+
+/* As img_png_write for values already encoded for a display (e.g. by
+ * img_ocio_apply): codes are the values clamped to [0,1] and rounded, with
+ * no transfer function applied; colour chunks as `tag` says. */
+pt_status img_png_write_display(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
+                                img_png_tag tag, diag *d);
+
 /* Read any PNG (1-16 bit grey, grey+alpha, RGB, RGBA, palette; interlaced or
  * not). Colour codes are decoded with img_srgb_decode unless `raw`, then
  * values are code/max. Alpha (incl. tRNS) goes to fb->alpha as code/max. */
