@@ -33,9 +33,12 @@ void accel_free(accel *a);
  * from CSG parents when the leaf has none of its own.
  *
  * Self-intersection rule: every query uses an effective tmin of
- * max(tmin, accel_epsilon(a, org, dir)), i.e. 1e-6 * (accel_scale + max|org_i|)
- * / |dir|, so a ray leaving a surface does not hit it again at t ~ 0.
- * Thread-safe: any number of threads may query one accel concurrently. */
+ * max(tmin, accel_epsilon(a, org, dir)), i.e.
+ * ACCEL_EPS_REL * (accel_scale + max|org_i|) / |dir|, so a ray leaving a
+ * surface does not hit it again at t ~ 0 (reasoning in accel.c). */
+#define ACCEL_EPS_REL 1e-5
+/* Thread-safe: any number of threads may query one accel concurrently. */
+
 /* Nearest hit with t in (tmin, tmax); returns 1 on hit. (no_image and
  * no_reflection are not applied here yet: callers see them in hit->obj->flags.) */
 int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, accel_hit *hit);
