@@ -1,0 +1,595 @@
+/* sdl_material.c - textures, pigments, finishes, interiors, transforms. */
+#include "sdl_material.h"
+#include <math.h>
+#include <string.h>
+#include "sdl_directive.h"
+#include "sdl_expr.h"
+
+/* ------------------------------------------------------------ transforms */
+
+/* scale_vector: a vector or float; zero components become 1 with a
+ * warning, as POV-Ray does. */
+static vec3 scale_vector(sdl_parser *p)
+{
+    src_loc loc = sdl_peek(p)->tk.loc;
+    vec3 s = sdl_vector(p);
+    double *c[3] = {&s.x, &s.y, &s.z};
+    for (int i = 0; i < 3; i++) {
+        if (*c[i] != 0.0) continue;
+        sdl_warning(p, loc, "scale %c component is zero; changed to 1", "xyz"[i]);
+        *c[i] = 1.0;
+    }
+    return s;
+}
+
+/* matrix := 'matrix' '<' float x12 '>' (commas optional) */
+static xform matrix_value(sdl_parser *p)
+{
+    double m[12];
+    sdl_expect(p, TOK_LT, "'<' after matrix");
+    for (int i = 0; i < 12 && sdl_ok(p); i++) {
+        m[i] = sdl_float(p);
+        if (i < 11) sdl_accept(p, TOK_COMMA);
+    }
+    sdl_expect(p, TOK_GT, "'>' closing the matrix");
+    if (!sdl_ok(p)) return xform_identity();
+    return xform_matrix(m);
+}
+
+int sdl_transform_item(sdl_parser *p, xform *out)
+{
+    const sdl_tok *t = sdl_peek(p);
+    if (t->tk.kind != TOK_KEYWORD) return 0;
+    switch (t->tk.kw) {
+    case KW_TRANSLATE: sdl_next(p); *out = xform_translate(sdl_vector(p)); return 1;
+    case KW_ROTATE: sdl_next(p); *out = xform_rotate(sdl_vector(p)); return 1;
+    case KW_SCALE: sdl_next(p); *out = xform_scale(scale_vector(p)); return 1;
+    case KW_MATRIX: sdl_next(p); *out = matrix_value(p); return 1;
+    case KW_TRANSFORM: sdl_next(p); *out = sdl_parse_transform(p); return 1;
+    default: return 0;
+    }
+}
+
+/* transform_block := '{' { transform_identifier | transform_item | 'inverse' } '}' */
+static xform transform_block(sdl_parser *p)
+{
+    xform x = xform_identity(), item;
+    int inverse = 0;
+    if (!sdl_begin_block(p, "transform")) return x;
+    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
+        const sdl_tok *t = sdl_peek(p);
+        if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_TRANSFORM) {
+            sdl_tok id = sdl_next(p);
+            x = xform_then(x, *(const xform *)id.val.ptr);
+        } else if (sdl_accept_kw(p, KW_INVERSE)) {
+            inverse = !inverse;
+        } else if (sdl_transform_item(p, &item)) {
+            x = xform_then(x, item);
+        } else {
+            sdl_tok bad = sdl_next(p);
+            sdl_unexpected(p, &bad, "transformation");
+        }
+    }
+    sdl_end_block(p);
+    return inverse ? xform_inverse(x) : x;
+}
+
+/* transform := 'transform' ( transform_block | transform_identifier ) */
+xform sdl_parse_transform(sdl_parser *p)
+{
+    const sdl_tok *t = sdl_peek(p);
+    if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_TRANSFORM) {
+        sdl_tok id = sdl_next(p);
+        return *(const xform *)id.val.ptr;
+    }
+    return transform_block(p);
+}
+
+/* ------------------------------------------------------------ copies */
+
+scene_texture *sdl_copy_texture(sdl_parser *p, const scene_texture *t)
+{
+    scene_texture *head = NULL, **tail = &head;
+    for (; t; t = t->next) {
+        scene_texture *c = sdl_alloc(p, sizeof *c);
+        if (!c) return head;
+        *c = *t;
+        c->next = NULL;
+        *tail = c;
+        tail = &c->next;
+    }
+    return head;
+}
+
+void sdl_transform_texture(scene_texture *t, const xform *x)
+{
+    for (; t; t = t->next) t->transform = xform_then(t->transform, *x);
+}
+
+/* ------------------------------------------------------------ pigments */
+
+static int is_pattern_kw(sdl_kw k)
+{
+    switch (k) {
+    case KW_AGATE: case KW_AOI: case KW_AVERAGE: case KW_BOXED: case KW_BOZO: case KW_BRICK:
+    case KW_BUMPS: case KW_CELLS: case KW_CHECKER: case KW_CRACKLE: case KW_CYLINDRICAL:
+    case KW_DENSITY_FILE: case KW_DENTS: case KW_FACETS: case KW_FUNCTION: case KW_GRADIENT:
+    case KW_GRANITE: case KW_HEXAGON: case KW_IMAGE_MAP: case KW_IMAGE_PATTERN: case KW_JULIA:
+    case KW_LEOPARD: case KW_MAGNET: case KW_MANDEL: case KW_MARBLE: case KW_OBJECT:
+    case KW_ONION: case KW_PAVEMENT: case KW_PIGMENT_PATTERN: case KW_PLANAR: case KW_QUILTED:
+    case KW_RADIAL: case KW_RIPPLES: case KW_SLOPE: case KW_SPHERICAL: case KW_SPIRAL1:
+    case KW_SPIRAL2: case KW_SPOTTED: case KW_SQUARE: case KW_TILING: case KW_TRIANGULAR:
+    case KW_WAVES: case KW_WOOD: case KW_WRINKLES: case KW_BUMP_MAP: case KW_TILES:
+    case KW_MATERIAL_MAP: case KW_CUBIC:
+        return 1;
+    default:
+        return 0;
+    }
+}
+
+/* colour_map_entry := '[' float [','] [float [','] ] colour [colour] ']' ;
+ * the first entry's colour is kept. */
+static void colour_map_block(sdl_parser *p, colour5 *first, int *have)
+{
+    if (sdl_is(sdl_peek(p), TOK_IDENT)) { /* a declared colour_map: opaque */
+        sdl_next(p);
+        return;
+    }
+    if (!sdl_begin_block(p, "colour_map")) return;
+    while (sdl_ok(p) && sdl_accept(p, TOK_LBRACKET)) {
+        sdl_float(p);
+        sdl_accept(p, TOK_COMMA);
+        if (!sdl_starts_colour(sdl_peek(p))) {
+            sdl_float(p);
+            sdl_accept(p, TOK_COMMA);
+        }
+        colour5 c = sdl_colour(p, 1);
+        if (!*have) {
+            *first = c;
+            *have = 1;
+        }
+        if (sdl_starts_colour(sdl_peek(p))) sdl_colour(p, 1);
+        sdl_expect(p, TOK_RBRACKET, "']'");
+    }
+    sdl_end_block(p);
+}
+
+/* Loose skip of one token of a pattern's arguments: nested blocks skipped,
+ * nested pigments and colours give the pattern's first colour. */
+static void pattern_token(sdl_parser *p, scene_pigment *pg, int *have)
+{
+    const sdl_tok *t = sdl_peek(p);
+    if (sdl_starts_colour(t) && t->tk.kind != TOK_IDENT) {
+        colour5 c = sdl_colour(p, 1);
+        if (!*have) pg->colour = c;
+        *have = 1;
+        return;
+    }
+    sdl_tok n = sdl_next(p);
+    if (n.tk.kind == TOK_IDENT && n.val.kind == VAL_NONE) {
+        sdl_error(p, n.tk.loc, PT_ERR_SYNTAX, "undeclared identifier '%.*s'", n.tk.len, n.tk.text);
+    } else if (n.tk.kind == TOK_IDENT && n.val.kind == VAL_COLOUR) {
+        if (!*have) memcpy(&pg->colour, n.val.v, sizeof pg->colour);
+        *have = 1;
+    } else if (n.tk.kind == TOK_IDENT && n.val.kind == VAL_PIGMENT) {
+        if (!*have) pg->colour = ((const scene_pigment *)n.val.ptr)->colour;
+        *have = 1;
+    } else if (sdl_is_kw(&n, KW_COLOR_MAP) || sdl_is_kw(&n, KW_COLOUR_MAP)) {
+        colour_map_block(p, &pg->colour, have);
+    } else if (sdl_is_kw(&n, KW_PIGMENT) && sdl_is(sdl_peek(p), TOK_LBRACE)) {
+        scene_pigment sub;
+        scene_default_pigment(&sub);
+        sdl_parse_pigment(p, &sub);
+        if (!*have) pg->colour = sub.colour;
+        *have = 1;
+    } else if (n.tk.kind == TOK_LBRACE) {
+        sdl_unget(p, &n);
+        if (sdl_begin_block(p, "pattern argument")) sdl_skip_block(p);
+    }
+}
+
+/* pigment_item := colour | pattern { pattern argument } | colour_map |
+ *                 transform_item | pigment modifier */
+static void pigment_item(sdl_parser *p, scene_pigment *pg, int *have_colour)
+{
+    const sdl_tok *t = sdl_peek(p);
+    xform x;
+    if (sdl_transform_item(p, &x)) {
+        pg->transform = xform_then(pg->transform, x);
+    } else if (pg->kind == PIGMENT_SOLID && sdl_starts_colour(t)) {
+        pg->colour = sdl_colour(p, 1);
+        *have_colour = 1;
+    } else if (pg->kind == PIGMENT_SOLID && t->tk.kind == TOK_KEYWORD && is_pattern_kw(t->tk.kw)) {
+        sdl_tok k = sdl_next(p);
+        sdl_warn_once(p, k.tk.loc, "pigment pattern '%s' is not evaluated yet; its first colour is used", sdl_kw_text(k.tk.kw));
+        pg->kind = PIGMENT_OTHER;
+        pg->pattern = sdl_kw_text(k.tk.kw);
+        *have_colour = 0;
+    } else {
+        pattern_token(p, pg, have_colour);
+    }
+}
+
+/* pigment := '{' [ pigment_identifier ] { pigment_item } '}' */
+void sdl_parse_pigment(sdl_parser *p, scene_pigment *pg)
+{
+    int have_colour = 0;
+    if (!sdl_begin_block(p, "pigment")) return;
+    const sdl_tok *t = sdl_peek(p);
+    if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_PIGMENT) {
+        sdl_tok id = sdl_next(p);
+        *pg = *(const scene_pigment *)id.val.ptr;
+        have_colour = 1;
+    }
+    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
+        if (sdl_is(sdl_peek(p), TOK_EOF)) break;
+        pigment_item(p, pg, &have_colour);
+    }
+    sdl_end_block(p);
+}
+
+scene_pigment *sdl_parse_pigment_new(sdl_parser *p)
+{
+    scene_pigment *pg = sdl_alloc(p, sizeof *pg);
+    if (!pg) return NULL;
+    *pg = p->s->default_texture.pigment;
+    sdl_parse_pigment(p, pg);
+    return pg;
+}
+
+/* ------------------------------------------------------------ finishes */
+
+/* reflection := 'reflection' ( colour | '{' colour [','] [colour]
+ *               { fresnel [bool] | falloff f | exponent f | metallic [f] } '}' ) */
+static void reflection(sdl_parser *p, scene_finish *f)
+{
+    if (!sdl_is(sdl_peek(p), TOK_LBRACE)) {
+        f->reflection_max = sdl_rgb(p);
+        f->reflection_min = f->reflection_max;
+        f->reflection_falloff = 1;
+        f->fresnel = 0;
+        return;
+    }
+    int second = 0;
+    sdl_begin_block(p, "reflection");
+    f->reflection_min = sdl_rgb(p);
+    sdl_accept(p, TOK_COMMA);
+    if (sdl_starts_expr(sdl_peek(p))) {
+        f->reflection_max = sdl_rgb(p);
+        second = 1;
+    } else {
+        f->reflection_max = f->reflection_min;
+    }
+    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
+        sdl_tok t = sdl_next(p);
+        if (sdl_is_kw(&t, KW_FRESNEL)) {
+            f->fresnel = sdl_true(sdl_allow_float(p, 1.0));
+            if (!second && f->fresnel) f->reflection_min = (rgb){0, 0, 0};
+        } else if (sdl_is_kw(&t, KW_FALLOFF)) {
+            f->reflection_falloff = sdl_float(p);
+        } else if (sdl_is_kw(&t, KW_EXPONENT)) {
+            f->reflection_exponent = sdl_float(p);
+        } else if (sdl_is_kw(&t, KW_METALLIC)) {
+            f->reflection_metallic = sdl_allow_float(p, 1.0);
+        } else {
+            sdl_unexpected(p, &t, "reflection modifier");
+        }
+    }
+    sdl_end_block(p);
+}
+
+/* Skip a '{...}' finish sub-block (irid, subsurface) with a warning. */
+static void skip_sub_block(sdl_parser *p, const sdl_tok *k)
+{
+    sdl_warn_once(p, k->tk.loc, "finish '%s' is not supported yet and is ignored", sdl_kw_text(k->tk.kw));
+    if (sdl_begin_block(p, sdl_kw_text(k->tk.kw))) sdl_skip_block(p);
+}
+
+typedef struct { int diffuse, phong, specular; } albedo_flags;
+
+/* albedo-adjustable values: 'diffuse' ['albedo'] f [',' f], phong, specular */
+static void albedo_value(sdl_parser *p, sdl_kw k, scene_finish *f, albedo_flags *a)
+{
+    int albedo = sdl_accept_kw(p, KW_ALBEDO);
+    if (k == KW_DIFFUSE) {
+        a->diffuse = albedo;
+        f->diffuse = sdl_float(p);
+        sdl_accept(p, TOK_COMMA);
+        f->diffuse_back = sdl_allow_float(p, 0.0);
+    } else if (k == KW_PHONG) {
+        a->phong = albedo;
+        f->phong = sdl_float(p);
+    } else {
+        a->specular = albedo;
+        f->specular = sdl_float(p);
+    }
+}
+
+/* finish_item := ambient c | emission c | brilliance f | diffuse .. | phong .. |
+ *   phong_size f | specular .. | roughness f | metallic [f] | crand f |
+ *   reflection .. | reflection_exponent f | conserve_energy | irid {..} |
+ *   subsurface {..} | ior f | caustics f | refraction f */
+static void finish_item(sdl_parser *p, scene_finish *f, albedo_flags *a)
+{
+    sdl_tok t = sdl_next(p);
+    sdl_kw k = t.tk.kind == TOK_KEYWORD ? t.tk.kw : KW_NONE;
+    switch (k) {
+    case KW_AMBIENT: f->ambient = sdl_rgb(p); break;
+    case KW_EMISSION: f->emission = sdl_rgb(p); break;
+    case KW_BRILLIANCE: f->brilliance = sdl_float(p); break;
+    case KW_DIFFUSE: case KW_PHONG: case KW_SPECULAR: albedo_value(p, k, f, a); break;
+    case KW_PHONG_SIZE: f->phong_size = sdl_float(p); break;
+    case KW_ROUGHNESS:
+        f->roughness = sdl_float(p);
+        if (f->roughness == 0) sdl_warning(p, t.tk.loc, "zero roughness used");
+        break;
+    case KW_METALLIC: f->metallic = sdl_starts_float(sdl_peek(p)) ? sdl_float(p) : 1.0; break;
+    case KW_CRAND: f->crand = sdl_float(p); break;
+    case KW_REFLECTION: reflection(p, f); break;
+    case KW_REFLECTION_EXPONENT: f->reflection_exponent = sdl_float(p); break;
+    case KW_CONSERVE_ENERGY: f->conserve_energy = 1; break;
+    case KW_IRID: case KW_SUBSURFACE: skip_sub_block(p, &t); break;
+    case KW_IOR: case KW_CAUSTICS: case KW_REFRACTION:
+        sdl_warn_once(p, t.tk.loc, "finish '%s' belongs in interior{} and is ignored", sdl_kw_text(k));
+        sdl_float(p);
+        break;
+    default: sdl_unexpected(p, &t, "finish item"); break;
+    }
+}
+
+/* POV-Ray 3.7's 'albedo' adjustments, applied after the whole block. */
+static void apply_albedo(scene_finish *f, const albedo_flags *a)
+{
+    if (a->diffuse) {
+        f->diffuse *= (f->brilliance + 1.0) / 2.0;
+        f->diffuse_back *= (f->brilliance + 1.0) / 2.0;
+    }
+    if (a->phong) f->phong *= (f->phong_size + 1.0) / 2.0;
+    if (a->specular && f->roughness != 0) {
+        double r = 1.0 / f->roughness; /* POV-Ray keeps 1/roughness internally */
+        f->specular *= (r + 2.0) / (4.0 * (2.0 - pow(2.0, -r / 2.0)));
+    }
+}
+
+/* finish := '{' [ finish_identifier ] { finish_item } '}' */
+void sdl_parse_finish(sdl_parser *p, scene_finish *f)
+{
+    albedo_flags a = {0, 0, 0};
+    if (!sdl_begin_block(p, "finish")) return;
+    const sdl_tok *t = sdl_peek(p);
+    if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_FINISH) {
+        sdl_tok id = sdl_next(p);
+        *f = *(const scene_finish *)id.val.ptr;
+    }
+    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE) && !sdl_is(sdl_peek(p), TOK_EOF)) finish_item(p, f, &a);
+    sdl_end_block(p);
+    apply_albedo(f, &a);
+}
+
+scene_finish *sdl_parse_finish_new(sdl_parser *p)
+{
+    scene_finish *f = sdl_alloc(p, sizeof *f);
+    if (!f) return NULL;
+    *f = p->s->default_texture.finish;
+    sdl_parse_finish(p, f);
+    return f;
+}
+
+void sdl_parse_normal(sdl_parser *p)
+{
+    if (sdl_begin_block(p, "normal")) sdl_skip_block(p);
+}
+
+/* ------------------------------------------------------------ interiors */
+
+/* interior_item := ior f | dispersion f | dispersion_samples n | caustics f |
+ *   fade_distance f | fade_power f | fade_colour c | media {..} */
+static void interior_item(sdl_parser *p, scene_interior *in)
+{
+    sdl_tok t = sdl_next(p);
+    sdl_kw k = t.tk.kind == TOK_KEYWORD ? t.tk.kw : KW_NONE;
+    switch (k) {
+    case KW_IOR: in->ior = sdl_float(p); break;
+    case KW_DISPERSION: in->dispersion = sdl_float(p); break;
+    case KW_DISPERSION_SAMPLES: sdl_float(p); break;
+    case KW_CAUSTICS: sdl_float(p); in->caustics_set = 1; break;
+    case KW_FADE_DISTANCE: in->fade_distance = sdl_float(p); break;
+    case KW_FADE_POWER: in->fade_power = sdl_float(p); break;
+    case KW_FADE_COLOR: case KW_FADE_COLOUR: in->fade_colour = sdl_rgb(p); break;
+    case KW_MEDIA:
+        sdl_warn_once(p, t.tk.loc, "media is not supported yet and is ignored");
+        if (sdl_begin_block(p, "media")) sdl_skip_block(p);
+        break;
+    default: sdl_unexpected(p, &t, "interior item"); break;
+    }
+}
+
+/* interior := '{' [ interior_identifier ] { interior_item } '}' */
+void sdl_parse_interior(sdl_parser *p, scene_interior *in)
+{
+    if (!sdl_begin_block(p, "interior")) return;
+    const sdl_tok *t = sdl_peek(p);
+    if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_INTERIOR) {
+        sdl_tok id = sdl_next(p);
+        *in = *(const scene_interior *)id.val.ptr;
+    }
+    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE) && !sdl_is(sdl_peek(p), TOK_EOF)) interior_item(p, in);
+    sdl_end_block(p);
+}
+
+scene_interior *sdl_parse_interior_new(sdl_parser *p)
+{
+    scene_interior *in = sdl_alloc(p, sizeof *in);
+    if (!in) return NULL;
+    scene_default_interior(in);
+    sdl_parse_interior(p, in);
+    return in;
+}
+
+/* ------------------------------------------------------------ textures */
+
+static scene_texture *new_texture(sdl_parser *p)
+{
+    scene_texture *t = sdl_alloc(p, sizeof *t);
+    if (!t) return NULL;
+    *t = p->s->default_texture;
+    t->next = NULL;
+    t->transform = xform_identity();
+    return t;
+}
+
+/* A patterned texture (texture_map, tiles, material_map, checker of
+ * textures...): kept as one texture with a PIGMENT_OTHER pigment that
+ * takes the look of the first texture inside. */
+static void pattern_texture(sdl_parser *p, scene_texture *t)
+{
+    sdl_tok k = sdl_next(p);
+    const char *name = k.tk.kind == TOK_KEYWORD ? sdl_kw_text(k.tk.kw) : "pattern";
+    sdl_warn_once(p, k.tk.loc, "patterned texture '%s' is not evaluated yet; its first texture is used", name);
+    int have = 0;
+    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE) && !sdl_is(sdl_peek(p), TOK_EOF)) {
+        sdl_tok n = sdl_next(p);
+        xform x;
+        if (sdl_is_kw(&n, KW_TEXTURE) && sdl_is(sdl_peek(p), TOK_LBRACE)) {
+            scene_texture *sub = sdl_parse_texture(p);
+            if (!have && sub) {
+                xform keep = t->transform;
+                *t = *sub;
+                t->transform = keep;
+                t->next = NULL;
+                have = 1;
+            }
+        } else if (n.tk.kind == TOK_IDENT && n.val.kind == VAL_TEXTURE && !have) {
+            xform keep = t->transform;
+            *t = *(const scene_texture *)n.val.ptr;
+            t->transform = keep;
+            t->next = NULL;
+            have = 1;
+        } else if (n.tk.kind == TOK_LBRACE || n.tk.kind == TOK_LBRACKET) {
+            if (n.tk.kind == TOK_LBRACE) {
+                sdl_unget(p, &n);
+                if (sdl_begin_block(p, name)) sdl_skip_block(p);
+            }
+        } else if (n.tk.kind == TOK_KEYWORD) {
+            sdl_unget(p, &n);
+            if (sdl_transform_item(p, &x)) t->transform = xform_then(t->transform, x);
+            else sdl_next(p);
+        }
+    }
+    t->pigment.kind = PIGMENT_OTHER;
+    t->pigment.pattern = name;
+}
+
+/* texture_item := pigment_identifier | finish_identifier | normal_identifier |
+ *   'pigment' pigment | 'finish' finish | 'normal' normal | transform_item */
+static int texture_item(sdl_parser *p, scene_texture *t)
+{
+    const sdl_tok *pk = sdl_peek(p);
+    xform x;
+    if (pk->tk.kind == TOK_IDENT && (pk->val.kind == VAL_PIGMENT || pk->val.kind == VAL_FINISH || pk->val.kind == VAL_NORMAL)) {
+        sdl_tok id = sdl_next(p);
+        if (id.val.kind == VAL_PIGMENT) t->pigment = *(const scene_pigment *)id.val.ptr;
+        else if (id.val.kind == VAL_FINISH) t->finish = *(const scene_finish *)id.val.ptr;
+        else t->has_normal = 1;
+        return 1;
+    }
+    if (sdl_transform_item(p, &x)) {
+        t->transform = xform_then(t->transform, x);
+        return 1;
+    }
+    if (sdl_accept_kw(p, KW_PIGMENT)) {
+        sdl_parse_pigment(p, &t->pigment);
+        return 1;
+    }
+    if (sdl_accept_kw(p, KW_FINISH)) {
+        sdl_parse_finish(p, &t->finish);
+        return 1;
+    }
+    if (sdl_accept_kw(p, KW_NORMAL)) {
+        sdl_parse_normal(p);
+        t->has_normal = 1;
+        return 1;
+    }
+    return sdl_accept_kw(p, KW_NO_BUMP_SCALE);
+}
+
+/* texture := '{' [ texture_identifier ] { texture_item } | '{' texture_pattern ... '}' */
+scene_texture *sdl_parse_texture(sdl_parser *p)
+{
+    src_loc loc = sdl_peek(p)->tk.loc;
+    if (!sdl_begin_block(p, "texture")) return NULL;
+    scene_texture *t = NULL;
+    int modified = 0;
+    const sdl_tok *pk = sdl_peek(p);
+    if (pk->tk.kind == TOK_IDENT && pk->val.kind == VAL_TEXTURE) {
+        sdl_tok id = sdl_next(p);
+        t = sdl_copy_texture(p, id.val.ptr);
+        modified = 1;
+    } else {
+        t = new_texture(p);
+    }
+    if (!t) return NULL;
+    t->loc = loc;
+    while (sdl_ok(p) && texture_item(p, t)) modified = 1;
+    const sdl_tok *rest = sdl_peek(p);
+    if (!modified && !sdl_is(rest, TOK_RBRACE) && rest->tk.kind == TOK_KEYWORD && is_pattern_kw(rest->tk.kw))
+        pattern_texture(p, t);
+    sdl_end_block(p);
+    return t;
+}
+
+/* ------------------------------------------------------------ materials */
+
+/* material := '{' [ material_identifier ] { texture | interior_texture | interior | transform_item } '}' */
+void sdl_parse_material(sdl_parser *p, sdl_material *m)
+{
+    if (!sdl_begin_block(p, "material")) return;
+    const sdl_tok *pk = sdl_peek(p);
+    if (pk->tk.kind == TOK_IDENT && pk->val.kind == VAL_MATERIAL) {
+        sdl_tok id = sdl_next(p);
+        const sdl_material *src = id.val.ptr;
+        m->texture = sdl_copy_texture(p, src->texture);
+        m->interior_texture = sdl_copy_texture(p, src->interior_texture);
+        m->interior = src->interior;
+    }
+    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
+        sdl_tok t = sdl_next(p);
+        xform x;
+        if (sdl_is_kw(&t, KW_TEXTURE)) {
+            scene_texture *nt = sdl_parse_texture(p);
+            if (nt) {
+                scene_texture *last = nt;
+                while (last->next) last = last->next;
+                last->next = m->texture;
+                m->texture = nt;
+            }
+        } else if (sdl_is_kw(&t, KW_INTERIOR_TEXTURE)) {
+            m->interior_texture = sdl_parse_texture(p);
+        } else if (sdl_is_kw(&t, KW_INTERIOR)) {
+            scene_interior *in = sdl_alloc(p, sizeof *in);
+            if (!in) return;
+            if (m->interior) *in = *m->interior;
+            else scene_default_interior(in);
+            sdl_parse_interior(p, in);
+            m->interior = in;
+        } else {
+            sdl_unget(p, &t);
+            if (!sdl_transform_item(p, &x)) {
+                sdl_next(p);
+                sdl_unexpected(p, &t, "texture, interior or transformation");
+                return;
+            }
+            sdl_transform_texture(m->texture, &x);
+            sdl_transform_texture(m->interior_texture, &x);
+        }
+    }
+    sdl_end_block(p);
+}
+
+sdl_material *sdl_parse_material_new(sdl_parser *p)
+{
+    sdl_material *m = sdl_alloc(p, sizeof *m);
+    if (!m) return NULL;
+    sdl_parse_material(p, m);
+    return m;
+}

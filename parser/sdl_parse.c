@@ -1,0 +1,316 @@
+/* sdl_parse.c - public entry points (sdl.h), errors, token helpers. */
+#include "sdl_parse.h"
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "sdl_directive.h"
+#include "sdl_expr.h"
+#include "sdl_scene.h"
+
+/* ------------------------------------------------------------ errors */
+
+void sdl_error(sdl_parser *p, src_loc loc, pt_status st, const char *fmt, ...)
+{
+    if (!sdl_ok(p)) return;
+    p->status = st;
+    char *chain = sdl_chain(p);
+    va_list ap;
+    va_start(ap, fmt);
+    char buf[1024];
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    diag_report(p->d, DIAG_ERROR, loc, chain, "%s", buf);
+    free(chain);
+}
+
+static void report(sdl_parser *p, diag_severity sev, src_loc loc, const char *fmt, va_list ap)
+{
+    char buf[1024];
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    char *chain = sdl_chain(p);
+    diag_report(p->d, sev, loc, chain, "%s", buf);
+    free(chain);
+}
+
+void sdl_warning(sdl_parser *p, src_loc loc, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    report(p, DIAG_WARNING, loc, fmt, ap);
+    va_end(ap);
+}
+
+void sdl_note(sdl_parser *p, src_loc loc, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    report(p, DIAG_NOTE, loc, fmt, ap);
+    va_end(ap);
+}
+
+void sdl_warn_once(sdl_parser *p, src_loc loc, const char *fmt, ...)
+{
+    char buf[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    diag_warn_once(p->d, loc, "%s", buf);
+}
+
+void sdl_unexpected(sdl_parser *p, const sdl_tok *t, const char *expected)
+{
+    char what[128];
+    if (t->tk.kind == TOK_EOF && p->nblocks > 0) {
+        const sdl_block *b = &p->blocks[p->nblocks - 1];
+        if (b->loc.file && t->tk.loc.file && strcmp(b->loc.file, t->tk.loc.file) != 0)
+            sdl_error(p, t->tk.loc, PT_ERR_SYNTAX, "unterminated %s block opened at %s:%d:%d", b->name, b->loc.file, b->loc.line, b->loc.col);
+        else
+            sdl_error(p, t->tk.loc, PT_ERR_SYNTAX, "unterminated %s block opened at %d:%d", b->name, b->loc.line, b->loc.col);
+        return;
+    }
+    if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_NONE) {
+        sdl_error(p, t->tk.loc, PT_ERR_SYNTAX, "expected %s, found undeclared identifier '%.*s'", expected, t->tk.len, t->tk.text);
+        return;
+    }
+    sdl_error(p, t->tk.loc, PT_ERR_SYNTAX, "expected %s, found %s", expected, sdl_tok_describe(&t->tk, what, sizeof what));
+}
+
+/* ------------------------------------------------------------ tokens */
+
+int sdl_is(const sdl_tok *t, sdl_tok_kind k) { return t->tk.kind == k; }
+int sdl_is_kw(const sdl_tok *t, sdl_kw k) { return t->tk.kind == TOK_KEYWORD && t->tk.kw == k; }
+
+int sdl_accept(sdl_parser *p, sdl_tok_kind k)
+{
+    if (!sdl_is(sdl_peek(p), k)) return 0;
+    sdl_next(p);
+    return 1;
+}
+
+int sdl_accept_kw(sdl_parser *p, sdl_kw k)
+{
+    if (!sdl_is_kw(sdl_peek(p), k)) return 0;
+    sdl_next(p);
+    return 1;
+}
+
+int sdl_expect(sdl_parser *p, sdl_tok_kind k, const char *what)
+{
+    sdl_tok t = sdl_next(p);
+    if (t.tk.kind == k) return 1;
+    sdl_unexpected(p, &t, what);
+    return 0;
+}
+
+int sdl_begin_block(sdl_parser *p, const char *name)
+{
+    sdl_tok t = sdl_next(p);
+    if (t.tk.kind != TOK_LBRACE) {
+        char what[96];
+        snprintf(what, sizeof what, "'{' after %s", name);
+        sdl_unexpected(p, &t, what);
+        return 0;
+    }
+    if (p->nblocks == p->cap_blocks) {
+        int nc = p->cap_blocks ? p->cap_blocks * 2 : 32;
+        sdl_block *nb = realloc(p->blocks, sizeof *nb * (size_t)nc);
+        if (!nb) {
+            sdl_error(p, t.tk.loc, PT_ERR_NOMEM, "out of memory");
+            return 0;
+        }
+        p->blocks = nb;
+        p->cap_blocks = nc;
+    }
+    p->blocks[p->nblocks].name = name;
+    p->blocks[p->nblocks].loc = t.tk.loc;
+    p->nblocks++;
+    return 1;
+}
+
+int sdl_end_block(sdl_parser *p)
+{
+    sdl_tok t = sdl_next(p);
+    if (t.tk.kind != TOK_RBRACE) {
+        char what[96];
+        snprintf(what, sizeof what, "'}' closing %s", p->nblocks ? p->blocks[p->nblocks - 1].name : "block");
+        sdl_unexpected(p, &t, what);
+        return 0;
+    }
+    if (p->nblocks > 0) p->nblocks--;
+    return 1;
+}
+
+void sdl_skip_block(sdl_parser *p)
+{
+    int depth = 0;
+    while (sdl_ok(p)) {
+        sdl_tok t = sdl_next(p);
+        if (t.tk.kind == TOK_EOF) {
+            sdl_unexpected(p, &t, "'}'");
+            return;
+        }
+        if (t.tk.kind == TOK_LBRACE) depth++;
+        if (t.tk.kind != TOK_RBRACE) continue;
+        if (depth == 0) {
+            if (p->nblocks > 0) p->nblocks--;
+            return;
+        }
+        depth--;
+    }
+}
+
+void sdl_skip_item(sdl_parser *p)
+{
+    const sdl_tok *t = sdl_peek(p);
+    if (sdl_is(t, TOK_LBRACE)) {
+        if (sdl_begin_block(p, "block")) sdl_skip_block(p);
+        return;
+    }
+    if (sdl_starts_string(t)) {
+        sdl_string(p);
+        return;
+    }
+    while (sdl_ok(p) && sdl_starts_expr(sdl_peek(p))) {
+        sdl_value v;
+        sdl_expr(p, &v);
+        if (!sdl_accept(p, TOK_COMMA)) return;
+    }
+}
+
+/* ------------------------------------------------------------ memory */
+
+void *sdl_alloc(sdl_parser *p, size_t n)
+{
+    void *m = arena_alloc(p->s->mem, n ? n : 1);
+    if (!m && sdl_ok(p)) {
+        src_loc none = {NULL, 0, 0};
+        sdl_error(p, none, PT_ERR_NOMEM, "out of memory");
+    }
+    return m;
+}
+
+char *sdl_strndup(sdl_parser *p, const char *s, size_t n)
+{
+    char *r = sdl_alloc(p, n + 1);
+    if (!r) return NULL;
+    memcpy(r, s, n);
+    r[n] = 0;
+    return r;
+}
+
+/* ------------------------------------------------------------ entry points */
+
+void sdl_default_options(sdl_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->image_width = 320;  /* POV-Ray's default +W/+H */
+    o->image_height = 240;
+    o->max_loop_iterations = 10000000;
+    o->max_include_depth = 64;
+    o->max_macro_depth = 256;
+}
+
+static void declare_float(sdl_parser *p, const char *name, double v)
+{
+    sdl_value val = {VAL_FLOAT, 1, {v, 0, 0, 0, 0}, NULL, NULL};
+    sdl_symtab_declare(p->sym, name, strlen(name), &val);
+}
+
+/* -D NAME=VALUE: a float when VALUE is a number, else a string. */
+static void declare_define(sdl_parser *p, const char *def)
+{
+    const char *eq = strchr(def, '=');
+    size_t n = eq ? (size_t)(eq - def) : strlen(def);
+    sdl_value val;
+    memset(&val, 0, sizeof val);
+    val.kind = VAL_FLOAT;
+    val.dim = 1;
+    val.v[0] = 1;
+    if (eq) {
+        char *end = NULL;
+        double d = strtod(eq + 1, &end);
+        if (end != eq + 1 && end && *end == 0) {
+            val.v[0] = d;
+        } else {
+            const char *s = eq + 1;
+            size_t len = strlen(s);
+            if (len >= 2 && s[0] == '"' && s[len - 1] == '"') {
+                s++;
+                len -= 2;
+            }
+            val.kind = VAL_STRING;
+            val.dim = 0;
+            val.str = sdl_strndup(p, s, len);
+        }
+    }
+    if (n > 0) sdl_symtab_declare(p->sym, def, n, &val);
+}
+
+/* Identifiers POV-Ray's front end declares before parsing. */
+static void predeclare(sdl_parser *p)
+{
+    declare_float(p, "image_width", p->opt.image_width);
+    declare_float(p, "image_height", p->opt.image_height);
+    declare_float(p, "clock_delta", 1);
+    declare_float(p, "frame_number", 0);
+    declare_float(p, "initial_clock", 0);
+    declare_float(p, "final_clock", 0);
+    declare_float(p, "initial_frame", 0);
+    declare_float(p, "final_frame", 0);
+    for (int i = 0; i < p->opt.ndefines; i++)
+        if (p->opt.defines[i]) declare_define(p, p->opt.defines[i]);
+}
+
+static void set_options(sdl_parser *p, const sdl_options *opt)
+{
+    sdl_options def;
+    sdl_default_options(&def);
+    p->opt = opt ? *opt : def;
+    if (p->opt.max_loop_iterations <= 0) p->opt.max_loop_iterations = def.max_loop_iterations;
+    if (p->opt.max_include_depth <= 0) p->opt.max_include_depth = def.max_include_depth;
+    if (p->opt.max_macro_depth <= 0) p->opt.max_macro_depth = def.max_macro_depth;
+}
+
+static pt_status run(const char *name, const char *text, const sdl_options *opt, scene **out, diag *d)
+{
+    sdl_parser p;
+    memset(&p, 0, sizeof p);
+    *out = NULL;
+    p.d = d;
+    p.version = 3.7;
+    set_options(&p, opt);
+    p.s = scene_new();
+    p.sym = sdl_symtab_new();
+    if (!p.s || !p.sym) {
+        scene_free(p.s);
+        sdl_symtab_free(p.sym);
+        return PT_ERR_NOMEM;
+    }
+    p.s->clock = p.opt.clock;
+    predeclare(&p);
+    if (sdl_ok(&p) && sdl_open_main(&p, name, text) == PT_OK) {
+        sdl_parse_scene(&p);
+        sdl_check_closed(&p);
+    }
+    sdl_close_inputs(&p);
+    sdl_symtab_free(p.sym);
+    free(p.blocks);
+    if (p.status != PT_OK) {
+        scene_free(p.s);
+        return p.status;
+    }
+    *out = p.s;
+    return PT_OK;
+}
+
+pt_status sdl_parse_file(const char *path, const sdl_options *opt, scene **out, diag *d)
+{
+    return run(path, NULL, opt, out, d);
+}
+
+pt_status sdl_parse_string(const char *name, const char *text, const sdl_options *opt, scene **out, diag *d)
+{
+    return run(name ? name : "<string>", text ? text : "", opt, out, d);
+}

@@ -1,0 +1,483 @@
+/* sdl_scene.c - camera, lights, global settings, background, statements. */
+#include "sdl_scene.h"
+#include <math.h>
+#include <string.h>
+#include "sdl_directive.h"
+#include "sdl_expr.h"
+#include "sdl_material.h"
+#include "sdl_object.h"
+
+/* ------------------------------------------------------------ camera */
+
+/* What a camera block said, before POV-Ray 3.5+'s fixed-order evaluation. */
+typedef struct {
+    int had_angle, had_up, had_right, had_look_at, had_focal;
+    double angle;
+    xform trans;
+} camera_said;
+
+/* camera_type := perspective | orthographic | fisheye | ultra_wide_angle |
+ *   omnimax | panoramic | spherical | cylinder N ; returns 0 if none */
+static int camera_type(sdl_parser *p, scene_camera *c)
+{
+    const sdl_tok *t = sdl_peek(p);
+    if (t->tk.kind != TOK_KEYWORD) return 0;
+    switch (t->tk.kw) {
+    case KW_PERSPECTIVE: c->kind = CAMERA_PERSPECTIVE; break;
+    case KW_ORTHOGRAPHIC: c->kind = CAMERA_ORTHOGRAPHIC; break;
+    case KW_FISHEYE: c->kind = CAMERA_FISHEYE; break;
+    case KW_ULTRA_WIDE_ANGLE: c->kind = CAMERA_ULTRA_WIDE_ANGLE; break;
+    case KW_OMNIMAX: c->kind = CAMERA_OMNIMAX; break;
+    case KW_PANORAMIC: c->kind = CAMERA_PANORAMIC; break;
+    case KW_SPHERICAL: c->kind = CAMERA_SPHERICAL; break;
+    case KW_CYLINDER: {
+        sdl_tok k = sdl_next(p);
+        int n = (int)sdl_float(p);
+        if (n < 1 || n > 4) sdl_error(p, k.tk.loc, PT_ERR_SYNTAX, "invalid cylinder camera type %d (1 to 4)", n);
+        c->kind = CAMERA_CYLINDER;
+        c->cylinder_type = n;
+        return 1;
+    }
+    case KW_MESH_CAMERA:
+        sdl_error(p, t->tk.loc, PT_ERR_UNSUPPORTED, "mesh_camera is not supported yet");
+        return 0;
+    default: return 0;
+    }
+    sdl_next(p);
+    return 1;
+}
+
+/* camera_angle := 'angle' float [ ',' float ]  (orthographic: the float is optional) */
+static void camera_angle(sdl_parser *p, scene_camera *c, camera_said *said, src_loc loc)
+{
+    double a = c->kind == CAMERA_ORTHOGRAPHIC ? sdl_allow_float(p, 0.0) : sdl_float(p);
+    if (c->kind == CAMERA_SPHERICAL && sdl_accept(p, TOK_COMMA)) sdl_allow_float(p, a * 0.5);
+    if (a < 0) sdl_error(p, loc, PT_ERR_SYNTAX, "negative viewing angle");
+    said->had_angle = 1;
+    said->angle = a;
+}
+
+/* camera_item := angle .. | location v | direction v | up v | right v | sky v |
+ *   look_at v | transform_item | aperture f | blur_samples n [, n] |
+ *   focal_point v | confidence f | variance f | normal {..} | bokeh {..} */
+static int camera_item(sdl_parser *p, scene_camera *c, camera_said *said)
+{
+    xform x;
+    if (sdl_transform_item(p, &x)) {
+        said->trans = xform_then(said->trans, x);
+        return 1;
+    }
+    const sdl_tok *pk = sdl_peek(p);
+    if (pk->tk.kind != TOK_KEYWORD) return 0;
+    sdl_tok t = sdl_next(p);
+    switch (t.tk.kw) {
+    case KW_ANGLE: camera_angle(p, c, said, t.tk.loc); break;
+    case KW_LOCATION: c->location = sdl_vector(p); break;
+    case KW_DIRECTION: c->direction = sdl_vector(p); break;
+    case KW_UP: c->up = sdl_vector(p); said->had_up = 1; break;
+    case KW_RIGHT: c->right = sdl_vector(p); said->had_right = 1; break;
+    case KW_SKY: c->sky = sdl_vector(p); break;
+    case KW_LOOK_AT: c->look_at = sdl_vector(p); said->had_look_at = 1; break;
+    case KW_APERTURE: c->aperture = sdl_float(p); break;
+    case KW_BLUR_SAMPLES:
+        c->blur_samples = (int)sdl_float(p);
+        if (sdl_accept(p, TOK_COMMA)) {
+            double mx = sdl_allow_float(p, 0.0);
+            if (mx > 0) c->blur_samples = (int)mx;
+        }
+        break;
+    case KW_FOCAL_POINT: c->focal_point = sdl_vector(p); said->had_focal = 1; break;
+    case KW_CONFIDENCE: case KW_VARIANCE: sdl_float(p); break;
+    case KW_NORMAL: case KW_BOKEH:
+        sdl_warn_once(p, t.tk.loc, "camera %s is not supported yet and is ignored", sdl_kw_text(t.tk.kw));
+        if (sdl_begin_block(p, sdl_kw_text(t.tk.kw))) sdl_skip_block(p);
+        break;
+    default:
+        sdl_unget(p, &t);
+        return 0;
+    }
+    return 1;
+}
+
+/* POV-Ray 3.7 (Parse_Camera, language >= 3.5): `angle` rescales direction
+ * to |right|/2/tan(angle/2) keeping its orientation; `look_at` then turns
+ * direction towards the point and rebuilds right = sky x direction and
+ * up = direction x right, keeping each vector's length and the handedness
+ * of the (up, direction, right) triple as given. */
+static void camera_look_at(sdl_parser *p, scene_camera *c, src_loc loc)
+{
+    double dl = v3_len(c->direction), ul = v3_len(c->up), rl = v3_len(c->right);
+    double handed = v3_dot(v3_cross(c->up, c->direction), c->right);
+    vec3 d = v3_sub(c->look_at, c->location);
+    if (v3_len2(d) < 1e-10) {
+        sdl_error(p, loc, PT_ERR_SYNTAX, "camera location and look_at point must be different");
+        return;
+    }
+    d = v3_norm(d);
+    vec3 r = v3_cross(c->sky, d);
+    if (fabs(r.x) < 1e-10 && fabs(r.y) < 1e-10 && fabs(r.z) < 1e-10) {
+        sdl_warning(p, loc, "camera look_at direction and sky are parallel; using the given right vector");
+        r = c->right;
+    }
+    r = v3_norm(r);
+    c->up = v3_scale(v3_cross(d, r), ul);
+    c->direction = v3_scale(d, dl);
+    c->right = v3_scale(r, handed > 0 ? rl : -rl);
+}
+
+static void camera_apply(sdl_parser *p, scene_camera *c, const camera_said *said, src_loc loc)
+{
+    if (said->had_angle) {
+        c->angle = said->angle;
+        if ((c->kind == CAMERA_PERSPECTIVE || c->kind == CAMERA_ORTHOGRAPHIC) && said->angle >= 180)
+            sdl_error(p, loc, PT_ERR_SYNTAX, "viewing angle has to be smaller than 180 degrees");
+        if ((c->kind == CAMERA_PERSPECTIVE || c->kind == CAMERA_ORTHOGRAPHIC) && said->angle > 0 && said->angle < 180)
+            c->direction = v3_scale(v3_norm(c->direction), v3_len(c->right) / tan(said->angle * M_PI / 360.0) / 2.0);
+    }
+    if (said->had_look_at && sdl_ok(p)) camera_look_at(p, c, loc);
+    if (c->kind == CAMERA_ORTHOGRAPHIC && ((!said->had_up && !said->had_right) || said->had_angle)) {
+        /* same image area as the perspective camera would show at look_at */
+        double k1 = v3_len(v3_sub(c->look_at, c->location)), k2 = v3_len(c->direction);
+        if (k1 > 1e-10 && k2 > 1e-10) {
+            c->right = v3_scale(c->right, k1 / k2);
+            c->up = v3_scale(c->up, k1 / k2);
+        }
+    }
+    c->location = xform_point(&said->trans, c->location);
+    c->direction = xform_vector(&said->trans, c->direction);
+    c->up = xform_vector(&said->trans, c->up);
+    c->right = xform_vector(&said->trans, c->right);
+}
+
+/* Before #version 3.5 camera items apply in the order written. */
+static void camera_old_style(sdl_parser *p, scene_camera *c, src_loc loc)
+{
+    for (;;) {
+        camera_said said;
+        memset(&said, 0, sizeof said);
+        said.trans = xform_identity();
+        if (!sdl_ok(p) || (!camera_type(p, c) && !camera_item(p, c, &said))) return;
+        camera_apply(p, c, &said, loc);
+    }
+}
+
+/* camera := '{' ( camera_identifier { transform_item } |
+ *                 { camera_type } { camera_item } ) '}' */
+static void camera_block(sdl_parser *p, scene_camera *c)
+{
+    src_loc loc = sdl_peek(p)->tk.loc;
+    if (!sdl_begin_block(p, "camera")) return;
+    c->loc = loc;
+    camera_said said;
+    memset(&said, 0, sizeof said);
+    said.trans = xform_identity();
+    const sdl_tok *t = sdl_peek(p);
+    if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_CAMERA) {
+        sdl_tok id = sdl_next(p);
+        *c = *(const scene_camera *)id.val.ptr;
+        xform x;
+        while (sdl_ok(p) && sdl_transform_item(p, &x)) said.trans = xform_then(said.trans, x);
+        c->location = xform_point(&said.trans, c->location);
+        c->direction = xform_vector(&said.trans, c->direction);
+        c->up = xform_vector(&said.trans, c->up);
+        c->right = xform_vector(&said.trans, c->right);
+    } else if (p->version < 3.5) {
+        camera_old_style(p, c, loc);
+    } else {
+        while (sdl_ok(p) && camera_type(p, c)) {}
+        while (sdl_ok(p) && camera_item(p, c, &said)) {}
+        if (sdl_ok(p)) camera_apply(p, c, &said, loc);
+    }
+    sdl_end_block(p);
+}
+
+scene_camera *sdl_parse_camera_new(sdl_parser *p)
+{
+    scene_camera *c = sdl_alloc(p, sizeof *c);
+    if (!c) return NULL;
+    scene_default_camera(c);
+    camera_block(p, c);
+    return c;
+}
+
+/* ------------------------------------------------------------ lights */
+
+static int is_spot(const scene_light *l) { return l->kind == LIGHT_SPOT || l->kind == LIGHT_CYLINDER; }
+
+/* area_light := 'area_light' axis ',' axis ',' size ',' size */
+static void area_light(sdl_parser *p, scene_light *l, src_loc loc)
+{
+    l->area = 1;
+    l->axis1 = sdl_vector(p);
+    sdl_accept(p, TOK_COMMA);
+    l->axis2 = sdl_vector(p);
+    sdl_accept(p, TOK_COMMA);
+    l->size1 = (int)sdl_float(p);
+    sdl_accept(p, TOK_COMMA);
+    l->size2 = (int)sdl_float(p);
+    if (sdl_ok(p) && (l->size1 <= 0 || l->size2 <= 0)) sdl_error(p, loc, PT_ERR_SYNTAX, "area light sizes must be greater than zero");
+}
+
+/* looks_like := 'looks_like' '{' object_statement object_mods '}' */
+static void looks_like(sdl_parser *p, scene_light *l)
+{
+    if (!sdl_begin_block(p, "looks_like")) return;
+    sdl_obj *o = sdl_parse_object(p);
+    if (o && o->obj) {
+        xform t = xform_translate(l->position);
+        sdl_obj_transform(o, &t);
+        sdl_object_mods(p, o);
+        o->obj->flags |= OBJ_NO_SHADOW;
+        l->looks_like = o->obj;
+    }
+    sdl_end_block(p);
+}
+
+/* spot_param := ( radius | falloff | tightness | point_at ) value, only
+ * for spotlights / cylinder lights (point_at also for parallel lights) */
+static void spot_param(sdl_parser *p, scene_light *l, const sdl_tok *t)
+{
+    sdl_kw k = t->tk.kw;
+    if (!(is_spot(l) || (k == KW_POINT_AT && l->parallel))) {
+        sdl_error(p, t->tk.loc, PT_ERR_SYNTAX, "'%s' cannot be used with a standard light source", sdl_kw_text(k));
+        return;
+    }
+    switch (k) {
+    case KW_RADIUS: l->radius = sdl_float(p); break;
+    case KW_FALLOFF: l->falloff = sdl_float(p); break;
+    case KW_TIGHTNESS: l->tightness = sdl_float(p); break;
+    default: l->point_at = sdl_vector(p); break;
+    }
+}
+
+/* light_item := spotlight | cylinder | parallel | point_at v | radius f |
+ *   falloff f | tightness f | area_light .. | jitter | adaptive f | circular |
+ *   orient | area_illumination [b] | fade_distance f | fade_power f |
+ *   shadowless | media_interaction [b] | media_attenuation [b] |
+ *   looks_like {..} | projected_through {..} | photons {..} | colour_map {..} |
+ *   transform_item */
+static int light_item(sdl_parser *p, sdl_obj *so)
+{
+    scene_light *l = &so->lights[0];
+    xform x;
+    if (sdl_transform_item(p, &x)) {
+        sdl_obj_transform(so, &x);
+        return 1;
+    }
+    if (sdl_peek(p)->tk.kind != TOK_KEYWORD) return 0;
+    sdl_tok t = sdl_next(p);
+    switch (t.tk.kw) {
+    case KW_SPOTLIGHT: l->kind = LIGHT_SPOT; l->radius = 30; l->falloff = 45; l->tightness = 0; break;
+    case KW_CYLINDER: l->kind = LIGHT_CYLINDER; l->radius = 0.75; l->falloff = 1; l->tightness = 0; l->parallel = 1; break;
+    case KW_PARALLEL: l->parallel = 1; break;
+    case KW_POINT_AT: case KW_RADIUS: case KW_FALLOFF: case KW_TIGHTNESS: spot_param(p, l, &t); break;
+    case KW_AREA_LIGHT: area_light(p, l, t.tk.loc); break;
+    case KW_JITTER: l->jitter = 1; break;
+    case KW_ADAPTIVE: l->adaptive = (int)sdl_float(p); break;
+    case KW_CIRCULAR: l->circular = 1; break;
+    case KW_ORIENT: l->orient = 1; break;
+    case KW_AREA_ILLUMINATION: l->area_illumination = sdl_allow_float(p, 1.0) > 0; break;
+    case KW_FADE_DISTANCE: l->fade_distance = sdl_float(p); break;
+    case KW_FADE_POWER: l->fade_power = sdl_float(p); break;
+    case KW_SHADOWLESS: l->shadowless = 1; break;
+    case KW_MEDIA_INTERACTION: l->media_interaction = sdl_allow_float(p, 1.0) > 0; break;
+    case KW_MEDIA_ATTENUATION: l->media_attenuation = sdl_allow_float(p, 1.0) > 0; break;
+    case KW_LOOKS_LIKE: looks_like(p, l); break;
+    case KW_PROJECTED_THROUGH: case KW_PHOTONS: case KW_COLOR_MAP: case KW_COLOUR_MAP:
+        if (t.tk.kw == KW_PROJECTED_THROUGH) sdl_warn_once(p, t.tk.loc, "projected_through is not supported yet and is ignored");
+        if (sdl_begin_block(p, sdl_kw_text(t.tk.kw))) sdl_skip_block(p);
+        break;
+    default:
+        sdl_unget(p, &t);
+        return 0;
+    }
+    return 1;
+}
+
+/* light := '{' ( light_identifier { transform_item } |
+ *                location [','] colour { light_item } ) '}' */
+sdl_obj *sdl_parse_light(sdl_parser *p, src_loc loc)
+{
+    if (!sdl_begin_block(p, "light_source")) return NULL;
+    sdl_obj *so = NULL;
+    const sdl_tok *t = sdl_peek(p);
+    if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_OBJECT) {
+        sdl_tok id = sdl_next(p);
+        so = sdl_copy_obj(p, id.val.ptr);
+        if (so) sdl_object_mods(p, so);
+    } else {
+        so = sdl_alloc(p, sizeof *so);
+        scene_light *l = sdl_alloc(p, sizeof *l);
+        if (!so || !l) return NULL;
+        scene_default_light(l);
+        l->loc = loc;
+        so->lights = l;
+        so->nlights = 1;
+        l->position = sdl_vector(p);
+        sdl_accept(p, TOK_COMMA);
+        l->colour = sdl_rgb(p);
+        while (sdl_ok(p) && light_item(p, so)) {}
+        if (sdl_ok(p) && l->circular && (l->size1 <= 1 || l->size2 <= 1))
+            sdl_error(p, loc, PT_ERR_SYNTAX, "circular area light must have more than 1 point per axis");
+    }
+    if (!sdl_end_block(p)) return NULL;
+    return so;
+}
+
+/* ------------------------------------------------------------ global settings */
+
+/* radiosity_item := adc_bailout f | always_sample b | brightness f |
+ *   count n [, n] | error_bound f | gray_threshold f | low_error_factor f |
+ *   max_sample f | maximum_reuse f | minimum_reuse f | nearest_count n [, n] |
+ *   normal b | media b | pretrace_start f | pretrace_end f |
+ *   recursion_limit n | subsurface b | load_file s | save_file s */
+static int radiosity_item(sdl_parser *p, scene_radiosity *r)
+{
+    if (sdl_peek(p)->tk.kind != TOK_KEYWORD) return 0;
+    sdl_tok t = sdl_next(p);
+    switch (t.tk.kw) {
+    case KW_ADC_BAILOUT: sdl_float(p); break;
+    case KW_ALWAYS_SAMPLE: r->always_sample = sdl_true(sdl_float(p)); break;
+    case KW_BRIGHTNESS: r->brightness = sdl_float(p); break;
+    case KW_COUNT:
+        r->count = (int)sdl_float(p);
+        if (sdl_accept(p, TOK_COMMA)) sdl_float(p);
+        break;
+    case KW_ERROR_BOUND: r->error_bound = sdl_float(p); break;
+    case KW_GRAY_THRESHOLD: r->gray_threshold = sdl_float(p); break;
+    case KW_LOW_ERROR_FACTOR: r->low_error_factor = sdl_float(p); break;
+    case KW_MAX_SAMPLE: case KW_MAXIMUM_REUSE: sdl_float(p); break;
+    case KW_MINIMUM_REUSE: r->minimum_reuse = sdl_float(p); break;
+    case KW_NEAREST_COUNT:
+        r->nearest_count = (int)sdl_float(p);
+        if (sdl_accept(p, TOK_COMMA)) sdl_float(p);
+        break;
+    case KW_NORMAL: r->normal = sdl_true(sdl_float(p)); break;
+    case KW_MEDIA: r->media = sdl_true(sdl_float(p)); break;
+    case KW_PRETRACE_START: r->pretrace_start = sdl_float(p); break;
+    case KW_PRETRACE_END: r->pretrace_end = sdl_float(p); break;
+    case KW_RECURSION_LIMIT: r->recursion_limit = (int)sdl_float(p); break;
+    case KW_SUBSURFACE: sdl_float(p); break;
+    case KW_LOAD_FILE: case KW_SAVE_FILE: sdl_string(p); break;
+    default:
+        sdl_unget(p, &t);
+        return 0;
+    }
+    return 1;
+}
+
+static void radiosity_block(sdl_parser *p, scene_radiosity *r)
+{
+    r->enabled = 1;
+    if (!sdl_begin_block(p, "radiosity")) return;
+    while (sdl_ok(p) && radiosity_item(p, r)) {}
+    sdl_end_block(p);
+}
+
+/* photons := '{' { spacing f | count n | ... } '}' (spacing and count kept) */
+static void photons_block(sdl_parser *p, scene_global *g)
+{
+    g->photons = 1;
+    if (!sdl_begin_block(p, "photons")) return;
+    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
+        sdl_tok t = sdl_next(p);
+        if (sdl_is_kw(&t, KW_SPACING)) g->photons_spacing = sdl_float(p);
+        else if (sdl_is_kw(&t, KW_COUNT)) g->photons_count = (int)sdl_float(p);
+        else if (t.tk.kind == TOK_KEYWORD) sdl_skip_item(p);
+        else if (t.tk.kind == TOK_EOF) sdl_unexpected(p, &t, "'}'");
+    }
+    sdl_end_block(p);
+}
+
+/* global_item := assumed_gamma f | ambient_light c | max_trace_level n |
+ *   adc_bailout f | max_intersections n | noise_generator n |
+ *   irid_wavelength c | radiosity {..} | photons {..} | other (skipped) */
+static int global_item(sdl_parser *p, scene_global *g)
+{
+    if (sdl_peek(p)->tk.kind != TOK_KEYWORD) return 0;
+    sdl_tok t = sdl_next(p);
+    switch (t.tk.kw) {
+    case KW_ASSUMED_GAMMA: g->assumed_gamma = sdl_float(p); break;
+    case KW_AMBIENT_LIGHT: g->ambient_light = sdl_rgb(p); break;
+    case KW_MAX_TRACE_LEVEL: g->max_trace_level = (int)sdl_float(p); break;
+    case KW_ADC_BAILOUT: g->adc_bailout = sdl_float(p); break;
+    case KW_MAX_INTERSECTIONS: g->max_intersections = (int)sdl_float(p); break;
+    case KW_NOISE_GENERATOR: g->noise_generator = (int)sdl_float(p); break;
+    case KW_IRID_WAVELENGTH: {
+        rgb w = sdl_rgb(p);
+        g->irid_wavelength[0] = w.r;
+        g->irid_wavelength[1] = w.g;
+        g->irid_wavelength[2] = w.b;
+        break;
+    }
+    case KW_RADIOSITY: radiosity_block(p, &g->radiosity); break;
+    case KW_PHOTONS: photons_block(p, g); break;
+    case KW_CHARSET: sdl_next(p); break;
+    default:
+        sdl_warn_once(p, t.tk.loc, "global_settings '%s' is not supported yet and is ignored", sdl_kw_text(t.tk.kw));
+        sdl_skip_item(p);
+        break;
+    }
+    return 1;
+}
+
+static void global_settings(sdl_parser *p)
+{
+    if (!sdl_begin_block(p, "global_settings")) return;
+    while (sdl_ok(p) && global_item(p, &p->s->global)) {}
+    sdl_end_block(p);
+}
+
+/* background := '{' colour '}' */
+static void background(sdl_parser *p)
+{
+    if (!sdl_begin_block(p, "background")) return;
+    p->s->background = sdl_colour(p, 1);
+    sdl_end_block(p);
+}
+
+/* ------------------------------------------------------------ statements */
+
+static void skipped_statement(sdl_parser *p, const sdl_tok *t)
+{
+    sdl_warn_once(p, t->tk.loc, "'%s' is not supported yet and is ignored", sdl_kw_text(t->tk.kw));
+    if (sdl_begin_block(p, sdl_kw_text(t->tk.kw))) sdl_skip_block(p);
+}
+
+/* statement := camera | object_statement | global_settings | background |
+ *   fog | sky_sphere | rainbow | media */
+static void statement(sdl_parser *p)
+{
+    const sdl_tok *pk = sdl_peek(p);
+    if (sdl_starts_object(pk)) {
+        sdl_obj *o = sdl_parse_object(p);
+        sdl_obj_add_to_scene(p, o);
+        return;
+    }
+    sdl_tok t = sdl_next(p);
+    switch (t.tk.kind == TOK_KEYWORD ? t.tk.kw : KW_NONE) {
+    case KW_CAMERA: {
+        scene_camera *c = sdl_parse_camera_new(p);
+        if (c && sdl_ok(p)) {
+            p->s->camera = *c;
+            p->s->camera_set = 1;
+        }
+        return;
+    }
+    case KW_GLOBAL_SETTINGS: global_settings(p); return;
+    case KW_BACKGROUND: background(p); return;
+    case KW_FOG: case KW_SKY_SPHERE: case KW_RAINBOW: case KW_MEDIA: skipped_statement(p, &t); return;
+    default: break;
+    }
+    if (t.tk.kind == TOK_IDENT && t.val.kind == VAL_NONE)
+        sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "unknown identifier '%.*s'", t.tk.len, t.tk.text);
+    else if (t.tk.kind == TOK_IDENT)
+        sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "identifier '%.*s' cannot start a statement (use object { %.*s })", t.tk.len, t.tk.text, t.tk.len, t.tk.text);
+    else
+        sdl_unexpected(p, &t, "object, light_source, camera or other scene statement");
+}
+
+void sdl_parse_scene(sdl_parser *p)
+{
+    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_EOF)) statement(p);
+}

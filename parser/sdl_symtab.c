@@ -1,0 +1,162 @@
+/* sdl_symtab.c - chained hash table with a per-scope list for cheap pops. */
+#include "sdl_symtab.h"
+#include <stdlib.h>
+#include <string.h>
+
+#define SYM_BUCKETS 1024u
+
+typedef struct sym_entry {
+    struct sym_entry *hnext;     /* hash chain, innermost scope first */
+    struct sym_entry *snext;     /* entries of the same scope */
+    int depth;
+    char *name;
+    sdl_value val;
+} sym_entry;
+
+struct sdl_symtab {
+    sym_entry *buckets[SYM_BUCKETS];
+    sym_entry **scopes;          /* scopes[d]: list of entries of depth d */
+    int depth, cap;
+};
+
+static unsigned hash_name(const char *s, size_t n)
+{
+    unsigned h = 2166136261u;
+    for (size_t i = 0; i < n; i++) h = (h ^ (unsigned char)s[i]) * 16777619u;
+    return h % SYM_BUCKETS;
+}
+
+sdl_symtab *sdl_symtab_new(void)
+{
+    sdl_symtab *t = calloc(1, sizeof *t);
+    if (!t) return NULL;
+    t->cap = 16;
+    t->scopes = calloc((size_t)t->cap, sizeof *t->scopes);
+    if (!t->scopes) {
+        free(t);
+        return NULL;
+    }
+    return t;
+}
+
+static void free_entry(sym_entry *e)
+{
+    free(e->name);
+    free(e);
+}
+
+static void unlink_entry(sdl_symtab *t, sym_entry *e)
+{
+    sym_entry **pp = &t->buckets[hash_name(e->name, strlen(e->name))];
+    while (*pp && *pp != e) pp = &(*pp)->hnext;
+    if (*pp) *pp = e->hnext;
+    sym_entry **sp = &t->scopes[e->depth];
+    while (*sp && *sp != e) sp = &(*sp)->snext;
+    if (*sp) *sp = e->snext;
+}
+
+void sdl_symtab_free(sdl_symtab *t)
+{
+    if (!t) return;
+    for (int d = 0; d <= t->depth; d++) {
+        sym_entry *e = t->scopes[d];
+        while (e) {
+            sym_entry *n = e->snext;
+            free_entry(e);
+            e = n;
+        }
+    }
+    free(t->scopes);
+    free(t);
+}
+
+int sdl_symtab_depth(const sdl_symtab *t) { return t->depth; }
+
+int sdl_symtab_push(sdl_symtab *t)
+{
+    if (t->depth + 1 >= t->cap) {
+        int nc = t->cap * 2;
+        sym_entry **n = realloc(t->scopes, sizeof *n * (size_t)nc);
+        if (!n) return 0;
+        t->scopes = n;
+        t->cap = nc;
+    }
+    t->scopes[++t->depth] = NULL;
+    return 1;
+}
+
+void sdl_symtab_pop(sdl_symtab *t)
+{
+    if (t->depth == 0) return;
+    while (t->scopes[t->depth]) {
+        sym_entry *e = t->scopes[t->depth];
+        unlink_entry(t, e);
+        free_entry(e);
+    }
+    t->depth--;
+}
+
+static sym_entry *find_entry(const sdl_symtab *t, const char *name, size_t n)
+{
+    for (sym_entry *e = t->buckets[hash_name(name, n)]; e; e = e->hnext)
+        if (strlen(e->name) == n && memcmp(e->name, name, n) == 0) return e;
+    return NULL;
+}
+
+const sdl_value *sdl_symtab_find(const sdl_symtab *t, const char *name, size_t n)
+{
+    sym_entry *e = find_entry(t, name, n);
+    return e ? &e->val : NULL;
+}
+
+/* Insert a new entry at `depth`. Hash chains stay ordered innermost first. */
+static int insert_entry(sdl_symtab *t, const char *name, size_t n, int depth, const sdl_value *v)
+{
+    sym_entry *e = calloc(1, sizeof *e);
+    if (!e) return 0;
+    e->name = malloc(n + 1);
+    if (!e->name) {
+        free(e);
+        return 0;
+    }
+    memcpy(e->name, name, n);
+    e->name[n] = 0;
+    e->depth = depth;
+    e->val = *v;
+    sym_entry **pp = &t->buckets[hash_name(name, n)];
+    while (*pp && (*pp)->depth > depth) pp = &(*pp)->hnext;
+    e->hnext = *pp;
+    *pp = e;
+    e->snext = t->scopes[depth];
+    t->scopes[depth] = e;
+    return 1;
+}
+
+int sdl_symtab_declare(sdl_symtab *t, const char *name, size_t n, const sdl_value *v)
+{
+    sym_entry *e = find_entry(t, name, n);
+    if (e) {
+        e->val = *v;
+        return 1;
+    }
+    return insert_entry(t, name, n, 0, v);
+}
+
+int sdl_symtab_local(sdl_symtab *t, const char *name, size_t n, const sdl_value *v)
+{
+    sym_entry *e = find_entry(t, name, n);
+    if (e && e->depth == t->depth) {
+        e->val = *v;
+        return 1;
+    }
+    return insert_entry(t, name, n, t->depth, v);
+}
+
+int sdl_symtab_undef(sdl_symtab *t, const char *name, size_t n)
+{
+    sym_entry *e = find_entry(t, name, n);
+    if (!e) return 0;
+    unlink_entry(t, e);
+    free_entry(e);
+    return 1;
+}

@@ -1,0 +1,56 @@
+/* sdl_symtab.h - identifiers and their values, in nested scopes.
+ *
+ * Scope 0 is global (#declare); every included file and every macro call
+ * opens a scope for its #local identifiers (POV-Ray 3.7 semantics):
+ *   #declare X: assigns the innermost visible X, else creates a global X;
+ *   #local X:   assigns X in the innermost scope, creating it there. */
+#ifndef PT_SDL_SYMTAB_H
+#define PT_SDL_SYMTAB_H
+#include <stddef.h>
+
+typedef enum {
+    VAL_NONE = 0,
+    VAL_FLOAT,     /* dim 1 */
+    VAL_VECTOR,    /* dim 2..5 (u/v vectors, 3D vectors, 4D, 5D) */
+    VAL_COLOUR,    /* dim 5: r g b filter transmit */
+    VAL_STRING,    /* str */
+    VAL_TEXTURE,   /* ptr: scene_texture (layered list) */
+    VAL_PIGMENT,   /* ptr: scene_pigment */
+    VAL_FINISH,    /* ptr: scene_finish */
+    VAL_NORMAL,    /* no data yet */
+    VAL_INTERIOR,  /* ptr: scene_interior */
+    VAL_MATERIAL,  /* ptr: sdl_material (parser-internal) */
+    VAL_OBJECT,    /* ptr: sdl_obj (parser-internal; may be a light) */
+    VAL_CAMERA,    /* ptr: scene_camera */
+    VAL_TRANSFORM, /* ptr: xform */
+    VAL_MACRO,     /* ptr: sdl_macro (parser-internal) */
+    VAL_OPAQUE     /* something parsed but not modelled (function, media, fog,
+                      colour_map, spline, array...): str names the kind */
+} sdl_val_kind;
+
+typedef struct {
+    sdl_val_kind kind;
+    int dim;
+    double v[5];
+    const char *str;
+    void *ptr;
+} sdl_value;
+
+typedef struct sdl_symtab sdl_symtab;
+
+sdl_symtab *sdl_symtab_new(void);
+void sdl_symtab_free(sdl_symtab *t);
+/* Scope depth: 0 = only the global scope. */
+int sdl_symtab_depth(const sdl_symtab *t);
+/* Returns 0 on out-of-memory. */
+int sdl_symtab_push(sdl_symtab *t);
+void sdl_symtab_pop(sdl_symtab *t);
+/* Innermost visible value, or NULL. */
+const sdl_value *sdl_symtab_find(const sdl_symtab *t, const char *name, size_t n);
+/* #declare / #local assignment; returns 0 on out-of-memory. */
+int sdl_symtab_declare(sdl_symtab *t, const char *name, size_t n, const sdl_value *v);
+int sdl_symtab_local(sdl_symtab *t, const char *name, size_t n, const sdl_value *v);
+/* #undef: removes the innermost visible entry; returns 0 if there was none. */
+int sdl_symtab_undef(sdl_symtab *t, const char *name, size_t n);
+
+#endif
