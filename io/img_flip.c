@@ -273,10 +273,70 @@ static void color_rows(void *ctx, int index, int thread)
     }
 }
 
-/* ---- LDR-FLIP on linear RGB in [0,1] ---- */
+/* How input values become linear RGB in [0,1] for LDR-FLIP. */
+typedef enum {
+    FLIP_IN_SRGB,  /* display-encoded: clamp, then the sRGB decoding */
+    FLIP_IN_TONED  /* scene-linear: scale by 2^c, ACES tone curve, clamp */
+} flip_input_mode;
+
+typedef struct {
+    flip_input_mode mode;
+    double scale; /* 2^c for FLIP_IN_TONED */
+} flip_input;
+
+static double srgb_decode(double e)
+{
+    return e <= 0.04045 ? e / 12.92 : pow((e + 0.055) / 1.055, 2.4);
+}
+
+static double input_linear(const flip_input *in, float v)
+{
+    if (in->mode == FLIP_IN_SRGB) {
+        double e = !isfinite(v) ? 0.0 : (v < 0.0f ? 0.0 : (v > 1.0f ? 1.0 : (double)v));
+        /* sRGB transfer function, IEC 61966-2-1. */
+        return srgb_decode(e);
+    }
+    /* Negative values count as 0: the rational tone curve is meant for
+     * x >= 0 (it would turn x = -1 into 1.34). */
+    double x = isfinite(v) && v > 0.0f ? (double)v * in->scale : 0.0;
+    double y = (aces_c[0] * x * x + aces_c[1] * x + aces_c[2]) /
+               (aces_c[3] * x * x + aces_c[4] * x + aces_c[5]);
+    if (!isfinite(y)) y = 1.0; /* overflow of a huge value */
+    return y < 0.0 ? 0.0 : (y > 1.0 ? 1.0 : y);
+}
+
+/* Input -> linear RGB (float, as the pipeline stores it) -> YyCxCz planes,
+ * for a block of rows of both images. */
+typedef struct {
+    const flip_consts *k;
+    const flip_input *in;
+    const float *src[2];
+    float *(*P)[3];
+    int w, h;
+} ycc_job;
+
+static void ycc_rows(void *ctx, int index, int thread)
+{
+    const ycc_job *j = ctx;
+    int y1 = (index + 1) * ROWS_PER_JOB;
+    if (y1 > j->h) y1 = j->h;
+    size_t i0 = (size_t)index * ROWS_PER_JOB * (size_t)j->w, i1 = (size_t)y1 * (size_t)j->w;
+    for (int im = 0; im < 2; im++)
+        for (size_t i = i0; i < i1; i++) {
+            double rgb[3], xyz[3];
+            for (int c = 0; c < 3; c++) rgb[c] = (float)input_linear(j->in, j->src[im][i * 3 + (size_t)c]);
+            for (int r = 0; r < 3; r++)
+                xyz[r] = (rgb2xyz[r][0] * rgb[0] + rgb2xyz[r][1] * rgb[1] + rgb2xyz[r][2] * rgb[2]) / j->k->white[r];
+            j->P[im][0][i] = (float)(116.0 * xyz[1] - 16.0);
+            j->P[im][1][i] = (float)(500.0 * (xyz[0] - xyz[1]));
+            j->P[im][2][i] = (float)(200.0 * (xyz[1] - xyz[2]));
+        }
+}
+
+/* ---- LDR-FLIP (inputs mapped to linear RGB in [0,1] by `in`) ---- */
 
 static pt_status flip_ldr_linear(const float *ref, const float *test, int w, int h,
-                                 double ppd, float *err, diag *d)
+                                 const flip_input *in, double ppd, float *err, diag *d)
 {
     flip_consts k;
     consts_init(&k);
@@ -296,8 +356,8 @@ static pt_status flip_ldr_linear(const float *ref, const float *test, int w, int
     int nf = 2 * rf + 1;
 
     double *ks = calloc((size_t)(4 * ns + 3 * nf), sizeof(double));
-    /* planes: 3 YCxCz per image (6), filtered temp, scratch, and 2 feature
-     * responses per image and direction handled in-place below. */
+    /* 12 planes of w*h floats: YCxCz of both images (6), two results (F1,
+     * F2), the between-passes plane T, and E, Q, S (see below). */
     float *buf = malloc(n * 12 * sizeof(float));
     conv_ctx cc;
     cc.w = w;
@@ -321,8 +381,10 @@ static pt_status flip_ldr_linear(const float *ref, const float *test, int w, int
         double sY = 0, sCx = 0, s1 = 0, s2 = 0;
         for (int i = 0; i < ns; i++) {
             double x = (double)(i - rs) / ppd, x2 = x * x;
-            /* One 1-D factor of a 2-D Gaussian a sqrt(pi/b) exp(-pi^2 r^2/b):
-             * each factor carries the square root of the amplitude. */
+            /* 1-D factors of the 2-D kernels. A single Gaussian is normalised
+             * on its own, so its amplitude drops out; for the blue-yellow sum
+             * each factor of a sqrt(pi/b) exp(-pi^2 (x^2 + y^2)/b) carries the
+             * square root of the amplitude, keeping the two terms' ratio. */
             kY[i] = csf_a1[0] * sqrt(M_PI / csf_b1[0]) * exp(-M_PI * M_PI * x2 / csf_b1[0]);
             kCx[i] = csf_a1[1] * sqrt(M_PI / csf_b1[1]) * exp(-M_PI * M_PI * x2 / csf_b1[1]);
             kCz1[i] = sqrt(csf_a1[2] * sqrt(M_PI / csf_b1[2])) * exp(-M_PI * M_PI * x2 / csf_b1[2]);
@@ -358,30 +420,17 @@ static pt_status flip_ldr_linear(const float *ref, const float *test, int w, int
         }
     }
 
-    /* Plane layout. */
+    /* Plane layout: E and Q end up holding the feature difference and a
+     * reference feature response, S the normalised achromatic channel. */
     float *P[2][3];
     for (int im = 0; im < 2; im++)
         for (int c = 0; c < 3; c++) P[im][c] = buf + (size_t)(im * 3 + c) * n;
     float *F1 = buf + 6 * n, *F2 = buf + 7 * n, *T = buf + 8 * n;
     float *E = buf + 9 * n, *Q = buf + 10 * n, *S = buf + 11 * n;
 
-    /* 1. linear RGB -> YCxCz. */
-    for (int im = 0; im < 2; im++) {
-        const float *src = im ? test : ref;
-        for (size_t i = 0; i < n; i++) {
-            double rgb[3];
-            for (int c = 0; c < 3; c++) {
-                double v = src[i * 3 + (size_t)c];
-                rgb[c] = v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
-            }
-            double xyz[3];
-            for (int r = 0; r < 3; r++)
-                xyz[r] = (rgb2xyz[r][0] * rgb[0] + rgb2xyz[r][1] * rgb[1] + rgb2xyz[r][2] * rgb[2]) / k.white[r];
-            P[im][0][i] = (float)(116.0 * xyz[1] - 16.0);
-            P[im][1][i] = (float)(500.0 * (xyz[0] - xyz[1]));
-            P[im][2][i] = (float)(200.0 * (xyz[1] - xyz[2]));
-        }
-    }
+    /* 1. input -> linear RGB -> YCxCz. */
+    ycc_job yj = {&k, in, {ref, test}, P, w, h};
+    pool_run(cc.nthreads, (h + ROWS_PER_JOB - 1) / ROWS_PER_JOB, ycc_rows, &yj);
 
     /* 5-6. Feature pipeline first (it reads the unfiltered achromatic channel).
      * Achromatic channel normalised to [0,1]: (Y' + 16) / 116 = Y / Yn. For
@@ -452,34 +501,14 @@ static pt_status check_pair(const framebuffer *ref, const framebuffer *test, con
     return PT_OK;
 }
 
-static double srgb_decode(double e)
-{
-    return e <= 0.04045 ? e / 12.92 : pow((e + 0.055) / 1.055, 2.4);
-}
-
 pt_status img_flip_ldr(const framebuffer *ref, const framebuffer *test,
                        const img_flip_params *p, float *err, diag *d)
 {
     pt_status st = check_pair(ref, test, err, d);
     if (st != PT_OK) return st;
-    size_t n = (size_t)ref->width * (size_t)ref->height * 3u;
-    float *lin = malloc(2 * n * sizeof(float));
-    if (!lin) {
-        diag_report(d, DIAG_ERROR, (src_loc){0}, NULL, "FLIP: out of memory");
-        return PT_ERR_NOMEM;
-    }
-    /* The sRGB transfer function (IEC 61966-2-1) on clamped values. */
-    for (size_t i = 0; i < n; i++) {
-        double a = ref->rgb[i], b = test->rgb[i];
-        a = !isfinite(a) ? 0.0 : (a < 0.0 ? 0.0 : (a > 1.0 ? 1.0 : a));
-        b = !isfinite(b) ? 0.0 : (b < 0.0 ? 0.0 : (b > 1.0 ? 1.0 : b));
-        lin[i] = (float)srgb_decode(a);
-        lin[n + i] = (float)srgb_decode(b);
-    }
+    flip_input in = {FLIP_IN_SRGB, 1.0};
     double ppd = (p && p->ppd > 0.0) ? p->ppd : IMG_FLIP_DEFAULT_PPD;
-    st = flip_ldr_linear(lin, lin + n, ref->width, ref->height, ppd, err, d);
-    free(lin);
-    return st;
+    return flip_ldr_linear(ref->rgb, test->rgb, ref->width, ref->height, &in, ppd, err, d);
 }
 
 static double luminance(const float *rgb)
@@ -587,35 +616,21 @@ pt_status img_flip_hdr(const framebuffer *ref, const framebuffer *test,
 
     int w = ref->width, h = ref->height;
     size_t n = (size_t)w * (size_t)h;
-    float *ldr = malloc((2 * 3 * n + n) * sizeof(float));
-    if (!ldr) {
+    float *e1 = malloc(n * sizeof(float));
+    if (!e1) {
         diag_report(d, DIAG_ERROR, (src_loc){0}, NULL, "HDR-FLIP: out of memory");
         return PT_ERR_NOMEM;
     }
-    float *lr = ldr, *lt = ldr + 3 * n, *e1 = ldr + 6 * n;
     for (size_t i = 0; i < n; i++) err[i] = 0.0f;
     double step = ne > 1 ? (p->exp_stop - p->exp_start) / (ne - 1) : 0.0;
     for (int k = 0; k < ne; k++) {
-        double m = pow(2.0, p->exp_start + k * step);
-        for (int im = 0; im < 2; im++) {
-            const float *src = im ? test->rgb : ref->rgb;
-            float *dst = im ? lt : lr;
-            for (size_t i = 0; i < 3 * n; i++) {
-                /* Negative values count as 0: the rational tone curve
-                 * is meant for x >= 0 (it turns x = -1 into 1.34). */
-                double x = isfinite(src[i]) && src[i] > 0.0f ? (double)src[i] * m : 0.0;
-                double y = (aces_c[0] * x * x + aces_c[1] * x + aces_c[2]) /
-                           (aces_c[3] * x * x + aces_c[4] * x + aces_c[5]);
-                if (!isfinite(y)) y = 1.0; /* overflow of a huge value */
-                dst[i] = (float)(y < 0.0 ? 0.0 : (y > 1.0 ? 1.0 : y));
-            }
-        }
-        st = flip_ldr_linear(lr, lt, w, h, ppd, e1, d);
+        flip_input in = {FLIP_IN_TONED, pow(2.0, p->exp_start + k * step)};
+        st = flip_ldr_linear(ref->rgb, test->rgb, w, h, &in, ppd, e1, d);
         if (st != PT_OK) break;
         for (size_t i = 0; i < n; i++)
             if (e1[i] > err[i]) err[i] = e1[i];
     }
-    free(ldr);
+    free(e1);
     return st;
 }
 
