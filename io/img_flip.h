@@ -46,11 +46,14 @@ pt_status img_flip_ldr(const framebuffer *ref, const framebuffer *test,
 pt_status img_flip_hdr(const framebuffer *ref, const framebuffer *test,
                        img_flip_params *p, float *err, diag *d);
 
-/* HDR-FLIP's automatic exposure range (EG 2021): with t(x) the ACES
- * tone curve, start = log2(x85 / Ymax) and stop = log2(x85 / Ymedian), where
- * t(x85) = 0.85 and Y is the reference's luminance; n = max(2, ceil(stop -
- * start)). A reference with median luminance 0 gets stop = start + 1.
- * Returns PT_ERR_USAGE for an empty or all-black image. */
+/* HDR-FLIP's automatic exposure range (EG 2021): with t(x) the ACES tone
+ * curve, start = log2(x85 / Ymax) and stop = log2(x85 / Ymedian), where
+ * t(x85) = 0.85 and Y is the reference's luminance (Rec. 709 weights; the
+ * median is the element at index n/2 of the sorted values, as in the
+ * authors' tool); n = max(2, ceil(stop - start)). Our additions for
+ * degenerate references: a median of 0 is replaced by the median of the
+ * positive luminances, and an all-black reference gets 0 to 1 (with a
+ * warning). PT_ERR_USAGE for an empty image. */
 pt_status img_flip_exposures(const framebuffer *ref, double *start, double *stop,
                              int *n, diag *d);
 

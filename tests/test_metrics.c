@@ -239,6 +239,16 @@ static void test_flip_identical(void **st)
     for (int i = 0; i < 40 * 30; i++) assert_true(err[i] == 0.0f);
     assert_true(p.nexposures >= 2);
     assert_true(p.exp_start <= p.exp_stop);
+    /* A given range: n = max(2, ceil(stop - start)). */
+    img_flip_default_params(&p);
+    p.exp_start = -1.0;
+    p.exp_stop = 1.5;
+    assert_int_equal(img_flip_hdr(h, h, &p, err, NULL), PT_OK);
+    assert_int_equal(p.nexposures, 3);
+    assert_true(p.exp_start == -1.0 && p.exp_stop == 1.5);
+    p.exp_start = 2.0;
+    p.nexposures = 0;
+    assert_int_equal(img_flip_hdr(h, h, &p, err, NULL), PT_ERR_USAGE); /* start > stop */
 
     img_compare_result r;
     assert_int_equal(img_compare(a, a, 0, &r, NULL, NULL), PT_OK);
@@ -301,6 +311,10 @@ static void test_flip_pooling(void **st)
     assert_true(fabs(img_flip_weighted_percentile(v, 4, 0.5) - 0.3) < 1e-7);
     assert_true(fabs(img_flip_weighted_percentile(v, 4, 0.25) - 0.2) < 1e-7);
     assert_true(fabs(img_flip_weighted_percentile(v, 4, 0.75) - 0.4) < 1e-7);
+    /* Histogram form: bins 10, 20, 30, 40 weighted by their centres 0.105,
+     * 0.205, 0.305, 0.405 (total 1.02); half is 0.51, reached inside bin 30
+     * at (0.51 - 0.31) / 0.305 of its width: 0.01 (30 + 0.2 / 0.305). */
+    assert_true(fabs(img_flip_hist_weighted_percentile(v, 4, 0.5) - 0.01 * (30.0 + 0.2 / 0.305)) < 1e-6);
     /* Default viewing conditions: 0.7 m, 3840 px over 0.7 m -> 67.02 ppd. */
     assert_true(fabs(img_flip_ppd(0.7, 3840, 0.7) - 67.0206) < 1e-4);
     assert_true(fabs(IMG_FLIP_DEFAULT_PPD - img_flip_ppd(0.7, 3840, 0.7)) < 1e-9);
