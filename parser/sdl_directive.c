@@ -632,6 +632,25 @@ static const char *opaque_rvalue_name(sdl_kw k)
     }
 }
 
+/* layered_texture := texture_block { 'texture' texture_block } (last on top) */
+static scene_texture *layered_texture(sdl_parser *p)
+{
+    scene_texture *top = sdl_parse_texture(p);
+    for (;;) {
+        p->defer++;
+        int more = sdl_ok(p) && top && sdl_accept_kw(p, KW_TEXTURE);
+        p->defer--;
+        if (!more) break;
+        scene_texture *t = sdl_parse_texture(p);
+        if (!t) break;
+        scene_texture *last = t;
+        while (last->next) last = last->next;
+        last->next = top;
+        top = t;
+    }
+    return top;
+}
+
 /* keyword_rvalue: texture/pigment/finish/normal/interior/material/camera/
  * transform/object/function/array/maps */
 static void keyword_rvalue(sdl_parser *p, sdl_value *out)
@@ -647,7 +666,7 @@ static void keyword_rvalue(sdl_parser *p, sdl_value *out)
     }
     sdl_tok kt = sdl_next(p);
     switch (k) {
-    case KW_TEXTURE: out->kind = VAL_TEXTURE; out->ptr = sdl_parse_texture(p); return;
+    case KW_TEXTURE: out->kind = VAL_TEXTURE; out->ptr = layered_texture(p); return;
     case KW_PIGMENT: out->kind = VAL_PIGMENT; out->ptr = sdl_parse_pigment_new(p); return;
     case KW_FINISH: out->kind = VAL_FINISH; out->ptr = sdl_parse_finish_new(p); return;
     case KW_NORMAL: out->kind = VAL_NORMAL; sdl_parse_normal(p); return;
@@ -705,9 +724,14 @@ void sdl_rvalue(sdl_parser *p, sdl_value *out)
     }
 }
 
-/* declare_directive := ('#declare' | '#local') identifier '=' rvalue [';'] */
+/* declare_directive := ('#declare' | '#local') [ 'deprecated' ['once'] [string] ]
+ *                      identifier '=' rvalue [';'] */
 static void declare_directive(sdl_parser *p, int local)
 {
+    if (sdl_accept_kw(p, KW_DEPRECATED)) {
+        sdl_accept_kw(p, KW_ONCE);
+        if (sdl_starts_string(sdl_peek(p))) sdl_string(p);
+    }
     sdl_tok id = name_token(p, "an identifier");
     if (!sdl_ok(p)) return;
     if (sdl_is(sdl_peek(p), TOK_LBRACKET)) {
@@ -715,16 +739,19 @@ static void declare_directive(sdl_parser *p, int local)
         return;
     }
     if (!sdl_expect(p, TOK_EQ, "'='")) return;
+    /* Directives after the value must run after the assignment: look-ahead
+     * past an expression (and the ';' check) defers them, as POV-Ray does. */
+    const sdl_tok *first = sdl_peek(p);
+    int expression = sdl_starts_expr(first) || sdl_starts_string(first);
     sdl_value v;
+    p->defer += expression;
     sdl_rvalue(p, &v);
-    if (!sdl_ok(p)) return;
-    int ok = local ? sdl_symtab_local(p->sym, id.tk.text, (size_t)id.tk.len, &v)
-                   : sdl_symtab_declare(p->sym, id.tk.text, (size_t)id.tk.len, &v);
-    if (!ok) {
-        sdl_error(p, id.tk.loc, PT_ERR_NOMEM, "out of memory");
-        return;
-    }
+    p->defer += !expression;
+    int ok = !sdl_ok(p) || (local ? sdl_symtab_local(p->sym, id.tk.text, (size_t)id.tk.len, &v)
+                                  : sdl_symtab_declare(p->sym, id.tk.text, (size_t)id.tk.len, &v));
+    if (!ok) sdl_error(p, id.tk.loc, PT_ERR_NOMEM, "out of memory");
     sdl_accept(p, TOK_SEMI);
+    p->defer--;
 }
 
 /* undef_directive := '#undef' identifier */
@@ -739,9 +766,12 @@ static void undef_directive(sdl_parser *p)
 /* version_directive := '#version' float [';'] */
 static void version_directive(sdl_parser *p)
 {
+    sdl_peek(p);
+    p->defer++;
     double v = sdl_float(p);
-    if (!sdl_ok(p)) return;
     sdl_accept(p, TOK_SEMI);
+    p->defer--;
+    if (!sdl_ok(p)) return;
     p->version = v;
     if (p->nframes == 1) {
         p->s->version_major = (int)floor(v + 1e-9);
@@ -864,34 +894,6 @@ static void macro_call(sdl_parser *p, const sdl_tok *id)
     p->macro_depth++;
 }
 
-/* default_directive := '#default' '{' { texture | pigment | finish | normal } '}' */
-static void default_directive(sdl_parser *p)
-{
-    if (!sdl_begin_block(p, "#default")) return;
-    scene_texture *dt = &p->s->default_texture;
-    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
-        sdl_tok t = sdl_next(p);
-        if (sdl_is_kw(&t, KW_TEXTURE)) {
-            scene_texture *nt = sdl_parse_texture(p);
-            if (nt) {
-                *dt = *nt;
-                dt->next = NULL;
-            }
-        } else if (sdl_is_kw(&t, KW_PIGMENT)) {
-            sdl_parse_pigment(p, &dt->pigment);
-        } else if (sdl_is_kw(&t, KW_FINISH)) {
-            sdl_parse_finish(p, &dt->finish);
-        } else if (sdl_is_kw(&t, KW_NORMAL)) {
-            sdl_parse_normal(p);
-            dt->has_normal = 1;
-        } else {
-            sdl_unexpected(p, &t, "texture, pigment, finish or normal");
-        }
-    }
-    sdl_end_block(p);
-    p->default_texture_set = 1;
-}
-
 /* directive := '#' directive_keyword ... */
 static void directive(sdl_parser *p, const sdl_token *hash)
 {
@@ -918,7 +920,7 @@ static void directive(sdl_parser *p, const sdl_token *hash)
     case KW_VERSION: version_directive(p); break;
     case KW_DEBUG: case KW_WARNING: case KW_ERROR: message_directive(p, k.kw, loc); break;
     case KW_MACRO: macro_directive(p, loc); break;
-    case KW_DEFAULT: default_directive(p); break;
+    case KW_DEFAULT: sdl_parse_default(p); break;
     case KW_FOPEN: case KW_FCLOSE: case KW_READ: case KW_WRITE:
         sdl_error(p, loc, PT_ERR_UNSUPPORTED, "#%s is not supported yet", sdl_kw_text(k.kw));
         break;
@@ -964,9 +966,20 @@ sdl_tok sdl_next(sdl_parser *p)
 {
     for (;;) {
         if (!sdl_ok(p) || p->nframes == 0) return eof_token(p);
-        if (p->nahead > 0) return p->last = p->ahead[--p->nahead];
         sdl_tok t;
         memset(&t, 0, sizeof t);
+        if (p->nahead > 0) {
+            t = p->ahead[--p->nahead];
+            if (t.tk.kind == TOK_HASH && p->defer == 0) {
+                directive(p, &t.tk);
+                continue;
+            }
+            if (t.tk.kind == TOK_IDENT && t.val.kind == VAL_MACRO && p->hold_macros == 0 && p->defer == 0) {
+                macro_call(p, &t);
+                continue;
+            }
+            return p->last = t;
+        }
         t.tk = sdl_scan_next(&top_frame(p)->sc);
         if (t.tk.kind == TOK_ERROR) {
             sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "%s", top_frame(p)->sc.err);
@@ -978,13 +991,14 @@ sdl_tok sdl_next(sdl_parser *p)
             return p->last = t;
         }
         if (t.tk.kind == TOK_HASH) {
+            if (p->defer > 0) return p->last = t;
             directive(p, &t.tk);
             continue;
         }
         if (t.tk.kind == TOK_IDENT) {
             const sdl_value *v = sdl_symtab_find(p->sym, t.tk.text, (size_t)t.tk.len);
             if (v) t.val = *v;
-            if (v && v->kind == VAL_MACRO && p->hold_macros == 0) {
+            if (v && v->kind == VAL_MACRO && p->hold_macros == 0 && p->defer == 0) {
                 macro_call(p, &t);
                 continue;
             }

@@ -540,7 +540,7 @@ static void keyword_primary(sdl_parser *p, const sdl_tok *t, ex_val *out)
 
 /* primary := number | identifier | function | '<' vector '>' | '(' expression ')'
  *          | ('-' | '+' | '!') factor */
-static void primary(sdl_parser *p, ex_val *out)
+static void primary_inner(sdl_parser *p, ex_val *out)
 {
     sdl_tok t = sdl_next(p);
     ex_float(out, 0);
@@ -566,6 +566,16 @@ static void primary(sdl_parser *p, ex_val *out)
         sdl_unexpected(p, &t, "numeric expression");
         return;
     }
+}
+
+/* Inside a primary, directives and macros run even while a declaration's
+ * look-ahead defers them (POV-Ray: Ok_To_Declare within Parse_Num_Factor). */
+static void primary(sdl_parser *p, ex_val *out)
+{
+    int saved = p->defer;
+    p->defer = 0;
+    primary_inner(p, out);
+    p->defer = saved;
 }
 
 /* component := x | y | z | u | v | t | red | green | blue | filter | transmit | gray */

@@ -136,6 +136,7 @@ static void colour_map_block(sdl_parser *p, colour5 *first, int *have)
         return;
     }
     if (!sdl_begin_block(p, "colour_map")) return;
+    if (sdl_is(sdl_peek(p), TOK_IDENT)) sdl_next(p); /* colour_map { Declared_Map } */
     while (sdl_ok(p) && sdl_accept(p, TOK_LBRACKET)) {
         sdl_float(p);
         sdl_accept(p, TOK_COMMA);

@@ -101,6 +101,9 @@ typedef struct sdl_parser {
     sdl_block *blocks;    /* open { } blocks, for "unterminated" messages */
     int nblocks, cap_blocks;
     int hold_macros;      /* >0: macro identifiers are returned, not invoked */
+    int defer;            /* >0: a '#' or macro name met while looking ahead is
+                             returned as a token and runs when read again (the
+                             look-ahead past the end of a #declare) */
     int macro_depth;
     int include_depth;
     double version;       /* language version from #version, 3.7 by default */

@@ -436,6 +436,34 @@ static void background(sdl_parser *p)
     sdl_end_block(p);
 }
 
+/* default := ['#'] 'default' '{' { texture | pigment | finish | normal } '}' */
+void sdl_parse_default(sdl_parser *p)
+{
+    if (!sdl_begin_block(p, "#default")) return;
+    scene_texture *dt = &p->s->default_texture;
+    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
+        sdl_tok t = sdl_next(p);
+        if (sdl_is_kw(&t, KW_TEXTURE)) {
+            scene_texture *nt = sdl_parse_texture(p);
+            if (nt) {
+                *dt = *nt;
+                dt->next = NULL;
+            }
+        } else if (sdl_is_kw(&t, KW_PIGMENT)) {
+            sdl_parse_pigment(p, &dt->pigment);
+        } else if (sdl_is_kw(&t, KW_FINISH)) {
+            sdl_parse_finish(p, &dt->finish);
+        } else if (sdl_is_kw(&t, KW_NORMAL)) {
+            sdl_parse_normal(p);
+            dt->has_normal = 1;
+        } else {
+            sdl_unexpected(p, &t, "texture, pigment, finish or normal");
+        }
+    }
+    sdl_end_block(p);
+    p->default_texture_set = 1;
+}
+
 /* ------------------------------------------------------------ statements */
 
 static void skipped_statement(sdl_parser *p, const sdl_tok *t)
@@ -465,6 +493,7 @@ static void statement(sdl_parser *p)
         return;
     }
     case KW_GLOBAL_SETTINGS: global_settings(p); return;
+    case KW_DEFAULT: sdl_parse_default(p); return;
     case KW_BACKGROUND: background(p); return;
     case KW_FOG: case KW_SKY_SPHERE: case KW_RAINBOW: case KW_MEDIA: skipped_statement(p, &t); return;
     default: break;

@@ -8,6 +8,8 @@
 void sdl_parse_scene(sdl_parser *p);
 /* After 'light_source': '{' ... '}' -> an sdl_obj holding one light. */
 sdl_obj *sdl_parse_light(sdl_parser *p, src_loc loc);
+/* After 'default' / '#default': '{' { texture | pigment | finish | normal } '}' */
+void sdl_parse_default(sdl_parser *p);
 /* After 'camera': '{' ... '}' -> a new camera with its final vectors. */
 scene_camera *sdl_parse_camera_new(sdl_parser *p);
 
