@@ -110,6 +110,7 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
     o->aa_threshold = 0.3;
     o->aa_depth = 3;
     o->spp = 1;
+    o->exr_compression = -1;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -144,6 +145,37 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
         } else if (strcmp(a, "--stats") == 0) {
             if (!has_value(a, next, err, errlen)) return 2;
             o->stats = next;
+            i++;
+        } else if (strcmp(a, "--display") == 0 || strcmp(a, "--view") == 0 || strcmp(a, "--look") == 0 ||
+                   strcmp(a, "--working-space") == 0 || strcmp(a, "--ocio-config") == 0 ||
+                   strcmp(a, "--false-color") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (strcmp(a, "--display") == 0) o->display = next;
+            else if (strcmp(a, "--view") == 0) o->view = next;
+            else if (strcmp(a, "--look") == 0) o->look = next;
+            else if (strcmp(a, "--working-space") == 0) o->working_space = next;
+            else if (strcmp(a, "--ocio-config") == 0) o->ocio_config = next;
+            else o->false_color = next;
+            i++;
+        } else if (strcmp(a, "--exposure") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (!parse_double(next, &o->exposure)) { snprintf(err, (size_t)errlen, "--exposure wants a number of stops"); return 2; }
+            i++;
+        } else if (strcmp(a, "--false-color-range") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (sscanf(next, "%lf,%lf", &o->fc_lo, &o->fc_hi) != 2 || !(o->fc_lo > 0) || !(o->fc_hi > o->fc_lo)) {
+                snprintf(err, (size_t)errlen, "--false-color-range wants LO,HI with 0 < LO < HI");
+                return 2;
+            }
+            i++;
+        } else if (strcmp(a, "--png16") == 0) {
+            o->png16 = 1;
+        } else if (strcmp(a, "--exr-compression") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (strcmp(next, "none") == 0) o->exr_compression = 0;
+            else if (strcmp(next, "zip") == 0) o->exr_compression = 1;
+            else if (strcmp(next, "piz") == 0) o->exr_compression = 2;
+            else { snprintf(err, (size_t)errlen, "--exr-compression wants none, zip or piz"); return 2; }
             i++;
         } else if (strcmp(a, "--float") == 0) {
             o->exr_float = 1;

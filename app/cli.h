@@ -26,6 +26,13 @@ typedef struct {
     int exr_float;
     int quiet;
     long max_loop;
+    /* colour management (io/img_ocio.h) */
+    const char *display, *view, *look, *working_space, *ocio_config;
+    double exposure;
+    int png16;
+    int exr_compression;    /* -1 = default (zip) */
+    const char *false_color;/* luminance false-colour PNG */
+    double fc_lo, fc_hi;    /* false-colour range, 0 = automatic */
     int max_include_depth, max_macro_depth;
 } cli_render;
 

@@ -10,7 +10,9 @@
 #include "diag.h"
 #include "framebuffer.h"
 #include "gi.h"
+#include "img_falsecolor.h"
 #include "img_io.h"
+#include "img_ocio.h"
 #include "pool.h"
 #include "scene.h"
 #include "sdl.h"
@@ -36,7 +38,11 @@ static const char *usage_text =
     "usage:\n"
     "  partray render SCENE.pov [-o OUT.exr|.png|.pfm]... [--size WxH] [--gi MODE] [--spp N]\n"
     "                 [--threads N] [--seed N] [--stats FILE.json] [-D NAME=VALUE] [-L DIR]\n"
-    "                 [--float] [--max-loop N] [--max-include-depth N] [--max-macro-depth N]\n"
+    "                 [--float] [--exr-compression none|zip|piz] [--png16]\n"
+    "                 [--display NAME] [--view NAME] [--look NAME] [--exposure STOPS]\n"
+    "                 [--working-space NAME] [--ocio-config FILE] [--false-color OUT.png]\n"
+    "                 [--false-color-range LO,HI]\n"
+    "                 [--max-loop N] [--max-include-depth N] [--max-macro-depth N]\n"
     "                 [+W640 +H480 +A0.3 +R3 +Oout.png +Iscene.pov +Ldir ...]\n"
     "  partray parse SCENE.pov [-D NAME=VALUE] [-L DIR]\n"
     "  partray compare REF TEST [--heatmap OUT.png] [--json]\n"
@@ -146,6 +152,30 @@ static char *default_output(const char *scene_path)
     return s;
 }
 
+/* Luminance false-colour image of the render (log scale, legend with values).
+ * Values are the renderer's relative luminance (Rec.709 Y of the linear
+ * values); absolute units need a photometric light model (not built yet). */
+static int write_false_color(const cli_render *o, const framebuffer *fb)
+{
+    diag *d = diag_new();
+    float *y = img_fc_luminance(fb, 1.0);
+    framebuffer *out = NULL;
+    double lo = 0, hi = 0;
+    img_fc_opts fo;
+    img_fc_default_opts(&fo);
+    fo.lo = o->fc_lo;
+    fo.hi = o->fc_hi;
+    fo.unit = NULL;
+    pt_status st = y ? img_falsecolor(y, fb->width, fb->height, &fo, &out, &lo, &hi, d) : PT_ERR_NOMEM;
+    if (st == PT_OK) st = img_write(o->false_color, out, NULL, d);
+    if (st == PT_OK && !o->quiet) fprintf(stderr, "partray: false colour %s, luminance %.4g to %.4g (log scale)\n", o->false_color, lo, hi);
+    print_diags(d, 0);
+    diag_free(d);
+    free(y);
+    fb_free(out);
+    return status_exit(st);
+}
+
 static int cmd_render(int argc, char **argv)
 {
     double t_start = timer_now();
@@ -169,6 +199,20 @@ static int cmd_render(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
+    /* Colour management: check the names before spending time on a render. */
+    img_ocio *oc = NULL;
+    int want_ocio = o.display || o.view || o.look || o.working_space || o.ocio_config;
+    if (want_ocio) {
+        diag *od = diag_new();
+        pt_status os = img_ocio_open(o.ocio_config, &oc, od);
+        if (os == PT_OK) os = img_ocio_check(oc, o.working_space, o.display, o.view, o.look, od);
+        print_diags(od, 0);
+        diag_free(od);
+        if (os != PT_OK) {
+            img_ocio_close(oc);
+            return status_exit(os == PT_ERR_IO ? PT_ERR_IO : PT_ERR_USAGE);
+        }
+    }
     char *default_out = NULL;
     if (o.noutputs == 0) {
         default_out = default_output(o.scene);
@@ -186,6 +230,7 @@ static int cmd_render(int argc, char **argv)
         print_diags(d, 0);
         diag_free(d);
         free(default_out);
+        img_ocio_close(oc);
         return status_exit(st);
     }
     if (!o.gi && sc->global.radiosity.enabled) gi = GI_PARTICLE;
@@ -207,6 +252,7 @@ static int cmd_render(int argc, char **argv)
         scene_free(sc);
         diag_free(d);
         free(default_out);
+        img_ocio_close(oc);
         return status_exit(st == PT_OK ? PT_ERR_DEVICE : st);
     }
 
@@ -235,6 +281,14 @@ static int cmd_render(int argc, char **argv)
     img_write_opts wo;
     img_default_write_opts(&wo);
     wo.exr_float = o.exr_float;
+    if (o.exr_compression >= 0) wo.exr_compression = o.exr_compression;
+    wo.png_16bit = o.png16;
+    wo.ocio = oc;
+    wo.working_space = o.working_space;
+    wo.display = o.display;
+    wo.view = o.view;
+    wo.look = o.look;
+    wo.exposure = o.exposure;
     char tbuf[64];
     snprintf(tbuf, sizeof tbuf, "%.3f", t_render);
     const char *keys[] = {"partray:scene", "partray:gi", "partray:version", "partray:render_seconds"};
@@ -263,6 +317,7 @@ static int cmd_render(int argc, char **argv)
             diag_free(wd);
             if (ws != PT_OK) rc = status_exit(ws);
         }
+        if (rc == EXIT_OK && o.false_color) rc = write_false_color(&o, fb);
     }
     double t_total = timer_now() - t_start;
     if (o.stats && rc == EXIT_OK) {
@@ -312,6 +367,7 @@ static int cmd_render(int argc, char **argv)
                 ss.height, gi_used, t_parse, t_accel, t_render,
                 t_render > 0 ? (sst.primary_rays + sst.shadow_rays + sst.secondary_rays) / t_render * 1e-6 : 0.0);
     fb_free(fb);
+    img_ocio_close(oc);
     accel_free(acc);
     scene_free(sc);
     diag_free(d);
