@@ -289,13 +289,19 @@ static int cmd_render(int argc, char **argv)
     wo.view = o.view;
     wo.look = o.look;
     wo.exposure = o.exposure;
-    char tbuf[64];
+    char tbuf[64], timings[160], settings[256];
     snprintf(tbuf, sizeof tbuf, "%.3f", t_render);
-    const char *keys[] = {"partray:scene", "partray:gi", "partray:version", "partray:render_seconds"};
-    const char *vals[] = {o.scene, gi_used, PARTRAY_VERSION, tbuf};
+    snprintf(timings, sizeof timings, "parse %.3f s, accel %.3f s, gi_geometry 0 s, gi_lighting 0 s, render %.3f s", t_parse,
+             t_accel, t_render);
+    snprintf(settings, sizeof settings, "size %dx%d, antialias %s threshold %.3g depth %d, spp %d, seed %llu, threads %d",
+             ss.width, ss.height, ss.antialias == 1 ? "adaptive" : (ss.antialias == 2 ? "fixed" : "off"), ss.aa_threshold,
+             ss.aa_depth, ss.spp, (unsigned long long)ss.seed, threads);
+    const char *keys[] = {"partray:scene", "partray:gi", "partray:version", "partray:render_seconds", "partray:timings",
+                          "partray:settings"};
+    const char *vals[] = {o.scene, gi_used, PARTRAY_VERSION, tbuf, timings, settings};
     wo.meta_keys = keys;
     wo.meta_values = vals;
-    wo.nmeta = 4;
+    wo.nmeta = 6;
     if (st == PT_OK && g_cancel) {
         /* Interrupted: keep what was rendered under a clearly partial name. */
         for (int i = 0; i < o.noutputs; i++) {
