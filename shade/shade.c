@@ -539,6 +539,7 @@ static void tile_first_pass(void *ctx, int tile, int thread)
         if (n < 1) n = 1;
     }
     for (int y = y0; y < y1; y++) {
+        if (c->s->cancel && *c->s->cancel) return;
         for (int x = x0; x < x1; x++) {
             rng r;
             pixel_rng(&r, c->s->seed, x, y, 0);
@@ -581,6 +582,7 @@ static void tile_supersample(void *ctx, int tile, int thread)
     int d = c->s->aa_depth > 0 ? c->s->aa_depth : 3;
     double step = 1.0 / d;
     for (int y = y0; y < y1; y++) {
+        if (c->s->cancel && *c->s->cancel) return;
         for (int x = x0; x < x1; x++) {
             if (!c->flag[(size_t)y * c->s->width + x]) continue;
             rng r;

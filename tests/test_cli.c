@@ -163,6 +163,42 @@ static void test_render_outputs_and_stats(void **st)
     }
 }
 
+/* Ctrl-C during a long render: exit 130 within a second or so, the partial
+ * image kept as NAME.partial.png, nothing under the final name. */
+static void test_sigint_partial(void **st)
+{
+    (void)st;
+    char scene[512], out[512], partial[512], cmd[2048];
+    snprintf(scene, sizeof scene, "%s/slow.pov", tmpdir);
+    snprintf(out, sizeof out, "%s/slow.png", tmpdir);
+    snprintf(partial, sizeof partial, "%s/slow.partial.png", tmpdir);
+    write_file(scene,
+               "camera { location <0, 3, -6> look_at 0 }\n"
+               "light_source { <0, 5, 0> rgb 1 area_light 2*x, 2*z, 16, 16 jitter }\n"
+               "plane { y, 0 pigment { rgb 1 } }\n"
+               "sphere { <0, 1, 0>, 1 pigment { rgb 0.5 } }\n");
+    /* Start the render in the background, interrupt it after 0.7 s, and time the stop. */
+    snprintf(cmd, sizeof cmd,
+             "'%s' render '%s' -o '%s' --size 2000x2000 --threads 2 --quiet & pid=$!; sleep 0.7; "
+             "t0=$(date +%%s%%N); kill -INT $pid; wait $pid; rc=$?; t1=$(date +%%s%%N); "
+             "echo \"rc=$rc ms=$(( (t1 - t0) / 1000000 ))\"",
+             PARTRAY_BIN, scene, out);
+    run_capture(cmd);
+    printf("%s", out_text);
+    int rc = -1, ms = -1;
+    const char *p = strstr(out_text, "rc=");
+    assert_non_null(p);
+    assert_int_equal(sscanf(p, "rc=%d ms=%d", &rc, &ms), 2);
+    assert_int_equal(rc, 130);
+    assert_true(ms >= 0 && ms < 1000);
+    assert_true(exists(partial));
+    assert_false(exists(out));
+    framebuffer *fb = NULL;
+    assert_int_equal(img_read(partial, 0, &fb, NULL), PT_OK);
+    assert_int_equal(fb->width, 2000);
+    fb_free(fb);
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/partray-cli-XXXXXX");
@@ -174,6 +210,7 @@ int main(void)
         cmocka_unit_test(test_include_chain),
         cmocka_unit_test(test_usage),
         cmocka_unit_test(test_render_outputs_and_stats),
+        cmocka_unit_test(test_sigint_partial),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     char cmd[600];
