@@ -6,7 +6,10 @@
  *     objects that cast shadows, one for no_shadow objects. A per-primitive
  *     table leads back to the leaf object and the triangle index within it.
  *   - one user geometry (RTC_GEOMETRY_TYPE_USER) whose primitives are the
- *     analytic shapes (accel_shapes.c), intersected exactly in double precision.
+ *     analytic shapes (accel_shapes.c), intersected exactly in double
+ *     precision, followed by one primitive per CSG intersection, difference
+ *     or merge (accel_csg.c; unions are flattened, and a CSG with a mesh
+ *     member falls back to a union with a warning).
  *   - one instance geometry per object that references a shared mesh: a mesh
  *     used by more than one object is built once as its own RTCScene in
  *     object space and placed with the object's transform.
@@ -52,11 +55,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "accel_csg.h"
 #include "accel_shapes.h"
 #include "timer.h"
 
 #define PLANE_EXTENT_FACTOR 1e4
 #define MAX_CSG_DEPTH 512
+#define MAX_MERGE_MEMBERS 64
 
 enum { GEOM_NONE = 0, GEOM_TRI, GEOM_USER, GEOM_INSTANCE };
 enum { INHERITED_FLAGS = OBJ_NO_SHADOW | OBJ_NO_IMAGE | OBJ_NO_REFLECTION | OBJ_NO_RADIOSITY };
@@ -67,6 +72,7 @@ typedef struct {
     unsigned flags;               /* effective: CSG parents' no_* flags included */
     double wind;                  /* -1 when the transform mirrors, else 1 */
     int identity;                 /* transform is the identity */
+    int in_csg;                   /* member of a CSG primitive, built there */
     int group;                    /* shared-mesh group, -1 if none */
 } accel_leaf;
 
@@ -100,6 +106,8 @@ struct accel {
     int nshapes, capshapes;
     mesh_group *groups;
     int ngroups;
+    accel_csg *csgs;              /* user primitives nshapes .. nshapes + ncsgs - 1 */
+    int ncsgs, capcsgs;
     geom_info *ginfo;
     unsigned nginfo;
     vec3 lo, hi;
@@ -119,7 +127,7 @@ typedef struct {
     vec3 org, dir;
     double tmin;
     double ut;               /* last accepted user-geometry hit */
-    int upart;
+    int upart, ushape, uflip; /* ushape, uflip: CSG member */
     unsigned uprim;
     int uhit;
 } accel_query;
@@ -198,8 +206,117 @@ static int add_leaf(accel *a, const scene_object *o, const scene_texture *tex, u
                  m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
     l->wind = det < 0.0 ? -1.0 : 1.0;
     l->identity = xform_is_identity(&o->transform);
+    l->in_csg = 0;
     l->group = -1;
     return a->nleaves++;
+}
+
+/* ------------------------------------------------------------ CSG */
+
+static int is_csg_kind(shape_kind k)
+{
+    return k == SHAPE_UNION || k == SHAPE_MERGE || k == SHAPE_INTERSECTION || k == SHAPE_DIFFERENCE;
+}
+
+static int csg_has_mesh(const scene_object *o, int depth)
+{
+    if (!o || depth > MAX_CSG_DEPTH) return 0;
+    if (o->kind == SHAPE_MESH) return 1;
+    if (is_csg_kind(o->kind))
+        for (int i = 0; i < o->u.csg.nkids; i++)
+            if (csg_has_mesh(o->u.csg.kids[i], depth + 1)) return 1;
+    return 0;
+}
+
+static int csg_leaf_count(const scene_object *o, int depth)
+{
+    if (!o || depth > MAX_CSG_DEPTH) return 0;
+    if (!is_csg_kind(o->kind)) return 1;
+    int n = 0;
+    for (int i = 0; i < o->u.csg.nkids; i++) n += csg_leaf_count(o->u.csg.kids[i], depth + 1);
+    return n;
+}
+
+static pt_status csg_member(accel *a, diag *d, accel_csg *c, const scene_object *o, const scene_texture *ptex,
+                            unsigned pflags, int parent, int depth)
+{
+    if (!o) return PT_OK;
+    const scene_texture *tex = o->texture ? o->texture : ptex;
+    unsigned flags = o->flags | (pflags & INHERITED_FLAGS);
+    int inverse = (o->flags & OBJ_INVERSE) != 0;
+    accel_csg_op parent_op = parent >= 0 ? c->nodes[parent].op : CSG_UNION;
+    if (is_csg_kind(o->kind)) {
+        if (depth >= MAX_CSG_DEPTH) {
+            diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", MAX_CSG_DEPTH);
+            return PT_ERR_LIMIT;
+        }
+        accel_csg_op op = o->kind == SHAPE_UNION ? CSG_UNION
+                        : o->kind == SHAPE_MERGE ? CSG_MERGE
+                        : o->kind == SHAPE_INTERSECTION ? CSG_INTERSECTION : CSG_DIFFERENCE;
+        int node = accel_csg_add_node(c, op, inverse, parent);
+        if (node < 0) return PT_ERR_NOMEM;
+        for (int i = 0; i < o->u.csg.nkids; i++) {
+            pt_status st = csg_member(a, d, c, o->u.csg.kids[i], tex, flags, node, depth + 1);
+            if (st != PT_OK) return st;
+        }
+        return PT_OK;
+    }
+    int ok = 0;
+    accel_shape sh;
+    switch (o->kind) {
+    case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_PLANE: case SHAPE_TRIANGLE: case SHAPE_SMOOTH_TRIANGLE:
+    case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC: case SHAPE_TORUS:
+        ok = accel_shape_init(&sh, o) == 0;
+        if (!ok)
+            diag_warn_once(d, o->loc, "degenerate %s ignored (zero size, singular transform or non-finite numbers)",
+                           o->name ? o->name : "shape");
+        break;
+    default:
+        a->stats.unsupported++;
+        diag_warn_once(d, o->loc, "%s is not rendered yet", o->name ? o->name : "this shape");
+        break;
+    }
+    if (!ok) {
+        /* A skipped member of an intersection is left out; elsewhere it holds
+         * its place as an empty set (a difference whose first member is gone
+         * is empty, as in POV-Ray). */
+        if (parent_op == CSG_INTERSECTION) return PT_OK;
+        return accel_csg_add_node(c, CSG_UNION, inverse, parent) < 0 ? PT_ERR_NOMEM : PT_OK;
+    }
+    int li = add_leaf(a, o, tex, flags);
+    if (li < 0) return PT_ERR_NOMEM;
+    a->leaves[li].in_csg = 1;
+    return accel_csg_add_leaf(c, &sh, (unsigned)li, inverse, parent) < 0 ? PT_ERR_NOMEM : PT_OK;
+}
+
+/* An intersection or difference (with everything below it) becomes one
+ * user primitive. */
+static pt_status build_csg(accel *a, diag *d, const scene_object *o, const scene_texture *ptex, unsigned pflags,
+                           int depth)
+{
+    if (a->ncsgs == a->capcsgs) {
+        size_t cap = (size_t)a->capcsgs;
+        if (!grow((void **)&a->csgs, &cap, (size_t)a->ncsgs + 1, sizeof(accel_csg))) return PT_ERR_NOMEM;
+        a->capcsgs = (int)cap;
+    }
+    accel_csg *c = &a->csgs[a->ncsgs];
+    memset(c, 0, sizeof *c);
+    c->flags = o->flags | (pflags & INHERITED_FLAGS);
+    pt_status st = csg_member(a, d, c, o, ptex, pflags, -1, depth);
+    if (st != PT_OK) {
+        accel_csg_free(c);
+        return st;
+    }
+    if (!accel_csg_finish(c)) { /* provably empty */
+        accel_csg_free(c);
+        return PT_OK;
+    }
+    a->ncsgs++;
+    if (v3_finite(c->lo) && v3_finite(c->hi)) {
+        a->lo = v3_min(a->lo, c->lo);
+        a->hi = v3_max(a->hi, c->hi);
+    }
+    return PT_OK;
 }
 
 static pt_status collect(accel *a, diag *d, const scene_object *o, const scene_texture *ptex, unsigned pflags,
@@ -210,11 +327,25 @@ static pt_status collect(accel *a, diag *d, const scene_object *o, const scene_t
     unsigned flags = o->flags | (pflags & INHERITED_FLAGS);
     switch (o->kind) {
     case SHAPE_INTERSECTION:
-    case SHAPE_DIFFERENCE:
-        diag_warn_once(d, o->loc, "CSG intersection/difference is not evaluated yet: their parts are rendered as a union");
+    case SHAPE_DIFFERENCE: {
+        if (depth >= MAX_CSG_DEPTH) {
+            diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", MAX_CSG_DEPTH);
+            return PT_ERR_LIMIT;
+        }
+        if (!csg_has_mesh(o, depth)) return build_csg(a, d, o, ptex, pflags, depth);
+        diag_warn_once(d, o->loc,
+                       "CSG intersection/difference with a mesh member is not evaluated yet: its parts are rendered as a union");
+    }
+        /* fall through */
+    case SHAPE_MERGE:
+        /* merge drops the members' internal surfaces (matters for
+         * transparency): evaluated as a CSG primitive while small */
+        if (depth < MAX_CSG_DEPTH && !csg_has_mesh(o, depth) && csg_leaf_count(o, depth) <= MAX_MERGE_MEMBERS)
+            return build_csg(a, d, o, ptex, pflags, depth);
+        diag_warn_once(d, o->loc, "merge with a mesh or more than %d members keeps its internal surfaces",
+                       MAX_MERGE_MEMBERS);
         /* fall through */
     case SHAPE_UNION:
-    case SHAPE_MERGE:
         if (depth >= MAX_CSG_DEPTH) {
             diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", MAX_CSG_DEPTH);
             return PT_ERR_LIMIT;
@@ -298,8 +429,14 @@ static int set_ginfo(accel *a, unsigned id, int kind, unsigned idx)
 static void user_bounds(const struct RTCBoundsFunctionArguments *args)
 {
     const accel *a = args->geometryUserPtr;
-    const accel_shape *sh = &a->shapes[args->primID];
-    vec3 lo = sh->lo, hi = sh->hi;
+    vec3 lo, hi;
+    if (args->primID < (unsigned)a->nshapes) {
+        lo = a->shapes[args->primID].lo;
+        hi = a->shapes[args->primID].hi;
+    } else {
+        lo = a->csgs[args->primID - (unsigned)a->nshapes].lo;
+        hi = a->csgs[args->primID - (unsigned)a->nshapes].hi;
+    }
     double ext = v3_maxc(v3_sub(hi, lo));
     float out[6];
     for (int i = 0; i < 3; i++) {
@@ -313,10 +450,35 @@ static void user_bounds(const struct RTCBoundsFunctionArguments *args)
     b->upper_x = out[3]; b->upper_y = out[4]; b->upper_z = out[5];
 }
 
+/* One user primitive against a ray: an analytic shape or a CSG tree. */
+static int prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, double tmax, accel_csg_hit *h)
+{
+    if (prim < (unsigned)a->nshapes) {
+        accel_shape_hit sh;
+        if (!accel_shape_intersect(&a->shapes[prim], o, d, tmin, tmax, &sh)) return 0;
+        h->t = sh.t;
+        h->part = sh.part;
+        h->shape = 0;
+        h->flip = 0;
+        return 1;
+    }
+    return accel_csg_intersect(&a->csgs[prim - (unsigned)a->nshapes], o, d, tmin, tmax, h);
+}
+
+static const accel_shape *prim_shape(const accel *a, unsigned prim, int member)
+{
+    return prim < (unsigned)a->nshapes ? &a->shapes[prim] : &a->csgs[prim - (unsigned)a->nshapes].shapes[member];
+}
+
+static unsigned prim_flags(const accel *a, unsigned prim)
+{
+    return prim < (unsigned)a->nshapes ? a->leaves[a->shape_leaf[prim]].flags
+                                       : a->csgs[prim - (unsigned)a->nshapes].flags;
+}
+
 static void user_intersect(const struct RTCIntersectFunctionNArguments *args)
 {
     const accel *a = args->geometryUserPtr;
-    const accel_shape *sh = &a->shapes[args->primID];
     accel_query *q = tls_query;
     unsigned N = args->N;
     int exact = q && (void *)q == (void *)args->context && N == 1;
@@ -336,18 +498,21 @@ static void user_intersect(const struct RTCIntersectFunctionNArguments *args)
             d = v3(SOA_F(ray, N, i, 4), SOA_F(ray, N, i, 5), SOA_F(ray, N, i, 6));
             tmin = SOA_F(ray, N, i, 3);
         }
-        accel_shape_hit h;
-        if (!accel_shape_intersect(sh, o, d, tmin, (double)tfar, &h)) continue;
+        accel_csg_hit h;
+        if (!prim_hit(a, args->primID, o, d, tmin, (double)tfar, &h)) continue;
         SOA_F(ray, N, i, 8) = (float)h.t;
         vec3 ng = v3(0, 0, 0);
         double u = 0, v = 0;
         if (exact) {
             q->ut = h.t;
             q->upart = h.part;
+            q->ushape = h.shape;
+            q->uflip = h.flip;
             q->uprim = args->primID;
             q->uhit = 1;
         } else {
-            accel_shape_surface(sh, v3_madd(o, d, h.t), h.part, &ng, &u, &v);
+            accel_shape_surface(prim_shape(a, args->primID, h.shape), v3_madd(o, d, h.t), h.part, &ng, &u, &v);
+            if (h.flip) ng = v3_neg(ng);
         }
         SOA_F(hit, N, i, 0) = (float)ng.x;
         SOA_F(hit, N, i, 1) = (float)ng.y;
@@ -363,8 +528,7 @@ static void user_intersect(const struct RTCIntersectFunctionNArguments *args)
 static void user_occluded(const struct RTCOccludedFunctionNArguments *args)
 {
     const accel *a = args->geometryUserPtr;
-    if (a->leaves[a->shape_leaf[args->primID]].flags & OBJ_NO_SHADOW) return;
-    const accel_shape *sh = &a->shapes[args->primID];
+    if (prim_flags(a, args->primID) & OBJ_NO_SHADOW) return;
     accel_query *q = tls_query;
     unsigned N = args->N;
     int exact = q && (void *)q == (void *)args->context && N == 1;
@@ -382,8 +546,8 @@ static void user_occluded(const struct RTCOccludedFunctionNArguments *args)
             d = v3(SOA_F(ray, N, i, 4), SOA_F(ray, N, i, 5), SOA_F(ray, N, i, 6));
             tmin = SOA_F(ray, N, i, 3);
         }
-        accel_shape_hit h;
-        if (accel_shape_intersect(sh, o, d, tmin, (double)SOA_F(ray, N, i, 8), &h)) SOA_F(ray, N, i, 8) = -INFINITY;
+        accel_csg_hit h;
+        if (prim_hit(a, args->primID, o, d, tmin, (double)SOA_F(ray, N, i, 8), &h)) SOA_F(ray, N, i, 8) = -INFINITY;
     }
 }
 
@@ -604,7 +768,7 @@ static pt_status build_shapes(accel *a, diag *d)
     int n = 0;
     for (int i = 0; i < a->nleaves; i++) {
         shape_kind k = a->leaves[i].obj->kind;
-        if (k != SHAPE_TRIANGLE && k != SHAPE_SMOOTH_TRIANGLE && k != SHAPE_MESH) n++;
+        if (k != SHAPE_TRIANGLE && k != SHAPE_SMOOTH_TRIANGLE && k != SHAPE_MESH && !a->leaves[i].in_csg) n++;
     }
     if (n == 0) return PT_OK;
     a->shapes = malloc((size_t)n * sizeof *a->shapes);
@@ -612,7 +776,9 @@ static pt_status build_shapes(accel *a, diag *d)
     if (!a->shapes || !a->shape_leaf) return PT_ERR_NOMEM;
     for (int i = 0; i < a->nleaves; i++) {
         const scene_object *o = a->leaves[i].obj;
-        if (o->kind == SHAPE_TRIANGLE || o->kind == SHAPE_SMOOTH_TRIANGLE || o->kind == SHAPE_MESH) continue;
+        if (o->kind == SHAPE_TRIANGLE || o->kind == SHAPE_SMOOTH_TRIANGLE || o->kind == SHAPE_MESH ||
+            a->leaves[i].in_csg)
+            continue;
         accel_shape *sh = &a->shapes[a->nshapes];
         if (accel_shape_init(sh, o) != 0) {
             diag_warn_once(d, o->loc, "degenerate %s ignored (zero size, singular transform or non-finite numbers)",
@@ -629,6 +795,15 @@ static pt_status build_shapes(accel *a, diag *d)
 }
 
 /* Clip boxes for planes (see the comment at the top) and the scene scale. */
+static double plane_distance(const accel_shape *sh, vec3 c)
+{
+    vec3 nw = sh->identity ? sh->g.plane.n : v3_norm(xform_normal(&sh->x, sh->g.plane.n));
+    vec3 p0 = v3_scale(sh->g.plane.n, sh->g.plane.d);
+    if (!sh->identity) p0 = xform_point(&sh->x, p0);
+    double dist = fabs(v3_dot(v3_sub(c, p0), nw));
+    return isfinite(dist) ? dist : 0.0;
+}
+
 static void finish_bounds(accel *a)
 {
     const scene *s = a->s;
@@ -642,14 +817,21 @@ static void finish_bounds(accel *a)
     for (int i = 0; i < a->nshapes; i++) {
         accel_shape *sh = &a->shapes[i];
         if (sh->kind != SHAPE_PLANE) continue;
-        vec3 nw = sh->identity ? sh->g.plane.n : v3_norm(xform_normal(&sh->x, sh->g.plane.n));
-        vec3 p0 = v3_scale(sh->g.plane.n, sh->g.plane.d);
-        if (!sh->identity) p0 = xform_point(&sh->x, p0);
-        double dist = fabs(v3_dot(v3_sub(c, p0), nw));
-        if (!isfinite(dist)) dist = 0.0;
+        double dist = plane_distance(sh, c);
         double hsz = PLANE_EXTENT_FACTOR * fmax(diag_e, dist);
         if (!(hsz > 0.0)) hsz = PLANE_EXTENT_FACTOR;
         accel_shape_clip_plane(sh, v3_sub(c, v3s(hsz)), v3_add(c, v3s(hsz)));
+        far_plane = fmax(far_plane, dist);
+    }
+    /* CSG primitives: one cube for all their planes, the largest one needs */
+    for (int i = 0; i < a->ncsgs; i++) {
+        accel_csg *cs = &a->csgs[i];
+        double dist = 0.0;
+        for (int k = 0; k < cs->nshapes; k++)
+            if (cs->shapes[k].kind == SHAPE_PLANE) dist = fmax(dist, plane_distance(&cs->shapes[k], c));
+        double hsz = PLANE_EXTENT_FACTOR * fmax(diag_e, dist);
+        if (!(hsz > 0.0)) hsz = PLANE_EXTENT_FACTOR;
+        accel_csg_clip(cs, v3_sub(c, v3s(hsz)), v3_add(c, v3s(hsz)));
         far_plane = fmax(far_plane, dist);
     }
     if (a->lo.x <= a->hi.x) {
@@ -665,10 +847,10 @@ static void finish_bounds(accel *a)
 
 static pt_status build_user_geometry(accel *a)
 {
-    if (a->nshapes == 0) return PT_OK;
+    if (a->nshapes + a->ncsgs == 0) return PT_OK;
     RTCGeometry g = rtcNewGeometry(a->dev, RTC_GEOMETRY_TYPE_USER);
     if (!g) return PT_ERR_DEVICE;
-    rtcSetGeometryUserPrimitiveCount(g, (unsigned)a->nshapes);
+    rtcSetGeometryUserPrimitiveCount(g, (unsigned)(a->nshapes + a->ncsgs));
     rtcSetGeometryUserData(g, a);
     rtcSetGeometryBoundsFunction(g, user_bounds, a);
     rtcSetGeometryIntersectFunction(g, user_intersect);
@@ -678,7 +860,7 @@ static pt_status build_user_geometry(accel *a)
     rtcReleaseGeometry(g);
     if (!set_ginfo(a, id, GEOM_USER, 0)) return PT_ERR_DEVICE;
     a->stats.geometries++;
-    a->stats.user_prims = a->nshapes;
+    a->stats.user_prims = a->nshapes + a->ncsgs;
     return PT_OK;
 }
 
@@ -735,7 +917,7 @@ accel *accel_build(const scene *s, int threads, diag *d, pt_status *status)
                                "no_shadow on triangles/meshes is ignored: Embree was built without filter functions");
     for (int i = 0; i < a->nleaves && st == PT_OK; i++) {
         shape_kind k = a->leaves[i].obj->kind;
-        if (k == SHAPE_TRIANGLE || k == SHAPE_SMOOTH_TRIANGLE) st = add_flat_triangles(a, d, i);
+        if ((k == SHAPE_TRIANGLE || k == SHAPE_SMOOTH_TRIANGLE) && !a->leaves[i].in_csg) st = add_flat_triangles(a, d, i);
     }
     if (st == PT_OK) st = build_meshes(a, d);
     if (st == PT_OK) st = build_shapes(a, d);
@@ -780,6 +962,8 @@ void accel_free(accel *a)
     free(a->shapes);
     free(a->shape_leaf);
     free(a->groups);
+    for (int i = 0; i < a->ncsgs; i++) accel_csg_free(&a->csgs[i]);
+    free(a->csgs);
     free(a->ginfo);
     free(a);
 }
@@ -916,20 +1100,25 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
     } else if (gid < a->nginfo && a->ginfo[gid].kind == GEOM_TRI) {
         const tri_ref *r = &a->tri[a->ginfo[gid].idx].refs[prim];
         fill_triangle(a, &a->leaves[r->leaf], r->local, rh.hit.u, rh.hit.v, rh.ray.tfar, org, dir, hit);
-    } else if (gid < a->nginfo && a->ginfo[gid].kind == GEOM_USER && prim < (unsigned)a->nshapes) {
-        const accel_shape *sh = &a->shapes[prim];
-        accel_shape_hit h;
+    } else if (gid < a->nginfo && a->ginfo[gid].kind == GEOM_USER && prim < (unsigned)(a->nshapes + a->ncsgs)) {
+        accel_csg_hit h;
         if (q.uhit && q.uprim == prim) {
             h.t = q.ut;
             h.part = q.upart;
-        } else if (!accel_shape_intersect(sh, org, dir, t0, tmax, &h)) {
+            h.shape = q.ushape;
+            h.flip = q.uflip;
+        } else if (!prim_hit(a, prim, org, dir, t0, tmax, &h)) {
             return 0;
         }
-        const accel_leaf *l = &a->leaves[a->shape_leaf[prim]];
+        const accel_shape *sh = prim_shape(a, prim, h.shape);
+        unsigned li = prim < (unsigned)a->nshapes ? a->shape_leaf[prim]
+                                                  : a->csgs[prim - (unsigned)a->nshapes].shape_leaf[h.shape];
+        const accel_leaf *l = &a->leaves[li];
         hit->t = h.t;
         hit->p = v3_madd(org, dir, h.t);
         accel_shape_surface(sh, hit->p, h.part, &hit->ng, &hit->u, &hit->v);
-        hit->ns = hit->ng;
+        if (h.flip) hit->ng = v3_neg(hit->ng);
+        accel_shape_shading(sh, hit->p, hit->ng, &hit->ns);
         hit->obj = l->obj;
         hit->texture = l->texture;
         hit->prim = (unsigned)h.part;

@@ -234,6 +234,21 @@ int accel_shape_init(accel_shape *sh, const scene_object *o)
         hi = v3_add(c, e);
         break;
     }
+    case SHAPE_TRIANGLE:
+    case SHAPE_SMOOTH_TRIANGLE: {
+        const vec3 *v = o->u.triangle.v;
+        if (!v3_finite(v[0]) || !v3_finite(v[1]) || !v3_finite(v[2])) return -1;
+        sh->g.tri.v0 = v[0];
+        sh->g.tri.e1 = v3_sub(v[1], v[0]);
+        sh->g.tri.e2 = v3_sub(v[2], v[0]);
+        if (!(v3_len2(v3_cross(sh->g.tri.e1, sh->g.tri.e2)) > 0.0)) return -1;
+        sh->g.tri.smooth = o->kind == SHAPE_SMOOTH_TRIANGLE;
+        for (int k = 0; k < 3; k++) sh->g.tri.n[k] = o->u.triangle.n[k];
+        sh->g.tri.wind = det < 0.0 ? -1.0 : 1.0;
+        lo = v3_min(v[0], v3_min(v[1], v[2]));
+        hi = v3_max(v[0], v3_max(v[1], v[2]));
+        break;
+    }
     case SHAPE_TORUS: {
         double R = fabs(o->u.torus.major), r = fabs(o->u.torus.minor);
         if (!(R > 0.0) || !(r > 0.0) || !finite_d(R) || !finite_d(r)) return -1;
@@ -277,7 +292,24 @@ void accel_shape_clip_plane(accel_shape *sh, vec3 lo, vec3 hi)
 
 static int in_range(double t, double tmin, double tmax) { return t > tmin && t < tmax; }
 
-static int hit_sphere(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *h)
+/* Each hits_* function writes up to `max` crossings with t in (tmin, tmax),
+ * in ascending order, and returns how many. */
+
+/* Insert a candidate into an ascending list of at most `max` entries. */
+static int push_hit(accel_shape_hit *out, int n, int max, double t, int part)
+{
+    if (n == max && !(t < out[n - 1].t)) return n;
+    int i = n < max ? n++ : n - 1;
+    while (i > 0 && out[i - 1].t > t) {
+        out[i] = out[i - 1];
+        i--;
+    }
+    out[i].t = t;
+    out[i].part = part;
+    return n;
+}
+
+static int hits_sphere(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
 {
     vec3 oc = v3_sub(o, sh->g.sphere.c);
     double r = sh->g.sphere.r;
@@ -290,9 +322,10 @@ static int hit_sphere(const accel_shape *sh, vec3 o, vec3 d, double tmin, double
     double q = -(b + copysign(sqrt(disc), b));
     double t0 = q / a, t1 = (q != 0.0) ? c / q : t0;
     if (t0 > t1) { double t = t0; t0 = t1; t1 = t; }
-    if (in_range(t0, tmin, tmax)) { h->t = t0; h->part = 0; return 1; }
-    if (in_range(t1, tmin, tmax)) { h->t = t1; h->part = 0; return 1; }
-    return 0;
+    int n = 0;
+    if (in_range(t0, tmin, tmax)) n = push_hit(out, n, max, t0, 0);
+    if (in_range(t1, tmin, tmax) && t1 > t0) n = push_hit(out, n, max, t1, 0);
+    return n;
 }
 
 /* Slab test; entry/exit with the face each happens on. */
@@ -321,14 +354,14 @@ static int slabs(vec3 o, vec3 d, vec3 lo, vec3 hi, double *tn, int *fn, double *
     return 1;
 }
 
-static int hit_box(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *h)
+static int hits_box(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
 {
     double t0, t1;
-    int f0, f1;
+    int f0, f1, n = 0;
     if (!slabs(o, d, sh->g.box.lo, sh->g.box.hi, &t0, &f0, &t1, &f1)) return 0;
-    if (in_range(t0, tmin, tmax)) { h->t = t0; h->part = f0; return 1; }
-    if (in_range(t1, tmin, tmax)) { h->t = t1; h->part = f1; return 1; }
-    return 0;
+    if (in_range(t0, tmin, tmax)) n = push_hit(out, n, max, t0, f0);
+    if (in_range(t1, tmin, tmax) && t1 > t0) n = push_hit(out, n, max, t1, f1);
+    return n;
 }
 
 static int in_box(vec3 p, vec3 lo, vec3 hi)
@@ -336,61 +369,53 @@ static int in_box(vec3 p, vec3 lo, vec3 hi)
     return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
 }
 
-static int hit_plane(const accel_shape *sh, vec3 o, vec3 d, vec3 worg, vec3 wdir, double tmin, double tmax,
-                     accel_shape_hit *h)
+static int hits_plane(const accel_shape *sh, vec3 o, vec3 d, vec3 worg, vec3 wdir, double tmin, double tmax,
+                      accel_shape_hit *out, int max)
 {
     double den = v3_dot(sh->g.plane.n, d);
     if (den == 0.0) return 0;
     double t = (sh->g.plane.d - v3_dot(sh->g.plane.n, o)) / den;
     if (!in_range(t, tmin, tmax)) return 0;
     if (sh->clipped && !in_box(v3_madd(worg, wdir, t), sh->clip_lo, sh->clip_hi)) return 0;
-    h->t = t;
-    h->part = 0;
-    return 1;
+    return push_hit(out, 0, max, t, 0);
 }
 
-static int hit_cone(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *h)
+static int hits_cone(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
 {
     vec3 rel = v3_sub(o, sh->g.cone.base);
     double ox = v3_dot(rel, sh->g.cone.u), oy = v3_dot(rel, sh->g.cone.v), oz = v3_dot(rel, sh->g.cone.w);
     double dx = v3_dot(d, sh->g.cone.u), dy = v3_dot(d, sh->g.cone.v), dz = v3_dot(d, sh->g.cone.w);
     double H = sh->g.cone.h, k = sh->g.cone.k, r0 = sh->g.cone.r0;
-    double best = INFINITY;
-    int part = -1;
+    int n = 0;
     /* side: x^2 + y^2 = (r0 + k z)^2 for z in [0, H] */
     double Ro = r0 + k * oz;
     double a = dx * dx + dy * dy - k * k * dz * dz;
     double b = ox * dx + oy * dy - k * Ro * dz;
     double c = ox * ox + oy * oy - Ro * Ro;
     double ts[2];
-    int n = quad_half(a, b, c, &ts[0], &ts[1]);
-    for (int i = 0; i < n; i++) {
+    int nq = quad_half(a, b, c, &ts[0], &ts[1]);
+    for (int i = 0; i < nq; i++) {
         double t = ts[i];
-        if (!in_range(t, tmin, tmax) || t >= best) continue;
+        if (!in_range(t, tmin, tmax) || (i == 1 && t == ts[0])) continue;
         double z = oz + t * dz;
         if (z < 0.0 || z > H) continue;
-        best = t;
-        part = ACCEL_PART_CONE_SIDE;
+        n = push_hit(out, n, max, t, ACCEL_PART_CONE_SIDE);
     }
     if (!sh->open && dz != 0.0) {
         for (int e = 0; e < 2; e++) {
             double zc = e ? H : 0.0, rc = e ? sh->g.cone.r1 : r0;
             if (rc <= 0.0) continue;
             double t = (zc - oz) / dz;
-            if (!in_range(t, tmin, tmax) || t >= best) continue;
+            if (!in_range(t, tmin, tmax)) continue;
             double x = ox + t * dx, y = oy + t * dy;
             if (x * x + y * y > rc * rc) continue;
-            best = t;
-            part = e ? ACCEL_PART_CONE_CAP : ACCEL_PART_CONE_BASE;
+            n = push_hit(out, n, max, t, e ? ACCEL_PART_CONE_CAP : ACCEL_PART_CONE_BASE);
         }
     }
-    if (part < 0) return 0;
-    h->t = best;
-    h->part = part;
-    return 1;
+    return n;
 }
 
-static int hit_disc(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *h)
+static int hits_disc(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
 {
     double den = v3_dot(sh->g.disc.n, d);
     if (den == 0.0) return 0;
@@ -398,12 +423,30 @@ static int hit_disc(const accel_shape *sh, vec3 o, vec3 d, double tmin, double t
     if (!in_range(t, tmin, tmax)) return 0;
     double r2 = v3_len2(v3_sub(v3_madd(o, d, t), sh->g.disc.c));
     if (r2 > sh->g.disc.r2 || r2 < sh->g.disc.h2) return 0;
-    h->t = t;
-    h->part = 0;
-    return 1;
+    return push_hit(out, 0, max, t, 0);
 }
 
-static int hit_torus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *h)
+/* Double-precision Moller-Trumbore (Moller & Trumbore 1997). */
+static int hits_triangle(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out,
+                         int max)
+{
+    vec3 e1 = sh->g.tri.e1, e2 = sh->g.tri.e2;
+    vec3 pv = v3_cross(d, e2);
+    double det = v3_dot(e1, pv);
+    if (det == 0.0 || !isfinite(det)) return 0;
+    double inv = 1.0 / det;
+    vec3 tv = v3_sub(o, sh->g.tri.v0);
+    double u = v3_dot(tv, pv) * inv;
+    if (u < 0.0 || u > 1.0) return 0;
+    vec3 qv = v3_cross(tv, e1);
+    double v = v3_dot(d, qv) * inv;
+    if (v < 0.0 || u + v > 1.0) return 0;
+    double t = v3_dot(e2, qv) * inv;
+    if (!in_range(t, tmin, tmax)) return 0;
+    return push_hit(out, 0, max, t, 0);
+}
+
+static int hits_torus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
 {
     double s = v3_len(d);
     if (!(s > 0.0) || !isfinite(s)) return 0;
@@ -434,23 +477,20 @@ static int hit_torus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
     c[1] = 4.0 * f * G - 8.0 * R1 * R1 * B;
     c[0] = G * G - 4.0 * R1 * R1 * C;
     double roots[4];
-    int n = accel_poly_roots(c, 4, 0.0, hi - lo, roots);
-    for (int i = 0; i < n; i++) {
+    int nr = accel_poly_roots(c, 4, 0.0, hi - lo, roots), n = 0;
+    for (int i = 0; i < nr && n < max; i++) {
         double tau = lo + roots[i];
-        if (tau > ta && tau < tb) {
-            double t = tau / sk;
-            if (!in_range(t, tmin, tmax)) continue;
-            h->t = t;
-            h->part = 0;
-            return 1;
-        }
+        if (!(tau > ta && tau < tb)) continue;
+        double t = tau / sk;
+        if (in_range(t, tmin, tmax)) n = push_hit(out, n, max, t, 0);
     }
-    return 0;
+    return n;
 }
 
-int accel_shape_intersect(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
-                          accel_shape_hit *h)
+int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, accel_shape_hit *out,
+                     int max)
 {
+    if (max <= 0) return 0;
     vec3 o = org, d = dir;
     if (!sh->identity) {
         o = xform_inv_point(&sh->x, org);
@@ -458,14 +498,54 @@ int accel_shape_intersect(const accel_shape *sh, vec3 org, vec3 dir, double tmin
     }
     if (v3_len2(d) == 0.0) return 0;
     switch (sh->kind) {
-    case SHAPE_SPHERE: return hit_sphere(sh, o, d, tmin, tmax, h);
-    case SHAPE_BOX: return hit_box(sh, o, d, tmin, tmax, h);
-    case SHAPE_PLANE: return hit_plane(sh, o, d, org, dir, tmin, tmax, h);
+    case SHAPE_SPHERE: return hits_sphere(sh, o, d, tmin, tmax, out, max);
+    case SHAPE_BOX: return hits_box(sh, o, d, tmin, tmax, out, max);
+    case SHAPE_PLANE: return hits_plane(sh, o, d, org, dir, tmin, tmax, out, max);
     case SHAPE_CYLINDER:
-    case SHAPE_CONE: return hit_cone(sh, o, d, tmin, tmax, h);
-    case SHAPE_DISC: return hit_disc(sh, o, d, tmin, tmax, h);
-    case SHAPE_TORUS: return hit_torus(sh, o, d, tmin, tmax, h);
+    case SHAPE_CONE: return hits_cone(sh, o, d, tmin, tmax, out, max);
+    case SHAPE_DISC: return hits_disc(sh, o, d, tmin, tmax, out, max);
+    case SHAPE_TORUS: return hits_torus(sh, o, d, tmin, tmax, out, max);
+    case SHAPE_TRIANGLE:
+    case SHAPE_SMOOTH_TRIANGLE: return hits_triangle(sh, o, d, tmin, tmax, out, max);
     default: return 0;
+    }
+}
+
+int accel_shape_intersect(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
+                          accel_shape_hit *h)
+{
+    return accel_shape_hits(sh, org, dir, tmin, tmax, h, 1);
+}
+
+int accel_shape_inside(const accel_shape *sh, vec3 p)
+{
+    vec3 q = sh->identity ? p : xform_inv_point(&sh->x, p);
+    switch (sh->kind) {
+    case SHAPE_SPHERE:
+        return v3_len2(v3_sub(q, sh->g.sphere.c)) < sh->g.sphere.r * sh->g.sphere.r;
+    case SHAPE_BOX:
+        return q.x > sh->g.box.lo.x && q.x < sh->g.box.hi.x && q.y > sh->g.box.lo.y && q.y < sh->g.box.hi.y &&
+               q.z > sh->g.box.lo.z && q.z < sh->g.box.hi.z;
+    case SHAPE_PLANE:
+        return v3_dot(sh->g.plane.n, q) < sh->g.plane.d;
+    case SHAPE_CYLINDER:
+    case SHAPE_CONE: {
+        /* the closed solid, also for `open` ones */
+        vec3 rel = v3_sub(q, sh->g.cone.base);
+        double x = v3_dot(rel, sh->g.cone.u), y = v3_dot(rel, sh->g.cone.v), z = v3_dot(rel, sh->g.cone.w);
+        if (!(z > 0.0 && z < sh->g.cone.h)) return 0;
+        double rz = sh->g.cone.r0 + sh->g.cone.k * z;
+        return x * x + y * y < rz * rz;
+    }
+    case SHAPE_DISC:
+        /* POV-Ray: the half-space behind the disc (against its normal) */
+        return v3_dot(sh->g.disc.n, v3_sub(q, sh->g.disc.c)) < 0.0;
+    case SHAPE_TORUS: {
+        double rho = sqrt(q.x * q.x + q.z * q.z) - sh->g.torus.R;
+        return rho * rho + q.y * q.y < sh->g.torus.r * sh->g.torus.r;
+    }
+    default:
+        return 0; /* triangles have no inside */
     }
 }
 
@@ -479,6 +559,32 @@ static double wrap01(double a)
 }
 
 static double clamp01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : (isfinite(x) ? x : 0.0)); }
+
+/* Barycentrics (weights of v1 and v2) of an object-space point in the triangle's plane. */
+static void tri_bary(const accel_shape *sh, vec3 po, double *u, double *v)
+{
+    vec3 e1 = sh->g.tri.e1, e2 = sh->g.tri.e2, w = v3_sub(po, sh->g.tri.v0);
+    double d11 = v3_dot(e1, e1), d12 = v3_dot(e1, e2), d22 = v3_dot(e2, e2);
+    double w1 = v3_dot(w, e1), w2 = v3_dot(w, e2);
+    double den = d11 * d22 - d12 * d12;
+    *u = den != 0.0 ? clamp01((d22 * w1 - d12 * w2) / den) : 0.0;
+    *v = den != 0.0 ? clamp01((d11 * w2 - d12 * w1) / den) : 0.0;
+}
+
+void accel_shape_shading(const accel_shape *sh, vec3 p, vec3 ng, vec3 *ns)
+{
+    *ns = ng;
+    if ((sh->kind != SHAPE_SMOOTH_TRIANGLE) || !sh->g.tri.smooth) return;
+    double u, v;
+    tri_bary(sh, sh->identity ? p : xform_inv_point(&sh->x, p), &u, &v);
+    vec3 n = v3_add(v3_add(v3_scale(sh->g.tri.n[0], 1.0 - u - v), v3_scale(sh->g.tri.n[1], u)),
+                    v3_scale(sh->g.tri.n[2], v));
+    if (!sh->identity) n = xform_normal(&sh->x, n);
+    double l = v3_len(n);
+    if (!(l > 0.0) || !isfinite(l)) return;
+    n = v3_scale(n, 1.0 / l);
+    *ns = v3_dot(n, ng) < 0.0 ? v3_neg(n) : n;
+}
 
 void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, double *u, double *v)
 {
@@ -547,6 +653,11 @@ void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, doub
         sv = wrap01(atan2(po.y, rho - R));
         break;
     }
+    case SHAPE_TRIANGLE:
+    case SHAPE_SMOOTH_TRIANGLE:
+        n = v3_scale(v3_cross(sh->g.tri.e1, sh->g.tri.e2), sh->g.tri.wind);
+        tri_bary(sh, po, &su, &sv);
+        break;
     default:
         break;
     }

@@ -29,6 +29,7 @@ typedef struct {
         struct { vec3 base, u, v, w; double h, r0, r1, k; } cone; /* frame: w along the axis */
         struct { vec3 c, n; double r2, h2; } disc; /* unit n, squared radii */
         struct { double R, r; } torus;           /* in the xz plane, axis y */
+        struct { vec3 v0, e1, e2, n[3]; int smooth; double wind; } tri; /* CSG members only */
     } g;
     vec3 lo, hi;       /* world bounds (planes: the clip box) */
     vec3 clip_lo, clip_hi;
@@ -39,7 +40,9 @@ typedef struct {
     int part;
 } accel_shape_hit;
 
-/* Fill `sh` from a leaf object of an analytic kind. Returns 0 on success, -1
+/* Fill `sh` from a leaf object of an analytic kind (triangles and smooth
+ * triangles too: they are intersected here when they belong to a CSG
+ * intersection/difference; otherwise Embree handles them). Returns 0 on success, -1
  * when the object is degenerate (zero radius, singular transform, non-finite
  * numbers) and should be skipped. World bounds are computed for finite shapes;
  * planes get them from accel_shape_clip_plane. */
@@ -52,9 +55,20 @@ void accel_shape_clip_plane(accel_shape *sh, vec3 lo, vec3 hi);
  * Returns 1 and fills `h` on a hit. Never produces NaN for finite input. */
 int accel_shape_intersect(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
                           accel_shape_hit *h);
+/* All crossings with t in (tmin, tmax), ascending, at most `max` of them
+ * (a torus has up to 4, the others up to 2). */
+int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, accel_shape_hit *out,
+                     int max);
+/* Whether the world point p is strictly inside the solid, as POV-Ray defines
+ * it for CSG: planes and discs are half-spaces (the side against the normal),
+ * open cylinders and cones are their closed solids, triangles have no inside. */
+int accel_shape_inside(const accel_shape *sh, vec3 p);
 /* Surface data at world point p (on the shape, `part` from the hit): unit
- * outward world normal and natural surface parameters in [0,1]. */
+ * outward world normal and natural surface parameters in [0,1] (triangles:
+ * barycentrics, normal by world winding; `ns` gets the interpolated normal
+ * of smooth triangles, else the geometric one; it may be NULL). */
 void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, double *u, double *v);
+void accel_shape_shading(const accel_shape *sh, vec3 p, vec3 ng, vec3 *ns);
 
 /* Real roots of c[0] + c[1] x + ... + c[n] x^n (n <= 4) inside [a, b], in
  * ascending order; returns their number. Exposed for the unit tests. */

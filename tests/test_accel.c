@@ -736,6 +736,38 @@ static void test_no_shadow(void **st)
     scene_free(s);
 }
 
+static scene_object *csg(scene *s, shape_kind k, int n, int top)
+{
+    scene_object *o = top ? add_obj(s, k) : scene_new_object(s, k, here);
+    o->name = k == SHAPE_DIFFERENCE ? "difference" : k == SHAPE_INTERSECTION ? "intersection" : "union";
+    o->u.csg.kids = arena_alloc(s->mem, (size_t)n * sizeof(scene_object *));
+    o->u.csg.nkids = n;
+    return o;
+}
+
+static scene_object *member(scene *s, shape_kind k)
+{
+    scene_object *o = scene_new_object(s, k, here);
+    o->name = k == SHAPE_SPHERE ? "sphere" : k == SHAPE_BOX ? "box" : k == SHAPE_PLANE ? "plane" : "shape";
+    return o;
+}
+
+static scene_object *msphere(scene *s, vec3 c, double r)
+{
+    scene_object *o = member(s, SHAPE_SPHERE);
+    o->u.sphere.centre = c;
+    o->u.sphere.radius = r;
+    return o;
+}
+
+static scene_object *mplane(scene *s, vec3 n, double off)
+{
+    scene_object *o = member(s, SHAPE_PLANE);
+    o->u.plane.normal = n;
+    o->u.plane.offset = off;
+    return o;
+}
+
 static void test_warnings_csg(void **st)
 {
     (void)st;
@@ -747,36 +779,221 @@ static void test_warnings_csg(void **st)
     }
     scene_object *o = add_obj(s, SHAPE_UNSUPPORTED);
     o->name = "sor";
+    /* a difference whose subtracted member is unsupported: warned, the base stays whole */
     scene_texture *tx = scene_new_texture(s);
+    scene_object *df = csg(s, SHAPE_DIFFERENCE, 2, 1);
+    df->texture = tx;
+    df->u.csg.kids[0] = msphere(s, v3(10, 0, 5), 1);
+    df->u.csg.kids[1] = member(s, SHAPE_UNSUPPORTED);
+    df->u.csg.kids[1]->name = "lathe";
+    /* a difference with a mesh member: rendered as a union, with one warning */
+    scene_mesh *m = quad_mesh(s, NULL, NULL);
     for (int i = 0; i < 2; i++) {
-        scene_object *df = add_obj(s, SHAPE_DIFFERENCE);
-        df->texture = tx;
-        df->u.csg.kids = arena_alloc(s->mem, 2 * sizeof(scene_object *));
-        df->u.csg.nkids = 2;
-        for (int k = 0; k < 2; k++) {
-            scene_object *c = scene_new_object(s, SHAPE_SPHERE, here);
-            c->u.sphere.centre = v3(10 * i + 3 * k, 0, 5);
-            c->u.sphere.radius = 1;
-            df->u.csg.kids[k] = c;
-        }
+        scene_object *dm = csg(s, SHAPE_DIFFERENCE, 2, 1);
+        dm->u.csg.kids[0] = msphere(s, v3(20 + 5 * i, 0, 5), 1);
+        scene_object *mo = scene_new_object(s, SHAPE_MESH, here);
+        mo->u.mesh.mesh = m;
+        mo->transform = xform_translate(v3(20 + 5 * i, 0, 5));
+        m->uses++;
+        dm->u.csg.kids[1] = mo;
     }
     accel *a = build(s, d);
-    int lathe = 0, sor = 0, csg = 0;
+    int lathe = 0, sor = 0, csgw = 0;
     for (int i = 0; i < diag_count(d); i++) {
-        const diag_msg *m = diag_get(d, i);
-        assert_int_equal(m->severity, DIAG_WARNING);
-        if (strstr(m->text, "lathe is not rendered yet")) lathe++;
-        if (strstr(m->text, "sor is not rendered yet")) sor++;
-        if (strstr(m->text, "CSG intersection/difference is not evaluated yet")) csg++;
+        const diag_msg *dm = diag_get(d, i);
+        assert_int_equal(dm->severity, DIAG_WARNING);
+        if (strstr(dm->text, "lathe is not rendered yet")) lathe++;
+        if (strstr(dm->text, "sor is not rendered yet")) sor++;
+        if (strstr(dm->text, "with a mesh member is not evaluated yet")) csgw++;
     }
     assert_int_equal(lathe, 1);
     assert_int_equal(sor, 1);
-    assert_int_equal(csg, 1);
-    assert_int_equal(accel_get_stats(a).unsupported, 3);
-    /* the difference's children render (as a union) with the parent's texture */
+    assert_int_equal(csgw, 1);
+    assert_int_equal(accel_get_stats(a).unsupported, 4);
     accel_hit h;
-    expect_hit(a, v3(13, 0, 0), v3(0, 0, 1), 4.0, v3(0, 0, -1), 1e-12, 1e-12, &h);
+    /* the base sphere, whole, with the difference's texture */
+    expect_hit(a, v3(10, 0, 0), v3(0, 0, 1), 4.0, v3(0, 0, -1), 1e-12, 1e-12, &h);
     assert_ptr_equal(h.texture, tx);
+    /* the union fallback: the mesh quad at z = 5 in front of the sphere's back */
+    expect_hit(a, v3(20.5, 0.5, 0), v3(0, 0, 1), 5.0 - sqrt(1 - 0.5), v3_norm(v3(0.5, 0.5, -sqrt(0.5))), 1e-9,
+               1e-9, NULL);
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+static void test_csg(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    scene_texture *ta = scene_new_texture(s), *tb = scene_new_texture(s);
+    /* 1. sphere minus a sphere biting its front */
+    scene_object *d1 = csg(s, SHAPE_DIFFERENCE, 2, 1);
+    d1->texture = ta;
+    d1->u.csg.kids[0] = msphere(s, v3(0, 0, 5), 1);
+    d1->u.csg.kids[1] = msphere(s, v3(0, 0, 4), 1);
+    d1->u.csg.kids[1]->texture = tb;
+    /* 2. box intersected with a sphere */
+    scene_object *i2 = csg(s, SHAPE_INTERSECTION, 2, 1);
+    i2->u.csg.kids[0] = member(s, SHAPE_BOX);
+    i2->u.csg.kids[0]->u.box.c1 = v3(-1, -1, -1);
+    i2->u.csg.kids[0]->u.box.c2 = v3(1, 1, 1);
+    i2->u.csg.kids[1] = msphere(s, v3(0, 0, 0), 1.2);
+    i2->transform = xform_translate(v3(10, 0, 5));
+    for (int k = 0; k < 2; k++) i2->u.csg.kids[k]->transform = xform_translate(v3(10, 0, 5));
+    /* 3. box minus the half-space y < 0 (plane): the top half */
+    scene_object *d3 = csg(s, SHAPE_DIFFERENCE, 2, 1);
+    d3->u.csg.kids[0] = member(s, SHAPE_BOX);
+    d3->u.csg.kids[0]->u.box.c1 = v3(19, -1, 4);
+    d3->u.csg.kids[0]->u.box.c2 = v3(21, 1, 6);
+    d3->u.csg.kids[1] = mplane(s, v3(0, 1, 0), 0);
+    /* 4. a shell: big sphere intersected with an inverse small one */
+    scene_object *i4 = csg(s, SHAPE_INTERSECTION, 2, 1);
+    i4->u.csg.kids[0] = msphere(s, v3(30, 0, 5), 2);
+    i4->u.csg.kids[1] = msphere(s, v3(30, 0, 5), 1);
+    i4->u.csg.kids[1]->flags |= OBJ_INVERSE;
+    /* 5. a triangle with a hole */
+    scene_object *d5 = csg(s, SHAPE_DIFFERENCE, 2, 1);
+    scene_object *tri = member(s, SHAPE_TRIANGLE);
+    tri->u.triangle.v[0] = v3(37, -3, 5);
+    tri->u.triangle.v[1] = v3(43, -3, 5);
+    tri->u.triangle.v[2] = v3(40, 3, 5);
+    d5->u.csg.kids[0] = tri;
+    d5->u.csg.kids[1] = msphere(s, v3(40, 0, 5), 0.5);
+    /* 6. a cube from six planes, no_shadow */
+    scene_object *i6 = csg(s, SHAPE_INTERSECTION, 6, 1);
+    i6->flags |= OBJ_NO_SHADOW;
+    for (int k = 0; k < 6; k++) {
+        vec3 n = v3(k / 2 == 0 ? 1 : 0, k / 2 == 1 ? 1 : 0, k / 2 == 2 ? 1 : 0);
+        if (k & 1) n = v3_neg(n);
+        i6->u.csg.kids[k] = mplane(s, n, 1.0);
+    }
+    i6->transform = xform_translate(v3(50, 0, 5));
+    for (int k = 0; k < 6; k++) i6->u.csg.kids[k]->transform = xform_translate(v3(50, 0, 5));
+    /* 7. merge nested in an intersection with a big box: no internal surface */
+    accel_hit h;
+    scene_object *i7 = csg(s, SHAPE_INTERSECTION, 2, 1);
+    scene_object *mg = csg(s, SHAPE_UNION, 2, 0);
+    mg->kind = SHAPE_MERGE;
+    mg->u.csg.kids[0] = msphere(s, v3(60, 0, 5), 1);
+    mg->u.csg.kids[1] = msphere(s, v3(60, 0, 6), 1);
+    i7->u.csg.kids[0] = mg;
+    i7->u.csg.kids[1] = member(s, SHAPE_BOX);
+    i7->u.csg.kids[1]->u.box.c1 = v3(50, -10, -10);
+    i7->u.csg.kids[1]->u.box.c2 = v3(70, 10, 20);
+    /* 8. a top-level merge: its internal surfaces are gone too */
+    scene_object *m8 = csg(s, SHAPE_UNION, 2, 1);
+    m8->kind = SHAPE_MERGE;
+    m8->u.csg.kids[0] = msphere(s, v3(70, 0, 5), 1);
+    m8->u.csg.kids[1] = msphere(s, v3(70, 0, 6), 1);
+    accel *a = build(s, d);
+    assert_int_equal(diag_count(d), 0);
+    assert_int_equal(accel_get_stats(a).user_prims, 8);
+    expect_hit(a, v3(70, 0, 0), v3(0, 0, 1), 4.0, v3(0, 0, -1), 1e-12, 1e-12, NULL);
+    assert_true(accel_intersect(a, v3(70, 0, 0), v3(0, 0, 1), 4.5, INFINITY, &h));
+    assert_near(h.t, 7.0, 1e-12);
+    /* 1: the bite's far side at z = 5, normal flipped towards the ray, the bite's texture */
+    expect_hit(a, v3(0, 0, 0), v3(0, 0, 1), 5.0, v3(0, 0, -1), 1e-12, 1e-12, &h);
+    assert_ptr_equal(h.texture, tb);
+    assert_true(accel_intersect(a, v3(0, 0, 0), v3(0, 0, 1), 5.5, INFINITY, &h));
+    assert_near(h.t, 6.0, 1e-12);
+    assert_vec(h.ng, v3(0, 0, 1), 1e-12);
+    assert_ptr_equal(h.texture, ta);
+    /* outside the bite (x = 0.9: A at z = 5 - sqrt(.19), B's reach ends at sqrt(1-.81)) */
+    expect_hit(a, v3(0.9, 0, 0), v3(0, 0, 1), 5 - sqrt(0.19), v3(0.9, 0, -sqrt(0.19)), 1e-12, 1e-12, NULL);
+    /* 2: box face inside the sphere; sphere inside the box */
+    expect_hit(a, v3(10, 0, 0), v3(0, 0, 1), 4.0, v3(0, 0, -1), 1e-12, 1e-12, NULL);
+    double zs = sqrt(1.44 - 0.64);
+    expect_hit(a, v3(10.8, 0, 0), v3(0, 0, 1), 5.0 - zs, v3(0.8 / 1.2, 0, -zs / 1.2), 1e-12, 1e-12, NULL);
+    expect_miss(a, v3(10.9, 0.9, 0), v3(0, 0, 1));
+    /* 3: from below, the cut face at y = 0 with the flipped plane normal; from above the box top */
+    expect_hit(a, v3(20, -5, 5), v3(0, 1, 0), 5.0, v3(0, -1, 0), 1e-12, 1e-12, NULL);
+    expect_hit(a, v3(20, 5, 5), v3(0, -1, 0), 4.0, v3(0, 1, 0), 1e-12, 1e-12, NULL);
+    assert_false(accel_intersect(a, v3(15, -0.5, 5), v3(1, 0, 0), 0.0, 10.0, &h)); /* through the removed half */
+    /* 4: from the centre of the shell: the inner wall at r = 1, normal towards the centre */
+    expect_hit(a, v3(30, 0, 5), v3(1, 0, 0), 1.0, v3(-1, 0, 0), 1e-12, 1e-12, NULL);
+    expect_hit(a, v3(30, 0, 0), v3(0, 0, 1), 3.0, v3(0, 0, -1), 1e-12, 1e-12, NULL);
+    /* 5: triangle hole: through the hole we see the hole's edge? no: the sphere surface is kept only inside the
+     * triangle, which has no inside, so the hole is empty */
+    expect_miss(a, v3(40, 0, 0), v3(0, 0, 1));
+    expect_hit(a, v3(40, 1, 0), v3(0, 0, 1), 5.0, v3(0, 0, 1), 1e-12, 1e-12, NULL);
+    /* 6: plane cube: bounded, visible, no shadow */
+    expect_hit(a, v3(50, 0, 0), v3(0, 0, 1), 4.0, v3(0, 0, -1), 1e-12, 1e-12, NULL);
+    expect_hit(a, v3(50.5, -10, 5.5), v3(0, 1, 0), 9.0, v3(0, -1, 0), 1e-12, 1e-12, NULL);
+    assert_false(accel_occluded(a, v3(50, 0, 0), v3(0, 0, 1), 0.0, 10.0));
+    assert_true(accel_occluded(a, v3(0, 0, 0), v3(0, 0, 1), 0.0, 10.0));
+    /* 7: merged spheres: the front one's back (z = 6) is inside the other: not a surface */
+    expect_hit(a, v3(60, 0, 0), v3(0, 0, 1), 4.0, v3(0, 0, -1), 1e-12, 1e-12, NULL);
+    assert_true(accel_intersect(a, v3(60, 0, 0), v3(0, 0, 1), 4.5, INFINITY, &h));
+    assert_near(h.t, 7.0, 1e-12);
+    /* bounds are finite: the plane cube is [49,51]x[-1,1]x[4,6] */
+    vec3 lo, hi;
+    accel_bounds(a, &lo, &hi);
+    assert_true(v3_finite(lo) && v3_finite(hi));
+    assert_near(hi.x, 71.0, 1e-9); /* the merge m8; i7 is bounded by its merge, not by its big box (x <= 70) */
+    assert_near(lo.x, -1.0, 1e-9);
+    assert_near(hi.z, 7.0, 1e-9);
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
+/* CSG against brute force: a lens (intersection of two spheres) minus a
+ * cylinder; the first change of the inside state along the ray (sampled)
+ * must agree with the reported hit. */
+static int lens_inside(vec3 p)
+{
+    double a = v3_len2(v3_sub(p, v3(0, 0, -0.5))), b = v3_len2(v3_sub(p, v3(0, 0, 0.5)));
+    int lens = a < 1.0 && b < 1.0;
+    int cyl = p.x * p.x + p.z * p.z < 0.09 && p.y > -2 && p.y < 2;
+    return lens && !cyl;
+}
+
+static void test_csg_brute(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    scene_object *df = csg(s, SHAPE_DIFFERENCE, 2, 1);
+    scene_object *in = csg(s, SHAPE_INTERSECTION, 2, 0);
+    in->u.csg.kids[0] = msphere(s, v3(0, 0, -0.5), 1);
+    in->u.csg.kids[1] = msphere(s, v3(0, 0, 0.5), 1);
+    df->u.csg.kids[0] = in;
+    scene_object *cy = member(s, SHAPE_CYLINDER);
+    cy->u.cone.base = v3(0, -2, 0);
+    cy->u.cone.cap = v3(0, 2, 0);
+    cy->u.cone.base_radius = cy->u.cone.cap_radius = 0.3;
+    df->u.csg.kids[1] = cy;
+    accel *a = build(s, d);
+    rng r;
+    rng_seed(&r, 3, 4);
+    int hits = 0;
+    for (int i = 0; i < 3000; i++) {
+        vec3 org = v3(4 * rng_f64(&r) - 2, 4 * rng_f64(&r) - 2, 4 * rng_f64(&r) - 2);
+        vec3 tgt = v3(1.6 * rng_f64(&r) - 0.8, 1.6 * rng_f64(&r) - 0.8, 1.2 * rng_f64(&r) - 0.6);
+        vec3 dir = v3_norm(v3_sub(tgt, org));
+        accel_hit h;
+        int hit = accel_intersect(a, org, dir, 0.0, 10.0, &h);
+        double tend = hit ? h.t : 10.0;
+        if (hit) {
+            hits++;
+            assert_hit_sane(&h);
+            /* the normal points out of the solid */
+            assert_false(lens_inside(v3_madd(h.p, h.ng, 1e-6)));
+        }
+        double t0 = 2.0 * accel_epsilon(a, org, dir); /* crossings closer than this are skipped by design */
+        int s0 = lens_inside(v3_madd(org, dir, t0));
+        for (double t = t0 + 1e-3; t < tend - 1e-6; t += 1e-3)
+            if (lens_inside(v3_madd(org, dir, t)) != s0)
+                fail_msg("ray %d: inside state changes at t~%g before the reported %s %g", i, t, hit ? "hit" : "end",
+                         tend);
+        if (hit) {
+            int before = lens_inside(v3_madd(org, dir, h.t - 1e-7)), after = lens_inside(v3_madd(org, dir, h.t + 1e-7));
+            if (before == after) fail_msg("ray %d: no state change at the hit t=%g", i, h.t);
+        }
+    }
+    assert_true(hits > 300);
     accel_free(a);
     diag_free(d);
     scene_free(s);
@@ -994,6 +1211,8 @@ int main(void)
         cmocka_unit_test(test_scales),
         cmocka_unit_test(test_no_shadow),
         cmocka_unit_test(test_warnings_csg),
+        cmocka_unit_test(test_csg),
+        cmocka_unit_test(test_csg_brute),
         cmocka_unit_test(test_empty_and_errors),
         cmocka_unit_test(test_random_rays),
         cmocka_unit_test(test_torus_brute),

@@ -1,0 +1,313 @@
+/* accel_csg.c - CSG intersection/difference along a ray (rules in accel_csg.h).
+ *
+ * Bounds: every node gets two boxes, S (where its surface can be) and V
+ * (where its inside can be), with infinite sides where half-spaces leave
+ * them open. Leaves: S is the shape's bounds, V the solid's (a plane or disc
+ * is the half-space behind it, a triangle has none, an inverse leaf is
+ * everywhere). union/merge: unions of both. intersection: S is the union over
+ * members of S_i clipped by the other members' V, V the intersection of all
+ * V. difference: S is S_0 plus the subtracted S_k clipped by V_0, V is V_0.
+ * The root's S bounds the primitive; an intersection of six planes gets a
+ * tight box this way. */
+#include "accel_csg.h"
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct { vec3 lo, hi; } bbox;
+
+static bbox bb_all(void) { bbox b = {v3s(-INFINITY), v3s(INFINITY)}; return b; }
+static bbox bb_empty(void) { bbox b = {v3s(INFINITY), v3s(-INFINITY)}; return b; }
+static bbox bb_union(bbox a, bbox b) { bbox r = {v3_min(a.lo, b.lo), v3_max(a.hi, b.hi)}; return r; }
+static bbox bb_inter(bbox a, bbox b) { bbox r = {v3_max(a.lo, b.lo), v3_min(a.hi, b.hi)}; return r; }
+static int bb_empty_p(bbox b) { return !(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z); }
+
+static int grow(void **p, int *cap, int need, size_t elem)
+{
+    if (need <= *cap) return 1;
+    int nc = *cap ? *cap : 8;
+    while (nc < need) nc *= 2;
+    void *n = realloc(*p, (size_t)nc * elem);
+    if (!n) return 0;
+    *p = n;
+    *cap = nc;
+    return 1;
+}
+
+int accel_csg_add_node(accel_csg *c, accel_csg_op op, int inverse, int parent)
+{
+    if (!grow((void **)&c->nodes, &c->capnodes, c->nnodes + 1, sizeof(accel_csg_node))) return -1;
+    accel_csg_node *n = &c->nodes[c->nnodes];
+    memset(n, 0, sizeof *n);
+    n->op = op;
+    n->inverse = inverse != 0;
+    n->parent = parent;
+    n->shape = -1;
+    return c->nnodes++;
+}
+
+int accel_csg_add_leaf(accel_csg *c, const accel_shape *sh, unsigned tag, int inverse, int parent)
+{
+    if (!grow((void **)&c->shapes, &c->capshapes, c->nshapes + 1, sizeof(accel_shape))) return -1;
+    int cap = c->capshapes;
+    /* shape_leaf and shape_node follow the capacity of shapes */
+    unsigned *sl = realloc(c->shape_leaf, (size_t)cap * sizeof *sl);
+    if (!sl) return -1;
+    c->shape_leaf = sl;
+    int *sn = realloc(c->shape_node, (size_t)cap * sizeof *sn);
+    if (!sn) return -1;
+    c->shape_node = sn;
+    int node = accel_csg_add_node(c, CSG_LEAF, inverse, parent);
+    if (node < 0) return -1;
+    c->shapes[c->nshapes] = *sh;
+    c->shape_leaf[c->nshapes] = tag;
+    c->shape_node[c->nshapes] = node;
+    c->nodes[node].shape = c->nshapes++;
+    return node;
+}
+
+/* Half-space behind a plane through p0 with unit normal n: bounded on one
+ * side only when n is along an axis. */
+static bbox half_space(vec3 n, vec3 p0)
+{
+    bbox b = bb_all();
+    double a[3] = {n.x, n.y, n.z};
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        if (fabs(a[j]) > 1e-12 || fabs(a[k]) > 1e-12) continue;
+        double c = v3_idx(p0, i);
+        if (a[i] > 0) { if (i == 0) b.hi.x = c; else if (i == 1) b.hi.y = c; else b.hi.z = c; }
+        if (a[i] < 0) { if (i == 0) b.lo.x = c; else if (i == 1) b.lo.y = c; else b.lo.z = c; }
+    }
+    return b;
+}
+
+static void leaf_boxes(const accel_shape *sh, int inverse, bbox *s, bbox *v)
+{
+    const xform *x = &sh->x;
+    bbox own = {sh->lo, sh->hi};
+    switch (sh->kind) {
+    case SHAPE_PLANE: {
+        vec3 n = sh->identity ? sh->g.plane.n : v3_norm(xform_normal(x, sh->g.plane.n));
+        vec3 p0 = v3_scale(sh->g.plane.n, sh->g.plane.d);
+        if (!sh->identity) p0 = xform_point(x, p0);
+        *v = half_space(n, p0);
+        /* the surface: the plane itself, a slice when axis-aligned */
+        bbox hs = *v, neg = half_space(v3_neg(n), p0);
+        *s = bb_inter(hs, neg);
+        break;
+    }
+    case SHAPE_DISC: {
+        vec3 n = sh->identity ? sh->g.disc.n : v3_norm(xform_normal(x, sh->g.disc.n));
+        vec3 p0 = sh->identity ? sh->g.disc.c : xform_point(x, sh->g.disc.c);
+        *s = own;
+        *v = half_space(n, p0);
+        break;
+    }
+    case SHAPE_TRIANGLE:
+    case SHAPE_SMOOTH_TRIANGLE:
+        *s = own;
+        *v = bb_empty();
+        break;
+    default:
+        *s = own;
+        *v = own;
+        break;
+    }
+    if (inverse) *v = bb_all();
+}
+
+int accel_csg_finish(accel_csg *c)
+{
+    if (c->nnodes == 0) return 0;
+    /* member lists, in insertion order */
+    int *count = calloc((size_t)c->nnodes, sizeof(int));
+    bbox *S = malloc((size_t)c->nnodes * sizeof(bbox)), *V = malloc((size_t)c->nnodes * sizeof(bbox));
+    c->kids = malloc((size_t)c->nnodes * sizeof(int));
+    if (!count || !S || !V || !c->kids) {
+        free(count); free(S); free(V);
+        return 0;
+    }
+    c->nkids = c->capkids = c->nnodes;
+    for (int i = 1; i < c->nnodes; i++) count[c->nodes[i].parent]++;
+    int pos = 0;
+    for (int i = 0; i < c->nnodes; i++) {
+        c->nodes[i].first = pos;
+        c->nodes[i].nkids = 0;
+        pos += count[i];
+    }
+    for (int i = 1; i < c->nnodes; i++) {
+        accel_csg_node *p = &c->nodes[c->nodes[i].parent];
+        c->kids[p->first + p->nkids++] = i;
+    }
+    /* normal flips: inverse nodes and subtracted members on the way to the root */
+    for (int s = 0; s < c->nshapes; s++) {
+        int flip = 0;
+        for (int n = c->shape_node[s]; n >= 0; n = c->nodes[n].parent) {
+            const accel_csg_node *nd = &c->nodes[n];
+            if (nd->inverse) flip ^= 1;
+            if (nd->parent >= 0) {
+                const accel_csg_node *p = &c->nodes[nd->parent];
+                if (p->op == CSG_DIFFERENCE && c->kids[p->first] != n) flip ^= 1;
+            }
+        }
+        c->nodes[c->shape_node[s]].flip = flip;
+    }
+    /* bounds, children before parents (children have larger indices) */
+    for (int i = c->nnodes - 1; i >= 0; i--) {
+        accel_csg_node *nd = &c->nodes[i];
+        const int *k = c->kids + nd->first;
+        int n = nd->nkids;
+        bbox s = bb_empty(), v = bb_empty();
+        switch (nd->op) {
+        case CSG_LEAF:
+            leaf_boxes(&c->shapes[nd->shape], nd->inverse, &s, &v);
+            break;
+        case CSG_UNION:
+        case CSG_MERGE:
+            for (int j = 0; j < n; j++) {
+                s = bb_union(s, S[k[j]]);
+                v = bb_union(v, V[k[j]]);
+            }
+            break;
+        case CSG_INTERSECTION:
+            v = n > 0 ? bb_all() : bb_empty();
+            for (int j = 0; j < n; j++) {
+                v = bb_inter(v, V[k[j]]);
+                bbox sj = S[k[j]];
+                for (int m = 0; m < n; m++)
+                    if (m != j) sj = bb_inter(sj, V[k[m]]);
+                s = bb_union(s, sj);
+            }
+            break;
+        case CSG_DIFFERENCE:
+            if (n > 0) {
+                s = S[k[0]];
+                v = V[k[0]];
+                for (int j = 1; j < n; j++) s = bb_union(s, bb_inter(S[k[j]], V[k[0]]));
+            }
+            break;
+        }
+        if (nd->op != CSG_LEAF && nd->inverse) v = bb_all();
+        /* normalise empty boxes so unions with them stay neutral */
+        S[i] = bb_empty_p(s) ? bb_empty() : s;
+        V[i] = bb_empty_p(v) ? bb_empty() : v;
+    }
+    c->lo = S[0].lo;
+    c->hi = S[0].hi;
+    int ok = !bb_empty_p(S[0]) && c->nshapes > 0;
+    free(count);
+    free(S);
+    free(V);
+    return ok;
+}
+
+void accel_csg_clip(accel_csg *c, vec3 lo, vec3 hi)
+{
+    for (int i = 0; i < c->nshapes; i++)
+        if (c->shapes[i].kind == SHAPE_PLANE) accel_shape_clip_plane(&c->shapes[i], lo, hi);
+    c->lo = v3_max(c->lo, lo);
+    c->hi = v3_min(c->hi, hi);
+}
+
+void accel_csg_free(accel_csg *c)
+{
+    if (!c) return;
+    free(c->nodes);
+    free(c->kids);
+    free(c->shapes);
+    free(c->shape_leaf);
+    free(c->shape_node);
+    memset(c, 0, sizeof *c);
+}
+
+int accel_csg_inside(const accel_csg *c, int node, vec3 p)
+{
+    const accel_csg_node *nd = &c->nodes[node];
+    const int *k = c->kids + nd->first;
+    int r = 0;
+    switch (nd->op) {
+    case CSG_LEAF:
+        r = accel_shape_inside(&c->shapes[nd->shape], p);
+        break;
+    case CSG_UNION:
+    case CSG_MERGE:
+        for (int j = 0; j < nd->nkids && !r; j++) r = accel_csg_inside(c, k[j], p);
+        break;
+    case CSG_INTERSECTION:
+        r = nd->nkids > 0;
+        for (int j = 0; j < nd->nkids && r; j++) r = accel_csg_inside(c, k[j], p);
+        break;
+    case CSG_DIFFERENCE:
+        r = nd->nkids > 0 && accel_csg_inside(c, k[0], p);
+        for (int j = 1; j < nd->nkids && r; j++) r = !accel_csg_inside(c, k[j], p);
+        break;
+    }
+    return r ^ nd->inverse;
+}
+
+/* Does a crossing of leaf `node`'s surface at p belong to the result? */
+static int kept(const accel_csg *c, int node, vec3 p)
+{
+    int child = node;
+    for (int par = c->nodes[child].parent; par >= 0; child = par, par = c->nodes[par].parent) {
+        const accel_csg_node *P = &c->nodes[par];
+        const int *k = c->kids + P->first;
+        switch (P->op) {
+        case CSG_MERGE:
+            for (int j = 0; j < P->nkids; j++)
+                if (k[j] != child && accel_csg_inside(c, k[j], p)) return 0;
+            break;
+        case CSG_INTERSECTION:
+            for (int j = 0; j < P->nkids; j++)
+                if (k[j] != child && !accel_csg_inside(c, k[j], p)) return 0;
+            break;
+        case CSG_DIFFERENCE:
+            if (k[0] != child && !accel_csg_inside(c, k[0], p)) return 0;
+            for (int j = 1; j < P->nkids; j++)
+                if (k[j] != child && accel_csg_inside(c, k[j], p)) return 0;
+            break;
+        default:
+            break;
+        }
+    }
+    return 1;
+}
+
+int accel_csg_intersect(const accel_csg *c, vec3 org, vec3 dir, double tmin, double tmax, accel_csg_hit *h)
+{
+    accel_csg_hit local[64];
+    accel_csg_hit *buf = local;
+    size_t need = (size_t)c->nshapes * 4;
+    if (need > sizeof local / sizeof local[0]) {
+        buf = malloc(need * sizeof *buf);
+        if (!buf) return 0;
+    }
+    int n = 0;
+    for (int s = 0; s < c->nshapes; s++) {
+        accel_shape_hit tmp[4];
+        int k = accel_shape_hits(&c->shapes[s], org, dir, tmin, tmax, tmp, 4);
+        for (int j = 0; j < k; j++) {
+            /* insertion into the ascending list */
+            int i = n++;
+            while (i > 0 && buf[i - 1].t > tmp[j].t) {
+                buf[i] = buf[i - 1];
+                i--;
+            }
+            buf[i].t = tmp[j].t;
+            buf[i].shape = s;
+            buf[i].part = tmp[j].part;
+            buf[i].flip = 0;
+        }
+    }
+    int found = 0;
+    for (int i = 0; i < n && !found; i++) {
+        int node = c->shape_node[buf[i].shape];
+        if (kept(c, node, v3_madd(org, dir, buf[i].t))) {
+            *h = buf[i];
+            h->flip = c->nodes[node].flip;
+            found = 1;
+        }
+    }
+    if (buf != local) free(buf);
+    return found;
+}

@@ -1,0 +1,63 @@
+/* accel_csg.h - POV-Ray CSG intersection and difference (with any unions,
+ * merges and inverses nested in them) evaluated exactly along a ray, over
+ * analytic shapes and triangles (accel_shapes.h).
+ *
+ * The rule is POV-Ray's: a crossing of a member's surface belongs to the
+ * result when the point passes the inside tests of that member's siblings,
+ * at every level up to the root: intersection keeps it if inside all
+ * siblings, difference keeps the first member's surface outside all the
+ * others and a subtracted member's surface inside the first and outside the
+ * rest (its normal flipped), merge keeps it outside all siblings, union
+ * always. The result's inside test combines the members' tests the same way
+ * (inverse negates it). accel.c turns each tree into one user-geometry
+ * primitive. */
+#ifndef PT_ACCEL_CSG_H
+#define PT_ACCEL_CSG_H
+#include "accel_shapes.h"
+
+typedef enum { CSG_LEAF, CSG_UNION, CSG_MERGE, CSG_INTERSECTION, CSG_DIFFERENCE } accel_csg_op;
+
+typedef struct {
+    accel_csg_op op;
+    int inverse;      /* inside test negated */
+    int parent;       /* -1 at the root */
+    int first, nkids; /* members: kids[first .. first + nkids) */
+    int shape;        /* CSG_LEAF: index into shapes */
+    int flip;         /* CSG_LEAF: normal points into the result's outside when negated */
+} accel_csg_node;
+
+typedef struct {
+    accel_csg_node *nodes;
+    int nnodes, capnodes;
+    int *kids;
+    int nkids, capkids;
+    accel_shape *shapes;
+    unsigned *shape_leaf;  /* caller's tag per shape (accel.c: its leaf record) */
+    int *shape_node;
+    int nshapes, capshapes;
+    vec3 lo, hi;           /* world bounds of the result's surface (may be infinite before clipping) */
+    unsigned flags;        /* caller's tag (accel.c: effective object flags of the root) */
+} accel_csg;
+
+typedef struct {
+    double t;
+    int shape, part, flip;
+} accel_csg_hit;
+
+/* Building: nodes are added parent first; returns the node index or -1 on
+ * out-of-memory. Leaves take a copy of `sh`. */
+int accel_csg_add_node(accel_csg *c, accel_csg_op op, int inverse, int parent);
+int accel_csg_add_leaf(accel_csg *c, const accel_shape *sh, unsigned tag, int inverse, int parent);
+/* After all nodes are in: fixes the member lists, the normal flips and the
+ * bounds (infinite where half-spaces leave it open). Returns 0 when the
+ * result is provably empty or has no members. */
+int accel_csg_finish(accel_csg *c);
+/* Limit infinite parts (planes) to the world box [lo, hi] and clip the bounds to it. */
+void accel_csg_clip(accel_csg *c, vec3 lo, vec3 hi);
+void accel_csg_free(accel_csg *c);
+
+/* Nearest crossing of the result with t in (tmin, tmax). */
+int accel_csg_intersect(const accel_csg *c, vec3 org, vec3 dir, double tmin, double tmax, accel_csg_hit *h);
+int accel_csg_inside(const accel_csg *c, int node, vec3 p);
+
+#endif
