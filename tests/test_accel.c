@@ -728,6 +728,7 @@ static void test_no_shadow(void **st)
         vec3 org = v3(x[i], 0, 0), dir = v3(0, 0, 1);
         accel_hit h;
         assert_true(accel_intersect(a, org, dir, 0.0, 10.0, &h)); /* visible to camera rays */
+        assert_int_equal((h.flags & OBJ_NO_SHADOW) != 0, !occl[i]); /* inherited flags reported */
         assert_int_equal(accel_occluded(a, org, dir, 0.0, 10.0), occl[i]);
         /* the bare Embree scene honours it too (filters live in the scene) */
     }
