@@ -900,8 +900,17 @@ static void directive(sdl_parser *p, const sdl_token *hash)
     sdl_token k = sdl_scan_next(&top_frame(p)->sc);
     src_loc loc = hash->loc;
     if (k.kind != TOK_KEYWORD) {
-        sdl_tok t = {k, {0}};
-        sdl_unexpected(p, &t, "directive after '#'");
+        /* POV-Ray ignores a '#' that no directive follows */
+        sdl_warning(p, loc, "'#' without a directive ignored");
+        sdl_tok t;
+        memset(&t, 0, sizeof t);
+        t.tk = k;
+        if (k.kind == TOK_IDENT) {
+            const sdl_value *v = sdl_symtab_find(p->sym, k.text, (size_t)k.len);
+            if (v) t.val = *v;
+        }
+        if (k.kind == TOK_ERROR) sdl_error(p, k.loc, PT_ERR_SYNTAX, "%s", top_frame(p)->sc.err);
+        else sdl_unget(p, &t);
         return;
     }
     switch (k.kw) {
@@ -953,6 +962,20 @@ static int end_of_input(sdl_parser *p, const sdl_token *eof)
     return 1;
 }
 
+/* After a '#' read while directives are deferred: is it the #end of the
+ * running macro body? (That one always runs: the macro's value ends there.)
+ * Consumes the 'end' if so. */
+static int macro_end_ahead(sdl_parser *p)
+{
+    sdl_frame *f = top_frame(p);
+    if (f->kind != FRAME_MACRO || local_cond(p)) return 0;
+    sdl_scan_pos at = sdl_scan_tell(&f->sc);
+    sdl_token k = sdl_scan_next(&f->sc);
+    if (k.kind == TOK_KEYWORD && k.kw == KW_END) return 1;
+    sdl_scan_seek(&f->sc, at);
+    return 0;
+}
+
 static sdl_tok eof_token(const sdl_parser *p)
 {
     sdl_tok t;
@@ -991,6 +1014,10 @@ sdl_tok sdl_next(sdl_parser *p)
             return p->last = t;
         }
         if (t.tk.kind == TOK_HASH) {
+            if (p->defer > 0 && macro_end_ahead(p)) {
+                return_from_macro(p);
+                continue;
+            }
             if (p->defer > 0) return p->last = t;
             directive(p, &t.tk);
             continue;

@@ -482,7 +482,8 @@ static void pattern_texture(sdl_parser *p, scene_texture *t)
 }
 
 /* texture_item := pigment_identifier | finish_identifier | normal_identifier |
- *   'pigment' pigment | 'finish' finish | 'normal' normal | transform_item */
+ *   'pigment' pigment | 'finish' finish | 'normal' normal | transform_item |
+ *   no_bump_scale | uv_mapping */
 static int texture_item(sdl_parser *p, scene_texture *t)
 {
     const sdl_tok *pk = sdl_peek(p);
@@ -511,7 +512,7 @@ static int texture_item(sdl_parser *p, scene_texture *t)
         t->has_normal = 1;
         return 1;
     }
-    return sdl_accept_kw(p, KW_NO_BUMP_SCALE);
+    return sdl_accept_kw(p, KW_NO_BUMP_SCALE) || sdl_accept_kw(p, KW_UV_MAPPING);
 }
 
 /* texture := '{' [ texture_identifier ] { texture_item } | '{' texture_pattern ... '}' */

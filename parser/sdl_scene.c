@@ -218,11 +218,18 @@ static void area_light(sdl_parser *p, scene_light *l, src_loc loc)
     if (sdl_ok(p) && (l->size1 <= 0 || l->size2 <= 0)) sdl_error(p, loc, PT_ERR_SYNTAX, "area light sizes must be greater than zero");
 }
 
-/* looks_like := 'looks_like' '{' object_statement object_mods '}' */
+/* looks_like := 'looks_like' '{' ( object_identifier | object_statement ) object_mods '}' */
 static void looks_like(sdl_parser *p, scene_light *l)
 {
     if (!sdl_begin_block(p, "looks_like")) return;
-    sdl_obj *o = sdl_parse_object(p);
+    const sdl_tok *t = sdl_peek(p);
+    sdl_obj *o = NULL;
+    if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_OBJECT) {
+        sdl_tok id = sdl_next(p);
+        o = sdl_copy_obj(p, id.val.ptr);
+    } else {
+        o = sdl_parse_object(p);
+    }
     if (o && o->obj) {
         xform t = xform_translate(l->position);
         sdl_obj_transform(o, &t);
