@@ -374,9 +374,11 @@ static double fresnel_r(double cos_i, double n)
     return fmin(1.0, fmax(0.0, f));
 }
 
-static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, double ior_outside, rng *r);
+/* `skip`: objects with any of these flags are invisible to this ray (no_image
+ * for camera rays, no_reflection for reflected rays). */
+static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, rng *r);
 
-static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, int level, double weight, rng *r)
+static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip, rng *r)
 {
     const scene *sc = c->sc;
     const scene_texture *tex = h->texture ? h->texture : &sc->default_texture;
@@ -429,7 +431,7 @@ static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, in
         if (w > sc->global.adc_bailout) {
             vec3 rd = v3_madd(dir, n, 2.0 * cos_i);
             c->ts[thread].secondary++;
-            rgb rc = trace_ray(c, thread, p, rd, level + 1, w, 1.0, r);
+            rgb rc = trace_ray(c, thread, p, rd, level + 1, w, OBJ_NO_REFLECTION, r);
             if (f->reflection_exponent != 1.0) {
                 rc.r = pow(fmax(rc.r, 0.0), f->reflection_exponent);
                 rc.g = pow(fmax(rc.g, 0.0), f->reflection_exponent);
@@ -451,25 +453,31 @@ static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, in
                 /* total internal reflection: all of the transmitted part reflects */
                 vec3 rd = v3_madd(dir, n, 2.0 * cos_i);
                 c->ts[thread].secondary++;
-                rgb rc = trace_ray(c, thread, p, rd, level + 1, tw, 1.0, r);
+                rgb rc = trace_ray(c, thread, p, rd, level + 1, tw, OBJ_NO_REFLECTION, r);
                 return rgb_add(col, rgb_mul(trans_colour, rc));
             }
             td = v3_norm(v3_add(v3_scale(dir, eta), v3_scale(n, eta * cos_i - sqrt(k))));
         }
         c->ts[thread].secondary++;
-        rgb tc = trace_ray(c, thread, q, td, level + 1, tw, 1.0, r);
+        rgb tc = trace_ray(c, thread, q, td, level + 1, tw, skip, r);
         col = rgb_add(col, rgb_mul(trans_colour, tc));
     }
     return col;
 }
 
-static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, double ior_outside, rng *r)
+static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, rng *r)
 {
-    (void)ior_outside;
     if (level > c->max_level) return rgb_make(0, 0, 0);
     accel_hit h;
-    if (!accel_intersect(c->a, org, dir, c->eps, INFINITY, &h)) return background(c->sc);
-    return shade_hit(c, thread, &h, dir, level, weight, r);
+    double tmin = c->eps;
+    /* Step past objects this ray must not see (bounded: a pathological stack
+     * of such surfaces ends as background). */
+    for (int k = 0; k < 64; k++) {
+        if (!accel_intersect(c->a, org, dir, tmin, INFINITY, &h)) return background(c->sc);
+        if (!(h.flags & skip)) return shade_hit(c, thread, &h, dir, level, weight, skip, r);
+        tmin = h.t + fmax(c->eps, h.t * 1e-7);
+    }
+    return background(c->sc);
 }
 
 static double scene_eps(const accel *a)
@@ -487,7 +495,7 @@ rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 o
     thread_stats ts[1];
     memset(ts, 0, sizeof ts);
     render_ctx c = {sc, a, s, scene_eps(a), s->max_trace_level > 0 ? s->max_trace_level : sc->global.max_trace_level, ts, NULL, NULL, 0, 0};
-    return trace_ray(&c, 0, org, v3_norm(dir), 1, 1.0, 1.0, r);
+    return trace_ray(&c, 0, org, v3_norm(dir), 1, 1.0, OBJ_NO_IMAGE, r);
 }
 
 /* --------------------------------------------------------------- the image */
@@ -509,7 +517,7 @@ static rgb sample(render_ctx *c, int thread, double px, double py, rng *r)
     vec3 org, dir;
     scene_camera_ray(&c->sc->camera, px, py, c->s->width, c->s->height, &org, &dir);
     c->ts[thread].primary++;
-    rgb v = trace_ray(c, thread, org, dir, 1, 1.0, 1.0, r);
+    rgb v = trace_ray(c, thread, org, dir, 1, 1.0, OBJ_NO_IMAGE, r);
     if (!isfinite(v.r) || !isfinite(v.g) || !isfinite(v.b)) {
         c->ts[thread].discarded++;
         return rgb_make(0, 0, 0);

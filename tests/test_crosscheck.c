@@ -21,6 +21,9 @@
 
 #define SIZE 160
 #define TOLERANCE 0.01
+/* Our own regression bound: measured values are 0.0002-0.0012; the issue's
+ * acceptance bound above is loose enough to miss a small missing feature. */
+#define REGRESSION 0.004
 
 static char tmpdir[256];
 
@@ -113,14 +116,18 @@ static void test_cornell_direct(void **st)
     char path[512];
     snprintf(path, sizeof path, "%s/cornell_direct.pov", tmpdir);
     assert_true(strip_radiosity("/usr/share/povray-3.7/scenes/radiosity/cornell.pov", path));
-    assert_true(crosscheck(path, "cornell_direct") <= TOLERANCE);
+    double mad = crosscheck(path, "cornell_direct");
+    assert_true(mad <= TOLERANCE);
+    assert_true(mad <= REGRESSION);
 }
 
 static void scene_test(const char *name)
 {
     char path[512];
     snprintf(path, sizeof path, "%s/scenes/%s.pov", TESTS_DIR, name);
-    assert_true(crosscheck(path, name) <= TOLERANCE);
+    double mad = crosscheck(path, name);
+    assert_true(mad <= TOLERANCE);
+    assert_true(mad <= REGRESSION);
 }
 
 static void test_point_phong(void **st) { (void)st; scene_test("xc_point_phong"); }

@@ -15,3 +15,7 @@ union {
   finish { ambient 0.1 diffuse 0.8 }
   rotate y*20 translate <0, 0, -1.2>
 }
+// invisible to the camera but seen in reflections and casting a shadow
+sphere { <-0.2, 0.4, 1.8>, 0.4 no_image pigment { rgb <0.2, 0.9, 0.3> } finish { diffuse 0.8 } }
+// seen by the camera but not in reflections
+box { <1.6, 0, -1.8>, <2.2, 0.6, -1.2> no_reflection pigment { rgb <0.9, 0.9, 0.2> } finish { diffuse 0.8 } }
