@@ -82,6 +82,10 @@ void scene_default_global(scene_global *g)
     r->gray_threshold = 0.0;
     r->low_error_factor = 0.5;
     r->minimum_reuse = 0.015;
+    r->adc_bailout = 0.01;
+    r->max_sample = -1.0;
+    r->maximum_reuse = 0.2;
+    r->direction_pool = 1600; /* raised to `count` when that is larger */
 }
 
 scene *scene_new(void)

@@ -203,6 +203,13 @@ typedef struct {
     double minimum_reuse;
     int always_sample;
     int normal, media;
+    /* The rest of POV-Ray 3.7's radiosity keywords (appended). */
+    double adc_bailout;     /* default 0.01 */
+    double max_sample;      /* default -1 = no limit */
+    double maximum_reuse;   /* default 0.2 */
+    int direction_pool;     /* "count N, M": M, default max(1600, count) */
+    int nearest_count_pretrace; /* "nearest_count N, M": M (adaptive pretrace), default 0 */
+    int subsurface;
 } scene_radiosity;
 
 typedef struct {

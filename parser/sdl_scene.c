@@ -333,6 +333,30 @@ sdl_obj *sdl_parse_light(sdl_parser *p, src_loc loc)
 
 /* ------------------------------------------------------------ global settings */
 
+/* A radiosity value with POV-Ray 3.7's range check. */
+static double checked(sdl_parser *p, src_loc loc, double v, int ok, const char *what)
+{
+    if (!ok && sdl_ok(p)) sdl_error(p, loc, PT_ERR_SYNTAX, "radiosity %s", what);
+    return v;
+}
+
+/* radiosity count/nearest_count: N [ ',' M ] */
+static void radiosity_counts(sdl_parser *p, scene_radiosity *r, sdl_kw k, src_loc loc)
+{
+    int n = (int)sdl_float(p);
+    sdl_accept(p, TOK_COMMA);
+    if (k == KW_COUNT) {
+        r->count = (int)checked(p, loc, n, n > 0, "count must be a positive number");
+        r->direction_pool = (int)sdl_allow_float(p, n > 1600 ? n : 1600);
+        checked(p, loc, 0, r->direction_pool >= n, "count can not be more than the direction pool size (count's 2nd value)");
+    } else {
+        r->nearest_count = (int)checked(p, loc, n, n >= 1 && n <= 20, "nearest_count must be from 1 to 20");
+        r->nearest_count_pretrace = (int)sdl_allow_float(p, 0.0);
+        checked(p, loc, 0, r->nearest_count_pretrace >= 0 && r->nearest_count_pretrace < n,
+                "nearest_count for adaptive pretrace must be non-negative and smaller than nearest_count");
+    }
+}
+
 /* radiosity_item := adc_bailout f | always_sample b | brightness f |
  *   count n [, n] | error_bound f | gray_threshold f | low_error_factor f |
  *   max_sample f | maximum_reuse f | minimum_reuse f | nearest_count n [, n] |
@@ -342,30 +366,29 @@ static int radiosity_item(sdl_parser *p, scene_radiosity *r)
 {
     if (sdl_peek(p)->tk.kind != TOK_KEYWORD) return 0;
     sdl_tok t = sdl_next(p);
+    src_loc at = t.tk.loc;
+    double v;
     switch (t.tk.kw) {
-    case KW_ADC_BAILOUT: sdl_float(p); break;
-    case KW_ALWAYS_SAMPLE: r->always_sample = sdl_true(sdl_float(p)); break;
-    case KW_BRIGHTNESS: r->brightness = sdl_float(p); break;
-    case KW_COUNT:
-        r->count = (int)sdl_float(p);
-        if (sdl_accept(p, TOK_COMMA)) sdl_float(p);
+    case KW_ADC_BAILOUT: v = sdl_float(p); r->adc_bailout = checked(p, at, v, v > 0, "adc_bailout must be a positive number"); break;
+    case KW_ALWAYS_SAMPLE: r->always_sample = (int)sdl_float(p) != 0; break;
+    case KW_BRIGHTNESS: v = sdl_float(p); r->brightness = checked(p, at, v, v > 0, "brightness must be a positive number"); break;
+    case KW_COUNT: case KW_NEAREST_COUNT: radiosity_counts(p, r, t.tk.kw, at); break;
+    case KW_ERROR_BOUND: v = sdl_float(p); r->error_bound = checked(p, at, v, v > 0, "error_bound must be a positive number"); break;
+    case KW_GRAY_THRESHOLD: v = sdl_float(p); r->gray_threshold = checked(p, at, v, v >= 0 && v <= 1, "gray_threshold must be from 0 to 1"); break;
+    case KW_LOW_ERROR_FACTOR: v = sdl_float(p); r->low_error_factor = checked(p, at, v, v > 0, "low_error_factor must be a positive number"); break;
+    case KW_MAX_SAMPLE: r->max_sample = sdl_float(p); break;
+    case KW_MAXIMUM_REUSE: v = sdl_float(p); r->maximum_reuse = checked(p, at, v, v > 0, "maximum_reuse must be a positive number"); break;
+    case KW_MINIMUM_REUSE: v = sdl_float(p); r->minimum_reuse = checked(p, at, v, v >= 0, "minimum_reuse can not be negative"); break;
+    case KW_NORMAL: r->normal = (int)sdl_float(p) != 0; break;
+    case KW_MEDIA: r->media = (int)sdl_float(p) != 0; break;
+    case KW_SUBSURFACE: r->subsurface = (int)sdl_float(p) != 0; break;
+    case KW_PRETRACE_START: v = sdl_float(p); r->pretrace_start = checked(p, at, v, v > 0 && v <= 1, "pretrace_start must be greater than 0 and at most 1"); break;
+    case KW_PRETRACE_END: v = sdl_float(p); r->pretrace_end = checked(p, at, v, v > 0 && v <= 1, "pretrace_end must be greater than 0 and at most 1"); break;
+    case KW_RECURSION_LIMIT: v = sdl_float(p); r->recursion_limit = (int)checked(p, at, v, v >= 1 && v <= 20, "recursion_limit must be from 1 to 20"); break;
+    case KW_LOAD_FILE: case KW_SAVE_FILE:
+        sdl_warn_once(p, at, "radiosity %s is ignored (POV-Ray 3.7 takes it from the command line)", sdl_kw_text(t.tk.kw));
+        sdl_string(p);
         break;
-    case KW_ERROR_BOUND: r->error_bound = sdl_float(p); break;
-    case KW_GRAY_THRESHOLD: r->gray_threshold = sdl_float(p); break;
-    case KW_LOW_ERROR_FACTOR: r->low_error_factor = sdl_float(p); break;
-    case KW_MAX_SAMPLE: case KW_MAXIMUM_REUSE: sdl_float(p); break;
-    case KW_MINIMUM_REUSE: r->minimum_reuse = sdl_float(p); break;
-    case KW_NEAREST_COUNT:
-        r->nearest_count = (int)sdl_float(p);
-        if (sdl_accept(p, TOK_COMMA)) sdl_float(p);
-        break;
-    case KW_NORMAL: r->normal = sdl_true(sdl_float(p)); break;
-    case KW_MEDIA: r->media = sdl_true(sdl_float(p)); break;
-    case KW_PRETRACE_START: r->pretrace_start = sdl_float(p); break;
-    case KW_PRETRACE_END: r->pretrace_end = sdl_float(p); break;
-    case KW_RECURSION_LIMIT: r->recursion_limit = (int)sdl_float(p); break;
-    case KW_SUBSURFACE: sdl_float(p); break;
-    case KW_LOAD_FILE: case KW_SAVE_FILE: sdl_string(p); break;
     default:
         sdl_unget(p, &t);
         return 0;

@@ -378,6 +378,9 @@ static void test_cornell_lights(void **st)
     assert_near(s->global.radiosity.error_bound, 0.5, 0);
     assert_near(s->global.radiosity.pretrace_start, 0.04, 0);
     assert_near(s->global.radiosity.pretrace_end, 0.01, 0);
+    assert_int_equal(s->global.radiosity.direction_pool, 1600);
+    assert_near(s->global.radiosity.maximum_reuse, 0.2, 0); /* defaults */
+    assert_near(s->global.radiosity.adc_bailout, 0.01, 0);
     assert_near(s->global.assumed_gamma, 1.0, 0);
     assert_int_equal(s->version_major, 3);
     assert_int_equal(s->version_minor, 7);
@@ -682,7 +685,8 @@ static void test_global_settings(void **st)
 {
     (void)st;
     scene *s = parse_ok("global_settings { assumed_gamma 2.2 ambient_light rgb <0.5,0.5,1> max_trace_level 10 adc_bailout 0.01\n"
-                        "  radiosity { brightness 2 gray_threshold 0.5 low_error_factor 0.7 minimum_reuse 0.01 always_sample on normal on media off count 10, 20 nearest_count 3, 1 }\n"
+                        "  radiosity { brightness 2 gray_threshold 0.5 low_error_factor 0.7 minimum_reuse 0.01 always_sample on normal on media off count 10, 20 nearest_count 3, 1\n"
+                        "    adc_bailout 0.05 max_sample 2 maximum_reuse 0.3 subsurface on }\n"
                         "  number_of_waves 5 }\n"
                         "background { rgb <0.1, 0.2, 0.3> }\n");
     assert_near(s->global.assumed_gamma, 2.2, 0);
@@ -697,9 +701,18 @@ static void test_global_settings(void **st)
     assert_true(s->global.radiosity.normal);
     assert_int_equal(s->global.radiosity.count, 10);
     assert_int_equal(s->global.radiosity.nearest_count, 3);
+    assert_int_equal(s->global.radiosity.direction_pool, 20);
+    assert_int_equal(s->global.radiosity.nearest_count_pretrace, 1);
+    assert_near(s->global.radiosity.adc_bailout, 0.05, 0);
+    assert_near(s->global.radiosity.max_sample, 2, 0);
+    assert_near(s->global.radiosity.maximum_reuse, 0.3, 0);
+    assert_true(s->global.radiosity.subsurface);
     assert_near(s->background.g, 0.2, 0);
     assert_near(s->background.t, 0, 0);
     scene_free(s);
+    char *e = parse_err("global_settings { radiosity {\n  count 0 } }", PT_ERR_SYNTAX);
+    assert_string_equal(e, "test.pov:2:3: error: radiosity count must be a positive number");
+    free(e);
 }
 
 /* ------------------------------------------------------------ errors */
