@@ -90,6 +90,15 @@ void diag_report(diag *d, diag_severity sev, src_loc loc, const char *chain, con
     va_end(ap);
 }
 
+void diag_error(diag *d, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    src_loc none = {NULL, 0, 0};
+    diag_vreport(d, DIAG_ERROR, none, NULL, fmt, ap);
+    va_end(ap);
+}
+
 void diag_warn_once(diag *d, src_loc loc, const char *fmt, ...)
 {
     if (!d) return;

@@ -51,6 +51,12 @@ void diag_warn_once(diag *d, src_loc loc, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+/* An error with no source location (files, devices, arguments). */
+void diag_error(diag *d, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
 int diag_count(const diag *d);
 int diag_errors(const diag *d);
 const diag_msg *diag_get(const diag *d, int i);

@@ -35,21 +35,6 @@ static void on_error(exr_const_context_t ctxt, exr_result_t code, const char *ms
     snprintf(exr_msg, sizeof exr_msg, "%s", msg ? msg : exr_get_default_error_message(code));
 }
 
-static void report(diag *d, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-
-static void report(diag *d, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    src_loc none = {NULL, 0, 0};
-    diag_vreport(d, DIAG_ERROR, none, NULL, fmt, ap);
-    va_end(ap);
-}
-
 /* The reason for a failed library call: errno text for I/O failures in our
  * callbacks, otherwise the library's message (or its generic one). */
 typedef struct {
@@ -190,7 +175,7 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
         rv = exr_attr_set_string(ctx, part, k, v);
         if (rv != EXR_ERR_SUCCESS) {
             exr_finish(&ctx);
-            report(d, "cannot write '%s': cannot set EXR attribute '%s': %s", name, k, reason(&s, rv));
+            diag_error(d, "cannot write '%s': cannot set EXR attribute '%s': %s", name, k, reason(&s, rv));
             return PT_ERR_IO;
         }
     }
@@ -207,7 +192,7 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
     buf = malloc(sizeof(float) * (size_t)w * (size_t)lpc * (size_t)nch);
     if (!buf) {
         exr_finish(&ctx);
-        report(d, "cannot write '%s': out of memory", name);
+        diag_error(d, "cannot write '%s': out of memory", name);
         return PT_ERR_NOMEM;
     }
     const float lim = use_float ? INFINITY : HALF_MAX;
@@ -257,7 +242,7 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
     what = "cannot finish EXR file";
     rv = exr_finish(&ctx);
     if (rv != EXR_ERR_SUCCESS || s.err) {
-        report(d, "cannot write '%s': %s: %s", name, what, reason(&s, rv));
+        diag_error(d, "cannot write '%s': %s: %s", name, what, reason(&s, rv));
         return PT_ERR_IO;
     }
     return PT_OK;
@@ -266,7 +251,7 @@ fail:
     if (enc_init) exr_encoding_destroy(ctx, &enc);
     free(buf);
     if (ctx) exr_finish(&ctx);
-    report(d, "cannot write '%s': %s: %s", name, what, reason(&s, rv));
+    diag_error(d, "cannot write '%s': %s: %s", name, what, reason(&s, rv));
     return PT_ERR_IO;
 }
 
@@ -335,7 +320,7 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
     exr_stream s = {-1, 0};
     s.fd = open(path, O_RDONLY | O_CLOEXEC);
     if (s.fd < 0) {
-        report(d, "cannot read '%s': %s", path, strerror(errno));
+        diag_error(d, "cannot read '%s': %s", path, strerror(errno));
         return PT_ERR_IO;
     }
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
@@ -364,7 +349,7 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
     rv = exr_get_storage(ctx, 0, &storage);
     if (rv != EXR_ERR_SUCCESS) goto libfail;
     if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED) {
-        report(d, "cannot read '%s': deep EXR images are not supported", path);
+        diag_error(d, "cannot read '%s': deep EXR images are not supported", path);
         goto done;
     }
     exr_attr_box2i_t dw;
@@ -373,7 +358,7 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
     int64_t w64 = (int64_t)dw.max.x - dw.min.x + 1, h64 = (int64_t)dw.max.y - dw.min.y + 1;
     if (w64 <= 0 || h64 <= 0 || w64 > IMG_MAX_SIDE || h64 > IMG_MAX_SIDE ||
         (uint64_t)w64 * (uint64_t)h64 > IMG_MAX_PIXELS) {
-        report(d, "cannot read '%s': image size %lldx%lld is empty or exceeds the limit (%d per side, %llu pixels)",
+        diag_error(d, "cannot read '%s': image size %lldx%lld is empty or exceeds the limit (%d per side, %llu pixels)",
                path, (long long)w64, (long long)h64, IMG_MAX_SIDE, (unsigned long long)IMG_MAX_PIXELS);
         goto done;
     }
@@ -395,7 +380,7 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
         if (e->x_sampling != 1 || e->y_sampling != 1) {
             if (slot == SLOT_Y) sub_y = 1;
             if (slot == SLOT_Y || slot == SLOT_A) continue; /* Y: reported below if it matters */
-            report(d, "cannot read '%s': subsampled channel '%s' is not supported", path, n);
+            diag_error(d, "cannot read '%s': subsampled channel '%s' is not supported", path, n);
             goto done;
         }
         have[slot] = 1;
@@ -403,9 +388,9 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
     const int use_y = !have[SLOT_R] && !have[SLOT_G] && !have[SLOT_B] && have[SLOT_Y];
     if (!have[SLOT_R] && !have[SLOT_G] && !have[SLOT_B] && !have[SLOT_Y]) {
         if (sub_y)
-            report(d, "cannot read '%s': subsampled luminance channel 'Y' is not supported", path);
+            diag_error(d, "cannot read '%s': subsampled luminance channel 'Y' is not supported", path);
         else
-            report(d, "cannot read '%s': no R, G, B or Y channel (of %d channels)", path, chl->num_channels);
+            diag_error(d, "cannot read '%s': no R, G, B or Y channel (of %d channels)", path, chl->num_channels);
         goto done;
     }
     if (use_y && chroma) {
@@ -416,7 +401,7 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
     if (fb && have[SLOT_A]) fb->alpha = calloc((size_t)w * (size_t)h, sizeof(float));
     if (fb && use_y) grey = calloc((size_t)w * (size_t)h, sizeof(float));
     if (!fb || (have[SLOT_A] && !fb->alpha) || (use_y && !grey)) {
-        report(d, "cannot read '%s': out of memory for %dx%d image", path, w, h);
+        diag_error(d, "cannot read '%s': out of memory for %dx%d image", path, w, h);
         st = PT_ERR_NOMEM;
         goto done;
     }
@@ -433,7 +418,7 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
             if (rv != EXR_ERR_SUCCESS) goto libfail;
             int row = ci.start_y - dw.min.y;
             if (row < 0 || row + ci.height > h || ci.width != w) {
-                report(d, "cannot read '%s': inconsistent scanline block at y=%d", path, ci.start_y);
+                diag_error(d, "cannot read '%s': inconsistent scanline block at y=%d", path, ci.start_y);
                 goto done;
             }
             rv = decode_chunk(ctx, &ci, &dec, &dec_init, fb, grey, 0, row, use_y);
@@ -449,7 +434,7 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
         rv = exr_get_level_sizes(ctx, 0, 0, 0, &lw, &lh);
         if (rv != EXR_ERR_SUCCESS) goto libfail;
         if (tw == 0 || th == 0 || lw != w || lh != h) {
-            report(d, "cannot read '%s': inconsistent tile description", path);
+            diag_error(d, "cannot read '%s': inconsistent tile description", path);
             goto done;
         }
         int ntx = (int)(((uint32_t)w + tw - 1) / tw), nty = (int)(((uint32_t)h + th - 1) / th);
@@ -460,7 +445,7 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
                 if (rv != EXR_ERR_SUCCESS) goto libfail;
                 int x0 = tx * (int)tw, y0 = ty * (int)th;
                 if (ci.width <= 0 || ci.height <= 0 || x0 + ci.width > w || y0 + ci.height > h) {
-                    report(d, "cannot read '%s': inconsistent tile (%d,%d)", path, tx, ty);
+                    diag_error(d, "cannot read '%s': inconsistent tile (%d,%d)", path, tx, ty);
                     goto done;
                 }
                 rv = decode_chunk(ctx, &ci, &dec, &dec_init, fb, grey, x0, y0, use_y);
@@ -478,7 +463,7 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
     goto done;
 
 libfail:
-    report(d, "cannot read '%s': %s: %s", path, what, reason(&s, rv));
+    diag_error(d, "cannot read '%s': %s: %s", path, what, reason(&s, rv));
     st = PT_ERR_IO;
 done:
     if (dec_init) exr_decoding_destroy(ctx, &dec);

@@ -14,21 +14,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void report(diag *d, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-
-static void report(diag *d, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    src_loc none = {NULL, 0, 0};
-    diag_vreport(d, DIAG_ERROR, none, NULL, fmt, ap);
-    va_end(ap);
-}
-
 /* ---- the ramp ------------------------------------------------------------- */
 
 #define NKNOTS 8
@@ -140,12 +125,12 @@ pt_status img_fc_auto_range(const float *values, size_t n, double *lo, double *h
     size_t m = 0;
     for (size_t i = 0; i < n; i++) m += isfinite(values[i]) && values[i] > 0.0f;
     if (m == 0) {
-        report(d, "false colour: no positive values to choose a range from (give one)");
+        diag_error(d, "false colour: no positive values to choose a range from (give one)");
         return PT_ERR_USAGE;
     }
     float *v = malloc(sizeof(float) * m);
     if (!v) {
-        report(d, "false colour: out of memory");
+        diag_error(d, "false colour: out of memory");
         return PT_ERR_NOMEM;
     }
     m = 0;
@@ -366,7 +351,7 @@ pt_status img_falsecolor(const float *values, int w, int h, const img_fc_opts *o
         o = &defaults;
     }
     if (!values || w <= 0 || h <= 0 || w > IMG_MAX_SIDE || h > IMG_MAX_SIDE) {
-        report(d, "false colour: invalid image");
+        diag_error(d, "false colour: invalid image");
         return PT_ERR_USAGE;
     }
     double lo = o->lo, hi = o->hi;
@@ -374,18 +359,18 @@ pt_status img_falsecolor(const float *values, int w, int h, const img_fc_opts *o
         pt_status st = img_fc_auto_range(values, (size_t)w * (size_t)h, &lo, &hi, d);
         if (st != PT_OK) return st;
     } else if (!(lo > 0.0) || !(hi > lo) || !isfinite(hi)) {
-        report(d, "false colour: range %g..%g is invalid (need 0 < low < high)", lo, hi);
+        diag_error(d, "false colour: range %g..%g is invalid (need 0 < low < high)", lo, hi);
         return PT_ERR_USAGE;
     }
     legend_layout L = layout_legend(h, o->unit);
     const int total_w = o->legend ? w + L.width : w;
     if (total_w > IMG_MAX_SIDE) {
-        report(d, "false colour: image too wide for a legend");
+        diag_error(d, "false colour: image too wide for a legend");
         return PT_ERR_USAGE;
     }
     framebuffer *fb = fb_new(total_w, h);
     if (!fb) {
-        report(d, "false colour: out of memory for %dx%d image", total_w, h);
+        diag_error(d, "false colour: out of memory for %dx%d image", total_w, h);
         return PT_ERR_NOMEM;
     }
     /* Every pixel is mapped exactly (no lookup table: it would round t). */

@@ -76,21 +76,6 @@ img_format img_format_from_path(const char *path)
     return IMG_FMT_UNKNOWN;
 }
 
-static void report(diag *d, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-
-static void report(diag *d, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    src_loc none = {NULL, 0, 0};
-    diag_vreport(d, DIAG_ERROR, none, NULL, fmt, ap);
-    va_end(ap);
-}
-
 /* "<dir>/.<name>.tmp-<pid>" for `path`; malloc'd, NULL when out of memory. */
 static char *temp_path_for(const char *path)
 {
@@ -138,7 +123,7 @@ static pt_status plan_colour(const char *path, img_format fmt, const framebuffer
     p->have_xy = 1;
     p->tag = IMG_PNG_TAG_SRGB;
     if (fmt == IMG_FMT_PNG && (!isfinite(o->exposure) || fabs(o->exposure) > 64.0)) {
-        report(d, "cannot write '%s': exposure %g stops is out of range (finite, at most 64 either way)", path,
+        diag_error(d, "cannot write '%s': exposure %g stops is out of range (finite, at most 64 either way)", path,
                o->exposure);
         return PT_ERR_USAGE;
     }
@@ -165,7 +150,7 @@ static pt_status plan_colour(const char *path, img_format fmt, const framebuffer
     if (st == PT_OK && convert) {
         p->copy = fb_new(fb->width, fb->height);
         if (!p->copy) {
-            report(d, "cannot write '%s': out of memory", path);
+            diag_error(d, "cannot write '%s': out of memory", path);
             st = PT_ERR_NOMEM;
         } else {
             memcpy(p->copy->rgb, fb->rgb, sizeof(float) * 3u * (size_t)fb->width * (size_t)fb->height);
@@ -210,25 +195,25 @@ pt_status img_write(const char *path, const framebuffer *fb, const img_write_opt
         o = &defaults;
     }
     if (!path || !*path) {
-        report(d, "cannot write image: empty output path");
+        diag_error(d, "cannot write image: empty output path");
         return PT_ERR_USAGE;
     }
     img_format fmt = img_format_from_path(path);
     if (fmt == IMG_FMT_UNKNOWN) {
-        report(d, "cannot write '%s': unknown image extension (expected .exr, .png or .pfm)", path);
+        diag_error(d, "cannot write '%s': unknown image extension (expected .exr, .png or .pfm)", path);
         return PT_ERR_USAGE;
     }
     if (!valid_fb(fb)) {
-        report(d, "cannot write '%s': invalid framebuffer", path);
+        diag_error(d, "cannot write '%s': invalid framebuffer", path);
         return PT_ERR_USAGE;
     }
     if (fmt == IMG_FMT_EXR && (o->exr_compression < 0 || o->exr_compression > 2)) {
-        report(d, "cannot write '%s': unknown EXR compression %d (0 none, 1 zip, 2 piz)", path,
+        diag_error(d, "cannot write '%s': unknown EXR compression %d (0 none, 1 zip, 2 piz)", path,
                o->exr_compression);
         return PT_ERR_USAGE;
     }
     if (o->nmeta < 0 || (o->nmeta > 0 && (!o->meta_keys || !o->meta_values))) {
-        report(d, "cannot write '%s': inconsistent metadata arguments", path);
+        diag_error(d, "cannot write '%s': inconsistent metadata arguments", path);
         return PT_ERR_USAGE;
     }
 
@@ -240,7 +225,7 @@ pt_status img_write(const char *path, const framebuffer *fb, const img_write_opt
     char *tmp = temp_path_for(path);
     if (!tmp) {
         plan_free(&plan);
-        report(d, "cannot write '%s': out of memory", path);
+        diag_error(d, "cannot write '%s': out of memory", path);
         return PT_ERR_NOMEM;
     }
     int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
@@ -250,7 +235,7 @@ pt_status img_write(const char *path, const framebuffer *fb, const img_write_opt
         fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     }
     if (fd < 0) {
-        report(d, "cannot write '%s': cannot create temporary file '%s': %s", path, tmp, strerror(errno));
+        diag_error(d, "cannot write '%s': cannot create temporary file '%s': %s", path, tmp, strerror(errno));
         free(tmp);
         plan_free(&plan);
         return PT_ERR_IO;
@@ -267,15 +252,15 @@ pt_status img_write(const char *path, const framebuffer *fb, const img_write_opt
     plan_free(&plan);
 
     if (st == PT_OK && fsync(fd) != 0 && errno != EINVAL && errno != EROFS) {
-        report(d, "cannot write '%s': %s", path, strerror(errno));
+        diag_error(d, "cannot write '%s': %s", path, strerror(errno));
         st = PT_ERR_IO;
     }
     if (close(fd) != 0 && st == PT_OK) {
-        report(d, "cannot write '%s': %s", path, strerror(errno));
+        diag_error(d, "cannot write '%s': %s", path, strerror(errno));
         st = PT_ERR_IO;
     }
     if (st == PT_OK && rename(tmp, path) != 0) {
-        report(d, "cannot write '%s': cannot rename '%s' to it: %s", path, tmp, strerror(errno));
+        diag_error(d, "cannot write '%s': cannot rename '%s' to it: %s", path, tmp, strerror(errno));
         st = PT_ERR_IO;
     }
     if (st != PT_OK) unlink(tmp);
@@ -288,12 +273,12 @@ pt_status img_read(const char *path, int png_raw, framebuffer **out, diag *d)
     if (!out) return PT_ERR_USAGE;
     *out = NULL;
     if (!path || !*path) {
-        report(d, "cannot read image: empty path");
+        diag_error(d, "cannot read image: empty path");
         return PT_ERR_USAGE;
     }
     FILE *f = fopen(path, "rb");
     if (!f) {
-        report(d, "cannot read '%s': %s", path, strerror(errno));
+        diag_error(d, "cannot read '%s': %s", path, strerror(errno));
         return PT_ERR_IO;
     }
     unsigned char magic[8] = {0};
@@ -302,7 +287,7 @@ pt_status img_read(const char *path, int png_raw, framebuffer **out, diag *d)
     int saved = errno;
     fclose(f);
     if (rerr) {
-        report(d, "cannot read '%s': %s", path, strerror(saved));
+        diag_error(d, "cannot read '%s': %s", path, strerror(saved));
         return PT_ERR_IO;
     }
     /* OpenEXR file layout: magic number 20000630 as a little-endian int. */
@@ -315,8 +300,8 @@ pt_status img_read(const char *path, int png_raw, framebuffer **out, diag *d)
         (magic[2] == '\n' || magic[2] == '\r' || magic[2] == ' ' || magic[2] == '\t'))
         return img_pfm_read(path, out, d);
     if (n == 0)
-        report(d, "cannot read '%s': file is empty", path);
+        diag_error(d, "cannot read '%s': file is empty", path);
     else
-        report(d, "cannot read '%s': not an EXR, PNG or PFM file (unrecognized magic bytes)", path);
+        diag_error(d, "cannot read '%s': not an EXR, PNG or PFM file (unrecognized magic bytes)", path);
     return PT_ERR_IO;
 }

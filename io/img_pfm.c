@@ -16,21 +16,6 @@
 #include <string.h>
 #include <unistd.h>
 
-static void report(diag *d, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-
-static void report(diag *d, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    src_loc none = {NULL, 0, 0};
-    diag_vreport(d, DIAG_ERROR, none, NULL, fmt, ap);
-    va_end(ap);
-}
-
 /* Write all of buf; 0 on success, errno value on failure. */
 static int write_all(int fd, const void *buf, size_t n)
 {
@@ -76,13 +61,13 @@ pt_status img_pfm_write(int fd, const char *name, const framebuffer *fb, diag *d
     int hn = snprintf(header, sizeof header, "PF\n%d %d\n-1.0\n", fb->width, fb->height);
     int err = write_all(fd, header, (size_t)hn);
     if (err) {
-        report(d, "cannot write '%s': %s", name, strerror(err));
+        diag_error(d, "cannot write '%s': %s", name, strerror(err));
         return PT_ERR_IO;
     }
     size_t rowbytes = (size_t)fb->width * 3u * 4u;
     unsigned char *row = malloc(rowbytes);
     if (!row) {
-        report(d, "cannot write '%s': out of memory", name);
+        diag_error(d, "cannot write '%s': out of memory", name);
         return PT_ERR_NOMEM;
     }
     for (int i = 0; i < fb->height && !err; i++) {
@@ -96,7 +81,7 @@ pt_status img_pfm_write(int fd, const char *name, const framebuffer *fb, diag *d
     }
     free(row);
     if (err) {
-        report(d, "cannot write '%s': %s", name, strerror(err));
+        diag_error(d, "cannot write '%s': %s", name, strerror(err));
         return PT_ERR_IO;
     }
     return PT_OK;
@@ -137,7 +122,7 @@ pt_status img_pfm_read(const char *path, framebuffer **out, diag *d)
     *out = NULL;
     FILE *f = fopen(path, "rb");
     if (!f) {
-        report(d, "cannot read '%s': %s", path, strerror(errno));
+        diag_error(d, "cannot read '%s': %s", path, strerror(errno));
         return PT_ERR_IO;
     }
     pt_status st = PT_ERR_IO;
@@ -149,29 +134,29 @@ pt_status img_pfm_read(const char *path, framebuffer **out, diag *d)
 
     int c0 = getc(f), c1 = getc(f), c2 = getc(f);
     if (c0 != 'P' || (c1 != 'F' && c1 != 'f') || c2 == EOF || !is_space(c2)) {
-        report(d, "cannot read '%s': not a PFM file (bad magic)", path);
+        diag_error(d, "cannot read '%s': not a PFM file (bad magic)", path);
         goto done;
     }
     ch = c1 == 'F' ? 3 : 1;
     if (read_token(f, tok, sizeof tok, &term) || parse_dim(tok, &w) || term == EOF ||
         read_token(f, tok, sizeof tok, &term) || parse_dim(tok, &h) || term == EOF) {
-        report(d, "cannot read '%s': bad PFM header (width/height)", path);
+        diag_error(d, "cannot read '%s': bad PFM header (width/height)", path);
         goto done;
     }
     if (read_token(f, tok, sizeof tok, &term) || term == EOF) {
-        report(d, "cannot read '%s': bad PFM header (scale)", path);
+        diag_error(d, "cannot read '%s': bad PFM header (scale)", path);
         goto done;
     }
     {
         char *end;
         scale = strtod(tok, &end);
         if (*end || end == tok || !isfinite(scale) || scale == 0.0) {
-            report(d, "cannot read '%s': bad PFM scale '%s'", path, tok);
+            diag_error(d, "cannot read '%s': bad PFM scale '%s'", path, tok);
             goto done;
         }
     }
     if (w > IMG_MAX_SIDE || h > IMG_MAX_SIDE || (uint64_t)w * (uint64_t)h > IMG_MAX_PIXELS) {
-        report(d, "cannot read '%s': image size %dx%d exceeds the limit (%d per side, %llu pixels)", path, w,
+        diag_error(d, "cannot read '%s': image size %dx%d exceeds the limit (%d per side, %llu pixels)", path, w,
                h, IMG_MAX_SIDE, (unsigned long long)IMG_MAX_PIXELS);
         goto done;
     }
@@ -179,7 +164,7 @@ pt_status img_pfm_read(const char *path, framebuffer **out, diag *d)
     size_t rowbytes = (size_t)w * (size_t)ch * 4u;
     row = malloc(rowbytes);
     if (!fb || !row) {
-        report(d, "cannot read '%s': out of memory for %dx%d image", path, w, h);
+        diag_error(d, "cannot read '%s': out of memory for %dx%d image", path, w, h);
         st = PT_ERR_NOMEM;
         goto done;
     }
@@ -187,9 +172,9 @@ pt_status img_pfm_read(const char *path, framebuffer **out, diag *d)
     for (int i = 0; i < h; i++) {
         if (fread(row, 1, rowbytes, f) != rowbytes) {
             if (ferror(f))
-                report(d, "cannot read '%s': %s", path, strerror(errno));
+                diag_error(d, "cannot read '%s': %s", path, strerror(errno));
             else
-                report(d, "cannot read '%s': truncated PFM file (%d of %d rows present)", path, i, h);
+                diag_error(d, "cannot read '%s': truncated PFM file (%d of %d rows present)", path, i, h);
             goto done;
         }
         float *dst = fb_px(fb, 0, h - 1 - i); /* file rows run bottom to top */

@@ -24,21 +24,6 @@ typedef struct {
     char msg[256]; /* last libpng error message */
 } png_ctx;
 
-static void report(diag *d, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-
-static void report(diag *d, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    src_loc none = {NULL, 0, 0};
-    diag_vreport(d, DIAG_ERROR, none, NULL, fmt, ap);
-    va_end(ap);
-}
-
 static void on_error(png_structp png, png_const_charp msg)
 {
     png_ctx *c = png_get_error_ptr(png);
@@ -137,16 +122,16 @@ static pt_status write_png(int fd, const char *name, const framebuffer *fb, cons
     if (!row || !png || !info) {
         if (png) png_destroy_write_struct(&png, info ? &info : NULL);
         free(row);
-        report(d, "cannot write '%s': out of memory", name);
+        diag_error(d, "cannot write '%s': out of memory", name);
         return PT_ERR_NOMEM;
     }
     if (setjmp(png_jmpbuf(png))) {
         png_destroy_write_struct(&png, &info);
         free(row);
         if (ctx.err)
-            report(d, "cannot write '%s': %s", name, strerror(ctx.err));
+            diag_error(d, "cannot write '%s': %s", name, strerror(ctx.err));
         else
-            report(d, "cannot write '%s': PNG error: %s", name, ctx.msg);
+            diag_error(d, "cannot write '%s': PNG error: %s", name, ctx.msg);
         return PT_ERR_IO;
     }
     png_set_write_fn(png, &ctx, on_write, on_flush);
@@ -197,7 +182,7 @@ pt_status img_png_read(const char *path, int raw, framebuffer **out, diag *d)
     *out = NULL;
     FILE *f = fopen(path, "rb");
     if (!f) {
-        report(d, "cannot read '%s': %s", path, strerror(errno));
+        diag_error(d, "cannot read '%s': %s", path, strerror(errno));
         return PT_ERR_IO;
     }
     png_ctx ctx = {-1, 0, {0}};
@@ -206,7 +191,7 @@ pt_status img_png_read(const char *path, int raw, framebuffer **out, diag *d)
     if (!png || !info) {
         if (png) png_destroy_read_struct(&png, info ? &info : NULL, NULL);
         fclose(f);
-        report(d, "cannot read '%s': out of memory", path);
+        diag_error(d, "cannot read '%s': out of memory", path);
         return PT_ERR_NOMEM;
     }
     /* Assigned after setjmp and used after a longjmp: must be volatile
@@ -220,11 +205,11 @@ pt_status img_png_read(const char *path, int raw, framebuffer **out, diag *d)
         if (reported)
             ;
         else if (fail == PT_ERR_NOMEM)
-            report(d, "cannot read '%s': out of memory", path);
+            diag_error(d, "cannot read '%s': out of memory", path);
         else if (ctx.err)
-            report(d, "cannot read '%s': %s", path, strerror(ctx.err));
+            diag_error(d, "cannot read '%s': %s", path, strerror(ctx.err));
         else
-            report(d, "cannot read '%s': PNG error: %s", path, ctx.msg[0] ? ctx.msg : "unknown error");
+            diag_error(d, "cannot read '%s': PNG error: %s", path, ctx.msg[0] ? ctx.msg : "unknown error");
         png_destroy_read_struct(&png, &info, NULL);
         free(image);
         free(rows);
@@ -240,7 +225,7 @@ pt_status img_png_read(const char *path, int raw, framebuffer **out, diag *d)
     int bit_depth, color_type, interlace;
     png_get_IHDR(png, info, &w, &h, &bit_depth, &color_type, &interlace, NULL, NULL);
     if ((uint64_t)w * (uint64_t)h > IMG_MAX_PIXELS) {
-        report(d, "cannot read '%s': image size %ux%u exceeds the limit (%llu pixels)", path, (unsigned)w,
+        diag_error(d, "cannot read '%s': image size %ux%u exceeds the limit (%llu pixels)", path, (unsigned)w,
                (unsigned)h, (unsigned long long)IMG_MAX_PIXELS);
         reported = 1;
         png_longjmp(png, 1);
