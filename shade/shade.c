@@ -30,6 +30,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "pool.h"
+#include "shade_light.h"
 #include "timer.h"
 
 #define SHADE_MAX_THREADS 256
@@ -79,100 +80,12 @@ void shade_default_settings(shade_settings *s)
 
 /* ------------------------------------------------------------------ lights */
 
-/* cubic_spline(low, high, x): 0 below low, 1 above high, smooth in between
- * (3 - 2t) t^2 -- POV-Ray's spotlight falloff curve. */
-static double cubic_step(double low, double high, double x)
-{
-    if (x <= low) return 0.0;
-    if (x >= high) return 1.0;
-    double t = (x - low) / (high - low);
-    return (3.0 - 2.0 * t) * t * t;
-}
-
-/* Angle- and distance-based attenuation of `l` seen from `p` along unit `dir`
- * (towards the light) at distance `depth`. */
-static double light_attenuation(const scene_light *l, vec3 p, vec3 dir, double depth)
-{
-    double att = 1.0;
-    if (l->kind == LIGHT_SPOT) {
-        vec3 axis = v3_norm(v3_sub(l->point_at, l->position));
-        double c = -v3_dot(dir, axis);
-        if (c <= 0.0) return 0.0;
-        double cos_radius = cos(l->radius * M_PI / 180.0);
-        double cos_falloff = cos(l->falloff * M_PI / 180.0);
-        att = l->tightness != 0.0 ? pow(c, l->tightness) : 1.0;
-        if (cos_radius > 0.0 && c < cos_radius) att *= cubic_step(cos_falloff, cos_radius, c);
-    } else if (l->kind == LIGHT_CYLINDER) {
-        /* radius and falloff are distances from the axis for cylinder lights */
-        vec3 axis = v3_norm(v3_sub(l->point_at, l->position));
-        vec3 v1 = v3_sub(p, l->position);
-        double k = v3_dot(v1, axis);
-        if (k <= 0.0) return 0.0;
-        double len = v3_len(v3_sub(v1, v3_scale(axis, k)));
-        if (len >= l->falloff) return 0.0;
-        double d = 1.0 - len / l->falloff;
-        att = l->tightness != 0.0 ? pow(d, l->tightness) : 1.0;
-        if (l->radius > 0.0 && len > l->radius) att *= cubic_step(0.0, 1.0 - l->radius / l->falloff, d);
-    }
-    if (att > 0.0 && l->fade_power > 0.0) {
-        if (fabs(l->fade_distance) >= 1e-10)
-            att *= 2.0 / (1.0 + pow(depth / l->fade_distance, l->fade_power));
-        else
-            att *= pow(depth, -l->fade_power);
-    }
-    return att;
-}
-
-/* Direction from p towards the light point `centre` (which may be a jittered
- * grid point) and the distance to it, with POV-Ray's handling of cylinder
- * and parallel lights. */
-static void light_ray(const scene_light *l, vec3 centre, vec3 p, vec3 *dir, double *depth)
-{
-    if (l->kind == LIGHT_CYLINDER) {
-        vec3 d = v3_sub(centre, l->point_at);
-        double dl = v3_len(d);
-        *dir = v3_scale(d, 1.0 / dl);
-        *depth = v3_dot(v3_sub(centre, p), *dir);
-    } else {
-        vec3 d = v3_sub(centre, p);
-        *depth = v3_len(d);
-        *dir = *depth > 0 ? v3_scale(d, 1.0 / *depth) : v3(0, 1, 0);
-    }
-    if (l->parallel || l->kind == LIGHT_PARALLEL) {
-        vec3 axis = v3_norm(v3_sub(centre, l->point_at));
-        double a = v3_dot(axis, *dir);
-        *depth *= a;
-        *dir = axis;
-    }
-}
-
 static int shadow_blocked(render_ctx *c, int thread, vec3 p, vec3 dir, double depth)
 {
     c->ts[thread].shadow++;
     double tmax = depth - fmax(c->eps, depth * 1e-6);
     if (tmax <= c->eps) return 0;
     return accel_occluded(c->a, p, dir, c->eps, tmax);
-}
-
-/* Offset of grid point (u, v) on an area light (POV-Ray's layout: points span
- * -axis/2 .. +axis/2; jitter moves each by up to half a cell). */
-static vec3 area_point(const scene_light *l, vec3 ax1, vec3 ax2, int u, int v, rng *r)
-{
-    double ju = u, jv = v;
-    if (l->jitter) {
-        ju += rng_f64(r) - 0.5;
-        jv += rng_f64(r) - 0.5;
-    }
-    if (l->circular && l->size1 > 1 && l->size2 > 1) {
-        ju = ju / (l->size1 - 1) - 0.5 + 0.001;
-        jv = jv / (l->size2 - 1) - 0.5 + 0.001;
-        double sf = fmax(fabs(ju), fabs(jv)) / sqrt(ju * ju + jv * jv);
-        return v3_add(v3_scale(ax1, ju * sf), v3_scale(ax2, jv * sf));
-    }
-    vec3 o = v3(0, 0, 0);
-    if (l->size1 > 1) o = v3_add(o, v3_scale(ax1, ju / (l->size1 - 1) - 0.5));
-    if (l->size2 > 1) o = v3_add(o, v3_scale(ax2, jv / (l->size2 - 1) - 0.5));
-    return o;
 }
 
 /* Visibility (0..1) of the rectangle [u1,u2]x[v1,v2] of the grid, adaptively. */
@@ -189,7 +102,7 @@ static double area_sample(area_job *j, int u, int v)
 {
     double *g = &j->grid[u * j->l->size2 + v];
     if (*g >= 0.0) return *g;
-    vec3 centre = v3_add(j->l->position, area_point(j->l, j->ax1, j->ax2, u, v, j->r));
+    vec3 centre = v3_add(j->l->position, light_area_point(j->l, j->ax1, j->ax2, u, v, j->r));
     vec3 dir;
     double depth;
     light_ray(j->l, centre, j->p, &dir, &depth);
@@ -224,15 +137,7 @@ static double area_visibility(render_ctx *c, int thread, const scene_light *l, v
     if (!grid) return 1.0;
     for (int i = 0; i < n; i++) grid[i] = -1.0;
     area_job j = {c, l, p, l->axis1, l->axis2, grid, r, thread};
-    if (l->orient) {
-        vec3 dir;
-        double depth;
-        light_ray(l, l->position, p, &dir, &depth);
-        double len = v3_len(l->axis1);
-        vec3 helper = fabs(fabs(dir.z) - 1.0) < 0.01 ? v3(0, 1, 0) : v3(0, 0, 1);
-        j.ax1 = v3_scale(v3_norm(v3_cross(dir, helper)), len);
-        j.ax2 = v3_scale(v3_norm(v3_cross(dir, v3_norm(j.ax1))), len);
-    }
+    light_area_axes(l, p, &j.ax1, &j.ax2);
     double vis = area_subset(&j, 0, 0, l->size1 - 1, l->size2 - 1, 0);
     if (grid != stack_grid) free(grid);
     return vis;
@@ -240,70 +145,7 @@ static double area_visibility(render_ctx *c, int thread, const scene_light *l, v
 
 /* --------------------------------------------------------------- BRDF terms */
 
-static void metallic_tint(rgb *cs, double metallic, rgb pigment, double cos_angle)
-{
-    if (metallic == 0.0) return;
-    double x = fabs(acos(fmax(-1.0, fmin(1.0, cos_angle)))) / (M_PI / 2.0);
-    double f = 0.014567225 / ((x - 1.12) * (x - 1.12)) - 0.011612903;
-    f = fmin(1.0, fmax(0.0, f));
-    double k = metallic * (1.0 - f);
-    cs->r *= 1.0 + k * (pigment.r - 1.0);
-    cs->g *= 1.0 + k * (pigment.g - 1.0);
-    cs->b *= 1.0 + k * (pigment.b - 1.0);
-}
-
-typedef struct {
-    const scene_finish *f;
-    rgb pigment;
-    vec3 n;       /* shading normal facing the viewer */
-    vec3 eye;     /* incoming ray direction, unit */
-    double att;   /* opacity of the layer */
-    rng *r;
-} surface;
-
-/* Diffuse + highlights of one light of colour `lc` arriving along unit `l`. */
-static rgb light_terms(const surface *s, vec3 l, rgb lc, int backside)
-{
-    const scene_finish *f = s->f;
-    rgb out = {0, 0, 0};
-    double diffuse = backside ? f->diffuse_back : f->diffuse;
-    if (diffuse > 0.0) {
-        double ci = v3_dot(s->n, l);
-        double intensity = f->brilliance != 1.0 ? pow(fabs(ci), f->brilliance) : fabs(ci);
-        intensity *= diffuse * s->att;
-        if (f->crand > 0.0) intensity -= rng_f64(s->r) * f->crand;
-        out = rgb_add(out, rgb_scale(rgb_mul(s->pigment, lc), intensity));
-    }
-    if (backside) return out;
-    if (f->phong > 0.0) {
-        vec3 refl = v3_madd(s->eye, s->n, -2.0 * v3_dot(s->eye, s->n));
-        double ca = v3_dot(refl, l);
-        if (ca > 0.0 && (f->phong_size < 60 || ca > 0.0008)) {
-            double intensity = f->phong * pow(ca, f->phong_size);
-            rgb cs = {1, 1, 1};
-            metallic_tint(&cs, f->metallic, s->pigment, v3_dot(s->n, l));
-            out = rgb_add(out, rgb_scale(rgb_mul(lc, cs), intensity));
-        }
-    }
-    if (f->specular > 0.0) {
-        vec3 h = v3_scale(v3_sub(l, s->eye), 0.5);
-        double hl = v3_len(h);
-        if (hl > 0.0) {
-            double ca = v3_dot(h, s->n) / hl;
-            if (ca > 0.0) {
-                /* POV-Ray stores 1/roughness as the exponent. */
-                double rough = f->roughness > 0.0 ? f->roughness : 0.05;
-                double intensity = f->specular * pow(ca, 1.0 / rough);
-                rgb cs = {1, 1, 1};
-                metallic_tint(&cs, f->metallic, s->pigment, v3_dot(h, l) / hl);
-                out = rgb_add(out, rgb_scale(rgb_mul(lc, cs), intensity));
-            }
-        }
-    }
-    return out;
-}
-
-static rgb direct_light(render_ctx *c, int thread, const surface *s, const accel_hit *h, vec3 p, rng *r)
+static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const accel_hit *h, vec3 p, rng *r)
 {
     rgb total = {0, 0, 0};
     int double_illum = (h->obj->flags & OBJ_DOUBLE_ILLUMINATE) != 0;
@@ -327,7 +169,7 @@ static rgb direct_light(render_ctx *c, int thread, const surface *s, const accel
             rgb sample_lc = rgb_scale(l->colour, 1.0 / n);
             for (int v = 0; v < l->size2; v++) {
                 for (int u = 0; u < l->size1; u++) {
-                    vec3 q = v3_add(l->position, area_point(l, l->axis1, l->axis2, u, v, r));
+                    vec3 q = v3_add(l->position, light_area_point(l, l->axis1, l->axis2, u, v, r));
                     vec3 d2;
                     double dep2;
                     light_ray(l, q, p, &d2, &dep2);
@@ -361,19 +203,6 @@ static rgb direct_light(render_ctx *c, int thread, const surface *s, const accel
 
 static rgb background(const scene *sc) { return rgb_make(sc->background.r, sc->background.g, sc->background.b); }
 
-/* Fresnel reflectance for unpolarised light, relative ior n (the standard
- * dielectric formula in the form POV-Ray documents for `fresnel`). */
-static double fresnel_r(double cos_i, double n)
-{
-    double g2 = n * n + cos_i * cos_i - 1.0;
-    if (g2 <= 0.0) return 1.0;
-    double g = sqrt(g2);
-    double q1 = (g - cos_i) / (g + cos_i);
-    double q2 = (cos_i * (g + cos_i) - 1.0) / (cos_i * (g - cos_i) + 1.0);
-    double f = 0.5 * q1 * q1 * (1.0 + q2 * q2);
-    return fmin(1.0, fmax(0.0, f));
-}
-
 /* `skip`: objects with any of these flags are invisible to this ray (no_image
  * for camera rays, no_reflection for reflected rays). */
 static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, rng *r);
@@ -399,7 +228,7 @@ static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, in
     rgb trans_colour = {filt * pig.r + transm, filt * pig.g + transm, filt * pig.b + transm};
     double opacity = 1.0 - fmin(1.0, fmax(0.0, rgb_grey(trans_colour)));
 
-    surface s = {f, pig, n, dir, opacity, r};
+    light_surface s = {f, pig, n, dir, opacity, r};
     rgb col = f->emission;
     if (c->s->use_ambient) col = rgb_add(col, rgb_mul(f->ambient, sc->global.ambient_light));
     col = rgb_scale(rgb_mul(pig, col), opacity);
@@ -420,13 +249,13 @@ static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, in
     if (rgb_max(rmax) > 0.0 || rgb_max(rmin) > 0.0) {
         rgb refl;
         if (f->fresnel) {
-            double fr = fresnel_r(cos_i, rel_ior);
+            double fr = light_fresnel(cos_i, rel_ior);
             refl = rgb_add(rgb_scale(rmax, fr), rgb_scale(rmin, 1.0 - fr));
         } else {
             double frac = fabs(f->reflection_falloff - 1.0) > 1e-10 ? pow(1.0 - cos_i, f->reflection_falloff) : 1.0 - cos_i;
             refl = rgb_add(rgb_scale(rmax, frac), rgb_scale(rmin, 1.0 - frac));
         }
-        metallic_tint(&refl, f->reflection_metallic, pig, cos_i);
+        light_metallic_tint(&refl, f->reflection_metallic, pig, cos_i);
         double w = weight * rgb_max(refl);
         if (w > sc->global.adc_bailout) {
             vec3 rd = v3_madd(dir, n, 2.0 * cos_i);

@@ -1,0 +1,274 @@
+/* shade_light.c - POV-Ray 3.7 light sources and the surface response to them
+ * (moved out of shade.c unchanged), plus a continuous direct-light estimator
+ * for the GI modes. Formulas follow the POV-Ray 3.7 reference manual
+ * ("Light Source", "Finish"); see shade.c's header for the model. */
+#include "shade_light.h"
+#include <math.h>
+#include <stdlib.h>
+
+static inline rgb lrgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
+static inline rgb lrgb_add(rgb a, rgb b) { return lrgb(a.r + b.r, a.g + b.g, a.b + b.b); }
+static inline rgb lrgb_mul(rgb a, rgb b) { return lrgb(a.r * b.r, a.g * b.g, a.b * b.b); }
+static inline rgb lrgb_scale(rgb a, double s) { return lrgb(a.r * s, a.g * s, a.b * s); }
+static inline int lrgb_near_zero(rgb a) { return fabs(a.r) < 1e-10 && fabs(a.g) < 1e-10 && fabs(a.b) < 1e-10; }
+
+double light_cubic_step(double low, double high, double x)
+{
+    if (x <= low) return 0.0;
+    if (x >= high) return 1.0;
+    double t = (x - low) / (high - low);
+    return (3.0 - 2.0 * t) * t * t;
+}
+
+double light_attenuation(const scene_light *l, vec3 p, vec3 dir, double depth)
+{
+    double att = 1.0;
+    if (l->kind == LIGHT_SPOT) {
+        vec3 axis = v3_norm(v3_sub(l->point_at, l->position));
+        double c = -v3_dot(dir, axis);
+        if (c <= 0.0) return 0.0;
+        double cos_radius = cos(l->radius * M_PI / 180.0);
+        double cos_falloff = cos(l->falloff * M_PI / 180.0);
+        att = l->tightness != 0.0 ? pow(c, l->tightness) : 1.0;
+        if (cos_radius > 0.0 && c < cos_radius) att *= light_cubic_step(cos_falloff, cos_radius, c);
+    } else if (l->kind == LIGHT_CYLINDER) {
+        /* radius and falloff are distances from the axis for cylinder lights */
+        vec3 axis = v3_norm(v3_sub(l->point_at, l->position));
+        vec3 v1 = v3_sub(p, l->position);
+        double k = v3_dot(v1, axis);
+        if (k <= 0.0) return 0.0;
+        double len = v3_len(v3_sub(v1, v3_scale(axis, k)));
+        if (len >= l->falloff) return 0.0;
+        double d = 1.0 - len / l->falloff;
+        att = l->tightness != 0.0 ? pow(d, l->tightness) : 1.0;
+        if (l->radius > 0.0 && len > l->radius) att *= light_cubic_step(0.0, 1.0 - l->radius / l->falloff, d);
+    }
+    if (att > 0.0 && l->fade_power > 0.0) {
+        if (fabs(l->fade_distance) >= 1e-10)
+            att *= 2.0 / (1.0 + pow(depth / l->fade_distance, l->fade_power));
+        else
+            att *= pow(depth, -l->fade_power);
+    }
+    return att;
+}
+
+void light_ray(const scene_light *l, vec3 centre, vec3 p, vec3 *dir, double *depth)
+{
+    if (l->kind == LIGHT_CYLINDER) {
+        vec3 d = v3_sub(centre, l->point_at);
+        double dl = v3_len(d);
+        *dir = v3_scale(d, 1.0 / dl);
+        *depth = v3_dot(v3_sub(centre, p), *dir);
+    } else {
+        vec3 d = v3_sub(centre, p);
+        *depth = v3_len(d);
+        *dir = *depth > 0 ? v3_scale(d, 1.0 / *depth) : v3(0, 1, 0);
+    }
+    if (l->parallel || l->kind == LIGHT_PARALLEL) {
+        vec3 axis = v3_norm(v3_sub(centre, l->point_at));
+        double a = v3_dot(axis, *dir);
+        *depth *= a;
+        *dir = axis;
+    }
+}
+
+vec3 light_area_point(const scene_light *l, vec3 ax1, vec3 ax2, int u, int v, rng *r)
+{
+    double ju = u, jv = v;
+    if (l->jitter) {
+        ju += rng_f64(r) - 0.5;
+        jv += rng_f64(r) - 0.5;
+    }
+    if (l->circular && l->size1 > 1 && l->size2 > 1) {
+        ju = ju / (l->size1 - 1) - 0.5 + 0.001;
+        jv = jv / (l->size2 - 1) - 0.5 + 0.001;
+        double sf = fmax(fabs(ju), fabs(jv)) / sqrt(ju * ju + jv * jv);
+        return v3_add(v3_scale(ax1, ju * sf), v3_scale(ax2, jv * sf));
+    }
+    vec3 o = v3(0, 0, 0);
+    if (l->size1 > 1) o = v3_add(o, v3_scale(ax1, ju / (l->size1 - 1) - 0.5));
+    if (l->size2 > 1) o = v3_add(o, v3_scale(ax2, jv / (l->size2 - 1) - 0.5));
+    return o;
+}
+
+void light_area_axes(const scene_light *l, vec3 p, vec3 *ax1, vec3 *ax2)
+{
+    *ax1 = l->axis1;
+    *ax2 = l->axis2;
+    if (l->orient) {
+        vec3 dir;
+        double depth;
+        light_ray(l, l->position, p, &dir, &depth);
+        double len = v3_len(l->axis1);
+        vec3 helper = fabs(fabs(dir.z) - 1.0) < 0.01 ? v3(0, 1, 0) : v3(0, 0, 1);
+        *ax1 = v3_scale(v3_norm(v3_cross(dir, helper)), len);
+        *ax2 = v3_scale(v3_norm(v3_cross(dir, v3_norm(*ax1))), len);
+    }
+}
+
+void light_metallic_tint(rgb *cs, double metallic, rgb pigment, double cos_angle)
+{
+    if (metallic == 0.0) return;
+    double x = fabs(acos(fmax(-1.0, fmin(1.0, cos_angle)))) / (M_PI / 2.0);
+    double f = 0.014567225 / ((x - 1.12) * (x - 1.12)) - 0.011612903;
+    f = fmin(1.0, fmax(0.0, f));
+    double k = metallic * (1.0 - f);
+    cs->r *= 1.0 + k * (pigment.r - 1.0);
+    cs->g *= 1.0 + k * (pigment.g - 1.0);
+    cs->b *= 1.0 + k * (pigment.b - 1.0);
+}
+
+/* The standard dielectric formula in the form POV-Ray documents for `fresnel`. */
+double light_fresnel(double cos_i, double n)
+{
+    double g2 = n * n + cos_i * cos_i - 1.0;
+    if (g2 <= 0.0) return 1.0;
+    double g = sqrt(g2);
+    double q1 = (g - cos_i) / (g + cos_i);
+    double q2 = (cos_i * (g + cos_i) - 1.0) / (cos_i * (g - cos_i) + 1.0);
+    double f = 0.5 * q1 * q1 * (1.0 + q2 * q2);
+    return fmin(1.0, fmax(0.0, f));
+}
+
+rgb light_terms(const light_surface *s, vec3 l, rgb lc, int backside)
+{
+    const scene_finish *f = s->f;
+    rgb out = {0, 0, 0};
+    double diffuse = backside ? f->diffuse_back : f->diffuse;
+    if (diffuse > 0.0) {
+        double ci = v3_dot(s->n, l);
+        double intensity = f->brilliance != 1.0 ? pow(fabs(ci), f->brilliance) : fabs(ci);
+        intensity *= diffuse * s->att;
+        if (f->crand > 0.0) intensity -= rng_f64(s->r) * f->crand;
+        out = lrgb_add(out, lrgb_scale(lrgb_mul(s->pigment, lc), intensity));
+    }
+    if (backside) return out;
+    if (f->phong > 0.0) {
+        vec3 refl = v3_madd(s->eye, s->n, -2.0 * v3_dot(s->eye, s->n));
+        double ca = v3_dot(refl, l);
+        if (ca > 0.0 && (f->phong_size < 60 || ca > 0.0008)) {
+            double intensity = f->phong * pow(ca, f->phong_size);
+            rgb cs = {1, 1, 1};
+            light_metallic_tint(&cs, f->metallic, s->pigment, v3_dot(s->n, l));
+            out = lrgb_add(out, lrgb_scale(lrgb_mul(lc, cs), intensity));
+        }
+    }
+    if (f->specular > 0.0) {
+        vec3 h = v3_scale(v3_sub(l, s->eye), 0.5);
+        double hl = v3_len(h);
+        if (hl > 0.0) {
+            double ca = v3_dot(h, s->n) / hl;
+            if (ca > 0.0) {
+                /* POV-Ray stores 1/roughness as the exponent. */
+                double rough = f->roughness > 0.0 ? f->roughness : 0.05;
+                double intensity = f->specular * pow(ca, 1.0 / rough);
+                rgb cs = {1, 1, 1};
+                light_metallic_tint(&cs, f->metallic, s->pigment, v3_dot(h, l) / hl);
+                out = lrgb_add(out, lrgb_scale(lrgb_mul(lc, cs), intensity));
+            }
+        }
+    }
+    return out;
+}
+
+/* ------------------------------------------------------------ GI direct light */
+
+/* The same test as shade.c's shadow_blocked. */
+static int blocked(const light_ctx *c, vec3 p, vec3 dir, double depth)
+{
+    if (c->shadow_rays) (*c->shadow_rays)++;
+    double tmax = depth - fmax(c->eps, depth * 1e-6);
+    if (tmax <= c->eps) return 0;
+    return accel_occluded(c->a, p, dir, c->eps, tmax);
+}
+
+/* Point of the continuous area light for (u, v) in [0,1)^2: uniform over the
+ * parallelogram spanned by the axes whose grid size exceeds 1, or over the
+ * ellipse inscribed in it for `circular` (POV-Ray applies circular only when
+ * both sizes exceed 1; its square-to-disc mapping of the grid is not
+ * area-preserving, the continuous version is uniform by area). */
+static vec3 area_offset(const scene_light *l, vec3 ax1, vec3 ax2, double u, double v)
+{
+    vec3 e1 = l->size1 > 1 ? ax1 : v3s(0.0), e2 = l->size2 > 1 ? ax2 : v3s(0.0);
+    if (l->circular && l->size1 > 1 && l->size2 > 1) {
+        double rho = 0.5 * sqrt(u), phi = 2.0 * M_PI * v;
+        return v3_add(v3_scale(e1, rho * cos(phi)), v3_scale(e2, rho * sin(phi)));
+    }
+    return v3_add(v3_scale(e1, u - 0.5), v3_scale(e2, v - 0.5));
+}
+
+/* Stratum k of n (k*k grid, the remainder uniformly random). */
+static void stratum(int k, int n, rng *r, double *u, double *v)
+{
+    int g = (int)floor(sqrt((double)n));
+    if (g < 1) g = 1;
+    if (k < g * g) {
+        *u = ((k % g) + rng_f64(r)) / g;
+        *v = ((k / g) + rng_f64(r)) / g;
+    } else {
+        *u = rng_f64(r);
+        *v = rng_f64(r);
+    }
+}
+
+rgb light_nee(const light_ctx *c, const scene_light *l, const light_surface *s, vec3 p, int double_illum,
+              int nsamples, rng *r)
+{
+    rgb zero = {0, 0, 0};
+    if (nsamples < 1) nsamples = 1;
+    vec3 dir;
+    double depth;
+    light_ray(l, l->position, p, &dir, &depth);
+    int full_area = l->area && l->area_illumination && l->size1 * l->size2 > 0;
+    if (full_area) {
+        /* area_illumination: every point of the light shades on its own. */
+        rgb total = zero;
+        for (int k = 0; k < nsamples; k++) {
+            double u, v;
+            stratum(k, nsamples, r, &u, &v);
+            vec3 q = v3_add(l->position, area_offset(l, l->axis1, l->axis2, u, v));
+            vec3 d2;
+            double dep2;
+            light_ray(l, q, p, &d2, &dep2);
+            rgb slc = lrgb_scale(l->colour, light_attenuation(l, p, d2, dep2));
+            int back2 = 0;
+            if (!double_illum && v3_dot(s->n, d2) < 1e-10) {
+                if (s->f->diffuse_back != 0.0) back2 = 1;
+                else continue;
+            }
+            if (!l->shadowless && blocked(c, p, d2, dep2)) continue;
+            total = lrgb_add(total, light_terms(s, d2, slc, back2));
+        }
+        return lrgb_scale(total, 1.0 / nsamples);
+    }
+    rgb lc = lrgb_scale(l->colour, light_attenuation(l, p, dir, depth));
+    if (lrgb_near_zero(lc)) return zero;
+    int backside = 0;
+    if (!double_illum && v3_dot(s->n, dir) < 1e-10) {
+        if (s->f->diffuse_back != 0.0) backside = 1;
+        else return zero;
+    }
+    if (!l->shadowless) {
+        double vis;
+        if (l->area && l->size1 * l->size2 > 1) {
+            vec3 ax1, ax2;
+            light_area_axes(l, p, &ax1, &ax2);
+            int seen = 0;
+            for (int k = 0; k < nsamples; k++) {
+                double u, v;
+                stratum(k, nsamples, r, &u, &v);
+                vec3 q = v3_add(l->position, area_offset(l, ax1, ax2, u, v));
+                vec3 d2;
+                double dep2;
+                light_ray(l, q, p, &d2, &dep2);
+                if (!blocked(c, p, d2, dep2)) seen++;
+            }
+            vis = (double)seen / nsamples;
+        } else {
+            vis = blocked(c, p, dir, depth) ? 0.0 : 1.0;
+        }
+        if (vis <= 0.0) return zero;
+        lc = lrgb_scale(lc, vis);
+    }
+    return light_terms(s, dir, lc, backside);
+}

@@ -1,0 +1,97 @@
+/* shade_light.h - POV-Ray 3.7 light sources and the surface response to
+ * them, shared by the Whitted integrator (shade.c) and the GI modes.
+ *
+ * Units. A light of colour C seen along unit direction l from a point with
+ * (viewer-facing) normal n gives a surface with `diffuse d` and pigment P the
+ * colour d * P * C * cos(n,l)^brilliance * attenuation (POV-Ray 3.7 manual,
+ * "Finish" and "Light Source"). Read physically with brilliance 1, this is a
+ * Lambertian BRDF d*P/pi under an irradiance E = pi * C * att * cos: POV-Ray
+ * lights deliver that irradiance at any distance (no 1/d^2 unless
+ * fade_power says so). The GI modes use exactly these functions, so their
+ * direct light is POV-Ray's.
+ *
+ * What moved here from shade.c (behaviour unchanged): the spotlight falloff
+ * curve, light_attenuation, light_ray, the area-light grid point layout, the
+ * metallic tint, the diffuse/phong/specular terms of one light and the
+ * Fresnel reflectance used by `reflection { fresnel }`. New: light_nee, a
+ * continuous direct-light estimator for the GI modes. */
+#ifndef PT_SHADE_LIGHT_H
+#define PT_SHADE_LIGHT_H
+#include "accel.h"
+#include "rng.h"
+#include "scene.h"
+
+/* POV-Ray's spotlight falloff: 0 below low, 1 above high, (3-2t)t^2 between. */
+double light_cubic_step(double low, double high, double x);
+
+/* Angle- and distance-based attenuation of `l` seen from `p` along unit `dir`
+ * (towards the light) at distance `depth`: spotlight cos^tightness with the
+ * cubic falloff between cos(radius) and cos(falloff), cylinder lights (radius
+ * and falloff are distances from the axis), fade 2/(1+(d/fade_distance)^fade_power)
+ * (or d^-fade_power with fade_distance 0). */
+double light_attenuation(const scene_light *l, vec3 p, vec3 dir, double depth);
+
+/* Unit direction from p towards the light point `centre` (the light's
+ * position or a point of its area) and the distance to it, with POV-Ray's
+ * handling of cylinder and parallel lights (fixed direction, depth measured
+ * along it). */
+void light_ray(const scene_light *l, vec3 centre, vec3 p, vec3 *dir, double *depth);
+
+/* Offset of grid point (u, v) of an area light from its position (POV-Ray's
+ * layout: points span -axis/2 .. +axis/2, an axis with size 1 contributes
+ * nothing; `jitter` moves each by up to half a cell; `circular` maps the
+ * square onto a disc). Uses `r` only when the light jitters. */
+vec3 light_area_point(const scene_light *l, vec3 ax1, vec3 ax2, int u, int v, rng *r);
+
+/* Axes of an area light as seen from p: the light's own, or for `orient`
+ * the same lengths turned to face p (POV-Ray's rule). */
+void light_area_axes(const scene_light *l, vec3 p, vec3 *ax1, vec3 *ax2);
+
+/* POV-Ray's empirical metallic tint of a highlight or reflection colour:
+ * F(x) = 0.014567225/(x-1.12)^2 - 0.011612903 with x = angle/(pi/2). */
+void light_metallic_tint(rgb *cs, double metallic, rgb pigment, double cos_angle);
+
+/* Fresnel reflectance for unpolarised light at relative ior n. */
+double light_fresnel(double cos_i, double n);
+
+/* The surface a light shines on. */
+typedef struct {
+    const scene_finish *f;
+    rgb pigment;
+    vec3 n;       /* shading normal facing the viewer */
+    vec3 eye;     /* incoming (viewing) ray direction, unit */
+    double att;   /* opacity of the layer: 1 - grey(filter*pigment + transmit) */
+    rng *r;       /* for crand */
+} light_surface;
+
+/* Diffuse + phong + specular response to a light of colour `lc` arriving
+ * along unit `l` (towards the light); `backside` uses diffuse_back and no
+ * highlights. */
+rgb light_terms(const light_surface *s, vec3 l, rgb lc, int backside);
+
+/* ------------------------------------------------------------ GI direct light */
+
+/* Everything light_nee needs besides the light. */
+typedef struct {
+    const accel *a;
+    double eps;          /* scene distance epsilon (shade.c's: accel_scale * 1e-6) */
+    long *shadow_rays;   /* incremented per shadow ray; may be NULL */
+} light_ctx;
+
+/* Direct light from one POV-Ray light source at the surface point p (already
+ * offset off the surface on the viewer's side), estimated with `nsamples`
+ * shadow rays for area lights (1 for the others). Same terms and
+ * attenuation as shade.c's direct light, with one difference: an area light
+ * is sampled continuously (stratified, nsamples = k*k strata, uniform over
+ * the parallelogram axis1 x axis2, or the ellipse inside it when `circular`)
+ * instead of POV-Ray's jittered size1 x size2 grid with adaptive
+ * subdivision; an axis whose size is 1 has no extent, as in the grid. The
+ * intensity (spot, fade, cosine) comes from the light's centre unless
+ * area_illumination is on, as in shade.c. `double_illum` is the object's
+ * double_illuminate flag. Shadows: accel_occluded (no_shadow objects do not
+ * block; every other object is opaque, as in shade.c). Unbiased for the
+ * continuous light. */
+rgb light_nee(const light_ctx *c, const scene_light *l, const light_surface *s, vec3 p, int double_illum,
+              int nsamples, rng *r);
+
+#endif

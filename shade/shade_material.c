@@ -1,0 +1,233 @@
+/* shade_material.c - POV-Ray finish -> BSDF + emission (model in the header).
+ *
+ * Photon weight through refraction (used by mat_scatter.eta2). Camera-side
+ * transport is L(x, wo) = kt L(y, T(wo)), T the refraction map (no radiance
+ * scaling, as shade.c). As a BSDF: f(wi, wo) = kt delta(wi - T(wo)) / |cos wi|.
+ * A particle carrying flux uses the adjoint: arriving along wi it leaves along
+ * wo = T^-1(wi) with weight  int f(wi, wo) |cos wo| dwo
+ *   = kt |cos wo| / |cos wi| * |dwo/dwi| = kt * eta_i^2 / eta_t^2,
+ * by Snell's law in the form eta_i^2 cos_i dw_i = eta_t^2 cos_t dw_t (the
+ * radiance-invariance relation, Veach 1997, ch. 5). So entering glass of ior
+ * 1.5 a photon keeps 1/2.25 of kt, leaving it gets 2.25: a round trip is kt^2,
+ * and surfaces inside a medium receive what the camera-side transport sees. */
+#include "shade_material.h"
+#include <math.h>
+#include <string.h>
+
+static inline rgb mrgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
+static inline rgb mrgb_scale(rgb a, double s) { return mrgb(a.r * s, a.g * s, a.b * s); }
+static inline double mrgb_max(rgb a) { return fmax(a.r, fmax(a.g, a.b)); }
+/* POV-Ray's greyscale weights (0.297, 0.589, 0.114), as shade.c. */
+static inline double mrgb_grey(rgb a) { return 0.297 * a.r + 0.589 * a.g + 0.114 * a.b; }
+
+static rgb texture_pigment(const scene_texture *tex, double *filt, double *transm, int *unsupported)
+{
+    const scene_pigment *pg = &tex->pigment;
+    if (unsupported) *unsupported = pg->kind != PIGMENT_SOLID;
+    *filt = pg->colour.f;
+    *transm = pg->colour.t;
+    return mrgb(pg->colour.r, pg->colour.g, pg->colour.b);
+}
+
+static double opacity_of(rgb pig, double filt, double transm)
+{
+    rgb tc = {filt * pig.r + transm, filt * pig.g + transm, filt * pig.b + transm};
+    return 1.0 - fmin(1.0, fmax(0.0, mrgb_grey(tc)));
+}
+
+rgb mat_texture_emission(const scene *sc, const scene_texture *tex)
+{
+    if (!tex) tex = &sc->default_texture;
+    double filt, transm;
+    rgb pig = texture_pigment(tex, &filt, &transm, NULL);
+    double op = opacity_of(pig, filt, transm);
+    const scene_finish *f = &tex->finish;
+    rgb e = f->emission;
+    if (sc->global.radiosity.enabled) {
+        rgb al = sc->global.ambient_light;
+        e.r += f->ambient.r * al.r;
+        e.g += f->ambient.g * al.g;
+        e.b += f->ambient.b * al.b;
+    }
+    return mrgb(pig.r * e.r * op, pig.g * e.g * op, pig.b * e.b * op);
+}
+
+void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r)
+{
+    memset(b, 0, sizeof *b);
+    const scene_texture *tex = h->texture ? h->texture : &sc->default_texture;
+    const scene_finish *f = &tex->finish;
+    double filt, transm;
+    rgb pig = texture_pigment(tex, &filt, &transm, &b->unsupported);
+    b->tex = tex;
+    b->pigment = pig;
+    b->dir = dir;
+    b->p = h->p;
+
+    /* Normals face the viewer (shade.c's rule). */
+    vec3 ng = h->ng, n = h->ns;
+    b->entering = v3_dot(dir, ng) < 0.0;
+    if (v3_dot(dir, n) > 0.0) n = v3_neg(n);
+    if (!b->entering) ng = v3_neg(ng);
+    b->n = n;
+    b->ng = ng;
+    b->p_out = v3_madd(h->p, ng, eps);
+    b->p_in = v3_madd(h->p, ng, -eps);
+
+    rgb tc = {filt * pig.r + transm, filt * pig.g + transm, filt * pig.b + transm};
+    double opacity = 1.0 - fmin(1.0, fmax(0.0, mrgb_grey(tc)));
+    b->opacity = opacity;
+    b->emission = mat_texture_emission(sc, tex);
+    b->double_illum = (h->obj && (h->obj->flags & OBJ_DOUBLE_ILLUMINATE)) || (h->flags & OBJ_DOUBLE_ILLUMINATE);
+
+    double kd = f->diffuse * opacity;
+    double kb = (b->double_illum ? f->diffuse : f->diffuse_back) * opacity;
+    b->k[MAT_LOBE_DIFFUSE] = mrgb_scale(pig, kd);
+    b->k[MAT_LOBE_BACK] = mrgb_scale(pig, kb);
+    b->nee = f->diffuse != 0.0 || f->diffuse_back != 0.0 || f->phong != 0.0 || f->specular != 0.0;
+
+    double cos_i = -v3_dot(dir, n);
+    const scene_interior *in = h->obj ? h->obj->interior : NULL;
+    double rel_ior = 1.0;
+    if (in && in->ior > 0.0) rel_ior = b->entering ? in->ior : 1.0 / in->ior;
+    b->refl_dir = v3_madd(dir, n, 2.0 * cos_i);
+    b->eta2 = 1.0;
+
+    /* Reflection (shade.c: falloff blend or fresnel, metallic tint). */
+    rgb rmax = f->reflection_max, rmin = f->reflection_min;
+    rgb refl = {0, 0, 0};
+    if (mrgb_max(rmax) > 0.0 || mrgb_max(rmin) > 0.0) {
+        if (f->fresnel) {
+            double fr = light_fresnel(cos_i, rel_ior);
+            refl = mrgb(rmax.r * fr + rmin.r * (1.0 - fr), rmax.g * fr + rmin.g * (1.0 - fr),
+                        rmax.b * fr + rmin.b * (1.0 - fr));
+        } else {
+            double frac = fabs(f->reflection_falloff - 1.0) > 1e-10 ? pow(1.0 - cos_i, f->reflection_falloff) : 1.0 - cos_i;
+            refl = mrgb(rmax.r * frac + rmin.r * (1.0 - frac), rmax.g * frac + rmin.g * (1.0 - frac),
+                        rmax.b * frac + rmin.b * (1.0 - frac));
+        }
+        light_metallic_tint(&refl, f->reflection_metallic, pig, cos_i);
+    }
+    /* Transmission: straight through, or refracted when an ior is given. */
+    rgb trans = {0, 0, 0};
+    if (mrgb_max(tc) > 0.0) {
+        trans = tc;
+        b->trans_dir = dir;
+        if (fabs(rel_ior - 1.0) > 1e-9) {
+            double eta = 1.0 / rel_ior;
+            double k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+            if (k < 0.0) {
+                /* total internal reflection: the transmitted part reflects */
+                refl = mrgb(refl.r + trans.r, refl.g + trans.g, refl.b + trans.b);
+                trans = mrgb(0, 0, 0);
+            } else {
+                b->trans_dir = v3_norm(v3_add(v3_scale(dir, eta), v3_scale(n, eta * cos_i - sqrt(k))));
+                b->eta2 = eta * eta;
+            }
+        }
+    }
+    b->k[MAT_LOBE_REFLECT] = refl;
+    b->k[MAT_LOBE_TRANSMIT] = trans;
+    b->msum = 0.0;
+    for (int i = 0; i < MAT_NLOBES; i++) {
+        double m = mrgb_max(b->k[i]);
+        b->m[i] = m > 0.0 && isfinite(m) ? m : 0.0;
+        b->msum += b->m[i];
+    }
+    light_surface ls = {f, pig, n, dir, opacity, r};
+    b->ls = ls;
+}
+
+rgb mat_eval(const mat_bsdf *b, vec3 wi)
+{
+    double cn = v3_dot(wi, b->n), cg = v3_dot(wi, b->ng);
+    if (cn > 0.0 && cg > 0.0) return mrgb_scale(b->k[MAT_LOBE_DIFFUSE], 1.0 / M_PI);
+    if (cn < 0.0 && cg < 0.0) return mrgb_scale(b->k[MAT_LOBE_BACK], 1.0 / M_PI);
+    return mrgb(0, 0, 0);
+}
+
+double mat_pdf(const mat_bsdf *b, vec3 wi)
+{
+    if (!(b->msum > 0.0)) return 0.0;
+    double cn = v3_dot(wi, b->n), cg = v3_dot(wi, b->ng);
+    if (cn > 0.0 && cg > 0.0) return b->m[MAT_LOBE_DIFFUSE] / b->msum * cn / M_PI;
+    if (cn < 0.0 && cg < 0.0) return b->m[MAT_LOBE_BACK] / b->msum * -cn / M_PI;
+    return 0.0;
+}
+
+vec3 mat_cosine_dir(vec3 n, double u1, double u2)
+{
+    double r = sqrt(u1), phi = 2.0 * M_PI * u2;
+    double x = r * cos(phi), y = r * sin(phi), z = sqrt(fmax(0.0, 1.0 - u1));
+    vec3 t, bt;
+    v3_basis(n, &t, &bt);
+    return v3_add(v3_add(v3_scale(t, x), v3_scale(bt, y)), v3_scale(n, z));
+}
+
+int mat_sample_lobe(const mat_bsdf *b, double u_lobe, double u1, double u2, int absorb, mat_scatter *s)
+{
+    memset(s, 0, sizeof *s);
+    s->eta2 = 1.0;
+    if (!(b->msum > 0.0)) return 0;
+    double scale = absorb ? (b->msum > 1.0 ? 1.0 / b->msum : 1.0) : 1.0 / b->msum;
+    int lobe = -1;
+    double acc = 0.0, p = 0.0;
+    for (int i = 0; i < MAT_NLOBES; i++) {
+        if (b->m[i] <= 0.0) continue;
+        acc += b->m[i] * scale;
+        if (u_lobe < acc) {
+            lobe = i;
+            p = b->m[i] * scale;
+            break;
+        }
+    }
+    if (lobe < 0) {
+        if (absorb) return 0;
+        /* rounding at the top end: take the last non-empty lobe */
+        for (int i = MAT_NLOBES - 1; i >= 0; i--)
+            if (b->m[i] > 0.0) { lobe = i; p = b->m[i] * scale; break; }
+        if (lobe < 0) return 0;
+    }
+    s->lobe = lobe;
+    s->weight = mrgb_scale(b->k[lobe], 1.0 / p);
+    switch (lobe) {
+    case MAT_LOBE_DIFFUSE:
+        s->dir = mat_cosine_dir(b->n, u1, u2);
+        if (v3_dot(s->dir, b->ng) <= 0.0) return 0;
+        s->org = b->p_out;
+        s->pdf = p * v3_dot(s->dir, b->n) / M_PI;
+        break;
+    case MAT_LOBE_BACK:
+        s->dir = mat_cosine_dir(v3_neg(b->n), u1, u2);
+        if (v3_dot(s->dir, b->ng) >= 0.0) return 0;
+        s->org = b->p_in;
+        s->pdf = p * -v3_dot(s->dir, b->n) / M_PI;
+        break;
+    case MAT_LOBE_REFLECT:
+        s->dir = b->refl_dir;
+        s->org = b->p_out;
+        s->specular = 1;
+        break;
+    default:
+        s->dir = b->trans_dir;
+        s->org = b->p_in;
+        s->specular = 1;
+        s->eta2 = b->eta2;
+        break;
+    }
+    if (!(s->pdf > 0.0) && !s->specular) return 0;
+    return 1;
+}
+
+int mat_sample(const mat_bsdf *b, rng *r, int absorb, mat_scatter *s)
+{
+    double ul = rng_f64(r), u1 = rng_f64(r), u2 = rng_f64(r);
+    return mat_sample_lobe(b, ul, u1, u2, absorb, s);
+}
+
+rgb mat_light_nee(const mat_bsdf *b, const light_ctx *c, const scene_light *l, int nsamples, rng *r)
+{
+    light_surface ls = b->ls;
+    ls.r = r;
+    return light_nee(c, l, &ls, b->p_out, b->double_illum, nsamples, r);
+}

@@ -1,0 +1,115 @@
+/* shade_material.h - the light-transport model every GI mode converges to:
+ * a POV-Ray finish read as a BSDF, plus emission. One piece of code for the
+ * path tracer, the photon mapper and (later) the particle GI.
+ *
+ * At a hit seen along unit `dir` (n = shading normal turned towards the
+ * viewer, opacity = 1 - grey(filter*pigment + transmit) as in shade.c):
+ *
+ *   f(wi) = kd/pi   for wi on the viewer's side    kd = diffuse * opacity * pigment
+ *         + kb/pi   for wi on the other side        kb = diffuse_back * opacity * pigment
+ *                                                        (diffuse for double_illuminate)
+ *         + kr * delta(mirror direction)            kr = reflection colour with fresnel or
+ *                                                        falloff and metallic tint, as shade.c
+ *         + kt * delta(refracted direction)         kt = filter * pigment + transmit (per
+ *                                                        channel), ior from the interior;
+ *                                                        total internal reflection adds kt to
+ *                                                        the mirror direction, as shade.c
+ *   Le      = pigment * opacity * (emission + ambient * ambient_light [radiosity{} only])
+ *
+ * Lambertian terms ignore brilliance and crand (they are POV-Ray's shaping
+ * of direct light only). Phong and specular highlights are not part of f:
+ * they are not energy-conserving and are added for light arriving straight
+ * from light sources only, by light_terms/light_nee (shade_light.h), exactly
+ * as shade.c computes them; so `--gi none` (with ambient 0 or radiosity on)
+ * is the direct part (first vertex) of the path tracer. Emission is the same
+ * on both sides of a surface (POV-Ray turns normals towards the viewer).
+ * The `ambient` rule is DESIGN.md's: with radiosity{} on, ambient makes a
+ * surface a light source for GI (the Cornell example's light patch is
+ * `ambient 0.78`). POV-Ray 3.7 itself ignores ambient when radiosity is on
+ * in #version 3.7 scenes and uses `emission` only; without radiosity{} the
+ * GI modes drop ambient (the GI replaces that constant term).
+ * reflection_exponent and conserve_energy are not modelled (the exponent is
+ * non-linear in the reflected radiance); interior fade (absorption) neither,
+ * as in shade.c. The weights need not sum to 1 (POV-Ray finishes are not
+ * energy-conserving); estimators stay unbiased, Russian roulette bounds the
+ * cost.
+ *
+ * Radiance through refraction is not scaled by the squared ior ratio (shade.c
+ * does not); the adjoint rule for particles carrying flux (photons) is then a
+ * factor (eta_i/eta_t)^2 per refraction, given in mat_scatter.eta2 (derivation
+ * in shade_material.c). */
+#ifndef PT_SHADE_MATERIAL_H
+#define PT_SHADE_MATERIAL_H
+#include "accel.h"
+#include "rng.h"
+#include "scene.h"
+#include "shade_light.h"
+
+enum { MAT_LOBE_DIFFUSE = 0, MAT_LOBE_BACK = 1, MAT_LOBE_REFLECT = 2, MAT_LOBE_TRANSMIT = 3, MAT_NLOBES = 4 };
+
+typedef struct {
+    const scene_texture *tex;
+    rgb pigment;
+    double opacity;
+    vec3 p;            /* hit point */
+    vec3 p_out;        /* p moved off the surface towards the viewer (eps along ng) */
+    vec3 p_in;         /* p moved off the surface away from the viewer */
+    vec3 dir;          /* incoming ray direction, unit */
+    vec3 n;            /* shading normal facing the viewer */
+    vec3 ng;           /* geometric normal facing the viewer */
+    int entering;      /* the ray hits the outside (geometric normal against it) */
+    rgb emission;      /* Le */
+    rgb k[MAT_NLOBES]; /* kd, kb, kr, kt */
+    vec3 refl_dir, trans_dir;
+    double eta2;       /* (eta_i/eta_t)^2 of the refraction, 1 without */
+    double m[MAT_NLOBES]; /* lobe sizes: max channel of k (>= 0) */
+    double msum;
+    int nee;           /* direct light applies (diffuse, diffuse_back, phong or specular) */
+    int double_illum;
+    int unsupported;   /* a pigment pattern the shader cannot evaluate (its colour is used) */
+    light_surface ls;  /* for light_terms / light_nee */
+} mat_bsdf;
+
+typedef struct {
+    vec3 org, dir;     /* continuation ray (origin off the right side of the surface) */
+    rgb weight;        /* f cos / pdf: the throughput multiplier (incl. selection probability) */
+    double pdf;        /* solid-angle density for diffuse lobes (for MIS), 0 for the delta lobes */
+    int lobe;
+    int specular;      /* a delta lobe */
+    double eta2;       /* photons: multiply flux by this as well (refraction), else 1 */
+} mat_scatter;
+
+/* Emission Le of a texture (both sides), under the scene's rules above. */
+rgb mat_texture_emission(const scene *sc, const scene_texture *tex);
+
+/* Set up the BSDF at hit `h` for a ray of unit direction `dir`. `eps` is the
+ * distance the origins are moved off the surface (shade.c's rule: accel_scale
+ * * 1e-6). `r` feeds crand in light_terms. */
+void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r);
+
+/* Lambertian part of f (no cosine) for unit wi (towards where light comes
+ * from); 0 where wi and the geometric normal disagree about the side. */
+rgb mat_eval(const mat_bsdf *b, vec3 wi);
+
+/* Density with which mat_sample(absorb = 0) picks the direction wi (solid
+ * angle; delta lobes excluded). */
+double mat_pdf(const mat_bsdf *b, vec3 wi);
+
+/* Sample a lobe and a direction. absorb = 0: a lobe is always chosen, with
+ * probability m_k / sum m (path tracer; Russian roulette is separate).
+ * absorb = 1: probability m_k (scaled down when sum m > 1), else the particle
+ * is absorbed (photon Russian roulette, seed 002 appendix A step 2(b)-(d),
+ * with the max channel as scatter probability so powers never grow).
+ * Returns 0 when nothing is sampled (absorbed, black, or a diffuse direction
+ * that the shading normal allows but the geometric normal does not). */
+int mat_sample_lobe(const mat_bsdf *b, double u_lobe, double u1, double u2, int absorb, mat_scatter *s);
+int mat_sample(const mat_bsdf *b, rng *r, int absorb, mat_scatter *s);
+
+/* Cosine-weighted direction about unit n for (u1, u2) in [0,1)^2 (Malley:
+ * uniform on the disc, projected up); pdf cos/pi. */
+vec3 mat_cosine_dir(vec3 n, double u1, double u2);
+
+/* Direct light of one POV-Ray light at the hit (light_nee at p_out). */
+rgb mat_light_nee(const mat_bsdf *b, const light_ctx *c, const scene_light *l, int nsamples, rng *r);
+
+#endif
