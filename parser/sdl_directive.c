@@ -219,6 +219,10 @@ void sdl_close_inputs(sdl_parser *p)
 
 static sdl_cond *push_cond(sdl_parser *p, sdl_cond_kind kind, src_loc loc)
 {
+    if (p->nconds >= SDL_MAX_CONDITIONALS) {
+        sdl_error(p, loc, PT_ERR_LIMIT, "more than %d nested conditionals and macro calls", SDL_MAX_CONDITIONALS);
+        return NULL;
+    }
     if (p->nconds == p->cap_conds) {
         int nc = p->cap_conds ? p->cap_conds * 2 : 32;
         sdl_cond *n = realloc(p->conds, sizeof *n * (size_t)nc);
@@ -867,17 +871,20 @@ static void macro_directive(sdl_parser *p, src_loc loc)
 static void macro_call(sdl_parser *p, const sdl_tok *id)
 {
     const sdl_macro *m = id->val.ptr;
-    sdl_value args[64];
+    sdl_value *args = sdl_alloc(p, sizeof(sdl_value) * 64);
     int n = 0;
+    if (!args) return;
     if (!sdl_expect(p, TOK_LPAREN, "'(' after the macro name")) return;
+    if (!sdl_enter(p, id->tk.loc)) return;
     while (sdl_ok(p) && !sdl_accept(p, TOK_RPAREN)) {
         if (n == 64) {
             sdl_error(p, id->tk.loc, PT_ERR_LIMIT, "too many macro arguments");
-            return;
+            break;
         }
         sdl_rvalue(p, &args[n++]);
         if (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RPAREN)) sdl_expect(p, TOK_COMMA, "',' or ')'");
     }
+    sdl_leave(p);
     if (!sdl_ok(p)) return;
     if (n != m->nparams) {
         sdl_error(p, id->tk.loc, PT_ERR_SYNTAX, "macro %s expects %d argument%s, %d given", m->name, m->nparams, m->nparams == 1 ? "" : "s", n);
@@ -895,7 +902,16 @@ static void macro_call(sdl_parser *p, const sdl_tok *id)
 }
 
 /* directive := '#' directive_keyword ... */
+static void directive_body(sdl_parser *p, const sdl_token *hash);
+
 static void directive(sdl_parser *p, const sdl_token *hash)
+{
+    if (!sdl_enter(p, hash->loc)) return;
+    directive_body(p, hash);
+    sdl_leave(p);
+}
+
+static void directive_body(sdl_parser *p, const sdl_token *hash)
 {
     sdl_token k = sdl_scan_next(&top_frame(p)->sc);
     src_loc loc = hash->loc;

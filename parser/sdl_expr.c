@@ -572,10 +572,13 @@ static void primary_inner(sdl_parser *p, ex_val *out)
  * look-ahead defers them (POV-Ray: Ok_To_Declare within Parse_Num_Factor). */
 static void primary(sdl_parser *p, ex_val *out)
 {
+    ex_float(out, 0);
+    if (!sdl_enter(p, p->last.tk.loc)) return;
     int saved = p->defer;
     p->defer = 0;
     primary_inner(p, out);
     p->defer = saved;
+    sdl_leave(p);
 }
 
 /* component := x | y | z | u | v | t | red | green | blue | filter | transmit | gray */
@@ -735,9 +738,11 @@ static void expression(sdl_parser *p, ex_val *out)
     if (!sdl_ok(p) || !sdl_accept(p, TOK_QUESTION)) return;
     double c = want_float(p, out, loc);
     ex_val a, b;
+    if (!sdl_enter(p, loc)) return;
     expression(p, &a);
     sdl_expect(p, TOK_COLON, "':'");
     expression(p, &b);
+    sdl_leave(p);
     *out = sdl_true(c) ? a : b;
 }
 

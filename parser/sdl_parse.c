@@ -77,6 +77,16 @@ void sdl_unexpected(sdl_parser *p, const sdl_tok *t, const char *expected)
     sdl_error(p, t->tk.loc, PT_ERR_SYNTAX, "expected %s, found %s", expected, sdl_tok_describe(&t->tk, what, sizeof what));
 }
 
+int sdl_enter(sdl_parser *p, src_loc loc)
+{
+    if (p->depth >= SDL_MAX_NESTING) {
+        sdl_error(p, loc, PT_ERR_LIMIT, "expressions, directives or macro calls nested more than %d deep", SDL_MAX_NESTING);
+        return 0;
+    }
+    p->depth++;
+    return 1;
+}
+
 /* ------------------------------------------------------------ tokens */
 
 int sdl_is(const sdl_tok *t, sdl_tok_kind k) { return t->tk.kind == k; }
@@ -106,6 +116,10 @@ int sdl_expect(sdl_parser *p, sdl_tok_kind k, const char *what)
 
 int sdl_begin_block(sdl_parser *p, const char *name)
 {
+    if (p->nblocks >= SDL_MAX_NESTING) {
+        sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_LIMIT, "blocks nested more than %d deep", SDL_MAX_NESTING);
+        return 0;
+    }
     sdl_tok t = sdl_next(p);
     if (t.tk.kind != TOK_LBRACE) {
         char what[96];
@@ -183,6 +197,10 @@ void sdl_skip_item(sdl_parser *p)
 
 void *sdl_alloc(sdl_parser *p, size_t n)
 {
+    if (arena_bytes(p->s->mem) + n > SDL_MAX_SCENE_BYTES) {
+        if (sdl_ok(p)) sdl_error(p, p->last.tk.loc, PT_ERR_LIMIT, "scene needs more than %d GiB", (int)(SDL_MAX_SCENE_BYTES >> 30));
+        return NULL;
+    }
     void *m = arena_alloc(p->s->mem, n ? n : 1);
     if (!m && sdl_ok(p)) {
         src_loc none = {NULL, 0, 0};

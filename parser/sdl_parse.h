@@ -12,6 +12,11 @@
 #include "sdl_scan.h"
 #include "sdl_symtab.h"
 
+/* Limits that keep bad input from exhausting the stack or memory. */
+#define SDL_MAX_NESTING 1000                 /* nested blocks, nested expressions */
+#define SDL_MAX_CONDITIONALS 100000          /* open #if/#while/... and macro calls */
+#define SDL_MAX_SCENE_BYTES ((size_t)4 << 30) /* scene arena */
+
 /* A token as the grammar sees it: identifiers carry their value as it was
  * when the token was read (VAL_NONE: undeclared). */
 typedef struct {
@@ -105,11 +110,17 @@ typedef struct sdl_parser {
                              returned as a token and runs when read again (the
                              look-ahead past the end of a #declare) */
     int macro_depth;
+    int depth;            /* C recursion through expressions, directives and
+                             macro arguments (bounded by SDL_MAX_NESTING) */
     int include_depth;
     double version;       /* language version from #version, 3.7 by default */
     int default_texture_set;
     sdl_tok last;         /* last token returned (for end-of-file locations) */
 } sdl_parser;
+
+/* --- recursion guard: 0 (with an error recorded) when nested too deep --- */
+int sdl_enter(sdl_parser *p, src_loc loc);
+static inline void sdl_leave(sdl_parser *p) { p->depth--; }
 
 /* --- errors and warnings (sdl_parse.c) --- */
 static inline int sdl_ok(const sdl_parser *p) { return p->status == PT_OK; }
