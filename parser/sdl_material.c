@@ -62,7 +62,7 @@ static xform transform_block(sdl_parser *p)
             sdl_tok id = sdl_next(p);
             x = xform_then(x, *(const xform *)id.val.ptr);
         } else if (sdl_accept_kw(p, KW_INVERSE)) {
-            inverse = !inverse;
+            inverse = 1; /* inverts the whole block, wherever it is written */
         } else if (sdl_transform_item(p, &item)) {
             x = xform_then(x, item);
         } else {
@@ -190,13 +190,16 @@ static void pattern_token(sdl_parser *p, scene_pigment *pg, int *have)
 }
 
 /* pigment_item := colour | pattern { pattern argument } | colour_map |
- *                 transform_item | pigment modifier */
+ *                 transform_item | quick_color colour | pigment modifier */
 static void pigment_item(sdl_parser *p, scene_pigment *pg, int *have_colour)
 {
     const sdl_tok *t = sdl_peek(p);
     xform x;
     if (sdl_transform_item(p, &x)) {
         pg->transform = xform_then(pg->transform, x);
+    } else if (sdl_is_kw(t, KW_QUICK_COLOR) || sdl_is_kw(t, KW_QUICK_COLOUR)) {
+        sdl_next(p);
+        sdl_colour(p, 1); /* a preview colour: not the pigment's colour */
     } else if (pg->kind == PIGMENT_SOLID && sdl_starts_colour(t)) {
         pg->colour = sdl_colour(p, 1);
         *have_colour = 1;
