@@ -268,7 +268,7 @@ void sdl_check_closed(sdl_parser *p)
 {
     if (!sdl_ok(p) || p->nconds == 0) return;
     sdl_cond *c = &p->conds[p->nconds - 1];
-    unterminated_cond(p, p->last.tk.loc, cond_name(c->kind), c->loc);
+    unterminated_cond(p, p->last_loc, cond_name(c->kind), c->loc);
 }
 
 static int opens_block(sdl_kw k)
@@ -997,7 +997,7 @@ static sdl_tok eof_token(const sdl_parser *p)
     sdl_tok t;
     memset(&t, 0, sizeof t);
     t.tk.kind = TOK_EOF;
-    t.tk.loc = p->last.tk.loc;
+    t.tk.loc = p->last_loc;
     return t;
 }
 
@@ -1006,7 +1006,7 @@ sdl_tok sdl_next(sdl_parser *p)
     for (;;) {
         if (!sdl_ok(p) || p->nframes == 0) return eof_token(p);
         sdl_tok t;
-        memset(&t, 0, sizeof t);
+        t.val.kind = VAL_NONE;
         if (p->nahead > 0) {
             t = p->ahead[--p->nahead];
             if (t.tk.kind == TOK_HASH && p->defer == 0) {
@@ -1017,7 +1017,8 @@ sdl_tok sdl_next(sdl_parser *p)
                 macro_call(p, &t);
                 continue;
             }
-            return p->last = t;
+            p->last_loc = t.tk.loc;
+            return t;
         }
         t.tk = sdl_scan_next(&top_frame(p)->sc);
         if (t.tk.kind == TOK_ERROR) {
@@ -1027,14 +1028,18 @@ sdl_tok sdl_next(sdl_parser *p)
         if (t.tk.kind == TOK_EOF) {
             if (end_of_input(p, &t.tk)) continue;
             if (!sdl_ok(p)) continue;
-            return p->last = t;
+            p->last_loc = t.tk.loc;
+            return t;
         }
         if (t.tk.kind == TOK_HASH) {
             if (p->defer > 0 && macro_end_ahead(p)) {
                 return_from_macro(p);
                 continue;
             }
-            if (p->defer > 0) return p->last = t;
+            if (p->defer > 0) {
+                p->last_loc = t.tk.loc;
+                return t;
+            }
             directive(p, &t.tk);
             continue;
         }
@@ -1046,7 +1051,8 @@ sdl_tok sdl_next(sdl_parser *p)
                 continue;
             }
         }
-        return p->last = t;
+        p->last_loc = t.tk.loc;
+        return t;
     }
 }
 

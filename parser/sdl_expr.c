@@ -573,7 +573,7 @@ static void primary_inner(sdl_parser *p, ex_val *out)
 static void primary(sdl_parser *p, ex_val *out)
 {
     ex_float(out, 0);
-    if (!sdl_enter(p, p->last.tk.loc)) return;
+    if (!sdl_enter(p, p->last_loc)) return;
     int saved = p->defer;
     p->defer = 0;
     primary_inner(p, out);

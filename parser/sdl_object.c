@@ -498,7 +498,7 @@ static int reserve_tri(mesh_build *b)
 static int add_tri(sdl_parser *p, mesh_build *b, const int v[3], const int n[3], int tex)
 {
     if (!reserve_tri(b)) {
-        sdl_error(p, p->last.tk.loc, PT_ERR_NOMEM, "out of memory");
+        sdl_error(p, p->last_loc, PT_ERR_NOMEM, "out of memory");
         return 0;
     }
     memcpy(b->tri[b->nt], v, sizeof b->tri[0]);

@@ -198,7 +198,7 @@ void sdl_skip_item(sdl_parser *p)
 void *sdl_alloc(sdl_parser *p, size_t n)
 {
     if (arena_bytes(p->s->mem) + n > SDL_MAX_SCENE_BYTES) {
-        if (sdl_ok(p)) sdl_error(p, p->last.tk.loc, PT_ERR_LIMIT, "scene needs more than %d GiB", (int)(SDL_MAX_SCENE_BYTES >> 30));
+        if (sdl_ok(p)) sdl_error(p, p->last_loc, PT_ERR_LIMIT, "scene needs more than %d GiB", (int)(SDL_MAX_SCENE_BYTES >> 30));
         return NULL;
     }
     void *m = arena_alloc(p->s->mem, n ? n : 1);

@@ -115,7 +115,7 @@ typedef struct sdl_parser {
     int include_depth;
     double version;       /* language version from #version, 3.7 by default */
     int default_texture_set;
-    sdl_tok last;         /* last token returned (for end-of-file locations) */
+    src_loc last_loc;     /* last token returned (for end-of-file locations) */
 } sdl_parser;
 
 /* --- recursion guard: 0 (with an error recorded) when nested too deep --- */
