@@ -325,6 +325,12 @@ static pt_status run(const char *name, const char *text, const sdl_options *opt,
 
 pt_status sdl_parse_file(const char *path, const sdl_options *opt, scene **out, diag *d)
 {
+    if (!path) {
+        src_loc none = {NULL, 0, 0};
+        *out = NULL;
+        diag_report(d, DIAG_ERROR, none, NULL, "no scene file given");
+        return PT_ERR_IO;
+    }
     return run(path, NULL, opt, out, d);
 }
 

@@ -47,6 +47,7 @@ void sdl_scan_init(sdl_scanner *s, const char *file, const char *text, size_t le
     s->at.pos = 0;
     s->at.line = 1;
     s->at.col = 1;
+    if (len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0) s->at.pos = 3; /* UTF-8 byte order mark */
 }
 
 sdl_scan_pos sdl_scan_tell(const sdl_scanner *s) { return s->at; }

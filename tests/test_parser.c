@@ -755,6 +755,12 @@ static void test_error_unterminated(void **st)
     e = parse_err("#declare S = \"abc\n", PT_ERR_SYNTAX);
     assert_string_equal(e, "test.pov:1:14: error: unterminated string");
     free(e);
+    scene *s = parse_ok("\xEF\xBB\xBFsphere { 0, 1 }\r\n// CRLF and a byte order mark\r\n");
+    assert_int_equal(s->objects[0]->loc.col, 1);
+    scene_free(s);
+    e = parse_err("sphere { 0, 1 }\r\n\r\n  @", PT_ERR_SYNTAX);
+    assert_string_equal(e, "test.pov:3:3: error: unexpected character '@'");
+    free(e);
     e = parse_err("sphere { 0, 1 } }", PT_ERR_SYNTAX);
     assert_prefix(e, "test.pov:1:17: error: expected object");
     free(e);
