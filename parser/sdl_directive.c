@@ -1001,58 +1001,72 @@ static sdl_tok eof_token(const sdl_parser *p)
     return t;
 }
 
+/* A pushed-back token: a deferred '#' or macro name runs now unless
+ * look-ahead is still deferring. Returns 1 if t is to be returned. */
+static int resume_token(sdl_parser *p, sdl_tok *t)
+{
+    if (t->tk.kind == TOK_HASH && p->defer == 0) {
+        directive(p, &t->tk);
+        return 0;
+    }
+    if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_MACRO && p->hold_macros == 0 && p->defer == 0) {
+        macro_call(p, t);
+        return 0;
+    }
+    return 1;
+}
+
+/* A token just scanned from the current input: errors, end of input,
+ * directives and macro calls are dealt with here. Returns 1 if t is to be
+ * returned. */
+static int fresh_token(sdl_parser *p, sdl_tok *t)
+{
+    switch (t->tk.kind) {
+    case TOK_ERROR:
+        sdl_error(p, t->tk.loc, PT_ERR_SYNTAX, "%s", top_frame(p)->sc.err);
+        return 0;
+    case TOK_EOF:
+        return !end_of_input(p, &t->tk) && sdl_ok(p);
+    case TOK_HASH:
+        if (p->defer > 0 && macro_end_ahead(p)) {
+            return_from_macro(p);
+            return 0;
+        }
+        if (p->defer > 0) return 1;
+        directive(p, &t->tk);
+        return 0;
+    case TOK_IDENT: {
+        const sdl_value *v = sdl_symtab_find(p->sym, t->tk.text, (size_t)t->tk.len);
+        if (v) t->val = *v;
+        if (v && v->kind == VAL_MACRO && p->hold_macros == 0 && p->defer == 0) {
+            macro_call(p, t);
+            return 0;
+        }
+        return 1;
+    }
+    default:
+        return 1;
+    }
+}
+
 sdl_tok sdl_next(sdl_parser *p)
 {
     for (;;) {
         if (!sdl_ok(p) || p->nframes == 0) return eof_token(p);
         sdl_tok t;
         t.val.kind = VAL_NONE;
+        int take;
         if (p->nahead > 0) {
             t = p->ahead[--p->nahead];
-            if (t.tk.kind == TOK_HASH && p->defer == 0) {
-                directive(p, &t.tk);
-                continue;
-            }
-            if (t.tk.kind == TOK_IDENT && t.val.kind == VAL_MACRO && p->hold_macros == 0 && p->defer == 0) {
-                macro_call(p, &t);
-                continue;
-            }
+            take = resume_token(p, &t);
+        } else {
+            t.tk = sdl_scan_next(&top_frame(p)->sc);
+            take = fresh_token(p, &t);
+        }
+        if (take && sdl_ok(p)) {
             p->last_loc = t.tk.loc;
             return t;
         }
-        t.tk = sdl_scan_next(&top_frame(p)->sc);
-        if (t.tk.kind == TOK_ERROR) {
-            sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "%s", top_frame(p)->sc.err);
-            continue;
-        }
-        if (t.tk.kind == TOK_EOF) {
-            if (end_of_input(p, &t.tk)) continue;
-            if (!sdl_ok(p)) continue;
-            p->last_loc = t.tk.loc;
-            return t;
-        }
-        if (t.tk.kind == TOK_HASH) {
-            if (p->defer > 0 && macro_end_ahead(p)) {
-                return_from_macro(p);
-                continue;
-            }
-            if (p->defer > 0) {
-                p->last_loc = t.tk.loc;
-                return t;
-            }
-            directive(p, &t.tk);
-            continue;
-        }
-        if (t.tk.kind == TOK_IDENT) {
-            const sdl_value *v = sdl_symtab_find(p->sym, t.tk.text, (size_t)t.tk.len);
-            if (v) t.val = *v;
-            if (v && v->kind == VAL_MACRO && p->hold_macros == 0 && p->defer == 0) {
-                macro_call(p, &t);
-                continue;
-            }
-        }
-        p->last_loc = t.tk.loc;
-        return t;
     }
 }
 
