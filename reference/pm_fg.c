@@ -1,0 +1,404 @@
+/* pm_fg.c - photon map + final gathering (see pm_fg.h).
+ *
+ * Final gather at an eye vertex x with Lambertian albedos kd (viewer's side)
+ * and kb (other side): N_f rays cosine-distributed about n, N_b about -n,
+ * stratified on a grid over the unit square that the cosine map takes to
+ * the hemisphere. Each ray's estimate of  int kd/pi L(w) cos dw  is kd L(w)
+ * (cosine density cos/pi), so the gathered radiance is
+ *     kd (1/N_f) sum L(w_i) + kb (1/N_b) sum L(w_j).
+ * L at a gather hit y (seen along w) is its emission (weighted against the
+ * emitter samples taken at x, pm_nee.h) plus its reflected radiance:
+ * direct light by shadow rays + k_y/pi E_ind(y) + specular lobes, where
+ * E_ind is the photon irradiance estimate (pm_kdtree_irradiance; the maps
+ * hold only light that made at least one bounce, pm_photon.h).
+ *
+ * The caustic map adds at x: kd/pi E_c(x, n) + kb/pi E_c(x, -n). */
+#include "pm_fg.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "pm_kdtree.h"
+#include "pm_nee.h"
+#include "pm_photon.h"
+#include "pool.h"
+#include "shade_material.h"
+#include "timer.h"
+
+#define SKIP_MAX 64
+#define KMAX 1024
+#define NORMAL_DOT 0.5   /* photons count for a query when their normals are within 60 degrees */
+#define EYE_RR 1e-3      /* eye branches below this weight go on by Russian roulette */
+
+void pm_fg_default_settings(pm_fg_settings *s)
+{
+    memset(s, 0, sizeof *s);
+    pm_common_defaults(&s->c);
+    s->c.spp = 1;
+    s->photons = 1000000;
+    s->fg_rays = 4096;
+    s->k_global = 64;
+    s->k_caustic = 32;
+    s->irradiance_stride = 4;
+    s->caustics = -1;
+    s->area_samples = 16;
+    s->emitter_samples = 16;
+    s->max_eye_depth = 16;
+    s->max_gather_depth = 8;
+    s->max_photon_bounces = 256;
+}
+
+typedef struct {
+    const scene *sc;
+    const accel *a;
+    const pm_fg_settings *s;
+    const pm_lights *L;
+    double eps;
+    pm_kdtree *global, *caustic, *irr;
+    double r_global, r_caustic;
+    int k_global, k_caustic;
+    int fg_per_sample;
+    pm_neighbour *scratch; /* KMAX per thread */
+} fg_ctx;
+
+static inline rgb frgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
+static inline void acc_add(rgb *a, rgb t, rgb v)
+{
+    a->r += t.r * v.r;
+    a->g += t.g * v.g;
+    a->b += t.b * v.b;
+}
+static inline double fmax3(rgb t) { return fmax(t.r, fmax(t.g, t.b)); }
+
+static int trace_skip(const fg_ctx *c, vec3 org, vec3 dir, unsigned skip, accel_hit *h)
+{
+    double tmin = c->eps;
+    for (int k = 0; k < SKIP_MAX; k++) {
+        if (!accel_intersect(c->a, org, dir, tmin, INFINITY, h)) return 0;
+        if (!(h->flags & skip)) return 1;
+        tmin = h->t + fmax(c->eps, h->t * 1e-7);
+    }
+    return 0;
+}
+
+static rgb background(const scene *sc) { return frgb(sc->background.r, sc->background.g, sc->background.b); }
+
+/* Indirect irradiance at p on the side n from the global map. */
+static rgb global_irradiance(const fg_ctx *c, vec3 p, vec3 n, int thread)
+{
+    rgb e = {0, 0, 0};
+    if (!c->global || pm_kdtree_size(c->global) == 0) return e;
+    if (c->irr) {
+        long i = pm_kdtree_nearest(c->irr, p, n, NORMAL_DOT, c->r_global * c->r_global);
+        if (i >= 0) {
+            const pm_photon *ph = &pm_kdtree_photons(c->irr)[i];
+            return frgb(ph->power[0], ph->power[1], ph->power[2]);
+        }
+    }
+    pm_kdtree_irradiance(c->global, p, n, NORMAL_DOT, c->k_global, c->r_global, c->scratch + (size_t)thread * KMAX, &e);
+    return e;
+}
+
+/* Reflected radiance at a gather hit (not its emission). */
+static rgb gather_hit(const fg_ctx *c, const mat_bsdf *b, int level, int thread, rng *r, pm_counts *cnt)
+{
+    rgb L = {0, 0, 0};
+    if (b->nee) {
+        rgb d = pm_direct_lights(c->L, b, 1, r, &cnt->shadow);
+        L.r += d.r;
+        L.g += d.g;
+        L.b += d.b;
+    }
+    if (b->m[MAT_LOBE_DIFFUSE] > 0.0 || b->m[MAT_LOBE_BACK] > 0.0) {
+        rgb d = pm_direct_emitters(c->L, b, 1, 0.0, 0.0, r, &cnt->shadow);
+        L.r += d.r;
+        L.g += d.g;
+        L.b += d.b;
+        if (b->m[MAT_LOBE_DIFFUSE] > 0.0) {
+            rgb e = global_irradiance(c, b->p, b->n, thread);
+            acc_add(&L, b->k[MAT_LOBE_DIFFUSE], frgb(e.r / M_PI, e.g / M_PI, e.b / M_PI));
+        }
+        if (b->m[MAT_LOBE_BACK] > 0.0) {
+            rgb e = global_irradiance(c, b->p, v3_neg(b->n), thread);
+            acc_add(&L, b->k[MAT_LOBE_BACK], frgb(e.r / M_PI, e.g / M_PI, e.b / M_PI));
+        }
+    }
+    double ms = b->m[MAT_LOBE_REFLECT] + b->m[MAT_LOBE_TRANSMIT];
+    if (ms > 0.0 && level < c->s->max_gather_depth) {
+        double q = fmin(1.0, ms);
+        if (rng_f64(r) < q) {
+            int lobe = rng_f64(r) * ms < b->m[MAT_LOBE_REFLECT] ? MAT_LOBE_REFLECT : MAT_LOBE_TRANSMIT;
+            double p = q * b->m[lobe] / ms;
+            rgb w = b->k[lobe];
+            w = frgb(w.r / p, w.g / p, w.b / p);
+            vec3 org = lobe == MAT_LOBE_REFLECT ? b->p_out : b->p_in;
+            vec3 dir = lobe == MAT_LOBE_REFLECT ? b->refl_dir : b->trans_dir;
+            cnt->bsdf++;
+            accel_hit h;
+            if (!trace_skip(c, org, dir, lobe == MAT_LOBE_REFLECT ? OBJ_NO_REFLECTION : 0u, &h)) {
+                acc_add(&L, w, background(c->sc));
+            } else {
+                mat_bsdf b2;
+                mat_setup(&b2, c->sc, &h, dir, c->eps, r);
+                acc_add(&L, w, b2.emission);
+                acc_add(&L, w, gather_hit(c, &b2, level + 1, thread, r, cnt));
+            }
+        }
+    }
+    return L;
+}
+
+/* (1/n) sum of radiance over n stratified cosine directions about `axis`. */
+static rgb gather_lobe(const fg_ctx *c, const mat_bsdf *b, vec3 axis, vec3 org, int front, int n, int nf, int nb,
+                       int thread, rng *r, pm_counts *cnt)
+{
+    rgb sum = {0, 0, 0};
+    if (n <= 0) return sum;
+    int g1 = (int)floor(sqrt((double)n));
+    if (g1 < 1) g1 = 1;
+    int g2 = n / g1;
+    for (int i = 0; i < n; i++) {
+        double u1, u2;
+        if (i < g1 * g2) {
+            u1 = ((i % g1) + rng_f64(r)) / g1;
+            u2 = ((i / g1) + rng_f64(r)) / g2;
+        } else {
+            u1 = rng_f64(r);
+            u2 = rng_f64(r);
+        }
+        vec3 w = mat_cosine_dir(axis, u1, u2);
+        double cg = v3_dot(w, b->ng);
+        if (front ? cg <= 0.0 : cg >= 0.0) continue;
+        cnt->gather++;
+        accel_hit h;
+        if (!accel_intersect(c->a, org, w, c->eps, INFINITY, &h)) {
+            rgb bg = background(c->sc);
+            sum.r += bg.r;
+            sum.g += bg.g;
+            sum.b += bg.b;
+            continue;
+        }
+        mat_bsdf b2;
+        mat_setup(&b2, c->sc, &h, w, c->eps, r);
+        rgb le = b2.emission;
+        if (le.r != 0.0 || le.g != 0.0 || le.b != 0.0) {
+            double cosx = fabs(v3_dot(w, b->n));
+            double cb = (front ? nf : nb) * cosx / M_PI;
+            double wt = pm_mis(cb, pm_emitter_density(c->L, &h, org, c->s->emitter_samples));
+            sum.r += le.r * wt;
+            sum.g += le.g * wt;
+            sum.b += le.b * wt;
+        }
+        rgb lr = gather_hit(c, &b2, 0, thread, r, cnt);
+        sum.r += lr.r;
+        sum.g += lr.g;
+        sum.b += lr.b;
+    }
+    return frgb(sum.r / n, sum.g / n, sum.b / n);
+}
+
+static void eye_trace(const fg_ctx *c, vec3 org, vec3 dir, unsigned skip, rgb T, int depth, int thread, rng *r,
+                      pm_counts *cnt, rgb *L)
+{
+    if (depth >= c->s->max_eye_depth) return;
+    accel_hit h;
+    if (!trace_skip(c, org, dir, skip, &h)) {
+        acc_add(L, T, background(c->sc));
+        return;
+    }
+    mat_bsdf b;
+    mat_setup(&b, c->sc, &h, dir, c->eps, r);
+    if (b.unsupported) cnt->unsupported++;
+    acc_add(L, T, b.emission);
+    if (b.nee) acc_add(L, T, pm_direct_lights(c->L, &b, c->s->area_samples, r, &cnt->shadow));
+    double md = b.m[MAT_LOBE_DIFFUSE], mb = b.m[MAT_LOBE_BACK];
+    if (md > 0.0 || mb > 0.0) {
+        double scale = depth == 0 ? 1.0 : fmin(1.0, fmax3(T));
+        int ng = (int)lround(c->fg_per_sample * scale);
+        if (ng < 16) ng = 16;
+        int nf = md > 0.0 ? (int)lround(ng * md / (md + mb)) : 0;
+        int nb = mb > 0.0 ? ng - nf : 0;
+        if (md > 0.0 && nf < 1) nf = 1;
+        if (mb > 0.0 && nb < 1) nb = 1;
+        acc_add(L, T, pm_direct_emitters(c->L, &b, c->s->emitter_samples, nf, nb, r, &cnt->shadow));
+        if (c->caustic && pm_kdtree_size(c->caustic) > 0) {
+            pm_neighbour *sc = c->scratch + (size_t)thread * KMAX;
+            rgb e;
+            if (md > 0.0) {
+                pm_kdtree_irradiance(c->caustic, b.p, b.n, NORMAL_DOT, c->k_caustic, c->r_caustic, sc, &e);
+                acc_add(L, T, frgb(b.k[MAT_LOBE_DIFFUSE].r * e.r / M_PI, b.k[MAT_LOBE_DIFFUSE].g * e.g / M_PI,
+                                   b.k[MAT_LOBE_DIFFUSE].b * e.b / M_PI));
+            }
+            if (mb > 0.0) {
+                pm_kdtree_irradiance(c->caustic, b.p, v3_neg(b.n), NORMAL_DOT, c->k_caustic, c->r_caustic, sc, &e);
+                acc_add(L, T, frgb(b.k[MAT_LOBE_BACK].r * e.r / M_PI, b.k[MAT_LOBE_BACK].g * e.g / M_PI,
+                                   b.k[MAT_LOBE_BACK].b * e.b / M_PI));
+            }
+        }
+        cnt->gather_points++;
+        if (nf > 0) {
+            rgb g = gather_lobe(c, &b, b.n, b.p_out, 1, nf, nf, nb, thread, r, cnt);
+            acc_add(L, T, frgb(b.k[MAT_LOBE_DIFFUSE].r * g.r, b.k[MAT_LOBE_DIFFUSE].g * g.g,
+                               b.k[MAT_LOBE_DIFFUSE].b * g.b));
+        }
+        if (nb > 0) {
+            rgb g = gather_lobe(c, &b, v3_neg(b.n), b.p_in, 0, nb, nf, nb, thread, r, cnt);
+            acc_add(L, T, frgb(b.k[MAT_LOBE_BACK].r * g.r, b.k[MAT_LOBE_BACK].g * g.g, b.k[MAT_LOBE_BACK].b * g.b));
+        }
+    }
+    /* specular lobes: both followed (Whitted-style), small weights by roulette */
+    for (int lobe = MAT_LOBE_REFLECT; lobe <= MAT_LOBE_TRANSMIT; lobe++) {
+        if (b.m[lobe] <= 0.0) continue;
+        rgb T2 = frgb(T.r * b.k[lobe].r, T.g * b.k[lobe].g, T.b * b.k[lobe].b);
+        double mt = fmax3(T2);
+        if (!(mt > 0.0)) continue;
+        if (mt < EYE_RR) {
+            double q = mt / EYE_RR;
+            if (rng_f64(r) >= q) continue;
+            T2 = frgb(T2.r / q, T2.g / q, T2.b / q);
+        }
+        cnt->bsdf++;
+        if (lobe == MAT_LOBE_REFLECT)
+            eye_trace(c, b.p_out, b.refl_dir, OBJ_NO_REFLECTION, T2, depth + 1, thread, r, cnt, L);
+        else
+            eye_trace(c, b.p_in, b.trans_dir, skip, T2, depth + 1, thread, r, cnt, L);
+    }
+}
+
+static rgb fg_sample(void *ctx, double px, double py, int thread, rng *r, pm_counts *cnt)
+{
+    const fg_ctx *c = ctx;
+    vec3 org, dir;
+    scene_camera_ray(&c->sc->camera, px, py, c->s->c.width, c->s->c.height, &org, &dir);
+    cnt->camera++;
+    rgb L = {0, 0, 0}, T = {1, 1, 1};
+    eye_trace(c, org, dir, OBJ_NO_IMAGE, T, 0, thread, r, cnt, &L);
+    return L;
+}
+
+/* ------------------------------------------------------------ precomputed irradiance */
+
+typedef struct {
+    const fg_ctx *c;
+    const pm_photon *src;
+    long n, stride;
+    pm_photon *out;
+    pm_neighbour *scratch;
+} irr_job;
+
+#define IRR_BLOCK 2048
+
+static void irr_block(void *ctx, int bi, int thread)
+{
+    irr_job *j = ctx;
+    long i0 = (long)bi * IRR_BLOCK, i1 = i0 + IRR_BLOCK < j->n ? i0 + IRR_BLOCK : j->n;
+    for (long i = i0; i < i1; i++) {
+        const pm_photon *ph = &j->src[i * j->stride];
+        vec3 p = pm_photon_pos(ph), n = v3_norm(pm_photon_normal(ph));
+        rgb e;
+        pm_kdtree_irradiance(j->c->global, p, n, NORMAL_DOT, j->c->k_global, j->c->r_global,
+                             j->scratch + (size_t)thread * KMAX, &e);
+        pm_photon_set(&j->out[i], p, e, n);
+    }
+}
+
+pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s, framebuffer *fb, pm_stats *st,
+                       diag *d)
+{
+    double t0 = timer_now();
+    pm_stats local;
+    if (!st) st = &local;
+    memset(st, 0, sizeof *st);
+    if (!sc || !a || !s || !fb) return PT_ERR_INTERNAL;
+    int threads = pm_threads(s->c.threads);
+    pt_status status;
+    pm_lights *L = pm_lights_new(sc, a, d, &status);
+    if (!L) return status;
+    st->emitter_pieces = accel_surf_count(pm_lights_emitters(L));
+    double t1 = timer_now();
+    st->t_lights = t1 - t0;
+
+    fg_ctx c;
+    memset(&c, 0, sizeof c);
+    c.sc = sc;
+    c.a = a;
+    c.s = s;
+    c.L = L;
+    c.eps = pm_lights_eps(L);
+    double scale = accel_scale(a);
+    if (!(scale > 0.0) || !isfinite(scale)) scale = 1.0;
+    c.r_global = s->radius_global > 0.0 ? s->radius_global : 0.1 * scale;
+    c.r_caustic = s->radius_caustic > 0.0 ? s->radius_caustic : 0.02 * scale;
+    c.k_global = s->k_global < 2 ? 2 : (s->k_global > KMAX ? KMAX : s->k_global);
+    c.k_caustic = s->k_caustic < 2 ? 2 : (s->k_caustic > KMAX ? KMAX : s->k_caustic);
+    int spp = s->c.spp > 0 ? s->c.spp : 1;
+    c.fg_per_sample = (s->fg_rays + spp - 1) / spp;
+    if (c.fg_per_sample < 1) c.fg_per_sample = 1;
+    c.scratch = malloc(sizeof(pm_neighbour) * KMAX * (size_t)threads);
+    if (!c.scratch) {
+        pm_lights_free(L);
+        return PT_ERR_NOMEM;
+    }
+
+    int caustics = s->caustics < 0 ? sc->global.photons != 0 : s->caustics != 0;
+    st->caustic_reason = s->caustics < 0 ? (caustics ? "on: the scene has a photons{} block"
+                                                     : "off: no photons{} block in the scene")
+                                         : (caustics ? "on: requested" : "off: requested");
+
+    /* 1. photons */
+    pm_photon_settings ps = {s->photons, caustics, s->max_photon_bounces > 0 ? s->max_photon_bounces : 256, s->c.seed,
+                             threads, s->c.cancel};
+    pm_photon_result pr;
+    status = pm_photons_trace(sc, a, L, &ps, &pr);
+    double t2 = timer_now();
+    st->t_photons = t2 - t1;
+    if (status != PT_OK) {
+        free(c.scratch);
+        pm_lights_free(L);
+        return status;
+    }
+    st->photons_emitted = pr.emitted;
+    st->photons_global = pr.nglobal;
+    st->photons_caustic = pr.ncaustic;
+    st->photon_rays = pr.rays;
+
+    /* 2. maps */
+    c.global = pm_kdtree_build(pr.global, pr.nglobal, threads);
+    c.caustic = pm_kdtree_build(pr.caustic, pr.ncaustic, threads);
+    st->caustic_map = caustics && pr.ncaustic > 0;
+    if (caustics && pr.ncaustic == 0) st->caustic_reason = "on, but no photon reached a diffuse surface through specular ones";
+    double t3 = timer_now();
+    if (!c.global || !c.caustic) status = PT_ERR_NOMEM;
+
+    /* 3. precomputed irradiance */
+    if (status == PT_OK && s->irradiance_stride > 0 && pr.nglobal > 0) {
+        long stride = s->irradiance_stride;
+        long n = (pr.nglobal + stride - 1) / stride;
+        pm_photon *pts = malloc(sizeof(pm_photon) * (size_t)n);
+        if (!pts) {
+            status = PT_ERR_NOMEM;
+        } else {
+            irr_job j = {&c, pm_kdtree_photons(c.global), n, stride, pts, c.scratch};
+            pool_run(threads, (int)((n + IRR_BLOCK - 1) / IRR_BLOCK), irr_block, &j);
+            double t4 = timer_now();
+            st->t_irradiance = t4 - t3;
+            c.irr = pm_kdtree_build(pts, n, threads);
+            if (!c.irr) status = PT_ERR_NOMEM;
+            st->irradiance_points = n;
+            st->t_maps += timer_now() - t4;
+        }
+    }
+    st->t_maps += t3 - t2;
+
+    /* 4. eye pass */
+    double t5 = timer_now();
+    if (status == PT_OK) status = pm_image_render(sc, &s->c, 1, fb, fg_sample, &c, st);
+    double t6 = timer_now();
+    st->t_render = t6 - t5;
+    st->t_total = t6 - t0;
+    pm_kdtree_free(c.global);
+    pm_kdtree_free(c.caustic);
+    pm_kdtree_free(c.irr);
+    free(c.scratch);
+    pm_lights_free(L);
+    return status;
+}

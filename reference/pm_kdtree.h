@@ -1,0 +1,60 @@
+/* pm_kdtree.h - photons and a balanced kd-tree over them (Jensen 2001,
+ * "Realistic Image Synthesis Using Photon Maps", ch. 6: median splits on
+ * the axis of largest extent; here stored implicitly: the node of a range
+ * [lo, hi) is its middle element), built in parallel, with k-nearest and
+ * nearest queries restricted to photons on a compatible surface side. */
+#ifndef PT_PM_KDTREE_H
+#define PT_PM_KDTREE_H
+#include "scene.h"
+#include "vec.h"
+
+/* A stored photon (28 bytes): position, power (flux, RGB), and the unit
+ * normal of the surface it hit, turned towards the side it arrived from
+ * (quantised to int8). The same record holds precomputed irradiance points
+ * (power = irradiance). */
+typedef struct {
+    float p[3];
+    float power[3];
+    signed char n[3];
+    unsigned char axis;   /* split axis of the node (kd-tree internal) */
+} pm_photon;
+
+void pm_photon_set(pm_photon *ph, vec3 p, rgb power, vec3 n);
+vec3 pm_photon_pos(const pm_photon *ph);
+vec3 pm_photon_normal(const pm_photon *ph);
+
+typedef struct pm_kdtree pm_kdtree;
+
+/* Build over `n` photons; takes ownership of `ph` (malloc'd; reordered in
+ * place). Deterministic for any thread count. NULL on out-of-memory. */
+pm_kdtree *pm_kdtree_build(pm_photon *ph, long n, int threads);
+void pm_kdtree_free(pm_kdtree *t);
+long pm_kdtree_size(const pm_kdtree *t);
+const pm_photon *pm_kdtree_photons(const pm_kdtree *t);
+
+typedef struct {
+    long idx;
+    float d2;
+} pm_neighbour;
+
+/* The up to k nearest photons to p within squared radius max_r2 whose
+ * normal n_ph satisfies dot(n_ph, n) >= min_dot (pass min_dot = -2 for no
+ * filter). `out` has room for k; returns the number found, as a max-heap on
+ * d2 (out[0] is the farthest). */
+int pm_kdtree_knn(const pm_kdtree *t, vec3 p, vec3 n, double min_dot, int k, double max_r2, pm_neighbour *out);
+
+/* Density estimate of the irradiance at p on the side n from the k nearest
+ * compatible photons: sum of the k-1 nearest powers / (pi r_k^2), r_k the
+ * distance of the k-th; with fewer than k photons inside max_r, sum of all /
+ * (pi max_r^2). The k-1 rule is unbiased for a uniform (Poisson) photon
+ * density: given r_k, the k-1 photons inside are uniform in the disc, and
+ * E[(k-1)/(pi r_k^2)] equals the density (r_k^2 is Gamma(k) distributed);
+ * Jensen's sum of all k over pi r_k^2 overestimates by k/(k-1). `scratch`
+ * has room for k entries. Returns the number of photons used. */
+int pm_kdtree_irradiance(const pm_kdtree *t, vec3 p, vec3 n, double min_dot, int k, double max_r, pm_neighbour *scratch,
+                         rgb *e);
+
+/* The nearest compatible photon within max_r2, or -1. */
+long pm_kdtree_nearest(const pm_kdtree *t, vec3 p, vec3 n, double min_dot, double max_r2);
+
+#endif

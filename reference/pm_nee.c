@@ -1,0 +1,168 @@
+/* pm_nee.c - next-event estimation for the reference renderers (see pm_nee.h).
+ *
+ * Emitter sampling: a point y with density p_A (per unit area, from
+ * accel_surface) seen from x along wi at distance d has the solid-angle
+ * density p_l = p_A d^2 / |cos theta_y| (emission is two-sided). The
+ * estimator of  int f(wi) Le(y) |cos theta_x| dwi  is
+ *     f(wi) Le |cos theta_x| V(x, y) / p_l,
+ * weighted by the power heuristic (Veach & Guibas 1995, eq. for beta = 2)
+ * against the BSDF strategy. */
+#include "pm_nee.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "shade_light.h"
+
+struct pm_lights {
+    const scene *sc;
+    const accel *a;
+    double eps;
+    accel_surf *emit;
+    rgb *le;          /* emission per piece */
+};
+
+static double emit_weight(void *ctx, const scene_object *leaf, const scene_texture *tex, unsigned flags)
+{
+    (void)leaf;
+    (void)flags;
+    const scene *sc = ctx;
+    rgb e = mat_texture_emission(sc, tex);
+    return fmax(fabs(e.r), fmax(fabs(e.g), fabs(e.b)));
+}
+
+pm_lights *pm_lights_new(const scene *sc, const accel *a, diag *d, pt_status *st)
+{
+    *st = PT_OK;
+    pm_lights *L = calloc(1, sizeof *L);
+    if (!L) {
+        *st = PT_ERR_NOMEM;
+        return NULL;
+    }
+    L->sc = sc;
+    L->a = a;
+    double s = accel_scale(a);
+    if (!(s > 0.0) || !isfinite(s)) s = 1.0;
+    L->eps = s * 1e-6;
+    L->emit = accel_surf_build(sc, a, emit_weight, (void *)sc, d, st);
+    if (!L->emit) {
+        free(L);
+        return NULL;
+    }
+    int n = accel_surf_count(L->emit);
+    L->le = malloc(sizeof(rgb) * (size_t)(n > 0 ? n : 1));
+    if (!L->le) {
+        pm_lights_free(L);
+        *st = PT_ERR_NOMEM;
+        return NULL;
+    }
+    for (int i = 0; i < n; i++) L->le[i] = mat_texture_emission(sc, accel_surf_piece_at(L->emit, i)->texture);
+    return L;
+}
+
+void pm_lights_free(pm_lights *L)
+{
+    if (!L) return;
+    accel_surf_free(L->emit);
+    free(L->le);
+    free(L);
+}
+
+const accel_surf *pm_lights_emitters(const pm_lights *L) { return L->emit; }
+rgb pm_lights_piece_emission(const pm_lights *L, int piece) { return L->le[piece]; }
+double pm_lights_eps(const pm_lights *L) { return L->eps; }
+
+int pm_lights_any(const pm_lights *L)
+{
+    const colour5 *bg = &L->sc->background;
+    return L->sc->nlights > 0 || accel_surf_count(L->emit) > 0 || bg->r != 0.0 || bg->g != 0.0 || bg->b != 0.0;
+}
+
+rgb pm_direct_lights(const pm_lights *L, const mat_bsdf *b, int area_samples, rng *r, long *shadow_rays)
+{
+    rgb total = {0, 0, 0};
+    if (!b->nee) return total;
+    light_ctx c = {L->a, L->eps, shadow_rays};
+    for (int i = 0; i < L->sc->nlights; i++) {
+        rgb v = mat_light_nee(b, &c, &L->sc->lights[i], area_samples, r);
+        total.r += v.r;
+        total.g += v.g;
+        total.b += v.b;
+    }
+    return total;
+}
+
+/* Visibility of y from o: nothing in between (emitters are found by BSDF
+ * rays with accel_intersect, so no_shadow objects block here too). */
+static int visible(const pm_lights *L, vec3 o, vec3 y, vec3 *dir, double *dist)
+{
+    vec3 d = v3_sub(y, o);
+    double len = v3_len(d);
+    if (!(len > 0.0)) return 0;
+    *dir = v3_scale(d, 1.0 / len);
+    *dist = len;
+    double tmax = len - fmax(L->eps, len * 1e-5);
+    if (tmax <= L->eps) return 1;
+    accel_hit h;
+    return !accel_intersect(L->a, o, *dir, L->eps, tmax, &h);
+}
+
+rgb pm_direct_emitters(const pm_lights *L, const mat_bsdf *b, int n_light, double bsdf_front, double bsdf_back, rng *r,
+                       long *shadow_rays)
+{
+    rgb total = {0, 0, 0};
+    if (n_light < 1 || accel_surf_count(L->emit) == 0) return total;
+    if (b->m[MAT_LOBE_DIFFUSE] <= 0.0 && b->m[MAT_LOBE_BACK] <= 0.0) return total;
+    int g = (int)floor(sqrt((double)n_light));
+    for (int k = 0; k < n_light; k++) {
+        double u1, u2;
+        if (k < g * g) {
+            u1 = ((k % g) + rng_f64(r)) / g;
+            u2 = ((k / g) + rng_f64(r)) / g;
+        } else {
+            u1 = rng_f64(r);
+            u2 = rng_f64(r);
+        }
+        accel_surf_sample s;
+        if (!accel_surf_sample_point(L->emit, rng_f64(r), u1, u2, r, &s)) break;
+        /* which side of the surface the light arrives on decides the origin */
+        int front = v3_dot(v3_sub(s.p, b->p), b->ng) > 0.0;
+        vec3 o = front ? b->p_out : b->p_in;
+        vec3 wi;
+        double dist;
+        vec3 d0 = v3_sub(s.p, o);
+        double l0 = v3_len(d0);
+        if (!(l0 > 0.0)) continue;
+        wi = v3_scale(d0, 1.0 / l0);
+        rgb f = mat_eval(b, wi);
+        if (f.r == 0.0 && f.g == 0.0 && f.b == 0.0) continue;
+        double cos_y = fabs(v3_dot(s.n, wi));
+        if (!(cos_y > 1e-12)) continue;
+        if (shadow_rays) (*shadow_rays)++;
+        if (!visible(L, o, s.p, &wi, &dist)) continue;
+        double p_l = s.pdf_area * dist * dist / cos_y;
+        double cos_x = fabs(v3_dot(b->n, wi));
+        double c_b = (v3_dot(b->n, wi) > 0.0 ? bsdf_front : bsdf_back) * cos_x / M_PI;
+        double w = pm_mis(n_light * p_l, c_b);
+        rgb le = L->le[s.piece];
+        double k_ = w * cos_x / p_l;
+        total.r += f.r * le.r * k_;
+        total.g += f.g * le.g * k_;
+        total.b += f.b * le.b * k_;
+    }
+    total.r /= n_light;
+    total.g /= n_light;
+    total.b /= n_light;
+    return total;
+}
+
+double pm_emitter_density(const pm_lights *L, const accel_hit *h, vec3 from, int n_light)
+{
+    if (n_light < 1) return 0.0;
+    double pa = accel_surf_pdf(L->emit, h);
+    if (!(pa > 0.0)) return 0.0;
+    vec3 d = v3_sub(h->p, from);
+    double d2 = v3_len2(d);
+    double cos_y = fabs(v3_dot(h->ng, d)) / sqrt(d2);
+    if (!(cos_y > 1e-12)) return INFINITY;
+    return n_light * pa * d2 / cos_y;
+}

@@ -1,0 +1,61 @@
+/* pm_nee.h - next-event estimation shared by the path tracer and the final
+ * gatherer: POV-Ray light sources (shade_light.h's light_nee: the same terms
+ * and attenuation as shade.c, area lights sampled continuously) and emissive
+ * surfaces (sampled by area with accel_surface.h, combined with BSDF
+ * sampling by multiple importance sampling, Veach & Guibas 1995, power
+ * heuristic with sample counts).
+ *
+ * POV-Ray lights are invisible to camera and BSDF rays (looks_like is
+ * ignored): they are reached by next-event estimation only. Emissive
+ * surfaces (pigment * emission, plus ambient under radiosity{}, see
+ * shade_material.h) are found both ways. */
+#ifndef PT_PM_NEE_H
+#define PT_PM_NEE_H
+#include "accel.h"
+#include "accel_surface.h"
+#include "diag.h"
+#include "rng.h"
+#include "scene.h"
+#include "shade_material.h"
+
+typedef struct pm_lights pm_lights;
+
+pm_lights *pm_lights_new(const scene *sc, const accel *a, diag *d, pt_status *st);
+void pm_lights_free(pm_lights *L);
+
+const accel_surf *pm_lights_emitters(const pm_lights *L); /* may be empty */
+rgb pm_lights_piece_emission(const pm_lights *L, int piece);
+double pm_lights_eps(const pm_lights *L);                  /* distance epsilon (shade.c's) */
+int pm_lights_any(const pm_lights *L);                     /* POV lights, emitters or a background */
+
+/* Direct light of all POV-Ray light sources at b (diffuse, diffuse_back,
+ * phong, specular), area lights with `area_samples` stratified samples. */
+rgb pm_direct_lights(const pm_lights *L, const mat_bsdf *b, int area_samples, rng *r, long *shadow_rays);
+
+/* Direct light of the emissive surfaces at b through its Lambertian lobes,
+ * `n_light` samples by area. MIS against a BSDF strategy whose
+ * count-weighted density for a direction wi is
+ *     c_b(wi) = bsdf_front * cos(n, wi)/pi   (wi on the viewer's side)
+ *             = bsdf_back * |cos(n, wi)|/pi  (other side)
+ * (path tracer: 1 sample, bsdf_front = m_d/sum m, bsdf_back = m_b/sum m;
+ * final gather: N_front and N_back gather rays); pass 0, 0 for no MIS (the
+ * BSDF strategy does not count emission). Each light sample gets weight
+ * (n p_l)^2 / ((n p_l)^2 + c_b^2). */
+rgb pm_direct_emitters(const pm_lights *L, const mat_bsdf *b, int n_light, double bsdf_front, double bsdf_back, rng *r,
+                       long *shadow_rays);
+
+/* Count-weighted light-sampling density n_light * p_l (solid angle, seen
+ * from `from`) of the hit point h, 0 if h is not on a sampled emitter. */
+double pm_emitter_density(const pm_lights *L, const accel_hit *h, vec3 from, int n_light);
+
+/* Power heuristic weight of strategy a: a^2 / (a^2 + b^2) for count-weighted densities. */
+static inline double pm_mis(double a, double b)
+{
+    if (!(a > 0.0)) return 0.0;
+    if (!(b > 0.0) || !isfinite(b)) return isfinite(b) ? 1.0 : 0.0;
+    if (!isfinite(a)) return 1.0;
+    double r = b / a;
+    return 1.0 / (1.0 + r * r);
+}
+
+#endif

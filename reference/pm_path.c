@@ -1,0 +1,158 @@
+/* pm_path.c - the path tracer (see pm_path.h).
+ *
+ * Estimator per pixel sample (Veach 1997, ch. 9-10): along the path x0, x1, ...
+ * with throughput T_k = prod f cos / pdf over the sampled directions,
+ *   L = sum_k T_k [ w_bsdf(x_k) Le(x_k) + NEE_lights(x_k) + NEE_emitters(x_k) ]
+ * where Le at x_k counts fully after a camera or specular step and with the
+ * power-heuristic weight against emitter sampling after a Lambertian step;
+ * NEE_emitters carries the complementary weight. At the last vertex allowed
+ * (max_depth) the emitter NEE is unweighted, since no BSDF step follows.
+ * Russian roulette from vertex rr_depth on survives with q = min(1, max(T) / t)
+ * (t = rr_threshold) and divides T by q (unbiased for any q > 0). */
+#include "pm_path.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "pm_nee.h"
+#include "shade_material.h"
+#include "timer.h"
+
+#define HARD_DEPTH 1024
+#define SKIP_MAX 64
+
+void pm_path_default_settings(pm_path_settings *s)
+{
+    memset(s, 0, sizeof *s);
+    pm_common_defaults(&s->c);
+    s->c.spp = 64;
+    s->max_depth = 0;
+    s->rr_depth = 3;
+    s->rr_threshold = 0.1;
+    s->area_samples = 1;
+}
+
+typedef struct {
+    const scene *sc;
+    const accel *a;
+    const pm_path_settings *s;
+    const pm_lights *L;
+    double eps;
+    int max_depth;
+} path_ctx;
+
+/* Nearest hit not carrying any of the `skip` flags. */
+static int trace_skip(const path_ctx *c, vec3 org, vec3 dir, unsigned skip, accel_hit *h)
+{
+    double tmin = c->eps;
+    for (int k = 0; k < SKIP_MAX; k++) {
+        if (!accel_intersect(c->a, org, dir, tmin, INFINITY, h)) return 0;
+        if (!(h->flags & skip)) return 1;
+        tmin = h->t + fmax(c->eps, h->t * 1e-7);
+    }
+    return 0;
+}
+
+static inline double tmax3(rgb t) { return fmax(t.r, fmax(t.g, t.b)); }
+
+static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_counts *cnt)
+{
+    (void)thread;
+    const path_ctx *c = ctx;
+    const scene *sc = c->sc;
+    vec3 org, dir;
+    scene_camera_ray(&sc->camera, px, py, c->s->c.width, c->s->c.height, &org, &dir);
+    cnt->camera++;
+    rgb L = {0, 0, 0}, T = {1, 1, 1};
+    unsigned skip = OBJ_NO_IMAGE;
+    int prev_spec = 1;
+    double prev_cb = 0.0;
+    vec3 prev_org = org;
+    for (int depth = 0;; depth++) {
+        accel_hit h;
+        if (!trace_skip(c, org, dir, skip, &h)) {
+            L.r += T.r * sc->background.r;
+            L.g += T.g * sc->background.g;
+            L.b += T.b * sc->background.b;
+            break;
+        }
+        mat_bsdf b;
+        mat_setup(&b, sc, &h, dir, c->eps, r);
+        if (b.unsupported) cnt->unsupported++;
+        rgb le = b.emission;
+        if (le.r != 0.0 || le.g != 0.0 || le.b != 0.0) {
+            double w = 1.0;
+            if (!prev_spec) w = pm_mis(prev_cb, pm_emitter_density(c->L, &h, prev_org, 1));
+            L.r += T.r * le.r * w;
+            L.g += T.g * le.g * w;
+            L.b += T.b * le.b * w;
+        }
+        int last = depth + 1 >= c->max_depth;
+        if (b.nee) {
+            rgb d = pm_direct_lights(c->L, &b, c->s->area_samples, r, &cnt->shadow);
+            L.r += T.r * d.r;
+            L.g += T.g * d.g;
+            L.b += T.b * d.b;
+        }
+        if ((b.m[MAT_LOBE_DIFFUSE] > 0.0 || b.m[MAT_LOBE_BACK] > 0.0) && b.msum > 0.0) {
+            double bf = last ? 0.0 : b.m[MAT_LOBE_DIFFUSE] / b.msum, bb = last ? 0.0 : b.m[MAT_LOBE_BACK] / b.msum;
+            rgb d = pm_direct_emitters(c->L, &b, 1, bf, bb, r, &cnt->shadow);
+            L.r += T.r * d.r;
+            L.g += T.g * d.g;
+            L.b += T.b * d.b;
+        }
+        if (last) break;
+        mat_scatter s;
+        if (!mat_sample(&b, r, 0, &s)) break;
+        T.r *= s.weight.r;
+        T.g *= s.weight.g;
+        T.b *= s.weight.b;
+        if (depth + 1 >= c->s->rr_depth) {
+            double thr = c->s->rr_threshold > 0.0 ? c->s->rr_threshold : 1.0;
+            double q = fmin(1.0, tmax3(T) / thr);
+            if (!(q > 0.0)) break;
+            if (q < 1.0) {
+                if (rng_f64(r) >= q) break;
+                T.r /= q;
+                T.g /= q;
+                T.b /= q;
+            }
+        }
+        if (s.specular) {
+            prev_spec = 1;
+            if (s.lobe == MAT_LOBE_REFLECT) skip = OBJ_NO_REFLECTION;
+        } else {
+            prev_spec = 0;
+            prev_cb = s.pdf;
+            skip = 0;
+        }
+        org = s.org;
+        dir = s.dir;
+        prev_org = s.org;
+        cnt->bsdf++;
+    }
+    return L;
+}
+
+pt_status pm_path_render(const scene *sc, const accel *a, const pm_path_settings *s, framebuffer *fb, pm_stats *st,
+                         diag *d)
+{
+    double t0 = timer_now();
+    pm_stats local;
+    if (!st) st = &local;
+    memset(st, 0, sizeof *st);
+    if (!sc || !a || !s || !fb) return PT_ERR_INTERNAL;
+    pt_status status;
+    pm_lights *L = pm_lights_new(sc, a, d, &status);
+    if (!L) return status;
+    st->emitter_pieces = accel_surf_count(pm_lights_emitters(L));
+    double t1 = timer_now();
+    st->t_lights = t1 - t0;
+    path_ctx c = {sc, a, s, L, pm_lights_eps(L), s->max_depth > 0 ? s->max_depth : HARD_DEPTH};
+    if (c.max_depth > HARD_DEPTH) c.max_depth = HARD_DEPTH;
+    status = pm_image_render(sc, &s->c, 16, fb, path_sample, &c, st);
+    double t2 = timer_now();
+    st->t_render = t2 - t1;
+    st->t_total = t2 - t0;
+    pm_lights_free(L);
+    return status;
+}

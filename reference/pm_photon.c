@@ -1,0 +1,378 @@
+/* pm_photon.c - photon tracing (see pm_photon.h).
+ *
+ * Power of a photon from a POV-Ray point-like light. POV-Ray's diffuse term
+ * d * P * C * att * cos (shade.c) is a Lambertian BRDF d*P/pi under the
+ * irradiance E(y) = pi C att(y) cos. Photons leave the light with direction
+ * density p(w) (per solid angle), N of them; the number landing on a patch
+ * dA at distance d with cosine cos is N p(w) dA cos / d^2, so giving each
+ * the power Phi = pi C att d^2 / (N p(w)) makes the flux density
+ * Phi * N p(w) cos / d^2 = pi C att cos = E. For a point on an area light
+ * (uniform over the parallelogram) the same holds per point, with the
+ * attenuation evaluated from that point (as `area_illumination on` does;
+ * shade.c otherwise takes the spot/fade factor from the light's centre, a
+ * difference of second order in the light's size that only reaches the
+ * indirect light). Parallel and cylinder lights send photons along their
+ * fixed direction from a disc of area A perpendicular to it: flux density
+ * per unit perpendicular area N/A, so Phi = pi C att A / N. Emissive surfaces
+ * of radiance Le (both sides): point y with area density p_A, side 1/2,
+ * cosine direction: Phi = Le cos / (N p_A (1/2) cos/pi) = 2 pi Le / (N p_A).
+ * Background of radiance B: direction uniform on the sphere, origin uniform
+ * on a disc of radius R (the bounding sphere) across it: Phi = B 4 pi pi R^2 / N
+ * (check: an unoccluded patch inside receives N (1/4pi) (1/(pi R^2)) int cos dw
+ * = N / (4 pi R^2) photons per unit area; times Phi that is pi B, the
+ * irradiance under a uniform sky).
+ *
+ * Bounces: Russian roulette on the BSDF of shade_material.h (seed 002,
+ * appendix A, steps 2(b)-(d)): lobe k with probability max-channel(k_k)
+ * (scaled down if their sum exceeds 1), power times k_k / p_k (and
+ * (eta_i/eta_t)^2 through refraction, see shade_material.c). */
+#include "pm_photon.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "pool.h"
+#include "shade_light.h"
+#include "shade_material.h"
+
+#define CHUNK 1024
+#define SKIP_MAX 64
+
+typedef enum { SRC_LIGHT, SRC_EMIT, SRC_ENV } src_kind;
+
+typedef struct {
+    src_kind kind;
+    const scene_light *l;
+    double power;      /* allocation proxy only */
+    long n, first;     /* photons of this source: [first, first + n) */
+    double cos_max;    /* cone of directions (point-like lights) */
+} source;
+
+typedef struct {
+    pm_photon *g, *c;
+    long ng, cg, nc, cc;
+    long rays;
+    int oom;
+} chunk_out;
+
+typedef struct {
+    const scene *sc;
+    const accel *a;
+    const pm_lights *L;
+    const pm_photon_settings *s;
+    source *src;
+    int nsrc;
+    long total;
+    chunk_out *chunks;
+    int nchunks;
+    double eps;
+    vec3 centre;       /* bounding sphere of finite geometry */
+    double radius;
+} trace_ctx;
+
+static inline rgb crgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
+static inline double cmax(rgb c) { return fmax(fabs(c.r), fmax(fabs(c.g), fabs(c.b))); }
+
+static int push(pm_photon **arr, long *n, long *cap, vec3 p, rgb pw, vec3 nrm)
+{
+    if (*n == *cap) {
+        long nc = *cap ? *cap * 2 : 256;
+        pm_photon *na = realloc(*arr, sizeof(pm_photon) * (size_t)nc);
+        if (!na) return 0;
+        *arr = na;
+        *cap = nc;
+    }
+    pm_photon_set(&(*arr)[(*n)++], p, pw, nrm);
+    return 1;
+}
+
+/* Uniform direction in the cone cos(theta) >= cos_max about unit axis. */
+static vec3 cone_dir(vec3 axis, double cos_max, double u1, double u2)
+{
+    double ct = 1.0 - u1 * (1.0 - cos_max), st = sqrt(fmax(0.0, 1.0 - ct * ct)), phi = 2.0 * M_PI * u2;
+    vec3 t, b;
+    v3_basis(axis, &t, &b);
+    return v3_add(v3_add(v3_scale(t, st * cos(phi)), v3_scale(b, st * sin(phi))), v3_scale(axis, ct));
+}
+
+static vec3 disc_point(vec3 c, vec3 axis, double radius, double u1, double u2)
+{
+    vec3 t, b;
+    v3_basis(axis, &t, &b);
+    double rho = radius * sqrt(u1), phi = 2.0 * M_PI * u2;
+    return v3_add(c, v3_add(v3_scale(t, rho * cos(phi)), v3_scale(b, rho * sin(phi))));
+}
+
+/* First hit seen from a POV-Ray light: no_shadow objects let it through, as
+ * they do for shade.c's shadow rays. */
+static int light_first_hit(const trace_ctx *c, vec3 o, vec3 w, accel_hit *h, long *rays)
+{
+    double tmin = c->eps;
+    for (int k = 0; k < SKIP_MAX; k++) {
+        (*rays)++;
+        if (!accel_intersect(c->a, o, w, tmin, INFINITY, h)) return 0;
+        if (!(h->flags & OBJ_NO_SHADOW)) return 1;
+        tmin = h->t + fmax(c->eps, h->t * 1e-7);
+    }
+    return 0;
+}
+
+/* Emit one photon of source `src`: fills the first hit and its power. */
+static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec3 *w, rgb *phi, long *rays)
+{
+    double n = (double)src->n;
+    if (src->kind == SRC_LIGHT) {
+        const scene_light *l = src->l;
+        rgb C = l->colour;
+        if (l->kind == LIGHT_CYLINDER) {
+            vec3 axis = v3_norm(v3_sub(l->point_at, l->position));
+            double R = fabs(l->falloff);
+            vec3 o = disc_point(l->position, axis, R, rng_f64(r), rng_f64(r));
+            *w = axis;
+            if (!light_first_hit(c, o, axis, h, rays)) return 0;
+            vec3 dl;
+            double depth;
+            light_ray(l, l->position, h->p, &dl, &depth);
+            double att = light_attenuation(l, h->p, dl, depth);
+            double k = M_PI * att * M_PI * R * R / n;
+            *phi = crgb(C.r * k, C.g * k, C.b * k);
+            return 1;
+        }
+        if (l->parallel || l->kind == LIGHT_PARALLEL) {
+            vec3 to_light = v3_norm(v3_sub(l->position, l->point_at));
+            vec3 cp = v3_sub(c->centre, v3_scale(to_light, v3_dot(v3_sub(c->centre, l->position), to_light)));
+            double R = c->radius;
+            vec3 o = disc_point(cp, to_light, R, rng_f64(r), rng_f64(r));
+            *w = v3_neg(to_light);
+            if (!light_first_hit(c, o, *w, h, rays)) return 0;
+            vec3 dl;
+            double depth;
+            light_ray(l, l->position, h->p, &dl, &depth);
+            double att = light_attenuation(l, h->p, dl, depth);
+            double k = M_PI * att * M_PI * R * R / n;
+            *phi = crgb(C.r * k, C.g * k, C.b * k);
+            return 1;
+        }
+        vec3 q = l->position;
+        if (l->area && l->size1 * l->size2 > 1) {
+            double u = rng_f64(r), v = rng_f64(r);
+            vec3 e1 = l->size1 > 1 ? l->axis1 : v3s(0.0), e2 = l->size2 > 1 ? l->axis2 : v3s(0.0);
+            if (l->circular && l->size1 > 1 && l->size2 > 1) {
+                double rho = 0.5 * sqrt(u), ph = 2.0 * M_PI * v;
+                q = v3_add(q, v3_add(v3_scale(e1, rho * cos(ph)), v3_scale(e2, rho * sin(ph))));
+            } else {
+                q = v3_add(q, v3_add(v3_scale(e1, u - 0.5), v3_scale(e2, v - 0.5)));
+            }
+        }
+        vec3 axis = v3(0, 0, 1);
+        double cos_max = src->cos_max;
+        if (l->kind == LIGHT_SPOT) axis = v3_norm(v3_sub(l->point_at, l->position));
+        *w = cone_dir(axis, cos_max, rng_f64(r), rng_f64(r));
+        double pdf = 1.0 / (2.0 * M_PI * (1.0 - cos_max));
+        if (!light_first_hit(c, q, *w, h, rays)) return 0;
+        vec3 dl;
+        double depth;
+        light_ray(l, q, h->p, &dl, &depth);
+        double att = light_attenuation(l, h->p, dl, depth);
+        double d = v3_len(v3_sub(h->p, q));
+        double k = M_PI * att * d * d / (n * pdf);
+        *phi = crgb(C.r * k, C.g * k, C.b * k);
+        return 1;
+    }
+    if (src->kind == SRC_EMIT) {
+        const accel_surf *es = pm_lights_emitters(c->L);
+        accel_surf_sample s;
+        if (!accel_surf_sample_point(es, rng_f64(r), rng_f64(r), rng_f64(r), r, &s)) return 0;
+        vec3 ns = rng_f64(r) < 0.5 ? s.n : v3_neg(s.n);
+        *w = mat_cosine_dir(ns, rng_f64(r), rng_f64(r));
+        vec3 o = v3_madd(s.p, ns, c->eps);
+        (*rays)++;
+        if (!accel_intersect(c->a, o, *w, c->eps, INFINITY, h)) return 0;
+        rgb le = pm_lights_piece_emission(c->L, s.piece);
+        double k = 2.0 * M_PI / (n * s.pdf_area);
+        *phi = crgb(le.r * k, le.g * k, le.b * k);
+        return 1;
+    }
+    /* background */
+    vec3 wd = cone_dir(v3(0, 0, 1), -1.0, rng_f64(r), rng_f64(r));
+    double R = c->radius;
+    vec3 o = disc_point(v3_madd(c->centre, wd, -R * 1.001), wd, R, rng_f64(r), rng_f64(r));
+    *w = wd;
+    (*rays)++;
+    if (!accel_intersect(c->a, o, wd, c->eps, INFINITY, h)) return 0;
+    const colour5 *bg = &c->sc->background;
+    double k = 4.0 * M_PI * M_PI * R * R / n;
+    *phi = crgb(bg->r * k, bg->g * k, bg->b * k);
+    return 1;
+}
+
+static void trace_one(const trace_ctx *c, const source *src, long index, chunk_out *out)
+{
+    rng r;
+    rng_seed(&r, pm_mix64(c->s->seed ^ 0x70686f746f6e73ULL), (uint64_t)index);
+    accel_hit h;
+    vec3 w;
+    rgb phi;
+    if (!emit(c, src, &r, &h, &w, &phi, &out->rays)) return;
+    int from_light = src->kind == SRC_LIGHT;
+    int store_first = src->kind == SRC_ENV;
+    int spec_only = 1;
+    for (int bounce = 0;; bounce++) {
+        mat_bsdf b;
+        mat_setup(&b, c->sc, &h, w, c->eps, &r);
+        int lambert = b.m[MAT_LOBE_DIFFUSE] > 0.0 || b.m[MAT_LOBE_BACK] > 0.0;
+        if (lambert && (bounce >= 1 || store_first) && cmax(phi) > 0.0) {
+            if (!push(&out->g, &out->ng, &out->cg, h.p, phi, b.ng)) { out->oom = 1; return; }
+            if (c->s->caustics && from_light && spec_only && bounce >= 1)
+                if (!push(&out->c, &out->nc, &out->cc, h.p, phi, b.ng)) { out->oom = 1; return; }
+        }
+        if (bounce >= c->s->max_bounces) return;
+        mat_scatter s;
+        if (!mat_sample(&b, &r, 1, &s)) return;
+        if (s.specular && bounce == 0 && from_light && !c->s->caustics) return;
+        if (!s.specular) spec_only = 0;
+        double k = s.eta2;
+        phi = crgb(phi.r * s.weight.r * k, phi.g * s.weight.g * k, phi.b * s.weight.b * k);
+        if (!(cmax(phi) > 0.0) || !isfinite(phi.r + phi.g + phi.b)) return;
+        w = s.dir;
+        out->rays++;
+        if (!accel_intersect(c->a, s.org, w, c->eps, INFINITY, &h)) return;
+    }
+}
+
+static void chunk_job(void *ctx, int ci, int thread)
+{
+    (void)thread;
+    trace_ctx *c = ctx;
+    if (c->s->cancel && *c->s->cancel) return;
+    long i0 = (long)ci * CHUNK, i1 = i0 + CHUNK < c->total ? i0 + CHUNK : c->total;
+    chunk_out *out = &c->chunks[ci];
+    int si = 0;
+    for (long i = i0; i < i1 && !out->oom; i++) {
+        while (si < c->nsrc - 1 && i >= c->src[si].first + c->src[si].n) si++;
+        trace_one(c, &c->src[si], i, out);
+    }
+}
+
+static double fade_at(const scene_light *l, double d)
+{
+    if (l->fade_power <= 0.0) return 1.0;
+    if (fabs(l->fade_distance) >= 1e-10) return 2.0 / (1.0 + pow(d / l->fade_distance, l->fade_power));
+    return pow(d, -l->fade_power);
+}
+
+pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, const pm_photon_settings *s,
+                           pm_photon_result *out)
+{
+    memset(out, 0, sizeof *out);
+    trace_ctx c;
+    memset(&c, 0, sizeof c);
+    c.sc = sc;
+    c.a = a;
+    c.L = L;
+    c.s = s;
+    c.eps = pm_lights_eps(L);
+    vec3 lo, hi;
+    accel_bounds(a, &lo, &hi);
+    c.centre = v3_scale(v3_add(lo, hi), 0.5);
+    c.radius = 0.5 * v3_len(v3_sub(hi, lo)) * 1.01 + 1e-9;
+    double D = 0.5 * v3_len(v3_sub(hi, lo));
+    if (!(D > 0.0)) D = 1.0;
+
+    source *src = calloc((size_t)sc->nlights + 2, sizeof(source));
+    if (!src) return PT_ERR_NOMEM;
+    int ns = 0;
+    for (int i = 0; i < sc->nlights; i++) {
+        const scene_light *l = &sc->lights[i];
+        source *q = &src[ns];
+        q->kind = SRC_LIGHT;
+        q->l = l;
+        q->cos_max = -1.0;
+        double cm = cmax(l->colour);
+        if (l->kind == LIGHT_CYLINDER) {
+            q->power = cm * M_PI * M_PI * l->falloff * l->falloff;
+        } else if (l->parallel || l->kind == LIGHT_PARALLEL) {
+            q->power = cm * M_PI * M_PI * c.radius * c.radius;
+        } else {
+            if (l->kind == LIGHT_SPOT) {
+                double cr = cos(l->radius * M_PI / 180.0), cf = cos(l->falloff * M_PI / 180.0);
+                q->cos_max = cr > 0.0 ? fmax(0.0, fmin(cf, cr)) : 0.0;
+            }
+            q->power = cm * M_PI * 2.0 * M_PI * (1.0 - q->cos_max) * D * D * fade_at(l, D);
+        }
+        if (q->power > 0.0 && isfinite(q->power)) ns++;
+    }
+    const accel_surf *es = pm_lights_emitters(L);
+    if (accel_surf_count(es) > 0 && accel_surf_total_weight(es) > 0.0) {
+        src[ns].kind = SRC_EMIT;
+        src[ns].power = 2.0 * M_PI * accel_surf_total_weight(es);
+        ns++;
+    }
+    rgb bgc = crgb(sc->background.r, sc->background.g, sc->background.b);
+    if (cmax(bgc) > 0.0 && D > 0.0) {
+        src[ns].kind = SRC_ENV;
+        src[ns].power = cmax(bgc) * M_PI * 4.0 * M_PI * c.radius * c.radius;
+        ns++;
+    }
+    out->sources = ns;
+    if (ns == 0 || s->photons <= 0) {
+        free(src);
+        return PT_OK;
+    }
+    double ptotal = 0.0;
+    for (int i = 0; i < ns; i++) ptotal += src[i].power;
+    long total = 0;
+    long minimum = s->photons / 10 < 1000 ? s->photons / 10 : 1000;
+    if (minimum < 1) minimum = 1;
+    for (int i = 0; i < ns; i++) {
+        long n = (long)floor((double)s->photons * src[i].power / ptotal + 0.5);
+        if (n < minimum) n = minimum;
+        src[i].n = n;
+        src[i].first = total;
+        total += n;
+    }
+    c.src = src;
+    c.nsrc = ns;
+    c.total = total;
+    c.nchunks = (int)((total + CHUNK - 1) / CHUNK);
+    c.chunks = calloc((size_t)c.nchunks, sizeof(chunk_out));
+    if (!c.chunks) {
+        free(src);
+        return PT_ERR_NOMEM;
+    }
+    pool_run(pm_threads(s->threads), c.nchunks, chunk_job, &c);
+
+    long ng = 0, nc = 0;
+    int oom = 0;
+    for (int i = 0; i < c.nchunks; i++) {
+        ng += c.chunks[i].ng;
+        nc += c.chunks[i].nc;
+        out->rays += c.chunks[i].rays;
+        oom |= c.chunks[i].oom;
+    }
+    out->global = malloc(sizeof(pm_photon) * (size_t)(ng > 0 ? ng : 1));
+    out->caustic = malloc(sizeof(pm_photon) * (size_t)(nc > 0 ? nc : 1));
+    if (!out->global || !out->caustic) oom = 1;
+    long kg = 0, kc = 0;
+    for (int i = 0; i < c.nchunks; i++) {
+        if (!oom) {
+            memcpy(out->global + kg, c.chunks[i].g, sizeof(pm_photon) * (size_t)c.chunks[i].ng);
+            memcpy(out->caustic + kc, c.chunks[i].c, sizeof(pm_photon) * (size_t)c.chunks[i].nc);
+        }
+        kg += c.chunks[i].ng;
+        kc += c.chunks[i].nc;
+        free(c.chunks[i].g);
+        free(c.chunks[i].c);
+    }
+    free(c.chunks);
+    free(src);
+    if (oom) {
+        free(out->global);
+        free(out->caustic);
+        memset(out, 0, sizeof *out);
+        return PT_ERR_NOMEM;
+    }
+    out->nglobal = ng;
+    out->ncaustic = nc;
+    out->emitted = total;
+    return PT_OK;
+}

@@ -1,0 +1,65 @@
+/* pm_photon.h - photon tracing for pmfg (Jensen 1996; seed 002, appendix A:
+ * emission in proportion to power, Russian roulette at every bounce with
+ * the surface's scatter probability, power scaled by reflectance/probability).
+ *
+ * Sources: every POV-Ray light type (point, spot, cylinder, parallel, area
+ * grids), the emissive surfaces, and a non-black background. The photons
+ * carry only the light that next-event estimation does not: a photon's
+ * first hit after leaving a light source or an emitter is not stored (that
+ * direct light is computed by shadow rays, pm_nee.h); photons of the
+ * background (no NEE) are stored from their first hit on.
+ *
+ * Power normalisation (POV-Ray units, derived in pm_photon.c): a POV-Ray
+ * light of colour C gives irradiance E = pi * C * att * cos at any distance,
+ * i.e. a point source of distance-dependent intensity I(d) = pi C att(d) d^2.
+ * A photon leaving it along w (density p(w)) and first hitting at distance
+ * d gets power  Phi = pi C att(d) d^2 / (N p(w)),  so the photon density
+ * times Phi reproduces exactly the E that shade.c's diffuse term uses.
+ * Without fade_power these lights are not physical (their total power grows
+ * with the scene size); the indirect light is still the one the NEE direct
+ * light implies, because every photon's power is fixed at its first hit.
+ *
+ * Maps: global = photons stored at surfaces with a Lambertian lobe after at
+ * least one bounce (all path types); caustic = photons from POV-Ray lights
+ * that reached a Lambertian surface through specular bounces only (L S+ D).
+ * POV-Ray lights are invisible to BSDF rays, so the path tracer cannot find
+ * L S+ ... paths from them; with caustics off, photons from POV-Ray lights
+ * whose first bounce is specular are dropped so that pmfg and path converge
+ * to the same image. With caustics on (default when the scene has a
+ * global photons{} block, which is how POV-Ray asks for caustics) those
+ * paths are kept: pmfg then shows caustics that path cannot. Per-object
+ * photons{target ...} blocks are not read (the IR does not carry them yet):
+ * every specular surface is a caustic target. */
+#ifndef PT_PM_PHOTON_H
+#define PT_PM_PHOTON_H
+#include "accel.h"
+#include "pm.h"
+#include "pm_kdtree.h"
+#include "pm_nee.h"
+
+typedef struct {
+    long photons;        /* photon paths emitted (all sources together) */
+    int caustics;        /* 1: keep L S+ D paths of POV-Ray lights and fill the caustic map */
+    int max_bounces;     /* hard cap on bounces (Russian roulette ends most paths first) */
+    uint64_t seed;
+    int threads;
+    volatile int *cancel;
+} pm_photon_settings;
+
+typedef struct {
+    pm_photon *global;
+    long nglobal;
+    pm_photon *caustic;
+    long ncaustic;
+    long emitted;        /* photon paths actually emitted */
+    long rays;           /* segments traced */
+    int sources;
+} pm_photon_result;
+
+/* Trace. The arrays in `out` are malloc'd (ownership passes to the caller,
+ * e.g. to pm_kdtree_build). Deterministic for a given seed, independent of
+ * the thread count. */
+pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, const pm_photon_settings *s,
+                           pm_photon_result *out);
+
+#endif

@@ -1,0 +1,529 @@
+/* test_reference.c - the reference renderers (issue 6) and their parts.
+ *
+ * Numbers and tolerances (each test prints what it measured):
+ *  - furnace: camera inside a closed unit sphere, surface emission Le = 1
+ *    (pigment 1, emission 1, ambient 0), albedo rho = diffuse. Every pixel
+ *    converges to Le / (1 - rho). 16x16 pixels. The image mean must be
+ *    within 1% (rho 0.5) / 2% (rho 0.9), as issue 6 asks, and every pixel
+ *    within the same bound (path: enough samples that the per-pixel noise,
+ *    printed, is far below it).
+ *  - point-light furnace: the same sphere without emission and a POV-Ray
+ *    point light of colour 1 at the centre. POV-Ray lights give irradiance
+ *    pi*C at any distance, so L = rho C + rho L, L = rho C / (1 - rho).
+ *    This checks the photon power normalisation of POV-Ray lights.
+ *  - direct-only equivalence: path tracer with max depth 1 and pixel-centre
+ *    samples against shade_render (--gi none, ambient off) on a scene with a
+ *    point light, a spotlight, diffuse and phong/specular surfaces: equal to
+ *    1e-5 relative (the same NEE code; the only differences are rounding).
+ *  - determinism: a fixed seed gives bit-identical images, with 1 or 2 threads.
+ *  - no NaN: lights touching and inside surfaces: every pixel finite.
+ *  - accel_surface: world areas against closed forms (spheroid, sheared box,
+ *    torus) to 1e-6, the clipped plane to 1e-4 (padded clip box), uniformity of spheroid samples per z band
+ *    against the exact band areas (within 5 sigma), pdf lookup at hits.
+ *  - kd-tree: k nearest equal to brute force. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "accel.h"
+#include "accel_surface.h"
+#include "framebuffer.h"
+#include "pm.h"
+#include "pm_fg.h"
+#include "pm_kdtree.h"
+#include "pm_path.h"
+#include "sdl.h"
+#include "shade.h"
+
+#define THREADS 2
+
+static scene *parse(const char *text)
+{
+    sdl_options so;
+    sdl_default_options(&so);
+    diag *d = diag_new();
+    scene *sc = NULL;
+    pt_status st = sdl_parse_string("test.pov", text, &so, &sc, d);
+    if (st != PT_OK) {
+        for (int i = 0; i < diag_count(d); i++) {
+            char *m = diag_format(diag_get(d, i));
+            fprintf(stderr, "%s\n", m ? m : "?");
+            free(m);
+        }
+    }
+    diag_free(d);
+    assert_int_equal(st, PT_OK);
+    return sc;
+}
+
+static accel *build(const scene *sc)
+{
+    diag *d = diag_new();
+    pt_status st;
+    accel *a = accel_build(sc, THREADS, d, &st);
+    diag_free(d);
+    assert_int_equal(st, PT_OK);
+    assert_non_null(a);
+    return a;
+}
+
+/* Mean over pixels and channels, and the largest relative deviation of a
+ * pixel's channel mean from `expect`. */
+static void image_stats(const framebuffer *fb, double expect, double *mean, double *maxdev, double *sd)
+{
+    double s = 0.0, s2 = 0.0, md = 0.0;
+    int n = fb->width * fb->height;
+    for (int i = 0; i < n; i++) {
+        const float *p = fb->rgb + (size_t)i * 3;
+        double v = (p[0] + p[1] + p[2]) / 3.0;
+        assert_true(isfinite(v));
+        s += v;
+        s2 += v * v;
+        md = fmax(md, fabs(v / expect - 1.0));
+    }
+    *mean = s / n;
+    *sd = sqrt(fmax(0.0, s2 / n - *mean * *mean)) / expect;
+    *maxdev = md;
+}
+
+static const char *furnace_fmt =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 }\n"
+    "camera { perspective location <0,0,0> look_at <0,0,1> angle 90 }\n"
+    "sphere { <0,0,0>, 1 pigment { rgb 1 } finish { ambient 0 diffuse %g emission %g } }\n"
+    "%s\n";
+
+static void furnace_path(double rho, double le, const char *light, int spp, double expect, double tol)
+{
+    char text[1024];
+    snprintf(text, sizeof text, furnace_fmt, rho, le, light);
+    scene *sc = parse(text);
+    accel *a = build(sc);
+    pm_path_settings s;
+    pm_path_default_settings(&s);
+    s.c.width = s.c.height = 16;
+    s.c.threads = THREADS;
+    s.c.spp = spp;
+    s.c.seed = 7;
+    framebuffer *fb = fb_new(16, 16);
+    pm_stats st;
+    assert_int_equal(pm_path_render(sc, a, &s, fb, &st, NULL), PT_OK);
+    double mean, maxdev, sd;
+    image_stats(fb, expect, &mean, &maxdev, &sd);
+    printf("furnace path  rho %.1f %-11s spp %5d: mean %.5f (expect %.5f, rel err %+.4f), max pixel dev %.4f, "
+           "pixel sd %.4f (tol %.2f), %.1f s, %.2f Mrays/s, discarded %ld\n",
+           rho, light[0] ? "point light" : "emission", spp, mean, expect, mean / expect - 1.0, maxdev, sd, tol,
+           st.t_total, (st.camera_rays + st.bsdf_rays + st.shadow_rays) / st.t_render * 1e-6, st.discarded_samples);
+    assert_true(fabs(mean / expect - 1.0) <= tol);
+    assert_true(maxdev <= tol);
+    assert_int_equal(st.discarded_samples, 0);
+    fb_free(fb);
+    accel_free(a);
+    scene_free(sc);
+}
+
+static void furnace_fg(double rho, double le, const char *light, long photons, double expect, double tol)
+{
+    char text[1024];
+    snprintf(text, sizeof text, furnace_fmt, rho, le, light);
+    scene *sc = parse(text);
+    accel *a = build(sc);
+    pm_fg_settings s;
+    pm_fg_default_settings(&s);
+    s.c.width = s.c.height = 16;
+    s.c.threads = THREADS;
+    s.c.seed = 11;
+    s.photons = photons;
+    framebuffer *fb = fb_new(16, 16);
+    pm_stats st;
+    assert_int_equal(pm_fg_render(sc, a, &s, fb, &st, NULL), PT_OK);
+    double mean, maxdev, sd;
+    image_stats(fb, expect, &mean, &maxdev, &sd);
+    printf("furnace pmfg  rho %.1f %-11s fg %d photons %ld (global %ld): mean %.5f (expect %.5f, rel err %+.4f), "
+           "max pixel dev %.4f, pixel sd %.4f (tol %.2f), photons %.2f s, irradiance %.2f s, render %.2f s\n",
+           rho, light[0] ? "point light" : "emission", s.fg_rays, st.photons_emitted, st.photons_global, mean, expect,
+           mean / expect - 1.0, maxdev, sd, tol, st.t_photons, st.t_irradiance, st.t_render);
+    assert_true(fabs(mean / expect - 1.0) <= tol);
+    assert_true(maxdev <= tol);
+    assert_int_equal(st.discarded_samples, 0);
+    fb_free(fb);
+    accel_free(a);
+    scene_free(sc);
+}
+
+static void test_furnace_path_05(void **state) { (void)state; furnace_path(0.5, 1.0, "", 2048, 2.0, 0.01); }
+static void test_furnace_path_09(void **state) { (void)state; furnace_path(0.9, 1.0, "", 1024, 10.0, 0.02); }
+static void test_furnace_fg_05(void **state) { (void)state; furnace_fg(0.5, 1.0, "", 100000, 2.0, 0.01); }
+static void test_furnace_fg_09(void **state) { (void)state; furnace_fg(0.9, 1.0, "", 100000, 10.0, 0.02); }
+
+static const char *centre_light = "light_source { <0,0,0> color rgb 1 }";
+static void test_furnace_point_path(void **state) { (void)state; furnace_path(0.5, 0.0, centre_light, 2048, 1.0, 0.01); }
+static void test_furnace_point_fg(void **state) { (void)state; furnace_fg(0.5, 0.0, centre_light, 100000, 1.0, 0.01); }
+
+/* ------------------------------------------------------------ direct only == --gi none */
+
+static const char *direct_scene =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 }\n"
+    "camera { location <0, 2, -6> look_at <0, 0.5, 0> angle 50 }\n"
+    "light_source { <3, 5, -4> color rgb <1, 0.9, 0.8> }\n"
+    "light_source { <-3, 4, -1> color rgb 0.6 spotlight point_at <0,0,0> radius 15 falloff 25 tightness 5 }\n"
+    "plane { y, 0 pigment { rgb <0.8, 0.7, 0.6> } finish { ambient 0 diffuse 0.7 } }\n"
+    "sphere { <0, 1, 0>, 1 pigment { rgb <0.9, 0.2, 0.2> } finish { ambient 0 diffuse 0.6 phong 0.8 phong_size 30 } }\n"
+    "box { <1.3, 0, -0.5>, <2.3, 1.2, 0.5> rotate y*30 pigment { rgb <0.2, 0.5, 0.9> }\n"
+    "      finish { ambient 0 diffuse 0.8 brilliance 2 specular 0.5 roughness 0.02 } }\n";
+
+static void test_direct_equivalence(void **state)
+{
+    (void)state;
+    scene *sc = parse(direct_scene);
+    accel *a = build(sc);
+    int w = 48, h = 36;
+    shade_settings ss;
+    shade_default_settings(&ss);
+    ss.width = w;
+    ss.height = h;
+    ss.threads = THREADS;
+    ss.use_ambient = 0;
+    framebuffer *ref = fb_new(w, h);
+    shade_stats sst;
+    assert_int_equal(shade_render(sc, a, &ss, ref, &sst, NULL), PT_OK);
+    pm_path_settings ps;
+    pm_path_default_settings(&ps);
+    ps.c.width = w;
+    ps.c.height = h;
+    ps.c.threads = THREADS;
+    ps.c.spp = 1;
+    ps.c.jitter = 0;
+    ps.max_depth = 1;
+    framebuffer *fb = fb_new(w, h);
+    pm_stats st;
+    assert_int_equal(pm_path_render(sc, a, &ps, fb, &st, NULL), PT_OK);
+    double maxdiff = 0.0, maxval = 0.0, mean_ref = 0.0, mean_pt = 0.0;
+    for (int i = 0; i < w * h * 3; i++) {
+        maxdiff = fmax(maxdiff, fabs(fb->rgb[i] - ref->rgb[i]));
+        maxval = fmax(maxval, fabs(ref->rgb[i]));
+        mean_ref += ref->rgb[i];
+        mean_pt += fb->rgb[i];
+    }
+    printf("direct only: path(max depth 1) vs --gi none: max |diff| %.3g (max value %.3g), means %.6f / %.6f "
+           "(tol 1e-5 relative)\n",
+           maxdiff, maxval, mean_pt / (w * h * 3), mean_ref / (w * h * 3));
+    assert_true(maxval > 0.1);
+    assert_true(maxdiff <= 1e-5 * maxval);
+    fb_free(fb);
+    fb_free(ref);
+    accel_free(a);
+    scene_free(sc);
+}
+
+/* ------------------------------------------------------------ determinism */
+
+static const char *small_scene =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 }\n"
+    "camera { location <0, 2, -5> look_at <0, 0.5, 0> angle 50 }\n"
+    "light_source { <2, 4, -3> color rgb 1 area_light x, z, 3, 3 }\n"
+    "plane { y, 0 pigment { rgb 0.7 } finish { ambient 0 diffuse 0.8 } }\n"
+    "sphere { <0, 1, 0>, 1 pigment { rgb <0.9, 0.3, 0.2> } finish { ambient 0 diffuse 0.7 reflection 0.2 } }\n"
+    "box { <-3, 0, -1>, <-2, 2, 1> pigment { rgb 1 } finish { ambient 0 diffuse 0 emission 2 } }\n"
+    "sphere { <1.6, 0.5, -0.8>, 0.5 pigment { rgbf <1, 1, 1, 0.9> } interior { ior 1.5 } }\n";
+
+static framebuffer *render_small(int fg, int threads, uint64_t seed, pm_stats *st)
+{
+    scene *sc = parse(small_scene);
+    accel *a = build(sc);
+    framebuffer *fb = fb_new(24, 16);
+    if (fg) {
+        pm_fg_settings s;
+        pm_fg_default_settings(&s);
+        s.c.width = 24;
+        s.c.height = 16;
+        s.c.threads = threads;
+        s.c.seed = seed;
+        s.c.spp = 2;
+        s.fg_rays = 64;
+        s.photons = 20000;
+        s.caustics = 1;
+        assert_int_equal(pm_fg_render(sc, a, &s, fb, st, NULL), PT_OK);
+    } else {
+        pm_path_settings s;
+        pm_path_default_settings(&s);
+        s.c.width = 24;
+        s.c.height = 16;
+        s.c.threads = threads;
+        s.c.seed = seed;
+        s.c.spp = 16;
+        assert_int_equal(pm_path_render(sc, a, &s, fb, st, NULL), PT_OK);
+    }
+    accel_free(a);
+    scene_free(sc);
+    return fb;
+}
+
+static void test_determinism(void **state)
+{
+    (void)state;
+    for (int fg = 0; fg < 2; fg++) {
+        pm_stats s1, s2, s3, s4;
+        framebuffer *a = render_small(fg, 2, 5, &s1);
+        framebuffer *b = render_small(fg, 2, 5, &s2);
+        framebuffer *c = render_small(fg, 1, 5, &s3);
+        framebuffer *d = render_small(fg, 2, 6, &s4);
+        size_t n = sizeof(float) * 24 * 16 * 3;
+        int same_ab = memcmp(a->rgb, b->rgb, n) == 0, same_ac = memcmp(a->rgb, c->rgb, n) == 0;
+        int same_ad = memcmp(a->rgb, d->rgb, n) == 0;
+        printf("determinism %s: seed 5 twice %s, 1 vs 2 threads %s, seed 6 %s; caustic photons %ld\n",
+               fg ? "pmfg" : "path", same_ab ? "identical" : "DIFFERENT", same_ac ? "identical" : "DIFFERENT",
+               same_ad ? "IDENTICAL" : "differs (as it should)", s1.photons_caustic);
+        assert_true(same_ab);
+        assert_true(same_ac);
+        assert_false(same_ad);
+        assert_int_equal(s1.samples, s2.samples);
+        fb_free(a);
+        fb_free(b);
+        fb_free(c);
+        fb_free(d);
+    }
+}
+
+/* ------------------------------------------------------------ no NaN */
+
+static const char *touch_scene =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 }\n"
+    "camera { location <0, 2, -5> look_at <0, 0.5, 0> angle 60 }\n"
+    "light_source { <0, 0, 0> color rgb 1 }\n"                                   /* on the floor */
+    "light_source { <1, 1, 0> color rgb 1 fade_distance 0 fade_power 2 }\n"        /* on the sphere, d^-2 */
+    "light_source { <-1, 0.5, 0> color rgb 1 area_light 2*x, 2*z, 4, 4 }\n"     /* through the box */
+    "light_source { <2, 0.5, 0> color rgb 1 spotlight point_at <2,0,0> radius 10 falloff 20 }\n"
+    "plane { y, 0 pigment { rgb 0.7 } finish { ambient 0 diffuse 0.8 } }\n"
+    "sphere { <1, 2, 0>, 1 pigment { rgb 0.5 } finish { ambient 0 diffuse 0.8 phong 1 } }\n"
+    "box { <-1.5, 0, -0.5>, <-0.5, 1, 0.5> pigment { rgb 0.8 } finish { ambient 0 diffuse 0.8 } }\n"
+    "sphere { <0, 0.3, -1>, 0.3 pigment { rgb 1 } finish { ambient 0 diffuse 0.5 emission 3 } }\n"
+    "sphere { <2, 0.5, 0>, 0.5 pigment { rgbt <1,1,1,0.8> } finish { reflection 0.1 } interior { ior 1.3 } }\n";
+
+static void test_no_nan(void **state)
+{
+    (void)state;
+    scene *sc = parse(touch_scene);
+    accel *a = build(sc);
+    for (int fg = 0; fg < 2; fg++) {
+        framebuffer *fb = fb_new(32, 24);
+        pm_stats st;
+        if (fg) {
+            pm_fg_settings s;
+            pm_fg_default_settings(&s);
+            s.c.width = 32;
+            s.c.height = 24;
+            s.c.threads = THREADS;
+            s.fg_rays = 64;
+            s.photons = 20000;
+            s.caustics = 1;
+            assert_int_equal(pm_fg_render(sc, a, &s, fb, &st, NULL), PT_OK);
+        } else {
+            pm_path_settings s;
+            pm_path_default_settings(&s);
+            s.c.width = 32;
+            s.c.height = 24;
+            s.c.threads = THREADS;
+            s.c.spp = 16;
+            assert_int_equal(pm_path_render(sc, a, &s, fb, &st, NULL), PT_OK);
+        }
+        int finite = 1;
+        for (int i = 0; i < 32 * 24 * 3; i++) finite &= isfinite(fb->rgb[i]) != 0;
+        printf("no NaN %s: lights touching surfaces: all pixels finite: %s, discarded samples %ld of %ld, mean %.4f\n",
+               fg ? "pmfg" : "path", finite ? "yes" : "NO", st.discarded_samples, st.samples, fb_mean(fb, -1));
+        assert_true(finite);
+        fb_free(fb);
+    }
+    accel_free(a);
+    scene_free(sc);
+}
+
+/* ------------------------------------------------------------ accel_surface */
+
+static void test_surface_areas(void **state)
+{
+    (void)state;
+    scene *sc = parse("#version 3.7;\n"
+                      "sphere { 0, 1 scale <1, 1, 3> translate <10, 0, 0> }\n"
+                      "box { <0,0,0>, <1,2,3> matrix <1,0,0, 0.5,1,0, 0,0.3,1, 0,0,0> translate <0, 0, 10> }\n"
+                      "torus { 2, 0.5 scale 1.5 translate <-10, 0, 0> }\n"
+                      "plane { y, 0.5 }\n");
+    accel *a = build(sc);
+    diag *d = diag_new();
+    pt_status st;
+    accel_surf *as = accel_surf_build(sc, a, NULL, NULL, d, &st);
+    assert_non_null(as);
+    assert_int_equal(accel_surf_count(as), 4);
+    /* prolate spheroid a = 1, c = 3: 2 pi a^2 (1 + c/(a e) asin e), e = sqrt(1 - a^2/c^2) */
+    double e = sqrt(1.0 - 1.0 / 9.0);
+    double spheroid = 2.0 * M_PI * (1.0 + 3.0 / e * asin(e));
+    /* sheared box: sum of |M e1 x M e2| over faces; POV-Ray's row-vector
+     * matrix maps x, y, z to its rows (1,0,0), (0.5,1,0), (0,0.3,1) */
+    vec3 ex = v3(1, 0, 0), ey = v3(0.5, 1, 0), ez = v3(0, 0.3, 1);
+    double box = 2.0 * (2 * 3 * v3_len(v3_cross(ey, ez)) + 1 * 3 * v3_len(v3_cross(ex, ez)) +
+                        1 * 2 * v3_len(v3_cross(ex, ey)));
+    double torus = 4.0 * M_PI * M_PI * 2.0 * 0.5 * 1.5 * 1.5;
+    vec3 lo, hi;
+    accel_bounds(a, &lo, &hi);
+    double plane = (hi.x - lo.x) * (hi.z - lo.z);
+    double expect[4] = {spheroid, box, torus, plane};
+    const char *name[4] = {"spheroid", "sheared box", "torus", "clipped plane"};
+    /* the plane's clip box is the scene bounds padded by 1e-6 of their size */
+    double tol[4] = {1e-6, 1e-6, 1e-6, 1e-4};
+    for (int i = 0; i < 4; i++) {
+        double got = accel_surf_piece_at(as, i)->area;
+        printf("surface area %-13s %.9f expect %.9f (rel %.2e, tol %g)\n", name[i], got, expect[i],
+               fabs(got / expect[i] - 1.0), tol[i]);
+        assert_true(fabs(got / expect[i] - 1.0) < tol[i]);
+    }
+    accel_surf_free(as);
+    diag_free(d);
+    accel_free(a);
+    scene_free(sc);
+}
+
+static double only_spheroid(void *ctx, const scene_object *o, const scene_texture *t, unsigned f)
+{
+    (void)ctx; (void)t; (void)f;
+    return o->kind == SHAPE_SPHERE ? 1.0 : 0.0;
+}
+
+/* Band area of the spheroid x^2 + y^2 + z^2/9 = 1 between z0 and z1. */
+static double band_area(double z0, double z1)
+{
+    int n = 20000;
+    double acc = 0.0, h = (z1 - z0) / n;
+    for (int i = 0; i < n; i++) {
+        double z = z0 + (i + 0.5) * h;
+        double rho = sqrt(fmax(0.0, 1.0 - z * z / 9.0));
+        double drho = -z / (9.0 * rho);
+        acc += 2.0 * M_PI * rho * sqrt(1.0 + drho * drho) * h;
+    }
+    return acc;
+}
+
+static void test_surface_uniform(void **state)
+{
+    (void)state;
+    scene *sc = parse("#version 3.7;\n"
+                      "sphere { 0, 1 scale <1, 1, 3> rotate <0, 0, 0> pigment { rgb 1 } finish { emission 1 } }\n"
+                      "box { <-5,-5,-5>, <5,5,5> }\n");
+    accel *a = build(sc);
+    diag *d = diag_new();
+    pt_status st;
+    accel_surf *as = accel_surf_build(sc, a, only_spheroid, NULL, d, &st);
+    assert_int_equal(accel_surf_count(as), 1);
+    double total = accel_surf_total_area(as);
+    enum { NB = 12, N = 240000 };
+    long bins[NB] = {0};
+    rng r;
+    rng_seed(&r, 3, 1);
+    int pdf_ok = 1;
+    for (int i = 0; i < N; i++) {
+        accel_surf_sample s;
+        assert_true(accel_surf_sample_point(as, rng_f64(&r), rng_f64(&r), rng_f64(&r), &r, &s));
+        int b = (int)floor((s.p.z + 3.0) / 6.0 * NB);
+        if (b >= 0 && b < NB) bins[b]++;
+        if (i < 200) {
+            /* hit the sample from outside along its normal: same pdf */
+            vec3 o = v3_madd(s.p, s.n, 0.5);
+            accel_hit h;
+            if (accel_intersect(a, o, v3_neg(s.n), 0.0, 1.0, &h))
+                pdf_ok &= fabs(accel_surf_pdf(as, &h) - s.pdf_area) < 1e-12 && fabs(s.pdf_area * total - 1.0) < 1e-12;
+            else
+                pdf_ok = 0;
+        }
+    }
+    double worst = 0.0;
+    for (int b = 0; b < NB; b++) {
+        double p = band_area(-3.0 + 6.0 * b / NB, -3.0 + 6.0 * (b + 1) / NB) / total;
+        double sigma = sqrt(N * p * (1.0 - p));
+        worst = fmax(worst, fabs(bins[b] - N * p) / sigma);
+    }
+    printf("surface uniform: spheroid samples per z band, worst deviation %.2f sigma (tol 5); pdf at hits %s\n", worst,
+           pdf_ok ? "consistent" : "WRONG");
+    assert_true(worst < 5.0);
+    assert_true(pdf_ok);
+    accel_surf_free(as);
+    diag_free(d);
+    accel_free(a);
+    scene_free(sc);
+}
+
+/* ------------------------------------------------------------ kd-tree */
+
+static void test_kdtree(void **state)
+{
+    (void)state;
+    long n = 20000;
+    pm_photon *ph = malloc(sizeof(pm_photon) * (size_t)n);
+    pm_photon *copy = malloc(sizeof(pm_photon) * (size_t)n);
+    rng r;
+    rng_seed(&r, 9, 2);
+    for (long i = 0; i < n; i++) {
+        vec3 p = v3(rng_f64(&r), rng_f64(&r), rng_f64(&r) * 0.1);
+        vec3 nn = rng_f64(&r) < 0.5 ? v3(0, 0, 1) : v3(0, 0, -1);
+        rgb pw = {1, 1, 1};
+        pm_photon_set(&ph[i], p, pw, nn);
+    }
+    memcpy(copy, ph, sizeof(pm_photon) * (size_t)n);
+    pm_kdtree *t = pm_kdtree_build(ph, n, THREADS);
+    const pm_photon *tp = pm_kdtree_photons(t);
+    int mismatches = 0;
+    for (int q = 0; q < 200; q++) {
+        vec3 p = v3(rng_f64(&r), rng_f64(&r), rng_f64(&r) * 0.1);
+        vec3 nq = v3(0, 0, 1);
+        pm_neighbour out[16];
+        int k = pm_kdtree_knn(t, p, nq, 0.5, 16, 1.0, out);
+        /* brute force: 16th smallest d2 among compatible photons */
+        double best[16];
+        int nb = 0;
+        for (long i = 0; i < n; i++) {
+            if (copy[i].n[2] < 0) continue;
+            double dx = copy[i].p[0] - (float)p.x, dy = copy[i].p[1] - (float)p.y, dz = copy[i].p[2] - (float)p.z;
+            double d2 = dx * dx + dy * dy + dz * dz;
+            if (nb < 16) best[nb++] = d2;
+            else {
+                int m = 0;
+                for (int j = 1; j < 16; j++) if (best[j] > best[m]) m = j;
+                if (d2 < best[m]) best[m] = d2;
+            }
+        }
+        double far = 0.0;
+        for (int j = 0; j < nb; j++) far = fmax(far, best[j]);
+        if (k != 16 || fabs(out[0].d2 - far) > 1e-6 * far) mismatches++;
+        for (int j = 0; j < k; j++)
+            if (tp[out[j].idx].n[2] < 0) mismatches++;
+    }
+    printf("kd-tree: 200 queries of 16 nearest with a normal filter against brute force: %d mismatches\n", mismatches);
+    assert_int_equal(mismatches, 0);
+    pm_kdtree_free(t);
+    free(copy);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_kdtree),
+        cmocka_unit_test(test_surface_areas),
+        cmocka_unit_test(test_surface_uniform),
+        cmocka_unit_test(test_direct_equivalence),
+        cmocka_unit_test(test_determinism),
+        cmocka_unit_test(test_no_nan),
+        cmocka_unit_test(test_furnace_path_05),
+        cmocka_unit_test(test_furnace_path_09),
+        cmocka_unit_test(test_furnace_fg_05),
+        cmocka_unit_test(test_furnace_fg_09),
+        cmocka_unit_test(test_furnace_point_path),
+        cmocka_unit_test(test_furnace_point_fg),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
