@@ -8,7 +8,9 @@
  *     kd (1/N_f) sum L(w_i) + kb (1/N_b) sum L(w_j).
  * L at a gather hit y (seen along w) is its emission (weighted against the
  * emitter samples taken at x, pm_nee.h) plus its reflected radiance:
- * direct light by shadow rays + k_y/pi E_ind(y) + specular lobes, where
+ * direct light by shadow rays (one POV-Ray light picked in proportion to its
+ * unoccluded intensity, one emitter sample) + k_y/pi E_ind(y) + specular
+ * lobes, where
  * E_ind is the photon irradiance estimate (pm_kdtree_irradiance; the maps
  * hold only light that made at least one bounce, pm_photon.h).
  *
@@ -103,7 +105,7 @@ static rgb gather_hit(const fg_ctx *c, const mat_bsdf *b, int level, int thread,
 {
     rgb L = {0, 0, 0};
     if (b->nee) {
-        rgb d = pm_direct_lights(c->L, b, 1, r, &cnt->shadow);
+        rgb d = pm_direct_one_light(c->L, b, r, &cnt->shadow);
         L.r += d.r;
         L.g += d.g;
         L.b += d.b;

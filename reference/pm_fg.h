@@ -13,9 +13,10 @@
  *     emitters with emitter_samples samples and MIS against the gather rays),
  *     the caustic map at the eye hit, and a final gather of cosine-weighted,
  *     stratified rays over the Lambertian lobes. At a gather hit: the hit's
- *     own emission (MIS-weighted), its direct light by one shadow ray per
- *     light and emitter, the global-map irradiance times its Lambertian
- *     albedo, and its specular lobes followed by Russian roulette.
+ *     own emission (MIS-weighted), its direct light by one shadow ray to a
+ *     light picked at random and one to an emitter, the global-map
+ *     irradiance times its Lambertian albedo, and its specular lobes
+ *     followed by Russian roulette.
  *
  * The photon maps hold only light that NEE does not (pm_photon.h), so the
  * direct light of pmfg is the NEE term of the path tracer, and both converge

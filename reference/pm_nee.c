@@ -91,6 +91,45 @@ rgb pm_direct_lights(const pm_lights *L, const mat_bsdf *b, int area_samples, rn
     return total;
 }
 
+rgb pm_direct_one_light(const pm_lights *L, const mat_bsdf *b, rng *r, long *shadow_rays)
+{
+    rgb zero = {0, 0, 0};
+    int n = L->sc->nlights;
+    if (!b->nee || n == 0) return zero;
+    if (n == 1) return pm_direct_lights(L, b, 1, r, shadow_rays);
+    double wsum = 0.0, wstack[64];
+    double *w = n <= 64 ? wstack : malloc(sizeof(double) * (size_t)n);
+    if (!w) return pm_direct_lights(L, b, 1, r, shadow_rays);
+    for (int i = 0; i < n; i++) {
+        const scene_light *l = &L->sc->lights[i];
+        vec3 dir;
+        double depth;
+        light_ray(l, l->position, b->p_out, &dir, &depth);
+        double att = l->area && l->area_illumination ? 1.0 : light_attenuation(l, b->p_out, dir, depth);
+        double c = fmax(fabs(l->colour.r), fmax(fabs(l->colour.g), fabs(l->colour.b)));
+        w[i] = isfinite(att * c) && att * c > 0.0 ? att * c : 0.0;
+        wsum += w[i];
+    }
+    rgb out = zero;
+    if (wsum > 0.0) {
+        double u = rng_f64(r) * wsum, acc = 0.0;
+        int pick = n - 1;
+        for (int i = 0; i < n; i++) {
+            acc += w[i];
+            if (u < acc && w[i] > 0.0) { pick = i; break; }
+        }
+        while (pick > 0 && w[pick] <= 0.0) pick--;
+        double p = w[pick] / wsum;
+        light_ctx c = {L->a, L->eps, shadow_rays};
+        rgb v = mat_light_nee(b, &c, &L->sc->lights[pick], 1, r);
+        out.r = v.r / p;
+        out.g = v.g / p;
+        out.b = v.b / p;
+    }
+    if (w != wstack) free(w);
+    return out;
+}
+
 /* Visibility of y from o: nothing in between (emitters are found by BSDF
  * rays with accel_intersect, so no_shadow objects block here too). */
 static int visible(const pm_lights *L, vec3 o, vec3 y, vec3 *dir, double *dist)

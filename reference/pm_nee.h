@@ -32,6 +32,12 @@ int pm_lights_any(const pm_lights *L);                     /* POV lights, emitte
  * phong, specular), area lights with `area_samples` stratified samples. */
 rgb pm_direct_lights(const pm_lights *L, const mat_bsdf *b, int area_samples, rng *r, long *shadow_rays);
 
+/* The same estimated with one light chosen at random, with probability
+ * proportional to max-channel(colour) * attenuation seen from b (spot,
+ * cylinder and fade factors; unoccluded), one shadow ray: unbiased, for
+ * places that take many samples anyway (final-gather hits). */
+rgb pm_direct_one_light(const pm_lights *L, const mat_bsdf *b, rng *r, long *shadow_rays);
+
 /* Direct light of the emissive surfaces at b through its Lambertian lobes,
  * `n_light` samples by area. MIS against a BSDF strategy whose
  * count-weighted density for a direction wi is
