@@ -1,0 +1,281 @@
+/* bench_gi.c - particle-space GI (gi/gi_particle.h) figures: geometry stage
+ * time and memory, lighting stage time, frame time with GI against the
+ * same frame without (shade.c Whitted), and optionally a sweep of particle
+ * counts and bounce counts. Prints figures; never fails on a number.
+ *
+ *   bench_gi [SCENE.pov] [--size N] [--count N] [--nb N] [--threads N]
+ *            [--device SPEC] [--reps N] [--out PREFIX] [--sweep]
+ *
+ * --out PREFIX writes PREFIX_none.exr and PREFIX_particle.exr. --sweep runs
+ * counts 50K/100K/200K/400K x n_b 1/3/6/9 and prints lighting and frame
+ * times with the image's mean against the first setting's. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "accel.h"
+#include "gi_particle.h"
+#include "img_io.h"
+#include "sdl.h"
+#include "shade.h"
+#include "timer.h"
+
+#ifndef BENCH_SCENE_DIR
+#define BENCH_SCENE_DIR "scenes"
+#endif
+
+typedef struct {
+    const char *scene;
+    int size, threads, nb, reps, sweep;
+    long count;
+    const char *device, *out;
+} opts;
+
+static double mean_lum(const framebuffer *fb)
+{
+    double s = 0.0;
+    size_t n = (size_t)fb->width * fb->height;
+    for (size_t i = 0; i < n; i++) s += 0.2126 * fb->rgb[3 * i] + 0.7152 * fb->rgb[3 * i + 1] + 0.0722 * fb->rgb[3 * i + 2];
+    return s / (double)n;
+}
+
+static void report_diag(diag *d)
+{
+    for (int i = 0; i < diag_count(d); i++) {
+        char *m = diag_format(diag_get(d, i));
+        if (m) fprintf(stderr, "%s\n", m);
+        free(m);
+    }
+}
+
+static double render(const scene *sc, const accel *a, int size, int threads, gi_particle *gp, framebuffer *fb,
+                     shade_stats *ss, diag *d)
+{
+    shade_settings s;
+    shade_default_settings(&s);
+    s.width = s.height = size;
+    s.threads = threads;
+    if (gp) {
+        s.use_ambient = 0;
+        s.indirect = gi_particle_indirect;
+        s.indirect_ctx = gp;
+    }
+    double t0 = timer_now();
+    shade_render(sc, a, &s, fb, ss, d);
+    return timer_now() - t0;
+}
+
+static int cmp_d(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_d);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* One full GI frame: lighting + view + render. Returns the frame time. */
+static double gi_frame(const scene *sc, const accel *a, const opts *o, gi_particle *gp, framebuffer *fb, double *t_light,
+                       double *t_view, double *t_render, diag *d)
+{
+    double t0 = timer_now();
+    gi_particle_relight(gp, d);
+    double t1 = timer_now();
+    gi_particle_prepare_view(gp, &sc->camera, o->size, o->size, d);
+    double t2 = timer_now();
+    shade_stats ss;
+    render(sc, a, o->size, o->threads, gp, fb, &ss, d);
+    double t3 = timer_now();
+    *t_light = t1 - t0;
+    *t_view = t2 - t1;
+    *t_render = t3 - t2;
+    return t3 - t0;
+}
+
+static void sweep(const scene *sc, const accel *a, const opts *o, diag *d)
+{
+    static const long counts[] = {50000, 100000, 200000, 400000};
+    static const int nbs[] = {1, 3, 6, 9};
+    framebuffer *fb = fb_new(o->size, o->size);
+    double ref_mean = -1.0;
+    printf("\nsweep (mean luminance relative to 400K, n_b 9)\n");
+    printf("%8s %4s %10s %10s %10s %10s %10s %12s\n", "count", "n_b", "geom s", "light ms", "view ms", "render ms",
+           "frame ms", "mean rel");
+    double means[4][4], rows[4][4][5];
+    for (int ci = 3; ci >= 0; ci--) {
+        gi_particle_settings s;
+        gi_particle_settings_from_scene(&s, sc);
+        s.count = counts[ci];
+        s.threads = o->threads;
+        s.cl_device = o->device;
+        gi_particle_stats st;
+        pt_status status;
+        gi_particle *gp = gi_particle_build(sc, a, &s, &st, d, &status);
+        if (!gp) {
+            report_diag(d);
+            continue;
+        }
+        for (int bi = 3; bi >= 0; bi--) {
+            gi_particle_free(gp);
+            s.bounces = nbs[bi];
+            gp = gi_particle_build(sc, a, &s, &st, d, &status);
+            if (!gp) break;
+            double tl, tv, tr;
+            double tf = gi_frame(sc, a, o, gp, fb, &tl, &tv, &tr, d);
+            double m = mean_lum(fb);
+            if (ref_mean < 0.0) ref_mean = m;
+            means[ci][bi] = m;
+            rows[ci][bi][0] = st.t_geometry;
+            rows[ci][bi][1] = tl;
+            rows[ci][bi][2] = tv;
+            rows[ci][bi][3] = tr;
+            rows[ci][bi][4] = tf;
+        }
+        gi_particle_free(gp);
+    }
+    for (int ci = 0; ci < 4; ci++)
+        for (int bi = 0; bi < 4; bi++)
+            printf("%8ld %4d %10.3f %10.2f %10.2f %10.2f %10.2f %12.4f\n", counts[ci], nbs[bi], rows[ci][bi][0],
+                   1e3 * rows[ci][bi][1], 1e3 * rows[ci][bi][2], 1e3 * rows[ci][bi][3], 1e3 * rows[ci][bi][4],
+                   means[ci][bi] / ref_mean);
+    fb_free(fb);
+}
+
+int main(int argc, char **argv)
+{
+    opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 50000, NULL, NULL};
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--size") && v) { o.size = atoi(v); i++; }
+        else if (!strcmp(a, "--count") && v) { o.count = atol(v); i++; }
+        else if (!strcmp(a, "--nb") && v) { o.nb = atoi(v); i++; }
+        else if (!strcmp(a, "--threads") && v) { o.threads = atoi(v); i++; }
+        else if (!strcmp(a, "--device") && v) { o.device = v; i++; }
+        else if (!strcmp(a, "--reps") && v) { o.reps = atoi(v); i++; }
+        else if (!strcmp(a, "--out") && v) { o.out = v; i++; }
+        else if (!strcmp(a, "--sweep")) o.sweep = 1;
+        else if (a[0] != '-') o.scene = a;
+        else { fprintf(stderr, "bench_gi: unknown option %s\n", a); return 2; }
+    }
+    if (o.reps < 1) o.reps = 1;
+    diag *d = diag_new();
+    sdl_options so;
+    sdl_default_options(&so);
+    so.image_width = so.image_height = o.size;
+    scene *sc = NULL;
+    double t0 = timer_now();
+    if (sdl_parse_file(o.scene, &so, &sc, d) != PT_OK) {
+        report_diag(d);
+        return 1;
+    }
+    double t_parse = timer_now() - t0;
+    pt_status st;
+    t0 = timer_now();
+    accel *a = accel_build(sc, o.threads, d, &st);
+    if (!a) {
+        report_diag(d);
+        return 1;
+    }
+    double t_accel = timer_now() - t0;
+    scene_counts cnt = scene_count(sc);
+    printf("scene %s: %ld objects, %ld triangles, %ld lights; parse %.3f s, accel %.3f s; %dx%d\n", o.scene, cnt.objects,
+           cnt.triangles, cnt.lights, t_parse, t_accel, o.size, o.size);
+
+    gi_particle_settings s;
+    gi_particle_settings_from_scene(&s, sc);
+    s.count = o.count;
+    s.bounces = o.nb;
+    s.threads = o.threads;
+    s.cl_device = o.device;
+    gi_particle_stats gs;
+    gi_particle *gp = gi_particle_build(sc, a, &s, &gs, d, &st);
+    if (!gp) {
+        report_diag(d);
+        fprintf(stderr, "bench_gi: GI build failed: %s\n", pt_status_name(st));
+        return 1;
+    }
+    printf("device: %s (kernel build %.3f s)\n", gs.device, gs.t_kernel_build);
+    printf("geometry stage %.3f s: surfaces %.3f, sampling %.3f, pruning %.3f, 4x4 links %.3f, 16x16 links %.3f, "
+           "lists %.3f, upload %.3f\n",
+           gs.t_geometry, gs.t_surfaces, gs.t_sampling, gs.t_prune, gs.t_scatter_links, gs.t_gather_links, gs.t_lists,
+           gs.t_upload);
+    printf("  particles %ld (candidates %ld, pruned %ld), spacing %.4f, tess %.4f, radius %.4f\n", gs.particles,
+           gs.candidates, gs.pruned, gs.spacing, gs.tess, gs.radius);
+    printf("  link rays %ld (%.1f%% miss, %.2f%% unresolved), radiance particles %ld, list entries %ld (%.1f per "
+           "list; %ld widened, %ld empty)\n",
+           gs.link_rays, 100.0 * gs.link_misses / fmax(1, gs.link_rays), 100.0 * gs.link_unresolved / fmax(1, gs.link_rays),
+           gs.radiance_particles, gs.list_entries, (double)gs.list_entries / fmax(1, gs.radiance_particles),
+           gs.lists_widened, gs.lists_empty);
+    printf("  memory %.1f MiB: particles %.1f, links %.1f, lists %.1f, surfaces %.1f, device %.1f\n",
+           gs.bytes_total / 1048576.0, gs.bytes_particles / 1048576.0, gs.bytes_links / 1048576.0,
+           gs.bytes_lists / 1048576.0, gs.bytes_surfaces / 1048576.0, gs.bytes_device / 1048576.0);
+
+    /* lighting stage: median of reps (relighting reruns only this stage) */
+    double *tl = calloc((size_t)o.reps, sizeof *tl), *tk = calloc((size_t)o.reps, sizeof *tk);
+    double *tvis = calloc((size_t)o.reps, sizeof *tvis);
+    for (int r = 0; r < o.reps; r++) {
+        gi_particle_relight(gp, d);
+        const gi_particle_stats *x = gi_particle_get_stats(gp);
+        tl[r] = x->t_lighting;
+        tk[r] = x->t_emit + x->t_scatter;
+        tvis[r] = x->t_visibility;
+    }
+    const gi_particle_stats *x = gi_particle_get_stats(gp);
+    printf("lighting stage (n_b %d, median of %d): %.2f ms = visibility %.2f ms (%ld shadow rays) + emission and "
+           "scattering kernels %.2f ms; %ld sources\n",
+           x->bounces, o.reps, 1e3 * median(tl, o.reps), 1e3 * median(tvis, o.reps), x->shadow_rays,
+           1e3 * median(tk, o.reps), x->sources);
+    printf("  flux: direct %.4g, emitted %.4g, scattered %.4g\n", x->flux_direct, x->flux_emitted, x->flux_scattered);
+
+    framebuffer *fb_none = fb_new(o.size, o.size), *fb_gi = fb_new(o.size, o.size);
+    double *tn = calloc((size_t)o.reps, sizeof *tn), *tf = calloc((size_t)o.reps, sizeof *tf);
+    double *tfl = calloc((size_t)o.reps, sizeof *tfl), *tfv = calloc((size_t)o.reps, sizeof *tfv);
+    double *tfr = calloc((size_t)o.reps, sizeof *tfr);
+    shade_stats ss;
+    for (int r = 0; r < o.reps; r++) {
+        tn[r] = render(sc, a, o.size, o.threads, NULL, fb_none, &ss, d);
+        tf[r] = gi_frame(sc, a, &o, gp, fb_gi, &tfl[r], &tfv[r], &tfr[r], d);
+    }
+    x = gi_particle_get_stats(gp);
+    double mn = median(tn, o.reps), mf = median(tf, o.reps);
+    printf("frame --gi none: %.1f ms (%ld primary, %ld shadow rays)\n", 1e3 * mn, ss.primary_rays, ss.shadow_rays);
+    printf("frame --gi particle: %.1f ms = lighting %.1f + view %.1f (pre-pass %.1f, gather %.1f, estimate %.1f; "
+           "found %ld radiance, used %ld area particles) + render %.1f; ratio %.2f\n",
+           1e3 * mf, 1e3 * median(tfl, o.reps), 1e3 * median(tfv, o.reps), 1e3 * x->t_prepass, 1e3 * x->t_gather,
+           1e3 * x->t_estimate, x->found, x->used, 1e3 * median(tfr, o.reps), mf / mn);
+    printf("  hook: %ld lookups, %ld late, %ld without particles, %ld discarded\n", x->lookups, x->lookups_late,
+           x->lookups_none, x->discarded);
+    printf("mean luminance: none %.5f, particle %.5f\n", mean_lum(fb_none), mean_lum(fb_gi));
+    if (o.out) {
+        char path[4096];
+        img_write_opts wo;
+        img_default_write_opts(&wo);
+        snprintf(path, sizeof path, "%s_none.exr", o.out);
+        img_write(path, fb_none, &wo, d);
+        snprintf(path, sizeof path, "%s_particle.exr", o.out);
+        img_write(path, fb_gi, &wo, d);
+        snprintf(path, sizeof path, "%s_particle.png", o.out);
+        img_write(path, fb_gi, &wo, d);
+    }
+    if (o.sweep) sweep(sc, a, &o, d);
+    report_diag(d);
+    free(tl);
+    free(tk);
+    free(tvis);
+    free(tn);
+    free(tf);
+    free(tfl);
+    free(tfv);
+    free(tfr);
+    fb_free(fb_none);
+    fb_free(fb_gi);
+    gi_particle_free(gp);
+    accel_free(a);
+    scene_free(sc);
+    diag_free(d);
+    return 0;
+}

@@ -1,0 +1,640 @@
+/* gi_cl.c - OpenCL host code for the particle GI kernels, and dispatch to the
+ * C build of the same kernels (gi_cl_c.c). See gi_cl.h. */
+#include "gi_cl.h"
+#include <ctype.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "gi_cl_c.h"
+#include "pool.h"
+#include "timer.h"
+
+/* Device records: 4-byte scalars only, layout fixed (gi_types.h). */
+_Static_assert(sizeof(gi_dev_particle) == 64, "gi_dev_particle is 64 bytes");
+_Static_assert(offsetof(gi_dev_particle, p) == 0, "p");
+_Static_assert(offsetof(gi_dev_particle, area) == 12, "area");
+_Static_assert(offsetof(gi_dev_particle, n) == 16, "n");
+_Static_assert(offsetof(gi_dev_particle, brilliance) == 28, "brilliance");
+_Static_assert(offsetof(gi_dev_particle, rho) == 32, "rho");
+_Static_assert(offsetof(gi_dev_particle, le) == 48, "le");
+_Static_assert(sizeof(gi_dev_light) == 80, "gi_dev_light is 80 bytes");
+_Static_assert(offsetof(gi_dev_light, pos) == 0, "pos");
+_Static_assert(offsetof(gi_dev_light, kind) == 12, "kind");
+_Static_assert(offsetof(gi_dev_light, colour) == 16, "colour");
+_Static_assert(offsetof(gi_dev_light, parallel) == 28, "parallel");
+_Static_assert(offsetof(gi_dev_light, point_at) == 32, "point_at");
+_Static_assert(offsetof(gi_dev_light, tightness) == 44, "tightness");
+_Static_assert(offsetof(gi_dev_light, cos_radius) == 48, "cos_radius");
+_Static_assert(offsetof(gi_dev_light, cos_falloff) == 52, "cos_falloff");
+_Static_assert(offsetof(gi_dev_light, radius) == 56, "radius");
+_Static_assert(offsetof(gi_dev_light, falloff) == 60, "falloff");
+_Static_assert(offsetof(gi_dev_light, fade_distance) == 64, "fade_distance");
+_Static_assert(offsetof(gi_dev_light, fade_power) == 68, "fade_power");
+_Static_assert(offsetof(gi_dev_light, shadowless) == 72, "shadowless");
+_Static_assert(sizeof(gi_i64) == 8 && sizeof(gi_u32) == 4 && sizeof(float) == 4 && sizeof(int) == 4,
+               "scalar sizes match OpenCL C");
+
+#ifdef PARTRAY_HAVE_OPENCL
+#define CL_TARGET_OPENCL_VERSION 120
+#include <CL/cl.h>
+/* Generated at build time from gi/kernels (gi/CMakeLists.txt). */
+extern const char gi_kernel_source[];
+extern const char *const gi_kernel_files[];
+extern const int gi_kernel_nfiles;
+#endif
+
+#define GI_CL_LOCAL 64
+
+enum { KE_EMIT, KE_SCATTER, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_COUNT };
+
+struct gi_dev {
+    int is_cl;
+    char name[256];
+    int threads;
+    double build_seconds;
+    size_t bytes;
+    /* geometry (host pointers, caller-owned) */
+    const gi_dev_particle *part;
+    int n, ns2, ng, nrp;
+    const int *slink, *glink, *list_off, *list_idx;
+    /* C build scratch */
+    float *edir, *src;
+    gi_i64 *acc;
+    const float *lout_host;  /* last scatter's output (C build reads it in gather) */
+    const float *eind_host;  /* last gather's output (C build reads it in estimate) */
+#ifdef PARTRAY_HAVE_OPENCL
+    cl_context ctx;
+    cl_command_queue q;
+    cl_program prog;
+    cl_kernel k[KE_COUNT];
+    cl_mem b_part, b_slink, b_glink, b_off, b_idx;
+    cl_mem b_lights, b_vis, b_edir, b_src, b_acc, b_tally, b_srcidx, b_lout, b_phi, b_eind, b_list, b_vout;
+    size_t sz_lights, sz_vis, sz_srcidx, sz_list, sz_vout;
+    float *tmp;  /* n*4 readback scratch */
+#endif
+};
+
+int gi_dev_opencl_built(void)
+{
+#ifdef PARTRAY_HAVE_OPENCL
+    return 1;
+#else
+    return 0;
+#endif
+}
+
+const char *gi_dev_name(const gi_dev *dv) { return dv ? dv->name : "none"; }
+int gi_dev_is_opencl(const gi_dev *dv) { return dv && dv->is_cl; }
+double gi_dev_build_seconds(const gi_dev *dv) { return dv ? dv->build_seconds : 0.0; }
+size_t gi_dev_bytes(const gi_dev *dv) { return dv ? dv->bytes : 0; }
+
+/* One error with one string argument. */
+static void err(diag *d, const char *fmt, const char *a)
+{
+    src_loc nowhere = {0};
+    diag_report(d, DIAG_ERROR, nowhere, NULL, fmt, a);
+}
+
+/* ------------------------------------------------------------------ OpenCL */
+#ifdef PARTRAY_HAVE_OPENCL
+
+static const char *cl_err_name(cl_int e)
+{
+    switch (e) {
+    case CL_DEVICE_NOT_FOUND: return "CL_DEVICE_NOT_FOUND";
+    case CL_DEVICE_NOT_AVAILABLE: return "CL_DEVICE_NOT_AVAILABLE";
+    case CL_COMPILER_NOT_AVAILABLE: return "CL_COMPILER_NOT_AVAILABLE";
+    case CL_MEM_OBJECT_ALLOCATION_FAILURE: return "CL_MEM_OBJECT_ALLOCATION_FAILURE";
+    case CL_OUT_OF_RESOURCES: return "CL_OUT_OF_RESOURCES";
+    case CL_OUT_OF_HOST_MEMORY: return "CL_OUT_OF_HOST_MEMORY";
+    case CL_BUILD_PROGRAM_FAILURE: return "CL_BUILD_PROGRAM_FAILURE";
+    case CL_INVALID_VALUE: return "CL_INVALID_VALUE";
+    case CL_INVALID_DEVICE: return "CL_INVALID_DEVICE";
+    case CL_INVALID_BINARY: return "CL_INVALID_BINARY";
+    case CL_INVALID_BUILD_OPTIONS: return "CL_INVALID_BUILD_OPTIONS";
+    case CL_INVALID_PROGRAM: return "CL_INVALID_PROGRAM";
+    case CL_INVALID_KERNEL_NAME: return "CL_INVALID_KERNEL_NAME";
+    case CL_INVALID_KERNEL_ARGS: return "CL_INVALID_KERNEL_ARGS";
+    case CL_INVALID_ARG_INDEX: return "CL_INVALID_ARG_INDEX";
+    case CL_INVALID_ARG_VALUE: return "CL_INVALID_ARG_VALUE";
+    case CL_INVALID_ARG_SIZE: return "CL_INVALID_ARG_SIZE";
+    case CL_INVALID_WORK_GROUP_SIZE: return "CL_INVALID_WORK_GROUP_SIZE";
+    case CL_INVALID_BUFFER_SIZE: return "CL_INVALID_BUFFER_SIZE";
+    case CL_INVALID_MEM_OBJECT: return "CL_INVALID_MEM_OBJECT";
+    case CL_INVALID_COMMAND_QUEUE: return "CL_INVALID_COMMAND_QUEUE";
+    case -1001: return "CL_PLATFORM_NOT_FOUND_KHR";
+    default: return "OpenCL error";
+    }
+}
+
+static pt_status cl_fail(diag *d, const char *what, cl_int e)
+{
+    src_loc nowhere = {0};
+    diag_report(d, DIAG_ERROR, nowhere, NULL, "OpenCL: %s failed: %s (%d)", what, cl_err_name(e), (int)e);
+    if (e == CL_MEM_OBJECT_ALLOCATION_FAILURE || e == CL_OUT_OF_HOST_MEMORY || e == CL_OUT_OF_RESOURCES)
+        return PT_ERR_NOMEM;
+    return PT_ERR_DEVICE;
+}
+
+static int contains_ci(const char *hay, const char *needle)
+{
+    size_t nl = strlen(needle);
+    for (const char *h = hay; *h; h++) {
+        size_t i = 0;
+        while (i < nl && h[i] && tolower((unsigned char)h[i]) == tolower((unsigned char)needle[i])) i++;
+        if (i == nl) return 1;
+    }
+    return nl == 0;
+}
+
+/* Concatenate the kernel files from $PARTRAY_CL_DIR; NULL if unset. */
+static char *source_from_dir(const char *dir, diag *d, pt_status *st)
+{
+    size_t cap = 1 << 16, len = 0;
+    char *s = malloc(cap);
+    if (!s) { *st = PT_ERR_NOMEM; return NULL; }
+    for (int f = 0; f < gi_kernel_nfiles; f++) {
+        char path[4096];
+        snprintf(path, sizeof path, "%s/%s", dir, gi_kernel_files[f]);
+        FILE *fp = fopen(path, "rb");
+        if (!fp) {
+            err(d, "OpenCL: PARTRAY_CL_DIR is set but %s cannot be read", path);
+            free(s);
+            *st = PT_ERR_IO;
+            return NULL;
+        }
+        char buf[8192];
+        size_t k;
+        while ((k = fread(buf, 1, sizeof buf, fp)) > 0) {
+            if (len + k + 2 > cap) {
+                while (len + k + 2 > cap) cap *= 2;
+                char *ns = realloc(s, cap);
+                if (!ns) { fclose(fp); free(s); *st = PT_ERR_NOMEM; return NULL; }
+                s = ns;
+            }
+            memcpy(s + len, buf, k);
+            len += k;
+        }
+        fclose(fp);
+        s[len++] = '\n';
+    }
+    s[len] = 0;
+    return s;
+}
+
+static pt_status pick_device(const char *spec, cl_platform_id *pp, cl_device_id *dd, diag *d)
+{
+    cl_platform_id plats[16];
+    cl_uint np = 0;
+    cl_int e = clGetPlatformIDs(16, plats, &np);
+    if (e != CL_SUCCESS || np == 0) {
+        src_loc nowhere = {0};
+        diag_report(d, DIAG_ERROR, nowhere, NULL,
+                    "OpenCL: no platform found (%s). Install an OpenCL driver -- on Debian the CPU driver is the "
+                    "package pocl-opencl-icd, with the ICD loader ocl-icd-libopencl1 -- or run the kernels "
+                    "as C with --cl-device c",
+                    e == CL_SUCCESS ? "0 platforms" : cl_err_name(e));
+        return PT_ERR_DEVICE;
+    }
+    int want_p = -1, want_d = -1;
+    int automatic = !spec || !*spec || strcmp(spec, "auto") == 0;
+    if (!automatic && isdigit((unsigned char)spec[0]) && strchr(spec, ':')) {
+        want_p = atoi(spec);
+        want_d = atoi(strchr(spec, ':') + 1);
+    }
+    cl_device_id first = NULL, first_gpu = NULL;
+    cl_platform_id first_p = NULL, first_gpu_p = NULL;
+    for (cl_uint p = 0; p < np; p++) {
+        cl_device_id devs[16];
+        cl_uint nd = 0;
+        if (clGetDeviceIDs(plats[p], CL_DEVICE_TYPE_ALL, 16, devs, &nd) != CL_SUCCESS) continue;
+        char pname[256] = "";
+        clGetPlatformInfo(plats[p], CL_PLATFORM_NAME, sizeof pname, pname, NULL);
+        for (cl_uint k = 0; k < nd; k++) {
+            char dname[256] = "";
+            clGetDeviceInfo(devs[k], CL_DEVICE_NAME, sizeof dname, dname, NULL);
+            cl_device_type ty = 0;
+            clGetDeviceInfo(devs[k], CL_DEVICE_TYPE, sizeof ty, &ty, NULL);
+            if (want_p >= 0) {
+                if ((int)p == want_p && (int)k == want_d) {
+                    *pp = plats[p];
+                    *dd = devs[k];
+                    return PT_OK;
+                }
+                continue;
+            }
+            if (!automatic) {
+                if (contains_ci(dname, spec) || contains_ci(pname, spec)) {
+                    *pp = plats[p];
+                    *dd = devs[k];
+                    return PT_OK;
+                }
+                continue;
+            }
+            if (!first) { first = devs[k]; first_p = plats[p]; }
+            if (!first_gpu && (ty & CL_DEVICE_TYPE_GPU)) { first_gpu = devs[k]; first_gpu_p = plats[p]; }
+        }
+    }
+    if (first_gpu) { *pp = first_gpu_p; *dd = first_gpu; return PT_OK; }
+    if (automatic && first) { *pp = first_p; *dd = first; return PT_OK; }
+    src_loc nowhere = {0};
+    if (automatic)
+        diag_report(d, DIAG_ERROR, nowhere, NULL,
+                    "OpenCL: no device found on %u platform(s); on Debian install pocl-opencl-icd for the CPU "
+                    "device, or run the kernels as C with --cl-device c", (unsigned)np);
+    else
+        diag_report(d, DIAG_ERROR, nowhere, NULL, "OpenCL: no device matches '%s' (use auto, c, P:D or part of a name)",
+                    spec);
+    return PT_ERR_DEVICE;
+}
+
+static pt_status cl_open(gi_dev *dv, const gi_dev_options *o, diag *d)
+{
+    cl_platform_id plat;
+    cl_device_id dev;
+    pt_status st = pick_device(o ? o->spec : NULL, &plat, &dev, d);
+    if (st != PT_OK) return st;
+    char dname[200] = "", pname[48] = "";
+    clGetDeviceInfo(dev, CL_DEVICE_NAME, sizeof dname, dname, NULL);
+    clGetPlatformInfo(plat, CL_PLATFORM_NAME, sizeof pname, pname, NULL);
+    snprintf(dv->name, sizeof dv->name, "OpenCL: %s (%s)", dname, pname);
+    char ext[8192] = "";
+    clGetDeviceInfo(dev, CL_DEVICE_EXTENSIONS, sizeof ext, ext, NULL);
+    if (!strstr(ext, "cl_khr_int64_base_atomics")) {
+        err(d, "OpenCL: device %s lacks cl_khr_int64_base_atomics (64-bit atomics for deterministic flux "
+               "accumulation); run the kernels as C with --cl-device c", dname);
+        return PT_ERR_UNSUPPORTED;
+    }
+    cl_int e;
+    cl_context_properties props[] = {CL_CONTEXT_PLATFORM, (cl_context_properties)plat, 0};
+    dv->ctx = clCreateContext(props, 1, &dev, NULL, NULL, &e);
+    if (!dv->ctx) return cl_fail(d, "clCreateContext", e);
+    dv->q = clCreateCommandQueue(dv->ctx, dev, 0, &e);
+    if (!dv->q) return cl_fail(d, "clCreateCommandQueue", e);
+
+    char *owned = NULL;
+    const char *src = o ? o->source : NULL;
+    if (!src) {
+        const char *dir = getenv("PARTRAY_CL_DIR");
+        if (dir && *dir) {
+            pt_status s2 = PT_OK;
+            owned = source_from_dir(dir, d, &s2);
+            if (!owned) return s2;
+            src = owned;
+        } else {
+            src = gi_kernel_source;
+        }
+    }
+    double t0 = timer_now();
+    dv->prog = clCreateProgramWithSource(dv->ctx, 1, &src, NULL, &e);
+    free(owned);
+    if (!dv->prog) return cl_fail(d, "clCreateProgramWithSource", e);
+    e = clBuildProgram(dv->prog, 1, &dev, "-cl-std=CL1.2", NULL, NULL);
+    dv->build_seconds = timer_now() - t0;
+    if (e != CL_SUCCESS) {
+        size_t loglen = 0;
+        clGetProgramBuildInfo(dv->prog, dev, CL_PROGRAM_BUILD_LOG, 0, NULL, &loglen);
+        char *log = malloc(loglen + 1);
+        if (log) {
+            log[0] = 0;
+            clGetProgramBuildInfo(dv->prog, dev, CL_PROGRAM_BUILD_LOG, loglen, log, NULL);
+            log[loglen] = 0;
+        }
+        src_loc nowhere = {0};
+        diag_report(d, DIAG_ERROR, nowhere, NULL, "OpenCL: kernel build failed on %s (%s); build log:\n%s", dname,
+                    cl_err_name(e), log ? log : "(no log)");
+        free(log);
+        return PT_ERR_DEVICE;
+    }
+    static const char *const names[KE_COUNT] = {"gi_k_emit", "gi_k_scatter", "gi_k_resolve", "gi_k_gather",
+                                                "gi_k_estimate"};
+    for (int k = 0; k < KE_COUNT; k++) {
+        dv->k[k] = clCreateKernel(dv->prog, names[k], &e);
+        if (!dv->k[k]) return cl_fail(d, names[k], e);
+    }
+    return PT_OK;
+}
+
+static void rel(cl_mem *m)
+{
+    if (*m) clReleaseMemObject(*m);
+    *m = NULL;
+}
+
+/* (Re)allocate buffer *m to at least `size` bytes; *have tracks its size. */
+static pt_status ensure(gi_dev *dv, cl_mem *m, size_t *have, size_t size, diag *d)
+{
+    if (size == 0) size = 16;
+    if (*m && *have >= size) return PT_OK;
+    if (*m) { dv->bytes -= *have; rel(m); }
+    cl_int e;
+    *m = clCreateBuffer(dv->ctx, CL_MEM_READ_WRITE, size, NULL, &e);
+    if (!*m) { *have = 0; return cl_fail(d, "clCreateBuffer", e); }
+    *have = size;
+    dv->bytes += size;
+    return PT_OK;
+}
+
+static pt_status upload(gi_dev *dv, cl_mem *m, size_t *have, const void *data, size_t size, diag *d)
+{
+    pt_status st = ensure(dv, m, have, size, d);
+    if (st != PT_OK) return st;
+    if (size == 0) return PT_OK;
+    cl_int e = clEnqueueWriteBuffer(dv->q, *m, CL_TRUE, 0, size, data, 0, NULL, NULL);
+    return e == CL_SUCCESS ? PT_OK : cl_fail(d, "clEnqueueWriteBuffer", e);
+}
+
+static pt_status download(gi_dev *dv, cl_mem m, void *data, size_t size, diag *d)
+{
+    if (size == 0) return PT_OK;
+    cl_int e = clEnqueueReadBuffer(dv->q, m, CL_TRUE, 0, size, data, 0, NULL, NULL);
+    return e == CL_SUCCESS ? PT_OK : cl_fail(d, "clEnqueueReadBuffer", e);
+}
+
+static pt_status zero(gi_dev *dv, cl_mem m, size_t size, diag *d)
+{
+    if (size == 0) return PT_OK;
+    static const gi_i64 z = 0;
+    cl_int e = clEnqueueFillBuffer(dv->q, m, &z, sizeof z, 0, size, 0, NULL, NULL);
+    return e == CL_SUCCESS ? PT_OK : cl_fail(d, "clEnqueueFillBuffer", e);
+}
+
+typedef struct {
+    size_t size;
+    const void *ptr;
+} karg;
+#define KMEM(m) ((karg){sizeof(cl_mem), &(m)})
+#define KINT(v) ((karg){sizeof(int), &(v)})
+#define KF(v) ((karg){sizeof(float), &(v)})
+
+static pt_status run_kernel(gi_dev *dv, int which, size_t n, const karg *args, int nargs, diag *d)
+{
+    cl_kernel k = dv->k[which];
+    for (int i = 0; i < nargs; i++) {
+        cl_int e = clSetKernelArg(k, (cl_uint)i, args[i].size, args[i].ptr);
+        if (e != CL_SUCCESS) return cl_fail(d, "clSetKernelArg", e);
+    }
+    if (n == 0) return PT_OK;
+    /* a fixed work-group size (PoCL compiles a kernel once per size) and a
+     * global size rounded up to it; the kernels ignore ids past n */
+    size_t local = GI_CL_LOCAL, global = (n + local - 1) / local * local;
+    cl_int e = clEnqueueNDRangeKernel(dv->q, k, 1, NULL, &global, &local, 0, NULL, NULL);
+    if (e != CL_SUCCESS) return cl_fail(d, "clEnqueueNDRangeKernel", e);
+    e = clFinish(dv->q);
+    return e == CL_SUCCESS ? PT_OK : cl_fail(d, "clFinish", e);
+}
+#endif /* PARTRAY_HAVE_OPENCL */
+
+/* ------------------------------------------------------------------ common */
+
+gi_dev *gi_dev_open(const gi_dev_options *o, diag *d, pt_status *status)
+{
+    pt_status dummy;
+    if (!status) status = &dummy;
+    gi_dev *dv = calloc(1, sizeof *dv);
+    if (!dv) { *status = PT_ERR_NOMEM; return NULL; }
+    dv->threads = o && o->threads > 0 ? o->threads : pool_default_threads();
+    const char *spec = o ? o->spec : NULL;
+    if (spec && strcmp(spec, "c") == 0) {
+        snprintf(dv->name, sizeof dv->name, "C build of the kernels (%d threads)", dv->threads);
+        *status = PT_OK;
+        return dv;
+    }
+#ifdef PARTRAY_HAVE_OPENCL
+    dv->is_cl = 1;
+    *status = cl_open(dv, o, d);
+    if (*status != PT_OK) {
+        gi_dev_free(dv);
+        return NULL;
+    }
+    return dv;
+#else
+    if (spec && *spec && strcmp(spec, "auto") != 0) {
+        err(d, "OpenCL device '%s' requested but partray was built with PARTRAY_OPENCL=OFF", spec);
+        free(dv);
+        *status = PT_ERR_UNSUPPORTED;
+        return NULL;
+    }
+    snprintf(dv->name, sizeof dv->name, "C build of the kernels (%d threads, OpenCL off)", dv->threads);
+    *status = PT_OK;
+    return dv;
+#endif
+}
+
+void gi_dev_free(gi_dev *dv)
+{
+    if (!dv) return;
+#ifdef PARTRAY_HAVE_OPENCL
+    if (dv->is_cl) {
+        cl_mem *ms[] = {&dv->b_part, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
+                        &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_acc, &dv->b_tally, &dv->b_srcidx,
+                        &dv->b_lout, &dv->b_phi, &dv->b_eind, &dv->b_list, &dv->b_vout};
+        for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
+        for (int k = 0; k < KE_COUNT; k++)
+            if (dv->k[k]) clReleaseKernel(dv->k[k]);
+        if (dv->prog) clReleaseProgram(dv->prog);
+        if (dv->q) clReleaseCommandQueue(dv->q);
+        if (dv->ctx) clReleaseContext(dv->ctx);
+        free(dv->tmp);
+    }
+#endif
+    free(dv->edir);
+    free(dv->src);
+    free(dv->acc);
+    free(dv);
+}
+
+pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, const int *slink, int ns2,
+                               const int *glink, int ng, diag *d)
+{
+    dv->part = part;
+    dv->n = n;
+    dv->slink = slink;
+    dv->ns2 = ns2;
+    dv->glink = glink;
+    dv->ng = ng;
+    size_t nn = (size_t)(n > 0 ? n : 1);
+    if (!dv->is_cl) {
+        free(dv->edir);
+        free(dv->src);
+        free(dv->acc);
+        dv->edir = calloc(nn * 4, sizeof(float));
+        dv->src = calloc(nn * 4, sizeof(float));
+        dv->acc = calloc(nn * 3, sizeof(gi_i64));
+        dv->bytes = nn * (32 + 24);
+        if (!dv->edir || !dv->src || !dv->acc) return PT_ERR_NOMEM;
+        return PT_OK;
+    }
+#ifdef PARTRAY_HAVE_OPENCL
+    size_t have = 0;
+    pt_status st;
+    /* a new geometry: drop every buffer and start the byte count again */
+    cl_mem *ms[] = {&dv->b_part, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
+                    &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_acc, &dv->b_tally, &dv->b_srcidx,
+                    &dv->b_lout, &dv->b_phi, &dv->b_eind, &dv->b_list, &dv->b_vout};
+    for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
+    dv->sz_lights = dv->sz_vis = dv->sz_srcidx = dv->sz_list = dv->sz_vout = 0;
+    dv->bytes = 0;
+    if ((st = upload(dv, &dv->b_part, &have, part, nn * sizeof *part, d)) != PT_OK) return st;
+    have = 0;
+    if ((st = upload(dv, &dv->b_slink, &have, slink, nn * (size_t)ns2 * sizeof(int), d)) != PT_OK) return st;
+    have = 0;
+    if ((st = upload(dv, &dv->b_glink, &have, glink, nn * (size_t)ng * sizeof(int), d)) != PT_OK) return st;
+    size_t f4 = nn * 4 * sizeof(float);
+    have = 0;
+    if ((st = ensure(dv, &dv->b_edir, &have, f4, d)) != PT_OK) return st;
+    have = 0;
+    if ((st = ensure(dv, &dv->b_src, &have, f4, d)) != PT_OK) return st;
+    have = 0;
+    if ((st = ensure(dv, &dv->b_acc, &have, nn * 3 * sizeof(gi_i64), d)) != PT_OK) return st;
+    have = 0;
+    if ((st = ensure(dv, &dv->b_lout, &have, f4, d)) != PT_OK) return st;
+    have = 0;
+    if ((st = ensure(dv, &dv->b_phi, &have, f4, d)) != PT_OK) return st;
+    have = 0;
+    if ((st = ensure(dv, &dv->b_eind, &have, f4, d)) != PT_OK) return st;
+    if ((st = zero(dv, dv->b_eind, f4, d)) != PT_OK) return st;
+    if ((st = zero(dv, dv->b_lout, f4, d)) != PT_OK) return st;
+    free(dv->tmp);
+    dv->tmp = malloc(f4);
+    if (!dv->tmp) return PT_ERR_NOMEM;
+    return PT_OK;
+#else
+    return PT_ERR_INTERNAL;
+#endif
+}
+
+pt_status gi_dev_set_lists(gi_dev *dv, const int *list_off, int nrp, const int *list_idx, diag *d)
+{
+    dv->list_off = list_off;
+    dv->list_idx = list_idx;
+    dv->nrp = nrp;
+    if (!dv->is_cl) return PT_OK;
+#ifdef PARTRAY_HAVE_OPENCL
+    rel(&dv->b_off);
+    rel(&dv->b_idx);
+    size_t have = 0;
+    pt_status st = upload(dv, &dv->b_off, &have, list_off, ((size_t)nrp + 1) * sizeof(int), d);
+    if (st != PT_OK) return st;
+    have = 0;
+    return upload(dv, &dv->b_idx, &have, list_idx, (size_t)list_off[nrp] * sizeof(int), d);
+#else
+    return PT_ERR_INTERNAL;
+#endif
+}
+
+pt_status gi_dev_emit(gi_dev *dv, const gi_dev_light *lights, int nlights, const float *vis, float *edir, float *src,
+                      diag *d)
+{
+    size_t nn = (size_t)dv->n;
+    if (!dv->is_cl) {
+        gi_c_emit(dv->threads, dv->part, dv->n, lights, nlights, vis, dv->edir, dv->src);
+        memcpy(edir, dv->edir, nn * 4 * sizeof(float));
+        memcpy(src, dv->src, nn * 4 * sizeof(float));
+        return PT_OK;
+    }
+#ifdef PARTRAY_HAVE_OPENCL
+    pt_status st;
+    if ((st = upload(dv, &dv->b_lights, &dv->sz_lights, lights, (size_t)nlights * sizeof *lights, d)) != PT_OK)
+        return st;
+    if ((st = upload(dv, &dv->b_vis, &dv->sz_vis, vis, nn * (size_t)nlights * sizeof(float), d)) != PT_OK) return st;
+    int n = dv->n;
+    karg a[] = {KMEM(dv->b_part), KINT(n), KMEM(dv->b_lights), KINT(nlights), KMEM(dv->b_vis), KMEM(dv->b_edir),
+                KMEM(dv->b_src)};
+    if ((st = run_kernel(dv, KE_EMIT, nn, a, 7, d)) != PT_OK) return st;
+    if ((st = download(dv, dv->b_edir, edir, nn * 4 * sizeof(float), d)) != PT_OK) return st;
+    return download(dv, dv->b_src, src, nn * 4 * sizeof(float), d);
+#else
+    return PT_ERR_INTERNAL;
+#endif
+}
+
+pt_status gi_dev_scatter(gi_dev *dv, int nb, gi_u32 seed, float scale, const int *srcidx, int nsrc, gi_i64 *tally,
+                         float *lout, float *phi, diag *d)
+{
+    size_t nn = (size_t)dv->n;
+    if (nb > GI_MAX_BOUNCES) nb = GI_MAX_BOUNCES;
+    gi_i64 tally_local[GI_MAX_BOUNCES * 3];
+    gi_i64 *tl = tally ? tally : tally_local;
+    memset(tl, 0, sizeof(gi_i64) * 3 * (size_t)(nb > 0 ? nb : 1));
+    float inv_scale = 1.0f / scale;
+    if (!dv->is_cl) {
+        memset(dv->acc, 0, nn * 3 * sizeof(gi_i64));
+        if (nb > 0) gi_c_scatter(dv->threads, dv->part, dv->slink, dv->ns2, nb, seed, scale, srcidx, nsrc, dv->src,
+                                 dv->acc, tl);
+        gi_c_resolve(dv->threads, dv->part, dv->n, dv->edir, dv->acc, inv_scale, lout, phi);
+        dv->lout_host = lout;
+        return PT_OK;
+    }
+#ifdef PARTRAY_HAVE_OPENCL
+    pt_status st;
+    size_t have_t = dv->b_tally ? (size_t)GI_MAX_BOUNCES * 3 * sizeof(gi_i64) : 0;
+    if ((st = ensure(dv, &dv->b_tally, &have_t, (size_t)GI_MAX_BOUNCES * 3 * sizeof(gi_i64), d)) != PT_OK) return st;
+    if ((st = zero(dv, dv->b_tally, (size_t)GI_MAX_BOUNCES * 3 * sizeof(gi_i64), d)) != PT_OK) return st;
+    if ((st = zero(dv, dv->b_acc, nn * 3 * sizeof(gi_i64), d)) != PT_OK) return st;
+    if (nb > 0 && nsrc > 0) {
+        if ((st = upload(dv, &dv->b_srcidx, &dv->sz_srcidx, srcidx, (size_t)nsrc * sizeof(int), d)) != PT_OK)
+            return st;
+        int ns2 = dv->ns2;
+        cl_uint sd = seed;
+        karg a[] = {KMEM(dv->b_part), KMEM(dv->b_slink), KINT(ns2), KINT(nb), {sizeof(cl_uint), &sd}, KF(scale),
+                    KMEM(dv->b_srcidx), KINT(nsrc), KMEM(dv->b_src), KMEM(dv->b_acc), KMEM(dv->b_tally)};
+        if ((st = run_kernel(dv, KE_SCATTER, (size_t)nsrc, a, 11, d)) != PT_OK) return st;
+        if ((st = download(dv, dv->b_tally, tl, (size_t)nb * 3 * sizeof(gi_i64), d)) != PT_OK) return st;
+    }
+    int n = dv->n;
+    karg r[] = {KMEM(dv->b_part), KINT(n), KMEM(dv->b_edir), KMEM(dv->b_acc), KF(inv_scale), KMEM(dv->b_lout),
+                KMEM(dv->b_phi)};
+    if ((st = run_kernel(dv, KE_RESOLVE, nn, r, 7, d)) != PT_OK) return st;
+    if ((st = download(dv, dv->b_lout, lout, nn * 4 * sizeof(float), d)) != PT_OK) return st;
+    return download(dv, dv->b_phi, phi, nn * 4 * sizeof(float), d);
+#else
+    return PT_ERR_INTERNAL;
+#endif
+}
+
+pt_status gi_dev_gather(gi_dev *dv, const int *used, int nused, const float bg[3], float *eind, diag *d)
+{
+    if (!dv->is_cl) {
+        gi_c_gather(dv->threads, dv->glink, dv->ng, dv->lout_host, used, nused, bg, eind);
+        dv->eind_host = eind;
+        return PT_OK;
+    }
+#ifdef PARTRAY_HAVE_OPENCL
+    if (nused <= 0) return PT_OK;
+    pt_status st;
+    if ((st = upload(dv, &dv->b_list, &dv->sz_list, used, (size_t)nused * sizeof(int), d)) != PT_OK) return st;
+    int ng = dv->ng;
+    float r = bg[0], g = bg[1], b = bg[2];
+    karg a[] = {KMEM(dv->b_glink), KINT(ng), KMEM(dv->b_lout), KMEM(dv->b_list), KINT(nused), KF(r), KF(g), KF(b),
+                KMEM(dv->b_eind)};
+    if ((st = run_kernel(dv, KE_GATHER, (size_t)nused, a, 9, d)) != PT_OK) return st;
+    size_t nn = (size_t)dv->n;
+    if ((st = download(dv, dv->b_eind, dv->tmp, nn * 4 * sizeof(float), d)) != PT_OK) return st;
+    for (int t = 0; t < nused; t++) memcpy(&eind[4 * (size_t)used[t]], &dv->tmp[4 * (size_t)used[t]], 4 * sizeof(float));
+    return PT_OK;
+#else
+    return PT_ERR_INTERNAL;
+#endif
+}
+
+pt_status gi_dev_estimate(gi_dev *dv, const int *found, int nfound, float *vout, diag *d)
+{
+    if (!dv->is_cl) {
+        gi_c_estimate(dv->threads, dv->part, dv->list_off, dv->list_idx, dv->eind_host, found, nfound, vout);
+        return PT_OK;
+    }
+#ifdef PARTRAY_HAVE_OPENCL
+    if (nfound <= 0) return PT_OK;
+    pt_status st;
+    if ((st = upload(dv, &dv->b_list, &dv->sz_list, found, (size_t)nfound * sizeof(int), d)) != PT_OK) return st;
+    if ((st = ensure(dv, &dv->b_vout, &dv->sz_vout, (size_t)nfound * 4 * sizeof(float), d)) != PT_OK) return st;
+    karg a[] = {KMEM(dv->b_part), KMEM(dv->b_off), KMEM(dv->b_idx), KMEM(dv->b_eind), KMEM(dv->b_list), KINT(nfound),
+                KMEM(dv->b_vout)};
+    if ((st = run_kernel(dv, KE_ESTIMATE, (size_t)nfound, a, 7, d)) != PT_OK) return st;
+    return download(dv, dv->b_vout, vout, (size_t)nfound * 4 * sizeof(float), d);
+#else
+    return PT_ERR_INTERNAL;
+#endif
+}

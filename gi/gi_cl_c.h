@@ -1,0 +1,22 @@
+/* gi_cl_c.h - the particle GI kernels (gi/kernels, .cl files) compiled as C through
+ * gi/kernels/gi_shim.h, with launchers that run work-items on core/pool.
+ * This is the device used when OpenCL is off (PARTRAY_OPENCL=OFF or the "c"
+ * device) and the host's own path for radiance particles that the view
+ * pre-pass missed: the same kernel code either way. `threads` <= 1 runs on
+ * the calling thread. Argument meanings: see the kernels. */
+#ifndef PT_GI_CL_C_H
+#define PT_GI_CL_C_H
+#include "kernels/gi_types.h"
+
+void gi_c_emit(int threads, const gi_dev_particle *part, int n, const gi_dev_light *lights, int nlights,
+               const float *vis, float *edir, float *src);
+void gi_c_scatter(int threads, const gi_dev_particle *part, const int *slink, int ns2, int nb, gi_u32 seed,
+                  float scale, const int *srcidx, int nsrc, const float *src, gi_i64 *acc, gi_i64 *tally);
+void gi_c_resolve(int threads, const gi_dev_particle *part, int n, const float *edir, const gi_i64 *acc,
+                  float inv_scale, float *lout, float *phi);
+void gi_c_gather(int threads, const int *glink, int ng, const float *lout, const int *used, int nused,
+                 const float bg[3], float *eind);
+void gi_c_estimate(int threads, const gi_dev_particle *part, const int *list_off, const int *list_idx,
+                   const float *eind, const int *found, int nfound, float *vout);
+
+#endif

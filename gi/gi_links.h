@@ -1,0 +1,32 @@
+/* gi_links.h - area particle links (paper section 3.1): for every particle,
+ * n x n stratified cosine-weighted directions over its hemisphere, one ray
+ * each (Embree ray streams, rtcIntersect1M, on core/pool threads), and for
+ * every ray the area particle closest to the hit point on the side the ray
+ * arrives at. 4 x 4 of them are the scattering links, 16 x 16 the gathering
+ * links. A ray that leaves the scene, or finds no particle within maxdist of
+ * its hit, gives -1. Internal to gi/. */
+#ifndef PT_GI_LINKS_H
+#define PT_GI_LINKS_H
+#include <stdint.h>
+#include "accel.h"
+#include "gi_particles.h"
+
+typedef struct {
+    long rays;       /* traced */
+    long misses;     /* left the scene */
+    long unresolved; /* hit, but no particle near the hit on that side */
+} gi_link_stats;
+
+/* links: n * nside^2 ints (may be NULL when only anyhit is wanted);
+ * grid: particle lookup (NULL: links are not resolved); anyhit (may be
+ * NULL): 1 where at least one ray of the particle hit something. */
+pt_status gi_links_build(const accel *a, const gi_dev_particle *p, int n, int nside, uint64_t seed,
+                         const gi_lookup *grid, double maxdist, int threads, int *links, unsigned char *anyhit,
+                         gi_link_stats *st);
+
+/* Direction j of the n x n stratified cosine-weighted set around unit
+ * normal nrm, from uniform numbers (u1, u2) in [0,1): Malley's method on
+ * Shirley and Chiu's concentric disk map (JGT 2(3), 1997). */
+vec3 gi_links_direction(vec3 nrm, int nside, int j, double u1, double u2);
+
+#endif

@@ -1,0 +1,784 @@
+/* gi_particle.c - the particle GI mode: stages, lights, view pre-pass and the
+ * shading hook (see gi_particle.h). */
+#include "gi_particle.h"
+#include <math.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "gi_cl.h"
+#include "gi_cl_c.h"
+#include "gi_links.h"
+#include "gi_particles.h"
+#include "gi_radiance.h"
+#include "gi_surface.h"
+#include "pool.h"
+#include "rng.h"
+#include "timer.h"
+
+#define GI_MAX_THREADS 256
+
+typedef struct {
+    long lookups, late, none, discarded;
+    char pad[32];
+} thread_count;
+
+struct gi_particle {
+    const scene *sc;
+    const accel *a;
+    gi_particle_settings set;
+    int threads;
+    int ambient_emits;
+    gi_surface *surf;
+    gi_particles ps;
+    int ns2, ng;
+    int *slink, *glink;
+    gi_lists lists;
+    gi_dev *dev;
+    /* lighting */
+    int nlights;
+    gi_dev_light *lights;
+    float *vis;
+    float *edir, *src, *phi, *lout;
+    int *srcidx;
+    double bounce_flux[GI_MAX_BOUNCES];
+    int nbounce_flux;
+    int lit;
+    /* view */
+    float *eind;                 /* n*4: gathered E~/pi */
+    atomic_uchar *e_state;       /* 0 none, 1 being computed, 2 done */
+    unsigned char *dev_gathered; /* the device's eind holds it */
+    float *rp_val;               /* nrp*4: estimated E/pi at radiance particles */
+    atomic_uchar *rp_state;
+    atomic_uchar *mark;
+    float bg[3];
+    thread_count tc[GI_MAX_THREADS];
+    gi_particle_stats st;
+};
+
+/* ------------------------------------------------------------------ settings */
+
+void gi_particle_default_settings(gi_particle_settings *s)
+{
+    memset(s, 0, sizeof *s);
+    s->count = 50000;
+    s->scatter_side = 4;
+    s->gather_side = 16;
+    s->bounces = 8;
+    s->tess = 0.0;
+    s->tess_factor = 3.0;
+    s->radius = 0.0;
+    s->radius_factor = 3.0;
+    s->normal_cos = 0.9;
+    s->ambient_emits = -1;
+    s->area_samples = 0;
+    s->brightness = 1.0;
+    s->seed = 0;
+    s->threads = 0;
+}
+
+void gi_particle_settings_from_scene(gi_particle_settings *s, const scene *sc)
+{
+    gi_particle_default_settings(s);
+    const scene_radiosity *r = &sc->global.radiosity;
+    if (!r->enabled) return;
+    long count = 500L * (r->count > 0 ? r->count : 35);
+    s->count = count < 10000 ? 10000 : (count > 1000000 ? 1000000 : count);
+    s->bounces = r->recursion_limit - 1 > 0 ? r->recursion_limit - 1 : 0;
+    if (r->error_bound > 0.0) {
+        double f = 3.0 * r->error_bound / 1.8;
+        s->radius_factor = f < 2.0 ? 2.0 : (f > 5.0 ? 5.0 : f);
+    }
+    if (r->brightness > 0.0) s->brightness = r->brightness;
+}
+
+/* ------------------------------------------------------------------ build */
+
+static void *xcalloc(size_t n, size_t size, pt_status *st)
+{
+    void *p = calloc(n ? n : 1, size);
+    if (!p) *st = PT_ERR_NOMEM;
+    return p;
+}
+
+static void update_bytes(gi_particle *gp)
+{
+    gi_particle_stats *s = &gp->st;
+    size_t n = (size_t)gp->ps.n, nrp = (size_t)gp->lists.nrp;
+    s->bytes_particles = n * (sizeof(gi_dev_particle) + sizeof(int) + 1) + n * 4 * sizeof(float) * 6 + n * 2 +
+                         (size_t)gp->nlights * n * sizeof(float);
+    s->bytes_links = n * (size_t)(gp->ns2 + gp->ng) * sizeof(int);
+    s->bytes_lists = (nrp + 1) * sizeof(int) + (gp->lists.off ? (size_t)gp->lists.off[nrp] : 0) * sizeof(int) +
+                     nrp * (4 * sizeof(float) + 2);
+    s->bytes_surfaces = gp->surf ? gi_surface_bytes(gp->surf) : 0;
+    s->bytes_device = gi_dev_bytes(gp->dev);
+    s->bytes_total = s->bytes_particles + s->bytes_links + s->bytes_lists + s->bytes_surfaces + s->bytes_device;
+}
+
+static void fill_stats(gi_particle *gp, gi_particle_stats *out)
+{
+    update_bytes(gp);
+    long look = 0, late = 0, none = 0, disc = 0;
+    for (int t = 0; t < GI_MAX_THREADS; t++) {
+        look += gp->tc[t].lookups;
+        late += gp->tc[t].late;
+        none += gp->tc[t].none;
+        disc += gp->tc[t].discarded;
+    }
+    gp->st.lookups = look;
+    gp->st.lookups_late = late;
+    gp->st.lookups_none = none;
+    gp->st.discarded = disc;
+    if (out && out != &gp->st) *out = gp->st;
+}
+
+gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particle_settings *s,
+                               gi_particle_stats *stats, diag *d, pt_status *status)
+{
+    pt_status dummy, st = PT_OK;
+    if (!status) status = &dummy;
+    gi_particle *gp = calloc(1, sizeof *gp);
+    if (!gp) {
+        *status = PT_ERR_NOMEM;
+        return NULL;
+    }
+    gp->sc = sc;
+    gp->a = a;
+    if (s) gp->set = *s;
+    else gi_particle_default_settings(&gp->set);
+    gi_particle_settings *set = &gp->set;
+    if (set->scatter_side < 1) set->scatter_side = 1;
+    if (set->gather_side < 1) set->gather_side = 1;
+    if (set->bounces < 0) set->bounces = 0;
+    if (set->bounces > GI_MAX_BOUNCES) set->bounces = GI_MAX_BOUNCES;
+    if (!(set->brightness > 0.0)) set->brightness = 1.0;
+    gp->threads = set->threads > 0 ? set->threads : pool_default_threads();
+    if (gp->threads > GI_MAX_THREADS) gp->threads = GI_MAX_THREADS;
+    gp->ambient_emits = set->ambient_emits >= 0 ? set->ambient_emits : sc->global.radiosity.enabled;
+    gp->ns2 = set->scatter_side * set->scatter_side;
+    gp->ng = set->gather_side * set->gather_side;
+    gp->bg[0] = (float)sc->background.r;
+    gp->bg[1] = (float)sc->background.g;
+    gp->bg[2] = (float)sc->background.b;
+    gi_particle_stats *S = &gp->st;
+    S->bounces = set->bounces;
+
+    /* the device first: a missing OpenCL driver should fail before seconds of ray tracing */
+    double t0 = timer_now();
+    gi_dev_options o = {set->cl_device, set->cl_source, gp->threads};
+    gp->dev = gi_dev_open(&o, d, &st);
+    if (!gp->dev) goto fail;
+    S->t_kernel_build = gi_dev_build_seconds(gp->dev);
+    snprintf(S->device, sizeof S->device, "%s", gi_dev_name(gp->dev));
+
+    double tg = timer_now();
+    gp->surf = gi_surface_build(sc, a, 1e30, d, &st);
+    if (!gp->surf) goto fail;
+    S->skipped_objects = gi_surface_skipped(gp->surf);
+    double total = gi_surface_total_area(gp->surf);
+    double spacing = total > 0.0 ? sqrt(total / (double)(set->count > 0 ? set->count : 1)) : 1.0;
+    S->spacing = spacing;
+    S->tess = set->tess > 0.0 ? set->tess : set->tess_factor * spacing;
+    S->radius = set->radius > 0.0 ? set->radius : set->radius_factor * spacing;
+    gi_surface_retess(gp->surf, S->tess);
+    S->t_surfaces = timer_now() - tg;
+
+    /* area particles: candidates on every side */
+    tg = timer_now();
+    st = gi_particles_sample(&gp->ps, gp->surf, a, sc, set->count, set->seed, gp->ambient_emits, d);
+    if (st != PT_OK) goto fail;
+    S->candidates = gp->ps.n;
+    S->probed_out = gp->ps.probed_out;
+    S->t_sampling = timer_now() - tg;
+
+    /* drop the sides of two-sided surfaces that face only the void: all of
+     * their scattering rays leave the scene */
+    tg = timer_now();
+    {
+        unsigned char *any = xcalloc((size_t)gp->ps.n, 1, &st);
+        if (!any) goto fail;
+        gi_link_stats ls = {0};
+        st = gi_links_build(a, gp->ps.p, gp->ps.n, set->scatter_side, set->seed ^ 0x5eedULL, NULL, 0.0, gp->threads,
+                            NULL, any, &ls);
+        if (st == PT_OK) {
+            for (int i = 0; i < gp->ps.n; i++)
+                if (gi_surface_sides(gp->surf, gp->ps.patch[i]) == 1) any[i] = 1;
+            st = gi_particles_compact(&gp->ps, any);
+        }
+        free(any);
+        if (st != PT_OK) goto fail;
+        S->pruned = S->candidates - gp->ps.n;
+        S->particles = gp->ps.n;
+    }
+    S->t_prune = timer_now() - tg;
+
+    /* links */
+    {
+        /* (reorders the particles into grid-cell order) */
+        gi_lookup *grid = gi_lookup_build(&gp->ps, 2.0 * spacing);
+        int n = gp->ps.n;
+        gp->slink = xcalloc((size_t)n * (size_t)gp->ns2, sizeof(int), &st);
+        gp->glink = xcalloc((size_t)n * (size_t)gp->ng, sizeof(int), &st);
+        if (!grid) st = PT_ERR_NOMEM;
+        if (st != PT_OK) {
+            gi_lookup_free(grid);
+            goto fail;
+        }
+        gi_link_stats ls = {0};
+        double maxdist = 3.0 * spacing;
+        tg = timer_now();
+        st = gi_links_build(a, gp->ps.p, n, set->scatter_side, set->seed ^ 0x51ULL, grid, maxdist, gp->threads,
+                            gp->slink, NULL, &ls);
+        S->t_scatter_links = timer_now() - tg;
+        tg = timer_now();
+        if (st == PT_OK)
+            st = gi_links_build(a, gp->ps.p, n, set->gather_side, set->seed ^ 0x6a7ULL, grid, maxdist, gp->threads,
+                                gp->glink, NULL, &ls);
+        S->t_gather_links = timer_now() - tg;
+        gi_lookup_free(grid);
+        if (st != PT_OK) goto fail;
+        S->link_rays = ls.rays;
+        S->link_misses = ls.misses;
+        S->link_unresolved = ls.unresolved;
+    }
+
+    /* radiance particles and estimation lists */
+    tg = timer_now();
+    st = gi_radiance_lists(&gp->lists, gp->surf, &gp->ps, S->radius, set->normal_cos, gp->threads, d);
+    if (st != PT_OK) goto fail;
+    S->radiance_particles = gp->lists.nrp;
+    S->list_entries = gp->lists.off[gp->lists.nrp];
+    S->lists_widened = gp->lists.widened;
+    S->lists_empty = gp->lists.empty;
+    S->t_lists = timer_now() - tg;
+
+    /* host state */
+    {
+        size_t n = (size_t)gp->ps.n, nrp = (size_t)gp->lists.nrp;
+        gp->edir = xcalloc(n * 4, sizeof(float), &st);
+        gp->src = xcalloc(n * 4, sizeof(float), &st);
+        gp->phi = xcalloc(n * 4, sizeof(float), &st);
+        gp->lout = xcalloc(n * 4, sizeof(float), &st);
+        gp->eind = xcalloc(n * 4, sizeof(float), &st);
+        gp->srcidx = xcalloc(n, sizeof(int), &st);
+        gp->e_state = xcalloc(n, sizeof(atomic_uchar), &st);
+        gp->dev_gathered = xcalloc(n, 1, &st);
+        gp->rp_val = xcalloc(nrp * 4, sizeof(float), &st);
+        gp->rp_state = xcalloc(nrp, sizeof(atomic_uchar), &st);
+        gp->mark = xcalloc(nrp, sizeof(atomic_uchar), &st);
+        if (st != PT_OK) goto fail;
+    }
+
+    tg = timer_now();
+    st = gi_dev_set_particles(gp->dev, gp->ps.p, gp->ps.n, gp->slink, gp->ns2, gp->glink, gp->ng, d);
+    if (st == PT_OK) st = gi_dev_set_lists(gp->dev, gp->lists.off, (int)gp->lists.nrp, gp->lists.idx, d);
+    if (st != PT_OK) goto fail;
+    S->t_upload = timer_now() - tg;
+    S->t_geometry = timer_now() - t0 - S->t_kernel_build;
+    fill_stats(gp, stats);
+    *status = PT_OK;
+    return gp;
+fail:
+    if (st == PT_OK) st = PT_ERR_INTERNAL;
+    *status = st;
+    gi_particle_free(gp);
+    return NULL;
+}
+
+void gi_particle_free(gi_particle *gp)
+{
+    if (!gp) return;
+    gi_dev_free(gp->dev);
+    gi_surface_free(gp->surf);
+    gi_particles_free(&gp->ps);
+    gi_lists_free(&gp->lists);
+    free(gp->slink);
+    free(gp->glink);
+    free(gp->lights);
+    free(gp->vis);
+    free(gp->edir);
+    free(gp->src);
+    free(gp->phi);
+    free(gp->lout);
+    free(gp->eind);
+    free(gp->srcidx);
+    free(gp->e_state);
+    free(gp->dev_gathered);
+    free(gp->rp_val);
+    free(gp->rp_state);
+    free(gp->mark);
+    free(gp);
+}
+
+const gi_particle_stats *gi_particle_get_stats(gi_particle *gp)
+{
+    fill_stats(gp, NULL);
+    return &gp->st;
+}
+
+/* ------------------------------------------------------------------ lighting */
+
+static void pack_light(const scene_light *l, gi_dev_light *o)
+{
+    memset(o, 0, sizeof *o);
+    o->pos[0] = (float)l->position.x;
+    o->pos[1] = (float)l->position.y;
+    o->pos[2] = (float)l->position.z;
+    o->kind = l->kind == LIGHT_SPOT ? GI_LIGHT_SPOT
+              : l->kind == LIGHT_CYLINDER ? GI_LIGHT_CYLINDER
+              : l->kind == LIGHT_PARALLEL ? GI_LIGHT_PARALLEL
+                                          : GI_LIGHT_POINT;
+    o->colour[0] = (float)l->colour.r;
+    o->colour[1] = (float)l->colour.g;
+    o->colour[2] = (float)l->colour.b;
+    o->parallel = l->parallel;
+    o->point_at[0] = (float)l->point_at.x;
+    o->point_at[1] = (float)l->point_at.y;
+    o->point_at[2] = (float)l->point_at.z;
+    o->tightness = (float)l->tightness;
+    o->cos_radius = (float)cos(l->radius * M_PI / 180.0);
+    o->cos_falloff = (float)cos(l->falloff * M_PI / 180.0);
+    o->radius = (float)l->radius;
+    o->falloff = (float)l->falloff;
+    o->fade_distance = (float)l->fade_distance;
+    o->fade_power = (float)l->fade_power;
+    o->shadowless = l->shadowless;
+}
+
+/* Grid point (u, v) of an area light, as shade.c area_point lays them out
+ * (jittered by up to half a cell when `jitter` is set). */
+static vec3 area_point(const scene_light *l, vec3 ax1, vec3 ax2, int u, int v, rng *r)
+{
+    double ju = u, jv = v;
+    if (l->jitter) {
+        ju += rng_f64(r) - 0.5;
+        jv += rng_f64(r) - 0.5;
+    }
+    if (l->circular && l->size1 > 1 && l->size2 > 1) {
+        ju = ju / (l->size1 - 1) - 0.5 + 0.001;
+        jv = jv / (l->size2 - 1) - 0.5 + 0.001;
+        double sf = fmax(fabs(ju), fabs(jv)) / sqrt(ju * ju + jv * jv);
+        return v3_add(v3_scale(ax1, ju * sf), v3_scale(ax2, jv * sf));
+    }
+    vec3 o = v3(0, 0, 0);
+    if (l->size1 > 1) o = v3_add(o, v3_scale(ax1, ju / (l->size1 - 1) - 0.5));
+    if (l->size2 > 1) o = v3_add(o, v3_scale(ax2, jv / (l->size2 - 1) - 0.5));
+    return o;
+}
+
+typedef struct {
+    gi_particle *gp;
+    double eps;
+    atomic_long rays;
+} vis_job;
+
+#define VIS_CHUNK 256
+
+static double shadow_test(const accel *a, vec3 p, vec3 dir, double depth, double eps)
+{
+    double tmax = depth - fmax(eps, depth * 1e-6);
+    if (tmax <= eps) return 1.0;
+    return accel_occluded(a, p, dir, eps, tmax) ? 0.0 : 1.0;
+}
+
+static void vis_chunk(void *ctx, int chunk, int thread)
+{
+    (void)thread;
+    vis_job *J = ctx;
+    gi_particle *gp = J->gp;
+    const scene *sc = gp->sc;
+    int n = gp->ps.n, nl = gp->nlights;
+    int i0 = chunk * VIS_CHUNK, i1 = i0 + VIS_CHUNK < n ? i0 + VIS_CHUNK : n;
+    long rays = 0;
+    for (int i = i0; i < i1; i++) {
+        const gi_dev_particle *pt = &gp->ps.p[i];
+        vec3 p = v3(pt->p[0], pt->p[1], pt->p[2]), nrm = v3(pt->n[0], pt->n[1], pt->n[2]);
+        vec3 org = v3_madd(p, nrm, J->eps);
+        for (int li = 0; li < nl; li++) {
+            const scene_light *l = &sc->lights[li];
+            const gi_dev_light *dl = &gp->lights[li];
+            float d[3];
+            float depth = gi_light_ray(dl, dl->pos[0], dl->pos[1], dl->pos[2], pt->p[0], pt->p[1], pt->p[2], d);
+            float v = 0.0f;
+            float ci = pt->n[0] * d[0] + pt->n[1] * d[1] + pt->n[2] * d[2];
+            if (ci >= 1e-10f && gi_light_attenuation(dl, pt->p[0], pt->p[1], pt->p[2], d, depth) > 0.0f) {
+                if (l->shadowless) {
+                    v = 1.0f;
+                } else if (l->area && l->size1 * l->size2 > 1) {
+                    vec3 ax1 = l->axis1, ax2 = l->axis2;
+                    if (l->orient) {
+                        vec3 dir = v3(d[0], d[1], d[2]);
+                        double len = v3_len(l->axis1);
+                        vec3 helper = fabs(fabs(dir.z) - 1.0) < 0.01 ? v3(0, 1, 0) : v3(0, 0, 1);
+                        ax1 = v3_scale(v3_norm(v3_cross(dir, helper)), len);
+                        ax2 = v3_scale(v3_norm(v3_cross(dir, v3_norm(ax1))), len);
+                    }
+                    rng r;
+                    rng_seed(&r, gp->set.seed ^ 0xa11ULL, (uint64_t)i * 131u + (uint64_t)li);
+                    int total = l->size1 * l->size2;
+                    int m = gp->set.area_samples > 0 && gp->set.area_samples < total ? gp->set.area_samples : total;
+                    /* a subset: every (total/m)-th grid point from a random start */
+                    double stride = (double)total / m, start = rng_f64(&r) * stride;
+                    double sum = 0.0;
+                    for (int k = 0; k < m; k++) {
+                        int g = m == total ? k : (int)(start + k * stride);
+                        if (g >= total) g = total - 1;
+                        int u = g % l->size1, vv = g / l->size1;
+                        vec3 c = v3_add(l->position, area_point(l, ax1, ax2, u, vv, &r));
+                        float dd[3];
+                        float dep = gi_light_ray(dl, (float)c.x, (float)c.y, (float)c.z, pt->p[0], pt->p[1], pt->p[2],
+                                                 dd);
+                        sum += shadow_test(gp->a, org, v3(dd[0], dd[1], dd[2]), dep, J->eps);
+                        rays++;
+                    }
+                    v = (float)(sum / m);
+                } else {
+                    v = (float)shadow_test(gp->a, org, v3(d[0], d[1], d[2]), depth, J->eps);
+                    rays++;
+                }
+            }
+            gp->vis[(size_t)i * nl + li] = v;
+        }
+    }
+    atomic_fetch_add(&J->rays, rays);
+}
+
+static void reset_view(gi_particle *gp)
+{
+    size_t n = (size_t)gp->ps.n, nrp = (size_t)gp->lists.nrp;
+    for (size_t i = 0; i < n; i++) atomic_store(&gp->e_state[i], 0);
+    memset(gp->dev_gathered, 0, n);
+    for (size_t l = 0; l < nrp; l++) atomic_store(&gp->rp_state[l], 0);
+}
+
+pt_status gi_particle_light(gi_particle *gp, diag *d)
+{
+    double t0 = timer_now();
+    const scene *sc = gp->sc;
+    gi_particle_stats *S = &gp->st;
+    int n = gp->ps.n;
+    pt_status st = PT_OK;
+    /* lights and visibility (host, Embree shadow rays) */
+    double tv = timer_now();
+    free(gp->lights);
+    free(gp->vis);
+    gp->nlights = sc->nlights;
+    gp->lights = xcalloc((size_t)sc->nlights, sizeof *gp->lights, &st);
+    gp->vis = xcalloc((size_t)n * (size_t)(sc->nlights > 0 ? sc->nlights : 1), sizeof(float), &st);
+    if (st != PT_OK) return st;
+    for (int l = 0; l < sc->nlights; l++) pack_light(&sc->lights[l], &gp->lights[l]);
+    vis_job J;
+    J.gp = gp;
+    J.eps = 1e-6 * (accel_scale(gp->a) > 0.0 ? accel_scale(gp->a) : 1.0);
+    atomic_init(&J.rays, 0);
+    if (gp->nlights > 0 && n > 0) pool_run(gp->threads, (n + VIS_CHUNK - 1) / VIS_CHUNK, vis_chunk, &J);
+    S->shadow_rays = atomic_load(&J.rays);
+    S->t_visibility = timer_now() - tv;
+
+    /* emission kernel */
+    double te = timer_now();
+    st = gi_dev_emit(gp->dev, gp->lights, gp->nlights, gp->vis, gp->edir, gp->src, d);
+    if (st != PT_OK) return st;
+    int nsrc = 0;
+    double total = 0.0, rho_max = 0.0, fd = 0.0, fe = 0.0;
+    for (int i = 0; i < n; i++) {
+        const float *s = &gp->src[4 * (size_t)i];
+        double a = fabs(s[0]) + fabs(s[1]) + fabs(s[2]);
+        if (a > 0.0 && isfinite(a)) {
+            gp->srcidx[nsrc++] = i;
+            total += a;
+        }
+        const gi_dev_particle *p = &gp->ps.p[i];
+        for (int c = 0; c < 3; c++) {
+            rho_max = fmax(rho_max, fabs(p->rho[c]));
+            fd += M_PI * gp->edir[4 * (size_t)i + c] * p->area / 3.0;
+            fe += M_PI * p->le[c] * p->area / 3.0;
+        }
+    }
+    S->sources = nsrc;
+    S->flux_direct = fd;
+    S->flux_emitted = fe;
+    S->t_emit = timer_now() - te;
+
+    /* scattering: fixed-point scale 2^e so that nb bounces of the total
+     * cannot overflow 2^62 (see gi_lighting.cl) */
+    double ts = timer_now();
+    int nb = gp->set.bounces;
+    double growth = 0.0, gpow = 1.0;
+    for (int b = 0; b < nb; b++) {
+        growth += gpow;
+        gpow *= fmax(1.0, rho_max);
+    }
+    double bound = total * fmax(growth, 1.0);
+    int e = bound > 0.0 ? (int)floor(61.0 - log2(bound)) : 0;
+    if (e > 100) e = 100;
+    if (e < -100) e = -100;
+    float scale = ldexpf(1.0f, e);
+    gi_i64 tally[GI_MAX_BOUNCES * 3];
+    st = gi_dev_scatter(gp->dev, nsrc > 0 ? nb : 0, (gi_u32)(gp->set.seed * 2654435761u + 12345u), scale, gp->srcidx,
+                        nsrc, tally, gp->lout, gp->phi, d);
+    if (st != PT_OK) return st;
+    gp->nbounce_flux = nsrc > 0 ? nb : 0;
+    double fs = 0.0;
+    for (int b = 0; b < gp->nbounce_flux; b++) {
+        gp->bounce_flux[b] = ((double)tally[3 * b] + (double)tally[3 * b + 1] + (double)tally[3 * b + 2]) /
+                             (3.0 * (double)scale);
+        fs += gp->bounce_flux[b];
+    }
+    S->flux_scattered = fs;
+    S->t_scatter = timer_now() - ts;
+    reset_view(gp);
+    gp->lit = 1;
+    S->t_lighting = timer_now() - t0;
+    return PT_OK;
+}
+
+pt_status gi_particle_relight(gi_particle *gp, diag *d) { return gi_particle_light(gp, d); }
+
+/* ------------------------------------------------------------------ the view */
+
+typedef struct {
+    gi_particle *gp;
+    const scene_camera *cam;
+    int w, h, max_level;
+    double eps;
+    atomic_long rays;
+} view_job;
+
+static void mark_hit(gi_particle *gp, const accel_hit *h, vec3 n)
+{
+    long rp[3];
+    double w[3];
+    if (!gi_surface_locate(gp->surf, h, n, rp, w)) return;
+    for (int k = 0; k < 3; k++) atomic_store_explicit(&gp->mark[rp[k]], 1, memory_order_relaxed);
+}
+
+/* The rays the Whitted pass will trace (shade.c): primary, then reflected
+ * and transmitted ones; shadow rays are not needed. Marks the radiance
+ * particles around every diffuse hit. */
+static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_level, double eps)
+{
+    accel_hit h;
+    if (!accel_intersect(gp->a, org, dir, eps, INFINITY, &h)) return 1;
+    long rays = 1;
+    const scene_texture *tex = h.texture ? h.texture : &gp->sc->default_texture;
+    const scene_finish *f = &tex->finish;
+    vec3 n = h.ns, ng = h.ng;
+    int entering = v3_dot(dir, ng) < 0.0;
+    if (v3_dot(dir, n) > 0.0) n = v3_neg(n);
+    if (!entering) ng = v3_neg(ng);
+    if (f->diffuse > 0.0) mark_hit(gp, &h, n);
+    if (level >= max_level) return rays;
+    double cos_i = -v3_dot(dir, n);
+    vec3 p = v3_madd(h.p, ng, eps);
+    int refl = fmax(f->reflection_max.r, fmax(f->reflection_max.g, f->reflection_max.b)) > 0.0 ||
+               fmax(f->reflection_min.r, fmax(f->reflection_min.g, f->reflection_min.b)) > 0.0;
+    if (refl) rays += prepass_ray(gp, p, v3_madd(dir, n, 2.0 * cos_i), level + 1, max_level, eps);
+    const colour5 *pc = &tex->pigment.colour;
+    if (pc->f > 0.0 || pc->t > 0.0) {
+        const scene_interior *in = h.obj->interior;
+        double rel = 1.0;
+        if (in && in->ior > 0.0) rel = entering ? in->ior : 1.0 / in->ior;
+        vec3 td = dir;
+        vec3 q = v3_madd(h.p, ng, -eps);
+        if (fabs(rel - 1.0) > 1e-9) {
+            double eta = 1.0 / rel, k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+            if (k < 0.0) return rays + prepass_ray(gp, p, v3_madd(dir, n, 2.0 * cos_i), level + 1, max_level, eps);
+            td = v3_norm(v3_add(v3_scale(dir, eta), v3_scale(n, eta * cos_i - sqrt(k))));
+        }
+        rays += prepass_ray(gp, q, td, level + 1, max_level, eps);
+    }
+    return rays;
+}
+
+static void view_row(void *ctx, int y, int thread)
+{
+    (void)thread;
+    view_job *J = ctx;
+    long rays = 0;
+    for (int x = 0; x < J->w; x++) {
+        vec3 org, dir;
+        scene_camera_ray(J->cam, x + 0.5, y + 0.5, J->w, J->h, &org, &dir);
+        rays += prepass_ray(J->gp, org, dir, 1, J->max_level, J->eps);
+    }
+    atomic_fetch_add(&J->rays, rays);
+}
+
+pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w, int h, diag *d)
+{
+    double t0 = timer_now();
+    gi_particle_stats *S = &gp->st;
+    pt_status st = PT_OK;
+    if (!gp->lit) {
+        st = gi_particle_light(gp, d);
+        if (st != PT_OK) return st;
+    }
+    view_job J;
+    J.gp = gp;
+    J.cam = c;
+    J.w = w;
+    J.h = h;
+    J.max_level = gp->set.max_trace_level > 0 ? gp->set.max_trace_level : gp->sc->global.max_trace_level;
+    if (J.max_level < 1) J.max_level = 1;
+    double sc = accel_scale(gp->a);
+    J.eps = (sc > 0.0 && isfinite(sc) ? sc : 1.0) * 1e-6;
+    atomic_init(&J.rays, 0);
+    if (w > 0 && h > 0) pool_run(gp->threads, h, view_row, &J);
+    S->prepass_rays = atomic_load(&J.rays);
+    S->t_prepass = timer_now() - t0;
+
+    /* found radiance particles (not yet estimated) and the area particles
+     * their lists need (not yet gathered on the device) */
+    double tg = timer_now();
+    long nrp = gp->lists.nrp;
+    int *found = malloc((size_t)(nrp > 0 ? nrp : 1) * sizeof *found);
+    int *used = malloc((size_t)(gp->ps.n > 0 ? gp->ps.n : 1) * sizeof *used);
+    unsigned char *umark = calloc((size_t)(gp->ps.n > 0 ? gp->ps.n : 1), 1);
+    float *vout = NULL;
+    if (!found || !used || !umark) {
+        st = PT_ERR_NOMEM;
+        goto done;
+    }
+    int nfound = 0, nused = 0;
+    for (long l = 0; l < nrp; l++) {
+        if (!atomic_load_explicit(&gp->mark[l], memory_order_relaxed)) continue;
+        atomic_store_explicit(&gp->mark[l], 0, memory_order_relaxed);
+        if (atomic_load(&gp->rp_state[l]) == 2) continue;
+        found[nfound++] = (int)l;
+        for (int q = gp->lists.off[l]; q < gp->lists.off[l + 1]; q++) {
+            int m = gp->lists.idx[q];
+            if (!gp->dev_gathered[m]) umark[m] = 1;
+        }
+    }
+    for (int i = 0; i < gp->ps.n; i++)
+        if (umark[i]) used[nused++] = i;
+    S->found = nfound;
+    S->used = nused;
+    st = gi_dev_gather(gp->dev, used, nused, gp->bg, gp->eind, d);
+    if (st != PT_OK) goto done;
+    for (int t = 0; t < nused; t++) {
+        gp->dev_gathered[used[t]] = 1;
+        atomic_store(&gp->e_state[used[t]], 2);
+    }
+    S->t_gather = timer_now() - tg;
+
+    double te = timer_now();
+    vout = malloc((size_t)(nfound > 0 ? nfound : 1) * 4 * sizeof *vout);
+    if (!vout) {
+        st = PT_ERR_NOMEM;
+        goto done;
+    }
+    st = gi_dev_estimate(gp->dev, found, nfound, vout, d);
+    if (st != PT_OK) goto done;
+    for (int t = 0; t < nfound; t++) {
+        long l = found[t];
+        int empty = gp->lists.off[l] == gp->lists.off[l + 1];
+        for (int c = 0; c < 3; c++) gp->rp_val[4 * l + c] = empty ? gp->bg[c] : vout[4 * t + c];
+        gp->rp_val[4 * l + 3] = 0.0f;
+        atomic_store(&gp->rp_state[l], 2);
+    }
+    S->t_estimate = timer_now() - te;
+done:
+    free(found);
+    free(used);
+    free(umark);
+    free(vout);
+    S->t_view = timer_now() - t0;
+    return st;
+}
+
+/* ------------------------------------------------------------------ the hook */
+
+/* Claim a state slot: returns 1 if the caller must compute it, 0 once it is
+ * done (waiting while another thread computes). */
+static int claim(atomic_uchar *s)
+{
+    for (;;) {
+        unsigned char v = atomic_load_explicit(s, memory_order_acquire);
+        if (v == 2) return 0;
+        if (v == 0) {
+            unsigned char expect = 0;
+            if (atomic_compare_exchange_weak_explicit(s, &expect, 1, memory_order_acq_rel, memory_order_acquire))
+                return 1;
+            continue;
+        }
+        /* 1: someone else is on it */
+        for (volatile int k = 0; k < 64; k++) {
+        }
+    }
+}
+
+static void late_rp(gi_particle *gp, long l)
+{
+    if (!claim(&gp->rp_state[l])) return;
+    int lo = gp->lists.off[l], hi = gp->lists.off[l + 1];
+    for (int q = lo; q < hi; q++) {
+        int m = gp->lists.idx[q];
+        if (claim(&gp->e_state[m])) {
+            /* the gathering kernel, C build, on this thread */
+            gi_c_gather(1, gp->glink, gp->ng, gp->lout, &m, 1, gp->bg, gp->eind);
+            atomic_store_explicit(&gp->e_state[m], 2, memory_order_release);
+        }
+    }
+    int li = (int)l;
+    float v[4];
+    gi_c_estimate(1, gp->ps.p, gp->lists.off, gp->lists.idx, gp->eind, &li, 1, v);
+    for (int c = 0; c < 3; c++) gp->rp_val[4 * l + c] = lo == hi ? gp->bg[c] : v[c];
+    atomic_store_explicit(&gp->rp_state[l], 2, memory_order_release);
+}
+
+rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
+{
+    gi_particle *gp = ctx;
+    rgb out = {0.0, 0.0, 0.0};
+    thread_count *tc = &gp->tc[(unsigned)thread < GI_MAX_THREADS ? thread : 0];
+    tc->lookups++;
+    long rp[3];
+    double w[3];
+    if (!gp->lit || !gi_surface_locate(gp->surf, hit, n, rp, w)) {
+        tc->none++;
+        return out;
+    }
+    for (int k = 0; k < 3; k++) {
+        if (atomic_load_explicit(&gp->rp_state[rp[k]], memory_order_acquire) != 2) {
+            tc->late++;
+            late_rp(gp, rp[k]);
+        }
+        const float *v = &gp->rp_val[4 * rp[k]];
+        out.r += w[k] * v[0];
+        out.g += w[k] * v[1];
+        out.b += w[k] * v[2];
+    }
+    double b = gp->set.brightness;
+    out.r *= b;
+    out.g *= b;
+    out.b *= b;
+    if (!isfinite(out.r) || !isfinite(out.g) || !isfinite(out.b)) {
+        tc->discarded++;
+        out.r = out.g = out.b = 0.0;
+    }
+    return out;
+}
+
+/* ------------------------------------------------------------------ debug */
+
+int gi_particle_debug(const gi_particle *gp, const float **edir, const float **phi, const float **lout,
+                      const double **bounce_flux, int *nbounces)
+{
+    if (edir) *edir = gp->edir;
+    if (phi) *phi = gp->phi;
+    if (lout) *lout = gp->lout;
+    if (bounce_flux) *bounce_flux = gp->bounce_flux;
+    if (nbounces) *nbounces = gp->nbounce_flux;
+    return gp->ps.n;
+}
+
+void gi_particle_debug_particle(const gi_particle *gp, int i, double *area, double rho[3], vec3 *pos, vec3 *nrm)
+{
+    const gi_dev_particle *p = &gp->ps.p[i];
+    if (area) *area = p->area;
+    if (rho)
+        for (int c = 0; c < 3; c++) rho[c] = p->rho[c];
+    if (pos) *pos = v3(p->p[0], p->p[1], p->p[2]);
+    if (nrm) *nrm = v3(p->n[0], p->n[1], p->n[2]);
+}

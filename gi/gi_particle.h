@@ -1,0 +1,142 @@
+/* gi_particle.h - particle-space global illumination (`--gi particle`), after
+ * Chang, Park and Ihm, "Diffuse Global Illumination in Particle Spaces",
+ * Multimedia Tools and Applications 74(13), 2015 (seed 000). Rays are traced
+ * by Embree on the host; the particle work (emission, scattering, gathering,
+ * radiance estimation) runs as OpenCL kernels (gi/kernels), or as the same
+ * kernels compiled as C.
+ *
+ * Stages, and when to run them:
+ *   gi_particle_build         geometry stage: area particles, 4x4 scattering
+ *                             and 16x16 gathering links, radiance particles,
+ *                             estimation lists; the OpenCL device. Once per
+ *                             geometry.
+ *   gi_particle_light         lighting stage: emission from every light and
+ *                             emissive surface, n_b scattering bounces. After
+ *                             build, and again whenever a light changes
+ *                             (gi_particle_relight: same stage, nothing else).
+ *   gi_particle_prepare_view  ray-tracing stage, first half: preliminary rays
+ *                             mark the radiance particles the view needs;
+ *                             gathering at their area particles; radiance
+ *                             estimation. Once per camera/frame.
+ *   gi_particle_indirect      the shade_settings.indirect hook, during the
+ *                             Whitted pass: barycentric interpolation of the
+ *                             3 radiance particles around each hit.
+ *
+ * Units (see gi/kernels/gi_types.h): the hook returns E/pi, the indirect
+ * irradiance divided by pi. shade.c multiplies it by diffuse*pigment, which
+ * gives the reflected radiance rho*E/pi of a Lambertian surface in the same
+ * units as its direct term (diffuse*pigment*colour*cos), so a path tracer
+ * with the BRDF rho/pi and a light delivering E = pi*colour*cos converges
+ * to the same image.
+ *
+ * What counts as emitted light: light_sources (every kind, with shade.c's
+ * attenuation and shadow rays), finish emission, and finish ambient *
+ * ambient_light when `ambient_emits` (default: when the scene has
+ * radiosity{}, as POV-Ray 3.7 does). Rays that leave the scene see the
+ * background colour (sky_sphere is ignored). Only diffuse interreflection is
+ * simulated (as in the paper): no caustics; reflective and refractive
+ * surfaces take part through the Whitted pass only.
+ *
+ * radiosity{} -> settings (gi_particle_settings_from_scene):
+ *   count            -> particle count = 500 * count, within [10000, 1000000]
+ *                       (the default count 35 gives 17,500; cbox's 100 gives
+ *                       the paper's 50,000)
+ *   recursion_limit  -> bounces n_b = recursion_limit - 1, at least 0
+ *                       (POV-Ray counts diffuse bounces; here the gathering
+ *                       step adds one to the n_b scattering bounces)
+ *   error_bound      -> estimation list radius factor 3 * error_bound / 1.8,
+ *                       within [2, 5] (smaller error_bound: sharper, noisier)
+ *   nearest_count    -> not used (lists replace the nearest-sample search)
+ *   brightness       -> multiplies the indirect term returned by the hook
+ *   always other fields are ignored.
+ */
+#ifndef PT_GI_PARTICLE_H
+#define PT_GI_PARTICLE_H
+#include <stddef.h>
+#include <stdint.h>
+#include "accel.h"
+#include "diag.h"
+#include "scene.h"
+
+typedef struct gi_particle gi_particle;
+
+typedef struct {
+    long count;          /* area particles per one-sided scene area (default 50,000) */
+    int scatter_side;    /* n_s: n_s x n_s scattering links (default 4) */
+    int gather_side;     /* gathering links gather_side^2 (default 16: the paper's 256) */
+    int bounces;         /* n_b: scattering bounces, the first full fan-out included (default 8) */
+    double tess;         /* sub-triangle edge / grid cell bound; <= 0: tess_factor * spacing */
+    double tess_factor;  /* default 3 (spacing = sqrt(area per particle)) */
+    double radius;       /* estimation list radius; <= 0: radius_factor * spacing */
+    double radius_factor;/* default 3 */
+    double normal_cos;   /* list normal threshold: n_m . n_q > normal_cos (default 0.9, 25.8 degrees) */
+    int ambient_emits;   /* -1: from the scene (radiosity{} on), 0 no, 1 yes */
+    int area_samples;    /* shadow rays per particle per area light; 0: the whole grid (default 0) */
+    double brightness;   /* multiplies the returned indirect light (default 1) */
+    int max_trace_level; /* pre-pass depth; 0: the scene's */
+    uint64_t seed;
+    int threads;         /* <= 0: all cores */
+    const char *cl_device; /* NULL/"auto", "c", "P:D" or part of a name (gi_cl.h) */
+    const char *cl_source; /* NULL: the built-in kernels; tests pass broken text here */
+} gi_particle_settings;
+
+typedef struct {
+    /* times, seconds */
+    double t_geometry;      /* whole geometry stage (kernel build excluded) */
+    double t_surfaces, t_sampling, t_prune, t_scatter_links, t_gather_links, t_lists, t_upload;
+    double t_kernel_build;  /* OpenCL program build (PoCL caches it) */
+    double t_lighting;      /* whole lighting stage */
+    double t_visibility, t_emit, t_scatter;
+    double t_view;          /* whole last prepare_view */
+    double t_prepass, t_gather, t_estimate;
+    /* counts */
+    long candidates, particles, pruned, probed_out;
+    long radiance_particles, list_entries, lists_widened, lists_empty;
+    long link_rays, link_misses, link_unresolved;
+    long sources;           /* particles that emit or reflect direct light */
+    long shadow_rays;
+    long prepass_rays, found, used;  /* last prepare_view: new radiance / area particles */
+    long lookups, lookups_late, lookups_none, discarded;
+    long skipped_objects;
+    double flux_direct, flux_emitted, flux_scattered; /* sums over particles (grey) */
+    /* memory, bytes */
+    size_t bytes_particles, bytes_links, bytes_lists, bytes_surfaces, bytes_device, bytes_total;
+    double spacing, tess, radius;
+    int bounces;
+    char device[256];
+} gi_particle_stats;
+
+void gi_particle_default_settings(gi_particle_settings *s);
+/* Defaults, then the radiosity{} mapping above when the scene has one. */
+void gi_particle_settings_from_scene(gi_particle_settings *s, const scene *sc);
+
+/* Geometry stage. The scene and accel must outlive the result. `stats` may
+ * be NULL; it is filled at the end (and again by the later stages, see
+ * gi_particle_get_stats). */
+gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particle_settings *s,
+                               gi_particle_stats *stats, diag *d, pt_status *status);
+/* Lighting stage from the scene's current lights (sc->lights may have been
+ * edited in place since build: positions, colours, kinds). */
+pt_status gi_particle_light(gi_particle *gp, diag *d);
+/* A light moved or changed: rerun the lighting stage and forget the view's
+ * gathered values (the next prepare_view recomputes them). */
+pt_status gi_particle_relight(gi_particle *gp, diag *d);
+/* Ray-tracing stage for a w x h image from camera c (after light). */
+pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w, int h, diag *d);
+/* The shade_settings.indirect hook (signature of shade_indirect_fn): ctx is
+ * the gi_particle. Thread-safe; `thread` < 256. Radiance particles the
+ * pre-pass missed are computed on the spot with the C build of the kernels. */
+rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread);
+const gi_particle_stats *gi_particle_get_stats(gi_particle *gp);
+void gi_particle_free(gi_particle *gp);
+
+/* For tests and tools: the particles' state after the lighting stage.
+ * Returns the count; arrays are owned by gp (n*4 floats: E/pi direct,
+ * received flux phi, reflected radiance L), and the per-bounce tally of the
+ * last scattering (grey sums, fixed point converted to flux). */
+int gi_particle_debug(const gi_particle *gp, const float **edir, const float **phi, const float **lout,
+                      const double **bounce_flux, int *nbounces);
+/* Area, reflectance and position of particle i (tests). */
+void gi_particle_debug_particle(const gi_particle *gp, int i, double *area, double rho[3], vec3 *pos, vec3 *nrm);
+
+#endif

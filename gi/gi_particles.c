@@ -1,0 +1,534 @@
+/* gi_particles.c - area particle sampling and the particle hash grid. */
+#include "gi_particles.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "rng.h"
+
+/* R2 low-discrepancy sequence (M. Roberts, "The unreasonable effectiveness of
+ * quasirandom sequences", 2018): alpha = (1/g, 1/g^2) with g the plastic
+ * number, the real root of x^3 = x + 1. */
+#define R2_G 1.32471795724474602596
+#define R2_A1 (1.0 / R2_G)
+#define R2_A2 (1.0 / (R2_G * R2_G))
+
+static double frac(double x) { return x - floor(x); }
+
+/* POV-Ray's greyscale weights (as shade.c). */
+static double grey(double r, double g, double b) { return 0.297 * r + 0.589 * g + 0.114 * b; }
+
+static void material(const scene *sc, const scene_texture *tex, int ambient_emits, gi_dev_particle *p)
+{
+    if (!tex) tex = &sc->default_texture;
+    const scene_finish *f = &tex->finish;
+    const colour5 *c = &tex->pigment.colour;
+    double tr = c->f * c->r + c->t, tg = c->f * c->g + c->t, tb = c->f * c->b + c->t;
+    double opacity = 1.0 - fmin(1.0, fmax(0.0, grey(tr, tg, tb)));
+    double pig[3] = {c->r, c->g, c->b};
+    double em[3] = {f->emission.r, f->emission.g, f->emission.b};
+    if (ambient_emits) {
+        em[0] += f->ambient.r * sc->global.ambient_light.r;
+        em[1] += f->ambient.g * sc->global.ambient_light.g;
+        em[2] += f->ambient.b * sc->global.ambient_light.b;
+    }
+    for (int k = 0; k < 3; k++) {
+        double rho = f->diffuse * pig[k] * opacity;
+        double le = pig[k] * em[k] * opacity;
+        p->rho[k] = isfinite(rho) ? (float)rho : 0.0f;
+        p->le[k] = isfinite(le) ? (float)le : 0.0f;
+    }
+    p->brilliance = isfinite(f->brilliance) && f->brilliance > 0.0 ? (float)f->brilliance : 1.0f;
+}
+
+typedef struct {
+    gi_dev_particle *p;
+    int *patch;
+    unsigned char *side;
+    long n, cap;
+} pbuf;
+
+static int push(pbuf *b, const gi_dev_particle *p, int patch, int side)
+{
+    if (b->n == b->cap) {
+        long nc = b->cap ? b->cap * 2 : 4096;
+        gi_dev_particle *np = realloc(b->p, (size_t)nc * sizeof *np);
+        if (!np) return 0;
+        b->p = np;
+        int *npa = realloc(b->patch, (size_t)nc * sizeof *npa);
+        if (!npa) return 0;
+        b->patch = npa;
+        unsigned char *ns = realloc(b->side, (size_t)nc);
+        if (!ns) return 0;
+        b->side = ns;
+        b->cap = nc;
+    }
+    b->p[b->n] = *p;
+    b->patch[b->n] = patch;
+    b->side[b->n] = (unsigned char)side;
+    b->n++;
+    return 1;
+}
+
+/* Does the rendered surface of `o` pass through pos (a CSG member's surface
+ * may be cut away)? A short ray towards the surface along -nrm must hit o
+ * near pos. */
+static int probe_ok(const accel *a, const scene_object *o, vec3 pos, vec3 nrm)
+{
+    double delta = 1e-3 * (accel_scale(a) + fmax(fabs(pos.x), fmax(fabs(pos.y), fabs(pos.z))));
+    for (int s = 0; s < 2; s++) {
+        vec3 nn = s ? v3_neg(nrm) : nrm;
+        accel_hit h;
+        if (accel_intersect(a, v3_madd(pos, nn, delta), v3_neg(nn), 0.0, 2.0 * delta, &h) && h.obj == o &&
+            fabs(h.t - delta) < 0.5 * delta)
+            return 1;
+    }
+    return 0;
+}
+
+pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel *a, const scene *sc, long count,
+                              uint64_t seed, int ambient_emits, diag *d)
+{
+    memset(ps, 0, sizeof *ps);
+    double total = gi_surface_total_area(g);
+    if (count < 1) count = 1;
+    if (!(total > 0.0)) return PT_OK;
+    double density = (double)count / total;
+    ps->dA = total / (double)count;
+    ps->spacing = sqrt(ps->dA);
+    pbuf b = {0};
+    rng r;
+    rng_seed(&r, seed, 0x9a17c1e5ULL);
+    double offset = rng_f64(&r), cum = 0.0;
+    int np = gi_surface_npatches(g);
+    for (int i = 0; i < np; i++) {
+        double area = gi_surface_area(g, i);
+        int sides = gi_surface_sides(g, i);
+        if (sides == 0 || !(area > 0.0)) continue;
+        /* systematic sampling of the patch counts: exactly `count` over all */
+        long before = (long)floor(cum * density + offset);
+        cum += area;
+        long m = (long)floor(cum * density + offset) - before;
+        if (m <= 0) continue;
+        rng pr;
+        rng_seed(&pr, seed, (uint64_t)i * 2 + 1);
+        double su = rng_f64(&pr), sv = rng_f64(&pr);
+        const scene_object *o = gi_surface_object(g, i);
+        gi_dev_particle proto;
+        memset(&proto, 0, sizeof proto);
+        proto.area = (float)ps->dA;
+        material(sc, gi_surface_texture(g, i), ambient_emits, &proto);
+        int probe = gi_surface_probe(g, i);
+        long got = 0, tries = 0, limit = 64 * m + 64;
+        for (long q = 0; got < m && tries < limit; q++, tries++) {
+            double u = frac(su + (double)q * R2_A1), v = frac(sv + (double)q * R2_A2);
+            vec3 pos, nrm;
+            if (!gi_surface_sample(g, i, u, v, rng_f64(&pr), &pos, &nrm)) continue;
+            got++;
+            for (int s = 0; s < sides; s++) {
+                vec3 nn = s ? v3_neg(nrm) : nrm;
+                if (probe && !probe_ok(a, o, pos, nn)) {
+                    ps->probed_out++;
+                    continue;
+                }
+                gi_dev_particle p = proto;
+                p.p[0] = (float)pos.x;
+                p.p[1] = (float)pos.y;
+                p.p[2] = (float)pos.z;
+                p.n[0] = (float)nn.x;
+                p.n[1] = (float)nn.y;
+                p.n[2] = (float)nn.z;
+                if (!push(&b, &p, i, s)) {
+                    free(b.p);
+                    free(b.patch);
+                    free(b.side);
+                    return PT_ERR_NOMEM;
+                }
+            }
+        }
+        if (b.n > 2147483000L) {
+            diag_report(d, DIAG_ERROR, (src_loc){0}, NULL, "particle GI: too many particles");
+            free(b.p);
+            free(b.patch);
+            free(b.side);
+            return PT_ERR_LIMIT;
+        }
+    }
+    ps->n = (int)b.n;
+    ps->p = b.p;
+    ps->patch = b.patch;
+    ps->side = b.side;
+    return PT_OK;
+}
+
+pt_status gi_particles_compact(gi_particles *ps, const unsigned char *keep)
+{
+    int m = 0;
+    for (int i = 0; i < ps->n; i++) {
+        if (!keep[i]) continue;
+        ps->p[m] = ps->p[i];
+        ps->patch[m] = ps->patch[i];
+        ps->side[m] = ps->side[i];
+        m++;
+    }
+    ps->n = m;
+    return PT_OK;
+}
+
+void gi_particles_free(gi_particles *ps)
+{
+    if (!ps) return;
+    free(ps->p);
+    free(ps->patch);
+    free(ps->side);
+    memset(ps, 0, sizeof *ps);
+}
+
+/* ------------------------------------------------------------------ grid */
+
+typedef struct {
+    float x, y, z;
+    int idx;
+    float nx, ny, nz;
+    float pad;
+} gentry;
+
+struct gi_grid {
+    double cell, inv;
+    vec3 origin;
+    unsigned mask;
+    int *start; /* mask+2 */
+    gentry *e;
+    int n;
+};
+
+static unsigned cell_hash(long ix, long iy, long iz, unsigned mask)
+{
+    /* primes from Teschner et al. 2003 */
+    unsigned long h = ((unsigned long)ix * 73856093UL) ^ ((unsigned long)iy * 19349663UL) ^
+                      ((unsigned long)iz * 83492791UL);
+    return (unsigned)(h & mask);
+}
+
+gi_grid *gi_grid_build(const gi_dev_particle *p, int n, double cell)
+{
+    gi_grid *g = calloc(1, sizeof *g);
+    if (!g) return NULL;
+    g->cell = cell > 0.0 ? cell : 1.0;
+    g->inv = 1.0 / g->cell;
+    g->n = n;
+    vec3 lo = v3s(INFINITY);
+    for (int i = 0; i < n; i++) lo = v3_min(lo, v3(p[i].p[0], p[i].p[1], p[i].p[2]));
+    g->origin = n > 0 ? v3_sub(lo, v3s(g->cell)) : v3s(0.0);
+    unsigned size = 1024;
+    while (size < 2u * (unsigned)n && size < (1u << 30)) size *= 2;
+    g->mask = size - 1;
+    g->start = calloc((size_t)size + 2, sizeof *g->start);
+    g->e = malloc((size_t)(n > 0 ? n : 1) * sizeof *g->e);
+    unsigned *key = malloc((size_t)(n > 0 ? n : 1) * sizeof *key);
+    if (!g->start || !g->e || !key) {
+        free(key);
+        gi_grid_free(g);
+        return NULL;
+    }
+    for (int i = 0; i < n; i++) {
+        long ix = (long)floor((p[i].p[0] - g->origin.x) * g->inv);
+        long iy = (long)floor((p[i].p[1] - g->origin.y) * g->inv);
+        long iz = (long)floor((p[i].p[2] - g->origin.z) * g->inv);
+        key[i] = cell_hash(ix, iy, iz, g->mask);
+        g->start[key[i] + 2]++;
+    }
+    for (unsigned b = 0; b <= size; b++) g->start[b + 1] += g->start[b];
+    /* start[b+1] is now the beginning of bucket b; fill (stable) */
+    for (int i = 0; i < n; i++) {
+        gentry *e = &g->e[g->start[key[i] + 1]++];
+        e->x = p[i].p[0];
+        e->y = p[i].p[1];
+        e->z = p[i].p[2];
+        e->idx = i;
+        e->nx = p[i].n[0];
+        e->ny = p[i].n[1];
+        e->nz = p[i].n[2];
+        e->pad = 0.0f;
+    }
+    /* now start[b] .. start[b+1] is bucket b */
+    free(key);
+    return g;
+}
+
+void gi_grid_free(gi_grid *g)
+{
+    if (!g) return;
+    free(g->start);
+    free(g->e);
+    free(g);
+}
+
+size_t gi_grid_bytes(const gi_grid *g)
+{
+    return g ? ((size_t)g->mask + 3) * sizeof(int) + (size_t)g->n * sizeof(gentry) : 0;
+}
+
+int gi_grid_nearest(const gi_grid *g, vec3 q, vec3 dir, double maxdist)
+{
+    if (g->n == 0) return -1;
+    double fx = (q.x - g->origin.x) * g->inv, fy = (q.y - g->origin.y) * g->inv, fz = (q.z - g->origin.z) * g->inv;
+    if (!isfinite(fx) || !isfinite(fy) || !isfinite(fz)) return -1;
+    long ix = (long)floor(fx), iy = (long)floor(fy), iz = (long)floor(fz);
+    double rx = fx - ix, ry = fy - iy, rz = fz - iz;
+    float qx = (float)q.x, qy = (float)q.y, qz = (float)q.z;
+    float dx = (float)dir.x, dy = (float)dir.y, dz = (float)dir.z;
+    double best = maxdist * maxdist;
+    int bi = -1;
+    int rings = (int)ceil(maxdist * g->inv) + 1;
+    if (rings > 64) rings = 64;
+    for (int ring = 0; ring <= rings; ring++) {
+        for (int ox = -ring; ox <= ring; ox++) {
+            double bx = ox < 0 ? (rx - ox - 1) : (ox > 0 ? (ox - rx) : 0.0);
+            for (int oy = -ring; oy <= ring; oy++) {
+                double by = oy < 0 ? (ry - oy - 1) : (oy > 0 ? (oy - ry) : 0.0);
+                for (int oz = -ring; oz <= ring; oz++) {
+                    if (abs(ox) != ring && abs(oy) != ring && abs(oz) != ring) continue;
+                    double bz = oz < 0 ? (rz - oz - 1) : (oz > 0 ? (oz - rz) : 0.0);
+                    double md = (bx * bx + by * by + bz * bz) * g->cell * g->cell;
+                    if (md >= best) continue;
+                    unsigned h = cell_hash(ix + ox, iy + oy, iz + oz, g->mask);
+                    for (int k = g->start[h]; k < g->start[h + 1]; k++) {
+                        const gentry *e = &g->e[k];
+                        if (e->nx * dx + e->ny * dy + e->nz * dz >= 0.0f) continue;
+                        float ex = e->x - qx, ey = e->y - qy, ez = e->z - qz;
+                        double d2 = (double)(ex * ex + ey * ey + ez * ez);
+                        if (d2 < best || (d2 == best && e->idx < bi)) {
+                            best = d2;
+                            bi = e->idx;
+                        }
+                    }
+                }
+            }
+        }
+        /* every cell of the next ring is at least ring*cell away */
+        if (bi >= 0 && best <= (double)ring * ring * g->cell * g->cell) break;
+    }
+    return bi;
+}
+
+static int cmp_int(const void *a, const void *b)
+{
+    int x = *(const int *)a, y = *(const int *)b;
+    return (x > y) - (x < y);
+}
+
+long gi_grid_radius(const gi_grid *g, vec3 q, vec3 nq, double r, double cos_thr, int **out, long *len, long *cap)
+{
+    long start = *len;
+    int reach = (int)ceil(r * g->inv);
+    long ix = (long)floor((q.x - g->origin.x) * g->inv);
+    long iy = (long)floor((q.y - g->origin.y) * g->inv);
+    long iz = (long)floor((q.z - g->origin.z) * g->inv);
+    double r2 = r * r;
+    /* hash collisions may scan a bucket twice: duplicates go below */
+    for (int ox = -reach; ox <= reach; ox++) {
+        for (int oy = -reach; oy <= reach; oy++) {
+            for (int oz = -reach; oz <= reach; oz++) {
+                unsigned h = cell_hash(ix + ox, iy + oy, iz + oz, g->mask);
+                for (int k = g->start[h]; k < g->start[h + 1]; k++) {
+                    const gentry *e = &g->e[k];
+                    double ex = e->x - q.x, ey = e->y - q.y, ez = e->z - q.z;
+                    if (ex * ex + ey * ey + ez * ez > r2) continue;
+                    if (e->nx * nq.x + e->ny * nq.y + e->nz * nq.z <= cos_thr) continue;
+                    if (*len == *cap) {
+                        long nc = *cap ? *cap * 2 : 1024;
+                        int *no = realloc(*out, (size_t)nc * sizeof *no);
+                        if (!no) return -1;
+                        *out = no;
+                        *cap = nc;
+                    }
+                    (*out)[(*len)++] = e->idx;
+                }
+            }
+        }
+    }
+    long m = *len - start;
+    if (m > 1) {
+        int *o = *out + start;
+        qsort(o, (size_t)m, sizeof *o, cmp_int);
+        long u = 1;
+        for (long i = 1; i < m; i++)
+            if (o[i] != o[u - 1]) o[u++] = o[i];
+        m = u;
+        *len = start + m;
+    }
+    return m;
+}
+
+/* ------------------------------------------------------------------ dense lookup */
+
+/* Nearest-particle lookup by cell lists with a margin: each cell of a
+ * dense grid lists every particle within `margin` of it (a particle is
+ * entered in the up to 8 cells its [p - margin, p + margin] box touches).
+ * The nearest particle to q, if it is within margin, is then in the list of
+ * q's own cell, so a query reads one contiguous run of memory. Farther
+ * answers fall back to the hashed grid's ring search. */
+typedef struct {
+    float x, y, z;
+    int idx;
+    signed char nx, ny, nz, pad;
+} lentry;
+
+struct gi_lookup {
+    double cell, inv, margin;
+    vec3 origin;
+    long dim[3];
+    int *start; /* ncells + 2 */
+    lentry *e;
+    long ne;
+    int n;
+    gi_grid *fallback;
+};
+
+static long lk_index(const gi_lookup *g, double x, double y, double z, long *c)
+{
+    double f[3] = {(x - g->origin.x) * g->inv, (y - g->origin.y) * g->inv, (z - g->origin.z) * g->inv};
+    for (int k = 0; k < 3; k++) {
+        long i = isfinite(f[k]) ? (long)floor(f[k]) : 0;
+        c[k] = i < 0 ? 0 : (i >= g->dim[k] ? g->dim[k] - 1 : i);
+    }
+    return (c[2] * g->dim[1] + c[1]) * g->dim[0] + c[0];
+}
+
+gi_lookup *gi_lookup_build(const gi_particles *ps, double cell)
+{
+    gi_lookup *g = calloc(1, sizeof *g);
+    if (!g) return NULL;
+    int n = ps->n;
+    g->n = n;
+    vec3 lo = v3s(INFINITY), hi = v3s(-INFINITY);
+    for (int i = 0; i < n; i++) {
+        vec3 p = v3(ps->p[i].p[0], ps->p[i].p[1], ps->p[i].p[2]);
+        lo = v3_min(lo, p);
+        hi = v3_max(hi, p);
+    }
+    if (n == 0) lo = hi = v3s(0.0);
+    if (!(cell > 0.0)) cell = 1.0;
+    g->margin = 0.5 * cell;
+    vec3 ext = v3_sub(hi, lo);
+    double limit = 4.0 * n + 4096.0;
+    for (;;) {
+        double cells = 1.0;
+        for (int k = 0; k < 3; k++) cells *= floor(v3_idx(ext, k) / cell) + 3.0;
+        if (cells <= limit) break;
+        cell *= 1.25;
+    }
+    g->cell = cell;
+    g->inv = 1.0 / cell;
+    g->origin = v3_sub(lo, v3s(cell));
+    for (int k = 0; k < 3; k++) g->dim[k] = (long)floor(v3_idx(ext, k) / cell) + 3;
+    long ncells = g->dim[0] * g->dim[1] * g->dim[2];
+    g->start = calloc((size_t)ncells + 2, sizeof *g->start);
+    g->fallback = gi_grid_build(ps->p, n, g->margin);
+    if (!g->start || !g->fallback) {
+        gi_lookup_free(g);
+        return NULL;
+    }
+    double m = g->margin;
+    for (int pass = 0; pass < 2; pass++) {
+        for (int i = 0; i < n; i++) {
+            const gi_dev_particle *p = &ps->p[i];
+            long a[3], b[3];
+            lk_index(g, p->p[0] - m, p->p[1] - m, p->p[2] - m, a);
+            lk_index(g, p->p[0] + m, p->p[1] + m, p->p[2] + m, b);
+            for (long z = a[2]; z <= b[2]; z++)
+                for (long y = a[1]; y <= b[1]; y++)
+                    for (long x = a[0]; x <= b[0]; x++) {
+                        long c = (z * g->dim[1] + y) * g->dim[0] + x;
+                        if (pass == 0) {
+                            g->start[c + 2]++;
+                            continue;
+                        }
+                        lentry *e = &g->e[g->start[c + 1]++];
+                        e->x = p->p[0];
+                        e->y = p->p[1];
+                        e->z = p->p[2];
+                        e->idx = i;
+                        e->nx = (signed char)lrintf(p->n[0] * 127.0f);
+                        e->ny = (signed char)lrintf(p->n[1] * 127.0f);
+                        e->nz = (signed char)lrintf(p->n[2] * 127.0f);
+                        e->pad = 0;
+                    }
+        }
+        if (pass == 0) {
+            for (long c = 0; c <= ncells; c++) g->start[c + 1] += g->start[c];
+            g->ne = g->start[ncells + 1];
+            g->e = malloc((size_t)(g->ne > 0 ? g->ne : 1) * sizeof *g->e);
+            if (!g->e) {
+                gi_lookup_free(g);
+                return NULL;
+            }
+        }
+    }
+    return g;
+}
+
+void gi_lookup_free(gi_lookup *g)
+{
+    if (!g) return;
+    free(g->start);
+    free(g->e);
+    gi_grid_free(g->fallback);
+    free(g);
+}
+
+size_t gi_lookup_bytes(const gi_lookup *g)
+{
+    return g ? ((size_t)(g->dim[0] * g->dim[1] * g->dim[2]) + 2) * sizeof(int) + (size_t)g->ne * sizeof(lentry) +
+                   gi_grid_bytes(g->fallback)
+             : 0;
+}
+
+long gi_lookup_cell(const gi_lookup *g, vec3 q)
+{
+    long c[3];
+    return g->n ? lk_index(g, q.x, q.y, q.z, c) : 0;
+}
+
+void gi_lookup_prefetch(const gi_lookup *g, long cell, int stage)
+{
+    if (g->n == 0) return;
+    if (stage == 0) {
+        __builtin_prefetch(&g->start[cell]);
+        return;
+    }
+    int k = g->start[cell];
+    if (k < g->ne) {
+        __builtin_prefetch(&g->e[k]);
+        __builtin_prefetch((const char *)&g->e[k] + 64);
+    }
+}
+
+int gi_lookup_nearest(const gi_lookup *g, vec3 q, vec3 dir, double maxdist)
+{
+    if (g->n == 0 || !v3_finite(q)) return -1;
+    return gi_lookup_nearest_in(g, gi_lookup_cell(g, q), q, dir, maxdist);
+}
+
+int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, double maxdist)
+{
+    if (g->n == 0 || !v3_finite(q)) return -1;
+    float qx = (float)q.x, qy = (float)q.y, qz = (float)q.z;
+    float dx = (float)dir.x, dy = (float)dir.y, dz = (float)dir.z;
+    double m = fmin(g->margin, maxdist);
+    float best = (float)(m * m);
+    int bi = -1;
+    /* branch-free: the comparisons are unpredictable */
+    for (int k = g->start[cell]; k < g->start[cell + 1]; k++) {
+        const lentry *e = &g->e[k];
+        float ex = e->x - qx, ey = e->y - qy, ez = e->z - qz;
+        float d2 = ex * ex + ey * ey + ez * ez;
+        float f = (float)e->nx * dx + (float)e->ny * dy + (float)e->nz * dz;
+        int ok = (d2 < best) & (f < 0.0f);
+        best = ok ? d2 : best;
+        bi = ok ? e->idx : bi;
+    }
+    if (bi >= 0) return bi;
+    /* nothing within the margin: the ring search, up to maxdist */
+    return maxdist > m ? gi_grid_nearest(g->fallback, q, dir, maxdist) : -1;
+}

@@ -1,0 +1,67 @@
+/* gi_particles.h - area particles (paper section 3.1): samples distributed
+ * uniformly by area over every surface patch, each standing for the same
+ * area dA = A/N, with normal, diffuse reflectance and emission; and a
+ * hashed uniform grid over them for the nearest-particle lookups of the link
+ * builder and the radius queries of the estimation lists. Internal to gi/. */
+#ifndef PT_GI_PARTICLES_H
+#define PT_GI_PARTICLES_H
+#include <stdint.h>
+#include "accel.h"
+#include "gi_surface.h"
+#include "kernels/gi_types.h"
+
+typedef struct {
+    int n;
+    gi_dev_particle *p; /* n records (device layout) */
+    int *patch;         /* patch of each particle */
+    unsigned char *side;
+    double dA;          /* area per particle */
+    double spacing;     /* sqrt(dA): typical distance between neighbours */
+    long probed_out;    /* candidates a CSG probe removed */
+} gi_particles;
+
+/* Candidates: `count` particles per unit of one-sided area A (dA = A/count),
+ * stratified per patch (low-discrepancy R2 points, Roberts 2018, with a
+ * random shift per patch), one per side of two-sided patches. Materials:
+ * rho = diffuse * pigment * opacity, le = pigment * (emission + [ambient *
+ * ambient_light if ambient_emits]) * opacity, as shade.c's terms. */
+pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel *a, const scene *sc, long count,
+                              uint64_t seed, int ambient_emits, diag *d);
+/* Keep the particles with keep[i] != 0, in order. */
+pt_status gi_particles_compact(gi_particles *ps, const unsigned char *keep);
+void gi_particles_free(gi_particles *ps);
+
+typedef struct gi_grid gi_grid;
+/* Spatial hash of the particles (Teschner et al., "Optimized Spatial Hashing
+ * for Collision Detection of Deformable Objects", VMV 2003) with the given
+ * cell size; colliding cells share a bucket, which costs only extra distance
+ * tests. */
+gi_grid *gi_grid_build(const gi_dev_particle *p, int n, double cell);
+void gi_grid_free(gi_grid *g);
+size_t gi_grid_bytes(const gi_grid *g);
+/* Nearest particle to q whose normal faces against dir (n.dir < 0: the side
+ * a ray travelling along dir hits), within maxdist; -1 if none. */
+int gi_grid_nearest(const gi_grid *g, vec3 q, vec3 dir, double maxdist);
+/* Particles within r of q with n.nq > cos_thr, in increasing index order,
+ * appended to *out (grown with realloc); returns how many, -1 on OOM. */
+long gi_grid_radius(const gi_grid *g, vec3 q, vec3 nq, double r, double cos_thr, int **out, long *len, long *cap);
+
+/* Nearest-particle lookup for the link builder: a dense grid of `cell`-wide
+ * cells (grown when the box would need more than 4 cells per particle),
+ * each listing every particle within cell/2 of it, so that a query reads
+ * one contiguous list; answers farther than cell/2 come from a ring search
+ * in a hashed grid. */
+typedef struct gi_lookup gi_lookup;
+gi_lookup *gi_lookup_build(const gi_particles *ps, double cell);
+void gi_lookup_free(gi_lookup *g);
+size_t gi_lookup_bytes(const gi_lookup *g);
+/* As gi_grid_nearest. */
+int gi_lookup_nearest(const gi_lookup *g, vec3 q, vec3 dir, double maxdist);
+/* The same in steps, for batches (queries are bound by memory latency, so a
+ * batch first computes every cell, prefetches stage 0 (the cell's list
+ * head) for all, then stage 1 (the list), then queries). */
+long gi_lookup_cell(const gi_lookup *g, vec3 q);
+void gi_lookup_prefetch(const gi_lookup *g, long cell, int stage);
+int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, double maxdist);
+
+#endif

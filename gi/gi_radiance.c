@@ -1,0 +1,153 @@
+/* gi_radiance.c - estimation lists for the radiance particles. */
+#include "gi_radiance.h"
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include "pool.h"
+
+#define RP_CHUNK 1024
+
+typedef struct {
+    const gi_surface *g;
+    const gi_particles *ps;
+    gi_grid *grid, *fine;
+    const int *alive; /* particles per patch side */
+    double r, cos_thr;
+    long nrp;
+    int **out;    /* per chunk: entries */
+    long *outlen; /* per chunk */
+    int *count;   /* per radiance particle */
+    atomic_long widened, empty, dead;
+    atomic_int oom;
+} list_job;
+
+static void job(void *ctx, int chunk, int thread)
+{
+    (void)thread;
+    list_job *J = ctx;
+    long lo = (long)chunk * RP_CHUNK, hi = lo + RP_CHUNK < J->nrp ? lo + RP_CHUNK : J->nrp;
+    int *buf = NULL;
+    long len = 0, cap = 0, wid = 0, emp = 0, dead = 0;
+    for (long l = lo; l < hi; l++) {
+        int pa = gi_surface_rp_patch(J->g, l);
+        int side = gi_surface_rp_side(J->g, l);
+        if (!J->alive[2 * (size_t)pa + side]) {
+            /* a side without particles (it faces only the void): empty list */
+            J->count[l] = 0;
+            dead++;
+            continue;
+        }
+        vec3 q, nq;
+        gi_surface_rp(J->g, l, &q, &nq);
+        long m = gi_grid_radius(J->grid, q, nq, J->r, J->cos_thr, &buf, &len, &cap);
+        for (int widen = 2; m == 0 && widen <= 4; widen *= 2) {
+            m = gi_grid_radius(J->grid, q, nq, J->r * widen, J->cos_thr, &buf, &len, &cap);
+            if (m > 0) wid++;
+        }
+        if (m == 0) {
+            /* the nearest particle facing the same way, within 16 r */
+            int near = gi_grid_nearest(J->fine, q, v3_neg(nq), 16.0 * J->r);
+            if (near >= 0) {
+                if (len == cap) {
+                    long nc = cap ? cap * 2 : 1024;
+                    int *nb = realloc(buf, (size_t)nc * sizeof *nb);
+                    if (!nb) m = -1;
+                    else { buf = nb; cap = nc; }
+                }
+                if (m == 0) {
+                    buf[len++] = near;
+                    m = 1;
+                    wid++;
+                }
+            } else {
+                emp++;
+            }
+        }
+        if (m < 0) {
+            atomic_store(&J->oom, 1);
+            break;
+        }
+        J->count[l] = (int)m;
+    }
+    J->out[chunk] = buf;
+    J->outlen[chunk] = len;
+    atomic_fetch_add(&J->widened, wid);
+    atomic_fetch_add(&J->empty, emp);
+    atomic_fetch_add(&J->dead, dead);
+}
+
+pt_status gi_radiance_lists(gi_lists *L, const gi_surface *g, const gi_particles *ps, double r, double cos_thr,
+                            int threads, diag *d)
+{
+    memset(L, 0, sizeof *L);
+    L->nrp = gi_surface_nrp(g);
+    list_job J;
+    memset(&J, 0, sizeof J);
+    J.g = g;
+    J.ps = ps;
+    J.r = r;
+    J.cos_thr = cos_thr;
+    J.nrp = L->nrp;
+    atomic_init(&J.widened, 0);
+    atomic_init(&J.empty, 0);
+    atomic_init(&J.dead, 0);
+    atomic_init(&J.oom, 0);
+    int chunks = (int)((L->nrp + RP_CHUNK - 1) / RP_CHUNK);
+    J.grid = gi_grid_build(ps->p, ps->n, r);
+    J.fine = gi_grid_build(ps->p, ps->n, ps->spacing > 0.0 ? ps->spacing : r);
+    int np = gi_surface_npatches(g);
+    int *alive = calloc(2 * (size_t)np + 2, sizeof *alive);
+    if (alive)
+        for (int i = 0; i < ps->n; i++) alive[2 * (size_t)ps->patch[i] + ps->side[i]]++;
+    J.alive = alive;
+    J.out = calloc((size_t)chunks + 1, sizeof *J.out);
+    J.outlen = calloc((size_t)chunks + 1, sizeof *J.outlen);
+    J.count = calloc((size_t)L->nrp + 1, sizeof *J.count);
+    L->off = malloc(((size_t)L->nrp + 1) * sizeof *L->off);
+    pt_status st = PT_OK;
+    if (!J.grid || !J.fine || !alive || !J.out || !J.outlen || !J.count || !L->off) st = PT_ERR_NOMEM;
+    if (st == PT_OK && chunks > 0) pool_run(threads, chunks, job, &J);
+    if (st == PT_OK && atomic_load(&J.oom)) st = PT_ERR_NOMEM;
+    long total = 0;
+    if (st == PT_OK) {
+        for (int c = 0; c < chunks; c++) total += J.outlen[c];
+        if (total > 2147483000L) {
+            diag_report(d, DIAG_ERROR, (src_loc){0}, NULL,
+                        "particle GI: estimation lists too long (%ld entries); lower the list radius", total);
+            st = PT_ERR_LIMIT;
+        }
+    }
+    if (st == PT_OK) {
+        L->idx = malloc((size_t)(total > 0 ? total : 1) * sizeof *L->idx);
+        if (!L->idx) st = PT_ERR_NOMEM;
+    }
+    if (st == PT_OK) {
+        long at = 0;
+        for (int c = 0; c < chunks; c++) {
+            if (J.outlen[c]) memcpy(L->idx + at, J.out[c], (size_t)J.outlen[c] * sizeof *L->idx);
+            at += J.outlen[c];
+        }
+        L->off[0] = 0;
+        for (long l = 0; l < L->nrp; l++) L->off[l + 1] = L->off[l] + J.count[l];
+        L->widened = atomic_load(&J.widened);
+        L->empty = atomic_load(&J.empty);
+        L->dead = atomic_load(&J.dead);
+    }
+    for (int c = 0; c < chunks; c++) free(J.out[c]);
+    free(J.out);
+    free(J.outlen);
+    free(J.count);
+    gi_grid_free(J.grid);
+    gi_grid_free(J.fine);
+    free(alive);
+    if (st != PT_OK) gi_lists_free(L);
+    return st;
+}
+
+void gi_lists_free(gi_lists *L)
+{
+    if (!L) return;
+    free(L->off);
+    free(L->idx);
+    memset(L, 0, sizeof *L);
+}

@@ -1,0 +1,754 @@
+/* gi_surface.c - surface patches for particle GI (see gi_surface.h). */
+#include "gi_surface.h"
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { PATCH_TRI = 0, PATCH_SPHERE = 1, PATCH_DISC = 2 };
+
+typedef struct {
+    unsigned char kind;
+    unsigned char nsides;
+    unsigned char probe;
+    int obj;          /* object record */
+    int k;            /* TRI: edge subdivisions */
+    int nu, nv;       /* grids */
+    long rp_first;    /* side s: rp_first + s * rp_count */
+    long rp_count;
+    double area;      /* one side, world */
+    vec3 v0, e1, e2;  /* TRI */
+    vec3 nrm;         /* TRI: unit front normal */
+    /* grids, object space: sphere centre c, radius r; disc centre c, normal n, radii */
+    vec3 c, gn, ga, gb;
+    double r0, r1;    /* sphere: r, -; disc: hole, outer */
+    double lu, lv;    /* TRI: longest edge; grids: longest u and v lines */
+    double jmax, jmin, jobj, detm;
+    const scene_texture *tex;
+} patch;
+
+typedef struct {
+    const scene_object *obj;
+    int first, count; /* patches */
+    int kind;         /* shape_kind */
+} obj_rec;
+
+struct gi_surface {
+    patch *p;
+    int np, capp;
+    obj_rec *o;
+    int no, capo;
+    int *hash;        /* open addressing: object pointer -> record, -1 empty */
+    int hcap;
+    long nrp;
+    long skipped;
+    double total_area;
+    double tess;
+    vec3 lo, hi;      /* clip box for planes */
+    const scene *sc;
+    diag *d;
+};
+
+static void layout(gi_surface *g);
+static void set_resolution(const gi_surface *g, patch *p);
+
+/* ------------------------------------------------------------ helpers */
+
+static int add_patch(gi_surface *g, const patch *p)
+{
+    if (g->np == g->capp) {
+        int nc = g->capp ? g->capp * 2 : 256;
+        patch *np = realloc(g->p, (size_t)nc * sizeof *np);
+        if (!np) return -1;
+        g->p = np;
+        g->capp = nc;
+    }
+    g->p[g->np] = *p;
+    return g->np++;
+}
+
+static int add_obj(gi_surface *g, const scene_object *o)
+{
+    if (g->no == g->capo) {
+        int nc = g->capo ? g->capo * 2 : 64;
+        obj_rec *no = realloc(g->o, (size_t)nc * sizeof *no);
+        if (!no) return -1;
+        g->o = no;
+        g->capo = nc;
+    }
+    g->o[g->no].obj = o;
+    g->o[g->no].first = g->np;
+    g->o[g->no].count = 0;
+    g->o[g->no].kind = o->kind;
+    return g->no++;
+}
+
+static uint64_t ptr_hash(const void *p)
+{
+    uint64_t z = (uint64_t)(uintptr_t)p;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+static int build_hash(gi_surface *g)
+{
+    int cap = 16;
+    while (cap < 2 * g->no + 2) cap *= 2;
+    g->hash = malloc((size_t)cap * sizeof *g->hash);
+    if (!g->hash) return 0;
+    g->hcap = cap;
+    for (int i = 0; i < cap; i++) g->hash[i] = -1;
+    for (int i = 0; i < g->no; i++) {
+        unsigned h = (unsigned)(ptr_hash(g->o[i].obj) & (uint64_t)(cap - 1));
+        while (g->hash[h] >= 0) h = (h + 1) & (unsigned)(cap - 1);
+        g->hash[h] = i;
+    }
+    return 1;
+}
+
+static const obj_rec *find_obj(const gi_surface *g, const scene_object *o)
+{
+    if (!g->hash) return NULL;
+    unsigned h = (unsigned)(ptr_hash(o) & (uint64_t)(g->hcap - 1));
+    while (g->hash[h] >= 0) {
+        if (g->o[g->hash[h]].obj == o) return &g->o[g->hash[h]];
+        h = (h + 1) & (unsigned)(g->hcap - 1);
+    }
+    return NULL;
+}
+
+static double det3(const xform *x)
+{
+    const double (*m)[4] = x->m;
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+
+/* Add a world triangle patch; skips degenerate ones. */
+static int add_tri(gi_surface *g, int obj, vec3 a, vec3 b, vec3 c, vec3 front, int nsides, int probe,
+                   const scene_texture *tex)
+{
+    patch p;
+    memset(&p, 0, sizeof p);
+    p.kind = PATCH_TRI;
+    p.v0 = a;
+    p.e1 = v3_sub(b, a);
+    p.e2 = v3_sub(c, a);
+    vec3 cr = v3_cross(p.e1, p.e2);
+    double l = v3_len(cr);
+    if (!(l > 0.0) || !isfinite(l)) return 0;
+    p.area = 0.5 * l;
+    p.nrm = v3_scale(cr, 1.0 / l);
+    if (v3_dot(front, front) > 0.0 && v3_dot(p.nrm, front) < 0.0) p.nrm = v3_neg(p.nrm);
+    p.lu = fmax(v3_len(p.e1), fmax(v3_len(p.e2), v3_len(v3_sub(c, b))));
+    p.nsides = (unsigned char)nsides;
+    p.probe = (unsigned char)probe;
+    p.obj = obj;
+    p.tex = tex;
+    set_resolution(g, &p);
+    if (add_patch(g, &p) < 0) return -1;
+    g->o[obj].count++;
+    return 1;
+}
+
+/* Point and front (outward) normal of a grid patch at (u, v); world. */
+static void grid_eval(const gi_surface *g, const patch *p, double u, double v, vec3 *pos, vec3 *nrm)
+{
+    const xform *x = &g->o[p->obj].obj->transform;
+    double ph = 2.0 * M_PI * u;
+    vec3 po, no;
+    if (p->kind == PATCH_SPHERE) {
+        double y = p->r0 * (2.0 * v - 1.0);
+        double rr = sqrt(fmax(0.0, p->r0 * p->r0 - y * y));
+        vec3 d = v3(rr * cos(ph), y, rr * sin(ph));
+        po = v3_add(p->c, d);
+        no = v3_scale(d, 1.0 / p->r0);
+    } else {
+        double rr = sqrt(p->r0 * p->r0 + v * (p->r1 * p->r1 - p->r0 * p->r0));
+        po = v3_add(p->c, v3_add(v3_scale(p->ga, rr * cos(ph)), v3_scale(p->gb, rr * sin(ph))));
+        no = p->gn;
+    }
+    if (pos) *pos = xform_point(x, po);
+    if (nrm) *nrm = v3_norm(xform_normal(x, no));
+}
+
+/* World area density of a grid at (u, v), relative to object space. */
+static double grid_jac(const gi_surface *g, const patch *p, double u, double v)
+{
+    const xform *x = &g->o[p->obj].obj->transform;
+    vec3 no;
+    if (p->kind == PATCH_SPHERE) {
+        double y = p->r0 * (2.0 * v - 1.0);
+        double rr = sqrt(fmax(0.0, p->r0 * p->r0 - y * y));
+        double ph = 2.0 * M_PI * u;
+        no = v3(rr * cos(ph) / p->r0, y / p->r0, rr * sin(ph) / p->r0);
+    } else {
+        no = p->gn;
+    }
+    return p->jobj * p->detm * v3_len(xform_normal(x, no));
+}
+
+/* Sub-tessellation / grid resolution from the tessellation bound. */
+static void set_resolution(const gi_surface *g, patch *p)
+{
+    if (p->kind == PATCH_TRI) {
+        if (p->nsides == 0) return;
+        double k = ceil(p->lu / g->tess);
+        p->k = k < 1.0 ? 1 : (k > 2048.0 ? 2048 : (int)k);
+        p->rp_count = (long)(p->k + 1) * (p->k + 2) / 2;
+        return;
+    }
+    double nu = ceil(p->lu / g->tess), nv = ceil(p->lv / g->tess);
+    p->nu = nu < 3.0 ? 3 : (nu > 4096.0 ? 4096 : (int)nu);
+    p->nv = nv < 1.0 ? 1 : (nv > 4096.0 ? 4096 : (int)nv);
+    p->rp_count = (long)(p->nu + 1) * (p->nv + 1);
+}
+
+/* Grid area and longest grid lines, from world lengths measured along the grid. */
+static int finish_grid(gi_surface *g, int obj, patch *p)
+{
+    p->detm = fabs(det3(&g->o[obj].obj->transform));
+    if (!(p->detm > 0.0) || !isfinite(p->detm)) return 0;
+    const int S = 48;
+    double area = 0.0, jmax = 0.0, jmin = INFINITY;
+    for (int j = 0; j < S; j++) {
+        for (int i = 0; i < S; i++) {
+            double jac = grid_jac(g, p, (i + 0.5) / S, (j + 0.5) / S);
+            area += jac;
+            jmax = fmax(jmax, jac);
+            jmin = fmin(jmin, jac);
+        }
+    }
+    p->area = area / (S * S);
+    p->jmax = jmax;
+    p->jmin = jmin;
+    if (!(p->area > 0.0) || !isfinite(p->area)) return 0;
+    /* longest u line and v line */
+    double lu = 0.0, lv = 0.0;
+    for (int k = 0; k <= 4; k++) {
+        double fixed = (k + 0.5) / 5.0, su = 0.0, sv = 0.0;
+        vec3 a, b;
+        grid_eval(g, p, 0.0, fixed, &a, NULL);
+        for (int i = 1; i <= S; i++) {
+            grid_eval(g, p, (double)i / S, fixed, &b, NULL);
+            su += v3_len(v3_sub(b, a));
+            a = b;
+        }
+        grid_eval(g, p, fixed, 0.0, &a, NULL);
+        for (int i = 1; i <= S; i++) {
+            grid_eval(g, p, fixed, (double)i / S, &b, NULL);
+            sv += v3_len(v3_sub(b, a));
+            a = b;
+        }
+        lu = fmax(lu, su);
+        lv = fmax(lv, sv);
+    }
+    p->lu = lu;
+    p->lv = lv;
+    set_resolution(g, p);
+    return 1;
+}
+
+/* Is world point q inside the closed solid o (sphere, box)? */
+static int inside_solid(const scene_object *o, vec3 q)
+{
+    vec3 qo = xform_inv_point(&o->transform, q);
+    if (o->kind == SHAPE_SPHERE) return v3_len(v3_sub(qo, o->u.sphere.centre)) < fabs(o->u.sphere.radius);
+    if (o->kind == SHAPE_BOX) {
+        vec3 a = v3_min(o->u.box.c1, o->u.box.c2), b = v3_max(o->u.box.c1, o->u.box.c2);
+        return qo.x > a.x && qo.x < b.x && qo.y > a.y && qo.y < b.y && qo.z > a.z && qo.z < b.z;
+    }
+    return 0;
+}
+
+static int solid_sides(const gi_surface *g, const scene_object *o)
+{
+    if (o->flags & OBJ_INVERSE) return 2;
+    const scene *s = g->sc;
+    if (s->camera_set && inside_solid(o, s->camera.location)) return 2;
+    for (int i = 0; i < s->nlights; i++)
+        if (inside_solid(o, s->lights[i].position)) return 2;
+    return 1;
+}
+
+/* Sutherland-Hodgman clip of a convex polygon against n.p <= d. */
+static int clip_poly(vec3 *in, int n, vec3 *out, vec3 pn, double d)
+{
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        vec3 a = in[i], b = in[(i + 1) % n];
+        double da = v3_dot(pn, a) - d, db = v3_dot(pn, b) - d;
+        if (da <= 0.0) out[m++] = a;
+        if ((da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0)) {
+            double t = da / (da - db);
+            out[m++] = v3_add(a, v3_scale(v3_sub(b, a), t));
+        }
+    }
+    return m;
+}
+
+static pt_status add_plane(gi_surface *g, int obj, const scene_object *o, int probe, const scene_texture *tex)
+{
+    vec3 n = o->u.plane.normal;
+    double l2 = v3_len2(n);
+    if (!(l2 > 0.0)) return PT_OK;
+    vec3 p0 = xform_point(&o->transform, v3_scale(n, o->u.plane.offset / l2));
+    vec3 nw = v3_norm(xform_normal(&o->transform, n));
+    if (!v3_finite(p0) || !v3_finite(nw)) return PT_OK;
+    vec3 c = v3_scale(v3_add(g->lo, g->hi), 0.5);
+    double half = v3_len(v3_sub(g->hi, g->lo));
+    vec3 q = v3_sub(c, v3_scale(nw, v3_dot(v3_sub(c, p0), nw)));
+    vec3 t, b;
+    v3_basis(nw, &t, &b);
+    vec3 poly[16], tmp[16];
+    poly[0] = v3_add(q, v3_add(v3_scale(t, -half), v3_scale(b, -half)));
+    poly[1] = v3_add(q, v3_add(v3_scale(t, half), v3_scale(b, -half)));
+    poly[2] = v3_add(q, v3_add(v3_scale(t, half), v3_scale(b, half)));
+    poly[3] = v3_add(q, v3_add(v3_scale(t, -half), v3_scale(b, half)));
+    int m = 4;
+    for (int ax = 0; ax < 3 && m > 0; ax++) {
+        vec3 e = v3(ax == 0, ax == 1, ax == 2);
+        m = clip_poly(poly, m, tmp, e, v3_idx(g->hi, ax));
+        m = clip_poly(tmp, m, poly, v3_neg(e), -v3_idx(g->lo, ax));
+    }
+    for (int i = 1; i + 1 < m; i++)
+        if (add_tri(g, obj, poly[0], poly[i], poly[i + 1], nw, 2, probe, tex) < 0) return PT_ERR_NOMEM;
+    return PT_OK;
+}
+
+static pt_status add_box(gi_surface *g, int obj, const scene_object *o, int probe, const scene_texture *tex)
+{
+    vec3 a = v3_min(o->u.box.c1, o->u.box.c2), b = v3_max(o->u.box.c1, o->u.box.c2);
+    int sides = solid_sides(g, o);
+    const xform *x = &o->transform;
+    for (int ax = 0; ax < 3; ax++) {
+        int u = (ax + 1) % 3, v = (ax + 2) % 3;
+        for (int hiside = 0; hiside < 2; hiside++) {
+            double val = v3_idx(hiside ? b : a, ax);
+            vec3 corner[4];
+            for (int k = 0; k < 4; k++) {
+                double cu = (k == 1 || k == 2) ? v3_idx(b, u) : v3_idx(a, u);
+                double cv = (k >= 2) ? v3_idx(b, v) : v3_idx(a, v);
+                double w[3];
+                w[ax] = val;
+                w[u] = cu;
+                w[v] = cv;
+                corner[k] = xform_point(x, v3(w[0], w[1], w[2]));
+            }
+            vec3 no = v3(ax == 0 ? (hiside ? 1 : -1) : 0, ax == 1 ? (hiside ? 1 : -1) : 0, ax == 2 ? (hiside ? 1 : -1) : 0);
+            vec3 nw = v3_norm(xform_normal(x, no));
+            if (add_tri(g, obj, corner[0], corner[1], corner[2], nw, sides, probe, tex) < 0) return PT_ERR_NOMEM;
+            if (add_tri(g, obj, corner[0], corner[2], corner[3], nw, sides, probe, tex) < 0) return PT_ERR_NOMEM;
+        }
+    }
+    return PT_OK;
+}
+
+static pt_status add_leaf(gi_surface *g, const scene_object *o, const scene_texture *tex, int probe)
+{
+    int two = 2;
+    switch (o->kind) {
+    case SHAPE_TRIANGLE:
+    case SHAPE_SMOOTH_TRIANGLE:
+    case SHAPE_MESH:
+    case SHAPE_PLANE:
+    case SHAPE_BOX:
+    case SHAPE_SPHERE:
+    case SHAPE_DISC: break;
+    default:
+        g->skipped++;
+        diag_warn_once(g->d, o->loc, "particle GI: no particles on %s objects (they get no indirect light)",
+                       o->name ? o->name : "these");
+        return PT_OK;
+    }
+    int obj = add_obj(g, o);
+    if (obj < 0) return PT_ERR_NOMEM;
+    const xform *x = &o->transform;
+    if (o->kind == SHAPE_TRIANGLE || o->kind == SHAPE_SMOOTH_TRIANGLE) {
+        vec3 v[3];
+        for (int k = 0; k < 3; k++) v[k] = xform_point(x, o->u.triangle.v[k]);
+        if (add_tri(g, obj, v[0], v[1], v[2], v3(0, 0, 0), two, probe, tex) < 0) return PT_ERR_NOMEM;
+    } else if (o->kind == SHAPE_MESH) {
+        const scene_mesh *m = o->u.mesh.mesh;
+        for (int t = 0; t < m->ntris; t++) {
+            const int *tv = m->tris[t];
+            int ok = tv[0] >= 0 && tv[0] < m->nverts && tv[1] >= 0 && tv[1] < m->nverts && tv[2] >= 0 &&
+                     tv[2] < m->nverts;
+            const scene_texture *tt = tex;
+            if (m->tri_texture) {
+                int ti = m->tri_texture[t];
+                if (ti >= 0 && ti < m->ntextures && m->textures && m->textures[ti]) tt = m->textures[ti];
+            }
+            vec3 v[3];
+            for (int k = 0; k < 3; k++) {
+                int vi = ok ? tv[k] : 0;
+                v[k] = xform_point(x, v3(m->verts[vi][0], m->verts[vi][1], m->verts[vi][2]));
+            }
+            /* keep patch index == triangle index: degenerate triangles get an empty patch */
+            int r = ok ? add_tri(g, obj, v[0], v[1], v[2], v3(0, 0, 0), two, probe, tt) : 0;
+            if (r < 0) return PT_ERR_NOMEM;
+            if (r == 0) {
+                patch p;
+                memset(&p, 0, sizeof p);
+                p.kind = PATCH_TRI;
+                p.obj = obj;
+                p.k = 1;
+                p.nsides = 0;
+                p.tex = tt;
+                if (add_patch(g, &p) < 0) return PT_ERR_NOMEM;
+                g->o[obj].count++;
+            }
+        }
+    } else if (o->kind == SHAPE_PLANE) {
+        pt_status st = add_plane(g, obj, o, probe, tex);
+        if (st != PT_OK) return st;
+    } else if (o->kind == SHAPE_BOX) {
+        pt_status st = add_box(g, obj, o, probe, tex);
+        if (st != PT_OK) return st;
+    } else {
+        patch p;
+        memset(&p, 0, sizeof p);
+        p.obj = obj;
+        p.probe = (unsigned char)probe;
+        p.tex = tex;
+        if (o->kind == SHAPE_SPHERE) {
+            p.kind = PATCH_SPHERE;
+            p.c = o->u.sphere.centre;
+            p.r0 = fabs(o->u.sphere.radius);
+            p.jobj = 4.0 * M_PI * p.r0 * p.r0;
+            p.nsides = (unsigned char)solid_sides(g, o);
+            if (!(p.r0 > 0.0)) return PT_OK;
+        } else {
+            p.kind = PATCH_DISC;
+            p.c = o->u.disc.centre;
+            p.gn = v3_norm(o->u.disc.normal);
+            if (!(v3_len2(p.gn) > 0.0)) return PT_OK;
+            v3_basis(p.gn, &p.ga, &p.gb);
+            p.r0 = fabs(o->u.disc.hole_radius);
+            p.r1 = fabs(o->u.disc.radius);
+            if (!(p.r1 > p.r0)) return PT_OK;
+            p.jobj = M_PI * (p.r1 * p.r1 - p.r0 * p.r0);
+            p.nsides = 2;
+        }
+        if (!finish_grid(g, obj, &p)) return PT_OK;
+        if (add_patch(g, &p) < 0) return PT_ERR_NOMEM;
+        g->o[obj].count++;
+    }
+    return PT_OK;
+}
+
+static pt_status walk(gi_surface *g, const scene_object *o, const scene_texture *tex, int probe)
+{
+    if (o->texture) tex = o->texture;
+    if (o->flags & OBJ_NO_RADIOSITY) return PT_OK;
+    switch (o->kind) {
+    case SHAPE_UNION:
+    case SHAPE_MERGE:
+    case SHAPE_INTERSECTION:
+    case SHAPE_DIFFERENCE: {
+        int pr = probe || o->kind != SHAPE_UNION;
+        for (int i = 0; i < o->u.csg.nkids; i++) {
+            pt_status st = walk(g, o->u.csg.kids[i], tex, pr);
+            if (st != PT_OK) return st;
+        }
+        return PT_OK;
+    }
+    default: return add_leaf(g, o, tex, probe);
+    }
+}
+
+gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *d, pt_status *status)
+{
+    pt_status dummy;
+    if (!status) status = &dummy;
+    gi_surface *g = calloc(1, sizeof *g);
+    if (!g) { *status = PT_ERR_NOMEM; return NULL; }
+    g->sc = s;
+    g->d = d;
+    g->tess = tess > 0.0 ? tess : 1.0;
+    accel_bounds(a, &g->lo, &g->hi);
+    if (!(g->lo.x <= g->hi.x) || v3_len(v3_sub(g->hi, g->lo)) <= 0.0) {
+        /* only planes: bound them by the camera and lights */
+        vec3 lo = v3s(INFINITY), hi = v3s(-INFINITY);
+        if (s->camera_set) { lo = v3_min(lo, s->camera.location); hi = v3_max(hi, s->camera.location); }
+        for (int i = 0; i < s->nlights; i++) {
+            lo = v3_min(lo, s->lights[i].position);
+            hi = v3_max(hi, s->lights[i].position);
+        }
+        if (!(lo.x <= hi.x)) { lo = v3s(-1.0); hi = v3s(1.0); }
+        double e = fmax(1.0, v3_len(v3_sub(hi, lo)));
+        g->lo = v3_sub(lo, v3s(e));
+        g->hi = v3_add(hi, v3s(e));
+    } else {
+        /* a little margin so planes under or behind the geometry cover its footprint */
+        vec3 m = v3s(1e-3 * v3_len(v3_sub(g->hi, g->lo)));
+        g->lo = v3_sub(g->lo, m);
+        g->hi = v3_add(g->hi, m);
+    }
+    const scene_texture *deft = &s->default_texture;
+    for (int i = 0; i < s->nobjects; i++) {
+        pt_status st = walk(g, s->objects[i], deft, 0);
+        if (st != PT_OK) {
+            gi_surface_free(g);
+            *status = st;
+            return NULL;
+        }
+    }
+    if (!build_hash(g)) {
+        gi_surface_free(g);
+        *status = PT_ERR_NOMEM;
+        return NULL;
+    }
+    for (int i = 0; i < g->np; i++) g->total_area += g->p[i].area;
+    layout(g);
+    *status = PT_OK;
+    return g;
+}
+
+static void layout(gi_surface *g)
+{
+    long rp = 0;
+    for (int i = 0; i < g->np; i++) {
+        g->p[i].rp_first = rp;
+        rp += g->p[i].rp_count * g->p[i].nsides;
+    }
+    g->nrp = rp;
+}
+
+void gi_surface_retess(gi_surface *g, double tess)
+{
+    g->tess = tess > 0.0 ? tess : g->tess;
+    for (int i = 0; i < g->np; i++) set_resolution(g, &g->p[i]);
+    layout(g);
+}
+
+void gi_surface_free(gi_surface *g)
+{
+    if (!g) return;
+    free(g->p);
+    free(g->o);
+    free(g->hash);
+    free(g);
+}
+
+int gi_surface_npatches(const gi_surface *g) { return g->np; }
+double gi_surface_area(const gi_surface *g, int i) { return g->p[i].area; }
+int gi_surface_sides(const gi_surface *g, int i) { return g->p[i].nsides; }
+int gi_surface_probe(const gi_surface *g, int i) { return g->p[i].probe; }
+const scene_object *gi_surface_object(const gi_surface *g, int i) { return g->o[g->p[i].obj].obj; }
+const scene_texture *gi_surface_texture(const gi_surface *g, int i) { return g->p[i].tex; }
+double gi_surface_total_area(const gi_surface *g) { return g->total_area; }
+long gi_surface_nrp(const gi_surface *g) { return g->nrp; }
+long gi_surface_skipped(const gi_surface *g) { return g->skipped; }
+
+size_t gi_surface_bytes(const gi_surface *g)
+{
+    return (size_t)g->capp * sizeof(patch) + (size_t)g->capo * sizeof(obj_rec) + (size_t)g->hcap * sizeof(int);
+}
+
+int gi_surface_sample(const gi_surface *g, int i, double u, double v, double xi, vec3 *pos, vec3 *nrm)
+{
+    const patch *p = &g->p[i];
+    if (p->kind == PATCH_TRI) {
+        /* fold the unit square onto the triangle (uniform, keeps stratification) */
+        if (u + v > 1.0) {
+            u = 1.0 - u;
+            v = 1.0 - v;
+        }
+        *pos = v3_add(p->v0, v3_add(v3_scale(p->e1, u), v3_scale(p->e2, v)));
+        *nrm = p->nrm;
+        return 1;
+    }
+    if (p->jmax > p->jmin * (1.0 + 1e-9)) {
+        double jac = grid_jac(g, p, u, v);
+        if (xi * p->jmax > jac) return 0;
+    }
+    grid_eval(g, p, u, v, pos, nrm);
+    return v3_finite(*pos) && v3_finite(*nrm);
+}
+
+int gi_surface_rp_patch(const gi_surface *g, long rp)
+{
+    int lo = 0, hi = g->np - 1;
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (g->p[mid].rp_first <= rp) lo = mid;
+        else hi = mid - 1;
+    }
+    return lo;
+}
+
+int gi_surface_rp_side(const gi_surface *g, long rp)
+{
+    const patch *p = &g->p[gi_surface_rp_patch(g, rp)];
+    return rp - p->rp_first >= p->rp_count;
+}
+
+void gi_surface_rp(const gi_surface *g, long rp, vec3 *pos, vec3 *nrm)
+{
+    const patch *p = &g->p[gi_surface_rp_patch(g, rp)];
+    long local = rp - p->rp_first;
+    int side = local >= p->rp_count;
+    if (side) local -= p->rp_count;
+    if (p->kind == PATCH_TRI) {
+        /* row a holds vertices (a, 0..k-a); row start a(k+1) - a(a-1)/2 */
+        int k = p->k, a = 0;
+        while (a < k && (long)(a + 1) * (k + 1) - (long)(a + 1) * a / 2 <= local) a++;
+        long b = local - ((long)a * (k + 1) - (long)a * (a - 1) / 2);
+        *pos = v3_add(p->v0, v3_add(v3_scale(p->e1, (double)a / k), v3_scale(p->e2, (double)b / k)));
+        *nrm = p->nrm;
+    } else {
+        int i = (int)(local % (p->nu + 1)), j = (int)(local / (p->nu + 1));
+        grid_eval(g, p, (double)i / p->nu, (double)j / p->nv, pos, nrm);
+    }
+    if (side) *nrm = v3_neg(*nrm);
+}
+
+/* Barycentrics (of e1, e2) of world point q in triangle patch p. */
+static void tri_bary(const patch *p, vec3 q, double *u, double *v)
+{
+    vec3 r = v3_sub(q, p->v0);
+    double d00 = v3_dot(p->e1, p->e1), d01 = v3_dot(p->e1, p->e2), d11 = v3_dot(p->e2, p->e2);
+    double d20 = v3_dot(r, p->e1), d21 = v3_dot(r, p->e2);
+    double den = d00 * d11 - d01 * d01;
+    if (!(fabs(den) > 0.0)) {
+        *u = *v = 0.0;
+        return;
+    }
+    *u = (d11 * d20 - d01 * d21) / den;
+    *v = (d00 * d21 - d01 * d20) / den;
+}
+
+static double tri_outside(double u, double v)
+{
+    return fmax(0.0, -u) + fmax(0.0, -v) + fmax(0.0, u + v - 1.0);
+}
+
+static long tri_index(int k, int a, int b) { return (long)a * (k + 1) - (long)a * (a - 1) / 2 + b; }
+
+int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, long rp[3], double w[3])
+{
+    if (!hit || !hit->obj) return 0;
+    const obj_rec *o = find_obj(g, hit->obj);
+    if (!o || o->count == 0) return 0;
+    int first = o->first, count = o->count;
+    if (o->kind == SHAPE_MESH) {
+        if (hit->prim >= (unsigned)count) return 0;
+        first += (int)hit->prim;
+        count = 1;
+    }
+    const patch *p = NULL;
+    double u = 0.0, v = 0.0;
+    if (g->p[first].kind == PATCH_TRI) {
+        double best = INFINITY;
+        for (int i = first; i < first + count; i++) {
+            const patch *c = &g->p[i];
+            if (c->nsides == 0) continue;
+            /* boxes and clipped planes have several triangles: take the one
+             * the point lies in (or nearest to, off a plane's clipped part) */
+            double cu, cv;
+            tri_bary(c, hit->p, &cu, &cv);
+            double out = tri_outside(cu, cv) + fabs(v3_dot(v3_sub(hit->p, c->v0), c->nrm)) / (sqrt(c->area) + 1e-300);
+            if (out < best) {
+                best = out;
+                p = c;
+                u = cu;
+                v = cv;
+            }
+        }
+    } else {
+        p = &g->p[first];
+        vec3 q = xform_inv_point(&hit->obj->transform, hit->p);
+        vec3 d = v3_sub(q, p->c);
+        if (p->kind == PATCH_SPHERE) {
+            u = atan2(d.z, d.x) / (2.0 * M_PI);
+            v = 0.5 * (d.y / p->r0 + 1.0);
+        } else {
+            u = atan2(v3_dot(d, p->gb), v3_dot(d, p->ga)) / (2.0 * M_PI);
+            double r2 = v3_len2(v3_sub(d, v3_scale(p->gn, v3_dot(d, p->gn))));
+            v = (r2 - p->r0 * p->r0) / (p->r1 * p->r1 - p->r0 * p->r0);
+        }
+        if (u < 0.0) u += 1.0;
+    }
+    if (!p || p->nsides == 0) return 0;
+    /* side: the geometric normal on the viewer's side, against the front normal */
+    vec3 ng = v3_dot(n_view, hit->ng) >= 0.0 ? hit->ng : v3_neg(hit->ng);
+    vec3 front;
+    if (p->kind == PATCH_TRI) front = p->nrm;
+    else grid_eval(g, p, fmin(fmax(u, 0.0), 1.0), fmin(fmax(v, 0.0), 1.0), NULL, &front);
+    int side = v3_dot(ng, front) < 0.0;
+    if (side >= p->nsides) return 0;
+    long base = p->rp_first + side * p->rp_count;
+    if (p->kind == PATCH_TRI) {
+        /* clamp into the triangle, then find the sub-triangle */
+        u = fmax(0.0, u);
+        v = fmax(0.0, v);
+        if (u + v > 1.0) {
+            double s = u + v;
+            u /= s;
+            v /= s;
+        }
+        int k = p->k;
+        double fa = u * k, fb = v * k;
+        int a = (int)floor(fa), b = (int)floor(fb);
+        if (a > k - 1) a = k - 1;
+        if (b > k - 1) b = k - 1;
+        if (a < 0) a = 0;
+        if (b < 0) b = 0;
+        if (a + b > k - 1) {
+            /* on the far edge: step back into the last row */
+            if (a >= b) a = k - 1 - b;
+            else b = k - 1 - a;
+        }
+        double x = fa - a, y = fb - b;
+        if (x + y <= 1.0 || a + b + 2 > k) {
+            rp[0] = base + tri_index(k, a, b);
+            rp[1] = base + tri_index(k, a + 1, b);
+            rp[2] = base + tri_index(k, a, b + 1);
+            w[0] = 1.0 - x - y;
+            w[1] = x;
+            w[2] = y;
+        } else {
+            rp[0] = base + tri_index(k, a + 1, b + 1);
+            rp[1] = base + tri_index(k, a + 1, b);
+            rp[2] = base + tri_index(k, a, b + 1);
+            w[0] = x + y - 1.0;
+            w[1] = 1.0 - y;
+            w[2] = 1.0 - x;
+        }
+    } else {
+        u = fmin(fmax(u, 0.0), 1.0);
+        v = fmin(fmax(v, 0.0), 1.0);
+        double fu = u * p->nu, fv = v * p->nv;
+        int i = (int)floor(fu), j = (int)floor(fv);
+        if (i > p->nu - 1) i = p->nu - 1;
+        if (j > p->nv - 1) j = p->nv - 1;
+        double x = fu - i, y = fv - j;
+        long row = p->nu + 1;
+        if (x + y <= 1.0) {
+            rp[0] = base + (long)j * row + i;
+            rp[1] = base + (long)j * row + i + 1;
+            rp[2] = base + (long)(j + 1) * row + i;
+            w[0] = 1.0 - x - y;
+            w[1] = x;
+            w[2] = y;
+        } else {
+            rp[0] = base + (long)(j + 1) * row + i + 1;
+            rp[1] = base + (long)j * row + i + 1;
+            rp[2] = base + (long)(j + 1) * row + i;
+            w[0] = x + y - 1.0;
+            w[1] = 1.0 - y;
+            w[2] = 1.0 - x;
+        }
+    }
+    /* clamp tiny negative weights from rounding */
+    double sum = 0.0;
+    for (int k = 0; k < 3; k++) {
+        w[k] = fmin(1.0, fmax(0.0, w[k]));
+        sum += w[k];
+    }
+    if (sum > 0.0)
+        for (int k = 0; k < 3; k++) w[k] /= sum;
+    return 1;
+}

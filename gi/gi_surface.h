@@ -1,0 +1,73 @@
+/* gi_surface.h - the surfaces particle GI works on, as patches with one
+ * interface: area, sampling by area, radiance-particle layout, and mapping a
+ * ray hit to the 3 radiance particles around it with barycentric weights.
+ *
+ *  - Triangle patches: triangles, smooth triangles, every mesh triangle, the
+ *    faces of boxes (2 per face) and infinite planes clipped to the scene's
+ *    finite bounds (a convex polygon, fanned). Radiance particles are the
+ *    vertices of a regular sub-tessellation: every edge is split into k
+ *    segments, k = ceil(longest edge / tess), giving (k+1)(k+2)/2 vertices
+ *    (paper, section 3.2: "tessellating the three edges such that the
+ *    resulting elements have sizes smaller than a user-specified threshold").
+ *  - Grid patches (analytic shapes: spheres, discs): a (u,v) grid of
+ *    nu x nv cells whose world size stays under tess; each cell is split
+ *    into two triangles for interpolation. The parameterisations are
+ *    area-preserving in object space (sphere: azimuth and height, Archimedes'
+ *    hat-box theorem; disc: angle and squared radius).
+ *
+ * Sides. A closed solid (sphere, box) gets particles on its outside only,
+ * plus its inside when the camera or a light is inside it. Open surfaces
+ * (triangles, meshes, planes, discs, and anything inverse) get both sides;
+ * gi_particles later drops a side whose scattering links all miss.
+ * Side 0 is the patch's front normal, side 1 its opposite.
+ *
+ * CSG: members of union are ordinary leaves. Members of merge, intersection
+ * and difference are sampled on their whole surface and marked `probe`:
+ * a particle is kept only if a short probe ray finds the CSG result's
+ * surface there (gi_particles). Cylinders, cones, tori and unsupported
+ * shapes get no particles (counted in gi_surface_skipped); hits on them
+ * receive no indirect light. */
+#ifndef PT_GI_SURFACE_H
+#define PT_GI_SURFACE_H
+#include "accel.h"
+#include "diag.h"
+#include "scene.h"
+
+typedef struct gi_surface gi_surface;
+
+/* tess: bound on sub-triangle edges and grid cell size (world units). */
+gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *d, pt_status *status);
+void gi_surface_free(gi_surface *g);
+/* Change the tessellation bound (radiance particles are laid out anew). */
+void gi_surface_retess(gi_surface *g, double tess);
+
+int gi_surface_npatches(const gi_surface *g);
+double gi_surface_area(const gi_surface *g, int patch); /* one side */
+int gi_surface_sides(const gi_surface *g, int patch);
+int gi_surface_probe(const gi_surface *g, int patch);
+const scene_object *gi_surface_object(const gi_surface *g, int patch);
+const scene_texture *gi_surface_texture(const gi_surface *g, int patch);
+double gi_surface_total_area(const gi_surface *g);
+
+/* Map (u, v) in [0,1)^2 to a point of the patch, uniformly by area; xi in
+ * [0,1) drives the rejection step of grids under non-uniform scaling
+ * (returns 0 when the sample is rejected). nrm: unit front normal. */
+int gi_surface_sample(const gi_surface *g, int patch, double u, double v, double xi, vec3 *pos, vec3 *nrm);
+
+/* Radiance particles: gi_surface_nrp of them, patch by patch, side by side. */
+long gi_surface_nrp(const gi_surface *g);
+void gi_surface_rp(const gi_surface *g, long rp, vec3 *pos, vec3 *nrm);
+/* Patch and side (0 front, 1 back) a radiance particle belongs to. */
+int gi_surface_rp_patch(const gi_surface *g, long rp);
+int gi_surface_rp_side(const gi_surface *g, long rp);
+
+/* The 3 radiance particles around a hit and their barycentric weights.
+ * n_view is the shading normal facing the viewer (shade.c's n); it picks the
+ * side. Returns 1, or 0 when the hit is on a surface without particles. */
+int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, long rp[3], double w[3]);
+
+/* Objects skipped (no particles) and a patch count per kind, for stats. */
+long gi_surface_skipped(const gi_surface *g);
+size_t gi_surface_bytes(const gi_surface *g);
+
+#endif

@@ -1,0 +1,143 @@
+/* gi_lighting.cl - the lighting stage of particle-space GI (Chang, Park, Ihm,
+ * "Diffuse Global Illumination in Particle Spaces", MTAP 2015, section 4.2):
+ * emission from lights into area particles, scattering along the particle
+ * links, and the per-particle reflected radiance L^(i).
+ *
+ * Compiled by OpenCL (gi_cl.c) and, unchanged, as C through gi_shim.h
+ * (gi_cl_c.c): both builds run this code. Units: see gi_types.h (E/pi). */
+
+#ifdef __OPENCL_VERSION__
+#pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
+#endif
+
+/* Fixed-point flux accumulation. The paper scatters with atomic float adds
+ * (section 4.2.2); float addition is not associative, so the result would
+ * depend on thread timing. We add 64-bit integers instead: each deposit x is
+ * rounded once to rint(x * scale) (scale a power of two chosen on the host so
+ * that the total cannot overflow), and integer sums do not depend on order,
+ * so scattering is deterministic on any device. */
+static inline gi_i64 gi_fixed(float x, float scale) { return (gi_i64)rint(x * scale); }
+
+static inline void gi_deposit(GI_GLOBAL gi_i64 *acc, int j, const float *pk, float scale, gi_i64 *tally)
+{
+    for (int c = 0; c < 3; c++) {
+        gi_i64 q = gi_fixed(pk[c], scale);
+        if (q != 0) atom_add(&acc[3 * j + c], q);
+        tally[c] += q;
+    }
+}
+
+/* Emission (section 4.2.1). The paper gives point lights only, with
+ *   phi^(i) += Phi_j/(4 pi) * dA^(i) cos(theta_i) / d_i^2.
+ * partray follows POV-Ray's light model instead, so that the particles'
+ * direct light is exactly what the Whitted pass shows (shade.c): a light of
+ * colour C reaches a particle with E/pi = C * att * cos^brilliance * V, where
+ * att is the spot/cylinder/fade attenuation (gi_light_attenuation) and V the
+ * visibility fraction traced by Embree on the host (area lights: the average
+ * over the light's grid). The direct flux is phi_d = pi * (E/pi) * dA.
+ *
+ * Outputs per particle i (4 floats each, w unused):
+ *   edir[i] = direct E/pi,
+ *   src[i]  = flux leaving i in the first bounce: rho * phi_d + pi * Le * dA
+ *             (reflected direct light plus emission of a Lambertian emitter). */
+__kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global const gi_dev_light *lights, int nlights,
+                        __global const float *vis, __global float *edir, __global float *src)
+{
+    int i = (int)get_global_id(0);
+    if (i >= n) return;
+    __global const gi_dev_particle *pt = &part[i];
+    float e[3] = {0.0f, 0.0f, 0.0f};
+    for (int l = 0; l < nlights; l++) {
+        float v = vis[(long)i * nlights + l];
+        if (!(v > 0.0f)) continue;
+        __global const gi_dev_light *lt = &lights[l];
+        float d[3];
+        float depth = gi_light_ray(lt, lt->pos[0], lt->pos[1], lt->pos[2], pt->p[0], pt->p[1], pt->p[2], d);
+        float ci = pt->n[0] * d[0] + pt->n[1] * d[1] + pt->n[2] * d[2];
+        if (ci < 1e-10f) continue; /* the other side's particle takes it (shade.c: backside rule) */
+        float att = gi_light_attenuation(lt, pt->p[0], pt->p[1], pt->p[2], d, depth);
+        float intensity = pt->brilliance != 1.0f ? pow(ci, pt->brilliance) : ci;
+        float w = att * intensity * v;
+        for (int c = 0; c < 3; c++) e[c] += lt->colour[c] * w;
+    }
+    for (int c = 0; c < 3; c++) {
+        if (!isfinite(e[c])) e[c] = 0.0f;
+        float phid = GI_PI_F * e[c] * pt->area;
+        edir[4 * i + c] = e[c];
+        src[4 * i + c] = pt->rho[c] * phid + GI_PI_F * pt->le[c] * pt->area;
+    }
+    edir[4 * i + 3] = 0.0f;
+    src[4 * i + 3] = 0.0f;
+}
+
+/* Indirect light scattering (section 4.2.2, Fig. 5). One work-item per
+ * source particle i (directly lit or emitting, compacted on the host):
+ *  - first bounce: all ns2 = n_s x n_s scattering links get src[i]/ns2
+ *    (the paper's rho^(i) phi^(i) / n_s^2, plus emission);
+ *  - then every one of those ns2 packets walks on: at the end particle j the
+ *    packet is multiplied by rho^(j) and deposited in full at the end of ONE
+ *    link of j chosen at random (probability 1/ns2 for each of j's links, so
+ *    the expected deposit equals the full fan-out rho^(j) P / ns2 per link).
+ * Bounce convention: nb counts ALL scattering bounces, the full fan-out
+ * included (nb = 1: fan-out only; nb = 0: no scattering, the kernel is not
+ * run). With the gathering step the rendered indirect light has up to nb + 1
+ * diffuse bounces, as the paper's text counts it ("n_b + 1 including the
+ * indirect light gathering step").
+ * Links of -1 (rays that left the scene) end the packet. tally[b] sums what
+ * bounce b deposited (fixed point), for energy checks. */
+__kernel void gi_k_scatter(__global const gi_dev_particle *part, __global const int *slink, int ns2, int nb,
+                           uint seed, float scale, __global const int *srcidx, int nsrc, __global const float *src,
+                           __global gi_i64 *acc, __global gi_i64 *tally)
+{
+    int t = (int)get_global_id(0);
+    if (t >= nsrc) return;
+    int i = srcidx[t];
+    gi_i64 tl[GI_MAX_BOUNCES * 3];
+    int nbc = nb < GI_MAX_BOUNCES ? nb : GI_MAX_BOUNCES;
+    for (int b = 0; b < nbc * 3; b++) tl[b] = 0;
+    float w = 1.0f / (float)ns2;
+    for (int k = 0; k < ns2; k++) {
+        int j = slink[(long)i * ns2 + k];
+        if (j < 0) continue;
+        float pk[3] = {src[4 * i] * w, src[4 * i + 1] * w, src[4 * i + 2] * w};
+        gi_deposit(acc, j, pk, scale, &tl[0]);
+        for (int s = 1; s < nbc; s++) {
+            __global const gi_dev_particle *pj = &part[j];
+            pk[0] *= pj->rho[0];
+            pk[1] *= pj->rho[1];
+            pk[2] *= pj->rho[2];
+            if (pk[0] == 0.0f && pk[1] == 0.0f && pk[2] == 0.0f) break;
+            gi_u32 h = gi_hash(seed ^ gi_hash((gi_u32)i ^ gi_hash((gi_u32)(k + ns2 * s))));
+            int j2 = slink[(long)j * ns2 + (int)(h % (gi_u32)ns2)];
+            if (j2 < 0) break;
+            gi_deposit(acc, j2, pk, scale, &tl[3 * s]);
+            j = j2;
+        }
+    }
+    for (int b = 0; b < nbc * 3; b++)
+        if (tl[b] != 0) atom_add(&tally[b], tl[b]);
+}
+
+/* Reflected radiance of every area particle after scattering (section 4.2.2,
+ * the equation after Fig. 5): L^(i) = f_rd^(i) phi^(i) / dA^(i) with
+ * f_rd = rho/pi, phi = phi_d + scattered flux; plus the particle's own
+ * emission, since the gathering step (eq. for E~ in 4.3.1) reads L^(k*) as
+ * the radiance arriving from k*. Writes lout[i] (radiance) and phi[i]
+ * (total received flux), 4 floats each. */
+__kernel void gi_k_resolve(__global const gi_dev_particle *part, int n, __global const float *edir,
+                           __global const gi_i64 *acc, float inv_scale, __global float *lout, __global float *phi)
+{
+    int i = (int)get_global_id(0);
+    if (i >= n) return;
+    __global const gi_dev_particle *pt = &part[i];
+    for (int c = 0; c < 3; c++) {
+        float f = GI_PI_F * edir[4 * i + c] * pt->area + (float)acc[3 * i + c] * inv_scale;
+        float l = pt->le[c] + pt->rho[c] * f / (GI_PI_F * pt->area);
+        if (!isfinite(l)) l = 0.0f;
+        if (!isfinite(f)) f = 0.0f;
+        lout[4 * i + c] = l;
+        phi[4 * i + c] = f;
+    }
+    lout[4 * i + 3] = 0.0f;
+    phi[4 * i + 3] = 0.0f;
+}

@@ -1,0 +1,30 @@
+/* gi_shim.h - lets the OpenCL C kernels in this folder compile as C11, so the
+ * build without OpenCL (PARTRAY_OPENCL=OFF, or the "c" device) runs the very
+ * same kernel code. Only the small subset the kernels use is mapped:
+ * address-space qualifiers vanish, get_global_id(0) reads a thread-local
+ * index set by the launcher (gi_cl_c.c), atom_add is a relaxed atomic add.
+ * Math calls (pow, sqrt, fabs, rint) resolve to the C library's double
+ * versions, so results can differ from the OpenCL build in the last float
+ * bits; tests compare the two with a tolerance. */
+#ifndef GI_SHIM_H
+#define GI_SHIM_H
+#ifdef __OPENCL_VERSION__
+#error "gi_shim.h is for the C build of the kernels only"
+#endif
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#define __kernel
+#define __global
+#define __constant const
+#define __local
+#define __private
+
+typedef unsigned int uint;
+
+extern _Thread_local size_t gi_shim_gid;
+#define get_global_id(dim) ((void)(dim), gi_shim_gid)
+#define atom_add(p, v) __atomic_fetch_add((p), (v), __ATOMIC_RELAXED)
+
+#endif

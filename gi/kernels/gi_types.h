@@ -1,0 +1,173 @@
+/* gi_types.h - records and helpers shared by the host (C11) and the particle
+ * GI kernels (OpenCL C 1.2). This file is the first part of the kernel
+ * program (see gi/CMakeLists.txt for the order) and is also included by the
+ * host and by the C build of the kernels (gi_cl_c.c through gi_shim.h).
+ *
+ * Records hold only 4-byte scalars (float, int, uint), so their layout is the
+ * same in both languages; gi_cl.c checks sizeof and every offsetof with
+ * _Static_assert. Vector types (float3, float4) are deliberately not used:
+ * the same source compiles as C.
+ *
+ * Units. POV-Ray's diffuse term is diffuse * pigment * colour * cos (no 1/pi,
+ * shade.c), i.e. a light of colour C delivers the radiance rho*C*cos from a
+ * surface of reflectance rho = diffuse*pigment. A Lambertian surface reflects
+ * L = rho*E/pi, so C*cos is E/pi: every "irradiance" below is stored divided
+ * by pi ("E/pi units"), and a flux is E*dA = pi*(E/pi)*dA. */
+#ifndef GI_TYPES_H
+#define GI_TYPES_H
+
+#ifdef __OPENCL_VERSION__
+typedef long gi_i64;
+typedef uint gi_u32;
+#define GI_GLOBAL __global
+#else
+#include <math.h>
+#include <stdint.h>
+typedef int64_t gi_i64;
+typedef uint32_t gi_u32;
+#ifndef GI_GLOBAL
+#define GI_GLOBAL
+#endif
+#endif
+
+#define GI_PI_F 3.14159265358979323846f
+/* Most scattering bounces the kernels accept (tally array size). */
+#define GI_MAX_BOUNCES 64
+
+/* One area particle (paper section 4.2.1: position p, normal n, area dA,
+ * diffuse reflectance rho_d; the BRDF is rho_d/pi). `n` is the normal of the
+ * side the particle stands for (two-sided surfaces get one particle per
+ * side). `le` is the emitted radiance (finish emission, and ambient when
+ * radiosity{} makes it a light source). 64 bytes. */
+typedef struct {
+    float p[3];
+    float area;
+    float n[3];
+    float brilliance;
+    float rho[3];
+    float pad0;
+    float le[3];
+    float pad1;
+} gi_dev_particle;
+
+enum { GI_LIGHT_POINT = 0, GI_LIGHT_SPOT = 1, GI_LIGHT_CYLINDER = 2, GI_LIGHT_PARALLEL = 3 };
+
+/* One light_source with POV-Ray semantics (shade.c). Spotlights carry the
+ * cosines of radius and falloff; cylinder lights carry radius and falloff as
+ * distances from the axis. 80 bytes. */
+typedef struct {
+    float pos[3];
+    int kind;
+    float colour[3];
+    int parallel;
+    float point_at[3];
+    float tightness;
+    float cos_radius, cos_falloff, radius, falloff;
+    float fade_distance, fade_power;
+    int shadowless;
+    int pad;
+} gi_dev_light;
+
+/* Direction from p towards the light point (cx, cy, cz) (the light's
+ * position, or a point of an area light) and the distance along it.
+ * Mirrors shade.c light_ray: cylinder lights shine along their axis,
+ * `parallel` lights along position - point_at. Returns the depth. */
+static inline float gi_light_ray(GI_GLOBAL const gi_dev_light *l, float cx, float cy, float cz, float px, float py,
+                                 float pz, float *d)
+{
+    float depth;
+    if (l->kind == GI_LIGHT_CYLINDER) {
+        float ax = cx - l->point_at[0], ay = cy - l->point_at[1], az = cz - l->point_at[2];
+        float al = sqrt(ax * ax + ay * ay + az * az);
+        float inv = al > 0.0f ? 1.0f / al : 0.0f;
+        d[0] = ax * inv;
+        d[1] = ay * inv;
+        d[2] = az * inv;
+        depth = (cx - px) * d[0] + (cy - py) * d[1] + (cz - pz) * d[2];
+    } else {
+        float vx = cx - px, vy = cy - py, vz = cz - pz;
+        depth = sqrt(vx * vx + vy * vy + vz * vz);
+        if (depth > 0.0f) {
+            d[0] = vx / depth;
+            d[1] = vy / depth;
+            d[2] = vz / depth;
+        } else {
+            d[0] = 0.0f;
+            d[1] = 1.0f;
+            d[2] = 0.0f;
+        }
+    }
+    if (l->parallel || l->kind == GI_LIGHT_PARALLEL) {
+        float ax = cx - l->point_at[0], ay = cy - l->point_at[1], az = cz - l->point_at[2];
+        float al = sqrt(ax * ax + ay * ay + az * az);
+        float inv = al > 0.0f ? 1.0f / al : 0.0f;
+        ax *= inv;
+        ay *= inv;
+        az *= inv;
+        depth *= ax * d[0] + ay * d[1] + az * d[2];
+        d[0] = ax;
+        d[1] = ay;
+        d[2] = az;
+    }
+    return depth;
+}
+
+/* POV-Ray's spotlight falloff curve: (3 - 2t) t^2 between low and high. */
+static inline float gi_cubic_step(float low, float high, float x)
+{
+    if (x <= low) return 0.0f;
+    if (x >= high) return 1.0f;
+    float t = (x - low) / (high - low);
+    return (3.0f - 2.0f * t) * t * t;
+}
+
+/* Angle and distance attenuation of light l seen from p along unit d at
+ * distance depth. Mirrors shade.c light_attenuation (spot cos^tightness with
+ * a cubic falloff, cylinder lights, fade 2/(1+(d/fade_distance)^fade_power)). */
+static inline float gi_light_attenuation(GI_GLOBAL const gi_dev_light *l, float px, float py, float pz,
+                                         const float *d, float depth)
+{
+    float att = 1.0f;
+    if (l->kind == GI_LIGHT_SPOT || l->kind == GI_LIGHT_CYLINDER) {
+        float ax = l->point_at[0] - l->pos[0], ay = l->point_at[1] - l->pos[1], az = l->point_at[2] - l->pos[2];
+        float al = sqrt(ax * ax + ay * ay + az * az);
+        float inv = al > 0.0f ? 1.0f / al : 0.0f;
+        ax *= inv;
+        ay *= inv;
+        az *= inv;
+        if (l->kind == GI_LIGHT_SPOT) {
+            float c = -(d[0] * ax + d[1] * ay + d[2] * az);
+            if (c <= 0.0f) return 0.0f;
+            att = l->tightness != 0.0f ? pow(c, l->tightness) : 1.0f;
+            if (l->cos_radius > 0.0f && c < l->cos_radius) att *= gi_cubic_step(l->cos_falloff, l->cos_radius, c);
+        } else {
+            float vx = px - l->pos[0], vy = py - l->pos[1], vz = pz - l->pos[2];
+            float k = vx * ax + vy * ay + vz * az;
+            if (k <= 0.0f) return 0.0f;
+            float rx = vx - ax * k, ry = vy - ay * k, rz = vz - az * k;
+            float len = sqrt(rx * rx + ry * ry + rz * rz);
+            if (len >= l->falloff) return 0.0f;
+            float dd = 1.0f - len / l->falloff;
+            att = l->tightness != 0.0f ? pow(dd, l->tightness) : 1.0f;
+            if (l->radius > 0.0f && len > l->radius) att *= gi_cubic_step(0.0f, 1.0f - l->radius / l->falloff, dd);
+        }
+    }
+    if (att > 0.0f && l->fade_power > 0.0f) {
+        if (fabs(l->fade_distance) >= 1e-10f)
+            att *= 2.0f / (1.0f + pow(depth / l->fade_distance, l->fade_power));
+        else
+            att *= pow(depth, -l->fade_power);
+    }
+    return att;
+}
+
+/* Integer hash for the random link choices: PCG-based hash from Jarzynski
+ * and Olano, "Hash Functions for GPU Rendering", JCGT 9(3), 2020. */
+static inline gi_u32 gi_hash(gi_u32 v)
+{
+    gi_u32 state = v * 747796405u + 2891336453u;
+    gi_u32 word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+#endif
