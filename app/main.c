@@ -7,6 +7,8 @@
 #include "accel.h"
 #include "cli.h"
 #include "cmd_compare.h"
+#include "cmd_crosscheck.h"
+#include "cmd_sweep.h"
 #include "diag.h"
 #include "framebuffer.h"
 #include "gi.h"
@@ -46,6 +48,9 @@ static const char *usage_text =
     "                 [+W640 +H480 +A0.3 +R3 +Oout.png +Iscene.pov +Ldir ...]\n"
     "  partray parse SCENE.pov [-D NAME=VALUE] [-L DIR]\n"
     "  partray compare REF TEST [--heatmap OUT.png] [--json]\n"
+    "  partray sweep SCENE.pov --ref REF.exr [--gi MODE[,MODE...]] --vary [MODE/]KEY=v1,v2,... [--out DIR]\n"
+    "                [--size WxH] [--metric relmse|rmse|flip|psnr|ssim] [--time total|render|wall] [render options]\n"
+    "  partray crosscheck SCENE.pov [--size WxH] [+A0.3] [--threads N] [--out DIR] [--json] [--povray PATH]\n"
     "  partray view SCENE.pov\n"
     "  partray --help | --version\n"
     "\n"
@@ -399,6 +404,8 @@ int main(int argc, char **argv)
     if (strcmp(cmd, "render") == 0) return cmd_render(argc - 2, argv + 2);
     if (strcmp(cmd, "parse") == 0) return cmd_parse(argc - 2, argv + 2);
     if (strcmp(cmd, "compare") == 0) return cmd_compare(argc - 2, argv + 2);
+    if (strcmp(cmd, "sweep") == 0) return cmd_sweep(argc - 2, argv + 2);
+    if (strcmp(cmd, "crosscheck") == 0) return cmd_crosscheck(argc - 2, argv + 2);
     if (strcmp(cmd, "view") == 0) {
         fprintf(stderr, "partray view: the interactive viewer is not built yet\n");
         return EXIT_USAGE;

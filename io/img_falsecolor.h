@@ -26,8 +26,8 @@
 typedef struct {
     double lo, hi;    /* values mapped to the ends of the ramp; 0 < lo < hi. Both 0 = automatic */
     int legend;       /* 1: a legend strip (colour bar, values at the decades) right of the image */
-    const char *unit; /* legend title, e.g. "cd/m2" or "lx" (glyphs: digits, . - + / and
-                         c d e i l m n r s t u x W; others are left blank); NULL = none */
+    const char *unit; /* legend title, e.g. "cd/m2" or "lx" (glyphs: see img_fc_text;
+                         others are left blank); NULL = none */
 } img_fc_opts;
 
 void img_fc_default_opts(img_fc_opts *o); /* automatic range, legend on, no unit */
@@ -57,6 +57,17 @@ double img_fc_unramp(const float srgb[3], double *dist);
 /* Value <-> ramp position for the range [lo, hi] (log10 scale). */
 double img_fc_position(double value, double lo, double hi);
 double img_fc_value_at(double t, double lo, double hi);
+
+/* The legend's 5x7 pixel font, for other drawings (plots, labels): draws
+ * `text` with its top-left corner at (x, y), every glyph scaled by s (>= 1)
+ * and advancing 6s pixels, in the display sRGB colour `srgb` (stored as its
+ * linear value, like the rest of the image); pixels outside fb are skipped.
+ * Glyphs: digits, . - + / = , ( ) _ : and a b c d e f g h i k l m n o p r s
+ * t u v w x y z W; other characters (space included) leave a blank cell.
+ * Returns the text's width in pixels (img_fc_text_width). */
+int img_fc_text(framebuffer *fb, int x, int y, int s, const char *text, const float srgb[3]);
+/* Width in pixels of `text` at scale s: 6s per character less the last gap. */
+int img_fc_text_width(const char *text, int s);
 
 /* Readout: the mean of the finite values in the (2r+1)^2 window around
  * (x, y), clipped to the image; NaN when the window holds none. */

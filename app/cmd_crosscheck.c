@@ -1,0 +1,549 @@
+/* cmd_crosscheck.c - `partray crosscheck SCENE.pov [--size WxH | +Wn +Hn]
+ *     [+A[t] | -A] [+Rn] [--threads N | +WTn] [-D NAME=VALUE] [-L DIR]
+ *     [--gi MODE] [--out DIR] [--json] [--povray PATH] [--quiet]`
+ *
+ * Renders the scene with POV-Ray 3.7 and with partray (its default GI
+ * choice unless --gi is given) at the same size (default 320x240, POV-Ray's)
+ * and antialiasing (default off; +A0.3 +R3 as POV-Ray reads them), both
+ * written as sRGB-encoded 8-bit PNGs (POV-Ray with File_Gamma=sRGB, which is
+ * also what partray writes), and reports `partray compare`'s metrics on the
+ * display values (LDR: RMSE, relMSE, PSNR, SSIM, LDR-FLIP, POV-Ray's image
+ * as the reference), the mean absolute difference of the display values
+ * (plain and after a 4x4 box downsample, which absorbs antialiasing and
+ * area-light jitter), and the mean luminance (Rec.709 Y of the decoded
+ * linear values) of both images with their ratio partray/POV-Ray. The ratio
+ * is the figure to read when the scene has radiosity{}: POV-Ray's radiosity
+ * is itself an approximation, so a per-pixel difference says little there.
+ *
+ * POV-Ray may only write in its working directory (Debian's povray.conf):
+ * it runs in a temporary directory holding a copy of the scene, with the
+ * scene's own directory (and every -L) on its library path; -D becomes
+ * Declare=NAME=VALUE. With --out DIR the images (povray.png, partray.png),
+ * the FLIP heat map (flip.png), partray's stats and both logs are kept in
+ * DIR; otherwise they are removed. POV-Ray is `povray` on PATH, or
+ * $PARTRAY_POVRAY, or --povray PATH.
+ *
+ * Exit: 0 when both renders were made and compared (this reports; it does
+ * not judge); 1 when either renderer failed on the scene; 2 usage; 3 when
+ * POV-Ray is missing or a file cannot be read or written. */
+#include "cmd_crosscheck.h"
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include "diag.h"
+#include "framebuffer.h"
+#include "img_io.h"
+#include "img_metrics.h"
+#include "scene.h"
+#include "sdl.h"
+#include "stats_json.h"
+#include "stats_read.h"
+#include "subproc.h"
+
+#define XC_MAX_LIST 64
+#define XC_MAX_ARGS (2 * XC_MAX_LIST + 32)
+
+static const char *usage =
+    "usage: partray crosscheck SCENE.pov [--size WxH] [+A0.3 | -A] [+R3] [--threads N] [-D NAME=VALUE] [-L DIR]\n"
+    "                          [--gi MODE] [--out DIR] [--json] [--povray PATH] [--quiet]\n";
+
+typedef struct {
+    const char *scene, *out_dir, *povray, *gi;
+    int width, height;
+    int aa;           /* 0 off, 1 on */
+    double aa_threshold;
+    int aa_depth;
+    int threads;
+    int json, quiet;
+    const char *defines[XC_MAX_LIST];
+    int ndefines;
+    const char *libs[XC_MAX_LIST];
+    int nlibs;
+} xc_opts;
+
+static void print_diags(const diag *d)
+{
+    for (int i = 0; i < diag_count(d); i++) {
+        char *s = diag_format(diag_get(d, i));
+        if (s) {
+            fprintf(stderr, "%s\n", s);
+            free(s);
+        }
+    }
+}
+
+static int parse_int(const char *s, int *out)
+{
+    char *end;
+    long v = strtol(s, &end, 10);
+    if (end == s || *end || v < 0 || v > INT_MAX) return 0;
+    *out = (int)v;
+    return 1;
+}
+
+static int parse_args(int argc, char **argv, xc_opts *o)
+{
+    memset(o, 0, sizeof *o);
+    o->width = 320;
+    o->height = 240;
+    o->aa_threshold = 0.3;
+    o->aa_depth = 3;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
+        int takes = strcmp(a, "--size") == 0 || strcmp(a, "--threads") == 0 || strcmp(a, "--out") == 0 ||
+                    strcmp(a, "--povray") == 0 || strcmp(a, "--gi") == 0 || strcmp(a, "-L") == 0 ||
+                    strcmp(a, "-D") == 0;
+        if (takes && !next) {
+            fprintf(stderr, "partray crosscheck: option '%s' needs a value\n", a);
+            return 0;
+        }
+        char x;
+        if (strcmp(a, "--size") == 0) {
+            if (sscanf(next, "%d%c%d", &o->width, &x, &o->height) != 3 || (x != 'x' && x != 'X') || o->width <= 0 ||
+                o->height <= 0 || o->width > 65536 || o->height > 65536) {
+                fprintf(stderr, "partray crosscheck: --size wants WxH, got '%s'\n", next);
+                return 0;
+            }
+            i++;
+        } else if (strcmp(a, "--threads") == 0) {
+            if (!parse_int(next, &o->threads)) {
+                fprintf(stderr, "partray crosscheck: --threads wants a non-negative integer\n");
+                return 0;
+            }
+            i++;
+        } else if (strcmp(a, "--out") == 0) {
+            o->out_dir = argv[++i];
+        } else if (strcmp(a, "--povray") == 0) {
+            o->povray = argv[++i];
+        } else if (strcmp(a, "--gi") == 0) {
+            o->gi = argv[++i];
+        } else if (strcmp(a, "--json") == 0) {
+            o->json = 1;
+        } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
+            o->quiet = 1;
+        } else if ((strcmp(a, "-D") == 0 || (strncmp(a, "-D", 2) == 0 && a[2])) && o->ndefines < XC_MAX_LIST) {
+            const char *v = a[2] ? a + 2 : argv[++i];
+            if (!strchr(v, '=')) {
+                fprintf(stderr, "partray crosscheck: -D wants NAME=VALUE, got '%s'\n", v);
+                return 0;
+            }
+            o->defines[o->ndefines++] = v;
+        } else if ((strcmp(a, "-L") == 0 || (strncmp(a, "-L", 2) == 0 && a[2])) && o->nlibs < XC_MAX_LIST) {
+            o->libs[o->nlibs++] = a[2] ? a + 2 : argv[++i];
+        } else if ((a[0] == '+' || a[0] == '-') && (a[1] == 'A' || a[1] == 'a')) {
+            o->aa = a[0] == '+';
+            if (a[2]) {
+                char *end;
+                o->aa_threshold = strtod(a + 2, &end);
+                if (*end || !(o->aa_threshold >= 0)) {
+                    fprintf(stderr, "partray crosscheck: bad option '%s'\n", a);
+                    return 0;
+                }
+            }
+        } else if (a[0] == '+' && (a[1] == 'R' || a[1] == 'r')) {
+            if (!parse_int(a + 2, &o->aa_depth) || o->aa_depth < 1 || o->aa_depth > 9) {
+                fprintf(stderr, "partray crosscheck: bad option '%s'\n", a);
+                return 0;
+            }
+        } else if (a[0] == '+' && (a[1] == 'W' || a[1] == 'w') && (a[2] == 'T' || a[2] == 't')) {
+            if (!parse_int(a + 3, &o->threads)) {
+                fprintf(stderr, "partray crosscheck: bad option '%s'\n", a);
+                return 0;
+            }
+        } else if (a[0] == '+' && (a[1] == 'W' || a[1] == 'w' || a[1] == 'H' || a[1] == 'h')) {
+            int v;
+            if (!parse_int(a + 2, &v) || v < 1 || v > 65536) {
+                fprintf(stderr, "partray crosscheck: bad option '%s'\n", a);
+                return 0;
+            }
+            if (a[1] == 'W' || a[1] == 'w') o->width = v;
+            else o->height = v;
+        } else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "partray crosscheck: unknown option '%s'\n", a);
+            return 0;
+        } else if (!o->scene) {
+            o->scene = a;
+        } else {
+            fprintf(stderr, "partray crosscheck: unexpected argument '%s'\n", a);
+            return 0;
+        }
+    }
+    if (!o->scene) {
+        fprintf(stderr, "partray crosscheck: no scene file given\n");
+        return 0;
+    }
+    return 1;
+}
+
+static int copy_file(const char *src, const char *dst)
+{
+    size_t n = 0;
+    char *text = subproc_read_text(src, &n);
+    if (!text) return 0;
+    FILE *f = fopen(dst, "wb");
+    int ok = f && fwrite(text, 1, n, f) == n;
+    if (f) ok = (fclose(f) == 0) && ok;
+    free(text);
+    return ok;
+}
+
+static void print_log_tail(const char *path, const char *who)
+{
+    char *text = subproc_read_text(path, NULL);
+    if (!text) return;
+    size_t n = strlen(text);
+    fprintf(stderr, "--- %s log (%s), last lines ---\n%s\n", who, path, n > 3000 ? text + n - 3000 : text);
+    free(text);
+}
+
+/* Mean |a - b| over all values, and after a 4x4 box downsample (-1 when the
+ * image is smaller than 4x4). */
+static void mean_abs_diff(const framebuffer *a, const framebuffer *b, double *plain, double *down)
+{
+    size_t n = (size_t)a->width * (size_t)a->height * 3u;
+    double s = 0.0;
+    for (size_t i = 0; i < n; i++) s += fabs((double)a->rgb[i] - (double)b->rgb[i]);
+    *plain = n ? s / (double)n : 0.0;
+    int w = a->width / 4, h = a->height / 4;
+    if (w < 1 || h < 1) {
+        *down = -1.0;
+        return;
+    }
+    s = 0.0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            for (int c = 0; c < 3; c++) {
+                double sa = 0.0, sb = 0.0;
+                for (int j = 0; j < 4; j++)
+                    for (int i = 0; i < 4; i++) {
+                        size_t k = ((size_t)(y * 4 + j) * (size_t)a->width + (size_t)(x * 4 + i)) * 3u + (size_t)c;
+                        sa += a->rgb[k];
+                        sb += b->rgb[k];
+                    }
+                s += fabs(sa - sb) / 16.0;
+            }
+    *down = s / (3.0 * w * h);
+}
+
+/* Mean Rec.709 luminance of the sRGB-decoded display values. */
+static double mean_luminance(const framebuffer *fb)
+{
+    size_t n = (size_t)fb->width * (size_t)fb->height;
+    double s = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const float *p = fb->rgb + 3 * i;
+        s += 0.2126 * img_srgb_decode(p[0]) + 0.7152 * img_srgb_decode(p[1]) + 0.0722 * img_srgb_decode(p[2]);
+    }
+    return n ? s / (double)n : 0.0;
+}
+
+/* Absolute path of `p` (relative to the current directory). */
+static void absolute(const char *p, char *buf, size_t n)
+{
+    if (p[0] == '/') {
+        snprintf(buf, n, "%s", p);
+        return;
+    }
+    char cwd[4096];
+    if (!getcwd(cwd, sizeof cwd)) cwd[0] = 0;
+    snprintf(buf, n, "%s/%s", cwd, p);
+}
+
+int cmd_crosscheck(int argc, char **argv)
+{
+    xc_opts o;
+    if (!parse_args(argc, argv, &o)) {
+        fputs(usage, stderr);
+        return 2;
+    }
+    if (access(o.scene, R_OK) != 0) {
+        fprintf(stderr, "partray crosscheck: cannot read scene '%s'\n", o.scene);
+        return 3;
+    }
+    char povray[4096];
+    const char *pv = o.povray ? o.povray : getenv("PARTRAY_POVRAY");
+    if (!subproc_find_program(pv && *pv ? pv : "povray", povray, sizeof povray)) {
+        fprintf(stderr, "partray crosscheck: POV-Ray not found (%s); install Debian's povray or pass --povray PATH\n",
+                pv && *pv ? pv : "povray on PATH");
+        return 3;
+    }
+    char self[4096];
+    if (!subproc_self_exe(self, sizeof self)) {
+        fprintf(stderr, "partray crosscheck: cannot find the partray binary (/proc/self/exe)\n");
+        return 3;
+    }
+
+    /* Does the scene use radiosity? (partray's parser; errors stop here.) */
+    diag *d = diag_new();
+    sdl_options so;
+    sdl_default_options(&so);
+    so.lib_paths = o.libs;
+    so.nlib_paths = o.nlibs;
+    so.defines = o.defines;
+    so.ndefines = o.ndefines;
+    so.image_width = o.width;
+    so.image_height = o.height;
+    scene *sc = NULL;
+    pt_status st = sdl_parse_file(o.scene, &so, &sc, d);
+    if (st != PT_OK) {
+        print_diags(d);
+        diag_free(d);
+        return st == PT_ERR_IO ? 3 : (st == PT_ERR_USAGE ? 2 : 1);
+    }
+    int radiosity = sc->global.radiosity.enabled != 0;
+    scene_free(sc);
+
+    /* Directories: POV-Ray's working one, and where the results go. */
+    char work[] = "/tmp/partray-crosscheck-XXXXXX";
+    if (!mkdtemp(work)) {
+        fprintf(stderr, "partray crosscheck: cannot create a temporary directory\n");
+        diag_free(d);
+        return 3;
+    }
+    char out[4096];
+    if (o.out_dir) {
+        if (!subproc_mkdirs(o.out_dir)) {
+            fprintf(stderr, "partray crosscheck: cannot create directory '%s'\n", o.out_dir);
+            diag_free(d);
+            return 3;
+        }
+        absolute(o.out_dir, out, sizeof out);
+    } else {
+        snprintf(out, sizeof out, "%s", work);
+    }
+    char scene_abs[4096], scene_dir[4096], base[1024], stem[1024];
+    absolute(o.scene, scene_abs, sizeof scene_abs);
+    snprintf(scene_dir, sizeof scene_dir, "%s", scene_abs);
+    char *slash = strrchr(scene_dir, '/');
+    snprintf(base, sizeof base, "%s", slash + 1);
+    *slash = 0;
+    if (!scene_dir[0]) snprintf(scene_dir, sizeof scene_dir, "/");
+    snprintf(stem, sizeof stem, "%s", base);
+    char *dot = strrchr(stem, '.');
+    if (dot && dot != stem) *dot = 0;
+
+    char copy[4200], pov_out[1100], pov_png[4200], pov_log[4200], pt_png[4200], pt_log[4200], pt_json[4200],
+        flip_png[4200];
+    snprintf(copy, sizeof copy, "%s/%s", work, base);
+    snprintf(pov_out, sizeof pov_out, "%s_pov.png", stem);
+    snprintf(pov_png, sizeof pov_png, "%s/povray.png", out);
+    snprintf(pov_log, sizeof pov_log, "%s/povray.log", out);
+    snprintf(pt_png, sizeof pt_png, "%s/partray.png", out);
+    snprintf(pt_log, sizeof pt_log, "%s/partray.log", out);
+    snprintf(pt_json, sizeof pt_json, "%s/partray.json", out);
+    snprintf(flip_png, sizeof flip_png, "%s/flip.png", out);
+    int rc = 0;
+    char(*xc_args)[4200] = malloc(XC_MAX_ARGS * sizeof *xc_args);
+    framebuffer *a = NULL, *b = NULL, *map = NULL;
+    double t_pov = 0, t_pt = 0;
+    char gi_used[64] = "?";
+    if (!xc_args) {
+        rc = 1;
+        goto done;
+    }
+    if (!copy_file(o.scene, copy)) {
+        fprintf(stderr, "partray crosscheck: cannot copy the scene into %s\n", work);
+        rc = 3;
+        goto done;
+    }
+    remove(pov_log);
+    remove(pt_log);
+
+    /* POV-Ray. */
+    {
+        char(*args)[4200] = xc_args;
+        const char *argvv[XC_MAX_ARGS + 1];
+        int n = 0;
+        snprintf(args[n++], sizeof args[0], "%s", povray);
+        snprintf(args[n++], sizeof args[0], "+I%s", base);
+        snprintf(args[n++], sizeof args[0], "+O%s", pov_out);
+        snprintf(args[n++], sizeof args[0], "+W%d", o.width);
+        snprintf(args[n++], sizeof args[0], "+H%d", o.height);
+        if (o.aa) {
+            snprintf(args[n++], sizeof args[0], "+A%g", o.aa_threshold);
+            snprintf(args[n++], sizeof args[0], "+R%d", o.aa_depth);
+        } else {
+            snprintf(args[n++], sizeof args[0], "-A");
+        }
+        snprintf(args[n++], sizeof args[0], "-D");
+        snprintf(args[n++], sizeof args[0], "-V");
+        snprintf(args[n++], sizeof args[0], "-P");
+        snprintf(args[n++], sizeof args[0], "+FN");
+        snprintf(args[n++], sizeof args[0], "-UA");
+        snprintf(args[n++], sizeof args[0], "File_Gamma=sRGB");
+        if (o.threads > 0) snprintf(args[n++], sizeof args[0], "+WT%d", o.threads);
+        snprintf(args[n++], sizeof args[0], "+L%s", scene_dir);
+        for (int i = 0; i < o.nlibs; i++) {
+            char lib[4096];
+            absolute(o.libs[i], lib, sizeof lib);
+            snprintf(args[n++], sizeof args[0], "+L%s", lib);
+        }
+        for (int i = 0; i < o.ndefines; i++) snprintf(args[n++], sizeof args[0], "Declare=%s", o.defines[i]);
+        for (int i = 0; i < n; i++) argvv[i] = args[i];
+        argvv[n] = NULL;
+        int prc = subproc_run(argvv, work, pov_log, &t_pov, d);
+        char made[4300];
+        snprintf(made, sizeof made, "%s/%s", work, pov_out);
+        if (prc != 0 || access(made, R_OK) != 0) {
+            print_diags(d);
+            fprintf(stderr, "partray crosscheck: POV-Ray failed on %s (exit %d)\n", o.scene, prc);
+            print_log_tail(pov_log, "POV-Ray");
+            rc = prc < 0 ? 3 : 1;
+            goto done;
+        }
+        if (strcmp(made, pov_png) != 0 && rename(made, pov_png) != 0 && !copy_file(made, pov_png)) {
+            fprintf(stderr, "partray crosscheck: cannot write %s\n", pov_png);
+            rc = 3;
+            goto done;
+        }
+    }
+
+    /* partray. */
+    {
+        char(*args)[4200] = xc_args;
+        const char *argvv[XC_MAX_ARGS + 1];
+        int n = 0;
+        snprintf(args[n++], sizeof args[0], "%s", self);
+        snprintf(args[n++], sizeof args[0], "render");
+        snprintf(args[n++], sizeof args[0], "%s", o.scene);
+        snprintf(args[n++], sizeof args[0], "-o");
+        snprintf(args[n++], sizeof args[0], "%s", pt_png);
+        snprintf(args[n++], sizeof args[0], "--size");
+        snprintf(args[n++], sizeof args[0], "%dx%d", o.width, o.height);
+        if (o.aa) {
+            snprintf(args[n++], sizeof args[0], "+A%g", o.aa_threshold);
+            snprintf(args[n++], sizeof args[0], "+R%d", o.aa_depth);
+        }
+        if (o.threads > 0) {
+            snprintf(args[n++], sizeof args[0], "--threads");
+            snprintf(args[n++], sizeof args[0], "%d", o.threads);
+        }
+        if (o.gi) {
+            snprintf(args[n++], sizeof args[0], "--gi");
+            snprintf(args[n++], sizeof args[0], "%s", o.gi);
+        }
+        for (int i = 0; i < o.nlibs; i++) snprintf(args[n++], sizeof args[0], "-L%s", o.libs[i]);
+        for (int i = 0; i < o.ndefines; i++) snprintf(args[n++], sizeof args[0], "-D%s", o.defines[i]);
+        snprintf(args[n++], sizeof args[0], "--stats");
+        snprintf(args[n++], sizeof args[0], "%s", pt_json);
+        for (int i = 0; i < n; i++) argvv[i] = args[i];
+        argvv[n] = NULL;
+        int prc = subproc_run(argvv, NULL, pt_log, &t_pt, d);
+        if (prc != 0) {
+            print_diags(d);
+            fprintf(stderr, "partray crosscheck: partray render failed (exit %d)\n", prc);
+            print_log_tail(pt_log, "partray");
+            rc = prc < 0 ? 3 : prc;
+            goto done;
+        }
+        char *js = subproc_read_text(pt_json, NULL);
+        if (js) stats_read_str(js, "gi", gi_used, sizeof gi_used);
+        free(js);
+    }
+
+    /* Compare. */
+    img_compare_result r;
+    memset(&r, 0, sizeof r);
+    st = img_read(pov_png, 1, &a, d);
+    if (st == PT_OK) st = img_read(pt_png, 1, &b, d);
+    if (st == PT_OK && (a->width != b->width || a->height != b->height)) {
+        fprintf(stderr, "partray crosscheck: sizes differ: POV-Ray %dx%d, partray %dx%d\n", a->width, a->height, b->width,
+                b->height);
+        rc = 1;
+        goto done;
+    }
+    if (st == PT_OK) st = img_compare(a, b, 0, &r, o.out_dir ? &map : NULL, d);
+    if (st == PT_OK && map) st = img_write(flip_png, map, NULL, d);
+    if (st != PT_OK) {
+        print_diags(d);
+        rc = st == PT_ERR_IO ? 3 : 1;
+        goto done;
+    }
+    double mad = 0, mad4 = 0;
+    mean_abs_diff(a, b, &mad, &mad4);
+    double lum_pov = mean_luminance(a), lum_pt = mean_luminance(b);
+    double ratio = lum_pov > 0 ? lum_pt / lum_pov : (lum_pt > 0 ? INFINITY : 1.0);
+    if (!o.quiet) print_diags(d);
+    if (o.json) {
+        stats_json js;
+        stats_begin(&js);
+        stats_str(&js, "scene", o.scene);
+        stats_int(&js, "width", a->width);
+        stats_int(&js, "height", a->height);
+        stats_int(&js, "antialias", o.aa);
+        stats_num(&js, "aa_threshold", o.aa ? o.aa_threshold : 0.0);
+        stats_int(&js, "radiosity", radiosity);
+        stats_obj_begin(&js, "povray");
+        stats_num(&js, "seconds", t_pov);
+        if (o.out_dir) stats_str(&js, "image", pov_png);
+        stats_obj_end(&js);
+        stats_obj_begin(&js, "partray");
+        stats_num(&js, "seconds", t_pt);
+        stats_str(&js, "gi", gi_used);
+        if (o.out_dir) stats_str(&js, "image", pt_png);
+        stats_obj_end(&js);
+        stats_str(&js, "mode", "ldr");
+        stats_num(&js, "rmse", r.rmse);
+        stats_num(&js, "relmse", r.relmse);
+        stats_num(&js, "psnr", r.psnr);
+        stats_num(&js, "ssim", r.ssim);
+        stats_obj_begin(&js, "flip");
+        stats_num(&js, "mean", r.flip_mean);
+        stats_num(&js, "weighted_median", r.flip_wmedian);
+        stats_obj_end(&js);
+        stats_num(&js, "mean_abs_diff", mad);
+        stats_num(&js, "mean_abs_diff_4x4", mad4);
+        stats_obj_begin(&js, "luminance");
+        stats_num(&js, "povray", lum_pov);
+        stats_num(&js, "partray", lum_pt);
+        stats_num(&js, "ratio", ratio);
+        stats_obj_end(&js);
+        fputs(stats_end(&js), stdout);
+        stats_free(&js);
+    } else {
+        printf("scene       %s (%s)\n", o.scene, radiosity ? "radiosity{}: POV-Ray's and partray's GI are both approximate; read the luminance ratio" : "no radiosity");
+        if (o.aa)
+            printf("size        %dx%d, antialias +A%g +R%d\n", a->width, a->height, o.aa_threshold, o.aa_depth);
+        else
+            printf("size        %dx%d, antialias off\n", a->width, a->height);
+        printf("povray      %.3f s%s%s\n", t_pov, o.out_dir ? ", " : "", o.out_dir ? pov_png : "");
+        printf("partray     %.3f s, gi %s%s%s\n", t_pt, gi_used, o.out_dir ? ", " : "", o.out_dir ? pt_png : "");
+        printf("(POV-Ray's image is the reference; sRGB-encoded values, LDR-FLIP)\n");
+        printf("RMSE        %.6f\n", r.rmse);
+        printf("relMSE      %.6f\n", r.relmse);
+        printf("PSNR        %.3f dB\n", r.psnr);
+        printf("SSIM        %.6f\n", r.ssim);
+        printf("FLIP        mean %.6f, weighted median %.6f\n", r.flip_mean, r.flip_wmedian);
+        printf("mean |diff| %.6f (after 4x4 downsample %.6f)\n", mad, mad4);
+        printf("luminance   povray %.6f, partray %.6f, ratio partray/povray %.4f\n", lum_pov, lum_pt, ratio);
+        if (o.out_dir) printf("heat map    %s\n", flip_png);
+    }
+
+done:
+    free(xc_args);
+    fb_free(a);
+    fb_free(b);
+    fb_free(map);
+    diag_free(d);
+    /* POV-Ray's working directory always goes; with no --out it held everything. */
+    {
+        char made[4300];
+        snprintf(made, sizeof made, "%s/%s", work, pov_out);
+        remove(made);
+        remove(copy);
+        if (!o.out_dir) {
+            remove(pov_png);
+            remove(pov_log);
+            remove(pt_png);
+            remove(pt_log);
+            remove(pt_json);
+            remove(flip_png);
+        }
+        if (rmdir(work) != 0 && !o.quiet && rc == 0)
+            fprintf(stderr, "partray crosscheck: left files in %s\n", work);
+    }
+    return rc;
+}
