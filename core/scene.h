@@ -105,7 +105,19 @@ typedef enum {
     SHAPE_CONE,
     SHAPE_DISC,
     SHAPE_TORUS,
-    SHAPE_UNSUPPORTED /* parsed, not renderable yet: `name` says which */
+    SHAPE_UNSUPPORTED, /* parsed, not renderable yet: `name` says which */
+    /* Appended for issue 4 (POV-Ray's further shapes); their data live in
+     * arena-allocated records (below) referenced from the union. */
+    SHAPE_POLYGON,        /* u.polygon */
+    SHAPE_LATHE,          /* u.lathe */
+    SHAPE_SOR,            /* u.lathe (spline ignored: always POV-Ray's sor curve) */
+    SHAPE_PRISM,          /* u.prism */
+    SHAPE_SUPERELLIPSOID, /* u.superellipsoid */
+    SHAPE_QUADRIC,        /* u.quadric */
+    SHAPE_POLY,           /* u.poly: poly, cubic, quartic, polynomial */
+    SHAPE_BLOB,           /* u.blob */
+    SHAPE_HEIGHT_FIELD,   /* u.height_field */
+    SHAPE_TEXT            /* u.text: glyph outlines extruded along z */
 } shape_kind;
 
 enum {
@@ -119,6 +131,57 @@ enum {
     OBJ_STURM = 1u << 7,
     OBJ_NO_RADIOSITY = 1u << 8
 };
+
+/* ---------------------------------------------------------------- further shapes (issue 4)
+ * Plain POV-Ray data as written in the scene (object space); accel/ derives
+ * what it needs to intersect them. */
+typedef enum { SPLINE_LINEAR, SPLINE_QUADRATIC, SPLINE_CUBIC, SPLINE_BEZIER } scene_spline;
+
+/* polygon { n, <p1> ... <pn> }: sub-polygons close where a point repeats
+ * the sub-polygon's first point; the last one is closed implicitly. */
+typedef struct { int npoints; vec3 *points; } scene_polygon;
+
+/* lathe / sor: 2-D points <radius, height> revolved about the y axis. */
+typedef struct { scene_spline spline; int npoints; double (*points)[2]; } scene_lathe;
+
+/* prism: 2-D points <x, z> swept along y from height1 to height2
+ * (conic_sweep: scaled by y, apex at the origin). */
+typedef struct {
+    scene_spline spline;
+    int conic;
+    double height1, height2;
+    int npoints;
+    double (*points)[2];
+} scene_prism;
+
+/* blob component: sphere (a = centre) or cylinder (axis a..b, hemispherical
+ * ends), field strength * (1 - (d/radius)^2)^2; `transform` maps component
+ * space to blob space (component transforms). */
+typedef struct {
+    int cylinder;
+    vec3 a, b;
+    double radius, strength;
+    xform transform;
+    const struct scene_texture *texture; /* NULL = the blob's */
+} scene_blob_component;
+typedef struct { double threshold; int ncomponents; scene_blob_component *components; } scene_blob;
+
+/* poly/cubic/quartic/polynomial: sum of coef[i] x^a y^b z^c over POV-Ray's
+ * term order for `order` (x power descending, then y, then z). */
+typedef struct { int order; int ncoefs; double *coefs; } scene_poly;
+
+/* height_field: grid of heights in [0,1] (row 0 at z = 0, column 0 at x = 0)
+ * over the unit square; water_level cuts away what is below it. */
+typedef struct {
+    int width, height;   /* columns (x), rows (z) */
+    float *heights;      /* width * height */
+    int smooth;
+    double water_level;
+} scene_height_field;
+
+/* text: closed glyph contours as cubic Bezier segments (4 points of 2-D
+ * x, y each) in the z = 0 plane, extruded from z = 0 to z = depth. */
+typedef struct { int nsegments; double (*segments)[8]; double depth; } scene_text;
 
 typedef struct scene_object scene_object;
 struct scene_object {
@@ -140,7 +203,21 @@ struct scene_object {
         struct { vec3 base, cap; double base_radius, cap_radius; } cone; /* cylinder: equal radii */
         struct { vec3 centre, normal; double radius, hole_radius; } disc;
         struct { double major, minor; } torus;
+        /* issue 4 shapes */
+        const scene_polygon *polygon;
+        const scene_lathe *lathe;           /* lathe and sor */
+        const scene_prism *prism;
+        struct { double e, n; } superellipsoid; /* east-west, north-south exponents */
+        struct { double a[10]; } quadric;   /* A x2 + B y2 + C z2 + D xy + E xz + F yz + G x + H y + I z + J */
+        const scene_poly *poly;
+        const scene_blob *blob;
+        const scene_height_field *height_field;
+        const scene_text *text;
     } u;
+    /* clipped_by (issue 4): the clipping solid, its transform relative to
+     * this object's space (world = clip->transform then this->transform), so
+     * later transforms of the object move it along. NULL = none. */
+    const scene_object *clip;
 };
 
 /* ---------------------------------------------------------------- lights */

@@ -6,6 +6,7 @@
 #include "sdl_expr.h"
 #include "sdl_material.h"
 #include "sdl_scene.h"
+#include "sdl_shape.h"
 
 /* ------------------------------------------------------------ keywords */
 
@@ -325,6 +326,11 @@ void sdl_object_mods(sdl_parser *p, sdl_obj *so)
             return;
         }
         sdl_tok t = sdl_next(p);
+        if (t.tk.kw == KW_CLIPPED_BY || t.tk.kw == KW_BOUNDED_BY) { /* issue 4: sdl_shape.c */
+            if (t.tk.kw == KW_CLIPPED_BY) sdl_shape_clipped_by(p, so);
+            else sdl_shape_bounded_by(p, so);
+            continue;
+        }
         if (flag_mod(p, so->obj, t.tk.kw) || material_mod(p, so->obj, t.tk.kw) || skipped_mod(p, &t)) continue;
         sdl_unget(p, &t);
         return;
@@ -815,7 +821,10 @@ static void shape_args(sdl_parser *p, sdl_kw k, sdl_obj *so, src_loc loc)
     case KW_TORUS: torus_args(p, o); break;
     case KW_MESH: mesh_body(p, so, loc); break;
     case KW_MESH2: mesh2_body(p, so, loc); break;
-    default: csg_body(p, so); break;
+    default:
+        if (sdl_shape_handles(k)) sdl_shape_args(p, k, so, loc); /* issue 4 shapes */
+        else csg_body(p, so);
+        break;
     }
 }
 
@@ -837,7 +846,7 @@ sdl_obj *sdl_parse_object(sdl_parser *p)
         return NULL;
     }
     if (k.tk.kw == KW_LIGHT_SOURCE) return sdl_parse_light(p, k.tk.loc);
-    if (is_unsupported_shape(k.tk.kw)) return unsupported_shape(p, &k);
+    if (is_unsupported_shape(k.tk.kw) && !sdl_shape_handles(k.tk.kw)) return unsupported_shape(p, &k);
     if (k.tk.kw == KW_LIGHT_GROUP) sdl_warn_once(p, k.tk.loc, "light_group is treated as a union (its lights light the whole scene)");
     const char *name = sdl_kw_text(k.tk.kw);
     if (!sdl_begin_block(p, name)) return NULL;

@@ -1,0 +1,21 @@
+/* sdl_hfimage.h - height_field images: PNG (libpng) and PGM/PPM (P2, P3,
+ * P5, P6), read into POV-Ray's 16-bit heights (its image_height_at):
+ * greyscale value * 65535, palette index * 256, 8-bit colour red * 256 +
+ * green (the "high byte / low byte" convention), 16-bit colour the grey
+ * value 0.297 r + 0.589 g + 0.114 b times 65535. Other formats (GIF, TGA,
+ * JPEG, TIFF, IFF, EXR, HDR, sys, pot) are reported as unsupported. */
+#ifndef PT_SDL_HFIMAGE_H
+#define PT_SDL_HFIMAGE_H
+#include <stddef.h>
+
+enum { SDL_HF_OK = 0, SDL_HF_ERROR = 1, SDL_HF_UNSUPPORTED = 2 };
+
+typedef struct {
+    int width, height;
+    unsigned short *values; /* malloc'd, width * height, row 0 = top of the image */
+} sdl_hf_image;
+
+/* SDL_HF_OK, or an error / unsupported format with a reason in `why`. */
+int sdl_hf_read(const char *path, sdl_hf_image *out, char *why, size_t whycap);
+
+#endif

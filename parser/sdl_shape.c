@@ -1,0 +1,1103 @@
+/* sdl_shape.c - grammar of the further POV-Ray shapes (sdl_shape.h).
+ *
+ * Each rule follows POV-Ray 3.7's documented syntax; counts, point checks
+ * and closing rules are POV-Ray's (its parser is the reference for what a
+ * scene means). EPSILON below is POV-Ray's 1e-10 for "the same point". */
+#include "sdl_shape.h"
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include "sdl_directive.h"
+#include "sdl_expr.h"
+#include "sdl_font.h"
+#include "sdl_hfimage.h"
+#include "sdl_material.h"
+#include "sdl_object.h"
+
+#define SDL_SHAPE_EPSILON 1e-10
+#define SDL_DEFAULT_LIB_DIR "/usr/share/povray-3.7/include"
+#define MAX_POLY_ORDER 35 /* POV-Ray's MAX_ORDER */
+
+int sdl_shape_handles(sdl_kw k)
+{
+    switch (k) {
+    case KW_POLYGON: case KW_LATHE: case KW_SOR: case KW_PRISM: case KW_SUPERELLIPSOID:
+    case KW_QUADRIC: case KW_POLY: case KW_CUBIC: case KW_QUARTIC: case KW_POLYNOMIAL:
+    case KW_BLOB: case KW_HEIGHT_FIELD: case KW_TEXT: case KW_SPHERE_SWEEP: case KW_BICUBIC_PATCH:
+        return 1;
+    default:
+        return 0;
+    }
+}
+
+/* ------------------------------------------------------------ helpers */
+
+static void *alloc_n(sdl_parser *p, size_t n, size_t elem)
+{
+    if (n == 0) n = 1;
+    if (n > SIZE_MAX / elem) {
+        sdl_error(p, p->last_loc, PT_ERR_LIMIT, "too many points");
+        return NULL;
+    }
+    return sdl_alloc(p, n * elem);
+}
+
+/* count := float ; checked against [lo, hi] */
+static int parse_count(sdl_parser *p, const char *what, int lo, int hi)
+{
+    src_loc loc = sdl_peek(p)->tk.loc;
+    double n = sdl_float(p);
+    if (!sdl_ok(p)) return -1;
+    if (!(n >= lo) || n > hi) {
+        sdl_error(p, loc, PT_ERR_SYNTAX, "%s: %g points given, %d to %d allowed", what, n, lo, hi);
+        return -1;
+    }
+    return (int)n;
+}
+
+/* uv_list := uv { [','] uv } ; n 2-D points */
+static double (*uv_list(sdl_parser *p, int n, int extra))[2]
+{
+    double(*pts)[2] = alloc_n(p, (size_t)n + (size_t)extra, sizeof *pts);
+    if (!pts) return NULL;
+    sdl_accept(p, TOK_COMMA);
+    for (int i = 0; i < n && sdl_ok(p); i++) {
+        sdl_vector_n(p, pts[i], 2);
+        sdl_accept(p, TOK_COMMA);
+    }
+    return pts;
+}
+
+/* spline_type := linear_spline | quadratic_spline | cubic_spline | bezier_spline */
+static int spline_kw(sdl_kw k, scene_spline *out)
+{
+    switch (k) {
+    case KW_LINEAR_SPLINE: *out = SPLINE_LINEAR; return 1;
+    case KW_QUADRATIC_SPLINE: *out = SPLINE_QUADRATIC; return 1;
+    case KW_CUBIC_SPLINE: *out = SPLINE_CUBIC; return 1;
+    case KW_BEZIER_SPLINE: *out = SPLINE_BEZIER; return 1;
+    default: return 0;
+    }
+}
+
+static int same2(const double *a, const double *b)
+{
+    return fabs(a[0] - b[0]) < SDL_SHAPE_EPSILON && fabs(a[1] - b[1]) < SDL_SHAPE_EPSILON;
+}
+
+/* A data file by POV-Ray's search: as given when absolute, else the -L
+ * directories, the current file's directory, POV-Ray's include directory.
+ * malloc'd path or NULL. */
+static char *find_data_file(sdl_parser *p, const char *name, const char *ext)
+{
+    if (!name || !*name) return NULL;
+    if (name[0] == '/') return access(name, R_OK) == 0 ? strdup(name) : NULL;
+    if (!ext) ext = "";
+    const char *dirs[64];
+    int nd = 0;
+    for (int i = 0; i < p->opt.nlib_paths && nd < 60; i++) dirs[nd++] = p->opt.lib_paths[i];
+    char *cur = NULL;
+    if (p->nframes > 0 && p->frames[p->nframes - 1].src && p->frames[p->nframes - 1].src->path) {
+        const char *path = p->frames[p->nframes - 1].src->path;
+        const char *slash = strrchr(path, '/');
+        if (slash) {
+            cur = strndup(path, (size_t)(slash - path) + (slash == path));
+            if (cur) dirs[nd++] = cur;
+        }
+    }
+    dirs[nd++] = ".";
+    if (!p->opt.no_default_lib) dirs[nd++] = SDL_DEFAULT_LIB_DIR;
+    char *found = NULL;
+    for (int i = 0; i < nd && !found; i++)
+        for (int e = 0; e < 2 && !found && ext; e++) {
+            size_t n = strlen(dirs[i]) + strlen(name) + strlen(ext) + 2;
+            char *f = malloc(n);
+            if (!f) break;
+            snprintf(f, n, "%s/%s%s", dirs[i], name, e ? ext : "");
+            if (access(f, R_OK) == 0) found = f;
+            else free(f);
+        }
+    free(cur);
+    return found;
+}
+
+/* ------------------------------------------------------------ polygon */
+
+/* polygon := n ',' point { [','] point }
+ * Sub-polygons end where a point repeats their first point; an unclosed
+ * last one is closed (POV-Ray warns "Polygon not closed"). */
+static void polygon_args(sdl_parser *p, scene_object *o, src_loc loc)
+{
+    int n = parse_count(p, "polygon", 3, 1 << 24);
+    if (n < 0) return;
+    vec3 *pts = alloc_n(p, (size_t)n + 1, sizeof *pts);
+    if (!pts) return;
+    sdl_accept(p, TOK_COMMA);
+    for (int i = 0; i < n && sdl_ok(p); i++) {
+        pts[i] = sdl_vector(p);
+        sdl_accept(p, TOK_COMMA);
+    }
+    if (!sdl_ok(p)) return;
+    vec3 first = pts[0];
+    int closed = 0;
+    for (int i = 1; i < n; i++) {
+        closed = 0;
+        if (fabs(first.x - pts[i].x) < SDL_SHAPE_EPSILON && fabs(first.y - pts[i].y) < SDL_SHAPE_EPSILON &&
+            fabs(first.z - pts[i].z) < SDL_SHAPE_EPSILON) {
+            pts[i] = first;
+            i++;
+            if (i < n) first = pts[i];
+            closed = 1;
+        }
+    }
+    if (!closed) {
+        sdl_warn_once(p, loc, "polygon not closed; closing it");
+        pts[n++] = first;
+    }
+    scene_polygon *pg = sdl_alloc(p, sizeof *pg);
+    if (!pg) return;
+    pg->npoints = n;
+    pg->points = pts;
+    o->kind = SHAPE_POLYGON;
+    o->u.polygon = pg;
+}
+
+/* ------------------------------------------------------------ lathe, sor */
+
+/* lathe := [ spline_type ] n ',' uv { [','] uv } [ sturm ]
+ * (linear >= 2 points, quadratic >= 3, cubic >= 4, bezier 4 per segment) */
+static void lathe_args(sdl_parser *p, scene_object *o)
+{
+    scene_spline sp = SPLINE_LINEAR;
+    while (sdl_ok(p) && sdl_peek(p)->tk.kind == TOK_KEYWORD && spline_kw(sdl_peek(p)->tk.kw, &sp)) sdl_next(p);
+    src_loc loc = sdl_peek(p)->tk.loc;
+    int n = parse_count(p, "lathe", 2, 1 << 24);
+    if (n < 0) return;
+    static const int min_pts[4] = {2, 3, 4, 4};
+    if (n < min_pts[sp] || (sp == SPLINE_BEZIER && (n & 3))) {
+        sdl_error(p, loc, PT_ERR_SYNTAX, "lathe with %s splines needs %s", sp == SPLINE_LINEAR ? "linear" : sp == SPLINE_QUADRATIC ? "quadratic" : sp == SPLINE_CUBIC ? "cubic" : "Bezier",
+                  sp == SPLINE_LINEAR ? "at least two points" : sp == SPLINE_QUADRATIC ? "at least three points" : sp == SPLINE_CUBIC ? "at least four points" : "four points per segment");
+        return;
+    }
+    double(*pts)[2] = uv_list(p, n, 0);
+    if (!pts || !sdl_ok(p)) return;
+    scene_lathe *l = sdl_alloc(p, sizeof *l);
+    if (!l) return;
+    l->spline = sp;
+    l->npoints = n;
+    l->points = pts;
+    o->kind = SHAPE_LATHE;
+    o->u.lathe = l;
+}
+
+/* sor := n ',' uv { [','] uv } [ open ] [ sturm ]
+ * (n >= 4; radii >= 0; heights of points 1 .. n-2 strictly increasing) */
+static void sor_args(sdl_parser *p, scene_object *o)
+{
+    src_loc loc = sdl_peek(p)->tk.loc;
+    int n = parse_count(p, "sor", 4, 1 << 24);
+    if (n < 0) return;
+    double(*pts)[2] = uv_list(p, n, 0);
+    if (!pts || !sdl_ok(p)) return;
+    for (int i = 0; i < n; i++)
+        if (pts[i][0] < 0.0 || (i > 1 && i < n - 1 && pts[i][1] <= pts[i - 1][1])) {
+            sdl_error(p, loc, PT_ERR_SYNTAX, "incorrect point %d in surface of revolution (radius < 0 or height not increasing)", i + 1);
+            return;
+        }
+    for (int i = 0; i + 3 < n; i++)
+        if (fabs(pts[i + 2][1] - pts[i][1]) < SDL_SHAPE_EPSILON || fabs(pts[i + 3][1] - pts[i + 1][1]) < SDL_SHAPE_EPSILON) {
+            sdl_error(p, loc, PT_ERR_SYNTAX, "incorrect point in surface of revolution (equal heights)");
+            return;
+        }
+    if (sdl_accept_kw(p, KW_OPEN)) o->flags |= OBJ_OPEN;
+    scene_lathe *l = sdl_alloc(p, sizeof *l);
+    if (!l) return;
+    l->spline = SPLINE_CUBIC;
+    l->npoints = n;
+    l->points = pts;
+    o->kind = SHAPE_SOR;
+    o->u.lathe = l;
+}
+
+/* ------------------------------------------------------------ prism */
+
+/* prism := { spline_type | linear_sweep | conic_sweep } height1 ',' height2 ','
+ *   n ',' uv { [','] uv } [ open ] [ sturm ]
+ * (linear >= 3 points, quadratic >= 5, cubic >= 6, bezier 4 per segment).
+ * Closing rules as POV-Ray: a sub-curve ends where a point repeats its
+ * first point (quadratic/cubic: the second point, the first is a control
+ * point); an unclosed linear prism is closed, any other is ignored. */
+static void prism_args(sdl_parser *p, scene_object *o, src_loc oloc)
+{
+    scene_spline sp = SPLINE_LINEAR;
+    int conic = 0;
+    for (;;) {
+        const sdl_tok *t = sdl_peek(p);
+        if (t->tk.kind != TOK_KEYWORD) break;
+        if (spline_kw(t->tk.kw, &sp)) sdl_next(p);
+        else if (t->tk.kw == KW_LINEAR_SWEEP) { conic = 0; sdl_next(p); }
+        else if (t->tk.kw == KW_CONIC_SWEEP) { conic = 1; sdl_next(p); }
+        else break;
+    }
+    double h1 = sdl_float(p);
+    sdl_accept(p, TOK_COMMA);
+    double h2 = sdl_float(p);
+    sdl_accept(p, TOK_COMMA);
+    if (h1 > h2) { double t = h1; h1 = h2; h2 = t; }
+    src_loc loc = sdl_peek(p)->tk.loc;
+    int n = parse_count(p, "prism", 3, 1 << 24);
+    if (n < 0) return;
+    static const int min_pts[4] = {3, 5, 6, 4};
+    if (n < min_pts[sp] || (sp == SPLINE_BEZIER && (n & 3))) {
+        sdl_error(p, loc, PT_ERR_SYNTAX, "prism with %s splines needs %s", sp == SPLINE_LINEAR ? "linear" : sp == SPLINE_QUADRATIC ? "quadratic" : sp == SPLINE_CUBIC ? "cubic" : "Bezier",
+                  sp == SPLINE_LINEAR ? "at least three points" : sp == SPLINE_QUADRATIC ? "at least five points" : sp == SPLINE_CUBIC ? "at least six points" : "four points per segment");
+        return;
+    }
+    double(*pts)[2] = uv_list(p, n, 1);
+    if (!pts || !sdl_ok(p)) return;
+    if (sdl_accept_kw(p, KW_OPEN)) o->flags |= OBJ_OPEN;
+    int closed = 0;
+    if (sp != SPLINE_BEZIER) {
+        int i = sp == SPLINE_LINEAR ? 1 : 2;
+        const double *first = pts[i - 1];
+        for (; i < n; i++) {
+            closed = 0;
+            if (same2(first, pts[i])) {
+                i += sp == SPLINE_LINEAR ? 1 : sp == SPLINE_QUADRATIC ? 2 : 3;
+                if (i < n) first = pts[i];
+                closed = 1;
+            }
+        }
+        if (!closed && sp == SPLINE_LINEAR) {
+            sdl_warn_once(p, oloc, "linear prism not closed; closing it");
+            pts[n][0] = first[0];
+            pts[n][1] = first[1];
+            n++;
+            closed = 1;
+        }
+    } else {
+        closed = 1;
+        int start = 0;
+        for (int i = 4; i < n; i += 4) {
+            if (!same2(pts[i], pts[i - 1])) {
+                if (!same2(pts[i - 1], pts[start])) { closed = 0; break; }
+                start = i;
+            }
+        }
+        if (!same2(pts[n - 1], pts[start])) closed = 0;
+    }
+    scene_prism *pr = sdl_alloc(p, sizeof *pr);
+    if (!pr) return;
+    if (!closed) {
+        sdl_warn_once(p, oloc, "prism not closed; it is ignored (as POV-Ray does)");
+        n = 0;
+    }
+    pr->spline = sp;
+    pr->conic = conic;
+    pr->height1 = h1;
+    pr->height2 = h2;
+    pr->npoints = n;
+    pr->points = pts;
+    o->kind = SHAPE_PRISM;
+    o->u.prism = pr;
+}
+
+/* ------------------------------------------------------------ superellipsoid, quadric */
+
+/* superellipsoid := '<' e ',' n '>' */
+static void superellipsoid_args(sdl_parser *p, scene_object *o, src_loc loc)
+{
+    double v[2];
+    sdl_vector_n(p, v, 2);
+    if (sdl_ok(p) && (!(v[0] > 0.0) || !(v[1] > 0.0)))
+        sdl_error(p, loc, PT_ERR_SYNTAX, "superellipsoid exponents must be positive");
+    o->kind = SHAPE_SUPERELLIPSOID;
+    o->u.superellipsoid.e = v[0];
+    o->u.superellipsoid.n = v[1];
+}
+
+/* quadric := '<' A ',' B ',' C '>' ',' '<' D ',' E ',' F '>' ',' '<' G ',' H ',' I '>' ',' J */
+static void quadric_args(sdl_parser *p, scene_object *o)
+{
+    vec3 sq = sdl_vector(p);
+    sdl_accept(p, TOK_COMMA);
+    vec3 mx = sdl_vector(p);
+    sdl_accept(p, TOK_COMMA);
+    vec3 ln = sdl_vector(p);
+    sdl_accept(p, TOK_COMMA);
+    double j = sdl_float(p);
+    double a[10] = {sq.x, sq.y, sq.z, mx.x, mx.y, mx.z, ln.x, ln.y, ln.z, j};
+    o->kind = SHAPE_QUADRIC;
+    memcpy(o->u.quadric.a, a, sizeof a);
+}
+
+/* ------------------------------------------------------------ poly */
+
+static int poly_terms(int order) { return (order + 1) * (order + 2) * (order + 3) / 6; }
+
+/* Index of x^i y^j z^k in POV-Ray's term order for `order` (x power
+ * descending, then y, then z; the remaining power belongs to the constant). */
+static int poly_index(int order, int i, int j, int k)
+{
+    int idx = 0;
+    for (int a = order; a >= 0; a--)
+        for (int b = order - a; b >= 0; b--)
+            for (int c = order - a - b; c >= 0; c--) {
+                if (a == i && b == j && c == k) return idx;
+                idx++;
+            }
+    return -1;
+}
+
+static scene_poly *new_poly(sdl_parser *p, int order)
+{
+    scene_poly *pl = sdl_alloc(p, sizeof *pl);
+    if (!pl) return NULL;
+    pl->order = order;
+    pl->ncoefs = poly_terms(order);
+    pl->coefs = alloc_n(p, (size_t)pl->ncoefs, sizeof(double));
+    return pl->coefs ? pl : NULL;
+}
+
+/* poly := order ',' coefs ; cubic := coefs ; quartic := coefs ;
+ * coefs := '<' c { ',' c } '>' with exactly (order+1)(order+2)(order+3)/6 terms */
+static void poly_args(sdl_parser *p, scene_object *o, int order)
+{
+    if (order == 0) {
+        src_loc loc = sdl_peek(p)->tk.loc;
+        double ord = sdl_float(p);
+        sdl_accept(p, TOK_COMMA);
+        if (!sdl_ok(p)) return;
+        if (!(ord >= 2) || ord > MAX_POLY_ORDER) {
+            sdl_error(p, loc, PT_ERR_SYNTAX, "order of poly is out of range (2 to %d)", MAX_POLY_ORDER);
+            return;
+        }
+        order = (int)ord;
+    }
+    scene_poly *pl = new_poly(p, order);
+    if (!pl) return;
+    if (!sdl_expect(p, TOK_LT, "'<' starting the coefficients")) return;
+    for (int i = 0; i < pl->ncoefs && sdl_ok(p); i++) {
+        if (i) sdl_accept(p, TOK_COMMA); /* POV-Ray's commas are optional here too */
+        pl->coefs[i] = sdl_float(p);
+    }
+    if (!sdl_ok(p)) return;
+    sdl_tok t = sdl_next(p);
+    if (t.tk.kind != TOK_GT) {
+        sdl_unexpected(p, &t, "'>' after the coefficients (wrong number of coefficients?)");
+        return;
+    }
+    o->kind = SHAPE_POLY;
+    o->u.poly = pl;
+}
+
+/* polynomial := order ',' { xyz '(' i ',' j ',' k ')' ':' value [','] } */
+static void polynomial_args(sdl_parser *p, scene_object *o)
+{
+    src_loc loc = sdl_peek(p)->tk.loc;
+    double ord = sdl_float(p);
+    sdl_accept(p, TOK_COMMA);
+    if (!sdl_ok(p)) return;
+    if (!(ord >= 2) || ord > MAX_POLY_ORDER) {
+        sdl_error(p, loc, PT_ERR_SYNTAX, "order of polynomial is out of range (2 to %d)", MAX_POLY_ORDER);
+        return;
+    }
+    scene_poly *pl = new_poly(p, (int)ord);
+    if (!pl) return;
+    while (sdl_ok(p) && sdl_accept_kw(p, KW_XYZ)) {
+        src_loc at = p->last_loc;
+        sdl_expect(p, TOK_LPAREN, "'(' after xyz");
+        double e[3];
+        for (int i = 0; i < 3; i++) {
+            if (i) sdl_expect(p, TOK_COMMA, "','");
+            e[i] = sdl_float(p);
+        }
+        sdl_expect(p, TOK_RPAREN, "')'");
+        sdl_expect(p, TOK_COLON, "':' after xyz(i,j,k)");
+        double v = sdl_float(p);
+        sdl_accept(p, TOK_COMMA);
+        if (!sdl_ok(p)) return;
+        int idx = (e[0] >= 0 && e[1] >= 0 && e[2] >= 0 && e[0] + e[1] + e[2] <= pl->order)
+                      ? poly_index(pl->order, (int)e[0], (int)e[1], (int)e[2]) : -1;
+        if (idx < 0) {
+            sdl_error(p, at, PT_ERR_SYNTAX, "coefficient of polynomial is out of range");
+            return;
+        }
+        pl->coefs[idx] = v;
+    }
+    o->kind = SHAPE_POLY;
+    o->u.poly = pl;
+}
+
+/* ------------------------------------------------------------ blob */
+
+typedef struct {
+    scene_blob_component *c;
+    int n, cap;
+} comp_list;
+
+static scene_blob_component *comp_add(sdl_parser *p, comp_list *l)
+{
+    if (l->n == l->cap) {
+        int nc = l->cap ? l->cap * 2 : 16;
+        scene_blob_component *c = realloc(l->c, sizeof *c * (size_t)nc);
+        if (!c) {
+            sdl_error(p, p->last_loc, PT_ERR_NOMEM, "out of memory");
+            return NULL;
+        }
+        l->c = c;
+        l->cap = nc;
+    }
+    scene_blob_component *c = &l->c[l->n++];
+    memset(c, 0, sizeof *c);
+    c->transform = xform_identity();
+    return c;
+}
+
+/* component_mods := { translate | rotate | scale | matrix | transform |
+ *   texture | pigment | finish | normal } '}' */
+static void component_mods(sdl_parser *p, scene_blob_component *c)
+{
+    scene_texture *tex = NULL;
+    while (sdl_ok(p)) {
+        xform x;
+        if (sdl_transform_item(p, &x)) {
+            c->transform = xform_then(c->transform, x);
+            if (tex) sdl_transform_texture(tex, &x);
+            continue;
+        }
+        if (sdl_accept_kw(p, KW_TEXTURE)) {
+            scene_texture *t = sdl_parse_texture(p);
+            if (t) {
+                scene_texture *last = t;
+                while (last->next) last = last->next;
+                last->next = tex;
+                tex = t;
+            }
+            continue;
+        }
+        const sdl_tok *pk = sdl_peek(p);
+        if (pk->tk.kind == TOK_KEYWORD && (pk->tk.kw == KW_PIGMENT || pk->tk.kw == KW_FINISH || pk->tk.kw == KW_NORMAL)) {
+            sdl_kw k = sdl_next(p).tk.kw;
+            if (!tex) {
+                tex = sdl_alloc(p, sizeof *tex);
+                if (!tex) return;
+                *tex = p->s->default_texture;
+                tex->next = NULL;
+                tex->transform = xform_identity();
+                tex->loc = p->last_loc;
+            }
+            if (k == KW_PIGMENT) sdl_parse_pigment(p, &tex->pigment);
+            else if (k == KW_FINISH) sdl_parse_finish(p, &tex->finish);
+            else { sdl_parse_normal(p); tex->has_normal = 1; }
+            continue;
+        }
+        break;
+    }
+    c->texture = tex;
+    sdl_end_block(p);
+}
+
+/* blob := { threshold float | component strength ',' radius ',' centre |
+ *   sphere '{' centre ',' radius ',' [strength] s component_mods |
+ *   cylinder '{' end1 ',' end2 ',' radius ',' [strength] s component_mods }
+ *   (threshold default 1) */
+static void blob_args(sdl_parser *p, scene_object *o, src_loc loc)
+{
+    comp_list l = {0};
+    double threshold = 1.0;
+    while (sdl_ok(p)) {
+        if (sdl_accept_kw(p, KW_THRESHOLD)) {
+            threshold = sdl_float(p);
+        } else if (sdl_accept_kw(p, KW_COMPONENT)) {
+            scene_blob_component *c = comp_add(p, &l);
+            if (!c) break;
+            c->strength = sdl_float(p);
+            sdl_accept(p, TOK_COMMA);
+            c->radius = sdl_float(p);
+            sdl_accept(p, TOK_COMMA);
+            c->a = sdl_vector(p);
+        } else if (sdl_accept_kw(p, KW_SPHERE)) {
+            if (!sdl_begin_block(p, "sphere")) break;
+            scene_blob_component *c = comp_add(p, &l);
+            if (!c) break;
+            c->a = sdl_vector(p);
+            sdl_accept(p, TOK_COMMA);
+            c->radius = sdl_float(p);
+            sdl_accept(p, TOK_COMMA);
+            sdl_accept_kw(p, KW_STRENGTH);
+            c->strength = sdl_float(p);
+            component_mods(p, c);
+        } else if (sdl_accept_kw(p, KW_CYLINDER)) {
+            if (!sdl_begin_block(p, "cylinder")) break;
+            scene_blob_component *c = comp_add(p, &l);
+            if (!c) break;
+            src_loc at = p->last_loc;
+            c->cylinder = 1;
+            c->a = sdl_vector(p);
+            sdl_accept(p, TOK_COMMA);
+            c->b = sdl_vector(p);
+            sdl_accept(p, TOK_COMMA);
+            c->radius = sdl_float(p);
+            sdl_accept(p, TOK_COMMA);
+            sdl_accept_kw(p, KW_STRENGTH);
+            c->strength = sdl_float(p);
+            if (sdl_ok(p) && v3_len(v3_sub(c->b, c->a)) < 1e-10) {
+                sdl_error(p, at, PT_ERR_SYNTAX, "degenerate cylindrical component in blob");
+                break;
+            }
+            component_mods(p, c);
+        } else if (sdl_accept_kw(p, KW_HIERARCHY)) {
+            sdl_allow_float(p, 1.0);
+        } else {
+            break;
+        }
+    }
+    if (sdl_ok(p) && l.n == 0) sdl_warn_once(p, loc, "blob without components");
+    scene_blob *b = sdl_alloc(p, sizeof *b);
+    if (b && sdl_ok(p)) {
+        b->threshold = threshold;
+        b->ncomponents = l.n;
+        b->components = l.n ? arena_memdup(p->s->mem, l.c, sizeof *l.c * (size_t)l.n) : NULL;
+        for (int i = 0; i < l.n; i++) b->components[i].radius = fabs(b->components[i].radius);
+        o->kind = SHAPE_BLOB;
+        o->u.blob = b;
+    }
+    free(l.c);
+}
+
+/* ------------------------------------------------------------ height_field */
+
+/* height_field := [ file_type ] file_name { water_level float | smooth [bool] | hierarchy [bool] }
+ * file_type := png | pgm | ppm | gif | tga | iff | jpeg | tiff | sys | pot | exr | hdr | bmp | function ... */
+static void height_field_args(sdl_parser *p, scene_object *o, src_loc loc)
+{
+    const sdl_tok *t = sdl_peek(p);
+    int is_function = 0;
+    const char *ext = NULL;
+    if (t->tk.kind == TOK_KEYWORD && !sdl_starts_string(t)) {
+        sdl_kw type = sdl_next(p).tk.kw;
+        ext = type == KW_PNG ? ".png" : type == KW_PGM ? ".pgm" : type == KW_PPM ? ".ppm" : NULL;
+        if (type == KW_FUNCTION) {
+            is_function = 1;
+            /* function W, H { pigment/expression }: needs pattern evaluation */
+            sdl_float(p);
+            sdl_accept(p, TOK_COMMA);
+            sdl_float(p);
+            if (sdl_begin_block(p, "function")) sdl_skip_block(p);
+            o->kind = SHAPE_UNSUPPORTED;
+            o->name = "height_field function";
+            sdl_warn_once(p, loc, "height_field from a function is not supported yet; it is skipped");
+        }
+    }
+    const char *name = NULL;
+    if (!is_function) name = sdl_string(p);
+    double water = 0.0;
+    int smooth = 0;
+    while (sdl_ok(p)) {
+        if (sdl_accept_kw(p, KW_WATER_LEVEL)) water = sdl_float(p);
+        else if (sdl_accept_kw(p, KW_SMOOTH)) smooth = sdl_allow_float(p, 1.0) != 0.0;
+        else if (sdl_accept_kw(p, KW_HIERARCHY)) sdl_allow_float(p, 1.0);
+        else break;
+    }
+    if (!sdl_ok(p) || is_function) return;
+    char *path = find_data_file(p, name, ext);
+    if (!path) {
+        sdl_error(p, loc, PT_ERR_IO, "height_field image '%s' not found", name ? name : "");
+        return;
+    }
+    sdl_hf_image img;
+    char why[256] = "";
+    int r = sdl_hf_read(path, &img, why, sizeof why);
+    free(path);
+    if (r == SDL_HF_UNSUPPORTED) {
+        o->kind = SHAPE_UNSUPPORTED;
+        o->name = "height_field";
+        sdl_warn_once(p, loc, "height_field image '%s': %s; the height field is skipped", name, why);
+        return;
+    }
+    if (r != SDL_HF_OK) {
+        sdl_error(p, loc, PT_ERR_IO, "height_field image '%s': %s", name, why);
+        return;
+    }
+    if (img.width < 2 || img.height < 2) {
+        free(img.values);
+        sdl_error(p, loc, PT_ERR_SYNTAX, "height_field image '%s' is smaller than 2x2", name);
+        return;
+    }
+    scene_height_field *hf = sdl_alloc(p, sizeof *hf);
+    float *h = hf ? alloc_n(p, (size_t)img.width * (size_t)img.height, sizeof *h) : NULL;
+    if (!h) {
+        free(img.values);
+        return;
+    }
+    /* POV-Ray: map row z is image row (height - 1 - z), heights value / 65536 */
+    for (int z = 0; z < img.height; z++)
+        for (int x = 0; x < img.width; x++)
+            h[(size_t)z * img.width + x] = (float)(img.values[(size_t)(img.height - 1 - z) * img.width + x] / 65536.0);
+    free(img.values);
+    hf->width = img.width;
+    hf->height = img.height;
+    hf->heights = h;
+    hf->smooth = smooth;
+    hf->water_level = water;
+    o->kind = SHAPE_HEIGHT_FIELD;
+    o->u.height_field = hf;
+}
+
+/* ------------------------------------------------------------ text */
+
+/* text := ttf file_name string thickness ',' offset  (also `internal n`,
+ * not supported). POV-Ray then rotates the text by <0.001,0.001,0.001>
+ * degrees ("to fix cracks in text that lies along an axis"); so do we. */
+static void text_args(sdl_parser *p, scene_object *o, src_loc loc)
+{
+    if (sdl_accept_kw(p, KW_INTERNAL)) {
+        sdl_float(p);
+        sdl_accept(p, TOK_COMMA);
+        sdl_string(p);
+        sdl_accept(p, TOK_COMMA);
+        sdl_float(p);
+        sdl_accept(p, TOK_COMMA);
+        sdl_vector(p);
+        o->kind = SHAPE_UNSUPPORTED;
+        o->name = "text internal";
+        sdl_warn_once(p, loc, "text with a built-in font is not supported; it is skipped");
+        return;
+    }
+    if (!sdl_accept_kw(p, KW_TTF)) {
+        sdl_tok t = sdl_next(p);
+        sdl_unexpected(p, &t, "ttf or internal");
+        return;
+    }
+    const char *font = sdl_string(p);
+    sdl_accept(p, TOK_COMMA);
+    const char *str = sdl_string(p);
+    sdl_accept(p, TOK_COMMA);
+    double depth = sdl_float(p);
+    sdl_accept(p, TOK_COMMA);
+    vec3 offset = sdl_vector(p);
+    if (!sdl_ok(p)) return;
+    char *path = find_data_file(p, font, ".ttf");
+    if (!path) {
+        sdl_error(p, loc, PT_ERR_IO, "font file '%s' not found", font ? font : "");
+        return;
+    }
+    sdl_font_outline out;
+    char why[256] = "";
+    pt_status st = sdl_font_text(path, str, offset, &out, why, sizeof why);
+    free(path);
+    if (st != PT_OK) {
+        sdl_error(p, loc, st, "text: font '%s': %s", font, why);
+        return;
+    }
+    scene_text *tx = sdl_alloc(p, sizeof *tx);
+    if (!tx) {
+        free(out.segments);
+        return;
+    }
+    tx->nsegments = out.nsegments;
+    tx->segments = out.nsegments ? arena_memdup(p->s->mem, out.segments, sizeof *out.segments * (size_t)out.nsegments) : NULL;
+    tx->depth = depth;
+    free(out.segments);
+    o->kind = SHAPE_TEXT;
+    o->u.text = tx;
+    o->transform = xform_then(o->transform, xform_rotate(v3(0.001, 0.001, 0.001)));
+}
+
+/* ------------------------------------------------------------ sphere_sweep */
+
+static scene_object *kid(sdl_parser *p, shape_kind k, const char *name, src_loc loc)
+{
+    scene_object *o = scene_new_object(p->s, k, loc);
+    if (!o) sdl_error(p, loc, PT_ERR_NOMEM, "out of memory");
+    else o->name = name;
+    return o;
+}
+
+/* The sweep of one sphere to another: a truncated cone tangent to both
+ * (the envelope of the linearly moving sphere), open at both ends, or
+ * nothing when one sphere contains the other. */
+static scene_object *tangent_cone(sdl_parser *p, vec3 c1, double r1, vec3 c2, double r2, src_loc loc)
+{
+    vec3 ax = v3_sub(c2, c1);
+    double d = v3_len(ax);
+    if (!(d > fabs(r1 - r2)) || d <= 0.0) return NULL;
+    vec3 u = v3_scale(ax, 1.0 / d);
+    double s = (r1 - r2) / d, c = sqrt(fmax(0.0, 1.0 - s * s));
+    scene_object *o = kid(p, SHAPE_CONE, "sphere_sweep", loc);
+    if (!o) return NULL;
+    o->u.cone.base = v3_madd(c1, u, r1 * s);
+    o->u.cone.cap = v3_madd(c2, u, r2 * s);
+    o->u.cone.base_radius = r1 * c;
+    o->u.cone.cap_radius = r2 * c;
+    o->flags |= OBJ_OPEN;
+    return o;
+}
+
+/* Point i of the sweep's spline segment: centre and radius at t in [0,1]
+ * from 4 control spheres (Catmull-Rom for cubic_spline, uniform cubic
+ * B-spline for b_spline). */
+static void sweep_eval(int bspline, const vec3 *c, const double *r, double t, vec3 *pc, double *pr)
+{
+    double w[4];
+    double t2 = t * t, t3 = t2 * t;
+    if (bspline) {
+        w[0] = (1 - t) * (1 - t) * (1 - t) / 6.0;
+        w[1] = (3 * t3 - 6 * t2 + 4) / 6.0;
+        w[2] = (-3 * t3 + 3 * t2 + 3 * t + 1) / 6.0;
+        w[3] = t3 / 6.0;
+    } else {
+        w[0] = 0.5 * (-t3 + 2 * t2 - t);
+        w[1] = 0.5 * (3 * t3 - 5 * t2 + 2);
+        w[2] = 0.5 * (-3 * t3 + 4 * t2 + t);
+        w[3] = 0.5 * (t3 - t2);
+    }
+    vec3 s = v3s(0.0);
+    double rr = 0.0;
+    for (int i = 0; i < 4; i++) {
+        s = v3_madd(s, c[i], w[i]);
+        rr += r[i] * w[i];
+    }
+    *pc = s;
+    *pr = rr;
+}
+
+#define SWEEP_PIECES 16 /* linear pieces per spline segment */
+
+/* sphere_sweep := ( linear_spline | cubic_spline | b_spline ) [','] n ','
+ *   centre ',' radius { [','] centre ',' radius } [ tolerance float ]
+ * -> union of spheres and tangent cones. */
+static void sphere_sweep_args(sdl_parser *p, sdl_obj *so, src_loc loc)
+{
+    scene_object *o = so->obj;
+    int kind = -1; /* 0 linear, 1 Catmull-Rom, 2 B-spline */
+    if (sdl_accept_kw(p, KW_LINEAR_SPLINE)) kind = 0;
+    else if (sdl_accept_kw(p, KW_CUBIC_SPLINE)) kind = 1;
+    else if (sdl_accept_kw(p, KW_B_SPLINE)) kind = 2;
+    else {
+        sdl_tok t = sdl_next(p);
+        sdl_unexpected(p, &t, "linear_spline, cubic_spline or b_spline");
+        return;
+    }
+    sdl_accept(p, TOK_COMMA);
+    int n = parse_count(p, "sphere_sweep", kind ? 4 : 2, 1 << 20);
+    if (n < 0) return;
+    sdl_accept(p, TOK_COMMA);
+    vec3 *c = malloc(sizeof *c * (size_t)n);
+    double *r = malloc(sizeof *r * (size_t)n);
+    if (!c || !r) {
+        free(c);
+        free(r);
+        sdl_error(p, loc, PT_ERR_NOMEM, "out of memory");
+        return;
+    }
+    for (int i = 0; i < n && sdl_ok(p); i++) {
+        c[i] = sdl_vector(p);
+        sdl_accept(p, TOK_COMMA);
+        r[i] = fabs(sdl_float(p));
+        sdl_accept(p, TOK_COMMA);
+    }
+    if (sdl_accept_kw(p, KW_TOLERANCE)) sdl_float(p);
+    /* centres and radii along the sweep */
+    int npts = kind == 0 ? n : (n - 3) * SWEEP_PIECES + 1;
+    vec3 *pc = malloc(sizeof *pc * (size_t)npts);
+    double *pr = malloc(sizeof *pr * (size_t)npts);
+    scene_object **kids = malloc(sizeof *kids * (size_t)(2 * npts));
+    int nk = 0;
+    if (!pc || !pr || !kids) {
+        sdl_error(p, loc, PT_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    if (!sdl_ok(p)) goto done;
+    if (kind == 0) {
+        memcpy(pc, c, sizeof *pc * (size_t)n);
+        memcpy(pr, r, sizeof *pr * (size_t)n);
+    } else {
+        for (int s = 0; s < n - 3; s++)
+            for (int k = 0; k < SWEEP_PIECES; k++)
+                sweep_eval(kind == 2, c + s, r + s, (double)k / SWEEP_PIECES, &pc[s * SWEEP_PIECES + k], &pr[s * SWEEP_PIECES + k]);
+        sweep_eval(kind == 2, c + n - 4, r + n - 4, 1.0, &pc[npts - 1], &pr[npts - 1]);
+    }
+    for (int i = 0; i < npts && sdl_ok(p); i++) {
+        if (pr[i] > 0.0) {
+            scene_object *s = kid(p, SHAPE_SPHERE, "sphere_sweep", loc);
+            if (!s) break;
+            s->u.sphere.centre = pc[i];
+            s->u.sphere.radius = pr[i];
+            kids[nk++] = s;
+        }
+        if (i + 1 < npts) {
+            scene_object *cn = tangent_cone(p, pc[i], pr[i], pc[i + 1], pr[i + 1], loc);
+            if (cn) kids[nk++] = cn;
+        }
+    }
+    o->kind = SHAPE_UNION;
+    o->u.csg.nkids = nk;
+    o->u.csg.kids = nk ? arena_memdup(p->s->mem, kids, sizeof *kids * (size_t)nk) : NULL;
+done:
+    free(c);
+    free(r);
+    free(pc);
+    free(pr);
+    free(kids);
+}
+
+/* ------------------------------------------------------------ bicubic_patch */
+
+static void bernstein(double t, double b[4], double db[4])
+{
+    double s = 1.0 - t;
+    b[0] = s * s * s;
+    b[1] = 3 * t * s * s;
+    b[2] = 3 * t * t * s;
+    b[3] = t * t * t;
+    db[0] = -3 * s * s;
+    db[1] = 3 * s * s - 6 * t * s;
+    db[2] = 6 * t * s - 3 * t * t;
+    db[3] = 3 * t * t;
+}
+
+/* bicubic_patch := { type n | flatness f | u_steps n | v_steps n | accuracy a |
+ *   uv_vectors uv ',' uv ',' uv ',' uv } 16 points
+ * -> a smooth mesh of 2^u_steps x 2^v_steps quads (at least 4 x 4), vertex
+ * normals from the patch's derivatives. */
+static void bicubic_args(sdl_parser *p, sdl_obj *so, src_loc loc)
+{
+    scene_object *o = so->obj;
+    int us = 3, vs = 3;
+    while (sdl_ok(p)) {
+        if (sdl_accept_kw(p, KW_TYPE)) sdl_float(p);
+        else if (sdl_accept_kw(p, KW_FLATNESS)) sdl_float(p);
+        else if (sdl_accept_kw(p, KW_U_STEPS)) us = (int)sdl_float(p);
+        else if (sdl_accept_kw(p, KW_V_STEPS)) vs = (int)sdl_float(p);
+        else if (sdl_accept_kw(p, KW_ACCURACY)) sdl_float(p);
+        else if (sdl_accept_kw(p, KW_UV_VECTORS)) {
+            double uv[2];
+            for (int i = 0; i < 4; i++) {
+                if (i) sdl_accept(p, TOK_COMMA);
+                sdl_vector_n(p, uv, 2);
+            }
+        } else break;
+    }
+    sdl_accept(p, TOK_COMMA);
+    vec3 cp[4][4];
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            cp[i][j] = sdl_vector(p);
+            sdl_accept(p, TOK_COMMA);
+        }
+    if (!sdl_ok(p)) return;
+    us = us < 0 ? 0 : (us > 8 ? 8 : us);
+    vs = vs < 0 ? 0 : (vs > 8 ? 8 : vs);
+    int nu = 1 << us, nv = 1 << vs;
+    if (nu < 4) nu = 4;
+    if (nv < 4) nv = 4;
+    scene_mesh *m = scene_new_mesh(p->s);
+    int nvert = (nu + 1) * (nv + 1);
+    if (!m) {
+        sdl_error(p, loc, PT_ERR_NOMEM, "out of memory");
+        return;
+    }
+    m->loc = loc;
+    m->nverts = m->nnormals = nvert;
+    m->ntris = 2 * nu * nv;
+    m->verts = alloc_n(p, (size_t)nvert, sizeof *m->verts);
+    m->normals = alloc_n(p, (size_t)nvert, sizeof *m->normals);
+    m->tris = alloc_n(p, (size_t)m->ntris, sizeof *m->tris);
+    if (!m->verts || !m->normals || !m->tris) return;
+    for (int a = 0; a <= nv; a++) {
+        double bv[4], dbv[4];
+        bernstein((double)a / nv, bv, dbv);
+        for (int b = 0; b <= nu; b++) {
+            double bu[4], dbu[4];
+            bernstein((double)b / nu, bu, dbu);
+            vec3 pt = v3s(0), du = v3s(0), dv = v3s(0);
+            for (int i = 0; i < 4; i++)
+                for (int j = 0; j < 4; j++) {
+                    pt = v3_madd(pt, cp[i][j], bv[i] * bu[j]);
+                    du = v3_madd(du, cp[i][j], bv[i] * dbu[j]);
+                    dv = v3_madd(dv, cp[i][j], dbv[i] * bu[j]);
+                }
+            vec3 nrm = v3_cross(du, dv);
+            if (!(v3_len2(nrm) > 0.0)) {
+                /* degenerate edge (a collapsed row): use the neighbouring cell's diagonal */
+                vec3 e1 = v3_sub(cp[3][3], cp[0][0]), e2 = v3_sub(cp[3][0], cp[0][3]);
+                nrm = v3_cross(e1, e2);
+            }
+            int k = a * (nu + 1) + b;
+            m->verts[k][0] = (float)pt.x;
+            m->verts[k][1] = (float)pt.y;
+            m->verts[k][2] = (float)pt.z;
+            vec3 un = v3_norm(nrm);
+            m->normals[k][0] = (float)un.x;
+            m->normals[k][1] = (float)un.y;
+            m->normals[k][2] = (float)un.z;
+        }
+    }
+    int t = 0;
+    for (int a = 0; a < nv; a++)
+        for (int b = 0; b < nu; b++) {
+            int v00 = a * (nu + 1) + b, v01 = v00 + 1, v10 = v00 + nu + 1, v11 = v10 + 1;
+            m->tris[t][0] = v00; m->tris[t][1] = v01; m->tris[t][2] = v11; t++;
+            m->tris[t][0] = v00; m->tris[t][1] = v11; m->tris[t][2] = v10; t++;
+        }
+    m->tri_normals = NULL; /* normals indexed like the vertices */
+    o->kind = SHAPE_MESH;
+    o->u.mesh.mesh = m;
+}
+
+/* ------------------------------------------------------------ dispatch */
+
+void sdl_shape_args(sdl_parser *p, sdl_kw k, sdl_obj *so, src_loc loc)
+{
+    scene_object *o = so->obj;
+    switch (k) {
+    case KW_POLYGON: polygon_args(p, o, loc); break;
+    case KW_LATHE: lathe_args(p, o); break;
+    case KW_SOR: sor_args(p, o); break;
+    case KW_PRISM: prism_args(p, o, loc); break;
+    case KW_SUPERELLIPSOID: superellipsoid_args(p, o, loc); break;
+    case KW_QUADRIC: quadric_args(p, o); break;
+    case KW_POLY: poly_args(p, o, 0); break;
+    case KW_CUBIC: poly_args(p, o, 3); break;
+    case KW_QUARTIC: poly_args(p, o, 4); break;
+    case KW_POLYNOMIAL: polynomial_args(p, o); break;
+    case KW_BLOB: blob_args(p, o, loc); break;
+    case KW_HEIGHT_FIELD: height_field_args(p, o, loc); break;
+    case KW_TEXT: text_args(p, o, loc); break;
+    case KW_SPHERE_SWEEP: sphere_sweep_args(p, so, loc); break;
+    case KW_BICUBIC_PATCH: bicubic_args(p, so, loc); break;
+    default: break;
+    }
+    /* anything that did not produce a shape stays reported as unsupported */
+    if (o->kind == SHAPE_UNSUPPORTED && !o->name) o->name = sdl_kw_text(k);
+}
+
+/* ------------------------------------------------------------ clipped_by, bounded_by */
+
+/* Make every node of a clip tree relative to the host's space (see
+ * scene_object.clip). */
+static void relativize(scene_object *c, const xform *host_inv, int depth)
+{
+    if (!c || depth > 1000) return;
+    c->transform = xform_then(c->transform, *host_inv);
+    if (c->kind == SHAPE_UNION || c->kind == SHAPE_MERGE || c->kind == SHAPE_INTERSECTION || c->kind == SHAPE_DIFFERENCE)
+        for (int i = 0; i < c->u.csg.nkids; i++) relativize(c->u.csg.kids[i], host_inv, depth + 1);
+}
+
+/* Add `c` (world transforms) to the host's clip: several clip objects
+ * intersect, as in POV-Ray. */
+static void add_clip(sdl_parser *p, scene_object *host, scene_object *c)
+{
+    if (!c) return;
+    xform inv = xform_inverse(host->transform);
+    relativize(c, &inv, 0);
+    if (!host->clip) {
+        host->clip = c;
+        return;
+    }
+    scene_object *both = scene_new_object(p->s, SHAPE_INTERSECTION, c->loc);
+    scene_object **k = sdl_alloc(p, 2 * sizeof *k);
+    if (!both || !k) return;
+    both->name = "clipped_by";
+    /* identity in host space */
+    k[0] = (scene_object *)host->clip;
+    k[1] = c;
+    both->u.csg.kids = k;
+    both->u.csg.nkids = 2;
+    host->clip = both;
+}
+
+/* objects := { object_statement } '}' -> one object (an intersection when
+ * several) with world transforms, or NULL */
+static scene_object *clip_objects(sdl_parser *p, src_loc loc)
+{
+    scene_object *acc = NULL;
+    while (sdl_ok(p) && sdl_starts_object(sdl_peek(p))) {
+        sdl_obj *k = sdl_parse_object(p);
+        if (!k || !k->obj) continue;
+        if (!acc) {
+            acc = k->obj;
+            continue;
+        }
+        scene_object *both = scene_new_object(p->s, SHAPE_INTERSECTION, loc);
+        scene_object **kids = sdl_alloc(p, 2 * sizeof *kids);
+        if (!both || !kids) return acc;
+        both->name = "clipped_by";
+        kids[0] = acc;
+        kids[1] = k->obj;
+        both->u.csg.kids = kids;
+        both->u.csg.nkids = 2;
+        acc = both;
+    }
+    return acc;
+}
+
+static scene_object *copy_tree(sdl_parser *p, const scene_object *o, int depth)
+{
+    if (!o || depth > 1000) return NULL;
+    scene_object *c = sdl_alloc(p, sizeof *c);
+    if (!c) return NULL;
+    *c = *o;
+    if (o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE) {
+        c->u.csg.kids = o->u.csg.nkids ? sdl_alloc(p, sizeof *c->u.csg.kids * (size_t)o->u.csg.nkids) : NULL;
+        for (int i = 0; i < o->u.csg.nkids && c->u.csg.kids; i++) c->u.csg.kids[i] = copy_tree(p, o->u.csg.kids[i], depth + 1);
+    }
+    return c;
+}
+
+/* The last bounded_by seen per thread (for `clipped_by { bounded_by }`). */
+static _Thread_local const scene_object *last_bound_host;
+static _Thread_local scene_object *last_bound;
+
+static int is_unbounded_kind(shape_kind k) { return k == SHAPE_QUADRIC || k == SHAPE_POLY; }
+
+/* clipped_by := '{' ( objects | bounded_by ) '}' */
+void sdl_shape_clipped_by(sdl_parser *p, sdl_obj *so)
+{
+    src_loc loc = p->last_loc;
+    if (!sdl_begin_block(p, "clipped_by")) return;
+    scene_object *host = so ? so->obj : NULL;
+    if (sdl_accept_kw(p, KW_BOUNDED_BY)) {
+        if (host && last_bound_host == host && last_bound) {
+            /* the bounding objects, already relative to the host */
+            scene_object *c = copy_tree(p, last_bound, 0);
+            xform fwd = host->transform;
+            relativize(c, &fwd, 0); /* back to world, add_clip makes it relative again */
+            add_clip(p, host, c);
+        }
+        sdl_end_block(p);
+        return;
+    }
+    scene_object *c = clip_objects(p, loc);
+    sdl_end_block(p);
+    if (host && c && sdl_ok(p)) add_clip(p, host, c);
+}
+
+/* bounded_by := '{' ( objects | clipped_by ) '}'
+ * Bounds are a speed hint in POV-Ray; we intersect exactly and need none,
+ * except for the unbounded quadric and poly shapes, which POV-Ray examples
+ * limit with bounded_by: there the bound clips. */
+void sdl_shape_bounded_by(sdl_parser *p, sdl_obj *so)
+{
+    src_loc loc = p->last_loc;
+    if (!sdl_begin_block(p, "bounded_by")) return;
+    scene_object *host = so ? so->obj : NULL;
+    if (sdl_accept_kw(p, KW_CLIPPED_BY)) {
+        sdl_end_block(p);
+        return;
+    }
+    scene_object *c = clip_objects(p, loc);
+    sdl_end_block(p);
+    if (!host || !c || !sdl_ok(p)) return;
+    xform inv = xform_inverse(host->transform);
+    scene_object *rel = copy_tree(p, c, 0);
+    relativize(rel, &inv, 0);
+    last_bound_host = host;
+    last_bound = rel;
+    if (is_unbounded_kind(host->kind)) add_clip(p, host, c);
+}
