@@ -16,6 +16,14 @@ typedef struct {
     long max_loop_iterations;     /* per #while/#for loop, 0 = default (10,000,000) */
     int max_include_depth;        /* 0 = default (64) */
     int max_macro_depth;          /* 0 = default (256) */
+    /* Work and memory limits (0 = default); hitting one is a located
+     * PT_ERR_LIMIT error. */
+    long long max_tokens;         /* tokens read in all, loop repeats, macro bodies and
+                                     skipped branches included (default 10^10) */
+    long long max_memory;         /* bytes the scene may take while parsing, meshes being
+                                     built included (default: half the physical memory) */
+    long max_string_length;       /* bytes in one string value (default 1 MiB) */
+    long long max_array_elements; /* elements in one array (default 10^8) */
 } sdl_options;
 
 void sdl_default_options(sdl_options *o);

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "sdl_directive.h"
 #include "sdl_expr.h"
 #include "sdl_scene.h"
@@ -195,12 +196,36 @@ void sdl_skip_item(sdl_parser *p)
 
 /* ------------------------------------------------------------ memory */
 
+/* "1.5 GiB", "12 MiB", "300 bytes" */
+static const char *bytes_text(double b, char *buf, size_t cap)
+{
+    if (b >= 1024.0 * 1024 * 1024) snprintf(buf, cap, "%.1f GiB", b / (1024.0 * 1024 * 1024));
+    else if (b >= 1024.0 * 1024) snprintf(buf, cap, "%.0f MiB", b / (1024.0 * 1024));
+    else snprintf(buf, cap, "%.0f bytes", b);
+    return buf;
+}
+
+int sdl_memory_ok(sdl_parser *p, size_t extra, src_loc loc, const char *what)
+{
+    double need = (double)arena_bytes(p->s->mem) + (double)p->build_bytes + (double)extra;
+    if (need <= (double)p->opt.max_memory) return 1;
+    char a[32], b[32];
+    sdl_error(p, loc, PT_ERR_LIMIT, "%s needs %s, more than the parser's memory limit of %s (--max-memory)", what,
+              bytes_text(need, a, sizeof a), bytes_text((double)p->opt.max_memory, b, sizeof b));
+    return 0;
+}
+
+int sdl_count_token(sdl_parser *p, src_loc loc)
+{
+    if (++p->ntokens <= p->opt.max_tokens) return 1;
+    sdl_error(p, loc, PT_ERR_LIMIT, "scene reads more than %lld tokens, loop repeats and macro calls included (--max-tokens)",
+              p->opt.max_tokens);
+    return 0;
+}
+
 void *sdl_alloc(sdl_parser *p, size_t n)
 {
-    if (arena_bytes(p->s->mem) + n > SDL_MAX_SCENE_BYTES) {
-        if (sdl_ok(p)) sdl_error(p, p->last_loc, PT_ERR_LIMIT, "scene needs more than %d GiB", (int)(SDL_MAX_SCENE_BYTES >> 30));
-        return NULL;
-    }
+    if (!sdl_memory_ok(p, n, p->last_loc, "the scene")) return NULL;
     void *m = arena_alloc(p->s->mem, n ? n : 1);
     if (!m && sdl_ok(p)) {
         src_loc none = {NULL, 0, 0};
@@ -228,6 +253,13 @@ void sdl_default_options(sdl_options *o)
     o->max_loop_iterations = 10000000;
     o->max_include_depth = 64;
     o->max_macro_depth = 256;
+    o->max_tokens = 10000000000LL;
+    o->max_string_length = 1L << 20;
+    o->max_array_elements = 100000000LL;
+    /* half the physical memory: the rest is for the acceleration structure
+     * and the framebuffer */
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    o->max_memory = pages > 0 && page > 0 ? (long long)pages * page / 2 : 4LL << 30;
 }
 
 static void declare_float(sdl_parser *p, const char *name, double v)
@@ -289,6 +321,10 @@ static void set_options(sdl_parser *p, const sdl_options *opt)
     if (p->opt.max_loop_iterations <= 0) p->opt.max_loop_iterations = def.max_loop_iterations;
     if (p->opt.max_include_depth <= 0) p->opt.max_include_depth = def.max_include_depth;
     if (p->opt.max_macro_depth <= 0) p->opt.max_macro_depth = def.max_macro_depth;
+    if (p->opt.max_tokens <= 0) p->opt.max_tokens = def.max_tokens;
+    if (p->opt.max_memory <= 0) p->opt.max_memory = def.max_memory;
+    if (p->opt.max_string_length <= 0) p->opt.max_string_length = def.max_string_length;
+    if (p->opt.max_array_elements <= 0) p->opt.max_array_elements = def.max_array_elements;
 }
 
 static pt_status run(const char *name, const char *text, const sdl_options *opt, scene **out, diag *d)

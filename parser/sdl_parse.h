@@ -15,7 +15,6 @@
 /* Limits that keep bad input from exhausting the stack or memory. */
 #define SDL_MAX_NESTING 1000                 /* nested blocks, nested expressions */
 #define SDL_MAX_CONDITIONALS 100000          /* open #if/#while/... and macro calls */
-#define SDL_MAX_SCENE_BYTES ((size_t)4 << 30) /* scene arena */
 
 /* A token as the grammar sees it: identifiers carry their value as it was
  * when the token was read (VAL_NONE: undeclared). */
@@ -116,6 +115,9 @@ typedef struct sdl_parser {
     double version;       /* language version from #version, 3.7 by default */
     int default_texture_set;
     src_loc last_loc;     /* last token returned (for end-of-file locations) */
+    long long ntokens;    /* tokens read so far (opt.max_tokens) */
+    size_t build_bytes;   /* malloc'd work memory outside the arena (meshes being
+                             built), counted against opt.max_memory */
 } sdl_parser;
 
 /* --- recursion guard: 0 (with an error recorded) when nested too deep --- */
@@ -167,6 +169,11 @@ void sdl_skip_item(sdl_parser *p);
 
 /* --- memory --- */
 void *sdl_alloc(sdl_parser *p, size_t n);
+/* Room for `extra` more bytes of work memory within opt.max_memory? If not,
+ * a located limit error naming `what` is recorded and 0 returned. */
+int sdl_memory_ok(sdl_parser *p, size_t extra, src_loc loc, const char *what);
+/* Count one token read (opt.max_tokens); 0 with an error when over. */
+int sdl_count_token(sdl_parser *p, src_loc loc);
 char *sdl_strndup(sdl_parser *p, const char *s, size_t n);
 
 #endif
