@@ -1,5 +1,6 @@
 /* sdl_object.c - shapes, CSG, meshes, object modifiers. */
 #include "sdl_object.h"
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "sdl_directive.h"
@@ -437,6 +438,8 @@ typedef struct {
     const scene_texture **tex;
     int ntex, captex;
     int any_normals, any_tex;
+    sdl_parser *p;   /* work memory is counted in p->build_bytes */
+    size_t bytes;    /* this mesh's share of it */
 } mesh_build;
 
 static int grow(void **arr, int *cap, int need, size_t elem)
@@ -451,8 +454,27 @@ static int grow(void **arr, int *cap, int need, size_t elem)
     return 1;
 }
 
+/* grow() for a mesh's work arrays, within the parser's memory limit. */
+static int mesh_grow(mesh_build *b, void **arr, int *cap, int need, size_t elem)
+{
+    if (need <= *cap) return 1;
+    if (need > (1 << 28)) {
+        sdl_error(b->p, b->p->last_loc, PT_ERR_LIMIT, "mesh has more than %d entries in one list", 1 << 28);
+        return 0;
+    }
+    int old = *cap;
+    size_t more = elem * (size_t)((old ? old * 2 : 64) < need ? need : (old ? old * 2 : 64));
+    if (!sdl_memory_ok(b->p, more, b->p->last_loc, "the mesh")) return 0;
+    if (!grow(arr, cap, need, elem)) return 0;
+    more = elem * (size_t)(*cap - old);
+    b->bytes += more;
+    b->p->build_bytes += more;
+    return 1;
+}
+
 static void mesh_build_free(mesh_build *b)
 {
+    b->p->build_bytes -= b->bytes;
     free(b->v);
     free(b->n);
     free(b->uv);
@@ -462,9 +484,9 @@ static void mesh_build_free(mesh_build *b)
     free(b->tex);
 }
 
-static int add_vec(sdl_parser *p, float (**arr)[3], int *n, int *cap, vec3 v)
+static int add_vec(sdl_parser *p, mesh_build *b, float (**arr)[3], int *n, int *cap, vec3 v)
 {
-    if (!grow((void **)arr, cap, *n + 1, sizeof **arr)) {
+    if (!mesh_grow(b, (void **)arr, cap, *n + 1, sizeof **arr)) {
         src_loc none = {NULL, 0, 0};
         sdl_error(p, none, PT_ERR_NOMEM, "out of memory");
         return -1;
@@ -480,7 +502,7 @@ static int mesh_texture_index(mesh_build *b, const scene_texture *t)
 {
     for (int i = 0; i < b->ntex; i++)
         if (b->tex[i] == t) return i;
-    if (!grow((void **)&b->tex, &b->captex, b->ntex + 1, sizeof *b->tex)) return -1;
+    if (!mesh_grow(b, (void **)&b->tex, &b->captex, b->ntex + 1, sizeof *b->tex)) return -1;
     b->tex[b->ntex] = t;
     return b->ntex++;
 }
@@ -490,6 +512,12 @@ static int reserve_tri(mesh_build *b)
 {
     if (b->nt < b->capt) return 1;
     int nc = b->capt ? b->capt * 2 : 64;
+    size_t more = (sizeof *b->tri + sizeof *b->trin + sizeof *b->trit) * (size_t)(nc - b->capt);
+    if (nc > (1 << 28)) {
+        sdl_error(b->p, b->p->last_loc, PT_ERR_LIMIT, "mesh has more than %d triangles", 1 << 28);
+        return 0;
+    }
+    if (!sdl_memory_ok(b->p, more, b->p->last_loc, "the mesh")) return 0;
     int (*tri)[3] = realloc(b->tri, sizeof *tri * (size_t)nc);
     if (tri) b->tri = tri;
     int (*trin)[3] = tri ? realloc(b->trin, sizeof *trin * (size_t)nc) : NULL;
@@ -498,6 +526,8 @@ static int reserve_tri(mesh_build *b)
     if (trit) b->trit = trit;
     if (!trit) return 0;
     b->capt = nc;
+    b->bytes += more;
+    b->p->build_bytes += more;
     return 1;
 }
 
@@ -543,9 +573,9 @@ static void mesh_triangle(sdl_parser *p, mesh_build *b, int smooth)
     sdl_end_block(p);
     if (!sdl_ok(p)) return;
     int vi[3], ni[3];
-    for (int i = 0; i < 3; i++) vi[i] = add_vec(p, &b->v, &b->nv, &b->capv, v[i]);
+    for (int i = 0; i < 3; i++) vi[i] = add_vec(p, b, &b->v, &b->nv, &b->capv, v[i]);
     if (!smooth) n[0] = n[1] = n[2] = v3_cross(v3_sub(v[1], v[0]), v3_sub(v[2], v[0]));
-    for (int i = 0; i < 3; i++) ni[i] = add_vec(p, &b->n, &b->nn, &b->capn, n[i]);
+    for (int i = 0; i < 3; i++) ni[i] = add_vec(p, b, &b->n, &b->nn, &b->capn, n[i]);
     if (smooth) b->any_normals = 1;
     if (sdl_ok(p)) add_tri(p, b, vi, ni, tex);
 }
@@ -591,6 +621,7 @@ static void mesh_body(sdl_parser *p, sdl_obj *so, src_loc loc)
 {
     mesh_build b;
     memset(&b, 0, sizeof b);
+    b.p = p;
     for (;;) {
         if (!sdl_ok(p)) break;
         if (sdl_accept_kw(p, KW_TRIANGLE)) mesh_triangle(p, &b, 0);
@@ -603,22 +634,45 @@ static void mesh_body(sdl_parser *p, sdl_obj *so, src_loc loc)
     mesh_build_free(&b);
 }
 
+/* The count that opens a mesh2 list: a whole number of entries that fits
+ * the parser's memory limit (checked before any entry is read, so a huge
+ * declared mesh fails at once with a clear message). */
+static int list_count(sdl_parser *p, const char *name, size_t entry_bytes)
+{
+    src_loc at = sdl_peek(p)->tk.loc;
+    double c = sdl_float(p);
+    if (!sdl_ok(p)) return 0;
+    if (!(c >= 0)) {
+        sdl_error(p, at, PT_ERR_SYNTAX, "%s: count %g is not a number of entries", name, c);
+        return 0;
+    }
+    double bytes = (c < 1e15 ? c : 1e15) * (double)entry_bytes;
+    char what[96];
+    snprintf(what, sizeof what, "%s with %.0f entries", name, c < 1e15 ? c : 1e15);
+    if (!sdl_memory_ok(p, (size_t)bytes, at, what)) return 0;
+    if (c > (1 << 28)) {
+        sdl_error(p, at, PT_ERR_LIMIT, "%s: %.0f entries, more than a mesh may have (%d)", name, c, 1 << 28);
+        return 0;
+    }
+    return (int)c;
+}
+
 /* count_list := '{' count [','] item { [','] item } '}' for vertex_vectors,
  * normal_vectors, uv_vectors: vectors with `dim` terms */
 static void vector_list(sdl_parser *p, const char *name, int dim, mesh_build *b, int which)
 {
     if (!sdl_begin_block(p, name)) return;
     src_loc loc = sdl_peek(p)->tk.loc;
-    int count = (int)sdl_float(p);
+    int count = list_count(p, name, dim == 2 ? sizeof *b->uv : sizeof *b->v);
     int got = 0;
     while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
         sdl_accept(p, TOK_COMMA);
         if (sdl_is(sdl_peek(p), TOK_RBRACE)) break;
         double v[3] = {0, 0, 0};
         sdl_vector_n(p, v, dim);
-        if (which == 0) add_vec(p, &b->v, &b->nv, &b->capv, v3(v[0], v[1], v[2]));
-        else if (which == 1) add_vec(p, &b->n, &b->nn, &b->capn, v3(v[0], v[1], v[2]));
-        else if (grow((void **)&b->uv, &b->capuv, b->nuv + 1, sizeof *b->uv)) {
+        if (which == 0) add_vec(p, b, &b->v, &b->nv, &b->capv, v3(v[0], v[1], v[2]));
+        else if (which == 1) add_vec(p, b, &b->n, &b->nn, &b->capn, v3(v[0], v[1], v[2]));
+        else if (mesh_grow(b, (void **)&b->uv, &b->capuv, b->nuv + 1, sizeof *b->uv)) {
             b->uv[b->nuv][0] = (float)v[0];
             b->uv[b->nuv][1] = (float)v[1];
             b->nuv++;
@@ -634,7 +688,7 @@ static void texture_list(sdl_parser *p, mesh_build *b)
 {
     if (!sdl_begin_block(p, "texture_list")) return;
     src_loc loc = sdl_peek(p)->tk.loc;
-    int count = (int)sdl_float(p);
+    int count = list_count(p, "texture_list", sizeof *b->tex);
     while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
         sdl_accept(p, TOK_COMMA);
         if (!sdl_accept_kw(p, KW_TEXTURE)) {
@@ -643,7 +697,7 @@ static void texture_list(sdl_parser *p, mesh_build *b)
             return;
         }
         scene_texture *t = sdl_parse_texture(p);
-        if (grow((void **)&b->tex, &b->captex, b->ntex + 1, sizeof *b->tex)) b->tex[b->ntex++] = t;
+        if (mesh_grow(b, (void **)&b->tex, &b->captex, b->ntex + 1, sizeof *b->tex)) b->tex[b->ntex++] = t;
     }
     sdl_end_block(p);
     if (sdl_ok(p) && b->ntex != count) sdl_error(p, loc, PT_ERR_SYNTAX, "texture_list: %d entries declared but %d given", count, b->ntex);
@@ -661,7 +715,7 @@ static void face_indices(sdl_parser *p, mesh_build *b)
 {
     if (!sdl_begin_block(p, "face_indices")) return;
     src_loc loc = sdl_peek(p)->tk.loc;
-    int count = (int)sdl_float(p);
+    int count = list_count(p, "face_indices", sizeof *b->tri + sizeof *b->trin + sizeof *b->trit);
     while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
         sdl_accept(p, TOK_COMMA);
         if (sdl_is(sdl_peek(p), TOK_RBRACE)) break;
@@ -694,7 +748,7 @@ static void index_list(sdl_parser *p, mesh_build *b, int normals)
     const char *name = normals ? "normal_indices" : "uv_indices";
     if (!sdl_begin_block(p, name)) return;
     src_loc loc = sdl_peek(p)->tk.loc;
-    int count = (int)sdl_float(p), got = 0;
+    int count = list_count(p, name, sizeof *b->trin), got = 0;
     while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
         sdl_accept(p, TOK_COMMA);
         if (sdl_is(sdl_peek(p), TOK_RBRACE)) break;
@@ -719,6 +773,7 @@ static void mesh2_body(sdl_parser *p, sdl_obj *so, src_loc loc)
 {
     mesh_build b;
     memset(&b, 0, sizeof b);
+    b.p = p;
     while (sdl_ok(p)) {
         if (sdl_accept_kw(p, KW_VERTEX_VECTORS)) vector_list(p, "vertex_vectors", 3, &b, 0);
         else if (sdl_accept_kw(p, KW_NORMAL_VECTORS)) vector_list(p, "normal_vectors", 3, &b, 1);
