@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include "sdl_expr.h"
 #include "sdl_material.h"
 #include "sdl_object.h"
@@ -18,16 +19,31 @@ static void directive(sdl_parser *p, const sdl_token *hash);
 
 /* ------------------------------------------------------------ sources */
 
-static char *read_file(const char *path, size_t *len)
+/* The whole file, or NULL with errno set. Only regular files when
+ * `regular_only` (an #include of /dev/zero or a FIFO must not hang the
+ * parse); never more than `max` bytes (EFBIG). */
+static char *read_file(const char *path, int regular_only, size_t max, size_t *len)
 {
     FILE *f = fopen(path, "rb");
     if (!f) return NULL;
+    struct stat st;
+    if (fstat(fileno(f), &st) != 0 || (regular_only && !S_ISREG(st.st_mode))) {
+        fclose(f);
+        errno = EINVAL;
+        return NULL;
+    }
     size_t cap = 1 << 16, n = 0;
     char *buf = malloc(cap);
     while (buf) {
         size_t got = fread(buf + n, 1, cap - n, f);
         n += got;
         if (n < cap) break;
+        if (cap > max) {
+            free(buf);
+            fclose(f);
+            errno = EFBIG;
+            return NULL;
+        }
         char *nb = realloc(buf, cap * 2);
         if (!nb) {
             free(buf);
@@ -180,7 +196,7 @@ pt_status sdl_open_main(sdl_parser *p, const char *path, const char *text)
         buf = malloc(len + 1);
         if (buf) memcpy(buf, text, len + 1);
     } else {
-        buf = read_file(path, &len);
+        buf = read_file(path, 0, (size_t)p->opt.max_memory, &len);
         if (!buf) {
             src_loc at = {path, 0, 0};
             sdl_error(p, at, PT_ERR_IO, "cannot read scene file: %s", strerror(errno ? errno : ENOENT));
@@ -284,6 +300,7 @@ static sdl_kw skip_tokens(sdl_parser *p, skip_mode mode, int depth, const char *
     sdl_scanner *sc = &top_frame(p)->sc;
     for (;;) {
         sdl_token t = sdl_scan_next(sc);
+        if (!sdl_count_token(p, t.loc)) return KW_END;
         if (t.kind == TOK_EOF) {
             unterminated_cond(p, t.loc, what, opened);
             return KW_END;
@@ -815,9 +832,10 @@ static void include_directive(sdl_parser *p, src_loc loc)
         return;
     }
     size_t len = 0;
-    char *text = read_file(path, &len);
+    char *text = read_file(path, 1, (size_t)p->opt.max_memory, &len);
     if (!text) {
-        sdl_error(p, loc, PT_ERR_IO, "cannot read include file \"%s\"", path);
+        sdl_error(p, loc, PT_ERR_IO, "cannot read include file \"%s\": %s", path,
+                  errno == EINVAL ? "not a regular file" : strerror(errno));
         free(path);
         return;
     }
@@ -1061,7 +1079,7 @@ sdl_tok sdl_next(sdl_parser *p)
             take = resume_token(p, &t);
         } else {
             t.tk = sdl_scan_next(&top_frame(p)->sc);
-            take = fresh_token(p, &t);
+            take = sdl_count_token(p, t.tk.loc) && fresh_token(p, &t);
         }
         if (take && sdl_ok(p)) {
             p->last_loc = t.tk.loc;

@@ -871,6 +871,11 @@ rgb sdl_rgb(sdl_parser *p)
 static char *concat2(sdl_parser *p, const char *a, const char *b)
 {
     size_t la = strlen(a), lb = strlen(b);
+    if (la + lb > (size_t)p->opt.max_string_length) {
+        sdl_error(p, p->last_loc, PT_ERR_LIMIT, "concat makes a string of %zu bytes, longer than the limit of %ld (--max-string)",
+                  la + lb, p->opt.max_string_length);
+        return (char *)"";
+    }
     char *s = sdl_alloc(p, la + lb + 1);
     if (!s) return (char *)"";
     memcpy(s, a, la);
