@@ -11,6 +11,7 @@
 #include "diag.h"
 #include "vec.h"
 #include "xform.h"
+#include "scene_pattern.h"
 
 /* Colour with POV-Ray's filter and transmit channels. */
 typedef struct { double r, g, b, f, t; } colour5;
@@ -19,14 +20,20 @@ typedef struct { double r, g, b; } rgb;
 /* ---------------------------------------------------------------- pigment */
 typedef enum {
     PIGMENT_SOLID = 0,
-    PIGMENT_OTHER /* a pattern the renderer does not evaluate yet: uses `colour` */
+    PIGMENT_OTHER,  /* a pattern the renderer does not evaluate yet: uses `colour` */
+    PIGMENT_PATTERN /* `pat` evaluated through `map` (shade_pattern.h) */
 } pigment_kind;
 
-typedef struct {
+typedef struct scene_pigment {
     pigment_kind kind;
     colour5 colour;      /* solid colour (also the fallback for patterns) */
-    const char *pattern; /* pattern keyword for PIGMENT_OTHER, else NULL */
+    const char *pattern; /* pattern keyword for PIGMENT_OTHER/PATTERN, else NULL */
     xform transform;     /* pattern space -> object space */
+    /* PIGMENT_PATTERN (scene_pattern.h): the pattern (its warps follow
+     * `transform`) and its colour_map or pigment_map; map NULL = the
+     * pattern's POV-Ray default map (image_map: the image's colours). */
+    const scene_pattern *pat;
+    const scene_blend_map *map;
 } scene_pigment;
 
 /* ---------------------------------------------------------------- finish */
@@ -70,6 +77,13 @@ typedef struct scene_texture {
     xform transform;           /* texture transform (applied after the object's) */
     struct scene_texture *next;
     src_loc loc;
+    /* Appended (scene_pattern.h). normal: NULL = unperturbed. A patterned
+     * texture (texture_map, checker/hexagon/brick of textures, average,
+     * tiles) has `pat` and `map` (MAP_TEXTURE) set; its pigment and finish
+     * then hold the first entry's look for code that needs one colour. */
+    const scene_normal *normal;
+    const scene_pattern *pat;
+    const scene_blend_map *map;
 } scene_texture;
 
 /* ---------------------------------------------------------------- meshes */
@@ -318,6 +332,9 @@ typedef struct {
     int version_major, version_minor; /* from #version; 0 if absent */
     int nfiles;             /* files read (scene + includes) */
     double clock;
+    /* Appended (scene_pattern.h): atmosphere. */
+    const scene_fog *fogs;  /* linked through `next`; NULL = none */
+    const scene_sky_sphere *sky_sphere; /* NULL = none */
 } scene;
 
 scene *scene_new(void);

@@ -31,6 +31,7 @@
 #include <string.h>
 #include "pool.h"
 #include "shade_light.h"
+#include "shade_texture.h"
 #include "timer.h"
 
 #define SHADE_MAX_THREADS 256
@@ -207,91 +208,32 @@ static rgb background(const scene *sc) { return rgb_make(sc->background.r, sc->b
  * for camera rays, no_reflection for reflected rays). */
 static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, rng *r);
 
+/* The surface model (patterns, layers, normals, reflection, refraction,
+ * interior fade) is POV-Ray's ComputeLightedTexture in shade_texture.c; it
+ * calls back here for rays, direct light and the GI indirect term. */
+static rgb tex_cb_trace(void *ctx, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, rng *r)
+{
+    render_ctx *c = ctx;
+    c->ts[thread].secondary++;
+    return trace_ray(c, thread, org, dir, level, weight, skip, r);
+}
+
+static rgb tex_cb_direct(void *ctx, int thread, const light_surface *s, const accel_hit *h, vec3 p, rng *r)
+{
+    return direct_light(ctx, thread, s, h, p, r);
+}
+
+static rgb tex_cb_indirect(void *ctx, int thread, const accel_hit *h, vec3 n)
+{
+    render_ctx *c = ctx;
+    return c->s->indirect(c->s->indirect_ctx, h, n, thread);
+}
+
 static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip, rng *r)
 {
-    const scene *sc = c->sc;
-    const scene_texture *tex = h->texture ? h->texture : &sc->default_texture;
-    const scene_finish *f = &tex->finish;
-    const scene_pigment *pg = &tex->pigment;
-    if (pg->kind != PIGMENT_SOLID) c->ts[thread].unsupported++;
-    rgb pig = {pg->colour.r, pg->colour.g, pg->colour.b};
-    double filt = pg->colour.f, transm = pg->colour.t;
-
-    /* Normals: face the viewer (POV-Ray flips the normal towards the ray). */
-    vec3 ng = h->ng, n = h->ns;
-    int entering = v3_dot(dir, ng) < 0.0;
-    if (v3_dot(dir, n) > 0.0) n = v3_neg(n);
-    if (!entering) ng = v3_neg(ng);
-    /* Offset the hit point off the surface, on the viewer's side. */
-    vec3 p = v3_madd(h->p, ng, c->eps);
-
-    rgb trans_colour = {filt * pig.r + transm, filt * pig.g + transm, filt * pig.b + transm};
-    double opacity = 1.0 - fmin(1.0, fmax(0.0, rgb_grey(trans_colour)));
-
-    light_surface s = {f, pig, n, dir, opacity, r};
-    rgb col = f->emission;
-    if (c->s->use_ambient) col = rgb_add(col, rgb_mul(f->ambient, sc->global.ambient_light));
-    col = rgb_scale(rgb_mul(pig, col), opacity);
-    if (c->s->indirect && f->diffuse > 0.0) {
-        rgb ind = c->s->indirect(c->s->indirect_ctx, h, n, thread);
-        col = rgb_add(col, rgb_scale(rgb_mul(pig, ind), f->diffuse * opacity));
-    }
-    if (f->diffuse != 0.0 || f->diffuse_back != 0.0 || f->phong != 0.0 || f->specular != 0.0)
-        col = rgb_add(col, direct_light(c, thread, &s, h, p, r));
-
-    double cos_i = -v3_dot(dir, n);
-    const scene_interior *in = h->obj->interior;
-    double rel_ior = 1.0;
-    if (in && in->ior > 0.0) rel_ior = entering ? in->ior : 1.0 / in->ior;
-
-    /* Reflection (ComputeReflectivity semantics: falloff blend or fresnel). */
-    rgb rmax = f->reflection_max, rmin = f->reflection_min;
-    if (rgb_max(rmax) > 0.0 || rgb_max(rmin) > 0.0) {
-        rgb refl;
-        if (f->fresnel) {
-            double fr = light_fresnel(cos_i, rel_ior);
-            refl = rgb_add(rgb_scale(rmax, fr), rgb_scale(rmin, 1.0 - fr));
-        } else {
-            double frac = fabs(f->reflection_falloff - 1.0) > 1e-10 ? pow(1.0 - cos_i, f->reflection_falloff) : 1.0 - cos_i;
-            refl = rgb_add(rgb_scale(rmax, frac), rgb_scale(rmin, 1.0 - frac));
-        }
-        light_metallic_tint(&refl, f->reflection_metallic, pig, cos_i);
-        double w = weight * rgb_max(refl);
-        if (w > sc->global.adc_bailout) {
-            vec3 rd = v3_madd(dir, n, 2.0 * cos_i);
-            c->ts[thread].secondary++;
-            rgb rc = trace_ray(c, thread, p, rd, level + 1, w, OBJ_NO_REFLECTION, r);
-            if (f->reflection_exponent != 1.0) {
-                rc.r = pow(fmax(rc.r, 0.0), f->reflection_exponent);
-                rc.g = pow(fmax(rc.g, 0.0), f->reflection_exponent);
-                rc.b = pow(fmax(rc.b, 0.0), f->reflection_exponent);
-            }
-            col = rgb_add(col, rgb_mul(refl, rc));
-        }
-    }
-
-    /* Transmission: straight through, or refracted when an ior is given. */
-    double tw = weight * rgb_max(trans_colour);
-    if (rgb_max(trans_colour) > 0.0 && tw > sc->global.adc_bailout) {
-        vec3 q = v3_madd(h->p, ng, -c->eps);
-        vec3 td = dir;
-        if (fabs(rel_ior - 1.0) > 1e-9) {
-            double eta = 1.0 / rel_ior;
-            double k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-            if (k < 0.0) {
-                /* total internal reflection: all of the transmitted part reflects */
-                vec3 rd = v3_madd(dir, n, 2.0 * cos_i);
-                c->ts[thread].secondary++;
-                rgb rc = trace_ray(c, thread, p, rd, level + 1, tw, OBJ_NO_REFLECTION, r);
-                return rgb_add(col, rgb_mul(trans_colour, rc));
-            }
-            td = v3_norm(v3_add(v3_scale(dir, eta), v3_scale(n, eta * cos_i - sqrt(k))));
-        }
-        c->ts[thread].secondary++;
-        rgb tc = trace_ray(c, thread, q, td, level + 1, tw, skip, r);
-        col = rgb_add(col, rgb_mul(trans_colour, tc));
-    }
-    return col;
+    tex_env e = {c->sc, c->eps, c->s->use_ambient, c->max_level, c, thread, r, tex_cb_trace, tex_cb_direct,
+                 c->s->indirect ? tex_cb_indirect : NULL, &c->ts[thread].unsupported};
+    return tex_shade(&e, h, dir, level, weight, skip);
 }
 
 static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, rng *r)

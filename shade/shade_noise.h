@@ -1,0 +1,45 @@
+/* shade_noise.h - POV-Ray 3.7's noise functions, reproduced so that patterns
+ * land where POV-Ray puts them: Noise with noise_generator 1 (original),
+ * 2 (range-corrected, the default) and 3 (Perlin gradient noise), the
+ * vector-valued DNoise, fractal Turbulence/DTurbulence, the cycloidal and
+ * triangle waves, the lattice hash and the random values used by cells and
+ * crackle, and the wave sources of the ripples/waves patterns.
+ *
+ * The tables are generated at first use exactly as POV-Ray defines them
+ * (see shade_noise.c for each rule); nothing here is copied from POV-Ray's
+ * sources. All functions are thread-safe after noise_init() (called
+ * implicitly; cheap after the first call). */
+#ifndef PT_SHADE_NOISE_H
+#define PT_SHADE_NOISE_H
+#include "vec.h"
+
+/* Build the tables (idempotent, thread-safe). */
+void noise_init(void);
+
+/* POV-Ray's Noise(p, generator): a value in [0, 1]. generator 1..3. */
+double noise_value(vec3 p, int generator);
+/* POV-Ray's DNoise(p): vector noise, components roughly in [-1, 1]. */
+vec3 noise_dvector(vec3 p);
+
+/* Fractal sums (POV-Ray's Turbulence and DTurbulence) with the given
+ * octaves, omega and lambda. */
+double noise_turbulence(vec3 p, int octaves, double omega, double lambda, int generator);
+vec3 noise_dturbulence(vec3 p, int octaves, double omega, double lambda);
+
+/* sin(2 pi x) as POV-Ray computes it (fraction quantised to 1/50000), and
+ * the triangle wave 0..1..0 of period 1. */
+double noise_cycloidal(double x);
+double noise_triangle_wave(double x);
+
+/* POV-Ray's Hash3d lattice hash (each argument masked to 12 bits): 0..4095. */
+int noise_hash3d(int a, int b, int c);
+/* POV-Ray's PatternRands(i): 32768 uniform doubles in [0,1) (mt19937 with its
+ * default seed, divided by 2^32), index taken modulo 32768. */
+double noise_pattern_rand(unsigned long i);
+
+/* The ripples/waves sources: POV-Ray's number_of_waves (default 10). */
+#define NOISE_WAVES 10
+vec3 noise_wave_source(int i);
+double noise_wave_frequency(int i);
+
+#endif

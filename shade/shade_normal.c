@@ -1,0 +1,196 @@
+/* shade_normal.c - POV-Ray 3.7 normal perturbation (see shade_normal.h).
+ *
+ * Reproduced semantics (POV-Ray 3.7 normal.cpp and warps.cpp, studied, not
+ * copied):
+ *  - Warp_Normal takes a normal into pattern space through every transform
+ *    of the pattern's warp list in order (n' = M^T n, M the forward
+ *    transform), UnWarp_Normal back in reverse order (n' = M^-T n); both
+ *    normalise before and after unless no_bump_scale.
+ *  - bumps: n += amount * DNoise(p); dents: n += amount * Noise(p)^3 *
+ *    DNoise(p); wrinkles: n += amount * sum_{i<10} |DNoise(2^i p)| / 2^i;
+ *    ripples/waves: n += amount * sum over the 10 wave sources of
+ *    cycloidal(|p - s| f (* wave frequency) + phase) (/ wave frequency)
+ *    * (p - s) / (|p - s| * 10); quilted: n += amount * q(p) with the
+ *    quilt cubic.
+ *  - Any other pattern: four samples at p + accuracy * v_i over a regular
+ *    tetrahedron v_i, each value (through the slope_map's Hermite segments
+ *    if any) times -5 * amount * 0.02/accuracy added along v_i.
+ *  - normal_map: entries evaluated at the warped point, blended linearly,
+ *    normalised; average: weighted mean of the entries' perturbed normals. */
+#include "shade_normal.h"
+#include <math.h>
+#include "shade_noise.h"
+
+static const vec3 pyramid[4] = {{0.942809041, -0.333333333, 0.0},
+                                {-0.471404521, -0.333333333, 0.816496581},
+                                {-0.471404521, -0.333333333, -0.816496581},
+                                {0.0, 1.0, 0.0}};
+
+static inline double pov_floor(double x) { return x >= 0.0 ? floor(x) : (0.0 - floor(0.0 - x) - 1.0); }
+
+vec3 normal_warp(vec3 n, const xform *xf, const xform *outer, const scene_pattern *pat, int dont_scale)
+{
+    if (!dont_scale) n = v3_norm(n);
+    if (xf) n = pattern_normal_to_pattern(xf, n);
+    if (outer) n = pattern_normal_to_pattern(outer, n);
+    if (pat)
+        for (int i = 0; i < pat->nwarps; i++)
+            if (pat->warps[i].kind == WARP_TRANSFORM) n = pattern_normal_to_pattern(&pat->warps[i].transform, n);
+    if (!dont_scale) n = v3_norm(n);
+    return n;
+}
+
+vec3 normal_unwarp(vec3 n, const xform *xf, const xform *outer, const scene_pattern *pat, int dont_scale)
+{
+    if (!dont_scale) n = v3_norm(n);
+    if (pat)
+        for (int i = pat->nwarps - 1; i >= 0; i--)
+            if (pat->warps[i].kind == WARP_TRANSFORM) n = xform_normal(&pat->warps[i].transform, n);
+    if (outer) n = xform_normal(outer, n);
+    if (xf) n = xform_normal(xf, n);
+    if (!dont_scale) n = v3_norm(n);
+    return n;
+}
+
+static double hermite(double t, double h1, double s1, double h2, double s2)
+{
+    double tt = t * t, ttt = tt * t;
+    double rv = ttt * (s1 + s2 + 2.0 * (h1 - h2));
+    rv += -tt * (2.0 * s1 + s2 + 3.0 * (h1 - h2));
+    rv += t * s1 + h1;
+    return rv;
+}
+
+static double slope_map(double v, const scene_blend_map *m)
+{
+    if (!m || m->kind != MAP_SLOPE) return v;
+    int ip, ic;
+    blend_map_search(m, v, &ip, &ic);
+    if (ip == ic) return m->e[ic].height;
+    double t = (v - m->e[ip].value) / (m->e[ic].value - m->e[ip].value);
+    return hermite(t, m->e[ip].height, m->e[ip].slope, m->e[ic].height, m->e[ic].slope);
+}
+
+static vec3 waves_normal(const scene_normal *nm, vec3 p, vec3 n, int ripples)
+{
+    const scene_pattern *pat = nm->pat;
+    for (int i = 0; i < NOISE_WAVES; i++) {
+        vec3 d = v3_sub(p, noise_wave_source(i));
+        double len = v3_len(d);
+        if (len == 0.0) len = 1.0;
+        double s;
+        if (ripples) {
+            s = noise_cycloidal(len * pat->frequency + pat->phase) * nm->amount;
+        } else {
+            double f = noise_wave_frequency(i);
+            s = noise_cycloidal(len * pat->frequency * f + pat->phase) * nm->amount / f;
+        }
+        n = v3_madd(n, d, s / (len * (double)NOISE_WAVES));
+    }
+    return n;
+}
+
+static vec3 perturb(const scene_normal *nm, vec3 n, vec3 p, const xform *xf, const pattern_ctx *c);
+
+/* The bump patterns proper (POV-Ray's normal-only patterns). */
+static int is_bump_pattern(pattern_kind k)
+{
+    return k == PAT_BUMPS || k == PAT_DENTS || k == PAT_RIPPLES || k == PAT_WAVES || k == PAT_WRINKLES ||
+           k == PAT_QUILTED || k == PAT_FACETS || k == PAT_AVERAGE || k == PAT_IMAGE;
+}
+
+static vec3 bump_pattern(const scene_normal *nm, vec3 n, vec3 tp, const pattern_ctx *c)
+{
+    const scene_pattern *pat = nm->pat;
+    int gen = pat->noise_generator ? pat->noise_generator : c->noise_generator;
+    switch (pat->kind) {
+    case PAT_BUMPS: return v3_madd(n, noise_dvector(tp), nm->amount);
+    case PAT_DENTS: {
+        double v = noise_value(tp, gen);
+        return v3_madd(n, noise_dvector(tp), v * v * v * nm->amount);
+    }
+    case PAT_RIPPLES: return waves_normal(nm, tp, n, 1);
+    case PAT_WAVES: return waves_normal(nm, tp, n, 0);
+    case PAT_WRINKLES: {
+        vec3 r = v3(0, 0, 0);
+        double scale = 1.0;
+        for (int i = 0; i < 10; scale *= 2.0, i++) {
+            vec3 v = noise_dvector(v3_scale(tp, scale));
+            r.x += fabs(v.x / scale);
+            r.y += fabs(v.y / scale);
+            r.z += fabs(v.z / scale);
+        }
+        return v3_madd(n, r, nm->amount);
+    }
+    case PAT_QUILTED: {
+        vec3 v = v3(tp.x - pov_floor(tp.x) - 0.5, tp.y - pov_floor(tp.y) - 0.5, tp.z - pov_floor(tp.z) - 0.5);
+        double t = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+        double it = 1 - t;
+        t = (t * t * t + 3.0 * t * it * it * pat->control0 + 3.0 * t * t * it * pat->control1) * 1.154700538;
+        return v3_madd(n, v3_scale(v, t), nm->amount);
+    }
+    case PAT_AVERAGE: {
+        const scene_blend_map *m = nm->map;
+        if (!m || m->kind != MAP_NORMAL) return n;
+        vec3 acc = v3(0, 0, 0);
+        double total = 0.0;
+        for (int i = 0; i < m->n; i++) {
+            float w = (float)m->e[i].value;
+            vec3 v = m->e[i].normal ? perturb(m->e[i].normal, n, tp, NULL, c) : n;
+            acc = v3_madd(acc, v, w);
+            total += w;
+        }
+        return total != 0.0 ? v3_scale(acc, 1.0 / total) : n;
+    }
+    default: return n; /* facets, bump_map: not modelled (unperturbed) */
+    }
+}
+
+static vec3 perturb(const scene_normal *nm, vec3 n, vec3 p, const xform *xf, const pattern_ctx *c)
+{
+    const scene_pattern *pat = nm->pat;
+    if (!pat || pat->kind == PAT_PLAIN) return n;
+    const xform *outer = xform_is_identity(&nm->transform) ? NULL : &nm->transform;
+    int ds = nm->no_bump_scale;
+    vec3 q = outer ? xform_inv_point(outer, p) : p;
+    const scene_blend_map *m = nm->map;
+    if (m && m->kind == MAP_NORMAL && pat->kind != PAT_AVERAGE) {
+        vec3 tp = pattern_warp(pat, q);
+        double v = pattern_value(pat, tp, c);
+        int ip, ic;
+        blend_map_search(m, v, &ip, &ic);
+        n = normal_warp(n, xf, outer, pat, ds);
+        vec3 p1 = n;
+        if (m->e[ic].normal) n = perturb(m->e[ic].normal, n, tp, NULL, c);
+        if (ip != ic) {
+            if (m->e[ip].normal) p1 = perturb(m->e[ip].normal, p1, tp, NULL, c);
+            double v2 = (v - m->e[ip].value) / (m->e[ic].value - m->e[ip].value);
+            double v1 = 1.0 - v2;
+            n = v3_add(v3_scale(p1, v1), v3_scale(n, v2));
+        }
+        n = normal_unwarp(n, xf, outer, pat, ds);
+        return v3_norm(n);
+    }
+    if (is_bump_pattern(pat->kind)) {
+        n = normal_warp(n, xf, outer, pat, ds);
+        vec3 tp = pattern_warp(pat, q);
+        n = bump_pattern(nm, n, tp, c);
+        return normal_unwarp(n, xf, outer, pat, ds);
+    }
+    n = normal_warp(n, xf, outer, pat, ds);
+    double amount = nm->amount * -5.0;
+    amount *= 0.02 / nm->delta;
+    vec3 tp = pattern_warp(pat, q);
+    for (int i = 0; i < 4; i++) {
+        vec3 p1 = v3_madd(tp, pyramid[i], nm->delta);
+        double v = slope_map(pattern_value(pat, p1, c), m);
+        n = v3_madd(n, pyramid[i], v * amount);
+    }
+    return normal_unwarp(n, xf, outer, pat, ds);
+}
+
+vec3 normal_perturb(const scene_normal *nm, vec3 n, vec3 p, const xform *xf, const pattern_ctx *c)
+{
+    if (!nm) return n;
+    return perturb(nm, n, p, xf, c);
+}

@@ -1,0 +1,884 @@
+/* shade_pattern.c - POV-Ray 3.7 patterns, warps, blend maps, pigments.
+ *
+ * Reproduced semantics (studied in POV-Ray 3.7's pattern.cpp, warps.cpp,
+ * pigment.cpp and imageutil.cpp; independent implementation):
+ *  - Warp_EPoint: warps in list order; classic turbulence is skipped for
+ *    marble and wood (they use it inside the pattern); coordinates are
+ *    clamped to +-1e17 afterwards.
+ *  - Evaluate_TPat: value = pattern(p); with frequency f != 0,
+ *    value = fmod(value * f + phase, 1.00001); negative values wrap by
+ *    value -= floor(value); then the wave: ramp, sine (1+cycloidal)/2,
+ *    triangle, scallop |cycloidal(v/2)|, cubic 3v^2-2v^3, poly v^exponent.
+ *  - Each pattern function as POV-Ray defines it (the formulas are in the
+ *    functions below, with the constants POV-Ray uses: EPSILON 1e-10 offsets
+ *    in checker/cells/brick/crackle, 1.00001 modulus, hexagon's 6x6 block
+ *    tiling, brick's mortar layers, crackle's 81 neighbouring cubes, the
+ *    4x-scaled 6-octave granite, 10-octave wrinkles, ...).
+ *  - Search_Blend_Map and Compute_Pigment: linear blend between the entries
+ *    around the value (entries' values are single-precision as in POV-Ray);
+ *    pigment_map entries are evaluated at the parent's warped point.
+ *  - The default colour maps of Post_Pigment (bozo, wood, radial, marble,
+ *    agate, brick, hexagon, checker, square, triangular, cubic; grey ramp
+ *    for the rest). */
+#include "shade_pattern.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "shade_noise.h"
+
+#define PAT_EPSILON 1.0e-10
+#define COORD_LIMIT 1.0e17
+#define TWO_PI 6.283185307179586476925286766560
+#define HALF_PI 1.57079632679489661923
+#define PI_ 3.1415926535897932384626
+/* POV-Ray's greyscale weights. */
+#define GREY(r, g, b) (0.297 * (r) + 0.589 * (g) + 0.114 * (b))
+
+static inline double pov_floor(double x) { return x >= 0.0 ? floor(x) : (0.0 - floor(0.0 - x) - 1.0); }
+
+pattern_ctx pattern_ctx_plain(const scene *sc)
+{
+    pattern_ctx c;
+    memset(&c, 0, sizeof c);
+    int g = sc ? sc->global.noise_generator : 2;
+    c.noise_generator = g >= 1 && g <= 3 ? g : 2;
+    return c;
+}
+
+vec3 pattern_normal_to_pattern(const xform *x, vec3 n)
+{
+    /* m^T n: the forward matrix transposed (POV-Ray's row-vector matrix times n). */
+    return v3(x->m[0][0] * n.x + x->m[1][0] * n.y + x->m[2][0] * n.z,
+              x->m[0][1] * n.x + x->m[1][1] * n.y + x->m[2][1] * n.z,
+              x->m[0][2] * n.x + x->m[1][2] * n.y + x->m[2][2] * n.z);
+}
+
+/* ------------------------------------------------------------ warps */
+
+/* Orientation remap shared by the mapping warps (POV-Ray's rule for a
+ * non-default orientation vector o). */
+static vec3 orient(vec3 o, double x, double y, double z)
+{
+    if (o.x == 0.0 && o.y == 0.0 && o.z == 1.0) return v3(x, y, z);
+    return v3(o.x * z + o.y * x + o.z * x, o.x * y + o.y * -z + o.z * y, o.x * -x + o.y * y + o.z * z);
+}
+
+/* Angle of (x, z) from +x in the x-z plane, 0..2pi (acos-based, as POV-Ray). */
+static double xz_angle(double x, double z, double len)
+{
+    if (z == 0.0) return x > 0 ? 0.0 : PI_;
+    double t = acos(x / len);
+    return z < 0.0 ? TWO_PI - t : t;
+}
+
+static vec3 warp_cylindrical(const scene_warp *w, vec3 p)
+{
+    double len = sqrt(p.x * p.x + p.z * p.z);
+    if (len == 0.0) return p;
+    double theta = xz_angle(p.x, p.z, len) / TWO_PI;
+    if (w->dist_exp == 1.0) theta *= len;
+    else if (w->dist_exp != 0.0) theta *= pow(len, w->dist_exp);
+    return orient(w->orientation, theta, p.y, len);
+}
+
+static vec3 warp_spherical(const scene_warp *w, vec3 p)
+{
+    double dist = sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
+    if (dist == 0.0) return p;
+    double x = p.x / dist, y = p.y / dist, z = p.z / dist;
+    double phi = 0.5 + asin(y) / PI_;
+    double len = sqrt(x * x + z * z);
+    double theta = len == 0.0 ? 0.0 : xz_angle(x, z, len) / TWO_PI;
+    if (w->dist_exp == 1.0) {
+        theta *= dist;
+        phi *= dist;
+    } else if (w->dist_exp != 0.0) {
+        theta *= pow(dist, w->dist_exp);
+        phi *= pow(dist, w->dist_exp);
+    }
+    return orient(w->orientation, theta, phi, dist);
+}
+
+static vec3 warp_toroidal(const scene_warp *w, vec3 p)
+{
+    double len = sqrt(p.x * p.x + p.z * p.z);
+    if (len == 0.0) return p;
+    double theta = 0.0 - xz_angle(p.x, p.z, len);
+    double x = len - w->major_radius, y = p.y;
+    len = sqrt(x * x + y * y);
+    double phi = acos(-x / len);
+    if (y > 0.0) phi = TWO_PI - phi;
+    theta /= -TWO_PI;
+    phi /= TWO_PI;
+    if (w->dist_exp == 1.0) {
+        theta *= len;
+        phi *= len;
+    } else if (w->dist_exp != 0.0) {
+        theta *= pow(len, w->dist_exp);
+        phi *= pow(len, w->dist_exp);
+    }
+    return orient(w->orientation, theta, phi, len);
+}
+
+static vec3 warp_planar(const scene_warp *w, vec3 p) { return orient(w->orientation, p.x, p.y, w->plane_offset); }
+
+static vec3 warp_cubic(vec3 p)
+{
+    double x = p.x, y = p.y, z = p.z, ax = fabs(x), ay = fabs(y), az = fabs(z);
+    if (x >= 0 && x >= ay && x >= az) return v3(0.75 - 0.25 * (z / x + 1.0) / 2.0, 1.0 / 3.0 + (1.0 / 3.0) * (y / x + 1.0) / 2.0, x);
+    if (y >= 0 && y >= ax && y >= az) return v3(0.25 + 0.25 * (x / y + 1.0) / 2.0, 1.0 - (1.0 / 3.0) * (z / y + 1.0) / 2.0, y);
+    if (z >= 0 && z >= ax && z >= ay) return v3(0.25 + 0.25 * (x / z + 1.0) / 2.0, 1.0 / 3.0 + (1.0 / 3.0) * (y / z + 1.0) / 2.0, z);
+    if (x < 0 && x <= -ay && x <= -az) {
+        x = -x;
+        return v3(0.25 * (z / x + 1.0) / 2.0, 1.0 / 3.0 + (1.0 / 3.0) * (y / x + 1.0) / 2.0, x);
+    }
+    if (y < 0 && y <= -ax && y <= -az) {
+        y = -y;
+        return v3(0.25 + 0.25 * (x / y + 1.0) / 2.0, (1.0 / 3.0) * (z / y + 1.0) / 2.0, y);
+    }
+    z = -z;
+    return v3(1.0 - 0.25 * (x / z + 1.0) / 2.0, 1.0 / 3.0 + (1.0 / 3.0) * (y / z + 1.0) / 2.0, z);
+}
+
+static vec3 warp_repeat(const scene_warp *w, vec3 p)
+{
+    double c[3] = {p.x, p.y, p.z};
+    double r[3] = {p.x, p.y, p.z};
+    int a = w->axis;
+    float blk = (float)floor(c[a] / w->width); /* POV-Ray keeps the block number as SNGL */
+    r[a] = c[a] - blk * w->width;
+    if (((int)blk) & 1) {
+        r[0] *= w->flip.x;
+        r[1] *= w->flip.y;
+        r[2] *= w->flip.z;
+        if (v3_idx(w->flip, a) < 0) r[a] = w->width + r[a];
+    }
+    return v3(r[0] + blk * w->offset.x, r[1] + blk * w->offset.y, r[2] + blk * w->offset.z);
+}
+
+static vec3 warp_black_hole(const scene_warp *w, vec3 p)
+{
+    vec3 centre = w->centre;
+    if (w->bh_repeat) {
+        int bx = 0, by = 0, bz = 0;
+        if (w->repeat_vec.x >= PAT_EPSILON) bx = (int)floor(p.x / w->repeat_vec.x);
+        if (w->repeat_vec.y >= PAT_EPSILON) by = (int)floor(p.y / w->repeat_vec.y);
+        if (w->repeat_vec.z >= PAT_EPSILON) bz = (int)floor(p.z / w->repeat_vec.z);
+        if (w->uncertain) {
+            int seed = noise_hash3d(bx, by, bz);
+            centre.x += noise_pattern_rand((unsigned long)seed) * w->uncertainty.x;
+            centre.y += noise_pattern_rand((unsigned long)seed + 1) * w->uncertainty.y;
+            centre.z += noise_pattern_rand((unsigned long)seed + 2) * w->uncertainty.z;
+        }
+        centre.x += w->repeat_vec.x * bx;
+        centre.y += w->repeat_vec.y * by;
+        centre.z += w->repeat_vec.z * bz;
+    }
+    vec3 d = v3_sub(p, centre);
+    double len = v3_len(d);
+    if (len >= w->radius || w->bh_type != 0) return p;
+    len = (w->radius - len) / w->radius;
+    double s = pow(len, w->power) * w->strength;
+    if (s > 1.0) s = 1.0;
+    return v3_add(p, v3_scale(d, w->inverted ? -s : s));
+}
+
+vec3 pattern_warp(const scene_pattern *pat, vec3 p)
+{
+    for (int i = 0; i < pat->nwarps; i++) {
+        const scene_warp *w = &pat->warps[i];
+        switch (w->kind) {
+        case WARP_TURBULENCE:
+            if (w->classic && (pat->kind == PAT_MARBLE || pat->kind == PAT_WOOD || pat->kind == PAT_PLAIN)) break;
+            {
+                vec3 t = noise_dturbulence(p, w->octaves, w->omega, w->lambda);
+                p.x += t.x * w->turbulence.x;
+                p.y += t.y * w->turbulence.y;
+                p.z += t.z * w->turbulence.z;
+            }
+            break;
+        case WARP_TRANSFORM: p = xform_inv_point(&w->transform, p); break;
+        case WARP_REPEAT: p = warp_repeat(w, p); break;
+        case WARP_BLACK_HOLE: p = warp_black_hole(w, p); break;
+        case WARP_CYLINDRICAL: p = warp_cylindrical(w, p); break;
+        case WARP_SPHERICAL: p = warp_spherical(w, p); break;
+        case WARP_TOROIDAL: p = warp_toroidal(w, p); break;
+        case WARP_PLANAR: p = warp_planar(w, p); break;
+        case WARP_CUBIC: p = warp_cubic(p); break;
+        }
+    }
+    p.x = fmin(fmax(p.x, -COORD_LIMIT), COORD_LIMIT);
+    p.y = fmin(fmax(p.y, -COORD_LIMIT), COORD_LIMIT);
+    p.z = fmin(fmax(p.z, -COORD_LIMIT), COORD_LIMIT);
+    return p;
+}
+
+const scene_warp *pattern_classic_turb(const scene_pattern *pat)
+{
+    if (pat->nwarps == 0) return NULL;
+    const scene_warp *w = &pat->warps[pat->nwarps - 1];
+    return w->kind == WARP_TURBULENCE && w->classic ? w : NULL;
+}
+
+/* ------------------------------------------------------------ patterns */
+
+static double turb_scalar(const scene_pattern *pat, vec3 p, int gen)
+{
+    const scene_warp *t = pattern_classic_turb(pat);
+    return t ? t->turbulence.x * noise_turbulence(p, t->octaves, t->omega, t->lambda, gen) : 0.0;
+}
+
+static double agate(const scene_pattern *pat, vec3 p, int gen)
+{
+    const scene_warp *t = pattern_classic_turb(pat);
+    /* agate always has a classic turbulence record (octaves etc.), default turbulence 0 */
+    double tv = pat->agate_turb * (t ? noise_turbulence(p, t->octaves, t->omega, t->lambda, gen)
+                                     : noise_turbulence(p, 6, 0.5, 2.0, gen));
+    double n = 0.5 * (noise_cycloidal(1.3 * tv + 1.1 * p.z) + 1.0);
+    if (n < 0.0) return 0.0;
+    n = fmin(1.0, n);
+    return pow(n, 0.77);
+}
+
+static double clip01(double v) { return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v); }
+
+static double brick(const scene_pattern *pat, vec3 p)
+{
+    double fudge = PAT_EPSILON + pat->mortar;
+    double x = p.x + fudge, y = p.y + fudge, z = p.z + fudge;
+    double bw = pat->brick_size.x, bh = pat->brick_size.y, bd = pat->brick_size.z;
+    double mw = pat->mortar / bw, mh = pat->mortar / bh, md = pat->mortar / bd;
+    double by = y / bh;
+    by -= (double)(int)by;
+    if (by < 0.0) by += 1.0;
+    if (by <= mh) return 0.0;
+    by = (y / bh) * 0.5;
+    by -= (double)(int)by;
+    if (by < 0.0) by += 1.0;
+    double bx = x / bw;
+    bx -= (double)(int)bx;
+    if (bx < 0.0) bx += 1.0;
+    if (bx <= mw && by <= 0.5) return 0.0;
+    bx = (x / bw) + 0.5;
+    bx -= (double)(int)bx;
+    if (bx < 0.0) bx += 1.0;
+    if (bx <= mw && by > 0.5) return 0.0;
+    double bz = z / bd;
+    bz -= (double)(int)bz;
+    if (bz < 0.0) bz += 1.0;
+    if (bz <= md && by > 0.5) return 0.0;
+    bz = (z / bd) + 0.5;
+    bz -= (double)(int)bz;
+    if (bz < 0.0) bz += 1.0;
+    if (bz <= md && by <= 0.5) return 0.0;
+    return 1.0;
+}
+
+static double cells(vec3 p)
+{
+    int h = noise_hash3d((int)floor(p.x + PAT_EPSILON), (int)floor(p.y + PAT_EPSILON), (int)floor(p.z + PAT_EPSILON));
+    return fmin(noise_pattern_rand((unsigned long)h), 1.0);
+}
+
+static double checker(vec3 p)
+{
+    int v = (int)(floor(p.x + PAT_EPSILON) + floor(p.y + PAT_EPSILON) + floor(p.z + PAT_EPSILON));
+    return (v & 1) ? 1.0 : 0.0;
+}
+
+/* One random point in the unit cube at integer corner (x, y, z). */
+static vec3 cube_point(int x, int y, int z)
+{
+    unsigned long seed = (unsigned long)noise_hash3d(x & 0xFFF, y & 0xFFF, z & 0xFFF);
+    return v3(x + noise_pattern_rand(seed), y + noise_pattern_rand(seed + 1), z + noise_pattern_rand(seed + 2));
+}
+
+static double metric_sum(vec3 d, double metric)
+{
+    if (metric == 2) return d.x * d.x + d.y * d.y + d.z * d.z;
+    if (metric == 1) return fabs(d.x) + fabs(d.y) + fabs(d.z);
+    return pow(fabs(d.x), metric) + pow(fabs(d.y), metric) + pow(fabs(d.z), metric);
+}
+
+static double crackle(const scene_pattern *pat, vec3 p, int gen)
+{
+    int fx = (int)floor(p.x - PAT_EPSILON), fy = (int)floor(p.y - PAT_EPSILON), fz = (int)floor(p.z - PAT_EPSILON);
+    double metric = pat->crackle_metric;
+    /* The 81 cubes within a "3D knight move" (offsets -2..2 with at most one
+     * coordinate of magnitude 2), in POV-Ray's table order. */
+    vec3 pts[81];
+    int n = 0;
+    for (int ax = -2; ax <= 2; ax++)
+        for (int ay = -2; ay <= 2; ay++)
+            for (int az = -2; az <= 2; az++)
+                if ((abs(ax) == 2) + (abs(ay) == 2) + (abs(az) == 2) <= 1) pts[n++] = cube_point(fx + ax, fy + ay, fz + az);
+    double m1 = metric_sum(v3_sub(pts[0], p), metric);
+    double m2 = metric_sum(v3_sub(pts[1], p), metric);
+    double m3 = metric_sum(v3_sub(pts[2], p), metric);
+    int mi = 0;
+    double t;
+    if (m2 < m1) { t = m1; m1 = m2; m2 = t; mi = 1; }
+    if (m3 < m1) { t = m1; m1 = m3; m3 = t; mi = 2; }
+    if (m3 < m2) { t = m2; m2 = m3; m3 = t; }
+    for (int i = 3; i < 81; i++) {
+        double s = metric_sum(v3_sub(pts[i], p), metric);
+        if (s < m1) {
+            m3 = m2;
+            m2 = m1;
+            m1 = s;
+            mi = i;
+        } else if (s < m2) {
+            m3 = m2;
+            m2 = s;
+        } else if (s < m3) {
+            m3 = s;
+        }
+    }
+    double off = pat->crackle_offset;
+    if (off != 0.0) {
+        double a = metric == 2 ? off * off : (metric == 1 ? off : pow(off, metric));
+        m1 += a;
+        m2 += a;
+        m3 += a;
+    }
+    vec3 f = pat->crackle_form;
+    if (pat->crackle_solid) t = noise_value(pts[mi], gen);
+    else if (metric == 2) t = f.x * sqrt(m1) + f.y * sqrt(m2) + f.z * sqrt(m3);
+    else if (metric == 1) t = f.x * m1 + f.y * m2 + f.z * m3;
+    else t = f.x * pow(m1, 1.0 / metric) + f.y * pow(m2, 1.0 / metric) + f.z * pow(m3, 1.0 / metric);
+    return fmax(fmin(t, 1.0), 0.0);
+}
+
+static double granite(vec3 p, int gen)
+{
+    double noise = 0.0, freq = 1.0;
+    vec3 tv1 = v3_scale(p, 4.0);
+    for (int i = 0; i < 6; freq *= 2.0, i++) {
+        vec3 tv2 = v3_scale(tv1, freq);
+        double t;
+        if (gen == 1) {
+            t = fabs(0.5 - noise_value(tv2, gen));
+        } else {
+            t = fabs(1.0 - 2.0 * noise_value(tv2, gen));
+            if (t > 0.5) t = 0.5;
+        }
+        noise += t / freq;
+    }
+    return noise;
+}
+
+static double hexagon(vec3 p)
+{
+    const double xf = 0.5, zf = 0.866025404;
+    double x = fabs(p.x), z = p.z;
+    z = z < 0.0 ? 5.196152424 - fabs(z) : z;
+    double xs = x / xf, zs = z / zf;
+    xs -= floor(xs / 6.0) * 6.0;
+    zs -= floor(zs / 6.0) * 6.0;
+    int xm = (int)pov_floor(xs) % 6, zm = (int)pov_floor(zs) % 6;
+    double v = 0.0;
+    switch (xm) {
+    case 0: case 5:
+        v = (zm == 0 || zm == 5) ? 0 : (zm == 1 || zm == 2) ? 1 : 2;
+        break;
+    case 2: case 3:
+        v = (zm == 0 || zm == 1) ? 2 : (zm == 2 || zm == 3) ? 0 : 1;
+        break;
+    case 1: case 4: {
+        double xl = xs - xm, zl = zs - zm;
+        if (((xm + zm) % 2) == 1) xl = 1.0 - xl;
+        if (xl == 0.0) xl = 0.0001;
+        if ((zl / xl) < 1.0) v = (zm == 0 || zm == 3) ? 0 : (zm == 2 || zm == 5) ? 1 : 2;
+        else v = (zm == 0 || zm == 3) ? 2 : (zm == 2 || zm == 5) ? 0 : 1;
+        break;
+    }
+    }
+    return fmod(v, 3.0);
+}
+
+static double square_pat(vec3 p)
+{
+    int vx = (int)floor(p.x), vz = (int)floor(p.z);
+    if (vx & 1) return (vz & 1) ? 2.0 : 3.0;
+    return (vz & 1) ? 1.0 : 0.0;
+}
+
+static double triangular(vec3 p)
+{
+    const double sqrt3 = 1.7320508075688772935274463415059, sqrt3_2 = 0.86602540378443864676372317075294;
+    double xs = p.x - 3.0 * floor(p.x / 3.0), zs = p.z - sqrt3 * floor(p.z / sqrt3);
+    int a = (int)floor(xs);
+    xs -= a;
+    int b = zs < sqrt3_2 ? 0 : 1;
+    if (b) zs = sqrt3 - zs;
+    double k = 1.0 - xs, ans = 1.0;
+    if (xs != 0.0 && k != 0.0) {
+        double s1 = zs / xs, s2 = zs / k;
+        switch ((s1 < sqrt3 ? 1 : 0) + (s2 < sqrt3 ? 2 : 0)) {
+        case 3: ans = 0.0; break;
+        case 2: ans = 1.0; break;
+        case 1: ans = 3.0; break;
+        default: ans = 0.0; break; /* unreachable in POV-Ray (value left unset there) */
+        }
+    }
+    int mask = (int)ans;
+    ans = (mask & 1) ? fmod(ans + 2.0 * a, 6.0) : fmod(6.0 + ans - 2.0 * a, 6.0);
+    if (b) ans = 5.0 - ans;
+    return ans;
+}
+
+static double cubic_pat(vec3 p)
+{
+    double x = p.x, y = p.y, z = p.z, ax = fabs(x), ay = fabs(y), az = fabs(z);
+    if (x >= 0 && x >= ay && x >= az) return 0.0;
+    if (y >= 0 && y >= ax && y >= az) return 1.0;
+    if (z >= 0 && z >= ax && z >= ay) return 2.0;
+    if (x < 0 && x <= -ay && x <= -az) return 3.0;
+    if (y < 0 && y <= -ax && y <= -az) return 4.0;
+    return 5.0;
+}
+
+static double quilt_cubic(double t, double p1, double p2)
+{
+    double it = 1 - t, itsq = it * it, tsq = t * t, tcube = t * tsq;
+    return (tcube + 3.0 * t * itsq * p1 + 3.0 * tsq * it * p2) * 1.154700538;
+}
+
+static double quilted(const scene_pattern *pat, vec3 p)
+{
+    vec3 v = v3(p.x - pov_floor(p.x) - 0.5, p.y - pov_floor(p.y) - 0.5, p.z - pov_floor(p.z) - 0.5);
+    double t = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+    t = quilt_cubic(t, pat->control0, pat->control1);
+    return (fabs(v.x * t) + fabs(v.y * t) + fabs(v.z * t)) / 3.0;
+}
+
+static double radial(vec3 p)
+{
+    if (fabs(p.x) < 0.001 && fabs(p.z) < 0.001) return 0.25;
+    return 0.25 + (atan2(p.x, p.z) + PI_) / TWO_PI;
+}
+
+static double ripples(const scene_pattern *pat, vec3 p)
+{
+    double s = 0.0;
+    for (int i = 0; i < NOISE_WAVES; i++) {
+        double len = v3_len(v3_sub(p, noise_wave_source(i)));
+        if (len == 0.0) len = 1.0;
+        s += noise_cycloidal(len * pat->frequency + pat->phase);
+    }
+    return 0.5 * (1.0 + (s / (double)NOISE_WAVES));
+}
+
+static double waves(const scene_pattern *pat, vec3 p)
+{
+    double s = 0.0;
+    for (int i = 0; i < NOISE_WAVES; i++) {
+        double len = v3_len(v3_sub(p, noise_wave_source(i)));
+        if (len == 0.0) len = 1.0;
+        double f = noise_wave_frequency(i);
+        s += noise_cycloidal(len * pat->frequency * f + pat->phase) / f;
+    }
+    return 0.2 * (2.5 + (s / (double)NOISE_WAVES));
+}
+
+static double spiral_phi(double x, double y, double rad)
+{
+    if (rad == 0.0) return 0.0;
+    return x < 0.0 ? 3.0 * HALF_PI - asin(y / rad) : HALF_PI + asin(y / rad);
+}
+
+static double spiral1(const scene_pattern *pat, vec3 p, int gen)
+{
+    double tv = turb_scalar(pat, p, gen);
+    double rad = sqrt(p.x * p.x + p.y * p.y);
+    double phi = spiral_phi(p.x, p.y, rad);
+    return p.z + rad + (double)pat->arms * phi / TWO_PI + tv;
+}
+
+static double spiral2(const scene_pattern *pat, vec3 p, int gen)
+{
+    double tv = turb_scalar(pat, p, gen);
+    double rad = sqrt(p.x * p.x + p.y * p.y);
+    double phi = spiral_phi(p.x, p.y, rad);
+    tv = noise_triangle_wave(p.z + rad + (double)pat->arms * phi / TWO_PI + tv);
+    return noise_triangle_wave(rad) + tv;
+}
+
+static double wood(const scene_pattern *pat, vec3 p)
+{
+    const scene_warp *t = pattern_classic_turb(pat);
+    double px = 0.0, py = 0.0;
+    if (t) {
+        vec3 wt = noise_dturbulence(p, t->octaves, t->omega, t->lambda);
+        px = noise_cycloidal((p.x + wt.x) * t->turbulence.x);
+        py = noise_cycloidal((p.y + wt.y) * t->turbulence.y);
+    }
+    px += p.x;
+    py += p.y;
+    return sqrt(px * px + py * py);
+}
+
+static double wrinkles(vec3 p, int gen)
+{
+    double lambda = 2.0, omega = 0.5, value;
+    if (gen > 1) value = fmin(fmax(noise_value(p, gen) * 2.0 - 0.5, 0.0), 1.0);
+    else value = noise_value(p, gen);
+    for (int i = 1; i < 10; i++) {
+        vec3 t = v3_scale(p, lambda);
+        if (gen > 1) value += omega * fmin(fmax(noise_value(t, gen) * 2.0 - 0.5, 0.0), 1.0);
+        else value += omega * noise_value(t, gen);
+        lambda *= 2.0;
+        omega *= 0.5;
+    }
+    return value / 2.0;
+}
+
+static double slope(const scene_pattern *pat, const pattern_ctx *c)
+{
+    if (!c->has_hit) return 0.0;
+    double v = v3_dot(c->normal, pat->slope_dir);
+    if (v > 1.0) v = 1.0;
+    else if (v < -1.0) v = -1.0;
+    v = asin(v) / PI_ * 2;
+    v = (v + 1.0) * 0.5;
+    if (pat->slope_hi != 0.0) v = (v - pat->slope_lo) / pat->slope_hi;
+    if (v == 1.0) return v - PAT_EPSILON;
+    return v < 0.0 ? 1.0 + fmod(v, 1.0) : fmod(v, 1.0);
+}
+
+static double aoi(const pattern_ctx *c)
+{
+    if (!c->has_hit) return 0.0;
+    double ca = v3_dot(v3_norm(c->normal), v3_norm(c->dir));
+    ca = fmin(1.0, fmax(-1.0, ca));
+    return acos(ca) / PI_;
+}
+
+static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
+{
+    int gen = pat->noise_generator ? pat->noise_generator : c->noise_generator;
+    switch (pat->kind) {
+    case PAT_AGATE: return agate(pat, p, gen);
+    case PAT_BOZO: case PAT_SPOTTED: case PAT_BUMPS: return noise_value(p, gen);
+    case PAT_BRICK: return brick(pat, p);
+    case PAT_CELLS: return cells(p);
+    case PAT_CHECKER: return checker(p);
+    case PAT_CRACKLE: return crackle(pat, p, gen);
+    case PAT_GRADIENT: {
+        double r = v3_dot(p, pat->gradient);
+        return r > 1.0 ? fmod(r, 1.0) : r;
+    }
+    case PAT_GRANITE: return granite(p, gen);
+    case PAT_HEXAGON: return hexagon(p);
+    case PAT_SQUARE: return square_pat(p);
+    case PAT_TRIANGULAR: return triangular(p);
+    case PAT_CUBIC: return cubic_pat(p);
+    case PAT_LEOPARD: {
+        double s = (sin(p.x) + sin(p.y) + sin(p.z)) / 3.0;
+        return s * s;
+    }
+    case PAT_MARBLE: return p.x + turb_scalar(pat, p, gen);
+    case PAT_ONION: return fmod(sqrt(p.x * p.x + p.y * p.y + p.z * p.z), 1.0);
+    case PAT_RADIAL: return radial(p);
+    case PAT_SPIRAL1: return spiral1(pat, p, gen);
+    case PAT_SPIRAL2: return spiral2(pat, p, gen);
+    case PAT_WOOD: return wood(pat, p);
+    case PAT_WAVES: return waves(pat, p);
+    case PAT_RIPPLES: return ripples(pat, p);
+    case PAT_WRINKLES: return wrinkles(p, gen);
+    case PAT_DENTS: {
+        double n = noise_value(p, gen);
+        return n * n * n;
+    }
+    case PAT_QUILTED: return quilted(pat, p);
+    case PAT_PLANAR: return clip01(fabs(p.y));
+    case PAT_BOXED: return clip01(fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
+    case PAT_SPHERICAL: return clip01(v3_len(p));
+    case PAT_CYLINDRICAL: return clip01(sqrt(p.x * p.x + p.z * p.z));
+    case PAT_PIGMENT: {
+        colour5 col;
+        if (!pat->pigment || !pigment_eval(pat->pigment, p, c, &col)) return 0.0;
+        return GREY(col.r, col.g, col.b);
+    }
+    case PAT_IMAGE: {
+        /* image_pattern: the greyscale (or alpha with use_alpha) of the image */
+        colour5 col;
+        if (!pattern_image_colour(&pat->image, p, &col)) return 0.0;
+        if (pat->image.use_alpha) return 1.0 - col.t;
+        return GREY(col.r, col.g, col.b);
+    }
+    case PAT_SLOPE: return slope(pat, c);
+    case PAT_AOI: return aoi(c);
+    default: return 0.0;
+    }
+}
+
+double pattern_value(const scene_pattern *pat, vec3 tp, const pattern_ctx *c)
+{
+    double v = raw_value(pat, tp, c);
+    if (pat->frequency != 0.0) v = fmod(v * pat->frequency + pat->phase, 1.00001);
+    if (v < 0.0) v -= floor(v);
+    switch (pat->wave) {
+    case WAVE_RAMP: break;
+    case WAVE_SINE: v = (1.0 + noise_cycloidal(v)) * 0.5; break;
+    case WAVE_TRIANGLE: v = noise_triangle_wave(v); break;
+    case WAVE_SCALLOP: v = fabs(noise_cycloidal(v * 0.5)); break;
+    case WAVE_CUBIC: v = v * v * ((-2.0 * v) + 3.0); break;
+    case WAVE_POLY: v = pow(v, pat->exponent); break;
+    }
+    return v;
+}
+
+/* ------------------------------------------------------------ blend maps */
+
+#define F(x) ((double)(float)(x))
+#define E(v, r, g, b) {F(v), {F(r), F(g), F(b), 0, 0}, NULL, NULL, NULL, 0, 0}
+static const scene_map_entry grey_e[] = {E(0.0, 0, 0, 0), E(1.0, 1, 1, 1)};
+static const scene_map_entry bozo_e[] = {E(0.4, 1, 1, 1), E(0.4, 0, 1, 0), E(0.6, 0, 1, 0),
+                                         E(0.6, 0, 0, 1), E(0.8, 0, 0, 1), E(0.8, 1, 0, 0)};
+static const scene_map_entry wood_e[] = {E(0.6, 0.666, 0.312, 0.2), E(0.6, 0.4, 0.1333, 0.066)};
+static const scene_map_entry agate_e[] = {E(0.0, 1.0, 1.0, 1.0), E(0.5, 0.95, 0.75, 0.5), E(0.5, 0.9, 0.7, 0.5),
+                                          E(0.6, 0.9, 0.7, 0.4), E(0.6, 1.0, 0.7, 0.4), E(1.0, 0.6, 0.3, 0.0)};
+static const scene_map_entry radial_e[] = {E(0.0, 0, 1, 1), E(0.333, 1, 1, 0), E(0.666, 1, 0, 1), E(1.0, 0, 1, 1)};
+static const scene_map_entry marble_e[] = {E(0.0, 0.9, 0.8, 0.8), E(0.9, 0.9, 0.08, 0.08), E(0.9, 0, 0, 0)};
+static const scene_map_entry brick_e[] = {E(0.0, 0.5, 0.5, 0.5), E(1.0, 0.6, 0.15, 0.15)};
+static const scene_map_entry hex_e[] = {E(0.0, 0, 0, 1), E(1.0, 0, 1, 0), E(2.0, 1, 0, 0)};
+static const scene_map_entry cubic_e[] = {E(0.0, 1, 0, 0), E(1.0, 0, 1, 0), E(1.0, 0, 0, 1),
+                                          E(1.0, 1, 1, 0), E(1.0, 0, 1, 1), E(2.0, 1, 0, 1)};
+#undef E
+static const scene_blend_map grey_map = {MAP_COLOUR, 2, grey_e};
+static const scene_blend_map bozo_map = {MAP_COLOUR, 6, bozo_e};
+static const scene_blend_map wood_map = {MAP_COLOUR, 2, wood_e};
+static const scene_blend_map agate_map = {MAP_COLOUR, 6, agate_e};
+static const scene_blend_map radial_map = {MAP_COLOUR, 4, radial_e};
+static const scene_blend_map marble_map = {MAP_COLOUR, 3, marble_e};
+static const scene_blend_map brick_map = {MAP_COLOUR, 2, brick_e};
+static const scene_blend_map hex_map = {MAP_COLOUR, 3, hex_e};
+static const scene_blend_map check_map = {MAP_COLOUR, 2, hex_e};      /* POV-Ray uses the hexagon entries */
+static const scene_blend_map cubic_map = {MAP_COLOUR, 6, cubic_e};
+static const scene_blend_map square_map = {MAP_COLOUR, 4, cubic_e};   /* likewise the cubic entries */
+
+const scene_blend_map *pattern_default_map(pattern_kind k)
+{
+    switch (k) {
+    case PAT_BOZO: return &bozo_map;
+    case PAT_BRICK: return &brick_map;
+    case PAT_WOOD: return &wood_map;
+    case PAT_RADIAL: return &radial_map;
+    case PAT_AGATE: return &agate_map;
+    case PAT_MARBLE: return &marble_map;
+    case PAT_HEXAGON: return &hex_map;
+    case PAT_SQUARE: return &square_map;
+    case PAT_TRIANGULAR: case PAT_CUBIC: return &cubic_map;
+    case PAT_CHECKER: return &check_map;
+    default: return &grey_map;
+    }
+}
+
+void blend_map_search(const scene_blend_map *m, double v, int *prev, int *cur)
+{
+    int last = m->n - 1, p, c;
+    if (v >= m->e[last].value) {
+        p = c = last;
+    } else {
+        p = c = 0;
+        while (v > m->e[c].value) p = c++;
+    }
+    if (v == m->e[c].value) p = c;
+    *prev = p;
+    *cur = c;
+}
+
+/* ------------------------------------------------------------ pigments */
+
+static colour5 c5_lerp(colour5 a, colour5 b, double f)
+{
+    /* POV-Ray: Temp + fraction * (colour - Temp) */
+    colour5 r = {a.r + f * (b.r - a.r), a.g + f * (b.g - a.g), a.b + f * (b.b - a.b), a.f + f * (b.f - a.f), a.t + f * (b.t - a.t)};
+    return r;
+}
+
+static colour5 entry_colour(const scene_map_entry *e)
+{
+    colour5 c = {e->c[0], e->c[1], e->c[2], e->c[3], e->c[4]};
+    return c;
+}
+
+int pigment_eval(const scene_pigment *pg, vec3 p, const pattern_ctx *c, colour5 *out)
+{
+    if (pg->kind != PIGMENT_PATTERN || !pg->pat) {
+        *out = pg->colour;
+        return 1;
+    }
+    const scene_pattern *pat = pg->pat;
+    vec3 q = xform_is_identity(&pg->transform) ? p : xform_inv_point(&pg->transform, p);
+    vec3 tp = pattern_warp(pat, q);
+    if (pat->kind == PAT_IMAGE && !pg->map) return pattern_image_colour(&pat->image, tp, out);
+    const scene_blend_map *m = pg->map ? pg->map : pattern_default_map(pat->kind);
+    if (pat->kind == PAT_AVERAGE) {
+        colour5 acc = {0, 0, 0, 0, 0};
+        double total = 0.0;
+        for (int i = 0; i < m->n; i++) {
+            colour5 lc = {0, 0, 0, 0, 0};
+            float w = (float)m->e[i].value;
+            if (m->kind == MAP_PIGMENT && m->e[i].pigment) pigment_eval(m->e[i].pigment, tp, c, &lc);
+            else lc = entry_colour(&m->e[i]);
+            acc.r += lc.r * w; acc.g += lc.g * w; acc.b += lc.b * w; acc.f += lc.f * w; acc.t += lc.t * w;
+            total += w;
+        }
+        if (total != 0.0) {
+            acc.r /= total; acc.g /= total; acc.b /= total; acc.f /= total; acc.t /= total;
+        }
+        *out = acc;
+        return 1;
+    }
+    double v = pattern_value(pat, tp, c);
+    int ip, ic;
+    blend_map_search(m, v, &ip, &ic);
+    int found = 0;
+    colour5 col = {0, 0, 0, 0, 0}, prev = {0, 0, 0, 0, 0};
+    if (m->kind == MAP_PIGMENT) {
+        if (m->e[ic].pigment && pigment_eval(m->e[ic].pigment, tp, c, &col)) found = 1;
+    } else {
+        col = entry_colour(&m->e[ic]);
+        found = 1;
+    }
+    if (ip != ic) {
+        if (m->kind == MAP_PIGMENT) {
+            if (m->e[ip].pigment && pigment_eval(m->e[ip].pigment, tp, c, &prev)) found = 1;
+        } else {
+            prev = entry_colour(&m->e[ip]);
+        }
+        double f = (v - m->e[ip].value) / (m->e[ic].value - m->e[ip].value);
+        col = c5_lerp(prev, col, f);
+    }
+    *out = col;
+    return found;
+}
+
+/* ------------------------------------------------------------ image maps */
+
+static double wrap_to(double v, double n)
+{
+    double t = fmod(v, n);
+    if (t < 0.0) t += n;
+    if (t >= n) t = 0.0;
+    return t;
+}
+
+static int image_uv(const scene_image_map *im, vec3 p, double *u, double *v)
+{
+    const scene_image *img = im->image;
+    double w = img->width, h = img->height;
+    double x = p.x, y = p.y, z = p.z;
+    switch (im->map_type) {
+    case 1: { /* spherical */
+        double len = sqrt(x * x + y * y + z * z);
+        if (len == 0.0) return 0;
+        x /= len; y /= len; z /= len;
+        double phi = 0.5 + asin(y) / PI_;
+        double l2 = sqrt(x * x + z * z);
+        double theta = l2 == 0.0 ? 0.0 : xz_angle(x, z, l2) / TWO_PI;
+        *u = theta * w;
+        *v = phi * h;
+        return 1;
+    }
+    case 2: { /* cylindrical */
+        if (im->once && (y < 0.0 || y > 1.0)) return 0;
+        *v = fmod(y * h, h);
+        double len = sqrt(x * x + y * y + z * z);
+        if (len == 0.0) return 0;
+        x /= len; z /= len;
+        double l2 = sqrt(x * x + z * z);
+        if (l2 == 0.0) return 0;
+        *u = xz_angle(x, z, l2) / TWO_PI * w;
+        return 1;
+    }
+    case 5: { /* torus */
+        double len = sqrt(x * x + z * z);
+        if (len == 0.0) return 0;
+        double theta = 0.0 - xz_angle(x, z, len);
+        x = len - im->major_radius;
+        len = sqrt(x * x + y * y);
+        double phi = acos(-x / len);
+        if (y > 0.0) phi = TWO_PI - phi;
+        *u = -(theta / TWO_PI) * w;
+        *v = (phi / TWO_PI) * h;
+        return 1;
+    }
+    default: /* planar: gradient <1,-1,0>: u from x, v from y */
+        if (im->once && (x < 0.0 || x > 1.0)) return 0;
+        *u = fmod(x * w, w);
+        if (im->once && (y < 0.0 || y > 1.0)) return 0;
+        *v = fmod(y * h, h);
+        return 1;
+    }
+}
+
+static colour5 pixel(const scene_image_map *im, double xc, double yc)
+{
+    const scene_image *img = im->image;
+    int ix, iy;
+    if (im->once) {
+        ix = xc < 0.0 ? 0 : (xc >= img->width ? img->width - 1 : (int)xc);
+        iy = yc < 0.0 ? 0 : (yc >= img->height ? img->height - 1 : (int)yc);
+    } else {
+        ix = (int)wrap_to(xc, img->width);
+        iy = (int)wrap_to(yc, img->height);
+    }
+    const float *px = img->pixels + ((size_t)iy * img->width + ix) * 5;
+    colour5 c = {px[0], px[1], px[2], px[3], px[4]};
+    if (im->transmit_all_set) c.t += im->transmit_all;
+    if (im->filter_all_set) c.f += im->filter_all;
+    return c;
+}
+
+int pattern_image_colour(const scene_image_map *im, vec3 tp, colour5 *out)
+{
+    colour5 clear = {1, 1, 1, 0, 1};
+    if (!im->image || !im->image->pixels) {
+        *out = clear;
+        return 0;
+    }
+    double xc = 0.0, yc = 0.0;
+    if (!image_uv(im, tp, &xc, &yc)) {
+        *out = clear;
+        return 0;
+    }
+    double w = im->image->width, h = im->image->height;
+    xc += PAT_EPSILON;
+    yc += PAT_EPSILON;
+    if (im->once && (xc >= w || yc >= h || xc < 0.0 || yc < 0.0)) {
+        *out = clear;
+        return 0;
+    }
+    xc = wrap_to(xc, w);
+    yc = wrap_to(-yc, h); /* image rows run top-down */
+    if (im->interpolate != 2 && im->interpolate != 4) {
+        *out = pixel(im, xc, yc);
+        return 1;
+    }
+    xc += 0.5;
+    yc += 0.5;
+    int ix = (int)xc, iy = (int)yc;
+    colour5 cc[4] = {pixel(im, ix, iy), pixel(im, ix - 1.0, iy), pixel(im, ix, iy - 1.0), pixel(im, ix - 1.0, iy - 1.0)};
+    double pp = xc - (int)xc, q = yc - (int)yc, f[4];
+    if (im->interpolate == 2) {
+        f[0] = pp * q;
+        f[1] = (1 - pp) * q;
+        f[2] = pp * (1 - q);
+        f[3] = (1 - pp) * (1 - q);
+    } else {
+        double wt[4] = {1.0 / ((1 - pp) * (1 - pp) + (1 - q) * (1 - q)), 1.0 / (pp * pp + (1 - q) * (1 - q)),
+                        1.0 / ((1 - pp) * (1 - pp) + q * q), 1.0 / (pp * pp + q * q)};
+        double s = wt[0] + wt[1] + wt[2] + wt[3];
+        for (int i = 0; i < 4; i++) f[i] = wt[i] / s;
+    }
+    colour5 r = {0, 0, 0, 0, 0};
+    for (int i = 0; i < 4; i++) {
+        r.r += cc[i].r * f[i]; r.g += cc[i].g * f[i]; r.b += cc[i].b * f[i];
+        r.f += cc[i].f * f[i]; r.t += cc[i].t * f[i];
+    }
+    *out = r;
+    return 1;
+}

@@ -1,0 +1,51 @@
+/* shade_pattern.h - POV-Ray 3.7 pattern evaluation: warps, the pattern
+ * functions, frequency/phase/wave types, blend-map lookup and pigments
+ * (solid, patterned with color_map/pigment_map, image_map).
+ *
+ * This is the function the GI modes use to get a surface's colour where it
+ * varies: pigment_eval at the hit point (see also shade_texture.h,
+ * tex_pigment_at, which resolves texture transforms and texture_maps). */
+#ifndef PT_SHADE_PATTERN_H
+#define PT_SHADE_PATTERN_H
+#include "scene.h"
+
+/* What patterns may need besides the point. */
+typedef struct {
+    int noise_generator;  /* the scene's global_settings noise_generator (1..3) */
+    vec3 ipoint;          /* world hit point (slope point_at) */
+    vec3 normal;          /* perturbed world normal facing the viewer (slope, aoi); zero if unknown */
+    vec3 dir;             /* ray direction (aoi) */
+    int has_hit;          /* normal/dir are meaningful */
+} pattern_ctx;
+
+/* A context for evaluating patterns away from a surface. */
+pattern_ctx pattern_ctx_plain(const scene *sc);
+
+/* Apply a pattern's warps (POV-Ray's Warp_EPoint) to p. */
+vec3 pattern_warp(const scene_pattern *pat, vec3 p);
+/* Pattern value at an already warped point, with frequency, phase and the
+ * wave type applied (POV-Ray's Evaluate_TPat). */
+double pattern_value(const scene_pattern *pat, vec3 tp, const pattern_ctx *c);
+/* The classic turbulence warp of a pattern (the last warp), or NULL. */
+const scene_warp *pattern_classic_turb(const scene_pattern *pat);
+
+/* Blend-map lookup (POV-Ray's Search_Blend_Map): indices of the entries
+ * below and above v (equal when v is on or outside an end). */
+void blend_map_search(const scene_blend_map *m, double v, int *prev, int *cur);
+/* POV-Ray's default colour map for a pattern kind (bozo, wood, radial...). */
+const scene_blend_map *pattern_default_map(pattern_kind k);
+
+/* Pigment colour (rgb, filter, transmit) at p in the pigment's owner space
+ * (texture space for a texture's pigment). Returns 0 when no colour was
+ * found (outside an image_map used `once`), POV-Ray's Compute_Pigment. */
+int pigment_eval(const scene_pigment *pg, vec3 p, const pattern_ctx *c, colour5 *out);
+
+/* Image-map colour at a warped point (POV-Ray's image_map); 0 outside a
+ * `once` image (then *out is clear: transmit 1). */
+int pattern_image_colour(const scene_image_map *im, vec3 tp, colour5 *out);
+
+/* A linear transform's transpose applied to a vector (POV-Ray's
+ * MInvTransNormal: world normal -> pattern space). */
+vec3 pattern_normal_to_pattern(const xform *x, vec3 n);
+
+#endif

@@ -1,0 +1,423 @@
+/* shade_texture.c - POV-Ray 3.7 surface model at a hit (see shade_texture.h).
+ *
+ * Follows POV-Ray 3.7's Trace::ComputeOneTextureColour and
+ * ComputeLightedTexture (render/trace.cpp, studied for semantics):
+ *  - A patterned texture evaluates its pattern at the (texture-transformed,
+ *    warped) point and blends the fully lit colours of the two map entries
+ *    around the value; entries are evaluated at the warped point, and normals
+ *    of entries are warped through the parents' transforms first.
+ *  - A plain texture is a list of layers, top first. Per layer: the
+ *    perturbed normal, the pigment, the reflectivity (falloff or fresnel,
+ *    metallic tint), att = 1 - filter - transmit (1 - (filter * max(rgb) +
+ *    transmit) before #version 3.7), the layer's emission/ambient and direct
+ *    light times att, all filtered by the filter colour of the layers above;
+ *    then filter *= rgb*filter + transmit of the layer (and 1 - reflectivity
+ *    with conserve_energy); layers stop once grey(filter) drops under
+ *    adc_bailout.
+ *  - Transmission (trans > adc_bailout): a refracted ray with the top
+ *    layer's normal (ior 1 -> straight through); total internal reflection
+ *    reflects instead and is added unfiltered, and the layers' reflections
+ *    with the top normal are then skipped; otherwise the transmitted colour
+ *    is filtered. Interior fade on leaving an object:
+ *    fade_colour + (1 - fade_colour) / (1 + (d/fade_distance)^fade_power)
+ *    (exp(-(1 - fade_colour) d / fade_distance) for fade_power >= 1000).
+ *  - Reflection per layer along the layer's normal (POV-Ray's fix when the
+ *    mirrored ray goes below the raw surface), weighted by its
+ *    reflectivity, raised to reflection_exponent.
+ *
+ * Not modelled here: photons, media, subsurface, iridescence, uv_mapping,
+ * material_map, dispersion (ior used as is). */
+#include "shade_texture.h"
+#include <math.h>
+#include <string.h>
+#include "shade_normal.h"
+#include "shade_pattern.h"
+
+#define TEX_EPSILON 1.0e-10
+#define MAX_PARENTS 32
+#define MAX_LAYERS 64
+#define GREY(c) (0.297 * (c).r + 0.589 * (c).g + 0.114 * (c).b)
+
+static inline rgb trgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
+static inline rgb tadd(rgb a, rgb b) { return trgb(a.r + b.r, a.g + b.g, a.b + b.b); }
+static inline rgb tmul(rgb a, rgb b) { return trgb(a.r * b.r, a.g * b.g, a.b * b.b); }
+static inline rgb tscale(rgb a, double s) { return trgb(a.r * s, a.g * s, a.b * s); }
+static inline double tmax3(rgb a) { return fmax(a.r, fmax(a.g, a.b)); }
+
+/* A parent patterned texture whose transforms apply to normals below it. */
+typedef struct {
+    const xform *xf;
+    const scene_pattern *pat;
+} parent_frame;
+
+/* What stays the same for every texture evaluated at one hit. */
+typedef struct {
+    const tex_env *e;
+    const accel_hit *h;
+    vec3 dir;
+    vec3 raw;        /* raw normal facing the viewer */
+    vec3 ng;         /* geometric normal facing the viewer */
+    int entering;
+    vec3 p_out, p_in;
+    const scene_interior *interior;
+    int level;
+    unsigned skip;
+    double version;
+    pattern_ctx pc;
+} hit_info;
+
+static double scene_version(const scene *sc)
+{
+    if (sc->version_major <= 0) return 3.7;
+    return sc->version_major + sc->version_minor / 10.0;
+}
+
+static vec3 to_texture_space(const scene_texture *t, vec3 p)
+{
+    return xform_is_identity(&t->transform) ? p : xform_inv_point(&t->transform, p);
+}
+
+/* Perturbed normal of one layer (POV-Ray: parents' Warp_Normal, Perturb_Normal,
+ * normalise with no_bump_scale, parents' UnWarp_Normal). */
+static vec3 layer_normal(const hit_info *hi, const scene_texture *layer, vec3 point, const parent_frame *pf, int npf)
+{
+    vec3 n = hi->raw;
+    if (!layer->normal || !layer->normal->pat || layer->normal->pat->kind == PAT_PLAIN) return n;
+    for (int i = 0; i < npf; i++) n = normal_warp(n, pf[i].xf, NULL, pf[i].pat, 0);
+    vec3 tp = to_texture_space(layer, point);
+    n = normal_perturb(layer->normal, n, tp, xform_is_identity(&layer->transform) ? NULL : &layer->transform, &hi->pc);
+    if (layer->normal->no_bump_scale) n = v3_norm(n);
+    for (int i = npf - 1; i >= 0; i--) n = normal_unwarp(n, pf[i].xf, NULL, pf[i].pat, 0);
+    return v3_norm(n);
+}
+
+static int layer_pigment(const hit_info *hi, const scene_texture *layer, vec3 point, vec3 n, colour5 *out)
+{
+    pattern_ctx pc = hi->pc;
+    pc.normal = n;
+    return pigment_eval(&layer->pigment, to_texture_space(layer, point), &pc, out);
+}
+
+/* POV-Ray's ComputeReflection direction: mirror about n, fixed with the raw
+ * normal when it would leave below the surface. */
+static vec3 reflect_dir(vec3 d, vec3 n, vec3 raw)
+{
+    vec3 r = v3_madd(d, n, -2.0 * v3_dot(d, n));
+    double k = v3_dot(r, raw);
+    if (k < 0.0) {
+        if (v3_dot(r, n) < 0.0) r = v3_madd(d, raw, -2.0 * v3_dot(d, raw));
+        else r = v3_madd(r, raw, -2.0 * k);
+    }
+    return v3_norm(r);
+}
+
+static rgb trace_reflection(const hit_info *hi, vec3 n, double weight)
+{
+    const tex_env *e = hi->e;
+    if (weight < e->sc->global.adc_bailout) return trgb(0, 0, 0);
+    vec3 rd = reflect_dir(hi->dir, n, hi->raw);
+    return e->trace(e->ctx, e->thread, hi->p_out, rd, hi->level + 1, weight, OBJ_NO_REFLECTION, e->r);
+}
+
+static double interior_ior(const scene_interior *in) { return in && in->ior > 0.0 ? in->ior : 1.0; }
+
+/* Reflectivity of a layer (POV-Ray's ComputeReflectivity) and the weight of
+ * its reflected ray. */
+static rgb reflectivity(const hit_info *hi, const scene_finish *f, double cos_i, double *weight)
+{
+    rgb rmax = f->reflection_max, rmin = f->reflection_min, refl;
+    if (f->fresnel) {
+        double ior = interior_ior(hi->interior);
+        if (!hi->entering) ior = 1.0 / ior;
+        double sqx = ior * ior + cos_i * cos_i - 1.0;
+        if (sqx > 0.0) {
+            double g = sqrt(sqx);
+            double fr = 0.5 * ((g - cos_i) * (g - cos_i) / ((g + cos_i) * (g + cos_i)));
+            double a = cos_i * (g + cos_i) - 1.0, b = cos_i * (g - cos_i) + 1.0;
+            fr = fr * (1.0 + a * a / (b * b));
+            fr = fmin(1.0, fmax(0.0, fr));
+            refl = tadd(tscale(rmax, fr), tscale(rmin, 1.0 - fr));
+        } else {
+            refl = rmax;
+        }
+        *weight *= tmax3(refl);
+        return refl;
+    }
+    *weight *= fmax(tmax3(rmax), tmax3(rmin));
+    double frac = fabs(f->reflection_falloff - 1.0) > TEX_EPSILON ? pow(1.0 - cos_i, f->reflection_falloff) : 1.0 - cos_i;
+    if (fabs(frac) < TEX_EPSILON) return rmin;
+    if (fabs(frac - 1.0) < TEX_EPSILON) return rmax;
+    return tadd(tscale(rmax, frac), tscale(rmin, 1.0 - frac));
+}
+
+/* Refracted (or straight) ray through the surface; returns 1 on total
+ * internal reflection (colour then holds the reflected radiance). */
+static int refraction(const hit_info *hi, vec3 top, double weight, rgb *colour)
+{
+    const tex_env *e = hi->e;
+    double ior = interior_ior(hi->interior);
+    /* POV-Ray's ratio: outside/inside entering, inside/outside leaving. */
+    double eta = hi->entering ? 1.0 / ior : ior;
+    *colour = trgb(0, 0, 0);
+    if (weight < e->sc->global.adc_bailout) return 0;
+    if (fabs(eta - 1.0) < TEX_EPSILON) {
+        *colour = e->trace(e->ctx, e->thread, hi->p_in, hi->dir, hi->level + 1, weight, hi->skip, e->r);
+        return 0;
+    }
+    double n = v3_dot(hi->dir, top);
+    vec3 local;
+    if (n <= 0.0) {
+        local = top;
+        n = -n;
+    } else {
+        local = v3_neg(top);
+    }
+    double t = 1.0 + eta * eta * (n * n - 1.0);
+    if (t < 0.0) {
+        *colour = trace_reflection(hi, top, weight);
+        return 1;
+    }
+    t = eta * n - sqrt(t);
+    vec3 td = v3_norm(v3_add(v3_scale(hi->dir, eta), v3_scale(local, t)));
+    *colour = e->trace(e->ctx, e->thread, hi->p_in, td, hi->level + 1, weight, hi->skip, e->r);
+    return 0;
+}
+
+/* Interior fade of a ray segment of length d inside the object. */
+static rgb fade(const scene_interior *in, double d)
+{
+    rgb one = {1, 1, 1};
+    if (!in || fabs(in->fade_distance) <= TEX_EPSILON || in->fade_power <= 0.0) return one;
+    rgb fc = in->fade_colour;
+    if (in->fade_power >= 1000) {
+        double k = d / in->fade_distance;
+        return trgb(exp(-(1.0 - fc.r) * k), exp(-(1.0 - fc.g) * k), exp(-(1.0 - fc.b) * k));
+    }
+    double a = 1.0 + pow(d / in->fade_distance, in->fade_power);
+    return trgb(fc.r + (1.0 - fc.r) / a, fc.g + (1.0 - fc.g) / a, fc.b + (1.0 - fc.b) / a);
+}
+
+typedef struct {
+    double weight;
+    vec3 normal;
+    rgb reflec;
+    double exponent;
+    const scene_finish *f;
+} layer_refl;
+
+static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, const parent_frame *pf, int npf, double weight)
+{
+    const tex_env *e = hi->e;
+    const scene *sc = e->sc;
+    double bail = sc->global.adc_bailout;
+    rgb result = {0, 0, 0}, filcol = {1, 1, 1};
+    double trans = 1.0;
+    int one_colour_found = 0, nl = 0;
+    layer_refl lr[MAX_LAYERS];
+    vec3 top = hi->raw;
+
+    for (const scene_texture *layer = tex; layer && trans > bail && nl < MAX_LAYERS; layer = layer->next) {
+        const scene_finish *f = &layer->finish;
+        vec3 ln = layer_normal(hi, layer, point, pf, npf);
+        if (nl == 0) top = ln;
+        double new_weight = weight * trans;
+        colour5 lc = {0, 0, 0, 0, 0};
+        int found = layer_pigment(hi, layer, point, ln, &lc);
+        if (layer->pigment.kind == PIGMENT_OTHER && e->unsupported) (*e->unsupported)++;
+        one_colour_found |= found;
+        rgb pig = {lc.r, lc.g, lc.b};
+
+        layer_refl *L = &lr[nl++];
+        L->weight = new_weight;
+        L->normal = ln;
+        L->exponent = f->reflection_exponent;
+        L->f = f;
+        double cos_i = -v3_dot(hi->dir, ln);
+        L->reflec = reflectivity(hi, f, cos_i, &L->weight);
+        light_metallic_tint(&L->reflec, f->reflection_metallic, pig, cos_i);
+
+        double att = hi->version < 3.7 ? 1.0 - (lc.f * tmax3(pig) + lc.t) : 1.0 - lc.f - lc.t;
+        rgb tmp = {0, 0, 0};
+        if (e->indirect && f->diffuse > 0.0) tmp = tadd(tmp, tscale(tmul(pig, e->indirect(e->ctx, e->thread, hi->h, ln)), f->diffuse * att));
+        if (e->use_ambient) tmp = tadd(tmp, tscale(tmul(pig, tmul(f->ambient, sc->global.ambient_light)), att));
+        tmp = tadd(tmp, tscale(tmul(pig, f->emission), att));
+        if (f->diffuse != 0.0 || f->diffuse_back != 0.0 || f->specular != 0.0 || f->phong != 0.0) {
+            light_surface s = {f, pig, ln, hi->dir, att, e->r};
+            tmp = tadd(tmp, e->direct(e->ctx, e->thread, &s, hi->h, hi->p_out, e->r));
+        }
+        result = tadd(result, tmul(tmp, filcol));
+
+        if (found) {
+            filcol = tmul(filcol, trgb(lc.r * lc.f + lc.t, lc.g * lc.f + lc.t, lc.b * lc.f + lc.t));
+            if (f->conserve_energy)
+                filcol = tmul(filcol, trgb(fmin(1.0, 1.0 - L->reflec.r), fmin(1.0, 1.0 - L->reflec.g), fmin(1.0, 1.0 - L->reflec.b)));
+        }
+        trans = fmin(1.0, fabs(GREY(filcol)));
+    }
+
+    int tir = 0;
+    if (trans > bail) {
+        double w1 = fmax(fabs(filcol.r), fmax(fabs(filcol.g), fabs(filcol.b)));
+        rgb rfr;
+        tir = refraction(hi, top, weight * w1, &rfr);
+        rgb att = {1, 1, 1};
+        if (!hi->entering) att = fade(hi->interior, hi->h->t);
+        if (tir || !one_colour_found) result = tadd(result, tmul(att, rfr));
+        else result = tadd(result, tmul(tmul(att, rfr), filcol));
+    }
+
+    for (int i = 0; i < nl; i++) {
+        if (tir && fabs(top.x - lr[i].normal.x) <= TEX_EPSILON && fabs(top.y - lr[i].normal.y) <= TEX_EPSILON &&
+            fabs(top.z - lr[i].normal.z) <= TEX_EPSILON)
+            continue;
+        rgb rf = lr[i].reflec;
+        if (rf.r == 0.0 && rf.g == 0.0 && rf.b == 0.0) continue;
+        rgb rc = trace_reflection(hi, lr[i].normal, lr[i].weight);
+        if (lr[i].exponent != 1.0)
+            rc = trgb(pow(fmax(rc.r, 0.0), lr[i].exponent), pow(fmax(rc.g, 0.0), lr[i].exponent), pow(fmax(rc.b, 0.0), lr[i].exponent));
+        result = tadd(result, tmul(rf, rc));
+    }
+    return result;
+}
+
+static rgb one_texture(const hit_info *hi, const scene_texture *tex, vec3 point, parent_frame *pf, int npf, double weight)
+{
+    if (!tex->pat || !tex->map || tex->map->n == 0 || npf >= MAX_PARENTS) return lighted(hi, tex, point, pf, npf, weight);
+    const scene_pattern *pat = tex->pat;
+    const scene_blend_map *m = tex->map;
+    vec3 tp = pattern_warp(pat, to_texture_space(tex, point));
+    pf[npf].xf = xform_is_identity(&tex->transform) ? NULL : &tex->transform;
+    pf[npf].pat = pat;
+    if (pat->kind == PAT_AVERAGE) {
+        rgb acc = {0, 0, 0};
+        double total = 0.0;
+        for (int i = 0; i < m->n; i++) {
+            float w = (float)m->e[i].value;
+            if (m->e[i].texture) acc = tadd(acc, tscale(one_texture(hi, m->e[i].texture, tp, pf, npf + 1, weight), w));
+            total += w;
+        }
+        return total != 0.0 ? tscale(acc, 1.0 / total) : acc;
+    }
+    pattern_ctx pc = hi->pc;
+    double v = pattern_value(pat, tp, &pc);
+    int ip, ic;
+    blend_map_search(m, v, &ip, &ic);
+    rgb c = m->e[ic].texture ? one_texture(hi, m->e[ic].texture, tp, pf, npf + 1, weight) : trgb(0, 0, 0);
+    if (ip != ic) {
+        rgb c2 = m->e[ip].texture ? one_texture(hi, m->e[ip].texture, tp, pf, npf + 1, weight) : trgb(0, 0, 0);
+        double v1 = (v - m->e[ip].value) / (m->e[ic].value - m->e[ip].value);
+        c = tadd(tscale(c, v1), tscale(c2, 1.0 - v1));
+    }
+    return c;
+}
+
+static const scene_texture *hit_texture(const scene *sc, const accel_hit *h, int entering)
+{
+    if (!entering && h->obj && h->obj->interior_texture) return h->obj->interior_texture;
+    return h->texture ? h->texture : &sc->default_texture;
+}
+
+rgb tex_shade(const tex_env *e, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip)
+{
+    hit_info hi;
+    memset(&hi, 0, sizeof hi);
+    hi.e = e;
+    hi.h = h;
+    hi.dir = dir;
+    hi.level = level;
+    hi.skip = skip;
+    hi.version = scene_version(e->sc);
+    vec3 ng = h->ng, n = h->ns;
+    hi.entering = v3_dot(dir, ng) < 0.0;
+    if (v3_dot(dir, n) > 0.0) n = v3_neg(n);
+    if (!hi.entering) ng = v3_neg(ng);
+    hi.raw = n;
+    hi.ng = ng;
+    hi.p_out = v3_madd(h->p, ng, e->eps);
+    hi.p_in = v3_madd(h->p, ng, -e->eps);
+    hi.interior = h->obj ? h->obj->interior : NULL;
+    hi.pc = pattern_ctx_plain(e->sc);
+    hi.pc.ipoint = h->p;
+    hi.pc.normal = n;
+    hi.pc.dir = dir;
+    hi.pc.has_hit = 1;
+    parent_frame pf[MAX_PARENTS];
+    return one_texture(&hi, hit_texture(e->sc, h, hi.entering), h->p, pf, 0, weight);
+}
+
+/* ------------------------------------------------------------ colour only */
+
+static int texture_colour(const scene_texture *tex, vec3 point, const pattern_ctx *pc, colour5 *out, int depth)
+{
+    if (tex->pat && tex->map && tex->map->n > 0 && depth < MAX_PARENTS) {
+        const scene_blend_map *m = tex->map;
+        vec3 tp = pattern_warp(tex->pat, to_texture_space(tex, point));
+        double v = pattern_value(tex->pat, tp, pc);
+        int ip, ic;
+        blend_map_search(m, v, &ip, &ic);
+        colour5 a = {0, 0, 0, 0, 0}, b = {0, 0, 0, 0, 0};
+        int found = m->e[ic].texture ? texture_colour(m->e[ic].texture, tp, pc, &a, depth + 1) : 0;
+        if (ip != ic && m->e[ip].texture) {
+            found |= texture_colour(m->e[ip].texture, tp, pc, &b, depth + 1);
+            double f = (v - m->e[ip].value) / (m->e[ic].value - m->e[ip].value);
+            a.r = f * a.r + (1 - f) * b.r;
+            a.g = f * a.g + (1 - f) * b.g;
+            a.b = f * a.b + (1 - f) * b.b;
+            a.f = f * a.f + (1 - f) * b.f;
+            a.t = f * a.t + (1 - f) * b.t;
+        }
+        *out = a;
+        return found;
+    }
+    return pigment_eval(&tex->pigment, to_texture_space(tex, point), pc, out);
+}
+
+int tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_hit *h, colour5 *out)
+{
+    if (!tex) tex = h->texture ? h->texture : &sc->default_texture;
+    pattern_ctx pc = pattern_ctx_plain(sc);
+    pc.ipoint = h->p;
+    pc.normal = h->ns;
+    pc.has_hit = 1;
+    return texture_colour(tex, h->p, &pc, out, 0);
+}
+
+static rgb shadow_layers(const scene_texture *tex, vec3 point, const pattern_ctx *pc, int depth)
+{
+    if (tex->pat && tex->map && tex->map->n > 0 && depth < MAX_PARENTS) {
+        const scene_blend_map *m = tex->map;
+        vec3 tp = pattern_warp(tex->pat, to_texture_space(tex, point));
+        double v = pattern_value(tex->pat, tp, pc);
+        int ip, ic;
+        blend_map_search(m, v, &ip, &ic);
+        rgb a = m->e[ic].texture ? shadow_layers(m->e[ic].texture, tp, pc, depth + 1) : trgb(0, 0, 0);
+        if (ip != ic) {
+            rgb b = m->e[ip].texture ? shadow_layers(m->e[ip].texture, tp, pc, depth + 1) : trgb(0, 0, 0);
+            double f = (v - m->e[ip].value) / (m->e[ic].value - m->e[ip].value);
+            a = tadd(tscale(a, f), tscale(b, 1.0 - f));
+        }
+        return a;
+    }
+    rgb c = {1, 1, 1};
+    for (const scene_texture *l = tex; l; l = l->next) {
+        colour5 lc;
+        if (pigment_eval(&l->pigment, to_texture_space(l, point), pc, &lc))
+            c = tmul(c, trgb(lc.r * lc.f + lc.t, lc.g * lc.f + lc.t, lc.b * lc.f + lc.t));
+    }
+    return c;
+}
+
+rgb tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir)
+{
+    int entering = v3_dot(dir, h->ng) < 0.0;
+    const scene_texture *tex = hit_texture(sc, h, entering);
+    pattern_ctx pc = pattern_ctx_plain(sc);
+    pc.ipoint = h->p;
+    pc.normal = h->ns;
+    pc.dir = dir;
+    pc.has_hit = 1;
+    rgb c = shadow_layers(tex, h->p, &pc, 0);
+    const scene_interior *in = h->obj ? h->obj->interior : NULL;
+    if (!entering) c = tmul(c, fade(in, h->t));
+    return c;
+}

@@ -1,0 +1,54 @@
+/* shade_texture.h - POV-Ray 3.7 texture evaluation at a ray hit: patterned
+ * textures (texture_map and friends) blended from fully lit sub-textures,
+ * layered textures (filter colour through the layers), perturbed normals,
+ * per-layer reflection, refraction with total internal reflection, interior
+ * fade, all as POV-Ray's ComputeOneTextureColour / ComputeLightedTexture.
+ *
+ * The integrator (shade.c) supplies ray tracing, direct light and the GI
+ * indirect term through callbacks, so this module owns the surface model
+ * and nothing about rays or lights.
+ *
+ * For the GI modes: tex_pigment_at gives the pigment colour of a surface at a
+ * hit (patterns, image maps, texture maps resolved), the colour to use as
+ * albedo where pigments vary over a surface. */
+#ifndef PT_SHADE_TEXTURE_H
+#define PT_SHADE_TEXTURE_H
+#include "accel.h"
+#include "rng.h"
+#include "scene.h"
+#include "shade_light.h"
+
+typedef struct {
+    const scene *sc;
+    double eps;          /* distance the secondary origins move off the surface */
+    int use_ambient;     /* add finish ambient * ambient_light */
+    int max_level;
+    void *ctx;           /* the integrator's, passed back to the callbacks */
+    int thread;
+    rng *r;
+    /* Radiance along a ray (level = the new ray's level; skip = OBJ_* flags
+     * of objects the ray does not see). */
+    rgb (*trace)(void *ctx, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, rng *r);
+    /* Direct light of every light source on the layer surface s at p. */
+    rgb (*direct)(void *ctx, int thread, const light_surface *s, const accel_hit *h, vec3 p, rng *r);
+    /* GI indirect irradiance-like term at a diffuse layer (NULL = none). */
+    rgb (*indirect)(void *ctx, int thread, const accel_hit *h, vec3 n);
+    long *unsupported;   /* incremented when a hit uses something not evaluated (may be NULL) */
+} tex_env;
+
+/* Colour seen along unit `dir` at hit h (the ray's level and weight as in
+ * POV-Ray's TraceRay; skip as for trace). */
+rgb tex_shade(const tex_env *e, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip);
+
+/* Pigment colour (r g b filter transmit) of the top layer of the texture at
+ * a hit: texture transforms applied, texture maps blended. `tex` NULL = the
+ * hit's effective texture. Returns 0 if no colour was found (outside an
+ * image map used `once`). */
+int tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_hit *h, colour5 *out);
+
+/* Filter colour of a surface for a shadow ray crossing it at h (POV-Ray's
+ * ComputeShadowTexture: rgb*filter + transmit of the layers, multiplied;
+ * 0 for opaque surfaces). */
+rgb tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir);
+
+#endif
