@@ -21,6 +21,7 @@
 #include "shade.h"
 #include "stats_json.h"
 #include "timer.h"
+#include "view.h"
 
 #ifndef PARTRAY_VERSION
 #define PARTRAY_VERSION "0.0.0"
@@ -406,10 +407,7 @@ int main(int argc, char **argv)
     if (strcmp(cmd, "compare") == 0) return cmd_compare(argc - 2, argv + 2);
     if (strcmp(cmd, "sweep") == 0) return cmd_sweep(argc - 2, argv + 2);
     if (strcmp(cmd, "crosscheck") == 0) return cmd_crosscheck(argc - 2, argv + 2);
-    if (strcmp(cmd, "view") == 0) {
-        fprintf(stderr, "partray view: the interactive viewer is not built yet\n");
-        return EXIT_USAGE;
-    }
+    if (strcmp(cmd, "view") == 0) return cmd_view(argc - 2, argv + 2);
     /* POV-Ray habit: `partray scene.pov +W..` means render. */
     if (strstr(cmd, ".pov") || cmd[0] == '+') return cmd_render(argc - 1, argv + 1);
     fprintf(stderr, "partray: unknown command '%s'\n%s", cmd, usage_text);

@@ -1,0 +1,312 @@
+/* view_gi.c - the function table of the viewer's lighting modes. */
+#include "view_gi.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "gi.h"
+#include "shade.h"
+#include "timer.h"
+#include "gi_particle.h"
+#include "pm_path.h"
+
+typedef struct {
+    int mode;
+    int last_level;
+    pt_status (*open)(void **ctx, const scene *sc, const accel *a, int threads, view_gi_times *t, diag *d);
+    pt_status (*relight)(void *ctx, view_gi_times *t, diag *d);
+    pt_status (*render)(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d);
+    void (*describe)(void *ctx, char *buf, int n);
+    void (*close)(void *ctx);
+} gi_backend;
+
+struct view_gi {
+    const gi_backend *b;
+    void *ctx;
+};
+
+/* ------------------------------------------------------------------ none */
+
+typedef struct {
+    const scene *sc;
+    const accel *a;
+    long rays;
+} none_ctx;
+
+/* Shade settings for a pass of the Whitted renderer (none and particle). */
+static void whitted_settings(shade_settings *ss, const view_gi_pass *p)
+{
+    shade_default_settings(ss);
+    ss->width = p->width;
+    ss->height = p->height;
+    ss->threads = p->threads;
+    ss->seed = p->seed;
+    ss->antialias = p->level >= 2 ? 1 : 0;
+    ss->aa_threshold = 0.3;
+    ss->aa_depth = 3;
+    ss->use_ambient = 1;
+    ss->cancel = p->cancel;
+}
+
+static pt_status none_open(void **ctx, const scene *sc, const accel *a, int threads, view_gi_times *t, diag *d)
+{
+    none_ctx *c = calloc(1, sizeof *c);
+    if (!c) return PT_ERR_NOMEM;
+    c->sc = sc;
+    c->a = a;
+    *ctx = c;
+    return PT_OK;
+}
+
+static pt_status none_relight(void *ctx, view_gi_times *t, diag *d) { return PT_OK; }
+
+static pt_status none_render(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
+{
+    none_ctx *c = ctx;
+    shade_settings ss;
+    whitted_settings(&ss, p);
+    shade_stats st;
+    double t0 = timer_now();
+    pt_status s = shade_render(c->sc, c->a, &ss, fb, &st, d);
+    t->render = timer_now() - t0;
+    c->rays = st.primary_rays + st.shadow_rays + st.secondary_rays;
+    return s;
+}
+
+static void none_describe(void *ctx, char *buf, int n)
+{
+    none_ctx *c = ctx;
+    snprintf(buf, (size_t)n, "%.2f Mrays", c->rays * 1e-6);
+}
+
+static void none_close(void *ctx) { free(ctx); }
+
+/* -------------------------------------------------------------- particle */
+typedef struct {
+    const scene *sc;
+    const accel *a;
+    gi_particle *gp;
+    gi_particle_stats stats;
+} particle_ctx;
+
+static pt_status particle_open(void **ctx, const scene *sc, const accel *a, int threads, view_gi_times *t, diag *d)
+{
+    particle_ctx *c = calloc(1, sizeof *c);
+    if (!c) return PT_ERR_NOMEM;
+    c->sc = sc;
+    c->a = a;
+    gi_particle_settings s;
+    gi_particle_settings_from_scene(&s, sc);
+    s.threads = threads;
+    pt_status st = PT_OK;
+    c->gp = gi_particle_build(sc, a, &s, &c->stats, d, &st);
+    if (!c->gp || st != PT_OK) {
+        gi_particle_free(c->gp);
+        free(c);
+        return st != PT_OK ? st : PT_ERR_INTERNAL;
+    }
+    st = gi_particle_light(c->gp, d);
+    const gi_particle_stats *gs = gi_particle_get_stats(c->gp);
+    t->build = gs->t_geometry;
+    t->light = gs->t_lighting;
+    *ctx = c;
+    if (st != PT_OK) return st;
+    return PT_OK;
+}
+
+static pt_status particle_relight(void *ctx, view_gi_times *t, diag *d)
+{
+    particle_ctx *c = ctx;
+    pt_status st = gi_particle_relight(c->gp, d);
+    t->light = gi_particle_get_stats(c->gp)->t_lighting;
+    return st;
+}
+
+static pt_status particle_render(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
+{
+    particle_ctx *c = ctx;
+    pt_status st = gi_particle_prepare_view(c->gp, &c->sc->camera, p->width, p->height, d);
+    t->view = gi_particle_get_stats(c->gp)->t_view;
+    if (st != PT_OK) return st;
+    shade_settings ss;
+    whitted_settings(&ss, p);
+    ss.use_ambient = 0;
+    ss.indirect = gi_particle_indirect;
+    ss.indirect_ctx = c->gp;
+    double t0 = timer_now();
+    st = shade_render(c->sc, c->a, &ss, fb, NULL, d);
+    t->render = timer_now() - t0;
+    return st;
+}
+
+static void particle_describe(void *ctx, char *buf, int n)
+{
+    particle_ctx *c = ctx;
+    const gi_particle_stats *s = gi_particle_get_stats(c->gp);
+    snprintf(buf, (size_t)n, "%ld particles, %d bounces", s->particles, s->bounces);
+}
+
+static void particle_close(void *ctx)
+{
+    particle_ctx *c = ctx;
+    if (!c) return;
+    gi_particle_free(c->gp);
+    free(c);
+}
+
+/* ------------------------------------------------------------------ path */
+#define PATH_LAST_LEVEL 8 /* 1 + 1 + 2 + ... + 128 = 256 spp */
+
+typedef struct {
+    const scene *sc;
+    const accel *a;
+    framebuffer *sum;  /* running sum at full resolution */
+    int spp;           /* samples in sum */
+} path_ctx;
+
+static pt_status path_open(void **ctx, const scene *sc, const accel *a, int threads, view_gi_times *t, diag *d)
+{
+    path_ctx *c = calloc(1, sizeof *c);
+    if (!c) return PT_ERR_NOMEM;
+    c->sc = sc;
+    c->a = a;
+    *ctx = c;
+    return PT_OK;
+}
+
+static pt_status path_relight(void *ctx, view_gi_times *t, diag *d) { return PT_OK; }
+
+static pt_status path_render(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
+{
+    path_ctx *c = ctx;
+    int spp = p->level <= 1 ? 1 : 1 << (p->level - 1);
+    pm_path_settings s;
+    pm_path_default_settings(&s);
+    s.c.width = p->width;
+    s.c.height = p->height;
+    s.c.threads = p->threads;
+    /* each pass its own samples: the seed says which */
+    s.c.seed = p->seed + 0x9e3779b97f4a7c15ULL * (uint64_t)(p->level + 1);
+    s.c.spp = spp;
+    s.c.cancel = p->cancel;
+    s.c.image_interval = 1e9;
+    pm_stats st;
+    memset(&st, 0, sizeof st);
+    double t0 = timer_now();
+    pt_status r = pm_path_render(c->sc, c->a, &s, fb, &st, d);
+    t->render = timer_now() - t0;
+    if (r != PT_OK || (p->cancel && *p->cancel)) return r;
+    if (p->level == 0) return PT_OK;
+    size_t n = (size_t)p->width * (size_t)p->height * 3u;
+    if (p->level == 1 || !c->sum || c->sum->width != p->width || c->sum->height != p->height) {
+        fb_free(c->sum);
+        c->sum = fb_new(p->width, p->height);
+        if (!c->sum) return PT_ERR_NOMEM;
+        memset(c->sum->rgb, 0, n * sizeof(float));
+        c->spp = 0;
+    }
+    for (size_t i = 0; i < n; i++) c->sum->rgb[i] += fb->rgb[i] * (float)spp;
+    c->spp += spp;
+    float k = 1.0f / (float)c->spp;
+    for (size_t i = 0; i < n; i++) fb->rgb[i] = c->sum->rgb[i] * k;
+    return PT_OK;
+}
+
+static void path_describe(void *ctx, char *buf, int n)
+{
+    path_ctx *c = ctx;
+    snprintf(buf, (size_t)n, "%d spp", c->spp);
+}
+
+static void path_close(void *ctx)
+{
+    path_ctx *c = ctx;
+    if (!c) return;
+    fb_free(c->sum);
+    free(c);
+}
+
+/* ----------------------------------------------------------------- table */
+
+static const gi_backend backends[] = {
+    {GI_NONE, 2, none_open, none_relight, none_render, none_describe, none_close},
+    {GI_PARTICLE, 2, particle_open, particle_relight, particle_render, particle_describe, particle_close},
+    {GI_PATH, PATH_LAST_LEVEL, path_open, path_relight, path_render, path_describe, path_close},
+};
+enum { NBACKENDS = (int)(sizeof backends / sizeof backends[0]) };
+
+static const gi_backend *find(int mode)
+{
+    for (int i = 0; i < NBACKENDS; i++)
+        if (backends[i].mode == mode) return &backends[i];
+    return NULL;
+}
+
+int view_gi_modes(int *modes, int n)
+{
+    int k = 0;
+    for (int i = 0; i < NBACKENDS && k < n; i++) modes[k++] = backends[i].mode;
+    return k;
+}
+
+int view_gi_available(int mode) { return find(mode) != NULL; }
+
+int view_gi_next(int mode)
+{
+    for (int i = 0; i < NBACKENDS; i++)
+        if (backends[i].mode == mode) return backends[(i + 1) % NBACKENDS].mode;
+    return backends[0].mode;
+}
+
+const char *view_gi_name(int mode) { return gi_mode_name((gi_mode)mode); }
+
+pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a, int threads, view_gi_times *t, diag *d)
+{
+    *out = NULL;
+    memset(t, 0, sizeof *t);
+    const gi_backend *b = find(mode);
+    if (!b) {
+        diag_error(d, "GI mode '%s' is not available in the viewer", view_gi_name(mode));
+        return PT_ERR_UNSUPPORTED;
+    }
+    view_gi *g = calloc(1, sizeof *g);
+    if (!g) return PT_ERR_NOMEM;
+    g->b = b;
+    double t0 = timer_now();
+    pt_status st = b->open(&g->ctx, sc, a, threads, t, d);
+    if (t->build == 0 && t->light == 0) t->build = timer_now() - t0;
+    if (st != PT_OK) {
+        if (g->ctx) b->close(g->ctx);
+        free(g);
+        return st;
+    }
+    *out = g;
+    return PT_OK;
+}
+
+int view_gi_mode(const view_gi *g) { return g->b->mode; }
+int view_gi_last_level(const view_gi *g) { return g->b->last_level; }
+
+pt_status view_gi_relight(view_gi *g, view_gi_times *t, diag *d)
+{
+    memset(t, 0, sizeof *t);
+    return g->b->relight(g->ctx, t, d);
+}
+
+pt_status view_gi_render(view_gi *g, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
+{
+    memset(t, 0, sizeof *t);
+    return g->b->render(g->ctx, p, fb, t, d);
+}
+
+void view_gi_describe(const view_gi *g, char *buf, int n)
+{
+    if (n > 0) buf[0] = 0;
+    g->b->describe(g->ctx, buf, n);
+}
+
+void view_gi_close(view_gi *g)
+{
+    if (!g) return;
+    g->b->close(g->ctx);
+    free(g);
+}

@@ -1,0 +1,66 @@
+/* view_gi.h - the viewer's lighting modes behind one small interface. Each
+ * mode is a row of a function table in view_gi.c (open, relight, render,
+ * close, number of refinement levels); nothing else in the viewer knows
+ * which renderer runs.
+ *
+ *   none      shade_render: direct light + Whitted (+ POV-Ray's ambient).
+ *             Levels: 0 preview, 1 full resolution, 2 adaptive antialiasing
+ *             (+A0.3 +R3).
+ *   particle  gi_particle (seed 000): open = geometry + lighting stage,
+ *             relight = lighting stage only, every pass = prepare_view +
+ *             shade_render with the indirect hook. Levels as `none`.
+ *   path      pm_path (reference preview): levels 0 preview at 1 spp, 1 full
+ *             resolution at 1 spp, then passes of 1, 2, 4, ... more samples
+ *             averaged in, up to 256 spp in all.
+ *
+ * Calls come from one thread (the viewer's render thread). The scene's
+ * lights may be edited between calls; call relight after such an edit. */
+#ifndef PT_VIEW_GI_H
+#define PT_VIEW_GI_H
+#include <stdint.h>
+#include "accel.h"
+#include "diag.h"
+#include "framebuffer.h"
+#include "scene.h"
+
+typedef struct view_gi view_gi;
+
+/* Seconds spent by the last call, by stage (0 for stages it did not run). */
+typedef struct {
+    double build;   /* geometry stage (open) */
+    double light;   /* lighting stage (open, relight) */
+    double view;    /* per-view work before the pass (particle: prepare_view) */
+    double render;  /* the pass itself */
+} view_gi_times;
+
+typedef struct {
+    int width, height;      /* size of this pass (fb has it) */
+    int level;              /* 0 preview, 1 first full-resolution pass, >= 2 refinements */
+    int threads;            /* <= 0: all cores */
+    uint64_t seed;
+    volatile int *cancel;   /* non-zero: stop soon; the pass's image is then incomplete */
+} view_gi_pass;
+
+/* The modes (gi.h's gi_mode values) the viewer can switch to, in the order
+ * `G` cycles them. Returns the count written into modes[] (at most n). */
+int view_gi_modes(int *modes, int n);
+int view_gi_available(int mode);
+/* The mode after `mode` in the cycle. */
+int view_gi_next(int mode);
+const char *view_gi_name(int mode);
+
+/* Opens a mode on a scene: runs whatever the mode precomputes. */
+pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a, int threads, view_gi_times *t, diag *d);
+int view_gi_mode(const view_gi *g);
+/* The last level of the refinement (none/particle 2, path 8). */
+int view_gi_last_level(const view_gi *g);
+/* The scene's lights changed (positions, colours). */
+pt_status view_gi_relight(view_gi *g, view_gi_times *t, diag *d);
+/* One pass of the refinement into fb (p->width x p->height) with the
+ * scene's current camera. */
+pt_status view_gi_render(view_gi *g, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d);
+/* A line of mode-specific figures (particle counts, spp) for the title bar. */
+void view_gi_describe(const view_gi *g, char *buf, int n);
+void view_gi_close(view_gi *g);
+
+#endif

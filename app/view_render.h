@@ -1,0 +1,92 @@
+/* view_render.h - the viewer's render thread: progressive refinement off the
+ * UI thread, cancellation, double-buffered images.
+ *
+ * The UI thread posts the wanted state (camera, lights, GI mode) with
+ * view_render_submit and never waits for a render: the thread renders the
+ * newest state in levels (view_gi.h): level 0 is a quick preview at 1/d of
+ * the resolution (d adapts so a preview takes about 40 ms, 2 <= d <= 16),
+ * level 1 the full resolution, higher levels refine (antialiasing, more
+ * samples) while nothing changes. Each finished pass is upsampled to the
+ * full size, converted to sRGB 8-bit and swapped with the front buffer under
+ * a short lock; the UI copies the front buffer when its serial changes, so
+ * the window keeps showing the last complete image while the next one
+ * computes (the asynchronous updates of seed 001).
+ *
+ * A submit cancels a refinement pass (level >= 1) through
+ * shade_settings.cancel; a preview pass is left to finish (so continuous
+ * motion still shows frames) unless the GI mode changed. Light edits rerun
+ * only the GI's lighting stage (view_gi_relight), camera moves only the
+ * per-view work and the passes, a mode change opens the new mode (its
+ * geometry stage) while the old image stays on screen. */
+#ifndef PT_VIEW_RENDER_H
+#define PT_VIEW_RENDER_H
+#include <stdint.h>
+#include "accel.h"
+#include "diag.h"
+#include "framebuffer.h"
+#include "scene.h"
+#include "view_gi.h"
+
+typedef struct view_render view_render;
+
+/* The editable part of a light. */
+typedef struct {
+    vec3 position, point_at;
+    rgb colour;
+} view_light;
+
+typedef struct {
+    scene_camera camera;
+    int gi_mode;
+    const view_light *lights; /* the scene's light count of them (copied) */
+} view_state;
+
+enum { VIEW_CAUSE_CAMERA = 1, VIEW_CAUSE_LIGHT = 2, VIEW_CAUSE_MODE = 4 };
+
+typedef struct {
+    int width, height;      /* full image size */
+    int threads;            /* <= 0: all cores */
+    uint64_t seed;
+    int preview_div;        /* 0: adaptive (start 4); else fixed */
+} view_render_opts;
+
+typedef struct {
+    long serial;            /* counts published images from 1 */
+    long generation;        /* the submit it shows (0 = the initial state) */
+    int level, last_level;
+    int width, height;      /* size of the pass (full size after upsampling) */
+    int gi_mode;            /* the mode that made it */
+    double frame;           /* seconds from the pass's start to its publication, GI stages included */
+    view_gi_times times;    /* stages run for this pass (build/light only when they ran) */
+    double latency;         /* seconds from the oldest submit its generation answers to its publication */
+    int first;              /* the first image of its generation */
+    int cause;              /* VIEW_CAUSE_* of the submits in its generation */
+    int complete;           /* last level reached: the refinement is done */
+    char describe[96];      /* view_gi_describe */
+} view_frame_info;
+
+/* Starts the thread on the scene (which it owns from now on: the UI must
+ * not read or change it until view_render_stop) and the initial state. */
+pt_status view_render_start(view_render **out, scene *sc, const accel *a, const view_render_opts *o,
+                            const view_state *initial, diag *d);
+/* Post a new state; cause is VIEW_CAUSE_* bits (for latency figures). */
+void view_render_submit(view_render *vr, const view_state *s, int cause);
+/* Copies the front image (width*height*4 bytes, RGBA, sRGB) into rgba and
+ * its info when it is newer than *serial; returns 1 then, else 0. */
+int view_render_fetch(view_render *vr, long *serial, uint8_t *rgba, view_frame_info *info);
+/* 1 when the newest posted state is rendered to its last level. */
+int view_render_idle(view_render *vr);
+/* What the thread works on: level (or -1 when waiting) and for how long. */
+int view_render_busy(view_render *vr, double *seconds);
+/* Copy of the front image as linear floats at the full size (NULL before
+ * the first image); info may be NULL. */
+framebuffer *view_render_snapshot(view_render *vr, view_frame_info *info);
+/* Moves the thread's new messages (GI failures, warnings) into d. */
+void view_render_messages(view_render *vr, diag *d);
+/* Stops the thread (cancelling the pass) and frees everything but the scene. */
+void view_render_stop(view_render *vr);
+
+/* Linear -> sRGB 8-bit (clamped), the conversion used for the window. */
+uint8_t view_render_srgb8(float v);
+
+#endif
