@@ -795,8 +795,8 @@ static void version_directive(sdl_parser *p)
     if (!sdl_ok(p)) return;
     p->version = v;
     if (p->nframes == 1) {
-        p->s->version_major = (int)floor(v + 1e-9);
-        p->s->version_minor = (int)floor((v - p->s->version_major) * 10 + 0.5);
+        p->s->version_major = sdl_to_int(floor(v + 1e-9));
+        p->s->version_minor = sdl_to_int(floor((v - p->s->version_major) * 10 + 0.5));
     }
 }
 

@@ -262,7 +262,7 @@ static double seed_fn(sdl_parser *p)
 
 static double rand_fn(sdl_parser *p, src_loc loc)
 {
-    int i = (int)sdl_float_param(p);
+    int i = sdl_to_int(sdl_float_param(p));
     rand_streams *r = streams_of(p);
     if (!r || i < 0 || i >= r->n) {
         sdl_error(p, loc, PT_ERR_SYNTAX, "illegal random number generator");
@@ -889,9 +889,9 @@ static const char *str_fn(sdl_parser *p)
     sdl_expect(p, TOK_LPAREN, "'('");
     double v = sdl_float(p);
     sdl_accept(p, TOK_COMMA);
-    int w = (int)sdl_float(p);
+    int w = sdl_to_int(sdl_float(p));
     sdl_accept(p, TOK_COMMA);
-    int prec = (int)sdl_float(p);
+    int prec = sdl_to_int(sdl_float(p));
     sdl_expect(p, TOK_RPAREN, "')'");
     char buf[128];
     if (prec < 0) prec = 6; /* POV-Ray: negative precision = as needed (up to 6) */
@@ -906,7 +906,7 @@ static const char *str_fn(sdl_parser *p)
 static const char *vstr_fn(sdl_parser *p)
 {
     sdl_expect(p, TOK_LPAREN, "'('");
-    int n = (int)sdl_float(p);
+    int n = sdl_to_int(sdl_float(p));
     sdl_accept(p, TOK_COMMA);
     double v[5];
     if (n < 2) n = 2;
@@ -915,9 +915,9 @@ static const char *vstr_fn(sdl_parser *p)
     sdl_accept(p, TOK_COMMA);
     const char *sep = string_expr(p);
     sdl_accept(p, TOK_COMMA);
-    int w = (int)sdl_float(p);
+    int w = sdl_to_int(sdl_float(p));
     sdl_accept(p, TOK_COMMA);
-    int prec = (int)sdl_float(p);
+    int prec = sdl_to_int(sdl_float(p));
     sdl_expect(p, TOK_RPAREN, "')'");
     if (prec < 0) prec = 6;
     char buf[512];
@@ -935,9 +935,9 @@ static const char *substr_fn(sdl_parser *p, src_loc loc)
     sdl_expect(p, TOK_LPAREN, "'('");
     const char *s = string_expr(p);
     sdl_accept(p, TOK_COMMA);
-    int start = (int)sdl_float(p);
+    int start = sdl_to_int(sdl_float(p));
     sdl_accept(p, TOK_COMMA);
-    int len = (int)sdl_float(p);
+    int len = sdl_to_int(sdl_float(p));
     sdl_expect(p, TOK_RPAREN, "')'");
     int n = (int)strlen(s);
     if (start < 1 || len < 0 || start - 1 + len > n) {
@@ -960,7 +960,7 @@ static const char *string_function(sdl_parser *p, const sdl_tok *t)
     }
     case KW_CHR: {
         char b[8];
-        int c = (int)sdl_float_param(p);
+        int c = sdl_to_int(sdl_float_param(p));
         b[0] = (char)(c > 0 && c < 256 ? c : '?');
         return sdl_strndup(p, b, 1);
     }

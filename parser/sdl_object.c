@@ -721,11 +721,11 @@ static void face_indices(sdl_parser *p, mesh_build *b)
         if (sdl_is(sdl_peek(p), TOK_RBRACE)) break;
         src_loc at = sdl_peek(p)->tk.loc;
         vec3 f = sdl_vector(p);
-        int v[3] = {(int)f.x, (int)f.y, (int)f.z}, tex = -1;
+        int v[3] = {sdl_to_int(f.x), sdl_to_int(f.y), sdl_to_int(f.z)}, tex = -1;
         if (sdl_is(sdl_peek(p), TOK_COMMA)) {
             sdl_next(p);
             if (sdl_starts_float(sdl_peek(p))) {
-                tex = (int)sdl_float(p);
+                tex = sdl_to_int(sdl_float(p));
                 b->any_tex = 1;
                 if (sdl_accept(p, TOK_COMMA) && sdl_starts_float(sdl_peek(p))) {
                     sdl_float(p);
@@ -754,7 +754,7 @@ static void index_list(sdl_parser *p, mesh_build *b, int normals)
         if (sdl_is(sdl_peek(p), TOK_RBRACE)) break;
         src_loc at = sdl_peek(p)->tk.loc;
         vec3 f = sdl_vector(p);
-        int v[3] = {(int)f.x, (int)f.y, (int)f.z};
+        int v[3] = {sdl_to_int(f.x), sdl_to_int(f.y), sdl_to_int(f.z)};
         if (normals && got < b->nt) {
             for (int i = 0; i < 3; i++) check_index(p, v[i], b->nn, "normal", at);
             memcpy(b->trin[got], v, sizeof v);

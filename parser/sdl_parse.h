@@ -7,6 +7,7 @@
  * function unwinds; callers check sdl_ok() where they must stop early. */
 #ifndef PT_SDL_PARSE_H
 #define PT_SDL_PARSE_H
+#include <limits.h>
 #include "scene.h"
 #include "sdl.h"
 #include "sdl_scan.h"
@@ -119,6 +120,16 @@ typedef struct sdl_parser {
     size_t build_bytes;   /* malloc'd work memory outside the arena (meshes being
                              built), counted against opt.max_memory */
 } sdl_parser;
+
+/* A number from the scene as an int: truncated toward zero, clamped to the
+ * int range, NaN as 0 (a plain (int) cast is undefined out of range). */
+static inline int sdl_to_int(double v)
+{
+    if (!(v == v)) return 0;
+    if (v >= (double)INT_MAX) return INT_MAX;
+    if (v <= (double)INT_MIN) return INT_MIN;
+    return (int)v;
+}
 
 /* --- recursion guard: 0 (with an error recorded) when nested too deep --- */
 int sdl_enter(sdl_parser *p, src_loc loc);

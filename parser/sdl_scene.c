@@ -32,7 +32,7 @@ static int camera_type(sdl_parser *p, scene_camera *c)
     case KW_SPHERICAL: c->kind = CAMERA_SPHERICAL; break;
     case KW_CYLINDER: {
         sdl_tok k = sdl_next(p);
-        int n = (int)sdl_float(p);
+        int n = sdl_to_int(sdl_float(p));
         if (n < 1 || n > 4) sdl_error(p, k.tk.loc, PT_ERR_SYNTAX, "invalid cylinder camera type %d (1 to 4)", n);
         c->kind = CAMERA_CYLINDER;
         c->cylinder_type = n;
@@ -80,7 +80,7 @@ static int camera_item(sdl_parser *p, scene_camera *c, camera_said *said)
     case KW_LOOK_AT: c->look_at = sdl_vector(p); said->had_look_at = 1; break;
     case KW_APERTURE: c->aperture = sdl_float(p); break;
     case KW_BLUR_SAMPLES:
-        c->blur_samples = (int)sdl_float(p);
+        c->blur_samples = sdl_to_int(sdl_float(p));
         if (sdl_accept(p, TOK_COMMA)) {
             double mx = sdl_allow_float(p, 0.0);
             if (mx > 0) c->blur_samples = (int)mx;
@@ -212,9 +212,9 @@ static void area_light(sdl_parser *p, scene_light *l, src_loc loc)
     sdl_accept(p, TOK_COMMA);
     l->axis2 = sdl_vector(p);
     sdl_accept(p, TOK_COMMA);
-    l->size1 = (int)sdl_float(p);
+    l->size1 = sdl_to_int(sdl_float(p));
     sdl_accept(p, TOK_COMMA);
-    l->size2 = (int)sdl_float(p);
+    l->size2 = sdl_to_int(sdl_float(p));
     if (sdl_ok(p) && (l->size1 <= 0 || l->size2 <= 0)) sdl_error(p, loc, PT_ERR_SYNTAX, "area light sizes must be greater than zero");
 }
 
@@ -280,7 +280,7 @@ static int light_item(sdl_parser *p, sdl_obj *so)
     case KW_POINT_AT: case KW_RADIUS: case KW_FALLOFF: case KW_TIGHTNESS: spot_param(p, l, &t); break;
     case KW_AREA_LIGHT: area_light(p, l, t.tk.loc); break;
     case KW_JITTER: l->jitter = 1; break;
-    case KW_ADAPTIVE: l->adaptive = (int)sdl_float(p); break;
+    case KW_ADAPTIVE: l->adaptive = sdl_to_int(sdl_float(p)); break;
     case KW_CIRCULAR: l->circular = 1; break;
     case KW_ORIENT: l->orient = 1; break;
     case KW_AREA_ILLUMINATION: l->area_illumination = sdl_allow_float(p, 1.0) > 0; break;
@@ -343,15 +343,15 @@ static double checked(sdl_parser *p, src_loc loc, double v, int ok, const char *
 /* radiosity count/nearest_count: N [ ',' M ] */
 static void radiosity_counts(sdl_parser *p, scene_radiosity *r, sdl_kw k, src_loc loc)
 {
-    int n = (int)sdl_float(p);
+    int n = sdl_to_int(sdl_float(p));
     sdl_accept(p, TOK_COMMA);
     if (k == KW_COUNT) {
         r->count = (int)checked(p, loc, n, n > 0, "count must be a positive number");
-        r->direction_pool = (int)sdl_allow_float(p, n > 1600 ? n : 1600);
+        r->direction_pool = sdl_to_int(sdl_allow_float(p, n > 1600 ? n : 1600));
         checked(p, loc, 0, r->direction_pool >= n, "count can not be more than the direction pool size (count's 2nd value)");
     } else {
         r->nearest_count = (int)checked(p, loc, n, n >= 1 && n <= 20, "nearest_count must be from 1 to 20");
-        r->nearest_count_pretrace = (int)sdl_allow_float(p, 0.0);
+        r->nearest_count_pretrace = sdl_to_int(sdl_allow_float(p, 0.0));
         checked(p, loc, 0, r->nearest_count_pretrace >= 0 && r->nearest_count_pretrace < n,
                 "nearest_count for adaptive pretrace must be non-negative and smaller than nearest_count");
     }
@@ -370,7 +370,7 @@ static int radiosity_item(sdl_parser *p, scene_radiosity *r)
     double v;
     switch (t.tk.kw) {
     case KW_ADC_BAILOUT: v = sdl_float(p); r->adc_bailout = checked(p, at, v, v > 0, "adc_bailout must be a positive number"); break;
-    case KW_ALWAYS_SAMPLE: r->always_sample = (int)sdl_float(p) != 0; break;
+    case KW_ALWAYS_SAMPLE: r->always_sample = sdl_to_int(sdl_float(p)) != 0; break;
     case KW_BRIGHTNESS: v = sdl_float(p); r->brightness = checked(p, at, v, v > 0, "brightness must be a positive number"); break;
     case KW_COUNT: case KW_NEAREST_COUNT: radiosity_counts(p, r, t.tk.kw, at); break;
     case KW_ERROR_BOUND: v = sdl_float(p); r->error_bound = checked(p, at, v, v > 0, "error_bound must be a positive number"); break;
@@ -379,9 +379,9 @@ static int radiosity_item(sdl_parser *p, scene_radiosity *r)
     case KW_MAX_SAMPLE: r->max_sample = sdl_float(p); break;
     case KW_MAXIMUM_REUSE: v = sdl_float(p); r->maximum_reuse = checked(p, at, v, v > 0, "maximum_reuse must be a positive number"); break;
     case KW_MINIMUM_REUSE: v = sdl_float(p); r->minimum_reuse = checked(p, at, v, v >= 0, "minimum_reuse can not be negative"); break;
-    case KW_NORMAL: r->normal = (int)sdl_float(p) != 0; break;
-    case KW_MEDIA: r->media = (int)sdl_float(p) != 0; break;
-    case KW_SUBSURFACE: r->subsurface = (int)sdl_float(p) != 0; break;
+    case KW_NORMAL: r->normal = sdl_to_int(sdl_float(p)) != 0; break;
+    case KW_MEDIA: r->media = sdl_to_int(sdl_float(p)) != 0; break;
+    case KW_SUBSURFACE: r->subsurface = sdl_to_int(sdl_float(p)) != 0; break;
     case KW_PRETRACE_START: v = sdl_float(p); r->pretrace_start = checked(p, at, v, v > 0 && v <= 1, "pretrace_start must be greater than 0 and at most 1"); break;
     case KW_PRETRACE_END: v = sdl_float(p); r->pretrace_end = checked(p, at, v, v > 0 && v <= 1, "pretrace_end must be greater than 0 and at most 1"); break;
     case KW_RECURSION_LIMIT: v = sdl_float(p); r->recursion_limit = (int)checked(p, at, v, v >= 1 && v <= 20, "recursion_limit must be from 1 to 20"); break;
@@ -412,7 +412,7 @@ static void photons_block(sdl_parser *p, scene_global *g)
     while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
         sdl_tok t = sdl_next(p);
         if (sdl_is_kw(&t, KW_SPACING)) g->photons_spacing = sdl_float(p);
-        else if (sdl_is_kw(&t, KW_COUNT)) g->photons_count = (int)sdl_float(p);
+        else if (sdl_is_kw(&t, KW_COUNT)) g->photons_count = sdl_to_int(sdl_float(p));
         else if (t.tk.kind == TOK_KEYWORD) sdl_skip_item(p);
         else if (t.tk.kind == TOK_EOF) sdl_unexpected(p, &t, "'}'");
     }
@@ -429,10 +429,10 @@ static int global_item(sdl_parser *p, scene_global *g)
     switch (t.tk.kw) {
     case KW_ASSUMED_GAMMA: g->assumed_gamma = sdl_float(p); break;
     case KW_AMBIENT_LIGHT: g->ambient_light = sdl_rgb(p); break;
-    case KW_MAX_TRACE_LEVEL: g->max_trace_level = (int)sdl_float(p); break;
+    case KW_MAX_TRACE_LEVEL: g->max_trace_level = sdl_to_int(sdl_float(p)); break;
     case KW_ADC_BAILOUT: g->adc_bailout = sdl_float(p); break;
-    case KW_MAX_INTERSECTIONS: g->max_intersections = (int)sdl_float(p); break;
-    case KW_NOISE_GENERATOR: g->noise_generator = (int)sdl_float(p); break;
+    case KW_MAX_INTERSECTIONS: g->max_intersections = sdl_to_int(sdl_float(p)); break;
+    case KW_NOISE_GENERATOR: g->noise_generator = sdl_to_int(sdl_float(p)); break;
     case KW_IRID_WAVELENGTH: {
         rgb w = sdl_rgb(p);
         g->irid_wavelength[0] = w.r;

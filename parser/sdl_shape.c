@@ -872,8 +872,8 @@ static void bicubic_args(sdl_parser *p, sdl_obj *so, src_loc loc)
     while (sdl_ok(p)) {
         if (sdl_accept_kw(p, KW_TYPE)) sdl_float(p);
         else if (sdl_accept_kw(p, KW_FLATNESS)) sdl_float(p);
-        else if (sdl_accept_kw(p, KW_U_STEPS)) us = (int)sdl_float(p);
-        else if (sdl_accept_kw(p, KW_V_STEPS)) vs = (int)sdl_float(p);
+        else if (sdl_accept_kw(p, KW_U_STEPS)) us = sdl_to_int(sdl_float(p));
+        else if (sdl_accept_kw(p, KW_V_STEPS)) vs = sdl_to_int(sdl_float(p));
         else if (sdl_accept_kw(p, KW_ACCURACY)) sdl_float(p);
         else if (sdl_accept_kw(p, KW_UV_VECTORS)) {
             double uv[2];
