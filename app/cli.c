@@ -22,6 +22,17 @@ static int parse_int(const char *s, int *out)
     return 1;
 }
 
+/* A positive integer up to `max`. */
+static int parse_count(const char *s, long long max, long long *out)
+{
+    char *end;
+    errno = 0;
+    long long v = strtoll(s, &end, 10);
+    if (errno || end == s || *end || v < 1 || v > max) return 0;
+    *out = v;
+    return 1;
+}
+
 static int parse_double(const char *s, double *out)
 {
     char *end;
@@ -194,6 +205,20 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
         } else if (strcmp(a, "--max-macro-depth") == 0) {
             if (!has_value(a, next, err, errlen)) return 2;
             if (!parse_int(next, &o->max_macro_depth) || o->max_macro_depth < 1) { snprintf(err, (size_t)errlen, "bad --max-macro-depth"); return 2; }
+            i++;
+        } else if (strcmp(a, "--max-tokens") == 0 || strcmp(a, "--max-memory") == 0 ||
+                   strcmp(a, "--max-string") == 0 || strcmp(a, "--max-array") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            long long v;
+            if (!parse_count(next, 1LL << 53, &v)) {
+                snprintf(err, (size_t)errlen, "%s wants a positive integer%s", a,
+                         strcmp(a, "--max-memory") == 0 ? " (MiB)" : "");
+                return 2;
+            }
+            if (strcmp(a, "--max-tokens") == 0) o->max_tokens = v;
+            else if (strcmp(a, "--max-memory") == 0) o->max_memory_mib = v;
+            else if (strcmp(a, "--max-array") == 0) o->max_array = v;
+            else o->max_string = v > 0x7fffffffL ? 0x7fffffffL : (long)v;
             i++;
         } else if (strncmp(a, "-D", 2) == 0 && a[2]) {
             if (!strchr(a + 2, '=') || !add_list(o->defines, &o->ndefines, a + 2)) {

@@ -34,6 +34,9 @@ typedef struct {
     const char *false_color;/* luminance false-colour PNG */
     double fc_lo, fc_hi;    /* false-colour range, 0 = automatic */
     int max_include_depth, max_macro_depth;
+    /* parser work/memory limits (sdl_options), 0 = the parser's default */
+    long long max_tokens, max_memory_mib, max_array;
+    long max_string;
 } cli_render;
 
 /* Parses argv (after the subcommand). Returns 0 on success, otherwise writes

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "accel.h"
 #include "cli.h"
 #include "cmd_compare.h"
@@ -31,10 +32,11 @@ enum { EXIT_OK = 0, EXIT_SCENE = 1, EXIT_USAGE = 2, EXIT_IO = 3, EXIT_INTERRUPTE
 
 static volatile int g_cancel = 0;
 
+/* SIGINT or SIGTERM: the render stops within a tile row; g_cancel keeps
+ * the signal number for the exit code (128 + signal: 130, 143). */
 static void on_sigint(int sig)
 {
-    (void)sig;
-    g_cancel = 1;
+    g_cancel = sig > 0 ? sig : SIGINT;
 }
 
 static const char *usage_text =
@@ -46,6 +48,7 @@ static const char *usage_text =
     "                 [--working-space NAME] [--ocio-config FILE] [--false-color OUT.png]\n"
     "                 [--false-color-range LO,HI]\n"
     "                 [--max-loop N] [--max-include-depth N] [--max-macro-depth N]\n"
+    "                 [--max-tokens N] [--max-memory MIB] [--max-string BYTES] [--max-array N]\n"
     "                 [+W640 +H480 +A0.3 +R3 +Oout.png +Iscene.pov +Ldir ...]\n"
     "  partray parse SCENE.pov [-D NAME=VALUE] [-L DIR]\n"
     "  partray compare REF TEST [--heatmap OUT.png] [--json]\n"
@@ -57,7 +60,7 @@ static const char *usage_text =
     "\n"
     "GI modes: none (direct light + Whitted), particle, pmfg, path.\n"
     "Without --gi a scene with radiosity{} asks for particle GI, otherwise none.\n"
-    "Exit codes: 0 ok, 1 scene error, 2 usage, 3 I/O, 130 interrupted.\n";
+    "Exit codes: 0 ok, 1 scene error, 2 usage, 3 I/O, 130 interrupted (143 terminated).\n";
 
 /* Print every message in d to stderr; returns the number of errors. */
 static int print_diags(const diag *d, int quiet)
@@ -96,6 +99,37 @@ static void fill_sdl_options(sdl_options *so, const cli_render *o)
     if (o->max_loop > 0) so->max_loop_iterations = o->max_loop;
     if (o->max_include_depth > 0) so->max_include_depth = o->max_include_depth;
     if (o->max_macro_depth > 0) so->max_macro_depth = o->max_macro_depth;
+    if (o->max_tokens > 0) so->max_tokens = o->max_tokens;
+    if (o->max_memory_mib > 0) so->max_memory = o->max_memory_mib > (1LL << 40) ? (1LL << 60) : o->max_memory_mib << 20;
+    if (o->max_string > 0) so->max_string_length = o->max_string;
+    if (o->max_array > 0) so->max_array_elements = o->max_array;
+}
+
+/* The image size must fit what the writers accept and the memory there is:
+ * refused before parsing, so a long render is never lost at the end. The
+ * framebuffer is 12 bytes a pixel; writing a PNG or converting colours
+ * makes a second copy. Returns 0 and prints why when not. */
+static int check_image_size(int w, int h)
+{
+    if (w > IMG_MAX_SIDE || h > IMG_MAX_SIDE) {
+        fprintf(stderr, "partray render: image size %dx%d: a side is larger than %d pixels\n", w, h, IMG_MAX_SIDE);
+        return 0;
+    }
+    unsigned long long px = (unsigned long long)w * (unsigned long long)h;
+    if (px > IMG_MAX_PIXELS) {
+        fprintf(stderr, "partray render: image size %dx%d: %llu pixels, more than the %llu an image may have\n", w, h, px,
+                (unsigned long long)IMG_MAX_PIXELS);
+        return 0;
+    }
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    double need = (double)px * 2.0 * 3.0 * sizeof(float);
+    double have = pages > 0 && page > 0 ? (double)pages * (double)page : 0.0;
+    if (have > 0 && need > have) {
+        fprintf(stderr, "partray render: image size %dx%d needs %.1f GiB for its framebuffers, more than the %.1f GiB of memory\n",
+                w, h, need / (1 << 30), have / (1 << 30));
+        return 0;
+    }
+    return 1;
 }
 
 static int cmd_parse(int argc, char **argv)
@@ -197,6 +231,7 @@ static int cmd_render(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
+    if (!check_image_size(o.width > 0 ? o.width : 320, o.height > 0 ? o.height : 240)) return EXIT_USAGE;
     int gi = GI_NONE;
     if (o.gi) {
         gi = gi_mode_parse(o.gi);
@@ -278,6 +313,7 @@ static int cmd_render(int argc, char **argv)
     shade_stats sst;
     memset(&sst, 0, sizeof sst);
     signal(SIGINT, on_sigint);
+    signal(SIGTERM, on_sigint); /* kill, systemd, timeout(1): stop like Ctrl-C */
     t0 = timer_now();
     st = fb ? shade_render(sc, acc, &ss, fb, &sst, d) : PT_ERR_NOMEM;
     double t_render = timer_now() - t0;
@@ -318,7 +354,7 @@ static int cmd_render(int argc, char **argv)
             diag_free(wd);
             free(pn);
         }
-        rc = EXIT_INTERRUPTED;
+        rc = g_cancel == SIGTERM ? 128 + SIGTERM : EXIT_INTERRUPTED;
     } else if (st != PT_OK) {
         rc = status_exit(st);
     } else {
@@ -389,6 +425,9 @@ static int cmd_render(int argc, char **argv)
 
 int main(int argc, char **argv)
 {
+    /* Past a file size limit (ulimit -f) a write must fail with EFBIG and be
+     * reported (exit 3, temporary file removed), not kill the process. */
+    signal(SIGXFSZ, SIG_IGN);
     if (argc < 2) {
         fputs(usage_text, stderr);
         return EXIT_USAGE;
