@@ -83,7 +83,8 @@ typedef struct {
     int quit;
     /* figures */
     double t_start, t_first_image;
-    long images;
+    long images;             /* images shown (fetched by the UI) */
+    long published;          /* images the render thread finished (serial) */
     double recent[64];       /* times of the last images, for images/s */
     int nrecent;
     long last_gen_first;     /* generation whose first image was counted */
@@ -241,9 +242,9 @@ static void print_mark(viewer *v, const char *name)
     series_stats(&v->lat_light_first, &lf, &lfm);
     series_stats(&v->lat_light_full, &lF, &lFm);
     series_stats(&v->lat_camera_first, &cf, &cfm);
-    printf("view: mark %s time=%.4f images=%ld light_moves=%d light_first_ms=%.2f light_first_max_ms=%.2f "
+    printf("view: mark %s time=%.4f images=%ld shown=%ld light_moves=%d light_first_ms=%.2f light_first_max_ms=%.2f "
            "light_full_ms=%.2f camera_moves=%d camera_first_ms=%.2f camera_first_max_ms=%.2f\n",
-           name, timer_now() - v->t_start, v->images, v->lat_light_first.n, lf * 1e3, lfm * 1e3, lF * 1e3,
+           name, timer_now() - v->t_start, v->published, v->images, v->lat_light_first.n, lf * 1e3, lfm * 1e3, lF * 1e3,
            v->lat_camera_first.n, cf * 1e3, cfm * 1e3);
     fflush(stdout);
 }
@@ -477,6 +478,7 @@ static int take_image(viewer *v, double now)
     if (!view_render_fetch(v->vr, &v->serial, v->rgba, &in)) return 0;
     v->info = in;
     v->images++;
+    v->published = in.serial;
     if (!v->have_image) v->t_first_image = now;
     v->have_image = 1;
     if (v->nrecent == (int)(sizeof v->recent / sizeof v->recent[0])) {
@@ -484,14 +486,16 @@ static int take_image(viewer *v, double now)
         v->nrecent--;
     }
     v->recent[v->nrecent++] = now;
-    if (in.first && in.generation != v->last_gen_first) {
+    /* latencies per generation, from the render thread's figures (an
+     * image the UI did not fetch in time still counts) */
+    if (in.generation != v->last_gen_first && in.first_latency > 0) {
         v->last_gen_first = in.generation;
-        if (in.cause & VIEW_CAUSE_LIGHT) series_add(&v->lat_light_first, in.latency);
-        else if (in.cause & VIEW_CAUSE_CAMERA) series_add(&v->lat_camera_first, in.latency);
+        if (in.cause & VIEW_CAUSE_LIGHT) series_add(&v->lat_light_first, in.first_latency);
+        else if (in.cause & VIEW_CAUSE_CAMERA) series_add(&v->lat_camera_first, in.first_latency);
     }
-    if (in.level == 1 && in.generation != v->last_gen_full) {
+    if (in.generation != v->last_gen_full && in.full_latency > 0) {
         v->last_gen_full = in.generation;
-        if (in.cause & VIEW_CAUSE_LIGHT) series_add(&v->lat_light_full, in.latency);
+        if (in.cause & VIEW_CAUSE_LIGHT) series_add(&v->lat_light_full, in.full_latency);
     }
     if (v->tex) SDL_UpdateTexture(v->tex, NULL, v->rgba, v->width * 4);
     return 1;
@@ -737,9 +741,9 @@ int cmd_view(int argc, char **argv)
         series_stats(&v.lat_light_full, &lF, &lFm);
         series_stats(&v.lat_camera_first, &cf, &cfm);
         fprintf(stderr,
-                "view: %ld images in %.2f s (%.1f/s), first image after %.3f s; light move -> image %.1f ms mean, %.1f ms "
+                "view: %ld images (%ld shown) in %.2f s (%.1f/s), first image after %.3f s; light move -> image %.1f ms mean, %.1f ms "
                 "max (%d), -> full resolution %.1f ms mean; camera move -> image %.1f ms mean (%d)\n",
-                v.images, span, span > 0 ? v.images / span : 0.0, v.t_first_image - v.t_start, lf * 1e3, lfm * 1e3,
+                v.published, v.images, span, span > 0 ? v.published / span : 0.0, v.t_first_image - v.t_start, lf * 1e3, lfm * 1e3,
                 v.lat_light_first.n, lF * 1e3, cf * 1e3, v.lat_camera_first.n);
         view_render_stop(v.vr);
         v.vr = NULL;

@@ -161,7 +161,7 @@ static void *render_main(void *arg)
     view_light *cur_lights = calloc((size_t)(vr->nlights > 0 ? vr->nlights : 1), sizeof *cur_lights);
     long work_gen = -1;
     int level = 0, last_level = 0, cause = 0;
-    double submit_time = 0;
+    double submit_time = 0, first_latency = 0, full_latency = 0;
     int lights_ok = 0; /* applied_lights holds what the scene has */
     framebuffer *pass = NULL;
 
@@ -182,6 +182,7 @@ static void *render_main(void *arg)
             vr->posted_cause = 0;
             vr->posted_time = 0;
             level = 0;
+            first_latency = full_latency = 0;
         }
         vr->cancel = 0;
         vr->busy_level = level;
@@ -272,6 +273,10 @@ static void *render_main(void *arg)
         in->frame = now - t0;
         in->latency = now - submit_time;
         in->first = level == 0;
+        if (level == 0) first_latency = in->latency;
+        if (level == 1) full_latency = in->latency;
+        in->first_latency = first_latency;
+        in->full_latency = full_latency;
         in->cause = cause;
         in->complete = level >= last_level;
         memcpy(in->describe, desc, sizeof desc);

@@ -60,6 +60,8 @@ typedef struct {
     view_gi_times times;    /* stages run for this pass (build/light only when they ran) */
     double latency;         /* seconds from the oldest submit its generation answers to its publication */
     int first;              /* the first image of its generation */
+    double first_latency;   /* latency of its generation's first image (so a UI that missed it still knows) */
+    double full_latency;    /* latency of its generation's first full-resolution image; 0 before it */
     int cause;              /* VIEW_CAUSE_* of the submits in its generation */
     int complete;           /* last level reached: the refinement is done */
     char describe[96];      /* view_gi_describe */

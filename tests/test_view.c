@@ -1,0 +1,508 @@
+/* test_view.c - `partray view` (issue 10).
+ *
+ * Headless run under Xvfb (started here on a free display with -displayfd,
+ * so neither xvfb-run nor xauth is needed): a plane, two spheres and a point
+ * light at 128x128; the script waits for the refinement, takes a screenshot,
+ * moves the light, screenshots again, dims the light, screenshots, orbits the
+ * camera and writes it out. Asserted: the images differ where the shadows
+ * moved (regions computed analytically from the scene), hardly anywhere
+ * else, no NaN, not black, dimming halves the direct light, and the written
+ * camera{} block parses back to the orbited camera. Skips only when there
+ * is no Xvfb binary at all.
+ *
+ * Without a display: camera moves (orbit keeps the distance, +yaw goes to
+ * screen right also for mirrored cameras, the camera{} block round-trips
+ * through the parser) and the script grammar (order, errors with columns). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include "img_io.h"
+#include "scene.h"
+#include "sdl.h"
+#include "view_camera.h"
+#include "view_script.h"
+
+#define W 128
+#define H 128
+
+static char tmpdir[256];
+static char out_text[65536];
+static pid_t xvfb_pid = -1;
+static char display[32];
+
+/* ------------------------------------------------------------- helpers */
+
+static int run_capture(const char *cmd)
+{
+    char full[4096];
+    snprintf(full, sizeof full, "%s 2>&1", cmd);
+    FILE *p = popen(full, "r");
+    if (!p) return -1;
+    size_t n = fread(out_text, 1, sizeof out_text - 1, p);
+    out_text[n] = 0;
+    int rc = pclose(p);
+    return WIFEXITED(rc) ? WEXITSTATUS(rc) : 128;
+}
+
+static void write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+static char *read_text(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    static char buf[8192];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    buf[n] = 0;
+    fclose(f);
+    return buf;
+}
+
+static int have_program(const char *name)
+{
+    const char *path = getenv("PATH");
+    char dirs[4096];
+    snprintf(dirs, sizeof dirs, "%s:/usr/bin:/usr/local/bin", path ? path : "");
+    for (char *save = NULL, *d = strtok_r(dirs, ":", &save); d; d = strtok_r(NULL, ":", &save)) {
+        char p[4200];
+        snprintf(p, sizeof p, "%s/%s", d, name);
+        if (access(p, X_OK) == 0) return 1;
+    }
+    return 0;
+}
+
+/* Starts Xvfb on a display it picks itself (-displayfd); 1 on success. */
+static int start_xvfb(void)
+{
+    int fd[2];
+    if (pipe(fd) != 0) return 0;
+    pid_t pid = fork();
+    if (pid < 0) return 0;
+    if (pid == 0) {
+        close(fd[0]);
+        char fds[16];
+        snprintf(fds, sizeof fds, "%d", fd[1]);
+        int nul = open("/dev/null", O_RDWR);
+        if (nul >= 0) {
+            dup2(nul, 0);
+            dup2(nul, 1);
+            dup2(nul, 2);
+        }
+        execlp("Xvfb", "Xvfb", "-displayfd", fds, "-screen", "0", "640x480x24", "-nolisten", "tcp", "-noreset", (char *)NULL);
+        _exit(127);
+    }
+    close(fd[1]);
+    xvfb_pid = pid;
+    char buf[32] = "";
+    size_t n = 0;
+    struct pollfd pf = {fd[0], POLLIN, 0};
+    while (n < sizeof buf - 1 && poll(&pf, 1, 20000) > 0) {
+        ssize_t r = read(fd[0], buf + n, sizeof buf - 1 - n);
+        if (r <= 0) break;
+        n += (size_t)r;
+        buf[n] = 0;
+        if (strchr(buf, '\n')) break;
+    }
+    close(fd[0]);
+    int num;
+    if (sscanf(buf, "%d", &num) != 1) return 0;
+    snprintf(display, sizeof display, ":%d", num);
+    return 1;
+}
+
+static void stop_xvfb(void)
+{
+    if (xvfb_pid > 0) {
+        kill(xvfb_pid, SIGTERM);
+        waitpid(xvfb_pid, NULL, 0);
+        xvfb_pid = -1;
+    }
+}
+
+/* ----------------------------------------------------- the scene, analytically */
+
+static const char *two_spheres_pov =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 }\n"
+    "camera { location <0, 8, -8> direction <0, -0.70710678, 0.70710678>\n"
+    "         up <0, 0.70710678, 0.70710678> right <1, 0, 0> }\n"
+    "light_source { <-3, 10, -1> color rgb 1 }\n"
+    "plane { y, 0 pigment { rgb 0.8 } finish { ambient 0.05 diffuse 0.8 } }\n"
+    "sphere { <-1.5, 1, 0>, 1 pigment { rgb <0.9, 0.2, 0.2> } finish { ambient 0.05 diffuse 0.8 } }\n"
+    "sphere { <1.5, 0.7, 1.5>, 0.7 pigment { rgb <0.2, 0.3, 0.9> } finish { ambient 0.05 diffuse 0.8 } }\n"
+    "background { rgb <0.1, 0.15, 0.3> }\n";
+
+static const vec3 light_a = {-3, 10, -1}, light_b = {3, 10, -1}; /* the script moves it by <6, 0, 0> */
+static const vec3 sph_c[2] = {{-1.5, 1, 0}, {1.5, 0.7, 1.5}};
+static const double sph_r[2] = {1, 0.7};
+
+/* First t in (0, tmax) where o + t d meets a sphere, or 0. */
+static int hits_sphere(vec3 o, vec3 d, double tmax)
+{
+    for (int i = 0; i < 2; i++) {
+        vec3 oc = v3_sub(o, sph_c[i]);
+        double a = v3_dot(d, d), b = v3_dot(oc, d), c = v3_dot(oc, oc) - sph_r[i] * sph_r[i];
+        double disc = b * b - a * c;
+        if (disc < 0) continue;
+        double s = sqrt(disc);
+        double t0 = (-b - s) / a, t1 = (-b + s) / a;
+        if ((t0 > 1e-6 && t0 < tmax) || (t1 > 1e-6 && t1 < tmax)) return 1;
+    }
+    return 0;
+}
+
+/* Pixel classes from 4x4 sub-samples: -1 mixed or not on the plane,
+ * else bit 0 = shadowed from light A, bit 1 = shadowed from light B. */
+static int classify(int px, int py)
+{
+    const vec3 loc = {0, 8, -8}, dir = {0, -0.70710678, 0.70710678}, up = {0, 0.70710678, 0.70710678}, right = {1, 0, 0};
+    int cls = -2;
+    for (int j = 0; j < 4; j++) {
+        for (int i = 0; i < 4; i++) {
+            double sx = (px + (i + 0.5) / 4) / W - 0.5, sy = 0.5 - (py + (j + 0.5) / 4) / H;
+            vec3 d = v3_add(dir, v3_add(v3_scale(right, sx), v3_scale(up, sy)));
+            if (d.y >= 0) return -1;
+            double t = -loc.y / d.y;
+            if (hits_sphere(loc, d, t)) return -1;
+            vec3 p = v3_madd(loc, d, t);
+            int c = (hits_sphere(p, v3_sub(light_a, p), 1.0) ? 1 : 0) | (hits_sphere(p, v3_sub(light_b, p), 1.0) ? 2 : 0);
+            if (cls == -2) cls = c;
+            else if (cls != c) return -1;
+        }
+    }
+    return cls;
+}
+
+static double luma(const framebuffer *fb, int x, int y)
+{
+    const float *p = fb->rgb + ((size_t)y * fb->width + x) * 3;
+    return (p[0] + p[1] + p[2]) / 3.0;
+}
+
+static void check_image(const framebuffer *fb, const char *name)
+{
+    assert_int_equal(fb->width, W);
+    assert_int_equal(fb->height, H);
+    long nan = 0;
+    double sum = 0;
+    for (size_t i = 0; i < (size_t)W * H * 3; i++) {
+        if (!isfinite(fb->rgb[i])) nan++;
+        else sum += fb->rgb[i];
+    }
+    double mean = sum / (W * H * 3.0);
+    printf("%s: mean %.4f, non-finite values %ld\n", name, mean, nan);
+    assert_int_equal(nan, 0);
+    assert_true(mean > 0.1); /* lit plane ~0.6, background 0.18: far from black */
+}
+
+/* ------------------------------------------------------------ the viewer */
+
+static void test_viewer_script(void **st)
+{
+    (void)st;
+    if (!have_program("Xvfb")) {
+        printf("Xvfb not found on PATH: the viewer cannot be run headless here\n");
+        skip();
+    }
+    assert_true(start_xvfb());
+    printf("Xvfb on display %s\n", display);
+    char scene_path[512], script[512], cmd[4096], path[600];
+    snprintf(scene_path, sizeof scene_path, "%s/two.pov", tmpdir);
+    snprintf(script, sizeof script, "%s/run.txt", tmpdir);
+    write_file(scene_path, two_spheres_pov);
+    char text[2048];
+    snprintf(text, sizeof text,
+             "# screenshot, move the light, screenshot, dim it, screenshot, orbit, write the camera\n"
+             "0.0 wait-idle\n"
+             "0.1 screenshot %s/a\n"
+             "0.2 light 1 move 6 0 0\n"
+             "0.2 wait-idle\n"
+             "0.3 screenshot %s/b.exr\n"
+             "0.4 light 1 scale 0.5\n"
+             "0.4 wait-idle\n"
+             "0.5 screenshot %s/c.exr\n"
+             "0.6 camera orbit 30 0\n"
+             "0.6 camera write %s/cam.inc\n"
+             "0.6 wait-idle\n"
+             "0.7 quit\n",
+             tmpdir, tmpdir, tmpdir, tmpdir);
+    write_file(script, text);
+    snprintf(cmd, sizeof cmd, "cd '%s' && DISPLAY=%s timeout 120 '%s' view '%s' --size %dx%d --gi none --threads 2 --script '%s'",
+             tmpdir, display, PARTRAY_BIN, scene_path, W, H, script);
+    int rc = run_capture(cmd);
+    stop_xvfb();
+    printf("exit %d:\n%s", rc, out_text);
+    assert_int_equal(rc, 0);
+    assert_non_null(strstr(out_text, "screenshot"));
+
+    framebuffer *a = NULL, *b = NULL, *c = NULL, *ap = NULL;
+    diag *d = diag_new();
+    snprintf(path, sizeof path, "%s/a.exr", tmpdir);
+    assert_int_equal(img_read(path, 0, &a, d), PT_OK);
+    snprintf(path, sizeof path, "%s/a.png", tmpdir);
+    assert_int_equal(img_read(path, 0, &ap, d), PT_OK);
+    snprintf(path, sizeof path, "%s/b.exr", tmpdir);
+    assert_int_equal(img_read(path, 0, &b, d), PT_OK);
+    snprintf(path, sizeof path, "%s/c.exr", tmpdir);
+    assert_int_equal(img_read(path, 0, &c, d), PT_OK);
+    check_image(a, "a (light at <-3,10,-1>)");
+    check_image(b, "b (light moved to <3,10,-1>)");
+    check_image(c, "c (light dimmed to 0.5)");
+
+    /* The PNG is the sRGB encoding of the EXR (8-bit, half-float EXR). */
+    double png_err = 0;
+    for (size_t i = 0; i < (size_t)W * H * 3; i++) {
+        double e = fabs(img_srgb_encode(fmin(1.0, fmax(0.0, a->rgb[i]))) - img_srgb_encode(ap->rgb[i]));
+        if (e > png_err) png_err = e;
+    }
+    printf("PNG vs EXR: largest difference %.4f (sRGB encoded)\n", png_err);
+    assert_true(png_err < 1.5 / 255);
+
+    /* Regions: S = the shadow moved in or out (analytically), F = plane lit
+     * by both lights. */
+    double sum_s = 0, sum_f = 0, sum_fb = 0, sum_fc = 0;
+    long n_s = 0, n_f = 0, n_s_darker_a = 0;
+    for (int y = 0; y < H; y++) {
+        for (int x = 0; x < W; x++) {
+            int k = classify(x, y);
+            if (k < 0) continue;
+            double da = luma(a, x, y), db = luma(b, x, y);
+            if (k == 1 || k == 2) {
+                sum_s += fabs(da - db);
+                n_s++;
+                if ((k == 1) == (da < db)) n_s_darker_a++;
+            } else if (k == 0) {
+                sum_f += fabs(da - db);
+                sum_fb += db;
+                sum_fc += luma(c, x, y);
+                n_f++;
+            }
+        }
+    }
+    double mean_s = sum_s / (n_s ? n_s : 1), mean_f = sum_f / (n_f ? n_f : 1);
+    printf("shadow-change region: %ld px, mean |b-a| %.4f, %ld px darker on the shadowed side\n", n_s, mean_s, n_s_darker_a);
+    printf("lit-in-both region:   %ld px, mean |b-a| %.4f (ratio %.1f)\n", n_f, mean_f, mean_f > 0 ? mean_s / mean_f : 0.0);
+    assert_true(n_s > 100);
+    assert_true(n_f > 2000);
+    assert_true(mean_s > 0.3);
+    assert_true(mean_f < 0.1);
+    assert_true(mean_s > 5 * mean_f);
+    assert_true(n_s_darker_a == n_s); /* every pixel is darker where it is in shadow */
+
+    /* Dimming: plane = 0.8 * 0.05 ambient + direct, direct halves. */
+    double mb = sum_fb / n_f, mc = sum_fc / n_f, amb = 0.8 * 0.05;
+    printf("dimming: lit plane %.4f -> %.4f, expected %.4f\n", mb, mc, amb + 0.5 * (mb - amb));
+    assert_true(fabs(mc - (amb + 0.5 * (mb - amb))) < 0.01);
+
+    /* The camera written after `camera orbit 30 0`: look_at is where the
+     * view met the plane (the origin), the location turned 30 degrees
+     * towards screen right (+x) around it. */
+    snprintf(path, sizeof path, "%s/cam.inc", tmpdir);
+    char *block = read_text(path);
+    assert_non_null(block);
+    char src[9000];
+    snprintf(src, sizeof src, "#version 3.7;\n%s", block);
+    scene *sc = NULL;
+    sdl_options so;
+    sdl_default_options(&so);
+    assert_int_equal(sdl_parse_string("cam.inc", src, &so, &sc, d), PT_OK);
+    vec3 l = sc->camera.location;
+    double r = 8.0; /* horizontal radius of <0,8,-8> about the origin */
+    printf("orbited camera: location <%.4f, %.4f, %.4f>, expected <%.4f, 8, %.4f>\n", l.x, l.y, l.z, r * sin(M_PI / 6),
+           -r * cos(M_PI / 6));
+    assert_true(fabs(l.x - r * sin(M_PI / 6)) < 1e-3);
+    assert_true(fabs(l.y - 8) < 1e-3);
+    assert_true(fabs(l.z + r * cos(M_PI / 6)) < 1e-3);
+    vec3 dn = v3_norm(sc->camera.direction);
+    vec3 to = v3_norm(v3_neg(l));
+    assert_true(v3_dot(dn, to) > 1 - 1e-6);
+    scene_free(sc);
+    fb_free(a);
+    fb_free(ap);
+    fb_free(b);
+    fb_free(c);
+    diag_free(d);
+}
+
+/* ------------------------------------------------- camera, no display */
+
+static scene_camera parse_camera(const char *text)
+{
+    scene *sc = NULL;
+    sdl_options so;
+    sdl_default_options(&so);
+    diag *d = diag_new();
+    pt_status st = sdl_parse_string("cam", text, &so, &sc, d);
+    for (int i = 0; i < diag_count(d); i++) printf("%s\n", diag_get(d, i)->text);
+    assert_int_equal(st, PT_OK);
+    scene_camera c = sc->camera;
+    scene_free(sc);
+    diag_free(d);
+    return c;
+}
+
+static double vdiff(vec3 a, vec3 b) { return v3_len(v3_sub(a, b)); }
+
+static void roundtrip(const char *camera_text, int mirrored)
+{
+    scene_camera c0 = parse_camera(camera_text);
+    view_camera vc;
+    view_camera_from_scene(&vc, &c0, 10.0);
+    assert_int_equal(vc.mirrored, mirrored);
+    /* unmoved: the scene's camera unchanged */
+    scene_camera same;
+    view_camera_to_scene(&vc, &same);
+    assert_true(vdiff(same.direction, c0.direction) < 1e-12);
+
+    double dist0 = v3_len(v3_sub(vc.location, vc.look_at));
+    vec3 r0;
+    view_camera_frame(&vc, NULL, &r0, NULL);
+    vec3 loc0 = vc.location;
+    view_camera_orbit(&vc, 10, 0);
+    double moved_right = v3_dot(v3_sub(vc.location, loc0), r0);
+    printf("orbit +10: moved %.4f along screen right, distance %.6f -> %.6f\n", moved_right, dist0,
+           v3_len(v3_sub(vc.location, vc.look_at)));
+    assert_true(moved_right > 0);
+    assert_true(fabs(v3_len(v3_sub(vc.location, vc.look_at)) - dist0) < 1e-9 * dist0);
+    view_camera_orbit(&vc, 20, 200); /* pitch clamps at 89 degrees */
+    vec3 fw;
+    view_camera_frame(&vc, &fw, NULL, NULL);
+    assert_true(v3_dot(fw, vc.sky) < -sin(88.9 * M_PI / 180));
+    view_camera_orbit(&vc, 0, -120);
+    vec3 fw1, rt1;
+    view_camera_frame(&vc, &fw1, &rt1, NULL);
+    view_camera_look(&vc, 5, 0);
+    vec3 fw2;
+    view_camera_frame(&vc, &fw2, NULL, NULL);
+    assert_true(v3_dot(v3_sub(fw2, fw1), rt1) > 0); /* +yaw looks towards screen right */
+    view_camera_move(&vc, 1.5, -0.5, 0.25);
+    view_camera_zoom(&vc, 0.8);
+
+    scene_camera want;
+    view_camera_to_scene(&vc, &want);
+    char block[2048], src[2200];
+    view_camera_format(&vc, block, sizeof block);
+    snprintf(src, sizeof src, "#version 3.7;\n%s", block);
+    scene_camera got = parse_camera(src);
+    double e = fmax(fmax(vdiff(got.location, want.location), vdiff(got.direction, want.direction)),
+                    fmax(vdiff(got.right, want.right), vdiff(got.up, want.up)));
+    printf("camera{} round trip: largest vector difference %.3g\n", e);
+    assert_true(e < 1e-6);
+    /* mirrored stays mirrored */
+    assert_true((v3_dot(v3_cross(got.up, got.direction), got.right) < 0) == mirrored);
+}
+
+static void test_camera_roundtrip(void **st)
+{
+    (void)st;
+    /* cbox's mirrored camera */
+    roundtrip("camera { location <27.8, 27.3, -80.0> direction <0, 0, 1> up <0, 1, 0> right <-1, 0, 0> angle 39.3 }\n", 1);
+    roundtrip("camera { location <3, 4, -6> right x*1.5 up y look_at <0, 1, 0> angle 50 }\n", 0);
+    roundtrip("camera { orthographic location <0, 5, -5> look_at 0 right 4*x up 3*y }\n", 0);
+}
+
+/* ------------------------------------------------- script, no display */
+
+static void test_script_grammar(void **st)
+{
+    (void)st;
+    diag *d = diag_new();
+    view_script *vs = NULL;
+    const char *text = "# comment\n"
+                       "1.0 light 2 move 1 -2 3.5   # trailing comment\n"
+                       "0.5 camera orbit 10 -5\n"
+                       "1.0 gi next\n"
+                       "\n"
+                       "1.5 wait-idle\n"
+                       "2.0 screenshot x.png\n"
+                       "2.5 quit\n";
+    assert_int_equal(view_script_parse("s", text, &vs, d), PT_OK);
+    assert_int_equal(view_script_count(vs), 6);
+    view_action a;
+    assert_int_equal(view_script_next(vs, 100.0, 1, &a), 0); /* not started */
+    view_script_start(vs, 10.0);
+    assert_int_equal(view_script_next(vs, 10.4, 1, &a), 0);
+    assert_int_equal(view_script_next(vs, 10.5, 1, &a), 1);
+    assert_int_equal(a.kind, VIEW_ACT_CAMERA_ORBIT);
+    assert_true(a.v[0] == 10 && a.v[1] == -5);
+    assert_int_equal(view_script_next(vs, 11.0, 1, &a), 1);
+    assert_int_equal(a.kind, VIEW_ACT_LIGHT_MOVE); /* ties keep file order */
+    assert_int_equal(a.light, 2);
+    assert_true(a.v[0] == 1 && a.v[1] == -2 && a.v[2] == 3.5);
+    assert_int_equal(view_script_next(vs, 11.0, 1, &a), 1);
+    assert_int_equal(a.kind, VIEW_ACT_GI);
+    assert_int_equal(a.mode, -1);
+    /* wait-idle at 1.5 holds until idle; the clock then resumes at 1.5 */
+    assert_int_equal(view_script_next(vs, 11.6, 0, &a), 0);
+    assert_int_equal(view_script_next(vs, 20.0, 0, &a), 0);
+    assert_int_equal(view_script_next(vs, 30.0, 1, &a), 0); /* released; screenshot due at 30.5 */
+    assert_int_equal(view_script_next(vs, 30.4, 1, &a), 0);
+    assert_int_equal(view_script_next(vs, 30.5, 1, &a), 1);
+    assert_int_equal(a.kind, VIEW_ACT_SCREENSHOT);
+    assert_string_equal(a.text, "x.png");
+    assert_int_equal(view_script_next(vs, 31.0, 1, &a), 1);
+    assert_int_equal(a.kind, VIEW_ACT_QUIT);
+    assert_true(view_script_done(vs));
+    view_script_free(vs);
+
+    struct { const char *text, *msg; int line, col; } bad[] = {
+        {"0 light 0 move 1 2 3\n", "integer >= 1", 1, 9},
+        {"0 quit\n1 camera spin 3 4\n", "unknown camera action 'spin'", 2, 10},
+        {"x screenshot\n", "expected a time", 1, 1},
+        {"1 light 1 move 1 2\n", "wrong number of values", 1, 19},
+        {"1 gi photon\n", "unknown GI mode 'photon'", 1, 6},
+        {"1 wait-idle now\n", "takes no arguments", 1, 13},
+        {"2 camera zoom 0\n", "must be > 0", 1, 15},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        diag *e = diag_new();
+        vs = NULL;
+        assert_int_equal(view_script_parse("bad.txt", bad[i].text, &vs, e), PT_ERR_SYNTAX);
+        assert_null(vs);
+        assert_true(diag_errors(e) >= 1);
+        const diag_msg *m = diag_get(e, 0);
+        char *f = diag_format(m);
+        printf("%s\n", f);
+        assert_non_null(strstr(m->text, bad[i].msg));
+        assert_int_equal(m->loc.line, bad[i].line);
+        assert_int_equal(m->loc.col, bad[i].col);
+        free(f);
+        diag_free(e);
+    }
+    diag_free(d);
+}
+
+int main(void)
+{
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/partray-view-XXXXXX");
+    if (!mkdtemp(tmpdir)) return 1;
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_camera_roundtrip),
+        cmocka_unit_test(test_script_grammar),
+        cmocka_unit_test(test_viewer_script),
+    };
+    int rc = cmocka_run_group_tests(tests, NULL, NULL);
+    stop_xvfb();
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+    if (rc == 0) run_capture(cmd);
+    return rc;
+}
