@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include "sdl_array.h"
 #include "sdl_expr.h"
 #include "sdl_material.h"
 #include "sdl_object.h"
@@ -330,24 +331,6 @@ static double cond_param(sdl_parser *p)
     return v;
 }
 
-/* ifdef_param := '(' identifier ')' */
-static int ifdef_param(sdl_parser *p)
-{
-    sdl_expect(p, TOK_LPAREN, "'('");
-    p->hold_macros++;
-    sdl_tok t = sdl_next(p);
-    p->hold_macros--;
-    int defined = 0;
-    if (t.tk.kind == TOK_IDENT) defined = t.val.kind != VAL_NONE;
-    else sdl_unexpected(p, &t, "identifier");
-    if (sdl_accept(p, TOK_LBRACKET)) {
-        sdl_error(p, t.tk.loc, PT_ERR_UNSUPPORTED, "arrays are not supported yet");
-        return 0;
-    }
-    sdl_expect(p, TOK_RPAREN, "')'");
-    return defined;
-}
-
 /* After a false #if branch: look for the branch to run, if any. */
 static void false_branch(sdl_parser *p, src_loc loc)
 {
@@ -366,7 +349,7 @@ static void if_directive(sdl_parser *p, sdl_kw kw, src_loc loc)
 {
     int truth;
     if (kw == KW_IF) truth = sdl_true(cond_param(p));
-    else truth = ifdef_param(p) == (kw == KW_IFDEF);
+    else truth = sdl_defined_param(p) == (kw == KW_IFDEF);
     if (!sdl_ok(p)) return;
     if (truth) push_cond(p, COND_IF, loc);
     else false_branch(p, loc);
@@ -594,23 +577,15 @@ static void end_directive(sdl_parser *p, src_loc loc)
 static sdl_tok name_token(sdl_parser *p, const char *what)
 {
     p->hold_macros++;
+    p->hold_arrays++;
     sdl_tok t = sdl_next(p);
+    p->hold_arrays--;
     p->hold_macros--;
     if (t.tk.kind == TOK_KEYWORD)
         sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "'%s' is a reserved word and cannot be used as %s", sdl_kw_text(t.tk.kw), what);
     else if (t.tk.kind != TOK_IDENT)
         sdl_unexpected(p, &t, what);
     return t;
-}
-
-/* Skip '[...]' dimension lists and an optional '{...}' initialiser. */
-static void skip_array(sdl_parser *p)
-{
-    while (sdl_ok(p) && sdl_accept(p, TOK_LBRACKET)) {
-        if (!sdl_is(sdl_peek(p), TOK_RBRACKET)) sdl_float(p);
-        sdl_expect(p, TOK_RBRACKET, "']'");
-    }
-    if (sdl_is(sdl_peek(p), TOK_LBRACE) && sdl_begin_block(p, "array")) sdl_skip_block(p);
 }
 
 static void opaque_value(sdl_parser *p, sdl_value *out, const char *what)
@@ -703,9 +678,8 @@ static void keyword_rvalue(sdl_parser *p, sdl_value *out)
     }
     case KW_FUNCTION: function_rvalue(p, out); return;
     case KW_ARRAY:
-        sdl_warn_once(p, kt.tk.loc, "arrays are not supported yet; array values are ignored");
-        skip_array(p);
-        opaque_value(p, out, "array");
+        out->ptr = sdl_parse_array(p, kt.tk.loc);
+        out->kind = out->ptr ? VAL_ARRAY : VAL_NONE;
         return;
     default:
         break;
@@ -732,10 +706,11 @@ void sdl_rvalue(sdl_parser *p, sdl_value *out)
         out->dim = 5;
         out->v[0] = c.r; out->v[1] = c.g; out->v[2] = c.b; out->v[3] = c.f; out->v[4] = c.t;
     } else if (sdl_starts_expr(t)) {
-        sdl_expr(p, out);
+        sdl_sum(p, out); /* POV-Ray reads a declared value at the sum level: comparisons need ( ) */
     } else if (t->tk.kind == TOK_IDENT && t->val.kind != VAL_NONE) {
         sdl_tok id = sdl_next(p);
         *out = id.val;
+        if (out->kind == VAL_ARRAY && out->ptr) out->ptr = sdl_array_copy(p, out->ptr); /* arrays are copied */
     } else if (t->tk.kind == TOK_IDENT) {
         sdl_error(p, t->tk.loc, PT_ERR_SYNTAX, "undeclared identifier '%.*s'", t->tk.len, t->tk.text);
     } else if (t->tk.kind == TOK_KEYWORD) {
@@ -745,32 +720,70 @@ void sdl_rvalue(sdl_parser *p, sdl_value *out)
     }
 }
 
+/* element_lvalue := array_identifier '[' i ']' { '[' i ']' } ; nested arrays
+ * are followed down. Returns the array holding the element and its index. */
+static sdl_array *element_lvalue(sdl_parser *p, const sdl_tok *id, long *index)
+{
+    sdl_array *a = id->val.ptr;
+    for (;;) {
+        long i = sdl_array_subscripts(p, a, id->tk.loc);
+        if (i < 0) return NULL;
+        const sdl_value *e = &a->elems[i];
+        if (e->kind == VAL_ARRAY && e->ptr && sdl_is(sdl_peek(p), TOK_LBRACKET)) {
+            a = e->ptr;
+            continue;
+        }
+        *index = i;
+        return a;
+    }
+}
+
 /* declare_directive := ('#declare' | '#local') [ 'deprecated' ['once'] [string] ]
- *                      identifier '=' rvalue [';'] */
+ *                      identifier { '[' float ']' } '=' rvalue [';'] */
 static void declare_directive(sdl_parser *p, int local)
 {
-    if (sdl_accept_kw(p, KW_DEPRECATED)) {
+    /* the look-ahead for 'deprecated' must not run a macro or index an array */
+    p->hold_macros++;
+    p->hold_arrays++;
+    int deprecated = sdl_accept_kw(p, KW_DEPRECATED);
+    p->hold_arrays--;
+    p->hold_macros--;
+    if (deprecated) {
         sdl_accept_kw(p, KW_ONCE);
         if (sdl_starts_string(sdl_peek(p))) sdl_string(p);
     }
     sdl_tok id = name_token(p, "an identifier");
     if (!sdl_ok(p)) return;
+    sdl_array *arr = NULL;
+    long index = -1;
     if (sdl_is(sdl_peek(p), TOK_LBRACKET)) {
-        sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_UNSUPPORTED, "arrays are not supported yet");
+        if (id.val.kind != VAL_ARRAY || !id.val.ptr) {
+            sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_SYNTAX, "'%.*s' is not an array and cannot take a subscript", id.tk.len, id.tk.text);
+            return;
+        }
+        arr = element_lvalue(p, &id, &index);
+        if (!arr) return;
+    } else if (id.val.kind == VAL_FUNCTION) {
+        sdl_error(p, id.tk.loc, PT_ERR_SYNTAX, "function '%.*s' cannot be redeclared (#undef it first)", id.tk.len, id.tk.text);
         return;
     }
     if (!sdl_expect(p, TOK_EQ, "'='")) return;
     /* Directives after the value must run after the assignment: look-ahead
      * past an expression (and the ';' check) defers them, as POV-Ray does. */
     const sdl_tok *first = sdl_peek(p);
+    src_loc at = first->tk.loc;
     int expression = sdl_starts_expr(first) || sdl_starts_string(first);
     sdl_value v;
     p->defer += expression;
     sdl_rvalue(p, &v);
     p->defer += !expression;
-    int ok = !sdl_ok(p) || (local ? sdl_symtab_local(p->sym, id.tk.text, (size_t)id.tk.len, &v)
-                                  : sdl_symtab_declare(p->sym, id.tk.text, (size_t)id.tk.len, &v));
-    if (!ok) sdl_error(p, id.tk.loc, PT_ERR_NOMEM, "out of memory");
+    if (arr) {
+        sdl_array_set(p, arr, index, &v, at);
+    } else {
+        int ok = !sdl_ok(p) || (local ? sdl_symtab_local(p->sym, id.tk.text, (size_t)id.tk.len, &v)
+                                      : sdl_symtab_declare(p->sym, id.tk.text, (size_t)id.tk.len, &v));
+        if (!ok) sdl_error(p, id.tk.loc, PT_ERR_NOMEM, "out of memory");
+    }
     sdl_accept(p, TOK_SEMI);
     p->defer--;
 }
@@ -864,7 +877,7 @@ static void macro_directive(sdl_parser *p, src_loc loc)
             return;
         }
         params[n++] = sdl_strndup(p, t.tk.text, (size_t)t.tk.len);
-        if (!sdl_is(sdl_peek(p), TOK_RPAREN)) sdl_expect(p, TOK_COMMA, "',' or ')'");
+        sdl_accept(p, TOK_COMMA); /* optional, as in POV-Ray (shapes3.inc omits one) */
     }
     if (!sdl_ok(p)) return;
     sdl_macro *m = sdl_alloc(p, sizeof *m);
@@ -885,13 +898,40 @@ static void macro_directive(sdl_parser *p, src_loc loc)
     skip_tokens(p, SKIP_TO_END, 0, "#macro", loc);
 }
 
-/* macro_call := macro_identifier '(' [ rvalue { ',' rvalue } ] ')' */
+/* macro_argument := identifier | rvalue ; an identifier standing alone (a
+ * ',' or ')' follows) is passed by reference, except a function (POV-Ray 3.7
+ * Parse_RValue): #declare of the parameter inside the macro assigns the
+ * caller's identifier. *ref is set for a reference. */
+static void macro_argument(sdl_parser *p, const sdl_macro *m, sdl_value *arg, sdl_symref **ref)
+{
+    *ref = NULL;
+    const sdl_tok *t = sdl_peek(p);
+    if (t->tk.kind == TOK_IDENT && !t->elem && t->val.kind != VAL_FUNCTION) {
+        sdl_tok id = sdl_next(p);
+        sdl_tok_kind after = sdl_peek(p)->tk.kind;
+        if (after == TOK_COMMA || after == TOK_RPAREN) {
+            if (id.val.kind == VAL_NONE) {
+                sdl_error(p, id.tk.loc, PT_ERR_SYNTAX, "undeclared identifier '%.*s' cannot be passed to macro %s (declare it first)",
+                          id.tk.len, id.tk.text, m->name);
+                return;
+            }
+            *arg = id.val;
+            *ref = sdl_symtab_ref(p->sym, id.tk.text, (size_t)id.tk.len);
+            return;
+        }
+        sdl_unget(p, &id);
+    }
+    sdl_rvalue(p, arg);
+}
+
+/* macro_call := macro_identifier '(' [ macro_argument { [','] macro_argument } [','] ] ')' */
 static void macro_call(sdl_parser *p, const sdl_tok *id)
 {
     const sdl_macro *m = id->val.ptr;
     sdl_value *args = sdl_alloc(p, sizeof(sdl_value) * 64);
+    sdl_symref **refs = sdl_alloc(p, sizeof(sdl_symref *) * 64);
     int n = 0;
-    if (!args) return;
+    if (!args || !refs) return;
     if (!sdl_expect(p, TOK_LPAREN, "'(' after the macro name")) return;
     if (!sdl_enter(p, id->tk.loc)) return;
     while (sdl_ok(p) && !sdl_accept(p, TOK_RPAREN)) {
@@ -899,8 +939,9 @@ static void macro_call(sdl_parser *p, const sdl_tok *id)
             sdl_error(p, id->tk.loc, PT_ERR_LIMIT, "too many macro arguments");
             break;
         }
-        sdl_rvalue(p, &args[n++]);
-        if (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RPAREN)) sdl_expect(p, TOK_COMMA, "',' or ')'");
+        macro_argument(p, m, &args[n], &refs[n]);
+        n++;
+        sdl_accept(p, TOK_COMMA);
     }
     sdl_leave(p);
     if (!sdl_ok(p)) return;
@@ -913,7 +954,11 @@ static void macro_call(sdl_parser *p, const sdl_tok *id)
         return;
     }
     if (!push_cond(p, COND_MACRO, id->tk.loc) || !sdl_symtab_push(p->sym)) return;
-    for (int i = 0; i < n; i++) sdl_symtab_local(p->sym, m->params[i], strlen(m->params[i]), &args[i]);
+    for (int i = 0; i < n; i++) {
+        size_t len = strlen(m->params[i]);
+        if (refs[i]) sdl_symtab_alias(p->sym, m->params[i], len, refs[i]);
+        else sdl_symtab_local(p->sym, m->params[i], len, &args[i]);
+    }
     if (!push_frame(p, FRAME_MACRO, m->src, id->tk.loc, m->name)) return;
     sdl_scan_seek(&top_frame(p)->sc, m->body);
     p->macro_depth++;
@@ -1073,6 +1118,7 @@ sdl_tok sdl_next(sdl_parser *p)
         if (!sdl_ok(p) || p->nframes == 0) return eof_token(p);
         sdl_tok t;
         t.val.kind = VAL_NONE;
+        t.elem = 0;
         int take;
         if (p->nahead > 0) {
             t = p->ahead[--p->nahead];
@@ -1081,6 +1127,8 @@ sdl_tok sdl_next(sdl_parser *p)
             t.tk = sdl_scan_next(&top_frame(p)->sc);
             take = sdl_count_token(p, t.tk.loc) && fresh_token(p, &t);
         }
+        if (take && sdl_ok(p) && t.tk.kind == TOK_IDENT && t.val.kind == VAL_ARRAY && p->hold_arrays == 0)
+            sdl_array_resolve(p, &t);
         if (take && sdl_ok(p)) {
             p->last_loc = t.tk.loc;
             return t;
@@ -1096,6 +1144,17 @@ const sdl_tok *sdl_peek(sdl_parser *p)
         sdl_unget(p, &t);
     }
     return &p->ahead[p->nahead - 1];
+}
+
+int sdl_raw_next_is(sdl_parser *p, sdl_tok_kind k)
+{
+    if (p->nahead > 0) return p->ahead[p->nahead - 1].tk.kind == k;
+    if (p->nframes == 0) return 0;
+    sdl_scanner *sc = &top_frame(p)->sc;
+    sdl_scan_pos at = sdl_scan_tell(sc);
+    sdl_token t = sdl_scan_next(sc);
+    sdl_scan_seek(sc, at);
+    return t.kind == k;
 }
 
 void sdl_unget(sdl_parser *p, const sdl_tok *t)

@@ -15,6 +15,10 @@ sdl_tok sdl_next(sdl_parser *p);
 const sdl_tok *sdl_peek(sdl_parser *p);
 /* Push a token back (at most 4 deep). */
 void sdl_unget(sdl_parser *p, const sdl_tok *t);
+/* Is the next token of kind k? Looked at in the raw text (or the pushed-back
+ * tokens), so no directive or macro runs: POV-Ray's check for '[' after an
+ * array identifier. */
+int sdl_raw_next_is(sdl_parser *p, sdl_tok_kind k);
 
 /* Start reading a file (path as given) or a string (text != NULL). */
 pt_status sdl_open_main(sdl_parser *p, const char *path, const char *text);

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "sdl_array.h"
 #include "sdl_directive.h"
 
 #define SDL_EPSILON 1e-10 /* POV-Ray's truth threshold for floats */
@@ -221,16 +222,29 @@ static double select_fn(sdl_parser *p)
     return gt;
 }
 
-/* defined '(' identifier ')' */
-static double defined_fn(sdl_parser *p)
+/* array_param: an array identifier (or an element that is an array) */
+static const sdl_array *array_param(sdl_parser *p)
+{
+    sdl_tok t = sdl_next(p);
+    if (t.tk.kind == TOK_IDENT && t.val.kind == VAL_ARRAY && t.val.ptr) return t.val.ptr;
+    sdl_unexpected(p, &t, "array identifier");
+    return NULL;
+}
+
+/* dimensions '(' array ')' | dimension_size '(' array ',' float ')' ;
+ * a dimension outside 1..dimensions gives 0 (POV-Ray 3.7). */
+static double dimension_fn(sdl_parser *p, sdl_kw k)
 {
     sdl_expect(p, TOK_LPAREN, "'('");
-    p->hold_macros++;
-    sdl_tok t = sdl_next(p);
-    p->hold_macros--;
+    const sdl_array *a = array_param(p);
     double v = 0;
-    if (t.tk.kind == TOK_IDENT) v = t.val.kind != VAL_NONE;
-    else if (t.tk.kind != TOK_KEYWORD) sdl_unexpected(p, &t, "identifier");
+    if (k == KW_DIMENSION_SIZE) {
+        sdl_accept(p, TOK_COMMA);
+        int d = sdl_to_int(sdl_float(p)) - 1;
+        if (a && d >= 0 && d < a->ndims) v = a->sizes[d];
+    } else if (a) {
+        v = a->ndims;
+    }
     sdl_expect(p, TOK_RPAREN, "')'");
     return v;
 }
@@ -402,7 +416,8 @@ static double float_function(sdl_parser *p, sdl_kw k, src_loc loc)
     case KW_MIN: case KW_MAX: case KW_BITWISE_AND: case KW_BITWISE_OR: case KW_BITWISE_XOR:
         return float_list_param(p, k);
     case KW_SELECT: return select_fn(p);
-    case KW_DEFINED: return defined_fn(p);
+    case KW_DIMENSIONS: case KW_DIMENSION_SIZE: return dimension_fn(p, k);
+    case KW_DEFINED: return sdl_defined_param(p);
     case KW_SEED: return seed_fn(p);
     case KW_RAND: return rand_fn(p, loc);
     case KW_STRCMP: case KW_STRLEN: case KW_VAL: case KW_ASC: case KW_FILE_EXISTS:
@@ -569,15 +584,18 @@ static void primary_inner(sdl_parser *p, ex_val *out)
 }
 
 /* Inside a primary, directives and macros run even while a declaration's
- * look-ahead defers them (POV-Ray: Ok_To_Declare within Parse_Num_Factor). */
+ * look-ahead defers them or a condition holds macros (POV-Ray: Ok_To_Declare
+ * is set within Parse_Num_Factor, so `#while (Macro(A))` calls the macro). */
 static void primary(sdl_parser *p, ex_val *out)
 {
     ex_float(out, 0);
     if (!sdl_enter(p, p->last_loc)) return;
-    int saved = p->defer;
+    int saved = p->defer, held = p->hold_macros;
     p->defer = 0;
+    p->hold_macros = 0;
     primary_inner(p, out);
     p->defer = saved;
+    p->hold_macros = held;
     sdl_leave(p);
 }
 

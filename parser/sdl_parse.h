@@ -22,6 +22,7 @@
 typedef struct {
     sdl_token tk;
     sdl_value val;
+    int elem;             /* an array element: val is the element's value */
 } sdl_tok;
 
 /* A loaded file; kept until the parse ends (macro bodies point into it). */
@@ -106,6 +107,8 @@ typedef struct sdl_parser {
     sdl_block *blocks;    /* open { } blocks, for "unterminated" messages */
     int nblocks, cap_blocks;
     int hold_macros;      /* >0: macro identifiers are returned, not invoked */
+    int hold_arrays;      /* >0: an array identifier followed by '[' is returned
+                             as the array (lvalues, defined()), not indexed */
     int defer;            /* >0: a '#' or macro name met while looking ahead is
                              returned as a token and runs when read again (the
                              look-ahead past the end of a #declare) */

@@ -8,6 +8,7 @@
 typedef struct sym_entry {
     struct sym_entry *hnext;     /* hash chain, innermost scope first */
     struct sym_entry *snext;     /* entries of the same scope */
+    struct sym_entry *alias;     /* by-reference macro parameter: the caller's entry */
     int depth;
     char *name;
     sdl_value val;
@@ -17,6 +18,7 @@ struct sdl_symtab {
     sym_entry *buckets[SYM_BUCKETS];
     sym_entry **scopes;          /* scopes[d]: list of entries of depth d */
     int depth, cap;
+    sym_entry *undefined;        /* #undef'd entries, freed with the table */
 };
 
 static unsigned hash_name(const char *s, size_t n)
@@ -66,6 +68,11 @@ void sdl_symtab_free(sdl_symtab *t)
             e = n;
         }
     }
+    while (t->undefined) {
+        sym_entry *n = t->undefined->snext;
+        free_entry(t->undefined);
+        t->undefined = n;
+    }
     free(t->scopes);
     free(t);
 }
@@ -103,10 +110,17 @@ static sym_entry *find_entry(const sdl_symtab *t, const char *name, size_t n)
     return NULL;
 }
 
+/* The entry an alias stands for (the entry itself if it is no alias). */
+static sym_entry *resolve(sym_entry *e)
+{
+    while (e && e->alias) e = e->alias;
+    return e;
+}
+
 const sdl_value *sdl_symtab_find(const sdl_symtab *t, const char *name, size_t n)
 {
-    sym_entry *e = find_entry(t, name, n);
-    return e ? &e->val : NULL;
+    sym_entry *e = resolve(find_entry(t, name, n));
+    return e && e->val.kind != VAL_NONE ? &e->val : NULL;
 }
 
 /* Insert a new entry at `depth`. Hash chains stay ordered innermost first. */
@@ -134,7 +148,7 @@ static int insert_entry(sdl_symtab *t, const char *name, size_t n, int depth, co
 
 int sdl_symtab_declare(sdl_symtab *t, const char *name, size_t n, const sdl_value *v)
 {
-    sym_entry *e = find_entry(t, name, n);
+    sym_entry *e = resolve(find_entry(t, name, n));
     if (e) {
         e->val = *v;
         return 1;
@@ -146,7 +160,7 @@ int sdl_symtab_local(sdl_symtab *t, const char *name, size_t n, const sdl_value 
 {
     sym_entry *e = find_entry(t, name, n);
     if (e && e->depth == t->depth) {
-        e->val = *v;
+        resolve(e)->val = *v;
         return 1;
     }
     return insert_entry(t, name, n, t->depth, v);
@@ -157,6 +171,36 @@ int sdl_symtab_undef(sdl_symtab *t, const char *name, size_t n)
     sym_entry *e = find_entry(t, name, n);
     if (!e) return 0;
     unlink_entry(t, e);
-    free_entry(e);
+    /* kept (undefined) for aliases that may still point at it */
+    memset(&e->val, 0, sizeof e->val);
+    e->alias = NULL;
+    e->hnext = NULL;
+    e->snext = t->undefined;
+    t->undefined = e;
     return 1;
+}
+
+sdl_symref *sdl_symtab_ref(const sdl_symtab *t, const char *name, size_t n)
+{
+    return resolve(find_entry(t, name, n));
+}
+
+int sdl_symtab_alias(sdl_symtab *t, const char *name, size_t n, sdl_symref *target)
+{
+    sdl_value none;
+    memset(&none, 0, sizeof none);
+    sym_entry *e = find_entry(t, name, n);
+    if (!e || e->depth != t->depth) {
+        if (!insert_entry(t, name, n, t->depth, &none)) return 0;
+        e = find_entry(t, name, n);
+    }
+    e->alias = resolve(target);
+    if (e->alias == e) e->alias = NULL;
+    return 1;
+}
+
+int sdl_symtab_scope_of(const sdl_symtab *t, const char *name, size_t n)
+{
+    sym_entry *e = find_entry(t, name, n);
+    return e ? e->depth : -1;
 }

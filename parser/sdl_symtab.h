@@ -24,8 +24,12 @@ typedef enum {
     VAL_CAMERA,    /* ptr: scene_camera */
     VAL_TRANSFORM, /* ptr: xform */
     VAL_MACRO,     /* ptr: sdl_macro (parser-internal) */
-    VAL_OPAQUE     /* something parsed but not modelled (function, media, fog,
-                      colour_map, spline, array...): str names the kind */
+    VAL_OPAQUE,    /* something parsed but not modelled (media, fog,
+                      colour_map...): str names the kind */
+    VAL_ARRAY,     /* ptr: sdl_array (sdl_array.h) */
+    VAL_FUNCTION,  /* ptr: scene_function (core/func.h); dim = result terms */
+    VAL_SPLINE,    /* ptr: scene_spline (core/spline.h) */
+    VAL_FILE       /* ptr: sdl_file (sdl_file.h), an #fopen'ed file */
 } sdl_val_kind;
 
 typedef struct {
@@ -52,5 +56,18 @@ int sdl_symtab_declare(sdl_symtab *t, const char *name, size_t n, const sdl_valu
 int sdl_symtab_local(sdl_symtab *t, const char *name, size_t n, const sdl_value *v);
 /* #undef: removes the innermost visible entry; returns 0 if there was none. */
 int sdl_symtab_undef(sdl_symtab *t, const char *name, size_t n);
+
+/* Macro parameters passed by reference (POV-Ray 3.7: an argument that is a
+ * lone identifier). sdl_symtab_ref returns a handle on the innermost visible
+ * entry (NULL if none); sdl_symtab_alias creates `name` in the innermost
+ * scope as an alias of that entry: reading it reads the caller's identifier,
+ * #declare/#local of it assign the caller's identifier. Entries removed by
+ * #undef stay allocated (undefined) until the table is freed, so a handle
+ * never dangles. */
+typedef struct sym_entry sdl_symref;
+sdl_symref *sdl_symtab_ref(const sdl_symtab *t, const char *name, size_t n);
+int sdl_symtab_alias(sdl_symtab *t, const char *name, size_t n, sdl_symref *target);
+/* Scope depth of the innermost visible entry, -1 if none. */
+int sdl_symtab_scope_of(const sdl_symtab *t, const char *name, size_t n);
 
 #endif
