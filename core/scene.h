@@ -335,6 +335,7 @@ typedef struct {
     /* Appended (scene_pattern.h): atmosphere. */
     const scene_fog *fogs;  /* linked through `next`; NULL = none */
     const scene_sky_sphere *sky_sphere; /* NULL = none */
+    scene_image *images;    /* every image the scene references (image_map...), to load */
 } scene;
 
 scene *scene_new(void);

@@ -79,11 +79,14 @@ typedef enum { WAVE_RAMP, WAVE_SINE, WAVE_TRIANGLE, WAVE_SCALLOP, WAVE_CUBIC, WA
 
 /* An image for image_map / image_pattern / bump_map, decoded to linear
  * RGBFT floats (POV-Ray 3.7 gamma rules applied when loading). */
-typedef struct {
-    const char *path;
+typedef struct scene_image {
+    const char *path;       /* resolved file path */
+    double gamma;           /* file gamma given in the scene, 0 = POV-Ray's default rules */
     int width, height;
-    float *pixels;          /* width*height*5: r g b filter transmit, row 0 = top */
+    float *pixels;          /* width*height*5: r g b filter transmit, row 0 = top; NULL until
+                               loaded (io/img_scene.h fills it after parsing) */
     int has_alpha;
+    struct scene_image *next; /* the scene's list of images (scene.images) */
 } scene_image;
 
 typedef struct {

@@ -4,6 +4,7 @@
 #include <string.h>
 #include "sdl_directive.h"
 #include "sdl_expr.h"
+#include "sdl_pattern.h"
 
 /* ------------------------------------------------------------ transforms */
 
@@ -108,127 +109,11 @@ void sdl_transform_texture(scene_texture *t, const xform *x)
 
 /* ------------------------------------------------------------ pigments */
 
-static int is_pattern_kw(sdl_kw k)
-{
-    switch (k) {
-    case KW_AGATE: case KW_AOI: case KW_AVERAGE: case KW_BOXED: case KW_BOZO: case KW_BRICK:
-    case KW_BUMPS: case KW_CELLS: case KW_CHECKER: case KW_CRACKLE: case KW_CYLINDRICAL:
-    case KW_DENSITY_FILE: case KW_DENTS: case KW_FACETS: case KW_FUNCTION: case KW_GRADIENT:
-    case KW_GRANITE: case KW_HEXAGON: case KW_IMAGE_MAP: case KW_IMAGE_PATTERN: case KW_JULIA:
-    case KW_LEOPARD: case KW_MAGNET: case KW_MANDEL: case KW_MARBLE: case KW_OBJECT:
-    case KW_ONION: case KW_PAVEMENT: case KW_PIGMENT_PATTERN: case KW_PLANAR: case KW_QUILTED:
-    case KW_RADIAL: case KW_RIPPLES: case KW_SLOPE: case KW_SPHERICAL: case KW_SPIRAL1:
-    case KW_SPIRAL2: case KW_SPOTTED: case KW_SQUARE: case KW_TILING: case KW_TRIANGULAR:
-    case KW_WAVES: case KW_WOOD: case KW_WRINKLES: case KW_BUMP_MAP: case KW_TILES:
-    case KW_MATERIAL_MAP: case KW_CUBIC:
-        return 1;
-    default:
-        return 0;
-    }
-}
-
-/* colour_map_entry := '[' float [','] [float [','] ] colour [colour] ']' ;
- * the first entry's colour is kept. */
-static void colour_map_block(sdl_parser *p, colour5 *first, int *have)
-{
-    if (sdl_is(sdl_peek(p), TOK_IDENT)) { /* a declared colour_map: opaque */
-        sdl_next(p);
-        return;
-    }
-    if (!sdl_begin_block(p, "colour_map")) return;
-    if (sdl_is(sdl_peek(p), TOK_IDENT)) sdl_next(p); /* colour_map { Declared_Map } */
-    while (sdl_ok(p) && sdl_accept(p, TOK_LBRACKET)) {
-        sdl_float(p);
-        sdl_accept(p, TOK_COMMA);
-        if (!sdl_starts_colour(sdl_peek(p))) {
-            sdl_float(p);
-            sdl_accept(p, TOK_COMMA);
-        }
-        colour5 c = sdl_colour(p, 1);
-        if (!*have) {
-            *first = c;
-            *have = 1;
-        }
-        if (sdl_starts_colour(sdl_peek(p))) sdl_colour(p, 1);
-        sdl_expect(p, TOK_RBRACKET, "']'");
-    }
-    sdl_end_block(p);
-}
-
-/* Loose skip of one token of a pattern's arguments: nested blocks skipped,
- * nested pigments and colours give the pattern's first colour. */
-static void pattern_token(sdl_parser *p, scene_pigment *pg, int *have)
-{
-    const sdl_tok *t = sdl_peek(p);
-    if (sdl_starts_colour(t) && t->tk.kind != TOK_IDENT) {
-        colour5 c = sdl_colour(p, 1);
-        if (!*have) pg->colour = c;
-        *have = 1;
-        return;
-    }
-    sdl_tok n = sdl_next(p);
-    if (n.tk.kind == TOK_IDENT && n.val.kind == VAL_NONE) {
-        sdl_error(p, n.tk.loc, PT_ERR_SYNTAX, "undeclared identifier '%.*s'", n.tk.len, n.tk.text);
-    } else if (n.tk.kind == TOK_IDENT && n.val.kind == VAL_COLOUR) {
-        if (!*have) memcpy(&pg->colour, n.val.v, sizeof pg->colour);
-        *have = 1;
-    } else if (n.tk.kind == TOK_IDENT && n.val.kind == VAL_PIGMENT) {
-        if (!*have) pg->colour = ((const scene_pigment *)n.val.ptr)->colour;
-        *have = 1;
-    } else if (sdl_is_kw(&n, KW_COLOR_MAP) || sdl_is_kw(&n, KW_COLOUR_MAP)) {
-        colour_map_block(p, &pg->colour, have);
-    } else if (sdl_is_kw(&n, KW_PIGMENT) && sdl_is(sdl_peek(p), TOK_LBRACE)) {
-        scene_pigment sub;
-        scene_default_pigment(&sub);
-        sdl_parse_pigment(p, &sub);
-        if (!*have) pg->colour = sub.colour;
-        *have = 1;
-    } else if (n.tk.kind == TOK_LBRACE) {
-        sdl_unget(p, &n);
-        if (sdl_begin_block(p, "pattern argument")) sdl_skip_block(p);
-    }
-}
-
-/* pigment_item := colour | pattern { pattern argument } | colour_map |
- *                 transform_item | quick_color colour | pigment modifier */
-static void pigment_item(sdl_parser *p, scene_pigment *pg, int *have_colour)
-{
-    const sdl_tok *t = sdl_peek(p);
-    xform x;
-    if (sdl_transform_item(p, &x)) {
-        pg->transform = xform_then(pg->transform, x);
-    } else if (sdl_is_kw(t, KW_QUICK_COLOR) || sdl_is_kw(t, KW_QUICK_COLOUR)) {
-        sdl_next(p);
-        sdl_colour(p, 1); /* a preview colour: not the pigment's colour */
-    } else if (pg->kind == PIGMENT_SOLID && sdl_starts_colour(t)) {
-        pg->colour = sdl_colour(p, 1);
-        *have_colour = 1;
-    } else if (pg->kind == PIGMENT_SOLID && t->tk.kind == TOK_KEYWORD && is_pattern_kw(t->tk.kw)) {
-        sdl_tok k = sdl_next(p);
-        sdl_warn_once(p, k.tk.loc, "pigment pattern '%s' is not evaluated yet; its first colour is used", sdl_kw_text(k.tk.kw));
-        pg->kind = PIGMENT_OTHER;
-        pg->pattern = sdl_kw_text(k.tk.kw);
-        *have_colour = 0;
-    } else {
-        pattern_token(p, pg, have_colour);
-    }
-}
-
-/* pigment := '{' [ pigment_identifier ] { pigment_item } '}' */
+/* pigment := '{' pigment body '}' (grammar in sdl_pattern.c) */
 void sdl_parse_pigment(sdl_parser *p, scene_pigment *pg)
 {
-    int have_colour = 0;
     if (!sdl_begin_block(p, "pigment")) return;
-    const sdl_tok *t = sdl_peek(p);
-    if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_PIGMENT) {
-        sdl_tok id = sdl_next(p);
-        *pg = *(const scene_pigment *)id.val.ptr;
-        have_colour = 1;
-    }
-    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
-        if (sdl_is(sdl_peek(p), TOK_EOF)) break;
-        pigment_item(p, pg, &have_colour);
-    }
+    sdl_pattern_pigment_body(p, pg);
     sdl_end_block(p);
 }
 
@@ -379,10 +264,15 @@ scene_finish *sdl_parse_finish_new(sdl_parser *p)
     return f;
 }
 
-void sdl_parse_normal(sdl_parser *p)
+scene_normal *sdl_parse_normal_from(sdl_parser *p, const scene_normal *base)
 {
-    if (sdl_begin_block(p, "normal")) sdl_skip_block(p);
+    if (!sdl_begin_block(p, "normal")) return NULL;
+    scene_normal *nm = sdl_pattern_normal_body(p, base);
+    sdl_end_block(p);
+    return nm;
 }
+
+scene_normal *sdl_parse_normal(sdl_parser *p) { return sdl_parse_normal_from(p, p->s->default_texture.normal); }
 
 /* ------------------------------------------------------------ interiors */
 
@@ -442,48 +332,6 @@ static scene_texture *new_texture(sdl_parser *p)
     return t;
 }
 
-/* A patterned texture (texture_map, tiles, material_map, checker of
- * textures...): kept as one texture with a PIGMENT_OTHER pigment that
- * takes the look of the first texture inside. */
-static void pattern_texture(sdl_parser *p, scene_texture *t)
-{
-    sdl_tok k = sdl_next(p);
-    const char *name = k.tk.kind == TOK_KEYWORD ? sdl_kw_text(k.tk.kw) : "pattern";
-    sdl_warn_once(p, k.tk.loc, "patterned texture '%s' is not evaluated yet; its first texture is used", name);
-    int have = 0;
-    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE) && !sdl_is(sdl_peek(p), TOK_EOF)) {
-        sdl_tok n = sdl_next(p);
-        xform x;
-        if (sdl_is_kw(&n, KW_TEXTURE) && sdl_is(sdl_peek(p), TOK_LBRACE)) {
-            scene_texture *sub = sdl_parse_texture(p);
-            if (!have && sub) {
-                xform keep = t->transform;
-                *t = *sub;
-                t->transform = keep;
-                t->next = NULL;
-                have = 1;
-            }
-        } else if (n.tk.kind == TOK_IDENT && n.val.kind == VAL_TEXTURE && !have) {
-            xform keep = t->transform;
-            *t = *(const scene_texture *)n.val.ptr;
-            t->transform = keep;
-            t->next = NULL;
-            have = 1;
-        } else if (n.tk.kind == TOK_LBRACE || n.tk.kind == TOK_LBRACKET) {
-            if (n.tk.kind == TOK_LBRACE) {
-                sdl_unget(p, &n);
-                if (sdl_begin_block(p, name)) sdl_skip_block(p);
-            }
-        } else if (n.tk.kind == TOK_KEYWORD) {
-            sdl_unget(p, &n);
-            if (sdl_transform_item(p, &x)) t->transform = xform_then(t->transform, x);
-            else sdl_next(p);
-        }
-    }
-    t->pigment.kind = PIGMENT_OTHER;
-    t->pigment.pattern = name;
-}
-
 /* texture_item := pigment_identifier | finish_identifier | normal_identifier |
  *   'pigment' pigment | 'finish' finish | 'normal' normal | transform_item |
  *   no_bump_scale | uv_mapping */
@@ -495,7 +343,10 @@ static int texture_item(sdl_parser *p, scene_texture *t)
         sdl_tok id = sdl_next(p);
         if (id.val.kind == VAL_PIGMENT) t->pigment = *(const scene_pigment *)id.val.ptr;
         else if (id.val.kind == VAL_FINISH) t->finish = *(const scene_finish *)id.val.ptr;
-        else t->has_normal = 1;
+        else {
+            t->has_normal = 1;
+            if (id.val.ptr) t->normal = id.val.ptr;
+        }
         return 1;
     }
     if (sdl_transform_item(p, &x)) {
@@ -511,18 +362,28 @@ static int texture_item(sdl_parser *p, scene_texture *t)
         return 1;
     }
     if (sdl_accept_kw(p, KW_NORMAL)) {
-        sdl_parse_normal(p);
+        scene_normal *nm = sdl_parse_normal_from(p, t->normal);
+        if (nm) t->normal = nm;
         t->has_normal = 1;
         return 1;
     }
     return sdl_accept_kw(p, KW_NO_BUMP_SCALE) || sdl_accept_kw(p, KW_UV_MAPPING);
 }
 
-/* texture := '{' [ texture_identifier ] { texture_item } | '{' texture_pattern ... '}' */
+/* texture := '{' texture_body '}' */
 scene_texture *sdl_parse_texture(sdl_parser *p)
 {
-    src_loc loc = sdl_peek(p)->tk.loc;
     if (!sdl_begin_block(p, "texture")) return NULL;
+    scene_texture *t = sdl_parse_texture_body(p);
+    sdl_end_block(p);
+    return t;
+}
+
+/* texture_body := [ texture_identifier ] { texture_item } | texture_pattern ...
+ * (patterned textures: sdl_pattern.c) */
+scene_texture *sdl_parse_texture_body(sdl_parser *p)
+{
+    src_loc loc = sdl_peek(p)->tk.loc;
     scene_texture *t = NULL;
     int modified = 0;
     const sdl_tok *pk = sdl_peek(p);
@@ -537,9 +398,9 @@ scene_texture *sdl_parse_texture(sdl_parser *p)
     t->loc = loc;
     while (sdl_ok(p) && texture_item(p, t)) modified = 1;
     const sdl_tok *rest = sdl_peek(p);
-    if (!modified && !sdl_is(rest, TOK_RBRACE) && rest->tk.kind == TOK_KEYWORD && is_pattern_kw(rest->tk.kw))
-        pattern_texture(p, t);
-    sdl_end_block(p);
+    if (!modified && rest->tk.kind == TOK_KEYWORD &&
+        (sdl_pattern_is_type(rest->tk.kw) || rest->tk.kw == KW_TILES || rest->tk.kw == KW_MATERIAL_MAP))
+        sdl_pattern_texture(p, t);
     return t;
 }
 

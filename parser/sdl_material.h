@@ -13,14 +13,18 @@
 
 /* texture '{' ... '}' -> new texture (layer list) */
 scene_texture *sdl_parse_texture(sdl_parser *p);
+/* The inside of a texture block (a texture_map entry after its value). */
+scene_texture *sdl_parse_texture_body(sdl_parser *p);
 /* pigment '{' ... '}' modifying pg / as a new pigment */
 void sdl_parse_pigment(sdl_parser *p, scene_pigment *pg);
 scene_pigment *sdl_parse_pigment_new(sdl_parser *p);
 /* finish '{' ... '}' */
 void sdl_parse_finish(sdl_parser *p, scene_finish *f);
 scene_finish *sdl_parse_finish_new(sdl_parser *p);
-/* normal '{' ... '}' (skipped: normals are not evaluated yet) */
-void sdl_parse_normal(sdl_parser *p);
+/* normal '{' ... '}' -> a new normal (grammar in sdl_pattern.c), starting
+ * from the default texture's normal / from `base`. NULL after an error. */
+scene_normal *sdl_parse_normal(sdl_parser *p);
+scene_normal *sdl_parse_normal_from(sdl_parser *p, const scene_normal *base);
 /* interior '{' ... '}' */
 void sdl_parse_interior(sdl_parser *p, scene_interior *in);
 scene_interior *sdl_parse_interior_new(sdl_parser *p);

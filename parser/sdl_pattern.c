@@ -1,0 +1,1250 @@
+/* sdl_pattern.c - POV-Ray 3.7 pattern grammar (see sdl_pattern.h).
+ *
+ * Follows the structure of POV-Ray 3.7's Parse_Pattern, Parse_Blend_List,
+ * Parse_Blend_Map, Parse_Colour_Map, Parse_Warp and Check_Turb (semantics
+ * studied, not copied): a pattern type comes first (after an optional
+ * identifier), then any number of modifiers; listed colours or pigments
+ * (checker Red, Blue) make a map with entries at 0, 1, 2...; missing listed
+ * entries come from the pattern's default map (or the default pigment /
+ * texture); map values are kept in single precision as POV-Ray keeps them;
+ * `mortar` is stored less 2e-10, brick/checker/hexagon/... set frequency 0;
+ * marble, wood and spirals default to the triangle wave; agate always has a
+ * classic turbulence record. Unknown modifiers are skipped with a warning. */
+#include "sdl_pattern.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include "sdl_directive.h"
+#include "sdl_expr.h"
+#include "sdl_material.h"
+
+#define PAT_EPS 1.0e-10
+#define MAX_MAP_ENTRIES 256
+
+typedef enum { TGT_PIGMENT, TGT_NORMAL, TGT_TEXTURE } tgt_kind;
+
+/* What a pattern block is filling in. */
+typedef struct {
+    tgt_kind kind;
+    scene_pattern *pat;             /* mutable copy, NULL while no pattern type was given */
+    const scene_blend_map **map;
+    xform *outer;
+    scene_pigment *pg;
+    scene_normal *nm;
+    scene_texture *tx;
+} target;
+
+static double sngl(double v) { return (double)(float)v; }
+
+/* ------------------------------------------------------------ records */
+
+void sdl_pattern_default_normal(scene_normal *nm)
+{
+    memset(nm, 0, sizeof *nm);
+    nm->amount = 0.5;
+    nm->delta = 0.02;
+    nm->transform = xform_identity();
+}
+
+static scene_pattern *new_pattern(sdl_parser *p, const scene_pattern *from)
+{
+    scene_pattern *pt = sdl_alloc(p, sizeof *pt);
+    if (!pt) return NULL;
+    if (from) {
+        *pt = *from;
+    } else {
+        pt->kind = PAT_PLAIN;
+        pt->wave = WAVE_RAMP;
+        pt->exponent = 1.0;
+        pt->frequency = 1.0;
+    }
+    return pt;
+}
+
+static scene_warp default_turb(void)
+{
+    scene_warp w;
+    memset(&w, 0, sizeof w);
+    w.kind = WARP_TURBULENCE;
+    w.octaves = 6;
+    w.omega = 0.5;
+    w.lambda = 2.0;
+    w.transform = xform_identity();
+    return w;
+}
+
+/* Replace the warp array by a copy with room for one more. */
+static scene_warp *grow_warps(sdl_parser *p, scene_pattern *pt, int extra)
+{
+    scene_warp *w = sdl_alloc(p, sizeof *w * (size_t)(pt->nwarps + extra));
+    if (!w) return NULL;
+    if (pt->nwarps) memcpy(w, pt->warps, sizeof *w * (size_t)pt->nwarps);
+    pt->warps = w;
+    return w;
+}
+
+/* POV-Ray's Check_Turb: the classic turbulence record, appended if the last
+ * warp is not one. Returns a mutable pointer (the array is copied). */
+static scene_warp *classic_turb(sdl_parser *p, scene_pattern *pt)
+{
+    if (pt->nwarps > 0 && pt->warps[pt->nwarps - 1].kind == WARP_TURBULENCE && pt->warps[pt->nwarps - 1].classic) {
+        scene_warp *w = grow_warps(p, pt, 0);
+        return w ? &w[pt->nwarps - 1] : NULL;
+    }
+    scene_warp *w = grow_warps(p, pt, 1);
+    if (!w) return NULL;
+    w[pt->nwarps] = default_turb();
+    w[pt->nwarps].classic = 1;
+    return &w[pt->nwarps++];
+}
+
+/* A warp{} goes in front of the list, after the owner's pending transforms
+ * (which become a transform warp right behind it). */
+static void push_warp(sdl_parser *p, target *tg, const scene_warp *nw)
+{
+    scene_pattern *pt = tg->pat;
+    int has_outer = !xform_is_identity(tg->outer);
+    scene_warp *w = sdl_alloc(p, sizeof *w * (size_t)(pt->nwarps + 1 + has_outer));
+    if (!w) return;
+    int k = 0;
+    w[k++] = *nw;
+    if (has_outer) {
+        scene_warp t;
+        memset(&t, 0, sizeof t);
+        t.kind = WARP_TRANSFORM;
+        t.transform = *tg->outer;
+        w[k++] = t;
+        *tg->outer = xform_identity();
+    }
+    if (pt->nwarps) memcpy(w + k, pt->warps, sizeof *w * (size_t)pt->nwarps);
+    pt->warps = w;
+    pt->nwarps += k;
+}
+
+/* ------------------------------------------------------------ images */
+
+static char *try_path(const char *dir, const char *name)
+{
+    size_t n = (dir ? strlen(dir) + 1 : 0) + strlen(name) + 1;
+    char *f = malloc(n);
+    if (!f) return NULL;
+    if (dir) snprintf(f, n, "%s/%s", dir, name);
+    else snprintf(f, n, "%s", name);
+    if (access(f, R_OK) == 0) return f;
+    free(f);
+    return NULL;
+}
+
+/* POV-Ray looks for input images in the working directory and then the
+ * library paths; we also look next to the file being read. */
+static const char *resolve_image(sdl_parser *p, const char *name)
+{
+    char *found = NULL;
+    if (name[0] == '/') {
+        found = try_path(NULL, name);
+    } else {
+        found = try_path(NULL, name);
+        if (!found && p->nframes > 0 && p->frames[p->nframes - 1].src && p->frames[p->nframes - 1].src->path) {
+            const char *sp = p->frames[p->nframes - 1].src->path;
+            const char *slash = strrchr(sp, '/');
+            if (slash) {
+                char *d = sdl_strndup(p, sp, (size_t)(slash - sp));
+                if (d) found = try_path(d, name);
+            }
+        }
+        for (int i = 0; i < p->opt.nlib_paths && !found; i++) found = try_path(p->opt.lib_paths[i], name);
+        if (!found && !p->opt.no_default_lib) found = try_path("/usr/share/povray-3.7/include", name);
+    }
+    if (!found) return NULL;
+    const char *r = sdl_strndup(p, found, strlen(found));
+    free(found);
+    return r;
+}
+
+static int is_image_type_kw(sdl_kw k)
+{
+    switch (k) {
+    case KW_GIF: case KW_IFF: case KW_POT: case KW_SYS: case KW_TGA: case KW_PNG: case KW_PGM:
+    case KW_PPM: case KW_JPEG: case KW_TIFF: case KW_BMP: case KW_EXR: case KW_HDR:
+        return 1;
+    default:
+        return 0;
+    }
+}
+
+/* image_spec := [file_type] string [gamma g | premultiplied b] | function w, h { .. } */
+static scene_image *image_spec(sdl_parser *p)
+{
+    const sdl_tok *t = sdl_peek(p);
+    src_loc loc = t->tk.loc;
+    if (sdl_is_kw(t, KW_FUNCTION)) {
+        sdl_next(p);
+        sdl_warn_once(p, loc, "function images are not supported; the image is transparent");
+        sdl_float(p);
+        sdl_accept(p, TOK_COMMA);
+        sdl_float(p);
+        if (sdl_begin_block(p, "function")) sdl_skip_block(p);
+        return NULL;
+    }
+    if (t->tk.kind == TOK_KEYWORD && is_image_type_kw(t->tk.kw)) sdl_next(p);
+    const char *name = sdl_string(p);
+    if (!sdl_ok(p) || !name) return NULL;
+    scene_image *img = sdl_alloc(p, sizeof *img);
+    if (!img) return NULL;
+    for (;;) {
+        if (sdl_accept_kw(p, KW_GAMMA)) {
+            if (sdl_accept_kw(p, KW_SRGB)) img->gamma = -1.0; /* sRGB curve */
+            else img->gamma = sdl_float(p);
+        } else if (sdl_accept_kw(p, KW_PREMULTIPLIED)) {
+            sdl_float(p);
+        } else {
+            break;
+        }
+    }
+    img->path = resolve_image(p, name);
+    if (!img->path && !strchr(name, '.')) {
+        /* no extension: POV-Ray tries the file type's extensions */
+        static const char *const ext[] = {".png", ".tga", ".jpg", ".jpeg", ".ppm", ".pgm", ".gif", ".bmp", ".tif", ".tiff",
+                                          ".exr", ".hdr", ".iff"};
+        for (size_t i = 0; i < sizeof ext / sizeof ext[0] && !img->path; i++) {
+            char buf[1024];
+            snprintf(buf, sizeof buf, "%s%s", name, ext[i]);
+            img->path = resolve_image(p, buf);
+        }
+    }
+    if (!img->path) {
+        sdl_warning(p, loc, "cannot find image file '%s'; the image is transparent", name);
+        return NULL;
+    }
+    img->next = p->s->images;
+    p->s->images = img;
+    return img;
+}
+
+/* image_map { image_spec { once | interpolate n | map_type n | use_colour |
+ *   use_index | repeat uv | offset uv | filter [all] .. | transmit [all] .. } } */
+static void image_block(sdl_parser *p, scene_image_map *im, int is_pattern)
+{
+    if (!sdl_begin_block(p, is_pattern ? "image_pattern" : "image_map")) return;
+    im->image = image_spec(p);
+    im->major_radius = 1.0;
+    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
+        sdl_tok t = sdl_next(p);
+        sdl_kw k = t.tk.kind == TOK_KEYWORD ? t.tk.kw : KW_NONE;
+        switch (k) {
+        case KW_ONCE: im->once = 1; break;
+        case KW_INTERPOLATE: im->interpolate = sdl_to_int(sdl_float(p)); break;
+        case KW_MAP_TYPE: im->map_type = sdl_to_int(sdl_float(p)); break;
+        case KW_USE_COLOR: case KW_USE_COLOUR: case KW_USE_INDEX: break;
+        case KW_USE_ALPHA: im->use_alpha = 1; break;
+        case KW_REPEAT: case KW_OFFSET: {
+            double uv[2];
+            sdl_vector_n(p, uv, 2);
+            sdl_warn_once(p, t.tk.loc, "image_map %s is not supported and is ignored", sdl_kw_text(k));
+            break;
+        }
+        case KW_FILTER: case KW_TRANSMIT: case KW_ALPHA: {
+            int filter = k != KW_TRANSMIT;
+            if (sdl_accept_kw(p, KW_ALL)) {
+                double v = sdl_float(p);
+                if (filter) {
+                    im->filter_all = v;
+                    im->filter_all_set = 1;
+                } else {
+                    im->transmit_all = v;
+                    im->transmit_all_set = 1;
+                }
+            } else {
+                sdl_float(p);
+                sdl_accept(p, TOK_COMMA);
+                sdl_float(p);
+                sdl_warn_once(p, t.tk.loc, "image_map filter/transmit of one palette index is not supported");
+            }
+            break;
+        }
+        default:
+            sdl_unexpected(p, &t, "image_map modifier");
+            break;
+        }
+    }
+    sdl_end_block(p);
+}
+
+/* ------------------------------------------------------------ maps */
+
+static scene_map_entry *entries(sdl_parser *p, int n)
+{
+    scene_map_entry *e = sdl_alloc(p, sizeof *e * (size_t)(n > 0 ? n : 1));
+    return e;
+}
+
+static scene_blend_map *make_map(sdl_parser *p, map_kind k, scene_map_entry *e, int n)
+{
+    scene_blend_map *m = sdl_alloc(p, sizeof *m);
+    if (!m) return NULL;
+    m->kind = k;
+    m->n = n;
+    m->e = e;
+    return m;
+}
+
+static void colour_into(double c[5], colour5 v)
+{
+    c[0] = v.r;
+    c[1] = v.g;
+    c[2] = v.b;
+    c[3] = v.f;
+    c[4] = v.t;
+}
+
+/* A declared map used as `map { Id }`. */
+static const scene_blend_map *declared_map(sdl_parser *p, const char *what)
+{
+    sdl_tok id = sdl_next(p);
+    if (id.val.kind == VAL_OPAQUE && id.val.ptr && id.val.str && strcmp(id.val.str, what) == 0) return id.val.ptr;
+    sdl_warn_once(p, id.tk.loc, "declared %s '%.*s' is not available; the default map is used", what, id.tk.len, id.tk.text);
+    return NULL;
+}
+
+/* colour_map := '{' ( map_id | { '[' v [','] ( colour | v2 [','] colour colour ) ']' } ) '}' */
+static const scene_blend_map *colour_map(sdl_parser *p)
+{
+    if (!sdl_begin_block(p, "color_map")) return NULL;
+    if (sdl_is(sdl_peek(p), TOK_IDENT) && sdl_peek(p)->val.kind == VAL_OPAQUE) {
+        const scene_blend_map *m = declared_map(p, "colour_map");
+        sdl_end_block(p);
+        return m;
+    }
+    scene_map_entry *e = entries(p, MAX_MAP_ENTRIES);
+    int n = 0;
+    if (!e) return NULL;
+    while (sdl_ok(p) && sdl_accept(p, TOK_LBRACKET)) {
+        if (n + 2 > MAX_MAP_ENTRIES) {
+            sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_LIMIT, "too many entries in color_map (at most %d)", MAX_MAP_ENTRIES);
+            break;
+        }
+        double v = sngl(sdl_float(p));
+        sdl_accept(p, TOK_COMMA);
+        if (!sdl_starts_colour(sdl_peek(p))) {
+            /* old style [v1 v2 colour c1 colour c2] or [v <r,g,b,f,t>] */
+            sdl_value ex;
+            sdl_sum(p, &ex);
+            if (ex.dim == 5 || ex.kind == VAL_COLOUR) {
+                e[n].value = v;
+                for (int i = 0; i < 5; i++) e[n].c[i] = ex.v[i];
+                n++;
+            } else {
+                double v2 = sngl(ex.v[0]);
+                sdl_accept(p, TOK_COMMA);
+                e[n].value = v;
+                colour_into(e[n].c, sdl_colour(p, 1));
+                e[n + 1].value = v2;
+                colour_into(e[n + 1].c, sdl_colour(p, 1));
+                n += 2;
+            }
+        } else {
+            e[n].value = v;
+            colour_into(e[n].c, sdl_colour(p, 1));
+            n++;
+        }
+        sdl_expect(p, TOK_RBRACKET, "']' closing the color_map entry");
+    }
+    sdl_end_block(p);
+    if (n == 0) {
+        if (sdl_ok(p)) sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_SYNTAX, "must have at least one color in color map");
+        return NULL;
+    }
+    /* POV-Ray drops an entry identical to the one before it. */
+    int k = 0;
+    for (int i = 1; i < n; i++) {
+        if (memcmp(&e[k], &e[i], sizeof e[i]) == 0) continue;
+        e[++k] = e[i];
+    }
+    return make_map(p, MAP_COLOUR, e, k + 1);
+}
+
+static const char *map_name(map_kind k)
+{
+    switch (k) {
+    case MAP_PIGMENT: return "pigment_map";
+    case MAP_NORMAL: return "normal_map";
+    case MAP_TEXTURE: return "texture_map";
+    case MAP_SLOPE: return "slope_map";
+    default: return "colour_map";
+    }
+}
+
+/* blend_map := '{' ( map_id | { '[' v [','] entry ']' } ) '}'; `average`
+ * allows the value to be omitted (weight 1). */
+static const scene_blend_map *blend_map(sdl_parser *p, map_kind k, int average)
+{
+    if (!sdl_begin_block(p, map_name(k))) return NULL;
+    if (sdl_is(sdl_peek(p), TOK_IDENT) && sdl_peek(p)->val.kind == VAL_OPAQUE) {
+        const scene_blend_map *m = declared_map(p, map_name(k));
+        sdl_end_block(p);
+        return m;
+    }
+    scene_map_entry *e = entries(p, MAX_MAP_ENTRIES);
+    int n = 0;
+    if (!e) return NULL;
+    while (sdl_ok(p) && sdl_accept(p, TOK_LBRACKET)) {
+        if (n >= MAX_MAP_ENTRIES) {
+            sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_LIMIT, "too many entries in map (at most %d)", MAX_MAP_ENTRIES);
+            break;
+        }
+        e[n].value = sngl(average ? sdl_allow_float(p, 1.0) : sdl_float(p));
+        sdl_accept(p, TOK_COMMA);
+        switch (k) {
+        case MAP_PIGMENT: {
+            scene_pigment *pg = sdl_alloc(p, sizeof *pg);
+            if (!pg) return NULL;
+            *pg = p->s->default_texture.pigment;
+            sdl_pattern_pigment_body(p, pg);
+            e[n].pigment = pg;
+            break;
+        }
+        case MAP_NORMAL:
+            e[n].normal = sdl_pattern_normal_body(p, p->s->default_texture.normal);
+            break;
+        case MAP_TEXTURE:
+            e[n].texture = sdl_parse_texture_body(p);
+            break;
+        case MAP_SLOPE: {
+            double hs[2];
+            sdl_vector_n(p, hs, 2);
+            e[n].height = hs[0];
+            e[n].slope = hs[1];
+            break;
+        }
+        default:
+            break;
+        }
+        n++;
+        sdl_expect(p, TOK_RBRACKET, "']' closing the map entry");
+    }
+    sdl_end_block(p);
+    if (n == 0) {
+        if (sdl_ok(p)) sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_SYNTAX, "must have at least one entry in map");
+        return NULL;
+    }
+    return make_map(p, k, e, n);
+}
+
+const scene_blend_map *sdl_pattern_map(sdl_parser *p, sdl_kw k)
+{
+    switch (k) {
+    case KW_COLOR_MAP: case KW_COLOUR_MAP: return colour_map(p);
+    case KW_PIGMENT_MAP: return blend_map(p, MAP_PIGMENT, 0);
+    case KW_NORMAL_MAP: return blend_map(p, MAP_NORMAL, 0);
+    case KW_SLOPE_MAP: return blend_map(p, MAP_SLOPE, 0);
+    case KW_TEXTURE_MAP: return blend_map(p, MAP_TEXTURE, 0);
+    default: return NULL;
+    }
+}
+
+/* ------------------------------------------------------------ blend lists */
+
+/* Default colours of the listed-pattern maps (POV-Ray's default maps). */
+static colour5 list_default_colour(pattern_kind k, int i)
+{
+    static const double hex[3][3] = {{0, 0, 1}, {0, 1, 0}, {1, 0, 0}};
+    static const double cub[6][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {0, 1, 1}, {1, 0, 1}};
+    static const double brk[2][3] = {{0.5, 0.5, 0.5}, {0.6, 0.15, 0.15}};
+    colour5 c = {0, 0, 0, 0, 0};
+    const double *v;
+    if (k == PAT_BRICK) v = brk[i % 2];
+    else if (k == PAT_CHECKER || k == PAT_HEXAGON) v = hex[i % 3];
+    else v = cub[i % 6];
+    c.r = sngl(v[0]);
+    c.g = sngl(v[1]);
+    c.b = sngl(v[2]);
+    return c;
+}
+
+/* blend_list := { colour [','] } | { pigment {..} [','] } | { normal {..} [','] } |
+ *               { texture {..} [','] }, at most `count` items. */
+static void blend_list(sdl_parser *p, target *tg, int count)
+{
+    scene_map_entry *e = entries(p, count);
+    if (!e) return;
+    int n = 0;
+    map_kind mk = MAP_COLOUR;
+    if (tg->kind == TGT_PIGMENT) {
+        mk = sdl_is_kw(sdl_peek(p), KW_PIGMENT) ? MAP_PIGMENT : MAP_COLOUR;
+        while (sdl_ok(p) && n < count) {
+            const sdl_tok *t = sdl_peek(p);
+            if (mk == MAP_PIGMENT) {
+                if (!sdl_accept_kw(p, KW_PIGMENT)) break;
+                scene_pigment *pg = sdl_alloc(p, sizeof *pg);
+                if (!pg) return;
+                *pg = p->s->default_texture.pigment;
+                if (sdl_begin_block(p, "pigment")) {
+                    sdl_pattern_pigment_body(p, pg);
+                    sdl_end_block(p);
+                }
+                e[n].pigment = pg;
+            } else {
+                if (!(sdl_starts_colour(t) || sdl_starts_expr(t))) break;
+                colour_into(e[n].c, sdl_colour(p, 1));
+            }
+            sdl_accept(p, TOK_COMMA);
+            n++;
+        }
+    } else if (tg->kind == TGT_NORMAL) {
+        mk = MAP_NORMAL;
+        while (sdl_ok(p) && n < count && sdl_accept_kw(p, KW_NORMAL)) {
+            if (sdl_begin_block(p, "normal")) {
+                e[n].normal = sdl_pattern_normal_body(p, p->s->default_texture.normal);
+                sdl_end_block(p);
+            }
+            sdl_accept(p, TOK_COMMA);
+            n++;
+        }
+        if (n == 0) {
+            *tg->map = NULL;
+            return;
+        }
+    } else {
+        mk = MAP_TEXTURE;
+        while (sdl_ok(p) && n < count && sdl_accept_kw(p, KW_TEXTURE)) {
+            e[n].texture = sdl_parse_texture(p);
+            sdl_accept(p, TOK_COMMA);
+            n++;
+        }
+    }
+    for (int i = 0; i < count; i++) {
+        e[i].value = i;
+        if (i < n) continue;
+        switch (mk) {
+        case MAP_COLOUR: colour_into(e[i].c, list_default_colour(tg->pat->kind, i)); break;
+        case MAP_PIGMENT: {
+            scene_pigment *pg = sdl_alloc(p, sizeof *pg);
+            if (pg) *pg = p->s->default_texture.pigment;
+            e[i].pigment = pg;
+            break;
+        }
+        case MAP_NORMAL: e[i].normal = p->s->default_texture.normal; break;
+        case MAP_TEXTURE: {
+            scene_texture *t = sdl_copy_texture(p, &p->s->default_texture);
+            if (t) t->transform = xform_identity();
+            e[i].texture = t;
+            break;
+        }
+        default: break;
+        }
+    }
+    *tg->map = make_map(p, mk, e, count);
+}
+
+/* ------------------------------------------------------------ warps */
+
+/* warp := '{' ( turbulence v {octaves|omega|lambda} | repeat v {offset v|flip v} |
+ *   black_hole v, r {strength|falloff|inverse|type|repeat v|turbulence v} |
+ *   cylindrical|spherical|toroidal {orientation v|dist_exp f|major_radius f} |
+ *   planar [v, f] | cubic ) '}' */
+static void warp_block(sdl_parser *p, target *tg)
+{
+    src_loc loc = sdl_peek(p)->tk.loc;
+    if (!sdl_begin_block(p, "warp")) return;
+    scene_warp w;
+    memset(&w, 0, sizeof w);
+    w.transform = xform_identity();
+    w.orientation = v3(0, 0, 1);
+    w.major_radius = 1.0;
+    sdl_tok t = sdl_next(p);
+    sdl_kw k = t.tk.kind == TOK_KEYWORD ? t.tk.kw : KW_NONE;
+    switch (k) {
+    case KW_TURBULENCE:
+        w = default_turb();
+        w.turbulence = sdl_vector(p);
+        for (;;) {
+            if (sdl_accept_kw(p, KW_OCTAVES)) {
+                w.octaves = sdl_to_int(sdl_float(p));
+                if (w.octaves < 1) w.octaves = 1;
+                if (w.octaves > 10) w.octaves = 10;
+            } else if (sdl_accept_kw(p, KW_OMEGA)) {
+                w.omega = sdl_float(p);
+            } else if (sdl_accept_kw(p, KW_LAMBDA)) {
+                w.lambda = sdl_float(p);
+            } else {
+                break;
+            }
+        }
+        break;
+    case KW_REPEAT: {
+        w.kind = WARP_REPEAT;
+        vec3 v = sdl_vector(p);
+        w.axis = -1;
+        double c[3] = {v.x, v.y, v.z};
+        for (int i = 0; i < 3; i++) {
+            if (c[i] == 0.0) continue;
+            if (w.axis >= 0) sdl_error(p, loc, PT_ERR_SYNTAX, "can only repeat along 1 axis");
+            w.axis = i;
+        }
+        if (w.axis < 0) {
+            sdl_error(p, loc, PT_ERR_SYNTAX, "no axis specified in repeat");
+            w.axis = 0;
+        }
+        w.width = c[w.axis];
+        w.flip = v3(1, 1, 1);
+        for (;;) {
+            if (sdl_accept_kw(p, KW_OFFSET)) {
+                w.offset = sdl_vector(p);
+            } else if (sdl_accept_kw(p, KW_FLIP)) {
+                vec3 f = sdl_vector(p);
+                w.flip = v3(f.x != 0.0 ? -1.0 : 1.0, f.y != 0.0 ? -1.0 : 1.0, f.z != 0.0 ? -1.0 : 1.0);
+            } else {
+                break;
+            }
+        }
+        break;
+    }
+    case KW_BLACK_HOLE:
+        w.kind = WARP_BLACK_HOLE;
+        w.centre = sdl_vector(p);
+        sdl_accept(p, TOK_COMMA);
+        w.radius = sdl_float(p);
+        w.strength = 1.0;
+        w.power = 2.0;
+        for (;;) {
+            if (sdl_accept_kw(p, KW_STRENGTH)) w.strength = sdl_float(p);
+            else if (sdl_accept_kw(p, KW_FALLOFF)) w.power = sdl_float(p);
+            else if (sdl_accept_kw(p, KW_INVERSE)) w.inverted = 1;
+            else if (sdl_accept_kw(p, KW_TYPE)) w.bh_type = sdl_to_int(sdl_float(p));
+            else if (sdl_accept_kw(p, KW_REPEAT)) {
+                w.repeat_vec = sdl_vector(p);
+                w.bh_repeat = 1;
+            } else if (sdl_accept_kw(p, KW_TURBULENCE)) {
+                w.uncertainty = sdl_vector(p);
+                w.uncertain = 1;
+            } else {
+                break;
+            }
+        }
+        break;
+    case KW_CYLINDRICAL: case KW_SPHERICAL: case KW_TOROIDAL:
+        w.kind = k == KW_CYLINDRICAL ? WARP_CYLINDRICAL : (k == KW_SPHERICAL ? WARP_SPHERICAL : WARP_TOROIDAL);
+        for (;;) {
+            if (sdl_accept_kw(p, KW_ORIENTATION)) w.orientation = v3_norm(sdl_vector(p));
+            else if (sdl_accept_kw(p, KW_DIST_EXP)) w.dist_exp = sdl_float(p);
+            else if (k == KW_TOROIDAL && sdl_accept_kw(p, KW_MAJOR_RADIUS)) w.major_radius = sdl_float(p);
+            else break;
+        }
+        break;
+    case KW_PLANAR:
+        w.kind = WARP_PLANAR;
+        if (sdl_starts_expr(sdl_peek(p))) {
+            w.orientation = v3_norm(sdl_vector(p));
+            sdl_accept(p, TOK_COMMA);
+            w.plane_offset = sdl_float(p);
+        }
+        break;
+    case KW_CUBIC: w.kind = WARP_CUBIC; break;
+    default:
+        sdl_unexpected(p, &t, "warp type");
+        return;
+    }
+    sdl_end_block(p);
+    if (sdl_ok(p) && tg->pat) push_warp(p, tg, &w);
+}
+
+/* ------------------------------------------------------------ pattern types */
+
+static const char *kw_name(sdl_kw k) { return sdl_kw_text(k); }
+
+int sdl_pattern_is_type(sdl_kw k)
+{
+    switch (k) {
+    case KW_AGATE: case KW_AOI: case KW_AVERAGE: case KW_BOXED: case KW_BOZO: case KW_BRICK:
+    case KW_BUMPS: case KW_CELLS: case KW_CHECKER: case KW_CRACKLE: case KW_CUBIC: case KW_CYLINDRICAL:
+    case KW_DENSITY_FILE: case KW_DENTS: case KW_FACETS: case KW_FUNCTION: case KW_GRADIENT:
+    case KW_GRANITE: case KW_HEXAGON: case KW_IMAGE_MAP: case KW_IMAGE_PATTERN: case KW_JULIA:
+    case KW_LEOPARD: case KW_MAGNET: case KW_MANDEL: case KW_MARBLE: case KW_OBJECT: case KW_ONION:
+    case KW_PAVEMENT: case KW_PIGMENT_PATTERN: case KW_PLANAR: case KW_QUILTED: case KW_RADIAL:
+    case KW_RIPPLES: case KW_SLOPE: case KW_SPHERICAL: case KW_SPIRAL1: case KW_SPIRAL2: case KW_SPOTTED:
+    case KW_SQUARE: case KW_TILING: case KW_TRIANGULAR: case KW_WAVES: case KW_WOOD: case KW_WRINKLES:
+    case KW_BUMP_MAP: case KW_UV_MAPPING:
+        return 1;
+    default:
+        return 0;
+    }
+}
+
+static void set_kind(target *tg, pattern_kind k, const char *name)
+{
+    tg->pat->kind = k;
+    tg->pat->name = name;
+}
+
+static void unsupported_pattern(sdl_parser *p, target *tg, const sdl_tok *t)
+{
+    set_kind(tg, PAT_UNSUPPORTED, kw_name(t->tk.kw));
+    sdl_warn_once(p, t->tk.loc, "pattern '%s' is not supported; it evaluates to 0", kw_name(t->tk.kw));
+}
+
+/* Skip the arguments of an unsupported pattern: floats/vectors and blocks. */
+static void skip_args(sdl_parser *p)
+{
+    for (;;) {
+        const sdl_tok *t = sdl_peek(p);
+        if (sdl_is(t, TOK_LBRACE)) {
+            if (sdl_begin_block(p, "pattern argument")) sdl_skip_block(p);
+        } else if (sdl_starts_expr(t)) {
+            sdl_value v;
+            sdl_sum(p, &v);
+            sdl_accept(p, TOK_COMMA);
+        } else {
+            return;
+        }
+        if (!sdl_ok(p)) return;
+    }
+}
+
+/* pattern_type: the keyword is next. Returns 1 if one was parsed. */
+static int pattern_type(sdl_parser *p, target *tg)
+{
+    const sdl_tok *pk = sdl_peek(p);
+    if (pk->tk.kind != TOK_KEYWORD || !sdl_pattern_is_type(pk->tk.kw)) return 0;
+    sdl_tok t = sdl_next(p);
+    sdl_kw k = t.tk.kw;
+    if (k == KW_UV_MAPPING) {
+        sdl_warn_once(p, t.tk.loc, "uv_mapping is not supported; the pattern is evaluated in 3D");
+        pk = sdl_peek(p);
+        if (pk->tk.kind != TOK_KEYWORD || !sdl_pattern_is_type(pk->tk.kw) || pk->tk.kw == KW_UV_MAPPING) return 1;
+        t = sdl_next(p);
+        k = t.tk.kw;
+    }
+    if (!tg->pat) tg->pat = new_pattern(p, NULL);
+    else tg->pat = new_pattern(p, tg->pat);
+    scene_pattern *pt = tg->pat;
+    if (!pt) return 1;
+    pattern_kind old = pt->kind;
+    const char *name = kw_name(k);
+    switch (k) {
+    case KW_AGATE:
+        set_kind(tg, PAT_AGATE, name);
+        classic_turb(p, pt);
+        pt->agate_turb = 1.0;
+        break;
+    case KW_BOZO: set_kind(tg, PAT_BOZO, name); break;
+    case KW_SPOTTED: set_kind(tg, PAT_SPOTTED, name); break;
+    case KW_GRANITE: set_kind(tg, PAT_GRANITE, name); break;
+    case KW_LEOPARD: set_kind(tg, PAT_LEOPARD, name); break;
+    case KW_ONION: set_kind(tg, PAT_ONION, name); break;
+    case KW_RADIAL: set_kind(tg, PAT_RADIAL, name); break;
+    case KW_CELLS: set_kind(tg, PAT_CELLS, name); break;
+    case KW_WAVES: set_kind(tg, PAT_WAVES, name); break;
+    case KW_RIPPLES: set_kind(tg, PAT_RIPPLES, name); break;
+    case KW_WRINKLES: set_kind(tg, PAT_WRINKLES, name); break;
+    case KW_BUMPS: set_kind(tg, PAT_BUMPS, name); break;
+    case KW_DENTS: set_kind(tg, PAT_DENTS, name); break;
+    case KW_PLANAR: set_kind(tg, PAT_PLANAR, name); break;
+    case KW_BOXED: set_kind(tg, PAT_BOXED, name); break;
+    case KW_SPHERICAL: set_kind(tg, PAT_SPHERICAL, name); break;
+    case KW_CYLINDRICAL: set_kind(tg, PAT_CYLINDRICAL, name); break;
+    case KW_AVERAGE: set_kind(tg, PAT_AVERAGE, name); break;
+    case KW_AOI: set_kind(tg, PAT_AOI, name); break;
+    case KW_MARBLE:
+        set_kind(tg, PAT_MARBLE, name);
+        pt->wave = WAVE_TRIANGLE;
+        break;
+    case KW_WOOD:
+        set_kind(tg, PAT_WOOD, name);
+        pt->wave = WAVE_TRIANGLE;
+        break;
+    case KW_SPIRAL1: case KW_SPIRAL2:
+        set_kind(tg, k == KW_SPIRAL1 ? PAT_SPIRAL1 : PAT_SPIRAL2, name);
+        pt->arms = (short)sdl_float(p);
+        pt->wave = WAVE_TRIANGLE;
+        break;
+    case KW_GRADIENT:
+        set_kind(tg, PAT_GRADIENT, name);
+        pt->gradient = v3_norm(sdl_vector(p));
+        break;
+    case KW_CRACKLE:
+        set_kind(tg, PAT_CRACKLE, name);
+        pt->crackle_solid = 0;
+        pt->crackle_form = v3(-1, 1, 0);
+        pt->crackle_metric = 2;
+        pt->crackle_offset = 0;
+        break;
+    case KW_QUILTED:
+        set_kind(tg, PAT_QUILTED, name);
+        pt->control0 = 1.0;
+        pt->control1 = 1.0;
+        pt->frequency = 0.0;
+        break;
+    case KW_FACETS:
+        set_kind(tg, PAT_FACETS, name);
+        pt->facets_size = 0.1;
+        pt->facets_metric = 2;
+        if (tg->kind != TGT_NORMAL) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "facets can only be used in normal");
+        break;
+    case KW_CHECKER: case KW_HEXAGON: case KW_SQUARE: case KW_TRIANGULAR: case KW_CUBIC: case KW_BRICK: {
+        pattern_kind pk2 = k == KW_CHECKER ? PAT_CHECKER : k == KW_HEXAGON ? PAT_HEXAGON : k == KW_SQUARE ? PAT_SQUARE
+                         : k == KW_TRIANGULAR ? PAT_TRIANGULAR : k == KW_CUBIC ? PAT_CUBIC : PAT_BRICK;
+        int count = k == KW_CHECKER || k == KW_BRICK ? 2 : k == KW_HEXAGON ? 3 : k == KW_SQUARE ? 4 : 6;
+        if (pk2 == PAT_BRICK && old != PAT_BRICK) {
+            pt->brick_size = v3(8.0, 3.0, 4.5);
+            pt->mortar = 0.5 - PAT_EPS * 2.0;
+        }
+        set_kind(tg, pk2, name);
+        pt->frequency = 0.0;
+        blend_list(p, tg, count);
+        break;
+    }
+    case KW_IMAGE_MAP:
+        set_kind(tg, PAT_IMAGE, name);
+        pt->frequency = 0.0;
+        if (tg->kind != TGT_PIGMENT) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "image_map can only be used in pigment");
+        image_block(p, &pt->image, 0);
+        break;
+    case KW_IMAGE_PATTERN:
+        set_kind(tg, PAT_IMAGE, name);
+        pt->frequency = 0.0;
+        image_block(p, &pt->image, 1);
+        break;
+    case KW_BUMP_MAP:
+        set_kind(tg, PAT_IMAGE, name);
+        pt->frequency = 0.0;
+        sdl_warn_once(p, t.tk.loc, "bump_map is not supported yet; the normal is unperturbed");
+        if (sdl_begin_block(p, "bump_map")) sdl_skip_block(p);
+        break;
+    case KW_PIGMENT_PATTERN: {
+        set_kind(tg, PAT_PIGMENT, name);
+        scene_pigment *sub = sdl_alloc(p, sizeof *sub);
+        if (!sub) return 1;
+        scene_default_pigment(sub);
+        if (sdl_begin_block(p, "pigment_pattern")) {
+            sdl_pattern_pigment_body(p, sub);
+            sdl_end_block(p);
+        }
+        pt->pigment = sub;
+        break;
+    }
+    case KW_SLOPE: {
+        set_kind(tg, PAT_SLOPE, name);
+        pt->slope_lo = pt->slope_hi = 0.0;
+        if (sdl_is(sdl_peek(p), TOK_LBRACE)) {
+            sdl_begin_block(p, "slope");
+            if (sdl_accept_kw(p, KW_POINT_AT)) sdl_warn_once(p, t.tk.loc, "slope point_at is not supported");
+            pt->slope_dir = v3_norm(sdl_vector(p));
+            sdl_accept(p, TOK_COMMA);
+            double lo = sdl_allow_float(p, 0.0);
+            sdl_accept(p, TOK_COMMA);
+            double hi = sdl_allow_float(p, 0.0);
+            if (hi != 0.0 && hi != lo) {
+                pt->slope_lo = lo;
+                pt->slope_hi = hi - lo;
+            }
+            if (sdl_accept_kw(p, KW_ALTITUDE)) {
+                sdl_warn_once(p, t.tk.loc, "slope altitude is not supported and is ignored");
+                sdl_vector(p);
+                sdl_accept(p, TOK_COMMA);
+                sdl_allow_float(p, 0.0);
+                sdl_accept(p, TOK_COMMA);
+                sdl_allow_float(p, 0.0);
+            }
+            sdl_end_block(p);
+        } else {
+            pt->slope_dir = v3_norm(sdl_vector(p));
+        }
+        break;
+    }
+    case KW_OBJECT:
+        unsupported_pattern(p, tg, &t);
+        pt->frequency = 0.0;
+        if (sdl_begin_block(p, "object")) sdl_skip_block(p);
+        blend_list(p, tg, 2);
+        break;
+    case KW_FUNCTION:
+        unsupported_pattern(p, tg, &t);
+        if (sdl_is(sdl_peek(p), TOK_LBRACE) && sdl_begin_block(p, "function")) sdl_skip_block(p);
+        break;
+    case KW_DENSITY_FILE:
+        unsupported_pattern(p, tg, &t);
+        sdl_accept_kw(p, KW_DF3);
+        sdl_string(p);
+        break;
+    case KW_MAGNET:
+        unsupported_pattern(p, tg, &t);
+        sdl_float(p);
+        if (!sdl_accept_kw(p, KW_MANDEL)) {
+            sdl_accept_kw(p, KW_JULIA);
+            double uv[2];
+            sdl_vector_n(p, uv, 2);
+            sdl_accept(p, TOK_COMMA);
+        }
+        sdl_float(p);
+        break;
+    default: /* julia, mandel, pavement, tiling */
+        unsupported_pattern(p, tg, &t);
+        skip_args(p);
+        break;
+    }
+    return 1;
+}
+
+/* ------------------------------------------------------------ modifiers */
+
+static void need_pattern(sdl_parser *p, target *tg)
+{
+    if (!tg->pat) tg->pat = new_pattern(p, NULL);
+}
+
+/* One pattern modifier; 0 if the next token is not one. */
+static int modifier(sdl_parser *p, target *tg)
+{
+    xform x;
+    if (sdl_transform_item(p, &x)) {
+        *tg->outer = xform_then(*tg->outer, x);
+        return 1;
+    }
+    const sdl_tok *pk = sdl_peek(p);
+    if (pk->tk.kind != TOK_KEYWORD) return 0;
+    sdl_kw k = pk->tk.kw;
+    switch (k) {
+    case KW_TURBULENCE: case KW_OCTAVES: case KW_OMEGA: case KW_LAMBDA: case KW_FREQUENCY: case KW_PHASE:
+    case KW_RAMP_WAVE: case KW_TRIANGLE_WAVE: case KW_SINE_WAVE: case KW_SCALLOP_WAVE: case KW_CUBIC_WAVE:
+    case KW_POLY_WAVE: case KW_NOISE_GENERATOR: case KW_WARP: case KW_AGATE_TURB: case KW_BRICK_SIZE:
+    case KW_MORTAR: case KW_CONTROL0: case KW_CONTROL1: case KW_FORM: case KW_METRIC: case KW_OFFSET:
+    case KW_SOLID: case KW_COORDS: case KW_SIZE:
+        break;
+    case KW_COLOR_MAP: case KW_COLOUR_MAP: case KW_PIGMENT_MAP: case KW_NORMAL_MAP: case KW_SLOPE_MAP:
+    case KW_TEXTURE_MAP: case KW_QUICK_COLOR: case KW_QUICK_COLOUR: case KW_BUMP_SIZE: case KW_ACCURACY:
+    case KW_NO_BUMP_SCALE: case KW_DENSITY_MAP: case KW_INTERPOLATE: case KW_EXTERIOR: case KW_INTERIOR:
+    case KW_MAX_ITERATION: case KW_NUMBER_OF_SIDES: case KW_NUMBER_OF_TILES: case KW_PATTERN:
+        break;
+    default:
+        return 0;
+    }
+    sdl_tok t = sdl_next(p);
+    switch (k) {
+    case KW_TURBULENCE: case KW_OCTAVES: case KW_OMEGA: case KW_LAMBDA: {
+        need_pattern(p, tg);
+        scene_warp *w = classic_turb(p, tg->pat);
+        if (!w) return 1;
+        if (k == KW_TURBULENCE) {
+            w->turbulence = sdl_vector(p);
+        } else if (k == KW_OCTAVES) {
+            w->octaves = sdl_to_int(sdl_float(p));
+            if (w->octaves < 1) w->octaves = 1;
+            if (w->octaves > 10) w->octaves = 10;
+        } else if (k == KW_OMEGA) {
+            w->omega = sdl_float(p);
+        } else {
+            w->lambda = sdl_float(p);
+        }
+        return 1;
+    }
+    case KW_WARP:
+        need_pattern(p, tg);
+        warp_block(p, tg);
+        return 1;
+    case KW_COLOR_MAP: case KW_COLOUR_MAP:
+        *tg->map = colour_map(p);
+        return 1;
+    case KW_PIGMENT_MAP:
+        *tg->map = blend_map(p, MAP_PIGMENT, tg->pat && tg->pat->kind == PAT_AVERAGE);
+        return 1;
+    case KW_NORMAL_MAP:
+        *tg->map = blend_map(p, MAP_NORMAL, tg->pat && tg->pat->kind == PAT_AVERAGE);
+        return 1;
+    case KW_SLOPE_MAP:
+        *tg->map = blend_map(p, MAP_SLOPE, 0);
+        return 1;
+    case KW_TEXTURE_MAP:
+        *tg->map = blend_map(p, MAP_TEXTURE, tg->pat && tg->pat->kind == PAT_AVERAGE);
+        return 1;
+    case KW_DENSITY_MAP:
+        sdl_warn_once(p, t.tk.loc, "density_map is not supported and is ignored");
+        if (sdl_begin_block(p, "density_map")) sdl_skip_block(p);
+        return 1;
+    case KW_QUICK_COLOR: case KW_QUICK_COLOUR:
+        sdl_colour(p, 1);
+        return 1;
+    case KW_BUMP_SIZE:
+        if (tg->nm) tg->nm->amount = sdl_float(p);
+        else sdl_float(p);
+        return 1;
+    case KW_ACCURACY:
+        if (tg->nm) tg->nm->delta = sdl_float(p);
+        else sdl_float(p);
+        return 1;
+    case KW_NO_BUMP_SCALE:
+        if (tg->nm) tg->nm->no_bump_scale = 1;
+        return 1;
+    default:
+        break;
+    }
+    need_pattern(p, tg);
+    scene_pattern *pt = tg->pat;
+    if (!pt) return 1;
+    switch (k) {
+    case KW_FREQUENCY: pt->frequency = sdl_float(p); break;
+    case KW_PHASE: pt->phase = sdl_float(p); break;
+    case KW_RAMP_WAVE: pt->wave = WAVE_RAMP; break;
+    case KW_TRIANGLE_WAVE: pt->wave = WAVE_TRIANGLE; break;
+    case KW_SINE_WAVE: pt->wave = WAVE_SINE; break;
+    case KW_SCALLOP_WAVE: pt->wave = WAVE_SCALLOP; break;
+    case KW_CUBIC_WAVE: pt->wave = WAVE_CUBIC; break;
+    case KW_POLY_WAVE:
+        pt->wave = WAVE_POLY;
+        pt->exponent = sdl_allow_float(p, pt->exponent);
+        break;
+    case KW_NOISE_GENERATOR: {
+        int g = sdl_to_int(sdl_float(p));
+        if (g < 0 || g > 3) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "value for noise_generator must be 0, 1, 2, or 3");
+        pt->noise_generator = g;
+        break;
+    }
+    case KW_AGATE_TURB:
+        pt->agate_turb = sdl_float(p);
+        classic_turb(p, pt);
+        break;
+    case KW_BRICK_SIZE: pt->brick_size = sdl_vector(p); break;
+    case KW_MORTAR: pt->mortar = sdl_float(p) - PAT_EPS * 2.0; break;
+    case KW_CONTROL0: pt->control0 = sdl_float(p); break;
+    case KW_CONTROL1: pt->control1 = sdl_float(p); break;
+    case KW_FORM:
+        if (pt->kind == PAT_CRACKLE) pt->crackle_form = sdl_vector(p);
+        else sdl_float(p);
+        break;
+    case KW_METRIC: {
+        vec3 m = sdl_vector(p);
+        if (pt->kind == PAT_FACETS) pt->facets_metric = m.x;
+        else pt->crackle_metric = m.x;
+        break;
+    }
+    case KW_OFFSET: pt->crackle_offset = sdl_float(p); break;
+    case KW_SOLID: pt->crackle_solid = 1; break;
+    case KW_COORDS: pt->facets_coords = sdl_float(p); break;
+    case KW_SIZE: pt->facets_size = sdl_float(p); break;
+    case KW_EXTERIOR: case KW_INTERIOR:
+        sdl_float(p);
+        if (pt->kind != PAT_UNSUPPORTED || sdl_accept(p, TOK_COMMA)) sdl_allow_float(p, 0.0);
+        break;
+    default: /* interpolate, max_iteration, number_of_sides, number_of_tiles, pattern */
+        sdl_float(p);
+        break;
+    }
+    return 1;
+}
+
+/* Modifiers until the block's end; anything else is skipped with a warning. */
+static void modifiers(sdl_parser *p, target *tg, const char *what)
+{
+    while (sdl_ok(p)) {
+        const sdl_tok *t = sdl_peek(p);
+        if (sdl_is(t, TOK_RBRACE) || sdl_is(t, TOK_RBRACKET) || sdl_is(t, TOK_EOF)) return;
+        if (modifier(p, tg)) continue;
+        sdl_tok bad = sdl_next(p);
+        if (bad.tk.kind == TOK_KEYWORD) {
+            sdl_warn_once(p, bad.tk.loc, "%s modifier '%s' is not supported and is ignored", what, sdl_kw_text(bad.tk.kw));
+            sdl_skip_item(p);
+        } else {
+            sdl_unexpected(p, &bad, what);
+            return;
+        }
+    }
+}
+
+/* ------------------------------------------------------------ pigments */
+
+static colour5 first_colour(const scene_blend_map *m, colour5 fallback)
+{
+    if (!m || m->n == 0) return fallback;
+    if (m->kind == MAP_COLOUR) {
+        colour5 c = {m->e[0].c[0], m->e[0].c[1], m->e[0].c[2], m->e[0].c[3], m->e[0].c[4]};
+        return c;
+    }
+    if (m->kind == MAP_PIGMENT && m->e[0].pigment) return m->e[0].pigment->colour;
+    return fallback;
+}
+
+void sdl_pattern_pigment_body(sdl_parser *p, scene_pigment *pg)
+{
+    const sdl_tok *t = sdl_peek(p);
+    if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_PIGMENT && t->val.ptr) {
+        sdl_tok id = sdl_next(p);
+        *pg = *(const scene_pigment *)id.val.ptr;
+        t = sdl_peek(p);
+    }
+    target tg;
+    memset(&tg, 0, sizeof tg);
+    tg.kind = TGT_PIGMENT;
+    tg.pg = pg;
+    tg.pat = pg->pat ? new_pattern(p, pg->pat) : NULL;
+    tg.map = &pg->map;
+    tg.outer = &pg->transform;
+    if (sdl_starts_colour(t) || sdl_is(t, TOK_LT)) {
+        pg->colour = sdl_colour(p, 1);
+        pg->kind = PIGMENT_SOLID;
+        pg->pattern = NULL;
+        pg->pat = NULL;
+        pg->map = NULL;
+        tg.pat = NULL;
+    } else {
+        pattern_type(p, &tg);
+    }
+    modifiers(p, &tg, "pigment");
+    if (pg->kind == PIGMENT_SOLID && (!tg.pat || tg.pat->kind == PAT_PLAIN)) {
+        pg->pat = NULL;
+        return;
+    }
+    if (tg.pat && tg.pat->kind != PAT_PLAIN) {
+        pg->pat = tg.pat;
+        pg->pattern = tg.pat->name;
+        pg->kind = tg.pat->kind == PAT_UNSUPPORTED ? PIGMENT_OTHER : PIGMENT_PATTERN;
+        if (pg->map && pg->map->kind != MAP_COLOUR && pg->map->kind != MAP_PIGMENT) pg->map = NULL;
+        const scene_blend_map *m = pg->map;
+        if (!m && tg.pat->kind == PAT_BRICK) {
+            colour5 c = {sngl(0.5), sngl(0.5), sngl(0.5), 0, 0};
+            pg->colour = c;
+        } else if (m) {
+            pg->colour = first_colour(m, pg->colour);
+        }
+    }
+}
+
+/* ------------------------------------------------------------ normals */
+
+scene_normal *sdl_pattern_normal_body(sdl_parser *p, const scene_normal *base)
+{
+    scene_normal *nm = sdl_alloc(p, sizeof *nm);
+    if (!nm) return NULL;
+    if (base) *nm = *base;
+    else sdl_pattern_default_normal(nm);
+    const sdl_tok *t = sdl_peek(p);
+    if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_NORMAL) {
+        sdl_tok id = sdl_next(p);
+        if (id.val.ptr) *nm = *(const scene_normal *)id.val.ptr;
+    }
+    target tg;
+    memset(&tg, 0, sizeof tg);
+    tg.kind = TGT_NORMAL;
+    tg.nm = nm;
+    tg.pat = nm->pat ? new_pattern(p, nm->pat) : NULL;
+    tg.map = &nm->map;
+    tg.outer = &nm->transform;
+    if (pattern_type(p, &tg)) {
+        /* POV-Ray: [','] [amount] after the pattern type */
+        sdl_accept(p, TOK_COMMA);
+        nm->amount = sdl_allow_float(p, nm->amount);
+    }
+    modifiers(p, &tg, "normal");
+    nm->pat = tg.pat;
+    return nm;
+}
+
+/* ------------------------------------------------------------ textures */
+
+/* tiles := '{' texture {..} {texture {..}} tile2 texture {..} {texture {..}} '}' */
+static void tiles(sdl_parser *p, scene_texture *t, src_loc loc)
+{
+    if (!sdl_begin_block(p, "tiles")) return;
+    scene_texture *lists[2] = {NULL, NULL};
+    int which = 0;
+    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
+        if (sdl_accept_kw(p, KW_TILE2)) {
+            which = 1;
+        } else if (sdl_accept_kw(p, KW_TEXTURE)) {
+            scene_texture *nt = sdl_parse_texture(p);
+            if (!nt) break;
+            scene_texture *last = nt;
+            while (last->next) last = last->next;
+            last->next = lists[which];
+            lists[which] = nt;
+        } else {
+            sdl_tok bad = sdl_next(p);
+            sdl_unexpected(p, &bad, "texture or tile2");
+        }
+    }
+    sdl_end_block(p);
+    if (!lists[0]) sdl_error(p, loc, PT_ERR_SYNTAX, "first texture missing from tiles");
+    scene_pattern *pt = new_pattern(p, NULL);
+    scene_map_entry *e = entries(p, 2);
+    if (!pt || !e) return;
+    pt->kind = PAT_CHECKER;
+    pt->name = "tiles";
+    pt->frequency = 0.0;
+    e[0].value = 0;
+    e[0].texture = lists[0];
+    e[1].value = 1;
+    e[1].texture = lists[1] ? lists[1] : sdl_copy_texture(p, &p->s->default_texture);
+    t->pat = pt;
+    t->map = make_map(p, MAP_TEXTURE, e, 2);
+}
+
+static void fallback_look(scene_texture *t)
+{
+    if (!t->map || t->map->n == 0) return;
+    const scene_texture *first = t->map->e[0].texture;
+    if (!first) return;
+    while (first->pat && first->map && first->map->n > 0 && first->map->e[0].texture) first = first->map->e[0].texture;
+    t->pigment = first->pigment;
+    t->finish = first->finish;
+    t->normal = first->normal;
+}
+
+void sdl_pattern_texture(sdl_parser *p, scene_texture *t)
+{
+    const sdl_tok *pk = sdl_peek(p);
+    src_loc loc = pk->tk.loc;
+    t->next = NULL;
+    t->pat = NULL;
+    t->map = NULL;
+    if (sdl_accept_kw(p, KW_TILES)) {
+        tiles(p, t, loc);
+    } else if (sdl_accept_kw(p, KW_MATERIAL_MAP)) {
+        sdl_warn_once(p, loc, "material_map is not supported yet; its first texture is used");
+        if (sdl_begin_block(p, "material_map")) {
+            scene_texture *first = NULL;
+            while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
+                const sdl_tok *q = sdl_peek(p);
+                if (sdl_is_kw(q, KW_TEXTURE)) {
+                    sdl_next(p);
+                    scene_texture *nt = sdl_parse_texture(p);
+                    if (!first) first = nt;
+                } else if (q->tk.kind == TOK_KEYWORD && is_image_type_kw(q->tk.kw)) {
+                    sdl_next(p);
+                } else if (sdl_starts_string(q)) {
+                    sdl_string(p);
+                } else {
+                    sdl_next(p);
+                    if (sdl_starts_expr(sdl_peek(p))) sdl_skip_item(p);
+                }
+            }
+            sdl_end_block(p);
+            if (first) {
+                xform keep = t->transform;
+                *t = *first;
+                t->transform = xform_then(first->transform, keep);
+                t->next = NULL;
+            }
+        }
+    } else {
+        target tg;
+        memset(&tg, 0, sizeof tg);
+        tg.kind = TGT_TEXTURE;
+        tg.tx = t;
+        tg.map = &t->map;
+        tg.outer = &t->transform;
+        pattern_type(p, &tg);
+        modifiers(p, &tg, "texture");
+        t->pat = tg.pat;
+        if (t->map && t->map->kind != MAP_TEXTURE) t->map = NULL;
+        if (tg.pat && sdl_ok(p) && !t->map) sdl_error(p, loc, PT_ERR_SYNTAX, "patterned texture must have texture_map");
+    }
+    if (t->pat) {
+        t->pigment.kind = t->pat->kind == PAT_UNSUPPORTED ? PIGMENT_OTHER : t->pigment.kind;
+        fallback_look(t);
+    }
+    while (sdl_ok(p)) {
+        xform x;
+        if (sdl_transform_item(p, &x)) t->transform = xform_then(t->transform, x);
+        else break;
+    }
+}
