@@ -188,6 +188,17 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
             else if (strcmp(next, "piz") == 0) o->exr_compression = 2;
             else { snprintf(err, (size_t)errlen, "--exr-compression wants none, zip or piz"); return 2; }
             i++;
+        } else if (strcmp(a, "--particles") == 0 || strcmp(a, "--photons") == 0 || strcmp(a, "--nb") == 0 ||
+                   strcmp(a, "--fg-rays") == 0 || strcmp(a, "--max-depth") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            int v;
+            if (!parse_int(next, &v) || v < 1) { snprintf(err, (size_t)errlen, "%s wants a positive integer", a); return 2; }
+            if (strcmp(a, "--particles") == 0) o->particles = v;
+            else if (strcmp(a, "--photons") == 0) o->photons = v;
+            else if (strcmp(a, "--nb") == 0) o->bounces = v;
+            else if (strcmp(a, "--fg-rays") == 0) o->fg_rays = v;
+            else o->max_depth = v;
+            i++;
         } else if (strcmp(a, "--float") == 0) {
             o->exr_float = 1;
         } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {

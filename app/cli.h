@@ -37,6 +37,10 @@ typedef struct {
     /* parser work/memory limits (sdl_options), 0 = the parser's default */
     long long max_tokens, max_memory_mib, max_array;
     long max_string;
+    /* GI settings (render_gi.h); 0 = the mode's default */
+    long particles;
+    int bounces, fg_rays, max_depth;
+    long photons;
 } cli_render;
 
 /* Parses argv (after the subcommand). Returns 0 on success, otherwise writes

@@ -17,6 +17,7 @@
 #include "img_io.h"
 #include "img_ocio.h"
 #include "pool.h"
+#include "render_gi.h"
 #include "scene.h"
 #include "sdl.h"
 #include "shade.h"
@@ -276,13 +277,6 @@ static int cmd_render(int argc, char **argv)
     }
     if (!o.gi && sc->global.radiosity.enabled) gi = GI_PARTICLE;
     const char *gi_used = gi_mode_name(gi);
-    if (gi != GI_NONE) {
-        diag_report(d, DIAG_WARNING, (src_loc){0}, NULL,
-                    "GI mode '%s' is not built yet; rendering direct light + Whitted (--gi none)%s",
-                    gi_mode_name(gi), o.gi ? "" : " although the scene has radiosity{}");
-        gi = GI_NONE;
-        gi_used = "none";
-    }
 
     int threads = o.threads > 0 ? o.threads : pool_default_threads();
     t0 = timer_now();
@@ -297,8 +291,9 @@ static int cmd_render(int argc, char **argv)
         return status_exit(st == PT_OK ? PT_ERR_DEVICE : st);
     }
 
-    shade_settings ss;
-    shade_default_settings(&ss);
+    render_gi_opts ss;
+    memset(&ss, 0, sizeof ss);
+    ss.mode = gi;
     ss.width = o.width > 0 ? o.width : 320;
     ss.height = o.height > 0 ? o.height : 240;
     ss.threads = threads;
@@ -307,16 +302,29 @@ static int cmd_render(int argc, char **argv)
     ss.aa_threshold = o.aa_threshold;
     ss.aa_depth = o.aa_depth;
     ss.spp = o.spp;
-    ss.use_ambient = 1;
+    ss.particles = o.particles;
+    ss.bounces = o.bounces;
+    ss.fg_rays = o.fg_rays;
+    ss.photons = o.photons;
+    ss.max_depth = o.max_depth;
+    ss.progress = !o.quiet;
     ss.cancel = &g_cancel;
+    char *progressive = NULL;
+    if ((gi == GI_PATH || gi == GI_PMFG) && o.noutputs > 0 && img_format_from_path(o.outputs[0]) != IMG_FMT_UNKNOWN) {
+        progressive = partial_name(o.outputs[0]);
+        ss.progressive_path = progressive;
+    }
     framebuffer *fb = fb_new(ss.width, ss.height);
-    shade_stats sst;
+    render_gi_result sst;
     memset(&sst, 0, sizeof sst);
     signal(SIGINT, on_sigint);
     signal(SIGTERM, on_sigint); /* kill, systemd, timeout(1): stop like Ctrl-C */
     t0 = timer_now();
-    st = fb ? shade_render(sc, acc, &ss, fb, &sst, d) : PT_ERR_NOMEM;
-    double t_render = timer_now() - t0;
+    st = fb ? render_gi(sc, acc, &ss, fb, &sst, d) : PT_ERR_NOMEM;
+    double t_render = sst.t_render > 0 ? sst.t_render : timer_now() - t0;
+    /* the progressive image of a finished render is no longer needed */
+    if (progressive && !g_cancel) remove(progressive);
+    free(progressive);
     print_diags(d, o.quiet);
 
     int rc = EXIT_OK;
@@ -333,8 +341,8 @@ static int cmd_render(int argc, char **argv)
     wo.exposure = o.exposure;
     char tbuf[64], timings[160], settings[256];
     snprintf(tbuf, sizeof tbuf, "%.3f", t_render);
-    snprintf(timings, sizeof timings, "parse %.3f s, accel %.3f s, gi_geometry 0 s, gi_lighting 0 s, render %.3f s", t_parse,
-             t_accel, t_render);
+    snprintf(timings, sizeof timings, "parse %.3f s, accel %.3f s, gi_geometry %.3f s, gi_lighting %.3f s, render %.3f s",
+             t_parse, t_accel, sst.t_gi_geometry, sst.t_gi_lighting, t_render);
     snprintf(settings, sizeof settings, "size %dx%d, antialias %s threshold %.3g depth %d, spp %d, seed %llu, threads %d",
              ss.width, ss.height, ss.antialias == 1 ? "adaptive" : (ss.antialias == 2 ? "fixed" : "off"), ss.aa_threshold,
              ss.aa_depth, ss.spp, (unsigned long long)ss.seed, threads);
@@ -376,16 +384,17 @@ static int cmd_render(int argc, char **argv)
         stats_obj_begin(&js, "timings");
         stats_num(&js, "parse", t_parse);
         stats_num(&js, "accel", t_accel);
-        stats_num(&js, "gi_geometry", 0.0);
-        stats_num(&js, "gi_lighting", 0.0);
+        stats_num(&js, "gi_geometry", sst.t_gi_geometry);
+        stats_num(&js, "gi_lighting", sst.t_gi_lighting);
         stats_num(&js, "render", t_render);
         stats_num(&js, "total", t_total);
         stats_obj_end(&js);
-        stats_int(&js, "rays", sst.primary_rays + sst.shadow_rays + sst.secondary_rays);
+        stats_int(&js, "rays", sst.primary_rays + sst.shadow_rays + sst.secondary_rays + sst.other_rays);
         stats_int(&js, "primary_rays", sst.primary_rays);
         stats_int(&js, "shadow_rays", sst.shadow_rays);
         stats_int(&js, "secondary_rays", sst.secondary_rays);
-        stats_int(&js, "discarded_samples", sst.discarded_samples);
+        stats_int(&js, "other_rays", sst.other_rays);
+        stats_int(&js, "discarded_samples", sst.discarded);
         stats_int(&js, "width", ss.width);
         stats_int(&js, "height", ss.height);
         stats_int(&js, "threads", threads);
@@ -398,6 +407,7 @@ static int cmd_render(int argc, char **argv)
         stats_int(&js, "triangles", cnt.triangles);
         stats_int(&js, "unsupported", cnt.unsupported);
         stats_obj_end(&js);
+        render_gi_json(&sst, gi, &js);
         stats_obj_begin(&js, "accel");
         stats_int(&js, "geometries", as.geometries);
         stats_int(&js, "instances", as.instances);
@@ -414,6 +424,8 @@ static int cmd_render(int argc, char **argv)
         fprintf(stderr, "partray: %dx%d, gi %s, parse %.3f s, accel %.3f s, render %.3f s, %.2f Mrays/s\n", ss.width,
                 ss.height, gi_used, t_parse, t_accel, t_render,
                 t_render > 0 ? (sst.primary_rays + sst.shadow_rays + sst.secondary_rays) / t_render * 1e-6 : 0.0);
+    if (!o.quiet && rc == EXIT_OK && (sst.t_gi_geometry > 0 || sst.t_gi_lighting > 0))
+        fprintf(stderr, "partray: gi %s: geometry %.3f s, lighting %.3f s\n", gi_used, sst.t_gi_geometry, sst.t_gi_lighting);
     fb_free(fb);
     img_ocio_close(oc);
     accel_free(acc);

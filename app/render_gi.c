@@ -1,0 +1,242 @@
+/* render_gi.c - render a scene with one GI mode and collect its figures.
+ *
+ *  none      Whitted (shade_render) with POV-Ray's ambient term.
+ *  particle  seed 000: geometry stage, lighting stage, view preparation,
+ *            then the Whitted pass with the particles' indirect light
+ *            (ambient is replaced by GI, as POV-Ray does with radiosity).
+ *  pmfg      photon map + final gathering (reference/pm_fg.h).
+ *  path      path tracer (reference/pm_path.h). */
+#include "render_gi.h"
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+#include "gi.h"
+#include "img_io.h"
+#include "pm_fg.h"
+#include "pm_path.h"
+#include "timer.h"
+
+static void fill_shade(shade_settings *ss, const render_gi_opts *o)
+{
+    shade_default_settings(ss);
+    ss->width = o->width;
+    ss->height = o->height;
+    ss->threads = o->threads;
+    ss->seed = o->seed;
+    ss->antialias = o->antialias;
+    ss->aa_threshold = o->aa_threshold;
+    ss->aa_depth = o->aa_depth;
+    ss->spp = o->spp;
+    ss->cancel = o->cancel;
+}
+
+static pt_status render_none(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
+                             render_gi_result *r, diag *d)
+{
+    shade_settings ss;
+    fill_shade(&ss, o);
+    ss.use_ambient = 1;
+    double t0 = timer_now();
+    pt_status st = shade_render(sc, a, &ss, fb, &r->shade, d);
+    r->t_render = timer_now() - t0;
+    return st;
+}
+
+static pt_status render_particle(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
+                                 render_gi_result *r, diag *d)
+{
+    gi_particle_settings gs;
+    gi_particle_settings_from_scene(&gs, sc);
+    if (o->particles > 0) gs.count = o->particles;
+    if (o->bounces > 0) gs.bounces = o->bounces;
+    gs.seed = o->seed;
+    gs.threads = o->threads;
+    pt_status st = PT_OK;
+    double t0 = timer_now();
+    gi_particle *gp = gi_particle_build(sc, a, &gs, &r->particle, d, &st);
+    r->t_gi_geometry = timer_now() - t0;
+    if (!gp) return st == PT_OK ? PT_ERR_INTERNAL : st;
+    r->has_particle = 1;
+    t0 = timer_now();
+    st = gi_particle_light(gp, d);
+    r->t_gi_lighting = timer_now() - t0;
+    if (st == PT_OK) {
+        shade_settings ss;
+        fill_shade(&ss, o);
+        /* With radiosity{} on, `ambient` is an emitter (DESIGN.md): the
+         * particles carry its light to other surfaces, and a surface seen
+         * directly shows it, as in the path tracer. Otherwise GI replaces it. */
+        ss.use_ambient = gs.ambient_emits > 0 || (gs.ambient_emits < 0 && sc->global.radiosity.enabled);
+        ss.indirect = gi_particle_indirect;
+        ss.indirect_ctx = gp;
+        t0 = timer_now();
+        /* view preparation (pre-pass, gathering, estimation) belongs to the frame */
+        st = gi_particle_prepare_view(gp, &sc->camera, o->width, o->height, d);
+        if (st == PT_OK) st = shade_render(sc, a, &ss, fb, &r->shade, d);
+        r->t_render = timer_now() - t0;
+    }
+    r->particle = *gi_particle_get_stats(gp);
+    gi_particle_free(gp);
+    return st;
+}
+
+typedef struct {
+    const char *path;
+    double last;
+} progressive_ctx;
+
+static void on_image(void *ctx, const framebuffer *fb, int done, int total)
+{
+    progressive_ctx *p = ctx;
+    if (!p->path) return;
+    diag *d = diag_new();
+    img_write_opts wo;
+    img_default_write_opts(&wo);
+    if (img_write(p->path, fb, &wo, d) == PT_OK && isatty(2))
+        fprintf(stderr, "\rpartray: %d/%d samples per pixel written to %s\n", done, total, p->path);
+    diag_free(d);
+}
+
+static void on_progress(void *ctx, double f)
+{
+    (void)ctx;
+    int n = (int)(f * 40.0 + 0.5);
+    char bar[41];
+    for (int i = 0; i < 40; i++) bar[i] = i < n ? '#' : '.';
+    bar[40] = 0;
+    fprintf(stderr, "\r[%s] %5.1f%%%s", bar, f * 100.0, f >= 1.0 ? "\n" : "");
+}
+
+static void fill_common(pm_common *c, const render_gi_opts *o, progressive_ctx *pc)
+{
+    pm_common_defaults(c);
+    c->width = o->width;
+    c->height = o->height;
+    c->threads = o->threads;
+    c->seed = o->seed;
+    if (o->spp > 0) c->spp = o->spp;
+    c->cancel = o->cancel;
+    if (pc->path) {
+        c->on_image = on_image;
+        c->image_ctx = pc;
+    }
+    if (o->progress && isatty(2)) c->on_progress = on_progress;
+}
+
+static pt_status render_reference(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
+                                  render_gi_result *r, diag *d)
+{
+    progressive_ctx pc = {o->progressive_path, 0.0};
+    pt_status st;
+    r->has_pm = 1;
+    double t0 = timer_now();
+    if (o->mode == GI_PATH) {
+        pm_path_settings ps;
+        pm_path_default_settings(&ps);
+        fill_common(&ps.c, o, &pc);
+        if (o->max_depth > 0) ps.max_depth = o->max_depth;
+        st = pm_path_render(sc, a, &ps, fb, &r->pm, d);
+    } else {
+        pm_fg_settings fs;
+        pm_fg_default_settings(&fs);
+        fill_common(&fs.c, o, &pc);
+        if (o->spp <= 1) fs.c.spp = 1;
+        if (o->fg_rays > 0) fs.fg_rays = o->fg_rays;
+        if (o->photons > 0) fs.photons = o->photons;
+        st = pm_fg_render(sc, a, &fs, fb, &r->pm, d);
+    }
+    double total = timer_now() - t0;
+    r->t_gi_lighting = r->pm.t_lights + r->pm.t_photons + r->pm.t_maps + r->pm.t_irradiance;
+    r->t_render = r->pm.t_render > 0 ? r->pm.t_render : total - r->t_gi_lighting;
+    r->primary_rays = r->pm.camera_rays;
+    r->shadow_rays = r->pm.shadow_rays;
+    r->secondary_rays = r->pm.bsdf_rays + r->pm.gather_rays;
+    r->other_rays = r->pm.photon_rays;
+    r->discarded = r->pm.discarded_samples;
+    return st;
+}
+
+pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb, render_gi_result *r,
+                    diag *d)
+{
+    memset(r, 0, sizeof *r);
+    pt_status st;
+    switch (o->mode) {
+    case GI_PARTICLE: st = render_particle(sc, a, o, fb, r, d); break;
+    case GI_PMFG:
+    case GI_PATH: return render_reference(sc, a, o, fb, r, d);
+    default: st = render_none(sc, a, o, fb, r, d); break;
+    }
+    r->primary_rays = r->shade.primary_rays;
+    r->shadow_rays = r->shade.shadow_rays;
+    r->secondary_rays = r->shade.secondary_rays;
+    r->discarded = r->shade.discarded_samples;
+    if (r->has_particle) {
+        r->other_rays = r->particle.link_rays + r->particle.shadow_rays + r->particle.prepass_rays;
+        r->discarded += r->particle.discarded;
+    }
+    return st;
+}
+
+void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
+{
+    if (r->has_particle) {
+        const gi_particle_stats *p = &r->particle;
+        stats_obj_begin(js, "particle");
+        stats_str(js, "device", p->device);
+        stats_int(js, "particles", p->particles);
+        stats_int(js, "radiance_particles", p->radiance_particles);
+        stats_int(js, "list_entries", p->list_entries);
+        stats_int(js, "link_rays", p->link_rays);
+        stats_int(js, "link_misses", p->link_misses);
+        stats_int(js, "sources", p->sources);
+        stats_int(js, "bounces", p->bounces);
+        stats_int(js, "found", p->found);
+        stats_int(js, "used", p->used);
+        stats_int(js, "skipped_objects", p->skipped_objects);
+        stats_int(js, "discarded", p->discarded);
+        stats_num(js, "spacing", p->spacing);
+        stats_num(js, "radius", p->radius);
+        stats_int(js, "bytes_total", (long long)p->bytes_total);
+        stats_obj_begin(js, "timings");
+        stats_num(js, "kernel_build", p->t_kernel_build);
+        stats_num(js, "surfaces", p->t_surfaces);
+        stats_num(js, "sampling", p->t_sampling);
+        stats_num(js, "scatter_links", p->t_scatter_links);
+        stats_num(js, "gather_links", p->t_gather_links);
+        stats_num(js, "lists", p->t_lists);
+        stats_num(js, "visibility", p->t_visibility);
+        stats_num(js, "emit", p->t_emit);
+        stats_num(js, "scatter", p->t_scatter);
+        stats_num(js, "prepass", p->t_prepass);
+        stats_num(js, "gather", p->t_gather);
+        stats_num(js, "estimate", p->t_estimate);
+        stats_obj_end(js);
+        stats_obj_end(js);
+    }
+    if (r->has_pm) {
+        const pm_stats *p = &r->pm;
+        stats_obj_begin(js, mode == GI_PATH ? "path" : "pmfg");
+        stats_int(js, "spp", p->spp);
+        stats_int(js, "samples", p->samples);
+        stats_int(js, "camera_rays", p->camera_rays);
+        stats_int(js, "bsdf_rays", p->bsdf_rays);
+        stats_int(js, "gather_rays", p->gather_rays);
+        stats_int(js, "shadow_rays", p->shadow_rays);
+        stats_int(js, "photon_rays", p->photon_rays);
+        stats_int(js, "photons_emitted", p->photons_emitted);
+        stats_int(js, "photons_global", p->photons_global);
+        stats_int(js, "photons_caustic", p->photons_caustic);
+        stats_str(js, "caustic_map", p->caustic_reason ? p->caustic_reason : (p->caustic_map ? "built" : "not built"));
+        stats_int(js, "gather_points", p->gather_points);
+        stats_int(js, "emitter_pieces", p->emitter_pieces);
+        stats_obj_begin(js, "timings");
+        stats_num(js, "lights", p->t_lights);
+        stats_num(js, "photons", p->t_photons);
+        stats_num(js, "maps", p->t_maps);
+        stats_num(js, "irradiance", p->t_irradiance);
+        stats_num(js, "render", p->t_render);
+        stats_obj_end(js);
+        stats_obj_end(js);
+    }
+}

@@ -1,0 +1,49 @@
+/* render_gi.h - one place that renders a parsed scene with the chosen GI mode
+ * (none, particle, pmfg, path) and reports stage times and counts. Used by
+ * `partray render`; the viewer and sweep go through the same choice. */
+#ifndef PT_RENDER_GI_H
+#define PT_RENDER_GI_H
+#include <stdint.h>
+#include "accel.h"
+#include "diag.h"
+#include "framebuffer.h"
+#include "gi_particle.h"
+#include "pm.h"
+#include "scene.h"
+#include "shade.h"
+#include "stats_json.h"
+
+typedef struct {
+    int mode;                 /* gi_mode */
+    int width, height, threads;
+    uint64_t seed;
+    int antialias;            /* Whitted-based modes: 0 off, 1 +A adaptive, 2 fixed spp */
+    double aa_threshold;
+    int aa_depth;
+    int spp;                  /* path: samples per pixel; pmfg: eye samples; none/particle: fixed AA */
+    long particles;           /* particle: area particles (0 = from the scene/default) */
+    int bounces;              /* particle: n_b (0 = default) */
+    int fg_rays;              /* pmfg: final-gather rays per pixel (0 = default 4096) */
+    long photons;             /* pmfg: photon paths (0 = default) */
+    int max_depth;            /* path: vertices per path (0 = unlimited) */
+    volatile int *cancel;
+    int progress;             /* 1: progress bar on stderr (reference modes) */
+    const char *progressive_path; /* reference modes: write the image so far here every few seconds */
+} render_gi_opts;
+
+typedef struct {
+    double t_gi_geometry, t_gi_lighting, t_render;
+    long primary_rays, shadow_rays, secondary_rays, other_rays, discarded;
+    shade_stats shade;        /* Whitted pass (none, particle) */
+    int has_particle;
+    gi_particle_stats particle;
+    int has_pm;
+    pm_stats pm;
+} render_gi_result;
+
+pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb, render_gi_result *r,
+                    diag *d);
+/* Adds the method-specific object ("particle": {...}, "reference": {...}). */
+void render_gi_json(const render_gi_result *r, int mode, stats_json *js);
+
+#endif
