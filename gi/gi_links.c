@@ -117,7 +117,8 @@ static void job(void *ctx, int index, int thread)
             if (hit && J->grid) {
                 const struct RTCRayHit *h = &rh[m];
                 vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
-                target = gi_lookup_nearest_in(J->grid, cell[m], hp[m], d, J->maxdist);
+                vec3 o = v3(h->ray.org_x, h->ray.org_y, h->ray.org_z);
+                target = gi_lookup_nearest_in(J->grid, cell[m], hp[m], d, o, J->maxdist);
                 if (target < 0) unres++;
             }
             J->links[(size_t)i * J->k + j] = target;

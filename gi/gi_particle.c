@@ -132,6 +132,54 @@ static void fill_stats(gi_particle *gp, gi_particle_stats *out)
     if (out && out != &gp->st) *out = gp->st;
 }
 
+/* Scattering links of the particles in ps, then keep only the particles
+ * the light transport needs: those with at least one link ray that hit
+ * something (they receive indirect light) or that some link points at
+ * (they send light to others). The rest face only the void, and nothing
+ * sees them (the outside of a closed room, the underside of a floor): the
+ * indirect light there is just the background. Links are remapped to the
+ * kept particles (a link target is always kept). *links_out gets the
+ * n x ns2 scattering links of the kept particles. */
+static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t seed, int **links_out,
+                                 gi_link_stats *ls)
+{
+    pt_status st = PT_OK;
+    int n = ps->n, k = gp->ns2;
+    gi_link_stats local = {0};
+    if (!ls) ls = &local;
+    gi_lookup *grid = gi_lookup_build(ps, 2.0 * (ps->spacing > 0.0 ? ps->spacing : 1.0));
+    int *links = xcalloc((size_t)n * (size_t)k, sizeof(int), &st);
+    unsigned char *keep = xcalloc((size_t)n, 1, &st);
+    int *remap = xcalloc((size_t)n, sizeof(int), &st);
+    if (!grid) st = PT_ERR_NOMEM;
+    if (st == PT_OK)
+        st = gi_links_build(gp->a, ps->p, n, gp->set.scatter_side, seed, grid, 3.0 * ps->spacing, gp->threads, links,
+                            keep, ls);
+    gi_lookup_free(grid);
+    if (st == PT_OK) {
+        for (size_t j = 0; j < (size_t)n * (size_t)k; j++)
+            if (links[j] >= 0) keep[links[j]] = 1;
+        int m = 0;
+        for (int i = 0; i < n; i++) remap[i] = keep[i] ? m++ : -1;
+        for (int i = 0; i < n; i++) {
+            if (!keep[i]) continue;
+            for (int j = 0; j < k; j++) {
+                int t = links[(size_t)i * k + j];
+                links[(size_t)remap[i] * k + j] = t >= 0 ? remap[t] : -1;
+            }
+        }
+        st = gi_particles_compact(ps, keep);
+    }
+    free(keep);
+    free(remap);
+    if (st != PT_OK) {
+        free(links);
+        links = NULL;
+    }
+    *links_out = links;
+    return st;
+}
+
 gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particle_settings *s,
                                gi_particle_stats *stats, diag *d, pt_status *status)
 {
@@ -175,65 +223,75 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     gp->surf = gi_surface_build(sc, a, 1e30, d, &st);
     if (!gp->surf) goto fail;
     S->skipped_objects = gi_surface_skipped(gp->surf);
-    double total = gi_surface_total_area(gp->surf);
-    double spacing = total > 0.0 ? sqrt(total / (double)(set->count > 0 ? set->count : 1)) : 1.0;
+    S->t_surfaces = timer_now() - tg;
+
+    /* pilot: a quarter of the particles on every side, to learn which sides
+     * are needed (see keep_needed) and what fraction of each survives */
+    tg = timer_now();
+    int np = gi_surface_npatches(gp->surf);
+    float *frac = xcalloc(2 * (size_t)np + 2, sizeof(float), &st);
+    if (!frac) goto fail;
+    {
+        gi_particles pilot;
+        long pc = set->count / 4 > 500 ? set->count / 4 : 500;
+        st = gi_particles_sample(&pilot, gp->surf, a, sc, pc, set->seed ^ 0x9170ULL, gp->ambient_emits, NULL, d);
+        int *pl = NULL;
+        if (st == PT_OK) st = trace_and_prune(gp, &pilot, set->seed ^ 0x5eedULL, &pl, NULL);
+        free(pl);
+        if (st == PT_OK) {
+            /* pilot.patch/side now list the survivors; count them per side */
+            gi_particles all;
+            st = gi_particles_sample(&all, gp->surf, a, sc, pc, set->seed ^ 0x9170ULL, gp->ambient_emits, NULL, d);
+            if (st == PT_OK) {
+                float *tot = xcalloc(2 * (size_t)np + 2, sizeof(float), &st);
+                if (tot) {
+                    for (int i = 0; i < all.n; i++) tot[2 * all.patch[i] + all.side[i]] += 1.0f;
+                    for (int i = 0; i < pilot.n; i++) frac[2 * pilot.patch[i] + pilot.side[i]] += 1.0f;
+                    for (int k = 0; k < 2 * np; k++) frac[k] = tot[k] > 0.0f ? frac[k] / tot[k] : 1.0f;
+                }
+                free(tot);
+            }
+            gi_particles_free(&all);
+        }
+        gi_particles_free(&pilot);
+    }
+    if (st != PT_OK) {
+        free(frac);
+        goto fail;
+    }
+    S->t_prune = timer_now() - tg;
+
+    /* the area particles */
+    tg = timer_now();
+    st = gi_particles_sample(&gp->ps, gp->surf, a, sc, set->count, set->seed, gp->ambient_emits, frac, d);
+    free(frac);
+    if (st != PT_OK) goto fail;
+    S->candidates = gp->ps.n;
+    S->probed_out = gp->ps.probed_out;
+    double spacing = gp->ps.spacing > 0.0 ? gp->ps.spacing : 1.0;
     S->spacing = spacing;
     S->tess = set->tess > 0.0 ? set->tess : set->tess_factor * spacing;
     S->radius = set->radius > 0.0 ? set->radius : set->radius_factor * spacing;
     gi_surface_retess(gp->surf, S->tess);
-    S->t_surfaces = timer_now() - tg;
-
-    /* area particles: candidates on every side */
-    tg = timer_now();
-    st = gi_particles_sample(&gp->ps, gp->surf, a, sc, set->count, set->seed, gp->ambient_emits, d);
-    if (st != PT_OK) goto fail;
-    S->candidates = gp->ps.n;
-    S->probed_out = gp->ps.probed_out;
     S->t_sampling = timer_now() - tg;
 
-    /* drop the sides of two-sided surfaces that face only the void: all of
-     * their scattering rays leave the scene */
-    tg = timer_now();
+    /* scattering links (and the final pruning), then gathering links */
     {
-        unsigned char *any = xcalloc((size_t)gp->ps.n, 1, &st);
-        if (!any) goto fail;
         gi_link_stats ls = {0};
-        st = gi_links_build(a, gp->ps.p, gp->ps.n, set->scatter_side, set->seed ^ 0x5eedULL, NULL, 0.0, gp->threads,
-                            NULL, any, &ls);
-        if (st == PT_OK) {
-            for (int i = 0; i < gp->ps.n; i++)
-                if (gi_surface_sides(gp->surf, gp->ps.patch[i]) == 1) any[i] = 1;
-            st = gi_particles_compact(&gp->ps, any);
-        }
-        free(any);
+        tg = timer_now();
+        st = trace_and_prune(gp, &gp->ps, set->seed ^ 0x51ULL, &gp->slink, &ls);
+        S->t_scatter_links = timer_now() - tg;
         if (st != PT_OK) goto fail;
         S->pruned = S->candidates - gp->ps.n;
         S->particles = gp->ps.n;
-    }
-    S->t_prune = timer_now() - tg;
-
-    /* links */
-    {
-        /* (reorders the particles into grid-cell order) */
-        gi_lookup *grid = gi_lookup_build(&gp->ps, 2.0 * spacing);
         int n = gp->ps.n;
-        gp->slink = xcalloc((size_t)n * (size_t)gp->ns2, sizeof(int), &st);
+        gi_lookup *grid = gi_lookup_build(&gp->ps, 2.0 * spacing);
         gp->glink = xcalloc((size_t)n * (size_t)gp->ng, sizeof(int), &st);
         if (!grid) st = PT_ERR_NOMEM;
-        if (st != PT_OK) {
-            gi_lookup_free(grid);
-            goto fail;
-        }
-        gi_link_stats ls = {0};
-        double maxdist = 3.0 * spacing;
-        tg = timer_now();
-        st = gi_links_build(a, gp->ps.p, n, set->scatter_side, set->seed ^ 0x51ULL, grid, maxdist, gp->threads,
-                            gp->slink, NULL, &ls);
-        S->t_scatter_links = timer_now() - tg;
         tg = timer_now();
         if (st == PT_OK)
-            st = gi_links_build(a, gp->ps.p, n, set->gather_side, set->seed ^ 0x6a7ULL, grid, maxdist, gp->threads,
-                                gp->glink, NULL, &ls);
+            st = gi_links_build(a, gp->ps.p, n, set->gather_side, set->seed ^ 0x6a7ULL, grid, 3.0 * spacing,
+                                gp->threads, gp->glink, NULL, &ls);
         S->t_gather_links = timer_now() - tg;
         gi_lookup_free(grid);
         if (st != PT_OK) goto fail;

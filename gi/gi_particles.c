@@ -86,10 +86,14 @@ static int probe_ok(const accel *a, const scene_object *o, vec3 pos, vec3 nrm)
 }
 
 pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel *a, const scene *sc, long count,
-                              uint64_t seed, int ambient_emits, diag *d)
+                              uint64_t seed, int ambient_emits, const float *side_frac, diag *d)
 {
     memset(ps, 0, sizeof *ps);
-    double total = gi_surface_total_area(g);
+    int np = gi_surface_npatches(g);
+    double total = 0.0;
+    for (int i = 0; i < np; i++)
+        for (int s = 0; s < gi_surface_sides(g, i); s++)
+            total += gi_surface_area(g, i) * (side_frac ? side_frac[2 * i + s] : 1.0);
     if (count < 1) count = 1;
     if (!(total > 0.0)) return PT_OK;
     double density = (double)count / total;
@@ -99,11 +103,11 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
     rng r;
     rng_seed(&r, seed, 0x9a17c1e5ULL);
     double offset = rng_f64(&r), cum = 0.0;
-    int np = gi_surface_npatches(g);
     for (int i = 0; i < np; i++) {
         double area = gi_surface_area(g, i);
         int sides = gi_surface_sides(g, i);
         if (sides == 0 || !(area > 0.0)) continue;
+        if (side_frac && side_frac[2 * i] <= 0.0f && (sides < 2 || side_frac[2 * i + 1] <= 0.0f)) continue;
         /* systematic sampling of the patch counts: exactly `count` over all */
         long before = (long)floor(cum * density + offset);
         cum += area;
@@ -125,6 +129,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
             if (!gi_surface_sample(g, i, u, v, rng_f64(&pr), &pos, &nrm)) continue;
             got++;
             for (int s = 0; s < sides; s++) {
+                if (side_frac && side_frac[2 * i + s] <= 0.0f) continue;
                 vec3 nn = s ? v3_neg(nrm) : nrm;
                 if (probe && !probe_ok(a, o, pos, nn)) {
                     ps->probed_out++;
@@ -268,7 +273,7 @@ size_t gi_grid_bytes(const gi_grid *g)
     return g ? ((size_t)g->mask + 3) * sizeof(int) + (size_t)g->n * sizeof(gentry) : 0;
 }
 
-int gi_grid_nearest(const gi_grid *g, vec3 q, vec3 dir, double maxdist)
+int gi_grid_nearest(const gi_grid *g, vec3 q, vec3 dir, vec3 org, double maxdist)
 {
     if (g->n == 0) return -1;
     double fx = (q.x - g->origin.x) * g->inv, fy = (q.y - g->origin.y) * g->inv, fz = (q.z - g->origin.z) * g->inv;
@@ -277,6 +282,7 @@ int gi_grid_nearest(const gi_grid *g, vec3 q, vec3 dir, double maxdist)
     double rx = fx - ix, ry = fy - iy, rz = fz - iz;
     float qx = (float)q.x, qy = (float)q.y, qz = (float)q.z;
     float dx = (float)dir.x, dy = (float)dir.y, dz = (float)dir.z;
+    float orx = (float)org.x, ory = (float)org.y, orz = (float)org.z;
     double best = maxdist * maxdist;
     int bi = -1;
     int rings = (int)ceil(maxdist * g->inv) + 1;
@@ -295,6 +301,7 @@ int gi_grid_nearest(const gi_grid *g, vec3 q, vec3 dir, double maxdist)
                     for (int k = g->start[h]; k < g->start[h + 1]; k++) {
                         const gentry *e = &g->e[k];
                         if (e->nx * dx + e->ny * dy + e->nz * dz >= 0.0f) continue;
+                        if (e->nx * (orx - e->x) + e->ny * (ory - e->y) + e->nz * (orz - e->z) <= 0.0f) continue;
                         float ex = e->x - qx, ey = e->y - qy, ez = e->z - qz;
                         double d2 = (double)(ex * ex + ey * ey + ez * ez);
                         if (d2 < best || (d2 == best && e->idx < bi)) {
@@ -504,17 +511,18 @@ void gi_lookup_prefetch(const gi_lookup *g, long cell, int stage)
     }
 }
 
-int gi_lookup_nearest(const gi_lookup *g, vec3 q, vec3 dir, double maxdist)
+int gi_lookup_nearest(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double maxdist)
 {
     if (g->n == 0 || !v3_finite(q)) return -1;
-    return gi_lookup_nearest_in(g, gi_lookup_cell(g, q), q, dir, maxdist);
+    return gi_lookup_nearest_in(g, gi_lookup_cell(g, q), q, dir, org, maxdist);
 }
 
-int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, double maxdist)
+int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist)
 {
     if (g->n == 0 || !v3_finite(q)) return -1;
     float qx = (float)q.x, qy = (float)q.y, qz = (float)q.z;
     float dx = (float)dir.x, dy = (float)dir.y, dz = (float)dir.z;
+    float ox = (float)org.x, oy = (float)org.y, oz = (float)org.z;
     double m = fmin(g->margin, maxdist);
     float best = (float)(m * m);
     int bi = -1;
@@ -524,11 +532,12 @@ int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, double
         float ex = e->x - qx, ey = e->y - qy, ez = e->z - qz;
         float d2 = ex * ex + ey * ey + ez * ez;
         float f = (float)e->nx * dx + (float)e->ny * dy + (float)e->nz * dz;
-        int ok = (d2 < best) & (f < 0.0f);
+        float h = (float)e->nx * (ox - e->x) + (float)e->ny * (oy - e->y) + (float)e->nz * (oz - e->z);
+        int ok = (d2 < best) & (f < 0.0f) & (h > 0.0f);
         best = ok ? d2 : best;
         bi = ok ? e->idx : bi;
     }
     if (bi >= 0) return bi;
     /* nothing within the margin: the ring search, up to maxdist */
-    return maxdist > m ? gi_grid_nearest(g->fallback, q, dir, maxdist) : -1;
+    return maxdist > m ? gi_grid_nearest(g->fallback, q, dir, org, maxdist) : -1;
 }

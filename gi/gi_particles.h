@@ -20,13 +20,18 @@ typedef struct {
     long probed_out;    /* candidates a CSG probe removed */
 } gi_particles;
 
-/* Candidates: `count` particles per unit of one-sided area A (dA = A/count),
+/* Candidates: about `count` particles over every side of every patch,
+ * uniformly by area (dA = A/count, A the summed area of the sides),
  * stratified per patch (low-discrepancy R2 points, Roberts 2018, with a
- * random shift per patch), one per side of two-sided patches. Materials:
+ * random shift per patch); both sides of a two-sided patch share positions.
+ * side_frac (2 per patch, may be NULL = all 1) is the expected fraction of
+ * each side's particles that will be kept (from a pilot run): the density
+ * is set so that about `count` are kept, and sides of fraction 0 get none.
+ * Materials:
  * rho = diffuse * pigment * opacity, le = pigment * (emission + [ambient *
  * ambient_light if ambient_emits]) * opacity, as shade.c's terms. */
 pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel *a, const scene *sc, long count,
-                              uint64_t seed, int ambient_emits, diag *d);
+                              uint64_t seed, int ambient_emits, const float *side_frac, diag *d);
 /* Keep the particles with keep[i] != 0, in order. */
 pt_status gi_particles_compact(gi_particles *ps, const unsigned char *keep);
 void gi_particles_free(gi_particles *ps);
@@ -39,9 +44,12 @@ typedef struct gi_grid gi_grid;
 gi_grid *gi_grid_build(const gi_dev_particle *p, int n, double cell);
 void gi_grid_free(gi_grid *g);
 size_t gi_grid_bytes(const gi_grid *g);
-/* Nearest particle to q whose normal faces against dir (n.dir < 0: the side
- * a ray travelling along dir hits), within maxdist; -1 if none. */
-int gi_grid_nearest(const gi_grid *g, vec3 q, vec3 dir, double maxdist);
+/* Nearest particle to q, within maxdist, on the side a ray from org along
+ * dir arrives at: its normal faces against dir (n.dir < 0) and org lies in
+ * front of it (n.(org - p) > 0; this keeps a ray that hits near its own
+ * start, in a corner, from linking to the back side of its own surface).
+ * -1 if none. */
+int gi_grid_nearest(const gi_grid *g, vec3 q, vec3 dir, vec3 org, double maxdist);
 /* Particles within r of q with n.nq > cos_thr, in increasing index order,
  * appended to *out (grown with realloc); returns how many, -1 on OOM. */
 long gi_grid_radius(const gi_grid *g, vec3 q, vec3 nq, double r, double cos_thr, int **out, long *len, long *cap);
@@ -56,12 +64,12 @@ gi_lookup *gi_lookup_build(const gi_particles *ps, double cell);
 void gi_lookup_free(gi_lookup *g);
 size_t gi_lookup_bytes(const gi_lookup *g);
 /* As gi_grid_nearest. */
-int gi_lookup_nearest(const gi_lookup *g, vec3 q, vec3 dir, double maxdist);
+int gi_lookup_nearest(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double maxdist);
 /* The same in steps, for batches (queries are bound by memory latency, so a
  * batch first computes every cell, prefetches stage 0 (the cell's list
  * head) for all, then stage 1 (the list), then queries). */
 long gi_lookup_cell(const gi_lookup *g, vec3 q);
 void gi_lookup_prefetch(const gi_lookup *g, long cell, int stage);
-int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, double maxdist);
+int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist);
 
 #endif

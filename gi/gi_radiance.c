@@ -45,8 +45,8 @@ static void job(void *ctx, int chunk, int thread)
             if (m > 0) wid++;
         }
         if (m == 0) {
-            /* the nearest particle facing the same way, within 16 r */
-            int near = gi_grid_nearest(J->fine, q, v3_neg(nq), 16.0 * J->r);
+            /* the nearest particle facing the same way, within 4 r */
+            int near = gi_grid_nearest(J->fine, q, v3_neg(nq), v3_madd(q, nq, 4.0 * J->r), 4.0 * J->r);
             if (near >= 0) {
                 if (len == cap) {
                     long nc = cap ? cap * 2 : 1024;

@@ -5,7 +5,7 @@
  * (n_m . n_q > cos_thr), so radiance estimation is a list scan (kernel
  * gi_k_estimate). A radiance particle with an empty list (a small patch, or
  * a corner) takes the particles within 2r, then 4r, then the nearest one
- * facing the same way within 16r. Radiance particles on a side that kept no
+ * facing the same way within 4r. Radiance particles on a side that kept no
  * particles (pruned: it faces only the void) get an empty list; their value
  * is the background. Lists are stored as CSR arrays for the device.
  * Internal to gi/. */

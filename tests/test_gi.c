@@ -1,0 +1,496 @@
+/* test_gi.c - particle-space GI (gi/gi_particle.h, seed 000).
+ *
+ *  - energy: one scattering bounce in a closed box moves exactly rho times
+ *    the flux that left the lit particles (relative 1e-5, float sums); with
+ *    uniform rho every later bounce carries rho times the one before (1e-4).
+ *  - integrating sphere (a furnace with a closed form): inside a Lambertian
+ *    sphere the indirect irradiance is the same everywhere, whatever lights
+ *    it, E_ind = F_d / A * sum_{k=1}^{n_b+1} rho^k (form factor dA/A between
+ *    any two points of a sphere), with the direct flux of a POV-Ray point
+ *    light of colour C at distance a from the centre (no distance falloff)
+ *    F_d = pi C (4 pi R^2 - 4 pi a^2 / 3) (Gauss: the flux of the unit radial
+ *    field through the sphere is the integral of 2/r over the ball). The
+ *    relative error of the hook's value is printed for growing particle
+ *    counts and must end below 3%.
+ *  - direct light of the particles equals shade.c's Whitted direct term at
+ *    the same point (spotlight with fade; relative 1e-3 plus 1e-6: the
+ *    kernels work in float and the falloff tail cancels digits).
+ *  - determinism: two builds with the same seed give bit-identical particle
+ *    radiance and hook values; the OpenCL device and the C build of the
+ *    kernels agree within 1e-4 relative.
+ *  - OpenCL errors: a kernel source that does not compile gives
+ *    PT_ERR_DEVICE with the build log in the diagnostics; an unknown device
+ *    name gives PT_ERR_DEVICE too. (Skipped when no OpenCL platform exists.)
+ *  - no NaN/Inf from the hook, stats consistent. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "accel.h"
+#include "diag.h"
+#include "gi_cl.h"
+#include "gi_particle.h"
+#include "sdl.h"
+#include "shade.h"
+
+typedef struct {
+    scene *sc;
+    accel *a;
+    diag *d;
+} fixture;
+
+static void load(fixture *f, const char *text)
+{
+    f->d = diag_new();
+    sdl_options o;
+    sdl_default_options(&o);
+    pt_status st = sdl_parse_string("test.pov", text, &o, &f->sc, f->d);
+    if (st != PT_OK) {
+        for (int i = 0; i < diag_count(f->d); i++) {
+            char *m = diag_format(diag_get(f->d, i));
+            fprintf(stderr, "%s\n", m);
+            free(m);
+        }
+    }
+    assert_int_equal(st, PT_OK);
+    f->a = accel_build(f->sc, 2, f->d, &st);
+    assert_non_null(f->a);
+}
+
+static void unload(fixture *f)
+{
+    accel_free(f->a);
+    scene_free(f->sc);
+    diag_free(f->d);
+}
+
+static void print_diag(diag *d)
+{
+    for (int i = 0; i < diag_count(d); i++) {
+        char *m = diag_format(diag_get(d, i));
+        fprintf(stderr, "  diag: %s\n", m);
+        free(m);
+    }
+}
+
+/* Is an OpenCL device there at all? */
+static int have_opencl(void)
+{
+    if (!gi_dev_opencl_built()) return 0;
+    diag *d = diag_new();
+    pt_status st;
+    gi_dev_options o = {NULL, NULL, 1};
+    gi_dev *dv = gi_dev_open(&o, d, &st);
+    gi_dev_free(dv);
+    diag_free(d);
+    return st == PT_OK;
+}
+
+static const char *const device_c = "c";
+
+static gi_particle *build(fixture *f, long count, int nb, const char *device, uint64_t seed)
+{
+    gi_particle_settings s;
+    gi_particle_default_settings(&s);
+    s.count = count;
+    s.bounces = nb;
+    s.threads = 2;
+    s.seed = seed;
+    s.cl_device = device;
+    pt_status st;
+    gi_particle *gp = gi_particle_build(f->sc, f->a, &s, NULL, f->d, &st);
+    if (!gp) print_diag(f->d);
+    assert_non_null(gp);
+    assert_int_equal(gi_particle_light(gp, f->d), PT_OK);
+    return gp;
+}
+
+/* A closed cube (mesh, 12 triangles) of uniform reflectance with a point
+ * light inside. */
+static const char *cube_scene =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 }\n"
+    "camera { location <0.5, 0.5, 0.1> look_at <0.5, 0.5, 1> angle 90 }\n"
+    "light_source { <0.3, 0.7, 0.4> color rgb <1, 0.8, 0.6> }\n"
+    "mesh {\n"
+    "  triangle { <0,0,0>, <1,0,0>, <1,1,0> } triangle { <0,0,0>, <1,1,0>, <0,1,0> }\n"
+    "  triangle { <0,0,1>, <1,0,1>, <1,1,1> } triangle { <0,0,1>, <1,1,1>, <0,1,1> }\n"
+    "  triangle { <0,0,0>, <0,1,0>, <0,1,1> } triangle { <0,0,0>, <0,1,1>, <0,0,1> }\n"
+    "  triangle { <1,0,0>, <1,1,0>, <1,1,1> } triangle { <1,0,0>, <1,1,1>, <1,0,1> }\n"
+    "  triangle { <0,0,0>, <1,0,0>, <1,0,1> } triangle { <0,0,0>, <1,0,1>, <0,0,1> }\n"
+    "  triangle { <0,1,0>, <1,1,0>, <1,1,1> } triangle { <0,1,0>, <1,1,1>, <0,1,1> }\n"
+    "  pigment { rgb 1 } finish { ambient 0 diffuse 0.6 }\n"
+    "}\n";
+
+static void energy_check(const char *device)
+{
+    fixture f;
+    load(&f, cube_scene);
+    /* one bounce: received scattered flux == rho * flux that left */
+    gi_particle *gp = build(&f, 4000, 1, device, 1);
+    const gi_particle_stats *st = gi_particle_get_stats(gp);
+    assert_int_equal(st->link_unresolved, 0);
+    /* the outside of the cube faces the void: no particle there, and the
+     * count asked for lands inside (within 5%) */
+    const float *edir, *phi, *lout;
+    int n = gi_particle_debug(gp, &edir, &phi, &lout, NULL, NULL);
+    printf("  [%s] %d particles for 4000 asked (%ld candidates, %ld pruned)\n", device ? device : "auto", n,
+           st->candidates, st->pruned);
+    assert_true(abs(n - 4000) <= 200);
+    for (int i = 0; i < n; i++) {
+        vec3 p, nrm;
+        gi_particle_debug_particle(gp, i, NULL, NULL, &p, &nrm);
+        assert_true(v3_dot(nrm, v3_sub(v3(0.5, 0.5, 0.5), p)) > 0.0);
+    }
+    double before = 0.0, after = 0.0;
+    for (int i = 0; i < n; i++) {
+        double area, rho[3];
+        gi_particle_debug_particle(gp, i, &area, rho, NULL, NULL);
+        for (int c = 0; c < 3; c++) {
+            double fd = M_PI * edir[4 * i + c] * area;
+            before += rho[c] * fd;
+            after += phi[4 * i + c] - fd;
+        }
+    }
+    printf("  [%s] one bounce: flux leaving lit particles %.9g, received %.9g (rel %.2e)\n", device ? device : "auto",
+           before, after, fabs(after - before) / before);
+    assert_true(before > 0.0);
+    assert_true(fabs(after - before) <= 1e-5 * before);
+    gi_particle_free(gp);
+
+    /* several bounces: each carries rho = 0.6 times the one before */
+    gp = build(&f, 4000, 6, device, 1);
+    const double *bf;
+    int nbf;
+    gi_particle_debug(gp, NULL, NULL, NULL, &bf, &nbf);
+    assert_int_equal(nbf, 6);
+    for (int b = 1; b < nbf; b++) {
+        double ratio = bf[b] / bf[b - 1];
+        printf("  [%s] bounce %d / bounce %d = %.7f\n", device ? device : "auto", b + 1, b, ratio);
+        assert_true(fabs(ratio - 0.6) <= 1e-4);
+    }
+    gi_particle_free(gp);
+    unload(&f);
+}
+
+static void test_energy_c(void **state)
+{
+    (void)state;
+    energy_check(device_c);
+}
+
+static void test_energy_opencl(void **state)
+{
+    (void)state;
+    if (!have_opencl()) skip();
+    energy_check(NULL);
+}
+
+/* ------------------------------------------------------------------ sphere */
+
+static const char *sphere_scene =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 }\n"
+    "camera { location <0, 0, 0> look_at <0, 0, 1> }\n"
+    "light_source { <0.3, 0.2, 0.1> color rgb 1 }\n"
+    "sphere { 0, 1 pigment { rgb 1 } finish { ambient 0 diffuse 0.5 } }\n";
+
+static double sphere_error(fixture *f, long count, int nb, const char *device, double *expected)
+{
+    gi_particle *gp = build(f, count, nb, device, 7);
+    double rho = 0.5, sum = 0.0, pk = 1.0;
+    for (int k = 1; k <= nb + 1; k++) {
+        pk *= rho;
+        sum += pk;
+    }
+    double a2 = 0.3 * 0.3 + 0.2 * 0.2 + 0.1 * 0.1;
+    *expected = (1.0 - a2 / 3.0) * sum; /* E_ind / pi for C = 1, R = 1 */
+    /* probe points: a spiral of directions from the light */
+    double err2 = 0.0;
+    int m = 0;
+    const int probes = 200;
+    for (int i = 0; i < probes; i++) {
+        double z = 1.0 - 2.0 * (i + 0.5) / probes, r = sqrt(fmax(0.0, 1.0 - z * z));
+        double ph = i * 2.39996322972865332;
+        vec3 dir = v3(r * cos(ph), r * sin(ph), z);
+        accel_hit h;
+        if (!accel_intersect(f->a, v3(0.3, 0.2, 0.1), dir, 0.0, INFINITY, &h)) continue;
+        vec3 n = v3_dot(dir, h.ns) > 0.0 ? v3_neg(h.ns) : h.ns;
+        rgb e = gi_particle_indirect(gp, &h, n, 0);
+        assert_true(isfinite(e.r) && isfinite(e.g) && isfinite(e.b));
+        double rel = (e.g - *expected) / *expected;
+        err2 += rel * rel;
+        m++;
+    }
+    assert_true(m > probes / 2);
+    const gi_particle_stats *st = gi_particle_get_stats(gp);
+    assert_int_equal(st->discarded, 0);
+    assert_true(st->lookups_late > 0); /* no prepare_view: computed on demand */
+    gi_particle_free(gp);
+    return sqrt(err2 / m);
+}
+
+static void test_integrating_sphere(void **state)
+{
+    (void)state;
+    fixture f;
+    load(&f, sphere_scene);
+    static const long counts[] = {1000, 4000, 16000};
+    double err[3], expected = 0.0;
+    for (int i = 0; i < 3; i++) {
+        err[i] = sphere_error(&f, counts[i], 10, device_c, &expected);
+        printf("  integrating sphere, %6ld particles: expected E/pi %.6f, RMS relative error %.4f\n", counts[i],
+               expected, err[i]);
+    }
+    assert_true(err[2] < 0.03);
+    assert_true(err[2] < err[0]);
+    unload(&f);
+}
+
+/* ------------------------------------------------------------------ direct */
+
+static const char *floor_scene =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 }\n"
+    "camera { location <0, 5, -5> look_at <0, 0, 0> }\n"
+    "light_source { <0.5, 3, 0.2> color rgb <2, 1.5, 1>\n"
+    "  spotlight radius 20 falloff 40 tightness 2 point_at <0, 0, 0>\n"
+    "  fade_distance 2 fade_power 2 }\n"
+    "mesh { triangle { <-4,0,-4>, <4,0,-4>, <4,0,4> } triangle { <-4,0,-4>, <4,0,4>, <-4,0,4> }\n"
+    "  pigment { rgb <0.8, 0.7, 0.6> } finish { ambient 0 diffuse 0.9 } }\n"
+    "// a ceiling, so that the floor's upper side is seen by other particles\n"
+    "mesh { triangle { <-4,6,-4>, <4,6,-4>, <4,6,4> } triangle { <-4,6,-4>, <4,6,4>, <-4,6,4> } }\n";
+
+static void test_direct_matches_whitted(void **state)
+{
+    (void)state;
+    fixture f;
+    load(&f, floor_scene);
+    gi_particle *gp = build(&f, 3000, 1, device_c, 3);
+    const float *edir;
+    int n = gi_particle_debug(gp, &edir, NULL, NULL, NULL, NULL);
+    shade_settings ss;
+    shade_default_settings(&ss);
+    ss.use_ambient = 0;
+    int checked = 0;
+    double worst = 0.0;
+    for (int i = 0; i < n && checked < 40; i += 37) {
+        vec3 p, nrm;
+        double rho[3];
+        gi_particle_debug_particle(gp, i, NULL, rho, &p, &nrm);
+        if (nrm.y < 0.5) continue; /* the lit (upper) side */
+        vec3 org = v3_add(p, v3(0.0, 1.0, 0.0));
+        rng r;
+        rng_seed(&r, 1, 1);
+        rgb w = shade_trace(f.sc, f.a, &ss, org, v3(0, -1, 0), 0, &r);
+        double want[3] = {w.r / rho[0], w.g / rho[1], w.b / rho[2]};
+        for (int c = 0; c < 3; c++) {
+            double got = edir[4 * i + c];
+            /* float kernels: the spotlight's falloff tail cancels digits */
+            double tol = 1e-3 * fabs(want[c]) + 1e-6;
+            if (!(fabs(got - want[c]) <= tol))
+                fail_msg("particle %d channel %d: E/pi %.9g, Whitted %.9g", i, c, got, want[c]);
+            if (want[c] > 1e-3) worst = fmax(worst, fabs(got - want[c]) / want[c]);
+        }
+        checked++;
+    }
+    printf("  direct light of %d particles vs shade.c: worst relative difference %.2e\n", checked, worst);
+    assert_true(checked >= 10);
+    gi_particle_free(gp);
+    unload(&f);
+}
+
+/* ------------------------------------------------------------------ determinism */
+
+static void hook_values(fixture *f, gi_particle *gp, double *out, int nout)
+{
+    for (int i = 0; i < nout; i++) {
+        double x = 0.05 + 0.9 * ((i * 0.618034) - floor(i * 0.618034));
+        double y = 0.05 + 0.9 * ((i * 0.754878) - floor(i * 0.754878));
+        accel_hit h;
+        vec3 dir = v3_norm(v3(x - 0.5, y - 0.5, 0.9));
+        assert_true(accel_intersect(f->a, v3(0.5, 0.5, 0.1), dir, 0.0, INFINITY, &h));
+        vec3 n = v3_dot(dir, h.ns) > 0.0 ? v3_neg(h.ns) : h.ns;
+        rgb e = gi_particle_indirect(gp, &h, n, 0);
+        out[3 * i] = e.r;
+        out[3 * i + 1] = e.g;
+        out[3 * i + 2] = e.b;
+    }
+}
+
+static void test_determinism(void **state)
+{
+    (void)state;
+    fixture f;
+    load(&f, cube_scene);
+    int use_cl = have_opencl();
+    const char *devs[2] = {device_c, NULL};
+    double *vals[2] = {NULL, NULL};
+    const int nv = 64;
+    for (int k = 0; k < (use_cl ? 2 : 1); k++) {
+        gi_particle *g1 = build(&f, 3000, 6, devs[k], 11);
+        gi_particle *g2 = build(&f, 3000, 6, devs[k], 11);
+        assert_int_equal(gi_particle_prepare_view(g1, &f.sc->camera, 32, 32, f.d), PT_OK);
+        assert_int_equal(gi_particle_prepare_view(g2, &f.sc->camera, 32, 32, f.d), PT_OK);
+        const float *l1, *l2;
+        int n1 = gi_particle_debug(g1, NULL, NULL, &l1, NULL, NULL);
+        int n2 = gi_particle_debug(g2, NULL, NULL, &l2, NULL, NULL);
+        assert_int_equal(n1, n2);
+        assert_memory_equal(l1, l2, (size_t)n1 * 4 * sizeof(float));
+        double a[3 * 64], b[3 * 64];
+        hook_values(&f, g1, a, nv);
+        hook_values(&f, g2, b, nv);
+        assert_memory_equal(a, b, sizeof a);
+        vals[k] = malloc(sizeof a);
+        memcpy(vals[k], a, sizeof a);
+        /* a different seed moves the particles: values change a little */
+        gi_particle *g3 = build(&f, 3000, 6, devs[k], 12);
+        double c3[3 * 64];
+        hook_values(&f, g3, c3, nv);
+        assert_true(memcmp(a, c3, sizeof a) != 0);
+        gi_particle_free(g1);
+        gi_particle_free(g2);
+        gi_particle_free(g3);
+    }
+    if (use_cl) {
+        double worst = 0.0;
+        for (int i = 0; i < 3 * nv; i++) {
+            double rel = fabs(vals[0][i] - vals[1][i]) / fmax(1e-6, fabs(vals[0][i]));
+            worst = fmax(worst, rel);
+        }
+        printf("  OpenCL vs C build of the kernels: worst relative difference %.2e\n", worst);
+        assert_true(worst <= 1e-4);
+    }
+    free(vals[0]);
+    free(vals[1]);
+    unload(&f);
+}
+
+/* ------------------------------------------------------------------ errors */
+
+static void test_opencl_errors(void **state)
+{
+    (void)state;
+    if (!have_opencl()) skip();
+    fixture f;
+    load(&f, cube_scene);
+    gi_particle_settings s;
+    gi_particle_default_settings(&s);
+    s.count = 500;
+    s.cl_source = "__kernel void broken(__global float *x) { this is not OpenCL C; }\n";
+    pt_status st = PT_OK;
+    diag *d = diag_new();
+    gi_particle *gp = gi_particle_build(f.sc, f.a, &s, NULL, d, &st);
+    assert_null(gp);
+    assert_int_equal(st, PT_ERR_DEVICE);
+    assert_true(diag_errors(d) >= 1);
+    char *m = diag_format(diag_get(d, diag_count(d) - 1));
+    printf("  %.200s...\n", m);
+    assert_non_null(strstr(m, "build log"));
+    assert_non_null(strstr(m, "error"));
+    free(m);
+    diag_free(d);
+
+    d = diag_new();
+    s.cl_source = NULL;
+    s.cl_device = "no-such-device-anywhere";
+    gp = gi_particle_build(f.sc, f.a, &s, NULL, d, &st);
+    assert_null(gp);
+    assert_int_equal(st, PT_ERR_DEVICE);
+    m = diag_format(diag_get(d, 0));
+    assert_non_null(strstr(m, "no-such-device-anywhere"));
+    free(m);
+    diag_free(d);
+    unload(&f);
+}
+
+/* ------------------------------------------------------------------ view */
+
+static void test_view_and_render(void **state)
+{
+    (void)state;
+    fixture f;
+    load(&f, cube_scene);
+    gi_particle *gp = build(&f, 3000, 4, device_c, 5);
+    assert_int_equal(gi_particle_prepare_view(gp, &f.sc->camera, 24, 24, f.d), PT_OK);
+    const gi_particle_stats *st = gi_particle_get_stats(gp);
+    assert_true(st->found > 0);
+    assert_true(st->used > 0);
+    assert_true(st->used <= st->particles);
+    /* render through the hook: the pre-pass found (almost) everything */
+    shade_settings ss;
+    shade_default_settings(&ss);
+    ss.width = ss.height = 24;
+    ss.threads = 2;
+    ss.use_ambient = 0;
+    ss.indirect = gi_particle_indirect;
+    ss.indirect_ctx = gp;
+    framebuffer *fb = fb_new(24, 24);
+    shade_stats sst;
+    assert_int_equal(shade_render(f.sc, f.a, &ss, fb, &sst, f.d), PT_OK);
+    st = gi_particle_get_stats(gp);
+    printf("  hook lookups %ld, computed late %ld, without particles %ld\n", st->lookups, st->lookups_late,
+           st->lookups_none);
+    assert_true(st->lookups >= 24 * 24);
+    assert_int_equal(st->lookups_none, 0);
+    assert_true(st->lookups_late * 50 <= st->lookups);
+    assert_int_equal(sst.discarded_samples, 0);
+    /* indirect light makes the box brighter than direct light alone */
+    framebuffer *fb0 = fb_new(24, 24);
+    ss.indirect = NULL;
+    assert_int_equal(shade_render(f.sc, f.a, &ss, fb0, &sst, f.d), PT_OK);
+    assert_true(fb_mean(fb, -1) > 1.2 * fb_mean(fb0, -1));
+    /* relighting: a brighter light, same particles, twice the light */
+    double before = fb_mean(fb, -1);
+    f.sc->lights[0].colour.r *= 2.0;
+    f.sc->lights[0].colour.g *= 2.0;
+    f.sc->lights[0].colour.b *= 2.0;
+    assert_int_equal(gi_particle_relight(gp, f.d), PT_OK);
+    assert_int_equal(gi_particle_prepare_view(gp, &f.sc->camera, 24, 24, f.d), PT_OK);
+    ss.indirect = gi_particle_indirect;
+    assert_int_equal(shade_render(f.sc, f.a, &ss, fb, &sst, f.d), PT_OK);
+    double after = fb_mean(fb, -1);
+    printf("  relight x2: mean %.6f -> %.6f (ratio %.6f)\n", before, after, after / before);
+    assert_true(fabs(after / before - 2.0) < 1e-4);
+    fb_free(fb);
+    fb_free(fb0);
+    gi_particle_free(gp);
+    unload(&f);
+}
+
+static void test_settings_from_radiosity(void **state)
+{
+    (void)state;
+    fixture f;
+    load(&f, "#version 3.7;\n"
+             "global_settings { radiosity { count 100 recursion_limit 3 error_bound 0.8 brightness 1.5 } }\n"
+             "camera { location <0,0,-3> look_at 0 }\n"
+             "sphere { 0, 1 }\n");
+    gi_particle_settings s;
+    gi_particle_settings_from_scene(&s, f.sc);
+    assert_int_equal(s.count, 50000);
+    assert_int_equal(s.bounces, 2);
+    assert_true(fabs(s.radius_factor - 2.0) < 1e-12);
+    assert_true(fabs(s.brightness - 1.5) < 1e-12);
+    unload(&f);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_energy_c),
+        cmocka_unit_test(test_energy_opencl),
+        cmocka_unit_test(test_integrating_sphere),
+        cmocka_unit_test(test_direct_matches_whitted),
+        cmocka_unit_test(test_determinism),
+        cmocka_unit_test(test_opencl_errors),
+        cmocka_unit_test(test_view_and_render),
+        cmocka_unit_test(test_settings_from_radiosity),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
