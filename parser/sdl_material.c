@@ -404,6 +404,24 @@ scene_texture *sdl_parse_texture_body(sdl_parser *p)
     return t;
 }
 
+int sdl_parse_look_value(sdl_parser *p, sdl_kw k, sdl_value *out)
+{
+    const char *name;
+    switch (k) {
+    case KW_COLOR_MAP: case KW_COLOUR_MAP: name = "colour_map"; break;
+    case KW_PIGMENT_MAP: name = "pigment_map"; break;
+    case KW_NORMAL_MAP: name = "normal_map"; break;
+    case KW_SLOPE_MAP: name = "slope_map"; break;
+    case KW_TEXTURE_MAP: name = "texture_map"; break;
+    default: return 0;
+    }
+    memset(out, 0, sizeof *out);
+    out->kind = VAL_OPAQUE;
+    out->str = name;
+    out->ptr = (void *)sdl_pattern_map(p, k);
+    return 1;
+}
+
 /* ------------------------------------------------------------ materials */
 
 /* material := '{' [ material_identifier ] { texture | interior_texture | interior | transform_item } '}' */

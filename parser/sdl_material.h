@@ -37,6 +37,12 @@ xform sdl_parse_transform(sdl_parser *p);
  * it into *out and return 1; else return 0 and consume nothing. */
 int sdl_transform_item(sdl_parser *p, xform *out);
 
+/* #declare right-hand sides of appearance statements whose keyword k was
+ * just read: color_map, pigment_map, normal_map, slope_map, texture_map
+ * (VAL_OPAQUE named "colour_map"... with ptr = scene_blend_map). Returns 0
+ * (nothing read) for other keywords. */
+int sdl_parse_look_value(sdl_parser *p, sdl_kw k, sdl_value *out);
+
 /* Deep copy of a texture layer list (NULL stays NULL). */
 scene_texture *sdl_copy_texture(sdl_parser *p, const scene_texture *t);
 /* Apply x after a texture's current transform, every layer. */

@@ -253,8 +253,11 @@ static int material_mod(sdl_parser *p, scene_object *o, sdl_kw k)
     }
     case KW_NORMAL: {
         scene_texture *t = top_texture(p, o);
-        sdl_parse_normal(p);
-        if (t) t->has_normal = 1;
+        scene_normal *nm = sdl_parse_normal_from(p, t ? t->normal : NULL);
+        if (t) {
+            t->has_normal = 1;
+            if (nm) t->normal = nm;
+        }
         return 1;
     }
     case KW_INTERIOR: {

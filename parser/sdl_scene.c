@@ -484,7 +484,8 @@ void sdl_parse_default(sdl_parser *p)
         } else if (sdl_is_kw(&t, KW_FINISH)) {
             sdl_parse_finish(p, &dt->finish);
         } else if (sdl_is_kw(&t, KW_NORMAL)) {
-            sdl_parse_normal(p);
+            scene_normal *nm = sdl_parse_normal_from(p, dt->normal);
+            if (nm) dt->normal = nm;
             dt->has_normal = 1;
         } else {
             sdl_unexpected(p, &t, "texture, pigment, finish or normal");
