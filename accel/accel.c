@@ -237,14 +237,41 @@ static int csg_leaf_count(const scene_object *o, int depth)
     return n;
 }
 
+/* A CSG member. `post` (clipped_by solids, whose transforms are relative to
+ * their host) is applied after the member's own transform; `nosurf` marks
+ * leaves that only take part in inside tests; `clip_done` says o's own
+ * clipped_by has been wrapped around it already. */
+static pt_status csg_member_ex(accel *a, diag *d, accel_csg *c, const scene_object *o, const scene_texture *ptex,
+                               unsigned pflags, int parent, int depth, const xform *post, int nosurf, int clip_done);
+
 static pt_status csg_member(accel *a, diag *d, accel_csg *c, const scene_object *o, const scene_texture *ptex,
                             unsigned pflags, int parent, int depth)
+{
+    return csg_member_ex(a, d, c, o, ptex, pflags, parent, depth, NULL, 0, 0);
+}
+
+static pt_status csg_member_ex(accel *a, diag *d, accel_csg *c, const scene_object *o, const scene_texture *ptex,
+                               unsigned pflags, int parent, int depth, const xform *post, int nosurf, int clip_done)
 {
     if (!o) return PT_OK;
     const scene_texture *tex = o->texture ? o->texture : ptex;
     unsigned flags = o->flags | (pflags & INHERITED_FLAGS);
     int inverse = (o->flags & OBJ_INVERSE) != 0;
     accel_csg_op parent_op = parent >= 0 ? c->nodes[parent].op : CSG_UNION;
+    if (o->clip && !clip_done) {
+        /* clipped_by: an intersection of the object with its clip solids,
+         * whose surfaces do not count (issue 4) */
+        if (depth >= MAX_CSG_DEPTH) {
+            diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", MAX_CSG_DEPTH);
+            return PT_ERR_LIMIT;
+        }
+        int node = accel_csg_add_node(c, CSG_INTERSECTION, 0, parent);
+        if (node < 0) return PT_ERR_NOMEM;
+        pt_status st = csg_member_ex(a, d, c, o, ptex, pflags, node, depth + 1, post, nosurf, 1);
+        if (st != PT_OK) return st;
+        xform host = post ? xform_then(o->transform, *post) : o->transform;
+        return csg_member_ex(a, d, c, o->clip, tex, flags, node, depth + 1, &host, 1, 0);
+    }
     if (is_csg_kind(o->kind)) {
         if (depth >= MAX_CSG_DEPTH) {
             diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", MAX_CSG_DEPTH);
@@ -256,17 +283,26 @@ static pt_status csg_member(accel *a, diag *d, accel_csg *c, const scene_object 
         int node = accel_csg_add_node(c, op, inverse, parent);
         if (node < 0) return PT_ERR_NOMEM;
         for (int i = 0; i < o->u.csg.nkids; i++) {
-            pt_status st = csg_member(a, d, c, o->u.csg.kids[i], tex, flags, node, depth + 1);
+            pt_status st = csg_member_ex(a, d, c, o->u.csg.kids[i], tex, flags, node, depth + 1, post, nosurf, 0);
             if (st != PT_OK) return st;
         }
         return PT_OK;
     }
     int ok = 0;
     accel_shape sh;
+    scene_object moved;
+    const scene_object *src = o;
+    if (post) {
+        moved = *o;
+        moved.transform = xform_then(o->transform, *post);
+        src = &moved;
+    }
     switch (o->kind) {
     case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_PLANE: case SHAPE_TRIANGLE: case SHAPE_SMOOTH_TRIANGLE:
     case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC: case SHAPE_TORUS:
-        ok = accel_shape_init(&sh, o) == 0;
+    case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_SUPERELLIPSOID:
+    case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_HEIGHT_FIELD: case SHAPE_TEXT:
+        ok = accel_shape_init(&sh, src) == 0;
         if (!ok)
             diag_warn_once(d, o->loc, "degenerate %s ignored (zero size, singular transform or non-finite numbers)",
                            o->name ? o->name : "shape");
@@ -284,9 +320,18 @@ static pt_status csg_member(accel *a, diag *d, accel_csg *c, const scene_object 
         return accel_csg_add_node(c, CSG_UNION, inverse, parent) < 0 ? PT_ERR_NOMEM : PT_OK;
     }
     int li = add_leaf(a, o, tex, flags);
-    if (li < 0) return PT_ERR_NOMEM;
+    if (li < 0) {
+        accel_shape_release(&sh);
+        return PT_ERR_NOMEM;
+    }
     a->leaves[li].in_csg = 1;
-    return accel_csg_add_leaf(c, &sh, (unsigned)li, inverse, parent) < 0 ? PT_ERR_NOMEM : PT_OK;
+    int leaf = accel_csg_add_leaf(c, &sh, (unsigned)li, inverse, parent);
+    if (leaf < 0) {
+        accel_shape_release(&sh);
+        return PT_ERR_NOMEM;
+    }
+    c->nodes[leaf].nosurf = nosurf;
+    return PT_OK;
 }
 
 /* An intersection or difference (with everything below it) becomes one
@@ -325,6 +370,15 @@ static pt_status collect(accel *a, diag *d, const scene_object *o, const scene_t
     if (!o) return PT_OK;
     const scene_texture *tex = o->texture ? o->texture : ptex;
     unsigned flags = o->flags | (pflags & INHERITED_FLAGS);
+    if (o->clip && o->kind != SHAPE_UNSUPPORTED) {
+        /* clipped_by: one CSG primitive (exact) unless meshes are involved */
+        if (depth >= MAX_CSG_DEPTH) {
+            diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", MAX_CSG_DEPTH);
+            return PT_ERR_LIMIT;
+        }
+        if (!csg_has_mesh(o, depth) && !csg_has_mesh(o->clip, depth)) return build_csg(a, d, o, ptex, pflags, depth);
+        diag_warn_once(d, o->loc, "clipped_by with a mesh is not evaluated yet: the object is not clipped");
+    }
     switch (o->kind) {
     case SHAPE_INTERSECTION:
     case SHAPE_DIFFERENCE: {
@@ -357,6 +411,8 @@ static pt_status collect(accel *a, diag *d, const scene_object *o, const scene_t
         return PT_OK;
     case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_PLANE: case SHAPE_TRIANGLE: case SHAPE_SMOOTH_TRIANGLE:
     case SHAPE_MESH: case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC: case SHAPE_TORUS:
+    case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_SUPERELLIPSOID:
+    case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_HEIGHT_FIELD: case SHAPE_TEXT:
         return add_leaf(a, o, tex, flags) < 0 ? PT_ERR_NOMEM : PT_OK;
     case SHAPE_UNSUPPORTED:
     default:
@@ -786,7 +842,7 @@ static pt_status build_shapes(accel *a, diag *d)
             continue;
         }
         a->shape_leaf[a->nshapes++] = (unsigned)i;
-        if (o->kind != SHAPE_PLANE) {
+        if (o->kind != SHAPE_PLANE && !sh->infinite) {
             bounds_add(&a->lo, &a->hi, sh->lo);
             bounds_add(&a->lo, &a->hi, sh->hi);
         }
@@ -816,8 +872,8 @@ static void finish_bounds(accel *a)
     double far_plane = 0.0;
     for (int i = 0; i < a->nshapes; i++) {
         accel_shape *sh = &a->shapes[i];
-        if (sh->kind != SHAPE_PLANE) continue;
-        double dist = plane_distance(sh, c);
+        if (sh->kind != SHAPE_PLANE && !sh->infinite) continue;
+        double dist = sh->kind == SHAPE_PLANE ? plane_distance(sh, c) : 0.0;
         double hsz = PLANE_EXTENT_FACTOR * fmax(diag_e, dist);
         if (!(hsz > 0.0)) hsz = PLANE_EXTENT_FACTOR;
         accel_shape_clip_plane(sh, v3_sub(c, v3s(hsz)), v3_add(c, v3s(hsz)));
@@ -962,6 +1018,7 @@ void accel_free(accel *a)
         free(a->tri[k].refs);
     }
     free(a->leaves);
+    for (int i = 0; i < a->nshapes; i++) accel_shape_release(&a->shapes[i]);
     free(a->shapes);
     free(a->shape_leaf);
     free(a->groups);
@@ -1125,6 +1182,10 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
         accel_shape_shading(sh, hit->p, hit->ng, &hit->ns);
         hit->obj = l->obj;
         hit->texture = l->texture;
+        if (sh->kind == SHAPE_BLOB) {
+            const scene_texture *bt = accel_shape_texture(sh, hit->p);
+            if (bt) hit->texture = bt;
+        }
         hit->prim = (unsigned)h.part;
         hit->flags = l->flags;
     } else {

@@ -105,12 +105,18 @@ static void leaf_boxes(const accel_shape *sh, int inverse, bbox *s, bbox *v)
     }
     case SHAPE_TRIANGLE:
     case SHAPE_SMOOTH_TRIANGLE:
+    case SHAPE_POLYGON:
         *s = own;
         *v = bb_empty();
         break;
-    default:
+    case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_TORUS:
         *s = own;
         *v = own;
+        break;
+    default:
+        /* issue 4 shapes: unbounded surfaces and solids get infinite boxes */
+        *s = sh->infinite ? bb_all() : own;
+        *v = accel_shape_solid_bounded(sh) ? own : bb_all();
         break;
     }
     if (inverse) *v = bb_all();
@@ -161,6 +167,7 @@ int accel_csg_finish(accel_csg *c)
         switch (nd->op) {
         case CSG_LEAF:
             leaf_boxes(&c->shapes[nd->shape], nd->inverse, &s, &v);
+            if (nd->nosurf) s = bb_empty();
             break;
         case CSG_UNION:
         case CSG_MERGE:
@@ -204,7 +211,7 @@ int accel_csg_finish(accel_csg *c)
 void accel_csg_clip(accel_csg *c, vec3 lo, vec3 hi)
 {
     for (int i = 0; i < c->nshapes; i++)
-        if (c->shapes[i].kind == SHAPE_PLANE) accel_shape_clip_plane(&c->shapes[i], lo, hi);
+        if (c->shapes[i].kind == SHAPE_PLANE || c->shapes[i].infinite) accel_shape_clip_plane(&c->shapes[i], lo, hi);
     c->lo = v3_max(c->lo, lo);
     c->hi = v3_min(c->hi, hi);
 }
@@ -212,6 +219,7 @@ void accel_csg_clip(accel_csg *c, vec3 lo, vec3 hi)
 void accel_csg_free(accel_csg *c)
 {
     if (!c) return;
+    for (int i = 0; i < c->nshapes; i++) accel_shape_release(&c->shapes[i]);
     free(c->nodes);
     free(c->kids);
     free(c->shapes);
@@ -273,41 +281,39 @@ static int kept(const accel_csg *c, int node, vec3 p)
     return 1;
 }
 
+/* Each member's crossings are walked in order, a chunk at a time (shapes
+ * of issue 4 may have many), until one that the inside rules keep; the
+ * nearest kept crossing over all members is the answer. */
+#define CSG_CHUNK 8
+
 int accel_csg_intersect(const accel_csg *c, vec3 org, vec3 dir, double tmin, double tmax, accel_csg_hit *h)
 {
-    accel_csg_hit local[64];
-    accel_csg_hit *buf = local;
-    size_t need = (size_t)c->nshapes * 4;
-    if (need > sizeof local / sizeof local[0]) {
-        buf = malloc(need * sizeof *buf);
-        if (!buf) return 0;
-    }
-    int n = 0;
-    for (int s = 0; s < c->nshapes; s++) {
-        accel_shape_hit tmp[4];
-        int k = accel_shape_hits(&c->shapes[s], org, dir, tmin, tmax, tmp, 4);
-        for (int j = 0; j < k; j++) {
-            /* insertion into the ascending list */
-            int i = n++;
-            while (i > 0 && buf[i - 1].t > tmp[j].t) {
-                buf[i] = buf[i - 1];
-                i--;
-            }
-            buf[i].t = tmp[j].t;
-            buf[i].shape = s;
-            buf[i].part = tmp[j].part;
-            buf[i].flip = 0;
-        }
-    }
     int found = 0;
-    for (int i = 0; i < n && !found; i++) {
-        int node = c->shape_node[buf[i].shape];
-        if (kept(c, node, v3_madd(org, dir, buf[i].t))) {
-            *h = buf[i];
-            h->flip = c->nodes[node].flip;
-            found = 1;
+    double best = tmax;
+    for (int s = 0; s < c->nshapes; s++) {
+        int node = c->shape_node[s];
+        if (c->nodes[node].nosurf) continue;
+        double from = tmin;
+        for (int guard = 0; guard < 1000; guard++) {
+            accel_shape_hit tmp[CSG_CHUNK];
+            int k = accel_shape_hits(&c->shapes[s], org, dir, from, best, tmp, CSG_CHUNK);
+            int kept_one = 0;
+            for (int j = 0; j < k; j++) {
+                if (kept(c, node, v3_madd(org, dir, tmp[j].t))) {
+                    best = tmp[j].t;
+                    h->t = tmp[j].t;
+                    h->shape = s;
+                    h->part = tmp[j].part;
+                    h->flip = c->nodes[node].flip;
+                    found = 1;
+                    kept_one = 1;
+                    break;
+                }
+            }
+            if (kept_one || k < CSG_CHUNK) break;
+            if (!(tmp[k - 1].t > from)) break;
+            from = tmp[k - 1].t;
         }
     }
-    if (buf != local) free(buf);
     return found;
 }

@@ -24,6 +24,8 @@ typedef struct {
     int first, nkids; /* members: kids[first .. first + nkids) */
     int shape;        /* CSG_LEAF: index into shapes */
     int flip;         /* CSG_LEAF: normal points into the result's outside when negated */
+    int nosurf;       /* CSG_LEAF: takes part in inside tests only (a clipped_by
+                         solid); set by the caller after adding the leaf */
 } accel_csg_node;
 
 typedef struct {
@@ -52,8 +54,9 @@ int accel_csg_add_leaf(accel_csg *c, const accel_shape *sh, unsigned tag, int in
  * bounds (infinite where half-spaces leave it open). Returns 0 when the
  * result is provably empty or has no members. */
 int accel_csg_finish(accel_csg *c);
-/* Limit infinite parts (planes) to the world box [lo, hi] and clip the bounds to it. */
+/* Limit infinite parts (planes, unbounded quadrics and polys) to the world box [lo, hi] and clip the bounds to it. */
 void accel_csg_clip(accel_csg *c, vec3 lo, vec3 hi);
+/* Frees the members' shape data too (accel_shape_release). */
 void accel_csg_free(accel_csg *c);
 
 /* Nearest crossing of the result with t in (tmin, tmax). */

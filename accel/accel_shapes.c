@@ -14,6 +14,9 @@
 #include <float.h>
 #include <math.h>
 #include <string.h>
+#include "accel_hfield.h"
+#include "accel_implicit.h"
+#include "accel_sweep.h"
 
 #define TWO_PI 6.283185307179586476925
 
@@ -258,12 +261,70 @@ int accel_shape_init(accel_shape *sh, const scene_object *o)
         hi = v3(R + r, r, R + r);
         break;
     }
+    case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
+        if (accel_sweep_init(sh, o, &lo, &hi) != 0) return -1;
+        break;
+    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB:
+        if (accel_implicit_init(sh, o, &lo, &hi) != 0) return -1;
+        if (sh->infinite) {
+            /* bounds come from accel_shape_clip_plane, as for planes */
+            sh->lo = v3s(-1.0);
+            sh->hi = v3s(1.0);
+            return 0;
+        }
+        break;
+    case SHAPE_HEIGHT_FIELD:
+        if (accel_hfield_init(sh, o, &lo, &hi) != 0) return -1;
+        break;
     default:
         return -1;
     }
+    sh->olo = lo;
+    sh->ohi = hi;
     world_bounds(sh, lo, hi);
-    if (!v3_finite(sh->lo) || !v3_finite(sh->hi)) return -1;
+    if (!v3_finite(sh->lo) || !v3_finite(sh->hi)) {
+        accel_shape_release(sh);
+        return -1;
+    }
     return 0;
+}
+
+void accel_shape_release(accel_shape *sh)
+{
+    if (!sh || !sh->data) return;
+    switch (sh->kind) {
+    case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
+        accel_sweep_free(sh->data);
+        break;
+    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB:
+        accel_implicit_free(sh->data);
+        break;
+    case SHAPE_HEIGHT_FIELD:
+        accel_hfield_free(sh->data);
+        break;
+    default:
+        break;
+    }
+    sh->data = NULL;
+}
+
+int accel_shape_solid_bounded(const accel_shape *sh)
+{
+    switch (sh->kind) {
+    case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_TORUS:
+    case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
+        return 1;
+    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB:
+        return !sh->infinite && accel_implicit_solid_bounded(sh);
+    default:
+        return 0;
+    }
+}
+
+const scene_texture *accel_shape_texture(const accel_shape *sh, vec3 p)
+{
+    if (sh->kind != SHAPE_BLOB) return NULL;
+    return accel_blob_texture(sh, sh->identity ? p : xform_inv_point(&sh->x, p));
 }
 
 void accel_shape_clip_plane(accel_shape *sh, vec3 lo, vec3 hi)
@@ -273,6 +334,7 @@ void accel_shape_clip_plane(accel_shape *sh, vec3 lo, vec3 hi)
     sh->clip_hi = hi;
     sh->lo = lo;
     sh->hi = hi;
+    if (sh->kind != SHAPE_PLANE) return;
     /* An axis-aligned plane touches only a slice of the box. */
     vec3 nw = v3_norm(sh->identity ? sh->g.plane.n : xform_normal(&sh->x, sh->g.plane.n));
     vec3 p0 = v3_scale(sh->g.plane.n, sh->g.plane.d);
@@ -487,6 +549,27 @@ static int hits_torus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double
     return n;
 }
 
+/* Parameter interval of a ray inside a box. */
+static int slabs_t(vec3 o, vec3 d, vec3 lo, vec3 hi, double *t0, double *t1)
+{
+    double a = -INFINITY, b = INFINITY;
+    for (int i = 0; i < 3; i++) {
+        double oi = v3_idx(o, i), di = v3_idx(d, i), l = v3_idx(lo, i), u = v3_idx(hi, i);
+        if (di == 0.0) {
+            if (oi < l || oi > u) return 0;
+            continue;
+        }
+        double x = (l - oi) / di, y = (u - oi) / di;
+        if (x > y) { double t = x; x = y; y = t; }
+        if (x > a) a = x;
+        if (y < b) b = y;
+    }
+    if (!(a <= b)) return 0;
+    *t0 = a;
+    *t1 = b;
+    return 1;
+}
+
 int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, accel_shape_hit *out,
                      int max)
 {
@@ -507,8 +590,40 @@ int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, dou
     case SHAPE_TORUS: return hits_torus(sh, o, d, tmin, tmax, out, max);
     case SHAPE_TRIANGLE:
     case SHAPE_SMOOTH_TRIANGLE: return hits_triangle(sh, o, d, tmin, tmax, out, max);
-    default: return 0;
+    default: break;
     }
+    /* issue 4 shapes: the interval narrowed to the clip box (unbounded
+     * shapes: hits outside it are rejected, as for planes) or to the
+     * object-space bounds, padded */
+    double a = tmin, b = tmax, t0, t1;
+    if (sh->infinite) {
+        if (!sh->clipped || !slabs_t(org, dir, sh->clip_lo, sh->clip_hi, &t0, &t1)) return 0;
+    } else {
+        vec3 pad = v3s(1e-7 * v3_maxc(v3_sub(sh->ohi, sh->olo)) + 1e-300);
+        if (!slabs_t(o, d, v3_sub(sh->olo, pad), v3_add(sh->ohi, pad), &t0, &t1)) return 0;
+    }
+    if (t0 > a) a = t0;
+    if (t1 < b) b = t1;
+    if (!(a < b)) return 0;
+    int n;
+    switch (sh->kind) {
+    case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
+        n = accel_sweep_hits(sh, o, d, a, b, out, max);
+        break;
+    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB:
+        n = accel_implicit_hits(sh, o, d, a, b, out, max);
+        break;
+    case SHAPE_HEIGHT_FIELD:
+        n = accel_hfield_hits(sh, o, d, a, b, out, max);
+        break;
+    default:
+        return 0;
+    }
+    /* keep the caller's open interval exactly */
+    int k = 0;
+    for (int i = 0; i < n; i++)
+        if (out[i].t > tmin && out[i].t < tmax && isfinite(out[i].t)) out[k++] = out[i];
+    return k;
 }
 
 int accel_shape_intersect(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
@@ -544,8 +659,14 @@ int accel_shape_inside(const accel_shape *sh, vec3 p)
         double rho = sqrt(q.x * q.x + q.z * q.z) - sh->g.torus.R;
         return rho * rho + q.y * q.y < sh->g.torus.r * sh->g.torus.r;
     }
+    case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
+        return accel_sweep_inside(sh, q);
+    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB:
+        return accel_implicit_inside(sh, q);
+    case SHAPE_HEIGHT_FIELD:
+        return accel_hfield_inside(sh, q);
     default:
-        return 0; /* triangles have no inside */
+        return 0; /* triangles and polygons have no inside */
     }
 }
 
@@ -574,6 +695,16 @@ static void tri_bary(const accel_shape *sh, vec3 po, double *u, double *v)
 void accel_shape_shading(const accel_shape *sh, vec3 p, vec3 ng, vec3 *ns)
 {
     *ns = ng;
+    if (sh->kind == SHAPE_HEIGHT_FIELD) {
+        vec3 n = accel_hfield_shading(sh, sh->identity ? p : xform_inv_point(&sh->x, p));
+        if (!(v3_len2(n) > 0.0)) return;
+        if (!sh->identity) n = xform_normal(&sh->x, n);
+        double l = v3_len(n);
+        if (!(l > 0.0) || !isfinite(l)) return;
+        n = v3_scale(n, 1.0 / l);
+        *ns = v3_dot(n, ng) < 0.0 ? v3_neg(n) : n;
+        return;
+    }
     if ((sh->kind != SHAPE_SMOOTH_TRIANGLE) || !sh->g.tri.smooth) return;
     double u, v;
     tri_bary(sh, sh->identity ? p : xform_inv_point(&sh->x, p), &u, &v);
@@ -657,6 +788,15 @@ void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, doub
     case SHAPE_SMOOTH_TRIANGLE:
         n = v3_scale(v3_cross(sh->g.tri.e1, sh->g.tri.e2), sh->g.tri.wind);
         tri_bary(sh, po, &su, &sv);
+        break;
+    case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
+        accel_sweep_surface(sh, po, part, &n, &su, &sv);
+        break;
+    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB:
+        n = accel_implicit_normal(sh, po);
+        break;
+    case SHAPE_HEIGHT_FIELD:
+        accel_hfield_surface(sh, po, part, &n, &su, &sv);
         break;
     default:
         break;

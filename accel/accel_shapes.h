@@ -1,6 +1,9 @@
 /* accel_shapes.h - exact double-precision ray intersection with the analytic
- * POV-Ray shapes (sphere, box, plane, cylinder, cone, disc, torus). Pure math:
- * no Embree here; accel.c wraps these as Embree user geometry.
+ * POV-Ray shapes (sphere, box, plane, cylinder, cone, disc, torus; and, in
+ * their own modules, polygon, lathe, sor, prism, text (accel_sweep.h),
+ * superellipsoid, quadric, poly, blob (accel_implicit.h) and height_field
+ * (accel_hfield.h)). Pure math: no Embree here; accel.c wraps these as
+ * Embree user geometry.
  *
  * Every shape is intersected in its object space: the world ray is mapped by
  * the object's `inv` (direction not renormalised, so t is the same parameter
@@ -33,6 +36,10 @@ typedef struct {
     } g;
     vec3 lo, hi;       /* world bounds (planes: the clip box) */
     vec3 clip_lo, clip_hi;
+    /* issue 4 shapes */
+    void *data;        /* derived data owned by the shape (accel_shape_release frees it) */
+    int infinite;      /* unbounded surface (quadric, poly): clipped like planes */
+    vec3 olo, ohi;     /* object-space bounds of the finite ones */
 } accel_shape;
 
 typedef struct {
@@ -49,14 +56,24 @@ typedef struct {
 int accel_shape_init(accel_shape *sh, const scene_object *o);
 /* Planes are infinite: limit one to the world box [lo, hi] (see accel.c for
  * how that box is chosen) and set its bounds to the part of the box it can
- * touch. */
+ * touch. Also used for the other unbounded shapes (sh->infinite). */
 void accel_shape_clip_plane(accel_shape *sh, vec3 lo, vec3 hi);
+/* Free what accel_shape_init allocated (the shape may be copied before:
+ * exactly one copy is released). */
+void accel_shape_release(accel_shape *sh);
+/* 1 when the shape's inside lies within its bounds (CSG bounding); 0 for
+ * half-spaces, unbounded solids and shapes without an inside. */
+int accel_shape_solid_bounded(const accel_shape *sh);
+/* Blob components with their own textures: the one that dominates at the
+ * world point p; NULL otherwise. */
+const scene_texture *accel_shape_texture(const accel_shape *sh, vec3 p);
 /* Nearest intersection with t in (tmin, tmax) of the world ray org + t*dir.
  * Returns 1 and fills `h` on a hit. Never produces NaN for finite input. */
 int accel_shape_intersect(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
                           accel_shape_hit *h);
 /* All crossings with t in (tmin, tmax), ascending, at most `max` of them
- * (a torus has up to 4, the others up to 2). */
+ * (the `max` nearest; a torus has up to 4, the quadrics up to 2, the issue-4
+ * shapes any number). */
 int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, accel_shape_hit *out,
                      int max);
 /* Whether the world point p is strictly inside the solid, as POV-Ray defines

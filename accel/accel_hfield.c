@@ -1,0 +1,315 @@
+/* accel_hfield.c - height_field (accel_hfield.h).
+ *
+ * Work happens in grid coordinates (X, Y, Z) = (x (W-1), y, z (H-1)), where
+ * cells are unit squares; the ray parameter is the same in both. Node
+ * (level l, ix, iz) of the quadtree covers cells [ix 2^l, (ix+1) 2^l) x
+ * [iz 2^l, (iz+1) 2^l) and stores their height range; children are visited
+ * in the order given by the signs of the ray direction, which is front to
+ * back for a monotonic 2-D walk, so the search can stop at the first hit. */
+#include "accel_hfield.h"
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_LEVELS 40
+
+typedef struct {
+    int W, H;            /* grid points */
+    int nx, nz;          /* cells */
+    const float *h;      /* W * H heights (scene IR) */
+    double water;
+    int smooth;
+    int nlev;
+    int lw[MAX_LEVELS], lh[MAX_LEVELS]; /* nodes per level */
+    float *mn[MAX_LEVELS], *mx[MAX_LEVELS];
+    double ylo, yhi;
+} hf_data;
+
+static double H_at(const hf_data *f, int i, int j)
+{
+    double v = f->h[(size_t)j * (size_t)f->W + (size_t)i];
+    return v > f->water ? v : f->water;
+}
+
+static int put_hit(accel_shape_hit *out, int n, int max, double t, int part)
+{
+    if (max <= 0) return 0;
+    if (n == max && !(t < out[n - 1].t)) return n;
+    int i = n < max ? n++ : n - 1;
+    while (i > 0 && out[i - 1].t > t) {
+        out[i] = out[i - 1];
+        i--;
+    }
+    out[i].t = t;
+    out[i].part = part;
+    return n;
+}
+
+int accel_hfield_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
+{
+    const scene_height_field *s = o->u.height_field;
+    if (!s || !s->heights || s->width < 2 || s->height < 2) return -1;
+    hf_data *f = calloc(1, sizeof *f);
+    if (!f) return -1;
+    f->W = s->width;
+    f->H = s->height;
+    f->nx = f->W - 1;
+    f->nz = f->H - 1;
+    f->h = s->heights;
+    f->water = s->water_level;
+    f->smooth = s->smooth;
+    /* level 0: the cells */
+    int lw = f->nx, lh = f->nz, lev = 0;
+    for (;;) {
+        f->lw[lev] = lw;
+        f->lh[lev] = lh;
+        f->mn[lev] = malloc(sizeof(float) * (size_t)lw * (size_t)lh);
+        f->mx[lev] = malloc(sizeof(float) * (size_t)lw * (size_t)lh);
+        if (!f->mn[lev] || !f->mx[lev]) {
+            f->nlev = lev + 1;
+            accel_hfield_free(f);
+            return -1;
+        }
+        for (int j = 0; j < lh; j++)
+            for (int i = 0; i < lw; i++) {
+                double a = INFINITY, b = -INFINITY;
+                if (lev == 0) {
+                    for (int dj = 0; dj < 2; dj++)
+                        for (int di = 0; di < 2; di++) {
+                            double v = H_at(f, i + di, j + dj);
+                            a = fmin(a, v);
+                            b = fmax(b, v);
+                        }
+                } else {
+                    int pw = f->lw[lev - 1], ph = f->lh[lev - 1];
+                    for (int dj = 0; dj < 2; dj++)
+                        for (int di = 0; di < 2; di++) {
+                            int ci = 2 * i + di, cj = 2 * j + dj;
+                            if (ci >= pw || cj >= ph) continue;
+                            a = fmin(a, f->mn[lev - 1][(size_t)cj * pw + ci]);
+                            b = fmax(b, f->mx[lev - 1][(size_t)cj * pw + ci]);
+                        }
+                }
+                /* float storage: round outwards */
+                f->mn[lev][(size_t)j * lw + i] = nextafterf((float)a, -INFINITY);
+                f->mx[lev][(size_t)j * lw + i] = nextafterf((float)b, INFINITY);
+            }
+        lev++;
+        if ((lw == 1 && lh == 1) || lev == MAX_LEVELS) break;
+        lw = (lw + 1) / 2;
+        lh = (lh + 1) / 2;
+    }
+    f->nlev = lev;
+    f->ylo = f->mn[lev - 1][0];
+    f->yhi = f->mx[lev - 1][0];
+    *lo = v3(0.0, f->ylo, 0.0);
+    *hi = v3(1.0, f->yhi, 1.0);
+    sh->data = f;
+    return 0;
+}
+
+void accel_hfield_free(void *data)
+{
+    hf_data *f = data;
+    if (!f) return;
+    for (int i = 0; i < f->nlev; i++) {
+        free(f->mn[i]);
+        free(f->mx[i]);
+    }
+    free(f);
+}
+
+/* Double-precision ray / triangle (Moller & Trumbore 1997), no culling. */
+static int tri_hit(vec3 o, vec3 d, vec3 a, vec3 b, vec3 c, double *t)
+{
+    vec3 e1 = v3_sub(b, a), e2 = v3_sub(c, a);
+    vec3 pv = v3_cross(d, e2);
+    double det = v3_dot(e1, pv);
+    if (det == 0.0 || !isfinite(det)) return 0;
+    double inv = 1.0 / det;
+    vec3 tv = v3_sub(o, a);
+    double u = v3_dot(tv, pv) * inv;
+    if (u < 0.0 || u > 1.0) return 0;
+    vec3 qv = v3_cross(tv, e1);
+    double v = v3_dot(d, qv) * inv;
+    if (v < 0.0 || u + v > 1.0) return 0;
+    *t = v3_dot(e2, qv) * inv;
+    return 1;
+}
+
+static void cell_tri(const hf_data *f, int i, int j, int k, vec3 *a, vec3 *b, vec3 *c)
+{
+    if (k == 0) {
+        *a = v3(i, H_at(f, i, j), j);
+        *b = v3(i + 1, H_at(f, i + 1, j), j);
+        *c = v3(i, H_at(f, i, j + 1), j + 1);
+    } else {
+        *a = v3(i + 1, H_at(f, i + 1, j + 1), j + 1);
+        *b = v3(i, H_at(f, i, j + 1), j + 1);
+        *c = v3(i + 1, H_at(f, i + 1, j), j);
+    }
+}
+
+typedef struct {
+    const hf_data *f;
+    vec3 o, d;      /* grid space */
+    double tmin;
+    accel_shape_hit *out;
+    int n, max;
+    double tmax;    /* shrinks once `max` hits are held */
+} hf_walk;
+
+static int box_range(const hf_walk *w, double x0, double x1, double y0, double y1, double z0, double z1, double *ta,
+                     double *tb)
+{
+    double lo[3] = {x0, y0, z0}, hi[3] = {x1, y1, z1};
+    double o[3] = {w->o.x, w->o.y, w->o.z}, d[3] = {w->d.x, w->d.y, w->d.z};
+    double a = w->tmin, b = w->tmax;
+    for (int k = 0; k < 3; k++) {
+        if (d[k] == 0.0) {
+            if (o[k] < lo[k] || o[k] > hi[k]) return 0;
+            continue;
+        }
+        double p = (lo[k] - o[k]) / d[k], q = (hi[k] - o[k]) / d[k];
+        if (p > q) { double t = p; p = q; q = t; }
+        /* a hair of slack so grid lines do not leak */
+        double sl = 1e-12 * (fabs(p) + fabs(q)) + 1e-300;
+        if (p - sl > a) a = p - sl;
+        if (q + sl < b) b = q + sl;
+        if (!(a <= b)) return 0;
+    }
+    *ta = a;
+    *tb = b;
+    return 1;
+}
+
+static void walk(hf_walk *w, int lev, int ix, int iz)
+{
+    const hf_data *f = w->f;
+    if (ix >= f->lw[lev] || iz >= f->lh[lev]) return;
+    int span = 1 << lev;
+    double x0 = (double)ix * span, z0 = (double)iz * span;
+    double x1 = fmin((double)(ix + 1) * span, f->nx), z1 = fmin((double)(iz + 1) * span, f->nz);
+    size_t k = (size_t)iz * f->lw[lev] + ix;
+    double ta, tb;
+    if (!box_range(w, x0, x1, f->mn[lev][k], f->mx[lev][k], z0, z1, &ta, &tb)) return;
+    if (w->n == w->max && ta > w->out[w->max - 1].t) return;
+    if (lev == 0) {
+        for (int tri = 0; tri < 2; tri++) {
+            vec3 a, b, c;
+            double t;
+            cell_tri(f, ix, iz, tri, &a, &b, &c);
+            if (tri_hit(w->o, w->d, a, b, c, &t) && t > w->tmin && t < w->tmax) {
+                w->n = put_hit(w->out, w->n, w->max, t, (int)(2 * ((size_t)iz * f->nx + ix) + tri));
+                if (w->n == w->max) w->tmax = fmin(w->tmax, w->out[w->max - 1].t);
+            }
+        }
+        return;
+    }
+    int fx = w->d.x < 0.0, fz = w->d.z < 0.0;
+    for (int c = 0; c < 4; c++) {
+        int cx = (c & 1) ^ fx, cz = ((c >> 1) & 1) ^ fz;
+        walk(w, lev - 1, 2 * ix + cx, 2 * iz + cz);
+    }
+}
+
+int accel_hfield_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+{
+    const hf_data *f = sh->data;
+    if (!f || max <= 0) return 0;
+    hf_walk w;
+    w.f = f;
+    w.o = v3(o.x * f->nx, o.y, o.z * f->nz);
+    w.d = v3(d.x * f->nx, d.y, d.z * f->nz);
+    w.tmin = tmin;
+    w.tmax = tmax;
+    w.out = out;
+    w.n = 0;
+    w.max = max;
+    walk(&w, f->nlev - 1, 0, 0);
+    return w.n;
+}
+
+/* Cell and local coordinates of a grid point (clamped into the grid). */
+static void locate(const hf_data *f, double X, double Z, int *i, int *j, double *fx, double *fz)
+{
+    int a = (int)floor(X), b = (int)floor(Z);
+    a = a < 0 ? 0 : (a > f->nx - 1 ? f->nx - 1 : a);
+    b = b < 0 ? 0 : (b > f->nz - 1 ? f->nz - 1 : b);
+    *i = a;
+    *j = b;
+    *fx = X - a;
+    *fz = Z - b;
+}
+
+int accel_hfield_inside(const accel_shape *sh, vec3 q)
+{
+    const hf_data *f = sh->data;
+    if (!f) return 0;
+    double X = q.x * f->nx, Z = q.z * f->nz;
+    if (X < 0.0 || X >= f->nx || Z < 0.0 || Z >= f->nz) return 0;
+    if (q.y >= f->yhi) return 0;
+    if (q.y < f->water) return 1;
+    int i, j;
+    double fx, fz;
+    locate(f, X, Z, &i, &j, &fx, &fz);
+    vec3 a, b, c;
+    cell_tri(f, i, j, fx + fz < 1.0 ? 0 : 1, &a, &b, &c);
+    vec3 n = v3_cross(v3_sub(b, a), v3_sub(c, a));
+    if (n.y < 0.0) n = v3_neg(n);
+    return v3_dot(v3_sub(v3(X, q.y, Z), a), n) < 0.0;
+}
+
+void accel_hfield_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v)
+{
+    const hf_data *f = sh->data;
+    *n = v3(0, 1, 0);
+    *u = q.x;
+    *v = q.z;
+    if (!f) return;
+    int cell = part / 2, tri = part & 1;
+    int i = cell % f->nx, j = cell / f->nx;
+    if (part < 0 || j >= f->nz) {
+        double fx, fz;
+        locate(f, q.x * f->nx, q.z * f->nz, &i, &j, &fx, &fz);
+        tri = fx + fz < 1.0 ? 0 : 1;
+    }
+    vec3 a, b, c;
+    cell_tri(f, i, j, tri, &a, &b, &c);
+    vec3 g = v3_cross(v3_sub(b, a), v3_sub(c, a));
+    if (g.y < 0.0) g = v3_neg(g);
+    *n = v3(g.x * f->nx, g.y, g.z * f->nz);
+}
+
+/* Object-space vertex normal from central differences. */
+static vec3 vertex_normal(const hf_data *f, int i, int j)
+{
+    int i0 = i > 0 ? i - 1 : i, i1 = i < f->W - 1 ? i + 1 : i;
+    int j0 = j > 0 ? j - 1 : j, j1 = j < f->H - 1 ? j + 1 : j;
+    double dx = (H_at(f, i1, j) - H_at(f, i0, j)) / (double)(i1 - i0);
+    double dz = (H_at(f, i, j1) - H_at(f, i, j0)) / (double)(j1 - j0);
+    return v3_norm(v3(-dx * f->nx, 1.0, -dz * f->nz));
+}
+
+vec3 accel_hfield_shading(const accel_shape *sh, vec3 q)
+{
+    const hf_data *f = sh->data;
+    if (!f || !f->smooth) return v3s(0.0);
+    int i, j;
+    double fx, fz;
+    locate(f, q.x * f->nx, q.z * f->nz, &i, &j, &fx, &fz);
+    fx = fmin(1.0, fmax(0.0, fx));
+    fz = fmin(1.0, fmax(0.0, fz));
+    vec3 n;
+    if (fx + fz < 1.0) {
+        double w0 = 1.0 - fx - fz;
+        n = v3_add(v3_add(v3_scale(vertex_normal(f, i, j), w0), v3_scale(vertex_normal(f, i + 1, j), fx)),
+                   v3_scale(vertex_normal(f, i, j + 1), fz));
+    } else {
+        double w0 = fx + fz - 1.0; /* weight of (i+1, j+1) */
+        n = v3_add(v3_add(v3_scale(vertex_normal(f, i + 1, j + 1), w0), v3_scale(vertex_normal(f, i, j + 1), 1.0 - fx)),
+                   v3_scale(vertex_normal(f, i + 1, j), 1.0 - fz));
+    }
+    return n;
+}

@@ -1,0 +1,27 @@
+/* accel_hfield.h - POV-Ray height_field intersected exactly as its
+ * triangles, in double precision, by a front-to-back walk of a min/max
+ * quadtree over the grid cells (each node: the cells it covers and their
+ * height range).
+ *
+ * Geometry (POV-Ray's heightfield.cpp): heights h[z][x] over the unit
+ * square, grid point (i, j) at x = i / (W-1), z = j / (H-1); each cell is
+ * split along the diagonal from (i+1, j) to (i, j+1) into the triangles
+ * (i,j) (i+1,j) (i,j+1) and (i+1,j+1) (i,j+1) (i+1,j); heights below
+ * water_level are raised to it. Only the top surface exists (no walls); a
+ * point is inside when it lies over the square and below the surface.
+ * `smooth` interpolates vertex normals (central differences of the grid)
+ * for shading. Part = 2 * cell + triangle. */
+#ifndef PT_ACCEL_HFIELD_H
+#define PT_ACCEL_HFIELD_H
+#include "accel_shapes.h"
+
+int accel_hfield_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
+void accel_hfield_free(void *data);
+int accel_hfield_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max);
+int accel_hfield_inside(const accel_shape *sh, vec3 q);
+/* Object-space geometric normal of the triangle `part` and (u, v) = (x, z). */
+void accel_hfield_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v);
+/* Object-space smooth shading normal at q (0 when the field is not smooth). */
+vec3 accel_hfield_shading(const accel_shape *sh, vec3 q);
+
+#endif

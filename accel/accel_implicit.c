@@ -1,0 +1,824 @@
+/* accel_implicit.c - superellipsoid, quadric, poly and blob (accel_implicit.h).
+ *
+ * Rays are moved to the start of their interval with a unit direction
+ * before polynomial coefficients are formed, so the coefficients stay O(size)
+ * whatever the distance of the ray origin. Blob field facts are POV-Ray's
+ * (blob.cpp): a component contributes strength (1 - d^2/r^2)^2 for d < r;
+ * a cylinder component is the capsule around its axis segment (hemispherical
+ * ends); the surface is where the sum equals the threshold, the inside where
+ * it exceeds it. */
+#include "accel_implicit.h"
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "accel_poly.h"
+
+enum { IM_SUPER, IM_QUADRIC, IM_POLY, IM_BLOB };
+
+typedef struct {
+    int cylinder;
+    xform x;          /* component space -> blob space */
+    vec3 a, axis;     /* centre / first end and unit axis (component space) */
+    double len, r2, s;
+    const scene_texture *tex;
+} blob_comp;
+
+typedef struct {
+    int type, sturm;
+    /* superellipsoid: exponents p = 2/e (x, y), q = 2/n (the z blend) */
+    double p, q;
+    int convex;
+    /* quadric */
+    double a[10];
+    int solid_bounded;
+    /* poly */
+    int order, nterms;
+    const double *coef;
+    int (*pw)[3];
+    /* blob */
+    double threshold;
+    int ncomp;
+    blob_comp *comp;
+    vec3 blo, bhi;
+} im_data;
+
+static int put_hit(accel_shape_hit *out, int n, int max, double t, int part)
+{
+    if (max <= 0) return 0;
+    if (n == max && !(t < out[n - 1].t)) return n;
+    int i = n < max ? n++ : n - 1;
+    while (i > 0 && out[i - 1].t > t) {
+        out[i] = out[i - 1];
+        i--;
+    }
+    out[i].t = t;
+    out[i].part = part;
+    return n;
+}
+
+static double comp3(vec3 v, int i) { return i == 0 ? v.x : (i == 1 ? v.y : v.z); }
+
+static int slab3(vec3 o, vec3 d, vec3 lo, vec3 hi, double *t0, double *t1)
+{
+    double a = -INFINITY, b = INFINITY;
+    for (int i = 0; i < 3; i++) {
+        double oi = comp3(o, i), di = comp3(d, i), l = comp3(lo, i), h = comp3(hi, i);
+        if (di == 0.0) {
+            if (oi < l || oi > h) return 0;
+            continue;
+        }
+        double x = (l - oi) / di, y = (h - oi) / di;
+        if (x > y) { double t = x; x = y; y = t; }
+        if (x > a) a = x;
+        if (y < b) b = y;
+    }
+    if (!(a <= b)) return 0;
+    *t0 = a;
+    *t1 = b;
+    return 1;
+}
+
+/* ------------------------------------------------------------ superellipsoid */
+
+/* N(v) = ((|x|^p + |y|^p)^(q/p) + |z|^q)^(1/q), evaluated with the largest
+ * term factored out so huge exponents neither overflow nor underflow. */
+static double se_norm(const im_data *m, vec3 v, double *pa)
+{
+    double ax = fabs(v.x), ay = fabs(v.y), az = fabs(v.z);
+    double mxy = fmax(ax, ay), a = 0.0;
+    if (mxy > 0.0) a = mxy * pow(pow(ax / mxy, m->p) + pow(ay / mxy, m->p), 1.0 / m->p);
+    if (pa) *pa = a;
+    double mm = fmax(a, az);
+    if (!(mm > 0.0)) return 0.0;
+    return mm * pow(pow(a / mm, m->q) + pow(az / mm, m->q), 1.0 / m->q);
+}
+
+static vec3 se_grad(const im_data *m, vec3 v)
+{
+    double a, N = se_norm(m, v, &a);
+    if (!(N > 0.0)) return v3(0, 0, 1);
+    double ax = fabs(v.x), ay = fabs(v.y), az = fabs(v.z);
+    double gxy = a > 0.0 ? pow(a / N, m->q - 1.0) : 0.0;
+    double gx = a > 0.0 ? gxy * pow(ax / a, m->p - 1.0) : 0.0;
+    double gy = a > 0.0 ? gxy * pow(ay / a, m->p - 1.0) : 0.0;
+    double gz = pow(az / N, m->q - 1.0);
+    if (!isfinite(gx)) gx = 0.0;
+    if (!isfinite(gy)) gy = 0.0;
+    if (!isfinite(gz)) gz = 0.0;
+    vec3 g = v3(copysign(gx, v.x), copysign(gy, v.y), copysign(gz, v.z));
+    if (!(v3_len2(g) > 0.0)) g = v3(copysign(1.0, v.x), copysign(1.0, v.y), copysign(1.0, v.z));
+    return g;
+}
+
+static double se_g(const im_data *m, vec3 o, vec3 d, double t) { return se_norm(m, v3_madd(o, d, t), NULL) - 1.0; }
+
+/* Root of g in [a, b] with g(a), g(b) of opposite signs (Illinois regula falsi). */
+static double se_root(const im_data *m, vec3 o, vec3 d, double a, double b, double ga, double gb)
+{
+    int side = 0;
+    for (int it = 0; it < 100; it++) {
+        double c = (a * gb - b * ga) / (gb - ga);
+        if (!(c > a && c < b)) c = 0.5 * (a + b);
+        double gc = se_g(m, o, d, c);
+        if (gc == 0.0) return c;
+        if ((gc < 0.0) == (ga < 0.0)) {
+            a = c;
+            ga = gc;
+            if (side == -1) gb *= 0.5;
+            side = -1;
+        } else {
+            b = c;
+            gb = gc;
+            if (side == 1) ga *= 0.5;
+            side = 1;
+        }
+        if (b - a <= 1e-15 * (fabs(a) + fabs(b)) + 1e-300) break;
+    }
+    return 0.5 * (a + b);
+}
+
+/* Minimum of g on [a, b] (unimodal there) by golden sections; stops early
+ * once g < 0 is seen (then *tneg holds the point). */
+static double se_min(const im_data *m, vec3 o, vec3 d, double a, double b, double *tm, int *neg)
+{
+    const double r = 0.6180339887498949;
+    double x1 = b - r * (b - a), x2 = a + r * (b - a);
+    double f1 = se_g(m, o, d, x1), f2 = se_g(m, o, d, x2);
+    *neg = 0;
+    for (int it = 0; it < 80; it++) {
+        if (f1 < 0.0) { *tm = x1; *neg = 1; return f1; }
+        if (f2 < 0.0) { *tm = x2; *neg = 1; return f2; }
+        if (f1 < f2) {
+            b = x2; x2 = x1; f2 = f1;
+            x1 = b - r * (b - a);
+            f1 = se_g(m, o, d, x1);
+        } else {
+            a = x1; x1 = x2; f1 = f2;
+            x2 = a + r * (b - a);
+            f2 = se_g(m, o, d, x2);
+        }
+        if (b - a <= 1e-13 * (fabs(a) + fabs(b)) + 1e-300) break;
+    }
+    *tm = f1 < f2 ? x1 : x2;
+    return fmin(f1, f2);
+}
+
+/* Crossings on [a, b] of a unimodal-or-monotonic piece of g. */
+static int se_piece(const im_data *m, vec3 o, vec3 d, double a, double b, double *roots, int nr)
+{
+    double ga = se_g(m, o, d, a), gb = se_g(m, o, d, b);
+    if ((ga < 0.0) != (gb < 0.0)) {
+        roots[nr++] = se_root(m, o, d, a, b, ga, gb);
+        return nr;
+    }
+    if (ga < 0.0) return nr; /* inside at both ends: no crossing for a convex piece */
+    double tm;
+    int neg;
+    double gm = se_min(m, o, d, a, b, &tm, &neg);
+    if (neg) {
+        double g1 = se_g(m, o, d, tm);
+        roots[nr++] = se_root(m, o, d, a, tm, ga, g1);
+        roots[nr++] = se_root(m, o, d, tm, b, g1, gb);
+    } else if (gm <= 1e-12) {
+        roots[nr++] = tm; /* grazing */
+    }
+    return nr;
+}
+
+static int se_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+{
+    double t0, t1;
+    if (!slab3(o, d, v3s(-1.0 - 1e-9), v3s(1.0 + 1e-9), &t0, &t1)) return 0;
+    t0 = fmax(t0, tmin);
+    t1 = fmin(t1, tmax);
+    if (!(t0 < t1)) return 0;
+    /* move the origin into the box, unit direction */
+    double s = v3_len(d);
+    vec3 e = v3_scale(d, 1.0 / s), p = v3_madd(o, d, t0);
+    double L = (t1 - t0) * s;
+    /* split where a coordinate changes sign (the function's kinks) */
+    double cuts[5];
+    int nc = 0;
+    cuts[nc++] = 0.0;
+    double zs[3];
+    int nz = 0;
+    for (int i = 0; i < 3; i++) {
+        double ei = comp3(e, i);
+        if (ei != 0.0) {
+            double z = -comp3(p, i) / ei;
+            if (z > 0.0 && z < L) zs[nz++] = z;
+        }
+    }
+    for (int i = 0; i < nz; i++)
+        for (int j = i + 1; j < nz; j++)
+            if (zs[j] < zs[i]) { double t = zs[i]; zs[i] = zs[j]; zs[j] = t; }
+    for (int i = 0; i < nz; i++) cuts[nc++] = zs[i];
+    cuts[nc++] = L;
+    double roots[64];
+    int nr = 0;
+    if (m->convex) {
+        /* convex along the ray: at most two crossings; a norm is smooth
+         * enough across the kinks for the bracket search on the whole range */
+        nr = se_piece(m, p, e, 0.0, L, roots, nr);
+    } else {
+        for (int c = 0; c + 1 < nc && nr < 56; c++) {
+            const int N = 24;
+            double a = cuts[c], b = cuts[c + 1];
+            double prev = a, gprev = se_g(m, p, e, a);
+            for (int k = 1; k <= N && nr < 56; k++) {
+                double x = a + (b - a) * k / N, gx = se_g(m, p, e, x);
+                if ((gprev < 0.0) != (gx < 0.0)) roots[nr++] = se_root(m, p, e, prev, x, gprev, gx);
+                prev = x;
+                gprev = gx;
+            }
+        }
+    }
+    int n = 0;
+    for (int i = 0; i < nr; i++) {
+        double t = t0 + roots[i] / s;
+        if (t > tmin && t < tmax) n = put_hit(out, n, max, t, 0);
+    }
+    return n;
+}
+
+/* ------------------------------------------------------------ quadric */
+
+static double quadric_eval(const double *a, vec3 p)
+{
+    return a[0] * p.x * p.x + a[1] * p.y * p.y + a[2] * p.z * p.z + a[3] * p.x * p.y + a[4] * p.x * p.z +
+           a[5] * p.y * p.z + a[6] * p.x + a[7] * p.y + a[8] * p.z + a[9];
+}
+
+static vec3 quadric_grad(const double *a, vec3 p)
+{
+    return v3(2.0 * a[0] * p.x + a[3] * p.y + a[4] * p.z + a[6], 2.0 * a[1] * p.y + a[3] * p.x + a[5] * p.z + a[7],
+              2.0 * a[2] * p.z + a[4] * p.x + a[5] * p.y + a[8]);
+}
+
+static int quadric_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+{
+    if (!isfinite(tmin)) tmin = -1e300;
+    double t0 = tmin;
+    if (!isfinite(tmax)) return 0; /* unbounded ranges come clipped by accel_shapes */
+    double s = v3_len(d);
+    vec3 e = v3_scale(d, 1.0 / s), p = v3_madd(o, d, t0);
+    const double *a = m->a;
+    double A = a[0] * e.x * e.x + a[1] * e.y * e.y + a[2] * e.z * e.z + a[3] * e.x * e.y + a[4] * e.x * e.z +
+               a[5] * e.y * e.z;
+    vec3 g = quadric_grad(a, p);
+    double B = v3_dot(g, e), C = quadric_eval(a, p);
+    double c[3] = {C, B, A}, roots[2];
+    int nr = accel_poly_solve(c, 2, 0.0, (tmax - t0) * s, roots, 0);
+    int n = 0;
+    for (int i = 0; i < nr; i++) {
+        double t = t0 + roots[i] / s;
+        if (t > tmin && t < tmax) n = put_hit(out, n, max, t, 0);
+    }
+    return n;
+}
+
+/* Bounds of an ellipsoidal quadric (positive definite form, negative value
+ * at the centre): centre -M^-1 g / 2, half extents sqrt(-k (M^-1)_ii). */
+static int quadric_bounds(im_data *m, vec3 *lo, vec3 *hi)
+{
+    const double *a = m->a;
+    double M[3][3] = {{a[0], 0.5 * a[3], 0.5 * a[4]}, {0.5 * a[3], a[1], 0.5 * a[5]}, {0.5 * a[4], 0.5 * a[5], a[2]}};
+    double d1 = M[0][0], d2 = M[0][0] * M[1][1] - M[0][1] * M[1][0];
+    double det = M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) - M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0]) +
+                 M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0]);
+    if (!(d1 > 0.0 && d2 > 0.0 && det > 0.0)) return 0;
+    double inv[3][3];
+    inv[0][0] = (M[1][1] * M[2][2] - M[1][2] * M[2][1]) / det;
+    inv[0][1] = (M[0][2] * M[2][1] - M[0][1] * M[2][2]) / det;
+    inv[0][2] = (M[0][1] * M[1][2] - M[0][2] * M[1][1]) / det;
+    inv[1][0] = inv[0][1];
+    inv[1][1] = (M[0][0] * M[2][2] - M[0][2] * M[2][0]) / det;
+    inv[1][2] = (M[0][2] * M[1][0] - M[0][0] * M[1][2]) / det;
+    inv[2][0] = inv[0][2];
+    inv[2][1] = inv[1][2];
+    inv[2][2] = (M[0][0] * M[1][1] - M[0][1] * M[1][0]) / det;
+    double g[3] = {a[6], a[7], a[8]}, c[3];
+    for (int i = 0; i < 3; i++) c[i] = -0.5 * (inv[i][0] * g[0] + inv[i][1] * g[1] + inv[i][2] * g[2]);
+    vec3 cv = v3(c[0], c[1], c[2]);
+    double k = quadric_eval(a, cv);
+    if (!(k < 0.0)) return -1; /* empty (or a single point) */
+    vec3 h = v3(sqrt(-k * inv[0][0]), sqrt(-k * inv[1][1]), sqrt(-k * inv[2][2]));
+    *lo = v3_sub(cv, h);
+    *hi = v3_add(cv, h);
+    return 1;
+}
+
+/* ------------------------------------------------------------ poly */
+
+static double ipow(double x, int n)
+{
+    double r = 1.0;
+    while (n > 0) {
+        if (n & 1) r *= x;
+        x *= x;
+        n >>= 1;
+    }
+    return r;
+}
+
+static double poly_eval3(const im_data *m, vec3 p)
+{
+    double xs[ACCEL_POLY_MAX + 1], ys[ACCEL_POLY_MAX + 1], zs[ACCEL_POLY_MAX + 1];
+    xs[0] = ys[0] = zs[0] = 1.0;
+    for (int i = 1; i <= m->order; i++) {
+        xs[i] = xs[i - 1] * p.x;
+        ys[i] = ys[i - 1] * p.y;
+        zs[i] = zs[i - 1] * p.z;
+    }
+    double f = 0.0;
+    for (int t = 0; t < m->nterms; t++)
+        if (m->coef[t] != 0.0) f += m->coef[t] * xs[m->pw[t][0]] * ys[m->pw[t][1]] * zs[m->pw[t][2]];
+    return f;
+}
+
+static vec3 poly_grad(const im_data *m, vec3 p)
+{
+    vec3 g = v3s(0.0);
+    for (int t = 0; t < m->nterms; t++) {
+        double c = m->coef[t];
+        if (c == 0.0) continue;
+        int i = m->pw[t][0], j = m->pw[t][1], k = m->pw[t][2];
+        double px = ipow(p.x, i), py = ipow(p.y, j), pz = ipow(p.z, k);
+        if (i) g.x += c * i * ipow(p.x, i - 1) * py * pz;
+        if (j) g.y += c * j * px * ipow(p.y, j - 1) * pz;
+        if (k) g.z += c * k * px * py * ipow(p.z, k - 1);
+    }
+    return g;
+}
+
+/* Coefficients of (a + b t)^i for i = 0..n: row i, entry j = C(i,j) a^(i-j) b^j. */
+static void lin_powers(double a, double b, int n, double P[][ACCEL_POLY_MAX + 1])
+{
+    P[0][0] = 1.0;
+    for (int i = 1; i <= n; i++) {
+        for (int j = 0; j <= i; j++) {
+            double v = 0.0;
+            if (j < i) v += P[i - 1][j] * a;
+            if (j > 0) v += P[i - 1][j - 1] * b;
+            P[i][j] = v;
+        }
+    }
+}
+
+static int poly_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+{
+    if (!isfinite(tmax) || !isfinite(tmin)) return 0;
+    double t0 = tmin;
+    double s = v3_len(d);
+    vec3 e = v3_scale(d, 1.0 / s), p = v3_madd(o, d, t0);
+    int n = m->order;
+    static _Thread_local double X[ACCEL_POLY_MAX + 1][ACCEL_POLY_MAX + 1], Y[ACCEL_POLY_MAX + 1][ACCEL_POLY_MAX + 1],
+        Z[ACCEL_POLY_MAX + 1][ACCEL_POLY_MAX + 1];
+    lin_powers(p.x, e.x, n, X);
+    lin_powers(p.y, e.y, n, Y);
+    lin_powers(p.z, e.z, n, Z);
+    double c[ACCEL_POLY_MAX + 1] = {0}, xy[2 * ACCEL_POLY_MAX + 1];
+    for (int t = 0; t < m->nterms; t++) {
+        double cf = m->coef[t];
+        if (cf == 0.0) continue;
+        int i = m->pw[t][0], j = m->pw[t][1], k = m->pw[t][2];
+        for (int a = 0; a <= i + j; a++) xy[a] = 0.0;
+        for (int a = 0; a <= i; a++)
+            for (int b = 0; b <= j; b++) xy[a + b] += X[i][a] * Y[j][b];
+        for (int a = 0; a <= i + j; a++)
+            for (int b = 0; b <= k; b++) c[a + b] += cf * xy[a] * Z[k][b];
+    }
+    double roots[ACCEL_POLY_MAX];
+    int nr = accel_poly_solve(c, n, 0.0, (tmax - t0) * s, roots, m->sturm);
+    int nh = 0;
+    for (int i = 0; i < nr; i++) {
+        double t = t0 + roots[i] / s;
+        if (t > tmin && t < tmax) nh = put_hit(out, nh, max, t, 0);
+    }
+    return nh;
+}
+
+/* ------------------------------------------------------------ blob */
+
+/* One reach interval of a component along the local ray p + tau e, with
+ * the quadratic d^2(tau) = q0 + q1 tau + q2 tau^2 (component space). */
+typedef struct {
+    double a, b;
+    double q[3];
+    double r2, s;
+} blob_span;
+
+/* Quadratic |o + tau d - c|^2 and, for a cylinder body, distance to the
+ * axis line; spans where the component reaches (d^2 < r^2). */
+static int blob_spans(const blob_comp *c, vec3 p, vec3 e, double ta, double tb, blob_span *sp)
+{
+    vec3 oc = xform_inv_point(&c->x, p), dc = xform_inv_vector(&c->x, e);
+    int n = 0;
+    /* sphere (or a cylinder's end caps): distance to a point */
+    for (int end = 0; end < (c->cylinder ? 2 : 1); end++) {
+        vec3 ctr = end ? v3_madd(c->a, c->axis, c->len) : c->a;
+        vec3 rel = v3_sub(oc, ctr);
+        double q2 = v3_dot(dc, dc), q1 = 2.0 * v3_dot(rel, dc), q0 = v3_dot(rel, rel);
+        double qc[3] = {q0 - c->r2, q1, q2}, r[2];
+        if (accel_poly_solve(qc, 2, -INFINITY, INFINITY, r, 0) < 2) continue;
+        double a = r[0], b = r[1];
+        if (c->cylinder) {
+            /* hemispheres: the part beyond the end along the axis */
+            double w0 = v3_dot(rel, c->axis), w1 = v3_dot(dc, c->axis);
+            /* end 0: w < 0; end 1: w > 0 (w measured from this end) */
+            if (w1 != 0.0) {
+                double tw = -w0 / w1;
+                int below_after = end == 0 ? (w1 < 0.0) : (w1 > 0.0); /* the cap side is reached after tw */
+                if (below_after) a = fmax(a, tw);
+                else b = fmin(b, tw);
+            } else if ((end == 0 && w0 >= 0.0) || (end == 1 && w0 <= 0.0)) {
+                continue;
+            }
+        }
+        a = fmax(a, ta);
+        b = fmin(b, tb);
+        if (!(a < b)) continue;
+        sp[n].a = a;
+        sp[n].b = b;
+        sp[n].q[0] = q0;
+        sp[n].q[1] = q1;
+        sp[n].q[2] = q2;
+        sp[n].r2 = c->r2;
+        sp[n].s = c->s;
+        n++;
+    }
+    if (c->cylinder) {
+        /* body: distance to the axis line while 0 <= w <= len */
+        vec3 rel = v3_sub(oc, c->a);
+        double w0 = v3_dot(rel, c->axis), w1 = v3_dot(dc, c->axis);
+        vec3 pr = v3_madd(rel, c->axis, -w0), dr = v3_madd(dc, c->axis, -w1);
+        double q2 = v3_dot(dr, dr), q1 = 2.0 * v3_dot(pr, dr), q0 = v3_dot(pr, pr);
+        double a, b;
+        if (q2 > 0.0) {
+            double qc[3] = {q0 - c->r2, q1, q2}, r[2];
+            if (accel_poly_solve(qc, 2, -INFINITY, INFINITY, r, 0) < 2) return n;
+            a = r[0];
+            b = r[1];
+        } else {
+            if (q0 >= c->r2) return n;
+            a = -INFINITY;
+            b = INFINITY;
+        }
+        if (w1 != 0.0) {
+            double x = -w0 / w1, y = (c->len - w0) / w1;
+            if (x > y) { double t = x; x = y; y = t; }
+            a = fmax(a, x);
+            b = fmin(b, y);
+        } else if (w0 < 0.0 || w0 > c->len) {
+            return n;
+        }
+        a = fmax(a, ta);
+        b = fmin(b, tb);
+        if (a < b) {
+            sp[n].a = a;
+            sp[n].b = b;
+            sp[n].q[0] = q0;
+            sp[n].q[1] = q1;
+            sp[n].q[2] = q2;
+            sp[n].r2 = c->r2;
+            sp[n].s = c->s;
+            n++;
+        }
+    }
+    return n;
+}
+
+typedef struct {
+    double t;
+    int span, enter;
+} blob_event;
+
+static int cmp_event(const void *x, const void *y)
+{
+    const blob_event *a = x, *b = y;
+    return a->t < b->t ? -1 : (a->t > b->t);
+}
+
+static int blob_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+{
+    double b0, b1;
+    if (!slab3(o, d, m->blo, m->bhi, &b0, &b1)) return 0;
+    double t0 = fmax(tmin, b0), t1 = fmin(tmax, b1);
+    if (!(t0 < t1)) return 0;
+    double s = v3_len(d);
+    vec3 e = v3_scale(d, 1.0 / s), p = v3_madd(o, d, t0);
+    double L = (t1 - t0) * s;
+    blob_span local[64];
+    blob_span *sp = local;
+    size_t need = (size_t)m->ncomp * 3;
+    if (need > 64) {
+        sp = malloc(need * sizeof *sp);
+        if (!sp) return 0;
+    }
+    int ns = 0;
+    for (int i = 0; i < m->ncomp; i++) ns += blob_spans(&m->comp[i], p, e, 0.0, L, sp + ns);
+    int n = 0;
+    if (ns > 0) {
+        blob_event lev[128];
+        blob_event *ev = 2 * (size_t)ns > 128 ? malloc(sizeof *ev * 2 * (size_t)ns) : lev;
+        int *active = malloc(sizeof *active * (size_t)ns);
+        if (ev && active) {
+            for (int i = 0; i < ns; i++) {
+                ev[2 * i] = (blob_event){sp[i].a, i, 1};
+                ev[2 * i + 1] = (blob_event){sp[i].b, i, 0};
+            }
+            qsort(ev, 2 * (size_t)ns, sizeof *ev, cmp_event);
+            int na = 0;
+            for (int k = 0; k + 1 < 2 * ns; k++) {
+                if (ev[k].enter) active[na++] = ev[k].span;
+                else
+                    for (int j = 0; j < na; j++)
+                        if (active[j] == ev[k].span) { active[j] = active[--na]; break; }
+                double a = ev[k].t, b = ev[k + 1].t;
+                if (!(b > a) || na == 0) continue;
+                /* field - threshold as a quartic in tau */
+                double c[5] = {-m->threshold, 0, 0, 0, 0};
+                for (int j = 0; j < na; j++) {
+                    const blob_span *q = &sp[active[j]];
+                    /* s (1 - d^2/r^2)^2 with u = 1 - d^2/r^2 = u0 + u1 tau + u2 tau^2 */
+                    double u0 = 1.0 - q->q[0] / q->r2, u1 = -q->q[1] / q->r2, u2 = -q->q[2] / q->r2;
+                    c[0] += q->s * u0 * u0;
+                    c[1] += q->s * 2.0 * u0 * u1;
+                    c[2] += q->s * (u1 * u1 + 2.0 * u0 * u2);
+                    c[3] += q->s * 2.0 * u1 * u2;
+                    c[4] += q->s * u2 * u2;
+                }
+                double roots[4];
+                int nr = accel_poly_solve(c, 4, a, b, roots, m->sturm);
+                for (int i = 0; i < nr; i++) {
+                    double t = t0 + roots[i] / s;
+                    if (t > tmin && t < tmax) n = put_hit(out, n, max, t, 0);
+                }
+            }
+        }
+        if (ev != lev) free(ev);
+        free(active);
+    }
+    if (sp != local) free(sp);
+    return n;
+}
+
+/* Field of component c at blob-space point q, and its blob-space gradient. */
+static double blob_comp_field(const blob_comp *c, vec3 q, vec3 *grad)
+{
+    vec3 pc = xform_inv_point(&c->x, q), rel = v3_sub(pc, c->a), dv;
+    if (c->cylinder) {
+        double w = v3_dot(rel, c->axis);
+        if (w < 0.0) dv = rel;
+        else if (w > c->len) dv = v3_sub(pc, v3_madd(c->a, c->axis, c->len));
+        else dv = v3_madd(rel, c->axis, -w);
+    } else {
+        dv = rel;
+    }
+    double d2 = v3_dot(dv, dv);
+    if (grad) *grad = v3s(0.0);
+    if (d2 >= c->r2) return 0.0;
+    double u = 1.0 - d2 / c->r2;
+    if (grad) {
+        /* d/dp of s u^2 = s 2 u (-2 dv / r2), to blob space by the inverse transpose */
+        vec3 g = v3_scale(dv, -4.0 * c->s * u / c->r2);
+        *grad = xform_normal(&c->x, g);
+    }
+    return c->s * u * u;
+}
+
+static double blob_field(const im_data *m, vec3 q, vec3 *grad)
+{
+    double f = 0.0;
+    vec3 g = v3s(0.0);
+    for (int i = 0; i < m->ncomp; i++) {
+        vec3 gi;
+        f += blob_comp_field(&m->comp[i], q, grad ? &gi : NULL);
+        if (grad) g = v3_add(g, gi);
+    }
+    if (grad) *grad = g;
+    return f;
+}
+
+static int blob_setup(im_data *m, const scene_blob *b, vec3 *lo, vec3 *hi)
+{
+    if (!b || b->ncomponents <= 0) return -1;
+    m->comp = calloc((size_t)b->ncomponents, sizeof *m->comp);
+    if (!m->comp) return -1;
+    m->threshold = b->threshold;
+    vec3 blo = v3s(INFINITY), bhi = v3s(-INFINITY);
+    for (int i = 0; i < b->ncomponents; i++) {
+        const scene_blob_component *sc = &b->components[i];
+        blob_comp *c = &m->comp[m->ncomp];
+        double r = fabs(sc->radius);
+        if (!(r > 0.0) || !isfinite(r) || !isfinite(sc->strength) || sc->strength == 0.0) continue;
+        c->cylinder = sc->cylinder;
+        c->x = sc->transform;
+        c->a = sc->a;
+        c->r2 = r * r;
+        c->s = sc->strength;
+        c->tex = sc->texture;
+        vec3 clo = v3_sub(sc->a, v3s(r)), chi = v3_add(sc->a, v3s(r));
+        if (sc->cylinder) {
+            vec3 ax = v3_sub(sc->b, sc->a);
+            c->len = v3_len(ax);
+            if (!(c->len > 0.0)) continue;
+            c->axis = v3_scale(ax, 1.0 / c->len);
+            clo = v3_min(clo, v3_sub(sc->b, v3s(r)));
+            chi = v3_max(chi, v3_add(sc->b, v3s(r)));
+        }
+        m->ncomp++;
+        if (c->s <= 0.0 && m->threshold > 0.0) continue; /* cannot make surface on its own */
+        for (int k = 0; k < 8; k++) {
+            vec3 pk = v3(k & 1 ? chi.x : clo.x, k & 2 ? chi.y : clo.y, k & 4 ? chi.z : clo.z);
+            vec3 w = xform_point(&c->x, pk);
+            blo = v3_min(blo, w);
+            bhi = v3_max(bhi, w);
+        }
+    }
+    if (m->ncomp == 0 || !(blo.x <= bhi.x)) return -1;
+    if (!(m->threshold > 0.0)) {
+        /* threshold <= 0: the surface can lie anywhere the field is
+         * positive... or everywhere (0 > threshold far away); keep the
+         * components' reach and report the solid as unbounded */
+        m->solid_bounded = 0;
+    } else {
+        m->solid_bounded = 1;
+    }
+    m->blo = blo;
+    m->bhi = bhi;
+    *lo = blo;
+    *hi = bhi;
+    return 0;
+}
+
+/* ------------------------------------------------------------ public */
+
+static const int *poly_powers_alloc(im_data *m, int order, int nterms)
+{
+    m->pw = malloc(sizeof *m->pw * (size_t)nterms);
+    if (!m->pw) return NULL;
+    int idx = 0;
+    for (int a = order; a >= 0; a--)
+        for (int b = order - a; b >= 0; b--)
+            for (int c = order - a - b; c >= 0; c--) {
+                if (idx < nterms) {
+                    m->pw[idx][0] = a;
+                    m->pw[idx][1] = b;
+                    m->pw[idx][2] = c;
+                }
+                idx++;
+            }
+    return idx == nterms ? &m->pw[0][0] : NULL;
+}
+
+int accel_implicit_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
+{
+    im_data *m = calloc(1, sizeof *m);
+    if (!m) return -1;
+    m->sturm = (o->flags & OBJ_STURM) != 0;
+    int st = -1;
+    switch (o->kind) {
+    case SHAPE_SUPERELLIPSOID: {
+        double e = o->u.superellipsoid.e, n = o->u.superellipsoid.n;
+        if (!(e > 0.0) || !(n > 0.0) || !isfinite(e) || !isfinite(n)) break;
+        m->type = IM_SUPER;
+        m->p = 2.0 / e;
+        m->q = 2.0 / n;
+        m->convex = e <= 2.0 && n <= 2.0;
+        m->solid_bounded = 1;
+        *lo = v3s(-1.0);
+        *hi = v3s(1.0);
+        st = 0;
+        break;
+    }
+    case SHAPE_QUADRIC: {
+        m->type = IM_QUADRIC;
+        memcpy(m->a, o->u.quadric.a, sizeof m->a);
+        int ok = 0;
+        for (int i = 0; i < 10; i++) {
+            if (!isfinite(m->a[i])) { ok = -1; break; }
+            if (i < 9 && m->a[i] != 0.0) ok = 1;
+        }
+        if (ok <= 0) break;
+        int b = quadric_bounds(m, lo, hi);
+        if (b < 0) break; /* empty */
+        if (b == 1) {
+            m->solid_bounded = 1;
+        } else {
+            *lo = v3s(-INFINITY);
+            *hi = v3s(INFINITY);
+            sh->infinite = 1;
+        }
+        st = 0;
+        break;
+    }
+    case SHAPE_POLY: {
+        const scene_poly *pl = o->u.poly;
+        if (!pl || pl->order < 1 || pl->order > ACCEL_POLY_MAX || !pl->coefs) break;
+        m->type = IM_POLY;
+        m->order = pl->order;
+        m->nterms = pl->ncoefs;
+        m->coef = pl->coefs;
+        if (!poly_powers_alloc(m, pl->order, pl->ncoefs)) break;
+        int any = 0;
+        for (int i = 0; i < pl->ncoefs; i++) {
+            if (!isfinite(pl->coefs[i])) { any = -1; break; }
+            if (pl->coefs[i] != 0.0 && i + 1 < pl->ncoefs) any = 1;
+        }
+        if (any <= 0) break;
+        *lo = v3s(-INFINITY);
+        *hi = v3s(INFINITY);
+        sh->infinite = 1;
+        st = 0;
+        break;
+    }
+    case SHAPE_BLOB:
+        m->type = IM_BLOB;
+        st = blob_setup(m, o->u.blob, lo, hi);
+        break;
+    default:
+        break;
+    }
+    if (st != 0) {
+        accel_implicit_free(m);
+        return -1;
+    }
+    sh->data = m;
+    return 0;
+}
+
+void accel_implicit_free(void *data)
+{
+    im_data *m = data;
+    if (!m) return;
+    free(m->pw);
+    free(m->comp);
+    free(m);
+}
+
+int accel_implicit_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out,
+                        int max)
+{
+    const im_data *m = sh->data;
+    if (!m || max <= 0) return 0;
+    switch (m->type) {
+    case IM_SUPER: return se_hits(m, o, d, tmin, tmax, out, max);
+    case IM_QUADRIC: return quadric_hits(m, o, d, tmin, tmax, out, max);
+    case IM_POLY: return poly_hits(m, o, d, tmin, tmax, out, max);
+    default: return blob_hits(m, o, d, tmin, tmax, out, max);
+    }
+}
+
+int accel_implicit_inside(const accel_shape *sh, vec3 q)
+{
+    const im_data *m = sh->data;
+    if (!m) return 0;
+    switch (m->type) {
+    case IM_SUPER: return se_norm(m, q, NULL) < 1.0;
+    case IM_QUADRIC: return quadric_eval(m->a, q) < 0.0;
+    case IM_POLY: return poly_eval3(m, q) < 0.0;
+    default: return blob_field(m, q, NULL) > m->threshold;
+    }
+}
+
+vec3 accel_implicit_normal(const accel_shape *sh, vec3 q)
+{
+    const im_data *m = sh->data;
+    if (!m) return v3(0, 1, 0);
+    switch (m->type) {
+    case IM_SUPER: return se_grad(m, q);
+    case IM_QUADRIC: return quadric_grad(m->a, q);
+    case IM_POLY: return poly_grad(m, q);
+    default: {
+        vec3 g;
+        blob_field(m, q, &g);
+        return v3_neg(g);
+    }
+    }
+}
+
+int accel_implicit_solid_bounded(const accel_shape *sh)
+{
+    const im_data *m = sh->data;
+    return m && m->solid_bounded;
+}
+
+const scene_texture *accel_blob_texture(const accel_shape *sh, vec3 q)
+{
+    const im_data *m = sh->data;
+    if (!m || m->type != IM_BLOB) return NULL;
+    double best = 0.0;
+    const scene_texture *t = NULL;
+    int any = 0;
+    for (int i = 0; i < m->ncomp; i++) {
+        if (m->comp[i].tex) any = 1;
+        double f = blob_comp_field(&m->comp[i], q, NULL);
+        if (f > best) {
+            best = f;
+            t = m->comp[i].tex;
+        }
+    }
+    return any ? t : NULL;
+}

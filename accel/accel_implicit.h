@@ -1,0 +1,39 @@
+/* accel_implicit.h - shapes given by a function f(p) whose sign is the
+ * inside test, intersected in double precision in object space:
+ *   superellipsoid  ((|x|^(2/e) + |y|^(2/e))^(e/n) + |z|^(2/n))^(n/2) - 1
+ *                   (POV-Ray's function raised to the power n/2, which
+ *                   keeps its zero set and sign and makes it homogeneous of
+ *                   degree 1, so its slope along a ray is O(1))
+ *   quadric         A x2 + B y2 + C z2 + D xy + E xz + F yz + G x + H y + I z + J
+ *   poly            sum of the POV-Ray terms (orders 2..35)
+ *   blob            threshold - sum of strength (1 - (d/r)^2)^2 over the
+ *                   components within reach (d: distance to a sphere's
+ *                   centre or a cylinder's axis segment, in the component's
+ *                   own space)
+ * Quadric, poly and blob are polynomials along a ray (degree 2, order, and 4
+ * between consecutive component boundaries), solved with accel_poly
+ * (`sturm` honoured); the superellipsoid is convex for e, n <= 2, where its
+ * two crossings are bracketed around the minimum along the ray, and sampled
+ * finely otherwise. Inside means f < 0. */
+#ifndef PT_ACCEL_IMPLICIT_H
+#define PT_ACCEL_IMPLICIT_H
+#include "accel_shapes.h"
+
+/* Set up sh from o (kinds SHAPE_SUPERELLIPSOID, QUADRIC, POLY, BLOB);
+ * object-space bounds in lo/hi, infinite components for unbounded
+ * surfaces. May allocate sh->data. -1 when degenerate. */
+int accel_implicit_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
+void accel_implicit_free(void *data);
+/* Object-space ray o + t d, crossings with t in (tmin, tmax), ascending. */
+int accel_implicit_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out,
+                        int max);
+int accel_implicit_inside(const accel_shape *sh, vec3 q);
+/* Object-space gradient (outward normal, not unit). */
+vec3 accel_implicit_normal(const accel_shape *sh, vec3 q);
+/* 1 when the inside is bounded by the shape's own box. */
+int accel_implicit_solid_bounded(const accel_shape *sh);
+/* Blob: the texture of the component contributing most at q (object
+ * space), NULL when the blob's own texture applies. */
+const scene_texture *accel_blob_texture(const accel_shape *sh, vec3 q);
+
+#endif

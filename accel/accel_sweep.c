@@ -1,0 +1,1060 @@
+/* accel_sweep.c - lathe, sor, prism, text and polygon (accel_sweep.h).
+ *
+ * Conditioning: every shape is moved to local coordinates q' = (q - c) / L
+ * (c the centre of its extent, L its size; conic prisms keep their apex at
+ * the origin) and a ray's origin is moved to where it enters the padded
+ * bounding box, with a unit direction, so the polynomial coefficients are
+ * O(1) whatever the scale of the scene or the distance of the origin.
+ *
+ * Spline segments (POV-Ray's lathe.cpp/prism.cpp define the point roles):
+ *   linear     P0 -> P1:                      p = P0 + (P1 - P0) t
+ *   quadratic  P0 control, P1 -> P2:          p = P1 + (P2 - P0)/2 t + (P0/2 - P1 + P2/2) t^2
+ *   cubic      P0, P3 controls, P1 -> P2:     Catmull-Rom
+ *   Bezier     P0 -> P3 with P1, P2 controls: Bernstein form
+ * A lathe uses consecutive points (segments n-1, n-2, n-3, n/4); a prism
+ * steps over the point that closes each sub-curve (the closing rules are in
+ * parser/sdl_shape.c). A sor segment i fits r^2 as a cubic in y through
+ * P[i+1] and P[i+2] with the slopes of the chords P[i]P[i+2] and
+ * P[i+1]P[i+3] (POV-Ray's sor.cpp Hermite conditions). */
+#include "accel_sweep.h"
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "accel_poly.h"
+
+#define TWO_PI 6.283185307179586476925
+#define T_SLACK 1e-9   /* roots this far outside [0,1] still belong to a segment */
+#define FLAT_RAY 1e-5  /* |e.y| below this: the lathe's horizontal-ray method */
+
+enum { SW_LATHE, SW_SOR, SW_PRISM, SW_POLYGON };
+
+typedef struct {
+    double a[2], b[2], c[2], d[2]; /* p(t) = ((a t + b) t + c) t + d */
+    double e0[2], e1[2];           /* exact end points */
+    double lo[2], hi[2];           /* bounds over t in [0,1] */
+    int deg;                       /* 1 or 3 */
+    double out;                    /* outward 2-D normal = out * (p1', -p0') */
+} sw_seg;
+
+typedef struct {
+    double g[4];  /* r^2 = g(s), s = (y - y0) / (y1 - y0) in [0,1] */
+    double y0, y1;
+    double rmax2;
+} sor_seg;
+
+typedef struct {
+    int type;
+    int nseg;
+    sw_seg *seg;
+    sor_seg *sor;
+    double clo[2], chi[2];  /* curve bounds (local) */
+    vec3 c;                 /* object -> local: (q - c) / L */
+    double L;
+    vec3 blo, bhi;          /* local bounding box of the shape */
+    /* prism/text: local axes (u, w, v) = object components ax[0], ax[1], ax[2] */
+    int ax[3];
+    double h1, h2;          /* local sweep range */
+    int conic, open, sturm;
+    /* sor caps */
+    double base_r2, cap_r2;
+    /* polygon: object-space plane and in-plane frame */
+    vec3 pn, pu, pv, p0;
+} sw_data;
+
+/* ------------------------------------------------------------ small helpers */
+
+static int put_hit(accel_shape_hit *out, int n, int max, double t, int part)
+{
+    if (max <= 0) return 0;
+    if (n == max && !(t < out[n - 1].t)) return n;
+    int i = n < max ? n++ : n - 1;
+    while (i > 0 && out[i - 1].t > t) {
+        out[i] = out[i - 1];
+        i--;
+    }
+    out[i].t = t;
+    out[i].part = part;
+    return n;
+}
+
+static double comp(vec3 v, int i) { return i == 0 ? v.x : (i == 1 ? v.y : v.z); }
+
+static vec3 from_local_axes(const int ax[3], double u, double w, double v)
+{
+    double r[3];
+    r[ax[0]] = u;
+    r[ax[1]] = w;
+    r[ax[2]] = v;
+    return v3(r[0], r[1], r[2]);
+}
+
+static void seg_eval(const sw_seg *s, double t, double p[2], double dp[2])
+{
+    for (int k = 0; k < 2; k++) {
+        p[k] = ((s->a[k] * t + s->b[k]) * t + s->c[k]) * t + s->d[k];
+        if (dp) dp[k] = (3.0 * s->a[k] * t + 2.0 * s->b[k]) * t + s->c[k];
+    }
+}
+
+static void seg_poly(const sw_seg *s, int k, double c[4])
+{
+    c[0] = s->d[k];
+    c[1] = s->c[k];
+    c[2] = s->b[k];
+    c[3] = s->a[k];
+}
+
+/* Segment from the four power-basis vectors and its exact end points. */
+static void seg_set(sw_seg *s, const double a[2], const double b[2], const double c[2], const double d[2],
+                    const double *e0, const double *e1, int deg)
+{
+    memset(s, 0, sizeof *s);
+    for (int k = 0; k < 2; k++) {
+        s->a[k] = a[k];
+        s->b[k] = b[k];
+        s->c[k] = c[k];
+        s->d[k] = d[k];
+        s->e0[k] = e0[k];
+        s->e1[k] = e1[k];
+    }
+    s->deg = deg;
+    for (int k = 0; k < 2; k++) {
+        double lo = fmin(e0[k], e1[k]), hi = fmax(e0[k], e1[k]);
+        if (deg > 1) {
+            double dc[3] = {c[k], 2.0 * b[k], 3.0 * a[k]}, r[2];
+            int nr = accel_poly_solve(dc, 2, 0.0, 1.0, r, 0);
+            for (int i = 0; i < nr; i++) {
+                double p[2];
+                seg_eval(s, r[i], p, NULL);
+                lo = fmin(lo, p[k]);
+                hi = fmax(hi, p[k]);
+            }
+        }
+        s->lo[k] = lo;
+        s->hi[k] = hi;
+    }
+    s->out = 1.0;
+}
+
+/* Segment `type` from points P (P[0..3] as the spline rule needs). */
+static void seg_from_points(sw_seg *s, scene_spline type, const double (*P)[2])
+{
+    double a[2], b[2], c[2], d[2];
+    const double *e0, *e1;
+    int deg = 3;
+    for (int k = 0; k < 2; k++) {
+        switch (type) {
+        case SPLINE_LINEAR:
+            a[k] = b[k] = 0.0;
+            c[k] = P[1][k] - P[0][k];
+            d[k] = P[0][k];
+            break;
+        case SPLINE_QUADRATIC:
+            a[k] = 0.0;
+            b[k] = 0.5 * P[0][k] - P[1][k] + 0.5 * P[2][k];
+            c[k] = -0.5 * P[0][k] + 0.5 * P[2][k];
+            d[k] = P[1][k];
+            break;
+        case SPLINE_CUBIC:
+            a[k] = -0.5 * P[0][k] + 1.5 * P[1][k] - 1.5 * P[2][k] + 0.5 * P[3][k];
+            b[k] = P[0][k] - 2.5 * P[1][k] + 2.0 * P[2][k] - 0.5 * P[3][k];
+            c[k] = -0.5 * P[0][k] + 0.5 * P[2][k];
+            d[k] = P[1][k];
+            break;
+        default: /* Bezier */
+            a[k] = -P[0][k] + 3.0 * P[1][k] - 3.0 * P[2][k] + P[3][k];
+            b[k] = 3.0 * P[0][k] - 6.0 * P[1][k] + 3.0 * P[2][k];
+            c[k] = -3.0 * P[0][k] + 3.0 * P[1][k];
+            d[k] = P[0][k];
+            break;
+        }
+    }
+    switch (type) {
+    case SPLINE_LINEAR: e0 = P[0]; e1 = P[1]; deg = 1; break;
+    case SPLINE_QUADRATIC: e0 = P[1]; e1 = P[2]; break;
+    case SPLINE_CUBIC: e0 = P[1]; e1 = P[2]; break;
+    default: e0 = P[0]; e1 = P[3]; break;
+    }
+    seg_set(s, a, b, c, d, e0, e1, deg);
+}
+
+/* ------------------------------------------------------------ 2-D inside test */
+
+/* Crossings, in +u direction from (u, v), of segment s: each monotonic
+ * piece of p_v between the exact end values counts when v lies in it
+ * (half-open: a value equal to v counts as above) and the crossing is at
+ * u' >= u. */
+static int seg_crossings(const sw_seg *s, double u, double v)
+{
+    if (v < s->lo[1] || v > s->hi[1] || u > s->hi[0]) return 0;
+    if (s->deg == 1) {
+        int a = s->e0[1] >= v, b = s->e1[1] >= v;
+        if (a == b) return 0;
+        double t = (v - s->e0[1]) / (s->e1[1] - s->e0[1]);
+        double x = s->e0[0] + t * (s->e1[0] - s->e0[0]);
+        return x >= u;
+    }
+    double pv[4];
+    seg_poly(s, 1, pv);
+    pv[0] -= v;
+    double dc[3] = {pv[1], 2.0 * pv[2], 3.0 * pv[3]}, crit[2];
+    int nc = accel_poly_solve(dc, 2, 0.0, 1.0, crit, 0);
+    double ts[4];
+    int m = 0;
+    ts[m++] = 0.0;
+    for (int i = 0; i < nc; i++)
+        if (crit[i] > ts[m - 1] && crit[i] < 1.0) ts[m++] = crit[i];
+    ts[m++] = 1.0;
+    int count = 0;
+    for (int j = 0; j + 1 < m; j++) {
+        double fa = j == 0 ? s->e0[1] - v : accel_poly_eval(pv, 3, ts[j]);
+        double fb = j + 2 == m ? s->e1[1] - v : accel_poly_eval(pv, 3, ts[j + 1]);
+        if ((fa >= 0.0) == (fb >= 0.0)) continue;
+        /* one crossing in the monotonic piece: bisection */
+        double lo = ts[j], hi = ts[j + 1], flo = fa;
+        for (int it = 0; it < 60 && hi - lo > 1e-15; it++) {
+            double mid = 0.5 * (lo + hi), fm = accel_poly_eval(pv, 3, mid);
+            if ((fm >= 0.0) == (flo >= 0.0)) { lo = mid; flo = fm; } else hi = mid;
+        }
+        double p[2];
+        seg_eval(s, 0.5 * (lo + hi), p, NULL);
+        if (p[0] >= u) count++;
+    }
+    return count;
+}
+
+static int in_curve(const sw_data *w, double u, double v)
+{
+    if (u < w->clo[0] || u > w->chi[0] || v < w->clo[1] || v > w->chi[1]) return 0;
+    int n = 0;
+    for (int i = 0; i < w->nseg; i++) n += seg_crossings(&w->seg[i], u, v);
+    return n & 1;
+}
+
+/* Closest parameter on segment s to the 2-D point q. */
+static double seg_closest(const sw_seg *s, const double q[2])
+{
+    double best = 0.0, bd = INFINITY;
+    for (int i = 0; i <= 16; i++) {
+        double t = i / 16.0, p[2];
+        seg_eval(s, t, p, NULL);
+        double d = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]);
+        if (d < bd) { bd = d; best = t; }
+    }
+    double t = best;
+    for (int it = 0; it < 20; it++) {
+        double p[2], dp[2];
+        seg_eval(s, t, p, dp);
+        double dd[2] = {6.0 * s->a[0] * t + 2.0 * s->b[0], 6.0 * s->a[1] * t + 2.0 * s->b[1]};
+        double r0 = p[0] - q[0], r1 = p[1] - q[1];
+        double g = r0 * dp[0] + r1 * dp[1];
+        double h = dp[0] * dp[0] + dp[1] * dp[1] + r0 * dd[0] + r1 * dd[1];
+        if (!(h > 0.0)) break;
+        double tn = t - g / h;
+        tn = tn < 0.0 ? 0.0 : (tn > 1.0 ? 1.0 : tn);
+        if (fabs(tn - t) < 1e-15) { t = tn; break; }
+        t = tn;
+    }
+    return t;
+}
+
+/* Outward 2-D normal of segment s at t (not unit). */
+static void seg_normal(const sw_seg *s, double t, double n[2])
+{
+    double p[2], dp[2];
+    seg_eval(s, t, p, dp);
+    if (dp[0] == 0.0 && dp[1] == 0.0) { /* a cusp: the chord's normal */
+        dp[0] = s->e1[0] - s->e0[0];
+        dp[1] = s->e1[1] - s->e0[1];
+    }
+    n[0] = s->out * dp[1];
+    n[1] = -s->out * dp[0];
+}
+
+/* Orient every segment's normal away from the region (mid-point test). */
+static void orient_segments(sw_data *w)
+{
+    double ext = fmax(w->chi[0] - w->clo[0], w->chi[1] - w->clo[1]);
+    for (int i = 0; i < w->nseg; i++) {
+        sw_seg *s = &w->seg[i];
+        double p[2], n[2];
+        s->out = 1.0;
+        seg_eval(s, 0.5, p, NULL);
+        seg_normal(s, 0.5, n);
+        double l = sqrt(n[0] * n[0] + n[1] * n[1]);
+        if (!(l > 0.0)) continue;
+        double delta = 1e-7 * ext;
+        if (in_curve(w, p[0] + delta * n[0] / l, p[1] + delta * n[1] / l)) s->out = -1.0;
+    }
+}
+
+static void curve_bounds(sw_data *w)
+{
+    w->clo[0] = w->clo[1] = INFINITY;
+    w->chi[0] = w->chi[1] = -INFINITY;
+    for (int i = 0; i < w->nseg; i++)
+        for (int k = 0; k < 2; k++) {
+            w->clo[k] = fmin(w->clo[k], w->seg[i].lo[k]);
+            w->chi[k] = fmax(w->chi[k], w->seg[i].hi[k]);
+        }
+}
+
+/* ------------------------------------------------------------ local rays */
+
+typedef struct {
+    vec3 o, e;     /* local origin (moved to the box entry) and unit direction */
+    double s, te;  /* t = te + tau / s */
+    double ta, tb; /* tau range */
+} lray;
+
+static int slab(vec3 o, vec3 d, vec3 lo, vec3 hi, double *t0, double *t1)
+{
+    double a = -INFINITY, b = INFINITY;
+    for (int i = 0; i < 3; i++) {
+        double oi = comp(o, i), di = comp(d, i), l = comp(lo, i), h = comp(hi, i);
+        if (di == 0.0) {
+            if (oi < l || oi > h) return 0;
+            continue;
+        }
+        double x = (l - oi) / di, y = (h - oi) / di;
+        if (x > y) { double t = x; x = y; y = t; }
+        if (x > a) a = x;
+        if (y < b) b = y;
+    }
+    if (!(a <= b)) return 0;
+    *t0 = a;
+    *t1 = b;
+    return 1;
+}
+
+static int make_lray(const sw_data *w, vec3 o, vec3 d, double tmin, double tmax, lray *r)
+{
+    vec3 lo = v3_scale(v3_sub(o, w->c), 1.0 / w->L), ld = v3_scale(d, 1.0 / w->L);
+    double s = v3_len(ld);
+    if (!(s > 0.0) || !isfinite(s)) return 0;
+    vec3 pad = v3s(0.01);
+    double b0, b1;
+    if (!slab(lo, ld, v3_sub(w->blo, pad), v3_add(w->bhi, pad), &b0, &b1)) return 0;
+    double t0 = fmax(tmin, b0), t1 = fmin(tmax, b1);
+    if (!(t0 < t1)) return 0;
+    r->te = t0;
+    r->s = s;
+    r->e = v3_scale(ld, 1.0 / s);
+    r->o = v3_madd(lo, ld, t0);
+    r->ta = 0.0;
+    r->tb = (t1 - t0) * s;
+    return 1;
+}
+
+static double lray_t(const lray *r, double tau) { return r->te + tau / r->s; }
+
+/* ------------------------------------------------------------ lathe */
+
+/* Newton on (t, tau): Y(t) = Py + tau ey, |Pxz + tau exz| = R(t). */
+static void lathe_polish(const sw_seg *s, const lray *r, double *pt, double *ptau)
+{
+    double t = *pt, tau = *ptau;
+    vec3 P = r->o, e = r->e;
+    for (int it = 0; it < 8; it++) {
+        double p[2], dp[2];
+        seg_eval(s, t, p, dp);
+        double x = P.x + tau * e.x, z = P.z + tau * e.z;
+        double f1 = p[1] - P.y - tau * e.y;
+        double f2 = x * x + z * z - p[0] * p[0];
+        double j11 = dp[1], j12 = -e.y, j21 = -2.0 * p[0] * dp[0], j22 = 2.0 * (x * e.x + z * e.z);
+        double det = j11 * j22 - j12 * j21;
+        if (!(fabs(det) > 0.0) || !isfinite(det)) break;
+        double dt = (f1 * j22 - f2 * j12) / det, dtau = (j11 * f2 - j21 * f1) / det;
+        if (!isfinite(dt) || !isfinite(dtau) || fabs(dt) > 0.1) break;
+        t -= dt;
+        tau -= dtau;
+        if (fabs(dt) < 1e-15 && fabs(dtau) < 1e-15 * (1.0 + fabs(tau))) break;
+    }
+    if (isfinite(t) && isfinite(tau) && t > -1e-6 && t < 1.0 + 1e-6) {
+        *pt = t;
+        *ptau = tau;
+    }
+}
+
+static int lathe_hits(const sw_data *w, const lray *r, double tmin, double tmax, accel_shape_hit *out, int n,
+                      int max)
+{
+    vec3 P = r->o, e = r->e;
+    double rxz = e.x * e.x + e.z * e.z, m = P.x * e.x + P.z * e.z, P2 = P.x * P.x + P.z * P.z;
+    for (int k = 0; k < w->nseg; k++) {
+        const sw_seg *s = &w->seg[k];
+        /* cull: the ray's y range and its distance from the axis there */
+        double ta = r->ta, tb = r->tb;
+        if (e.y != 0.0) {
+            double y0 = (s->lo[1] - P.y) / e.y, y1 = (s->hi[1] - P.y) / e.y;
+            if (y0 > y1) { double t = y0; y0 = y1; y1 = t; }
+            ta = fmax(ta, y0 - 1e-9);
+            tb = fmin(tb, y1 + 1e-9);
+        } else if (P.y < s->lo[1] - 1e-9 || P.y > s->hi[1] + 1e-9) {
+            continue;
+        }
+        if (!(ta <= tb)) continue;
+        double qa = P2 + 2.0 * m * ta + rxz * ta * ta, qb = P2 + 2.0 * m * tb + rxz * tb * tb;
+        double tv = rxz > 0.0 ? -m / rxz : ta, qmin = fmin(qa, qb);
+        if (tv > ta && tv < tb) qmin = fmin(qmin, P2 + 2.0 * m * tv + rxz * tv * tv);
+        double rh = s->hi[0] + 1e-9, rl = fmax(0.0, s->lo[0] - 1e-9);
+        if (qmin > rh * rh || fmax(qa, qb) < rl * rl) continue;
+
+        double Y[4], R[4];
+        seg_poly(s, 1, Y);
+        seg_poly(s, 0, R);
+        Y[0] -= P.y;
+        double cand_t[12], cand_tau[12];
+        int nc = 0;
+        if (fabs(e.y) > FLAT_RAY) {
+            /* G(t) = rxz Y^2 + 2 ey m Y + ey^2 (P2 - R^2) */
+            double G[7] = {0};
+            for (int i = 0; i < 4; i++)
+                for (int j = 0; j < 4; j++) {
+                    G[i + j] += rxz * Y[i] * Y[j];
+                    G[i + j] -= e.y * e.y * R[i] * R[j];
+                }
+            for (int i = 0; i < 4; i++) G[i] += 2.0 * e.y * m * Y[i];
+            G[0] += e.y * e.y * P2;
+            double roots[6];
+            int nr = accel_poly_solve(G, s->deg == 1 ? 2 : 6, -T_SLACK, 1.0 + T_SLACK, roots, w->sturm);
+            for (int i = 0; i < nr; i++) {
+                cand_t[nc] = roots[i];
+                cand_tau[nc] = accel_poly_eval(Y, 3, roots[i]) / e.y;
+                nc++;
+            }
+        } else {
+            /* nearly horizontal: heights first, then the circle at that height */
+            double roots[3];
+            int nr = accel_poly_solve(Y, s->deg == 1 ? 1 : 3, -T_SLACK, 1.0 + T_SLACK, roots, w->sturm);
+            for (int i = 0; i < nr && rxz > 0.0; i++) {
+                double p[2];
+                seg_eval(s, roots[i], p, NULL);
+                double tq[2];
+                double qc[3] = {P2 - p[0] * p[0], 2.0 * m, rxz};
+                int nq = accel_poly_solve(qc, 2, -INFINITY, INFINITY, tq, 0);
+                for (int j = 0; j < nq; j++) {
+                    cand_t[nc] = roots[i];
+                    cand_tau[nc] = tq[j];
+                    nc++;
+                }
+            }
+        }
+        for (int i = 0; i < nc; i++) {
+            double t = cand_t[i], tau = cand_tau[i];
+            lathe_polish(s, r, &t, &tau);
+            if (t < -T_SLACK || t > 1.0 + T_SLACK) continue;
+            double tt = lray_t(r, tau);
+            if (tt > tmin && tt < tmax) n = put_hit(out, n, max, tt, 2 + k);
+        }
+    }
+    return n;
+}
+
+/* ------------------------------------------------------------ sor */
+
+static int sor_hits(const sw_data *w, const lray *r, double tmin, double tmax, accel_shape_hit *out, int n, int max)
+{
+    vec3 P = r->o, e = r->e;
+    double rxz = e.x * e.x + e.z * e.z, m = P.x * e.x + P.z * e.z, P2 = P.x * P.x + P.z * P.z;
+    for (int k = 0; k < w->nseg; k++) {
+        const sor_seg *s = &w->sor[k];
+        double h = s->y1 - s->y0;
+        double ta = r->ta, tb = r->tb;
+        if (e.y != 0.0) {
+            double y0 = (s->y0 - P.y) / e.y, y1 = (s->y1 - P.y) / e.y;
+            if (y0 > y1) { double t = y0; y0 = y1; y1 = t; }
+            ta = fmax(ta, y0);
+            tb = fmin(tb, y1);
+        } else if (P.y < s->y0 || P.y > s->y1) {
+            continue;
+        }
+        if (!(ta <= tb)) continue;
+        double qa = P2 + 2.0 * m * ta + rxz * ta * ta, qb = P2 + 2.0 * m * tb + rxz * tb * tb;
+        double tv = rxz > 0.0 ? -m / rxz : ta, qmin = fmin(qa, qb);
+        if (tv > ta && tv < tb) qmin = fmin(qmin, P2 + 2.0 * m * tv + rxz * tv * tv);
+        if (qmin > s->rmax2 * (1.0 + 1e-9) + 1e-12) continue;
+        /* P2 + 2 m tau + rxz tau^2 - g(s0 + s1 tau) = 0 */
+        double s0 = (P.y - s->y0) / h, s1 = e.y / h;
+        double c[4] = {P2, 2.0 * m, rxz, 0.0};
+        double pw[4] = {1.0, 0, 0, 0}; /* (s0 + s1 tau)^i */
+        for (int i = 0; i < 4; i++) {
+            for (int j = 0; j <= i; j++) c[j] -= s->g[i] * pw[j];
+            double nw[4] = {0};
+            for (int j = 0; j <= i && j < 3; j++) {
+                nw[j] += pw[j] * s0;
+                nw[j + 1] += pw[j] * s1;
+            }
+            memcpy(pw, nw, sizeof pw);
+        }
+        double roots[3];
+        int nr = accel_poly_solve(c, 3, ta, tb, roots, w->sturm);
+        for (int i = 0; i < nr; i++) {
+            double tt = lray_t(r, roots[i]);
+            if (tt > tmin && tt < tmax) n = put_hit(out, n, max, tt, 2 + k);
+        }
+    }
+    if (!w->open && e.y != 0.0) {
+        double ycap[2] = {w->sor[0].y0, w->sor[w->nseg - 1].y1}, r2[2] = {w->base_r2, w->cap_r2};
+        for (int c = 0; c < 2; c++) {
+            if (!(r2[c] > 0.0)) continue;
+            double tau = (ycap[c] - P.y) / e.y;
+            double x = P.x + tau * e.x, z = P.z + tau * e.z;
+            if (x * x + z * z > r2[c]) continue;
+            double tt = lray_t(r, tau);
+            if (tt > tmin && tt < tmax) n = put_hit(out, n, max, tt, c);
+        }
+    }
+    return n;
+}
+
+static double sor_g(const sor_seg *s, double y, double *dg)
+{
+    double h = s->y1 - s->y0, t = (y - s->y0) / h;
+    if (dg) *dg = ((3.0 * s->g[3] * t + 2.0 * s->g[2]) * t + s->g[1]) / h;
+    return ((s->g[3] * t + s->g[2]) * t + s->g[1]) * t + s->g[0];
+}
+
+static int sor_segment_at(const sw_data *w, double y)
+{
+    int lo = 0, hi = w->nseg - 1;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (y > w->sor[mid].y1) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
+/* ------------------------------------------------------------ prism, text */
+
+/* Newton on (t, tau) for a prism side. */
+static void prism_polish(const sw_data *w, const sw_seg *s, double Pu, double Pw, double Pv, double eu, double ew,
+                         double ev, double *pt, double *ptau)
+{
+    double t = *pt, tau = *ptau;
+    for (int it = 0; it < 8; it++) {
+        double p[2], dp[2];
+        seg_eval(s, t, p, dp);
+        double sc = w->conic ? Pw + tau * ew : 1.0;
+        double f1 = Pu + tau * eu - sc * p[0], f2 = Pv + tau * ev - sc * p[1];
+        double j11 = eu - (w->conic ? ew * p[0] : 0.0), j12 = -sc * dp[0];
+        double j21 = ev - (w->conic ? ew * p[1] : 0.0), j22 = -sc * dp[1];
+        double det = j11 * j22 - j12 * j21;
+        if (!(fabs(det) > 0.0) || !isfinite(det)) break;
+        double dtau = (f1 * j22 - f2 * j12) / det, dt = (j11 * f2 - j21 * f1) / det;
+        if (!isfinite(dt) || !isfinite(dtau) || fabs(dt) > 0.1) break;
+        t -= dt;
+        tau -= dtau;
+        if (fabs(dt) < 1e-15 && fabs(dtau) < 1e-15 * (1.0 + fabs(tau))) break;
+    }
+    if (isfinite(t) && isfinite(tau) && t > -1e-6 && t < 1.0 + 1e-6) {
+        *pt = t;
+        *ptau = tau;
+    }
+}
+
+static int prism_hits(const sw_data *w, const lray *r, double tmin, double tmax, accel_shape_hit *out, int n,
+                      int max)
+{
+    double Pu = comp(r->o, w->ax[0]), Pw = comp(r->o, w->ax[1]), Pv = comp(r->o, w->ax[2]);
+    double eu = comp(r->e, w->ax[0]), ew = comp(r->e, w->ax[1]), ev = comp(r->e, w->ax[2]);
+    /* caps */
+    if (!w->open && ew != 0.0) {
+        double hh[2] = {w->h1, w->h2};
+        for (int c = 0; c < 2; c++) {
+            if (w->conic && hh[c] == 0.0) continue;
+            double tau = (hh[c] - Pw) / ew;
+            if (tau < r->ta - 1e-9 || tau > r->tb + 1e-9) continue;
+            double u = Pu + tau * eu, v = Pv + tau * ev;
+            if (w->conic) { u /= hh[c]; v /= hh[c]; }
+            if (!in_curve(w, u, v)) continue;
+            double tt = lray_t(r, tau);
+            if (tt > tmin && tt < tmax) n = put_hit(out, n, max, tt, c);
+        }
+    }
+    if (fabs(eu) < 1e-12 && fabs(ev) < 1e-12 && !w->conic) return n; /* along the sweep axis */
+    /* tau range where the ray is within the sweep heights */
+    double ta = r->ta, tb = r->tb;
+    if (ew != 0.0) {
+        double a = (w->h1 - Pw) / ew, b = (w->h2 - Pw) / ew;
+        if (a > b) { double t = a; a = b; b = t; }
+        ta = fmax(ta, a - 1e-9);
+        tb = fmin(tb, b + 1e-9);
+    } else if (Pw < w->h1 || Pw > w->h2) {
+        return n;
+    }
+    if (!(ta <= tb)) return n;
+    for (int k = 0; k < w->nseg; k++) {
+        const sw_seg *s = &w->seg[k];
+        if (!w->conic) {
+            /* cull by the segment's 2-D box against the 2-D ray over [ta, tb] */
+            double ua = Pu + ta * eu, ub = Pu + tb * eu, va = Pv + ta * ev, vb = Pv + tb * ev;
+            if (fmax(ua, ub) < s->lo[0] - 1e-9 || fmin(ua, ub) > s->hi[0] + 1e-9 || fmax(va, vb) < s->lo[1] - 1e-9 ||
+                fmin(va, vb) > s->hi[1] + 1e-9)
+                continue;
+        }
+        double X[4], Z[4], f[4];
+        seg_poly(s, 0, X);
+        seg_poly(s, 1, Z);
+        if (!w->conic) {
+            for (int i = 0; i < 4; i++) f[i] = ev * X[i] - eu * Z[i];
+            f[0] += eu * Pv - ev * Pu;
+        } else {
+            double cx = Pw * ev - Pv * ew, cz = Pu * ew - Pw * eu;
+            for (int i = 0; i < 4; i++) f[i] = cx * X[i] + cz * Z[i];
+            f[0] += Pv * eu - Pu * ev;
+        }
+        double roots[3];
+        int nr = accel_poly_solve(f, s->deg == 1 ? 1 : 3, -T_SLACK, 1.0 + T_SLACK, roots, w->sturm);
+        for (int i = 0; i < nr; i++) {
+            double t = roots[i], p[2];
+            seg_eval(s, t, p, NULL);
+            double tau;
+            if (!w->conic) {
+                tau = fabs(eu) >= fabs(ev) ? (p[0] - Pu) / eu : (p[1] - Pv) / ev;
+            } else {
+                double du = eu - ew * p[0], dv = ev - ew * p[1];
+                if (fabs(du) >= fabs(dv)) tau = (Pw * p[0] - Pu) / du;
+                else tau = (Pw * p[1] - Pv) / dv;
+            }
+            if (!isfinite(tau)) continue;
+            prism_polish(w, s, Pu, Pw, Pv, eu, ew, ev, &t, &tau);
+            double hw = Pw + tau * ew;
+            if (hw < w->h1 || hw > w->h2) continue;
+            double tt = lray_t(r, tau);
+            if (tt > tmin && tt < tmax) n = put_hit(out, n, max, tt, 2 + k);
+        }
+    }
+    return n;
+}
+
+/* ------------------------------------------------------------ polygon */
+
+static int polygon_hits(const sw_data *w, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+{
+    double den = v3_dot(w->pn, d);
+    if (den == 0.0) return 0;
+    double t = v3_dot(w->pn, v3_sub(w->p0, o)) / den;
+    if (!(t > tmin && t < tmax)) return 0;
+    vec3 q = v3_sub(v3_madd(o, d, t), w->p0);
+    if (!in_curve(w, v3_dot(q, w->pu) / w->L, v3_dot(q, w->pv) / w->L)) return 0;
+    return put_hit(out, 0, max, t, 2);
+}
+
+/* ------------------------------------------------------------ setup */
+
+static int alloc_segs(sw_data *w, int n)
+{
+    w->seg = calloc((size_t)(n > 0 ? n : 1), sizeof *w->seg);
+    return w->seg != NULL;
+}
+
+/* Normalised copy of 2-D points: ((p - c) / L). */
+static double (*norm_points(const double (*pts)[2], int n, double c0, double c1, double L))[2]
+{
+    double(*q)[2] = malloc(sizeof *q * (size_t)(n > 0 ? n : 1));
+    if (!q) return NULL;
+    for (int i = 0; i < n; i++) {
+        q[i][0] = (pts[i][0] - c0) / L;
+        q[i][1] = (pts[i][1] - c1) / L;
+    }
+    return q;
+}
+
+static void extent2(const double (*pts)[2], int n, double lo[2], double hi[2])
+{
+    lo[0] = lo[1] = INFINITY;
+    hi[0] = hi[1] = -INFINITY;
+    for (int i = 0; i < n; i++)
+        for (int k = 0; k < 2; k++) {
+            lo[k] = fmin(lo[k], pts[i][k]);
+            hi[k] = fmax(hi[k], pts[i][k]);
+        }
+}
+
+static int setup_lathe(sw_data *w, const scene_lathe *l)
+{
+    int n = l->npoints;
+    if (!l->points || n < 2) return -1;
+    double lo[2], hi[2];
+    extent2(l->points, n, lo, hi);
+    double L = fmax(fmax(fabs(lo[0]), fabs(hi[0])), hi[1] - lo[1]);
+    if (!(L > 0.0) || !isfinite(L)) return -1;
+    w->L = L;
+    w->c = v3(0.0, 0.5 * (lo[1] + hi[1]), 0.0);
+    double(*P)[2] = norm_points(l->points, n, 0.0, w->c.y, L);
+    if (!P) return -1;
+    int ns = l->spline == SPLINE_LINEAR ? n - 1 : l->spline == SPLINE_QUADRATIC ? n - 2 : l->spline == SPLINE_CUBIC ? n - 3 : n / 4;
+    if (ns < 1 || !alloc_segs(w, ns)) { free(P); return -1; }
+    for (int i = 0; i < ns; i++) seg_from_points(&w->seg[i], l->spline, P + (l->spline == SPLINE_BEZIER ? 4 * i : i));
+    free(P);
+    w->nseg = ns;
+    curve_bounds(w);
+    orient_segments(w);
+    double R = fmax(fabs(w->clo[0]), fabs(w->chi[0]));
+    w->blo = v3(-R, w->clo[1], -R);
+    w->bhi = v3(R, w->chi[1], R);
+    return 0;
+}
+
+static int setup_sor(sw_data *w, const scene_lathe *l)
+{
+    int n = l->npoints;
+    if (!l->points || n < 4) return -1;
+    double lo[2], hi[2];
+    extent2(l->points, n, lo, hi);
+    double L = fmax(hi[0], hi[1] - lo[1]);
+    if (!(L > 0.0) || !isfinite(L)) return -1;
+    w->L = L;
+    w->c = v3(0.0, 0.5 * (lo[1] + hi[1]), 0.0);
+    double(*P)[2] = norm_points(l->points, n, 0.0, w->c.y, L);
+    w->sor = calloc((size_t)(n - 3), sizeof *w->sor);
+    if (!P || !w->sor) { free(P); return -1; }
+    w->nseg = n - 3;
+    double rmax2 = 0.0, ylo = INFINITY, yhi = -INFINITY;
+    for (int i = 0; i < n - 3; i++) {
+        sor_seg *s = &w->sor[i];
+        double y0 = P[i + 1][1], y1 = P[i + 2][1], h = y1 - y0;
+        if (!(h > 0.0)) { free(P); return -1; }
+        double r0 = P[i + 1][0], r1 = P[i + 2][0];
+        double k0 = 2.0 * r0 * (P[i + 2][0] - P[i][0]) / (P[i + 2][1] - P[i][1]);
+        double k1 = 2.0 * r1 * (P[i + 3][0] - P[i + 1][0]) / (P[i + 3][1] - P[i + 1][1]);
+        /* Hermite in s: values r0^2, r1^2, slopes k0 h, k1 h */
+        double v0 = r0 * r0, v1 = r1 * r1, m0 = k0 * h, m1 = k1 * h;
+        s->g[0] = v0;
+        s->g[1] = m0;
+        s->g[2] = -3.0 * v0 + 3.0 * v1 - 2.0 * m0 - m1;
+        s->g[3] = 2.0 * v0 - 2.0 * v1 + m0 + m1;
+        s->y0 = y0;
+        s->y1 = y1;
+        double mx = fmax(v0, v1), dc[3] = {s->g[1], 2.0 * s->g[2], 3.0 * s->g[3]}, rr[2];
+        int nr = accel_poly_solve(dc, 2, 0.0, 1.0, rr, 0);
+        for (int j = 0; j < nr; j++) mx = fmax(mx, accel_poly_eval(s->g, 3, rr[j]));
+        s->rmax2 = mx;
+        rmax2 = fmax(rmax2, mx);
+        ylo = fmin(ylo, y0);
+        yhi = fmax(yhi, y1);
+    }
+    free(P);
+    w->base_r2 = fmax(0.0, w->sor[0].g[0]);
+    const sor_seg *last = &w->sor[w->nseg - 1];
+    w->cap_r2 = fmax(0.0, last->g[0] + last->g[1] + last->g[2] + last->g[3]);
+    double R = sqrt(rmax2);
+    w->blo = v3(-R, ylo, -R);
+    w->bhi = v3(R, yhi, R);
+    return 0;
+}
+
+/* Prism segments from the points with POV-Ray's sub-curve stepping. */
+static int prism_segments(sw_data *w, scene_spline sp, double (*P)[2], int n)
+{
+    if (!alloc_segs(w, n)) return -1;
+    int ns = 0;
+    if (sp == SPLINE_BEZIER) {
+        for (int i = 0; i + 3 < n; i += 4) seg_from_points(&w->seg[ns++], sp, P + i);
+    } else {
+        const double *first = sp == SPLINE_LINEAR ? P[0] : P[1];
+        for (int i = 0; i < n - 1; i++) {
+            int need = sp == SPLINE_LINEAR ? 1 : sp == SPLINE_QUADRATIC ? 2 : 3;
+            if (i + need >= n) break;
+            seg_from_points(&w->seg[ns++], sp, P + i);
+            int close_idx = sp == SPLINE_LINEAR ? i + 1 : i + 2;
+            if (fabs(P[close_idx][0] - first[0]) < 1e-10 && fabs(P[close_idx][1] - first[1]) < 1e-10) {
+                i += sp == SPLINE_LINEAR ? 1 : sp == SPLINE_QUADRATIC ? 2 : 3;
+                int next = sp == SPLINE_LINEAR ? i + 1 : i + 2;
+                if (next < n) first = P[next];
+            }
+        }
+    }
+    w->nseg = ns;
+    return ns > 0 ? 0 : -1;
+}
+
+static int setup_prism(sw_data *w, const scene_prism *pr)
+{
+    int n = pr->npoints;
+    if (!pr->points || n < 3) return -1;
+    w->ax[0] = 0; w->ax[1] = 1; w->ax[2] = 2;
+    w->conic = pr->conic;
+    double lo[2], hi[2];
+    extent2(pr->points, n, lo, hi);
+    double c0 = 0.0, c1 = 0.0, cw = 0.0, L;
+    if (pr->conic) {
+        L = fmax(fmax(fabs(pr->height1), fabs(pr->height2)), 1e-300);
+    } else {
+        c0 = 0.5 * (lo[0] + hi[0]);
+        c1 = 0.5 * (lo[1] + hi[1]);
+        cw = 0.5 * (pr->height1 + pr->height2);
+        L = fmax(fmax(hi[0] - lo[0], hi[1] - lo[1]), pr->height2 - pr->height1);
+    }
+    if (!(L > 0.0) || !isfinite(L)) return -1;
+    w->L = L;
+    w->c = v3(c0, cw, c1);
+    /* conic: the curve stays in its own units (it is scaled by the height) */
+    double(*P)[2] = pr->conic ? norm_points(pr->points, n, 0.0, 0.0, 1.0) : norm_points(pr->points, n, c0, c1, L);
+    if (!P) return -1;
+    int st = prism_segments(w, pr->spline, P, n);
+    free(P);
+    if (st) return -1;
+    w->h1 = (pr->height1 - cw) / L;
+    w->h2 = (pr->height2 - cw) / L;
+    if (!(w->h2 >= w->h1)) return -1;
+    curve_bounds(w);
+    orient_segments(w);
+    if (!pr->conic) {
+        w->blo = v3(w->clo[0], w->h1, w->clo[1]);
+        w->bhi = v3(w->chi[0], w->h2, w->chi[1]);
+    } else {
+        double xs[4] = {w->clo[0] * w->h1, w->clo[0] * w->h2, w->chi[0] * w->h1, w->chi[0] * w->h2};
+        double zs[4] = {w->clo[1] * w->h1, w->clo[1] * w->h2, w->chi[1] * w->h1, w->chi[1] * w->h2};
+        w->blo = v3(fmin(fmin(xs[0], xs[1]), fmin(xs[2], xs[3])), w->h1, fmin(fmin(zs[0], zs[1]), fmin(zs[2], zs[3])));
+        w->bhi = v3(fmax(fmax(xs[0], xs[1]), fmax(xs[2], xs[3])), w->h2, fmax(fmax(zs[0], zs[1]), fmax(zs[2], zs[3])));
+        /* the apex when the heights straddle 0 */
+        w->blo = v3_min(w->blo, v3(0, w->h1, 0));
+        w->bhi = v3_max(w->bhi, v3(0, w->h2, 0));
+    }
+    return 0;
+}
+
+static int setup_text(sw_data *w, const scene_text *tx)
+{
+    if (!tx->segments || tx->nsegments < 1 || !(tx->depth != 0.0)) return -1;
+    w->ax[0] = 0; w->ax[1] = 2; w->ax[2] = 1; /* curve in (x, y), swept along z */
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (int i = 0; i < tx->nsegments; i++)
+        for (int j = 0; j < 4; j++)
+            for (int k = 0; k < 2; k++) {
+                lo[k] = fmin(lo[k], tx->segments[i][2 * j + k]);
+                hi[k] = fmax(hi[k], tx->segments[i][2 * j + k]);
+            }
+    double z1 = fmin(0.0, tx->depth), z2 = fmax(0.0, tx->depth);
+    double L = fmax(fmax(hi[0] - lo[0], hi[1] - lo[1]), z2 - z1);
+    if (!(L > 0.0) || !isfinite(L)) return -1;
+    double c0 = 0.5 * (lo[0] + hi[0]), c1 = 0.5 * (lo[1] + hi[1]), cw = 0.5 * (z1 + z2);
+    w->L = L;
+    w->c = v3(c0, c1, cw);
+    if (!alloc_segs(w, tx->nsegments)) return -1;
+    for (int i = 0; i < tx->nsegments; i++) {
+        double P[4][2];
+        for (int j = 0; j < 4; j++) {
+            P[j][0] = (tx->segments[i][2 * j] - c0) / L;
+            P[j][1] = (tx->segments[i][2 * j + 1] - c1) / L;
+        }
+        /* a straight line stored as a cubic: keep it linear (exact crossings) */
+        double d1[2] = {P[1][0] - P[0][0] - (P[3][0] - P[0][0]) / 3.0, P[1][1] - P[0][1] - (P[3][1] - P[0][1]) / 3.0};
+        double d2[2] = {P[2][0] - P[0][0] - 2.0 * (P[3][0] - P[0][0]) / 3.0,
+                        P[2][1] - P[0][1] - 2.0 * (P[3][1] - P[0][1]) / 3.0};
+        if (fabs(d1[0]) + fabs(d1[1]) + fabs(d2[0]) + fabs(d2[1]) < 1e-12) {
+            double Q[2][2] = {{P[0][0], P[0][1]}, {P[3][0], P[3][1]}};
+            seg_from_points(&w->seg[i], SPLINE_LINEAR, Q);
+        } else {
+            seg_from_points(&w->seg[i], SPLINE_BEZIER, P);
+        }
+    }
+    w->nseg = tx->nsegments;
+    w->h1 = (z1 - cw) / L;
+    w->h2 = (z2 - cw) / L;
+    curve_bounds(w);
+    orient_segments(w);
+    w->blo = v3(w->clo[0], w->clo[1], w->h1);
+    w->bhi = v3(w->chi[0], w->chi[1], w->h2);
+    return 0;
+}
+
+static int setup_polygon(sw_data *w, const scene_polygon *pg, vec3 *lo, vec3 *hi)
+{
+    int n = pg->npoints;
+    const vec3 *p = pg->points;
+    if (!p || n < 3) return -1;
+    /* Newell normal and the centroid */
+    vec3 nn = v3s(0), c = v3s(0);
+    for (int i = 0; i < n; i++) {
+        vec3 a = p[i], b = p[(i + 1) % n];
+        nn.x += (a.y - b.y) * (a.z + b.z);
+        nn.y += (a.z - b.z) * (a.x + b.x);
+        nn.z += (a.x - b.x) * (a.y + b.y);
+        c = v3_add(c, a);
+    }
+    double l = v3_len(nn);
+    if (!(l > 0.0) || !isfinite(l)) return -1;
+    w->pn = v3_scale(nn, 1.0 / l);
+    w->p0 = v3_scale(c, 1.0 / n);
+    v3_basis(w->pn, &w->pu, &w->pv);
+    vec3 blo = v3s(INFINITY), bhi = v3s(-INFINITY);
+    double ext = 0.0;
+    for (int i = 0; i < n; i++) {
+        blo = v3_min(blo, p[i]);
+        bhi = v3_max(bhi, p[i]);
+    }
+    ext = v3_maxc(v3_sub(bhi, blo));
+    if (!(ext > 0.0)) return -1;
+    w->L = ext;
+    w->c = v3s(0);
+    if (!alloc_segs(w, n)) return -1;
+    /* sub-polygons: each ends where its first point repeats */
+    int ns = 0, start = 0;
+    for (int i = 1; i < n; i++) {
+        vec3 a = v3_sub(p[i - 1], w->p0), b = v3_sub(p[i], w->p0);
+        double P[2][2] = {{v3_dot(a, w->pu) / ext, v3_dot(a, w->pv) / ext}, {v3_dot(b, w->pu) / ext, v3_dot(b, w->pv) / ext}};
+        seg_from_points(&w->seg[ns++], SPLINE_LINEAR, P);
+        if (p[i].x == p[start].x && p[i].y == p[start].y && p[i].z == p[start].z && i > start) {
+            start = i + 1;
+            i++; /* the next sub-polygon starts at i + 1 */
+        }
+    }
+    w->nseg = ns;
+    curve_bounds(w);
+    *lo = blo;
+    *hi = bhi;
+    return 0;
+}
+
+int accel_sweep_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
+{
+    sw_data *w = calloc(1, sizeof *w);
+    if (!w) return -1;
+    w->sturm = (o->flags & OBJ_STURM) != 0;
+    w->open = (o->flags & OBJ_OPEN) != 0;
+    int st = -1;
+    switch (o->kind) {
+    case SHAPE_LATHE: w->type = SW_LATHE; st = o->u.lathe ? setup_lathe(w, o->u.lathe) : -1; break;
+    case SHAPE_SOR: w->type = SW_SOR; st = o->u.lathe ? setup_sor(w, o->u.lathe) : -1; break;
+    case SHAPE_PRISM: w->type = SW_PRISM; st = o->u.prism ? setup_prism(w, o->u.prism) : -1; break;
+    case SHAPE_TEXT: w->type = SW_PRISM; w->open = 0; st = o->u.text ? setup_text(w, o->u.text) : -1; break;
+    case SHAPE_POLYGON: w->type = SW_POLYGON; st = o->u.polygon ? setup_polygon(w, o->u.polygon, lo, hi) : -1; break;
+    default: break;
+    }
+    if (st != 0) {
+        accel_sweep_free(w);
+        return -1;
+    }
+    if (w->type != SW_POLYGON) {
+        *lo = v3_add(w->c, v3_scale(w->blo, w->L));
+        *hi = v3_add(w->c, v3_scale(w->bhi, w->L));
+    }
+    sh->data = w;
+    return 0;
+}
+
+void accel_sweep_free(void *data)
+{
+    sw_data *w = data;
+    if (!w) return;
+    free(w->seg);
+    free(w->sor);
+    free(w);
+}
+
+int accel_sweep_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+{
+    const sw_data *w = sh->data;
+    if (!w || max <= 0) return 0;
+    if (w->type == SW_POLYGON) return polygon_hits(w, o, d, tmin, tmax, out, max);
+    lray r;
+    if (!make_lray(w, o, d, tmin, tmax, &r)) return 0;
+    switch (w->type) {
+    case SW_LATHE: return lathe_hits(w, &r, tmin, tmax, out, 0, max);
+    case SW_SOR: return sor_hits(w, &r, tmin, tmax, out, 0, max);
+    default: return prism_hits(w, &r, tmin, tmax, out, 0, max);
+    }
+}
+
+int accel_sweep_inside(const accel_shape *sh, vec3 q)
+{
+    const sw_data *w = sh->data;
+    if (!w || w->type == SW_POLYGON) return 0;
+    vec3 l = v3_scale(v3_sub(q, w->c), 1.0 / w->L);
+    switch (w->type) {
+    case SW_LATHE: {
+        double r = sqrt(l.x * l.x + l.z * l.z);
+        return in_curve(w, r, l.y);
+    }
+    case SW_SOR: {
+        if (l.y < w->sor[0].y0 || l.y > w->sor[w->nseg - 1].y1) return 0;
+        const sor_seg *s = &w->sor[sor_segment_at(w, l.y)];
+        return l.x * l.x + l.z * l.z <= sor_g(s, l.y, NULL);
+    }
+    default: {
+        double u = comp(l, w->ax[0]), h = comp(l, w->ax[1]), v = comp(l, w->ax[2]);
+        if (!(h > w->h1 && h < w->h2)) return 0;
+        if (w->conic) {
+            if (h == 0.0) return 0;
+            u /= h;
+            v /= h;
+        }
+        return in_curve(w, u, v);
+    }
+    }
+}
+
+void accel_sweep_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v)
+{
+    const sw_data *w = sh->data;
+    *n = v3(0, 1, 0);
+    *u = *v = 0.0;
+    if (!w) return;
+    if (w->type == SW_POLYGON) {
+        *n = w->pn;
+        vec3 rel = v3_sub(q, w->p0);
+        *u = v3_dot(rel, w->pu) / w->L + 0.5;
+        *v = v3_dot(rel, w->pv) / w->L + 0.5;
+        return;
+    }
+    vec3 l = v3_scale(v3_sub(q, w->c), 1.0 / w->L);
+    int k = part - 2;
+    switch (w->type) {
+    case SW_LATHE: {
+        double r = sqrt(l.x * l.x + l.z * l.z);
+        if (k < 0 || k >= w->nseg) k = 0;
+        const sw_seg *s = &w->seg[k];
+        double p2[2] = {r, l.y}, n2[2];
+        double t = seg_closest(s, p2);
+        seg_normal(s, t, n2);
+        if (r > 0.0) *n = v3(n2[0] * l.x / r, n2[1], n2[0] * l.z / r);
+        else *n = v3(0.0, n2[1] >= 0.0 ? 1.0 : -1.0, 0.0);
+        double th = atan2(l.z, l.x);
+        *u = (th < 0 ? th + TWO_PI : th) / TWO_PI;
+        *v = fmin(1.0, (k + t) / w->nseg);
+        break;
+    }
+    case SW_SOR: {
+        double th = atan2(l.z, l.x);
+        *u = (th < 0 ? th + TWO_PI : th) / TWO_PI;
+        if (part == 0) { *n = v3(0, -1, 0); *v = 0.0; break; }
+        if (part == 1) { *n = v3(0, 1, 0); *v = 1.0; break; }
+        if (k < 0 || k >= w->nseg) k = sor_segment_at(w, l.y);
+        double dg;
+        sor_g(&w->sor[k], l.y, &dg);
+        *n = v3(l.x, -0.5 * dg, l.z);
+        *v = (k + (l.y - w->sor[k].y0) / (w->sor[k].y1 - w->sor[k].y0)) / w->nseg;
+        break;
+    }
+    default: {
+        double pu = comp(l, w->ax[0]), h = comp(l, w->ax[1]), pv = comp(l, w->ax[2]);
+        *v = w->h2 > w->h1 ? (h - w->h1) / (w->h2 - w->h1) : 0.0;
+        if (part == 0 || part == 1) {
+            *n = from_local_axes(w->ax, 0.0, part == 0 ? -1.0 : 1.0, 0.0);
+            *u = 0.0;
+            break;
+        }
+        if (k < 0 || k >= w->nseg) k = 0;
+        const sw_seg *s = &w->seg[k];
+        double sc = w->conic && h != 0.0 ? h : 1.0;
+        double p2[2] = {pu / sc, pv / sc}, n2[2];
+        double t = seg_closest(s, p2);
+        seg_normal(s, t, n2);
+        if (!w->conic) {
+            *n = from_local_axes(w->ax, n2[0], 0.0, n2[1]);
+        } else {
+            double pc[2];
+            seg_eval(s, t, pc, NULL);
+            double sg = h < 0.0 ? -1.0 : 1.0;
+            *n = from_local_axes(w->ax, sg * n2[0], -sg * (pc[0] * n2[0] + pc[1] * n2[1]), sg * n2[1]);
+        }
+        *u = (k + t) / w->nseg;
+        break;
+    }
+    }
+}

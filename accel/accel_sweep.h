@@ -1,0 +1,32 @@
+/* accel_sweep.h - shapes made from 2-D spline curves, intersected exactly
+ * in double precision in object space: lathe (curve revolved about y),
+ * sor (POV-Ray's r^2 = cubic(y) surface of revolution), prism (curve swept
+ * along y, linearly or conically), text (glyph outlines swept along z) and
+ * polygon (planar, even-odd sub-polygons).
+ *
+ * Every curve segment is a polynomial p(t) = a t^3 + b t^2 + c t + d,
+ * t in [0,1], built from the points by POV-Ray's spline rules (linear,
+ * quadratic and Catmull-Rom cubic interpolation, Bezier). The ray equation
+ * per segment is a polynomial in t (lathe: degree 2 x spline degree, prism:
+ * spline degree) or in the ray parameter (sor: 3), solved with accel_poly
+ * and polished by Newton steps on the original two-equation system, so hits
+ * are exact to rounding. Insides follow POV-Ray: a point is inside a lathe,
+ * prism or glyph when a ray from it in +x (+r) crosses the curve an odd
+ * number of times (evaluated on monotonic pieces with the segments' exact end
+ * points, so a vertex is counted once); inside a sor when r^2 <= f(y).
+ *
+ * Parts (accel_shape_hit.part): 0 base cap, 1 top cap, 2 + k segment k. */
+#ifndef PT_ACCEL_SWEEP_H
+#define PT_ACCEL_SWEEP_H
+#include "accel_shapes.h"
+
+/* Set up sh (kind SHAPE_LATHE, SOR, PRISM, TEXT or POLYGON) from o; object
+ * space bounds in lo/hi. Allocates sh->data. -1 when degenerate. */
+int accel_sweep_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
+void accel_sweep_free(void *data);
+/* Object-space ray o + t d; crossings with t in (tmin, tmax), ascending. */
+int accel_sweep_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max);
+int accel_sweep_inside(const accel_shape *sh, vec3 q);
+/* Object-space outward normal (not unit) and surface parameters at q. */
+void accel_sweep_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v);
+#endif
