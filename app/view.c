@@ -28,7 +28,7 @@ enum { EXIT_OK = 0, EXIT_SCENE = 1, EXIT_USAGE = 2, EXIT_IO = 3 };
 
 static const char *view_usage =
     "usage: partray view SCENE.pov [--size WxH] [--gi none|particle|path] [--threads N] [--seed N]\n"
-    "                    [--script FILE] [--preview D] [-D NAME=VALUE] [-L DIR]\n"
+    "                    [--script FILE] [--preview D] [--verbose] [-D NAME=VALUE] [-L DIR]\n"
     "keys: WASD/QE fly, right drag look, left drag orbit, wheel zoom, R reset camera,\n"
     "      1-9/Tab select light, arrows/PgUp/PgDn move it, +/- brighten/dim it,\n"
     "      G cycle GI mode, F12/P screenshot, C write camera, H help, Esc quit\n";
@@ -78,6 +78,8 @@ typedef struct {
     long serial;
     view_frame_info info;
     int have_image;
+    int need_present;        /* new image or window damage since the last present */
+    int verbose;             /* print a line per image shown */
     /* script */
     view_script *script;
     int quit;
@@ -416,6 +418,7 @@ static void on_event(viewer *v, const SDL_Event *e)
 {
     switch (e->type) {
     case SDL_QUIT: v->quit = 1; break;
+    case SDL_WINDOWEVENT: v->need_present = 1; break;
     case SDL_KEYDOWN:
         if (!e->key.repeat) on_key(v, &e->key);
         break;
@@ -458,13 +461,18 @@ static void update_title(viewer *v, double now)
                  l->position.y, l->position.z, (l->colour.r + l->colour.g + l->colour.b) / 3);
     }
     if (busy >= 0) snprintf(work, sizeof work, "L%d %.1fs", busy, busy_for);
+    char mode[64];
+    if (v->have_image && in->wanted_mode != in->gi_mode)
+        snprintf(mode, sizeof mode, "%s (building %s)", view_gi_name(in->gi_mode), view_gi_name(in->wanted_mode));
+    else
+        snprintf(mode, sizeof mode, "%s", view_gi_name(v->have_image ? in->gi_mode : v->gi_mode));
     if (!v->have_image) {
-        snprintf(title, sizeof title, "partray view: %s | %s | first image... (%s)", v->stem, view_gi_name(v->gi_mode), work);
+        snprintf(title, sizeof title, "partray view: %s | %s | first image... (%s)", v->stem, mode, work);
     } else {
         snprintf(title, sizeof title,
                  "partray view: %s | %s | %dx%d L%d/%d | frame %.0f ms (build %.0f, light %.0f, view %.0f, render %.0f) "
                  "| %.0f img/s | %s | %s | %s",
-                 v->stem, view_gi_name(in->gi_mode), in->width, in->height, in->level, in->last_level, in->frame * 1e3,
+                 v->stem, mode, in->width, in->height, in->level, in->last_level, in->frame * 1e3,
                  in->times.build * 1e3, in->times.light * 1e3, in->times.view * 1e3, in->times.render * 1e3, rate,
                  in->describe, light, work);
     }
@@ -479,6 +487,13 @@ static int take_image(viewer *v, double now)
     v->info = in;
     v->images++;
     v->published = in.serial;
+    if (v->verbose)
+        printf("view: image %ld gen %ld L%d/%d %dx%d %s%s%s frame %.1f ms (build %.1f light %.1f view %.1f render %.1f) "
+               "latency %.1f ms%s%s\n",
+               in.serial, in.generation, in.level, in.last_level, in.width, in.height, view_gi_name(in.gi_mode),
+               in.wanted_mode != in.gi_mode ? " building " : "", in.wanted_mode != in.gi_mode ? view_gi_name(in.wanted_mode) : "",
+               in.frame * 1e3, in.times.build * 1e3, in.times.light * 1e3, in.times.view * 1e3, in.times.render * 1e3,
+               in.latency * 1e3, in.cause & VIEW_CAUSE_LIGHT ? " light" : "", in.cause & VIEW_CAUSE_CAMERA ? " camera" : "");
     if (!v->have_image) v->t_first_image = now;
     v->have_image = 1;
     if (v->nrecent == (int)(sizeof v->recent / sizeof v->recent[0])) {
@@ -497,7 +512,11 @@ static int take_image(viewer *v, double now)
         v->last_gen_full = in.generation;
         if (in.cause & VIEW_CAUSE_LIGHT) series_add(&v->lat_light_full, in.full_latency);
     }
-    if (v->tex) SDL_UpdateTexture(v->tex, NULL, v->rgba, v->width * 4);
+    if (v->tex) {
+        SDL_Rect r = {0, 0, in.width, in.height};
+        SDL_UpdateTexture(v->tex, &r, v->rgba, in.width * 4);
+    }
+    v->need_present = 1;
     return 1;
 }
 
@@ -506,8 +525,13 @@ static void present(viewer *v)
     if (!v->ren) return;
     SDL_SetRenderDrawColor(v->ren, 0, 0, 0, 255);
     SDL_RenderClear(v->ren);
-    if (v->have_image) SDL_RenderCopy(v->ren, v->tex, NULL, NULL);
+    if (v->have_image) {
+        /* the pass's corner of the texture, stretched over the window */
+        SDL_Rect r = {0, 0, v->info.width, v->info.height};
+        SDL_RenderCopy(v->ren, v->tex, &r, NULL);
+    }
     SDL_RenderPresent(v->ren);
+    v->need_present = 0;
 }
 
 static int open_window(viewer *v)
@@ -537,6 +561,8 @@ static int open_window(viewer *v)
         fprintf(stderr, "partray view: cannot create a texture: %s\n", SDL_GetError());
         return 0;
     }
+    SDL_SetTextureScaleMode(v->tex, SDL_ScaleModeLinear); /* previews are stretched */
+    v->need_present = 1;
     return 1;
 }
 
@@ -577,18 +603,21 @@ static void run_loop(viewer *v)
             update_title(v, now);
             v->title_time = now;
         }
-        present(v);
+        if (v->need_present) present(v);
     }
 }
 
 /* --------------------------------------------------------------- command */
 
 /* Takes the viewer's own options out of argv (into *script, *preview). */
-static int split_args(int argc, char **argv, char **rest, int *nrest, const char **script, int *preview, char *err, int n)
+static int split_args(int argc, char **argv, char **rest, int *nrest, const char **script, int *preview, int *verbose,
+                      char *err, int n)
 {
     *nrest = 0;
     for (int i = 0; i < argc; i++) {
-        if (strcmp(argv[i], "--script") == 0 || strcmp(argv[i], "--preview") == 0) {
+        if (strcmp(argv[i], "--verbose") == 0 || strcmp(argv[i], "-v") == 0) {
+            *verbose = 1;
+        } else if (strcmp(argv[i], "--script") == 0 || strcmp(argv[i], "--preview") == 0) {
             if (i + 1 >= argc) {
                 snprintf(err, (size_t)n, "option '%s' needs a value", argv[i]);
                 return 0;
@@ -616,10 +645,10 @@ int cmd_view(int argc, char **argv)
     char err[512];
     char **rest = calloc((size_t)argc + 1, sizeof *rest);
     if (!rest) return EXIT_IO;
-    int nrest = 0, preview = 0;
+    int nrest = 0, preview = 0, verbose = 0;
     const char *script_path = NULL;
     cli_render o;
-    if (!split_args(argc, argv, rest, &nrest, &script_path, &preview, err, sizeof err) ||
+    if (!split_args(argc, argv, rest, &nrest, &script_path, &preview, &verbose, err, sizeof err) ||
         cli_parse_render(nrest, rest, &o, err, sizeof err)) {
         fprintf(stderr, "partray view: %s\n%s", err, view_usage);
         free(rest);
@@ -638,6 +667,7 @@ int cmd_view(int argc, char **argv)
     viewer v;
     memset(&v, 0, sizeof v);
     v.t_start = timer_now();
+    v.verbose = verbose;
     v.scene_path = o.scene;
     v.width = o.width > 0 ? o.width : 512;
     v.height = o.height > 0 ? o.height : (o.width > 0 ? o.width : 512);

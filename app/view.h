@@ -1,7 +1,7 @@
 /* view.h - `partray view`: the interactive viewer (issue 10).
  *
  *   partray view SCENE.pov [--size WxH] [--gi MODE] [--threads N] [--seed N]
- *                [--script FILE] [--preview D] [-D NAME=VALUE] [-L DIR]
+ *                [--script FILE] [--preview D] [--verbose] [-D NAME=VALUE] [-L DIR]
  *
  * An SDL2 window shows the scene while the render thread (view_render.h)
  * refines it; the UI thread only handles input, swaps in finished images and
@@ -18,7 +18,8 @@
  * The title bar shows the GI mode, the refinement level, the frame time and
  * its stages (GI build, lighting, per-view, render), images per second and
  * the selected light. --script (view_script.h) injects the same actions on
- * a timeline; --preview D fixes the preview's divisor (default: adaptive).
+ * a timeline; --preview D fixes the preview's divisor (default: adaptive);
+ * --verbose prints a line per image shown (level, size, stage times, latency).
  * On exit the viewer prints figures (images/s, latencies) to stderr.
  * Exit status: 0 ok, 1 scene or script error, 2 usage, 3 I/O or no display. */
 #ifndef PT_VIEW_H

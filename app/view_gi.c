@@ -22,6 +22,8 @@ typedef struct {
 struct view_gi {
     const gi_backend *b;
     void *ctx;
+    scene sc;             /* shallow copy: own camera and lights, shared objects */
+    scene_light *lights;
 };
 
 /* ------------------------------------------------------------------ none */
@@ -271,11 +273,21 @@ pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a,
     view_gi *g = calloc(1, sizeof *g);
     if (!g) return PT_ERR_NOMEM;
     g->b = b;
+    g->sc = *sc;
+    g->lights = malloc((size_t)(sc->nlights > 0 ? sc->nlights : 1) * sizeof *g->lights);
+    if (!g->lights) {
+        free(g);
+        return PT_ERR_NOMEM;
+    }
+    if (sc->nlights > 0) memcpy(g->lights, sc->lights, (size_t)sc->nlights * sizeof *g->lights);
+    g->sc.lights = g->lights;
+    g->sc.cap_lights = sc->nlights;
     double t0 = timer_now();
-    pt_status st = b->open(&g->ctx, sc, a, threads, t, d);
+    pt_status st = b->open(&g->ctx, &g->sc, a, threads, t, d);
     if (t->build == 0 && t->light == 0) t->build = timer_now() - t0;
     if (st != PT_OK) {
         if (g->ctx) b->close(g->ctx);
+        free(g->lights);
         free(g);
         return st;
     }
@@ -284,6 +296,7 @@ pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a,
 }
 
 int view_gi_mode(const view_gi *g) { return g->b->mode; }
+scene *view_gi_scene(view_gi *g) { return &g->sc; }
 int view_gi_last_level(const view_gi *g) { return g->b->last_level; }
 
 pt_status view_gi_relight(view_gi *g, view_gi_times *t, diag *d)
@@ -308,5 +321,6 @@ void view_gi_close(view_gi *g)
 {
     if (!g) return;
     g->b->close(g->ctx);
+    free(g->lights);
     free(g);
 }

@@ -13,8 +13,11 @@
  *             resolution at 1 spp, then passes of 1, 2, 4, ... more samples
  *             averaged in, up to 256 spp in all.
  *
- * Calls come from one thread (the viewer's render thread). The scene's
- * lights may be edited between calls; call relight after such an edit. */
+ * Each open mode works on its own shallow copy of the scene (camera and
+ * lights copied, objects shared), so a mode can be opened on one thread
+ * while another renders with a different mode. After open, calls on one
+ * instance come from one thread: edit view_gi_scene's camera and lights
+ * between calls, and call relight after a light edit. */
 #ifndef PT_VIEW_GI_H
 #define PT_VIEW_GI_H
 #include <stdint.h>
@@ -49,9 +52,12 @@ int view_gi_available(int mode);
 int view_gi_next(int mode);
 const char *view_gi_name(int mode);
 
-/* Opens a mode on a scene: runs whatever the mode precomputes. */
+/* Opens a mode on a copy of the scene (read only here; the objects must
+ * outlive the instance): runs whatever the mode precomputes. */
 pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a, int threads, view_gi_times *t, diag *d);
 int view_gi_mode(const view_gi *g);
+/* The instance's scene: set its camera and lights before a pass. */
+scene *view_gi_scene(view_gi *g);
 /* The last level of the refinement (none/particle 2, path 8). */
 int view_gi_last_level(const view_gi *g);
 /* The scene's lights changed (positions, colours). */

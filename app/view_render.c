@@ -12,9 +12,11 @@
 #define PREVIEW_DIV_MAX 16
 #define SRGB_LUT 4096
 
+#define GI_MODES 8
+
 struct view_render {
     /* fixed after start */
-    scene *sc;
+    const scene *sc;           /* read only: every mode works on its own copy (view_gi.h) */
     const accel *a;
     view_render_opts o;
     int nlights;
@@ -30,24 +32,33 @@ struct view_render {
     view_light *posted_lights;
     int posted_cause;          /* causes since the thread last took a state */
     double posted_time;        /* time of the oldest submit not yet taken */
+    double last_submit;        /* time of the newest submit */
     int busy_level;            /* -1 waiting */
-    long busy_gen;
     double busy_since;
-    long idle_gen;             /* newest generation rendered to its last level */
-    framebuffer *front;        /* full size, linear */
-    uint8_t *front8;           /* full size, RGBA sRGB */
+    long idle_gen;             /* newest generation rendered to its last level in the wanted mode */
+    framebuffer *front;        /* the last pass, linear (storage for the full size) */
+    uint8_t *front8;           /* the same, RGBA sRGB */
     view_frame_info front_info;
     long serial;
     diag *msgs;                /* messages for the UI */
+    /* the opener thread: builds a mode while the render thread goes on
+     * with the modes it has (seed 001's asynchronous updates) */
+    int opening;               /* mode being opened, -1 none */
+    int open_done;             /* the opener has finished: join it */
+    pthread_t opener;
+    scene *open_scene;         /* the copy handed to the opener (lights at that time) */
+    view_gi *open_result;
+    pt_status open_status;
+    view_gi_times open_times;
 
     volatile int cancel;       /* written by both threads, read by the workers */
 
     /* render thread only */
-    framebuffer *back;
+    framebuffer *back;         /* the pass being rendered (storage for the full size) */
     uint8_t *back8;
-    view_gi *gi;
+    view_gi *opened[GI_MODES]; /* every mode opened so far, kept for quick switching */
     int failed_modes;          /* bit per gi_mode that failed to open */
-    view_light *applied_lights;
+    int shown_mode;            /* the mode of the last pass */
     int preview_div;
 };
 
@@ -71,6 +82,7 @@ uint8_t view_render_srgb8(float v)
     if (v >= 1.0f) return 255;
     return srgb_lut[(int)(v * SRGB_LUT + 0.5f)];
 }
+
 
 /* Upsample src (w x h) into dst (W x H) bilinearly (pixel centres aligned);
  * a copy when the sizes agree. */
@@ -102,13 +114,20 @@ static void upsample(const framebuffer *src, framebuffer *dst)
     }
 }
 
+static inline uint8_t srgb8(float v)
+{
+    if (!(v > 0.0f)) return 0; /* also NaN */
+    if (v >= 1.0f) return 255;
+    return srgb_lut[(int)(v * SRGB_LUT + 0.5f)];
+}
+
 static void to_rgba8(const framebuffer *fb, uint8_t *out)
 {
     size_t n = (size_t)fb->width * (size_t)fb->height;
     for (size_t i = 0; i < n; i++) {
-        out[4 * i + 0] = view_render_srgb8(fb->rgb[3 * i + 0]);
-        out[4 * i + 1] = view_render_srgb8(fb->rgb[3 * i + 1]);
-        out[4 * i + 2] = view_render_srgb8(fb->rgb[3 * i + 2]);
+        out[4 * i + 0] = srgb8(fb->rgb[3 * i + 0]);
+        out[4 * i + 1] = srgb8(fb->rgb[3 * i + 1]);
+        out[4 * i + 2] = srgb8(fb->rgb[3 * i + 2]);
         out[4 * i + 3] = 255;
     }
 }
@@ -122,36 +141,108 @@ static void copy_messages(diag *dst, const diag *src)
     }
 }
 
-static int lights_equal(const view_light *a, const view_light *b, int n)
+static void *opener_main(void *arg)
 {
-    for (int i = 0; i < n; i++) {
-        if (memcmp(&a[i].position, &b[i].position, sizeof(vec3)) || memcmp(&a[i].point_at, &b[i].point_at, sizeof(vec3)) ||
-            memcmp(&a[i].colour, &b[i].colour, sizeof(rgb)))
-            return 0;
-    }
-    return 1;
+    view_render *vr = arg;
+    diag *d = diag_new();
+    view_gi *g = NULL;
+    view_gi_times t;
+    memset(&t, 0, sizeof t);
+    pt_status st = view_gi_open(&g, vr->opening, vr->open_scene, vr->a, vr->o.threads, &t, d);
+    pthread_mutex_lock(&vr->mu);
+    copy_messages(vr->msgs, d);
+    vr->open_result = g;
+    vr->open_status = st;
+    vr->open_times = t;
+    vr->open_done = 1;
+    pthread_cond_signal(&vr->cv);
+    pthread_mutex_unlock(&vr->mu);
+    diag_free(d);
+    return NULL;
 }
 
-/* Make sure the wanted mode is open; falls back to `none` (once per mode)
- * when it cannot be opened. Returns 1 when it opened a mode (stage times in
- * t), 0 when the mode was open already. */
-static int ensure_mode(view_render *vr, int mode, view_gi_times *t, diag *d)
+/* Called with mu held: collect a finished open (joined: the opener thread
+ * is joined already). Returns the mode it opened (or that failed), -1 when
+ * none finished. */
+static int collect_open(view_render *vr, view_gi_times *t, int joined)
 {
-    if (vr->failed_modes & (1 << mode)) mode = GI_NONE;
-    if (vr->gi && view_gi_mode(vr->gi) == mode) return 0;
-    view_gi_close(vr->gi);
-    vr->gi = NULL;
-    pt_status st = view_gi_open(&vr->gi, mode, vr->sc, vr->a, vr->o.threads, t, d);
-    if (st != PT_OK && mode != GI_NONE) {
+    if (!vr->open_done) return -1;
+    if (!joined) pthread_join(vr->opener, NULL);
+    int mode = vr->opening;
+    if (vr->open_status == PT_OK && vr->open_result) {
+        vr->opened[mode] = vr->open_result;
+        *t = vr->open_times;
+    } else {
         vr->failed_modes |= 1 << mode;
-        diag_report(d, DIAG_WARNING, (src_loc){0}, NULL, "GI mode '%s' failed (%s); showing --gi none",
-                    view_gi_name(mode), pt_status_name(st));
-        view_gi_times t2;
-        st = view_gi_open(&vr->gi, GI_NONE, vr->sc, vr->a, vr->o.threads, &t2, d);
+        diag_report(vr->msgs, DIAG_WARNING, (src_loc){0}, NULL, "GI mode '%s' failed (%s); showing --gi %s",
+                    view_gi_name(mode), pt_status_name(vr->open_status), view_gi_name(vr->shown_mode));
     }
-    if (st != PT_OK) vr->gi = NULL;
-    return 1;
+    free(vr->open_scene->lights);
+    free(vr->open_scene);
+    vr->open_scene = NULL;
+    vr->open_result = NULL;
+    vr->opening = -1;
+    vr->open_done = 0;
+    return mode;
 }
+
+/* Called with mu held: start opening `mode` on the lights of `cur`. */
+static void start_open(view_render *vr, int mode, const view_state *cur)
+{
+    scene *s = malloc(sizeof *s);
+    scene_light *ls = malloc((size_t)(vr->nlights > 0 ? vr->nlights : 1) * sizeof *ls);
+    if (!s || !ls) {
+        free(s);
+        free(ls);
+        vr->failed_modes |= 1 << mode;
+        return;
+    }
+    *s = *vr->sc;
+    if (vr->nlights > 0) memcpy(ls, vr->sc->lights, (size_t)vr->nlights * sizeof *ls);
+    for (int i = 0; i < vr->nlights; i++) {
+        ls[i].position = cur->lights[i].position;
+        ls[i].point_at = cur->lights[i].point_at;
+        ls[i].colour = cur->lights[i].colour;
+    }
+    s->lights = ls;
+    s->camera = cur->camera;
+    vr->open_scene = s;
+    vr->opening = mode;
+    vr->open_done = 0;
+    if (pthread_create(&vr->opener, NULL, opener_main, vr) != 0) {
+        free(ls);
+        free(s);
+        vr->open_scene = NULL;
+        vr->opening = -1;
+        vr->failed_modes |= 1 << mode;
+    }
+}
+
+/* The wanted mode, or `none` when it failed. */
+static int wanted_mode(const view_render *vr, int mode)
+{
+    if (mode < 0 || mode >= GI_MODES || (vr->failed_modes & (1 << mode))) return GI_NONE;
+    return mode;
+}
+
+/* Light edits into a mode's scene; returns 1 when something changed. */
+static int apply_lights(view_render *vr, scene *gs, const view_light *l)
+{
+    int changed = 0;
+    for (int i = 0; i < vr->nlights; i++) {
+        scene_light *s = &gs->lights[i];
+        if (memcmp(&s->position, &l[i].position, sizeof(vec3)) || memcmp(&s->point_at, &l[i].point_at, sizeof(vec3)) ||
+            memcmp(&s->colour, &l[i].colour, sizeof(rgb))) {
+            s->position = l[i].position;
+            s->point_at = l[i].point_at;
+            s->colour = l[i].colour;
+            changed = 1;
+        }
+    }
+    return changed;
+}
+
+#define QUIET 0.12 /* seconds without a submit before refinement passes start */
 
 static void *render_main(void *arg)
 {
@@ -162,73 +253,101 @@ static void *render_main(void *arg)
     long work_gen = -1;
     int level = 0, last_level = 0, cause = 0;
     double submit_time = 0, first_latency = 0, full_latency = 0;
-    int lights_ok = 0; /* applied_lights holds what the scene has */
-    framebuffer *pass = NULL;
+    int published = 1; /* an image of work_gen was published */
+    view_gi_times opened_times;
+    memset(&opened_times, 0, sizeof opened_times);
 
     pthread_mutex_lock(&vr->mu);
     for (;;) {
-        while (!vr->stop && vr->posted_gen == work_gen && level > last_level) {
+        while (!vr->stop && vr->posted_gen == work_gen && level > last_level && !vr->open_done) {
             vr->busy_level = -1;
             pthread_cond_wait(&vr->cv, &vr->mu);
         }
         if (vr->stop) break;
+        /* a finished open (or failure) restarts the refinement */
+        if (collect_open(vr, &opened_times, 0) >= 0) level = 0;
         if (vr->posted_gen != work_gen) {
             work_gen = vr->posted_gen;
             cur = vr->posted;
             memcpy(cur_lights, vr->posted_lights, (size_t)vr->nlights * sizeof *cur_lights);
             cur.lights = cur_lights;
-            cause = vr->posted_cause;
-            submit_time = vr->posted_time;
+            if (published) {
+                cause = vr->posted_cause;
+                submit_time = vr->posted_time;
+            } else {
+                /* the last generation never made it to the screen: this
+                 * image answers its inputs too */
+                cause |= vr->posted_cause;
+                if (submit_time == 0 || (vr->posted_time > 0 && vr->posted_time < submit_time)) submit_time = vr->posted_time;
+            }
+            published = 0;
             vr->posted_cause = 0;
             vr->posted_time = 0;
             level = 0;
             first_latency = full_latency = 0;
         }
+        if (level > last_level) continue; /* an open finished for a mode not wanted now */
+        /* refinement waits until the input has been quiet a moment */
+        if (level >= 1) {
+            double quiet = timer_now() - vr->last_submit;
+            if (quiet < QUIET) {
+                vr->busy_level = -1;
+                struct timespec ts;
+                clock_gettime(CLOCK_REALTIME, &ts);
+                double until = ts.tv_sec + ts.tv_nsec * 1e-9 + (QUIET - quiet);
+                ts.tv_sec = (time_t)until;
+                ts.tv_nsec = (long)((until - (double)ts.tv_sec) * 1e9);
+                pthread_cond_timedwait(&vr->cv, &vr->mu, &ts);
+                continue;
+            }
+        }
+        /* the mode: the wanted one when it is open, else open it in the
+         * background and go on with the one on screen */
+        int want = wanted_mode(vr, cur.gi_mode);
+        if (!vr->opened[want] && vr->opening < 0 && want != GI_NONE) start_open(vr, want, &cur);
+        want = wanted_mode(vr, cur.gi_mode); /* start_open may have failed */
+        int use = vr->opened[want] ? want : vr->shown_mode;
+        int waiting_for_mode = use != want;
         vr->cancel = 0;
         vr->busy_level = level;
-        vr->busy_gen = work_gen;
         vr->busy_since = timer_now();
         pthread_mutex_unlock(&vr->mu);
 
         /* ---- one pass, no lock held */
         double t0 = timer_now();
         diag *d = diag_new();
-        view_gi_times acc, t;
-        memset(&acc, 0, sizeof acc);
-        int lights_changed = !lights_ok || !lights_equal(cur.lights, vr->applied_lights, vr->nlights);
-        if (lights_changed) {
-            for (int i = 0; i < vr->nlights; i++) {
-                scene_light *l = &vr->sc->lights[i];
-                l->position = cur.lights[i].position;
-                l->point_at = cur.lights[i].point_at;
-                l->colour = cur.lights[i].colour;
+        view_gi_times acc = opened_times, t;
+        memset(&opened_times, 0, sizeof opened_times);
+        pt_status st = PT_OK;
+        if (!vr->opened[use]) {
+            /* `none` opens at once, on this thread */
+            st = view_gi_open(&vr->opened[use], use, vr->sc, vr->a, vr->o.threads, &t, d);
+            acc.build += t.build;
+        }
+        view_gi *g = vr->opened[use];
+        if (st == PT_OK && g) {
+            vr->shown_mode = use;
+            scene *gs = view_gi_scene(g);
+            gs->camera = cur.camera;
+            if (apply_lights(vr, gs, cur.lights)) {
+                st = view_gi_relight(g, &t, d);
+                acc.light += t.light;
             }
-            memcpy(vr->applied_lights, cur.lights, (size_t)vr->nlights * sizeof *cur_lights);
         }
-        vr->sc->camera = cur.camera;
-        int opened = ensure_mode(vr, cur.gi_mode, &acc, d);
-        pt_status st = vr->gi ? PT_OK : PT_ERR_INTERNAL;
-        /* a mode just opened has lit the scene as it is now */
-        if (st == PT_OK && lights_changed && lights_ok && !opened) {
-            st = view_gi_relight(vr->gi, &t, d);
-            acc.light += t.light;
-        }
-        lights_ok = 1;
-        last_level = vr->gi ? view_gi_last_level(vr->gi) : 0;
+        last_level = g ? view_gi_last_level(g) : 0;
         int div = level == 0 ? vr->preview_div : 1;
         int pw = vr->o.width / div, ph = vr->o.height / div;
         if (pw < 1) pw = 1;
         if (ph < 1) ph = 1;
-        if (st == PT_OK && (!pass || pass->width != pw || pass->height != ph)) {
-            fb_free(pass);
-            pass = fb_new(pw, ph);
-            if (!pass) st = PT_ERR_NOMEM;
-        }
-        if (st == PT_OK) {
+        vr->back->width = pw;
+        vr->back->height = ph;
+        if (st == PT_OK && g) {
             view_gi_pass p = {pw, ph, level, vr->o.threads, vr->o.seed, &vr->cancel};
-            st = view_gi_render(vr->gi, &p, pass, &t, d);
+            st = view_gi_render(g, &p, vr->back, &t, d);
             acc.view += t.view;
             acc.render += t.render;
+        } else if (st == PT_OK) {
+            st = PT_ERR_INTERNAL;
         }
         int cancelled = vr->cancel != 0;
         if (st == PT_OK && !cancelled) {
@@ -237,19 +356,20 @@ static void *render_main(void *arg)
                 if (tp > 1.5 * PREVIEW_TARGET && vr->preview_div < PREVIEW_DIV_MAX) vr->preview_div++;
                 else if (tp < 0.4 * PREVIEW_TARGET && vr->preview_div > PREVIEW_DIV_MIN) vr->preview_div--;
             }
-            upsample(pass, vr->back);
             to_rgba8(vr->back, vr->back8);
         }
         char desc[96] = "";
-        if (vr->gi) view_gi_describe(vr->gi, desc, sizeof desc);
+        if (g) view_gi_describe(g, desc, sizeof desc);
 
         pthread_mutex_lock(&vr->mu);
         copy_messages(vr->msgs, d);
         diag_free(d);
         if (st != PT_OK && !cancelled) {
             /* nothing sensible to show for this state: wait for the next */
+            diag_report(vr->msgs, DIAG_ERROR, (src_loc){0}, NULL, "view: the %s pass failed (%s)", view_gi_name(use),
+                        pt_status_name(st));
             level = last_level + 1;
-            vr->idle_gen = work_gen;
+            if (!waiting_for_mode) vr->idle_gen = work_gen;
             continue;
         }
         if (cancelled) continue; /* a newer state (or stop) is posted */
@@ -267,30 +387,40 @@ static void *render_main(void *arg)
         in->last_level = last_level;
         in->width = pw;
         in->height = ph;
-        in->gi_mode = vr->gi ? view_gi_mode(vr->gi) : GI_NONE;
+        in->gi_mode = use;
+        in->wanted_mode = want;
         in->times = acc;
         double now = timer_now();
         in->frame = now - t0;
         in->latency = now - submit_time;
         in->first = level == 0;
-        if (level == 0) first_latency = in->latency;
-        if (level == 1) full_latency = in->latency;
+        if (level == 0 && first_latency == 0) first_latency = in->latency;
+        if (level == 1 && full_latency == 0) full_latency = in->latency;
         in->first_latency = first_latency;
         in->full_latency = full_latency;
         in->cause = cause;
-        in->complete = level >= last_level;
+        in->complete = level >= last_level && !waiting_for_mode;
         memcpy(in->describe, desc, sizeof desc);
-        if (level >= last_level) vr->idle_gen = work_gen;
+        if (in->complete) vr->idle_gen = work_gen;
+        published = 1;
         level++;
     }
     vr->busy_level = -1;
+    if (vr->opening >= 0) {
+        /* an open cannot be cancelled: wait for it, then drop it */
+        pthread_mutex_unlock(&vr->mu);
+        pthread_join(vr->opener, NULL);
+        pthread_mutex_lock(&vr->mu);
+        vr->open_done = 1;
+        view_gi_times t;
+        collect_open(vr, &t, 1);
+    }
     pthread_mutex_unlock(&vr->mu);
-    fb_free(pass);
     free(cur_lights);
     return NULL;
 }
 
-pt_status view_render_start(view_render **out, scene *sc, const accel *a, const view_render_opts *o,
+pt_status view_render_start(view_render **out, const scene *sc, const accel *a, const view_render_opts *o,
                             const view_state *initial, diag *d)
 {
     *out = NULL;
@@ -307,17 +437,18 @@ pt_status view_render_start(view_render **out, scene *sc, const accel *a, const 
     vr->nlights = sc->nlights;
     vr->preview_div = o->preview_div > 0 ? o->preview_div : 4;
     vr->idle_gen = -1;
+    vr->opening = -1;
+    vr->shown_mode = GI_NONE;
     vr->busy_level = -1;
     size_t nl = (size_t)(vr->nlights > 0 ? vr->nlights : 1);
     size_t npx = (size_t)o->width * (size_t)o->height;
     vr->posted_lights = calloc(nl, sizeof *vr->posted_lights);
-    vr->applied_lights = calloc(nl, sizeof *vr->applied_lights);
     vr->front = fb_new(o->width, o->height);
     vr->back = fb_new(o->width, o->height);
     vr->front8 = calloc(npx, 4);
     vr->back8 = calloc(npx, 4);
     vr->msgs = diag_new();
-    if (!vr->posted_lights || !vr->applied_lights || !vr->front || !vr->back || !vr->front8 || !vr->back8 || !vr->msgs) {
+    if (!vr->posted_lights || !vr->front || !vr->back || !vr->front8 || !vr->back8 || !vr->msgs) {
         view_render_stop(vr);
         return PT_ERR_NOMEM;
     }
@@ -326,6 +457,7 @@ pt_status view_render_start(view_render **out, scene *sc, const accel *a, const 
     vr->posted.lights = vr->posted_lights;
     vr->posted_gen = 0;
     vr->posted_time = timer_now();
+    vr->last_submit = 0;
     vr->posted_cause = 0;
     pthread_mutex_init(&vr->mu, NULL);
     pthread_cond_init(&vr->cv, NULL);
@@ -338,7 +470,6 @@ pt_status view_render_start(view_render **out, scene *sc, const accel *a, const 
         free(vr->front8);
         free(vr->back8);
         free(vr->posted_lights);
-        free(vr->applied_lights);
         diag_free(vr->msgs);
         free(vr);
         return PT_ERR_INTERNAL;
@@ -357,7 +488,9 @@ void view_render_submit(view_render *vr, const view_state *s, int cause)
     vr->posted.lights = vr->posted_lights;
     vr->posted_gen++;
     vr->posted_cause |= cause | (mode_changed ? VIEW_CAUSE_MODE : 0);
-    if (vr->posted_time == 0) vr->posted_time = timer_now();
+    double now = timer_now();
+    if (vr->posted_time == 0) vr->posted_time = now;
+    vr->last_submit = now;
     /* refinements give way at once; a preview finishes (continuous motion
      * keeps showing frames) unless the mode changed */
     if (vr->busy_level >= 1 || (vr->busy_level == 0 && mode_changed)) vr->cancel = 1;
@@ -370,7 +503,7 @@ int view_render_fetch(view_render *vr, long *serial, uint8_t *rgba, view_frame_i
     int got = 0;
     pthread_mutex_lock(&vr->mu);
     if (vr->serial != *serial && vr->serial > 0) {
-        memcpy(rgba, vr->front8, (size_t)vr->o.width * (size_t)vr->o.height * 4u);
+        memcpy(rgba, vr->front8, (size_t)vr->front->width * (size_t)vr->front->height * 4u);
         if (info) *info = vr->front_info;
         *serial = vr->serial;
         got = 1;
@@ -402,7 +535,7 @@ framebuffer *view_render_snapshot(view_render *vr, view_frame_info *info)
     pthread_mutex_lock(&vr->mu);
     if (vr->serial > 0) {
         fb = fb_new(vr->o.width, vr->o.height);
-        if (fb) memcpy(fb->rgb, vr->front->rgb, (size_t)vr->o.width * (size_t)vr->o.height * 3u * sizeof(float));
+        if (fb) upsample(vr->front, fb);
         if (info) *info = vr->front_info;
     }
     pthread_mutex_unlock(&vr->mu);
@@ -433,13 +566,12 @@ void view_render_stop(view_render *vr)
         pthread_mutex_destroy(&vr->mu);
         pthread_cond_destroy(&vr->cv);
     }
-    view_gi_close(vr->gi);
+    for (int i = 0; i < GI_MODES; i++) view_gi_close(vr->opened[i]);
     fb_free(vr->front);
     fb_free(vr->back);
     free(vr->front8);
     free(vr->back8);
     free(vr->posted_lights);
-    free(vr->applied_lights);
     diag_free(vr->msgs);
     free(vr);
 }

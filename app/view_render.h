@@ -6,9 +6,9 @@
  * newest state in levels (view_gi.h): level 0 is a quick preview at 1/d of
  * the resolution (d adapts so a preview takes about 40 ms, 2 <= d <= 16),
  * level 1 the full resolution, higher levels refine (antialiasing, more
- * samples) while nothing changes. Each finished pass is upsampled to the
- * full size, converted to sRGB 8-bit and swapped with the front buffer under
- * a short lock; the UI copies the front buffer when its serial changes, so
+ * samples) while nothing changes. Each finished pass is converted to sRGB
+ * 8-bit and swapped with the front buffer under a short lock; the UI copies
+ * the front buffer when its serial changes (and scales it to the window), so
  * the window keeps showing the last complete image while the next one
  * computes (the asynchronous updates of seed 001).
  *
@@ -16,8 +16,13 @@
  * shade_settings.cancel; a preview pass is left to finish (so continuous
  * motion still shows frames) unless the GI mode changed. Light edits rerun
  * only the GI's lighting stage (view_gi_relight), camera moves only the
- * per-view work and the passes, a mode change opens the new mode (its
- * geometry stage) while the old image stays on screen. */
+ * per-view work and the passes. A mode that is not open yet is opened on a
+ * thread of its own (its geometry and lighting stages) while the render
+ * thread goes on refining with the mode on screen (at the start: `none`);
+ * the new mode takes over when it is ready. Opened modes stay open, so
+ * switching back is immediate. Refinement passes start only after the input
+ * has been quiet for 0.12 s (a pass that cannot be cancelled, such as the
+ * particle GI's per-view stage, does not delay the next preview). */
 #ifndef PT_VIEW_RENDER_H
 #define PT_VIEW_RENDER_H
 #include <stdint.h>
@@ -54,8 +59,9 @@ typedef struct {
     long serial;            /* counts published images from 1 */
     long generation;        /* the submit it shows (0 = the initial state) */
     int level, last_level;
-    int width, height;      /* size of the pass (full size after upsampling) */
+    int width, height;      /* size of the pass (previews are smaller than the full size) */
     int gi_mode;            /* the mode that made it */
+    int wanted_mode;        /* the mode asked for (differs while that one is being built) */
     double frame;           /* seconds from the pass's start to its publication, GI stages included */
     view_gi_times times;    /* stages run for this pass (build/light only when they ran) */
     double latency;         /* seconds from the oldest submit its generation answers to its publication */
@@ -67,21 +73,22 @@ typedef struct {
     char describe[96];      /* view_gi_describe */
 } view_frame_info;
 
-/* Starts the thread on the scene (which it owns from now on: the UI must
- * not read or change it until view_render_stop) and the initial state. */
-pt_status view_render_start(view_render **out, scene *sc, const accel *a, const view_render_opts *o,
+/* Starts the thread on the scene (read only; every mode works on its own
+ * copy of the camera and lights) and the initial state. */
+pt_status view_render_start(view_render **out, const scene *sc, const accel *a, const view_render_opts *o,
                             const view_state *initial, diag *d);
 /* Post a new state; cause is VIEW_CAUSE_* bits (for latency figures). */
 void view_render_submit(view_render *vr, const view_state *s, int cause);
-/* Copies the front image (width*height*4 bytes, RGBA, sRGB) into rgba and
- * its info when it is newer than *serial; returns 1 then, else 0. */
+/* Copies the front image into rgba (info.width * info.height * 4 bytes,
+ * RGBA, sRGB; rgba must hold the full size) and its info when it is newer
+ * than *serial; returns 1 then, else 0. */
 int view_render_fetch(view_render *vr, long *serial, uint8_t *rgba, view_frame_info *info);
 /* 1 when the newest posted state is rendered to its last level. */
 int view_render_idle(view_render *vr);
 /* What the thread works on: level (or -1 when waiting) and for how long. */
 int view_render_busy(view_render *vr, double *seconds);
-/* Copy of the front image as linear floats at the full size (NULL before
- * the first image); info may be NULL. */
+/* Copy of the front image as linear floats at the full size (a preview is
+ * upsampled bilinearly; NULL before the first image); info may be NULL. */
 framebuffer *view_render_snapshot(view_render *vr, view_frame_info *info);
 /* Moves the thread's new messages (GI failures, warnings) into d. */
 void view_render_messages(view_render *vr, diag *d);
