@@ -240,7 +240,8 @@ static double agate(const scene_pattern *pat, vec3 p, int gen)
     return pow(n, 0.77);
 }
 
-static double clip01(double v) { return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v); }
+/* POV-Ray's CLIP_DENSITY: 1 - v inside [0, 1], 1 below, 0 above. */
+static double clip_density(double v) { return v < 0.0 ? 1.0 : (v > 1.0 ? 0.0 : 1.0 - v); }
 
 static double brick(const scene_pattern *pat, vec3 p)
 {
@@ -591,10 +592,10 @@ static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
         return n * n * n;
     }
     case PAT_QUILTED: return quilted(pat, p);
-    case PAT_PLANAR: return clip01(fabs(p.y));
-    case PAT_BOXED: return clip01(fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
-    case PAT_SPHERICAL: return clip01(v3_len(p));
-    case PAT_CYLINDRICAL: return clip01(sqrt(p.x * p.x + p.z * p.z));
+    case PAT_PLANAR: return clip_density(fabs(p.y));
+    case PAT_BOXED: return clip_density(fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
+    case PAT_SPHERICAL: return clip_density(v3_len(p));
+    case PAT_CYLINDRICAL: return clip_density(sqrt(p.x * p.x + p.z * p.z));
     case PAT_PIGMENT: {
         colour5 col;
         if (!pat->pigment || !pigment_eval(pat->pigment, p, c, &col)) return 0.0;
