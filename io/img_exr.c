@@ -115,6 +115,22 @@ void img_exr_primaries(img_primaries prim, float xy[8])
     memcpy(xy, v, sizeof v);
 }
 
+/* OpenEXRCore 3.1's ZIP encoder keeps the zlib bytes when they come out
+ * exactly as long as the packed data, but a reader takes a chunk whose
+ * stored size equals its unpacked size as uncompressed: that chunk reads back
+ * as garbage (OpenEXR issue #2306, fixed upstream after 3.4.7). Seen with
+ * noisy float renders (a 64x64 path-traced Cornell box). Store such a chunk
+ * uncompressed, as the fixed library does. */
+static exr_result_t compress_checked(exr_encode_pipeline_t *e)
+{
+    exr_result_t (*fn)(exr_encode_pipeline_t *) = (exr_result_t(*)(exr_encode_pipeline_t *))e->encoding_user_data;
+    exr_result_t rv = fn(e);
+    if (rv == EXR_ERR_SUCCESS && e->compressed_buffer && e->packed_buffer && e->compressed_buffer != e->packed_buffer &&
+        e->compressed_bytes == e->packed_bytes && e->compressed_alloc_size >= e->packed_bytes)
+        memcpy(e->compressed_buffer, e->packed_buffer, (size_t)e->packed_bytes);
+    return rv;
+}
+
 static exr_compression_t compression_of(int c)
 {
     switch (c) {
@@ -231,6 +247,10 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
             enc_init = 1;
             rv = exr_encoding_choose_default_routines(ctx, part, &enc);
             if (rv != EXR_ERR_SUCCESS) goto fail;
+            if (enc.compress_fn) {
+                enc.encoding_user_data = (void *)enc.compress_fn;
+                enc.compress_fn = compress_checked;
+            }
         }
         rv = exr_encoding_run(ctx, part, &enc);
         if (rv != EXR_ERR_SUCCESS) goto fail;
