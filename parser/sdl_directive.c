@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include "sdl_array.h"
 #include "sdl_expr.h"
+#include "sdl_function.h"
 #include "sdl_material.h"
 #include "sdl_object.h"
 #include "sdl_scene.h"
@@ -595,17 +596,14 @@ static void opaque_value(sdl_parser *p, sdl_value *out, const char *what)
     out->str = what;
 }
 
-/* function_rvalue := 'function' [ '(' params ')' ] '{' ... '}' (kept opaque) */
-static void function_rvalue(sdl_parser *p, sdl_value *out)
+/* function_rvalue := 'function' ... (sdl_function.h) */
+static void function_rvalue(sdl_parser *p, src_loc loc, sdl_value *out)
 {
-    if (sdl_accept(p, TOK_LPAREN)) {
-        while (sdl_ok(p) && !sdl_accept(p, TOK_RPAREN)) {
-            sdl_tok t = sdl_next(p);
-            if (t.tk.kind == TOK_EOF) sdl_unexpected(p, &t, "')'");
-        }
-    }
-    if (sdl_begin_block(p, "function")) sdl_skip_block(p);
-    opaque_value(p, out, "function");
+    scene_function *f = sdl_parse_function(p, loc, NULL);
+    if (!f) return;
+    out->kind = VAL_FUNCTION;
+    out->dim = f->nterms;
+    out->ptr = f;
 }
 
 /* Keyword rvalues that are skipped and kept as opaque values. */
@@ -623,7 +621,6 @@ static const char *opaque_rvalue_name(sdl_kw k)
     case KW_FOG: return "fog";
     case KW_RAINBOW: return "rainbow";
     case KW_SKY_SPHERE: return "sky_sphere";
-    case KW_SPLINE: return "spline";
     default: return NULL;
     }
 }
@@ -676,7 +673,11 @@ static void keyword_rvalue(sdl_parser *p, sdl_value *out)
         out->ptr = x;
         return;
     }
-    case KW_FUNCTION: function_rvalue(p, out); return;
+    case KW_FUNCTION: function_rvalue(p, kt.tk.loc, out); return;
+    case KW_SPLINE:
+        out->ptr = sdl_parse_spline(p, kt.tk.loc);
+        out->kind = out->ptr ? VAL_SPLINE : VAL_NONE;
+        return;
     case KW_ARRAY:
         out->ptr = sdl_parse_array(p, kt.tk.loc);
         out->kind = out->ptr ? VAL_ARRAY : VAL_NONE;
@@ -694,6 +695,21 @@ static void keyword_rvalue(sdl_parser *p, sdl_value *out)
     sdl_unexpected(p, &kt, "value to declare");
 }
 
+/* A function or spline identifier not followed by '(' is a copy of it
+ * (#declare G = F). Returns 1 if that was the case. */
+static int callable_copy(sdl_parser *p, sdl_value *out)
+{
+    const sdl_tok *t = sdl_peek(p);
+    if (t->tk.kind != TOK_IDENT || (t->val.kind != VAL_FUNCTION && t->val.kind != VAL_SPLINE)) return 0;
+    sdl_tok id = sdl_next(p);
+    if (sdl_is(sdl_peek(p), TOK_LPAREN)) {
+        sdl_unget(p, &id);
+        return 0;
+    }
+    *out = id.val;
+    return 1;
+}
+
 void sdl_rvalue(sdl_parser *p, sdl_value *out)
 {
     const sdl_tok *t = sdl_peek(p);
@@ -706,6 +722,8 @@ void sdl_rvalue(sdl_parser *p, sdl_value *out)
         out->kind = VAL_COLOUR;
         out->dim = 5;
         out->v[0] = c.r; out->v[1] = c.g; out->v[2] = c.b; out->v[3] = c.f; out->v[4] = c.t;
+    } else if (callable_copy(p, out)) {
+        return;
     } else if (sdl_starts_expr(t)) {
         sdl_sum(p, out); /* POV-Ray reads a declared value at the sum level: comparisons need ( ) */
     } else if (t->tk.kind == TOK_IDENT && t->val.kind != VAL_NONE) {
@@ -768,6 +786,9 @@ static void declare_directive(sdl_parser *p, int local)
         sdl_error(p, id.tk.loc, PT_ERR_SYNTAX, "function '%.*s' cannot be redeclared (#undef it first)", id.tk.len, id.tk.text);
         return;
     }
+    /* the target is resolved now: the value may call macros or end the
+     * running macro (POV-Ray's Parse_Declare adds the symbol first) */
+    sdl_symtarget target = sdl_symtab_target(p->sym, id.tk.text, (size_t)id.tk.len, local);
     if (!sdl_expect(p, TOK_EQ, "'='")) return;
     /* Directives after the value must run after the assignment: look-ahead
      * past an expression (and the ';' check) defers them, as POV-Ray does. */
@@ -781,9 +802,8 @@ static void declare_directive(sdl_parser *p, int local)
     if (arr) {
         sdl_array_set(p, arr, index, &v, at);
     } else {
-        int ok = !sdl_ok(p) || (local ? sdl_symtab_local(p->sym, id.tk.text, (size_t)id.tk.len, &v)
-                                      : sdl_symtab_declare(p->sym, id.tk.text, (size_t)id.tk.len, &v));
-        if (!ok) sdl_error(p, id.tk.loc, PT_ERR_NOMEM, "out of memory");
+        if (sdl_ok(p) && sdl_symtab_assign(p->sym, &target, id.tk.text, (size_t)id.tk.len, &v) == 0)
+            sdl_error(p, id.tk.loc, PT_ERR_NOMEM, "out of memory");
     }
     sdl_accept(p, TOK_SEMI);
     p->defer--;

@@ -6,6 +6,7 @@
 #include <string.h>
 #include "sdl_array.h"
 #include "sdl_directive.h"
+#include "sdl_function.h"
 
 #define SDL_EPSILON 1e-10 /* POV-Ray's truth threshold for floats */
 
@@ -107,7 +108,7 @@ int sdl_starts_float(const sdl_tok *t)
     case TOK_KEYWORD:
         return kw_is_float_fn(t->tk.kw);
     case TOK_IDENT:
-        return t->val.kind == VAL_FLOAT || (t->val.kind == VAL_OPAQUE && t->val.str && strcmp(t->val.str, "function") == 0);
+        return t->val.kind == VAL_FLOAT || t->val.kind == VAL_FUNCTION;
     default:
         return 0;
     }
@@ -126,7 +127,7 @@ int sdl_starts_expr(const sdl_tok *t)
     if (t->tk.kind == TOK_LT) return 1;
     if (t->tk.kind == TOK_KEYWORD)
         return kw_is_vector_fn(t->tk.kw) || t->tk.kw == KW_U || t->tk.kw == KW_V || t->tk.kw == KW_T;
-    return ident_kind(t, VAL_VECTOR);
+    return ident_kind(t, VAL_VECTOR) || ident_kind(t, VAL_FUNCTION) || ident_kind(t, VAL_SPLINE);
 }
 
 int sdl_starts_string(const sdl_tok *t)
@@ -512,12 +513,14 @@ static void identifier_value(sdl_parser *p, const sdl_tok *t, ex_val *out)
     case VAL_NONE:
         sdl_error(p, t->tk.loc, PT_ERR_SYNTAX, "undeclared identifier '%.*s'", t->tk.len, t->tk.text);
         return;
-    case VAL_OPAQUE:
-        if (t->val.str && strcmp(t->val.str, "function") == 0) {
-            sdl_error(p, t->tk.loc, PT_ERR_UNSUPPORTED, "calling user-defined function '%.*s' is not supported yet", t->tk.len, t->tk.text);
-            return;
-        }
-        break;
+    case VAL_FUNCTION: case VAL_SPLINE: {
+        /* a float function's value fills every term it is promoted to;
+         * vector, colour and spline results keep their terms */
+        if (t->val.kind == VAL_FUNCTION) sdl_call_function(p, t, out->v);
+        else sdl_call_spline(p, t, out->v);
+        out->n = t->val.kind == VAL_FUNCTION ? ((const scene_function *)t->val.ptr)->nterms : ((const user_spline *)t->val.ptr)->terms;
+        return;
+    }
     default:
         break;
     }

@@ -17,6 +17,8 @@ typedef struct sym_entry {
 struct sdl_symtab {
     sym_entry *buckets[SYM_BUCKETS];
     sym_entry **scopes;          /* scopes[d]: list of entries of depth d */
+    unsigned long *ids;          /* ids[d]: serial number of the scope at depth d */
+    unsigned long next_id;
     int depth, cap;
     sym_entry *undefined;        /* #undef'd entries, freed with the table */
 };
@@ -34,10 +36,14 @@ sdl_symtab *sdl_symtab_new(void)
     if (!t) return NULL;
     t->cap = 16;
     t->scopes = calloc((size_t)t->cap, sizeof *t->scopes);
-    if (!t->scopes) {
+    t->ids = calloc((size_t)t->cap, sizeof *t->ids);
+    if (!t->scopes || !t->ids) {
+        free(t->scopes);
+        free(t->ids);
         free(t);
         return NULL;
     }
+    t->next_id = 1;
     return t;
 }
 
@@ -74,6 +80,7 @@ void sdl_symtab_free(sdl_symtab *t)
         t->undefined = n;
     }
     free(t->scopes);
+    free(t->ids);
     free(t);
 }
 
@@ -86,9 +93,13 @@ int sdl_symtab_push(sdl_symtab *t)
         sym_entry **n = realloc(t->scopes, sizeof *n * (size_t)nc);
         if (!n) return 0;
         t->scopes = n;
+        unsigned long *ni = realloc(t->ids, sizeof *ni * (size_t)nc);
+        if (!ni) return 0;
+        t->ids = ni;
         t->cap = nc;
     }
     t->scopes[++t->depth] = NULL;
+    t->ids[t->depth] = t->next_id++;
     return 1;
 }
 
@@ -203,4 +214,42 @@ int sdl_symtab_scope_of(const sdl_symtab *t, const char *name, size_t n)
 {
     sym_entry *e = find_entry(t, name, n);
     return e ? e->depth : -1;
+}
+
+sdl_symtarget sdl_symtab_target(const sdl_symtab *t, const char *name, size_t n, int local)
+{
+    sdl_symtarget tg;
+    memset(&tg, 0, sizeof tg);
+    sym_entry *e = find_entry(t, name, n);
+    if (local) {
+        tg.depth = t->depth;
+        tg.entry = e && e->depth == t->depth ? e : NULL;
+    } else if (e) {
+        tg.depth = e->depth;
+        tg.entry = e;
+    } else {
+        tg.depth = 0;
+    }
+    tg.scope = t->ids[tg.depth];
+    return tg;
+}
+
+int sdl_symtab_assign(sdl_symtab *t, const sdl_symtarget *tg, const char *name, size_t n, const sdl_value *v)
+{
+    if (tg->depth > t->depth || t->ids[tg->depth] != tg->scope) return -1; /* the scope has ended */
+    if (tg->entry) {
+        resolve(tg->entry)->val = *v;
+        return 1;
+    }
+    sym_entry *e = find_entry(t, name, n);
+    while (e && e->depth > tg->depth) { /* an entry made meanwhile further in: look past it */
+        sym_entry *o = e->hnext;
+        while (o && !(strlen(o->name) == n && memcmp(o->name, name, n) == 0)) o = o->hnext;
+        e = o;
+    }
+    if (e && e->depth == tg->depth) {
+        resolve(e)->val = *v;
+        return 1;
+    }
+    return insert_entry(t, name, n, tg->depth, v);
 }

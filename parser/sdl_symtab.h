@@ -28,7 +28,7 @@ typedef enum {
                       colour_map...): str names the kind */
     VAL_ARRAY,     /* ptr: sdl_array (sdl_array.h) */
     VAL_FUNCTION,  /* ptr: scene_function (core/func.h); dim = result terms */
-    VAL_SPLINE,    /* ptr: scene_spline (core/spline.h) */
+    VAL_SPLINE,    /* ptr: user_spline (core/uspline.h) */
     VAL_FILE       /* ptr: sdl_file (sdl_file.h), an #fopen'ed file */
 } sdl_val_kind;
 
@@ -67,6 +67,19 @@ int sdl_symtab_undef(sdl_symtab *t, const char *name, size_t n);
 typedef struct sym_entry sdl_symref;
 sdl_symref *sdl_symtab_ref(const sdl_symtab *t, const char *name, size_t n);
 int sdl_symtab_alias(sdl_symtab *t, const char *name, size_t n, sdl_symref *target);
+/* Where a #declare/#local assigns, resolved when the directive starts (as
+ * POV-Ray does): parsing the value may call macros or leave the current
+ * macro, so the scope is remembered by identity. local: the innermost
+ * scope; else the innermost visible entry, or the global scope. */
+typedef struct {
+    sdl_symref *entry;    /* the entry to assign (NULL: create one) */
+    int depth;
+    unsigned long scope;  /* serial number of the scope at `depth` */
+} sdl_symtarget;
+sdl_symtarget sdl_symtab_target(const sdl_symtab *t, const char *name, size_t n, int local);
+/* Assign v to the target: 1 done, 0 out of memory, -1 the target's scope has
+ * ended meanwhile (nothing assigned). */
+int sdl_symtab_assign(sdl_symtab *t, const sdl_symtarget *tg, const char *name, size_t n, const sdl_value *v);
 /* Scope depth of the innermost visible entry, -1 if none. */
 int sdl_symtab_scope_of(const sdl_symtab *t, const char *name, size_t n);
 

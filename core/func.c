@@ -1,0 +1,179 @@
+/* func.c - evaluation of compiled POV-Ray functions. */
+#include "func.h"
+#include <math.h>
+#include <string.h>
+#include "func_internal.h"
+
+#define FUNC_MAX_CALL_DEPTH 256
+
+typedef struct {
+    const func_env *env;
+    const char *why;
+    int depth;
+    int failed;
+} eval_ctx;
+
+static int truth(double v) { return v != 0.0; }
+
+static pt_status eval_function(const scene_function *f, const double *args, double *out, eval_ctx *c);
+
+static double math1(func_math m, double x)
+{
+    switch (m) {
+    case FM_SIN: return sin(x);
+    case FM_COS: return cos(x);
+    case FM_TAN: return tan(x);
+    case FM_ASIN: return asin(x);
+    case FM_ACOS: return acos(x);
+    case FM_ATAN: return atan(x);
+    case FM_SINH: return sinh(x);
+    case FM_COSH: return cosh(x);
+    case FM_TANH: return tanh(x);
+    case FM_ASINH: return asinh(x);
+    case FM_ACOSH: return acosh(x);
+    case FM_ATANH: return atanh(x);
+    case FM_ABS: return fabs(x);
+    case FM_RADIANS: return x * (M_PI / 180.0);
+    case FM_DEGREES: return x * (180.0 / M_PI);
+    case FM_FLOOR: return floor(x);
+    case FM_INT: return trunc(x);
+    case FM_CEIL: return ceil(x);
+    case FM_SQRT: return sqrt(x);
+    case FM_EXP: return exp(x);
+    case FM_LN: return log(x);
+    case FM_LOG: return log10(x);
+    default: return x * x; /* FM_SQR */
+    }
+}
+
+/* One node's value; slots holds the parameters and loop variables. */
+static double node_value(const scene_function *f, int i, double *slots, eval_ctx *c)
+{
+    const func_node *n = &f->nodes[i];
+    const int *k = f->kids + n->kid;
+    if (c->failed) return 0;
+#define KID(j) node_value(f, k[j], slots, c)
+    switch ((func_op)n->op) {
+    case FN_CONST: return n->k;
+    case FN_ARG: return slots[n->slot];
+    case FN_NEG: return -KID(0);
+    case FN_ADD: return KID(0) + KID(1);
+    case FN_SUB: return KID(0) - KID(1);
+    case FN_MUL: return KID(0) * KID(1);
+    case FN_DIV: return KID(0) / KID(1);
+    case FN_LT: return KID(0) < KID(1);
+    case FN_LE: return KID(0) <= KID(1);
+    case FN_EQ: return KID(0) == KID(1);
+    case FN_NE: return KID(0) != KID(1);
+    case FN_GE: return KID(0) >= KID(1);
+    case FN_GT: return KID(0) > KID(1);
+    case FN_AND: { double a = KID(0); double b = KID(1); return truth(a) && truth(b); }
+    case FN_OR: { double a = KID(0); double b = KID(1); return truth(a) || truth(b); }
+    case FN_MATH: return math1((func_math)n->sub, KID(0));
+    case FN_ATAN2: { double a = KID(0); return atan2(a, KID(1)); }
+    case FN_POW: { double a = KID(0); return pow(a, KID(1)); }
+    case FN_MOD: { double a = KID(0); return fmod(a, KID(1)); }
+    case FN_IDIV: { double a = KID(0); return trunc(a / KID(1)); }
+    case FN_MIN: case FN_MAX: {
+        double v = KID(0);
+        for (int j = 1; j < n->nkids; j++) {
+            double w = KID(j);
+            if (n->op == FN_MIN ? w < v : w > v) v = w;
+        }
+        return v;
+    }
+    case FN_SELECT: {
+        double a = KID(0);
+        if (a < 0) return KID(1);
+        if (n->nkids == 3 || a == 0) return KID(2);
+        return KID(3);
+    }
+    case FN_SUM: case FN_PROD: {
+        double from = KID(0), to = KID(1), acc = n->op == FN_SUM ? 0.0 : 1.0;
+        for (double v = from; v <= to && !c->failed; v += 1.0) {
+            slots[n->slot] = v;
+            double b = KID(2);
+            acc = n->op == FN_SUM ? acc + b : acc * b;
+        }
+        return acc;
+    }
+    case FN_CALL: {
+        double a[FUNC_MAX_SLOTS], r[5];
+        for (int j = 0; j < n->nkids && j < FUNC_MAX_SLOTS; j++) a[j] = KID(j);
+        if (eval_function(n->fn, a, r, c) != PT_OK) return 0;
+        if (n->sub == 5) return 0.297 * r[0] + 0.589 * r[1] + 0.114 * r[2]; /* gray */
+        return n->sub < n->fn->nterms ? r[n->sub] : 0.0;
+    }
+    case FN_INTERNAL: {
+        double v;
+        if (func_internal_eval(n->slot, slots, c->env, &v)) return v;
+        c->failed = 1;
+        c->why = func_internal_name(n->slot);
+        return 0;
+    }
+    }
+#undef KID
+    return 0;
+}
+
+static pt_status eval_function(const scene_function *f, const double *args, double *out, eval_ctx *c)
+{
+    for (int i = 0; i < (f->nterms > 0 ? f->nterms : 1); i++) out[i] = 0;
+    if (c->failed) return PT_ERR_UNSUPPORTED;
+    if (c->depth >= FUNC_MAX_CALL_DEPTH) {
+        c->failed = 1;
+        c->why = "calls nested too deep";
+        return PT_ERR_UNSUPPORTED;
+    }
+    c->depth++;
+    switch (f->kind) {
+    case FUNC_FLOAT: {
+        double slots[FUNC_MAX_SLOTS];
+        int np = f->nparams < FUNC_MAX_SLOTS ? f->nparams : FUNC_MAX_SLOTS;
+        memset(slots, 0, sizeof slots);
+        memcpy(slots, args, sizeof(double) * (size_t)np);
+        out[0] = node_value(f, f->root, slots, c);
+        break;
+    }
+    case FUNC_TRANSFORM: {
+        vec3 p = xform_point(&f->transform, v3(args[0], args[1], args[2]));
+        out[0] = p.x;
+        out[1] = p.y;
+        out[2] = p.z;
+        break;
+    }
+    case FUNC_SPLINE: {
+        double v[5];
+        uspline_eval(f->spline, f->spline->kind, f->spline->m, args[0], v);
+        for (int i = 0; i < f->nterms; i++) out[i] = v[i];
+        break;
+    }
+    case FUNC_PIGMENT: case FUNC_PATTERN: {
+        double v[5] = {0, 0, 0, 0, 0};
+        if (!c->env || !c->env->pigment || !c->env->pigment(c->env->user, f, v3(args[0], args[1], args[2]), v)) {
+            c->failed = 1;
+            c->why = f->kind == FUNC_PIGMENT ? "pigment function" : "pattern function";
+            break;
+        }
+        for (int i = 0; i < f->nterms; i++) out[i] = v[i];
+        break;
+    }
+    }
+    c->depth--;
+    return c->failed ? PT_ERR_UNSUPPORTED : PT_OK;
+}
+
+pt_status func_eval(const scene_function *f, const double *args, double *out, const func_env *env, const char **why)
+{
+    eval_ctx c = {env, NULL, 0, 0};
+    pt_status st = eval_function(f, args, out, &c);
+    if (why) *why = c.why;
+    return st;
+}
+
+double func_eval_float(const scene_function *f, const double *args, const func_env *env)
+{
+    double out[5];
+    if (func_eval(f, args, out, env, NULL) != PT_OK) return NAN;
+    return out[0];
+}
