@@ -384,6 +384,7 @@ static int lathe_hits(const sw_data *w, const lray *r, double tmin, double tmax,
     double rxz = e.x * e.x + e.z * e.z, m = P.x * e.x + P.z * e.z, P2 = P.x * P.x + P.z * P.z;
     for (int k = 0; k < w->nseg; k++) {
         const sw_seg *s = &w->seg[k];
+        if (s->hi[0] <= 0.0 && s->lo[0] >= 0.0) continue; /* on the axis: no surface */
         /* cull: the ray's y range and its distance from the axis there */
         double ta = r->ta, tb = r->tb;
         if (e.y != 0.0) {

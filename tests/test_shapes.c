@@ -1,0 +1,771 @@
+/* test_shapes.c - issue 4 shapes end to end (SDL -> IR -> accel): hit
+ * distances and normals against closed-form answers, grazing rays, rays
+ * starting on the surface, scales 1e-4 to 1e5, inside tests, clipped_by;
+ * where no closed form exists (Catmull-Rom lathe, sor, Bezier prism, text)
+ * the first hit is checked against a brute-force march of the shape's
+ * inside test along the ray (bisected to 1e-12 of the ray length). Plus the
+ * polynomial solver (both isolation methods) and the height_field reader.
+ * Tolerances: 1e-9 relative for distances unless stated, 1e-8 for normals. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include "accel.h"
+#include "accel_poly.h"
+#include "accel_shapes.h"
+#include "diag.h"
+#include "scene.h"
+#include "sdl.h"
+
+static void assert_near(double a, double b, double tol)
+{
+    if (!(fabs(a - b) <= tol)) fail_msg("got %.17g, expected %.17g (tol %g)", a, b, tol);
+}
+
+static void assert_vec(vec3 a, vec3 b, double tol)
+{
+    if (!(fabs(a.x - b.x) <= tol && fabs(a.y - b.y) <= tol && fabs(a.z - b.z) <= tol))
+        fail_msg("got <%.12g,%.12g,%.12g>, expected <%.12g,%.12g,%.12g> (tol %g)", a.x, a.y, a.z, b.x, b.y, b.z, tol);
+}
+
+typedef struct {
+    scene *s;
+    accel *a;
+    diag *d;
+} world;
+
+static world build(const char *src)
+{
+    world w;
+    w.d = diag_new();
+    sdl_options opt;
+    sdl_default_options(&opt);
+    pt_status st = sdl_parse_string("shapes.pov", src, &opt, &w.s, w.d);
+    if (st != PT_OK) {
+        for (int i = 0; i < diag_count(w.d); i++) {
+            char *m = diag_format(diag_get(w.d, i));
+            fprintf(stderr, "%s\n", m);
+            free(m);
+        }
+        fail_msg("parse failed");
+    }
+    w.a = accel_build(w.s, 1, w.d, &st);
+    assert_non_null(w.a);
+    return w;
+}
+
+static void done(world *w)
+{
+    accel_free(w->a);
+    scene_free(w->s);
+    diag_free(w->d);
+}
+
+static int hit(const world *w, vec3 o, vec3 d, accel_hit *h) { return accel_intersect(w->a, o, d, 0.0, INFINITY, h); }
+
+static void expect_hit(const world *w, vec3 o, vec3 d, double t, vec3 n, double ttol, double ntol)
+{
+    accel_hit h;
+    if (!hit(w, o, d, &h)) fail_msg("expected a hit at t = %.17g", t);
+    assert_near(h.t, t, ttol);
+    if (ntol > 0) assert_vec(h.ng, v3_norm(n), ntol);
+}
+
+static void expect_miss(const world *w, vec3 o, vec3 d)
+{
+    accel_hit h;
+    if (hit(w, o, d, &h)) fail_msg("expected a miss, got t = %.17g", h.t);
+}
+
+/* The only leaf shape of the scene (first object, or its first kid). */
+static accel_shape shape_of(const world *w)
+{
+    const scene_object *o = w->s->objects[0];
+    accel_shape sh;
+    assert_int_equal(accel_shape_init(&sh, o), 0);
+    return sh;
+}
+
+/* Brute force: the first change of the inside test along o + t d for t in
+ * (t0, t1], marched in n steps and bisected. */
+static double march(const accel_shape *sh, vec3 o, vec3 d, double t0, double t1, int n)
+{
+    int in0 = accel_shape_inside(sh, v3_madd(o, d, t0));
+    double prev = t0;
+    for (int i = 1; i <= n; i++) {
+        double t = t0 + (t1 - t0) * i / n;
+        if (accel_shape_inside(sh, v3_madd(o, d, t)) != in0) {
+            double a = prev, b = t;
+            for (int k = 0; k < 80; k++) {
+                double m = 0.5 * (a + b);
+                if (accel_shape_inside(sh, v3_madd(o, d, m)) != in0) b = m;
+                else a = m;
+            }
+            return 0.5 * (a + b);
+        }
+        prev = t;
+    }
+    return INFINITY;
+}
+
+/* ------------------------------------------------------------ polynomial roots */
+
+static void test_poly_roots(void **st)
+{
+    (void)st;
+    /* (x-0.1)(x-0.2)(x-0.3)(x-0.4)(x-0.5) expanded */
+    double r[5] = {0.1, 0.2, 0.3, 0.4, 0.5}, c[6] = {1, 0, 0, 0, 0, 0};
+    for (int k = 0; k < 5; k++) {
+        for (int i = k + 1; i > 0; i--) c[i] = c[i - 1] - r[k] * c[i];
+        c[0] = -r[k] * c[0];
+    }
+    for (int sturm = 0; sturm < 2; sturm++) {
+        double out[5];
+        assert_int_equal(accel_poly_solve(c, 5, 0.0, 1.0, out, sturm), 5);
+        for (int i = 0; i < 5; i++) assert_near(out[i], r[i], 1e-12);
+        assert_int_equal(accel_poly_solve(c, 5, 0.25, 0.45, out, sturm), 2);
+        assert_near(out[0], 0.3, 1e-12);
+    }
+    /* degree 12: roots 1..12 scaled by 1/16 (Wilkinson-like clustering) */
+    double w[13] = {1};
+    for (int k = 1; k <= 12; k++) {
+        double rk = k / 16.0;
+        for (int i = k; i > 0; i--) w[i] = w[i - 1] - rk * w[i];
+        w[0] = -rk * w[0];
+    }
+    for (int sturm = 0; sturm < 2; sturm++) {
+        double out[12];
+        int n = accel_poly_solve(w, 12, 0.0, 1.0, out, sturm);
+        assert_int_equal(n, 12);
+        for (int i = 0; i < 12; i++) assert_near(out[i], (i + 1) / 16.0, 1e-7);
+    }
+    /* double root (a grazing ray): (x - 0.5)^2 (x + 3) */
+    double g[4] = {0.75, 2.0, 2.0, 1.0}; /* x^3 + 2x^2 - 2.75x... recomputed below */
+    g[0] = 0.25 * 3.0;   /* 0.75 */
+    g[1] = 0.25 - 3.0;   /* x coefficient: 0.25 - 3 = -2.75 */
+    g[2] = -1.0 + 3.0;   /* 2 */
+    g[3] = 1.0;
+    double out[3];
+    int n = accel_poly_solve(g, 3, 0.0, 1.0, out, 0);
+    assert_true(n >= 1);
+    assert_near(out[0], 0.5, 1e-7);
+}
+
+/* ------------------------------------------------------------ polygon */
+
+static void test_polygon(void **st)
+{
+    (void)st;
+    /* a 4x4 square with a 2x2 hole (two sub-polygons) in the z = 0 plane */
+    world w = build("polygon { 10, <-2,-2>, <2,-2>, <2,2>, <-2,2>, <-2,-2>,"
+                    " <-1,-1>, <1,-1>, <1,1>, <-1,1>, <-1,-1> }");
+    assert_int_equal(w.s->objects[0]->kind, SHAPE_POLYGON);
+    expect_hit(&w, v3(1.5, 0.5, -5), v3(0, 0, 1), 5.0, v3(0, 0, -1), 1e-12, -1);
+    accel_hit h;
+    assert_true(hit(&w, v3(1.5, 0.5, -5), v3(0, 0, 1), &h));
+    assert_near(fabs(h.ng.z), 1.0, 1e-12);
+    expect_miss(&w, v3(0, 0, -5), v3(0, 0, 1));      /* the hole */
+    expect_miss(&w, v3(2.5, 0, -5), v3(0, 0, 1));    /* outside */
+    expect_miss(&w, v3(-5, 1.5, 0), v3(1, 0, 0));    /* in the plane */
+    expect_hit(&w, v3(-1.99, -1.99, 3), v3(0, 0, -2), 1.5, v3(0, 0, 1), 1e-12, -1);
+    done(&w);
+    /* unclosed: closed automatically (a warning) */
+    w = build("polygon { 3, <0,0,1>, <1,0,1>, <0,1,1> }");
+    expect_hit(&w, v3(0.2, 0.2, 0), v3(0, 0, 1), 1.0, v3(0, 0, 1), 1e-12, -1);
+    done(&w);
+}
+
+/* ------------------------------------------------------------ lathe */
+
+static void test_lathe_linear(void **st)
+{
+    (void)st;
+    /* closed profile: a cylinder r = 1, 0 <= y <= 1 with flat ends */
+    world w = build("lathe { linear_spline 5, <0,0>, <1,0>, <1,1>, <0,1>, <0,0> }");
+    assert_int_equal(w.s->objects[0]->kind, SHAPE_LATHE);
+    expect_hit(&w, v3(-5, 0.5, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12);
+    expect_hit(&w, v3(0.3, 5, 0.2), v3(0, -1, 0), 4.0, v3(0, 1, 0), 1e-12, 1e-12);
+    expect_hit(&w, v3(0.3, -5, 0.2), v3(0, 1, 0), 5.0, v3(0, -1, 0), 1e-12, 1e-12);
+    /* a diagonal ray: enters the side at x = -1 */
+    expect_hit(&w, v3(-3, 0.5, -2), v3(1, 0, 1), 2.0, v3(-1, 0, 0), 1e-12, 1e-12);
+    expect_miss(&w, v3(-5, 1.5, 0), v3(1, 0, 0));
+    /* starting on the side, going in: the far side */
+    double xs = sqrt(0.99);
+    expect_hit(&w, v3(-xs, 0.5, 0.1), v3(1, 0, 0), 2 * xs, v3(xs, 0, 0.1), 1e-12, 1e-12);
+    accel_shape sh = shape_of(&w);
+    assert_true(accel_shape_inside(&sh, v3(0.5, 0.5, 0.1)));
+    assert_false(accel_shape_inside(&sh, v3(1.5, 0.5, 0)));
+    assert_false(accel_shape_inside(&sh, v3(0.5, 1.5, 0)));
+    accel_shape_release(&sh);
+    done(&w);
+}
+
+/* r = 1 + y^2 for y in [0,1], reproduced exactly by quadratic, cubic
+ * (Catmull-Rom: quadratics are reproduced) and Bezier segments. */
+static void check_paraboloid_lathe(const char *src, double scale)
+{
+    world w = build(src);
+    for (int i = 1; i < 10; i++) {
+        double y = i / 10.0, r = 1.0 + y * y;
+        vec3 o = v3(-5 * scale, y * scale, 0);
+        vec3 n = v3(-1, -2 * y, 0);
+        expect_hit(&w, o, v3(1, 0, 0), (5 - r) * scale, n, 1e-11 * 5 * scale, 1e-9);
+    }
+    /* nearly horizontal rays (the special method below 1e-5) and steeper ones agree */
+    for (int k = 0; k < 4; k++) {
+        double ey = k == 0 ? 3e-6 : k == 1 ? 2e-5 : k == 2 ? 0.01 : 0.3;
+        vec3 d = v3_norm(v3(1, ey, 0.0));
+        vec3 o = v3(-5 * scale, 0.5 * scale - 5 * scale * ey, 0.0);
+        accel_hit h;
+        assert_true(hit(&w, o, d, &h));
+        vec3 p = v3_scale(h.p, 1.0 / scale);
+        double r = sqrt(p.x * p.x + p.z * p.z);
+        assert_near(r, 1.0 + p.y * p.y, 1e-9);
+    }
+    done(&w);
+}
+
+static void test_lathe_splines(void **st)
+{
+    (void)st;
+    char buf[1024];
+    const double scales[] = {1e-4, 1.0, 1e5};
+    for (int s = 0; s < 3; s++) {
+        double k = scales[s];
+        /* quadratic: first point is a control point; points on r = 1 + y^2, y step 0.25 */
+        snprintf(buf, sizeof buf,
+                 "lathe { quadratic_spline 6, <1.0625,-0.25>, <1,0>, <1.0625,0.25>, <1.25,0.5>, <1.5625,0.75>, <2,1> scale %g }", k);
+        check_paraboloid_lathe(buf, k);
+        snprintf(buf, sizeof buf,
+                 "lathe { cubic_spline 7, <1.0625,-0.25>, <1,0>, <1.0625,0.25>, <1.25,0.5>, <1.5625,0.75>, <2,1>, <2.5625,1.25> scale %g }", k);
+        check_paraboloid_lathe(buf, k);
+        snprintf(buf, sizeof buf, "lathe { bezier_spline 4, <1,0>, <1,0.333333333333333333>, <1.333333333333333333,0.66666666666666667>, <2,1> scale %g }", k);
+        check_paraboloid_lathe(buf, k);
+    }
+}
+
+static void test_lathe_brute(void **st)
+{
+    (void)st;
+    /* a vase-like closed Catmull-Rom profile: first hit = inside-test march */
+    world w = build("lathe { cubic_spline 8, <0,-0.2>, <0,0>, <1,0.2>, <0.5,0.6>, <0.8,1.2>, <0.6,1.6>, <0,1.7>, <-0.3,1.8> sturm }");
+    accel_shape sh = shape_of(&w);
+    int checked = 0;
+    for (int i = 0; i < 40; i++) {
+        double y = 0.05 + 1.6 * i / 40.0, a = 0.3 * i;
+        vec3 o = v3(-3 * cos(a), y + 0.4, -3 * sin(a));
+        vec3 d = v3_norm(v3(3 * cos(a), -0.4 + 0.01 * i, 3 * sin(a) + 0.2));
+        accel_hit h;
+        double tb = march(&sh, o, d, 1e-9, 6.0, 4000);
+        int got = hit(&w, o, d, &h);
+        if (isinf(tb)) {
+            if (got) fail_msg("ray %d: hit at %g, march found none", i, h.t);
+            continue;
+        }
+        assert_true(got);
+        assert_near(h.t, tb, 1e-9);
+        checked++;
+    }
+    assert_true(checked > 20);
+    accel_shape_release(&sh);
+    done(&w);
+}
+
+/* ------------------------------------------------------------ sor */
+
+static void test_sor(void **st)
+{
+    (void)st;
+    /* points on r = 1 (a cylinder, exact), caps at y = 0 and y = 1 */
+    world w = build("sor { 4, <1,-1>, <1,0>, <1,1>, <1,2> }");
+    assert_int_equal(w.s->objects[0]->kind, SHAPE_SOR);
+    expect_hit(&w, v3(-5, 0.5, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12);
+    expect_hit(&w, v3(0.2, 5, 0.3), v3(0, -1, 0), 4.0, v3(0, 1, 0), 1e-12, 1e-12);
+    expect_hit(&w, v3(0.2, -5, 0.3), v3(0, 1, 0), 5.0, v3(0, -1, 0), 1e-12, 1e-12);
+    expect_miss(&w, v3(-5, 1.5, 0), v3(1, 0, 0));
+    done(&w);
+    w = build("sor { 4, <1,-1>, <1,0>, <1,1>, <1,2> open }");
+    expect_miss(&w, v3(0.2, 5, 0.3), v3(0, -1, 0)); /* down the open tube */
+    expect_hit(&w, v3(-5, 0.5, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12);
+    done(&w);
+}
+
+static void test_sor_brute(void **st)
+{
+    (void)st;
+    world w = build("sor { 6, <0.5,-0.5>, <1,0>, <0.4,0.5>, <0.8,1.3>, <0.2,1.6>, <0.3,2> }");
+    accel_shape sh = shape_of(&w);
+    int checked = 0;
+    for (int i = 0; i < 30; i++) {
+        double a = 0.21 * i;
+        vec3 o = v3(-3 * cos(a), 0.1 + 0.05 * i, -3 * sin(a));
+        vec3 d = v3_norm(v3(3 * cos(a) + 0.1, 0.5 - 0.03 * i, 3 * sin(a)));
+        double tb = march(&sh, o, d, 1e-9, 6.0, 4000);
+        accel_hit h;
+        int got = hit(&w, o, d, &h);
+        if (isinf(tb)) {
+            assert_false(got);
+            continue;
+        }
+        assert_true(got);
+        assert_near(h.t, tb, 1e-9);
+        checked++;
+    }
+    assert_true(checked > 10);
+    accel_shape_release(&sh);
+    done(&w);
+}
+
+/* ------------------------------------------------------------ prism */
+
+static void test_prism(void **st)
+{
+    (void)st;
+    const double scales[] = {1e-4, 1.0, 1e5};
+    char buf[512];
+    for (int s = 0; s < 3; s++) {
+        double k = scales[s];
+        /* a 2x2 square with a 1x1 hole, y from 0 to 1 */
+        snprintf(buf, sizeof buf,
+                 "prism { linear_sweep linear_spline 0, 1, 10, <-1,-1>, <1,-1>, <1,1>, <-1,1>, <-1,-1>,"
+                 " <-0.5,-0.5>, <0.5,-0.5>, <0.5,0.5>, <-0.5,0.5>, <-0.5,-0.5> scale %g translate <%g,0,0> }", k, 3 * k);
+        world w = build(buf);
+        vec3 c = v3(3 * k, 0, 0);
+        expect_hit(&w, v3_add(c, v3(-5 * k, 0.5 * k, 0.75 * k)), v3(1, 0, 0), 4 * k, v3(-1, 0, 0), 1e-11 * k, 1e-9);
+        /* through the hole along x at z = 0: outer wall, then the hole's wall */
+        expect_hit(&w, v3_add(c, v3(-0.75 * k, 0.5 * k, 0)), v3(1, 0, 0), 0.25 * k, v3(1, 0, 0), 1e-11 * k, 1e-9);
+        expect_hit(&w, v3_add(c, v3(0.75 * k, 3 * k, 0.1 * k)), v3(0, -1, 0), 2 * k, v3(0, 1, 0), 1e-11 * k, 1e-9);
+        expect_miss(&w, v3_add(c, v3(0, 3 * k, 0)), v3(0, -1, 0)); /* down the hole */
+        done(&w);
+    }
+    /* conic sweep: a pyramid |x|, |z| < y for 0 < y < 1 */
+    world w = build("prism { conic_sweep linear_spline 0, 1, 5, <-1,-1>, <1,-1>, <1,1>, <-1,1>, <-1,-1> }");
+    expect_hit(&w, v3(-5, 0.5, 0), v3(1, 0, 0), 4.5, v3(-1, -1, 0), 1e-12, 1e-9);
+    expect_hit(&w, v3(0.3, 5, -0.2), v3(0, -1, 0), 4.0, v3(0, 1, 0), 1e-12, 1e-12);
+    done(&w);
+    /* open: no caps */
+    w = build("prism { 0, 1, 4, <-1,-1>, <1,-1>, <1,1>, <-1,1> open }");
+    expect_miss(&w, v3(0, 5, 0), v3(0, -1, 0));
+    expect_hit(&w, v3(-5, 0.5, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12);
+    done(&w);
+}
+
+static void test_prism_brute(void **st)
+{
+    (void)st;
+    const char *src[] = {
+        "prism { bezier_spline 0, 1, 8, <0,0>, <1,0>, <1,1>, <1,1>, <1,1>, <0,1>, <0,0.5>, <0,0> }",
+        "prism { quadratic_spline 0, 1, 6, <0,-1>, <1,0>, <0,1>, <-1,0>, <0,-1>, <1,0> }",
+        "prism { cubic_spline -0.5, 0.5, 7, <0,-1>, <1,0>, <0,1>, <-1,0>, <0,-1>, <1,0>, <0,1> }",
+        "prism { conic_sweep cubic_spline 0.5, 1, 7, <0,-1>, <1,0>, <0,1>, <-1,0>, <0,-1>, <1,0>, <0,1> }",
+    };
+    for (int s = 0; s < 4; s++) {
+        world w = build(src[s]);
+        accel_shape sh = shape_of(&w);
+        int checked = 0;
+        for (int i = 0; i < 30; i++) {
+            double a = 0.37 * i;
+            vec3 o = v3(-3 * cos(a) + 0.3, 0.3 + 0.02 * i, -3 * sin(a));
+            vec3 d = v3_norm(v3(3 * cos(a), 0.3 - 0.02 * i, 3 * sin(a) + 0.1));
+            double tb = march(&sh, o, d, 1e-9, 6.0, 4000);
+            accel_hit h;
+            int got = hit(&w, o, d, &h);
+            if (isinf(tb)) {
+                if (got) fail_msg("shape %d ray %d: hit %g, march none", s, i, h.t);
+                continue;
+            }
+            if (!got) fail_msg("shape %d ray %d: march %g, no hit", s, i, tb);
+            assert_near(h.t, tb, 1e-9);
+            checked++;
+        }
+        if (checked < 3) fail_msg("shape %d: only %d rays hit", s, checked);
+        accel_shape_release(&sh);
+        done(&w);
+    }
+}
+
+/* ------------------------------------------------------------ text */
+
+static void test_text(void **st)
+{
+    (void)st;
+    if (access("/usr/share/povray-3.7/include/timrom.ttf", R_OK) != 0) skip();
+    world w = build("text { ttf \"timrom.ttf\" \"I-I\" 0.25, 0 }");
+    const scene_object *o = w.s->objects[0];
+    assert_int_equal(o->kind, SHAPE_TEXT);
+    assert_true(o->u.text->nsegments > 8);
+    /* the front face lies in z = 0 (up to POV-Ray's 0.001 degree turn), the back in z = 0.25 */
+    accel_shape sh = shape_of(&w);
+    vec3 lo = sh.lo, hi = sh.hi;
+    assert_near(lo.z, 0.0, 1e-4);
+    assert_near(hi.z, 0.25, 1e-4);
+    assert_true(hi.y > 0.5 && hi.y < 1.0); /* caps height of a Roman face, em = 1 */
+    int front = 0;
+    for (int i = 0; i < 200; i++) {
+        double x = lo.x + (hi.x - lo.x) * (i + 0.5) / 200.0, y = 0.3;
+        accel_hit h;
+        vec3 org = v3(x, y, -2);
+        int in = accel_shape_inside(&sh, v3(x, y, 0.125));
+        int got = hit(&w, org, v3(0, 0, 1), &h);
+        assert_int_equal(in, got);
+        if (got) {
+            assert_near(h.t, 2.0, 1e-4);
+            assert_true(h.ng.z < -0.9999);
+            front++;
+        }
+    }
+    assert_true(front > 10);
+    /* side hits agree with the inside march */
+    for (int i = 0; i < 20; i++) {
+        vec3 org = v3(lo.x - 1, 0.05 + 0.03 * i, 0.1);
+        vec3 d = v3(1, 0.001 * i, 0.0);
+        double tb = march(&sh, org, d, 1e-9, hi.x - lo.x + 2, 20000);
+        accel_hit h;
+        int got = hit(&w, org, d, &h);
+        if (isinf(tb)) continue;
+        assert_true(got);
+        assert_near(h.t, tb, 1e-8);
+    }
+    accel_shape_release(&sh);
+    done(&w);
+}
+
+/* ------------------------------------------------------------ superellipsoid */
+
+static void test_superellipsoid(void **st)
+{
+    (void)st;
+    const double scales[] = {1e-4, 1.0, 1e5};
+    char buf[256];
+    for (int s = 0; s < 3; s++) {
+        double k = scales[s];
+        /* <1,1>: the unit sphere */
+        snprintf(buf, sizeof buf, "superellipsoid { <1,1> scale %g }", k);
+        world w = build(buf);
+        for (int i = 0; i < 8; i++) {
+            double y = 0.11 * i, z = -0.07 * i;
+            double x = sqrt(1 - y * y - z * z);
+            expect_hit(&w, v3(-5 * k, y * k, z * k), v3(1, 0, 0), (5 - x) * k, v3(-x, y, z), 1e-10 * k, 1e-8);
+        }
+        /* grazing: just inside touches, just outside misses */
+        accel_hit h;
+        assert_true(hit(&w, v3(-5 * k, (1 - 1e-7) * k, 0), v3(1, 0, 0), &h));
+        assert_near(h.t, 5 * k, 1e-3 * k);
+        expect_miss(&w, v3(-5 * k, (1 + 1e-7) * k, 0), v3(1, 0, 0));
+        /* from the surface inwards: the far side */
+        expect_hit(&w, v3(-k, 0, 0), v3(1, 0, 0), 2 * k, v3(1, 0, 0), 1e-9 * k, 1e-8);
+        done(&w);
+    }
+    /* <2,2>: the octahedron |x| + |y| + |z| = 1 */
+    world w = build("superellipsoid { <2,2> }");
+    expect_hit(&w, v3(-5, 0.2, 0.1), v3(1, 0, 0), 4.3, v3(-1, 1, 1), 1e-10, 1e-8);
+    done(&w);
+    /* <0.5, 3> (not convex in z: sampled), against the inside march */
+    w = build("superellipsoid { <0.5, 3> }");
+    accel_shape sh = shape_of(&w);
+    for (int i = 0; i < 20; i++) {
+        vec3 o = v3(-3, -0.9 + 0.09 * i, 0.3 - 0.05 * i);
+        vec3 d = v3_norm(v3(1, 0.05, 0.1 * sin(i)));
+        double tb = march(&sh, o, d, 1e-9, 6, 6000);
+        accel_hit h;
+        int got = hit(&w, o, d, &h);
+        if (isinf(tb)) continue;
+        assert_true(got);
+        assert_near(h.t, tb, 1e-9);
+    }
+    accel_shape_release(&sh);
+    done(&w);
+}
+
+/* ------------------------------------------------------------ quadric, poly */
+
+static void test_quadric(void **st)
+{
+    (void)st;
+    /* sphere radius 2 centred at <1,0,0>: x2 + y2 + z2 - 2x - 3 */
+    world w = build("quadric { <1,1,1>, <0,0,0>, <-2,0,0>, -3 }");
+    expect_hit(&w, v3(-5, 0, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12);
+    expect_hit(&w, v3(1, 5, 0), v3(0, -1, 0), 3.0, v3(0, 1, 0), 1e-12, 1e-12);
+    done(&w);
+    /* infinite cylinder x2 + z2 = 1 along y (clipped like a plane), 1e5 away */
+    w = build("quadric { <1,0,1>, <0,0,0>, <0,0,0>, -1 } sphere { <0,0,0>, 0.1 }");
+    expect_hit(&w, v3(-5, 1e3, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-9, 1e-9);
+    expect_hit(&w, v3(0.5, 3, 0), v3(1, 0, 0), 0.5, v3(1, 0, 0), 1e-12, 1e-12);
+    accel_shape sh = shape_of(&w);
+    assert_true(accel_shape_inside(&sh, v3(0.2, 1e6, 0.2)));
+    assert_false(accel_shape_inside(&sh, v3(1.2, 0, 0)));
+    accel_shape_release(&sh);
+    done(&w);
+    /* clipped_by { bounded_by }: the cylinder between y = -1 and 1 */
+    w = build("quadric { <1,0,1>, <0,0,0>, <0,0,0>, -1 bounded_by { box { <-2,-1,-2>, <2,1,2> } } clipped_by { bounded_by } }");
+    expect_hit(&w, v3(-5, 0.5, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12);
+    expect_miss(&w, v3(-5, 1.5, 0), v3(1, 0, 0));
+    done(&w);
+}
+
+static void test_poly(void **st)
+{
+    (void)st;
+    /* torus R = 1, r = 0.25 as a quartic: (x2+y2+z2+R2-r2)^2 - 4R2(x2+z2) */
+    double R2 = 1.0, r2 = 0.0625, k = R2 - r2;
+    /* POV-Ray quartic order: x4 x3y x3z x3 x2y2 x2yz x2y x2z2 x2z x2 | xy3 .. x | y4 y3z y3 y2z2 y2z y2 yz3 yz2 yz y | z4 z3 z2 z c */
+    double c[35] = {0};
+    c[0] = 1;            /* x4 */
+    c[4] = 2;            /* x2y2 */
+    c[7] = 2;            /* x2z2 */
+    c[9] = 2 * k - 4 * R2; /* x2 */
+    c[20] = 1;           /* y4 */
+    c[23] = 2;           /* y2z2 */
+    c[25] = 2 * k;       /* y2 */
+    c[30] = 1;           /* z4 */
+    c[32] = 2 * k - 4 * R2; /* z2 */
+    c[34] = k * k;
+    char buf[2048];
+    for (int sturm = 0; sturm < 2; sturm++) {
+        int n = snprintf(buf, sizeof buf, "quartic { <");
+        for (int i = 0; i < 35; i++) n += snprintf(buf + n, sizeof buf - n, "%s%.17g", i ? "," : "", c[i]);
+        snprintf(buf + n, sizeof buf - n, "> %s clipped_by { box { -2, 2 } } }", sturm ? "sturm" : "");
+        world w = build(buf);
+        assert_int_equal(w.s->objects[0]->kind, SHAPE_POLY);
+        assert_int_equal(w.s->objects[0]->u.poly->order, 4);
+        expect_hit(&w, v3(-5, 0, 0), v3(1, 0, 0), 3.75, v3(-1, 0, 0), 1e-10, 1e-8);
+        expect_hit(&w, v3(-1, 5, 0), v3(0, -1, 0), 4.75, v3(0, 1, 0), 1e-10, 1e-8);
+        /* from the hole's middle outwards: the inner wall at x = 0.75 */
+        expect_hit(&w, v3(0, 0, 0), v3(1, 0, 0), 0.75, v3(-1, 0, 0), 1e-10, 1e-8);
+        /* grazing the tube's top: y = 0.25 - 1e-6 hits, + 1e-6 misses */
+        accel_hit h;
+        assert_true(hit(&w, v3(-1, 0.25 - 1e-6, -5), v3(0, 0, 1), &h));
+        expect_miss(&w, v3(-1, 0.25 + 1e-6, -5), v3(0, 0, 1));
+        done(&w);
+    }
+    /* poly syntax and the 3.7 polynomial syntax describe the same cubic: y = x^3 */
+    world w = build("polynomial { 3, xyz(3,0,0): 1, xyz(0,1,0): -1 clipped_by { box { -3, 3 } } }");
+    for (int i = -4; i <= 4; i++) {
+        double x = 0.3 * i;
+        expect_hit(&w, v3(x, -20, 0.5), v3(0, 1, 0), 20 + x * x * x, v3(0, 0, 0), 1e-10, -1);
+    }
+    done(&w);
+}
+
+/* ------------------------------------------------------------ blob */
+
+static void test_blob(void **st)
+{
+    (void)st;
+    /* one sphere component: s (1 - d2/r2)^2 = T at d = r sqrt(1 - sqrt(T/s)) */
+    const double scales[] = {1e-4, 1.0, 1e5};
+    char buf[256];
+    for (int s = 0; s < 3; s++) {
+        double k = scales[s];
+        snprintf(buf, sizeof buf, "blob { threshold 0.25 sphere { <0,0,0>, 2, 1 } scale %g }", k);
+        world w = build(buf);
+        double d = 2 * sqrt(1 - sqrt(0.25));
+        expect_hit(&w, v3(-5 * k, 0, 0), v3(1, 0, 0), (5 - d) * k, v3(-1, 0, 0), 1e-10 * k, 1e-9);
+        expect_hit(&w, v3(0.3 * d * k, -5 * k, 0), v3(0, 1, 0), (5 - d * sqrt(1 - 0.09)) * k, v3(0.3, -sqrt(1 - 0.09), 0), 1e-10 * k, 1e-9);
+        /* from inside: the far side */
+        expect_hit(&w, v3(0, 0, 0), v3(0, 0, 1), d * k, v3(0, 0, 1), 1e-10 * k, 1e-9);
+        done(&w);
+    }
+    /* two far components are two spheres; a cylinder component is a capsule */
+    world w = build("blob { threshold 0.5 sphere { <-3,0,0>, 1, 2 } cylinder { <2,0,0>, <2,4,0>, 1, 2 } }");
+    double d = sqrt(1 - sqrt(0.25));
+    expect_hit(&w, v3(-3, 0, -5), v3(0, 0, 1), 5 - d, v3(0, 0, -1), 1e-10, 1e-9);
+    expect_hit(&w, v3(2, 2, -5), v3(0, 0, 1), 5 - d, v3(0, 0, -1), 1e-10, 1e-9);
+    expect_hit(&w, v3(2, 10, 0), v3(0, -1, 0), 6 - d, v3(0, 1, 0), 1e-10, 1e-9);
+    expect_miss(&w, v3(0, 0, -5), v3(0, 0, 1));
+    accel_shape sh = shape_of(&w);
+    assert_true(accel_shape_inside(&sh, v3(2, 1, 0)));
+    assert_false(accel_shape_inside(&sh, v3(0, 0, 0)));
+    /* a general ray against the march */
+    for (int i = 0; i < 10; i++) {
+        vec3 o = v3(-6, -1 + 0.3 * i, 0.2);
+        vec3 dd = v3_norm(v3(1, 0.1, 0.02 * i));
+        double tb = march(&sh, o, dd, 1e-9, 14, 14000);
+        accel_hit h;
+        int got = hit(&w, o, dd, &h);
+        if (isinf(tb)) { assert_false(got); continue; }
+        assert_true(got);
+        assert_near(h.t, tb, 1e-9);
+    }
+    accel_shape_release(&sh);
+    done(&w);
+}
+
+/* ------------------------------------------------------------ height_field */
+
+static void write_pgm(const char *path, int w, int h, const unsigned char *v)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fprintf(f, "P5\n%d %d\n255\n", w, h);
+    fwrite(v, 1, (size_t)w * h, f);
+    fclose(f);
+}
+
+static void test_height_field(void **st)
+{
+    (void)st;
+    /* a 3x3 ramp rising with x: heights 0, 127, 254 (/255 * 65535/65536) */
+    char path[] = "/tmp/test_shapes_hfXXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    unsigned char v[9] = {0, 127, 254, 0, 127, 254, 0, 127, 254};
+    write_pgm(path, 3, 3, v);
+    char src[512];
+    snprintf(src, sizeof src, "height_field { pgm \"%s\" }", path);
+    world w = build(src);
+    const scene_object *o = w.s->objects[0];
+    assert_int_equal(o->kind, SHAPE_HEIGHT_FIELD);
+    assert_int_equal(o->u.height_field->width, 3);
+    double top = 254 * 257 / 65536.0; /* 8-bit grey -> value * 257 */
+    assert_near(o->u.height_field->heights[2], top, 1e-6);
+    /* the surface is the plane y = x * top; normal (-top, 1, 0) */
+    for (int i = 1; i < 10; i++) {
+        double x = i / 10.0, z = 0.37;
+        expect_hit(&w, v3(x, 5, z), v3(0, -1, 0), 5 - x * top, v3(-top, 1, 0), 1e-6, 1e-6);
+    }
+    /* a slanted ray */
+    vec3 d = v3_norm(v3(1, -1, 0.1));
+    accel_hit h;
+    assert_true(hit(&w, v3(-0.5, 1.0, 0.2), d, &h));
+    assert_near(h.p.y, h.p.x * top, 1e-6);
+    accel_shape sh = shape_of(&w);
+    assert_true(accel_shape_inside(&sh, v3(0.5, 0.1, 0.5)));
+    assert_true(accel_shape_inside(&sh, v3(0.5, -10, 0.5)));
+    assert_false(accel_shape_inside(&sh, v3(0.5, 0.9, 0.5)));
+    assert_false(accel_shape_inside(&sh, v3(1.5, 0.1, 0.5)));
+    accel_shape_release(&sh);
+    done(&w);
+    /* water_level raises the low part */
+    snprintf(src, sizeof src, "height_field { pgm \"%s\" water_level 0.5 smooth }", path);
+    w = build(src);
+    expect_hit(&w, v3(0.2, 5, 0.5), v3(0, -1, 0), 4.5, v3(0, 1, 0), 1e-6, 1e-6);
+    done(&w);
+    unlink(path);
+}
+
+/* the distribution's plasma3.png is a palette image: heights = index * 256 */
+static void test_height_field_png(void **st)
+{
+    (void)st;
+    if (access("/usr/share/povray-3.7/include/plasma3.png", R_OK) != 0) skip();
+    world w = build("height_field { png \"plasma3.png\" smooth }");
+    const scene_height_field *hf = w.s->objects[0]->u.height_field;
+    assert_int_equal(hf->width, 100);
+    assert_int_equal(hf->height, 100);
+    for (int i = 0; i < 100 * 100; i++) {
+        double v = hf->heights[i] * 65536.0;
+        assert_near(v, 256.0 * floor(v / 256.0 + 0.5), 1e-3);
+    }
+    /* vertical rays hit where the grid interpolates */
+    for (int i = 0; i < 20; i++) {
+        double x = (i + 0.5) / 20.0, z = 0.5;
+        accel_hit h;
+        assert_true(hit(&w, v3(x, 5, z), v3(0, -1, 0), &h));
+        assert_true(h.p.y >= 0.0 && h.p.y <= 1.0);
+        assert_true(h.ns.y > 0.0);
+    }
+    done(&w);
+}
+
+/* ------------------------------------------------------------ sphere_sweep, bicubic_patch */
+
+static void test_sphere_sweep(void **st)
+{
+    (void)st;
+    /* linear: spheres r = 1 at x = 0 and r = 0.5 at x = 4 joined by the tangent cone */
+    world w = build("sphere_sweep { linear_spline 2, <0,0,0>, 1, <4,0,0>, 0.5 }");
+    expect_hit(&w, v3(-5, 0, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12);
+    expect_hit(&w, v3(9, 0, 0), v3(-1, 0, 0), 4.5, v3(1, 0, 0), 1e-12, 1e-12);
+    /* the cone's side: the envelope's distance from the axis at x = 2.
+     * sin a = (r1 - r2) / d = 1/8; the tangent line is at distance
+     * r(x) = (r1 - x sin a) / cos a from the axis */
+    double sa = 0.125, ca = sqrt(1 - sa * sa), r = (1 - 2 * sa) / ca;
+    expect_hit(&w, v3(2, 5, 0), v3(0, -1, 0), 5 - r, v3(sa, ca, 0), 1e-9, 1e-9);
+    done(&w);
+    /* b_spline sweeps are sampled into linear pieces: the tube stays within its radius */
+    w = build("sphere_sweep { b_spline 4, <-2,0,0>, 0.5, <0,0,0>, 0.5, <2,0,0>, 0.5, <4,0,0>, 0.5 }");
+    expect_hit(&w, v3(1, 5, 0), v3(0, -1, 0), 4.5, v3(0, 1, 0), 1e-9, 1e-9);
+    done(&w);
+}
+
+static void test_bicubic_patch(void **st)
+{
+    (void)st;
+    /* a flat patch (control points on z = 0): the mesh lies in the plane */
+    world w = build("bicubic_patch { type 1 u_steps 3 v_steps 3 "
+                    "<0,0,0>, <1,0,0>, <2,0,0>, <3,0,0>, <0,1,0>, <1,1,0>, <2,1,0>, <3,1,0>,"
+                    "<0,2,0>, <1,2,0>, <2,2,0>, <3,2,0>, <0,3,0>, <1,3,0>, <2,3,0>, <3,3,0> }");
+    assert_int_equal(w.s->objects[0]->kind, SHAPE_MESH);
+    expect_hit(&w, v3(1.3, 2.2, -5), v3(0, 0, 1), 5.0, v3(0, 0, 0), 1e-6, -1);
+    expect_miss(&w, v3(3.3, 2.2, -5), v3(0, 0, 1));
+    done(&w);
+}
+
+/* ------------------------------------------------------------ clipped_by, CSG */
+
+static void test_clipped_by(void **st)
+{
+    (void)st;
+    /* a sphere clipped by a box: the sphere's surface only where inside the box */
+    world w = build("sphere { 0, 1 clipped_by { box { <-2,-2,-2>, <2,0.5,2> } } translate <0,0,10> }");
+    expect_hit(&w, v3(-5, 0, 10), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12);
+    /* above y = 0.5 the sphere is gone: the ray sees the inside of the far wall */
+    double y = 0.8, x = sqrt(1 - y * y);
+    expect_miss(&w, v3(-5, y, 10), v3(1, 0, 0) );
+    (void)x;
+    /* looking down into the open top: the inner surface at the bottom */
+    expect_hit(&w, v3(0, 5, 10), v3(0, -1, 0), 6.0, v3(0, 1, 0), 1e-12, -1);
+    done(&w);
+    /* a lathe in a difference with a box (CSG members with many crossings) */
+    w = build("difference { lathe { linear_spline 5, <0,0>, <1,0>, <1,1>, <0,1>, <0,0> } box { <0,-1,-2>, <2,2,2> } }");
+    expect_hit(&w, v3(-5, 0.5, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12);
+    expect_hit(&w, v3(5, 0.5, 0.5), v3(-1, 0, 0), 5.0, v3(1, 0, 0), 1e-12, 1e-12); /* the cut face at x = 0 */
+    done(&w);
+}
+
+/* unsupported shapes are reported once and skipped */
+static void test_unsupported(void **st)
+{
+    (void)st;
+    world w = build("julia_fractal { <0,0,0,0> } julia_fractal { <0,0,0,0> } sphere { 0, 1 }");
+    assert_int_equal(w.s->objects[0]->kind, SHAPE_UNSUPPORTED);
+    accel_stats s = accel_get_stats(w.a);
+    assert_int_equal(s.unsupported, 2);
+    expect_hit(&w, v3(-5, 0, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12);
+    done(&w);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_poly_roots),
+        cmocka_unit_test(test_polygon),
+        cmocka_unit_test(test_lathe_linear),
+        cmocka_unit_test(test_lathe_splines),
+        cmocka_unit_test(test_lathe_brute),
+        cmocka_unit_test(test_sor),
+        cmocka_unit_test(test_sor_brute),
+        cmocka_unit_test(test_prism),
+        cmocka_unit_test(test_prism_brute),
+        cmocka_unit_test(test_text),
+        cmocka_unit_test(test_superellipsoid),
+        cmocka_unit_test(test_quadric),
+        cmocka_unit_test(test_poly),
+        cmocka_unit_test(test_blob),
+        cmocka_unit_test(test_height_field),
+        cmocka_unit_test(test_height_field_png),
+        cmocka_unit_test(test_sphere_sweep),
+        cmocka_unit_test(test_bicubic_patch),
+        cmocka_unit_test(test_clipped_by),
+        cmocka_unit_test(test_unsupported),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
