@@ -1,5 +1,6 @@
 /* scene.c - scene IR construction helpers and POV-Ray 3.7 defaults. */
 #include "scene.h"
+#include "camera.h"
 #include <stdlib.h>
 #include <string.h>
 
@@ -192,15 +193,8 @@ scene_counts scene_count(const scene *s)
 
 void scene_camera_ray(const scene_camera *c, double px, double py, int w, int h, vec3 *org, vec3 *dir)
 {
-    /* POV-Ray: screen x runs -0.5..0.5 left to right along `right`, y runs
-     * 0.5..-0.5 top to bottom along `up`. */
-    double sx = px / w - 0.5;
-    double sy = 0.5 - py / h;
-    if (c->kind == CAMERA_ORTHOGRAPHIC) {
-        *org = v3_add(c->location, v3_add(v3_scale(c->right, sx), v3_scale(c->up, sy)));
+    if (!camera_ray(c, px, py, w, h, 0.0, 0.0, org, dir)) {
+        *org = c->location;
         *dir = v3_norm(c->direction);
-        return;
     }
-    *org = c->location;
-    *dir = v3_norm(v3_add(c->direction, v3_add(v3_scale(c->right, sx), v3_scale(c->up, sy))));
 }

@@ -278,6 +278,9 @@ typedef struct {
     double aperture;        /* focal blur, 0 = off */
     int blur_samples;
     vec3 focal_point;
+    /* Appended (issue 5, core/camera.h). */
+    double v_angle;         /* spherical camera: vertical field of view in degrees, 0 = angle/2 */
+    double focal_distance;  /* focal blur: distance to the focal plane; 0 = |direction| */
 } scene_camera;
 
 /* ---------------------------------------------------------------- global settings */
@@ -364,8 +367,10 @@ typedef struct {
 } scene_counts;
 scene_counts scene_count(const scene *s);
 
-/* Camera ray for pixel position (px, py) in [0,w)x[0,h), pixel centres at .5;
- * perspective and orthographic only for now. Direction is normalised. */
+/* Camera ray for pixel position (px, py) in [0,w)x[0,h), pixel centres at .5,
+ * every camera type (core/camera.h; where a camera traces no ray, e.g.
+ * outside a fisheye's circle, this gives the camera's direction: use
+ * camera_ray to know). Direction is normalised. */
 void scene_camera_ray(const scene_camera *c, double px, double py, int w, int h, vec3 *org, vec3 *dir);
 
 #endif

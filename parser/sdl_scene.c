@@ -51,7 +51,10 @@ static int camera_type(sdl_parser *p, scene_camera *c)
 static void camera_angle(sdl_parser *p, scene_camera *c, camera_said *said, src_loc loc)
 {
     double a = c->kind == CAMERA_ORTHOGRAPHIC ? sdl_allow_float(p, 0.0) : sdl_float(p);
-    if (c->kind == CAMERA_SPHERICAL && sdl_accept(p, TOK_COMMA)) sdl_allow_float(p, a * 0.5);
+    if (c->kind == CAMERA_SPHERICAL) { /* angle h [,] [v]: the vertical angle defaults to h/2 */
+        sdl_accept(p, TOK_COMMA);
+        c->v_angle = sdl_allow_float(p, a * 0.5);
+    }
     if (a < 0) sdl_error(p, loc, PT_ERR_SYNTAX, "negative viewing angle");
     said->had_angle = 1;
     said->angle = a;
@@ -143,6 +146,8 @@ static void camera_apply(sdl_parser *p, scene_camera *c, const camera_said *said
             c->up = v3_scale(c->up, k1 / k2);
         }
     }
+    /* focal blur: POV-Ray measures the focal distance before the transforms */
+    c->focal_distance = said->had_focal ? v3_len(v3_sub(c->focal_point, c->location)) : v3_len(c->direction);
     c->location = xform_point(&said->trans, c->location);
     c->direction = xform_vector(&said->trans, c->direction);
     c->up = xform_vector(&said->trans, c->up);

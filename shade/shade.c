@@ -26,6 +26,7 @@
  *    averaged with the first sample.
  */
 #include "shade.h"
+#include "camera.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -283,10 +284,11 @@ static void pixel_rng(rng *r, uint64_t seed, int x, int y, int pass)
     rng_seed(r, mix64(seed * 0x9e3779b97f4a7c15ULL + (uint64_t)pass), ((uint64_t)y << 32) | (uint64_t)x);
 }
 
-static rgb sample(render_ctx *c, int thread, double px, double py, rng *r)
+static rgb sample_ray(render_ctx *c, int thread, double px, double py, double lu, double lv, rng *r)
 {
     vec3 org, dir;
-    scene_camera_ray(&c->sc->camera, px, py, c->s->width, c->s->height, &org, &dir);
+    /* Every camera type (core/camera.h); no ray (outside a fisheye) is black. */
+    if (!camera_ray(&c->sc->camera, px, py, c->s->width, c->s->height, lu, lv, &org, &dir)) return rgb_make(0, 0, 0);
     c->ts[thread].primary++;
     rgb v = trace_ray(c, thread, org, dir, 1, 1.0, OBJ_NO_IMAGE, r);
     if (!isfinite(v.r) || !isfinite(v.g) || !isfinite(v.b)) {
@@ -294,6 +296,22 @@ static rgb sample(render_ctx *c, int thread, double px, double py, rng *r)
         return rgb_make(0, 0, 0);
     }
     return v;
+}
+
+static rgb sample(render_ctx *c, int thread, double px, double py, rng *r)
+{
+    const scene_camera *cam = &c->sc->camera;
+    if (!camera_focal_blur(cam)) return sample_ray(c, thread, px, py, 0.0, 0.0, r);
+    /* Focal blur: blur_samples rays over the lens disc (stratified in area
+     * and angle) and over the pixel, averaged (POV-Ray jitters both). */
+    int n = cam->blur_samples;
+    rgb acc = {0, 0, 0};
+    for (int i = 0; i < n; i++) {
+        double rad = 0.5 * sqrt((i + rng_f64(r)) / n);
+        double phi = 2.0 * M_PI * (i * 0.6180339887498949 + rng_f64(r) / n);
+        acc = rgb_add(acc, sample_ray(c, thread, px + rng_f64(r) - 0.5, py + rng_f64(r) - 0.5, rad * cos(phi), rad * sin(phi), r));
+    }
+    return rgb_scale(acc, 1.0 / n);
 }
 
 static void tile_bounds(const render_ctx *c, int tile, int *x0, int *y0, int *x1, int *y1)
