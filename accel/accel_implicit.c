@@ -138,33 +138,12 @@ static double se_root(const im_data *m, vec3 o, vec3 d, double a, double b, doub
     return 0.5 * (a + b);
 }
 
-/* Minimum of g on [a, b] (unimodal there) by golden sections; stops early
- * once g < 0 is seen (then *tneg holds the point). */
-static double se_min(const im_data *m, vec3 o, vec3 d, double a, double b, double *tm, int *neg)
-{
-    const double r = 0.6180339887498949;
-    double x1 = b - r * (b - a), x2 = a + r * (b - a);
-    double f1 = se_g(m, o, d, x1), f2 = se_g(m, o, d, x2);
-    *neg = 0;
-    for (int it = 0; it < 80; it++) {
-        if (f1 < 0.0) { *tm = x1; *neg = 1; return f1; }
-        if (f2 < 0.0) { *tm = x2; *neg = 1; return f2; }
-        if (f1 < f2) {
-            b = x2; x2 = x1; f2 = f1;
-            x1 = b - r * (b - a);
-            f1 = se_g(m, o, d, x1);
-        } else {
-            a = x1; x1 = x2; f1 = f2;
-            x2 = a + r * (b - a);
-            f2 = se_g(m, o, d, x2);
-        }
-        if (b - a <= 1e-13 * (fabs(a) + fabs(b)) + 1e-300) break;
-    }
-    *tm = f1 < f2 ? x1 : x2;
-    return fmin(f1, f2);
-}
+static double se_dg(const im_data *m, vec3 o, vec3 d, double t) { return v3_dot(se_grad(m, v3_madd(o, d, t)), d); }
 
-/* Crossings on [a, b] of a unimodal-or-monotonic piece of g. */
+/* Crossings on [a, b] of g, convex there: tangent lines bound g from below
+ * (Kelley's cutting planes), so the search either finds a point with
+ * g < 0 (two crossings, bracketed on both sides), proves the minimum
+ * positive (no crossing) or closes in on a touching point (grazing). */
 static int se_piece(const im_data *m, vec3 o, vec3 d, double a, double b, double *roots, int nr)
 {
     double ga = se_g(m, o, d, a), gb = se_g(m, o, d, b);
@@ -172,16 +151,28 @@ static int se_piece(const im_data *m, vec3 o, vec3 d, double a, double b, double
         roots[nr++] = se_root(m, o, d, a, b, ga, gb);
         return nr;
     }
-    if (ga < 0.0) return nr; /* inside at both ends: no crossing for a convex piece */
-    double tm;
-    int neg;
-    double gm = se_min(m, o, d, a, b, &tm, &neg);
-    if (neg) {
-        double g1 = se_g(m, o, d, tm);
-        roots[nr++] = se_root(m, o, d, a, tm, ga, g1);
-        roots[nr++] = se_root(m, o, d, tm, b, g1, gb);
-    } else if (gm <= 1e-12) {
-        roots[nr++] = tm; /* grazing */
+    if (ga < 0.0) return nr; /* inside at both ends of a convex piece: no crossing */
+    double da = se_dg(m, o, d, a), db = se_dg(m, o, d, b);
+    double a0 = a, b0 = b, ga0 = ga, gb0 = gb;
+    for (int it = 0; it < 100; it++) {
+        if (da >= 0.0 || db <= 0.0) return nr; /* the minimum is at an end, where g >= 0 */
+        double t = (gb - ga + da * a - db * b) / (da - db);
+        if (!(t > a && t < b)) t = 0.5 * (a + b);
+        double lower = ga + da * (t - a);
+        if (lower > 0.0) return nr;
+        double gt = se_g(m, o, d, t);
+        if (gt < 0.0) {
+            roots[nr++] = se_root(m, o, d, a0, t, ga0, gt);
+            roots[nr++] = se_root(m, o, d, t, b0, gt, gb0);
+            return nr;
+        }
+        if (b - a <= 1e-13 * (fabs(a) + fabs(b)) + 1e-300 || gt - lower <= 1e-15) {
+            if (gt <= 1e-12) roots[nr++] = t; /* grazing */
+            return nr;
+        }
+        double dt = se_dg(m, o, d, t);
+        if (dt < 0.0) { a = t; ga = gt; da = dt; }
+        else { b = t; gb = gt; db = dt; }
     }
     return nr;
 }
