@@ -18,7 +18,8 @@ struct pm_lights {
     const accel *a;
     double eps;
     accel_surf *emit;
-    rgb *le;          /* emission per piece */
+    rgb *le;          /* emission per piece (its fallback colour when it varies) */
+    unsigned char *varies; /* the piece's colour varies: evaluate Le at the sampled point */
 };
 
 static double emit_weight(void *ctx, const scene_object *leaf, const scene_texture *tex, unsigned flags)
@@ -27,7 +28,18 @@ static double emit_weight(void *ctx, const scene_object *leaf, const scene_textu
     (void)flags;
     const scene *sc = ctx;
     rgb e = mat_texture_emission(sc, tex);
-    return fmax(fabs(e.r), fmax(fabs(e.g), fabs(e.b)));
+    double w = fmax(fabs(e.r), fmax(fabs(e.g), fabs(e.b)));
+    if (mat_texture_varies(tex)) {
+        /* the fallback colour says little: weigh by the finish alone */
+        rgb f = tex->finish.emission;
+        if (sc->global.radiosity.enabled) {
+            f.r += tex->finish.ambient.r;
+            f.g += tex->finish.ambient.g;
+            f.b += tex->finish.ambient.b;
+        }
+        w = fmax(w, fmax(fabs(f.r), fmax(fabs(f.g), fabs(f.b))));
+    }
+    return w;
 }
 
 pm_lights *pm_lights_new(const scene *sc, const accel *a, diag *d, pt_status *st)
@@ -50,12 +62,17 @@ pm_lights *pm_lights_new(const scene *sc, const accel *a, diag *d, pt_status *st
     }
     int n = accel_surf_count(L->emit);
     L->le = malloc(sizeof(rgb) * (size_t)(n > 0 ? n : 1));
-    if (!L->le) {
+    L->varies = calloc((size_t)(n > 0 ? n : 1), 1);
+    if (!L->le || !L->varies) {
         pm_lights_free(L);
         *st = PT_ERR_NOMEM;
         return NULL;
     }
-    for (int i = 0; i < n; i++) L->le[i] = mat_texture_emission(sc, accel_surf_piece_at(L->emit, i)->texture);
+    for (int i = 0; i < n; i++) {
+        const scene_texture *t = accel_surf_piece_at(L->emit, i)->texture;
+        L->le[i] = mat_texture_emission(sc, t);
+        L->varies[i] = (unsigned char)mat_texture_varies(t);
+    }
     return L;
 }
 
@@ -64,11 +81,24 @@ void pm_lights_free(pm_lights *L)
     if (!L) return;
     accel_surf_free(L->emit);
     free(L->le);
+    free(L->varies);
     free(L);
 }
 
 const accel_surf *pm_lights_emitters(const pm_lights *L) { return L->emit; }
-rgb pm_lights_piece_emission(const pm_lights *L, int piece) { return L->le[piece]; }
+rgb pm_lights_piece_emission(const pm_lights *L, const accel_surf_sample *s)
+{
+    if (!L->varies[s->piece]) return L->le[s->piece];
+    accel_hit eh;
+    memset(&eh, 0, sizeof eh);
+    eh.p = s->p;
+    eh.ng = eh.ns = s->n;
+    eh.obj = s->obj;
+    eh.texture = s->texture;
+    eh.prim = s->prim;
+    eh.flags = s->flags;
+    return mat_emission_at(L->sc, s->texture, &eh);
+}
 double pm_lights_eps(const pm_lights *L) { return L->eps; }
 
 int pm_lights_any(const pm_lights *L)
@@ -182,7 +212,7 @@ rgb pm_direct_emitters(const pm_lights *L, const mat_bsdf *b, int n_light, doubl
         double cos_x = fabs(v3_dot(b->n, wi));
         double c_b = (v3_dot(b->n, wi) > 0.0 ? bsdf_front : bsdf_back) * cos_x / M_PI;
         double w = pm_mis(n_light * p_l, c_b);
-        rgb le = L->le[s.piece];
+        rgb le = pm_lights_piece_emission(L, &s);
         double k_ = w * cos_x / p_l;
         total.r += f.r * le.r * k_;
         total.g += f.g * le.g * k_;

@@ -24,7 +24,8 @@ pm_lights *pm_lights_new(const scene *sc, const accel *a, diag *d, pt_status *st
 void pm_lights_free(pm_lights *L);
 
 const accel_surf *pm_lights_emitters(const pm_lights *L); /* may be empty */
-rgb pm_lights_piece_emission(const pm_lights *L, int piece);
+/* Le at an emitter sample (evaluated at the point when the texture varies). */
+rgb pm_lights_piece_emission(const pm_lights *L, const accel_surf_sample *s);
 double pm_lights_eps(const pm_lights *L);                  /* distance epsilon (shade.c's) */
 int pm_lights_any(const pm_lights *L);                     /* POV lights, emitters or a background */
 

@@ -187,7 +187,7 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         vec3 o = v3_madd(s.p, ns, c->eps);
         (*rays)++;
         if (!accel_intersect(c->a, o, *w, c->eps, INFINITY, h)) return 0;
-        rgb le = pm_lights_piece_emission(c->L, s.piece);
+        rgb le = pm_lights_piece_emission(c->L, &s);
         double k = 2.0 * M_PI / (n * s.pdf_area);
         *phi = crgb(le.r * k, le.g * k, le.b * k);
         return 1;

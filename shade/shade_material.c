@@ -13,6 +13,7 @@
 #include "shade_material.h"
 #include <math.h>
 #include <string.h>
+#include "shade_texture.h"
 
 static inline rgb mrgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
 static inline rgb mrgb_scale(rgb a, double s) { return mrgb(a.r * s, a.g * s, a.b * s); }
@@ -20,10 +21,22 @@ static inline double mrgb_max(rgb a) { return fmax(a.r, fmax(a.g, a.b)); }
 /* POV-Ray's greyscale weights (0.297, 0.589, 0.114), as shade.c. */
 static inline double mrgb_grey(rgb a) { return 0.297 * a.r + 0.589 * a.g + 0.114 * a.b; }
 
-static rgb texture_pigment(const scene_texture *tex, double *filt, double *transm, int *unsupported)
+/* Pigment at a hit: patterns, image maps and texture maps through
+ * shade_texture's tex_pigment_at (the colour `shade.c` would see on the top
+ * layer); solid colours directly. h NULL: the texture's fallback colour. */
+static rgb texture_pigment(const scene *sc, const scene_texture *tex, const accel_hit *h, double *filt, double *transm,
+                           int *unsupported)
 {
     const scene_pigment *pg = &tex->pigment;
-    if (unsupported) *unsupported = pg->kind != PIGMENT_SOLID;
+    if (unsupported) *unsupported = pg->kind == PIGMENT_OTHER;
+    if (h && (pg->kind == PIGMENT_PATTERN || tex->pat)) {
+        colour5 c;
+        if (tex_pigment_at(sc, tex, h, &c)) {
+            *filt = c.f;
+            *transm = c.t;
+            return mrgb(c.r, c.g, c.b);
+        }
+    }
     *filt = pg->colour.f;
     *transm = pg->colour.t;
     return mrgb(pg->colour.r, pg->colour.g, pg->colour.b);
@@ -35,12 +48,8 @@ static double opacity_of(rgb pig, double filt, double transm)
     return 1.0 - fmin(1.0, fmax(0.0, mrgb_grey(tc)));
 }
 
-rgb mat_texture_emission(const scene *sc, const scene_texture *tex)
+static rgb emission_of(const scene *sc, const scene_texture *tex, rgb pig, double op)
 {
-    if (!tex) tex = &sc->default_texture;
-    double filt, transm;
-    rgb pig = texture_pigment(tex, &filt, &transm, NULL);
-    double op = opacity_of(pig, filt, transm);
     const scene_finish *f = &tex->finish;
     rgb e = f->emission;
     if (sc->global.radiosity.enabled) {
@@ -52,13 +61,28 @@ rgb mat_texture_emission(const scene *sc, const scene_texture *tex)
     return mrgb(pig.r * e.r * op, pig.g * e.g * op, pig.b * e.b * op);
 }
 
+rgb mat_emission_at(const scene *sc, const scene_texture *tex, const accel_hit *h)
+{
+    if (!tex) tex = h && h->texture ? h->texture : &sc->default_texture;
+    double filt, transm;
+    rgb pig = texture_pigment(sc, tex, h, &filt, &transm, NULL);
+    return emission_of(sc, tex, pig, opacity_of(pig, filt, transm));
+}
+
+rgb mat_texture_emission(const scene *sc, const scene_texture *tex) { return mat_emission_at(sc, tex, NULL); }
+
+int mat_texture_varies(const scene_texture *tex)
+{
+    return tex && (tex->pigment.kind == PIGMENT_PATTERN || tex->pat);
+}
+
 void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r)
 {
     memset(b, 0, sizeof *b);
     const scene_texture *tex = h->texture ? h->texture : &sc->default_texture;
     const scene_finish *f = &tex->finish;
     double filt, transm;
-    rgb pig = texture_pigment(tex, &filt, &transm, &b->unsupported);
+    rgb pig = texture_pigment(sc, tex, h, &filt, &transm, &b->unsupported);
     b->tex = tex;
     b->pigment = pig;
     b->dir = dir;
@@ -77,7 +101,7 @@ void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, doubl
     rgb tc = {filt * pig.r + transm, filt * pig.g + transm, filt * pig.b + transm};
     double opacity = 1.0 - fmin(1.0, fmax(0.0, mrgb_grey(tc)));
     b->opacity = opacity;
-    b->emission = mat_texture_emission(sc, tex);
+    b->emission = emission_of(sc, tex, pig, opacity);
     b->double_illum = (h->obj && (h->obj->flags & OBJ_DOUBLE_ILLUMINATE)) || (h->flags & OBJ_DOUBLE_ILLUMINATE);
 
     double kd = f->diffuse * opacity;

@@ -16,6 +16,13 @@
  *                                                        the mirror direction, as shade.c
  *   Le      = pigment * opacity * (emission + ambient * ambient_light [radiosity{} only])
  *
+ * The pigment is evaluated at the hit (patterns, image maps, texture maps:
+ * shade_texture.h's tex_pigment_at, the top layer's colour) and the finish
+ * is the hit texture's. Approximations for now: layered textures use the
+ * top layer only, and normal{} perturbation is not applied to the GI
+ * BSDF (shade.c applies both), so `--gi none` equals the direct part of
+ * the path tracer only for scenes without layers and normal{}.
+ *
  * Lambertian terms ignore brilliance and crand (they are POV-Ray's shaping
  * of direct light only). Phong and specular highlights are not part of f:
  * they are not energy-conserving and are added for light arriving straight
@@ -79,8 +86,12 @@ typedef struct {
     double eta2;       /* photons: multiply flux by this as well (refraction), else 1 */
 } mat_scatter;
 
-/* Emission Le of a texture (both sides), under the scene's rules above. */
+/* Emission Le (both sides) under the scene's rules above: at a hit (h may
+ * be NULL; tex NULL = the hit's texture), or the texture's fallback colour. */
+rgb mat_emission_at(const scene *sc, const scene_texture *tex, const accel_hit *h);
 rgb mat_texture_emission(const scene *sc, const scene_texture *tex);
+/* 1 if the texture's colour varies over the surface (pattern, texture map). */
+int mat_texture_varies(const scene_texture *tex);
 
 /* Set up the BSDF at hit `h` for a ray of unit direction `dir`. `eps` is the
  * distance the origins are moved off the surface (shade.c's rule: accel_scale

@@ -16,6 +16,8 @@
  *    point light, a spotlight, diffuse and phong/specular surfaces: equal to
  *    1e-5 relative (the same NEE code; the only differences are rounding).
  *  - determinism: a fixed seed gives bit-identical images, with 1 or 2 threads.
+ *  - progressive output: on_image between passes with increasing sample
+ *    counts and finite images, progress ends at 1.
  *  - no NaN: lights touching and inside surfaces: every pixel finite.
  *  - accel_surface: world areas against closed forms (spheroid, sheared box,
  *    torus) to 1e-6, the clipped plane to 1e-4 (padded clip box), uniformity of spheroid samples per z band
@@ -509,6 +511,64 @@ static void test_kdtree(void **state)
     free(copy);
 }
 
+/* ------------------------------------------------------------ progressive output */
+
+typedef struct {
+    int calls, last_done, monotonic, finite, total;
+    double last_fraction;
+    int progress_calls;
+} prog_log;
+
+static void on_image(void *ctx, const framebuffer *fb, int done, int total)
+{
+    prog_log *p = ctx;
+    p->calls++;
+    if (done <= p->last_done || done >= total) p->monotonic = 0;
+    p->last_done = done;
+    p->total = total;
+    for (int i = 0; i < fb->width * fb->height * 3; i++) p->finite &= isfinite(fb->rgb[i]) != 0;
+}
+
+static void on_progress(void *ctx, double f)
+{
+    prog_log *p = ctx;
+    p->progress_calls++;
+    p->last_fraction = f;
+}
+
+static void test_progressive(void **state)
+{
+    (void)state;
+    scene *sc = parse(small_scene);
+    accel *a = build(sc);
+    prog_log log = {0, 0, 1, 1, 0, 0.0, 0};
+    pm_path_settings s;
+    pm_path_default_settings(&s);
+    s.c.width = 24;
+    s.c.height = 16;
+    s.c.threads = THREADS;
+    s.c.spp = 64;
+    s.c.on_image = on_image;
+    s.c.image_ctx = &log;
+    s.c.image_interval = 1e-9;
+    s.c.on_progress = on_progress;
+    s.c.progress_ctx = &log;
+    framebuffer *fb = fb_new(24, 16);
+    pm_stats st;
+    assert_int_equal(pm_path_render(sc, a, &s, fb, &st, NULL), PT_OK);
+    printf("progressive: %d passes, on_image called %d times (last at %d of %d spp), increasing %s, finite %s; "
+           "progress called %d times, last %.2f\n",
+           st.passes, log.calls, log.last_done, log.total, log.monotonic ? "yes" : "NO", log.finite ? "yes" : "NO",
+           log.progress_calls, log.last_fraction);
+    assert_int_equal(log.calls, st.passes - 1);
+    assert_true(log.monotonic);
+    assert_true(log.finite);
+    assert_true(log.last_fraction == 1.0);
+    fb_free(fb);
+    accel_free(a);
+    scene_free(sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -517,6 +577,7 @@ int main(void)
         cmocka_unit_test(test_surface_uniform),
         cmocka_unit_test(test_direct_equivalence),
         cmocka_unit_test(test_determinism),
+        cmocka_unit_test(test_progressive),
         cmocka_unit_test(test_no_nan),
         cmocka_unit_test(test_furnace_path_05),
         cmocka_unit_test(test_furnace_path_09),
