@@ -162,7 +162,8 @@ typedef struct scene_fog {
     double colour[5];              /* r g b filter transmit */
     vec3 up;                       /* ground fog: default <0,1,0> */
     double offset, alt;            /* ground fog */
-    vec3 turbulence;               /* turbulence (0 = none) */
+    int has_turb;                  /* turbulence/octaves/omega/lambda given */
+    vec3 turbulence;
     int octaves;
     double omega, lambda, turb_depth;
     struct scene_fog *next;

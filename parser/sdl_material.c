@@ -3,6 +3,7 @@
 #include <math.h>
 #include <string.h>
 #include "sdl_directive.h"
+#include "sdl_atmos.h"
 #include "sdl_expr.h"
 #include "sdl_pattern.h"
 
@@ -413,6 +414,12 @@ int sdl_parse_look_value(sdl_parser *p, sdl_kw k, sdl_value *out)
     case KW_NORMAL_MAP: name = "normal_map"; break;
     case KW_SLOPE_MAP: name = "slope_map"; break;
     case KW_TEXTURE_MAP: name = "texture_map"; break;
+    case KW_FOG: case KW_SKY_SPHERE:
+        memset(out, 0, sizeof *out);
+        out->kind = VAL_OPAQUE;
+        out->str = k == KW_FOG ? "fog" : "sky_sphere";
+        out->ptr = k == KW_FOG ? (void *)sdl_parse_fog(p) : (void *)sdl_parse_sky_sphere(p);
+        return 1;
     default: return 0;
     }
     memset(out, 0, sizeof *out);

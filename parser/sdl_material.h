@@ -39,7 +39,8 @@ int sdl_transform_item(sdl_parser *p, xform *out);
 
 /* #declare right-hand sides of appearance statements whose keyword k was
  * just read: color_map, pigment_map, normal_map, slope_map, texture_map
- * (VAL_OPAQUE named "colour_map"... with ptr = scene_blend_map). Returns 0
+ * (VAL_OPAQUE named "colour_map"... with ptr = scene_blend_map), fog and
+ * sky_sphere (VAL_OPAQUE "fog"/"sky_sphere", ptr = the record). Returns 0
  * (nothing read) for other keywords. */
 int sdl_parse_look_value(sdl_parser *p, sdl_kw k, sdl_value *out);
 

@@ -2,6 +2,7 @@
 #include "sdl_scene.h"
 #include <math.h>
 #include <string.h>
+#include "sdl_atmos.h"
 #include "sdl_directive.h"
 #include "sdl_expr.h"
 #include "sdl_material.h"
@@ -531,7 +532,8 @@ static void statement(sdl_parser *p)
     case KW_GLOBAL_SETTINGS: global_settings(p); return;
     case KW_DEFAULT: sdl_parse_default(p); return;
     case KW_BACKGROUND: background(p); return;
-    case KW_FOG: case KW_SKY_SPHERE: case KW_RAINBOW: case KW_MEDIA: skipped_statement(p, &t); return;
+    case KW_FOG: case KW_SKY_SPHERE: sdl_atmos_statement(p, t.tk.kw); return; /* sdl_atmos.c (issue 5) */
+    case KW_RAINBOW: case KW_MEDIA: skipped_statement(p, &t); return;
     default: break;
     }
     if (t.tk.kind == TOK_IDENT && t.val.kind == VAL_NONE)

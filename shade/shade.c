@@ -31,6 +31,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "pool.h"
+#include "shade_atmos.h"
 #include "shade_light.h"
 #include "shade_texture.h"
 #include "timer.h"
@@ -203,7 +204,8 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
 
 /* ------------------------------------------------------------------ tracing */
 
-static rgb background(const scene *sc) { return rgb_make(sc->background.r, sc->background.g, sc->background.b); }
+/* background, sky_sphere and fog: shade_atmos.c */
+static rgb background(const scene *sc, vec3 org, vec3 dir) { return atmos_fog(sc, org, dir, INFINITY, atmos_sky(sc, dir)); }
 
 /* `skip`: objects with any of these flags are invisible to this ray (no_image
  * for camera rays, no_reflection for reflected rays). */
@@ -245,11 +247,11 @@ static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, d
     /* Step past objects this ray must not see (bounded: a pathological stack
      * of such surfaces ends as background). */
     for (int k = 0; k < 64; k++) {
-        if (!accel_intersect(c->a, org, dir, tmin, INFINITY, &h)) return background(c->sc);
-        if (!(h.flags & skip)) return shade_hit(c, thread, &h, dir, level, weight, skip, r);
+        if (!accel_intersect(c->a, org, dir, tmin, INFINITY, &h)) return background(c->sc, org, dir);
+        if (!(h.flags & skip)) return atmos_fog(c->sc, org, dir, h.t, shade_hit(c, thread, &h, dir, level, weight, skip, r));
         tmin = h.t + fmax(c->eps, h.t * 1e-7);
     }
-    return background(c->sc);
+    return background(c->sc, org, dir);
 }
 
 static double scene_eps(const accel *a)

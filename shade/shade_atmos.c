@@ -1,0 +1,108 @@
+/* shade_atmos.c - background, sky_sphere and fog (see shade_atmos.h).
+ *
+ * POV-Ray 3.7's Trace::ComputeSky (language version 3.7 rules) and
+ * ComputeFog / ComputeConstantFogColour / ComputeGroundFogColour, studied
+ * for semantics:
+ *  - sky_sphere: the pigments are layers evaluated at the ray direction
+ *    (through the inverse sky transform, applied as to a point), the LAST
+ *    listed on top: colour += pigment * (1 - filter - transmit) * filter_so_far
+ *    * emission, filter_so_far *= rgb*filter + transmit; the background colour
+ *    (filter and transmit ignored) is the bottom layer.
+ *  - fog: per fog, attenuation a = exp(-d / distance) (constant fog) or
+ *    exp(-d * density / distance) with ground fog's density the mean of
+ *    1/(1+y^2) (y = (height along up - offset) / fog_alt, 1 below 0) over the
+ *    segment, from atan; turbulence shortens d by
+ *    k * min(1, Turbulence(mid point * turbulence) * turb_depth), k =
+ *    exp(-d/distance); a >= the fog's transmit; the seen colour becomes
+ *    sum (1-a) fog + prod a ((1 - filter) + filter * fog) * colour.
+ *    A ray that hits nothing travels an unbounded distance (POV-Ray's
+ *    BOUND_HUGE). */
+#include "shade_atmos.h"
+#include <math.h>
+#include "shade_noise.h"
+#include "shade_pattern.h"
+
+#define ATM_EPSILON 1.0e-10
+#define BOUND_HUGE 2.0e10
+
+rgb atmos_sky(const scene *sc, vec3 dir)
+{
+    rgb col = {0, 0, 0}, fil = {1, 1, 1};
+    const scene_sky_sphere *sky = sc->sky_sphere;
+    if (sky && sky->npigments > 0) {
+        vec3 p = xform_inv_point(&sky->transform, dir);
+        pattern_ctx pc = pattern_ctx_plain(sc);
+        for (int i = sky->npigments - 1; i >= 0; i--) {
+            colour5 c;
+            pigment_eval(sky->pigments[i], p, &pc, &c);
+            double att = 1.0 - c.f - c.t;
+            col.r += c.r * att * fil.r * sky->emission[0];
+            col.g += c.g * att * fil.g * sky->emission[1];
+            col.b += c.b * att * fil.b * sky->emission[2];
+            fil.r *= c.r * c.f + c.t;
+            fil.g *= c.g * c.f + c.t;
+            fil.b *= c.b * c.f + c.t;
+        }
+    }
+    col.r += sc->background.r * fil.r;
+    col.g += sc->background.g * fil.g;
+    col.b += sc->background.b * fil.b;
+    return col;
+}
+
+static double fog_turb(const scene *sc, const scene_fog *f, vec3 p)
+{
+    p = v3_mul(p, f->turbulence);
+    int g = sc->global.noise_generator >= 1 && sc->global.noise_generator <= 3 ? sc->global.noise_generator : 2;
+    return noise_turbulence(p, f->octaves, f->omega, f->lambda, g);
+}
+
+static double fog_att(const scene *sc, const scene_fog *f, vec3 org, vec3 dir, double width)
+{
+    if (f->type == 2) {
+        vec3 p1 = org, p2 = v3_madd(org, dir, width);
+        double y1 = v3_dot(p1, f->up), y2 = v3_dot(p2, f->up);
+        double s = (y1 - f->offset) / f->alt, e = (y2 - f->offset) / f->alt, density;
+        if (s <= 0.0) {
+            density = e <= 0.0 ? 1.0 : (atan(e) - s) / (e - s);
+        } else if (e <= 0.0) {
+            density = (atan(s) - e) / (s - e);
+        } else {
+            double delta = s - e;
+            density = fabs(delta) > ATM_EPSILON ? (atan(s) - atan(e)) / delta : 1.0 / (s * s + 1.0);
+        }
+        if (f->has_turb) {
+            vec3 mid = v3_scale(v3_add(p1, p2), 0.5);
+            double k = exp(-width / f->distance);
+            width *= 1.0 - k * fmin(1.0, fog_turb(sc, f, mid) * f->turb_depth);
+        }
+        return exp(-width * density / f->distance);
+    }
+    if (f->has_turb) {
+        vec3 p = v3_madd(org, dir, width / 2.0);
+        double k = exp(-width / f->distance);
+        width *= 1.0 - k * fmin(1.0, fog_turb(sc, f, p) * f->turb_depth);
+    }
+    return exp(-width / f->distance);
+}
+
+rgb atmos_fog(const scene *sc, vec3 org, vec3 dir, double depth, rgb c)
+{
+    if (!sc->fogs) return c;
+    double width = isfinite(depth) ? depth : BOUND_HUGE;
+    rgb satt = {1, 1, 1}, scol = {0, 0, 0};
+    for (const scene_fog *f = sc->fogs; f; f = f->next) {
+        if (fabs(f->distance) <= ATM_EPSILON) continue;
+        double a = fog_att(sc, f, org, dir, width);
+        const double *fc = f->colour;
+        if (a < fc[4]) a = fc[4];
+        satt.r *= a * ((1.0 - fc[3]) + fc[3] * fc[0]);
+        satt.g *= a * ((1.0 - fc[3]) + fc[3] * fc[1]);
+        satt.b *= a * ((1.0 - fc[3]) + fc[3] * fc[2]);
+        scol.r += (1.0 - a) * fc[0];
+        scol.g += (1.0 - a) * fc[1];
+        scol.b += (1.0 - a) * fc[2];
+    }
+    rgb r = {scol.r + satt.r * c.r, scol.g + satt.g * c.g, scol.b + satt.b * c.b};
+    return r;
+}

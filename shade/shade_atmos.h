@@ -1,0 +1,14 @@
+/* shade_atmos.h - what a ray sees besides surfaces: the background colour,
+ * sky_sphere pigments, and constant and ground fog along the ray (POV-Ray
+ * 3.7 semantics; rainbow and atmospheric media are not modelled). */
+#ifndef PT_SHADE_ATMOS_H
+#define PT_SHADE_ATMOS_H
+#include "scene.h"
+
+/* Colour of a ray that hits nothing (unit direction). */
+rgb atmos_sky(const scene *sc, vec3 dir);
+/* Colour `c` seen at distance `depth` (INFINITY: nothing hit) along the ray
+ * after the scene's fogs. Returns c unchanged without fog. */
+rgb atmos_fog(const scene *sc, vec3 org, vec3 dir, double depth, rgb c);
+
+#endif
