@@ -510,7 +510,7 @@ static void break_directive(sdl_parser *p, src_loc loc)
 
 static int loop_limit_hit(sdl_parser *p, sdl_cond *c)
 {
-    if (++c->iterations < p->opt.max_loop_iterations) return 0;
+    if (++c->iterations <= p->opt.max_loop_iterations) return 0;
     sdl_error(p, c->loc, PT_ERR_LIMIT, "%s loop exceeded %ld iterations", cond_name(c->kind), p->opt.max_loop_iterations);
     return 1;
 }
