@@ -313,3 +313,19 @@ vec3 accel_hfield_shading(const accel_shape *sh, vec3 q)
     }
     return n;
 }
+
+int accel_hfield_ntriangles(const accel_shape *sh)
+{
+    const hf_data *f = sh->data;
+    return f ? 2 * f->nx * f->nz : 0;
+}
+
+void accel_hfield_triangle(const accel_shape *sh, int part, vec3 *a, vec3 *b, vec3 *c)
+{
+    const hf_data *f = sh->data;
+    int cell = part / 2, i = cell % f->nx, j = cell / f->nx;
+    cell_tri(f, i, j, part & 1, a, b, c);
+    /* grid -> object space */
+    a->x /= f->nx; b->x /= f->nx; c->x /= f->nx;
+    a->z /= f->nz; b->z /= f->nz; c->z /= f->nz;
+}

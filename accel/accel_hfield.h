@@ -24,4 +24,8 @@ void accel_hfield_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, doub
 /* Object-space smooth shading normal at q (0 when the field is not smooth). */
 vec3 accel_hfield_shading(const accel_shape *sh, vec3 q);
 
+/* Triangle count (2 per cell) and triangle `part` in object space. */
+int accel_hfield_ntriangles(const accel_shape *sh);
+void accel_hfield_triangle(const accel_shape *sh, int part, vec3 *a, vec3 *b, vec3 *c);
+
 #endif

@@ -5,6 +5,8 @@
  * constant; for curved parts its maximum over all n is |det A| sigma_max(A^-1),
  * the bound used for rejection. */
 #include "accel_surface.h"
+#include "accel_hfield.h"
+#include "accel_sweep.h"
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -387,9 +389,50 @@ static int add_leaf(accel_surf *as, const scene_object *o, const scene_texture *
     return 1;
 }
 
+/* Issue 4 shapes whose surfaces are exactly triangles: polygon (its
+ * even-odd region cut into trapezoids) and height_field (its cells). The
+ * curved ones (lathe, sor, prism, text, superellipsoid, quadric, poly,
+ * blob) are not sampled yet: pdf 0, which keeps MIS unbiased. */
+typedef struct {
+    accel_surf *as;
+    const scene_object *o;
+    const scene_texture *tex;
+    unsigned flags;
+    double w;
+} tri_sink;
+
+static int sink_tri(void *ctx, vec3 a, vec3 b, vec3 c)
+{
+    tri_sink *k = ctx;
+    return add_triangle(k->as, k->o, k->tex, k->flags, ACCEL_SURF_ANY, a, b, c, k->w);
+}
+
+static int add_issue4(accel_surf *as, const scene_object *o, const scene_texture *tex, unsigned flags)
+{
+    double w = weight_of(as, o, tex, flags);
+    if (w <= 0.0) return 1;
+    accel_shape sh;
+    if (accel_shape_init(&sh, o) != 0) return 1;
+    int ok = 1;
+    if (o->kind == SHAPE_POLYGON) {
+        tri_sink k = {as, o, tex, flags, w};
+        ok = accel_polygon_triangles(&sh, sink_tri, &k) >= 0;
+    } else {
+        int n = accel_hfield_ntriangles(&sh);
+        for (int i = 0; i < n && ok; i++) {
+            vec3 a, b, c;
+            accel_hfield_triangle(&sh, i, &a, &b, &c);
+            ok = add_triangle(as, o, tex, flags, (unsigned)i, a, b, c, w);
+        }
+    }
+    accel_shape_release(&sh);
+    return ok;
+}
+
 static int collect(accel_surf *as, const scene_object *o, const scene_texture *ptex, unsigned pflags, int depth)
 {
     if (!o || depth > MAX_DEPTH) return 1;
+    if (o->clip) return 1; /* clipped_by: only part of the surface exists; not sampled */
     const scene_texture *tex = o->texture ? o->texture : ptex;
     unsigned flags = o->flags | (pflags & INHERITED);
     switch (o->kind) {
@@ -400,6 +443,8 @@ static int collect(accel_surf *as, const scene_object *o, const scene_texture *p
     case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_PLANE: case SHAPE_TRIANGLE: case SHAPE_SMOOTH_TRIANGLE:
     case SHAPE_MESH: case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC: case SHAPE_TORUS:
         return add_leaf(as, o, tex ? tex : &as->s->default_texture, flags);
+    case SHAPE_POLYGON: case SHAPE_HEIGHT_FIELD:
+        return add_issue4(as, o, tex ? tex : &as->s->default_texture, flags);
     default: /* merge, intersection, difference, unsupported: not sampled */
         return 1;
     }
@@ -413,7 +458,10 @@ static uint64_t hash_key(const scene_object *o, unsigned prim)
     return z ^ (z >> 31);
 }
 
-static unsigned key_prim(const scene_object *o, unsigned prim) { return o->kind == SHAPE_MESH ? prim : ACCEL_SURF_ANY; }
+static unsigned key_prim(const scene_object *o, unsigned prim)
+{
+    return o->kind == SHAPE_MESH || o->kind == SHAPE_HEIGHT_FIELD ? prim : ACCEL_SURF_ANY;
+}
 
 static int build_table(accel_surf *as)
 {

@@ -27,7 +27,11 @@
  * surface counts it with full weight): members of CSG intersection,
  * difference and merge (their visible surface is a part of the members'
  * surfaces; a later version can sample a member and reject points that the
- * CSG inside rules remove), unsupported shapes, degenerate objects.
+ * CSG inside rules remove), unsupported shapes, degenerate objects,
+ * objects with clipped_by, and the curved issue-4 shapes (lathe, sor,
+ * prism, text, superellipsoid, quadric, poly, blob). Polygons (their
+ * region cut into triangles) and height fields (their cells' triangles)
+ * are sampled exactly.
  * Union members are sampled as separate leaves, as accel renders them. */
 #ifndef PT_ACCEL_SURFACE_H
 #define PT_ACCEL_SURFACE_H

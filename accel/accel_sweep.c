@@ -1059,3 +1059,76 @@ void accel_sweep_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, doubl
     }
     }
 }
+
+/* ------------------------------------------------------------ polygon triangles */
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : (x > y);
+}
+
+typedef struct { double um, u0, u1; } slab_edge;
+
+static int cmp_edge(const void *a, const void *b)
+{
+    const slab_edge *x = a, *y = b;
+    return x->um < y->um ? -1 : (x->um > y->um);
+}
+
+int accel_polygon_triangles(const accel_shape *sh, int (*emit)(void *ctx, vec3 a, vec3 b, vec3 c), void *ctx)
+{
+    const sw_data *w = sh->data;
+    if (!w || w->type != SW_POLYGON || w->nseg < 1) return 0;
+    int n = w->nseg;
+    double *vs = malloc(sizeof *vs * 2 * (size_t)n);
+    slab_edge *ed = malloc(sizeof *ed * (size_t)n);
+    if (!vs || !ed) {
+        free(vs);
+        free(ed);
+        return -1;
+    }
+    for (int i = 0; i < n; i++) {
+        vs[2 * i] = w->seg[i].e0[1];
+        vs[2 * i + 1] = w->seg[i].e1[1];
+    }
+    qsort(vs, 2 * (size_t)n, sizeof *vs, cmp_double);
+    int count = 0;
+    for (int k = 0; k + 1 < 2 * n && count >= 0; k++) {
+        double va = vs[k], vb = vs[k + 1];
+        if (!(vb > va)) continue;
+        double vm = 0.5 * (va + vb);
+        int ne = 0;
+        for (int i = 0; i < n; i++) {
+            const sw_seg *s = &w->seg[i];
+            double y0 = s->e0[1], y1 = s->e1[1];
+            if (!(fmin(y0, y1) <= va && fmax(y0, y1) >= vb) || y0 == y1) continue;
+            double du = (s->e1[0] - s->e0[0]) / (y1 - y0);
+            ed[ne].u0 = s->e0[0] + (va - y0) * du;
+            ed[ne].u1 = s->e0[0] + (vb - y0) * du;
+            ed[ne].um = s->e0[0] + (vm - y0) * du;
+            ne++;
+        }
+        qsort(ed, (size_t)ne, sizeof *ed, cmp_edge);
+        for (int e = 0; e + 1 < ne; e += 2) {
+            const slab_edge *l = &ed[e], *r = &ed[e + 1];
+            double q[4][2] = {{l->u0, va}, {r->u0, va}, {r->u1, vb}, {l->u1, vb}};
+            vec3 P[4];
+            for (int c = 0; c < 4; c++)
+                P[c] = v3_add(w->p0, v3_add(v3_scale(w->pu, q[c][0] * w->L), v3_scale(w->pv, q[c][1] * w->L)));
+            if (r->u0 > l->u0) {
+                if (!emit(ctx, P[0], P[1], P[2])) { count = -1; break; }
+                count++;
+            }
+            if (r->u1 > l->u1) {
+                if (!emit(ctx, P[0], P[2], P[3])) { count = -1; break; }
+                count++;
+            } else if (r->u0 > l->u0) {
+                /* (the first triangle already covers a trapezoid degenerate at the top) */
+            }
+        }
+    }
+    free(vs);
+    free(ed);
+    return count;
+}

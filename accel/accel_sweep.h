@@ -29,4 +29,10 @@ int accel_sweep_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
 int accel_sweep_inside(const accel_shape *sh, vec3 q);
 /* Object-space outward normal (not unit) and surface parameters at q. */
 void accel_sweep_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v);
+/* Polygon: its even-odd region as object-space triangles (trapezoids of
+ * the slabs between vertex heights, two triangles each; exact for simple
+ * and holed polygons). Calls emit(ctx, a, b, c) per triangle; returns the
+ * number emitted, or -1 when emit failed. */
+int accel_polygon_triangles(const accel_shape *sh, int (*emit)(void *ctx, vec3 a, vec3 b, vec3 c), void *ctx);
+
 #endif

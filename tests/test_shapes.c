@@ -19,6 +19,8 @@
 #include "accel.h"
 #include "accel_poly.h"
 #include "accel_shapes.h"
+#include "accel_surface.h"
+#include "rng.h"
 #include "diag.h"
 #include "scene.h"
 #include "sdl.h"
@@ -731,6 +733,58 @@ static void test_clipped_by(void **st)
     done(&w);
 }
 
+/* GI sampling: polygons and height fields are sampled uniformly by area */
+static void test_surface_sampling(void **st)
+{
+    (void)st;
+    world w = build("polygon { 10, <-2,-2>, <2,-2>, <2,2>, <-2,2>, <-2,-2>,"
+                    " <-1,-1>, <1,-1>, <1,1>, <-1,1>, <-1,-1> scale <2,1,1> rotate 30*y }");
+    pt_status ps;
+    accel_surf *as = accel_surf_build(w.s, w.a, NULL, NULL, w.d, &ps);
+    assert_non_null(as);
+    assert_near(accel_surf_total_area(as), 2 * 12.0, 1e-9);
+    rng r;
+    rng_seed(&r, 7, 1);
+    double inner = 0;
+    for (int i = 0; i < 4000; i++) {
+        accel_surf_sample sm;
+        assert_true(accel_surf_sample_point(as, rng_f64(&r), rng_f64(&r), rng_f64(&r), &r, &sm));
+        assert_near(sm.pdf_area, 1.0 / 24.0, 1e-12);
+        /* back to the polygon's plane: inside the square, outside the hole */
+        vec3 q = xform_inv_point(&w.s->objects[0]->transform, sm.p);
+        assert_near(q.z, 0.0, 1e-9);
+        assert_true(fabs(q.x) <= 2 + 1e-9 && fabs(q.y) <= 2 + 1e-9);
+        assert_false(fabs(q.x) < 1 - 1e-9 && fabs(q.y) < 1 - 1e-9);
+        if (fabs(q.x) < 1.5 && fabs(q.y) < 1.5) inner++;
+    }
+    /* the ring 1 < max(|x|,|y|) < 1.5 holds 5 of the 12 area units */
+    assert_near(inner / 4000.0, 5.0 / 12.0, 0.03);
+    accel_hit h;
+    assert_true(hit(&w, v3(3, 0.5, -10), v3(0, 0, 1), &h) || hit(&w, v3(0, 1.5, -10), v3(0, 0, 1), &h));
+    assert_near(accel_surf_pdf(as, &h), 1.0 / 24.0, 1e-12);
+    accel_surf_free(as);
+    done(&w);
+
+    char path[] = "/tmp/test_shapes_hf2XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    unsigned char v[9] = {0, 127, 254, 0, 127, 254, 0, 127, 254};
+    write_pgm(path, 3, 3, v);
+    char src[512];
+    snprintf(src, sizeof src, "height_field { pgm \"%s\" scale <2,1,3> }", path);
+    w = build(src);
+    as = accel_surf_build(w.s, w.a, NULL, NULL, w.d, &ps);
+    assert_non_null(as);
+    double top = 254 * 257 / 65536.0;
+    assert_near(accel_surf_total_area(as), 3.0 * sqrt(4.0 + top * top), 1e-9);
+    assert_true(hit(&w, v3(1.1, 5, 1.7), v3(0, -1, 0), &h));
+    assert_near(accel_surf_pdf(as, &h), 1.0 / accel_surf_total_area(as), 1e-12);
+    accel_surf_free(as);
+    done(&w);
+    unlink(path);
+}
+
 /* unsupported shapes are reported once and skipped */
 static void test_unsupported(void **st)
 {
@@ -765,6 +819,7 @@ int main(void)
         cmocka_unit_test(test_sphere_sweep),
         cmocka_unit_test(test_bicubic_patch),
         cmocka_unit_test(test_clipped_by),
+        cmocka_unit_test(test_surface_sampling),
         cmocka_unit_test(test_unsupported),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
