@@ -18,6 +18,7 @@
 #include <unistd.h>
 #include "sdl_directive.h"
 #include "sdl_expr.h"
+#include "sdl_image.h"
 #include "sdl_material.h"
 
 #define PAT_EPS 1.0e-10
@@ -216,6 +217,11 @@ static scene_image *image_spec(sdl_parser *p)
     }
     if (!img->path) {
         sdl_warning(p, loc, "cannot find image file '%s'; the image is transparent", name);
+        return NULL;
+    }
+    char why[512];
+    if (sdl_image_load(img, p->s->mem, why, sizeof why) != 0) {
+        sdl_warning(p, loc, "%s; the image is transparent", why);
         return NULL;
     }
     img->next = p->s->images;

@@ -1,0 +1,13 @@
+/* sdl_image.h - images for image_map / image_pattern, read at parse time as
+ * POV-Ray does: PNG through libpng (any bit depth, grey, palette, RGB, with
+ * alpha or tRNS), decoded to linear RGBFT with POV-Ray 3.7's gamma rules. */
+#ifndef PT_SDL_IMAGE_H
+#define PT_SDL_IMAGE_H
+#include <stddef.h>
+#include "scene.h"
+
+/* Fill img->width/height/pixels (in `mem`, the scene's arena) from
+ * img->path. Returns 0 on success, else a reason in `why`. */
+int sdl_image_load(scene_image *img, arena *mem, char *why, size_t whycap);
+
+#endif
