@@ -4,8 +4,14 @@
  * counts and bounce counts. Prints figures; never fails on a number.
  *
  *   bench_gi [SCENE.pov] [--size N] [--count N] [--nb N] [--threads N]
- *            [--device SPEC] [--reps N] [--out PREFIX] [--sweep]
+ *            [--device SPEC] [--reps N] [--out PREFIX] [--sweep] [--spp N] [--full]
+ *            [--area-samples N]
  *
+ * --full scatters along all links every bounce (GI_PARTICLE_SCATTER_FULL)
+ * instead of the paper's random walks; --area-samples N caps the shadow rays
+ * per particle per area light (0: the whole grid).
+ * --spp N renders N stratified samples per pixel (shade.c fixed
+ * supersampling) in both modes, for image comparisons against references.
  * --out PREFIX writes PREFIX_none.exr and PREFIX_particle.exr. --sweep runs
  * counts 50K/100K/200K/400K x n_b 1/3/6/9 and prints lighting and frame
  * times with the image's mean against the first setting's. */
@@ -13,6 +19,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include "accel.h"
 #include "gi_particle.h"
 #include "img_io.h"
@@ -26,10 +33,20 @@
 
 typedef struct {
     const char *scene;
-    int size, threads, nb, reps, sweep;
+    int size, threads, nb, reps, sweep, spp, full, area_samples;
     long count;
     const char *device, *out;
 } opts;
+
+/* CPU seconds of the whole process (all threads, PoCL's included): on a
+ * shared machine this says more than wall time, which other processes'
+ * load stretches. */
+static double cpu_now(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
 
 static double mean_lum(const framebuffer *fb)
 {
@@ -48,6 +65,8 @@ static void report_diag(diag *d)
     }
 }
 
+static int g_spp = 1;
+
 static double render(const scene *sc, const accel *a, int size, int threads, gi_particle *gp, framebuffer *fb,
                      shade_stats *ss, diag *d)
 {
@@ -55,6 +74,10 @@ static double render(const scene *sc, const accel *a, int size, int threads, gi_
     shade_default_settings(&s);
     s.width = s.height = size;
     s.threads = threads;
+    if (g_spp > 1) {
+        s.antialias = 2;
+        s.spp = g_spp;
+    }
     if (gp) {
         s.use_ambient = 0;
         s.indirect = gi_particle_indirect;
@@ -146,7 +169,7 @@ static void sweep(const scene *sc, const accel *a, const opts *o, diag *d)
 
 int main(int argc, char **argv)
 {
-    opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 50000, NULL, NULL};
+    opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 1, 0, -1, 50000, NULL, NULL};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -158,10 +181,14 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--reps") && v) { o.reps = atoi(v); i++; }
         else if (!strcmp(a, "--out") && v) { o.out = v; i++; }
         else if (!strcmp(a, "--sweep")) o.sweep = 1;
+        else if (!strcmp(a, "--spp") && v) { o.spp = atoi(v); i++; }
+        else if (!strcmp(a, "--full")) o.full = 1;
+        else if (!strcmp(a, "--area-samples") && v) { o.area_samples = atoi(v); i++; }
         else if (a[0] != '-') o.scene = a;
         else { fprintf(stderr, "bench_gi: unknown option %s\n", a); return 2; }
     }
     if (o.reps < 1) o.reps = 1;
+    g_spp = o.spp;
     diag *d = diag_new();
     sdl_options so;
     sdl_default_options(&so);
@@ -191,8 +218,12 @@ int main(int argc, char **argv)
     s.bounces = o.nb;
     s.threads = o.threads;
     s.cl_device = o.device;
+    if (o.full) s.scatter = GI_PARTICLE_SCATTER_FULL;
+    if (o.area_samples >= 0) s.area_samples = o.area_samples;
     gi_particle_stats gs;
+    double c0 = cpu_now();
     gi_particle *gp = gi_particle_build(sc, a, &s, &gs, d, &st);
+    double cpu_geom = cpu_now() - c0;
     if (!gp) {
         report_diag(d);
         fprintf(stderr, "bench_gi: GI build failed: %s\n", pt_status_name(st));
@@ -203,6 +234,7 @@ int main(int argc, char **argv)
            "lists %.3f, upload %.3f\n",
            gs.t_geometry, gs.t_surfaces, gs.t_sampling, gs.t_prune, gs.t_scatter_links, gs.t_gather_links, gs.t_lists,
            gs.t_upload);
+    printf("  CPU time %.3f s (all threads; kernel build included)\n", cpu_geom);
     printf("  particles %ld (candidates %ld, pruned %ld), spacing %.4f, tess %.4f, radius %.4f\n", gs.particles,
            gs.candidates, gs.pruned, gs.spacing, gs.tess, gs.radius);
     printf("  link rays %ld (%.1f%% miss, %.2f%% unresolved), radiance particles %ld, list entries %ld (%.1f per "
@@ -217,18 +249,22 @@ int main(int argc, char **argv)
     /* lighting stage: median of reps (relighting reruns only this stage) */
     double *tl = calloc((size_t)o.reps, sizeof *tl), *tk = calloc((size_t)o.reps, sizeof *tk);
     double *tvis = calloc((size_t)o.reps, sizeof *tvis);
+    double *tcpu = calloc((size_t)o.reps, sizeof *tcpu);
     for (int r = 0; r < o.reps; r++) {
+        double cc = cpu_now();
         gi_particle_relight(gp, d);
+        tcpu[r] = cpu_now() - cc;
         const gi_particle_stats *x = gi_particle_get_stats(gp);
         tl[r] = x->t_lighting;
         tk[r] = x->t_emit + x->t_scatter;
         tvis[r] = x->t_visibility;
     }
     const gi_particle_stats *x = gi_particle_get_stats(gp);
-    printf("lighting stage (n_b %d, median of %d): %.2f ms = visibility %.2f ms (%ld shadow rays) + emission and "
-           "scattering kernels %.2f ms; %ld sources\n",
-           x->bounces, o.reps, 1e3 * median(tl, o.reps), 1e3 * median(tvis, o.reps), x->shadow_rays,
-           1e3 * median(tk, o.reps), x->sources);
+    printf("lighting stage (n_b %d, %s scattering, median of %d): %.2f ms = visibility %.2f ms (%ld shadow rays) + "
+           "emission and scattering kernels %.2f ms; %ld sources\n",
+           x->bounces, s.scatter == GI_PARTICLE_SCATTER_FULL ? "full" : "walk", o.reps, 1e3 * median(tl, o.reps),
+           1e3 * median(tvis, o.reps), x->shadow_rays, 1e3 * median(tk, o.reps), x->sources);
+    printf("  CPU time per lighting stage %.2f ms (all threads, median)\n", 1e3 * median(tcpu, o.reps));
     printf("  flux: direct %.4g, emitted %.4g, scattered %.4g\n", x->flux_direct, x->flux_emitted, x->flux_scattered);
 
     framebuffer *fb_none = fb_new(o.size, o.size), *fb_gi = fb_new(o.size, o.size);
@@ -266,6 +302,7 @@ int main(int argc, char **argv)
     free(tl);
     free(tk);
     free(tvis);
+    free(tcpu);
     free(tn);
     free(tf);
     free(tfl);

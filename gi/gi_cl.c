@@ -46,7 +46,7 @@ extern const int gi_kernel_nfiles;
 
 #define GI_CL_LOCAL 64
 
-enum { KE_EMIT, KE_SCATTER, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_COUNT };
+enum { KE_EMIT, KE_SCATTER, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_PULL_INIT, KE_PULL, KE_COUNT };
 
 struct gi_dev {
     int is_cl;
@@ -57,9 +57,9 @@ struct gi_dev {
     /* geometry (host pointers, caller-owned) */
     const gi_dev_particle *part;
     int n, ns2, ng, nrp;
-    const int *slink, *glink, *list_off, *list_idx;
+    const int *slink, *glink, *list_off, *list_idx, *rin_off, *rin_src;
     /* C build scratch */
-    float *edir, *src;
+    float *edir, *src, *bin, *bout, *total;
     gi_i64 *acc;
     const float *lout_host;  /* last scatter's output (C build reads it in gather) */
     const float *eind_host;  /* last gather's output (C build reads it in estimate) */
@@ -70,6 +70,7 @@ struct gi_dev {
     cl_kernel k[KE_COUNT];
     cl_mem b_part, b_slink, b_glink, b_off, b_idx;
     cl_mem b_lights, b_vis, b_edir, b_src, b_acc, b_tally, b_srcidx, b_lout, b_phi, b_eind, b_list, b_vout;
+    cl_mem b_rin_off, b_rin_src, b_bin, b_bout, b_total;
     size_t sz_lights, sz_vis, sz_srcidx, sz_list, sz_vout;
     float *tmp;  /* n*4 readback scratch */
 #endif
@@ -307,8 +308,8 @@ static pt_status cl_open(gi_dev *dv, const gi_dev_options *o, diag *d)
         free(log);
         return PT_ERR_DEVICE;
     }
-    static const char *const names[KE_COUNT] = {"gi_k_emit", "gi_k_scatter", "gi_k_resolve", "gi_k_gather",
-                                                "gi_k_estimate"};
+    static const char *const names[KE_COUNT] = {"gi_k_emit",     "gi_k_scatter",   "gi_k_resolve", "gi_k_gather",
+                                                "gi_k_estimate", "gi_k_pull_init", "gi_k_pull"};
     for (int k = 0; k < KE_COUNT; k++) {
         dv->k[k] = clCreateKernel(dv->prog, names[k], &e);
         if (!dv->k[k]) return cl_fail(d, names[k], e);
@@ -429,7 +430,8 @@ void gi_dev_free(gi_dev *dv)
     if (dv->is_cl) {
         cl_mem *ms[] = {&dv->b_part, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
                         &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_acc, &dv->b_tally, &dv->b_srcidx,
-                        &dv->b_lout, &dv->b_phi, &dv->b_eind, &dv->b_list, &dv->b_vout};
+                        &dv->b_lout, &dv->b_phi, &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off,
+                        &dv->b_rin_src, &dv->b_bin, &dv->b_bout, &dv->b_total};
         for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
         for (int k = 0; k < KE_COUNT; k++)
             if (dv->k[k]) clReleaseKernel(dv->k[k]);
@@ -442,6 +444,9 @@ void gi_dev_free(gi_dev *dv)
     free(dv->edir);
     free(dv->src);
     free(dv->acc);
+    free(dv->bin);
+    free(dv->bout);
+    free(dv->total);
     free(dv);
 }
 
@@ -459,11 +464,17 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
         free(dv->edir);
         free(dv->src);
         free(dv->acc);
+        free(dv->bin);
+        free(dv->bout);
+        free(dv->total);
         dv->edir = calloc(nn * 4, sizeof(float));
         dv->src = calloc(nn * 4, sizeof(float));
         dv->acc = calloc(nn * 3, sizeof(gi_i64));
-        dv->bytes = nn * (32 + 24);
-        if (!dv->edir || !dv->src || !dv->acc) return PT_ERR_NOMEM;
+        dv->bin = calloc(nn * 4, sizeof(float));
+        dv->bout = calloc(nn * 4, sizeof(float));
+        dv->total = calloc(nn * 4, sizeof(float));
+        dv->bytes = nn * (5 * 16 + 24);
+        if (!dv->edir || !dv->src || !dv->acc || !dv->bin || !dv->bout || !dv->total) return PT_ERR_NOMEM;
         return PT_OK;
     }
 #ifdef PARTRAY_HAVE_OPENCL
@@ -472,7 +483,8 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     /* a new geometry: drop every buffer and start the byte count again */
     cl_mem *ms[] = {&dv->b_part, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
                     &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_acc, &dv->b_tally, &dv->b_srcidx,
-                    &dv->b_lout, &dv->b_phi, &dv->b_eind, &dv->b_list, &dv->b_vout};
+                    &dv->b_lout, &dv->b_phi, &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off,
+                    &dv->b_rin_src, &dv->b_bin, &dv->b_bout, &dv->b_total};
     for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
     dv->sz_lights = dv->sz_vis = dv->sz_srcidx = dv->sz_list = dv->sz_vout = 0;
     dv->bytes = 0;
@@ -495,6 +507,12 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     have = 0;
     if ((st = ensure(dv, &dv->b_eind, &have, f4, d)) != PT_OK) return st;
     if ((st = zero(dv, dv->b_eind, f4, d)) != PT_OK) return st;
+    cl_mem *fb[] = {&dv->b_bin, &dv->b_bout, &dv->b_total};
+    for (int k = 0; k < 3; k++) {
+        have = 0;
+        if ((st = ensure(dv, fb[k], &have, f4, d)) != PT_OK) return st;
+        if ((st = zero(dv, *fb[k], f4, d)) != PT_OK) return st;
+    }
     if ((st = zero(dv, dv->b_lout, f4, d)) != PT_OK) return st;
     free(dv->tmp);
     dv->tmp = malloc(f4);
@@ -519,6 +537,24 @@ pt_status gi_dev_set_lists(gi_dev *dv, const int *list_off, int nrp, const int *
     if (st != PT_OK) return st;
     have = 0;
     return upload(dv, &dv->b_idx, &have, list_idx, (size_t)list_off[nrp] * sizeof(int), d);
+#else
+    return PT_ERR_INTERNAL;
+#endif
+}
+
+pt_status gi_dev_set_reverse(gi_dev *dv, const int *rin_off, const int *rin_src, diag *d)
+{
+    dv->rin_off = rin_off;
+    dv->rin_src = rin_src;
+    if (!dv->is_cl) return PT_OK;
+#ifdef PARTRAY_HAVE_OPENCL
+    rel(&dv->b_rin_off);
+    rel(&dv->b_rin_src);
+    size_t have = 0;
+    pt_status st = upload(dv, &dv->b_rin_off, &have, rin_off, ((size_t)dv->n + 1) * sizeof(int), d);
+    if (st != PT_OK) return st;
+    have = 0;
+    return upload(dv, &dv->b_rin_src, &have, rin_src, (size_t)rin_off[dv->n] * sizeof(int), d);
 #else
     return PT_ERR_INTERNAL;
 #endif
@@ -550,8 +586,8 @@ pt_status gi_dev_emit(gi_dev *dv, const gi_dev_light *lights, int nlights, const
 #endif
 }
 
-pt_status gi_dev_scatter(gi_dev *dv, int nb, gi_u32 seed, float scale, const int *srcidx, int nsrc, gi_i64 *tally,
-                         float *lout, float *phi, diag *d)
+pt_status gi_dev_scatter(gi_dev *dv, int mode, int nb, gi_u32 seed, float scale, const int *srcidx, int nsrc,
+                         gi_i64 *tally, float *lout, float *phi, diag *d)
 {
     size_t nn = (size_t)dv->n;
     if (nb > GI_MAX_BOUNCES) nb = GI_MAX_BOUNCES;
@@ -559,37 +595,65 @@ pt_status gi_dev_scatter(gi_dev *dv, int nb, gi_u32 seed, float scale, const int
     gi_i64 *tl = tally ? tally : tally_local;
     memset(tl, 0, sizeof(gi_i64) * 3 * (size_t)(nb > 0 ? nb : 1));
     float inv_scale = 1.0f / scale;
+    int full = mode == GI_SCATTER_FULL && dv->rin_off;
     if (!dv->is_cl) {
         memset(dv->acc, 0, nn * 3 * sizeof(gi_i64));
-        if (nb > 0) gi_c_scatter(dv->threads, dv->part, dv->slink, dv->ns2, nb, seed, scale, srcidx, nsrc, dv->src,
-                                 dv->acc, tl);
-        gi_c_resolve(dv->threads, dv->part, dv->n, dv->edir, dv->acc, inv_scale, lout, phi);
+        memset(dv->total, 0, nn * 4 * sizeof(float));
+        if (full && nb > 0) {
+            gi_c_pull_init(dv->threads, dv->n, dv->ns2, dv->src, dv->bin, dv->total);
+            for (int b = 0; b < nb; b++) {
+                gi_c_pull(dv->threads, dv->part, dv->n, dv->ns2, dv->rin_off, dv->rin_src, dv->bin, dv->bout,
+                          dv->total);
+                float *t = dv->bin;
+                dv->bin = dv->bout;
+                dv->bout = t;
+            }
+        } else if (nb > 0) {
+            gi_c_scatter(dv->threads, dv->part, dv->slink, dv->ns2, nb, seed, scale, srcidx, nsrc, dv->src, dv->acc,
+                         tl);
+        }
+        gi_c_resolve(dv->threads, dv->part, dv->n, dv->edir, dv->acc, inv_scale, dv->total, lout, phi);
         dv->lout_host = lout;
         return PT_OK;
     }
 #ifdef PARTRAY_HAVE_OPENCL
     pt_status st;
+    size_t f4 = nn * 4 * sizeof(float);
     size_t have_t = dv->b_tally ? (size_t)GI_MAX_BOUNCES * 3 * sizeof(gi_i64) : 0;
     if ((st = ensure(dv, &dv->b_tally, &have_t, (size_t)GI_MAX_BOUNCES * 3 * sizeof(gi_i64), d)) != PT_OK) return st;
     if ((st = zero(dv, dv->b_tally, (size_t)GI_MAX_BOUNCES * 3 * sizeof(gi_i64), d)) != PT_OK) return st;
     if ((st = zero(dv, dv->b_acc, nn * 3 * sizeof(gi_i64), d)) != PT_OK) return st;
-    if (nb > 0 && nsrc > 0) {
+    if ((st = zero(dv, dv->b_total, f4, d)) != PT_OK) return st;
+    int n = dv->n, ns2 = dv->ns2;
+    if (full && nb > 0) {
+        karg a0[] = {KINT(n), KINT(ns2), KMEM(dv->b_src), KMEM(dv->b_bin), KMEM(dv->b_total)};
+        if ((st = run_kernel(dv, KE_PULL_INIT, nn, a0, 5, d)) != PT_OK) return st;
+        for (int b = 0; b < nb; b++) {
+            karg a1[] = {KMEM(dv->b_part), KINT(n), KINT(ns2), KMEM(dv->b_rin_off), KMEM(dv->b_rin_src),
+                         KMEM(dv->b_bin), KMEM(dv->b_bout), KMEM(dv->b_total)};
+            if ((st = run_kernel(dv, KE_PULL, nn, a1, 8, d)) != PT_OK) return st;
+            cl_mem t = dv->b_bin;
+            dv->b_bin = dv->b_bout;
+            dv->b_bout = t;
+        }
+    } else if (nb > 0 && nsrc > 0) {
         if ((st = upload(dv, &dv->b_srcidx, &dv->sz_srcidx, srcidx, (size_t)nsrc * sizeof(int), d)) != PT_OK)
             return st;
-        int ns2 = dv->ns2;
         cl_uint sd = seed;
         karg a[] = {KMEM(dv->b_part), KMEM(dv->b_slink), KINT(ns2), KINT(nb), {sizeof(cl_uint), &sd}, KF(scale),
                     KMEM(dv->b_srcidx), KINT(nsrc), KMEM(dv->b_src), KMEM(dv->b_acc), KMEM(dv->b_tally)};
         if ((st = run_kernel(dv, KE_SCATTER, (size_t)nsrc, a, 11, d)) != PT_OK) return st;
         if ((st = download(dv, dv->b_tally, tl, (size_t)nb * 3 * sizeof(gi_i64), d)) != PT_OK) return st;
     }
-    int n = dv->n;
-    karg r[] = {KMEM(dv->b_part), KINT(n), KMEM(dv->b_edir), KMEM(dv->b_acc), KF(inv_scale), KMEM(dv->b_lout),
-                KMEM(dv->b_phi)};
-    if ((st = run_kernel(dv, KE_RESOLVE, nn, r, 7, d)) != PT_OK) return st;
-    if ((st = download(dv, dv->b_lout, lout, nn * 4 * sizeof(float), d)) != PT_OK) return st;
-    return download(dv, dv->b_phi, phi, nn * 4 * sizeof(float), d);
+    karg r[] = {KMEM(dv->b_part), KINT(n),         KMEM(dv->b_edir), KMEM(dv->b_acc),
+                KF(inv_scale),    KMEM(dv->b_total), KMEM(dv->b_lout), KMEM(dv->b_phi)};
+    if ((st = run_kernel(dv, KE_RESOLVE, nn, r, 8, d)) != PT_OK) return st;
+    if ((st = download(dv, dv->b_lout, lout, f4, d)) != PT_OK) return st;
+    return download(dv, dv->b_phi, phi, f4, d);
 #else
+    (void)seed;
+    (void)srcidx;
+    (void)nsrc;
     return PT_ERR_INTERNAL;
 #endif
 }

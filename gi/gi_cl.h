@@ -50,16 +50,22 @@ int gi_dev_opencl_built(void);
 pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, const int *slink, int ns2,
                                const int *glink, int ng, diag *d);
 pt_status gi_dev_set_lists(gi_dev *dv, const int *list_off, int nrp, const int *list_idx, diag *d);
+/* Incoming scattering links (CSR by target, sources ascending), for the
+ * "full" scattering mode. */
+pt_status gi_dev_set_reverse(gi_dev *dv, const int *rin_off, const int *rin_src, diag *d);
 
 /* Lighting stage. emit: direct E/pi and first-bounce source flux of every
- * particle (read back into edir and src, n*4 floats). scatter: scattering
- * from the nsrc particles srcidx (nb bounces, fixed-point scale), then the
- * reflected radiance lout and flux phi of every particle (n*4 floats read
- * back); tally gets nb*3 fixed-point bounce totals (may be NULL). */
+ * particle (read back into edir and src, n*4 floats). scatter: nb bounces,
+ * mode GI_SCATTER_WALK (the paper's: fan-out then random single links from
+ * the nsrc particles srcidx, fixed-point atomics with `scale`; tally gets
+ * nb*3 fixed-point bounce totals, may be NULL) or GI_SCATTER_FULL (every
+ * bounce along all links, gi_k_pull; tally zero); then the reflected
+ * radiance lout and flux phi of every particle (n*4 floats read back). */
+enum { GI_SCATTER_WALK = 0, GI_SCATTER_FULL = 1 };
 pt_status gi_dev_emit(gi_dev *dv, const gi_dev_light *lights, int nlights, const float *vis, float *edir, float *src,
                       diag *d);
-pt_status gi_dev_scatter(gi_dev *dv, int nb, gi_u32 seed, float scale, const int *srcidx, int nsrc, gi_i64 *tally,
-                         float *lout, float *phi, diag *d);
+pt_status gi_dev_scatter(gi_dev *dv, int mode, int nb, gi_u32 seed, float scale, const int *srcidx, int nsrc,
+                         gi_i64 *tally, float *lout, float *phi, diag *d);
 /* Ray-tracing stage. gather: E~/pi of the used particles, written into the
  * device's copy and into eind[4*used[t]] on the host. estimate: radiance
  * particles found[t] into vout[4*t] (compact). */

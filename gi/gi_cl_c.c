@@ -29,9 +29,12 @@ typedef struct {
     float scale;
     gi_i64 *acc, *tally;
     const gi_i64 *cacc;
+    const float *total;
+    float *ftot;
+    const int *rin_off, *rin_src;
 } c_launch;
 
-enum { K_EMIT, K_SCATTER, K_RESOLVE, K_GATHER, K_ESTIMATE };
+enum { K_EMIT, K_SCATTER, K_RESOLVE, K_GATHER, K_ESTIMATE, K_PULL_INIT, K_PULL };
 
 static void run_chunk(void *ctx, int chunk, int thread)
 {
@@ -46,7 +49,11 @@ static void run_chunk(void *ctx, int chunk, int thread)
             gi_k_scatter(a->part, a->slink, a->ns2, a->nb, a->seed, a->scale, a->idx, (int)a->n, a->src, a->acc,
                          a->tally);
             break;
-        case K_RESOLVE: gi_k_resolve(a->part, a->np, a->edir, a->cacc, a->scale, a->fout, a->fout2); break;
+        case K_RESOLVE: gi_k_resolve(a->part, a->np, a->edir, a->cacc, a->scale, a->total, a->fout, a->fout2); break;
+        case K_PULL_INIT: gi_k_pull_init(a->np, a->ns2, a->src, a->fout, a->ftot); break;
+        case K_PULL:
+            gi_k_pull(a->part, a->np, a->ns2, a->rin_off, a->rin_src, a->src, a->fout, a->ftot);
+            break;
         case K_GATHER:
             gi_k_gather(a->glink, a->ng, a->lout, a->idx, (int)a->n, a->bg[0], a->bg[1], a->bg[2], a->fout);
             break;
@@ -82,11 +89,25 @@ void gi_c_scatter(int threads, const gi_dev_particle *part, const int *slink, in
     launch(threads, &a);
 }
 
+void gi_c_pull_init(int threads, int n, int ns2, const float *src, float *bin, float *total)
+{
+    c_launch a = {.kernel = K_PULL_INIT, .n = (size_t)n, .np = n, .ns2 = ns2, .src = src, .fout = bin, .ftot = total};
+    launch(threads, &a);
+}
+
+void gi_c_pull(int threads, const gi_dev_particle *part, int n, int ns2, const int *rin_off, const int *rin_src,
+               const float *bin, float *bout, float *total)
+{
+    c_launch a = {.kernel = K_PULL, .n = (size_t)n, .part = part, .np = n, .ns2 = ns2, .rin_off = rin_off,
+                  .rin_src = rin_src, .src = bin, .fout = bout, .ftot = total};
+    launch(threads, &a);
+}
+
 void gi_c_resolve(int threads, const gi_dev_particle *part, int n, const float *edir, const gi_i64 *acc,
-                  float inv_scale, float *lout, float *phi)
+                  float inv_scale, const float *total, float *lout, float *phi)
 {
     c_launch a = {.kernel = K_RESOLVE, .n = (size_t)n, .part = part, .np = n, .edir = edir, .cacc = acc,
-                  .scale = inv_scale, .fout = lout, .fout2 = phi};
+                  .scale = inv_scale, .total = total, .fout = lout, .fout2 = phi};
     launch(threads, &a);
 }
 

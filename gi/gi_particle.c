@@ -33,6 +33,7 @@ struct gi_particle {
     gi_particles ps;
     int ns2, ng;
     int *slink, *glink;
+    int *rin_off, *rin_src; /* incoming scattering links (FULL mode) */
     gi_lists lists;
     gi_dev *dev;
     /* lighting */
@@ -107,7 +108,7 @@ static void update_bytes(gi_particle *gp)
     size_t n = (size_t)gp->ps.n, nrp = (size_t)gp->lists.nrp;
     s->bytes_particles = n * (sizeof(gi_dev_particle) + sizeof(int) + 1) + n * 4 * sizeof(float) * 6 + n * 2 +
                          (size_t)gp->nlights * n * sizeof(float);
-    s->bytes_links = n * (size_t)(gp->ns2 + gp->ng) * sizeof(int);
+    s->bytes_links = n * (size_t)(2 * gp->ns2 + gp->ng) * sizeof(int) + (n + 2) * sizeof(int);
     s->bytes_lists = (nrp + 1) * sizeof(int) + (gp->lists.off ? (size_t)gp->lists.off[nrp] : 0) * sizeof(int) +
                      nrp * (4 * sizeof(float) + 2);
     s->bytes_surfaces = gp->surf ? gi_surface_bytes(gp->surf) : 0;
@@ -196,6 +197,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     else gi_particle_default_settings(&gp->set);
     gi_particle_settings *set = &gp->set;
     if (set->scatter_side < 1) set->scatter_side = 1;
+    if (set->scatter_side > 8) set->scatter_side = 8; /* GI_MAX_SCATTER links */
     if (set->gather_side < 1) set->gather_side = 1;
     if (set->bounces < 0) set->bounces = 0;
     if (set->bounces > GI_MAX_BOUNCES) set->bounces = GI_MAX_BOUNCES;
@@ -327,9 +329,24 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         if (st != PT_OK) goto fail;
     }
 
+    /* incoming scattering links, sources ascending (FULL scattering) */
+    {
+        int n = gp->ps.n;
+        size_t nl = (size_t)n * (size_t)gp->ns2;
+        gp->rin_off = xcalloc((size_t)n + 2, sizeof(int), &st);
+        gp->rin_src = xcalloc(nl, sizeof(int), &st);
+        if (st != PT_OK) goto fail;
+        for (size_t q = 0; q < nl; q++)
+            if (gp->slink[q] >= 0) gp->rin_off[gp->slink[q] + 2]++;
+        for (int j = 0; j < n; j++) gp->rin_off[j + 2] += gp->rin_off[j + 1];
+        for (size_t q = 0; q < nl; q++)
+            if (gp->slink[q] >= 0) gp->rin_src[gp->rin_off[gp->slink[q] + 1]++] = (int)(q / (size_t)gp->ns2);
+    }
+
     tg = timer_now();
     st = gi_dev_set_particles(gp->dev, gp->ps.p, gp->ps.n, gp->slink, gp->ns2, gp->glink, gp->ng, d);
     if (st == PT_OK) st = gi_dev_set_lists(gp->dev, gp->lists.off, (int)gp->lists.nrp, gp->lists.idx, d);
+    if (st == PT_OK) st = gi_dev_set_reverse(gp->dev, gp->rin_off, gp->rin_src, d);
     if (st != PT_OK) goto fail;
     S->t_upload = timer_now() - tg;
     S->t_geometry = timer_now() - t0 - S->t_kernel_build;
@@ -352,6 +369,8 @@ void gi_particle_free(gi_particle *gp)
     gi_lists_free(&gp->lists);
     free(gp->slink);
     free(gp->glink);
+    free(gp->rin_off);
+    free(gp->rin_src);
     free(gp->lights);
     free(gp->vis);
     free(gp->edir);
@@ -573,7 +592,8 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
     if (e < -100) e = -100;
     float scale = ldexpf(1.0f, e);
     gi_i64 tally[GI_MAX_BOUNCES * 3];
-    st = gi_dev_scatter(gp->dev, nsrc > 0 ? nb : 0, (gi_u32)(gp->set.seed * 2654435761u + 12345u), scale, gp->srcidx,
+    st = gi_dev_scatter(gp->dev, gp->set.scatter == GI_PARTICLE_SCATTER_FULL ? GI_SCATTER_FULL : GI_SCATTER_WALK,
+                        nsrc > 0 ? nb : 0, (gi_u32)(gp->set.seed * 2654435761u + 12345u), scale, gp->srcidx,
                         nsrc, tally, gp->lout, gp->phi, d);
     if (st != PT_OK) return st;
     gp->nbounce_flux = nsrc > 0 ? nb : 0;

@@ -60,11 +60,21 @@
 
 typedef struct gi_particle gi_particle;
 
+/* How flux is scattered after emission (gi_lighting.cl):
+ *  WALK  the paper's (section 4.2.2, Fig. 5): the first bounce along all
+ *        n_s x n_s links, then n_b - 1 bounces along one random link per
+ *        packet, with atomic (fixed-point, deterministic) accumulation;
+ *  FULL  every bounce along all links, computed as a gather over incoming
+ *        links: no atomics, no random-walk noise, memory-friendly on CPUs;
+ *        the same expected flux. */
+typedef enum { GI_PARTICLE_SCATTER_WALK = 0, GI_PARTICLE_SCATTER_FULL = 1 } gi_particle_scatter;
+
 typedef struct {
     long count;          /* area particles per one-sided scene area (default 50,000) */
     int scatter_side;    /* n_s: n_s x n_s scattering links (default 4) */
     int gather_side;     /* gathering links gather_side^2 (default 16: the paper's 256) */
     int bounces;         /* n_b: scattering bounces, the first full fan-out included (default 8) */
+    int scatter;         /* gi_particle_scatter (default WALK) */
     double tess;         /* sub-triangle edge / grid cell bound; <= 0: tess_factor * spacing */
     double tess_factor;  /* default 3 (spacing = sqrt(area per particle)) */
     double radius;       /* estimation list radius; <= 0: radius_factor * spacing */

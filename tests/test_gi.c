@@ -2,7 +2,8 @@
  *
  *  - energy: one scattering bounce in a closed box moves exactly rho times
  *    the flux that left the lit particles (relative 1e-5, float sums); with
- *    uniform rho every later bounce carries rho times the one before (1e-4).
+ *    uniform rho every later bounce carries rho times the one before (1e-4);
+ *    the same for the FULL scattering mode over 1..3 bounces.
  *  - integrating sphere (a furnace with a closed form): inside a Lambertian
  *    sphere the indirect irradiance is the same everywhere, whatever lights
  *    it, E_ind = F_d / A * sum_{k=1}^{n_b+1} rho^k (form factor dA/A between
@@ -93,10 +94,13 @@ static int have_opencl(void)
 
 static const char *const device_c = "c";
 
+static int g_scatter = GI_PARTICLE_SCATTER_WALK;
+
 static gi_particle *build(fixture *f, long count, int nb, const char *device, uint64_t seed)
 {
     gi_particle_settings s;
     gi_particle_default_settings(&s);
+    s.scatter = g_scatter;
     s.count = count;
     s.bounces = nb;
     s.threads = 2;
@@ -182,6 +186,45 @@ static void test_energy_c(void **state)
 {
     (void)state;
     energy_check(device_c);
+}
+
+/* FULL scattering: n_b bounces along all links move exactly
+ * (rho + rho^2 + ... + rho^n_b) / rho times the flux leaving the lit
+ * particles in a closed box of uniform rho (float sums, 1e-5). */
+static void full_check(const char *device)
+{
+    fixture f;
+    load(&f, cube_scene);
+    g_scatter = GI_PARTICLE_SCATTER_FULL;
+    for (int nb = 1; nb <= 3; nb++) {
+        gi_particle *gp = build(&f, 4000, nb, device, 1);
+        const float *edir, *phi;
+        int n = gi_particle_debug(gp, &edir, &phi, NULL, NULL, NULL);
+        double before = 0.0, after = 0.0;
+        for (int i = 0; i < n; i++) {
+            double area, rho[3];
+            gi_particle_debug_particle(gp, i, &area, rho, NULL, NULL);
+            for (int c = 0; c < 3; c++) {
+                double fd = M_PI * edir[4 * i + c] * area;
+                before += rho[c] * fd;
+                after += phi[4 * i + c] - fd;
+            }
+        }
+        double want = before * (nb == 1 ? 1.0 : nb == 2 ? 1.6 : 1.96);
+        printf("  [%s] full scattering, %d bounces: received %.9g, expected %.9g (rel %.2e)\n",
+               device ? device : "auto", nb, after, want, fabs(after - want) / want);
+        assert_true(fabs(after - want) <= 1e-5 * want);
+        gi_particle_free(gp);
+    }
+    g_scatter = GI_PARTICLE_SCATTER_WALK;
+    unload(&f);
+}
+
+static void test_full_scatter(void **state)
+{
+    (void)state;
+    full_check(device_c);
+    if (have_opencl()) full_check(NULL);
 }
 
 static void test_energy_opencl(void **state)
@@ -485,6 +528,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_energy_c),
         cmocka_unit_test(test_energy_opencl),
+        cmocka_unit_test(test_full_scatter),
         cmocka_unit_test(test_integrating_sphere),
         cmocka_unit_test(test_direct_matches_whitted),
         cmocka_unit_test(test_determinism),

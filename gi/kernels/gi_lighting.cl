@@ -92,46 +92,115 @@ __kernel void gi_k_scatter(__global const gi_dev_particle *part, __global const 
     int t = (int)get_global_id(0);
     if (t >= nsrc) return;
     int i = srcidx[t];
-    gi_i64 tl[GI_MAX_BOUNCES * 3];
     int nbc = nb < GI_MAX_BOUNCES ? nb : GI_MAX_BOUNCES;
-    for (int b = 0; b < nbc * 3; b++) tl[b] = 0;
+    int nk = ns2 < GI_MAX_SCATTER ? ns2 : GI_MAX_SCATTER;
+    /* The ns2 packets advance in lockstep, one bounce at a time: their
+     * memory reads are independent, so they overlap; each bounce first
+     * prefetches the lines its deposits will add to. (Same packets, same
+     * random choices and same integer sums as walking them one by one.) */
+    int jj[GI_MAX_SCATTER];
+    float pk[GI_MAX_SCATTER * 3];
     float w = 1.0f / (float)ns2;
-    for (int k = 0; k < ns2; k++) {
-        int j = slink[(long)i * ns2 + k];
-        if (j < 0) continue;
-        float pk[3] = {src[4 * i] * w, src[4 * i + 1] * w, src[4 * i + 2] * w};
-        gi_deposit(acc, j, pk, scale, &tl[0]);
-        for (int s = 1; s < nbc; s++) {
-            __global const gi_dev_particle *pj = &part[j];
-            pk[0] *= pj->rho[0];
-            pk[1] *= pj->rho[1];
-            pk[2] *= pj->rho[2];
-            if (pk[0] == 0.0f && pk[1] == 0.0f && pk[2] == 0.0f) break;
-            gi_u32 h = gi_hash(seed ^ gi_hash((gi_u32)i ^ gi_hash((gi_u32)(k + ns2 * s))));
-            int j2 = slink[(long)j * ns2 + (int)(h % (gi_u32)ns2)];
-            if (j2 < 0) break;
-            gi_deposit(acc, j2, pk, scale, &tl[3 * s]);
-            j = j2;
-        }
+    for (int k = 0; k < nk; k++) {
+        jj[k] = slink[(long)i * ns2 + k];
+        pk[3 * k] = src[4 * i] * w;
+        pk[3 * k + 1] = src[4 * i + 1] * w;
+        pk[3 * k + 2] = src[4 * i + 2] * w;
     }
-    for (int b = 0; b < nbc * 3; b++)
-        if (tl[b] != 0) atom_add(&tally[b], tl[b]);
+    for (int s = 0; s < nbc; s++) {
+        if (s > 0) {
+            /* move every live packet one link on from where it lies */
+            for (int k = 0; k < nk; k++) {
+                int j = jj[k];
+                if (j < 0) continue;
+                __global const gi_dev_particle *pj = &part[j];
+                pk[3 * k] *= pj->rho[0];
+                pk[3 * k + 1] *= pj->rho[1];
+                pk[3 * k + 2] *= pj->rho[2];
+                if (pk[3 * k] == 0.0f && pk[3 * k + 1] == 0.0f && pk[3 * k + 2] == 0.0f) {
+                    jj[k] = -1;
+                    continue;
+                }
+                gi_u32 h = gi_hash(seed ^ gi_hash((gi_u32)i ^ gi_hash((gi_u32)(k + ns2 * s))));
+                jj[k] = slink[(long)j * ns2 + (int)(h % (gi_u32)ns2)];
+            }
+        }
+        int live = 0;
+        for (int k = 0; k < nk; k++)
+            if (jj[k] >= 0) {
+                prefetch(&acc[3 * jj[k]], 3);
+                live++;
+            }
+        if (live == 0) break;
+        gi_i64 tl[3] = {0, 0, 0};
+        for (int k = 0; k < nk; k++)
+            if (jj[k] >= 0) gi_deposit(acc, jj[k], &pk[3 * k], scale, tl);
+        for (int c = 0; c < 3; c++)
+            if (tl[c] != 0) atom_add(&tally[3 * s + c], tl[c]);
+    }
+}
+
+/* Alternative scattering (settings scatter_mode "full"): every bounce along
+ * all ns2 links, as the paper's first bounce, written as a gather so that
+ * no atomics are needed. One launch per bounce: particle j receives
+ *   recv_j = sum over links i -> j of bin_i,   bin_i = rho_i recv_i / ns2
+ * (bin for the first bounce: src_i / ns2), over the incoming links listed
+ * in rin_src[rin_off[j] .. rin_off[j+1]) in ascending source order (fixed
+ * summation order: deterministic in float). It adds recv_j to total_j and
+ * writes bout_j = rho_j recv_j / ns2 for the next bounce. Same expected
+ * flux as the random walks, without their noise; 4 floats per particle. */
+__kernel void gi_k_pull(__global const gi_dev_particle *part, int n, int ns2, __global const int *rin_off,
+                        __global const int *rin_src, __global const float *bin, __global float *bout,
+                        __global float *total)
+{
+    int j = (int)get_global_id(0);
+    if (j >= n) return;
+    float r[3] = {0.0f, 0.0f, 0.0f};
+    for (int q = rin_off[j]; q < rin_off[j + 1]; q++) {
+        int i = rin_src[q];
+        r[0] += bin[4 * i];
+        r[1] += bin[4 * i + 1];
+        r[2] += bin[4 * i + 2];
+    }
+    float w = 1.0f / (float)ns2;
+    __global const gi_dev_particle *pj = &part[j];
+    for (int c = 0; c < 3; c++) {
+        total[4 * j + c] += r[c];
+        bout[4 * j + c] = pj->rho[c] * r[c] * w;
+    }
+    total[4 * j + 3] = 0.0f;
+    bout[4 * j + 3] = 0.0f;
+}
+
+/* First-bounce input of gi_k_pull: bin_i = src_i / ns2. */
+__kernel void gi_k_pull_init(int n, int ns2, __global const float *src, __global float *bin, __global float *total)
+{
+    int i = (int)get_global_id(0);
+    if (i >= n) return;
+    float w = 1.0f / (float)ns2;
+    for (int c = 0; c < 4; c++) {
+        bin[4 * i + c] = c < 3 ? src[4 * i + c] * w : 0.0f;
+        total[4 * i + c] = 0.0f;
+    }
 }
 
 /* Reflected radiance of every area particle after scattering (section 4.2.2,
  * the equation after Fig. 5): L^(i) = f_rd^(i) phi^(i) / dA^(i) with
  * f_rd = rho/pi, phi = phi_d + scattered flux; plus the particle's own
  * emission, since the gathering step (eq. for E~ in 4.3.1) reads L^(k*) as
- * the radiance arriving from k*. Writes lout[i] (radiance) and phi[i]
- * (total received flux), 4 floats each. */
+ * the radiance arriving from k*. The scattered flux is acc (fixed point,
+ * gi_k_scatter) plus total (float, gi_k_pull); the mode not used left its
+ * array at zero. Writes lout[i] (radiance) and phi[i] (total received
+ * flux), 4 floats each. */
 __kernel void gi_k_resolve(__global const gi_dev_particle *part, int n, __global const float *edir,
-                           __global const gi_i64 *acc, float inv_scale, __global float *lout, __global float *phi)
+                           __global const gi_i64 *acc, float inv_scale, __global const float *total,
+                           __global float *lout, __global float *phi)
 {
     int i = (int)get_global_id(0);
     if (i >= n) return;
     __global const gi_dev_particle *pt = &part[i];
     for (int c = 0; c < 3; c++) {
-        float f = GI_PI_F * edir[4 * i + c] * pt->area + (float)acc[3 * i + c] * inv_scale;
+        float f = GI_PI_F * edir[4 * i + c] * pt->area + (float)acc[3 * i + c] * inv_scale + total[4 * i + c];
         float l = pt->le[c] + pt->rho[c] * f / (GI_PI_F * pt->area);
         if (!isfinite(l)) l = 0.0f;
         if (!isfinite(f)) f = 0.0f;
