@@ -80,6 +80,11 @@ typedef struct {
     int have_image;
     int need_present;        /* new image or window damage since the last present */
     int verbose;             /* print a line per image shown */
+    /* keys held down, from the event queue (real and scripted presses) */
+    unsigned char held[SDL_NUM_SCANCODES];
+    struct { double at; SDL_Keycode key; SDL_Scancode code; } release[16];
+    int nrelease;
+    int raw_input;           /* a script action queued raw input this tick */
     /* script */
     view_script *script;
     int quit;
@@ -321,6 +326,55 @@ static void apply(viewer *v, const view_action *a)
         view_camera_zoom(&v->cam, a->v[0]);
         v->dirty |= VIEW_CAUSE_CAMERA;
         break;
+    case VIEW_ACT_KEY: {
+        char name[64];
+        snprintf(name, sizeof name, "%s", a->text);
+        for (char *p = name; *p; p++)
+            if (*p == '_') *p = ' ';
+        SDL_Keycode k = SDL_GetKeyFromName(name);
+        if (k == SDLK_UNKNOWN) {
+            fprintf(stderr, "partray view: unknown key '%s'\n", a->text);
+            break;
+        }
+        SDL_Event e;
+        memset(&e, 0, sizeof e);
+        e.type = SDL_KEYDOWN;
+        e.key.state = SDL_PRESSED;
+        e.key.keysym.sym = k;
+        e.key.keysym.scancode = SDL_GetScancodeFromKey(k);
+        SDL_PushEvent(&e);
+        if (v->nrelease < (int)(sizeof v->release / sizeof v->release[0])) {
+            v->release[v->nrelease].at = timer_now() + a->v[0];
+            v->release[v->nrelease].key = k;
+            v->release[v->nrelease].code = e.key.keysym.scancode;
+            v->nrelease++;
+        }
+        v->raw_input = 1;
+        break;
+    }
+    case VIEW_ACT_DRAG: {
+        SDL_Event e;
+        memset(&e, 0, sizeof e);
+        e.type = SDL_MOUSEMOTION;
+        e.motion.state = a->mode == 1 ? SDL_BUTTON_LMASK : SDL_BUTTON_RMASK;
+        e.motion.xrel = (Sint32)lround(a->v[0]);
+        e.motion.yrel = (Sint32)lround(a->v[1]);
+        e.motion.x = v->width / 2;
+        e.motion.y = v->height / 2;
+        SDL_PushEvent(&e);
+        v->raw_input = 1;
+        break;
+    }
+    case VIEW_ACT_WHEEL: {
+        SDL_Event e;
+        memset(&e, 0, sizeof e);
+        e.type = SDL_MOUSEWHEEL;
+        e.wheel.y = (Sint32)lround(a->v[0]);
+        e.wheel.direction = SDL_MOUSEWHEEL_NORMAL;
+        SDL_PushEvent(&e);
+        v->raw_input = 1;
+        break;
+    }
     case VIEW_ACT_GI: {
         int m = a->mode < 0 ? view_gi_next(v->gi_mode) : a->mode;
         if (!view_gi_available(m)) {
@@ -386,11 +440,10 @@ static void on_key(viewer *v, const SDL_KeyboardEvent *k)
 /* Held keys: flying and light moves, scaled by the tick's length. */
 static void held_keys(viewer *v, double dt)
 {
-    const Uint8 *ks = SDL_GetKeyboardState(NULL);
-    SDL_Keymod mod = SDL_GetModState();
+    const unsigned char *ks = v->held;
     double speed = 0.25 * v->scale * dt;
-    if (mod & KMOD_SHIFT) speed *= 4;
-    if (mod & KMOD_CTRL) speed *= 0.25;
+    if (ks[SDL_SCANCODE_LSHIFT] || ks[SDL_SCANCODE_RSHIFT]) speed *= 4;
+    if (ks[SDL_SCANCODE_LCTRL] || ks[SDL_SCANCODE_RCTRL]) speed *= 0.25;
     double f = (ks[SDL_SCANCODE_W] ? 1 : 0) - (ks[SDL_SCANCODE_S] ? 1 : 0);
     double r = (ks[SDL_SCANCODE_D] ? 1 : 0) - (ks[SDL_SCANCODE_A] ? 1 : 0);
     double u = (ks[SDL_SCANCODE_E] ? 1 : 0) - (ks[SDL_SCANCODE_Q] ? 1 : 0);
@@ -420,7 +473,11 @@ static void on_event(viewer *v, const SDL_Event *e)
     case SDL_QUIT: v->quit = 1; break;
     case SDL_WINDOWEVENT: v->need_present = 1; break;
     case SDL_KEYDOWN:
+        if (e->key.keysym.scancode < SDL_NUM_SCANCODES) v->held[e->key.keysym.scancode] = 1;
         if (!e->key.repeat) on_key(v, &e->key);
+        break;
+    case SDL_KEYUP:
+        if (e->key.keysym.scancode < SDL_NUM_SCANCODES) v->held[e->key.keysym.scancode] = 0;
         break;
     case SDL_MOUSEMOTION:
         if (e->motion.state & SDL_BUTTON_LMASK) {
@@ -587,13 +644,26 @@ static void run_loop(viewer *v)
         double dt = now - last;
         last = now;
         held_keys(v, dt > 0.1 ? 0.1 : dt);
+        for (int i = 0; i < v->nrelease; i++) {
+            if (now < v->release[i].at) continue;
+            SDL_Event up;
+            memset(&up, 0, sizeof up);
+            up.type = SDL_KEYUP;
+            up.key.state = SDL_RELEASED;
+            up.key.keysym.sym = v->release[i].key;
+            up.key.keysym.scancode = v->release[i].code;
+            SDL_PushEvent(&up);
+            v->release[i--] = v->release[--v->nrelease];
+        }
         flush_state(v);
         int fresh = take_image(v, now);
         if (v->script) {
             if (v->have_image) view_script_start(v->script, now);
             view_action a;
-            /* idle is asked after every action has been posted */
-            while (!v->quit && view_script_next(v->script, timer_now(), view_render_idle(v->vr), &a)) {
+            /* idle is asked after every action has been posted; raw input
+             * goes through the event queue first (next tick) */
+            v->raw_input = 0;
+            while (!v->quit && !v->raw_input && view_script_next(v->script, timer_now(), view_render_idle(v->vr), &a)) {
                 apply(v, &a);
                 flush_state(v);
             }
@@ -750,6 +820,18 @@ int cmd_view(int argc, char **argv)
     }
 
     if (rc == EXIT_OK && !open_window(&v)) rc = EXIT_IO;
+    for (int i = 0; rc == EXIT_OK && v.script && i < view_script_count(v.script); i++) {
+        const view_action *a = view_script_action(v.script, i);
+        if (a->kind != VIEW_ACT_KEY) continue;
+        char name[64];
+        snprintf(name, sizeof name, "%s", a->text);
+        for (char *p = name; *p; p++)
+            if (*p == '_') *p = ' ';
+        if (SDL_GetKeyFromName(name) == SDLK_UNKNOWN) {
+            fprintf(stderr, "%s: error: unknown key name '%s' (SDL key names, '_' for spaces)\n", script_path, a->text);
+            rc = EXIT_SCENE;
+        }
+    }
     if (rc == EXIT_OK) {
         view_render_opts ro = {v.width, v.height, v.threads, o.seed, preview};
         view_state s0 = current_state(&v);

@@ -103,6 +103,26 @@ static int parse_command(ctx *c, view_script *vs, word *w, int n, int eol_col, v
         a->mode = strcmp(m, "next") == 0 ? -1 : gi_mode_parse(m);
         if (strcmp(m, "next") != 0 && a->mode < 0) { err_at(c, w[1].col, "unknown GI mode '%s' (none, particle, path, next)", m); return 0; }
         return 1;
+    } else if (word_is(&w[0], "key")) {
+        a->kind = VIEW_ACT_KEY;
+        if (n < 2 || n > 3) { err_at(c, n > 3 ? w[3].col : eol_col, "key takes NAME [HOLD]%s", ""); return 0; }
+        a->text = keep(vs, w[1].s, w[1].len);
+        if (n == 3 && (!word_num(&w[2], &a->v[0]) || a->v[0] < 0)) { err_at(c, w[2].col, "key HOLD must be seconds >= 0%s", ""); return 0; }
+        return 1;
+    } else if (word_is(&w[0], "drag")) {
+        a->kind = VIEW_ACT_DRAG;
+        if (n != 4) { err_at(c, n > 4 ? w[4].col : eol_col, "drag takes left|right DX DY%s", ""); return 0; }
+        if (word_is(&w[1], "left")) a->mode = 1;
+        else if (word_is(&w[1], "right")) a->mode = 3;
+        else { err_at(c, w[1].col, "drag wants left or right%s", ""); return 0; }
+        for (int i = 0; i < 2; i++)
+            if (!word_num(&w[2 + i], &a->v[i]) || fabs(a->v[i]) > 1e5) { err_at(c, w[2 + i].col, "expected a number of pixels%s", ""); return 0; }
+        return 1;
+    } else if (word_is(&w[0], "wheel")) {
+        a->kind = VIEW_ACT_WHEEL;
+        if (n != 2) { err_at(c, n > 2 ? w[2].col : eol_col, "wheel takes one number of clicks%s", ""); return 0; }
+        if (!word_num(&w[1], &a->v[0]) || fabs(a->v[0]) > 1e4 || a->v[0] != floor(a->v[0])) { err_at(c, w[1].col, "expected a whole number of clicks%s", ""); return 0; }
+        return 1;
     } else if (word_is(&w[0], "light")) {
         double idx;
         if (n < 3) { err_at(c, n > 1 ? w[1].col + w[1].len : eol_col, "light needs N and an action (select, move, scale)%s", ""); return 0; }
@@ -156,7 +176,7 @@ static int parse_command(ctx *c, view_script *vs, word *w, int n, int eol_col, v
         if (a->kind == VIEW_ACT_CAMERA_ZOOM && !(a->v[0] > 0)) { err_at(c, w[2].col, "camera zoom must be > 0%s", ""); return 0; }
         return 1;
     } else {
-        err_at(c, w[0].col, "unknown command '%s' (screenshot, light, camera, gi, wait-idle, mark, quit)", cmd);
+        err_at(c, w[0].col, "unknown command '%s' (screenshot, light, camera, gi, key, drag, wheel, wait-idle, mark, quit)", cmd);
         return 0;
     }
     if (n != need) {
@@ -322,6 +342,8 @@ int view_script_next(view_script *vs, double now, int idle, view_action *a)
     }
     return 0;
 }
+
+const view_action *view_script_action(const view_script *vs, int i) { return &vs->ev[i].a; }
 
 int view_script_done(const view_script *vs) { return vs->next >= vs->n; }
 int view_script_count(const view_script *vs) { return vs->n; }

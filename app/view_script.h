@@ -7,6 +7,9 @@
  *
  *     TIME COMMAND [ARGUMENTS]        # comment
  *
+ * The commands name what the viewer does; key, drag and wheel instead feed
+ * raw input through the window's event queue.
+ *
  * TIME is in seconds (a decimal number >= 0), counted from the moment the
  * first image is on screen; events run in time order (ties in file order).
  * Blank lines and everything after '#' are ignored. Commands:
@@ -28,6 +31,16 @@
  *   camera write [PATH]        print the camera{} block and write it to
  *                              PATH (default: the next free SCENE-camera-NNNN.inc)
  *   gi MODE                    switch to none | particle | path | next
+ *   key NAME [HOLD]            press the key NAME (SDL key names: w, Left,
+ *                              Page Up, F12, Tab, 1, ...; a name with a space
+ *                              is written with '_': Page_Up) and release it
+ *                              HOLD seconds later (default 0: a tap); goes
+ *                              through the window's event queue as a real
+ *                              key press does, so held keys fly and move
+ *                              lights at their real speed
+ *   drag left|right DX DY      a mouse motion of DX, DY pixels with that
+ *                              button down (left orbits, right looks)
+ *   wheel N                    N wheel clicks (positive: towards the screen)
  *   wait-idle                  hold the later events until the image is
  *                              refined to its last level; the clock then
  *                              resumes at this event's TIME, so the next
@@ -62,7 +75,10 @@ typedef enum {
     VIEW_ACT_GI,           /* mode: a gi_mode, or -1 = the next one (G) */
     VIEW_ACT_WAIT_IDLE,    /* scripts only; handled inside view_script_next */
     VIEW_ACT_MARK,         /* text: name */
-    VIEW_ACT_QUIT
+    VIEW_ACT_QUIT,
+    VIEW_ACT_KEY,          /* text: key name ('_' for spaces), v[0]: hold seconds */
+    VIEW_ACT_DRAG,         /* mode: 1 left, 3 right button; v[0], v[1]: pixels */
+    VIEW_ACT_WHEEL         /* v[0]: clicks */
 } view_action_kind;
 
 typedef struct {
@@ -88,6 +104,8 @@ int view_script_started(const view_script *vs);
 /* The next due event at wall time `now`: returns 1 and fills *a, or 0 when
  * nothing is due yet (or a wait-idle holds: `idle` is the renderer's state). */
 int view_script_next(view_script *vs, double now, int idle, view_action *a);
+/* Event i's action (0 <= i < view_script_count), for checks before a run. */
+const view_action *view_script_action(const view_script *vs, int i);
 /* 1 when every event has run. */
 int view_script_done(const view_script *vs);
 int view_script_count(const view_script *vs);

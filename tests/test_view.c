@@ -4,7 +4,8 @@
  * so neither xvfb-run nor xauth is needed): a plane, two spheres and a point
  * light at 128x128; the script waits for the refinement, takes a screenshot,
  * moves the light, screenshots again, dims the light, screenshots, orbits the
- * camera and writes it out. Asserted: the images differ where the shadows
+ * camera and writes it out; then raw input through the window's event queue
+ * (a left drag, C, the wheel, P, Escape). Asserted: the images differ where the shadows
  * moved (regions computed analytically from the scene), hardly anywhere
  * else, no NaN, not black, dimming halves the direct light, and the written
  * camera{} block parses back to the orbited camera. Skips only when there
@@ -242,7 +243,16 @@ static void test_viewer_script(void **st)
              "0.6 camera orbit 30 0\n"
              "0.6 camera write %s/cam.inc\n"
              "0.6 wait-idle\n"
-             "0.7 quit\n",
+             "# raw input through the event queue: a left drag of -100 px orbits +30\n"
+             "# degrees more, C writes the camera, two wheel clicks zoom in, C again, P\n"
+             "# takes a screenshot, Escape quits\n"
+             "0.7 drag left -100 0\n"
+             "0.7 key c\n"
+             "0.7 wheel 2\n"
+             "0.7 key c\n"
+             "0.7 wait-idle\n"
+             "0.8 key p\n"
+             "0.9 key Escape\n",
              tmpdir, tmpdir, tmpdir, tmpdir);
     write_file(script, text);
     snprintf(cmd, sizeof cmd, "cd '%s' && DISPLAY=%s timeout 120 '%s' view '%s' --size %dx%d --gi none --threads 2 --script '%s'",
@@ -335,6 +345,30 @@ static void test_viewer_script(void **st)
     vec3 to = v3_norm(v3_neg(l));
     assert_true(v3_dot(dn, to) > 1 - 1e-6);
     scene_free(sc);
+
+    /* keys and mouse: after the drag, 60 degrees; after the wheel, 0.9^2 of
+     * the distance; P saved both files under the counter name */
+    for (int k = 1; k <= 2; k++) {
+        snprintf(path, sizeof path, "%s/two-camera-%04d.inc", tmpdir, k);
+        block = read_text(path);
+        assert_non_null(block);
+        snprintf(src, sizeof src, "#version 3.7;\n%s", block);
+        sc = NULL;
+        assert_int_equal(sdl_parse_string("cam.inc", src, &so, &sc, d), PT_OK);
+        l = sc->camera.location;
+        double f = k == 1 ? 1.0 : 0.81;
+        vec3 want = v3(f * r * sin(M_PI / 3), f * 8, -f * r * cos(M_PI / 3));
+        printf("camera after drag%s: <%.4f, %.4f, %.4f>, expected <%.4f, %.4f, %.4f>\n", k == 2 ? " + wheel" : "", l.x, l.y,
+               l.z, want.x, want.y, want.z);
+        assert_true(v3_len(v3_sub(l, want)) < 1e-3);
+        scene_free(sc);
+    }
+    struct stat sb;
+    snprintf(path, sizeof path, "%s/two-0001.exr", tmpdir);
+    assert_int_equal(stat(path, &sb), 0);
+    snprintf(path, sizeof path, "%s/two-0001.png", tmpdir);
+    assert_int_equal(stat(path, &sb), 0);
+
     fb_free(a);
     fb_free(ap);
     fb_free(b);
@@ -471,6 +505,9 @@ static void test_script_grammar(void **st)
         {"1 gi photon\n", "unknown GI mode 'photon'", 1, 6},
         {"1 wait-idle now\n", "takes no arguments", 1, 13},
         {"2 camera zoom 0\n", "must be > 0", 1, 15},
+        {"1 drag middle 1 2\n", "left or right", 1, 8},
+        {"1 wheel 1.5\n", "whole number", 1, 9},
+        {"1 key\n", "key takes NAME", 1, 6},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         diag *e = diag_new();
