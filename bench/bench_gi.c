@@ -250,20 +250,41 @@ int main(int argc, char **argv)
     double *tl = calloc((size_t)o.reps, sizeof *tl), *tk = calloc((size_t)o.reps, sizeof *tk);
     double *tvis = calloc((size_t)o.reps, sizeof *tvis);
     double *tcpu = calloc((size_t)o.reps, sizeof *tcpu);
+    long colour_rays = 0;
     for (int r = 0; r < o.reps; r++) {
         double cc = cpu_now();
         gi_particle_relight(gp, d);
         tcpu[r] = cpu_now() - cc;
+        colour_rays = gi_particle_get_stats(gp)->shadow_rays;
         const gi_particle_stats *x = gi_particle_get_stats(gp);
         tl[r] = x->t_lighting;
         tk[r] = x->t_emit + x->t_scatter;
         tvis[r] = x->t_visibility;
     }
+    /* the same after moving the lights a little: visibility traced again */
+    double *tm = calloc((size_t)o.reps, sizeof *tm), *tmc = calloc((size_t)o.reps, sizeof *tmc);
+    long moved_rays = 0;
+    for (int r = 0; r < o.reps; r++) {
+        for (int l = 0; l < sc->nlights; l++) sc->lights[l].position.x += (r % 2 ? -1e-4 : 1e-4);
+        double cc = cpu_now();
+        gi_particle_relight(gp, d);
+        tmc[r] = cpu_now() - cc;
+        const gi_particle_stats *x = gi_particle_get_stats(gp);
+        tm[r] = x->t_lighting;
+        moved_rays = x->shadow_rays;
+    }
+    if (o.reps % 2)
+        for (int l = 0; l < sc->nlights; l++) sc->lights[l].position.x -= 1e-4;
+    gi_particle_relight(gp, d);
+    printf("lighting stage after a light moved (median of %d): %.2f ms wall, %.2f ms CPU, %ld shadow rays\n", o.reps,
+           1e3 * median(tm, o.reps), 1e3 * median(tmc, o.reps), moved_rays);
+    free(tm);
+    free(tmc);
     const gi_particle_stats *x = gi_particle_get_stats(gp);
-    printf("lighting stage (n_b %d, %s scattering, median of %d): %.2f ms = visibility %.2f ms (%ld shadow rays) + "
-           "emission and scattering kernels %.2f ms; %ld sources\n",
+    printf("lighting stage, colour change only (n_b %d, %s scattering, median of %d): %.2f ms = visibility %.2f ms "
+           "(%ld shadow rays) + emission and scattering kernels %.2f ms; %ld sources\n",
            x->bounces, s.scatter == GI_PARTICLE_SCATTER_FULL ? "full" : "walk", o.reps, 1e3 * median(tl, o.reps),
-           1e3 * median(tvis, o.reps), x->shadow_rays, 1e3 * median(tk, o.reps), x->sources);
+           1e3 * median(tvis, o.reps), colour_rays, 1e3 * median(tk, o.reps), x->sources);
     printf("  CPU time per lighting stage %.2f ms (all threads, median)\n", 1e3 * median(tcpu, o.reps));
     printf("  flux: direct %.4g, emitted %.4g, scattered %.4g\n", x->flux_direct, x->flux_emitted, x->flux_scattered);
 

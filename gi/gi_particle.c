@@ -40,6 +40,8 @@ struct gi_particle {
     int nlights;
     gi_dev_light *lights;
     float *vis;
+    scene_light *vis_lights; /* the lights vis was traced for (colour aside) */
+    unsigned char *dirty;
     float *edir, *src, *phi, *lout;
     int *srcidx;
     double bounce_flux[GI_MAX_BOUNCES];
@@ -373,6 +375,8 @@ void gi_particle_free(gi_particle *gp)
     free(gp->rin_src);
     free(gp->lights);
     free(gp->vis);
+    free(gp->vis_lights);
+    free(gp->dirty);
     free(gp->edir);
     free(gp->src);
     free(gp->phi);
@@ -472,6 +476,7 @@ static void vis_chunk(void *ctx, int chunk, int thread)
         vec3 p = v3(pt->p[0], pt->p[1], pt->p[2]), nrm = v3(pt->n[0], pt->n[1], pt->n[2]);
         vec3 org = v3_madd(p, nrm, J->eps);
         for (int li = 0; li < nl; li++) {
+            if (!gp->dirty[li]) continue;
             const scene_light *l = &sc->lights[li];
             const gi_dev_light *dl = &gp->lights[li];
             float d[3];
@@ -520,6 +525,19 @@ static void vis_chunk(void *ctx, int chunk, int thread)
     atomic_fetch_add(&J->rays, rays);
 }
 
+/* Whether two lights cast the same shadows on the particles (everything
+ * but the colour: visibility also skips particles the attenuation zeroes). */
+static int same_geometry(const scene_light *a, const scene_light *b)
+{
+    return a->kind == b->kind && v3_len2(v3_sub(a->position, b->position)) == 0.0 &&
+           v3_len2(v3_sub(a->point_at, b->point_at)) == 0.0 && a->radius == b->radius && a->falloff == b->falloff &&
+           a->tightness == b->tightness && a->parallel == b->parallel && a->area == b->area &&
+           v3_len2(v3_sub(a->axis1, b->axis1)) == 0.0 && v3_len2(v3_sub(a->axis2, b->axis2)) == 0.0 &&
+           a->size1 == b->size1 && a->size2 == b->size2 && a->jitter == b->jitter && a->circular == b->circular &&
+           a->orient == b->orient && a->area_illumination == b->area_illumination &&
+           a->fade_distance == b->fade_distance && a->fade_power == b->fade_power && a->shadowless == b->shadowless;
+}
+
 static void reset_view(gi_particle *gp)
 {
     size_t n = (size_t)gp->ps.n, nrp = (size_t)gp->lists.nrp;
@@ -535,20 +553,42 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
     gi_particle_stats *S = &gp->st;
     int n = gp->ps.n;
     pt_status st = PT_OK;
-    /* lights and visibility (host, Embree shadow rays) */
+    /* lights and visibility (host, Embree shadow rays); a light whose
+     * geometry did not change since the last lighting stage (only its
+     * colour, say) keeps its visibility */
     double tv = timer_now();
-    free(gp->lights);
-    free(gp->vis);
-    gp->nlights = sc->nlights;
-    gp->lights = xcalloc((size_t)sc->nlights, sizeof *gp->lights, &st);
-    gp->vis = xcalloc((size_t)n * (size_t)(sc->nlights > 0 ? sc->nlights : 1), sizeof(float), &st);
-    if (st != PT_OK) return st;
-    for (int l = 0; l < sc->nlights; l++) pack_light(&sc->lights[l], &gp->lights[l]);
+    int nl = sc->nlights;
+    if (nl != gp->nlights) {
+        free(gp->lights);
+        free(gp->vis);
+        free(gp->vis_lights);
+        free(gp->dirty);
+        gp->lights = xcalloc((size_t)nl, sizeof *gp->lights, &st);
+        gp->vis = xcalloc((size_t)n * (size_t)(nl > 0 ? nl : 1), sizeof(float), &st);
+        gp->vis_lights = xcalloc((size_t)nl, sizeof *gp->vis_lights, &st);
+        gp->dirty = xcalloc((size_t)nl, 1, &st);
+        if (st != PT_OK) {
+            gp->nlights = 0;
+            return st;
+        }
+        gp->nlights = nl;
+        for (int l = 0; l < nl; l++) gp->dirty[l] = 1;
+    }
+    int ndirty = 0;
+    for (int l = 0; l < nl; l++) {
+        pack_light(&sc->lights[l], &gp->lights[l]);
+        if (!gp->dirty[l] && !same_geometry(&gp->vis_lights[l], &sc->lights[l])) gp->dirty[l] = 1;
+        ndirty += gp->dirty[l];
+    }
     vis_job J;
     J.gp = gp;
     J.eps = 1e-6 * (accel_scale(gp->a) > 0.0 ? accel_scale(gp->a) : 1.0);
     atomic_init(&J.rays, 0);
-    if (gp->nlights > 0 && n > 0) pool_run(gp->threads, (n + VIS_CHUNK - 1) / VIS_CHUNK, vis_chunk, &J);
+    if (ndirty > 0 && n > 0) pool_run(gp->threads, (n + VIS_CHUNK - 1) / VIS_CHUNK, vis_chunk, &J);
+    for (int l = 0; l < nl; l++) {
+        gp->vis_lights[l] = sc->lights[l];
+        gp->dirty[l] = 0;
+    }
     S->shadow_rays = atomic_load(&J.rays);
     S->t_visibility = timer_now() - tv;
 
