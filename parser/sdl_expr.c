@@ -7,6 +7,7 @@
 #include "sdl_array.h"
 #include "sdl_directive.h"
 #include "sdl_function.h"
+#include "sdl_geom.h"
 
 #define SDL_EPSILON 1e-10 /* POV-Ray's truth threshold for floats */
 
@@ -433,6 +434,7 @@ static double float_function(sdl_parser *p, sdl_kw k, src_loc loc)
         vector_param(p, &a, NULL);
         return v3_len(a);
     }
+    case KW_INSIDE: return sdl_inside_fn(p, loc);
     default:
         sdl_error(p, loc, PT_ERR_UNSUPPORTED, "'%s' is not supported yet", sdl_kw_text(k));
         return 0;
@@ -480,8 +482,11 @@ static vec3 vector_function(sdl_parser *p, sdl_kw k, src_loc loc)
     }
     case KW_VAXIS_ROTATE:
         return vaxis_rotate_fn(p);
-    default:
-        sdl_error(p, loc, PT_ERR_UNSUPPORTED, "'%s' is not supported yet", sdl_kw_text(k));
+    case KW_TRACE: return sdl_trace_fn(p, loc);
+    case KW_MIN_EXTENT: case KW_MAX_EXTENT: return sdl_extent_fn(p, loc, k == KW_MAX_EXTENT);
+    default: /* vturbulence */
+        sdl_error(p, loc, PT_ERR_UNSUPPORTED,
+                  "'%s' needs POV-Ray's noise, which the parser cannot evaluate (shade_noise is not a dependency-free module)", sdl_kw_text(k));
         return v3(0, 0, 0);
     }
 }

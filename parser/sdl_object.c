@@ -373,7 +373,7 @@ static void plane_args(sdl_parser *p, scene_object *o, src_loc loc)
         return;
     }
     o->u.plane.normal = v3_scale(n, 1.0 / len);
-    o->u.plane.offset = d / len;
+    o->u.plane.offset = d; /* POV-Ray normalises the normal but not the distance */
 }
 
 /* triangle_args := v ',' v ',' v ; smooth_triangle_args := v ',' n ',' v ',' n ',' v ',' n */

@@ -119,6 +119,7 @@ typedef struct sdl_parser {
     double version;       /* language version from #version, 3.7 by default */
     int default_texture_set;
     src_loc last_loc;     /* last token returned (for end-of-file locations) */
+    void *geom_cache;     /* sdl_geom: mesh BVHs built for trace/inside */
     long long ntokens;    /* tokens read so far (opt.max_tokens) */
     size_t build_bytes;   /* malloc'd work memory outside the arena (meshes being
                              built), counted against opt.max_memory */

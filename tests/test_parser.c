@@ -454,7 +454,7 @@ static void test_shapes(void **st)
     assert_int_equal(s->nobjects, 9);
     const scene_object *const *o = (const scene_object *const *)s->objects;
     assert_vec(o[0]->u.plane.normal, v3(0, 1, 0), 0);
-    assert_near(o[0]->u.plane.offset, 2, 0);
+    assert_near(o[0]->u.plane.offset, 4, 0); /* POV-Ray: y = 4 (the distance is not divided by |n|) */
     assert_vec(o[1]->u.box.c1, v3(-1, -1, -3), 0);
     assert_vec(o[1]->u.box.c2, v3(1, 1, 3), 0);
     assert_int_equal(o[2]->kind, SHAPE_CYLINDER);
