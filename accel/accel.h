@@ -62,4 +62,11 @@ void *accel_rtc_scene(const accel *a);
 /* The smallest ray parameter queries accept (see the self-intersection rule). */
 double accel_epsilon(const accel *a, vec3 org, vec3 dir);
 
+/* Evaluators (POV-Ray noise, pigment functions) that isosurface functions
+ * may need, from the renderer (core/func.h). Process-wide; set it before
+ * rendering. Without it such functions are NaN and those isosurfaces stay
+ * empty. */
+struct func_env;
+void accel_set_function_env(const struct func_env *env);
+
 #endif

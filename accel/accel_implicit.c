@@ -13,8 +13,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include "accel_poly.h"
+#include "func.h"
 
-enum { IM_SUPER, IM_QUADRIC, IM_POLY, IM_BLOB };
+enum { IM_SUPER, IM_QUADRIC, IM_POLY, IM_BLOB, IM_ISO };
 
 typedef struct {
     int cylinder;
@@ -41,7 +42,17 @@ typedef struct {
     int ncomp;
     blob_comp *comp;
     vec3 blo, bhi;
+    /* isosurface */
+    const scene_function *fn;
+    int iso_sphere, open;
+    vec3 ic1, ic2;
+    double ir, thr, acc, grad, size;
 } im_data;
+
+/* The renderer's evaluators for functions (noise, pigments); process-wide. */
+static const func_env *volatile g_func_env;
+
+void accel_set_function_env(const func_env *env) { g_func_env = env; }
 
 static int put_hit(accel_shape_hit *out, int n, int max, double t, int part)
 {
@@ -644,6 +655,94 @@ static int blob_setup(im_data *m, const scene_blob *b, vec3 *lo, vec3 *hi)
     return 0;
 }
 
+/* ------------------------------------------------------------ isosurface */
+
+/* f(p) - threshold; NaN where the function cannot be evaluated. */
+static double iso_f(const im_data *m, vec3 p)
+{
+    double args[FUNC_MAX_SLOTS] = {p.x, p.y, p.z};
+    return func_eval_float(m->fn, args, (const func_env *)g_func_env) - m->thr;
+}
+
+static int iso_container(const im_data *m, vec3 o, vec3 d, double *a, double *b)
+{
+    if (!m->iso_sphere) return slab3(o, d, m->ic1, m->ic2, a, b);
+    vec3 oc = v3_sub(o, m->ic1);
+    double qc[3] = {v3_dot(oc, oc) - m->ir * m->ir, 2.0 * v3_dot(oc, d), v3_dot(d, d)}, r[2];
+    if (accel_poly_solve(qc, 2, -INFINITY, INFINITY, r, 0) < 2) return 0;
+    *a = r[0];
+    *b = r[1];
+    return 1;
+}
+
+static int iso_in_container(const im_data *m, vec3 q)
+{
+    if (m->iso_sphere) return v3_len2(v3_sub(q, m->ic1)) <= m->ir * m->ir;
+    return q.x >= m->ic1.x && q.x <= m->ic2.x && q.y >= m->ic1.y && q.y <= m->ic2.y && q.z >= m->ic1.z && q.z <= m->ic2.z;
+}
+
+/* Crossings: steps no longer than |f - threshold| / max_gradient (a
+ * crossing cannot be jumped while max_gradient bounds the slope, POV-Ray's
+ * rule), at least `accuracy`; each sign change bisected to rounding. The
+ * container's surface counts where it is inside (unless `open`). */
+static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+{
+    double ca, cb;
+    if (!iso_container(m, o, d, &ca, &cb)) return 0;
+    double a = fmax(ca, tmin), b = fmin(cb, tmax);
+    if (!(a < b)) return 0;
+    double s = v3_len(d);
+    vec3 e = v3_scale(d, 1.0 / s), p0 = v3_madd(o, d, a);
+    double len = (b - a) * s;
+    int n = 0;
+    if (!m->open) {
+        if (ca > tmin && ca < tmax && iso_f(m, v3_madd(o, d, ca)) < 0.0) n = put_hit(out, n, max, ca, 1);
+        if (cb > tmin && cb < tmax && iso_f(m, v3_madd(o, d, cb)) < 0.0) n = put_hit(out, n, max, cb, 1);
+    }
+    double tau = 0.0, v0 = iso_f(m, p0);
+    double minstep = fmax(m->acc, 1e-9 * m->size);
+    int steps = 0;
+    while (tau < len && steps++ < 1000000) {
+        if (n == max && a + tau / s > out[max - 1].t) break;
+        double step = isfinite(v0) ? fmax(fabs(v0) / m->grad, minstep) : minstep;
+        double t1 = fmin(tau + step, len);
+        double v1 = iso_f(m, v3_madd(p0, e, t1));
+        if (isfinite(v0) && isfinite(v1) && (v0 < 0.0) != (v1 < 0.0)) {
+            double lo = tau, hi = t1, flo = v0;
+            for (int it = 0; it < 200 && hi - lo > 1e-15 * (len + fabs(hi)); it++) {
+                double mid = 0.5 * (lo + hi), fm = iso_f(m, v3_madd(p0, e, mid));
+                if (!isfinite(fm)) break;
+                if ((fm < 0.0) == (flo < 0.0)) { lo = mid; flo = fm; } else hi = mid;
+            }
+            double t = a + 0.5 * (lo + hi) / s;
+            if (t > tmin && t < tmax) n = put_hit(out, n, max, t, 0);
+        }
+        tau = t1;
+        v0 = v1;
+    }
+    return n;
+}
+
+static vec3 iso_normal(const im_data *m, vec3 q, int part)
+{
+    if (part == 1) {
+        if (m->iso_sphere) return v3_sub(q, m->ic1);
+        double best = INFINITY;
+        vec3 n = v3(0, 1, 0);
+        for (int i = 0; i < 3; i++) {
+            double lo = comp3(m->ic1, i), hi = comp3(m->ic2, i), x = comp3(q, i);
+            if (fabs(x - lo) < best) { best = fabs(x - lo); n = v3(i == 0 ? -1 : 0, i == 1 ? -1 : 0, i == 2 ? -1 : 0); }
+            if (fabs(x - hi) < best) { best = fabs(x - hi); n = v3(i == 0 ? 1 : 0, i == 1 ? 1 : 0, i == 2 ? 1 : 0); }
+        }
+        return n;
+    }
+    double h = 1e-6 * m->size;
+    vec3 g = v3(iso_f(m, v3_add(q, v3(h, 0, 0))) - iso_f(m, v3_sub(q, v3(h, 0, 0))),
+                iso_f(m, v3_add(q, v3(0, h, 0))) - iso_f(m, v3_sub(q, v3(0, h, 0))),
+                iso_f(m, v3_add(q, v3(0, 0, h))) - iso_f(m, v3_sub(q, v3(0, 0, h))));
+    return v3_finite(g) && v3_len2(g) > 0.0 ? g : v3(0, 1, 0);
+}
+
 /* ------------------------------------------------------------ public */
 
 static const int *poly_powers_alloc(im_data *m, int order, int nterms)
@@ -729,6 +828,33 @@ int accel_implicit_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *
         m->type = IM_BLOB;
         st = blob_setup(m, o->u.blob, lo, hi);
         break;
+    case SHAPE_ISOSURFACE: {
+        const scene_isosurface *is = o->u.isosurface;
+        if (!is || !is->fn) break;
+        m->type = IM_ISO;
+        m->fn = is->fn;
+        m->iso_sphere = is->sphere;
+        m->ic1 = is->c1;
+        m->ic2 = is->c2;
+        m->ir = is->radius;
+        m->thr = is->threshold;
+        m->acc = is->accuracy > 0.0 ? is->accuracy : 0.001;
+        m->grad = is->max_gradient > 0.0 ? is->max_gradient : 1.1;
+        m->open = (o->flags & OBJ_OPEN) != 0;
+        m->solid_bounded = 1;
+        if (m->iso_sphere) {
+            if (!(m->ir > 0.0)) break;
+            *lo = v3_sub(m->ic1, v3s(m->ir));
+            *hi = v3_add(m->ic1, v3s(m->ir));
+        } else {
+            *lo = m->ic1;
+            *hi = m->ic2;
+        }
+        m->size = v3_maxc(v3_sub(*hi, *lo));
+        if (!(m->size > 0.0) || !isfinite(m->size)) break;
+        st = 0;
+        break;
+    }
     default:
         break;
     }
@@ -758,6 +884,7 @@ int accel_implicit_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, doub
     case IM_SUPER: return se_hits(m, o, d, tmin, tmax, out, max);
     case IM_QUADRIC: return quadric_hits(m, o, d, tmin, tmax, out, max);
     case IM_POLY: return poly_hits(m, o, d, tmin, tmax, out, max);
+    case IM_ISO: return iso_hits(m, o, d, tmin, tmax, out, max);
     default: return blob_hits(m, o, d, tmin, tmax, out, max);
     }
 }
@@ -770,15 +897,17 @@ int accel_implicit_inside(const accel_shape *sh, vec3 q)
     case IM_SUPER: return se_norm(m, q, NULL) < 1.0;
     case IM_QUADRIC: return quadric_eval(m->a, q) < 0.0;
     case IM_POLY: return poly_eval3(m, q) < 0.0;
+    case IM_ISO: return iso_in_container(m, q) && iso_f(m, q) < 0.0;
     default: return blob_field(m, q, NULL) > m->threshold;
     }
 }
 
-vec3 accel_implicit_normal(const accel_shape *sh, vec3 q)
+vec3 accel_implicit_normal(const accel_shape *sh, vec3 q, int part)
 {
     const im_data *m = sh->data;
     if (!m) return v3(0, 1, 0);
     switch (m->type) {
+    case IM_ISO: return iso_normal(m, q, part);
     case IM_SUPER: return se_grad(m, q);
     case IM_QUADRIC: return quadric_grad(m->a, q);
     case IM_POLY: return poly_grad(m, q);

@@ -10,6 +10,10 @@
  *                   components within reach (d: distance to a sphere's
  *                   centre or a cylinder's axis segment, in the component's
  *                   own space)
+ *   isosurface      function(x, y, z) - threshold (core/func.h), inside its
+ *                   container; marched with steps bounded by max_gradient
+ *                   (POV-Ray's rule), sign changes bisected to rounding; the
+ *                   container's surface shows where it is inside (not `open`)
  * Quadric, poly and blob are polynomials along a ray (degree 2, order, and 4
  * between consecutive component boundaries), solved with accel_poly
  * (`sturm` honoured); the superellipsoid is convex for e, n <= 2, where its
@@ -19,7 +23,7 @@
 #define PT_ACCEL_IMPLICIT_H
 #include "accel_shapes.h"
 
-/* Set up sh from o (kinds SHAPE_SUPERELLIPSOID, QUADRIC, POLY, BLOB);
+/* Set up sh from o (kinds SHAPE_SUPERELLIPSOID, QUADRIC, POLY, BLOB, ISOSURFACE);
  * object-space bounds in lo/hi, infinite components for unbounded
  * surfaces. May allocate sh->data. -1 when degenerate. */
 int accel_implicit_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
@@ -28,8 +32,9 @@ void accel_implicit_free(void *data);
 int accel_implicit_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out,
                         int max);
 int accel_implicit_inside(const accel_shape *sh, vec3 q);
-/* Object-space gradient (outward normal, not unit). */
-vec3 accel_implicit_normal(const accel_shape *sh, vec3 q);
+/* Object-space gradient (outward normal, not unit); part 1 of an
+ * isosurface is its container's surface. */
+vec3 accel_implicit_normal(const accel_shape *sh, vec3 q, int part);
 /* 1 when the inside is bounded by the shape's own box. */
 int accel_implicit_solid_bounded(const accel_shape *sh);
 /* Blob: the texture of the component contributing most at q (object

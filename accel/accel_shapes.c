@@ -264,7 +264,7 @@ int accel_shape_init(accel_shape *sh, const scene_object *o)
     case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
         if (accel_sweep_init(sh, o, &lo, &hi) != 0) return -1;
         break;
-    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB:
+    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
         if (accel_implicit_init(sh, o, &lo, &hi) != 0) return -1;
         if (sh->infinite) {
             /* bounds come from accel_shape_clip_plane, as for planes */
@@ -296,7 +296,7 @@ void accel_shape_release(accel_shape *sh)
     case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
         accel_sweep_free(sh->data);
         break;
-    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB:
+    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
         accel_implicit_free(sh->data);
         break;
     case SHAPE_HEIGHT_FIELD:
@@ -314,7 +314,7 @@ int accel_shape_solid_bounded(const accel_shape *sh)
     case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_TORUS:
     case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
         return 1;
-    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB:
+    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
         return !sh->infinite && accel_implicit_solid_bounded(sh);
     default:
         return 0;
@@ -610,7 +610,7 @@ int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, dou
     case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
         n = accel_sweep_hits(sh, o, d, a, b, out, max);
         break;
-    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB:
+    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
         n = accel_implicit_hits(sh, o, d, a, b, out, max);
         break;
     case SHAPE_HEIGHT_FIELD:
@@ -661,7 +661,7 @@ int accel_shape_inside(const accel_shape *sh, vec3 p)
     }
     case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
         return accel_sweep_inside(sh, q);
-    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB:
+    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
         return accel_implicit_inside(sh, q);
     case SHAPE_HEIGHT_FIELD:
         return accel_hfield_inside(sh, q);
@@ -792,8 +792,8 @@ void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, doub
     case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
         accel_sweep_surface(sh, po, part, &n, &su, &sv);
         break;
-    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB:
-        n = accel_implicit_normal(sh, po);
+    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
+        n = accel_implicit_normal(sh, po, part);
         break;
     case SHAPE_HEIGHT_FIELD:
         accel_hfield_surface(sh, po, part, &n, &su, &sv);

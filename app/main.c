@@ -12,6 +12,7 @@
 #include "cmd_sweep.h"
 #include "diag.h"
 #include "framebuffer.h"
+#include "func.h"
 #include "gi.h"
 #include "img_falsecolor.h"
 #include "img_io.h"
@@ -21,6 +22,7 @@
 #include "scene.h"
 #include "sdl.h"
 #include "shade.h"
+#include "shade_noise.h"
 #include "stats_json.h"
 #include "timer.h"
 #include "view.h"
@@ -30,6 +32,13 @@
 #endif
 
 enum { EXIT_OK = 0, EXIT_SCENE = 1, EXIT_USAGE = 2, EXIT_IO = 3, EXIT_INTERRUPTED = 130 };
+
+/* POV-Ray's Noise for user functions (f_noise3d and friends). */
+static double app_func_noise(void *user, vec3 p, int generator)
+{
+    (void)user;
+    return noise_value(p, generator);
+}
 
 static volatile int g_cancel = 0;
 
@@ -279,6 +288,11 @@ static int cmd_render(int argc, char **argv)
     const char *gi_used = gi_mode_name(gi);
 
     int threads = o.threads > 0 ? o.threads : pool_default_threads();
+    /* isosurface functions may call POV-Ray's noise (issue 4) */
+    static func_env fenv;
+    fenv.noise = app_func_noise;
+    fenv.noise_generator = sc->global.noise_generator > 0 ? sc->global.noise_generator : 2;
+    accel_set_function_env(&fenv);
     t0 = timer_now();
     accel *acc = accel_build(sc, threads, d, &st);
     double t_accel = timer_now() - t0;

@@ -131,7 +131,8 @@ typedef enum {
     SHAPE_POLY,           /* u.poly: poly, cubic, quartic, polynomial */
     SHAPE_BLOB,           /* u.blob */
     SHAPE_HEIGHT_FIELD,   /* u.height_field */
-    SHAPE_TEXT            /* u.text: glyph outlines extruded along z */
+    SHAPE_TEXT,           /* u.text: glyph outlines extruded along z */
+    SHAPE_ISOSURFACE      /* u.isosurface */
 } shape_kind;
 
 enum {
@@ -197,6 +198,20 @@ typedef struct {
  * x, y each) in the z = 0 plane, extruded from z = 0 to z = depth. */
 typedef struct { int nsegments; double (*segments)[8]; double depth; } scene_text;
 
+/* isosurface: function(x, y, z) = threshold inside a box or sphere
+ * (contained_by, default box { -1, 1 }); inside where the function is below
+ * the threshold. The function is core/func.h's scene_function. */
+typedef struct {
+    const struct scene_function *fn;
+    int sphere;            /* container: 0 box c1..c2, 1 sphere centre c1 radius */
+    vec3 c1, c2;
+    double radius;
+    double threshold;      /* default 0 */
+    double accuracy;       /* default 0.001 */
+    double max_gradient;   /* default 1.1 */
+    int max_trace;         /* crossings wanted per ray, 0 = all_intersections (default 1) */
+} scene_isosurface;
+
 typedef struct scene_object scene_object;
 struct scene_object {
     shape_kind kind;
@@ -227,6 +242,7 @@ struct scene_object {
         const scene_blob *blob;
         const scene_height_field *height_field;
         const scene_text *text;
+        const scene_isosurface *isosurface;
     } u;
     /* clipped_by (issue 4): the clipping solid, its transform relative to
      * this object's space (world = clip->transform then this->transform), so

@@ -13,6 +13,7 @@
 #include "sdl_directive.h"
 #include "sdl_expr.h"
 #include "sdl_font.h"
+#include "sdl_function.h"
 #include "sdl_hfimage.h"
 #include "sdl_material.h"
 #include "sdl_object.h"
@@ -27,6 +28,7 @@ int sdl_shape_handles(sdl_kw k)
     case KW_POLYGON: case KW_LATHE: case KW_SOR: case KW_PRISM: case KW_SUPERELLIPSOID:
     case KW_QUADRIC: case KW_POLY: case KW_CUBIC: case KW_QUARTIC: case KW_POLYNOMIAL:
     case KW_BLOB: case KW_HEIGHT_FIELD: case KW_TEXT: case KW_SPHERE_SWEEP: case KW_BICUBIC_PATCH:
+    case KW_ISOSURFACE:
         return 1;
     default:
         return 0;
@@ -950,6 +952,99 @@ static void bicubic_args(sdl_parser *p, sdl_obj *so, src_loc loc)
     o->u.mesh.mesh = m;
 }
 
+/* ------------------------------------------------------------ isosurface */
+
+/* isosurface := { function function_block | contained_by '{' ( box '{' v ',' v '}' |
+ *   sphere '{' v ',' r '}' ) '}' | threshold f | accuracy f | max_gradient f |
+ *   evaluate f ',' f ',' f | open | max_trace n | all_intersections }
+ * (defaults as POV-Ray 3.7: box { -1, 1 }, threshold 0, accuracy 0.001,
+ * max_gradient 1.1, max_trace 1) */
+static void isosurface_args(sdl_parser *p, scene_object *o, src_loc loc)
+{
+    scene_isosurface *iso = sdl_alloc(p, sizeof *iso);
+    if (!iso) return;
+    iso->c1 = v3s(-1.0);
+    iso->c2 = v3s(1.0);
+    iso->accuracy = 0.001;
+    iso->max_gradient = 1.1;
+    iso->max_trace = 1;
+    while (sdl_ok(p)) {
+        const sdl_tok *t = sdl_peek(p);
+        if (t->tk.kind != TOK_KEYWORD) break;
+        sdl_kw k = t->tk.kw;
+        src_loc at = t->tk.loc;
+        if (k == KW_FUNCTION) {
+            sdl_next(p);
+            iso->fn = sdl_parse_function(p, at, NULL);
+        } else if (k == KW_CONTAINED_BY) {
+            sdl_next(p);
+            if (!sdl_begin_block(p, "contained_by")) return;
+            if (sdl_accept_kw(p, KW_BOX)) {
+                if (!sdl_begin_block(p, "box")) return;
+                vec3 a = sdl_vector(p);
+                sdl_accept(p, TOK_COMMA);
+                vec3 b = sdl_vector(p);
+                sdl_end_block(p);
+                iso->sphere = 0;
+                iso->c1 = v3_min(a, b);
+                iso->c2 = v3_max(a, b);
+            } else if (sdl_accept_kw(p, KW_SPHERE)) {
+                if (!sdl_begin_block(p, "sphere")) return;
+                iso->c1 = sdl_vector(p);
+                sdl_accept(p, TOK_COMMA);
+                iso->radius = fabs(sdl_float(p));
+                sdl_end_block(p);
+                iso->sphere = 1;
+            } else {
+                sdl_tok bad = sdl_next(p);
+                sdl_unexpected(p, &bad, "box or sphere");
+                return;
+            }
+            sdl_end_block(p);
+        } else if (k == KW_THRESHOLD) {
+            sdl_next(p);
+            iso->threshold = sdl_float(p);
+        } else if (k == KW_ACCURACY) {
+            sdl_next(p);
+            iso->accuracy = fabs(sdl_float(p));
+        } else if (k == KW_MAX_GRADIENT) {
+            sdl_next(p);
+            iso->max_gradient = fabs(sdl_float(p));
+        } else if (k == KW_EVALUATE) {
+            sdl_next(p);
+            for (int i = 0; i < 3; i++) {
+                if (i) sdl_accept(p, TOK_COMMA);
+                sdl_float(p);
+            }
+        } else if (k == KW_OPEN) {
+            sdl_next(p);
+            o->flags |= OBJ_OPEN;
+        } else if (k == KW_MAX_TRACE) {
+            sdl_next(p);
+            iso->max_trace = (int)sdl_float(p);
+        } else if (k == KW_ALL_INTERSECTIONS) {
+            sdl_next(p);
+            iso->max_trace = 0;
+        } else {
+            break;
+        }
+    }
+    if (!sdl_ok(p)) return;
+    if (!iso->fn) {
+        sdl_error(p, loc, PT_ERR_SYNTAX, "isosurface needs a function");
+        return;
+    }
+    if (iso->fn->kind != FUNC_FLOAT && iso->fn->kind != FUNC_PATTERN) {
+        sdl_warn_once(p, loc, "isosurface with a non-float function is not supported; it is skipped");
+        o->name = "isosurface";
+        return;
+    }
+    if (!(iso->max_gradient > 0.0)) iso->max_gradient = 1.1;
+    if (!(iso->accuracy > 0.0)) iso->accuracy = 0.001;
+    o->kind = SHAPE_ISOSURFACE;
+    o->u.isosurface = iso;
+}
+
 /* ------------------------------------------------------------ dispatch */
 
 void sdl_shape_args(sdl_parser *p, sdl_kw k, sdl_obj *so, src_loc loc)
@@ -971,6 +1066,7 @@ void sdl_shape_args(sdl_parser *p, sdl_kw k, sdl_obj *so, src_loc loc)
     case KW_TEXT: text_args(p, o, loc); break;
     case KW_SPHERE_SWEEP: sphere_sweep_args(p, so, loc); break;
     case KW_BICUBIC_PATCH: bicubic_args(p, so, loc); break;
+    case KW_ISOSURFACE: isosurface_args(p, o, loc); break;
     default: break;
     }
     /* anything that did not produce a shape stays reported as unsupported */

@@ -733,6 +733,36 @@ static void test_clipped_by(void **st)
     done(&w);
 }
 
+/* isosurface: user functions (core/func.h) against closed forms */
+static void test_isosurface(void **st)
+{
+    (void)st;
+    world w = build("isosurface { function { sqrt(x*x + y*y + z*z) - 0.5 } contained_by { box { -1, 1 } } "
+                    "max_gradient 1.01 accuracy 1e-4 translate <0,0,3> }");
+    assert_int_equal(w.s->objects[0]->kind, SHAPE_ISOSURFACE);
+    for (int i = 0; i < 6; i++) {
+        double y = 0.08 * i, x = sqrt(0.25 - y * y);
+        expect_hit(&w, v3(-5, y, 3), v3(1, 0, 0), 5 - x, v3(-x, y, 0), 1e-10, 1e-6);
+    }
+    expect_miss(&w, v3(-5, 0.6, 3), v3(1, 0, 0));
+    done(&w);
+    /* the half-space y < 0 in a box: the box's faces show where they are inside */
+    w = build("isosurface { function { y } }");
+    expect_hit(&w, v3(0.3, 5, 0.2), v3(0, -1, 0), 5.0, v3(0, 1, 0), 1e-10, 1e-6);
+    expect_hit(&w, v3(-5, -0.5, 0.2), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12);
+    expect_miss(&w, v3(-5, 0.5, 0.2), v3(1, 0, 0));
+    accel_shape sh = shape_of(&w);
+    assert_true(accel_shape_inside(&sh, v3(0.2, -0.3, 0.1)));
+    assert_false(accel_shape_inside(&sh, v3(0.2, 0.3, 0.1)));
+    assert_false(accel_shape_inside(&sh, v3(0.2, -1.3, 0.1)));
+    accel_shape_release(&sh);
+    done(&w);
+    w = build("isosurface { function { y } open contained_by { sphere { 0, 1 } } threshold 0.25 }");
+    expect_miss(&w, v3(-5, -0.5, 0.0), v3(1, 0, 0));
+    expect_hit(&w, v3(0.3, 5, 0.2), v3(0, -1, 0), 4.75, v3(0, 1, 0), 1e-10, 1e-6);
+    done(&w);
+}
+
 /* GI sampling: polygons and height fields are sampled uniformly by area */
 static void test_surface_sampling(void **st)
 {
@@ -819,6 +849,7 @@ int main(void)
         cmocka_unit_test(test_sphere_sweep),
         cmocka_unit_test(test_bicubic_patch),
         cmocka_unit_test(test_clipped_by),
+        cmocka_unit_test(test_isosurface),
         cmocka_unit_test(test_surface_sampling),
         cmocka_unit_test(test_unsupported),
     };
