@@ -28,7 +28,7 @@ int sdl_shape_handles(sdl_kw k)
     case KW_POLYGON: case KW_LATHE: case KW_SOR: case KW_PRISM: case KW_SUPERELLIPSOID:
     case KW_QUADRIC: case KW_POLY: case KW_CUBIC: case KW_QUARTIC: case KW_POLYNOMIAL:
     case KW_BLOB: case KW_HEIGHT_FIELD: case KW_TEXT: case KW_SPHERE_SWEEP: case KW_BICUBIC_PATCH:
-    case KW_ISOSURFACE:
+    case KW_ISOSURFACE: case KW_PARAMETRIC:
         return 1;
     default:
         return 0;
@@ -1045,6 +1045,108 @@ static void isosurface_args(sdl_parser *p, scene_object *o, src_loc loc)
     o->u.isosurface = iso;
 }
 
+/* ------------------------------------------------------------ parametric */
+
+#define PARAM_GRID 96 /* quads per side of the parametric tessellation */
+
+static double param_eval(const scene_function *f, double u, double v)
+{
+    double args[FUNC_MAX_SLOTS] = {u, v, 0.0};
+    return f ? func_eval_float(f, args, NULL) : 0.0;
+}
+
+static vec3 param_point(scene_function *const fn[3], double u, double v)
+{
+    return v3(param_eval(fn[0], u, v), param_eval(fn[1], u, v), param_eval(fn[2], u, v));
+}
+
+/* parametric := function_block [','] function_block [','] function_block
+ *   uv ',' uv { contained_by {..} | max_gradient f | accuracy f |
+ *   precompute n ',' x ',' y ',' z }
+ * -> a smooth mesh of PARAM_GRID x PARAM_GRID quads over [u1,u2] x [v1,v2],
+ * vertex normals from central differences (tessellated: POV-Ray subdivides
+ * the uv domain to `accuracy` instead; contained_by is not applied). */
+static void parametric_args(sdl_parser *p, sdl_obj *so, src_loc loc)
+{
+    scene_object *o = so->obj;
+    scene_function *fn[3] = {NULL, NULL, NULL};
+    for (int i = 0; i < 3 && sdl_ok(p); i++) {
+        if (i) sdl_accept(p, TOK_COMMA);
+        if (!sdl_accept_kw(p, KW_FUNCTION)) {
+            sdl_tok t = sdl_next(p);
+            sdl_unexpected(p, &t, "function");
+            return;
+        }
+        fn[i] = sdl_parse_function(p, p->last_loc, NULL);
+    }
+    sdl_accept(p, TOK_COMMA);
+    double a[2], b[2];
+    sdl_vector_n(p, a, 2);
+    sdl_accept(p, TOK_COMMA);
+    sdl_vector_n(p, b, 2);
+    while (sdl_ok(p)) {
+        if (sdl_accept_kw(p, KW_CONTAINED_BY)) {
+            if (sdl_begin_block(p, "contained_by")) sdl_skip_block(p);
+        } else if (sdl_accept_kw(p, KW_MAX_GRADIENT) || sdl_accept_kw(p, KW_ACCURACY)) {
+            sdl_float(p);
+        } else if (sdl_accept_kw(p, KW_PRECOMPUTE)) {
+            sdl_float(p);
+            while (sdl_accept(p, TOK_COMMA)) {
+                if (!sdl_accept_kw(p, KW_X) && !sdl_accept_kw(p, KW_Y) && !sdl_accept_kw(p, KW_Z)) break;
+            }
+        } else {
+            break;
+        }
+    }
+    if (!sdl_ok(p)) return;
+    for (int i = 0; i < 3; i++)
+        if (!fn[i] || fn[i]->kind != FUNC_FLOAT) {
+            sdl_warn_once(p, loc, "parametric with a non-float function is not supported; it is skipped");
+            return;
+        }
+    const int N = PARAM_GRID;
+    scene_mesh *m = scene_new_mesh(p->s);
+    if (!m) {
+        sdl_error(p, loc, PT_ERR_NOMEM, "out of memory");
+        return;
+    }
+    m->loc = loc;
+    m->nverts = m->nnormals = (N + 1) * (N + 1);
+    m->ntris = 2 * N * N;
+    m->verts = alloc_n(p, (size_t)m->nverts, sizeof *m->verts);
+    m->normals = alloc_n(p, (size_t)m->nverts, sizeof *m->normals);
+    m->tris = alloc_n(p, (size_t)m->ntris, sizeof *m->tris);
+    if (!m->verts || !m->normals || !m->tris) return;
+    double du = (b[0] - a[0]) / N, dv = (b[1] - a[1]) / N, h = 1e-4;
+    for (int j = 0; j <= N; j++)
+        for (int i = 0; i <= N; i++) {
+            double u = a[0] + du * i, v = a[1] + dv * j;
+            vec3 pt = param_point(fn, u, v);
+            double hu = h * fmax(fabs(du) * N, 1e-12), hv = h * fmax(fabs(dv) * N, 1e-12);
+            vec3 tu = v3_sub(param_point(fn, u + hu, v), param_point(fn, u - hu, v));
+            vec3 tv = v3_sub(param_point(fn, u, v + hv), param_point(fn, u, v - hv));
+            vec3 nn = v3_norm(v3_cross(tu, tv));
+            int k = j * (N + 1) + i;
+            if (!v3_finite(pt)) pt = v3s(0.0);
+            if (!v3_finite(nn)) nn = v3(0, 1, 0);
+            m->verts[k][0] = (float)pt.x;
+            m->verts[k][1] = (float)pt.y;
+            m->verts[k][2] = (float)pt.z;
+            m->normals[k][0] = (float)nn.x;
+            m->normals[k][1] = (float)nn.y;
+            m->normals[k][2] = (float)nn.z;
+        }
+    int t = 0;
+    for (int j = 0; j < N; j++)
+        for (int i = 0; i < N; i++) {
+            int v00 = j * (N + 1) + i, v01 = v00 + 1, v10 = v00 + N + 1, v11 = v10 + 1;
+            m->tris[t][0] = v00; m->tris[t][1] = v01; m->tris[t][2] = v11; t++;
+            m->tris[t][0] = v00; m->tris[t][1] = v11; m->tris[t][2] = v10; t++;
+        }
+    o->kind = SHAPE_MESH;
+    o->u.mesh.mesh = m;
+}
+
 /* ------------------------------------------------------------ dispatch */
 
 void sdl_shape_args(sdl_parser *p, sdl_kw k, sdl_obj *so, src_loc loc)
@@ -1067,6 +1169,7 @@ void sdl_shape_args(sdl_parser *p, sdl_kw k, sdl_obj *so, src_loc loc)
     case KW_SPHERE_SWEEP: sphere_sweep_args(p, so, loc); break;
     case KW_BICUBIC_PATCH: bicubic_args(p, so, loc); break;
     case KW_ISOSURFACE: isosurface_args(p, o, loc); break;
+    case KW_PARAMETRIC: parametric_args(p, so, loc); break;
     default: break;
     }
     /* anything that did not produce a shape stays reported as unsupported */

@@ -763,6 +763,24 @@ static void test_isosurface(void **st)
     done(&w);
 }
 
+/* parametric: tessellated (96 x 96 quads); a unit sphere to within its chord error */
+static void test_parametric(void **st)
+{
+    (void)st;
+    world w = build("parametric { function { cos(u)*cos(v) } function { sin(v) } function { sin(u)*cos(v) }"
+                    " <0,-pi/2>, <2*pi,pi/2> contained_by { box { -1, 1 } } precompute 10, x, y, z }");
+    assert_int_equal(w.s->objects[0]->kind, SHAPE_MESH);
+    for (int i = 0; i < 8; i++) {
+        double y = 0.1 * i, x = sqrt(1 - y * y);
+        accel_hit h;
+        assert_true(hit(&w, v3(-5, y, 0.03), v3(1, 0, 0), &h));
+        assert_near(v3_len(h.p), 1.0, 1e-3);
+        assert_near(h.t, 5 - sqrt(x * x - 0.0009), 2e-3);
+        assert_true(v3_dot(h.ns, v3_norm(h.p)) > 0.999 || v3_dot(h.ns, v3_norm(h.p)) < -0.999);
+    }
+    done(&w);
+}
+
 /* GI sampling: polygons and height fields are sampled uniformly by area */
 static void test_surface_sampling(void **st)
 {
@@ -850,6 +868,7 @@ int main(void)
         cmocka_unit_test(test_bicubic_patch),
         cmocka_unit_test(test_clipped_by),
         cmocka_unit_test(test_isosurface),
+        cmocka_unit_test(test_parametric),
         cmocka_unit_test(test_surface_sampling),
         cmocka_unit_test(test_unsupported),
     };
