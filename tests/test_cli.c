@@ -177,12 +177,16 @@ static void test_sigint_partial(void **st)
                "light_source { <0, 5, 0> rgb 1 area_light 2*x, 2*z, 16, 16 jitter }\n"
                "plane { y, 0 pigment { rgb 1 } }\n"
                "sphere { <0, 1, 0>, 1 pigment { rgb 0.5 } }\n");
-    /* Start the render in the background, interrupt it after 0.7 s, and time the stop. */
+    /* Start the render in the background, interrupt it once it renders (after
+     * 1.5 s: a sanitizer build starts slower), and time the stop: until the
+     * partial file's temporary appears, i.e. the render loop has ended (the
+     * write of 4 Mpx that follows is not part of stopping). */
     snprintf(cmd, sizeof cmd,
-             "'%s' render '%s' -o '%s' --size 2000x2000 --threads 2 --quiet & pid=$!; sleep 0.7; "
-             "t0=$(date +%%s%%N); kill -INT $pid; wait $pid; rc=$?; t1=$(date +%%s%%N); "
-             "echo \"rc=$rc ms=$(( (t1 - t0) / 1000000 ))\"",
-             PARTRAY_BIN, scene, out);
+             "'%s' render '%s' -o '%s' --size 2000x2000 --threads 2 --quiet & pid=$!; sleep 1.5; "
+             "t0=$(date +%%s%%N); kill -INT $pid; "
+             "while kill -0 $pid 2>/dev/null && ! ls -a '%s' | grep -q '^\\.slow\\.partial\\.png\\.tmp-'; do sleep 0.005; done; "
+             "t1=$(date +%%s%%N); wait $pid; rc=$?; echo \"rc=$rc ms=$(( (t1 - t0) / 1000000 ))\"",
+             PARTRAY_BIN, scene, out, tmpdir);
     run_capture(cmd);
     printf("%s", out_text);
     int rc = -1, ms = -1;
