@@ -123,47 +123,49 @@ static void sweep(const scene *sc, const accel *a, const opts *o, diag *d)
     static const long counts[] = {50000, 100000, 200000, 400000};
     static const int nbs[] = {1, 3, 6, 9};
     framebuffer *fb = fb_new(o->size, o->size);
-    double ref_mean = -1.0;
-    printf("\nsweep (mean luminance relative to 400K, n_b 9)\n");
-    printf("%8s %4s %10s %10s %10s %10s %10s %12s\n", "count", "n_b", "geom s", "light ms", "view ms", "render ms",
-           "frame ms", "mean rel");
-    double means[4][4], rows[4][4][5];
-    for (int ci = 3; ci >= 0; ci--) {
+    double means[4][4], rows[4][4][6];
+    memset(means, 0, sizeof means);
+    memset(rows, 0, sizeof rows);
+    for (int ci = 0; ci < 4; ci++) {
         gi_particle_settings s;
         gi_particle_settings_from_scene(&s, sc);
         s.count = counts[ci];
         s.threads = o->threads;
         s.cl_device = o->device;
+        if (o->full) s.scatter = GI_PARTICLE_SCATTER_FULL;
+        if (o->area_samples >= 0) s.area_samples = o->area_samples;
         gi_particle_stats st;
         pt_status status;
+        double c0 = cpu_now();
         gi_particle *gp = gi_particle_build(sc, a, &s, &st, d, &status);
+        double cg = cpu_now() - c0;
         if (!gp) {
             report_diag(d);
             continue;
         }
-        for (int bi = 3; bi >= 0; bi--) {
-            gi_particle_free(gp);
-            s.bounces = nbs[bi];
-            gp = gi_particle_build(sc, a, &s, &st, d, &status);
-            if (!gp) break;
+        for (int bi = 0; bi < 4; bi++) {
+            gi_particle_set_scattering(gp, nbs[bi], s.scatter);
             double tl, tv, tr;
             double tf = gi_frame(sc, a, o, gp, fb, &tl, &tv, &tr, d);
-            double m = mean_lum(fb);
-            if (ref_mean < 0.0) ref_mean = m;
-            means[ci][bi] = m;
+            means[ci][bi] = mean_lum(fb);
             rows[ci][bi][0] = st.t_geometry;
-            rows[ci][bi][1] = tl;
-            rows[ci][bi][2] = tv;
-            rows[ci][bi][3] = tr;
-            rows[ci][bi][4] = tf;
+            rows[ci][bi][1] = cg;
+            rows[ci][bi][2] = tl;
+            rows[ci][bi][3] = tv;
+            rows[ci][bi][4] = tr;
+            rows[ci][bi][5] = tf;
         }
         gi_particle_free(gp);
     }
+    double ref = means[3][3] > 0.0 ? means[3][3] : 1.0;
+    printf("\nsweep, %dx%d (mean luminance relative to 400K particles, n_b 9)\n", o->size, o->size);
+    printf("%8s %4s %9s %9s %10s %10s %10s %10s %10s\n", "count", "n_b", "geom s", "geom cpu", "light ms", "view ms",
+           "render ms", "frame ms", "mean rel");
     for (int ci = 0; ci < 4; ci++)
         for (int bi = 0; bi < 4; bi++)
-            printf("%8ld %4d %10.3f %10.2f %10.2f %10.2f %10.2f %12.4f\n", counts[ci], nbs[bi], rows[ci][bi][0],
-                   1e3 * rows[ci][bi][1], 1e3 * rows[ci][bi][2], 1e3 * rows[ci][bi][3], 1e3 * rows[ci][bi][4],
-                   means[ci][bi] / ref_mean);
+            printf("%8ld %4d %9.2f %9.2f %10.2f %10.2f %10.2f %10.2f %10.4f\n", counts[ci], nbs[bi], rows[ci][bi][0],
+                   rows[ci][bi][1], 1e3 * rows[ci][bi][2], 1e3 * rows[ci][bi][3], 1e3 * rows[ci][bi][4],
+                   1e3 * rows[ci][bi][5], means[ci][bi] / ref);
     fb_free(fb);
 }
 

@@ -19,8 +19,10 @@
 #define GI_MAX_THREADS 256
 
 typedef struct {
-    long lookups, late, none, discarded;
-    char pad[32];
+    long lookups, late, none, discarded, onthefly;
+    int *buf; /* on-the-fly estimation list */
+    long len, cap;
+    char pad[8];
 } thread_count;
 
 struct gi_particle {
@@ -35,6 +37,7 @@ struct gi_particle {
     int *slink, *glink;
     int *rin_off, *rin_src; /* incoming scattering links (FULL mode) */
     gi_lists lists;
+    gi_grid *rgrid; /* particles by list radius: estimates on surfaces without radiance particles */
     gi_dev *dev;
     /* lighting */
     int nlights;
@@ -121,8 +124,9 @@ static void update_bytes(gi_particle *gp)
 static void fill_stats(gi_particle *gp, gi_particle_stats *out)
 {
     update_bytes(gp);
-    long look = 0, late = 0, none = 0, disc = 0;
+    long look = 0, late = 0, none = 0, disc = 0, otf = 0;
     for (int t = 0; t < GI_MAX_THREADS; t++) {
+        otf += gp->tc[t].onthefly;
         look += gp->tc[t].lookups;
         late += gp->tc[t].late;
         none += gp->tc[t].none;
@@ -132,6 +136,7 @@ static void fill_stats(gi_particle *gp, gi_particle_stats *out)
     gp->st.lookups_late = late;
     gp->st.lookups_none = none;
     gp->st.discarded = disc;
+    gp->st.lookups_onthefly = otf;
     if (out && out != &gp->st) *out = gp->st;
 }
 
@@ -312,6 +317,11 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     S->list_entries = gp->lists.off[gp->lists.nrp];
     S->lists_widened = gp->lists.widened;
     S->lists_empty = gp->lists.empty;
+    gp->rgrid = gi_grid_build(gp->ps.p, gp->ps.n, S->radius);
+    if (!gp->rgrid) {
+        st = PT_ERR_NOMEM;
+        goto fail;
+    }
     S->t_lists = timer_now() - tg;
 
     /* host state */
@@ -369,6 +379,8 @@ void gi_particle_free(gi_particle *gp)
     gi_surface_free(gp->surf);
     gi_particles_free(&gp->ps);
     gi_lists_free(&gp->lists);
+    gi_grid_free(gp->rgrid);
+    for (int t = 0; t < GI_MAX_THREADS; t++) free(gp->tc[t].buf);
     free(gp->slink);
     free(gp->glink);
     free(gp->rin_off);
@@ -636,13 +648,14 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
                         nsrc > 0 ? nb : 0, (gi_u32)(gp->set.seed * 2654435761u + 12345u), scale, gp->srcidx,
                         nsrc, tally, gp->lout, gp->phi, d);
     if (st != PT_OK) return st;
-    gp->nbounce_flux = nsrc > 0 ? nb : 0;
-    double fs = 0.0;
-    for (int b = 0; b < gp->nbounce_flux; b++) {
+    gp->nbounce_flux = nsrc > 0 && gp->set.scatter != GI_PARTICLE_SCATTER_FULL ? nb : 0;
+    for (int b = 0; b < gp->nbounce_flux; b++)
         gp->bounce_flux[b] = ((double)tally[3 * b] + (double)tally[3 * b + 1] + (double)tally[3 * b + 2]) /
                              (3.0 * (double)scale);
-        fs += gp->bounce_flux[b];
-    }
+    double fs = 0.0;
+    for (int i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++)
+            fs += (gp->phi[4 * (size_t)i + c] - M_PI * gp->edir[4 * (size_t)i + c] * gp->ps.p[i].area) / 3.0;
     S->flux_scattered = fs;
     S->t_scatter = timer_now() - ts;
     reset_view(gp);
@@ -652,6 +665,13 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
 }
 
 pt_status gi_particle_relight(gi_particle *gp, diag *d) { return gi_particle_light(gp, d); }
+
+void gi_particle_set_scattering(gi_particle *gp, int bounces, int scatter)
+{
+    gp->set.bounces = bounces < 0 ? 0 : (bounces > GI_MAX_BOUNCES ? GI_MAX_BOUNCES : bounces);
+    gp->set.scatter = scatter;
+    gp->st.bounces = gp->set.bounces;
+}
 
 /* ------------------------------------------------------------------ the view */
 
@@ -845,6 +865,38 @@ static void late_rp(gi_particle *gp, long l)
     atomic_store_explicit(&gp->rp_state[l], 2, memory_order_release);
 }
 
+/* Surfaces with area particles but no radiance particles (cylinders,
+ * cones, tori): the estimation list is made at the hit (the same radius,
+ * normal test and widening as gi_radiance), then the estimate of section
+ * 4.3.2 over it, gathering its particles first where needed. */
+static int onthefly(gi_particle *gp, const accel_hit *h, vec3 n, thread_count *tc, rgb *out)
+{
+    vec3 ng = v3_dot(n, h->ng) >= 0.0 ? h->ng : v3_neg(h->ng);
+    double r = gp->st.radius;
+    tc->len = 0;
+    long m = gi_grid_radius(gp->rgrid, h->p, ng, r, gp->set.normal_cos, &tc->buf, &tc->len, &tc->cap);
+    for (int widen = 2; m == 0 && widen <= 4; widen *= 2)
+        m = gi_grid_radius(gp->rgrid, h->p, ng, r * widen, gp->set.normal_cos, &tc->buf, &tc->len, &tc->cap);
+    if (m <= 0) return 0;
+    double s[3] = {0.0, 0.0, 0.0}, a = 0.0;
+    for (long q = 0; q < m; q++) {
+        int k = tc->buf[q];
+        if (claim(&gp->e_state[k])) {
+            gi_c_gather(1, gp->glink, gp->ng, gp->lout, &k, 1, gp->bg, gp->eind);
+            atomic_store_explicit(&gp->e_state[k], 2, memory_order_release);
+        }
+        double da = gp->ps.p[k].area;
+        for (int c = 0; c < 3; c++) s[c] += gp->eind[4 * (size_t)k + c] * da;
+        a += da;
+    }
+    if (!(a > 0.0)) return 0;
+    out->r = s[0] / a;
+    out->g = s[1] / a;
+    out->b = s[2] / a;
+    tc->onthefly++;
+    return 1;
+}
+
 rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
 {
     gi_particle *gp = ctx;
@@ -853,9 +905,16 @@ rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
     tc->lookups++;
     long rp[3];
     double w[3];
-    if (!gp->lit || !gi_surface_locate(gp->surf, hit, n, rp, w)) {
+    if (!gp->lit) {
         tc->none++;
         return out;
+    }
+    if (!gi_surface_locate(gp->surf, hit, n, rp, w)) {
+        if (!gi_surface_has_particles(gp->surf, hit) || !onthefly(gp, hit, n, tc, &out)) {
+            tc->none++;
+            return out;
+        }
+        goto finish;
     }
     for (int k = 0; k < 3; k++) {
         if (atomic_load_explicit(&gp->rp_state[rp[k]], memory_order_acquire) != 2) {
@@ -867,6 +926,7 @@ rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
         out.g += w[k] * v[1];
         out.b += w[k] * v[2];
     }
+finish:;
     double b = gp->set.brightness;
     out.r *= b;
     out.g *= b;

@@ -107,6 +107,7 @@ typedef struct {
     long shadow_rays;
     long prepass_rays, found, used;  /* last prepare_view: new radiance / area particles */
     long lookups, lookups_late, lookups_none, discarded;
+    long lookups_onthefly;  /* hits on cylinders/cones/tori: estimated at the hit */
     long skipped_objects;
     double flux_direct, flux_emitted, flux_scattered; /* sums over particles (grey) */
     /* memory, bytes */
@@ -131,6 +132,9 @@ pt_status gi_particle_light(gi_particle *gp, diag *d);
 /* A light moved or changed: rerun the lighting stage and forget the view's
  * gathered values (the next prepare_view recomputes them). */
 pt_status gi_particle_relight(gi_particle *gp, diag *d);
+/* Change n_b and the scattering mode; takes effect at the next
+ * gi_particle_relight (no geometry work). */
+void gi_particle_set_scattering(gi_particle *gp, int bounces, int scatter);
 /* Ray-tracing stage for a w x h image from camera c (after light). */
 pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w, int h, diag *d);
 /* The shade_settings.indirect hook (signature of shade_indirect_fn): ctx is

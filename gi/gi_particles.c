@@ -126,7 +126,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
         for (long q = 0; got < m && tries < limit; q++, tries++) {
             double u = frac(su + (double)q * R2_A1), v = frac(sv + (double)q * R2_A2);
             vec3 pos, nrm;
-            if (!gi_surface_sample(g, i, u, v, rng_f64(&pr), &pos, &nrm)) continue;
+            if (!gi_surface_sample(g, i, u, v, &pr, &pos, &nrm)) continue;
             got++;
             for (int s = 0; s < sides; s++) {
                 if (side_frac && side_frac[2 * i + s] <= 0.0f) continue;

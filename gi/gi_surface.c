@@ -1,11 +1,14 @@
 /* gi_surface.c - surface patches for particle GI (see gi_surface.h). */
 #include "gi_surface.h"
 #include <math.h>
+#include "accel_surface.h"
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-enum { PATCH_TRI = 0, PATCH_SPHERE = 1, PATCH_DISC = 2 };
+/* PATCH_PIECE: a surface sampled through accel_surface (cylinders, cones,
+ * tori) that has particles but no radiance particles. */
+enum { PATCH_TRI = 0, PATCH_SPHERE = 1, PATCH_DISC = 2, PATCH_PIECE = 3 };
 
 typedef struct {
     unsigned char kind;
@@ -24,6 +27,7 @@ typedef struct {
     double r0, r1;    /* sphere: r, -; disc: hole, outer */
     double lu, lv;    /* TRI: longest edge; grids: longest u and v lines */
     double jmax, jmin, jobj, detm;
+    int piece;        /* accel_surface piece, -1 if none */
     const scene_texture *tex;
 } patch;
 
@@ -47,6 +51,7 @@ struct gi_surface {
     vec3 lo, hi;      /* clip box for planes */
     const scene *sc;
     diag *d;
+    accel_surf *as;   /* area sampling shared with reference/ (accel_surface.h) */
 };
 
 static void layout(gi_surface *g);
@@ -356,7 +361,30 @@ static pt_status add_leaf(gi_surface *g, const scene_object *o, const scene_text
     case SHAPE_BOX:
     case SHAPE_SPHERE:
     case SHAPE_DISC: break;
-    default:
+    case SHAPE_CYLINDER:
+    case SHAPE_CONE:
+    case SHAPE_TORUS: {
+        int piece = probe || !g->as ? -1 : accel_surf_find(g->as, o, ACCEL_SURF_ANY);
+        const accel_surf_piece *pc = piece >= 0 ? accel_surf_piece_at(g->as, piece) : NULL;
+        if (!pc || !(pc->area > 0.0)) break;
+        int obj = add_obj(g, o);
+        if (obj < 0) return PT_ERR_NOMEM;
+        patch p;
+        memset(&p, 0, sizeof p);
+        p.kind = PATCH_PIECE;
+        p.obj = obj;
+        p.piece = piece;
+        p.area = pc->area;
+        p.tex = tex;
+        p.nsides = (unsigned char)((o->flags & (OBJ_OPEN | OBJ_INVERSE)) ? 2 : 1);
+        if (add_patch(g, &p) < 0) return PT_ERR_NOMEM;
+        g->o[obj].count++;
+        return PT_OK;
+    }
+    default: break;
+    }
+    if (o->kind != SHAPE_TRIANGLE && o->kind != SHAPE_SMOOTH_TRIANGLE && o->kind != SHAPE_MESH &&
+        o->kind != SHAPE_PLANE && o->kind != SHAPE_BOX && o->kind != SHAPE_SPHERE && o->kind != SHAPE_DISC) {
         g->skipped++;
         diag_warn_once(g->d, o->loc, "particle GI: no particles on %s objects (they get no indirect light)",
                        o->name ? o->name : "these");
@@ -432,6 +460,7 @@ static pt_status add_leaf(gi_surface *g, const scene_object *o, const scene_text
             p.nsides = 2;
         }
         if (!finish_grid(g, obj, &p)) return PT_OK;
+        p.piece = probe || !g->as ? -1 : accel_surf_find(g->as, o, ACCEL_SURF_ANY);
         if (add_patch(g, &p) < 0) return PT_ERR_NOMEM;
         g->o[obj].count++;
     }
@@ -486,6 +515,13 @@ gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *
         g->lo = v3_sub(g->lo, m);
         g->hi = v3_add(g->hi, m);
     }
+    pt_status ast = PT_OK;
+    g->as = accel_surf_build(s, a, NULL, NULL, d, &ast);
+    if (!g->as) {
+        gi_surface_free(g);
+        *status = ast != PT_OK ? ast : PT_ERR_NOMEM;
+        return NULL;
+    }
     const scene_texture *deft = &s->default_texture;
     for (int i = 0; i < s->nobjects; i++) {
         pt_status st = walk(g, s->objects[i], deft, 0);
@@ -526,6 +562,7 @@ void gi_surface_retess(gi_surface *g, double tess)
 void gi_surface_free(gi_surface *g)
 {
     if (!g) return;
+    accel_surf_free(g->as);
     free(g->p);
     free(g->o);
     free(g->hash);
@@ -542,14 +579,41 @@ double gi_surface_total_area(const gi_surface *g) { return g->total_area; }
 long gi_surface_nrp(const gi_surface *g) { return g->nrp; }
 long gi_surface_skipped(const gi_surface *g) { return g->skipped; }
 
+int gi_surface_has_particles(const gi_surface *g, const accel_hit *hit)
+{
+    const obj_rec *o = hit && hit->obj ? find_obj(g, hit->obj) : NULL;
+    return o && o->count > 0;
+}
+
 size_t gi_surface_bytes(const gi_surface *g)
 {
     return (size_t)g->capp * sizeof(patch) + (size_t)g->capo * sizeof(obj_rec) + (size_t)g->hcap * sizeof(int);
 }
 
-int gi_surface_sample(const gi_surface *g, int i, double u, double v, double xi, vec3 *pos, vec3 *nrm)
+int gi_surface_sample(const gi_surface *g, int i, double u, double v, rng *r, vec3 *pos, vec3 *nrm)
 {
     const patch *p = &g->p[i];
+    if (p->piece >= 0 && p->kind != PATCH_TRI) {
+        /* analytic shapes: accel_surface's sampler (uniform by world area,
+         * rejection under non-similarity transforms) */
+        accel_surf_sample smp;
+        /* (v, u): the R2 sequence's second coordinate drives the polar
+         * direction; measured on the integrating sphere (test_gi), this
+         * order spreads the points more evenly (mean bias 0.6% vs 1.4% at
+         * 16K particles) */
+        if (!accel_surf_sample_piece(g->as, p->piece, v, u, r, &smp)) return 0;
+        *pos = smp.p;
+        *nrm = smp.n;
+        if (p->kind == PATCH_DISC) {
+            /* side 0 is the disc's own normal, as in locate */
+            vec3 front;
+            grid_eval(g, p, 0.0, 0.0, NULL, &front);
+            if (v3_dot(*nrm, front) < 0.0) *nrm = v3_neg(*nrm);
+        }
+        return v3_finite(*pos) && v3_finite(*nrm);
+    }
+    if (p->kind == PATCH_PIECE) return 0;
+    double xi = rng_f64(r);
     if (p->kind == PATCH_TRI) {
         /* fold the unit square onto the triangle (uniform, keeps stratification) */
         if (u + v > 1.0) {
@@ -657,6 +721,8 @@ int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, lo
                 v = cv;
             }
         }
+    } else if (g->p[first].kind == PATCH_PIECE) {
+        return 0;
     } else {
         p = &g->p[first];
         vec3 q = xform_inv_point(&hit->obj->transform, hit->p);
@@ -671,7 +737,7 @@ int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, lo
         }
         if (u < 0.0) u += 1.0;
     }
-    if (!p || p->nsides == 0) return 0;
+    if (!p || p->nsides == 0 || p->kind == PATCH_PIECE) return 0;
     /* side: the geometric normal on the viewer's side, against the front normal */
     vec3 ng = v3_dot(n_view, hit->ng) >= 0.0 ? hit->ng : v3_neg(hit->ng);
     vec3 front;

@@ -21,16 +21,21 @@
  * gi_particles later drops a side whose scattering links all miss.
  * Side 0 is the patch's front normal, side 1 its opposite.
  *
+ * Cylinders, cones and tori get area particles (sampled by accel_surface)
+ * but no radiance particles: gi_particle estimates indirect light at hits
+ * on them from the particles around the hit.
+ *
  * CSG: members of union are ordinary leaves. Members of merge, intersection
  * and difference are sampled on their whole surface and marked `probe`:
  * a particle is kept only if a short probe ray finds the CSG result's
- * surface there (gi_particles). Cylinders, cones, tori and unsupported
- * shapes get no particles (counted in gi_surface_skipped); hits on them
- * receive no indirect light. */
+ * surface there (gi_particles); cylinders, cones and tori inside such CSG,
+ * and unsupported shapes, get no particles (counted in gi_surface_skipped);
+ * hits on them receive no indirect light. */
 #ifndef PT_GI_SURFACE_H
 #define PT_GI_SURFACE_H
 #include "accel.h"
 #include "diag.h"
+#include "rng.h"
 #include "scene.h"
 
 typedef struct gi_surface gi_surface;
@@ -49,10 +54,12 @@ const scene_object *gi_surface_object(const gi_surface *g, int patch);
 const scene_texture *gi_surface_texture(const gi_surface *g, int patch);
 double gi_surface_total_area(const gi_surface *g);
 
-/* Map (u, v) in [0,1)^2 to a point of the patch, uniformly by area; xi in
- * [0,1) drives the rejection step of grids under non-uniform scaling
- * (returns 0 when the sample is rejected). nrm: unit front normal. */
-int gi_surface_sample(const gi_surface *g, int patch, double u, double v, double xi, vec3 *pos, vec3 *nrm);
+/* Map (u, v) in [0,1)^2 to a point of the patch, uniformly by area; r
+ * drives rejection steps (curved shapes under non-similarity transforms);
+ * returns 0 when the sample is rejected. nrm: unit front normal. Analytic
+ * shapes are sampled by accel_surface (shared with reference/), triangles
+ * by folding the unit square. */
+int gi_surface_sample(const gi_surface *g, int patch, double u, double v, rng *r, vec3 *pos, vec3 *nrm);
 
 /* Radiance particles: gi_surface_nrp of them, patch by patch, side by side. */
 long gi_surface_nrp(const gi_surface *g);
@@ -66,6 +73,9 @@ int gi_surface_rp_side(const gi_surface *g, long rp);
  * side. Returns 1, or 0 when the hit is on a surface without particles. */
 int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, long rp[3], double w[3]);
 
+/* Whether the hit object carries area particles (it may have no radiance
+ * particles: cylinders, cones, tori; gi_particle then estimates at the hit). */
+int gi_surface_has_particles(const gi_surface *g, const accel_hit *hit);
 /* Objects skipped (no particles) and a patch count per kind, for stats. */
 long gi_surface_skipped(const gi_surface *g);
 size_t gi_surface_bytes(const gi_surface *g);

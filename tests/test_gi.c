@@ -11,8 +11,10 @@
  *    light of colour C at distance a from the centre (no distance falloff)
  *    F_d = pi C (4 pi R^2 - 4 pi a^2 / 3) (Gauss: the flux of the unit radial
  *    field through the sphere is the integral of 2/r over the ball). The
- *    relative error of the hook's value is printed for growing particle
- *    counts and must end below 3%.
+ *    RMS relative error of the hook's value over 200 points is printed for
+ *    1K, 4K, 16K particles; it must fall, and end below 1.5%.
+ *  - a cylinder (particles from accel_surface, no radiance particles) gets
+ *    its indirect light estimated at the hit, close to the floor's.
  *  - direct light of the particles equals shade.c's Whitted direct term at
  *    the same point (spotlight with fade; relative 1e-3 plus 1e-6: the
  *    kernels work in float and the falloff tail cancels digits).
@@ -243,6 +245,8 @@ static const char *sphere_scene =
     "light_source { <0.3, 0.2, 0.1> color rgb 1 }\n"
     "sphere { 0, 1 pigment { rgb 1 } finish { ambient 0 diffuse 0.5 } }\n";
 
+static double g_bias;
+
 static double sphere_error(fixture *f, long count, int nb, const char *device, double *expected)
 {
     gi_particle *gp = build(f, count, nb, device, 7);
@@ -254,7 +258,7 @@ static double sphere_error(fixture *f, long count, int nb, const char *device, d
     double a2 = 0.3 * 0.3 + 0.2 * 0.2 + 0.1 * 0.1;
     *expected = (1.0 - a2 / 3.0) * sum; /* E_ind / pi for C = 1, R = 1 */
     /* probe points: a spiral of directions from the light */
-    double err2 = 0.0;
+    double err2 = 0.0, bias = 0.0;
     int m = 0;
     const int probes = 200;
     for (int i = 0; i < probes; i++) {
@@ -268,6 +272,7 @@ static double sphere_error(fixture *f, long count, int nb, const char *device, d
         assert_true(isfinite(e.r) && isfinite(e.g) && isfinite(e.b));
         double rel = (e.g - *expected) / *expected;
         err2 += rel * rel;
+        bias += rel;
         m++;
     }
     assert_true(m > probes / 2);
@@ -275,6 +280,7 @@ static double sphere_error(fixture *f, long count, int nb, const char *device, d
     assert_int_equal(st->discarded, 0);
     assert_true(st->lookups_late > 0); /* no prepare_view: computed on demand */
     gi_particle_free(gp);
+    g_bias = bias / m;
     return sqrt(err2 / m);
 }
 
@@ -287,10 +293,14 @@ static void test_integrating_sphere(void **state)
     double err[3], expected = 0.0;
     for (int i = 0; i < 3; i++) {
         err[i] = sphere_error(&f, counts[i], 10, device_c, &expected);
-        printf("  integrating sphere, %6ld particles: expected E/pi %.6f, RMS relative error %.4f\n", counts[i],
-               expected, err[i]);
+        printf("  integrating sphere, %6ld particles: expected E/pi %.6f, RMS relative error %.4f (mean %+.4f)\n",
+               counts[i], expected, err[i], g_bias);
     }
-    assert_true(err[2] < 0.03);
+    /* measured 2.8%, 0.9%, 0.6% (a positive bias: the gather meets each
+     * particle in proportion to its Voronoi area, while L divides its flux
+     * by the mean area, so uneven spacing reads high; it shrinks as the
+     * points fill in) */
+    assert_true(err[2] < 0.015);
     assert_true(err[2] < err[0]);
     unload(&f);
 }
@@ -506,6 +516,38 @@ static void test_view_and_render(void **state)
     unload(&f);
 }
 
+/* A cylinder has area particles (accel_surface samples it) but no radiance
+ * particles: the hook estimates at the hit. Its indirect light must be
+ * close to that of the cube wall next to it (both see the same room). */
+static void test_cylinder_onthefly(void **state)
+{
+    (void)state;
+    char text[4096];
+    snprintf(text, sizeof text, "%s%s", cube_scene,
+             "cylinder { <0.7, 0, 0.7>, <0.7, 0.5, 0.7>, 0.1 pigment { rgb 1 } finish { ambient 0 diffuse 0.6 } }\n");
+    fixture f;
+    load(&f, text);
+    gi_particle *gp = build(&f, 4000, 6, device_c, 2);
+    accel_hit h;
+    vec3 dir = v3_norm(v3(0.2, -0.15, 0.6));
+    vec3 org = v3(0.5, 0.4, 0.1);
+    assert_true(accel_intersect(f.a, org, dir, 0.0, INFINITY, &h));
+    assert_int_equal(h.obj->kind, SHAPE_CYLINDER);
+    vec3 n = v3_dot(dir, h.ns) > 0.0 ? v3_neg(h.ns) : h.ns;
+    rgb e = gi_particle_indirect(gp, &h, n, 0);
+    const gi_particle_stats *st = gi_particle_get_stats(gp);
+    assert_int_equal(st->lookups_onthefly, 1);
+    assert_int_equal(st->lookups_none, 0);
+    /* the floor right under the viewer's side of the cylinder */
+    accel_hit h2;
+    assert_true(accel_intersect(f.a, v3(0.55, 0.3, 0.55), v3(0, -1, 0), 0.0, INFINITY, &h2));
+    rgb e2 = gi_particle_indirect(gp, &h2, v3(0, 1, 0), 0);
+    printf("  cylinder E/pi %.4f (on the fly), floor nearby %.4f\n", e.g, e2.g);
+    assert_true(e.g > 0.3 * e2.g && e.g < 3.0 * e2.g);
+    gi_particle_free(gp);
+    unload(&f);
+}
+
 static void test_settings_from_radiosity(void **state)
 {
     (void)state;
@@ -534,6 +576,7 @@ int main(void)
         cmocka_unit_test(test_determinism),
         cmocka_unit_test(test_opencl_errors),
         cmocka_unit_test(test_view_and_render),
+        cmocka_unit_test(test_cylinder_onthefly),
         cmocka_unit_test(test_settings_from_radiosity),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
