@@ -159,13 +159,17 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
             i++;
         } else if (strcmp(a, "--display") == 0 || strcmp(a, "--view") == 0 || strcmp(a, "--look") == 0 ||
                    strcmp(a, "--working-space") == 0 || strcmp(a, "--ocio-config") == 0 ||
-                   strcmp(a, "--false-color") == 0) {
+                   strcmp(a, "--false-color") == 0 || strcmp(a, "--aovs") == 0 || strcmp(a, "--units") == 0 ||
+                   strcmp(a, "--false-color-quantity") == 0) {
             if (!has_value(a, next, err, errlen)) return 2;
             if (strcmp(a, "--display") == 0) o->display = next;
             else if (strcmp(a, "--view") == 0) o->view = next;
             else if (strcmp(a, "--look") == 0) o->look = next;
             else if (strcmp(a, "--working-space") == 0) o->working_space = next;
             else if (strcmp(a, "--ocio-config") == 0) o->ocio_config = next;
+            else if (strcmp(a, "--aovs") == 0) o->aovs = next;
+            else if (strcmp(a, "--units") == 0) o->units = next;
+            else if (strcmp(a, "--false-color-quantity") == 0) o->fc_quantity = next;
             else o->false_color = next;
             i++;
         } else if (strcmp(a, "--exposure") == 0) {

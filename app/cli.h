@@ -41,6 +41,10 @@ typedef struct {
     long particles;
     int bounces, fg_rays, max_depth;
     long photons;
+    /* lighting studies (app/lighting.h, docs/units.md) */
+    const char *aovs;       /* --aovs LIST: extra EXR layers */
+    const char *units;      /* --units m|cm|mm|ft|...|METRES: photometric lights */
+    const char *fc_quantity;/* --false-color-quantity luminance|illuminance */
 } cli_render;
 
 /* Parses argv (after the subcommand). Returns 0 on success, otherwise writes

@@ -12,17 +12,16 @@
 #include "cmd_sweep.h"
 #include "diag.h"
 #include "framebuffer.h"
-#include "func.h"
 #include "gi.h"
 #include "img_falsecolor.h"
 #include "img_io.h"
 #include "img_ocio.h"
+#include "lighting.h"
 #include "pool.h"
 #include "render_gi.h"
 #include "scene.h"
 #include "sdl.h"
 #include "shade.h"
-#include "shade_noise.h"
 #include "stats_json.h"
 #include "timer.h"
 #include "view.h"
@@ -32,13 +31,6 @@
 #endif
 
 enum { EXIT_OK = 0, EXIT_SCENE = 1, EXIT_USAGE = 2, EXIT_IO = 3, EXIT_INTERRUPTED = 130 };
-
-/* POV-Ray's Noise for user functions (f_noise3d and friends). */
-static double app_func_noise(void *user, vec3 p, int generator)
-{
-    (void)user;
-    return noise_value(p, generator);
-}
 
 static volatile int g_cancel = 0;
 
@@ -56,7 +48,8 @@ static const char *usage_text =
     "                 [--float] [--exr-compression none|zip|piz] [--png16]\n"
     "                 [--display NAME] [--view NAME] [--look NAME] [--exposure STOPS]\n"
     "                 [--working-space NAME] [--ocio-config FILE] [--false-color OUT.png]\n"
-    "                 [--false-color-range LO,HI]\n"
+    "                 [--false-color-range LO,HI] [--false-color-quantity luminance|illuminance]\n"
+    "                 [--aovs direct,indirect,albedo,normal,depth,illuminance] [--units m|cm|mm|ft|METRES]\n"
     "                 [--max-loop N] [--max-include-depth N] [--max-macro-depth N]\n"
     "                 [--max-tokens N] [--max-memory MIB] [--max-string BYTES] [--max-array N]\n"
     "                 [+W640 +H480 +A0.3 +R3 +Oout.png +Iscene.pov +Ldir ...]\n"
@@ -202,23 +195,24 @@ static char *default_output(const char *scene_path)
     return s;
 }
 
-/* Luminance false-colour image of the render (log scale, legend with values).
- * Values are the renderer's relative luminance (Rec.709 Y of the linear
- * values); absolute units need a photometric light model (not built yet). */
-static int write_false_color(const cli_render *o, const framebuffer *fb)
+/* False-colour image of the render's luminance (Rec.709 Y of the linear
+ * values) or of the illuminance AOV (log scale, legend with values):
+ * cd/m^2 and lux under --units (docs/units.md), relative values otherwise. */
+static int write_false_color(const cli_render *o, const framebuffer *fb, const lighting_study *ls)
 {
     diag *d = diag_new();
-    float *y = img_fc_luminance(fb, 1.0);
+    float *y = lighting_fc_values(ls, fb);
     framebuffer *out = NULL;
     double lo = 0, hi = 0;
     img_fc_opts fo;
     img_fc_default_opts(&fo);
     fo.lo = o->fc_lo;
     fo.hi = o->fc_hi;
-    fo.unit = NULL;
+    fo.unit = lighting_fc_unit(ls);
     pt_status st = y ? img_falsecolor(y, fb->width, fb->height, &fo, &out, &lo, &hi, d) : PT_ERR_NOMEM;
     if (st == PT_OK) st = img_write(o->false_color, out, NULL, d);
-    if (st == PT_OK && !o->quiet) fprintf(stderr, "partray: false colour %s, luminance %.4g to %.4g (log scale)\n", o->false_color, lo, hi);
+    if (st == PT_OK && !o->quiet) fprintf(stderr, "partray: false colour %s, %s %.4g to %.4g %s%s(log scale)\n", o->false_color,
+                                          lighting_fc_name(ls), lo, hi, fo.unit ? fo.unit : "", fo.unit ? " " : "");
     print_diags(d, 0);
     diag_free(d);
     free(y);
@@ -264,6 +258,16 @@ static int cmd_render(int argc, char **argv)
             return status_exit(os == PT_ERR_IO ? PT_ERR_IO : PT_ERR_USAGE);
         }
     }
+    /* Lighting studies: --units, --aovs, --false-color-quantity (lighting.h). */
+    lighting_study ls;
+    diag *ld = diag_new();
+    pt_status lst = lighting_setup(&ls, o.units, o.aovs, o.fc_quantity, ld);
+    print_diags(ld, 0);
+    diag_free(ld);
+    if (lst != PT_OK) {
+        img_ocio_close(oc);
+        return EXIT_USAGE;
+    }
     char *default_out = NULL;
     if (o.noutputs == 0) {
         default_out = default_output(o.scene);
@@ -284,15 +288,11 @@ static int cmd_render(int argc, char **argv)
         img_ocio_close(oc);
         return status_exit(st);
     }
+    lighting_apply_units(&ls, sc, d); /* photometric lights; warns about fade */
     if (!o.gi && sc->global.radiosity.enabled) gi = GI_PARTICLE;
     const char *gi_used = gi_mode_name(gi);
 
     int threads = o.threads > 0 ? o.threads : pool_default_threads();
-    /* isosurface functions may call POV-Ray's noise (issue 4) */
-    static func_env fenv;
-    fenv.noise = app_func_noise;
-    fenv.noise_generator = sc->global.noise_generator > 0 ? sc->global.noise_generator : 2;
-    accel_set_function_env(&fenv);
     t0 = timer_now();
     accel *acc = accel_build(sc, threads, d, &st);
     double t_accel = timer_now() - t0;
@@ -334,7 +334,9 @@ static int cmd_render(int argc, char **argv)
     signal(SIGINT, on_sigint);
     signal(SIGTERM, on_sigint); /* kill, systemd, timeout(1): stop like Ctrl-C */
     t0 = timer_now();
-    st = fb ? render_gi(sc, acc, &ss, fb, &sst, d) : PT_ERR_NOMEM;
+    lst = lighting_alloc(&ls, ss.width, ss.height, d);
+    ss.aov = ls.aov;
+    st = fb && lst == PT_OK ? render_gi(sc, acc, &ss, fb, &sst, d) : PT_ERR_NOMEM;
     double t_render = sst.t_render > 0 ? sst.t_render : timer_now() - t0;
     /* the progressive image of a finished render is no longer needed */
     if (progressive && !g_cancel) remove(progressive);
@@ -353,6 +355,7 @@ static int cmd_render(int argc, char **argv)
     wo.view = o.view;
     wo.look = o.look;
     wo.exposure = o.exposure;
+    lighting_write_opts(&ls, &wo);
     char tbuf[64], timings[160], settings[256];
     snprintf(tbuf, sizeof tbuf, "%.3f", t_render);
     snprintf(timings, sizeof timings, "parse %.3f s, accel %.3f s, gi_geometry %.3f s, gi_lighting %.3f s, render %.3f s",
@@ -361,11 +364,11 @@ static int cmd_render(int argc, char **argv)
              ss.width, ss.height, ss.antialias == 1 ? "adaptive" : (ss.antialias == 2 ? "fixed" : "off"), ss.aa_threshold,
              ss.aa_depth, ss.spp, (unsigned long long)ss.seed, threads);
     const char *keys[] = {"partray:scene", "partray:gi", "partray:version", "partray:render_seconds", "partray:timings",
-                          "partray:settings"};
-    const char *vals[] = {o.scene, gi_used, PARTRAY_VERSION, tbuf, timings, settings};
+                          "partray:settings", "partray:units", "partray:aovs"};
+    const char *vals[] = {o.scene, gi_used, PARTRAY_VERSION, tbuf, timings, settings, ls.units_text, ls.aovs_text};
     wo.meta_keys = keys;
     wo.meta_values = vals;
-    wo.nmeta = 6;
+    wo.nmeta = ls.aovs_text[0] ? 8 : 7;
     if (st == PT_OK && g_cancel) {
         /* Interrupted: keep what was rendered under a clearly partial name. */
         for (int i = 0; i < o.noutputs; i++) {
@@ -387,7 +390,7 @@ static int cmd_render(int argc, char **argv)
             diag_free(wd);
             if (ws != PT_OK) rc = status_exit(ws);
         }
-        if (rc == EXIT_OK && o.false_color) rc = write_false_color(&o, fb);
+        if (rc == EXIT_OK && o.false_color) rc = write_false_color(&o, fb, &ls);
     }
     double t_total = timer_now() - t_start;
     if (o.stats && rc == EXIT_OK) {
@@ -401,6 +404,7 @@ static int cmd_render(int argc, char **argv)
         stats_num(&js, "gi_geometry", sst.t_gi_geometry);
         stats_num(&js, "gi_lighting", sst.t_gi_lighting);
         stats_num(&js, "render", t_render);
+        if (ls.aov) stats_num(&js, "aov", sst.t_aov);
         stats_num(&js, "total", t_total);
         stats_obj_end(&js);
         stats_int(&js, "rays", sst.primary_rays + sst.shadow_rays + sst.secondary_rays + sst.other_rays);
@@ -441,6 +445,7 @@ static int cmd_render(int argc, char **argv)
     if (!o.quiet && rc == EXIT_OK && (sst.t_gi_geometry > 0 || sst.t_gi_lighting > 0))
         fprintf(stderr, "partray: gi %s: geometry %.3f s, lighting %.3f s\n", gi_used, sst.t_gi_geometry, sst.t_gi_lighting);
     fb_free(fb);
+    lighting_free(&ls);
     img_ocio_close(oc);
     accel_free(acc);
     scene_free(sc);

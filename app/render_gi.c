@@ -30,6 +30,18 @@ static void fill_shade(shade_settings *ss, const render_gi_opts *o)
     ss->cancel = o->cancel;
 }
 
+/* The AOV pass (shade_aov.h) with the Whitted settings of the render and,
+ * for particle GI, its indirect hook. */
+static pt_status render_aovs(const scene *sc, const accel *a, const render_gi_opts *o, const shade_settings *ss,
+                             render_gi_result *r, diag *d)
+{
+    if (!o->aov) return PT_OK;
+    double t0 = timer_now();
+    pt_status st = shade_aov_render(sc, a, ss, o->aov, d);
+    r->t_aov = timer_now() - t0;
+    return st;
+}
+
 static pt_status render_none(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
                              render_gi_result *r, diag *d)
 {
@@ -39,6 +51,7 @@ static pt_status render_none(const scene *sc, const accel *a, const render_gi_op
     double t0 = timer_now();
     pt_status st = shade_render(sc, a, &ss, fb, &r->shade, d);
     r->t_render = timer_now() - t0;
+    if (st == PT_OK) st = render_aovs(sc, a, o, &ss, r, d);
     return st;
 }
 
@@ -74,6 +87,7 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
         st = gi_particle_prepare_view(gp, &sc->camera, o->width, o->height, d);
         if (st == PT_OK) st = shade_render(sc, a, &ss, fb, &r->shade, d);
         r->t_render = timer_now() - t0;
+        if (st == PT_OK) st = render_aovs(sc, a, o, &ss, r, d);
     }
     r->particle = *gi_particle_get_stats(gp);
     gi_particle_free(gp);
@@ -153,6 +167,13 @@ static pt_status render_reference(const scene *sc, const accel *a, const render_
     r->secondary_rays = r->pm.bsdf_rays + r->pm.gather_rays;
     r->other_rays = r->pm.photon_rays;
     r->discarded = r->pm.discarded_samples;
+    if (st == PT_OK && o->aov) {
+        /* direct, albedo, normal, depth, illuminance as for none; the
+         * reference modes do not split off their indirect light (AOV 0) */
+        shade_settings ss;
+        fill_shade(&ss, o);
+        st = render_aovs(sc, a, o, &ss, r, d);
+    }
     return st;
 }
 

@@ -11,6 +11,7 @@
 #include "pm.h"
 #include "scene.h"
 #include "shade.h"
+#include "shade_aov.h"
 #include "stats_json.h"
 
 typedef struct {
@@ -29,6 +30,8 @@ typedef struct {
     volatile int *cancel;
     int progress;             /* 1: progress bar on stderr (reference modes) */
     const char *progressive_path; /* reference modes: write the image so far here every few seconds */
+    shade_aov *aov;           /* non-NULL: fill these AOVs after the render (shade_aov.h); the indirect
+                                 AOV comes from particle GI only (0 for none, pmfg, path) */
 } render_gi_opts;
 
 typedef struct {
@@ -39,6 +42,7 @@ typedef struct {
     gi_particle_stats particle;
     int has_pm;
     pm_stats pm;
+    double t_aov;             /* the AOV pass, seconds (not in t_render) */
 } render_gi_result;
 
 pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb, render_gi_result *r,

@@ -148,6 +148,43 @@ pt_status img_exr_write(int fd, const char *name, const framebuffer *fb, const i
     return img_exr_write_xy(fd, name, fb, o, xy, d);
 }
 
+/* One channel of the file: where its floats come from. */
+typedef struct {
+    char name[80];
+    const float *src;  /* first pixel's value */
+    int stride;        /* floats from one pixel to the next */
+    int use_float;     /* 1: FLOAT in the file, 0: HALF */
+} out_channel;
+
+/* Beauty R,G,B[,A] then every layer's channels "name.X". */
+static int list_channels(const framebuffer *fb, const img_write_opts *o, int use_float, out_channel **out)
+{
+    int n = fb->alpha ? 4 : 3;
+    for (int i = 0; o && i < o->nlayers; i++) n += (int)strlen(o->layers[i].suffixes);
+    out_channel *ch = calloc((size_t)n, sizeof *ch);
+    if (!ch) return -1;
+    static const char *const names[4] = {"R", "G", "B", "A"};
+    int k = 0;
+    for (int c = 0; c < (fb->alpha ? 4 : 3); c++, k++) {
+        snprintf(ch[k].name, sizeof ch[k].name, "%s", names[c]);
+        ch[k].src = c < 3 ? fb->rgb + c : fb->alpha;
+        ch[k].stride = c < 3 ? 3 : 1;
+        ch[k].use_float = use_float;
+    }
+    for (int i = 0; o && i < o->nlayers; i++) {
+        const img_layer *l = &o->layers[i];
+        int nc = (int)strlen(l->suffixes);
+        for (int c = 0; c < nc; c++, k++) {
+            snprintf(ch[k].name, sizeof ch[k].name, "%s.%c", l->name, l->suffixes[c]);
+            ch[k].src = l->data + c;
+            ch[k].stride = nc;
+            ch[k].use_float = use_float || l->full_float;
+        }
+    }
+    *out = ch;
+    return n;
+}
+
 pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
                            const float *xy, diag *d)
 {
@@ -159,9 +196,13 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
     init.write_fn = on_write;
 
     const int w = fb->width, h = fb->height;
-    const int nch = fb->alpha ? 4 : 3;
     const int use_float = o && o->exr_float;
-    const exr_pixel_type_t ptype = use_float ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF;
+    out_channel *ch = NULL;
+    const int nch = list_channels(fb, o, use_float, &ch);
+    if (nch < 0) {
+        diag_error(d, "cannot write '%s': out of memory", name);
+        return PT_ERR_NOMEM;
+    }
 
     exr_context_t ctx = NULL;
     exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
@@ -177,13 +218,15 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
     if (rv == EXR_ERR_SUCCESS)
         rv = exr_initialize_required_attr_simple(ctx, part, w, h, compression_of(o ? o->exr_compression : 1));
     /* Channel order in the file is alphabetical whatever the add order. */
-    static const char *const names[4] = {"R", "G", "B", "A"};
     for (int c = 0; c < nch && rv == EXR_ERR_SUCCESS; c++)
-        rv = exr_add_channel(ctx, part, names[c], ptype, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+        rv = exr_add_channel(ctx, part, ch[c].name, ch[c].use_float ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF,
+                             EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
     if (rv == EXR_ERR_SUCCESS && xy) {
         const exr_attr_chromaticities_t chr = {xy[0], xy[1], xy[2], xy[3], xy[4], xy[5], xy[6], xy[7]};
         rv = exr_attr_set_chromaticities(ctx, part, "chromaticities", &chr);
     }
+    if (rv == EXR_ERR_SUCCESS && o && o->white_luminance > 0.0 && isfinite(o->white_luminance))
+        rv = exr_attr_set_float(ctx, part, "whiteLuminance", (float)o->white_luminance);
     if (rv != EXR_ERR_SUCCESS) goto fail;
     for (int i = 0; o && i < o->nmeta; i++) {
         const char *k = o->meta_keys[i], *v = o->meta_values[i];
@@ -191,6 +234,7 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
         rv = exr_attr_set_string(ctx, part, k, v);
         if (rv != EXR_ERR_SUCCESS) {
             exr_finish(&ctx);
+            free(ch);
             diag_error(d, "cannot write '%s': cannot set EXR attribute '%s': %s", name, k, reason(&s, rv));
             return PT_ERR_IO;
         }
@@ -204,29 +248,30 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
     rv = exr_get_scanlines_per_chunk(ctx, part, &lpc);
     if (rv != EXR_ERR_SUCCESS) goto fail;
     if (lpc < 1) lpc = 1;
-    /* One block of sanitized, interleaved R,G,B[,A] floats. */
-    buf = malloc(sizeof(float) * (size_t)w * (size_t)lpc * (size_t)nch);
+    /* One block of sanitized floats, channel after channel (planar). */
+    const size_t plane = (size_t)w * (size_t)lpc;
+    buf = malloc(sizeof(float) * plane * (size_t)nch);
     if (!buf) {
         exr_finish(&ctx);
+        free(ch);
         diag_error(d, "cannot write '%s': out of memory", name);
         return PT_ERR_NOMEM;
     }
-    const float lim = use_float ? INFINITY : HALF_MAX;
     for (int y0 = 0; y0 < h; y0 += lpc) {
         exr_chunk_info_t ci;
         rv = exr_write_scanline_chunk_info(ctx, part, y0, &ci);
         if (rv != EXR_ERR_SUCCESS) goto fail;
-        for (int y = 0; y < ci.height; y++) {
-            const float *src = fb->rgb + (size_t)(y0 + y) * (size_t)w * 3u;
-            const float *asrc = fb->alpha ? fb->alpha + (size_t)(y0 + y) * (size_t)w : NULL;
-            float *dst = buf + (size_t)y * (size_t)w * (size_t)nch;
-            for (int x = 0; x < w; x++) {
-                for (int c = 0; c < nch; c++) {
-                    float v = c < 3 ? src[x * 3 + c] : asrc[x];
+        for (int c = 0; c < nch; c++) {
+            const float lim = ch[c].use_float ? INFINITY : HALF_MAX;
+            for (int y = 0; y < ci.height; y++) {
+                const float *src = ch[c].src + (size_t)(y0 + y) * (size_t)w * (size_t)ch[c].stride;
+                float *dst = buf + (size_t)c * plane + (size_t)y * (size_t)w;
+                for (int x = 0; x < w; x++) {
+                    float v = src[(size_t)x * (size_t)ch[c].stride];
                     if (!isfinite(v)) v = 0.0f;
                     if (v > lim) v = lim;
                     if (v < -lim) v = -lim;
-                    dst[x * nch + c] = v;
+                    dst[x] = v;
                 }
             }
         }
@@ -235,13 +280,13 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
         for (int c = 0; c < enc.channel_count; c++) {
             exr_coding_channel_info_t *ec = &enc.channels[c];
             int slot = 0;
-            while (slot < nch && strcmp(ec->channel_name, names[slot]) != 0) slot++;
+            while (slot < nch && strcmp(ec->channel_name, ch[slot].name) != 0) slot++;
             if (slot == nch) slot = 0; /* cannot happen: we declared exactly these */
             ec->user_data_type = EXR_PIXEL_FLOAT;
             ec->user_bytes_per_element = 4;
-            ec->user_pixel_stride = (int32_t)(sizeof(float) * (size_t)nch);
-            ec->user_line_stride = (int32_t)(sizeof(float) * (size_t)nch * (size_t)w);
-            ec->encode_from_ptr = (const uint8_t *)(buf + slot);
+            ec->user_pixel_stride = (int32_t)sizeof(float);
+            ec->user_line_stride = (int32_t)(sizeof(float) * (size_t)w);
+            ec->encode_from_ptr = (const uint8_t *)(buf + (size_t)slot * plane);
         }
         if (!enc_init) {
             enc_init = 1;
@@ -259,6 +304,8 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
     enc_init = 0;
     free(buf);
     buf = NULL;
+    free(ch);
+    ch = NULL;
     what = "cannot finish EXR file";
     rv = exr_finish(&ctx);
     if (rv != EXR_ERR_SUCCESS || s.err) {
@@ -270,6 +317,7 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
 fail:
     if (enc_init) exr_encoding_destroy(ctx, &enc);
     free(buf);
+    free(ch);
     if (ctx) exr_finish(&ctx);
     diag_error(d, "cannot write '%s': %s: %s", name, what, reason(&s, rv));
     return PT_ERR_IO;
@@ -491,5 +539,173 @@ done:
     close(s.fd);
     free(grey);
     fb_free(fb);
+    return st;
+}
+
+/* ---- reading named channels (AOV layers) ------------------------------- */
+
+typedef struct {
+    char names[4][80];
+    int n;
+    float *data; /* w*h*n */
+    int w;
+} layer_sink;
+
+static void bind_layer(exr_decode_pipeline_t *dec, const layer_sink *ls, int x0, int y0)
+{
+    for (int c = 0; c < dec->channel_count; c++) {
+        exr_coding_channel_info_t *dc = &dec->channels[c];
+        int slot = -1;
+        for (int k = 0; k < ls->n && dc->channel_name; k++)
+            if (strcmp(dc->channel_name, ls->names[k]) == 0) slot = k;
+        dc->decode_to_ptr = NULL;
+        dc->user_pixel_stride = 0;
+        dc->user_line_stride = 0;
+        if (slot >= 0 && dc->x_samples == 1 && dc->y_samples == 1) {
+            size_t pix = (size_t)y0 * (size_t)ls->w + (size_t)x0;
+            dc->decode_to_ptr = (uint8_t *)(ls->data + pix * (size_t)ls->n + (size_t)slot);
+            dc->user_pixel_stride = (int32_t)(sizeof(float) * (size_t)ls->n);
+            dc->user_line_stride = (int32_t)(sizeof(float) * (size_t)ls->n * (size_t)ls->w);
+        }
+        dc->user_data_type = EXR_PIXEL_FLOAT;
+        dc->user_bytes_per_element = 4;
+    }
+}
+
+static exr_result_t decode_layer_chunk(exr_context_t ctx, const exr_chunk_info_t *ci, exr_decode_pipeline_t *dec,
+                                       int *dec_init, const layer_sink *ls, int x0, int y0)
+{
+    exr_result_t rv = *dec_init ? exr_decoding_update(ctx, 0, ci, dec) : exr_decoding_initialize(ctx, 0, ci, dec);
+    if (rv != EXR_ERR_SUCCESS) return rv;
+    bind_layer(dec, ls, x0, y0);
+    if (!*dec_init) {
+        *dec_init = 1;
+        rv = exr_decoding_choose_default_routines(ctx, 0, dec);
+        if (rv != EXR_ERR_SUCCESS) return rv;
+    }
+    return exr_decoding_run(ctx, 0, dec);
+}
+
+pt_status img_read_exr_layer(const char *path, const char *layer, const char *suffixes, float **out, int *width,
+                             int *height, diag *d)
+{
+    *out = NULL;
+    layer_sink ls;
+    memset(&ls, 0, sizeof ls);
+    ls.n = suffixes ? (int)strlen(suffixes) : 0;
+    if (ls.n < 1 || ls.n > 4) {
+        diag_error(d, "cannot read '%s': 1 to 4 channel suffixes wanted", path);
+        return PT_ERR_USAGE;
+    }
+    for (int k = 0; k < ls.n; k++) {
+        if (layer && *layer) snprintf(ls.names[k], sizeof ls.names[k], "%s.%c", layer, suffixes[k]);
+        else snprintf(ls.names[k], sizeof ls.names[k], "%c", suffixes[k]);
+    }
+    exr_msg[0] = '\0';
+    exr_stream s = {-1, 0};
+    s.fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (s.fd < 0) {
+        diag_error(d, "cannot read '%s': %s", path, strerror(errno));
+        return PT_ERR_IO;
+    }
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = on_error;
+    init.user_data = &s;
+    init.read_fn = on_read;
+    init.size_fn = on_size;
+    init.max_image_width = IMG_MAX_SIDE;
+    init.max_image_height = IMG_MAX_SIDE;
+    init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
+    pt_status st = PT_ERR_IO;
+    exr_context_t ctx = NULL;
+    exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
+    int dec_init = 0;
+    const char *what = "not a readable EXR file";
+    exr_result_t rv = exr_start_read(&ctx, path, &init);
+    if (rv != EXR_ERR_SUCCESS) goto libfail;
+    exr_storage_t storage;
+    exr_attr_box2i_t dw;
+    const exr_attr_chlist_t *chl = NULL;
+    what = "cannot read EXR header";
+    if ((rv = exr_get_storage(ctx, 0, &storage)) != EXR_ERR_SUCCESS) goto libfail;
+    if ((rv = exr_get_data_window(ctx, 0, &dw)) != EXR_ERR_SUCCESS) goto libfail;
+    if ((rv = exr_get_channels(ctx, 0, &chl)) != EXR_ERR_SUCCESS) goto libfail;
+    int64_t w64 = (int64_t)dw.max.x - dw.min.x + 1, h64 = (int64_t)dw.max.y - dw.min.y + 1;
+    if ((storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED) || w64 <= 0 || h64 <= 0 ||
+        w64 > IMG_MAX_SIDE || h64 > IMG_MAX_SIDE || (uint64_t)w64 * (uint64_t)h64 > IMG_MAX_PIXELS) {
+        diag_error(d, "cannot read '%s': unsupported storage or image size", path);
+        goto done;
+    }
+    for (int k = 0; k < ls.n; k++) {
+        int found = 0;
+        for (int i = 0; i < chl->num_channels; i++) {
+            const exr_attr_chlist_entry_t *e = &chl->entries[i];
+            if (e->name.str && strcmp(e->name.str, ls.names[k]) == 0 && e->x_sampling == 1 && e->y_sampling == 1) found = 1;
+        }
+        if (!found) {
+            diag_error(d, "cannot read '%s': no channel '%s'", path, ls.names[k]);
+            goto done;
+        }
+    }
+    ls.w = (int)w64;
+    ls.data = calloc((size_t)w64 * (size_t)h64 * (size_t)ls.n, sizeof(float));
+    if (!ls.data) {
+        diag_error(d, "cannot read '%s': out of memory", path);
+        st = PT_ERR_NOMEM;
+        goto done;
+    }
+    what = "cannot read EXR pixels";
+    if (storage == EXR_STORAGE_SCANLINE) {
+        int32_t lpc = 1;
+        if ((rv = exr_get_scanlines_per_chunk(ctx, 0, &lpc)) != EXR_ERR_SUCCESS) goto libfail;
+        if (lpc < 1) lpc = 1;
+        for (int64_t y = dw.min.y; y <= dw.max.y; y += lpc) {
+            exr_chunk_info_t ci;
+            if ((rv = exr_read_scanline_chunk_info(ctx, 0, (int)y, &ci)) != EXR_ERR_SUCCESS) goto libfail;
+            int row = ci.start_y - dw.min.y;
+            if (row < 0 || row + ci.height > h64 || ci.width != w64) {
+                diag_error(d, "cannot read '%s': inconsistent scanline block at y=%d", path, ci.start_y);
+                goto done;
+            }
+            if ((rv = decode_layer_chunk(ctx, &ci, &dec, &dec_init, &ls, 0, row)) != EXR_ERR_SUCCESS) goto libfail;
+        }
+    } else {
+        uint32_t tw = 0, th = 0;
+        exr_tile_level_mode_t lm;
+        exr_tile_round_mode_t rm;
+        if ((rv = exr_get_tile_descriptor(ctx, 0, &tw, &th, &lm, &rm)) != EXR_ERR_SUCCESS) goto libfail;
+        if (tw == 0 || th == 0) {
+            diag_error(d, "cannot read '%s': inconsistent tile description", path);
+            goto done;
+        }
+        int ntx = (int)(((uint32_t)w64 + tw - 1) / tw), nty = (int)(((uint32_t)h64 + th - 1) / th);
+        for (int ty = 0; ty < nty; ty++) {
+            for (int tx = 0; tx < ntx; tx++) {
+                exr_chunk_info_t ci;
+                if ((rv = exr_read_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &ci)) != EXR_ERR_SUCCESS) goto libfail;
+                int x0 = tx * (int)tw, y0 = ty * (int)th;
+                if (ci.width <= 0 || ci.height <= 0 || x0 + ci.width > w64 || y0 + ci.height > h64) {
+                    diag_error(d, "cannot read '%s': inconsistent tile (%d,%d)", path, tx, ty);
+                    goto done;
+                }
+                if ((rv = decode_layer_chunk(ctx, &ci, &dec, &dec_init, &ls, x0, y0)) != EXR_ERR_SUCCESS) goto libfail;
+            }
+        }
+    }
+    *out = ls.data;
+    ls.data = NULL;
+    *width = (int)w64;
+    *height = (int)h64;
+    st = PT_OK;
+    goto done;
+
+libfail:
+    diag_error(d, "cannot read '%s': %s: %s", path, what, reason(&s, rv));
+    st = PT_ERR_IO;
+done:
+    if (dec_init) exr_decoding_destroy(ctx, &dec);
+    if (ctx) exr_finish(&ctx);
+    close(s.fd);
+    free(ls.data);
     return st;
 }

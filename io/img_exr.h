@@ -14,7 +14,9 @@ void img_exr_primaries(img_primaries prim, float xy[8]);
 
 /* Write `fb` as a single-part scanline EXR to the open file `fd` (positioned
  * writes; the caller closes it). `name` is only used in messages. Channels
- * R,G,B (+A when fb->alpha) as half (default) or float (o->exr_float);
+ * R,G,B (+A when fb->alpha) as half (default) or float (o->exr_float),
+ * then the channels "name.X" of every layer in o->layers (AOVs; float when
+ * the layer asks for it), and whiteLuminance when o->white_luminance > 0;
  * non-finite values are written as 0 and, for half channels, finite values
  * are clamped to +-65504 (the largest half) so no Inf ever reaches the file. */
 pt_status img_exr_write(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,

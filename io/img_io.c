@@ -17,6 +17,7 @@
 #include "img_pfm.h"
 #include "img_png.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -106,6 +107,9 @@ typedef struct {
     int have_xy;       /* 0: write no chromaticities attribute */
     int png_display;   /* 1: copy holds display-encoded values */
     img_png_tag tag;
+    img_layer *layers; /* EXR layers with the colour ones converted (NULL: o->layers as given) */
+    float **owned;     /* their converted data, per layer (NULL where borrowed) */
+    int nlayers;
 } colour_plan;
 
 static void plan_free(colour_plan *p)
@@ -113,6 +117,54 @@ static void plan_free(colour_plan *p)
     if (p->copy) p->copy->alpha = NULL; /* borrowed */
     fb_free(p->copy);
     p->copy = NULL;
+    for (int i = 0; p->owned && i < p->nlayers; i++) free(p->owned[i]);
+    free(p->owned);
+    free(p->layers);
+    p->owned = NULL;
+    p->layers = NULL;
+}
+
+/* The colour layers (3 channels, `colour` set) go into the working space
+ * with the beauty; data layers (normals, depth) are written as they are. */
+static pt_status convert_layers(img_ocio *oc, const img_write_opts *o, int w, int h, const char *fbs, const char *ws,
+                                colour_plan *p, diag *d)
+{
+    p->layers = calloc((size_t)o->nlayers, sizeof *p->layers);
+    p->owned = calloc((size_t)o->nlayers, sizeof *p->owned);
+    if (!p->layers || !p->owned) return PT_ERR_NOMEM;
+    p->nlayers = o->nlayers;
+    for (int i = 0; i < o->nlayers; i++) {
+        p->layers[i] = o->layers[i];
+        if (!o->layers[i].colour || strlen(o->layers[i].suffixes) != 3) continue;
+        framebuffer *t = fb_new(w, h);
+        if (!t) return PT_ERR_NOMEM;
+        memcpy(t->rgb, o->layers[i].data, sizeof(float) * 3u * (size_t)w * (size_t)h);
+        pt_status st = img_ocio_convert(oc, t, fbs, ws, d);
+        p->owned[i] = t->rgb;
+        t->rgb = NULL;
+        fb_free(t);
+        if (st != PT_OK) return st;
+        p->layers[i].data = p->owned[i];
+    }
+    return PT_OK;
+}
+
+/* Layer names that make valid, distinct channel names. */
+static int layers_valid(const img_write_opts *o)
+{
+    if (o->nlayers < 0 || (o->nlayers > 0 && !o->layers)) return 0;
+    for (int i = 0; i < o->nlayers; i++) {
+        const img_layer *l = &o->layers[i];
+        size_t n = l->name ? strlen(l->name) : 0, ns = l->suffixes ? strlen(l->suffixes) : 0;
+        if (n == 0 || n > 60 || ns < 1 || ns > 4 || !l->data) return 0;
+        for (size_t k = 0; k < n; k++)
+            if (!isalnum((unsigned char)l->name[k]) && l->name[k] != '_' && l->name[k] != '-') return 0;
+        for (size_t k = 0; k < ns; k++)
+            if (!isalpha((unsigned char)l->suffixes[k]) || strchr(l->suffixes + k + 1, l->suffixes[k])) return 0;
+        for (int j = 0; j < i; j++)
+            if (strcmp(o->layers[j].name, l->name) == 0) return 0;
+    }
+    return 1;
 }
 
 static pt_status plan_colour(const char *path, img_format fmt, const framebuffer *fb, const img_write_opts *o,
@@ -164,6 +216,10 @@ static pt_status plan_colour(const char *path, img_format fmt, const framebuffer
         for (size_t i = 0; i < n; i++) p->copy->rgb[i] *= k;
     } else if (st == PT_OK && fmt == IMG_FMT_EXR) {
         if (convert) st = img_ocio_convert(oc, p->copy, fbs, ws, d);
+        if (convert && st == PT_OK && o->nlayers > 0) {
+            st = convert_layers(oc, o, fb->width, fb->height, fbs, ws, p, d);
+            if (st == PT_ERR_NOMEM) diag_error(d, "cannot write '%s': out of memory", path);
+        }
         if (st == PT_OK) p->have_xy = img_ocio_chromaticities(oc, ws, p->xy, d);
     } else if (st == PT_OK) {
         st = img_ocio_apply(oc, p->copy, fbs, o->display, o->view, o->look, o->exposure, d);
@@ -217,6 +273,11 @@ pt_status img_write(const char *path, const framebuffer *fb, const img_write_opt
         return PT_ERR_USAGE;
     }
 
+    if (fmt == IMG_FMT_EXR && !layers_valid(o)) {
+        diag_error(d, "cannot write '%s': bad EXR layer list (names: letters, digits, _ or -; 1 to 4 distinct channel letters)", path);
+        return PT_ERR_USAGE;
+    }
+
     colour_plan plan;
     pt_status cst = plan_colour(path, fmt, fb, o, &plan, d);
     if (cst != PT_OK) return cst;
@@ -243,7 +304,12 @@ pt_status img_write(const char *path, const framebuffer *fb, const img_write_opt
 
     pt_status st;
     switch (fmt) {
-    case IMG_FMT_EXR: st = img_exr_write_xy(fd, path, out, o, plan.have_xy ? plan.xy : NULL, d); break;
+    case IMG_FMT_EXR: {
+        img_write_opts eo = *o;
+        if (plan.layers) eo.layers = plan.layers;
+        st = img_exr_write_xy(fd, path, out, &eo, plan.have_xy ? plan.xy : NULL, d);
+        break;
+    }
     case IMG_FMT_PNG:
         st = plan.png_display ? img_png_write_display(fd, path, out, o, plan.tag, d) : img_png_write(fd, path, out, o, d);
         break;

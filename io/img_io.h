@@ -13,6 +13,16 @@
 
 typedef enum { IMG_FMT_UNKNOWN, IMG_FMT_EXR, IMG_FMT_PNG, IMG_FMT_PFM } img_format;
 
+/* An extra EXR layer (an AOV): channels "name.<letter>" beside the beauty's
+ * R,G,B in the same part, as OpenEXR's layer naming convention has it. */
+typedef struct {
+    const char *name;      /* layer name, e.g. "direct" */
+    const char *suffixes;  /* one letter per channel: "RGB", "XYZ", "Z"... (1 to 4) */
+    const float *data;     /* width*height*strlen(suffixes) floats, interleaved, row 0 at the top */
+    int colour;            /* 1: RGB in the beauty's colour space, converted into the working space with it */
+    int full_float;        /* 1: 32-bit float channels even when the beauty is half (depth) */
+} img_layer;
+
 typedef struct {
     int exr_float;        /* 1 = 32-bit float channels, 0 = half (default) */
     int exr_compression;  /* 0 none, 1 zip (default), 2 piz */
@@ -39,6 +49,10 @@ typedef struct {
      * unrecognised display -> none. Ignored for EXR and PFM. */
     const char *display, *view, *look;
     double exposure;           /* PNG only: values x 2^exposure before the view or the sRGB encoding */
+    /* EXR only (appended for lighting studies, issue 9). */
+    const img_layer *layers;   /* extra layers of the same size as fb (AOVs); ignored by PNG and PFM */
+    int nlayers;
+    double white_luminance;    /* > 0: the standard `whiteLuminance` attribute, cd/m^2 of RGB (1,1,1) */
 } img_write_opts;
 
 void img_default_write_opts(img_write_opts *o);
@@ -50,6 +64,12 @@ pt_status img_write(const char *path, const framebuffer *fb, const img_write_opt
 /* Reads EXR (R,G,B channels, half or float), PFM, PNG (8/16 bit; sRGB decoded
  * to linear unless `png_raw` is set, then values are code/max). */
 pt_status img_read(const char *path, int png_raw, framebuffer **out, diag *d);
+/* Reads the channels "layer.<letter>" of an EXR's part 0 for each letter of
+ * `suffixes` (e.g. "direct", "RGB"; layer NULL or "" = the unprefixed
+ * channels) into *out: width*height*strlen(suffixes) interleaved floats
+ * (malloc'd). PT_ERR_IO when a channel is missing or the file unreadable. */
+pt_status img_read_exr_layer(const char *path, const char *layer, const char *suffixes, float **out, int *width,
+                             int *height, diag *d);
 
 /* sRGB transfer functions (IEC 61966-2-1). */
 double img_srgb_encode(double linear);

@@ -10,6 +10,7 @@
 #include "framebuffer.h"
 #include "rng.h"
 #include "scene.h"
+#include "shade_light.h"
 
 /* Irradiance-like indirect term at a diffuse hit: returns the incoming
  * indirect radiance weighting that multiplies pigment*diffuse (POV-Ray's
@@ -45,5 +46,9 @@ rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 o
 /* POV-Ray's colour distance used for antialiasing decisions: sum of the
  * absolute channel differences. */
 double shade_colour_distance(rgb a, rgb b);
+/* The Whitted direct term (every light, its attenuation, area grid and
+ * shadows: what tex_shade's direct callback gets) of surface s at hit h,
+ * shaded from p (off the surface on the viewer's side). For shade_aov.c. */
+rgb shade_direct(const scene *sc, const accel *a, const light_surface *s, const accel_hit *h, vec3 p, rng *r);
 
 #endif

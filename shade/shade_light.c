@@ -272,3 +272,35 @@ rgb light_nee(const light_ctx *c, const scene_light *l, const light_surface *s, 
     }
     return light_terms(s, dir, lc, backside);
 }
+
+/* ------------------------------------------------------ photometric units */
+
+double light_luminance(rgb c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
+
+pt_status light_units_apply(scene *sc, double metres_per_unit, diag *d)
+{
+    if (!(metres_per_unit > 0.0) || !isfinite(metres_per_unit)) {
+        diag_error(d, "units: %g metres per scene unit is not a positive number", metres_per_unit);
+        return PT_ERR_USAGE;
+    }
+    for (int i = 0; i < sc->nlights; i++) {
+        scene_light *l = &sc->lights[i];
+        if (l->fade_power > 0.0)
+            diag_report(d, DIAG_WARNING, l->loc, NULL,
+                        "photometric units: this light's fade_distance %g / fade_power %g are ignored "
+                        "(inverse-square falloff in metres instead)",
+                        l->fade_distance, l->fade_power);
+        if (l->parallel || l->kind == LIGHT_PARALLEL || l->kind == LIGHT_CYLINDER) {
+            /* illuminance I lux on a surface facing the light: E = pi C' */
+            l->colour = lrgb_scale(l->colour, 1.0 / M_PI);
+            l->fade_distance = 0.0;
+            l->fade_power = 0.0;
+        } else {
+            /* E = I cos / (m d)^2 = pi C' cos d^-2 with d in scene units */
+            l->colour = lrgb_scale(l->colour, 1.0 / (M_PI * metres_per_unit * metres_per_unit));
+            l->fade_distance = 0.0;
+            l->fade_power = 2.0;
+        }
+    }
+    return PT_OK;
+}

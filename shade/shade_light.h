@@ -18,6 +18,7 @@
 #ifndef PT_SHADE_LIGHT_H
 #define PT_SHADE_LIGHT_H
 #include "accel.h"
+#include "diag.h"
 #include "rng.h"
 #include "scene.h"
 
@@ -93,5 +94,34 @@ typedef struct {
  * continuous light. */
 rgb light_nee(const light_ctx *c, const scene_light *l, const light_surface *s, vec3 p, int double_illum,
               int nsamples, rng *r);
+
+/* ------------------------------------------------------ photometric units */
+
+/* Rec.709 luminance weights (the Y row of the linear sRGB -> XYZ matrix). */
+double light_luminance(rgb c);
+
+/* Photometric light units for lighting studies (docs/units.md): one scene
+ * unit is `metres_per_unit` metres; a light's colour C has luminance
+ * I = light_luminance(C). Point and spot lights (and area lights, whose
+ * intensity is spread over their grid as POV-Ray spreads it) become
+ * isotropic sources of I candela (on the axis for spotlights) with
+ * inverse-square falloff, E = I cos / d^2 lux, d in metres; parallel,
+ * cylinder and `parallel` lights give I lux on a surface facing them, at
+ * any distance. The renderer's values then read as luminance in cd/m^2:
+ * a diffuse surface of reflectance rho = pigment * diffuse under E shows
+ * L = rho E / pi.
+ *
+ * The model is applied by rewriting the lights once, after parsing, into
+ * the POV-Ray terms every integrator already evaluates: colour scaled by
+ * 1/(pi m^2) with fade_distance 0 and fade_power 2 (light_attenuation's
+ * d^-fade_power branch, d in scene units), or colour / pi with no fade for
+ * the parallel kinds. So shade.c (Whitted), gi/ (particle GI: the OpenCL
+ * kernels' gi_light_attenuation in gi/kernels/gi_types.h, a copy of
+ * light_attenuation) and reference/ (light_nee, light_attenuation and the
+ * photon powers of pm_photon.c) all see the same falloff.
+ * A light's own fade_distance/fade_power are replaced; each such light
+ * gets a warning in d. PT_ERR_USAGE when metres_per_unit is not a positive
+ * finite number. Applying it twice scales twice: call it once. */
+pt_status light_units_apply(scene *sc, double metres_per_unit, diag *d);
 
 #endif
