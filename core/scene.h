@@ -66,6 +66,7 @@ typedef struct {
     double fade_power;
     rgb fade_colour;
     int caustics_set;
+    double caustics;      /* appended: POV-Ray's internal value, 45 * the given one (faked caustics) */
 } scene_interior;
 
 /* A texture: one pigment, finish and (later) normal. Layered textures are a

@@ -19,7 +19,7 @@
 
 static double srgb_decode(double v) { return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4); }
 
-int sdl_image_load(scene_image *img, arena *mem, char *why, size_t whycap)
+int sdl_image_load(scene_image *img, arena *mem, double working_gamma, char *why, size_t whycap)
 {
     FILE *f = fopen(img->path, "rb");
     if (!f) {
@@ -94,7 +94,10 @@ int sdl_image_load(scene_image *img, arena *mem, char *why, size_t whycap)
     fclose(f);
     for (int i = 0; i < 65536; i++) {
         double v = i / 65535.0;
-        lut[i] = (float)(curve == 0 ? srgb_decode(v) : pow(v, exponent));
+        double lin = curve == 0 ? srgb_decode(v) : pow(v, exponent);
+        if (working_gamma == 0.0) lin = v; /* gamma handling off */
+        else if (working_gamma != 1.0) lin = pow(lin, 1.0 / working_gamma);
+        lut[i] = (float)lin;
     }
     for (size_t i = 0; i < (size_t)w * h; i++) {
         const unsigned short *s = buf + i * 4;

@@ -7,7 +7,10 @@
 #include "scene.h"
 
 /* Fill img->width/height/pixels (in `mem`, the scene's arena) from
- * img->path. Returns 0 on success, else a reason in `why`. */
-int sdl_image_load(scene_image *img, arena *mem, char *why, size_t whycap);
+ * img->path, in the scene's working space: working_gamma = assumed_gamma
+ * (1 = linear), or 0 when gamma handling is off (pre-3.7 scene without
+ * assumed_gamma: the file's codes as they are). Returns 0 on success, else
+ * a reason in `why`. */
+int sdl_image_load(scene_image *img, arena *mem, double working_gamma, char *why, size_t whycap);
 
 #endif

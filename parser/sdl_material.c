@@ -287,7 +287,7 @@ static void interior_item(sdl_parser *p, scene_interior *in)
     case KW_IOR: in->ior = sdl_float(p); break;
     case KW_DISPERSION: in->dispersion = sdl_float(p); break;
     case KW_DISPERSION_SAMPLES: sdl_float(p); break;
-    case KW_CAUSTICS: sdl_float(p); in->caustics_set = 1; break;
+    case KW_CAUSTICS: in->caustics = sdl_float(p) * 45.0; in->caustics_set = 1; break;
     case KW_FADE_DISTANCE: in->fade_distance = sdl_float(p); break;
     case KW_FADE_POWER: in->fade_power = sdl_float(p); break;
     case KW_FADE_COLOR: case KW_FADE_COLOUR: in->fade_colour = sdl_rgb(p); break;

@@ -220,7 +220,8 @@ static scene_image *image_spec(sdl_parser *p)
         return NULL;
     }
     char why[512];
-    if (sdl_image_load(img, p->s->mem, why, sizeof why) != 0) {
+    double wg = p->s->global.assumed_gamma > 0.0 ? p->s->global.assumed_gamma : (p->version < 3.65 ? 0.0 : 1.0);
+    if (sdl_image_load(img, p->s->mem, wg, why, sizeof why) != 0) {
         sdl_warning(p, loc, "%s; the image is transparent", why);
         return NULL;
     }

@@ -32,6 +32,7 @@
 #include <string.h>
 #include "pool.h"
 #include "shade_atmos.h"
+#include "shade_gamma.h"
 #include "shade_light.h"
 #include "shade_texture.h"
 #include "timer.h"
@@ -54,6 +55,7 @@ typedef struct {
     framebuffer *fb;
     unsigned char *flag; /* per pixel: needs supersampling */
     int tiles_x, tiles_y;
+    int transparent;     /* some surface lets light through: filtered shadows */
 } render_ctx;
 
 static inline rgb rgb_make(double r, double g, double b) { rgb c = {r, g, b}; return c; }
@@ -91,35 +93,46 @@ static int shadow_blocked(render_ctx *c, int thread, vec3 p, vec3 dir, double de
     return accel_occluded(c->a, p, dir, c->eps, tmax);
 }
 
+/* Light reaching p along a shadow ray: 0 or 1 in scenes without transparent
+ * surfaces, else filtered by the surfaces crossed (shade_texture.c). */
+static rgb shadow_rgb(render_ctx *c, int thread, vec3 p, vec3 dir, double depth)
+{
+    if (!c->transparent) return shadow_blocked(c, thread, p, dir, depth) ? rgb_make(0, 0, 0) : rgb_make(1, 1, 1);
+    c->ts[thread].shadow++;
+    double tmax = depth - fmax(c->eps, depth * 1e-6);
+    if (tmax <= c->eps) return rgb_make(1, 1, 1);
+    return tex_shadow_ray(c->sc, c->a, p, dir, c->eps, tmax);
+}
+
 /* Visibility (0..1) of the rectangle [u1,u2]x[v1,v2] of the grid, adaptively. */
 typedef struct {
     render_ctx *c;
     const scene_light *l;
     vec3 p, ax1, ax2;
-    double *grid; /* size1*size2, <0 = not sampled */
+    rgb *grid; /* size1*size2, r < 0 = not sampled */
     rng *r;
     int thread;
 } area_job;
 
-static double area_sample(area_job *j, int u, int v)
+static rgb area_sample(area_job *j, int u, int v)
 {
-    double *g = &j->grid[u * j->l->size2 + v];
-    if (*g >= 0.0) return *g;
+    rgb *g = &j->grid[u * j->l->size2 + v];
+    if (g->r >= 0.0) return *g;
     vec3 centre = v3_add(j->l->position, light_area_point(j->l, j->ax1, j->ax2, u, v, j->r));
     vec3 dir;
     double depth;
     light_ray(j->l, centre, j->p, &dir, &depth);
-    *g = shadow_blocked(j->c, j->thread, j->p, dir, depth) ? 0.0 : 1.0;
+    *g = shadow_rgb(j->c, j->thread, j->p, dir, depth);
     return *g;
 }
 
-static double area_subset(area_job *j, int u1, int v1, int u2, int v2, int level)
+static rgb area_subset(area_job *j, int u1, int v1, int u2, int v2, int level)
 {
-    double s[4] = {area_sample(j, u1, v1), area_sample(j, u2, v1), area_sample(j, u1, v2), area_sample(j, u2, v2)};
+    rgb s[4] = {area_sample(j, u1, v1), area_sample(j, u2, v1), area_sample(j, u1, v2), area_sample(j, u2, v2)};
     if (u2 - u1 > 1 || v2 - v1 > 1) {
-        /* ColourDistance on grey visibilities: |a-b| summed over 3 channels. */
-        int differ = 3.0 * fabs(s[0] - s[1]) > 0.1 || 3.0 * fabs(s[1] - s[3]) > 0.1 ||
-                     3.0 * fabs(s[3] - s[2]) > 0.1 || 3.0 * fabs(s[2] - s[0]) > 0.1;
+        /* POV-Ray's ColourDistance: |a-b| summed over the 3 channels. */
+        int differ = shade_colour_distance(s[0], s[1]) > 0.1 || shade_colour_distance(s[1], s[3]) > 0.1 ||
+                     shade_colour_distance(s[3], s[2]) > 0.1 || shade_colour_distance(s[2], s[0]) > 0.1;
         if (level < j->l->adaptive || differ) {
             int um0 = (int)floor((u1 + u2) / 2.0), um1 = (int)ceil((u1 + u2) / 2.0);
             int vm0 = (int)floor((v1 + v2) / 2.0), vm1 = (int)ceil((v1 + v2) / 2.0);
@@ -129,19 +142,19 @@ static double area_subset(area_job *j, int u1, int v1, int u2, int v2, int level
             s[3] = area_subset(j, um1, vm1, u2, v2, level + 1);
         }
     }
-    return 0.25 * (s[0] + s[1] + s[2] + s[3]);
+    return rgb_scale(rgb_add(rgb_add(s[0], s[1]), rgb_add(s[2], s[3])), 0.25);
 }
 
-static double area_visibility(render_ctx *c, int thread, const scene_light *l, vec3 p, rng *r)
+static rgb area_visibility(render_ctx *c, int thread, const scene_light *l, vec3 p, rng *r)
 {
-    double stack_grid[256];
+    rgb stack_grid[256];
     int n = l->size1 * l->size2;
-    double *grid = n <= 256 ? stack_grid : malloc(sizeof(double) * (size_t)n);
-    if (!grid) return 1.0;
-    for (int i = 0; i < n; i++) grid[i] = -1.0;
+    rgb *grid = n <= 256 ? stack_grid : malloc(sizeof(rgb) * (size_t)n);
+    if (!grid) return rgb_make(1, 1, 1);
+    for (int i = 0; i < n; i++) grid[i].r = -1.0;
     area_job j = {c, l, p, l->axis1, l->axis2, grid, r, thread};
     light_area_axes(l, p, &j.ax1, &j.ax2);
-    double vis = area_subset(&j, 0, 0, l->size1 - 1, l->size2 - 1, 0);
+    rgb vis = area_subset(&j, 0, 0, l->size1 - 1, l->size2 - 1, 0);
     if (grid != stack_grid) free(grid);
     return vis;
 }
@@ -182,20 +195,23 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
                         if (s->f->diffuse_back != 0.0) back2 = 1;
                         else continue;
                     }
-                    if (!l->shadowless && shadow_blocked(c, thread, p, d2, dep2)) continue;
+                    if (!l->shadowless) {
+                        slc = rgb_mul(slc, shadow_rgb(c, thread, p, d2, dep2));
+                        if (rgb_near_zero(slc)) continue;
+                    }
                     total = rgb_add(total, light_terms(s, d2, slc, back2));
                 }
             }
             continue;
         }
         if (!l->shadowless) {
-            double vis;
+            rgb vis;
             if (l->area && l->size1 * l->size2 > 1)
                 vis = area_visibility(c, thread, l, p, r);
             else
-                vis = shadow_blocked(c, thread, p, dir, depth) ? 0.0 : 1.0;
-            if (vis <= 0.0) continue;
-            lc = rgb_scale(lc, vis);
+                vis = shadow_rgb(c, thread, p, dir, depth);
+            if (rgb_near_zero(vis)) continue;
+            lc = rgb_mul(lc, vis);
         }
         total = rgb_add(total, light_terms(s, dir, lc, backside));
     }
@@ -268,7 +284,7 @@ rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 o
 {
     thread_stats ts[1];
     memset(ts, 0, sizeof ts);
-    render_ctx c = {sc, a, s, scene_eps(a), s->max_trace_level > 0 ? s->max_trace_level : sc->global.max_trace_level, ts, NULL, NULL, 0, 0};
+    render_ctx c = {sc, a, s, scene_eps(a), s->max_trace_level > 0 ? s->max_trace_level : sc->global.max_trace_level, ts, NULL, NULL, 0, 0, 1};
     return trace_ray(&c, 0, org, v3_norm(dir), 1, 1.0, OBJ_NO_IMAGE, r);
 }
 
@@ -427,6 +443,7 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     c.fb = fb;
     c.tiles_x = (s->width + TILE - 1) / TILE;
     c.tiles_y = (s->height + TILE - 1) / TILE;
+    c.transparent = tex_scene_transparent(sc);
     int ntiles = c.tiles_x * c.tiles_y;
 
     pool_run(threads, ntiles, tile_first_pass, &c);
@@ -447,6 +464,7 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
         free(c.flag);
     }
 
+    gamma_fb_to_linear(sc, fb); /* assumed_gamma: working space -> linear (shade_gamma.c) */
     long fixed = fb_sanitize(fb);
     if (st) {
         memset(st, 0, sizeof *st);
@@ -462,23 +480,4 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     }
     free(ts);
     return PT_OK;
-}
-
-/* ------------------------------------------------------ for shade_aov.c */
-
-rgb shade_direct(const scene *sc, const accel *a, const light_surface *s, const accel_hit *h, vec3 p, rng *r)
-{
-    thread_stats ts[1];
-    memset(ts, 0, sizeof ts);
-    shade_settings ss;
-    shade_default_settings(&ss);
-    render_ctx c;
-    memset(&c, 0, sizeof c);
-    c.sc = sc;
-    c.a = a;
-    c.s = &ss;
-    c.eps = scene_eps(a);
-    c.max_level = 1;
-    c.ts = ts;
-    return direct_light(&c, 0, s, h, p, r);
 }

@@ -41,6 +41,8 @@ pattern_ctx pattern_ctx_plain(const scene *sc)
     pattern_ctx c;
     memset(&c, 0, sizeof c);
     int g = sc ? sc->global.noise_generator : 2;
+    /* POV-Ray defaults to the original noise for #version < 3.5 scenes */
+    if (sc && g == 2 && sc->version_major > 0 && sc->version_major + sc->version_minor / 10.0 < 3.45) g = 1;
     c.noise_generator = g >= 1 && g <= 3 ? g : 2;
     return c;
 }

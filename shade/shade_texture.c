@@ -183,11 +183,13 @@ static int refraction(const hit_info *hi, vec3 top, double weight, rgb *colour)
     return 0;
 }
 
-/* Interior fade of a ray segment of length d inside the object. */
-static rgb fade(const scene_interior *in, double d)
+/* Interior fade of a ray segment of length d inside the object (POV-Ray
+ * tests fade_distance only for lit surfaces, fade_power > 0 as well for
+ * shadows: `shadow`). */
+static rgb fade(const scene_interior *in, double d, int shadow)
 {
     rgb one = {1, 1, 1};
-    if (!in || fabs(in->fade_distance) <= TEX_EPSILON || in->fade_power <= 0.0) return one;
+    if (!in || fabs(in->fade_distance) <= TEX_EPSILON || (shadow && in->fade_power <= 0.0)) return one;
     rgb fc = in->fade_colour;
     if (in->fade_power >= 1000) {
         double k = d / in->fade_distance;
@@ -261,7 +263,7 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
         rgb rfr;
         tir = refraction(hi, top, weight * w1, &rfr);
         rgb att = {1, 1, 1};
-        if (!hi->entering) att = fade(hi->interior, hi->h->t);
+        if (!hi->entering) att = fade(hi->interior, hi->h->t, 0);
         if (tir || !one_colour_found) result = tadd(result, tmul(att, rfr));
         else result = tadd(result, tmul(tmul(att, rfr), filcol));
     }
@@ -382,7 +384,8 @@ int tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_hit *h
     return texture_colour(tex, h->p, &pc, out, 0);
 }
 
-static rgb shadow_layers(const scene_texture *tex, vec3 point, const pattern_ctx *pc, int depth)
+static rgb shadow_layers(const scene_texture *tex, vec3 point, const pattern_ctx *pc, int depth, double caustics, vec3 raw,
+                         vec3 dir)
 {
     if (tex->pat && tex->map && tex->map->n > 0 && depth < MAX_PARENTS) {
         const scene_blend_map *m = tex->map;
@@ -390,9 +393,9 @@ static rgb shadow_layers(const scene_texture *tex, vec3 point, const pattern_ctx
         double v = pattern_value(tex->pat, tp, pc);
         int ip, ic;
         blend_map_search(m, v, &ip, &ic);
-        rgb a = m->e[ic].texture ? shadow_layers(m->e[ic].texture, tp, pc, depth + 1) : trgb(0, 0, 0);
+        rgb a = m->e[ic].texture ? shadow_layers(m->e[ic].texture, tp, pc, depth + 1, caustics, raw, dir) : trgb(0, 0, 0);
         if (ip != ic) {
-            rgb b = m->e[ip].texture ? shadow_layers(m->e[ip].texture, tp, pc, depth + 1) : trgb(0, 0, 0);
+            rgb b = m->e[ip].texture ? shadow_layers(m->e[ip].texture, tp, pc, depth + 1, caustics, raw, dir) : trgb(0, 0, 0);
             double f = (v - m->e[ip].value) / (m->e[ic].value - m->e[ip].value);
             a = tadd(tscale(a, f), tscale(b, 1.0 - f));
         }
@@ -403,6 +406,16 @@ static rgb shadow_layers(const scene_texture *tex, vec3 point, const pattern_ctx
         colour5 lc;
         if (pigment_eval(&l->pigment, to_texture_space(l, point), pc, &lc))
             c = tmul(c, trgb(lc.r * lc.f + lc.t, lc.g * lc.f + lc.t, lc.b * lc.f + lc.t));
+        if (caustics != 0.0) {
+            /* POV-Ray's faked caustics: 1 + |n.d|^caustics per layer (layer normal) */
+            vec3 n = raw;
+            if (l->normal && l->normal->pat && l->normal->pat->kind != PAT_PLAIN) {
+                n = normal_perturb(l->normal, n, to_texture_space(l, point),
+                                   xform_is_identity(&l->transform) ? NULL : &l->transform, pc);
+                n = v3_norm(n);
+            }
+            c = tscale(c, 1.0 + pow(fabs(v3_dot(n, dir)), caustics));
+        }
     }
     return c;
 }
@@ -416,8 +429,98 @@ rgb tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir)
     pc.normal = h->ns;
     pc.dir = dir;
     pc.has_hit = 1;
-    rgb c = shadow_layers(tex, h->p, &pc, 0);
     const scene_interior *in = h->obj ? h->obj->interior : NULL;
-    if (!entering) c = tmul(c, fade(in, h->t));
+    vec3 raw = h->ns;
+    if (v3_dot(raw, dir) > 0.0) raw = v3_neg(raw);
+    rgb c = shadow_layers(tex, h->p, &pc, 0, in ? in->caustics : 0.0, raw, dir);
+    if (!entering) c = tmul(c, fade(in, h->t, 1));
+    return c;
+}
+
+/* ------------------------------------------------------------ shadows */
+
+static int pigment_transparent(const scene_pigment *pg, int depth);
+
+static int map_transparent(const scene_blend_map *m, int depth)
+{
+    if (!m || depth > MAX_PARENTS) return 0;
+    for (int i = 0; i < m->n; i++) {
+        const scene_map_entry *e = &m->e[i];
+        if (m->kind == MAP_COLOUR && (e->c[3] != 0.0 || e->c[4] != 0.0)) return 1;
+        if (m->kind == MAP_PIGMENT && e->pigment && pigment_transparent(e->pigment, depth + 1)) return 1;
+        if (m->kind == MAP_TEXTURE && e->texture && tex_transparent(e->texture)) return 1;
+    }
+    return 0;
+}
+
+static int pigment_transparent(const scene_pigment *pg, int depth)
+{
+    if (pg->colour.f != 0.0 || pg->colour.t != 0.0) return 1;
+    if (pg->kind != PIGMENT_PATTERN || !pg->pat) return 0;
+    const scene_pattern *pat = pg->pat;
+    if (pat->kind == PAT_IMAGE && !pg->map) {
+        const scene_image_map *im = &pat->image;
+        return im->once || im->filter_all_set || im->transmit_all_set || !im->image || im->image->has_alpha;
+    }
+    return map_transparent(pg->map, depth);
+}
+
+int tex_transparent(const scene_texture *t)
+{
+    for (; t; t = t->next) {
+        if (t->pat && t->map) {
+            if (map_transparent(t->map, 0)) return 1;
+        } else if (pigment_transparent(&t->pigment, 0)) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+static int object_transparent(const scene_object *o, int depth)
+{
+    if (depth > 64) return 1;
+    if (o->texture && tex_transparent(o->texture)) return 1;
+    if (o->interior_texture && tex_transparent(o->interior_texture)) return 1;
+    switch (o->kind) {
+    case SHAPE_UNION: case SHAPE_MERGE: case SHAPE_INTERSECTION: case SHAPE_DIFFERENCE:
+        for (int i = 0; i < o->u.csg.nkids; i++)
+            if (object_transparent(o->u.csg.kids[i], depth + 1)) return 1;
+        return 0;
+    case SHAPE_MESH:
+        if (o->u.mesh.mesh)
+            for (int i = 0; i < o->u.mesh.mesh->ntextures; i++)
+                if (o->u.mesh.mesh->textures[i] && tex_transparent(o->u.mesh.mesh->textures[i])) return 1;
+        return 0;
+    default:
+        return 0;
+    }
+}
+
+int tex_scene_transparent(const scene *sc)
+{
+    if (tex_transparent(&sc->default_texture)) return 1;
+    for (int i = 0; i < sc->nobjects; i++)
+        if (object_transparent(sc->objects[i], 0)) return 1;
+    return 0;
+}
+
+rgb tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, double tmin, double tmax)
+{
+    rgb c = {1, 1, 1};
+    accel_hit h;
+    double t0 = tmin;
+    for (int k = 0; k < 256 && t0 < tmax; k++) {
+        if (!accel_intersect(a, p, dir, t0, tmax, &h)) return c;
+        double next = h.t + fmax(tmin, h.t * 1e-7);
+        if (!(h.flags & OBJ_NO_SHADOW)) {
+            /* distance inside the object: from the previous crossing */
+            accel_hit hh = h;
+            hh.t = h.t - (t0 > tmin ? t0 - fmax(tmin, t0 * 1e-7) : 0.0);
+            c = tmul(c, tex_shadow_filter(sc, &hh, dir));
+            if (fabs(c.r) < TEX_EPSILON && fabs(c.g) < TEX_EPSILON && fabs(c.b) < TEX_EPSILON) return trgb(0, 0, 0);
+        }
+        t0 = next;
+    }
     return c;
 }

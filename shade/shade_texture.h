@@ -47,8 +47,22 @@ rgb tex_shade(const tex_env *e, const accel_hit *h, vec3 dir, int level, double 
 int tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_hit *h, colour5 *out);
 
 /* Filter colour of a surface for a shadow ray crossing it at h (POV-Ray's
- * ComputeShadowTexture: rgb*filter + transmit of the layers, multiplied;
- * 0 for opaque surfaces). */
+ * ComputeShadowTexture: rgb*filter + transmit of the layers, multiplied,
+ * with the interior's faked caustics and fade; 0 for opaque surfaces).
+ * h->t is taken as the distance travelled inside the object when the ray
+ * leaves it. */
 rgb tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir);
+
+/* Light left along a shadow ray from p (unit dir) over (tmin, tmax): 0 when
+ * an opaque surface blocks it, else the product of the filter colours of the
+ * (transparent) surfaces crossed; no_shadow objects are ignored (POV-Ray's
+ * TracePointLightShadowRay). */
+rgb tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, double tmin, double tmax);
+
+/* Can any surface of the scene let light through (filter/transmit anywhere
+ * in its textures, image maps with alpha or `once`)? When not, shadows are
+ * plain occlusion tests. */
+int tex_scene_transparent(const scene *sc);
+int tex_transparent(const scene_texture *t);
 
 #endif

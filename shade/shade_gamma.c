@@ -1,0 +1,31 @@
+/* shade_gamma.c - working gamma (see shade_gamma.h). POV-Ray 3.7 (parse.cpp,
+ * imageprocessing.cpp): with assumed_gamma G an output pixel is the file's
+ * encoding of decode_G(v) = v^G; a pre-3.7 scene without assumed_gamma runs
+ * with gamma handling off (values written as computed). */
+#include "shade_gamma.h"
+#include <math.h>
+
+double gamma_working(const scene *sc)
+{
+    if (sc->global.assumed_gamma > 0.0) return sc->global.assumed_gamma;
+    double v = sc->version_major > 0 ? sc->version_major + sc->version_minor / 10.0 : 3.7;
+    return v < 3.65 ? 0.0 : 1.0;
+}
+
+static float srgb_decode(float v)
+{
+    if (v <= 0.0f) return v;
+    return v <= 0.04045f ? v / 12.92f : (float)pow((v + 0.055) / 1.055, 2.4);
+}
+
+void gamma_fb_to_linear(const scene *sc, framebuffer *fb)
+{
+    double g = gamma_working(sc);
+    if (g == 1.0) return;
+    size_t n = (size_t)fb->width * fb->height * 3;
+    for (size_t i = 0; i < n; i++) {
+        float v = fb->rgb[i];
+        if (!isfinite(v)) continue;
+        fb->rgb[i] = g == 0.0 ? srgb_decode(v) : (v > 0.0f ? (float)pow(v, g) : v);
+    }
+}

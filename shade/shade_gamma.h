@@ -1,0 +1,20 @@
+/* shade_gamma.h - POV-Ray 3.7's working gamma (assumed_gamma): colours in
+ * the scene and the arithmetic of shading live in the working space; output
+ * files decode it to linear before encoding for the file. */
+#ifndef PT_SHADE_GAMMA_H
+#define PT_SHADE_GAMMA_H
+#include "framebuffer.h"
+#include "scene.h"
+
+/* assumed_gamma when given; 1 for #version 3.7 scenes without it; 0 for
+ * older scenes without it (POV-Ray then turns gamma handling off: computed
+ * values are written to the file as they are). */
+double gamma_working(const scene *sc);
+
+/* Convert a rendered framebuffer from the working space to linear values
+ * (v^gamma; for gamma handling off, the sRGB decoding, so that the usual
+ * sRGB encoding of a PNG writes the computed values unchanged). No-op for
+ * gamma 1. */
+void gamma_fb_to_linear(const scene *sc, framebuffer *fb);
+
+#endif
