@@ -481,3 +481,22 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     free(ts);
     return PT_OK;
 }
+
+/* ------------------------------------------------------ for shade_aov.c */
+
+rgb shade_direct(const scene *sc, const accel *a, const light_surface *s, const accel_hit *h, vec3 p, rng *r)
+{
+    thread_stats ts[1];
+    memset(ts, 0, sizeof ts);
+    shade_settings ss;
+    shade_default_settings(&ss);
+    render_ctx c;
+    memset(&c, 0, sizeof c);
+    c.sc = sc;
+    c.a = a;
+    c.s = &ss;
+    c.eps = scene_eps(a);
+    c.max_level = 1;
+    c.ts = ts;
+    return direct_light(&c, 0, s, h, p, r);
+}
