@@ -280,7 +280,8 @@ typedef struct {
 /* ---------------------------------------------------------------- camera */
 typedef enum {
     CAMERA_PERSPECTIVE, CAMERA_ORTHOGRAPHIC, CAMERA_FISHEYE, CAMERA_ULTRA_WIDE_ANGLE,
-    CAMERA_OMNIMAX, CAMERA_PANORAMIC, CAMERA_CYLINDER, CAMERA_SPHERICAL
+    CAMERA_OMNIMAX, CAMERA_PANORAMIC, CAMERA_CYLINDER, CAMERA_SPHERICAL,
+    CAMERA_MESH /* appended (issue 3): mesh_camera, parsed into the fields below */
 } camera_kind;
 
 typedef struct {
@@ -298,6 +299,15 @@ typedef struct {
     /* Appended (issue 5, core/camera.h). */
     double v_angle;         /* spherical camera: vertical field of view in degrees, 0 = angle/2 */
     double focal_distance;  /* focal blur: distance to the focal plane; 0 = |direction| */
+    /* Appended (issue 3): mesh_camera { rays_per_pixel, distribution [, max_distance]
+     * mesh { } ... [smooth] } (POV-Ray 3.7); meshes are SHAPE_MESH objects with
+     * their transforms. location/direction then hold the mesh camera's offsets. */
+    int mesh_rays_per_pixel;
+    int mesh_distribution;  /* 0..3 */
+    double mesh_max_distance; /* 0 = none */
+    int mesh_smooth;
+    int nmeshes;
+    const struct scene_object *const *meshes;
 } scene_camera;
 
 /* ---------------------------------------------------------------- global settings */

@@ -24,6 +24,9 @@ typedef struct {
                                      built included (default: half the physical memory) */
     long max_string_length;       /* bytes in one string value (default 1 MiB) */
     long long max_array_elements; /* elements in one array (default 10^8) */
+    const char *write_dir;        /* NULL: #fopen ... write/append writes beside the scene
+                                     (scene or working directory only); else every
+                                     written file goes into this directory */
 } sdl_options;
 
 void sdl_default_options(sdl_options *o);

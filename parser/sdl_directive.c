@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include "sdl_array.h"
 #include "sdl_expr.h"
+#include "sdl_file.h"
 #include "sdl_function.h"
 #include "sdl_material.h"
 #include "sdl_object.h"
@@ -834,7 +835,9 @@ static void version_directive(sdl_parser *p)
     }
 }
 
-/* message_directive := ('#debug' | '#warning' | '#error') string */
+/* message_directive := ('#debug' | '#warning' | '#error' | '#render' | '#statistics') string
+ * (#render and #statistics go to POV-Ray's render and statistics streams:
+ * notes here, like #debug) */
 static void message_directive(sdl_parser *p, sdl_kw kw, src_loc loc)
 {
     const char *msg = sdl_string(p);
@@ -1030,9 +1033,11 @@ static void directive_body(sdl_parser *p, const sdl_token *hash)
     case KW_DEBUG: case KW_WARNING: case KW_ERROR: message_directive(p, k.kw, loc); break;
     case KW_MACRO: macro_directive(p, loc); break;
     case KW_DEFAULT: sdl_parse_default(p); break;
-    case KW_FOPEN: case KW_FCLOSE: case KW_READ: case KW_WRITE:
-        sdl_error(p, loc, PT_ERR_UNSUPPORTED, "#%s is not supported yet", sdl_kw_text(k.kw));
-        break;
+    case KW_FOPEN: sdl_fopen_directive(p, loc); break;
+    case KW_FCLOSE: sdl_fclose_directive(p, loc); break;
+    case KW_READ: sdl_read_directive(p, loc); break;
+    case KW_WRITE: sdl_write_directive(p, loc); break;
+    case KW_RENDER: case KW_STATISTICS: message_directive(p, k.kw, loc); break;
     default:
         sdl_error(p, k.loc, PT_ERR_SYNTAX, "unknown directive #%s", sdl_kw_text(k.kw));
         break;

@@ -7,6 +7,7 @@
 #include <unistd.h>
 #include "sdl_directive.h"
 #include "sdl_expr.h"
+#include "sdl_file.h"
 #include "sdl_geom.h"
 #include "sdl_scene.h"
 
@@ -351,6 +352,7 @@ static pt_status run(const char *name, const char *text, const sdl_options *opt,
     }
     sdl_close_inputs(&p);
     sdl_geom_free(&p);
+    sdl_files_close(&p);
     sdl_symtab_free(p.sym);
     free(p.blocks);
     if (p.status != PT_OK) {

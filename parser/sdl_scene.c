@@ -17,8 +17,58 @@ typedef struct {
     xform trans;
 } camera_said;
 
+/* mesh_camera := 'mesh_camera' '{' rays_per_pixel [','] distribution [ [','] max_distance ]
+ *   ( mesh | mesh2 ) { mesh | mesh2 } [ 'smooth' ] '}'   (POV-Ray 3.7's checks) */
+static void mesh_camera(sdl_parser *p, scene_camera *c, src_loc loc)
+{
+    if (!sdl_begin_block(p, "mesh_camera")) return;
+    src_loc at = sdl_peek(p)->tk.loc;
+    c->kind = CAMERA_MESH;
+    c->mesh_rays_per_pixel = sdl_to_int(sdl_float(p));
+    if (sdl_ok(p) && c->mesh_rays_per_pixel <= 0) sdl_error(p, at, PT_ERR_SYNTAX, "mesh_camera rays per pixel must be at least 1");
+    sdl_accept(p, TOK_COMMA);
+    at = sdl_peek(p)->tk.loc;
+    c->mesh_distribution = sdl_to_int(sdl_float(p));
+    if (sdl_ok(p) && (c->mesh_distribution < 0 || c->mesh_distribution > 3))
+        sdl_error(p, at, PT_ERR_SYNTAX, "unknown mesh_camera distribution %d (0 to 3)", c->mesh_distribution);
+    if (sdl_ok(p) && c->mesh_distribution >= 2 && c->mesh_rays_per_pixel != 1)
+        sdl_error(p, at, PT_ERR_SYNTAX, "mesh_camera distribution %d needs 1 ray per pixel", c->mesh_distribution);
+    sdl_accept(p, TOK_COMMA);
+    c->mesh_max_distance = sdl_allow_float(p, 0.0);
+    const scene_object *meshes[256];
+    int n = 0;
+    while (sdl_ok(p) && (sdl_is_kw(sdl_peek(p), KW_MESH) || sdl_is_kw(sdl_peek(p), KW_MESH2))) {
+        src_loc ml = sdl_peek(p)->tk.loc;
+        sdl_obj *o = sdl_parse_object(p);
+        if (!o || !o->obj) break;
+        if (n == 256) {
+            sdl_error(p, ml, PT_ERR_LIMIT, "mesh_camera has more than 256 meshes");
+            break;
+        }
+        meshes[n++] = o->obj;
+    }
+    c->mesh_smooth = sdl_accept_kw(p, KW_SMOOTH);
+    if (sdl_ok(p) && c->mesh_smooth && c->mesh_distribution != 3)
+        sdl_error(p, p->last_loc, PT_ERR_SYNTAX, "smooth needs mesh_camera distribution 3");
+    if (sdl_ok(p) && n == 0) {
+        sdl_tok t = sdl_next(p);
+        sdl_unexpected(p, &t, "mesh or mesh2 in mesh_camera");
+        return;
+    }
+    sdl_end_block(p);
+    if (sdl_ok(p) && c->mesh_distribution == 0 && c->mesh_rays_per_pixel > n)
+        sdl_error(p, loc, PT_ERR_SYNTAX, "mesh_camera distribution 0 needs at least as many meshes (%d) as rays per pixel (%d)", n,
+                  c->mesh_rays_per_pixel);
+    const scene_object **m = sdl_alloc(p, sizeof *m * (size_t)(n ? n : 1));
+    if (!m) return;
+    memcpy(m, meshes, sizeof *m * (size_t)n);
+    c->meshes = m;
+    c->nmeshes = n;
+    sdl_warn_once(p, loc, "mesh_camera is parsed but the renderer does not support it yet");
+}
+
 /* camera_type := perspective | orthographic | fisheye | ultra_wide_angle |
- *   omnimax | panoramic | spherical | cylinder N ; returns 0 if none */
+ *   omnimax | panoramic | spherical | cylinder N | mesh_camera ; returns 0 if none */
 static int camera_type(sdl_parser *p, scene_camera *c)
 {
     const sdl_tok *t = sdl_peek(p);
@@ -39,9 +89,12 @@ static int camera_type(sdl_parser *p, scene_camera *c)
         c->cylinder_type = n;
         return 1;
     }
-    case KW_MESH_CAMERA:
-        sdl_error(p, t->tk.loc, PT_ERR_UNSUPPORTED, "mesh_camera is not supported yet");
-        return 0;
+    case KW_MESH_CAMERA: {
+        sdl_tok k = sdl_next(p);
+        if (p->version < 3.5) sdl_error(p, k.tk.loc, PT_ERR_SYNTAX, "mesh_camera needs #version 3.5 or later");
+        else mesh_camera(p, c, k.tk.loc);
+        return 1;
+    }
     default: return 0;
     }
     sdl_next(p);
