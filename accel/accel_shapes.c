@@ -14,6 +14,7 @@
 #include <float.h>
 #include <math.h>
 #include <string.h>
+#include "accel_fractal.h"
 #include "accel_hfield.h"
 #include "accel_implicit.h"
 #include "accel_sweep.h"
@@ -276,6 +277,9 @@ int accel_shape_init(accel_shape *sh, const scene_object *o)
     case SHAPE_HEIGHT_FIELD:
         if (accel_hfield_init(sh, o, &lo, &hi) != 0) return -1;
         break;
+    case SHAPE_JULIA:
+        if (accel_fractal_init(sh, o, &lo, &hi) != 0) return -1;
+        break;
     default:
         return -1;
     }
@@ -302,6 +306,9 @@ void accel_shape_release(accel_shape *sh)
     case SHAPE_HEIGHT_FIELD:
         accel_hfield_free(sh->data);
         break;
+    case SHAPE_JULIA:
+        accel_fractal_free(sh->data);
+        break;
     default:
         break;
     }
@@ -312,7 +319,7 @@ int accel_shape_solid_bounded(const accel_shape *sh)
 {
     switch (sh->kind) {
     case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_TORUS:
-    case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
+    case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT: case SHAPE_JULIA:
         return 1;
     case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
         return !sh->infinite && accel_implicit_solid_bounded(sh);
@@ -616,6 +623,9 @@ int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, dou
     case SHAPE_HEIGHT_FIELD:
         n = accel_hfield_hits(sh, o, d, a, b, out, max);
         break;
+    case SHAPE_JULIA:
+        n = accel_fractal_hits(sh, o, d, a, b, out, max);
+        break;
     default:
         return 0;
     }
@@ -665,6 +675,8 @@ int accel_shape_inside(const accel_shape *sh, vec3 p)
         return accel_implicit_inside(sh, q);
     case SHAPE_HEIGHT_FIELD:
         return accel_hfield_inside(sh, q);
+    case SHAPE_JULIA:
+        return accel_fractal_inside(sh, q);
     default:
         return 0; /* triangles and polygons have no inside */
     }
@@ -797,6 +809,9 @@ void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, doub
         break;
     case SHAPE_HEIGHT_FIELD:
         accel_hfield_surface(sh, po, part, &n, &su, &sv);
+        break;
+    case SHAPE_JULIA:
+        n = accel_fractal_normal(sh, po);
         break;
     default:
         break;

@@ -133,7 +133,8 @@ typedef enum {
     SHAPE_BLOB,           /* u.blob */
     SHAPE_HEIGHT_FIELD,   /* u.height_field */
     SHAPE_TEXT,           /* u.text: glyph outlines extruded along z */
-    SHAPE_ISOSURFACE      /* u.isosurface */
+    SHAPE_ISOSURFACE,     /* u.isosurface */
+    SHAPE_JULIA           /* u.julia: julia_fractal */
 } shape_kind;
 
 enum {
@@ -213,6 +214,26 @@ typedef struct {
     int max_trace;         /* crossings wanted per ray, 0 = all_intersections (default 1) */
 } scene_isosurface;
 
+/* julia_fractal: the points p whose 4-D iterates z -> f(z) + c stay within
+ * the bailout for max_iteration steps, z0 = p on the slice plane
+ * slice . (x, y, z, w) = slice_dist (slice normalised). Quaternions support
+ * sqr and cube; hypercomplex numbers any of the functions. */
+typedef enum {
+    JULIA_SQR, JULIA_CUBE, JULIA_EXP, JULIA_LN, JULIA_SIN, JULIA_ASIN, JULIA_COS, JULIA_ACOS, JULIA_TAN,
+    JULIA_ATAN, JULIA_SINH, JULIA_ASINH, JULIA_COSH, JULIA_ACOSH, JULIA_TANH, JULIA_ATANH, JULIA_RECIPROCAL,
+    JULIA_PWR
+} scene_julia_func;
+typedef struct {
+    double c[4];
+    int hypercomplex;
+    scene_julia_func func;
+    double pwr[2];          /* pwr(x, y): exponent x + i y */
+    int max_iteration;      /* default 20 */
+    double precision;       /* default 20: the march's smallest step is 1 / precision */
+    double slice[4];        /* default <0,0,0,1> */
+    double slice_dist;      /* default 0 */
+} scene_julia;
+
 typedef struct scene_object scene_object;
 struct scene_object {
     shape_kind kind;
@@ -244,6 +265,7 @@ struct scene_object {
         const scene_height_field *height_field;
         const scene_text *text;
         const scene_isosurface *isosurface;
+        const scene_julia *julia;
     } u;
     /* clipped_by (issue 4): the clipping solid, its transform relative to
      * this object's space (world = clip->transform then this->transform), so

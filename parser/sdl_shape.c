@@ -28,7 +28,7 @@ int sdl_shape_handles(sdl_kw k)
     case KW_POLYGON: case KW_LATHE: case KW_SOR: case KW_PRISM: case KW_SUPERELLIPSOID:
     case KW_QUADRIC: case KW_POLY: case KW_CUBIC: case KW_QUARTIC: case KW_POLYNOMIAL:
     case KW_BLOB: case KW_HEIGHT_FIELD: case KW_TEXT: case KW_SPHERE_SWEEP: case KW_BICUBIC_PATCH:
-    case KW_ISOSURFACE: case KW_PARAMETRIC:
+    case KW_ISOSURFACE: case KW_PARAMETRIC: case KW_JULIA_FRACTAL:
         return 1;
     default:
         return 0;
@@ -1147,6 +1147,92 @@ static void parametric_args(sdl_parser *p, sdl_obj *so, src_loc loc)
     o->u.mesh.mesh = m;
 }
 
+/* ------------------------------------------------------------ julia_fractal */
+
+static int julia_func_kw(sdl_kw k, scene_julia_func *f)
+{
+    static const struct { sdl_kw k; scene_julia_func f; } map[] = {
+        {KW_SQR, JULIA_SQR}, {KW_CUBE, JULIA_CUBE}, {KW_EXP, JULIA_EXP}, {KW_LN, JULIA_LN},
+        {KW_SIN, JULIA_SIN}, {KW_ASIN, JULIA_ASIN}, {KW_COS, JULIA_COS}, {KW_ACOS, JULIA_ACOS},
+        {KW_TAN, JULIA_TAN}, {KW_ATAN, JULIA_ATAN}, {KW_SINH, JULIA_SINH}, {KW_ASINH, JULIA_ASINH},
+        {KW_COSH, JULIA_COSH}, {KW_ACOSH, JULIA_ACOSH}, {KW_TANH, JULIA_TANH}, {KW_ATANH, JULIA_ATANH},
+        {KW_RECIPROCAL, JULIA_RECIPROCAL},
+    };
+    for (size_t i = 0; i < sizeof map / sizeof map[0]; i++)
+        if (map[i].k == k) {
+            *f = map[i].f;
+            return 1;
+        }
+    return 0;
+}
+
+/* julia_fractal := vector4 { quaternion | hypercomplex | function_kw |
+ *   pwr '(' f ',' f ')' | max_iteration n | precision f | slice vector4 ',' f }
+ * (POV-Ray 3.7 defaults: quaternion, sqr, max_iteration 20, precision 20,
+ * slice <0,0,0,1>, 0; max_iteration >= 1, precision >= 1) */
+static void julia_args(sdl_parser *p, scene_object *o, src_loc loc)
+{
+    scene_julia *j = sdl_alloc(p, sizeof *j);
+    if (!j) return;
+    sdl_vector_n(p, j->c, 4);
+    j->func = JULIA_SQR;
+    j->max_iteration = 20;
+    j->precision = 20.0;
+    j->slice[3] = 1.0;
+    while (sdl_ok(p)) {
+        const sdl_tok *t = sdl_peek(p);
+        if (t->tk.kind != TOK_KEYWORD) break;
+        sdl_kw k = t->tk.kw;
+        src_loc at = t->tk.loc;
+        scene_julia_func f;
+        if (k == KW_QUATERNION) { sdl_next(p); j->hypercomplex = 0; }
+        else if (k == KW_HYPERCOMPLEX) { sdl_next(p); j->hypercomplex = 1; }
+        else if (julia_func_kw(k, &f)) { sdl_next(p); j->func = f; }
+        else if (k == KW_PWR) {
+            sdl_next(p);
+            sdl_expect(p, TOK_LPAREN, "'(' after pwr");
+            j->pwr[0] = sdl_float(p);
+            sdl_accept(p, TOK_COMMA);
+            j->pwr[1] = sdl_float(p);
+            sdl_expect(p, TOK_RPAREN, "')'");
+            j->func = JULIA_PWR;
+        } else if (k == KW_MAX_ITERATION) {
+            sdl_next(p);
+            double n = floor(sdl_float(p));
+            j->max_iteration = n < 1 ? 1 : (n > 10000 ? 10000 : (int)n);
+        } else if (k == KW_PRECISION) {
+            sdl_next(p);
+            double pr = sdl_float(p);
+            j->precision = pr < 1.0 ? 1.0 : pr;
+        } else if (k == KW_SLICE) {
+            sdl_next(p);
+            sdl_vector_n(p, j->slice, 4);
+            sdl_accept(p, TOK_COMMA);
+            j->slice_dist = sdl_float(p);
+            double l = sqrt(j->slice[0] * j->slice[0] + j->slice[1] * j->slice[1] + j->slice[2] * j->slice[2] +
+                            j->slice[3] * j->slice[3]);
+            if (sdl_ok(p) && !(l > SDL_SHAPE_EPSILON)) {
+                sdl_error(p, at, PT_ERR_SYNTAX, "slice vector is zero");
+                return;
+            }
+            for (int i = 0; i < 4; i++) j->slice[i] /= l;
+            if (sdl_ok(p) && fabs(j->slice[3]) < SDL_SHAPE_EPSILON) {
+                sdl_error(p, at, PT_ERR_SYNTAX, "slice t component is zero");
+                return;
+            }
+        } else {
+            break;
+        }
+    }
+    if (!sdl_ok(p)) return;
+    if (!j->hypercomplex && j->func != JULIA_SQR && j->func != JULIA_CUBE) {
+        sdl_error(p, loc, PT_ERR_SYNTAX, "quaternion julia_fractal supports only sqr and cube");
+        return;
+    }
+    o->kind = SHAPE_JULIA;
+    o->u.julia = j;
+}
+
 /* ------------------------------------------------------------ dispatch */
 
 void sdl_shape_args(sdl_parser *p, sdl_kw k, sdl_obj *so, src_loc loc)
@@ -1170,6 +1256,7 @@ void sdl_shape_args(sdl_parser *p, sdl_kw k, sdl_obj *so, src_loc loc)
     case KW_BICUBIC_PATCH: bicubic_args(p, so, loc); break;
     case KW_ISOSURFACE: isosurface_args(p, o, loc); break;
     case KW_PARAMETRIC: parametric_args(p, so, loc); break;
+    case KW_JULIA_FRACTAL: julia_args(p, o, loc); break;
     default: break;
     }
     /* anything that did not produce a shape stays reported as unsupported */

@@ -449,8 +449,8 @@ static void test_shapes(void **st)
                         "disc { <1,2,3>, z, 2, 1 }\n"
                         "torus { 2, 0.5 sturm }\n"
                         "smooth_triangle { 0, y, x, y, z, y }\n"
-                        "julia_fractal { <0,0,0,0> }\n"
-                        "julia_fractal { <0,0,0,0> }\n");
+                        "ovus { 1, 0.5 }\n"
+                        "ovus { 1, 0.5 }\n");
     assert_int_equal(s->nobjects, 9);
     const scene_object *const *o = (const scene_object *const *)s->objects;
     assert_vec(o[0]->u.plane.normal, v3(0, 1, 0), 0);
@@ -470,11 +470,11 @@ static void test_shapes(void **st)
     assert_int_equal(o[6]->kind, SHAPE_SMOOTH_TRIANGLE);
     assert_vec(o[6]->u.triangle.n[2], v3(0, 1, 0), 0);
     assert_int_equal(o[7]->kind, SHAPE_UNSUPPORTED);
-    assert_string_equal(o[7]->name, "julia_fractal");
+    assert_string_equal(o[7]->name, "ovus");
     scene_free(s);
 
     diag *d = diag_new();
-    assert_int_equal(sdl_parse_string("w.pov", "julia_fractal { <0,0,0,0> } julia_fractal { <0,0,0,0> }", NULL, &s, d), PT_OK);
+    assert_int_equal(sdl_parse_string("w.pov", "ovus { 1, 0.5 } ovus { 1, 0.5 }", NULL, &s, d), PT_OK);
     assert_int_equal(diag_count(d), 1); /* one warning per kind */
     assert_int_equal(diag_get(d, 0)->severity, DIAG_WARNING);
     scene_free(s);

@@ -781,6 +781,37 @@ static void test_parametric(void **st)
     done(&w);
 }
 
+/* julia_fractal with c = 0: z -> z^2 keeps |z| <= 1, so the set is (to
+ * ~1e-6 at 20 iterations) the unit ball for quaternions; for hypercomplex
+ * numbers (two complex squares) the points with x^2 + (y +- z)^2 <= 1 */
+static void test_julia(void **st)
+{
+    (void)st;
+    world w = build("julia_fractal { <0,0,0,0> quaternion sqr max_iteration 20 precision 50 }");
+    assert_int_equal(w.s->objects[0]->kind, SHAPE_JULIA);
+    for (int i = 0; i < 5; i++) {
+        double y = 0.15 * i, x = sqrt(1 - y * y);
+        expect_hit(&w, v3(-5, y, 0.1), v3(1, 0, 0), 5 - sqrt(x * x - 0.01), v3(-sqrt(x * x - 0.01), y, 0.1), 1e-5, 1e-3);
+    }
+    expect_miss(&w, v3(-5, 1.01, 0), v3(1, 0, 0));
+    accel_shape sh = shape_of(&w);
+    assert_true(accel_shape_inside(&sh, v3(0.3, 0.4, 0.5)));
+    assert_false(accel_shape_inside(&sh, v3(0.7, 0.6, 0.5)));
+    accel_shape_release(&sh);
+    done(&w);
+    w = build("julia_fractal { <0,0,0,0> hypercomplex sqr }");
+    expect_hit(&w, v3(-5, 0, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-5, 1e-3);
+    /* at y = 0.5 along x: x^2 + 0.25 = 1 */
+    expect_hit(&w, v3(-5, 0.5, 0), v3(1, 0, 0), 5 - sqrt(0.75), v3(-sqrt(0.75), 0.5, 0), 1e-5, 1e-3);
+    done(&w);
+    /* the distribution's cube quaternion parses and renders something */
+    w = build("julia_fractal { <-.54,.57,0,-.37> quaternion cube max_iteration 8 precision 20 }");
+    accel_hit h;
+    assert_true(hit(&w, v3(-5, 0, 0), v3(1, 0, 0), &h));
+    assert_true(h.t > 3.0 && h.t < 5.0);
+    done(&w);
+}
+
 /* GI sampling: polygons and height fields are sampled uniformly by area */
 static void test_surface_sampling(void **st)
 {
@@ -837,7 +868,7 @@ static void test_surface_sampling(void **st)
 static void test_unsupported(void **st)
 {
     (void)st;
-    world w = build("julia_fractal { <0,0,0,0> } julia_fractal { <0,0,0,0> } sphere { 0, 1 }");
+    world w = build("ovus { 1, 0.5 } ovus { 1, 0.5 } sphere { 0, 1 }");
     assert_int_equal(w.s->objects[0]->kind, SHAPE_UNSUPPORTED);
     accel_stats s = accel_get_stats(w.a);
     assert_int_equal(s.unsupported, 2);
@@ -869,6 +900,7 @@ int main(void)
         cmocka_unit_test(test_clipped_by),
         cmocka_unit_test(test_isosurface),
         cmocka_unit_test(test_parametric),
+        cmocka_unit_test(test_julia),
         cmocka_unit_test(test_surface_sampling),
         cmocka_unit_test(test_unsupported),
     };

@@ -1,0 +1,316 @@
+/* accel_fractal.c - julia_fractal (accel_fractal.h).
+ *
+ * Hypercomplex numbers x + y i + z j + w k (POV-Ray's commutative algebra:
+ * its square is (x2 + w2 - y2 - z2, 2(xy - zw), 2(xz - wy), 2(xw + yz)))
+ * are handled as the pair of complex numbers a = (x - w) + i (y + z),
+ * b = (x + w) + i (y - z): products act on a and b separately, so
+ * f(x + y i + z j + w k) is (f(a), f(b)) for any analytic f. */
+#include "accel_fractal.h"
+#include <complex.h>
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    double c[4];
+    int hyper;
+    scene_julia_func func;
+    double complex pwr;
+    int n;                /* max_iteration */
+    double step;          /* 1 / precision */
+    double slice[4], sdist;
+    double R, exit;       /* bounding radius, bailout on |z|^2 */
+    double complex ca, cb; /* c as the complex pair (hypercomplex) */
+} jf_data;
+
+static int put_hit(accel_shape_hit *out, int n, int max, double t, int part)
+{
+    if (max <= 0) return 0;
+    if (n == max && !(t < out[n - 1].t)) return n;
+    int i = n < max ? n++ : n - 1;
+    while (i > 0 && out[i - 1].t > t) {
+        out[i] = out[i - 1];
+        i--;
+    }
+    out[i].t = t;
+    out[i].part = part;
+    return n;
+}
+
+/* The slice: z0 = (x, y, z, w(x, y, z)). */
+static void lift(const jf_data *f, vec3 p, double q[4])
+{
+    q[0] = p.x;
+    q[1] = p.y;
+    q[2] = p.z;
+    q[3] = (f->sdist - f->slice[0] * p.x - f->slice[1] * p.y - f->slice[2] * p.z) / f->slice[3];
+}
+
+static void qmul(const double a[4], const double b[4], double r[4])
+{
+    double t[4];
+    t[0] = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3];
+    t[1] = a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2];
+    t[2] = a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1];
+    t[3] = a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0];
+    memcpy(r, t, sizeof t);
+}
+
+static void to_pair(const double q[4], double complex *a, double complex *b)
+{
+    *a = CMPLX(q[0] - q[3], q[1] + q[2]);
+    *b = CMPLX(q[0] + q[3], q[1] - q[2]);
+}
+
+/* Plain complex product (C's `*` goes through the Annex G inf/nan
+ * handling, several times slower). */
+static inline double complex cmul(double complex a, double complex b)
+{
+    double ar = creal(a), ai = cimag(a), br = creal(b), bi = cimag(b);
+    return CMPLX(ar * br - ai * bi, ar * bi + ai * br);
+}
+
+static double complex cfun(const jf_data *f, double complex z)
+{
+    switch (f->func) {
+    case JULIA_SQR: return cmul(z, z);
+    case JULIA_CUBE: return cmul(cmul(z, z), z);
+    case JULIA_EXP: return cexp(z);
+    case JULIA_LN: return clog(z);
+    case JULIA_SIN: return csin(z);
+    case JULIA_ASIN: return casin(z);
+    case JULIA_COS: return ccos(z);
+    case JULIA_ACOS: return cacos(z);
+    case JULIA_TAN: return ctan(z);
+    case JULIA_ATAN: return catan(z);
+    case JULIA_SINH: return csinh(z);
+    case JULIA_ASINH: return casinh(z);
+    case JULIA_COSH: return ccosh(z);
+    case JULIA_ACOSH: return cacosh(z);
+    case JULIA_TANH: return ctanh(z);
+    case JULIA_ATANH: return catanh(z);
+    case JULIA_RECIPROCAL: return 1.0 / z;
+    default: return cpow(z, f->pwr);
+    }
+}
+
+static double complex cderiv(const jf_data *f, double complex z)
+{
+    switch (f->func) {
+    case JULIA_SQR: return 2.0 * z;
+    case JULIA_CUBE: return 3.0 * cmul(z, z);
+    case JULIA_EXP: return cexp(z);
+    case JULIA_LN: return 1.0 / z;
+    case JULIA_SIN: return ccos(z);
+    case JULIA_ASIN: return 1.0 / csqrt(1.0 - z * z);
+    case JULIA_COS: return -csin(z);
+    case JULIA_ACOS: return -1.0 / csqrt(1.0 - z * z);
+    case JULIA_TAN: { double complex c = ccos(z); return 1.0 / (c * c); }
+    case JULIA_ATAN: return 1.0 / (1.0 + z * z);
+    case JULIA_SINH: return ccosh(z);
+    case JULIA_ASINH: return 1.0 / csqrt(1.0 + z * z);
+    case JULIA_COSH: return csinh(z);
+    case JULIA_ACOSH: return 1.0 / (csqrt(z - 1.0) * csqrt(z + 1.0));
+    case JULIA_TANH: { double complex c = ccosh(z); return 1.0 / (c * c); }
+    case JULIA_ATANH: return 1.0 / (1.0 - z * z);
+    case JULIA_RECIPROCAL: return -1.0 / (z * z);
+    default: return f->pwr * cpow(z, f->pwr - 1.0);
+    }
+}
+
+/* Inside test; when outside and `de` is given, a step estimate: for
+ * quaternions POV-Ray's distance estimate |z| ln|z|^2 / (k^i prod |z_j|)
+ * (k = 2 or 3); for hypercomplex numbers POV-Ray's rule F / (2 |dF/dt|)
+ * along the ray direction e (F = |z|^2 at the escape, used only while the
+ * ray approaches and the step stays within 1 to 30 precision steps), else 0. */
+static int jf_inside(const jf_data *f, vec3 p, vec3 e, double *de)
+{
+    double q[4];
+    lift(f, p, q);
+    if (de) *de = 0.0;
+    if (!f->hyper) {
+        double k = f->func == JULIA_CUBE ? 3.0 : 2.0, prod = 1.0, pw = 1.0;
+        for (int i = 1; i <= f->n; i++) {
+            double r2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+            prod *= sqrt(r2);
+            pw *= k;
+            if (r2 > f->exit) {
+                if (de && prod > 0.0) *de = sqrt(r2) * log(r2) / (pw * prod);
+                return 0;
+            }
+            double t[4];
+            qmul(q, q, t);
+            if (f->func == JULIA_CUBE) qmul(t, q, t);
+            for (int j = 0; j < 4; j++) q[j] = t[j] + f->c[j];
+        }
+        return 1;
+    }
+    double complex a, b, da = 0, db = 0;
+    to_pair(q, &a, &b);
+    if (de) {
+        double dq[4] = {e.x, e.y, e.z, -(f->slice[0] * e.x + f->slice[1] * e.y + f->slice[2] * e.z) / f->slice[3]};
+        to_pair(dq, &da, &db);
+    }
+    for (int i = 1; i <= f->n; i++) {
+        double r2 = 0.5 * (creal(a) * creal(a) + cimag(a) * cimag(a) + creal(b) * creal(b) + cimag(b) * cimag(b));
+        if (!(r2 <= f->exit)) {
+            if (de) {
+                double dF = creal(cmul(conj(a), da)) + creal(cmul(conj(b), db));
+                if (dF < -1e-7) {
+                    double S = -2.0 * dF;
+                    if (r2 > f->step * S && r2 < 30.0 * f->step * S) *de = r2 / S;
+                }
+            }
+            return 0;
+        }
+        if (de) {
+            da = cmul(da, cderiv(f, a));
+            db = cmul(db, cderiv(f, b));
+        }
+        a = cfun(f, a) + f->ca;
+        b = cfun(f, b) + f->cb;
+    }
+    return 1;
+}
+
+int accel_fractal_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
+{
+    const scene_julia *j = o->u.julia;
+    if (!j) return -1;
+    jf_data *f = calloc(1, sizeof *f);
+    if (!f) return -1;
+    memcpy(f->c, j->c, sizeof f->c);
+    f->hyper = j->hypercomplex;
+    f->func = j->func;
+    f->pwr = CMPLX(j->pwr[0], j->pwr[1]);
+    f->n = j->max_iteration > 0 ? j->max_iteration : 1;
+    f->step = 1.0 / (j->precision >= 1.0 ? j->precision : 1.0);
+    memcpy(f->slice, j->slice, sizeof f->slice);
+    f->sdist = j->slice_dist;
+    if (!(fabs(f->slice[3]) > 0.0)) {
+        free(f);
+        return -1;
+    }
+    if (!f->hyper) {
+        double R = 1.0 + sqrt(f->c[0] * f->c[0] + f->c[1] * f->c[1] + f->c[2] * f->c[2] + f->c[3] * f->c[3]) + 1e-7;
+        f->R = R > 2.0 ? 2.0 : R;
+        f->exit = f->R * f->R + 1e-7;
+    } else {
+        f->R = 4.0;
+        f->exit = 16.0;
+        to_pair(f->c, &f->ca, &f->cb);
+    }
+    *lo = v3s(-f->R);
+    *hi = v3s(f->R);
+    sh->data = f;
+    return 0;
+}
+
+void accel_fractal_free(void *data) { free(data); }
+
+int accel_fractal_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+{
+    const jf_data *f = sh->data;
+    if (!f || max <= 0) return 0;
+    /* the bounding sphere */
+    double A = v3_dot(d, d), B = v3_dot(o, d), C = v3_dot(o, o) - f->R * f->R;
+    double disc = B * B - A * C;
+    if (!(disc > 0.0)) return 0;
+    double sq = sqrt(disc), t0 = (-B - sq) / A, t1 = (-B + sq) / A;
+    double a = fmax(t0, tmin), b = fmin(t1, tmax);
+    if (!(a < b)) return 0;
+    double s = sqrt(A);
+    vec3 e = v3_scale(d, 1.0 / s), p0 = v3_madd(o, d, a);
+    double len = (b - a) * s, tau = 0.0, de;
+    int cur = jf_inside(f, p0, e, &de), n = 0;
+    for (long guard = 0; tau < len && guard < 10000000; guard++) {
+        if (n == max && a + tau / s > out[max - 1].t) break;
+        double step = cur ? f->step : fmax(de, f->step);
+        double tn = fmin(tau + step, len);
+        double den;
+        int next = jf_inside(f, v3_madd(p0, e, tn), e, &den);
+        if (next != cur) {
+            double lo = tau, hi = tn;
+            for (int it = 0; it < 200 && hi - lo > 1e-15 * (len + hi); it++) {
+                double m = 0.5 * (lo + hi);
+                if (jf_inside(f, v3_madd(p0, e, m), e, NULL) == cur) lo = m;
+                else hi = m;
+            }
+            double t = a + 0.5 * (lo + hi) / s;
+            if (t > tmin && t < tmax) n = put_hit(out, n, max, t, 0);
+        }
+        tau = tn;
+        cur = next;
+        de = den;
+    }
+    return n;
+}
+
+int accel_fractal_inside(const accel_shape *sh, vec3 q)
+{
+    const jf_data *f = sh->data;
+    if (!f || v3_len2(q) > f->R * f->R) return 0;
+    return jf_inside(f, q, v3(0, 0, 1), NULL);
+}
+
+/* Gradient of |z_N|^2 with respect to (x, y, z): z0 moves along the slice. */
+vec3 accel_fractal_normal(const accel_shape *sh, vec3 p)
+{
+    const jf_data *f = sh->data;
+    if (!f) return v3(0, 1, 0);
+    /* the point just inside, where all N iterates exist */
+    double q[4], dq[3][4];
+    lift(f, p, q);
+    for (int k = 0; k < 3; k++) {
+        memset(dq[k], 0, sizeof dq[k]);
+        dq[k][k] = 1.0;
+        dq[k][3] = -f->slice[k] / f->slice[3];
+    }
+    double g[3] = {0, 0, 0};
+    if (!f->hyper) {
+        for (int i = 1; i <= f->n; i++) {
+            double q2[4], t[4], u[4];
+            qmul(q, q, q2);
+            for (int k = 0; k < 3; k++) {
+                if (f->func == JULIA_CUBE) {
+                    /* d(q^3) = dq q^2 + q dq q + q^2 dq */
+                    double a1[4], a2[4], a3[4];
+                    qmul(dq[k], q2, a1);
+                    qmul(q, dq[k], t);
+                    qmul(t, q, a2);
+                    qmul(q2, dq[k], a3);
+                    for (int j = 0; j < 4; j++) dq[k][j] = a1[j] + a2[j] + a3[j];
+                } else {
+                    /* d(q^2) = q dq + dq q */
+                    qmul(q, dq[k], t);
+                    qmul(dq[k], q, u);
+                    for (int j = 0; j < 4; j++) dq[k][j] = t[j] + u[j];
+                }
+            }
+            double nq[4];
+            if (f->func == JULIA_CUBE) qmul(q2, q, nq);
+            else memcpy(nq, q2, sizeof nq);
+            for (int j = 0; j < 4; j++) q[j] = nq[j] + f->c[j];
+            if (!(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] < 1e200)) break;
+        }
+        for (int k = 0; k < 3; k++) g[k] = q[0] * dq[k][0] + q[1] * dq[k][1] + q[2] * dq[k][2] + q[3] * dq[k][3];
+    } else {
+        double complex a, b, da[3], db[3];
+        to_pair(q, &a, &b);
+        for (int k = 0; k < 3; k++) to_pair(dq[k], &da[k], &db[k]);
+        for (int i = 1; i <= f->n; i++) {
+            double complex fa = cderiv(f, a), fb = cderiv(f, b);
+            for (int k = 0; k < 3; k++) {
+                da[k] = cmul(da[k], fa);
+                db[k] = cmul(db[k], fb);
+            }
+            a = cfun(f, a) + f->ca;
+            b = cfun(f, b) + f->cb;
+            if (!(cabs(a) + cabs(b) < 1e100)) break;
+        }
+        for (int k = 0; k < 3; k++) g[k] = creal(cmul(conj(a), da[k])) + creal(cmul(conj(b), db[k]));
+    }
+    vec3 n = v3(g[0], g[1], g[2]);
+    return v3_finite(n) && v3_len2(n) > 0.0 ? n : v3_norm(p);
+}
