@@ -168,7 +168,12 @@ void sdl_obj_add_to_scene(sdl_parser *p, sdl_obj *o)
         if (scene_add_object(p->s, o->obj) != PT_OK) sdl_error(p, o->obj->loc, PT_ERR_NOMEM, "out of memory");
     }
     for (int i = 0; i < o->nlights; i++) {
-        if (o->lights[i].looks_like) post_process(p, (scene_object *)o->lights[i].looks_like, NULL, deflt);
+        if (o->lights[i].looks_like) {
+            post_process(p, (scene_object *)o->lights[i].looks_like, NULL, deflt);
+            /* POV-Ray renders the looks_like object with the scene (issue 5) */
+            if (scene_add_object(p->s, (scene_object *)o->lights[i].looks_like) != PT_OK)
+                sdl_error(p, o->lights[i].loc, PT_ERR_NOMEM, "out of memory");
+        }
         if (scene_add_light(p->s, &o->lights[i]) != PT_OK) sdl_error(p, o->lights[i].loc, PT_ERR_NOMEM, "out of memory");
     }
 }
