@@ -297,6 +297,7 @@ typedef struct {
     int shadowless;
     int media_interaction, media_attenuation;
     const scene_object *looks_like;
+    const scene_object *projected_through; /* appended (issue 5): parsed, not rendered yet */
 } scene_light;
 
 /* ---------------------------------------------------------------- camera */

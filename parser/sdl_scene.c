@@ -349,8 +349,26 @@ static int light_item(sdl_parser *p, sdl_obj *so)
     case KW_MEDIA_INTERACTION: l->media_interaction = sdl_allow_float(p, 1.0) > 0; break;
     case KW_MEDIA_ATTENUATION: l->media_attenuation = sdl_allow_float(p, 1.0) > 0; break;
     case KW_LOOKS_LIKE: looks_like(p, l); break;
-    case KW_PROJECTED_THROUGH: case KW_PHOTONS: case KW_COLOR_MAP: case KW_COLOUR_MAP:
-        if (t.tk.kw == KW_PROJECTED_THROUGH) sdl_warn_once(p, t.tk.loc, "projected_through is not supported yet and is ignored");
+    case KW_PROJECTED_THROUGH:
+        /* projected_through := '{' ( object_identifier | object_statement ) object_mods '}' */
+        sdl_warn_once(p, t.tk.loc, "projected_through is not supported yet and is ignored");
+        if (sdl_begin_block(p, "projected_through")) {
+            const sdl_tok *pt = sdl_peek(p);
+            sdl_obj *o = NULL;
+            if (pt->tk.kind == TOK_IDENT && pt->val.kind == VAL_OBJECT) {
+                sdl_tok id = sdl_next(p);
+                o = sdl_copy_obj(p, id.val.ptr);
+            } else if (sdl_starts_object(pt)) {
+                o = sdl_parse_object(p);
+            }
+            if (o && o->obj) {
+                sdl_object_mods(p, o);
+                l->projected_through = o->obj;
+            }
+            sdl_end_block(p);
+        }
+        break;
+    case KW_PHOTONS: case KW_COLOR_MAP: case KW_COLOUR_MAP:
         if (sdl_begin_block(p, sdl_kw_text(t.tk.kw))) sdl_skip_block(p);
         break;
     default:
