@@ -67,6 +67,15 @@ pt_status lighting_setup(lighting_study *ls, const char *units, const char *aovs
     return PT_OK;
 }
 
+void lighting_check_outputs(const lighting_study *ls, const char *const *outputs, int n, diag *d)
+{
+    if (!ls->aov_mask) return;
+    for (int i = 0; i < n; i++)
+        if (img_format_from_path(outputs[i]) == IMG_FMT_EXR) return;
+    src_loc none = {NULL, 0, 0};
+    diag_report(d, DIAG_WARNING, none, NULL, "--aovs: the layers are written into .exr outputs only, and none is given");
+}
+
 pt_status lighting_apply_units(lighting_study *ls, scene *sc, diag *d)
 {
     if (!(ls->metres_per_unit > 0.0)) return PT_OK;

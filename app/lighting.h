@@ -32,6 +32,9 @@ pt_status lighting_setup(lighting_study *ls, const char *units, const char *aovs
 /* "cm" -> 0.01 etc.; returns 0 (and *mpu untouched) when not a unit. */
 int lighting_parse_units(const char *s, double *mpu);
 
+/* A warning in d when AOVs are asked for but no output is an EXR. */
+void lighting_check_outputs(const lighting_study *ls, const char *const *outputs, int n, diag *d);
+
 /* After parsing: make the lights photometric when --units was given
  * (light_units_apply; warnings into d). */
 pt_status lighting_apply_units(lighting_study *ls, scene *sc, diag *d);

@@ -262,6 +262,7 @@ static int cmd_render(int argc, char **argv)
     lighting_study ls;
     diag *ld = diag_new();
     pt_status lst = lighting_setup(&ls, o.units, o.aovs, o.fc_quantity, ld);
+    if (lst == PT_OK) lighting_check_outputs(&ls, o.outputs, o.noutputs, ld);
     print_diags(ld, 0);
     diag_free(ld);
     if (lst != PT_OK) {
