@@ -652,30 +652,24 @@ static void height_field_args(sdl_parser *p, scene_object *o, src_loc loc)
 
 /* ------------------------------------------------------------ text */
 
-/* text := ttf file_name string thickness ',' offset  (also `internal n`,
- * not supported). POV-Ray then rotates the text by <0.001,0.001,0.001>
- * degrees ("to fix cracks in text that lies along an axis"); so do we. */
+/* text := ( ttf file_name | internal n ) string thickness ',' offset
+ * POV-Ray's built-in fonts are copies of the distribution's: 1 timrom.ttf,
+ * 2 cyrvetic.ttf, 3 crystal.ttf, any other number povlogo.ttf (read from
+ * the include path here). POV-Ray then rotates the text by
+ * <0.001,0.001,0.001> degrees ("to fix cracks in text that lies along an
+ * axis"); so do we. */
 static void text_args(sdl_parser *p, scene_object *o, src_loc loc)
 {
+    const char *font = NULL;
     if (sdl_accept_kw(p, KW_INTERNAL)) {
-        sdl_float(p);
-        sdl_accept(p, TOK_COMMA);
-        sdl_string(p);
-        sdl_accept(p, TOK_COMMA);
-        sdl_float(p);
-        sdl_accept(p, TOK_COMMA);
-        sdl_vector(p);
-        o->kind = SHAPE_UNSUPPORTED;
-        o->name = "text internal";
-        sdl_warn_once(p, loc, "text with a built-in font is not supported; it is skipped");
-        return;
-    }
-    if (!sdl_accept_kw(p, KW_TTF)) {
+        int id = (int)sdl_float(p);
+        font = id == 1 ? "timrom.ttf" : id == 2 ? "cyrvetic.ttf" : id == 3 ? "crystal.ttf" : "povlogo.ttf";
+    } else if (!sdl_accept_kw(p, KW_TTF)) {
         sdl_tok t = sdl_next(p);
         sdl_unexpected(p, &t, "ttf or internal");
         return;
     }
-    const char *font = sdl_string(p);
+    if (!font) font = sdl_string(p);
     sdl_accept(p, TOK_COMMA);
     const char *str = sdl_string(p);
     sdl_accept(p, TOK_COMMA);

@@ -402,6 +402,7 @@ static void test_text(void **st)
     const scene_object *o = w.s->objects[0];
     assert_int_equal(o->kind, SHAPE_TEXT);
     assert_true(o->u.text->nsegments > 8);
+    int nseg = o->u.text->nsegments;
     /* the front face lies in z = 0 (up to POV-Ray's 0.001 degree turn), the back in z = 0.25 */
     accel_shape sh = shape_of(&w);
     vec3 lo = sh.lo, hi = sh.hi;
@@ -435,6 +436,11 @@ static void test_text(void **st)
         assert_near(h.t, tb, 1e-8);
     }
     accel_shape_release(&sh);
+    done(&w);
+    /* POV-Ray's built-in font 1 is timrom.ttf: the same outline */
+    w = build("text { internal 1 \"I-I\" 0.25, 0 }");
+    assert_int_equal(w.s->objects[0]->kind, SHAPE_TEXT);
+    assert_int_equal(w.s->objects[0]->u.text->nsegments, nseg);
     done(&w);
 }
 
