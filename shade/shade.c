@@ -212,6 +212,9 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
                 vis = shadow_rgb(c, thread, p, dir, depth);
             if (rgb_near_zero(vis)) continue;
             lc = rgb_mul(lc, vis);
+            /* media_attenuation: fog dims the light on its way (shade_atmos.c) */
+            if (l->media_attenuation && l->media_interaction && c->sc->fogs)
+                lc = rgb_mul(lc, atmos_fog_attenuation(c->sc, p, dir, depth));
         }
         total = rgb_add(total, light_terms(s, dir, lc, backside));
     }

@@ -3,7 +3,7 @@
  * POV-Ray 3.7's Trace::ComputeSky (language version 3.7 rules) and
  * ComputeFog / ComputeConstantFogColour / ComputeGroundFogColour, studied
  * for semantics:
- *  - sky_sphere: the pigments are layers evaluated at the ray direction
+ *  - sky_sphere (#version 3.7; older scenes: sky_legacy): the pigments are layers evaluated at the ray direction
  *    (through the inverse sky transform, applied as to a point), the LAST
  *    listed on top: colour += pigment * (1 - filter - transmit) * filter_so_far
  *    * emission, filter_so_far *= rgb*filter + transmit; the background colour
@@ -16,7 +16,8 @@
  *    exp(-d/distance); a >= the fog's transmit; the seen colour becomes
  *    sum (1-a) fog + prod a ((1 - filter) + filter * fog) * colour.
  *    A ray that hits nothing travels an unbounded distance (POV-Ray's
- *    BOUND_HUGE). */
+ *    BOUND_HUGE). Shadow rays of lights with media_attenuation on are
+ *    dimmed by the attenuation part (POV-Ray's ComputeShadowMedia). */
 #include "shade_atmos.h"
 #include <math.h>
 #include "shade_noise.h"
@@ -25,10 +26,42 @@
 #define ATM_EPSILON 1.0e-10
 #define BOUND_HUGE 2.0e10
 
+/* Before #version 3.7 POV-Ray filtered the sky layers with the full
+ * five-channel colour product: the layers add colour * trans * (1 - filter
+ * - transmit) with trans = |filter| + |transmit| of the product so far, and
+ * the background shows through rgb * filter + transmit of the product. */
+static rgb sky_legacy(const scene *sc, const scene_sky_sphere *sky, vec3 dir)
+{
+    double fc[5] = {1, 1, 1, 1, 1}, trans = 1.0;
+    rgb col = {0, 0, 0};
+    vec3 p = xform_inv_point(&sky->transform, dir);
+    pattern_ctx pc = pattern_ctx_plain(sc);
+    for (int i = sky->npigments - 1; i >= 0; i--) {
+        colour5 c;
+        pigment_eval(sky->pigments[i], p, &pc, &c);
+        double att = trans * (1.0 - c.f - c.t);
+        col.r += c.r * att;
+        col.g += c.g * att;
+        col.b += c.b * att;
+        fc[0] *= c.r;
+        fc[1] *= c.g;
+        fc[2] *= c.b;
+        fc[3] *= c.f;
+        fc[4] *= c.t;
+        trans = fabs(fc[3]) + fabs(fc[4]);
+    }
+    rgb out = {col.r * sky->emission[0] + sc->background.r * (fc[0] * fc[3] + fc[4]),
+               col.g * sky->emission[1] + sc->background.g * (fc[1] * fc[3] + fc[4]),
+               col.b * sky->emission[2] + sc->background.b * (fc[2] * fc[3] + fc[4])};
+    return out;
+}
+
 rgb atmos_sky(const scene *sc, vec3 dir)
 {
     rgb col = {0, 0, 0}, fil = {1, 1, 1};
     const scene_sky_sphere *sky = sc->sky_sphere;
+    if (sky && sky->npigments > 0 && sc->version_major > 0 && sc->version_major + sc->version_minor / 10.0 < 3.65)
+        return sky_legacy(sc, sky, dir);
     if (sky && sky->npigments > 0) {
         vec3 p = xform_inv_point(&sky->transform, dir);
         pattern_ctx pc = pattern_ctx_plain(sc);
@@ -86,9 +119,26 @@ static double fog_att(const scene *sc, const scene_fog *f, vec3 org, vec3 dir, d
     return exp(-width / f->distance);
 }
 
+static void fog_sums(const scene *sc, vec3 org, vec3 dir, double depth, rgb *att, rgb *col);
+
 rgb atmos_fog(const scene *sc, vec3 org, vec3 dir, double depth, rgb c)
 {
     if (!sc->fogs) return c;
+    rgb satt, scol;
+    fog_sums(sc, org, dir, depth, &satt, &scol);
+    rgb r = {scol.r + satt.r * c.r, scol.g + satt.g * c.g, scol.b + satt.b * c.b};
+    return r;
+}
+
+rgb atmos_fog_attenuation(const scene *sc, vec3 org, vec3 dir, double depth)
+{
+    rgb satt = {1, 1, 1}, scol;
+    if (sc->fogs) fog_sums(sc, org, dir, depth, &satt, &scol);
+    return satt;
+}
+
+static void fog_sums(const scene *sc, vec3 org, vec3 dir, double depth, rgb *att, rgb *col)
+{
     double width = isfinite(depth) ? depth : BOUND_HUGE;
     rgb satt = {1, 1, 1}, scol = {0, 0, 0};
     for (const scene_fog *f = sc->fogs; f; f = f->next) {
@@ -103,6 +153,6 @@ rgb atmos_fog(const scene *sc, vec3 org, vec3 dir, double depth, rgb c)
         scol.g += (1.0 - a) * fc[1];
         scol.b += (1.0 - a) * fc[2];
     }
-    rgb r = {scol.r + satt.r * c.r, scol.g + satt.g * c.g, scol.b + satt.b * c.b};
-    return r;
+    *att = satt;
+    *col = scol;
 }

@@ -10,5 +10,8 @@ rgb atmos_sky(const scene *sc, vec3 dir);
 /* Colour `c` seen at distance `depth` (INFINITY: nothing hit) along the ray
  * after the scene's fogs. Returns c unchanged without fog. */
 rgb atmos_fog(const scene *sc, vec3 org, vec3 dir, double depth, rgb c);
+/* The fogs' attenuation alone over a segment (a light with
+ * media_attenuation on sees its light dimmed so along shadow rays). */
+rgb atmos_fog_attenuation(const scene *sc, vec3 org, vec3 dir, double depth);
 
 #endif
