@@ -351,7 +351,7 @@ static int texture_item(sdl_parser *p, scene_texture *t)
         return 1;
     }
     if (sdl_transform_item(p, &x)) {
-        t->transform = xform_then(t->transform, x);
+        sdl_transform_texture(t, &x); /* every layer (POV-Ray's Transform_Textures) */
         return 1;
     }
     if (sdl_accept_kw(p, KW_PIGMENT)) {
