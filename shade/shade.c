@@ -501,5 +501,6 @@ rgb shade_direct(const scene *sc, const accel *a, const light_surface *s, const 
     c.eps = scene_eps(a);
     c.max_level = 1;
     c.ts = ts;
+    c.transparent = 1; /* filtered shadows, as shade_trace: exact for opaque surfaces too */
     return direct_light(&c, 0, s, h, p, r);
 }

@@ -227,6 +227,25 @@ static void test_aov_layers(void **st)
     assert_true(layer_y("aovs.exr", "illuminance", 0, 32) < E);
 }
 
+/* The direct AOV shades like the beauty behind a transparent sphere
+ * (filtered shadow: 0.6 transmit, pigment <1, .5, .5>). */
+static void test_filtered_shadow(void **st)
+{
+    (void)st;
+    write_scene("tr.pov", "light_source { <0, 2, 0>*S color rgb 100 }\n"
+                          "sphere { <0, 1, 0>, 0.3 pigment { rgbt <1, 0.5, 0.5, 0.6> } }");
+    render("tr.pov", "tr.exr", "--float --units m --aovs direct,illuminance");
+    const double E = I_CD / (D_M * D_M);
+    for (int k = 0; k < 3; k++) {
+        double b = layer_px("tr.exr", NULL, "RGB", 16, 16, k), dir = layer_px("tr.exr", "direct", "RGB", 16, 16, k);
+        double il = layer_px("tr.exr", "illuminance", "RGB", 16, 16, k);
+        printf("filtered shadow, channel %d: beauty %.4f, direct %.4f, illuminance %.4f of %.4f lx\n", k, b, dir, il, E);
+        assert_float_equal(dir / b, 1.0, 1e-4);
+        assert_true(il > 0.1 * E && il < 0.95 * E);
+        assert_float_equal(il / (M_PI * b), 1.0, 1e-4); /* white Lambertian: E = pi L */
+    }
+}
+
 /* A parallel light of luminance Y gives Y lux on a surface facing it, at any distance. */
 static void test_parallel_light(void **st)
 {
@@ -359,6 +378,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_light_metres),   cmocka_unit_test(test_point_light_centimetres),
         cmocka_unit_test(test_aov_layers),           cmocka_unit_test(test_parallel_light),
+        cmocka_unit_test(test_filtered_shadow),
         cmocka_unit_test(test_povray_units_and_fade), cmocka_unit_test(test_path_agrees),
         cmocka_unit_test(test_povray_reads_layers),  cmocka_unit_test(test_options),
     };
