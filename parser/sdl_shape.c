@@ -61,16 +61,46 @@ static int parse_count(sdl_parser *p, const char *what, int lo, int hi)
 }
 
 /* uv_list := uv { [','] uv } ; n 2-D points */
-static double (*uv_list(sdl_parser *p, int n, int extra))[2]
+/* n items of `elem` bytes read by `one` into a buffer that grows as they
+ * arrive (a huge declared count costs nothing until its points exist), then
+ * moved to the scene arena with room for `extra` more. */
+static void *read_items(sdl_parser *p, int n, int extra, size_t elem, void (*one)(sdl_parser *, void *))
 {
-    double(*pts)[2] = alloc_n(p, (size_t)n + (size_t)extra, sizeof *pts);
-    if (!pts) return NULL;
+    size_t cap = 0, got = 0;
+    unsigned char *buf = NULL;
     sdl_accept(p, TOK_COMMA);
     for (int i = 0; i < n && sdl_ok(p); i++) {
-        sdl_vector_n(p, pts[i], 2);
+        if (got == cap) {
+            size_t nc = cap ? 2 * cap : 64;
+            unsigned char *nb = realloc(buf, nc * elem);
+            if (!nb) {
+                free(buf);
+                sdl_error(p, p->last_loc, PT_ERR_NOMEM, "out of memory");
+                return NULL;
+            }
+            buf = nb;
+            cap = nc;
+        }
+        one(p, buf + got * elem);
+        got++;
         sdl_accept(p, TOK_COMMA);
     }
-    return pts;
+    void *out = NULL;
+    if (sdl_ok(p)) {
+        out = alloc_n(p, got + (size_t)extra, elem);
+        if (out && got) memcpy(out, buf, got * elem);
+    }
+    free(buf);
+    return out;
+}
+
+static void read_uv(sdl_parser *p, void *dst) { sdl_vector_n(p, (double *)dst, 2); }
+static void read_vec(sdl_parser *p, void *dst) { *(vec3 *)dst = sdl_vector(p); }
+
+/* uv_list := uv { [','] uv } ; n 2-D points */
+static double (*uv_list(sdl_parser *p, int n, int extra))[2]
+{
+    return read_items(p, n, extra, sizeof(double[2]), read_uv);
 }
 
 /* spline_type := linear_spline | quadratic_spline | cubic_spline | bezier_spline */
@@ -135,14 +165,8 @@ static void polygon_args(sdl_parser *p, scene_object *o, src_loc loc)
 {
     int n = parse_count(p, "polygon", 3, 1 << 24);
     if (n < 0) return;
-    vec3 *pts = alloc_n(p, (size_t)n + 1, sizeof *pts);
-    if (!pts) return;
-    sdl_accept(p, TOK_COMMA);
-    for (int i = 0; i < n && sdl_ok(p); i++) {
-        pts[i] = sdl_vector(p);
-        sdl_accept(p, TOK_COMMA);
-    }
-    if (!sdl_ok(p)) return;
+    vec3 *pts = read_items(p, n, 1, sizeof *pts, read_vec);
+    if (!pts || !sdl_ok(p)) return;
     vec3 first = pts[0];
     int closed = 0;
     for (int i = 1; i < n; i++) {

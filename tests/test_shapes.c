@@ -870,6 +870,61 @@ static void test_surface_sampling(void **st)
     unlink(path);
 }
 
+/* malformed shapes give located errors; degenerate ones are skipped with a
+ * warning; nothing crashes */
+static void test_bad_input(void **st)
+{
+    (void)st;
+    static const char *bad[] = {
+        "lathe { 1, <0,0> }",
+        "lathe { bezier_spline 5, <0,0>, <1,0>, <1,1>, <0,1>, <0,2> }",
+        "prism { 0, 1, 2, <0,0>, <1,1> }",
+        "sor { 4, <1,0>, <1,0>, <1,0>, <1,0> }",
+        "sor { 4, <-1,0>, <1,1>, <1,2>, <1,3> }",
+        "polygon { 2, <0,0>, <1,0> }",
+        "polygon { 100000000, <0,0>, <1,0>, <1,1> }",
+        "blob { cylinder { <0,0,0>, <0,0,0>, 1, 1 } }",
+        "height_field { png \"no_such_file.png\" }",
+        "text { ttf \"no_such_font.ttf\" \"a\" 1, 0 }",
+        "quartic { <1, 2, 3> }",
+        "poly { 99, <1> }",
+        "julia_fractal { <0,0,0,0> quaternion exp }",
+        "julia_fractal { <0,0,0,0> slice <0,0,0,0>, 0 }",
+        "isosurface { threshold 1 }",
+        "superellipsoid { <0, 1> }",
+        "sphere_sweep { linear_spline 1, <0,0,0>, 1 }",
+        "sphere_sweep { cubic_spline 3, <0,0,0>, 1, <1,0,0>, 1, <2,0,0>, 1 }",
+        "polynomial { 3, xyz(4,0,0): 1 }",
+        "clipped_by { sphere { 0, 1 } }",
+        "sphere { 0, 1 clipped_by { 3 } }",
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        diag *d = diag_new();
+        scene *sc = NULL;
+        pt_status st2 = sdl_parse_string("bad.pov", bad[i], NULL, &sc, d);
+        if (st2 == PT_OK) fail_msg("'%s' parsed", bad[i]);
+        assert_null(sc);
+        assert_true(diag_errors(d) >= 1);
+        const diag_msg *m = diag_get(d, diag_count(d) - 1);
+        assert_true(m->loc.line >= 1);
+        diag_free(d);
+    }
+    /* degenerate but valid: parsed, skipped by the accel with a warning */
+    static const char *degen[] = {
+        "lathe { 2, <0,0>, <0,1> }",
+        "prism { 0, 0, 4, <0,0>, <1,0>, <1,1>, <0,0> }",
+        "prism { cubic_spline 0, 1, 6, <0,0>, <1,0>, <1,1>, <0,1>, <2,2>, <3,3> }",
+        "blob { threshold 1 sphere { 0, 0, 1 } }",
+        "quadric { <1,1,1>, <0,0,0>, <0,0,0>, 1 }",
+        "text { ttf \"timrom.ttf\" \"\" 0.1, 0 }",
+    };
+    for (size_t i = 0; i < sizeof degen / sizeof degen[0]; i++) {
+        world w = build(degen[i]);
+        expect_miss(&w, v3(-5, 0.5, 0.5), v3(1, 0, 0));
+        done(&w);
+    }
+}
+
 /* unsupported shapes are reported once and skipped */
 static void test_unsupported(void **st)
 {
@@ -908,6 +963,7 @@ int main(void)
         cmocka_unit_test(test_parametric),
         cmocka_unit_test(test_julia),
         cmocka_unit_test(test_surface_sampling),
+        cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_unsupported),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
