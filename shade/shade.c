@@ -216,6 +216,15 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
             if (l->media_attenuation && l->media_interaction && c->sc->fogs)
                 lc = rgb_mul(lc, atmos_fog_attenuation(c->sc, p, dir, depth));
         }
+        if (l->shadowless && (s->f->phong != 0.0 || s->f->specular != 0.0)) {
+            /* POV-Ray: fill lights (shadowless) add no highlights */
+            scene_finish ff = *s->f;
+            ff.phong = ff.specular = 0.0;
+            light_surface fs = *s;
+            fs.f = &ff;
+            total = rgb_add(total, light_terms(&fs, dir, lc, backside));
+            continue;
+        }
         total = rgb_add(total, light_terms(s, dir, lc, backside));
     }
     return total;
