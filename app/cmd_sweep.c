@@ -427,13 +427,13 @@ static int write_html(const char *dir, const char *scene, const char *ref_path, 
     snprintf(path, sizeof path, "%s/index.html", dir);
     FILE *f = open_tmp(path, tmp, sizeof tmp);
     if (!f) return 0;
-    int dw = ref_w > 384 ? 384 : ref_w;
+    int dw = ref_w > 384 ? 384 : ref_w < 192 ? 192 : ref_w; /* small images shown enlarged, pixels kept sharp */
     fputs("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>partray sweep: ", f);
     html_escape(f, scene);
     fputs("</title>\n<style>body{font-family:sans-serif;margin:1em}table{border-collapse:collapse}"
           "td,th{border:1px solid #ccc;padding:4px;vertical-align:top;text-align:left}"
           "figure{margin:0}.row{display:flex;gap:16px;flex-wrap:wrap;align-items:flex-start}"
-          "td.m{font-family:monospace;white-space:nowrap}</style></head><body>\n<h1>partray sweep</h1>\n<p>scene ",
+          "td.m{font-family:monospace;white-space:nowrap}img.px{image-rendering:pixelated}</style></head><body>\n<h1>partray sweep</h1>\n<p>scene ",
           f);
     html_escape(f, scene);
     fputs(", reference ", f);
@@ -442,7 +442,7 @@ static int write_html(const char *dir, const char *scene, const char *ref_path, 
             ref_w, ref_h, metric, tname);
     fprintf(f,
             "<div class=\"row\"><figure><img src=\"plot.png\" alt=\"error against time\"><figcaption>%s against %s "
-            "seconds</figcaption></figure>\n<figure><img src=\"ref.png\" width=\"%d\" alt=\"reference\"><figcaption>reference</figcaption></figure></div>\n",
+            "seconds</figcaption></figure>\n<figure><img class=\"px\" src=\"ref.png\" width=\"%d\" alt=\"reference\"><figcaption>reference</figcaption></figure></div>\n",
             metric, tname, dw);
     fputs("<table>\n<tr><th>mode</th><th>settings</th><th>seconds</th><th>error</th><th>image</th><th>FLIP heat map</th></tr>\n",
           f);
@@ -471,8 +471,8 @@ static int write_html(const char *dir, const char *scene, const char *ref_path, 
         }
         fputs("</td>", f);
         if (r->compared) {
-            fprintf(f, "<td><a href=\"%s.exr\"><img src=\"%s.png\" width=\"%d\" alt=\"render\"></a></td>", r->base, r->base, dw);
-            fprintf(f, "<td><img src=\"%s_flip.png\" width=\"%d\" alt=\"FLIP\"></td>", r->base, dw);
+            fprintf(f, "<td><a href=\"%s.exr\"><img class=\"px\" src=\"%s.png\" width=\"%d\" alt=\"render\"></a></td>", r->base, r->base, dw);
+            fprintf(f, "<td><img class=\"px\" src=\"%s_flip.png\" width=\"%d\" alt=\"FLIP\"></td>", r->base, dw);
         } else {
             fputs("<td></td><td></td>", f);
         }
