@@ -22,6 +22,7 @@
 #include "scene.h"
 #include "sdl.h"
 #include "shade.h"
+#include "shade_funcenv.h"
 #include "stats_json.h"
 #include "timer.h"
 #include "view.h"
@@ -106,6 +107,7 @@ static void fill_sdl_options(sdl_options *so, const cli_render *o)
     if (o->max_memory_mib > 0) so->max_memory = o->max_memory_mib > (1LL << 40) ? (1LL << 60) : o->max_memory_mib << 20;
     if (o->max_string > 0) so->max_string_length = o->max_string;
     if (o->max_array > 0) so->max_array_elements = o->max_array;
+    so->func_env = shade_func_env(); /* pattern/pigment functions, noise, vturbulence while parsing */
 }
 
 /* The image size must fit what the writers accept and the memory there is:

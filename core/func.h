@@ -82,6 +82,8 @@ typedef struct func_env {
     int (*pigment)(void *user, const scene_function *f, vec3 p, double out[5]);
     /* POV-Ray's Noise(p, generator) in [0, 1] (internal 29, 58, 59, 76, 78) */
     double (*noise)(void *user, vec3 p, int generator);
+    /* POV-Ray's DTurbulence (the SDL's vturbulence) */
+    vec3 (*dturbulence)(void *user, vec3 p, int octaves, double omega, double lambda);
     int noise_generator;       /* the scene's global_settings noise_generator (default 2) */
     void *user;
 } func_env;

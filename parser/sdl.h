@@ -27,6 +27,9 @@ typedef struct {
     const char *write_dir;        /* NULL: #fopen ... write/append writes beside the scene
                                      (scene or working directory only); else every
                                      written file goes into this directory */
+    const struct func_env *func_env; /* evaluators for pigment/pattern functions, noise and
+                                     vturbulence at parse time (core/func.h); NULL: such
+                                     calls are located PT_ERR_UNSUPPORTED errors */
 } sdl_options;
 
 void sdl_default_options(sdl_options *o);

@@ -457,6 +457,30 @@ static vec3 vaxis_rotate_fn(sdl_parser *p)
     return v3_add(v3_add(v3_scale(pt, c), v3_scale(v3_cross(ax, pt), s)), v3_scale(ax, v3_dot(ax, pt) * (1 - c)));
 }
 
+/* vturbulence '(' lambda ',' omega ',' octaves ',' point ')' : POV-Ray's
+ * DTurbulence, from the evaluators the app supplies (sdl_options.func_env). */
+static vec3 vturbulence_fn(sdl_parser *p, src_loc loc)
+{
+    sdl_expect(p, TOK_LPAREN, "'('");
+    double lambda = sdl_float(p);
+    sdl_accept(p, TOK_COMMA);
+    double omega = sdl_float(p);
+    sdl_accept(p, TOK_COMMA);
+    int octaves = sdl_to_int(sdl_float(p));
+    sdl_accept(p, TOK_COMMA);
+    vec3 v = sdl_vector(p);
+    sdl_accept(p, TOK_COMMA);
+    sdl_expect(p, TOK_RPAREN, "')'");
+    if (!sdl_ok(p)) return v3(0, 0, 0);
+    octaves = octaves < 1 ? 1 : (octaves > 10 ? 10 : octaves); /* POV-Ray's clamp */
+    const func_env *env = p->opt.func_env;
+    if (!env || !env->dturbulence) {
+        sdl_error(p, loc, PT_ERR_UNSUPPORTED, "vturbulence needs POV-Ray's noise, which this parse was given no evaluator for");
+        return v3(0, 0, 0);
+    }
+    return env->dturbulence(env->user, v, octaves, omega, lambda);
+}
+
 /* vector_function: the keyword k has been read. */
 static vec3 vector_function(sdl_parser *p, sdl_kw k, src_loc loc)
 {
@@ -484,10 +508,7 @@ static vec3 vector_function(sdl_parser *p, sdl_kw k, src_loc loc)
         return vaxis_rotate_fn(p);
     case KW_TRACE: return sdl_trace_fn(p, loc);
     case KW_MIN_EXTENT: case KW_MAX_EXTENT: return sdl_extent_fn(p, loc, k == KW_MAX_EXTENT);
-    default: /* vturbulence */
-        sdl_error(p, loc, PT_ERR_UNSUPPORTED,
-                  "'%s' needs POV-Ray's noise, which the parser cannot evaluate (shade_noise is not a dependency-free module)", sdl_kw_text(k));
-        return v3(0, 0, 0);
+    default: return vturbulence_fn(p, loc);
     }
 }
 

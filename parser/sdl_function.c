@@ -686,7 +686,7 @@ void sdl_call_function(sdl_parser *p, const sdl_tok *id, double out[5])
         return;
     }
     const char *why = NULL;
-    if (func_eval(f, args, out, NULL, &why) != PT_OK)
+    if (func_eval(f, args, out, p->opt.func_env, &why) != PT_OK)
         sdl_error(p, id->tk.loc, PT_ERR_UNSUPPORTED, "calling function '%.*s' at parse time needs %s, which the parser cannot evaluate",
                   id->tk.len, id->tk.text, why ? why : "an evaluator");
 }

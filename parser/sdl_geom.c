@@ -567,6 +567,345 @@ static void marched_hits(geom *g, const scene_object *o, vec3 org, vec3 dir, hit
     }
 }
 
+/* ------------------------------------------------------------ lathe, prism, blob */
+
+/* One cubic segment of a lathe/prism curve: (u, v)(w) = A w^3 + B w^2 + C w + D,
+ * w in [0, 1] (u = radius or x, v = height or z). */
+typedef struct {
+    double a[2], b[2], c[2], d[2];
+} curve_seg;
+
+/* Segment coefficients for POV-Ray's four curve types from the points
+ * starting at i (3.7's lathe/prism formulas). */
+static void curve_coeffs(scene_spline type, double (*pt)[2], int i, curve_seg *s)
+{
+    for (int k = 0; k < 2; k++) {
+        double p0 = pt[i][k], p1 = type == SPLINE_LINEAR ? 0 : pt[i + 1][k], p2 = 0, p3 = 0;
+        switch (type) {
+        case SPLINE_LINEAR:
+            s->a[k] = s->b[k] = 0;
+            s->c[k] = pt[i + 1][k] - p0;
+            s->d[k] = p0;
+            break;
+        case SPLINE_QUADRATIC:
+            p2 = pt[i + 2][k];
+            s->a[k] = 0;
+            s->b[k] = 0.5 * p0 - p1 + 0.5 * p2;
+            s->c[k] = -0.5 * p0 + 0.5 * p2;
+            s->d[k] = p1;
+            break;
+        case SPLINE_CUBIC:
+            p2 = pt[i + 2][k];
+            p3 = pt[i + 3][k];
+            s->a[k] = -0.5 * p0 + 1.5 * p1 - 1.5 * p2 + 0.5 * p3;
+            s->b[k] = p0 - 2.5 * p1 + 2.0 * p2 - 0.5 * p3;
+            s->c[k] = -0.5 * p0 + 0.5 * p2;
+            s->d[k] = p1;
+            break;
+        default: /* bezier */
+            p2 = pt[i + 2][k];
+            p3 = pt[i + 3][k];
+            s->a[k] = p3 - 3 * p2 + 3 * p1 - p0;
+            s->b[k] = 3 * p2 - 6 * p1 + 3 * p0;
+            s->c[k] = 3 * p1 - 3 * p0;
+            s->d[k] = p0;
+            break;
+        }
+    }
+}
+
+static double seg_at(const curve_seg *s, int k, double w) { return ((s->a[k] * w + s->b[k]) * w + s->c[k]) * w + s->d[k]; }
+static double seg_slope(const curve_seg *s, int k, double w) { return (3 * s->a[k] * w + 2 * s->b[k]) * w + s->c[k]; }
+
+/* Roots in [0, 1] of the segment's v(w) = v0 (monotone pieces between the
+ * derivative's roots, then bisection). Returns the count (at most 3). */
+static int seg_roots(const curve_seg *s, double v0, double *w)
+{
+    double cuts[4] = {0, 0, 0, 1};
+    int nc = 1;
+    double qa = 3 * s->a[1], qb = 2 * s->b[1], qc = s->c[1];
+    if (fabs(qa) > 1e-300) {
+        double disc = qb * qb - 4 * qa * qc;
+        if (disc > 0) {
+            double r1 = (-qb - sqrt(disc)) / (2 * qa), r2 = (-qb + sqrt(disc)) / (2 * qa);
+            if (r1 > r2) { double t = r1; r1 = r2; r2 = t; }
+            if (r1 > 0 && r1 < 1) cuts[nc++] = r1;
+            if (r2 > 0 && r2 < 1) cuts[nc++] = r2;
+        }
+    } else if (fabs(qb) > 1e-300) {
+        double r = -qc / qb;
+        if (r > 0 && r < 1) cuts[nc++] = r;
+    }
+    cuts[nc++] = 1;
+    int n = 0;
+    for (int i = 0; i + 1 < nc; i++) {
+        double a = cuts[i], b = cuts[i + 1], fa = seg_at(s, 1, a) - v0, fb = seg_at(s, 1, b) - v0;
+        if (fa == 0 && i > 0) continue; /* counted as the previous piece's end */
+        if ((fa > 0 && fb > 0) || (fa < 0 && fb < 0)) continue;
+        for (int k = 0; k < 80 && b - a > 1e-15; k++) {
+            double m = 0.5 * (a + b), fm = seg_at(s, 1, m) - v0;
+            if ((fm < 0) == (fa < 0) && fm != 0) { a = m; fa = fm; } else b = m;
+        }
+        if (n < 3) w[n++] = 0.5 * (a + b);
+    }
+    return n;
+}
+
+typedef struct {
+    curve_seg *segs;
+    int n;
+} curve;
+
+/* The lathe's segments: linear/quadratic/cubic advance one point, bezier four. */
+static int lathe_curve(const scene_lathe *la, curve *c)
+{
+    int n = la->npoints, count;
+    switch (la->spline) {
+    case SPLINE_LINEAR: count = n - 1; break;
+    case SPLINE_QUADRATIC: count = n - 2; break;
+    case SPLINE_CUBIC: count = n - 3; break;
+    default: count = n / 4; break;
+    }
+    if (count < 1) return 0;
+    c->segs = malloc(sizeof *c->segs * (size_t)count);
+    if (!c->segs) return 0;
+    for (int s = 0, i = 0; s < count; s++, i += la->spline == SPLINE_BEZIER ? 4 : 1) curve_coeffs(la->spline, la->points, i, &c->segs[s]);
+    c->n = count;
+    return 1;
+}
+
+/* The prism's segments: sub-polygons end where a point repeats the
+ * sub-polygon's first point (POV-Ray 3.7's Compute_Prism walk). */
+static int prism_curve(const scene_prism *pr, curve *c)
+{
+    int n = pr->npoints;
+    c->segs = malloc(sizeof *c->segs * (size_t)(n > 0 ? n : 1));
+    c->n = 0;
+    if (!c->segs || n < 2) return c->segs != NULL;
+    double (*p)[2] = pr->points;
+    double first[2] = {p[0][0], p[0][1]};
+    if (pr->spline == SPLINE_QUADRATIC || pr->spline == SPLINE_CUBIC) {
+        first[0] = p[1][0];
+        first[1] = p[1][1];
+    }
+    int need = pr->spline == SPLINE_LINEAR ? 1 : (pr->spline == SPLINE_QUADRATIC ? 2 : 3);
+    for (int i = 0; i < n - 1; i++) {
+        if (i + need >= n) break;
+        curve_coeffs(pr->spline, p, i, &c->segs[c->n++]);
+        int close = pr->spline == SPLINE_LINEAR ? i + 1 : i + 2;
+        int same = fabs(p[close][0] - first[0]) < 1e-10 && fabs(p[close][1] - first[1]) < 1e-10;
+        if (pr->spline == SPLINE_BEZIER) {
+            i += 3;
+        } else if (same) {
+            int skip = pr->spline == SPLINE_LINEAR ? 1 : (pr->spline == SPLINE_QUADRATIC ? 2 : 3);
+            i += skip;
+            int nf = i + (pr->spline == SPLINE_LINEAR ? 1 : 2);
+            if (nf < n) {
+                first[0] = p[nf][0];
+                first[1] = p[nf][1];
+            }
+        }
+    }
+    return 1;
+}
+
+/* POV-Ray's crossing rule: count the curve points at height v whose u is
+ * not left of the point; odd = inside. */
+static int curve_inside(const curve *c, double u, double v)
+{
+    int nc = 0;
+    for (int i = 0; i < c->n; i++) {
+        double w[3];
+        int n = seg_roots(&c->segs[i], v, w);
+        for (int k = 0; k < n; k++)
+            if (seg_at(&c->segs[i], 0, w[k]) - u >= 0) nc++;
+    }
+    return nc & 1;
+}
+
+/* The 2-D outward normal of the curve near (u, v) (the closest crossing). */
+static int curve_normal(const curve *c, double u, double v, double *nu, double *nv)
+{
+    double best = INFINITY;
+    for (int i = 0; i < c->n; i++) {
+        double w[3];
+        int n = seg_roots(&c->segs[i], v, w);
+        for (int k = 0; k < n; k++) {
+            double du = fabs(seg_at(&c->segs[i], 0, w[k]) - u);
+            if (du < best) {
+                best = du;
+                *nu = seg_slope(&c->segs[i], 1, w[k]);
+                *nv = -seg_slope(&c->segs[i], 0, w[k]);
+            }
+        }
+    }
+    return best < INFINITY;
+}
+
+static int lathe_inside_local(const scene_object *o, vec3 q)
+{
+    curve c = {NULL, 0};
+    if (!o->u.lathe || !lathe_curve(o->u.lathe, &c)) return 0;
+    int in = curve_inside(&c, sqrt(q.x * q.x + q.z * q.z), q.y);
+    free(c.segs);
+    return in;
+}
+
+static int prism_inside_local(const scene_object *o, vec3 q)
+{
+    const scene_prism *pr = o->u.prism;
+    if (!pr) return 0;
+    double h1 = fmin(pr->height1, pr->height2), h2 = fmax(pr->height1, pr->height2);
+    if (!(q.y >= h1 && q.y < h2)) return 0;
+    double u = q.x, v = q.z;
+    if (pr->conic) {
+        if (fabs(q.y) <= 1e-10) return 0;
+        u /= q.y;
+        v /= q.y;
+    }
+    curve c = {NULL, 0};
+    if (!prism_curve(pr, &c)) return 0;
+    int in = curve_inside(&c, u, v);
+    free(c.segs);
+    return in;
+}
+
+/* Blob density at a point of blob space (POV-Ray: strength * (1 - d^2/r^2)^2
+ * inside each component's radius; d to the centre or to the cylinder's axis
+ * segment). */
+static double blob_density(const scene_blob *b, vec3 q)
+{
+    double sum = 0;
+    for (int i = 0; i < b->ncomponents; i++) {
+        const scene_blob_component *c = &b->components[i];
+        vec3 l = xform_inv_point(&c->transform, q), d;
+        if (c->cylinder) {
+            vec3 ax = v3_sub(c->b, c->a);
+            double len2 = v3_dot(ax, ax), t = len2 > 0 ? v3_dot(v3_sub(l, c->a), ax) / len2 : 0;
+            t = t < 0 ? 0 : (t > 1 ? 1 : t);
+            d = v3_sub(l, v3_madd(c->a, ax, t));
+        } else {
+            d = v3_sub(l, c->a);
+        }
+        double r2 = c->radius * c->radius, d2 = v3_dot(d, d);
+        if (d2 < r2) {
+            double f = 1 - d2 / r2;
+            sum += c->strength * f * f;
+        }
+    }
+    return sum;
+}
+
+/* The curved and blobby shapes as an implicit function f (inside: f < 0). */
+static double shape_f(const scene_object *o, vec3 q)
+{
+    switch (o->kind) {
+    case SHAPE_LATHE: return lathe_inside_local(o, q) ? -1 : 1;
+    case SHAPE_PRISM: return prism_inside_local(o, q) ? -1 : 1;
+    default: return o->u.blob->threshold - blob_density(o->u.blob, q);
+    }
+}
+
+static bbox leaf_box_local(const scene_object *o, vec3 *lo, vec3 *hi);
+
+/* Normal of a marched hit in the object's space. */
+static vec3 shape_normal(const scene_object *o, vec3 q, vec3 rd)
+{
+    vec3 n = v3(0, 0, 0);
+    if (o->kind == SHAPE_BLOB) {
+        double h = 1e-7;
+        n = v3(shape_f(o, v3(q.x + h, q.y, q.z)) - shape_f(o, v3(q.x - h, q.y, q.z)),
+               shape_f(o, v3(q.x, q.y + h, q.z)) - shape_f(o, v3(q.x, q.y - h, q.z)),
+               shape_f(o, v3(q.x, q.y, q.z + h)) - shape_f(o, v3(q.x, q.y, q.z - h)));
+    } else if (o->kind == SHAPE_PRISM) {
+        const scene_prism *pr = o->u.prism;
+        double h1 = fmin(pr->height1, pr->height2), h2 = fmax(pr->height1, pr->height2), tol = 1e-7 * (1 + fabs(h2 - h1));
+        curve c = {NULL, 0};
+        double nu = 0, nv = 0;
+        double u = q.x, v = q.z, y = q.y;
+        if (pr->conic && fabs(y) > 1e-10) {
+            u /= y;
+            v /= y;
+        }
+        if (fabs(q.y - h1) < tol) n = v3(0, -1, 0);
+        else if (fabs(q.y - h2) < tol) n = v3(0, 1, 0);
+        else if (prism_curve(pr, &c) && curve_normal(&c, u, v, &nu, &nv)) n = v3(nu, 0, nv);
+        free(c.segs);
+    } else {
+        curve c = {NULL, 0};
+        double r = sqrt(q.x * q.x + q.z * q.z), nr = 0, ny = 0;
+        if (o->u.lathe && lathe_curve(o->u.lathe, &c) && r > 0) {
+            /* the profile's normal, found at the crossing with the hit's height */
+            double ur, uy;
+            if (curve_normal(&c, r, q.y, &ur, &uy)) {
+                nr = ur;
+                ny = uy;
+            }
+        }
+        free(c.segs);
+        n = r > 0 ? v3(nr * q.x / r, ny, nr * q.z / r) : v3(0, ny, 0);
+    }
+    if (v3_len2(n) == 0) n = v3_neg(rd);
+    n = v3_norm(n);
+    /* outward: a small step along it leaves the solid */
+    double eps = 1e-6 * (1 + v3_len(q));
+    if (o->kind != SHAPE_BLOB && shape_f(o, v3_madd(q, n, eps)) < 0) n = v3_neg(n);
+    return n;
+}
+
+/* March the ray through the shape's box with small steps, bisect each change
+ * between inside and outside. */
+static void shape_marched_hits(geom *g, const scene_object *o, vec3 org, vec3 dir, hit_list *l)
+{
+    vec3 ro, rd, lo, hi;
+    local_ray(o, org, dir, &ro, &rd);
+    bbox lb = leaf_box_local(o, &lo, &hi);
+    (void)lb;
+    double t0 = -INFINITY, t1 = INFINITY;
+    for (int i = 0; i < 3; i++) {
+        double d = v3_idx(rd, i), oo = v3_idx(ro, i), a = v3_idx(lo, i), b = v3_idx(hi, i);
+        double pad = 1e-9 * (1 + fabs(b - a));
+        a -= pad;
+        b += pad;
+        if (fabs(d) < 1e-300) {
+            if (oo < a || oo > b) return;
+            continue;
+        }
+        double ta = (a - oo) / d, tb = (b - oo) / d;
+        if (ta > tb) { double t = ta; ta = tb; tb = t; }
+        if (ta > t0) t0 = ta;
+        if (tb < t1) t1 = tb;
+    }
+    if (t0 > t1) return;
+    double diag = v3_len(v3_sub(hi, lo)), len = v3_len(rd);
+    double step = diag / 4000;
+    if (o->kind == SHAPE_BLOB) {
+        double rmin = INFINITY;
+        for (int i = 0; i < o->u.blob->ncomponents; i++) rmin = fmin(rmin, o->u.blob->components[i].radius);
+        if (rmin < INFINITY) step = fmin(step, rmin / 16);
+    }
+    if (len <= 0 || step <= 0) return;
+    long n = (long)ceil((t1 - t0) * len / step);
+    if (n > 200000) n = 200000;
+    if (n < 1) n = 1;
+    double dt = (t1 - t0) / (double)n;
+    double ta = t0, fa = shape_f(o, v3_madd(ro, rd, ta));
+    for (long i = 1; i <= n; i++) {
+        double tb = t0 + dt * (double)i, fb = shape_f(o, v3_madd(ro, rd, tb));
+        if ((fa < 0) != (fb < 0)) {
+            double a = ta, b = tb, va = fa;
+            for (int k = 0; k < 100 && b - a > 1e-14 * (1 + fabs(a)); k++) {
+                double m = 0.5 * (a + b), vm = shape_f(o, v3_madd(ro, rd, m));
+                if ((vm < 0) == (va < 0)) { a = m; va = vm; } else b = m;
+            }
+            double t = 0.5 * (a + b);
+            add_hit(g, l, t, world_normal(o, shape_normal(o, v3_madd(ro, rd, t), rd)), o);
+        }
+        ta = tb;
+        fa = fb;
+    }
+}
+
 /* ------------------------------------------------------------ objects */
 
 static int obj_inside(geom *g, const scene_object *o, vec3 p);
@@ -592,6 +931,8 @@ static int leaf_inside(geom *g, const scene_object *o, vec3 q)
     case SHAPE_CYLINDER: case SHAPE_CONE: return cone_inside(o, q);
     case SHAPE_TORUS: case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: return implicit_f(o, q) < 0;
     case SHAPE_DISC: case SHAPE_POLYGON: return 0;
+    case SHAPE_LATHE: case SHAPE_PRISM: return shape_f(o, q) < 0;
+    case SHAPE_BLOB: if (!o->u.blob) break; return shape_f(o, q) < 0;
     case SHAPE_MESH: {
         if (!o->u.mesh.inside_vector_set) break;
         /* parity of the crossings along inside_vector (POV-Ray's rule) */
@@ -655,6 +996,9 @@ static void leaf_hits(geom *g, const scene_object *o, vec3 org, vec3 dir, hit_li
     case SHAPE_DISC: disc_hits(g, o, org, dir, l); return;
     case SHAPE_QUADRIC: quadric_hits(g, o, org, dir, l); return;
     case SHAPE_TORUS: case SHAPE_SUPERELLIPSOID: marched_hits(g, o, org, dir, l); return;
+    case SHAPE_LATHE: case SHAPE_PRISM: case SHAPE_BLOB:
+        if (o->u.lathe) shape_marched_hits(g, o, org, dir, l); /* u.lathe/u.prism/u.blob share the slot */
+        return;
     default:
         if (!g->unsupported) g->unsupported = o->name ? o->name : "object";
         return;
@@ -902,7 +1246,12 @@ static bbox leaf_box(geom *g, const scene_object *o)
     }
     case SHAPE_SUPERELLIPSOID: return transformed_box(x, v3s(-1), v3s(1));
     case SHAPE_POLYGON: return o->u.polygon ? points_box(x, o->u.polygon->points, o->u.polygon->npoints) : huge_box();
-    case SHAPE_LATHE: case SHAPE_SOR: {
+    case SHAPE_LATHE: {
+        vec3 lo, hi;
+        leaf_box_local(o, &lo, &hi);
+        return transformed_box(x, lo, hi);
+    }
+    case SHAPE_SOR: {
         const scene_lathe *la = o->u.lathe;
         double rmax = 0, ylo = INFINITY, yhi = -INFINITY;
         for (int i = 0; la && i < la->npoints; i++) {
@@ -1121,4 +1470,88 @@ void sdl_geom_free(sdl_parser *p)
         h = n;
     }
     p->geom_cache = NULL;
+}
+
+/* Boxes in the shape's own space for the marched shapes (lathe: POV-Ray's
+ * bounding cylinder from the segments' extremes). */
+static bbox leaf_box_local(const scene_object *o, vec3 *lo, vec3 *hi)
+{
+    *lo = v3s(-1);
+    *hi = v3s(1);
+    if (o->kind == SHAPE_LATHE && o->u.lathe) {
+        curve c = {NULL, 0};
+        double rmax = 0, ylo = INFINITY, yhi = -INFINITY;
+        if (lathe_curve(o->u.lathe, &c)) {
+            for (int i = 0; i < c.n; i++) {
+                const curve_seg *s = &c.segs[i];
+                double ws[4] = {0, 1, -1, -1};
+                for (int k = 0; k < 2; k++) { /* extremes where the derivative vanishes */
+                    double qa = 3 * s->a[k], qb = 2 * s->b[k], qc = s->c[k];
+                    double cand[2];
+                    int nc = 0;
+                    if (fabs(qa) > 1e-300) {
+                        double disc = qb * qb - 4 * qa * qc;
+                        if (disc >= 0) {
+                            cand[nc++] = (-qb - sqrt(disc)) / (2 * qa);
+                            cand[nc++] = (-qb + sqrt(disc)) / (2 * qa);
+                        }
+                    } else if (fabs(qb) > 1e-300) {
+                        cand[nc++] = -qc / qb;
+                    }
+                    for (int j = 0; j < nc; j++) ws[2 + j] = cand[j];
+                    for (int j = 0; j < 4; j++) {
+                        double w = ws[j];
+                        if (w < 0 || w > 1) continue;
+                        if (k == 0) rmax = fmax(rmax, fabs(seg_at(s, 0, w)));
+                        else {
+                            ylo = fmin(ylo, seg_at(s, 1, w));
+                            yhi = fmax(yhi, seg_at(s, 1, w));
+                        }
+                    }
+                    ws[2] = ws[3] = -1;
+                }
+            }
+            free(c.segs);
+            if (o->u.lathe->spline == SPLINE_BEZIER) /* POV-Ray bounds a bezier segment by its 4 points */
+                for (int i = 0; i < c.n * 4 && i < o->u.lathe->npoints; i++) {
+                    rmax = fmax(rmax, fabs(o->u.lathe->points[i][0]));
+                    ylo = fmin(ylo, o->u.lathe->points[i][1]);
+                    yhi = fmax(yhi, o->u.lathe->points[i][1]);
+                }
+        }
+        if (ylo > yhi) ylo = yhi = 0;
+        *lo = v3(-rmax, ylo, -rmax);
+        *hi = v3(rmax, yhi, rmax);
+    } else if (o->kind == SHAPE_PRISM && o->u.prism) {
+        const scene_prism *pr = o->u.prism;
+        double xl = INFINITY, xh = -INFINITY, zl = INFINITY, zh = -INFINITY;
+        for (int i = 0; i < pr->npoints; i++) {
+            xl = fmin(xl, pr->points[i][0]);
+            xh = fmax(xh, pr->points[i][0]);
+            zl = fmin(zl, pr->points[i][1]);
+            zh = fmax(zh, pr->points[i][1]);
+        }
+        double y0 = fmin(pr->height1, pr->height2), y1 = fmax(pr->height1, pr->height2);
+        if (pr->conic) {
+            double s = fmax(fabs(y0), fabs(y1));
+            xl = fmin(xl * s, 0);
+            xh = fmax(xh * s, 0);
+            zl = fmin(zl * s, 0);
+            zh = fmax(zh * s, 0);
+        }
+        *lo = v3(xl, y0, zl);
+        *hi = v3(xh, y1, zh);
+    } else if (o->kind == SHAPE_BLOB && o->u.blob) {
+        *lo = v3s(INFINITY);
+        *hi = v3s(-INFINITY);
+        for (int i = 0; i < o->u.blob->ncomponents; i++) {
+            const scene_blob_component *c = &o->u.blob->components[i];
+            vec3 b2 = c->cylinder ? c->b : c->a;
+            bbox cb = transformed_box(&c->transform, v3_sub(v3_min(c->a, b2), v3s(c->radius)), v3_add(v3_max(c->a, b2), v3s(c->radius)));
+            *lo = v3_min(*lo, cb.lo);
+            *hi = v3_max(*hi, cb.hi);
+        }
+        if (o->u.blob->ncomponents == 0) *lo = *hi = v3s(0);
+    }
+    return box_of(*lo, *hi);
 }

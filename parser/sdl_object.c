@@ -919,8 +919,12 @@ sdl_obj *sdl_parse_object(sdl_parser *p)
         if (!so) return NULL;
         shape_args(p, k.tk.kw, so, k.tk.loc);
     }
-    if (k.tk.kw == KW_LIGHT_GROUP) sdl_accept_kw(p, KW_GLOBAL_LIGHTS);
     sdl_object_mods(p, so);
+    /* light_group: global_lights [bool] may stand among the modifiers */
+    while (k.tk.kw == KW_LIGHT_GROUP && sdl_ok(p) && sdl_accept_kw(p, KW_GLOBAL_LIGHTS)) {
+        sdl_allow_float(p, 1.0);
+        sdl_object_mods(p, so);
+    }
     if (!sdl_end_block(p)) return NULL;
     return so;
 }
