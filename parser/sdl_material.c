@@ -275,6 +275,17 @@ scene_normal *sdl_parse_normal_from(sdl_parser *p, const scene_normal *base)
 
 scene_normal *sdl_parse_normal(sdl_parser *p) { return sdl_parse_normal_from(p, p->s->default_texture.normal); }
 
+void sdl_attach_normal(sdl_parser *p, scene_texture *t)
+{
+    int fresh = t->normal == NULL;
+    scene_normal *nm = sdl_parse_normal_from(p, t->normal);
+    t->has_normal = 1;
+    if (!nm) return;
+    /* transforms already applied to t moved its pigment, not this new normal */
+    if (fresh && !xform_is_identity(&t->transform)) nm->transform = xform_then(nm->transform, xform_inverse(t->transform));
+    t->normal = nm;
+}
+
 /* ------------------------------------------------------------ interiors */
 
 /* interior_item := ior f | dispersion f | dispersion_samples n | caustics f |

@@ -25,6 +25,10 @@ scene_finish *sdl_parse_finish_new(sdl_parser *p);
  * from the default texture's normal / from `base`. NULL after an error. */
 scene_normal *sdl_parse_normal(sdl_parser *p);
 scene_normal *sdl_parse_normal_from(sdl_parser *p, const scene_normal *base);
+/* normal '{' ... '}' on texture t (its top layer): modifies t's normal, or
+ * creates one that the transforms already applied to t do not move (POV-Ray
+ * transforms only the parts of a texture that exist). */
+void sdl_attach_normal(sdl_parser *p, scene_texture *t);
 /* interior '{' ... '}' */
 void sdl_parse_interior(sdl_parser *p, scene_interior *in);
 scene_interior *sdl_parse_interior_new(sdl_parser *p);

@@ -258,11 +258,8 @@ static int material_mod(sdl_parser *p, scene_object *o, sdl_kw k)
     }
     case KW_NORMAL: {
         scene_texture *t = top_texture(p, o);
-        scene_normal *nm = sdl_parse_normal_from(p, t ? t->normal : NULL);
-        if (t) {
-            t->has_normal = 1;
-            if (nm) t->normal = nm;
-        }
+        if (t) sdl_attach_normal(p, t);
+        else sdl_parse_normal(p);
         return 1;
     }
     case KW_INTERIOR: {
