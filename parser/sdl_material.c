@@ -374,9 +374,7 @@ static int texture_item(sdl_parser *p, scene_texture *t)
         return 1;
     }
     if (sdl_accept_kw(p, KW_NORMAL)) {
-        scene_normal *nm = sdl_parse_normal_from(p, t->normal);
-        if (nm) t->normal = nm;
-        t->has_normal = 1;
+        sdl_attach_normal(p, t);
         return 1;
     }
     return sdl_accept_kw(p, KW_NO_BUMP_SCALE) || sdl_accept_kw(p, KW_UV_MAPPING);
