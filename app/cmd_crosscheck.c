@@ -25,10 +25,12 @@
  *
  * Exit: 0 when both renders were made and compared (this reports; it does
  * not judge); 1 when either renderer failed on the scene; 2 usage; 3 when
- * POV-Ray is missing or a file cannot be read or written. */
+ * POV-Ray is missing or a file cannot be read or written; 130 (143) after
+ * Ctrl-C (SIGTERM), with the temporary files removed. */
 #include "cmd_crosscheck.h"
 #include <limits.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -252,6 +254,15 @@ static void absolute(const char *p, char *buf, size_t n)
     snprintf(buf, n, "%s/%s", cwd, p);
 }
 
+/* Ctrl-C / SIGTERM stop the running renderer (same process group); the
+ * command then cleans up its temporary directory and exits 130 / 143. */
+static volatile sig_atomic_t g_stop = 0;
+static void on_stop(int sig)
+{
+    g_stop = sig;
+    subproc_forward_signal(sig);
+}
+
 int cmd_crosscheck(int argc, char **argv)
 {
     xc_opts o;
@@ -351,6 +362,8 @@ int cmd_crosscheck(int argc, char **argv)
     }
     remove(pov_log);
     remove(pt_log);
+    signal(SIGINT, on_stop);
+    signal(SIGTERM, on_stop);
 
     /* POV-Ray. */
     {
@@ -545,5 +558,6 @@ done:
         if (rmdir(work) != 0 && !o.quiet && rc == 0)
             fprintf(stderr, "partray crosscheck: left files in %s\n", work);
     }
+    if (g_stop) rc = g_stop == SIGTERM ? 143 : 130;
     return rc;
 }

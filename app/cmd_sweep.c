@@ -10,7 +10,8 @@
  * Each image is compared with the reference: on linear values (HDR-FLIP)
  * when the reference is EXR or PFM, on display values (LDR-FLIP) when it
  * is a PNG. A render whose size differs from the reference's (a sweep over
- * `size`) is resampled bilinearly to the reference's size first.
+ * `size`) is resampled to the reference's size first: box-filtered when it
+ * is larger, bilinearly interpolated when it is smaller.
  *
  * KEY -> render option:
  *   size=WxH        --size WxH
@@ -36,7 +37,8 @@
  *               times, metrics, image and FLIP heat map
  *   ref.png, runs/NNN_MODE.{exr,png,json,log}, runs/NNN_MODE_flip.png
  * Exit: 0 all renders done; else the first failing render's exit code
- * (outputs are still written for the others); 2 usage; 3 I/O. */
+ * (outputs are still written for the others); 2 usage; 3 I/O; 130 (143)
+ * after Ctrl-C (SIGTERM): the outputs then cover the renders done so far. */
 #include "cmd_sweep.h"
 #include <math.h>
 #include <signal.h>
@@ -122,6 +124,15 @@ static void av_free(argvec *a)
     for (int i = 0; i < a->n; i++) free(a->v[i]);
     free(a->v);
     memset(a, 0, sizeof *a);
+}
+
+/* Ctrl-C / SIGTERM reach the running render too (same process group); the
+ * sweep notes them, stops after that render and still writes its outputs. */
+static volatile sig_atomic_t g_stop = 0;
+static void on_stop(int sig)
+{
+    g_stop = sig;
+    subproc_forward_signal(sig);
 }
 
 /* Prints the messages recorded since the last call. */
@@ -233,9 +244,38 @@ static int reserved_option(const char *a)
     return (a[0] == '+' || a[0] == '-') && (a[1] == 'O' || a[1] == 'o' || a[1] == 'I' || a[1] == 'i') && a[2];
 }
 
-/* Bilinear resampling (pixel centres aligned) to w x h. */
+/* Box filter down to w x h: each output pixel is the mean of the source
+ * pixels whose centres fall inside its footprint. */
+static framebuffer *downsample(const framebuffer *src, int w, int h)
+{
+    framebuffer *dst = fb_new(w, h);
+    if (!dst) return NULL;
+    double sx = (double)src->width / w, sy = (double)src->height / h;
+    for (int y = 0; y < h; y++) {
+        int y0 = (int)ceil(y * sy - 0.5), y1 = (int)ceil((y + 1) * sy - 0.5);
+        if (y1 <= y0) y1 = y0 + 1;
+        if (y1 > src->height) y1 = src->height;
+        for (int x = 0; x < w; x++) {
+            int x0 = (int)ceil(x * sx - 0.5), x1 = (int)ceil((x + 1) * sx - 0.5);
+            if (x1 <= x0) x1 = x0 + 1;
+            if (x1 > src->width) x1 = src->width;
+            double acc[3] = {0, 0, 0};
+            int n = 0;
+            for (int j = y0; j < y1; j++)
+                for (int i = x0; i < x1; i++, n++)
+                    for (int c = 0; c < 3; c++) acc[c] += src->rgb[((size_t)j * (size_t)src->width + (size_t)i) * 3 + (size_t)c];
+            float *o = fb_px(dst, x, y);
+            for (int c = 0; c < 3; c++) o[c] = n ? (float)(acc[c] / n) : 0.0f;
+        }
+    }
+    return dst;
+}
+
+/* To w x h: box filter where the source is larger in both directions,
+ * bilinear interpolation (pixel centres aligned) otherwise. */
 static framebuffer *resample(const framebuffer *src, int w, int h)
 {
+    if (src->width >= w && src->height >= h) return downsample(src, w, h);
     framebuffer *dst = fb_new(w, h);
     if (!dst) return NULL;
     double sx = (double)src->width / w, sy = (double)src->height / h;
@@ -759,6 +799,9 @@ int cmd_sweep(int argc, char **argv)
     /* Render and compare. */
     int first_fail = 0, interrupted = 0;
     double t_sweep = timer_now();
+    g_stop = 0;
+    signal(SIGINT, on_stop);
+    signal(SIGTERM, on_stop);
     for (int i = 0; i < nruns; i++) {
         sweep_run *r = &runs[i];
         char exr[4200], png[4200], js[4200], log[4200];
@@ -821,8 +864,9 @@ int cmd_sweep(int argc, char **argv)
                 fprintf(stderr, "%s", n > 2000 ? text + n - 2000 : text);
             }
             free(text);
-            if (r->exit_code == 130 || r->exit_code == 128 + SIGINT) interrupted = 1;
+            if (r->exit_code == 130 || r->exit_code == 143) interrupted = 1;
         }
+        if (g_stop) interrupted = 1;
         if (!quiet) {
             fprintf(stderr, "[%d/%d] %s %s: ", i + 1, nruns, r->mode, r->settings[0] ? r->settings : "(base)");
             if (r->compared)
@@ -857,7 +901,7 @@ int cmd_sweep(int argc, char **argv)
     if (!quiet)
         fprintf(stderr, "partray sweep: %d renders in %.1f s; %s/sweep.csv, %s/plot.png, %s/index.html\n", nruns,
                 timer_now() - t_sweep, out_dir, out_dir, out_dir);
-    rc = interrupted ? 130 : first_fail;
+    rc = interrupted ? (g_stop == SIGTERM ? 143 : 130) : first_fail;
 
 done:
     for (int v = 0; v < nvary; v++) free(vary[v].buf);

@@ -2,6 +2,7 @@
 #include "subproc.h"
 #include <errno.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,6 +39,14 @@ int subproc_find_program(const char *name, char *buf, size_t n)
         path = colon + 1;
     }
     return 0;
+}
+
+static volatile sig_atomic_t g_child = 0;
+
+void subproc_forward_signal(int sig)
+{
+    pid_t pid = (pid_t)g_child;
+    if (pid > 0) kill(pid, sig);
 }
 
 int subproc_self_exe(char *buf, size_t n)
@@ -90,13 +99,16 @@ int subproc_run(const char *const *argv, const char *cwd, const char *log_path, 
         _exit(127);
     }
     if (logfd >= 0) close(logfd);
+    g_child = (sig_atomic_t)pid;
     int status = 0;
     while (waitpid(pid, &status, 0) < 0) {
         if (errno != EINTR) {
+            g_child = 0;
             diag_error(d, "waiting for '%s': %s", prog, strerror(errno));
             return -1;
         }
     }
+    g_child = 0;
     if (seconds) *seconds = timer_now() - t0;
     if (WIFEXITED(status)) {
         int rc = WEXITSTATUS(status);

@@ -13,6 +13,10 @@
  * *seconds (may be NULL) receives the wall-clock time. */
 int subproc_run(const char *const *argv, const char *cwd, const char *log_path, double *seconds, diag *d);
 
+/* Sends `sig` to the child subproc_run is waiting for, if any (safe to
+ * call from a signal handler). */
+void subproc_forward_signal(int sig);
+
 /* The path of the running executable ("/proc/self/exe" resolved), written
  * into buf; 0 when it cannot be found. */
 int subproc_self_exe(char *buf, size_t n);
