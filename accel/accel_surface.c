@@ -228,6 +228,10 @@ static double shape_area(shape_geo *g)
         }
         break;
     }
+    case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
+        /* uniform in object space (accel_sweep), so only under similarities */
+        if (g->similar) parts[0] = accel_sweep_area(sh) * jac(x, v3(0, 1, 0));
+        break;
     default:
         break;
     }
@@ -445,6 +449,8 @@ static int collect(accel_surf *as, const scene_object *o, const scene_texture *p
         return add_leaf(as, o, tex ? tex : &as->s->default_texture, flags);
     case SHAPE_POLYGON: case SHAPE_HEIGHT_FIELD:
         return add_issue4(as, o, tex ? tex : &as->s->default_texture, flags);
+    case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
+        return add_leaf(as, o, tex ? tex : &as->s->default_texture, flags);
     default: /* merge, intersection, difference, unsupported: not sampled */
         return 1;
     }
@@ -668,6 +674,9 @@ static void sample_shape(const shape_geo *g, double u1, double u2, rng *r, vec3 
         *n = v3_norm(xform_normal(x, sh->g.plane.n));
         return;
     }
+    case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
+        accel_sweep_sample(sh, u1, u2, r, &po, &no, part);
+        break;
     default:
         break;
     }

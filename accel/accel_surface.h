@@ -28,10 +28,12 @@
  * difference and merge (their visible surface is a part of the members'
  * surfaces; a later version can sample a member and reject points that the
  * CSG inside rules remove), unsupported shapes, degenerate objects,
- * objects with clipped_by, and the curved issue-4 shapes (lathe, sor,
- * prism, text, superellipsoid, quadric, poly, blob). Polygons (their
- * region cut into triangles) and height fields (their cells' triangles)
- * are sampled exactly.
+ * objects with clipped_by, and the issue-4 shapes superellipsoid, quadric,
+ * poly, blob, isosurface, julia_fractal, conic prisms, and lathes, sors,
+ * prisms and text under non-similarity transforms. Polygons (their region
+ * cut into triangles) and height fields (their cells' triangles) are
+ * sampled exactly; lathe, sor, linear prism and text uniformly by area
+ * (accel_sweep_sample) under similarities.
  * Union members are sampled as separate leaves, as accel renders them. */
 #ifndef PT_ACCEL_SURFACE_H
 #define PT_ACCEL_SURFACE_H

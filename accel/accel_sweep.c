@@ -60,6 +60,10 @@ typedef struct {
     double base_r2, cap_r2;
     /* polygon: object-space plane and in-plane frame */
     vec3 pn, pu, pv, p0;
+    /* GI sampling: parts 0 base cap, 1 top cap, 2 + k segment k (local areas) */
+    int nparts;
+    double *part_area, *part_cdf, *part_max;
+    double total_area;       /* object space */
 } sw_data;
 
 /* ------------------------------------------------------------ small helpers */
@@ -912,6 +916,193 @@ static int setup_polygon(sw_data *w, const scene_polygon *pg, vec3 *lo, vec3 *hi
     return 0;
 }
 
+/* ------------------------------------------------------------ areas and sampling */
+
+/* 5-point Gauss-Legendre on [0,1] (exact for degree 9), composite over 8
+ * pieces for the non-polynomial integrands. */
+static const double GL_X[5] = {0.04691007703066800, 0.23076534494715845, 0.5, 0.76923465505284155,
+                               0.95308992296933200};
+static const double GL_W[5] = {0.11846344252809454, 0.23931433524968324, 0.28444444444444444, 0.23931433524968324,
+                               0.11846344252809454};
+
+/* Densities over a part's parameter (local units). */
+static double lathe_density(const sw_seg *s, double t)
+{
+    double p[2], dp[2];
+    seg_eval(s, t, p, dp);
+    return fabs(p[0]) * sqrt(dp[0] * dp[0] + dp[1] * dp[1]);
+}
+
+static double side_density(const sw_seg *s, double t)
+{
+    double p[2], dp[2];
+    seg_eval(s, t, p, dp);
+    return sqrt(dp[0] * dp[0] + dp[1] * dp[1]);
+}
+
+static double sor_density(const sor_seg *s, double u)
+{
+    double h = s->y1 - s->y0, y = s->y0 + u * h, dg;
+    double g = sor_g(s, y, &dg);
+    return sqrt(fmax(0.0, g + 0.25 * dg * dg)) * h;
+}
+
+static double part_density(const sw_data *w, int part, double t)
+{
+    int k = part - 2;
+    if (w->type == SW_LATHE) return lathe_density(&w->seg[k], t);
+    if (w->type == SW_SOR) return sor_density(&w->sor[k], t);
+    return side_density(&w->seg[k], t);
+}
+
+/* Integral over [0,1] and a bound of the density (dense samples + 10 %). */
+static void integrate_part(const sw_data *w, int part, double *area, double *bound)
+{
+    double acc = 0.0, mx = 0.0;
+    for (int piece = 0; piece < 8; piece++)
+        for (int i = 0; i < 5; i++) acc += GL_W[i] * part_density(w, part, (piece + GL_X[i]) / 8.0) / 8.0;
+    for (int i = 0; i <= 128; i++) mx = fmax(mx, part_density(w, part, i / 128.0));
+    *area = acc;
+    *bound = 1.1 * mx + 1e-300;
+}
+
+/* Area of the cap region, 1/2 sum of the integral of p . n_out ds. */
+static double cap_area(const sw_data *w)
+{
+    double a = 0.0;
+    for (int k = 0; k < w->nseg; k++) {
+        const sw_seg *s = &w->seg[k];
+        for (int i = 0; i < 5; i++) {
+            double p[2], n[2];
+            seg_eval(s, GL_X[i], p, NULL);
+            seg_normal(s, GL_X[i], n);
+            a += 0.5 * GL_W[i] * (p[0] * n[0] + p[1] * n[1]);
+        }
+    }
+    return fabs(a);
+}
+
+static void setup_areas(sw_data *w)
+{
+    if (w->type == SW_POLYGON || (w->type == SW_PRISM && w->conic)) return;
+    int np = 2 + w->nseg;
+    w->part_area = calloc((size_t)np, sizeof(double));
+    w->part_cdf = calloc((size_t)np, sizeof(double));
+    w->part_max = calloc((size_t)np, sizeof(double));
+    if (!w->part_area || !w->part_cdf || !w->part_max) return;
+    w->nparts = np;
+    if (w->type == SW_SOR) {
+        if (!w->open) {
+            w->part_area[0] = M_PI * w->base_r2;
+            w->part_area[1] = M_PI * w->cap_r2;
+        }
+        for (int k = 0; k < w->nseg; k++) {
+            integrate_part(w, 2 + k, &w->part_area[2 + k], &w->part_max[2 + k]);
+            w->part_area[2 + k] *= 2.0 * M_PI;
+        }
+    } else if (w->type == SW_LATHE) {
+        for (int k = 0; k < w->nseg; k++) {
+            integrate_part(w, 2 + k, &w->part_area[2 + k], &w->part_max[2 + k]);
+            w->part_area[2 + k] *= 2.0 * M_PI;
+        }
+    } else {
+        if (!w->open) w->part_area[0] = w->part_area[1] = cap_area(w);
+        for (int k = 0; k < w->nseg; k++) {
+            integrate_part(w, 2 + k, &w->part_area[2 + k], &w->part_max[2 + k]);
+            w->part_area[2 + k] *= w->h2 - w->h1;
+        }
+    }
+    double tot = 0.0;
+    for (int i = 0; i < np; i++) tot += w->part_area[i];
+    double acc = 0.0;
+    for (int i = 0; i < np; i++) {
+        acc += w->part_area[i];
+        w->part_cdf[i] = tot > 0.0 ? acc / tot : (double)(i + 1) / np;
+    }
+    w->total_area = isfinite(tot) ? tot * w->L * w->L : 0.0;
+}
+
+double accel_sweep_area(const accel_shape *sh)
+{
+    const sw_data *w = sh->data;
+    return w && w->nparts ? w->total_area : 0.0;
+}
+
+static double next_rand(rng *r, int *k, double u)
+{
+    /* with no generator: an additive recurrence from u (deterministic) */
+    if (r) return rng_f64(r);
+    double v = u + 0.6180339887498949 * ++*k;
+    return v - floor(v);
+}
+
+void accel_sweep_sample(const accel_shape *sh, double u1, double u2, rng *r, vec3 *p, vec3 *n, unsigned *part)
+{
+    const sw_data *w = sh->data;
+    *p = v3s(0.0);
+    *n = v3(0, 1, 0);
+    *part = 0;
+    if (!w || !w->nparts) return;
+    int i = 0;
+    while (i < w->nparts - 1 && u1 >= w->part_cdf[i]) i++;
+    double a = i > 0 ? w->part_cdf[i - 1] : 0.0, b = w->part_cdf[i];
+    double v = b > a ? (u1 - a) / (b - a) : 0.5;
+    v = fmin(fmax(v, 0.0), 0x1.fffffffffffffp-1);
+    *part = (unsigned)i;
+    int k = 0;
+    vec3 lp = v3s(0.0), ln = v3(0, 1, 0);
+    if (i >= 2) {
+        /* the curve parameter by rejection against the density bound */
+        double t = v;
+        for (int it = 0; it < 4096 && r; it++) {
+            if (next_rand(r, &k, u2) * w->part_max[i] <= part_density(w, i, t)) break;
+            t = next_rand(r, &k, u2);
+        }
+        double u = u2;
+        if (w->type == SW_LATHE) {
+            const sw_seg *s = &w->seg[i - 2];
+            double c[2], n2[2], phi = 2.0 * M_PI * u;
+            seg_eval(s, t, c, NULL);
+            seg_normal(s, t, n2);
+            lp = v3(c[0] * cos(phi), c[1], c[0] * sin(phi));
+            ln = v3(n2[0] * cos(phi), n2[1], n2[0] * sin(phi));
+        } else if (w->type == SW_SOR) {
+            const sor_seg *s = &w->sor[i - 2];
+            double y = s->y0 + t * (s->y1 - s->y0), dg, phi = 2.0 * M_PI * u;
+            double rr = sqrt(fmax(0.0, sor_g(s, y, &dg)));
+            lp = v3(rr * cos(phi), y, rr * sin(phi));
+            ln = v3(lp.x, -0.5 * dg, lp.z);
+        } else {
+            const sw_seg *s = &w->seg[i - 2];
+            double c[2], n2[2], h = w->h1 + u * (w->h2 - w->h1);
+            seg_eval(s, t, c, NULL);
+            seg_normal(s, t, n2);
+            lp = from_local_axes(w->ax, c[0], h, c[1]);
+            ln = from_local_axes(w->ax, n2[0], 0.0, n2[1]);
+        }
+    } else if (w->type == SW_SOR) {
+        double r2 = i == 0 ? w->base_r2 : w->cap_r2, rho = sqrt(r2 * v), phi = 2.0 * M_PI * u2;
+        double y = i == 0 ? w->sor[0].y0 : w->sor[w->nseg - 1].y1;
+        lp = v3(rho * cos(phi), y, rho * sin(phi));
+        ln = v3(0, i == 0 ? -1 : 1, 0);
+    } else {
+        /* a prism cap: rejection in the curve's box */
+        double x = v, y = u2;
+        for (int it = 0; it < 100000; it++) {
+            double cu = w->clo[0] + x * (w->chi[0] - w->clo[0]), cv = w->clo[1] + y * (w->chi[1] - w->clo[1]);
+            if (in_curve(w, cu, cv) || it == 99999) {
+                lp = from_local_axes(w->ax, cu, i == 0 ? w->h1 : w->h2, cv);
+                break;
+            }
+            x = next_rand(r, &k, v);
+            y = next_rand(r, &k, u2 + 0.5);
+        }
+        ln = from_local_axes(w->ax, 0.0, i == 0 ? -1.0 : 1.0, 0.0);
+    }
+    *p = v3_add(w->c, v3_scale(lp, w->L));
+    *n = v3_norm(ln);
+}
+
 int accel_sweep_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
 {
     sw_data *w = calloc(1, sizeof *w);
@@ -935,6 +1126,7 @@ int accel_sweep_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
         *lo = v3_add(w->c, v3_scale(w->blo, w->L));
         *hi = v3_add(w->c, v3_scale(w->bhi, w->L));
     }
+    setup_areas(w);
     sh->data = w;
     return 0;
 }
@@ -943,6 +1135,9 @@ void accel_sweep_free(void *data)
 {
     sw_data *w = data;
     if (!w) return;
+    free(w->part_area);
+    free(w->part_cdf);
+    free(w->part_max);
     free(w->seg);
     free(w->sor);
     free(w);

@@ -19,6 +19,7 @@
 #ifndef PT_ACCEL_SWEEP_H
 #define PT_ACCEL_SWEEP_H
 #include "accel_shapes.h"
+#include "rng.h"
 
 /* Set up sh (kind SHAPE_LATHE, SOR, PRISM, TEXT or POLYGON) from o; object
  * space bounds in lo/hi. Allocates sh->data. -1 when degenerate. */
@@ -29,6 +30,18 @@ int accel_sweep_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
 int accel_sweep_inside(const accel_shape *sh, vec3 q);
 /* Object-space outward normal (not unit) and surface parameters at q. */
 void accel_sweep_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v);
+/* GI sampling (lathe, sor, linear-sweep prism, text): the object-space
+ * surface area (0 when not supported: conic prisms, polygons), and a point
+ * uniform by object-space area with its outward object-space normal and
+ * part. Parts are picked by exact area (Gauss-Legendre on the polynomial
+ * integrands: caps by the divergence theorem, sides with |C'| and the
+ * lathe's radius), positions within a part by rejection against a bound of
+ * the density taken from dense samples with a 10 % margin, caps by rejection
+ * against the even-odd test. With r NULL the first candidate is taken
+ * (u1 picks the part and the curve parameter, u2 the angle or height). */
+double accel_sweep_area(const accel_shape *sh);
+void accel_sweep_sample(const accel_shape *sh, double u1, double u2, rng *r, vec3 *p, vec3 *n, unsigned *part);
+
 /* Polygon: its even-odd region as object-space triangles (trapezoids of
  * the slabs between vertex heights, two triangles each; exact for simple
  * and holed polygons). Calls emit(ctx, a, b, c) per triangle; returns the

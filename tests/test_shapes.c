@@ -870,6 +870,57 @@ static void test_surface_sampling(void **st)
     unlink(path);
 }
 
+/* GI sampling of the spline shapes: exact areas, points on the surface
+ * with outward normals, parts in proportion to their areas */
+static void check_sampled(const char *src, double area, unsigned side_lo, unsigned side_hi, double side_fraction)
+{
+    world w = build(src);
+    pt_status ps;
+    accel_surf *as = accel_surf_build(w.s, w.a, NULL, NULL, w.d, &ps);
+    assert_non_null(as);
+    assert_near(accel_surf_total_area(as), area, 1e-9 * area);
+    accel_shape sh = shape_of(&w);
+    rng r;
+    rng_seed(&r, 11, 3);
+    int side = 0, n = 4000;
+    for (int i = 0; i < n; i++) {
+        accel_surf_sample sm;
+        assert_true(accel_surf_sample_point(as, rng_f64(&r), rng_f64(&r), rng_f64(&r), &r, &sm));
+        assert_near(sm.pdf_area, 1.0 / area, 1e-9 / area);
+        double e = 1e-6 * sqrt(area);
+        assert_true(accel_shape_inside(&sh, v3_madd(sm.p, sm.n, -e)));
+        assert_false(accel_shape_inside(&sh, v3_madd(sm.p, sm.n, e)));
+        if (sm.prim >= side_lo && sm.prim <= side_hi) side++;
+    }
+    assert_near((double)side / n, side_fraction, 0.03);
+    accel_shape_release(&sh);
+    accel_surf_free(as);
+    done(&w);
+}
+
+static void test_sweep_sampling(void **st)
+{
+    (void)st;
+    /* cylinder r = 1, h = 1 with flat ends: 4 pi, half of it the side */
+    check_sampled("lathe { linear_spline 5, <0,0>, <1,0>, <1,1>, <0,1>, <0,0> }", 4 * M_PI, 3, 3, 0.5);
+    check_sampled("sor { 4, <1,-1>, <1,0>, <1,1>, <1,2> scale 2 translate x }", 16 * M_PI, 2, 2, 0.5);
+    /* 2x2 square with a 1x1 hole, height 1: caps 2 x 3, walls 12 */
+    check_sampled("prism { 0, 1, 10, <-1,-1>, <1,-1>, <1,1>, <-1,1>, <-1,-1>, <-0.5,-0.5>, <0.5,-0.5>, <0.5,0.5>,"
+                  " <-0.5,0.5>, <-0.5,-0.5> rotate <10,20,30> }", 18.0, 2, 1000, 12.0 / 18.0);
+    /* paraboloid lathe r = 1 + y^2, y in [0,1] (open): 2 pi int (1 + y^2) sqrt(1 + 4 y^2) dy */
+    double a = 0.0;
+    for (int i = 0; i < 200000; i++) {
+        double y = (i + 0.5) / 200000.0;
+        a += (1 + y * y) * sqrt(1 + 4 * y * y) / 200000.0;
+    }
+    world w = build("lathe { quadratic_spline 6, <1.0625,-0.25>, <1,0>, <1.0625,0.25>, <1.25,0.5>, <1.5625,0.75>, <2,1> }");
+    pt_status ps;
+    accel_surf *as = accel_surf_build(w.s, w.a, NULL, NULL, w.d, &ps);
+    assert_near(accel_surf_total_area(as), 2 * M_PI * a, 1e-8);
+    accel_surf_free(as);
+    done(&w);
+}
+
 /* malformed shapes give located errors; degenerate ones are skipped with a
  * warning; nothing crashes */
 static void test_bad_input(void **st)
@@ -963,6 +1014,7 @@ int main(void)
         cmocka_unit_test(test_parametric),
         cmocka_unit_test(test_julia),
         cmocka_unit_test(test_surface_sampling),
+        cmocka_unit_test(test_sweep_sampling),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_unsupported),
     };
