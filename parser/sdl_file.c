@@ -115,7 +115,7 @@ static char *place_write(sdl_parser *p, const char *name, src_loc loc)
 
 /* ------------------------------------------------------------ #fopen / #fclose */
 
-static sdl_file *new_file(sdl_parser *p, char *path)
+static sdl_file *new_file(sdl_parser *p, char *path, const char *given)
 {
     sdl_file *f = calloc(1, sizeof *f);
     if (!f) {
@@ -123,7 +123,7 @@ static sdl_file *new_file(sdl_parser *p, char *path)
         return NULL;
     }
     f->path = path;
-    f->name = sdl_strndup(p, path, strlen(path));
+    f->name = sdl_strndup(p, given, strlen(given)); /* messages name it as the scene does */
     f->next = p->files;
     p->files = f;
     return f;
@@ -184,7 +184,7 @@ void sdl_fopen_directive(sdl_parser *p, src_loc loc)
             free(path);
             return;
         }
-        f = new_file(p, path);
+        f = new_file(p, path, name);
         if (!f) {
             free(text);
             sdl_error(p, loc, PT_ERR_NOMEM, "out of memory");
@@ -203,7 +203,7 @@ void sdl_fopen_directive(sdl_parser *p, src_loc loc)
             free(path);
             return;
         }
-        f = new_file(p, path);
+        f = new_file(p, path, name);
         if (!f) {
             fclose(out);
             sdl_error(p, loc, PT_ERR_NOMEM, "out of memory");

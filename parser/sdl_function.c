@@ -139,7 +139,7 @@ static int math_of(sdl_kw k)
     case KW_ABS: return FM_ABS; case KW_RADIANS: return FM_RADIANS; case KW_DEGREES: return FM_DEGREES;
     case KW_FLOOR: return FM_FLOOR; case KW_INT: return FM_INT; case KW_CEIL: return FM_CEIL;
     case KW_SQRT: return FM_SQRT; case KW_EXP: return FM_EXP; case KW_LN: return FM_LN;
-    case KW_LOG: return FM_LOG; case KW_SQR: return FM_SQR;
+    case KW_LOG: return FM_LOG; /* no sqr: POV-Ray 3.7's function syntax lacks it */
     default: return -1;
     }
 }
@@ -297,8 +297,6 @@ static int keyword_operand(fn_build *b, const sdl_tok *t)
     case KW_Z: return register_node(b, 2);
     case KW_PI: return const_node(b, M_PI);
     case KW_CLOCK: return const_node(b, p->opt.clock);
-    case KW_TRUE: case KW_YES: case KW_ON: return const_node(b, 1);
-    case KW_FALSE: case KW_NO: case KW_OFF: return const_node(b, 0);
     case KW_INTERNAL:
         sdl_error(p, t->tk.loc, PT_ERR_SYNTAX, "internal(N) must be the whole function body");
         return -1;

@@ -7,9 +7,10 @@
  * stand for x and y), declared float constants (folded in), vector and
  * colour constants with a member (.x ... .gray), the built-ins abs acos
  * acosh asin asinh atan atan2 atanh ceil cos cosh degrees div exp floor int
- * ln log max min mod pow prod radians select sin sinh sqr sqrt sum tan tanh,
- * pi and clock, and calls of declared functions (vector functions with a
- * member). `internal(N)` as the whole body is POV-Ray's built-in N. */
+ * ln log max min mod pow prod radians select sin sinh sqrt sum tan tanh
+ * (not sqr, true or false, which 3.7 rejects there), pi and clock, and calls
+ * of declared functions (vector functions with a member). `internal(N)` as
+ * the whole body is POV-Ray's built-in N. */
 #ifndef PT_SDL_FUNCTION_H
 #define PT_SDL_FUNCTION_H
 #include "func.h"

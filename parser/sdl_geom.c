@@ -317,7 +317,8 @@ static vec3 mesh_normal(const scene_object *o, const scene_mesh *m, int t, doubl
         vec3 s = v3(0, 0, 0);
         double w[3] = {1 - u - v, u, v};
         for (int i = 0; i < 3; i++)
-            if (ni[i] >= 0 && ni[i] < m->nnormals) s = v3_madd(s, v3(m->normals[ni[i]][0], m->normals[ni[i]][1], m->normals[ni[i]][2]), w[i]);
+            if (ni[i] >= 0 && ni[i] < m->nnormals) /* POV-Ray keeps mesh normals normalised */
+                s = v3_madd(s, v3_norm(v3(m->normals[ni[i]][0], m->normals[ni[i]][1], m->normals[ni[i]][2])), w[i]);
         if (v3_len2(s) > 0) n = s;
     }
     return world_normal(o, n);
