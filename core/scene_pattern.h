@@ -72,7 +72,8 @@ typedef enum {
     PAT_SPHERICAL, PAT_SPIRAL1, PAT_SPIRAL2, PAT_SPOTTED, PAT_SQUARE,
     PAT_TRIANGULAR, PAT_WAVES, PAT_WOOD, PAT_WRINKLES, PAT_MANDEL, PAT_JULIA,
     PAT_SLOPE, PAT_AOI,
-    PAT_UNSUPPORTED   /* parsed (name kept), evaluates to 0 */
+    PAT_UNSUPPORTED,  /* parsed (name kept), evaluates to 0 */
+    PAT_FUNCTION      /* function { ... } (core/func.h) */
 } pattern_kind;
 
 typedef enum { WAVE_RAMP, WAVE_SINE, WAVE_TRIANGLE, WAVE_SCALLOP, WAVE_CUBIC, WAVE_POLY } wave_kind;
@@ -125,6 +126,7 @@ typedef struct scene_pattern {
     vec3 slope_dir;            /* PAT_SLOPE: direction (normalised); altitude not modelled */
     double slope_lo, slope_hi; /* slope range: value = (s - lo) / (hi - lo) when hi != 0 */
     double facets_size, facets_coords, facets_metric;
+    const struct scene_function *function; /* PAT_FUNCTION */
 } scene_pattern;
 
 /* ---------------------------------------------------------------- blend maps */

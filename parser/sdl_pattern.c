@@ -18,6 +18,7 @@
 #include <unistd.h>
 #include "sdl_directive.h"
 #include "sdl_expr.h"
+#include "sdl_function.h"
 #include "sdl_image.h"
 #include "sdl_material.h"
 
@@ -867,8 +868,10 @@ static int pattern_type(sdl_parser *p, target *tg)
         blend_list(p, tg, 2);
         break;
     case KW_FUNCTION:
-        unsupported_pattern(p, tg, &t);
-        if (sdl_is(sdl_peek(p), TOK_LBRACE) && sdl_begin_block(p, "function")) sdl_skip_block(p);
+        /* function { body }: a user function of x, y, z (sdl_function.c) */
+        set_kind(tg, PAT_FUNCTION, name);
+        pt->function = sdl_parse_function(p, t.tk.loc, NULL);
+        if (!pt->function) set_kind(tg, PAT_UNSUPPORTED, name);
         break;
     case KW_DENSITY_FILE:
         unsupported_pattern(p, tg, &t);

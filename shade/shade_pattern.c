@@ -24,6 +24,8 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "func.h"
+#include "shade_funcenv.h"
 #include "shade_noise.h"
 
 #define PAT_EPSILON 1.0e-10
@@ -609,6 +611,14 @@ static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
         if (!pattern_image_colour(&pat->image, p, &col)) return 0.0;
         if (pat->image.use_alpha) return 1.0 - col.t;
         return GREY(col.r, col.g, col.b);
+    }
+    case PAT_FUNCTION: {
+        /* POV-Ray's function_pattern: f(x, y, z), values above 1 taken mod 1 */
+        if (!pat->function) return 0.0;
+        double args[3] = {p.x, p.y, p.z};
+        double v = func_eval_float(pat->function, args, shade_func_env());
+        if (!isfinite(v)) return 0.0;
+        return v > 1.0 ? fmod(v, 1.0) : v;
     }
     case PAT_SLOPE: return slope(pat, c);
     case PAT_AOI: return aoi(c);
