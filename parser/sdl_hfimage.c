@@ -106,6 +106,145 @@ static int read_png(FILE *f, sdl_hf_image *out, char *why, size_t whycap)
     return SDL_HF_OK;
 }
 
+/* ------------------------------------------------------------ GIF (and POT) */
+
+/* First image of a GIF file as palette indices (LZW decoded, interlacing
+ * undone). GIF89a: codes of 2..12 bits, clear and end codes, sub-blocks. */
+static int read_gif(FILE *f, int pot, sdl_hf_image *out, char *why, size_t whycap)
+{
+    unsigned char hdr[13];
+    if (fread(hdr, 1, 13, f) != 13 || memcmp(hdr, "GIF", 3) != 0) {
+        snprintf(why, whycap, "not a GIF file");
+        return SDL_HF_ERROR;
+    }
+    if (hdr[10] & 0x80) fseek(f, 3L * (1L << ((hdr[10] & 7) + 1)), SEEK_CUR); /* global palette */
+    int c;
+    for (;;) {
+        c = fgetc(f);
+        if (c == 0x21) { /* extension: skip its sub-blocks */
+            fgetc(f);
+            int n;
+            while ((n = fgetc(f)) > 0) fseek(f, n, SEEK_CUR);
+            if (n < 0) break;
+            continue;
+        }
+        break;
+    }
+    unsigned char id[9];
+    if (c != 0x2C || fread(id, 1, 9, f) != 9) {
+        snprintf(why, whycap, "no image in the GIF file");
+        return SDL_HF_ERROR;
+    }
+    unsigned w = id[4] | id[5] << 8, h = id[6] | id[7] << 8;
+    int interlaced = (id[8] & 0x40) != 0;
+    if (id[8] & 0x80) fseek(f, 3L * (1L << ((id[8] & 7) + 1)), SEEK_CUR); /* local palette */
+    int minbits = fgetc(f);
+    if (!size_ok(w, h) || minbits < 2 || minbits > 11 || (pot && (w & 1))) {
+        snprintf(why, whycap, "bad GIF image header");
+        return SDL_HF_ERROR;
+    }
+    size_t npix = (size_t)w * h;
+    unsigned char *idx = calloc(npix, 1);
+    unsigned short *prefix = malloc(4096 * sizeof *prefix);
+    unsigned char *suffix = malloc(4096), *stack = malloc(4097);
+    if (!idx || !prefix || !suffix || !stack) {
+        free(idx); free(prefix); free(suffix); free(stack);
+        snprintf(why, whycap, "out of memory");
+        return SDL_HF_ERROR;
+    }
+    int clear = 1 << minbits, end = clear + 1, next = end + 1, bits = minbits + 1, old = -1;
+    unsigned char first = 0;
+    unsigned long acc = 0;
+    int nacc = 0, blk = 0;
+    size_t pos = 0;
+    for (int i = 0; i < clear; i++) { prefix[i] = 0xFFFF; suffix[i] = (unsigned char)i; }
+    while (pos < npix) {
+        while (nacc < bits) {
+            if (blk == 0) {
+                blk = fgetc(f);
+                if (blk <= 0) goto done;
+            }
+            int byte = fgetc(f);
+            if (byte < 0) goto done;
+            blk--;
+            acc |= (unsigned long)byte << nacc;
+            nacc += 8;
+        }
+        int code = (int)(acc & ((1UL << bits) - 1));
+        acc >>= bits;
+        nacc -= bits;
+        if (code == clear) {
+            next = end + 1;
+            bits = minbits + 1;
+            old = -1;
+            continue;
+        }
+        if (code == end) break;
+        int sp = 0, cur = code;
+        if (old < 0) {
+            if (code >= clear) break;
+            first = (unsigned char)code;
+            idx[pos++] = first;
+            old = code;
+            continue;
+        }
+        if (code >= next) { /* the KwKwK case */
+            if (code > next) break;
+            stack[sp++] = first;
+            cur = old;
+        }
+        while (cur >= clear && sp < 4096) {
+            stack[sp++] = suffix[cur];
+            cur = prefix[cur];
+        }
+        if (cur >= clear) break;
+        first = (unsigned char)cur;
+        stack[sp++] = first;
+        while (sp > 0 && pos < npix) idx[pos++] = stack[--sp];
+        if (next < 4096) {
+            prefix[next] = (unsigned short)old;
+            suffix[next] = first;
+            next++;
+            if (next == (1 << bits) && bits < 12) bits++;
+        }
+        old = code;
+    }
+done:
+    free(prefix);
+    free(suffix);
+    free(stack);
+    if (pos < npix) {
+        free(idx);
+        snprintf(why, whycap, "GIF image data ends early");
+        return SDL_HF_ERROR;
+    }
+    /* row order (interlaced: passes of every 8th from 0, 8th from 4, 4th from 2, 2nd from 1) */
+    unsigned *row = malloc(sizeof *row * h);
+    if (!row) { free(idx); snprintf(why, whycap, "out of memory"); return SDL_HF_ERROR; }
+    if (interlaced) {
+        static const unsigned start[4] = {0, 4, 2, 1}, step[4] = {8, 8, 4, 2};
+        unsigned r = 0;
+        for (int pass = 0; pass < 4; pass++)
+            for (unsigned y = start[pass]; y < h; y += step[pass]) row[r++] = y;
+    } else {
+        for (unsigned y = 0; y < h; y++) row[y] = y;
+    }
+    unsigned ow = pot ? w / 2 : w;
+    out->values = malloc(sizeof *out->values * (size_t)ow * h);
+    if (!out->values) { free(idx); free(row); snprintf(why, whycap, "out of memory"); return SDL_HF_ERROR; }
+    for (unsigned r = 0; r < h; r++) {
+        const unsigned char *src = idx + (size_t)r * w;
+        unsigned short *dst = out->values + (size_t)row[r] * ow;
+        for (unsigned x = 0; x < ow; x++)
+            dst[x] = pot ? (unsigned short)(src[x] << 8 | src[x + ow]) : (unsigned short)(src[x] * 256u);
+    }
+    free(idx);
+    free(row);
+    out->width = (int)ow;
+    out->height = (int)h;
+    return SDL_HF_OK;
+}
+
 /* ------------------------------------------------------------ PNM */
 
 static int pnm_int(FILE *f, long *v)
@@ -186,11 +325,18 @@ int sdl_hf_read(const char *path, sdl_hf_image *out, char *why, size_t whycap)
     if (n == 8 && !png_sig_cmp(sig, 0, 8)) {
         rewind(f);
         r = read_png(f, out, why, whycap);
+    } else if (n >= 6 && memcmp(sig, "GIF8", 4) == 0) {
+        /* POT (Fractint continuous potential): a GIF whose right half holds
+         * each pixel's low byte (POV-Ray's gif.cpp) */
+        size_t len = strlen(path);
+        int pot = len > 4 && (strcmp(path + len - 4, ".pot") == 0 || strcmp(path + len - 4, ".POT") == 0);
+        rewind(f);
+        r = read_gif(f, pot, out, why, whycap);
     } else if (n >= 2 && sig[0] == 'P' && sig[1] >= '2' && sig[1] <= '6' && sig[1] != '4') {
         fseek(f, 2, SEEK_SET);
         r = read_pnm(f, sig[1] - '0', out, why, whycap);
     } else {
-        snprintf(why, whycap, "image format not supported for height fields (PNG, PGM and PPM are)");
+        snprintf(why, whycap, "image format not supported for height fields (PNG, GIF, POT, PGM and PPM are)");
         r = SDL_HF_UNSUPPORTED;
     }
     fclose(f);

@@ -606,7 +606,7 @@ static void height_field_args(sdl_parser *p, scene_object *o, src_loc loc)
     const char *ext = NULL;
     if (t->tk.kind == TOK_KEYWORD && !sdl_starts_string(t)) {
         sdl_kw type = sdl_next(p).tk.kw;
-        ext = type == KW_PNG ? ".png" : type == KW_PGM ? ".pgm" : type == KW_PPM ? ".ppm" : NULL;
+        ext = type == KW_PNG ? ".png" : type == KW_PGM ? ".pgm" : type == KW_PPM ? ".ppm" : type == KW_GIF ? ".gif" : type == KW_POT ? ".pot" : NULL;
         if (type == KW_FUNCTION) {
             is_function = 1;
             /* function W, H { pigment/expression }: needs pattern evaluation */

@@ -659,6 +659,70 @@ static void test_height_field(void **st)
     unlink(path);
 }
 
+/* A minimal GIF (no palette, 8-bit LZW codes written as literals of 9 bits). */
+static void write_gif(const char *path, int w, int h, const unsigned char *px)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    unsigned char hdr[13] = {'G', 'I', 'F', '8', '9', 'a', (unsigned char)w, 0, (unsigned char)h, 0, 0x07, 0, 0};
+    fwrite(hdr, 1, 13, f);
+    unsigned char id[10] = {0x2C, 0, 0, 0, 0, (unsigned char)w, 0, (unsigned char)h, 0, 0};
+    fwrite(id, 1, 10, f);
+    fputc(8, f);
+    unsigned char data[256];
+    int nd = 0, nbits = 0;
+    unsigned long acc = 0;
+    int ncodes = w * h + 2;
+    for (int i = 0; i < ncodes; i++) {
+        int code = i == 0 ? 256 : (i == ncodes - 1 ? 257 : px[i - 1]);
+        acc |= (unsigned long)code << nbits;
+        nbits += 9;
+        while (nbits >= 8) {
+            data[nd++] = (unsigned char)(acc & 255);
+            acc >>= 8;
+            nbits -= 8;
+        }
+    }
+    if (nbits > 0) data[nd++] = (unsigned char)acc;
+    fputc(nd, f);
+    fwrite(data, 1, (size_t)nd, f);
+    fputc(0, f);
+    fputc(0x3B, f);
+    fclose(f);
+}
+
+static void test_height_field_gif(void **st)
+{
+    (void)st;
+    unsigned char px[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+    const char *gif = "/tmp/test_shapes_hf.gif", *pot = "/tmp/test_shapes_hf.pot";
+    write_gif(gif, 4, 2, px);
+    write_gif(pot, 4, 2, px);
+    char src[256];
+    snprintf(src, sizeof src, "height_field { gif \"%s\" }", gif);
+    world w = build(src);
+    const scene_height_field *hf = w.s->objects[0]->u.height_field;
+    assert_int_equal(hf->width, 4);
+    assert_int_equal(hf->height, 2);
+    /* map row 0 is the image's bottom row */
+    for (int x = 0; x < 4; x++) {
+        assert_near(hf->heights[x] * 65536.0, (4 + x) * 256.0, 1e-3);
+        assert_near(hf->heights[4 + x] * 65536.0, x * 256.0, 1e-3);
+    }
+    done(&w);
+    snprintf(src, sizeof src, "height_field { pot \"%s\" }", pot);
+    w = build(src);
+    hf = w.s->objects[0]->u.height_field;
+    assert_int_equal(hf->width, 2);
+    assert_near(hf->heights[0] * 65536.0, 4 * 256 + 6, 1e-3);
+    assert_near(hf->heights[1] * 65536.0, 5 * 256 + 7, 1e-3);
+    assert_near(hf->heights[2] * 65536.0, 0 * 256 + 2, 1e-3);
+    assert_near(hf->heights[3] * 65536.0, 1 * 256 + 3, 1e-3);
+    done(&w);
+    unlink(gif);
+    unlink(pot);
+}
+
 /* the distribution's plasma3.png is a palette image: heights = index * 256 */
 static void test_height_field_png(void **st)
 {
@@ -1007,6 +1071,7 @@ int main(void)
         cmocka_unit_test(test_blob),
         cmocka_unit_test(test_height_field),
         cmocka_unit_test(test_height_field_png),
+        cmocka_unit_test(test_height_field_gif),
         cmocka_unit_test(test_sphere_sweep),
         cmocka_unit_test(test_bicubic_patch),
         cmocka_unit_test(test_clipped_by),
