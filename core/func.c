@@ -50,7 +50,7 @@ static double math1(func_math m, double x)
 static double node_value(const scene_function *f, int i, double *slots, eval_ctx *c)
 {
     const func_node *n = &f->nodes[i];
-    const int *k = f->kids + n->kid;
+    const int *k = f->kids ? f->kids + n->kid : NULL; /* no kids: no NULL + 0 */
     if (c->failed) return 0;
 #define KID(j) node_value(f, k[j], slots, c)
     switch ((func_op)n->op) {
