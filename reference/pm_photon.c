@@ -355,8 +355,9 @@ pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, 
     long kg = 0, kc = 0;
     for (int i = 0; i < c.nchunks; i++) {
         if (!oom) {
-            memcpy(out->global + kg, c.chunks[i].g, sizeof(pm_photon) * (size_t)c.chunks[i].ng);
-            memcpy(out->caustic + kc, c.chunks[i].c, sizeof(pm_photon) * (size_t)c.chunks[i].nc);
+            /* an empty chunk's array may be NULL: memcpy must not get it */
+            if (c.chunks[i].ng) memcpy(out->global + kg, c.chunks[i].g, sizeof(pm_photon) * (size_t)c.chunks[i].ng);
+            if (c.chunks[i].nc) memcpy(out->caustic + kc, c.chunks[i].c, sizeof(pm_photon) * (size_t)c.chunks[i].nc);
         }
         kg += c.chunks[i].ng;
         kc += c.chunks[i].nc;
