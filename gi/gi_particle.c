@@ -204,7 +204,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     else gi_particle_default_settings(&gp->set);
     gi_particle_settings *set = &gp->set;
     if (set->scatter_side < 1) set->scatter_side = 1;
-    if (set->scatter_side > 8) set->scatter_side = 8; /* GI_MAX_SCATTER links */
+    if (set->scatter_side > 4) set->scatter_side = 4; /* GI_MAX_SCATTER links */
     if (set->gather_side < 1) set->gather_side = 1;
     if (set->bounces < 0) set->bounces = 0;
     if (set->bounces > GI_MAX_BOUNCES) set->bounces = GI_MAX_BOUNCES;
