@@ -123,8 +123,12 @@ typedef struct scene_pattern {
     int arms;                  /* spiral1/2 */
     scene_image_map image;     /* PAT_IMAGE */
     const struct scene_pigment *pigment; /* PAT_PIGMENT (pigment_pattern) */
-    vec3 slope_dir;            /* PAT_SLOPE: direction (normalised); altitude not modelled */
-    double slope_lo, slope_hi; /* slope range: value = (s - lo) / (hi - lo) when hi != 0 */
+    vec3 slope_dir;            /* PAT_SLOPE: direction (normalised), or the point_at point */
+    double slope_lo, slope_hi; /* slope range as POV-Ray keeps it: value = (s - lo) / hi when hi != 0 */
+    int slope_point_at;
+    double slope_len, altit_len;   /* weights of slope and altitude (sum 1) */
+    vec3 altit_dir;                /* altitude direction (normalised) */
+    double altit_lo, altit_hi;     /* altitude range as the slope's */
     double facets_size, facets_coords, facets_metric;
     const struct scene_function *function; /* PAT_FUNCTION */
 } scene_pattern;

@@ -833,31 +833,52 @@ static int pattern_type(sdl_parser *p, target *tg)
         break;
     }
     case KW_SLOPE: {
+        /* slope := v | '{' [point_at] v [, lo [, hi]] [altitude v [, lo [, hi]]] '}' */
         set_kind(tg, PAT_SLOPE, name);
-        pt->slope_lo = pt->slope_hi = 0.0;
+        pt->slope_lo = pt->slope_hi = pt->altit_lo = pt->altit_hi = 0.0;
+        pt->slope_point_at = 0;
+        vec3 sv = v3(0, 0, 0), av = v3(0, 0, 0);
         if (sdl_is(sdl_peek(p), TOK_LBRACE)) {
             sdl_begin_block(p, "slope");
-            if (sdl_accept_kw(p, KW_POINT_AT)) sdl_warn_once(p, t.tk.loc, "slope point_at is not supported");
-            pt->slope_dir = v3_norm(sdl_vector(p));
+            pt->slope_point_at = sdl_accept_kw(p, KW_POINT_AT);
+            sv = sdl_vector(p);
             sdl_accept(p, TOK_COMMA);
-            double lo = sdl_allow_float(p, 0.0);
+            pt->slope_lo = sdl_allow_float(p, 0.0);
             sdl_accept(p, TOK_COMMA);
-            double hi = sdl_allow_float(p, 0.0);
-            if (hi != 0.0 && hi != lo) {
-                pt->slope_lo = lo;
-                pt->slope_hi = hi - lo;
-            }
+            pt->slope_hi = sdl_allow_float(p, 0.0);
+            /* POV-Ray: an empty range is ignored, else hi holds its width */
+            if (pt->slope_hi != 0.0 && pt->slope_hi == pt->slope_lo) pt->slope_lo = pt->slope_hi = 0.0;
+            else pt->slope_hi -= pt->slope_lo;
             if (sdl_accept_kw(p, KW_ALTITUDE)) {
-                sdl_warn_once(p, t.tk.loc, "slope altitude is not supported and is ignored");
-                sdl_vector(p);
+                if (pt->slope_point_at) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "'altitude' cannot be used with 'point_at' in slope pattern");
+                av = sdl_vector(p);
                 sdl_accept(p, TOK_COMMA);
-                sdl_allow_float(p, 0.0);
+                pt->altit_lo = sdl_allow_float(p, 0.0);
                 sdl_accept(p, TOK_COMMA);
-                sdl_allow_float(p, 0.0);
+                pt->altit_hi = sdl_allow_float(p, 0.0);
+                if (pt->altit_hi != 0.0 && pt->altit_hi == pt->altit_lo) pt->altit_lo = pt->altit_hi = 0.0;
+                else pt->altit_hi -= pt->altit_lo;
             }
             sdl_end_block(p);
         } else {
-            pt->slope_dir = v3_norm(sdl_vector(p));
+            sv = sdl_vector(p);
+        }
+        if (pt->slope_point_at) {
+            pt->slope_dir = sv;
+            pt->slope_len = 1.0;
+            pt->altit_len = 0.0;
+        } else {
+            pt->slope_len = v3_len(sv);
+            pt->altit_len = v3_len(av);
+            pt->slope_dir = pt->slope_len != 0.0 ? v3_scale(sv, 1.0 / pt->slope_len) : sv;
+            pt->altit_dir = pt->altit_len != 0.0 ? v3_scale(av, 1.0 / pt->altit_len) : av;
+            double tot = pt->slope_len + pt->altit_len;
+            if (tot == 0.0) {
+                sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "zero length for both slope and gradient");
+            } else {
+                pt->slope_len /= tot;
+                pt->altit_len = 1.0 - pt->slope_len;
+            }
         }
         break;
     }

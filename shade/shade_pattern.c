@@ -538,17 +538,30 @@ static double wrinkles(vec3 p, int gen)
     return value / 2.0;
 }
 
-static double slope(const scene_pattern *pat, const pattern_ctx *c)
+/* POV-Ray's slope_pattern: the angle of the (perturbed, world) normal to
+ * the slope direction (or the direction to the point_at point) mapped to
+ * [0, 1], optionally mixed with the altitude along a direction (at the
+ * pattern-space point). */
+static double slope(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
 {
     if (!c->has_hit) return 0.0;
-    double v = v3_dot(c->normal, pat->slope_dir);
+    double v;
+    if (pat->slope_point_at) v = v3_dot(c->normal, v3_norm(v3_sub(pat->slope_dir, c->ipoint)));
+    else v = v3_dot(c->normal, pat->slope_dir);
     if (v > 1.0) v = 1.0;
     else if (v < -1.0) v = -1.0;
     v = asin(v) / PI_ * 2;
     v = (v + 1.0) * 0.5;
     if (pat->slope_hi != 0.0) v = (v - pat->slope_lo) / pat->slope_hi;
-    if (v == 1.0) return v - PAT_EPSILON;
-    return v < 0.0 ? 1.0 + fmod(v, 1.0) : fmod(v, 1.0);
+    if (pat->altit_len == 0.0) {
+        if (v == 1.0) return v - PAT_EPSILON;
+        return v < 0.0 ? 1.0 + fmod(v, 1.0) : fmod(v, 1.0);
+    }
+    double a = v3_dot(p, pat->altit_dir);
+    if (pat->altit_hi != 0.0) a = (a - pat->altit_lo) / pat->altit_hi;
+    double value = pat->slope_len * v + pat->altit_len * a;
+    if (value - 1.0 < PAT_EPSILON && value >= 1.0) return value - PAT_EPSILON;
+    return value < 0.0 ? 1.0 + fmod(value, 1.0) : fmod(value, 1.0);
 }
 
 static double aoi(const pattern_ctx *c)
@@ -620,7 +633,7 @@ static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
         if (!isfinite(v)) return 0.0;
         return v > 1.0 ? fmod(v, 1.0) : v;
     }
-    case PAT_SLOPE: return slope(pat, c);
+    case PAT_SLOPE: return slope(pat, p, c);
     case PAT_AOI: return aoi(c);
     default: return 0.0;
     }

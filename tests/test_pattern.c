@@ -94,6 +94,7 @@ static const pattern_case cases[] = {
     {"average", "average pigment_map { [1 rgb <1,0,0>] [2 bozo " GREY " scale 0.4] }"},
     {"pigment_pattern", "pigment_pattern { checker rgb 0, rgb 1 scale 0.5 } " GREY " turbulence 0.3"},
     {"old_colour_map", "granite color_map { [0.0 0.4 color rgb 0 color rgb 0.5] [0.4 1.0 color rgb 0.5 color rgb 1] }"},
+    {"function", "function { 0.3 * x * y + 0.5 * sin(2 * x) } " GREY},
 };
 #define NCASES ((int)(sizeof cases / sizeof cases[0]))
 
