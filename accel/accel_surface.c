@@ -387,8 +387,14 @@ static int add_leaf(accel_surf *as, const scene_object *o, const scene_texture *
         g->jmax = jacobian_bound(&o->transform);
         area = shape_area(g);
     }
-    if (!(area > 0.0) || !isfinite(area)) return 1;
-    if (!add_piece(as, o, tex, flags, ACCEL_SURF_ANY, area, w, 1, as->nshapes)) return 0;
+    if (!(area > 0.0) || !isfinite(area)) {
+        accel_shape_release(&g->sh);
+        return 1;
+    }
+    if (!add_piece(as, o, tex, flags, ACCEL_SURF_ANY, area, w, 1, as->nshapes)) {
+        accel_shape_release(&g->sh);
+        return 0;
+    }
     as->nshapes++;
     return 1;
 }
@@ -538,6 +544,7 @@ void accel_surf_free(accel_surf *as)
     if (!as) return;
     free(as->pieces);
     free(as->tris);
+    for (int i = 0; i < as->nshapes; i++) accel_shape_release(&as->shapes[i].sh); /* issue-4 shapes' data */
     free(as->shapes);
     free(as->cdf);
     free(as->tab);
