@@ -949,13 +949,23 @@ static void macro_argument(sdl_parser *p, const sdl_macro *m, sdl_value *arg, sd
 }
 
 /* macro_call := macro_identifier '(' [ macro_argument { [','] macro_argument } [','] ] ')' */
+static void macro_invoke(sdl_parser *p, const sdl_tok *id, sdl_value *args, sdl_symref **refs);
+
 static void macro_call(sdl_parser *p, const sdl_tok *id)
 {
+    /* argument storage lives only until the parameters are bound */
+    sdl_value *args = malloc(sizeof(sdl_value) * 64);
+    sdl_symref **refs = malloc(sizeof(sdl_symref *) * 64);
+    if (args && refs) macro_invoke(p, id, args, refs);
+    else sdl_error(p, id->tk.loc, PT_ERR_NOMEM, "out of memory");
+    free(args);
+    free(refs);
+}
+
+static void macro_invoke(sdl_parser *p, const sdl_tok *id, sdl_value *args, sdl_symref **refs)
+{
     const sdl_macro *m = id->val.ptr;
-    sdl_value *args = sdl_alloc(p, sizeof(sdl_value) * 64);
-    sdl_symref **refs = sdl_alloc(p, sizeof(sdl_symref *) * 64);
     int n = 0;
-    if (!args || !refs) return;
     if (!sdl_expect(p, TOK_LPAREN, "'(' after the macro name")) return;
     if (!sdl_enter(p, id->tk.loc)) return;
     while (sdl_ok(p) && !sdl_accept(p, TOK_RPAREN)) {

@@ -16,21 +16,29 @@ const char *sdl_kw_text(sdl_kw k)
     return (k > KW_NONE && k < SDL_KW_LIMIT) ? kw_texts[k] : "";
 }
 
-/* Compare the word s[0..n) with a NUL-terminated keyword, strcmp order. */
-static int word_cmp(const char *s, size_t n, const char *kw)
+static const unsigned char kw_lens[] = {
+    0,
+#define SDL_KW_LEN(id, text) (unsigned char)(sizeof(text) - 1),
+    SDL_KEYWORDS(SDL_KW_LEN)
+#undef SDL_KW_LEN
+};
+
+/* Compare the word s[0..n) with keyword k, strcmp order. */
+static int word_cmp(const char *s, size_t n, int k)
 {
-    size_t m = strlen(kw);
-    int c = strncmp(s, kw, n < m ? n : m);
+    size_t m = kw_lens[k];
+    int c = memcmp(s, kw_texts[k], n < m ? n : m);
     if (c != 0) return c;
     return n < m ? -1 : (n > m ? 1 : 0);
 }
 
 sdl_kw sdl_kw_lookup(const char *s, size_t n)
 {
+    if (n == 0 || n > 31) return KW_NONE; /* no keyword is longer */
     int lo = 1, hi = SDL_KW_LIMIT - 1;
     while (lo <= hi) {
         int mid = (lo + hi) / 2;
-        int c = word_cmp(s, n, kw_texts[mid]);
+        int c = word_cmp(s, n, mid);
         if (c == 0) return (sdl_kw)mid;
         if (c < 0) hi = mid - 1;
         else lo = mid + 1;
@@ -133,6 +141,54 @@ static int is_digit(int c) { return c >= '0' && c <= '9'; }
 static int is_ident_start(int c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; }
 static int is_ident_char(int c) { return is_ident_start(c) || is_digit(c); }
 
+/* Correctly rounded value of a short decimal without calling strtod: at
+ * most 15 significant digits and a power of ten up to 22 (both exact in a
+ * double, so one multiplication or division rounds once). 0 if the number
+ * does not qualify. */
+static int fast_number(const char *p, size_t n, double *out)
+{
+    static const double pow10[23] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11,
+                                     1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+    unsigned long long m = 0;
+    int digits = 0, scale = 0, seen_dot = 0;
+    size_t i = 0;
+    for (; i < n; i++) {
+        char c = p[i];
+        if (c >= '0' && c <= '9') {
+            if (m == 0 && c == '0') {
+                if (seen_dot) scale--;
+                continue;
+            }
+            if (++digits > 15) return 0;
+            m = m * 10 + (unsigned)(c - '0');
+            if (seen_dot) scale--;
+        } else if (c == '.' && !seen_dot) {
+            seen_dot = 1;
+        } else {
+            break;
+        }
+    }
+    if (i < n) { /* exponent */
+        if (p[i] != 'e' && p[i] != 'E') return 0;
+        i++;
+        int sign = 1, e = 0;
+        if (i < n && (p[i] == '+' || p[i] == '-')) sign = p[i++] == '-' ? -1 : 1;
+        if (i >= n) return 0;
+        for (; i < n; i++) {
+            if (p[i] < '0' || p[i] > '9' || e > 1000) return 0;
+            e = e * 10 + (p[i] - '0');
+        }
+        scale += sign * e;
+    }
+    if (m == 0) {
+        *out = 0.0;
+        return 1;
+    }
+    if (scale < -22 || scale > 22) return 0;
+    *out = scale < 0 ? (double)m / pow10[-scale] : (double)m * pow10[scale];
+    return 1;
+}
+
 /* number: digits [ '.' [digits] ] [ exponent ] | '.' digits [ exponent ] */
 static void scan_number(sdl_scanner *s, sdl_token *t)
 {
@@ -150,13 +206,15 @@ static void scan_number(sdl_scanner *s, sdl_token *t)
             while (is_digit(peek_char(s, 0))) advance(s);
         }
     }
-    char buf[128];
     size_t n = s->at.pos - start;
-    if (n >= sizeof buf) n = sizeof buf - 1;
-    memcpy(buf, s->text + start, n);
-    buf[n] = 0;
     t->kind = TOK_NUMBER;
-    t->num = strtod(buf, NULL);
+    if (!fast_number(s->text + start, n, &t->num)) {
+        char buf[128];
+        if (n >= sizeof buf) n = sizeof buf - 1;
+        memcpy(buf, s->text + start, n);
+        buf[n] = 0;
+        t->num = strtod(buf, NULL);
+    }
     t->text = s->text + start;
     t->len = (int)(s->at.pos - start);
 }

@@ -10,6 +10,7 @@ typedef struct sym_entry {
     struct sym_entry *snext;     /* entries of the same scope */
     struct sym_entry *alias;     /* by-reference macro parameter: the caller's entry */
     int depth;
+    size_t len;                  /* strlen(name) */
     char *name;
     sdl_value val;
 } sym_entry;
@@ -55,7 +56,7 @@ static void free_entry(sym_entry *e)
 
 static void unlink_entry(sdl_symtab *t, sym_entry *e)
 {
-    sym_entry **pp = &t->buckets[hash_name(e->name, strlen(e->name))];
+    sym_entry **pp = &t->buckets[hash_name(e->name, e->len)];
     while (*pp && *pp != e) pp = &(*pp)->hnext;
     if (*pp) *pp = e->hnext;
     sym_entry **sp = &t->scopes[e->depth];
@@ -117,7 +118,7 @@ void sdl_symtab_pop(sdl_symtab *t)
 static sym_entry *find_entry(const sdl_symtab *t, const char *name, size_t n)
 {
     for (sym_entry *e = t->buckets[hash_name(name, n)]; e; e = e->hnext)
-        if (strlen(e->name) == n && memcmp(e->name, name, n) == 0) return e;
+        if (e->len == n && memcmp(e->name, name, n) == 0) return e;
     return NULL;
 }
 
@@ -146,6 +147,7 @@ static int insert_entry(sdl_symtab *t, const char *name, size_t n, int depth, co
     }
     memcpy(e->name, name, n);
     e->name[n] = 0;
+    e->len = n;
     e->depth = depth;
     e->val = *v;
     sym_entry **pp = &t->buckets[hash_name(name, n)];
@@ -244,7 +246,7 @@ int sdl_symtab_assign(sdl_symtab *t, const sdl_symtarget *tg, const char *name, 
     sym_entry *e = find_entry(t, name, n);
     while (e && e->depth > tg->depth) { /* an entry made meanwhile further in: look past it */
         sym_entry *o = e->hnext;
-        while (o && !(strlen(o->name) == n && memcmp(o->name, name, n) == 0)) o = o->hnext;
+        while (o && !(o->len == n && memcmp(o->name, name, n) == 0)) o = o->hnext;
         e = o;
     }
     if (e && e->depth == tg->depth) {
