@@ -144,7 +144,8 @@ static void particle_describe(void *ctx, char *buf, int n)
 {
     particle_ctx *c = ctx;
     const gi_particle_stats *s = gi_particle_get_stats(c->gp);
-    snprintf(buf, (size_t)n, "%ld particles, %d bounces", s->particles, s->bounces);
+    snprintf(buf, (size_t)n, "%ld particles, %d bounces, lighting %.0f ms (visibility %.0f, emit %.0f, scatter %.0f)",
+             s->particles, s->bounces, s->t_lighting * 1e3, s->t_visibility * 1e3, s->t_emit * 1e3, s->t_scatter * 1e3);
 }
 
 static void particle_close(void *ctx)
