@@ -714,6 +714,12 @@ static int split_args(int argc, char **argv, char **rest, int *nrest, const char
 int cmd_view(int argc, char **argv)
 {
     char err[512];
+    for (int i = 0; i < argc; i++) {
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            fputs(view_usage, stdout);
+            return EXIT_OK;
+        }
+    }
     char **rest = calloc((size_t)argc + 1, sizeof *rest);
     if (!rest) return EXIT_IO;
     int nrest = 0, preview = 0, verbose = 0;
