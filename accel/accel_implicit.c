@@ -942,3 +942,39 @@ const scene_texture *accel_blob_texture(const accel_shape *sh, vec3 q)
     }
     return any ? t : NULL;
 }
+
+/* ------------------------------------------------------------ grid */
+
+static double spow(double x, double p) { return copysign(pow(fabs(x), p), x); }
+
+int accel_implicit_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
+{
+    const im_data *m = sh->data;
+    if (!m || m->type != IM_SUPER) return 0;
+    /* POV-Ray's superellipsoid as the signed-power sphere: angle u around z
+     * for the x, y exponent 2/p = e, angle v from the equator for n = 2/q */
+    int nu = 4 * n, nv = 2 * n, count = 0;
+    double e = 2.0 / m->p, nn = 2.0 / m->q;
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++) {
+            vec3 P[4], N[4];
+            for (int c = 0; c < 4; c++) {
+                double u = 2.0 * M_PI * (i + (c == 1 || c == 2)) / nu - M_PI;
+                double v = M_PI * (j + (c >= 2)) / nv - 0.5 * M_PI;
+                double cv = spow(cos(v), nn);
+                P[c] = v3(cv * spow(cos(u), e), cv * spow(sin(u), e), spow(sin(v), nn));
+                N[c] = se_grad(m, P[c]);
+            }
+            vec3 t1[3] = {P[0], P[1], P[2]}, n1[3] = {N[0], N[1], N[2]};
+            vec3 t2[3] = {P[0], P[2], P[3]}, n2[3] = {N[0], N[2], N[3]};
+            if (v3_len2(v3_cross(v3_sub(P[1], P[0]), v3_sub(P[2], P[0]))) > 0.0) {
+                if (!fn(ctx, t1, n1)) return -1;
+                count++;
+            }
+            if (v3_len2(v3_cross(v3_sub(P[2], P[0]), v3_sub(P[3], P[0]))) > 0.0) {
+                if (!fn(ctx, t2, n2)) return -1;
+                count++;
+            }
+        }
+    return count;
+}

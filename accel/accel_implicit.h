@@ -41,4 +41,7 @@ int accel_implicit_solid_bounded(const accel_shape *sh);
  * space), NULL when the blob's own texture applies. */
 const scene_texture *accel_blob_texture(const accel_shape *sh, vec3 q);
 
+/* Grid triangles (accel_shape_grid) of a superellipsoid; 0 for the others. */
+int accel_implicit_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx);
+
 #endif

@@ -636,6 +636,55 @@ int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, dou
     return k;
 }
 
+typedef struct {
+    accel_grid_fn fn;
+    void *ctx;
+    const accel_shape *sh;
+} grid_poly;
+
+static int grid_poly_tri(void *ctx, vec3 a, vec3 b, vec3 c)
+{
+    grid_poly *g = ctx;
+    vec3 p[3] = {a, b, c}, nn;
+    double u, v;
+    accel_sweep_surface(g->sh, a, 2, &nn, &u, &v);
+    vec3 n[3] = {nn, nn, nn};
+    return g->fn(g->ctx, p, n);
+}
+
+int accel_shape_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
+{
+    if (!sh->data || n < 1) return 0;
+    switch (sh->kind) {
+    case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
+        return accel_sweep_grid(sh, n, fn, ctx);
+    case SHAPE_POLYGON: {
+        grid_poly g = {fn, ctx, sh};
+        return accel_polygon_triangles(sh, grid_poly_tri, &g);
+    }
+    case SHAPE_SUPERELLIPSOID:
+        return accel_implicit_grid(sh, n, fn, ctx);
+    case SHAPE_HEIGHT_FIELD: {
+        int nt = accel_hfield_ntriangles(sh), count = 0;
+        for (int i = 0; i < nt; i++) {
+            vec3 p[3], nn[3], g;
+            double u, v;
+            accel_hfield_triangle(sh, i, &p[0], &p[1], &p[2]);
+            accel_hfield_surface(sh, p[0], i, &g, &u, &v);
+            for (int k = 0; k < 3; k++) {
+                vec3 s = accel_hfield_shading(sh, p[k]);
+                nn[k] = v3_len2(s) > 0.0 ? s : g;
+            }
+            if (!fn(ctx, p, nn)) return -1;
+            count++;
+        }
+        return count;
+    }
+    default:
+        return 0;
+    }
+}
+
 int accel_shape_intersect(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
                           accel_shape_hit *h)
 {

@@ -87,6 +87,16 @@ int accel_shape_inside(const accel_shape *sh, vec3 p);
 void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, double *u, double *v);
 void accel_shape_shading(const accel_shape *sh, vec3 p, vec3 ng, vec3 *ns);
 
+/* Parametric grid for radiance particles (DESIGN.md) on the issue-4
+ * shapes: object-space triangles whose vertices lie on the exact surface,
+ * with the exact outward normals there, about n x n per part (polygon and
+ * height_field: their own triangles). Calls fn per triangle; returns the
+ * number of triangles, 0 when the shape has no grid (quadric, poly, blob,
+ * isosurface, julia_fractal, and the original shapes, which GI
+ * parametrises itself), -1 when fn returned 0. */
+typedef int (*accel_grid_fn)(void *ctx, const vec3 p[3], const vec3 n[3]);
+int accel_shape_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx);
+
 /* Real roots of c[0] + c[1] x + ... + c[n] x^n (n <= 4) inside [a, b], in
  * ascending order; returns their number. Exposed for the unit tests. */
 int accel_poly_roots(const double *c, int n, double a, double b, double *roots);

@@ -1327,3 +1327,164 @@ int accel_polygon_triangles(const accel_shape *sh, int (*emit)(void *ctx, vec3 a
     free(ed);
     return count;
 }
+
+/* ------------------------------------------------------------ grid */
+
+typedef struct {
+    const sw_data *w;
+    accel_grid_fn fn;
+    void *ctx;
+    int count;
+} grid_out;
+
+static vec3 to_object(const sw_data *w, vec3 l) { return v3_add(w->c, v3_scale(l, w->L)); }
+
+/* A quad of local points/normals as two triangles (degenerate ones dropped). */
+static int emit_quad(grid_out *g, const vec3 P[4], const vec3 N[4])
+{
+    static const int tri[2][3] = {{0, 1, 2}, {0, 2, 3}};
+    for (int t = 0; t < 2; t++) {
+        vec3 p[3], n[3];
+        for (int k = 0; k < 3; k++) {
+            p[k] = to_object(g->w, P[tri[t][k]]);
+            n[k] = v3_norm(N[tri[t][k]]);
+        }
+        if (!(v3_len2(v3_cross(v3_sub(p[1], p[0]), v3_sub(p[2], p[0]))) > 0.0)) continue;
+        if (!g->fn(g->ctx, p, n)) return 0;
+        g->count++;
+    }
+    return 1;
+}
+
+/* Surface point and normal of part `part` at (a, b) in [0,1]^2 (local). */
+static void grid_point(const sw_data *w, int part, double a, double b, vec3 *p, vec3 *n)
+{
+    int k = part - 2;
+    if (w->type == SW_LATHE) {
+        const sw_seg *s = &w->seg[k];
+        double c[2], n2[2], phi = 2.0 * M_PI * b;
+        seg_eval(s, a, c, NULL);
+        seg_normal(s, a, n2);
+        *p = v3(c[0] * cos(phi), c[1], c[0] * sin(phi));
+        *n = v3(n2[0] * cos(phi), n2[1], n2[0] * sin(phi));
+    } else if (w->type == SW_SOR) {
+        double phi = 2.0 * M_PI * b;
+        if (part < 2) {
+            double r2 = part == 0 ? w->base_r2 : w->cap_r2, rho = sqrt(r2) * a;
+            *p = v3(rho * cos(phi), part == 0 ? w->sor[0].y0 : w->sor[w->nseg - 1].y1, rho * sin(phi));
+            *n = v3(0, part == 0 ? -1 : 1, 0);
+            return;
+        }
+        const sor_seg *s = &w->sor[k];
+        double y = s->y0 + a * (s->y1 - s->y0), dg, rr = sqrt(fmax(0.0, sor_g(s, y, &dg)));
+        *p = v3(rr * cos(phi), y, rr * sin(phi));
+        *n = v3(p->x, -0.5 * dg, p->z);
+    } else {
+        const sw_seg *s = &w->seg[k];
+        double c[2], n2[2], h = w->h1 + b * (w->h2 - w->h1);
+        seg_eval(s, a, c, NULL);
+        seg_normal(s, a, n2);
+        if (!w->conic) {
+            *p = from_local_axes(w->ax, c[0], h, c[1]);
+            *n = from_local_axes(w->ax, n2[0], 0.0, n2[1]);
+        } else {
+            double sg = h < 0.0 ? -1.0 : 1.0;
+            *p = from_local_axes(w->ax, h * c[0], h, h * c[1]);
+            *n = from_local_axes(w->ax, sg * n2[0], -sg * (c[0] * n2[0] + c[1] * n2[1]), sg * n2[1]);
+        }
+    }
+}
+
+int accel_sweep_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
+{
+    const sw_data *w = sh->data;
+    if (!w) return 0;
+    grid_out g = {w, fn, ctx, 0};
+    int na = n, nb = w->type == SW_PRISM ? n : 4 * n;
+    for (int k = 0; k < w->nseg; k++) {
+        if (w->type == SW_LATHE && w->seg[k].hi[0] <= 0.0 && w->seg[k].lo[0] >= 0.0) continue;
+        for (int j = 0; j < nb; j++)
+            for (int i = 0; i < na; i++) {
+                vec3 P[4], N[4];
+                double as[4] = {(double)i / na, (double)(i + 1) / na, (double)(i + 1) / na, (double)i / na};
+                double bs[4] = {(double)j / nb, (double)j / nb, (double)(j + 1) / nb, (double)(j + 1) / nb};
+                for (int c = 0; c < 4; c++) grid_point(w, 2 + k, as[c], bs[c], &P[c], &N[c]);
+                if (!emit_quad(&g, P, N)) return -1;
+            }
+    }
+    if (w->type == SW_SOR && !w->open) {
+        for (int part = 0; part < 2; part++)
+            for (int j = 0; j < 4 * n; j++)
+                for (int i = 0; i < n; i++) {
+                    vec3 P[4], N[4];
+                    double as[4] = {(double)i / n, (double)(i + 1) / n, (double)(i + 1) / n, (double)i / n};
+                    double bs[4] = {(double)j / (4 * n), (double)j / (4 * n), (double)(j + 1) / (4 * n),
+                                    (double)(j + 1) / (4 * n)};
+                    for (int c = 0; c < 4; c++) grid_point(w, part, as[c], bs[c], &P[c], &N[c]);
+                    if (!emit_quad(&g, P, N)) return -1;
+                }
+    }
+    if (w->type == SW_PRISM && !w->open) {
+        /* caps: the curves polygonised (n pieces per segment), cut into
+         * trapezoids between vertex heights (even-odd) */
+        int m = w->nseg * n;
+        double *vs = malloc(sizeof *vs * (size_t)m);
+        double(*pts)[2] = malloc(sizeof *pts * (size_t)m * 2);
+        if (!vs || !pts) {
+            free(vs);
+            free(pts);
+            return g.count;
+        }
+        for (int k = 0; k < w->nseg; k++)
+            for (int i = 0; i < n; i++) {
+                seg_eval(&w->seg[k], (double)i / n, pts[2 * (k * n + i)], NULL);
+                seg_eval(&w->seg[k], (double)(i + 1) / n, pts[2 * (k * n + i) + 1], NULL);
+                vs[k * n + i] = pts[2 * (k * n + i)][1];
+            }
+        qsort(vs, (size_t)m, sizeof *vs, cmp_double);
+        double(*ed)[3] = malloc(sizeof *ed * (size_t)m);
+        for (int s2 = 0; ed && s2 + 1 < m; s2++) {
+            double va = vs[s2], vb = vs[s2 + 1];
+            if (!(vb > va)) continue;
+            double vm = 0.5 * (va + vb);
+            int ne = 0;
+            for (int e = 0; e < m; e++) {
+                const double *p0 = pts[2 * e], *p1 = pts[2 * e + 1];
+                if (!(fmin(p0[1], p1[1]) <= va && fmax(p0[1], p1[1]) >= vb) || p0[1] == p1[1]) continue;
+                double du = (p1[0] - p0[0]) / (p1[1] - p0[1]);
+                ed[ne][0] = p0[0] + (vm - p0[1]) * du;
+                ed[ne][1] = p0[0] + (va - p0[1]) * du;
+                ed[ne][2] = p0[0] + (vb - p0[1]) * du;
+                ne++;
+            }
+            for (int x = 1; x < ne; x++)
+                for (int y = x; y > 0 && ed[y][0] < ed[y - 1][0]; y--) {
+                    double t[3];
+                    memcpy(t, ed[y], sizeof t);
+                    memcpy(ed[y], ed[y - 1], sizeof t);
+                    memcpy(ed[y - 1], t, sizeof t);
+                }
+            for (int e = 0; e + 1 < ne; e += 2)
+                for (int cap = 0; cap < 2; cap++) {
+                    double h = cap ? w->h2 : w->h1, sc = w->conic ? h : 1.0;
+                    if (w->conic && h == 0.0) continue;
+                    double q[4][2] = {{ed[e][1], va}, {ed[e + 1][1], va}, {ed[e + 1][2], vb}, {ed[e][2], vb}};
+                    vec3 P[4], N[4];
+                    for (int c = 0; c < 4; c++) {
+                        P[c] = from_local_axes(w->ax, sc * q[c][0], h, sc * q[c][1]);
+                        N[c] = from_local_axes(w->ax, 0.0, cap ? 1.0 : -1.0, 0.0);
+                    }
+                    if (!emit_quad(&g, P, N)) {
+                        free(vs);
+                        free(pts);
+                        free(ed);
+                        return -1;
+                    }
+                }
+        }
+        free(vs);
+        free(pts);
+        free(ed);
+    }
+    return g.count;
+}

@@ -42,6 +42,9 @@ void accel_sweep_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, doubl
 double accel_sweep_area(const accel_shape *sh);
 void accel_sweep_sample(const accel_shape *sh, double u1, double u2, rng *r, vec3 *p, vec3 *n, unsigned *part);
 
+/* Grid triangles (accel_shape_grid) of a lathe, sor, prism, text or polygon. */
+int accel_sweep_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx);
+
 /* Polygon: its even-odd region as object-space triangles (trapezoids of
  * the slabs between vertex heights, two triangles each; exact for simple
  * and holed polygons). Calls emit(ctx, a, b, c) per triangle; returns the

@@ -985,6 +985,74 @@ static void test_sweep_sampling(void **st)
     done(&w);
 }
 
+/* parametric grids for GI: vertices on the surface with outward normals,
+ * total area close to the exact one */
+typedef struct {
+    const accel_shape *sh;
+    double area;
+    int bad, inside_checks, verts;
+} grid_check;
+
+static int grid_cb(void *ctx, const vec3 p[3], const vec3 n[3])
+{
+    grid_check *g = ctx;
+    g->area += 0.5 * v3_len(v3_cross(v3_sub(p[1], p[0]), v3_sub(p[2], p[0])));
+    for (int k = 0; k < 3; k++) {
+        g->verts++;
+        if (fabs(v3_len(n[k]) - 1.0) > 1e-9) g->bad += 1000;
+        if (g->inside_checks) {
+            /* back along the normal from just outside: the surface at the vertex */
+            /* nudged towards the triangle's centre, off edges and corners */
+            vec3 c = v3_scale(v3_add(v3_add(p[0], p[1]), p[2]), 1.0 / 3.0);
+            vec3 q = v3_madd(p[k], v3_sub(c, p[k]), 1e-6);
+            double e = 1e-3;
+            accel_shape_hit h;
+            if (!accel_shape_intersect(g->sh, v3_madd(q, n[k], e), v3_neg(n[k]), 0.0, 1.0, &h) || fabs(h.t - e) > 1e-8)
+                g->bad++;
+        }
+    }
+    return 1;
+}
+
+static void check_grid(const char *src, int inside_checks, double area, double rel)
+{
+    world w = build(src);
+    accel_shape sh = shape_of(&w);
+    grid_check g = {&sh, 0.0, 0, inside_checks, 0};
+    int nt = accel_shape_grid(&sh, 16, grid_cb, &g);
+    if (nt <= 0) fail_msg("%s: no grid", src);
+    /* (a vertex exactly on a cap's rim may miss the cap by rounding) */
+    if (g.bad > g.verts / 100) fail_msg("%s: %d of %d vertices off the surface", src, g.bad, g.verts);
+    assert_near(g.area, area, rel * area);
+    accel_shape_release(&sh);
+    done(&w);
+}
+
+static void test_grid(void **st)
+{
+    (void)st;
+    /* areas: tessellation error ~ (2 pi / 64)^2 / 12 for the round parts */
+    check_grid("lathe { linear_spline 5, <0,0>, <1,0>, <1,1>, <0,1>, <0,0> }", 1, 4 * M_PI, 2e-3);
+    check_grid("sor { 4, <1,-1>, <1,0>, <1,1>, <1,2> }", 1, 4 * M_PI, 2e-3);
+    check_grid("prism { 0, 1, 10, <-1,-1>, <1,-1>, <1,1>, <-1,1>, <-1,-1>, <-0.5,-0.5>, <0.5,-0.5>, <0.5,0.5>,"
+               " <-0.5,0.5>, <-0.5,-0.5> }", 1, 18.0, 1e-12);
+    check_grid("prism { conic_sweep 0.5, 1, 5, <-1,-1>, <1,-1>, <1,1>, <-1,1>, <-1,-1> }", 1,
+               /* caps 4 (0.25 + 1), sides 4 x trapezoids of height sqrt(0.25 + 0.25) and widths 1, 2 */
+               4 * 1.25 + 4 * 1.5 * sqrt(0.5), 1e-9);
+    check_grid("polygon { 10, <-2,-2>, <2,-2>, <2,2>, <-2,2>, <-2,-2>, <-1,-1>, <1,-1>, <1,1>, <-1,1>, <-1,-1> }", 0,
+               12.0, 1e-12);
+    check_grid("superellipsoid { <1, 1> }", 1, 4 * M_PI, 5e-3);
+    if (access("/usr/share/povray-3.7/include/timrom.ttf", R_OK) == 0) {
+        world w = build("text { ttf \"timrom.ttf\" \"O\" 0.2, 0 }");
+        accel_shape sh = shape_of(&w);
+        grid_check g = {&sh, 0.0, 0, 0, 0};
+        assert_true(accel_shape_grid(&sh, 8, grid_cb, &g) > 10);
+        assert_int_equal(g.bad, 0);
+        accel_shape_release(&sh);
+        done(&w);
+    }
+}
+
 /* malformed shapes give located errors; degenerate ones are skipped with a
  * warning; nothing crashes */
 static void test_bad_input(void **st)
@@ -1080,6 +1148,7 @@ int main(void)
         cmocka_unit_test(test_julia),
         cmocka_unit_test(test_surface_sampling),
         cmocka_unit_test(test_sweep_sampling),
+        cmocka_unit_test(test_grid),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_unsupported),
     };
