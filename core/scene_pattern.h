@@ -131,6 +131,12 @@ typedef struct scene_pattern {
     double altit_lo, altit_hi;     /* altitude range as the slope's */
     double facets_size, facets_coords, facets_metric;
     const struct scene_function *function; /* PAT_FUNCTION */
+    /* PAT_MANDEL / PAT_JULIA (magnet 1 or 2 for the magnet fractals) */
+    int magnet;
+    int iterations, fractal_exponent; /* exponent default 2 */
+    int interior_type, exterior_type; /* defaults 0, 1 */
+    double ifactor, efactor;       /* defaults 1, 1 */
+    double julia_c[2];             /* julia / magnet julia parameter */
 } scene_pattern;
 
 /* ---------------------------------------------------------------- blend maps */

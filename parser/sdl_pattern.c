@@ -899,17 +899,33 @@ static int pattern_type(sdl_parser *p, target *tg)
         sdl_accept_kw(p, KW_DF3);
         sdl_string(p);
         break;
-    case KW_MAGNET:
-        unsupported_pattern(p, tg, &t);
-        sdl_float(p);
-        if (!sdl_accept_kw(p, KW_MANDEL)) {
-            sdl_accept_kw(p, KW_JULIA);
-            double uv[2];
-            sdl_vector_n(p, uv, 2);
+    case KW_MANDEL: case KW_JULIA: case KW_MAGNET: {
+        /* mandel N | julia <c>, N | magnet 1|2 ( mandel N | julia <c>, N ) */
+        pt->magnet = 0;
+        if (k == KW_MAGNET) {
+            pt->magnet = sdl_to_int(sdl_float(p));
+            if (pt->magnet != 1 && pt->magnet != 2) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "invalid magnet pattern type (1 or 2)");
+            if (sdl_accept_kw(p, KW_MANDEL)) {
+                k = KW_MANDEL;
+            } else if (sdl_accept_kw(p, KW_JULIA)) {
+                k = KW_JULIA;
+            } else {
+                sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "invalid magnet pattern: 'mandel' or 'julia' expected");
+                break;
+            }
+        }
+        set_kind(tg, k == KW_MANDEL ? PAT_MANDEL : PAT_JULIA, name);
+        if (k == KW_JULIA) {
+            sdl_vector_n(p, pt->julia_c, 2);
             sdl_accept(p, TOK_COMMA);
         }
-        sdl_float(p);
+        pt->iterations = sdl_to_int(sdl_float(p));
+        pt->fractal_exponent = pt->magnet ? 0 : 2;
+        pt->interior_type = 0;
+        pt->exterior_type = 1;
+        pt->ifactor = pt->efactor = 1.0;
         break;
+    }
     default: /* julia, mandel, pavement, tiling */
         unsupported_pattern(p, tg, &t);
         skip_args(p);
@@ -946,7 +962,7 @@ static int modifier(sdl_parser *p, target *tg)
     case KW_COLOR_MAP: case KW_COLOUR_MAP: case KW_PIGMENT_MAP: case KW_NORMAL_MAP: case KW_SLOPE_MAP:
     case KW_TEXTURE_MAP: case KW_QUICK_COLOR: case KW_QUICK_COLOUR: case KW_BUMP_SIZE: case KW_ACCURACY:
     case KW_NO_BUMP_SCALE: case KW_DENSITY_MAP: case KW_INTERPOLATE: case KW_EXTERIOR: case KW_INTERIOR:
-    case KW_MAX_ITERATION: case KW_NUMBER_OF_SIDES: case KW_NUMBER_OF_TILES: case KW_PATTERN:
+    case KW_MAX_ITERATION: case KW_NUMBER_OF_SIDES: case KW_NUMBER_OF_TILES: case KW_PATTERN: case KW_EXPONENT:
         break;
     default:
         return 0;
@@ -1053,10 +1069,35 @@ static int modifier(sdl_parser *p, target *tg)
     case KW_SOLID: pt->crackle_solid = 1; break;
     case KW_COORDS: pt->facets_coords = sdl_float(p); break;
     case KW_SIZE: pt->facets_size = sdl_float(p); break;
-    case KW_EXTERIOR: case KW_INTERIOR:
-        sdl_float(p);
-        if (pt->kind != PAT_UNSUPPORTED || sdl_accept(p, TOK_COMMA)) sdl_allow_float(p, 0.0);
+    case KW_EXTERIOR: case KW_INTERIOR: {
+        int type = sdl_to_int(sdl_float(p));
+        sdl_accept(p, TOK_COMMA);
+        double f = sdl_float(p);
+        if (pt->kind == PAT_MANDEL || pt->kind == PAT_JULIA) {
+            int max = k == KW_EXTERIOR ? 8 : 6;
+            if (type < 0 || type > max) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "invalid fractal pattern %s type (0 to %d)", sdl_kw_text(k), max);
+            if (k == KW_EXTERIOR) {
+                pt->exterior_type = type;
+                pt->efactor = f;
+            } else {
+                pt->interior_type = type;
+                pt->ifactor = f;
+            }
+        }
         break;
+    }
+    case KW_EXPONENT: {
+        int e = sdl_to_int(sdl_float(p));
+        if ((pt->kind != PAT_MANDEL && pt->kind != PAT_JULIA) || pt->magnet) {
+            sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "exponent can only be used with mandel or julia");
+        } else if (e < 2 || e > 33) {
+            sdl_warning(p, t.tk.loc, "invalid %s pattern exponent (2 to 33); using 2", pt->name);
+            pt->fractal_exponent = 2;
+        } else {
+            pt->fractal_exponent = e;
+        }
+        break;
+    }
     default: /* interpolate, max_iteration, number_of_sides, number_of_tiles, pattern */
         sdl_float(p);
         break;

@@ -542,6 +542,130 @@ static double wrinkles(vec3 p, int gen)
  * the slope direction (or the direction to the point_at point) mapped to
  * [0, 1], optionally mixed with the altitude along a direction (at the
  * pattern-space point). */
+/* ------------------------------------------------------------ fractals
+ * POV-Ray's mandel/julia (exponents 2, 3, 4 in closed form, 5..33 through
+ * binomial sums), magnet 1/2 (mandel and julia forms), escape at |z|^2 > 4
+ * (magnet: > 10000 or within 1/100 of 1), and the exterior/interior colour
+ * rules (iterations fraction, a, b, a^2, b^2, |z|, modulo counts; smallest
+ * |z| seen, ...). */
+
+static double fractal_exterior(const scene_pattern *pat, int iters, double a, double b)
+{
+    double f = pat->efactor;
+    switch (pat->exterior_type) {
+    case 0: return f;
+    case 1: return (double)iters / (double)pat->iterations;
+    case 2: return a * f;
+    case 3: return b * f;
+    case 4: return a * a * f;
+    case 5: return b * b * f;
+    case 6: return sqrt(a * a + b * b) * f;
+    case 7: {
+        unsigned m = (unsigned)f;
+        return m ? (double)(iters % m) / f : 0.0;
+    }
+    case 8: return (double)(iters % (unsigned)(1 + f)) / f;
+    default: return 0.0;
+    }
+}
+
+static double fractal_interior(const scene_pattern *pat, double a, double b, double mindist2)
+{
+    double f = pat->ifactor;
+    switch (pat->interior_type) {
+    case 0: return f;
+    case 1: return sqrt(mindist2) * f;
+    case 2: return a * f;
+    case 3: return b * f;
+    case 4: return a * a * f;
+    case 5: return b * b * f;
+    case 6: return a * a + b * b * f; /* as POV-Ray writes it */
+    default: return 0.0;
+    }
+}
+
+static double binomial(int n, int k)
+{
+    double r = 1.0;
+    for (int i = 1; i <= k; i++) r = r * (n - k + i) / i;
+    return floor(r + 0.5);
+}
+
+static double mandel_julia(const scene_pattern *pat, vec3 p)
+{
+    int julia = pat->kind == PAT_JULIA, n = pat->fractal_exponent, it_max = pat->iterations, col;
+    double cr = julia ? pat->julia_c[0] : p.x, ci = julia ? pat->julia_c[1] : p.y;
+    double a = p.x, b = p.y, a2 = a * a, b2 = b * b, mindist2 = a2 + b2, dist2;
+    for (col = 0; col < it_max; col++) {
+        if (n == 2) {
+            b = 2.0 * a * b + ci;
+            a = a2 - b2 + cr;
+        } else if (n == 3) {
+            b = 3.0 * a2 * b - b2 * b + ci;
+            a = a2 * a - 3.0 * a * b2 + cr;
+        } else if (n == 4) {
+            b = 4.0 * (a2 * a * b - a * b2 * b) + ci;
+            a = a2 * a2 - 6.0 * a2 * b2 + b2 * b2 + cr;
+        } else {
+            double na = pow(a, n), nb = 0.0;
+            for (int k = 2; k <= n; k += 2) na += ((k & 2) ? -1.0 : 1.0) * binomial(n, k) * pow(a, n - k) * pow(b, k);
+            for (int l = 1; l <= n; l += 2) nb += ((l & 2) ? -1.0 : 1.0) * binomial(n, l) * pow(a, n - l) * pow(b, l);
+            a = na + cr;
+            b = nb + ci;
+        }
+        a2 = a * a;
+        b2 = b * b;
+        dist2 = a2 + b2;
+        if (dist2 < mindist2) mindist2 = dist2;
+        if (dist2 > 4.0) return fractal_exterior(pat, col, a, b);
+    }
+    return fractal_interior(pat, a, b, mindist2);
+}
+
+static double magnet(const scene_pattern *pat, vec3 p)
+{
+    int julia = pat->kind == PAT_JULIA, it_max = pat->iterations, col;
+    double cr = julia ? pat->julia_c[0] : p.x, ci = julia ? pat->julia_c[1] : p.y;
+    double a, b, a2, b2, mindist2, dist2, t, t1r, t1i, t2r, t2i;
+    if (julia) {
+        a = p.x;
+        b = p.y;
+        a2 = a * a;
+        b2 = b * b;
+        mindist2 = a2 + b2;
+    } else {
+        a = a2 = b = b2 = 0.0;
+        mindist2 = 10000;
+    }
+    double c1r = cr - 1, c2r = cr - 2, c1c2r = c1r * c2r - ci * ci, c1c2i = (c1r + c2r) * ci;
+    for (col = 0; col < it_max; col++) {
+        if (pat->magnet == 1) {
+            t1r = a2 - b2 + cr - 1;
+            t1i = 2 * a * b + ci;
+            t2r = 2 * a + cr - 2;
+            t2i = 2 * b + ci;
+        } else {
+            t1r = a2 * a - 3 * a * b2 + 3 * (a * c1r - b * ci) + c1c2r;
+            t1i = 3 * a2 * b - b2 * b + 3 * (a * ci + b * c1r) + c1c2i;
+            t2r = 3 * (a2 - b2) + 3 * (a * c2r - b * ci) + c1c2r + 1;
+            t2i = 6 * a * b + 3 * (a * ci + b * c2r) + c1c2i;
+        }
+        t = t2r * t2r + t2i * t2i;
+        a = (t1r * t2r + t1i * t2i) / t;
+        b = (t1i * t2r - t1r * t2i) / t;
+        b2 = b * b;
+        b = 2 * a * b;
+        a = a * a - b2;
+        a2 = a * a;
+        b2 = b * b;
+        dist2 = a2 + b2;
+        if (dist2 < mindist2) mindist2 = dist2;
+        t1r = a - 1;
+        if (dist2 > 10000.0 || t1r * t1r + b2 < 1 / 10000.0) return fractal_exterior(pat, col, a, b);
+    }
+    return fractal_interior(pat, a, b, mindist2);
+}
+
 static double slope(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
 {
     if (!c->has_hit) return 0.0;
@@ -634,6 +758,7 @@ static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
         return v > 1.0 ? fmod(v, 1.0) : v;
     }
     case PAT_SLOPE: return slope(pat, p, c);
+    case PAT_MANDEL: case PAT_JULIA: return pat->magnet ? magnet(pat, p) : mandel_julia(pat, p);
     case PAT_AOI: return aoi(c);
     default: return 0.0;
     }
@@ -669,6 +794,8 @@ static const scene_map_entry radial_e[] = {E(0.0, 0, 1, 1), E(0.333, 1, 1, 0), E
 static const scene_map_entry marble_e[] = {E(0.0, 0.9, 0.8, 0.8), E(0.9, 0.9, 0.08, 0.08), E(0.9, 0, 0, 0)};
 static const scene_map_entry brick_e[] = {E(0.0, 0.5, 0.5, 0.5), E(1.0, 0.6, 0.15, 0.15)};
 static const scene_map_entry hex_e[] = {E(0.0, 0, 0, 1), E(1.0, 0, 1, 0), E(2.0, 1, 0, 0)};
+static const scene_map_entry mandel_e[] = {E(0.001, 0, 0, 0), E(0.001, 0, 1, 1), E(0.012, 1, 1, 0), E(0.015, 1, 0, 1),
+                                           E(0.1, 0, 1, 1)};
 static const scene_map_entry cubic_e[] = {E(0.0, 1, 0, 0), E(1.0, 0, 1, 0), E(1.0, 0, 0, 1),
                                           E(1.0, 1, 1, 0), E(1.0, 0, 1, 1), E(2.0, 1, 0, 1)};
 #undef E
@@ -682,6 +809,7 @@ static const scene_blend_map brick_map = {MAP_COLOUR, 2, brick_e};
 static const scene_blend_map hex_map = {MAP_COLOUR, 3, hex_e};
 static const scene_blend_map check_map = {MAP_COLOUR, 2, hex_e};      /* POV-Ray uses the hexagon entries */
 static const scene_blend_map cubic_map = {MAP_COLOUR, 6, cubic_e};
+static const scene_blend_map mandel_map = {MAP_COLOUR, 5, mandel_e};
 static const scene_blend_map square_map = {MAP_COLOUR, 4, cubic_e};   /* likewise the cubic entries */
 
 const scene_blend_map *pattern_default_map(pattern_kind k)
@@ -697,6 +825,7 @@ const scene_blend_map *pattern_default_map(pattern_kind k)
     case PAT_SQUARE: return &square_map;
     case PAT_TRIANGULAR: case PAT_CUBIC: return &cubic_map;
     case PAT_CHECKER: return &check_map;
+    case PAT_MANDEL: return &mandel_map; /* POV-Ray: mandel (not julia, magnet) */
     default: return &grey_map;
     }
 }
@@ -741,6 +870,7 @@ int pigment_eval(const scene_pigment *pg, vec3 p, const pattern_ctx *c, colour5 
     vec3 tp = pattern_warp(pat, q);
     if (pat->kind == PAT_IMAGE && !pg->map) return pattern_image_colour(&pat->image, tp, out);
     const scene_blend_map *m = pg->map ? pg->map : pattern_default_map(pat->kind);
+    if (!pg->map && pat->kind == PAT_MANDEL && (pat->magnet || pat->fractal_exponent != 2)) m = &grey_map;
     if (pat->kind == PAT_AVERAGE) {
         colour5 acc = {0, 0, 0, 0, 0};
         double total = 0.0;

@@ -95,6 +95,11 @@ static const pattern_case cases[] = {
     {"pigment_pattern", "pigment_pattern { checker rgb 0, rgb 1 scale 0.5 } " GREY " turbulence 0.3"},
     {"old_colour_map", "granite color_map { [0.0 0.4 color rgb 0 color rgb 0.5] [0.4 1.0 color rgb 0.5 color rgb 1] }"},
     {"function", "function { 0.3 * x * y + 0.5 * sin(2 * x) } " GREY},
+    {"mandel", "mandel 40 scale 0.8 translate -x*0.5 " GREY},
+    {"mandel5", "mandel 30 exponent 5 exterior 6, 0.3 interior 1, 2 scale 0.7 " GREY},
+    {"julia3", "julia <0.35, 0.2>, 30 exponent 3 interior 2, 1 scale 0.6 " GREY},
+    {"magnet1m", "magnet 1 mandel 30 exterior 7, 5 scale 1.5 translate x*1.2 " GREY},
+    {"magnet2j", "magnet 2 julia <1.1, 0.4>, 25 exterior 4, 0.1 scale 1.2 " GREY},
 };
 #define NCASES ((int)(sizeof cases / sizeof cases[0]))
 
