@@ -7,7 +7,8 @@
 #     BUILD_DIR  where `partray` is (default: build)
 #     SCENE      default scenes/cbox.pov;  SIZE default 512x512
 #     MODES      default "none particle"
-#   THREADS=N (default 2, the CI machine's cores), ORBIT_S=5, MOVES=4.
+#   THREADS=N (default 2, the CI machine's cores), ORBIT_S=5, MOVES=4,
+#   PREVIEW=D fixes the preview at 1/D of the size (default: adaptive).
 #
 # Runs `partray view --script` under Xvfb (started here on a free display
 # when DISPLAY is not set). The script waits until the mode is built and the
@@ -30,6 +31,8 @@ MODES=${4:-none particle}
 THREADS=${THREADS:-2}
 ORBIT_S=${ORBIT_S:-5}
 MOVES=${MOVES:-4}
+PREVIEW_OPT=
+[ -n "${PREVIEW:-}" ] && PREVIEW_OPT="--preview $PREVIEW"
 BIN=$BUILD/partray
 [ -x "$BIN" ] || { echo "bench_view: no $BIN (build the partray target first)" >&2; exit 2; }
 
@@ -72,12 +75,13 @@ fi
     echo "$t quit"
 } >"$TMP/script.txt"
 
-printf '%s %s, %s threads, %s\n' "$SCENE" "$SIZE" "$THREADS" "$(uname -m)"
+printf '%s %s, %s threads, preview %s, %s, load %s\n' "$SCENE" "$SIZE" "$THREADS" "${PREVIEW:-adaptive}" "$(uname -m)" \
+    "$(cut -d' ' -f1 /proc/loadavg)"
 printf '%-9s %10s %11s %10s %14s %15s %11s %9s\n' mode "orbit img/s" "preview px" "cam->img ms" "light->img ms" "light->full ms" "relight ms" "build s"
 for mode in $MODES; do
     LOG=$TMP/$mode.log
     if ! timeout 900 "$BIN" view "$SCENE" --size "$SIZE" --gi "$mode" --threads "$THREADS" --script "$TMP/script.txt" \
-        --verbose >"$LOG" 2>&1; then
+        $PREVIEW_OPT --verbose >"$LOG" 2>&1; then
         echo "$mode: the viewer failed:"; tail -5 "$LOG"; continue
     fi
     awk -v mode="$mode" '
