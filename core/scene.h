@@ -368,6 +368,7 @@ typedef struct {
     int photons_count;
     double irid_wavelength[3];
     int noise_generator;    /* default 2 */
+    int number_of_waves;    /* appended (issue 5): ripples/waves sources, 0 = POV-Ray's 10 */
 } scene_global;
 
 /* ---------------------------------------------------------------- the scene */

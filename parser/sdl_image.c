@@ -95,8 +95,11 @@ int sdl_image_load(scene_image *img, arena *mem, double working_gamma, char *why
     for (int i = 0; i < 65536; i++) {
         double v = i / 65535.0;
         double lin = curve == 0 ? srgb_decode(v) : pow(v, exponent);
-        if (working_gamma == 0.0) lin = v; /* gamma handling off */
-        else if (working_gamma != 1.0) lin = pow(lin, 1.0 / working_gamma);
+        if (working_gamma == 0.0) {
+            if (img->gamma == 0.0) lin = v; /* gamma handling off: the codes as they are */
+        } else if (working_gamma != 1.0) {
+            lin = pow(lin, 1.0 / working_gamma);
+        }
         lut[i] = (float)lin;
     }
     for (size_t i = 0; i < (size_t)w * h; i++) {

@@ -9,8 +9,9 @@
 /* Fill img->width/height/pixels (in `mem`, the scene's arena) from
  * img->path, in the scene's working space: working_gamma = assumed_gamma
  * (1 = linear), or 0 when gamma handling is off (pre-3.7 scene without
- * assumed_gamma: the file's codes as they are). Returns 0 on success, else
- * a reason in `why`. */
+ * assumed_gamma, or an image used as data): the file's codes as they are,
+ * unless the scene gave the file's gamma (img->gamma), then linear values.
+ * Returns 0 on success, else a reason in `why`. */
 int sdl_image_load(scene_image *img, arena *mem, double working_gamma, char *why, size_t whycap);
 
 #endif

@@ -177,7 +177,9 @@ static int is_image_type_kw(sdl_kw k)
 }
 
 /* image_spec := [file_type] string [gamma g | premultiplied b] | function w, h { .. } */
-static scene_image *image_spec(sdl_parser *p)
+/* `data`: the image holds data (image_pattern, bump_map): POV-Ray reads it
+ * without gamma handling unless the scene gives the file's gamma. */
+static scene_image *image_spec(sdl_parser *p, int data)
 {
     const sdl_tok *t = sdl_peek(p);
     src_loc loc = t->tk.loc;
@@ -222,6 +224,7 @@ static scene_image *image_spec(sdl_parser *p)
     }
     char why[512];
     double wg = p->s->global.assumed_gamma > 0.0 ? p->s->global.assumed_gamma : (p->version < 3.65 ? 0.0 : 1.0);
+    if (data) wg = 0.0;
     if (sdl_image_load(img, p->s->mem, wg, why, sizeof why) != 0) {
         sdl_warning(p, loc, "%s; the image is transparent", why);
         return NULL;
@@ -232,11 +235,14 @@ static scene_image *image_spec(sdl_parser *p)
 }
 
 /* image_map { image_spec { once | interpolate n | map_type n | use_colour |
- *   use_index | repeat uv | offset uv | filter [all] .. | transmit [all] .. } } */
-static void image_block(sdl_parser *p, scene_image_map *im, int is_pattern)
+ *   use_index | repeat uv | offset uv | filter [all] .. | transmit [all] .. } };
+ * image_pattern and bump_map (kind 1, 2) the same without filter/transmit,
+ * bump_map with bump_size (into *amount). */
+static void image_block(sdl_parser *p, scene_image_map *im, int kind, double *amount)
 {
-    if (!sdl_begin_block(p, is_pattern ? "image_pattern" : "image_map")) return;
-    im->image = image_spec(p);
+    static const char *const names[] = {"image_map", "image_pattern", "bump_map"};
+    if (!sdl_begin_block(p, names[kind])) return;
+    im->image = image_spec(p, kind != 0);
     im->major_radius = 1.0;
     while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
         sdl_tok t = sdl_next(p);
@@ -247,6 +253,10 @@ static void image_block(sdl_parser *p, scene_image_map *im, int is_pattern)
         case KW_MAP_TYPE: im->map_type = sdl_to_int(sdl_float(p)); break;
         case KW_USE_COLOR: case KW_USE_COLOUR: case KW_USE_INDEX: break;
         case KW_USE_ALPHA: im->use_alpha = 1; break;
+        case KW_BUMP_SIZE:
+            if (kind == 2 && amount) *amount = sdl_float(p);
+            else sdl_unexpected(p, &t, "image modifier");
+            break;
         case KW_REPEAT: case KW_OFFSET: {
             double uv[2];
             sdl_vector_n(p, uv, 2);
@@ -807,18 +817,18 @@ static int pattern_type(sdl_parser *p, target *tg)
         set_kind(tg, PAT_IMAGE, name);
         pt->frequency = 0.0;
         if (tg->kind != TGT_PIGMENT) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "image_map can only be used in pigment");
-        image_block(p, &pt->image, 0);
+        image_block(p, &pt->image, 0, NULL);
         break;
     case KW_IMAGE_PATTERN:
         set_kind(tg, PAT_IMAGE, name);
         pt->frequency = 0.0;
-        image_block(p, &pt->image, 1);
+        image_block(p, &pt->image, 1, NULL);
         break;
     case KW_BUMP_MAP:
         set_kind(tg, PAT_IMAGE, name);
         pt->frequency = 0.0;
-        sdl_warn_once(p, t.tk.loc, "bump_map is not supported yet; the normal is unperturbed");
-        if (sdl_begin_block(p, "bump_map")) sdl_skip_block(p);
+        if (tg->kind != TGT_NORMAL) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "bump_map can only be used in normal");
+        image_block(p, &pt->image, 2, tg->nm ? &tg->nm->amount : NULL);
         break;
     case KW_PIGMENT_PATTERN: {
         set_kind(tg, PAT_PIGMENT, name);

@@ -510,6 +510,15 @@ static int global_item(sdl_parser *p, scene_global *g)
     case KW_ADC_BAILOUT: g->adc_bailout = sdl_float(p); break;
     case KW_MAX_INTERSECTIONS: g->max_intersections = sdl_to_int(sdl_float(p)); break;
     case KW_NOISE_GENERATOR: g->noise_generator = sdl_to_int(sdl_float(p)); break;
+    case KW_NUMBER_OF_WAVES: {
+        int n = sdl_to_int(sdl_float(p));
+        if (n <= 0) {
+            sdl_warning(p, t.tk.loc, "illegal value for number_of_waves; using 1");
+            n = 1;
+        }
+        g->number_of_waves = n;
+        break;
+    }
     case KW_IRID_WAVELENGTH: {
         rgb w = sdl_rgb(p);
         g->irid_wavelength[0] = w.r;

@@ -38,7 +38,7 @@
  *    x / 2^32, as boost's uniform_real(0, 1) over mt19937 gives them.
  *  - Waves: source i is DNoise(<i, 0, 0>) normalised; frequency i from the
  *    LCG seeded with -560851967: ((r >> 16) & 0x7FFF) * 0.000030518509476
- *    + 0.01 (POV-Ray's Initialize_Waves, number_of_waves 10). */
+ *    + 0.01 (POV-Ray's Initialize_Waves; the first number_of_waves are used). */
 #include "shade_noise.h"
 #include <math.h>
 #include <pthread.h>
@@ -58,8 +58,8 @@ static double rtab[267];
 static int solid_perm[2 * (SOLID_N + 1)];
 static vec3 solid_grad[2 * (SOLID_N + 1)];
 static double pattern_rands[RANDS_N];
-static vec3 wave_src[NOISE_WAVES];
-static double wave_freq[NOISE_WAVES];
+static vec3 wave_src[NOISE_MAX_WAVES];
+static double wave_freq[NOISE_MAX_WAVES];
 static pthread_once_t init_once = PTHREAD_ONCE_INIT;
 
 /* POV-Ray's LCG step on a 32-bit int; returns the 15 bits it uses. */
@@ -164,7 +164,7 @@ static vec3 dnoise(vec3 p);
 static void init_waves(void)
 {
     uint32_t r = (uint32_t)-560851967;
-    for (int i = 0; i < NOISE_WAVES; i++) {
+    for (int i = 0; i < NOISE_MAX_WAVES; i++) {
         wave_src[i] = v3_norm(dnoise(v3((double)i, 0.0, 0.0)));
         wave_freq[i] = (double)lcg15(&r) * 0.000030518509476 + 0.01;
     }

@@ -37,8 +37,10 @@ int noise_hash3d(int a, int b, int c);
  * default seed, divided by 2^32), index taken modulo 32768. */
 double noise_pattern_rand(unsigned long i);
 
-/* The ripples/waves sources: POV-Ray's number_of_waves (default 10). */
+/* The ripples/waves sources (POV-Ray's number_of_waves, default 10; up to
+ * NOISE_MAX_WAVES are generated). */
 #define NOISE_WAVES 10
+#define NOISE_MAX_WAVES 1000
 vec3 noise_wave_source(int i);
 double noise_wave_frequency(int i);
 

@@ -71,10 +71,10 @@ static double slope_map(double v, const scene_blend_map *m)
     return hermite(t, m->e[ip].height, m->e[ip].slope, m->e[ic].height, m->e[ic].slope);
 }
 
-static vec3 waves_normal(const scene_normal *nm, vec3 p, vec3 n, int ripples)
+static vec3 waves_normal(const scene_normal *nm, vec3 p, vec3 n, int ripples, int nw)
 {
     const scene_pattern *pat = nm->pat;
-    for (int i = 0; i < NOISE_WAVES; i++) {
+    for (int i = 0; i < nw; i++) {
         vec3 d = v3_sub(p, noise_wave_source(i));
         double len = v3_len(d);
         if (len == 0.0) len = 1.0;
@@ -85,7 +85,7 @@ static vec3 waves_normal(const scene_normal *nm, vec3 p, vec3 n, int ripples)
             double f = noise_wave_frequency(i);
             s = noise_cycloidal(len * pat->frequency * f + pat->phase) * nm->amount / f;
         }
-        n = v3_madd(n, d, s / (len * (double)NOISE_WAVES));
+        n = v3_madd(n, d, s / (len * (double)nw));
     }
     return n;
 }
@@ -99,6 +99,44 @@ static int is_bump_pattern(pattern_kind k)
            k == PAT_QUILTED || k == PAT_FACETS || k == PAT_AVERAGE || k == PAT_IMAGE;
 }
 
+static double grey(colour5 c) { return 0.297 * c.r + 0.589 * c.g + 0.114 * c.b; }
+
+static double wrap_coord(double v, double n)
+{
+    if (v < 0.0) return v + n;
+    if (v >= n) return v - n;
+    return v;
+}
+
+/* POV-Ray's bump_map: heights (amount * grey) at the pixel and at its
+ * lower-left and lower-right neighbours make a triangle whose normal tilts
+ * the surface normal in a frame built from it and +y. */
+static vec3 bump_map(const scene_normal *nm, vec3 n, vec3 tp)
+{
+    const scene_image_map *im = &nm->pat->image;
+    double xc, yc;
+    if (!pattern_image_pos(im, tp, &xc, &yc)) return n;
+    double w = im->image->width, h = im->image->height, a = nm->amount;
+    double h1 = a * grey(pattern_image_at(im, xc, yc));
+    xc = wrap_coord(xc - 1.0, w);
+    yc = wrap_coord(yc + 1.0, h);
+    double h2 = a * grey(pattern_image_at(im, xc, yc));
+    xc = wrap_coord(xc + 2.0, w);
+    double h3 = a * grey(pattern_image_at(im, xc, yc));
+    vec3 p1 = v3(0, h1, 0), p2 = v3(-1, h2, 1), p3 = v3(1, h3, 1);
+    vec3 bn = v3_norm(v3_cross(v3_sub(p3, p2), v3_sub(p1, p2)));
+    vec3 yp = n, xp = v3_cross(yp, v3(0, 1, 0));
+    double len = v3_len(xp);
+    if (len < 1e-10) {
+        yp = fabs(n.y - 1.0) < 1e-10 ? v3(0, 1, 0) : v3(0, -1, 0);
+        xp = v3(1, 0, 0);
+        len = 1.0;
+    }
+    xp = v3_scale(xp, 1.0 / len);
+    vec3 zp = v3_norm(v3_cross(xp, yp));
+    return v3_add(v3_add(v3_scale(xp, bn.x), v3_scale(yp, bn.y)), v3_scale(zp, -bn.z));
+}
+
 static vec3 bump_pattern(const scene_normal *nm, vec3 n, vec3 tp, const pattern_ctx *c)
 {
     const scene_pattern *pat = nm->pat;
@@ -109,8 +147,8 @@ static vec3 bump_pattern(const scene_normal *nm, vec3 n, vec3 tp, const pattern_
         double v = noise_value(tp, gen);
         return v3_madd(n, noise_dvector(tp), v * v * v * nm->amount);
     }
-    case PAT_RIPPLES: return waves_normal(nm, tp, n, 1);
-    case PAT_WAVES: return waves_normal(nm, tp, n, 0);
+    case PAT_RIPPLES: return waves_normal(nm, tp, n, 1, c->nwaves > 0 ? c->nwaves : NOISE_WAVES);
+    case PAT_WAVES: return waves_normal(nm, tp, n, 0, c->nwaves > 0 ? c->nwaves : NOISE_WAVES);
     case PAT_WRINKLES: {
         vec3 r = v3(0, 0, 0);
         double scale = 1.0;
@@ -142,7 +180,8 @@ static vec3 bump_pattern(const scene_normal *nm, vec3 n, vec3 tp, const pattern_
         }
         return total != 0.0 ? v3_scale(acc, 1.0 / total) : n;
     }
-    default: return n; /* facets, bump_map: not modelled (unperturbed) */
+    case PAT_IMAGE: return bump_map(nm, n, tp);
+    default: return n; /* facets: not modelled (unperturbed) */
     }
 }
 

@@ -46,6 +46,8 @@ pattern_ctx pattern_ctx_plain(const scene *sc)
     /* POV-Ray defaults to the original noise for #version < 3.5 scenes */
     if (sc && g == 2 && sc->version_major > 0 && sc->version_major + sc->version_minor / 10.0 < 3.45) g = 1;
     c.noise_generator = g >= 1 && g <= 3 ? g : 2;
+    int nw = sc ? sc->global.number_of_waves : 0;
+    c.nwaves = nw <= 0 ? NOISE_WAVES : (nw > NOISE_MAX_WAVES ? NOISE_MAX_WAVES : nw);
     return c;
 }
 
@@ -463,27 +465,27 @@ static double radial(vec3 p)
     return 0.25 + (atan2(p.x, p.z) + PI_) / TWO_PI;
 }
 
-static double ripples(const scene_pattern *pat, vec3 p)
+static double ripples(const scene_pattern *pat, vec3 p, int nw)
 {
     double s = 0.0;
-    for (int i = 0; i < NOISE_WAVES; i++) {
+    for (int i = 0; i < nw; i++) {
         double len = v3_len(v3_sub(p, noise_wave_source(i)));
         if (len == 0.0) len = 1.0;
         s += noise_cycloidal(len * pat->frequency + pat->phase);
     }
-    return 0.5 * (1.0 + (s / (double)NOISE_WAVES));
+    return 0.5 * (1.0 + (s / (double)nw));
 }
 
-static double waves(const scene_pattern *pat, vec3 p)
+static double waves(const scene_pattern *pat, vec3 p, int nw)
 {
     double s = 0.0;
-    for (int i = 0; i < NOISE_WAVES; i++) {
+    for (int i = 0; i < nw; i++) {
         double len = v3_len(v3_sub(p, noise_wave_source(i)));
         if (len == 0.0) len = 1.0;
         double f = noise_wave_frequency(i);
         s += noise_cycloidal(len * pat->frequency * f + pat->phase) / f;
     }
-    return 0.2 * (2.5 + (s / (double)NOISE_WAVES));
+    return 0.2 * (2.5 + (s / (double)nw));
 }
 
 static double spiral_phi(double x, double y, double rad)
@@ -725,8 +727,8 @@ static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
     case PAT_SPIRAL1: return spiral1(pat, p, gen);
     case PAT_SPIRAL2: return spiral2(pat, p, gen);
     case PAT_WOOD: return wood(pat, p);
-    case PAT_WAVES: return waves(pat, p);
-    case PAT_RIPPLES: return ripples(pat, p);
+    case PAT_WAVES: return waves(pat, p, c->nwaves > 0 ? c->nwaves : NOISE_WAVES);
+    case PAT_RIPPLES: return ripples(pat, p, c->nwaves > 0 ? c->nwaves : NOISE_WAVES);
     case PAT_WRINKLES: return wrinkles(p, gen);
     case PAT_DENTS: {
         double n = noise_value(p, gen);
@@ -989,31 +991,35 @@ static colour5 pixel(const scene_image_map *im, double xc, double yc)
     return c;
 }
 
-int pattern_image_colour(const scene_image_map *im, vec3 tp, colour5 *out)
+int pattern_image_pos(const scene_image_map *im, vec3 tp, double *x, double *y)
 {
-    colour5 clear = {1, 1, 1, 0, 1};
-    if (!im->image || !im->image->pixels) {
-        *out = clear;
-        return 0;
-    }
+    if (!im->image || !im->image->pixels) return 0;
     double xc = 0.0, yc = 0.0;
-    if (!image_uv(im, tp, &xc, &yc)) {
-        *out = clear;
-        return 0;
-    }
+    if (!image_uv(im, tp, &xc, &yc)) return 0;
     double w = im->image->width, h = im->image->height;
     xc += PAT_EPSILON;
     yc += PAT_EPSILON;
-    if (im->once && (xc >= w || yc >= h || xc < 0.0 || yc < 0.0)) {
+    if (im->once && (xc >= w || yc >= h || xc < 0.0 || yc < 0.0)) return 0;
+    *x = wrap_to(xc, w);
+    *y = wrap_to(-yc, h); /* image rows run top-down */
+    return 1;
+}
+
+int pattern_image_colour(const scene_image_map *im, vec3 tp, colour5 *out)
+{
+    colour5 clear = {1, 1, 1, 0, 1};
+    double xc, yc;
+    if (!pattern_image_pos(im, tp, &xc, &yc)) {
         *out = clear;
         return 0;
     }
-    xc = wrap_to(xc, w);
-    yc = wrap_to(-yc, h); /* image rows run top-down */
-    if (im->interpolate != 2 && im->interpolate != 4) {
-        *out = pixel(im, xc, yc);
-        return 1;
-    }
+    *out = pattern_image_at(im, xc, yc);
+    return 1;
+}
+
+colour5 pattern_image_at(const scene_image_map *im, double xc, double yc)
+{
+    if (im->interpolate != 2 && im->interpolate != 4) return pixel(im, xc, yc);
     xc += 0.5;
     yc += 0.5;
     int ix = (int)xc, iy = (int)yc;
@@ -1035,6 +1041,5 @@ int pattern_image_colour(const scene_image_map *im, vec3 tp, colour5 *out)
         r.r += cc[i].r * f[i]; r.g += cc[i].g * f[i]; r.b += cc[i].b * f[i];
         r.f += cc[i].f * f[i]; r.t += cc[i].t * f[i];
     }
-    *out = r;
-    return 1;
+    return r;
 }

@@ -16,6 +16,7 @@ typedef struct {
     vec3 normal;          /* perturbed world normal facing the viewer (slope, aoi); zero if unknown */
     vec3 dir;             /* ray direction (aoi) */
     int has_hit;          /* normal/dir are meaningful */
+    int nwaves;           /* global_settings number_of_waves (default 10) */
 } pattern_ctx;
 
 /* A context for evaluating patterns away from a surface. */
@@ -43,6 +44,11 @@ int pigment_eval(const scene_pigment *pg, vec3 p, const pattern_ctx *c, colour5 
 /* Image-map colour at a warped point (POV-Ray's image_map); 0 outside a
  * `once` image (then *out is clear: transmit 1). */
 int pattern_image_colour(const scene_image_map *im, vec3 tp, colour5 *out);
+/* The image coordinates (pixels, wrapped, row 0 at the top) of a warped
+ * point (POV-Ray's map_pos); 0 outside a `once` image or without pixels. */
+int pattern_image_pos(const scene_image_map *im, vec3 tp, double *x, double *y);
+/* The image's colour at image coordinates, interpolated as asked. */
+colour5 pattern_image_at(const scene_image_map *im, double x, double y);
 
 /* A linear transform's transpose applied to a vector (POV-Ray's
  * MInvTransNormal: world normal -> pattern space). */
