@@ -296,6 +296,7 @@ static int cmd_render(int argc, char **argv)
     const char *gi_used = gi_mode_name(gi);
 
     int threads = o.threads > 0 ? o.threads : pool_default_threads();
+    accel_set_function_env(shade_func_env()); /* isosurface functions: noise, pigment functions (issue 4) */
     t0 = timer_now();
     accel *acc = accel_build(sc, threads, d, &st);
     double t_accel = timer_now() - t0;

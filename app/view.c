@@ -16,6 +16,7 @@
 #include "pool.h"
 #include "scene.h"
 #include "sdl.h"
+#include "shade_funcenv.h"
 #include "timer.h"
 #include "view_camera.h"
 #include "view_gi.h"
@@ -791,6 +792,7 @@ int cmd_view(int argc, char **argv)
     v.gi_mode = gi;
 
     diag *ad = diag_new();
+    accel_set_function_env(shade_func_env()); /* isosurface functions (issue 4) */
     accel *acc = accel_build(sc, v.threads, ad, &st);
     print_diags(ad);
     diag_free(ad);
