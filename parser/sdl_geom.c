@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "sdl_directive.h"
+#include "func.h"
 #include "sdl_expr.h"
 
 #define DEPTH_TOLERANCE 1e-6    /* POV-Ray's shapes ignore hits closer than this */
@@ -907,6 +908,116 @@ static void shape_marched_hits(geom *g, const scene_object *o, vec3 org, vec3 di
     }
 }
 
+/* ------------------------------------------------------------ isosurface */
+
+/* function - threshold at q (inside: < 0); on a function the parse cannot
+ * evaluate, g->unsupported says why. */
+static double iso_f(geom *g, const scene_object *o, vec3 q)
+{
+    const scene_isosurface *iso = o->u.isosurface;
+    double args[FUNC_MAX_SLOTS], out[5];
+    memset(args, 0, sizeof args);
+    args[0] = q.x;
+    args[1] = q.y;
+    args[2] = q.z;
+    const char *why = NULL;
+    if (func_eval(iso->fn, args, out, g->p->opt.func_env, &why) != PT_OK) {
+        if (!g->unsupported) {
+            char buf[160];
+            snprintf(buf, sizeof buf, "isosurface (its function needs %s)", why ? why : "an evaluator");
+            g->unsupported = sdl_strndup(g->p, buf, strlen(buf));
+        }
+        return 1;
+    }
+    return out[0] - iso->threshold;
+}
+
+static int iso_in_container(const scene_isosurface *iso, vec3 q)
+{
+    if (iso->sphere) {
+        vec3 d = v3_sub(q, iso->c1);
+        return v3_dot(d, d) <= iso->radius * iso->radius;
+    }
+    return q.x >= iso->c1.x && q.x <= iso->c2.x && q.y >= iso->c1.y && q.y <= iso->c2.y && q.z >= iso->c1.z && q.z <= iso->c2.z;
+}
+
+/* Entry and exit of the local ray through the container, with the
+ * container's outward normals there. 0 if it misses. */
+static int iso_span(const scene_isosurface *iso, vec3 ro, vec3 rd, double *t0, double *t1, vec3 *n0, vec3 *n1)
+{
+    if (iso->sphere) {
+        vec3 oc = v3_sub(ro, iso->c1);
+        double a = v3_dot(rd, rd), b = v3_dot(oc, rd), c = v3_dot(oc, oc) - iso->radius * iso->radius, disc = b * b - a * c;
+        if (disc < 0 || a == 0) return 0;
+        *t0 = (-b - sqrt(disc)) / a;
+        *t1 = (-b + sqrt(disc)) / a;
+        *n0 = v3_sub(v3_madd(ro, rd, *t0), iso->c1);
+        *n1 = v3_sub(v3_madd(ro, rd, *t1), iso->c1);
+        return 1;
+    }
+    *t0 = -INFINITY;
+    *t1 = INFINITY;
+    for (int i = 0; i < 3; i++) {
+        double d = v3_idx(rd, i), o = v3_idx(ro, i), lo = v3_idx(iso->c1, i), hi = v3_idx(iso->c2, i);
+        if (fabs(d) < 1e-300) {
+            if (o < lo || o > hi) return 0;
+            continue;
+        }
+        double ta = (lo - o) / d, tb = (hi - o) / d, sa = -1;
+        if (ta > tb) {
+            double t = ta;
+            ta = tb;
+            tb = t;
+            sa = 1;
+        }
+        vec3 na = v3(i == 0 ? sa : 0, i == 1 ? sa : 0, i == 2 ? sa : 0);
+        if (ta > *t0) { *t0 = ta; *n0 = na; }
+        if (tb < *t1) { *t1 = tb; *n1 = v3_neg(na); }
+    }
+    return *t0 <= *t1 && isfinite(*t0) && isfinite(*t1);
+}
+
+/* March the ray through the container (at least 512 steps, none longer than
+ * 1/1000 of the container), bisect every change of sign of the function;
+ * where the function is below the threshold at the container's wall, the
+ * wall is the surface (a closed isosurface). */
+static void iso_hits(geom *g, const scene_object *o, vec3 org, vec3 dir, hit_list *l)
+{
+    const scene_isosurface *iso = o->u.isosurface;
+    if (!iso || !iso->fn) return;
+    vec3 ro, rd, n0 = v3(0, 0, 0), n1 = v3(0, 0, 0);
+    local_ray(o, org, dir, &ro, &rd);
+    double t0, t1;
+    if (!iso_span(iso, ro, rd, &t0, &t1, &n0, &n1)) return;
+    double diag = iso->sphere ? 2 * iso->radius : v3_len(v3_sub(iso->c2, iso->c1)), len = v3_len(rd);
+    if (len <= 0) return;
+    long n = (long)ceil((t1 - t0) * len / (diag / 1000));
+    if (n < 512) n = 512;
+    if (n > 100000) n = 100000;
+    double dt = (t1 - t0) / (double)n, ta = t0, fa = iso_f(g, o, v3_madd(ro, rd, t0));
+    if (fa < 0) add_hit(g, l, t0, world_normal(o, n0), o);
+    for (long i = 1; i <= n && !g->unsupported; i++) {
+        double tb = t0 + dt * (double)i, fb = iso_f(g, o, v3_madd(ro, rd, tb));
+        if ((fa < 0) != (fb < 0)) {
+            double a = ta, b = tb, va = fa;
+            for (int k = 0; k < 100 && b - a > 1e-14 * (1 + fabs(a)); k++) {
+                double m = 0.5 * (a + b), vm = iso_f(g, o, v3_madd(ro, rd, m));
+                if ((vm < 0) == (va < 0)) { a = m; va = vm; } else b = m;
+            }
+            double t = 0.5 * (a + b);
+            vec3 q = v3_madd(ro, rd, t);
+            double h = 1e-6 * (1 + v3_len(q));
+            vec3 grad = v3(iso_f(g, o, v3(q.x + h, q.y, q.z)) - iso_f(g, o, v3(q.x - h, q.y, q.z)),
+                           iso_f(g, o, v3(q.x, q.y + h, q.z)) - iso_f(g, o, v3(q.x, q.y - h, q.z)),
+                           iso_f(g, o, v3(q.x, q.y, q.z + h)) - iso_f(g, o, v3(q.x, q.y, q.z - h)));
+            add_hit(g, l, t, world_normal(o, v3_len2(grad) > 0 ? grad : v3_neg(rd)), o);
+        }
+        ta = tb;
+        fa = fb;
+    }
+    if (fa < 0) add_hit(g, l, t1, world_normal(o, n1), o);
+}
+
 /* ------------------------------------------------------------ objects */
 
 static int obj_inside(geom *g, const scene_object *o, vec3 p);
@@ -933,6 +1044,12 @@ static int leaf_inside(geom *g, const scene_object *o, vec3 q)
     case SHAPE_TORUS: case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: return implicit_f(o, q) < 0;
     case SHAPE_DISC: case SHAPE_POLYGON: return 0;
     case SHAPE_LATHE: case SHAPE_PRISM: return shape_f(o, q) < 0;
+    case SHAPE_ISOSURFACE: {
+        if (!o->u.isosurface || !o->u.isosurface->fn) break;
+        if (!iso_in_container(o->u.isosurface, q)) return 0;
+        int in = iso_f(g, o, q) < 0;
+        return g->unsupported ? -1 : in;
+    }
     case SHAPE_BLOB: if (!o->u.blob) break; return shape_f(o, q) < 0;
     case SHAPE_MESH: {
         if (!o->u.mesh.inside_vector_set) break;
@@ -1000,6 +1117,7 @@ static void leaf_hits(geom *g, const scene_object *o, vec3 org, vec3 dir, hit_li
     case SHAPE_LATHE: case SHAPE_PRISM: case SHAPE_BLOB:
         if (o->u.lathe) shape_marched_hits(g, o, org, dir, l); /* u.lathe/u.prism/u.blob share the slot */
         return;
+    case SHAPE_ISOSURFACE: iso_hits(g, o, org, dir, l); return;
     default:
         if (!g->unsupported) g->unsupported = o->name ? o->name : "object";
         return;
@@ -1317,6 +1435,15 @@ static bbox leaf_box(geom *g, const scene_object *o)
         return transformed_box(x, v3(xl, yl, 0), v3(xh, yh, t->depth));
     }
     case SHAPE_QUADRIC: case SHAPE_POLY: return huge_box();
+    case SHAPE_ISOSURFACE: {
+        const scene_isosurface *iso = o->u.isosurface;
+        if (!iso) return huge_box();
+        if (iso->sphere) {
+            double r = iso->radius;
+            return transformed_box(x, v3_sub(iso->c1, v3s(r)), v3_add(iso->c1, v3s(r)));
+        }
+        return transformed_box(x, iso->c1, iso->c2);
+    }
     default:
         if (!g->unsupported) g->unsupported = o->name ? o->name : "object";
         return huge_box();
