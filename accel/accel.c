@@ -24,9 +24,11 @@
  * masks would also do, but they are an optional Embree build feature.)
  *
  * Epsilon rule (self-intersection): a ray's effective tmin is
- *   max(tmin, ACCEL_EPS_REL * (accel_scale + max|org_i|) / |dir|)
- * i.e. a distance of 1e-5 of the scene diagonal plus 1e-5 of the origin's
- * magnitude. Embree intersects triangles in single precision with the origin
+ *   max(tmin, ACCEL_EPS_REL * (accel_eps_scale + max|org_i|) / |dir|)
+ * i.e. a distance of 1e-5 of the working scale (the median of the leaf
+ * objects' bounding-box diagonals, not the scene diagonal, so that one far
+ * object does not make the epsilon larger than the room's details) plus
+ * 1e-5 of the origin's magnitude. Embree intersects triangles in single precision with the origin
  * rounded to float (relative error 6e-8), so a ray leaving a surface sits up
  * to about one float ulp of |org| off it, and a spurious re-hit lies at a
  * distance of that offset / sin(angle to the surface). The rule covers angles
@@ -112,6 +114,9 @@ struct accel {
     unsigned nginfo;
     vec3 lo, hi;
     double scale;
+    double eps_scale;  /* working scale of the epsilon rule (see the top) */
+    double *diags;     /* leaf bounding-box diagonals, during the build */
+    int ndiags, capdiags;
     accel_stats stats;
     atomic_int err;
     char errmsg[512];
@@ -133,6 +138,8 @@ typedef struct {
 } accel_query;
 
 static _Thread_local accel_query *tls_query;
+
+static void leaf_diag(accel *a, vec3 lo, vec3 hi);
 
 /* Embree's SoA ray/hit packets (rtcore_ray.h: RTCRayN/RTCHitN layout; the
  * accessors there are C++ only). Ray fields: org 0-2, tnear 3, dir 4-6, time
@@ -361,6 +368,7 @@ static pt_status build_csg(accel *a, diag *d, const scene_object *o, const scene
     if (v3_finite(c->lo) && v3_finite(c->hi)) {
         a->lo = v3_min(a->lo, c->lo);
         a->hi = v3_max(a->hi, c->hi);
+        leaf_diag(a, c->lo, c->hi);
     }
     return PT_OK;
 }
@@ -429,6 +437,22 @@ static void bounds_add(vec3 *lo, vec3 *hi, vec3 p)
     if (!v3_finite(p)) return;
     *lo = v3_min(*lo, p);
     *hi = v3_max(*hi, p);
+}
+
+/* Records one leaf object's bounding box for the epsilon scale; a failed
+ * allocation only leaves that box out. */
+static void leaf_diag(accel *a, vec3 lo, vec3 hi)
+{
+    double dg = v3_len(v3_sub(hi, lo));
+    if (!(dg > 0.0) || !isfinite(dg)) return;
+    if (a->ndiags == a->capdiags) {
+        int nc = a->capdiags ? 2 * a->capdiags : 64;
+        double *nd = realloc(a->diags, (size_t)nc * sizeof *nd);
+        if (!nd) return;
+        a->diags = nd;
+        a->capdiags = nc;
+    }
+    a->diags[a->ndiags++] = dg;
 }
 
 static int batch_add_vertex(tri_batch *b, vec3 p)
@@ -639,22 +663,28 @@ static pt_status add_flat_triangles(accel *a, diag *d, int li)
     const xform *x = &o->transform;
     if (o->kind == SHAPE_TRIANGLE || o->kind == SHAPE_SMOOTH_TRIANGLE) {
         unsigned base = (unsigned)b->nv;
+        vec3 tlo = v3s(INFINITY), thi = v3s(-INFINITY);
         for (int k = 0; k < 3; k++) {
             vec3 p = xform_point(x, o->u.triangle.v[k]);
             bounds_add(&a->lo, &a->hi, p);
+            bounds_add(&tlo, &thi, p);
             if (!batch_add_vertex(b, p)) return PT_ERR_NOMEM;
         }
+        leaf_diag(a, tlo, thi);
         if (!batch_add_tri(b, base, base + 1, base + 2, (unsigned)li, 0)) return PT_ERR_NOMEM;
         a->stats.triangles++;
         return PT_OK;
     }
     const scene_mesh *m = o->u.mesh.mesh;
     unsigned base = (unsigned)b->nv;
+    vec3 mlo = v3s(INFINITY), mhi = v3s(-INFINITY);
     for (int i = 0; i < m->nverts; i++) {
         vec3 p = xform_point(x, mesh_vert(m, i));
         bounds_add(&a->lo, &a->hi, p);
+        bounds_add(&mlo, &mhi, p);
         if (!batch_add_vertex(b, p)) return PT_ERR_NOMEM;
     }
+    if (m->nverts > 0) leaf_diag(a, mlo, mhi);
     for (int t = 0; t < m->ntris; t++) {
         int ok = mesh_tri_ok(m, t);
         if (!ok) diag_warn_once(d, m->loc, "mesh triangle with a vertex index out of range ignored");
@@ -765,11 +795,15 @@ static pt_status build_mesh_group(accel *a, diag *d, mesh_group *gr, const int *
         rtcReleaseGeometry(inst);
         if (!set_ginfo(a, id, GEOM_INSTANCE, (unsigned)leaves[i])) return PT_ERR_DEVICE;
         a->stats.instances++;
-        if (mlo.x <= mhi.x)
+        if (mlo.x <= mhi.x) {
+            vec3 ilo = v3s(INFINITY), ihi = v3s(-INFINITY);
             for (int c = 0; c < 8; c++) {
                 vec3 p = v3(c & 1 ? mhi.x : mlo.x, c & 2 ? mhi.y : mlo.y, c & 4 ? mhi.z : mlo.z);
                 bounds_add(&a->lo, &a->hi, xform_point(&o->transform, p));
+                bounds_add(&ilo, &ihi, xform_point(&o->transform, p));
             }
+            leaf_diag(a, ilo, ihi);
+        }
     }
     return PT_OK;
 }
@@ -847,6 +881,7 @@ static pt_status build_shapes(accel *a, diag *d)
         if (o->kind != SHAPE_PLANE && !sh->infinite) {
             bounds_add(&a->lo, &a->hi, sh->lo);
             bounds_add(&a->lo, &a->hi, sh->hi);
+            leaf_diag(a, sh->lo, sh->hi);
         }
     }
     return PT_OK;
@@ -860,6 +895,12 @@ static double plane_distance(const accel_shape *sh, vec3 c)
     if (!sh->identity) p0 = xform_point(&sh->x, p0);
     double dist = fabs(v3_dot(v3_sub(c, p0), nw));
     return isfinite(dist) ? dist : 0.0;
+}
+
+static int cmp_double(const void *x, const void *y)
+{
+    double u = *(const double *)x, v = *(const double *)y;
+    return (u > v) - (u < v);
 }
 
 static void finish_bounds(accel *a)
@@ -901,6 +942,18 @@ static void finish_bounds(accel *a)
     if (!(a->scale > 0.0) || !isfinite(a->scale)) a->scale = diag_e;
     if (!(a->scale > 0.0) || !isfinite(a->scale)) a->scale = far_plane;
     if (!(a->scale > 0.0) || !isfinite(a->scale)) a->scale = 1.0;
+    /* Epsilon scale: the median leaf diagonal, so one far or huge object
+     * does not grow the epsilon beyond the other objects' details; it scales
+     * with the scene like the diagonal does. */
+    a->eps_scale = a->scale;
+    if (a->ndiags > 0) {
+        qsort(a->diags, (size_t)a->ndiags, sizeof *a->diags, cmp_double);
+        double med = a->diags[a->ndiags / 2];
+        if (med < a->eps_scale) a->eps_scale = med;
+    }
+    free(a->diags);
+    a->diags = NULL;
+    a->ndiags = a->capdiags = 0;
 }
 
 static pt_status build_user_geometry(accel *a)
@@ -1023,6 +1076,7 @@ void accel_free(accel *a)
     for (int i = 0; i < a->nshapes; i++) accel_shape_release(&a->shapes[i]);
     free(a->shapes);
     free(a->shape_leaf);
+    free(a->diags);
     free(a->groups);
     for (int i = 0; i < a->ncsgs; i++) accel_csg_free(&a->csgs[i]);
     free(a->csgs);
@@ -1042,7 +1096,7 @@ double accel_epsilon(const accel *a, vec3 org, vec3 dir)
 {
     double l = v3_len(dir);
     if (!(l > 0.0) || !v3_finite(org)) return INFINITY;
-    return eps_rule(a ? a->scale : 1.0, org, l);
+    return eps_rule(a ? a->eps_scale : 1.0, org, l);
 }
 
 static int ray_ok(vec3 org, vec3 dir) { return v3_finite(org) && v3_finite(dir) && v3_len2(dir) > 0.0; }
@@ -1134,7 +1188,7 @@ static void fill_triangle(const accel *a, const accel_leaf *l, unsigned local, d
 int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, accel_hit *hit)
 {
     if (!a || !ray_ok(org, dir)) return 0;
-    double t0 = eps_rule(a->scale, org, v3_len(dir));
+    double t0 = eps_rule(a->eps_scale, org, v3_len(dir));
     if (tmin > t0) t0 = tmin;
     if (!(tmax > t0)) return 0;
     accel_query q;
@@ -1199,7 +1253,7 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
 int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax)
 {
     if (!a || !ray_ok(org, dir)) return 0;
-    double t0 = eps_rule(a->scale, org, v3_len(dir));
+    double t0 = eps_rule(a->eps_scale, org, v3_len(dir));
     if (tmin > t0) t0 = tmin;
     if (!(tmax > t0)) return 0;
     accel_query q;
@@ -1224,6 +1278,7 @@ void accel_bounds(const accel *a, vec3 *lo, vec3 *hi)
 }
 
 double accel_scale(const accel *a) { return a ? a->scale : 1.0; }
+double accel_eps_scale(const accel *a) { return a ? a->eps_scale : 1.0; }
 
 accel_stats accel_get_stats(const accel *a)
 {

@@ -42,7 +42,7 @@ void accel_free(accel *a);
  *
  * Self-intersection rule: every query uses an effective tmin of
  * max(tmin, accel_epsilon(a, org, dir)), i.e.
- * ACCEL_EPS_REL * (accel_scale + max|org_i|) / |dir|, so a ray leaving a
+ * ACCEL_EPS_REL * (accel_eps_scale + max|org_i|) / |dir|, so a ray leaving a
  * surface does not hit it again at t ~ 0 (reasoning in accel.c). */
 #define ACCEL_EPS_REL 1e-5
 /* Thread-safe: any number of threads may query one accel concurrently. */
@@ -56,6 +56,10 @@ int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax)
  * scale (bounding-box diagonal) for epsilons. */
 void accel_bounds(const accel *a, vec3 *lo, vec3 *hi);
 double accel_scale(const accel *a);
+/* Working scale of the epsilon rule: the median of the leaf objects'
+ * bounding-box diagonals (at most accel_scale), so one far object does not
+ * coarsen the epsilons of the rest; scales with the scene. */
+double accel_eps_scale(const accel *a);
 accel_stats accel_get_stats(const accel *a);
 /* The underlying RTCScene (as void*), for benchmarks that drive Embree directly. */
 void *accel_rtc_scene(const accel *a);

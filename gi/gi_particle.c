@@ -594,7 +594,7 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
     }
     vis_job J;
     J.gp = gp;
-    J.eps = 1e-6 * (accel_scale(gp->a) > 0.0 ? accel_scale(gp->a) : 1.0);
+    J.eps = 1e-6 * (accel_eps_scale(gp->a) > 0.0 ? accel_eps_scale(gp->a) : 1.0);
     atomic_init(&J.rays, 0);
     if (ndirty > 0 && n > 0) pool_run(gp->threads, (n + VIS_CHUNK - 1) / VIS_CHUNK, vis_chunk, &J);
     for (int l = 0; l < nl; l++) {
@@ -758,7 +758,7 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
     J.h = h;
     J.max_level = gp->set.max_trace_level > 0 ? gp->set.max_trace_level : gp->sc->global.max_trace_level;
     if (J.max_level < 1) J.max_level = 1;
-    double sc = accel_scale(gp->a);
+    double sc = accel_eps_scale(gp->a);
     J.eps = (sc > 0.0 && isfinite(sc) ? sc : 1.0) * 1e-6;
     atomic_init(&J.rays, 0);
     if (w > 0 && h > 0) pool_run(gp->threads, h, view_row, &J);

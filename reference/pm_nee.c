@@ -52,7 +52,7 @@ pm_lights *pm_lights_new(const scene *sc, const accel *a, diag *d, pt_status *st
     }
     L->sc = sc;
     L->a = a;
-    double s = accel_scale(a);
+    double s = accel_eps_scale(a); /* median object size: a far object does not grow it */
     if (!(s > 0.0) || !isfinite(s)) s = 1.0;
     L->eps = s * 1e-6;
     L->emit = accel_surf_build(sc, a, emit_weight, (void *)sc, d, st);

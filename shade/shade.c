@@ -287,7 +287,7 @@ static double scene_eps(const accel *a)
     /* Distance epsilon: a fixed fraction of the scene's extent, so that tiny
      * and huge scenes behave alike (single-precision Embree hits carry a
      * relative error near 1e-7 of the coordinates). */
-    double s = accel_scale(a);
+    double s = accel_eps_scale(a); /* median object size: a far object does not grow it */
     if (!(s > 0.0) || !isfinite(s)) s = 1.0;
     return s * 1e-6;
 }
