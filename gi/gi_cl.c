@@ -488,11 +488,14 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
     dv->sz_lights = dv->sz_vis = dv->sz_srcidx = dv->sz_list = dv->sz_vout = 0;
     dv->bytes = 0;
-    if ((st = upload(dv, &dv->b_part, &have, part, nn * sizeof *part, d)) != PT_OK) return st;
+    /* the real count: with no particles the arrays may be NULL (buffers get a
+     * minimal size, nothing is written) */
+    size_t nr = n > 0 ? (size_t)n : 0;
+    if ((st = upload(dv, &dv->b_part, &have, part, nr * sizeof *part, d)) != PT_OK) return st;
     have = 0;
-    if ((st = upload(dv, &dv->b_slink, &have, slink, nn * (size_t)ns2 * sizeof(int), d)) != PT_OK) return st;
+    if ((st = upload(dv, &dv->b_slink, &have, slink, nr * (size_t)ns2 * sizeof(int), d)) != PT_OK) return st;
     have = 0;
-    if ((st = upload(dv, &dv->b_glink, &have, glink, nn * (size_t)ng * sizeof(int), d)) != PT_OK) return st;
+    if ((st = upload(dv, &dv->b_glink, &have, glink, nr * (size_t)ng * sizeof(int), d)) != PT_OK) return st;
     size_t f4 = nn * 4 * sizeof(float);
     have = 0;
     if ((st = ensure(dv, &dv->b_edir, &have, f4, d)) != PT_OK) return st;
