@@ -88,6 +88,7 @@ typedef struct scene_image {
                                loaded (io/img_scene.h fills it after parsing) */
     int has_alpha;
     struct scene_image *next; /* the scene's list of images (scene.images) */
+    unsigned char *indices; /* palette images: width*height palette indices, else NULL */
 } scene_image;
 
 typedef struct {
@@ -99,6 +100,7 @@ typedef struct {
     double filter_all, transmit_all; /* applied to every pixel when set */
     int filter_all_set, transmit_all_set;
     double major_radius;        /* torus map */
+    int material;               /* a material_map (texture chosen by palette index / red) */
 } scene_image_map;
 
 typedef struct scene_pattern {

@@ -19,6 +19,45 @@
 
 static double srgb_decode(double v) { return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4); }
 
+/* The palette indices of a palette PNG (for material_map), or NULL. */
+static unsigned char *read_indices(const char *path, arena *mem, int w, int h)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    png_infop info = png ? png_create_info_struct(png) : NULL;
+    unsigned char *idx = NULL;
+    png_bytep *rows = NULL;
+    if (!png || !info) {
+        png_destroy_read_struct(&png, &info, NULL);
+        fclose(f);
+        return NULL;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_read_struct(&png, &info, NULL);
+        fclose(f);
+        free(rows);
+        return NULL;
+    }
+    png_init_io(png, f);
+    png_read_info(png, info);
+    if (png_get_color_type(png, info) != PNG_COLOR_TYPE_PALETTE || (int)png_get_image_width(png, info) != w ||
+        (int)png_get_image_height(png, info) != h)
+        png_error(png, "not a palette image");
+    png_set_packing(png);
+    png_set_interlace_handling(png);
+    png_read_update_info(png, info);
+    idx = arena_alloc(mem, (size_t)w * h);
+    rows = malloc(sizeof *rows * (size_t)h);
+    if (!idx || !rows) png_error(png, "memory");
+    for (int y = 0; y < h; y++) rows[y] = idx + (size_t)y * w;
+    png_read_image(png, rows);
+    png_destroy_read_struct(&png, &info, NULL);
+    fclose(f);
+    free(rows);
+    return idx;
+}
+
 int sdl_image_load(scene_image *img, arena *mem, double working_gamma, char *why, size_t whycap)
 {
     FILE *f = fopen(img->path, "rb");
@@ -73,6 +112,7 @@ int sdl_image_load(scene_image *img, arena *mem, double working_gamma, char *why
         exponent = fg > 0.0 ? 1.0 / fg : 2.2;
     }
     int ct = png_get_color_type(png, info);
+    int palette = ct == PNG_COLOR_TYPE_PALETTE;
     img->has_alpha = (ct & PNG_COLOR_MASK_ALPHA) || png_get_valid(png, info, PNG_INFO_tRNS);
     png_set_expand(png);
     png_set_expand_16(png);
@@ -117,5 +157,6 @@ int sdl_image_load(scene_image *img, arena *mem, double working_gamma, char *why
     img->width = (int)w;
     img->height = (int)h;
     img->pixels = px;
+    if (palette) img->indices = read_indices(img->path, mem, (int)w, (int)h);
     return 0;
 }

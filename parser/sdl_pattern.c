@@ -1260,6 +1260,57 @@ static void tiles(sdl_parser *p, scene_texture *t, src_loc loc)
     t->map = make_map(p, MAP_TEXTURE, e, 2);
 }
 
+/* material_map := '{' image_spec { once | interpolate n | map_type n |
+ *   repeat uv | offset uv } texture {..} { texture {..} } '}' : the texture
+ * whose number is the image's palette index (or red * 255) at the point. */
+static void material_map(sdl_parser *p, scene_texture *t)
+{
+    if (!sdl_begin_block(p, "material_map")) return;
+    scene_pattern *pt = new_pattern(p, NULL);
+    scene_map_entry *e = entries(p, MAX_MAP_ENTRIES);
+    if (!pt || !e) return;
+    pt->kind = PAT_IMAGE;
+    pt->name = "material_map";
+    pt->frequency = 0.0;
+    pt->image.material = 1;
+    pt->image.major_radius = 1.0;
+    pt->image.image = image_spec(p, 1);
+    int n = 0;
+    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
+        sdl_tok k = sdl_next(p);
+        switch (k.tk.kind == TOK_KEYWORD ? k.tk.kw : KW_NONE) {
+        case KW_ONCE: pt->image.once = 1; break;
+        case KW_INTERPOLATE: pt->image.interpolate = sdl_to_int(sdl_float(p)); break;
+        case KW_MAP_TYPE: pt->image.map_type = sdl_to_int(sdl_float(p)); break;
+        case KW_REPEAT: case KW_OFFSET: {
+            double uv[2];
+            sdl_vector_n(p, uv, 2);
+            sdl_warn_once(p, k.tk.loc, "material_map %s is not supported and is ignored", sdl_kw_text(k.tk.kw));
+            break;
+        }
+        case KW_TEXTURE:
+            if (n >= MAX_MAP_ENTRIES) {
+                sdl_error(p, k.tk.loc, PT_ERR_LIMIT, "too many textures in material_map (at most %d)", MAX_MAP_ENTRIES);
+                break;
+            }
+            e[n].value = n;
+            e[n].texture = sdl_parse_texture(p);
+            n++;
+            break;
+        default:
+            sdl_unexpected(p, &k, "material_map item");
+            break;
+        }
+    }
+    sdl_end_block(p);
+    if (n == 0) {
+        if (sdl_ok(p)) sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_SYNTAX, "material_map needs at least one texture");
+        return;
+    }
+    t->pat = pt;
+    t->map = make_map(p, MAP_TEXTURE, e, n);
+}
+
 static void fallback_look(scene_texture *t)
 {
     if (!t->map || t->map->n == 0) return;
@@ -1281,32 +1332,7 @@ void sdl_pattern_texture(sdl_parser *p, scene_texture *t)
     if (sdl_accept_kw(p, KW_TILES)) {
         tiles(p, t, loc);
     } else if (sdl_accept_kw(p, KW_MATERIAL_MAP)) {
-        sdl_warn_once(p, loc, "material_map is not supported yet; its first texture is used");
-        if (sdl_begin_block(p, "material_map")) {
-            scene_texture *first = NULL;
-            while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
-                const sdl_tok *q = sdl_peek(p);
-                if (sdl_is_kw(q, KW_TEXTURE)) {
-                    sdl_next(p);
-                    scene_texture *nt = sdl_parse_texture(p);
-                    if (!first) first = nt;
-                } else if (q->tk.kind == TOK_KEYWORD && is_image_type_kw(q->tk.kw)) {
-                    sdl_next(p);
-                } else if (sdl_starts_string(q)) {
-                    sdl_string(p);
-                } else {
-                    sdl_next(p);
-                    if (sdl_starts_expr(sdl_peek(p))) sdl_skip_item(p);
-                }
-            }
-            sdl_end_block(p);
-            if (first) {
-                xform keep = t->transform;
-                *t = *first;
-                t->transform = xform_then(first->transform, keep);
-                t->next = NULL;
-            }
-        }
+        material_map(p, t);
     } else {
         target tg;
         memset(&tg, 0, sizeof tg);

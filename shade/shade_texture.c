@@ -282,6 +282,29 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
     return result;
 }
 
+/* POV-Ray's material_map: the palette index of the image at the point (its
+ * red * 255 for other images), 0 outside a `once` image; past the number of
+ * textures it wraps (at exactly that number the last texture is used). */
+static int material_index(const scene_image_map *im, vec3 tp, int n)
+{
+    double x, y;
+    int k = 0;
+    if (pattern_image_pos(im, tp, &x, &y)) {
+        const scene_image *img = im->image;
+        if (img->indices) {
+            int ix = (int)x, iy = (int)y;
+            if (ix >= img->width) ix = img->width - 1;
+            if (iy >= img->height) iy = img->height - 1;
+            k = img->indices[(size_t)iy * img->width + ix];
+        } else {
+            k = (int)(pattern_image_at(im, x, y).r * 255.0);
+        }
+    }
+    if (k > n) k %= n;
+    if (k >= n) k = n - 1;
+    return k < 0 ? 0 : k;
+}
+
 static rgb one_texture(const hit_info *hi, const scene_texture *tex, vec3 point, parent_frame *pf, int npf, double weight)
 {
     if (!tex->pat || !tex->map || tex->map->n == 0 || npf >= MAX_PARENTS) return lighted(hi, tex, point, pf, npf, weight);
@@ -299,6 +322,10 @@ static rgb one_texture(const hit_info *hi, const scene_texture *tex, vec3 point,
             total += w;
         }
         return total != 0.0 ? tscale(acc, 1.0 / total) : acc;
+    }
+    if (pat->kind == PAT_IMAGE && pat->image.material) {
+        int k = material_index(&pat->image, tp, m->n);
+        return m->e[k].texture ? one_texture(hi, m->e[k].texture, tp, pf, npf + 1, weight) : trgb(0, 0, 0);
     }
     pattern_ctx pc = hi->pc;
     double v = pattern_value(pat, tp, &pc);
@@ -354,6 +381,10 @@ static int texture_colour(const scene_texture *tex, vec3 point, const pattern_ct
     if (tex->pat && tex->map && tex->map->n > 0 && depth < MAX_PARENTS) {
         const scene_blend_map *m = tex->map;
         vec3 tp = pattern_warp(tex->pat, to_texture_space(tex, point));
+        if (tex->pat->kind == PAT_IMAGE && tex->pat->image.material) {
+            const scene_texture *st = m->e[material_index(&tex->pat->image, tp, m->n)].texture;
+            return st ? texture_colour(st, tp, pc, out, depth + 1) : 0;
+        }
         double v = pattern_value(tex->pat, tp, pc);
         int ip, ic;
         blend_map_search(m, v, &ip, &ic);
@@ -390,6 +421,10 @@ static rgb shadow_layers(const scene_texture *tex, vec3 point, const pattern_ctx
     if (tex->pat && tex->map && tex->map->n > 0 && depth < MAX_PARENTS) {
         const scene_blend_map *m = tex->map;
         vec3 tp = pattern_warp(tex->pat, to_texture_space(tex, point));
+        if (tex->pat->kind == PAT_IMAGE && tex->pat->image.material) {
+            const scene_texture *st = m->e[material_index(&tex->pat->image, tp, m->n)].texture;
+            return st ? shadow_layers(st, tp, pc, depth + 1, caustics, raw, dir) : trgb(0, 0, 0);
+        }
         double v = pattern_value(tex->pat, tp, pc);
         int ip, ic;
         blend_map_search(m, v, &ip, &ic);
