@@ -322,6 +322,7 @@ typedef struct {
     /* Appended (issue 5, core/camera.h). */
     double v_angle;         /* spherical camera: vertical field of view in degrees, 0 = angle/2 */
     double focal_distance;  /* focal blur: distance to the focal plane; 0 = |direction| */
+    const struct scene_normal *normal; /* camera { normal {..} }: perturbs primary rays, NULL = none */
     /* Appended (issue 3): mesh_camera { rays_per_pixel, distribution [, max_distance]
      * mesh { } ... [smooth] } (POV-Ray 3.7); meshes are SHAPE_MESH objects with
      * their transforms. location/direction then hold the mesh camera's offsets. */

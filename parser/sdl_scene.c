@@ -145,7 +145,10 @@ static int camera_item(sdl_parser *p, scene_camera *c, camera_said *said)
         break;
     case KW_FOCAL_POINT: c->focal_point = sdl_vector(p); said->had_focal = 1; break;
     case KW_CONFIDENCE: case KW_VARIANCE: sdl_float(p); break;
-    case KW_NORMAL: case KW_BOKEH:
+    case KW_NORMAL:
+        c->normal = sdl_parse_normal(p); /* issue 5: shade.c perturbs the primary rays */
+        break;
+    case KW_BOKEH:
         sdl_warn_once(p, t.tk.loc, "camera %s is not supported yet and is ignored", sdl_kw_text(t.tk.kw));
         if (sdl_begin_block(p, sdl_kw_text(t.tk.kw))) sdl_skip_block(p);
         break;

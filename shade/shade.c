@@ -34,6 +34,7 @@
 #include "shade_atmos.h"
 #include "shade_gamma.h"
 #include "shade_light.h"
+#include "shade_normal.h"
 #include "shade_texture.h"
 #include "timer.h"
 
@@ -319,6 +320,12 @@ static rgb sample_ray(render_ctx *c, int thread, double px, double py, double lu
     vec3 org, dir;
     /* Every camera type (core/camera.h); no ray (outside a fisheye) is black. */
     if (!camera_ray(&c->sc->camera, px, py, c->s->width, c->s->height, lu, lv, &org, &dir)) return rgb_make(0, 0, 0);
+    if (c->sc->camera.normal) {
+        /* camera normal: POV-Ray perturbs the direction at the screen point <x0, y0, 0> */
+        pattern_ctx pc = pattern_ctx_plain(c->sc);
+        vec3 sp = v3(px / c->s->width - 0.5, 0.5 - py / c->s->height, 0.0);
+        dir = v3_norm(normal_perturb(c->sc->camera.normal, dir, sp, NULL, &pc));
+    }
     c->ts[thread].primary++;
     rgb v = trace_ray(c, thread, org, dir, 1, 1.0, OBJ_NO_IMAGE, r);
     if (!isfinite(v.r) || !isfinite(v.g) || !isfinite(v.b)) {
