@@ -893,16 +893,21 @@ static void macro_directive(sdl_parser *p, src_loc loc)
     if (!sdl_expect(p, TOK_LPAREN, "'(' after the macro name")) return;
     const char *params[64];
     int n = 0;
-    while (sdl_ok(p) && !sdl_accept(p, TOK_RPAREN)) {
+    /* parameter names may be macro or array names elsewhere (debug.inc's Str) */
+    p->hold_macros++;
+    p->hold_arrays++;
+    while (sdl_ok(p) && !sdl_accept(p, TOK_RPAREN) && n <= 64) {
         sdl_tok t = name_token(p, "a macro parameter");
-        if (!sdl_ok(p)) return;
+        if (!sdl_ok(p)) break;
         if (n == 64) {
             sdl_error(p, t.tk.loc, PT_ERR_LIMIT, "too many macro parameters");
-            return;
+            break;
         }
         params[n++] = sdl_strndup(p, t.tk.text, (size_t)t.tk.len);
         sdl_accept(p, TOK_COMMA); /* optional, as in POV-Ray (shapes3.inc omits one) */
     }
+    p->hold_arrays--;
+    p->hold_macros--;
     if (!sdl_ok(p)) return;
     sdl_macro *m = sdl_alloc(p, sizeof *m);
     const char **pp = sdl_alloc(p, sizeof(char *) * (size_t)(n ? n : 1));

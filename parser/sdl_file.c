@@ -53,11 +53,18 @@ static char *scene_dir(const sdl_parser *p)
     return strdup(".");
 }
 
-/* A file to read: the scene's directory, the including file's directory,
- * the library path, the working directory. */
+/* A file to read: the write_dir option's directory (files this parse
+ * wrote), the scene's directory, the including file's directory, the
+ * library path, the working directory. */
 static char *find_read(sdl_parser *p, const char *name)
 {
     if (name[0] == '/') return regular_file(name) ? strdup(name) : NULL;
+    if (p->opt.write_dir) { /* a file this parse wrote there */
+        const char *base = strrchr(name, '/');
+        char *w = join(p->opt.write_dir, base ? base + 1 : name);
+        if (w && regular_file(w)) return w;
+        free(w);
+    }
     char *dirs[4] = {scene_dir(p), NULL, NULL, NULL};
     if (p->nframes > 0 && p->frames[p->nframes - 1].src) dirs[1] = dir_part(p->frames[p->nframes - 1].src->path);
     char *found = NULL;

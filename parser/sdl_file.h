@@ -6,7 +6,8 @@
  * Writing is confined like POV-Ray's default I/O restriction: the file must
  * lie in the scene's directory or the current directory (or below), else a
  * located error; sdl_options.write_dir redirects every written file into
- * one directory (tests, sweeps over read-only example trees).
+ * one directory (tests, sweeps over read-only example trees), which is then
+ * also searched first for files to read.
  *
  * #read declares new identifiers globally and stops at the end of the file:
  * the identifiers not yet read keep their values and the file identifier
