@@ -248,6 +248,7 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
         stats_int(js, "photons_emitted", p->photons_emitted);
         stats_int(js, "photons_global", p->photons_global);
         stats_int(js, "photons_caustic", p->photons_caustic);
+        stats_int(js, "photons_dropped", p->photons_dropped);
         stats_str(js, "caustic_map", p->caustic_reason ? p->caustic_reason : (p->caustic_map ? "built" : "not built"));
         stats_int(js, "gather_points", p->gather_points);
         stats_int(js, "emitter_pieces", p->emitter_pieces);

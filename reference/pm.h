@@ -37,6 +37,7 @@ typedef struct {
     long photons_emitted;
     long photons_global;    /* stored in the global map */
     long photons_caustic;   /* stored in the caustic map */
+    long photons_dropped;   /* not stored: the memory cap on stored photons was reached */
     long irradiance_points;
     int caustic_map;        /* 1 if a caustic map was built */
     const char *caustic_reason; /* why (not): a static string */

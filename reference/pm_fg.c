@@ -362,6 +362,13 @@ pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s,
     st->photons_global = pr.nglobal;
     st->photons_caustic = pr.ncaustic;
     st->photon_rays = pr.rays;
+    st->photons_dropped = pr.dropped;
+    if (pr.dropped > 0) {
+        src_loc nowhere = {0};
+        diag_report(d, DIAG_WARNING, nowhere, NULL,
+                    "pmfg: %ld photons not stored, the cap on stored photons (memory) was reached; indirect light is "
+                    "too dark (fewer --photons or a lower albedo)", pr.dropped);
+    }
 
     /* 2. maps */
     c.global = pm_kdtree_build(pr.global, pr.nglobal, threads);

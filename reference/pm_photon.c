@@ -36,6 +36,18 @@
 
 #define CHUNK 1024
 #define SKIP_MAX 64
+/* Termination that does not depend on the albedo: from bounce RR_BOUNCES on,
+ * a path survives each further bounce with probability RR_SURVIVE and its
+ * power is divided by it (unbiased); with albedo 1 the material's roulette
+ * never ends a path, so this bounds the expected photons stored per emitted
+ * one near RR_BOUNCES + 1 / (1 - RR_SURVIVE). */
+#define RR_BOUNCES 8
+#define RR_SURVIVE 0.8
+/* Hard cap on stored photons (memory): STORED_PER_EMITTED per emitted
+ * photon, at most STORED_MAX in all; photons beyond it are dropped and
+ * counted (pm_photon_result.dropped). */
+#define STORED_PER_EMITTED 16
+#define STORED_MAX (1L << 25)
 
 typedef enum { SRC_LIGHT, SRC_EMIT, SRC_ENV } src_kind;
 
@@ -51,6 +63,8 @@ typedef struct {
     pm_photon *g, *c;
     long ng, cg, nc, cc;
     long rays;
+    long cap;          /* stored photons allowed in this chunk (both maps) */
+    long dropped;
     int oom;
 } chunk_out;
 
@@ -221,6 +235,7 @@ static void trace_one(const trace_ctx *c, const source *src, long index, chunk_o
         mat_setup(&b, c->sc, &h, w, c->eps, &r);
         int lambert = b.m[MAT_LOBE_DIFFUSE] > 0.0 || b.m[MAT_LOBE_BACK] > 0.0;
         if (lambert && (bounce >= 1 || store_first) && cmax(phi) > 0.0) {
+            if (out->ng + out->nc >= out->cap) { out->dropped++; return; }
             if (!push(&out->g, &out->ng, &out->cg, h.p, phi, b.ng)) { out->oom = 1; return; }
             if (c->s->caustics && from_light && spec_only && bounce >= 1)
                 if (!push(&out->c, &out->nc, &out->cc, h.p, phi, b.ng)) { out->oom = 1; return; }
@@ -231,6 +246,10 @@ static void trace_one(const trace_ctx *c, const source *src, long index, chunk_o
         if (s.specular && bounce == 0 && from_light && !c->s->caustics) return;
         if (!s.specular) spec_only = 0;
         double k = s.eta2;
+        if (bounce + 1 >= RR_BOUNCES) {
+            if (rng_f64(&r) >= RR_SURVIVE) return;
+            k /= RR_SURVIVE;
+        }
         phi = crgb(phi.r * s.weight.r * k, phi.g * s.weight.g * k, phi.b * s.weight.b * k);
         if (!(cmax(phi) > 0.0) || !isfinite(phi.r + phi.g + phi.b)) return;
         w = s.dir;
@@ -247,7 +266,7 @@ static void chunk_job(void *ctx, int ci, int thread)
     long i0 = (long)ci * CHUNK, i1 = i0 + CHUNK < c->total ? i0 + CHUNK : c->total;
     chunk_out *out = &c->chunks[ci];
     int si = 0;
-    for (long i = i0; i < i1 && !out->oom; i++) {
+    for (long i = i0; i < i1 && !out->oom && !(c->s->cancel && *c->s->cancel); i++) {
         while (si < c->nsrc - 1 && i >= c->src[si].first + c->src[si].n) si++;
         trace_one(c, &c->src[si], i, out);
     }
@@ -339,6 +358,11 @@ pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, 
         free(src);
         return PT_ERR_NOMEM;
     }
+    double cap = fmin((double)STORED_PER_EMITTED * (double)total, (double)STORED_MAX);
+    for (int i = 0; i < c.nchunks; i++) {
+        long i0 = (long)i * CHUNK, i1 = i0 + CHUNK < total ? i0 + CHUNK : total;
+        c.chunks[i].cap = (long)ceil(cap * (double)(i1 - i0) / (double)total);
+    }
     pool_run(pm_threads(s->threads), c.nchunks, chunk_job, &c);
 
     long ng = 0, nc = 0;
@@ -347,6 +371,7 @@ pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, 
         ng += c.chunks[i].ng;
         nc += c.chunks[i].nc;
         out->rays += c.chunks[i].rays;
+        out->dropped += c.chunks[i].dropped;
         oom |= c.chunks[i].oom;
     }
     out->global = malloc(sizeof(pm_photon) * (size_t)(ng > 0 ? ng : 1));

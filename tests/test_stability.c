@@ -86,6 +86,7 @@ typedef struct {
     double min, max;
     long nonfinite;    /* NaN/Inf values in the EXR */
     double discarded;  /* stats discarded_samples; NAN when missing */
+    double stored;     /* pmfg: photons stored per photon emitted; NAN for other modes */
     framebuffer *fb;
 } render_result;
 
@@ -145,6 +146,9 @@ static render_result render(const char *name, const char *text, const gi_mode *m
     if (!stats_read_str(js, "gi", gi, sizeof gi) || strcmp(gi, m->name) != 0)
         fail_msg("mode '%s' is listed in test_stability but partray rendered '%s'", m->name, gi);
     if (!stats_read_num(js, "discarded_samples", &r.discarded)) fail_msg("stats of %s lack discarded_samples", name);
+    double ng, ne;
+    r.stored = stats_read_num(js, "photons_global", &ng) && stats_read_num(js, "photons_emitted", &ne) && ne > 0 ? ng / ne
+                                                                                                                : NAN;
     printf("  %-26s %-8s mean %.9g  min %.6g  max %.6g  nonfinite %ld  discarded %.0f\n", name, m->name, r.mean, r.min,
            r.max, r.nonfinite, r.discarded);
     return r;
@@ -289,6 +293,12 @@ static void test_albedo(void **st)
                m->name, r0.mean, (r1.mean - r0.mean) / (r5.mean - r0.mean));
         assert_true(r0.min >= 0.0);
         assert_true(r0.mean < 0.01);
+        /* photon paths end at albedo 1 too (pm_photon.c: roulette past 8
+         * bounces); at most 16 stored per emitted photon (the memory cap) */
+        if (isfinite(r1.stored)) {
+            printf("albedo 1   %-8s photons stored per photon emitted %.3f (at most 16)\n", m->name, r1.stored);
+            assert_true(r1.stored <= 16.0);
+        }
         double ratio = (r1.mean - r0.mean) / (r5.mean - r0.mean);
         if (m->interreflect)
             assert_true(ratio >= 2.0 * (1.0 - 1e-3));
