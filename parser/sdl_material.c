@@ -296,7 +296,10 @@ static void interior_item(sdl_parser *p, scene_interior *in)
     sdl_kw k = t.tk.kind == TOK_KEYWORD ? t.tk.kw : KW_NONE;
     switch (k) {
     case KW_IOR: in->ior = sdl_float(p); break;
-    case KW_DISPERSION: in->dispersion = sdl_float(p); break;
+    case KW_DISPERSION:
+        in->dispersion = sdl_float(p);
+        if (in->dispersion != 1.0) sdl_warn_once(p, t.tk.loc, "interior dispersion is not supported yet and is ignored (ior used for all colours)");
+        break;
     case KW_DISPERSION_SAMPLES: sdl_float(p); break;
     case KW_CAUSTICS: in->caustics = sdl_float(p) * 45.0; in->caustics_set = 1; break;
     case KW_FADE_DISTANCE: in->fade_distance = sdl_float(p); break;
