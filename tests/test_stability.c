@@ -147,7 +147,7 @@ static render_result render(const char *name, const char *text, const gi_mode *m
         fail_msg("mode '%s' is listed in test_stability but partray rendered '%s'", m->name, gi);
     if (!stats_read_num(js, "discarded_samples", &r.discarded)) fail_msg("stats of %s lack discarded_samples", name);
     double ng, ne;
-    r.stored = stats_read_num(js, "photons_global", &ng) && stats_read_num(js, "photons_emitted", &ne) && ne > 0 ? ng / ne
+    r.stored = stats_read_num(js, "pmfg.photons_global", &ng) && stats_read_num(js, "pmfg.photons_emitted", &ne) && ne > 0 ? ng / ne
                                                                                                                 : NAN;
     printf("  %-26s %-8s mean %.9g  min %.6g  max %.6g  nonfinite %ld  discarded %.0f\n", name, m->name, r.mean, r.min,
            r.max, r.nonfinite, r.discarded);
