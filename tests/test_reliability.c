@@ -204,6 +204,25 @@ static void test_limit_usage(void **st)
     expect("u.pov", camera, "--max-array -3", 2, "--max-array wants a positive integer");
 }
 
+/* ------------------------------------------------------------ OpenCL */
+
+/* No OpenCL platform at all (the ICD loader finds no vendor): particle GI
+ * stops with a clear error naming the way out, exit 1, no output. The
+ * kernel build log on a bad kernel and an unknown device are checked in
+ * tests/test_gi.c. */
+static void test_opencl_no_platform(void **st)
+{
+    (void)st;
+    char text[512], args[256];
+    snprintf(text, sizeof text, "%slight_source { <2, 4, -3> rgb 1 }\nplane { y, -1 pigment { rgb 0.8 } }\n"
+             "sphere { 0, 1 pigment { rgb <0.8, 0.3, 0.2> } }\n", camera);
+    snprintf(args, sizeof args, "--gi particle");
+    setenv("OCL_ICD_VENDORS", "/nonexistent", 1);
+    expect("ocl.pov", text, args, 1, "error: OpenCL: no platform found");
+    unsetenv("OCL_ICD_VENDORS");
+    assert_non_null(strstr(out_text, "pocl-opencl-icd"));
+}
+
 /* ------------------------------------------------------------ outputs */
 
 static const char slow_scene[] =
@@ -239,7 +258,7 @@ static void test_write_fails_file_size_limit(void **st)
 static void test_write_fails_unwritable_dir(void **st)
 {
     (void)st;
-    char scene[512], dir[512], out[512], cmd[2048];
+    char scene[512], dir[512], out[640], cmd[2048];
     snprintf(scene, sizeof scene, "%s/ro.pov", tmpdir);
     write_file(scene, "camera { location -5*z look_at 0 } sphere { 0, 1 pigment { rgb 1 } } light_source { -5*z, 1 }\n");
     /* a path through a regular file: cannot be created, even by root */
@@ -366,6 +385,7 @@ int main(void)
         cmocka_unit_test(test_mesh_memory_limit),
         cmocka_unit_test(test_image_size_limit),
         cmocka_unit_test(test_limit_usage),
+        cmocka_unit_test(test_opencl_no_platform),
         cmocka_unit_test(test_write_fails_file_size_limit),
         cmocka_unit_test(test_write_fails_unwritable_dir),
         cmocka_unit_test(test_sigterm_partial),
