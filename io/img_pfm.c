@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 /* Write all of buf; 0 on success, errno value on failure. */
@@ -159,6 +160,18 @@ pt_status img_pfm_read(const char *path, framebuffer **out, diag *d)
         diag_error(d, "cannot read '%s': image size %dx%d exceeds the limit (%d per side, %llu pixels)", path, w,
                h, IMG_MAX_SIDE, (unsigned long long)IMG_MAX_PIXELS);
         goto done;
+    }
+    /* A header may claim far more pixels than the file holds: check the
+     * data is there before allocating for it. */
+    {
+        struct stat sb;
+        long at = ftell(f);
+        uint64_t need = (uint64_t)w * (uint64_t)h * (uint64_t)ch * 4u;
+        if (at >= 0 && fstat(fileno(f), &sb) == 0 && S_ISREG(sb.st_mode) && (uint64_t)(sb.st_size - at) < need) {
+            diag_error(d, "cannot read '%s': truncated PFM file (%dx%d needs %llu bytes of pixels, %lld present)", path, w,
+                       h, (unsigned long long)need, (long long)(sb.st_size - at));
+            goto done;
+        }
     }
     fb = fb_new(w, h);
     size_t rowbytes = (size_t)w * (size_t)ch * 4u;
