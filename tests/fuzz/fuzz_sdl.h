@@ -2,8 +2,47 @@
  * runs in milliseconds) and the parse-and-check step they share. */
 #ifndef PT_FUZZ_SDL_H
 #define PT_FUZZ_SDL_H
+#include <dirent.h>
+#include <unistd.h>
 #include "fuzz_common.h"
 #include "sdl.h"
+
+/* #fopen ... write/append of a fuzzed scene goes into a directory of our
+ * own (never the working directory, where it could overwrite anything),
+ * emptied after every input. */
+static char fuzz_write_dir[64];
+
+static inline void fuzz_empty_write_dir(void);
+
+static void fuzz_remove_write_dir(void)
+{
+    fuzz_empty_write_dir();
+    rmdir(fuzz_write_dir);
+}
+
+static inline const char *fuzz_write_dir_path(void)
+{
+    if (!fuzz_write_dir[0]) {
+        snprintf(fuzz_write_dir, sizeof fuzz_write_dir, "/tmp/partray-fuzz-XXXXXX");
+        if (!mkdtemp(fuzz_write_dir)) abort();
+        atexit(fuzz_remove_write_dir);
+    }
+    return fuzz_write_dir;
+}
+
+static inline void fuzz_empty_write_dir(void)
+{
+    DIR *d = opendir(fuzz_write_dir_path());
+    if (!d) return;
+    struct dirent *e;
+    char path[512];
+    while ((e = readdir(d))) {
+        if (e->d_name[0] == '.' && (!e->d_name[1] || (e->d_name[1] == '.' && !e->d_name[2]))) continue;
+        snprintf(path, sizeof path, "%s/%s", fuzz_write_dir, e->d_name);
+        unlink(path);
+    }
+    closedir(d);
+}
 
 static inline void fuzz_sdl_options(sdl_options *o)
 {
@@ -23,6 +62,7 @@ static inline void fuzz_sdl_options(sdl_options *o)
     o->no_default_lib = 1;
     o->lib_paths = lib;
     o->nlib_paths = 1;
+    o->write_dir = fuzz_write_dir_path();
 }
 
 /* Parse `text` as a whole scene under the fuzzing limits and check the
@@ -54,6 +94,7 @@ static inline void fuzz_parse_text(const char *name, const char *text)
         free(m);
     }
     diag_free(d);
+    fuzz_empty_write_dir();
 }
 
 #endif
