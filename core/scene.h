@@ -390,6 +390,7 @@ typedef struct {
     /* Appended (scene_pattern.h): atmosphere. */
     const scene_fog *fogs;  /* linked through `next`; NULL = none */
     const scene_sky_sphere *sky_sphere; /* NULL = none */
+    const scene_rainbow *rainbows;      /* appended (issue 5): linked through `next` */
     scene_image *images;    /* every image the scene references (image_map...), to load */
 } scene;
 

@@ -183,6 +183,16 @@ typedef struct scene_fog {
     struct scene_fog *next;
 } scene_fog;
 
+/* rainbow { } (angles in radians as POV-Ray keeps them: `angle` already
+ * less half the width; arc and falloff angles halved). */
+typedef struct scene_rainbow {
+    double angle, width, distance, jitter;
+    double arc_angle, falloff_angle, falloff_width;
+    vec3 antisolar, up, right;     /* unit, perpendicular */
+    const struct scene_pigment *pigment; /* gradient x through the colour_map */
+    struct scene_rainbow *next;
+} scene_rainbow;
+
 typedef struct {
     int npigments;
     const struct scene_pigment **pigments; /* layered, first on top (evaluated at the ray direction) */

@@ -12,7 +12,11 @@ scene_fog *sdl_parse_fog(sdl_parser *p);
 /* sky_sphere := '{' [sky_sphere_identifier] { pigment {..} | emission c |
  *   transform_item } '}' */
 scene_sky_sphere *sdl_parse_sky_sphere(sdl_parser *p);
-/* Statement forms: add to the scene (fogs accumulate, the last sky_sphere wins). */
+/* rainbow := '{' [rainbow_identifier] { angle f | direction v | colour_map {..} |
+ *   distance f | jitter f | width f | up v | falloff_angle f | arc_angle f } '}' */
+scene_rainbow *sdl_parse_rainbow(sdl_parser *p);
+/* Statement forms: add to the scene (fogs and rainbows accumulate, the last
+ * sky_sphere wins). */
 void sdl_atmos_statement(sdl_parser *p, sdl_kw k);
 
 #endif

@@ -426,11 +426,11 @@ int sdl_parse_look_value(sdl_parser *p, sdl_kw k, sdl_value *out)
     case KW_NORMAL_MAP: name = "normal_map"; break;
     case KW_SLOPE_MAP: name = "slope_map"; break;
     case KW_TEXTURE_MAP: name = "texture_map"; break;
-    case KW_FOG: case KW_SKY_SPHERE:
+    case KW_FOG: case KW_SKY_SPHERE: case KW_RAINBOW:
         memset(out, 0, sizeof *out);
         out->kind = VAL_OPAQUE;
-        out->str = k == KW_FOG ? "fog" : "sky_sphere";
-        out->ptr = k == KW_FOG ? (void *)sdl_parse_fog(p) : (void *)sdl_parse_sky_sphere(p);
+        out->str = k == KW_FOG ? "fog" : k == KW_RAINBOW ? "rainbow" : "sky_sphere";
+        out->ptr = k == KW_FOG ? (void *)sdl_parse_fog(p) : k == KW_RAINBOW ? (void *)sdl_parse_rainbow(p) : (void *)sdl_parse_sky_sphere(p);
         return 1;
     default: return 0;
     }

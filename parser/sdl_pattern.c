@@ -1191,6 +1191,20 @@ void sdl_pattern_pigment_body(sdl_parser *p, scene_pigment *pg)
     }
 }
 
+void sdl_pattern_rainbow_pigment(sdl_parser *p, scene_pigment *pg)
+{
+    sdl_tok k = sdl_next(p);
+    scene_pattern *pt = new_pattern(p, NULL);
+    if (!pt) return;
+    pt->kind = PAT_GRADIENT;
+    pt->name = "rainbow";
+    pt->gradient = v3(1, 0, 0);
+    pg->map = sdl_pattern_map(p, k.tk.kw);
+    pg->pat = pt;
+    pg->pattern = pt->name;
+    pg->kind = PIGMENT_PATTERN;
+}
+
 /* ------------------------------------------------------------ normals */
 
 scene_normal *sdl_pattern_normal_body(sdl_parser *p, const scene_normal *base)

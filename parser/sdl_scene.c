@@ -616,7 +616,8 @@ static void statement(sdl_parser *p)
     case KW_DEFAULT: sdl_parse_default(p); return;
     case KW_BACKGROUND: background(p); return;
     case KW_FOG: case KW_SKY_SPHERE: sdl_atmos_statement(p, t.tk.kw); return; /* sdl_atmos.c (issue 5) */
-    case KW_RAINBOW: case KW_MEDIA: skipped_statement(p, &t); return;
+    case KW_RAINBOW: sdl_atmos_statement(p, t.tk.kw); return; /* sdl_atmos.c (issue 5) */
+    case KW_MEDIA: skipped_statement(p, &t); return;
     default: break;
     }
     if (t.tk.kind == TOK_IDENT && t.val.kind == VAL_NONE)

@@ -121,8 +121,54 @@ static double fog_att(const scene *sc, const scene_fog *f, vec3 org, vec3 dir, d
 
 static void fog_sums(const scene *sc, vec3 org, vec3 dir, double depth, rgb *att, rgb *col);
 
+/* POV-Ray's ComputeRainbow: inside the arc, a colour from the map at the
+ * angle to the antisolar direction (jittered), blended over c by
+ * k = max(exp(-depth/distance), fade*(1-transmit)+transmit); several
+ * rainbows average. */
+static rgb rainbow(const scene *sc, vec3 dir, double depth, rgb c)
+{
+    rgb ct = {0, 0, 0};
+    int n = 0;
+    pattern_ctx pc = pattern_ctx_plain(sc);
+    for (const scene_rainbow *r = sc->rainbows; r; r = r->next) {
+        if (!r->pigment || r->distance == 0.0 || r->width == 0.0) continue;
+        double x = v3_dot(dir, r->right), y = v3_dot(dir, r->up), l = x * x + y * y;
+        if (l > 0.0) y /= sqrt(l);
+        double angle = fabs(acos(fmax(-1.0, fmin(1.0, y))));
+        if (angle > r->arc_angle) continue;
+        double d1 = v3_dot(dir, r->antisolar);
+        if (d1 < 0.0) continue;
+        double index = (acos(fmin(1.0, d1)) - r->angle) / r->width;
+        if (r->jitter > 0.0) {
+            /* POV-Ray draws a random number; a hash of the direction here */
+            unsigned long h = (unsigned long)(fabs(dir.x) * 1e9) * 2654435761ul ^ (unsigned long)(fabs(dir.y) * 1e9) * 40503ul ^
+                              (unsigned long)(fabs(dir.z) * 1e9);
+            index += (2.0 * noise_pattern_rand(h) - 1.0) * r->jitter;
+        }
+        if (index < 0.0 || index > 1.0 - ATM_EPSILON) continue;
+        colour5 cr;
+        pigment_eval(r->pigment, v3(index, 0, 0), &pc, &cr);
+        double fade = 0.0;
+        if (r->falloff_width > 0.0 && angle > r->falloff_angle) {
+            fade = (angle - r->falloff_angle) / r->falloff_width;
+            fade = (3.0 - 2.0 * fade) * fade * fade;
+        }
+        double k = exp(-depth / r->distance);
+        k = fmax(k, fade * (1.0 - cr.t) + cr.t);
+        double ki = 1.0 - k, f = cr.f * ki;
+        ct.r += k * c.r * ((1.0 - f) + f * cr.r) + ki * cr.r;
+        ct.g += k * c.g * ((1.0 - f) + f * cr.g) + ki * cr.g;
+        ct.b += k * c.b * ((1.0 - f) + f * cr.b) + ki * cr.b;
+        n++;
+    }
+    if (n == 0) return c;
+    rgb out = {ct.r / n, ct.g / n, ct.b / n};
+    return out;
+}
+
 rgb atmos_fog(const scene *sc, vec3 org, vec3 dir, double depth, rgb c)
 {
+    if (sc->rainbows) c = rainbow(sc, dir, isfinite(depth) ? depth : BOUND_HUGE, c);
     if (!sc->fogs) return c;
     rgb satt, scol;
     fog_sums(sc, org, dir, depth, &satt, &scol);

@@ -8,7 +8,8 @@
 /* Colour of a ray that hits nothing (unit direction). */
 rgb atmos_sky(const scene *sc, vec3 dir);
 /* Colour `c` seen at distance `depth` (INFINITY: nothing hit) along the ray
- * after the scene's fogs. Returns c unchanged without fog. */
+ * after the scene's rainbows and fogs (in POV-Ray's order). Returns c
+ * unchanged without them. */
 rgb atmos_fog(const scene *sc, vec3 org, vec3 dir, double depth, rgb c);
 /* The fogs' attenuation alone over a segment (a light with
  * media_attenuation on sees its light dimmed so along shadow rays). */
