@@ -297,7 +297,7 @@ typedef struct {
     int shadowless;
     int media_interaction, media_attenuation;
     const scene_object *looks_like;
-    const scene_object *projected_through; /* appended (issue 5): parsed, not rendered yet */
+    const scene_object *projected_through; /* appended (issue 5): light only through it (shade_project.c) */
 } scene_light;
 
 /* ---------------------------------------------------------------- camera */

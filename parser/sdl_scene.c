@@ -354,7 +354,6 @@ static int light_item(sdl_parser *p, sdl_obj *so)
     case KW_LOOKS_LIKE: looks_like(p, l); break;
     case KW_PROJECTED_THROUGH:
         /* projected_through := '{' ( object_identifier | object_statement ) object_mods '}' */
-        sdl_warn_once(p, t.tk.loc, "projected_through is not supported yet and is ignored");
         if (sdl_begin_block(p, "projected_through")) {
             const sdl_tok *pt = sdl_peek(p);
             sdl_obj *o = NULL;

@@ -35,6 +35,7 @@
 #include "shade_gamma.h"
 #include "shade_light.h"
 #include "shade_normal.h"
+#include "shade_project.h"
 #include "shade_texture.h"
 #include "timer.h"
 
@@ -57,6 +58,7 @@ typedef struct {
     unsigned char *flag; /* per pixel: needs supersampling */
     int tiles_x, tiles_y;
     int transparent;     /* some surface lets light through: filtered shadows */
+    light_projection *proj; /* projected_through lights (shade_project.c), NULL = none */
 } render_ctx;
 
 static inline rgb rgb_make(double r, double g, double b) { rgb c = {r, g, b}; return c; }
@@ -171,6 +173,8 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
         vec3 dir;
         double depth;
         light_ray(l, l->position, p, &dir, &depth);
+        double sdepth = depth; /* shadows are tested up to a projected_through object */
+        if (l->projected_through && !projection_pass(c->proj, i, p, dir, depth, &sdepth)) continue;
         int full_area = l->area && l->area_illumination && l->size1 * l->size2 > 0;
         double att = full_area ? 1.0 : light_attenuation(l, p, dir, depth);
         rgb lc = rgb_scale(l->colour, att);
@@ -210,7 +214,7 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
             if (l->area && l->size1 * l->size2 > 1)
                 vis = area_visibility(c, thread, l, p, r);
             else
-                vis = shadow_rgb(c, thread, p, dir, depth);
+                vis = shadow_rgb(c, thread, p, dir, sdepth);
             if (rgb_near_zero(vis)) continue;
             lc = rgb_mul(lc, vis);
             /* media_attenuation: fog dims the light on its way (shade_atmos.c) */
@@ -463,13 +467,14 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     c.tiles_x = (s->width + TILE - 1) / TILE;
     c.tiles_y = (s->height + TILE - 1) / TILE;
     c.transparent = tex_scene_transparent(sc);
+    c.proj = projection_build(sc, d);
     int ntiles = c.tiles_x * c.tiles_y;
 
     pool_run(threads, ntiles, tile_first_pass, &c);
 
     if (s->antialias == 1 && !(s->cancel && *s->cancel)) {
         c.flag = calloc((size_t)s->width * (size_t)s->height, 1);
-        if (!c.flag) { free(ts); return PT_ERR_NOMEM; }
+        if (!c.flag) { projection_free(c.proj); free(ts); return PT_ERR_NOMEM; }
         for (int y = 0; y < s->height; y++) {
             for (int x = 0; x < s->width; x++) {
                 rgb cur = aa_encode(fb_px(fb, x, y));
@@ -497,6 +502,7 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
         st->discarded_samples += fixed;
         st->seconds = timer_now() - t0;
     }
+    projection_free(c.proj);
     free(ts);
     return PT_OK;
 }
