@@ -12,6 +12,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* glibc defines CMPLX only for GCC >= 4.7; clang (the sanitizer and fuzz
+ * build) has the same builtin. */
+#ifndef CMPLX
+#define CMPLX(x, y) __builtin_complex((double)(x), (double)(y))
+#endif
+
 typedef struct {
     double c[4];
     int hyper;
