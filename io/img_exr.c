@@ -327,9 +327,47 @@ fail:
 
 enum { SLOT_R, SLOT_G, SLOT_B, SLOT_A, SLOT_Y, NSLOTS };
 
+/* OpenEXRCore 3.1 may choose an unpacking routine that writes through the
+ * NULL decode_to_ptr of a channel that is meant to be skipped (fuzz_image:
+ * a file with channels b, G, R crashed in exr_decoding_run). So a channel
+ * we do not want is decoded into this scratch block, in its own type, and
+ * dropped. */
+typedef struct {
+    uint8_t *p;
+    size_t cap;
+} exr_scratch;
+
+/* Room in s for any one channel of the block dec is set up for. */
+static int scratch_fit(exr_scratch *s, const exr_decode_pipeline_t *dec)
+{
+    size_t need = 16;
+    for (int c = 0; c < dec->channel_count; c++) {
+        const exr_coding_channel_info_t *dc = &dec->channels[c];
+        size_t n = (size_t)(dc->width > 0 ? dc->width : 0) * (size_t)(dc->height > 0 ? dc->height : 0) *
+                   (size_t)(dc->bytes_per_element > 0 ? dc->bytes_per_element : 4);
+        if (n > need) need = n;
+    }
+    if (need <= s->cap) return 1;
+    uint8_t *p = realloc(s->p, need);
+    if (!p) return 0;
+    s->p = p;
+    s->cap = need;
+    return 1;
+}
+
+static void bind_scratch(exr_coding_channel_info_t *dc, exr_scratch *s)
+{
+    dc->decode_to_ptr = s->p;
+    dc->user_pixel_stride = dc->bytes_per_element;
+    dc->user_line_stride = dc->width * dc->bytes_per_element;
+    dc->user_data_type = dc->data_type;
+    dc->user_bytes_per_element = dc->bytes_per_element;
+}
+
 /* Point the decoder's channels at their places in fb for the block whose
  * top-left pixel is (x0, y0) in image coordinates. */
-static void bind_channels(exr_decode_pipeline_t *dec, framebuffer *fb, float *grey, int x0, int y0, int use_y)
+static void bind_channels(exr_decode_pipeline_t *dec, framebuffer *fb, float *grey, int x0, int y0, int use_y,
+                          exr_scratch *scratch)
 {
     const size_t w = (size_t)fb->width;
     for (int c = 0; c < dec->channel_count; c++) {
@@ -358,6 +396,10 @@ static void bind_channels(exr_decode_pipeline_t *dec, framebuffer *fb, float *gr
                 lstride = (int32_t)(w * sizeof(float));
             }
         }
+        if (!ptr) {
+            bind_scratch(dc, scratch);
+            continue;
+        }
         dc->decode_to_ptr = ptr;
         dc->user_pixel_stride = pstride;
         dc->user_line_stride = lstride;
@@ -368,11 +410,13 @@ static void bind_channels(exr_decode_pipeline_t *dec, framebuffer *fb, float *gr
 
 /* Decode one chunk described by ci into fb at (x0, y0). */
 static exr_result_t decode_chunk(exr_context_t ctx, const exr_chunk_info_t *ci, exr_decode_pipeline_t *dec,
-                                 int *dec_init, framebuffer *fb, float *grey, int x0, int y0, int use_y)
+                                 int *dec_init, framebuffer *fb, float *grey, int x0, int y0, int use_y,
+                                 exr_scratch *scratch)
 {
     exr_result_t rv = *dec_init ? exr_decoding_update(ctx, 0, ci, dec) : exr_decoding_initialize(ctx, 0, ci, dec);
     if (rv != EXR_ERR_SUCCESS) return rv;
-    bind_channels(dec, fb, grey, x0, y0, use_y);
+    if (!scratch_fit(scratch, dec)) return EXR_ERR_OUT_OF_MEMORY;
+    bind_channels(dec, fb, grey, x0, y0, use_y, scratch);
     if (!*dec_init) {
         *dec_init = 1;
         rv = exr_decoding_choose_default_routines(ctx, 0, dec);
@@ -405,6 +449,7 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
     exr_context_t ctx = NULL;
     exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
     int dec_init = 0;
+    exr_scratch scratch = {NULL, 0};
     framebuffer *fb = NULL;
     float *grey = NULL;
     const char *what = "not a readable EXR file";
@@ -489,7 +534,7 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
                 diag_error(d, "cannot read '%s': inconsistent scanline block at y=%d", path, ci.start_y);
                 goto done;
             }
-            rv = decode_chunk(ctx, &ci, &dec, &dec_init, fb, grey, 0, row, use_y);
+            rv = decode_chunk(ctx, &ci, &dec, &dec_init, fb, grey, 0, row, use_y, &scratch);
             if (rv != EXR_ERR_SUCCESS) goto libfail;
         }
     } else {
@@ -516,7 +561,7 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
                     diag_error(d, "cannot read '%s': inconsistent tile (%d,%d)", path, tx, ty);
                     goto done;
                 }
-                rv = decode_chunk(ctx, &ci, &dec, &dec_init, fb, grey, x0, y0, use_y);
+                rv = decode_chunk(ctx, &ci, &dec, &dec_init, fb, grey, x0, y0, use_y, &scratch);
                 if (rv != EXR_ERR_SUCCESS) goto libfail;
             }
         }
@@ -535,6 +580,7 @@ libfail:
     st = PT_ERR_IO;
 done:
     if (dec_init) exr_decoding_destroy(ctx, &dec);
+    free(scratch.p);
     if (ctx) exr_finish(&ctx);
     close(s.fd);
     free(grey);
@@ -551,7 +597,7 @@ typedef struct {
     int w;
 } layer_sink;
 
-static void bind_layer(exr_decode_pipeline_t *dec, const layer_sink *ls, int x0, int y0)
+static void bind_layer(exr_decode_pipeline_t *dec, const layer_sink *ls, int x0, int y0, exr_scratch *scratch)
 {
     for (int c = 0; c < dec->channel_count; c++) {
         exr_coding_channel_info_t *dc = &dec->channels[c];
@@ -569,15 +615,17 @@ static void bind_layer(exr_decode_pipeline_t *dec, const layer_sink *ls, int x0,
         }
         dc->user_data_type = EXR_PIXEL_FLOAT;
         dc->user_bytes_per_element = 4;
+        if (!dc->decode_to_ptr) bind_scratch(dc, scratch);
     }
 }
 
 static exr_result_t decode_layer_chunk(exr_context_t ctx, const exr_chunk_info_t *ci, exr_decode_pipeline_t *dec,
-                                       int *dec_init, const layer_sink *ls, int x0, int y0)
+                                       int *dec_init, const layer_sink *ls, int x0, int y0, exr_scratch *scratch)
 {
     exr_result_t rv = *dec_init ? exr_decoding_update(ctx, 0, ci, dec) : exr_decoding_initialize(ctx, 0, ci, dec);
     if (rv != EXR_ERR_SUCCESS) return rv;
-    bind_layer(dec, ls, x0, y0);
+    if (!scratch_fit(scratch, dec)) return EXR_ERR_OUT_OF_MEMORY;
+    bind_layer(dec, ls, x0, y0, scratch);
     if (!*dec_init) {
         *dec_init = 1;
         rv = exr_decoding_choose_default_routines(ctx, 0, dec);
@@ -620,6 +668,7 @@ pt_status img_read_exr_layer(const char *path, const char *layer, const char *su
     exr_context_t ctx = NULL;
     exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
     int dec_init = 0;
+    exr_scratch scratch = {NULL, 0};
     const char *what = "not a readable EXR file";
     exr_result_t rv = exr_start_read(&ctx, path, &init);
     if (rv != EXR_ERR_SUCCESS) goto libfail;
@@ -667,7 +716,7 @@ pt_status img_read_exr_layer(const char *path, const char *layer, const char *su
                 diag_error(d, "cannot read '%s': inconsistent scanline block at y=%d", path, ci.start_y);
                 goto done;
             }
-            if ((rv = decode_layer_chunk(ctx, &ci, &dec, &dec_init, &ls, 0, row)) != EXR_ERR_SUCCESS) goto libfail;
+            if ((rv = decode_layer_chunk(ctx, &ci, &dec, &dec_init, &ls, 0, row, &scratch)) != EXR_ERR_SUCCESS) goto libfail;
         }
     } else {
         uint32_t tw = 0, th = 0;
@@ -688,7 +737,7 @@ pt_status img_read_exr_layer(const char *path, const char *layer, const char *su
                     diag_error(d, "cannot read '%s': inconsistent tile (%d,%d)", path, tx, ty);
                     goto done;
                 }
-                if ((rv = decode_layer_chunk(ctx, &ci, &dec, &dec_init, &ls, x0, y0)) != EXR_ERR_SUCCESS) goto libfail;
+                if ((rv = decode_layer_chunk(ctx, &ci, &dec, &dec_init, &ls, x0, y0, &scratch)) != EXR_ERR_SUCCESS) goto libfail;
             }
         }
     }
@@ -704,6 +753,7 @@ libfail:
     st = PT_ERR_IO;
 done:
     if (dec_init) exr_decoding_destroy(ctx, &dec);
+    free(scratch.p);
     if (ctx) exr_finish(&ctx);
     close(s.fd);
     free(ls.data);
