@@ -374,19 +374,28 @@ long gi_grid_radius(const gi_grid *g, vec3 q, vec3 nq, double r, double cos_thr,
  * entered in the up to 8 cells its [p - margin, p + margin] box touches).
  * The nearest particle to q, if it is within margin, is then in the list of
  * q's own cell, so a query reads one contiguous run of memory. Farther
- * answers fall back to the hashed grid's ring search. */
+ * answers fall back to the hashed grid's ring search.
+ *
+ * Layout: each cell's list is padded to whole blocks of LK_W entries stored
+ * as structure-of-arrays (positions and normals as floats: 192 bytes,
+ * three cache lines per block), so that the distance and side tests of a
+ * query run over LK_W lanes at once (the compiler vectorizes the fixed-width
+ * loops); padding entries lie at infinity. The particle index of a slot is
+ * in a separate array, read only for the winner. */
+#define LK_W 8
 typedef struct {
-    float x, y, z;
-    int idx;
-    signed char nx, ny, nz, pad;
-} lentry;
+    float x[LK_W], y[LK_W], z[LK_W];
+    float nx[LK_W], ny[LK_W], nz[LK_W]; /* rounded to 1/127 as the hashed grid's */
+} lblock;
+_Static_assert(sizeof(lblock) == 192, "lookup block is three cache lines");
 
 struct gi_lookup {
     double cell, inv, margin;
     vec3 origin;
     long dim[3];
-    int *start; /* ncells + 2 */
-    lentry *e;
+    int *start; /* ncells + 2, in slots (multiples of LK_W) */
+    lblock *b;  /* ne / LK_W blocks */
+    int *idx;   /* ne: particle of each slot, -1 for padding */
     long ne;
     int n;
     gi_grid *fallback;
@@ -451,27 +460,42 @@ gi_lookup *gi_lookup_build(const gi_particles *ps, double cell)
                             g->start[c + 2]++;
                             continue;
                         }
-                        lentry *e = &g->e[g->start[c + 1]++];
-                        e->x = p->p[0];
-                        e->y = p->p[1];
-                        e->z = p->p[2];
-                        e->idx = i;
-                        e->nx = (signed char)lrintf(p->n[0] * 127.0f);
-                        e->ny = (signed char)lrintf(p->n[1] * 127.0f);
-                        e->nz = (signed char)lrintf(p->n[2] * 127.0f);
-                        e->pad = 0;
+                        long s = g->start[c + 1]++;
+                        lblock *e = &g->b[s / LK_W];
+                        int l = (int)(s % LK_W);
+                        e->x[l] = p->p[0];
+                        e->y[l] = p->p[1];
+                        e->z[l] = p->p[2];
+                        e->nx[l] = (float)lrintf(p->n[0] * 127.0f);
+                        e->ny[l] = (float)lrintf(p->n[1] * 127.0f);
+                        e->nz[l] = (float)lrintf(p->n[2] * 127.0f);
+                        g->idx[s] = i;
                     }
         }
         if (pass == 0) {
+            /* pad every list to whole blocks, then prefix sums */
+            for (long c = 0; c < ncells; c++) g->start[c + 2] = (g->start[c + 2] + LK_W - 1) / LK_W * LK_W;
             for (long c = 0; c <= ncells; c++) g->start[c + 1] += g->start[c];
             g->ne = g->start[ncells + 1];
-            g->e = malloc((size_t)(g->ne > 0 ? g->ne : 1) * sizeof *g->e);
-            if (!g->e) {
+            long nb = g->ne / LK_W > 0 ? g->ne / LK_W : 1;
+            g->b = aligned_alloc(64, (size_t)nb * sizeof *g->b);
+            g->idx = malloc((size_t)nb * LK_W * sizeof *g->idx);
+            if (!g->b || !g->idx) {
                 gi_lookup_free(g);
                 return NULL;
             }
+            for (long k = 0; k < nb; k++) {
+                for (int l = 0; l < LK_W; l++) {
+                    g->b[k].x[l] = g->b[k].y[l] = g->b[k].z[l] = INFINITY;
+                    g->b[k].nx[l] = g->b[k].ny[l] = g->b[k].nz[l] = 0.0f;
+                    g->idx[k * LK_W + l] = -1;
+                }
+            }
         }
     }
+    /* start[c + 1] is now the end of cell c's entries: round it up to the
+     * cell's padded end (its blocks start on multiples of LK_W) */
+    for (long c = 0; c < ncells; c++) g->start[c + 1] = (g->start[c + 1] + LK_W - 1) / LK_W * LK_W;
     return g;
 }
 
@@ -479,15 +503,16 @@ void gi_lookup_free(gi_lookup *g)
 {
     if (!g) return;
     free(g->start);
-    free(g->e);
+    free(g->b);
+    free(g->idx);
     gi_grid_free(g->fallback);
     free(g);
 }
 
 size_t gi_lookup_bytes(const gi_lookup *g)
 {
-    return g ? ((size_t)(g->dim[0] * g->dim[1] * g->dim[2]) + 2) * sizeof(int) + (size_t)g->ne * sizeof(lentry) +
-                   gi_grid_bytes(g->fallback)
+    return g ? ((size_t)(g->dim[0] * g->dim[1] * g->dim[2]) + 2) * sizeof(int) +
+                   (size_t)g->ne / LK_W * sizeof(lblock) + (size_t)g->ne * sizeof(int) + gi_grid_bytes(g->fallback)
              : 0;
 }
 
@@ -506,8 +531,9 @@ void gi_lookup_prefetch(const gi_lookup *g, long cell, int stage)
     }
     int k = g->start[cell];
     if (k < g->ne) {
-        __builtin_prefetch(&g->e[k]);
-        __builtin_prefetch((const char *)&g->e[k] + 64);
+        __builtin_prefetch(&g->b[k / LK_W]);
+        __builtin_prefetch((const char *)&g->b[k / LK_W] + 64);
+        __builtin_prefetch((const char *)&g->b[k / LK_W] + 128);
     }
 }
 
@@ -524,18 +550,56 @@ int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 o
     float dx = (float)dir.x, dy = (float)dir.y, dz = (float)dir.z;
     float ox = (float)org.x, oy = (float)org.y, oz = (float)org.z;
     double m = fmin(g->margin, maxdist);
-    float best = (float)(m * m);
+    /* GCC/Clang vector extensions: 4 lanes (SSE2 on x86-64), two per block */
+    typedef float v4f __attribute__((vector_size(16)));
+    typedef int v4i __attribute__((vector_size(16)));
+    v4f best[2], vqx = {qx, qx, qx, qx}, vqy = {qy, qy, qy, qy}, vqz = {qz, qz, qz, qz};
+    v4f vdx = {dx, dx, dx, dx}, vdy = {dy, dy, dy, dy}, vdz = {dz, dz, dz, dz};
+    v4f vox = {ox, ox, ox, ox}, voy = {oy, oy, oy, oy}, voz = {oz, oz, oz, oz}, zero = {0, 0, 0, 0};
+    v4i vslot[2], lane = {0, 1, 2, 3};
+    float m2 = (float)(m * m);
+    for (int h = 0; h < 2; h++) {
+        best[h] = (v4f){m2, m2, m2, m2};
+        vslot[h] = (v4i){-1, -1, -1, -1};
+    }
+    /* LK_W lanes at once, branch-free (the comparisons are unpredictable);
+     * each lane keeps its first strictly nearest slot */
+    for (int k = g->start[cell]; k < g->start[cell + 1]; k += LK_W) {
+        const lblock *e = &g->b[k / LK_W];
+        for (int h = 0; h < 2; h++) {
+            v4f x, y, z;
+            v4f nx, ny, nz;
+            memcpy(&x, e->x + 4 * h, sizeof x);
+            memcpy(&y, e->y + 4 * h, sizeof y);
+            memcpy(&z, e->z + 4 * h, sizeof z);
+            memcpy(&nx, e->nx + 4 * h, sizeof nx);
+            memcpy(&ny, e->ny + 4 * h, sizeof ny);
+            memcpy(&nz, e->nz + 4 * h, sizeof nz);
+            v4f ex = x - vqx, ey = y - vqy, ez = z - vqz;
+            v4f d2 = ex * ex + ey * ey + ez * ez;
+            v4f f = nx * vdx + ny * vdy + nz * vdz;
+            v4f hh = nx * (vox - x) + ny * (voy - y) + nz * (voz - z);
+            v4i ok = (d2 < best[h]) & (f < zero) & (hh > zero);
+            best[h] = (v4f)(((v4i)d2 & ok) | ((v4i)best[h] & ~ok));
+            v4i sl = lane + (k + 4 * h);
+            vslot[h] = (sl & ok) | (vslot[h] & ~ok);
+        }
+    }
+    float bestl[LK_W];
+    int slot[LK_W];
+    memcpy(bestl, best, sizeof bestl);
+    memcpy(slot, vslot, sizeof slot);
+    /* across lanes: nearest, ties to the lower particle index (the order of
+     * a single scan over the list, which is in index order) */
     int bi = -1;
-    /* branch-free: the comparisons are unpredictable */
-    for (int k = g->start[cell]; k < g->start[cell + 1]; k++) {
-        const lentry *e = &g->e[k];
-        float ex = e->x - qx, ey = e->y - qy, ez = e->z - qz;
-        float d2 = ex * ex + ey * ey + ez * ez;
-        float f = (float)e->nx * dx + (float)e->ny * dy + (float)e->nz * dz;
-        float h = (float)e->nx * (ox - e->x) + (float)e->ny * (oy - e->y) + (float)e->nz * (oz - e->z);
-        int ok = (d2 < best) & (f < 0.0f) & (h > 0.0f);
-        best = ok ? d2 : best;
-        bi = ok ? e->idx : bi;
+    float bd = 0.0f;
+    for (int l = 0; l < LK_W; l++) {
+        if (slot[l] < 0) continue;
+        int id = g->idx[slot[l]];
+        if (bi < 0 || bestl[l] < bd || (bestl[l] == bd && id < bi)) {
+            bi = id;
+            bd = bestl[l];
+        }
     }
     if (bi >= 0) return bi;
     /* nothing within the margin: the ring search, up to maxdist */
