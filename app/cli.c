@@ -192,6 +192,10 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
             else if (strcmp(next, "piz") == 0) o->exr_compression = 2;
             else { snprintf(err, (size_t)errlen, "--exr-compression wants none, zip or piz"); return 2; }
             i++;
+        } else if (strcmp(a, "--cl-device") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            o->cl_device = next;
+            i++;
         } else if (strcmp(a, "--particles") == 0 || strcmp(a, "--photons") == 0 || strcmp(a, "--nb") == 0 ||
                    strcmp(a, "--fg-rays") == 0 || strcmp(a, "--max-depth") == 0) {
             if (!has_value(a, next, err, errlen)) return 2;

@@ -41,6 +41,7 @@ typedef struct {
     long particles;
     int bounces, fg_rays, max_depth;
     long photons;
+    const char *cl_device;  /* particle GI: OpenCL device (NULL/"auto", "c", "P:D" or part of a name) */
     /* lighting studies (app/lighting.h, docs/units.md) */
     const char *aovs;       /* --aovs LIST: extra EXR layers */
     const char *units;      /* --units m|cm|mm|ft|...|METRES: photometric lights */

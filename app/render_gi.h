@@ -27,6 +27,7 @@ typedef struct {
     int fg_rays;              /* pmfg: final-gather rays per pixel (0 = default 4096) */
     long photons;             /* pmfg: photon paths (0 = default) */
     int max_depth;            /* path: vertices per path (0 = unlimited) */
+    const char *cl_device;    /* particle: OpenCL device choice (gi_cl.h), NULL = auto */
     volatile int *cancel;
     int progress;             /* 1: progress bar on stderr (reference modes) */
     const char *progressive_path; /* reference modes: write the image so far here every few seconds */
