@@ -17,90 +17,18 @@
 #include "accel_fractal.h"
 #include "accel_hfield.h"
 #include "accel_implicit.h"
+#include "accel_poly.h"
 #include "accel_sweep.h"
 
 #define TWO_PI 6.283185307179586476925
 
 /* ------------------------------------------------------------ polynomials */
 
-static double poly_eval(const double *c, int n, double x)
-{
-    double f = c[n];
-    for (int i = n - 1; i >= 0; i--) f = f * x + c[i];
-    return f;
-}
-
-/* f monotonic on [lo, hi] with f(lo) and f(hi) of opposite signs: Newton
- * steps kept inside a shrinking bracket, falling back to bisection. */
-static double poly_refine(const double *c, int n, double lo, double hi, double flo)
-{
-    double width = hi - lo;
-    double x = 0.5 * (lo + hi);
-    for (int it = 0; it < 100; it++) {
-        double f = c[n], df = 0.0;
-        for (int i = n - 1; i >= 0; i--) {
-            df = df * x + f;
-            f = f * x + c[i];
-        }
-        if (f == 0.0) return x;
-        if ((f < 0.0) == (flo < 0.0)) lo = x; else hi = x;
-        double xn = (df != 0.0) ? x - f / df : 0.5 * (lo + hi);
-        if (!(xn > lo && xn < hi)) xn = 0.5 * (lo + hi);
-        double step = fabs(xn - x);
-        x = xn;
-        if (step <= 1e-15 * (fabs(x) + width) || hi - lo <= 1e-15 * (fabs(x) + width)) break;
-    }
-    return x;
-}
-
-static int add_root(double *roots, int nr, double r)
-{
-    if (nr > 0 && r <= roots[nr - 1]) return nr; /* duplicate at a bracket end */
-    roots[nr] = r;
-    return nr + 1;
-}
-
+/* Real roots in [a, b], ascending: accel_poly.c's derivative-bracket solver
+ * (one root finder for every shape). */
 int accel_poly_roots(const double *c, int n, double a, double b, double *roots)
 {
-    while (n > 0 && c[n] == 0.0) n--;
-    if (n <= 0 || !(a <= b)) return 0;
-    if (n == 1) {
-        double r = -c[0] / c[1];
-        if (r >= a && r <= b) { roots[0] = r; return 1; }
-        return 0;
-    }
-    if (n == 2) {
-        double A = c[2], B = c[1], C = c[0];
-        double disc = B * B - 4.0 * A * C;
-        if (disc < 0.0) return 0;
-        double q = -0.5 * (B + copysign(sqrt(disc), B));
-        double r0 = q / A, r1 = (q != 0.0) ? C / q : r0;
-        if (r0 > r1) { double t = r0; r0 = r1; r1 = t; }
-        int nr = 0;
-        if (r0 >= a && r0 <= b) roots[nr++] = r0;
-        if (r1 >= a && r1 <= b && (nr == 0 || r1 > roots[0])) roots[nr++] = r1;
-        return nr;
-    }
-    /* Critical points split [a, b] into monotonic brackets. */
-    double d[4], crit[4], xs[6];
-    for (int i = 0; i < n; i++) d[i] = (double)(i + 1) * c[i + 1];
-    int nc = accel_poly_roots(d, n - 1, a, b, crit);
-    xs[0] = a;
-    for (int i = 0; i < nc; i++) xs[i + 1] = crit[i];
-    xs[nc + 1] = b;
-    int nr = 0;
-    double f0 = poly_eval(c, n, a);
-    if (f0 == 0.0) nr = add_root(roots, nr, a);
-    for (int j = 0; j <= nc; j++) {
-        double x0 = xs[j], x1 = xs[j + 1];
-        double f1 = poly_eval(c, n, x1);
-        if (f1 == 0.0)
-            nr = add_root(roots, nr, x1);
-        else if (f0 != 0.0 && (f0 < 0.0) != (f1 < 0.0) && x1 > x0)
-            nr = add_root(roots, nr, poly_refine(c, n, x0, x1, f0));
-        f0 = f1;
-    }
-    return nr;
+    return accel_poly_solve(c, n, a, b, roots, 0);
 }
 
 /* Real roots of a t^2 + 2 b t + c = 0 (note the half b), ascending. */
