@@ -31,6 +31,25 @@ static void on_error(png_structp png, png_const_charp msg)
     png_longjmp(png, 1);
 }
 
+/* libpng's own allocations (chunk data, zlib state, a row or two) never
+ * need much: the image itself is allocated here. libpng 1.6.39 warns that a
+ * tEXt chunk's length is too large and then allocates it anyway (fuzz_image:
+ * a 57 KB file asked for 1.5 GB), so its allocator refuses anything above
+ * 64 MiB, which libpng reports as an error. */
+#define PNG_LIB_ALLOC_MAX ((png_alloc_size_t)64 << 20)
+
+static png_voidp lib_malloc(png_structp png, png_alloc_size_t n)
+{
+    (void)png;
+    return n <= PNG_LIB_ALLOC_MAX ? malloc(n) : NULL;
+}
+
+static void lib_free(png_structp png, png_voidp p)
+{
+    (void)png;
+    free(p);
+}
+
 static void on_warning(png_structp png, png_const_charp msg)
 {
     (void)png;
@@ -186,7 +205,7 @@ pt_status img_png_read(const char *path, int raw, framebuffer **out, diag *d)
         return PT_ERR_IO;
     }
     png_ctx ctx = {-1, 0, {0}};
-    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &ctx, on_error, on_warning);
+    png_structp png = png_create_read_struct_2(PNG_LIBPNG_VER_STRING, &ctx, on_error, on_warning, NULL, lib_malloc, lib_free);
     png_infop info = png ? png_create_info_struct(png) : NULL;
     if (!png || !info) {
         if (png) png_destroy_read_struct(&png, info ? &info : NULL, NULL);
