@@ -188,7 +188,7 @@ static inline double scurve(double a) { return a * a * (3.0 - 2.0 * a); }
 /* Cell index (12 bits) and fraction along one axis, POV-Ray's way. */
 static inline void lattice(double x, int *i, double *f)
 {
-    int t = x >= 0 ? (int)x : (int)(x - (1 - NOISE_EPSILON));
+    int t = x >= 0 ? noise_to_int(x) : noise_to_int(x - (1 - NOISE_EPSILON));
     *i = (t - LATTICE_MIN) & 0xFFF;
     *f = x - t;
 }
@@ -284,7 +284,7 @@ static vec3 dnoise(vec3 p)
 static inline void solid_setup(double v, int *b0, int *b1, double *r0, double *r1)
 {
     double t = v + ROLLOVER;
-    int it = (int)floor(t);
+    int it = noise_to_int(floor(t));
     *b0 = it & (SOLID_N - 1);
     *b1 = (*b0 + 1) & (SOLID_N - 1);
     *r0 = t - it;

@@ -11,7 +11,17 @@
  * implicitly; cheap after the first call). */
 #ifndef PT_SHADE_NOISE_H
 #define PT_SHADE_NOISE_H
+#include <limits.h>
 #include "vec.h"
+
+/* A double truncated to int as POV-Ray's (int) casts behave on x86-64
+ * (cvttsd2si): NaN and values outside int's range give INT_MIN. Patterns use
+ * it where coordinates can be arbitrarily large (far points of infinite
+ * planes), where a plain C cast would be undefined. */
+static inline int noise_to_int(double x)
+{
+    return (x > -2147483649.0 && x < 2147483648.0) ? (int)x : INT_MIN;
+}
 
 /* Build the tables (idempotent, thread-safe). */
 void noise_init(void);

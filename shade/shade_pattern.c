@@ -153,7 +153,7 @@ static vec3 warp_repeat(const scene_warp *w, vec3 p)
     int a = w->axis;
     float blk = (float)floor(c[a] / w->width); /* POV-Ray keeps the block number as SNGL */
     r[a] = c[a] - blk * w->width;
-    if (((int)blk) & 1) {
+    if (noise_to_int(blk) & 1) {
         r[0] *= w->flip.x;
         r[1] *= w->flip.y;
         r[2] *= w->flip.z;
@@ -167,9 +167,9 @@ static vec3 warp_black_hole(const scene_warp *w, vec3 p)
     vec3 centre = w->centre;
     if (w->bh_repeat) {
         int bx = 0, by = 0, bz = 0;
-        if (w->repeat_vec.x >= PAT_EPSILON) bx = (int)floor(p.x / w->repeat_vec.x);
-        if (w->repeat_vec.y >= PAT_EPSILON) by = (int)floor(p.y / w->repeat_vec.y);
-        if (w->repeat_vec.z >= PAT_EPSILON) bz = (int)floor(p.z / w->repeat_vec.z);
+        if (w->repeat_vec.x >= PAT_EPSILON) bx = noise_to_int(floor(p.x / w->repeat_vec.x));
+        if (w->repeat_vec.y >= PAT_EPSILON) by = noise_to_int(floor(p.y / w->repeat_vec.y));
+        if (w->repeat_vec.z >= PAT_EPSILON) bz = noise_to_int(floor(p.z / w->repeat_vec.z));
         if (w->uncertain) {
             int seed = noise_hash3d(bx, by, bz);
             centre.x += noise_pattern_rand((unsigned long)seed) * w->uncertainty.x;
@@ -256,26 +256,26 @@ static double brick(const scene_pattern *pat, vec3 p)
     double bw = pat->brick_size.x, bh = pat->brick_size.y, bd = pat->brick_size.z;
     double mw = pat->mortar / bw, mh = pat->mortar / bh, md = pat->mortar / bd;
     double by = y / bh;
-    by -= (double)(int)by;
+    by -= (double)noise_to_int(by);
     if (by < 0.0) by += 1.0;
     if (by <= mh) return 0.0;
     by = (y / bh) * 0.5;
-    by -= (double)(int)by;
+    by -= (double)noise_to_int(by);
     if (by < 0.0) by += 1.0;
     double bx = x / bw;
-    bx -= (double)(int)bx;
+    bx -= (double)noise_to_int(bx);
     if (bx < 0.0) bx += 1.0;
     if (bx <= mw && by <= 0.5) return 0.0;
     bx = (x / bw) + 0.5;
-    bx -= (double)(int)bx;
+    bx -= (double)noise_to_int(bx);
     if (bx < 0.0) bx += 1.0;
     if (bx <= mw && by > 0.5) return 0.0;
     double bz = z / bd;
-    bz -= (double)(int)bz;
+    bz -= (double)noise_to_int(bz);
     if (bz < 0.0) bz += 1.0;
     if (bz <= md && by > 0.5) return 0.0;
     bz = (z / bd) + 0.5;
-    bz -= (double)(int)bz;
+    bz -= (double)noise_to_int(bz);
     if (bz < 0.0) bz += 1.0;
     if (bz <= md && by <= 0.5) return 0.0;
     return 1.0;
@@ -283,13 +283,14 @@ static double brick(const scene_pattern *pat, vec3 p)
 
 static double cells(vec3 p)
 {
-    int h = noise_hash3d((int)floor(p.x + PAT_EPSILON), (int)floor(p.y + PAT_EPSILON), (int)floor(p.z + PAT_EPSILON));
+    int h = noise_hash3d(noise_to_int(floor(p.x + PAT_EPSILON)), noise_to_int(floor(p.y + PAT_EPSILON)),
+                         noise_to_int(floor(p.z + PAT_EPSILON)));
     return fmin(noise_pattern_rand((unsigned long)h), 1.0);
 }
 
 static double checker(vec3 p)
 {
-    int v = (int)(floor(p.x + PAT_EPSILON) + floor(p.y + PAT_EPSILON) + floor(p.z + PAT_EPSILON));
+    int v = noise_to_int(floor(p.x + PAT_EPSILON) + floor(p.y + PAT_EPSILON) + floor(p.z + PAT_EPSILON));
     return (v & 1) ? 1.0 : 0.0;
 }
 
@@ -309,7 +310,8 @@ static double metric_sum(vec3 d, double metric)
 
 static double crackle(const scene_pattern *pat, vec3 p, int gen)
 {
-    int fx = (int)floor(p.x - PAT_EPSILON), fy = (int)floor(p.y - PAT_EPSILON), fz = (int)floor(p.z - PAT_EPSILON);
+    int fx = noise_to_int(floor(p.x - PAT_EPSILON)), fy = noise_to_int(floor(p.y - PAT_EPSILON)),
+        fz = noise_to_int(floor(p.z - PAT_EPSILON));
     double metric = pat->crackle_metric;
     /* The 81 cubes within a "3D knight move" (offsets -2..2 with at most one
      * coordinate of magnitude 2), in POV-Ray's table order. */
@@ -382,7 +384,7 @@ static double hexagon(vec3 p)
     double xs = x / xf, zs = z / zf;
     xs -= floor(xs / 6.0) * 6.0;
     zs -= floor(zs / 6.0) * 6.0;
-    int xm = (int)pov_floor(xs) % 6, zm = (int)pov_floor(zs) % 6;
+    int xm = noise_to_int(pov_floor(xs)) % 6, zm = noise_to_int(pov_floor(zs)) % 6;
     double v = 0.0;
     switch (xm) {
     case 0: case 5:
@@ -405,7 +407,7 @@ static double hexagon(vec3 p)
 
 static double square_pat(vec3 p)
 {
-    int vx = (int)floor(p.x), vz = (int)floor(p.z);
+    int vx = noise_to_int(floor(p.x)), vz = noise_to_int(floor(p.z));
     if (vx & 1) return (vz & 1) ? 2.0 : 3.0;
     return (vz & 1) ? 1.0 : 0.0;
 }
@@ -414,7 +416,7 @@ static double triangular(vec3 p)
 {
     const double sqrt3 = 1.7320508075688772935274463415059, sqrt3_2 = 0.86602540378443864676372317075294;
     double xs = p.x - 3.0 * floor(p.x / 3.0), zs = p.z - sqrt3 * floor(p.z / sqrt3);
-    int a = (int)floor(xs);
+    int a = noise_to_int(floor(xs));
     xs -= a;
     int b = zs < sqrt3_2 ? 0 : 1;
     if (b) zs = sqrt3 - zs;
@@ -978,12 +980,14 @@ static colour5 pixel(const scene_image_map *im, double xc, double yc)
     const scene_image *img = im->image;
     int ix, iy;
     if (im->once) {
-        ix = xc < 0.0 ? 0 : (xc >= img->width ? img->width - 1 : (int)xc);
-        iy = yc < 0.0 ? 0 : (yc >= img->height ? img->height - 1 : (int)yc);
+        ix = xc < 0.0 ? 0 : (xc >= img->width ? img->width - 1 : noise_to_int(xc));
+        iy = yc < 0.0 ? 0 : (yc >= img->height ? img->height - 1 : noise_to_int(yc));
     } else {
-        ix = (int)wrap_to(xc, img->width);
-        iy = (int)wrap_to(yc, img->height);
+        ix = noise_to_int(wrap_to(xc, img->width));
+        iy = noise_to_int(wrap_to(yc, img->height));
     }
+    if (ix < 0 || ix >= img->width) ix = 0; /* NaN coordinates */
+    if (iy < 0 || iy >= img->height) iy = 0;
     const float *px = img->pixels + ((size_t)iy * img->width + ix) * 5;
     colour5 c = {px[0], px[1], px[2], px[3], px[4]};
     if (im->transmit_all_set) c.t += im->transmit_all;
@@ -1022,9 +1026,9 @@ colour5 pattern_image_at(const scene_image_map *im, double xc, double yc)
     if (im->interpolate != 2 && im->interpolate != 4) return pixel(im, xc, yc);
     xc += 0.5;
     yc += 0.5;
-    int ix = (int)xc, iy = (int)yc;
+    int ix = noise_to_int(xc), iy = noise_to_int(yc);
     colour5 cc[4] = {pixel(im, ix, iy), pixel(im, ix - 1.0, iy), pixel(im, ix, iy - 1.0), pixel(im, ix - 1.0, iy - 1.0)};
-    double pp = xc - (int)xc, q = yc - (int)yc, f[4];
+    double pp = xc - ix, q = yc - iy, f[4];
     if (im->interpolate == 2) {
         f[0] = pp * q;
         f[1] = (1 - pp) * q;

@@ -30,6 +30,7 @@
 #include "shade_texture.h"
 #include <math.h>
 #include <string.h>
+#include "shade_noise.h"
 #include "shade_normal.h"
 #include "shade_pattern.h"
 
@@ -292,9 +293,9 @@ static int material_index(const scene_image_map *im, vec3 tp, int n)
     if (pattern_image_pos(im, tp, &x, &y)) {
         const scene_image *img = im->image;
         if (img->indices) {
-            int ix = (int)x, iy = (int)y;
-            if (ix >= img->width) ix = img->width - 1;
-            if (iy >= img->height) iy = img->height - 1;
+            int ix = noise_to_int(x), iy = noise_to_int(y);
+            if (ix >= img->width || ix < 0) ix = ix < 0 ? 0 : img->width - 1;
+            if (iy >= img->height || iy < 0) iy = iy < 0 ? 0 : img->height - 1;
             k = img->indices[(size_t)iy * img->width + ix];
         } else {
             k = (int)(pattern_image_at(im, x, y).r * 255.0);
