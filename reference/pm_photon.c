@@ -43,6 +43,7 @@
  * one near RR_BOUNCES + 1 / (1 - RR_SURVIVE). */
 #define RR_BOUNCES 8
 #define RR_SURVIVE 0.8
+#define RR_MASS 0.95
 /* Hard cap on stored photons (memory): STORED_PER_EMITTED per emitted
  * photon, at most STORED_MAX in all; photons beyond it are dropped and
  * counted (pm_photon_result.dropped). */
@@ -246,7 +247,11 @@ static void trace_one(const trace_ctx *c, const source *src, long index, chunk_o
         if (s.specular && bounce == 0 && from_light && !c->s->caustics) return;
         if (!s.specular) spec_only = 0;
         double k = s.eta2;
-        if (bounce + 1 >= RR_BOUNCES) {
+        /* Only where the material's own roulette hardly ends paths (total
+         * lobe size near 1): elsewhere it would add variance for nothing
+         * (the rho = 0.9 furnace's worst pixel went from 0.55% to 3%). */
+        double mass = b.m[MAT_LOBE_DIFFUSE] + b.m[MAT_LOBE_BACK] + b.m[MAT_LOBE_REFLECT] + b.m[MAT_LOBE_TRANSMIT];
+        if (bounce + 1 >= RR_BOUNCES && mass > RR_MASS) {
             if (rng_f64(&r) >= RR_SURVIVE) return;
             k /= RR_SURVIVE;
         }
