@@ -68,27 +68,6 @@ static int put_hit(accel_shape_hit *out, int n, int max, double t, int part)
     return n;
 }
 
-static double comp3(vec3 v, int i) { return i == 0 ? v.x : (i == 1 ? v.y : v.z); }
-
-static int slab3(vec3 o, vec3 d, vec3 lo, vec3 hi, double *t0, double *t1)
-{
-    double a = -INFINITY, b = INFINITY;
-    for (int i = 0; i < 3; i++) {
-        double oi = comp3(o, i), di = comp3(d, i), l = comp3(lo, i), h = comp3(hi, i);
-        if (di == 0.0) {
-            if (oi < l || oi > h) return 0;
-            continue;
-        }
-        double x = (l - oi) / di, y = (h - oi) / di;
-        if (x > y) { double t = x; x = y; y = t; }
-        if (x > a) a = x;
-        if (y < b) b = y;
-    }
-    if (!(a <= b)) return 0;
-    *t0 = a;
-    *t1 = b;
-    return 1;
-}
 
 /* ------------------------------------------------------------ superellipsoid */
 
@@ -191,7 +170,7 @@ static int se_piece(const im_data *m, vec3 o, vec3 d, double a, double b, double
 static int se_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
 {
     double t0, t1;
-    if (!slab3(o, d, v3s(-1.0 - 1e-9), v3s(1.0 + 1e-9), &t0, &t1)) return 0;
+    if (!v3_slab(o, d, v3s(-1.0 - 1e-9), v3s(1.0 + 1e-9), &t0, &t1)) return 0;
     t0 = fmax(t0, tmin);
     t1 = fmin(t1, tmax);
     if (!(t0 < t1)) return 0;
@@ -206,9 +185,9 @@ static int se_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, a
     double zs[3];
     int nz = 0;
     for (int i = 0; i < 3; i++) {
-        double ei = comp3(e, i);
+        double ei = v3_idx(e, i);
         if (ei != 0.0) {
-            double z = -comp3(p, i) / ei;
+            double z = -v3_idx(p, i) / ei;
             if (z > 0.0 && z < L) zs[nz++] = z;
         }
     }
@@ -505,7 +484,7 @@ static int cmp_event(const void *x, const void *y)
 static int blob_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
 {
     double b0, b1;
-    if (!slab3(o, d, m->blo, m->bhi, &b0, &b1)) return 0;
+    if (!v3_slab(o, d, m->blo, m->bhi, &b0, &b1)) return 0;
     double t0 = fmax(tmin, b0), t1 = fmin(tmax, b1);
     if (!(t0 < t1)) return 0;
     double s = v3_len(d);
@@ -666,7 +645,7 @@ static double iso_f(const im_data *m, vec3 p)
 
 static int iso_container(const im_data *m, vec3 o, vec3 d, double *a, double *b)
 {
-    if (!m->iso_sphere) return slab3(o, d, m->ic1, m->ic2, a, b);
+    if (!m->iso_sphere) return v3_slab(o, d, m->ic1, m->ic2, a, b);
     vec3 oc = v3_sub(o, m->ic1);
     double qc[3] = {v3_dot(oc, oc) - m->ir * m->ir, 2.0 * v3_dot(oc, d), v3_dot(d, d)}, r[2];
     if (accel_poly_solve(qc, 2, -INFINITY, INFINITY, r, 0) < 2) return 0;
@@ -730,7 +709,7 @@ static vec3 iso_normal(const im_data *m, vec3 q, int part)
         double best = INFINITY;
         vec3 n = v3(0, 1, 0);
         for (int i = 0; i < 3; i++) {
-            double lo = comp3(m->ic1, i), hi = comp3(m->ic2, i), x = comp3(q, i);
+            double lo = v3_idx(m->ic1, i), hi = v3_idx(m->ic2, i), x = v3_idx(q, i);
             if (fabs(x - lo) < best) { best = fabs(x - lo); n = v3(i == 0 ? -1 : 0, i == 1 ? -1 : 0, i == 2 ? -1 : 0); }
             if (fabs(x - hi) < best) { best = fabs(x - hi); n = v3(i == 0 ? 1 : 0, i == 1 ? 1 : 0, i == 2 ? 1 : 0); }
         }

@@ -485,26 +485,6 @@ static int hits_torus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double
 }
 
 /* Parameter interval of a ray inside a box. */
-static int slabs_t(vec3 o, vec3 d, vec3 lo, vec3 hi, double *t0, double *t1)
-{
-    double a = -INFINITY, b = INFINITY;
-    for (int i = 0; i < 3; i++) {
-        double oi = v3_idx(o, i), di = v3_idx(d, i), l = v3_idx(lo, i), u = v3_idx(hi, i);
-        if (di == 0.0) {
-            if (oi < l || oi > u) return 0;
-            continue;
-        }
-        double x = (l - oi) / di, y = (u - oi) / di;
-        if (x > y) { double t = x; x = y; y = t; }
-        if (x > a) a = x;
-        if (y < b) b = y;
-    }
-    if (!(a <= b)) return 0;
-    *t0 = a;
-    *t1 = b;
-    return 1;
-}
-
 int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, accel_shape_hit *out,
                      int max)
 {
@@ -532,10 +512,10 @@ int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, dou
      * object-space bounds, padded */
     double a = tmin, b = tmax, t0, t1;
     if (sh->infinite) {
-        if (!sh->clipped || !slabs_t(org, dir, sh->clip_lo, sh->clip_hi, &t0, &t1)) return 0;
+        if (!sh->clipped || !v3_slab(org, dir, sh->clip_lo, sh->clip_hi, &t0, &t1)) return 0;
     } else {
         vec3 pad = v3s(1e-7 * v3_maxc(v3_sub(sh->ohi, sh->olo)) + 1e-300);
-        if (!slabs_t(o, d, v3_sub(sh->olo, pad), v3_add(sh->ohi, pad), &t0, &t1)) return 0;
+        if (!v3_slab(o, d, v3_sub(sh->olo, pad), v3_add(sh->ohi, pad), &t0, &t1)) return 0;
     }
     if (t0 > a) a = t0;
     if (t1 < b) b = t1;

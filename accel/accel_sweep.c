@@ -82,7 +82,6 @@ static int put_hit(accel_shape_hit *out, int n, int max, double t, int part)
     return n;
 }
 
-static double comp(vec3 v, int i) { return i == 0 ? v.x : (i == 1 ? v.y : v.z); }
 
 static vec3 from_local_axes(const int ax[3], double u, double w, double v)
 {
@@ -312,26 +311,6 @@ typedef struct {
     double ta, tb; /* tau range */
 } lray;
 
-static int slab(vec3 o, vec3 d, vec3 lo, vec3 hi, double *t0, double *t1)
-{
-    double a = -INFINITY, b = INFINITY;
-    for (int i = 0; i < 3; i++) {
-        double oi = comp(o, i), di = comp(d, i), l = comp(lo, i), h = comp(hi, i);
-        if (di == 0.0) {
-            if (oi < l || oi > h) return 0;
-            continue;
-        }
-        double x = (l - oi) / di, y = (h - oi) / di;
-        if (x > y) { double t = x; x = y; y = t; }
-        if (x > a) a = x;
-        if (y < b) b = y;
-    }
-    if (!(a <= b)) return 0;
-    *t0 = a;
-    *t1 = b;
-    return 1;
-}
-
 static int make_lray(const sw_data *w, vec3 o, vec3 d, double tmin, double tmax, lray *r)
 {
     vec3 lo = v3_scale(v3_sub(o, w->c), 1.0 / w->L), ld = v3_scale(d, 1.0 / w->L);
@@ -339,7 +318,7 @@ static int make_lray(const sw_data *w, vec3 o, vec3 d, double tmin, double tmax,
     if (!(s > 0.0) || !isfinite(s)) return 0;
     vec3 pad = v3s(0.01);
     double b0, b1;
-    if (!slab(lo, ld, v3_sub(w->blo, pad), v3_add(w->bhi, pad), &b0, &b1)) return 0;
+    if (!v3_slab(lo, ld, v3_sub(w->blo, pad), v3_add(w->bhi, pad), &b0, &b1)) return 0;
     double t0 = fmax(tmin, b0), t1 = fmin(tmax, b1);
     if (!(t0 < t1)) return 0;
     r->te = t0;
@@ -563,8 +542,8 @@ static void prism_polish(const sw_data *w, const sw_seg *s, double Pu, double Pw
 static int prism_hits(const sw_data *w, const lray *r, double tmin, double tmax, accel_shape_hit *out, int n,
                       int max)
 {
-    double Pu = comp(r->o, w->ax[0]), Pw = comp(r->o, w->ax[1]), Pv = comp(r->o, w->ax[2]);
-    double eu = comp(r->e, w->ax[0]), ew = comp(r->e, w->ax[1]), ev = comp(r->e, w->ax[2]);
+    double Pu = v3_idx(r->o, w->ax[0]), Pw = v3_idx(r->o, w->ax[1]), Pv = v3_idx(r->o, w->ax[2]);
+    double eu = v3_idx(r->e, w->ax[0]), ew = v3_idx(r->e, w->ax[1]), ev = v3_idx(r->e, w->ax[2]);
     /* caps */
     if (!w->open && ew != 0.0) {
         double hh[2] = {w->h1, w->h2};
@@ -1173,7 +1152,7 @@ int accel_sweep_inside(const accel_shape *sh, vec3 q)
         return l.x * l.x + l.z * l.z <= sor_g(s, l.y, NULL);
     }
     default: {
-        double u = comp(l, w->ax[0]), h = comp(l, w->ax[1]), v = comp(l, w->ax[2]);
+        double u = v3_idx(l, w->ax[0]), h = v3_idx(l, w->ax[1]), v = v3_idx(l, w->ax[2]);
         if (!(h > w->h1 && h < w->h2)) return 0;
         if (w->conic) {
             if (h == 0.0) return 0;
@@ -1228,7 +1207,7 @@ void accel_sweep_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, doubl
         break;
     }
     default: {
-        double pu = comp(l, w->ax[0]), h = comp(l, w->ax[1]), pv = comp(l, w->ax[2]);
+        double pu = v3_idx(l, w->ax[0]), h = v3_idx(l, w->ax[1]), pv = v3_idx(l, w->ax[2]);
         *v = w->h2 > w->h1 ? (h - w->h1) / (w->h2 - w->h1) : 0.0;
         if (part == 0 || part == 1) {
             *n = from_local_axes(w->ax, 0.0, part == 0 ? -1.0 : 1.0, 0.0);

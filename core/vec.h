@@ -30,6 +30,27 @@ static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fmax(a.x, b.x), fmax(a.y, 
 static inline double v3_maxc(vec3 a) { return fmax(a.x, fmax(a.y, a.z)); }
 static inline double v3_idx(vec3 a, int i) { return i == 0 ? a.x : (i == 1 ? a.y : a.z); }
 static inline int v3_finite(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+/* Ray o + t d against the box [lo, hi] (slab method): the parameter interval
+ * [*t0, *t1] inside the box; 0 if the ray misses it. */
+static inline int v3_slab(vec3 o, vec3 d, vec3 lo, vec3 hi, double *t0, double *t1)
+{
+    double a = -INFINITY, b = INFINITY;
+    for (int i = 0; i < 3; i++) {
+        double oi = v3_idx(o, i), di = v3_idx(d, i), l = v3_idx(lo, i), u = v3_idx(hi, i);
+        if (di == 0.0) {
+            if (oi < l || oi > u) return 0;
+            continue;
+        }
+        double x = (l - oi) / di, y = (u - oi) / di;
+        if (x > y) { double t = x; x = y; y = t; }
+        if (x > a) a = x;
+        if (y < b) b = y;
+    }
+    if (!(a <= b)) return 0;
+    *t0 = a;
+    *t1 = b;
+    return 1;
+}
 /* Build an orthonormal basis (t, b) around unit vector n (Duff et al. 2017). */
 static inline void v3_basis(vec3 n, vec3 *t, vec3 *b)
 {
