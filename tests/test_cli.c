@@ -13,37 +13,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include "img_io.h"
+#include "test_util.h"
 
 static char tmpdir[256];
-static char out_text[65536];
-
-/* Run a shell command, capture stdout+stderr into out_text, return exit code. */
-static int run_capture(const char *cmd)
-{
-    char full[4096];
-    snprintf(full, sizeof full, "%s 2>&1", cmd);
-    FILE *p = popen(full, "r");
-    if (!p) return -1;
-    size_t n = fread(out_text, 1, sizeof out_text - 1, p);
-    out_text[n] = 0;
-    int rc = pclose(p);
-    return WEXITSTATUS(rc);
-}
-
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
-
-static int exists(const char *path)
-{
-    struct stat sb;
-    return stat(path, &sb) == 0;
-}
-
 /* Render SCENE_TEXT; expect exit `code`, `needle` in the output and no file. */
 static void expect_failure(const char *scene_text, int code, const char *needle)
 {
@@ -51,14 +23,14 @@ static void expect_failure(const char *scene_text, int code, const char *needle)
     snprintf(scene, sizeof scene, "%s/bad.pov", tmpdir);
     snprintf(out, sizeof out, "%s/bad.png", tmpdir);
     remove(out);
-    if (scene_text) write_file(scene, scene_text);
+    if (scene_text) tu_write_file(scene, scene_text);
     else remove(scene);
     snprintf(cmd, sizeof cmd, "'%s' render '%s' -o '%s' --size 16x16", PARTRAY_BIN, scene, out);
-    int rc = run_capture(cmd);
-    printf("exit %d: %s", rc, out_text);
+    int rc = tu_run_capture(cmd);
+    printf("exit %d: %s", rc, tu_out);
     assert_int_equal(rc, code);
-    assert_non_null(strstr(out_text, needle));
-    assert_false(exists(out));
+    assert_non_null(strstr(tu_out, needle));
+    assert_false(tu_exists(out));
 }
 
 static void test_missing_file(void **st)
@@ -83,7 +55,7 @@ static void test_unterminated_block(void **st)
     char needle[600];
     snprintf(needle, sizeof needle, "%s/bad.pov:", tmpdir);
     expect_failure("camera { location -5*z look_at 0 }\nsphere { 0, 1\n  pigment { rgb 1 }\n", 1, needle);
-    assert_non_null(strstr(out_text, "error:"));
+    assert_non_null(strstr(tu_out, "error:"));
 }
 
 static void test_include_chain(void **st)
@@ -91,11 +63,11 @@ static void test_include_chain(void **st)
     (void)st;
     char inc[512];
     snprintf(inc, sizeof inc, "%s/inc_bad.inc", tmpdir);
-    write_file(inc, "#declare A = 1;\nbogus_word\n");
+    tu_write_file(inc, "#declare A = 1;\nbogus_word\n");
     char needle[600];
     snprintf(needle, sizeof needle, "%s/inc_bad.inc:2:1: error:", tmpdir);
     expect_failure("#include \"inc_bad.inc\"\n", 1, needle);
-    assert_non_null(strstr(out_text, "bad.pov:1"));
+    assert_non_null(strstr(tu_out, "bad.pov:1"));
 }
 
 static void test_usage(void **st)
@@ -103,17 +75,17 @@ static void test_usage(void **st)
     (void)st;
     char cmd[1024];
     snprintf(cmd, sizeof cmd, "'%s' render", PARTRAY_BIN);
-    assert_int_equal(run_capture(cmd), 2);
+    assert_int_equal(tu_run_capture(cmd), 2);
     snprintf(cmd, sizeof cmd, "'%s' render x.pov --size 12", PARTRAY_BIN);
-    assert_int_equal(run_capture(cmd), 2);
+    assert_int_equal(tu_run_capture(cmd), 2);
     snprintf(cmd, sizeof cmd, "'%s' frobnicate", PARTRAY_BIN);
-    assert_int_equal(run_capture(cmd), 2);
+    assert_int_equal(tu_run_capture(cmd), 2);
     snprintf(cmd, sizeof cmd, "'%s' --version", PARTRAY_BIN);
-    assert_int_equal(run_capture(cmd), 0);
-    assert_non_null(strstr(out_text, "partray "));
+    assert_int_equal(tu_run_capture(cmd), 0);
+    assert_non_null(strstr(tu_out, "partray "));
     snprintf(cmd, sizeof cmd, "'%s' --help", PARTRAY_BIN);
-    assert_int_equal(run_capture(cmd), 0);
-    assert_non_null(strstr(out_text, "partray render"));
+    assert_int_equal(tu_run_capture(cmd), 0);
+    assert_non_null(strstr(tu_out, "partray render"));
 }
 
 /* A white diffuse plane under a point light straight above: the pixel in the
@@ -125,7 +97,7 @@ static void test_render_outputs_and_stats(void **st)
     (void)st;
     char scene[512], cmd[4096], stats[512];
     snprintf(scene, sizeof scene, "%s/plane.pov", tmpdir);
-    write_file(scene,
+    tu_write_file(scene,
                "#version 3.7;\n"
                "global_settings { assumed_gamma 1.0 }\n"
                "camera { orthographic location <0, 5, 0> direction -y right x*2 up z*2 }\n"
@@ -135,8 +107,8 @@ static void test_render_outputs_and_stats(void **st)
     snprintf(cmd, sizeof cmd,
              "'%s' render '%s' -D Power=1 +W32 +H24 +O%s/a.pfm -o %s/a.exr -o %s/a.png --stats '%s' --seed 3 --threads 2",
              PARTRAY_BIN, scene, tmpdir, tmpdir, tmpdir, stats);
-    int rc = run_capture(cmd);
-    printf("%s", out_text);
+    int rc = tu_run_capture(cmd);
+    printf("%s", tu_out);
     assert_int_equal(rc, 0);
     const char *exts[] = {"pfm", "exr", "png"};
     for (int i = 0; i < 3; i++) {
@@ -153,13 +125,13 @@ static void test_render_outputs_and_stats(void **st)
     }
     FILE *f = fopen(stats, "rb");
     assert_non_null(f);
-    size_t n = fread(out_text, 1, sizeof out_text - 1, f);
-    out_text[n] = 0;
+    size_t n = fread(tu_out, 1, sizeof tu_out - 1, f);
+    tu_out[n] = 0;
     fclose(f);
     const char *keys[] = {"\"timings\"", "\"parse\"", "\"accel\"", "\"gi_geometry\"", "\"gi_lighting\"", "\"render\"",
                           "\"total\"", "\"rays\"", "\"width\": 32", "\"height\": 24", "\"gi\": \"none\""};
     for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) {
-        if (!strstr(out_text, keys[i])) fail_msg("stats lacks %s:\n%s", keys[i], out_text);
+        if (!strstr(tu_out, keys[i])) fail_msg("stats lacks %s:\n%s", keys[i], tu_out);
     }
 }
 
@@ -172,7 +144,7 @@ static void test_sigint_partial(void **st)
     snprintf(scene, sizeof scene, "%s/slow.pov", tmpdir);
     snprintf(out, sizeof out, "%s/slow.png", tmpdir);
     snprintf(partial, sizeof partial, "%s/slow.partial.png", tmpdir);
-    write_file(scene,
+    tu_write_file(scene,
                "camera { location <0, 3, -6> look_at 0 }\n"
                "light_source { <0, 5, 0> rgb 1 area_light 2*x, 2*z, 16, 16 jitter }\n"
                "plane { y, 0 pigment { rgb 1 } }\n"
@@ -187,16 +159,16 @@ static void test_sigint_partial(void **st)
              "while kill -0 $pid 2>/dev/null && ! ls -a '%s' | grep -q '^\\.slow\\.partial\\.png\\.tmp-'; do sleep 0.005; done; "
              "t1=$(date +%%s%%N); wait $pid; rc=$?; echo \"rc=$rc ms=$(( (t1 - t0) / 1000000 ))\"",
              PARTRAY_BIN, scene, out, tmpdir);
-    run_capture(cmd);
-    printf("%s", out_text);
+    tu_run_capture(cmd);
+    printf("%s", tu_out);
     int rc = -1, ms = -1;
-    const char *p = strstr(out_text, "rc=");
+    const char *p = strstr(tu_out, "rc=");
     assert_non_null(p);
     assert_int_equal(sscanf(p, "rc=%d ms=%d", &rc, &ms), 2);
     assert_int_equal(rc, 130);
     assert_true(ms >= 0 && ms < 1000);
-    assert_true(exists(partial));
-    assert_false(exists(out));
+    assert_true(tu_exists(partial));
+    assert_false(tu_exists(out));
     framebuffer *fb = NULL;
     assert_int_equal(img_read(partial, 0, &fb, NULL), PT_OK);
     assert_int_equal(fb->width, 2000);
@@ -219,6 +191,6 @@ int main(void)
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     char cmd[600];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-    if (rc == 0) run_capture(cmd);
+    if (rc == 0) tu_run_capture(cmd);
     return rc;
 }

@@ -19,6 +19,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include "img_io.h"
+#include "test_util.h"
 
 #define W 160
 #define H 120
@@ -26,56 +27,14 @@
 
 static char tmpdir[256];
 
-static int run(const char *cmd)
-{
-    int rc = system(cmd);
-    return rc == -1 ? -1 : WEXITSTATUS(rc);
-}
-
-static double downsampled_mad(const framebuffer *a, const framebuffer *b)
-{
-    int w = a->width / 4, h = a->height / 4;
-    double sum = 0.0;
-    for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++)
-            for (int c = 0; c < 3; c++) {
-                double sa = 0, sb = 0;
-                for (int j = 0; j < 4; j++)
-                    for (int i = 0; i < 4; i++) {
-                        size_t k = ((size_t)(y * 4 + j) * (size_t)a->width + (size_t)(x * 4 + i)) * 3 + (size_t)c;
-                        sa += a->rgb[k];
-                        sb += b->rgb[k];
-                    }
-                sum += fabs(sa - sb) / 16.0;
-            }
-    return sum / (3.0 * w * h);
-}
-
-/* Render tests/scenes/<scene>.pov (copied to the temporary directory, where
- * its images are) with both renderers; `decl` is NAME=VALUE or NULL. */
+/* Render tests/scenes/<scene>.pov with both renderers in the temporary
+ * directory (where its images are); `decl` is NAME=VALUE or NULL. */
 static double crosscheck(const char *scene, const char *decl, const char *tag)
 {
-    char cmd[4096], pov[512], pt[512];
-    snprintf(pov, sizeof pov, "%s/%s_pov.png", tmpdir, tag);
-    snprintf(pt, sizeof pt, "%s/%s_pt.png", tmpdir, tag);
-    snprintf(cmd, sizeof cmd, "cp '%s/scenes/%s.pov' '%s/%s.pov'", TESTS_DIR, scene, tmpdir, scene);
-    assert_int_equal(run(cmd), 0);
-    snprintf(cmd, sizeof cmd,
-             "cd '%s' && povray +I%s.pov +O%s_pov.png +W%d +H%d +A0.3 +R3 -D -V -GA +WT2 +FN %s%s >povray_%s.log 2>&1", tmpdir,
-             scene, tag, W, H, decl ? "Declare=" : "", decl ? decl : "", tag);
-    if (run(cmd) != 0) fail_msg("povray failed on %s; see %s/povray_%s.log", scene, tmpdir, tag);
-    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' render %s.pov -o '%s' +W%d +H%d +A0.3 +R3 --threads 2 --quiet %s%s 2>partray_%s.log",
-             tmpdir, PARTRAY_BIN, scene, pt, W, H, decl ? "-D " : "", decl ? decl : "", tag);
-    if (run(cmd) != 0) fail_msg("partray failed on %s; see %s/partray_%s.log", scene, tmpdir, tag);
-    framebuffer *a = NULL, *b = NULL;
-    assert_int_equal(img_read(pov, 1, &a, NULL), PT_OK);
-    assert_int_equal(img_read(pt, 1, &b, NULL), PT_OK);
-    assert_int_equal(a->width, b->width);
-    assert_int_equal(a->height, b->height);
-    double mad = downsampled_mad(a, b);
+    char path[512];
+    snprintf(path, sizeof path, "%s/scenes/%s.pov", TESTS_DIR, scene);
+    double mad = tu_crosscheck(PARTRAY_BIN, tmpdir, path, tag, W, H, decl);
     printf("look %-18s mean |diff| after 4x4 downsample = %.5f (tolerance %.3f)\n", tag, mad, TOLERANCE);
-    fb_free(a);
-    fb_free(b);
     return mad;
 }
 
@@ -132,8 +91,7 @@ static void test_gamma_image(void **st)
 
 int main(void)
 {
-    snprintf(tmpdir, sizeof tmpdir, "/tmp/partray-look-XXXXXX");
-    if (!mkdtemp(tmpdir)) return 1;
+    if (tu_mkdtemp(tmpdir, sizeof tmpdir, "partray-look") != 0) return 1;
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_textures),
         cmocka_unit_test(test_glass),
@@ -142,11 +100,9 @@ int main(void)
         cmocka_unit_test(test_gamma_image),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
-    if (rc == 0) {
-        char cmd[600];
-        snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-        run(cmd);
-    } else {
+    if (rc == 0)
+        tu_rm_rf(tmpdir);
+    else {
         printf("images kept in %s\n", tmpdir);
     }
     return rc;

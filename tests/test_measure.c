@@ -16,41 +16,9 @@
 #include "img_io.h"
 #include "img_plot.h"
 #include "stats_read.h"
+#include "test_util.h"
 
 static char tmpdir[256];
-static char out_text[1 << 16];
-
-static int run_capture(const char *cmd)
-{
-    char full[8192];
-    snprintf(full, sizeof full, "%s 2>&1", cmd);
-    FILE *p = popen(full, "r");
-    if (!p) return -1;
-    size_t n = fread(out_text, 1, sizeof out_text - 1, p);
-    out_text[n] = 0;
-    int rc = pclose(p);
-    return WEXITSTATUS(rc);
-}
-
-/* stdout only (stderr to the terminal), for --json. */
-static int run_stdout(const char *cmd)
-{
-    FILE *p = popen(cmd, "r");
-    if (!p) return -1;
-    size_t n = fread(out_text, 1, sizeof out_text - 1, p);
-    out_text[n] = 0;
-    int rc = pclose(p);
-    return WEXITSTATUS(rc);
-}
-
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
-
 static char *read_file(const char *path)
 {
     FILE *f = fopen(path, "rb");
@@ -127,14 +95,14 @@ static void test_sweep_spp(void **st)
     snprintf(scene, sizeof scene, "%s/sweep.pov", tmpdir);
     snprintf(ref, sizeof ref, "%s/ref.exr", tmpdir);
     snprintf(dir, sizeof dir, "%s/sweep_spp", tmpdir);
-    write_file(scene, scene_text);
+    tu_write_file(scene, scene_text);
     snprintf(cmd, sizeof cmd, "'%s' render '%s' -o '%s' --float --size 64x64 --spp 32 --threads 2 --quiet", PARTRAY_BIN,
              scene, ref);
-    assert_int_equal(run_capture(cmd), 0);
+    assert_int_equal(tu_run_capture(cmd), 0);
     snprintf(cmd, sizeof cmd, "'%s' sweep '%s' --gi none --vary spp=1,8 --ref '%s' --out '%s' --threads 2", PARTRAY_BIN,
              scene, ref, dir);
-    int rc = run_capture(cmd);
-    printf("%s", out_text);
+    int rc = tu_run_capture(cmd);
+    printf("%s", tu_out);
     assert_int_equal(rc, 0);
 
     /* CSV: a header and one row per setting, in order. */
@@ -227,15 +195,15 @@ static void test_sweep_size_and_usage(void **st)
     snprintf(scene, sizeof scene, "%s/sweep2.pov", tmpdir);
     snprintf(ref, sizeof ref, "%s/ref2.exr", tmpdir);
     snprintf(dir, sizeof dir, "%s/sweep_size", tmpdir);
-    write_file(scene, scene_text);
+    tu_write_file(scene, scene_text);
     snprintf(cmd, sizeof cmd, "'%s' render '%s' -o '%s' --float --size 64x64 --threads 2 --quiet", PARTRAY_BIN, scene, ref);
-    assert_int_equal(run_capture(cmd), 0);
+    assert_int_equal(tu_run_capture(cmd), 0);
     snprintf(cmd, sizeof cmd,
              "'%s' sweep '%s' --gi none --vary none/size=32x32,64x64 --vary D:Power=1 --ref '%s' --out '%s' "
              "--metric flip --time render --plot-size 400x300 --threads 2 --quiet",
              PARTRAY_BIN, scene, ref, dir);
-    int rc = run_capture(cmd);
-    printf("%s", out_text);
+    int rc = tu_run_capture(cmd);
+    printf("%s", tu_out);
     assert_int_equal(rc, 0);
     snprintf(path, sizeof path, "%s/sweep.csv", dir);
     char *csv = read_file(path);
@@ -264,14 +232,14 @@ static void test_sweep_size_and_usage(void **st)
                          "--ref x.exr --vary spp=1 -o y.exr"};
     for (int i = 0; i < 4; i++) {
         snprintf(cmd, sizeof cmd, "'%s' sweep '%s' %s --out '%s/bad'", PARTRAY_BIN, scene, bad[i], tmpdir);
-        rc = run_capture(cmd);
-        printf("sweep %s -> exit %d: %s", bad[i], rc, out_text);
+        rc = tu_run_capture(cmd);
+        printf("sweep %s -> exit %d: %s", bad[i], rc, tu_out);
         assert_int_equal(rc, 2);
     }
     /* A missing reference is an I/O error. */
     snprintf(cmd, sizeof cmd, "'%s' sweep '%s' --ref '%s/none.exr' --vary spp=1 --out '%s/bad'", PARTRAY_BIN, scene, tmpdir,
              tmpdir);
-    rc = run_capture(cmd);
+    rc = tu_run_capture(cmd);
     printf("missing reference -> exit %d\n", rc);
     assert_int_equal(rc, 3);
 }
@@ -289,7 +257,7 @@ static void test_crosscheck_direct(void **st)
     char scene[512], dir[512], cmd[4096], path[1024];
     snprintf(scene, sizeof scene, "%s/xc.pov", tmpdir);
     snprintf(dir, sizeof dir, "%s/xc", tmpdir);
-    write_file(scene,
+    tu_write_file(scene,
                "#version 3.7;\n"
                "global_settings { assumed_gamma 1.0 }\n"
                "camera { location <0, 2, -5> look_at <0, 0.6, 0> angle 50 }\n"
@@ -297,17 +265,17 @@ static void test_crosscheck_direct(void **st)
                "plane { y, 0 pigment { rgb 0.6 } finish { ambient 0.05 diffuse 0.8 } }\n"
                "sphere { <0, 1, 0>, 1 pigment { rgb <0.8, 0.2, 0.15> } finish { ambient 0.1 diffuse 0.7 phong 0.8 phong_size 60 } }\n");
     snprintf(cmd, sizeof cmd, "'%s' crosscheck '%s' --size 64x64 +A0.3 --threads 2 --json --out '%s'", PARTRAY_BIN, scene, dir);
-    int rc = run_stdout(cmd);
-    printf("%s", out_text);
+    int rc = tu_run_stdout(cmd);
+    printf("%s", tu_out);
     assert_int_equal(rc, 0);
     double mad = -1, mad4 = -1, rmse = -1, flip = -1, ratio = -1, rad = -1, w = 0;
-    assert_true(stats_read_num(out_text, "mean_abs_diff", &mad));
-    assert_true(stats_read_num(out_text, "mean_abs_diff_4x4", &mad4));
-    assert_true(stats_read_num(out_text, "rmse", &rmse));
-    assert_true(stats_read_num(out_text, "flip.mean", &flip));
-    assert_true(stats_read_num(out_text, "luminance.ratio", &ratio));
-    assert_true(stats_read_num(out_text, "radiosity", &rad));
-    assert_true(stats_read_num(out_text, "width", &w));
+    assert_true(stats_read_num(tu_out, "mean_abs_diff", &mad));
+    assert_true(stats_read_num(tu_out, "mean_abs_diff_4x4", &mad4));
+    assert_true(stats_read_num(tu_out, "rmse", &rmse));
+    assert_true(stats_read_num(tu_out, "flip.mean", &flip));
+    assert_true(stats_read_num(tu_out, "luminance.ratio", &ratio));
+    assert_true(stats_read_num(tu_out, "radiosity", &rad));
+    assert_true(stats_read_num(tu_out, "width", &w));
     printf("crosscheck direct: mean |diff| %.5f (4x4 %.5f, bound 0.01), rmse %.5f, flip %.5f, luminance ratio %.5f\n", mad,
            mad4, rmse, flip, ratio);
     assert_true(w == 64);
@@ -322,11 +290,11 @@ static void test_crosscheck_direct(void **st)
     }
     /* The text report names the metrics. */
     snprintf(cmd, sizeof cmd, "'%s' crosscheck '%s' --size 32x32 --threads 2", PARTRAY_BIN, scene);
-    rc = run_capture(cmd);
-    printf("%s", out_text);
+    rc = tu_run_capture(cmd);
+    printf("%s", tu_out);
     assert_int_equal(rc, 0);
-    assert_non_null(strstr(out_text, "FLIP"));
-    assert_non_null(strstr(out_text, "luminance"));
+    assert_non_null(strstr(tu_out, "FLIP"));
+    assert_non_null(strstr(tu_out, "luminance"));
 }
 
 /* A scene with radiosity{}: reported with the luminance ratio; POV-Ray
@@ -336,28 +304,28 @@ static void test_crosscheck_radiosity_and_missing(void **st)
     (void)st;
     char scene[512], cmd[4096];
     snprintf(scene, sizeof scene, "%s/xc_rad.pov", tmpdir);
-    write_file(scene,
+    tu_write_file(scene,
                "#version 3.7;\n"
                "global_settings { assumed_gamma 1.0 radiosity { count 20 recursion_limit 1 } }\n"
                "camera { location <0, 1, -2.5> look_at <0, 1, 0> angle 60 }\n"
                "light_source { <0, 1.8, -0.5> color rgb 1 }\n"
                "box { <-1, 0, -3>, <1, 2, 1> pigment { rgb 0.7 } finish { ambient 0 diffuse 0.8 } hollow }\n");
     snprintf(cmd, sizeof cmd, "'%s' crosscheck '%s' --povray /nonexistent/povray", PARTRAY_BIN, scene);
-    int rc = run_capture(cmd);
-    printf("missing povray -> exit %d: %s", rc, out_text);
+    int rc = tu_run_capture(cmd);
+    printf("missing povray -> exit %d: %s", rc, tu_out);
     assert_int_equal(rc, 3);
     if (!have_povray()) {
         printf("povray not installed; skipping the radiosity render\n");
         skip();
     }
     snprintf(cmd, sizeof cmd, "'%s' crosscheck '%s' --size 32x32 --threads 2 --json", PARTRAY_BIN, scene);
-    rc = run_stdout(cmd);
-    printf("%s", out_text);
+    rc = tu_run_stdout(cmd);
+    printf("%s", tu_out);
     assert_int_equal(rc, 0);
     double rad = -1, ratio = -1, lp = -1;
-    assert_true(stats_read_num(out_text, "radiosity", &rad));
-    assert_true(stats_read_num(out_text, "luminance.ratio", &ratio));
-    assert_true(stats_read_num(out_text, "luminance.povray", &lp));
+    assert_true(stats_read_num(tu_out, "radiosity", &rad));
+    assert_true(stats_read_num(tu_out, "luminance.ratio", &ratio));
+    assert_true(stats_read_num(tu_out, "luminance.povray", &lp));
     printf("crosscheck radiosity: luminance ratio partray/POV-Ray %.4f (POV-Ray mean %.4f)\n", ratio, lp);
     assert_true(rad == 1);
     assert_true(lp > 0 && isfinite(ratio) && ratio > 0);
@@ -377,7 +345,7 @@ int main(void)
     char cmd[600];
     if (rc == 0) {
         snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-        run_capture(cmd);
+        tu_run_capture(cmd);
     } else {
         printf("files kept in %s\n", tmpdir);
     }

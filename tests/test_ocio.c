@@ -21,6 +21,7 @@
 #include "diag.h"
 #include "framebuffer.h"
 #include "img_io.h"
+#include "test_util.h"
 #include "img_ocio.h"
 
 /* ---- helpers ------------------------------------------------------------- */
@@ -34,8 +35,7 @@ static int setup_dir(void **state)
 {
     tmpdir *t = calloc(1, sizeof *t);
     if (!t) return -1;
-    snprintf(t->dir, sizeof t->dir, "/tmp/pt_test_ocio_XXXXXX");
-    if (!mkdtemp(t->dir)) {
+    if (tu_mkdtemp(t->dir, sizeof t->dir, "pt_test_ocio") != 0) {
         free(t);
         return -1;
     }
@@ -46,18 +46,7 @@ static int setup_dir(void **state)
 static int teardown_dir(void **state)
 {
     tmpdir *t = *state;
-    DIR *dp = opendir(t->dir);
-    if (dp) {
-        struct dirent *e;
-        char p[512];
-        while ((e = readdir(dp))) {
-            if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
-            snprintf(p, sizeof p, "%s/%s", t->dir, e->d_name);
-            unlink(p);
-        }
-        closedir(dp);
-    }
-    rmdir(t->dir);
+    tu_rm_rf(t->dir);
     free(t);
     return 0;
 }
