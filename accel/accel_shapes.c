@@ -19,6 +19,7 @@
 #include "accel_implicit.h"
 #include "accel_poly.h"
 #include "accel_sweep.h"
+#include "accel_tess.h"
 
 #define TWO_PI 6.283185307179586476925
 
@@ -572,6 +573,9 @@ int accel_shape_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
     }
     case SHAPE_SUPERELLIPSOID:
         return accel_implicit_grid(sh, n, fn, ctx);
+    case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE: case SHAPE_JULIA:
+        /* no parametrisation of their own: marching tetrahedra (accel_tess.h) */
+        return accel_tess_grid(sh, n, fn, ctx);
     case SHAPE_HEIGHT_FIELD: {
         int nt = accel_hfield_ntriangles(sh), count = 0;
         for (int i = 0; i < nt; i++) {

@@ -90,10 +90,13 @@ void accel_shape_shading(const accel_shape *sh, vec3 p, vec3 ng, vec3 *ns);
 /* Parametric grid for radiance particles (DESIGN.md) on the issue-4
  * shapes: object-space triangles whose vertices lie on the exact surface,
  * with the exact outward normals there, about n x n per part (polygon and
- * height_field: their own triangles). Calls fn per triangle; returns the
- * number of triangles, 0 when the shape has no grid (quadric, poly, blob,
- * isosurface, julia_fractal, and the original shapes, which GI
- * parametrises itself), -1 when fn returned 0. */
+ * height_field: their own triangles; quadric, poly, blob, isosurface and
+ * julia_fractal: marching tetrahedra on n cells along the longest side of
+ * their bounds, accel_tess.h; the unbounded quadric and poly within their
+ * clip box, so clip them first with accel_shape_clip_plane). Calls fn per
+ * triangle; returns the number of triangles, 0 when the shape has no grid
+ * (the original shapes, which GI parametrises itself), -1 when fn returned
+ * 0 or memory ran out. */
 typedef int (*accel_grid_fn)(void *ctx, const vec3 p[3], const vec3 n[3]);
 int accel_shape_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx);
 

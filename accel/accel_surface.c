@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "accel_shapes.h"
+#include "accel_tess.h"
 
 enum { INHERITED = OBJ_NO_SHADOW | OBJ_NO_IMAGE | OBJ_NO_REFLECTION | OBJ_NO_RADIOSITY };
 #define MAX_DEPTH 256
@@ -31,7 +32,14 @@ typedef struct {
     vec3 poly[12];
     double tri_cdf[12];
     vec3 clip_lo, clip_hi;
+    int crofton;           /* sampled by random lines (accel_tess.h) */
+    accel_tess_sampler cro; /* its sh pointer is set at each use (the array moves) */
 } shape_geo;
+
+/* Crofton sampling: the relative standard error asked of the area estimate
+ * and the most lines cast for it (per shape). */
+#define CROFTON_REL_ERR 1e-3
+#define CROFTON_MAX_LINES 65536
 
 typedef struct {
     accel_surf_piece pub;
@@ -245,6 +253,22 @@ static double shape_area(shape_geo *g)
     return total;
 }
 
+/* Shapes sampled by random lines: those without a parametrisation of their
+ * own, and the sweeps where theirs is not uniform (non-similar transforms,
+ * conic prisms: accel_sweep_area 0). */
+static int use_crofton(const shape_geo *g)
+{
+    switch (g->sh.kind) {
+    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
+    case SHAPE_JULIA:
+        return 1;
+    case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
+        return !g->similar || !(accel_sweep_area(&g->sh) > 0.0);
+    default:
+        return 0;
+    }
+}
+
 /* Plane clipped to the box [lo, hi]: convex polygon, fan-triangulated. */
 static double plane_polygon(shape_geo *g, vec3 lo, vec3 hi)
 {
@@ -385,7 +409,23 @@ static int add_leaf(accel_surf *as, const scene_object *o, const scene_texture *
     } else {
         g->similar = is_similarity(&o->transform);
         g->jmax = jacobian_bound(&o->transform);
-        area = shape_area(g);
+        area = use_crofton(g) ? 0.0 : shape_area(g);
+        if (!(area > 0.0) && use_crofton(g)) {
+            /* implicit shapes, and sweeps the own parametrisation cannot
+             * sample under this transform: random lines (exact in
+             * distribution); unbounded ones within the scene's extent */
+            if (g->sh.infinite) {
+                if (!as->have_bounds) {
+                    accel_shape_release(&g->sh);
+                    return 1;
+                }
+                accel_shape_clip_plane(&g->sh, as->lo, as->hi);
+                g->clip_lo = as->lo;
+                g->clip_hi = as->hi;
+            }
+            g->crofton = 1;
+            area = accel_tess_sampler_init(&g->cro, &g->sh, NULL, NULL, CROFTON_REL_ERR, CROFTON_MAX_LINES);
+        }
     }
     if (!(area > 0.0) || !isfinite(area)) {
         accel_shape_release(&g->sh);
@@ -456,6 +496,8 @@ static int collect(accel_surf *as, const scene_object *o, const scene_texture *p
     case SHAPE_POLYGON: case SHAPE_HEIGHT_FIELD:
         return add_issue4(as, o, tex ? tex : &as->s->default_texture, flags);
     case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
+    case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
+    case SHAPE_JULIA:
         return add_leaf(as, o, tex ? tex : &as->s->default_texture, flags);
     default: /* merge, intersection, difference, unsupported: not sampled */
         return 1;
@@ -584,6 +626,15 @@ static void sample_shape(const shape_geo *g, double u1, double u2, rng *r, vec3 
     const xform *x = &sh->x;
     vec3 po = v3s(0.0), no = v3(0, 0, 1);
     *part = 0;
+    if (g->crofton) {
+        accel_tess_sampler cs = g->cro;
+        cs.sh = sh;
+        if (!accel_tess_sample(&cs, u1, u2, r, p, n, part)) {
+            *p = cs.c;
+            *n = v3(0, 1, 0);
+        }
+        return;
+    }
     switch (sh->kind) {
     case SHAPE_SPHERE:
         for (int t = 0; t < MAX_REJECT; t++) {
@@ -743,7 +794,7 @@ double accel_surf_pdf(const accel_surf *as, const accel_hit *h)
     int i = accel_surf_find(as, h->obj, h->prim);
     if (i < 0) return 0.0;
     const piece_rec *pr = &as->pieces[i];
-    if (pr->is_shape && as->shapes[pr->idx].sh.kind == SHAPE_PLANE) {
+    if (pr->is_shape && (as->shapes[pr->idx].sh.kind == SHAPE_PLANE || as->shapes[pr->idx].sh.infinite)) {
         const shape_geo *g = &as->shapes[pr->idx];
         vec3 p = h->p;
         if (p.x < g->clip_lo.x || p.y < g->clip_lo.y || p.z < g->clip_lo.z || p.x > g->clip_hi.x ||

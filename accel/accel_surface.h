@@ -27,13 +27,16 @@
  * surface counts it with full weight): members of CSG intersection,
  * difference and merge (their visible surface is a part of the members'
  * surfaces; a later version can sample a member and reject points that the
- * CSG inside rules remove), unsupported shapes, degenerate objects,
- * objects with clipped_by, and the issue-4 shapes superellipsoid, quadric,
- * poly, blob, isosurface, julia_fractal, conic prisms, and lathes, sors,
- * prisms and text under non-similarity transforms. Polygons (their region
- * cut into triangles) and height fields (their cells' triangles) are
- * sampled exactly; lathe, sor, linear prism and text uniformly by area
- * (accel_sweep_sample) under similarities.
+ * CSG inside rules remove), unsupported shapes, degenerate objects and
+ * objects with clipped_by. Polygons (their region cut into triangles) and
+ * height fields (their cells' triangles) are sampled exactly; lathe, sor,
+ * linear prism and text uniformly by area (accel_sweep_sample) under
+ * similarities. Superellipsoid, quadric, poly, blob, isosurface,
+ * julia_fractal, conic prisms and the sweeps under other transforms are
+ * sampled by random lines (accel_tess.h: Crofton's formula, exact in
+ * distribution; their area is a quasi-Monte Carlo estimate to 0.1%
+ * standard error or 65536 lines); quadric and poly within the scene's
+ * finite bounds, as planes.
  * Union members are sampled as separate leaves, as accel renders them. */
 #ifndef PT_ACCEL_SURFACE_H
 #define PT_ACCEL_SURFACE_H

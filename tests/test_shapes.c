@@ -985,6 +985,91 @@ static void test_sweep_sampling(void **st)
     done(&w);
 }
 
+/* GI sampling of the implicit shapes by random lines (accel_tess.h):
+ * the area estimate against closed forms, points on the surface with
+ * outward normals, uniform by area (Archimedes: z uniform on a sphere).
+ * The estimate's standard error is asked at 0.1% (CROFTON_REL_ERR);
+ * tolerance 1%. */
+static double only_kind_w(void *ctx, const scene_object *o, const scene_texture *t, unsigned f)
+{
+    (void)t; (void)f;
+    return o->kind == *(const shape_kind *)ctx ? 1.0 : 0.0;
+}
+
+/* prolate spheroid x^2/a^2 + y^2/a^2 + z^2/c^2 = 1, c > a */
+static double prolate_area(double a, double c)
+{
+    double e = sqrt(1.0 - a * a / (c * c));
+    return 2.0 * M_PI * a * a * (1.0 + c / (a * e) * asin(e));
+}
+
+static void check_crofton(const char *src, shape_kind kind, double area, double zlo, double zhi, double zfrac)
+{
+    world w = build(src);
+    pt_status ps;
+    accel_surf *as = accel_surf_build(w.s, w.a, only_kind_w, &kind, w.d, &ps);
+    assert_non_null(as);
+    assert_int_equal(accel_surf_count(as), 1);
+    double got = accel_surf_total_area(as);
+    if (fabs(got - area) > 0.01 * area) fail_msg("%s: area %.6g, exact %.6g", src, got, area);
+    print_message("crofton area %+.4f%% %s\n", 100.0 * (got - area) / area, src);
+    const scene_object *o = NULL;
+    for (int i = 0; i < w.s->nobjects; i++)
+        if (w.s->objects[i]->kind == kind) o = w.s->objects[i];
+    accel_shape sh;
+    assert_int_equal(accel_shape_init(&sh, o), 0);
+    if (sh.infinite) accel_shape_clip_plane(&sh, v3s(-1e3), v3s(1e3));
+    rng r;
+    rng_seed(&r, 5, 9);
+    int n = 4000, band = 0;
+    for (int i = 0; i < n; i++) {
+        accel_surf_sample sm;
+        assert_true(accel_surf_sample_point(as, rng_f64(&r), rng_f64(&r), rng_f64(&r), &r, &sm));
+        assert_near(sm.pdf_area, 1.0 / got, 1e-9 / got);
+        double e = 1e-6 * sqrt(area);
+        if (!accel_shape_inside(&sh, v3_madd(sm.p, sm.n, -e)) || accel_shape_inside(&sh, v3_madd(sm.p, sm.n, e)))
+            fail_msg("%s: sample %d not on the surface with an outward normal", src, i);
+        if (sm.p.z > zlo && sm.p.z < zhi) band++;
+        /* the sample's own hit gets the same density */
+        accel_hit h;
+        if (i < 200 && hit(&w, v3_madd(sm.p, sm.n, 1e-3), v3_neg(sm.n), &h) && h.obj == o)
+            assert_near(accel_surf_pdf(as, &h), 1.0 / got, 1e-9 / got);
+    }
+    /* binomial: 4 standard deviations */
+    double sd = sqrt(zfrac * (1 - zfrac) / n);
+    if (fabs((double)band / n - zfrac) > 4 * sd) fail_msg("%s: band holds %.4f, expected %.4f", src, (double)band / n, zfrac);
+    accel_shape_release(&sh);
+    accel_surf_free(as);
+    done(&w);
+}
+
+static void test_implicit_sampling(void **st)
+{
+    (void)st;
+    /* one blob component: strength (1 - (d/r)^2)^2 = threshold at
+     * d = r sqrt(1 - sqrt(threshold / strength)) */
+    double d = 2.0 * sqrt(1.0 - sqrt(0.5));
+    check_crofton("blob { threshold 0.5 sphere { <0,0,0>, 2, 1 } }", SHAPE_BLOB, 4 * M_PI * d * d, 0.5 * d, d, 0.25);
+    /* the same under a non-uniform scale: a prolate spheroid */
+    check_crofton("blob { threshold 0.5 sphere { <0,0,0>, 2, 1 } scale <1,1,2> }", SHAPE_BLOB,
+                  prolate_area(d, 2 * d), -1e9, 1e9, 1.0);
+    /* quadric ellipsoid x^2 + y^2 + z^2/4 = 1, rotated */
+    check_crofton("quadric { <1,1,0.25>, <0,0,0>, <0,0,0>, -1 rotate <30,40,50> }", SHAPE_QUADRIC,
+                  prolate_area(1, 2), -1e9, 1e9, 1.0);
+    /* infinite cylinder quadric x^2 + y^2 = 1 inside the scene's finite extent
+     * (a box, z in [-3, 3]): the side, 12 pi; z uniform on it */
+    check_crofton("quadric { <1,1,0>, <0,0,0>, <0,0,0>, -1 } box { <-2,-2,-3>, <2,2,3> }", SHAPE_QUADRIC,
+                  12 * M_PI, 1.5, 3.0, 0.25);
+    /* the unit sphere as a poly (order 2: x2 xy xz x y2 yz y z2 z 1), an
+     * isosurface, a superellipsoid and a julia_fractal (c = 0: |q| <= 1) */
+    check_crofton("poly { 2, <1,0,0,0,1,0,0,1,0,-1> } box { <-2,-2,-2>, <2,2,2> }", SHAPE_POLY, 4 * M_PI, 0.5, 1,
+                  0.25);
+    check_crofton("isosurface { function { x*x + y*y + z*z - 1 } contained_by { box { -2, 2 } } max_gradient 8 }", SHAPE_ISOSURFACE,
+                  4 * M_PI, 0.5, 1, 0.25);
+    check_crofton("superellipsoid { <1, 1> }", SHAPE_SUPERELLIPSOID, 4 * M_PI, 0.5, 1, 0.25);
+    check_crofton("julia_fractal { <0,0,0,0> quaternion sqr max_iteration 20 precision 50 }", SHAPE_JULIA, 4 * M_PI, 0.5, 1, 0.25);
+}
+
 /* parametric grids for GI: vertices on the surface with outward normals,
  * total area close to the exact one */
 typedef struct {
@@ -1000,7 +1085,11 @@ static int grid_cb(void *ctx, const vec3 p[3], const vec3 n[3])
     for (int k = 0; k < 3; k++) {
         g->verts++;
         if (fabs(v3_len(n[k]) - 1.0) > 1e-9) g->bad += 1000;
-        if (g->inside_checks) {
+        if (g->inside_checks == 2) {
+            /* the vertex on the surface to 1e-9, the normal outward */
+            if (!accel_shape_inside(g->sh, v3_madd(p[k], n[k], -1e-9)) || accel_shape_inside(g->sh, v3_madd(p[k], n[k], 1e-9)))
+                g->bad++;
+        } else if (g->inside_checks) {
             /* back along the normal from just outside: the surface at the vertex */
             /* nudged towards the triangle's centre, off edges and corners */
             vec3 c = v3_scale(v3_add(v3_add(p[0], p[1]), p[2]), 1.0 / 3.0);
@@ -1042,6 +1131,13 @@ static void test_grid(void **st)
     check_grid("polygon { 10, <-2,-2>, <2,-2>, <2,2>, <-2,2>, <-2,-2>, <-1,-1>, <1,-1>, <1,1>, <-1,1>, <-1,-1> }", 0,
                12.0, 1e-12);
     check_grid("superellipsoid { <1, 1> }", 1, 4 * M_PI, 5e-3);
+    /* marching tetrahedra (accel_tess.h), 16 cells across: the inscribed
+     * triangles' area falls short by O(h^2); 2% at this resolution */
+    double d = 2.0 * sqrt(1.0 - sqrt(0.5));
+    check_grid("blob { threshold 0.5 sphere { <0,0,0>, 2, 1 } }", 2, 4 * M_PI * d * d, 2e-2);
+    check_grid("quadric { <1,1,0.25>, <0,0,0>, <0,0,0>, -1 }", 2, 2 * M_PI * (1 + 2 / sqrt(0.75) * asin(sqrt(0.75))), 2e-2);
+    check_grid("isosurface { function { x*x + y*y + z*z - 1 } contained_by { box { -2, 2 } } max_gradient 8 }", 2, 4 * M_PI, 2e-2);
+    check_grid("julia_fractal { <0,0,0,0> quaternion sqr max_iteration 20 precision 50 }", 2, 4 * M_PI, 2e-2);
     if (access("/usr/share/povray-3.7/include/timrom.ttf", R_OK) == 0) {
         world w = build("text { ttf \"timrom.ttf\" \"O\" 0.2, 0 }");
         accel_shape sh = shape_of(&w);
@@ -1148,6 +1244,7 @@ int main(void)
         cmocka_unit_test(test_julia),
         cmocka_unit_test(test_surface_sampling),
         cmocka_unit_test(test_sweep_sampling),
+        cmocka_unit_test(test_implicit_sampling),
         cmocka_unit_test(test_grid),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_unsupported),
