@@ -208,6 +208,8 @@ void sdl_array_resolve(sdl_parser *p, sdl_tok *t)
         }
         t->val = a->elems[i];
         t->elem = 1;
+        t->elem_arr = (sdl_array *)a;
+        t->elem_idx = i;
     }
 }
 

@@ -4,6 +4,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#include <limits.h>
 #include "sdl_array.h"
 #include "sdl_directive.h"
 #include "sdl_function.h"
@@ -21,6 +23,8 @@ static void factor(sdl_parser *p, ex_val *out);
 static void expression(sdl_parser *p, ex_val *out);
 static void sum(sdl_parser *p, ex_val *out);
 static const char *string_expr(sdl_parser *p);
+static unsigned utf8_at(const char **ps);
+static long utf8_len(const char *s);
 
 int sdl_true(double x) { return fabs(x) > SDL_EPSILON; }
 
@@ -314,14 +318,19 @@ static double string_float_fn(sdl_parser *p, sdl_kw k)
     if (k == KW_STRCMP) {
         sdl_accept(p, TOK_COMMA);
         const char *b = string_expr(p);
-        int c = strcmp(a, b);
-        v = c < 0 ? -1 : (c > 0 ? 1 : 0);
+        /* POV-Ray's UCS2_strcmp: the difference of the first differing codes */
+        unsigned ca, cb;
+        do {
+            ca = utf8_at(&a);
+            cb = utf8_at(&b);
+        } while (ca == cb && ca != 0);
+        v = (double)ca - (double)cb;
     } else if (k == KW_STRLEN) {
-        v = (double)strlen(a);
+        v = (double)utf8_len(a);
     } else if (k == KW_VAL) {
         v = atof(a);
     } else if (k == KW_ASC) {
-        v = (unsigned char)a[0];
+        v = utf8_at(&a);
     } else {
         v = sdl_file_exists(p, a);
     }
@@ -414,7 +423,12 @@ static double float_function(sdl_parser *p, sdl_kw k, src_loc loc)
     case KW_CLOCK: return p->opt.clock;
     case KW_CLOCK_ON: return 0;
     case KW_VERSION: return p->version;
-    case KW_NOW: return 0;
+    case KW_NOW: {
+        /* days since 2000-01-01 00:00 UTC, to the microsecond (POV-Ray 3.7) */
+        struct timespec ts;
+        timespec_get(&ts, TIME_UTC);
+        return ((double)ts.tv_sec - 946684800.0 + (double)(ts.tv_nsec / 1000) * 1e-6) / 86400.0;
+    }
     case KW_MIN: case KW_MAX: case KW_BITWISE_AND: case KW_BITWISE_OR: case KW_BITWISE_XOR:
         return float_list_param(p, k);
     case KW_SELECT: return select_fn(p);
@@ -930,6 +944,30 @@ static char *concat2(sdl_parser *p, const char *a, const char *b)
     return s;
 }
 
+/* POV-Ray 3.7's number formatting for str() and vstr() (Parse_Str): width
+ * w > 0 gives "%wf", w < 0 "%0|w|f" (zero padded), w = 0 no width;
+ * precision d >= 0 gives ".d", d < 0 printf's default (6). A value whose %f
+ * text does not fit POV-Ray's 256-byte buffer is written with %g instead. */
+static void pov_number(char *out, size_t cap, double v, int w, int d)
+{
+    char fmt[64];
+    int o = 0;
+    fmt[o++] = '%';
+    if (w > 0) o += snprintf(fmt + o, sizeof fmt - (size_t)o, "%d", w);
+    else if (w < 0) o += snprintf(fmt + o, sizeof fmt - (size_t)o, "0%d", w == INT_MIN ? INT_MAX : -w);
+    if (d >= 0) o += snprintf(fmt + o, sizeof fmt - (size_t)o, ".%d", d);
+    fmt[o] = 'f';
+    fmt[o + 1] = 0;
+    char buf[256];
+    int n = snprintf(buf, sizeof buf - 1, fmt, v);
+    if (n < 0 || n >= (int)sizeof buf - 1) {
+        fmt[o] = 'g';
+        n = snprintf(buf, sizeof buf - 1, fmt, v);
+        if (n < 0 || n >= (int)sizeof buf - 1) snprintf(buf, sizeof buf, "<invalid>");
+    }
+    snprintf(out, cap, "%s", buf);
+}
+
 /* str '(' float ',' width ',' precision ')' */
 static const char *str_fn(sdl_parser *p)
 {
@@ -940,25 +978,23 @@ static const char *str_fn(sdl_parser *p)
     sdl_accept(p, TOK_COMMA);
     int prec = sdl_to_int(sdl_float(p));
     sdl_expect(p, TOK_RPAREN, "')'");
-    char buf[128];
-    if (prec < 0) prec = 6; /* POV-Ray: negative precision = as needed (up to 6) */
-    if (w < 0)
-        snprintf(buf, sizeof buf, "%0*.*f", -w > 60 ? 60 : -w, prec > 30 ? 30 : prec, v);
-    else
-        snprintf(buf, sizeof buf, "%*.*f", w > 60 ? 60 : w, prec > 30 ? 30 : prec, v);
+    char buf[256];
+    pov_number(buf, sizeof buf, v, w, prec);
     return sdl_strndup(p, buf, strlen(buf));
 }
 
-/* vstr '(' dims ',' vector ',' separator ',' width ',' precision ')' */
+/* vstr '(' dims ',' vector ',' separator ',' width ',' precision ')'.
+ * The vector is read as POV-Ray's Parse_Unknown_Vector reads it (a sum, no
+ * promotion): a float fills the first term only, missing terms are 0. */
 static const char *vstr_fn(sdl_parser *p)
 {
     sdl_expect(p, TOK_LPAREN, "'('");
     int n = sdl_to_int(sdl_float(p));
     sdl_accept(p, TOK_COMMA);
-    double v[5];
     if (n < 2) n = 2;
     if (n > 5) n = 5;
-    sdl_vector_n(p, v, n);
+    ex_val e;
+    sum(p, &e);
     sdl_accept(p, TOK_COMMA);
     const char *sep = string_expr(p);
     sdl_accept(p, TOK_COMMA);
@@ -966,17 +1002,48 @@ static const char *vstr_fn(sdl_parser *p)
     sdl_accept(p, TOK_COMMA);
     int prec = sdl_to_int(sdl_float(p));
     sdl_expect(p, TOK_RPAREN, "')'");
-    if (prec < 0) prec = 6;
-    char buf[512];
-    size_t o = 0;
-    for (int i = 0; i < n && o < sizeof buf - 80; i++) {
-        if (i) o += (size_t)snprintf(buf + o, sizeof buf - o, "%.20s", sep);
-        o += (size_t)snprintf(buf + o, sizeof buf - o, "%*.*f", w > 60 ? 60 : (w < 0 ? 0 : w), prec > 30 ? 30 : prec, v[i]);
+    if (!sdl_ok(p)) return "";
+    const char *out = "";
+    for (int i = 0; i < n; i++) {
+        char buf[256];
+        pov_number(buf, sizeof buf, i < e.n ? e.v[i] : 0.0, w, prec);
+        if (i) out = concat2(p, out, sep);
+        out = concat2(p, out, buf);
     }
-    return sdl_strndup(p, buf, o);
+    return out;
 }
 
-/* substr '(' string ',' start ',' length ')'  (start is 1-based) */
+/* Strings are UTF-8 inside the parser; POV-Ray's are UCS-2, so lengths,
+ * positions and character codes count code points. */
+static unsigned utf8_at(const char **ps)
+{
+    const unsigned char *s = (const unsigned char *)*ps;
+    unsigned c = s[0];
+    int n = c >= 0xF0 ? 3 : c >= 0xE0 ? 2 : c >= 0xC0 ? 1 : 0;
+    for (int i = 1; i <= n; i++)
+        if ((s[i] & 0xC0) != 0x80) n = 0;
+    if (n == 0) {
+        *ps += c ? 1 : 0;
+        return c;
+    }
+    c &= 0x3Fu >> n;
+    for (int i = 1; i <= n; i++) c = (c << 6) | (s[i] & 0x3Fu);
+    *ps += n + 1;
+    return c;
+}
+
+static long utf8_len(const char *s)
+{
+    long n = 0;
+    while (*s) {
+        utf8_at(&s);
+        n++;
+    }
+    return n;
+}
+
+/* substr '(' string ',' start ',' length ')'  (start is 1-based; POV-Ray's
+ * check: start + length - 1 <= strlen, start >= 0, length >= 0) */
 static const char *substr_fn(sdl_parser *p, src_loc loc)
 {
     sdl_expect(p, TOK_LPAREN, "'('");
@@ -986,12 +1053,80 @@ static const char *substr_fn(sdl_parser *p, src_loc loc)
     sdl_accept(p, TOK_COMMA);
     int len = sdl_to_int(sdl_float(p));
     sdl_expect(p, TOK_RPAREN, "')'");
-    int n = (int)strlen(s);
-    if (start < 1 || len < 0 || start - 1 + len > n) {
+    if (!sdl_ok(p)) return "";
+    long n = utf8_len(s);
+    if (start < 1 || len < 0 || (long)start - 1 + len > n) {
+        /* POV-Ray lets start 0 through and reads before the string */
         sdl_error(p, loc, PT_ERR_SYNTAX, "illegal parameters in substr");
         return "";
     }
-    return sdl_strndup(p, s + start - 1, (size_t)len);
+    const char *a = s;
+    for (int i = 1; i < start; i++) utf8_at(&a);
+    const char *b = a;
+    for (int i = 0; i < len; i++) utf8_at(&b);
+    return sdl_strndup(p, a, (size_t)(b - a));
+}
+
+/* chr '(' float ')': code 0..65535 (POV-Ray's UCS-2 range), kept as UTF-8 */
+static const char *chr_fn(sdl_parser *p, src_loc loc)
+{
+    int c = sdl_to_int(sdl_float_param(p));
+    if (!sdl_ok(p)) return "";
+    if (c < 0 || c > 65535) {
+        sdl_error(p, loc, PT_ERR_SYNTAX, "value %d cannot be used in chr(...)", c);
+        return "";
+    }
+    char b[4];
+    size_t n;
+    if (c < 0x80) {
+        b[0] = (char)c;
+        n = 1;
+    } else if (c < 0x800) {
+        b[0] = (char)(0xC0 | (c >> 6));
+        b[1] = (char)(0x80 | (c & 0x3F));
+        n = 2;
+    } else {
+        b[0] = (char)(0xE0 | (c >> 12));
+        b[1] = (char)(0x80 | ((c >> 6) & 0x3F));
+        b[2] = (char)(0x80 | (c & 0x3F));
+        n = 3;
+    }
+    return sdl_strndup(p, b, n);
+}
+
+/* datetime '(' days [',' format] ')': days since 2000-01-01 00:00 UTC,
+ * rounded to the second, formatted by strftime in UTC (POV-Ray 3.7's
+ * Parse_Datetime: default format "%Y-%m-%d %H:%M:%SZ", at most 200 bytes,
+ * an empty format or an empty result is an error). */
+static const char *datetime_fn(sdl_parser *p, src_loc loc)
+{
+    sdl_expect(p, TOK_LPAREN, "'('");
+    double days = sdl_float(p);
+    sdl_accept(p, TOK_COMMA);
+    const char *fmt = "%Y-%m-%d %H:%M:%SZ";
+    if (!sdl_is(sdl_peek(p), TOK_RPAREN)) {
+        fmt = string_expr(p);
+        if (sdl_ok(p) && fmt[0] == 0) sdl_error(p, loc, PT_ERR_SYNTAX, "empty format string in datetime");
+        if (sdl_ok(p) && strlen(fmt) > 200) sdl_error(p, loc, PT_ERR_SYNTAX, "format string of datetime too long (more than 200 characters)");
+    }
+    sdl_expect(p, TOK_RPAREN, "')'");
+    if (!sdl_ok(p)) return "";
+    /* 10957 days from 1970-01-01 to 2000-01-01 (365*30+7 in POV-Ray) */
+    double secs = floor((days + 10957.0) * 86400.0 + 0.5);
+    if (!(fabs(secs) < 1e15)) {
+        sdl_error(p, loc, PT_ERR_SYNTAX, "date out of range in datetime");
+        return "";
+    }
+    time_t ts = (time_t)secs;
+    struct tm tm;
+    char buf[201];
+    size_t n = 0;
+    if (gmtime_r(&ts, &tm)) n = strftime(buf, 200, fmt, &tm);
+    if (n == 0 || n >= 200) {
+        sdl_error(p, loc, PT_ERR_SYNTAX, "invalid formatting code in datetime's format string, or the result is too long");
+        return "";
+    }
+    return sdl_strndup(p, buf, n);
 }
 
 /* string_function: concat chr str substr strupr strlwr vstr */
@@ -1005,12 +1140,8 @@ static const char *string_function(sdl_parser *p, const sdl_tok *t)
         sdl_expect(p, TOK_RPAREN, "')'");
         return s;
     }
-    case KW_CHR: {
-        char b[8];
-        int c = sdl_to_int(sdl_float_param(p));
-        b[0] = (char)(c > 0 && c < 256 ? c : '?');
-        return sdl_strndup(p, b, 1);
-    }
+    case KW_CHR: return chr_fn(p, t->tk.loc);
+    case KW_DATETIME: return datetime_fn(p, t->tk.loc);
     case KW_STR: return str_fn(p);
     case KW_VSTR: return vstr_fn(p);
     case KW_SUBSTR: return substr_fn(p, t->tk.loc);

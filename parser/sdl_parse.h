@@ -23,6 +23,8 @@ typedef struct {
     sdl_token tk;
     sdl_value val;
     int elem;             /* an array element: val is the element's value */
+    struct sdl_array *elem_arr; /* the element's array and index (elem != 0), */
+    long elem_idx;        /* so a macro can take the element by reference */
 } sdl_tok;
 
 /* A loaded file; kept until the parse ends (macro bodies point into it). */
