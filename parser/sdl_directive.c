@@ -800,6 +800,10 @@ static void declare_directive(sdl_parser *p, int local)
     p->defer += expression;
     sdl_rvalue(p, &v);
     p->defer += !expression;
+    if (!arr && target.elem_owner) { /* a parameter that stands for an array element */
+        arr = target.elem_owner;
+        index = target.elem_index;
+    }
     if (arr) {
         sdl_array_set(p, arr, index, &v, at);
     } else {
@@ -927,14 +931,36 @@ static void macro_directive(sdl_parser *p, src_loc loc)
     skip_tokens(p, SKIP_TO_END, 0, "#macro", loc);
 }
 
-/* macro_argument := identifier | rvalue ; an identifier standing alone (a
- * ',' or ')' follows) is passed by reference, except a function (POV-Ray 3.7
- * Parse_RValue): #declare of the parameter inside the macro assigns the
- * caller's identifier. *ref is set for a reference. */
-static void macro_argument(sdl_parser *p, const sdl_macro *m, sdl_value *arg, sdl_symref **ref)
+/* A macro argument passed by reference: an identifier (ref) or an array
+ * element (arr, index). */
+typedef struct {
+    sdl_symref *ref;
+    sdl_array *arr;
+    long index;
+} macro_ref;
+
+/* macro_argument := identifier | element | rvalue ; an identifier or an
+ * array element standing alone (a ',' or ')' follows) is passed by
+ * reference, except a function (POV-Ray 3.7 Parse_RValue, which keeps the
+ * element's slot too): #declare or #local of the parameter inside the macro
+ * assigns the caller's identifier or element. The element keeps the
+ * array's type: 3.7 lets the parameter change it (Test_Redefine) and then
+ * reads every element of the array as the new type; here that is an error. */
+static void macro_argument(sdl_parser *p, const sdl_macro *m, sdl_value *arg, macro_ref *r)
 {
-    *ref = NULL;
+    memset(r, 0, sizeof *r);
     const sdl_tok *t = sdl_peek(p);
+    if (t->tk.kind == TOK_IDENT && t->elem && t->elem_arr && t->val.kind != VAL_FUNCTION) {
+        sdl_tok el = sdl_next(p);
+        sdl_tok_kind after = sdl_peek(p)->tk.kind;
+        if (after == TOK_COMMA || after == TOK_RPAREN) {
+            *arg = el.val;
+            r->arr = el.elem_arr;
+            r->index = el.elem_idx;
+            return;
+        }
+        sdl_unget(p, &el);
+    }
     if (t->tk.kind == TOK_IDENT && !t->elem && t->val.kind != VAL_FUNCTION) {
         sdl_tok id = sdl_next(p);
         sdl_tok_kind after = sdl_peek(p)->tk.kind;
@@ -945,7 +971,7 @@ static void macro_argument(sdl_parser *p, const sdl_macro *m, sdl_value *arg, sd
                 return;
             }
             *arg = id.val;
-            *ref = sdl_symtab_ref(p->sym, id.tk.text, (size_t)id.tk.len);
+            r->ref = sdl_symtab_ref(p->sym, id.tk.text, (size_t)id.tk.len);
             return;
         }
         sdl_unget(p, &id);
@@ -954,20 +980,20 @@ static void macro_argument(sdl_parser *p, const sdl_macro *m, sdl_value *arg, sd
 }
 
 /* macro_call := macro_identifier '(' [ macro_argument { [','] macro_argument } [','] ] ')' */
-static void macro_invoke(sdl_parser *p, const sdl_tok *id, sdl_value *args, sdl_symref **refs);
+static void macro_invoke(sdl_parser *p, const sdl_tok *id, sdl_value *args, macro_ref *refs);
 
 static void macro_call(sdl_parser *p, const sdl_tok *id)
 {
     /* argument storage lives only until the parameters are bound */
     sdl_value *args = malloc(sizeof(sdl_value) * 64);
-    sdl_symref **refs = malloc(sizeof(sdl_symref *) * 64);
+    macro_ref *refs = malloc(sizeof(macro_ref) * 64);
     if (args && refs) macro_invoke(p, id, args, refs);
     else sdl_error(p, id->tk.loc, PT_ERR_NOMEM, "out of memory");
     free(args);
     free(refs);
 }
 
-static void macro_invoke(sdl_parser *p, const sdl_tok *id, sdl_value *args, sdl_symref **refs)
+static void macro_invoke(sdl_parser *p, const sdl_tok *id, sdl_value *args, macro_ref *refs)
 {
     const sdl_macro *m = id->val.ptr;
     int n = 0;
@@ -995,8 +1021,15 @@ static void macro_invoke(sdl_parser *p, const sdl_tok *id, sdl_value *args, sdl_
     if (!push_cond(p, COND_MACRO, id->tk.loc) || !sdl_symtab_push(p->sym)) return;
     for (int i = 0; i < n; i++) {
         size_t len = strlen(m->params[i]);
-        if (refs[i]) sdl_symtab_alias(p->sym, m->params[i], len, refs[i]);
-        else sdl_symtab_local(p->sym, m->params[i], len, &args[i]);
+        int ok;
+        if (refs[i].ref) ok = sdl_symtab_alias(p->sym, m->params[i], len, refs[i].ref);
+        else if (refs[i].arr)
+            ok = sdl_symtab_alias_elem(p->sym, m->params[i], len, &refs[i].arr->elems[refs[i].index], refs[i].arr, refs[i].index);
+        else ok = sdl_symtab_local(p->sym, m->params[i], len, &args[i]);
+        if (!ok) {
+            sdl_error(p, id->tk.loc, PT_ERR_NOMEM, "out of memory");
+            return;
+        }
     }
     if (!push_frame(p, FRAME_MACRO, m->src, id->tk.loc, m->name)) return;
     sdl_scan_seek(&top_frame(p)->sc, m->body);
@@ -1160,6 +1193,8 @@ sdl_tok sdl_next(sdl_parser *p)
         sdl_tok t;
         t.val.kind = VAL_NONE;
         t.elem = 0;
+        t.elem_arr = NULL;
+        t.elem_idx = 0;
         int take;
         if (p->nahead > 0) {
             t = p->ahead[--p->nahead];

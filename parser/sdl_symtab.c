@@ -9,6 +9,9 @@ typedef struct sym_entry {
     struct sym_entry *hnext;     /* hash chain, innermost scope first */
     struct sym_entry *snext;     /* entries of the same scope */
     struct sym_entry *alias;     /* by-reference macro parameter: the caller's entry */
+    sdl_value *slot;             /* by-reference array element: its storage, */
+    void *owner;                 /* its array (opaque) and index */
+    long index;
     int depth;
     size_t len;                  /* strlen(name) */
     char *name;
@@ -132,7 +135,15 @@ static sym_entry *resolve(sym_entry *e)
 const sdl_value *sdl_symtab_find(const sdl_symtab *t, const char *name, size_t n)
 {
     sym_entry *e = resolve(find_entry(t, name, n));
+    if (e && e->slot) return e->slot->kind != VAL_NONE ? e->slot : NULL;
     return e && e->val.kind != VAL_NONE ? &e->val : NULL;
+}
+
+/* Store v in the entry (or in the element it stands for). */
+static void store(sym_entry *e, const sdl_value *v)
+{
+    if (e->slot) *e->slot = *v;
+    else e->val = *v;
 }
 
 /* Insert a new entry at `depth`. Hash chains stay ordered innermost first. */
@@ -163,7 +174,7 @@ int sdl_symtab_declare(sdl_symtab *t, const char *name, size_t n, const sdl_valu
 {
     sym_entry *e = resolve(find_entry(t, name, n));
     if (e) {
-        e->val = *v;
+        store(e, v);
         return 1;
     }
     return insert_entry(t, name, n, 0, v);
@@ -173,7 +184,7 @@ int sdl_symtab_local(sdl_symtab *t, const char *name, size_t n, const sdl_value 
 {
     sym_entry *e = find_entry(t, name, n);
     if (e && e->depth == t->depth) {
-        resolve(e)->val = *v;
+        store(resolve(e), v);
         return 1;
     }
     return insert_entry(t, name, n, t->depth, v);
@@ -187,6 +198,7 @@ int sdl_symtab_undef(sdl_symtab *t, const char *name, size_t n)
     /* kept (undefined) for aliases that may still point at it */
     memset(&e->val, 0, sizeof e->val);
     e->alias = NULL;
+    e->slot = NULL;
     e->hnext = NULL;
     e->snext = t->undefined;
     t->undefined = e;
@@ -207,8 +219,25 @@ int sdl_symtab_alias(sdl_symtab *t, const char *name, size_t n, sdl_symref *targ
         if (!insert_entry(t, name, n, t->depth, &none)) return 0;
         e = find_entry(t, name, n);
     }
+    e->slot = NULL;
     e->alias = resolve(target);
     if (e->alias == e) e->alias = NULL;
+    return 1;
+}
+
+int sdl_symtab_alias_elem(sdl_symtab *t, const char *name, size_t n, sdl_value *slot, void *owner, long index)
+{
+    sdl_value none;
+    memset(&none, 0, sizeof none);
+    sym_entry *e = find_entry(t, name, n);
+    if (!e || e->depth != t->depth) {
+        if (!insert_entry(t, name, n, t->depth, &none)) return 0;
+        e = find_entry(t, name, n);
+    }
+    e->alias = NULL;
+    e->slot = slot;
+    e->owner = owner;
+    e->index = index;
     return 1;
 }
 
@@ -233,6 +262,11 @@ sdl_symtarget sdl_symtab_target(const sdl_symtab *t, const char *name, size_t n,
         tg.depth = 0;
     }
     tg.scope = t->ids[tg.depth];
+    sym_entry *r = resolve(tg.entry);
+    if (r && r->slot) {
+        tg.elem_owner = r->owner;
+        tg.elem_index = r->index;
+    }
     return tg;
 }
 
@@ -240,7 +274,7 @@ int sdl_symtab_assign(sdl_symtab *t, const sdl_symtarget *tg, const char *name, 
 {
     if (tg->depth > t->depth || t->ids[tg->depth] != tg->scope) return -1; /* the scope has ended */
     if (tg->entry) {
-        resolve(tg->entry)->val = *v;
+        store(resolve(tg->entry), v);
         return 1;
     }
     sym_entry *e = find_entry(t, name, n);
@@ -250,7 +284,7 @@ int sdl_symtab_assign(sdl_symtab *t, const sdl_symtarget *tg, const char *name, 
         e = o;
     }
     if (e && e->depth == tg->depth) {
-        resolve(e)->val = *v;
+        store(resolve(e), v);
         return 1;
     }
     return insert_entry(t, name, n, tg->depth, v);

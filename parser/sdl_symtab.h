@@ -67,6 +67,11 @@ int sdl_symtab_undef(sdl_symtab *t, const char *name, size_t n);
 typedef struct sym_entry sdl_symref;
 sdl_symref *sdl_symtab_ref(const sdl_symtab *t, const char *name, size_t n);
 int sdl_symtab_alias(sdl_symtab *t, const char *name, size_t n, sdl_symref *target);
+/* A parameter that stands for an array element (POV-Ray 3.7 passes `M(A[i])`
+ * by reference too): reading `name` reads *slot; a #declare/#local of it is
+ * reported by sdl_symtab_target (elem_owner, elem_index) so that the caller
+ * stores the value with the array's type rule. owner is opaque here. */
+int sdl_symtab_alias_elem(sdl_symtab *t, const char *name, size_t n, sdl_value *slot, void *owner, long index);
 /* Where a #declare/#local assigns, resolved when the directive starts (as
  * POV-Ray does): parsing the value may call macros or leave the current
  * macro, so the scope is remembered by identity. local: the innermost
@@ -75,6 +80,8 @@ typedef struct {
     sdl_symref *entry;    /* the entry to assign (NULL: create one) */
     int depth;
     unsigned long scope;  /* serial number of the scope at `depth` */
+    void *elem_owner;     /* non-NULL: the target is element elem_index of */
+    long elem_index;      /* this array (sdl_symtab_alias_elem) */
 } sdl_symtarget;
 sdl_symtarget sdl_symtab_target(const sdl_symtab *t, const char *name, size_t n, int local);
 /* Assign v to the target: 1 done, 0 out of memory, -1 the target's scope has
