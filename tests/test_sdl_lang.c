@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 #include "func.h"
 #include "scene.h"
@@ -114,6 +115,50 @@ static void test_lang_checks(void **st)
     assert_true(n >= 50);
     assert_int_equal(bad, 0);
     scene_free(s);
+    diag_free(d);
+}
+
+/* String functions and macro arguments by reference (identifiers and array
+ * elements): every #debug line must equal POV-Ray 3.7.0's byte for byte
+ * (tests/sdl/strings.expected). `now` cannot be compared with a file: it
+ * must be the days since 2000-01-01 UTC within a second of the clock. */
+static void test_strings(void **st)
+{
+    (void)st;
+    char path[1024], exp[1024];
+    snprintf(path, sizeof path, "%s/sdl/strings.pov", PT_TESTS_DIR);
+    snprintf(exp, sizeof exp, "%s/sdl/strings.expected", PT_TESTS_DIR);
+    FILE *f = fopen(exp, "r");
+    assert_non_null(f);
+    diag *d = diag_new();
+    scene *s = NULL;
+    pt_status rc = sdl_parse_file(path, NULL, &s, d);
+    if (rc != PT_OK) print_diag(d);
+    assert_int_equal(rc, PT_OK);
+    char line[1024];
+    int n = 0, bad = 0;
+    while (fgets(line, sizeof line, f)) {
+        line[strcspn(line, "\n")] = 0;
+        const char *got = note(d, n);
+        if (!got || strcmp(got, line) != 0) {
+            print_message("line %d: partray \"%s\"\n         POV-Ray \"%s\"\n", n + 1, got ? got : "(none)", line);
+            bad++;
+        }
+        n++;
+    }
+    fclose(f);
+    assert_true(n >= 20);
+    assert_null(note(d, n)); /* no extra lines either */
+    assert_int_equal(bad, 0);
+    scene_free(s);
+    diag_free(d);
+
+    double t0 = ((double)time(NULL) - 946684800.0) / 86400.0;
+    d = parse_text("#debug str(now, 0, 9)\n#debug datetime(now, \"%Y\")\n", NULL, PT_OK, NULL);
+    double t1 = ((double)time(NULL) - 946684800.0) / 86400.0;
+    double now = atof(note(d, 0));
+    assert_true(now >= t0 - 1.0 / 86400 && now <= t1 + 1.0 / 86400);
+    assert_true(atoi(note(d, 1)) >= 2024);
     diag_free(d);
 }
 
@@ -517,6 +562,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_lang_checks),
+        cmocka_unit_test(test_strings),
         cmocka_unit_test(test_arrays_ir),
         cmocka_unit_test(test_macros),
         cmocka_unit_test(test_functions_ir),
