@@ -1,11 +1,11 @@
-/* sdl_hfimage.h - height_field images: PNG (libpng), GIF and POT (own LZW
- * decoder) and PGM/PPM (P2, P3, P5, P6), read into POV-Ray's 16-bit heights
- * (its image_height_at; POT: index of the left half * 256 + index of the
- * right half):
- * greyscale value * 65535, palette index * 256, 8-bit colour red * 256 +
- * green (the "high byte / low byte" convention), 16-bit colour the grey
- * value 0.297 r + 0.589 g + 0.114 b times 65535. Other formats (TGA,
- * JPEG, TIFF, IFF, EXR, HDR, sys) are reported as unsupported. */
+/* sdl_hfimage.h - height_field images, decoded by the one image reader
+ * (sdl_imgread.h: PNG, GIF, TGA, PGM/PPM, JPEG, TIFF; POT = a GIF named
+ * .pot) and read into POV-Ray's 16-bit heights (its image_height_at; POT:
+ * index of the left half * 256 + index of the right half): greyscale value
+ * * 65535, palette index * 256, 8-bit colour red * 256 + green (the "high
+ * byte / low byte" convention), 16-bit colour the grey value 0.297 r +
+ * 0.589 g + 0.114 b times 65535. Other formats (IFF, EXR, HDR, BMP, sys)
+ * are reported as unsupported. */
 #ifndef PT_SDL_HFIMAGE_H
 #define PT_SDL_HFIMAGE_H
 #include <stddef.h>

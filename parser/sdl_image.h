@@ -1,6 +1,7 @@
 /* sdl_image.h - images for image_map / image_pattern, read at parse time as
- * POV-Ray does: PNG through libpng (any bit depth, grey, palette, RGB, with
- * alpha or tRNS), decoded to linear RGBFT with POV-Ray 3.7's gamma rules. */
+ * POV-Ray does: PNG, GIF, TGA, PGM/PPM, JPEG or TIFF through the one image
+ * reader (sdl_imgread.h), decoded to linear RGBFT with POV-Ray 3.7's gamma
+ * rules (formats without gamma information: sRGB). */
 #ifndef PT_SDL_IMAGE_H
 #define PT_SDL_IMAGE_H
 #include <stddef.h>

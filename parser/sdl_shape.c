@@ -599,28 +599,73 @@ static void blob_args(sdl_parser *p, scene_object *o, src_loc loc)
 
 /* height_field := [ file_type ] file_name { water_level float | smooth [bool] | hierarchy [bool] }
  * file_type := png | pgm | ppm | gif | tga | iff | jpeg | tiff | sys | pot | exr | hdr | bmp | function ... */
+/* height_field { function W, H { ... } }: POV-Ray 3.7 (its
+ * Make_Pattern_Image) evaluates the function at x = j / (W - 1),
+ * y = i / (H - 1), z = 0 into row i, column j of a 16-bit grey image (a
+ * pigment function: its colour's grey value), which the height field then
+ * reads as it reads a file (row 0 = the top of the image). */
+static unsigned short *function_heights(sdl_parser *p, src_loc loc, int *wp, int *hp)
+{
+    double fw = sdl_float(p);
+    sdl_accept(p, TOK_COMMA);
+    double fh = sdl_float(p);
+    src_loc at = sdl_peek(p)->tk.loc;
+    const scene_function *fn = sdl_parse_function(p, at, NULL);
+    if (!sdl_ok(p) || !fn) return NULL;
+    if (!(fw >= 1.5 && fh >= 1.5 && fw < 65536.5 && fh < 65536.5) || (int)(fw + 0.5) * (double)(int)(fh + 0.5) > (double)(1 << 26)) {
+        sdl_error(p, loc, PT_ERR_SYNTAX, "height_field function size %gx%g out of range (2 to 65536 a side, 2^26 samples)", fw, fh);
+        return NULL;
+    }
+    int w = (int)(fw + 0.5), h = (int)(fh + 0.5);
+    unsigned short *v = malloc(sizeof *v * (size_t)w * (size_t)h);
+    if (!v) {
+        sdl_error(p, loc, PT_ERR_NOMEM, "out of memory for a %dx%d height_field function", w, h);
+        return NULL;
+    }
+    for (int i = 0; i < h; i++)
+        for (int j = 0; j < w; j++) {
+            double args[FUNC_MAX_PARAMS] = {0}, out[8] = {0};
+            args[0] = (double)j / (w - 1);
+            args[1] = (double)i / (h - 1);
+            const char *why = NULL;
+            if (func_eval(fn, args, out, p->opt.func_env, &why) != PT_OK) {
+                free(v);
+                sdl_error(p, loc, PT_ERR_UNSUPPORTED, "height_field function: %s cannot be evaluated at parse time",
+                          why ? why : "the function");
+                return NULL;
+            }
+            double g = fn->nterms >= 3 ? 0.297 * out[0] + 0.589 * out[1] + 0.114 * out[2] : out[0];
+            if (!(g > 0.0)) g = 0.0; /* NaN too */
+            if (g > 1.0) g = 1.0;
+            v[(size_t)i * w + j] = (unsigned short)(g * 65535.0 + 0.5);
+        }
+    *wp = w;
+    *hp = h;
+    return v;
+}
+
+/* height_field := [ file_type ] file_name { water_level float | smooth [bool] | hierarchy [bool] }
+ *               | function W, H { function_body } { ... }
+ * file_type := png | pgm | ppm | gif | tga | iff | jpeg | tiff | sys | pot | exr | hdr | bmp */
 static void height_field_args(sdl_parser *p, scene_object *o, src_loc loc)
 {
     const sdl_tok *t = sdl_peek(p);
-    int is_function = 0;
-    const char *ext = NULL;
+    sdl_hf_image img;
+    memset(&img, 0, sizeof img);
+    int have = 0;
+    const char *ext = NULL, *name = "function";
     if (t->tk.kind == TOK_KEYWORD && !sdl_starts_string(t)) {
         sdl_kw type = sdl_next(p).tk.kw;
-        ext = type == KW_PNG ? ".png" : type == KW_PGM ? ".pgm" : type == KW_PPM ? ".ppm" : type == KW_GIF ? ".gif" : type == KW_POT ? ".pot" : NULL;
+        ext = type == KW_PNG ? ".png" : type == KW_PGM ? ".pgm" : type == KW_PPM ? ".ppm" : type == KW_GIF ? ".gif"
+            : type == KW_POT ? ".pot" : type == KW_TGA ? ".tga" : type == KW_JPEG ? ".jpg" : type == KW_TIFF ? ".tif"
+            : NULL;
         if (type == KW_FUNCTION) {
-            is_function = 1;
-            /* function W, H { pigment/expression }: needs pattern evaluation */
-            sdl_float(p);
-            sdl_accept(p, TOK_COMMA);
-            sdl_float(p);
-            if (sdl_begin_block(p, "function")) sdl_skip_block(p);
-            o->kind = SHAPE_UNSUPPORTED;
-            o->name = "height_field function";
-            sdl_warn_once(p, loc, "height_field from a function is not supported yet; it is skipped");
+            img.values = function_heights(p, loc, &img.width, &img.height);
+            if (!img.values) return;
+            have = 1;
         }
     }
-    const char *name = NULL;
-    if (!is_function) name = sdl_string(p);
+    if (!have) name = sdl_string(p);
     double water = 0.0;
     int smooth = 0;
     while (sdl_ok(p)) {
@@ -629,25 +674,29 @@ static void height_field_args(sdl_parser *p, scene_object *o, src_loc loc)
         else if (sdl_accept_kw(p, KW_HIERARCHY)) sdl_allow_float(p, 1.0);
         else break;
     }
-    if (!sdl_ok(p) || is_function) return;
-    char *path = find_data_file(p, name, ext);
-    if (!path) {
-        sdl_error(p, loc, PT_ERR_IO, "height_field image '%s' not found", name ? name : "");
+    if (!sdl_ok(p)) {
+        free(img.values);
         return;
     }
-    sdl_hf_image img;
-    char why[256] = "";
-    int r = sdl_hf_read(path, &img, why, sizeof why);
-    free(path);
-    if (r == SDL_HF_UNSUPPORTED) {
-        o->kind = SHAPE_UNSUPPORTED;
-        o->name = "height_field";
-        sdl_warn_once(p, loc, "height_field image '%s': %s; the height field is skipped", name, why);
-        return;
-    }
-    if (r != SDL_HF_OK) {
-        sdl_error(p, loc, PT_ERR_IO, "height_field image '%s': %s", name, why);
-        return;
+    if (!have) {
+        char *path = find_data_file(p, name, ext);
+        if (!path) {
+            sdl_error(p, loc, PT_ERR_IO, "height_field image '%s' not found", name ? name : "");
+            return;
+        }
+        char why[256] = "";
+        int r = sdl_hf_read(path, &img, why, sizeof why);
+        free(path);
+        if (r == SDL_HF_UNSUPPORTED) {
+            o->kind = SHAPE_UNSUPPORTED;
+            o->name = "height_field";
+            sdl_warn_once(p, loc, "height_field image '%s': %s; the height field is skipped", name, why);
+            return;
+        }
+        if (r != SDL_HF_OK) {
+            sdl_error(p, loc, PT_ERR_IO, "height_field image '%s': %s", name, why);
+            return;
+        }
     }
     if (img.width < 2 || img.height < 2) {
         free(img.values);

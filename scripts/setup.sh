@@ -6,7 +6,7 @@ set -eu
 PKGS="build-essential cmake pkg-config
 libembree-dev libopenexr-dev libopencolorio-dev libpng-dev
 ocl-icd-opencl-dev opencl-headers pocl-opencl-icd
-libcmocka-dev libsdl2-dev libfreetype-dev
+libcmocka-dev libsdl2-dev libfreetype-dev libjpeg-dev libtiff-dev libgif-dev
 povray povray-includes povray-examples
 xvfb clang libclang-rt-14-dev valgrind"
 
