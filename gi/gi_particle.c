@@ -50,6 +50,7 @@ struct gi_particle {
     double bounce_flux[GI_MAX_BOUNCES];
     int nbounce_flux;
     int lit;
+    volatile int *cancel; /* gi_particle_set_cancel: non-zero stops the visibility pass */
     /* view */
     float *eind;                 /* n*4: gathered E~/pi */
     atomic_uchar *e_state;       /* 0 none, 1 being computed, 2 done */
@@ -479,6 +480,7 @@ static void vis_chunk(void *ctx, int chunk, int thread)
     (void)thread;
     vis_job *J = ctx;
     gi_particle *gp = J->gp;
+    if (gp->cancel && *gp->cancel) return; /* superseded: the rest of the chunks are skipped */
     const scene *sc = gp->sc;
     int n = gp->ps.n, nl = gp->nlights;
     int i0 = chunk * VIS_CHUNK, i1 = i0 + VIS_CHUNK < n ? i0 + VIS_CHUNK : n;
@@ -597,6 +599,14 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
     J.eps = 1e-6 * (accel_eps_scale(gp->a) > 0.0 ? accel_eps_scale(gp->a) : 1.0);
     atomic_init(&J.rays, 0);
     if (ndirty > 0 && n > 0) pool_run(gp->threads, (n + VIS_CHUNK - 1) / VIS_CHUNK, vis_chunk, &J);
+    if (gp->cancel && *gp->cancel) {
+        /* cancelled during (or before) the visibility pass: nothing the
+         * indirect hook reads has changed yet (edir, src, lout, phi, the
+         * view's gathered values), so the previous lighting stays in place;
+         * the lights stay dirty and the next call traces them again */
+        S->t_visibility = timer_now() - tv;
+        return PT_OK;
+    }
     for (int l = 0; l < nl; l++) {
         gp->vis_lights[l] = sc->lights[l];
         gp->dirty[l] = 0;
@@ -665,6 +675,8 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
 }
 
 pt_status gi_particle_relight(gi_particle *gp, diag *d) { return gi_particle_light(gp, d); }
+
+void gi_particle_set_cancel(gi_particle *gp, volatile int *cancel) { gp->cancel = cancel; }
 
 void gi_particle_set_scattering(gi_particle *gp, int bounces, int scatter)
 {
@@ -749,7 +761,7 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
     pt_status st = PT_OK;
     if (!gp->lit) {
         st = gi_particle_light(gp, d);
-        if (st != PT_OK) return st;
+        if (st != PT_OK || !gp->lit) return st; /* !lit: cancelled (gi_particle_set_cancel) */
     }
     view_job J;
     J.gp = gp;

@@ -132,6 +132,15 @@ pt_status gi_particle_light(gi_particle *gp, diag *d);
 /* A light moved or changed: rerun the lighting stage and forget the view's
  * gathered values (the next prepare_view recomputes them). */
 pt_status gi_particle_relight(gi_particle *gp, diag *d);
+/* Cancellation of the lighting stage (the interactive viewer's relight):
+ * while *cancel is non-zero, gi_particle_light/relight stop at the next
+ * chunk of the visibility pass (its shadow rays, most of the stage) and
+ * return PT_OK without touching what the view reads: the previous lighting
+ * stays in place and consistent, and the next call redoes the changed
+ * lights. Once emission has started the stage runs to its end (one scatter
+ * kernel runs all bounces). The caller tells a cancelled stage by its own
+ * flag. NULL (the default): never cancelled. */
+void gi_particle_set_cancel(gi_particle *gp, volatile int *cancel);
 /* Change n_b and the scattering mode; takes effect at the next
  * gi_particle_relight (no geometry work). */
 void gi_particle_set_scattering(gi_particle *gp, int bounces, int scatter);
