@@ -97,7 +97,8 @@ typedef struct {
     int nrecent;
     long last_gen_first;     /* generation whose first image was counted */
     long last_gen_full;
-    series lat_light_first, lat_light_full, lat_camera_first;
+    long last_gen_relit;
+    series lat_light_first, lat_light_relit, lat_light_full, lat_camera_first;
     double title_time;
     diag *msgs;
 } viewer;
@@ -246,14 +247,16 @@ static void write_camera(viewer *v, const char *path)
 
 static void print_mark(viewer *v, const char *name)
 {
-    double lf, lfm, lF, lFm, cf, cfm;
+    double lf, lfm, lr, lrm, lF, lFm, cf, cfm;
     series_stats(&v->lat_light_first, &lf, &lfm);
+    series_stats(&v->lat_light_relit, &lr, &lrm);
     series_stats(&v->lat_light_full, &lF, &lFm);
     series_stats(&v->lat_camera_first, &cf, &cfm);
     printf("view: mark %s time=%.4f images=%ld shown=%ld light_moves=%d light_first_ms=%.2f light_first_max_ms=%.2f "
-           "light_full_ms=%.2f camera_moves=%d camera_first_ms=%.2f camera_first_max_ms=%.2f\n",
-           name, timer_now() - v->t_start, v->published, v->images, v->lat_light_first.n, lf * 1e3, lfm * 1e3, lF * 1e3,
-           v->lat_camera_first.n, cf * 1e3, cfm * 1e3);
+           "light_relit_ms=%.2f light_relit_max_ms=%.2f light_full_ms=%.2f camera_moves=%d camera_first_ms=%.2f "
+           "camera_first_max_ms=%.2f\n",
+           name, timer_now() - v->t_start, v->published, v->images, v->lat_light_first.n, lf * 1e3, lfm * 1e3, lr * 1e3,
+           lrm * 1e3, lF * 1e3, v->lat_camera_first.n, cf * 1e3, cfm * 1e3);
     fflush(stdout);
 }
 
@@ -547,12 +550,12 @@ static int take_image(viewer *v, double now)
     v->published = in.serial;
     if (v->verbose)
         printf("view: image %ld gen %ld L%d/%d %dx%d %s%s%s frame %.1f ms (build %.1f light %.1f view %.1f render %.1f) "
-               "latency %.1f ms%s%s [%s]\n",
+               "latency %.1f ms%s%s%s [%s]\n",
                in.serial, in.generation, in.level, in.last_level, in.width, in.height, view_gi_name(in.gi_mode),
                in.wanted_mode != in.gi_mode ? " building " : "", in.wanted_mode != in.gi_mode ? view_gi_name(in.wanted_mode) : "",
                in.frame * 1e3, in.times.build * 1e3, in.times.light * 1e3, in.times.view * 1e3, in.times.render * 1e3,
                in.latency * 1e3, in.cause & VIEW_CAUSE_LIGHT ? " light" : "", in.cause & VIEW_CAUSE_CAMERA ? " camera" : "",
-               in.describe);
+               in.gi_stale ? " gi-stale" : "", in.describe);
     if (!v->have_image) v->t_first_image = now;
     v->have_image = 1;
     if (v->nrecent == (int)(sizeof v->recent / sizeof v->recent[0])) {
@@ -566,6 +569,10 @@ static int take_image(viewer *v, double now)
         v->last_gen_first = in.generation;
         if (in.cause & VIEW_CAUSE_LIGHT) series_add(&v->lat_light_first, in.first_latency);
         else if (in.cause & VIEW_CAUSE_CAMERA) series_add(&v->lat_camera_first, in.first_latency);
+    }
+    if (in.generation != v->last_gen_relit && in.relit_latency > 0) {
+        v->last_gen_relit = in.generation;
+        if (in.cause & VIEW_CAUSE_LIGHT) series_add(&v->lat_light_relit, in.relit_latency);
     }
     if (in.generation != v->last_gen_full && in.full_latency > 0) {
         v->last_gen_full = in.generation;
@@ -750,7 +757,7 @@ int cmd_view(int argc, char **argv)
     v.width = o.width > 0 ? o.width : 512;
     v.height = o.height > 0 ? o.height : (o.width > 0 ? o.width : 512);
     v.threads = o.threads > 0 ? o.threads : pool_default_threads();
-    v.last_gen_first = v.last_gen_full = -1;
+    v.last_gen_first = v.last_gen_full = v.last_gen_relit = -1;
     scene_stem(o.scene, v.stem, sizeof v.stem);
 
     diag *d = diag_new();
@@ -857,15 +864,17 @@ int cmd_view(int argc, char **argv)
         run_loop(&v);
         double now = timer_now();
         double span = now - v.t_first_image;
-        double lf, lfm, lF, lFm, cf, cfm;
+        double lf, lfm, lr, lrm, lF, lFm, cf, cfm;
         series_stats(&v.lat_light_first, &lf, &lfm);
+        series_stats(&v.lat_light_relit, &lr, &lrm);
         series_stats(&v.lat_light_full, &lF, &lFm);
         series_stats(&v.lat_camera_first, &cf, &cfm);
         fprintf(stderr,
                 "view: %ld images (%ld shown) in %.2f s (%.1f/s), first image after %.3f s; light move -> image %.1f ms mean, %.1f ms "
-                "max (%d), -> full resolution %.1f ms mean; camera move -> image %.1f ms mean (%d)\n",
+                "max (%d), -> relit image %.1f ms mean, %.1f ms max (%d), -> full resolution %.1f ms mean; camera move -> image "
+                "%.1f ms mean (%d)\n",
                 v.published, v.images, span, span > 0 ? v.published / span : 0.0, v.t_first_image - v.t_start, lf * 1e3, lfm * 1e3,
-                v.lat_light_first.n, lF * 1e3, cf * 1e3, v.lat_camera_first.n);
+                v.lat_light_first.n, lr * 1e3, lrm * 1e3, v.lat_light_relit.n, lF * 1e3, cf * 1e3, v.lat_camera_first.n);
         view_render_stop(v.vr);
         v.vr = NULL;
     }

@@ -7,13 +7,15 @@
 #include "shade.h"
 #include "timer.h"
 #include "gi_particle.h"
+#include "pm_fg.h"
 #include "pm_path.h"
 
 typedef struct {
     int mode;
-    int last_level;
-    pt_status (*open)(void **ctx, const scene *sc, const accel *a, int threads, view_gi_times *t, diag *d);
-    pt_status (*relight)(void *ctx, view_gi_times *t, diag *d);
+    int slow_light;   /* the lighting stage is slow: a pass with the new lights and the old GI first */
+    int (*last_level)(const view_gi_opts *o);
+    pt_status (*open)(void **ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d);
+    pt_status (*relight)(void *ctx, volatile int *cancel, view_gi_times *t, diag *d);
     pt_status (*render)(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d);
     void (*describe)(void *ctx, char *buf, int n);
     void (*close)(void *ctx);
@@ -22,6 +24,9 @@ typedef struct {
 struct view_gi {
     const gi_backend *b;
     void *ctx;
+    view_gi_opts o;
+    int last_level;
+    int stale;            /* lights changed since the last complete lighting stage */
     scene sc;             /* shallow copy: own camera and lights, shared objects */
     scene_light *lights;
 };
@@ -49,7 +54,9 @@ static void whitted_settings(shade_settings *ss, const view_gi_pass *p)
     ss->cancel = p->cancel;
 }
 
-static pt_status none_open(void **ctx, const scene *sc, const accel *a, int threads, view_gi_times *t, diag *d)
+static int whitted_last_level(const view_gi_opts *o) { (void)o; return 2; }
+
+static pt_status none_open(void **ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
 {
     none_ctx *c = calloc(1, sizeof *c);
     if (!c) return PT_ERR_NOMEM;
@@ -59,7 +66,7 @@ static pt_status none_open(void **ctx, const scene *sc, const accel *a, int thre
     return PT_OK;
 }
 
-static pt_status none_relight(void *ctx, view_gi_times *t, diag *d) { return PT_OK; }
+static pt_status none_relight(void *ctx, volatile int *cancel, view_gi_times *t, diag *d) { return PT_OK; }
 
 static pt_status none_render(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
 {
@@ -90,7 +97,7 @@ typedef struct {
     gi_particle_stats stats;
 } particle_ctx;
 
-static pt_status particle_open(void **ctx, const scene *sc, const accel *a, int threads, view_gi_times *t, diag *d)
+static pt_status particle_open(void **ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
 {
     particle_ctx *c = calloc(1, sizeof *c);
     if (!c) return PT_ERR_NOMEM;
@@ -98,7 +105,7 @@ static pt_status particle_open(void **ctx, const scene *sc, const accel *a, int 
     c->a = a;
     gi_particle_settings s;
     gi_particle_settings_from_scene(&s, sc);
-    s.threads = threads;
+    s.threads = o->threads;
     pt_status st = PT_OK;
     c->gp = gi_particle_build(sc, a, &s, &c->stats, d, &st);
     if (!c->gp || st != PT_OK) {
@@ -115,11 +122,14 @@ static pt_status particle_open(void **ctx, const scene *sc, const accel *a, int 
     return PT_OK;
 }
 
-static pt_status particle_relight(void *ctx, view_gi_times *t, diag *d)
+static pt_status particle_relight(void *ctx, volatile int *cancel, view_gi_times *t, diag *d)
 {
     particle_ctx *c = ctx;
+    double t0 = timer_now();
+    gi_particle_set_cancel(c->gp, cancel); /* stops in the visibility pass, old lighting kept */
     pt_status st = gi_particle_relight(c->gp, d);
-    t->light = gi_particle_get_stats(c->gp)->t_lighting;
+    gi_particle_set_cancel(c->gp, NULL);
+    t->light = timer_now() - t0;
     return st;
 }
 
@@ -156,47 +166,98 @@ static void particle_close(void *ctx)
     free(c);
 }
 
-/* ------------------------------------------------------------------ path */
-#define PATH_LAST_LEVEL 8 /* 1 + 1 + 2 + ... + 128 = 256 spp */
+/* ------------------------------------------------- reference previews */
+/* path and pmfg: each pass its own samples (its own seed), averaged at full
+ * resolution: level 0 a preview at 1 sample per pixel, level 1 the full
+ * resolution at 1, then 1, 2, 4, ... more up to o->ref_spp in all. */
 
 typedef struct {
     const scene *sc;
     const accel *a;
+    int mode;
+    int photons;       /* pmfg: photon paths per pass */
     framebuffer *sum;  /* running sum at full resolution */
     int spp;           /* samples in sum */
-} path_ctx;
+    double t_photons;  /* pmfg: photon maps of the last pass */
+} ref_ctx;
 
-static pt_status path_open(void **ctx, const scene *sc, const accel *a, int threads, view_gi_times *t, diag *d)
+static int ref_spp(const view_gi_opts *o) { return o->ref_spp > 0 ? o->ref_spp : 256; }
+
+/* 1 + 1 + 2 + ... + 2^(L-2) = 2^(L-1) samples after level L */
+static int ref_last_level(const view_gi_opts *o)
 {
-    path_ctx *c = calloc(1, sizeof *c);
+    int L = 1;
+    while ((1 << (L - 1)) < ref_spp(o)) L++;
+    return L;
+}
+
+static pt_status ref_open(void **ctx, const scene *sc, const accel *a, int mode, const view_gi_opts *o)
+{
+    ref_ctx *c = calloc(1, sizeof *c);
     if (!c) return PT_ERR_NOMEM;
     c->sc = sc;
     c->a = a;
+    c->mode = mode;
+    c->photons = o->ref_photons > 0 ? o->ref_photons : 50000;
     *ctx = c;
     return PT_OK;
 }
 
-static pt_status path_relight(void *ctx, view_gi_times *t, diag *d) { return PT_OK; }
-
-static pt_status path_render(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
+static pt_status path_open(void **ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
 {
-    path_ctx *c = ctx;
+    return ref_open(ctx, sc, a, GI_PATH, o);
+}
+
+static pt_status pmfg_open(void **ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
+{
+    return ref_open(ctx, sc, a, GI_PMFG, o);
+}
+
+static pt_status ref_relight(void *ctx, volatile int *cancel, view_gi_times *t, diag *d) { return PT_OK; }
+
+static pt_status ref_render(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
+{
+    ref_ctx *c = ctx;
     int spp = p->level <= 1 ? 1 : 1 << (p->level - 1);
-    pm_path_settings s;
-    pm_path_default_settings(&s);
-    s.c.width = p->width;
-    s.c.height = p->height;
-    s.c.threads = p->threads;
     /* each pass its own samples: the seed says which */
-    s.c.seed = p->seed + 0x9e3779b97f4a7c15ULL * (uint64_t)(p->level + 1);
-    s.c.spp = spp;
-    s.c.cancel = p->cancel;
-    s.c.image_interval = 1e9;
+    uint64_t seed = p->seed + 0x9e3779b97f4a7c15ULL * (uint64_t)(p->level + 1);
     pm_stats st;
     memset(&st, 0, sizeof st);
     double t0 = timer_now();
-    pt_status r = pm_path_render(c->sc, c->a, &s, fb, &st, d);
-    t->render = timer_now() - t0;
+    pt_status r;
+    if (c->mode == GI_PMFG) {
+        /* low settings (the offline defaults are 1M photons and 4096 gather
+         * rays per pixel, pm_fg.h): a photon map of its own per pass, 16
+         * gather rays and 4 light samples per eye sample */
+        pm_fg_settings s;
+        pm_fg_default_settings(&s);
+        s.c.width = p->width;
+        s.c.height = p->height;
+        s.c.threads = p->threads;
+        s.c.seed = seed;
+        s.c.spp = spp;
+        s.c.cancel = p->cancel;
+        s.c.image_interval = 1e9;
+        s.photons = c->photons;
+        s.fg_rays = 16 * spp;
+        s.area_samples = 4;
+        s.emitter_samples = 4;
+        r = pm_fg_render(c->sc, c->a, &s, fb, &st, d);
+        c->t_photons = st.t_lights + st.t_photons + st.t_maps + st.t_irradiance;
+        t->light = c->t_photons;
+    } else {
+        pm_path_settings s;
+        pm_path_default_settings(&s);
+        s.c.width = p->width;
+        s.c.height = p->height;
+        s.c.threads = p->threads;
+        s.c.seed = seed;
+        s.c.spp = spp;
+        s.c.cancel = p->cancel;
+        s.c.image_interval = 1e9;
+        r = pm_path_render(c->sc, c->a, &s, fb, &st, d);
+    }
+    t->render = timer_now() - t0 - t->light;
     if (r != PT_OK || (p->cancel && *p->cancel)) return r;
     if (p->level == 0) return PT_OK;
     size_t n = (size_t)p->width * (size_t)p->height * 3u;
@@ -214,15 +275,19 @@ static pt_status path_render(void *ctx, const view_gi_pass *p, framebuffer *fb, 
     return PT_OK;
 }
 
-static void path_describe(void *ctx, char *buf, int n)
+static void ref_describe(void *ctx, char *buf, int n)
 {
-    path_ctx *c = ctx;
-    snprintf(buf, (size_t)n, "%d spp", c->spp);
+    ref_ctx *c = ctx;
+    if (c->mode == GI_PMFG)
+        snprintf(buf, (size_t)n, "reference preview, %d spp, %d photons/pass (%.0f ms)", c->spp, c->photons,
+                 c->t_photons * 1e3);
+    else
+        snprintf(buf, (size_t)n, "reference preview, %d spp", c->spp);
 }
 
-static void path_close(void *ctx)
+static void ref_close(void *ctx)
 {
-    path_ctx *c = ctx;
+    ref_ctx *c = ctx;
     if (!c) return;
     fb_free(c->sum);
     free(c);
@@ -231,9 +296,10 @@ static void path_close(void *ctx)
 /* ----------------------------------------------------------------- table */
 
 static const gi_backend backends[] = {
-    {GI_NONE, 2, none_open, none_relight, none_render, none_describe, none_close},
-    {GI_PARTICLE, 2, particle_open, particle_relight, particle_render, particle_describe, particle_close},
-    {GI_PATH, PATH_LAST_LEVEL, path_open, path_relight, path_render, path_describe, path_close},
+    {GI_NONE, 0, whitted_last_level, none_open, none_relight, none_render, none_describe, none_close},
+    {GI_PARTICLE, 1, whitted_last_level, particle_open, particle_relight, particle_render, particle_describe, particle_close},
+    {GI_PATH, 0, ref_last_level, path_open, ref_relight, ref_render, ref_describe, ref_close},
+    {GI_PMFG, 0, ref_last_level, pmfg_open, ref_relight, ref_render, ref_describe, ref_close},
 };
 enum { NBACKENDS = (int)(sizeof backends / sizeof backends[0]) };
 
@@ -262,7 +328,8 @@ int view_gi_next(int mode)
 
 const char *view_gi_name(int mode) { return gi_mode_name((gi_mode)mode); }
 
-pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a, int threads, view_gi_times *t, diag *d)
+pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t,
+                       diag *d)
 {
     *out = NULL;
     memset(t, 0, sizeof *t);
@@ -274,6 +341,8 @@ pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a,
     view_gi *g = calloc(1, sizeof *g);
     if (!g) return PT_ERR_NOMEM;
     g->b = b;
+    g->o = *o;
+    g->last_level = b->last_level(o);
     g->sc = *sc;
     g->lights = malloc((size_t)(sc->nlights > 0 ? sc->nlights : 1) * sizeof *g->lights);
     if (!g->lights) {
@@ -284,7 +353,7 @@ pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a,
     g->sc.lights = g->lights;
     g->sc.cap_lights = sc->nlights;
     double t0 = timer_now();
-    pt_status st = b->open(&g->ctx, &g->sc, a, threads, t, d);
+    pt_status st = b->open(&g->ctx, &g->sc, a, o, t, d);
     if (t->build == 0 && t->light == 0) t->build = timer_now() - t0;
     if (st != PT_OK) {
         if (g->ctx) b->close(g->ctx);
@@ -298,12 +367,20 @@ pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a,
 
 int view_gi_mode(const view_gi *g) { return g->b->mode; }
 scene *view_gi_scene(view_gi *g) { return &g->sc; }
-int view_gi_last_level(const view_gi *g) { return g->b->last_level; }
+int view_gi_last_level(const view_gi *g) { return g->last_level; }
 
-pt_status view_gi_relight(view_gi *g, view_gi_times *t, diag *d)
+void view_gi_lights_changed(view_gi *g) { g->stale = 1; }
+int view_gi_stale(const view_gi *g) { return g->stale; }
+int view_gi_slow_light(const view_gi *g) { return g->b->slow_light; }
+
+pt_status view_gi_relight(view_gi *g, volatile int *cancel, view_gi_times *t, diag *d)
 {
     memset(t, 0, sizeof *t);
-    return g->b->relight(g->ctx, t, d);
+    g->stale = 1;
+    pt_status st = g->b->relight(g->ctx, cancel, t, d);
+    /* a cancelled stage leaves the old lighting: still stale */
+    if (st == PT_OK && !(cancel && *cancel)) g->stale = 0;
+    return st;
 }
 
 pt_status view_gi_render(view_gi *g, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)

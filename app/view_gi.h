@@ -9,9 +9,16 @@
  *   particle  gi_particle (seed 000): open = geometry + lighting stage,
  *             relight = lighting stage only, every pass = prepare_view +
  *             shade_render with the indirect hook. Levels as `none`.
- *   path      pm_path (reference preview): levels 0 preview at 1 spp, 1 full
- *             resolution at 1 spp, then passes of 1, 2, 4, ... more samples
- *             averaged in, up to 256 spp in all.
+ *             The lighting stage is the slow part of a light edit: the
+ *             render thread first shows a pass with the new lights' direct
+ *             term over the old indirect light (view_gi_slow_light), and a
+ *             newer light edit cancels a relight in progress (its visibility
+ *             pass; the old lighting stays until one finishes).
+ *   path      reference previews: pm_path (path tracer) and pm_fg (photon
+ *   pmfg      map + final gathering at low settings: a photon map of its own
+ *             per pass, 16 gather rays per eye sample). Levels: 0 preview at
+ *             1 spp, 1 full resolution at 1 spp, then passes of 1, 2, 4, ...
+ *             more samples averaged in, up to view_gi_opts.ref_spp in all.
  *
  * Each open mode works on its own shallow copy of the scene (camera and
  * lights copied, objects shared), so a mode can be opened on one thread
@@ -36,6 +43,13 @@ typedef struct {
     double render;  /* the pass itself */
 } view_gi_times;
 
+/* Settings of every mode. */
+typedef struct {
+    int threads;            /* <= 0: all cores */
+    int ref_spp;            /* path/pmfg: samples per pixel at the last level (<= 0: 256) */
+    int ref_photons;        /* pmfg: photon paths per pass (<= 0: 50,000) */
+} view_gi_opts;
+
 typedef struct {
     int width, height;      /* size of this pass (fb has it) */
     int level;              /* 0 preview, 1 first full-resolution pass, >= 2 refinements */
@@ -54,14 +68,25 @@ const char *view_gi_name(int mode);
 
 /* Opens a mode on a copy of the scene (read only here; the objects must
  * outlive the instance): runs whatever the mode precomputes. */
-pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a, int threads, view_gi_times *t, diag *d);
+pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t,
+                       diag *d);
 int view_gi_mode(const view_gi *g);
 /* The instance's scene: set its camera and lights before a pass. */
 scene *view_gi_scene(view_gi *g);
-/* The last level of the refinement (none/particle 2, path 8). */
+/* The last level of the refinement (none/particle 2, path/pmfg 1 + log2 ref_spp). */
 int view_gi_last_level(const view_gi *g);
-/* The scene's lights changed (positions, colours). */
-pt_status view_gi_relight(view_gi *g, view_gi_times *t, diag *d);
+/* Say that the scene's lights were edited (positions, colours): the GI is
+ * stale until view_gi_relight completes. A pass before that shows the new
+ * lights' direct term over the old indirect light. */
+void view_gi_lights_changed(view_gi *g);
+int view_gi_stale(const view_gi *g);
+/* 1 when the mode's lighting stage is slow enough that a stale pass is
+ * worth showing first (particle). */
+int view_gi_slow_light(const view_gi *g);
+/* Reruns the lighting stage for the scene's current lights. While *cancel
+ * (may be NULL) is non-zero it may stop early: it returns PT_OK with the old
+ * lighting in place and the mode still stale. */
+pt_status view_gi_relight(view_gi *g, volatile int *cancel, view_gi_times *t, diag *d);
 /* One pass of the refinement into fb (p->width x p->height) with the
  * scene's current camera. */
 pt_status view_gi_render(view_gi *g, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d);

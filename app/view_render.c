@@ -13,6 +13,11 @@
 #define SRGB_LUT 4096
 
 #define GI_MODES 8
+/* A light edit cancels a relight in progress (the newer lights win) only
+ * while the GI has been out of date with the lights for less than this;
+ * past it the relight finishes, so dragging a light without pause still
+ * updates the GI about every RELIGHT_MAX_STALE + one lighting stage. */
+#define RELIGHT_MAX_STALE 0.5
 
 struct view_render {
     /* fixed after start */
@@ -52,6 +57,9 @@ struct view_render {
     view_gi_times open_times;
 
     volatile int cancel;       /* written by both threads, read by the workers */
+    int relighting;            /* the render thread runs a lighting stage (guarded by mu) */
+    double stale_since;        /* first light edit the GI does not show yet (0: none) */
+    double edit_in_relight;    /* first light edit posted while the relight runs (0: none) */
 
     /* render thread only */
     framebuffer *back;         /* the pass being rendered (storage for the full size) */
@@ -148,7 +156,8 @@ static void *opener_main(void *arg)
     view_gi *g = NULL;
     view_gi_times t;
     memset(&t, 0, sizeof t);
-    pt_status st = view_gi_open(&g, vr->opening, vr->open_scene, vr->a, vr->o.threads, &t, d);
+    view_gi_opts go = {vr->o.threads, vr->o.ref_spp, 0};
+    pt_status st = view_gi_open(&g, vr->opening, vr->open_scene, vr->a, &go, &t, d);
     pthread_mutex_lock(&vr->mu);
     copy_messages(vr->msgs, d);
     vr->open_result = g;
@@ -252,7 +261,8 @@ static void *render_main(void *arg)
     view_light *cur_lights = calloc((size_t)(vr->nlights > 0 ? vr->nlights : 1), sizeof *cur_lights);
     long work_gen = -1;
     int level = 0, last_level = 0, cause = 0;
-    double submit_time = 0, first_latency = 0, full_latency = 0;
+    double submit_time = 0, first_latency = 0, full_latency = 0, relit_latency = 0;
+    int quick_pending = 0; /* lights changed: show them over the old GI before relighting */
     int published = 1; /* an image of work_gen was published */
     view_gi_times opened_times;
     memset(&opened_times, 0, sizeof opened_times);
@@ -284,7 +294,7 @@ static void *render_main(void *arg)
             vr->posted_cause = 0;
             vr->posted_time = 0;
             level = 0;
-            first_latency = full_latency = 0;
+            first_latency = full_latency = relit_latency = 0;
         }
         if (level > last_level) continue; /* an open finished for a mode not wanted now */
         /* refinement waits until the input has been quiet a moment */
@@ -309,6 +319,7 @@ static void *render_main(void *arg)
         int use = vr->opened[want] ? want : vr->shown_mode;
         int waiting_for_mode = use != want;
         vr->cancel = 0;
+        vr->relighting = 0;
         vr->busy_level = level;
         vr->busy_since = timer_now();
         pthread_mutex_unlock(&vr->mu);
@@ -321,18 +332,40 @@ static void *render_main(void *arg)
         pt_status st = PT_OK;
         if (!vr->opened[use]) {
             /* `none` opens at once, on this thread */
-            st = view_gi_open(&vr->opened[use], use, vr->sc, vr->a, vr->o.threads, &t, d);
+            view_gi_opts go = {vr->o.threads, vr->o.ref_spp, 0};
+            st = view_gi_open(&vr->opened[use], use, vr->sc, vr->a, &go, &t, d);
             acc.build += t.build;
         }
         view_gi *g = vr->opened[use];
+        int quick = 0, stale = 0;
         if (st == PT_OK && g) {
             vr->shown_mode = use;
             scene *gs = view_gi_scene(g);
             gs->camera = cur.camera;
             if (apply_lights(vr, gs, cur.lights)) {
-                st = view_gi_relight(g, &t, d);
-                acc.light += t.light;
+                view_gi_lights_changed(g);
+                quick_pending = view_gi_slow_light(g);
             }
+            if (view_gi_stale(g)) {
+                if (quick_pending && level == 0) {
+                    /* the new lights' direct term over the old indirect
+                     * light at once; the relight follows in the next pass */
+                    quick = 1;
+                } else {
+                    pthread_mutex_lock(&vr->mu);
+                    vr->relighting = !vr->cancel;
+                    vr->edit_in_relight = 0;
+                    pthread_mutex_unlock(&vr->mu);
+                    if (vr->relighting) st = view_gi_relight(g, &vr->cancel, &t, d);
+                    pthread_mutex_lock(&vr->mu);
+                    vr->relighting = 0;
+                    if (st == PT_OK && !view_gi_stale(g)) vr->stale_since = vr->edit_in_relight;
+                    pthread_mutex_unlock(&vr->mu);
+                    acc.light += t.light;
+                }
+            }
+            quick_pending = 0;
+            stale = view_gi_stale(g);
         }
         last_level = g ? view_gi_last_level(g) : 0;
         int div = level == 0 ? vr->preview_div : 1;
@@ -341,17 +374,17 @@ static void *render_main(void *arg)
         if (ph < 1) ph = 1;
         vr->back->width = pw;
         vr->back->height = ph;
-        if (st == PT_OK && g) {
+        if (st == PT_OK && g && !vr->cancel) {
             view_gi_pass p = {pw, ph, level, vr->o.threads, vr->o.seed, &vr->cancel};
             st = view_gi_render(g, &p, vr->back, &t, d);
             acc.view += t.view;
             acc.render += t.render;
-        } else if (st == PT_OK) {
+        } else if (st == PT_OK && !g) {
             st = PT_ERR_INTERNAL;
         }
         int cancelled = vr->cancel != 0;
         if (st == PT_OK && !cancelled) {
-            if (level == 0 && vr->o.preview_div <= 0) {
+            if (level == 0 && !quick && vr->o.preview_div <= 0) {
                 double tp = acc.view + acc.render;
                 if (tp > 1.5 * PREVIEW_TARGET && vr->preview_div < PREVIEW_DIV_MAX) vr->preview_div++;
                 else if (tp < 0.4 * PREVIEW_TARGET && vr->preview_div > PREVIEW_DIV_MIN) vr->preview_div--;
@@ -395,15 +428,18 @@ static void *render_main(void *arg)
         in->latency = now - submit_time;
         in->first = level == 0;
         if (level == 0 && first_latency == 0) first_latency = in->latency;
+        if (!stale && relit_latency == 0) relit_latency = in->latency;
         if (level == 1 && full_latency == 0) full_latency = in->latency;
         in->first_latency = first_latency;
+        in->relit_latency = relit_latency;
         in->full_latency = full_latency;
+        in->gi_stale = stale;
         in->cause = cause;
-        in->complete = level >= last_level && !waiting_for_mode;
+        in->complete = level >= last_level && !waiting_for_mode && !stale;
         memcpy(in->describe, desc, sizeof desc);
         if (in->complete) vr->idle_gen = work_gen;
         published = 1;
-        level++;
+        if (!quick) level++; /* after a stale preview: the relit preview */
     }
     vr->busy_level = -1;
     if (vr->opening >= 0) {
@@ -483,6 +519,7 @@ void view_render_submit(view_render *vr, const view_state *s, int cause)
 {
     pthread_mutex_lock(&vr->mu);
     int mode_changed = s->gi_mode != vr->posted.gi_mode;
+    int lights_changed = memcmp(vr->posted_lights, s->lights, (size_t)vr->nlights * sizeof *vr->posted_lights) != 0;
     vr->posted = *s;
     memcpy(vr->posted_lights, s->lights, (size_t)vr->nlights * sizeof *vr->posted_lights);
     vr->posted.lights = vr->posted_lights;
@@ -492,8 +529,14 @@ void view_render_submit(view_render *vr, const view_state *s, int cause)
     if (vr->posted_time == 0) vr->posted_time = now;
     vr->last_submit = now;
     /* refinements give way at once; a preview finishes (continuous motion
-     * keeps showing frames) unless the mode changed */
+     * keeps showing frames) unless the mode changed; a relight gives way to
+     * newer lights (superseded) while the GI on screen is recent enough */
     if (vr->busy_level >= 1 || (vr->busy_level == 0 && mode_changed)) vr->cancel = 1;
+    if (lights_changed) {
+        if (vr->stale_since == 0) vr->stale_since = now;
+        if (vr->relighting && vr->edit_in_relight == 0) vr->edit_in_relight = now;
+        if (vr->relighting && now - vr->stale_since < RELIGHT_MAX_STALE) vr->cancel = 1;
+    }
     pthread_cond_signal(&vr->cv);
     pthread_mutex_unlock(&vr->mu);
 }

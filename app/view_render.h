@@ -15,7 +15,10 @@
  * A submit cancels a refinement pass (level >= 1) through
  * shade_settings.cancel; a preview pass is left to finish (so continuous
  * motion still shows frames) unless the GI mode changed. Light edits rerun
- * only the GI's lighting stage (view_gi_relight), camera moves only the
+ * only the GI's lighting stage (view_gi_relight; where that is slow, the
+ * first pass after the edit shows the new lights' direct term over the old
+ * indirect light, gi_stale, and a newer light edit cancels a relight in
+ * progress: the stale job is abandoned), camera moves only the
  * per-view work and the passes. A mode that is not open yet is opened on a
  * thread of its own (its geometry and lighting stages) while the render
  * thread goes on refining with the mode on screen (at the start: `none`);
@@ -53,6 +56,7 @@ typedef struct {
     int threads;            /* <= 0: all cores */
     uint64_t seed;
     int preview_div;        /* 0: adaptive (start 4); else fixed */
+    int ref_spp;            /* path/pmfg previews: samples per pixel at the last level (0: 256) */
 } view_render_opts;
 
 typedef struct {
@@ -67,7 +71,9 @@ typedef struct {
     double latency;         /* seconds from the oldest submit its generation answers to its publication */
     int first;              /* the first image of its generation */
     double first_latency;   /* latency of its generation's first image (so a UI that missed it still knows) */
+    double relit_latency;   /* latency of its generation's first image with the GI up to date with its lights */
     double full_latency;    /* latency of its generation's first full-resolution image; 0 before it */
+    int gi_stale;           /* the indirect light is from before a light edit (the relight follows) */
     int cause;              /* VIEW_CAUSE_* of the submits in its generation */
     int complete;           /* last level reached: the refinement is done */
     char describe[96];      /* view_gi_describe */
