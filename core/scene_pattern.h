@@ -71,7 +71,7 @@ typedef enum {
     PAT_ONION, PAT_PIGMENT, PAT_PLANAR, PAT_QUILTED, PAT_RADIAL, PAT_RIPPLES,
     PAT_SPHERICAL, PAT_SPIRAL1, PAT_SPIRAL2, PAT_SPOTTED, PAT_SQUARE,
     PAT_TRIANGULAR, PAT_WAVES, PAT_WOOD, PAT_WRINKLES, PAT_MANDEL, PAT_JULIA,
-    PAT_SLOPE, PAT_AOI,
+    PAT_SLOPE, PAT_AOI, PAT_TILING, PAT_DENSITY, PAT_OBJECT,
     PAT_UNSUPPORTED,  /* parsed (name kept), evaluates to 0 */
     PAT_FUNCTION      /* function { ... } (core/func.h) */
 } pattern_kind;
@@ -139,7 +139,20 @@ typedef struct scene_pattern {
     int interior_type, exterior_type; /* defaults 0, 1 */
     double ifactor, efactor;       /* defaults 1, 1 */
     double julia_c[2];             /* julia / magnet julia parameter */
+    int tiling;                    /* PAT_TILING: tiling number 1..27 */
+    const struct scene_density *density; /* PAT_DENSITY (NULL: file not read, evaluates to 0) */
+    int density_interpolate;       /* 0 none, 1 trilinear, 2 tricubic */
+    const struct scene_object *object;   /* PAT_OBJECT: inside 1, outside 0 */
 } scene_pattern;
+
+/* density_file df3 data (POV-Ray's DF3 format: three big-endian 16-bit
+ * sizes, then nx*ny*nz samples of 1, 2 or 4 bytes, x fastest), values
+ * scaled to 0..1 as POV-Ray reads them. */
+typedef struct scene_density {
+    const char *path;
+    int nx, ny, nz;
+    double *v;                     /* nx*ny*nz, x fastest, then y, then z */
+} scene_density;
 
 /* ---------------------------------------------------------------- blend maps */
 typedef enum { MAP_COLOUR, MAP_PIGMENT, MAP_NORMAL, MAP_TEXTURE, MAP_SLOPE } map_kind;

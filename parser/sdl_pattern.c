@@ -18,6 +18,7 @@
 #include <unistd.h>
 #include "sdl_directive.h"
 #include "sdl_expr.h"
+#include "sdl_df3.h"
 #include "sdl_function.h"
 #include "sdl_image.h"
 #include "sdl_material.h"
@@ -904,11 +905,45 @@ static int pattern_type(sdl_parser *p, target *tg)
         pt->function = sdl_parse_function(p, t.tk.loc, NULL);
         if (!pt->function) set_kind(tg, PAT_UNSUPPORTED, name);
         break;
-    case KW_DENSITY_FILE:
-        unsupported_pattern(p, tg, &t);
-        sdl_accept_kw(p, KW_DF3);
-        sdl_string(p);
+    case KW_DENSITY_FILE: {
+        /* density_file df3 "file": read now, as POV-Ray does */
+        set_kind(tg, PAT_DENSITY, name);
+        pt->density = NULL;
+        pt->density_interpolate = 0;
+        if (!sdl_accept_kw(p, KW_DF3)) {
+            sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_SYNTAX, "df3 expected after density_file");
+            break;
+        }
+        src_loc floc = sdl_peek(p)->tk.loc;
+        const char *file = sdl_string(p);
+        if (!sdl_ok(p) || !file) break;
+        const char *path = resolve_image(p, file);
+        if (!path) {
+            sdl_error(p, floc, PT_ERR_IO, "cannot find density file '%s'", file);
+            break;
+        }
+        scene_density *d = sdl_alloc(p, sizeof *d);
+        char why[512];
+        if (d && sdl_df3_load(d, path, p->s->mem, why, sizeof why) != 0) {
+            sdl_error(p, floc, PT_ERR_IO, "%s", why);
+            break;
+        }
+        pt->density = d;
         break;
+    }
+    case KW_TILING: {
+        set_kind(tg, PAT_TILING, name);
+        src_loc nloc = sdl_peek(p)->tk.loc;
+        double n = sdl_float(p);
+        /* POV-Ray keeps the number as an unsigned char; 0 and values past
+         * 27 give the square tiling */
+        pt->tiling = (int)(unsigned char)sdl_to_int(n);
+        if (pt->tiling > 7 && pt->tiling <= 27)
+            sdl_warn_once(p, nloc, "tiling %d is not supported (tilings 1 to 7 are); it evaluates to 0", pt->tiling);
+        else if (pt->tiling < 1 || pt->tiling > 27)
+            pt->tiling = 1;
+        break;
+    }
     case KW_MANDEL: case KW_JULIA: case KW_MAGNET: {
         /* mandel N | julia <c>, N | magnet 1|2 ( mandel N | julia <c>, N ) */
         pt->magnet = 0;
@@ -1108,7 +1143,11 @@ static int modifier(sdl_parser *p, target *tg)
         }
         break;
     }
-    default: /* interpolate, max_iteration, number_of_sides, number_of_tiles, pattern */
+    case KW_INTERPOLATE:
+        if (pt->kind != PAT_DENSITY) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "interpolate cannot be used with non-density_file");
+        pt->density_interpolate = sdl_to_int(sdl_float(p));
+        break;
+    default: /* max_iteration, number_of_sides, number_of_tiles, pattern */
         sdl_float(p);
         break;
     }

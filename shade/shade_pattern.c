@@ -27,6 +27,7 @@
 #include "func.h"
 #include "shade_funcenv.h"
 #include "shade_noise.h"
+#include "shade_tiling.h"
 
 #define PAT_EPSILON 1.0e-10
 #define COORD_LIMIT 1.0e17
@@ -700,6 +701,74 @@ static double aoi(const pattern_ctx *c)
     return acos(ca) / PI_;
 }
 
+/* density_file: the df3 samples over the unit cube [0,1)^3, 0 outside
+ * (POV-Ray 3.7's density_pattern). Interpolation 0: the sample of the
+ * cell; 1: trilinear; 2 (and others): tricubic through four samples per
+ * axis, indices wrapping around the grid as POV-Ray's unsigned arithmetic
+ * wraps them (index -1 becomes SIZE_MAX modulo the size). */
+static double df3_at(const scene_density *d, size_t x, size_t y, size_t z)
+{
+    return d->v[(z * (size_t)d->ny + y) * (size_t)d->nx + x];
+}
+
+/* Cubic through fa..fd at t between fb and fc, with slopes from the
+ * neighbours (central differences), in POV-Ray's single precision. */
+static float df3_cubic(float t, float fa, float fb, float fc, float fd)
+{
+    float b = (float)((fc - fa) * 0.5);
+    float d = (float)((fd - fb) * 0.5);
+    float e = (float)(2.0 * (fb - fc) + b + d);
+    float f = (float)(-3.0 * (fb - fc) - 2.0 * b - d);
+    return (float)(((e * t + f) * t + b) * t + fb);
+}
+
+static double density(const scene_pattern *pat, vec3 p)
+{
+    const scene_density *d = pat->density;
+    if (!d || !d->v || d->nx <= 0 || d->ny <= 0 || d->nz <= 0) return 0.0;
+    if (!(p.x >= 0.0 && p.x < 1.0 && p.y >= 0.0 && p.y < 1.0 && p.z >= 0.0 && p.z < 1.0)) return 0.0;
+    size_t nx = (size_t)d->nx, ny = (size_t)d->ny, nz = (size_t)d->nz;
+    double xx = p.x * (double)nx, yy = p.y * (double)ny, zz = p.z * (double)nz;
+    size_t x1 = (size_t)xx, y1 = (size_t)yy, z1 = (size_t)zz;
+    double v;
+    int mode = pat->density_interpolate % 10;
+    if (mode == 0) {
+        if (x1 >= nx || y1 >= ny || z1 >= nz) return 0.0;
+        v = df3_at(d, x1, y1, z1);
+    } else if (mode == 1) {
+        if (x1 >= nx || y1 >= ny || z1 >= nz) return 0.0;
+        size_t x2 = (x1 + 1) % nx, y2 = (y1 + 1) % ny, z2 = (z1 + 1) % nz;
+        xx -= floor(xx);
+        yy -= floor(yy);
+        zz -= floor(zz);
+        double xi = 1.0 - xx, yi = 1.0 - yy;
+        double lo = (df3_at(d, x1, y1, z1) * xi + df3_at(d, x2, y1, z1) * xx) * yi +
+                    (df3_at(d, x1, y2, z1) * xi + df3_at(d, x2, y2, z1) * xx) * yy;
+        double hi = (df3_at(d, x1, y1, z2) * xi + df3_at(d, x2, y1, z2) * xx) * yi +
+                    (df3_at(d, x1, y2, z2) * xi + df3_at(d, x2, y2, z2) * xx) * yy;
+        v = lo * (1.0 - zz) + hi * zz;
+    } else {
+        xx -= floor(xx);
+        yy -= floor(yy);
+        zz -= floor(zz);
+        size_t k[4];
+        for (int i = 0; i < 4; i++) k[i] = (z1 + (size_t)i - 1) % nz;
+        float col[4][4]; /* [x][y], each interpolated along z */
+        for (int i = 0; i < 4; i++) {
+            size_t ii = (x1 + (size_t)i - 1) % nx;
+            for (int j = 0; j < 4; j++) {
+                size_t jj = (y1 + (size_t)j - 1) % ny;
+                col[i][j] = df3_cubic((float)zz, (float)df3_at(d, ii, jj, k[0]), (float)df3_at(d, ii, jj, k[1]),
+                                      (float)df3_at(d, ii, jj, k[2]), (float)df3_at(d, ii, jj, k[3]));
+            }
+        }
+        float row[4];
+        for (int i = 0; i < 4; i++) row[i] = df3_cubic((float)yy, col[i][0], col[i][1], col[i][2], col[i][3]);
+        v = df3_cubic((float)xx, row[0], row[1], row[2], row[3]);
+    }
+    return v < 0.0 ? 0.0 : v;
+}
+
 static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
 {
     int gen = pat->noise_generator ? pat->noise_generator : c->noise_generator;
@@ -764,6 +833,8 @@ static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
     case PAT_SLOPE: return slope(pat, p, c);
     case PAT_MANDEL: case PAT_JULIA: return pat->magnet ? magnet(pat, p) : mandel_julia(pat, p);
     case PAT_AOI: return aoi(c);
+    case PAT_TILING: return tiling_value(pat->tiling, p);
+    case PAT_DENSITY: return density(pat, p);
     default: return 0.0;
     }
 }

@@ -100,6 +100,16 @@ static const pattern_case cases[] = {
     {"julia3", "julia <0.35, 0.2>, 30 exponent 3 interior 2, 1 scale 0.6 " GREY},
     {"magnet1m", "magnet 1 mandel 30 exterior 7, 5 scale 1.5 translate x*1.2 " GREY},
     {"magnet2j", "magnet 2 julia <1.1, 0.4>, 25 exterior 4, 0.1 scale 1.2 " GREY},
+    {"tiling1", "tiling 1 rotate x*90 scale 0.7 " GREY},
+    {"tiling2", "tiling 2 rotate x*90 scale 0.5 " GREY},
+    {"tiling3", "tiling 3 rotate x*90 scale 0.6 " GREY},
+    {"tiling4", "tiling 4 rotate x*90 scale 0.6 " GREY},
+    {"tiling5", "tiling 5 rotate x*90 scale 0.5 " GREY},
+    {"tiling6", "tiling 6 rotate x*90 scale 0.4 " GREY},
+    {"tiling7", "tiling 7 rotate x*90 rotate y*20 scale 0.5 " GREY},
+    {"df3_nearest", "density_file df3 \"spiral.df3\" warp { repeat x } warp { repeat y } translate -z*0.4 scale 3 " GREY},
+    {"df3_linear", "density_file df3 \"spiral.df3\" interpolate 1 warp { repeat x } warp { repeat y } translate -z*0.5 scale 3 " GREY},
+    {"df3_cubic", "density_file df3 \"spiral.df3\" interpolate 2 warp { repeat x } warp { repeat y } translate -z*0.6 scale 3 " GREY},
 };
 #define NCASES ((int)(sizeof cases / sizeof cases[0]))
 
