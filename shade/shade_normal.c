@@ -19,6 +19,7 @@
  *    normalised; average: weighted mean of the entries' perturbed normals. */
 #include "shade_normal.h"
 #include <math.h>
+#include <stdlib.h>
 #include "shade_noise.h"
 
 static const vec3 pyramid[4] = {{0.942809041, -0.333333333, 0.0},
@@ -137,6 +138,46 @@ static vec3 bump_map(const scene_normal *nm, vec3 n, vec3 tp)
     return v3_add(v3_add(v3_scale(xp, bn.x), v3_scale(yp, bn.y)), v3_scale(zp, -bn.z));
 }
 
+/* facets (POV-Ray 3.7's facets normal): the normal, or with `coords` the
+ * point, scaled by 1/size, is snapped to the nearest of the random cell
+ * points (one per unit cube, as crackle's) in the 81 cubes around it; the
+ * facet's normal is that point. With coords c the point's DNoise gradient,
+ * less its part along the normal, is added c times instead. Metric 1 sums
+ * the signed differences, as POV-Ray does. */
+static vec3 facets(const scene_pattern *pat, vec3 n, vec3 tp)
+{
+    double metric = pat->facets_metric;
+    n = v3_norm(n);
+    double scale = pat->facets_size < 1e-6 ? 1e6 : 1.0 / pat->facets_size;
+    vec3 tv = v3_scale(pat->facets_coords != 0.0 ? tp : n, scale);
+    double best = 0.0;
+    vec3 pick = v3(0, 0, 0);
+    int first = 1;
+    for (int ax = -2; ax <= 2; ax++)
+        for (int ay = -2; ay <= 2; ay++)
+            for (int az = -2; az <= 2; az++) {
+                if ((abs(ax) == 2) + (abs(ay) == 2) + (abs(az) == 2) > 1) continue;
+                double fx = floor(tv.x + ax - 1.0e-10), fy = floor(tv.y + ay - 1.0e-10), fz = floor(tv.z + az - 1.0e-10);
+                unsigned long seed = (unsigned long)noise_hash3d(noise_to_int(fx) & 0xFFF, noise_to_int(fy) & 0xFFF,
+                                                                 noise_to_int(fz) & 0xFFF);
+                vec3 cp = v3(fx + noise_pattern_rand(seed), fy + noise_pattern_rand(seed + 1), fz + noise_pattern_rand(seed + 2));
+                vec3 d = v3_sub(cp, tv);
+                double sum;
+                if (metric == 2) sum = d.x * d.x + d.y * d.y + d.z * d.z;
+                else if (metric == 1) sum = d.x + d.y + d.z;
+                else sum = pow(fabs(d.x), metric) + pow(fabs(d.y), metric) + pow(fabs(d.z), metric);
+                if (first || sum < best) {
+                    best = sum;
+                    pick = cp;
+                    first = 0;
+                }
+            }
+    if (pat->facets_coords == 0.0) return pick;
+    vec3 pert = noise_dvector(pick);
+    pert = v3_sub(pert, v3_scale(n, v3_dot(pert, n)));
+    return v3_madd(n, pert, pat->facets_coords);
+}
+
 static vec3 bump_pattern(const scene_normal *nm, vec3 n, vec3 tp, const pattern_ctx *c)
 {
     const scene_pattern *pat = nm->pat;
@@ -181,7 +222,8 @@ static vec3 bump_pattern(const scene_normal *nm, vec3 n, vec3 tp, const pattern_
         return total != 0.0 ? v3_scale(acc, 1.0 / total) : n;
     }
     case PAT_IMAGE: return bump_map(nm, n, tp);
-    default: return n; /* facets: not modelled (unperturbed) */
+    case PAT_FACETS: return facets(pat, n, tp);
+    default: return n;
     }
 }
 
