@@ -56,6 +56,10 @@ typedef struct {
     double reflection_metallic; /* default 0 */
     int fresnel;                /* reflection { fresnel on } */
     int conserve_energy;
+    /* irid { amount thickness t turbulence u } (appended, issue 5): thin-film
+     * interference as POV-Ray 3.7 models it, single precision as it keeps
+     * them; defaults 0 */
+    double irid, irid_thickness, irid_turb;
 } scene_finish;
 
 /* ---------------------------------------------------------------- interior */

@@ -168,7 +168,27 @@ static void reflection(sdl_parser *p, scene_finish *f)
     sdl_end_block(p);
 }
 
-/* Skip a '{...}' finish sub-block (irid, subsurface) with a warning. */
+/* irid { amount [thickness f] [turbulence v] } (POV-Ray 3.7's finish irid:
+ * turbulence takes a vector of which x is used; values kept in single
+ * precision). */
+static void irid(sdl_parser *p, scene_finish *f)
+{
+    if (!sdl_begin_block(p, "irid")) return;
+    f->irid = (float)sdl_float(p);
+    for (;;) {
+        if (sdl_accept_kw(p, KW_THICKNESS)) {
+            f->irid_thickness = (float)sdl_float(p);
+        } else if (sdl_accept_kw(p, KW_TURBULENCE)) {
+            vec3 v = sdl_vector(p);
+            f->irid_turb = (float)v.x;
+        } else {
+            break;
+        }
+    }
+    sdl_end_block(p);
+}
+
+/* Skip a '{...}' finish sub-block (subsurface) with a warning. */
 static void skip_sub_block(sdl_parser *p, const sdl_tok *k)
 {
     sdl_warn_once(p, k->tk.loc, "finish '%s' is not supported yet and is ignored", sdl_kw_text(k->tk.kw));
@@ -218,7 +238,8 @@ static void finish_item(sdl_parser *p, scene_finish *f, albedo_flags *a)
     case KW_REFLECTION: reflection(p, f); break;
     case KW_REFLECTION_EXPONENT: f->reflection_exponent = sdl_float(p); break;
     case KW_CONSERVE_ENERGY: f->conserve_energy = 1; break;
-    case KW_IRID: case KW_SUBSURFACE: skip_sub_block(p, &t); break;
+    case KW_IRID: irid(p, f); break;
+    case KW_SUBSURFACE: skip_sub_block(p, &t); break;
     case KW_IOR: case KW_CAUSTICS: case KW_REFRACTION:
         sdl_warn_once(p, t.tk.loc, "finish '%s' belongs in interior{} and is ignored", sdl_kw_text(k));
         sdl_float(p);

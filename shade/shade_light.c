@@ -5,6 +5,7 @@
 #include "shade_light.h"
 #include <math.h>
 #include <stdlib.h>
+#include "shade_noise.h"
 
 static inline rgb lrgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
 static inline rgb lrgb_add(rgb a, rgb b) { return lrgb(a.r + b.r, a.g + b.g, a.b + b.b); }
@@ -130,7 +131,33 @@ double light_fresnel(double cos_i, double n)
     return fmin(1.0, fmax(0.0, f));
 }
 
+static rgb light_terms_plain(const light_surface *s, vec3 l, rgb lc, int backside);
+
+rgb light_irid(const scene_finish *f, vec3 l, vec3 e, vec3 n, vec3 ipoint, const scene_global *g)
+{
+    double thickness = f->irid_thickness;
+    int gen = g && g->noise_generator ? g->noise_generator : 2;
+    if (f->irid_turb != 0.0) {
+        /* fixed octaves 5, omega 0.5, lambda 2 (POV-Ray 3.7 trace.cpp) */
+        double nz = noise_turbulence(ipoint, 5, 0.5, 2.0, gen);
+        thickness *= 1.0 + (2.0 * nz - 1.0) * f->irid_turb;
+    }
+    /* default wavelengths 0.70, 0.52, 0.48 (POV-Ray 3.7 scene.cpp; kept as floats) */
+    double wl[3] = {(float)0.70, (float)0.52, (float)0.48};
+    if (g && g->irid_wavelength[0] > 0.0)
+        for (int i = 0; i < 3; i++) wl[i] = g->irid_wavelength[i];
+    double phase = 2.0 * M_PI * thickness * (fabs(v3_dot(n, l)) + fabs(v3_dot(n, e)));
+    return lrgb(1.0 + f->irid * cos(phase / wl[0]), 1.0 + f->irid * cos(phase / wl[1]), 1.0 + f->irid * cos(phase / wl[2]));
+}
+
 rgb light_terms(const light_surface *s, vec3 l, rgb lc, int backside)
+{
+    rgb out = light_terms_plain(s, l, lc, backside);
+    if (s->f->irid > 0.0) out = lrgb_mul(out, light_irid(s->f, l, s->eye, s->n, s->ipoint, s->global));
+    return out;
+}
+
+static rgb light_terms_plain(const light_surface *s, vec3 l, rgb lc, int backside)
 {
     const scene_finish *f = s->f;
     rgb out = {0, 0, 0};

@@ -63,7 +63,16 @@ typedef struct {
     vec3 eye;     /* incoming (viewing) ray direction, unit */
     double att;   /* opacity of the layer: 1 - grey(filter*pigment + transmit) */
     rng *r;       /* for crand */
+    /* irid (appended): the surface point and the scene's settings (irid
+     * wavelengths, noise generator); NULL: POV-Ray's defaults */
+    vec3 ipoint;
+    const scene_global *global;
 } light_surface;
+
+/* POV-Ray 3.7's iridescence factor (ComputeIridColour) of a finish with
+ * irid > 0: per channel 1 + irid * cos(2 pi d (|n.l| + |n.e|) / wavelength),
+ * d the film thickness varied by turbulence at ipoint; l, e unit. */
+rgb light_irid(const scene_finish *f, vec3 l, vec3 e, vec3 n, vec3 ipoint, const scene_global *g);
 
 /* Diffuse + phong + specular response to a light of colour `lc` arriving
  * along unit `l` (towards the light); `backside` uses diffuse_back and no

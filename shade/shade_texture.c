@@ -25,7 +25,7 @@
  *    mirrored ray goes below the raw surface), weighted by its
  *    reflectivity, raised to reflection_exponent.
  *
- * Not modelled here: photons, media, subsurface, iridescence, uv_mapping,
+ * Not modelled here: photons, media, subsurface, uv_mapping,
  * material_map, dispersion (ior used as is). */
 #include "shade_texture.h"
 #include <math.h>
@@ -112,12 +112,16 @@ static vec3 reflect_dir(vec3 d, vec3 n, vec3 raw)
     return v3_norm(r);
 }
 
-static rgb trace_reflection(const hit_info *hi, vec3 n, double weight)
+/* The reflected ray's radiance; a finish with irid tints it as POV-Ray
+ * 3.7's ComputeReflection does (f may be NULL). */
+static rgb trace_reflection(const hit_info *hi, vec3 n, double weight, const scene_finish *f)
 {
     const tex_env *e = hi->e;
     if (weight < e->sc->global.adc_bailout) return trgb(0, 0, 0);
     vec3 rd = reflect_dir(hi->dir, n, hi->raw);
-    return e->trace(e->ctx, e->thread, hi->p_out, rd, hi->level + 1, weight, OBJ_NO_REFLECTION, e->r);
+    rgb c = e->trace(e->ctx, e->thread, hi->p_out, rd, hi->level + 1, weight, OBJ_NO_REFLECTION, e->r);
+    if (f && f->irid > 0.0) c = tmul(c, light_irid(f, rd, hi->dir, n, hi->pc.ipoint, &e->sc->global));
+    return c;
 }
 
 static double interior_ior(const scene_interior *in) { return in && in->ior > 0.0 ? in->ior : 1.0; }
@@ -175,7 +179,7 @@ static int refraction(const hit_info *hi, vec3 top, double weight, rgb *colour)
     }
     double t = 1.0 + eta * eta * (n * n - 1.0);
     if (t < 0.0) {
-        *colour = trace_reflection(hi, top, weight);
+        *colour = trace_reflection(hi, top, weight, NULL);
         return 1;
     }
     t = eta * n - sqrt(t);
@@ -245,7 +249,7 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
         if (e->use_ambient) tmp = tadd(tmp, tscale(tmul(pig, tmul(f->ambient, sc->global.ambient_light)), att));
         tmp = tadd(tmp, tscale(tmul(pig, f->emission), att));
         if (f->diffuse != 0.0 || f->diffuse_back != 0.0 || f->specular != 0.0 || f->phong != 0.0) {
-            light_surface s = {f, pig, ln, hi->dir, att, e->r};
+            light_surface s = {f, pig, ln, hi->dir, att, e->r, hi->pc.ipoint, &sc->global};
             tmp = tadd(tmp, e->direct(e->ctx, e->thread, &s, hi->h, hi->p_out, e->r));
         }
         result = tadd(result, tmul(tmp, filcol));
@@ -275,7 +279,7 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
             continue;
         rgb rf = lr[i].reflec;
         if (rf.r == 0.0 && rf.g == 0.0 && rf.b == 0.0) continue;
-        rgb rc = trace_reflection(hi, lr[i].normal, lr[i].weight);
+        rgb rc = trace_reflection(hi, lr[i].normal, lr[i].weight, lr[i].f);
         if (lr[i].exponent != 1.0)
             rc = trgb(pow(fmax(rc.r, 0.0), lr[i].exponent), pow(fmax(rc.g, 0.0), lr[i].exponent), pow(fmax(rc.b, 0.0), lr[i].exponent));
         result = tadd(result, tmul(rf, rc));
