@@ -309,7 +309,7 @@ static pt_status csg_member_ex(accel *a, diag *d, accel_csg *c, const scene_obje
     case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC: case SHAPE_TORUS:
     case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_SUPERELLIPSOID:
     case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_HEIGHT_FIELD: case SHAPE_TEXT: case SHAPE_ISOSURFACE:
-    case SHAPE_JULIA:
+    case SHAPE_JULIA: case SHAPE_OVUS:
         ok = accel_shape_init(&sh, src) == 0;
         if (!ok)
             diag_warn_once(d, o->loc, "degenerate %s ignored (zero size, singular transform or non-finite numbers)",
@@ -422,7 +422,7 @@ static pt_status collect(accel *a, diag *d, const scene_object *o, const scene_t
     case SHAPE_MESH: case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC: case SHAPE_TORUS:
     case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_SUPERELLIPSOID:
     case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_HEIGHT_FIELD: case SHAPE_TEXT: case SHAPE_ISOSURFACE:
-    case SHAPE_JULIA:
+    case SHAPE_JULIA: case SHAPE_OVUS:
         return add_leaf(a, o, tex, flags) < 0 ? PT_ERR_NOMEM : PT_OK;
     case SHAPE_UNSUPPORTED:
     default:

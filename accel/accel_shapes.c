@@ -191,6 +191,29 @@ int accel_shape_init(accel_shape *sh, const scene_object *o)
         hi = v3(R + r, r, R + r);
         break;
     }
+    case SHAPE_OVUS: {
+        /* POV-Ray 3.7's Parse_Ovus: the tube radius is twice the larger
+         * radius; its circle is tangent (inside) to both spheres, which fixes
+         * v and h: h^2 + v^2 = (rc - rb)^2, h^2 + (v - rb)^2 = (rc - rt)^2;
+         * the tangent points are at yb and yt */
+        double rb = o->u.ovus.bottom, rt = o->u.ovus.top;
+        if (!(rb > 0.0) || !(rt > 0.0) || !(rt < 2.0 * rb) || !finite_d(rb) || !finite_d(rt)) return -1;
+        double rc = 2.0 * fmax(rb, rt);
+        double v = (rb * rb + (rc - rb) * (rc - rb) - (rc - rt) * (rc - rt)) / (2.0 * rb);
+        double h2 = (rc - rb) * (rc - rb) - v * v;
+        if (!(h2 > 0.0)) return -1;
+        sh->g.ovus.rb = rb;
+        sh->g.ovus.rt = rt;
+        sh->g.ovus.rc = rc;
+        sh->g.ovus.h = sqrt(h2);
+        sh->g.ovus.v = v;
+        sh->g.ovus.yb = -v * rb / (rc - rb);
+        sh->g.ovus.yt = (rc * rb - v * rt) / (rc - rt);
+        double wide = fmax(rc - sh->g.ovus.h, fmax(rb, rt));
+        lo = v3(-wide, -rb, -wide);
+        hi = v3(wide, rb + rt, wide);
+        break;
+    }
     case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
         if (accel_sweep_init(sh, o, &lo, &hi) != 0) return -1;
         break;
@@ -248,7 +271,7 @@ int accel_shape_solid_bounded(const accel_shape *sh)
 {
     switch (sh->kind) {
     case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_TORUS:
-    case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT: case SHAPE_JULIA:
+    case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT: case SHAPE_JULIA: case SHAPE_OVUS:
         return 1;
     case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
         return !sh->infinite && accel_implicit_solid_bounded(sh);
@@ -485,6 +508,80 @@ static int hits_torus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double
     return n;
 }
 
+/* Ovus: the ray in units of the ovus' height (rb + rt), moved to its
+ * padded box; each sphere's roots where that sphere is the surface, the
+ * spindle torus' quartic (the torus equation with major radius h, tube rc,
+ * centred at y = v) where the lemon is, on the lemon's branch. */
+static int hits_ovus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+{
+    double s = v3_len(d);
+    if (!(s > 0.0) || !isfinite(s)) return 0;
+    double k = 1.0 / (sh->g.ovus.rb + sh->g.ovus.rt), sk = s * k;
+    double rb = sh->g.ovus.rb * k, rt = sh->g.ovus.rt * k, rc = sh->g.ovus.rc * k, H = sh->g.ovus.h * k;
+    double V = sh->g.ovus.v * k, yb = sh->g.ovus.yb * k, yt = sh->g.ovus.yt * k;
+    vec3 e = v3_scale(d, 1.0 / s), o1 = v3_scale(o, k);
+    double wide = fmax(rc - H, fmax(rb, rt)) + 0.01;
+    double b0, b1;
+    int f0, f1;
+    if (!slabs(o1, e, v3(-wide, -rb - 0.01, -wide), v3(wide, 1.01, wide), &b0, &f0, &b1, &f1)) return 0;
+    double ta = tmin * sk, tb = tmax * sk;
+    double lo = fmax(ta, b0), hi = fmin(tb, b1);
+    if (!(lo < hi)) return 0;
+    vec3 q = v3_madd(o1, e, lo);
+    double cand[8];
+    int part[8], nc = 0;
+    /* spheres (unit direction: a = 1) */
+    for (int sp = 0; sp < 2; sp++) {
+        vec3 c = v3(0.0, sp ? rb : 0.0, 0.0);
+        double r = sp ? rt : rb;
+        vec3 oc = v3_sub(q, c);
+        double b = v3_dot(oc, e);
+        vec3 l = v3_madd(oc, e, -b);
+        double disc = r * r - v3_dot(l, l);
+        if (disc < 0.0) continue;
+        double cc = v3_dot(oc, oc) - r * r, qq = -(b + copysign(sqrt(disc), b));
+        double r0 = qq, r1 = qq != 0.0 ? cc / qq : qq;
+        double rr[2] = {r0, r1};
+        for (int i = 0; i < 2; i++) {
+            double y = q.y + e.y * rr[i];
+            if (sp ? y > yt : y < yb) {
+                cand[nc] = rr[i];
+                part[nc++] = sp ? ACCEL_PART_OVUS_TOP : ACCEL_PART_OVUS_BOTTOM;
+            }
+        }
+    }
+    /* lemon: ((x^2+z^2) + (y-V)^2 + H^2 - rc^2)^2 = 4 H^2 (x^2+z^2) */
+    vec3 qt = v3(q.x, q.y - V, q.z);
+    double G = v3_dot(qt, qt) + H * H - rc * rc, f = v3_dot(qt, e);
+    double A = e.x * e.x + e.z * e.z, B = qt.x * e.x + qt.z * e.z, C = qt.x * qt.x + qt.z * qt.z;
+    double c[5];
+    c[4] = 1.0;
+    c[3] = 4.0 * f;
+    c[2] = 4.0 * f * f + 2.0 * G - 4.0 * H * H * A;
+    c[1] = 4.0 * f * G - 8.0 * H * H * B;
+    c[0] = G * G - 4.0 * H * H * C;
+    double roots[4];
+    int nr = accel_poly_roots(c, 4, 0.0, hi - lo, roots);
+    for (int i = 0; i < nr; i++) {
+        vec3 p = v3_madd(q, e, roots[i]);
+        if (!(p.y > yb && p.y < yt)) continue;
+        double hh = sqrt(p.x * p.x + p.z * p.z), dy = p.y - V;
+        double inner = (hh + H) * (hh + H) + dy * dy - rc * rc, outer = (hh - H) * (hh - H) + dy * dy - rc * rc;
+        if (fabs(inner) <= fabs(outer)) {
+            cand[nc] = roots[i];
+            part[nc++] = ACCEL_PART_OVUS_LEMON;
+        }
+    }
+    int n = 0;
+    for (int i = 0; i < nc; i++) {
+        double tau = lo + cand[i];
+        if (!(tau > ta && tau < tb)) continue;
+        double t = tau / sk;
+        if (in_range(t, tmin, tmax)) n = push_hit(out, n, max, t, part[i]);
+    }
+    return n;
+}
+
 /* Parameter interval of a ray inside a box. */
 int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, accel_shape_hit *out,
                      int max)
@@ -504,6 +601,7 @@ int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, dou
     case SHAPE_CONE: return hits_cone(sh, o, d, tmin, tmax, out, max);
     case SHAPE_DISC: return hits_disc(sh, o, d, tmin, tmax, out, max);
     case SHAPE_TORUS: return hits_torus(sh, o, d, tmin, tmax, out, max);
+    case SHAPE_OVUS: return hits_ovus(sh, o, d, tmin, tmax, out, max);
     case SHAPE_TRIANGLE:
     case SHAPE_SMOOTH_TRIANGLE: return hits_triangle(sh, o, d, tmin, tmax, out, max);
     default: break;
@@ -563,6 +661,7 @@ static int grid_poly_tri(void *ctx, vec3 a, vec3 b, vec3 c)
 
 int accel_shape_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
 {
+    if (sh->kind == SHAPE_OVUS) return accel_tess_grid(sh, n, fn, ctx);
     if (!sh->data || n < 1) return 0;
     switch (sh->kind) {
     case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
@@ -573,7 +672,7 @@ int accel_shape_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
     }
     case SHAPE_SUPERELLIPSOID:
         return accel_implicit_grid(sh, n, fn, ctx);
-    case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE: case SHAPE_JULIA:
+    case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE: case SHAPE_JULIA: case SHAPE_OVUS:
         /* no parametrisation of their own: marching tetrahedra (accel_tess.h) */
         return accel_tess_grid(sh, n, fn, ctx);
     case SHAPE_HEIGHT_FIELD: {
@@ -629,6 +728,16 @@ int accel_shape_inside(const accel_shape *sh, vec3 p)
     case SHAPE_TORUS: {
         double rho = sqrt(q.x * q.x + q.z * q.z) - sh->g.torus.R;
         return rho * rho + q.y * q.y < sh->g.torus.r * sh->g.torus.r;
+    }
+    case SHAPE_OVUS: {
+        /* POV-Ray's Inside: either sphere, or the lemon between yb and yt */
+        double rb = sh->g.ovus.rb, rt = sh->g.ovus.rt;
+        if (v3_len2(q) < rb * rb) return 1;
+        vec3 qt = v3(q.x, q.y - rb, q.z);
+        if (v3_len2(qt) < rt * rt) return 1;
+        if (!(q.y > sh->g.ovus.yb && q.y < sh->g.ovus.yt)) return 0;
+        double hh = sqrt(q.x * q.x + q.z * q.z) + sh->g.ovus.h, dy = q.y - sh->g.ovus.v;
+        return hh * hh + dy * dy < sh->g.ovus.rc * sh->g.ovus.rc;
     }
     case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
         return accel_sweep_inside(sh, q);
@@ -762,6 +871,21 @@ void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, doub
         n = v3_scale(v3_cross(sh->g.tri.e1, sh->g.tri.e2), sh->g.tri.wind);
         tri_bary(sh, po, &su, &sv);
         break;
+    case SHAPE_OVUS: {
+        if (part == ACCEL_PART_OVUS_BOTTOM) {
+            n = po;
+        } else if (part == ACCEL_PART_OVUS_TOP) {
+            n = v3(po.x, po.y - sh->g.ovus.rb, po.z);
+        } else {
+            /* away from the generating circle's centre on the far side of the axis */
+            double hh = sqrt(po.x * po.x + po.z * po.z);
+            double f = hh > 0.0 ? 1.0 + sh->g.ovus.h / hh : 1.0;
+            n = hh > 0.0 ? v3(po.x * f, po.y - sh->g.ovus.v, po.z * f) : v3(0.0, po.y > sh->g.ovus.v ? 1.0 : -1.0, 0.0);
+        }
+        su = wrap01(atan2(po.z, po.x));
+        sv = clamp01((po.y + sh->g.ovus.rb) / (sh->g.ovus.rb + sh->g.ovus.rt));
+        break;
+    }
     case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
         accel_sweep_surface(sh, po, part, &n, &su, &sv);
         break;

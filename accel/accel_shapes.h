@@ -16,7 +16,8 @@
 enum {
     ACCEL_PART_BOX_NX = 0, ACCEL_PART_BOX_PX, ACCEL_PART_BOX_NY,
     ACCEL_PART_BOX_PY, ACCEL_PART_BOX_NZ, ACCEL_PART_BOX_PZ,
-    ACCEL_PART_CONE_SIDE = 0, ACCEL_PART_CONE_BASE = 1, ACCEL_PART_CONE_CAP = 2
+    ACCEL_PART_CONE_SIDE = 0, ACCEL_PART_CONE_BASE = 1, ACCEL_PART_CONE_CAP = 2,
+    ACCEL_PART_OVUS_BOTTOM = 0, ACCEL_PART_OVUS_TOP = 1, ACCEL_PART_OVUS_LEMON = 2
 };
 
 typedef struct {
@@ -33,6 +34,11 @@ typedef struct {
         struct { vec3 c, n; double r2, h2; } disc; /* unit n, squared radii */
         struct { double R, r; } torus;           /* in the xz plane, axis y */
         struct { vec3 v0, e1, e2, n[3]; int smooth; double wind; } tri; /* CSG members only */
+        /* ovus: bottom sphere (0, rb) below y = yb, top sphere ((0, rb, 0), rt)
+         * above y = yt, between them the inner ("lemon") part of the spindle
+         * torus of tube radius rc around the circle of radius h at y = v
+         * (centres of the generating circle on the far side of the axis) */
+        struct { double rb, rt, rc, h, v, yb, yt; } ovus;
     } g;
     vec3 lo, hi;       /* world bounds (planes: the clip box) */
     vec3 clip_lo, clip_hi;

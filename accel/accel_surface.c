@@ -260,7 +260,7 @@ static int use_crofton(const shape_geo *g)
 {
     switch (g->sh.kind) {
     case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
-    case SHAPE_JULIA:
+    case SHAPE_JULIA: case SHAPE_OVUS:
         return 1;
     case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
         return !g->similar || !(accel_sweep_area(&g->sh) > 0.0);
@@ -497,7 +497,7 @@ static int collect(accel_surf *as, const scene_object *o, const scene_texture *p
         return add_issue4(as, o, tex ? tex : &as->s->default_texture, flags);
     case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
     case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
-    case SHAPE_JULIA:
+    case SHAPE_JULIA: case SHAPE_OVUS:
         return add_leaf(as, o, tex ? tex : &as->s->default_texture, flags);
     default: /* merge, intersection, difference, unsupported: not sampled */
         return 1;

@@ -138,7 +138,8 @@ typedef enum {
     SHAPE_HEIGHT_FIELD,   /* u.height_field */
     SHAPE_TEXT,           /* u.text: glyph outlines extruded along z */
     SHAPE_ISOSURFACE,     /* u.isosurface */
-    SHAPE_JULIA           /* u.julia: julia_fractal */
+    SHAPE_JULIA,          /* u.julia: julia_fractal */
+    SHAPE_OVUS            /* u.ovus: POV-Ray 3.7's egg (bottom sphere at the origin, top sphere at y = bottom) */
 } shape_kind;
 
 enum {
@@ -270,6 +271,7 @@ struct scene_object {
         const scene_text *text;
         const scene_isosurface *isosurface;
         const scene_julia *julia;
+        struct { double bottom, top; } ovus; /* radii, 0 < top < 2 bottom */
     } u;
     /* clipped_by (issue 4): the clipping solid, its transform relative to
      * this object's space (world = clip->transform then this->transform), so

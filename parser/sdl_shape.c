@@ -28,7 +28,7 @@ int sdl_shape_handles(sdl_kw k)
     case KW_POLYGON: case KW_LATHE: case KW_SOR: case KW_PRISM: case KW_SUPERELLIPSOID:
     case KW_QUADRIC: case KW_POLY: case KW_CUBIC: case KW_QUARTIC: case KW_POLYNOMIAL:
     case KW_BLOB: case KW_HEIGHT_FIELD: case KW_TEXT: case KW_SPHERE_SWEEP: case KW_BICUBIC_PATCH:
-    case KW_ISOSURFACE: case KW_PARAMETRIC: case KW_JULIA_FRACTAL:
+    case KW_ISOSURFACE: case KW_PARAMETRIC: case KW_JULIA_FRACTAL: case KW_OVUS:
         return 1;
     default:
         return 0;
@@ -1300,6 +1300,35 @@ static void julia_args(sdl_parser *p, scene_object *o, src_loc loc)
     o->u.julia = j;
 }
 
+/* ------------------------------------------------------------ ovus */
+
+/* ovus := bottom_radius ',' top_radius (POV-Ray 3.7's Parse_Ovus: negative
+ * radii are an error; top >= 2 bottom makes the sphere of the top radius
+ * centred at <0, bottom, 0>, with a warning, as POV-Ray substitutes it) */
+static void ovus_args(sdl_parser *p, scene_object *o, src_loc loc)
+{
+    double b = sdl_float(p);
+    sdl_accept(p, TOK_COMMA);
+    double t = sdl_float(p);
+    if (!sdl_ok(p)) return;
+    if (!(b >= 0.0) || !(t >= 0.0)) {
+        sdl_error(p, loc, PT_ERR_SYNTAX, "both ovus radii must be positive");
+        return;
+    }
+    if (!(t < 2.0 * b)) {
+        sdl_warning(p, loc, "ovus top radius should be less than twice the bottom radius; a sphere replaces it, as in POV-Ray");
+        o->kind = SHAPE_SPHERE;
+        o->name = "ovus";
+        o->u.sphere.centre = v3(0.0, b, 0.0);
+        o->u.sphere.radius = t;
+        return;
+    }
+    o->kind = SHAPE_OVUS;
+    o->name = "ovus";
+    o->u.ovus.bottom = b;
+    o->u.ovus.top = t;
+}
+
 /* ------------------------------------------------------------ dispatch */
 
 void sdl_shape_args(sdl_parser *p, sdl_kw k, sdl_obj *so, src_loc loc)
@@ -1324,6 +1353,7 @@ void sdl_shape_args(sdl_parser *p, sdl_kw k, sdl_obj *so, src_loc loc)
     case KW_ISOSURFACE: isosurface_args(p, o, loc); break;
     case KW_PARAMETRIC: parametric_args(p, so, loc); break;
     case KW_JULIA_FRACTAL: julia_args(p, o, loc); break;
+    case KW_OVUS: ovus_args(p, o, loc); break;
     default: break;
     }
     /* anything that did not produce a shape stays reported as unsupported */
