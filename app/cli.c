@@ -4,7 +4,8 @@
  * options"): +Wn +Hn (size), +Ofile (output), +Ifile (input), +A[t] / -A
  * (antialiasing with threshold t, default 0.3), +Rn (AA depth), +Lpath
  * (library path), +FE/+FN (format, implied by the output name here), +WTn
- * (work threads), +Kc (clock). Switches that only concern POV-Ray's display
+ * (work threads), +Kc (clock), +KFIn +KFFn +KIc +KFc +KC (animation frames
+ * and clocks, cyclic), +SFn +EFn (frame subset). Switches that only concern POV-Ray's display
  * or its own files (+D, -D, +P, +V, +J...) are accepted and ignored. */
 #include "cli.h"
 #include <errno.h>
@@ -88,7 +89,38 @@ static int pov_switch(const char *arg, cli_render *o, char *err, int errlen)
     case 'L':
         if (*v && add_list(o->libs, &o->nlibs, v)) return 0;
         break;
-    case 'F': case 'D': case 'P': case 'V': case 'J': case 'X': case 'Q': case 'K': case 'G': case 'B': case 'C':
+    case 'K': /* +KFIn +KFFn +KIc +KFc +KC +Kc (POV-Ray 3.7 "Animation Options") */
+        if ((v[0] == 'F' || v[0] == 'f') && (v[1] == 'I' || v[1] == 'i')) {
+            if (parse_int(v + 2, &o->kfi)) { o->kfi_given = 1; return 0; }
+        } else if ((v[0] == 'F' || v[0] == 'f') && (v[1] == 'F' || v[1] == 'f')) {
+            if (parse_int(v + 2, &o->kff)) { o->kff_given = 1; return 0; }
+        } else if (v[0] == 'I' || v[0] == 'i') {
+            if (parse_double(v + 1, &o->ki)) return 0;
+        } else if (v[0] == 'F' || v[0] == 'f') {
+            if (parse_double(v + 1, &o->kf)) return 0;
+        } else if ((v[0] == 'C' || v[0] == 'c') && !v[1]) {
+            o->cyclic = on;
+            return 0;
+        } else if (!*v) {
+            return 0; /* "+K" alone: clock_on with the current clock */
+        } else if (parse_double(v, &o->clock)) {
+            o->clock_given = 1;
+            return 0;
+        }
+        break;
+    case 'S': case 'E': /* +SFn / +EFn: subset of frames; +SR +SC +ER +EC (render window) are ignored */
+        if (v[0] == 'F' || v[0] == 'f') {
+            int *f = c == 'S' ? &o->sf : &o->ef;
+            if (parse_int(v + 1, f)) {
+                if (c == 'S') o->sf_given = 1;
+                else o->ef_given = 1;
+                return 0;
+            }
+            break;
+        }
+        if (v[0] == 'R' || v[0] == 'r' || v[0] == 'C' || v[0] == 'c') return 0;
+        break;
+    case 'F': case 'D': case 'P': case 'V': case 'J': case 'X': case 'Q': case 'G': case 'B': case 'C':
         return 0; /* format (from the file name), display, pause, verbose, jitter...: ignored */
     default:
         break;
@@ -118,6 +150,8 @@ static int parse_size(const char *v, cli_render *o)
 int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen)
 {
     memset(o, 0, sizeof *o);
+    o->kfi = o->kff = 1; /* POV-Ray's Initial_Frame, Final_Frame, Initial_Clock, Final_Clock */
+    o->kf = 1;
     o->aa_threshold = 0.3;
     o->aa_depth = 3;
     o->spp = 1;
@@ -207,6 +241,17 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
             else if (strcmp(a, "--fg-rays") == 0) o->fg_rays = v;
             else o->max_depth = v;
             i++;
+        } else if (strcmp(a, "--clock") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (!parse_double(next, &o->clock)) { snprintf(err, (size_t)errlen, "--clock wants a number"); return 2; }
+            o->clock_given = 1;
+            i++;
+        } else if (strcmp(a, "--frame") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (!parse_int(next, &o->sf)) { snprintf(err, (size_t)errlen, "--frame wants an integer"); return 2; }
+            o->ef = o->sf;
+            o->sf_given = o->ef_given = 1;
+            i++;
         } else if (strcmp(a, "--float") == 0) {
             o->exr_float = 1;
         } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
@@ -270,6 +315,34 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
     }
     if (!o->scene) {
         snprintf(err, (size_t)errlen, "no scene file given");
+        return 2;
+    }
+    sdl_options check; /* frame options are checked here, applied by the caller */
+    sdl_default_options(&check);
+    return cli_animation(o, &check, err, errlen);
+}
+
+int cli_animation(const cli_render *o, sdl_options *so, char *err, int errlen)
+{
+    int kfi = o->kfi, kff = o->kff;
+    if (o->kfi_given && !o->kff_given && kff < kfi) kff = kfi; /* +KFI3 alone: frames 3..3 (POV-Ray) */
+    int anim = (o->kfi_given || o->kff_given) && !(kfi == 1 && kff == 1 && !o->cyclic);
+    if (!anim) {
+        if (o->sf_given || o->ef_given) {
+            snprintf(err, (size_t)errlen, "+SF/+EF/--frame need an animation (+KFI and +KFF)");
+            return 2;
+        }
+        if (o->clock_given) sdl_set_still_clock(so, o->clock);
+        return 0;
+    }
+    int sf = o->sf_given ? o->sf : kfi;
+    int ef = o->ef_given ? o->ef : (o->sf_given ? sf : kfi);
+    if (sf != ef) {
+        snprintf(err, (size_t)errlen, "partray parses and renders one frame per run: choose it with --frame N (or +SFn +EFn with n equal), not frames %d..%d", sf, ef);
+        return 2;
+    }
+    if (sdl_set_frame(so, kfi, kff, o->ki, o->kf, o->cyclic, sf) != 0) {
+        snprintf(err, (size_t)errlen, "frame %d is outside the animation's frames %d..%d", sf, kfi, kff);
         return 2;
     }
     return 0;

@@ -3,6 +3,7 @@
 #ifndef PT_CLI_H
 #define PT_CLI_H
 #include <stdint.h>
+#include "sdl.h"
 
 #define CLI_MAX_LIST 64
 
@@ -46,7 +47,22 @@ typedef struct {
     const char *aovs;       /* --aovs LIST: extra EXR layers */
     const char *units;      /* --units m|cm|mm|ft|...|METRES: photometric lights */
     const char *fc_quantity;/* --false-color-quantity luminance|illuminance */
+    /* clock and animation (POV-Ray 3.7: +K, +KFI, +KFF, +KI, +KF, +KC, +SF, +EF) */
+    double clock;           /* --clock V / +KV: a still's clock */
+    int clock_given;
+    int kfi, kff;           /* initial/final frame (default 1, 1) */
+    int kfi_given, kff_given;
+    double ki, kf;          /* initial/final clock (default 0, 1) */
+    int cyclic;
+    int sf, ef;             /* subset start/end frame (--frame N sets both) */
+    int sf_given, ef_given;
 } cli_render;
+
+/* The animation the options ask for, applied to the parser's options
+ * (sdl_options clock, frame_number...): a still with +K, or one frame of an
+ * animation (partray parses and renders one frame per run: +SF/+EF or
+ * --frame choose it, default the first). Returns 0, or 2 with a message. */
+int cli_animation(const cli_render *o, sdl_options *so, char *err, int errlen);
 
 /* Parses argv (after the subcommand). Returns 0 on success, otherwise writes
  * a message into err and returns 2 (usage). */

@@ -55,7 +55,8 @@ static const char *usage_text =
     "                 [--max-loop N] [--max-include-depth N] [--max-macro-depth N]\n"
     "                 [--max-tokens N] [--max-memory MIB] [--max-string BYTES] [--max-array N]\n"
     "                 [+W640 +H480 +A0.3 +R3 +Oout.png +Iscene.pov +Ldir ...]\n"
-    "  partray parse SCENE.pov [-D NAME=VALUE] [-L DIR]\n"
+    "                 [--clock V | +KV] [+KFIn +KFFn +KIv +KFv +KC] [--frame N | +SFn +EFn]\n"
+    "  partray parse SCENE.pov [-D NAME=VALUE] [-L DIR] [--clock V] [frame options as render]\n"
     "  partray compare REF TEST [--heatmap OUT.png] [--json]\n"
     "  partray sweep SCENE.pov --ref REF.exr [--gi MODE[,MODE...]] --vary [MODE/]KEY=v1,v2,... [--out DIR]\n"
     "                [--size WxH] [--metric relmse|rmse|flip|psnr|ssim] [--time total|render|wall] [render options]\n"
@@ -109,6 +110,8 @@ static void fill_sdl_options(sdl_options *so, const cli_render *o)
     if (o->max_string > 0) so->max_string_length = o->max_string;
     if (o->max_array > 0) so->max_array_elements = o->max_array;
     so->func_env = shade_func_env(); /* pattern/pigment functions, noise, vturbulence while parsing */
+    char err[256];
+    cli_animation(o, so, err, sizeof err); /* checked by cli_parse_render already */
 }
 
 /* The image size must fit what the writers accept and the memory there is:

@@ -11,7 +11,15 @@ typedef struct {
     int no_default_lib;           /* 1: do not add /usr/share/povray-3.7/include */
     const char *const *defines;   /* "NAME=VALUE" (-D): declared before parsing; VALUE a float or a string */
     int ndefines;
-    double clock;                 /* value of `clock`, default 0 */
+    /* Animation values as POV-Ray 3.7's front end sets them: `clock`,
+     * `clock_on`, `clock_delta`, `frame_number`, `initial_frame`,
+     * `final_frame`, `initial_clock`, `final_clock`. sdl_default_options
+     * gives a still without +K (all 0); sdl_set_still_clock and
+     * sdl_set_frame fill them for +K and for a frame of an animation. */
+    double clock;
+    int clock_on;
+    double clock_delta, initial_clock, final_clock;
+    int frame_number, initial_frame, final_frame;
     int image_width, image_height;/* values of image_width/image_height */
     long max_loop_iterations;     /* per #while/#for loop, 0 = default (10,000,000) */
     int max_include_depth;        /* 0 = default (64) */
@@ -33,6 +41,19 @@ typedef struct {
 } sdl_options;
 
 void sdl_default_options(sdl_options *o);
+/* A still rendered with +K<clock>: clock = v, clock_on = 1, the frame
+ * values 0. */
+void sdl_set_still_clock(sdl_options *o, double clock);
+/* Frame `frame` of the animation +KFI<initial_frame> +KFF<final_frame>
+ * +KI<initial_clock> +KF<final_clock> [+KC]: clock_delta = (KF - KI) /
+ * (KFF - KFI), or / (KFF - KFI + 1) and final_frame = KFF + 1 when cyclic;
+ * clock = KI + (frame - KFI) * clock_delta (measured against povray 3.7.0,
+ * tests/test_sdl_lang.c). A single frame 1..1 is a still, as in POV-Ray; any
+ * other single frame gets clock = KI (POV-Ray divides by zero there).
+ * Returns 0, or -1 (nothing changed) when frame is outside KFI..KFF or
+ * KFF < KFI. */
+int sdl_set_frame(sdl_options *o, int initial_frame, int final_frame, double initial_clock, double final_clock, int cyclic,
+                  int frame);
 
 /* Parse a file. On success *out holds a new scene (caller frees with
  * scene_free). On error, messages with locations and the include/macro chain

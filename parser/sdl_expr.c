@@ -421,7 +421,7 @@ static double float_function(sdl_parser *p, sdl_kw k, src_loc loc)
     case KW_TRUE: case KW_YES: case KW_ON: return 1;
     case KW_FALSE: case KW_NO: case KW_OFF: return 0;
     case KW_CLOCK: return p->opt.clock;
-    case KW_CLOCK_ON: return 0;
+    case KW_CLOCK_ON: return p->opt.clock_on;
     case KW_VERSION: return p->version;
     case KW_NOW: {
         /* days since 2000-01-01 00:00 UTC, to the microsecond (POV-Ray 3.7) */

@@ -264,6 +264,37 @@ void sdl_default_options(sdl_options *o)
     o->max_memory = pages > 0 && page > 0 ? (long long)pages * page / 2 : 4LL << 30;
 }
 
+void sdl_set_still_clock(sdl_options *o, double clock)
+{
+    o->clock = clock;
+    o->clock_on = 1;
+    o->clock_delta = o->initial_clock = o->final_clock = 0;
+    o->frame_number = o->initial_frame = o->final_frame = 0;
+}
+
+int sdl_set_frame(sdl_options *o, int initial_frame, int final_frame, double initial_clock, double final_clock, int cyclic,
+                  int frame)
+{
+    if (final_frame < initial_frame || frame < initial_frame || frame > final_frame) return -1;
+    if (initial_frame == 1 && final_frame == 1 && !cyclic) { /* POV-Ray: not an animation */
+        o->clock = 0;
+        o->clock_on = 0;
+        o->clock_delta = o->initial_clock = o->final_clock = 0;
+        o->frame_number = o->initial_frame = o->final_frame = 0;
+        return 0;
+    }
+    int span = final_frame - initial_frame + (cyclic ? 1 : 0);
+    o->clock_on = 1;
+    o->initial_frame = initial_frame;
+    o->final_frame = final_frame + (cyclic ? 1 : 0);
+    o->frame_number = frame;
+    o->initial_clock = initial_clock;
+    o->final_clock = final_clock;
+    o->clock_delta = span > 0 ? (final_clock - initial_clock) / span : 0;
+    o->clock = initial_clock + (frame - initial_frame) * o->clock_delta;
+    return 0;
+}
+
 static void declare_float(sdl_parser *p, const char *name, double v)
 {
     sdl_value val = {VAL_FLOAT, 1, {v, 0, 0, 0, 0}, NULL, NULL};
@@ -305,12 +336,12 @@ static void predeclare(sdl_parser *p)
 {
     declare_float(p, "image_width", p->opt.image_width);
     declare_float(p, "image_height", p->opt.image_height);
-    declare_float(p, "clock_delta", 1);
-    declare_float(p, "frame_number", 0);
-    declare_float(p, "initial_clock", 0);
-    declare_float(p, "final_clock", 0);
-    declare_float(p, "initial_frame", 0);
-    declare_float(p, "final_frame", 0);
+    declare_float(p, "clock_delta", p->opt.clock_delta);
+    declare_float(p, "frame_number", p->opt.frame_number);
+    declare_float(p, "initial_clock", p->opt.initial_clock);
+    declare_float(p, "final_clock", p->opt.final_clock);
+    declare_float(p, "initial_frame", p->opt.initial_frame);
+    declare_float(p, "final_frame", p->opt.final_frame);
     for (int i = 0; i < p->opt.ndefines; i++)
         if (p->opt.defines[i]) declare_define(p, p->opt.defines[i]);
 }

@@ -88,6 +88,52 @@ static void test_usage(void **st)
     assert_non_null(strstr(tu_out, "partray render"));
 }
 
+/* --clock, +K and the animation switches: the predeclared identifiers as
+ * POV-Ray 3.7.0 gives them (each expected pair printed by
+ * `povray +Ik.pov -F -D +W8 +H6 OPTIONS` with the same scene). */
+static void test_animation(void **st)
+{
+    (void)st;
+    static const struct {
+        const char *opts, *k, *c;
+    } cases[] = {
+        {"", "K 0.000000 0 fn 0 if 0 ff 0", "C 0.000000 0.000000 0.000000"},
+        {"+K0.5", "K 0.500000 1 fn 0 if 0 ff 0", "C 0.000000 0.000000 0.000000"},
+        {"--clock 0.25", "K 0.250000 1 fn 0 if 0 ff 0", "C 0.000000 0.000000 0.000000"},
+        {"+KFI1 +KFF10 +SF4 +EF4", "K 0.333333 1 fn 4 if 1 ff 10", "C 0.000000 1.000000 0.111111"},
+        {"+KFI1 +KFF10", "K 0.000000 1 fn 1 if 1 ff 10", "C 0.000000 1.000000 0.111111"},
+        {"+KFI0 +KFF4 +KI2 +KF3 +SF2 +EF2", "K 2.500000 1 fn 2 if 0 ff 4", "C 2.000000 3.000000 0.250000"},
+        {"+KFI1 +KFF5 +KC +SF3 +EF3", "K 0.400000 1 fn 3 if 1 ff 6", "C 0.000000 1.000000 0.200000"},
+        {"+KFF3 +SF2 +EF2", "K 0.500000 1 fn 2 if 1 ff 3", "C 0.000000 1.000000 0.500000"},
+        {"+K0.5 +KFF3 --frame 2", "K 0.500000 1 fn 2 if 1 ff 3", "C 0.000000 1.000000 0.500000"},
+        {"+KI1 +KF2", "K 0.000000 0 fn 0 if 0 ff 0", "C 0.000000 0.000000 0.000000"},
+        {"+KFI2 +KFF4 +KI1 +KF0 +SF4 +EF4", "K 0.000000 1 fn 4 if 2 ff 4", "C 1.000000 0.000000 -0.500000"},
+        {"+KFI2 +KFF4 +KC +SF2 +EF2", "K 0.000000 1 fn 2 if 2 ff 5", "C 0.000000 1.000000 0.333333"},
+        {"+K2 +KFI1 +KFF1", "K 2.000000 1 fn 0 if 0 ff 0", "C 0.000000 0.000000 0.000000"},
+    };
+    char scene[512], cmd[2048];
+    snprintf(scene, sizeof scene, "%s/anim.pov", tmpdir);
+    tu_write_file(scene, "#debug concat(\"K \", str(clock,0,6), \" \", str(clock_on,0,0), \" fn \", str(frame_number,0,0), "
+                         "\" if \", str(initial_frame,0,0), \" ff \", str(final_frame,0,0), \"\\n\")\n"
+                         "#debug concat(\"C \", str(initial_clock,0,6), \" \", str(final_clock,0,6), \" \", "
+                         "str(clock_delta,0,6), \"\\n\")\nsphere { 0, 1 }\n");
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        snprintf(cmd, sizeof cmd, "'%s' parse '%s' %s", PARTRAY_BIN, scene, cases[i].opts);
+        int rc = tu_run_capture(cmd);
+        if (rc != 0 || !strstr(tu_out, cases[i].k) || !strstr(tu_out, cases[i].c))
+            printf("%s\n  want \"%s\" and \"%s\"\n  got %s", cases[i].opts, cases[i].k, cases[i].c, tu_out);
+        assert_int_equal(rc, 0);
+        assert_non_null(strstr(tu_out, cases[i].k));
+        assert_non_null(strstr(tu_out, cases[i].c));
+    }
+    /* one frame per run; a frame needs an animation and must be in it */
+    const char *bad[] = {"+KFI1 +KFF10 +SF4 +EF5", "--frame 3", "+KFI1 +KFF3 --frame 9", "+KFI5 +KFF2", "--clock x"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        snprintf(cmd, sizeof cmd, "'%s' parse '%s' %s", PARTRAY_BIN, scene, bad[i]);
+        assert_int_equal(tu_run_capture(cmd), 2);
+    }
+}
+
 /* A white diffuse plane under a point light straight above: the pixel in the
  * image centre sees radiance L = diffuse * I * cos(0) = 0.5 * 1 * 1 (POV-Ray's
  * lights do not fall off with distance unless fade is given). Checks -D, the
@@ -185,6 +231,7 @@ int main(void)
         cmocka_unit_test(test_unterminated_block),
         cmocka_unit_test(test_include_chain),
         cmocka_unit_test(test_usage),
+        cmocka_unit_test(test_animation),
         cmocka_unit_test(test_render_outputs_and_stats),
         cmocka_unit_test(test_sigint_partial),
     };
