@@ -11,6 +11,7 @@
 #include "cmd_crosscheck.h"
 #include "cmd_sweep.h"
 #include "diag.h"
+#include "accel_query.h"
 #include "framebuffer.h"
 #include "gi.h"
 #include "img_falsecolor.h"
@@ -110,6 +111,7 @@ static void fill_sdl_options(sdl_options *so, const cli_render *o)
     if (o->max_string > 0) so->max_string_length = o->max_string;
     if (o->max_array > 0) so->max_array_elements = o->max_array;
     so->func_env = shade_func_env(); /* pattern/pigment functions, noise, vturbulence while parsing */
+    so->geom_env = accel_geom_env();  /* trace()/inside() of the shapes the parser does not intersect */
     char err[256];
     cli_animation(o, so, err, sizeof err); /* checked by cli_parse_render already */
 }

@@ -38,6 +38,10 @@ typedef struct {
     const struct func_env *func_env; /* evaluators for pigment/pattern functions, noise and
                                      vturbulence at parse time (core/func.h); NULL: such
                                      calls are located PT_ERR_UNSUPPORTED errors */
+    const struct geom_env *geom_env; /* trace()/inside() of sor, poly (cubic, quartic,
+                                     polynomial), text, julia_fractal, polygon and
+                                     height_field through the renderer's intersector
+                                     (core/geom_env.h); NULL: located PT_ERR_UNSUPPORTED */
 } sdl_options;
 
 void sdl_default_options(sdl_options *o);

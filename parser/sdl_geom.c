@@ -7,6 +7,7 @@
 #include <string.h>
 #include "sdl_directive.h"
 #include "func.h"
+#include "geom_env.h"
 #include "sdl_expr.h"
 
 #define DEPTH_TOLERANCE 1e-6    /* POV-Ray's shapes ignore hits closer than this */
@@ -1018,6 +1019,78 @@ static void iso_hits(geom *g, const scene_object *o, vec3 org, vec3 dir, hit_lis
     if (fa < 0) add_hit(g, l, t1, world_normal(o, n1), o);
 }
 
+/* ------------------------------------------------------------ the renderer's shapes */
+
+/* Shapes without a parse-time intersector here are asked of the renderer's
+ * (sdl_options.geom_env): each object is prepared once per parse. */
+#define ENV_BUCKETS 256
+#define ENV_MAX_HITS 256
+
+typedef struct env_shape {
+    const scene_object *o;
+    void *sh;                   /* NULL: degenerate, no hits, never inside */
+    struct env_shape *next;
+} env_shape;
+
+static int env_kind(shape_kind k)
+{
+    return k == SHAPE_SOR || k == SHAPE_POLY || k == SHAPE_TEXT || k == SHAPE_JULIA || k == SHAPE_POLYGON ||
+           k == SHAPE_HEIGHT_FIELD;
+}
+
+/* The prepared shape of o; sets g->unsupported without an environment. */
+static const env_shape *env_get(geom *g, const scene_object *o)
+{
+    const geom_env *env = g->p->opt.geom_env;
+    if (!env) {
+        if (!g->unsupported) g->unsupported = o->name ? o->name : "object";
+        return NULL;
+    }
+    env_shape **tab = g->p->geom_shapes;
+    if (!tab) {
+        tab = calloc(ENV_BUCKETS, sizeof *tab);
+        if (!tab) {
+            g->nomem = 1;
+            return NULL;
+        }
+        g->p->geom_shapes = tab;
+    }
+    size_t b = ((size_t)o >> 4) % ENV_BUCKETS;
+    for (env_shape *e = tab[b]; e; e = e->next)
+        if (e->o == o) return e;
+    env_shape *e = calloc(1, sizeof *e);
+    if (!e) {
+        g->nomem = 1;
+        return NULL;
+    }
+    int nomem = 0;
+    e->o = o;
+    e->sh = env->prepare(o, &nomem);
+    if (nomem) g->nomem = 1;
+    e->next = tab[b];
+    tab[b] = e;
+    return e;
+}
+
+static void env_hits(geom *g, const scene_object *o, vec3 org, vec3 dir, hit_list *l)
+{
+    const env_shape *e = env_get(g, o);
+    if (!e || !e->sh) return;
+    double t[ENV_MAX_HITS];
+    vec3 n[ENV_MAX_HITS];
+    /* from behind the origin too: CSG filters and inside tests count them */
+    int k = g->p->opt.geom_env->hits(e->sh, org, dir, -INFINITY, INFINITY, t, n, ENV_MAX_HITS);
+    for (int i = 0; i < k; i++) add_hit(g, l, t[i], n[i], o);
+}
+
+/* -1: cannot say */
+static int env_inside(geom *g, const scene_object *o, vec3 pw)
+{
+    const env_shape *e = env_get(g, o);
+    if (!e) return -1;
+    return e->sh ? g->p->opt.geom_env->inside(e->sh, pw) != 0 : 0;
+}
+
 /* ------------------------------------------------------------ objects */
 
 static int obj_inside(geom *g, const scene_object *o, vec3 p);
@@ -1028,9 +1101,11 @@ static int is_csg(const scene_object *o)
     return o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE;
 }
 
-/* Inside test of a leaf in its own space, before `inverse`. -1: cannot. */
-static int leaf_inside(geom *g, const scene_object *o, vec3 q)
+/* Inside test of a leaf at q in its own space (pw in the world), before
+ * `inverse`. -1: cannot. */
+static int leaf_inside(geom *g, const scene_object *o, vec3 q, vec3 pw)
 {
+    if (env_kind(o->kind) && o->kind != SHAPE_POLYGON) return env_inside(g, o, pw);
     switch (o->kind) {
     case SHAPE_SPHERE: {
         vec3 d = v3_sub(q, o->u.sphere.centre);
@@ -1090,7 +1165,7 @@ static int obj_inside(geom *g, const scene_object *o, vec3 p)
             }
         }
     } else {
-        in = leaf_inside(g, o, xform_inv_point(&o->transform, p));
+        in = leaf_inside(g, o, xform_inv_point(&o->transform, p), p);
         if (in < 0) return -1;
     }
     if (o->flags & OBJ_INVERSE) in = !in;
@@ -1118,6 +1193,9 @@ static void leaf_hits(geom *g, const scene_object *o, vec3 org, vec3 dir, hit_li
         if (o->u.lathe) shape_marched_hits(g, o, org, dir, l); /* u.lathe/u.prism/u.blob share the slot */
         return;
     case SHAPE_ISOSURFACE: iso_hits(g, o, org, dir, l); return;
+    case SHAPE_SOR: case SHAPE_POLY: case SHAPE_TEXT: case SHAPE_JULIA: case SHAPE_POLYGON: case SHAPE_HEIGHT_FIELD:
+        env_hits(g, o, org, dir, l);
+        return;
     default:
         if (!g->unsupported) g->unsupported = o->name ? o->name : "object";
         return;
@@ -1598,6 +1676,20 @@ void sdl_geom_free(sdl_parser *p)
         h = n;
     }
     p->geom_cache = NULL;
+    env_shape **tab = p->geom_shapes;
+    if (tab) {
+        for (int b = 0; b < ENV_BUCKETS; b++) {
+            env_shape *e = tab[b];
+            while (e) {
+                env_shape *n = e->next;
+                if (e->sh) p->opt.geom_env->release(e->sh);
+                free(e);
+                e = n;
+            }
+        }
+        free(tab);
+    }
+    p->geom_shapes = NULL;
 }
 
 /* Boxes in the shape's own space for the marched shapes (lathe: POV-Ray's

@@ -9,9 +9,13 @@
  * member of an intersection, outside every other member of a merge) and
  * clipped_by. Torus and superellipsoid hits are found by marching the ray
  * (steps of minor radius/16, resp. 1/64 of the box) and bisection: exact to
- * 1e-12 except for grazing rays that touch without crossing. Other shapes
- * (lathe, sor, prism, blob, poly, height_field, text, isosurface, ...) give a
- * located PT_ERR_UNSUPPORTED error for trace/inside.
+ * 1e-12 except for grazing rays that touch without crossing; lathe, prism,
+ * blob and isosurface are marched the same way. sor, poly (cubic, quartic,
+ * polynomial), text, julia_fractal, polygon and height_field are asked of the
+ * renderer's intersector through sdl_options.geom_env (accel_query.h: the
+ * code that renders them); without it, and for shapes the IR cannot draw,
+ * trace/inside give a located PT_ERR_UNSUPPORTED error. sphere_sweep and
+ * bicubic_patch are unions of spheres and cones, resp. meshes, in the IR.
  *
  * Extents follow POV-Ray 3.7's bounding boxes: the shape's box in its own
  * space, transformed corner by corner (spheres moved only by translation,
