@@ -19,6 +19,7 @@
 #include "scene.h"
 #include "sdl.h"
 #include "shade_funcenv.h"
+#include "accel_query.h"
 
 #ifndef PT_TESTS_DIR
 #define PT_TESTS_DIR "tests"
@@ -159,6 +160,54 @@ static void test_strings(void **st)
     double now = atof(note(d, 0));
     assert_true(now >= t0 - 1.0 / 86400 && now <= t1 + 1.0 / 86400);
     assert_true(atoi(note(d, 1)) >= 2024);
+    diag_free(d);
+}
+
+/* trace() and inside() of sor, poly/cubic/quartic, text, julia_fractal,
+ * polygon and height_field through the renderer's intersector
+ * (accel_geom_env): each #debug line within 1e-5 of POV-Ray 3.7.0's
+ * (tests/sdl/trace_shapes.expected). Without the environment they are a
+ * located PT_ERR_UNSUPPORTED error. */
+static void test_trace_shapes(void **st)
+{
+    (void)st;
+    char path[1024], exp[1024];
+    snprintf(path, sizeof path, "%s/sdl/trace_shapes.pov", PT_TESTS_DIR);
+    snprintf(exp, sizeof exp, "%s/sdl/trace_shapes.expected", PT_TESTS_DIR);
+    FILE *f = fopen(exp, "r");
+    assert_non_null(f);
+    sdl_options o;
+    sdl_default_options(&o);
+    o.func_env = shade_func_env();
+    o.geom_env = accel_geom_env();
+    diag *d = diag_new();
+    scene *s = NULL;
+    pt_status rc = sdl_parse_file(path, &o, &s, d);
+    if (rc != PT_OK) print_diag(d);
+    assert_int_equal(rc, PT_OK);
+    char line[1024];
+    int n = 0, bad = 0;
+    while (fgets(line, sizeof line, f)) {
+        line[strcspn(line, "\n")] = 0;
+        const char *full = note(d, n);
+        char got[1024] = "";
+        if (full) snprintf(got, sizeof got, "%.*s", (int)strcspn(full, "\n"), full); /* the macro chain follows */
+        if (!full || !same_line(got, line, 1e-5)) {
+            print_message("line %d: partray \"%s\"\n         POV-Ray \"%s\"\n", n + 1, full ? got : "(none)", line);
+            bad++;
+        }
+        n++;
+    }
+    fclose(f);
+    assert_true(n >= 20);
+    assert_int_equal(bad, 0);
+    scene_free(s);
+    diag_free(d);
+
+    d = parse_text("#declare S = sor { 4, <0,0>, <1,0>, <0.5,1>, <0,2> }\n#declare P = trace(S, 3*x, -x);\n", NULL,
+                   PT_ERR_UNSUPPORTED, NULL);
+    assert_non_null(strstr(first_error(d), "trace: shape 'sor' is not supported"));
+    assert_int_equal(diag_get(d, 0)->loc.line, 2);
     diag_free(d);
 }
 
@@ -563,6 +612,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_lang_checks),
         cmocka_unit_test(test_strings),
+        cmocka_unit_test(test_trace_shapes),
         cmocka_unit_test(test_arrays_ir),
         cmocka_unit_test(test_macros),
         cmocka_unit_test(test_functions_ir),
