@@ -20,6 +20,7 @@
 #include "timer.h"
 #include "view_camera.h"
 #include "view_gi.h"
+#include "view_overlay.h"
 #include "view_render.h"
 #include "view_script.h"
 
@@ -28,11 +29,11 @@ enum { EXIT_OK = 0, EXIT_SCENE = 1, EXIT_USAGE = 2, EXIT_IO = 3 };
 #define MAX_LATENCIES 4096
 
 static const char *view_usage =
-    "usage: partray view SCENE.pov [--size WxH] [--gi none|particle|path] [--threads N] [--seed N]\n"
-    "                    [--script FILE] [--preview D] [--verbose] [-D NAME=VALUE] [-L DIR]\n"
+    "usage: partray view SCENE.pov [--size WxH] [--gi none|particle|path|pmfg] [--threads N] [--seed N]\n"
+    "                    [--script FILE] [--preview D] [--ref-spp N] [--verbose] [-D NAME=VALUE] [-L DIR]\n"
     "keys: WASD/QE fly, right drag look, left drag orbit, wheel zoom, R reset camera,\n"
     "      1-9/Tab select light, arrows/PgUp/PgDn move it, +/- brighten/dim it,\n"
-    "      G cycle GI mode, F12/P screenshot, C write camera, H help, Esc quit\n";
+    "      G cycle GI mode, O overlay on/off, F12/P screenshot, C write camera, H help, Esc quit\n";
 
 /* Figures for the exit summary and `mark`. */
 typedef struct {
@@ -75,6 +76,10 @@ typedef struct {
     SDL_Window *win;
     SDL_Renderer *ren;
     SDL_Texture *tex;
+    SDL_Texture *otex;       /* the overlay (figures), blended over the image */
+    uint8_t *orgba;
+    int overlay;             /* O toggles */
+    const char *window_shot; /* `window PATH`: saved after the next redraw */
     uint8_t *rgba;
     long serial;
     view_frame_info info;
@@ -262,6 +267,9 @@ static void print_mark(viewer *v, const char *name)
 
 /* --------------------------------------------------------------- actions */
 
+static int take_image(viewer *v, double now);
+static void present(viewer *v);
+
 static void light_move(viewer *v, int i, vec3 delta)
 {
     view_light *l = &v->lights[i];
@@ -292,6 +300,12 @@ static void apply(viewer *v, const view_action *a)
     case VIEW_ACT_WAIT_IDLE:
         break;
     case VIEW_ACT_SCREENSHOT: screenshot(v, a->text); break;
+    case VIEW_ACT_WINDOW_SHOT:
+        /* drawn now, so the file shows the state at this event */
+        take_image(v, timer_now());
+        v->window_shot = a->text;
+        present(v);
+        break;
     case VIEW_ACT_CAMERA_WRITE: write_camera(v, a->text); break;
     case VIEW_ACT_MARK: print_mark(v, a->text); break;
     case VIEW_ACT_QUIT: v->quit = 1; break;
@@ -432,6 +446,10 @@ static void on_key(viewer *v, const SDL_KeyboardEvent *k)
     case SDLK_MINUS:
     case SDLK_KP_MINUS: a = act3(VIEW_ACT_LIGHT_SCALE, 0.8, 0, 0); break;
     case SDLK_h: fputs(view_usage, stdout); return;
+    case SDLK_o:
+        v->overlay = !v->overlay;
+        v->need_present = 1;
+        return;
     case SDLK_r:
         v->cam = v->cam_home;
         v->dirty |= VIEW_CAUSE_CAMERA;
@@ -525,6 +543,8 @@ static void update_title(viewer *v, double now)
     char mode[64];
     if (v->have_image && in->wanted_mode != in->gi_mode)
         snprintf(mode, sizeof mode, "%s (building %s)", view_gi_name(in->gi_mode), view_gi_name(in->wanted_mode));
+    else if (v->have_image && in->gi_stale)
+        snprintf(mode, sizeof mode, "%s (relighting)", view_gi_name(in->gi_mode));
     else
         snprintf(mode, sizeof mode, "%s", view_gi_name(v->have_image ? in->gi_mode : v->gi_mode));
     if (!v->have_image) {
@@ -586,6 +606,72 @@ static int take_image(viewer *v, double now)
     return 1;
 }
 
+/* The overlay's lines: the same figures as the title bar. */
+static int overlay_lines(viewer *v, double now, char lines[][128], int max)
+{
+    const view_frame_info *in = &v->info;
+    int n = 0;
+    double busy_for = 0;
+    int busy = view_render_busy(v->vr, &busy_for);
+    int k = 0;
+    for (int i = 0; i < v->nrecent; i++)
+        if (now - v->recent[i] <= 1.0) k++;
+    char work[48] = "IDLE";
+    if (busy >= 0) snprintf(work, sizeof work, "BUSY L%d %.1f S", busy, busy_for);
+    if (!v->have_image) {
+        snprintf(lines[n++], 128, "%s: FIRST IMAGE... (%s)", view_gi_name(v->gi_mode), work);
+        return n;
+    }
+    if (in->wanted_mode != in->gi_mode)
+        snprintf(lines[n++], 128, "%s (BUILDING %s) %dX%d L%d/%d %d IMG/S %s", view_gi_name(in->gi_mode),
+                 view_gi_name(in->wanted_mode), in->width, in->height, in->level, in->last_level, k, work);
+    else
+        snprintf(lines[n++], 128, "%s %dX%d L%d/%d %d IMG/S %s", view_gi_name(in->gi_mode), in->width, in->height,
+                 in->level, in->last_level, k, work);
+    snprintf(lines[n++], 128, "FRAME %.0f MS: BUILD %.0f LIGHT %.0f VIEW %.0f RENDER %.0f", in->frame * 1e3,
+             in->times.build * 1e3, in->times.light * 1e3, in->times.view * 1e3, in->times.render * 1e3);
+    snprintf(lines[n++], 128, "LATENCY %.0f MS%s%s", in->latency * 1e3, in->gi_stale ? ", GI STALE (RELIGHTING)" : "",
+             in->complete ? ", DONE" : "");
+    if (n < max && in->describe[0]) snprintf(lines[n++], 128, "%.80s", in->describe);
+    if (n < max && v->nlights > 0) {
+        const view_light *l = &v->lights[v->selected];
+        snprintf(lines[n++], 128, "LIGHT %d/%d <%.3g,%.3g,%.3g> X%.3g", v->selected + 1, v->nlights, l->position.x,
+                 l->position.y, l->position.z, (l->colour.r + l->colour.g + l->colour.b) / 3);
+    }
+    return n;
+}
+
+/* `window PATH`: the window's pixels as drawn, 8-bit sRGB, into a PNG. */
+static void save_window(viewer *v, const char *path)
+{
+    int w = 0, h = 0;
+    if (SDL_GetRendererOutputSize(v->ren, &w, &h) != 0 || w < 1 || h < 1) {
+        fprintf(stderr, "partray view: cannot read the window: %s\n", SDL_GetError());
+        return;
+    }
+    uint8_t *px = malloc((size_t)w * (size_t)h * 4u);
+    framebuffer *fb = fb_new(w, h);
+    if (px && fb && SDL_RenderReadPixels(v->ren, NULL, SDL_PIXELFORMAT_RGBA32, px, w * 4) == 0) {
+        /* decoded to linear so that the PNG writer's sRGB encoding gives the
+         * same 8-bit values back */
+        float lut[256];
+        for (int i = 0; i < 256; i++) lut[i] = (float)img_srgb_decode(i / 255.0);
+        for (size_t i = 0; i < (size_t)w * (size_t)h; i++)
+            for (int c = 0; c < 3; c++) fb->rgb[3 * i + (size_t)c] = lut[px[4 * i + (size_t)c]];
+        img_write_opts wo;
+        img_default_write_opts(&wo);
+        diag *d = diag_new();
+        if (img_write(path, fb, &wo, d) == PT_OK) printf("view: window %s (%dx%d, overlay %s)\n", path, w, h, v->overlay ? "on" : "off");
+        print_diags(d);
+        diag_free(d);
+        fflush(stdout);
+    } else {
+        fprintf(stderr, "partray view: cannot read the window: %s\n", SDL_GetError());
+    }
+    free(px);
+    fb_free(fb);
+}
+
 static void present(viewer *v)
 {
     if (!v->ren) return;
@@ -595,6 +681,28 @@ static void present(viewer *v)
         /* the pass's corner of the texture, stretched over the window */
         SDL_Rect r = {0, 0, v->info.width, v->info.height};
         SDL_RenderCopy(v->ren, v->tex, &r, NULL);
+    }
+    if (v->overlay && v->otex) {
+        char lines[6][128];
+        const char *lp[6];
+        int n = overlay_lines(v, timer_now(), lines, 6);
+        for (int i = 0; i < n; i++) lp[i] = lines[i];
+        int scale = v->width >= 900 ? 2 : 1;
+        /* drawn at the top left of a cleared buffer the size of the box */
+        view_overlay_box b = view_overlay_measure(lp, n, scale);
+        if (b.w > v->width) b.w = v->width;
+        if (b.h > v->height) b.h = v->height;
+        if (b.w > 0 && b.h > 0) {
+            memset(v->orgba, 0, (size_t)b.w * (size_t)b.h * 4u);
+            view_overlay_draw(v->orgba, b.w, b.h, 0, 0, lp, n, scale, 160);
+            SDL_Rect r = {0, 0, b.w, b.h};
+            SDL_UpdateTexture(v->otex, &r, v->orgba, b.w * 4);
+            SDL_RenderCopy(v->ren, v->otex, &r, &r);
+        }
+    }
+    if (v->window_shot) {
+        save_window(v, v->window_shot);
+        v->window_shot = NULL;
     }
     SDL_RenderPresent(v->ren);
     v->need_present = 0;
@@ -628,6 +736,13 @@ static int open_window(viewer *v)
         return 0;
     }
     SDL_SetTextureScaleMode(v->tex, SDL_ScaleModeLinear); /* previews are stretched */
+    v->otex = SDL_CreateTexture(v->ren, SDL_PIXELFORMAT_RGBA32, SDL_TEXTUREACCESS_STREAMING, v->width, v->height);
+    v->orgba = calloc((size_t)v->width * (size_t)v->height, 4);
+    if (!v->otex || !v->orgba) {
+        fprintf(stderr, "partray view: cannot create the overlay: %s\n", SDL_GetError());
+        return 0;
+    }
+    SDL_SetTextureBlendMode(v->otex, SDL_BLENDMODE_BLEND);
     v->need_present = 1;
     return 1;
 }
@@ -635,6 +750,8 @@ static int open_window(viewer *v)
 static void close_window(viewer *v)
 {
     if (v->tex) SDL_DestroyTexture(v->tex);
+    if (v->otex) SDL_DestroyTexture(v->otex);
+    free(v->orgba);
     if (v->ren) SDL_DestroyRenderer(v->ren);
     if (v->win) SDL_DestroyWindow(v->win);
     SDL_Quit();
@@ -681,6 +798,7 @@ static void run_loop(viewer *v)
         if (fresh || now - v->title_time > 0.25) {
             update_title(v, now);
             v->title_time = now;
+            if (v->overlay) v->need_present = 1; /* the overlay's figures (busy time, img/s) */
         }
         if (v->need_present) present(v);
     }
@@ -689,13 +807,22 @@ static void run_loop(viewer *v)
 /* --------------------------------------------------------------- command */
 
 /* Takes the viewer's own options out of argv (into *script, *preview). */
-static int split_args(int argc, char **argv, char **rest, int *nrest, const char **script, int *preview, int *verbose,
-                      char *err, int n)
+static int split_args(int argc, char **argv, char **rest, int *nrest, const char **script, int *preview, int *ref_spp,
+                      int *verbose, char *err, int n)
 {
     *nrest = 0;
     for (int i = 0; i < argc; i++) {
         if (strcmp(argv[i], "--verbose") == 0 || strcmp(argv[i], "-v") == 0) {
             *verbose = 1;
+        } else if (strcmp(argv[i], "--ref-spp") == 0) {
+            char *end;
+            long k = i + 1 < argc ? strtol(argv[i + 1], &end, 10) : 0;
+            if (i + 1 >= argc || *end || k < 1 || k > 65536) {
+                snprintf(err, (size_t)n, "--ref-spp wants a sample count from 1 to 65536");
+                return 0;
+            }
+            *ref_spp = (int)k;
+            i++;
         } else if (strcmp(argv[i], "--script") == 0 || strcmp(argv[i], "--preview") == 0) {
             if (i + 1 >= argc) {
                 snprintf(err, (size_t)n, "option '%s' needs a value", argv[i]);
@@ -730,10 +857,10 @@ int cmd_view(int argc, char **argv)
     }
     char **rest = calloc((size_t)argc + 1, sizeof *rest);
     if (!rest) return EXIT_IO;
-    int nrest = 0, preview = 0, verbose = 0;
+    int nrest = 0, preview = 0, ref_spp = 0, verbose = 0;
     const char *script_path = NULL;
     cli_render o;
-    if (!split_args(argc, argv, rest, &nrest, &script_path, &preview, &verbose, err, sizeof err) ||
+    if (!split_args(argc, argv, rest, &nrest, &script_path, &preview, &ref_spp, &verbose, err, sizeof err) ||
         cli_parse_render(nrest, rest, &o, err, sizeof err)) {
         fprintf(stderr, "partray view: %s\n%s", err, view_usage);
         free(rest);
@@ -744,7 +871,7 @@ int cmd_view(int argc, char **argv)
     if (o.gi) {
         gi = gi_mode_parse(o.gi);
         if (gi < 0) {
-            fprintf(stderr, "partray view: unknown --gi mode '%s' (none, particle, path)\n", o.gi);
+            fprintf(stderr, "partray view: unknown --gi mode '%s' (none, particle, path, pmfg)\n", o.gi);
             return EXIT_USAGE;
         }
     }
@@ -753,6 +880,7 @@ int cmd_view(int argc, char **argv)
     memset(&v, 0, sizeof v);
     v.t_start = timer_now();
     v.verbose = verbose;
+    v.overlay = 1;
     v.scene_path = o.scene;
     v.width = o.width > 0 ? o.width : 512;
     v.height = o.height > 0 ? o.height : (o.width > 0 ? o.width : 512);
@@ -849,7 +977,7 @@ int cmd_view(int argc, char **argv)
         }
     }
     if (rc == EXIT_OK) {
-        view_render_opts ro = {v.width, v.height, v.threads, o.seed, preview};
+        view_render_opts ro = {v.width, v.height, v.threads, o.seed, preview, ref_spp, o.particles, o.bounces, o.cl_device};
         view_state s0 = current_state(&v);
         diag *rd = diag_new();
         st = view_render_start(&v.vr, sc, acc, &ro, &s0, rd);

@@ -106,6 +106,9 @@ static pt_status particle_open(void **ctx, const scene *sc, const accel *a, cons
     gi_particle_settings s;
     gi_particle_settings_from_scene(&s, sc);
     s.threads = o->threads;
+    if (o->particles > 0) s.count = o->particles;
+    if (o->bounces > 0) s.bounces = o->bounces;
+    if (o->cl_device) s.cl_device = o->cl_device;
     pt_status st = PT_OK;
     c->gp = gi_particle_build(sc, a, &s, &c->stats, d, &st);
     if (!c->gp || st != PT_OK) {
@@ -169,7 +172,8 @@ static void particle_close(void *ctx)
 /* ------------------------------------------------- reference previews */
 /* path and pmfg: each pass its own samples (its own seed), averaged at full
  * resolution: level 0 a preview at 1 sample per pixel, level 1 the full
- * resolution at 1, then 1, 2, 4, ... more up to o->ref_spp in all. */
+ * resolution at 1, then 1, 2, 4, ... more: 2^(L-1) samples after level L,
+ * up to o->ref_spp (rounded up to a power of 2). */
 
 typedef struct {
     const scene *sc;
@@ -183,7 +187,6 @@ typedef struct {
 
 static int ref_spp(const view_gi_opts *o) { return o->ref_spp > 0 ? o->ref_spp : 256; }
 
-/* 1 + 1 + 2 + ... + 2^(L-2) = 2^(L-1) samples after level L */
 static int ref_last_level(const view_gi_opts *o)
 {
     int L = 1;
@@ -218,7 +221,7 @@ static pt_status ref_relight(void *ctx, volatile int *cancel, view_gi_times *t, 
 static pt_status ref_render(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
 {
     ref_ctx *c = ctx;
-    int spp = p->level <= 1 ? 1 : 1 << (p->level - 1);
+    int spp = p->level <= 1 ? 1 : 1 << (p->level - 2);
     /* each pass its own samples: the seed says which */
     uint64_t seed = p->seed + 0x9e3779b97f4a7c15ULL * (uint64_t)(p->level + 1);
     pm_stats st;
@@ -279,7 +282,7 @@ static void ref_describe(void *ctx, char *buf, int n)
 {
     ref_ctx *c = ctx;
     if (c->mode == GI_PMFG)
-        snprintf(buf, (size_t)n, "reference preview, %d spp, %d photons/pass (%.0f ms)", c->spp, c->photons,
+        snprintf(buf, (size_t)n, "reference preview, %d spp, %d photons/pass (photon maps %.0f ms)", c->spp, c->photons,
                  c->t_photons * 1e3);
     else
         snprintf(buf, (size_t)n, "reference preview, %d spp", c->spp);

@@ -48,6 +48,9 @@ typedef struct {
     int threads;            /* <= 0: all cores */
     int ref_spp;            /* path/pmfg: samples per pixel at the last level (<= 0: 256) */
     int ref_photons;        /* pmfg: photon paths per pass (<= 0: 50,000) */
+    long particles;         /* particle: area particles (<= 0: from the scene, gi_particle.h) */
+    int bounces;            /* particle: n_b (<= 0: from the scene) */
+    const char *cl_device;  /* particle: OpenCL device (NULL: auto) */
 } view_gi_opts;
 
 typedef struct {

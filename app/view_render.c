@@ -149,6 +149,18 @@ static void copy_messages(diag *dst, const diag *src)
     }
 }
 
+static view_gi_opts gi_opts(const view_render *vr)
+{
+    view_gi_opts go;
+    memset(&go, 0, sizeof go);
+    go.threads = vr->o.threads;
+    go.ref_spp = vr->o.ref_spp;
+    go.particles = vr->o.particles;
+    go.bounces = vr->o.bounces;
+    go.cl_device = vr->o.cl_device;
+    return go;
+}
+
 static void *opener_main(void *arg)
 {
     view_render *vr = arg;
@@ -156,7 +168,7 @@ static void *opener_main(void *arg)
     view_gi *g = NULL;
     view_gi_times t;
     memset(&t, 0, sizeof t);
-    view_gi_opts go = {vr->o.threads, vr->o.ref_spp, 0};
+    view_gi_opts go = gi_opts(vr);
     pt_status st = view_gi_open(&g, vr->opening, vr->open_scene, vr->a, &go, &t, d);
     pthread_mutex_lock(&vr->mu);
     copy_messages(vr->msgs, d);
@@ -332,7 +344,7 @@ static void *render_main(void *arg)
         pt_status st = PT_OK;
         if (!vr->opened[use]) {
             /* `none` opens at once, on this thread */
-            view_gi_opts go = {vr->o.threads, vr->o.ref_spp, 0};
+            view_gi_opts go = gi_opts(vr);
             st = view_gi_open(&vr->opened[use], use, vr->sc, vr->a, &go, &t, d);
             acc.build += t.build;
         }
@@ -377,6 +389,7 @@ static void *render_main(void *arg)
         if (st == PT_OK && g && !vr->cancel) {
             view_gi_pass p = {pw, ph, level, vr->o.threads, vr->o.seed, &vr->cancel};
             st = view_gi_render(g, &p, vr->back, &t, d);
+            acc.light += t.light;
             acc.view += t.view;
             acc.render += t.render;
         } else if (st == PT_OK && !g) {

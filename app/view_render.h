@@ -57,6 +57,9 @@ typedef struct {
     uint64_t seed;
     int preview_div;        /* 0: adaptive (start 4); else fixed */
     int ref_spp;            /* path/pmfg previews: samples per pixel at the last level (0: 256) */
+    long particles;         /* particle GI: area particles (0: from the scene) */
+    int bounces;            /* particle GI: n_b (0: from the scene) */
+    const char *cl_device;  /* particle GI: OpenCL device (NULL: auto) */
 } view_render_opts;
 
 typedef struct {

@@ -88,6 +88,12 @@ static int parse_command(ctx *c, view_script *vs, word *w, int n, int eol_col, v
         if (n == 2) a->text = keep(vs, w[1].s, w[1].len);
         return 1;
     }
+    if (word_is(&w[0], "window")) {
+        a->kind = VIEW_ACT_WINDOW_SHOT;
+        if (n != 2) { err_at(c, n > 2 ? w[2].col : eol_col, "window takes one PATH (.png)%s", ""); return 0; }
+        a->text = keep(vs, w[1].s, w[1].len);
+        return 1;
+    }
     if (word_is(&w[0], "wait-idle")) { a->kind = VIEW_ACT_WAIT_IDLE; need = 1; }
     else if (word_is(&w[0], "quit")) { a->kind = VIEW_ACT_QUIT; need = 1; }
     else if (word_is(&w[0], "mark")) {
@@ -97,11 +103,11 @@ static int parse_command(ctx *c, view_script *vs, word *w, int n, int eol_col, v
         return 1;
     } else if (word_is(&w[0], "gi")) {
         a->kind = VIEW_ACT_GI;
-        if (n != 2) { err_at(c, n > 2 ? w[2].col : eol_col, "gi takes one MODE (none, particle, path, next)%s", ""); return 0; }
+        if (n != 2) { err_at(c, n > 2 ? w[2].col : eol_col, "gi takes one MODE (none, particle, path, pmfg, next)%s", ""); return 0; }
         char m[32];
         snprintf(m, sizeof m, "%.*s", w[1].len < 30 ? w[1].len : 30, w[1].s);
         a->mode = strcmp(m, "next") == 0 ? -1 : gi_mode_parse(m);
-        if (strcmp(m, "next") != 0 && a->mode < 0) { err_at(c, w[1].col, "unknown GI mode '%s' (none, particle, path, next)", m); return 0; }
+        if (strcmp(m, "next") != 0 && a->mode < 0) { err_at(c, w[1].col, "unknown GI mode '%s' (none, particle, path, pmfg, next)", m); return 0; }
         return 1;
     } else if (word_is(&w[0], "key")) {
         a->kind = VIEW_ACT_KEY;
@@ -176,7 +182,7 @@ static int parse_command(ctx *c, view_script *vs, word *w, int n, int eol_col, v
         if (a->kind == VIEW_ACT_CAMERA_ZOOM && !(a->v[0] > 0)) { err_at(c, w[2].col, "camera zoom must be > 0%s", ""); return 0; }
         return 1;
     } else {
-        err_at(c, w[0].col, "unknown command '%s' (screenshot, light, camera, gi, key, drag, wheel, wait-idle, mark, quit)", cmd);
+        err_at(c, w[0].col, "unknown command '%s' (screenshot, window, light, camera, gi, key, drag, wheel, wait-idle, mark, quit)", cmd);
         return 0;
     }
     if (n != need) {

@@ -18,6 +18,9 @@
  *                              or .png writes that file; any other PATH
  *                              writes PATH.exr and PATH.png; no PATH: the
  *                              next free SCENE-NNNN.exr/.png (as F12)
+ *   window PATH                save the window as shown (the image scaled
+ *                              to the window, the overlay over it) as an
+ *                              8-bit PNG, after the next redraw
  *   light N select             make light N (1-based, scene order) the
  *                              selected light (as the number keys)
  *   light N move DX DY DZ      move light N by a world-space offset (spot
@@ -30,7 +33,7 @@
  *   camera zoom K              distance to look_at times K (as the wheel)
  *   camera write [PATH]        print the camera{} block and write it to
  *                              PATH (default: the next free SCENE-camera-NNNN.inc)
- *   gi MODE                    switch to none | particle | path | next
+ *   gi MODE                    switch to none | particle | path | pmfg | next
  *   key NAME [HOLD]            press the key NAME (SDL key names: w, Left,
  *                              Page Up, F12, Tab, 1, ...; a name with a space
  *                              is written with '_': Page_Up) and release it
@@ -78,7 +81,8 @@ typedef enum {
     VIEW_ACT_QUIT,
     VIEW_ACT_KEY,          /* text: key name ('_' for spaces), v[0]: hold seconds */
     VIEW_ACT_DRAG,         /* mode: 1 left, 3 right button; v[0], v[1]: pixels */
-    VIEW_ACT_WHEEL         /* v[0]: clicks */
+    VIEW_ACT_WHEEL,        /* v[0]: clicks */
+    VIEW_ACT_WINDOW_SHOT   /* text: path (PNG) */
 } view_action_kind;
 
 typedef struct {

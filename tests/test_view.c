@@ -8,10 +8,13 @@
  * (a left drag, C, the wheel, P, Escape). Asserted: the images differ where the shadows
  * moved (regions computed analytically from the scene), hardly anywhere
  * else, no NaN, not black, dimming halves the direct light, and the written
- * camera{} block parses back to the orbited camera. Skips only when there
- * is no Xvfb binary at all.
+ * camera{} block parses back to the orbited camera. A second run: the
+ * window saved with the overlay on and off (`window`, the O key) differs in
+ * the overlay's box and nowhere else; switching to the reference previews
+ * (path, pmfg) gives refined images that are not black and NaN-free. Skips
+ * only when there is no Xvfb binary at all.
  *
- * Without a display: the render thread (its last level equals a direct
+ * Without a display: the overlay's font (pixel counts of known glyphs), the render thread (its last level equals a direct
  * shade_render, a burst of submits ends idle on the newest state), camera moves (orbit keeps the distance, +yaw goes to
  * screen right also for mirrored cameras, the camera{} block round-trips
  * through the parser) and the script grammar (order, errors with columns). */
@@ -38,6 +41,8 @@
 #include "sdl.h"
 #include "shade.h"
 #include "view_camera.h"
+#include "view_gi.h"
+#include "view_overlay.h"
 #include "view_render.h"
 #include "view_script.h"
 
@@ -384,6 +389,244 @@ static void test_viewer_script(void **st)
     diag_free(d);
 }
 
+/* Overlay on/off and the reference previews, in one headless run. */
+static void test_viewer_overlay_reference(void **st)
+{
+    (void)st;
+    if (!have_program("Xvfb")) {
+        printf("Xvfb not found on PATH: the viewer cannot be run headless here\n");
+        skip();
+    }
+    assert_true(start_xvfb());
+    char scene_path[512], script[512], cmd[4096], path[600], text[2048];
+    snprintf(scene_path, sizeof scene_path, "%s/two.pov", tmpdir);
+    snprintf(script, sizeof script, "%s/ov.txt", tmpdir);
+    write_file(scene_path, two_spheres_pov);
+    snprintf(text, sizeof text,
+             "0.0 wait-idle\n"
+             "0.1 window %s/on.png\n"
+             "0.2 key o\n"
+             "0.3 window %s/off.png\n"
+             "0.4 gi path\n"
+             "0.4 wait-idle\n"
+             "0.5 screenshot %s/path.exr\n"
+             "0.6 gi pmfg\n"
+             "0.6 wait-idle\n"
+             "0.7 screenshot %s/pmfg.exr\n"
+             "0.8 quit\n",
+             tmpdir, tmpdir, tmpdir, tmpdir);
+    write_file(script, text);
+    /* --ref-spp 2: the previews' last level is 2 (1 + 1 samples per pixel) */
+    snprintf(cmd, sizeof cmd,
+             "cd '%s' && ASAN_OPTIONS=detect_leaks=0 DISPLAY=%s timeout 120 '%s' view '%s' --size %dx%d --gi none --threads 2 "
+             "--ref-spp 2 --script '%s'",
+             tmpdir, display, PARTRAY_BIN, scene_path, W, H, script);
+    int rc = run_capture(cmd);
+    stop_xvfb();
+    printf("exit %d:\n%s", rc, out_text);
+    assert_int_equal(rc, 0);
+    assert_non_null(strstr(out_text, "(path, level 2/2)"));
+    assert_non_null(strstr(out_text, "(pmfg, level 2/2)"));
+
+    diag *d = diag_new();
+    framebuffer *on = NULL, *off = NULL;
+    snprintf(path, sizeof path, "%s/on.png", tmpdir);
+    assert_int_equal(img_read(path, 0, &on, d), PT_OK);
+    snprintf(path, sizeof path, "%s/off.png", tmpdir);
+    assert_int_equal(img_read(path, 0, &off, d), PT_OK);
+    assert_int_equal(on->width, W);
+    assert_int_equal(off->height, H);
+    /* at most 5 lines of 9 font pixels, a 3-pixel margin: the box ends
+     * above row 5 * 9 - 2 + 6 = 49 (scale 1 below 900 pixels) */
+    const int box_rows = 49;
+    long in_box = 0, differ_box = 0, differ_out = 0, lighter = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            double a = luma(on, x, y), b = luma(off, x, y);
+            int differ = fabs(a - b) > 1e-6;
+            if (y < box_rows) {
+                in_box++;
+                differ_box += differ;
+                lighter += a > b + 0.2; /* white glyph pixels */
+            } else {
+                differ_out += differ;
+            }
+        }
+    /* the first line starts at the top left: its first glyph cells */
+    long first_cell = 0;
+    for (int y = 3; y < 10; y++)
+        for (int x = 3; x < 8; x++) first_cell += fabs(luma(on, x, y) - luma(off, x, y)) > 1e-6;
+    printf("overlay: %ld of %ld pixels in the box rows differ (%ld lighter: glyphs), %ld differ below the box; first glyph "
+           "cell %ld px\n",
+           differ_box, in_box, lighter, differ_out, first_cell);
+    assert_true(differ_box > in_box / 4); /* the darkened box covers the top left */
+    assert_true(lighter > 100);
+    assert_true(first_cell > 5);
+    assert_int_equal(differ_out, 0);
+
+    const char *names[] = {"path", "pmfg"};
+    double means[2];
+    for (int k = 0; k < 2; k++) {
+        framebuffer *fb = NULL;
+        snprintf(path, sizeof path, "%s/%s.exr", tmpdir, names[k]);
+        assert_int_equal(img_read(path, 0, &fb, d), PT_OK);
+        char label[64];
+        snprintf(label, sizeof label, "%s reference preview", names[k]);
+        check_image(fb, label); /* NaN-free, mean > 0.1 */
+        means[k] = 0;
+        for (size_t i = 0; i < (size_t)W * H * 3; i++) means[k] += fb->rgb[i];
+        means[k] /= W * H * 3.0;
+        fb_free(fb);
+    }
+    /* both estimate the same light (pm_fg.h: pmfg's direct term is the path
+     * tracer's NEE); at 2 spp the image means agree to noise */
+    printf("reference previews: mean path %.4f, pmfg %.4f\n", means[0], means[1]);
+    assert_true(fabs(means[0] - means[1]) < 0.03 * means[0]);
+    fb_free(on);
+    fb_free(off);
+    diag_free(d);
+}
+
+/* ------------------------------------- particle relight, no display */
+
+static framebuffer *gi_pass(view_gi *g, int w, int h)
+{
+    framebuffer *fb = fb_new(w, h);
+    assert_non_null(fb);
+    view_gi_pass p = {w, h, 1, 2, 0, NULL};
+    view_gi_times t;
+    diag *d = diag_new();
+    assert_int_equal(view_gi_render(g, &p, fb, &t, d), PT_OK);
+    diag_free(d);
+    return fb;
+}
+
+static double max_diff(const framebuffer *a, const framebuffer *b)
+{
+    double e = 0;
+    for (size_t i = 0; i < (size_t)a->width * a->height * 3; i++) e = fmax(e, fabs(a->rgb[i] - b->rgb[i]));
+    return e;
+}
+
+/* The particle mode's light edit: a cancelled relight keeps the old
+ * lighting exactly (the image with the moved light's direct term and the
+ * old indirect light does not change), the mode stays stale, and the relight
+ * that completes gives exactly the image of a mode opened with the light
+ * already there (same particles, same seed). 3,000 particles: about 1 s. */
+static void test_particle_relight_cancel(void **st)
+{
+    (void)st;
+    scene *sc = NULL;
+    sdl_options so;
+    sdl_default_options(&so);
+    diag *d = diag_new();
+    assert_int_equal(sdl_parse_string("two.pov", two_spheres_pov, &so, &sc, d), PT_OK);
+    pt_status ps = PT_OK;
+    accel *acc = accel_build(sc, 2, d, &ps);
+    assert_non_null(acc);
+    const int w = 48, h = 48;
+    view_gi_opts go;
+    memset(&go, 0, sizeof go);
+    go.threads = 2;
+    go.particles = 3000;
+    go.bounces = 3;
+    view_gi_times t;
+    view_gi *g = NULL;
+    assert_int_equal(view_gi_open(&g, GI_PARTICLE, sc, acc, &go, &t, d), PT_OK);
+    assert_true(view_gi_slow_light(g));
+    framebuffer *a = gi_pass(g, w, h);
+
+    view_gi_scene(g)->lights[0].position = light_b;
+    view_gi_lights_changed(g);
+    assert_true(view_gi_stale(g));
+    framebuffer *q = gi_pass(g, w, h); /* new direct, old indirect */
+    volatile int cancel = 1;
+    assert_int_equal(view_gi_relight(g, &cancel, &t, d), PT_OK);
+    assert_true(view_gi_stale(g));
+    framebuffer *q2 = gi_pass(g, w, h);
+    double e_cancel = max_diff(q, q2);
+    cancel = 0;
+    assert_int_equal(view_gi_relight(g, &cancel, &t, d), PT_OK);
+    assert_false(view_gi_stale(g));
+    printf("relight: %.1f ms\n", t.light * 1e3);
+    framebuffer *r = gi_pass(g, w, h);
+
+    /* a mode opened with the light at B */
+    scene sc_b = *sc;
+    scene_light lb = sc->lights[0];
+    lb.position = light_b;
+    sc_b.lights = &lb;
+    view_gi *gb = NULL;
+    assert_int_equal(view_gi_open(&gb, GI_PARTICLE, &sc_b, acc, &go, &t, d), PT_OK);
+    framebuffer *fresh = gi_pass(gb, w, h);
+    double e_fresh = max_diff(r, fresh), e_stale = max_diff(q, r), e_moved = max_diff(a, q);
+    printf("cancelled relight changed the image by %.3g; relit vs opened at B %.3g; stale vs relit %.3g; before vs after "
+           "the move %.3g\n",
+           e_cancel, e_fresh, e_stale, e_moved);
+    assert_true(e_cancel == 0);
+    assert_true(e_fresh < 1e-5);
+    assert_true(e_stale > 1e-3); /* the indirect light did change */
+    assert_true(e_moved > 0.1);  /* the shadows moved */
+    view_gi_close(g);
+    view_gi_close(gb);
+    fb_free(a);
+    fb_free(q);
+    fb_free(q2);
+    fb_free(r);
+    fb_free(fresh);
+    accel_free(acc);
+    scene_free(sc);
+    diag_free(d);
+}
+
+/* ------------------------------------------------- overlay, no display */
+
+static void test_overlay_font(void **st)
+{
+    (void)st;
+    /* every character the overlay prints has a glyph */
+    const char *used = "0123456789 ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz.,:;/()[]<>-+=*%#|_!?'";
+    for (const char *c = used; *c; c++) assert_true(view_overlay_has_glyph(*c));
+    assert_false(view_overlay_has_glyph('~'));
+    /* "1" has 10 set font pixels (5x7); at scale 2 each is 2x2 white */
+    enum { BW = 40, BH = 30 };
+    uint8_t buf[BW * BH * 4];
+    memset(buf, 0, sizeof buf);
+    const char *one[] = {"1"};
+    view_overlay_box b = view_overlay_draw(buf, BW, BH, 2, 1, one, 1, 2, 160);
+    long white = 0, dark = 0, untouched = 0;
+    for (int y = 0; y < BH; y++)
+        for (int x = 0; x < BW; x++) {
+            const uint8_t *p = buf + (y * BW + x) * 4;
+            int inside = x >= b.x && x < b.x + b.w && y >= b.y && y < b.y + b.h;
+            if (p[3] == 255 && p[0] == 255) white++;
+            else if (p[3] == 160 && p[0] == 0) dark += inside;
+            else untouched += !inside && p[3] == 0;
+        }
+    printf("glyph '1' at scale 2: box %dx%d at (%d,%d), %ld white, %ld dark, %ld untouched\n", b.w, b.h, b.x, b.y, white,
+           dark, untouched);
+    /* box: (1 char * 6 - 1 + 2 * 3) x (1 line * 9 - 2 + 2 * 3) font pixels */
+    assert_int_equal(b.w, 11 * 2);
+    assert_int_equal(b.h, 13 * 2);
+    assert_int_equal(white, 40);
+    assert_int_equal(dark, b.w * b.h - 40);
+    assert_int_equal(untouched, BW * BH - b.w * b.h);
+    /* lower case draws as capitals */
+    uint8_t u[BW * BH * 4], l[BW * BH * 4];
+    memset(u, 0, sizeof u);
+    memset(l, 0, sizeof l);
+    const char *up[] = {"GI"}, *lo[] = {"gi"};
+    view_overlay_draw(u, BW, BH, 0, 0, up, 1, 1, 160);
+    view_overlay_draw(l, BW, BH, 0, 0, lo, 1, 1, 160);
+    assert_memory_equal(u, l, sizeof u);
+    /* clipped at the buffer's edge: no writes outside, box clipped */
+    memset(buf, 0, sizeof buf);
+    const char *wide[] = {"FRAME 123 MS: BUILD 0 LIGHT 0"};
+    b = view_overlay_draw(buf, BW, BH, 30, 20, wide, 1, 1, 160);
+    assert_int_equal(b.w, BW - 30);
+    assert_int_equal(b.h, BH - 20);
+}
+
 /* ------------------------------------------- render thread, no display */
 
 static int wait_idle(view_render *vr, double seconds)
@@ -423,7 +666,7 @@ static void test_render_thread(void **st)
 
     view_light lights[1] = {{sc->lights[0].position, sc->lights[0].point_at, sc->lights[0].colour}};
     view_state s0 = {sc->camera, GI_NONE, lights};
-    view_render_opts ro = {w, h, 2, 0, 0};
+    view_render_opts ro = {w, h, 2, 0, 0, 0};
     view_render *vr = NULL;
     assert_int_equal(view_render_start(&vr, sc, acc, &ro, &s0, d), PT_OK);
     assert_true(wait_idle(vr, 60));
@@ -640,7 +883,10 @@ int main(void)
         cmocka_unit_test(test_camera_roundtrip),
         cmocka_unit_test(test_script_grammar),
         cmocka_unit_test(test_render_thread),
+        cmocka_unit_test(test_overlay_font),
+        cmocka_unit_test(test_particle_relight_cancel),
         cmocka_unit_test(test_viewer_script),
+        cmocka_unit_test(test_viewer_overlay_reference),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     stop_xvfb();
