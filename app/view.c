@@ -570,11 +570,11 @@ static int take_image(viewer *v, double now)
     v->published = in.serial;
     if (v->verbose)
         printf("view: image %ld gen %ld L%d/%d %dx%d %s%s%s frame %.1f ms (build %.1f light %.1f view %.1f render %.1f) "
-               "latency %.1f ms%s%s%s [%s]\n",
+               "cpu %.1f ms (light %.1f) latency %.1f ms%s%s%s [%s]\n",
                in.serial, in.generation, in.level, in.last_level, in.width, in.height, view_gi_name(in.gi_mode),
                in.wanted_mode != in.gi_mode ? " building " : "", in.wanted_mode != in.gi_mode ? view_gi_name(in.wanted_mode) : "",
                in.frame * 1e3, in.times.build * 1e3, in.times.light * 1e3, in.times.view * 1e3, in.times.render * 1e3,
-               in.latency * 1e3, in.cause & VIEW_CAUSE_LIGHT ? " light" : "", in.cause & VIEW_CAUSE_CAMERA ? " camera" : "",
+               in.frame_cpu * 1e3, in.light_cpu * 1e3, in.latency * 1e3, in.cause & VIEW_CAUSE_LIGHT ? " light" : "", in.cause & VIEW_CAUSE_CAMERA ? " camera" : "",
                in.gi_stale ? " gi-stale" : "", in.describe);
     if (!v->have_image) v->t_first_image = now;
     v->have_image = 1;

@@ -27,6 +27,7 @@ struct view_gi {
     view_gi_opts o;
     int last_level;
     int stale;            /* lights changed since the last complete lighting stage */
+    double t_light;       /* seconds of the last complete lighting stage */
     scene sc;             /* shallow copy: own camera and lights, shared objects */
     scene_light *lights;
 };
@@ -358,6 +359,7 @@ pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a,
     double t0 = timer_now();
     pt_status st = b->open(&g->ctx, &g->sc, a, o, t, d);
     if (t->build == 0 && t->light == 0) t->build = timer_now() - t0;
+    g->t_light = t->light;
     if (st != PT_OK) {
         if (g->ctx) b->close(g->ctx);
         free(g->lights);
@@ -374,7 +376,10 @@ int view_gi_last_level(const view_gi *g) { return g->last_level; }
 
 void view_gi_lights_changed(view_gi *g) { g->stale = 1; }
 int view_gi_stale(const view_gi *g) { return g->stale; }
-int view_gi_slow_light(const view_gi *g) { return g->b->slow_light; }
+/* A stale preview costs about one preview pass before the relight starts:
+ * worth it when the lighting stage is longer than a preview (40 ms,
+ * view_render.c's target). */
+int view_gi_slow_light(const view_gi *g) { return g->b->slow_light && g->t_light > 0.040; }
 
 pt_status view_gi_relight(view_gi *g, volatile int *cancel, view_gi_times *t, diag *d)
 {
@@ -382,7 +387,10 @@ pt_status view_gi_relight(view_gi *g, volatile int *cancel, view_gi_times *t, di
     g->stale = 1;
     pt_status st = g->b->relight(g->ctx, cancel, t, d);
     /* a cancelled stage leaves the old lighting: still stale */
-    if (st == PT_OK && !(cancel && *cancel)) g->stale = 0;
+    if (st == PT_OK && !(cancel && *cancel)) {
+        g->stale = 0;
+        g->t_light = t->light;
+    }
     return st;
 }
 

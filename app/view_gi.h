@@ -84,7 +84,8 @@ int view_gi_last_level(const view_gi *g);
 void view_gi_lights_changed(view_gi *g);
 int view_gi_stale(const view_gi *g);
 /* 1 when the mode's lighting stage is slow enough that a stale pass is
- * worth showing first (particle). */
+ * worth showing first (particle, when its last lighting stage took more
+ * than 40 ms). */
 int view_gi_slow_light(const view_gi *g);
 /* Reruns the lighting stage for the scene's current lights. While *cancel
  * (may be NULL) is non-zero it may stop early: it returns PT_OK with the old

@@ -263,6 +263,15 @@ static int apply_lights(view_render *vr, scene *gs, const view_light *l)
     return changed;
 }
 
+/* Process CPU seconds (every thread): with the machine shared, CPU time
+ * over the thread count estimates the wall time on an idle machine. */
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
 #define QUIET 0.12 /* seconds without a submit before refinement passes start */
 
 static void *render_main(void *arg)
@@ -350,6 +359,7 @@ static void *render_main(void *arg)
         }
         view_gi *g = vr->opened[use];
         int quick = 0, stale = 0;
+        double light_cpu = 0, pass_cpu0 = cpu_now();
         if (st == PT_OK && g) {
             vr->shown_mode = use;
             scene *gs = view_gi_scene(g);
@@ -368,7 +378,9 @@ static void *render_main(void *arg)
                     vr->relighting = !vr->cancel;
                     vr->edit_in_relight = 0;
                     pthread_mutex_unlock(&vr->mu);
+                    double c0 = cpu_now();
                     if (vr->relighting) st = view_gi_relight(g, &vr->cancel, &t, d);
+                    light_cpu = cpu_now() - c0;
                     pthread_mutex_lock(&vr->mu);
                     vr->relighting = 0;
                     if (st == PT_OK && !view_gi_stale(g)) vr->stale_since = vr->edit_in_relight;
@@ -438,6 +450,8 @@ static void *render_main(void *arg)
         in->times = acc;
         double now = timer_now();
         in->frame = now - t0;
+        in->frame_cpu = cpu_now() - pass_cpu0;
+        in->light_cpu = light_cpu;
         in->latency = now - submit_time;
         in->first = level == 0;
         if (level == 0 && first_latency == 0) first_latency = in->latency;

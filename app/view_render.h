@@ -71,6 +71,8 @@ typedef struct {
     int wanted_mode;        /* the mode asked for (differs while that one is being built) */
     double frame;           /* seconds from the pass's start to its publication, GI stages included */
     view_gi_times times;    /* stages run for this pass (build/light only when they ran) */
+    double frame_cpu;       /* process CPU seconds during the pass (every thread: a mode being built meanwhile too) */
+    double light_cpu;       /* of which the lighting stage: / threads ~ its wall time on an idle machine */
     double latency;         /* seconds from the oldest submit its generation answers to its publication */
     int first;              /* the first image of its generation */
     double first_latency;   /* latency of its generation's first image (so a UI that missed it still knows) */

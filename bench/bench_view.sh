@@ -8,7 +8,9 @@
 #     SCENE      default scenes/cbox.pov;  SIZE default 512x512
 #     MODES      default "none particle"
 #   THREADS=N (default 2, the CI machine's cores), ORBIT_S=5, MOVES=4,
-#   PREVIEW=D fixes the preview at 1/D of the size (default: adaptive).
+#   PREVIEW=D fixes the preview at 1/D of the size (default: adaptive),
+#   EXTRA="--particles N ..." more viewer options, KEEP_LOG=PREFIX keeps the
+#   verbose logs as PREFIX.MODE.log.
 #
 # Runs `partray view --script` under Xvfb (started here on a free display
 # when DISPLAY is not set). The script waits until the mode is built and the
@@ -18,9 +20,17 @@
 #   orbit img/s     images the render thread finished while orbiting / time
 #   preview px      mean width of those images (the preview adapts its size)
 #   cam->img ms     input to the first image showing it, mean
-#   light->img ms   light move to the first relit image (a preview), mean/max
+#   light->img ms   light move to the first image showing it, mean/max (for
+#                   particle: the new direct light over the old indirect
+#                   light, the "gi-stale" preview)
+#   light->relit ms light move to the first image with the GI relit (a
+#                   preview), mean/max, and what that image's pass spent:
+#     lighting ms   the GI's lighting stage (gi_particle_relight)
+#     regather ms   the per-view stage after it (gathering, estimation)
+#     render ms     the preview pass itself
+#     lighting cpu  the lighting stage's process CPU time / THREADS: about
+#                   its wall time on an idle machine (this one is shared)
 #   light->full ms  light move to the relit full-resolution image, mean
-#   relight ms      the GI's lighting stage inside that, mean
 #   build s         the mode's geometry + lighting stages at start
 set -eu
 cd "$(dirname "$0")/.."
@@ -33,6 +43,7 @@ ORBIT_S=${ORBIT_S:-5}
 MOVES=${MOVES:-4}
 PREVIEW_OPT=
 [ -n "${PREVIEW:-}" ] && PREVIEW_OPT="--preview $PREVIEW"
+EXTRA=${EXTRA:-}
 BIN=$BUILD/partray
 [ -x "$BIN" ] || { echo "bench_view: no $BIN (build the partray target first)" >&2; exit 2; }
 
@@ -77,29 +88,36 @@ fi
 
 printf '%s %s, %s threads, preview %s, %s, load %s\n' "$SCENE" "$SIZE" "$THREADS" "${PREVIEW:-adaptive}" "$(uname -m)" \
     "$(cut -d' ' -f1 /proc/loadavg)"
-printf '%-9s %10s %11s %10s %14s %15s %11s %9s\n' mode "orbit img/s" "preview px" "cam->img ms" "light->img ms" "light->full ms" "relight ms" "build s"
+printf '%-9s %10s %10s %10s %13s %15s %11s %12s %11s %9s %14s %8s\n' mode "orbit img/s" "preview px" "cam->img ms" \
+    "light->img ms" "light->relit ms" "lighting ms" "lighting cpu" "regather ms" "render ms" "light->full ms" "build s"
 for mode in $MODES; do
     LOG=$TMP/$mode.log
     if ! timeout 900 "$BIN" view "$SCENE" --size "$SIZE" --gi "$mode" --threads "$THREADS" --script "$TMP/script.txt" \
-        $PREVIEW_OPT --verbose >"$LOG" 2>&1; then
+        $PREVIEW_OPT $EXTRA --verbose >"$LOG" 2>&1; then
         echo "$mode: the viewer failed:"; tail -5 "$LOG"; continue
     fi
-    awk -v mode="$mode" '
+    [ -n "${KEEP_LOG:-}" ] && cp "$LOG" "$KEEP_LOG.$mode.log"
+    awk -v mode="$mode" -v threads="$THREADS" '
         function kv(key,   i, a) { for (i = 1; i <= NF; i++) { split($i, a, "="); if (a[1] == key) return a[2] } return "" }
+        function stage(name,   r) { if (match($0, "[(]?" name " [0-9.]+")) { r = substr($0, RSTART, RLENGTH); sub(/.* /, "", r); return r + 0 } return 0 }
         /^view: image / {
             if (phase == 1) { n++; w += substr($7, 1, index($7, "x") - 1) }
-            if (phase == 3 && $0 ~ / L0\//) {
-                match($0, /light [0-9.]+/); rl += substr($0, RSTART + 6, RLENGTH - 6); nrl++
+            # the relit preview after each light move (its pass ran the lighting stage)
+            if (phase == 3 && $0 ~ / L0\// && $0 ~ /latency [0-9.]+ ms light/ && $0 !~ /gi-stale/ && stage("light") > 0) {
+                rl += stage("light"); rv += stage("view"); rr += stage("render"); nrl++
+                if (match($0, /[(]light [0-9.]+[)]/)) { c = substr($0, RSTART + 7, RLENGTH - 8); rc += c / threads }
             }
-            if (build == "" && $0 ~ /build [0-9.]+/) { match($0, /build [0-9.]+/); b = substr($0, RSTART + 6, RLENGTH - 6) + 0; if (b > 0) build = b / 1000 }
+            if (build == "" && $0 ~ /build [0-9.]+/) { b = stage("build"); if (b > 0) build = b / 1000 }
         }
         /^view: mark ready/   { t0 = kv("time"); i0 = kv("images"); phase = 1 }
         /^view: mark orbited/ { t1 = kv("time"); i1 = kv("images"); cam = kv("camera_first_ms"); phase = 2 }
         /^view: mark settled/ { phase = 3 }
-        /^view: mark lit/     { lf = kv("light_first_ms"); lfm = kv("light_first_max_ms"); lF = kv("light_full_ms"); phase = 4 }
+        /^view: mark lit/     { lf = kv("light_first_ms"); lfm = kv("light_first_max_ms"); lr = kv("light_relit_ms");
+                                lrm = kv("light_relit_max_ms"); lF = kv("light_full_ms"); phase = 4 }
         END {
             fps = (t1 > t0) ? (i1 - i0) / (t1 - t0) : 0
-            printf "%-9s %10.1f %11.0f %10.1f %8.1f/%-5.0f %15.1f %11.1f %9.2f\n", mode, fps, n ? w / n : 0, cam, lf, lfm, lF,
-                   nrl ? rl / nrl : 0, build + 0
+            printf "%-9s %10.1f %10.0f %10.1f %7.1f/%-5.0f %8.1f/%-6.0f %11.1f %12.1f %11.1f %9.1f %14.1f %8.2f\n", mode, fps,
+                   n ? w / n : 0, cam, lf, lfm, lr, lrm, nrl ? rl / nrl : 0, nrl ? rc / nrl : 0, nrl ? rv / nrl : 0,
+                   nrl ? rr / nrl : 0, lF, build + 0
         }' "$LOG"
 done

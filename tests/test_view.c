@@ -533,7 +533,7 @@ static void test_particle_relight_cancel(void **st)
     view_gi_times t;
     view_gi *g = NULL;
     assert_int_equal(view_gi_open(&g, GI_PARTICLE, sc, acc, &go, &t, d), PT_OK);
-    assert_true(view_gi_slow_light(g));
+    assert_int_equal(view_gi_slow_light(g), t.light > 0.040); /* a stale preview first only when relighting is slow */
     framebuffer *a = gi_pass(g, w, h);
 
     view_gi_scene(g)->lights[0].position = light_b;
