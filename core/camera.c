@@ -23,7 +23,10 @@
  *    (axes up x direction and direction x that), direction scaled to the
  *    focal distance / |direction| and corrected by the same offset, as
  *    POV-Ray's JitterCameraRay. Angles default to 90 degrees (spherical 360
- *    by angle/2). */
+ *    by angle/2).
+ *  - mesh_camera: one ray per mesh face, from its centroid along its
+ *    normal (distributions 0, 1, 2) or from the point of the face whose uv
+ *    is the pixel's (3), as TracePixel::CreateCameraRay's MESH_CAMERA case. */
 #include "camera.h"
 #include <math.h>
 
@@ -43,8 +46,110 @@ static vec3 rotate_axis(vec3 v, vec3 k, double a)
     return v3_add(v3_add(v3_scale(v, c), v3_scale(k, (1.0 - c) * v3_dot(k, v))), v3_scale(kxv, s));
 }
 
+/* ------------------------------------------------------------ mesh_camera */
+
+static vec3 fv3(const float *f) { return v3(f[0], f[1], f[2]); }
+
+/* Origin and direction from face `face` of mesh object m: the centroid and
+ * POV-Ray's face normal normalize((P3-P1) x (P2-P1)) (Compute_Mesh_Triangle),
+ * or, for distribution 3, the point with barycentrics b and (smooth) the
+ * interpolated vertex normal. Returns 0 for a degenerate face. */
+static int mesh_face_ray(const scene_camera *c, const scene_object *m, int face, const double *b, vec3 *org, vec3 *dir)
+{
+    const scene_mesh *ms = m->u.mesh.mesh;
+    const int *t = ms->tris[face];
+    vec3 p1 = fv3(ms->verts[t[0]]), p2 = fv3(ms->verts[t[1]]), p3 = fv3(ms->verts[t[2]]);
+    vec3 n = v3_cross(v3_sub(p3, p1), v3_sub(p2, p1));
+    double ln = v3_len(n);
+    if (!(ln > 0.0)) return 0;
+    n = v3_scale(n, 1.0 / ln);
+    vec3 o;
+    if (b) {
+        o = v3_add(v3_add(v3_scale(p1, b[0]), v3_scale(p2, b[1])), v3_scale(p3, b[2]));
+        if (c->mesh_smooth && ms->normals && ms->tri_normals) {
+            const int *tn = ms->tri_normals[face];
+            vec3 s = v3_add(v3_add(v3_scale(fv3(ms->normals[tn[0]]), b[0]), v3_scale(fv3(ms->normals[tn[1]]), b[1])),
+                            v3_scale(fv3(ms->normals[tn[2]]), b[2]));
+            if (v3_len(s) > 0.0) n = v3_norm(s);
+        }
+    } else {
+        o = v3_scale(v3_add(v3_add(p1, p2), p3), 1.0 / 3.0);
+    }
+    /* location.z moves the origin along the normal; direction.z < 0 turns
+     * the ray round (POV-Ray 3.7's conventions for the mesh camera) */
+    o = v3_madd(o, n, c->location.z);
+    if (c->direction.z < -CAM_EPSILON) n = v3_neg(n);
+    *org = xform_point(&m->transform, o);
+    *dir = v3_norm(xform_normal(&m->transform, n));
+    return v3_finite(*org) && v3_finite(*dir);
+}
+
+int camera_mesh_ray(const scene_camera *c, double px, double py, int w, int h, int ray, vec3 *org, vec3 *dir)
+{
+    if (c->nmeshes <= 0 || w <= 0 || h <= 0) return 0;
+    /* POV-Ray's coordinates: CreateCameraRay gets the pixel's column and row
+     * and moves them by +0.5 and -0.5 (for a pixel centre px = col + 0.5,
+     * py = row + 0.5 here: x = px, y = py - 1), then clamps them into the
+     * image and truncates them to indices; so rows 0 and 1 both use the
+     * first row of faces and row r > 0 uses row r - 1, as POV-Ray 3.7 does. */
+    double x0 = px, y0 = py - 1.0;
+    double x = fmax(0.0, fmin(x0, w - 1.0)), y = fmax(0.0, fmin(y0, h - 1.0));
+    unsigned ix = (unsigned)x, iy = (unsigned)y;
+    switch (c->mesh_distribution) {
+    case 0: { /* pixel i -> face i; ray r of a pixel uses mesh r */
+        if (ray < 0 || ray >= c->nmeshes) return 0;
+        const scene_object *m = c->meshes[ray];
+        unsigned long face = (unsigned long)iy * (unsigned)w + ix;
+        if (!m->u.mesh.mesh || face >= (unsigned long)m->u.mesh.mesh->ntris) return 0;
+        return mesh_face_ray(c, m, (int)face, NULL, org, dir);
+    }
+    case 1: { /* the meshes' faces summed; ray r adds r * (all faces) */
+        unsigned long total = 0;
+        for (int i = 0; i < c->nmeshes; i++) total += c->meshes[i]->u.mesh.mesh ? (unsigned long)c->meshes[i]->u.mesh.mesh->ntris : 0;
+        unsigned long face = (unsigned long)iy * (unsigned)w + ix + (unsigned long)(ray < 0 ? 0 : ray) * total;
+        for (int i = 0; i < c->nmeshes; i++) {
+            const scene_mesh *ms = c->meshes[i]->u.mesh.mesh;
+            unsigned long n = ms ? (unsigned long)ms->ntris : 0;
+            if (face < n) return mesh_face_ray(c, c->meshes[i], (int)face, NULL, org, dir);
+            face -= n;
+        }
+        return 0;
+    }
+    case 2: { /* one camera per mesh, side by side */
+        unsigned per = (unsigned)w / (unsigned)c->nmeshes;
+        if (per == 0) return 0;
+        unsigned mi = ix / per;
+        if (mi >= (unsigned)c->nmeshes) return 0;
+        const scene_object *m = c->meshes[mi];
+        /* POV-Ray 3.7 indexes with the full x here (not x - mi * per) */
+        unsigned long face = (unsigned long)iy * per + ix;
+        if (!m->u.mesh.mesh || face >= (unsigned long)m->u.mesh.mesh->ntris) return 0;
+        return mesh_face_ray(c, m, (int)face, NULL, org, dir);
+    }
+    default: { /* 3: the pixel's (u, v) located in the first mesh's uv map */
+        const scene_object *m = c->meshes[0];
+        const scene_mesh *ms = m->u.mesh.mesh;
+        if (!ms || !ms->uvs || ms->nuvs != ms->nverts) return 0;
+        double u = (x - 0.5) / w, v = 1.0 - (y + 0.5) / h;
+        for (int f = 0; f < ms->ntris; f++) {
+            const int *t = ms->tris[f];
+            double u1 = ms->uvs[t[0]][0], v1 = ms->uvs[t[0]][1], u2 = ms->uvs[t[1]][0], v2 = ms->uvs[t[1]][1];
+            double u3 = ms->uvs[t[2]][0], v3_ = ms->uvs[t[2]][1];
+            double sc = (u2 - u1) * (v3_ - v1) - (u3 - u1) * (v2 - v1);
+            if (sc == 0.0) continue;
+            double b[3] = {((u2 - u) * (v3_ - v) - (u3 - u) * (v2 - v)) / sc, ((u3 - u) * (v1 - v) - (u1 - u) * (v3_ - v)) / sc,
+                           ((u1 - u) * (v2 - v) - (u2 - u) * (v1 - v)) / sc};
+            if (b[0] < 0 || b[1] < 0 || b[2] < 0) continue;
+            return mesh_face_ray(c, m, f, b, org, dir);
+        }
+        return 0;
+    }
+    }
+}
+
 int camera_ray(const scene_camera *c, double px, double py, int w, int h, double lu, double lv, vec3 *org, vec3 *dir)
 {
+    if (c->kind == CAMERA_MESH) return camera_mesh_ray(c, px, py, w, h, 0, org, dir);
     double x0 = px / w - 0.5, y0 = 0.5 - py / h;
     vec3 D = c->direction, R = c->right, U = c->up;
     double lr = v3_len(R), lup = v3_len(U);

@@ -64,7 +64,8 @@ static void mesh_camera(sdl_parser *p, scene_camera *c, src_loc loc)
     memcpy(m, meshes, sizeof *m * (size_t)n);
     c->meshes = m;
     c->nmeshes = n;
-    sdl_warn_once(p, loc, "mesh_camera is parsed but the renderer does not support it yet");
+    if (c->mesh_rays_per_pixel > 1)
+        sdl_warn_once(p, loc, "mesh_camera: only the first of the %d rays per pixel is traced", c->mesh_rays_per_pixel);
 }
 
 /* camera_type := perspective | orthographic | fisheye | ultra_wide_angle |
