@@ -48,7 +48,32 @@ typedef struct {
     long **cell;
     atomic_long misses, unresolved;
     double off, scale;
+    int *order; /* stratum of the j-th ray of a particle */
+    int coherent;
 } link_job;
+
+/* Float version of gi_links_direction for the hot loop, with the frame
+ * (t, b, nrm) built once per particle (same map, float precision). */
+static void direction_f(const float t[3], const float b[3], const float nrm[3], int nside, int j, float u1, float u2,
+                        float out[3])
+{
+    float su = 2.0f * ((float)(j % nside) + u1) / (float)nside - 1.0f;
+    float sv = 2.0f * ((float)(j / nside) + u2) / (float)nside - 1.0f;
+    float r, th;
+    if (su == 0.0f && sv == 0.0f) {
+        r = 0.0f;
+        th = 0.0f;
+    } else if (fabsf(su) > fabsf(sv)) {
+        r = su;
+        th = (float)(M_PI / 4.0) * (sv / su);
+    } else {
+        r = sv;
+        th = (float)(M_PI / 2.0) - (float)(M_PI / 4.0) * (su / sv);
+    }
+    float x = r * cosf(th), y = r * sinf(th);
+    float z = sqrtf(fmaxf(0.0f, 1.0f - x * x - y * y));
+    for (int k = 0; k < 3; k++) out[k] = t[k] * x + b[k] * y + nrm[k] * z;
+}
 
 static void job(void *ctx, int index, int thread)
 {
@@ -63,22 +88,32 @@ static void job(void *ctx, int index, int thread)
         vec3 nrm = v3(pt->n[0], pt->n[1], pt->n[2]);
         double off = J->off * (J->scale + fmax(fabs(pos.x), fmax(fabs(pos.y), fabs(pos.z))));
         vec3 org = v3_madd(pos, nrm, off);
+        /* per particle: the frame and the ray epsilon (unit directions) */
+        vec3 tv, bv;
+        v3_basis(nrm, &tv, &bv);
+        float t[3] = {(float)tv.x, (float)tv.y, (float)tv.z}, bb[3] = {(float)bv.x, (float)bv.y, (float)bv.z};
+        float nf[3] = {(float)nrm.x, (float)nrm.y, (float)nrm.z};
+        float tnear = (float)accel_epsilon(J->a, org, nrm);
+        float ox = (float)org.x, oy = (float)org.y, oz = (float)org.z;
         rng r;
         rng_seed(&r, J->seed, (uint64_t)i);
         for (int j = 0; j < J->k; j++) {
-            double u1 = rng_f64(&r), u2 = rng_f64(&r);
-            vec3 d = gi_links_direction(nrm, J->nside, j, u1, u2);
+            float u1 = (float)rng_f64(&r), u2 = (float)rng_f64(&r);
+            float d[3];
+            direction_f(t, bb, nf, J->nside, J->order[j], u1, u2, d);
             struct RTCRayHit *h = &rh[m++];
-            memset(h, 0, sizeof *h);
-            h->ray.org_x = (float)org.x;
-            h->ray.org_y = (float)org.y;
-            h->ray.org_z = (float)org.z;
-            h->ray.dir_x = (float)d.x;
-            h->ray.dir_y = (float)d.y;
-            h->ray.dir_z = (float)d.z;
-            h->ray.tnear = (float)accel_epsilon(J->a, org, d);
+            h->ray.org_x = ox;
+            h->ray.org_y = oy;
+            h->ray.org_z = oz;
+            h->ray.tnear = tnear;
+            h->ray.dir_x = d[0];
+            h->ray.dir_y = d[1];
+            h->ray.dir_z = d[2];
+            h->ray.time = 0.0f;
             h->ray.tfar = INFINITY;
             h->ray.mask = 0xFFFFFFFFu;
+            h->ray.id = 0;
+            h->ray.flags = 0;
             h->hit.geomID = RTC_INVALID_GEOMETRY_ID;
             h->hit.primID = RTC_INVALID_GEOMETRY_ID;
             h->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
@@ -86,6 +121,7 @@ static void job(void *ctx, int index, int thread)
     }
     struct RTCIntersectContext c;
     rtcInitIntersectContext(&c);
+    if (J->coherent) c.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     rtcIntersect1M(J->scene, &c, rh, (unsigned)m, sizeof *rh);
     /* hit points and their lookup cells; the lookups are bound by memory
      * latency, so the whole batch prefetches first (gi_particles.h) */
@@ -121,7 +157,7 @@ static void job(void *ctx, int index, int thread)
                 target = gi_lookup_nearest_in(J->grid, cell[m], hp[m], d, o, J->maxdist);
                 if (target < 0) unres++;
             }
-            J->links[(size_t)i * J->k + j] = target;
+            J->links[(size_t)i * J->k + J->order[j]] = target;
         }
         if (J->anyhit) J->anyhit[i] = (unsigned char)any;
     }
@@ -142,6 +178,20 @@ pt_status gi_links_build(const accel *a, const gi_dev_particle *p, int n, int ns
     J.n = n;
     J.nside = nside;
     J.k = nside * nside;
+    /* rays in 4x4 blocks of strata (a narrow cone each) when the side
+     * divides by 4: Embree then traces each 16 as one coherent packet */
+    if (!J.scene) return PT_ERR_INTERNAL;
+    J.order = malloc((size_t)J.k * sizeof *J.order);
+    if (!J.order) return PT_ERR_NOMEM;
+    J.coherent = nside % 4 == 0;
+    for (int j = 0; j < J.k; j++) {
+        if (nside % 4 == 0) {
+            int blk = j / 16, w = j % 16, bpr = nside / 4;
+            J.order[j] = ((blk / bpr) * 4 + w / 4) * nside + (blk % bpr) * 4 + w % 4;
+        } else {
+            J.order[j] = j;
+        }
+    }
     J.per_job = J.k >= RAYS_PER_CALL ? 1 : RAYS_PER_CALL / J.k;
     J.seed = seed;
     J.grid = grid;
@@ -152,7 +202,6 @@ pt_status gi_links_build(const accel *a, const gi_dev_particle *p, int n, int ns
     J.scale = accel_scale(a);
     atomic_init(&J.misses, 0);
     atomic_init(&J.unresolved, 0);
-    if (!J.scene) return PT_ERR_INTERNAL;
     J.buf = calloc((size_t)threads, sizeof *J.buf);
     J.hp = calloc((size_t)threads, sizeof *J.hp);
     J.cell = calloc((size_t)threads, sizeof *J.cell);
@@ -175,6 +224,7 @@ pt_status gi_links_build(const accel *a, const gi_dev_particle *p, int n, int ns
     free(J.buf);
     free(J.hp);
     free(J.cell);
+    free(J.order);
     if (st) {
         st->rays += (long)n * J.k;
         st->misses += atomic_load(&J.misses);

@@ -369,47 +369,41 @@ long gi_grid_radius(const gi_grid *g, vec3 q, vec3 nq, double r, double cos_thr,
 
 /* ------------------------------------------------------------------ dense lookup */
 
-/* Nearest-particle lookup by cell lists with a margin: each cell of a
- * dense grid lists every particle within `margin` of it (a particle is
- * entered in the up to 8 cells its [p - margin, p + margin] box touches).
- * The nearest particle to q, if it is within margin, is then in the list of
- * q's own cell, so a query reads one contiguous run of memory. Farther
- * answers fall back to the hashed grid's ring search.
+/* Nearest-particle lookup by a dense grid of `cell`-wide cells, each particle
+ * stored once, in its own cell (a counting sort by cell index). The nearest
+ * particle to q within margin = cell/2 lies in the cells the box
+ * [q - margin, q + margin] overlaps, which are the 2x2x2 block of cells
+ * around the cell corner nearest to q. Cells are numbered with x fastest,
+ * so the two cells of a block row are one contiguous run of entries: a
+ * query reads 4 runs. Farther answers fall back to the hashed grid's ring
+ * search.
  *
- * Layout: each cell's list is padded to whole blocks of LK_W entries stored
- * as structure-of-arrays (positions and normals as floats: 192 bytes,
- * three cache lines per block), so that the distance and side tests of a
- * query run over LK_W lanes at once (the compiler vectorizes the fixed-width
- * loops); padding entries lie at infinity. The particle index of a slot is
- * in a separate array, read only for the winner. */
-#define LK_W 8
+ * Layout: every cell's entries are padded to whole blocks of LK_W stored as
+ * structure-of-arrays (position and normal as floats, then the particle
+ * indices: 128 bytes per block; padding lies at infinity), so a query tests LK_W entries at once with
+ * 4-lane vector operations; the particle indices complete the block to two
+ * cache lines. About 50 bytes per particle (padding included) against the previous layout's 8 copies of every particle (one
+ * per cell of its margin box): the structure stays in cache while link
+ * rays land all over the scene. */
+#define LK_W 4
 typedef struct {
     float x[LK_W], y[LK_W], z[LK_W];
     float nx[LK_W], ny[LK_W], nz[LK_W]; /* rounded to 1/127 as the hashed grid's */
+    int idx[LK_W];                      /* particle of each slot, -1 for padding */
+    int pad[LK_W];
 } lblock;
-_Static_assert(sizeof(lblock) == 192, "lookup block is three cache lines");
+_Static_assert(sizeof(lblock) == 128, "lookup block is two cache lines");
 
 struct gi_lookup {
     double cell, inv, margin;
     vec3 origin;
     long dim[3];
     int *start; /* ncells + 2, in slots (multiples of LK_W) */
-    lblock *b;  /* ne / LK_W blocks */
-    int *idx;   /* ne: particle of each slot, -1 for padding */
+    lblock *b;  /* ne / LK_W */
     long ne;
     int n;
     gi_grid *fallback;
 };
-
-static long lk_index(const gi_lookup *g, double x, double y, double z, long *c)
-{
-    double f[3] = {(x - g->origin.x) * g->inv, (y - g->origin.y) * g->inv, (z - g->origin.z) * g->inv};
-    for (int k = 0; k < 3; k++) {
-        long i = isfinite(f[k]) ? (long)floor(f[k]) : 0;
-        c[k] = i < 0 ? 0 : (i >= g->dim[k] ? g->dim[k] - 1 : i);
-    }
-    return (c[2] * g->dim[1] + c[1]) * g->dim[0] + c[0];
-}
 
 gi_lookup *gi_lookup_build(const gi_particles *ps, double cell)
 {
@@ -425,9 +419,8 @@ gi_lookup *gi_lookup_build(const gi_particles *ps, double cell)
     }
     if (n == 0) lo = hi = v3s(0.0);
     if (!(cell > 0.0)) cell = 1.0;
-    g->margin = 0.5 * cell;
     vec3 ext = v3_sub(hi, lo);
-    double limit = 4.0 * n + 4096.0;
+    double limit = 8.0 * n + 4096.0;
     for (;;) {
         double cells = 1.0;
         for (int k = 0; k < 3; k++) cells *= floor(v3_idx(ext, k) / cell) + 3.0;
@@ -436,66 +429,64 @@ gi_lookup *gi_lookup_build(const gi_particles *ps, double cell)
     }
     g->cell = cell;
     g->inv = 1.0 / cell;
+    g->margin = 0.5 * cell;
     g->origin = v3_sub(lo, v3s(cell));
     for (int k = 0; k < 3; k++) g->dim[k] = (long)floor(v3_idx(ext, k) / cell) + 3;
     long ncells = g->dim[0] * g->dim[1] * g->dim[2];
     g->start = calloc((size_t)ncells + 2, sizeof *g->start);
+    long *key = malloc((size_t)(n > 0 ? n : 1) * sizeof *key);
     g->fallback = gi_grid_build(ps->p, n, g->margin);
-    if (!g->start || !g->fallback) {
+    if (!g->start || !key || !g->fallback) {
+        free(key);
         gi_lookup_free(g);
         return NULL;
     }
-    double m = g->margin;
-    for (int pass = 0; pass < 2; pass++) {
-        for (int i = 0; i < n; i++) {
-            const gi_dev_particle *p = &ps->p[i];
-            long a[3], b[3];
-            lk_index(g, p->p[0] - m, p->p[1] - m, p->p[2] - m, a);
-            lk_index(g, p->p[0] + m, p->p[1] + m, p->p[2] + m, b);
-            for (long z = a[2]; z <= b[2]; z++)
-                for (long y = a[1]; y <= b[1]; y++)
-                    for (long x = a[0]; x <= b[0]; x++) {
-                        long c = (z * g->dim[1] + y) * g->dim[0] + x;
-                        if (pass == 0) {
-                            g->start[c + 2]++;
-                            continue;
-                        }
-                        long s = g->start[c + 1]++;
-                        lblock *e = &g->b[s / LK_W];
-                        int l = (int)(s % LK_W);
-                        e->x[l] = p->p[0];
-                        e->y[l] = p->p[1];
-                        e->z[l] = p->p[2];
-                        e->nx[l] = (float)lrintf(p->n[0] * 127.0f);
-                        e->ny[l] = (float)lrintf(p->n[1] * 127.0f);
-                        e->nz[l] = (float)lrintf(p->n[2] * 127.0f);
-                        g->idx[s] = i;
-                    }
+    for (int i = 0; i < n; i++) {
+        const float *p = ps->p[i].p;
+        long c[3];
+        for (int k = 0; k < 3; k++) {
+            double f = ((double)p[k] - v3_idx(g->origin, k)) * g->inv;
+            long ci = isfinite(f) ? (long)floor(f) : 0;
+            c[k] = ci < 0 ? 0 : (ci >= g->dim[k] ? g->dim[k] - 1 : ci);
         }
-        if (pass == 0) {
-            /* pad every list to whole blocks, then prefix sums */
-            for (long c = 0; c < ncells; c++) g->start[c + 2] = (g->start[c + 2] + LK_W - 1) / LK_W * LK_W;
-            for (long c = 0; c <= ncells; c++) g->start[c + 1] += g->start[c];
-            g->ne = g->start[ncells + 1];
-            long nb = g->ne / LK_W > 0 ? g->ne / LK_W : 1;
-            g->b = aligned_alloc(64, (size_t)nb * sizeof *g->b);
-            g->idx = malloc((size_t)nb * LK_W * sizeof *g->idx);
-            if (!g->b || !g->idx) {
-                gi_lookup_free(g);
-                return NULL;
-            }
-            for (long k = 0; k < nb; k++) {
-                for (int l = 0; l < LK_W; l++) {
-                    g->b[k].x[l] = g->b[k].y[l] = g->b[k].z[l] = INFINITY;
-                    g->b[k].nx[l] = g->b[k].ny[l] = g->b[k].nz[l] = 0.0f;
-                    g->idx[k * LK_W + l] = -1;
-                }
-            }
+        key[i] = (c[2] * g->dim[1] + c[1]) * g->dim[0] + c[0];
+        g->start[key[i] + 2]++;
+    }
+    /* pad every cell to whole blocks, then prefix sums */
+    for (long c = 0; c < ncells; c++) g->start[c + 2] = (g->start[c + 2] + LK_W - 1) / LK_W * LK_W;
+    for (long c = 0; c <= ncells; c++) g->start[c + 1] += g->start[c];
+    g->ne = g->start[ncells + 1];
+    long nb = g->ne / LK_W > 0 ? g->ne / LK_W : 1;
+    g->b = aligned_alloc(64, ((size_t)nb * sizeof *g->b + 63) / 64 * 64);
+    if (!g->b) {
+        free(key);
+        gi_lookup_free(g);
+        return NULL;
+    }
+    for (long k = 0; k < nb; k++)
+        for (int l = 0; l < LK_W; l++) {
+            g->b[k].x[l] = g->b[k].y[l] = g->b[k].z[l] = INFINITY;
+            g->b[k].nx[l] = g->b[k].ny[l] = g->b[k].nz[l] = 0.0f;
+            g->b[k].idx[l] = -1;
+            g->b[k].pad[l] = 0;
         }
+    for (int i = 0; i < n; i++) {
+        const gi_dev_particle *p = &ps->p[i];
+        long s = g->start[key[i] + 1]++;
+        lblock *e = &g->b[s / LK_W];
+        int l = (int)(s % LK_W);
+        e->x[l] = p->p[0];
+        e->y[l] = p->p[1];
+        e->z[l] = p->p[2];
+        e->nx[l] = (float)lrintf(p->n[0] * 127.0f);
+        e->ny[l] = (float)lrintf(p->n[1] * 127.0f);
+        e->nz[l] = (float)lrintf(p->n[2] * 127.0f);
+        e->idx[l] = i;
     }
     /* start[c + 1] is now the end of cell c's entries: round it up to the
-     * cell's padded end (its blocks start on multiples of LK_W) */
+     * cell's padded end */
     for (long c = 0; c < ncells; c++) g->start[c + 1] = (g->start[c + 1] + LK_W - 1) / LK_W * LK_W;
+    free(key);
     return g;
 }
 
@@ -504,7 +495,6 @@ void gi_lookup_free(gi_lookup *g)
     if (!g) return;
     free(g->start);
     free(g->b);
-    free(g->idx);
     gi_grid_free(g->fallback);
     free(g);
 }
@@ -512,28 +502,43 @@ void gi_lookup_free(gi_lookup *g)
 size_t gi_lookup_bytes(const gi_lookup *g)
 {
     return g ? ((size_t)(g->dim[0] * g->dim[1] * g->dim[2]) + 2) * sizeof(int) +
-                   (size_t)g->ne / LK_W * sizeof(lblock) + (size_t)g->ne * sizeof(int) + gi_grid_bytes(g->fallback)
+                   (size_t)g->ne / LK_W * sizeof(lblock) + gi_grid_bytes(g->fallback)
              : 0;
 }
 
+/* The lowest corner cell of the 2x2x2 block a query at q reads. */
 long gi_lookup_cell(const gi_lookup *g, vec3 q)
 {
+    if (!g->n) return 0;
     long c[3];
-    return g->n ? lk_index(g, q.x, q.y, q.z, c) : 0;
+    double qq[3] = {q.x, q.y, q.z};
+    for (int k = 0; k < 3; k++) {
+        double f = (qq[k] - v3_idx(g->origin, k)) * g->inv;
+        long i = 0;
+        if (isfinite(f)) {
+            double fl = floor(f);
+            i = (long)fl - (f - fl < 0.5 ? 1 : 0);
+        }
+        c[k] = i < 0 ? 0 : (i > g->dim[k] - 2 ? g->dim[k] - 2 : i);
+    }
+    return (c[2] * g->dim[1] + c[1]) * g->dim[0] + c[0];
 }
 
 void gi_lookup_prefetch(const gi_lookup *g, long cell, int stage)
 {
     if (g->n == 0) return;
-    if (stage == 0) {
-        __builtin_prefetch(&g->start[cell]);
-        return;
-    }
-    int k = g->start[cell];
-    if (k < g->ne) {
-        __builtin_prefetch(&g->b[k / LK_W]);
-        __builtin_prefetch((const char *)&g->b[k / LK_W] + 64);
-        __builtin_prefetch((const char *)&g->b[k / LK_W] + 128);
+    long d0 = g->dim[0], d01 = g->dim[0] * g->dim[1];
+    long rows[4] = {cell, cell + d0, cell + d01, cell + d01 + d0};
+    for (int r = 0; r < 4; r++) {
+        if (stage == 0) {
+            __builtin_prefetch(&g->start[rows[r]]);
+        } else {
+            int k = g->start[rows[r]];
+            if (k < g->ne) {
+                __builtin_prefetch(&g->b[k / LK_W]);
+                __builtin_prefetch((const char *)&g->b[k / LK_W] + 64);
+            }
+        }
     }
 }
 
@@ -550,58 +555,53 @@ int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 o
     float dx = (float)dir.x, dy = (float)dir.y, dz = (float)dir.z;
     float ox = (float)org.x, oy = (float)org.y, oz = (float)org.z;
     double m = fmin(g->margin, maxdist);
-    /* GCC/Clang vector extensions: 4 lanes (SSE2 on x86-64), two per block */
+    /* GCC/Clang vector extensions: 4 lanes (SSE2 on x86-64) */
     typedef float v4f __attribute__((vector_size(16)));
     typedef int v4i __attribute__((vector_size(16)));
-    v4f best[2], vqx = {qx, qx, qx, qx}, vqy = {qy, qy, qy, qy}, vqz = {qz, qz, qz, qz};
+    float m2 = (float)(m * m);
+    v4f best = {m2, m2, m2, m2}, vqx = {qx, qx, qx, qx}, vqy = {qy, qy, qy, qy}, vqz = {qz, qz, qz, qz};
     v4f vdx = {dx, dx, dx, dx}, vdy = {dy, dy, dy, dy}, vdz = {dz, dz, dz, dz};
     v4f vox = {ox, ox, ox, ox}, voy = {oy, oy, oy, oy}, voz = {oz, oz, oz, oz}, zero = {0, 0, 0, 0};
-    v4i vslot[2], lane = {0, 1, 2, 3};
-    float m2 = (float)(m * m);
-    for (int h = 0; h < 2; h++) {
-        best[h] = (v4f){m2, m2, m2, m2};
-        vslot[h] = (v4i){-1, -1, -1, -1};
-    }
-    /* LK_W lanes at once, branch-free (the comparisons are unpredictable);
-     * each lane keeps its first strictly nearest slot */
-    for (int k = g->start[cell]; k < g->start[cell + 1]; k += LK_W) {
-        const lblock *e = &g->b[k / LK_W];
-        for (int h = 0; h < 2; h++) {
-            v4f x, y, z;
-            v4f nx, ny, nz;
-            memcpy(&x, e->x + 4 * h, sizeof x);
-            memcpy(&y, e->y + 4 * h, sizeof y);
-            memcpy(&z, e->z + 4 * h, sizeof z);
-            memcpy(&nx, e->nx + 4 * h, sizeof nx);
-            memcpy(&ny, e->ny + 4 * h, sizeof ny);
-            memcpy(&nz, e->nz + 4 * h, sizeof nz);
+    v4i vslot = {-1, -1, -1, -1}, lane = {0, 1, 2, 3};
+    long d0 = g->dim[0], d01 = g->dim[0] * g->dim[1];
+    long rows[4] = {cell, cell + d0, cell + d01, cell + d01 + d0};
+    /* the 4 runs in a fixed order, branch-free (the comparisons are
+     * unpredictable); each lane keeps its first strictly nearest slot */
+    for (int r = 0; r < 4; r++) {
+        int k1 = g->start[rows[r] + 2];
+        for (int k = g->start[rows[r]]; k < k1; k += LK_W) {
+            const lblock *e = &g->b[k / LK_W];
+            v4f x, y, z, nx, ny, nz;
+            memcpy(&x, e->x, sizeof x);
+            memcpy(&y, e->y, sizeof y);
+            memcpy(&z, e->z, sizeof z);
+            memcpy(&nx, e->nx, sizeof nx);
+            memcpy(&ny, e->ny, sizeof ny);
+            memcpy(&nz, e->nz, sizeof nz);
             v4f ex = x - vqx, ey = y - vqy, ez = z - vqz;
             v4f d2 = ex * ex + ey * ey + ez * ez;
             v4f f = nx * vdx + ny * vdy + nz * vdz;
             v4f hh = nx * (vox - x) + ny * (voy - y) + nz * (voz - z);
-            v4i ok = (d2 < best[h]) & (f < zero) & (hh > zero);
-            best[h] = (v4f)(((v4i)d2 & ok) | ((v4i)best[h] & ~ok));
-            v4i sl = lane + (k + 4 * h);
-            vslot[h] = (sl & ok) | (vslot[h] & ~ok);
+            v4i ok = (d2 < best) & (f < zero) & (hh > zero);
+            best = (v4f)(((v4i)d2 & ok) | ((v4i)best & ~ok));
+            vslot = ((lane + k) & ok) | (vslot & ~ok);
         }
     }
-    float bestl[LK_W];
-    int slot[LK_W];
-    memcpy(bestl, best, sizeof bestl);
-    memcpy(slot, vslot, sizeof slot);
-    /* across lanes: nearest, ties to the lower particle index (the order of
-     * a single scan over the list, which is in index order) */
-    int bi = -1;
+    float bl[LK_W];
+    int sl[LK_W];
+    memcpy(bl, &best, sizeof bl);
+    memcpy(sl, &vslot, sizeof sl);
+    /* across lanes: nearest, ties to the earlier slot in scan order */
+    int bs = -1;
     float bd = 0.0f;
     for (int l = 0; l < LK_W; l++) {
-        if (slot[l] < 0) continue;
-        int id = g->idx[slot[l]];
-        if (bi < 0 || bestl[l] < bd || (bestl[l] == bd && id < bi)) {
-            bi = id;
-            bd = bestl[l];
+        if (sl[l] < 0) continue;
+        if (bs < 0 || bl[l] < bd || (bl[l] == bd && sl[l] < bs)) {
+            bs = sl[l];
+            bd = bl[l];
         }
     }
-    if (bi >= 0) return bi;
+    if (bs >= 0) return g->b[bs / LK_W].idx[bs % LK_W];
     /* nothing within the margin: the ring search, up to maxdist */
     return maxdist > m ? gi_grid_nearest(g->fallback, q, dir, org, maxdist) : -1;
 }

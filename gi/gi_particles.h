@@ -55,19 +55,19 @@ int gi_grid_nearest(const gi_grid *g, vec3 q, vec3 dir, vec3 org, double maxdist
 long gi_grid_radius(const gi_grid *g, vec3 q, vec3 nq, double r, double cos_thr, int **out, long *len, long *cap);
 
 /* Nearest-particle lookup for the link builder: a dense grid of `cell`-wide
- * cells (grown when the box would need more than 4 cells per particle),
- * each listing every particle within cell/2 of it, so that a query reads
- * one contiguous list; answers farther than cell/2 come from a ring search
- * in a hashed grid. */
+ * cells (grown when the box would need more than 8 cells per particle),
+ * each particle stored once in its cell (16 bytes); a query reads the
+ * 2x2x2 cells around it, which hold every particle within cell/2; answers
+ * farther than cell/2 come from a ring search in a hashed grid. */
 typedef struct gi_lookup gi_lookup;
 gi_lookup *gi_lookup_build(const gi_particles *ps, double cell);
 void gi_lookup_free(gi_lookup *g);
 size_t gi_lookup_bytes(const gi_lookup *g);
 /* As gi_grid_nearest. */
 int gi_lookup_nearest(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double maxdist);
-/* The same in steps, for batches (queries are bound by memory latency, so a
- * batch first computes every cell, prefetches stage 0 (the cell's list
- * head) for all, then stage 1 (the list), then queries). */
+/* The same in steps, for batches (a batch first computes every query's
+ * block, prefetches stage 0 (the block's list heads) for all, then stage 1
+ * (the lists), then queries). */
 long gi_lookup_cell(const gi_lookup *g, vec3 q);
 void gi_lookup_prefetch(const gi_lookup *g, long cell, int stage);
 int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist);
