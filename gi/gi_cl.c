@@ -46,6 +46,26 @@ extern const int gi_kernel_nfiles;
 
 #define GI_CL_LOCAL 64
 
+/* Scatter slices for a CPU device of `units` cores (gi_k_scatter): one per
+ * core, at most GI_SCATTER_MAX_SLICES, and fewer when the slices (24 bytes
+ * per particle each) would pass 256 MiB. */
+#define GI_SCATTER_MAX_SLICES 16
+static int scatter_slices(int units, size_t n)
+{
+    int s = units < 1 ? 1 : (units > GI_SCATTER_MAX_SLICES ? GI_SCATTER_MAX_SLICES : units);
+    while (s > 1 && (size_t)s * n * 24 > ((size_t)256 << 20)) s--;
+    return s;
+}
+
+static void sum_tally(const gi_i64 *ts, int ns, int nb, gi_i64 *out)
+{
+    for (int b = 0; b < 3 * nb; b++) {
+        gi_i64 t = 0;
+        for (int w = 0; w < ns; w++) t += ts[(size_t)w * 3 * GI_MAX_BOUNCES + b];
+        out[b] = t;
+    }
+}
+
 enum { KE_EMIT, KE_SCATTER, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_PULL_INIT, KE_PULL, KE_COUNT };
 
 struct gi_dev {
@@ -57,6 +77,8 @@ struct gi_dev {
     /* geometry (host pointers, caller-owned) */
     const gi_dev_particle *part;
     int n, ns2, ng, nrp;
+    int slices; /* scatter slices (gi_k_scatter): 0 = atomic adds (GPUs) */
+    int cpu_units; /* OpenCL: compute units of a CPU device, 0 for other devices */
     const int *slink, *glink, *list_off, *list_idx, *rin_off, *rin_src;
     /* C build scratch */
     float *edir, *src, *bin, *bout, *total;
@@ -262,6 +284,11 @@ static pt_status cl_open(gi_dev *dv, const gi_dev_options *o, diag *d)
     snprintf(dv->name, sizeof dv->name, "OpenCL: %s (%s)", dname, pname);
     char ext[8192] = "";
     clGetDeviceInfo(dev, CL_DEVICE_EXTENSIONS, sizeof ext, ext, NULL);
+    cl_device_type type = 0;
+    cl_uint units = 1;
+    clGetDeviceInfo(dev, CL_DEVICE_TYPE, sizeof type, &type, NULL);
+    clGetDeviceInfo(dev, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof units, &units, NULL);
+    dv->cpu_units = (type & CL_DEVICE_TYPE_CPU) ? (int)(units < (cl_uint)dv->threads ? units : (cl_uint)dv->threads) : 0;
     if (!strstr(ext, "cl_khr_int64_base_atomics")) {
         err(d, "OpenCL: device %s lacks cl_khr_int64_base_atomics (64-bit atomics for deterministic flux "
                "accumulation); run the kernels as C with --cl-device c", dname);
@@ -369,7 +396,15 @@ typedef struct {
 #define KINT(v) ((karg){sizeof(int), &(v)})
 #define KF(v) ((karg){sizeof(float), &(v)})
 
+static pt_status run_kernel_local(gi_dev *dv, int which, size_t n, size_t local, const karg *args, int nargs,
+                                  diag *d);
 static pt_status run_kernel(gi_dev *dv, int which, size_t n, const karg *args, int nargs, diag *d)
+{
+    return run_kernel_local(dv, which, n, GI_CL_LOCAL, args, nargs, d);
+}
+
+static pt_status run_kernel_local(gi_dev *dv, int which, size_t n, size_t local, const karg *args, int nargs,
+                                  diag *d)
 {
     cl_kernel k = dv->k[which];
     for (int i = 0; i < nargs; i++) {
@@ -379,7 +414,7 @@ static pt_status run_kernel(gi_dev *dv, int which, size_t n, const karg *args, i
     if (n == 0) return PT_OK;
     /* a fixed work-group size (PoCL compiles a kernel once per size) and a
      * global size rounded up to it; the kernels ignore ids past n */
-    size_t local = GI_CL_LOCAL, global = (n + local - 1) / local * local;
+    size_t global = (n + local - 1) / local * local;
     cl_int e = clEnqueueNDRangeKernel(dv->q, k, 1, NULL, &global, &local, 0, NULL, NULL);
     if (e != CL_SUCCESS) return cl_fail(d, "clEnqueueNDRangeKernel", e);
     e = clFinish(dv->q);
@@ -469,11 +504,12 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
         free(dv->total);
         dv->edir = calloc(nn * 4, sizeof(float));
         dv->src = calloc(nn * 4, sizeof(float));
-        dv->acc = calloc(nn * 3, sizeof(gi_i64));
+        dv->slices = scatter_slices(dv->threads, nn);
+        dv->acc = calloc(nn * 3 * (size_t)dv->slices, sizeof(gi_i64));
         dv->bin = calloc(nn * 4, sizeof(float));
         dv->bout = calloc(nn * 4, sizeof(float));
         dv->total = calloc(nn * 4, sizeof(float));
-        dv->bytes = nn * (5 * 16 + 24);
+        dv->bytes = nn * (5 * 16 + 24 * (size_t)dv->slices);
         if (!dv->edir || !dv->src || !dv->acc || !dv->bin || !dv->bout || !dv->total) return PT_ERR_NOMEM;
         return PT_OK;
     }
@@ -491,6 +527,7 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     /* the real count: with no particles the arrays may be NULL (buffers get a
      * minimal size, nothing is written) */
     size_t nr = n > 0 ? (size_t)n : 0;
+    dv->slices = dv->cpu_units > 0 ? scatter_slices(dv->cpu_units, nn) : 0;
     if ((st = upload(dv, &dv->b_part, &have, part, nr * sizeof *part, d)) != PT_OK) return st;
     have = 0;
     if ((st = upload(dv, &dv->b_slink, &have, slink, nr * (size_t)ns2 * sizeof(int), d)) != PT_OK) return st;
@@ -502,7 +539,9 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     have = 0;
     if ((st = ensure(dv, &dv->b_src, &have, f4, d)) != PT_OK) return st;
     have = 0;
-    if ((st = ensure(dv, &dv->b_acc, &have, nn * 3 * sizeof(gi_i64), d)) != PT_OK) return st;
+    if ((st = ensure(dv, &dv->b_acc, &have, nn * 3 * sizeof(gi_i64) * (size_t)(dv->slices > 0 ? dv->slices : 1), d)) !=
+        PT_OK)
+        return st;
     have = 0;
     if ((st = ensure(dv, &dv->b_lout, &have, f4, d)) != PT_OK) return st;
     have = 0;
@@ -597,10 +636,13 @@ pt_status gi_dev_scatter(gi_dev *dv, int mode, int nb, gi_u32 seed, float scale,
     gi_i64 tally_local[GI_MAX_BOUNCES * 3];
     gi_i64 *tl = tally ? tally : tally_local;
     memset(tl, 0, sizeof(gi_i64) * 3 * (size_t)(nb > 0 ? nb : 1));
+    int ns = dv->slices > 0 ? dv->slices : 1;
+    gi_i64 tally_s[GI_SCATTER_MAX_SLICES * GI_MAX_BOUNCES * 3];
+    memset(tally_s, 0, sizeof tally_s);
     float inv_scale = 1.0f / scale;
     int full = mode == GI_SCATTER_FULL && dv->rin_off;
     if (!dv->is_cl) {
-        memset(dv->acc, 0, nn * 3 * sizeof(gi_i64));
+        memset(dv->acc, 0, nn * 3 * (size_t)ns * sizeof(gi_i64));
         memset(dv->total, 0, nn * 4 * sizeof(float));
         if (full && nb > 0) {
             gi_c_pull_init(dv->threads, dv->n, dv->ns2, dv->src, dv->bin, dv->total);
@@ -612,20 +654,22 @@ pt_status gi_dev_scatter(gi_dev *dv, int mode, int nb, gi_u32 seed, float scale,
                 dv->bout = t;
             }
         } else if (nb > 0) {
-            gi_c_scatter(dv->threads, dv->part, dv->slink, dv->ns2, nb, seed, scale, srcidx, nsrc, dv->src, dv->acc,
-                         tl);
+            gi_c_scatter(dv->threads, dv->part, dv->n, dv->slink, dv->ns2, nb, seed, scale, srcidx, nsrc, dv->src,
+                         dv->slices, dv->acc, tally_s);
+            sum_tally(tally_s, ns, nb, tl);
         }
-        gi_c_resolve(dv->threads, dv->part, dv->n, dv->edir, dv->acc, inv_scale, dv->total, lout, phi);
+        gi_c_resolve(dv->threads, dv->part, dv->n, dv->edir, dv->acc, dv->slices, inv_scale, dv->total, lout, phi);
         dv->lout_host = lout;
         return PT_OK;
     }
 #ifdef PARTRAY_HAVE_OPENCL
     pt_status st;
     size_t f4 = nn * 4 * sizeof(float);
-    size_t have_t = dv->b_tally ? (size_t)GI_MAX_BOUNCES * 3 * sizeof(gi_i64) : 0;
-    if ((st = ensure(dv, &dv->b_tally, &have_t, (size_t)GI_MAX_BOUNCES * 3 * sizeof(gi_i64), d)) != PT_OK) return st;
-    if ((st = zero(dv, dv->b_tally, (size_t)GI_MAX_BOUNCES * 3 * sizeof(gi_i64), d)) != PT_OK) return st;
-    if ((st = zero(dv, dv->b_acc, nn * 3 * sizeof(gi_i64), d)) != PT_OK) return st;
+    size_t tbytes = (size_t)ns * GI_MAX_BOUNCES * 3 * sizeof(gi_i64);
+    size_t have_t = dv->b_tally ? tbytes : 0;
+    if ((st = ensure(dv, &dv->b_tally, &have_t, tbytes, d)) != PT_OK) return st;
+    if ((st = zero(dv, dv->b_tally, tbytes, d)) != PT_OK) return st;
+    if ((st = zero(dv, dv->b_acc, nn * 3 * (size_t)ns * sizeof(gi_i64), d)) != PT_OK) return st;
     if ((st = zero(dv, dv->b_total, f4, d)) != PT_OK) return st;
     int n = dv->n, ns2 = dv->ns2;
     if (full && nb > 0) {
@@ -643,14 +687,23 @@ pt_status gi_dev_scatter(gi_dev *dv, int mode, int nb, gi_u32 seed, float scale,
         if ((st = upload(dv, &dv->b_srcidx, &dv->sz_srcidx, srcidx, (size_t)nsrc * sizeof(int), d)) != PT_OK)
             return st;
         cl_uint sd = seed;
-        karg a[] = {KMEM(dv->b_part), KMEM(dv->b_slink), KINT(ns2), KINT(nb), {sizeof(cl_uint), &sd}, KF(scale),
-                    KMEM(dv->b_srcidx), KINT(nsrc), KMEM(dv->b_src), KMEM(dv->b_acc), KMEM(dv->b_tally)};
-        if ((st = run_kernel(dv, KE_SCATTER, (size_t)nsrc, a, 11, d)) != PT_OK) return st;
-        if ((st = download(dv, dv->b_tally, tl, (size_t)nb * 3 * sizeof(gi_i64), d)) != PT_OK) return st;
+        int slices = dv->slices;
+        karg a[] = {KMEM(dv->b_part), KMEM(dv->b_slink), KINT(ns2), KINT(nb),  {sizeof(cl_uint), &sd},
+                    KF(scale),        KMEM(dv->b_srcidx), KINT(nsrc), KMEM(dv->b_src), KMEM(dv->b_acc),
+                    KMEM(dv->b_tally), KINT(n),          KINT(slices)};
+        /* slices: one work-item each, in work-groups of one (PoCL spreads
+         * work-groups over its threads) */
+        if ((st = run_kernel_local(dv, KE_SCATTER, slices > 0 ? (size_t)slices : (size_t)nsrc,
+                                   slices > 0 ? 1 : GI_CL_LOCAL, a, 13, d)) != PT_OK)
+            return st;
+        if ((st = download(dv, dv->b_tally, tally_s, tbytes, d)) != PT_OK) return st;
+        if (slices > 0) sum_tally(tally_s, ns, nb, tl);
+        else memcpy(tl, tally_s, (size_t)nb * 3 * sizeof(gi_i64));
     }
-    karg r[] = {KMEM(dv->b_part), KINT(n),         KMEM(dv->b_edir), KMEM(dv->b_acc),
+    int slices_r = dv->slices;
+    karg r[] = {KMEM(dv->b_part), KINT(n),           KMEM(dv->b_edir), KMEM(dv->b_acc), KINT(slices_r),
                 KF(inv_scale),    KMEM(dv->b_total), KMEM(dv->b_lout), KMEM(dv->b_phi)};
-    if ((st = run_kernel(dv, KE_RESOLVE, nn, r, 8, d)) != PT_OK) return st;
+    if ((st = run_kernel(dv, KE_RESOLVE, nn, r, 9, d)) != PT_OK) return st;
     if ((st = download(dv, dv->b_lout, lout, f4, d)) != PT_OK) return st;
     return download(dv, dv->b_phi, phi, f4, d);
 #else

@@ -32,6 +32,9 @@ typedef struct {
     const float *total;
     float *ftot;
     const int *rin_off, *rin_src;
+    int np_slices; /* scatter: slices (one work-item each) */
+    int nsrc;      /* scatter: sources */
+    size_t chunk;  /* work-items per pool job (0: GI_C_CHUNK) */
 } c_launch;
 
 enum { K_EMIT, K_SCATTER, K_RESOLVE, K_GATHER, K_ESTIMATE, K_PULL_INIT, K_PULL };
@@ -40,16 +43,19 @@ static void run_chunk(void *ctx, int chunk, int thread)
 {
     (void)thread;
     const c_launch *a = ctx;
-    size_t lo = (size_t)chunk * GI_C_CHUNK, hi = lo + GI_C_CHUNK < a->n ? lo + GI_C_CHUNK : a->n;
+    size_t cs = a->chunk ? a->chunk : GI_C_CHUNK;
+    size_t lo = (size_t)chunk * cs, hi = lo + cs < a->n ? lo + cs : a->n;
     for (size_t g = lo; g < hi; g++) {
         gi_shim_gid = g;
         switch (a->kernel) {
         case K_EMIT: gi_k_emit(a->part, a->np, a->lights, a->nlights, a->vis, a->fout, a->fout2); break;
         case K_SCATTER:
-            gi_k_scatter(a->part, a->slink, a->ns2, a->nb, a->seed, a->scale, a->idx, (int)a->n, a->src, a->acc,
-                         a->tally);
+            gi_k_scatter(a->part, a->slink, a->ns2, a->nb, a->seed, a->scale, a->idx, a->nsrc, a->src, a->acc,
+                         a->tally, a->np, a->np_slices);
             break;
-        case K_RESOLVE: gi_k_resolve(a->part, a->np, a->edir, a->cacc, a->scale, a->total, a->fout, a->fout2); break;
+        case K_RESOLVE:
+            gi_k_resolve(a->part, a->np, a->edir, a->cacc, a->np_slices, a->scale, a->total, a->fout, a->fout2);
+            break;
         case K_PULL_INIT: gi_k_pull_init(a->np, a->ns2, a->src, a->fout, a->ftot); break;
         case K_PULL:
             gi_k_pull(a->part, a->np, a->ns2, a->rin_off, a->rin_src, a->src, a->fout, a->ftot);
@@ -65,7 +71,8 @@ static void run_chunk(void *ctx, int chunk, int thread)
 static void launch(int threads, c_launch *a)
 {
     if (a->n == 0) return;
-    int chunks = (int)((a->n + GI_C_CHUNK - 1) / GI_C_CHUNK);
+    size_t cs = a->chunk ? a->chunk : GI_C_CHUNK;
+    int chunks = (int)((a->n + cs - 1) / cs);
     if (threads <= 1 || chunks == 1) {
         for (int c = 0; c < chunks; c++) run_chunk(a, c, 0);
         return;
@@ -81,11 +88,14 @@ void gi_c_emit(int threads, const gi_dev_particle *part, int n, const gi_dev_lig
     launch(threads, &a);
 }
 
-void gi_c_scatter(int threads, const gi_dev_particle *part, const int *slink, int ns2, int nb, gi_u32 seed,
-                  float scale, const int *srcidx, int nsrc, const float *src, gi_i64 *acc, gi_i64 *tally)
+void gi_c_scatter(int threads, const gi_dev_particle *part, int n, const int *slink, int ns2, int nb, gi_u32 seed,
+                  float scale, const int *srcidx, int nsrc, const float *src, int nslices, gi_i64 *acc, gi_i64 *tally)
 {
-    c_launch a = {.kernel = K_SCATTER, .n = (size_t)nsrc, .part = part, .slink = slink, .ns2 = ns2, .nb = nb,
-                  .seed = seed, .scale = scale, .idx = srcidx, .src = src, .acc = acc, .tally = tally};
+    /* one work-item per slice (nslices > 0), one pool job each */
+    c_launch a = {.kernel = K_SCATTER, .n = (size_t)(nslices > 0 ? nslices : nsrc), .part = part, .np = n,
+                  .slink = slink, .ns2 = ns2, .nb = nb, .seed = seed, .scale = scale, .idx = srcidx,
+                  .nsrc = nsrc, .src = src, .acc = acc, .tally = tally, .np_slices = nslices,
+                  .chunk = nslices > 0 ? 1 : 0};
     launch(threads, &a);
 }
 
@@ -104,10 +114,10 @@ void gi_c_pull(int threads, const gi_dev_particle *part, int n, int ns2, const i
 }
 
 void gi_c_resolve(int threads, const gi_dev_particle *part, int n, const float *edir, const gi_i64 *acc,
-                  float inv_scale, const float *total, float *lout, float *phi)
+                  int nslices, float inv_scale, const float *total, float *lout, float *phi)
 {
     c_launch a = {.kernel = K_RESOLVE, .n = (size_t)n, .part = part, .np = n, .edir = edir, .cacc = acc,
-                  .scale = inv_scale, .total = total, .fout = lout, .fout2 = phi};
+                  .np_slices = nslices, .scale = inv_scale, .total = total, .fout = lout, .fout2 = phi};
     launch(threads, &a);
 }
 

@@ -18,15 +18,6 @@
  * so scattering is deterministic on any device. */
 static inline gi_i64 gi_fixed(float x, float scale) { return (gi_i64)rint(x * scale); }
 
-static inline void gi_deposit(GI_GLOBAL gi_i64 *acc, int j, const float *pk, float scale, gi_i64 *tally)
-{
-    for (int c = 0; c < 3; c++) {
-        gi_i64 q = gi_fixed(pk[c], scale);
-        if (q != 0) atom_add(&acc[3 * j + c], q);
-        tally[c] += q;
-    }
-}
-
 /* Emission (section 4.2.1). The paper gives point lights only, with
  *   phi^(i) += Phi_j/(4 pi) * dA^(i) cos(theta_i) / d_i^2.
  * partray follows POV-Ray's light model instead, so that the particles'
@@ -70,8 +61,8 @@ __kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global co
     src[4 * i + 3] = 0.0f;
 }
 
-/* Indirect light scattering (section 4.2.2, Fig. 5). One work-item per
- * source particle i (directly lit or emitting, compacted on the host):
+/* Indirect light scattering (section 4.2.2, Fig. 5), from source particle i
+ * (directly lit or emitting):
  *  - first bounce: all ns2 = n_s x n_s scattering links get src[i]/ns2
  *    (the paper's rho^(i) phi^(i) / n_s^2, plus emission);
  *  - then every one of those ns2 packets walks on: at the end particle j the
@@ -83,61 +74,123 @@ __kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global co
  * run). With the gathering step the rendered indirect light has up to nb + 1
  * diffuse bounces, as the paper's text counts it ("n_b + 1 including the
  * indirect light gathering step").
- * Links of -1 (rays that left the scene) end the packet. tally[b] sums what
- * bounce b deposited (fixed point), for energy checks. */
-__kernel void gi_k_scatter(__global const gi_dev_particle *part, __global const int *slink, int ns2, int nb,
-                           uint seed, float scale, __global const int *srcidx, int nsrc, __global const float *src,
-                           __global gi_i64 *acc, __global gi_i64 *tally)
+ * Links of -1 (rays that left the scene) end the packet. tl[3b + c] sums
+ * what bounce b deposited (fixed point), for energy checks.
+ *
+ * gi_walk runs the packets of `cnt` sources (srcidx[t0], srcidx[t0 + step],
+ * ...; at most GI_WALK_BATCH) in lockstep, one bounce at a time, in passes
+ * over all packets: prefetch what the next pass reads (rho and link row of
+ * each packet's particle; then the accumulator lines), then read it. The
+ * walks are chains of dependent random reads; in passes, hundreds of them
+ * are in flight at once instead of one. (Same packets, same random choices
+ * and same integer sums as walking them one by one.) `atomic`: deposits
+ * are atomic adds (many work-items share acc), else plain adds (acc is
+ * this work-item's own). */
+#define GI_WALK_BATCH 32
+static inline void gi_walk(__global const gi_dev_particle *part, __global const int *slink, int ns2, int nb,
+                           uint seed, float scale, __global const int *srcidx, int t0, int step, int cnt,
+                           __global const float *src, GI_GLOBAL gi_i64 *acc, int atomic, gi_i64 *tl)
 {
-    int t = (int)get_global_id(0);
-    if (t >= nsrc) return;
-    int i = srcidx[t];
     int nbc = nb < GI_MAX_BOUNCES ? nb : GI_MAX_BOUNCES;
     int nk = ns2 < GI_MAX_SCATTER ? ns2 : GI_MAX_SCATTER;
-    /* The ns2 packets advance in lockstep, one bounce at a time: their
-     * memory reads are independent, so they overlap; each bounce first
-     * prefetches the lines its deposits will add to. (Same packets, same
-     * random choices and same integer sums as walking them one by one.) */
-    int jj[GI_MAX_SCATTER];
-    float pk[GI_MAX_SCATTER * 3];
+    int jj[GI_WALK_BATCH * GI_MAX_SCATTER];
+    gi_u32 hi[GI_WALK_BATCH];
+    float pk[GI_WALK_BATCH * GI_MAX_SCATTER * 3];
     float w = 1.0f / (float)ns2;
-    for (int k = 0; k < nk; k++) {
-        jj[k] = slink[(long)i * ns2 + k];
-        pk[3 * k] = src[4 * i] * w;
-        pk[3 * k + 1] = src[4 * i + 1] * w;
-        pk[3 * k + 2] = src[4 * i + 2] * w;
+    int np = cnt * nk;
+    for (int b = 0; b < cnt; b++) {
+        int i = srcidx[t0 + b * step];
+        hi[b] = (gi_u32)i;
+        for (int k = 0; k < nk; k++) {
+            int p = b * nk + k;
+            jj[p] = slink[(long)i * ns2 + k];
+            pk[3 * p] = src[4 * i] * w;
+            pk[3 * p + 1] = src[4 * i + 1] * w;
+            pk[3 * p + 2] = src[4 * i + 2] * w;
+        }
     }
     for (int s = 0; s < nbc; s++) {
         if (s > 0) {
+            for (int p = 0; p < np; p++)
+                if (jj[p] >= 0) {
+                    prefetch(&part[jj[p]].rho[0], 1);
+                    prefetch(&slink[(long)jj[p] * ns2], 1);
+                }
             /* move every live packet one link on from where it lies */
-            for (int k = 0; k < nk; k++) {
-                int j = jj[k];
+            for (int p = 0; p < np; p++) {
+                int j = jj[p];
                 if (j < 0) continue;
                 __global const gi_dev_particle *pj = &part[j];
-                pk[3 * k] *= pj->rho[0];
-                pk[3 * k + 1] *= pj->rho[1];
-                pk[3 * k + 2] *= pj->rho[2];
-                if (pk[3 * k] == 0.0f && pk[3 * k + 1] == 0.0f && pk[3 * k + 2] == 0.0f) {
-                    jj[k] = -1;
+                pk[3 * p] *= pj->rho[0];
+                pk[3 * p + 1] *= pj->rho[1];
+                pk[3 * p + 2] *= pj->rho[2];
+                if (pk[3 * p] == 0.0f && pk[3 * p + 1] == 0.0f && pk[3 * p + 2] == 0.0f) {
+                    jj[p] = -1;
                     continue;
                 }
-                gi_u32 h = gi_hash(seed ^ gi_hash((gi_u32)i ^ gi_hash((gi_u32)(k + ns2 * s))));
-                jj[k] = slink[(long)j * ns2 + (int)(h % (gi_u32)ns2)];
+                int k = p % nk;
+                gi_u32 h = gi_hash(seed ^ gi_hash(hi[p / nk] ^ gi_hash((gi_u32)(k + ns2 * s))));
+                jj[p] = slink[(long)j * ns2 + (int)(h % (gi_u32)ns2)];
             }
         }
         int live = 0;
-        for (int k = 0; k < nk; k++)
-            if (jj[k] >= 0) {
-                prefetch(&acc[3 * jj[k]], 3);
+        for (int p = 0; p < np; p++)
+            if (jj[p] >= 0) {
+                prefetch(&acc[3 * jj[p]], 3);
                 live++;
             }
         if (live == 0) break;
-        gi_i64 tl[3] = {0, 0, 0};
-        for (int k = 0; k < nk; k++)
-            if (jj[k] >= 0) gi_deposit(acc, jj[k], &pk[3 * k], scale, tl);
-        for (int c = 0; c < 3; c++)
-            if (tl[c] != 0) atom_add(&tally[3 * s + c], tl[c]);
+        for (int p = 0; p < np; p++) {
+            int j = jj[p];
+            if (j < 0) continue;
+            for (int c = 0; c < 3; c++) {
+                gi_i64 q = gi_fixed(pk[3 * p + c], scale);
+                if (q == 0) continue;
+                if (atomic)
+                    atom_add(&acc[3 * j + c], q);
+                else
+                    acc[3 * j + c] += q;
+                tl[3 * s + c] += q;
+            }
+        }
     }
+}
+
+/* The walks of section 4.2.2 (gi_walk above) for the nsrc source particles
+ * srcidx[]. Two launch shapes, the same integer sums:
+ *  - nslices = 0 (GPUs): one work-item per source; deposits and tallies are
+ *    atomic adds into acc and tally;
+ *  - nslices > 0 (CPUs): one work-item per slice w < nslices, walking the
+ *    sources w, w + nslices, ... (GI_WALK_BATCH at a time) and adding,
+ *    without atomics, into its own slice acc + 3 n w and tally +
+ *    3 GI_MAX_BOUNCES w; gi_k_resolve sums the slices. On a CPU an atomic
+ *    add costs a locked bus cycle per deposit (three per step); a private
+ *    slice costs one memory add.
+ * Integer sums do not depend on order, so both shapes, any slice count and
+ * any thread timing give the same acc and tally. */
+__kernel void gi_k_scatter(__global const gi_dev_particle *part, __global const int *slink, int ns2, int nb,
+                           uint seed, float scale, __global const int *srcidx, int nsrc, __global const float *src,
+                           __global gi_i64 *acc, __global gi_i64 *tally, int n, int nslices)
+{
+    int w = (int)get_global_id(0);
+    gi_i64 tl[GI_MAX_BOUNCES * 3];
+    int nbc = nb < GI_MAX_BOUNCES ? nb : GI_MAX_BOUNCES;
+    for (int b = 0; b < 3 * nbc; b++) tl[b] = 0;
+    if (nslices > 0) {
+        if (w >= nslices) return;
+        __global gi_i64 *mine = acc + (long)w * 3 * n;
+        int mycount = nsrc > w ? (nsrc - w + nslices - 1) / nslices : 0;
+        for (int b0 = 0; b0 < mycount; b0 += GI_WALK_BATCH) {
+            int cnt = mycount - b0 < GI_WALK_BATCH ? mycount - b0 : GI_WALK_BATCH;
+            gi_walk(part, slink, ns2, nb, seed, scale, srcidx, w + b0 * nslices, nslices, cnt, src, mine, 0, tl);
+        }
+        for (int b = 0; b < 3 * nbc; b++) tally[(long)w * 3 * GI_MAX_BOUNCES + b] = tl[b];
+        return;
+    }
+    if (w >= nsrc) return;
+    gi_walk(part, slink, ns2, nb, seed, scale, srcidx, w, 1, 1, src, acc, 1, tl);
+    for (int b = 0; b < 3 * nbc; b++)
+        if (tl[b] != 0) atom_add(&tally[b], tl[b]);
 }
 
 /* Alternative scattering (settings scatter_mode "full"): every bounce along
@@ -189,18 +242,21 @@ __kernel void gi_k_pull_init(int n, int ns2, __global const float *src, __global
  * f_rd = rho/pi, phi = phi_d + scattered flux; plus the particle's own
  * emission, since the gathering step (eq. for E~ in 4.3.1) reads L^(k*) as
  * the radiance arriving from k*. The scattered flux is acc (fixed point,
- * gi_k_scatter) plus total (float, gi_k_pull); the mode not used left its
+ * gi_k_scatter; the sum of its nslices slices) plus total (float, gi_k_pull); the mode not used left its
  * array at zero. Writes lout[i] (radiance) and phi[i] (total received
  * flux), 4 floats each. */
 __kernel void gi_k_resolve(__global const gi_dev_particle *part, int n, __global const float *edir,
-                           __global const gi_i64 *acc, float inv_scale, __global const float *total,
+                           __global const gi_i64 *acc, int nslices, float inv_scale, __global const float *total,
                            __global float *lout, __global float *phi)
 {
     int i = (int)get_global_id(0);
     if (i >= n) return;
     __global const gi_dev_particle *pt = &part[i];
+    int ns = nslices > 0 ? nslices : 1;
     for (int c = 0; c < 3; c++) {
-        float f = GI_PI_F * edir[4 * i + c] * pt->area + (float)acc[3 * i + c] * inv_scale + total[4 * i + c];
+        gi_i64 a = 0;
+        for (int w = 0; w < ns; w++) a += acc[(long)w * 3 * n + 3 * i + c];
+        float f = GI_PI_F * edir[4 * i + c] * pt->area + (float)a * inv_scale + total[4 * i + c];
         float l = pt->le[c] + pt->rho[c] * f / (GI_PI_F * pt->area);
         if (!isfinite(l)) l = 0.0f;
         if (!isfinite(f)) f = 0.0f;
