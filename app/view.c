@@ -30,7 +30,8 @@ enum { EXIT_OK = 0, EXIT_SCENE = 1, EXIT_USAGE = 2, EXIT_IO = 3 };
 
 static const char *view_usage =
     "usage: partray view SCENE.pov [--size WxH] [--gi none|particle|path|pmfg] [--threads N] [--seed N]\n"
-    "                    [--script FILE] [--preview D] [--ref-spp N] [--verbose] [-D NAME=VALUE] [-L DIR]\n"
+    "                    [--script FILE] [--preview D] [--ref-spp N] [--preview-particles N] [--verbose]\n"
+    "                    [--particles N] [--nb N] [--cl-device DEV] [-D NAME=VALUE] [-L DIR]\n"
     "keys: WASD/QE fly, right drag look, left drag orbit, wheel zoom, R reset camera,\n"
     "      1-9/Tab select light, arrows/PgUp/PgDn move it, +/- brighten/dim it,\n"
     "      G cycle GI mode, O overlay on/off, F12/P screenshot, C write camera, H help, Esc quit\n";
@@ -102,8 +103,8 @@ typedef struct {
     int nrecent;
     long last_gen_first;     /* generation whose first image was counted */
     long last_gen_full;
-    long last_gen_relit;
-    series lat_light_first, lat_light_relit, lat_light_full, lat_camera_first;
+    long last_gen_relit, last_gen_relit_full;
+    series lat_light_first, lat_light_relit, lat_light_relit_full, lat_light_full, lat_camera_first;
     double title_time;
     diag *msgs;
 } viewer;
@@ -252,16 +253,17 @@ static void write_camera(viewer *v, const char *path)
 
 static void print_mark(viewer *v, const char *name)
 {
-    double lf, lfm, lr, lrm, lF, lFm, cf, cfm;
+    double lf, lfm, lr, lrm, lR, lRm, lF, lFm, cf, cfm;
     series_stats(&v->lat_light_first, &lf, &lfm);
     series_stats(&v->lat_light_relit, &lr, &lrm);
+    series_stats(&v->lat_light_relit_full, &lR, &lRm);
     series_stats(&v->lat_light_full, &lF, &lFm);
     series_stats(&v->lat_camera_first, &cf, &cfm);
     printf("view: mark %s time=%.4f images=%ld shown=%ld light_moves=%d light_first_ms=%.2f light_first_max_ms=%.2f "
-           "light_relit_ms=%.2f light_relit_max_ms=%.2f light_full_ms=%.2f camera_moves=%d camera_first_ms=%.2f "
-           "camera_first_max_ms=%.2f\n",
+           "light_relit_ms=%.2f light_relit_max_ms=%.2f light_relit_full_ms=%.2f light_relit_full_max_ms=%.2f "
+           "light_full_ms=%.2f camera_moves=%d camera_first_ms=%.2f camera_first_max_ms=%.2f\n",
            name, timer_now() - v->t_start, v->published, v->images, v->lat_light_first.n, lf * 1e3, lfm * 1e3, lr * 1e3,
-           lrm * 1e3, lF * 1e3, v->lat_camera_first.n, cf * 1e3, cfm * 1e3);
+           lrm * 1e3, lR * 1e3, lRm * 1e3, lF * 1e3, v->lat_camera_first.n, cf * 1e3, cfm * 1e3);
     fflush(stdout);
 }
 
@@ -543,8 +545,8 @@ static void update_title(viewer *v, double now)
     char mode[64];
     if (v->have_image && in->wanted_mode != in->gi_mode)
         snprintf(mode, sizeof mode, "%s (building %s)", view_gi_name(in->gi_mode), view_gi_name(in->wanted_mode));
-    else if (v->have_image && in->gi_stale)
-        snprintf(mode, sizeof mode, "%s (relighting)", view_gi_name(in->gi_mode));
+    else if (v->have_image && (in->gi_stale || in->gi_coarse))
+        snprintf(mode, sizeof mode, "%s (%s)", view_gi_name(in->gi_mode), in->gi_stale ? "relighting" : "preview GI, relighting");
     else
         snprintf(mode, sizeof mode, "%s", view_gi_name(v->have_image ? in->gi_mode : v->gi_mode));
     if (!v->have_image) {
@@ -575,7 +577,7 @@ static int take_image(viewer *v, double now)
                in.wanted_mode != in.gi_mode ? " building " : "", in.wanted_mode != in.gi_mode ? view_gi_name(in.wanted_mode) : "",
                in.frame * 1e3, in.times.build * 1e3, in.times.light * 1e3, in.times.view * 1e3, in.times.render * 1e3,
                in.frame_cpu * 1e3, in.light_cpu * 1e3, in.latency * 1e3, in.cause & VIEW_CAUSE_LIGHT ? " light" : "", in.cause & VIEW_CAUSE_CAMERA ? " camera" : "",
-               in.gi_stale ? " gi-stale" : "", in.describe);
+               in.gi_stale ? " gi-stale" : (in.gi_coarse ? " gi-coarse" : ""), in.describe);
     if (!v->have_image) v->t_first_image = now;
     v->have_image = 1;
     if (v->nrecent == (int)(sizeof v->recent / sizeof v->recent[0])) {
@@ -593,6 +595,10 @@ static int take_image(viewer *v, double now)
     if (in.generation != v->last_gen_relit && in.relit_latency > 0) {
         v->last_gen_relit = in.generation;
         if (in.cause & VIEW_CAUSE_LIGHT) series_add(&v->lat_light_relit, in.relit_latency);
+    }
+    if (in.generation != v->last_gen_relit_full && in.relit_full_latency > 0) {
+        v->last_gen_relit_full = in.generation;
+        if (in.cause & VIEW_CAUSE_LIGHT) series_add(&v->lat_light_relit_full, in.relit_full_latency);
     }
     if (in.generation != v->last_gen_full && in.full_latency > 0) {
         v->last_gen_full = in.generation;
@@ -630,7 +636,7 @@ static int overlay_lines(viewer *v, double now, char lines[][128], int max)
                  in->level, in->last_level, k, work);
     snprintf(lines[n++], 128, "FRAME %.0f MS: BUILD %.0f LIGHT %.0f VIEW %.0f RENDER %.0f", in->frame * 1e3,
              in->times.build * 1e3, in->times.light * 1e3, in->times.view * 1e3, in->times.render * 1e3);
-    snprintf(lines[n++], 128, "LATENCY %.0f MS%s%s", in->latency * 1e3, in->gi_stale ? ", GI STALE (RELIGHTING)" : "",
+    snprintf(lines[n++], 128, "LATENCY %.0f MS%s%s", in->latency * 1e3, in->gi_stale ? ", GI STALE (RELIGHTING)" : (in->gi_coarse ? ", PREVIEW GI (RELIGHTING)" : ""),
              in->complete ? ", DONE" : "");
     if (n < max && in->describe[0]) snprintf(lines[n++], 128, "%.80s", in->describe);
     if (n < max && v->nlights > 0) {
@@ -808,12 +814,21 @@ static void run_loop(viewer *v)
 
 /* Takes the viewer's own options out of argv (into *script, *preview). */
 static int split_args(int argc, char **argv, char **rest, int *nrest, const char **script, int *preview, int *ref_spp,
-                      int *verbose, char *err, int n)
+                      long *preview_particles, int *verbose, char *err, int n)
 {
     *nrest = 0;
     for (int i = 0; i < argc; i++) {
         if (strcmp(argv[i], "--verbose") == 0 || strcmp(argv[i], "-v") == 0) {
             *verbose = 1;
+        } else if (strcmp(argv[i], "--preview-particles") == 0) {
+            char *end;
+            long k = i + 1 < argc ? strtol(argv[i + 1], &end, 10) : 0;
+            if (i + 1 >= argc || *end || k < -1 || k > 100000000) {
+                snprintf(err, (size_t)n, "--preview-particles wants a count (0: 1/8 of --particles, -1: none)");
+                return 0;
+            }
+            *preview_particles = k;
+            i++;
         } else if (strcmp(argv[i], "--ref-spp") == 0) {
             char *end;
             long k = i + 1 < argc ? strtol(argv[i + 1], &end, 10) : 0;
@@ -858,9 +873,10 @@ int cmd_view(int argc, char **argv)
     char **rest = calloc((size_t)argc + 1, sizeof *rest);
     if (!rest) return EXIT_IO;
     int nrest = 0, preview = 0, ref_spp = 0, verbose = 0;
+    long preview_particles = 0;
     const char *script_path = NULL;
     cli_render o;
-    if (!split_args(argc, argv, rest, &nrest, &script_path, &preview, &ref_spp, &verbose, err, sizeof err) ||
+    if (!split_args(argc, argv, rest, &nrest, &script_path, &preview, &ref_spp, &preview_particles, &verbose, err, sizeof err) ||
         cli_parse_render(nrest, rest, &o, err, sizeof err)) {
         fprintf(stderr, "partray view: %s\n%s", err, view_usage);
         free(rest);
@@ -885,7 +901,7 @@ int cmd_view(int argc, char **argv)
     v.width = o.width > 0 ? o.width : 512;
     v.height = o.height > 0 ? o.height : (o.width > 0 ? o.width : 512);
     v.threads = o.threads > 0 ? o.threads : pool_default_threads();
-    v.last_gen_first = v.last_gen_full = v.last_gen_relit = -1;
+    v.last_gen_first = v.last_gen_full = v.last_gen_relit = v.last_gen_relit_full = -1;
     scene_stem(o.scene, v.stem, sizeof v.stem);
 
     diag *d = diag_new();
@@ -977,7 +993,8 @@ int cmd_view(int argc, char **argv)
         }
     }
     if (rc == EXIT_OK) {
-        view_render_opts ro = {v.width, v.height, v.threads, o.seed, preview, ref_spp, o.particles, o.bounces, o.cl_device};
+        view_render_opts ro = {v.width, v.height, v.threads, o.seed, preview, ref_spp, o.particles, o.bounces, o.cl_device,
+                               preview_particles};
         view_state s0 = current_state(&v);
         diag *rd = diag_new();
         st = view_render_start(&v.vr, sc, acc, &ro, &s0, rd);
@@ -992,17 +1009,18 @@ int cmd_view(int argc, char **argv)
         run_loop(&v);
         double now = timer_now();
         double span = now - v.t_first_image;
-        double lf, lfm, lr, lrm, lF, lFm, cf, cfm;
+        double lf, lfm, lr, lrm, lR, lRm, lF, lFm, cf, cfm;
         series_stats(&v.lat_light_first, &lf, &lfm);
         series_stats(&v.lat_light_relit, &lr, &lrm);
+        series_stats(&v.lat_light_relit_full, &lR, &lRm);
         series_stats(&v.lat_light_full, &lF, &lFm);
         series_stats(&v.lat_camera_first, &cf, &cfm);
         fprintf(stderr,
                 "view: %ld images (%ld shown) in %.2f s (%.1f/s), first image after %.3f s; light move -> image %.1f ms mean, %.1f ms "
-                "max (%d), -> relit image %.1f ms mean, %.1f ms max (%d), -> full resolution %.1f ms mean; camera move -> image "
-                "%.1f ms mean (%d)\n",
+                "max (%d), -> relit image %.1f ms mean, %.1f ms max (%d), -> image relit by the full GI %.1f ms mean, -> full "
+                "resolution %.1f ms mean; camera move -> image %.1f ms mean (%d)\n",
                 v.published, v.images, span, span > 0 ? v.published / span : 0.0, v.t_first_image - v.t_start, lf * 1e3, lfm * 1e3,
-                v.lat_light_first.n, lr * 1e3, lrm * 1e3, v.lat_light_relit.n, lF * 1e3, cf * 1e3, v.lat_camera_first.n);
+                v.lat_light_first.n, lr * 1e3, lrm * 1e3, v.lat_light_relit.n, lR * 1e3, lF * 1e3, cf * 1e3, v.lat_camera_first.n);
         view_render_stop(v.vr);
         v.vr = NULL;
     }

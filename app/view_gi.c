@@ -16,6 +16,8 @@ typedef struct {
     int (*last_level)(const view_gi_opts *o);
     pt_status (*open)(void **ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d);
     pt_status (*relight)(void *ctx, volatile int *cancel, view_gi_times *t, diag *d);
+    int (*has_preview)(void *ctx); /* NULL: no preview lighting */
+    pt_status (*relight_preview)(void *ctx, volatile int *cancel, view_gi_times *t, diag *d);
     pt_status (*render)(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d);
     void (*describe)(void *ctx, char *buf, int n);
     void (*close)(void *ctx);
@@ -28,6 +30,8 @@ struct view_gi {
     int last_level;
     int stale;            /* lights changed since the last complete lighting stage */
     double t_light;       /* seconds of the last complete lighting stage */
+    int preview_fresh;    /* the preview lighting is up to date with the lights */
+    int last_coarse;      /* the last pass used the preview lighting */
     scene sc;             /* shallow copy: own camera and lights, shared objects */
     scene_light *lights;
 };
@@ -91,11 +95,19 @@ static void none_describe(void *ctx, char *buf, int n)
 static void none_close(void *ctx) { free(ctx); }
 
 /* -------------------------------------------------------------- particle */
+/* Two instances on the same scene copy: the mode's own (the scene's or
+ * --particles count) and a preview one with 1/8 of the particles and at
+ * most 4 shadow rays per particle per area light, whose lighting stage is
+ * about 1/8 to 1/30 as long: after a light edit it is relit first and
+ * renders the first relit preview (view_gi_relight_preview), while the
+ * full instance is relit in the next pass. */
 typedef struct {
     const scene *sc;
     const accel *a;
     gi_particle *gp;
-    gi_particle_stats stats;
+    gi_particle *gpq;      /* preview instance, NULL when the count is too small for one */
+    gi_particle_stats stats, statsq;
+    double t_light_q;      /* its last lighting stage */
 } particle_ctx;
 
 static pt_status particle_open(void **ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
@@ -123,31 +135,68 @@ static pt_status particle_open(void **ctx, const scene *sc, const accel *a, cons
     t->light = gs->t_lighting;
     *ctx = c;
     if (st != PT_OK) return st;
+    long nq = o->preview_particles > 0 ? o->preview_particles : s.count / 8;
+    if (o->preview_particles >= 0 && nq >= 500 && nq <= s.count / 2) {
+        gi_particle_settings sq = s;
+        sq.count = nq;
+        if (sq.area_samples <= 0 || sq.area_samples > 4) sq.area_samples = 4;
+        pt_status stq = PT_OK;
+        diag *dq = diag_new();
+        c->gpq = gi_particle_build(sc, a, &sq, &c->statsq, dq, &stq);
+        if (c->gpq && stq == PT_OK) stq = gi_particle_light(c->gpq, dq);
+        if (!c->gpq || stq != PT_OK) {
+            /* the mode works without it: its messages are dropped */
+            gi_particle_free(c->gpq);
+            c->gpq = NULL;
+        } else {
+            const gi_particle_stats *q = gi_particle_get_stats(c->gpq);
+            t->build += q->t_geometry;
+            c->t_light_q = q->t_lighting;
+        }
+        diag_free(dq);
+    }
     return PT_OK;
+}
+
+static pt_status relight_one(gi_particle *gp, volatile int *cancel, double *seconds, diag *d)
+{
+    double t0 = timer_now();
+    gi_particle_set_cancel(gp, cancel); /* stops in the visibility pass, old lighting kept */
+    pt_status st = gi_particle_relight(gp, d);
+    gi_particle_set_cancel(gp, NULL);
+    *seconds = timer_now() - t0;
+    return st;
 }
 
 static pt_status particle_relight(void *ctx, volatile int *cancel, view_gi_times *t, diag *d)
 {
     particle_ctx *c = ctx;
-    double t0 = timer_now();
-    gi_particle_set_cancel(c->gp, cancel); /* stops in the visibility pass, old lighting kept */
-    pt_status st = gi_particle_relight(c->gp, d);
-    gi_particle_set_cancel(c->gp, NULL);
-    t->light = timer_now() - t0;
+    return relight_one(c->gp, cancel, &t->light, d);
+}
+
+static int particle_has_preview(void *ctx) { return ((particle_ctx *)ctx)->gpq != NULL; }
+
+static pt_status particle_relight_preview(void *ctx, volatile int *cancel, view_gi_times *t, diag *d)
+{
+    particle_ctx *c = ctx;
+    if (!c->gpq) return PT_ERR_UNSUPPORTED;
+    pt_status st = relight_one(c->gpq, cancel, &t->light, d);
+    if (st == PT_OK && !(cancel && *cancel)) c->t_light_q = t->light;
     return st;
 }
 
 static pt_status particle_render(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
 {
     particle_ctx *c = ctx;
-    pt_status st = gi_particle_prepare_view(c->gp, &c->sc->camera, p->width, p->height, d);
-    t->view = gi_particle_get_stats(c->gp)->t_view;
+    gi_particle *gp = p->coarse && c->gpq ? c->gpq : c->gp;
+    pt_status st = gi_particle_prepare_view(gp, &c->sc->camera, p->width, p->height, d);
+    t->view = gi_particle_get_stats(gp)->t_view;
     if (st != PT_OK) return st;
     shade_settings ss;
     whitted_settings(&ss, p);
     ss.use_ambient = 0;
     ss.indirect = gi_particle_indirect;
-    ss.indirect_ctx = c->gp;
+    ss.indirect_ctx = gp;
     double t0 = timer_now();
     st = shade_render(c->sc, c->a, &ss, fb, NULL, d);
     t->render = timer_now() - t0;
@@ -158,8 +207,12 @@ static void particle_describe(void *ctx, char *buf, int n)
 {
     particle_ctx *c = ctx;
     const gi_particle_stats *s = gi_particle_get_stats(c->gp);
-    snprintf(buf, (size_t)n, "%ld particles, %d bounces, lighting %.0f ms (visibility %.0f, emit %.0f, scatter %.0f)",
-             s->particles, s->bounces, s->t_lighting * 1e3, s->t_visibility * 1e3, s->t_emit * 1e3, s->t_scatter * 1e3);
+    char q[48] = "";
+    if (c->gpq)
+        snprintf(q, sizeof q, " (preview %ld, %.0f ms)", gi_particle_get_stats(c->gpq)->particles, c->t_light_q * 1e3);
+    snprintf(buf, (size_t)n, "%ld particles%s, %d bounces, lighting %.0f ms (visibility %.0f, emit %.0f, scatter %.0f)",
+             s->particles, q, s->bounces, s->t_lighting * 1e3, s->t_visibility * 1e3, s->t_emit * 1e3,
+             s->t_scatter * 1e3);
 }
 
 static void particle_close(void *ctx)
@@ -167,6 +220,7 @@ static void particle_close(void *ctx)
     particle_ctx *c = ctx;
     if (!c) return;
     gi_particle_free(c->gp);
+    gi_particle_free(c->gpq);
     free(c);
 }
 
@@ -300,10 +354,11 @@ static void ref_close(void *ctx)
 /* ----------------------------------------------------------------- table */
 
 static const gi_backend backends[] = {
-    {GI_NONE, 0, whitted_last_level, none_open, none_relight, none_render, none_describe, none_close},
-    {GI_PARTICLE, 1, whitted_last_level, particle_open, particle_relight, particle_render, particle_describe, particle_close},
-    {GI_PATH, 0, ref_last_level, path_open, ref_relight, ref_render, ref_describe, ref_close},
-    {GI_PMFG, 0, ref_last_level, pmfg_open, ref_relight, ref_render, ref_describe, ref_close},
+    {GI_NONE, 0, whitted_last_level, none_open, none_relight, NULL, NULL, none_render, none_describe, none_close},
+    {GI_PARTICLE, 1, whitted_last_level, particle_open, particle_relight, particle_has_preview, particle_relight_preview,
+     particle_render, particle_describe, particle_close},
+    {GI_PATH, 0, ref_last_level, path_open, ref_relight, NULL, NULL, ref_render, ref_describe, ref_close},
+    {GI_PMFG, 0, ref_last_level, pmfg_open, ref_relight, NULL, NULL, ref_render, ref_describe, ref_close},
 };
 enum { NBACKENDS = (int)(sizeof backends / sizeof backends[0]) };
 
@@ -374,7 +429,24 @@ int view_gi_mode(const view_gi *g) { return g->b->mode; }
 scene *view_gi_scene(view_gi *g) { return &g->sc; }
 int view_gi_last_level(const view_gi *g) { return g->last_level; }
 
-void view_gi_lights_changed(view_gi *g) { g->stale = 1; }
+void view_gi_lights_changed(view_gi *g)
+{
+    g->stale = 1;
+    g->preview_fresh = 0;
+}
+
+int view_gi_has_preview_light(const view_gi *g) { return g->b->has_preview && g->b->has_preview(g->ctx); }
+
+pt_status view_gi_relight_preview(view_gi *g, volatile int *cancel, view_gi_times *t, diag *d)
+{
+    memset(t, 0, sizeof *t);
+    if (!view_gi_has_preview_light(g)) return PT_ERR_UNSUPPORTED;
+    pt_status st = g->b->relight_preview(g->ctx, cancel, t, d);
+    if (st == PT_OK && !(cancel && *cancel)) g->preview_fresh = 1;
+    return st;
+}
+
+int view_gi_last_coarse(const view_gi *g) { return g->last_coarse; }
 int view_gi_stale(const view_gi *g) { return g->stale; }
 /* A stale preview costs about one preview pass before the relight starts:
  * worth it when the lighting stage is longer than a preview (40 ms,
@@ -397,7 +469,12 @@ pt_status view_gi_relight(view_gi *g, volatile int *cancel, view_gi_times *t, di
 pt_status view_gi_render(view_gi *g, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
 {
     memset(t, 0, sizeof *t);
-    return g->b->render(g->ctx, p, fb, t, d);
+    view_gi_pass q = *p;
+    /* the full lighting is stale and the preview lighting is not: the pass
+     * uses the preview lighting */
+    q.coarse = g->stale && g->preview_fresh;
+    g->last_coarse = q.coarse;
+    return g->b->render(g->ctx, &q, fb, t, d);
 }
 
 void view_gi_describe(const view_gi *g, char *buf, int n)

@@ -10,10 +10,12 @@
  *             relight = lighting stage only, every pass = prepare_view +
  *             shade_render with the indirect hook. Levels as `none`.
  *             The lighting stage is the slow part of a light edit: the
- *             render thread first shows a pass with the new lights' direct
- *             term over the old indirect light (view_gi_slow_light), and a
- *             newer light edit cancels a relight in progress (its visibility
- *             pass; the old lighting stays until one finishes).
+ *             render thread first relights a preview instance with 1/8 of
+ *             the particles and shows a pass with it (or, without one, the
+ *             new lights' direct term over the old indirect light), then
+ *             relights the full instance; a newer light edit cancels a
+ *             relight in progress (its visibility pass; the old lighting
+ *             stays until one finishes).
  *   path      reference previews: pm_path (path tracer) and pm_fg (photon
  *   pmfg      map + final gathering at low settings: a photon map of its own
  *             per pass, 16 gather rays per eye sample). Levels: 0 preview at
@@ -51,6 +53,7 @@ typedef struct {
     long particles;         /* particle: area particles (<= 0: from the scene, gi_particle.h) */
     int bounces;            /* particle: n_b (<= 0: from the scene) */
     const char *cl_device;  /* particle: OpenCL device (NULL: auto) */
+    long preview_particles; /* particle: the preview instance's count (0: 1/8 of the mode's, < 0: none) */
 } view_gi_opts;
 
 typedef struct {
@@ -59,6 +62,7 @@ typedef struct {
     int threads;            /* <= 0: all cores */
     uint64_t seed;
     volatile int *cancel;   /* non-zero: stop soon; the pass's image is then incomplete */
+    int coarse;             /* set by view_gi_render: the pass uses the preview lighting */
 } view_gi_pass;
 
 /* The modes (gi.h's gi_mode values) the viewer can switch to, in the order
@@ -87,6 +91,14 @@ int view_gi_stale(const view_gi *g);
  * worth showing first (particle, when its last lighting stage took more
  * than 40 ms). */
 int view_gi_slow_light(const view_gi *g);
+/* Preview lighting (particle: a second instance with 1/8 of the particles,
+ * built at open when that is at least 500): view_gi_relight_preview relights
+ * it alone, fast; until the full relight completes, passes use it
+ * (view_gi_last_coarse says so). PT_ERR_UNSUPPORTED when the mode has none;
+ * cancellable as view_gi_relight. */
+int view_gi_has_preview_light(const view_gi *g);
+pt_status view_gi_relight_preview(view_gi *g, volatile int *cancel, view_gi_times *t, diag *d);
+int view_gi_last_coarse(const view_gi *g);
 /* Reruns the lighting stage for the scene's current lights. While *cancel
  * (may be NULL) is non-zero it may stop early: it returns PT_OK with the old
  * lighting in place and the mode still stale. */

@@ -153,6 +153,7 @@ static view_gi_opts gi_opts(const view_render *vr)
 {
     view_gi_opts go;
     memset(&go, 0, sizeof go);
+    go.preview_particles = vr->o.preview_particles;
     go.threads = vr->o.threads;
     go.ref_spp = vr->o.ref_spp;
     go.particles = vr->o.particles;
@@ -272,6 +273,30 @@ static double cpu_now(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
+/* Runs a lighting stage (the full one, or the preview one) on the render
+ * thread, cancellable by a newer light edit (view_render_submit). */
+static pt_status relight_step(view_render *vr, view_gi *g, int preview, view_gi_times *acc, double *cpu, diag *d)
+{
+    view_gi_times t;
+    memset(&t, 0, sizeof t);
+    pt_status st = PT_OK;
+    pthread_mutex_lock(&vr->mu);
+    vr->relighting = !vr->cancel;
+    vr->edit_in_relight = 0;
+    pthread_mutex_unlock(&vr->mu);
+    double c0 = cpu_now();
+    if (vr->relighting) st = preview ? view_gi_relight_preview(g, &vr->cancel, &t, d) : view_gi_relight(g, &vr->cancel, &t, d);
+    *cpu += cpu_now() - c0;
+    pthread_mutex_lock(&vr->mu);
+    vr->relighting = 0;
+    /* the full GI is up to date with the lights of this pass: stale again
+     * only from an edit posted meanwhile */
+    if (!preview && st == PT_OK && !view_gi_stale(g)) vr->stale_since = vr->edit_in_relight;
+    pthread_mutex_unlock(&vr->mu);
+    acc->light += t.light;
+    return st;
+}
+
 #define QUIET 0.12 /* seconds without a submit before refinement passes start */
 
 static void *render_main(void *arg)
@@ -282,7 +307,7 @@ static void *render_main(void *arg)
     view_light *cur_lights = calloc((size_t)(vr->nlights > 0 ? vr->nlights : 1), sizeof *cur_lights);
     long work_gen = -1;
     int level = 0, last_level = 0, cause = 0;
-    double submit_time = 0, first_latency = 0, full_latency = 0, relit_latency = 0;
+    double submit_time = 0, first_latency = 0, full_latency = 0, relit_latency = 0, relit_full_latency = 0;
     int quick_pending = 0; /* lights changed: show them over the old GI before relighting */
     int published = 1; /* an image of work_gen was published */
     view_gi_times opened_times;
@@ -315,7 +340,7 @@ static void *render_main(void *arg)
             vr->posted_cause = 0;
             vr->posted_time = 0;
             level = 0;
-            first_latency = full_latency = relit_latency = 0;
+            first_latency = full_latency = relit_latency = relit_full_latency = 0;
         }
         if (level > last_level) continue; /* an open finished for a mode not wanted now */
         /* refinement waits until the input has been quiet a moment */
@@ -358,7 +383,7 @@ static void *render_main(void *arg)
             acc.build += t.build;
         }
         view_gi *g = vr->opened[use];
-        int quick = 0, stale = 0;
+        int quick = 0, stale = 0, coarse = 0;
         double light_cpu = 0, pass_cpu0 = cpu_now();
         if (st == PT_OK && g) {
             vr->shown_mode = use;
@@ -370,26 +395,16 @@ static void *render_main(void *arg)
             }
             if (view_gi_stale(g)) {
                 if (quick_pending && level == 0) {
-                    /* the new lights' direct term over the old indirect
-                     * light at once; the relight follows in the next pass */
+                    /* at once: the preview lighting relit (fast), or else
+                     * the new lights' direct term over the old indirect
+                     * light; the full relight follows in the next pass */
                     quick = 1;
+                    if (view_gi_has_preview_light(g)) st = relight_step(vr, g, 1, &acc, &light_cpu, d);
                 } else {
-                    pthread_mutex_lock(&vr->mu);
-                    vr->relighting = !vr->cancel;
-                    vr->edit_in_relight = 0;
-                    pthread_mutex_unlock(&vr->mu);
-                    double c0 = cpu_now();
-                    if (vr->relighting) st = view_gi_relight(g, &vr->cancel, &t, d);
-                    light_cpu = cpu_now() - c0;
-                    pthread_mutex_lock(&vr->mu);
-                    vr->relighting = 0;
-                    if (st == PT_OK && !view_gi_stale(g)) vr->stale_since = vr->edit_in_relight;
-                    pthread_mutex_unlock(&vr->mu);
-                    acc.light += t.light;
+                    st = relight_step(vr, g, 0, &acc, &light_cpu, d);
                 }
             }
             quick_pending = 0;
-            stale = view_gi_stale(g);
         }
         last_level = g ? view_gi_last_level(g) : 0;
         int div = level == 0 ? vr->preview_div : 1;
@@ -404,6 +419,8 @@ static void *render_main(void *arg)
             acc.light += t.light;
             acc.view += t.view;
             acc.render += t.render;
+            coarse = view_gi_last_coarse(g);
+            stale = view_gi_stale(g) && !coarse;
         } else if (st == PT_OK && !g) {
             st = PT_ERR_INTERNAL;
         }
@@ -456,13 +473,16 @@ static void *render_main(void *arg)
         in->first = level == 0;
         if (level == 0 && first_latency == 0) first_latency = in->latency;
         if (!stale && relit_latency == 0) relit_latency = in->latency;
+        if (!stale && !coarse && relit_full_latency == 0) relit_full_latency = in->latency;
         if (level == 1 && full_latency == 0) full_latency = in->latency;
         in->first_latency = first_latency;
         in->relit_latency = relit_latency;
+        in->relit_full_latency = relit_full_latency;
+        in->gi_coarse = coarse;
         in->full_latency = full_latency;
         in->gi_stale = stale;
         in->cause = cause;
-        in->complete = level >= last_level && !waiting_for_mode && !stale;
+        in->complete = level >= last_level && !waiting_for_mode && !stale && !coarse;
         memcpy(in->describe, desc, sizeof desc);
         if (in->complete) vr->idle_gen = work_gen;
         published = 1;

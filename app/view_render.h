@@ -60,6 +60,7 @@ typedef struct {
     long particles;         /* particle GI: area particles (0: from the scene) */
     int bounces;            /* particle GI: n_b (0: from the scene) */
     const char *cl_device;  /* particle GI: OpenCL device (NULL: auto) */
+    long preview_particles; /* particle GI: preview instance's count (0: 1/8, < 0: none) */
 } view_render_opts;
 
 typedef struct {
@@ -76,9 +77,11 @@ typedef struct {
     double latency;         /* seconds from the oldest submit its generation answers to its publication */
     int first;              /* the first image of its generation */
     double first_latency;   /* latency of its generation's first image (so a UI that missed it still knows) */
-    double relit_latency;   /* latency of its generation's first image with the GI up to date with its lights */
+    double relit_latency;   /* latency of its generation's first image with the GI relit (preview lighting counts) */
+    double relit_full_latency; /* ... with the mode's full GI relit */
     double full_latency;    /* latency of its generation's first full-resolution image; 0 before it */
     int gi_stale;           /* the indirect light is from before a light edit (the relight follows) */
+    int gi_coarse;          /* the indirect light is the preview lighting's (the full relight follows) */
     int cause;              /* VIEW_CAUSE_* of the submits in its generation */
     int complete;           /* last level reached: the refinement is done */
     char describe[96];      /* view_gi_describe */

@@ -21,10 +21,12 @@
 #   preview px      mean width of those images (the preview adapts its size)
 #   cam->img ms     input to the first image showing it, mean
 #   light->img ms   light move to the first image showing it, mean/max (for
-#                   particle: the new direct light over the old indirect
-#                   light, the "gi-stale" preview)
-#   light->relit ms light move to the first image with the GI relit (a
-#                   preview), mean/max, and what that image's pass spent:
+#                   particle: relit by the preview instance, 1/8 of the
+#                   particles, "gi-coarse"; without one the new direct light
+#                   over the old indirect light, "gi-stale")
+#   prev.light ms   the preview instance's lighting stage in that pass
+#   light->relit ms light move to the first image relit by the mode's full
+#                   GI (a preview), mean/max, and what that image's pass spent:
 #     lighting ms   the GI's lighting stage (gi_particle_relight)
 #     regather ms   the per-view stage after it (gathering, estimation)
 #     render ms     the preview pass itself
@@ -88,8 +90,9 @@ fi
 
 printf '%s %s, %s threads, preview %s, %s, load %s\n' "$SCENE" "$SIZE" "$THREADS" "${PREVIEW:-adaptive}" "$(uname -m)" \
     "$(cut -d' ' -f1 /proc/loadavg)"
-printf '%-9s %10s %10s %10s %13s %15s %11s %12s %11s %9s %14s %8s\n' mode "orbit img/s" "preview px" "cam->img ms" \
-    "light->img ms" "light->relit ms" "lighting ms" "lighting cpu" "regather ms" "render ms" "light->full ms" "build s"
+printf '%-9s %10s %10s %10s %13s %13s %15s %11s %12s %11s %9s %14s %8s\n' mode "orbit img/s" "preview px" "cam->img ms" \
+    "light->img ms" "prev.light ms" "light->relit ms" "lighting ms" "lighting cpu" "regather ms" "render ms" "light->full ms" \
+    "build s"
 for mode in $MODES; do
     LOG=$TMP/$mode.log
     if ! timeout 900 "$BIN" view "$SCENE" --size "$SIZE" --gi "$mode" --threads "$THREADS" --script "$TMP/script.txt" \
@@ -103,7 +106,8 @@ for mode in $MODES; do
         /^view: image / {
             if (phase == 1) { n++; w += substr($7, 1, index($7, "x") - 1) }
             # the relit preview after each light move (its pass ran the lighting stage)
-            if (phase == 3 && $0 ~ / L0\// && $0 ~ /latency [0-9.]+ ms light/ && $0 !~ /gi-stale/ && stage("light") > 0) {
+            if (phase == 3 && $0 ~ /gi-coarse/ && stage("light") > 0) { ql += stage("light"); nql++ }
+            if (phase == 3 && $0 ~ / L0\// && $0 ~ /latency [0-9.]+ ms light/ && $0 !~ /gi-stale|gi-coarse/ && stage("light") > 0) {
                 rl += stage("light"); rv += stage("view"); rr += stage("render"); nrl++
                 if (match($0, /[(]light [0-9.]+[)]/)) { c = substr($0, RSTART + 7, RLENGTH - 8); rc += c / threads }
             }
@@ -112,12 +116,12 @@ for mode in $MODES; do
         /^view: mark ready/   { t0 = kv("time"); i0 = kv("images"); phase = 1 }
         /^view: mark orbited/ { t1 = kv("time"); i1 = kv("images"); cam = kv("camera_first_ms"); phase = 2 }
         /^view: mark settled/ { phase = 3 }
-        /^view: mark lit/     { lf = kv("light_first_ms"); lfm = kv("light_first_max_ms"); lr = kv("light_relit_ms");
-                                lrm = kv("light_relit_max_ms"); lF = kv("light_full_ms"); phase = 4 }
+        /^view: mark lit/     { lf = kv("light_first_ms"); lfm = kv("light_first_max_ms"); lr = kv("light_relit_full_ms");
+                                lrm = kv("light_relit_full_max_ms"); lF = kv("light_full_ms"); phase = 4 }
         END {
             fps = (t1 > t0) ? (i1 - i0) / (t1 - t0) : 0
-            printf "%-9s %10.1f %10.0f %10.1f %7.1f/%-5.0f %8.1f/%-6.0f %11.1f %12.1f %11.1f %9.1f %14.1f %8.2f\n", mode, fps,
-                   n ? w / n : 0, cam, lf, lfm, lr, lrm, nrl ? rl / nrl : 0, nrl ? rc / nrl : 0, nrl ? rv / nrl : 0,
+            printf "%-9s %10.1f %10.0f %10.1f %7.1f/%-5.0f %13.1f %8.1f/%-6.0f %11.1f %12.1f %11.1f %9.1f %14.1f %8.2f\n", mode, fps,
+                   n ? w / n : 0, cam, lf, lfm, nql ? ql / nql : 0, lr, lrm, nrl ? rl / nrl : 0, nrl ? rc / nrl : 0, nrl ? rv / nrl : 0,
                    nrl ? rr / nrl : 0, lF, build + 0
         }' "$LOG"
 done
