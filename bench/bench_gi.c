@@ -14,7 +14,10 @@
  * supersampling) in both modes, for image comparisons against references.
  * --out PREFIX writes PREFIX_none.exr and PREFIX_particle.exr. --sweep runs
  * counts 50K/100K/200K/400K x n_b 1/3/6/9 and prints lighting and frame
- * times with the image's mean against the first setting's. */
+ * times with the image's mean against the first setting's.
+ * --ref REF.exr (an image of the same size, e.g. a converged --gi path
+ * render) adds the error of every frame against it: mean FLIP (HDR), RMSE
+ * and the mean luminance relative to the reference's. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,6 +26,7 @@
 #include "accel.h"
 #include "gi_particle.h"
 #include "img_io.h"
+#include "img_metrics.h"
 #include "sdl.h"
 #include "shade.h"
 #include "timer.h"
@@ -35,8 +39,13 @@ typedef struct {
     const char *scene;
     int size, threads, nb, reps, sweep, spp, full, area_samples;
     long count;
-    const char *device, *out;
+    const char *device, *out, *ref;
 } opts;
+
+static framebuffer *g_ref;
+
+/* Error against the reference: mean FLIP, RMSE, mean luminance ratio - 1. */
+static int ref_error(const framebuffer *fb, double *flip, double *rmse, double *lum, diag *d);
 
 /* CPU seconds of the whole process (all threads, PoCL's included): on a
  * shared machine this says more than wall time, which other processes'
@@ -54,6 +63,19 @@ static double mean_lum(const framebuffer *fb)
     size_t n = (size_t)fb->width * fb->height;
     for (size_t i = 0; i < n; i++) s += 0.2126 * fb->rgb[3 * i] + 0.7152 * fb->rgb[3 * i + 1] + 0.0722 * fb->rgb[3 * i + 2];
     return s / (double)n;
+}
+
+static int ref_error(const framebuffer *fb, double *flip, double *rmse, double *lum, diag *d)
+{
+    *flip = *rmse = *lum = NAN;
+    if (!g_ref || g_ref->width != fb->width || g_ref->height != fb->height) return 0;
+    img_compare_result r;
+    if (img_compare(g_ref, fb, 1, &r, NULL, d) != PT_OK) return 0;
+    *flip = r.flip_mean;
+    *rmse = r.rmse;
+    double lr = mean_lum(g_ref);
+    *lum = lr > 0.0 ? mean_lum(fb) / lr - 1.0 : NAN;
+    return 1;
 }
 
 static void report_diag(diag *d)
@@ -123,7 +145,7 @@ static void sweep(const scene *sc, const accel *a, const opts *o, diag *d)
     static const long counts[] = {50000, 100000, 200000, 400000};
     static const int nbs[] = {1, 3, 6, 9};
     framebuffer *fb = fb_new(o->size, o->size);
-    double means[4][4], rows[4][4][6];
+    double means[4][4], rows[4][4][9];
     memset(means, 0, sizeof means);
     memset(rows, 0, sizeof rows);
     for (int ci = 0; ci < 4; ci++) {
@@ -154,24 +176,27 @@ static void sweep(const scene *sc, const accel *a, const opts *o, diag *d)
             rows[ci][bi][3] = tv;
             rows[ci][bi][4] = tr;
             rows[ci][bi][5] = tf;
+            ref_error(fb, &rows[ci][bi][6], &rows[ci][bi][7], &rows[ci][bi][8], d);
         }
         gi_particle_free(gp);
     }
     double ref = means[3][3] > 0.0 ? means[3][3] : 1.0;
     printf("\nsweep, %dx%d (mean luminance relative to 400K particles, n_b 9)\n", o->size, o->size);
-    printf("%8s %4s %9s %9s %10s %10s %10s %10s %10s\n", "count", "n_b", "geom s", "geom cpu", "light ms", "view ms",
-           "render ms", "frame ms", "mean rel");
+    if (g_ref) printf("error against %s: mean FLIP, RMSE, mean luminance relative to the reference's\n", o->ref);
+    printf("%8s %4s %9s %9s %10s %10s %10s %10s %10s %8s %9s %9s\n", "count", "n_b", "geom s", "geom cpu", "light ms",
+           "view ms", "render ms", "frame ms", "mean rel", "FLIP", "RMSE", "lum err");
     for (int ci = 0; ci < 4; ci++)
         for (int bi = 0; bi < 4; bi++)
-            printf("%8ld %4d %9.2f %9.2f %10.2f %10.2f %10.2f %10.2f %10.4f\n", counts[ci], nbs[bi], rows[ci][bi][0],
-                   rows[ci][bi][1], 1e3 * rows[ci][bi][2], 1e3 * rows[ci][bi][3], 1e3 * rows[ci][bi][4],
-                   1e3 * rows[ci][bi][5], means[ci][bi] / ref);
+            printf("%8ld %4d %9.2f %9.2f %10.2f %10.2f %10.2f %10.2f %10.4f %8.4f %9.5f %+8.2f%%\n", counts[ci], nbs[bi],
+                   rows[ci][bi][0], rows[ci][bi][1], 1e3 * rows[ci][bi][2], 1e3 * rows[ci][bi][3],
+                   1e3 * rows[ci][bi][4], 1e3 * rows[ci][bi][5], means[ci][bi] / ref, rows[ci][bi][6],
+                   rows[ci][bi][7], 100.0 * rows[ci][bi][8]);
     fb_free(fb);
 }
 
 int main(int argc, char **argv)
 {
-    opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 1, 0, -1, 50000, NULL, NULL};
+    opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 1, 0, -1, 50000, NULL, NULL, NULL};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -183,6 +208,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--reps") && v) { o.reps = atoi(v); i++; }
         else if (!strcmp(a, "--out") && v) { o.out = v; i++; }
         else if (!strcmp(a, "--sweep")) o.sweep = 1;
+        else if (!strcmp(a, "--ref") && v) { o.ref = v; i++; }
         else if (!strcmp(a, "--spp") && v) { o.spp = atoi(v); i++; }
         else if (!strcmp(a, "--full")) o.full = 1;
         else if (!strcmp(a, "--area-samples") && v) { o.area_samples = atoi(v); i++; }
@@ -192,6 +218,10 @@ int main(int argc, char **argv)
     if (o.reps < 1) o.reps = 1;
     g_spp = o.spp;
     diag *d = diag_new();
+    if (o.ref && img_read(o.ref, 0, &g_ref, d) != PT_OK) {
+        report_diag(d);
+        return 1;
+    }
     sdl_options so;
     sdl_default_options(&so);
     so.image_width = so.image_height = o.size;
@@ -309,6 +339,11 @@ int main(int argc, char **argv)
     printf("  hook: %ld lookups, %ld late, %ld without particles, %ld discarded\n", x->lookups, x->lookups_late,
            x->lookups_none, x->discarded);
     printf("mean luminance: none %.5f, particle %.5f\n", mean_lum(fb_none), mean_lum(fb_gi));
+    {
+        double fl, rm, lu;
+        if (ref_error(fb_gi, &fl, &rm, &lu, d))
+            printf("against %s: mean FLIP %.4f, RMSE %.5f, mean luminance %+.2f%%\n", o.ref, fl, rm, 100.0 * lu);
+    }
     if (o.out) {
         char path[4096];
         img_write_opts wo;
@@ -336,6 +371,7 @@ int main(int argc, char **argv)
     gi_particle_free(gp);
     accel_free(a);
     scene_free(sc);
+    fb_free(g_ref);
     diag_free(d);
     return 0;
 }

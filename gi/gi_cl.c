@@ -79,6 +79,7 @@ struct gi_dev {
     int n, ns2, ng, nrp;
     int slices; /* scatter slices (gi_k_scatter): 0 = atomic adds (GPUs) */
     int cpu_units; /* OpenCL: compute units of a CPU device, 0 for other devices */
+    float *rho4;   /* n x 4: the particles' reflectances (gi_k_scatter) */
     const int *slink, *glink, *list_off, *list_idx, *rin_off, *rin_src;
     /* C build scratch */
     float *edir, *src, *bin, *bout, *total;
@@ -90,7 +91,7 @@ struct gi_dev {
     cl_command_queue q;
     cl_program prog;
     cl_kernel k[KE_COUNT];
-    cl_mem b_part, b_slink, b_glink, b_off, b_idx;
+    cl_mem b_part, b_slink, b_glink, b_off, b_idx, b_rho;
     cl_mem b_lights, b_vis, b_edir, b_src, b_acc, b_tally, b_srcidx, b_lout, b_phi, b_eind, b_list, b_vout;
     cl_mem b_rin_off, b_rin_src, b_bin, b_bout, b_total;
     size_t sz_lights, sz_vis, sz_srcidx, sz_list, sz_vout;
@@ -463,7 +464,7 @@ void gi_dev_free(gi_dev *dv)
     if (!dv) return;
 #ifdef PARTRAY_HAVE_OPENCL
     if (dv->is_cl) {
-        cl_mem *ms[] = {&dv->b_part, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
+        cl_mem *ms[] = {&dv->b_part, &dv->b_rho, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
                         &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_acc, &dv->b_tally, &dv->b_srcidx,
                         &dv->b_lout, &dv->b_phi, &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off,
                         &dv->b_rin_src, &dv->b_bin, &dv->b_bout, &dv->b_total};
@@ -482,6 +483,7 @@ void gi_dev_free(gi_dev *dv)
     free(dv->bin);
     free(dv->bout);
     free(dv->total);
+    free(dv->rho4);
     free(dv);
 }
 
@@ -495,6 +497,11 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     dv->glink = glink;
     dv->ng = ng;
     size_t nn = (size_t)(n > 0 ? n : 1);
+    free(dv->rho4);
+    dv->rho4 = calloc(nn * 4, sizeof(float));
+    if (!dv->rho4) return PT_ERR_NOMEM;
+    for (int i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++) dv->rho4[4 * (size_t)i + c] = part[i].rho[c];
     if (!dv->is_cl) {
         free(dv->edir);
         free(dv->src);
@@ -509,7 +516,7 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
         dv->bin = calloc(nn * 4, sizeof(float));
         dv->bout = calloc(nn * 4, sizeof(float));
         dv->total = calloc(nn * 4, sizeof(float));
-        dv->bytes = nn * (5 * 16 + 24 * (size_t)dv->slices);
+        dv->bytes = nn * (6 * 16 + 24 * (size_t)dv->slices);
         if (!dv->edir || !dv->src || !dv->acc || !dv->bin || !dv->bout || !dv->total) return PT_ERR_NOMEM;
         return PT_OK;
     }
@@ -517,7 +524,7 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     size_t have = 0;
     pt_status st;
     /* a new geometry: drop every buffer and start the byte count again */
-    cl_mem *ms[] = {&dv->b_part, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
+    cl_mem *ms[] = {&dv->b_part, &dv->b_rho, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
                     &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_acc, &dv->b_tally, &dv->b_srcidx,
                     &dv->b_lout, &dv->b_phi, &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off,
                     &dv->b_rin_src, &dv->b_bin, &dv->b_bout, &dv->b_total};
@@ -529,6 +536,8 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     size_t nr = n > 0 ? (size_t)n : 0;
     dv->slices = dv->cpu_units > 0 ? scatter_slices(dv->cpu_units, nn) : 0;
     if ((st = upload(dv, &dv->b_part, &have, part, nr * sizeof *part, d)) != PT_OK) return st;
+    have = 0;
+    if ((st = upload(dv, &dv->b_rho, &have, dv->rho4, nr * 4 * sizeof(float), d)) != PT_OK) return st;
     have = 0;
     if ((st = upload(dv, &dv->b_slink, &have, slink, nr * (size_t)ns2 * sizeof(int), d)) != PT_OK) return st;
     have = 0;
@@ -654,7 +663,7 @@ pt_status gi_dev_scatter(gi_dev *dv, int mode, int nb, gi_u32 seed, float scale,
                 dv->bout = t;
             }
         } else if (nb > 0) {
-            gi_c_scatter(dv->threads, dv->part, dv->n, dv->slink, dv->ns2, nb, seed, scale, srcidx, nsrc, dv->src,
+            gi_c_scatter(dv->threads, dv->rho4, dv->n, dv->slink, dv->ns2, nb, seed, scale, srcidx, nsrc, dv->src,
                          dv->slices, dv->acc, tally_s);
             sum_tally(tally_s, ns, nb, tl);
         }
@@ -688,7 +697,7 @@ pt_status gi_dev_scatter(gi_dev *dv, int mode, int nb, gi_u32 seed, float scale,
             return st;
         cl_uint sd = seed;
         int slices = dv->slices;
-        karg a[] = {KMEM(dv->b_part), KMEM(dv->b_slink), KINT(ns2), KINT(nb),  {sizeof(cl_uint), &sd},
+        karg a[] = {KMEM(dv->b_rho), KMEM(dv->b_slink), KINT(ns2), KINT(nb),  {sizeof(cl_uint), &sd},
                     KF(scale),        KMEM(dv->b_srcidx), KINT(nsrc), KMEM(dv->b_src), KMEM(dv->b_acc),
                     KMEM(dv->b_tally), KINT(n),          KINT(slices)};
         /* slices: one work-item each, in work-groups of one (PoCL spreads

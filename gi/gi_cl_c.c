@@ -34,6 +34,7 @@ typedef struct {
     const int *rin_off, *rin_src;
     int np_slices; /* scatter: slices (one work-item each) */
     int nsrc;      /* scatter: sources */
+    const float *rho4;
     size_t chunk;  /* work-items per pool job (0: GI_C_CHUNK) */
 } c_launch;
 
@@ -50,7 +51,7 @@ static void run_chunk(void *ctx, int chunk, int thread)
         switch (a->kernel) {
         case K_EMIT: gi_k_emit(a->part, a->np, a->lights, a->nlights, a->vis, a->fout, a->fout2); break;
         case K_SCATTER:
-            gi_k_scatter(a->part, a->slink, a->ns2, a->nb, a->seed, a->scale, a->idx, a->nsrc, a->src, a->acc,
+            gi_k_scatter(a->rho4, a->slink, a->ns2, a->nb, a->seed, a->scale, a->idx, a->nsrc, a->src, a->acc,
                          a->tally, a->np, a->np_slices);
             break;
         case K_RESOLVE:
@@ -88,11 +89,11 @@ void gi_c_emit(int threads, const gi_dev_particle *part, int n, const gi_dev_lig
     launch(threads, &a);
 }
 
-void gi_c_scatter(int threads, const gi_dev_particle *part, int n, const int *slink, int ns2, int nb, gi_u32 seed,
+void gi_c_scatter(int threads, const float *rho4, int n, const int *slink, int ns2, int nb, gi_u32 seed,
                   float scale, const int *srcidx, int nsrc, const float *src, int nslices, gi_i64 *acc, gi_i64 *tally)
 {
     /* one work-item per slice (nslices > 0), one pool job each */
-    c_launch a = {.kernel = K_SCATTER, .n = (size_t)(nslices > 0 ? nslices : nsrc), .part = part, .np = n,
+    c_launch a = {.kernel = K_SCATTER, .n = (size_t)(nslices > 0 ? nslices : nsrc), .rho4 = rho4, .np = n,
                   .slink = slink, .ns2 = ns2, .nb = nb, .seed = seed, .scale = scale, .idx = srcidx,
                   .nsrc = nsrc, .src = src, .acc = acc, .tally = tally, .np_slices = nslices,
                   .chunk = nslices > 0 ? 1 : 0};

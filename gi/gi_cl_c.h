@@ -11,8 +11,8 @@
 void gi_c_emit(int threads, const gi_dev_particle *part, int n, const gi_dev_light *lights, int nlights,
                const float *vis, float *edir, float *src);
 /* nslices > 0: acc holds nslices slices of 3n, tally nslices x 3 GI_MAX_BOUNCES
- * (gi_k_scatter); nslices = 0: one of each, atomic adds. */
-void gi_c_scatter(int threads, const gi_dev_particle *part, int n, const int *slink, int ns2, int nb, gi_u32 seed,
+ * (gi_k_scatter); nslices = 0: one of each, atomic adds. rho4: n x 4 floats. */
+void gi_c_scatter(int threads, const float *rho4, int n, const int *slink, int ns2, int nb, gi_u32 seed,
                   float scale, const int *srcidx, int nsrc, const float *src, int nslices, gi_i64 *acc, gi_i64 *tally);
 void gi_c_pull_init(int threads, int n, int ns2, const float *src, float *bin, float *total);
 void gi_c_pull(int threads, const gi_dev_particle *part, int n, int ns2, const int *rin_off, const int *rin_src,

@@ -87,7 +87,7 @@ __kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global co
  * are atomic adds (many work-items share acc), else plain adds (acc is
  * this work-item's own). */
 #define GI_WALK_BATCH 32
-static inline void gi_walk(__global const gi_dev_particle *part, __global const int *slink, int ns2, int nb,
+static inline void gi_walk(__global const float *rho4, __global const int *slink, int ns2, int nb,
                            uint seed, float scale, __global const int *srcidx, int t0, int step, int cnt,
                            __global const float *src, GI_GLOBAL gi_i64 *acc, int atomic, gi_i64 *tl)
 {
@@ -113,17 +113,16 @@ static inline void gi_walk(__global const gi_dev_particle *part, __global const 
         if (s > 0) {
             for (int p = 0; p < np; p++)
                 if (jj[p] >= 0) {
-                    prefetch(&part[jj[p]].rho[0], 1);
+                    prefetch(&rho4[4 * jj[p]], 1);
                     prefetch(&slink[(long)jj[p] * ns2], 1);
                 }
             /* move every live packet one link on from where it lies */
             for (int p = 0; p < np; p++) {
                 int j = jj[p];
                 if (j < 0) continue;
-                __global const gi_dev_particle *pj = &part[j];
-                pk[3 * p] *= pj->rho[0];
-                pk[3 * p + 1] *= pj->rho[1];
-                pk[3 * p + 2] *= pj->rho[2];
+                pk[3 * p] *= rho4[4 * j];
+                pk[3 * p + 1] *= rho4[4 * j + 1];
+                pk[3 * p + 2] *= rho4[4 * j + 2];
                 if (pk[3 * p] == 0.0f && pk[3 * p + 1] == 0.0f && pk[3 * p + 2] == 0.0f) {
                     jj[p] = -1;
                     continue;
@@ -157,7 +156,10 @@ static inline void gi_walk(__global const gi_dev_particle *part, __global const 
 }
 
 /* The walks of section 4.2.2 (gi_walk above) for the nsrc source particles
- * srcidx[]. Two launch shapes, the same integer sums:
+ * srcidx[]. rho4: the particles' reflectances, 4 floats each (a compact
+ * copy of part[].rho: the walks read it at random, and 16 bytes a particle
+ * stay in cache where the 64-byte records do not). Two launch shapes, the
+ * same integer sums:
  *  - nslices = 0 (GPUs): one work-item per source; deposits and tallies are
  *    atomic adds into acc and tally;
  *  - nslices > 0 (CPUs): one work-item per slice w < nslices, walking the
@@ -168,7 +170,7 @@ static inline void gi_walk(__global const gi_dev_particle *part, __global const 
  *    slice costs one memory add.
  * Integer sums do not depend on order, so both shapes, any slice count and
  * any thread timing give the same acc and tally. */
-__kernel void gi_k_scatter(__global const gi_dev_particle *part, __global const int *slink, int ns2, int nb,
+__kernel void gi_k_scatter(__global const float *rho4, __global const int *slink, int ns2, int nb,
                            uint seed, float scale, __global const int *srcidx, int nsrc, __global const float *src,
                            __global gi_i64 *acc, __global gi_i64 *tally, int n, int nslices)
 {
@@ -182,13 +184,13 @@ __kernel void gi_k_scatter(__global const gi_dev_particle *part, __global const 
         int mycount = nsrc > w ? (nsrc - w + nslices - 1) / nslices : 0;
         for (int b0 = 0; b0 < mycount; b0 += GI_WALK_BATCH) {
             int cnt = mycount - b0 < GI_WALK_BATCH ? mycount - b0 : GI_WALK_BATCH;
-            gi_walk(part, slink, ns2, nb, seed, scale, srcidx, w + b0 * nslices, nslices, cnt, src, mine, 0, tl);
+            gi_walk(rho4, slink, ns2, nb, seed, scale, srcidx, w + b0 * nslices, nslices, cnt, src, mine, 0, tl);
         }
         for (int b = 0; b < 3 * nbc; b++) tally[(long)w * 3 * GI_MAX_BOUNCES + b] = tl[b];
         return;
     }
     if (w >= nsrc) return;
-    gi_walk(part, slink, ns2, nb, seed, scale, srcidx, w, 1, 1, src, acc, 1, tl);
+    gi_walk(rho4, slink, ns2, nb, seed, scale, srcidx, w, 1, 1, src, acc, 1, tl);
     for (int b = 0; b < 3 * nbc; b++)
         if (tl[b] != 0) atom_add(&tally[b], tl[b]);
 }
