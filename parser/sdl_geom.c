@@ -1046,6 +1046,12 @@ static const env_shape *env_get(geom *g, const scene_object *o)
         if (!g->unsupported) g->unsupported = o->name ? o->name : "object";
         return NULL;
     }
+    if (o->kind == SHAPE_HEIGHT_FIELD && (!o->u.height_field || !o->u.height_field->heights)) {
+        /* kept without height data (e.g. height_field { function ... }):
+         * no answer rather than a wrong one */
+        if (!g->unsupported) g->unsupported = "height_field without height data";
+        return NULL;
+    }
     env_shape **tab = g->p->geom_shapes;
     if (!tab) {
         tab = calloc(ENV_BUCKETS, sizeof *tab);

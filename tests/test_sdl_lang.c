@@ -597,6 +597,7 @@ static void test_example_sweep(void **st)
     sdl_default_options(&o);
     o.write_dir = dir;
     o.func_env = shade_func_env();
+    o.geom_env = accel_geom_env();
     int n = 0, ok = 0, unlocated = 0;
     if (!sweep("/usr/share/povray-3.7/scenes", &o, &n, &ok, &unlocated) || n == 0) skip();
     print_message("example scenes: %d of %d parse (%.1f%%)\n", ok, n, 100.0 * ok / n);
