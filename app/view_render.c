@@ -274,18 +274,22 @@ static double cpu_now(void)
 }
 
 /* Runs a lighting stage (the full one, or the preview one) on the render
- * thread, cancellable by a newer light edit (view_render_submit). */
+ * thread. The full one is cancelled by a newer light edit
+ * (view_render_submit); the preview one (tens of ms) is not: while a light
+ * is dragged each new edit would cancel it and nothing would be shown. Both
+ * stop on a mode change or stop. */
 static pt_status relight_step(view_render *vr, view_gi *g, int preview, view_gi_times *acc, double *cpu, diag *d)
 {
     view_gi_times t;
     memset(&t, 0, sizeof t);
     pt_status st = PT_OK;
     pthread_mutex_lock(&vr->mu);
-    vr->relighting = !vr->cancel;
+    int run = !vr->cancel;
+    vr->relighting = run && !preview;
     vr->edit_in_relight = 0;
     pthread_mutex_unlock(&vr->mu);
     double c0 = cpu_now();
-    if (vr->relighting) st = preview ? view_gi_relight_preview(g, &vr->cancel, &t, d) : view_gi_relight(g, &vr->cancel, &t, d);
+    if (run) st = preview ? view_gi_relight_preview(g, &vr->cancel, &t, d) : view_gi_relight(g, &vr->cancel, &t, d);
     *cpu += cpu_now() - c0;
     pthread_mutex_lock(&vr->mu);
     vr->relighting = 0;
