@@ -7,7 +7,7 @@
 #     BUILD_DIR  where `partray` is (default: build)
 #     SCENE      default scenes/cbox.pov;  SIZE default 512x512
 #     MODES      default "none particle"
-#   THREADS=N (default 2, the CI machine's cores), ORBIT_S=5, MOVES=4,
+#   THREADS=N (default 2, the CI machine's cores), ORBIT_S=5, MOVES=4, DRAG_S=2,
 #   PREVIEW=D fixes the preview at 1/D of the size (default: adaptive),
 #   EXTRA="--particles N ..." more viewer options, KEEP_LOG=PREFIX keeps the
 #   verbose logs as PREFIX.MODE.log.
@@ -34,6 +34,8 @@
 #                   its wall time on an idle machine (this one is shared)
 #   light->full ms  light move to the relit full-resolution image, mean
 #   build s         the mode's geometry + lighting stages at start
+#   drag img/s      images per second while a light is dragged (an arrow key
+#                   held DRAG_S seconds), and their mean latency (drag ms)
 set -eu
 cd "$(dirname "$0")/.."
 BUILD=${1:-build}
@@ -43,6 +45,7 @@ MODES=${4:-none particle}
 THREADS=${THREADS:-2}
 ORBIT_S=${ORBIT_S:-5}
 MOVES=${MOVES:-4}
+DRAG_S=${DRAG_S:-2}
 PREVIEW_OPT=
 [ -n "${PREVIEW:-}" ] && PREVIEW_OPT="--preview $PREVIEW"
 EXTRA=${EXTRA:-}
@@ -85,14 +88,22 @@ fi
         echo "$t wait-idle"
     done
     echo "$t mark lit"
+    # drag the light: the Right arrow held DRAG_S seconds (moves the selected
+    # light screen-right continuously, as a user would)
+    t=$(awk -v s="$t" 'BEGIN { printf "%.3f", s + 0.2 }')
+    echo "$t key Right $DRAG_S"
+    echo "$t mark drag"
+    t=$(awk -v s="$t" -v d="$DRAG_S" 'BEGIN { printf "%.3f", s + d }')
+    echo "$t mark dragged"
+    echo "$t wait-idle"
     echo "$t quit"
 } >"$TMP/script.txt"
 
 printf '%s %s, %s threads, preview %s, %s, load %s\n' "$SCENE" "$SIZE" "$THREADS" "${PREVIEW:-adaptive}" "$(uname -m)" \
     "$(cut -d' ' -f1 /proc/loadavg)"
-printf '%-9s %10s %10s %10s %13s %13s %15s %11s %12s %11s %9s %14s %8s\n' mode "orbit img/s" "preview px" "cam->img ms" \
+printf '%-9s %10s %10s %10s %13s %13s %15s %11s %12s %11s %9s %14s %8s %10s %8s\n' mode "orbit img/s" "preview px" "cam->img ms" \
     "light->img ms" "prev.light ms" "light->relit ms" "lighting ms" "lighting cpu" "regather ms" "render ms" "light->full ms" \
-    "build s"
+    "build s" "drag img/s" "drag ms"
 for mode in $MODES; do
     LOG=$TMP/$mode.log
     if ! timeout 900 "$BIN" view "$SCENE" --size "$SIZE" --gi "$mode" --threads "$THREADS" --script "$TMP/script.txt" \
@@ -118,10 +129,14 @@ for mode in $MODES; do
         /^view: mark settled/ { phase = 3 }
         /^view: mark lit/     { lf = kv("light_first_ms"); lfm = kv("light_first_max_ms"); lr = kv("light_relit_full_ms");
                                 lrm = kv("light_relit_full_max_ms"); lF = kv("light_full_ms"); phase = 4 }
+        /^view: mark drag /   { d0 = kv("time"); j0 = kv("images"); phase = 5 }
+        /^view: mark dragged/ { d1 = kv("time"); j1 = kv("images"); phase = 6 }
+        /^view: image / && phase == 5 { if (match($0, /latency [0-9.]+/)) { dl += substr($0, RSTART + 8, RLENGTH - 8); ndl++ } }
         END {
             fps = (t1 > t0) ? (i1 - i0) / (t1 - t0) : 0
-            printf "%-9s %10.1f %10.0f %10.1f %7.1f/%-5.0f %13.1f %8.1f/%-6.0f %11.1f %12.1f %11.1f %9.1f %14.1f %8.2f\n", mode, fps,
-                   n ? w / n : 0, cam, lf, lfm, nql ? ql / nql : 0, lr, lrm, nrl ? rl / nrl : 0, nrl ? rc / nrl : 0, nrl ? rv / nrl : 0,
-                   nrl ? rr / nrl : 0, lF, build + 0
+            dfps = (d1 > d0) ? (j1 - j0) / (d1 - d0) : 0
+            printf "%-9s %10.1f %10.0f %10.1f %7.1f/%-5.0f %13.1f %8.1f/%-6.0f %11.1f %12.1f %11.1f %9.1f %14.1f %8.2f %10.1f %8.1f\n",
+                   mode, fps, n ? w / n : 0, cam, lf, lfm, nql ? ql / nql : 0, lr, lrm, nrl ? rl / nrl : 0, nrl ? rc / nrl : 0,
+                   nrl ? rv / nrl : 0, nrl ? rr / nrl : 0, lF, build + 0, dfps, ndl ? dl / ndl : 0
         }' "$LOG"
 done
