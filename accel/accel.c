@@ -76,7 +76,16 @@ typedef struct {
     int identity;                 /* transform is the identity */
     int in_csg;                   /* member of a CSG primitive, built there */
     int group;                    /* shared-mesh group, -1 if none */
+    int b0, bn;                   /* bounded_by: a->bshapes[b0 .. b0+bn) (analytic leaves) */
 } accel_leaf;
+
+/* bounded_by of the objects above a leaf (unions are flattened into their
+ * members, which keep the union's bound, as POV-Ray's CSG union checks it
+ * before its children). Lives on the stack during collect(). */
+typedef struct bound_chain {
+    const scene_object *host;
+    const struct bound_chain *up;
+} bound_chain;
 
 typedef struct { unsigned leaf, local; } tri_ref;
 
@@ -117,6 +126,10 @@ struct accel {
     double eps_scale;  /* working scale of the epsilon rule (see the top) */
     double *diags;     /* leaf bounding-box diagonals, during the build */
     int ndiags, capdiags;
+    accel_shape *bshapes;         /* bounding objects (bounded_by), world space */
+    int nbshapes, capbshapes;
+    int *csg_b0, *csg_bn;         /* per CSG primitive, as accel_leaf.b0/bn */
+    const bound_chain *cur_chain; /* during collect(): the bounds above the current object */
     accel_stats stats;
     atomic_int err;
     char errmsg[512];
@@ -215,7 +228,92 @@ static int add_leaf(accel *a, const scene_object *o, const scene_texture *tex, u
     l->identity = xform_is_identity(&o->transform);
     l->in_csg = 0;
     l->group = -1;
+    l->b0 = l->bn = 0;
     return a->nleaves++;
+}
+
+/* ------------------------------------------------------------ bounded_by */
+
+static int is_csg_kind_early(shape_kind k)
+{
+    return k == SHAPE_UNION || k == SHAPE_MERGE || k == SHAPE_INTERSECTION || k == SHAPE_DIFFERENCE;
+}
+
+/* POV-Ray 3.7's Link_To_Frame drops the bound of a top-level object that is
+ * cheap to intersect (remove_bounds, on by default): it keeps those of
+ * unions, intersections/differences, merges, polys, text and quadrics
+ * without automatic (finite) bounds. Bounds below a CSG object stay. */
+static int keeps_bound(const scene_object *o, int top)
+{
+    if (!top) return 1;
+    switch (o->kind) {
+    case SHAPE_UNION: case SHAPE_MERGE: case SHAPE_INTERSECTION: case SHAPE_DIFFERENCE:
+    case SHAPE_POLY: case SHAPE_TEXT:
+        return 1;
+    case SHAPE_QUADRIC: {
+        accel_shape sh;
+        if (accel_shape_init(&sh, o) != 0) return 0;
+        int inf = sh.infinite;
+        accel_shape_release(&sh);
+        return inf;
+    }
+    default:
+        return 0;
+    }
+}
+
+static int add_bound_objects(accel *a, diag *d, const scene_object *host)
+{
+    const scene_object *list = host->bound;
+    for (int i = 0; list && i < list->u.csg.nkids; i++) {
+        const scene_object *k = list->u.csg.kids[i];
+        if (!k) continue;
+        if (is_csg_kind_early(k->kind) || k->clip) {
+            diag_warn_once(d, k->loc, "a CSG bounding object is not evaluated: the bound is ignored");
+            continue;
+        }
+        scene_object moved = *k;
+        moved.transform = xform_then(k->transform, host->transform);
+        if (a->nbshapes == a->capbshapes) {
+            size_t cap = (size_t)a->capbshapes;
+            if (!grow((void **)&a->bshapes, &cap, (size_t)a->nbshapes + 1, sizeof(accel_shape))) return 0;
+            a->capbshapes = (int)cap;
+        }
+        if (moved.kind == SHAPE_MESH || moved.kind == SHAPE_UNSUPPORTED ||
+            accel_shape_init(&a->bshapes[a->nbshapes], &moved) != 0) {
+            diag_warn_once(d, k->loc, "this bounding object is not evaluated: the bound is ignored");
+            continue;
+        }
+        if (a->bshapes[a->nbshapes].infinite)
+            accel_shape_clip_plane(&a->bshapes[a->nbshapes], v3s(-INFINITY), v3s(INFINITY));
+        a->nbshapes++;
+    }
+    return 1;
+}
+
+/* The bounds applying to object o (whose own bound counts if `own`), as a
+ * range of a->bshapes. 0 on out-of-memory. */
+static int collect_bounds(accel *a, diag *d, const scene_object *o, int own, int *b0, int *bn)
+{
+    *b0 = a->nbshapes;
+    for (const bound_chain *c = a->cur_chain; c; c = c->up)
+        if (!add_bound_objects(a, d, c->host)) return 0;
+    if (own && o->bound && !add_bound_objects(a, d, o)) return 0;
+    *bn = a->nbshapes - *b0;
+    return 1;
+}
+
+/* POV-Ray's Ray_In_Bound: the ray meets every bound ahead of its origin or
+ * starts inside it. */
+static int ray_in_bound(const accel *a, int b0, int bn, vec3 o, vec3 d, double tmin)
+{
+    for (int i = 0; i < bn; i++) {
+        const accel_shape *b = &a->bshapes[b0 + i];
+        accel_shape_hit h;
+        if (accel_shape_inside(b, o)) continue;
+        if (!accel_shape_intersect(b, o, d, tmin, INFINITY, &h)) return 0;
+    }
+    return 1;
 }
 
 /* ------------------------------------------------------------ CSG */
@@ -355,6 +453,20 @@ static pt_status build_csg(accel *a, diag *d, const scene_object *o, const scene
     accel_csg *c = &a->csgs[a->ncsgs];
     memset(c, 0, sizeof *c);
     c->flags = o->flags | (pflags & INHERITED_FLAGS);
+    int cb0 = 0, cbn = 0;
+    if (!collect_bounds(a, d, o, keeps_bound(o, depth == 0), &cb0, &cbn))
+        return PT_ERR_NOMEM;
+    {
+        size_t cap = (size_t)a->capcsgs;
+        int *n0 = realloc(a->csg_b0, cap * sizeof *n0);
+        if (!n0) return PT_ERR_NOMEM;
+        a->csg_b0 = n0;
+        int *n1 = realloc(a->csg_bn, cap * sizeof *n1);
+        if (!n1) return PT_ERR_NOMEM;
+        a->csg_bn = n1;
+        a->csg_b0[a->ncsgs] = cb0;
+        a->csg_bn[a->ncsgs] = cbn;
+    }
     pt_status st = csg_member(a, d, c, o, ptex, pflags, -1, depth);
     if (st != PT_OK) {
         accel_csg_free(c);
@@ -408,22 +520,35 @@ static pt_status collect(accel *a, diag *d, const scene_object *o, const scene_t
         diag_warn_once(d, o->loc, "merge with a mesh or more than %d members keeps its internal surfaces",
                        MAX_MERGE_MEMBERS);
         /* fall through */
-    case SHAPE_UNION:
+    case SHAPE_UNION: {
         if (depth >= MAX_CSG_DEPTH) {
             diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", MAX_CSG_DEPTH);
             return PT_ERR_LIMIT;
         }
-        for (int i = 0; i < o->u.csg.nkids; i++) {
-            pt_status st = collect(a, d, o->u.csg.kids[i], tex, flags, depth + 1);
-            if (st != PT_OK) return st;
-        }
-        return PT_OK;
+        /* the members keep the union's bound */
+        const bound_chain *saved = a->cur_chain;
+        bound_chain node = {o, saved};
+        if (o->bound) a->cur_chain = &node;
+        pt_status st = PT_OK;
+        for (int i = 0; i < o->u.csg.nkids && st == PT_OK; i++) st = collect(a, d, o->u.csg.kids[i], tex, flags, depth + 1);
+        a->cur_chain = saved;
+        return st;
+    }
     case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_PLANE: case SHAPE_TRIANGLE: case SHAPE_SMOOTH_TRIANGLE:
     case SHAPE_MESH: case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC: case SHAPE_TORUS:
     case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_SUPERELLIPSOID:
     case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_HEIGHT_FIELD: case SHAPE_TEXT: case SHAPE_ISOSURFACE:
-    case SHAPE_JULIA: case SHAPE_OVUS:
-        return add_leaf(a, o, tex, flags) < 0 ? PT_ERR_NOMEM : PT_OK;
+    case SHAPE_JULIA: case SHAPE_OVUS: {
+        int li = add_leaf(a, o, tex, flags);
+        if (li < 0) return PT_ERR_NOMEM;
+        if (o->kind != SHAPE_TRIANGLE && o->kind != SHAPE_SMOOTH_TRIANGLE && o->kind != SHAPE_MESH) {
+            int b0, bn;
+            if (!collect_bounds(a, d, o, keeps_bound(o, depth == 0), &b0, &bn)) return PT_ERR_NOMEM;
+            a->leaves[li].b0 = b0;
+            a->leaves[li].bn = bn;
+        }
+        return PT_OK;
+    }
     case SHAPE_UNSUPPORTED:
     default:
         a->stats.unsupported++;
@@ -538,13 +663,17 @@ static int prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, 
     if (prim < (unsigned)a->nshapes) {
         accel_shape_hit sh;
         if (!accel_shape_intersect(&a->shapes[prim], o, d, tmin, tmax, &sh)) return 0;
+        const accel_leaf *l = &a->leaves[a->shape_leaf[prim]];
+        if (l->bn && !ray_in_bound(a, l->b0, l->bn, o, d, tmin)) return 0;
         h->t = sh.t;
         h->part = sh.part;
         h->shape = 0;
         h->flip = 0;
         return 1;
     }
-    return accel_csg_intersect(&a->csgs[prim - (unsigned)a->nshapes], o, d, tmin, tmax, h);
+    unsigned ci = prim - (unsigned)a->nshapes;
+    if (!accel_csg_intersect(&a->csgs[ci], o, d, tmin, tmax, h)) return 0;
+    return !a->csg_bn[ci] || ray_in_bound(a, a->csg_b0[ci], a->csg_bn[ci], o, d, tmin);
 }
 
 static const accel_shape *prim_shape(const accel *a, unsigned prim, int member)
@@ -1080,6 +1209,10 @@ void accel_free(accel *a)
     free(a->groups);
     for (int i = 0; i < a->ncsgs; i++) accel_csg_free(&a->csgs[i]);
     free(a->csgs);
+    for (int i = 0; i < a->nbshapes; i++) accel_shape_release(&a->bshapes[i]);
+    free(a->bshapes);
+    free(a->csg_b0);
+    free(a->csg_bn);
     free(a->ginfo);
     free(a);
 }

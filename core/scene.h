@@ -277,6 +277,12 @@ struct scene_object {
      * this object's space (world = clip->transform then this->transform), so
      * later transforms of the object move it along. NULL = none. */
     const scene_object *clip;
+    /* bounded_by (issue 4): a SHAPE_UNION node named "bounded_by" whose kids
+     * are the bounding objects, transforms relative to this object as for
+     * clip. A ray sees the object only if it meets every bounding object (at
+     * any distance ahead) or starts inside it (POV-Ray's Ray_In_Bound).
+     * NULL = none. */
+    const scene_object *bound;
 };
 
 /* ---------------------------------------------------------------- lights */

@@ -1437,8 +1437,6 @@ static scene_object *copy_tree(sdl_parser *p, const scene_object *o, int depth)
 static _Thread_local const scene_object *last_bound_host;
 static _Thread_local scene_object *last_bound;
 
-static int is_unbounded_kind(shape_kind k) { return k == SHAPE_QUADRIC || k == SHAPE_POLY; }
-
 /* clipped_by := '{' ( objects | bounded_by ) '}' */
 void sdl_shape_clipped_by(sdl_parser *p, sdl_obj *so)
 {
@@ -1462,9 +1460,11 @@ void sdl_shape_clipped_by(sdl_parser *p, sdl_obj *so)
 }
 
 /* bounded_by := '{' ( objects | clipped_by ) '}'
- * Bounds are a speed hint in POV-Ray; we intersect exactly and need none,
- * except for the unbounded quadric and poly shapes, which POV-Ray examples
- * limit with bounded_by: there the bound clips. */
+ * POV-Ray's semantics (Ray_In_Bound): a ray sees the object only if it meets
+ * every bounding object or starts inside it; the bound never cuts the
+ * surface. Kept on every object (scene_object.bound); the renderer drops it
+ * where POV-Ray's Link_To_Frame does. `bounded_by { clipped_by }` makes the
+ * clip objects the bound. */
 void sdl_shape_bounded_by(sdl_parser *p, sdl_obj *so)
 {
     src_loc loc = p->last_loc;
@@ -1472,15 +1472,60 @@ void sdl_shape_bounded_by(sdl_parser *p, sdl_obj *so)
     scene_object *host = so ? so->obj : NULL;
     if (sdl_accept_kw(p, KW_CLIPPED_BY)) {
         sdl_end_block(p);
+        if (host && host->clip && !host->bound) {
+            scene_object *list = scene_new_object(p->s, SHAPE_UNION, loc);
+            scene_object **k = sdl_alloc(p, sizeof *k);
+            if (!list || !k) return;
+            list->name = "bounded_by";
+            k[0] = copy_tree(p, host->clip, 0); /* already relative to the host */
+            list->u.csg.kids = k;
+            list->u.csg.nkids = k[0] ? 1 : 0;
+            host->bound = list;
+        }
         return;
     }
-    scene_object *c = clip_objects(p, loc);
+    /* each object is a bound of its own (all must be met) */
+    scene_object *objs[64];
+    int n = 0;
+    while (sdl_ok(p) && sdl_starts_object(sdl_peek(p))) {
+        sdl_obj *k = sdl_parse_object(p);
+        if (k && k->obj && n < 64) objs[n++] = k->obj;
+    }
     sdl_end_block(p);
-    if (!host || !c || !sdl_ok(p)) return;
+    if (!host || n == 0 || !sdl_ok(p)) return;
     xform inv = xform_inverse(host->transform);
-    scene_object *rel = copy_tree(p, c, 0);
-    relativize(rel, &inv, 0);
+    /* clipped_by { bounded_by }: the objects intersected, relative to the host */
+    scene_object *acc = NULL;
+    for (int i = 0; i < n; i++) {
+        scene_object *c = copy_tree(p, objs[i], 0);
+        if (!c) return;
+        if (!acc) {
+            acc = c;
+            continue;
+        }
+        scene_object *both = scene_new_object(p->s, SHAPE_INTERSECTION, loc);
+        scene_object **kids = sdl_alloc(p, 2 * sizeof *kids);
+        if (!both || !kids) return;
+        both->name = "clipped_by";
+        kids[0] = acc;
+        kids[1] = c;
+        both->u.csg.kids = kids;
+        both->u.csg.nkids = 2;
+        acc = both;
+    }
+    relativize(acc, &inv, 0);
     last_bound_host = host;
-    last_bound = rel;
-    if (is_unbounded_kind(host->kind)) add_clip(p, host, c);
+    last_bound = acc;
+    scene_object *list = scene_new_object(p->s, SHAPE_UNION, loc);
+    scene_object **kids = sdl_alloc(p, sizeof *kids * (size_t)n);
+    if (!list || !kids) return;
+    list->name = "bounded_by";
+    for (int i = 0; i < n; i++) {
+        kids[i] = copy_tree(p, objs[i], 0);
+        if (!kids[i]) return;
+        relativize(kids[i], &inv, 0);
+    }
+    list->u.csg.kids = kids;
+    list->u.csg.nkids = n;
+    host->bound = list;
 }

@@ -1443,6 +1443,54 @@ static void test_ovus(void **st)
     done(&w);
 }
 
+/* bounded_by with POV-Ray 3.7's semantics: a ray sees the object only if it
+ * meets the bound (anywhere ahead) or starts inside it (Ray_In_Bound); the
+ * bound never cuts the surface; top-level objects that are cheap to
+ * intersect lose their bound (Link_To_Frame, remove_bounds on), objects in
+ * unions and CSG objects, polys, text and unbounded quadrics keep it */
+static void test_bounded_by(void **st)
+{
+    (void)st;
+    /* infinite cylinder x^2 + z^2 = 1 along y, bounded by the sphere r = 2 */
+    world w = build("quadric { <1,0,1>, <0,0,0>, <0,0,0>, -1 bounded_by { sphere { 0, 2 } } }");
+    expect_hit(&w, v3(-5, 0, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12);
+    /* a ray missing the bound sees nothing, though it crosses the cylinder */
+    expect_miss(&w, v3(-5, 3, 0), v3(1, 0, 0));
+    /* a ray crossing the bound sees the surface outside it: (-1, 2, 0) is
+     * sqrt(5) from the centre */
+    vec3 dir = v3_norm(v3(1, -0.25, 0));
+    expect_hit(&w, v3(-5, 3, 0), dir, 4.0 / dir.x, v3(-1, 0, 0), 1e-9, 1e-9);
+    /* a ray starting inside the bound */
+    expect_hit(&w, v3(0, 0, 0), v3(1, 0, 0), 1.0, v3(1, 0, 0), 1e-12, 1e-12);
+    done(&w);
+    /* a top-level sphere's bound is dropped, as POV-Ray does by default */
+    w = build("sphere { 0, 1 bounded_by { box { -0.5, 0.5 } } }");
+    expect_hit(&w, v3(-5, 0.8, 0), v3(1, 0, 0), 5 - 0.6, v3(-0.6, 0.8, 0), 1e-12, 1e-12);
+    done(&w);
+    /* ... kept inside a union; the union's own bound holds for its members */
+    w = build("union { sphere { 0, 1 bounded_by { box { -0.5, 0.5 } } } }");
+    expect_miss(&w, v3(-5, 0.8, 0), v3(1, 0, 0));
+    expect_hit(&w, v3(-5, 0.2, 0), v3(1, 0, 0), 5 - sqrt(0.96), v3(-sqrt(0.96), 0.2, 0), 1e-12, 1e-12);
+    done(&w);
+    w = build("union { sphere { <-2,0,0>, 0.5 } sphere { <2,0,0>, 0.5 } bounded_by { box { <-3,-1,-1>, <0,1,1> } } }");
+    expect_hit(&w, v3(-2, 5, 0), v3(0, -1, 0), 4.5, v3(0, 1, 0), 1e-12, 1e-12);
+    expect_miss(&w, v3(2, 5, 0), v3(0, -1, 0));
+    done(&w);
+    /* a CSG intersection (a lens) whose bound lies elsewhere: only rays
+     * through the bound see it */
+    w = build("intersection { sphere { 0, 1 } sphere { <0.5,0,0>, 1 } bounded_by { sphere { <-3,0,0>, 0.5 } } }");
+    expect_hit(&w, v3(-10, 0, 0), v3(1, 0, 0), 9.5, v3(-1, 0, 0), 1e-12, 1e-12);
+    expect_miss(&w, v3(0.25, 5, 0), v3(0, -1, 0));
+    done(&w);
+    /* shadows obey it too: the occlusion query of a ray missing the bound */
+    w = build("quartic { <0,0,0,0,0,0,0,0,0,0, 0,0,0,0,0,0,0,0,0,0, 0,0,0,0,0,1,0,0,0,0, 0,0,1,0,-1> "
+              "bounded_by { sphere { 0, 2 } } }");
+    assert_true(accel_occluded(w.a, v3(0, 0, -5), v3(0, 0, 1), 0.0, 10.0));
+    /* y^2 + z^2 = 1 along x: at x = 5 the ray crosses it but misses the bound */
+    assert_false(accel_occluded(w.a, v3(5, 0, -5), v3(0, 0, 1), 0.0, 10.0));
+    done(&w);
+}
+
 /* malformed shapes give located errors; degenerate ones are skipped with a
  * warning; nothing crashes */
 static void test_bad_input(void **st)
@@ -1553,6 +1601,7 @@ int main(void)
         cmocka_unit_test(test_implicit_sampling),
         cmocka_unit_test(test_grid),
         cmocka_unit_test(test_ovus),
+        cmocka_unit_test(test_bounded_by),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_unsupported),
     };
