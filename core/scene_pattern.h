@@ -94,13 +94,20 @@ typedef struct scene_image {
 typedef struct {
     const scene_image *image;   /* NULL: file not loaded (evaluates as transparent/0) */
     int map_type;               /* 0 planar, 1 spherical, 2 cylindrical, 5 torus */
-    int interpolate;            /* 0 none, 2 bilinear, 4 normalised distance */
+    int interpolate;            /* 0 none, 2 bilinear, 3 bicubic, 4 normalised distance */
     int once;
     int use_alpha;
     double filter_all, transmit_all; /* applied to every pixel when set */
     int filter_all_set, transmit_all_set;
     double major_radius;        /* torus map */
     int material;               /* a material_map (texture chosen by palette index / red) */
+    /* appended (issue 5): `repeat <u, v>` scales the mapped size (0 = 1);
+     * `offset <u, v>` shifts the image, kept in pixels as POV-Ray keeps it
+     * (-u * width, -v * height); use_index: bump_map heights from palette
+     * indices */
+    double repeat_u, repeat_v;
+    double offset_x, offset_y;
+    int use_index;
 } scene_image_map;
 
 typedef struct scene_pattern {

@@ -108,13 +108,26 @@ static int read_png(mem_src *m, sdl_img *out, char *why, size_t whycap)
         out->png_gamma = g > 0.0 ? g : 0.0;
     }
     int palette = ct == PNG_COLOR_TYPE_PALETTE;
-    png_colorp plte = NULL;
+    /* the palette is copied: libpng's own arrays die with png_destroy_read_struct */
+    png_color plte[256];
     int nplte = 0;
-    png_bytep trns = NULL;
+    unsigned char trns[256];
     int ntrns = 0;
     if (palette) {
-        png_get_PLTE(png, info, &plte, &nplte);
-        if (png_get_valid(png, info, PNG_INFO_tRNS)) png_get_tRNS(png, info, &trns, &ntrns, NULL);
+        png_colorp pp = NULL;
+        png_bytep tp = NULL;
+        if (png_get_PLTE(png, info, &pp, &nplte) && pp) {
+            if (nplte > 256) nplte = 256;
+            memcpy(plte, pp, sizeof plte[0] * (size_t)(nplte > 0 ? nplte : 0));
+        } else {
+            nplte = 0;
+        }
+        if (png_get_valid(png, info, PNG_INFO_tRNS) && png_get_tRNS(png, info, &tp, &ntrns, NULL) && tp) {
+            if (ntrns > 256) ntrns = 256;
+            memcpy(trns, tp, (size_t)(ntrns > 0 ? ntrns : 0));
+        } else {
+            ntrns = 0;
+        }
         png_set_packing(png); /* one index per byte */
     } else {
         png_set_expand(png);

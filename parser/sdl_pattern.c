@@ -235,6 +235,16 @@ static scene_image *image_spec(sdl_parser *p, int data)
     return img;
 }
 
+/* Set channel ch (3 filter, 4 transmit) of palette entry reg (-1: every
+ * entry) to v in a palette image's decoded pixels (its entries' colours are
+ * what the pixels hold, POV-Ray's SetRGBFTIndexedValue). */
+static void palette_set(scene_image *img, int reg, int ch, double v)
+{
+    size_t n = (size_t)img->width * (size_t)img->height;
+    for (size_t i = 0; i < n; i++)
+        if (reg < 0 || img->indices[i] == reg) img->pixels[i * 5 + (size_t)ch] = (float)v;
+}
+
 /* image_map { image_spec { once | interpolate n | map_type n | use_colour |
  *   use_index | repeat uv | offset uv | filter [all] .. | transmit [all] .. } };
  * image_pattern and bump_map (kind 1, 2) the same without filter/transmit,
@@ -250,9 +260,22 @@ static void image_block(sdl_parser *p, scene_image_map *im, int kind, double *am
         sdl_kw k = t.tk.kind == TOK_KEYWORD ? t.tk.kw : KW_NONE;
         switch (k) {
         case KW_ONCE: im->once = 1; break;
-        case KW_INTERPOLATE: im->interpolate = sdl_to_int(sdl_float(p)); break;
-        case KW_MAP_TYPE: im->map_type = sdl_to_int(sdl_float(p)); break;
-        case KW_USE_COLOR: case KW_USE_COLOUR: case KW_USE_INDEX: break;
+        case KW_INTERPOLATE:
+            /* POV-Ray 3.7 accepts 2 bilinear, 3 bicubic, 4 normalised distance
+             * (and 0 for bump_map and image_pattern) */
+            im->interpolate = sdl_to_int(sdl_float(p));
+            if (im->interpolate < 2 || im->interpolate > 4) {
+                if (kind == 0 || im->interpolate != 0) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "invalid interpolate value %d (2, 3 or 4)", im->interpolate);
+            }
+            break;
+        case KW_MAP_TYPE:
+            /* 0 planar, 1 spherical, 2 cylindrical, 5 torus (3.7 refuses the rest) */
+            im->map_type = sdl_to_int(sdl_float(p));
+            if (im->map_type != 0 && im->map_type != 1 && im->map_type != 2 && im->map_type != 5)
+                sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "invalid map_type value %d (0, 1, 2 or 5)", im->map_type);
+            break;
+        case KW_USE_COLOR: case KW_USE_COLOUR: im->use_index = 0; break;
+        case KW_USE_INDEX: im->use_index = kind == 2; break; /* only bump_map heights change (POV-Ray 3.7) */
         case KW_USE_ALPHA: im->use_alpha = 1; break;
         case KW_BUMP_SIZE:
             if (kind == 2 && amount) *amount = sdl_float(p);
@@ -261,25 +284,41 @@ static void image_block(sdl_parser *p, scene_image_map *im, int kind, double *am
         case KW_REPEAT: case KW_OFFSET: {
             double uv[2];
             sdl_vector_n(p, uv, 2);
-            sdl_warn_once(p, t.tk.loc, "image_map %s is not supported and is ignored", sdl_kw_text(k));
+            if (k == KW_REPEAT) {
+                if (uv[0] <= 0.0 || uv[1] <= 0.0) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "zero or negative image repeat vector");
+                im->repeat_u = uv[0];
+                im->repeat_v = uv[1];
+            } else if (im->image) {
+                im->offset_x = -uv[0] * im->image->width;
+                im->offset_y = -uv[1] * im->image->height;
+            }
             break;
         }
         case KW_FILTER: case KW_TRANSMIT: case KW_ALPHA: {
             int filter = k != KW_TRANSMIT;
+            scene_image *img = (scene_image *)im->image; /* this image_map's own copy */
+            int indexed = img && img->indices && img->pixels;
             if (sdl_accept_kw(p, KW_ALL)) {
                 double v = sdl_float(p);
-                if (filter) {
-                    im->filter_all = v;
+                if (indexed) {
+                    /* palette images: every palette entry gets the value */
+                    palette_set(img, -1, filter ? 3 : 4, v);
+                } else if (filter) {
+                    im->filter_all = v;  /* added to each pixel's own */
                     im->filter_all_set = 1;
                 } else {
                     im->transmit_all = v;
                     im->transmit_all_set = 1;
                 }
             } else {
-                sdl_float(p);
+                /* filter N, v: palette entry N (POV-Ray rounds N + 0.01 down) */
+                src_loc rloc = sdl_peek(p)->tk.loc;
+                int reg = sdl_to_int(sdl_float(p) + 0.01);
                 sdl_accept(p, TOK_COMMA);
-                sdl_float(p);
-                sdl_warn_once(p, t.tk.loc, "image_map filter/transmit of one palette index is not supported");
+                double v = sdl_float(p);
+                if (img && !img->indices) sdl_error(p, rloc, PT_ERR_SYNTAX, "%s of one colour register needs a palette image", filter ? "filter" : "transmit");
+                else if (reg < 0 || reg > 255) sdl_error(p, rloc, PT_ERR_SYNTAX, "%s colour register %d out of range", filter ? "filter" : "transmit", reg);
+                else if (indexed) palette_set(img, reg, filter ? 3 : 4, v);
             }
             break;
         }

@@ -118,12 +118,14 @@ static vec3 bump_map(const scene_normal *nm, vec3 n, vec3 tp)
     double xc, yc;
     if (!pattern_image_pos(im, tp, &xc, &yc)) return n;
     double w = im->image->width, h = im->image->height, a = nm->amount;
-    double h1 = a * grey(pattern_image_at(im, xc, yc));
+    /* use_index on a palette image: heights are the palette indices */
+    int by_index = im->use_index && im->image->indices;
+    double h1 = a * (by_index ? pattern_image_index(im, xc, yc) : grey(pattern_image_at(im, xc, yc)));
     xc = wrap_coord(xc - 1.0, w);
     yc = wrap_coord(yc + 1.0, h);
-    double h2 = a * grey(pattern_image_at(im, xc, yc));
+    double h2 = a * (by_index ? pattern_image_index(im, xc, yc) : grey(pattern_image_at(im, xc, yc)));
     xc = wrap_coord(xc + 2.0, w);
-    double h3 = a * grey(pattern_image_at(im, xc, yc));
+    double h3 = a * (by_index ? pattern_image_index(im, xc, yc) : grey(pattern_image_at(im, xc, yc)));
     vec3 p1 = v3(0, h1, 0), p2 = v3(-1, h2, 1), p3 = v3(1, h3, 1);
     vec3 bn = v3_norm(v3_cross(v3_sub(p3, p2), v3_sub(p1, p2)));
     vec3 yp = n, xp = v3_cross(yp, v3(0, 1, 0));

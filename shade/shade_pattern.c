@@ -1000,7 +1000,10 @@ static double wrap_to(double v, double n)
 static int image_uv(const scene_image_map *im, vec3 p, double *u, double *v)
 {
     const scene_image *img = im->image;
-    double w = img->width, h = img->height;
+    /* the mapped size: the image's, times `repeat` (POV-Ray's width/height
+     * beside iwidth/iheight) */
+    double w = img->width * (im->repeat_u > 0.0 ? im->repeat_u : 1.0);
+    double h = img->height * (im->repeat_v > 0.0 ? im->repeat_v : 1.0);
     double x = p.x, y = p.y, z = p.z;
     switch (im->map_type) {
     case 1: { /* spherical */
@@ -1066,14 +1069,24 @@ static colour5 pixel(const scene_image_map *im, double xc, double yc)
     return c;
 }
 
+int pattern_image_index(const scene_image_map *im, double xc, double yc)
+{
+    const scene_image *img = im->image;
+    if (!img || !img->indices) return -1;
+    int ix = noise_to_int(wrap_to(xc, img->width)), iy = noise_to_int(wrap_to(yc, img->height));
+    if (ix < 0 || ix >= img->width) ix = 0;
+    if (iy < 0 || iy >= img->height) iy = 0;
+    return img->indices[(size_t)iy * img->width + ix];
+}
+
 int pattern_image_pos(const scene_image_map *im, vec3 tp, double *x, double *y)
 {
     if (!im->image || !im->image->pixels) return 0;
     double xc = 0.0, yc = 0.0;
     if (!image_uv(im, tp, &xc, &yc)) return 0;
     double w = im->image->width, h = im->image->height;
-    xc += PAT_EPSILON;
-    yc += PAT_EPSILON;
+    xc += im->offset_x + PAT_EPSILON;
+    yc += im->offset_y + PAT_EPSILON;
     if (im->once && (xc >= w || yc >= h || xc < 0.0 || yc < 0.0)) return 0;
     *x = wrap_to(xc, w);
     *y = wrap_to(-yc, h); /* image rows run top-down */
@@ -1092,8 +1105,37 @@ int pattern_image_colour(const scene_image_map *im, vec3 tp, colour5 *out)
     return 1;
 }
 
+/* Catmull-Rom weights of the four samples around x (POV-Ray 3.7's bicubic
+ * image interpolation, after Hagan, C Programmer's Journal 9(8)). */
+static void cubic_weights(double x, double f[4])
+{
+    double p = x - (int)x, q = 1.0 - p;
+    f[0] = -0.5 * p * q * q;
+    f[1] = 0.5 * q * (q * (3.0 * p + 1.0) + 1.0);
+    f[2] = 0.5 * p * (p * (3.0 * q + 1.0) + 1.0);
+    f[3] = -0.5 * q * p * p;
+}
+
 colour5 pattern_image_at(const scene_image_map *im, double xc, double yc)
 {
+    if (im->interpolate == 3) {
+        xc += 0.5;
+        yc += 0.5;
+        int ix = noise_to_int(xc), iy = noise_to_int(yc);
+        double fx[4], fy[4];
+        cubic_weights(xc, fx);
+        cubic_weights(yc, fy);
+        colour5 r = {0, 0, 0, 0, 0};
+        for (int i = 0; i < 4; i++)
+            for (int j = 0; j < 4; j++) {
+                colour5 c = pixel(im, (double)ix + i - 2, (double)iy + j - 2);
+                double f = fx[i] * fy[j];
+                r.r += c.r * f; r.g += c.g * f; r.b += c.b * f; r.f += c.f * f; r.t += c.t * f;
+            }
+        /* POV-Ray sums in double and keeps the colour in single precision */
+        colour5 out = {(float)r.r, (float)r.g, (float)r.b, (float)r.f, (float)r.t};
+        return out;
+    }
     if (im->interpolate != 2 && im->interpolate != 4) return pixel(im, xc, yc);
     xc += 0.5;
     yc += 0.5;

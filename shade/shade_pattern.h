@@ -47,6 +47,9 @@ int pattern_image_colour(const scene_image_map *im, vec3 tp, colour5 *out);
 /* The image coordinates (pixels, wrapped, row 0 at the top) of a warped
  * point (POV-Ray's map_pos); 0 outside a `once` image or without pixels. */
 int pattern_image_pos(const scene_image_map *im, vec3 tp, double *x, double *y);
+/* The palette index of the pixel at image coordinates (nearest pixel), -1
+ * for images without a palette. */
+int pattern_image_index(const scene_image_map *im, double x, double y);
 /* The image's colour at image coordinates, interpolated as asked. */
 colour5 pattern_image_at(const scene_image_map *im, double x, double y);
 

@@ -1,7 +1,7 @@
 /* test_pattern.c - pattern values against POV-Ray 3.7 itself (issue 5).
  *
- * Every pattern is shown through a grey colour_map on its own tile (a box
- * face) seen by an orthographic camera with ambient 1, diffuse 0, so each
+ * Every pattern is shown through a grey colour_map on its own tile (a
+ * polygon) seen by an orthographic camera with ambient 1, diffuse 0, so each
  * pixel of POV-Ray's 16-bit PNG is the pattern's value at a known point; one
  * POV-Ray run renders all tiles. partray parses the same scene and evaluates
  * each box's pigment at each pixel's point directly (parser + IR +
@@ -33,6 +33,8 @@
 #define MAX_BAD 0.01   /* fraction of a tile's pixels allowed to disagree */
 
 static char tmpdir[256];
+
+static double clamp01(double v) { return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v); }
 
 static int run(const char *cmd)
 {
@@ -113,13 +115,13 @@ static const pattern_case cases[] = {
 };
 #define NCASES ((int)(sizeof cases / sizeof cases[0]))
 
-/* One POV-Ray render shows every pattern on its own tile (a box face at
+/* One POV-Ray render shows every case on its own tile (a box face at
  * z = 0); partray parses the same scene and evaluates each box's pigment at
- * every pixel's point. */
-static void test_patterns(void **st)
+ * every pixel's point. With a black background POV-Ray's pixel is the
+ * pigment's rgb * (1 - filter - transmit) (ambient 1, 3.7's attenuation). */
+static int run_tiles(const pattern_case *cs, int ncases, const char *tag)
 {
-    (void)st;
-    int rows = (NCASES + COLS - 1) / COLS;
+    int rows = (ncases + COLS - 1) / COLS;
     int w = COLS * TILE, h = rows * TILE;
     double ww = COLS * TSPAN, wh = rows * TSPAN;
     size_t cap = 65536, len = 0;
@@ -129,22 +131,24 @@ static void test_patterns(void **st)
                             "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
                             "camera { orthographic location <%g, %g, -10> direction z right x*%g up y*%g }\n",
                             ww / 2, -wh / 2, ww, wh);
-    for (int i = 0; i < NCASES; i++) {
+    for (int i = 0; i < ncases; i++) {
         double x0 = (i % COLS) * TSPAN, y0 = -(i / COLS + 1) * TSPAN;
-        len += (size_t)snprintf(src + len, cap - len, "box { <%g, %g, 0>, <%g, %g, 1> pigment { %s } finish { ambient 1 diffuse 0 } }\n",
-                                x0, y0, x0 + TSPAN, y0 + TSPAN, cases[i].pigment);
+        /* a polygon, so a transparent pigment shows the black background */
+        len += (size_t)snprintf(src + len, cap - len,
+                                "polygon { 4, <%g, %g, 0>, <%g, %g, 0>, <%g, %g, 0>, <%g, %g, 0> pigment { %s } finish { ambient 1 diffuse 0 } }\n",
+                                x0, y0, x0 + TSPAN, y0, x0 + TSPAN, y0 + TSPAN, x0, y0 + TSPAN, cs[i].pigment);
         assert_true(len < cap);
     }
     char path[512], png[512], cmd[2048];
-    snprintf(path, sizeof path, "%s/patterns.pov", tmpdir);
-    snprintf(png, sizeof png, "%s/patterns.png", tmpdir);
+    snprintf(path, sizeof path, "%s/%s.pov", tmpdir, tag);
+    snprintf(png, sizeof png, "%s/%s.png", tmpdir, tag);
     FILE *f = fopen(path, "w");
     assert_non_null(f);
     fputs(src, f);
     fclose(f);
-    snprintf(cmd, sizeof cmd, "cd '%s' && povray +Ipatterns.pov +Opatterns.png +W%d +H%d -A -D -V -GA +FN16 >patterns.log 2>&1",
-             tmpdir, w, h);
-    if (run(cmd) != 0) fail_msg("povray failed (see %s/patterns.log)", tmpdir);
+    snprintf(cmd, sizeof cmd, "cd '%s' && povray +I%s.pov +O%s.png +W%d +H%d -A -D -V -GA +FN16 >%s.log 2>&1", tmpdir, tag, tag,
+             w, h, tag);
+    if (run(cmd) != 0) fail_msg("povray failed (see %s/%s.log)", tmpdir, tag);
     framebuffer *fb = NULL;
     assert_int_equal(img_read(png, 0, &fb, NULL), PT_OK);
     assert_int_equal(fb->width, w);
@@ -153,11 +157,16 @@ static void test_patterns(void **st)
     sdl_default_options(&so);
     scene *sc = NULL;
     diag *d = diag_new();
-    assert_int_equal(sdl_parse_string("patterns", src, &so, &sc, d), PT_OK);
-    assert_int_equal(sc->nobjects, NCASES);
+    char cwd[1024];
+    assert_non_null(getcwd(cwd, sizeof cwd));
+    assert_int_equal(chdir(tmpdir), 0); /* image files are found beside the scene */
+    pt_status st = sdl_parse_string(tag, src, &so, &sc, d);
+    assert_int_equal(chdir(cwd), 0);
+    assert_int_equal(st, PT_OK);
+    assert_int_equal(sc->nobjects, ncases);
     pattern_ctx pc = pattern_ctx_plain(sc);
     int failed = 0;
-    for (int i = 0; i < NCASES; i++) {
+    for (int i = 0; i < ncases; i++) {
         const scene_texture *tex = sc->objects[i]->texture;
         assert_non_null(tex);
         int tx = (i % COLS) * TILE, ty = (i / COLS) * TILE, bad = 0, n = 0;
@@ -167,22 +176,164 @@ static void test_patterns(void **st)
                 vec3 p = v3((x + 0.5) / w * ww, -(y + 0.5) / h * wh, 0.0);
                 colour5 c;
                 pigment_eval(&tex->pigment, xform_inv_point(&tex->transform, p), &pc, &c);
+                double k = 1.0 - c.f - c.t;
                 const float *px = fb_px(fb, x, y);
-                double dmax = fmax(fabs(c.r - px[0]), fmax(fabs(c.g - px[1]), fabs(c.b - px[2])));
+                /* the PNG holds 0..1 (bicubic images overshoot) */
+                double dmax = fmax(fabs(clamp01(c.r * k) - px[0]), fmax(fabs(clamp01(c.g * k) - px[1]), fabs(clamp01(c.b * k) - px[2])));
                 if (dmax > 2e-3) bad++;
                 if (dmax > worst) worst = dmax;
                 n++;
             }
         }
         double frac = (double)bad / n;
-        printf("pattern %-16s %6.2f%% of pixels differ (worst %.4f)\n", cases[i].name, 100.0 * frac, worst);
+        printf("%s %-16s %6.2f%% of pixels differ (worst %.4f)\n", tag, cs[i].name, 100.0 * frac, worst);
         if (frac > MAX_BAD) failed++;
     }
     scene_free(sc);
     diag_free(d);
     fb_free(fb);
     free(src);
-    assert_int_equal(failed, 0);
+    return failed;
+}
+
+static void test_patterns(void **st)
+{
+    (void)st;
+    assert_int_equal(run_tiles(cases, NCASES, "patterns"), 0);
+}
+
+/* ------------------------------------------------------------ image_map options */
+
+/* A minimal PNG writer (stored deflate blocks) for the test images: 8-bit
+ * RGB (colour type 2) or palette (type 3, with a tRNS chunk when given). */
+static unsigned long crc_table[256];
+static unsigned long crc32_of(const unsigned char *b, size_t n, unsigned long c)
+{
+    if (!crc_table[1])
+        for (unsigned long i = 0; i < 256; i++) {
+            unsigned long v = i;
+            for (int k = 0; k < 8; k++) v = (v & 1) ? 0xEDB88320UL ^ (v >> 1) : v >> 1;
+            crc_table[i] = v;
+        }
+    c ^= 0xFFFFFFFFUL;
+    for (size_t i = 0; i < n; i++) c = crc_table[(c ^ b[i]) & 0xFF] ^ (c >> 8);
+    return c ^ 0xFFFFFFFFUL;
+}
+
+static void put32(unsigned char *b, unsigned long v)
+{
+    b[0] = (unsigned char)(v >> 24); b[1] = (unsigned char)(v >> 16); b[2] = (unsigned char)(v >> 8); b[3] = (unsigned char)v;
+}
+
+static void chunk(FILE *f, const char *type, const unsigned char *data, size_t n)
+{
+    unsigned char h[8];
+    put32(h, (unsigned long)n);
+    memcpy(h + 4, type, 4);
+    fwrite(h, 1, 8, f);
+    if (n) fwrite(data, 1, n, f);
+    unsigned long c = crc32_of((const unsigned char *)type, 4, 0);
+    c = crc32_of(data, n, c);
+    put32(h, c);
+    fwrite(h, 1, 4, f);
+}
+
+static void write_png(const char *name, int w, int h, int bpp, const unsigned char *pix, const unsigned char *plte, int nplte,
+                      const unsigned char *trns, int ntrns)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s", tmpdir, name);
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fwrite("\x89PNG\r\n\x1a\n", 1, 8, f);
+    unsigned char ihdr[13];
+    put32(ihdr, (unsigned long)w);
+    put32(ihdr + 4, (unsigned long)h);
+    ihdr[8] = 8;
+    ihdr[9] = bpp == 1 ? 3 : 2;
+    ihdr[10] = ihdr[11] = ihdr[12] = 0;
+    chunk(f, "IHDR", ihdr, 13);
+    if (plte) chunk(f, "PLTE", plte, (size_t)nplte * 3);
+    if (trns) chunk(f, "tRNS", trns, (size_t)ntrns);
+    size_t row = (size_t)w * bpp + 1, raw = row * h;
+    unsigned char *z = malloc(raw + raw / 65535 * 5 + 16);
+    assert_non_null(z);
+    size_t n = 0;
+    z[n++] = 0x78;
+    z[n++] = 0x01;
+    unsigned long a = 1, b = 0;
+    unsigned char *flat = malloc(raw);
+    assert_non_null(flat);
+    for (int y = 0; y < h; y++) {
+        flat[y * row] = 0;
+        memcpy(flat + y * row + 1, pix + (size_t)y * w * bpp, (size_t)w * bpp);
+    }
+    for (size_t i = 0; i < raw; i++) {
+        a = (a + flat[i]) % 65521;
+        b = (b + a) % 65521;
+    }
+    for (size_t off = 0; off < raw;) {
+        size_t len = raw - off > 65535 ? 65535 : raw - off;
+        z[n++] = off + len == raw ? 1 : 0;
+        z[n++] = (unsigned char)(len & 0xFF);
+        z[n++] = (unsigned char)(len >> 8);
+        z[n++] = (unsigned char)(~len & 0xFF);
+        z[n++] = (unsigned char)((~len >> 8) & 0xFF);
+        memcpy(z + n, flat + off, len);
+        n += len;
+        off += len;
+    }
+    put32(z + n, (b << 16) | a);
+    n += 4;
+    chunk(f, "IDAT", z, n);
+    chunk(f, "IEND", NULL, 0);
+    fclose(f);
+    free(z);
+    free(flat);
+}
+
+/* image_map and image_pattern options against POV-Ray 3.7: repeat, offset,
+ * bicubic interpolation, the mapping types, once, filter/transmit of a
+ * palette entry and of all entries, transmit all on an RGB image. */
+static const pattern_case image_cases[] = {
+    {"planar", "image_map { png \"xi_rgb.png\" } scale 1.5"},
+    {"repeat", "image_map { png \"xi_rgb.png\" repeat <2, 3> } scale 1.5"},
+    {"offset", "image_map { png \"xi_rgb.png\" offset <0.3, -0.2> } scale 1.5"},
+    {"rep_offset", "image_map { png \"xi_rgb.png\" repeat <0.5, 2> offset <0.25, 0.5> } scale 2"},
+    {"bilinear", "image_map { png \"xi_rgb.png\" interpolate 2 } scale 1.3"},
+    {"bicubic", "image_map { png \"xi_rgb.png\" interpolate 3 } scale 1.3"},
+    {"normdist", "image_map { png \"xi_rgb.png\" interpolate 4 } scale 1.3"},
+    {"once", "image_map { png \"xi_rgb.png\" once interpolate 3 } scale 1.2 translate <0.4, 0.6, 0>"},
+    {"spherical", "image_map { png \"xi_rgb.png\" map_type 1 } translate <1.5, 1.5, 0.5>"},
+    {"cylindrical", "image_map { png \"xi_rgb.png\" map_type 2 repeat <1, 2> } translate <1.5, 0, 0.5> scale <1, 0.5, 1>"},
+    {"torus", "image_map { png \"xi_rgb.png\" map_type 5 interpolate 2 } rotate x*90 translate <1.5, 1.5, 0.3>"},
+    {"pal_filter", "image_map { png \"xi_pal.png\" filter 1, 0.7 transmit 2, 0.4 } scale 1.5"},
+    {"pal_all", "image_map { png \"xi_pal.png\" transmit all 0.3 filter 3, 0.5 } scale 1.5"},
+    {"pal_trns_all", "image_map { png \"xi_trns.png\" transmit all 0.2 } scale 1.5"},
+    {"rgb_all", "image_map { png \"xi_rgb.png\" transmit all 0.3 filter all 0.2 } scale 1.5"},
+    {"pattern_rep", "image_pattern { png \"xi_rgb.png\" repeat <3, 1> offset <0.1, 0> interpolate 3 } " GREY " scale 1.5"},
+};
+#define NIMAGE ((int)(sizeof image_cases / sizeof image_cases[0]))
+
+static void test_image_options(void **st)
+{
+    (void)st;
+    enum { IW = 7, IH = 5 };
+    unsigned char rgb[IW * IH * 3], pal[IW * IH];
+    for (int y = 0; y < IH; y++)
+        for (int x = 0; x < IW; x++) {
+            unsigned char *q = rgb + (y * IW + x) * 3;
+            q[0] = (unsigned char)(x * 255 / (IW - 1));
+            q[1] = (unsigned char)(y * 255 / (IH - 1));
+            q[2] = (unsigned char)(((x + y) & 1) ? 230 : 25);
+            pal[y * IW + x] = (unsigned char)((x + 2 * y) % 4);
+        }
+    static const unsigned char plte[12] = {250, 40, 40, 40, 220, 40, 40, 60, 240, 230, 230, 60};
+    static const unsigned char trns[4] = {255, 128, 0, 200};
+    write_png("xi_rgb.png", IW, IH, 3, rgb, NULL, 0, NULL, 0);
+    write_png("xi_pal.png", IW, IH, 1, pal, plte, 4, NULL, 0);
+    write_png("xi_trns.png", IW, IH, 1, pal, plte, 4, trns, 4);
+    assert_int_equal(run_tiles(image_cases, NIMAGE, "images"), 0);
 }
 
 /* Closed forms: ranges and the blend-map search. */
@@ -236,6 +387,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_noise_closed_form),
         cmocka_unit_test(test_patterns),
+        cmocka_unit_test(test_image_options),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     if (rc == 0) {
