@@ -283,6 +283,12 @@ struct scene_object {
      * any distance ahead) or starts inside it (POV-Ray's Ray_In_Bound).
      * NULL = none. */
     const scene_object *bound;
+    /* light_group (appended, issue 5): the innermost group holding the
+     * object (0 none; lights with that `group` light it) and whether
+     * the scene's global lights are kept from it (global_lights off, the
+     * default inside a group) */
+    int light_group;
+    int no_global_lights;
 };
 
 /* ---------------------------------------------------------------- lights */
@@ -310,7 +316,17 @@ typedef struct {
     int media_interaction, media_attenuation;
     const scene_object *looks_like;
     const scene_object *projected_through; /* appended (issue 5): light only through it (shade_project.c) */
+    int group;              /* appended (issue 5): light_group id (lights only its objects), 0 = global */
 } scene_light;
+
+/* Whether light l lights object o (POV-Ray 3.7's light groups: a group's
+ * lights light only its objects; global lights light everything else, and
+ * a group's objects only with global_lights on). */
+static inline int scene_light_reaches(const scene_light *l, const scene_object *o)
+{
+    if (!o) return l->group == 0;
+    return l->group ? o->light_group == l->group : !o->no_global_lights;
+}
 
 /* ---------------------------------------------------------------- camera */
 typedef enum {

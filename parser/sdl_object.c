@@ -898,6 +898,17 @@ static sdl_obj *unsupported_shape(sdl_parser *p, const sdl_tok *k)
     return so;
 }
 
+/* Objects of a light_group not already in an inner one join group id; the
+ * global_lights setting of the outermost group wins for all of them, as
+ * POV-Ray's Set_CSG_Children_Flag overwrites the inner groups' flags. */
+static void mark_light_group(scene_object *o, int id, int no_global)
+{
+    if (!o->light_group) o->light_group = id;
+    o->no_global_lights = no_global;
+    if (is_csg(o))
+        for (int i = 0; i < o->u.csg.nkids; i++) mark_light_group(o->u.csg.kids[i], id, no_global);
+}
+
 sdl_obj *sdl_parse_object(sdl_parser *p)
 {
     sdl_tok k = sdl_next(p);
@@ -907,7 +918,6 @@ sdl_obj *sdl_parse_object(sdl_parser *p)
     }
     if (k.tk.kw == KW_LIGHT_SOURCE) return sdl_parse_light(p, k.tk.loc);
     if (is_unsupported_shape(k.tk.kw) && !sdl_shape_handles(k.tk.kw)) return unsupported_shape(p, &k);
-    if (k.tk.kw == KW_LIGHT_GROUP) sdl_warn_once(p, k.tk.loc, "light_group is treated as a union (its lights light the whole scene)");
     const char *name = sdl_kw_text(k.tk.kw);
     if (!sdl_begin_block(p, name)) return NULL;
     sdl_obj *so = k.tk.kw == KW_OBJECT ? object_body(p) : object_identifier(p);
@@ -917,11 +927,22 @@ sdl_obj *sdl_parse_object(sdl_parser *p)
         shape_args(p, k.tk.kw, so, k.tk.loc);
     }
     sdl_object_mods(p, so);
-    /* light_group: global_lights [bool] may stand among the modifiers */
+    /* light_group: global_lights [bool] may stand among the modifiers
+     * (default off: POV-Ray 3.7's Parse_Light_Group) */
+    int global_lights = 0;
     while (k.tk.kw == KW_LIGHT_GROUP && sdl_ok(p) && sdl_accept_kw(p, KW_GLOBAL_LIGHTS)) {
-        sdl_allow_float(p, 1.0);
+        global_lights = sdl_allow_float(p, 1.0) > 0.5;
         sdl_object_mods(p, so);
     }
     if (!sdl_end_block(p)) return NULL;
+    if (k.tk.kw == KW_LIGHT_GROUP) {
+        /* the group's own lights (not those of inner groups) light only its
+         * objects; objects of inner groups keep their group's lights only
+         * (POV-Ray's Promote_Local_Lights) */
+        int id = ++p->nlight_groups;
+        for (int i = 0; i < so->nlights; i++)
+            if (so->lights[i].group == 0) so->lights[i].group = id;
+        if (so->obj) mark_light_group(so->obj, id, !global_lights);
+    }
     return so;
 }

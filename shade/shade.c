@@ -170,6 +170,7 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
     int double_illum = (h->obj->flags & OBJ_DOUBLE_ILLUMINATE) != 0;
     for (int i = 0; i < c->sc->nlights; i++) {
         const scene_light *l = &c->sc->lights[i];
+        if (!scene_light_reaches(l, h->obj)) continue; /* light_group */
         vec3 dir;
         double depth;
         light_ray(l, l->position, p, &dir, &depth);
