@@ -314,8 +314,10 @@ static vec3 mesh_normal(const scene_object *o, const scene_mesh *m, int t, doubl
 {
     vec3 a = mesh_vert(m, m->tris[t][0]), b = mesh_vert(m, m->tris[t][1]), c = mesh_vert(m, m->tris[t][2]);
     vec3 n = v3_cross(v3_sub(c, a), v3_sub(b, a)); /* POV-Ray's mesh triangle normal */
-    if (m->normals && m->tri_normals) {
-        const int *ni = m->tri_normals[t];
+    /* normals per corner (tri_normals), or per vertex when there are as many
+     * (bicubic_patch meshes), as the renderer reads them */
+    const int *ni = m->normals ? (m->tri_normals ? m->tri_normals[t] : (m->nnormals == m->nverts ? m->tris[t] : NULL)) : NULL;
+    if (ni) {
         vec3 s = v3(0, 0, 0);
         double w[3] = {1 - u - v, u, v};
         for (int i = 0; i < 3; i++)

@@ -579,7 +579,9 @@ static void mesh_triangle(sdl_parser *p, mesh_build *b, int smooth)
     if (!sdl_ok(p)) return;
     int vi[3], ni[3];
     for (int i = 0; i < 3; i++) vi[i] = add_vec(p, b, &b->v, &b->nv, &b->capv, v[i]);
-    if (!smooth) n[0] = n[1] = n[2] = v3_cross(v3_sub(v[1], v[0]), v3_sub(v[2], v[0]));
+    /* a flat triangle among smooth ones keeps POV-Ray's face normal
+     * (P3-P1) x (P2-P1) (Mesh::Compute_Mesh_Triangle), which trace() reports */
+    if (!smooth) n[0] = n[1] = n[2] = v3_cross(v3_sub(v[2], v[0]), v3_sub(v[1], v[0]));
     for (int i = 0; i < 3; i++) ni[i] = add_vec(p, b, &b->n, &b->nn, &b->capn, n[i]);
     if (smooth) b->any_normals = 1;
     if (sdl_ok(p)) add_tri(p, b, vi, ni, tex);

@@ -991,11 +991,13 @@ static void bicubic_args(sdl_parser *p, sdl_obj *so, src_loc loc)
                     du = v3_madd(du, cp[i][j], bv[i] * dbu[j]);
                     dv = v3_madd(dv, cp[i][j], dbv[i] * bu[j]);
                 }
-            vec3 nrm = v3_cross(du, dv);
+            /* dv x du: the side POV-Ray's patch normal points to (trace() on a
+             * bicubic_patch matches povray 3.7's normals with this sign) */
+            vec3 nrm = v3_cross(dv, du);
             if (!(v3_len2(nrm) > 0.0)) {
                 /* degenerate edge (a collapsed row): use the neighbouring cell's diagonal */
                 vec3 e1 = v3_sub(cp[3][3], cp[0][0]), e2 = v3_sub(cp[3][0], cp[0][3]);
-                nrm = v3_cross(e1, e2);
+                nrm = v3_cross(e2, e1);
             }
             int k = a * (nu + 1) + b;
             m->verts[k][0] = (float)pt.x;

@@ -34,4 +34,25 @@ TT("polygon", polygon { 4, <0, 0>, <1, 0>, <0, 1>, <0, 0> rotate 10 * y }, <0.2,
   T("hf", Hf, Ps[i], -y, Ps[i] * <1, 0.01, 1>)
   T("hfr", object { Hf rotate 20 * x }, Ps[i] * 0.5, <0.1, -1, 0.2>, Ps[i] * <0.5, 0.02, 0.5>)
 #end
+// patches: POV-Ray's triangle normal (P3-P1) x (P2-P1), also for flat
+// triangles in a mesh among smooth ones; smooth normals interpolated, also
+// the vertex normals of a bicubic_patch mesh
+TT("t1", triangle { <0, 0, 0>, <1, 0, 0>, <0, 0, 1> }, <0.2, -3, 0.1>, y)
+TT("t2", triangle { <0, 0, 0>, <0, 0, 1>, <1, 0, 0> }, <0.2, 3, 0.1>, -y)
+TT("s1", smooth_triangle { <0, 0, 0>, <0, 1, 0>, <1, 0, 0>, <1, 1, 0>, <0, 0, 1>, <0, 1, 1> }, <0.2, 3, 0.1>, -y)
+#declare M = mesh {
+  smooth_triangle { <0, 0, 0>, <0, 1, 0>, <1, 0, 0>, <1, 1, 0>, <0, 0, 1>, <0, 1, 1> }
+  triangle { <0, 0, 1>, <1, 0, 1>, <0, 0, 2> }
+  triangle { <2, 0, 0>, <2, 0, 1>, <3, 0, 0> }
+  rotate 10 * x
+}
+TT("m1", M, <0.3, 3, 0.1>, -y)
+TT("m2", M, <0.3, 3, 1.2>, -y)
+TT("m3", M, <2.2, -3, 0.2>, y)
+#declare B = bicubic_patch { type 1 u_steps 3 v_steps 3
+  <0, 0, 0>, <1, 0, 0>, <2, 0, 0>, <3, 0, 0>, <0, 0, 1>, <1, 1, 1>, <2, 1, 1>, <3, 0, 1>,
+  <0, 0, 2>, <1, 1, 2>, <2, 1, 2>, <3, 0, 2>, <0, 0, 3>, <1, 0, 3>, <2, 0, 3>, <3, 0, 3> }
+TT("b1", B, <1.5, 3, 1.5>, -y)
+TT("b2", B, <0.7, 3, 1.1>, -y)
+T("sweep", sphere_sweep { linear_spline 2, <0, 0, 0>, 0.5, <1, 0, 0>, 0.25 }, <0.5, 3, 0.1>, -y, <0.9, 0.1, 0>)
 sphere { 0, 1 }
