@@ -1383,6 +1383,23 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
     return isfinite(hit->t) && v3_finite(hit->p);
 }
 
+const scene_object *accel_rtc_object(const accel *a, unsigned geom, unsigned prim, unsigned inst)
+{
+    if (!a || geom == RTC_INVALID_GEOMETRY_ID) return NULL;
+    if (inst != RTC_INVALID_GEOMETRY_ID) {
+        if (inst >= a->nginfo || a->ginfo[inst].kind != GEOM_INSTANCE) return NULL;
+        return a->leaves[a->ginfo[inst].idx].obj;
+    }
+    if (geom >= a->nginfo) return NULL;
+    if (a->ginfo[geom].kind == GEOM_TRI) {
+        const tri_batch *b = &a->tri[a->ginfo[geom].idx];
+        if ((size_t)prim >= b->nt) return NULL;
+        return a->leaves[b->refs[prim].leaf].obj;
+    }
+    if (a->ginfo[geom].kind == GEOM_USER && prim < (unsigned)a->nshapes) return a->leaves[a->shape_leaf[prim]].obj;
+    return NULL;
+}
+
 int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax)
 {
     if (!a || !ray_ok(org, dir)) return 0;

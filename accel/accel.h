@@ -63,6 +63,11 @@ double accel_eps_scale(const accel *a);
 accel_stats accel_get_stats(const accel *a);
 /* The underlying RTCScene (as void*), for benchmarks that drive Embree directly. */
 void *accel_rtc_scene(const accel *a);
+/* The leaf object of a hit that rtcIntersect on accel_rtc_scene reported
+ * (geomID, primID and instID[0] of its RTCHit), as accel_intersect would
+ * give it; NULL when the record alone does not tell (a member of a CSG) or
+ * the ids are invalid. */
+const scene_object *accel_rtc_object(const accel *a, unsigned geom, unsigned prim, unsigned inst);
 /* The smallest ray parameter queries accept (see the self-intersection rule). */
 double accel_epsilon(const accel *a, vec3 org, vec3 dir);
 

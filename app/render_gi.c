@@ -211,6 +211,7 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
         stats_int(js, "list_entries", p->list_entries);
         stats_int(js, "link_rays", p->link_rays);
         stats_int(js, "link_misses", p->link_misses);
+        stats_int(js, "visibility_rays", p->visibility_rays);
         stats_int(js, "sources", p->sources);
         stats_int(js, "bounces", p->bounces);
         stats_int(js, "found", p->found);

@@ -46,7 +46,9 @@ typedef struct {
     struct RTCRayHit **buf; /* per thread */
     vec3 **hp;
     long **cell;
-    atomic_long misses, unresolved;
+    atomic_long misses, unresolved, other;
+    const void *const *pobj;
+    const unsigned char *pin;
     double off, scale;
     int *order; /* stratum of the j-th ray of a particle */
     int coherent;
@@ -75,13 +77,23 @@ static void direction_f(const float t[3], const float b[3], const float nrm[3], 
     for (int k = 0; k < 3; k++) out[k] = t[k] * x + b[k] * y + nrm[k] * z;
 }
 
+#define AGREE 0.3
+
+/* Particle t moved a little along its normal, inside solid o? */
+static int inside_lifted(const scene_object *o, const gi_dev_particle *t)
+{
+    vec3 p = v3(t->p[0], t->p[1], t->p[2]);
+    double lift = 1e-5 * (1.0 + fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
+    return gi_surface_inside_solid(o, v3_madd(p, v3(t->n[0], t->n[1], t->n[2]), lift));
+}
+
 static void job(void *ctx, int index, int thread)
 {
     link_job *J = ctx;
     struct RTCRayHit *rh = J->buf[thread];
     int i0 = index * J->per_job, i1 = i0 + J->per_job < J->n ? i0 + J->per_job : J->n;
     int m = 0;
-    long miss = 0, unres = 0;
+    long miss = 0, unres = 0, other = 0;
     for (int i = i0; i < i1; i++) {
         const gi_dev_particle *pt = &J->p[i];
         vec3 pos = v3(pt->p[0], pt->p[1], pt->p[2]);
@@ -144,6 +156,7 @@ static void job(void *ctx, int index, int thread)
     m = 0;
     for (int i = i0; i < i1; i++) {
         int any = 0;
+        const gi_dev_particle *pt_i = &J->p[i];
         for (int j = 0; j < J->k; j++, m++) {
             int hit = cell[m] != -2;
             any |= hit;
@@ -155,6 +168,67 @@ static void job(void *ctx, int index, int thread)
                 vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
                 vec3 o = v3(h->ray.org_x, h->ray.org_y, h->ray.org_z);
                 target = gi_lookup_nearest_in(J->grid, cell[m], hp[m], d, o, J->maxdist);
+                if (target >= 0 && J->pobj) {
+                    /* the answer must lie on the object hit: near a contact
+                     * (a sphere on the floor) or where a box stands on the
+                     * floor the nearest particle can be another object's,
+                     * on the other side of a wall */
+                    const void *ho = accel_rtc_object(J->a, h->hit.geomID, h->hit.primID, h->hit.instID[0]);
+                    /* and on the face and side hit: its normal agrees with
+                     * the hit's geometric normal turned to the ray (within
+                     * about 70 degrees; Ng is in world space unless the
+                     * hit is in an instance) */
+                    vec3 agree = v3s(0.0);
+                    if (h->hit.instID[0] == RTC_INVALID_GEOMETRY_ID) {
+                        agree = v3(h->hit.Ng_x, h->hit.Ng_y, h->hit.Ng_z);
+                        if (v3_dot(agree, d) > 0.0) agree = v3_neg(agree);
+                    }
+                    const gi_dev_particle *tp = &J->p[target];
+                    double ag = tp->n[0] * agree.x + tp->n[1] * agree.y + tp->n[2] * agree.z;
+                    if (ho && (J->pobj[target] != ho || ag < AGREE * v3_len(agree))) {
+                        double al = v3_len(agree);
+                        target = gi_lookup_nearest_on(J->grid, hp[m], d, o, J->maxdist, J->pobj, ho,
+                                                      al > 0.0 ? v3_scale(agree, 1.0 / al) : agree, AGREE,
+                                                      J->pin ? J->pin + J->n : NULL);
+                        other++;
+                    }
+                }
+                if (target >= 0 && J->pin && J->pin[i]) {
+                    /* a ray from the inside of a closed sphere or box must
+                     * end inside it too: where the box stands on the floor
+                     * its ray hits the floor (the coplanar faces tie), and
+                     * the nearest floor particle may lie outside the box */
+                    const scene_object *so = J->pobj[i];
+                    if (!inside_lifted(so, &J->p[target])) {
+                        const struct RTCRayHit *h = &rh[m];
+                        vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
+                        vec3 o = v3(h->ray.org_x, h->ray.org_y, h->ray.org_z);
+                        vec3 agree = v3_neg(d);
+                        target = gi_lookup_nearest_on(J->grid, hp[m], d, o, J->maxdist, J->pobj, so, agree, 0.0, NULL);
+                        if (target >= 0 && !inside_lifted(so, &J->p[target])) target = -1;
+                        other++;
+                    }
+                }
+                if (target >= 0 && J->pin && J->pin[J->n + target] && !inside_lifted(J->pobj[J->n + target], pt_i)) {
+                    /* and a ray from outside must not end on a particle
+                     * buried in a closed solid (the floor under a box) */
+                    const struct RTCRayHit *h = &rh[m];
+                    vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
+                    vec3 o = v3(h->ray.org_x, h->ray.org_y, h->ray.org_z);
+                    target = gi_lookup_nearest_on(J->grid, hp[m], d, o, J->maxdist, J->pobj, J->pobj[target],
+                                                  v3_neg(d), 0.0, J->pin + J->n);
+                    other++;
+                }
+                if (target >= 0 && J->pin && J->pin[target] && !inside_lifted(J->pobj[target], pt_i)) {
+                    /* the inside of a closed sphere or box is reached only
+                     * by rays from inside it */
+                    const struct RTCRayHit *h = &rh[m];
+                    vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
+                    vec3 o = v3(h->ray.org_x, h->ray.org_y, h->ray.org_z);
+                    target = gi_lookup_nearest_on(J->grid, hp[m], d, o, J->maxdist, J->pobj, J->pobj[target],
+                                                  v3_neg(d), 0.0, J->pin);
+                    other++;
+                }
                 if (target < 0) unres++;
             }
             J->links[(size_t)i * J->k + J->order[j]] = target;
@@ -163,11 +237,12 @@ static void job(void *ctx, int index, int thread)
     }
     atomic_fetch_add(&J->misses, miss);
     atomic_fetch_add(&J->unresolved, unres);
+    atomic_fetch_add(&J->other, other);
 }
 
-pt_status gi_links_build(const accel *a, const gi_dev_particle *p, int n, int nside, uint64_t seed,
-                         const gi_lookup *grid, double maxdist, int threads, int *links, unsigned char *anyhit,
-                         gi_link_stats *st)
+pt_status gi_links_build(const accel *a, const gi_dev_particle *p, const void *const *pobj,
+                         const unsigned char *pin, int n, int nside, uint64_t seed, const gi_lookup *grid,
+                         double maxdist, int threads, int *links, unsigned char *anyhit, gi_link_stats *st)
 {
     if (threads <= 0) threads = pool_default_threads();
     link_job J;
@@ -175,6 +250,8 @@ pt_status gi_links_build(const accel *a, const gi_dev_particle *p, int n, int ns
     J.a = a;
     J.scene = (RTCScene)accel_rtc_scene(a);
     J.p = p;
+    J.pobj = pobj;
+    J.pin = pobj ? pin : NULL;
     J.n = n;
     J.nside = nside;
     J.k = nside * nside;
@@ -202,6 +279,7 @@ pt_status gi_links_build(const accel *a, const gi_dev_particle *p, int n, int ns
     J.scale = accel_scale(a);
     atomic_init(&J.misses, 0);
     atomic_init(&J.unresolved, 0);
+    atomic_init(&J.other, 0);
     J.buf = calloc((size_t)threads, sizeof *J.buf);
     J.hp = calloc((size_t)threads, sizeof *J.hp);
     J.cell = calloc((size_t)threads, sizeof *J.cell);
@@ -229,6 +307,7 @@ pt_status gi_links_build(const accel *a, const gi_dev_particle *p, int n, int ns
         st->rays += (long)n * J.k;
         st->misses += atomic_load(&J.misses);
         st->unresolved += atomic_load(&J.unresolved);
+        st->other_object += atomic_load(&J.other);
     }
     return rc;
 }

@@ -10,19 +10,29 @@
 #include <stdint.h>
 #include "accel.h"
 #include "gi_particles.h"
+#include "gi_surface.h"
 
 typedef struct {
     long rays;       /* traced */
     long misses;     /* left the scene */
     long unresolved; /* hit, but no particle near the hit on that side */
+    long other_object; /* the nearest particle lay on another object than the one hit: searched again */
 } gi_link_stats;
 
 /* links: n * nside^2 ints (may be NULL when only anyhit is wanted);
  * grid: particle lookup (NULL: links are not resolved); anyhit (may be
- * NULL): 1 where at least one ray of the particle hit something. */
-pt_status gi_links_build(const accel *a, const gi_dev_particle *p, int n, int nside, uint64_t seed,
-                         const gi_lookup *grid, double maxdist, int threads, int *links, unsigned char *anyhit,
-                         gi_link_stats *st);
+ * NULL): 1 where at least one ray of the particle hit something. pobj (may
+ * be NULL): 2n pointers, [0, n) the object (const scene_object *) of each
+ * particle, [n, 2n) the closed solid it is buried in (pin) or NULL; a link then
+ * ends on a particle of the object its ray hit (where accel_rtc_object
+ * knows it), on the side hit. pin (may be NULL): 2n flags: [0, n) 1 for
+ * particles on the inside of a closed sphere or box (their links end
+ * inside it), [n, 2n) 1 for particles buried in another closed sphere or
+ * box (the floor under a box standing on it: only rays from inside that
+ * solid end on them). */
+pt_status gi_links_build(const accel *a, const gi_dev_particle *p, const void *const *pobj,
+                         const unsigned char *pin, int n, int nside, uint64_t seed, const gi_lookup *grid,
+                         double maxdist, int threads, int *links, unsigned char *anyhit, gi_link_stats *st);
 
 /* Direction j of the n x n stratified cosine-weighted set around unit
  * normal nrm, from uniform numbers (u1, u2) in [0,1): Malley's method on

@@ -19,7 +19,7 @@
 #define GI_MAX_THREADS 256
 
 typedef struct {
-    long lookups, late, none, discarded, onthefly;
+    long lookups, late, none, discarded, onthefly, vis_rays;
     int *buf; /* on-the-fly estimation list */
     long len, cap;
     char pad[8];
@@ -59,6 +59,7 @@ struct gi_particle {
     atomic_uchar *rp_state;
     atomic_uchar *mark;
     float bg[3];
+    double vis_eps; /* gi_visible's eps: 1e-6 x accel_eps_scale */
     thread_count tc[GI_MAX_THREADS];
     gi_particle_stats st;
 };
@@ -125,8 +126,9 @@ static void update_bytes(gi_particle *gp)
 static void fill_stats(gi_particle *gp, gi_particle_stats *out)
 {
     update_bytes(gp);
-    long look = 0, late = 0, none = 0, disc = 0, otf = 0;
+    long look = 0, late = 0, none = 0, disc = 0, otf = 0, vis = gp->lists.vis_rays;
     for (int t = 0; t < GI_MAX_THREADS; t++) {
+        vis += gp->tc[t].vis_rays;
         otf += gp->tc[t].onthefly;
         look += gp->tc[t].lookups;
         late += gp->tc[t].late;
@@ -138,6 +140,7 @@ static void fill_stats(gi_particle *gp, gi_particle_stats *out)
     gp->st.lookups_none = none;
     gp->st.discarded = disc;
     gp->st.lookups_onthefly = otf;
+    gp->st.visibility_rays = vis;
     if (out && out != &gp->st) *out = gp->st;
 }
 
@@ -149,6 +152,51 @@ static void fill_stats(gi_particle *gp, gi_particle_stats *out)
  * indirect light there is just the background. Links are remapped to the
  * kept particles (a link target is always kept). *links_out gets the
  * n x ns2 scattering links of the kept particles. */
+#define MAX_BURY_SOLIDS 256
+
+/* The object of each particle and the solid it is buried in (2n pointers,
+ * for gi_links_build), and its 2n flags
+ * *pin: on the inside of a closed sphere or box; buried: on the surface of
+ * another closed sphere or box, facing its inside (moved a little along its
+ * normal the particle is inside it, moved back it is not: the floor under a
+ * box standing on it; tested against the first MAX_BURY_SOLIDS of them). */
+static const void **particle_objects(const gi_particle *gp, const gi_particles *ps, unsigned char **pin,
+                                     pt_status *st)
+{
+    int n = ps->n, np = gi_surface_npatches(gp->surf), ns = 0;
+    const void **o = xcalloc(2 * (size_t)n, sizeof *o, st);
+    *pin = xcalloc(2 * (size_t)n, 1, st);
+    const scene_object **solid = xcalloc(MAX_BURY_SOLIDS, sizeof *solid, st);
+    if (!o || !*pin || !solid) {
+        free(solid);
+        return o;
+    }
+    for (int pa = 0; pa < np && ns < MAX_BURY_SOLIDS; pa++) {
+        const scene_object *so = gi_surface_object(gp->surf, pa);
+        if (!so || (so->kind != SHAPE_SPHERE && so->kind != SHAPE_BOX) || (so->flags & OBJ_INVERSE)) continue;
+        if (ns == 0 || solid[ns - 1] != so) solid[ns++] = so; /* a box's faces are consecutive patches */
+    }
+    for (int i = 0; i < n; i++) {
+        const scene_object *so = gi_surface_object(gp->surf, ps->patch[i]);
+        o[i] = so;
+        (*pin)[i] = so && ps->side[i] == 1 && (so->kind == SHAPE_SPHERE || so->kind == SHAPE_BOX) &&
+                    !(so->flags & OBJ_INVERSE);
+        const gi_dev_particle *t = &ps->p[i];
+        vec3 p = v3(t->p[0], t->p[1], t->p[2]);
+        double lift = 1e-5 * (1.0 + fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
+        vec3 nn = v3(t->n[0], t->n[1], t->n[2]);
+        vec3 q = v3_madd(p, nn, lift), qb = v3_madd(p, nn, -lift);
+        for (int k = 0; k < ns; k++)
+            if (solid[k] != so && gi_surface_inside_solid(solid[k], q) && !gi_surface_inside_solid(solid[k], qb)) {
+                (*pin)[n + i] = 1;
+                o[n + i] = solid[k];
+                break;
+            }
+    }
+    free(solid);
+    return o;
+}
+
 static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t seed, int **links_out,
                                  gi_link_stats *ls)
 {
@@ -160,11 +208,15 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
     int *links = xcalloc((size_t)n * (size_t)k, sizeof(int), &st);
     unsigned char *keep = xcalloc((size_t)n, 1, &st);
     int *remap = xcalloc((size_t)n, sizeof(int), &st);
+    unsigned char *pin = NULL;
+    const void **pobj = particle_objects(gp, ps, &pin, &st);
     if (!grid) st = PT_ERR_NOMEM;
     if (st == PT_OK)
-        st = gi_links_build(gp->a, ps->p, n, gp->set.scatter_side, seed, grid, 3.0 * ps->spacing, gp->threads, links,
-                            keep, ls);
+        st = gi_links_build(gp->a, ps->p, pobj, pin, n, gp->set.scatter_side, seed, grid, 3.0 * ps->spacing, gp->threads,
+                            links, keep, ls);
     gi_lookup_free(grid);
+    free(pobj);
+    free(pin);
     if (st == PT_OK) {
         for (size_t j = 0; j < (size_t)n * (size_t)k; j++)
             if (links[j] >= 0) keep[links[j]] = 1;
@@ -201,6 +253,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     }
     gp->sc = sc;
     gp->a = a;
+    gp->vis_eps = 1e-6 * (accel_eps_scale(a) > 0.0 && isfinite(accel_eps_scale(a)) ? accel_eps_scale(a) : 1.0);
     if (s) gp->set = *s;
     else gi_particle_default_settings(&gp->set);
     gi_particle_settings *set = &gp->set;
@@ -297,13 +350,17 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         int n = gp->ps.n;
         gi_lookup *grid = gi_lookup_build(&gp->ps, 2.0 * spacing);
         gp->glink = xcalloc((size_t)n * (size_t)gp->ng, sizeof(int), &st);
+        unsigned char *pin = NULL;
+        const void **pobj = particle_objects(gp, &gp->ps, &pin, &st);
         if (!grid) st = PT_ERR_NOMEM;
         tg = timer_now();
         if (st == PT_OK)
-            st = gi_links_build(a, gp->ps.p, n, set->gather_side, set->seed ^ 0x6a7ULL, grid, 3.0 * spacing,
+            st = gi_links_build(a, gp->ps.p, pobj, pin, n, set->gather_side, set->seed ^ 0x6a7ULL, grid, 3.0 * spacing,
                                 gp->threads, gp->glink, NULL, &ls);
         S->t_gather_links = timer_now() - tg;
         gi_lookup_free(grid);
+        free(pobj);
+        free(pin);
         if (st != PT_OK) goto fail;
         S->link_rays = ls.rays;
         S->link_misses = ls.misses;
@@ -312,7 +369,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
 
     /* radiance particles and estimation lists */
     tg = timer_now();
-    st = gi_radiance_lists(&gp->lists, gp->surf, &gp->ps, S->radius, set->normal_cos, gp->threads, d);
+    st = gi_radiance_lists(&gp->lists, gp->surf, &gp->ps, gp->a, S->radius, set->normal_cos, gp->threads, d);
     if (st != PT_OK) goto fail;
     S->radiance_particles = gp->lists.nrp;
     S->list_entries = gp->lists.off[gp->lists.nrp];
@@ -881,14 +938,30 @@ static void late_rp(gi_particle *gp, long l)
  * cones, tori): the estimation list is made at the hit (the same radius,
  * normal test and widening as gi_radiance), then the estimate of section
  * 4.3.2 over it, gathering its particles first where needed. */
+/* Keeps the particles of the hit's own object (as gi_radiance's lists do;
+ * these pieces have one side unless open, and the normal test separates
+ * the sides of an open one only roughly). */
+static long onthefly_own(const gi_particle *gp, const scene_object *obj, thread_count *tc, long m)
+{
+    if (m <= 0) return m;
+    long w = 0;
+    for (long q = 0; q < m; q++)
+        if (gi_surface_object(gp->surf, gp->ps.patch[tc->buf[q]]) == obj) tc->buf[w++] = tc->buf[q];
+    tc->len = w;
+    return w;
+}
+
 static int onthefly(gi_particle *gp, const accel_hit *h, vec3 n, thread_count *tc, rgb *out)
 {
     vec3 ng = v3_dot(n, h->ng) >= 0.0 ? h->ng : v3_neg(h->ng);
     double r = gp->st.radius;
     tc->len = 0;
     long m = gi_grid_radius(gp->rgrid, h->p, ng, r, gp->set.normal_cos, &tc->buf, &tc->len, &tc->cap);
-    for (int widen = 2; m == 0 && widen <= 4; widen *= 2)
+    m = onthefly_own(gp, h->obj, tc, m);
+    for (int widen = 2; m == 0 && widen <= 4; widen *= 2) {
         m = gi_grid_radius(gp->rgrid, h->p, ng, r * widen, gp->set.normal_cos, &tc->buf, &tc->len, &tc->cap);
+        m = onthefly_own(gp, h->obj, tc, m);
+    }
     if (m <= 0) return 0;
     double s[3] = {0.0, 0.0, 0.0}, a = 0.0;
     for (long q = 0; q < m; q++) {
@@ -928,15 +1001,35 @@ rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
         }
         goto finish;
     }
+    /* only radiance particles the hit sees (gi_visible): one under a box
+     * standing on the floor must not lend its light to the floor outside */
+    vec3 ngv = v3_dot(n, hit->ng) >= 0.0 ? hit->ng : v3_neg(hit->ng);
+    double wsum = 0.0;
     for (int k = 0; k < 3; k++) {
+        if (!(w[k] > 0.0)) continue;
+        vec3 q, nq;
+        gi_surface_rp(gp->surf, rp[k], &q, &nq);
+        tc->vis_rays++;
+        if (!gi_visible(gp->a, gp->vis_eps, hit->p, ngv, q, nq, hit->obj)) {
+            w[k] = 0.0;
+            continue;
+        }
+        wsum += w[k];
+    }
+    if (!(wsum > 0.0)) {
+        tc->none++;
+        return out;
+    }
+    for (int k = 0; k < 3; k++) {
+        if (!(w[k] > 0.0)) continue;
         if (atomic_load_explicit(&gp->rp_state[rp[k]], memory_order_acquire) != 2) {
             tc->late++;
             late_rp(gp, rp[k]);
         }
         const float *v = &gp->rp_val[4 * rp[k]];
-        out.r += w[k] * v[0];
-        out.g += w[k] * v[1];
-        out.b += w[k] * v[2];
+        out.r += w[k] / wsum * v[0];
+        out.g += w[k] / wsum * v[1];
+        out.b += w[k] / wsum * v[2];
     }
 finish:;
     double b = gp->set.brightness;

@@ -273,8 +273,24 @@ size_t gi_grid_bytes(const gi_grid *g)
     return g ? ((size_t)g->mask + 3) * sizeof(int) + (size_t)g->n * sizeof(gentry) : 0;
 }
 
+/* A nearest-particle answer must also lie near the hit's tangent plane as
+ * the particle sees it: |n.(p - q)| <= 0.5 |p - q| (within 30 degrees of
+ * its plane; on a sphere, within 60 degrees of arc). Without it a ray that
+ * hit the outside of a sphere where no outside particle was near enough
+ * took a particle on the inside of the far wall (its normal faces the ray's
+ * origin too), and light from a lamp inside the sphere leaked out. */
+#define NEAR_PLANE2 0.25f
+
 int gi_grid_nearest(const gi_grid *g, vec3 q, vec3 dir, vec3 org, double maxdist)
 {
+    return gi_grid_nearest_on(g, q, dir, org, maxdist, NULL, NULL, v3s(0.0), 0.0, NULL);
+}
+
+int gi_grid_nearest_on(const gi_grid *g, vec3 q, vec3 dir, vec3 org, double maxdist, const void *const *pobj,
+                       const void *obj, vec3 agree, double min_agree, const unsigned char *skip)
+{
+    float ax = (float)agree.x, ay = (float)agree.y, az = (float)agree.z;
+    float amin = agree.x == 0.0 && agree.y == 0.0 && agree.z == 0.0 ? -2.0f : (float)min_agree;
     if (g->n == 0) return -1;
     double fx = (q.x - g->origin.x) * g->inv, fy = (q.y - g->origin.y) * g->inv, fz = (q.z - g->origin.z) * g->inv;
     if (!isfinite(fx) || !isfinite(fy) || !isfinite(fz)) return -1;
@@ -304,6 +320,11 @@ int gi_grid_nearest(const gi_grid *g, vec3 q, vec3 dir, vec3 org, double maxdist
                         if (e->nx * (orx - e->x) + e->ny * (ory - e->y) + e->nz * (orz - e->z) <= 0.0f) continue;
                         float ex = e->x - qx, ey = e->y - qy, ez = e->z - qz;
                         double d2 = (double)(ex * ex + ey * ey + ez * ez);
+                        float pe = e->nx * ex + e->ny * ey + e->nz * ez;
+                        if ((double)(pe * pe) > NEAR_PLANE2 * d2) continue;
+                        if (pobj && pobj[e->idx] != obj) continue;
+                        if (skip && skip[e->idx]) continue;
+                        if (e->nx * ax + e->ny * ay + e->nz * az < amin) continue;
                         if (d2 < best || (d2 == best && e->idx < bi)) {
                             best = d2;
                             bi = e->idx;
@@ -548,6 +569,13 @@ int gi_lookup_nearest(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double max
     return gi_lookup_nearest_in(g, gi_lookup_cell(g, q), q, dir, org, maxdist);
 }
 
+int gi_lookup_nearest_on(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double maxdist, const void *const *pobj,
+                         const void *obj, vec3 agree, double min_agree, const unsigned char *skip)
+{
+    if (g->n == 0 || !v3_finite(q)) return -1;
+    return gi_grid_nearest_on(g->fallback, q, dir, org, maxdist, pobj, obj, agree, min_agree, skip);
+}
+
 int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist)
 {
     if (g->n == 0 || !v3_finite(q)) return -1;
@@ -562,6 +590,7 @@ int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 o
     v4f best = {m2, m2, m2, m2}, vqx = {qx, qx, qx, qx}, vqy = {qy, qy, qy, qy}, vqz = {qz, qz, qz, qz};
     v4f vdx = {dx, dx, dx, dx}, vdy = {dy, dy, dy, dy}, vdz = {dz, dz, dz, dz};
     v4f vox = {ox, ox, ox, ox}, voy = {oy, oy, oy, oy}, voz = {oz, oz, oz, oz}, zero = {0, 0, 0, 0};
+    v4f vnp = {NEAR_PLANE2, NEAR_PLANE2, NEAR_PLANE2, NEAR_PLANE2};
     v4i vslot = {-1, -1, -1, -1}, lane = {0, 1, 2, 3};
     long d0 = g->dim[0], d01 = g->dim[0] * g->dim[1];
     long rows[4] = {cell, cell + d0, cell + d01, cell + d01 + d0};
@@ -582,7 +611,8 @@ int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 o
             v4f d2 = ex * ex + ey * ey + ez * ez;
             v4f f = nx * vdx + ny * vdy + nz * vdz;
             v4f hh = nx * (vox - x) + ny * (voy - y) + nz * (voz - z);
-            v4i ok = (d2 < best) & (f < zero) & (hh > zero);
+            v4f pe = nx * ex + ny * ey + nz * ez;
+            v4i ok = (d2 < best) & (f < zero) & (hh > zero) & (pe * pe <= vnp * d2);
             best = (v4f)(((v4i)d2 & ok) | ((v4i)best & ~ok));
             vslot = ((lane + k) & ok) | (vslot & ~ok);
         }

@@ -47,9 +47,15 @@ size_t gi_grid_bytes(const gi_grid *g);
 /* Nearest particle to q, within maxdist, on the side a ray from org along
  * dir arrives at: its normal faces against dir (n.dir < 0) and org lies in
  * front of it (n.(org - p) > 0; this keeps a ray that hits near its own
- * start, in a corner, from linking to the back side of its own surface).
+ * start, in a corner, from linking to the back side of its own surface),
+ * and q lies near its tangent plane (|n.(p - q)| <= |p - q| / 2).
  * -1 if none. */
 int gi_grid_nearest(const gi_grid *g, vec3 q, vec3 dir, vec3 org, double maxdist);
+/* As gi_grid_nearest, among the particles i with pobj[i] == obj only
+ * (pobj NULL: all) whose normal n has n.agree >= min_agree (agree = 0:
+ * any normal) and skip[i] == 0 (skip may be NULL). */
+int gi_grid_nearest_on(const gi_grid *g, vec3 q, vec3 dir, vec3 org, double maxdist, const void *const *pobj,
+                       const void *obj, vec3 agree, double min_agree, const unsigned char *skip);
 /* Particles within r of q with n.nq > cos_thr, in increasing index order,
  * appended to *out (grown with realloc); returns how many, -1 on OOM. */
 long gi_grid_radius(const gi_grid *g, vec3 q, vec3 nq, double r, double cos_thr, int **out, long *len, long *cap);
@@ -71,5 +77,9 @@ int gi_lookup_nearest(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double max
 long gi_lookup_cell(const gi_lookup *g, vec3 q);
 void gi_lookup_prefetch(const gi_lookup *g, long cell, int stage);
 int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist);
+/* As gi_lookup_nearest with gi_grid_nearest_on's filters (a ring search:
+ * the slow path for answers on the wrong object or side). */
+int gi_lookup_nearest_on(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double maxdist, const void *const *pobj,
+                         const void *obj, vec3 agree, double min_agree, const unsigned char *skip);
 
 #endif

@@ -1,5 +1,6 @@
 /* gi_radiance.c - estimation lists for the radiance particles. */
 #include "gi_radiance.h"
+#include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,6 +11,8 @@
 typedef struct {
     const gi_surface *g;
     const gi_particles *ps;
+    const accel *a;
+    double eps;
     gi_grid *grid, *fine;
     const int *alive; /* particles per patch side */
     double r, cos_thr;
@@ -17,9 +20,55 @@ typedef struct {
     int **out;    /* per chunk: entries */
     long *outlen; /* per chunk */
     int *count;   /* per radiance particle */
-    atomic_long widened, empty, dead;
+    atomic_long widened, empty, dead, rays;
     atomic_int oom;
 } list_job;
+
+int gi_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, const scene_object *own)
+{
+    double lift = GI_VIS_LIFT * eps;
+    vec3 p = v3_madd(x, nx, lift), q = v3_madd(y, ny, lift);
+    vec3 d = v3_sub(q, p);
+    double len = v3_len(d);
+    if (!(len > 2.0 * lift)) return 1;
+    d = v3_scale(d, 1.0 / len);
+    double tmin = 0.0;
+    for (int k = 0; k < 8; k++) {
+        accel_hit h;
+        if (!accel_intersect(a, p, d, tmin, len, &h)) return 1;
+        if (h.obj != own) return 0;
+        tmin = h.t + fmax(eps, h.t * 1e-7);
+    }
+    return 1;
+}
+
+static int visible(const list_job *J, vec3 q, vec3 nq, int i, const scene_object *obj)
+{
+    const gi_dev_particle *pt = &J->ps->p[i];
+    return gi_visible(J->a, J->eps, q, nq, v3(pt->p[0], pt->p[1], pt->p[2]), v3(pt->n[0], pt->n[1], pt->n[2]), obj);
+}
+
+/* Keeps, of the m entries just appended to buf[0, *len), those on the
+ * radiance particle's own object and side (gi_same_surface); returns how
+ * many are left (m < 0: out of memory, passed on). */
+static long same_surface(const list_job *J, const scene_object *obj, int side, vec3 q, vec3 nq, int *buf, long *len,
+                         long m, long *rays)
+{
+    if (m <= 0) return m;
+    long w = *len - m, first = w;
+    for (long i = first; i < *len; i++) {
+        if (!gi_same_surface(J->g, J->ps, buf[i], obj, side)) continue;
+        (*rays)++;
+        if (visible(J, q, nq, buf[i], obj)) buf[w++] = buf[i];
+    }
+    *len = w;
+    return w - first;
+}
+
+int gi_same_surface(const gi_surface *g, const gi_particles *ps, int i, const scene_object *obj, int side)
+{
+    return gi_surface_object(g, ps->patch[i]) == obj && ps->side[i] == side;
+}
 
 static void job(void *ctx, int chunk, int thread)
 {
@@ -27,7 +76,7 @@ static void job(void *ctx, int chunk, int thread)
     list_job *J = ctx;
     long lo = (long)chunk * RP_CHUNK, hi = lo + RP_CHUNK < J->nrp ? lo + RP_CHUNK : J->nrp;
     int *buf = NULL;
-    long len = 0, cap = 0, wid = 0, emp = 0, dead = 0;
+    long len = 0, cap = 0, wid = 0, emp = 0, dead = 0, vrays = 0;
     for (long l = lo; l < hi; l++) {
         int pa = gi_surface_rp_patch(J->g, l);
         int side = gi_surface_rp_side(J->g, l);
@@ -39,14 +88,18 @@ static void job(void *ctx, int chunk, int thread)
         }
         vec3 q, nq;
         gi_surface_rp(J->g, l, &q, &nq);
+        const scene_object *obj = gi_surface_object(J->g, pa);
         long m = gi_grid_radius(J->grid, q, nq, J->r, J->cos_thr, &buf, &len, &cap);
+        m = same_surface(J, obj, side, q, nq, buf, &len, m, &vrays);
         for (int widen = 2; m == 0 && widen <= 4; widen *= 2) {
             m = gi_grid_radius(J->grid, q, nq, J->r * widen, J->cos_thr, &buf, &len, &cap);
+            m = same_surface(J, obj, side, q, nq, buf, &len, m, &vrays);
             if (m > 0) wid++;
         }
         if (m == 0) {
             /* the nearest particle facing the same way, within 4 r */
             int near = gi_grid_nearest(J->fine, q, v3_neg(nq), v3_madd(q, nq, 4.0 * J->r), 4.0 * J->r);
+            if (near >= 0 && !(gi_same_surface(J->g, J->ps, near, obj, side) && visible(J, q, nq, near, obj))) near = -1;
             if (near >= 0) {
                 if (len == cap) {
                     long nc = cap ? cap * 2 : 1024;
@@ -74,10 +127,11 @@ static void job(void *ctx, int chunk, int thread)
     atomic_fetch_add(&J->widened, wid);
     atomic_fetch_add(&J->empty, emp);
     atomic_fetch_add(&J->dead, dead);
+    atomic_fetch_add(&J->rays, vrays);
 }
 
-pt_status gi_radiance_lists(gi_lists *L, const gi_surface *g, const gi_particles *ps, double r, double cos_thr,
-                            int threads, diag *d)
+pt_status gi_radiance_lists(gi_lists *L, const gi_surface *g, const gi_particles *ps, const accel *a, double r,
+                            double cos_thr, int threads, diag *d)
 {
     memset(L, 0, sizeof *L);
     L->nrp = gi_surface_nrp(g);
@@ -85,12 +139,15 @@ pt_status gi_radiance_lists(gi_lists *L, const gi_surface *g, const gi_particles
     memset(&J, 0, sizeof J);
     J.g = g;
     J.ps = ps;
+    J.a = a;
+    J.eps = 1e-6 * (accel_eps_scale(a) > 0.0 && isfinite(accel_eps_scale(a)) ? accel_eps_scale(a) : 1.0);
     J.r = r;
     J.cos_thr = cos_thr;
     J.nrp = L->nrp;
     atomic_init(&J.widened, 0);
     atomic_init(&J.empty, 0);
     atomic_init(&J.dead, 0);
+    atomic_init(&J.rays, 0);
     atomic_init(&J.oom, 0);
     int chunks = (int)((L->nrp + RP_CHUNK - 1) / RP_CHUNK);
     J.grid = gi_grid_build(ps->p, ps->n, r);
@@ -132,6 +189,7 @@ pt_status gi_radiance_lists(gi_lists *L, const gi_surface *g, const gi_particles
         L->widened = atomic_load(&J.widened);
         L->empty = atomic_load(&J.empty);
         L->dead = atomic_load(&J.dead);
+        L->vis_rays = atomic_load(&J.rays);
     }
     for (int c = 0; c < chunks; c++) free(J.out[c]);
     free(J.out);

@@ -2,7 +2,8 @@
  * section 3.2). Radiance particles are the vertices of the patches'
  * sub-tessellations (gi_surface); each gets the list of area particles
  * within radius r whose normal is within the threshold of its own
- * (n_m . n_q > cos_thr), so radiance estimation is a list scan (kernel
+ * (n_m . n_q > cos_thr), on its own object and side (gi_same_surface) and
+ * in its sight (gi_visible), so radiance estimation is a list scan (kernel
  * gi_k_estimate). A radiance particle with an empty list (a small patch, or
  * a corner) takes the particles within 2r, then 4r, then the nearest one
  * facing the same way within 4r. Radiance particles on a side that kept no
@@ -21,10 +22,34 @@ typedef struct {
     long widened;    /* lists that needed a larger radius */
     long empty;      /* lists still empty (no particle faces that way) */
     long dead;       /* on a side without particles (it faces only the void) */
+    long vis_rays;   /* visibility tests of list entries (gi_radiance.c visible) */
 } gi_lists;
 
-pt_status gi_radiance_lists(gi_lists *L, const gi_surface *g, const gi_particles *ps, double r, double cos_thr,
-                            int threads, diag *d);
+/* 1 when area particle i lies on object `obj`, on side `side` (0: the
+ * patches' front normal, 1: the opposite). Estimation lists hold only
+ * particles of the radiance particle's own object and side: the normal test
+ * alone let particles on the inside of a closed sphere or box (which exist
+ * when a light or the camera is inside it) count for the outside of its
+ * opposite wall, and the inner bottom of a box standing on the floor count
+ * for the floor around it (test_stability, light_inside). The estimate is
+ * an area-weighted mean, so fewer entries only smooth less; they bias
+ * nothing. */
+int gi_same_surface(const gi_surface *g, const gi_particles *ps, int i, const scene_object *obj, int side);
+
+/* Whether a sample at y (normal ny) may stand for light at x (normal nx) on
+ * object `own`: the segment between the two, lifted off the surface by
+ * GI_VIS_LIFT eps along their normals, crosses no other object (hits on
+ * `own` pass: a chord of a curved surface dips under it). Without it
+ * estimates reached across walls: the floor around a box standing on it
+ * took the particles (and radiance particles) of the floor under the box,
+ * lit by a light inside the box; the dark side of a thin wall took the lit
+ * side's. Used for the estimation lists and for the radiance particles a
+ * shading hit interpolates (gi_particle.c). */
+#define GI_VIS_LIFT 16.0
+int gi_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, const scene_object *own);
+
+pt_status gi_radiance_lists(gi_lists *L, const gi_surface *g, const gi_particles *ps, const accel *a, double r,
+                            double cos_thr, int threads, diag *d);
 void gi_lists_free(gi_lists *L);
 
 #endif

@@ -255,8 +255,7 @@ static int finish_grid(gi_surface *g, int obj, patch *p)
     return 1;
 }
 
-/* Is world point q inside the closed solid o (sphere, box)? */
-static int inside_solid(const scene_object *o, vec3 q)
+int gi_surface_inside_solid(const scene_object *o, vec3 q)
 {
     vec3 qo = xform_inv_point(&o->transform, q);
     if (o->kind == SHAPE_SPHERE) return v3_len(v3_sub(qo, o->u.sphere.centre)) < fabs(o->u.sphere.radius);
@@ -271,9 +270,9 @@ static int solid_sides(const gi_surface *g, const scene_object *o)
 {
     if (o->flags & OBJ_INVERSE) return 2;
     const scene *s = g->sc;
-    if (s->camera_set && inside_solid(o, s->camera.location)) return 2;
+    if (s->camera_set && gi_surface_inside_solid(o, s->camera.location)) return 2;
     for (int i = 0; i < s->nlights; i++)
-        if (inside_solid(o, s->lights[i].position)) return 2;
+        if (gi_surface_inside_solid(o, s->lights[i].position)) return 2;
     return 1;
 }
 

@@ -46,6 +46,10 @@ void gi_surface_free(gi_surface *g);
 /* Change the tessellation bound (radiance particles are laid out anew). */
 void gi_surface_retess(gi_surface *g, double tess);
 
+/* 1 when world point q is strictly inside the closed solid o (a sphere or a
+ * box; 0 for every other shape). */
+int gi_surface_inside_solid(const scene_object *o, vec3 q);
+
 int gi_surface_npatches(const gi_surface *g);
 double gi_surface_area(const gi_surface *g, int patch); /* one side */
 int gi_surface_sides(const gi_surface *g, int patch);

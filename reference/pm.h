@@ -31,7 +31,8 @@ typedef struct {
     long camera_rays;       /* primary rays */
     long bsdf_rays;         /* path continuations, specular eye rays, rays of specular gather chains */
     long gather_rays;       /* final-gather rays (pmfg) */
-    long shadow_rays;       /* next-event estimation (lights and emitters) */
+    long shadow_rays;       /* next-event estimation (lights and emitters); pmfg: also the visibility
+                               tests of its density estimates (pm_fg.c vis_ok) */
     long photon_rays;       /* photon path segments */
     /* photons */
     long photons_emitted;

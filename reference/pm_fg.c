@@ -84,24 +84,125 @@ static int trace_skip(const fg_ctx *c, vec3 org, vec3 dir, unsigned skip, accel_
 
 static rgb background(const scene *sc) { return frgb(sc->background.r, sc->background.g, sc->background.b); }
 
-/* Indirect irradiance at p on the side n from the global map. */
-static rgb global_irradiance(const fg_ctx *c, vec3 p, vec3 n, int thread)
+/* Whether the photon (or irradiance point) at y, normal ny, may stand for
+ * light at x, normal nx, on the surface of key `surf`: the segment between
+ * the two points lifted off the surface by VIS_LIFT eps along their normals
+ * crosses no other object. Hits on the surface's own object are passed
+ * (a chord of a curved surface dips under it). Without this test a density
+ * estimate reaches across walls: the floor just outside a box standing on
+ * it gathered the photons of a light inside the box, stored on the floor
+ * under the box (the two coplanar faces tie, and the ray hits the floor);
+ * likewise the dark side of a thin wall near the lit side. */
+#define VIS_LIFT 16.0
+static int vis_ok(const fg_ctx *c, vec3 x, vec3 nx, vec3 y, vec3 ny, uint32_t surf)
+{
+    double lift = VIS_LIFT * c->eps;
+    vec3 a = v3_madd(x, nx, lift), b = v3_madd(y, ny, lift);
+    vec3 d = v3_sub(b, a);
+    double len = v3_len(d);
+    if (!(len > 2.0 * lift)) return 1;
+    d = v3_scale(d, 1.0 / len);
+    double tmin = 0.0;
+    for (int k = 0; k < 8; k++) {
+        accel_hit h;
+        if (!accel_intersect(c->a, a, d, tmin, len, &h)) return 1;
+        if ((pm_surface_key(h.obj, 0) | 1u) != (surf | 1u)) return 0;
+        tmin = h.t + fmax(c->eps, h.t * 1e-7);
+    }
+    return 1;
+}
+
+/* Keeps the neighbours (a max-heap from pm_kdtree_knn) that vis_ok sees
+ * from x, in their order; returns how many. */
+static int vis_filter(const fg_ctx *c, const pm_kdtree *t, vec3 x, vec3 nx, uint32_t surf, pm_neighbour *nb, int n,
+                      long *rays)
+{
+    const pm_photon *ph = pm_kdtree_photons(t);
+    int w = 0;
+    for (int i = 0; i < n; i++) {
+        const pm_photon *p = &ph[nb[i].idx];
+        (*rays)++;
+        if (vis_ok(c, x, nx, pm_photon_pos(p), pm_photon_normal(p), surf)) nb[w++] = nb[i];
+    }
+    return w;
+}
+
+/* Irradiance on the side nx of x from the k nearest photons of key surf
+ * that x sees (vis_ok): the k-1 rule of pm_kdtree_irradiance over the
+ * visible ones, the distance of the farthest visible one as the radius
+ * (fewer than k in reach: all of them over pi max_r^2). */
+static int vis_irradiance(const fg_ctx *c, const pm_kdtree *t, vec3 x, vec3 nx, uint32_t surf, int k, double max_r,
+                          pm_neighbour *scratch, long *rays, rgb *e)
+{
+    e->r = e->g = e->b = 0.0;
+    int n = pm_kdtree_knn(t, x, nx, surf, NORMAL_DOT, k, max_r * max_r, scratch);
+    if (n == 0) return 0;
+    int full = n == k;
+    n = vis_filter(c, t, x, nx, surf, scratch, n, rays);
+    if (n == 0) return 0;
+    const pm_photon *ph = pm_kdtree_photons(t);
+    double area, sr = 0.0, sg = 0.0, sb = 0.0, far = 0.0;
+    int fi = 0;
+    for (int i = 0; i < n; i++)
+        if (scratch[i].d2 > far) {
+            far = scratch[i].d2;
+            fi = i;
+        }
+    int used = 0;
+    if (full && n >= 2) {
+        area = M_PI * far; /* the farthest visible photon gives the radius and is left out */
+    } else {
+        area = M_PI * max_r * max_r;
+        fi = -1;
+    }
+    for (int i = 0; i < n; i++) {
+        if (i == fi) continue;
+        sr += ph[scratch[i].idx].power[0];
+        sg += ph[scratch[i].idx].power[1];
+        sb += ph[scratch[i].idx].power[2];
+        used++;
+    }
+    if (!(area > 0.0)) return 0;
+    e->r = sr / area;
+    e->g = sg / area;
+    e->b = sb / area;
+    return used;
+}
+
+/* Indirect irradiance at p on the side n (surface key surf) from the global
+ * map: the nearest precomputed irradiance point that p sees (vis_ok; of the
+ * IRR_NEAR nearest), else none. */
+#define IRR_NEAR 4
+static rgb global_irradiance(const fg_ctx *c, vec3 p, vec3 n, uint32_t surf, int thread, long *rays)
 {
     rgb e = {0, 0, 0};
     if (!c->global || pm_kdtree_size(c->global) == 0) return e;
+    pm_neighbour *nb = c->scratch + (size_t)thread * KMAX;
     if (c->irr) {
-        long i = pm_kdtree_nearest(c->irr, p, n, NORMAL_DOT, c->r_global * c->r_global);
-        if (i >= 0) {
-            const pm_photon *ph = &pm_kdtree_photons(c->irr)[i];
-            return frgb(ph->power[0], ph->power[1], ph->power[2]);
+        int m = pm_kdtree_knn(c->irr, p, n, surf, NORMAL_DOT, IRR_NEAR, c->r_global * c->r_global, nb);
+        /* nearest first: the heap's order is not sorted */
+        for (int a = 1; a < m; a++)
+            for (int b = a; b > 0 && nb[b].d2 < nb[b - 1].d2; b--) {
+                pm_neighbour t = nb[b];
+                nb[b] = nb[b - 1];
+                nb[b - 1] = t;
+            }
+        const pm_photon *ph = pm_kdtree_photons(c->irr);
+        for (int a = 0; a < m; a++) {
+            const pm_photon *q = &ph[nb[a].idx];
+            (*rays)++;
+            if (vis_ok(c, p, n, pm_photon_pos(q), pm_photon_normal(q), surf))
+                return frgb(q->power[0], q->power[1], q->power[2]);
         }
+        return e;
     }
-    pm_kdtree_irradiance(c->global, p, n, NORMAL_DOT, c->k_global, c->r_global, c->scratch + (size_t)thread * KMAX, &e);
+    vis_irradiance(c, c->global, p, n, surf, c->k_global, c->r_global, nb, rays, &e);
     return e;
 }
 
-/* Reflected radiance at a gather hit (not its emission). */
-static rgb gather_hit(const fg_ctx *c, const mat_bsdf *b, int level, int thread, rng *r, pm_counts *cnt)
+/* Reflected radiance at a gather hit (not its emission); surf: the key of
+ * the side the gather ray arrived at (pm_surface_key). */
+static rgb gather_hit(const fg_ctx *c, const mat_bsdf *b, uint32_t surf, int level, int thread, rng *r, pm_counts *cnt)
 {
     rgb L = {0, 0, 0};
     if (b->nee) {
@@ -116,11 +217,11 @@ static rgb gather_hit(const fg_ctx *c, const mat_bsdf *b, int level, int thread,
         L.g += d.g;
         L.b += d.b;
         if (b->m[MAT_LOBE_DIFFUSE] > 0.0) {
-            rgb e = global_irradiance(c, b->p, b->n, thread);
+            rgb e = global_irradiance(c, b->p, b->n, surf, thread, &cnt->shadow);
             acc_add(&L, b->k[MAT_LOBE_DIFFUSE], frgb(e.r / M_PI, e.g / M_PI, e.b / M_PI));
         }
         if (b->m[MAT_LOBE_BACK] > 0.0) {
-            rgb e = global_irradiance(c, b->p, v3_neg(b->n), thread);
+            rgb e = global_irradiance(c, b->p, v3_neg(b->n), surf ^ 1u, thread, &cnt->shadow);
             acc_add(&L, b->k[MAT_LOBE_BACK], frgb(e.r / M_PI, e.g / M_PI, e.b / M_PI));
         }
     }
@@ -142,7 +243,7 @@ static rgb gather_hit(const fg_ctx *c, const mat_bsdf *b, int level, int thread,
                 mat_bsdf b2;
                 mat_setup(&b2, c->sc, &h, dir, c->eps, r);
                 acc_add(&L, w, b2.emission);
-                acc_add(&L, w, gather_hit(c, &b2, level + 1, thread, r, cnt));
+                acc_add(&L, w, gather_hit(c, &b2, pm_surface_key(h.obj, b2.entering), level + 1, thread, r, cnt));
             }
         }
     }
@@ -190,7 +291,7 @@ static rgb gather_lobe(const fg_ctx *c, const mat_bsdf *b, vec3 axis, vec3 org, 
             sum.g += le.g * wt;
             sum.b += le.b * wt;
         }
-        rgb lr = gather_hit(c, &b2, 0, thread, r, cnt);
+        rgb lr = gather_hit(c, &b2, pm_surface_key(h.obj, b2.entering), 0, thread, r, cnt);
         sum.r += lr.r;
         sum.g += lr.g;
         sum.b += lr.b;
@@ -224,14 +325,16 @@ static void eye_trace(const fg_ctx *c, vec3 org, vec3 dir, unsigned skip, rgb T,
         acc_add(L, T, pm_direct_emitters(c->L, &b, c->s->emitter_samples, nf, nb, r, &cnt->shadow));
         if (c->caustic && pm_kdtree_size(c->caustic) > 0) {
             pm_neighbour *sc = c->scratch + (size_t)thread * KMAX;
+            uint32_t key = pm_surface_key(h.obj, b.entering);
             rgb e;
             if (md > 0.0) {
-                pm_kdtree_irradiance(c->caustic, b.p, b.n, NORMAL_DOT, c->k_caustic, c->r_caustic, sc, &e);
+                vis_irradiance(c, c->caustic, b.p, b.n, key, c->k_caustic, c->r_caustic, sc, &cnt->shadow, &e);
                 acc_add(L, T, frgb(b.k[MAT_LOBE_DIFFUSE].r * e.r / M_PI, b.k[MAT_LOBE_DIFFUSE].g * e.g / M_PI,
                                    b.k[MAT_LOBE_DIFFUSE].b * e.b / M_PI));
             }
             if (mb > 0.0) {
-                pm_kdtree_irradiance(c->caustic, b.p, v3_neg(b.n), NORMAL_DOT, c->k_caustic, c->r_caustic, sc, &e);
+                vis_irradiance(c, c->caustic, b.p, v3_neg(b.n), key ^ 1u, c->k_caustic, c->r_caustic, sc, &cnt->shadow,
+                               &e);
                 acc_add(L, T, frgb(b.k[MAT_LOBE_BACK].r * e.r / M_PI, b.k[MAT_LOBE_BACK].g * e.g / M_PI,
                                    b.k[MAT_LOBE_BACK].b * e.b / M_PI));
             }
@@ -285,6 +388,7 @@ typedef struct {
     long n, stride;
     pm_photon *out;
     pm_neighbour *scratch;
+    long *rays;        /* visibility rays, per thread */
 } irr_job;
 
 #define IRR_BLOCK 2048
@@ -297,9 +401,9 @@ static void irr_block(void *ctx, int bi, int thread)
         const pm_photon *ph = &j->src[i * j->stride];
         vec3 p = pm_photon_pos(ph), n = v3_norm(pm_photon_normal(ph));
         rgb e;
-        pm_kdtree_irradiance(j->c->global, p, n, NORMAL_DOT, j->c->k_global, j->c->r_global,
-                             j->scratch + (size_t)thread * KMAX, &e);
-        pm_photon_set(&j->out[i], p, e, n);
+        vis_irradiance(j->c, j->c->global, p, n, ph->surf, j->c->k_global, j->c->r_global,
+                       j->scratch + (size_t)thread * KMAX, &j->rays[thread], &e);
+        pm_photon_set(&j->out[i], p, e, n, ph->surf);
     }
 }
 
@@ -386,8 +490,12 @@ pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s,
         if (!pts) {
             status = PT_ERR_NOMEM;
         } else {
-            irr_job j = {&c, pm_kdtree_photons(c.global), n, stride, pts, c.scratch};
-            pool_run(threads, (int)((n + IRR_BLOCK - 1) / IRR_BLOCK), irr_block, &j);
+            long *vrays = calloc((size_t)threads, sizeof *vrays);
+            irr_job j = {&c, pm_kdtree_photons(c.global), n, stride, pts, c.scratch, vrays};
+            if (vrays) pool_run(threads, (int)((n + IRR_BLOCK - 1) / IRR_BLOCK), irr_block, &j);
+            else status = PT_ERR_NOMEM;
+            for (int t = 0; vrays && t < threads; t++) st->shadow_rays += vrays[t]; /* visibility tests (vis_ok) */
+            free(vrays);
             double t4 = timer_now();
             st->t_irradiance = t4 - t3;
             c.irr = pm_kdtree_build(pts, n, threads);

@@ -23,7 +23,20 @@ static signed char q8(double v)
     return (signed char)lrint(s);
 }
 
-void pm_photon_set(pm_photon *ph, vec3 p, rgb power, vec3 n)
+uint32_t pm_surface_key(const void *object, int outside)
+{
+    /* splitmix64 finaliser of the address: distinct objects, distinct keys
+     * (a collision would only merge two objects' photons, as before keys) */
+    uint64_t z = (uint64_t)(uintptr_t)object + 0x9e3779b97f4a7c15ULL;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    z ^= z >> 31;
+    uint32_t k = (uint32_t)(z ^ (z >> 32)) & ~1u;
+    if (k == 0) k = 2;
+    return k | (outside ? 1u : 0u);
+}
+
+void pm_photon_set(pm_photon *ph, vec3 p, rgb power, vec3 n, uint32_t surf)
 {
     ph->p[0] = (float)p.x;
     ph->p[1] = (float)p.y;
@@ -35,6 +48,7 @@ void pm_photon_set(pm_photon *ph, vec3 p, rgb power, vec3 n)
     ph->n[1] = q8(n.y);
     ph->n[2] = q8(n.z);
     ph->axis = 0;
+    ph->surf = surf;
 }
 
 vec3 pm_photon_pos(const pm_photon *ph) { return v3(ph->p[0], ph->p[1], ph->p[2]); }
@@ -183,6 +197,7 @@ typedef struct {
     float q[3];
     float nq[3];
     float min_dot;
+    uint32_t surf;
     int k, count;
     float max_d2;     /* current search radius^2 */
     pm_neighbour *heap;
@@ -190,6 +205,7 @@ typedef struct {
 
 static int compatible(const knn_state *s, const pm_photon *p)
 {
+    if (s->surf != 0 && p->surf != s->surf) return 0;
     if (s->min_dot < -1.5f) return 1;
     float d = (p->n[0] * s->nq[0] + p->n[1] * s->nq[1] + p->n[2] * s->nq[2]) * (1.0f / 127.0f);
     return d >= s->min_dot;
@@ -250,7 +266,8 @@ static void knn_rec(knn_state *s, long lo, long hi)
     }
 }
 
-int pm_kdtree_knn(const pm_kdtree *t, vec3 p, vec3 n, double min_dot, int k, double max_r2, pm_neighbour *out)
+int pm_kdtree_knn(const pm_kdtree *t, vec3 p, vec3 n, uint32_t surf, double min_dot, int k, double max_r2,
+                  pm_neighbour *out)
 {
     if (!t || t->n <= 0 || k < 1) return 0;
     knn_state s;
@@ -262,6 +279,7 @@ int pm_kdtree_knn(const pm_kdtree *t, vec3 p, vec3 n, double min_dot, int k, dou
     s.nq[1] = (float)n.y;
     s.nq[2] = (float)n.z;
     s.min_dot = (float)min_dot;
+    s.surf = surf;
     s.k = k;
     s.count = 0;
     s.max_d2 = (float)max_r2;
@@ -270,12 +288,12 @@ int pm_kdtree_knn(const pm_kdtree *t, vec3 p, vec3 n, double min_dot, int k, dou
     return s.count;
 }
 
-int pm_kdtree_irradiance(const pm_kdtree *t, vec3 p, vec3 n, double min_dot, int k, double max_r, pm_neighbour *scratch,
-                         rgb *e)
+int pm_kdtree_irradiance(const pm_kdtree *t, vec3 p, vec3 n, uint32_t surf, double min_dot, int k, double max_r,
+                         pm_neighbour *scratch, rgb *e)
 {
     e->r = e->g = e->b = 0.0;
     if (k < 2) k = 2;
-    int c = pm_kdtree_knn(t, p, n, min_dot, k, max_r * max_r, scratch);
+    int c = pm_kdtree_knn(t, p, n, surf, min_dot, k, max_r * max_r, scratch);
     if (c == 0) return 0;
     double sr = 0, sg = 0, sb = 0, area;
     int first = 0;
@@ -299,9 +317,9 @@ int pm_kdtree_irradiance(const pm_kdtree *t, vec3 p, vec3 n, double min_dot, int
     return c - first;
 }
 
-long pm_kdtree_nearest(const pm_kdtree *t, vec3 p, vec3 n, double min_dot, double max_r2)
+long pm_kdtree_nearest(const pm_kdtree *t, vec3 p, vec3 n, uint32_t surf, double min_dot, double max_r2)
 {
     pm_neighbour one;
-    int c = pm_kdtree_knn(t, p, n, min_dot, 1, max_r2, &one);
+    int c = pm_kdtree_knn(t, p, n, surf, min_dot, 1, max_r2, &one);
     return c ? one.idx : -1;
 }

@@ -87,7 +87,7 @@ typedef struct {
 static inline rgb crgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
 static inline double cmax(rgb c) { return fmax(fabs(c.r), fmax(fabs(c.g), fabs(c.b))); }
 
-static int push(pm_photon **arr, long *n, long *cap, vec3 p, rgb pw, vec3 nrm)
+static int push(pm_photon **arr, long *n, long *cap, vec3 p, rgb pw, vec3 nrm, uint32_t surf)
 {
     if (*n == *cap) {
         long nc = *cap ? *cap * 2 : 256;
@@ -96,7 +96,7 @@ static int push(pm_photon **arr, long *n, long *cap, vec3 p, rgb pw, vec3 nrm)
         *arr = na;
         *cap = nc;
     }
-    pm_photon_set(&(*arr)[(*n)++], p, pw, nrm);
+    pm_photon_set(&(*arr)[(*n)++], p, pw, nrm, surf);
     return 1;
 }
 
@@ -236,10 +236,12 @@ static void trace_one(const trace_ctx *c, const source *src, long index, chunk_o
         mat_setup(&b, c->sc, &h, w, c->eps, &r);
         int lambert = b.m[MAT_LOBE_DIFFUSE] > 0.0 || b.m[MAT_LOBE_BACK] > 0.0;
         if (lambert && (bounce >= 1 || store_first) && cmax(phi) > 0.0) {
+            /* stored on the side of the object it arrived at (pm_kdtree.h) */
+            uint32_t key = pm_surface_key(h.obj, b.entering);
             if (out->ng + out->nc >= out->cap) { out->dropped++; return; }
-            if (!push(&out->g, &out->ng, &out->cg, h.p, phi, b.ng)) { out->oom = 1; return; }
+            if (!push(&out->g, &out->ng, &out->cg, h.p, phi, b.ng, key)) { out->oom = 1; return; }
             if (c->s->caustics && from_light && spec_only && bounce >= 1)
-                if (!push(&out->c, &out->nc, &out->cc, h.p, phi, b.ng)) { out->oom = 1; return; }
+                if (!push(&out->c, &out->nc, &out->cc, h.p, phi, b.ng, key)) { out->oom = 1; return; }
         }
         if (bounce >= c->s->max_bounces) return;
         mat_scatter s;

@@ -474,7 +474,8 @@ static void test_kdtree(void **state)
         vec3 p = v3(rng_f64(&r), rng_f64(&r), rng_f64(&r) * 0.1);
         vec3 nn = rng_f64(&r) < 0.5 ? v3(0, 0, 1) : v3(0, 0, -1);
         rgb pw = {1, 1, 1};
-        pm_photon_set(&ph[i], p, pw, nn);
+        /* two surface keys: the query must see only its own */
+        pm_photon_set(&ph[i], p, pw, nn, rng_f64(&r) < 0.5 ? 6u : 9u);
     }
     memcpy(copy, ph, sizeof(pm_photon) * (size_t)n);
     pm_kdtree *t = pm_kdtree_build(ph, n, THREADS);
@@ -484,12 +485,13 @@ static void test_kdtree(void **state)
         vec3 p = v3(rng_f64(&r), rng_f64(&r), rng_f64(&r) * 0.1);
         vec3 nq = v3(0, 0, 1);
         pm_neighbour out[16];
-        int k = pm_kdtree_knn(t, p, nq, 0.5, 16, 1.0, out);
+        uint32_t key = (q & 1) ? 9u : 0u; /* odd queries: key 9 only; even: any key */
+        int k = pm_kdtree_knn(t, p, nq, key, 0.5, 16, 1.0, out);
         /* brute force: 16th smallest d2 among compatible photons */
         double best[16];
         int nb = 0;
         for (long i = 0; i < n; i++) {
-            if (copy[i].n[2] < 0) continue;
+            if (copy[i].n[2] < 0 || (key && copy[i].surf != key)) continue;
             double dx = copy[i].p[0] - (float)p.x, dy = copy[i].p[1] - (float)p.y, dz = copy[i].p[2] - (float)p.z;
             double d2 = dx * dx + dy * dy + dz * dz;
             if (nb < 16) best[nb++] = d2;
@@ -503,9 +505,10 @@ static void test_kdtree(void **state)
         for (int j = 0; j < nb; j++) far = fmax(far, best[j]);
         if (k != 16 || fabs(out[0].d2 - far) > 1e-6 * far) mismatches++;
         for (int j = 0; j < k; j++)
-            if (tp[out[j].idx].n[2] < 0) mismatches++;
+            if (tp[out[j].idx].n[2] < 0 || (key && tp[out[j].idx].surf != key)) mismatches++;
     }
-    printf("kd-tree: 200 queries of 16 nearest with a normal filter against brute force: %d mismatches\n", mismatches);
+    printf("kd-tree: 200 queries of 16 nearest with a normal and a surface-key filter against brute force: %d mismatches\n",
+           mismatches);
     assert_int_equal(mismatches, 0);
     pm_kdtree_free(t);
     free(copy);
