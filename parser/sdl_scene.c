@@ -64,8 +64,8 @@ static void mesh_camera(sdl_parser *p, scene_camera *c, src_loc loc)
     memcpy(m, meshes, sizeof *m * (size_t)n);
     c->meshes = m;
     c->nmeshes = n;
-    if (c->mesh_rays_per_pixel > 1)
-        sdl_warn_once(p, loc, "mesh_camera: only the first of the %d rays per pixel is traced", c->mesh_rays_per_pixel);
+    if (c->mesh_max_distance > 0)
+        sdl_warn_once(p, loc, "mesh_camera: max_distance is not applied (rays go on past %g)", c->mesh_max_distance);
 }
 
 /* camera_type := perspective | orthographic | fisheye | ultra_wide_angle |

@@ -320,11 +320,34 @@ static void pixel_rng(rng *r, uint64_t seed, int x, int y, int pass)
     rng_seed(r, mix64(seed * 0x9e3779b97f4a7c15ULL + (uint64_t)pass), ((uint64_t)y << 32) | (uint64_t)x);
 }
 
+static rgb primary_ray(render_ctx *c, int thread, double px, double py, vec3 org, vec3 dir, rng *r);
+
 static rgb sample_ray(render_ctx *c, int thread, double px, double py, double lu, double lv, rng *r)
 {
     vec3 org, dir;
     /* Every camera type (core/camera.h); no ray (outside a fisheye) is black. */
     if (!camera_ray(&c->sc->camera, px, py, c->s->width, c->s->height, lu, lv, &org, &dir)) return rgb_make(0, 0, 0);
+    return primary_ray(c, thread, px, py, org, dir, r);
+}
+
+/* mesh_camera with several rays per pixel: the mean of the rays that are
+ * shot (POV-Ray 3.7's TracePixel divides by the number traced; none: black). */
+static rgb sample_mesh_rays(render_ctx *c, int thread, double px, double py, rng *r)
+{
+    const scene_camera *cam = &c->sc->camera;
+    rgb acc = {0, 0, 0};
+    int shot = 0;
+    for (int k = 0; k < cam->mesh_rays_per_pixel; k++) {
+        vec3 org, dir;
+        if (!camera_mesh_ray(cam, px, py, c->s->width, c->s->height, k, &org, &dir)) continue;
+        acc = rgb_add(acc, primary_ray(c, thread, px, py, org, dir, r));
+        shot++;
+    }
+    return shot ? rgb_scale(acc, 1.0 / shot) : rgb_make(0, 0, 0);
+}
+
+static rgb primary_ray(render_ctx *c, int thread, double px, double py, vec3 org, vec3 dir, rng *r)
+{
     if (c->sc->camera.normal) {
         /* camera normal: POV-Ray perturbs the direction at the screen point <x0, y0, 0> */
         pattern_ctx pc = pattern_ctx_plain(c->sc);
@@ -343,6 +366,7 @@ static rgb sample_ray(render_ctx *c, int thread, double px, double py, double lu
 static rgb sample(render_ctx *c, int thread, double px, double py, rng *r)
 {
     const scene_camera *cam = &c->sc->camera;
+    if (cam->kind == CAMERA_MESH && cam->mesh_rays_per_pixel > 1) return sample_mesh_rays(c, thread, px, py, r);
     if (!camera_focal_blur(cam)) return sample_ray(c, thread, px, py, 0.0, 0.0, r);
     /* Focal blur: blur_samples rays over the lens disc (stratified in area
      * and angle) and over the pixel, averaged (POV-Ray jitters both). */

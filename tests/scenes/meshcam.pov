@@ -1,6 +1,6 @@
 // mesh_camera, distribution 0: one triangle per pixel (row by row from the
 // top left), each shooting along its face normal; an orthographic view of a
-// checkered, lit scene. Compared with POV-Ray 3.7 (test_sdl_lang).
+// checkered, lit scene. Compared with POV-Ray 3.7 (test_cli).
 #version 3.7;
 global_settings { assumed_gamma 1 }
 #declare W = 32;
