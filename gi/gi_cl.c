@@ -93,7 +93,7 @@ struct gi_dev {
     cl_kernel k[KE_COUNT];
     cl_mem b_part, b_slink, b_glink, b_off, b_idx, b_rho;
     cl_mem b_lights, b_vis, b_edir, b_src, b_acc, b_tally, b_srcidx, b_lout, b_phi, b_eind, b_list, b_vout;
-    cl_mem b_rin_off, b_rin_src, b_bin, b_bout, b_total;
+    cl_mem b_rin_off, b_rin_src, b_bin, b_bout, b_total, b_next;
     size_t sz_lights, sz_vis, sz_srcidx, sz_list, sz_vout;
     float *tmp;  /* n*4 readback scratch */
 #endif
@@ -467,7 +467,7 @@ void gi_dev_free(gi_dev *dv)
         cl_mem *ms[] = {&dv->b_part, &dv->b_rho, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
                         &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_acc, &dv->b_tally, &dv->b_srcidx,
                         &dv->b_lout, &dv->b_phi, &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off,
-                        &dv->b_rin_src, &dv->b_bin, &dv->b_bout, &dv->b_total};
+                        &dv->b_rin_src, &dv->b_bin, &dv->b_bout, &dv->b_total, &dv->b_next};
         for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
         for (int k = 0; k < KE_COUNT; k++)
             if (dv->k[k]) clReleaseKernel(dv->k[k]);
@@ -527,7 +527,7 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     cl_mem *ms[] = {&dv->b_part, &dv->b_rho, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
                     &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_acc, &dv->b_tally, &dv->b_srcidx,
                     &dv->b_lout, &dv->b_phi, &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off,
-                    &dv->b_rin_src, &dv->b_bin, &dv->b_bout, &dv->b_total};
+                    &dv->b_rin_src, &dv->b_bin, &dv->b_bout, &dv->b_total, &dv->b_next};
     for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
     dv->sz_lights = dv->sz_vis = dv->sz_srcidx = dv->sz_list = dv->sz_vout = 0;
     dv->bytes = 0;
@@ -697,13 +697,16 @@ pt_status gi_dev_scatter(gi_dev *dv, int mode, int nb, gi_u32 seed, float scale,
             return st;
         cl_uint sd = seed;
         int slices = dv->slices;
+        size_t have_n = dv->b_next ? 16 : 0;
+        if ((st = ensure(dv, &dv->b_next, &have_n, 16, d)) != PT_OK) return st;
+        if ((st = zero(dv, dv->b_next, 16, d)) != PT_OK) return st;
         karg a[] = {KMEM(dv->b_rho), KMEM(dv->b_slink), KINT(ns2), KINT(nb),  {sizeof(cl_uint), &sd},
                     KF(scale),        KMEM(dv->b_srcidx), KINT(nsrc), KMEM(dv->b_src), KMEM(dv->b_acc),
-                    KMEM(dv->b_tally), KINT(n),          KINT(slices)};
+                    KMEM(dv->b_tally), KINT(n),          KINT(slices),   KMEM(dv->b_next)};
         /* slices: one work-item each, in work-groups of one (PoCL spreads
          * work-groups over its threads) */
         if ((st = run_kernel_local(dv, KE_SCATTER, slices > 0 ? (size_t)slices : (size_t)nsrc,
-                                   slices > 0 ? 1 : GI_CL_LOCAL, a, 13, d)) != PT_OK)
+                                   slices > 0 ? 1 : GI_CL_LOCAL, a, 14, d)) != PT_OK)
             return st;
         if ((st = download(dv, dv->b_tally, tally_s, tbytes, d)) != PT_OK) return st;
         if (slices > 0) sum_tally(tally_s, ns, nb, tl);

@@ -35,6 +35,7 @@ typedef struct {
     int np_slices; /* scatter: slices (one work-item each) */
     int nsrc;      /* scatter: sources */
     const float *rho4;
+    int *next; /* scatter: the shared batch counter */
     size_t chunk;  /* work-items per pool job (0: GI_C_CHUNK) */
 } c_launch;
 
@@ -52,7 +53,7 @@ static void run_chunk(void *ctx, int chunk, int thread)
         case K_EMIT: gi_k_emit(a->part, a->np, a->lights, a->nlights, a->vis, a->fout, a->fout2); break;
         case K_SCATTER:
             gi_k_scatter(a->rho4, a->slink, a->ns2, a->nb, a->seed, a->scale, a->idx, a->nsrc, a->src, a->acc,
-                         a->tally, a->np, a->np_slices);
+                         a->tally, a->np, a->np_slices, a->next);
             break;
         case K_RESOLVE:
             gi_k_resolve(a->part, a->np, a->edir, a->cacc, a->np_slices, a->scale, a->total, a->fout, a->fout2);
@@ -93,10 +94,11 @@ void gi_c_scatter(int threads, const float *rho4, int n, const int *slink, int n
                   float scale, const int *srcidx, int nsrc, const float *src, int nslices, gi_i64 *acc, gi_i64 *tally)
 {
     /* one work-item per slice (nslices > 0), one pool job each */
+    int next = 0;
     c_launch a = {.kernel = K_SCATTER, .n = (size_t)(nslices > 0 ? nslices : nsrc), .rho4 = rho4, .np = n,
                   .slink = slink, .ns2 = ns2, .nb = nb, .seed = seed, .scale = scale, .idx = srcidx,
                   .nsrc = nsrc, .src = src, .acc = acc, .tally = tally, .np_slices = nslices,
-                  .chunk = nslices > 0 ? 1 : 0};
+                  .chunk = nslices > 0 ? 1 : 0, .next = &next};
     launch(threads, &a);
 }
 

@@ -162,17 +162,19 @@ static inline void gi_walk(__global const float *rho4, __global const int *slink
  * same integer sums:
  *  - nslices = 0 (GPUs): one work-item per source; deposits and tallies are
  *    atomic adds into acc and tally;
- *  - nslices > 0 (CPUs): one work-item per slice w < nslices, walking the
- *    sources w, w + nslices, ... (GI_WALK_BATCH at a time) and adding,
+ *  - nslices > 0 (CPUs): one work-item per slice w < nslices, adding,
  *    without atomics, into its own slice acc + 3 n w and tally +
  *    3 GI_MAX_BOUNCES w; gi_k_resolve sums the slices. On a CPU an atomic
  *    add costs a locked bus cycle per deposit (three per step); a private
- *    slice costs one memory add.
- * Integer sums do not depend on order, so both shapes, any slice count and
- * any thread timing give the same acc and tally. */
+ *    slice costs one memory add. The work-items take batches of
+ *    GI_WALK_BATCH sources from a shared counter (*next, zero at launch),
+ *    so a thread the system holds up leaves its share to the others.
+ * Integer sums do not depend on order, so both shapes, any slice count,
+ * any batch assignment and any thread timing give the same acc and tally. */
 __kernel void gi_k_scatter(__global const float *rho4, __global const int *slink, int ns2, int nb,
                            uint seed, float scale, __global const int *srcidx, int nsrc, __global const float *src,
-                           __global gi_i64 *acc, __global gi_i64 *tally, int n, int nslices)
+                           __global gi_i64 *acc, __global gi_i64 *tally, int n, int nslices,
+                           __global int *next)
 {
     int w = (int)get_global_id(0);
     gi_i64 tl[GI_MAX_BOUNCES * 3];
@@ -181,10 +183,11 @@ __kernel void gi_k_scatter(__global const float *rho4, __global const int *slink
     if (nslices > 0) {
         if (w >= nslices) return;
         __global gi_i64 *mine = acc + (long)w * 3 * n;
-        int mycount = nsrc > w ? (nsrc - w + nslices - 1) / nslices : 0;
-        for (int b0 = 0; b0 < mycount; b0 += GI_WALK_BATCH) {
-            int cnt = mycount - b0 < GI_WALK_BATCH ? mycount - b0 : GI_WALK_BATCH;
-            gi_walk(rho4, slink, ns2, nb, seed, scale, srcidx, w + b0 * nslices, nslices, cnt, src, mine, 0, tl);
+        for (;;) {
+            int t0 = atomic_add(next, GI_WALK_BATCH);
+            if (t0 >= nsrc) break;
+            int cnt = nsrc - t0 < GI_WALK_BATCH ? nsrc - t0 : GI_WALK_BATCH;
+            gi_walk(rho4, slink, ns2, nb, seed, scale, srcidx, t0, 1, cnt, src, mine, 0, tl);
         }
         for (int b = 0; b < 3 * nbc; b++) tally[(long)w * 3 * GI_MAX_BOUNCES + b] = tl[b];
         return;
