@@ -35,8 +35,8 @@
  * julia_fractal, conic prisms and the sweeps under other transforms are
  * sampled by random lines (accel_tess.h: Crofton's formula, exact in
  * distribution; their area is a quasi-Monte Carlo estimate to 0.1%
- * standard error or 65536 lines); quadric and poly within the scene's
- * finite bounds, as planes.
+ * standard error or 65536 lines, within 2^19 lines per scene); quadric and
+ * poly within the scene's finite bounds, as planes.
  * Union members are sampled as separate leaves, as accel renders them. */
 #ifndef PT_ACCEL_SURFACE_H
 #define PT_ACCEL_SURFACE_H
