@@ -289,6 +289,10 @@ struct scene_object {
      * default inside a group) */
     int light_group;
     int no_global_lights;
+    /* uv_mapping (appended, issue 5): textures are evaluated at <u, v, 0>
+     * of the surface (scene_object_uv) and are not moved by the object's
+     * transforms */
+    int uv_mapping;
 };
 
 /* ---------------------------------------------------------------- lights */

@@ -64,11 +64,20 @@ static int is_csg(const scene_object *o)
     return o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE;
 }
 
+static void set_uv_mapping(scene_object *o)
+{
+    o->uv_mapping = 1;
+    if (is_csg(o))
+        for (int i = 0; i < o->u.csg.nkids; i++) set_uv_mapping(o->u.csg.kids[i]);
+}
+
 static void node_transform(scene_object *o, const xform *x)
 {
     o->transform = xform_then(o->transform, *x);
-    sdl_transform_texture(own_texture(o->texture), x);
-    sdl_transform_texture(own_texture(o->interior_texture), x);
+    if (!o->uv_mapping) { /* uv-mapped textures stay on the surface (POV-Ray's UV_FLAG) */
+        sdl_transform_texture(own_texture(o->texture), x);
+        sdl_transform_texture(own_texture(o->interior_texture), x);
+    }
     if (is_csg(o))
         for (int i = 0; i < o->u.csg.nkids; i++) node_transform(o->u.csg.kids[i], x);
 }
@@ -216,7 +225,7 @@ static void set_flag(scene_object *o, unsigned flag, int on, int recurse)
 /* flag_mod := ( no_image | no_reflection | no_radiosity | hollow |
  *   double_illuminate | sturm | hierarchy | split_union ) [ bool ] | no_shadow |
  *   inverse | open ; returns 0 if the keyword is not one of them. */
-static int flag_mod(sdl_parser *p, scene_object *o, sdl_kw k)
+static int flag_mod(sdl_parser *p, scene_object *o, sdl_kw k, src_loc loc)
 {
     unsigned flag = 0;
     int recurse = 0, has_arg = 1;
@@ -231,7 +240,13 @@ static int flag_mod(sdl_parser *p, scene_object *o, sdl_kw k)
     case KW_OPEN: flag = OBJ_OPEN; has_arg = 0; break;
     case KW_INVERSE: o->flags ^= OBJ_INVERSE; return 1;
     case KW_HIERARCHY: case KW_SPLIT_UNION: sdl_allow_float(p, 1.0); return 1;
-    case KW_UV_MAPPING: case KW_CUTAWAY_TEXTURES: return 1;
+    case KW_UV_MAPPING:
+        /* POV-Ray 3.7: "uv_mapping must be specified before texture" */
+        if (o->texture) sdl_error(p, loc, PT_ERR_SYNTAX, "uv_mapping must be specified before texture");
+        set_uv_mapping(o);
+        if (o->kind != SHAPE_SPHERE && !is_csg(o)) sdl_warn_once(p, loc, "uv_mapping is supported on spheres only; this shape's texture is evaluated in 3D");
+        return 1;
+    case KW_CUTAWAY_TEXTURES: return 1;
     default: return 0;
     }
     int on = has_arg ? sdl_allow_float(p, 1.0) > 0.0 : 1;
@@ -337,7 +352,7 @@ void sdl_object_mods(sdl_parser *p, sdl_obj *so)
             else sdl_shape_bounded_by(p, so);
             continue;
         }
-        if (flag_mod(p, so->obj, t.tk.kw) || material_mod(p, so->obj, t.tk.kw) || skipped_mod(p, &t)) continue;
+        if (flag_mod(p, so->obj, t.tk.kw, t.tk.loc) || material_mod(p, so->obj, t.tk.kw) || skipped_mod(p, &t)) continue;
         sdl_unget(p, &t);
         return;
     }

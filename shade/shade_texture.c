@@ -25,7 +25,7 @@
  *    mirrored ray goes below the raw surface), weighted by its
  *    reflectivity, raised to reflection_exponent.
  *
- * Not modelled here: photons, media, subsurface, uv_mapping,
+ * Not modelled here: photons, media, subsurface, uv_mapping except on spheres,
  * material_map, dispersion (ior used as is). */
 #include "shade_texture.h"
 #include <math.h>
@@ -71,6 +71,43 @@ static double scene_version(const scene *sc)
 {
     if (sc->version_major <= 0) return 3.7;
     return sc->version_major + sc->version_minor / 10.0;
+}
+
+/* POV-Ray 3.7's Sphere::UVCoord: u the angle around y from +x (0..1), v
+ * from the south pole (0) to the north pole (1), in the sphere's own
+ * space. Returns 0 for shapes without uv coordinates here. */
+static int object_uv(const scene_object *o, vec3 p, double *u, double *v)
+{
+    if (o->kind != SHAPE_SPHERE) return 0;
+    vec3 q = v3_sub(xform_inv_point(&o->transform, p), o->u.sphere.centre);
+    double len = v3_len(q);
+    if (len == 0.0) {
+        *u = *v = 0.0;
+        return 1;
+    }
+    q = v3_scale(q, 1.0 / len);
+    *v = 0.5 + asin(fmax(-1.0, fmin(1.0, q.y))) / M_PI;
+    double l2 = q.x * q.x + q.z * q.z, theta = 0.0;
+    if (l2 > 1.0e-10) {
+        l2 = sqrt(l2);
+        if (q.z == 0.0) theta = q.x > 0 ? 0.0 : M_PI;
+        else {
+            theta = acos(fmax(-1.0, fmin(1.0, q.x / l2)));
+            if (q.z < 0.0) theta = 2.0 * M_PI - theta;
+        }
+        theta /= 2.0 * M_PI;
+    }
+    *u = theta;
+    return 1;
+}
+
+/* Where a hit's textures are evaluated: the world point, or <u, v, 0> for
+ * an object with uv_mapping (on shapes with uv coordinates). */
+static vec3 texture_point(const accel_hit *h)
+{
+    double u, v;
+    if (h->obj && h->obj->uv_mapping && object_uv(h->obj, h->p, &u, &v)) return v3(u, v, 0.0);
+    return h->p;
 }
 
 static vec3 to_texture_space(const scene_texture *t, vec3 p)
@@ -376,10 +413,11 @@ rgb tex_shade(const tex_env *e, const accel_hit *h, vec3 dir, int level, double 
     hi.pc.dir = dir;
     hi.pc.has_hit = 1;
     parent_frame pf[MAX_PARENTS];
-    return one_texture(&hi, hit_texture(e->sc, h, hi.entering), h->p, pf, 0, weight);
+    return one_texture(&hi, hit_texture(e->sc, h, hi.entering), texture_point(h), pf, 0, weight);
 }
 
 /* ------------------------------------------------------------ colour only */
+
 
 static int texture_colour(const scene_texture *tex, vec3 point, const pattern_ctx *pc, colour5 *out, int depth)
 {
@@ -417,7 +455,7 @@ int tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_hit *h
     pc.ipoint = h->p;
     pc.normal = h->ns;
     pc.has_hit = 1;
-    return texture_colour(tex, h->p, &pc, out, 0);
+    return texture_colour(tex, texture_point(h), &pc, out, 0);
 }
 
 static rgb shadow_layers(const scene_texture *tex, vec3 point, const pattern_ctx *pc, int depth, double caustics, vec3 raw,
