@@ -141,7 +141,8 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         if (l->kind == LIGHT_CYLINDER) {
             vec3 axis = v3_norm(v3_sub(l->point_at, l->position));
             double R = fabs(l->falloff);
-            vec3 o = disc_point(l->position, axis, R, rng_f64(r), rng_f64(r));
+            double u1 = rng_f64(r), u2 = rng_f64(r);
+            vec3 o = disc_point(l->position, axis, R, u1, u2);
             *w = axis;
             if (!light_first_hit(c, o, axis, h, rays)) return 0;
             vec3 dl;
@@ -156,7 +157,8 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
             vec3 to_light = v3_norm(v3_sub(l->position, l->point_at));
             vec3 cp = v3_sub(c->centre, v3_scale(to_light, v3_dot(v3_sub(c->centre, l->position), to_light)));
             double R = c->radius;
-            vec3 o = disc_point(cp, to_light, R, rng_f64(r), rng_f64(r));
+            double u1 = rng_f64(r), u2 = rng_f64(r);
+            vec3 o = disc_point(cp, to_light, R, u1, u2);
             *w = v3_neg(to_light);
             if (!light_first_hit(c, o, *w, h, rays)) return 0;
             vec3 dl;
@@ -168,7 +170,7 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
             return 1;
         }
         vec3 q = l->position;
-        if (l->area && l->size1 * l->size2 > 1) {
+        if (light_extended(l)) {
             double u = rng_f64(r), v = rng_f64(r);
             vec3 e1 = l->size1 > 1 ? l->axis1 : v3s(0.0), e2 = l->size2 > 1 ? l->axis2 : v3s(0.0);
             if (l->circular && l->size1 > 1 && l->size2 > 1) {
@@ -181,7 +183,8 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         vec3 axis = v3(0, 0, 1);
         double cos_max = src->cos_max;
         if (l->kind == LIGHT_SPOT) axis = v3_norm(v3_sub(l->point_at, l->position));
-        *w = cone_dir(axis, cos_max, rng_f64(r), rng_f64(r));
+        double u1 = rng_f64(r), u2 = rng_f64(r);
+        *w = cone_dir(axis, cos_max, u1, u2);
         double pdf = 1.0 / (2.0 * M_PI * (1.0 - cos_max));
         if (!light_first_hit(c, q, *w, h, rays)) return 0;
         vec3 dl;
@@ -196,9 +199,11 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
     if (src->kind == SRC_EMIT) {
         const accel_surf *es = pm_lights_emitters(c->L);
         accel_surf_sample s;
-        if (!accel_surf_sample_point(es, rng_f64(r), rng_f64(r), rng_f64(r), r, &s)) return 0;
+        double u1 = rng_f64(r), u2 = rng_f64(r), u3 = rng_f64(r);
+        if (!accel_surf_sample_point(es, u1, u2, u3, r, &s)) return 0;
         vec3 ns = rng_f64(r) < 0.5 ? s.n : v3_neg(s.n);
-        *w = mat_cosine_dir(ns, rng_f64(r), rng_f64(r));
+        double u4 = rng_f64(r), u5 = rng_f64(r);
+        *w = mat_cosine_dir(ns, u4, u5);
         vec3 o = v3_madd(s.p, ns, c->eps);
         (*rays)++;
         if (!accel_intersect(c->a, o, *w, c->eps, INFINITY, h)) return 0;
@@ -208,9 +213,11 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         return 1;
     }
     /* background */
-    vec3 wd = cone_dir(v3(0, 0, 1), -1.0, rng_f64(r), rng_f64(r));
+    double u1 = rng_f64(r), u2 = rng_f64(r);
+    vec3 wd = cone_dir(v3(0, 0, 1), -1.0, u1, u2);
     double R = c->radius;
-    vec3 o = disc_point(v3_madd(c->centre, wd, -R * 1.001), wd, R, rng_f64(r), rng_f64(r));
+    double u3 = rng_f64(r), u4 = rng_f64(r);
+    vec3 o = disc_point(v3_madd(c->centre, wd, -R * 1.001), wd, R, u3, u4);
     *w = wd;
     (*rays)++;
     if (!accel_intersect(c->a, o, wd, c->eps, INFINITY, h)) return 0;

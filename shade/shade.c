@@ -375,7 +375,8 @@ static rgb sample(render_ctx *c, int thread, double px, double py, rng *r)
     for (int i = 0; i < n; i++) {
         double rad = 0.5 * sqrt((i + rng_f64(r)) / n);
         double phi = 2.0 * M_PI * (i * 0.6180339887498949 + rng_f64(r) / n);
-        acc = rgb_add(acc, sample_ray(c, thread, px + rng_f64(r) - 0.5, py + rng_f64(r) - 0.5, rad * cos(phi), rad * sin(phi), r));
+        double jx = rng_f64(r), jy = rng_f64(r); /* in this order (arguments are evaluated in any order) */
+        acc = rgb_add(acc, sample_ray(c, thread, px + jx - 0.5, py + jy - 0.5, rad * cos(phi), rad * sin(phi), r));
     }
     return rgb_scale(acc, 1.0 / n);
 }
@@ -411,8 +412,10 @@ static void tile_first_pass(void *ctx, int tile, int thread)
                 acc = sample(c, thread, x + 0.5, y + 0.5, &r);
             } else {
                 for (int j = 0; j < n; j++)
-                    for (int i = 0; i < n; i++)
-                        acc = rgb_add(acc, sample(c, thread, x + (i + rng_f64(&r)) / n, y + (j + rng_f64(&r)) / n, &r));
+                    for (int i = 0; i < n; i++) {
+                        double jx = rng_f64(&r), jy = rng_f64(&r); /* in this order, whatever the compiler */
+                        acc = rgb_add(acc, sample(c, thread, x + (i + jx) / n, y + (j + jy) / n, &r));
+                    }
                 acc = rgb_scale(acc, 1.0 / (n * n));
             }
             float *px = fb_px(c->fb, x, y);

@@ -209,6 +209,14 @@ static int blocked(const light_ctx *c, vec3 p, vec3 dir, double depth)
     return accel_occluded(c->a, p, dir, c->eps, tmax);
 }
 
+int light_extended(const scene_light *l)
+{
+    if (!l->area) return 0;
+    int e1 = l->size1 > 1 && v3_dot(l->axis1, l->axis1) > 0.0;
+    int e2 = l->size2 > 1 && v3_dot(l->axis2, l->axis2) > 0.0;
+    return e1 || e2;
+}
+
 /* Point of the continuous area light for (u, v) in [0,1)^2: uniform over the
  * parallelogram spanned by the axes whose grid size exceeds 1, or over the
  * ellipse inscribed in it for `circular` (POV-Ray applies circular only when
@@ -277,7 +285,7 @@ rgb light_nee(const light_ctx *c, const scene_light *l, const light_surface *s, 
     }
     if (!l->shadowless) {
         double vis;
-        if (l->area && l->size1 * l->size2 > 1) {
+        if (light_extended(l)) {
             vec3 ax1, ax2;
             light_area_axes(l, p, &ax1, &ax2);
             int seen = 0;

@@ -47,6 +47,12 @@ vec3 light_area_point(const scene_light *l, vec3 ax1, vec3 ax2, int u, int v, rn
 /* Axes of an area light as seen from p: the light's own, or for `orient`
  * the same lengths turned to face p (POV-Ray's rule). */
 void light_area_axes(const scene_light *l, vec3 p, vec3 *ax1, vec3 *ax2);
+/* 1 when l is an area light whose points do not all coincide: an axis with
+ * more than one sample and a non-zero length. An area light with zero axes
+ * (or a 1x1 grid) is the point light at its position; the Monte Carlo
+ * renderers sample it as one, so it draws no random numbers of its own and
+ * gives the point light's image exactly. */
+int light_extended(const scene_light *l);
 
 /* POV-Ray's empirical metallic tint of a highlight or reflection colour:
  * F(x) = 0.014567225/(x-1.12)^2 - 0.011612903 with x = angle/(pi/2). */

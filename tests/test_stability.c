@@ -39,6 +39,37 @@
 
 #define SIZE 64
 
+/* Every framebuffer a render returns is listed until freed, so that one a
+ * failed assertion skips past (cmocka leaves the test by longjmp) is still
+ * freed by the group teardown: no leak reports on a failure path under
+ * LeakSanitizer. fb_free below is this file's wrapper. */
+static framebuffer *live_fbs[64];
+
+static void fb_track(framebuffer *fb)
+{
+    for (size_t i = 0; i < sizeof live_fbs / sizeof live_fbs[0]; i++)
+        if (!live_fbs[i]) {
+            live_fbs[i] = fb;
+            return;
+        }
+    fail_msg("test_stability: more than %zu renders held at once", sizeof live_fbs / sizeof live_fbs[0]);
+}
+
+static void fb_release(framebuffer *fb)
+{
+    for (size_t i = 0; i < sizeof live_fbs / sizeof live_fbs[0]; i++)
+        if (live_fbs[i] == fb) live_fbs[i] = NULL;
+    fb_free(fb);
+}
+#define fb_free(fb) fb_release(fb)
+
+static int free_live_fbs(void **st)
+{
+    (void)st;
+    for (size_t i = 0; i < sizeof live_fbs / sizeof live_fbs[0]; i++) fb_release(live_fbs[i]);
+    return 0;
+}
+
 typedef struct {
     const char *name;  /* --gi value */
     const char *args;  /* extra render options */
@@ -119,6 +150,7 @@ static render_result render(const char *name, const char *text, const gi_mode *m
     render_result r;
     memset(&r, 0, sizeof r);
     assert_int_equal(img_read(exr, 0, &r.fb, NULL), PT_OK);
+    fb_track(r.fb);
     size_t n = (size_t)r.fb->width * (size_t)r.fb->height * 3u;
     double sum = 0.0;
     r.min = INFINITY;
@@ -409,8 +441,15 @@ static void test_area_light_extremes(void **st)
         assert_clean(&huge);
         printf("area light axes 0 %-8s 1x1 / point = %.9f, 5x5 / point = %.9f; axes 1e6 9x9: mean %.6g (point %.6g), max %.6g\n",
                m->name, zero1.mean / point.mean, zero5.mean / point.mean, huge.mean, point.mean, huge.max);
-        assert_true(fabs(zero1.mean / point.mean - 1.0) <= m->scale_tol);
-        assert_true(fabs(zero5.mean / point.mean - 1.0) <= m->scale_tol);
+        /* Zero axes: every sample of the area light is the light's centre,
+         * so it is the point light, and every mode samples it as one
+         * (light_extended): the same random numbers, the same image
+         * up to rounding. (Before, the 5x5 light's own draws gave pmfg an
+         * independent noise sample: ratios 0.978-1.057 over seeds 1-6, and
+         * 1.0229 in the clang build, where function arguments holding random
+         * draws were evaluated in the other order.) */
+        assert_true(fabs(zero1.mean / point.mean - 1.0) <= 1e-9);
+        assert_true(fabs(zero5.mean / point.mean - 1.0) <= 1e-9);
         /* The huge light's samples lie outside the closed room but one (its
          * centre): at most a point light's worth of light gets in. */
         assert_true(huge.min >= 0.0);
@@ -569,7 +608,7 @@ int main(void)
         cmocka_unit_test(test_degenerate_triangles),
         cmocka_unit_test(test_far_object),
     };
-    int rc = cmocka_run_group_tests(tests, NULL, NULL);
+    int rc = cmocka_run_group_tests(tests, NULL, free_live_fbs);
     char cmd[600];
     if (rc == 0) {
         snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
