@@ -271,17 +271,19 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
             if (!parse_int(next, &o->max_macro_depth) || o->max_macro_depth < 1) { snprintf(err, (size_t)errlen, "bad --max-macro-depth"); return 2; }
             i++;
         } else if (strcmp(a, "--max-tokens") == 0 || strcmp(a, "--max-memory") == 0 ||
-                   strcmp(a, "--max-string") == 0 || strcmp(a, "--max-array") == 0) {
+                   strcmp(a, "--max-string") == 0 || strcmp(a, "--max-array") == 0 ||
+                   strcmp(a, "--cl-max-memory") == 0) {
             if (!has_value(a, next, err, errlen)) return 2;
             long long v;
             if (!parse_count(next, 1LL << 53, &v)) {
                 snprintf(err, (size_t)errlen, "%s wants a positive integer%s", a,
-                         strcmp(a, "--max-memory") == 0 ? " (MiB)" : "");
+                         strcmp(a, "--max-memory") == 0 || strcmp(a, "--cl-max-memory") == 0 ? " (MiB)" : "");
                 return 2;
             }
             if (strcmp(a, "--max-tokens") == 0) o->max_tokens = v;
             else if (strcmp(a, "--max-memory") == 0) o->max_memory_mib = v;
             else if (strcmp(a, "--max-array") == 0) o->max_array = v;
+            else if (strcmp(a, "--cl-max-memory") == 0) o->cl_max_memory_mib = v > (1LL << 40) ? (1LL << 40) : v;
             else o->max_string = v > 0x7fffffffL ? 0x7fffffffL : (long)v;
             i++;
         } else if (strncmp(a, "-D", 2) == 0 && a[2]) {

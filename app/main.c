@@ -52,7 +52,8 @@ static const char *usage_text =
     "                 [--working-space NAME] [--ocio-config FILE] [--false-color OUT.png]\n"
     "                 [--false-color-range LO,HI] [--false-color-quantity luminance|illuminance]\n"
     "                 [--aovs direct,indirect,albedo,normal,depth,illuminance] [--units m|cm|mm|ft|METRES]\n"
-    "                 [--particles N] [--nb N] [--cl-device NAME] [--fg-rays N] [--photons N] [--max-depth N]\n"
+    "                 [--particles N] [--nb N] [--cl-device NAME] [--cl-max-memory MIB]\n"
+    "                 [--fg-rays N] [--photons N] [--max-depth N]\n"
     "                 [--max-loop N] [--max-include-depth N] [--max-macro-depth N]\n"
     "                 [--max-tokens N] [--max-memory MIB] [--max-string BYTES] [--max-array N]\n"
     "                 [+W640 +H480 +A0.3 +R3 +Oout.png +Iscene.pov +Ldir ...]\n"
@@ -332,6 +333,7 @@ static int cmd_render(int argc, char **argv)
     ss.photons = o.photons;
     ss.max_depth = o.max_depth;
     ss.cl_device = o.cl_device;
+    ss.cl_max_bytes = o.cl_max_memory_mib > 0 ? (size_t)o.cl_max_memory_mib << 20 : 0;
     ss.progress = !o.quiet;
     ss.cancel = &g_cancel;
     char *progressive = NULL;

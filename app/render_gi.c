@@ -65,6 +65,7 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     gs.seed = o->seed;
     gs.threads = o->threads;
     if (o->cl_device) gs.cl_device = o->cl_device;
+    gs.cl_max_bytes = o->cl_max_bytes;
     pt_status st = PT_OK;
     double t0 = timer_now();
     gi_particle *gp = gi_particle_build(sc, a, &gs, &r->particle, d, &st);

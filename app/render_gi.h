@@ -28,6 +28,7 @@ typedef struct {
     long photons;             /* pmfg: photon paths (0 = default) */
     int max_depth;            /* path: vertices per path (0 = unlimited) */
     const char *cl_device;    /* particle: OpenCL device choice (gi_cl.h), NULL = auto */
+    size_t cl_max_bytes;      /* particle: OpenCL device memory it may use, 0 = the device's */
     volatile int *cancel;
     int progress;             /* 1: progress bar on stderr (reference modes) */
     const char *progressive_path; /* reference modes: write the image so far here every few seconds */

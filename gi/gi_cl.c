@@ -4,6 +4,7 @@
 #include <ctype.h>
 #include <stddef.h>
 #include <stdio.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include "gi_cl_c.h"
@@ -74,6 +75,7 @@ struct gi_dev {
     int threads;
     double build_seconds;
     size_t bytes;
+    size_t max_alloc, max_total; /* OpenCL: CL_DEVICE_MAX_MEM_ALLOC_SIZE; memory budget (gi_dev_options.max_bytes) */
     /* geometry (host pointers, caller-owned) */
     const gi_dev_particle *part;
     int n, ns2, ng, nrp;
@@ -283,6 +285,12 @@ static pt_status cl_open(gi_dev *dv, const gi_dev_options *o, diag *d)
     clGetDeviceInfo(dev, CL_DEVICE_NAME, sizeof dname, dname, NULL);
     clGetPlatformInfo(plat, CL_PLATFORM_NAME, sizeof pname, pname, NULL);
     snprintf(dv->name, sizeof dv->name, "OpenCL: %s (%s)", dname, pname);
+    cl_ulong max_alloc = 0, global = 0;
+    clGetDeviceInfo(dev, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof max_alloc, &max_alloc, NULL);
+    clGetDeviceInfo(dev, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof global, &global, NULL);
+    dv->max_alloc = max_alloc > 0 && max_alloc < (cl_ulong)SIZE_MAX ? (size_t)max_alloc : SIZE_MAX;
+    dv->max_total = global > 0 && global < (cl_ulong)SIZE_MAX ? (size_t)global : SIZE_MAX;
+    if (o && o->max_bytes > 0 && o->max_bytes < dv->max_total) dv->max_total = o->max_bytes;
     char ext[8192] = "";
     clGetDeviceInfo(dev, CL_DEVICE_EXTENSIONS, sizeof ext, ext, NULL);
     cl_device_type type = 0;
@@ -351,15 +359,43 @@ static void rel(cl_mem *m)
     *m = NULL;
 }
 
-/* (Re)allocate buffer *m to at least `size` bytes; *have tracks its size. */
+static const char *mib(size_t n, char *buf, size_t cap)
+{
+    snprintf(buf, cap, "%.1f MiB", (double)n / (1024.0 * 1024.0));
+    return buf;
+}
+
+/* (Re)allocate buffer *m to at least `size` bytes; *have tracks its size.
+ * Sizes the device cannot hold are refused before they are requested (an
+ * implementation may crash or fail late instead of returning an error). */
 static pt_status ensure(gi_dev *dv, cl_mem *m, size_t *have, size_t size, diag *d)
 {
     if (size == 0) size = 16;
     if (*m && *have >= size) return PT_OK;
-    if (*m) { dv->bytes -= *have; rel(m); }
+    if (*m) { dv->bytes -= *have; rel(m); *have = 0; }
+    char a[32], b[32], c[32];
+    src_loc nowhere = {0};
+    if (size > dv->max_alloc) {
+        diag_report(d, DIAG_ERROR, nowhere, NULL,
+                    "OpenCL: out of device memory: particle GI needs a buffer of %s on %s, more than its largest "
+                    "allocation of %s (CL_DEVICE_MAX_MEM_ALLOC_SIZE); use fewer particles or --cl-device c",
+                    mib(size, a, sizeof a), dv->name, mib(dv->max_alloc, b, sizeof b));
+        return PT_ERR_NOMEM;
+    }
+    if (size > dv->max_total || dv->bytes > dv->max_total - size) {
+        diag_report(d, DIAG_ERROR, nowhere, NULL,
+                    "OpenCL: out of device memory: particle GI needs %s more on %s (%s held), more than the %s it "
+                    "may use (CL_DEVICE_GLOBAL_MEM_SIZE or --cl-max-memory); use fewer particles or --cl-device c",
+                    mib(size, a, sizeof a), dv->name, mib(dv->bytes, b, sizeof b), mib(dv->max_total, c, sizeof c));
+        return PT_ERR_NOMEM;
+    }
     cl_int e;
     *m = clCreateBuffer(dv->ctx, CL_MEM_READ_WRITE, size, NULL, &e);
-    if (!*m) { *have = 0; return cl_fail(d, "clCreateBuffer", e); }
+    if (!*m) {
+        *have = 0;
+        cl_fail(d, "clCreateBuffer", e);
+        return PT_ERR_NOMEM;
+    }
     *have = size;
     dv->bytes += size;
     return PT_OK;

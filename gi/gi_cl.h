@@ -33,6 +33,10 @@ typedef struct {
     const char *spec;   /* see above */
     const char *source; /* NULL: embedded (or $PARTRAY_CL_DIR); else this program text (tests) */
     int threads;        /* worker threads of the C build; <= 0: all cores */
+    size_t max_bytes;   /* OpenCL: device memory the buffers may take in all; 0 = the
+                           device's CL_DEVICE_GLOBAL_MEM_SIZE (never more). A buffer
+                           beyond it or beyond CL_DEVICE_MAX_MEM_ALLOC_SIZE is a
+                           PT_ERR_NOMEM error naming the sizes, before it is requested */
 } gi_dev_options;
 
 gi_dev *gi_dev_open(const gi_dev_options *o, diag *d, pt_status *status);

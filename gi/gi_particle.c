@@ -276,7 +276,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
 
     /* the device first: a missing OpenCL driver should fail before seconds of ray tracing */
     double t0 = timer_now();
-    gi_dev_options o = {set->cl_device, set->cl_source, gp->threads};
+    gi_dev_options o = {set->cl_device, set->cl_source, gp->threads, set->cl_max_bytes};
     gp->dev = gi_dev_open(&o, d, &st);
     if (!gp->dev) goto fail;
     S->t_kernel_build = gi_dev_build_seconds(gp->dev);

@@ -88,6 +88,7 @@ typedef struct {
     int threads;         /* <= 0: all cores */
     const char *cl_device; /* NULL/"auto", "c", "P:D" or part of a name (gi_cl.h) */
     const char *cl_source; /* NULL: the built-in kernels; tests pass broken text here */
+    size_t cl_max_bytes;   /* OpenCL device memory the GI may hold; 0 = the device's (gi_dev_options.max_bytes) */
 } gi_particle_settings;
 
 typedef struct {

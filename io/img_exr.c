@@ -78,6 +78,57 @@ static int64_t on_size(exr_const_context_t ctxt, void *ud)
     return (int64_t)st.st_size;
 }
 
+/* Before anything is allocated for the pixels: every chunk of part 0's
+ * offset table (level 0) must lie inside the file, so a truncated file that
+ * declares a huge image is refused here (0), with the reason in `why`.
+ * An uncompressed chunk must hold all its bytes. */
+static int chunks_inside(exr_context_t ctx, exr_storage_t storage, exr_attr_box2i_t dw, int64_t fsize, char *why,
+                         size_t whycap)
+{
+    exr_chunk_info_t ci;
+    exr_result_t rv;
+    int32_t ntx = 1, nty = 0, lpc = 1;
+    uint32_t tw = 0, th = 0;
+    if (storage == EXR_STORAGE_SCANLINE) {
+        if (exr_get_scanlines_per_chunk(ctx, 0, &lpc) != EXR_ERR_SUCCESS || lpc < 1) lpc = 1;
+        nty = (int32_t)(((int64_t)dw.max.y - dw.min.y + lpc) / lpc);
+    } else {
+        exr_tile_level_mode_t lm;
+        exr_tile_round_mode_t rm;
+        int32_t lw = 0, lh = 0;
+        if (exr_get_tile_descriptor(ctx, 0, &tw, &th, &lm, &rm) != EXR_ERR_SUCCESS || tw == 0 || th == 0 ||
+            exr_get_level_sizes(ctx, 0, 0, 0, &lw, &lh) != EXR_ERR_SUCCESS || lw <= 0 || lh <= 0) {
+            snprintf(why, whycap, "inconsistent tile description");
+            return 0;
+        }
+        ntx = (int32_t)(((uint32_t)lw + tw - 1) / tw);
+        nty = (int32_t)(((uint32_t)lh + th - 1) / th);
+    }
+    for (int32_t ty = 0; ty < nty; ty++)
+        for (int32_t tx = 0; tx < ntx; tx++) {
+            if (storage == EXR_STORAGE_SCANLINE)
+                rv = exr_read_scanline_chunk_info(ctx, 0, (int)((int64_t)dw.min.y + (int64_t)ty * lpc), &ci);
+            else
+                rv = exr_read_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &ci);
+            if (rv != EXR_ERR_SUCCESS) {
+                snprintf(why, whycap, "the file is truncated or corrupt: chunk %d of %d cannot be read (%s)",
+                         (int)(ty * ntx + tx), (int)(ntx * nty), exr_msg[0] ? exr_msg : exr_get_default_error_message(rv));
+                return 0;
+            }
+            if ((int64_t)ci.data_offset < 0 || ci.data_offset + ci.packed_size > (uint64_t)fsize ||
+                (ci.compression == EXR_COMPRESSION_NONE && ci.packed_size < ci.unpacked_size)) {
+                snprintf(why, whycap,
+                         "the file is truncated: chunk %d of %d needs bytes %llu to %llu, the file has %lld",
+                         (int)(ty * ntx + tx), (int)(ntx * nty), (unsigned long long)ci.data_offset,
+                         (unsigned long long)(ci.data_offset + (ci.compression == EXR_COMPRESSION_NONE
+                                                                    ? ci.unpacked_size : ci.packed_size)),
+                         (long long)fsize);
+                return 0;
+            }
+        }
+    return 1;
+}
+
 static int64_t on_write(exr_const_context_t ctxt, void *ud, const void *buf, uint64_t sz, uint64_t off,
                         exr_stream_error_func_ptr_t error_cb)
 {
@@ -425,7 +476,7 @@ static exr_result_t decode_chunk(exr_context_t ctx, const exr_chunk_info_t *ci, 
     return exr_decoding_run(ctx, 0, dec);
 }
 
-pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
+pt_status img_exr_read(const char *path, uint64_t max_pixels, framebuffer **out, diag *d)
 {
     *out = NULL;
     exr_msg[0] = '\0';
@@ -469,10 +520,10 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
     rv = exr_get_data_window(ctx, 0, &dw);
     if (rv != EXR_ERR_SUCCESS) goto libfail;
     int64_t w64 = (int64_t)dw.max.x - dw.min.x + 1, h64 = (int64_t)dw.max.y - dw.min.y + 1;
-    if (w64 <= 0 || h64 <= 0 || w64 > IMG_MAX_SIDE || h64 > IMG_MAX_SIDE ||
-        (uint64_t)w64 * (uint64_t)h64 > IMG_MAX_PIXELS) {
-        diag_error(d, "cannot read '%s': image size %lldx%lld is empty or exceeds the limit (%d per side, %llu pixels)",
-               path, (long long)w64, (long long)h64, IMG_MAX_SIDE, (unsigned long long)IMG_MAX_PIXELS);
+    char why[256];
+    if (w64 <= 0 || h64 <= 0 || imgcheck_size((uint64_t)w64, (uint64_t)h64, max_pixels, why, sizeof why)) {
+        if (w64 <= 0 || h64 <= 0) snprintf(why, sizeof why, "image size %lldx%lld is empty", (long long)w64, (long long)h64);
+        diag_error(d, "cannot read '%s': %s", path, why);
         goto done;
     }
     const int w = (int)w64, h = (int)h64;
@@ -509,6 +560,10 @@ pt_status img_exr_read(const char *path, framebuffer **out, diag *d)
     if (use_y && chroma) {
         src_loc none = {NULL, 0, 0};
         diag_warn_once(d, none, "'%s': luminance/chroma EXR read as greyscale (RY/BY ignored)", path);
+    }
+    if (!chunks_inside(ctx, storage, dw, on_size(ctx, &s), why, sizeof why)) {
+        diag_error(d, "cannot read '%s': %s", path, why);
+        goto done;
     }
     fb = fb_new(w, h);
     if (fb && have[SLOT_A]) fb->alpha = calloc((size_t)w * (size_t)h, sizeof(float));

@@ -30,6 +30,7 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
 /* Read part 0 of a scanline or tiled EXR (level 0 of a mip/rip-mapped file).
  * R,G,B (half/float/uint, missing ones are 0) or, without any of those, Y as
  * grey; A into fb->alpha when present. The data window becomes the image. */
-pt_status img_exr_read(const char *path, framebuffer **out, diag *d);
+/* At most max_pixels pixels (img_read_limited). */
+pt_status img_exr_read(const char *path, uint64_t max_pixels, framebuffer **out, diag *d);
 
 #endif

@@ -336,6 +336,12 @@ pt_status img_write(const char *path, const framebuffer *fb, const img_write_opt
 
 pt_status img_read(const char *path, int png_raw, framebuffer **out, diag *d)
 {
+    return img_read_limited(path, png_raw, 0, out, d);
+}
+
+pt_status img_read_limited(const char *path, int png_raw, uint64_t max_pixels, framebuffer **out, diag *d)
+{
+    if (max_pixels == 0 || max_pixels > IMG_MAX_PIXELS) max_pixels = IMG_MAX_PIXELS;
     if (!out) return PT_ERR_USAGE;
     *out = NULL;
     if (!path || !*path) {
@@ -360,11 +366,11 @@ pt_status img_read(const char *path, int png_raw, framebuffer **out, diag *d)
     static const unsigned char exr_magic[4] = {0x76, 0x2f, 0x31, 0x01};
     /* PNG specification, section 5.2: the 8-byte signature. */
     static const unsigned char png_magic[8] = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a};
-    if (n >= 4 && memcmp(magic, exr_magic, 4) == 0) return img_exr_read(path, out, d);
-    if (n >= 8 && memcmp(magic, png_magic, 8) == 0) return img_png_read(path, png_raw, out, d);
+    if (n >= 4 && memcmp(magic, exr_magic, 4) == 0) return img_exr_read(path, max_pixels, out, d);
+    if (n >= 8 && memcmp(magic, png_magic, 8) == 0) return img_png_read(path, png_raw, max_pixels, out, d);
     if (n >= 3 && magic[0] == 'P' && (magic[1] == 'F' || magic[1] == 'f') &&
         (magic[2] == '\n' || magic[2] == '\r' || magic[2] == ' ' || magic[2] == '\t'))
-        return img_pfm_read(path, out, d);
+        return img_pfm_read(path, max_pixels, out, d);
     if (n == 0)
         diag_error(d, "cannot read '%s': file is empty", path);
     else

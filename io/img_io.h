@@ -3,13 +3,16 @@
  * success, so a failed write never leaves a partial file under the final name. */
 #ifndef PT_IMG_IO_H
 #define PT_IMG_IO_H
+#include <stdint.h>
 #include "diag.h"
 #include "framebuffer.h"
+#include "imgcheck.h"
 
 /* Readers refuse images larger than this (a guard against corrupt headers);
- * writers refuse framebuffers beyond it too. */
-#define IMG_MAX_SIDE 65536
-#define IMG_MAX_PIXELS (1ull << 28)
+ * writers refuse framebuffers beyond it too. img_read_limited lowers the
+ * pixel limit. */
+#define IMG_MAX_SIDE IMGCHECK_MAX_SIDE
+#define IMG_MAX_PIXELS IMGCHECK_MAX_PIXELS
 
 typedef enum { IMG_FMT_UNKNOWN, IMG_FMT_EXR, IMG_FMT_PNG, IMG_FMT_PFM } img_format;
 
@@ -64,6 +67,13 @@ pt_status img_write(const char *path, const framebuffer *fb, const img_write_opt
 /* Reads EXR (R,G,B channels, half or float), PFM, PNG (8/16 bit; sRGB decoded
  * to linear unless `png_raw` is set, then values are code/max). */
 pt_status img_read(const char *path, int png_raw, framebuffer **out, diag *d);
+/* img_read with at most max_pixels pixels (0 = IMG_MAX_PIXELS; never more).
+ * Every reader checks the declared size against it, and that the file can
+ * hold that many pixels (PNG: enough compressed data, core/imgcheck.h; EXR:
+ * every chunk of the offset table inside the file; PFM: the pixel bytes),
+ * before the framebuffer is allocated: a corrupt or truncated file that
+ * declares a huge image is a PT_ERR_IO error naming the reason. */
+pt_status img_read_limited(const char *path, int png_raw, uint64_t max_pixels, framebuffer **out, diag *d);
 /* Reads the channels "layer.<letter>" of an EXR's part 0 for each letter of
  * `suffixes` (e.g. "direct", "RGB"; layer NULL or "" = the unprefixed
  * channels) into *out: width*height*strlen(suffixes) interleaved floats

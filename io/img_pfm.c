@@ -118,7 +118,7 @@ static int parse_dim(const char *s, int *out)
     return 0;
 }
 
-pt_status img_pfm_read(const char *path, framebuffer **out, diag *d)
+pt_status img_pfm_read(const char *path, uint64_t max_pixels, framebuffer **out, diag *d)
 {
     *out = NULL;
     FILE *f = fopen(path, "rb");
@@ -156,9 +156,9 @@ pt_status img_pfm_read(const char *path, framebuffer **out, diag *d)
             goto done;
         }
     }
-    if (w > IMG_MAX_SIDE || h > IMG_MAX_SIDE || (uint64_t)w * (uint64_t)h > IMG_MAX_PIXELS) {
-        diag_error(d, "cannot read '%s': image size %dx%d exceeds the limit (%d per side, %llu pixels)", path, w,
-               h, IMG_MAX_SIDE, (unsigned long long)IMG_MAX_PIXELS);
+    char why[256];
+    if (imgcheck_size((uint64_t)w, (uint64_t)h, max_pixels, why, sizeof why)) {
+        diag_error(d, "cannot read '%s': %s", path, why);
         goto done;
     }
     /* A header may claim far more pixels than the file holds: check the

@@ -10,6 +10,7 @@ pt_status img_pfm_write(int fd, const char *name, const framebuffer *fb, diag *d
 
 /* Read "PF" (RGB) or "Pf" (grey, replicated to RGB); a negative scale means
  * little-endian data, a positive one big-endian. The |scale| is not applied. */
-pt_status img_pfm_read(const char *path, framebuffer **out, diag *d);
+/* At most max_pixels pixels (img_read_limited). */
+pt_status img_pfm_read(const char *path, uint64_t max_pixels, framebuffer **out, diag *d);
 
 #endif

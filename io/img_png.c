@@ -196,12 +196,18 @@ static pt_status write_png(int fd, const char *name, const framebuffer *fb, cons
     return PT_OK;
 }
 
-pt_status img_png_read(const char *path, int raw, framebuffer **out, diag *d)
+pt_status img_png_read(const char *path, int raw, uint64_t max_pixels, framebuffer **out, diag *d)
 {
     *out = NULL;
     FILE *f = fopen(path, "rb");
     if (!f) {
         diag_error(d, "cannot read '%s': %s", path, strerror(errno));
+        return PT_ERR_IO;
+    }
+    char why[256];
+    if (imgcheck_png(f, max_pixels, why, sizeof why)) {
+        diag_error(d, "cannot read '%s': %s", path, why);
+        fclose(f);
         return PT_ERR_IO;
     }
     png_ctx ctx = {-1, 0, {0}};
@@ -243,9 +249,8 @@ pt_status img_png_read(const char *path, int raw, framebuffer **out, diag *d)
     png_uint_32 w, h;
     int bit_depth, color_type, interlace;
     png_get_IHDR(png, info, &w, &h, &bit_depth, &color_type, &interlace, NULL, NULL);
-    if ((uint64_t)w * (uint64_t)h > IMG_MAX_PIXELS) {
-        diag_error(d, "cannot read '%s': image size %ux%u exceeds the limit (%llu pixels)", path, (unsigned)w,
-               (unsigned)h, (unsigned long long)IMG_MAX_PIXELS);
+    if (imgcheck_size(w, h, max_pixels, why, sizeof why)) {
+        diag_error(d, "cannot read '%s': %s", path, why);
         reported = 1;
         png_longjmp(png, 1);
     }

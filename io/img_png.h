@@ -28,6 +28,8 @@ pt_status img_png_write_display(int fd, const char *name, const framebuffer *fb,
 /* Read any PNG (1-16 bit grey, grey+alpha, RGB, RGBA, palette; interlaced or
  * not). Colour codes are decoded with img_srgb_decode unless `raw`, then
  * values are code/max. Alpha (incl. tRNS) goes to fb->alpha as code/max. */
-pt_status img_png_read(const char *path, int raw, framebuffer **out, diag *d);
+/* At most max_pixels pixels (img_read_limited); the file is checked by
+ * imgcheck_png before anything is allocated for its pixels. */
+pt_status img_png_read(const char *path, int raw, uint64_t max_pixels, framebuffer **out, diag *d);
 
 #endif

@@ -16,6 +16,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <tiffio.h>
+#include "imgcheck.h"
 
 typedef struct {
     const unsigned char *b;
@@ -68,9 +69,43 @@ static void png_mem_read(png_structp png, png_bytep dst, size_t len)
     m->pos += len;
 }
 
+/* libpng's own allocations (chunk data, zlib state, a row) never need much:
+ * the pixels are allocated here. libpng 1.6 warns that a text chunk is too
+ * large and then allocates it anyway (io/img_png.c, fuzz_image), so more
+ * than 64 MiB at once is refused, which libpng reports as an error. */
+static png_voidp png_lib_malloc(png_structp png, png_alloc_size_t n)
+{
+    (void)png;
+    return n <= ((png_alloc_size_t)64 << 20) ? malloc(n) : NULL;
+}
+
+static void png_lib_free(png_structp png, png_voidp p)
+{
+    (void)png;
+    free(p);
+}
+
+static void png_lib_warning(png_structp png, png_const_charp msg)
+{
+    (void)png;
+    (void)msg; /* nothing deep inside prints */
+}
+
 static int read_png(mem_src *m, sdl_img *out, char *why, size_t whycap)
 {
-    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    /* The chunk list first (core/imgcheck.h): a file whose image data cannot
+     * inflate to its declared size, or that ends inside a chunk, is refused
+     * before 8 bytes a pixel are allocated for it. */
+    FILE *mf = fmemopen((void *)m->b, m->n, "rb");
+    if (!mf) {
+        snprintf(why, whycap, "out of memory");
+        return SDL_IMG_ERROR;
+    }
+    int bad = imgcheck_png(mf, SDL_IMG_MAX_PIXELS, why, whycap);
+    fclose(mf);
+    if (bad) return SDL_IMG_ERROR;
+    png_structp png =
+        png_create_read_struct_2(PNG_LIBPNG_VER_STRING, NULL, NULL, png_lib_warning, NULL, png_lib_malloc, png_lib_free);
     png_infop info = png ? png_create_info_struct(png) : NULL;
     if (!png || !info) {
         png_destroy_read_struct(&png, &info, NULL);
@@ -78,7 +113,8 @@ static int read_png(mem_src *m, sdl_img *out, char *why, size_t whycap)
         return SDL_IMG_ERROR;
     }
     unsigned char *buf = NULL;
-    png_bytep *rows = NULL;
+    /* set after setjmp and freed after a longjmp: volatile (C11 7.13.2.1p3) */
+    png_bytep *volatile rows = NULL;
     if (setjmp(png_jmpbuf(png))) {
         png_destroy_read_struct(&png, &info, NULL);
         free(rows);
@@ -505,7 +541,7 @@ static int read_jpeg(mem_src *m, sdl_img *out, char *why, size_t whycap)
     je.pub.error_exit = jpeg_fail;
     je.pub.emit_message = jpeg_quiet;
     je.msg[0] = 0;
-    unsigned char *row = NULL;
+    unsigned char *volatile row = NULL; /* freed after a longjmp: volatile */
     if (setjmp(je.jb)) {
         jpeg_destroy_decompress(&ci);
         free(row);

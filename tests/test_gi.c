@@ -459,6 +459,26 @@ static void test_opencl_errors(void **state)
     assert_non_null(strstr(m, "no-such-device-anywhere"));
     free(m);
     diag_free(d);
+
+    /* Out of device memory: a budget of 64 KiB (gi_dev_options.max_bytes,
+     * --cl-max-memory) cannot hold 500 particles' buffers (about 100 bytes
+     * each, plus links): a clear PT_ERR_NOMEM error naming the sizes, the
+     * device and the way out, before anything is requested from PoCL. */
+    d = diag_new();
+    s.cl_device = NULL;
+    s.cl_max_bytes = 64 << 10;
+    gp = gi_particle_build(f.sc, f.a, &s, NULL, d, &st);
+    if (gp) st = gi_particle_light(gp, d);
+    gi_particle_free(gp);
+    assert_int_equal(st, PT_ERR_NOMEM);
+    assert_true(diag_errors(d) >= 1);
+    m = diag_format(diag_get(d, 0));
+    printf("  %s\n", m);
+    assert_non_null(strstr(m, "OpenCL: out of device memory"));
+    assert_non_null(strstr(m, "than the 0.1 MiB it may use"));
+    assert_non_null(strstr(m, "--cl-device c"));
+    free(m);
+    diag_free(d);
     unload(&f);
 }
 

@@ -195,6 +195,127 @@ static void test_image_size_limit(void **st)
     expect("size_bad.pov", "sphere {", "--size 20000x20000", 2, "400000000 pixels");
 }
 
+/* ------------------------------------------------------------ image files */
+
+/* A w x h framebuffer written as `name` in tmpdir (format by extension,
+ * EXR uncompressed); returns the path in `path`. */
+static void write_image(const char *name, int w, int h, char *path, size_t cap)
+{
+    snprintf(path, cap, "%s/%s", tmpdir, name);
+    framebuffer *fb = fb_new(w, h);
+    assert_non_null(fb);
+    for (size_t i = 0; i < (size_t)w * (size_t)h * 3u; i++) fb->rgb[i] = (float)(i % 7) / 7.0f;
+    img_write_opts o;
+    img_default_write_opts(&o);
+    o.exr_compression = 0;
+    assert_int_equal(img_write(path, fb, &o, NULL), PT_OK);
+    fb_free(fb);
+}
+
+static unsigned char file_bytes[1 << 20];
+
+static size_t read_bytes(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    size_t n = fread(file_bytes, 1, sizeof file_bytes, f);
+    fclose(f);
+    return n;
+}
+
+static void write_bytes(const char *path, size_t n)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(file_bytes, 1, n, f), n);
+    fclose(f);
+}
+
+/* img_read's message for `path` (which must fail with PT_ERR_IO). */
+static void expect_read_error(const char *path, uint64_t max_pixels, const char *needle)
+{
+    diag *d = diag_new();
+    framebuffer *fb = NULL;
+    assert_int_equal(img_read_limited(path, 0, max_pixels, &fb, d), PT_ERR_IO);
+    assert_null(fb);
+    assert_true(diag_errors(d) >= 1);
+    char *m = diag_format(diag_get(d, 0));
+    printf("  %s\n", m);
+    assert_non_null(strstr(m, needle));
+    free(m);
+    diag_free(d);
+}
+
+/* A file that declares a huge image in a few bytes is refused before the
+ * framebuffer is allocated: the checks read only the file's structure
+ * (core/imgcheck.h, the EXR offset table), so the error names what is
+ * missing rather than running out of memory (a 16384 x 16384 framebuffer
+ * is 3 GiB). The pixel limit is settable for io/ (img_read_limited). */
+static void test_image_file_limits(void **st)
+{
+    (void)st;
+    char png[512], exr[512], path[600];
+    write_image("small.png", 16, 16, png, sizeof png);
+    write_image("small.exr", 64, 64, exr, sizeof exr);
+
+    /* the settable limit: 256 pixels pass at 256, not at 255 */
+    framebuffer *fb = NULL;
+    assert_int_equal(img_read_limited(png, 0, 256, &fb, NULL), PT_OK);
+    fb_free(fb);
+    expect_read_error(png, 255, "image size 16x16 exceeds the limit (65536 per side, 255 pixels in all)");
+    expect_read_error(exr, 4095, "image size 64x64 exceeds the limit (65536 per side, 4095 pixels in all)");
+
+    /* PNG whose IHDR says 16384 x 16384 (2^28 pixels, within the hard
+     * limit) over the 16 x 16 image's data */
+    size_t n = read_bytes(png);
+    assert_true(n > 33 && memcmp(file_bytes + 12, "IHDR", 4) == 0);
+    static const unsigned char big[8] = {0, 0, 0x40, 0, 0, 0, 0x40, 0};
+    memcpy(file_bytes + 16, big, 8);
+    snprintf(path, sizeof path, "%s/huge.png", tmpdir);
+    write_bytes(path, n);
+    expect_read_error(path, 0, "declares 16384x16384 pixels (805306368 bytes of image data)");
+    /* the same cut inside its image data */
+    write_bytes(path, n - 20);
+    expect_read_error(path, 0, "the file is truncated: chunk 'IDAT' at byte");
+
+    /* EXR cut in half: its last scanline chunks lie beyond the end */
+    n = read_bytes(exr);
+    snprintf(path, sizeof path, "%s/cut.exr", tmpdir);
+    write_bytes(path, n / 2);
+    expect_read_error(path, 0, "the file is truncated");
+    /* EXR whose data window says 16384 x 16384 */
+    n = read_bytes(exr);
+    unsigned char *dw = NULL;
+    for (size_t i = 0; i + 17 <= n && !dw; i++)
+        if (memcmp(file_bytes + i, "dataWindow\0box2i\0", 17) == 0) dw = file_bytes + i;
+    assert_non_null(dw);
+    static const unsigned char box[16] = {0, 0, 0, 0, 0, 0, 0, 0, 0xff, 0x3f, 0, 0, 0xff, 0x3f, 0, 0};
+    memcpy(dw + 17 + 4, box, 16);
+    snprintf(path, sizeof path, "%s/huge.exr", tmpdir);
+    write_bytes(path, n);
+    expect_read_error(path, 0, "the file is truncated or corrupt: chunk");
+
+    /* The parser's reader (parser/sdl_imgread.c) checks PNGs the same way:
+     * an image_map of the huge PNG is refused with the reason (a warning:
+     * the image is transparent, as for a missing file). */
+    char text[1024];
+    snprintf(text, sizeof text,
+             "%slight_source { <0, 5, -5> rgb 1 }\n"
+             "plane { z, 1 pigment { image_map { png \"huge.png\" } } }\n", camera);
+    n = read_bytes(png);
+    memcpy(file_bytes + 16, big, 8);
+    snprintf(path, sizeof path, "%s/huge.png", tmpdir);
+    write_bytes(path, n);
+    char cmd[2048];
+    snprintf(path, sizeof path, "%s/imgmap.pov", tmpdir);
+    write_file(path, text);
+    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' parse imgmap.pov", tmpdir, PARTRAY_BIN);
+    assert_int_equal(run_capture(cmd), 0);
+    printf("%s", out_text);
+    assert_non_null(strstr(out_text, "imgmap.pov:3:"));
+    assert_non_null(strstr(out_text, "the file is truncated or corrupt: it declares 16384x16384 pixels"));
+}
+
 static void test_limit_usage(void **st)
 {
     (void)st;
@@ -221,6 +342,22 @@ static void test_opencl_no_platform(void **st)
     expect("ocl.pov", text, args, 1, "error: OpenCL: no platform found");
     unsetenv("OCL_ICD_VENDORS");
     assert_non_null(strstr(out_text, "pocl-opencl-icd"));
+}
+
+/* Out of device memory (PoCL): the particle GI's buffers beyond the
+ * memory it may use (--cl-max-memory, else the device's global memory and
+ * largest allocation) are a clear error before PoCL is asked, exit 1, no
+ * output. */
+static void test_opencl_out_of_memory(void **st)
+{
+    (void)st;
+    char text[512];
+    snprintf(text, sizeof text, "%slight_source { <2, 4, -3> rgb 1 }\nplane { y, -1 pigment { rgb 0.8 } }\n"
+             "sphere { 0, 1 pigment { rgb <0.8, 0.3, 0.2> } }\n", camera);
+    expect("oom.pov", text, "--gi particle --particles 20000 --cl-max-memory 1", 1,
+           "error: OpenCL: out of device memory: particle GI needs");
+    assert_non_null(strstr(out_text, "than the 1.0 MiB it may use (CL_DEVICE_GLOBAL_MEM_SIZE or --cl-max-memory)"));
+    expect("oom.pov", text, "--gi particle --cl-max-memory 0", 2, "--cl-max-memory wants a positive integer (MiB)");
 }
 
 /* ------------------------------------------------------------ outputs */
@@ -384,8 +521,10 @@ int main(void)
         cmocka_unit_test(test_array_limit),
         cmocka_unit_test(test_mesh_memory_limit),
         cmocka_unit_test(test_image_size_limit),
+        cmocka_unit_test(test_image_file_limits),
         cmocka_unit_test(test_limit_usage),
         cmocka_unit_test(test_opencl_no_platform),
+        cmocka_unit_test(test_opencl_out_of_memory),
         cmocka_unit_test(test_write_fails_file_size_limit),
         cmocka_unit_test(test_write_fails_unwritable_dir),
         cmocka_unit_test(test_sigterm_partial),
