@@ -4,7 +4,7 @@
 #   tests/fuzz/run.sh [SECONDS_PER_TARGET] [TARGET...]
 #
 # SECONDS_PER_TARGET defaults to 600; TARGET is any of scan directive parse
-# mesh2 image (default: all, one after the other; fuzzers are not run in
+# mesh2 image sdlimage (default: all, one after the other; fuzzers are not run in
 # parallel). The build goes to $BUILD_DIR (default build-fuzz: clang,
 # -DPARTRAY_FUZZ=ON, so ASan + UBSan). The corpus grows across runs in
 # $BUILD_DIR/fuzz-work/corpus/; findings land in $BUILD_DIR/fuzz-work/artifacts/
@@ -14,7 +14,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 repo=$(cd "$here/../.." && pwd)
 secs=${1:-600}
 [ $# -gt 0 ] && shift
-targets=${*:-scan directive parse mesh2 image}
+targets=${*:-scan directive parse mesh2 image sdlimage}
 build=${BUILD_DIR:-$repo/build-fuzz}
 
 if [ ! -f "$build/CMakeCache.txt" ]; then
@@ -28,7 +28,7 @@ cmake --build "$build" -j "$(nproc)" --target $bins >/dev/null
 
 status=0
 for t in $targets; do
-    case "$t" in image) dict="$here/image.dict" ;; *) dict="$build/tests/fuzz/sdl.dict" ;; esac
+    case "$t" in image|sdlimage) dict="$here/image.dict" ;; *) dict="$build/tests/fuzz/sdl.dict" ;; esac
     "$here/fuzz_one.sh" "$build/tests/fuzz/fuzz_$t" "$t" "$build/fuzz-work" "$secs" -dict="$dict" || status=1
 done
 exit $status
