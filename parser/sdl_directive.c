@@ -846,6 +846,7 @@ static void message_directive(sdl_parser *p, sdl_kw kw, src_loc loc)
 {
     const char *msg = sdl_string(p);
     if (!sdl_ok(p)) return;
+    msg = sdl_c_string(p, msg);
     if (kw == KW_ERROR) {
         sdl_error(p, loc, PT_ERR_SYNTAX, "#error: %s", msg);
     } else if (kw == KW_WARNING) {

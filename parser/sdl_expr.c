@@ -1167,7 +1167,21 @@ static const char *string_expr(sdl_parser *p)
     if (t.tk.kind == TOK_STRING) {
         char *s = sdl_alloc(p, (size_t)t.tk.len * 3 + 1);
         if (!s) return "";
-        sdl_scan_unescape(&t.tk, s, (size_t)t.tk.len * 3 + 1);
+        sdl_token lit = t.tk;
+        char *ascii = NULL;
+        if (p->charset == 0 && p->version >= 3.5) {
+            /* POV-Ray 3.7's String_To_UCS2 with charset ascii (the default):
+             * each byte above 127 of the literal becomes a space (escapes
+             * such as \u00e9 are read afterwards and keep their code) */
+            for (int i = 0; i < lit.len && !ascii; i++)
+                if ((unsigned char)lit.text[i] > 127) ascii = sdl_alloc(p, (size_t)lit.len + 1);
+            if (ascii) {
+                for (int i = 0; i < lit.len; i++) ascii[i] = (unsigned char)lit.text[i] > 127 ? ' ' : lit.text[i];
+                lit.text = ascii;
+                sdl_warn_once(p, t.tk.loc, "non-ASCII characters in a string are replaced by spaces (global_settings { charset utf8 } keeps them), as POV-Ray 3.7 does");
+            }
+        }
+        sdl_scan_unescape(&lit, s, (size_t)t.tk.len * 3 + 1);
         return s;
     }
     if (t.tk.kind == TOK_IDENT && t.val.kind == VAL_STRING) return t.val.str;
@@ -1180,3 +1194,19 @@ static const char *string_expr(sdl_parser *p)
 }
 
 const char *sdl_string(sdl_parser *p) { return string_expr(p); }
+
+const char *sdl_c_string(sdl_parser *p, const char *s)
+{
+    const char *a = s;
+    int wide = 0;
+    for (; *a; a++) wide |= (unsigned char)*a > 127;
+    if (!wide) return s;
+    char *r = sdl_alloc(p, strlen(s) + 1), *o = r;
+    if (!r) return s;
+    for (a = s; *a;) {
+        unsigned c = utf8_at(&a);
+        *o++ = c > 127 ? ' ' : (char)c;
+    }
+    *o = 0;
+    return r;
+}

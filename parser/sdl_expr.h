@@ -35,6 +35,9 @@ colour5 sdl_colour(sdl_parser *p, int want_ft);
 rgb sdl_rgb(sdl_parser *p);
 /* A string expression; the result lives in the scene arena. */
 const char *sdl_string(sdl_parser *p);
+/* A string as POV-Ray 3.7 hands it to C (messages, #write): every code point
+ * above 127 becomes a space (UCS2_To_String). */
+const char *sdl_c_string(sdl_parser *p, const char *s);
 
 /* Token classes (POV-Ray's CASE_EXPRESS, CASE_FLOAT, colour and string starts). */
 int sdl_starts_expr(const sdl_tok *t);

@@ -474,7 +474,7 @@ static void write_item(sdl_parser *p, sdl_file *f)
         return;
     }
     if (sdl_starts_string(t)) {
-        fputs(sdl_string(p), f->out);
+        fputs(sdl_c_string(p, sdl_string(p)), f->out);
         return;
     }
     if (sdl_starts_expr(t)) {

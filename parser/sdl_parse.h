@@ -119,6 +119,7 @@ typedef struct sdl_parser {
                              macro arguments (bounded by SDL_MAX_NESTING) */
     int include_depth;
     double version;       /* language version from #version, 3.7 by default */
+    int charset;          /* global_settings { charset }: 0 ascii (POV-Ray's default), 1 utf8, 2 sys */
     int default_texture_set;
     src_loc last_loc;     /* last token returned (for end-of-file locations) */
     void *geom_cache;     /* sdl_geom: mesh BVHs built for trace/inside */

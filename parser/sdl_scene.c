@@ -531,7 +531,14 @@ static int global_item(sdl_parser *p, scene_global *g)
     }
     case KW_RADIOSITY: radiosity_block(p, &g->radiosity); break;
     case KW_PHOTONS: photons_block(p, g); break;
-    case KW_CHARSET: sdl_next(p); break;
+    case KW_CHARSET: { /* ascii | utf8 | sys: how string literals' bytes are read */
+        sdl_tok k = sdl_next(p);
+        if (k.tk.kind == TOK_KEYWORD && k.tk.kw == KW_ASCII) p->charset = 0;
+        else if (k.tk.kind == TOK_KEYWORD && k.tk.kw == KW_UTF8) p->charset = 1;
+        else if (k.tk.kind == TOK_KEYWORD && k.tk.kw == KW_SYS) p->charset = 2; /* read as UTF-8 here */
+        else sdl_unexpected(p, &k, "ascii, utf8 or sys");
+        break;
+    }
     default:
         sdl_warn_once(p, t.tk.loc, "global_settings '%s' is not supported yet and is ignored", sdl_kw_text(t.tk.kw));
         sdl_skip_item(p);

@@ -58,4 +58,10 @@ Inc(Nest[1][1])
 Inc(K)
 #debug concat("ref1 [", str(Arr[0], 0, 0), ",", str(Arr[1], 0, 0), ",", str(Arr[2], 0, 0), ",", str(Arr[3], 0, 0), ",", str(Arr[4], 0, 0), "]\n")
 #debug concat("ref2 [", str(G[1][0], 0, 0), ",", str(G[1][1], 0, 0), "][", Strs[0], Strs[1], "][", vstr(3, Vs[0], ",", 0, 0), "][", str(Nest[1][1], 0, 0), "][", str(K, 0, 0), "]\n")
+// ---- charset: ascii (the default) turns each byte above 127 of a literal
+// into a space; utf8 keeps code points; output to C strings (#debug) makes
+// every code point above 127 a space; \u escapes keep their code
+#debug concat("cs1 [", "éx", "][", str(strlen("éx"), 0, 0), "][", str(asc(chr(233)), 0, 0), "][", chr(233), "][", str(asc("\u00e9"), 0, 0), "]\n")
+global_settings { charset utf8 }
+#debug concat("cs2 [", "éx", "][", str(strlen("éx"), 0, 0), "][", str(asc("é"), 0, 0), "][", str(strcmp("é", "e"), 0, 0), "]\n")
 sphere { 0, 1 pigment { rgb 1 } }
