@@ -167,7 +167,9 @@ static void job(void *ctx, int index, int thread)
                 const struct RTCRayHit *h = &rh[m];
                 vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
                 vec3 o = v3(h->ray.org_x, h->ray.org_y, h->ray.org_z);
-                target = gi_lookup_nearest_in(J->grid, cell[m], hp[m], d, o, J->maxdist);
+                float tn[3];
+                int tobj;
+                target = gi_lookup_nearest_in2(J->grid, cell[m], hp[m], d, o, J->maxdist, tn, &tobj);
                 if (target >= 0 && J->pobj) {
                     /* the answer must lie on the object hit: near a contact
                      * (a sphere on the floor) or where a box stands on the
@@ -183,9 +185,20 @@ static void job(void *ctx, int index, int thread)
                         agree = v3(h->hit.Ng_x, h->hit.Ng_y, h->hit.Ng_z);
                         if (v3_dot(agree, d) > 0.0) agree = v3_neg(agree);
                     }
-                    const gi_dev_particle *tp = &J->p[target];
-                    double ag = tp->n[0] * agree.x + tp->n[1] * agree.y + tp->n[2] * agree.z;
-                    if (ho && (J->pobj[target] != ho || ag < AGREE * v3_len(agree))) {
+                    /* the answer's object and normal from the lookup's
+                     * copy when it has them (no random read of pobj[] and
+                     * the particle records) */
+                    int other_obj;
+                    double ag;
+                    if (tobj >= -1) {
+                        other_obj = ho && tobj != gi_lookup_object_id(J->grid, ho);
+                        ag = tn[0] * agree.x + tn[1] * agree.y + tn[2] * agree.z;
+                    } else {
+                        const gi_dev_particle *tp = &J->p[target];
+                        other_obj = J->pobj[target] != ho;
+                        ag = tp->n[0] * agree.x + tp->n[1] * agree.y + tp->n[2] * agree.z;
+                    }
+                    if (ho && (other_obj || ag < AGREE * v3_len(agree))) {
                         double al = v3_len(agree);
                         target = gi_lookup_nearest_on(J->grid, hp[m], d, o, J->maxdist, J->pobj, ho,
                                                       al > 0.0 ? v3_scale(agree, 1.0 / al) : agree, AGREE,

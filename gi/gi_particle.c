@@ -211,6 +211,7 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
     unsigned char *pin = NULL;
     const void **pobj = particle_objects(gp, ps, &pin, &st);
     if (!grid) st = PT_ERR_NOMEM;
+    if (st == PT_OK) st = gi_lookup_set_objects(grid, (const void *const *)pobj);
     if (st == PT_OK)
         st = gi_links_build(gp->a, ps->p, pobj, pin, n, gp->set.scatter_side, seed, grid, 3.0 * ps->spacing, gp->threads,
                             links, keep, ls);
@@ -353,6 +354,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         unsigned char *pin = NULL;
         const void **pobj = particle_objects(gp, &gp->ps, &pin, &st);
         if (!grid) st = PT_ERR_NOMEM;
+        if (st == PT_OK) st = gi_lookup_set_objects(grid, (const void *const *)pobj);
         tg = timer_now();
         if (st == PT_OK)
             st = gi_links_build(a, gp->ps.p, pobj, pin, n, set->gather_side, set->seed ^ 0x6a7ULL, grid, 3.0 * spacing,

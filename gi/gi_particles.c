@@ -411,7 +411,7 @@ typedef struct {
     float x[LK_W], y[LK_W], z[LK_W];
     float nx[LK_W], ny[LK_W], nz[LK_W]; /* rounded to 1/127 as the hashed grid's */
     int idx[LK_W];                      /* particle of each slot, -1 for padding */
-    int pad[LK_W];
+    int obj[LK_W];                      /* object id (gi_lookup_set_objects), -1 unknown */
 } lblock;
 _Static_assert(sizeof(lblock) == 128, "lookup block is two cache lines");
 
@@ -424,7 +424,65 @@ struct gi_lookup {
     long ne;
     int n;
     gi_grid *fallback;
+    /* object pointer -> id (open addressing, power-of-two size) */
+    const void **okey;
+    int omask;
 };
+
+static unsigned ptr_hash(const void *p)
+{
+    uint64_t v = (uint64_t)(uintptr_t)p;
+    v ^= v >> 33;
+    v *= 0xff51afd7ed558ccdULL;
+    v ^= v >> 33;
+    return (unsigned)v;
+}
+
+int gi_lookup_object_id(const gi_lookup *g, const void *obj)
+{
+    if (!g->okey || !obj) return -1;
+    for (unsigned h = ptr_hash(obj) & (unsigned)g->omask;; h = (h + 1) & (unsigned)g->omask) {
+        if (g->okey[h] == obj) return (int)h;
+        if (!g->okey[h]) return -1;
+    }
+}
+
+pt_status gi_lookup_set_objects(gi_lookup *g, const void *const *pobj)
+{
+    if (!pobj || g->n == 0) return PT_OK;
+    /* distinct objects: at most n; table at least twice that count */
+    int distinct = 0;
+    unsigned size = 64;
+    free(g->okey);
+    g->okey = NULL;
+    for (;;) {
+        g->okey = calloc(size, sizeof *g->okey);
+        if (!g->okey) return PT_ERR_NOMEM;
+        g->omask = (int)size - 1;
+        distinct = 0;
+        int full = 0;
+        for (int i = 0; i < g->n && !full; i++) {
+            if (!pobj[i]) continue;
+            unsigned h = ptr_hash(pobj[i]) & (unsigned)g->omask;
+            while (g->okey[h] && g->okey[h] != pobj[i]) h = (h + 1) & (unsigned)g->omask;
+            if (!g->okey[h]) {
+                g->okey[h] = pobj[i];
+                if (2 * (unsigned)++distinct > size) full = 1;
+            }
+        }
+        if (!full) break;
+        free(g->okey);
+        g->okey = NULL;
+        size *= 4;
+    }
+    long nb = g->ne / LK_W;
+    for (long k = 0; k < nb; k++)
+        for (int l = 0; l < LK_W; l++) {
+            int i = g->b[k].idx[l];
+            g->b[k].obj[l] = i >= 0 ? gi_lookup_object_id(g, pobj[i]) : -1;
+        }
+    return PT_OK;
+}
 
 gi_lookup *gi_lookup_build(const gi_particles *ps, double cell)
 {
@@ -489,7 +547,7 @@ gi_lookup *gi_lookup_build(const gi_particles *ps, double cell)
             g->b[k].x[l] = g->b[k].y[l] = g->b[k].z[l] = INFINITY;
             g->b[k].nx[l] = g->b[k].ny[l] = g->b[k].nz[l] = 0.0f;
             g->b[k].idx[l] = -1;
-            g->b[k].pad[l] = 0;
+            g->b[k].obj[l] = -1;
         }
     for (int i = 0; i < n; i++) {
         const gi_dev_particle *p = &ps->p[i];
@@ -516,6 +574,7 @@ void gi_lookup_free(gi_lookup *g)
     if (!g) return;
     free(g->start);
     free(g->b);
+    free(g->okey);
     gi_grid_free(g->fallback);
     free(g);
 }
@@ -527,20 +586,25 @@ size_t gi_lookup_bytes(const gi_lookup *g)
              : 0;
 }
 
-/* The lowest corner cell of the 2x2x2 block a query at q reads. */
+/* The lowest corner cell of the 2x2x2 block a query at q reads. (Per link
+ * ray: no floor() calls; a coordinate past the grid, or NaN, is clamped
+ * before the conversion.) */
 long gi_lookup_cell(const gi_lookup *g, vec3 q)
 {
     if (!g->n) return 0;
     long c[3];
-    double qq[3] = {q.x, q.y, q.z};
+    double qq[3] = {q.x - g->origin.x, q.y - g->origin.y, q.z - g->origin.z};
     for (int k = 0; k < 3; k++) {
-        double f = (qq[k] - v3_idx(g->origin, k)) * g->inv;
-        long i = 0;
-        if (isfinite(f)) {
-            double fl = floor(f);
-            i = (long)fl - (f - fl < 0.5 ? 1 : 0);
+        double f = qq[k] * g->inv, top = (double)g->dim[k];
+        long i;
+        if (!(f >= 0.5)) i = 0; /* also NaN */
+        else if (f >= top) i = g->dim[k] - 2;
+        else {
+            i = (long)f; /* floor: f >= 0 */
+            i -= f - (double)i < 0.5;
+            if (i > g->dim[k] - 2) i = g->dim[k] - 2;
         }
-        c[k] = i < 0 ? 0 : (i > g->dim[k] - 2 ? g->dim[k] - 2 : i);
+        c[k] = i;
     }
     return (c[2] * g->dim[1] + c[1]) * g->dim[0] + c[0];
 }
@@ -578,6 +642,13 @@ int gi_lookup_nearest_on(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double 
 
 int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist)
 {
+    return gi_lookup_nearest_in2(g, cell, q, dir, org, maxdist, NULL, NULL);
+}
+
+int gi_lookup_nearest_in2(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist, float nrm[3],
+                          int *obj)
+{
+    if (obj) *obj = -2;
     if (g->n == 0 || !v3_finite(q)) return -1;
     float qx = (float)q.x, qy = (float)q.y, qz = (float)q.z;
     float dx = (float)dir.x, dy = (float)dir.y, dz = (float)dir.z;
@@ -631,7 +702,19 @@ int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 o
             bd = bl[l];
         }
     }
-    if (bs >= 0) return g->b[bs / LK_W].idx[bs % LK_W];
+    if (bs >= 0) {
+        /* the winner's rounded normal and object id ride in its block (no
+         * second random read of the particle records) */
+        const lblock *e = &g->b[bs / LK_W];
+        int l = bs % LK_W;
+        if (nrm) {
+            nrm[0] = e->nx[l] * (1.0f / 127.0f);
+            nrm[1] = e->ny[l] * (1.0f / 127.0f);
+            nrm[2] = e->nz[l] * (1.0f / 127.0f);
+        }
+        if (obj) *obj = e->obj[l];
+        return e->idx[l];
+    }
     /* nothing within the margin: the ring search, up to maxdist */
     return maxdist > m ? gi_grid_nearest(g->fallback, q, dir, org, maxdist) : -1;
 }

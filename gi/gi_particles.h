@@ -77,6 +77,15 @@ int gi_lookup_nearest(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double max
 long gi_lookup_cell(const gi_lookup *g, vec3 q);
 void gi_lookup_prefetch(const gi_lookup *g, long cell, int stage);
 int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist);
+/* Object ids for the answers (pobj: the object of each particle). */
+pt_status gi_lookup_set_objects(gi_lookup *g, const void *const *pobj);
+/* The id of an object (-1: no particle of the lookup lies on it). */
+int gi_lookup_object_id(const gi_lookup *g, const void *obj);
+/* As gi_lookup_nearest_in, also giving the answer's normal (rounded to
+ * 1/127) and object id, read from the lookup's own copy; *obj = -2 when
+ * they are not known (the answer came from the ring search, or none). */
+int gi_lookup_nearest_in2(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist, float nrm[3],
+                          int *obj);
 /* As gi_lookup_nearest with gi_grid_nearest_on's filters (a ring search:
  * the slow path for answers on the wrong object or side). */
 int gi_lookup_nearest_on(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double maxdist, const void *const *pobj,
