@@ -242,7 +242,10 @@ static int is_csg_kind_early(shape_kind k)
 /* POV-Ray 3.7's Link_To_Frame drops the bound of a top-level object that is
  * cheap to intersect (remove_bounds, on by default): it keeps those of
  * unions, intersections/differences, merges, polys, text and quadrics
- * without automatic (finite) bounds. Bounds below a CSG object stay. */
+ * without automatic (finite) bounds. Bounds below a CSG object stay. But
+ * its Parse_Object_Mods has already given the object the bounding objects'
+ * box when that is smaller than its own, and rays missing that box skip the
+ * object; so a dropped bound still culls by its box. */
 static int keeps_bound(const scene_object *o, int top)
 {
     if (!top) return 1;
@@ -262,9 +265,28 @@ static int keeps_bound(const scene_object *o, int top)
     }
 }
 
-static int add_bound_objects(accel *a, diag *d, const scene_object *host)
+static int push_bshape(accel *a)
+{
+    if (a->nbshapes < a->capbshapes) return 1;
+    size_t cap = (size_t)a->capbshapes;
+    if (!grow((void **)&a->bshapes, &cap, (size_t)a->nbshapes + 1, sizeof(accel_shape))) return 0;
+    a->capbshapes = (int)cap;
+    return 1;
+}
+
+static double box_volume(vec3 lo, vec3 hi)
+{
+    vec3 e = v3_sub(hi, lo);
+    return e.x > 0 && e.y > 0 && e.z > 0 ? e.x * e.y * e.z : 0.0;
+}
+
+/* The bounding objects of `host` as shapes in a->bshapes; with `box_only`,
+ * one box: the intersection of their (non-inverted) world boxes, kept only
+ * when smaller than the host's own box (POV-Ray's rule). */
+static int add_bound_objects(accel *a, diag *d, const scene_object *host, int box_only)
 {
     const scene_object *list = host->bound;
+    vec3 blo = v3s(-INFINITY), bhi = v3s(INFINITY);
     for (int i = 0; list && i < list->u.csg.nkids; i++) {
         const scene_object *k = list->u.csg.kids[i];
         if (!k) continue;
@@ -274,31 +296,50 @@ static int add_bound_objects(accel *a, diag *d, const scene_object *host)
         }
         scene_object moved = *k;
         moved.transform = xform_then(k->transform, host->transform);
-        if (a->nbshapes == a->capbshapes) {
-            size_t cap = (size_t)a->capbshapes;
-            if (!grow((void **)&a->bshapes, &cap, (size_t)a->nbshapes + 1, sizeof(accel_shape))) return 0;
-            a->capbshapes = (int)cap;
-        }
+        if (!push_bshape(a)) return 0;
         if (moved.kind == SHAPE_MESH || moved.kind == SHAPE_UNSUPPORTED ||
             accel_shape_init(&a->bshapes[a->nbshapes], &moved) != 0) {
             diag_warn_once(d, k->loc, "this bounding object is not evaluated: the bound is ignored");
             continue;
         }
-        if (a->bshapes[a->nbshapes].infinite)
-            accel_shape_clip_plane(&a->bshapes[a->nbshapes], v3s(-INFINITY), v3s(INFINITY));
+        accel_shape *b = &a->bshapes[a->nbshapes];
+        if (box_only) {
+            if (!b->infinite && b->kind != SHAPE_PLANE && !(k->flags & OBJ_INVERSE)) {
+                blo = v3_max(blo, b->lo);
+                bhi = v3_min(bhi, b->hi);
+            }
+            accel_shape_release(b);
+            continue;
+        }
+        if (b->infinite) accel_shape_clip_plane(b, v3s(-INFINITY), v3s(INFINITY));
         a->nbshapes++;
+    }
+    if (box_only && v3_finite(blo) && v3_finite(bhi)) {
+        accel_shape own;
+        if (accel_shape_init(&own, host) != 0) return 1;
+        double vo = own.infinite || own.kind == SHAPE_PLANE ? INFINITY : box_volume(own.lo, own.hi);
+        accel_shape_release(&own);
+        if (!(box_volume(blo, bhi) < vo)) return 1;
+        scene_object box;
+        memset(&box, 0, sizeof box);
+        box.kind = SHAPE_BOX;
+        box.transform = xform_identity();
+        box.u.box.c1 = blo;
+        box.u.box.c2 = v3_max(blo, bhi);
+        if (!push_bshape(a)) return 0;
+        if (accel_shape_init(&a->bshapes[a->nbshapes], &box) == 0) a->nbshapes++;
     }
     return 1;
 }
 
-/* The bounds applying to object o (whose own bound counts if `own`), as a
- * range of a->bshapes. 0 on out-of-memory. */
+/* The bounds applying to object o (whose own bound counts in full if `own`,
+ * else by its box), as a range of a->bshapes. 0 on out-of-memory. */
 static int collect_bounds(accel *a, diag *d, const scene_object *o, int own, int *b0, int *bn)
 {
     *b0 = a->nbshapes;
     for (const bound_chain *c = a->cur_chain; c; c = c->up)
-        if (!add_bound_objects(a, d, c->host)) return 0;
-    if (own && o->bound && !add_bound_objects(a, d, o)) return 0;
+        if (!add_bound_objects(a, d, c->host, 0)) return 0;
+    if (o->bound && !add_bound_objects(a, d, o, !own)) return 0;
     *bn = a->nbshapes - *b0;
     return 1;
 }

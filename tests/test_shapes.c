@@ -1446,8 +1446,9 @@ static void test_ovus(void **st)
 /* bounded_by with POV-Ray 3.7's semantics: a ray sees the object only if it
  * meets the bound (anywhere ahead) or starts inside it (Ray_In_Bound); the
  * bound never cuts the surface; top-level objects that are cheap to
- * intersect lose their bound (Link_To_Frame, remove_bounds on), objects in
- * unions and CSG objects, polys, text and unbounded quadrics keep it */
+ * intersect lose their bound (Link_To_Frame, remove_bounds on) but keep its
+ * box when smaller than theirs; objects in unions and CSG objects, polys,
+ * text and unbounded quadrics keep the bound */
 static void test_bounded_by(void **st)
 {
     (void)st;
@@ -1463,8 +1464,16 @@ static void test_bounded_by(void **st)
     /* a ray starting inside the bound */
     expect_hit(&w, v3(0, 0, 0), v3(1, 0, 0), 1.0, v3(1, 0, 0), 1e-12, 1e-12);
     done(&w);
-    /* a top-level sphere's bound is dropped, as POV-Ray does by default */
-    w = build("sphere { 0, 1 bounded_by { box { -0.5, 0.5 } } }");
+    /* a top-level sphere's bound is dropped (remove_bounds) but the sphere
+     * keeps the bound's smaller box, which culls rays missing it */
+    w = build("sphere { 0, 1 bounded_by { sphere { 0, 0.5 } } }");
+    expect_miss(&w, v3(-5, 0.8, 0), v3(1, 0, 0));
+    /* through the box's corner region, outside the bounding sphere itself */
+    expect_hit(&w, v3(-5, 0.45, 0.45), v3(1, 0, 0), 5 - sqrt(1 - 2 * 0.45 * 0.45), v3(-sqrt(1 - 2 * 0.45 * 0.45), 0.45, 0.45),
+               1e-12, 1e-12);
+    done(&w);
+    /* a bound larger than the object's own box changes nothing */
+    w = build("sphere { 0, 1 bounded_by { sphere { 0, 3 } } }");
     expect_hit(&w, v3(-5, 0.8, 0), v3(1, 0, 0), 5 - 0.6, v3(-0.6, 0.8, 0), 1e-12, 1e-12);
     done(&w);
     /* ... kept inside a union; the union's own bound holds for its members */
