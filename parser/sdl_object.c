@@ -861,6 +861,11 @@ static sdl_obj *object_body(sdl_parser *p)
     return NULL;
 }
 
+sdl_obj *sdl_parse_object_body(sdl_parser *p)
+{
+    return object_body(p); /* no modifiers: POV-Ray's Parse_Bound_Clip takes the object as it is */
+}
+
 static shape_kind shape_of(sdl_kw k)
 {
     switch (k) {

@@ -15,6 +15,9 @@
 int sdl_starts_object(const sdl_tok *t);
 /* object_statement := object_keyword '{' ... '}' ; NULL after an error. */
 sdl_obj *sdl_parse_object(sdl_parser *p);
+/* An identifier or an object statement (no modifiers after it), for the
+ * object pattern; NULL after an error. */
+sdl_obj *sdl_parse_object_body(sdl_parser *p);
 /* Deep copy (textures copied, meshes shared). */
 sdl_obj *sdl_copy_obj(sdl_parser *p, const sdl_obj *o);
 void sdl_obj_transform(sdl_obj *o, const xform *x);

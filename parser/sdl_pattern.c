@@ -22,6 +22,7 @@
 #include "sdl_function.h"
 #include "sdl_image.h"
 #include "sdl_material.h"
+#include "sdl_object.h"
 
 #define PAT_EPS 1.0e-10
 #define MAX_MAP_ENTRIES 256
@@ -932,12 +933,21 @@ static int pattern_type(sdl_parser *p, target *tg)
         }
         break;
     }
-    case KW_OBJECT:
-        unsupported_pattern(p, tg, &t);
+    case KW_OBJECT: {
+        /* object { object-or-identifier [list entries] }: 1 inside, 0
+         * outside (POV-Ray 3.7's object pattern; the two listed entries
+         * stand inside the braces) */
+        set_kind(tg, PAT_OBJECT, name);
         pt->frequency = 0.0;
-        if (sdl_begin_block(p, "object")) sdl_skip_block(p);
+        pt->object = NULL;
+        if (!sdl_begin_block(p, "object")) break;
+        sdl_obj *so = sdl_parse_object_body(p);
+        if (so && so->obj) pt->object = so->obj;
+        else if (sdl_ok(p)) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "object or object identifier expected");
         blend_list(p, tg, 2);
+        sdl_end_block(p);
         break;
+    }
     case KW_FUNCTION:
         /* function { body }: a user function of x, y, z (sdl_function.c) */
         set_kind(tg, PAT_FUNCTION, name);

@@ -28,6 +28,7 @@
 #include "shade_funcenv.h"
 #include "shade_noise.h"
 #include "shade_tiling.h"
+#include "accel_shapes.h"
 
 #define PAT_EPSILON 1.0e-10
 #define COORD_LIMIT 1.0e17
@@ -769,6 +770,37 @@ static double density(const scene_pattern *pat, vec3 p)
     return v < 0.0 ? 0.0 : v;
 }
 
+/* The object pattern's inside test (POV-Ray's Inside_Object): CSG as
+ * union/merge any, intersection all, difference the first and none of the
+ * others, each node's `inverse` negating it; leaves by accel's shape test
+ * (a shape accel cannot build, or a patch without inside, is outside).
+ * Clipping objects are not applied. */
+static int object_inside(const scene_object *o, vec3 p, int depth)
+{
+    int in = 0;
+    if (depth > 64) return 0;
+    switch (o->kind) {
+    case SHAPE_UNION: case SHAPE_MERGE:
+        for (int i = 0; i < o->u.csg.nkids && !in; i++) in = object_inside(o->u.csg.kids[i], p, depth + 1);
+        break;
+    case SHAPE_INTERSECTION:
+        in = o->u.csg.nkids > 0;
+        for (int i = 0; i < o->u.csg.nkids && in; i++) in = object_inside(o->u.csg.kids[i], p, depth + 1);
+        break;
+    case SHAPE_DIFFERENCE:
+        in = o->u.csg.nkids > 0 && object_inside(o->u.csg.kids[0], p, depth + 1);
+        for (int i = 1; i < o->u.csg.nkids && in; i++) in = !object_inside(o->u.csg.kids[i], p, depth + 1);
+        break;
+    default: {
+        accel_shape sh;
+        if (accel_shape_init(&sh, o) == 0) in = accel_shape_inside(&sh, p);
+        accel_shape_release(&sh);
+        break;
+    }
+    }
+    return (o->flags & OBJ_INVERSE) ? !in : in;
+}
+
 static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
 {
     int gen = pat->noise_generator ? pat->noise_generator : c->noise_generator;
@@ -835,6 +867,7 @@ static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
     case PAT_AOI: return aoi(c);
     case PAT_TILING: return tiling_value(pat->tiling, p);
     case PAT_DENSITY: return density(pat, p);
+    case PAT_OBJECT: return pat->object && object_inside(pat->object, p, 0) ? 1.0 : 0.0;
     default: return 0.0;
     }
 }
