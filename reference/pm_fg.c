@@ -82,7 +82,6 @@ static int trace_skip(const fg_ctx *c, vec3 org, vec3 dir, unsigned skip, accel_
     return 0;
 }
 
-static rgb background(const scene *sc) { return frgb(sc->background.r, sc->background.g, sc->background.b); }
 
 /* Whether the photon (or irradiance point) at y, normal ny, may stand for
  * light at x, normal nx, on the surface of key `surf`: the segment between
@@ -238,7 +237,7 @@ static rgb gather_hit(const fg_ctx *c, const mat_bsdf *b, uint32_t surf, int lev
             cnt->bsdf++;
             accel_hit h;
             if (!trace_skip(c, org, dir, lobe == MAT_LOBE_REFLECT ? OBJ_NO_REFLECTION : 0u, &h)) {
-                acc_add(&L, w, background(c->sc));
+                acc_add(&L, w, pm_sky(c->sc, dir));
             } else {
                 mat_bsdf b2;
                 mat_setup(&b2, c->sc, &h, dir, c->eps, r);
@@ -274,7 +273,7 @@ static rgb gather_lobe(const fg_ctx *c, const mat_bsdf *b, vec3 axis, vec3 org, 
         cnt->gather++;
         accel_hit h;
         if (!accel_intersect(c->a, org, w, c->eps, INFINITY, &h)) {
-            rgb bg = background(c->sc);
+            rgb bg = pm_sky(c->sc, w);
             sum.r += bg.r;
             sum.g += bg.g;
             sum.b += bg.b;
@@ -305,7 +304,7 @@ static void eye_trace(const fg_ctx *c, vec3 org, vec3 dir, unsigned skip, rgb T,
     if (depth >= c->s->max_eye_depth) return;
     accel_hit h;
     if (!trace_skip(c, org, dir, skip, &h)) {
-        acc_add(L, T, background(c->sc));
+        acc_add(L, T, pm_sky(c->sc, dir));
         return;
     }
     mat_bsdf b;

@@ -8,6 +8,7 @@
  * weighted by the power heuristic (Veach & Guibas 1995, eq. for beta = 2)
  * against the BSDF strategy. */
 #include "pm_nee.h"
+#include "shade_atmos.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -101,10 +102,23 @@ rgb pm_lights_piece_emission(const pm_lights *L, const accel_surf_sample *s)
 }
 double pm_lights_eps(const pm_lights *L) { return L->eps; }
 
+int pm_sky_any(const scene *sc)
+{
+    const colour5 *bg = &sc->background;
+    return bg->r != 0.0 || bg->g != 0.0 || bg->b != 0.0 || (sc->sky_sphere && sc->sky_sphere->npigments > 0);
+}
+
+rgb pm_sky(const scene *sc, vec3 dir)
+{
+    double l = v3_len(dir);
+    rgb c = atmos_sky(sc, l > 0.0 ? v3_scale(dir, 1.0 / l) : v3(0, 0, 1));
+    if (!(isfinite(c.r) && isfinite(c.g) && isfinite(c.b))) c.r = c.g = c.b = 0.0;
+    return c;
+}
+
 int pm_lights_any(const pm_lights *L)
 {
-    const colour5 *bg = &L->sc->background;
-    return L->sc->nlights > 0 || accel_surf_count(L->emit) > 0 || bg->r != 0.0 || bg->g != 0.0 || bg->b != 0.0;
+    return L->sc->nlights > 0 || accel_surf_count(L->emit) > 0 || pm_sky_any(L->sc);
 }
 
 rgb pm_direct_lights(const pm_lights *L, const mat_bsdf *b, int area_samples, rng *r, long *shadow_rays)

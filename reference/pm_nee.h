@@ -27,7 +27,15 @@ const accel_surf *pm_lights_emitters(const pm_lights *L); /* may be empty */
 /* Le at an emitter sample (evaluated at the point when the texture varies). */
 rgb pm_lights_piece_emission(const pm_lights *L, const accel_surf_sample *s);
 double pm_lights_eps(const pm_lights *L);                  /* distance epsilon (shade.c's) */
-int pm_lights_any(const pm_lights *L);                     /* POV lights, emitters or a background */
+int pm_lights_any(const pm_lights *L);                     /* POV lights, emitters, a background or sky_sphere */
+/* Radiance arriving along a ray of direction dir (any length) that leaves
+ * the scene: the sky_sphere over the background, evaluated by shade's
+ * atmos_sky (the code --gi none uses; fog and rainbow are not applied). It
+ * is emitted radiance of the environment, reached by camera, BSDF and
+ * gather rays that escape, and the source of environment photons. */
+rgb pm_sky(const scene *sc, vec3 dir);
+/* 1 when pm_sky can be non-zero (a background colour or a sky_sphere). */
+int pm_sky_any(const scene *sc);
 
 /* Direct light of all POV-Ray light sources at b (diffuse, diffuse_back,
  * phong, specular), area lights with `area_samples` stratified samples. */

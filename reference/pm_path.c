@@ -70,9 +70,10 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
     for (int depth = 0;; depth++) {
         accel_hit h;
         if (!trace_skip(c, org, dir, skip, &h)) {
-            L.r += T.r * sc->background.r;
-            L.g += T.g * sc->background.g;
-            L.b += T.b * sc->background.b;
+            rgb sky = pm_sky(sc, dir); /* background and sky_sphere */
+            L.r += T.r * sky.r;
+            L.g += T.g * sky.g;
+            L.b += T.b * sky.b;
             break;
         }
         mat_bsdf b;

@@ -16,7 +16,8 @@
  * per unit perpendicular area N/A, so Phi = pi C att A / N. Emissive surfaces
  * of radiance Le (both sides): point y with area density p_A, side 1/2,
  * cosine direction: Phi = Le cos / (N p_A (1/2) cos/pi) = 2 pi Le / (N p_A).
- * Background of radiance B: direction uniform on the sphere, origin uniform
+ * Background (and sky_sphere, pm_sky) of radiance B(-w) for a photon travelling along w:
+ * direction uniform on the sphere, origin uniform
  * on a disc of radius R (the bounding sphere) across it: Phi = B 4 pi pi R^2 / N
  * (check: an unoccluded patch inside receives N (1/4pi) (1/(pi R^2)) int cos dw
  * = N / (4 pi R^2) photons per unit area; times Phi that is pi B, the
@@ -221,9 +222,10 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
     *w = wd;
     (*rays)++;
     if (!accel_intersect(c->a, o, wd, c->eps, INFINITY, h)) return 0;
-    const colour5 *bg = &c->sc->background;
+    /* it arrives from the sky in direction -wd */
+    rgb bg = pm_sky(c->sc, v3_neg(wd));
     double k = 4.0 * M_PI * M_PI * R * R / n;
-    *phi = crgb(bg->r * k, bg->g * k, bg->b * k);
+    *phi = crgb(bg.r * k, bg.g * k, bg.b * k);
     return 1;
 }
 
@@ -340,11 +342,20 @@ pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, 
         src[ns].power = 2.0 * M_PI * accel_surf_total_weight(es);
         ns++;
     }
-    rgb bgc = crgb(sc->background.r, sc->background.g, sc->background.b);
-    if (cmax(bgc) > 0.0 && D > 0.0) {
-        src[ns].kind = SRC_ENV;
-        src[ns].power = cmax(bgc) * M_PI * 4.0 * M_PI * c.radius * c.radius;
-        ns++;
+    if (pm_sky_any(sc) && D > 0.0) {
+        /* allocation proxy: mean max channel of the sky over 256 spiral
+         * directions (the photons' own powers are exact) */
+        double m = 0.0;
+        for (int i = 0; i < 256; i++) {
+            double z = 1.0 - (i + 0.5) / 128.0, rr = sqrt(fmax(0.0, 1.0 - z * z)), ph = i * 2.399963229728653;
+            m += cmax(pm_sky(sc, v3(rr * cos(ph), rr * sin(ph), z)));
+        }
+        m /= 256.0;
+        if (m > 0.0 && isfinite(m)) {
+            src[ns].kind = SRC_ENV;
+            src[ns].power = m * M_PI * 4.0 * M_PI * c.radius * c.radius;
+            ns++;
+        }
     }
     out->sources = ns;
     if (ns == 0 || s->photons <= 0) {

@@ -167,6 +167,67 @@ static const char *centre_light = "light_source { <0,0,0> color rgb 1 }";
 static void test_furnace_point_path(void **state) { (void)state; furnace_path(0.5, 0.0, centre_light, 2048, 1.0, 0.01); }
 static void test_furnace_point_fg(void **state) { (void)state; furnace_fg(0.5, 0.0, centre_light, 100000, 1.0, 0.01); }
 
+/* ------------------------------------------------------------ sky_sphere as emitted radiance */
+
+/* A white Lambertian plane (diffuse 0.8) under a sky_sphere, nothing else:
+ * every escaping BSDF or gather ray sees the sky. Constant sky L = 0.5:
+ * every pixel is kd L = 0.4 exactly (up to float rounding: tolerance 1e-4
+ * relative, both modes). Gradient sky L(w) = w_y (gradient y, colour_map
+ * 0 -> 0, 1 -> 1): Lo = kd/pi int w_y cos dw = kd 2/3 = 0.53333 (image
+ * mean within 0.5%, path 256 spp / pmfg 1024 gather rays; the per-pixel
+ * spread is printed). */
+static void sky_case(int pmfg, const char *pigment, double expect, double tol)
+{
+    char text[1024];
+    snprintf(text, sizeof text,
+             "#version 3.7;\n"
+             "global_settings { assumed_gamma 1.0 }\n"
+             "camera { location <0, 1, -1> look_at <0, 0, 0> angle 30 }\n"
+             "sky_sphere { pigment { %s } }\n"
+             "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 0.8 } }\n",
+             pigment);
+    scene *sc = parse(text);
+    accel *a = build(sc);
+    framebuffer *fb = fb_new(16, 16);
+    pm_stats st;
+    if (pmfg) {
+        pm_fg_settings s;
+        pm_fg_default_settings(&s);
+        s.c.width = s.c.height = 16;
+        s.c.threads = THREADS;
+        s.c.seed = 5;
+        s.fg_rays = 1024;
+        s.photons = 20000;
+        assert_int_equal(pm_fg_render(sc, a, &s, fb, &st, NULL), PT_OK);
+    } else {
+        pm_path_settings s;
+        pm_path_default_settings(&s);
+        s.c.width = s.c.height = 16;
+        s.c.threads = THREADS;
+        s.c.seed = 5;
+        s.c.spp = 256;
+        assert_int_equal(pm_path_render(sc, a, &s, fb, &st, NULL), PT_OK);
+    }
+    double mean, maxdev, sd;
+    image_stats(fb, expect, &mean, &maxdev, &sd);
+    printf("sky_sphere %-4s %-48s mean %.6f (expect %.6f, rel err %+.2e, tol %.0e), max pixel dev %.2e, pixel sd %.2e\n",
+           pmfg ? "pmfg" : "path", pigment, mean, expect, mean / expect - 1.0, tol, maxdev, sd);
+    assert_true(fabs(mean / expect - 1.0) <= tol);
+    fb_free(fb);
+    accel_free(a);
+    scene_free(sc);
+}
+
+static const char *sky_gradient = "gradient y colour_map { [0 rgb 0] [1 rgb 1] }";
+static void test_sky_sphere(void **state)
+{
+    (void)state;
+    for (int m = 0; m <= 1; m++) {
+        sky_case(m, "rgb 0.5", 0.4, 1e-4);
+        sky_case(m, sky_gradient, 0.8 * 2.0 / 3.0, 5e-3);
+    }
+}
+
 /* ------------------------------------------------------------ direct only == --gi none */
 
 static const char *direct_scene =
@@ -588,6 +649,7 @@ int main(void)
         cmocka_unit_test(test_furnace_fg_09),
         cmocka_unit_test(test_furnace_point_path),
         cmocka_unit_test(test_furnace_point_fg),
+        cmocka_unit_test(test_sky_sphere),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
