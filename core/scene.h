@@ -239,6 +239,20 @@ typedef struct {
     double slice_dist;      /* default 0 */
 } scene_julia;
 
+/* Per-object photons { } block (POV-Ray 3.7): which objects caustic photons
+ * are shot at and what they do there. As POV-Ray's parser reads it:
+ * `target [FLOAT]` (spacing multiplier, default 1; 0 or less: not a target),
+ * `reflection on|off`, `refraction on|off` (each off unless said on),
+ * `collect off` (photons are not stored on it), `pass_through [on|off]`. */
+typedef struct {
+    src_loc loc;            /* the `photons` keyword */
+    int target;
+    double spacing;         /* target's multiplier of the global spacing */
+    int reflection, refraction;
+    int collect;            /* default 1 */
+    int pass_through;
+} scene_obj_photons;
+
 typedef struct scene_object scene_object;
 struct scene_object {
     shape_kind kind;
@@ -293,6 +307,9 @@ struct scene_object {
      * of the surface (scene_object_uv) and are not moved by the object's
      * transforms */
     int uv_mapping;
+    /* photons { } (appended, issue 6): NULL = none; a block on a CSG is
+     * copied by the parser to its members that have none */
+    const scene_obj_photons *photons;
 };
 
 /* ---------------------------------------------------------------- lights */

@@ -308,12 +308,62 @@ static int material_mod(sdl_parser *p, scene_object *o, sdl_kw k)
     }
 }
 
+static void photons_to_members(scene_object *o, const scene_obj_photons *ph)
+{
+    if (!is_csg(o)) return;
+    for (int i = 0; i < o->u.csg.nkids; i++) {
+        scene_object *k = o->u.csg.kids[i];
+        if (!k->photons) {
+            k->photons = ph;
+            photons_to_members(k, ph);
+        }
+    }
+}
+
+/* photons_mod := photons '{' { target [f] | reflection b | refraction b |
+ *   collect [b] | pass_through [b] } '}'  (POV-Ray 3.7's object photons
+ *   block; IR: scene_obj_photons with the keyword's location) */
+static void photons_mod(sdl_parser *p, scene_object *o, src_loc loc)
+{
+    scene_obj_photons *ph = sdl_alloc(p, sizeof *ph);
+    if (!ph) return;
+    if (o->photons) *ph = *o->photons;
+    else {
+        memset(ph, 0, sizeof *ph);
+        ph->spacing = 1.0;
+        ph->collect = 1;
+    }
+    ph->loc = loc;
+    if (!sdl_begin_block(p, "photons")) return;
+    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
+        sdl_tok t = sdl_next(p);
+        if (sdl_is_kw(&t, KW_TARGET)) {
+            ph->spacing = sdl_allow_float(p, 1.0);
+            ph->target = ph->spacing > 0.0;
+        } else if (sdl_is_kw(&t, KW_REFLECTION)) {
+            ph->reflection = sdl_float(p) != 0.0;
+        } else if (sdl_is_kw(&t, KW_REFRACTION)) {
+            ph->refraction = sdl_float(p) != 0.0;
+        } else if (sdl_is_kw(&t, KW_COLLECT)) {
+            ph->collect = sdl_allow_float(p, 1.0) != 0.0;
+        } else if (sdl_is_kw(&t, KW_PASS_THROUGH)) {
+            ph->pass_through = sdl_allow_float(p, 1.0) != 0.0;
+        } else {
+            sdl_unexpected(p, &t, "target, reflection, refraction, collect, pass_through or '}'");
+            return;
+        }
+    }
+    sdl_end_block(p);
+    o->photons = ph;
+    photons_to_members(o, ph);
+}
+
 /* skipped_mod := bounded_by {..} | clipped_by {..} | photons {..} |
  *   radiosity {..} | quick colour ; 0 if not one of them */
 static int skipped_mod(sdl_parser *p, const sdl_tok *t)
 {
     sdl_kw k = t->tk.kw;
-    if (k == KW_BOUNDED_BY || k == KW_PHOTONS || k == KW_RADIOSITY) {
+    if (k == KW_BOUNDED_BY || k == KW_RADIOSITY) {
         if (sdl_begin_block(p, sdl_kw_text(k))) sdl_skip_block(p);
         return 1;
     }
@@ -350,6 +400,10 @@ void sdl_object_mods(sdl_parser *p, sdl_obj *so)
         if (t.tk.kw == KW_CLIPPED_BY || t.tk.kw == KW_BOUNDED_BY) { /* issue 4: sdl_shape.c */
             if (t.tk.kw == KW_CLIPPED_BY) sdl_shape_clipped_by(p, so);
             else sdl_shape_bounded_by(p, so);
+            continue;
+        }
+        if (t.tk.kw == KW_PHOTONS) {
+            photons_mod(p, so->obj, t.tk.loc);
             continue;
         }
         if (flag_mod(p, so->obj, t.tk.kw, t.tk.loc) || material_mod(p, so->obj, t.tk.kw) || skipped_mod(p, &t)) continue;

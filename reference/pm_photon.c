@@ -81,6 +81,7 @@ typedef struct {
     chunk_out *chunks;
     int nchunks;
     double eps;
+    int targets;       /* some object has photons { target }: caustic paths bounce on targets only */
     vec3 centre;       /* bounding sphere of finite geometry */
     double radius;
 } trace_ctx;
@@ -118,6 +119,41 @@ static vec3 disc_point(vec3 c, vec3 axis, double radius, double u1, double u2)
     return v3_add(c, v3_add(v3_scale(t, rho * cos(phi)), v3_scale(b, rho * sin(phi))));
 }
 
+/* photons { pass_through }: photons go through the object unchanged. */
+static int pass_through(const accel_hit *h) { return h->obj && h->obj->photons && h->obj->photons->pass_through; }
+
+/* Next hit of a photon, past pass_through objects. */
+static int photon_intersect(const trace_ctx *c, vec3 o, vec3 w, accel_hit *h, long *rays)
+{
+    double tmin = c->eps;
+    for (int k = 0; k < SKIP_MAX; k++) {
+        (*rays)++;
+        if (!accel_intersect(c->a, o, w, tmin, INFINITY, h)) return 0;
+        if (!pass_through(h)) return 1;
+        tmin = h->t + fmax(c->eps, h->t * 1e-7);
+    }
+    return 0;
+}
+
+/* With targets in the scene (POV-Ray 3.7 semantics), a photon on a caustic
+ * path (a POV-Ray light, specular bounces only so far) is reflected or
+ * refracted only by a target whose photons block turns that on. */
+static int caustic_bounce_ok(const accel_hit *h, int lobe)
+{
+    const scene_obj_photons *ph = h->obj ? h->obj->photons : NULL;
+    if (!ph || !ph->target) return 0;
+    return lobe == MAT_LOBE_REFLECT ? ph->reflection : ph->refraction;
+}
+
+static int any_target(const scene_object *o)
+{
+    if (o->photons && o->photons->target) return 1;
+    if (o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE)
+        for (int i = 0; i < o->u.csg.nkids; i++)
+            if (any_target(o->u.csg.kids[i])) return 1;
+    return 0;
+}
+
 /* First hit seen from a POV-Ray light: no_shadow objects let it through, as
  * they do for shade.c's shadow rays. */
 static int light_first_hit(const trace_ctx *c, vec3 o, vec3 w, accel_hit *h, long *rays)
@@ -126,7 +162,7 @@ static int light_first_hit(const trace_ctx *c, vec3 o, vec3 w, accel_hit *h, lon
     for (int k = 0; k < SKIP_MAX; k++) {
         (*rays)++;
         if (!accel_intersect(c->a, o, w, tmin, INFINITY, h)) return 0;
-        if (!(h->flags & OBJ_NO_SHADOW)) return 1;
+        if (!(h->flags & OBJ_NO_SHADOW) && !pass_through(h)) return 1;
         tmin = h->t + fmax(c->eps, h->t * 1e-7);
     }
     return 0;
@@ -206,8 +242,7 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         double u4 = rng_f64(r), u5 = rng_f64(r);
         *w = mat_cosine_dir(ns, u4, u5);
         vec3 o = v3_madd(s.p, ns, c->eps);
-        (*rays)++;
-        if (!accel_intersect(c->a, o, *w, c->eps, INFINITY, h)) return 0;
+        if (!photon_intersect(c, o, *w, h, rays)) return 0;
         rgb le = pm_lights_piece_emission(c->L, &s);
         double k = 2.0 * M_PI / (n * s.pdf_area);
         *phi = crgb(le.r * k, le.g * k, le.b * k);
@@ -220,8 +255,7 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
     double u3 = rng_f64(r), u4 = rng_f64(r);
     vec3 o = disc_point(v3_madd(c->centre, wd, -R * 1.001), wd, R, u3, u4);
     *w = wd;
-    (*rays)++;
-    if (!accel_intersect(c->a, o, wd, c->eps, INFINITY, h)) return 0;
+    if (!photon_intersect(c, o, wd, h, rays)) return 0;
     /* it arrives from the sky in direction -wd */
     rgb bg = pm_sky(c->sc, v3_neg(wd));
     double k = 4.0 * M_PI * M_PI * R * R / n;
@@ -244,7 +278,8 @@ static void trace_one(const trace_ctx *c, const source *src, long index, chunk_o
         mat_bsdf b;
         mat_setup(&b, c->sc, &h, w, c->eps, &r);
         int lambert = b.m[MAT_LOBE_DIFFUSE] > 0.0 || b.m[MAT_LOBE_BACK] > 0.0;
-        if (lambert && (bounce >= 1 || store_first) && cmax(phi) > 0.0) {
+        int collect = !(h.obj && h.obj->photons && !h.obj->photons->collect); /* photons { collect off } */
+        if (lambert && collect && (bounce >= 1 || store_first) && cmax(phi) > 0.0) {
             /* stored on the side of the object it arrived at (pm_kdtree.h) */
             uint32_t key = pm_surface_key(h.obj, b.entering);
             if (out->ng + out->nc >= out->cap) { out->dropped++; return; }
@@ -256,6 +291,7 @@ static void trace_one(const trace_ctx *c, const source *src, long index, chunk_o
         mat_scatter s;
         if (!mat_sample(&b, &r, 1, &s)) return;
         if (s.specular && bounce == 0 && from_light && !c->s->caustics) return;
+        if (s.specular && from_light && spec_only && c->targets && !caustic_bounce_ok(&h, s.lobe)) return;
         if (!s.specular) spec_only = 0;
         double k = s.eta2;
         /* Only where the material's own roulette hardly ends paths (total
@@ -269,8 +305,7 @@ static void trace_one(const trace_ctx *c, const source *src, long index, chunk_o
         phi = crgb(phi.r * s.weight.r * k, phi.g * s.weight.g * k, phi.b * s.weight.b * k);
         if (!(cmax(phi) > 0.0) || !isfinite(phi.r + phi.g + phi.b)) return;
         w = s.dir;
-        out->rays++;
-        if (!accel_intersect(c->a, s.org, w, c->eps, INFINITY, &h)) return;
+        if (!photon_intersect(c, s.org, w, &h, &out->rays)) return;
     }
 }
 
@@ -306,6 +341,8 @@ pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, 
     c.L = L;
     c.s = s;
     c.eps = pm_lights_eps(L);
+    for (int i = 0; i < sc->nobjects && !c.targets; i++) c.targets = any_target(sc->objects[i]);
+    out->targets = c.targets;
     vec3 lo, hi;
     accel_bounds(a, &lo, &hi);
     c.centre = v3_scale(v3_add(lo, hi), 0.5);

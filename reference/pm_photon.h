@@ -28,8 +28,16 @@
  * to the same image. With caustics on (default when the scene has a
  * global photons{} block, which is how POV-Ray asks for caustics) those
  * paths are kept: pmfg then shows caustics that path cannot. Per-object
- * photons{target ...} blocks are not read (the IR does not carry them yet):
- * every specular surface is a caustic target. */
+ * photons { } blocks (scene_obj_photons) as POV-Ray 3.7 reads them: when
+ * any object is a `target`, a caustic path (POV-Ray light, specular bounces
+ * only) reflects or refracts only at targets whose block says `reflection
+ * on` / `refraction on` (other such photons end); without any target every
+ * specular surface acts as one (partray's choice, POV-Ray would shoot no
+ * caustic photons). `collect off`: never stored on that object;
+ * `pass_through`: photons go through it unchanged. Photons are still
+ * emitted in all directions, not aimed at the targets' bounding spheres as
+ * POV-Ray does (the same estimate, more photons wasted), and the target's
+ * spacing multiplier is not used. */
 #ifndef PT_PM_PHOTON_H
 #define PT_PM_PHOTON_H
 #include "accel.h"
@@ -56,6 +64,7 @@ typedef struct {
     long rays;           /* segments traced */
     long dropped;        /* photons not stored: the memory cap on stored photons was reached */
     int sources;
+    int targets;         /* some object has photons { target } */
 } pm_photon_result;
 
 /* Trace. The arrays in `out` are malloc'd (ownership passes to the caller,
