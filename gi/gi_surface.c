@@ -1,6 +1,7 @@
 /* gi_surface.c - surface patches for particle GI (see gi_surface.h). */
 #include "gi_surface.h"
 #include <math.h>
+#include "accel_shapes.h"
 #include "accel_surface.h"
 #include <stdint.h>
 #include <stdlib.h>
@@ -27,7 +28,9 @@ typedef struct {
     double r0, r1;    /* sphere: r, -; disc: hole, outer */
     double lu, lv;    /* TRI: longest edge; grids: longest u and v lines */
     double jmax, jmin, jobj, detm;
-    int piece;        /* accel_surface piece, -1 if none */
+    int piece;        /* accel_surface piece, -1 if none; PIECE: the first of npieces */
+    int npieces;      /* PIECE: consecutive accel_surface pieces of the object */
+    long cdf0;        /* PIECE with npieces > 1: their cumulative areas at cdf[cdf0..] */
     const scene_texture *tex;
 } patch;
 
@@ -52,6 +55,8 @@ struct gi_surface {
     const scene *sc;
     diag *d;
     accel_surf *as;   /* area sampling shared with reference/ (accel_surface.h) */
+    double *cdf;      /* PIECE patches of several pieces (polygons, height fields) */
+    long ncdf, capcdf;
 };
 
 static void layout(gi_surface *g);
@@ -349,6 +354,47 @@ static pt_status add_box(gi_surface *g, int obj, const scene_object *o, int prob
     return PT_OK;
 }
 
+/* The accel_surface pieces of leaf o: one for an analytic or implicit
+ * shape, one per triangle for polygons and height fields (added
+ * consecutively by accel_surface). */
+static void piece_range(const gi_surface *g, const scene_object *o, int *first, int *count)
+{
+    *first = -1;
+    *count = 0;
+    if (!g->as) return;
+    int i = accel_surf_find(g->as, o, ACCEL_SURF_ANY);
+    if (i < 0) i = accel_surf_find(g->as, o, 0u); /* height fields are keyed by triangle */
+    if (i < 0) return;
+    int n = accel_surf_count(g->as), lo = i, hi = i;
+    while (lo > 0 && accel_surf_piece_at(g->as, lo - 1)->obj == o) lo--;
+    while (hi + 1 < n && accel_surf_piece_at(g->as, hi + 1)->obj == o) hi++;
+    *first = lo;
+    *count = hi - lo + 1;
+}
+
+/* Sides of a PIECE patch: sheets (polygons, height fields, lathe and sor,
+ * whose ends may be open, unbounded quadric/poly clipped like planes) and
+ * open or inverse objects get both; closed solids their outside, plus the
+ * inside when the camera or a light is in them (accel_shape_inside). */
+static int piece_sides(const gi_surface *g, const scene_object *o)
+{
+    if (o->flags & (OBJ_OPEN | OBJ_INVERSE)) return 2;
+    switch (o->kind) {
+    case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_TORUS: return 1;
+    case SHAPE_POLYGON: case SHAPE_HEIGHT_FIELD: case SHAPE_LATHE: case SHAPE_SOR: return 2;
+    default: break;
+    }
+    accel_shape sh;
+    if (accel_shape_init(&sh, o) != 0) return 1;
+    int sides = sh.infinite ? 2 : 1;
+    const scene *s = g->sc;
+    if (sides == 1 && s->camera_set && accel_shape_inside(&sh, s->camera.location)) sides = 2;
+    for (int i = 0; sides == 1 && i < s->nlights; i++)
+        if (accel_shape_inside(&sh, s->lights[i].position)) sides = 2;
+    accel_shape_release(&sh);
+    return sides;
+}
+
 static pt_status add_leaf(gi_surface *g, const scene_object *o, const scene_texture *tex, int probe)
 {
     int two = 2;
@@ -360,27 +406,53 @@ static pt_status add_leaf(gi_surface *g, const scene_object *o, const scene_text
     case SHAPE_BOX:
     case SHAPE_SPHERE:
     case SHAPE_DISC: break;
-    case SHAPE_CYLINDER:
-    case SHAPE_CONE:
-    case SHAPE_TORUS: {
-        int piece = probe || !g->as ? -1 : accel_surf_find(g->as, o, ACCEL_SURF_ANY);
-        const accel_surf_piece *pc = piece >= 0 ? accel_surf_piece_at(g->as, piece) : NULL;
-        if (!pc || !(pc->area > 0.0)) break;
+    default: {
+        /* every other shape accel_surface samples (accel_surface.h):
+         * cylinders, cones, tori; polygons and height fields (their
+         * triangles); lathe, sor, prism, text; and the implicit shapes
+         * (quadric, poly, blob, isosurface, julia_fractal, ovus,
+         * superellipsoid) by Crofton lines (accel_tess.h). Area particles,
+         * no radiance particles: the hook estimates at the hit. */
+        int first = -1, count = 0;
+        if (!probe) piece_range(g, o, &first, &count);
+        double area = 0.0;
+        for (int i = 0; i < count; i++) area += accel_surf_piece_at(g->as, first + i)->area;
+        if (!(area > 0.0) || !isfinite(area)) break;
+        long c0 = 0;
+        if (count > 1) {
+            /* cumulative piece areas: gi_surface_sample picks a piece by area */
+            c0 = g->ncdf;
+            if (g->ncdf + count > g->capcdf) {
+                long nc = g->capcdf ? g->capcdf : 1024;
+                while (nc < g->ncdf + count) nc *= 2;
+                double *nd = realloc(g->cdf, (size_t)nc * sizeof *nd);
+                if (!nd) return PT_ERR_NOMEM;
+                g->cdf = nd;
+                g->capcdf = nc;
+            }
+            double acc = 0.0;
+            for (int i = 0; i < count; i++) {
+                acc += accel_surf_piece_at(g->as, first + i)->area;
+                g->cdf[c0 + i] = acc;
+            }
+            g->ncdf += count;
+        }
         int obj = add_obj(g, o);
         if (obj < 0) return PT_ERR_NOMEM;
         patch p;
         memset(&p, 0, sizeof p);
         p.kind = PATCH_PIECE;
         p.obj = obj;
-        p.piece = piece;
-        p.area = pc->area;
+        p.piece = first;
+        p.npieces = count;
+        p.cdf0 = c0;
+        p.area = area;
         p.tex = tex;
-        p.nsides = (unsigned char)((o->flags & (OBJ_OPEN | OBJ_INVERSE)) ? 2 : 1);
+        p.nsides = (unsigned char)piece_sides(g, o);
         if (add_patch(g, &p) < 0) return PT_ERR_NOMEM;
         g->o[obj].count++;
         return PT_OK;
     }
-    default: break;
     }
     if (o->kind != SHAPE_TRIANGLE && o->kind != SHAPE_SMOOTH_TRIANGLE && o->kind != SHAPE_MESH &&
         o->kind != SHAPE_PLANE && o->kind != SHAPE_BOX && o->kind != SHAPE_SPHERE && o->kind != SHAPE_DISC) {
@@ -562,6 +634,7 @@ void gi_surface_free(gi_surface *g)
 {
     if (!g) return;
     accel_surf_free(g->as);
+    free(g->cdf);
     free(g->p);
     free(g->o);
     free(g->hash);
@@ -586,7 +659,8 @@ int gi_surface_has_particles(const gi_surface *g, const accel_hit *hit)
 
 size_t gi_surface_bytes(const gi_surface *g)
 {
-    return (size_t)g->capp * sizeof(patch) + (size_t)g->capo * sizeof(obj_rec) + (size_t)g->hcap * sizeof(int);
+    return (size_t)g->capp * sizeof(patch) + (size_t)g->capo * sizeof(obj_rec) + (size_t)g->hcap * sizeof(int) +
+           (size_t)g->capcdf * sizeof(double);
 }
 
 int gi_surface_sample(const gi_surface *g, int i, double u, double v, rng *r, vec3 *pos, vec3 *nrm)
@@ -596,11 +670,24 @@ int gi_surface_sample(const gi_surface *g, int i, double u, double v, rng *r, ve
         /* analytic shapes: accel_surface's sampler (uniform by world area,
          * rejection under non-similarity transforms) */
         accel_surf_sample smp;
+        int piece = p->piece;
+        if (p->kind == PATCH_PIECE && p->npieces > 1) {
+            /* a piece of a polygon / height field with probability by area */
+            const double *c = g->cdf + p->cdf0;
+            double t = rng_f64(r) * c[p->npieces - 1];
+            int lo = 0, hi = p->npieces - 1;
+            while (lo < hi) {
+                int mid = (lo + hi) / 2;
+                if (t < c[mid]) hi = mid;
+                else lo = mid + 1;
+            }
+            piece += lo;
+        }
         /* (v, u): the R2 sequence's second coordinate drives the polar
          * direction; measured on the integrating sphere (test_gi), this
          * order spreads the points more evenly (mean bias 0.6% vs 1.4% at
          * 16K particles) */
-        if (!accel_surf_sample_piece(g->as, p->piece, v, u, r, &smp)) return 0;
+        if (!accel_surf_sample_piece(g->as, piece, v, u, r, &smp)) return 0;
         *pos = smp.p;
         *nrm = smp.n;
         if (p->kind == PATCH_DISC) {

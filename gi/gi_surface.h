@@ -21,9 +21,15 @@
  * gi_particles later drops a side whose scattering links all miss.
  * Side 0 is the patch's front normal, side 1 its opposite.
  *
- * Cylinders, cones and tori get area particles (sampled by accel_surface)
- * but no radiance particles: gi_particle estimates indirect light at hits
- * on them from the particles around the hit.
+ * Every other shape accel_surface samples gets area particles (sampled by
+ * accel_surface, no second implementation) but no radiance particles:
+ * cylinders, cones, tori, polygons and height fields (their triangles, a
+ * piece chosen by area), lathe, sor, prism, text, and the implicit shapes
+ * (quadric, poly, blob, isosurface, julia_fractal, ovus, superellipsoid;
+ * Crofton lines, accel_tess.h). gi_particle estimates indirect light at
+ * hits on them from the particles around the hit. Closed ones get their
+ * outside (and inside when the camera or a light is in them); polygons,
+ * height fields, lathe, sor and unbounded quadric/poly both sides.
  *
  * CSG: members of union are ordinary leaves. Members of merge, intersection
  * and difference are sampled on their whole surface and marked `probe`:

@@ -15,6 +15,9 @@
  *    1K, 4K, 16K particles; it must fall, and end below 1.5%.
  *  - a cylinder (particles from accel_surface, no radiance particles) gets
  *    its indirect light estimated at the hit, close to the floor's.
+ *  - a sphere written as a one-component blob or an isosurface gets its
+ *    particles from accel_surface's Crofton lines: their total area is
+ *    4 pi r^2 within 1%, the GI render's mean that of the sphere within 2%.
  *  - direct light of the particles equals shade.c's Whitted direct term at
  *    the same point (spotlight with fade; relative 1e-3 plus 1e-6: the
  *    kernels work in float and the falloff tail cancels digits).
@@ -568,6 +571,83 @@ static void test_cylinder_onthefly(void **state)
     unload(&f);
 }
 
+/* Implicit shapes get particles (accel_surface's Crofton sampling): a
+ * sphere of radius 0.2 in the closed cube, written as a sphere, as a
+ * one-component blob (field s (1 - d^2/R^2)^2 = t at d = R sqrt(1 -
+ * sqrt(t/s)), POV-Ray's blob density) and as an isosurface. The particles
+ * on each carry 4 pi r^2 within 1% (Crofton estimate plus one particle of
+ * rounding), and the GI render (32x32, 6000 particles, n_b 4) of the three
+ * scenes has the same mean within 2% (measured: printed). */
+static double shape_particle_area(gi_particle *gp, vec3 c, double r, long *n)
+{
+    const gi_particle_stats *st = gi_particle_get_stats(gp);
+    double sum = 0.0;
+    *n = 0;
+    for (long i = 0; i < st->particles; i++) {
+        double a, rho[3];
+        vec3 p, nn;
+        gi_particle_debug_particle(gp, (int)i, &a, rho, &p, &nn);
+        if (fabs(v3_len(v3_sub(p, c)) - r) < 1e-3 * r) {
+            sum += a;
+            (*n)++;
+        }
+    }
+    return sum;
+}
+
+static void test_implicit_sphere(void **state)
+{
+    (void)state;
+    const double r = 0.2, t = 0.5, sgt = 1.0;
+    const double R = r / sqrt(1.0 - sqrt(t / sgt));
+    const vec3 c = v3(0.5, 0.25, 0.6);
+    char shapes[3][512];
+    snprintf(shapes[0], sizeof shapes[0], "sphere { <0.5, 0.25, 0.6>, %.17g pigment { rgb <0.9, 0.5, 0.3> } "
+             "finish { ambient 0 diffuse 0.7 } }\n", r);
+    snprintf(shapes[1], sizeof shapes[1], "blob { threshold %.17g sphere { <0.5, 0.25, 0.6>, %.17g, %.17g } "
+             "pigment { rgb <0.9, 0.5, 0.3> } finish { ambient 0 diffuse 0.7 } }\n", t, R, sgt);
+    snprintf(shapes[2], sizeof shapes[2], "isosurface { function { sqrt(x*x + y*y + z*z) - %.17g } "
+             "contained_by { box { -0.25, 0.25 } } max_gradient 1.1 translate <0.5, 0.25, 0.6> "
+             "pigment { rgb <0.9, 0.5, 0.3> } finish { ambient 0 diffuse 0.7 } }\n", r);
+    const char *names[3] = {"sphere", "blob", "isosurface"};
+    double mean[3];
+    for (int k = 0; k < 3; k++) {
+        char text[4096];
+        snprintf(text, sizeof text, "%s%s", cube_scene, shapes[k]);
+        fixture f;
+        load(&f, text);
+        gi_particle *gp = build(&f, 6000, 4, device_c, 3);
+        const gi_particle_stats *st = gi_particle_get_stats(gp);
+        assert_int_equal(st->skipped_objects, 0);
+        long n;
+        double area = shape_particle_area(gp, c, r, &n);
+        double exact = 4.0 * M_PI * r * r;
+        assert_int_equal(gi_particle_prepare_view(gp, &f.sc->camera, 32, 32, f.d), PT_OK);
+        shade_settings ss;
+        shade_default_settings(&ss);
+        ss.width = ss.height = 32;
+        ss.threads = 2;
+        ss.use_ambient = 0;
+        ss.indirect = gi_particle_indirect;
+        ss.indirect_ctx = gp;
+        framebuffer *fb = fb_new(32, 32);
+        shade_stats sst;
+        assert_int_equal(shade_render(f.sc, f.a, &ss, fb, &sst, f.d), PT_OK);
+        mean[k] = fb_mean(fb, -1);
+        st = gi_particle_get_stats(gp);
+        printf("  %-10s: %ld particles on it, area %.5f / 4 pi r^2 = %.5f; GI mean %.6f (%+.3f%% vs sphere); "
+               "lookups without particles %ld\n",
+               names[k], n, area, area / exact, mean[k], 100.0 * (mean[k] / mean[0] - 1.0), st->lookups_none);
+        assert_true(n > 100);
+        assert_true(fabs(area / exact - 1.0) < 0.01);
+        assert_int_equal(st->lookups_none, 0);
+        assert_true(fabs(mean[k] / mean[0] - 1.0) < 0.02);
+        fb_free(fb);
+        gi_particle_free(gp);
+        unload(&f);
+    }
+}
+
 static void test_settings_from_radiosity(void **state)
 {
     (void)state;
@@ -597,6 +677,7 @@ int main(void)
         cmocka_unit_test(test_opencl_errors),
         cmocka_unit_test(test_view_and_render),
         cmocka_unit_test(test_cylinder_onthefly),
+        cmocka_unit_test(test_implicit_sphere),
         cmocka_unit_test(test_settings_from_radiosity),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
