@@ -163,7 +163,18 @@ static void job(void *ctx, int index, int thread)
             if (!hit) miss++;
             if (!J->links) continue;
             int target = -1;
-            if (hit && J->grid) {
+            /* a hit on an object that carries no particles (unsupported
+             * shapes, CSG results whose members are not sampled) has no
+             * answer: the checks below would only accept a particle on that
+             * object, and the lookup would first search to maxdist for one
+             * (10 blobs without particles, 20K particles: gather links
+             * 11.7 -> 6.6 s). Same links, without the search. */
+            const void *hobj = hit && J->grid && J->pobj
+                                   ? accel_rtc_object(J->a, rh[m].hit.geomID, rh[m].hit.primID, rh[m].hit.instID[0])
+                                   : NULL;
+            if (hobj && gi_lookup_object_id(J->grid, hobj) < 0) {
+                unres++;
+            } else if (hit && J->grid) {
                 const struct RTCRayHit *h = &rh[m];
                 vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
                 vec3 o = v3(h->ray.org_x, h->ray.org_y, h->ray.org_z);
@@ -175,7 +186,7 @@ static void job(void *ctx, int index, int thread)
                      * (a sphere on the floor) or where a box stands on the
                      * floor the nearest particle can be another object's,
                      * on the other side of a wall */
-                    const void *ho = accel_rtc_object(J->a, h->hit.geomID, h->hit.primID, h->hit.instID[0]);
+                    const void *ho = hobj;
                     /* and on the face and side hit: its normal agrees with
                      * the hit's geometric normal turned to the ray (within
                      * about 70 degrees; Ng is in world space unless the
