@@ -950,6 +950,18 @@ static char *concat2(sdl_parser *p, const char *a, const char *b)
  * text does not fit POV-Ray's 256-byte buffer is written with %g instead. */
 static void pov_number(char *out, size_t cap, double v, int w, int d)
 {
+    /* A width past the buffer never fits, as %f or %g: say so without
+     * asking printf to count 2^31 padding characters first (str(1, 1e300,
+     * 0) ran for minutes: tests/fuzz/regress/parse/int_casts.pov). A
+     * precision past the buffer cannot fit as %f either; %g drops trailing
+     * zeros and a double has at most 767 significant decimal digits, so
+     * 800 gives the same text as any larger precision. */
+    if (w > 254 || w < -254) {
+        snprintf(out, cap, "<invalid>");
+        return;
+    }
+    int fixed_fits = d <= 254;
+    if (d > 800) d = 800;
     char fmt[64];
     int o = 0;
     fmt[o++] = '%';
@@ -959,7 +971,7 @@ static void pov_number(char *out, size_t cap, double v, int w, int d)
     fmt[o] = 'f';
     fmt[o + 1] = 0;
     char buf[256];
-    int n = snprintf(buf, sizeof buf - 1, fmt, v);
+    int n = fixed_fits ? snprintf(buf, sizeof buf - 1, fmt, v) : -1;
     if (n < 0 || n >= (int)sizeof buf - 1) {
         fmt[o] = 'g';
         n = snprintf(buf, sizeof buf - 1, fmt, v);

@@ -264,6 +264,16 @@ static int read_gif(mem_src *m, sdl_img *out, char *why, size_t whycap)
             snprintf(why, whycap, "image size %dx%d out of range", w, h);
             break;
         }
+        /* LZW codes have at least 3 bits and one gives at most 4096 pixels
+         * (the longest string of a 12-bit table, GIF89a appendix F): a file
+         * with fewer bytes left than that needs is cut short, refused before
+         * 9 bytes a pixel are allocated (fuzz_sdlimage: 2 GiB for a 59-byte
+         * file declaring 65535 x 4096) */
+        size_t left = m->n > m->pos ? m->n - m->pos : 0;
+        if ((unsigned long long)left * 8u / 3u * 4096u < (unsigned long long)w * (unsigned long long)h) {
+            snprintf(why, whycap, "the file is truncated: %dx%d pixels cannot come from the %zu bytes left", w, h, left);
+            break;
+        }
         const ColorMapObject *cm = g->Image.ColorMap ? g->Image.ColorMap : g->SColorMap;
         if (!alloc_pixels(out, w, h, 1)) {
             snprintf(why, whycap, "out of memory");
