@@ -1424,6 +1424,25 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
     return isfinite(hit->t) && v3_finite(hit->p);
 }
 
+int accel_mutually_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, accel_same_fn same,
+                           const void *ctx)
+{
+    double lift = 16.0 * eps;
+    vec3 p = v3_madd(x, nx, lift), q = v3_madd(y, ny, lift);
+    vec3 d = v3_sub(q, p);
+    double len = v3_len(d);
+    if (!(len > 2.0 * lift)) return 1;
+    d = v3_scale(d, 1.0 / len);
+    double tmin = 0.0;
+    for (int k = 0; k < 8; k++) {
+        accel_hit h;
+        if (!accel_intersect(a, p, d, tmin, len, &h)) return 1;
+        if (!same(h.obj, ctx)) return 0;
+        tmin = h.t + fmax(eps, h.t * 1e-7);
+    }
+    return 1;
+}
+
 const scene_object *accel_rtc_object(const accel *a, unsigned geom, unsigned prim, unsigned inst)
 {
     if (!a || geom == RTC_INVALID_GEOMETRY_ID) return NULL;

@@ -50,6 +50,15 @@ void accel_free(accel *a);
 /* Nearest hit with t in (tmin, tmax); returns 1 on hit. (no_image and
  * no_reflection are not applied here yet: callers see them in hit->obj->flags.) */
 int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, accel_hit *hit);
+/* Mutual visibility of two surface points for density estimates: 1 when
+ * the segment from x + lift*nx to y + lift*ny (lift = 16 eps) crosses no
+ * object for which same(obj, ctx) is 0; crossings of "same" objects are
+ * stepped over (at most 8). Points closer than twice the lift count as
+ * visible. Used by particle GI's estimation lists and pmfg's photon
+ * gathering, so neither reaches across a wall. */
+typedef int (*accel_same_fn)(const scene_object *obj, const void *ctx);
+int accel_mutually_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, accel_same_fn same,
+                           const void *ctx);
 /* Any hit in (tmin, tmax) by an object that casts shadows (not no_shadow). */
 int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax);
 /* World bounds of finite geometry (infinite planes excluded) and a scene

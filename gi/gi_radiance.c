@@ -24,22 +24,14 @@ typedef struct {
     atomic_int oom;
 } list_job;
 
+static int same_object(const scene_object *obj, const void *own)
+{
+    return obj == (const scene_object *)own;
+}
+
 int gi_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, const scene_object *own)
 {
-    double lift = GI_VIS_LIFT * eps;
-    vec3 p = v3_madd(x, nx, lift), q = v3_madd(y, ny, lift);
-    vec3 d = v3_sub(q, p);
-    double len = v3_len(d);
-    if (!(len > 2.0 * lift)) return 1;
-    d = v3_scale(d, 1.0 / len);
-    double tmin = 0.0;
-    for (int k = 0; k < 8; k++) {
-        accel_hit h;
-        if (!accel_intersect(a, p, d, tmin, len, &h)) return 1;
-        if (h.obj != own) return 0;
-        tmin = h.t + fmax(eps, h.t * 1e-7);
-    }
-    return 1;
+    return accel_mutually_visible(a, eps, x, nx, y, ny, same_object, own);
 }
 
 static int visible(const list_job *J, vec3 q, vec3 nq, int i, const scene_object *obj)

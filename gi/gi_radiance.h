@@ -38,14 +38,13 @@ int gi_same_surface(const gi_surface *g, const gi_particles *ps, int i, const sc
 
 /* Whether a sample at y (normal ny) may stand for light at x (normal nx) on
  * object `own`: the segment between the two, lifted off the surface by
- * GI_VIS_LIFT eps along their normals, crosses no other object (hits on
+ * 16 eps along their normals (accel_mutually_visible), crosses no other object (hits on
  * `own` pass: a chord of a curved surface dips under it). Without it
  * estimates reached across walls: the floor around a box standing on it
  * took the particles (and radiance particles) of the floor under the box,
  * lit by a light inside the box; the dark side of a thin wall took the lit
  * side's. Used for the estimation lists and for the radiance particles a
  * shading hit interpolates (gi_particle.c). */
-#define GI_VIS_LIFT 16.0
 int gi_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, const scene_object *own);
 
 pt_status gi_radiance_lists(gi_lists *L, const gi_surface *g, const gi_particles *ps, const accel *a, double r,

@@ -85,30 +85,21 @@ static int trace_skip(const fg_ctx *c, vec3 org, vec3 dir, unsigned skip, accel_
 
 /* Whether the photon (or irradiance point) at y, normal ny, may stand for
  * light at x, normal nx, on the surface of key `surf`: the segment between
- * the two points lifted off the surface by VIS_LIFT eps along their normals
+ * the two points lifted off the surface by 16 eps along their normals
  * crosses no other object. Hits on the surface's own object are passed
  * (a chord of a curved surface dips under it). Without this test a density
  * estimate reaches across walls: the floor just outside a box standing on
  * it gathered the photons of a light inside the box, stored on the floor
  * under the box (the two coplanar faces tie, and the ray hits the floor);
  * likewise the dark side of a thin wall near the lit side. */
-#define VIS_LIFT 16.0
+static int same_surface(const scene_object *obj, const void *surf)
+{
+    return (pm_surface_key(obj, 0) | 1u) == (*(const uint32_t *)surf | 1u);
+}
+
 static int vis_ok(const fg_ctx *c, vec3 x, vec3 nx, vec3 y, vec3 ny, uint32_t surf)
 {
-    double lift = VIS_LIFT * c->eps;
-    vec3 a = v3_madd(x, nx, lift), b = v3_madd(y, ny, lift);
-    vec3 d = v3_sub(b, a);
-    double len = v3_len(d);
-    if (!(len > 2.0 * lift)) return 1;
-    d = v3_scale(d, 1.0 / len);
-    double tmin = 0.0;
-    for (int k = 0; k < 8; k++) {
-        accel_hit h;
-        if (!accel_intersect(c->a, a, d, tmin, len, &h)) return 1;
-        if ((pm_surface_key(h.obj, 0) | 1u) != (surf | 1u)) return 0;
-        tmin = h.t + fmax(c->eps, h.t * 1e-7);
-    }
-    return 1;
+    return accel_mutually_visible(c->a, c->eps, x, nx, y, ny, same_surface, &surf);
 }
 
 /* Keeps the neighbours (a max-heap from pm_kdtree_knn) that vis_ok sees
