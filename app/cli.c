@@ -272,6 +272,7 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
             i++;
         } else if (strcmp(a, "--max-tokens") == 0 || strcmp(a, "--max-memory") == 0 ||
                    strcmp(a, "--max-string") == 0 || strcmp(a, "--max-array") == 0 ||
+                   strcmp(a, "--max-image-pixels") == 0 ||
                    strcmp(a, "--cl-max-memory") == 0) {
             if (!has_value(a, next, err, errlen)) return 2;
             long long v;
@@ -283,6 +284,7 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
             if (strcmp(a, "--max-tokens") == 0) o->max_tokens = v;
             else if (strcmp(a, "--max-memory") == 0) o->max_memory_mib = v;
             else if (strcmp(a, "--max-array") == 0) o->max_array = v;
+            else if (strcmp(a, "--max-image-pixels") == 0) o->max_image_pixels = v;
             else if (strcmp(a, "--cl-max-memory") == 0) o->cl_max_memory_mib = v > (1LL << 40) ? (1LL << 40) : v;
             else o->max_string = v > 0x7fffffffL ? 0x7fffffffL : (long)v;
             i++;

@@ -37,6 +37,7 @@ typedef struct {
     int max_include_depth, max_macro_depth;
     /* parser work/memory limits (sdl_options), 0 = the parser's default */
     long long max_tokens, max_memory_mib, max_array;
+    long long max_image_pixels; /* images read and the image rendered; 0 = default (2^28) */
     long max_string;
     /* GI settings (render_gi.h); 0 = the mode's default */
     long particles;

@@ -56,6 +56,7 @@ static const char *usage_text =
     "                 [--fg-rays N] [--photons N] [--max-depth N]\n"
     "                 [--max-loop N] [--max-include-depth N] [--max-macro-depth N]\n"
     "                 [--max-tokens N] [--max-memory MIB] [--max-string BYTES] [--max-array N]\n"
+    "                 [--max-image-pixels N]\n"
     "                 [+W640 +H480 +A0.3 +R3 +Oout.png +Iscene.pov +Ldir ...]\n"
     "                 [--clock V | +KV] [+KFIn +KFFn +KIv +KFv +KC] [--frame N | +SFn +EFn]\n"
     "  partray parse SCENE.pov [-D NAME=VALUE] [-L DIR] [--clock V] [frame options as render]\n"
@@ -111,6 +112,7 @@ static void fill_sdl_options(sdl_options *so, const cli_render *o)
     if (o->max_memory_mib > 0) so->max_memory = o->max_memory_mib > (1LL << 40) ? (1LL << 60) : o->max_memory_mib << 20;
     if (o->max_string > 0) so->max_string_length = o->max_string;
     if (o->max_array > 0) so->max_array_elements = o->max_array;
+    if (o->max_image_pixels > 0) so->max_image_pixels = o->max_image_pixels;
     so->func_env = shade_func_env(); /* pattern/pigment functions, noise, vturbulence while parsing */
     so->geom_env = accel_geom_env();  /* trace()/inside() of the shapes the parser does not intersect */
     char err[256];
@@ -121,16 +123,17 @@ static void fill_sdl_options(sdl_options *so, const cli_render *o)
  * refused before parsing, so a long render is never lost at the end. The
  * framebuffer is 12 bytes a pixel; writing a PNG or converting colours
  * makes a second copy. Returns 0 and prints why when not. */
-static int check_image_size(int w, int h)
+static int check_image_size(int w, int h, unsigned long long limit)
 {
     if (w > IMG_MAX_SIDE || h > IMG_MAX_SIDE) {
         fprintf(stderr, "partray render: image size %dx%d: a side is larger than %d pixels\n", w, h, IMG_MAX_SIDE);
         return 0;
     }
     unsigned long long px = (unsigned long long)w * (unsigned long long)h;
-    if (px > IMG_MAX_PIXELS) {
-        fprintf(stderr, "partray render: image size %dx%d: %llu pixels, more than the %llu an image may have\n", w, h, px,
-                (unsigned long long)IMG_MAX_PIXELS);
+    if (limit == 0 || limit > IMG_MAX_PIXELS) limit = IMG_MAX_PIXELS;
+    if (px > limit) {
+        fprintf(stderr, "partray render: image size %dx%d: %llu pixels, more than the %llu an image may have%s\n", w, h, px,
+                limit, limit < IMG_MAX_PIXELS ? " (--max-image-pixels)" : "");
         return 0;
     }
     long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
@@ -244,7 +247,8 @@ static int cmd_render(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
-    if (!check_image_size(o.width > 0 ? o.width : 320, o.height > 0 ? o.height : 240)) return EXIT_USAGE;
+    if (!check_image_size(o.width > 0 ? o.width : 320, o.height > 0 ? o.height : 240,
+                          (unsigned long long)o.max_image_pixels)) return EXIT_USAGE;
     int gi = GI_NONE;
     if (o.gi) {
         gi = gi_mode_parse(o.gi);

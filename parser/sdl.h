@@ -32,6 +32,8 @@ typedef struct {
                                      built included (default: half the physical memory) */
     long max_string_length;       /* bytes in one string value (default 1 MiB) */
     long long max_array_elements; /* elements in one array (default 10^8) */
+    long long max_image_pixels;   /* pixels in one image file read (image_map, height_field;
+                                     default and upper bound 2^28) */
     const char *write_dir;        /* NULL: #fopen ... write/append writes beside the scene
                                      (scene or working directory only); else every
                                      written file goes into this directory */

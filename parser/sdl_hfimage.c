@@ -18,11 +18,11 @@ static int is_pot_name(const char *path)
     return len > 4 && (strcmp(path + len - 4, ".pot") == 0 || strcmp(path + len - 4, ".POT") == 0);
 }
 
-int sdl_hf_read(const char *path, sdl_hf_image *out, char *why, size_t whycap)
+int sdl_hf_read(const char *path, unsigned long long max_pixels, sdl_hf_image *out, char *why, size_t whycap)
 {
     memset(out, 0, sizeof *out);
     sdl_img img;
-    int r = sdl_img_read(path, NULL, 0, &img, why, whycap);
+    int r = sdl_img_read(path, NULL, 0, max_pixels, &img, why, whycap);
     if (r != SDL_IMG_OK) return r == SDL_IMG_UNSUPPORTED ? SDL_HF_UNSUPPORTED : SDL_HF_ERROR;
     /* POT (Fractint continuous potential): a GIF whose right half holds each
      * pixel's low byte (POV-Ray's gif.cpp) */

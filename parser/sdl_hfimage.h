@@ -18,6 +18,6 @@ typedef struct {
 } sdl_hf_image;
 
 /* SDL_HF_OK, or an error / unsupported format with a reason in `why`. */
-int sdl_hf_read(const char *path, sdl_hf_image *out, char *why, size_t whycap);
+int sdl_hf_read(const char *path, unsigned long long max_pixels, sdl_hf_image *out, char *why, size_t whycap);
 
 #endif

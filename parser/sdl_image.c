@@ -16,10 +16,11 @@
 
 static double srgb_decode(double v) { return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4); }
 
-int sdl_image_load(scene_image *img, arena *mem, double working_gamma, char *why, size_t whycap)
+int sdl_image_load(scene_image *img, arena *mem, double working_gamma, unsigned long long max_pixels, char *why,
+                   size_t whycap)
 {
     sdl_img raw;
-    int r = sdl_img_read(img->path, NULL, 0, &raw, why, whycap);
+    int r = sdl_img_read(img->path, NULL, 0, max_pixels, &raw, why, whycap);
     if (r != SDL_IMG_OK) {
         char reason[256];
         snprintf(reason, sizeof reason, "%s", why);

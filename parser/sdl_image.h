@@ -13,6 +13,7 @@
  * assumed_gamma, or an image used as data): the file's codes as they are,
  * unless the scene gave the file's gamma (img->gamma), then linear values.
  * Returns 0 on success, else a reason in `why`. */
-int sdl_image_load(scene_image *img, arena *mem, double working_gamma, char *why, size_t whycap);
+int sdl_image_load(scene_image *img, arena *mem, double working_gamma, unsigned long long max_pixels, char *why,
+                   size_t whycap);
 
 #endif

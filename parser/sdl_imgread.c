@@ -21,11 +21,12 @@
 typedef struct {
     const unsigned char *b;
     size_t n, pos;
+    unsigned long long max_pixels; /* the caller's limit (sdl_img_read) */
 } mem_src;
 
-static int size_ok(unsigned long long w, unsigned long long h)
+static int size_ok(const mem_src *m, unsigned long long w, unsigned long long h)
 {
-    return w > 0 && h > 0 && w <= SDL_IMG_MAX_SIDE && h <= SDL_IMG_MAX_SIDE && w * h <= SDL_IMG_MAX_PIXELS;
+    return w > 0 && h > 0 && w <= SDL_IMG_MAX_SIDE && h <= SDL_IMG_MAX_SIDE && w * h <= m->max_pixels;
 }
 
 static int alloc_pixels(sdl_img *out, int w, int h, int indexed)
@@ -101,7 +102,7 @@ static int read_png(mem_src *m, sdl_img *out, char *why, size_t whycap)
         snprintf(why, whycap, "out of memory");
         return SDL_IMG_ERROR;
     }
-    int bad = imgcheck_png(mf, SDL_IMG_MAX_PIXELS, why, whycap);
+    int bad = imgcheck_png(mf, m->max_pixels, why, whycap);
     fclose(mf);
     if (bad) return SDL_IMG_ERROR;
     png_structp png =
@@ -128,8 +129,9 @@ static int read_png(mem_src *m, sdl_img *out, char *why, size_t whycap)
     png_read_info(png, info);
     png_uint_32 w = png_get_image_width(png, info), h = png_get_image_height(png, info);
     int depth = png_get_bit_depth(png, info), ct = png_get_color_type(png, info);
-    if (!size_ok(w, h)) {
-        snprintf(why, whycap, "image size %lux%lu out of range", (unsigned long)w, (unsigned long)h);
+    if (!size_ok(m, w, h)) {
+        snprintf(why, whycap, "image size %lux%lu out of range (at most %d a side and %llu pixels, --max-image-pixels)", (unsigned long)w, (unsigned long)h, SDL_IMG_MAX_SIDE,
+                 m->max_pixels);
         png_error(png, "size");
     }
     out->format = SDL_IMGF_PNG;
@@ -260,8 +262,9 @@ static int read_gif(mem_src *m, sdl_img *out, char *why, size_t whycap)
             break;
         }
         int w = g->Image.Width, h = g->Image.Height;
-        if (!size_ok((unsigned long long)(w > 0 ? w : 0), (unsigned long long)(h > 0 ? h : 0))) {
-            snprintf(why, whycap, "image size %dx%d out of range", w, h);
+        if (!size_ok(m, (unsigned long long)(w > 0 ? w : 0), (unsigned long long)(h > 0 ? h : 0))) {
+            snprintf(why, whycap, "image size %dx%d out of range (at most %d a side and %llu pixels, --max-image-pixels)", w, h, SDL_IMG_MAX_SIDE,
+                 m->max_pixels);
             break;
         }
         /* LZW codes have at least 3 bits and one gives at most 4096 pixels
@@ -368,8 +371,9 @@ static int read_tga(mem_src *m, sdl_img *out, char *why, size_t whycap)
         snprintf(why, whycap, "TGA pixel format (%d bits, type %d) not supported", bits, type);
         return SDL_IMG_UNSUPPORTED;
     }
-    if (!size_ok(w, ht)) {
-        snprintf(why, whycap, "image size %ux%u out of range", w, ht);
+    if (!size_ok(m, w, ht)) {
+        snprintf(why, whycap, "image size %ux%u out of range (at most %d a side and %llu pixels, --max-image-pixels)", w, ht, SDL_IMG_MAX_SIDE,
+                 m->max_pixels);
         return SDL_IMG_ERROR;
     }
     size_t pos = 18 + (size_t)idlen;
@@ -481,8 +485,9 @@ static int read_pnm(mem_src *m, int kind, sdl_img *out, char *why, size_t whycap
         snprintf(why, whycap, "bad PGM/PPM header");
         return SDL_IMG_ERROR;
     }
-    if (!size_ok((unsigned long long)w, (unsigned long long)h)) {
-        snprintf(why, whycap, "image size %ldx%ld out of range", w, h);
+    if (!size_ok(m, (unsigned long long)w, (unsigned long long)h)) {
+        snprintf(why, whycap, "image size %ldx%ld out of range (at most %d a side and %llu pixels, --max-image-pixels)", w, h, SDL_IMG_MAX_SIDE,
+                 m->max_pixels);
         return SDL_IMG_ERROR;
     }
     int colour = kind == 3 || kind == 6, binary = kind >= 5, wide = maxv > 255, ch = colour ? 3 : 1;
@@ -565,8 +570,9 @@ static int read_jpeg(mem_src *m, sdl_img *out, char *why, size_t whycap)
     ci.mem->max_memory_to_use = 1L << 30;
     jpeg_mem_src(&ci, m->b, (unsigned long)m->n);
     jpeg_read_header(&ci, TRUE);
-    if (!size_ok(ci.image_width, ci.image_height)) {
-        snprintf(why, whycap, "image size %ux%u out of range", (unsigned)ci.image_width, (unsigned)ci.image_height);
+    if (!size_ok(m, ci.image_width, ci.image_height)) {
+        snprintf(why, whycap, "image size %ux%u out of range (at most %d a side and %llu pixels, --max-image-pixels)", (unsigned)ci.image_width, (unsigned)ci.image_height, SDL_IMG_MAX_SIDE,
+                 m->max_pixels);
         jpeg_fail((j_common_ptr)&ci);
     }
     int grey = ci.num_components == 1;
@@ -651,9 +657,10 @@ static int read_tiff(mem_src *m, sdl_img *out, char *why, size_t whycap)
     TIFFGetFieldDefaulted(t, TIFFTAG_PLANARCONFIG, &planar);
     TIFFGetFieldDefaulted(t, TIFFTAG_EXTRASAMPLES, &extra, &extra_types);
     if (!TIFFGetField(t, TIFFTAG_PHOTOMETRIC, &photo)) photo = spp >= 3 ? PHOTOMETRIC_RGB : PHOTOMETRIC_MINISBLACK;
-    if (!size_ok(w, h)) {
+    if (!size_ok(m, w, h)) {
         TIFFClose(t);
-        snprintf(why, whycap, "image size %ux%u out of range", (unsigned)w, (unsigned)h);
+        snprintf(why, whycap, "image size %ux%u out of range (at most %d a side and %llu pixels, --max-image-pixels)", (unsigned)w, (unsigned)h, SDL_IMG_MAX_SIDE,
+                 m->max_pixels);
         return SDL_IMG_ERROR;
     }
     int r = SDL_IMG_ERROR;
@@ -760,7 +767,8 @@ static unsigned char *read_file(const char *path, size_t *n, char *why, size_t w
     return b;
 }
 
-int sdl_img_read(const char *path, const unsigned char *bytes, size_t n, sdl_img *out, char *why, size_t whycap)
+int sdl_img_read(const char *path, const unsigned char *bytes, size_t n, unsigned long long max_pixels, sdl_img *out,
+                 char *why, size_t whycap)
 {
     memset(out, 0, sizeof *out);
     if (whycap) why[0] = 0;
@@ -774,7 +782,8 @@ int sdl_img_read(const char *path, const unsigned char *bytes, size_t n, sdl_img
         if (!owned) return SDL_IMG_ERROR;
         bytes = owned;
     }
-    mem_src m = {bytes, n, 0};
+    if (max_pixels == 0 || max_pixels > SDL_IMG_MAX_PIXELS) max_pixels = SDL_IMG_MAX_PIXELS;
+    mem_src m = {bytes, n, 0, max_pixels};
     int r;
     if (n >= 8 && !png_sig_cmp(bytes, 0, 8)) {
         r = read_png(&m, out, why, whycap);

@@ -36,10 +36,12 @@ typedef struct {
 } sdl_img;
 
 /* Decode `bytes` (n of them) when bytes is not NULL, else the file at
- * `path`. SDL_IMG_OK and a filled `out` (free with sdl_img_free), or
+ * `path`, refusing images of more than max_pixels pixels (0 or more than
+ * SDL_IMG_MAX_PIXELS: SDL_IMG_MAX_PIXELS; --max-image-pixels). SDL_IMG_OK and a filled `out` (free with sdl_img_free), or
  * SDL_IMG_ERROR / SDL_IMG_UNSUPPORTED with a reason in `why`; on failure
  * `out` holds nothing to free. */
-int sdl_img_read(const char *path, const unsigned char *bytes, size_t n, sdl_img *out, char *why, size_t whycap);
+int sdl_img_read(const char *path, const unsigned char *bytes, size_t n, unsigned long long max_pixels, sdl_img *out,
+                 char *why, size_t whycap);
 void sdl_img_free(sdl_img *img);
 
 #endif

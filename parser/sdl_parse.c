@@ -258,6 +258,7 @@ void sdl_default_options(sdl_options *o)
     o->max_tokens = 10000000000LL;
     o->max_string_length = 1L << 20;
     o->max_array_elements = 100000000LL;
+    o->max_image_pixels = 1LL << 28; /* SDL_IMG_MAX_PIXELS */
     /* half the physical memory: the rest is for the acceleration structure
      * and the framebuffer */
     long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
@@ -358,6 +359,7 @@ static void set_options(sdl_parser *p, const sdl_options *opt)
     if (p->opt.max_memory <= 0) p->opt.max_memory = def.max_memory;
     if (p->opt.max_string_length <= 0) p->opt.max_string_length = def.max_string_length;
     if (p->opt.max_array_elements <= 0) p->opt.max_array_elements = def.max_array_elements;
+    if (p->opt.max_image_pixels <= 0) p->opt.max_image_pixels = def.max_image_pixels;
 }
 
 static pt_status run(const char *name, const char *text, const sdl_options *opt, scene **out, diag *d)

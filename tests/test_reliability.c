@@ -193,7 +193,12 @@ static void test_image_size_limit(void **st)
            "partray render: image size 20000x20000: 400000000 pixels, more than the 268435456 an image may have");
     /* refused before the scene is read: a broken scene does not matter */
     expect("size_bad.pov", "sphere {", "--size 20000x20000", 2, "400000000 pixels");
+    /* --max-image-pixels lowers the limit for the image rendered ... */
+    expect("size.pov", text, "--size 64x64 --max-image-pixels 4000", 2,
+           "image size 64x64: 4096 pixels, more than the 4000 an image may have (--max-image-pixels)");
+    assert_int_equal(render("size.pov", text, "--size 64x64 --max-image-pixels 4096"), 0);
 }
+
 
 /* ------------------------------------------------------------ image files */
 
@@ -314,6 +319,20 @@ static void test_image_file_limits(void **st)
     printf("%s", out_text);
     assert_non_null(strstr(out_text, "imgmap.pov:3:"));
     assert_non_null(strstr(out_text, "the file is truncated or corrupt: it declares 16384x16384 pixels"));
+}
+
+/* --max-image-pixels also bounds the images a scene reads: a 16x16
+ * PNG height_field passes at 256 pixels and is a located error at 255. */
+static void test_read_image_limit(void **st)
+{
+    (void)st;
+    char png[512], text[512];
+    write_image("hf16.png", 16, 16, png, sizeof png);
+    snprintf(text, sizeof text, "%slight_source { <0, 5, -5> rgb 1 }\nheight_field { png \"hf16.png\" }\n", camera);
+    assert_int_equal(render("hf.pov", text, "--max-image-pixels 256"), 0);
+    /* exit 3: the scene is fine, a file it reads is not (as a missing one) */
+    expect("hf.pov", text, "--max-image-pixels 255", 3,
+           "hf.pov:3:1: error: height_field image 'hf16.png': image size 16x16 exceeds the limit (65536 per side, 255 pixels in all)");
 }
 
 static void test_limit_usage(void **st)
@@ -521,6 +540,7 @@ int main(void)
         cmocka_unit_test(test_array_limit),
         cmocka_unit_test(test_mesh_memory_limit),
         cmocka_unit_test(test_image_size_limit),
+        cmocka_unit_test(test_read_image_limit),
         cmocka_unit_test(test_image_file_limits),
         cmocka_unit_test(test_limit_usage),
         cmocka_unit_test(test_opencl_no_platform),

@@ -997,7 +997,7 @@ static void check_hf_values(const char *path, int colour, int tol, int scale)
 {
     sdl_hf_image im;
     char why[256];
-    int r = sdl_hf_read(path, &im, why, sizeof why);
+    int r = sdl_hf_read(path, 0, &im, why, sizeof why);
     if (r != SDL_HF_OK) fail_msg("%s: %s", path, why);
     assert_int_equal(im.width, FW * scale);
     assert_int_equal(im.height, FH * scale);
@@ -1055,7 +1055,7 @@ static void test_height_field_formats(void **st)
     write_tiff(path, 16, 1);
     sdl_hf_image im;
     char why[256];
-    assert_int_equal(sdl_hf_read(path, &im, why, sizeof why), SDL_HF_OK);
+    assert_int_equal(sdl_hf_read(path, 0, &im, why, sizeof why), SDL_HF_OK);
     assert_int_equal(im.values[1], fmt_grey[0][1] * 257 + 3);
     free(im.values);
     /* JPEG: lossy; flat 8x8 blocks at quality 100 come back within 1 code */
@@ -1067,20 +1067,20 @@ static void test_height_field_formats(void **st)
     snprintf(path, sizeof path, "%s/huge.tga", dir);
     unsigned char hdr[18] = {0, 0, 3, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0xff, 0xff, 0xff, 0xff, 8, 0};
     write_bytes(path, hdr, sizeof hdr);
-    assert_int_equal(sdl_hf_read(path, &im, why, sizeof why), SDL_HF_ERROR);
+    assert_int_equal(sdl_hf_read(path, 0, &im, why, sizeof why), SDL_HF_ERROR);
     assert_null(im.values);
     snprintf(path, sizeof path, "%s/huge.pgm", dir);
     write_bytes(path, "P5 16000 16000 255\n\x01\x02", 21);
-    assert_int_equal(sdl_hf_read(path, &im, why, sizeof why), SDL_HF_ERROR);
+    assert_int_equal(sdl_hf_read(path, 0, &im, why, sizeof why), SDL_HF_ERROR);
     assert_non_null(strstr(why, "ends early"));
     /* the one reader takes bytes too */
     sdl_img raw;
     n = make_tga(b, 2, 0);
-    assert_int_equal(sdl_img_read(NULL, b, n, &raw, why, sizeof why), SDL_IMG_OK);
+    assert_int_equal(sdl_img_read(NULL, b, n, 0, &raw, why, sizeof why), SDL_IMG_OK);
     assert_int_equal(raw.width, FW);
     assert_int_equal(raw.rgba[(size_t)(2 * FW + 3) * 4], fmt_grey[2][3] * 257);
     sdl_img_free(&raw);
-    assert_int_equal(sdl_img_read(NULL, b, 17, &raw, why, sizeof why), SDL_IMG_UNSUPPORTED);
+    assert_int_equal(sdl_img_read(NULL, b, 17, 0, &raw, why, sizeof why), SDL_IMG_UNSUPPORTED);
     const char *names[] = {"g.tga", "c.ppm", "g8.tif", "c8.tif", "g16.tif", "g.jpg", "huge.tga", "huge.pgm"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, names[i]);

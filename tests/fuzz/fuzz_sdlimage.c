@@ -44,7 +44,7 @@ static void check_decoder(const uint8_t *data, size_t size)
 {
     sdl_img img;
     char why[512] = "";
-    int r = sdl_img_read(NULL, data, size, &img, why, sizeof why);
+    int r = sdl_img_read(NULL, data, size, 0, &img, why, sizeof why);
     if (r == SDL_IMG_OK) {
         FUZZ_CHECK(img.rgba && img.width > 0 && img.height > 0);
         FUZZ_CHECK(img.width <= SDL_IMG_MAX_SIDE && img.height <= SDL_IMG_MAX_SIDE);
@@ -72,7 +72,7 @@ static void check_map_image(double gamma, double working_gamma)
     img.path = g_path;
     img.gamma = gamma;
     char why[512] = "";
-    if (sdl_image_load(&img, mem, working_gamma, why, sizeof why) == 0) {
+    if (sdl_image_load(&img, mem, working_gamma, 0, why, sizeof why) == 0) {
         FUZZ_CHECK(img.pixels && img.width > 0 && img.height > 0);
         FUZZ_CHECK((uint64_t)img.width * (uint64_t)img.height <= SDL_IMG_MAX_PIXELS);
         size_t n = (size_t)img.width * (size_t)img.height * 5u; /* RGBFT */
@@ -88,7 +88,7 @@ static void check_height_field(const char *path)
     sdl_hf_image hf;
     memset(&hf, 0, sizeof hf);
     char why[512] = "";
-    int r = sdl_hf_read(path, &hf, why, sizeof why);
+    int r = sdl_hf_read(path, 0, &hf, why, sizeof why);
     if (r == SDL_HF_OK) {
         FUZZ_CHECK(hf.values && hf.width > 0 && hf.height > 0);
         FUZZ_CHECK((uint64_t)hf.width * (uint64_t)hf.height <= SDL_IMG_MAX_PIXELS);
