@@ -88,35 +88,49 @@ static int same_line(const char *a, const char *b, double tol)
 
 /* ------------------------------------------------------------ POV-Ray comparison */
 
-static void test_lang_checks(void **st)
+/* Parse tests/sdl/NAME.pov (with options o, or the defaults) and compare
+ * its #debug lines, each up to its first newline (a macro chain may
+ * follow), with POV-Ray 3.7.0's in tests/sdl/NAME.expected: numbers within
+ * tol (same_line), or byte for byte when tol < 0. At least min_lines;
+ * no_extra: partray may not print more. */
+static void check_debug_lines(const char *name, const sdl_options *o, double tol, int min_lines, int no_extra)
 {
-    (void)st;
     char path[1024], exp[1024];
-    snprintf(path, sizeof path, "%s/sdl/lang_checks.pov", PT_TESTS_DIR);
-    snprintf(exp, sizeof exp, "%s/sdl/lang_checks.expected", PT_TESTS_DIR);
+    snprintf(path, sizeof path, "%s/sdl/%s.pov", PT_TESTS_DIR, name);
+    snprintf(exp, sizeof exp, "%s/sdl/%s.expected", PT_TESTS_DIR, name);
     FILE *f = fopen(exp, "r");
     assert_non_null(f);
     diag *d = diag_new();
     scene *s = NULL;
-    pt_status rc = sdl_parse_file(path, NULL, &s, d);
+    pt_status rc = sdl_parse_file(path, o, &s, d);
     if (rc != PT_OK) print_diag(d);
     assert_int_equal(rc, PT_OK);
     char line[1024];
     int n = 0, bad = 0;
     while (fgets(line, sizeof line, f)) {
         line[strcspn(line, "\n")] = 0;
-        const char *got = note(d, n);
-        if (!got || !same_line(got, line, 1e-6)) {
-            print_message("line %d: partray \"%s\"\n         POV-Ray \"%s\"\n", n + 1, got ? got : "(none)", line);
+        const char *full = note(d, n);
+        char got[1024] = "";
+        if (full) snprintf(got, sizeof got, "%.*s", (int)strcspn(full, "\n"), full);
+        int same = full && (tol < 0 ? strcmp(got, line) == 0 : same_line(got, line, tol));
+        if (!same) {
+            print_message("line %d: partray \"%s\"\n         POV-Ray \"%s\"\n", n + 1, full ? got : "(none)", line);
             bad++;
         }
         n++;
     }
     fclose(f);
-    assert_true(n >= 50);
+    assert_true(n >= min_lines);
+    if (no_extra) assert_null(note(d, n));
     assert_int_equal(bad, 0);
     scene_free(s);
     diag_free(d);
+}
+
+static void test_lang_checks(void **st)
+{
+    (void)st;
+    check_debug_lines("lang_checks", NULL, 1e-6, 50, 0);
 }
 
 /* String functions and macro arguments by reference (identifiers and array
@@ -126,34 +140,9 @@ static void test_lang_checks(void **st)
 static void test_strings(void **st)
 {
     (void)st;
-    char path[1024], exp[1024];
-    snprintf(path, sizeof path, "%s/sdl/strings.pov", PT_TESTS_DIR);
-    snprintf(exp, sizeof exp, "%s/sdl/strings.expected", PT_TESTS_DIR);
-    FILE *f = fopen(exp, "r");
-    assert_non_null(f);
-    diag *d = diag_new();
-    scene *s = NULL;
-    pt_status rc = sdl_parse_file(path, NULL, &s, d);
-    if (rc != PT_OK) print_diag(d);
-    assert_int_equal(rc, PT_OK);
-    char line[1024];
-    int n = 0, bad = 0;
-    while (fgets(line, sizeof line, f)) {
-        line[strcspn(line, "\n")] = 0;
-        const char *got = note(d, n);
-        if (!got || strcmp(got, line) != 0) {
-            print_message("line %d: partray \"%s\"\n         POV-Ray \"%s\"\n", n + 1, got ? got : "(none)", line);
-            bad++;
-        }
-        n++;
-    }
-    fclose(f);
-    assert_true(n >= 20);
-    assert_null(note(d, n)); /* no extra lines either */
-    assert_int_equal(bad, 0);
-    scene_free(s);
-    diag_free(d);
+    check_debug_lines("strings", NULL, -1.0, 20, 1);
 
+    diag *d;
     double t0 = ((double)time(NULL) - 946684800.0) / 86400.0;
     d = parse_text("#debug str(now, 0, 9)\n#debug datetime(now, \"%Y\")\n", NULL, PT_OK, NULL);
     double t1 = ((double)time(NULL) - 946684800.0) / 86400.0;
@@ -173,39 +162,13 @@ static void test_strings(void **st)
 static void test_trace_shapes(void **st)
 {
     (void)st;
-    char path[1024], exp[1024];
-    snprintf(path, sizeof path, "%s/sdl/trace_shapes.pov", PT_TESTS_DIR);
-    snprintf(exp, sizeof exp, "%s/sdl/trace_shapes.expected", PT_TESTS_DIR);
-    FILE *f = fopen(exp, "r");
-    assert_non_null(f);
     sdl_options o;
     sdl_default_options(&o);
     o.func_env = shade_func_env();
     o.geom_env = accel_geom_env();
-    diag *d = diag_new();
-    scene *s = NULL;
-    pt_status rc = sdl_parse_file(path, &o, &s, d);
-    if (rc != PT_OK) print_diag(d);
-    assert_int_equal(rc, PT_OK);
-    char line[1024];
-    int n = 0, bad = 0;
-    while (fgets(line, sizeof line, f)) {
-        line[strcspn(line, "\n")] = 0;
-        const char *full = note(d, n);
-        char got[1024] = "";
-        if (full) snprintf(got, sizeof got, "%.*s", (int)strcspn(full, "\n"), full); /* the macro chain follows */
-        if (!full || !same_line(got, line, 1e-5)) {
-            print_message("line %d: partray \"%s\"\n         POV-Ray \"%s\"\n", n + 1, full ? got : "(none)", line);
-            bad++;
-        }
-        n++;
-    }
-    fclose(f);
-    assert_true(n >= 29);
-    assert_int_equal(bad, 0);
-    scene_free(s);
-    diag_free(d);
+    check_debug_lines("trace_shapes", &o, 1e-5, 29, 0);
 
+    diag *d;
     d = parse_text("#declare S = sor { 4, <0,0>, <1,0>, <0.5,1>, <0,2> }\n#declare P = trace(S, 3*x, -x);\n", NULL,
                    PT_ERR_UNSUPPORTED, NULL);
     assert_non_null(strstr(first_error(d), "trace: shape 'sor' is not supported"));
