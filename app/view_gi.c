@@ -273,6 +273,18 @@ static pt_status pmfg_open(void **ctx, const scene *sc, const accel *a, const vi
 
 static pt_status ref_relight(void *ctx, volatile int *cancel, view_gi_times *t, diag *d) { return PT_OK; }
 
+/* The image-loop options of one preview pass (either reference mode). */
+static void pass_settings(pm_common *c, const view_gi_pass *p, uint64_t seed, int spp)
+{
+    c->width = p->width;
+    c->height = p->height;
+    c->threads = p->threads;
+    c->seed = seed;
+    c->spp = spp;
+    c->cancel = p->cancel;
+    c->image_interval = 1e9;
+}
+
 static pt_status ref_render(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
 {
     ref_ctx *c = ctx;
@@ -289,13 +301,7 @@ static pt_status ref_render(void *ctx, const view_gi_pass *p, framebuffer *fb, v
          * gather rays and 4 light samples per eye sample */
         pm_fg_settings s;
         pm_fg_default_settings(&s);
-        s.c.width = p->width;
-        s.c.height = p->height;
-        s.c.threads = p->threads;
-        s.c.seed = seed;
-        s.c.spp = spp;
-        s.c.cancel = p->cancel;
-        s.c.image_interval = 1e9;
+        pass_settings(&s.c, p, seed, spp);
         s.photons = c->photons;
         s.fg_rays = 16 * spp;
         s.area_samples = 4;
@@ -306,13 +312,7 @@ static pt_status ref_render(void *ctx, const view_gi_pass *p, framebuffer *fb, v
     } else {
         pm_path_settings s;
         pm_path_default_settings(&s);
-        s.c.width = p->width;
-        s.c.height = p->height;
-        s.c.threads = p->threads;
-        s.c.seed = seed;
-        s.c.spp = spp;
-        s.c.cancel = p->cancel;
-        s.c.image_interval = 1e9;
+        pass_settings(&s.c, p, seed, spp);
         r = pm_path_render(c->sc, c->a, &s, fb, &st, d);
     }
     t->render = timer_now() - t0 - t->light;

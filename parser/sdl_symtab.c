@@ -205,6 +205,18 @@ int sdl_symtab_undef(sdl_symtab *t, const char *name, size_t n)
     return 1;
 }
 
+/* The entry for `name` in the innermost scope, made (with no value) when
+ * that scope has none; NULL when out of memory. */
+static sym_entry *local_entry(sdl_symtab *t, const char *name, size_t n)
+{
+    sym_entry *e = find_entry(t, name, n);
+    if (e && e->depth == t->depth) return e;
+    sdl_value none;
+    memset(&none, 0, sizeof none);
+    if (!insert_entry(t, name, n, t->depth, &none)) return NULL;
+    return find_entry(t, name, n);
+}
+
 sdl_symref *sdl_symtab_ref(const sdl_symtab *t, const char *name, size_t n)
 {
     return resolve(find_entry(t, name, n));
@@ -212,13 +224,8 @@ sdl_symref *sdl_symtab_ref(const sdl_symtab *t, const char *name, size_t n)
 
 int sdl_symtab_alias(sdl_symtab *t, const char *name, size_t n, sdl_symref *target)
 {
-    sdl_value none;
-    memset(&none, 0, sizeof none);
-    sym_entry *e = find_entry(t, name, n);
-    if (!e || e->depth != t->depth) {
-        if (!insert_entry(t, name, n, t->depth, &none)) return 0;
-        e = find_entry(t, name, n);
-    }
+    sym_entry *e = local_entry(t, name, n);
+    if (!e) return 0;
     e->slot = NULL;
     e->alias = resolve(target);
     if (e->alias == e) e->alias = NULL;
@@ -227,13 +234,8 @@ int sdl_symtab_alias(sdl_symtab *t, const char *name, size_t n, sdl_symref *targ
 
 int sdl_symtab_alias_elem(sdl_symtab *t, const char *name, size_t n, sdl_value *slot, void *owner, long index)
 {
-    sdl_value none;
-    memset(&none, 0, sizeof none);
-    sym_entry *e = find_entry(t, name, n);
-    if (!e || e->depth != t->depth) {
-        if (!insert_entry(t, name, n, t->depth, &none)) return 0;
-        e = find_entry(t, name, n);
-    }
+    sym_entry *e = local_entry(t, name, n);
+    if (!e) return 0;
     e->alias = NULL;
     e->slot = slot;
     e->owner = owner;

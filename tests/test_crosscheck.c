@@ -98,11 +98,5 @@ int main(void)
         cmocka_unit_test(test_parallel_reflect),
         cmocka_unit_test(test_area_fade),
     };
-    int rc = cmocka_run_group_tests(tests, NULL, NULL);
-    if (rc == 0)
-        tu_rm_rf(tmpdir);
-    else {
-        printf("images kept in %s\n", tmpdir);
-    }
-    return rc;
+    return tu_finish(cmocka_run_group_tests(tests, NULL, NULL), tmpdir);
 }

@@ -115,11 +115,5 @@ int main(void)
         cmocka_unit_test(test_cameras),
         cmocka_unit_test(test_gamma_image),
     };
-    int rc = cmocka_run_group_tests(tests, NULL, NULL);
-    if (rc == 0)
-        tu_rm_rf(tmpdir);
-    else {
-        printf("images kept in %s\n", tmpdir);
-    }
-    return rc;
+    return tu_finish(cmocka_run_group_tests(tests, NULL, NULL), tmpdir);
 }

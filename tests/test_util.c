@@ -85,6 +85,15 @@ void tu_rm_rf(const char *dir)
     rmdir(dir);
 }
 
+int tu_finish(int rc, const char *dir)
+{
+    if (rc == 0)
+        tu_rm_rf(dir);
+    else
+        printf("images kept in %s\n", dir);
+    return rc;
+}
+
 double tu_downsampled_mad(const framebuffer *a, const framebuffer *b, int f)
 {
     int w = a->width / f, h = a->height / f;

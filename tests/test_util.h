@@ -26,6 +26,9 @@ int tu_exists(const char *path);
  * returns 0 on success. tu_rm_rf removes it and its plain files. */
 int tu_mkdtemp(char *dir, size_t size, const char *prefix);
 void tu_rm_rf(const char *dir);
+/* End of a test program: removes dir when rc is 0, else says where its
+ * files were kept; returns rc. */
+int tu_finish(int rc, const char *dir);
 
 /* Mean absolute difference over all channels of the `f`x`f`
  * box-downsampled images (same size, sRGB-encoded values in 0..1). */
