@@ -982,15 +982,11 @@ static int pattern_type(sdl_parser *p, target *tg)
     }
     case KW_TILING: {
         set_kind(tg, PAT_TILING, name);
-        src_loc nloc = sdl_peek(p)->tk.loc;
         double n = sdl_float(p);
         /* POV-Ray keeps the number as an unsigned char; 0 and values past
          * 27 give the square tiling */
         pt->tiling = (int)(unsigned char)sdl_to_int(n);
-        if (pt->tiling > 7 && pt->tiling <= 27)
-            sdl_warn_once(p, nloc, "tiling %d is not supported (tilings 1 to 7 are); it evaluates to 0", pt->tiling);
-        else if (pt->tiling < 1 || pt->tiling > 27)
-            pt->tiling = 1;
+        if (pt->tiling < 1 || pt->tiling > 27) pt->tiling = 1;
         break;
     }
     case KW_MANDEL: case KW_JULIA: case KW_MAGNET: {
