@@ -71,7 +71,46 @@ typedef struct {
     rgb fade_colour;
     int caustics_set;
     double caustics;      /* appended: POV-Ray's internal value, 45 * the given one (faked caustics) */
+    /* appended (issue 5): the media { } blocks in order */
+    int nmedia;
+    const struct scene_media *const *media;
 } scene_interior;
+
+/* ---------------------------------------------------------------- media
+ * Participating media (appended, issue 5; shade/shade_media.c renders
+ * them). One media { } block as POV-Ray 3.7 keeps it. Defaults of a media
+ * written at #version 3.5 or later (POV-Ray's Parse_Media): method 3,
+ * intervals 1, samples 10,10; earlier: method 1, intervals 10, samples 1,1.
+ * Always: ratio 0.9, confidence 0.9, variance 1/128, jitter 0,
+ * aa_threshold 0.1, aa_level 3, scattering type 1 (isotropic),
+ * eccentricity 0, extinction 1. */
+typedef enum {
+    MEDIA_ISOTROPIC = 1, MEDIA_MIE_HAZY, MEDIA_MIE_MURKY, MEDIA_RAYLEIGH, MEDIA_HENYEY_GREENSTEIN
+} media_scatter_kind;
+
+typedef struct scene_media {
+    src_loc loc;
+    int method;           /* 1, 2, 3 */
+    int intervals;
+    int min_samples, max_samples;
+    double jitter, aa_threshold;
+    int aa_level;
+    double ratio, confidence, variance;
+    rgb absorption, emission, scattering;
+    int scattering_type;  /* media_scatter_kind (other values scatter isotropically) */
+    double eccentricity;  /* Henyey-Greenstein g */
+    double extinction;    /* scattering's share of the extinction (POV-Ray's sc_ext) */
+    int collect;          /* photons collected (parsed; photons in media are not modelled) */
+    /* density { } blocks (their colours multiply); each is a pigment
+     * evaluated in media space; ndensity 0 = constant density 1 */
+    int ndensity;
+    const scene_pigment *const *density;
+    /* media space -> the container's object space (interior media: the
+     * object's transforms written before the interior are undone here, so
+     * object -> world is the container's transform), or -> world
+     * (atmospheric media) */
+    xform transform;
+} scene_media;
 
 /* A texture: one pigment, finish and (later) normal. Layered textures are a
  * list linked through `next`, the first entry on top. */
@@ -441,6 +480,8 @@ typedef struct {
     const scene_sky_sphere *sky_sphere; /* NULL = none */
     const scene_rainbow *rainbows;      /* appended (issue 5): linked through `next` */
     scene_image *images;    /* every image the scene references (image_map...), to load */
+    int natmosphere;        /* appended (issue 5): atmospheric media { } statements in order */
+    const scene_media *const *atmosphere;
 } scene;
 
 scene *scene_new(void);

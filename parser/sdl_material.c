@@ -5,6 +5,7 @@
 #include "sdl_directive.h"
 #include "sdl_atmos.h"
 #include "sdl_expr.h"
+#include "sdl_media.h"
 #include "sdl_pattern.h"
 
 /* ------------------------------------------------------------ transforms */
@@ -326,10 +327,7 @@ static void interior_item(sdl_parser *p, scene_interior *in)
     case KW_FADE_DISTANCE: in->fade_distance = sdl_float(p); break;
     case KW_FADE_POWER: in->fade_power = sdl_float(p); break;
     case KW_FADE_COLOR: case KW_FADE_COLOUR: in->fade_colour = sdl_rgb(p); break;
-    case KW_MEDIA:
-        sdl_warn_once(p, t.tk.loc, "media is not supported yet and is ignored");
-        if (sdl_begin_block(p, "media")) sdl_skip_block(p);
-        break;
+    case KW_MEDIA: sdl_media_append(p, &in->media, &in->nmedia, sdl_parse_media(p)); break;
     default: sdl_unexpected(p, &t, "interior item"); break;
     }
 }
@@ -447,6 +445,12 @@ int sdl_parse_look_value(sdl_parser *p, sdl_kw k, sdl_value *out)
     case KW_NORMAL_MAP: name = "normal_map"; break;
     case KW_SLOPE_MAP: name = "slope_map"; break;
     case KW_TEXTURE_MAP: name = "texture_map"; break;
+    case KW_MEDIA: case KW_DENSITY: /* sdl_media.c (issue 5) */
+        memset(out, 0, sizeof *out);
+        out->kind = VAL_OPAQUE;
+        out->str = k == KW_MEDIA ? "media" : "density";
+        out->ptr = k == KW_MEDIA ? (void *)sdl_parse_media(p) : (void *)sdl_parse_density(p);
+        return 1;
     case KW_FOG: case KW_SKY_SPHERE: case KW_RAINBOW:
         memset(out, 0, sizeof *out);
         out->kind = VAL_OPAQUE;

@@ -6,6 +6,7 @@
 #include "sdl_directive.h"
 #include "sdl_expr.h"
 #include "sdl_material.h"
+#include "sdl_media.h"
 #include "sdl_scene.h"
 #include "sdl_shape.h"
 
@@ -158,7 +159,28 @@ static void post_process(sdl_parser *p, scene_object *o, const scene_object *par
     if (parent) {
         if (!o->texture) o->texture = parent->texture;
         if (!o->interior_texture) o->interior_texture = parent->interior_texture;
-        if (!o->interior) o->interior = parent->interior;
+        if (!o->interior) {
+            o->interior = parent->interior;
+            /* interior media live in the container's space: a member with
+             * transforms of its own sees the parent's media through them */
+            if (o->interior && o->interior->nmedia && memcmp(&o->transform, &parent->transform, sizeof o->transform) != 0) {
+                scene_interior *in = sdl_alloc(p, sizeof *in);
+                if (in) {
+                    *in = *parent->interior;
+                    in->nmedia = 0;
+                    in->media = NULL;
+                    xform rebase = xform_then(parent->transform, xform_inverse(o->transform));
+                    for (int i = 0; i < parent->interior->nmedia; i++) {
+                        scene_media *c = sdl_alloc(p, sizeof *c);
+                        if (!c) break;
+                        *c = *parent->interior->media[i];
+                        c->transform = xform_then(c->transform, rebase);
+                        sdl_media_append(p, &in->media, &in->nmedia, c);
+                    }
+                    o->interior = in;
+                }
+            }
+        }
         o->flags |= parent->flags & INHERITED_FLAGS;
     }
     if (!o->texture) o->texture = deflt;
@@ -283,14 +305,23 @@ static int material_mod(sdl_parser *p, scene_object *o, sdl_kw k)
         if (o->interior) *in = *o->interior;
         else scene_default_interior(in);
         sdl_parse_interior(p, in);
+        sdl_media_attach(p, in, o->interior, &o->transform); /* media: transforms written so far are not theirs */
         o->interior = in;
         return 1;
     }
     case KW_MATERIAL: {
+        const scene_interior *before = o->interior;
         sdl_material m = {own_texture(o->texture), own_texture(o->interior_texture), (scene_interior *)o->interior};
         sdl_parse_material(p, &m);
         o->texture = m.texture;
         o->interior_texture = m.interior_texture;
+        if (m.interior && m.interior != before && m.interior->nmedia) {
+            scene_interior *in = sdl_alloc(p, sizeof *in);
+            if (!in) return 1;
+            *in = *m.interior;
+            sdl_media_attach(p, in, before, &o->transform);
+            m.interior = in;
+        }
         o->interior = m.interior;
         return 1;
     }

@@ -1095,9 +1095,8 @@ static int modifier(sdl_parser *p, target *tg)
     case KW_TEXTURE_MAP:
         *tg->map = blend_map(p, MAP_TEXTURE, tg->pat && tg->pat->kind == PAT_AVERAGE);
         return 1;
-    case KW_DENSITY_MAP:
-        sdl_warn_once(p, t.tk.loc, "density_map is not supported and is ignored");
-        if (sdl_begin_block(p, "density_map")) sdl_skip_block(p);
+    case KW_DENSITY_MAP: /* entries are density bodies: pigment bodies (sdl_media.c) */
+        *tg->map = blend_map(p, MAP_PIGMENT, tg->pat && tg->pat->kind == PAT_AVERAGE);
         return 1;
     case KW_QUICK_COLOR: case KW_QUICK_COLOUR:
         sdl_colour(p, 1);
@@ -1233,7 +1232,9 @@ static colour5 first_colour(const scene_blend_map *m, colour5 fallback)
 void sdl_pattern_pigment_body(sdl_parser *p, scene_pigment *pg)
 {
     const sdl_tok *t = sdl_peek(p);
-    if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_PIGMENT && t->val.ptr) {
+    /* a declared density (sdl_media.c) starts a density body as a pigment does */
+    if (t->tk.kind == TOK_IDENT && t->val.ptr &&
+        (t->val.kind == VAL_PIGMENT || (t->val.kind == VAL_OPAQUE && t->val.str && strcmp(t->val.str, "density") == 0))) {
         sdl_tok id = sdl_next(p);
         *pg = *(const scene_pigment *)id.val.ptr;
         t = sdl_peek(p);

@@ -6,6 +6,7 @@
 #include "sdl_directive.h"
 #include "sdl_expr.h"
 #include "sdl_material.h"
+#include "sdl_media.h"
 #include "sdl_object.h"
 
 /* ------------------------------------------------------------ camera */
@@ -593,12 +594,6 @@ void sdl_parse_default(sdl_parser *p)
 
 /* ------------------------------------------------------------ statements */
 
-static void skipped_statement(sdl_parser *p, const sdl_tok *t)
-{
-    sdl_warn_once(p, t->tk.loc, "'%s' is not supported yet and is ignored", sdl_kw_text(t->tk.kw));
-    if (sdl_begin_block(p, sdl_kw_text(t->tk.kw))) sdl_skip_block(p);
-}
-
 /* statement := camera | object_statement | global_settings | background |
  *   fog | sky_sphere | rainbow | media */
 static void statement(sdl_parser *p)
@@ -624,7 +619,7 @@ static void statement(sdl_parser *p)
     case KW_BACKGROUND: background(p); return;
     case KW_FOG: case KW_SKY_SPHERE: sdl_atmos_statement(p, t.tk.kw); return; /* sdl_atmos.c (issue 5) */
     case KW_RAINBOW: sdl_atmos_statement(p, t.tk.kw); return; /* sdl_atmos.c (issue 5) */
-    case KW_MEDIA: skipped_statement(p, &t); return;
+    case KW_MEDIA: sdl_media_statement(p); return; /* atmospheric media (sdl_media.c, issue 5) */
     default: break;
     }
     if (t.tk.kind == TOK_IDENT && t.val.kind == VAL_NONE)

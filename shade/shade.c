@@ -34,6 +34,7 @@
 #include "shade_atmos.h"
 #include "shade_gamma.h"
 #include "shade_light.h"
+#include "shade_media.h"
 #include "shade_normal.h"
 #include "shade_project.h"
 #include "shade_texture.h"
@@ -59,7 +60,28 @@ typedef struct {
     int tiles_x, tiles_y;
     int transparent;     /* some surface lets light through: filtered shadows */
     light_projection *proj; /* projected_through lights (shade_project.c), NULL = none */
+    /* Media (issue 5, shade_media.c): whether the scene has any, the
+     * containers of the camera's location, and per thread the hit being
+     * shaded (its incoming ray's containers) for the rays it spawns. */
+    int media;
+    media_inside cam_in;
+    const struct hit_frame *frame[SHADE_MAX_THREADS];
 } render_ctx;
+
+/* The hit tex_shade is working on, for its callbacks: the containers of
+ * the ray that reached it. */
+typedef struct hit_frame {
+    const accel_hit *h;
+    vec3 dir;
+    const media_inside *in;
+} hit_frame;
+
+static const media_inside no_containers = {0, {0}};
+
+static const media_inside *frame_inside(const render_ctx *c, int thread)
+{
+    return c->frame[thread] ? c->frame[thread]->in : &no_containers;
+}
 
 static inline rgb rgb_make(double r, double g, double b) { rgb c = {r, g, b}; return c; }
 static inline rgb rgb_add(rgb a, rgb b) { return rgb_make(a.r + b.r, a.g + b.g, a.b + b.b); }
@@ -98,8 +120,24 @@ static int shadow_blocked(render_ctx *c, int thread, vec3 p, vec3 dir, double de
 
 /* Light reaching p along a shadow ray: 0 or 1 in scenes without transparent
  * surfaces, else filtered by the surfaces crossed (shade_texture.c). */
-static rgb shadow_rgb(render_ctx *c, int thread, vec3 p, vec3 dir, double depth)
+static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, const media_inside *in, vec3 *to_light);
+
+/* Media along shadow rays (shade_media.c): the light's media_attenuation
+ * through the atmosphere and fog, the containers' media on the way. */
+static int media_shadows(const render_ctx *c, const scene_light *l)
 {
+    return c->media || (l && c->sc->fogs && l->media_interaction && l->media_attenuation);
+}
+
+static rgb shadow_rgb(render_ctx *c, int thread, vec3 p, vec3 dir, double depth, const scene_light *l, const media_inside *in)
+{
+    if (media_shadows(c, l)) {
+        c->ts[thread].shadow++;
+        double tmax = depth - fmax(c->eps, depth * 1e-6);
+        if (tmax <= c->eps) return rgb_make(1, 1, 1);
+        media_env me = {c->sc, c, thread, NULL, media_light, NULL};
+        return media_shadow_ray(c->sc, c->a, &me, l, p, dir, c->eps, tmax, in ? in : &no_containers);
+    }
     if (!c->transparent) return shadow_blocked(c, thread, p, dir, depth) ? rgb_make(0, 0, 0) : rgb_make(1, 1, 1);
     c->ts[thread].shadow++;
     double tmax = depth - fmax(c->eps, depth * 1e-6);
@@ -115,6 +153,7 @@ typedef struct {
     rgb *grid; /* size1*size2, r < 0 = not sampled */
     rng *r;
     int thread;
+    const media_inside *in;
 } area_job;
 
 static rgb area_sample(area_job *j, int u, int v)
@@ -125,7 +164,7 @@ static rgb area_sample(area_job *j, int u, int v)
     vec3 dir;
     double depth;
     light_ray(j->l, centre, j->p, &dir, &depth);
-    *g = shadow_rgb(j->c, j->thread, j->p, dir, depth);
+    *g = shadow_rgb(j->c, j->thread, j->p, dir, depth, j->l, j->in);
     return *g;
 }
 
@@ -148,18 +187,50 @@ static rgb area_subset(area_job *j, int u1, int v1, int u2, int v2, int level)
     return rgb_scale(rgb_add(rgb_add(s[0], s[1]), rgb_add(s[2], s[3])), 0.25);
 }
 
-static rgb area_visibility(render_ctx *c, int thread, const scene_light *l, vec3 p, rng *r)
+static rgb area_visibility(render_ctx *c, int thread, const scene_light *l, vec3 p, rng *r, const media_inside *in)
 {
     rgb stack_grid[256];
     int n = l->size1 * l->size2;
     rgb *grid = n <= 256 ? stack_grid : malloc(sizeof(rgb) * (size_t)n);
     if (!grid) return rgb_make(1, 1, 1);
     for (int i = 0; i < n; i++) grid[i].r = -1.0;
-    area_job j = {c, l, p, l->axis1, l->axis2, grid, r, thread};
+    area_job j = {c, l, p, l->axis1, l->axis2, grid, r, thread, in};
     light_area_axes(l, p, &j.ax1, &j.ax2);
     rgb vis = area_subset(&j, 0, 0, l->size1 - 1, l->size2 - 1, 0);
     if (grid != stack_grid) free(grid);
     return vis;
+}
+
+/* Light of l reaching a media sample at p (POV-Ray's TestShadow): its
+ * attenuation there, then unless shadowless the shadow ray (area grid
+ * included) from the sampled ray's containers. */
+static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, const media_inside *in, vec3 *to_light)
+{
+    render_ctx *c = ctx;
+    vec3 dir;
+    double depth;
+    light_ray(l, l->position, p, &dir, &depth);
+    *to_light = dir;
+    double sdepth = depth;
+    if (l->projected_through && !projection_pass(c->proj, (int)(l - c->sc->lights), p, dir, depth, &sdepth))
+        return rgb_make(0, 0, 0);
+    rgb lc = rgb_scale(l->colour, light_attenuation(l, p, dir, depth));
+    if (rgb_near_zero(lc) || l->shadowless) return lc;
+    rgb vis;
+    if (l->area && l->size1 * l->size2 > 1) {
+        rng r; /* jittered area lights: a stream of the sample's own */
+        uint64_t k;
+        double coords[3] = {p.x, p.y, p.z};
+        memcpy(&k, &coords[0], sizeof k);
+        uint64_t k2, k3;
+        memcpy(&k2, &coords[1], sizeof k2);
+        memcpy(&k3, &coords[2], sizeof k3);
+        rng_seed(&r, k ^ (k2 * 0x9e3779b97f4a7c15ULL) ^ (k3 * 0xbf58476d1ce4e5b9ULL), (uint64_t)thread);
+        vis = area_visibility(c, thread, l, p, &r, in);
+    } else {
+        vis = shadow_rgb(c, thread, p, dir, sdepth, l, in);
+    }
+    return rgb_mul(lc, vis);
 }
 
 /* --------------------------------------------------------------- BRDF terms */
@@ -167,6 +238,7 @@ static rgb area_visibility(render_ctx *c, int thread, const scene_light *l, vec3
 static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const accel_hit *h, vec3 p, rng *r)
 {
     rgb total = {0, 0, 0};
+    const media_inside *in = frame_inside(c, thread);
     int double_illum = (h->obj->flags & OBJ_DOUBLE_ILLUMINATE) != 0;
     for (int i = 0; i < c->sc->nlights; i++) {
         const scene_light *l = &c->sc->lights[i];
@@ -202,7 +274,7 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
                         else continue;
                     }
                     if (!l->shadowless) {
-                        slc = rgb_mul(slc, shadow_rgb(c, thread, p, d2, dep2));
+                        slc = rgb_mul(slc, shadow_rgb(c, thread, p, d2, dep2, l, in));
                         if (rgb_near_zero(slc)) continue;
                     }
                     total = rgb_add(total, light_terms(s, d2, slc, back2));
@@ -213,13 +285,14 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
         if (!l->shadowless) {
             rgb vis;
             if (l->area && l->size1 * l->size2 > 1)
-                vis = area_visibility(c, thread, l, p, r);
+                vis = area_visibility(c, thread, l, p, r, in);
             else
-                vis = shadow_rgb(c, thread, p, dir, sdepth);
+                vis = shadow_rgb(c, thread, p, dir, sdepth, l, in);
             if (rgb_near_zero(vis)) continue;
             lc = rgb_mul(lc, vis);
-            /* media_attenuation: fog dims the light on its way (shade_atmos.c) */
-            if (l->media_attenuation && l->media_interaction && c->sc->fogs)
+            /* media_attenuation: fog dims the light on its way (shade_atmos.c;
+             * with media, per segment in shadow_rgb) */
+            if (l->media_attenuation && l->media_interaction && c->sc->fogs && !media_shadows(c, l))
                 lc = rgb_mul(lc, atmos_fog_attenuation(c->sc, p, dir, depth));
         }
         if (l->shadowless && (s->f->phong != 0.0 || s->f->specular != 0.0)) {
@@ -238,12 +311,11 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
 
 /* ------------------------------------------------------------------ tracing */
 
-/* background, sky_sphere and fog: shade_atmos.c */
-static rgb background(const scene *sc, vec3 org, vec3 dir) { return atmos_fog(sc, org, dir, INFINITY, atmos_sky(sc, dir)); }
-
 /* `skip`: objects with any of these flags are invisible to this ray (no_image
- * for camera rays, no_reflection for reflected rays). */
-static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, rng *r);
+ * for camera rays, no_reflection for reflected rays); `in`: the objects the
+ * ray starts inside (shade_media.h). */
+static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, rng *r,
+                     const media_inside *in);
 
 /* The surface model (patterns, layers, normals, reflection, refraction,
  * interior fade) is POV-Ray's ComputeLightedTexture in shade_texture.c; it
@@ -252,7 +324,13 @@ static rgb tex_cb_trace(void *ctx, int thread, vec3 org, vec3 dir, int level, do
 {
     render_ctx *c = ctx;
     c->ts[thread].secondary++;
-    return trace_ray(c, thread, org, dir, level, weight, skip, r);
+    const hit_frame *f = c->frame[thread];
+    if (!f) return trace_ray(c, thread, org, dir, level, weight, skip, r, &no_containers);
+    /* a ray going on through the surface (refracted or straight) enters or
+     * leaves the object; a reflected one stays where the incoming ray was */
+    media_inside in = *f->in;
+    if (v3_dot(dir, f->h->ng) * v3_dot(f->dir, f->h->ng) > 0.0) media_inside_cross(&in, f->h->obj);
+    return trace_ray(c, thread, org, dir, level, weight, skip, r, &in);
 }
 
 static rgb tex_cb_direct(void *ctx, int thread, const light_surface *s, const accel_hit *h, vec3 p, rng *r)
@@ -266,14 +344,40 @@ static rgb tex_cb_indirect(void *ctx, int thread, const accel_hit *h, vec3 n)
     return c->s->indirect(c->s->indirect_ctx, h, n, thread);
 }
 
-static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip, rng *r)
+static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip, rng *r,
+                     const media_inside *in)
 {
     tex_env e = {c->sc, c->eps, c->s->use_ambient, c->max_level, c, thread, r, tex_cb_trace, tex_cb_direct,
                  c->s->indirect ? tex_cb_indirect : NULL, &c->ts[thread].unsupported};
-    return tex_shade(&e, h, dir, level, weight, skip);
+    hit_frame f = {h, dir, in};
+    const hit_frame *outer = c->frame[thread];
+    c->frame[thread] = &f;
+    rgb col = tex_shade(&e, h, dir, level, weight, skip);
+    c->frame[thread] = outer;
+    return col;
 }
 
-static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, rng *r)
+/* What the ray sees besides the surface at depth (INFINITY: none), in
+ * POV-Ray's TraceRay order: the containers' media (with a surface), then
+ * for a hollow ray the atmosphere's media, rainbows and fog. */
+static rgb along_ray(render_ctx *c, int thread, vec3 org, vec3 dir, double depth, rgb col, rng *r, const media_inside *in,
+                     const scene_object *hit)
+{
+    int hollow = media_inside_hollow(in);
+    if (!hollow) return col;
+    if (c->media) {
+        media_env me = {c->sc, c, thread, r, media_light, hit};
+        if (isfinite(depth) && in->n > 0 && media_inside_has_media(in))
+            col = media_segment(&me, MEDIA_INTERIOR, in, org, dir, depth, col, 0);
+        if (c->sc->natmosphere > 0)
+            col = media_segment(&me, MEDIA_ATMOSPHERE, in, org, dir, isfinite(depth) ? depth : 2.0e10 /* POV-Ray's BOUND_HUGE */,
+                                col, 0);
+    }
+    return atmos_fog(c->sc, org, dir, depth, col);
+}
+
+static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, rng *r,
+                     const media_inside *in)
 {
     if (level > c->max_level) return rgb_make(0, 0, 0);
     accel_hit h;
@@ -281,11 +385,12 @@ static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, d
     /* Step past objects this ray must not see (bounded: a pathological stack
      * of such surfaces ends as background). */
     for (int k = 0; k < 64; k++) {
-        if (!accel_intersect(c->a, org, dir, tmin, INFINITY, &h)) return background(c->sc, org, dir);
-        if (!(h.flags & skip)) return atmos_fog(c->sc, org, dir, h.t, shade_hit(c, thread, &h, dir, level, weight, skip, r));
+        if (!accel_intersect(c->a, org, dir, tmin, INFINITY, &h)) break;
+        if (!(h.flags & skip))
+            return along_ray(c, thread, org, dir, h.t, shade_hit(c, thread, &h, dir, level, weight, skip, r, in), r, in, h.obj);
         tmin = h.t + fmax(c->eps, h.t * 1e-7);
     }
-    return background(c->sc, org, dir);
+    return along_ray(c, thread, org, dir, INFINITY, atmos_sky(c->sc, dir), r, in, NULL);
 }
 
 static double scene_eps(const accel *a)
@@ -303,7 +408,8 @@ rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 o
     thread_stats ts[1];
     memset(ts, 0, sizeof ts);
     render_ctx c = {sc, a, s, scene_eps(a), s->max_trace_level > 0 ? s->max_trace_level : sc->global.max_trace_level, ts, NULL, NULL, 0, 0, 1};
-    return trace_ray(&c, 0, org, v3_norm(dir), 1, 1.0, OBJ_NO_IMAGE, r);
+    c.media = media_scene_has(sc);
+    return trace_ray(&c, 0, org, v3_norm(dir), 1, 1.0, OBJ_NO_IMAGE, r, &no_containers);
 }
 
 /* --------------------------------------------------------------- the image */
@@ -355,7 +461,7 @@ static rgb primary_ray(render_ctx *c, int thread, double px, double py, vec3 org
         dir = v3_norm(normal_perturb(c->sc->camera.normal, dir, sp, NULL, &pc));
     }
     c->ts[thread].primary++;
-    rgb v = trace_ray(c, thread, org, dir, 1, 1.0, OBJ_NO_IMAGE, r);
+    rgb v = trace_ray(c, thread, org, dir, 1, 1.0, OBJ_NO_IMAGE, r, &c->cam_in);
     if (!isfinite(v.r) || !isfinite(v.g) || !isfinite(v.b)) {
         c->ts[thread].discarded++;
         return rgb_make(0, 0, 0);
@@ -496,6 +602,9 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     c.tiles_y = (s->height + TILE - 1) / TILE;
     c.transparent = tex_scene_transparent(sc);
     c.proj = projection_build(sc, d);
+    c.media = media_scene_has(sc);
+    /* the camera's containers matter to media and to fog (not in non-hollow objects) */
+    if (c.media || sc->fogs || sc->rainbows) media_inside_at(sc, sc->camera.location, &c.cam_in);
     int ntiles = c.tiles_x * c.tiles_y;
 
     pool_run(threads, ntiles, tile_first_pass, &c);

@@ -1,0 +1,651 @@
+/* shade_media.c - participating media (see shade_media.h).
+ *
+ * POV-Ray 3.7's media model, from its reference manual ("Media") and its
+ * MediaFunction (media.cpp) and Trace (trace.cpp), studied for semantics:
+ *  - Coefficients at a point: every density of a media multiplies (a
+ *    density is a pigment; its rgb is the density; no density = 1); the
+ *    media's absorption, emission and scattering times the density are
+ *    summed over the media acting on the segment; extinction = absorption
+ *    + extinction_factor * scattering.
+ *  - Lit intervals: every light with media_interaction lights the part of
+ *    the segment inside its cone (spotlight: the cone of its falloff angle),
+ *    cylinder (falloff radius) or all of it (point and area lights). The
+ *    interval starts and ends are sorted separately and merged into lit
+ *    and unlit intervals.
+ *  - Sampling intervals: max(intervals, number of lit intervals) of them;
+ *    one lit interval (or one unlit one of non-constant media) is cut into
+ *    `intervals` equal parts; one unlit interval of constant media is one
+ *    interval; several are given n = floor(w / sum(w) * intervals) + 1
+ *    parts each (w = ratio for lit, 1 - ratio for unlit), bounded so the
+ *    later ones still get one. The media with the most intervals decides
+ *    (and its method, samples, jitter, ratio); aa_threshold is the smallest.
+ *  - Method 3 (adaptive, POV-Ray 3.5+'s default): an interval is cut into
+ *    (min_samples + 1) / 2 sub-intervals; samples at their ends (moved by
+ *    jitter * (rand - 0.5) of a sub-interval); between two samples whose
+ *    colours differ by more than aa_threshold (sum of |channel
+ *    differences|) a middle sample is taken recursively, aa_level - 1
+ *    levels deep; at the last level the three samples average 1:1:1,
+ *    otherwise each half weighs its outer sample 1/3 and the middle one
+ *    1/6. A sub-interval's emitted light is attenuated by the optical depth
+ *    of the sub-intervals before it and by (1 - exp(-od)) / od of its own
+ *    (od = its optical depth).
+ *  - Methods 1 and 2: min_samples samples per interval at a random place
+ *    (1) or stratified (j + 0.5) / n + jitter * rand / n (2); each sample's
+ *    emitted light is ds * exp(-extinction * d) (d = its distance into the
+ *    interval); the interval's light and optical depth are the samples'
+ *    means. (POV-Ray adds samples up to max_samples while their variance
+ *    exceeds a chi-square threshold from confidence and variance: not done
+ *    here, the min_samples are used.)
+ *  - In-scattering at a sample in a lit interval: for each light whose
+ *    interval holds the sample, the light reaching the point (attenuation,
+ *    shadows through surfaces, media on the way) times scattering times the
+ *    phase function averaged over the media acting: isotropic 1, Rayleigh
+ *    0.799372013 (1 + a^2), Mie hazy 0.576655375 (1 + 9 ((1 + a)/2)^8),
+ *    Mie murky 0.495714547 (1 + 50 ((1 + a)/2)^32), Henyey-Greenstein
+ *    (1 - g^2) / (1 + g^2 - 2 g a)^1.5, a = cos(angle between the view ray
+ *    and the direction towards the light) (POV-Ray's constants).
+ *  - Intervals in order: colour * exp(-sum od) + sum te * exp(-od before).
+ *  - Shadow rays: extinction only; media whose densities are all constant
+ *    take a single sample per interval.
+ *  - Photons in media are not modelled. */
+#include "shade_media.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "accel_query.h"
+#include "shade_atmos.h"
+#include "shade_pattern.h"
+#include "shade_texture.h"
+
+#define MEDIA_MAX_DISTANCE 1.0e7   /* POV-Ray's MAX_DISTANCE */
+#define MEDIA_EPSILON 1.0e-10      /* POV-Ray's EPSILON */
+#define MEDIA_SMALL_TOLERANCE 1.0e-3 /* POV-Ray's SMALL_TOLERANCE */
+#define MAX_REFS 64
+#define MAX_LIGHTS 64
+#define MAX_INTERVALS 256
+
+static inline rgb mk(double r, double g, double b) { rgb c = {r, g, b}; return c; }
+static inline rgb add(rgb a, rgb b) { return mk(a.r + b.r, a.g + b.g, a.b + b.b); }
+static inline rgb mul(rgb a, rgb b) { return mk(a.r * b.r, a.g * b.g, a.b * b.b); }
+static inline rgb scl(rgb a, double s) { return mk(a.r * s, a.g * s, a.b * s); }
+static inline rgb expn(rgb a) { return mk(exp(-a.r), exp(-a.g), exp(-a.b)); }
+static inline int is_zero(rgb a) { return a.r == 0.0 && a.g == 0.0 && a.b == 0.0; }
+static inline double dist3(rgb a, rgb b) { return fabs(a.r - b.r) + fabs(a.g - b.g) + fabs(a.b - b.b); }
+
+/* ------------------------------------------------------------ containers */
+
+static const void *key_of(const scene_object *o) { return o->interior ? (const void *)o->interior : (const void *)o; }
+
+int media_scene_has(const scene *sc)
+{
+    if (sc->natmosphere > 0) return 1;
+    /* interior media: any object's (CSG members included) */
+    for (int i = 0; i < sc->nobjects; i++) {
+        const scene_object *stack[256];
+        int n = 0;
+        stack[n++] = sc->objects[i];
+        while (n > 0) {
+            const scene_object *o = stack[--n];
+            if (o->interior && o->interior->nmedia > 0) return 1;
+            if (o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION ||
+                o->kind == SHAPE_DIFFERENCE)
+                for (int k = 0; k < o->u.csg.nkids && n < 256; k++) stack[n++] = o->u.csg.kids[k];
+        }
+    }
+    return 0;
+}
+
+int media_inside_hollow(const media_inside *in)
+{
+    for (int i = 0; i < in->n; i++)
+        if (!(in->obj[i]->flags & OBJ_HOLLOW)) return 0;
+    return 1;
+}
+
+int media_inside_has_media(const media_inside *in)
+{
+    for (int i = 0; i < in->n; i++)
+        if (in->obj[i]->interior && in->obj[i]->interior->nmedia > 0) return 1;
+    return 0;
+}
+
+void media_inside_cross(media_inside *in, const scene_object *o)
+{
+    if (!o) return;
+    const void *k = key_of(o);
+    for (int i = 0; i < in->n; i++) {
+        if (key_of(in->obj[i]) == k) {
+            memmove(&in->obj[i], &in->obj[i + 1], sizeof in->obj[0] * (size_t)(in->n - i - 1));
+            in->n--;
+            return;
+        }
+    }
+    if (in->n < MEDIA_MAX_INSIDE) in->obj[in->n++] = o;
+}
+
+static int leaf_inside(const geom_env *g, const scene_object *o, vec3 p)
+{
+    int nomem = 0;
+    void *sh = g->prepare(o, &nomem);
+    if (!sh) return 0;
+    int r = g->inside(sh, p);
+    g->release(sh);
+    return (o->flags & OBJ_INVERSE) ? !r : r;
+}
+
+static void inside_at(const geom_env *g, const scene_object *o, vec3 p, media_inside *in, int depth)
+{
+    if (depth > 32) return;
+    if (o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE) {
+        for (int k = 0; k < o->u.csg.nkids; k++) inside_at(g, o->u.csg.kids[k], p, in, depth + 1);
+        return;
+    }
+    if (o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE || o->kind == SHAPE_UNSUPPORTED) return;
+    int matters = !(o->flags & OBJ_HOLLOW) || (o->interior && o->interior->nmedia > 0);
+    if (!matters || o->clip) return;
+    if (!leaf_inside(g, o, p)) return;
+    for (int i = 0; i < in->n; i++)
+        if (key_of(in->obj[i]) == key_of(o)) return;
+    if (in->n < MEDIA_MAX_INSIDE) in->obj[in->n++] = o;
+}
+
+void media_inside_at(const scene *sc, vec3 p, media_inside *in)
+{
+    in->n = 0;
+    const geom_env *g = accel_geom_env();
+    for (int i = 0; i < sc->nobjects; i++) inside_at(g, sc->objects[i], p, in, 0);
+}
+
+/* ------------------------------------------------------------ coefficients */
+
+typedef struct {
+    const scene_media *m;
+    const xform *obj; /* container's object -> world, NULL for the atmosphere */
+} media_ref;
+
+typedef struct {
+    rgb ext, emit, scat;
+} coeffs;
+
+static rgb density_at(const media_ref *r, vec3 p, const pattern_ctx *pc)
+{
+    const scene_media *m = r->m;
+    if (m->ndensity == 0) return mk(1, 1, 1);
+    vec3 q = r->obj ? xform_inv_point(r->obj, p) : p;
+    if (!xform_is_identity(&m->transform)) q = xform_inv_point(&m->transform, q);
+    rgb d = {1, 1, 1};
+    for (int i = 0; i < m->ndensity; i++) {
+        colour5 c = {0, 0, 0, 0, 0};
+        pigment_eval(m->density[i], q, pc, &c);
+        d = mul(d, mk(c.r, c.g, c.b));
+    }
+    return d;
+}
+
+static coeffs coeffs_at(const media_ref *refs, int n, vec3 p, int shadow, const pattern_ctx *pc)
+{
+    coeffs c = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    for (int i = 0; i < n; i++) {
+        const scene_media *m = refs[i].m;
+        rgb d = density_at(&refs[i], p, pc);
+        rgb ext = add(m->absorption, scl(m->scattering, m->extinction));
+        c.ext = add(c.ext, mul(d, ext));
+        if (!shadow) {
+            c.emit = add(c.emit, mul(d, m->emission));
+            c.scat = add(c.scat, mul(d, m->scattering));
+        }
+    }
+    return c;
+}
+
+/* The phase function averaged over the media acting (POV-Ray's constants);
+ * a = cos(view ray, direction towards the light). */
+static double phase(const media_ref *refs, int n, double a)
+{
+    double k = 0.0;
+    for (int i = 0; i < n; i++) {
+        const scene_media *m = refs[i].m;
+        switch (m->scattering_type) {
+        case MEDIA_RAYLEIGH: k += 0.799372013 * (1.0 + a * a); break;
+        case MEDIA_MIE_HAZY: k += 0.576655375 * (1.0 + 9.0 * pow(0.5 * (1.0 + a), 8.0)); break;
+        case MEDIA_MIE_MURKY: k += 0.495714547 * (1.0 + 50.0 * pow(0.5 * (1.0 + a), 32.0)); break;
+        case MEDIA_HENYEY_GREENSTEIN: {
+            double g = m->eccentricity;
+            k += (1.0 - g * g) / pow(1.0 + g * g - 2.0 * g * a, 1.5);
+            break;
+        }
+        default: k += 1.0; break;
+        }
+    }
+    return n > 0 ? k / n : 0.0;
+}
+
+/* ------------------------------------------------------------ lit intervals */
+
+/* Part of the ray org + t dir inside a spotlight's cone (half angle =
+ * falloff): the quadric |X - C|^2 cos^2 = ((X - C).D)^2 solved for t, with
+ * the branch rules for a ray starting inside the cone or meeting only its
+ * back half (POV-Ray's spotlight media interval). */
+static int spot_interval(vec3 org, vec3 dir, const scene_light *l, double *d1, double *d2)
+{
+    vec3 axis = v3_norm(v3_sub(l->point_at, l->position));
+    double cf = cos(l->falloff * M_PI / 180.0);
+    double m = 1.0 / (cf * cf);
+    vec3 v1 = v3_sub(org, l->position);
+    double k1 = v3_dot(dir, axis), k2 = v3_dot(v1, axis), len = v3_len(v1);
+    int in_cone = len > MEDIA_EPSILON ? k2 / len >= cf : 0;
+    if (k1 <= 0.0 && k2 < 0.0) return 0;
+    double k3 = v3_dot(v1, dir), k4 = v3_dot(v1, v1);
+    double a = 1.0 - k1 * k1 * m, b = k3 - k1 * k2 * m, c = k4 - k2 * k2 * m;
+    if (a != 0.0) {
+        double d = b * b - a * c;
+        if (d > MEDIA_EPSILON) {
+            d = sqrt(d);
+            double t1 = (-b + d) / a, t2 = (-b - d) / a;
+            if (t1 > t2) { double t = t1; t1 = t2; t2 = t; }
+            double l1 = k2 + t1 * k1, l2 = k2 + t2 * k1;
+            if (l1 <= 0.0 && l2 <= 0.0) return 0;
+            if (l1 <= 0.0 || l2 <= 0.0) {
+                if (l1 <= 0.0) {
+                    if (in_cone) { t1 = 0.0; t2 = t2 > 0.0 ? t2 : MEDIA_MAX_DISTANCE; }
+                    else { t1 = t2; t2 = MEDIA_MAX_DISTANCE; }
+                } else {
+                    if (in_cone) { t2 = t1; t1 = 0.0; }
+                    else t2 = MEDIA_MAX_DISTANCE;
+                }
+            }
+            *d1 = t1;
+            *d2 = t2;
+            return 1;
+        }
+        if (d > -MEDIA_EPSILON) {
+            if (in_cone) { *d1 = 0.0; *d2 = -b / a; }
+            else { *d1 = -b / a; *d2 = MEDIA_MAX_DISTANCE; }
+            return 1;
+        }
+        return 0;
+    }
+    if (in_cone) {
+        *d1 = 0.0;
+        *d2 = -c / b;
+        return 1;
+    }
+    return 0;
+}
+
+/* Part of the ray within a cylinder light's falloff radius of its axis,
+ * ahead of the light. */
+static int cylinder_interval(vec3 org, vec3 dir, const scene_light *l, double *d1, double *d2)
+{
+    vec3 axis = v3_norm(v3_sub(l->point_at, l->position));
+    vec3 v1 = v3_sub(org, l->position);
+    double k1 = v3_dot(dir, axis), k2 = v3_dot(v1, axis);
+    if (k1 <= 0.0 && k2 < 0.0) return 0;
+    double a = 1.0 - k1 * k1;
+    if (a == 0.0) return 0;
+    double k3 = v3_dot(v1, dir), k4 = v3_dot(v1, v1);
+    double b = k3 - k1 * k2, c = k4 - k2 * k2 - l->falloff * l->falloff;
+    double d = b * b - a * c;
+    if (!(d > MEDIA_EPSILON)) return 0;
+    d = sqrt(d);
+    double t1 = (-b + d) / a, t2 = (-b - d) / a;
+    if (t1 > t2) { double t = t1; t1 = t2; t2 = t; }
+    double l1 = k2 + t1 * k1, l2 = k2 + t2 * k1;
+    if (l1 <= 0.0 && l2 <= 0.0) return 0;
+    if (l1 <= 0.0 || l2 <= 0.0) {
+        if (l1 <= 0.0) t1 = 0.0;
+        else t2 = (MEDIA_MAX_DISTANCE - k2) / k1;
+    }
+    *d1 = t1;
+    *d2 = t2;
+    return 1;
+}
+
+typedef struct {
+    const scene_light *l;
+    double s0, s1;
+} lit_light;
+
+typedef struct {
+    int lit;
+    double s0, s1, ds;
+    rgb te, od;
+    int samples;
+} interval;
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* ------------------------------------------------------------ sampling */
+
+typedef struct {
+    const media_env *e;
+    const media_ref *refs;
+    int nrefs;
+    vec3 org, dir;
+    int shadow, use_scattering;
+    const lit_light *lights;
+    int nlights;
+    const media_inside *in;
+    pattern_ctx pc;
+} sampler;
+
+/* One sample at fraction d of interval iv: its emitted (and in-scattered)
+ * light times ds in *col, its optical depth over ds in *od. Methods 1/2
+ * accumulate into the interval (light attenuated over d * ds). */
+static void one_sample(const sampler *s, interval *iv, double d, int method, rgb *col, rgb *od)
+{
+    double d0 = d * iv->ds, d1 = iv->s0 + d0;
+    vec3 h = v3_madd(s->org, s->dir, d1);
+    coeffs c = coeffs_at(s->refs, s->nrefs, h, s->shadow, &s->pc);
+    *od = scl(c.ext, iv->ds);
+    if (method != 3) iv->od = add(iv->od, *od);
+    rgb emit = c.emit;
+    if (!s->shadow && s->use_scattering && iv->lit && s->e->light && !is_zero(c.scat)) {
+        for (int i = 0; i < s->nlights; i++) {
+            if (d1 < s->lights[i].s0 || d1 > s->lights[i].s1) continue;
+            vec3 to;
+            rgb lc = s->e->light(s->e->ctx, s->e->thread, s->lights[i].l, h, s->in, &to);
+            if (is_zero(lc)) continue;
+            double k = phase(s->refs, s->nrefs, v3_dot(to, s->dir));
+            emit = add(emit, scl(mul(c.scat, lc), k));
+        }
+    }
+    if (method == 3) {
+        emit = scl(emit, iv->ds);
+    } else {
+        emit = mul(scl(emit, iv->ds), expn(scl(c.ext, d0)));
+        iv->te = add(iv->te, emit);
+    }
+    *col = emit;
+    iv->samples++;
+}
+
+static double rnd(const media_env *e) { return e->r ? rng_f64(e->r) : 0.5; }
+
+/* POV-Ray's recursive adaptive sample between fractions d1 and d3. */
+static void recursive_sample(const sampler *s, interval *iv, double d1, double d3, rgb c1, rgb c3, rgb od1, rgb od3,
+                             int depth, double jitter, double aa, rgb *res, rgb *odres)
+{
+    double d2 = 0.5 * (d1 + d3);
+    double jd = d2 + (jitter != 0.0 ? jitter * (d3 - d1) * (rnd(s->e) - 0.5) : 0.0);
+    rgb c2, od2, r2, o2;
+    one_sample(s, iv, jd, 3, &c2, &od2);
+    if (depth <= 0) {
+        *res = scl(add(add(c1, c2), c3), 1.0 / 3.0);
+        *odres = scl(add(add(od1, od2), od3), 1.0 / 3.0);
+        return;
+    }
+    if (dist3(c1, c2) > aa) {
+        recursive_sample(s, iv, d1, d2, c1, c2, od1, od2, depth - 1, jitter, aa, &r2, &o2);
+        *res = scl(r2, 0.5);
+        *odres = scl(o2, 0.5);
+    } else {
+        *res = add(scl(c1, 1.0 / 3.0), scl(c2, 1.0 / 6.0));
+        *odres = add(scl(od1, 1.0 / 3.0), scl(od2, 1.0 / 6.0));
+    }
+    if (dist3(c2, c3) > aa) {
+        recursive_sample(s, iv, d2, d3, c2, c3, od2, od3, depth - 1, jitter, aa, &r2, &o2);
+        *res = add(*res, scl(r2, 0.5));
+        *odres = add(*odres, scl(o2, 0.5));
+    } else {
+        *res = add(*res, add(scl(c2, 1.0 / 6.0), scl(c3, 1.0 / 3.0)));
+        *odres = add(*odres, add(scl(od2, 1.0 / 6.0), scl(od3, 1.0 / 3.0)));
+    }
+}
+
+static void adaptive(const sampler *s, interval *iv, const scene_media *im, double aa)
+{
+    int sub = (im->min_samples + 1) / 2;
+    if (sub < 1) sub = 1;
+    double dd = 1.0 / sub;
+    rgb c0, od0, c1, od1, res, odres;
+    double j0 = im->jitter != 0.0 ? dd * im->jitter * (rnd(s->e) - 0.5) : 0.0;
+    one_sample(s, iv, j0, 3, &c0, &od0);
+    iv->te = mk(0, 0, 0);
+    iv->od = mk(0, 0, 0);
+    double d0 = 0.0;
+    for (int j = 1; j <= sub; j++) {
+        double d1 = d0 + dd;
+        double jj = im->jitter != 0.0 ? dd * im->jitter * (rnd(s->e) - 0.5) : 0.0;
+        one_sample(s, iv, d1 + jj, 3, &c1, &od1);
+        recursive_sample(s, iv, d0, d1, c0, c1, od0, od1, im->aa_level - 1, im->jitter, aa, &res, &odres);
+        /* attenuation by the sub-intervals before this one, then within it
+         * (exact for a constant emission / extinction ratio) */
+        res = mul(res, expn(scl(iv->od, dd)));
+        double odc[3] = {odres.r * dd, odres.g * dd, odres.b * dd};
+        double *rc[3] = {&res.r, &res.g, &res.b};
+        for (int k = 0; k < 3; k++)
+            if (odc[k] != 0.0) *rc[k] *= (1.0 - exp(-odc[k])) / odc[k];
+        iv->te = add(iv->te, res);
+        iv->od = add(iv->od, odres);
+        c0 = c1;
+        od0 = od1;
+        d0 = d1;
+    }
+    iv->samples = sub;
+}
+
+static int collect_refs(const media_env *e, int which, const media_inside *in, media_ref *refs)
+{
+    int n = 0;
+    if (which == MEDIA_ATMOSPHERE) {
+        for (int i = 0; i < e->sc->natmosphere && n < MAX_REFS; i++) {
+            refs[n].m = e->sc->atmosphere[i];
+            refs[n].obj = NULL;
+            n++;
+        }
+        return n;
+    }
+    for (int k = 0; in && k < in->n; k++) {
+        const scene_object *o = in->obj[k];
+        if (!o->interior) continue;
+        for (int i = 0; i < o->interior->nmedia && n < MAX_REFS; i++) {
+            refs[n].m = o->interior->media[i];
+            refs[n].obj = &o->transform;
+            n++;
+        }
+    }
+    return n;
+}
+
+static int light_acts(const scene_light *l, const scene_object *hit)
+{
+    if (!l->media_interaction) return 0;
+    return scene_light_reaches(l, hit);
+}
+
+rgb media_segment(const media_env *e, int which, const media_inside *in, vec3 org, vec3 dir, double depth, rgb c,
+                  int shadow)
+{
+    media_ref refs[MAX_REFS];
+    int nrefs = collect_refs(e, which, in, refs);
+    if (nrefs == 0 || !(depth > 0.0)) return c;
+    const scene_media *im = refs[0].m;
+    double aa = HUGE_VAL;
+    int use_ext = 0, use_scat = 0, all_constant = shadow;
+    for (int i = 0; i < nrefs; i++) {
+        const scene_media *m = refs[i].m;
+        if (m->intervals > im->intervals) im = m;
+        if (m->aa_threshold < aa) aa = m->aa_threshold;
+        if (!is_zero(m->absorption) || !is_zero(m->scattering)) use_ext = 1;
+        if (!is_zero(m->scattering)) use_scat = 1;
+        /* a density counts as constant when it is a plain colour */
+        for (int k = 0; k < m->ndensity; k++)
+            if (m->density[k]->kind == PIGMENT_PATTERN) all_constant = 0;
+    }
+    if (shadow && !use_ext) return c;
+
+    /* lit intervals */
+    lit_light lights[MAX_LIGHTS];
+    int nl = 0;
+    if (!shadow) {
+        for (int i = 0; i < e->sc->nlights && nl < MAX_LIGHTS; i++) {
+            const scene_light *l = &e->sc->lights[i];
+            if (!light_acts(l, e->hit)) continue;
+            double t1 = 0.0, t2 = 0.0;
+            int ins = 0;
+            if (l->kind == LIGHT_SPOT) {
+                if (spot_interval(org, dir, l, &t1, &t2)) ins = t1 < depth && t2 > MEDIA_SMALL_TOLERANCE;
+            } else if (l->kind == LIGHT_CYLINDER) {
+                if (cylinder_interval(org, dir, l, &t1, &t2)) ins = t1 < depth && t2 > MEDIA_SMALL_TOLERANCE;
+            } else {
+                t1 = 0.0;
+                t2 = depth;
+                ins = 1;
+            }
+            if (!ins) continue;
+            lights[nl].l = l;
+            lights[nl].s0 = fmax(t1, 0.0);
+            lights[nl].s1 = fmin(t2, depth);
+            nl++;
+        }
+    }
+    typedef struct { int lit; double s0, s1; } lit_iv;
+    lit_iv lit[2 * MAX_LIGHTS + 2];
+    int nlit = 0;
+    if (nl > 0) {
+        double s0[MAX_LIGHTS], s1[MAX_LIGHTS];
+        for (int i = 0; i < nl; i++) { s0[i] = lights[i].s0; s1[i] = lights[i].s1; }
+        qsort(s0, (size_t)nl, sizeof s0[0], cmp_double);
+        qsort(s1, (size_t)nl, sizeof s1[0], cmp_double);
+        if (s0[0] > 0.0) lit[nlit++] = (lit_iv){0, 0.0, s0[0]};
+        lit[nlit++] = (lit_iv){1, s0[0], s1[0]};
+        for (int i = 1; i < nl; i++) {
+            if (s0[i] > lit[nlit - 1].s1) {
+                double prev = lit[nlit - 1].s1;
+                lit[nlit++] = (lit_iv){0, prev, s0[i]};
+                lit[nlit++] = (lit_iv){1, s0[i], s1[i]};
+            } else if (s1[i] > lit[nlit - 1].s1) {
+                lit[nlit - 1].s1 = s1[i];
+            }
+        }
+        if (lit[nlit - 1].s1 < depth) {
+            double prev = lit[nlit - 1].s1;
+            lit[nlit++] = (lit_iv){0, prev, depth};
+        }
+    } else {
+        lit[nlit++] = (lit_iv){0, 0.0, depth};
+    }
+
+    /* sampling intervals */
+    interval ivs[MAX_INTERVALS + 2];
+    int niv = 0;
+    int want = im->intervals > nlit ? im->intervals : nlit;
+    if (want > MAX_INTERVALS) want = MAX_INTERVALS;
+    int constant = im->ndensity == 0;
+    memset(ivs, 0, sizeof ivs);
+    if (nlit == 1) {
+        if (!lit[0].lit && constant) {
+            ivs[niv++] = (interval){0, lit[0].s0, lit[0].s1, lit[0].s1 - lit[0].s0, {0, 0, 0}, {0, 0, 0}, 0};
+        } else {
+            double delta = (lit[0].s1 - lit[0].s0) / want;
+            for (int i = 0; i < want; i++)
+                ivs[niv++] = (interval){lit[0].lit, lit[0].s0 + delta * i, lit[0].s0 + delta * (i + 1), delta,
+                                        {0, 0, 0}, {0, 0, 0}, 0};
+        }
+    } else {
+        double sum = 0.0;
+        for (int i = 0; i < nlit; i++) sum += lit[i].lit ? im->ratio : 1.0 - im->ratio;
+        int remaining = want;
+        for (int i = 0; i < nlit; i++) {
+            double w = lit[i].lit ? im->ratio : 1.0 - im->ratio;
+            int n = (int)(w / sum * want) + 1;
+            int r = remaining - nlit + i + 1;
+            if (n > r) n = r;
+            if (n < 1) n = 1;
+            double delta = (lit[i].s1 - lit[i].s0) / n;
+            for (int j = 0; j < n && niv < MAX_INTERVALS; j++)
+                ivs[niv++] = (interval){lit[i].lit, lit[i].s0 + delta * j, lit[i].s0 + delta * (j + 1), delta,
+                                        {0, 0, 0}, {0, 0, 0}, 0};
+            remaining -= n;
+        }
+    }
+    if (niv == 0) return c;
+
+    sampler s;
+    s.e = e;
+    s.refs = refs;
+    s.nrefs = nrefs;
+    s.org = org;
+    s.dir = dir;
+    s.shadow = shadow;
+    s.use_scattering = use_scat;
+    s.lights = lights;
+    s.nlights = nl;
+    s.in = in;
+    s.pc = pattern_ctx_plain(e->sc);
+
+    int nmin = im->min_samples > 0 ? im->min_samples : 1;
+    for (int i = 0; i < niv; i++) {
+        interval *iv = &ivs[i];
+        if (im->method == 3 && !all_constant) {
+            adaptive(&s, iv, im, aa);
+            continue;
+        }
+        for (int j = 0; j < nmin; j++) {
+            rgb col, od;
+            double d;
+            if (im->method == 2) d = (j + 0.5) / nmin + rnd(e) * im->jitter / nmin;
+            else d = rnd(e);
+            one_sample(&s, iv, d, im->method == 2 ? 2 : 1, &col, &od);
+            if (all_constant) break;
+        }
+    }
+
+    rgb od = {0, 0, 0}, te = {0, 0, 0};
+    for (int i = 0; i < niv; i++) {
+        double n = ivs[i].samples > 0 ? 1.0 / ivs[i].samples : 0.0;
+        te = add(te, mul(scl(ivs[i].te, n), expn(od)));
+        od = add(od, scl(ivs[i].od, n));
+    }
+    return add(mul(c, expn(od)), te);
+}
+
+/* ------------------------------------------------------------ shadow rays */
+
+rgb media_shadow_ray(const scene *sc, const accel *a, const media_env *e, const scene_light *l, vec3 p, vec3 dir,
+                     double tmin, double tmax, const media_inside *in0)
+{
+    rgb c = {1, 1, 1};
+    media_inside in = *in0;
+    int atmos = l && l->media_interaction && l->media_attenuation;
+    accel_hit h;
+    double t0 = tmin, prev = 0.0; /* prev: where the current segment starts */
+    for (int k = 0; k < 256 && t0 < tmax; k++) {
+        if (!accel_intersect(a, p, dir, t0, tmax, &h)) break;
+        double next = h.t + fmax(tmin, h.t * 1e-7);
+        if (!(h.flags & OBJ_NO_SHADOW)) {
+            accel_hit hh = h;
+            hh.t = h.t - (t0 > tmin ? t0 - fmax(tmin, t0 * 1e-7) : 0.0);
+            rgb f = tex_shadow_filter(sc, &hh, dir);
+            if (fabs(f.r) < MEDIA_EPSILON && fabs(f.g) < MEDIA_EPSILON && fabs(f.b) < MEDIA_EPSILON) return mk(0, 0, 0);
+            vec3 q = v3_madd(p, dir, prev);
+            double len = h.t - prev;
+            int hollow = media_inside_hollow(&in);
+            /* the containers' media over the segment (a hollow ray) */
+            if (in.n > 0 && hollow && media_inside_has_media(&in)) f = media_segment(e, MEDIA_INTERIOR, &in, q, dir, len, f, 1);
+            c = mul(c, f);
+            /* POV-Ray applies the atmosphere before every surface crossed
+             * (each object has an interior there); fog only while hollow */
+            if (atmos && !is_zero(c)) {
+                if (sc->natmosphere) c = media_segment(e, MEDIA_ATMOSPHERE, &in, q, dir, len, c, 1);
+                if (sc->fogs && hollow) c = mul(c, atmos_fog_attenuation(sc, q, dir, len));
+            }
+            if (fabs(c.r) < MEDIA_EPSILON && fabs(c.g) < MEDIA_EPSILON && fabs(c.b) < MEDIA_EPSILON) return mk(0, 0, 0);
+            media_inside_cross(&in, h.obj);
+            prev = h.t;
+        }
+        t0 = next;
+    }
+    /* the rest of the way to the light: the atmosphere (a hollow ray) */
+    if (atmos && media_inside_hollow(&in) && tmax > prev) {
+        vec3 q = v3_madd(p, dir, prev);
+        if (sc->natmosphere) c = media_segment(e, MEDIA_ATMOSPHERE, &in, q, dir, tmax - prev, c, 1);
+        if (sc->fogs) c = mul(c, atmos_fog_attenuation(sc, q, dir, tmax - prev));
+    }
+    return c;
+}
