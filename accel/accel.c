@@ -1353,6 +1353,23 @@ static void fill_triangle(const accel *a, const accel_leaf *l, unsigned local, d
     hit->ns = ns;
     hit->u = bu;
     hit->v = bv;
+    /* uv: Mesh::UVCoord interpolates the corners' uv_vectors with the
+     * barycentrics (mesh.cpp; <0,0> without uv_vectors); a lone triangle
+     * has ObjectBase::UVCoord's world x, y */
+    hit->uv[0] = hit->p.x;
+    hit->uv[1] = hit->p.y;
+    if (o->kind == SHAPE_MESH) {
+        const scene_mesh *m = o->u.mesh.mesh;
+        hit->uv[0] = hit->uv[1] = 0.0;
+        if (m->uvs && m->tri_uvs && (int)local < m->ntris) {
+            const int *ti = m->tri_uvs[local];
+            double w = 1.0 - bu - bv;
+            if (ti[0] >= 0 && ti[0] < m->nuvs && ti[1] >= 0 && ti[1] < m->nuvs && ti[2] >= 0 && ti[2] < m->nuvs) {
+                hit->uv[0] = w * m->uvs[ti[0]][0] + bu * m->uvs[ti[1]][0] + bv * m->uvs[ti[2]][0];
+                hit->uv[1] = w * m->uvs[ti[0]][1] + bu * m->uvs[ti[1]][1] + bv * m->uvs[ti[2]][1];
+            }
+        }
+    }
     hit->obj = o;
     hit->texture = tex;
     hit->prim = local;
@@ -1408,6 +1425,7 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
         hit->t = h.t;
         hit->p = v3_madd(org, dir, h.t);
         accel_shape_surface(sh, hit->p, h.part, &hit->ng, &hit->u, &hit->v);
+        accel_shape_uv(sh, hit->p, h.part, hit->uv);
         if (h.flip) hit->ng = v3_neg(hit->ng);
         accel_shape_shading(sh, hit->p, hit->ng, &hit->ns);
         hit->obj = l->obj;

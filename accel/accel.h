@@ -23,6 +23,12 @@ typedef struct {
                                      ACCEL_PART_* in accel_shapes.h), else 0 */
     unsigned flags;               /* effective OBJ_* flags: obj->flags plus no_shadow/no_image/
                                      no_reflection/no_radiosity inherited from CSG parents */
+    double uv[2];                 /* POV-Ray 3.7's UV coordinates of the hit (ObjectBase::UVCoord and
+                                     its overrides), what uv_mapping evaluates textures at: sphere,
+                                     box (cube net), torus, lathe, sor, ovus in object space; mesh and
+                                     mesh2 interpolate their uv_vectors (<0,0> without); bicubic_patch
+                                     and parametric (tessellated) their patch/parameter uv; every
+                                     other shape the world hit point's x and y */
 } accel_hit;
 
 typedef struct {

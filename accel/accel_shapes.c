@@ -909,3 +909,78 @@ void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, doub
     *u = su;
     *v = sv;
 }
+
+/* POV-Ray 3.7's angle of (x, z) from +x around y over 2 pi, 0..1, and 0 at
+ * the poles (Sphere::UVCoord, Lathe::UVCoord, Ovus::CalcUV). */
+static double pov_theta(double x, double z)
+{
+    double len = x * x + z * z;
+    if (!(len > 1.0e-10)) return 0.0;
+    len = sqrt(len);
+    double th;
+    if (z == 0.0) th = x > 0.0 ? 0.0 : M_PI;
+    else {
+        th = acos(fmax(-1.0, fmin(1.0, x / len)));
+        if (z < 0.0) th = TWO_PI - th;
+    }
+    return th / TWO_PI;
+}
+
+/* Sphere-like uv of a direction d (Sphere::UVCoord): u = pov_theta, v from
+ * the south pole (0) to the north pole (1). Returns 0 for d = 0 (POV-Ray
+ * then leaves the uv as it was; we give <0, 0>). */
+static int pov_sphere_uv(vec3 d, double uv[2])
+{
+    double len = v3_len(d);
+    if (!(len > 0.0) || !isfinite(len)) return 0;
+    d = v3_scale(d, 1.0 / len);
+    uv[1] = 0.5 + asin(fmax(-1.0, fmin(1.0, d.y))) / M_PI;
+    uv[0] = pov_theta(d.x, d.z);
+    return 1;
+}
+
+void accel_shape_uv(const accel_shape *sh, vec3 p, int part, double uv[2])
+{
+    /* ObjectBase::UVCoord, for every shape without its own: world x and y */
+    uv[0] = p.x;
+    uv[1] = p.y;
+    vec3 po = sh->identity ? p : xform_inv_point(&sh->x, p);
+    switch (sh->kind) {
+    case SHAPE_SPHERE:
+        if (!pov_sphere_uv(v3_sub(po, sh->g.sphere.c), uv)) uv[0] = uv[1] = 0.0;
+        break;
+    case SHAPE_BOX: {
+        /* Box::UVCoord: the cube net of boxes.cpp's comment, faces at
+         * u in quarters and v in thirds, the box normalised to <0,0,0>..<1,1,1> */
+        vec3 ext = v3_sub(sh->g.box.hi, sh->g.box.lo), f = v3_sub(po, sh->g.box.lo);
+        double x = ext.x != 0.0 ? f.x / ext.x : 0.0, y = ext.y != 0.0 ? f.y / ext.y : 0.0,
+               z = ext.z != 0.0 ? f.z / ext.z : 0.0;
+        switch (part) {
+        case ACCEL_PART_BOX_NX: uv[0] = z / 4.0; uv[1] = (1.0 + y) / 3.0; break;
+        case ACCEL_PART_BOX_PX: uv[0] = 0.75 - z / 4.0; uv[1] = (1.0 + y) / 3.0; break;
+        case ACCEL_PART_BOX_NY: uv[0] = 0.25 + x / 4.0; uv[1] = z / 3.0; break;
+        case ACCEL_PART_BOX_PY: uv[0] = 0.25 + x / 4.0; uv[1] = 1.0 - z / 3.0; break;
+        case ACCEL_PART_BOX_NZ: uv[0] = 1.0 - x / 4.0; uv[1] = (1.0 + y) / 3.0; break;
+        default: uv[0] = 0.25 + x / 4.0; uv[1] = (1.0 + y) / 3.0; break;
+        }
+        break;
+    }
+    case SHAPE_TORUS: {
+        /* Torus::CalcUV: u = 1 - (atan2(z, x) + pi) / 2pi, v = (atan2(y, rho - R) + pi) / 2pi */
+        double rho = sqrt(po.x * po.x + po.z * po.z);
+        uv[0] = 1.0 - (atan2(po.z, po.x) + M_PI) / TWO_PI;
+        uv[1] = (atan2(po.y, rho - sh->g.torus.R) + M_PI) / TWO_PI;
+        break;
+    }
+    case SHAPE_OVUS:
+        /* Ovus::CalcUV: a sphere's uv about <0, top radius / 2, 0> */
+        if (!pov_sphere_uv(v3(po.x, po.y - sh->g.ovus.rt / 2.0, po.z), uv)) uv[0] = uv[1] = 0.0;
+        break;
+    case SHAPE_LATHE: case SHAPE_SOR:
+        accel_sweep_uv(sh, po, part, uv);
+        break;
+    default:
+        break;
+    }
+    if (!isfinite(uv[0]) || !isfinite(uv[1])) uv[0] = uv[1] = 0.0;
+}

@@ -92,6 +92,10 @@ int accel_shape_inside(const accel_shape *sh, vec3 p);
  * of smooth triangles, else the geometric one; it may be NULL). */
 void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, double *u, double *v);
 void accel_shape_shading(const accel_shape *sh, vec3 p, vec3 ng, vec3 *ns);
+/* POV-Ray 3.7's UV coordinates at world point p (accel_hit.uv): sphere,
+ * box, torus, ovus, lathe and sor in object space, every other shape the
+ * world x and y (ObjectBase::UVCoord). Always finite. */
+void accel_shape_uv(const accel_shape *sh, vec3 p, int part, double uv[2]);
 
 /* Parametric grid for radiance particles (DESIGN.md) on the issue-4
  * shapes: object-space triangles whose vertices lie on the exact surface,

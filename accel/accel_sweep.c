@@ -1234,6 +1234,27 @@ void accel_sweep_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, doubl
     }
 }
 
+/* POV-Ray 3.7's Lathe::UVCoord and Sor::UVCoord (backend/shape/lathe.cpp,
+ * sor.cpp): u the angle around y from +x over 2 pi; lathe v = (segment +
+ * its curve parameter) / segments (at most 1); sor v = (segment + height
+ * fraction in it) / segments on the curve, r / base radius - 1 on the base
+ * (-1..0) and 2 - r / cap radius on the cap (1..2). */
+void accel_sweep_uv(const accel_shape *sh, vec3 q, int part, double uv[2])
+{
+    const sw_data *w = sh->data;
+    vec3 n;
+    double u = 0.0, v = 0.0;
+    accel_sweep_surface(sh, q, part, &n, &u, &v);
+    if (w && w->type == SW_SOR && (part == 0 || part == 1)) {
+        vec3 l = v3_scale(v3_sub(q, w->c), 1.0 / w->L);
+        double r = sqrt(l.x * l.x + l.z * l.z), r2 = part == 0 ? w->base_r2 : w->cap_r2;
+        double f = r2 > 0.0 ? r / sqrt(r2) : 0.0;
+        v = part == 0 ? f - 1.0 : 2.0 - f;
+    }
+    uv[0] = u;
+    uv[1] = v;
+}
+
 /* ------------------------------------------------------------ polygon triangles */
 
 static int cmp_double(const void *a, const void *b)

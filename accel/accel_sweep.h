@@ -30,6 +30,8 @@ int accel_sweep_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
 int accel_sweep_inside(const accel_shape *sh, vec3 q);
 /* Object-space outward normal (not unit) and surface parameters at q. */
 void accel_sweep_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v);
+/* POV-Ray's UV coordinates (uv_mapping) of a lathe or sor at q. */
+void accel_sweep_uv(const accel_shape *sh, vec3 q, int part, double uv[2]);
 /* GI sampling (lathe, sor, linear-sweep prism, text): the object-space
  * surface area (0 when not supported: conic prisms, polygons), and a point
  * uniform by object-space area with its outward object-space normal and

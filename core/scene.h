@@ -128,6 +128,10 @@ typedef struct scene_texture {
     const scene_normal *normal;
     const scene_pattern *pat;
     const scene_blend_map *map;
+    /* `texture { uv_mapping ... }` (appended, issue 5): the texture is
+     * evaluated at the hit's <u, v, 0> (POV-Ray's UV_MAP_PATTERN), with its
+     * own transforms only */
+    int uv_mapping;
 } scene_texture;
 
 /* ---------------------------------------------------------------- meshes */
@@ -145,6 +149,9 @@ typedef struct scene_mesh {
     const scene_texture **textures;
     int uses;              /* number of objects that reference it */
     src_loc loc;
+    /* uv_vectors (appended, issue 5): uv indices per triangle into `uvs`
+     * (POV-Ray's UV1..UV3), NULL with uvs = NULL: every uv is <0, 0> */
+    int (*tri_uvs)[3];
 } scene_mesh;
 
 /* ---------------------------------------------------------------- objects */
@@ -343,8 +350,8 @@ struct scene_object {
     int light_group;
     int no_global_lights;
     /* uv_mapping (appended, issue 5): textures are evaluated at <u, v, 0>
-     * of the surface (scene_object_uv) and are not moved by the object's
-     * transforms */
+     * of the surface (accel_hit.uv: POV-Ray's UVCoord) and are not moved by
+     * the object's transforms */
     int uv_mapping;
     /* photons { } (appended, issue 6): NULL = none; a block on a CSG is
      * copied by the parser to its members that have none */

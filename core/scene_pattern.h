@@ -150,6 +150,11 @@ typedef struct scene_pattern {
     const struct scene_density *density; /* PAT_DENSITY (NULL: file not read, evaluates to 0) */
     int density_interpolate;       /* 0 none, 1 trilinear, 2 tricubic */
     const struct scene_object *object;   /* PAT_OBJECT: inside 1, outside 0 */
+    /* `pigment/normal { uv_mapping ... }` (appended, issue 5): evaluated at
+     * the hit's <u, v, 0> instead of the point it is given (POV-Ray's
+     * UV_MAP_PATTERN: the transforms of the enclosing texture and object
+     * do not apply, the pattern's own do) */
+    int uv_mapping;
 } scene_pattern;
 
 /* density_file df3 data (POV-Ray's DF3 format: three big-endian 16-bit

@@ -109,6 +109,12 @@ void sdl_transform_texture(scene_texture *t, const xform *x)
     for (; t; t = t->next) t->transform = xform_then(t->transform, *x);
 }
 
+void sdl_transform_texture_outer(scene_texture *t, const xform *x)
+{
+    for (; t; t = t->next)
+        if (!t->uv_mapping && !(t->pat && t->pat->uv_mapping)) t->transform = xform_then(t->transform, *x);
+}
+
 /* ------------------------------------------------------------ pigments */
 
 /* pigment := '{' pigment body '}' (grammar in sdl_pattern.c) */
@@ -399,7 +405,11 @@ static int texture_item(sdl_parser *p, scene_texture *t)
         sdl_attach_normal(p, t);
         return 1;
     }
-    return sdl_accept_kw(p, KW_NO_BUMP_SCALE) || sdl_accept_kw(p, KW_UV_MAPPING);
+    if (sdl_accept_kw(p, KW_UV_MAPPING)) {
+        t->uv_mapping = 1;
+        return 1;
+    }
+    return sdl_accept_kw(p, KW_NO_BUMP_SCALE);
 }
 
 /* texture := '{' texture_body '}' */
@@ -418,6 +428,9 @@ scene_texture *sdl_parse_texture_body(sdl_parser *p)
     src_loc loc = sdl_peek(p)->tk.loc;
     scene_texture *t = NULL;
     int modified = 0;
+    /* texture { uv_mapping ... }: POV-Ray 3.7's UV_MAP_PATTERN around the
+     * texture that follows (parstxtr.cpp), patterned or not */
+    int uv = sdl_accept_kw(p, KW_UV_MAPPING);
     const sdl_tok *pk = sdl_peek(p);
     if (pk->tk.kind == TOK_IDENT && pk->val.kind == VAL_TEXTURE) {
         sdl_tok id = sdl_next(p);
@@ -428,6 +441,7 @@ scene_texture *sdl_parse_texture_body(sdl_parser *p)
     }
     if (!t) return NULL;
     t->loc = loc;
+    if (uv) t->uv_mapping = 1;
     while (sdl_ok(p) && texture_item(p, t)) modified = 1;
     const sdl_tok *rest = sdl_peek(p);
     if (!modified && rest->tk.kind == TOK_KEYWORD &&
@@ -507,8 +521,8 @@ void sdl_parse_material(sdl_parser *p, sdl_material *m)
                 sdl_unexpected(p, &t, "texture, interior or transformation");
                 return;
             }
-            sdl_transform_texture(m->texture, &x);
-            sdl_transform_texture(m->interior_texture, &x);
+            sdl_transform_texture_outer(m->texture, &x);
+            sdl_transform_texture_outer(m->interior_texture, &x);
         }
     }
     sdl_end_block(p);

@@ -76,8 +76,8 @@ static void node_transform(scene_object *o, const xform *x)
 {
     o->transform = xform_then(o->transform, *x);
     if (!o->uv_mapping) { /* uv-mapped textures stay on the surface (POV-Ray's UV_FLAG) */
-        sdl_transform_texture(own_texture(o->texture), x);
-        sdl_transform_texture(own_texture(o->interior_texture), x);
+        sdl_transform_texture_outer(own_texture(o->texture), x);
+        sdl_transform_texture_outer(own_texture(o->interior_texture), x);
     }
     if (is_csg(o))
         for (int i = 0; i < o->u.csg.nkids; i++) node_transform(o->u.csg.kids[i], x);
@@ -266,7 +266,6 @@ static int flag_mod(sdl_parser *p, scene_object *o, sdl_kw k, src_loc loc)
         /* POV-Ray 3.7: "uv_mapping must be specified before texture" */
         if (o->texture) sdl_error(p, loc, PT_ERR_SYNTAX, "uv_mapping must be specified before texture");
         set_uv_mapping(o);
-        if (o->kind != SHAPE_SPHERE && !is_csg(o)) sdl_warn_once(p, loc, "uv_mapping is supported on spheres only; this shape's texture is evaluated in 3D");
         return 1;
     case KW_CUTAWAY_TEXTURES: return 1;
     default: return 0;
@@ -539,7 +538,11 @@ typedef struct {
     int (*tri)[3];
     int (*trin)[3];
     int *trit;
+    int (*triuv)[3]; /* uv indices per triangle (default: the vertex indices) */
     int nt, capt;
+    int zero_uv;     /* mesh: index of a <0,0> uv for triangles without uv_vectors, -1 none yet */
+    int uv_indices;  /* mesh2: uv_indices given */
+    int any_uv;      /* mesh: some triangle has uv_vectors */
     const scene_texture **tex;
     int ntex, captex;
     int any_normals, any_tex;
@@ -586,6 +589,7 @@ static void mesh_build_free(mesh_build *b)
     free(b->tri);
     free(b->trin);
     free(b->trit);
+    free(b->triuv);
     free(b->tex);
 }
 
@@ -617,7 +621,7 @@ static int reserve_tri(mesh_build *b)
 {
     if (b->nt < b->capt) return 1;
     int nc = b->capt ? b->capt * 2 : 64;
-    size_t more = (sizeof *b->tri + sizeof *b->trin + sizeof *b->trit) * (size_t)(nc - b->capt);
+    size_t more = (sizeof *b->tri + sizeof *b->trin + sizeof *b->trit + sizeof *b->triuv) * (size_t)(nc - b->capt);
     if (nc > (1 << 28)) {
         sdl_error(b->p, b->p->last_loc, PT_ERR_LIMIT, "mesh has more than %d triangles", 1 << 28);
         return 0;
@@ -629,7 +633,9 @@ static int reserve_tri(mesh_build *b)
     if (trin) b->trin = trin;
     int *trit = trin ? realloc(b->trit, sizeof *trit * (size_t)nc) : NULL;
     if (trit) b->trit = trit;
-    if (!trit) return 0;
+    int (*triuv)[3] = trit ? realloc(b->triuv, sizeof *triuv * (size_t)nc) : NULL;
+    if (triuv) b->triuv = triuv;
+    if (!triuv) return 0;
     b->capt = nc;
     b->bytes += more;
     b->p->build_bytes += more;
@@ -644,6 +650,7 @@ static int add_tri(sdl_parser *p, mesh_build *b, const int v[3], const int n[3],
     }
     memcpy(b->tri[b->nt], v, sizeof b->tri[0]);
     memcpy(b->trin[b->nt], n, sizeof b->trin[0]);
+    memcpy(b->triuv[b->nt], v, sizeof b->triuv[0]);
     b->trit[b->nt] = tex;
     b->nt++;
     return 1;
@@ -663,12 +670,17 @@ static void mesh_triangle(sdl_parser *p, mesh_build *b, int smooth)
             n[i] = sdl_vector(p);
         }
     }
+    /* uv_vectors: the corners' uv (POV-Ray's Parse_Three_UVCoords; <0,0>
+     * for all three without them) */
+    double uv[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+    int has_uv = 0;
     if (sdl_accept_kw(p, KW_UV_VECTORS)) {
-        double uv[2];
         for (int i = 0; i < 3; i++) {
             if (i) sdl_accept(p, TOK_COMMA);
-            sdl_vector_n(p, uv, 2);
+            sdl_vector_n(p, uv[i], 2);
         }
+        has_uv = 1;
+        b->any_uv = 1;
     }
     int tex = -1;
     if (sdl_accept_kw(p, KW_TEXTURE)) {
@@ -684,7 +696,19 @@ static void mesh_triangle(sdl_parser *p, mesh_build *b, int smooth)
     if (!smooth) n[0] = n[1] = n[2] = v3_cross(v3_sub(v[2], v[0]), v3_sub(v[1], v[0]));
     for (int i = 0; i < 3; i++) ni[i] = add_vec(p, b, &b->n, &b->nn, &b->capn, n[i]);
     if (smooth) b->any_normals = 1;
-    if (sdl_ok(p)) add_tri(p, b, vi, ni, tex);
+    int ui[3];
+    for (int i = 0; i < 3; i++) {
+        if (!has_uv && b->zero_uv >= 0) {
+            ui[i] = b->zero_uv;
+            continue;
+        }
+        if (!mesh_grow(b, (void **)&b->uv, &b->capuv, b->nuv + 1, sizeof *b->uv)) return;
+        b->uv[b->nuv][0] = (float)uv[i][0];
+        b->uv[b->nuv][1] = (float)uv[i][1];
+        ui[i] = b->nuv++;
+        if (!has_uv) b->zero_uv = ui[i];
+    }
+    if (sdl_ok(p) && add_tri(p, b, vi, ni, tex)) memcpy(b->triuv[b->nt - 1], ui, sizeof ui);
 }
 
 static scene_mesh *finish_mesh(sdl_parser *p, mesh_build *b, src_loc loc)
@@ -707,6 +731,7 @@ static scene_mesh *finish_mesh(sdl_parser *p, mesh_build *b, src_loc loc)
     if (b->nuv) {
         m->nuvs = b->nuv;
         m->uvs = arena_memdup(p->s->mem, b->uv, sizeof *b->uv * (size_t)b->nuv);
+        m->tri_uvs = arena_memdup(p->s->mem, b->triuv, sizeof *b->triuv * (size_t)(b->nt ? b->nt : 1));
     }
     if (b->any_tex && b->ntex) {
         m->ntextures = b->ntex;
@@ -729,6 +754,7 @@ static void mesh_body(sdl_parser *p, sdl_obj *so, src_loc loc)
     mesh_build b;
     memset(&b, 0, sizeof b);
     b.p = p;
+    b.zero_uv = -1;
     for (;;) {
         if (!sdl_ok(p)) break;
         if (sdl_accept_kw(p, KW_TRIANGLE)) mesh_triangle(p, &b, 0);
@@ -737,6 +763,7 @@ static void mesh_body(sdl_parser *p, sdl_obj *so, src_loc loc)
         else break;
     }
     if (sdl_ok(p) && b.nt == 0) sdl_error(p, loc, PT_ERR_SYNTAX, "mesh has no triangles");
+    if (!b.any_uv) b.nuv = 0; /* every uv <0,0>: keep none */
     if (sdl_ok(p)) so->obj->u.mesh.mesh = finish_mesh(p, &b, loc);
     mesh_build_free(&b);
 }
@@ -865,13 +892,19 @@ static void index_list(sdl_parser *p, mesh_build *b, int normals)
         if (normals && got < b->nt) {
             for (int i = 0; i < 3; i++) check_index(p, v[i], b->nn, "normal", at);
             memcpy(b->trin[got], v, sizeof v);
+        } else if (!normals && got < b->nt) {
+            for (int i = 0; i < 3; i++) check_index(p, v[i], b->nuv, "uv", at);
+            memcpy(b->triuv[got], v, sizeof v);
         }
         got++;
     }
     sdl_end_block(p);
     if (sdl_ok(p) && got != count) sdl_error(p, loc, PT_ERR_SYNTAX, "%s: %d entries declared but %d given", name, count, got);
     if (sdl_ok(p) && normals && got != b->nt) sdl_error(p, loc, PT_ERR_SYNTAX, "normal_indices must have one entry per face (%d)", b->nt);
+    /* POV-Ray 3.7 (parse.cpp, Parse_Mesh2): "Number of uv indices must equal number of faces." */
+    if (sdl_ok(p) && !normals && got != b->nt) sdl_error(p, loc, PT_ERR_SYNTAX, "uv_indices must have one entry per face (%d)", b->nt);
     if (normals) b->any_normals = 2;
+    else b->uv_indices = 1;
 }
 
 /* mesh2 := '{' vertex_vectors [normal_vectors] [uv_vectors] [texture_list]
@@ -898,6 +931,17 @@ static void mesh2_body(sdl_parser *p, sdl_obj *so, src_loc loc)
         if (b.nn != b.nv) sdl_error(p, loc, PT_ERR_SYNTAX, "mesh2 normal_vectors need normal_indices unless there is one per vertex");
         b.any_normals = 1;
     }
+    /* without uv_indices (POV-Ray 3.7's Parse_Mesh2): uvs are indexed like
+     * the vertices when there is one per vertex, a single uv serves every
+     * corner, otherwise it is an error */
+    if (sdl_ok(p) && b.nuv > 0 && !b.uv_indices) {
+        if (b.nuv == 1) {
+            for (int i = 0; i < b.nt; i++) b.triuv[i][0] = b.triuv[i][1] = b.triuv[i][2] = 0;
+        } else if (b.nuv != b.nv) {
+            sdl_error(p, loc, PT_ERR_SYNTAX, "mesh2 uv_vectors need uv_indices unless there is one per vertex");
+        }
+    }
+    if (sdl_ok(p) && b.uv_indices && b.nuv == 0) sdl_error(p, loc, PT_ERR_SYNTAX, "mesh2 uv_indices without uv_vectors");
     if (sdl_ok(p)) so->obj->u.mesh.mesh = finish_mesh(p, &b, loc);
     mesh_build_free(&b);
 }

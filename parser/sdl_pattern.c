@@ -38,6 +38,7 @@ typedef struct {
     scene_pigment *pg;
     scene_normal *nm;
     scene_texture *tx;
+    int uv;                         /* uv_mapping given: the pattern gets uv_mapping */
 } target;
 
 static double sngl(double v) { return (double)(float)v; }
@@ -769,7 +770,10 @@ static int pattern_type(sdl_parser *p, target *tg)
     sdl_tok t = sdl_next(p);
     sdl_kw k = t.tk.kw;
     if (k == KW_UV_MAPPING) {
-        sdl_warn_once(p, t.tk.loc, "uv_mapping is not supported; the pattern is evaluated in 3D");
+        /* POV-Ray 3.7 (parstxtr.cpp): UV_MAP_PATTERN holding the item that
+         * follows; here the pattern that follows is marked instead */
+        tg->uv = 1;
+        if (tg->pat) tg->pat->uv_mapping = 1;
         pk = sdl_peek(p);
         if (pk->tk.kind != TOK_KEYWORD || !sdl_pattern_is_type(pk->tk.kw) || pk->tk.kw == KW_UV_MAPPING) return 1;
         t = sdl_next(p);
@@ -779,6 +783,7 @@ static int pattern_type(sdl_parser *p, target *tg)
     else tg->pat = new_pattern(p, tg->pat);
     scene_pattern *pt = tg->pat;
     if (!pt) return 1;
+    if (tg->uv) pt->uv_mapping = 1;
     pattern_kind old = pt->kind;
     const char *name = kw_name(k);
     switch (k) {
@@ -1231,6 +1236,7 @@ static colour5 first_colour(const scene_blend_map *m, colour5 fallback)
 
 void sdl_pattern_pigment_body(sdl_parser *p, scene_pigment *pg)
 {
+    int uv = sdl_accept_kw(p, KW_UV_MAPPING);
     const sdl_tok *t = sdl_peek(p);
     /* a declared density (sdl_media.c) starts a density body as a pigment does */
     if (t->tk.kind == TOK_IDENT && t->val.ptr &&
@@ -1246,6 +1252,8 @@ void sdl_pattern_pigment_body(sdl_parser *p, scene_pigment *pg)
     tg.pat = pg->pat ? new_pattern(p, pg->pat) : NULL;
     tg.map = &pg->map;
     tg.outer = &pg->transform;
+    tg.uv = uv;
+    if (uv && tg.pat) tg.pat->uv_mapping = 1;
     if (sdl_starts_colour(t) || sdl_is(t, TOK_LT)) {
         pg->colour = sdl_colour(p, 1);
         pg->kind = PIGMENT_SOLID;
@@ -1298,6 +1306,7 @@ scene_normal *sdl_pattern_normal_body(sdl_parser *p, const scene_normal *base)
     if (!nm) return NULL;
     if (base) *nm = *base;
     else sdl_pattern_default_normal(nm);
+    int uv = sdl_accept_kw(p, KW_UV_MAPPING);
     const sdl_tok *t = sdl_peek(p);
     if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_NORMAL) {
         sdl_tok id = sdl_next(p);
@@ -1310,6 +1319,8 @@ scene_normal *sdl_pattern_normal_body(sdl_parser *p, const scene_normal *base)
     tg.pat = nm->pat ? new_pattern(p, nm->pat) : NULL;
     tg.map = &nm->map;
     tg.outer = &nm->transform;
+    tg.uv = uv;
+    if (uv && tg.pat) tg.pat->uv_mapping = 1;
     if (pattern_type(p, &tg)) {
         /* POV-Ray: [','] [amount] after the pattern type */
         sdl_accept(p, TOK_COMMA);

@@ -492,7 +492,7 @@ static void component_mods(sdl_parser *p, scene_blob_component *c)
         xform x;
         if (sdl_transform_item(p, &x)) {
             c->transform = xform_then(c->transform, x);
-            if (tex) sdl_transform_texture(tex, &x);
+            if (tex) sdl_transform_texture_outer(tex, &x);
             continue;
         }
         if (sdl_accept_kw(p, KW_TEXTURE)) {
@@ -938,6 +938,9 @@ static void bicubic_args(sdl_parser *p, sdl_obj *so, src_loc loc)
 {
     scene_object *o = so->obj;
     int us = 3, vs = 3;
+    /* uv_vectors: the patch corners' uv (POV-Ray 3.7's default ST: <0,0>,
+     * <1,0>, <1,1>, <0,1>, bezier.cpp) */
+    double st[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
     while (sdl_ok(p)) {
         if (sdl_accept_kw(p, KW_TYPE)) sdl_float(p);
         else if (sdl_accept_kw(p, KW_FLATNESS)) sdl_float(p);
@@ -945,10 +948,9 @@ static void bicubic_args(sdl_parser *p, sdl_obj *so, src_loc loc)
         else if (sdl_accept_kw(p, KW_V_STEPS)) vs = sdl_to_int(sdl_float(p));
         else if (sdl_accept_kw(p, KW_ACCURACY)) sdl_float(p);
         else if (sdl_accept_kw(p, KW_UV_VECTORS)) {
-            double uv[2];
             for (int i = 0; i < 4; i++) {
                 if (i) sdl_accept(p, TOK_COMMA);
-                sdl_vector_n(p, uv, 2);
+                sdl_vector_n(p, st[i], 2);
             }
         } else break;
     }
@@ -977,7 +979,9 @@ static void bicubic_args(sdl_parser *p, sdl_obj *so, src_loc loc)
     m->verts = alloc_n(p, (size_t)nvert, sizeof *m->verts);
     m->normals = alloc_n(p, (size_t)nvert, sizeof *m->normals);
     m->tris = alloc_n(p, (size_t)m->ntris, sizeof *m->tris);
-    if (!m->verts || !m->normals || !m->tris) return;
+    m->nuvs = nvert;
+    m->uvs = alloc_n(p, (size_t)nvert, sizeof *m->uvs);
+    if (!m->verts || !m->normals || !m->tris || !m->uvs) return;
     for (int a = 0; a <= nv; a++) {
         double bv[4], dbv[4];
         bernstein((double)a / nv, bv, dbv);
@@ -1007,8 +1011,17 @@ static void bicubic_args(sdl_parser *p, sdl_obj *so, src_loc loc)
             m->normals[k][0] = (float)un.x;
             m->normals[k][1] = (float)un.y;
             m->normals[k][2] = (float)un.z;
+            /* BicubicPatch::Compute_Texture_UV of the patch point (s, t) =
+             * (parameter along the second control-point index, along the
+             * first): bilinear in the four ST corners */
+            double ps = (double)b / nu, pt2 = (double)a / nv;
+            double u1[2] = {st[0][0] + ps * (st[1][0] - st[0][0]), st[0][1] + ps * (st[1][1] - st[0][1])};
+            double u2[2] = {st[3][0] + ps * (st[2][0] - st[3][0]), st[3][1] + ps * (st[2][1] - st[3][1])};
+            m->uvs[k][0] = (float)(u1[0] + pt2 * (u2[0] - u1[0]));
+            m->uvs[k][1] = (float)(u1[1] + pt2 * (u2[1] - u1[1]));
         }
     }
+    m->tri_uvs = m->tris; /* uvs indexed like the vertices */
     int t = 0;
     for (int a = 0; a < nv; a++)
         for (int b = 0; b < nu; b++) {
@@ -1185,7 +1198,10 @@ static void parametric_args(sdl_parser *p, sdl_obj *so, src_loc loc)
     m->verts = alloc_n(p, (size_t)m->nverts, sizeof *m->verts);
     m->normals = alloc_n(p, (size_t)m->nverts, sizeof *m->normals);
     m->tris = alloc_n(p, (size_t)m->ntris, sizeof *m->tris);
-    if (!m->verts || !m->normals || !m->tris) return;
+    m->nuvs = m->nverts;
+    m->uvs = alloc_n(p, (size_t)m->nverts, sizeof *m->uvs);
+    if (!m->verts || !m->normals || !m->tris || !m->uvs) return;
+    m->tri_uvs = m->tris; /* Parametric::UVCoord: the (u, v) parameters of the hit, per vertex here */
     double du = (b[0] - a[0]) / N, dv = (b[1] - a[1]) / N, h = 1e-4;
     for (int j = 0; j <= N; j++)
         for (int i = 0; i <= N; i++) {
@@ -1204,6 +1220,8 @@ static void parametric_args(sdl_parser *p, sdl_obj *so, src_loc loc)
             m->normals[k][0] = (float)nn.x;
             m->normals[k][1] = (float)nn.y;
             m->normals[k][2] = (float)nn.z;
+            m->uvs[k][0] = (float)u;
+            m->uvs[k][1] = (float)v;
         }
     int t = 0;
     for (int j = 0; j < N; j++)

@@ -233,6 +233,12 @@ static vec3 perturb(const scene_normal *nm, vec3 n, vec3 p, const xform *xf, con
 {
     const scene_pattern *pat = nm->pat;
     if (!pat || pat->kind == PAT_PLAIN) return n;
+    /* normal { uv_mapping ... }: at the hit's <u, v, 0> (POV-Ray's
+     * UV_MAP_PATTERN in normal.cpp), without the texture's transforms */
+    if (pat->uv_mapping && c && c->has_uv) {
+        p = v3(c->uv[0], c->uv[1], 0.0);
+        xf = NULL;
+    }
     const xform *outer = xform_is_identity(&nm->transform) ? NULL : &nm->transform;
     int ds = nm->no_bump_scale;
     vec3 q = outer ? xform_inv_point(outer, p) : p;

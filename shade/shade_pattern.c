@@ -974,6 +974,9 @@ int pigment_eval(const scene_pigment *pg, vec3 p, const pattern_ctx *c, colour5 
         return 1;
     }
     const scene_pattern *pat = pg->pat;
+    /* pigment { uv_mapping ... }: POV-Ray's UV_MAP_PATTERN evaluates the
+     * pigment at the hit's <u, v, 0> (pigment.cpp), its own transforms only */
+    if (pat->uv_mapping && c && c->has_uv) p = v3(c->uv[0], c->uv[1], 0.0);
     vec3 q = xform_is_identity(&pg->transform) ? p : xform_inv_point(&pg->transform, p);
     vec3 tp = pattern_warp(pat, q);
     if (pat->kind == PAT_IMAGE && !pg->map) return pattern_image_colour(&pat->image, tp, out);

@@ -17,6 +17,11 @@ typedef struct {
     vec3 dir;             /* ray direction (aoi) */
     int has_hit;          /* normal/dir are meaningful */
     int nwaves;           /* global_settings number_of_waves (default 10) */
+    /* The hit's POV-Ray UV coordinates (accel_hit.uv) for patterns,
+     * pigments, normals and textures with uv_mapping; has_uv 0 away from
+     * a surface (they then use the point they are given). */
+    int has_uv;
+    double uv[2];
 } pattern_ctx;
 
 /* A context for evaluating patterns away from a surface. */

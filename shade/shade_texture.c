@@ -25,8 +25,10 @@
  *    mirrored ray goes below the raw surface), weighted by its
  *    reflectivity, raised to reflection_exponent.
  *
- * Not modelled here: photons, media, subsurface, uv_mapping except on spheres,
- * material_map, dispersion (ior used as is). */
+ * uv_mapping (object, texture, pigment and normal level) evaluates at the
+ * hit's POV-Ray UV coordinates (accel_hit.uv).
+ *
+ * Not modelled here: photons, media, subsurface, dispersion (ior used as is). */
 #include "shade_texture.h"
 #include <math.h>
 #include <string.h>
@@ -73,45 +75,30 @@ static double scene_version(const scene *sc)
     return sc->version_major + sc->version_minor / 10.0;
 }
 
-/* POV-Ray 3.7's Sphere::UVCoord: u the angle around y from +x (0..1), v
- * from the south pole (0) to the north pole (1), in the sphere's own
- * space. Returns 0 for shapes without uv coordinates here. */
-static int object_uv(const scene_object *o, vec3 p, double *u, double *v)
-{
-    if (o->kind != SHAPE_SPHERE) return 0;
-    vec3 q = v3_sub(xform_inv_point(&o->transform, p), o->u.sphere.centre);
-    double len = v3_len(q);
-    if (len == 0.0) {
-        *u = *v = 0.0;
-        return 1;
-    }
-    q = v3_scale(q, 1.0 / len);
-    *v = 0.5 + asin(fmax(-1.0, fmin(1.0, q.y))) / M_PI;
-    double l2 = q.x * q.x + q.z * q.z, theta = 0.0;
-    if (l2 > 1.0e-10) {
-        l2 = sqrt(l2);
-        if (q.z == 0.0) theta = q.x > 0 ? 0.0 : M_PI;
-        else {
-            theta = acos(fmax(-1.0, fmin(1.0, q.x / l2)));
-            if (q.z < 0.0) theta = 2.0 * M_PI - theta;
-        }
-        theta /= 2.0 * M_PI;
-    }
-    *u = theta;
-    return 1;
-}
-
-/* Where a hit's textures are evaluated: the world point, or <u, v, 0> for
- * an object with uv_mapping (on shapes with uv coordinates). */
+/* Where a hit's textures are evaluated: the world point, or <u, v, 0> (the
+ * hit's POV-Ray UV coordinates, accel_hit.uv) for an object with
+ * uv_mapping (POV-Ray's UV_FLAG, trace.cpp). */
 static vec3 texture_point(const accel_hit *h)
 {
-    double u, v;
-    if (h->obj && h->obj->uv_mapping && object_uv(h->obj, h->p, &u, &v)) return v3(u, v, 0.0);
+    if (h->obj && h->obj->uv_mapping) return v3(h->uv[0], h->uv[1], 0.0);
     return h->p;
 }
 
-static vec3 to_texture_space(const scene_texture *t, vec3 p)
+static void ctx_from_hit(pattern_ctx *pc, const accel_hit *h)
 {
+    pc->ipoint = h->p;
+    pc->has_hit = 1;
+    pc->has_uv = 1;
+    pc->uv[0] = h->uv[0];
+    pc->uv[1] = h->uv[1];
+}
+
+/* A texture's point in its own space; `texture { uv_mapping .. }` (or a
+ * patterned texture whose pattern has uv_mapping) starts from the hit's
+ * <u, v, 0> instead (POV-Ray's UV_MAP_PATTERN in trace.cpp). */
+static vec3 to_texture_space_at(const scene_texture *t, vec3 p, const pattern_ctx *pc)
+{
+    if ((t->uv_mapping || (t->pat && t->pat->uv_mapping)) && pc && pc->has_uv) p = v3(pc->uv[0], pc->uv[1], 0.0);
     return xform_is_identity(&t->transform) ? p : xform_inv_point(&t->transform, p);
 }
 
@@ -122,7 +109,7 @@ static vec3 layer_normal(const hit_info *hi, const scene_texture *layer, vec3 po
     vec3 n = hi->raw;
     if (!layer->normal || !layer->normal->pat || layer->normal->pat->kind == PAT_PLAIN) return n;
     for (int i = 0; i < npf; i++) n = normal_warp(n, pf[i].xf, NULL, pf[i].pat, 0);
-    vec3 tp = to_texture_space(layer, point);
+    vec3 tp = to_texture_space_at(layer, point, &hi->pc);
     n = normal_perturb(layer->normal, n, tp, xform_is_identity(&layer->transform) ? NULL : &layer->transform, &hi->pc);
     if (layer->normal->no_bump_scale) n = v3_norm(n);
     for (int i = npf - 1; i >= 0; i--) n = normal_unwarp(n, pf[i].xf, NULL, pf[i].pat, 0);
@@ -133,7 +120,7 @@ static int layer_pigment(const hit_info *hi, const scene_texture *layer, vec3 po
 {
     pattern_ctx pc = hi->pc;
     pc.normal = n;
-    return pigment_eval(&layer->pigment, to_texture_space(layer, point), &pc, out);
+    return pigment_eval(&layer->pigment, to_texture_space_at(layer, point, &hi->pc), &pc, out);
 }
 
 /* POV-Ray's ComputeReflection direction: mirror about n, fixed with the raw
@@ -352,7 +339,7 @@ static rgb one_texture(const hit_info *hi, const scene_texture *tex, vec3 point,
     if (!tex->pat || !tex->map || tex->map->n == 0 || npf >= MAX_PARENTS) return lighted(hi, tex, point, pf, npf, weight);
     const scene_pattern *pat = tex->pat;
     const scene_blend_map *m = tex->map;
-    vec3 tp = pattern_warp(pat, to_texture_space(tex, point));
+    vec3 tp = pattern_warp(pat, to_texture_space_at(tex, point, &hi->pc));
     pf[npf].xf = xform_is_identity(&tex->transform) ? NULL : &tex->transform;
     pf[npf].pat = pat;
     if (pat->kind == PAT_AVERAGE) {
@@ -408,10 +395,9 @@ rgb tex_shade(const tex_env *e, const accel_hit *h, vec3 dir, int level, double 
     hi.p_in = v3_madd(h->p, ng, -e->eps);
     hi.interior = h->obj ? h->obj->interior : NULL;
     hi.pc = pattern_ctx_plain(e->sc);
-    hi.pc.ipoint = h->p;
+    ctx_from_hit(&hi.pc, h);
     hi.pc.normal = n;
     hi.pc.dir = dir;
-    hi.pc.has_hit = 1;
     parent_frame pf[MAX_PARENTS];
     return one_texture(&hi, hit_texture(e->sc, h, hi.entering), texture_point(h), pf, 0, weight);
 }
@@ -423,7 +409,7 @@ static int texture_colour(const scene_texture *tex, vec3 point, const pattern_ct
 {
     if (tex->pat && tex->map && tex->map->n > 0 && depth < MAX_PARENTS) {
         const scene_blend_map *m = tex->map;
-        vec3 tp = pattern_warp(tex->pat, to_texture_space(tex, point));
+        vec3 tp = pattern_warp(tex->pat, to_texture_space_at(tex, point, pc));
         if (tex->pat->kind == PAT_IMAGE && tex->pat->image.material) {
             const scene_texture *st = m->e[material_index(&tex->pat->image, tp, m->n)].texture;
             return st ? texture_colour(st, tp, pc, out, depth + 1) : 0;
@@ -445,16 +431,15 @@ static int texture_colour(const scene_texture *tex, vec3 point, const pattern_ct
         *out = a;
         return found;
     }
-    return pigment_eval(&tex->pigment, to_texture_space(tex, point), pc, out);
+    return pigment_eval(&tex->pigment, to_texture_space_at(tex, point, pc), pc, out);
 }
 
 int tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_hit *h, colour5 *out)
 {
     if (!tex) tex = h->texture ? h->texture : &sc->default_texture;
     pattern_ctx pc = pattern_ctx_plain(sc);
-    pc.ipoint = h->p;
+    ctx_from_hit(&pc, h);
     pc.normal = h->ns;
-    pc.has_hit = 1;
     return texture_colour(tex, texture_point(h), &pc, out, 0);
 }
 
@@ -463,7 +448,7 @@ static rgb shadow_layers(const scene_texture *tex, vec3 point, const pattern_ctx
 {
     if (tex->pat && tex->map && tex->map->n > 0 && depth < MAX_PARENTS) {
         const scene_blend_map *m = tex->map;
-        vec3 tp = pattern_warp(tex->pat, to_texture_space(tex, point));
+        vec3 tp = pattern_warp(tex->pat, to_texture_space_at(tex, point, pc));
         if (tex->pat->kind == PAT_IMAGE && tex->pat->image.material) {
             const scene_texture *st = m->e[material_index(&tex->pat->image, tp, m->n)].texture;
             return st ? shadow_layers(st, tp, pc, depth + 1, caustics, raw, dir) : trgb(0, 0, 0);
@@ -482,13 +467,13 @@ static rgb shadow_layers(const scene_texture *tex, vec3 point, const pattern_ctx
     rgb c = {1, 1, 1};
     for (const scene_texture *l = tex; l; l = l->next) {
         colour5 lc;
-        if (pigment_eval(&l->pigment, to_texture_space(l, point), pc, &lc))
+        if (pigment_eval(&l->pigment, to_texture_space_at(l, point, pc), pc, &lc))
             c = tmul(c, trgb(lc.r * lc.f + lc.t, lc.g * lc.f + lc.t, lc.b * lc.f + lc.t));
         if (caustics != 0.0) {
             /* POV-Ray's faked caustics: 1 + |n.d|^caustics per layer (layer normal) */
             vec3 n = raw;
             if (l->normal && l->normal->pat && l->normal->pat->kind != PAT_PLAIN) {
-                n = normal_perturb(l->normal, n, to_texture_space(l, point),
+                n = normal_perturb(l->normal, n, to_texture_space_at(l, point, pc),
                                    xform_is_identity(&l->transform) ? NULL : &l->transform, pc);
                 n = v3_norm(n);
             }
@@ -503,14 +488,13 @@ rgb tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir)
     int entering = v3_dot(dir, h->ng) < 0.0;
     const scene_texture *tex = hit_texture(sc, h, entering);
     pattern_ctx pc = pattern_ctx_plain(sc);
-    pc.ipoint = h->p;
+    ctx_from_hit(&pc, h);
     pc.normal = h->ns;
     pc.dir = dir;
-    pc.has_hit = 1;
     const scene_interior *in = h->obj ? h->obj->interior : NULL;
     vec3 raw = h->ns;
     if (v3_dot(raw, dir) > 0.0) raw = v3_neg(raw);
-    rgb c = shadow_layers(tex, h->p, &pc, 0, in ? in->caustics : 0.0, raw, dir);
+    rgb c = shadow_layers(tex, texture_point(h), &pc, 0, in ? in->caustics : 0.0, raw, dir);
     if (!entering) c = tmul(c, fade(in, h->t, 1));
     return c;
 }

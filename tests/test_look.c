@@ -59,6 +59,19 @@ static void test_irid(void **st) { (void)st; check("xl_irid", NULL, "irid", 0.00
 static void test_light_group(void **st) { (void)st; check("xl_lightgroup", NULL, "light_group", 0.002); }
 /* uv_mapping on spheres: measured 0.0006 when added */
 static void test_uv_mapping(void **st) { (void)st; check("xl_uv", NULL, "uv_mapping", 0.003); }
+/* uv_mapping on every shape POV-Ray 3.7 gives UV coordinates (issue 5):
+ * measured when added: shapes 0.0011, meshes/lathe/sor/bicubic 0.0014,
+ * pigment/normal/texture-level and image_map 0.0010 (before, with the
+ * patterns evaluated in 3D: 0.034, 0.0073 and no image at all). */
+static void test_uv_shapes(void **st) { (void)st; check("xl_uv_shapes", NULL, "uv_shapes", 0.003); }
+static void test_uv_mesh(void **st) { (void)st; check("xl_uv_mesh", NULL, "uv_mesh", 0.003); }
+static void write_image(void);
+static void test_uv_levels(void **st)
+{
+    (void)st;
+    write_image();
+    check("xl_uv_levels", NULL, "uv_levels", 0.003);
+}
 /* object pattern: measured 0.0003 when added */
 static void test_object_pattern(void **st) { (void)st; check("xl_objpattern", NULL, "object_pattern", 0.002); }
 static void test_cameras(void **st)
@@ -111,6 +124,9 @@ int main(void)
         cmocka_unit_test(test_irid),
         cmocka_unit_test(test_light_group),
         cmocka_unit_test(test_uv_mapping),
+        cmocka_unit_test(test_uv_shapes),
+        cmocka_unit_test(test_uv_mesh),
+        cmocka_unit_test(test_uv_levels),
         cmocka_unit_test(test_object_pattern),
         cmocka_unit_test(test_cameras),
         cmocka_unit_test(test_gamma_image),
