@@ -403,6 +403,98 @@ static void test_mesh_textures_normals(void **st)
     scene_free(s);
 }
 
+/* accel_hit.uv against POV-Ray 3.7's UVCoord formulas worked out by hand
+ * (spheres.cpp, boxes.cpp's cube net, torus.cpp, mesh.cpp; every other
+ * shape the world x, y); tolerance 1e-9 (analytic) / 1e-6 (triangles). */
+static void test_uv(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    scene_object *sp = sphere(s, v3(0, 0, 0), 1);
+    sp->transform = xform_then(xform_rotate(v3(0, 90, 0)), xform_translate(v3(0, 0, 5)));
+    box(s, v3(9, -2, -3), v3(11, 2, 3));
+    scene_object *to = add_obj(s, SHAPE_TORUS);
+    to->u.torus.major = 2;
+    to->u.torus.minor = 0.5;
+    to->transform = xform_translate(v3(0, 0, 20));
+    scene_object *di = add_obj(s, SHAPE_DISC);
+    di->u.disc.centre = v3(30, 0, 0);
+    di->u.disc.normal = v3(0, 0, -1);
+    di->u.disc.radius = 1;
+    scene_mesh *m = quad_mesh(s, NULL, NULL);
+    m->nuvs = 4;
+    m->uvs = arena_alloc(s->mem, sizeof(float[2]) * 4);
+    float uv[4][2] = {{0, 0}, {2, 0}, {2, 2}, {0, 2}};
+    memcpy(m->uvs, uv, sizeof uv);
+    m->tri_uvs = m->tris;
+    mesh_obj(s, m, xform_translate(v3(0, 0, 40)));
+    mesh_obj(s, m, xform_then(xform_rotate(v3(0, 0, 90)), xform_translate(v3(5, 0, 40))));
+    mesh_obj(s, quad_mesh(s, NULL, NULL), xform_translate(v3(10, 0, 40)));
+    triangle(s, v3(20, 0, 40), v3(21, 0, 40), v3(20, 1, 40));
+    accel *a = build(s, d);
+    accel_hit h;
+    /* sphere turned 90 about y (POV-Ray's left-handed rotate: object <x,y,z>
+     * goes to <z, y, -x>): world <1,0,5> is object <0,0,1>: u = acos(0)/2pi */
+    expect_hit(a, v3(5, 0, 5), v3(-1, 0, 0), 4.0, v3(1, 0, 0), 1e-12, 1e-12, &h);
+    assert_near(h.uv[0], 0.25, 1e-9);
+    assert_near(h.uv[1], 0.5, 1e-9);
+    /* world <-1,0,5> is object <0,0,-1>: u = (2pi - pi/2) / 2pi = 0.75 */
+    expect_hit(a, v3(-5, 0, 5), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12, &h);
+    assert_near(h.uv[0], 0.75, 1e-9);
+    assert_near(h.uv[1], 0.5, 1e-9);
+    /* north pole: v 1, u 0 */
+    expect_hit(a, v3(0, 5, 5), v3(0, -1, 0), 4.0, v3(0, 1, 0), 1e-12, 1e-12, &h);
+    assert_near(h.uv[0], 0.0, 1e-9);
+    assert_near(h.uv[1], 1.0, 1e-9);
+    /* box, normalised point <0, .75, .75> on min x: u = z/4, v = (1 + y)/3 */
+    expect_hit(a, v3(0, 1, 1.5), v3(1, 0, 0), 9.0, v3(-1, 0, 0), 1e-12, 0, &h);
+    assert_near(h.uv[0], 0.1875, 1e-9);
+    assert_near(h.uv[1], 1.75 / 3.0, 1e-9);
+    /* <.75, .5, 1> on max z: u = 1/4 + x/4, v = (1 + y)/3 */
+    expect_hit(a, v3(10.5, 0, 10), v3(0, 0, -1), 7.0, v3(0, 0, 1), 1e-12, 0, &h);
+    assert_near(h.uv[0], 0.4375, 1e-9);
+    assert_near(h.uv[1], 0.5, 1e-9);
+    /* <.75, 0, .75> on min y: u = 1/4 + x/4, v = z/3 */
+    expect_hit(a, v3(10.5, -10, 1.5), v3(0, 1, 0), 8.0, v3(0, -1, 0), 1e-12, 0, &h);
+    assert_near(h.uv[0], 0.4375, 1e-9);
+    assert_near(h.uv[1], 0.25, 1e-9);
+    /* <.25, .25, 0> on min z: u = 1 - x/4 */
+    expect_hit(a, v3(9.5, -1, -10), v3(0, 0, 1), 7.0, v3(0, 0, -1), 1e-12, 0, &h);
+    assert_near(h.uv[0], 0.9375, 1e-9);
+    assert_near(h.uv[1], 1.25 / 3.0, 1e-9);
+    /* torus top at object <2, .5, 0>: u = 1 - (atan2(0, 2) + pi)/2pi = .5,
+     * v = (atan2(.5, 0) + pi)/2pi = .75 */
+    expect_hit(a, v3(2, 5, 20), v3(0, -1, 0), 4.5, v3(0, 1, 0), 1e-10, 1e-10, &h);
+    assert_near(h.uv[0], 0.5, 1e-9);
+    assert_near(h.uv[1], 0.75, 1e-9);
+    /* disc: no UVCoord of its own, the world x and y */
+    expect_hit(a, v3(30.25, 0.5, -5), v3(0, 0, 1), 5.0, v3(0, 0, -1), 1e-12, 1e-12, &h);
+    assert_near(h.uv[0], 30.25, 1e-9);
+    assert_near(h.uv[1], 0.5, 1e-9);
+    /* mesh with uv_vectors: barycentric interpolation, also on the rotated instance */
+    expect_hit(a, v3(0.75, 0.25, 30), v3(0, 0, 1), 10.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
+    assert_near(h.uv[0], 1.5, 1e-6);
+    assert_near(h.uv[1], 0.5, 1e-6);
+    expect_hit(a, v3(0.25, 0.75, 30), v3(0, 0, 1), 10.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
+    assert_near(h.uv[0], 0.5, 1e-6);
+    assert_near(h.uv[1], 1.5, 1e-6);
+    /* rotated 90 about z: world <5 - .25, .75> is local <.75, .25> */
+    expect_hit(a, v3(4.75, 0.75, 30), v3(0, 0, 1), 10.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
+    assert_near(h.uv[0], 1.5, 1e-6);
+    assert_near(h.uv[1], 0.5, 1e-6);
+    /* mesh without uv_vectors: <0,0>; lone triangle: world x, y */
+    expect_hit(a, v3(10.75, 0.25, 30), v3(0, 0, 1), 10.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
+    assert_near(h.uv[0], 0.0, 0);
+    assert_near(h.uv[1], 0.0, 0);
+    expect_hit(a, v3(20.25, 0.25, 30), v3(0, 0, 1), 10.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
+    assert_near(h.uv[0], 20.25, 1e-6);
+    assert_near(h.uv[1], 0.25, 1e-6);
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
 static scene_object *cone(scene *s, shape_kind k, vec3 b, double rb, vec3 c, double rc)
 {
     scene_object *o = add_obj(s, k);
@@ -1203,6 +1295,7 @@ int main(void)
         cmocka_unit_test(test_triangles),
         cmocka_unit_test(test_mesh_instances),
         cmocka_unit_test(test_mesh_textures_normals),
+        cmocka_unit_test(test_uv),
         cmocka_unit_test(test_cylinder_cone),
         cmocka_unit_test(test_disc),
         cmocka_unit_test(test_torus),
