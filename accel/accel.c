@@ -77,6 +77,8 @@ typedef struct {
     int in_csg;                   /* member of a CSG primitive, built there */
     int group;                    /* shared-mesh group, -1 if none */
     int b0, bn;                   /* bounded_by: a->bshapes[b0 .. b0+bn) (analytic leaves) */
+    int want_uv;                  /* uv_mapping on the object or in its textures: analytic hits
+                                     compute POV-Ray's UV (else hit.uv is the world x, y) */
 } accel_leaf;
 
 /* bounded_by of the objects above a leaf (unions are flattened into their
@@ -210,6 +212,47 @@ static int grow(void **p, size_t *cap, size_t need, size_t elem)
     return 1;
 }
 
+/* Whether a pigment, normal or texture evaluates anything at the hit's UV
+ * (uv_mapping in it or in its maps); deep nesting counts as yes. */
+static int texture_uses_uv(const scene_texture *t, int depth);
+static int pigment_uses_uv(const scene_pigment *pg, int depth);
+
+static int map_uses_uv(const scene_blend_map *m, int depth)
+{
+    if (!m) return 0;
+    for (int i = 0; i < m->n; i++) {
+        const scene_map_entry *e = &m->e[i];
+        if (e->pigment && pigment_uses_uv(e->pigment, depth + 1)) return 1;
+        if (e->normal && e->normal->pat && (e->normal->pat->uv_mapping || map_uses_uv(e->normal->map, depth + 1)))
+            return 1;
+        if (e->texture && texture_uses_uv(e->texture, depth + 1)) return 1;
+    }
+    return 0;
+}
+
+static int pigment_uses_uv(const scene_pigment *pg, int depth)
+{
+    if (depth > 12) return 1;
+    const scene_pattern *pat = pg->pat;
+    if (!pat) return 0;
+    if (pat->uv_mapping) return 1;
+    if (pat->pigment && pigment_uses_uv(pat->pigment, depth + 1)) return 1;
+    return map_uses_uv(pg->map, depth);
+}
+
+static int texture_uses_uv(const scene_texture *t, int depth)
+{
+    if (depth > 12) return 1;
+    for (; t; t = t->next) {
+        if (t->uv_mapping || (t->pat && t->pat->uv_mapping)) return 1;
+        if (pigment_uses_uv(&t->pigment, depth + 1)) return 1;
+        if (t->normal && t->normal->pat && (t->normal->pat->uv_mapping || map_uses_uv(t->normal->map, depth + 1)))
+            return 1;
+        if (map_uses_uv(t->map, depth)) return 1;
+    }
+    return 0;
+}
+
 static int add_leaf(accel *a, const scene_object *o, const scene_texture *tex, unsigned flags)
 {
     if (a->nleaves == a->capleaves) {
@@ -229,6 +272,7 @@ static int add_leaf(accel *a, const scene_object *o, const scene_texture *tex, u
     l->in_csg = 0;
     l->group = -1;
     l->b0 = l->bn = 0;
+    l->want_uv = o->uv_mapping || texture_uses_uv(l->texture, 0) || (o->interior_texture && texture_uses_uv(o->interior_texture, 0));
     return a->nleaves++;
 }
 
@@ -1425,7 +1469,12 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
         hit->t = h.t;
         hit->p = v3_madd(org, dir, h.t);
         accel_shape_surface(sh, hit->p, h.part, &hit->ng, &hit->u, &hit->v);
-        accel_shape_uv(sh, hit->p, h.part, hit->uv);
+        if (l->want_uv) {
+            accel_shape_uv(sh, hit->p, h.part, hit->uv);
+        } else {
+            hit->uv[0] = hit->p.x;
+            hit->uv[1] = hit->p.y;
+        }
         if (h.flip) hit->ng = v3_neg(hit->ng);
         accel_shape_shading(sh, hit->p, hit->ng, &hit->ns);
         hit->obj = l->obj;

@@ -28,7 +28,9 @@ typedef struct {
                                      box (cube net), torus, lathe, sor, ovus in object space; mesh and
                                      mesh2 interpolate their uv_vectors (<0,0> without); bicubic_patch
                                      and parametric (tessellated) their patch/parameter uv; every
-                                     other shape the world hit point's x and y */
+                                     other shape the world hit point's x and y. Analytic shapes
+                                     compute it only when the object or its textures use
+                                     uv_mapping (else the world x and y) */
 } accel_hit;
 
 typedef struct {

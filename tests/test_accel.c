@@ -413,11 +413,13 @@ static void test_uv(void **st)
     diag *d = diag_new();
     scene_object *sp = sphere(s, v3(0, 0, 0), 1);
     sp->transform = xform_then(xform_rotate(v3(0, 90, 0)), xform_translate(v3(0, 0, 5)));
-    box(s, v3(9, -2, -3), v3(11, 2, 3));
+    sp->uv_mapping = 1; /* analytic shapes compute their UV only when asked */
+    box(s, v3(9, -2, -3), v3(11, 2, 3))->uv_mapping = 1;
     scene_object *to = add_obj(s, SHAPE_TORUS);
     to->u.torus.major = 2;
     to->u.torus.minor = 0.5;
     to->transform = xform_translate(v3(0, 0, 20));
+    to->uv_mapping = 1;
     scene_object *di = add_obj(s, SHAPE_DISC);
     di->u.disc.centre = v3(30, 0, 0);
     di->u.disc.normal = v3(0, 0, -1);
@@ -472,6 +474,13 @@ static void test_uv(void **st)
     expect_hit(a, v3(30.25, 0.5, -5), v3(0, 0, 1), 5.0, v3(0, 0, -1), 1e-12, 1e-12, &h);
     assert_near(h.uv[0], 30.25, 1e-9);
     assert_near(h.uv[1], 0.5, 1e-9);
+    /* without uv_mapping the sphere reports the world x, y */
+    sp->uv_mapping = 0;
+    accel *a2 = build(s, d);
+    expect_hit(a2, v3(5, 0.25, 5), v3(-1, 0, 0), 5.0 - sqrt(1.0 - 0.0625), v3(sqrt(1.0 - 0.0625), 0.25, 0), 1e-12, 1e-12, &h);
+    assert_near(h.uv[0], sqrt(1.0 - 0.0625), 1e-9);
+    assert_near(h.uv[1], 0.25, 1e-9);
+    accel_free(a2);
     /* mesh with uv_vectors: barycentric interpolation, also on the rotated instance */
     expect_hit(a, v3(0.75, 0.25, 30), v3(0, 0, 1), 10.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
     assert_near(h.uv[0], 1.5, 1e-6);
