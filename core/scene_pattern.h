@@ -73,7 +73,8 @@ typedef enum {
     PAT_TRIANGULAR, PAT_WAVES, PAT_WOOD, PAT_WRINKLES, PAT_MANDEL, PAT_JULIA,
     PAT_SLOPE, PAT_AOI, PAT_TILING, PAT_DENSITY, PAT_OBJECT,
     PAT_UNSUPPORTED,  /* parsed (name kept), evaluates to 0 */
-    PAT_FUNCTION      /* function { ... } (core/func.h) */
+    PAT_FUNCTION,     /* function { ... } (core/func.h) */
+    PAT_PAVEMENT      /* pavement (shade/shade_pavement.h) */
 } pattern_kind;
 
 typedef enum { WAVE_RAMP, WAVE_SINE, WAVE_TRIANGLE, WAVE_SCALLOP, WAVE_CUBIC, WAVE_POLY } wave_kind;
@@ -155,6 +156,10 @@ typedef struct scene_pattern {
      * UV_MAP_PATTERN: the transforms of the enclosing texture and object
      * do not apply, the pattern's own do) */
     int uv_mapping;
+    /* PAT_PAVEMENT: number_of_sides, number_of_tiles, pattern, exterior,
+     * interior, form (defaults 3, 1, 1, 0, 0, 0; each kept as POV-Ray keeps
+     * it, an unsigned char) */
+    int pave_sides, pave_tiles, pave_number, pave_exterior, pave_interior, pave_form;
 } scene_pattern;
 
 /* density_file df3 data (POV-Ray's DF3 format: three big-endian 16-bit

@@ -42,6 +42,8 @@ typedef struct {
 } target;
 
 static double sngl(double v) { return (double)(float)v; }
+/* a number kept as POV-Ray keeps it in an unsigned char */
+static int uchar_of(double v) { return (int)(unsigned char)sdl_to_int(v); }
 
 /* ------------------------------------------------------------ records */
 
@@ -1021,6 +1023,14 @@ static int pattern_type(sdl_parser *p, target *tg)
         pt->ifactor = pt->efactor = 1.0;
         break;
     }
+    case KW_PAVEMENT:
+        /* POV-Ray 3.7 parstxtr.cpp: triangles, one tile, pattern 1, sharp */
+        set_kind(tg, PAT_PAVEMENT, name);
+        pt->pave_sides = 3;
+        pt->pave_tiles = 1;
+        pt->pave_number = 1;
+        pt->pave_exterior = pt->pave_interior = pt->pave_form = 0;
+        break;
     default: /* julia, mandel, pavement, tiling */
         unsupported_pattern(p, tg, &t);
         skip_args(p);
@@ -1151,6 +1161,7 @@ static int modifier(sdl_parser *p, target *tg)
     case KW_CONTROL1: pt->control1 = sdl_float(p); break;
     case KW_FORM:
         if (pt->kind == PAT_CRACKLE) pt->crackle_form = sdl_vector(p);
+        else if (pt->kind == PAT_PAVEMENT) pt->pave_form = uchar_of(sdl_float(p));
         else sdl_float(p);
         break;
     case KW_METRIC: {
@@ -1164,6 +1175,12 @@ static int modifier(sdl_parser *p, target *tg)
     case KW_COORDS: pt->facets_coords = sdl_float(p); break;
     case KW_SIZE: pt->facets_size = sdl_float(p); break;
     case KW_EXTERIOR: case KW_INTERIOR: {
+        if (pt->kind == PAT_PAVEMENT) { /* one number for pavement */
+            int v = uchar_of(sdl_float(p));
+            if (k == KW_EXTERIOR) pt->pave_exterior = v;
+            else pt->pave_interior = v;
+            break;
+        }
         int type = sdl_to_int(sdl_float(p));
         sdl_accept(p, TOK_COMMA);
         double f = sdl_float(p);
@@ -1196,11 +1213,46 @@ static int modifier(sdl_parser *p, target *tg)
         if (pt->kind != PAT_DENSITY) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "interpolate cannot be used with non-density_file");
         pt->density_interpolate = sdl_to_int(sdl_float(p));
         break;
-    default: /* max_iteration, number_of_sides, number_of_tiles, pattern */
+    case KW_NUMBER_OF_SIDES: case KW_NUMBER_OF_TILES: case KW_PATTERN: {
+        int v = uchar_of(sdl_float(p));
+        if (pt->kind != PAT_PAVEMENT) break;
+        if (k == KW_NUMBER_OF_SIDES) pt->pave_sides = v;
+        else if (k == KW_NUMBER_OF_TILES) pt->pave_tiles = v;
+        else pt->pave_number = v;
+        break;
+    }
+    default: /* max_iteration */
         sdl_float(p);
         break;
     }
     return 1;
+}
+
+/* The pavings POV-Ray 3.7 defines for number_of_sides and number_of_tiles
+ * (its pattern.cpp tables; the documentation's table of pavement
+ * patterns): how many pattern numbers exist, 0 where the number is not
+ * used (one tile; two triangles or squares; counts other than 1-6). */
+static int pavement_patterns(int sides, int tiles)
+{
+    static const int tri[7] = {0, 0, 0, 1, 3, 4, 12};
+    static const int sq[7] = {0, 0, 0, 2, 5, 12, 35};
+    static const int hex[7] = {1, 1, 1, 3, 7, 22, 1};
+    if (sides == 6) return tiles >= 1 && tiles <= 5 ? hex[tiles] : 1; /* others: one hexagon */
+    if (tiles < 1 || tiles > 6) return 0;
+    return sides == 4 ? sq[tiles] : tri[tiles];
+}
+
+/* A pattern number the paving does not have is an error (POV-Ray reads
+ * past its tables there). */
+static void check_pavement(sdl_parser *p, const scene_pattern *pt, src_loc loc)
+{
+    if (!pt || pt->kind != PAT_PAVEMENT) return;
+    int n = pavement_patterns(pt->pave_sides, pt->pave_tiles);
+    if (n > 0 && (pt->pave_number < 1 || pt->pave_number > n)) {
+        int sides = pt->pave_sides == 4 || pt->pave_sides == 6 ? pt->pave_sides : 3;
+        sdl_error(p, loc, PT_ERR_SYNTAX, "pavement with number_of_sides %d and number_of_tiles %d has patterns 1 to %d, not %d",
+                  sides, pt->pave_tiles, n, pt->pave_number);
+    }
 }
 
 /* Modifiers until the block's end; anything else is skipped with a warning. */
@@ -1208,7 +1260,10 @@ static void modifiers(sdl_parser *p, target *tg, const char *what)
 {
     while (sdl_ok(p)) {
         const sdl_tok *t = sdl_peek(p);
-        if (sdl_is(t, TOK_RBRACE) || sdl_is(t, TOK_RBRACKET) || sdl_is(t, TOK_EOF)) return;
+        if (sdl_is(t, TOK_RBRACE) || sdl_is(t, TOK_RBRACKET) || sdl_is(t, TOK_EOF)) {
+            check_pavement(p, tg->pat, t->tk.loc);
+            return;
+        }
         if (modifier(p, tg)) continue;
         sdl_tok bad = sdl_next(p);
         if (bad.tk.kind == TOK_KEYWORD) {

@@ -28,6 +28,7 @@
 #include "shade_funcenv.h"
 #include "shade_noise.h"
 #include "shade_tiling.h"
+#include "shade_pavement.h"
 #include "accel_shapes.h"
 
 #define PAT_EPSILON 1.0e-10
@@ -866,6 +867,11 @@ static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
     case PAT_MANDEL: case PAT_JULIA: return pat->magnet ? magnet(pat, p) : mandel_julia(pat, p);
     case PAT_AOI: return aoi(c);
     case PAT_TILING: return tiling_value(pat->tiling, p);
+    case PAT_PAVEMENT: {
+        pavement_params pv = {pat->pave_sides, pat->pave_tiles, pat->pave_number,
+                              pat->pave_exterior, pat->pave_interior, pat->pave_form};
+        return pavement_value(&pv, p);
+    }
     case PAT_DENSITY: return density(pat, p);
     case PAT_OBJECT: return pat->object && object_inside(pat->object, p, 0) ? 1.0 : 0.0;
     default: return 0.0;

@@ -222,6 +222,39 @@ static void test_patterns(void **st)
     assert_int_equal(run_tiles(cases, NCASES, "patterns"), 0);
 }
 
+/* pavement: every paving POV-Ray 3.7 defines (number_of_sides 3, 4, 6;
+ * number_of_tiles 1-6; each pattern number), the corner treatments
+ * cycling through interior 0-2, exterior 0-2 and form 0-3 from case to
+ * case so each paving is seen with a different combination. */
+static void test_pavement(void **st)
+{
+    (void)st;
+    static const struct { int sides, tiles, count; } pavings[] = {
+        {3, 1, 1}, {3, 2, 1}, {3, 3, 1}, {3, 4, 3}, {3, 5, 4}, {3, 6, 12},
+        {4, 1, 1}, {4, 2, 1}, {4, 3, 2}, {4, 4, 5}, {4, 5, 12}, {4, 6, 35},
+        {6, 1, 1}, {6, 2, 1}, {6, 3, 3}, {6, 4, 7}, {6, 5, 22},
+    };
+    static char names[128][32], pigments[128][192];
+    static pattern_case pc[128];
+    int n = 0;
+    for (size_t k = 0; k < sizeof pavings / sizeof pavings[0]; k++) {
+        for (int num = 1; num <= pavings[k].count; num++, n++) {
+            int s = pavings[k].sides, t = pavings[k].tiles;
+            /* cells about a tenth of the tile's width: a whole period shows */
+            double scale = s == 4 ? 0.3 : 0.35;
+            snprintf(names[n], sizeof names[n], "pave_s%d_t%d_p%d", s, t, num);
+            snprintf(pigments[n], sizeof pigments[n],
+                     "pavement number_of_sides %d number_of_tiles %d pattern %d interior %d exterior %d form %d "
+                     "rotate x*90 rotate z*%d scale %g " GREY,
+                     s, t, num, n % 3, (n / 3) % 3, (n / 9) % 4, (n % 4) * 10, scale);
+            pc[n].name = names[n];
+            pc[n].pigment = pigments[n];
+        }
+    }
+    assert_int_equal(n, 112);
+    assert_int_equal(run_tiles(pc, n, "pavement"), 0);
+}
+
 /* ------------------------------------------------------------ image_map options */
 
 /* A minimal PNG writer (stored deflate blocks) for the test images: 8-bit
@@ -407,6 +440,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_noise_closed_form),
         cmocka_unit_test(test_patterns),
+        cmocka_unit_test(test_pavement),
         cmocka_unit_test(test_image_options),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
