@@ -637,6 +637,9 @@ static double triangle_cell(int how, double x, double z, const pavement_params *
 
 double pavement_value(const pavement_params *pv, vec3 p)
 {
+    /* lattice indices are longs: beyond 1e9 units (and for NaN) they would
+     * overflow; POV-Ray's result is undefined there, this gives 0 */
+    if (!(fabs(p.x) < 1e9 && fabs(p.z) < 1e9)) return 0.0;
     if (pv->sides == 4) {
         double x = p.x, y = p.z;
         long xv = (long)floor(x), zv = (long)floor(y);

@@ -937,6 +937,9 @@ int tiling_supported(int n) { return n >= 1 && n <= 27; }
 
 double tiling_value(int n, vec3 p)
 {
+    /* cell indices are ints: beyond 1e9 units (and for NaN) they would
+     * overflow; POV-Ray's result is undefined there, this gives 0 */
+    if (!(fabs(p.x) < 1e9 && fabs(p.z) < 1e9)) return 0.0;
     switch (n) {
     case 2: return hexagon_tiles(p);
     case 3: return triangle_tiles(p);

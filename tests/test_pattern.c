@@ -26,6 +26,8 @@
 #include "sdl.h"
 #include "shade_noise.h"
 #include "shade_pattern.h"
+#include "shade_pavement.h"
+#include "shade_tiling.h"
 
 #define TILE 24        /* pixels per pattern tile */
 #define COLS 8
@@ -255,6 +257,56 @@ static void test_pavement(void **st)
     assert_int_equal(run_tiles(pc, n, "pavement"), 0);
 }
 
+/* A pattern number the paving lacks is a located error (POV-Ray reads past
+ * its tables); numbers it ignores (one tile, two triangles) are accepted;
+ * points far out or NaN give 0, never NaN. */
+static void test_pavement_errors(void **st)
+{
+    (void)st;
+    static const struct { const char *body; int ok; } cs[] = {
+        {"pavement number_of_sides 4 number_of_tiles 5 pattern 13", 0},
+        {"pavement number_of_sides 4 number_of_tiles 5 pattern 12", 1},
+        {"pavement pattern 4 number_of_tiles 6", 1},
+        {"pavement pattern 13 number_of_tiles 6", 0},
+        {"pavement number_of_sides 6 number_of_tiles 5 pattern 23", 0},
+        {"pavement number_of_sides 6 number_of_tiles 2 pattern 2", 0},
+        {"pavement number_of_tiles 2 pattern 9", 1},
+        {"pavement number_of_sides 4 pattern 0", 1},
+    };
+    for (size_t i = 0; i < sizeof cs / sizeof cs[0]; i++) {
+        char src[256];
+        snprintf(src, sizeof src, "plane { y, 0\n  pigment { %s } }", cs[i].body);
+        sdl_options so;
+        sdl_default_options(&so);
+        scene *sc = NULL;
+        diag *d = diag_new();
+        pt_status stt = sdl_parse_string("pave.pov", src, &so, &sc, d);
+        if (cs[i].ok) {
+            assert_int_equal(stt, PT_OK);
+            scene_free(sc);
+        } else {
+            assert_int_equal(stt, PT_ERR_SYNTAX);
+            char *msg = NULL;
+            for (int k = 0; k < diag_count(d) && !msg; k++)
+                if (diag_get(d, k)->severity == DIAG_ERROR) msg = diag_format(diag_get(d, k));
+            assert_non_null(msg);
+            printf("%s\n", msg);
+            assert_true(strncmp(msg, "pave.pov:2:", 11) == 0);
+            assert_non_null(strstr(msg, "error: pavement with number_of_sides"));
+            free(msg);
+        }
+        diag_free(d);
+    }
+    pavement_params pv = {4, 6, 35, 2, 2, 2};
+    assert_true(pavement_value(&pv, v3(NAN, 0, 1)) == 0.0);
+    assert_true(pavement_value(&pv, v3(1e300, 0, -1e300)) == 0.0);
+    for (int t = 1; t <= 27; t++) {
+        assert_true(tiling_value(t, v3(INFINITY, 0, 1)) == 0.0);
+        double v = tiling_value(t, v3(123456.7, 0, -98765.4));
+        assert_true(v >= 0.0 && v <= 1.0 + 1e-6); /* 8, 9, ...: POV-Ray nudges edges past 1 by 1e-7 */
+    }
+}
+
 /* ------------------------------------------------------------ image_map options */
 
 /* A minimal PNG writer (stored deflate blocks) for the test images: 8-bit
@@ -441,6 +493,7 @@ int main(void)
         cmocka_unit_test(test_noise_closed_form),
         cmocka_unit_test(test_patterns),
         cmocka_unit_test(test_pavement),
+        cmocka_unit_test(test_pavement_errors),
         cmocka_unit_test(test_image_options),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
