@@ -19,6 +19,8 @@ static double srgb_decode(double v) { return v <= 0.04045 ? v / 12.92 : pow((v +
 int sdl_image_load(scene_image *img, arena *mem, double working_gamma, unsigned long long max_pixels, char *why,
                    size_t whycap)
 {
+    int legacy = working_gamma < 0.0; /* pre-3.7 scene with assumed_gamma (sdl_image.h) */
+    if (legacy) working_gamma = -working_gamma;
     sdl_img raw;
     int r = sdl_img_read(img->path, NULL, 0, max_pixels, &raw, why, whycap);
     if (r != SDL_IMG_OK) {
@@ -41,6 +43,7 @@ int sdl_image_load(scene_image *img, arena *mem, double working_gamma, unsigned 
         curve = 1;
         exponent = 1.0 / raw.png_gamma;
     }
+    int stated = img->gamma != 0.0 || raw.png_srgb || raw.png_gamma > 0.0;
     img->has_alpha = raw.has_alpha;
     float *px = arena_alloc(mem, sizeof *px * w * h * 5);
     float *lut = malloc(sizeof *lut * 65536);
@@ -54,7 +57,9 @@ int sdl_image_load(scene_image *img, arena *mem, double working_gamma, unsigned 
     for (int i = 0; i < 65536; i++) {
         double v = i / 65535.0;
         double lin = curve == 0 ? srgb_decode(v) : pow(v, exponent);
-        if (working_gamma == 0.0) {
+        if (legacy && !stated) {
+            lin = v; /* decoded with the working gamma into the working space: the codes */
+        } else if (working_gamma == 0.0) {
             if (img->gamma == 0.0) lin = v; /* gamma handling off: the codes as they are */
         } else if (working_gamma != 1.0) {
             lin = pow(lin, 1.0 / working_gamma);

@@ -12,6 +12,10 @@
  * (1 = linear), or 0 when gamma handling is off (pre-3.7 scene without
  * assumed_gamma, or an image used as data): the file's codes as they are,
  * unless the scene gave the file's gamma (img->gamma), then linear values.
+ * A negative working_gamma (-assumed_gamma) is a pre-3.7 scene that set
+ * assumed_gamma: POV-Ray 3.7 then takes the working gamma as the default
+ * gamma of files, so a file without gamma information keeps its codes
+ * (its "AssumedGamma36" mode); files that state a gamma are decoded.
  * Returns 0 on success, else a reason in `why`. */
 int sdl_image_load(scene_image *img, arena *mem, double working_gamma, unsigned long long max_pixels, char *why,
                    size_t whycap);

@@ -229,6 +229,8 @@ static scene_image *image_spec(sdl_parser *p, int data)
     }
     char why[512];
     double wg = p->s->global.assumed_gamma > 0.0 ? p->s->global.assumed_gamma : (p->version < 3.65 ? 0.0 : 1.0);
+    /* assumed_gamma in a pre-3.7 scene: files default to the working gamma (sdl_image.h) */
+    if (p->s->global.assumed_gamma > 0.0 && p->version < 3.65) wg = -wg;
     if (data) wg = 0.0;
     if (sdl_image_load(img, p->s->mem, wg, (unsigned long long)p->opt.max_image_pixels, why, sizeof why) != 0) {
         sdl_warning(p, loc, "%s; the image is transparent", why);
