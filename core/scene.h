@@ -351,7 +351,9 @@ struct scene_object {
     int no_global_lights;
     /* uv_mapping (appended, issue 5): textures are evaluated at <u, v, 0>
      * of the surface (accel_hit.uv: POV-Ray's UVCoord) and are not moved by
-     * the object's transforms */
+     * the object's transforms (1; 2: inherited by a CSG member, whose own
+     * texture the CSG's transforms still move, as POV-Ray sets the flag only
+     * after parsing) */
     int uv_mapping;
     /* photons { } (appended, issue 6): NULL = none; a block on a CSG is
      * copied by the parser to its members that have none */

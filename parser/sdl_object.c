@@ -65,17 +65,27 @@ static int is_csg(const scene_object *o)
     return o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE;
 }
 
-static void set_uv_mapping(scene_object *o)
+/* POV-Ray 3.7's Post_Process (parse.cpp) gives a CSG member the parent's
+ * UV flag when it copies the parent's texture or its interior_texture, so
+ * every member without an interior_texture of its own gets it, even one
+ * with its own texture (checked against povray: a textured sphere in a
+ * uv-mapped union is uv-mapped). It does so only after parsing, so the
+ * CSG's transforms still move such a member's own texture: members get
+ * uv_mapping 2 (inherited), which node_transform does not count. */
+static void set_uv_mapping(scene_object *o, int value)
 {
-    o->uv_mapping = 1;
+    if (o->uv_mapping != 1) o->uv_mapping = value;
     if (is_csg(o))
-        for (int i = 0; i < o->u.csg.nkids; i++) set_uv_mapping(o->u.csg.kids[i]);
+        for (int i = 0; i < o->u.csg.nkids; i++) {
+            scene_object *k = o->u.csg.kids[i];
+            if (!k->texture || !k->interior_texture) set_uv_mapping(k, 2);
+        }
 }
 
 static void node_transform(scene_object *o, const xform *x)
 {
     o->transform = xform_then(o->transform, *x);
-    if (!o->uv_mapping) { /* uv-mapped textures stay on the surface (POV-Ray's UV_FLAG) */
+    if (o->uv_mapping != 1) { /* uv-mapped textures stay on the surface (POV-Ray's UV_FLAG) */
         sdl_transform_texture_outer(own_texture(o->texture), x);
         sdl_transform_texture_outer(own_texture(o->interior_texture), x);
     }
@@ -265,7 +275,7 @@ static int flag_mod(sdl_parser *p, scene_object *o, sdl_kw k, src_loc loc)
     case KW_UV_MAPPING:
         /* POV-Ray 3.7: "uv_mapping must be specified before texture" */
         if (o->texture) sdl_error(p, loc, PT_ERR_SYNTAX, "uv_mapping must be specified before texture");
-        set_uv_mapping(o);
+        set_uv_mapping(o, 1);
         return 1;
     case KW_CUTAWAY_TEXTURES: return 1;
     default: return 0;
