@@ -31,6 +31,7 @@ void scene_default_interior(scene_interior *i)
     memset(i, 0, sizeof *i);
     i->ior = 1.0;
     i->dispersion = 1.0;
+    i->dispersion_samples = 7;
     i->fade_power = 0.0;
 }
 

@@ -66,6 +66,7 @@ typedef struct {
 typedef struct {
     double ior;           /* default 1 */
     double dispersion;    /* default 1 */
+    int dispersion_samples; /* dispersion elements, default 7 (POV-Ray 3.7's interior.cpp), at least 2 */
     double fade_distance; /* 0 = off */
     double fade_power;
     rgb fade_colour;

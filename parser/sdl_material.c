@@ -324,11 +324,18 @@ static void interior_item(sdl_parser *p, scene_interior *in)
     sdl_kw k = t.tk.kind == TOK_KEYWORD ? t.tk.kw : KW_NONE;
     switch (k) {
     case KW_IOR: in->ior = sdl_float(p); break;
-    case KW_DISPERSION:
-        in->dispersion = sdl_float(p);
-        if (in->dispersion != 1.0) sdl_warn_once(p, t.tk.loc, "interior dispersion is not supported yet and is ignored (ior used for all colours)");
+    case KW_DISPERSION: in->dispersion = sdl_float(p); break;
+    case KW_DISPERSION_SAMPLES: {
+        /* POV-Ray 3.7 (parstxtr.cpp) truncates to int and rejects fewer than
+         * 2; the upper bound here only keeps a typo from running for ever */
+        double v = sdl_float(p);
+        if (!(v >= 2.0 && v <= 1.0e5)) {
+            sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "dispersion_samples must be between 2 and 100000 (got %g)", v);
+            break;
+        }
+        in->dispersion_samples = (int)v;
         break;
-    case KW_DISPERSION_SAMPLES: sdl_float(p); break;
+    }
     case KW_CAUSTICS: in->caustics = sdl_float(p) * 45.0; in->caustics_set = 1; break;
     case KW_FADE_DISTANCE: in->fade_distance = sdl_float(p); break;
     case KW_FADE_POWER: in->fade_power = sdl_float(p); break;

@@ -314,23 +314,24 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
 /* `skip`: objects with any of these flags are invisible to this ray (no_image
  * for camera rays, no_reflection for reflected rays); `in`: the objects the
  * ray starts inside (shade_media.h). */
-static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, rng *r,
-                     const media_inside *in);
+static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, float wavelength,
+                     rng *r, const media_inside *in);
 
 /* The surface model (patterns, layers, normals, reflection, refraction,
  * interior fade) is POV-Ray's ComputeLightedTexture in shade_texture.c; it
  * calls back here for rays, direct light and the GI indirect term. */
-static rgb tex_cb_trace(void *ctx, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, rng *r)
+static rgb tex_cb_trace(void *ctx, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, float wavelength,
+                        rng *r)
 {
     render_ctx *c = ctx;
     c->ts[thread].secondary++;
     const hit_frame *f = c->frame[thread];
-    if (!f) return trace_ray(c, thread, org, dir, level, weight, skip, r, &no_containers);
+    if (!f) return trace_ray(c, thread, org, dir, level, weight, skip, wavelength, r, &no_containers);
     /* a ray going on through the surface (refracted or straight) enters or
      * leaves the object; a reflected one stays where the incoming ray was */
     media_inside in = *f->in;
     if (v3_dot(dir, f->h->ng) * v3_dot(f->dir, f->h->ng) > 0.0) media_inside_cross(&in, f->h->obj);
-    return trace_ray(c, thread, org, dir, level, weight, skip, r, &in);
+    return trace_ray(c, thread, org, dir, level, weight, skip, wavelength, r, &in);
 }
 
 static rgb tex_cb_direct(void *ctx, int thread, const light_surface *s, const accel_hit *h, vec3 p, rng *r)
@@ -344,15 +345,15 @@ static rgb tex_cb_indirect(void *ctx, int thread, const accel_hit *h, vec3 n)
     return c->s->indirect(c->s->indirect_ctx, h, n, thread);
 }
 
-static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip, rng *r,
-                     const media_inside *in)
+static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip,
+                     float wavelength, rng *r, const media_inside *in)
 {
     tex_env e = {c->sc, c->eps, c->s->use_ambient, c->max_level, c, thread, r, tex_cb_trace, tex_cb_direct,
                  c->s->indirect ? tex_cb_indirect : NULL, &c->ts[thread].unsupported};
     hit_frame f = {h, dir, in};
     const hit_frame *outer = c->frame[thread];
     c->frame[thread] = &f;
-    rgb col = tex_shade(&e, h, dir, level, weight, skip);
+    rgb col = tex_shade(&e, h, dir, level, weight, skip, wavelength);
     c->frame[thread] = outer;
     return col;
 }
@@ -376,8 +377,8 @@ static rgb along_ray(render_ctx *c, int thread, vec3 org, vec3 dir, double depth
     return atmos_fog(c->sc, org, dir, depth, col);
 }
 
-static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, rng *r,
-                     const media_inside *in)
+static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, float wavelength,
+                     rng *r, const media_inside *in)
 {
     if (level > c->max_level) return rgb_make(0, 0, 0);
     accel_hit h;
@@ -387,7 +388,7 @@ static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, d
     for (int k = 0; k < 64; k++) {
         if (!accel_intersect(c->a, org, dir, tmin, INFINITY, &h)) break;
         if (!(h.flags & skip))
-            return along_ray(c, thread, org, dir, h.t, shade_hit(c, thread, &h, dir, level, weight, skip, r, in), r, in, h.obj);
+            return along_ray(c, thread, org, dir, h.t, shade_hit(c, thread, &h, dir, level, weight, skip, wavelength, r, in), r, in, h.obj);
         tmin = h.t + fmax(c->eps, h.t * 1e-7);
     }
     return along_ray(c, thread, org, dir, INFINITY, atmos_sky(c->sc, dir), r, in, NULL);
@@ -409,7 +410,7 @@ rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 o
     memset(ts, 0, sizeof ts);
     render_ctx c = {sc, a, s, scene_eps(a), s->max_trace_level > 0 ? s->max_trace_level : sc->global.max_trace_level, ts, NULL, NULL, 0, 0, 1};
     c.media = media_scene_has(sc);
-    return trace_ray(&c, 0, org, v3_norm(dir), 1, 1.0, OBJ_NO_IMAGE, r, &no_containers);
+    return trace_ray(&c, 0, org, v3_norm(dir), 1, 1.0, OBJ_NO_IMAGE, 0.0f, r, &no_containers);
 }
 
 /* --------------------------------------------------------------- the image */
@@ -461,7 +462,7 @@ static rgb primary_ray(render_ctx *c, int thread, double px, double py, vec3 org
         dir = v3_norm(normal_perturb(c->sc->camera.normal, dir, sp, NULL, &pc));
     }
     c->ts[thread].primary++;
-    rgb v = trace_ray(c, thread, org, dir, 1, 1.0, OBJ_NO_IMAGE, r, &c->cam_in);
+    rgb v = trace_ray(c, thread, org, dir, 1, 1.0, OBJ_NO_IMAGE, 0.0f, r, &c->cam_in);
     if (!isfinite(v.r) || !isfinite(v.g) || !isfinite(v.b)) {
         c->ts[thread].discarded++;
         return rgb_make(0, 0, 0);

@@ -21,6 +21,16 @@
  *    is filtered. Interior fade on leaving an object:
  *    fade_colour + (1 - fade_colour) / (1 + (d/fade_distance)^fade_power)
  *    (exp(-(1 - fade_colour) d / fade_distance) for fade_power >= 1000).
+ *  - Dispersion (POV-Ray 3.7's ComputeRefraction): across a surface whose
+ *    dispersion ratio differs from 1, a ray of all colours is split into
+ *    dispersion_samples monochromatic rays, each refracted with its band's
+ *    ior (shade_spectral.c) and weighted with its band's hue; the sum is
+ *    divided by the number of bands. A band's total internal reflection
+ *    adds the reflected ray (traced with the incoming ray's band) times the
+ *    hue, and the split as a whole never counts as total internal
+ *    reflection. A monochromatic ray keeps its band through every later
+ *    reflection and refraction and bends with that band's ior at the next
+ *    dispersive surface instead of splitting again.
  *  - Reflection per layer along the layer's normal (POV-Ray's fix when the
  *    mirrored ray goes below the raw surface), weighted by its
  *    reflectivity, raised to reflection_exponent.
@@ -28,13 +38,14 @@
  * uv_mapping (object, texture, pigment and normal level) evaluates at the
  * hit's POV-Ray UV coordinates (accel_hit.uv).
  *
- * Not modelled here: photons, media, subsurface, dispersion (ior used as is). */
+ * Not modelled here: photons, media, subsurface. */
 #include "shade_texture.h"
 #include <math.h>
 #include <string.h>
 #include "shade_noise.h"
 #include "shade_normal.h"
 #include "shade_pattern.h"
+#include "shade_spectral.h"
 
 #define TEX_EPSILON 1.0e-10
 #define MAX_PARENTS 32
@@ -65,6 +76,7 @@ typedef struct {
     const scene_interior *interior;
     int level;
     unsigned skip;
+    float wavelength; /* the incoming ray's band, 0 = all colours */
     double version;
     pattern_ctx pc;
 } hit_info;
@@ -143,7 +155,7 @@ static rgb trace_reflection(const hit_info *hi, vec3 n, double weight, const sce
     const tex_env *e = hi->e;
     if (weight < e->sc->global.adc_bailout) return trgb(0, 0, 0);
     vec3 rd = reflect_dir(hi->dir, n, hi->raw);
-    rgb c = e->trace(e->ctx, e->thread, hi->p_out, rd, hi->level + 1, weight, OBJ_NO_REFLECTION, e->r);
+    rgb c = e->trace(e->ctx, e->thread, hi->p_out, rd, hi->level + 1, weight, OBJ_NO_REFLECTION, hi->wavelength, e->r);
     if (f && f->irid > 0.0) c = tmul(c, light_irid(f, rd, hi->dir, n, hi->pc.ipoint, &e->sc->global));
     return c;
 }
@@ -179,18 +191,44 @@ static rgb reflectivity(const hit_info *hi, const scene_finish *f, double cos_i,
     return tadd(tscale(rmax, frac), tscale(rmin, 1.0 - frac));
 }
 
-/* Refracted (or straight) ray through the surface; returns 1 on total
- * internal reflection (colour then holds the reflected radiance). */
+/* One refracted ray with the ior ratio eta (POV-Ray's TraceRefractionRay,
+ * Heckbert's method), of band `wavelength`; returns 1 on total internal
+ * reflection, when colour holds the reflected ray's radiance (traced with
+ * the incoming ray's band, as POV-Ray reflects the incoming ray). n is
+ * |cos| of the incidence, local the normal facing the incoming ray. */
+static int refract_one(const hit_info *hi, vec3 top, double eta, double n, vec3 local, double weight, float wavelength,
+                       rgb *colour)
+{
+    const tex_env *e = hi->e;
+    double t = 1.0 + eta * eta * (n * n - 1.0);
+    if (t < 0.0) {
+        *colour = trace_reflection(hi, top, weight, NULL);
+        return 1;
+    }
+    t = eta * n - sqrt(t);
+    vec3 td = v3_norm(v3_add(v3_scale(hi->dir, eta), v3_scale(local, t)));
+    *colour = e->trace(e->ctx, e->thread, hi->p_in, td, hi->level + 1, weight, hi->skip, wavelength, e->r);
+    return 0;
+}
+
+/* Refracted (or straight) ray through the surface, split into bands where
+ * the surface disperses (POV-Ray 3.7's ComputeRefraction); returns 1 on
+ * total internal reflection (colour then holds the reflected radiance). */
 static int refraction(const hit_info *hi, vec3 top, double weight, rgb *colour)
 {
     const tex_env *e = hi->e;
-    double ior = interior_ior(hi->interior);
-    /* POV-Ray's ratio: outside/inside entering, inside/outside leaving. */
+    const scene_interior *in = hi->interior;
+    double ior = interior_ior(in);
+    /* the interior keeps dispersion in single precision as POV-Ray does */
+    double disp = in ? (double)(float)in->dispersion : 1.0;
+    /* POV-Ray's ratios: outside/inside entering, inside/outside leaving
+     * (the atmosphere's ior and dispersion being 1). */
     double eta = hi->entering ? 1.0 / ior : ior;
+    double dr = hi->entering ? 1.0 / disp : disp;
     *colour = trgb(0, 0, 0);
     if (weight < e->sc->global.adc_bailout) return 0;
-    if (fabs(eta - 1.0) < TEX_EPSILON) {
-        *colour = e->trace(e->ctx, e->thread, hi->p_in, hi->dir, hi->level + 1, weight, hi->skip, e->r);
+    if (fabs(eta - 1.0) < TEX_EPSILON && fabs(dr - 1.0) < TEX_EPSILON) {
+        *colour = e->trace(e->ctx, e->thread, hi->p_in, hi->dir, hi->level + 1, weight, hi->skip, hi->wavelength, e->r);
         return 0;
     }
     double n = v3_dot(hi->dir, top);
@@ -201,14 +239,18 @@ static int refraction(const hit_info *hi, vec3 top, double weight, rgb *colour)
     } else {
         local = v3_neg(top);
     }
-    double t = 1.0 + eta * eta * (n * n - 1.0);
-    if (t < 0.0) {
-        *colour = trace_reflection(hi, top, weight, NULL);
-        return 1;
+    if (fabs(dr - 1.0) < TEX_EPSILON) return refract_one(hi, top, eta, n, local, weight, hi->wavelength, colour);
+    if (hi->wavelength > 0.0f)
+        return refract_one(hi, top, spectral_ior(hi->wavelength, eta, dr), n, local, weight, hi->wavelength, colour);
+    unsigned nb = in && in->dispersion_samples >= 2 ? (unsigned)in->dispersion_samples : 7u;
+    rgb sum = {0, 0, 0};
+    for (unsigned i = 0; i < nb; i++) {
+        spectral_band b = spectral_band_of(i, nb);
+        rgb c;
+        refract_one(hi, top, spectral_ior(b.wavelength, eta, dr), n, local, weight, b.wavelength, &c);
+        sum = tadd(sum, tmul(c, spectral_hue(b)));
     }
-    t = eta * n - sqrt(t);
-    vec3 td = v3_norm(v3_add(v3_scale(hi->dir, eta), v3_scale(local, t)));
-    *colour = e->trace(e->ctx, e->thread, hi->p_in, td, hi->level + 1, weight, hi->skip, e->r);
+    *colour = tscale(sum, 1.0 / nb);
     return 0;
 }
 
@@ -375,7 +417,7 @@ static const scene_texture *hit_texture(const scene *sc, const accel_hit *h, int
     return h->texture ? h->texture : &sc->default_texture;
 }
 
-rgb tex_shade(const tex_env *e, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip)
+rgb tex_shade(const tex_env *e, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip, float wavelength)
 {
     hit_info hi;
     memset(&hi, 0, sizeof hi);
@@ -384,6 +426,7 @@ rgb tex_shade(const tex_env *e, const accel_hit *h, vec3 dir, int level, double 
     hi.dir = dir;
     hi.level = level;
     hi.skip = skip;
+    hi.wavelength = wavelength;
     hi.version = scene_version(e->sc);
     vec3 ng = h->ng, n = h->ns;
     hi.entering = v3_dot(dir, ng) < 0.0;

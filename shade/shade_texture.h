@@ -1,8 +1,9 @@
 /* shade_texture.h - POV-Ray 3.7 texture evaluation at a ray hit: patterned
  * textures (texture_map and friends) blended from fully lit sub-textures,
  * layered textures (filter colour through the layers), perturbed normals,
- * per-layer reflection, refraction with total internal reflection, interior
- * fade, all as POV-Ray's ComputeOneTextureColour / ComputeLightedTexture.
+ * per-layer reflection, refraction with total internal reflection and
+ * dispersion, interior fade, all as POV-Ray's ComputeOneTextureColour /
+ * ComputeLightedTexture.
  *
  * The integrator (shade.c) supplies ray tracing, direct light and the GI
  * indirect term through callbacks, so this module owns the surface model
@@ -27,8 +28,11 @@ typedef struct {
     int thread;
     rng *r;
     /* Radiance along a ray (level = the new ray's level; skip = OBJ_* flags
-     * of objects the ray does not see). */
-    rgb (*trace)(void *ctx, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, rng *r);
+     * of objects the ray does not see; wavelength = the ray's spectral band
+     * in nm once a dispersive surface split it, 0 for a ray of all colours:
+     * pass it back to tex_shade for the ray's hits). */
+    rgb (*trace)(void *ctx, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, float wavelength,
+                 rng *r);
     /* Direct light of every light source on the layer surface s at p. */
     rgb (*direct)(void *ctx, int thread, const light_surface *s, const accel_hit *h, vec3 p, rng *r);
     /* GI indirect irradiance-like term at a diffuse layer (NULL = none). */
@@ -37,8 +41,8 @@ typedef struct {
 } tex_env;
 
 /* Colour seen along unit `dir` at hit h (the ray's level and weight as in
- * POV-Ray's TraceRay; skip as for trace). */
-rgb tex_shade(const tex_env *e, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip);
+ * POV-Ray's TraceRay; skip and wavelength as for trace). */
+rgb tex_shade(const tex_env *e, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip, float wavelength);
 
 /* Pigment colour (r g b filter transmit) of the top layer of the texture at
  * a hit: texture transforms applied, texture maps blended. `tex` NULL = the
