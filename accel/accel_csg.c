@@ -145,6 +145,19 @@ int accel_csg_finish(accel_csg *c)
         accel_csg_node *p = &c->nodes[c->nodes[i].parent];
         c->kids[p->first + p->nkids++] = i;
     }
+    /* inverse parity, parents before children (parents have smaller
+     * indices); a subtracted member counts as inverted (POV-Ray's
+     * difference is an intersection with its other members inverted) */
+    for (int i = 0; i < c->nnodes; i++) {
+        accel_csg_node *nd = &c->nodes[i];
+        int odd = nd->inverse;
+        if (nd->parent >= 0) {
+            const accel_csg_node *p = &c->nodes[nd->parent];
+            odd ^= p->inv_odd;
+            if (p->op == CSG_DIFFERENCE && c->kids[p->first] != i) odd ^= 1;
+        }
+        nd->inv_odd = odd;
+    }
     /* normal flips: inverse nodes and subtracted members on the way to the root */
     for (int s = 0; s < c->nshapes; s++) {
         int flip = 0;
@@ -260,7 +273,11 @@ static int kept(const accel_csg *c, int node, vec3 p)
     for (int par = c->nodes[child].parent; par >= 0; child = par, par = c->nodes[par].parent) {
         const accel_csg_node *P = &c->nodes[par];
         const int *k = c->kids + P->first;
-        switch (P->op) {
+        accel_csg_op op = P->op;
+        /* an inverted union is POV-Ray's intersection of inverted members:
+         * its surfaces are a merge's (accel_csg.h) */
+        if (op == CSG_UNION && P->inv_odd) op = CSG_MERGE;
+        switch (op) {
         case CSG_MERGE:
             for (int j = 0; j < P->nkids; j++)
                 if (k[j] != child && accel_csg_inside(c, k[j], p)) return 0;

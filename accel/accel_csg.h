@@ -8,7 +8,12 @@
  * siblings, difference keeps the first member's surface outside all the
  * others and a subtracted member's surface inside the first and outside the
  * rest (its normal flipped), merge keeps it outside all siblings, union
- * always. The result's inside test combines the members' tests the same way
+ * always. POV-Ray inverts a CSG by De Morgan (Invert_CSG_Object: members
+ * inverted, union and merge become an intersection, an intersection a
+ * merge; a difference is an intersection with its subtracted members
+ * inverted), so a union under an odd number of inversions (its own
+ * included) keeps a member's surface only outside all its siblings, as a
+ * merge does; the other operations keep the same surfaces either way. The result's inside test combines the members' tests the same way
  * (inverse negates it). accel.c turns each tree into one user-geometry
  * primitive. */
 #ifndef PT_ACCEL_CSG_H
@@ -26,6 +31,9 @@ typedef struct {
     int flip;         /* CSG_LEAF: normal points into the result's outside when negated */
     int nosurf;       /* CSG_LEAF: takes part in inside tests only (a clipped_by
                          solid); set by the caller after adding the leaf */
+    int inv_odd;      /* an odd number of inversions on the node and its
+                         ancestors, a subtracted member of a difference
+                         counting as one (set by accel_csg_finish) */
 } accel_csg_node;
 
 typedef struct {

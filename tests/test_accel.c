@@ -1041,6 +1041,47 @@ static void test_csg(void **st)
     scene_free(s);
 }
 
+/* An inverse union inside an intersection: POV-Ray inverts a CSG by De
+ * Morgan (the union becomes an intersection of its inverted members), so a
+ * member's surface inside another member is no surface. A box with a
+ * cavity of two overlapping spheres (centres x = -0.5 and 0.5, radius 1):
+ * from the centre along +x the first wall is the right sphere's at x = 1.5
+ * (the left sphere's wall at x = 0.5 lies inside the right one); the same
+ * cavity written as difference{box, union} (POV-Ray: an intersection with
+ * the union inverted) gives the same. The qtvr panorama example (camera
+ * inside such a box) differed by 0.059 from POV-Ray before this. */
+static void test_csg_inverse_union(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    for (int k = 0; k < 2; k++) {
+        double x0 = 10.0 * k;
+        scene_object *i = csg(s, k == 0 ? SHAPE_INTERSECTION : SHAPE_DIFFERENCE, 2, 1);
+        i->u.csg.kids[0] = member(s, SHAPE_BOX);
+        i->u.csg.kids[0]->u.box.c1 = v3(x0 - 3, -3, -3);
+        i->u.csg.kids[0]->u.box.c2 = v3(x0 + 3, 3, 3);
+        scene_object *u = csg(s, SHAPE_UNION, 2, 0);
+        u->u.csg.kids[0] = msphere(s, v3(x0 - 0.5, 0, 0), 1);
+        u->u.csg.kids[1] = msphere(s, v3(x0 + 0.5, 0, 0), 1);
+        if (k == 0) u->flags |= OBJ_INVERSE;
+        i->u.csg.kids[1] = u;
+    }
+    accel *a = build(s, d);
+    assert_int_equal(diag_count(d), 0);
+    for (int k = 0; k < 2; k++) {
+        double x0 = 10.0 * k;
+        /* the wall faces the cavity: normal towards the ray's origin */
+        expect_hit(a, v3(x0, 0, 0), v3(1, 0, 0), 1.5, v3(-1, 0, 0), 1e-12, 1e-12, NULL);
+        expect_hit(a, v3(x0, 0, 0), v3(-1, 0, 0), 1.5, v3(1, 0, 0), 1e-12, 1e-12, NULL);
+        /* from outside the box: its face */
+        expect_hit(a, v3(x0, 0, -10), v3(0, 0, 1), 7.0, v3(0, 0, -1), 1e-12, 1e-12, NULL);
+    }
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
 /* CSG against brute force: a lens (intersection of two spheres) minus a
  * cylinder; the first change of the inside state along the ray (sampled)
  * must agree with the reported hit. */
@@ -1315,6 +1356,7 @@ int main(void)
         cmocka_unit_test(test_no_shadow),
         cmocka_unit_test(test_warnings_csg),
         cmocka_unit_test(test_csg),
+        cmocka_unit_test(test_csg_inverse_union),
         cmocka_unit_test(test_csg_brute),
         cmocka_unit_test(test_empty_and_errors),
         cmocka_unit_test(test_random_rays),
