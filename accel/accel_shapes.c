@@ -363,7 +363,13 @@ static int slabs(vec3 o, vec3 d, vec3 lo, vec3 hi, double *tn, int *fn, double *
         }
         double ta = (l - oi) * inv, tb = (u - oi) * inv;
         int fa = 2 * i, fb = 2 * i + 1;
-        if (ta > tb) {
+        /* a zero-thickness slab (l == u) is entered through the face that
+         * opposes the ray, so that the hit reads as entering: POV-Ray reports
+         * the other face of such a box (Box::Intersect's Side2 at the same
+         * depth, the last pushed and first popped in Find_Intersection) but
+         * refracts by the ray's interior list, which a ray from outside
+         * always enters (textures/finishes/var_reflection.pov) */
+        if (ta > tb || (ta == tb && di < 0.0)) {
             double t = ta; ta = tb; tb = t;
             int f = fa; fa = fb; fb = f;
         }

@@ -186,11 +186,18 @@ static void test_box_faces(void **st)
     expect_miss(a, v3(-10, 5, 0), v3(1, 0, 0));
     /* rotated box: rotate 90 about z maps the x half-size 1 onto y */
     scene *s2 = scene_new();
+    /* a zero-thickness box (z from 0.25 to 0.25, var_reflection.pov's
+     * strips): from either side the face opposing the ray, so the hit
+     * reads as entering as POV-Ray's interior list has it */
+    box(s2, v3(20, -1, 0.25), v3(22, 1, 0.25));
     scene_object *o = box(s2, v3(-1, -2, -3), v3(1, 2, 3));
     o->transform = xform_rotate(v3(0, 0, 90));
     accel *a2 = build(s2, d);
     expect_hit(a2, v3(0, 10, 0), v3(0, -1, 0), 9.0, v3(0, 1, 0), 1e-12, 1e-12, NULL);
     expect_hit(a2, v3(10, 0, 0), v3(-1, 0, 0), 8.0, v3(1, 0, 0), 1e-12, 1e-12, NULL);
+    expect_hit(a2, v3(21, 0, 5.25), v3(0, 0, -1), 5.0, v3(0, 0, 1), 1e-12, 1e-12, NULL);
+    expect_hit(a2, v3(21, 0, -4.75), v3(0, 0, 1), 5.0, v3(0, 0, -1), 1e-12, 1e-12, NULL);
+    expect_hit(a2, v3(21, -5, 5.25), v3(0, 1, -1), 5.0, v3(0, 0, 1), 1e-12, 1e-12, NULL);
     accel_free(a2);
     scene_free(s2);
     accel_free(a);
