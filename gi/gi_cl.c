@@ -46,28 +46,10 @@ extern const int gi_kernel_nfiles;
 #endif
 
 #define GI_CL_LOCAL 64
+/* gi_k_bounce work-items (GI_BOUNCE_CHUNK particles each) per work-group */
+#define GI_BOUNCE_LOCAL 4
 
-/* Scatter slices for a CPU device of `units` cores (gi_k_scatter): one per
- * core, at most GI_SCATTER_MAX_SLICES, and fewer when the slices (24 bytes
- * per particle each) would pass 256 MiB. */
-#define GI_SCATTER_MAX_SLICES 16
-static int scatter_slices(int units, size_t n)
-{
-    int s = units < 1 ? 1 : (units > GI_SCATTER_MAX_SLICES ? GI_SCATTER_MAX_SLICES : units);
-    while (s > 1 && (size_t)s * n * 24 > ((size_t)256 << 20)) s--;
-    return s;
-}
-
-static void sum_tally(const gi_i64 *ts, int ns, int nb, gi_i64 *out)
-{
-    for (int b = 0; b < 3 * nb; b++) {
-        gi_i64 t = 0;
-        for (int w = 0; w < ns; w++) t += ts[(size_t)w * 3 * GI_MAX_BOUNCES + b];
-        out[b] = t;
-    }
-}
-
-enum { KE_EMIT, KE_SCATTER, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_PULL_INIT, KE_PULL, KE_COUNT };
+enum { KE_EMIT, KE_BOUNCE, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_COUNT };
 
 struct gi_dev {
     int is_cl;
@@ -79,13 +61,14 @@ struct gi_dev {
     /* geometry (host pointers, caller-owned) */
     const gi_dev_particle *part;
     int n, ns2, ng, nrp;
-    int slices; /* scatter slices (gi_k_scatter): 0 = atomic adds (GPUs) */
-    int cpu_units; /* OpenCL: compute units of a CPU device, 0 for other devices */
-    float *rho4;   /* n x 4: the particles' reflectances (gi_k_scatter) */
+    float *rho4;   /* n x 4: the particles' reflectances (gi_k_bounce) */
     const int *slink, *glink, *list_off, *list_idx, *rin_off, *rin_src;
+    const int *woff, *wsrc; /* WALK bounce lists (gi_dev_set_walk) */
+    int nwalk;
+    float *tally;  /* nb x 3 floats per gi_k_bounce work-item (read back) */
+    size_t tally_cap;
     /* C build scratch */
     float *edir, *src, *bin, *bout, *total;
-    gi_i64 *acc;
     const float *lout_host;  /* last scatter's output (C build reads it in gather) */
     const float *eind_host;  /* last gather's output (C build reads it in estimate) */
 #ifdef PARTRAY_HAVE_OPENCL
@@ -94,9 +77,9 @@ struct gi_dev {
     cl_program prog;
     cl_kernel k[KE_COUNT];
     cl_mem b_part, b_slink, b_glink, b_off, b_idx, b_rho;
-    cl_mem b_lights, b_vis, b_edir, b_src, b_acc, b_tally, b_srcidx, b_lout, b_phi, b_eind, b_list, b_vout;
-    cl_mem b_rin_off, b_rin_src, b_bin, b_bout, b_total, b_next;
-    size_t sz_lights, sz_vis, sz_srcidx, sz_list, sz_vout;
+    cl_mem b_lights, b_vis, b_edir, b_src, b_tally, b_lout, b_phi, b_eind, b_list, b_vout;
+    cl_mem b_rin_off, b_rin_src, b_bin, b_bout, b_total, b_woff, b_wsrc;
+    size_t sz_lights, sz_vis, sz_tally, sz_list, sz_vout;
     float *tmp;  /* n*4 readback scratch */
 #endif
 };
@@ -291,18 +274,6 @@ static pt_status cl_open(gi_dev *dv, const gi_dev_options *o, diag *d)
     dv->max_alloc = max_alloc > 0 && max_alloc < (cl_ulong)SIZE_MAX ? (size_t)max_alloc : SIZE_MAX;
     dv->max_total = global > 0 && global < (cl_ulong)SIZE_MAX ? (size_t)global : SIZE_MAX;
     if (o && o->max_bytes > 0 && o->max_bytes < dv->max_total) dv->max_total = o->max_bytes;
-    char ext[8192] = "";
-    clGetDeviceInfo(dev, CL_DEVICE_EXTENSIONS, sizeof ext, ext, NULL);
-    cl_device_type type = 0;
-    cl_uint units = 1;
-    clGetDeviceInfo(dev, CL_DEVICE_TYPE, sizeof type, &type, NULL);
-    clGetDeviceInfo(dev, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof units, &units, NULL);
-    dv->cpu_units = (type & CL_DEVICE_TYPE_CPU) ? (int)(units < (cl_uint)dv->threads ? units : (cl_uint)dv->threads) : 0;
-    if (!strstr(ext, "cl_khr_int64_base_atomics")) {
-        err(d, "OpenCL: device %s lacks cl_khr_int64_base_atomics (64-bit atomics for deterministic flux "
-               "accumulation); run the kernels as C with --cl-device c", dname);
-        return PT_ERR_UNSUPPORTED;
-    }
     cl_int e;
     cl_context_properties props[] = {CL_CONTEXT_PLATFORM, (cl_context_properties)plat, 0};
     dv->ctx = clCreateContext(props, 1, &dev, NULL, NULL, &e);
@@ -344,8 +315,8 @@ static pt_status cl_open(gi_dev *dv, const gi_dev_options *o, diag *d)
         free(log);
         return PT_ERR_DEVICE;
     }
-    static const char *const names[KE_COUNT] = {"gi_k_emit",     "gi_k_scatter",   "gi_k_resolve", "gi_k_gather",
-                                                "gi_k_estimate", "gi_k_pull_init", "gi_k_pull"};
+    static const char *const names[KE_COUNT] = {"gi_k_emit", "gi_k_bounce", "gi_k_resolve", "gi_k_gather",
+                                                "gi_k_estimate"};
     for (int k = 0; k < KE_COUNT; k++) {
         dv->k[k] = clCreateKernel(dv->prog, names[k], &e);
         if (!dv->k[k]) return cl_fail(d, names[k], e);
@@ -501,9 +472,9 @@ void gi_dev_free(gi_dev *dv)
 #ifdef PARTRAY_HAVE_OPENCL
     if (dv->is_cl) {
         cl_mem *ms[] = {&dv->b_part, &dv->b_rho, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
-                        &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_acc, &dv->b_tally, &dv->b_srcidx,
-                        &dv->b_lout, &dv->b_phi, &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off,
-                        &dv->b_rin_src, &dv->b_bin, &dv->b_bout, &dv->b_total, &dv->b_next};
+                        &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_tally, &dv->b_lout, &dv->b_phi,
+                        &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off, &dv->b_rin_src, &dv->b_bin,
+                        &dv->b_bout, &dv->b_total, &dv->b_woff, &dv->b_wsrc};
         for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
         for (int k = 0; k < KE_COUNT; k++)
             if (dv->k[k]) clReleaseKernel(dv->k[k]);
@@ -515,11 +486,11 @@ void gi_dev_free(gi_dev *dv)
 #endif
     free(dv->edir);
     free(dv->src);
-    free(dv->acc);
     free(dv->bin);
     free(dv->bout);
     free(dv->total);
     free(dv->rho4);
+    free(dv->tally);
     free(dv);
 }
 
@@ -541,19 +512,16 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     if (!dv->is_cl) {
         free(dv->edir);
         free(dv->src);
-        free(dv->acc);
         free(dv->bin);
         free(dv->bout);
         free(dv->total);
         dv->edir = calloc(nn * 4, sizeof(float));
         dv->src = calloc(nn * 4, sizeof(float));
-        dv->slices = scatter_slices(dv->threads, nn);
-        dv->acc = calloc(nn * 3 * (size_t)dv->slices, sizeof(gi_i64));
         dv->bin = calloc(nn * 4, sizeof(float));
         dv->bout = calloc(nn * 4, sizeof(float));
         dv->total = calloc(nn * 4, sizeof(float));
-        dv->bytes = nn * (6 * 16 + 24 * (size_t)dv->slices);
-        if (!dv->edir || !dv->src || !dv->acc || !dv->bin || !dv->bout || !dv->total) return PT_ERR_NOMEM;
+        dv->bytes = nn * 6 * 16;
+        if (!dv->edir || !dv->src || !dv->bin || !dv->bout || !dv->total) return PT_ERR_NOMEM;
         return PT_OK;
     }
 #ifdef PARTRAY_HAVE_OPENCL
@@ -561,16 +529,15 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     pt_status st;
     /* a new geometry: drop every buffer and start the byte count again */
     cl_mem *ms[] = {&dv->b_part, &dv->b_rho, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
-                    &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_acc, &dv->b_tally, &dv->b_srcidx,
-                    &dv->b_lout, &dv->b_phi, &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off,
-                    &dv->b_rin_src, &dv->b_bin, &dv->b_bout, &dv->b_total, &dv->b_next};
+                    &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_tally, &dv->b_lout, &dv->b_phi,
+                    &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off, &dv->b_rin_src, &dv->b_bin,
+                    &dv->b_bout, &dv->b_total, &dv->b_woff, &dv->b_wsrc};
     for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
-    dv->sz_lights = dv->sz_vis = dv->sz_srcidx = dv->sz_list = dv->sz_vout = 0;
+    dv->sz_lights = dv->sz_vis = dv->sz_tally = dv->sz_list = dv->sz_vout = 0;
     dv->bytes = 0;
     /* the real count: with no particles the arrays may be NULL (buffers get a
      * minimal size, nothing is written) */
     size_t nr = n > 0 ? (size_t)n : 0;
-    dv->slices = dv->cpu_units > 0 ? scatter_slices(dv->cpu_units, nn) : 0;
     if ((st = upload(dv, &dv->b_part, &have, part, nr * sizeof *part, d)) != PT_OK) return st;
     have = 0;
     if ((st = upload(dv, &dv->b_rho, &have, dv->rho4, nr * 4 * sizeof(float), d)) != PT_OK) return st;
@@ -583,10 +550,6 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     if ((st = ensure(dv, &dv->b_edir, &have, f4, d)) != PT_OK) return st;
     have = 0;
     if ((st = ensure(dv, &dv->b_src, &have, f4, d)) != PT_OK) return st;
-    have = 0;
-    if ((st = ensure(dv, &dv->b_acc, &have, nn * 3 * sizeof(gi_i64) * (size_t)(dv->slices > 0 ? dv->slices : 1), d)) !=
-        PT_OK)
-        return st;
     have = 0;
     if ((st = ensure(dv, &dv->b_lout, &have, f4, d)) != PT_OK) return st;
     have = 0;
@@ -647,117 +610,141 @@ pt_status gi_dev_set_reverse(gi_dev *dv, const int *rin_off, const int *rin_src,
 #endif
 }
 
-pt_status gi_dev_emit(gi_dev *dv, const gi_dev_light *lights, int nlights, const float *vis, float *edir, float *src,
-                      diag *d)
+pt_status gi_dev_set_walk(gi_dev *dv, const int *woff, const int *wsrc, int nwalk, diag *d)
 {
-    size_t nn = (size_t)dv->n;
-    if (!dv->is_cl) {
-        gi_c_emit(dv->threads, dv->part, dv->n, lights, nlights, vis, dv->edir, dv->src);
-        memcpy(edir, dv->edir, nn * 4 * sizeof(float));
-        memcpy(src, dv->src, nn * 4 * sizeof(float));
-        return PT_OK;
-    }
+    dv->woff = woff;
+    dv->wsrc = wsrc;
+    dv->nwalk = nwalk;
+    if (!dv->is_cl) return PT_OK;
 #ifdef PARTRAY_HAVE_OPENCL
-    pt_status st;
-    if ((st = upload(dv, &dv->b_lights, &dv->sz_lights, lights, (size_t)nlights * sizeof *lights, d)) != PT_OK)
-        return st;
-    if ((st = upload(dv, &dv->b_vis, &dv->sz_vis, vis, nn * (size_t)nlights * sizeof(float), d)) != PT_OK) return st;
-    int n = dv->n;
-    karg a[] = {KMEM(dv->b_part), KINT(n), KMEM(dv->b_lights), KINT(nlights), KMEM(dv->b_vis), KMEM(dv->b_edir),
-                KMEM(dv->b_src)};
-    if ((st = run_kernel(dv, KE_EMIT, nn, a, 7, d)) != PT_OK) return st;
-    if ((st = download(dv, dv->b_edir, edir, nn * 4 * sizeof(float), d)) != PT_OK) return st;
-    return download(dv, dv->b_src, src, nn * 4 * sizeof(float), d);
+    rel(&dv->b_woff);
+    rel(&dv->b_wsrc);
+    size_t have = 0, nr = (size_t)(dv->n > 0 ? dv->n : 0), k = (size_t)(nwalk > 0 ? nwalk : 0);
+    pt_status st = upload(dv, &dv->b_woff, &have, woff, k * (nr + 1) * sizeof(int), d);
+    if (st != PT_OK) return st;
+    have = 0;
+    return upload(dv, &dv->b_wsrc, &have, wsrc, k * nr * sizeof(int), d);
 #else
+    (void)d;
     return PT_ERR_INTERNAL;
 #endif
 }
 
-pt_status gi_dev_scatter(gi_dev *dv, int mode, int nb, gi_u32 seed, float scale, const int *srcidx, int nsrc,
-                         gi_i64 *tally, float *lout, float *phi, diag *d)
+/* The per-bounce tallies (3 floats per gi_k_bounce work-item) summed in a
+ * fixed order, grey (mean of the colours). */
+static void sum_bounces(const float *tally, size_t items, int nb, double *bounce_flux)
 {
+    for (int b = 0; b < nb; b++) {
+        double t = 0.0;
+        const float *tb = tally + (size_t)b * 3 * items;
+        for (size_t k = 0; k < 3 * items; k++) t += tb[k];
+        if (bounce_flux) bounce_flux[b] = t / 3.0;
+    }
+}
+
+static int cancelled(volatile int *cancel) { return cancel && *cancel; }
+
+pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, const float *vis, int mode, int nb,
+                          volatile int *cancel, float *edir, float *lout, float *phi, double *bounce_flux, int *done,
+                          double times[2], diag *d)
+{
+    double t0 = timer_now(), t1 = t0;
     size_t nn = (size_t)dv->n;
+    int n = dv->n, ns2 = dv->ns2 > 0 ? dv->ns2 : 1;
+    *done = 0;
     if (nb > GI_MAX_BOUNCES) nb = GI_MAX_BOUNCES;
-    gi_i64 tally_local[GI_MAX_BOUNCES * 3];
-    gi_i64 *tl = tally ? tally : tally_local;
-    memset(tl, 0, sizeof(gi_i64) * 3 * (size_t)(nb > 0 ? nb : 1));
-    int ns = dv->slices > 0 ? dv->slices : 1;
-    gi_i64 tally_s[GI_SCATTER_MAX_SLICES * GI_MAX_BOUNCES * 3];
-    memset(tally_s, 0, sizeof tally_s);
-    float inv_scale = 1.0f / scale;
-    int full = mode == GI_SCATTER_FULL && dv->rin_off;
+    if (nb < 0) nb = 0;
+    if (!dv->rin_off) nb = 0;
+    int walk = mode == GI_SCATTER_WALK;
+    if (walk && nb > dv->nwalk + 1) {
+        err(d, "particle GI: %s", "the walk lists are shorter than the bounce count (gi_dev_set_walk)");
+        return PT_ERR_INTERNAL;
+    }
+    float w_fan = 1.0f / (float)ns2;
+    size_t items = (nn + GI_BOUNCE_CHUNK - 1) / GI_BOUNCE_CHUNK;
+    size_t tcount = (size_t)(nb > 0 ? nb : 1) * 3 * (items > 0 ? items : 1);
+    if (tcount > dv->tally_cap) {
+        free(dv->tally);
+        dv->tally = malloc(tcount * sizeof(float));
+        dv->tally_cap = dv->tally ? tcount : 0;
+        if (!dv->tally) return PT_ERR_NOMEM;
+    }
     if (!dv->is_cl) {
-        memset(dv->acc, 0, nn * 3 * (size_t)ns * sizeof(gi_i64));
-        memset(dv->total, 0, nn * 4 * sizeof(float));
-        if (full && nb > 0) {
-            gi_c_pull_init(dv->threads, dv->n, dv->ns2, dv->src, dv->bin, dv->total);
-            for (int b = 0; b < nb; b++) {
-                gi_c_pull(dv->threads, dv->part, dv->n, dv->ns2, dv->rin_off, dv->rin_src, dv->bin, dv->bout,
-                          dv->total);
-                float *t = dv->bin;
-                dv->bin = dv->bout;
-                dv->bout = t;
-            }
-        } else if (nb > 0) {
-            gi_c_scatter(dv->threads, dv->rho4, dv->n, dv->slink, dv->ns2, nb, seed, scale, srcidx, nsrc, dv->src,
-                         dv->slices, dv->acc, tally_s);
-            sum_tally(tally_s, ns, nb, tl);
+        if (cancelled(cancel)) return PT_OK;
+        gi_c_emit(dv->threads, dv->part, n, lights, nlights, vis, dv->edir, dv->src);
+        t1 = timer_now();
+        const float *bin = dv->src;
+        for (int b = 0; b < nb; b++) {
+            if (cancelled(cancel)) return PT_OK;
+            int wb = walk && b > 0;
+            gi_c_bounce(dv->threads, n, wb ? dv->woff : dv->rin_off, wb ? (b - 1) * (n + 1) : 0,
+                        wb ? dv->wsrc : dv->rin_src, wb ? (b - 1) * n : 0, wb ? 1.0f : w_fan, bin, dv->rho4, b == 0,
+                        dv->bout, dv->total, dv->tally, b * 3 * (int)items);
+            float *t = dv->bin;
+            dv->bin = dv->bout;
+            dv->bout = t;
+            bin = dv->bin;
         }
-        gi_c_resolve(dv->threads, dv->part, dv->n, dv->edir, dv->acc, dv->slices, inv_scale, dv->total, lout, phi);
+        if (cancelled(cancel)) return PT_OK;
+        /* from here on the results are written: not cancelled any more */
+        gi_c_resolve(dv->threads, dv->part, n, dv->edir, nb > 0, dv->total, lout, phi);
+        memcpy(edir, dv->edir, nn * 4 * sizeof(float));
+        sum_bounces(dv->tally, items, nb, bounce_flux);
         dv->lout_host = lout;
+        *done = 1;
+        if (times) {
+            times[0] = t1 - t0;
+            times[1] = timer_now() - t1;
+        }
         return PT_OK;
     }
 #ifdef PARTRAY_HAVE_OPENCL
     pt_status st;
     size_t f4 = nn * 4 * sizeof(float);
-    size_t tbytes = (size_t)ns * GI_MAX_BOUNCES * 3 * sizeof(gi_i64);
-    size_t have_t = dv->b_tally ? tbytes : 0;
-    if ((st = ensure(dv, &dv->b_tally, &have_t, tbytes, d)) != PT_OK) return st;
-    if ((st = zero(dv, dv->b_tally, tbytes, d)) != PT_OK) return st;
-    if ((st = zero(dv, dv->b_acc, nn * 3 * (size_t)ns * sizeof(gi_i64), d)) != PT_OK) return st;
-    if ((st = zero(dv, dv->b_total, f4, d)) != PT_OK) return st;
-    int n = dv->n, ns2 = dv->ns2;
-    if (full && nb > 0) {
-        karg a0[] = {KINT(n), KINT(ns2), KMEM(dv->b_src), KMEM(dv->b_bin), KMEM(dv->b_total)};
-        if ((st = run_kernel(dv, KE_PULL_INIT, nn, a0, 5, d)) != PT_OK) return st;
-        for (int b = 0; b < nb; b++) {
-            karg a1[] = {KMEM(dv->b_part), KINT(n), KINT(ns2), KMEM(dv->b_rin_off), KMEM(dv->b_rin_src),
-                         KMEM(dv->b_bin), KMEM(dv->b_bout), KMEM(dv->b_total)};
-            if ((st = run_kernel(dv, KE_PULL, nn, a1, 8, d)) != PT_OK) return st;
-            cl_mem t = dv->b_bin;
-            dv->b_bin = dv->b_bout;
-            dv->b_bout = t;
-        }
-    } else if (nb > 0 && nsrc > 0) {
-        if ((st = upload(dv, &dv->b_srcidx, &dv->sz_srcidx, srcidx, (size_t)nsrc * sizeof(int), d)) != PT_OK)
-            return st;
-        cl_uint sd = seed;
-        int slices = dv->slices;
-        size_t have_n = dv->b_next ? 16 : 0;
-        if ((st = ensure(dv, &dv->b_next, &have_n, 16, d)) != PT_OK) return st;
-        if ((st = zero(dv, dv->b_next, 16, d)) != PT_OK) return st;
-        karg a[] = {KMEM(dv->b_rho), KMEM(dv->b_slink), KINT(ns2), KINT(nb),  {sizeof(cl_uint), &sd},
-                    KF(scale),        KMEM(dv->b_srcidx), KINT(nsrc), KMEM(dv->b_src), KMEM(dv->b_acc),
-                    KMEM(dv->b_tally), KINT(n),          KINT(slices),   KMEM(dv->b_next)};
-        /* slices: one work-item each, in work-groups of one (PoCL spreads
-         * work-groups over its threads) */
-        if ((st = run_kernel_local(dv, KE_SCATTER, slices > 0 ? (size_t)slices : (size_t)nsrc,
-                                   slices > 0 ? 1 : GI_CL_LOCAL, a, 14, d)) != PT_OK)
-            return st;
-        if ((st = download(dv, dv->b_tally, tally_s, tbytes, d)) != PT_OK) return st;
-        if (slices > 0) sum_tally(tally_s, ns, nb, tl);
-        else memcpy(tl, tally_s, (size_t)nb * 3 * sizeof(gi_i64));
+    if (cancelled(cancel)) return PT_OK;
+    if ((st = upload(dv, &dv->b_lights, &dv->sz_lights, lights, (size_t)nlights * sizeof *lights, d)) != PT_OK)
+        return st;
+    if ((st = upload(dv, &dv->b_vis, &dv->sz_vis, vis, nn * (size_t)nlights * sizeof(float), d)) != PT_OK) return st;
+    if ((st = ensure(dv, &dv->b_tally, &dv->sz_tally, tcount * sizeof(float), d)) != PT_OK) return st;
+    karg a[] = {KMEM(dv->b_part), KINT(n), KMEM(dv->b_lights), KINT(nlights), KMEM(dv->b_vis), KMEM(dv->b_edir),
+                KMEM(dv->b_src)};
+    if ((st = run_kernel(dv, KE_EMIT, nn, a, 7, d)) != PT_OK) return st;
+    t1 = timer_now();
+    cl_mem bin = dv->b_src;
+    for (int b = 0; b < nb; b++) {
+        if (cancelled(cancel)) return PT_OK;
+        int wb = walk && b > 0;
+        int obase = wb ? (b - 1) * (n + 1) : 0, sbase = wb ? (b - 1) * n : 0, first = b == 0;
+        int tbase = b * 3 * (int)items;
+        float w_in = wb ? 1.0f : w_fan;
+        cl_mem off = wb ? dv->b_woff : dv->b_rin_off, from = wb ? dv->b_wsrc : dv->b_rin_src;
+        karg k[] = {KINT(n),    KMEM(off),  KINT(obase),     KMEM(from),        KINT(sbase),      KF(w_in),    KMEM(bin),
+                    KMEM(dv->b_rho), KINT(first), KMEM(dv->b_bout), KMEM(dv->b_total), KMEM(dv->b_tally), KINT(tbase)};
+        if ((st = run_kernel_local(dv, KE_BOUNCE, items, GI_BOUNCE_LOCAL, k, 13, d)) != PT_OK) return st;
+        cl_mem t = dv->b_bin;
+        dv->b_bin = dv->b_bout;
+        dv->b_bout = t;
+        bin = dv->b_bin;
     }
-    int slices_r = dv->slices;
-    karg r[] = {KMEM(dv->b_part), KINT(n),           KMEM(dv->b_edir), KMEM(dv->b_acc), KINT(slices_r),
-                KF(inv_scale),    KMEM(dv->b_total), KMEM(dv->b_lout), KMEM(dv->b_phi)};
-    if ((st = run_kernel(dv, KE_RESOLVE, nn, r, 9, d)) != PT_OK) return st;
+    if (cancelled(cancel)) return PT_OK;
+    /* from here on the results are written: not cancelled any more */
+    int scattered = nb > 0;
+    karg r[] = {KMEM(dv->b_part), KINT(n), KMEM(dv->b_edir), KINT(scattered), KMEM(dv->b_total), KMEM(dv->b_lout),
+                KMEM(dv->b_phi)};
+    if ((st = run_kernel(dv, KE_RESOLVE, nn, r, 7, d)) != PT_OK) return st;
     if ((st = download(dv, dv->b_lout, lout, f4, d)) != PT_OK) return st;
-    return download(dv, dv->b_phi, phi, f4, d);
+    if ((st = download(dv, dv->b_phi, phi, f4, d)) != PT_OK) return st;
+    if ((st = download(dv, dv->b_edir, edir, f4, d)) != PT_OK) return st;
+    if (nb > 0 && (st = download(dv, dv->b_tally, dv->tally, (size_t)nb * 3 * items * sizeof(float), d)) != PT_OK)
+        return st;
+    sum_bounces(dv->tally, items, nb, bounce_flux);
+    *done = 1;
+    if (times) {
+        times[0] = t1 - t0;
+        times[1] = timer_now() - t1;
+    }
+    return PT_OK;
 #else
-    (void)seed;
-    (void)srcidx;
-    (void)nsrc;
     return PT_ERR_INTERNAL;
 #endif
 }

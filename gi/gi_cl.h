@@ -54,22 +54,29 @@ int gi_dev_opencl_built(void);
 pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, const int *slink, int ns2,
                                const int *glink, int ng, diag *d);
 pt_status gi_dev_set_lists(gi_dev *dv, const int *list_off, int nrp, const int *list_idx, diag *d);
-/* Incoming scattering links (CSR by target, sources ascending), for the
- * "full" scattering mode. */
+/* Incoming scattering links (CSR by target, sources ascending): the first
+ * bounce, and every bounce of the "full" mode. */
 pt_status gi_dev_set_reverse(gi_dev *dv, const int *rin_off, const int *rin_src, diag *d);
+/* The WALK mode's bounces 1..nwalk (gi_k_bounce): table b - 1 lists, per
+ * target, the particles whose chosen link of bounce b ends there:
+ * woff[(b-1)(n+1) + j .. + j + 1) indexes wsrc[(b-1) n + ...]. */
+pt_status gi_dev_set_walk(gi_dev *dv, const int *woff, const int *wsrc, int nwalk, diag *d);
 
-/* Lighting stage. emit: direct E/pi and first-bounce source flux of every
- * particle (read back into edir and src, n*4 floats). scatter: nb bounces,
- * mode GI_SCATTER_WALK (the paper's: fan-out then random single links from
- * the nsrc particles srcidx, fixed-point atomics with `scale`; tally gets
- * nb*3 fixed-point bounce totals, may be NULL) or GI_SCATTER_FULL (every
- * bounce along all links, gi_k_pull; tally zero); then the reflected
- * radiance lout and flux phi of every particle (n*4 floats read back). */
+/* Lighting stage (gi_lighting.cl): emission from the lights with the
+ * visibility vis (n x nlights), nb scattering bounces (mode
+ * GI_SCATTER_WALK: the first along all links, then the walk lists;
+ * GI_SCATTER_FULL: all along all links), then the reflected radiance. The
+ * host arrays edir (direct E/pi), lout (radiance) and phi (received flux),
+ * n*4 floats each, and bounce_flux (nb grey sums of what each bounce
+ * delivered; may be NULL) are written only at the end, and *done set to 1.
+ * While *cancel (may be NULL) is non-zero the stage stops before its next
+ * kernel, writes nothing the caller reads and returns PT_OK with *done 0:
+ * the previous results stay in place (on the device too). times (may be
+ * NULL): seconds of emission (uploads included) and of the rest. */
 enum { GI_SCATTER_WALK = 0, GI_SCATTER_FULL = 1 };
-pt_status gi_dev_emit(gi_dev *dv, const gi_dev_light *lights, int nlights, const float *vis, float *edir, float *src,
-                      diag *d);
-pt_status gi_dev_scatter(gi_dev *dv, int mode, int nb, gi_u32 seed, float scale, const int *srcidx, int nsrc,
-                         gi_i64 *tally, float *lout, float *phi, diag *d);
+pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, const float *vis, int mode, int nb,
+                          volatile int *cancel, float *edir, float *lout, float *phi, double *bounce_flux, int *done,
+                          double times[2], diag *d);
 /* Ray-tracing stage. gather: E~/pi of the used particles, written into the
  * device's copy and into eind[4*used[t]] on the host. estimate: radiance
  * particles found[t] into vout[4*t] (compact). */

@@ -23,23 +23,18 @@ typedef struct {
     int nlights;
     const float *vis, *src, *edir, *lout, *eind, *bg;
     float *fout, *fout2;
-    const int *slink, *glink, *idx, *list_off, *list_idx;
-    int ns2, nb, ng;
-    gi_u32 seed;
-    float scale;
-    gi_i64 *acc, *tally;
-    const gi_i64 *cacc;
+    const int *glink, *idx, *list_off, *list_idx;
+    int ng;
     const float *total;
-    float *ftot;
-    const int *rin_off, *rin_src;
-    int np_slices; /* scatter: slices (one work-item each) */
-    int nsrc;      /* scatter: sources */
+    float *ftot, *tally;
+    const int *off, *from;
+    int obase, sbase, first, tbase, scattered;
+    float w_in;
     const float *rho4;
-    int *next; /* scatter: the shared batch counter */
     size_t chunk;  /* work-items per pool job (0: GI_C_CHUNK) */
 } c_launch;
 
-enum { K_EMIT, K_SCATTER, K_RESOLVE, K_GATHER, K_ESTIMATE, K_PULL_INIT, K_PULL };
+enum { K_EMIT, K_BOUNCE, K_RESOLVE, K_GATHER, K_ESTIMATE };
 
 static void run_chunk(void *ctx, int chunk, int thread)
 {
@@ -51,17 +46,11 @@ static void run_chunk(void *ctx, int chunk, int thread)
         gi_shim_gid = g;
         switch (a->kernel) {
         case K_EMIT: gi_k_emit(a->part, a->np, a->lights, a->nlights, a->vis, a->fout, a->fout2); break;
-        case K_SCATTER:
-            gi_k_scatter(a->rho4, a->slink, a->ns2, a->nb, a->seed, a->scale, a->idx, a->nsrc, a->src, a->acc,
-                         a->tally, a->np, a->np_slices, a->next);
+        case K_BOUNCE:
+            gi_k_bounce(a->np, a->off, a->obase, a->from, a->sbase, a->w_in, a->src, a->rho4, a->first, a->fout,
+                        a->ftot, a->tally, a->tbase);
             break;
-        case K_RESOLVE:
-            gi_k_resolve(a->part, a->np, a->edir, a->cacc, a->np_slices, a->scale, a->total, a->fout, a->fout2);
-            break;
-        case K_PULL_INIT: gi_k_pull_init(a->np, a->ns2, a->src, a->fout, a->ftot); break;
-        case K_PULL:
-            gi_k_pull(a->part, a->np, a->ns2, a->rin_off, a->rin_src, a->src, a->fout, a->ftot);
-            break;
+        case K_RESOLVE: gi_k_resolve(a->part, a->np, a->edir, a->scattered, a->total, a->fout, a->fout2); break;
         case K_GATHER:
             gi_k_gather(a->glink, a->ng, a->lout, a->idx, (int)a->n, a->bg[0], a->bg[1], a->bg[2], a->fout);
             break;
@@ -90,37 +79,22 @@ void gi_c_emit(int threads, const gi_dev_particle *part, int n, const gi_dev_lig
     launch(threads, &a);
 }
 
-void gi_c_scatter(int threads, const float *rho4, int n, const int *slink, int ns2, int nb, gi_u32 seed,
-                  float scale, const int *srcidx, int nsrc, const float *src, int nslices, gi_i64 *acc, gi_i64 *tally)
+void gi_c_bounce(int threads, int n, const int *off, int obase, const int *from, int sbase, float w_in,
+                 const float *bin, const float *rho4, int first, float *bout, float *total, float *tally, int tbase)
 {
-    /* one work-item per slice (nslices > 0), one pool job each */
-    int next = 0;
-    c_launch a = {.kernel = K_SCATTER, .n = (size_t)(nslices > 0 ? nslices : nsrc), .rho4 = rho4, .np = n,
-                  .slink = slink, .ns2 = ns2, .nb = nb, .seed = seed, .scale = scale, .idx = srcidx,
-                  .nsrc = nsrc, .src = src, .acc = acc, .tally = tally, .np_slices = nslices,
-                  .chunk = nslices > 0 ? 1 : 0, .next = &next};
+    /* one work-item per GI_BOUNCE_CHUNK particles, 4 work-items per pool job */
+    size_t items = ((size_t)n + GI_BOUNCE_CHUNK - 1) / GI_BOUNCE_CHUNK;
+    c_launch a = {.kernel = K_BOUNCE, .n = items, .np = n, .off = off, .obase = obase, .from = from, .sbase = sbase,
+                  .w_in = w_in, .src = bin, .rho4 = rho4, .first = first, .fout = bout, .ftot = total,
+                  .tally = tally, .tbase = tbase, .chunk = 4};
     launch(threads, &a);
 }
 
-void gi_c_pull_init(int threads, int n, int ns2, const float *src, float *bin, float *total)
+void gi_c_resolve(int threads, const gi_dev_particle *part, int n, const float *edir, int scattered,
+                  const float *total, float *lout, float *phi)
 {
-    c_launch a = {.kernel = K_PULL_INIT, .n = (size_t)n, .np = n, .ns2 = ns2, .src = src, .fout = bin, .ftot = total};
-    launch(threads, &a);
-}
-
-void gi_c_pull(int threads, const gi_dev_particle *part, int n, int ns2, const int *rin_off, const int *rin_src,
-               const float *bin, float *bout, float *total)
-{
-    c_launch a = {.kernel = K_PULL, .n = (size_t)n, .part = part, .np = n, .ns2 = ns2, .rin_off = rin_off,
-                  .rin_src = rin_src, .src = bin, .fout = bout, .ftot = total};
-    launch(threads, &a);
-}
-
-void gi_c_resolve(int threads, const gi_dev_particle *part, int n, const float *edir, const gi_i64 *acc,
-                  int nslices, float inv_scale, const float *total, float *lout, float *phi)
-{
-    c_launch a = {.kernel = K_RESOLVE, .n = (size_t)n, .part = part, .np = n, .edir = edir, .cacc = acc,
-                  .np_slices = nslices, .scale = inv_scale, .total = total, .fout = lout, .fout2 = phi};
+    c_launch a = {.kernel = K_RESOLVE, .n = (size_t)n, .part = part, .np = n, .edir = edir, .scattered = scattered,
+                  .total = total, .fout = lout, .fout2 = phi};
     launch(threads, &a);
 }
 

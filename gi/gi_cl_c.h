@@ -10,15 +10,12 @@
 
 void gi_c_emit(int threads, const gi_dev_particle *part, int n, const gi_dev_light *lights, int nlights,
                const float *vis, float *edir, float *src);
-/* nslices > 0: acc holds nslices slices of 3n, tally nslices x 3 GI_MAX_BOUNCES
- * (gi_k_scatter); nslices = 0: one of each, atomic adds. rho4: n x 4 floats. */
-void gi_c_scatter(int threads, const float *rho4, int n, const int *slink, int ns2, int nb, gi_u32 seed,
-                  float scale, const int *srcidx, int nsrc, const float *src, int nslices, gi_i64 *acc, gi_i64 *tally);
-void gi_c_pull_init(int threads, int n, int ns2, const float *src, float *bin, float *total);
-void gi_c_pull(int threads, const gi_dev_particle *part, int n, int ns2, const int *rin_off, const int *rin_src,
-               const float *bin, float *bout, float *total);
-void gi_c_resolve(int threads, const gi_dev_particle *part, int n, const float *edir, const gi_i64 *acc,
-                  int nslices, float inv_scale, const float *total, float *lout, float *phi);
+/* gi_k_bounce: ceil(n / GI_BOUNCE_CHUNK) work-items; tally gets 3 floats
+ * per work-item from tbase. */
+void gi_c_bounce(int threads, int n, const int *off, int obase, const int *from, int sbase, float w_in,
+                 const float *bin, const float *rho4, int first, float *bout, float *total, float *tally, int tbase);
+void gi_c_resolve(int threads, const gi_dev_particle *part, int n, const float *edir, int scattered,
+                  const float *total, float *lout, float *phi);
 void gi_c_gather(int threads, const int *glink, int ng, const float *lout, const int *used, int nused,
                  const float bg[3], float *eind);
 void gi_c_estimate(int threads, const gi_dev_particle *part, const int *list_off, const int *list_idx,

@@ -35,7 +35,9 @@ struct gi_particle {
     gi_particles ps;
     int ns2, ng;
     int *slink, *glink;
-    int *rin_off, *rin_src; /* incoming scattering links (FULL mode) */
+    int *rin_off, *rin_src; /* incoming scattering links (first bounce, FULL mode) */
+    int *woff, *wsrc;       /* WALK bounces' incoming lists (build_walk) */
+    int nwalk;
     gi_lists lists;
     gi_grid *rgrid; /* particles by list radius: estimates on surfaces without radiance particles */
     gi_dev *dev;
@@ -45,12 +47,11 @@ struct gi_particle {
     float *vis;
     scene_light *vis_lights; /* the lights vis was traced for (colour aside) */
     unsigned char *dirty;
-    float *edir, *src, *phi, *lout;
-    int *srcidx;
+    float *edir, *phi, *lout;
     double bounce_flux[GI_MAX_BOUNCES];
     int nbounce_flux;
     int lit;
-    volatile int *cancel; /* gi_particle_set_cancel: non-zero stops the visibility pass */
+    volatile int *cancel; /* gi_particle_set_cancel: non-zero stops the lighting stage */
     /* view */
     float *eind;                 /* n*4: gathered E~/pi */
     atomic_uchar *e_state;       /* 0 none, 1 being computed, 2 done */
@@ -113,9 +114,10 @@ static void update_bytes(gi_particle *gp)
 {
     gi_particle_stats *s = &gp->st;
     size_t n = (size_t)gp->ps.n, nrp = (size_t)gp->lists.nrp;
-    s->bytes_particles = n * (sizeof(gi_dev_particle) + sizeof(int) + 1) + n * 4 * sizeof(float) * 6 + n * 2 +
+    s->bytes_particles = n * (sizeof(gi_dev_particle) + 1) + n * 4 * sizeof(float) * 4 + n * 2 +
                          (size_t)gp->nlights * n * sizeof(float);
-    s->bytes_links = n * (size_t)(2 * gp->ns2 + gp->ng) * sizeof(int) + (n + 2) * sizeof(int);
+    s->bytes_links = n * (size_t)(2 * gp->ns2 + gp->ng) * sizeof(int) + (n + 2) * sizeof(int) +
+                     (size_t)gp->nwalk * (2 * n + 1) * sizeof(int);
     s->bytes_lists = (nrp + 1) * sizeof(int) + (gp->lists.off ? (size_t)gp->lists.off[nrp] : 0) * sizeof(int) +
                      nrp * (4 * sizeof(float) + 2);
     s->bytes_surfaces = gp->surf ? gi_surface_bytes(gp->surf) : 0;
@@ -240,6 +242,57 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
     }
     *links_out = links;
     return st;
+}
+
+/* The WALK mode's bounces after the first (gi_k_bounce, the paper's
+ * single-link random bounces): in bounce b (1 <= b <= nwalk) particle i
+ * sends all it received along its scattering link c(i, b), drawn here once
+ * with probability 1/ns2 each (a hash of the seed, i and b; links of -1
+ * lose the flux, as a packet leaving the scene). Table b - 1 lists per
+ * target the particles sending to it, sources ascending: woff (n + 1) and
+ * wsrc (n) per bounce, 8 bytes per particle and bounce. Uploaded to the
+ * device; kept until the bounce count grows (gi_particle_set_scattering). */
+static pt_status build_walk(gi_particle *gp, int nwalk, diag *d)
+{
+    if (nwalk < 0) nwalk = 0;
+    if (gp->woff && nwalk <= gp->nwalk) return PT_OK;
+    pt_status st = PT_OK;
+    int n = gp->ps.n, k = gp->ns2;
+    size_t nn = (size_t)(n > 0 ? n : 0), nw = (size_t)nwalk;
+    int *woff = xcalloc(nw * (nn + 1), sizeof(int), &st);
+    int *wsrc = xcalloc(nw * nn, sizeof(int), &st);
+    int *tgt = xcalloc(nn, sizeof(int), &st);
+    int *cur = xcalloc(nn + 1, sizeof(int), &st);
+    if (st != PT_OK) {
+        free(woff);
+        free(wsrc);
+        free(tgt);
+        free(cur);
+        return st;
+    }
+    gi_u32 seed = (gi_u32)(gp->set.seed * 2654435761u + 12345u);
+    for (int b = 1; b <= nwalk; b++) {
+        int *off = woff + (size_t)(b - 1) * (nn + 1), *src = wsrc + (size_t)(b - 1) * nn;
+        gi_u32 hb = gi_hash((gi_u32)b);
+        for (int i = 0; i < n; i++) {
+            gi_u32 h = gi_hash(seed ^ gi_hash((gi_u32)i ^ hb));
+            int t = gp->slink[(size_t)i * (size_t)k + (size_t)(h % (gi_u32)k)];
+            tgt[i] = t;
+            if (t >= 0) off[t + 1]++;
+        }
+        for (int j = 0; j < n; j++) off[j + 1] += off[j];
+        memcpy(cur, off, (nn + 1) * sizeof(int));
+        for (int i = 0; i < n; i++)
+            if (tgt[i] >= 0) src[cur[tgt[i]]++] = i;
+    }
+    free(tgt);
+    free(cur);
+    free(gp->woff);
+    free(gp->wsrc);
+    gp->woff = woff;
+    gp->wsrc = wsrc;
+    gp->nwalk = nwalk;
+    return gi_dev_set_walk(gp->dev, gp->woff, gp->wsrc, gp->nwalk, d);
 }
 
 gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particle_settings *s,
@@ -388,11 +441,9 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     {
         size_t n = (size_t)gp->ps.n, nrp = (size_t)gp->lists.nrp;
         gp->edir = xcalloc(n * 4, sizeof(float), &st);
-        gp->src = xcalloc(n * 4, sizeof(float), &st);
         gp->phi = xcalloc(n * 4, sizeof(float), &st);
         gp->lout = xcalloc(n * 4, sizeof(float), &st);
         gp->eind = xcalloc(n * 4, sizeof(float), &st);
-        gp->srcidx = xcalloc(n, sizeof(int), &st);
         gp->e_state = xcalloc(n, sizeof(atomic_uchar), &st);
         gp->dev_gathered = xcalloc(n, 1, &st);
         gp->rp_val = xcalloc(nrp * 4, sizeof(float), &st);
@@ -419,6 +470,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     st = gi_dev_set_particles(gp->dev, gp->ps.p, gp->ps.n, gp->slink, gp->ns2, gp->glink, gp->ng, d);
     if (st == PT_OK) st = gi_dev_set_lists(gp->dev, gp->lists.off, (int)gp->lists.nrp, gp->lists.idx, d);
     if (st == PT_OK) st = gi_dev_set_reverse(gp->dev, gp->rin_off, gp->rin_src, d);
+    if (st == PT_OK && set->scatter != GI_PARTICLE_SCATTER_FULL) st = build_walk(gp, set->bounces - 1, d);
     if (st != PT_OK) goto fail;
     S->t_upload = timer_now() - tg;
     S->t_geometry = timer_now() - t0 - S->t_kernel_build;
@@ -450,11 +502,11 @@ void gi_particle_free(gi_particle *gp)
     free(gp->vis_lights);
     free(gp->dirty);
     free(gp->edir);
-    free(gp->src);
     free(gp->phi);
     free(gp->lout);
     free(gp->eind);
-    free(gp->srcidx);
+    free(gp->woff);
+    free(gp->wsrc);
     free(gp->e_state);
     free(gp->dev_gathered);
     free(gp->rp_val);
@@ -673,60 +725,46 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
     S->shadow_rays = atomic_load(&J.rays);
     S->t_visibility = timer_now() - tv;
 
-    /* emission kernel */
-    double te = timer_now();
-    st = gi_dev_emit(gp->dev, gp->lights, gp->nlights, gp->vis, gp->edir, gp->src, d);
+    /* emission, scattering and radiance on the device (gi_lighting.cl):
+     * cancellable before each kernel, and then nothing the view reads has
+     * changed (gi_dev_lighting writes edir, lout, phi only at its end) */
+    int nb = gp->set.bounces, full = gp->set.scatter == GI_PARTICLE_SCATTER_FULL;
+    if (!full && nb - 1 > gp->nwalk) {
+        st = build_walk(gp, nb - 1, d);
+        if (st != PT_OK) return st;
+    }
+    double kt[2] = {0.0, 0.0};
+    int done = 0;
+    st = gi_dev_lighting(gp->dev, gp->lights, gp->nlights, gp->vis, full ? GI_SCATTER_FULL : GI_SCATTER_WALK, nb,
+                      gp->cancel, gp->edir, gp->lout, gp->phi, gp->bounce_flux, &done, kt, d);
     if (st != PT_OK) return st;
-    int nsrc = 0;
-    double total = 0.0, rho_max = 0.0, fd = 0.0, fe = 0.0;
+    if (!done) return PT_OK; /* cancelled: the previous lighting stays */
+    S->t_emit = kt[0];
+    S->t_scatter = kt[1];
+    gp->nbounce_flux = nb;
+    /* sums for the stats: direct, emitted and scattered flux (grey), and the
+     * particles that send light in the first bounce */
+    double ts = timer_now();
+    long nsrc = 0;
+    double fd = 0.0, fe = 0.0, fs = 0.0;
     for (int i = 0; i < n; i++) {
-        const float *s = &gp->src[4 * (size_t)i];
-        double a = fabs(s[0]) + fabs(s[1]) + fabs(s[2]);
-        if (a > 0.0 && isfinite(a)) {
-            gp->srcidx[nsrc++] = i;
-            total += a;
-        }
         const gi_dev_particle *p = &gp->ps.p[i];
+        const float *e = &gp->edir[4 * (size_t)i], *f = &gp->phi[4 * (size_t)i];
+        int source = 0;
         for (int c = 0; c < 3; c++) {
-            rho_max = fmax(rho_max, fabs(p->rho[c]));
-            fd += M_PI * gp->edir[4 * (size_t)i + c] * p->area / 3.0;
-            fe += M_PI * p->le[c] * p->area / 3.0;
+            double direct = M_PI * e[c] * p->area, emitted = M_PI * p->le[c] * p->area;
+            fd += direct / 3.0;
+            fe += emitted / 3.0;
+            fs += (f[c] - direct) / 3.0;
+            source |= p->rho[c] * direct + emitted != 0.0;
         }
+        nsrc += source;
     }
     S->sources = nsrc;
     S->flux_direct = fd;
     S->flux_emitted = fe;
-    S->t_emit = timer_now() - te;
-
-    /* scattering: fixed-point scale 2^e so that nb bounces of the total
-     * cannot overflow 2^62 (see gi_lighting.cl) */
-    double ts = timer_now();
-    int nb = gp->set.bounces;
-    double growth = 0.0, gpow = 1.0;
-    for (int b = 0; b < nb; b++) {
-        growth += gpow;
-        gpow *= fmax(1.0, rho_max);
-    }
-    double bound = total * fmax(growth, 1.0);
-    int e = bound > 0.0 ? (int)floor(61.0 - log2(bound)) : 0;
-    if (e > 100) e = 100;
-    if (e < -100) e = -100;
-    float scale = ldexpf(1.0f, e);
-    gi_i64 tally[GI_MAX_BOUNCES * 3];
-    st = gi_dev_scatter(gp->dev, gp->set.scatter == GI_PARTICLE_SCATTER_FULL ? GI_SCATTER_FULL : GI_SCATTER_WALK,
-                        nsrc > 0 ? nb : 0, (gi_u32)(gp->set.seed * 2654435761u + 12345u), scale, gp->srcidx,
-                        nsrc, tally, gp->lout, gp->phi, d);
-    if (st != PT_OK) return st;
-    gp->nbounce_flux = nsrc > 0 && gp->set.scatter != GI_PARTICLE_SCATTER_FULL ? nb : 0;
-    for (int b = 0; b < gp->nbounce_flux; b++)
-        gp->bounce_flux[b] = ((double)tally[3 * b] + (double)tally[3 * b + 1] + (double)tally[3 * b + 2]) /
-                             (3.0 * (double)scale);
-    double fs = 0.0;
-    for (int i = 0; i < n; i++)
-        for (int c = 0; c < 3; c++)
-            fs += (gp->phi[4 * (size_t)i + c] - M_PI * gp->edir[4 * (size_t)i + c] * gp->ps.p[i].area) / 3.0;
     S->flux_scattered = fs;
-    S->t_scatter = timer_now() - ts;
+    S->t_scatter += timer_now() - ts;
     reset_view(gp);
     gp->lit = 1;
     S->t_lighting = timer_now() - t0;

@@ -60,13 +60,15 @@
 
 typedef struct gi_particle gi_particle;
 
-/* How flux is scattered after emission (gi_lighting.cl):
+/* How flux is scattered after emission (gi_lighting.cl, gi_k_bounce; every
+ * bounce a gather over incoming links, no atomics, deterministic):
  *  WALK  the paper's (section 4.2.2, Fig. 5): the first bounce along all
- *        n_s x n_s links, then n_b - 1 bounces along one random link per
- *        packet, with atomic (fixed-point, deterministic) accumulation;
- *  FULL  every bounce along all links, computed as a gather over incoming
- *        links: no atomics, no random-walk noise, memory-friendly on CPUs;
- *        the same expected flux. */
+ *        n_s x n_s links, then n_b - 1 bounces along one random link of
+ *        each particle, drawn once per particle and bounce at geometry time
+ *        (the same expected flux as the paper's per-packet choice; 8 bytes
+ *        per particle and bounce for the lists);
+ *  FULL  every bounce along all links: no random-walk noise, the same
+ *        expected flux, about n_s^2 times the gathers of a WALK bounce. */
 typedef enum { GI_PARTICLE_SCATTER_WALK = 0, GI_PARTICLE_SCATTER_FULL = 1 } gi_particle_scatter;
 
 typedef struct {
@@ -136,12 +138,13 @@ pt_status gi_particle_light(gi_particle *gp, diag *d);
 pt_status gi_particle_relight(gi_particle *gp, diag *d);
 /* Cancellation of the lighting stage (the interactive viewer's relight):
  * while *cancel is non-zero, gi_particle_light/relight stop at the next
- * chunk of the visibility pass (its shadow rays, most of the stage) and
- * return PT_OK without touching what the view reads: the previous lighting
- * stays in place and consistent, and the next call redoes the changed
- * lights. Once emission has started the stage runs to its end (one scatter
- * kernel runs all bounces). The caller tells a cancelled stage by its own
- * flag. NULL (the default): never cancelled. */
+ * chunk of the visibility pass (its shadow rays) or before the next kernel
+ * (emission, each bounce, radiance) and return PT_OK without touching what
+ * the view reads: the previous lighting stays in place and consistent, and
+ * the next call redoes what changed (lights whose visibility pass was cut
+ * stay marked). Once the radiance kernel has started the stage runs to its
+ * end. The caller tells a cancelled stage by its own flag. NULL (the
+ * default): never cancelled. */
 void gi_particle_set_cancel(gi_particle *gp, volatile int *cancel);
 /* Change n_b and the scattering mode; takes effect at the next
  * gi_particle_relight (no geometry work). */

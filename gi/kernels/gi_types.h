@@ -31,11 +31,12 @@ typedef uint32_t gi_u32;
 #endif
 
 #define GI_PI_F 3.14159265358979323846f
-/* Most scattering bounces the kernels accept (tally array size), and most
- * scattering links per particle (n_s <= 4; kept small: the walk kernel holds
- * one packet per link in private memory). */
+/* Most scattering bounces the kernels accept, and most scattering links
+ * per particle (n_s <= 4). GI_BOUNCE_CHUNK: particles per work-item of
+ * gi_k_bounce (one tally entry each). */
 #define GI_MAX_BOUNCES 64
 #define GI_MAX_SCATTER 16
+#define GI_BOUNCE_CHUNK 64
 
 /* One area particle (paper section 4.2.1: position p, normal n, area dA,
  * diffuse reflectance rho_d; the BRDF is rho_d/pi). `n` is the normal of the
