@@ -1548,6 +1548,60 @@ int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax)
     return r.tfar == -INFINITY;
 }
 
+void accel_occluded_n(const accel *a, int n, const vec3 *org, const vec3 *dir, const double *tmin,
+                      const double *tmax, unsigned char *out)
+{
+    for (int k0 = 0; k0 < n; k0 += 16) {
+        int m = n - k0 < 16 ? n - k0 : 16;
+        struct RTCRay16 r;
+        RTC_ALIGN(64) int valid[16];
+        int any = 0;
+        for (int k = 0; k < 16; k++) {
+            valid[k] = 0;
+            r.org_x[k] = r.org_y[k] = r.org_z[k] = 0.0f;
+            r.dir_x[k] = r.dir_y[k] = 0.0f;
+            r.dir_z[k] = 1.0f;
+            r.tnear[k] = 0.0f;
+            r.tfar[k] = 0.0f;
+            r.time[k] = 0.0f;
+            r.mask[k] = 0xFFFFFFFFu;
+            r.id[k] = (unsigned)k;
+            r.flags[k] = 0;
+            if (k >= m) continue;
+            int i = k0 + k;
+            out[i] = 0;
+            if (!a || !ray_ok(org[i], dir[i])) continue;
+            /* the same effective interval as accel_occluded */
+            double t0 = eps_rule(a->eps_scale, org[i], v3_len(dir[i]));
+            if (tmin[i] > t0) t0 = tmin[i];
+            if (!(tmax[i] > t0)) continue;
+            struct RTCRay one;
+            fill_rtc_ray(&one, org[i], dir[i], t0, tmax[i]);
+            r.org_x[k] = one.org_x;
+            r.org_y[k] = one.org_y;
+            r.org_z[k] = one.org_z;
+            r.dir_x[k] = one.dir_x;
+            r.dir_y[k] = one.dir_y;
+            r.dir_z[k] = one.dir_z;
+            r.tnear[k] = one.tnear;
+            r.tfar[k] = one.tfar;
+            valid[k] = -1;
+            any = 1;
+        }
+        if (!any) continue;
+        struct RTCIntersectContext c;
+        rtcInitIntersectContext(&c);
+        c.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        /* no accel_query: user geometry takes the packet's float rays */
+        accel_query *saved = tls_query;
+        tls_query = NULL;
+        rtcOccluded16(valid, a->root, &c, &r);
+        tls_query = saved;
+        for (int k = 0; k < m; k++)
+            if (valid[k]) out[k0 + k] = r.tfar[k] == -INFINITY;
+    }
+}
+
 void accel_bounds(const accel *a, vec3 *lo, vec3 *hi)
 {
     if (lo) *lo = a ? a->lo : v3s(0.0);

@@ -69,6 +69,12 @@ int accel_mutually_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, 
                            const void *ctx);
 /* Any hit in (tmin, tmax) by an object that casts shadows (not no_shadow). */
 int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax);
+/* accel_occluded for n rays at once (Embree packets of 16, flagged
+ * coherent: shadow rays towards one light from neighbouring points): out[k]
+ * = 1 when ray k is blocked. Same effective tmin rule; analytic shapes see
+ * the packet's float rays (accel_occluded passes them its double ray). */
+void accel_occluded_n(const accel *a, int n, const vec3 *org, const vec3 *dir, const double *tmin,
+                      const double *tmax, unsigned char *out);
 /* World bounds of finite geometry (infinite planes excluded) and a scene
  * scale (bounding-box diagonal) for epsilons. */
 void accel_bounds(const accel *a, vec3 *lo, vec3 *hi);

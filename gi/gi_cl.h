@@ -62,8 +62,8 @@ pt_status gi_dev_set_reverse(gi_dev *dv, const int *rin_off, const int *rin_src,
  * woff[(b-1)(n+1) + j .. + j + 1) indexes wsrc[(b-1) n + ...]. */
 pt_status gi_dev_set_walk(gi_dev *dv, const int *woff, const int *wsrc, int nwalk, diag *d);
 
-/* Lighting stage (gi_lighting.cl): emission from the lights with the
- * visibility vis (n x nlights), nb scattering bounces (mode
+/* Lighting stage (gi_lighting.cl): emission from the lights with vis
+ * (n x nlights: attenuation times visibility fraction), nb scattering bounces (mode
  * GI_SCATTER_WALK: the first along all links, then the walk lists;
  * GI_SCATTER_FULL: all along all links), then the reflected radiance. The
  * host arrays edir (direct E/pi), lout (radiance) and phi (received flux),

@@ -44,7 +44,7 @@ struct gi_particle {
     /* lighting */
     int nlights;
     gi_dev_light *lights;
-    float *vis;
+    float *vis;               /* n x nlights: attenuation x visibility fraction (gi_k_emit) */
     scene_light *vis_lights; /* the lights vis was traced for (colour aside) */
     unsigned char *dirty;
     float *edir, *phi, *lout;
@@ -579,11 +579,62 @@ typedef struct {
 
 #define VIS_CHUNK 256
 
-static double shadow_test(const accel *a, vec3 p, vec3 dir, double depth, double eps)
+/* The shadow rays of one chunk and light, traced together
+ * (accel_occluded_n: Embree packets of 16). */
+typedef struct {
+    vec3 *org, *dir;
+    double *tmin, *tmax;
+    int *owner; /* particle index within the chunk */
+    unsigned char *hit;
+    int n, cap;
+} ray_batch;
+
+static int batch_add(ray_batch *b, vec3 org, vec3 dir, double tmin, double tmax, int owner)
+{
+    if (b->n == b->cap) {
+        int cap = b->cap ? 2 * b->cap : 1024;
+        vec3 *o = realloc(b->org, (size_t)cap * sizeof *o);
+        if (o) b->org = o;
+        vec3 *d = realloc(b->dir, (size_t)cap * sizeof *d);
+        if (d) b->dir = d;
+        double *t0 = realloc(b->tmin, (size_t)cap * sizeof *t0);
+        if (t0) b->tmin = t0;
+        double *t1 = realloc(b->tmax, (size_t)cap * sizeof *t1);
+        if (t1) b->tmax = t1;
+        int *w = realloc(b->owner, (size_t)cap * sizeof *w);
+        if (w) b->owner = w;
+        unsigned char *h = realloc(b->hit, (size_t)cap);
+        if (h) b->hit = h;
+        if (!o || !d || !t0 || !t1 || !w || !h) return 0;
+        b->cap = cap;
+    }
+    b->org[b->n] = org;
+    b->dir[b->n] = dir;
+    b->tmin[b->n] = tmin;
+    b->tmax[b->n] = tmax;
+    b->owner[b->n] = owner;
+    b->n++;
+    return 1;
+}
+
+static void batch_free(ray_batch *b)
+{
+    free(b->org);
+    free(b->dir);
+    free(b->tmin);
+    free(b->tmax);
+    free(b->owner);
+    free(b->hit);
+}
+
+/* A shadow ray from p towards a light point at `depth` along dir: 1 (seen,
+ * no ray needed: the point is within eps) or queued (0). */
+static int shadow_ray(ray_batch *b, vec3 p, vec3 dir, double depth, double eps, int owner, const accel *a)
 {
     double tmax = depth - fmax(eps, depth * 1e-6);
-    if (tmax <= eps) return 1.0;
-    return accel_occluded(a, p, dir, eps, tmax) ? 0.0 : 1.0;
+    if (tmax <= eps) return 1;
+    if (!batch_add(b, p, dir, eps, tmax, owner)) return accel_occluded(a, p, dir, eps, tmax) ? 0 : 1;
+    return 0;
 }
 
 static void vis_chunk(void *ctx, int chunk, int thread)
@@ -596,57 +647,69 @@ static void vis_chunk(void *ctx, int chunk, int thread)
     int n = gp->ps.n, nl = gp->nlights;
     int i0 = chunk * VIS_CHUNK, i1 = i0 + VIS_CHUNK < n ? i0 + VIS_CHUNK : n;
     long rays = 0;
-    for (int i = i0; i < i1; i++) {
-        const gi_dev_particle *pt = &gp->ps.p[i];
-        vec3 p = v3(pt->p[0], pt->p[1], pt->p[2]), nrm = v3(pt->n[0], pt->n[1], pt->n[2]);
-        vec3 org = v3_madd(p, nrm, J->eps);
-        for (int li = 0; li < nl; li++) {
-            if (!gp->dirty[li]) continue;
-            const scene_light *l = &sc->lights[li];
-            const gi_dev_light *dl = &gp->lights[li];
+    float att[VIS_CHUNK], seen[VIS_CHUNK];
+    int m_of[VIS_CHUNK];
+    ray_batch B = {0};
+    for (int li = 0; li < nl; li++) {
+        if (!gp->dirty[li]) continue;
+        const scene_light *l = &sc->lights[li];
+        const gi_dev_light *dl = &gp->lights[li];
+        B.n = 0;
+        for (int i = i0; i < i1; i++) {
+            int o = i - i0;
+            const gi_dev_particle *pt = &gp->ps.p[i];
+            vec3 nrm = v3(pt->n[0], pt->n[1], pt->n[2]);
+            vec3 org = v3_madd(v3(pt->p[0], pt->p[1], pt->p[2]), nrm, J->eps);
             float d[3];
             float depth = gi_light_ray(dl, dl->pos[0], dl->pos[1], dl->pos[2], pt->p[0], pt->p[1], pt->p[2], d);
-            float v = 0.0f;
             float ci = pt->n[0] * d[0] + pt->n[1] * d[1] + pt->n[2] * d[2];
-            if (ci >= 1e-10f && gi_light_attenuation(dl, pt->p[0], pt->p[1], pt->p[2], d, depth) > 0.0f) {
-                if (l->shadowless) {
-                    v = 1.0f;
-                } else if (l->area && l->size1 * l->size2 > 1) {
-                    vec3 ax1 = l->axis1, ax2 = l->axis2;
-                    if (l->orient) {
-                        vec3 dir = v3(d[0], d[1], d[2]);
-                        double len = v3_len(l->axis1);
-                        vec3 helper = fabs(fabs(dir.z) - 1.0) < 0.01 ? v3(0, 1, 0) : v3(0, 0, 1);
-                        ax1 = v3_scale(v3_norm(v3_cross(dir, helper)), len);
-                        ax2 = v3_scale(v3_norm(v3_cross(dir, v3_norm(ax1))), len);
-                    }
-                    rng r;
-                    rng_seed(&r, gp->set.seed ^ 0xa11ULL, (uint64_t)i * 131u + (uint64_t)li);
-                    int total = l->size1 * l->size2;
-                    int m = gp->set.area_samples > 0 && gp->set.area_samples < total ? gp->set.area_samples : total;
-                    /* a subset: every (total/m)-th grid point from a random start */
-                    double stride = (double)total / m, start = rng_f64(&r) * stride;
-                    double sum = 0.0;
-                    for (int k = 0; k < m; k++) {
-                        int g = m == total ? k : (int)(start + k * stride);
-                        if (g >= total) g = total - 1;
-                        int u = g % l->size1, vv = g / l->size1;
-                        vec3 c = v3_add(l->position, area_point(l, ax1, ax2, u, vv, &r));
-                        float dd[3];
-                        float dep = gi_light_ray(dl, (float)c.x, (float)c.y, (float)c.z, pt->p[0], pt->p[1], pt->p[2],
-                                                 dd);
-                        sum += shadow_test(gp->a, org, v3(dd[0], dd[1], dd[2]), dep, J->eps);
-                        rays++;
-                    }
-                    v = (float)(sum / m);
-                } else {
-                    v = (float)shadow_test(gp->a, org, v3(d[0], d[1], d[2]), depth, J->eps);
+            att[o] = ci >= 1e-10f ? gi_light_attenuation(dl, pt->p[0], pt->p[1], pt->p[2], d, depth) : 0.0f;
+            seen[o] = 0.0f;
+            m_of[o] = 1;
+            if (!(att[o] > 0.0f)) continue;
+            if (l->shadowless) {
+                seen[o] = 1.0f;
+            } else if (l->area && l->size1 * l->size2 > 1) {
+                vec3 ax1 = l->axis1, ax2 = l->axis2;
+                if (l->orient) {
+                    vec3 dir = v3(d[0], d[1], d[2]);
+                    double len = v3_len(l->axis1);
+                    vec3 helper = fabs(fabs(dir.z) - 1.0) < 0.01 ? v3(0, 1, 0) : v3(0, 0, 1);
+                    ax1 = v3_scale(v3_norm(v3_cross(dir, helper)), len);
+                    ax2 = v3_scale(v3_norm(v3_cross(dir, v3_norm(ax1))), len);
+                }
+                rng r;
+                rng_seed(&r, gp->set.seed ^ 0xa11ULL, (uint64_t)i * 131u + (uint64_t)li);
+                int total = l->size1 * l->size2;
+                int m = gp->set.area_samples > 0 && gp->set.area_samples < total ? gp->set.area_samples : total;
+                /* a subset: every (total/m)-th grid point from a random start */
+                double stride = (double)total / m, start = rng_f64(&r) * stride;
+                for (int k = 0; k < m; k++) {
+                    int g = m == total ? k : (int)(start + k * stride);
+                    if (g >= total) g = total - 1;
+                    int u = g % l->size1, vv = g / l->size1;
+                    vec3 c = v3_add(l->position, area_point(l, ax1, ax2, u, vv, &r));
+                    float dd[3];
+                    float dep = gi_light_ray(dl, (float)c.x, (float)c.y, (float)c.z, pt->p[0], pt->p[1], pt->p[2], dd);
+                    seen[o] += (float)shadow_ray(&B, org, v3(dd[0], dd[1], dd[2]), dep, J->eps, o, gp->a);
                     rays++;
                 }
+                m_of[o] = m;
+            } else {
+                seen[o] = (float)shadow_ray(&B, org, v3(d[0], d[1], d[2]), depth, J->eps, o, gp->a);
+                rays++;
             }
-            gp->vis[(size_t)i * nl + li] = v;
+        }
+        if (B.n > 0) accel_occluded_n(gp->a, B.n, B.org, B.dir, B.tmin, B.tmax, B.hit);
+        for (int k = 0; k < B.n; k++)
+            if (!B.hit[k]) seen[B.owner[k]] += 1.0f;
+        /* gi_k_emit reads att * V, V the fraction of the light seen */
+        for (int i = i0; i < i1; i++) {
+            int o = i - i0;
+            gp->vis[(size_t)i * nl + li] = att[o] > 0.0f ? att[o] * (seen[o] / (float)m_of[o]) : 0.0f;
         }
     }
+    batch_free(&B);
     atomic_fetch_add(&J->rays, rays);
 }
 
@@ -665,10 +728,13 @@ static int same_geometry(const scene_light *a, const scene_light *b)
 
 static void reset_view(gi_particle *gp)
 {
+    /* no hook runs now (the stages are not run during a render): relaxed
+     * stores, plain byte writes instead of a locked exchange each */
     size_t n = (size_t)gp->ps.n, nrp = (size_t)gp->lists.nrp;
-    for (size_t i = 0; i < n; i++) atomic_store(&gp->e_state[i], 0);
+    for (size_t i = 0; i < n; i++) atomic_store_explicit(&gp->e_state[i], 0, memory_order_relaxed);
     memset(gp->dev_gathered, 0, n);
-    for (size_t l = 0; l < nrp; l++) atomic_store(&gp->rp_state[l], 0);
+    for (size_t l = 0; l < nrp; l++) atomic_store_explicit(&gp->rp_state[l], 0, memory_order_relaxed);
+    atomic_thread_fence(memory_order_release);
 }
 
 pt_status gi_particle_light(gi_particle *gp, diag *d)

@@ -24,6 +24,9 @@
  *  - determinism: two builds with the same seed give bit-identical particle
  *    radiance and hook values; the OpenCL device and the C build of the
  *    kernels agree within 1e-4 relative.
+ *  - cancellation: a cancelled relight (colour change: before the kernels;
+ *    moved light: in the visibility pass) leaves the particles' radiance
+ *    bit-identical; the next relight equals a fresh build with the new light.
  *  - OpenCL errors: a kernel source that does not compile gives
  *    PT_ERR_DEVICE with the build log in the diagnostics; an unknown device
  *    name gives PT_ERR_DEVICE too. (Skipped when no OpenCL platform exists.)
@@ -539,6 +542,59 @@ static void test_view_and_render(void **state)
     unload(&f);
 }
 
+/* Cancellation of the lighting stage (gi_particle_set_cancel): with the
+ * flag set, a relight after a colour change (stopped before its first
+ * kernel) and one after a move (stopped in the visibility pass) leave
+ * every particle's radiance bit for bit as it was; cleared, the relight
+ * after the move gives bit for bit what a fresh build with the moved light
+ * gives. Both devices. */
+static void cancel_check(const char *device)
+{
+    fixture f;
+    load(&f, cube_scene);
+    gi_particle *gp = build(&f, 2000, 4, device, 9);
+    const float *lout;
+    int n = gi_particle_debug(gp, NULL, NULL, &lout, NULL, NULL);
+    float *before = malloc((size_t)n * 4 * sizeof *before);
+    assert_non_null(before);
+    memcpy(before, lout, (size_t)n * 4 * sizeof *before);
+    volatile int cancel = 1;
+    gi_particle_set_cancel(gp, &cancel);
+    f.sc->lights[0].colour.r *= 3.0;
+    assert_int_equal(gi_particle_relight(gp, f.d), PT_OK);
+    gi_particle_debug(gp, NULL, NULL, &lout, NULL, NULL);
+    assert_memory_equal(before, lout, (size_t)n * 4 * sizeof *before);
+    f.sc->lights[0].colour.r /= 3.0;
+    f.sc->lights[0].position.x += 0.2;
+    assert_int_equal(gi_particle_relight(gp, f.d), PT_OK);
+    gi_particle_debug(gp, NULL, NULL, &lout, NULL, NULL);
+    assert_memory_equal(before, lout, (size_t)n * 4 * sizeof *before);
+    cancel = 0;
+    assert_int_equal(gi_particle_relight(gp, f.d), PT_OK);
+    gi_particle_set_cancel(gp, NULL);
+    gi_particle *fresh = build(&f, 2000, 4, device, 9);
+    const float *lf;
+    assert_int_equal(gi_particle_debug(fresh, NULL, NULL, &lf, NULL, NULL), n);
+    gi_particle_debug(gp, NULL, NULL, &lout, NULL, NULL);
+    int changed = 0;
+    for (int i = 0; i < 4 * n; i++) changed += lout[i] != before[i];
+    printf("  [%s] cancelled relights kept all %d particles; the relight after them changed %d values and equals a "
+           "fresh build\n", device ? device : "auto", n, changed);
+    assert_true(changed > n);
+    assert_memory_equal(lf, lout, (size_t)n * 4 * sizeof *lf);
+    free(before);
+    gi_particle_free(fresh);
+    gi_particle_free(gp);
+    unload(&f);
+}
+
+static void test_cancel(void **state)
+{
+    (void)state;
+    cancel_check(device_c);
+    if (have_opencl()) cancel_check(NULL);
+}
+
 /* A cylinder has area particles (accel_surface samples it) but no radiance
  * particles: the hook estimates at the hit. Its indirect light must be
  * close to that of the cube wall next to it (both see the same room). */
@@ -676,6 +732,7 @@ int main(void)
         cmocka_unit_test(test_determinism),
         cmocka_unit_test(test_opencl_errors),
         cmocka_unit_test(test_view_and_render),
+        cmocka_unit_test(test_cancel),
         cmocka_unit_test(test_cylinder_onthefly),
         cmocka_unit_test(test_implicit_sphere),
         cmocka_unit_test(test_settings_from_radiosity),

@@ -13,7 +13,10 @@
  * colour C reaches a particle with E/pi = C * att * cos^brilliance * V, where
  * att is the spot/cylinder/fade attenuation (gi_light_attenuation) and V the
  * visibility fraction traced by Embree on the host (area lights: the average
- * over the light's grid). The direct flux is phi_d = pi * (E/pi) * dA.
+ * over the light's grid). The host computes both when a light's geometry
+ * changes and passes their product vis = att * V (a colour change reuses it,
+ * and the kernel needs no pow for the spot's cos^tightness, slow on PoCL).
+ * The direct flux is phi_d = pi * (E/pi) * dA.
  *
  * Outputs per particle i (4 floats each, w unused):
  *   edir[i] = direct E/pi,
@@ -31,12 +34,11 @@ __kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global co
         if (!(v > 0.0f)) continue;
         __global const gi_dev_light *lt = &lights[l];
         float d[3];
-        float depth = gi_light_ray(lt, lt->pos[0], lt->pos[1], lt->pos[2], pt->p[0], pt->p[1], pt->p[2], d);
+        gi_light_ray(lt, lt->pos[0], lt->pos[1], lt->pos[2], pt->p[0], pt->p[1], pt->p[2], d);
         float ci = pt->n[0] * d[0] + pt->n[1] * d[1] + pt->n[2] * d[2];
         if (ci < 1e-10f) continue; /* the other side's particle takes it (shade.c: backside rule) */
-        float att = gi_light_attenuation(lt, pt->p[0], pt->p[1], pt->p[2], d, depth);
         float intensity = pt->brilliance != 1.0f ? pow(ci, pt->brilliance) : ci;
-        float w = att * intensity * v;
+        float w = intensity * v; /* v = att * V */
         for (int c = 0; c < 3; c++) e[c] += lt->colour[c] * w;
     }
     for (int c = 0; c < 3; c++) {
