@@ -10,7 +10,7 @@
 
 global_settings {
   assumed_gamma 1.0
-  radiosity { count 100 recursion_limit 3 error_bound 0.8 }
+  radiosity { count 400 recursion_limit 3 error_bound 0.8 }  // 200,000 particles
 }
 
 #ifndef (S) #declare S = 0.022; #end  // cell edge of the furniture grids

@@ -11,7 +11,7 @@
 
 global_settings {
   assumed_gamma 1.0
-  radiosity { count 100 recursion_limit 3 error_bound 0.8 }
+  radiosity { count 400 recursion_limit 3 error_bound 0.8 }  // 200,000 particles
 }
 
 #declare N = 16;      // cells per maze side
