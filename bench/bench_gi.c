@@ -5,7 +5,7 @@
  *
  *   bench_gi [SCENE.pov] [--size N] [--count N] [--nb N] [--threads N]
  *            [--device SPEC] [--reps N] [--out PREFIX] [--sweep] [--spp N] [--full]
- *            [--area-samples N]
+ *            [--area-samples N] [--ref REF.exr] [--ref-spp N]
  *
  * --full scatters along all links every bounce (GI_PARTICLE_SCATTER_FULL)
  * instead of the paper's random walks; --area-samples N caps the shadow rays
@@ -17,7 +17,10 @@
  * times with the image's mean against the first setting's.
  * --ref REF.exr (an image of the same size, e.g. a converged --gi path
  * render) adds the error of every frame against it: mean FLIP (HDR), RMSE
- * and the mean luminance relative to the reference's. */
+ * and the mean luminance relative to the reference's. A reference of another
+ * (square) size than --size gets one more frame of the same particles at its
+ * size with --ref-spp N eye samples per pixel (default --spp), compared with
+ * it (written as PREFIX_ref_particle.exr with --out). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,7 +40,7 @@
 
 typedef struct {
     const char *scene;
-    int size, threads, nb, reps, sweep, spp, full, area_samples;
+    int size, threads, nb, reps, sweep, spp, full, area_samples, ref_spp;
     long count;
     const char *device, *out, *ref;
 } opts;
@@ -196,7 +199,7 @@ static void sweep(const scene *sc, const accel *a, const opts *o, diag *d)
 
 int main(int argc, char **argv)
 {
-    opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 1, 0, -1, 50000, NULL, NULL, NULL};
+    opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 1, 0, -1, 0, 50000, NULL, NULL, NULL};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -209,6 +212,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--out") && v) { o.out = v; i++; }
         else if (!strcmp(a, "--sweep")) o.sweep = 1;
         else if (!strcmp(a, "--ref") && v) { o.ref = v; i++; }
+        else if (!strcmp(a, "--ref-spp") && v) { o.ref_spp = atoi(v); i++; }
         else if (!strcmp(a, "--spp") && v) { o.spp = atoi(v); i++; }
         else if (!strcmp(a, "--full")) o.full = 1;
         else if (!strcmp(a, "--area-samples") && v) { o.area_samples = atoi(v); i++; }
@@ -324,10 +328,15 @@ int main(int argc, char **argv)
     double *tn = calloc((size_t)o.reps, sizeof *tn), *tf = calloc((size_t)o.reps, sizeof *tf);
     double *tfl = calloc((size_t)o.reps, sizeof *tfl), *tfv = calloc((size_t)o.reps, sizeof *tfv);
     double *tfr = calloc((size_t)o.reps, sizeof *tfr);
+    double *cn = calloc((size_t)o.reps, sizeof *cn), *cf = calloc((size_t)o.reps, sizeof *cf);
     shade_stats ss;
     for (int r = 0; r < o.reps; r++) {
+        double c = cpu_now();
         tn[r] = render(sc, a, o.size, o.threads, NULL, fb_none, &ss, d);
+        cn[r] = cpu_now() - c;
+        c = cpu_now();
         tf[r] = gi_frame(sc, a, &o, gp, fb_gi, &tfl[r], &tfv[r], &tfr[r], d);
+        cf[r] = cpu_now() - c;
     }
     x = gi_particle_get_stats(gp);
     double mn = median(tn, o.reps), mf = median(tf, o.reps);
@@ -336,6 +345,8 @@ int main(int argc, char **argv)
            "found %ld radiance, used %ld area particles) + render %.1f; ratio %.2f\n",
            1e3 * mf, 1e3 * median(tfl, o.reps), 1e3 * median(tfv, o.reps), 1e3 * x->t_prepass, 1e3 * x->t_gather,
            1e3 * x->t_estimate, x->found, x->used, 1e3 * median(tfr, o.reps), mf / mn);
+    printf("  CPU time per frame (all threads, median): none %.1f ms, particle %.1f ms; ratio %.2f\n",
+           1e3 * median(cn, o.reps), 1e3 * median(cf, o.reps), median(cf, o.reps) / median(cn, o.reps));
     printf("  hook: %ld lookups, %ld late, %ld without particles, %ld discarded\n", x->lookups, x->lookups_late,
            x->lookups_none, x->discarded);
     printf("mean luminance: none %.5f, particle %.5f\n", mean_lum(fb_none), mean_lum(fb_gi));
@@ -343,6 +354,37 @@ int main(int argc, char **argv)
         double fl, rm, lu;
         if (ref_error(fb_gi, &fl, &rm, &lu, d))
             printf("against %s: mean FLIP %.4f, RMSE %.5f, mean luminance %+.2f%%\n", o.ref, fl, rm, 100.0 * lu);
+    }
+    if (g_ref && (g_ref->width != o.size || g_ref->height != o.size)) {
+        /* a reference of another size (a converged path render is affordable
+         * only small): one more frame of the same particles at its size,
+         * --ref-spp stratified eye samples per pixel, compared with it */
+        if (g_ref->width != g_ref->height) {
+            fprintf(stderr, "bench_gi: the reference %s is not square\n", o.ref);
+        } else {
+            opts oq = o;
+            oq.size = g_ref->width;
+            int keep = g_spp;
+            g_spp = o.ref_spp > 0 ? o.ref_spp : o.spp;
+            framebuffer *fq = fb_new(oq.size, oq.size);
+            double q1, q2, q3, cq = cpu_now();
+            double tq = gi_frame(sc, a, &oq, gp, fq, &q1, &q2, &q3, d);
+            cq = cpu_now() - cq;
+            double fl, rm, lu;
+            if (ref_error(fq, &fl, &rm, &lu, d))
+                printf("against %s (%dx%d frame, %d spp, %.2f s wall, %.2f s CPU): mean FLIP %.4f, RMSE %.5f, mean "
+                       "luminance %+.2f%%\n",
+                       o.ref, oq.size, oq.size, g_spp, tq, cq, fl, rm, 100.0 * lu);
+            if (o.out) {
+                char path[4096];
+                img_write_opts wo;
+                img_default_write_opts(&wo);
+                snprintf(path, sizeof path, "%s_ref_particle.exr", o.out);
+                img_write(path, fq, &wo, d);
+            }
+            g_spp = keep;
+            fb_free(fq);
+        }
     }
     if (o.out) {
         char path[4096];
@@ -363,6 +405,8 @@ int main(int argc, char **argv)
     free(tcpu);
     free(tn);
     free(tf);
+    free(cn);
+    free(cf);
     free(tfl);
     free(tfv);
     free(tfr);
