@@ -1,7 +1,8 @@
 #!/bin/sh
 # xc_look.sh - issue 5's measure: every POV-Ray 3.7 distribution example in
 # textures/, lights/, camera/ and interior/ (with their subdirectories;
-# camera/mesh_camera is issue 3's), and advanced/diffract.pov, rendered at 160x120 by partray and by
+# camera/mesh_camera is issue 3's), advanced/diffract.pov, incdemo/glasses/glass.pov and
+# qtvr/qtvrpanorama.pov (where installed), rendered at 160x120 by partray and by
 # povray, compared as scripts/xc_shapes.py does (mean absolute sRGB
 # difference after a 4x4 downsample, agreement <= 0.02; a scene counts as
 # supported when partray warns of nothing it skipped in it).
@@ -11,7 +12,10 @@
 # fraction of supported scenes that agree.
 here=$(dirname "$0")
 scenes=/usr/share/povray-3.7/scenes
-# examples elsewhere whose features issue 5 added (irid)
-extra="$scenes/advanced/diffract.pov"
+# examples elsewhere whose features issue 5 added (irid, dispersion) and
+# the panorama example Debian ships apart from the scenes
+extra="$scenes/advanced/diffract.pov $scenes/incdemo/glasses/glass.pov"
+qtvr=/usr/share/doc/povray/examples/qtvr/qtvrpanorama.pov
+[ -f "$qtvr" ] && extra="$extra $qtvr"
 list=$( (for d in textures lights camera interior; do find -L "$scenes/$d" -name '*.pov'; done | grep -v /mesh_camera/; echo "$extra") | sort)
 exec python3 "$here/xc_shapes.py" --out xc_look_out "$@" $list
