@@ -396,8 +396,9 @@ long gi_grid_radius(const gi_grid *g, vec3 q, vec3 nq, double r, double cos_thr,
  * [q - margin, q + margin] overlaps, which are the 2x2x2 block of cells
  * around the cell corner nearest to q. Cells are numbered with x fastest,
  * so the two cells of a block row are one contiguous run of entries: a
- * query reads 4 runs. Farther answers fall back to the hashed grid's ring
- * search.
+ * query reads 4 runs. Farther answers (up to 1.5 cells) come from the 16
+ * runs of the 4x4x4 block around the same corner, and beyond that from the
+ * hashed grid's ring search.
  *
  * Layout: every cell's entries are padded to whole blocks of LK_W stored as
  * structure-of-arrays (position and normal as floats, then the particle
@@ -409,7 +410,7 @@ long gi_grid_radius(const gi_grid *g, vec3 q, vec3 nq, double r, double cos_thr,
 #define LK_W 4
 typedef struct {
     float x[LK_W], y[LK_W], z[LK_W];
-    float nx[LK_W], ny[LK_W], nz[LK_W]; /* rounded to 1/127 as the hashed grid's */
+    float nx[LK_W], ny[LK_W], nz[LK_W]; /* unit normal */
     int idx[LK_W];                      /* particle of each slot, -1 for padding */
     int obj[LK_W];                      /* object id (gi_lookup_set_objects), -1 unknown */
 } lblock;
@@ -557,9 +558,13 @@ gi_lookup *gi_lookup_build(const gi_particles *ps, double cell)
         e->x[l] = p->p[0];
         e->y[l] = p->p[1];
         e->z[l] = p->p[2];
-        e->nx[l] = (float)lrintf(p->n[0] * 127.0f);
-        e->ny[l] = (float)lrintf(p->n[1] * 127.0f);
-        e->nz[l] = (float)lrintf(p->n[2] * 127.0f);
+        /* the particle's own unit normal, as the hashed grid's (was
+         * rounded to 127ths and stored unscaled, which made the
+         * near-plane test 127 times stricter and sent 2% of the cbox link
+         * queries to the ring search) */
+        e->nx[l] = p->n[0];
+        e->ny[l] = p->n[1];
+        e->nz[l] = p->n[2];
         e->idx[l] = i;
     }
     /* start[c + 1] is now the end of cell c's entries: round it up to the
@@ -595,16 +600,9 @@ long gi_lookup_cell(const gi_lookup *g, vec3 q)
     long c[3];
     double qq[3] = {q.x - g->origin.x, q.y - g->origin.y, q.z - g->origin.z};
     for (int k = 0; k < 3; k++) {
-        double f = qq[k] * g->inv, top = (double)g->dim[k];
-        long i;
-        if (!(f >= 0.5)) i = 0; /* also NaN */
-        else if (f >= top) i = g->dim[k] - 2;
-        else {
-            i = (long)f; /* floor: f >= 0 */
-            i -= f - (double)i < 0.5;
-            if (i > g->dim[k] - 2) i = g->dim[k] - 2;
-        }
-        c[k] = i;
+        /* floor(f - 1/2) clamped to [0, dim - 2]; t >= 0 converts by truncation */
+        double t = qq[k] * g->inv - 0.5, top = (double)(g->dim[k] - 2);
+        c[k] = !(t >= 0.0) ? 0 : (t >= top ? g->dim[k] - 2 : (long)t); /* NaN: 0 */
     }
     return (c[2] * g->dim[1] + c[1]) * g->dim[0] + c[0];
 }
@@ -645,54 +643,60 @@ int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 o
     return gi_lookup_nearest_in2(g, cell, q, dir, org, maxdist, NULL, NULL);
 }
 
-int gi_lookup_nearest_in2(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist, float nrm[3],
-                          int *obj)
+/* GCC/Clang vector extensions: 4 lanes (SSE2 on x86-64) */
+typedef float v4f __attribute__((vector_size(16)));
+typedef int v4i __attribute__((vector_size(16)));
+
+/* One query's broadcast operands and its running answer: per lane the
+ * nearest squared distance so far and its slot. */
+typedef struct {
+    v4f qx, qy, qz, dx, dy, dz, ox, oy, oz;
+    v4f best;
+    v4i slot;
+} lquery;
+
+/* Tests slots [k0, k1) (whole blocks) against q's filters (as
+ * gi_grid_nearest: the normal faces against the ray, the origin lies in
+ * front of the particle, the hit lies near its tangent plane), branch-free
+ * but for skipping blocks with no slot nearer than the best so far (the
+ * filters' comparisons are unpredictable); each lane keeps its first
+ * strictly nearest slot. */
+static inline __attribute__((always_inline)) void scan_run(const gi_lookup *g, int k0, int k1, lquery *q)
 {
-    if (obj) *obj = -2;
-    if (g->n == 0 || !v3_finite(q)) return -1;
-    float qx = (float)q.x, qy = (float)q.y, qz = (float)q.z;
-    float dx = (float)dir.x, dy = (float)dir.y, dz = (float)dir.z;
-    float ox = (float)org.x, oy = (float)org.y, oz = (float)org.z;
-    double m = fmin(g->margin, maxdist);
-    /* GCC/Clang vector extensions: 4 lanes (SSE2 on x86-64) */
-    typedef float v4f __attribute__((vector_size(16)));
-    typedef int v4i __attribute__((vector_size(16)));
-    float m2 = (float)(m * m);
-    v4f best = {m2, m2, m2, m2}, vqx = {qx, qx, qx, qx}, vqy = {qy, qy, qy, qy}, vqz = {qz, qz, qz, qz};
-    v4f vdx = {dx, dx, dx, dx}, vdy = {dy, dy, dy, dy}, vdz = {dz, dz, dz, dz};
-    v4f vox = {ox, ox, ox, ox}, voy = {oy, oy, oy, oy}, voz = {oz, oz, oz, oz}, zero = {0, 0, 0, 0};
-    v4f vnp = {NEAR_PLANE2, NEAR_PLANE2, NEAR_PLANE2, NEAR_PLANE2};
-    v4i vslot = {-1, -1, -1, -1}, lane = {0, 1, 2, 3};
-    long d0 = g->dim[0], d01 = g->dim[0] * g->dim[1];
-    long rows[4] = {cell, cell + d0, cell + d01, cell + d01 + d0};
-    /* the 4 runs in a fixed order, branch-free (the comparisons are
-     * unpredictable); each lane keeps its first strictly nearest slot */
-    for (int r = 0; r < 4; r++) {
-        int k1 = g->start[rows[r] + 2];
-        for (int k = g->start[rows[r]]; k < k1; k += LK_W) {
-            const lblock *e = &g->b[k / LK_W];
-            v4f x, y, z, nx, ny, nz;
-            memcpy(&x, e->x, sizeof x);
-            memcpy(&y, e->y, sizeof y);
-            memcpy(&z, e->z, sizeof z);
-            memcpy(&nx, e->nx, sizeof nx);
-            memcpy(&ny, e->ny, sizeof ny);
-            memcpy(&nz, e->nz, sizeof nz);
-            v4f ex = x - vqx, ey = y - vqy, ez = z - vqz;
-            v4f d2 = ex * ex + ey * ey + ez * ez;
-            v4f f = nx * vdx + ny * vdy + nz * vdz;
-            v4f hh = nx * (vox - x) + ny * (voy - y) + nz * (voz - z);
-            v4f pe = nx * ex + ny * ey + nz * ez;
-            v4i ok = (d2 < best) & (f < zero) & (hh > zero) & (pe * pe <= vnp * d2);
-            best = (v4f)(((v4i)d2 & ok) | ((v4i)best & ~ok));
-            vslot = ((lane + k) & ok) | (vslot & ~ok);
-        }
+    const v4f zero = {0, 0, 0, 0}, vnp = {NEAR_PLANE2, NEAR_PLANE2, NEAR_PLANE2, NEAR_PLANE2};
+    const v4i lane = {0, 1, 2, 3};
+    for (int k = k0; k < k1; k += LK_W) {
+        const lblock *e = &g->b[k / LK_W];
+        v4f x, y, z, nx, ny, nz;
+        memcpy(&x, e->x, sizeof x);
+        memcpy(&y, e->y, sizeof y);
+        memcpy(&z, e->z, sizeof z);
+        memcpy(&nx, e->nx, sizeof nx);
+        memcpy(&ny, e->ny, sizeof ny);
+        memcpy(&nz, e->nz, sizeof nz);
+        v4f ex = x - q->qx, ey = y - q->qy, ez = z - q->qz;
+        v4f d2 = ex * ex + ey * ey + ez * ez;
+        /* most slots of the block lie beyond the best so far (the block of
+         * cells is 4 margins wide): skip the filters then */
+        v4i near = d2 < q->best;
+        if (!(near[0] | near[1] | near[2] | near[3])) continue;
+        v4f f = nx * q->dx + ny * q->dy + nz * q->dz;
+        v4f hh = nx * (q->ox - x) + ny * (q->oy - y) + nz * (q->oz - z);
+        v4f pe = nx * ex + ny * ey + nz * ez;
+        v4i ok = near & (f < zero) & (hh > zero) & (pe * pe <= vnp * d2);
+        q->best = (v4f)(((v4i)d2 & ok) | ((v4i)q->best & ~ok));
+        q->slot = ((lane + k) & ok) | (q->slot & ~ok);
     }
+}
+
+/* The winning slot across lanes (nearest, ties to the earlier slot in scan
+ * order), -1 if none. */
+static int best_slot(const lquery *q)
+{
     float bl[LK_W];
     int sl[LK_W];
-    memcpy(bl, &best, sizeof bl);
-    memcpy(sl, &vslot, sizeof sl);
-    /* across lanes: nearest, ties to the earlier slot in scan order */
+    memcpy(bl, &q->best, sizeof bl);
+    memcpy(sl, &q->slot, sizeof sl);
     int bs = -1;
     float bd = 0.0f;
     for (int l = 0; l < LK_W; l++) {
@@ -702,15 +706,58 @@ int gi_lookup_nearest_in2(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 
             bd = bl[l];
         }
     }
+    return bs;
+}
+
+int gi_lookup_nearest_in2(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist, float nrm[3],
+                          int *obj)
+{
+    if (obj) *obj = -2;
+    if (g->n == 0 || !v3_finite(q)) return -1;
+    float qx = (float)q.x, qy = (float)q.y, qz = (float)q.z;
+    float dx = (float)dir.x, dy = (float)dir.y, dz = (float)dir.z;
+    float ox = (float)org.x, oy = (float)org.y, oz = (float)org.z;
+    double m = g->margin < maxdist ? g->margin : maxdist;
+    float m2 = (float)(m * m);
+    lquery Q = {{qx, qx, qx, qx}, {qy, qy, qy, qy}, {qz, qz, qz, qz}, {dx, dx, dx, dx}, {dy, dy, dy, dy},
+                {dz, dz, dz, dz}, {ox, ox, ox, ox}, {oy, oy, oy, oy}, {oz, oz, oz, oz}, {m2, m2, m2, m2},
+                {-1, -1, -1, -1}};
+    long d0 = g->dim[0], d01 = g->dim[0] * g->dim[1];
+    long rows[4] = {cell, cell + d0, cell + d01, cell + d01 + d0};
+    /* the 4 runs of the 2x2x2 block, in a fixed order */
+    for (int r = 0; r < 4; r++) scan_run(g, g->start[rows[r]], g->start[rows[r] + 2], &Q);
+    int bs = best_slot(&Q);
+    if (bs < 0 && maxdist > m && maxdist <= 1.5 * g->cell) {
+        /* nothing within the margin: the 4x4x4 block of cells around the
+         * same corner holds every particle within 1.5 cells of q (q lies
+         * within half a cell of that corner on every axis; the clamped
+         * block still holds every particle, which lie in cells 1..dim-2),
+         * so one scan of its 16 runs replaces the ring search (16K
+         * instructions a query on cbox, 2% of the link rays) */
+        float md2 = (float)(maxdist * maxdist);
+        Q.best = (v4f){md2, md2, md2, md2};
+        Q.slot = (v4i){-1, -1, -1, -1};
+        long cx = cell % d0, cy = (cell / d0) % g->dim[1], cz = cell / d01;
+        long x0 = cx > 0 ? cx - 1 : 0, x1 = cx + 2 < d0 ? cx + 2 : d0 - 1;
+        long y0 = cy > 0 ? cy - 1 : 0, y1 = cy + 2 < g->dim[1] ? cy + 2 : g->dim[1] - 1;
+        long z0 = cz > 0 ? cz - 1 : 0, z1 = cz + 2 < g->dim[2] ? cz + 2 : g->dim[2] - 1;
+        for (long z = z0; z <= z1; z++)
+            for (long y = y0; y <= y1; y++) {
+                long row = z * d01 + y * d0;
+                scan_run(g, g->start[row + x0], g->start[row + x1 + 1], &Q);
+            }
+        bs = best_slot(&Q);
+        if (bs < 0) return -1;
+    }
     if (bs >= 0) {
         /* the winner's rounded normal and object id ride in its block (no
          * second random read of the particle records) */
         const lblock *e = &g->b[bs / LK_W];
         int l = bs % LK_W;
         if (nrm) {
-            nrm[0] = e->nx[l] * (1.0f / 127.0f);
-            nrm[1] = e->ny[l] * (1.0f / 127.0f);
-            nrm[2] = e->nz[l] * (1.0f / 127.0f);
+            nrm[0] = e->nx[l];
+            nrm[1] = e->ny[l];
+            nrm[2] = e->nz[l];
         }
         if (obj) *obj = e->obj[l];
         return e->idx[l];

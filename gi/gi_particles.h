@@ -64,7 +64,8 @@ long gi_grid_radius(const gi_grid *g, vec3 q, vec3 nq, double r, double cos_thr,
  * cells (grown when the box would need more than 8 cells per particle),
  * each particle stored once in its cell (16 bytes); a query reads the
  * 2x2x2 cells around it, which hold every particle within cell/2; answers
- * farther than cell/2 come from a ring search in a hashed grid. */
+ * farther than cell/2 come from the 4x4x4 cells around it (within 1.5
+ * cells), farther ones from a ring search in a hashed grid. */
 typedef struct gi_lookup gi_lookup;
 gi_lookup *gi_lookup_build(const gi_particles *ps, double cell);
 void gi_lookup_free(gi_lookup *g);
@@ -81,8 +82,7 @@ int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 o
 pt_status gi_lookup_set_objects(gi_lookup *g, const void *const *pobj);
 /* The id of an object (-1: no particle of the lookup lies on it). */
 int gi_lookup_object_id(const gi_lookup *g, const void *obj);
-/* As gi_lookup_nearest_in, also giving the answer's normal (rounded to
- * 1/127) and object id, read from the lookup's own copy; *obj = -2 when
+/* As gi_lookup_nearest_in, also giving the answer's normal and object id, read from the lookup's own copy; *obj = -2 when
  * they are not known (the answer came from the ring search, or none). */
 int gi_lookup_nearest_in2(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist, float nrm[3],
                           int *obj);
