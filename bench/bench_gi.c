@@ -270,7 +270,10 @@ int main(int argc, char **argv)
            "lists %.3f, upload %.3f\n",
            gs.t_geometry, gs.t_surfaces, gs.t_sampling, gs.t_prune, gs.t_scatter_links, gs.t_gather_links, gs.t_lists,
            gs.t_upload);
-    printf("  CPU time %.3f s (all threads; kernel build included)\n", cpu_geom);
+    printf("  CPU time %.3f s (all threads; kernel build included): stage %.3f = pruning %.3f, 4x4 links %.3f, 16x16 "
+           "links %.3f, lists %.3f, rest %.3f\n",
+           cpu_geom, gs.c_geometry, gs.c_prune, gs.c_scatter_links, gs.c_gather_links, gs.c_lists,
+           gs.c_geometry - gs.c_prune - gs.c_scatter_links - gs.c_gather_links - gs.c_lists);
     printf("  particles %ld (candidates %ld, pruned %ld), spacing %.4f, tess %.4f, radius %.4f\n", gs.particles,
            gs.candidates, gs.pruned, gs.spacing, gs.tess, gs.radius);
     printf("  link rays %ld (%.1f%% miss, %.2f%% unresolved), radiance particles %ld, list entries %ld (%.1f per "
@@ -278,9 +281,13 @@ int main(int argc, char **argv)
            gs.link_rays, 100.0 * gs.link_misses / fmax(1, gs.link_rays), 100.0 * gs.link_unresolved / fmax(1, gs.link_rays),
            gs.radiance_particles, gs.list_entries, (double)gs.list_entries / fmax(1, gs.radiance_particles),
            gs.lists_widened, gs.lists_empty);
-    printf("  memory %.1f MiB: particles %.1f, links %.1f, lists %.1f, surfaces %.1f, device %.1f\n",
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    printf("  memory %.1f MiB: particles %.1f, links %.1f, lists %.1f, surfaces %.1f, device %.1f; peak RSS %.1f MiB "
+           "after the geometry stage\n",
            gs.bytes_total / 1048576.0, gs.bytes_particles / 1048576.0, gs.bytes_links / 1048576.0,
-           gs.bytes_lists / 1048576.0, gs.bytes_surfaces / 1048576.0, gs.bytes_device / 1048576.0);
+           gs.bytes_lists / 1048576.0, gs.bytes_surfaces / 1048576.0, gs.bytes_device / 1048576.0,
+           ru.ru_maxrss / 1024.0);
 
     /* lighting stage: median of reps (relighting reruns only this stage) */
     double *tl = calloc((size_t)o.reps, sizeof *tl), *tk = calloc((size_t)o.reps, sizeof *tk);

@@ -97,6 +97,9 @@ typedef struct {
     /* times, seconds */
     double t_geometry;      /* whole geometry stage (kernel build excluded) */
     double t_surfaces, t_sampling, t_prune, t_scatter_links, t_gather_links, t_lists, t_upload;
+    /* process CPU seconds (all threads) of the same stages: on a shared
+     * machine they say more than wall time */
+    double c_geometry, c_prune, c_scatter_links, c_gather_links, c_lists;
     double t_kernel_build;  /* OpenCL program build (PoCL caches it) */
     double t_lighting;      /* whole lighting stage */
     double t_visibility, t_emit, t_scatter;
