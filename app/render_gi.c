@@ -14,6 +14,7 @@
 #include "img_io.h"
 #include "pm_fg.h"
 #include "pm_path.h"
+#include "shade_texture.h"
 #include "timer.h"
 
 static void fill_shade(shade_settings *ss, const render_gi_opts *o)
@@ -60,6 +61,7 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
 {
     gi_particle_settings gs;
     gi_particle_settings_from_scene(&gs, sc);
+    gs.pigment = tex_pigment_at; /* particles reflect the pigment where they are */
     if (o->particles > 0) gs.count = o->particles;
     if (o->bounces > 0) gs.bounces = o->bounces;
     gs.seed = o->seed;

@@ -32,6 +32,7 @@
 #include "img_metrics.h"
 #include "sdl.h"
 #include "shade.h"
+#include "shade_texture.h"
 #include "timer.h"
 
 #ifndef BENCH_SCENE_DIR
@@ -154,6 +155,7 @@ static void sweep(const scene *sc, const accel *a, const opts *o, diag *d)
     for (int ci = 0; ci < 4; ci++) {
         gi_particle_settings s;
         gi_particle_settings_from_scene(&s, sc);
+        s.pigment = tex_pigment_at;
         s.count = counts[ci];
         s.threads = o->threads;
         s.cl_device = o->device;
@@ -250,6 +252,7 @@ int main(int argc, char **argv)
 
     gi_particle_settings s;
     gi_particle_settings_from_scene(&s, sc);
+    s.pigment = tex_pigment_at;
     s.count = o.count;
     s.bounces = o.nb;
     s.threads = o.threads;

@@ -184,14 +184,18 @@ static const void **particle_objects(const gi_particle *gp, const gi_particles *
     }
     for (int pa = 0; pa < np && ns < MAX_BURY_SOLIDS; pa++) {
         const scene_object *so = gi_surface_object(gp->surf, pa);
-        if (!so || (so->kind != SHAPE_SPHERE && so->kind != SHAPE_BOX) || (so->flags & OBJ_INVERSE)) continue;
+        if (!so || (so->kind != SHAPE_SPHERE && so->kind != SHAPE_BOX) || (so->flags & OBJ_INVERSE) ||
+            gi_surface_csg_member(gp->surf, pa))
+            continue;
         if (ns == 0 || solid[ns - 1] != so) solid[ns++] = so; /* a box's faces are consecutive patches */
     }
     for (int i = 0; i < n; i++) {
         const scene_object *so = gi_surface_object(gp->surf, ps->patch[i]);
         o[i] = so;
+        /* CSG members are not closed solids: the inside of a subtracted
+         * sphere is the outside of the result */
         (*pin)[i] = so && ps->side[i] == 1 && (so->kind == SHAPE_SPHERE || so->kind == SHAPE_BOX) &&
-                    !(so->flags & OBJ_INVERSE);
+                    !(so->flags & OBJ_INVERSE) && !gi_surface_csg_member(gp->surf, ps->patch[i]);
         const gi_dev_particle *t = &ps->p[i];
         vec3 p = v3(t->p[0], t->p[1], t->p[2]);
         double lift = 1e-5 * (1.0 + fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
@@ -362,14 +366,14 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     {
         gi_particles pilot;
         long pc = set->count / 4 > 500 ? set->count / 4 : 500;
-        st = gi_particles_sample(&pilot, gp->surf, a, sc, pc, set->seed ^ 0x9170ULL, gp->ambient_emits, NULL, d);
+        st = gi_particles_sample(&pilot, gp->surf, a, sc, pc, set->seed ^ 0x9170ULL, gp->ambient_emits, NULL, NULL, d);
         int *pl = NULL;
         if (st == PT_OK) st = trace_and_prune(gp, &pilot, set->seed ^ 0x5eedULL, &pl, NULL);
         free(pl);
         if (st == PT_OK) {
             /* pilot.patch/side now list the survivors; count them per side */
             gi_particles all;
-            st = gi_particles_sample(&all, gp->surf, a, sc, pc, set->seed ^ 0x9170ULL, gp->ambient_emits, NULL, d);
+            st = gi_particles_sample(&all, gp->surf, a, sc, pc, set->seed ^ 0x9170ULL, gp->ambient_emits, NULL, NULL, d);
             if (st == PT_OK) {
                 float *tot = xcalloc(2 * (size_t)np + 2, sizeof(float), &st);
                 if (tot) {
@@ -392,7 +396,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
 
     /* the area particles */
     tg = timer_now();
-    st = gi_particles_sample(&gp->ps, gp->surf, a, sc, set->count, set->seed, gp->ambient_emits, frac, d);
+    st = gi_particles_sample(&gp->ps, gp->surf, a, sc, set->count, set->seed, gp->ambient_emits, frac, set->pigment, d);
     free(frac);
     if (st != PT_OK) goto fail;
     S->candidates = gp->ps.n;

@@ -29,6 +29,11 @@
  * with the BRDF rho/pi and a light delivering E = pi*colour*cos converges
  * to the same image.
  *
+ * Reflectance of a particle: diffuse * pigment * opacity (gi_particles.h),
+ * the pigment evaluated at the particle's position when settings.pigment is
+ * set (the app passes shade's tex_pigment_at: checkers, image maps and
+ * texture maps reflect their own colours), else the texture's base colour.
+ *
  * What counts as emitted light: light_sources (every kind, with shade.c's
  * attenuation and shadow rays), finish emission, and finish ambient *
  * ambient_light when `ambient_emits` (default: when the scene has
@@ -59,6 +64,12 @@
 #include "scene.h"
 
 typedef struct gi_particle gi_particle;
+
+/* Pigment colour of texture `tex` at a surface point h (h->p, h->ng = h->ns,
+ * h->obj, h->texture): the signature of shade_texture.h's tex_pigment_at,
+ * which the app passes (gi does not link shade/). Returns 0 when no colour
+ * was found. */
+typedef int (*gi_pigment_fn)(const scene *sc, const scene_texture *tex, const accel_hit *h, colour5 *out);
 
 /* How flux is scattered after emission (gi_lighting.cl, gi_k_bounce; every
  * bounce a gather over incoming links, no atomics, deterministic):
@@ -91,6 +102,7 @@ typedef struct {
     const char *cl_device; /* NULL/"auto", "c", "P:D" or part of a name (gi_cl.h) */
     const char *cl_source; /* NULL: the built-in kernels; tests pass broken text here */
     size_t cl_max_bytes;   /* OpenCL device memory the GI may hold; 0 = the device's (gi_dev_options.max_bytes) */
+    gi_pigment_fn pigment; /* particles' pigment at their position; NULL: each texture's base colour */
 } gi_particle_settings;
 
 typedef struct {

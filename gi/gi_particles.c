@@ -17,11 +17,13 @@ static double frac(double x) { return x - floor(x); }
 /* POV-Ray's greyscale weights (as shade.c). */
 static double grey(double r, double g, double b) { return 0.297 * r + 0.589 * g + 0.114 * b; }
 
-static void material(const scene *sc, const scene_texture *tex, int ambient_emits, gi_dev_particle *p)
+/* c: the pigment (NULL: the texture's base colour). */
+static void material(const scene *sc, const scene_texture *tex, const colour5 *c, int ambient_emits,
+                     gi_dev_particle *p)
 {
     if (!tex) tex = &sc->default_texture;
     const scene_finish *f = &tex->finish;
-    const colour5 *c = &tex->pigment.colour;
+    if (!c) c = &tex->pigment.colour;
     double tr = c->f * c->r + c->t, tg = c->f * c->g + c->t, tb = c->f * c->b + c->t;
     double opacity = 1.0 - fmin(1.0, fmax(0.0, grey(tr, tg, tb)));
     double pig[3] = {c->r, c->g, c->b};
@@ -86,14 +88,15 @@ static int probe_ok(const accel *a, const scene_object *o, vec3 pos, vec3 nrm)
 }
 
 pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel *a, const scene *sc, long count,
-                              uint64_t seed, int ambient_emits, const float *side_frac, diag *d)
+                              uint64_t seed, int ambient_emits, const float *side_frac, gi_pigment_fn pig, diag *d)
 {
     memset(ps, 0, sizeof *ps);
     int np = gi_surface_npatches(g);
     double total = 0.0;
     for (int i = 0; i < np; i++)
         for (int s = 0; s < gi_surface_sides(g, i); s++)
-            total += gi_surface_area(g, i) * (side_frac ? side_frac[2 * i + s] : 1.0);
+            if (gi_surface_side_mask(g, i) >> s & 1)
+                total += gi_surface_area(g, i) * (side_frac ? side_frac[2 * i + s] : 1.0);
     if (count < 1) count = 1;
     if (!(total > 0.0)) return PT_OK;
     double density = (double)count / total;
@@ -120,22 +123,40 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
         gi_dev_particle proto;
         memset(&proto, 0, sizeof proto);
         proto.area = (float)ps->dA;
-        material(sc, gi_surface_texture(g, i), ambient_emits, &proto);
-        int probe = gi_surface_probe(g, i);
+        const scene_texture *tex = gi_surface_texture(g, i);
+        if (!tex) tex = &sc->default_texture;
+        material(sc, tex, NULL, ambient_emits, &proto);
+        int probe = gi_surface_probe(g, i), mask = gi_surface_side_mask(g, i);
         long got = 0, tries = 0, limit = 64 * m + 64;
         for (long q = 0; got < m && tries < limit; q++, tries++) {
             double u = frac(su + (double)q * R2_A1), v = frac(sv + (double)q * R2_A2);
             vec3 pos, nrm;
             if (!gi_surface_sample(g, i, u, v, &pr, &pos, &nrm)) continue;
             got++;
+            gi_dev_particle mat = proto;
+            if (pig) {
+                /* the pigment where the particle is (a checker floor reflects its checks) */
+                accel_hit h;
+                memset(&h, 0, sizeof h);
+                h.p = pos;
+                h.ng = h.ns = nrm;
+                h.obj = o;
+                h.texture = tex;
+                h.flags = o->flags;
+                colour5 c;
+                if (pig(sc, tex, &h, &c) && isfinite(c.r) && isfinite(c.g) && isfinite(c.b) && isfinite(c.f) &&
+                    isfinite(c.t))
+                    material(sc, tex, &c, ambient_emits, &mat);
+            }
             for (int s = 0; s < sides; s++) {
                 if (side_frac && side_frac[2 * i + s] <= 0.0f) continue;
+                if (!(mask >> s & 1)) continue;
                 vec3 nn = s ? v3_neg(nrm) : nrm;
                 if (probe && !probe_ok(a, o, pos, nn)) {
                     ps->probed_out++;
                     continue;
                 }
-                gi_dev_particle p = proto;
+                gi_dev_particle p = mat;
                 p.p[0] = (float)pos.x;
                 p.p[1] = (float)pos.y;
                 p.p[2] = (float)pos.z;

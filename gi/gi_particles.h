@@ -7,6 +7,7 @@
 #define PT_GI_PARTICLES_H
 #include <stdint.h>
 #include "accel.h"
+#include "gi_particle.h"
 #include "gi_surface.h"
 #include "kernels/gi_types.h"
 
@@ -29,9 +30,11 @@ typedef struct {
  * is set so that about `count` are kept, and sides of fraction 0 get none.
  * Materials:
  * rho = diffuse * pigment * opacity, le = pigment * (emission + [ambient *
- * ambient_light if ambient_emits]) * opacity, as shade.c's terms. */
+ * ambient_light if ambient_emits]) * opacity, as shade.c's terms; the
+ * pigment is `pig`'s at the particle (patterns, image maps, texture maps),
+ * or with pig NULL the texture's base colour. */
 pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel *a, const scene *sc, long count,
-                              uint64_t seed, int ambient_emits, const float *side_frac, diag *d);
+                              uint64_t seed, int ambient_emits, const float *side_frac, gi_pigment_fn pig, diag *d);
 /* Keep the particles with keep[i] != 0, in order. */
 pt_status gi_particles_compact(gi_particles *ps, const unsigned char *keep);
 void gi_particles_free(gi_particles *ps);

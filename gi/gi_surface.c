@@ -3,12 +3,14 @@
 #include <math.h>
 #include "accel_shapes.h"
 #include "accel_surface.h"
+#include "accel_tess.h"
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* PATCH_PIECE: a surface sampled through accel_surface (cylinders, cones,
- * tori) that has particles but no radiance particles. */
+/* PATCH_PIECE: a surface sampled through accel_surface (or, as a member of
+ * CSG, by its own Crofton sampler); the implicit shapes among them get
+ * radiance particles at the vertices of a marching-tetrahedra grid (mesh). */
 enum { PATCH_TRI = 0, PATCH_SPHERE = 1, PATCH_DISC = 2, PATCH_PIECE = 3 };
 
 typedef struct {
@@ -32,7 +34,34 @@ typedef struct {
     int npieces;      /* PIECE: consecutive accel_surface pieces of the object */
     long cdf0;        /* PIECE with npieces > 1: their cumulative areas at cdf[cdf0..] */
     const scene_texture *tex;
+    unsigned char mask; /* sides that get particles (bit s: side s); CSG members: the visible one */
+    int cnode;        /* CSG member: its node (csg_node), -1 otherwise */
+    /* PIECE: the shape (for its grid) and, for CSG members, its own sampler */
+    accel_shape *sh;
+    int own_sh;
+    struct keep_sampler *ks;
+    /* PIECE with a grid: vertices mv[vfirst .. vfirst + rp_count), triangles mt[tfirst .. tfirst + nt) */
+    long vfirst, tfirst, nt;
+    double cell;      /* locate hash cell */
 } patch;
+
+/* CSG trees of members with particles: node kids are consecutive. */
+typedef struct {
+    const scene_object *o;
+    int parent, first, nkids;
+    accel_shape *sh;  /* leaves: their shape (NULL: no inside) */
+} csg_node;
+
+typedef struct keep_sampler {
+    accel_tess_sampler cs;
+    const struct gi_surface *g;
+    int node;
+} keep_sampler;
+
+typedef struct {
+    uint64_t key;
+    long tri;
+} cell_entry;
 
 typedef struct {
     const scene_object *obj;
@@ -57,6 +86,19 @@ struct gi_surface {
     accel_surf *as;   /* area sampling shared with reference/ (accel_surface.h) */
     double *cdf;      /* PIECE patches of several pieces (polygons, height fields) */
     long ncdf, capcdf;
+    csg_node *cn;     /* CSG trees (csg_keep) */
+    int ncn, capcn;
+    int cur_node;     /* while walking CSG members: the member's node, else -1 */
+    unsigned char cur_mask;
+    /* grids of implicit shapes (PIECE patches): world vertices and normals,
+     * triangles (local vertex indices), and the locate hash (sorted cells) */
+    vec3 *mv, *mn;
+    long nmv, capmv;
+    int (*mt)[3];
+    int *mtp;         /* patch of each triangle */
+    long nmt, capmt;
+    cell_entry *ce;
+    long nce;
 };
 
 static void layout(gi_surface *g);
@@ -135,6 +177,141 @@ static double det3(const xform *x)
            m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
 }
 
+/* ------------------------------------------------------------ CSG members
+ *
+ * A member of merge, intersection or difference has particles only where
+ * its surface is the CSG result's surface: POV-Ray's rule (as accel_csg.h),
+ * applied at every level from the member up to the root: intersection keeps
+ * a point inside all siblings, merge outside all of them, difference the
+ * first member's points outside all the others and a subtracted member's
+ * inside the first and outside the rest; union keeps everything. Inside
+ * tests are the members' own (accel_shape_inside, POV-Ray's Inside_Object:
+ * union/merge any, intersection all, difference the first and none of the
+ * others, inverse negating). */
+
+static int add_cnode(gi_surface *g, const scene_object *o, int parent)
+{
+    if (g->ncn == g->capcn) {
+        int nc = g->capcn ? 2 * g->capcn : 64;
+        csg_node *nn = realloc(g->cn, (size_t)nc * sizeof *nn);
+        if (!nn) return -1;
+        g->cn = nn;
+        g->capcn = nc;
+    }
+    csg_node *c = &g->cn[g->ncn];
+    memset(c, 0, sizeof *c);
+    c->o = o;
+    c->parent = parent;
+    c->first = -1;
+    return g->ncn++;
+}
+
+static int is_csg_kind(shape_kind k)
+{
+    return k == SHAPE_UNION || k == SHAPE_MERGE || k == SHAPE_INTERSECTION || k == SHAPE_DIFFERENCE;
+}
+
+/* Kids of node `at` (a CSG object), consecutive, then their subtrees. */
+static pt_status build_cnodes(gi_surface *g, int at, int depth)
+{
+    const scene_object *o = g->cn[at].o;
+    if (depth > 512) return PT_ERR_LIMIT;
+    int first = g->ncn;
+    for (int i = 0; i < o->u.csg.nkids; i++)
+        if (add_cnode(g, o->u.csg.kids[i], at) < 0) return PT_ERR_NOMEM;
+    g->cn[at].first = first;
+    g->cn[at].nkids = o->u.csg.nkids;
+    for (int i = 0; i < o->u.csg.nkids; i++) {
+        const scene_object *k = o->u.csg.kids[i];
+        if (is_csg_kind(k->kind)) {
+            pt_status st = build_cnodes(g, first + i, depth + 1);
+            if (st != PT_OK) return st;
+        } else {
+            accel_shape *sh = malloc(sizeof *sh);
+            if (!sh) return PT_ERR_NOMEM;
+            if (accel_shape_init(sh, k) != 0) {
+                free(sh);
+                continue;
+            }
+            g->cn[first + i].sh = sh;
+        }
+    }
+    return PT_OK;
+}
+
+static int csg_inside(const gi_surface *g, int node, vec3 p)
+{
+    const csg_node *c = &g->cn[node];
+    int in = 0;
+    switch (c->o->kind) {
+    case SHAPE_UNION: case SHAPE_MERGE:
+        for (int i = 0; i < c->nkids && !in; i++) in = csg_inside(g, c->first + i, p);
+        break;
+    case SHAPE_INTERSECTION:
+        in = c->nkids > 0;
+        for (int i = 0; i < c->nkids && in; i++) in = csg_inside(g, c->first + i, p);
+        break;
+    case SHAPE_DIFFERENCE:
+        in = c->nkids > 0 && csg_inside(g, c->first, p);
+        for (int i = 1; i < c->nkids && in; i++) in = !csg_inside(g, c->first + i, p);
+        break;
+    default:
+        in = c->sh ? accel_shape_inside(c->sh, p) : 0;
+        break;
+    }
+    return (c->o->flags & OBJ_INVERSE) ? !in : in;
+}
+
+/* Is world point p (on the surface of member `node`) on the CSG result's surface? */
+static int csg_keep(const gi_surface *g, int node, vec3 p)
+{
+    for (int n = node; g->cn[n].parent >= 0; n = g->cn[n].parent) {
+        const csg_node *P = &g->cn[g->cn[n].parent];
+        int i = n - P->first;
+        shape_kind op = P->o->kind;
+        if (op == SHAPE_UNION) continue;
+        for (int j = 0; j < P->nkids; j++) {
+            if (j == i) continue;
+            int in = csg_inside(g, P->first + j, p);
+            int need_in = op == SHAPE_INTERSECTION || (op == SHAPE_DIFFERENCE && i > 0 && j == 0);
+            if (in != need_in) return 0;
+        }
+    }
+    return 1;
+}
+
+/* The side of member `node` that faces out of the result: 1 (its inside)
+ * when it is inverse, or subtracted in a difference, or under an inverse
+ * CSG an odd number of times in all. */
+static int csg_flip(const gi_surface *g, int node)
+{
+    int flip = (g->cn[node].o->flags & OBJ_INVERSE) != 0;
+    for (int n = node; g->cn[n].parent >= 0; n = g->cn[n].parent) {
+        const csg_node *P = &g->cn[g->cn[n].parent];
+        if (P->o->kind == SHAPE_DIFFERENCE && n - P->first > 0) flip ^= 1;
+        if (P->o->flags & OBJ_INVERSE) flip ^= 1;
+    }
+    return flip;
+}
+
+static int keep_fn(void *ctx, vec3 p)
+{
+    const keep_sampler *k = ctx;
+    return csg_keep(k->g, k->node, p);
+}
+
+/* A CSG member's sides: both exist, particles go on the one facing out of
+ * the result (cur_mask); triangles have no inside and keep both. */
+static void member_sides(const gi_surface *g, patch *p)
+{
+    p->cnode = g->cur_node;
+    p->mask = 3;
+    if (g->cur_node < 0 || p->nsides == 0) return;
+    shape_kind k = g->o[p->obj].kind;
+    p->nsides = 2;
+    if (k != SHAPE_TRIANGLE && k != SHAPE_SMOOTH_TRIANGLE && k != SHAPE_MESH) p->mask = g->cur_mask;
+}
+
 /* Add a world triangle patch; skips degenerate ones. */
 static int add_tri(gi_surface *g, int obj, vec3 a, vec3 b, vec3 c, vec3 front, int nsides, int probe,
                    const scene_texture *tex)
@@ -156,6 +333,7 @@ static int add_tri(gi_surface *g, int obj, vec3 a, vec3 b, vec3 c, vec3 front, i
     p.probe = (unsigned char)probe;
     p.obj = obj;
     p.tex = tex;
+    member_sides(g, &p);
     set_resolution(g, &p);
     if (add_patch(g, &p) < 0) return -1;
     g->o[obj].count++;
@@ -202,6 +380,7 @@ static double grid_jac(const gi_surface *g, const patch *p, double u, double v)
 /* Sub-tessellation / grid resolution from the tessellation bound. */
 static void set_resolution(const gi_surface *g, patch *p)
 {
+    if (p->kind == PATCH_PIECE) return; /* rp_count: its grid's vertices (build_meshes) */
     if (p->kind == PATCH_TRI) {
         if (p->nsides == 0) return;
         double k = ceil(p->lu / g->tess);
@@ -395,6 +574,83 @@ static int piece_sides(const gi_surface *g, const scene_object *o)
     return sides;
 }
 
+/* Shapes whose radiance particles are the vertices of their grid
+ * (accel_shape_grid: marching tetrahedra, vertices on the exact surface;
+ * superellipsoids their own parametric grid). */
+static int has_grid(shape_kind k)
+{
+    switch (k) {
+    case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE: case SHAPE_JULIA:
+    case SHAPE_SUPERELLIPSOID: case SHAPE_OVUS:
+        return 1;
+    default: return 0;
+    }
+}
+
+static void free_patch(patch *p)
+{
+    if (p->sh && p->own_sh == 1) accel_shape_release(p->sh);
+    if (p->own_sh) free(p->sh);
+    p->sh = NULL;
+    free(p->ks);
+    p->ks = NULL;
+}
+
+/* A PIECE-kind member of CSG (cur_node): sampled by Crofton lines over its
+ * own shape, keeping the crossings on the result's surface. */
+static pt_status add_member_piece(gi_surface *g, const scene_object *o, const scene_texture *tex)
+{
+    const accel_shape *nsh = g->cn[g->cur_node].sh;
+    if (!nsh) {
+        g->skipped++;
+        diag_warn_once(g->d, o->loc, "particle GI: no particles on %s objects in CSG (they get no indirect light)",
+                       o->name ? o->name : "these");
+        return PT_OK;
+    }
+    patch p;
+    memset(&p, 0, sizeof p);
+    p.kind = PATCH_PIECE;
+    p.piece = -1;
+    p.tex = tex;
+    p.nsides = 2;
+    p.mask = g->cur_mask;
+    p.cnode = g->cur_node;
+    /* a copy of the node's shape (which keeps serving the inside tests)
+     * that may be clipped; its data stays the node's */
+    p.sh = malloc(sizeof *p.sh);
+    p.ks = malloc(sizeof *p.ks);
+    if (!p.sh || !p.ks) {
+        free(p.sh);
+        free(p.ks);
+        return PT_ERR_NOMEM;
+    }
+    *p.sh = *nsh;
+    p.own_sh = 2;
+    if (p.sh->infinite) accel_shape_clip_plane(p.sh, g->lo, g->hi);
+    p.ks->g = g;
+    p.ks->node = g->cur_node;
+    /* accel_surface's accuracy for its own Crofton shapes: 0.1%, 65536 lines */
+    double area = accel_tess_sampler_init(&p.ks->cs, p.sh, keep_fn, p.ks, 1e-3, 65536);
+    if (!(area > 0.0) || !isfinite(area)) {
+        /* nothing of it is on the result's surface */
+        free_patch(&p);
+        return PT_OK;
+    }
+    p.area = area;
+    int obj = add_obj(g, o);
+    if (obj < 0) {
+        free_patch(&p);
+        return PT_ERR_NOMEM;
+    }
+    p.obj = obj;
+    if (add_patch(g, &p) < 0) {
+        free_patch(&p);
+        return PT_ERR_NOMEM;
+    }
+    g->o[obj].count++;
+    return PT_OK;
+}
+
 static pt_status add_leaf(gi_surface *g, const scene_object *o, const scene_texture *tex, int probe)
 {
     int two = 2;
@@ -411,10 +667,13 @@ static pt_status add_leaf(gi_surface *g, const scene_object *o, const scene_text
          * cylinders, cones, tori; polygons and height fields (their
          * triangles); lathe, sor, prism, text; and the implicit shapes
          * (quadric, poly, blob, isosurface, julia_fractal, ovus,
-         * superellipsoid) by Crofton lines (accel_tess.h). Area particles,
-         * no radiance particles: the hook estimates at the hit. */
+         * superellipsoid) by Crofton lines (accel_tess.h). Area particles;
+         * radiance particles on the implicit shapes' grids (build_mesh);
+         * the others are estimated at the hit. CSG members: their own
+         * Crofton sampler keeping only the result's surface (csg_keep). */
+        if (g->cur_node >= 0) return add_member_piece(g, o, tex);
         int first = -1, count = 0;
-        if (!probe) piece_range(g, o, &first, &count);
+        piece_range(g, o, &first, &count);
         double area = 0.0;
         for (int i = 0; i < count; i++) area += accel_surf_piece_at(g->as, first + i)->area;
         if (!(area > 0.0) || !isfinite(area)) break;
@@ -449,7 +708,23 @@ static pt_status add_leaf(gi_surface *g, const scene_object *o, const scene_text
         p.area = area;
         p.tex = tex;
         p.nsides = (unsigned char)piece_sides(g, o);
-        if (add_patch(g, &p) < 0) return PT_ERR_NOMEM;
+        p.mask = 3;
+        p.cnode = -1;
+        if (has_grid(o->kind)) {
+            p.sh = malloc(sizeof *p.sh);
+            if (!p.sh) return PT_ERR_NOMEM;
+            if (accel_shape_init(p.sh, o) != 0) {
+                free(p.sh);
+                p.sh = NULL;
+            } else {
+                p.own_sh = 1;
+                if (p.sh->infinite) accel_shape_clip_plane(p.sh, g->lo, g->hi);
+            }
+        }
+        if (add_patch(g, &p) < 0) {
+            free_patch(&p);
+            return PT_ERR_NOMEM;
+        }
         g->o[obj].count++;
         return PT_OK;
     }
@@ -495,6 +770,8 @@ static pt_status add_leaf(gi_surface *g, const scene_object *o, const scene_text
                 p.k = 1;
                 p.nsides = 0;
                 p.tex = tt;
+                p.cnode = -1;
+                p.mask = 3;
                 if (add_patch(g, &p) < 0) return PT_ERR_NOMEM;
                 g->o[obj].count++;
             }
@@ -531,11 +808,53 @@ static pt_status add_leaf(gi_surface *g, const scene_object *o, const scene_text
             p.nsides = 2;
         }
         if (!finish_grid(g, obj, &p)) return PT_OK;
+        member_sides(g, &p);
         p.piece = probe || !g->as ? -1 : accel_surf_find(g->as, o, ACCEL_SURF_ANY);
         if (add_patch(g, &p) < 0) return PT_ERR_NOMEM;
         g->o[obj].count++;
     }
     return PT_OK;
+}
+
+static int has_mesh_member(const scene_object *o, int depth)
+{
+    if (!o || depth > 512) return 0;
+    if (o->kind == SHAPE_MESH) return 1;
+    if (!is_csg_kind(o->kind)) return 0;
+    for (int i = 0; i < o->u.csg.nkids; i++)
+        if (has_mesh_member(o->u.csg.kids[i], depth + 1)) return 1;
+    return 0;
+}
+
+static long leaf_count(const scene_object *o, int depth)
+{
+    if (!o || depth > 512) return 0;
+    if (!is_csg_kind(o->kind)) return 1;
+    long n = 0;
+    for (int i = 0; i < o->u.csg.nkids; i++) n += leaf_count(o->u.csg.kids[i], depth + 1);
+    return n;
+}
+
+/* Members of a CSG tree built by build_cnodes; both: the camera or a light
+ * is inside the result, so the members get both sides. */
+static pt_status walk_member(gi_surface *g, int node, const scene_texture *tex, int both)
+{
+    const scene_object *o = g->cn[node].o;
+    if (o->texture) tex = o->texture;
+    if (o->flags & OBJ_NO_RADIOSITY) return PT_OK;
+    if (is_csg_kind(o->kind)) {
+        int first = g->cn[node].first, nk = g->cn[node].nkids;
+        for (int i = 0; i < nk; i++) {
+            pt_status st = walk_member(g, first + i, tex, both);
+            if (st != PT_OK) return st;
+        }
+        return PT_OK;
+    }
+    g->cur_node = node;
+    g->cur_mask = both ? 3 : (unsigned char)(1u << csg_flip(g, node));
+    pt_status st = add_leaf(g, o, tex, 1);
+    g->cur_node = -1;
+    return st;
 }
 
 static pt_status walk(gi_surface *g, const scene_object *o, const scene_texture *tex, int probe)
@@ -547,9 +866,24 @@ static pt_status walk(gi_surface *g, const scene_object *o, const scene_texture 
     case SHAPE_MERGE:
     case SHAPE_INTERSECTION:
     case SHAPE_DIFFERENCE: {
-        int pr = probe || o->kind != SHAPE_UNION;
+        /* accel renders CSG with a mesh member, and merges of more than 64
+         * members, as unions (accel.c) */
+        if (o->kind != SHAPE_UNION && !has_mesh_member(o, 0) && !(o->kind == SHAPE_MERGE && leaf_count(o, 0) > 64)) {
+            int root = add_cnode(g, o, -1);
+            if (root < 0) return PT_ERR_NOMEM;
+            pt_status st = build_cnodes(g, root, 0);
+            if (st != PT_OK) return st;
+            const scene *s = g->sc;
+            int both = s->camera_set && csg_inside(g, root, s->camera.location);
+            for (int i = 0; i < s->nlights && !both; i++) both = csg_inside(g, root, s->lights[i].position);
+            for (int i = 0; i < g->cn[root].nkids; i++) {
+                st = walk_member(g, g->cn[root].first + i, tex, both);
+                if (st != PT_OK) return st;
+            }
+            return PT_OK;
+        }
         for (int i = 0; i < o->u.csg.nkids; i++) {
-            pt_status st = walk(g, o->u.csg.kids[i], tex, pr);
+            pt_status st = walk(g, o->u.csg.kids[i], tex, probe);
             if (st != PT_OK) return st;
         }
         return PT_OK;
@@ -566,6 +900,7 @@ gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *
     if (!g) { *status = PT_ERR_NOMEM; return NULL; }
     g->sc = s;
     g->d = d;
+    g->cur_node = -1;
     g->tess = tess > 0.0 ? tess : 1.0;
     accel_bounds(a, &g->lo, &g->hi);
     if (!(g->lo.x <= g->hi.x) || v3_len(v3_sub(g->hi, g->lo)) <= 0.0) {
@@ -613,8 +948,295 @@ gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *
     return g;
 }
 
+/* ------------------------------------------------------------ grids of implicit shapes */
+
+typedef struct {
+    gi_surface *g;
+    int pi;
+    const accel_shape *sh;
+    long *vh;         /* vertex hash: global vertex index, -1 empty */
+    long vcap;
+    int oom;
+} mesh_ctx;
+
+static uint64_t vkey(vec3 p)
+{
+    uint64_t a, b, c;
+    memcpy(&a, &p.x, 8);
+    memcpy(&b, &p.y, 8);
+    memcpy(&c, &p.z, 8);
+    return ptr_hash((const void *)(uintptr_t)(a ^ ptr_hash((const void *)(uintptr_t)(b ^ ptr_hash((const void *)(uintptr_t)c)))));
+}
+
+static int mesh_grow_v(gi_surface *g)
+{
+    if (g->nmv < g->capmv) return 1;
+    long nc = g->capmv ? 2 * g->capmv : 4096;
+    vec3 *nv = realloc(g->mv, (size_t)nc * sizeof *nv);
+    if (!nv) return 0;
+    g->mv = nv;
+    vec3 *nn = realloc(g->mn, (size_t)nc * sizeof *nn);
+    if (!nn) return 0;
+    g->mn = nn;
+    g->capmv = nc;
+    return 1;
+}
+
+/* Global index of the vertex at world point w (shared by the triangles
+ * around it: the grid computes each lattice-edge crossing once). */
+static long mesh_vertex(mesh_ctx *m, vec3 w, vec3 n)
+{
+    gi_surface *g = m->g;
+    long first = g->p[m->pi].vfirst, used = g->nmv - first;
+    if (2 * (used + 1) > m->vcap) {
+        long nc = m->vcap ? 2 * m->vcap : 1024;
+        long *nh = malloc((size_t)nc * sizeof *nh);
+        if (!nh) return -1;
+        for (long i = 0; i < nc; i++) nh[i] = -1;
+        for (long v = first; v < g->nmv; v++) {
+            long h = (long)(vkey(g->mv[v]) & (uint64_t)(nc - 1));
+            while (nh[h] >= 0) h = (h + 1) & (nc - 1);
+            nh[h] = v;
+        }
+        free(m->vh);
+        m->vh = nh;
+        m->vcap = nc;
+    }
+    long h = (long)(vkey(w) & (uint64_t)(m->vcap - 1));
+    while (m->vh[h] >= 0) {
+        vec3 q = g->mv[m->vh[h]];
+        if (q.x == w.x && q.y == w.y && q.z == w.z) return m->vh[h];
+        h = (h + 1) & (m->vcap - 1);
+    }
+    if (!mesh_grow_v(g)) return -1;
+    g->mv[g->nmv] = w;
+    g->mn[g->nmv] = n;
+    m->vh[h] = g->nmv;
+    return g->nmv++;
+}
+
+static int mesh_tri(void *ctx, const vec3 p[3], const vec3 n[3])
+{
+    mesh_ctx *m = ctx;
+    gi_surface *g = m->g;
+    const patch *pp = &g->p[m->pi];
+    vec3 w[3], nw[3];
+    for (int k = 0; k < 3; k++) {
+        w[k] = m->sh->identity ? p[k] : xform_point(&m->sh->x, p[k]);
+        nw[k] = v3_norm(m->sh->identity ? n[k] : xform_normal(&m->sh->x, n[k]));
+        if (!v3_finite(w[k]) || !v3_finite(nw[k])) return 1;
+    }
+    if (pp->cnode >= 0) {
+        /* CSG members: the triangles touching the result's surface */
+        int keep = 0;
+        for (int k = 0; k < 3 && !keep; k++) keep = csg_keep(g, pp->cnode, w[k]);
+        if (!keep) return 1;
+    }
+    if (g->nmt == g->capmt) {
+        long nc = g->capmt ? 2 * g->capmt : 4096;
+        int (*nt)[3] = realloc(g->mt, (size_t)nc * sizeof *nt);
+        if (!nt) { m->oom = 1; return 0; }
+        g->mt = nt;
+        int *ntp = realloc(g->mtp, (size_t)nc * sizeof *ntp);
+        if (!ntp) { m->oom = 1; return 0; }
+        g->mtp = ntp;
+        g->capmt = nc;
+    }
+    for (int k = 0; k < 3; k++) {
+        long v = mesh_vertex(m, w[k], nw[k]);
+        if (v < 0) { m->oom = 1; return 0; }
+        g->mt[g->nmt][k] = (int)(v - pp->vfirst);
+    }
+    g->mtp[g->nmt] = m->pi;
+    g->nmt++;
+    return 1;
+}
+
+static uint64_t cell_key(int pi, long ix, long iy, long iz)
+{
+    uint64_t h = ptr_hash((const void *)(uintptr_t)((uint64_t)(unsigned)pi * 0x9e3779b97f4a7c15ULL ^ (uint64_t)ix));
+    h = ptr_hash((const void *)(uintptr_t)(h ^ (uint64_t)iy * 0xc2b2ae3d27d4eb4fULL));
+    return ptr_hash((const void *)(uintptr_t)(h ^ (uint64_t)iz * 0x165667b19e3779f9ULL));
+}
+
+static int cmp_cell(const void *a, const void *b)
+{
+    const cell_entry *x = a, *y = b;
+    if (x->key != y->key) return x->key < y->key ? -1 : 1;
+    return (x->tri > y->tri) - (x->tri < y->tri);
+}
+
+/* Grids for the PIECE patches with a shape (implicit shapes) at the
+ * tessellation bound: n lattice cells along the longest side of the
+ * shape's world bounds, n = ceil(extent / tess) within [2, 128]; then the
+ * locate hash (each triangle in the cells its box, widened by a quarter
+ * cell, touches). Patches whose grid fails keep rp_count 0 (estimated at
+ * the hit, as before). */
+static void build_meshes(gi_surface *g)
+{
+    g->nmv = g->nmt = 0;
+    free(g->ce);
+    g->ce = NULL;
+    g->nce = 0;
+    if (!(g->tess < 1e29)) {
+        for (int i = 0; i < g->np; i++)
+            if (g->p[i].kind == PATCH_PIECE) g->p[i].rp_count = 0;
+        return;
+    }
+    long nce = 0;
+    for (int i = 0; i < g->np; i++) {
+        patch *p = &g->p[i];
+        if (p->kind != PATCH_PIECE) continue;
+        p->rp_count = 0;
+        p->nt = 0;
+        p->vfirst = g->nmv;
+        p->tfirst = g->nmt;
+        if (!p->sh || !has_grid(g->o[p->obj].kind) || p->nsides == 0) continue;
+        double ext = v3_maxc(v3_sub(p->sh->hi, p->sh->lo));
+        if (!(ext > 0.0) || !isfinite(ext)) continue;
+        double nn = ceil(ext / g->tess);
+        int n = nn < 2.0 ? 2 : (nn > 128.0 ? 128 : (int)nn);
+        mesh_ctx m = {g, i, p->sh, NULL, 0, 0};
+        int r = accel_shape_grid(p->sh, n, mesh_tri, &m);
+        free(m.vh);
+        if (r < 0 || m.oom) {
+            g->nmv = p->vfirst;
+            g->nmt = p->tfirst;
+            continue;
+        }
+        p->rp_count = g->nmv - p->vfirst;
+        p->nt = g->nmt - p->tfirst;
+        double cell = 0.0;
+        for (long t = p->tfirst; t < p->tfirst + p->nt; t++)
+            for (int k = 0; k < 3; k++) {
+                vec3 a = g->mv[p->vfirst + g->mt[t][k]], b = g->mv[p->vfirst + g->mt[t][(k + 1) % 3]];
+                cell = fmax(cell, v3_len(v3_sub(a, b)));
+            }
+        p->cell = cell > 0.0 ? cell : 1.0;
+        for (long t = p->tfirst; t < p->tfirst + p->nt; t++) {
+            vec3 lo = v3s(INFINITY), hi = v3s(-INFINITY);
+            for (int k = 0; k < 3; k++) {
+                lo = v3_min(lo, g->mv[p->vfirst + g->mt[t][k]]);
+                hi = v3_max(hi, g->mv[p->vfirst + g->mt[t][k]]);
+            }
+            double e = 0.25 * p->cell;
+            long x0 = (long)floor((lo.x - e) / p->cell), x1 = (long)floor((hi.x + e) / p->cell);
+            long y0 = (long)floor((lo.y - e) / p->cell), y1 = (long)floor((hi.y + e) / p->cell);
+            long z0 = (long)floor((lo.z - e) / p->cell), z1 = (long)floor((hi.z + e) / p->cell);
+            nce += (x1 - x0 + 1) * (y1 - y0 + 1) * (z1 - z0 + 1);
+        }
+    }
+    if (nce == 0) return;
+    g->ce = malloc((size_t)nce * sizeof *g->ce);
+    if (!g->ce) {
+        /* no locate hash: hits are estimated where they are */
+        for (int i = 0; i < g->np; i++)
+            if (g->p[i].kind == PATCH_PIECE) g->p[i].nt = 0;
+        return;
+    }
+    for (int i = 0; i < g->np; i++) {
+        const patch *p = &g->p[i];
+        if (p->kind != PATCH_PIECE) continue;
+        for (long t = p->tfirst; t < p->tfirst + p->nt; t++) {
+            vec3 lo = v3s(INFINITY), hi = v3s(-INFINITY);
+            for (int k = 0; k < 3; k++) {
+                lo = v3_min(lo, g->mv[p->vfirst + g->mt[t][k]]);
+                hi = v3_max(hi, g->mv[p->vfirst + g->mt[t][k]]);
+            }
+            double e = 0.25 * p->cell;
+            long x0 = (long)floor((lo.x - e) / p->cell), x1 = (long)floor((hi.x + e) / p->cell);
+            long y0 = (long)floor((lo.y - e) / p->cell), y1 = (long)floor((hi.y + e) / p->cell);
+            long z0 = (long)floor((lo.z - e) / p->cell), z1 = (long)floor((hi.z + e) / p->cell);
+            for (long z = z0; z <= z1; z++)
+                for (long y = y0; y <= y1; y++)
+                    for (long x = x0; x <= x1; x++) {
+                        g->ce[g->nce].key = cell_key(i, x, y, z);
+                        g->ce[g->nce].tri = t;
+                        g->nce++;
+                    }
+        }
+    }
+    qsort(g->ce, (size_t)g->nce, sizeof *g->ce, cmp_cell);
+}
+
+/* Closest point to q on triangle (a, b, c), as barycentrics (wa, wb, wc)
+ * (Ericson, Real-Time Collision Detection, 5.1.5: the Voronoi regions of
+ * the vertices, then of the edges, then the face). */
+static double closest_on_tri(vec3 q, vec3 a, vec3 b, vec3 c, double w[3])
+{
+    vec3 ab = v3_sub(b, a), ac = v3_sub(c, a), ap = v3_sub(q, a);
+    double d1 = v3_dot(ab, ap), d2 = v3_dot(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0) { w[0] = 1; w[1] = w[2] = 0; goto out; }
+    vec3 bp = v3_sub(q, b);
+    double d3 = v3_dot(ab, bp), d4 = v3_dot(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) { w[1] = 1; w[0] = w[2] = 0; goto out; }
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+        double v = d1 / (d1 - d3);
+        w[0] = 1 - v; w[1] = v; w[2] = 0;
+        goto out;
+    }
+    vec3 cp = v3_sub(q, c);
+    double d5 = v3_dot(ab, cp), d6 = v3_dot(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) { w[2] = 1; w[0] = w[1] = 0; goto out; }
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+        double t = d2 / (d2 - d6);
+        w[0] = 1 - t; w[2] = t; w[1] = 0;
+        goto out;
+    }
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+        double t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        w[1] = 1 - t; w[2] = t; w[0] = 0;
+        goto out;
+    }
+    {
+        double den = va + vb + vc;
+        if (!(fabs(den) > 0.0)) { w[0] = 1; w[1] = w[2] = 0; goto out; }
+        w[1] = vb / den;
+        w[2] = vc / den;
+        w[0] = 1.0 - w[1] - w[2];
+    }
+out:;
+    vec3 r = v3_add(v3_add(v3_scale(a, w[0]), v3_scale(b, w[1])), v3_scale(c, w[2]));
+    return v3_len2(v3_sub(q, r));
+}
+
+/* The grid triangle of PIECE patch pi nearest to q: its index, or -1. */
+static long mesh_locate(const gi_surface *g, int pi, vec3 q, double w[3])
+{
+    const patch *p = &g->p[pi];
+    if (p->nt == 0 || g->nce == 0) return -1;
+    uint64_t key = cell_key(pi, (long)floor(q.x / p->cell), (long)floor(q.y / p->cell), (long)floor(q.z / p->cell));
+    long lo = 0, hi = g->nce;
+    while (lo < hi) {
+        long mid = lo + (hi - lo) / 2;
+        if (g->ce[mid].key < key) lo = mid + 1;
+        else hi = mid;
+    }
+    long best = -1;
+    double bd = INFINITY;
+    for (long e = lo; e < g->nce && g->ce[e].key == key; e++) {
+        long t = g->ce[e].tri;
+        if (g->mtp[t] != pi) continue;
+        double ww[3];
+        const vec3 *v = g->mv + p->vfirst;
+        double d = closest_on_tri(q, v[g->mt[t][0]], v[g->mt[t][1]], v[g->mt[t][2]], ww);
+        if (d < bd) {
+            bd = d;
+            best = t;
+            w[0] = ww[0];
+            w[1] = ww[1];
+            w[2] = ww[2];
+        }
+    }
+    return best;
+}
+
 static void layout(gi_surface *g)
 {
+    build_meshes(g);
     long rp = 0;
     for (int i = 0; i < g->np; i++) {
         g->p[i].rp_first = rp;
@@ -634,6 +1256,17 @@ void gi_surface_free(gi_surface *g)
 {
     if (!g) return;
     accel_surf_free(g->as);
+    for (int i = 0; i < g->np; i++) free_patch(&g->p[i]);
+    for (int i = 0; i < g->ncn; i++) {
+        if (g->cn[i].sh) accel_shape_release(g->cn[i].sh);
+        free(g->cn[i].sh);
+    }
+    free(g->cn);
+    free(g->mv);
+    free(g->mn);
+    free(g->mt);
+    free(g->mtp);
+    free(g->ce);
     free(g->cdf);
     free(g->p);
     free(g->o);
@@ -645,6 +1278,8 @@ int gi_surface_npatches(const gi_surface *g) { return g->np; }
 double gi_surface_area(const gi_surface *g, int i) { return g->p[i].area; }
 int gi_surface_sides(const gi_surface *g, int i) { return g->p[i].nsides; }
 int gi_surface_probe(const gi_surface *g, int i) { return g->p[i].probe; }
+int gi_surface_side_mask(const gi_surface *g, int i) { return g->p[i].mask ? g->p[i].mask : 3; }
+int gi_surface_csg_member(const gi_surface *g, int i) { return g->p[i].cnode >= 0; }
 const scene_object *gi_surface_object(const gi_surface *g, int i) { return g->o[g->p[i].obj].obj; }
 const scene_texture *gi_surface_texture(const gi_surface *g, int i) { return g->p[i].tex; }
 double gi_surface_total_area(const gi_surface *g) { return g->total_area; }
@@ -660,7 +1295,9 @@ int gi_surface_has_particles(const gi_surface *g, const accel_hit *hit)
 size_t gi_surface_bytes(const gi_surface *g)
 {
     return (size_t)g->capp * sizeof(patch) + (size_t)g->capo * sizeof(obj_rec) + (size_t)g->hcap * sizeof(int) +
-           (size_t)g->capcdf * sizeof(double);
+           (size_t)g->capcdf * sizeof(double) + (size_t)g->capcn * sizeof(csg_node) +
+           (size_t)g->capmv * 2 * sizeof(vec3) + (size_t)g->capmt * 4 * sizeof(int) +
+           (size_t)g->nce * sizeof(cell_entry);
 }
 
 int gi_surface_sample(const gi_surface *g, int i, double u, double v, rng *r, vec3 *pos, vec3 *nrm)
@@ -696,6 +1333,12 @@ int gi_surface_sample(const gi_surface *g, int i, double u, double v, rng *r, ve
             grid_eval(g, p, 0.0, 0.0, NULL, &front);
             if (v3_dot(*nrm, front) < 0.0) *nrm = v3_neg(*nrm);
         }
+        return v3_finite(*pos) && v3_finite(*nrm);
+    }
+    if (p->ks) {
+        /* CSG member: its own lines, keeping the result's surface */
+        unsigned part;
+        if (!accel_tess_sample(&p->ks->cs, v, u, r, pos, nrm, &part)) return 0;
         return v3_finite(*pos) && v3_finite(*nrm);
     }
     if (p->kind == PATCH_PIECE) return 0;
@@ -741,7 +1384,10 @@ void gi_surface_rp(const gi_surface *g, long rp, vec3 *pos, vec3 *nrm)
     long local = rp - p->rp_first;
     int side = local >= p->rp_count;
     if (side) local -= p->rp_count;
-    if (p->kind == PATCH_TRI) {
+    if (p->kind == PATCH_PIECE) {
+        *pos = g->mv[p->vfirst + local];
+        *nrm = g->mn[p->vfirst + local];
+    } else if (p->kind == PATCH_TRI) {
         /* row a holds vertices (a, 0..k-a); row start a(k+1) - a(a-1)/2 */
         int k = p->k, a = 0;
         while (a < k && (long)(a + 1) * (k + 1) - (long)(a + 1) * a / 2 <= local) a++;
@@ -808,7 +1454,30 @@ int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, lo
             }
         }
     } else if (g->p[first].kind == PATCH_PIECE) {
-        return 0;
+        /* a grid: the triangle nearest the hit, barycentrics of the nearest point on it */
+        const patch *pp = &g->p[first];
+        double tw[3];
+        long t = pp->nsides ? mesh_locate(g, first, hit->p, tw) : -1;
+        if (t < 0) return 0;
+        const vec3 *vv = g->mv + pp->vfirst, *vn = g->mn + pp->vfirst;
+        const int *tv = g->mt[t];
+        vec3 fn = v3_cross(v3_sub(vv[tv[1]], vv[tv[0]]), v3_sub(vv[tv[2]], vv[tv[0]]));
+        vec3 ns = v3_add(v3_add(vn[tv[0]], vn[tv[1]]), vn[tv[2]]);
+        if (v3_dot(fn, ns) < 0.0) fn = v3_neg(fn);
+        if (!(v3_len2(fn) > 0.0)) fn = ns;
+        vec3 ngv = v3_dot(n_view, hit->ng) >= 0.0 ? hit->ng : v3_neg(hit->ng);
+        int side = v3_dot(ngv, fn) < 0.0;
+        if (side >= pp->nsides) return 0;
+        long base = pp->rp_first + side * pp->rp_count;
+        double sum = 0.0;
+        for (int k = 0; k < 3; k++) {
+            rp[k] = base + tv[k];
+            w[k] = fmin(1.0, fmax(0.0, tw[k]));
+            sum += w[k];
+        }
+        if (!(sum > 0.0)) return 0;
+        for (int k = 0; k < 3; k++) w[k] /= sum;
+        return 1;
     } else {
         p = &g->p[first];
         vec3 q = xform_inv_point(&hit->obj->transform, hit->p);

@@ -22,21 +22,37 @@
  * Side 0 is the patch's front normal, side 1 its opposite.
  *
  * Every other shape accel_surface samples gets area particles (sampled by
- * accel_surface, no second implementation) but no radiance particles:
- * cylinders, cones, tori, polygons and height fields (their triangles, a
- * piece chosen by area), lathe, sor, prism, text, and the implicit shapes
- * (quadric, poly, blob, isosurface, julia_fractal, ovus, superellipsoid;
- * Crofton lines, accel_tess.h). gi_particle estimates indirect light at
- * hits on them from the particles around the hit. Closed ones get their
- * outside (and inside when the camera or a light is in them); polygons,
- * height fields, lathe, sor and unbounded quadric/poly both sides.
+ * accel_surface, no second implementation): cylinders, cones, tori,
+ * polygons and height fields (their triangles, a piece chosen by area),
+ * lathe, sor, prism, text, and the implicit shapes (quadric, poly, blob,
+ * isosurface, julia_fractal, ovus, superellipsoid; Crofton lines,
+ * accel_tess.h). The implicit shapes get radiance particles at the
+ * vertices of their grid (accel_shape_grid: marching tetrahedra, vertices
+ * on the exact surface, n = ceil(world extent / tess) cells along the
+ * longest side, within [2, 128]); gi_surface_locate takes the grid
+ * triangle nearest the hit (a hash of cells, each triangle in those its box
+ * widened by a quarter cell touches) and the barycentrics of the nearest
+ * point on it. The others have no radiance particles: gi_particle estimates
+ * indirect light at hits on them from the particles around the hit. Closed
+ * ones get their outside (and inside when the camera or a light is in
+ * them); polygons, height fields, lathe, sor and unbounded quadric/poly
+ * both sides.
  *
  * CSG: members of union are ordinary leaves. Members of merge, intersection
- * and difference are sampled on their whole surface and marked `probe`:
- * a particle is kept only if a short probe ray finds the CSG result's
- * surface there (gi_particles); cylinders, cones and tori inside such CSG,
- * and unsupported shapes, get no particles (counted in gi_surface_skipped);
- * hits on them receive no indirect light. */
+ * and difference (any depth, any shape) get particles only where their
+ * surface is the CSG result's: POV-Ray's rule at every level from the
+ * member to the root (intersection: inside all siblings; merge: outside
+ * all; difference: the first member outside the others, a subtracted one
+ * inside the first and outside the rest), with the members' own inside
+ * tests (accel_shape_inside). Spheres, boxes, discs, planes and triangles
+ * are sampled on their whole surface and marked `probe` (gi_particles keeps
+ * a particle only if a short probe ray finds the result's surface there);
+ * the other shapes get their own Crofton sampler whose keep filter is that
+ * rule (exact), and implicit ones the grid triangles touching the result.
+ * Both sides exist; particles go on the one facing out of the result
+ * (gi_surface_side_mask: a subtracted or inverse member's inside), both
+ * when the camera or a light is inside the result. CSG with a mesh member
+ * and merges of more than 64 members are unions here, as in accel. */
 #ifndef PT_GI_SURFACE_H
 #define PT_GI_SURFACE_H
 #include "accel.h"
@@ -60,6 +76,13 @@ int gi_surface_npatches(const gi_surface *g);
 double gi_surface_area(const gi_surface *g, int patch); /* one side */
 int gi_surface_sides(const gi_surface *g, int patch);
 int gi_surface_probe(const gi_surface *g, int patch);
+/* Sides of the patch that get particles (bit s: side s): 3, or for a member
+ * of merge/intersection/difference the side facing out of the CSG result
+ * (both when the camera or a light is inside the result). */
+int gi_surface_side_mask(const gi_surface *g, int patch);
+/* 1 for a member of merge/intersection/difference (its surface is not a
+ * closed solid's: gi_particle's inside/buried rules skip it). */
+int gi_surface_csg_member(const gi_surface *g, int patch);
 const scene_object *gi_surface_object(const gi_surface *g, int patch);
 const scene_texture *gi_surface_texture(const gi_surface *g, int patch);
 double gi_surface_total_area(const gi_surface *g);
