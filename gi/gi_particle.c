@@ -697,6 +697,8 @@ static void vis_chunk(void *ctx, int chunk, int thread)
             float depth = gi_light_ray(dl, dl->pos[0], dl->pos[1], dl->pos[2], pt->p[0], pt->p[1], pt->p[2], d);
             float ci = pt->n[0] * d[0] + pt->n[1] * d[1] + pt->n[2] * d[2];
             att[o] = ci >= 1e-10f ? gi_light_attenuation(dl, pt->p[0], pt->p[1], pt->p[2], d, depth) : 0.0f;
+            /* light_group: no light on objects the light does not reach (as shade.c) */
+            if (!scene_light_reaches(l, gi_surface_object(gp->surf, gp->ps.patch[i]))) att[o] = 0.0f;
             seen[o] = 0.0f;
             m_of[o] = 1;
             if (!(att[o] > 0.0f)) continue;

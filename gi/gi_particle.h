@@ -34,6 +34,10 @@
  * set (the app passes shade's tex_pigment_at: checkers, image maps and
  * texture maps reflect their own colours), else the texture's base colour.
  *
+ * light_group: a light gives direct light only to particles on objects it
+ * reaches (scene_light_reaches, as shade.c); what they scatter is indirect
+ * light and reaches everything.
+ *
  * What counts as emitted light: light_sources (every kind, with shade.c's
  * attenuation and shadow rays), finish emission, and finish ambient *
  * ambient_light when `ambient_emits` (default: when the scene has

@@ -127,6 +127,7 @@ rgb pm_direct_lights(const pm_lights *L, const mat_bsdf *b, int area_samples, rn
     if (!b->nee) return total;
     light_ctx c = {L->a, L->eps, shadow_rays};
     for (int i = 0; i < L->sc->nlights; i++) {
+        if (!scene_light_reaches(&L->sc->lights[i], b->obj)) continue; /* light_group, as shade.c */
         rgb v = mat_light_nee(b, &c, &L->sc->lights[i], area_samples, r);
         total.r += v.r;
         total.g += v.g;
@@ -152,6 +153,7 @@ rgb pm_direct_one_light(const pm_lights *L, const mat_bsdf *b, rng *r, long *sha
         double att = l->area && l->area_illumination ? 1.0 : light_attenuation(l, b->p_out, dir, depth);
         double c = fmax(fabs(l->colour.r), fmax(fabs(l->colour.g), fabs(l->colour.b)));
         w[i] = isfinite(att * c) && att * c > 0.0 ? att * c : 0.0;
+        if (!scene_light_reaches(l, b->obj)) w[i] = 0.0; /* light_group: never picked */
         wsum += w[i];
     }
     rgb out = zero;

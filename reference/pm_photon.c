@@ -274,6 +274,12 @@ static void trace_one(const trace_ctx *c, const source *src, long index, chunk_o
     int from_light = src->kind == SRC_LIGHT;
     int store_first = src->kind == SRC_ENV;
     int spec_only = 1;
+    /* light_group: a light's photons land only on what it lights (its
+     * group's members, or for a global light what global_lights reaches);
+     * elsewhere they end at once, as that light's direct light is absent
+     * there (shade.c); after the first bounce the light is indirect and
+     * reaches everything */
+    if (from_light && !scene_light_reaches(src->l, h.obj)) return;
     for (int bounce = 0;; bounce++) {
         mat_bsdf b;
         mat_setup(&b, c->sc, &h, w, c->eps, &r);

@@ -83,6 +83,7 @@ void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, doubl
     const scene_finish *f = &tex->finish;
     double filt, transm;
     rgb pig = texture_pigment(sc, tex, h, &filt, &transm, &b->unsupported);
+    b->obj = h->obj;
     b->tex = tex;
     b->pigment = pig;
     b->dir = dir;

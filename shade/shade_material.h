@@ -75,6 +75,7 @@ typedef struct {
     int double_illum;
     int unsupported;   /* a pigment pattern the shader cannot evaluate (its colour is used) */
     light_surface ls;  /* for light_terms / light_nee */
+    const scene_object *obj; /* the hit object: light_group decides which lights reach it (scene_light_reaches) */
 } mat_bsdf;
 
 typedef struct {

@@ -842,6 +842,79 @@ static void test_csg_members(void **state)
     unload(&f);
 }
 
+/* light_group in the particle GI (POV-Ray 3.7: a group's lights light only
+ * its members; global lights the rest, and the members only with
+ * global_lights on), as shade.c's direct light: the same room and sphere
+ * (in a light_group) with and without the group's own light, same
+ * particles. The particles' direct light (E/pi) on the walls is the same to
+ * float rounding (the group light does not reach them); on the sphere it is
+ * 0 without the group light (global_lights off keeps the global light from
+ * it) and > 0 with it; with global_lights on the global light reaches the
+ * sphere too. */
+static void test_light_group(void **state)
+{
+    (void)state;
+    const char *fmt = "#version 3.7;\n"
+                      "global_settings { assumed_gamma 1.0 }\n"
+                      "camera { location <0.5, 0.5, 0.05> look_at <0.5, 0.45, 1> angle 90 }\n"
+                      "light_source { <0.3, 0.8, 0.3> color rgb 1 }\n"
+                      "box { <0,0,0>, <1,1,1> inverse pigment { rgb 0.8 } finish { ambient 0 diffuse 0.7 } }\n"
+                      "light_group { %s\n"
+                      "  sphere { <0.5, 0.35, 0.6>, 0.15 pigment { rgb 0.9 } finish { ambient 0 diffuse 0.7 } } %s }\n";
+    const vec3 c = v3(0.5, 0.35, 0.6);
+    const double r = 0.15;
+    const char *light = "light_source { <0.75, 0.3, 0.45> color rgb <2, 1, 0.5> }";
+    double wall_diff = 0.0, sphere[3] = {0, 0, 0}, wall[3] = {0, 0, 0};
+    long nsph = 0, n0 = -1;
+    float *e0 = NULL;
+    for (int k = 0; k < 3; k++) {
+        char text[2048];
+        snprintf(text, sizeof text, fmt, k == 1 ? light : "", k == 2 ? "global_lights on" : "");
+        fixture f;
+        load(&f, text);
+        gi_particle *gp = build(&f, 6000, 2, device_c, 9);
+        const float *edir;
+        int n = gi_particle_debug(gp, &edir, NULL, NULL, NULL, NULL);
+        if (k == 0) {
+            n0 = n;
+            e0 = malloc((size_t)n * 4 * sizeof *e0);
+            memcpy(e0, edir, (size_t)n * 4 * sizeof *e0);
+        }
+        assert_int_equal(n, n0); /* lights do not move particles here */
+        long ns = 0;
+        for (int i = 0; i < n; i++) {
+            double a, rho[3];
+            vec3 p, nn;
+            gi_particle_debug_particle(gp, i, &a, rho, &p, &nn);
+            int on = fabs(v3_len(v3_sub(p, c)) - r) < 1e-3 * r;
+            double e = edir[4 * i] + edir[4 * i + 1] + edir[4 * i + 2];
+            if (on) {
+                sphere[k] += e;
+                ns++;
+            } else {
+                wall[k] += e;
+                if (k == 1) {
+                    double e0s = e0[4 * i] + e0[4 * i + 1] + e0[4 * i + 2];
+                    wall_diff = fmax(wall_diff, fabs(e - e0s) / fmax(1e-6, e0s));
+                }
+            }
+        }
+        if (k == 0) nsph = ns;
+        gi_particle_free(gp);
+        unload(&f);
+    }
+    free(e0);
+    printf("  light_group: %ld particles on the sphere; its direct E/pi summed: %.4f without the group light, %.4f with "
+           "it, %.4f with global_lights on; walls %.4f / %.4f / %.4f (worst particle %.1e)\n",
+           nsph, sphere[0], sphere[1], sphere[2], wall[0], wall[1], wall[2], wall_diff);
+    assert_true(nsph > 50);
+    assert_true(sphere[0] == 0.0);
+    assert_true(sphere[1] > 1.0);
+    assert_true(sphere[2] > 1.0);
+    assert_true(wall_diff < 1e-6);
+    assert_true(fabs(wall[1] / wall[0] - 1.0) < 1e-6 && fabs(wall[2] / wall[0] - 1.0) < 1e-6);
+}
+
 /* Particles take the pigment where they lie (settings.pigment =
  * tex_pigment_at): a room whose walls are a checker of two colours
  * (scale 0.25, walls at -0.1 and 1.1 so no wall lies on a check boundary).
@@ -956,6 +1029,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_implicit_sphere),
         cmocka_unit_test(test_csg_members),
         cmocka_unit_test(test_checker_particles),
+        cmocka_unit_test(test_light_group),
         cmocka_unit_test(test_settings_from_radiosity),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -385,6 +385,118 @@ static void test_direct_equivalence(void **state)
     scene_free(sc);
 }
 
+/* ------------------------------------------------------------ light_group */
+
+/* light_group in the reference modes (POV-Ray 3.7: a group's lights light
+ * only its members, global lights everything else and the members only
+ * with global_lights on). (1) Direct light: the path tracer's first vertex
+ * (max depth 1) equals --gi none (shade.c) within 1e-5 on a room with a
+ * sphere in a group with its own light. (2) A group light whose only member
+ * lies outside the room lights nothing in it: path (16 spp) and pmfg
+ * (60,000 photons, 512 gather rays) render the room as without that light
+ * (mean within LG_TOL; before, its direct light and photons lit the room:
+ * the image was several times brighter). */
+#define LG_TOL 0.03
+static const char *lg_room =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 }\n"
+    "camera { location <0.5, 0.5, 0.05> look_at <0.5, 0.45, 1> angle 90 }\n"
+    "light_source { <0.3, 0.8, 0.3> color rgb 1 }\n"
+    "box { <0,0,0>, <1,1,1> inverse pigment { rgb 0.8 } finish { ambient 0 diffuse 0.7 } }\n";
+
+static double fb_avg(const framebuffer *fb)
+{
+    double s = 0.0;
+    for (int i = 0; i < fb->width * fb->height * 3; i++) s += fb->rgb[i];
+    return s / (fb->width * fb->height * 3);
+}
+
+static void test_light_group(void **state)
+{
+    (void)state;
+    char text[2048];
+    /* (1) */
+    snprintf(text, sizeof text, "%slight_group { light_source { <0.7, 0.3, 0.5> color rgb <2, 1, 0.5> }\n"
+             "  sphere { <0.5, 0.35, 0.6>, 0.15 pigment { rgb 0.9 } finish { ambient 0 diffuse 0.7 } } }\n"
+             "light_group { light_source { <0.2, 0.2, 0.5> color rgb 1 }\n"
+             "  sphere { <0.25, 0.6, 0.7>, 0.1 pigment { rgb 0.9 } finish { ambient 0 diffuse 0.7 } } global_lights on }\n",
+             lg_room);
+    scene *sc = parse(text);
+    accel *a = build(sc);
+    int w = 32, h = 24;
+    shade_settings ss;
+    shade_default_settings(&ss);
+    ss.width = w;
+    ss.height = h;
+    ss.threads = THREADS;
+    ss.use_ambient = 0;
+    framebuffer *ref = fb_new(w, h), *fb = fb_new(w, h);
+    shade_stats sst;
+    assert_int_equal(shade_render(sc, a, &ss, ref, &sst, NULL), PT_OK);
+    pm_path_settings ps;
+    pm_path_default_settings(&ps);
+    ps.c.width = w;
+    ps.c.height = h;
+    ps.c.threads = THREADS;
+    ps.c.spp = 1;
+    ps.c.jitter = 0;
+    ps.max_depth = 1;
+    pm_stats st;
+    assert_int_equal(pm_path_render(sc, a, &ps, fb, &st, NULL), PT_OK);
+    double maxdiff = 0.0, maxval = 0.0;
+    for (int i = 0; i < w * h * 3; i++) {
+        maxdiff = fmax(maxdiff, fabs(fb->rgb[i] - ref->rgb[i]));
+        maxval = fmax(maxval, fabs(ref->rgb[i]));
+    }
+    printf("light_group direct: path (max depth 1) vs --gi none: max |diff| %.3g (max value %.3g, tol 1e-5 relative)\n",
+           maxdiff, maxval);
+    assert_true(maxval > 0.1);
+    assert_true(maxdiff <= 1e-5 * maxval);
+    fb_free(fb);
+    fb_free(ref);
+    accel_free(a);
+    scene_free(sc);
+
+    /* (2) */
+    double mean[2][2];
+    for (int with = 0; with < 2; with++) {
+        snprintf(text, sizeof text, "%slight_group { %s\n"
+                 "  sphere { <3, 0.5, 0.5>, 0.1 pigment { rgb 0.9 } finish { ambient 0 diffuse 0.7 } } }\n",
+                 lg_room, with ? "light_source { <0.6, 0.4, 0.6> color rgb 4 }" : "");
+        sc = parse(text);
+        a = build(sc);
+        enum { S = 16 };
+        framebuffer *f0 = fb_new(S, S), *f1 = fb_new(S, S);
+        pm_path_default_settings(&ps);
+        ps.c.width = ps.c.height = S;
+        ps.c.threads = THREADS;
+        ps.c.spp = 16;
+        ps.c.seed = 5;
+        assert_int_equal(pm_path_render(sc, a, &ps, f0, &st, NULL), PT_OK);
+        pm_fg_settings fs;
+        pm_fg_default_settings(&fs);
+        fs.c.width = fs.c.height = S;
+        fs.c.threads = THREADS;
+        fs.c.seed = 11;
+        fs.photons = 60000;
+        fs.fg_rays = 512;
+        assert_int_equal(pm_fg_render(sc, a, &fs, f1, &st, NULL), PT_OK);
+        mean[with][0] = fb_avg(f0);
+        mean[with][1] = fb_avg(f1);
+        fb_free(f0);
+        fb_free(f1);
+        accel_free(a);
+        scene_free(sc);
+    }
+    printf("light_group: a group light lighting nothing in the room: path mean %.5f vs %.5f without it (%+.3f%%), "
+           "pmfg %.5f vs %.5f (%+.3f%%), tol %.0f%%\n",
+           mean[1][0], mean[0][0], 100.0 * (mean[1][0] / mean[0][0] - 1.0), mean[1][1], mean[0][1],
+           100.0 * (mean[1][1] / mean[0][1] - 1.0), 100.0 * LG_TOL);
+    assert_true(mean[0][0] > 0.05 && mean[0][1] > 0.05);
+    assert_true(fabs(mean[1][0] / mean[0][0] - 1.0) < LG_TOL);
+    assert_true(fabs(mean[1][1] / mean[0][1] - 1.0) < LG_TOL);
+}
+
 /* ------------------------------------------------------------ determinism */
 
 static const char *small_scene =
@@ -733,13 +845,16 @@ static void test_progressive(void **state)
     scene_free(sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    /* test_reference NAME runs the tests matching NAME (cmocka's filter) */
+    if (argc > 1) cmocka_set_test_filter(argv[1]);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_kdtree),
         cmocka_unit_test(test_surface_areas),
         cmocka_unit_test(test_surface_uniform),
         cmocka_unit_test(test_direct_equivalence),
+        cmocka_unit_test(test_light_group),
         cmocka_unit_test(test_determinism),
         cmocka_unit_test(test_progressive),
         cmocka_unit_test(test_no_nan),
