@@ -1123,25 +1123,16 @@ static int onthefly(gi_particle *gp, const accel_hit *h, vec3 n, thread_count *t
     return 1;
 }
 
-rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
+/* E/pi on the side of the hit that n faces: barycentric interpolation of
+ * the radiance particles around it, or the estimate at the hit on surfaces
+ * without radiance particles. 0 when that side has no particles. */
+static int side_value(gi_particle *gp, const accel_hit *hit, vec3 n, thread_count *tc, rgb *out)
 {
-    gi_particle *gp = ctx;
-    rgb out = {0.0, 0.0, 0.0};
-    thread_count *tc = &gp->tc[(unsigned)thread < GI_MAX_THREADS ? thread : 0];
-    tc->lookups++;
     long rp[3];
     double w[3];
-    if (!gp->lit) {
-        tc->none++;
-        return out;
-    }
-    if (!gi_surface_locate(gp->surf, hit, n, rp, w)) {
-        if (!gi_surface_has_particles(gp->surf, hit) || !onthefly(gp, hit, n, tc, &out)) {
-            tc->none++;
-            return out;
-        }
-        goto finish;
-    }
+    out->r = out->g = out->b = 0.0;
+    if (!gi_surface_locate(gp->surf, hit, n, rp, w))
+        return gi_surface_has_particles(gp->surf, hit) && onthefly(gp, hit, n, tc, out);
     /* only radiance particles the hit sees (gi_visible): one under a box
      * standing on the floor must not lend its light to the floor outside */
     vec3 ngv = v3_dot(n, hit->ng) >= 0.0 ? hit->ng : v3_neg(hit->ng);
@@ -1157,10 +1148,7 @@ rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
         }
         wsum += w[k];
     }
-    if (!(wsum > 0.0)) {
-        tc->none++;
-        return out;
-    }
+    if (!(wsum > 0.0)) return 0;
     for (int k = 0; k < 3; k++) {
         if (!(w[k] > 0.0)) continue;
         if (atomic_load_explicit(&gp->rp_state[rp[k]], memory_order_acquire) != 2) {
@@ -1168,11 +1156,40 @@ rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
             late_rp(gp, rp[k]);
         }
         const float *v = &gp->rp_val[4 * rp[k]];
-        out.r += w[k] / wsum * v[0];
-        out.g += w[k] / wsum * v[1];
-        out.b += w[k] / wsum * v[2];
+        out->r += w[k] / wsum * v[0];
+        out->g += w[k] / wsum * v[1];
+        out->b += w[k] / wsum * v[2];
     }
-finish:;
+    return 1;
+}
+
+rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
+{
+    gi_particle *gp = ctx;
+    rgb out = {0.0, 0.0, 0.0};
+    thread_count *tc = &gp->tc[(unsigned)thread < GI_MAX_THREADS ? thread : 0];
+    tc->lookups++;
+    if (!gp->lit || !side_value(gp, hit, n, tc, &out)) {
+        tc->none++;
+        out.r = out.g = out.b = 0.0;
+        return out;
+    }
+    /* finish { diffuse A, B } (3.7's backside diffuse, shade_material.h:
+     * kb/pi for light arriving from the other side): shade.c multiplies the
+     * hook by diffuse, so the other side's E/pi enters scaled by B / A.
+     * Only at this last bounce: the particles themselves reflect with
+     * diffuse alone (the lighting kernels keep the sides apart). */
+    const scene_texture *tex = hit->texture ? hit->texture : &gp->sc->default_texture;
+    const scene_finish *f = &tex->finish;
+    if (f->diffuse_back != 0.0 && f->diffuse > 0.0) {
+        rgb back;
+        if (side_value(gp, hit, v3_neg(n), tc, &back)) {
+            double k = f->diffuse_back / f->diffuse;
+            out.r += k * back.r;
+            out.g += k * back.g;
+            out.b += k * back.b;
+        }
+    }
     double b = gp->set.brightness;
     out.r *= b;
     out.g *= b;

@@ -33,6 +33,10 @@
  * the pigment evaluated at the particle's position when settings.pigment is
  * set (the app passes shade's tex_pigment_at: checkers, image maps and
  * texture maps reflect their own colours), else the texture's base colour.
+ * finish { diffuse A, B } (3.7's backside diffuse): the hook adds the other
+ * side's E/pi times B / A (shade.c multiplies the hook by A), where the
+ * surface has particles on both sides; the particles themselves reflect
+ * with A only (no light crosses a surface inside the lighting stage).
  *
  * light_group: a light gives direct light only to particles on objects it
  * reaches (scene_light_reaches, as shade.c); what they scatter is indirect

@@ -915,6 +915,42 @@ static void test_light_group(void **state)
     assert_true(fabs(wall[1] / wall[0] - 1.0) < 1e-6 && fabs(wall[2] / wall[0] - 1.0) < 1e-6);
 }
 
+/* finish { diffuse A, B }: at the Whitted pass the hook adds the other
+ * side's indirect light scaled by B / A (shade.c multiplies the hook by A):
+ * a two-sided sheet across the room, seen from the light's side; the
+ * particles are the same with and without B (their reflectance is A's), so
+ * the hook with B equals the front's value + B/A x the back's within float
+ * rounding. */
+static void test_diffuse_back(void **state)
+{
+    (void)state;
+    double front[2] = {0, 0}, back = 0.0;
+    for (int k = 0; k < 2; k++) {
+        char text[4096];
+        snprintf(text, sizeof text, "%s"
+                 "triangle { <0.2, 0.2, 0.7>, <0.9, 0.2, 0.7>, <0.2, 0.9, 0.7> pigment { rgb 0.9 } "
+                 "finish { ambient 0 diffuse 0.6%s } }\n",
+                 cube_scene, k ? ", 0.3" : "");
+        fixture f;
+        load(&f, text);
+        gi_particle *gp = build(&f, 4000, 4, device_c, 4);
+        accel_hit h;
+        vec3 org = v3(0.5, 0.5, 0.1), dir = v3_norm(v3(0.05, -0.1, 1.0));
+        assert_true(accel_intersect(f.a, org, dir, 0.0, INFINITY, &h));
+        assert_int_equal(h.obj->kind, SHAPE_TRIANGLE);
+        vec3 n = v3_dot(dir, h.ns) > 0.0 ? v3_neg(h.ns) : h.ns;
+        front[k] = gi_particle_indirect(gp, &h, n, 0).g;
+        if (k == 0) back = gi_particle_indirect(gp, &h, v3_neg(n), 0).g;
+        gi_particle_free(gp);
+        unload(&f);
+    }
+    double expect = front[0] + 0.5 * back;
+    printf("  diffuse 0.6, 0.3: hook %.6f = front %.6f + 0.5 x back %.6f (expect %.6f)\n", front[1], front[0], back,
+           expect);
+    assert_true(back > 0.01 && front[0] > 0.01);
+    assert_true(fabs(front[1] / expect - 1.0) < 1e-5);
+}
+
 /* Particles take the pigment where they lie (settings.pigment =
  * tex_pigment_at): a room whose walls are a checker of two colours
  * (scale 0.25, walls at -0.1 and 1.1 so no wall lies on a check boundary).
@@ -1030,6 +1066,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_csg_members),
         cmocka_unit_test(test_checker_particles),
         cmocka_unit_test(test_light_group),
+        cmocka_unit_test(test_diffuse_back),
         cmocka_unit_test(test_settings_from_radiosity),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
