@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "accel_shapes.h"
 #include "rng.h"
 
 /* R2 low-discrepancy sequence (M. Roberts, "The unreasonable effectiveness of
@@ -127,6 +128,10 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
         if (!tex) tex = &sc->default_texture;
         material(sc, tex, NULL, ambient_emits, &proto);
         int probe = gi_surface_probe(g, i), mask = gi_surface_side_mask(g, i);
+        /* uv_mapping: the pigment is read at the particle's UV (accel_shape_uv;
+         * world x, y for meshes and the shapes it does not know, as accel.c) */
+        accel_shape ush;
+        int have_ush = pig && o->uv_mapping && accel_shape_init(&ush, o) == 0;
         long got = 0, tries = 0, limit = 64 * m + 64;
         for (long q = 0; got < m && tries < limit; q++, tries++) {
             double u = frac(su + (double)q * R2_A1), v = frac(sv + (double)q * R2_A2);
@@ -143,6 +148,9 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
                 h.obj = o;
                 h.texture = tex;
                 h.flags = o->flags;
+                h.uv[0] = pos.x;
+                h.uv[1] = pos.y;
+                if (have_ush) accel_shape_uv(&ush, pos, 0, h.uv);
                 colour5 c;
                 if (pig(sc, tex, &h, &c) && isfinite(c.r) && isfinite(c.g) && isfinite(c.b) && isfinite(c.f) &&
                     isfinite(c.t))
@@ -164,6 +172,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
                 p.n[1] = (float)nn.y;
                 p.n[2] = (float)nn.z;
                 if (!push(&b, &p, i, s)) {
+                    if (have_ush) accel_shape_release(&ush);
                     free(b.p);
                     free(b.patch);
                     free(b.side);
@@ -171,6 +180,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
                 }
             }
         }
+        if (have_ush) accel_shape_release(&ush);
         if (b.n > 2147483000L) {
             diag_report(d, DIAG_ERROR, (src_loc){0}, NULL, "particle GI: too many particles");
             free(b.p);
