@@ -262,6 +262,19 @@ static int csg_inside(const gi_surface *g, int node, vec3 p)
     return (c->o->flags & OBJ_INVERSE) ? !in : in;
 }
 
+/* An odd number of inversions on the node and its ancestors, a subtracted
+ * member of a difference counting as one (accel_csg.c's inv_odd). */
+static int csg_inv_odd(const gi_surface *g, int node)
+{
+    int odd = 0;
+    for (int n = node; n >= 0; n = g->cn[n].parent) {
+        odd ^= (g->cn[n].o->flags & OBJ_INVERSE) != 0;
+        int par = g->cn[n].parent;
+        if (par >= 0 && g->cn[par].o->kind == SHAPE_DIFFERENCE && n != g->cn[par].first) odd ^= 1;
+    }
+    return odd;
+}
+
 /* Is world point p (on the surface of member `node`) on the CSG result's surface? */
 static int csg_keep(const gi_surface *g, int node, vec3 p)
 {
@@ -269,6 +282,9 @@ static int csg_keep(const gi_surface *g, int node, vec3 p)
         const csg_node *P = &g->cn[g->cn[n].parent];
         int i = n - P->first;
         shape_kind op = P->o->kind;
+        /* an inverted union is POV-Ray's intersection of inverted members
+         * (De Morgan): its surfaces are a merge's, as accel_csg.c keeps them */
+        if (op == SHAPE_UNION && csg_inv_odd(g, g->cn[n].parent)) op = SHAPE_MERGE;
         if (op == SHAPE_UNION) continue;
         for (int j = 0; j < P->nkids; j++) {
             if (j == i) continue;
