@@ -1381,6 +1381,9 @@ static void fill_triangle(const accel *a, const accel_leaf *l, unsigned local, d
     if (lng > 0.0 && isfinite(lng)) ng = v3_scale(ng, 1.0 / lng);
     else ng = v3_norm(v3_neg(dir));
     vec3 ns = ng;
+    /* POV-Ray's triangle normal (P1-P2) x (P3-P2) (triangle.cpp, mesh.cpp)
+     * is the transformed object normal against the winding one */
+    hit->pov_flip = l->wind > 0.0;
     if (smooth) {
         double w = 1.0 - bu - bv;
         vec3 sn = v3_add(v3_add(v3_scale(n[0], w), v3_scale(n[1], bu)), v3_scale(n[2], bv));
@@ -1388,7 +1391,8 @@ static void fill_triangle(const accel *a, const accel_leaf *l, unsigned local, d
         double ls = v3_len(sn);
         if (ls > 0.0 && isfinite(ls)) {
             ns = v3_scale(sn, 1.0 / ls);
-            if (v3_dot(ns, ng) < 0.0) ns = v3_neg(ns);
+            hit->pov_flip = v3_dot(ns, ng) < 0.0; /* its smooth normal is the interpolated one */
+            if (hit->pov_flip) ns = v3_neg(ns);
         }
     }
     hit->t = t;
@@ -1476,6 +1480,9 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
             hit->uv[1] = hit->p.y;
         }
         if (h.flip) hit->ng = v3_neg(hit->ng);
+        /* triangles intersected here (CSG members): POV-Ray's normal as in fill_triangle */
+        hit->pov_flip = (sh->kind == SHAPE_TRIANGLE || sh->kind == SHAPE_SMOOTH_TRIANGLE) && sh->g.tri.wind > 0.0;
+        if (h.flip) hit->pov_flip = !hit->pov_flip;
         accel_shape_shading(sh, hit->p, hit->ng, &hit->ns);
         hit->obj = l->obj;
         hit->texture = l->texture;

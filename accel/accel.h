@@ -31,6 +31,11 @@ typedef struct {
                                      other shape the world hit point's x and y. Analytic shapes
                                      compute it only when the object or its textures use
                                      uv_mapping (else the world x and y) */
+    int pov_flip;                 /* 1 when POV-Ray's own surface normal (its Normal(), which picks
+                                     texture or interior_texture) points against ng: triangles and
+                                     meshes, whose POV-Ray normal is (P1-P2) x (P3-P2), the opposite
+                                     of the winding normal (smooth ones: the interpolated normal's
+                                     side); else 0 */
 } accel_hit;
 
 typedef struct {

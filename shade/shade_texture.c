@@ -411,9 +411,11 @@ static rgb one_texture(const hit_info *hi, const scene_texture *tex, vec3 point,
     return c;
 }
 
+/* The texture or, where POV-Ray's own normal faces away from the ray
+ * (Determine_Textures' hitinside, trace.cpp), the interior_texture. */
 static const scene_texture *hit_texture(const scene *sc, const accel_hit *h, int entering)
 {
-    if (!entering && h->obj && h->obj->interior_texture) return h->obj->interior_texture;
+    if (entering == h->pov_flip && h->obj && h->obj->interior_texture) return h->obj->interior_texture;
     return h->texture ? h->texture : &sc->default_texture;
 }
 

@@ -70,6 +70,9 @@ static void test_uv_mesh(void **st) { (void)st; check("xl_uv_mesh", NULL, "uv_me
  * with the member's own texture kept from the union's transforms, 0.0044
  * with that member not uv-mapped) */
 static void test_uv_csg(void **st) { (void)st; check("xl_uv_csg", NULL, "uv_csg", 0.002); }
+/* interior_texture on meshes: measured 0.0007 when added (0.258 with the
+ * side taken from the winding normal) */
+static void test_interior_texture(void **st) { (void)st; check("xl_interior_tex", NULL, "interior_texture", 0.002); }
 static void write_image(void);
 static void test_uv_levels(void **st)
 {
@@ -176,6 +179,7 @@ int main(void)
         cmocka_unit_test(test_uv_mesh),
         cmocka_unit_test(test_uv_levels),
         cmocka_unit_test(test_uv_csg),
+        cmocka_unit_test(test_interior_texture),
         cmocka_unit_test(test_object_pattern),
         cmocka_unit_test(test_cameras),
         cmocka_unit_test(test_gamma_image),
