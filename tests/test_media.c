@@ -172,6 +172,58 @@ static void test_shadow_through_media(void **st)
     done(&w);
 }
 
+/* Bad media are located errors (POV-Ray's messages), declared media and
+ * densities are reused, defaults follow #version. */
+static void test_media_parse(void **st)
+{
+    (void)st;
+    static const struct { const char *src; const char *msg; int line, col; } bad[] = {
+        {"sphere { 0, 1 interior { media { samples 0 } } }", "At least one sample per interval", 1, 34},
+        {"media {\n  scattering { 1, 0.3 eccentricity 0.5 } }", "Eccentricity cannot be used", 2, 23},
+        {"media { method 4 }", "Sample method choices are 1, 2, or 3.", 1, 9},
+        {"media { intervals 0 }", "At least one interval is needed", 1, 9},
+        {"media { samples 5, 2 }", "smaller than minimum", 1, 9},
+        {"media { aa_level 0 }", "aa_level in media must be at least one", 1, 9},
+        {"media { confidence 1 }", "Illegal confidence value", 1, 9},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        diag *d = diag_new();
+        scene *sc = NULL;
+        pt_status stt = sdl_parse_string("bad.pov", bad[i].src, NULL, &sc, d);
+        assert_int_not_equal(stt, PT_OK);
+        int found = 0;
+        for (int k = 0; k < diag_count(d); k++) {
+            char *m = diag_format(diag_get(d, k));
+            char want[64];
+            snprintf(want, sizeof want, "bad.pov:%d:%d: error:", bad[i].line, bad[i].col);
+            if (strstr(m, want) && strstr(m, bad[i].msg)) found = 1;
+            else printf("media parse: %s\n", m);
+            free(m);
+        }
+        assert_true(found);
+        scene_free(sc);
+        diag_free(d);
+    }
+    world w = build("#version 3.1;\n#declare M = media { emission 1 }\n#version 3.7;\n"
+                    "#declare D = density { spherical }\n"
+                    "media { M density { D scale 2 } }\n"
+                    "media { absorption 1 scattering { 5, 0.5 eccentricity 0.3 extinction 0.5 } }\n");
+    assert_int_equal(w.s->natmosphere, 2);
+    const scene_media *m0 = w.s->atmosphere[0], *m1 = w.s->atmosphere[1];
+    /* M was written at #version 3.1: method 1, intervals 10, samples 1 */
+    assert_int_equal(m0->method, 1);
+    assert_int_equal(m0->intervals, 10);
+    assert_int_equal(m0->min_samples, 1);
+    assert_int_equal(m0->ndensity, 1);
+    assert_true(m0->emission.g == 1.0);
+    assert_int_equal(m1->method, 3);
+    assert_int_equal(m1->intervals, 1);
+    assert_int_equal(m1->min_samples, 10);
+    assert_int_equal(m1->scattering_type, 5);
+    assert_true(m1->eccentricity == 0.3 && m1->extinction == 0.5);
+    done(&w);
+}
+
 /* ------------------------------------------------------------ POV-Ray */
 
 static char tmpdir[256];
@@ -199,6 +251,7 @@ int main(void)
         cmocka_unit_test(test_emission_absorption),
         cmocka_unit_test(test_atmosphere_hollow),
         cmocka_unit_test(test_shadow_through_media),
+        cmocka_unit_test(test_media_parse),
         cmocka_unit_test(test_xc_emit),
         cmocka_unit_test(test_xc_absorb),
         cmocka_unit_test(test_xc_scatter),
