@@ -164,8 +164,6 @@ scene_media *sdl_parse_media(sdl_parser *p)
         default: sdl_unexpected(p, &k, "media item"); break;
         }
     }
-    if (sdl_ok(p) && m->method != 3 && m->max_samples > m->min_samples)
-        sdl_warn_once(p, loc, "media samples min, max: the extra samples of methods 1 and 2 are not modelled (min used)");
     sdl_end_block(p);
     return sdl_ok(p) ? m : NULL;
 }

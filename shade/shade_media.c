@@ -33,9 +33,13 @@
  *    (1) or stratified (j + 0.5) / n + jitter * rand / n (2); each sample's
  *    emitted light is ds * exp(-extinction * d) (d = its distance into the
  *    interval); the interval's light and optical depth are the samples'
- *    means. (POV-Ray adds samples up to max_samples while their variance
- *    exceeds a chi-square threshold from confidence and variance: not done
- *    here, the min_samples are used.)
+ *    means. With samples min, max (max > min) an interval of a view ray
+ *    gets further random samples while the variance of the mean of its
+ *    samples' light, var(mean) = (E[x^2] - E[x]^2) / n per channel, is not
+ *    below threshold(n) = variance * chi2inv(n) / chi2inv(max - 1), chi2inv(k)
+ *    the chi-square value with k degrees of freedom that is exceeded with
+ *    probability `confidence` (POV-Ray's Sample_Threshold), up to max + 1
+ *    samples.
  *  - In-scattering at a sample in a lit interval: for each light whose
  *    interval holds the sample, the light reaching the point (attenuation,
  *    shadows through surfaces, media on the way) times scattering times the
@@ -311,6 +315,7 @@ typedef struct {
     double s0, s1, ds;
     rgb te, od;
     int samples;
+    rgb te2; /* sum of the squared sample lights (methods 1, 2) */
 } interval;
 
 static int cmp_double(const void *a, const void *b)
@@ -359,6 +364,7 @@ static void one_sample(const sampler *s, interval *iv, double d, int method, rgb
     } else {
         emit = mul(scl(emit, iv->ds), expn(scl(c.ext, d0)));
         iv->te = add(iv->te, emit);
+        iv->te2 = add(iv->te2, mul(emit, emit));
     }
     *col = emit;
     iv->samples++;
@@ -427,6 +433,59 @@ static void adaptive(const sampler *s, interval *iv, const scene_media *im, doub
         d0 = d1;
     }
     iv->samples = sub;
+}
+
+/* Regularised upper incomplete gamma Q(a, x) = Gamma(a, x) / Gamma(a):
+ * the power series of P = 1 - Q below x = a + 1, a continued fraction
+ * (modified Lentz) above. */
+static double gamma_q(double a, double x)
+{
+    if (!(x > 0.0)) return 1.0;
+    double lead = exp(-x + a * log(x) - lgamma(a));
+    if (x < a + 1.0) {
+        double term = 1.0 / a, sum = term;
+        for (int n = 1; n < 500 && fabs(term) > fabs(sum) * 1e-15; n++) {
+            term *= x / (a + n);
+            sum += term;
+        }
+        return 1.0 - sum * lead;
+    }
+    double tiny = 1e-300, b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, f = d;
+    for (int n = 1; n < 500; n++) {
+        double an = -n * (n - a);
+        b += 2.0;
+        d = an * d + b;
+        if (fabs(d) < tiny) d = tiny;
+        c = b + an / c;
+        if (fabs(c) < tiny) c = tiny;
+        d = 1.0 / d;
+        double delta = d * c;
+        f *= delta;
+        if (fabs(delta - 1.0) < 1e-15) break;
+    }
+    return lead * f;
+}
+
+/* The chi-square value with k degrees of freedom exceeded with
+ * probability y (Q(k/2, x/2) = y), by bisection (Q falls with x). */
+static double chi2_inv_q(double k, double y)
+{
+    double lo = 0.0, hi = 1.0;
+    while (gamma_q(0.5 * k, 0.5 * hi) > y && hi < 1e6) hi *= 2.0;
+    for (int i = 0; i < 200 && hi - lo > 1e-12 * hi; i++) {
+        double mid = 0.5 * (lo + hi);
+        if (gamma_q(0.5 * k, 0.5 * mid) > y) lo = mid;
+        else hi = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+/* Variance of the mean of an interval's sample lights, per channel. */
+static rgb sample_variance(const interval *iv)
+{
+    double n = 1.0 / iv->samples;
+    rgb m = scl(iv->te, n);
+    return scl(add(scl(iv->te2, n), scl(mul(m, m), -1.0)), n);
 }
 
 static int collect_refs(const media_env *e, int which, const media_inside *in, media_ref *refs)
@@ -540,12 +599,12 @@ rgb media_segment(const media_env *e, int which, const media_inside *in, vec3 or
     memset(ivs, 0, sizeof ivs);
     if (nlit == 1) {
         if (!lit[0].lit && constant) {
-            ivs[niv++] = (interval){0, lit[0].s0, lit[0].s1, lit[0].s1 - lit[0].s0, {0, 0, 0}, {0, 0, 0}, 0};
+            ivs[niv++] = (interval){0, lit[0].s0, lit[0].s1, lit[0].s1 - lit[0].s0, {0, 0, 0}, {0, 0, 0}, 0, {0, 0, 0}};
         } else {
             double delta = (lit[0].s1 - lit[0].s0) / want;
             for (int i = 0; i < want; i++)
                 ivs[niv++] = (interval){lit[0].lit, lit[0].s0 + delta * i, lit[0].s0 + delta * (i + 1), delta,
-                                        {0, 0, 0}, {0, 0, 0}, 0};
+                                        {0, 0, 0}, {0, 0, 0}, 0, {0, 0, 0}};
         }
     } else {
         double sum = 0.0;
@@ -560,7 +619,7 @@ rgb media_segment(const media_env *e, int which, const media_inside *in, vec3 or
             double delta = (lit[i].s1 - lit[i].s0) / n;
             for (int j = 0; j < n && niv < MAX_INTERVALS; j++)
                 ivs[niv++] = (interval){lit[i].lit, lit[i].s0 + delta * j, lit[i].s0 + delta * (j + 1), delta,
-                                        {0, 0, 0}, {0, 0, 0}, 0};
+                                        {0, 0, 0}, {0, 0, 0}, 0, {0, 0, 0}};
             remaining -= n;
         }
     }
@@ -593,6 +652,23 @@ rgb media_segment(const media_env *e, int which, const media_inside *in, vec3 or
             else d = rnd(e);
             one_sample(&s, iv, d, im->method == 2 ? 2 : 1, &col, &od);
             if (all_constant) break;
+        }
+    }
+    /* further samples where the view ray's samples vary too much */
+    if (!shadow && im->method != 3 && im->max_samples > nmin) {
+        double t = chi2_inv_q(im->max_samples - 1, im->confidence);
+        t = t > 0.0 ? im->variance / t : im->variance * MEDIA_EPSILON;
+        for (int i = 0; i < niv; i++) {
+            interval *iv = &ivs[i];
+            if (iv->samples < 1 || iv->samples >= im->max_samples) continue;
+            for (;;) {
+                rgb va = sample_variance(iv);
+                double thr = t * chi2_inv_q(iv->samples, im->confidence);
+                if (fabs(va.r) < thr && fabs(va.g) < thr && fabs(va.b) < thr) break;
+                rgb col, od;
+                one_sample(&s, iv, rnd(e), 1, &col, &od);
+                if (iv->samples > im->max_samples) break;
+            }
         }
     }
 
