@@ -143,8 +143,8 @@ k = (size * size) / (ps * ps)
 fixed = t["lights"] + t["photons"] + t["maps"] + t["irradiance"]
 parts = fixed + t["render"]
 scaled = t["render"] * k
-print("pmfg at %dx%d: lights+photons+maps %.2f s, irradiance %.2f s, render %.2f s (wall); process %.1f s wall, "
-      "%.1f s CPU" % (ps, ps, fixed, t["irradiance"], t["render"], wall, user + system))
+print("pmfg at %dx%d: lights %.2f s, photons %.2f s, maps %.2f s, irradiance %.2f s, render %.2f s (wall); process %.1f s wall, "
+      "%.1f s CPU" % (ps, ps, t["lights"], t["photons"], t["maps"], t["irradiance"], t["render"], wall, user + system))
 # CPU of the frame's parts: the process's CPU time shared out as their wall
 # times are (parse and accel, a few percent, counted in)
 cpu = (user + system) * (fixed + scaled) / parts
