@@ -598,6 +598,7 @@ static int has_grid(shape_kind k)
     switch (k) {
     case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE: case SHAPE_JULIA:
     case SHAPE_SUPERELLIPSOID: case SHAPE_OVUS:
+    case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_TORUS: /* analytic_grid */
         return 1;
     default: return 0;
     }
@@ -1021,7 +1022,9 @@ static long mesh_vertex(mesh_ctx *m, vec3 w, vec3 n)
     long h = (long)(vkey(w) & (uint64_t)(m->vcap - 1));
     while (m->vh[h] >= 0) {
         vec3 q = g->mv[m->vh[h]];
-        if (q.x == w.x && q.y == w.y && q.z == w.z) return m->vh[h];
+        vec3 qn = g->mn[m->vh[h]];
+        /* a cap's rim and the side's share positions, not normals */
+        if (q.x == w.x && q.y == w.y && q.z == w.z && qn.x == n.x && qn.y == n.y && qn.z == n.z) return m->vh[h];
         h = (h + 1) & (m->vcap - 1);
     }
     if (!mesh_grow_v(g)) return -1;
@@ -1042,6 +1045,7 @@ static int mesh_tri(void *ctx, const vec3 p[3], const vec3 n[3])
         nw[k] = v3_norm(m->sh->identity ? n[k] : xform_normal(&m->sh->x, n[k]));
         if (!v3_finite(w[k]) || !v3_finite(nw[k])) return 1;
     }
+    if (!(v3_len2(v3_cross(v3_sub(w[1], w[0]), v3_sub(w[2], w[0]))) > 0.0)) return 1; /* a cone's apex */
     if (pp->cnode >= 0) {
         /* CSG members: the triangles touching the result's surface */
         int keep = 0;
@@ -1066,6 +1070,95 @@ static int mesh_tri(void *ctx, const vec3 p[3], const vec3 n[3])
     g->mtp[g->nmt] = m->pi;
     g->nmt++;
     return 1;
+}
+
+/* Parametric grids of the analytic shapes accel_shape_grid leaves to GI
+ * (cylinder, cone, torus), in object space, n_* cells from the tessellation
+ * bound (object lengths times the transform's largest stretch): the side of
+ * a cone/cylinder by angle and height, its end caps by angle and radius (not
+ * on open ones; their rim vertices are separate from the side's, each with
+ * its own normal), a torus by its two angles. Vertices lie on the exact
+ * surface with its exact outward normals. */
+static int grid_count(double len, double tess, int lo)
+{
+    double c = ceil(len / tess);
+    return c < lo ? lo : (c > 256.0 ? 256 : (int)c);
+}
+
+static int analytic_grid(const accel_shape *sh, double tess, accel_grid_fn fn, void *ctx)
+{
+    const double (*m)[4] = sh->x.m;
+    double s = 0.0;
+    for (int c = 0; c < 3; c++) s = fmax(s, sqrt(m[0][c] * m[0][c] + m[1][c] * m[1][c] + m[2][c] * m[2][c]));
+    if (sh->identity) s = 1.0;
+    if (!(s > 0.0) || !isfinite(s)) return 0;
+    double t = tess / s; /* the bound in object units */
+    if (sh->kind == SHAPE_TORUS) {
+        double R = sh->g.torus.R, r = sh->g.torus.r;
+        int nu = grid_count(2.0 * M_PI * (R + r), t, 3), nv = grid_count(2.0 * M_PI * r, t, 3);
+        for (int j = 0; j < nv; j++)
+            for (int i = 0; i < nu; i++) {
+                vec3 P[4], N[4];
+                for (int k = 0; k < 4; k++) {
+                    int ii = (i + (k & 1)) % nu, jj = (j + (k >> 1)) % nv;
+                    double th = 2.0 * M_PI * ii / nu, ph = 2.0 * M_PI * jj / nv;
+                    N[k] = v3(cos(ph) * cos(th), sin(ph), cos(ph) * sin(th));
+                    P[k] = v3((R + r * cos(ph)) * cos(th), r * sin(ph), (R + r * cos(ph)) * sin(th));
+                }
+                vec3 a[3] = {P[0], P[1], P[3]}, na[3] = {N[0], N[1], N[3]};
+                vec3 b[3] = {P[0], P[3], P[2]}, nb[3] = {N[0], N[3], N[2]};
+                if (!fn(ctx, a, na) || !fn(ctx, b, nb)) return -1;
+            }
+        return 2 * nu * nv;
+    }
+    if (sh->kind != SHAPE_CYLINDER && sh->kind != SHAPE_CONE) return 0;
+    vec3 base = sh->g.cone.base, U = sh->g.cone.u, V = sh->g.cone.v, W = sh->g.cone.w;
+    double H = sh->g.cone.h, r0 = sh->g.cone.r0, r1 = sh->g.cone.r1, k = sh->g.cone.k;
+    int nu = grid_count(2.0 * M_PI * fmax(r0, r1), t, 3), nv = grid_count(H, t, 1);
+    int count = 0;
+    /* side: z = H v, radius r0 + k z; normal (x u + y v) - w k rz, normalised */
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++) {
+            vec3 P[4], N[4];
+            for (int q = 0; q < 4; q++) {
+                int ii = (i + (q & 1)) % nu, jj = j + (q >> 1);
+                double th = 2.0 * M_PI * ii / nu, z = H * jj / nv, rz = r0 + k * z;
+                vec3 radial = v3_add(v3_scale(U, cos(th)), v3_scale(V, sin(th)));
+                P[q] = v3_add(v3_add(base, v3_scale(W, z)), v3_scale(radial, rz));
+                vec3 nn = v3_sub(v3_scale(radial, rz), v3_scale(W, k * rz));
+                N[q] = v3_len2(nn) > 0.0 ? v3_norm(nn) : v3_scale(W, k <= 0.0 ? 1.0 : -1.0);
+            }
+            vec3 a[3] = {P[0], P[1], P[3]}, na[3] = {N[0], N[1], N[3]};
+            vec3 b[3] = {P[0], P[3], P[2]}, nb[3] = {N[0], N[3], N[2]};
+            if (!fn(ctx, a, na) || !fn(ctx, b, nb)) return -1;
+            count += 2;
+        }
+    if (sh->open) return count;
+    /* caps: rings around the centre */
+    for (int e = 0; e < 2; e++) {
+        double rr = e ? r1 : r0;
+        if (!(rr > 0.0)) continue;
+        vec3 c = e ? v3_add(base, v3_scale(W, H)) : base, nn = e ? W : v3_neg(W);
+        int nr = grid_count(rr, t, 1);
+        for (int j = 0; j < nr; j++)
+            for (int i = 0; i < nu; i++) {
+                vec3 P[4], N[3] = {nn, nn, nn};
+                for (int q = 0; q < 4; q++) {
+                    int ii = (i + (q & 1)) % nu, jj = j + (q >> 1);
+                    double th = 2.0 * M_PI * ii / nu, rad = rr * jj / nr;
+                    P[q] = v3_add(c, v3_scale(v3_add(v3_scale(U, cos(th)), v3_scale(V, sin(th))), rad));
+                }
+                vec3 b[3] = {P[0], P[3], P[2]};
+                if (!fn(ctx, b, N)) return -1;
+                count++;
+                if (j > 0) {
+                    vec3 a[3] = {P[0], P[1], P[3]};
+                    if (!fn(ctx, a, N)) return -1;
+                    count++;
+                }
+            }
+    }
+    return count;
 }
 
 static uint64_t cell_key(int pi, long ix, long iy, long iz)
@@ -1113,7 +1206,10 @@ static void build_meshes(gi_surface *g)
         double nn = ceil(ext / g->tess);
         int n = nn < 2.0 ? 2 : (nn > 128.0 ? 128 : (int)nn);
         mesh_ctx m = {g, i, p->sh, NULL, 0, 0};
-        int r = accel_shape_grid(p->sh, n, mesh_tri, &m);
+        shape_kind kind = g->o[p->obj].kind;
+        int r = kind == SHAPE_CYLINDER || kind == SHAPE_CONE || kind == SHAPE_TORUS
+                    ? analytic_grid(p->sh, g->tess, mesh_tri, &m)
+                    : accel_shape_grid(p->sh, n, mesh_tri, &m);
         free(m.vh);
         if (r < 0 || m.oom) {
             g->nmv = p->vfirst;

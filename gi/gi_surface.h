@@ -32,7 +32,10 @@
  * longest side, within [2, 128]); gi_surface_locate takes the grid
  * triangle nearest the hit (a hash of cells, each triangle in those its box
  * widened by a quarter cell touches) and the barycentrics of the nearest
- * point on it. The others have no radiance particles: gi_particle estimates
+ * point on it. Cylinders, cones and tori get a parametric grid of their own
+ * (angle x height, caps by angle x radius; the torus's two angles) with
+ * the same locate. The others (polygons, height fields, lathe, sor, prism,
+ * text) have no radiance particles: gi_particle estimates
  * indirect light at hits on them from the particles around the hit. Closed
  * ones get their outside (and inside when the camera or a light is in
  * them); polygons, height fields, lathe, sor and unbounded quadric/poly
@@ -107,7 +110,7 @@ int gi_surface_rp_side(const gi_surface *g, long rp);
 int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, long rp[3], double w[3]);
 
 /* Whether the hit object carries area particles (it may have no radiance
- * particles: cylinders, cones, tori; gi_particle then estimates at the hit). */
+ * particles: polygons, height fields, sweeps, text; gi_particle then estimates at the hit). */
 int gi_surface_has_particles(const gi_surface *g, const accel_hit *hit);
 /* Objects skipped (no particles) and a patch count per kind, for stats. */
 long gi_surface_skipped(const gi_surface *g);
