@@ -14,6 +14,7 @@
 
 #define GI_MODES 8
 /* A light edit cancels a relight in progress (the newer lights win) only
+ * when the last full lighting stage was slow (view_gi_slow_light) and only
  * while the GI has been out of date with the lights for less than this;
  * past it the relight finishes, so dragging a light without pause still
  * updates the GI about every RELIGHT_MAX_STALE + one lighting stage. */
@@ -58,6 +59,7 @@ struct view_render {
 
     volatile int cancel;       /* written by both threads, read by the workers */
     int relighting;            /* the render thread runs a lighting stage (guarded by mu) */
+    int relight_short;         /* that stage took under a preview pass last time: not cancelled */
     double stale_since;        /* first light edit the GI does not show yet (0: none) */
     double edit_in_relight;    /* first light edit posted while the relight runs (0: none) */
 
@@ -286,6 +288,7 @@ static pt_status relight_step(view_render *vr, view_gi *g, int preview, view_gi_
     pthread_mutex_lock(&vr->mu);
     int run = !vr->cancel;
     vr->relighting = run && !preview;
+    vr->relight_short = !view_gi_slow_light(g);
     vr->edit_in_relight = 0;
     pthread_mutex_unlock(&vr->mu);
     double c0 = cpu_now();
@@ -586,7 +589,9 @@ void view_render_submit(view_render *vr, const view_state *s, int cause)
     if (lights_changed) {
         if (vr->stale_since == 0) vr->stale_since = now;
         if (vr->relighting && vr->edit_in_relight == 0) vr->edit_in_relight = now;
-        if (vr->relighting && now - vr->stale_since < RELIGHT_MAX_STALE) vr->cancel = 1;
+        /* a short stage (under a preview pass, e.g. cbox's) finishes: redoing
+         * it for every edit of a dragged light would show nothing */
+        if (vr->relighting && !vr->relight_short && now - vr->stale_since < RELIGHT_MAX_STALE) vr->cancel = 1;
     }
     pthread_cond_signal(&vr->cv);
     pthread_mutex_unlock(&vr->mu);
