@@ -121,6 +121,7 @@ struct accel {
     int ngroups;
     accel_csg *csgs;              /* user primitives nshapes .. nshapes + ncsgs - 1 */
     int ncsgs, capcsgs;
+    float *ubox;                  /* 6 floats per user primitive: its box as user_bounds gives it */
     geom_info *ginfo;
     unsigned nginfo;
     vec3 lo, hi;
@@ -718,28 +719,60 @@ static int set_ginfo(accel *a, unsigned id, int kind, unsigned idx)
 
 /* ------------------------------------------------------------ callbacks */
 
-static void user_bounds(const struct RTCBoundsFunctionArguments *args)
+/* The box of user primitive prim (lower xyz, upper xyz), padded outwards. */
+static void user_box(const accel *a, unsigned prim, float out[6])
 {
-    const accel *a = args->geometryUserPtr;
     vec3 lo, hi;
-    if (args->primID < (unsigned)a->nshapes) {
-        lo = a->shapes[args->primID].lo;
-        hi = a->shapes[args->primID].hi;
+    if (prim < (unsigned)a->nshapes) {
+        lo = a->shapes[prim].lo;
+        hi = a->shapes[prim].hi;
     } else {
-        lo = a->csgs[args->primID - (unsigned)a->nshapes].lo;
-        hi = a->csgs[args->primID - (unsigned)a->nshapes].hi;
+        lo = a->csgs[prim - (unsigned)a->nshapes].lo;
+        hi = a->csgs[prim - (unsigned)a->nshapes].hi;
     }
     double ext = v3_maxc(v3_sub(hi, lo));
-    float out[6];
     for (int i = 0; i < 3; i++) {
         double l = v3_idx(lo, i), h = v3_idx(hi, i);
         double pad = 1e-6 * (fabs(l) + fabs(h) + ext);
         out[i] = nextafterf((float)(l - pad), -INFINITY);
         out[3 + i] = nextafterf((float)(h + pad), INFINITY);
     }
+}
+
+static void user_bounds(const struct RTCBoundsFunctionArguments *args)
+{
+    const accel *a = args->geometryUserPtr;
+    float out[6];
+    user_box(a, args->primID, out);
     struct RTCBounds *b = args->bounds_o;
     b->lower_x = out[0]; b->lower_y = out[1]; b->lower_z = out[2];
     b->upper_x = out[3]; b->upper_y = out[4]; b->upper_z = out[5];
+}
+
+/* Does lane i of an SOA ray miss user primitive prim's box within its
+ * [tnear, tfar]? Embree tests a primitive's box only from a BVH node
+ * above it, and a user geometry of one primitive is a lone leaf: every ray
+ * then called prim_hit (cbox's light patch: 2.07 M calls for 1.85 M link
+ * rays, 9% of the particle GI geometry stage's instructions). Conservative:
+ * a NaN slab (a zero direction component starting on a face) constrains
+ * nothing, and the interval must be empty by more than float rounding. */
+static int user_box_missed(const accel *a, unsigned prim, void *ray, unsigned N, unsigned i)
+{
+    if (!a->ubox) return 0;
+    const float *b = a->ubox + 6 * (size_t)prim;
+    float tn = SOA_F(ray, N, i, 3), tf = SOA_F(ray, N, i, 8);
+    for (int k = 0; k < 3; k++) {
+        float o = SOA_F(ray, N, i, k), inv = 1.0f / SOA_F(ray, N, i, 4 + k);
+        float t0 = (b[k] - o) * inv, t1 = (b[3 + k] - o) * inv;
+        if (t0 > t1) {
+            float t = t0;
+            t0 = t1;
+            t1 = t;
+        }
+        if (t0 > tn) tn = t0;
+        if (t1 < tf) tf = t1;
+    }
+    return tn > tf + 1e-5f * fabsf(tf) + 1e-30f;
 }
 
 /* One user primitive against a ray: an analytic shape or a CSG tree. */
@@ -781,7 +814,7 @@ static void user_intersect(const struct RTCIntersectFunctionNArguments *args)
     void *ray = args->rayhit;
     float *hit = (float *)args->rayhit + 12 * (size_t)N;
     for (unsigned i = 0; i < N; i++) {
-        if (args->valid[i] != -1) continue;
+        if (args->valid[i] != -1 || user_box_missed(a, args->primID, ray, N, i)) continue;
         float tfar = SOA_F(ray, N, i, 8);
         vec3 o, d;
         double tmin;
@@ -830,7 +863,7 @@ static void user_occluded(const struct RTCOccludedFunctionNArguments *args)
     int exact = q && (void *)q == (void *)args->context && N == 1;
     void *ray = args->ray;
     for (unsigned i = 0; i < N; i++) {
-        if (args->valid[i] != -1) continue;
+        if (args->valid[i] != -1 || user_box_missed(a, args->primID, ray, N, i)) continue;
         vec3 o, d;
         double tmin;
         if (exact) {
@@ -1175,6 +1208,10 @@ static pt_status build_user_geometry(accel *a)
     if (a->nshapes + a->ncsgs == 0) return PT_OK;
     RTCGeometry g = rtcNewGeometry(a->dev, RTC_GEOMETRY_TYPE_USER);
     if (!g) return PT_ERR_DEVICE;
+    unsigned np = (unsigned)(a->nshapes + a->ncsgs);
+    a->ubox = malloc((size_t)np * 6 * sizeof *a->ubox);
+    if (!a->ubox) return PT_ERR_NOMEM;
+    for (unsigned p = 0; p < np; p++) user_box(a, p, a->ubox + 6 * (size_t)p);
     rtcSetGeometryUserPrimitiveCount(g, (unsigned)(a->nshapes + a->ncsgs));
     rtcSetGeometryUserData(g, a);
     rtcSetGeometryBoundsFunction(g, user_bounds, a);
@@ -1298,6 +1335,7 @@ void accel_free(accel *a)
     free(a->bshapes);
     free(a->csg_b0);
     free(a->csg_bn);
+    free(a->ubox);
     free(a->ginfo);
     free(a);
 }
