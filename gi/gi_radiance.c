@@ -73,7 +73,7 @@ static void job(void *ctx, int chunk, int thread)
         int pa = gi_surface_rp_patch(J->g, l);
         int side = gi_surface_rp_side(J->g, l);
         if (!J->alive[2 * (size_t)pa + side]) {
-            /* a side without particles (it faces only the void): empty list */
+            /* its object has no particles on this side (it faces only the void): empty list */
             J->count[l] = 0;
             dead++;
             continue;
@@ -146,8 +146,29 @@ pt_status gi_radiance_lists(gi_lists *L, const gi_surface *g, const gi_particles
     J.fine = gi_grid_build(ps->p, ps->n, ps->spacing > 0.0 ? ps->spacing : r);
     int np = gi_surface_npatches(g);
     int *alive = calloc(2 * (size_t)np + 2, sizeof *alive);
-    if (alive)
+    if (alive) {
         for (int i = 0; i < ps->n; i++) alive[2 * (size_t)ps->patch[i] + ps->side[i]]++;
+        /* A side is dead (it faces only the void) when its object has no
+         * particles on that side, not merely its patch: a mesh's triangles
+         * smaller than the particle spacing mostly get no particle of their
+         * own (systematic sampling gives a patch floor(area / dA) or one
+         * more), yet their radiance particles need the neighbours' lists.
+         * An object's patches are consecutive (gi_surface_locate). */
+        for (int a = 0; a < np;) {
+            const scene_object *o = gi_surface_object(g, a);
+            int b = a, n0 = 0, n1 = 0;
+            while (b < np && gi_surface_object(g, b) == o) {
+                n0 |= alive[2 * (size_t)b] > 0;
+                n1 |= alive[2 * (size_t)b + 1] > 0;
+                b++;
+            }
+            for (int k = a; k < b; k++) {
+                alive[2 * (size_t)k] = n0;
+                alive[2 * (size_t)k + 1] = n1;
+            }
+            a = b;
+        }
+    }
     J.alive = alive;
     J.out = calloc((size_t)chunks + 1, sizeof *J.out);
     J.outlen = calloc((size_t)chunks + 1, sizeof *J.outlen);

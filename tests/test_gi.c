@@ -1104,6 +1104,94 @@ static void test_checker_particles(void **state)
     unload(&f);
 }
 
+/* A finely tessellated mesh (gi_fine_mesh.pov): a thin wall whose front is
+ * lit only indirectly, as 2 triangles a face (N = 1) and as 80 x 40 cells a
+ * face (N = 40, triangles smaller than the particle spacing, so most get no
+ * particle of their own). The fine wall must render like the coarse one: the
+ * mean over the wall's front within FINE_MEAN_TOL, and no pixel there below
+ * FINE_PIXEL_MIN of the coarse image's pixel (before the fix the fine wall's
+ * radiance particles on triangles without particles had empty lists: dark
+ * spots: the mean -74%, 248 of 334 pixels below half, some at 0). */
+#define FINE_MEAN_TOL 0.05
+#define FINE_PIXEL_MIN 0.5
+static double fine_wall(int n, int w, int h, float *out, unsigned char *on)
+{
+    char text[2048];
+    snprintf(text, sizeof text,
+             "#version 3.7;\n"
+             "global_settings { assumed_gamma 1.0 }\n"
+             "camera { location <2, 1.5, -3.5> look_at <0, 0.7, 0> angle 60 }\n"
+             "light_source { <-1.5, 2.5, 1.5> color rgb 3 fade_distance 1 fade_power 2 }\n"
+             "#macro Q(A, B, C, D, NU, NV)\n"
+             "  mesh2 { vertex_vectors { (NU+1)*(NV+1), #for (J,0,NV) #for (I,0,NU) #local U=I/NU; #local W=J/NV;"
+             " (1-W)*((1-U)*A+U*B)+W*((1-U)*D+U*C), #end #end }\n"
+             "    face_indices { 2*NU*NV, #for (J,0,NV-1) #for (I,0,NU-1) #local K=J*(NU+1)+I; <K,K+1,K+NU+2>,"
+             " <K,K+NU+2,K+NU+1>, #end #end }\n"
+             "    pigment { rgb 0.7 } finish { ambient 0 diffuse 0.8 } }\n"
+             "#end\n"
+             "Q(<-4,0,-4>,<4,0,-4>,<4,0,4>,<-4,0,4>, 8, 8)\n"
+             "Q(<-1.5,0,0>,<1.5,0,0>,<1.5,1.5,0>,<-1.5,1.5,0>, %d, %d)\n"
+             "Q(<-1.5,0,0.2>,<1.5,0,0.2>,<1.5,1.5,0.2>,<-1.5,1.5,0.2>, %d, %d)\n",
+             2 * n, n, 2 * n, n);
+    fixture f;
+    load(&f, text);
+    gi_particle *gp = build(&f, 20000, 8, device_c, 7);
+    assert_int_equal(gi_particle_prepare_view(gp, &f.sc->camera, w, h, f.d), PT_OK);
+    shade_settings ss;
+    shade_default_settings(&ss);
+    ss.width = w;
+    ss.height = h;
+    ss.threads = 2;
+    ss.use_ambient = 0;
+    ss.indirect = gi_particle_indirect;
+    ss.indirect_ctx = gp;
+    framebuffer *fb = fb_new(w, h);
+    shade_stats sst;
+    assert_int_equal(shade_render(f.sc, f.a, &ss, fb, &sst, f.d), PT_OK);
+    /* the wall's front (z = 0, seen from -z), away from its edges */
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            vec3 org, dir;
+            scene_camera_ray(&f.sc->camera, x + 0.5, y + 0.5, w, h, &org, &dir);
+            accel_hit hh;
+            int i = y * w + x;
+            on[i] = accel_intersect(f.a, org, dir, 0.0, INFINITY, &hh) && fabs(hh.p.z) < 1e-6 &&
+                    fabs(hh.p.x) < 1.4 && hh.p.y > 0.1 && hh.p.y < 1.4;
+            const float *p = fb->rgb + 3 * (size_t)i;
+            out[i] = (float)(0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]);
+        }
+    double m = luminance_mean(fb, on);
+    fb_free(fb);
+    gi_particle_free(gp);
+    unload(&f);
+    return m;
+}
+
+static void test_fine_mesh(void **state)
+{
+    (void)state;
+    enum { W = 48, H = 36 };
+    float lc[W * H], lf[W * H];
+    unsigned char onc[W * H], onf[W * H];
+    double mc = fine_wall(1, W, H, lc, onc), mf = fine_wall(40, W, H, lf, onf);
+    int non = 0, bad = 0;
+    double worst = INFINITY;
+    for (int i = 0; i < W * H; i++) {
+        if (!onc[i] || !onf[i]) continue;
+        non++;
+        double r = lf[i] / fmax(lc[i], 1e-12);
+        worst = fmin(worst, r);
+        bad += r < FINE_PIXEL_MIN;
+    }
+    printf("  fine mesh: wall front (%d pixels) mean luminance coarse %.5f fine %.5f (%+.2f%%), worst pixel ratio "
+           "%.3f, %d below %.2f\n",
+           non, mc, mf, 100.0 * (mf / mc - 1.0), worst, bad, FINE_PIXEL_MIN);
+    assert_true(non > 250);
+    assert_true(mc > 0.0);
+    assert_true(fabs(mf / mc - 1.0) < FINE_MEAN_TOL);
+    assert_int_equal(bad, 0);
+}
+
 static void test_settings_from_radiosity(void **state)
 {
     (void)state;
@@ -1143,6 +1231,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_light_group),
         cmocka_unit_test(test_diffuse_back),
         cmocka_unit_test(test_settings_from_radiosity),
+        cmocka_unit_test(test_fine_mesh),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
