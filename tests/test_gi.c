@@ -1213,6 +1213,59 @@ static void test_settings_from_radiosity(void **state)
     unload(&f);
 }
 
+/* ------------------------------------------------------------------ light on a surface */
+
+/* A light lying exactly in the plane of a ceiling (cornell.pov's nine
+ * spotlights sit at y = 54.88, the ceiling's height): the shadow ray from a
+ * particle must stop short of the ceiling by more than Embree's float
+ * error there. With a margin of 1e-6 x depth the ceiling triangle was hit
+ * (its t carries ~2e-6 relative error) and the whole top of cornell's tall
+ * block got no direct light (0 instead of 402 flux units: 10% of the
+ * image's mean luminance). The geometry is cornell.pov's ceiling and tall
+ * block top; the light is its first sub-patch centre as a plain point
+ * light (colour 1), so E/pi = cos(theta) (POV-Ray: diffuse x colour x cos,
+ * no distance falloff) at every particle on the top's upper side. */
+static void test_light_on_ceiling(void **state)
+{
+    (void)state;
+    fixture f;
+    load(&f, "#version 3.7;\n"
+             "global_settings { assumed_gamma 1.0 }\n"
+             "camera { location <27.8, 27.3, -80.0> look_at <27.8, 27.3, 0> }\n"
+             "light_source { <23.4667, 54.88, 24.45> color rgb 1 }\n"
+             "union {\n"
+             "  triangle { <55.60, 54.88, 0.0>, <55.60, 54.88, 55.92>, <0.0, 54.88, 55.92> }\n"
+             "  triangle { <55.60, 54.88, 0.0>, <0.0, 54.88, 55.92>, <0.0, 54.88, 0.0> }\n"
+             "  triangle { <42.30, 33.00, 24.70>, <26.50, 33.00, 29.60>, <31.40, 33.00, 45.60> }\n"
+             "  triangle { <42.30, 33.00, 24.70>, <31.40, 33.00, 45.60>, <47.20, 33.00, 40.60> }\n"
+             "  pigment { rgb 1 } finish { ambient 0 diffuse 0.75 }\n"
+             "}\n");
+    gi_particle *gp = build(&f, 4000, 1, device_c, 5);
+    const float *edir;
+    int n = gi_particle_debug(gp, &edir, NULL, NULL, NULL, NULL);
+    vec3 lp = v3(23.4667, 54.88, 24.45);
+    int checked = 0, dark = 0;
+    double worst = 0.0;
+    for (int i = 0; i < n; i++) {
+        vec3 p, nrm;
+        gi_particle_debug_particle(gp, i, NULL, NULL, &p, &nrm);
+        if (!(fabs(p.y - 33.0) < 1e-3 && nrm.y > 0.9)) continue; /* the block top's upper side */
+        vec3 l = v3_sub(lp, p);
+        double want = v3_dot(nrm, l) / v3_len(l);
+        double got = edir[4 * i + 1];
+        if (got < 0.5 * want) dark++;
+        worst = fmax(worst, fabs(got - want) / want);
+        checked++;
+    }
+    printf("  light in the ceiling plane: %d top particles, %d dark, worst relative error %.2e\n", checked, dark,
+           worst);
+    assert_true(checked >= 20);
+    assert_int_equal(dark, 0);
+    assert_true(worst < 1e-3);
+    gi_particle_free(gp);
+    unload(&f);
+}
+
 int main(int argc, char **argv)
 {
     /* test_gi NAME runs the tests matching NAME (cmocka's filter) */
@@ -1236,6 +1289,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_diffuse_back),
         cmocka_unit_test(test_settings_from_radiosity),
         cmocka_unit_test(test_fine_mesh),
+        cmocka_unit_test(test_light_on_ceiling),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
