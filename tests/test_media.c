@@ -30,6 +30,7 @@
 #include "sdl.h"
 #include "shade.h"
 #include "test_util.h"
+#include "test_world.h"
 
 #define W 160
 #define H 120
@@ -39,38 +40,11 @@
  * scene's size): measured 8.3e-6 at most (exp(-6) through 3 units). */
 #define TOL 3e-5
 
-typedef struct {
-    scene *s;
-    accel *a;
-    diag *d;
-} world;
+typedef tu_world world;
 
-static world build(const char *src)
-{
-    world w;
-    w.d = diag_new();
-    sdl_options opt;
-    sdl_default_options(&opt);
-    pt_status st = sdl_parse_string("media.pov", src, &opt, &w.s, w.d);
-    if (st != PT_OK) {
-        for (int i = 0; i < diag_count(w.d); i++) {
-            char *m = diag_format(diag_get(w.d, i));
-            fprintf(stderr, "%s\n", m);
-            free(m);
-        }
-        fail_msg("parse failed");
-    }
-    w.a = accel_build(w.s, 1, w.d, &st);
-    assert_non_null(w.a);
-    return w;
-}
+static world build(const char *src) { return tu_world_build("media.pov", src); }
 
-static void done(world *w)
-{
-    accel_free(w->a);
-    scene_free(w->s);
-    diag_free(w->d);
-}
+static void done(world *w) { tu_world_free(w); }
 
 static rgb trace(const world *w, vec3 org, vec3 dir)
 {

@@ -26,6 +26,7 @@
 #include "sdl.h"
 #include "sdl_hfimage.h"
 #include "sdl_imgread.h"
+#include "test_world.h"
 #include <jpeglib.h>
 #include <tiffio.h>
 
@@ -40,38 +41,11 @@ static void assert_vec(vec3 a, vec3 b, double tol)
         fail_msg("got <%.12g,%.12g,%.12g>, expected <%.12g,%.12g,%.12g> (tol %g)", a.x, a.y, a.z, b.x, b.y, b.z, tol);
 }
 
-typedef struct {
-    scene *s;
-    accel *a;
-    diag *d;
-} world;
+typedef tu_world world;
 
-static world build(const char *src)
-{
-    world w;
-    w.d = diag_new();
-    sdl_options opt;
-    sdl_default_options(&opt);
-    pt_status st = sdl_parse_string("shapes.pov", src, &opt, &w.s, w.d);
-    if (st != PT_OK) {
-        for (int i = 0; i < diag_count(w.d); i++) {
-            char *m = diag_format(diag_get(w.d, i));
-            fprintf(stderr, "%s\n", m);
-            free(m);
-        }
-        fail_msg("parse failed");
-    }
-    w.a = accel_build(w.s, 1, w.d, &st);
-    assert_non_null(w.a);
-    return w;
-}
+static world build(const char *src) { return tu_world_build("shapes.pov", src); }
 
-static void done(world *w)
-{
-    accel_free(w->a);
-    scene_free(w->s);
-    diag_free(w->d);
-}
+static void done(world *w) { tu_world_free(w); }
 
 static int hit(const world *w, vec3 o, vec3 d, accel_hit *h) { return accel_intersect(w->a, o, d, 0.0, INFINITY, h); }
 
