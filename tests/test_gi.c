@@ -263,6 +263,24 @@ static const char *sphere_scene =
 
 static double g_bias;
 
+/* Indirect light (the hook's E/pi, green) at the pixels of a pw x pw view
+ * of f's camera: on[i] is 1 where the primary ray hits a shape other than
+ * the mesh room, and only there is ind[i] written. */
+static void view_indirect(fixture *f, gi_particle *gp, int pw, unsigned char *on, double *ind)
+{
+    for (int y = 0; y < pw; y++)
+        for (int x = 0; x < pw; x++) {
+            vec3 org, dir;
+            scene_camera_ray(&f->sc->camera, x + 0.5, y + 0.5, pw, pw, &org, &dir);
+            accel_hit h;
+            int i = y * pw + x;
+            on[i] = accel_intersect(f->a, org, dir, 0.0, INFINITY, &h) && h.obj->kind != SHAPE_MESH;
+            if (!on[i]) continue;
+            vec3 n = v3_dot(dir, h.ns) > 0.0 ? v3_neg(h.ns) : h.ns;
+            ind[i] = gi_particle_indirect(gp, &h, n, 0).g;
+        }
+}
+
 static double sphere_error(fixture *f, long count, int nb, const char *device, double *expected)
 {
     gi_particle *gp = build(f, count, nb, device, 7);
@@ -716,17 +734,7 @@ static void test_implicit_sphere(void **state)
         double exact = 4.0 * M_PI * r * r;
         assert_int_equal(gi_particle_prepare_view(gp, &f.sc->camera, 32, 32, f.d), PT_OK);
         long otf0 = gi_particle_get_stats(gp)->lookups_onthefly;
-        for (int y = 0; y < PW; y++)
-            for (int x = 0; x < PW; x++) {
-                vec3 org, dir;
-                scene_camera_ray(&f.sc->camera, x + 0.5, y + 0.5, PW, PW, &org, &dir);
-                accel_hit h;
-                int i = y * PW + x;
-                on[k][i] = accel_intersect(f.a, org, dir, 0.0, INFINITY, &h) && h.obj->kind != SHAPE_MESH;
-                if (!on[k][i]) continue;
-                vec3 n = v3_dot(dir, h.ns) > 0.0 ? v3_neg(h.ns) : h.ns;
-                ind[k][i] = gi_particle_indirect(gp, &h, n, 0).g;
-            }
+        view_indirect(&f, gp, PW, on[k], ind[k]);
         long otf = gi_particle_get_stats(gp)->lookups_onthefly - otf0;
         shade_settings ss;
         shade_default_settings(&ss);
@@ -799,17 +807,7 @@ static void test_torus_grid(void **state)
         load(&f, text);
         gi_particle *gp = build(&f, 6000, 4, device_c, 3);
         assert_int_equal(gi_particle_prepare_view(gp, &f.sc->camera, PW, PW, f.d), PT_OK);
-        for (int y = 0; y < PW; y++)
-            for (int x = 0; x < PW; x++) {
-                vec3 org, dir;
-                scene_camera_ray(&f.sc->camera, x + 0.5, y + 0.5, PW, PW, &org, &dir);
-                accel_hit h;
-                int i = y * PW + x;
-                on[k][i] = accel_intersect(f.a, org, dir, 0.0, INFINITY, &h) && h.obj->kind != SHAPE_MESH;
-                if (!on[k][i]) continue;
-                vec3 n = v3_dot(dir, h.ns) > 0.0 ? v3_neg(h.ns) : h.ns;
-                ind[k][i] = gi_particle_indirect(gp, &h, n, 0).g;
-            }
+        view_indirect(&f, gp, PW, on[k], ind[k]);
         const gi_particle_stats *st = gi_particle_get_stats(gp);
         assert_int_equal(st->lookups_onthefly, 0);
         assert_int_equal(st->lookups_none, 0);

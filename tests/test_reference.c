@@ -341,19 +341,17 @@ static const char *direct_scene =
     "box { <1.3, 0, -0.5>, <2.3, 1.2, 0.5> rotate y*30 pigment { rgb <0.2, 0.5, 0.9> }\n"
     "      finish { ambient 0 diffuse 0.8 brilliance 2 specular 0.5 roughness 0.02 } }\n";
 
-static void test_direct_equivalence(void **state)
+/* Direct light only, two ways at w x h: --gi none (shade_render, no
+ * ambient) into ref, and the path tracer with max depth 1 (1 spp, no
+ * jitter) into fb. */
+static void render_direct_pair(const scene *sc, const accel *a, int w, int h, framebuffer *ref, framebuffer *fb)
 {
-    (void)state;
-    scene *sc = parse(direct_scene);
-    accel *a = build(sc);
-    int w = 48, h = 36;
     shade_settings ss;
     shade_default_settings(&ss);
     ss.width = w;
     ss.height = h;
     ss.threads = THREADS;
     ss.use_ambient = 0;
-    framebuffer *ref = fb_new(w, h);
     shade_stats sst;
     assert_int_equal(shade_render(sc, a, &ss, ref, &sst, NULL), PT_OK);
     pm_path_settings ps;
@@ -364,9 +362,18 @@ static void test_direct_equivalence(void **state)
     ps.c.spp = 1;
     ps.c.jitter = 0;
     ps.max_depth = 1;
-    framebuffer *fb = fb_new(w, h);
     pm_stats st;
     assert_int_equal(pm_path_render(sc, a, &ps, fb, &st, NULL), PT_OK);
+}
+
+static void test_direct_equivalence(void **state)
+{
+    (void)state;
+    scene *sc = parse(direct_scene);
+    accel *a = build(sc);
+    int w = 48, h = 36;
+    framebuffer *ref = fb_new(w, h), *fb = fb_new(w, h);
+    render_direct_pair(sc, a, w, h, ref, fb);
     double maxdiff = 0.0, maxval = 0.0, mean_ref = 0.0, mean_pt = 0.0;
     for (int i = 0; i < w * h * 3; i++) {
         maxdiff = fmax(maxdiff, fabs(fb->rgb[i] - ref->rgb[i]));
@@ -424,25 +431,10 @@ static void test_light_group(void **state)
     scene *sc = parse(text);
     accel *a = build(sc);
     int w = 32, h = 24;
-    shade_settings ss;
-    shade_default_settings(&ss);
-    ss.width = w;
-    ss.height = h;
-    ss.threads = THREADS;
-    ss.use_ambient = 0;
     framebuffer *ref = fb_new(w, h), *fb = fb_new(w, h);
-    shade_stats sst;
-    assert_int_equal(shade_render(sc, a, &ss, ref, &sst, NULL), PT_OK);
+    render_direct_pair(sc, a, w, h, ref, fb);
     pm_path_settings ps;
-    pm_path_default_settings(&ps);
-    ps.c.width = w;
-    ps.c.height = h;
-    ps.c.threads = THREADS;
-    ps.c.spp = 1;
-    ps.c.jitter = 0;
-    ps.max_depth = 1;
     pm_stats st;
-    assert_int_equal(pm_path_render(sc, a, &ps, fb, &st, NULL), PT_OK);
     double maxdiff = 0.0, maxval = 0.0;
     for (int i = 0; i < w * h * 3; i++) {
         maxdiff = fmax(maxdiff, fabs(fb->rgb[i] - ref->rgb[i]));
