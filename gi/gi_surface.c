@@ -1181,6 +1181,22 @@ static int cmp_cell(const void *a, const void *b)
  * locate hash (each triangle in the cells its box, widened by a quarter
  * cell, touches). Patches whose grid fails keep rp_count 0 (estimated at
  * the hit, as before). */
+/* Range of locate-hash cells [x0, x1] x [y0, y1] x [z0, z1] that piece
+ * p's triangle t touches: its bounding box grown by a quarter cell. */
+static void tri_cells(const gi_surface *g, const patch *p, long t, long *x0, long *x1, long *y0, long *y1, long *z0,
+                      long *z1)
+{
+    vec3 lo = v3s(INFINITY), hi = v3s(-INFINITY);
+    for (int k = 0; k < 3; k++) {
+        lo = v3_min(lo, g->mv[p->vfirst + g->mt[t][k]]);
+        hi = v3_max(hi, g->mv[p->vfirst + g->mt[t][k]]);
+    }
+    double e = 0.25 * p->cell;
+    *x0 = (long)floor((lo.x - e) / p->cell), *x1 = (long)floor((hi.x + e) / p->cell);
+    *y0 = (long)floor((lo.y - e) / p->cell), *y1 = (long)floor((hi.y + e) / p->cell);
+    *z0 = (long)floor((lo.z - e) / p->cell), *z1 = (long)floor((hi.z + e) / p->cell);
+}
+
 static void build_meshes(gi_surface *g)
 {
     g->nmv = g->nmt = 0;
@@ -1226,15 +1242,8 @@ static void build_meshes(gi_surface *g)
             }
         p->cell = cell > 0.0 ? cell : 1.0;
         for (long t = p->tfirst; t < p->tfirst + p->nt; t++) {
-            vec3 lo = v3s(INFINITY), hi = v3s(-INFINITY);
-            for (int k = 0; k < 3; k++) {
-                lo = v3_min(lo, g->mv[p->vfirst + g->mt[t][k]]);
-                hi = v3_max(hi, g->mv[p->vfirst + g->mt[t][k]]);
-            }
-            double e = 0.25 * p->cell;
-            long x0 = (long)floor((lo.x - e) / p->cell), x1 = (long)floor((hi.x + e) / p->cell);
-            long y0 = (long)floor((lo.y - e) / p->cell), y1 = (long)floor((hi.y + e) / p->cell);
-            long z0 = (long)floor((lo.z - e) / p->cell), z1 = (long)floor((hi.z + e) / p->cell);
+            long x0, x1, y0, y1, z0, z1;
+            tri_cells(g, p, t, &x0, &x1, &y0, &y1, &z0, &z1);
             nce += (x1 - x0 + 1) * (y1 - y0 + 1) * (z1 - z0 + 1);
         }
     }
@@ -1250,15 +1259,8 @@ static void build_meshes(gi_surface *g)
         const patch *p = &g->p[i];
         if (p->kind != PATCH_PIECE) continue;
         for (long t = p->tfirst; t < p->tfirst + p->nt; t++) {
-            vec3 lo = v3s(INFINITY), hi = v3s(-INFINITY);
-            for (int k = 0; k < 3; k++) {
-                lo = v3_min(lo, g->mv[p->vfirst + g->mt[t][k]]);
-                hi = v3_max(hi, g->mv[p->vfirst + g->mt[t][k]]);
-            }
-            double e = 0.25 * p->cell;
-            long x0 = (long)floor((lo.x - e) / p->cell), x1 = (long)floor((hi.x + e) / p->cell);
-            long y0 = (long)floor((lo.y - e) / p->cell), y1 = (long)floor((hi.y + e) / p->cell);
-            long z0 = (long)floor((lo.z - e) / p->cell), z1 = (long)floor((hi.z + e) / p->cell);
+            long x0, x1, y0, y1, z0, z1;
+            tri_cells(g, p, t, &x0, &x1, &y0, &y1, &z0, &z1);
             for (long z = z0; z <= z1; z++)
                 for (long y = y0; y <= y1; y++)
                     for (long x = x0; x <= x1; x++) {
