@@ -110,16 +110,22 @@ void shade_default_settings(shade_settings *s)
 
 /* ------------------------------------------------------------------ lights */
 
+/* Where a shadow ray toward a light at distance depth stops: short of the
+ * light by the scene's epsilon or 1e-6 of the distance, whichever is
+ * larger; at most c->eps means the light touches p (nothing in between). */
+static double shadow_tmax(const render_ctx *c, double depth)
+{
+    return depth - fmax(c->eps, depth * 1e-6);
+}
+
 static int shadow_blocked(render_ctx *c, int thread, vec3 p, vec3 dir, double depth)
 {
     c->ts[thread].shadow++;
-    double tmax = depth - fmax(c->eps, depth * 1e-6);
+    double tmax = shadow_tmax(c, depth);
     if (tmax <= c->eps) return 0;
     return accel_occluded(c->a, p, dir, c->eps, tmax);
 }
 
-/* Light reaching p along a shadow ray: 0 or 1 in scenes without transparent
- * surfaces, else filtered by the surfaces crossed (shade_texture.c). */
 static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, const media_inside *in, vec3 *to_light);
 
 /* Media along shadow rays (shade_media.c): the light's media_attenuation
@@ -129,19 +135,21 @@ static int media_shadows(const render_ctx *c, const scene_light *l)
     return c->media || (l && c->sc->fogs && l->media_interaction && l->media_attenuation);
 }
 
+/* Light reaching p along a shadow ray: 0 or 1 in scenes without transparent
+ * surfaces or media, else filtered by the surfaces crossed
+ * (shade_texture.c) and attenuated by the media on the way. */
 static rgb shadow_rgb(render_ctx *c, int thread, vec3 p, vec3 dir, double depth, const scene_light *l, const media_inside *in)
 {
-    if (media_shadows(c, l)) {
-        c->ts[thread].shadow++;
-        double tmax = depth - fmax(c->eps, depth * 1e-6);
-        if (tmax <= c->eps) return rgb_make(1, 1, 1);
+    int media = media_shadows(c, l);
+    if (!media && !c->transparent)
+        return shadow_blocked(c, thread, p, dir, depth) ? rgb_make(0, 0, 0) : rgb_make(1, 1, 1);
+    c->ts[thread].shadow++;
+    double tmax = shadow_tmax(c, depth);
+    if (tmax <= c->eps) return rgb_make(1, 1, 1);
+    if (media) {
         media_env me = {c->sc, c, thread, NULL, media_light, NULL};
         return media_shadow_ray(c->sc, c->a, &me, l, p, dir, c->eps, tmax, in ? in : &no_containers);
     }
-    if (!c->transparent) return shadow_blocked(c, thread, p, dir, depth) ? rgb_make(0, 0, 0) : rgb_make(1, 1, 1);
-    c->ts[thread].shadow++;
-    double tmax = depth - fmax(c->eps, depth * 1e-6);
-    if (tmax <= c->eps) return rgb_make(1, 1, 1);
     return tex_shadow_ray(c->sc, c->a, p, dir, c->eps, tmax);
 }
 
