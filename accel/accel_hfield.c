@@ -329,3 +329,44 @@ void accel_hfield_triangle(const accel_shape *sh, int part, vec3 *a, vec3 *b, ve
     a->x /= f->nx; b->x /= f->nx; c->x /= f->nx;
     a->z /= f->nz; b->z /= f->nz; c->z /= f->nz;
 }
+
+void accel_hfield_cells(const accel_shape *sh, int *nx, int *nz)
+{
+    const hf_data *f = sh->data;
+    *nx = f ? f->nx : 0;
+    *nz = f ? f->nz : 0;
+}
+
+/* Index of coarse line k of a field with n cells at stride s (the last one n). */
+static int coarse_at(int k, int s, int n) { return k * s < n ? k * s : n; }
+
+int accel_hfield_coarse_grid(const accel_shape *sh, int sx, int sz, accel_grid_fn fn, void *ctx)
+{
+    const hf_data *f = sh->data;
+    if (!f || f->nx < 1 || f->nz < 1) return 0;
+    if (sx < 1) sx = 1;
+    if (sz < 1) sz = 1;
+    int cx = (f->nx + sx - 1) / sx, cz = (f->nz + sz - 1) / sz, count = 0;
+    for (int j = 0; j < cz; j++)
+        for (int i = 0; i < cx; i++) {
+            /* corners (i, j) (i+1, j) (i, j+1) (i+1, j+1) of the coarse cell, with the
+             * coarse neighbours around each for its normal */
+            vec3 P[4], N[4];
+            for (int q = 0; q < 4; q++) {
+                int ki = i + (q & 1), kj = j + (q >> 1);
+                int gi = coarse_at(ki, sx, f->nx), gj = coarse_at(kj, sz, f->nz);
+                int i0 = coarse_at(ki > 0 ? ki - 1 : ki, sx, f->nx), i1 = coarse_at(ki < cx ? ki + 1 : ki, sx, f->nx);
+                int j0 = coarse_at(kj > 0 ? kj - 1 : kj, sz, f->nz), j1 = coarse_at(kj < cz ? kj + 1 : kj, sz, f->nz);
+                /* slopes dh/dx, dh/dz in object units (x = i / nx, z = j / nz) */
+                double dx = (H_at(f, i1, gj) - H_at(f, i0, gj)) * f->nx / (double)(i1 > i0 ? i1 - i0 : 1);
+                double dz = (H_at(f, gi, j1) - H_at(f, gi, j0)) * f->nz / (double)(j1 > j0 ? j1 - j0 : 1);
+                P[q] = v3((double)gi / f->nx, H_at(f, gi, gj), (double)gj / f->nz);
+                N[q] = v3_norm(v3(-dx, 1.0, -dz));
+            }
+            vec3 a[3] = {P[0], P[1], P[2]}, na[3] = {N[0], N[1], N[2]};
+            vec3 b[3] = {P[3], P[2], P[1]}, nb[3] = {N[3], N[2], N[1]};
+            if (!fn(ctx, a, na) || !fn(ctx, b, nb)) return -1;
+            count += 2;
+        }
+    return count;
+}

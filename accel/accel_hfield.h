@@ -28,4 +28,14 @@ vec3 accel_hfield_shading(const accel_shape *sh, vec3 q);
 int accel_hfield_ntriangles(const accel_shape *sh);
 void accel_hfield_triangle(const accel_shape *sh, int part, vec3 *a, vec3 *b, vec3 *c);
 
+/* Cells along x and z (0 when the field has no data). */
+void accel_hfield_cells(const accel_shape *sh, int *nx, int *nz);
+/* A coarser grid for GI's radiance particles (gi_surface): the grid points
+ * every sx-th along x and sz-th along z (and the last ones), split along
+ * the same diagonal as the cells; vertices on the exact surface, object
+ * normals from central differences over the coarse neighbours. Strides 1
+ * give the field's own triangles. Calls fn per triangle; returns their
+ * number, -1 when fn returned 0. */
+int accel_hfield_coarse_grid(const accel_shape *sh, int sx, int sz, accel_grid_fn fn, void *ctx);
+
 #endif

@@ -1395,18 +1395,18 @@ static void grid_point(const sw_data *w, int part, double a, double b, vec3 *p, 
     }
 }
 
-int accel_sweep_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
+/* Grid with na[k] cells along segment k, nb around (lathe, sor) or along
+ * the sweep (prism), nr along the radius of a sor's caps; prism caps from
+ * the curves polygonised into na[k] pieces each. */
+static int grid_sized(const sw_data *w, const int *na, int nb, int nr, accel_grid_fn fn, void *ctx)
 {
-    const sw_data *w = sh->data;
-    if (!w) return 0;
     grid_out g = {w, fn, ctx, 0};
-    int na = n, nb = w->type == SW_PRISM ? n : 4 * n;
     for (int k = 0; k < w->nseg; k++) {
         if (w->type == SW_LATHE && w->seg[k].hi[0] <= 0.0 && w->seg[k].lo[0] >= 0.0) continue;
         for (int j = 0; j < nb; j++)
-            for (int i = 0; i < na; i++) {
+            for (int i = 0; i < na[k]; i++) {
                 vec3 P[4], N[4];
-                double as[4] = {(double)i / na, (double)(i + 1) / na, (double)(i + 1) / na, (double)i / na};
+                double as[4] = {(double)i / na[k], (double)(i + 1) / na[k], (double)(i + 1) / na[k], (double)i / na[k]};
                 double bs[4] = {(double)j / nb, (double)j / nb, (double)(j + 1) / nb, (double)(j + 1) / nb};
                 for (int c = 0; c < 4; c++) grid_point(w, 2 + k, as[c], bs[c], &P[c], &N[c]);
                 if (!emit_quad(&g, P, N)) return -1;
@@ -1414,20 +1414,20 @@ int accel_sweep_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
     }
     if (w->type == SW_SOR && !w->open) {
         for (int part = 0; part < 2; part++)
-            for (int j = 0; j < 4 * n; j++)
-                for (int i = 0; i < n; i++) {
+            for (int j = 0; j < nb; j++)
+                for (int i = 0; i < nr; i++) {
                     vec3 P[4], N[4];
-                    double as[4] = {(double)i / n, (double)(i + 1) / n, (double)(i + 1) / n, (double)i / n};
-                    double bs[4] = {(double)j / (4 * n), (double)j / (4 * n), (double)(j + 1) / (4 * n),
-                                    (double)(j + 1) / (4 * n)};
+                    double as[4] = {(double)i / nr, (double)(i + 1) / nr, (double)(i + 1) / nr, (double)i / nr};
+                    double bs[4] = {(double)j / nb, (double)j / nb, (double)(j + 1) / nb, (double)(j + 1) / nb};
                     for (int c = 0; c < 4; c++) grid_point(w, part, as[c], bs[c], &P[c], &N[c]);
                     if (!emit_quad(&g, P, N)) return -1;
                 }
     }
     if (w->type == SW_PRISM && !w->open) {
-        /* caps: the curves polygonised (n pieces per segment), cut into
-         * trapezoids between vertex heights (even-odd) */
-        int m = w->nseg * n;
+        /* caps: the curves polygonised (na[k] pieces for segment k), cut
+         * into trapezoids between vertex heights (even-odd) */
+        int m = 0;
+        for (int k = 0; k < w->nseg; k++) m += na[k];
         double *vs = malloc(sizeof *vs * (size_t)m);
         double(*pts)[2] = malloc(sizeof *pts * (size_t)m * 2);
         if (!vs || !pts) {
@@ -1435,11 +1435,11 @@ int accel_sweep_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
             free(pts);
             return g.count;
         }
-        for (int k = 0; k < w->nseg; k++)
-            for (int i = 0; i < n; i++) {
-                seg_eval(&w->seg[k], (double)i / n, pts[2 * (k * n + i)], NULL);
-                seg_eval(&w->seg[k], (double)(i + 1) / n, pts[2 * (k * n + i) + 1], NULL);
-                vs[k * n + i] = pts[2 * (k * n + i)][1];
+        for (int k = 0, e = 0; k < w->nseg; k++)
+            for (int i = 0; i < na[k]; i++, e++) {
+                seg_eval(&w->seg[k], (double)i / na[k], pts[2 * e], NULL);
+                seg_eval(&w->seg[k], (double)(i + 1) / na[k], pts[2 * e + 1], NULL);
+                vs[e] = pts[2 * e][1];
             }
         qsort(vs, (size_t)m, sizeof *vs, cmp_double);
         double(*ed)[3] = malloc(sizeof *ed * (size_t)m);
@@ -1487,4 +1487,67 @@ int accel_sweep_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
         free(ed);
     }
     return g.count;
+}
+
+int accel_sweep_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
+{
+    const sw_data *w = sh->data;
+    if (!w || n < 1) return 0;
+    int *na = malloc(sizeof *na * (size_t)(w->nseg > 0 ? w->nseg : 1));
+    if (!na) return -1;
+    for (int k = 0; k < w->nseg; k++) na[k] = n;
+    int r = grid_sized(w, na, w->type == SW_PRISM ? n : 4 * n, n, fn, ctx);
+    free(na);
+    return r;
+}
+
+/* Cells for a length: ceil(len / cell) within [lo, 4096]. */
+static int cells_for(double len, double cell, int lo)
+{
+    double c = ceil(len / cell);
+    return !(c >= lo) ? lo : (c > 4096.0 ? 4096 : (int)c);
+}
+
+int accel_sweep_grid_cell(const accel_shape *sh, double cell, accel_grid_fn fn, void *ctx)
+{
+    const sw_data *w = sh->data;
+    if (!w || w->type == SW_POLYGON || !(cell > 0.0) || !isfinite(cell)) return 0;
+    double c = cell / w->L; /* the bound in local units */
+    enum { S = 32 };
+    int *na = malloc(sizeof *na * (size_t)(w->nseg > 0 ? w->nseg : 1));
+    if (!na) return -1;
+    double around = 0.0, rmax = 0.0;
+    for (int k = 0; k < w->nseg; k++) {
+        /* the segment's arc length (longest of the curve at the sweep's two
+         * ends, for conic prisms) and its ruling's or circle's length */
+        double arc = 0.0;
+        for (int e = 0; e < 2; e++) {
+            double len = 0.0;
+            vec3 a, b, nn;
+            grid_point(w, 2 + k, 0.0, (double)e, &a, &nn);
+            for (int i = 1; i <= S; i++) {
+                grid_point(w, 2 + k, (double)i / S, (double)e, &b, &nn);
+                len += v3_len(v3_sub(b, a));
+                rmax = fmax(rmax, sqrt(b.x * b.x + b.z * b.z));
+                a = b;
+            }
+            arc = fmax(arc, len);
+            if (w->type != SW_PRISM) break;
+        }
+        na[k] = cells_for(arc, c, 1);
+        if (w->type == SW_PRISM) {
+            for (int i = 0; i <= 4; i++) {
+                vec3 a, b, nn;
+                grid_point(w, 2 + k, i / 4.0, 0.0, &a, &nn);
+                grid_point(w, 2 + k, i / 4.0, 1.0, &b, &nn);
+                around = fmax(around, v3_len(v3_sub(b, a)));
+            }
+        }
+    }
+    if (w->type == SW_SOR) rmax = fmax(rmax, sqrt(fmax(w->base_r2, w->cap_r2)));
+    int nb = w->type == SW_PRISM ? cells_for(around, c, 1) : cells_for(2.0 * M_PI * rmax, c, 3);
+    int nr = cells_for(sqrt(fmax(w->base_r2, w->cap_r2)), c, 1);
+    int r = grid_sized(w, na, nb, nr, fn, ctx);
+    free(na);
+    return r;
 }

@@ -46,6 +46,12 @@ void accel_sweep_sample(const accel_shape *sh, double u1, double u2, rng *r, vec
 
 /* Grid triangles (accel_shape_grid) of a lathe, sor, prism, text or polygon. */
 int accel_sweep_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx);
+/* The same grid sized by length: cells of at most `cell` object units along
+ * each profile segment (by its arc length) and around (lathe, sor: the
+ * widest circle, at least 3) or along the sweep (prism, text); sor caps
+ * by their radius; prism and text caps from the curves polygonised as their
+ * sides (their trapezoids may be longer: GI splits them). 0 for polygons. */
+int accel_sweep_grid_cell(const accel_shape *sh, double cell, accel_grid_fn fn, void *ctx);
 
 /* Polygon: its even-odd region as object-space triangles (trapezoids of
  * the slabs between vertex heights, two triangles each; exact for simple

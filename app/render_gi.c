@@ -219,6 +219,10 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
         stats_int(js, "bounces", p->bounces);
         stats_int(js, "found", p->found);
         stats_int(js, "used", p->used);
+        /* the hook's lookups: all, without particles, estimated at the hit */
+        stats_int(js, "lookups", p->lookups);
+        stats_int(js, "lookups_none", p->lookups_none);
+        stats_int(js, "lookups_onthefly", p->lookups_onthefly);
         stats_int(js, "skipped_objects", p->skipped_objects);
         stats_int(js, "discarded", p->discarded);
         stats_num(js, "spacing", p->spacing);

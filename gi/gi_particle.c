@@ -1079,8 +1079,8 @@ static void late_rp(gi_particle *gp, long l)
     atomic_store_explicit(&gp->rp_state[l], 2, memory_order_release);
 }
 
-/* Surfaces with area particles but no radiance particles (polygons,
- * height fields, lathe, sor, prism, text): the estimation list is made at the hit (the same radius,
+/* Surfaces with area particles but no radiance particles (a grid that
+ * failed: gi_surface.h): the estimation list is made at the hit (the same radius,
  * normal test and widening as gi_radiance), then the estimate of section
  * 4.3.2 over it, gathering its particles first where needed. */
 /* Keeps the particles of the hit's own object (as gi_radiance's lists do;

@@ -133,7 +133,7 @@ typedef struct {
     long shadow_rays;
     long prepass_rays, found, used;  /* last prepare_view: new radiance / area particles */
     long lookups, lookups_late, lookups_none, discarded;
-    long lookups_onthefly;  /* hits on cylinders/cones/tori: estimated at the hit */
+    long lookups_onthefly;  /* hits on surfaces without radiance particles (no grid): estimated at the hit */
     long visibility_rays;   /* gi_visible tests: estimation list entries and radiance particles at hits */
     long skipped_objects;
     double flux_direct, flux_emitted, flux_scattered; /* sums over particles (grey) */

@@ -2,7 +2,9 @@
 #include "gi_surface.h"
 #include <math.h>
 #include "accel_shapes.h"
+#include "accel_hfield.h"
 #include "accel_surface.h"
+#include "accel_sweep.h"
 #include "accel_tess.h"
 #include <stdint.h>
 #include <stdlib.h>
@@ -102,6 +104,7 @@ struct gi_surface {
 };
 
 static void layout(gi_surface *g);
+static long mesh_locate(const gi_surface *g, int pi, vec3 q, vec3 ng, double w[3]);
 static void set_resolution(const gi_surface *g, patch *p);
 
 /* ------------------------------------------------------------ helpers */
@@ -599,6 +602,8 @@ static int has_grid(shape_kind k)
     case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE: case SHAPE_JULIA:
     case SHAPE_SUPERELLIPSOID: case SHAPE_OVUS:
     case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_TORUS: /* analytic_grid */
+    case SHAPE_POLYGON: case SHAPE_HEIGHT_FIELD: /* their triangles, split (split_grid) */
+    case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT: /* accel_sweep_grid_cell */
         return 1;
     default: return 0;
     }
@@ -974,6 +979,7 @@ typedef struct {
     long *vh;         /* vertex hash: global vertex index, -1 empty */
     long vcap;
     int oom;
+    double split;     /* > 0: world triangles with a longer edge are bisected (split_grid) */
 } mesh_ctx;
 
 static uint64_t vkey(vec3 p)
@@ -1034,6 +1040,37 @@ static long mesh_vertex(mesh_ctx *m, vec3 w, vec3 n)
     return g->nmv++;
 }
 
+/* Most grid triangles one patch may have (beyond: no grid, estimated at the hit). */
+#define MESH_MAX_TRIS 4000000L
+
+static int mesh_add(mesh_ctx *m, const vec3 w[3], const vec3 nw[3]);
+
+/* Longest-edge bisection of a world triangle until no edge is longer than
+ * m->split (Rivara's refinement: the midpoint of the longest edge joined to
+ * the opposite vertex). Midpoints are 0.5 (a + b), the same bits from both
+ * triangles sharing the edge, so mesh_vertex shares them; normals are the
+ * normalised mean of the edge's ends (the grids' vertex normals). */
+static int mesh_split(mesh_ctx *m, const vec3 w[3], const vec3 nw[3], int depth)
+{
+    int e = 0;
+    double l = -1.0;
+    for (int k = 0; k < 3; k++) {
+        double d = v3_len2(v3_sub(w[(k + 1) % 3], w[k]));
+        if (d > l) {
+            l = d;
+            e = k;
+        }
+    }
+    if (!(l > m->split * m->split) || depth >= 40) return mesh_add(m, w, nw);
+    int a = e, b = (e + 1) % 3, c = (e + 2) % 3;
+    vec3 mid = v3_scale(v3_add(w[a], w[b]), 0.5);
+    vec3 mn = v3_add(nw[a], nw[b]);
+    mn = v3_len2(mn) > 0.0 ? v3_norm(mn) : nw[a];
+    vec3 t0[3] = {w[a], mid, w[c]}, n0[3] = {nw[a], mn, nw[c]};
+    vec3 t1[3] = {mid, w[b], w[c]}, n1[3] = {mn, nw[b], nw[c]};
+    return mesh_split(m, t0, n0, depth + 1) && mesh_split(m, t1, n1, depth + 1);
+}
+
 static int mesh_tri(void *ctx, const vec3 p[3], const vec3 n[3])
 {
     mesh_ctx *m = ctx;
@@ -1052,6 +1089,15 @@ static int mesh_tri(void *ctx, const vec3 p[3], const vec3 n[3])
         for (int k = 0; k < 3 && !keep; k++) keep = csg_keep(g, pp->cnode, w[k]);
         if (!keep) return 1;
     }
+    return m->split > 0.0 ? mesh_split(m, w, nw, 0) : mesh_add(m, w, nw);
+}
+
+static int mesh_add(mesh_ctx *m, const vec3 w[3], const vec3 nw[3])
+{
+    gi_surface *g = m->g;
+    const patch *pp = &g->p[m->pi];
+    if (g->nmt - pp->tfirst >= MESH_MAX_TRIS) { m->oom = 1; return 0; }
+    if (!(v3_len2(v3_cross(v3_sub(w[1], w[0]), v3_sub(w[2], w[0]))) > 0.0)) return 1;
     if (g->nmt == g->capmt) {
         long nc = g->capmt ? 2 * g->capmt : 4096;
         int (*nt)[3] = realloc(g->mt, (size_t)nc * sizeof *nt);
@@ -1085,12 +1131,23 @@ static int grid_count(double len, double tess, int lo)
     return c < lo ? lo : (c > 256.0 ? 256 : (int)c);
 }
 
+/* World length of the shape's object axis c (its transform's column c). */
+static double axis_stretch(const accel_shape *sh, int c)
+{
+    if (sh->identity) return 1.0;
+    const double (*m)[4] = sh->x.m;
+    return sqrt(m[0][c] * m[0][c] + m[1][c] * m[1][c] + m[2][c] * m[2][c]);
+}
+
+/* The transform's largest stretch (1 for none). */
+static double max_stretch(const accel_shape *sh)
+{
+    return fmax(axis_stretch(sh, 0), fmax(axis_stretch(sh, 1), axis_stretch(sh, 2)));
+}
+
 static int analytic_grid(const accel_shape *sh, double tess, accel_grid_fn fn, void *ctx)
 {
-    const double (*m)[4] = sh->x.m;
-    double s = 0.0;
-    for (int c = 0; c < 3; c++) s = fmax(s, sqrt(m[0][c] * m[0][c] + m[1][c] * m[1][c] + m[2][c] * m[2][c]));
-    if (sh->identity) s = 1.0;
+    double s = max_stretch(sh);
     if (!(s > 0.0) || !isfinite(s)) return 0;
     double t = tess / s; /* the bound in object units */
     if (sh->kind == SHAPE_TORUS) {
@@ -1181,6 +1238,45 @@ static int cmp_cell(const void *a, const void *b)
  * locate hash (each triangle in the cells its box, widened by a quarter
  * cell, touches). Patches whose grid fails keep rp_count 0 (estimated at
  * the hit, as before). */
+/* Shapes whose grid is split to the tessellation bound (mesh_split):
+ * polygons (their even-odd region's triangles), height fields (their cells,
+ * or a coarser grid of every s-th point where the cells are smaller than
+ * the bound), lathe, sor, prism and text (accel_sweep_grid_cell: profile
+ * segments by arc length, around or along the sweep; prism and text caps
+ * are long trapezoids between vertex heights, split here). */
+static int split_grid(shape_kind k)
+{
+    return k == SHAPE_POLYGON || k == SHAPE_HEIGHT_FIELD || k == SHAPE_LATHE || k == SHAPE_SOR || k == SHAPE_PRISM ||
+           k == SHAPE_TEXT;
+}
+
+/* Triangles are split until no edge is longer than 1.5 tess: a grid cell
+ * of tess x tess has a diagonal of 1.41 tess and stays two triangles (on
+ * curved parts every split puts a vertex on a chord, off the surface). */
+#define SPLIT_FACTOR 1.5
+
+static int split_grid_build(const accel_shape *sh, double tess, mesh_ctx *m)
+{
+    double s = max_stretch(sh);
+    if (!(s > 0.0) || !isfinite(s)) return 0;
+    m->split = SPLIT_FACTOR * tess;
+    switch (sh->kind) {
+    case SHAPE_HEIGHT_FIELD: {
+        /* strides: every s-th grid point where a cell is shorter than the
+         * bound in world space (x = i / nx, z = j / nz in object space) */
+        int nx, nz;
+        accel_hfield_cells(sh, &nx, &nz);
+        if (nx < 1 || nz < 1) return 0;
+        double cx = axis_stretch(sh, 0) / nx, cz = axis_stretch(sh, 2) / nz;
+        double fx = cx > 0.0 ? floor(tess / cx) : 1.0, fz = cz > 0.0 ? floor(tess / cz) : 1.0;
+        int sx = !(fx >= 1.0) ? 1 : (fx > nx ? nx : (int)fx), sz = !(fz >= 1.0) ? 1 : (fz > nz ? nz : (int)fz);
+        return accel_hfield_coarse_grid(sh, sx, sz, mesh_tri, m);
+    }
+    case SHAPE_POLYGON: return accel_shape_grid(sh, 1, mesh_tri, m);
+    default: return accel_sweep_grid_cell(sh, tess / s, mesh_tri, m);
+    }
+}
+
 /* Range of locate-hash cells [x0, x1] x [y0, y1] x [z0, z1] that piece
  * p's triangle t touches: its bounding box grown by a quarter cell. */
 static void tri_cells(const gi_surface *g, const patch *p, long t, long *x0, long *x1, long *y0, long *y1, long *z0,
@@ -1221,11 +1317,12 @@ static void build_meshes(gi_surface *g)
         if (!(ext > 0.0) || !isfinite(ext)) continue;
         double nn = ceil(ext / g->tess);
         int n = nn < 2.0 ? 2 : (nn > 128.0 ? 128 : (int)nn);
-        mesh_ctx m = {g, i, p->sh, NULL, 0, 0};
+        mesh_ctx m = {g, i, p->sh, NULL, 0, 0, 0.0};
         shape_kind kind = g->o[p->obj].kind;
         int r = kind == SHAPE_CYLINDER || kind == SHAPE_CONE || kind == SHAPE_TORUS
                     ? analytic_grid(p->sh, g->tess, mesh_tri, &m)
-                    : accel_shape_grid(p->sh, n, mesh_tri, &m);
+                    : split_grid(kind) ? split_grid_build(p->sh, g->tess, &m)
+                                       : accel_shape_grid(p->sh, n, mesh_tri, &m);
         free(m.vh);
         if (r < 0 || m.oom) {
             g->nmv = p->vfirst;
@@ -1271,6 +1368,26 @@ static void build_meshes(gi_surface *g)
         }
     }
     qsort(g->ce, (size_t)g->nce, sizeof *g->ce, cmp_cell);
+    /* Side 0 of a patch is its sampler's normal (gi_particles); the split
+     * grids' vertex normals are outward or up, accel_surface's triangles of
+     * polygons and height fields have their world winding (a height
+     * field's faces down): turn the grid's normals to the sampler's side. */
+    for (int i = 0; i < g->np; i++) {
+        const patch *p = &g->p[i];
+        if (p->kind != PATCH_PIECE || p->nt == 0 || p->piece < 0 || !split_grid(g->o[p->obj].kind)) continue;
+        accel_surf_sample smp;
+        double w[3];
+        if (!accel_surf_sample_piece(g->as, p->piece, 1.0 / 3.0, 1.0 / 3.0, NULL, &smp)) continue;
+        long t = mesh_locate(g, i, smp.p, smp.n, w);
+        if (t < 0) continue;
+        const vec3 *v = g->mv + p->vfirst, *vn = g->mn + p->vfirst;
+        const int *tv = g->mt[t];
+        vec3 ns = v3_add(v3_add(vn[tv[0]], vn[tv[1]]), vn[tv[2]]);
+        vec3 fn = v3_cross(v3_sub(v[tv[1]], v[tv[0]]), v3_sub(v[tv[2]], v[tv[0]]));
+        if (v3_dot(fn, ns) < 0.0) fn = v3_neg(fn);
+        if (v3_dot(fn, smp.n) < 0.0)
+            for (long k = p->vfirst; k < p->vfirst + p->rp_count; k++) g->mn[k] = v3_neg(g->mn[k]);
+    }
 }
 
 /* Closest point to q on triangle (a, b, c), as barycentrics (wa, wb, wc)
@@ -1317,8 +1434,14 @@ out:;
     return v3_len2(v3_sub(q, r));
 }
 
-/* The grid triangle of PIECE patch pi nearest to q: its index, or -1. */
-static long mesh_locate(const gi_surface *g, int pi, vec3 q, double w[3])
+/* The grid triangle of PIECE patch pi nearest to q: its index, or -1.
+ * ng: the hit's geometric normal (either orientation). A triangle whose
+ * plane is more than 60 degrees off it counts a cell farther away: at a
+ * crease (a prism's cap and side, a cylinder's rim) a hit between the
+ * curve and its chords is about as near to both, and must take its own
+ * part's triangle (smooth grids never differ that much between
+ * neighbours). */
+static long mesh_locate(const gi_surface *g, int pi, vec3 q, vec3 ng, double w[3])
 {
     const patch *p = &g->p[pi];
     if (p->nt == 0 || g->nce == 0) return -1;
@@ -1336,7 +1459,11 @@ static long mesh_locate(const gi_surface *g, int pi, vec3 q, double w[3])
         if (g->mtp[t] != pi) continue;
         double ww[3];
         const vec3 *v = g->mv + p->vfirst;
-        double d = closest_on_tri(q, v[g->mt[t][0]], v[g->mt[t][1]], v[g->mt[t][2]], ww);
+        vec3 a = v[g->mt[t][0]], b = v[g->mt[t][1]], c = v[g->mt[t][2]];
+        double d = closest_on_tri(q, a, b, c, ww);
+        vec3 fn = v3_cross(v3_sub(b, a), v3_sub(c, a));
+        double c2 = v3_dot(fn, ng);
+        if (c2 * c2 < 0.25 * v3_len2(fn) * v3_len2(ng)) d += p->cell * p->cell;
         if (d < bd) {
             bd = d;
             best = t;
@@ -1571,7 +1698,7 @@ int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, lo
         /* a grid: the triangle nearest the hit, barycentrics of the nearest point on it */
         const patch *pp = &g->p[first];
         double tw[3];
-        long t = pp->nsides ? mesh_locate(g, first, hit->p, tw) : -1;
+        long t = pp->nsides ? mesh_locate(g, first, hit->p, hit->ng, tw) : -1;
         if (t < 0) return 0;
         const vec3 *vv = g->mv + pp->vfirst, *vn = g->mn + pp->vfirst;
         const int *tv = g->mt[t];

@@ -34,9 +34,17 @@
  * widened by a quarter cell touches) and the barycentrics of the nearest
  * point on it. Cylinders, cones and tori get a parametric grid of their own
  * (angle x height, caps by angle x radius; the torus's two angles) with
- * the same locate. The others (polygons, height fields, lathe, sor, prism,
- * text) have no radiance particles: gi_particle estimates
- * indirect light at hits on them from the particles around the hit. Closed
+ * the same locate. Polygons (their even-odd region's triangles), height
+ * fields (their cells' triangles, or every s-th grid point where cells are
+ * shorter than tess), lathe, sor, prism and text (accel_sweep_grid_cell:
+ * cells of at most tess along each profile segment's arc and around or
+ * along the sweep; prism/text caps as trapezoids) get grids whose
+ * triangles are split at the midpoint of their longest edge until no edge
+ * exceeds 1.5 tess, located the same way (a grid triangle more than 60
+ * degrees off the hit's normal counts a cell farther: creases). Only a
+ * surface whose grid fails (over 4M triangles, out of memory) has no
+ * radiance particles: gi_particle estimates indirect light at hits on it
+ * from the particles around the hit (counted: lookups_onthefly). Closed
  * ones get their outside (and inside when the camera or a light is in
  * them); polygons, height fields, lathe, sor and unbounded quadric/poly
  * both sides.
@@ -110,7 +118,7 @@ int gi_surface_rp_side(const gi_surface *g, long rp);
 int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, long rp[3], double w[3]);
 
 /* Whether the hit object carries area particles (it may have no radiance
- * particles: polygons, height fields, sweeps, text; gi_particle then estimates at the hit). */
+ * particles when its grid failed; gi_particle then estimates at the hit). */
 int gi_surface_has_particles(const gi_surface *g, const accel_hit *hit);
 /* Objects skipped (no particles) and a patch count per kind, for stats. */
 long gi_surface_skipped(const gi_surface *g);
