@@ -749,6 +749,32 @@ static void user_bounds(const struct RTCBoundsFunctionArguments *args)
     b->upper_x = out[3]; b->upper_y = out[4]; b->upper_z = out[5];
 }
 
+/* The link scene's user geometry (accel_rtc_link_scene): the primitives
+ * as user_bounds gives them, then one empty primitive, a box of 1e-6 of
+ * the scene's size placed 4 scene sizes beyond the upper corner of the
+ * scene's bounds (the user boxes included), where no link ray starts and
+ * hardly any passes; user_intersect answers it with no hit. */
+static void user_bounds_link(const struct RTCBoundsFunctionArguments *args)
+{
+    const accel *a = args->geometryUserPtr;
+    float out[6];
+    unsigned np = (unsigned)(a->nshapes + a->ncsgs);
+    if (args->primID < np) {
+        user_box(a, args->primID, out);
+    } else {
+        float hi[3] = {(float)a->hi.x, (float)a->hi.y, (float)a->hi.z}, ext = (float)(a->scale > 0.0 ? a->scale : 1.0);
+        for (unsigned p = 0; p < np; p++)
+            for (int k = 0; k < 3; k++) hi[k] = fmaxf(hi[k], a->ubox[6 * (size_t)p + 3 + k]);
+        for (int k = 0; k < 3; k++) {
+            out[k] = hi[k] + 4.0f * ext;
+            out[3 + k] = out[k] + 1e-6f * ext;
+        }
+    }
+    struct RTCBounds *b = args->bounds_o;
+    b->lower_x = out[0]; b->lower_y = out[1]; b->lower_z = out[2];
+    b->upper_x = out[3]; b->upper_y = out[4]; b->upper_z = out[5];
+}
+
 /* Does lane i of an SOA ray miss user primitive prim's box within its
  * [tnear, tfar]? Embree tests a primitive's box only from a BVH node
  * above it, and a user geometry of one primitive is a lone leaf: every ray
@@ -813,6 +839,7 @@ static void user_intersect(const struct RTCIntersectFunctionNArguments *args)
     int exact = q && (void *)q == (void *)args->context && N == 1;
     void *ray = args->rayhit;
     float *hit = (float *)args->rayhit + 12 * (size_t)N;
+    if (args->primID >= (unsigned)(a->nshapes + a->ncsgs)) return; /* the link scene's empty primitive */
     for (unsigned i = 0; i < N; i++) {
         if (args->valid[i] != -1 || user_box_missed(a, args->primID, ray, N, i)) continue;
         float tfar = SOA_F(ray, N, i, 8);
@@ -857,6 +884,7 @@ static void user_intersect(const struct RTCIntersectFunctionNArguments *args)
 static void user_occluded(const struct RTCOccludedFunctionNArguments *args)
 {
     const accel *a = args->geometryUserPtr;
+    if (args->primID >= (unsigned)(a->nshapes + a->ncsgs)) return; /* the link scene's empty primitive */
     if (prim_flags(a, args->primID) & OBJ_NO_SHADOW) return;
     accel_query *q = tls_query;
     unsigned N = args->N;
@@ -1553,6 +1581,49 @@ int accel_mutually_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, 
         tmin = h.t + fmax(eps, h.t * 1e-7);
     }
     return 1;
+}
+
+void *accel_rtc_link_scene(const accel *a)
+{
+    if (!a || !a->root) return NULL;
+    RTCScene s = rtcNewScene(a->dev);
+    if (!s) return NULL;
+    /* no RTC_SCENE_FLAG_ROBUST: a link ray that slips through a crack
+     * between two triangles ends further on or misses, which at 16 or 256
+     * rays a particle is noise, not a leak (measured in gi_links.c) */
+    rtcSetSceneFlags(s, RTC_SCENE_FLAG_NONE);
+    unsigned np = (unsigned)(a->nshapes + a->ncsgs);
+    for (unsigned id = 0; id < a->nginfo; id++) {
+        int kind = a->ginfo[id].kind;
+        if (kind == GEOM_TRI || kind == GEOM_INSTANCE || (kind == GEOM_USER && np > 1)) {
+            /* the same geometry, attached under the same id (Embree 3.13's
+             * rtcAttachGeometry: a geometry can be attached to several scenes) */
+            RTCGeometry g = rtcGetGeometry(a->root, id);
+            if (g) rtcAttachGeometryByID(s, g, id);
+        } else if (kind == GEOM_USER) {
+            RTCGeometry g = rtcNewGeometry(a->dev, RTC_GEOMETRY_TYPE_USER);
+            if (!g) continue;
+            rtcSetGeometryUserPrimitiveCount(g, np + 1);
+            rtcSetGeometryUserData(g, (void *)a);
+            rtcSetGeometryBoundsFunction(g, user_bounds_link, (void *)a);
+            rtcSetGeometryIntersectFunction(g, user_intersect);
+            rtcSetGeometryOccludedFunction(g, user_occluded);
+            rtcCommitGeometry(g);
+            rtcAttachGeometryByID(s, g, id);
+            rtcReleaseGeometry(g);
+        }
+    }
+    rtcCommitScene(s);
+    if (rtcGetDeviceError(a->dev) != RTC_ERROR_NONE) {
+        rtcReleaseScene(s);
+        return NULL;
+    }
+    return s;
+}
+
+void accel_rtc_link_scene_free(void *scene)
+{
+    if (scene) rtcReleaseScene((RTCScene)scene);
 }
 
 const scene_object *accel_rtc_object(const accel *a, unsigned geom, unsigned prim, unsigned inst)

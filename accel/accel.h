@@ -91,6 +91,17 @@ double accel_eps_scale(const accel *a);
 accel_stats accel_get_stats(const accel *a);
 /* The underlying RTCScene (as void*), for benchmarks that drive Embree directly. */
 void *accel_rtc_scene(const accel *a);
+/* A second RTCScene over the same geometries (the same geometry ids, so
+ * accel_rtc_object reads its hits too) for rays whose answers tolerate a
+ * rare crack between triangles: the particle GI's link rays. It is built
+ * without RTC_SCENE_FLAG_ROBUST (accel_rtc_scene keeps it), and a user
+ * geometry of one primitive
+ * gets a second, empty one far outside the scene so that Embree tests the
+ * first one's box before calling it (a lone primitive is a BVH leaf that
+ * every ray enters). Rays use a plain RTCIntersectContext. NULL on failure;
+ * accel_rtc_link_scene_free releases it (before accel_free). */
+void *accel_rtc_link_scene(const accel *a);
+void accel_rtc_link_scene_free(void *scene);
 /* The leaf object of a hit that rtcIntersect on accel_rtc_scene reported
  * (geomID, primID and instID[0] of its RTCHit), as accel_intersect would
  * give it; NULL when the record alone does not tell (a member of a CSG) or
