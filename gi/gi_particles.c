@@ -5,6 +5,10 @@
 #include <string.h>
 #include "accel_shapes.h"
 #include "rng.h"
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define LK_X86 1
+#endif
 
 /* R2 low-discrepancy sequence (M. Roberts, "The unreasonable effectiveness of
  * quasirandom sequences", 2018): alpha = (1/g, 1/g^2) with g the plastic
@@ -456,8 +460,10 @@ struct gi_lookup {
     long ne;
     int n;
     gi_grid *fallback;
+    int avx2; /* scan 8 slots (two blocks) at a time (the CPU has AVX2) */
     /* object pointer -> id (open addressing, power-of-two size) */
     const void **okey;
+    const void *const *opobj; /* the pobj array the ids were set from */
     int omask;
 };
 
@@ -482,6 +488,7 @@ int gi_lookup_object_id(const gi_lookup *g, const void *obj)
 pt_status gi_lookup_set_objects(gi_lookup *g, const void *const *pobj)
 {
     if (!pobj || g->n == 0) return PT_OK;
+    g->opobj = pobj;
     /* distinct objects: at most n; table at least twice that count */
     int distinct = 0;
     unsigned size = 64;
@@ -540,6 +547,10 @@ gi_lookup *gi_lookup_build(const gi_particles *ps, double cell)
     }
     g->cell = cell;
     g->inv = 1.0 / cell;
+#ifdef LK_X86
+    __builtin_cpu_init();
+    g->avx2 = __builtin_cpu_supports("avx2");
+#endif
     g->margin = 0.5 * cell;
     g->origin = v3_sub(lo, v3s(cell));
     for (int k = 0; k < 3; k++) g->dim[k] = (long)floor(v3_idx(ext, k) / cell) + 3;
@@ -567,7 +578,9 @@ gi_lookup *gi_lookup_build(const gi_particles *ps, double cell)
     for (long c = 0; c < ncells; c++) g->start[c + 2] = (g->start[c + 2] + LK_W - 1) / LK_W * LK_W;
     for (long c = 0; c <= ncells; c++) g->start[c + 1] += g->start[c];
     g->ne = g->start[ncells + 1];
-    long nb = g->ne / LK_W > 0 ? g->ne / LK_W : 1;
+    /* one more block of padding after the last: an 8-slot scan reads a
+     * block pair and may step past the last cell's entries */
+    long nb = g->ne / LK_W + 1;
     g->b = aligned_alloc(64, ((size_t)nb * sizeof *g->b + 63) / 64 * 64);
     if (!g->b) {
         free(key);
@@ -656,6 +669,39 @@ void gi_lookup_prefetch(const gi_lookup *g, long cell, int stage)
     }
 }
 
+void gi_lookup_cells(const gi_lookup *g, int n, const vec3 *q, long *cell)
+{
+    if (g->n == 0) return;
+    long d0 = g->dim[0], d01 = g->dim[0] * g->dim[1];
+    double top[3] = {(double)(g->dim[0] - 2), (double)(g->dim[1] - 2), (double)(g->dim[2] - 2)};
+    for (int i = 0; i < n; i++) {
+        if (cell[i] < -1) continue;
+        /* as gi_lookup_cell */
+        double qq[3] = {q[i].x - g->origin.x, q[i].y - g->origin.y, q[i].z - g->origin.z};
+        long c[3];
+        for (int k = 0; k < 3; k++) {
+            double t = qq[k] * g->inv - 0.5;
+            c[k] = !(t >= 0.0) ? 0 : (t >= top[k] ? (long)top[k] : (long)t);
+        }
+        long ce = (c[2] * g->dim[1] + c[1]) * d0 + c[0];
+        cell[i] = ce;
+        __builtin_prefetch(&g->start[ce]);
+        __builtin_prefetch(&g->start[ce + d0]);
+        __builtin_prefetch(&g->start[ce + d01]);
+        __builtin_prefetch(&g->start[ce + d01 + d0]);
+    }
+    for (int i = 0; i < n; i++) {
+        if (cell[i] < 0) continue;
+        long ce = cell[i];
+        long rows[4] = {ce, ce + d0, ce + d01, ce + d01 + d0};
+        for (int r = 0; r < 4; r++) {
+            int k = g->start[rows[r]];
+            __builtin_prefetch(&g->b[k / LK_W]);
+            __builtin_prefetch((const char *)&g->b[k / LK_W] + 64);
+        }
+    }
+}
+
 int gi_lookup_nearest(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double maxdist)
 {
     if (g->n == 0 || !v3_finite(q)) return -1;
@@ -666,7 +712,57 @@ int gi_lookup_nearest_on(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double 
                          const void *obj, vec3 agree, double min_agree, const unsigned char *skip)
 {
     if (g->n == 0 || !v3_finite(q)) return -1;
-    return gi_grid_nearest_on(g->fallback, q, dir, org, maxdist, pobj, obj, agree, min_agree, skip);
+    if (!pobj || pobj != g->opobj || !obj || !(maxdist <= 1.5 * g->cell))
+        return gi_grid_nearest_on(g->fallback, q, dir, org, maxdist, pobj, obj, agree, min_agree, skip);
+    /* the same answer from the dense grid: the 2x2x2 block holds every
+     * particle within the margin, the 4x4x4 block every one within 1.5
+     * cells (as gi_lookup_nearest_in2), with gi_grid_nearest_on's filters
+     * in its arithmetic, the object compared by its id (the ring search
+     * cost 3,600 instructions a call on cbox) */
+    int oid = gi_lookup_object_id(g, obj);
+    if (oid < 0) return -1; /* no particle lies on obj */
+    float ax = (float)agree.x, ay = (float)agree.y, az = (float)agree.z;
+    float amin = agree.x == 0.0 && agree.y == 0.0 && agree.z == 0.0 ? -2.0f : (float)min_agree;
+    float qx = (float)q.x, qy = (float)q.y, qz = (float)q.z;
+    float dx = (float)dir.x, dy = (float)dir.y, dz = (float)dir.z;
+    float orx = (float)org.x, ory = (float)org.y, orz = (float)org.z;
+    long cell = gi_lookup_cell(g, q);
+    long d0 = g->dim[0], d01 = g->dim[0] * g->dim[1];
+    long cx = cell % d0, cy = (cell / d0) % g->dim[1], cz = cell / d01;
+    int bi = -1;
+    for (int pass = 0; pass < 2 && bi < 0; pass++) {
+        double m = pass == 0 ? (g->margin < maxdist ? g->margin : maxdist) : maxdist;
+        if (pass == 1 && !(maxdist > g->margin)) break;
+        double best = m * m;
+        long w = pass == 0 ? 0 : 1; /* cells either side of the 2x2x2 block */
+        long x0 = cx - w > 0 ? cx - w : 0, x1 = cx + 1 + w < d0 ? cx + 1 + w : d0 - 1;
+        long y0 = cy - w > 0 ? cy - w : 0, y1 = cy + 1 + w < g->dim[1] ? cy + 1 + w : g->dim[1] - 1;
+        long z0 = cz - w > 0 ? cz - w : 0, z1 = cz + 1 + w < g->dim[2] ? cz + 1 + w : g->dim[2] - 1;
+        for (long z = z0; z <= z1; z++)
+            for (long y = y0; y <= y1; y++) {
+                long row = z * d01 + y * d0;
+                for (int k = g->start[row + x0]; k < g->start[row + x1 + 1]; k++) {
+                    const lblock *e = &g->b[k / LK_W];
+                    int l = k % LK_W, idx = e->idx[l];
+                    if (idx < 0 || e->obj[l] != oid) continue;
+                    float ex_ = e->x[l], ey_ = e->y[l], ez_ = e->z[l];
+                    float nx = e->nx[l], ny = e->ny[l], nz = e->nz[l];
+                    if (nx * dx + ny * dy + nz * dz >= 0.0f) continue;
+                    if (nx * (orx - ex_) + ny * (ory - ey_) + nz * (orz - ez_) <= 0.0f) continue;
+                    float ex = ex_ - qx, ey = ey_ - qy, ez = ez_ - qz;
+                    double d2 = (double)(ex * ex + ey * ey + ez * ez);
+                    float pe = nx * ex + ny * ey + nz * ez;
+                    if ((double)(pe * pe) > NEAR_PLANE2 * d2) continue;
+                    if (skip && skip[idx]) continue;
+                    if (nx * ax + ny * ay + nz * az < amin) continue;
+                    if (d2 < best || (d2 == best && idx < bi)) {
+                        best = d2;
+                        bi = idx;
+                    }
+                }
+            }
+    }
+    return bi;
 }
 
 int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist)
@@ -678,66 +774,128 @@ int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 o
 typedef float v4f __attribute__((vector_size(16)));
 typedef int v4i __attribute__((vector_size(16)));
 
-/* One query's broadcast operands and its running answer: per lane the
- * nearest squared distance so far and its slot. */
+/* One query: its point, ray direction and origin (9 floats), and its
+ * answer so far: the nearest squared distance (strictly below the start
+ * value) and its slot, -1 if none. */
 typedef struct {
-    v4f qx, qy, qz, dx, dy, dz, ox, oy, oz;
-    v4f best;
-    v4i slot;
+    float q[9];
+    float best;
+    int slot;
 } lquery;
 
-/* Tests slots [k0, k1) (whole blocks) against q's filters (as
- * gi_grid_nearest: the normal faces against the ray, the origin lies in
- * front of the particle, the hit lies near its tangent plane), branch-free
- * but for skipping blocks with no slot nearer than the best so far (the
- * filters' comparisons are unpredictable); each lane keeps its first
- * strictly nearest slot. */
-static inline __attribute__((always_inline)) void scan_run(const gi_lookup *g, int k0, int k1, lquery *q)
+/* Tests the slots of the runs [k0[r], k1[r]) (whole blocks) against the
+ * query's filters (as gi_grid_nearest: the normal faces against the ray,
+ * the origin lies in front of the particle, the hit lies near its tangent
+ * plane), branch-free but for skipping blocks with no slot nearer than
+ * the best so far (the filters' comparisons are unpredictable). Each lane
+ * keeps its first strictly nearest slot; the answer is the nearest over
+ * the lanes, ties to the lower slot. */
+static void scan_runs4(const gi_lookup *g, const int *k0, const int *k1, int nr, lquery *q)
 {
     const v4f zero = {0, 0, 0, 0}, vnp = {NEAR_PLANE2, NEAR_PLANE2, NEAR_PLANE2, NEAR_PLANE2};
     const v4i lane = {0, 1, 2, 3};
-    for (int k = k0; k < k1; k += LK_W) {
-        const lblock *e = &g->b[k / LK_W];
-        v4f x, y, z, nx, ny, nz;
-        memcpy(&x, e->x, sizeof x);
-        memcpy(&y, e->y, sizeof y);
-        memcpy(&z, e->z, sizeof z);
-        memcpy(&nx, e->nx, sizeof nx);
-        memcpy(&ny, e->ny, sizeof ny);
-        memcpy(&nz, e->nz, sizeof nz);
-        v4f ex = x - q->qx, ey = y - q->qy, ez = z - q->qz;
-        v4f d2 = ex * ex + ey * ey + ez * ez;
-        /* most slots of the block lie beyond the best so far (the block of
-         * cells is 4 margins wide): skip the filters then */
-        v4i near = d2 < q->best;
-        if (!(near[0] | near[1] | near[2] | near[3])) continue;
-        v4f f = nx * q->dx + ny * q->dy + nz * q->dz;
-        v4f hh = nx * (q->ox - x) + ny * (q->oy - y) + nz * (q->oz - z);
-        v4f pe = nx * ex + ny * ey + nz * ez;
-        v4i ok = near & (f < zero) & (hh > zero) & (pe * pe <= vnp * d2);
-        q->best = (v4f)(((v4i)d2 & ok) | ((v4i)q->best & ~ok));
-        q->slot = ((lane + k) & ok) | (q->slot & ~ok);
+    const v4f qx = zero + q->q[0], qy = zero + q->q[1], qz = zero + q->q[2];
+    const v4f dx = zero + q->q[3], dy = zero + q->q[4], dz = zero + q->q[5];
+    const v4f ox = zero + q->q[6], oy = zero + q->q[7], oz = zero + q->q[8];
+    v4f best = zero + q->best;
+    v4i slot = {-1, -1, -1, -1};
+    for (int r = 0; r < nr; r++)
+        for (int k = k0[r]; k < k1[r]; k += LK_W) {
+            const lblock *e = &g->b[k / LK_W];
+            v4f x, y, z, nx, ny, nz;
+            memcpy(&x, e->x, sizeof x);
+            memcpy(&y, e->y, sizeof y);
+            memcpy(&z, e->z, sizeof z);
+            v4f ex = x - qx, ey = y - qy, ez = z - qz;
+            v4f d2 = ex * ex + ey * ey + ez * ez;
+            /* most slots of the block lie beyond the best so far (the block of
+             * cells is 4 margins wide): skip the filters then */
+            v4i near = d2 < best;
+#ifdef LK_X86
+            if (!_mm_movemask_ps((__m128)near)) continue;
+#else
+            if (!(near[0] | near[1] | near[2] | near[3])) continue;
+#endif
+            memcpy(&nx, e->nx, sizeof nx);
+            memcpy(&ny, e->ny, sizeof ny);
+            memcpy(&nz, e->nz, sizeof nz);
+            v4f f = nx * dx + ny * dy + nz * dz;
+            v4f hh = nx * (ox - x) + ny * (oy - y) + nz * (oz - z);
+            v4f pe = nx * ex + ny * ey + nz * ez;
+            v4i ok = near & (f < zero) & (hh > zero) & (pe * pe <= vnp * d2);
+            best = (v4f)(((v4i)d2 & ok) | ((v4i)best & ~ok));
+            slot = ((lane + k) & ok) | (slot & ~ok);
+        }
+    for (int l = 0; l < LK_W; l++) {
+        if (slot[l] < 0) continue;
+        if (q->slot < 0 || best[l] < q->best || (best[l] == q->best && slot[l] < q->slot)) {
+            q->slot = slot[l];
+            q->best = best[l];
+        }
     }
 }
 
-/* The winning slot across lanes (nearest, ties to the earlier slot in scan
- * order), -1 if none. */
-static int best_slot(const lquery *q)
+#ifdef LK_X86
+/* The same with AVX2, 8 slots (a pair of blocks) at a time; the same
+ * operations in the same order (no FMA contraction: the target is avx2
+ * only), so the same answers. A run of an odd number of blocks reads the
+ * next block too: its slots are other cells' particles or padding, and a
+ * particle there can only win if it is nearer than everything in the runs,
+ * which hold every particle within the searched distance (so it cannot). */
+__attribute__((target("avx2"))) static void scan_runs8(const gi_lookup *g, const int *k0, const int *k1, int nr,
+                                                        lquery *q)
 {
-    float bl[LK_W];
-    int sl[LK_W];
-    memcpy(bl, &q->best, sizeof bl);
-    memcpy(sl, &q->slot, sizeof sl);
-    int bs = -1;
-    float bd = 0.0f;
-    for (int l = 0; l < LK_W; l++) {
+    const __m256 zero = _mm256_setzero_ps(), vnp = _mm256_set1_ps(NEAR_PLANE2);
+    const __m256 qx = _mm256_set1_ps(q->q[0]), qy = _mm256_set1_ps(q->q[1]), qz = _mm256_set1_ps(q->q[2]);
+    const __m256 dx = _mm256_set1_ps(q->q[3]), dy = _mm256_set1_ps(q->q[4]), dz = _mm256_set1_ps(q->q[5]);
+    const __m256 ox = _mm256_set1_ps(q->q[6]), oy = _mm256_set1_ps(q->q[7]), oz = _mm256_set1_ps(q->q[8]);
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    __m256 best = _mm256_set1_ps(q->best);
+    __m256i slot = _mm256_set1_epi32(-1);
+#define LK_LOAD8(f) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(e[0].f)), _mm_load_ps(e[1].f), 1)
+    for (int r = 0; r < nr; r++)
+        for (int k = k0[r]; k < k1[r]; k += 2 * LK_W) {
+            const lblock *e = &g->b[k / LK_W];
+            __m256 x = LK_LOAD8(x), y = LK_LOAD8(y), z = LK_LOAD8(z);
+            __m256 ex = _mm256_sub_ps(x, qx), ey = _mm256_sub_ps(y, qy), ez = _mm256_sub_ps(z, qz);
+            __m256 d2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ex, ex), _mm256_mul_ps(ey, ey)), _mm256_mul_ps(ez, ez));
+            __m256 near = _mm256_cmp_ps(d2, best, _CMP_LT_OQ);
+            if (!_mm256_movemask_ps(near)) continue;
+            __m256 nx = LK_LOAD8(nx), ny = LK_LOAD8(ny), nz = LK_LOAD8(nz);
+            __m256 f = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(nx, dx), _mm256_mul_ps(ny, dy)), _mm256_mul_ps(nz, dz));
+            __m256 hh = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(nx, _mm256_sub_ps(ox, x)), _mm256_mul_ps(ny, _mm256_sub_ps(oy, y))),
+                                      _mm256_mul_ps(nz, _mm256_sub_ps(oz, z)));
+            __m256 pe = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(nx, ex), _mm256_mul_ps(ny, ey)), _mm256_mul_ps(nz, ez));
+            __m256 ok = _mm256_and_ps(_mm256_and_ps(near, _mm256_cmp_ps(f, zero, _CMP_LT_OQ)),
+                                      _mm256_and_ps(_mm256_cmp_ps(hh, zero, _CMP_GT_OQ),
+                                                    _mm256_cmp_ps(_mm256_mul_ps(pe, pe), _mm256_mul_ps(vnp, d2), _CMP_LE_OQ)));
+            best = _mm256_blendv_ps(best, d2, ok);
+            slot = _mm256_blendv_epi8(slot, _mm256_add_epi32(lane, _mm256_set1_epi32(k)), _mm256_castps_si256(ok));
+        }
+#undef LK_LOAD8
+    float bl[8];
+    int sl[8];
+    _mm256_storeu_ps(bl, best);
+    _mm256_storeu_si256((__m256i *)sl, slot);
+    for (int l = 0; l < 8; l++) {
         if (sl[l] < 0) continue;
-        if (bs < 0 || bl[l] < bd || (bl[l] == bd && sl[l] < bs)) {
-            bs = sl[l];
-            bd = bl[l];
+        if (q->slot < 0 || bl[l] < q->best || (bl[l] == q->best && sl[l] < q->slot)) {
+            q->slot = sl[l];
+            q->best = bl[l];
         }
     }
-    return bs;
+}
+#endif
+
+static void scan_runs(const gi_lookup *g, const int *k0, const int *k1, int nr, lquery *q)
+{
+#ifdef LK_X86
+    if (g->avx2) {
+        scan_runs8(g, k0, k1, nr, q);
+        return;
+    }
+#endif
+    scan_runs4(g, k0, k1, nr, q);
 }
 
 int gi_lookup_nearest_in2(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist, float nrm[3],
@@ -745,19 +903,21 @@ int gi_lookup_nearest_in2(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 
 {
     if (obj) *obj = -2;
     if (g->n == 0 || !v3_finite(q)) return -1;
-    float qx = (float)q.x, qy = (float)q.y, qz = (float)q.z;
-    float dx = (float)dir.x, dy = (float)dir.y, dz = (float)dir.z;
-    float ox = (float)org.x, oy = (float)org.y, oz = (float)org.z;
     double m = g->margin < maxdist ? g->margin : maxdist;
-    float m2 = (float)(m * m);
-    lquery Q = {{qx, qx, qx, qx}, {qy, qy, qy, qy}, {qz, qz, qz, qz}, {dx, dx, dx, dx}, {dy, dy, dy, dy},
-                {dz, dz, dz, dz}, {ox, ox, ox, ox}, {oy, oy, oy, oy}, {oz, oz, oz, oz}, {m2, m2, m2, m2},
-                {-1, -1, -1, -1}};
+    lquery Q = {{(float)q.x, (float)q.y, (float)q.z, (float)dir.x, (float)dir.y, (float)dir.z, (float)org.x, (float)org.y,
+                 (float)org.z},
+                (float)(m * m),
+                -1};
     long d0 = g->dim[0], d01 = g->dim[0] * g->dim[1];
-    long rows[4] = {cell, cell + d0, cell + d01, cell + d01 + d0};
     /* the 4 runs of the 2x2x2 block, in a fixed order */
-    for (int r = 0; r < 4; r++) scan_run(g, g->start[rows[r]], g->start[rows[r] + 2], &Q);
-    int bs = best_slot(&Q);
+    int k0[16], k1[16];
+    long rows[4] = {cell, cell + d0, cell + d01, cell + d01 + d0};
+    for (int r = 0; r < 4; r++) {
+        k0[r] = g->start[rows[r]];
+        k1[r] = g->start[rows[r] + 2];
+    }
+    scan_runs(g, k0, k1, 4, &Q);
+    int bs = Q.slot;
     if (bs < 0 && maxdist > m && maxdist <= 1.5 * g->cell) {
         /* nothing within the margin: the 4x4x4 block of cells around the
          * same corner holds every particle within 1.5 cells of q (q lies
@@ -766,18 +926,22 @@ int gi_lookup_nearest_in2(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 
          * so one scan of its 16 runs replaces the ring search (16K
          * instructions a query on cbox, 2% of the link rays) */
         float md2 = (float)(maxdist * maxdist);
-        Q.best = (v4f){md2, md2, md2, md2};
-        Q.slot = (v4i){-1, -1, -1, -1};
+        Q.best = md2;
+        Q.slot = -1;
         long cx = cell % d0, cy = (cell / d0) % g->dim[1], cz = cell / d01;
         long x0 = cx > 0 ? cx - 1 : 0, x1 = cx + 2 < d0 ? cx + 2 : d0 - 1;
         long y0 = cy > 0 ? cy - 1 : 0, y1 = cy + 2 < g->dim[1] ? cy + 2 : g->dim[1] - 1;
         long z0 = cz > 0 ? cz - 1 : 0, z1 = cz + 2 < g->dim[2] ? cz + 2 : g->dim[2] - 1;
+        int nr = 0;
         for (long z = z0; z <= z1; z++)
             for (long y = y0; y <= y1; y++) {
                 long row = z * d01 + y * d0;
-                scan_run(g, g->start[row + x0], g->start[row + x1 + 1], &Q);
+                k0[nr] = g->start[row + x0];
+                k1[nr] = g->start[row + x1 + 1];
+                nr++;
             }
-        bs = best_slot(&Q);
+        scan_runs(g, k0, k1, nr, &Q);
+        bs = Q.slot;
         if (bs < 0) return -1;
     }
     if (bs >= 0) {

@@ -81,6 +81,10 @@ int gi_lookup_nearest(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double max
 long gi_lookup_cell(const gi_lookup *g, vec3 q);
 void gi_lookup_prefetch(const gi_lookup *g, long cell, int stage);
 int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist);
+/* The same first steps for a batch of n queries in one call: cell[i] =
+ * gi_lookup_cell(g, q[i]) for every i with cell[i] >= -1 on entry (others
+ * are left alone), then both prefetch stages. */
+void gi_lookup_cells(const gi_lookup *g, int n, const vec3 *q, long *cell);
 /* Object ids for the answers (pobj: the object of each particle). */
 pt_status gi_lookup_set_objects(gi_lookup *g, const void *const *pobj);
 /* The id of an object (-1: no particle of the lookup lies on it). */
