@@ -211,6 +211,7 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
         stats_str(js, "device", p->device);
         stats_int(js, "particles", p->particles);
         stats_int(js, "radiance_particles", p->radiance_particles);
+        stats_int(js, "radiance_slots", p->radiance_slots);
         stats_int(js, "list_entries", p->list_entries);
         stats_int(js, "link_rays", p->link_rays);
         stats_int(js, "link_misses", p->link_misses);

@@ -279,10 +279,10 @@ int main(int argc, char **argv)
            gs.c_geometry - gs.c_prune - gs.c_scatter_links - gs.c_gather_links - gs.c_lists);
     printf("  particles %ld (candidates %ld, pruned %ld), spacing %.4f, tess %.4f, radius %.4f\n", gs.particles,
            gs.candidates, gs.pruned, gs.spacing, gs.tess, gs.radius);
-    printf("  link rays %ld (%.1f%% miss, %.2f%% unresolved), radiance particles %ld, list entries %ld (%.1f per "
-           "list; %ld widened, %ld empty)\n",
+    printf("  link rays %ld (%.1f%% miss, %.2f%% unresolved), radiance particles %ld (%ld before "
+           "sharing), list entries %ld (%.1f per list; %ld widened, %ld empty)\n",
            gs.link_rays, 100.0 * gs.link_misses / fmax(1, gs.link_rays), 100.0 * gs.link_unresolved / fmax(1, gs.link_rays),
-           gs.radiance_particles, gs.list_entries, (double)gs.list_entries / fmax(1, gs.radiance_particles),
+           gs.radiance_particles, gs.radiance_slots, gs.list_entries, (double)gs.list_entries / fmax(1, gs.radiance_particles),
            gs.lists_widened, gs.lists_empty);
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);

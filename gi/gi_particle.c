@@ -458,6 +458,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     st = gi_radiance_lists(&gp->lists, gp->surf, &gp->ps, gp->a, S->radius, set->normal_cos, gp->threads, d);
     if (st != PT_OK) goto fail;
     S->radiance_particles = gp->lists.nrp;
+    S->radiance_slots = gi_surface_rp_slots(gp->surf);
     S->list_entries = gp->lists.off[gp->lists.nrp];
     S->lists_widened = gp->lists.widened;
     S->lists_empty = gp->lists.empty;

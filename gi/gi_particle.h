@@ -128,6 +128,7 @@ typedef struct {
     /* counts */
     long candidates, particles, pruned, probed_out;
     long radiance_particles, list_entries, lists_widened, lists_empty;
+    long radiance_slots;    /* radiance particles before patches shared them (gi_surface_rp_slots) */
     long link_rays, link_misses, link_unresolved;
     long sources;           /* particles that emit or reflect direct light */
     long shadow_rays;

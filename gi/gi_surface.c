@@ -6,6 +6,7 @@
 #include "accel_surface.h"
 #include "accel_sweep.h"
 #include "accel_tess.h"
+#include <limits.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,8 +23,8 @@ typedef struct {
     int obj;          /* object record */
     int k;            /* TRI: edge subdivisions */
     int nu, nv;       /* grids */
-    long rp_first;    /* side s: rp_first + s * rp_count */
-    long rp_count;
+    long slot_first;  /* radiance-particle slots of side s: slot_first + s * rp_count + local */
+    long rp_count;    /* slots per side (radiance particles before sharing: layout) */
     double area;      /* one side, world */
     vec3 v0, e1, e2;  /* TRI */
     vec3 nrm;         /* TRI: unit front normal */
@@ -101,6 +102,12 @@ struct gi_surface {
     long nmt, capmt;
     cell_entry *ce;
     long nce;
+    /* radiance particles shared between patches (layout): every patch side
+     * lays out rp_count slots; slot_rp maps a slot to its radiance
+     * particle, rp_slot a radiance particle to its first slot (NULL: one
+     * particle per slot, as when the map could not be allocated) */
+    long nslot;
+    int *slot_rp, *rp_slot;
 };
 
 static void layout(gi_surface *g);
@@ -1475,15 +1482,265 @@ static long mesh_locate(const gi_surface *g, int pi, vec3 q, vec3 ng, double w[3
     return best;
 }
 
+/* ------------------------------------------------------------ layout: shared radiance particles
+ *
+ * Every side of every patch lays out rp_count slots (its sub-tessellation's
+ * or grid's vertices), slot_first + side * rp_count + local. Slots at one
+ * point of one object with the same facing are one radiance particle: a
+ * mesh vertex shared by n triangles (and, where neighbouring triangles have
+ * the same k, the vertices along their shared edge), the two triangles of a
+ * box face or the fan of a clipped plane, a sphere's seam and poles. They
+ * would get identical estimation lists (same point, normal, object and side:
+ * gi_radiance), so one list and one value serve all of them; each hit still
+ * interpolates over its own triangle's three (gi_surface_locate maps slots
+ * to radiance particles). Only slots on a patch's boundary can coincide with
+ * another patch's (a triangle's edges, a grid's first and last rows and
+ * columns), so only those are looked up. Implicit shapes' grids share their
+ * vertices already (mesh_vertex). */
+
+/* Same point: within SHARE_TOL of the scene's largest coordinate on each
+ * axis (the same vertex reached through different triangles' v0 + e1 a/k +
+ * e2 b/k, or a sphere's seam at u = 0 and 1, differ by a few ulps). Same
+ * facing: oriented normals within 1 degree, far inside the lists' normal
+ * test (n . n' > 0.9, 25.8 degrees), so a list is the one each slot would
+ * have had up to that test's edge; creases (a box's edges, a tube's
+ * segments) keep a radiance particle per face. */
+#define SHARE_TOL 1e-9
+#define SHARE_COS 0.99984769515639127 /* cos(1 degree) */
+
+/* Slot -> its patch (the last patch whose slots start at or before it:
+ * patches without slots share slot_first with the next one). */
+static int slot_patch(const gi_surface *g, long slot)
+{
+    int lo = 0, hi = g->np - 1;
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (g->p[mid].slot_first <= slot) lo = mid;
+        else hi = mid - 1;
+    }
+    return lo;
+}
+
+static long rp_first_slot(const gi_surface *g, long rp) { return g->rp_slot ? g->rp_slot[rp] : rp; }
+static long slot_rp(const gi_surface *g, long slot) { return g->slot_rp ? g->slot_rp[slot] : slot; }
+
+static vec3 tri_point(const patch *p, int a, long b)
+{
+    return v3_add(p->v0, v3_add(v3_scale(p->e1, (double)a / p->k), v3_scale(p->e2, (double)b / p->k)));
+}
+
+/* Point and front normal of slot `local` (side 0) of patch p. */
+static void slot_point(const gi_surface *g, const patch *p, long local, vec3 *pos, vec3 *nrm)
+{
+    if (p->kind == PATCH_PIECE) {
+        *pos = g->mv[p->vfirst + local];
+        *nrm = g->mn[p->vfirst + local];
+    } else if (p->kind == PATCH_TRI) {
+        /* row a holds vertices (a, 0..k-a); row start a(k+1) - a(a-1)/2 */
+        int k = p->k, a = 0;
+        while (a < k && (long)(a + 1) * (k + 1) - (long)(a + 1) * a / 2 <= local) a++;
+        long b = local - ((long)a * (k + 1) - (long)a * (a - 1) / 2);
+        *pos = tri_point(p, a, b);
+        *nrm = p->nrm;
+    } else {
+        int i = (int)(local % (p->nu + 1)), j = (int)(local / (p->nu + 1));
+        grid_eval(g, p, (double)i / p->nu, (double)j / p->nv, pos, nrm);
+    }
+}
+
+/* Radiance particles on patch boundaries, in a hash of cells 4 SHARE_TOL
+ * wide keyed by (object, cell). */
+typedef struct {
+    double tol, cell;
+    int *head; /* bucket -> first entry, -1 empty */
+    size_t mask;
+    int *next, *rp, *obj;
+    vec3 *pos, *nrm;
+    long n, cap;
+} rp_share;
+
+static size_t share_bucket(const rp_share *S, int obj, const int64_t c[3])
+{
+    uint64_t h = (uint64_t)(unsigned)obj * 0x9e3779b97f4a7c15ULL;
+    for (int a = 0; a < 3; a++) {
+        h ^= (uint64_t)c[a] + 0x632be59bd9b4e019ULL + (h << 6) + (h >> 2);
+        h *= 0xbf58476d1ce4e5b9ULL;
+    }
+    h ^= h >> 31;
+    return (size_t)h & S->mask;
+}
+
+/* The radiance particle of object obj at p facing n; -1 if none, -2 if p
+ * is too far out to hash (home: p's cell, for share_add). A point within
+ * tol of p on every axis lies in p's cell or, where p is within a quarter
+ * cell (tol) of a cell face, in the cell across it. */
+static int share_find(const rp_share *S, int obj, vec3 p, vec3 n, int64_t home[3])
+{
+    double v[3] = {p.x, p.y, p.z};
+    int64_t c[3][2];
+    int nc[3];
+    for (int a = 0; a < 3; a++) {
+        double f = v[a] / S->cell;
+        if (!(fabs(f) < 1e15)) return -2; /* not hashable: a radiance particle of its own */
+        double fl = floor(f), fr = f - fl;
+        c[a][0] = home[a] = (int64_t)fl;
+        nc[a] = 1;
+        if (fr < 0.3) c[a][nc[a]++] = c[a][0] - 1;
+        else if (fr > 0.7) c[a][nc[a]++] = c[a][0] + 1;
+    }
+    for (int x = 0; x < nc[0]; x++)
+        for (int y = 0; y < nc[1]; y++)
+            for (int z = 0; z < nc[2]; z++) {
+                int64_t q[3] = {c[0][x], c[1][y], c[2][z]};
+                for (int e = S->head[share_bucket(S, obj, q)]; e >= 0; e = S->next[e]) {
+                    if (S->obj[e] != obj || fabs(S->pos[e].x - p.x) > S->tol || fabs(S->pos[e].y - p.y) > S->tol ||
+                        fabs(S->pos[e].z - p.z) > S->tol || v3_dot(S->nrm[e], n) < SHARE_COS)
+                        continue;
+                    return S->rp[e];
+                }
+            }
+    return -1;
+}
+
+static int share_add(rp_share *S, int obj, vec3 p, vec3 n, const int64_t home[3], int rp)
+{
+    if (S->n == S->cap) {
+        long nc = S->cap ? 2 * S->cap : 4096;
+        int *nx = realloc(S->next, (size_t)nc * sizeof *nx);
+        if (!nx) return 0;
+        S->next = nx;
+        int *nr = realloc(S->rp, (size_t)nc * sizeof *nr);
+        if (!nr) return 0;
+        S->rp = nr;
+        int *no = realloc(S->obj, (size_t)nc * sizeof *no);
+        if (!no) return 0;
+        S->obj = no;
+        vec3 *np = realloc(S->pos, (size_t)nc * sizeof *np);
+        if (!np) return 0;
+        S->pos = np;
+        vec3 *nn = realloc(S->nrm, (size_t)nc * sizeof *nn);
+        if (!nn) return 0;
+        S->nrm = nn;
+        S->cap = nc;
+    }
+    size_t b = share_bucket(S, obj, home);
+    long e = S->n++;
+    S->next[e] = S->head[b];
+    S->rp[e] = rp;
+    S->obj[e] = obj;
+    S->pos[e] = p;
+    S->nrm[e] = n;
+    S->head[b] = (int)e;
+    return 1;
+}
+
+/* Slot `slot` (oriented normal n at q) joins the radiance particle of an
+ * earlier slot there, or starts one; only boundary slots (edge) are looked
+ * up and remembered. */
+static int share_slot(gi_surface *g, rp_share *S, int obj, long slot, int edge, vec3 q, vec3 n, long *nrp)
+{
+    int64_t home[3];
+    int r = edge ? share_find(S, obj, q, n, home) : -2;
+    if (r >= 0) {
+        g->slot_rp[slot] = r;
+        return 1;
+    }
+    int id = (int)(*nrp)++;
+    g->rp_slot[id] = (int)slot;
+    g->slot_rp[slot] = id;
+    return r == -1 ? share_add(S, obj, q, n, home, id) : 1;
+}
+
+/* Fills slot_rp / rp_slot and nrp; returns 0 when out of memory. */
+static int share_rps(gi_surface *g)
+{
+    long ns = g->nslot, nb = 0;
+    for (int i = 0; i < g->np; i++) {
+        const patch *p = &g->p[i];
+        if (p->rp_count == 0) continue;
+        if (p->kind == PATCH_TRI) nb += 3L * p->k * p->nsides;
+        else if (p->kind != PATCH_PIECE) nb += (2L * (p->nu + 1) + 2L * (p->nv + 1)) * p->nsides;
+    }
+    rp_share S;
+    memset(&S, 0, sizeof S);
+    double sc = fmax(fmax(fmax(fabs(g->lo.x), fabs(g->lo.y)), fabs(g->lo.z)),
+                     fmax(fmax(fabs(g->hi.x), fabs(g->hi.y)), fabs(g->hi.z)));
+    S.tol = SHARE_TOL * (sc > 0.0 && isfinite(sc) ? sc : 1.0);
+    S.cell = 4.0 * S.tol;
+    size_t nbk = 1024;
+    while (nbk < (size_t)nb) nbk *= 2;
+    S.mask = nbk - 1;
+    S.head = malloc(nbk * sizeof *S.head);
+    g->slot_rp = malloc((size_t)ns * sizeof *g->slot_rp);
+    g->rp_slot = malloc((size_t)ns * sizeof *g->rp_slot);
+    int ok = S.head && g->slot_rp && g->rp_slot;
+    if (ok)
+        for (size_t b = 0; b < nbk; b++) S.head[b] = -1;
+    long nrp = 0;
+    for (int i = 0; i < g->np && ok; i++) {
+        const patch *p = &g->p[i];
+        for (int side = 0; side < p->nsides && ok; side++) {
+            long slot = p->slot_first + side * p->rp_count;
+            double sg = side ? -1.0 : 1.0;
+            if (p->kind == PATCH_TRI) {
+                /* slots row by row (tri_index); edges: a = 0, b = 0, a + b = k */
+                int k = p->k;
+                vec3 n = v3_scale(p->nrm, sg);
+                for (int a = 0; a <= k && ok; a++)
+                    for (int b = 0; b <= k - a && ok; b++, slot++) {
+                        int edge = a == 0 || b == 0 || a + b == k;
+                        ok = share_slot(g, &S, p->obj, slot, edge, edge ? tri_point(p, a, b) : n, n, &nrp);
+                    }
+            } else if (p->kind == PATCH_PIECE) {
+                for (long l = 0; l < p->rp_count && ok; l++, slot++)
+                    ok = share_slot(g, &S, p->obj, slot, 0, p->nrm, p->nrm, &nrp);
+            } else {
+                for (int j = 0; j <= p->nv && ok; j++)
+                    for (int u = 0; u <= p->nu && ok; u++, slot++) {
+                        int edge = u == 0 || u == p->nu || j == 0 || j == p->nv;
+                        vec3 q = p->nrm, n = p->nrm;
+                        if (edge) {
+                            grid_eval(g, p, (double)u / p->nu, (double)j / p->nv, &q, &n);
+                            n = v3_scale(n, sg);
+                        }
+                        ok = share_slot(g, &S, p->obj, slot, edge, q, n, &nrp);
+                    }
+            }
+        }
+    }
+    free(S.head);
+    free(S.next);
+    free(S.rp);
+    free(S.obj);
+    free(S.pos);
+    free(S.nrm);
+    if (!ok) return 0;
+    int *shrunk = realloc(g->rp_slot, (size_t)(nrp > 0 ? nrp : 1) * sizeof *shrunk);
+    if (shrunk) g->rp_slot = shrunk;
+    g->nrp = nrp;
+    return 1;
+}
+
 static void layout(gi_surface *g)
 {
     build_meshes(g);
-    long rp = 0;
+    long ns = 0;
     for (int i = 0; i < g->np; i++) {
-        g->p[i].rp_first = rp;
-        rp += g->p[i].rp_count * g->p[i].nsides;
+        g->p[i].slot_first = ns;
+        ns += g->p[i].rp_count * g->p[i].nsides;
     }
-    g->nrp = rp;
+    g->nslot = g->nrp = ns;
+    free(g->slot_rp);
+    free(g->rp_slot);
+    g->slot_rp = g->rp_slot = NULL;
+    if (ns == 0 || ns >= INT_MAX) return;
+    if (!share_rps(g)) {
+        /* out of memory: one radiance particle per slot, as before sharing */
+        free(g->slot_rp);
+        free(g->rp_slot);
+        g->slot_rp = g->rp_slot = NULL;
+        g->nrp = ns;
+    }
 }
 
 void gi_surface_retess(gi_surface *g, double tess)
@@ -1508,6 +1765,8 @@ void gi_surface_free(gi_surface *g)
     free(g->mt);
     free(g->mtp);
     free(g->ce);
+    free(g->slot_rp);
+    free(g->rp_slot);
     free(g->cdf);
     free(g->p);
     free(g->o);
@@ -1525,6 +1784,7 @@ const scene_object *gi_surface_object(const gi_surface *g, int i) { return g->o[
 const scene_texture *gi_surface_texture(const gi_surface *g, int i) { return g->p[i].tex; }
 double gi_surface_total_area(const gi_surface *g) { return g->total_area; }
 long gi_surface_nrp(const gi_surface *g) { return g->nrp; }
+long gi_surface_rp_slots(const gi_surface *g) { return g->nslot; }
 long gi_surface_skipped(const gi_surface *g) { return g->skipped; }
 
 int gi_surface_has_particles(const gi_surface *g, const accel_hit *hit)
@@ -1538,7 +1798,7 @@ size_t gi_surface_bytes(const gi_surface *g)
     return (size_t)g->capp * sizeof(patch) + (size_t)g->capo * sizeof(obj_rec) + (size_t)g->hcap * sizeof(int) +
            (size_t)g->capcdf * sizeof(double) + (size_t)g->capcn * sizeof(csg_node) +
            (size_t)g->capmv * 2 * sizeof(vec3) + (size_t)g->capmt * 4 * sizeof(int) +
-           (size_t)g->nce * sizeof(cell_entry);
+           (size_t)g->nce * sizeof(cell_entry) + (g->slot_rp ? (size_t)(g->nslot + g->nrp) * sizeof(int) : 0);
 }
 
 int gi_surface_sample(const gi_surface *g, int i, double u, double v, rng *r, vec3 *pos, vec3 *nrm)
@@ -1602,43 +1862,23 @@ int gi_surface_sample(const gi_surface *g, int i, double u, double v, rng *r, ve
     return v3_finite(*pos) && v3_finite(*nrm);
 }
 
-int gi_surface_rp_patch(const gi_surface *g, long rp)
-{
-    int lo = 0, hi = g->np - 1;
-    while (lo < hi) {
-        int mid = (lo + hi + 1) / 2;
-        if (g->p[mid].rp_first <= rp) lo = mid;
-        else hi = mid - 1;
-    }
-    return lo;
-}
+int gi_surface_rp_patch(const gi_surface *g, long rp) { return slot_patch(g, rp_first_slot(g, rp)); }
 
 int gi_surface_rp_side(const gi_surface *g, long rp)
 {
-    const patch *p = &g->p[gi_surface_rp_patch(g, rp)];
-    return rp - p->rp_first >= p->rp_count;
+    long slot = rp_first_slot(g, rp);
+    const patch *p = &g->p[slot_patch(g, slot)];
+    return slot - p->slot_first >= p->rp_count;
 }
 
 void gi_surface_rp(const gi_surface *g, long rp, vec3 *pos, vec3 *nrm)
 {
-    const patch *p = &g->p[gi_surface_rp_patch(g, rp)];
-    long local = rp - p->rp_first;
+    long slot = rp_first_slot(g, rp);
+    const patch *p = &g->p[slot_patch(g, slot)];
+    long local = slot - p->slot_first;
     int side = local >= p->rp_count;
     if (side) local -= p->rp_count;
-    if (p->kind == PATCH_PIECE) {
-        *pos = g->mv[p->vfirst + local];
-        *nrm = g->mn[p->vfirst + local];
-    } else if (p->kind == PATCH_TRI) {
-        /* row a holds vertices (a, 0..k-a); row start a(k+1) - a(a-1)/2 */
-        int k = p->k, a = 0;
-        while (a < k && (long)(a + 1) * (k + 1) - (long)(a + 1) * a / 2 <= local) a++;
-        long b = local - ((long)a * (k + 1) - (long)a * (a - 1) / 2);
-        *pos = v3_add(p->v0, v3_add(v3_scale(p->e1, (double)a / k), v3_scale(p->e2, (double)b / k)));
-        *nrm = p->nrm;
-    } else {
-        int i = (int)(local % (p->nu + 1)), j = (int)(local / (p->nu + 1));
-        grid_eval(g, p, (double)i / p->nu, (double)j / p->nv, pos, nrm);
-    }
+    slot_point(g, p, local, pos, nrm);
     if (side) *nrm = v3_neg(*nrm);
 }
 
@@ -1709,10 +1949,10 @@ int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, lo
         vec3 ngv = v3_dot(n_view, hit->ng) >= 0.0 ? hit->ng : v3_neg(hit->ng);
         int side = v3_dot(ngv, fn) < 0.0;
         if (side >= pp->nsides) return 0;
-        long base = pp->rp_first + side * pp->rp_count;
+        long base = pp->slot_first + side * pp->rp_count;
         double sum = 0.0;
         for (int k = 0; k < 3; k++) {
-            rp[k] = base + tv[k];
+            rp[k] = slot_rp(g, base + tv[k]);
             w[k] = fmin(1.0, fmax(0.0, tw[k]));
             sum += w[k];
         }
@@ -1741,7 +1981,7 @@ int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, lo
     else grid_eval(g, p, fmin(fmax(u, 0.0), 1.0), fmin(fmax(v, 0.0), 1.0), NULL, &front);
     int side = v3_dot(ng, front) < 0.0;
     if (side >= p->nsides) return 0;
-    long base = p->rp_first + side * p->rp_count;
+    long base = p->slot_first + side * p->rp_count;
     if (p->kind == PATCH_TRI) {
         /* clamp into the triangle, then find the sub-triangle */
         u = fmax(0.0, u);
@@ -1804,9 +2044,10 @@ int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, lo
             w[2] = 1.0 - x;
         }
     }
-    /* clamp tiny negative weights from rounding */
+    /* clamp tiny negative weights from rounding; slots to radiance particles */
     double sum = 0.0;
     for (int k = 0; k < 3; k++) {
+        rp[k] = slot_rp(g, rp[k]);
         w[k] = fmin(1.0, fmax(0.0, w[k]));
         sum += w[k];
     }

@@ -105,14 +105,26 @@ double gi_surface_total_area(const gi_surface *g);
  * by folding the unit square. */
 int gi_surface_sample(const gi_surface *g, int patch, double u, double v, rng *r, vec3 *pos, vec3 *nrm);
 
-/* Radiance particles: gi_surface_nrp of them, patch by patch, side by side. */
+/* Radiance particles: gi_surface_nrp of them, in the order of the patches
+ * and sides that first lay them out. Patches of one object share the ones
+ * at a common point with the same facing (normals within 1 degree): a
+ * mesh vertex is one radiance particle per side however many triangles
+ * meet there, as are the points along an edge two triangles with the same
+ * sub-tessellation share, a box face's or clipped plane's triangles'
+ * common vertices, a sphere's seam and poles. gi_surface_rp_slots: the
+ * count before sharing (every patch side its own). */
 long gi_surface_nrp(const gi_surface *g);
+long gi_surface_rp_slots(const gi_surface *g);
 void gi_surface_rp(const gi_surface *g, long rp, vec3 *pos, vec3 *nrm);
-/* Patch and side (0 front, 1 back) a radiance particle belongs to. */
+/* Patch and side (0 front, 1 back) of the first patch side that laid the
+ * radiance particle out (every other one sharing it is on the same object
+ * and faces the same way). */
 int gi_surface_rp_patch(const gi_surface *g, long rp);
 int gi_surface_rp_side(const gi_surface *g, long rp);
 
-/* The 3 radiance particles around a hit and their barycentric weights.
+/* The 3 radiance particles around a hit and their barycentric weights
+ * (those of the hit's own triangle or grid cell; two of them can be one
+ * radiance particle at a sphere's pole).
  * n_view is the shading normal facing the viewer (shade.c's n); it picks the
  * side. Returns 1, or 0 when the hit is on a surface without particles. */
 int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, long rp[3], double w[3]);

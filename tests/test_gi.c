@@ -38,6 +38,10 @@
  *    top below gets E/pi = cos(theta) of the point light within 1e-3
  *    (measured 1.6e-7; before the fix all 443 were 0: the ceiling occluded
  *    the shadow rays).
+ *  - shared radiance particles: an L-shaped mesh of two grids gets one
+ *    radiance particle per grid vertex and side (and per cell-edge midpoint
+ *    at k = 2), two along the right-angle crease; the two triangles on
+ *    either side of a shared edge give the same value at its midpoint.
  *  - no NaN/Inf from the hook, stats consistent. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -1215,6 +1219,80 @@ static void test_settings_from_radiosity(void **state)
     unload(&f);
 }
 
+/* ------------------------------------------------------------------ shared radiance particles */
+
+/* One radiance particle per distinct (point, object, facing): an L of two
+ * grids in one mesh, a floor of 6 x 4 cells and a wall of 6 x 3 (cells 0.5
+ * on a side, two triangles each) meeting at a right angle along their
+ * common edge. With every triangle's sub-tessellation k = 1 (tess 1 >= the
+ * cells' diagonal 0.707) the radiance particles are the grid vertices, 7 x
+ * 5 + 7 x 4 on each of the two sides: the 7 on the crease stay two (the
+ * faces' normals differ by 90 degrees). With k = 2 (tess 0.5) the cells'
+ * edge midpoints join them: 13 x 9 + 13 x 7 a side. One particle per
+ * triangle corner (before sharing) would be 84 x 3 x 2 = 504 and 84 x 6 x 2
+ * = 1008. Every hit still interpolates its own triangle's three: the hook
+ * is checked for NaN and for agreement across a shared edge. */
+static void test_shared_rps(void **state)
+{
+    (void)state;
+    fixture f;
+    load(&f, "#version 3.7;\n"
+             "global_settings { assumed_gamma 1.0 }\n"
+             "camera { location <1.5, 1.2, -2.5> look_at <1.5, 0.5, 0.5> }\n"
+             "light_source { <1, 1.2, -1> color rgb 1 }\n"
+             "mesh {\n"
+             "  #for (J, 0, 3) #for (I, 0, 5)\n"
+             "    triangle { <I, 0, J> * 0.5, <I + 1, 0, J> * 0.5, <I + 1, 0, J + 1> * 0.5 }\n"
+             "    triangle { <I, 0, J> * 0.5, <I + 1, 0, J + 1> * 0.5, <I, 0, J + 1> * 0.5 }\n"
+             "  #end #end\n"
+             "  #for (J, 0, 2) #for (I, 0, 5)\n"
+             "    triangle { <I, J, 4> * 0.5, <I + 1, J, 4> * 0.5, <I + 1, J + 1, 4> * 0.5 }\n"
+             "    triangle { <I, J, 4> * 0.5, <I + 1, J + 1, 4> * 0.5, <I, J + 1, 4> * 0.5 }\n"
+             "  #end #end\n"
+             "  pigment { rgb 0.8 } finish { ambient 0 diffuse 0.8 }\n"
+             "}\n");
+    const double tess[2] = {1.0, 0.5};
+    const long want[2] = {2 * (7 * 5 + 7 * 4), 2 * (13 * 9 + 13 * 7)};
+    for (int t = 0; t < 2; t++) {
+        gi_particle_settings s;
+        gi_particle_default_settings(&s);
+        s.count = 4000;
+        s.bounces = 2;
+        s.threads = 2;
+        s.seed = 3;
+        s.cl_device = device_c;
+        s.tess = tess[t];
+        gi_particle_stats st;
+        pt_status ps;
+        gi_particle *gp = gi_particle_build(f.sc, f.a, &s, &st, f.d, &ps);
+        if (!gp) print_diag(f.d);
+        assert_non_null(gp);
+        assert_int_equal(gi_particle_light(gp, f.d), PT_OK);
+        /* the floor's two triangles of cell (2, 1) (mesh triangles 16 and
+         * 17) share its diagonal from (1, 0, 0.5) to (1.5, 0, 1): the hook at
+         * its midpoint, as a hit on either */
+        vec3 mid = v3(1.25, 0.0, 0.75), n = v3(0, 1, 0);
+        accel_hit h[2];
+        double v[2];
+        assert_true(accel_intersect(f.a, v3(1.2, 1.0, 0.7), v3(0, -1, 0), 0.0, INFINITY, &h[0]));
+        h[0].p = mid;
+        h[1] = h[0];
+        h[0].prim = 16;
+        h[1].prim = 17;
+        for (int k = 0; k < 2; k++) {
+            v[k] = gi_particle_indirect(gp, &h[k], n, 0).g;
+            assert_true(isfinite(v[k]) && v[k] > 0.0);
+        }
+        printf("  shared radiance particles (tess %.1f): %ld (expect %ld; one per triangle corner %ld), "
+               "diagonal midpoint E/pi %.6f from triangle %u, %.6f from triangle %u\n",
+               tess[t], st.radiance_particles, want[t], 84L * (t ? 6 : 3) * 2, v[0], h[0].prim, v[1], h[1].prim);
+        assert_int_equal(st.radiance_particles, want[t]);
+        assert_true(fabs(v[0] - v[1]) <= 1e-6 * v[0]);
+        gi_particle_free(gp);
+    }
+    unload(&f);
+}
+
 /* ------------------------------------------------------------------ light on a surface */
 
 /* A light lying exactly in the plane of a ceiling (cornell.pov's nine
@@ -1292,6 +1370,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_settings_from_radiosity),
         cmocka_unit_test(test_fine_mesh),
         cmocka_unit_test(test_light_on_ceiling),
+        cmocka_unit_test(test_shared_rps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
