@@ -1549,13 +1549,18 @@ static void slot_point(const gi_surface *g, const patch *p, long local, vec3 *po
 }
 
 /* Radiance particles on patch boundaries, in a hash of cells 4 SHARE_TOL
- * wide keyed by (object, cell). */
+ * wide keyed by (object, cell); an entry is one cache line. */
+typedef struct {
+    vec3 pos;
+    float n[3];
+    int obj, rp, next;
+} share_entry;
+
 typedef struct {
     double tol, cell;
     int *head; /* bucket -> first entry, -1 empty */
     size_t mask;
-    int *next, *rp, *obj;
-    vec3 *pos, *nrm;
+    share_entry *e;
     long n, cap;
 } rp_share;
 
@@ -1592,11 +1597,12 @@ static int share_find(const rp_share *S, int obj, vec3 p, vec3 n, int64_t home[3
         for (int y = 0; y < nc[1]; y++)
             for (int z = 0; z < nc[2]; z++) {
                 int64_t q[3] = {c[0][x], c[1][y], c[2][z]};
-                for (int e = S->head[share_bucket(S, obj, q)]; e >= 0; e = S->next[e]) {
-                    if (S->obj[e] != obj || fabs(S->pos[e].x - p.x) > S->tol || fabs(S->pos[e].y - p.y) > S->tol ||
-                        fabs(S->pos[e].z - p.z) > S->tol || v3_dot(S->nrm[e], n) < SHARE_COS)
+                for (int i = S->head[share_bucket(S, obj, q)]; i >= 0; i = S->e[i].next) {
+                    const share_entry *e = &S->e[i];
+                    if (e->obj != obj || fabs(e->pos.x - p.x) > S->tol || fabs(e->pos.y - p.y) > S->tol ||
+                        fabs(e->pos.z - p.z) > S->tol || e->n[0] * n.x + e->n[1] * n.y + e->n[2] * n.z < SHARE_COS)
                         continue;
-                    return S->rp[e];
+                    return e->rp;
                 }
             }
     return -1;
@@ -1606,31 +1612,21 @@ static int share_add(rp_share *S, int obj, vec3 p, vec3 n, const int64_t home[3]
 {
     if (S->n == S->cap) {
         long nc = S->cap ? 2 * S->cap : 4096;
-        int *nx = realloc(S->next, (size_t)nc * sizeof *nx);
-        if (!nx) return 0;
-        S->next = nx;
-        int *nr = realloc(S->rp, (size_t)nc * sizeof *nr);
-        if (!nr) return 0;
-        S->rp = nr;
-        int *no = realloc(S->obj, (size_t)nc * sizeof *no);
-        if (!no) return 0;
-        S->obj = no;
-        vec3 *np = realloc(S->pos, (size_t)nc * sizeof *np);
-        if (!np) return 0;
-        S->pos = np;
-        vec3 *nn = realloc(S->nrm, (size_t)nc * sizeof *nn);
-        if (!nn) return 0;
-        S->nrm = nn;
+        share_entry *ne = realloc(S->e, (size_t)nc * sizeof *ne);
+        if (!ne) return 0;
+        S->e = ne;
         S->cap = nc;
     }
     size_t b = share_bucket(S, obj, home);
-    long e = S->n++;
-    S->next[e] = S->head[b];
-    S->rp[e] = rp;
-    S->obj[e] = obj;
-    S->pos[e] = p;
-    S->nrm[e] = n;
-    S->head[b] = (int)e;
+    share_entry *e = &S->e[S->n];
+    e->pos = p;
+    e->n[0] = (float)n.x;
+    e->n[1] = (float)n.y;
+    e->n[2] = (float)n.z;
+    e->obj = obj;
+    e->rp = rp;
+    e->next = S->head[b];
+    S->head[b] = (int)S->n++;
     return 1;
 }
 
@@ -1709,11 +1705,7 @@ static int share_rps(gi_surface *g)
         }
     }
     free(S.head);
-    free(S.next);
-    free(S.rp);
-    free(S.obj);
-    free(S.pos);
-    free(S.nrm);
+    free(S.e);
     if (!ok) return 0;
     int *shrunk = realloc(g->rp_slot, (size_t)(nrp > 0 ? nrp : 1) * sizeof *shrunk);
     if (shrunk) g->rp_slot = shrunk;
