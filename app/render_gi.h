@@ -45,6 +45,7 @@ typedef struct {
     int has_pm;
     pm_stats pm;
     double t_aov;             /* the AOV pass, seconds (not in t_render) */
+    double c_render;          /* particle: process CPU seconds of prepare_view + the Whitted pass */
 } render_gi_result;
 
 pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb, render_gi_result *r,
