@@ -38,8 +38,10 @@ int gi_same_surface(const gi_surface *g, const gi_particles *ps, int i, const sc
 
 /* Whether a sample at y (normal ny) may stand for light at x (normal nx) on
  * object `own`: the segment between the two, lifted off the surface by
- * 16 eps along their normals (accel_mutually_visible), crosses no other object (hits on
- * `own` pass: a chord of a curved surface dips under it). Without it
+ * 16 eps along their normals (accel_mutually_visible), crosses no other object, and
+ * `own` an even number of times (a chord of a curved surface dips under it
+ * and out again; one crossing puts y behind a sheet of `own`: the inside of
+ * a thin closed slab's other face). Without it
  * estimates reached across walls: the floor around a box standing on it
  * took the particles (and radiance particles) of the floor under the box,
  * lit by a light inside the box; the dark side of a thin wall took the lit
