@@ -692,6 +692,7 @@ static void vis_chunk(void *ctx, int chunk, int thread)
         if (!gp->dirty[li]) continue;
         const scene_light *l = &sc->lights[li];
         const gi_dev_light *dl = &gp->lights[li];
+        int last_patch = -1, reaches = 0;
         B.n = 0;
         for (int i = i0; i < i1; i++) {
             int o = i - i0;
@@ -702,11 +703,19 @@ static void vis_chunk(void *ctx, int chunk, int thread)
             float depth = gi_light_ray(dl, dl->pos[0], dl->pos[1], dl->pos[2], pt->p[0], pt->p[1], pt->p[2], d);
             float ci = pt->n[0] * d[0] + pt->n[1] * d[1] + pt->n[2] * d[2];
             att[o] = ci >= 1e-10f ? gi_light_attenuation(dl, pt->p[0], pt->p[1], pt->p[2], d, depth) : 0.0f;
-            /* light_group: no light on objects the light does not reach (as shade.c) */
-            if (!scene_light_reaches(l, gi_surface_object(gp->surf, gp->ps.patch[i]))) att[o] = 0.0f;
             seen[o] = 0.0f;
             m_of[o] = 1;
             if (!(att[o] > 0.0f)) continue;
+            /* light_group: no light on objects the light does not reach (as
+             * shade.c); a chunk's particles mostly share a few patches */
+            if (gp->ps.patch[i] != last_patch) {
+                last_patch = gp->ps.patch[i];
+                reaches = scene_light_reaches(l, gi_surface_object(gp->surf, last_patch));
+            }
+            if (!reaches) {
+                att[o] = 0.0f;
+                continue;
+            }
             if (l->shadowless) {
                 seen[o] = 1.0f;
             } else if (l->area && l->size1 * l->size2 > 1) {

@@ -19,12 +19,14 @@
 #ifdef __OPENCL_VERSION__
 typedef long gi_i64;
 typedef uint gi_u32;
+typedef float gi_wide; /* what pow returns */
 #define GI_GLOBAL __global
 #else
 #include <math.h>
 #include <stdint.h>
 typedef int64_t gi_i64;
 typedef uint32_t gi_u32;
+typedef double gi_wide; /* what pow returns */
 #ifndef GI_GLOBAL
 #define GI_GLOBAL
 #endif
@@ -142,7 +144,9 @@ static inline float gi_light_attenuation(GI_GLOBAL const gi_dev_light *l, float 
         if (l->kind == GI_LIGHT_SPOT) {
             float c = -(d[0] * ax + d[1] * ay + d[2] * az);
             if (c <= 0.0f) return 0.0f;
-            att = l->tightness != 0.0f ? pow(c, l->tightness) : 1.0f;
+            /* tightness 1 (cosine spotlights: cbox, conference) needs no
+             * pow: pow(c, 1) is c exactly */
+            att = l->tightness == 1.0f ? c : (l->tightness != 0.0f ? pow(c, l->tightness) : 1.0f);
             if (l->cos_radius > 0.0f && c < l->cos_radius) att *= gi_cubic_step(l->cos_falloff, l->cos_radius, c);
         } else {
             float vx = px - l->pos[0], vy = py - l->pos[1], vz = pz - l->pos[2];
@@ -157,10 +161,17 @@ static inline float gi_light_attenuation(GI_GLOBAL const gi_dev_light *l, float 
         }
     }
     if (att > 0.0f && l->fade_power > 0.0f) {
-        if (fabs(l->fade_distance) >= 1e-10f)
-            att *= 2.0f / (1.0f + pow(depth / l->fade_distance, l->fade_power));
-        else
+        if (fabs(l->fade_distance) >= 1e-10f) {
+            /* fade_power 2 (the inverse-square fade) as x * x, in the
+             * precision pow returns (C: double, where the square of a float
+             * is exact and equals pow(x, 2); OpenCL: float): the same
+             * value without a pow per particle and light on the host */
+            float x = depth / l->fade_distance;
+            gi_wide xx = (gi_wide)x * (gi_wide)x;
+            att *= 2.0f / (1.0f + (l->fade_power == 2.0f ? xx : pow(x, l->fade_power)));
+        } else {
             att *= pow(depth, -l->fade_power);
+        }
     }
     return att;
 }
