@@ -873,17 +873,21 @@ __attribute__((target("avx2"))) static void scan_runs8(const gi_lookup *g, const
             slot = _mm256_blendv_epi8(slot, _mm256_add_epi32(lane, _mm256_set1_epi32(k)), _mm256_castps_si256(ok));
         }
 #undef LK_LOAD8
-    float bl[8];
-    int sl[8];
-    _mm256_storeu_ps(bl, best);
-    _mm256_storeu_si256((__m256i *)sl, slot);
-    for (int l = 0; l < 8; l++) {
-        if (sl[l] < 0) continue;
-        if (q->slot < 0 || bl[l] < q->best || (bl[l] == q->best && sl[l] < q->slot)) {
-            q->slot = sl[l];
-            q->best = bl[l];
-        }
-    }
+    /* a lane with a slot holds a distance below the query's best on entry,
+     * a lane without one holds that best: the answer is the lanes'
+     * minimum distance and, among the lanes holding it, the lowest slot */
+    __m256i has = _mm256_cmpgt_epi32(slot, _mm256_set1_epi32(-1));
+    if (!_mm256_movemask_ps(_mm256_castsi256_ps(has))) return;
+    __m256 m = _mm256_min_ps(best, _mm256_permute2f128_ps(best, best, 1));
+    m = _mm256_min_ps(m, _mm256_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+    m = _mm256_min_ps(m, _mm256_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
+    __m256i eq = _mm256_and_si256(has, _mm256_castps_si256(_mm256_cmp_ps(best, m, _CMP_EQ_OQ)));
+    __m256i s = _mm256_blendv_epi8(_mm256_set1_epi32(0x7fffffff), slot, eq);
+    s = _mm256_min_epi32(s, _mm256_permute2x128_si256(s, s, 1));
+    s = _mm256_min_epi32(s, _mm256_shuffle_epi32(s, _MM_SHUFFLE(1, 0, 3, 2)));
+    s = _mm256_min_epi32(s, _mm256_shuffle_epi32(s, _MM_SHUFFLE(2, 3, 0, 1)));
+    q->best = _mm256_cvtss_f32(m);
+    q->slot = _mm256_cvtsi256_si32(s);
 }
 #endif
 
