@@ -5,11 +5,15 @@
  *
  *   bench_gi [SCENE.pov] [--size N] [--count N] [--nb N] [--threads N]
  *            [--device SPEC] [--reps N] [--out PREFIX] [--sweep] [--spp N] [--full]
- *            [--area-samples N] [--ref REF.exr] [--ref-spp N]
+ *            [--area-samples N] [--ref REF.exr] [--ref-spp N] [--per-hit]
+ *            [--stride N]
  *
  * --full scatters along all links every bounce (GI_PARTICLE_SCATTER_FULL)
  * instead of the paper's random walks; --area-samples N caps the shadow rays
- * per particle per area light (0: the whole grid).
+ * per particle per area light (0: the whole grid). --per-hit makes the
+ * hook's light-leak guard test every hit (leak_per_hit) instead of caching
+ * a verdict per cell. --stride N: the view pre-pass traces every Nth pixel
+ * in x and y (prepass_stride; 0 the default).
  * --spp N renders N stratified samples per pixel (shade.c fixed
  * supersampling) in both modes, for image comparisons against references.
  * --out PREFIX writes PREFIX_none.exr and PREFIX_particle.exr. --sweep runs
@@ -41,7 +45,7 @@
 
 typedef struct {
     const char *scene;
-    int size, threads, nb, reps, sweep, spp, full, area_samples, ref_spp;
+    int size, threads, nb, reps, sweep, spp, full, area_samples, ref_spp, per_hit, stride;
     long count;
     const char *device, *out, *ref;
 } opts;
@@ -201,7 +205,7 @@ static void sweep(const scene *sc, const accel *a, const opts *o, diag *d)
 
 int main(int argc, char **argv)
 {
-    opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 1, 0, -1, 0, 50000, NULL, NULL, NULL};
+    opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 1, 0, -1, 0, 0, 0, 50000, NULL, NULL, NULL};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -217,6 +221,8 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--ref-spp") && v) { o.ref_spp = atoi(v); i++; }
         else if (!strcmp(a, "--spp") && v) { o.spp = atoi(v); i++; }
         else if (!strcmp(a, "--full")) o.full = 1;
+        else if (!strcmp(a, "--per-hit")) o.per_hit = 1;
+        else if (!strcmp(a, "--stride") && v) { o.stride = atoi(v); i++; }
         else if (!strcmp(a, "--area-samples") && v) { o.area_samples = atoi(v); i++; }
         else if (a[0] != '-') o.scene = a;
         else { fprintf(stderr, "bench_gi: unknown option %s\n", a); return 2; }
@@ -259,6 +265,8 @@ int main(int argc, char **argv)
     s.cl_device = o.device;
     if (o.full) s.scatter = GI_PARTICLE_SCATTER_FULL;
     if (o.area_samples >= 0) s.area_samples = o.area_samples;
+    s.leak_per_hit = o.per_hit;
+    s.prepass_stride = o.stride;
     gi_particle_stats gs;
     double c0 = cpu_now();
     gi_particle *gp = gi_particle_build(sc, a, &s, &gs, d, &st);
@@ -374,8 +382,17 @@ int main(int argc, char **argv)
            1e3 * x->t_estimate, x->found, x->used, 1e3 * median(tfr, o.reps), mf / mn);
     printf("  CPU time per frame (all threads, median): none %.1f ms, particle %.1f ms; ratio %.2f\n",
            1e3 * median(cn, o.reps), 1e3 * median(cf, o.reps), median(cf, o.reps) / median(cn, o.reps));
-    printf("  hook: %ld lookups, %ld late, %ld without particles, %ld discarded\n", x->lookups, x->lookups_late,
-           x->lookups_none, x->discarded);
+    printf("  hook, per frame (mean of %d): %.0f lookups, %.0f late (%.0f radiance, %.0f area particles computed in "
+           "the hook), %.0f without particles, %.0f discarded; %.0f visibility rays\n",
+           o.reps, (double)x->lookups / o.reps, (double)x->lookups_late / o.reps, (double)x->late_radiance / o.reps,
+           (double)x->late_area / o.reps, (double)x->lookups_none / o.reps, (double)x->discarded / o.reps,
+           (double)(x->visibility_rays - gs.visibility_rays) / o.reps);
+    printf("  pre-pass: stride %d, %ld rays, %ld pixels on their neighbours' plane\n", o.stride > 0 ? o.stride : 2,
+           x->prepass_rays, x->prepass_planar);
+    printf("  light-leak guard: %s; %ld cells tested (%ld clear, %.1f%%), %.1f%% of lookups in clear cells, "
+           "table %.1f MiB\n",
+           o.per_hit ? "per hit" : "per cell", x->cells, x->cells_clear, 100.0 * x->cells_clear / fmax(1, x->cells),
+           100.0 * x->lookups_clear / fmax(1, x->lookups), x->bytes_cells / 1048576.0);
     printf("mean luminance: none %.5f, particle %.5f\n", mean_lum(fb_none), mean_lum(fb_gi));
     {
         double fl, rm, lu;

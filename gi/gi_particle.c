@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include "gi_cellvis.h"
 #include "gi_cl.h"
 #include "gi_cl_c.h"
 #include "gi_links.h"
@@ -21,6 +22,8 @@
 
 typedef struct {
     long lookups, late, none, discarded, onthefly, vis_rays;
+    long late_rp, late_area;        /* radiance / area particles computed in the hook (late_rp) */
+    long cells, cells_clear, clear; /* cells tested, of them clear; lookups in clear cells */
     int *buf; /* on-the-fly estimation list */
     long len, cap;
     char pad[8];
@@ -60,6 +63,7 @@ struct gi_particle {
     float *rp_val;               /* nrp*4: estimated E/pi at radiance particles */
     atomic_uchar *rp_state;
     atomic_uchar *mark;
+    gi_cellvis *cells; /* per-cell verdicts of the light-leak guard (side_value); NULL: per hit */
     float bg[3];
     double vis_eps; /* gi_visible's eps: 1e-6 x accel_eps_scale */
     thread_count tc[GI_MAX_THREADS];
@@ -131,14 +135,22 @@ static void update_bytes(gi_particle *gp)
                      nrp * (4 * sizeof(float) + 2);
     s->bytes_surfaces = gp->surf ? gi_surface_bytes(gp->surf) : 0;
     s->bytes_device = gi_dev_bytes(gp->dev);
-    s->bytes_total = s->bytes_particles + s->bytes_links + s->bytes_lists + s->bytes_surfaces + s->bytes_device;
+    s->bytes_cells = gi_cellvis_bytes(gp->cells);
+    s->bytes_total = s->bytes_particles + s->bytes_links + s->bytes_lists + s->bytes_surfaces + s->bytes_device +
+                     s->bytes_cells;
 }
 
 static void fill_stats(gi_particle *gp, gi_particle_stats *out)
 {
     update_bytes(gp);
     long look = 0, late = 0, none = 0, disc = 0, otf = 0, vis = gp->lists.vis_rays;
+    long lrp = 0, larea = 0, cells = 0, cclear = 0, clear = 0;
     for (int t = 0; t < GI_MAX_THREADS; t++) {
+        lrp += gp->tc[t].late_rp;
+        larea += gp->tc[t].late_area;
+        cells += gp->tc[t].cells;
+        cclear += gp->tc[t].cells_clear;
+        clear += gp->tc[t].clear;
         vis += gp->tc[t].vis_rays;
         otf += gp->tc[t].onthefly;
         look += gp->tc[t].lookups;
@@ -152,6 +164,11 @@ static void fill_stats(gi_particle *gp, gi_particle_stats *out)
     gp->st.discarded = disc;
     gp->st.lookups_onthefly = otf;
     gp->st.visibility_rays = vis;
+    gp->st.late_radiance = lrp;
+    gp->st.late_area = larea;
+    gp->st.cells = cells;
+    gp->st.cells_clear = cclear;
+    gp->st.lookups_clear = clear;
     if (out && out != &gp->st) *out = gp->st;
 }
 
@@ -483,6 +500,11 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         gp->rp_state = xcalloc(nrp, sizeof(atomic_uchar), &st);
         gp->mark = xcalloc(nrp, sizeof(atomic_uchar), &st);
         if (st != PT_OK) goto fail;
+        /* about 2 cells per radiance particle; room for twice that, within
+         * 4M slots (32 MiB): more cells than a 1920x1080 frame's hits.
+         * Without a table (out of memory) every hit is tested. */
+        long slots = 4 * (long)nrp;
+        if (!set->leak_per_hit) gp->cells = gi_cellvis_new(slots < (1L << 22) ? slots : (1L << 22));
     }
 
     /* incoming scattering links, sources ascending (FULL scattering) */
@@ -526,6 +548,7 @@ void gi_particle_free(gi_particle *gp)
     gi_particles_free(&gp->ps);
     gi_lists_free(&gp->lists);
     gi_grid_free(gp->rgrid);
+    gi_cellvis_free(gp->cells);
     for (int t = 0; t < GI_MAX_THREADS; t++) free(gp->tc[t].buf);
     free(gp->slink);
     free(gp->glink);
@@ -899,12 +922,38 @@ void gi_particle_set_scattering(gi_particle *gp, int bounces, int scatter)
 
 /* ------------------------------------------------------------------ the view */
 
+/* The pre-pass (gi_particle_prepare_view) in two steps. Step 1 traces the
+ * pixels of a coarse grid (every stride-th pixel in x and y, and the last
+ * column and row) as the Whitted pass will: primary, reflected and
+ * transmitted rays, marking the radiance particles around every diffuse
+ * hit. Step 2 visits the pixels in between: when the coarse pixels around
+ * one (2 on a coarse row or column, else the 4 corners of its block) all
+ * hit the same planar piece (one mesh triangle, triangle, box face, plane
+ * or disc: a convex flat piece, and the object seen directly, no reflected
+ * or transmitted rays from it), the pixel's ray meets that piece too (the
+ * block's pixels lie inside the corners' convex hull, and so does their hit
+ * on a convex piece), so its hit is the ray's intersection with the
+ * piece's plane and no ray is traced; else the pixel is traced as in step
+ * 1. What this misses: something smaller than the block standing in front
+ * of the piece between the coarse pixels, or a hole cut into the piece by
+ * CSG there; the radiance particles of those hits are estimated late, in
+ * the hook (stats late_radiance). */
+typedef struct {
+    const scene_object *obj; /* NULL: no plane to reuse (a miss, a curved object, secondary rays) */
+    unsigned prim;
+    int diffuse;             /* the piece has diffuse > 0 (its hits are marked) */
+    vec3 p, ng, n;           /* the hit, its geometric normal, the viewer-side normal mark_hit took */
+} coarse_hit;
+
 typedef struct {
     gi_particle *gp;
     const scene_camera *cam;
     int w, h, max_level;
+    int stride;     /* every stride-th pixel in x and y, and the last ones */
+    int ncx, ncy;   /* coarse grid */
+    coarse_hit *ch; /* ncx x ncy, NULL: step 2 traces every pixel */
     double eps;
-    atomic_long rays;
+    atomic_long rays, planar;
 } view_job;
 
 static void mark_hit(gi_particle *gp, const accel_hit *h, vec3 n)
@@ -915,12 +964,31 @@ static void mark_hit(gi_particle *gp, const accel_hit *h, vec3 n)
     for (int k = 0; k < 3; k++) atomic_store_explicit(&gp->mark[rp[k]], 1, memory_order_relaxed);
 }
 
+/* Objects whose surface pieces (hit->prim) are flat and convex. */
+static int flat_pieces(const scene_object *o)
+{
+    switch (o->kind) {
+    case SHAPE_MESH:
+    case SHAPE_TRIANGLE:
+    case SHAPE_SMOOTH_TRIANGLE:
+    case SHAPE_BOX:
+    case SHAPE_PLANE:
+        return 1;
+    case SHAPE_DISC:
+        return !(o->u.disc.hole_radius > 0.0); /* an annulus is not convex */
+    default:
+        return 0;
+    }
+}
+
 /* The rays the Whitted pass will trace (shade.c): primary, then reflected
  * and transmitted ones; shadow rays are not needed. Marks the radiance
- * particles around every diffuse hit. */
-static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_level, double eps)
+ * particles around every diffuse hit. rec (may be NULL): the first hit, when
+ * it is on a flat piece and spawns no further rays. */
+static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_level, double eps, coarse_hit *rec)
 {
     accel_hit h;
+    if (rec) rec->obj = NULL;
     if (!accel_intersect(gp->a, org, dir, eps, INFINITY, &h)) return 1;
     long rays = 1;
     const scene_texture *tex = h.texture ? h.texture : &gp->sc->default_texture;
@@ -930,14 +998,23 @@ static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_
     if (v3_dot(dir, n) > 0.0) n = v3_neg(n);
     if (!entering) ng = v3_neg(ng);
     if (f->diffuse > 0.0) mark_hit(gp, &h, n);
+    int refl = fmax(f->reflection_max.r, fmax(f->reflection_max.g, f->reflection_max.b)) > 0.0 ||
+               fmax(f->reflection_min.r, fmax(f->reflection_min.g, f->reflection_min.b)) > 0.0;
+    const colour5 *pc = &tex->pigment.colour;
+    int trans = pc->f > 0.0 || pc->t > 0.0;
+    if (rec && h.obj && flat_pieces(h.obj) && ((!refl && !trans) || level >= max_level)) {
+        rec->obj = h.obj;
+        rec->prim = h.prim;
+        rec->diffuse = f->diffuse > 0.0;
+        rec->p = h.p;
+        rec->ng = h.ng;
+        rec->n = n;
+    }
     if (level >= max_level) return rays;
     double cos_i = -v3_dot(dir, n);
     vec3 p = v3_madd(h.p, ng, eps);
-    int refl = fmax(f->reflection_max.r, fmax(f->reflection_max.g, f->reflection_max.b)) > 0.0 ||
-               fmax(f->reflection_min.r, fmax(f->reflection_min.g, f->reflection_min.b)) > 0.0;
-    if (refl) rays += prepass_ray(gp, p, v3_madd(dir, n, 2.0 * cos_i), level + 1, max_level, eps);
-    const colour5 *pc = &tex->pigment.colour;
-    if (pc->f > 0.0 || pc->t > 0.0) {
+    if (refl) rays += prepass_ray(gp, p, v3_madd(dir, n, 2.0 * cos_i), level + 1, max_level, eps, NULL);
+    if (trans) {
         const scene_interior *in = h.obj->interior;
         double rel = 1.0;
         if (in && in->ior > 0.0) rel = entering ? in->ior : 1.0 / in->ior;
@@ -945,25 +1022,134 @@ static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_
         vec3 q = v3_madd(h.p, ng, -eps);
         if (fabs(rel - 1.0) > 1e-9) {
             double eta = 1.0 / rel, k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-            if (k < 0.0) return rays + prepass_ray(gp, p, v3_madd(dir, n, 2.0 * cos_i), level + 1, max_level, eps);
+            if (k < 0.0)
+                return rays + prepass_ray(gp, p, v3_madd(dir, n, 2.0 * cos_i), level + 1, max_level, eps, NULL);
             td = v3_norm(v3_add(v3_scale(dir, eta), v3_scale(n, eta * cos_i - sqrt(k))));
         }
-        rays += prepass_ray(gp, q, td, level + 1, max_level, eps);
+        rays += prepass_ray(gp, q, td, level + 1, max_level, eps, NULL);
     }
     return rays;
 }
 
-static void view_row(void *ctx, int y, int thread)
+/* Coarse grid coordinate i along an axis of n pixels: stride * i, the last
+ * one n - 1. */
+static int coarse_at(int i, int stride, int n) { return i * stride < n - 1 ? i * stride : n - 1; }
+static int coarse_count(int stride, int n) { return n > 0 ? (n - 1 + stride - 1) / stride + 1 : 0; }
+
+static void coarse_row(void *ctx, int j, int thread)
 {
     (void)thread;
     view_job *J = ctx;
     long rays = 0;
-    for (int x = 0; x < J->w; x++) {
+    int y = coarse_at(j, J->stride, J->h);
+    for (int i = 0; i < J->ncx; i++) {
+        int x = coarse_at(i, J->stride, J->w);
         vec3 org, dir;
         scene_camera_ray(J->cam, x + 0.5, y + 0.5, J->w, J->h, &org, &dir);
-        rays += prepass_ray(J->gp, org, dir, 1, J->max_level, J->eps);
+        rays += prepass_ray(J->gp, org, dir, 1, J->max_level, J->eps, J->ch ? &J->ch[(size_t)j * J->ncx + i] : NULL);
     }
     atomic_fetch_add(&J->rays, rays);
+}
+
+/* Whether world point p lies in triangle `prim` of mesh object o (its
+ * barycentrics in object space, where the mesh is stored; affine maps keep
+ * them). */
+static int in_mesh_triangle(const scene_object *o, unsigned prim, vec3 p)
+{
+    const scene_mesh *m = o->u.mesh.mesh;
+    if (!m || prim >= (unsigned)m->ntris) return 0;
+    const int *t = m->tris[prim];
+    if (t[0] < 0 || t[1] < 0 || t[2] < 0 || t[0] >= m->nverts || t[1] >= m->nverts || t[2] >= m->nverts) return 0;
+    const float *a = m->verts[t[0]], *b = m->verts[t[1]], *c = m->verts[t[2]];
+    vec3 q = xform_inv_point(&o->transform, p);
+    vec3 v0 = v3(a[0], a[1], a[2]);
+    vec3 e1 = v3_sub(v3(b[0], b[1], b[2]), v0), e2 = v3_sub(v3(c[0], c[1], c[2]), v0), d = v3_sub(q, v0);
+    double d00 = v3_dot(e1, e1), d01 = v3_dot(e1, e2), d11 = v3_dot(e2, e2);
+    double d20 = v3_dot(d, e1), d21 = v3_dot(d, e2), den = d00 * d11 - d01 * d01;
+    if (!(den > 0.0)) return 0;
+    double v = (d11 * d20 - d01 * d21) / den, w = (d00 * d21 - d01 * d20) / den;
+    return v >= 0.0 && w >= 0.0 && v + w <= 1.0;
+}
+
+/* The hit of the ray (org, dir) on the flat pieces of the coarse hits
+ * c[0..nc): NULL unless they all lie on one object, seen from the same
+ * side; then, on one piece (its convexity puts the ray's hit on it), that
+ * piece, and on several pieces of a mesh, the nearest one whose triangle
+ * holds the ray's point on its plane. *t: the ray parameter. */
+static const coarse_hit *piece_hit(const coarse_hit *const *c, int nc, vec3 org, vec3 dir, double *t)
+{
+    int one = 1;
+    for (int k = 0; k < nc; k++) {
+        if (!c[k]->obj || c[k]->obj != c[0]->obj || !(v3_dot(c[k]->n, c[0]->n) > 0.0)) return NULL;
+        one &= c[k]->prim == c[0]->prim;
+    }
+    if (!one && c[0]->obj->kind != SHAPE_MESH) return NULL;
+    const coarse_hit *best = NULL;
+    double bt = INFINITY;
+    for (int k = 0; k < nc; k++) {
+        int seen = 0;
+        for (int q = 0; q < k && !seen; q++) seen = c[q]->prim == c[k]->prim;
+        if (seen) continue;
+        double den = v3_dot(dir, c[k]->ng);
+        double tk = fabs(den) > 1e-12 ? v3_dot(v3_sub(c[k]->p, org), c[k]->ng) / den : -1.0;
+        if (!(tk > 0.0) || !isfinite(tk) || !(tk < bt)) continue;
+        if (!one && !in_mesh_triangle(c[k]->obj, c[k]->prim, v3_madd(org, dir, tk))) continue;
+        best = c[k];
+        bt = tk;
+    }
+    *t = bt;
+    return best;
+}
+
+static void fill_row(void *ctx, int y, int thread)
+{
+    (void)thread;
+    view_job *J = ctx;
+    gi_particle *gp = J->gp;
+    long rays = 0, planar = 0;
+    int s = J->stride, j = y == J->h - 1 ? J->ncy - 1 : y / s, on_row = y % s == 0 || y == J->h - 1;
+    int j1 = j + 1 < J->ncy ? j + 1 : j;
+    for (int x = 0; x < J->w; x++) {
+        int i = x == J->w - 1 ? J->ncx - 1 : x / s, on_col = x % s == 0 || x == J->w - 1;
+        if (on_row && on_col) continue; /* a coarse pixel */
+        int i1 = i + 1 < J->ncx ? i + 1 : i;
+        const coarse_hit *c[4];
+        int nc = 0;
+        if (on_row) {
+            c[nc++] = &J->ch[(size_t)j * J->ncx + i];
+            c[nc++] = &J->ch[(size_t)j * J->ncx + i1];
+        } else if (on_col) {
+            c[nc++] = &J->ch[(size_t)j * J->ncx + i];
+            c[nc++] = &J->ch[(size_t)j1 * J->ncx + i];
+        } else {
+            c[nc++] = &J->ch[(size_t)j * J->ncx + i];
+            c[nc++] = &J->ch[(size_t)j * J->ncx + i1];
+            c[nc++] = &J->ch[(size_t)j1 * J->ncx + i];
+            c[nc++] = &J->ch[(size_t)j1 * J->ncx + i1];
+        }
+        vec3 org, dir;
+        scene_camera_ray(J->cam, x + 0.5, y + 0.5, J->w, J->h, &org, &dir);
+        double t;
+        const coarse_hit *b = piece_hit(c, nc, org, dir, &t);
+        if (b) {
+            planar++;
+            if (b->diffuse) {
+                accel_hit hh;
+                memset(&hh, 0, sizeof hh);
+                hh.t = t;
+                hh.p = v3_madd(org, dir, t);
+                hh.ng = b->ng;
+                hh.ns = b->ng;
+                hh.obj = b->obj;
+                hh.prim = b->prim;
+                mark_hit(gp, &hh, b->n);
+            }
+            continue;
+        }
+        rays += prepass_ray(gp, org, dir, 1, J->max_level, J->eps, NULL);
+    }
+    atomic_fetch_add(&J->rays, rays);
+    atomic_fetch_add(&J->planar, planar);
 }
 
 pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w, int h, diag *d)
@@ -984,9 +1170,27 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
     if (J.max_level < 1) J.max_level = 1;
     double sc = accel_eps_scale(gp->a);
     J.eps = (sc > 0.0 && isfinite(sc) ? sc : 1.0) * 1e-6;
+    J.stride = gp->set.prepass_stride > 0 ? gp->set.prepass_stride : 2;
+    J.ncx = coarse_count(J.stride, w);
+    J.ncy = coarse_count(J.stride, h);
+    J.ch = NULL;
     atomic_init(&J.rays, 0);
-    if (w > 0 && h > 0) pool_run(gp->threads, h, view_row, &J);
+    atomic_init(&J.planar, 0);
+    if (w > 0 && h > 0) {
+        /* step 1, then step 2; every pixel traced (step 1 alone, without
+         * records) at stride 1 or when the grid's memory is not there */
+        J.ch = J.stride > 1 ? malloc((size_t)J.ncx * (size_t)J.ncy * sizeof *J.ch) : NULL;
+        if (!J.ch) {
+            J.stride = 1;
+            J.ncx = w;
+            J.ncy = h;
+        }
+        pool_run(gp->threads, J.ncy, coarse_row, &J);
+        if (J.ch) pool_run(gp->threads, h, fill_row, &J);
+        free(J.ch);
+    }
     S->prepass_rays = atomic_load(&J.rays);
+    S->prepass_planar = atomic_load(&J.planar);
     S->t_prepass = timer_now() - t0;
 
     /* found radiance particles (not yet estimated) and the area particles
@@ -1070,9 +1274,10 @@ static int claim(atomic_uchar *s)
     }
 }
 
-static void late_rp(gi_particle *gp, long l)
+static void late_rp(gi_particle *gp, long l, thread_count *tc)
 {
     if (!claim(&gp->rp_state[l])) return;
+    tc->late_rp++;
     int lo = gp->lists.off[l], hi = gp->lists.off[l + 1];
     for (int q = lo; q < hi; q++) {
         int m = gp->lists.idx[q];
@@ -1080,6 +1285,7 @@ static void late_rp(gi_particle *gp, long l)
             /* the gathering kernel, C build, on this thread */
             gi_c_gather(1, gp->glink, gp->ng, gp->lout, &m, 1, gp->bg, gp->eind);
             atomic_store_explicit(&gp->e_state[m], 2, memory_order_release);
+            tc->late_area++;
         }
     }
     int li = (int)l;
@@ -1124,6 +1330,7 @@ static int onthefly(gi_particle *gp, const accel_hit *h, vec3 n, thread_count *t
         if (claim(&gp->e_state[k])) {
             gi_c_gather(1, gp->glink, gp->ng, gp->lout, &k, 1, gp->bg, gp->eind);
             atomic_store_explicit(&gp->e_state[k], 2, memory_order_release);
+            tc->late_area++;
         }
         double da = gp->ps.p[k].area;
         for (int c = 0; c < 3; c++) s[c] += gp->eind[4 * (size_t)k + c] * da;
@@ -1134,6 +1341,42 @@ static int onthefly(gi_particle *gp, const accel_hit *h, vec3 n, thread_count *t
     out->g = s[1] / a;
     out->b = s[2] / a;
     tc->onthefly++;
+    return 1;
+}
+
+/* Whether every point of the cell (the sub-triangle of radiance particles
+ * rp, on object own) sees its three vertices, as side_value's per-hit test
+ * (gi_visible, the same eps and object rule) would find: tested once per
+ * cell on six segments, the three edges and the three from the centroid
+ * (normal: the mean of the vertices') to each vertex. An object that cuts
+ * the (lifted) cell anywhere crosses an edge, or encloses the centroid and
+ * so crosses a spoke (a box standing on the floor, a wall across a cell).
+ * What this gives up: an occluder whose cross-section at the lifted cell
+ * lies entirely inside it and misses the three spokes (a thin post standing
+ * inside one floor cell; on a curved cell, something touching the surface
+ * between the chords, e.g. the floor under a sphere resting on it, within
+ * the one cell around the contact point). Hits there interpolate all three
+ * vertices where the per-hit test dropped some: light from a vertex on the
+ * far side of the post, never from inside a closed solid the cell's
+ * vertices are outside of. */
+static int cell_clear(gi_particle *gp, const long rp[3], const scene_object *own, thread_count *tc)
+{
+    vec3 q[3], nq[3], c = v3(0, 0, 0), nc = v3(0, 0, 0);
+    for (int k = 0; k < 3; k++) {
+        gi_surface_rp(gp->surf, rp[k], &q[k], &nq[k]);
+        c = v3_madd(c, q[k], 1.0 / 3.0);
+        nc = v3_add(nc, nq[k]);
+    }
+    nc = v3_len2(nc) > 0.0 ? v3_norm(nc) : nq[0];
+    tc->cells++;
+    for (int k = 0; k < 3; k++) {
+        int j = k + 1 < 3 ? k + 1 : 0;
+        tc->vis_rays++;
+        if (!gi_visible(gp->a, gp->vis_eps, q[k], nq[k], q[j], nq[j], own)) return 0;
+        tc->vis_rays++;
+        if (!gi_visible(gp->a, gp->vis_eps, c, nc, q[k], nq[k], own)) return 0;
+    }
+    tc->cells_clear++;
     return 1;
 }
 
@@ -1148,11 +1391,24 @@ static int side_value(gi_particle *gp, const accel_hit *hit, vec3 n, thread_coun
     if (!gi_surface_locate(gp->surf, hit, n, rp, w))
         return gi_surface_has_particles(gp->surf, hit) && onthefly(gp, hit, n, tc, out);
     /* only radiance particles the hit sees (gi_visible): one under a box
-     * standing on the floor must not lend its light to the floor outside */
-    vec3 ngv = v3_dot(n, hit->ng) >= 0.0 ? hit->ng : v3_neg(hit->ng);
+     * standing on the floor must not lend its light to the floor outside.
+     * A clear cell (cell_clear) sees all three from everywhere; the other
+     * cells test them from the hit. */
     double wsum = 0.0;
+    uint64_t key = gi_cellvis_key(rp);
+    int verdict = gi_cellvis_get(gp->cells, key);
+    if (verdict == GI_CELL_UNKNOWN && gp->cells && key) {
+        verdict = cell_clear(gp, rp, hit->obj, tc) ? GI_CELL_CLEAR : GI_CELL_BLOCKED;
+        gi_cellvis_put(gp->cells, key, verdict);
+    }
+    if (verdict == GI_CELL_CLEAR) tc->clear++;
+    vec3 ngv = v3_dot(n, hit->ng) >= 0.0 ? hit->ng : v3_neg(hit->ng);
     for (int k = 0; k < 3; k++) {
         if (!(w[k] > 0.0)) continue;
+        if (verdict == GI_CELL_CLEAR) {
+            wsum += w[k];
+            continue;
+        }
         vec3 q, nq;
         gi_surface_rp(gp->surf, rp[k], &q, &nq);
         tc->vis_rays++;
@@ -1167,7 +1423,7 @@ static int side_value(gi_particle *gp, const accel_hit *hit, vec3 n, thread_coun
         if (!(w[k] > 0.0)) continue;
         if (atomic_load_explicit(&gp->rp_state[rp[k]], memory_order_acquire) != 2) {
             tc->late++;
-            late_rp(gp, rp[k]);
+            late_rp(gp, rp[k], tc);
         }
         const float *v = &gp->rp_val[4 * rp[k]];
         out->r += w[k] / wsum * v[0];

@@ -105,6 +105,12 @@ typedef struct {
     int area_samples;    /* shadow rays per particle per area light; 0: the whole grid (default 0) */
     double brightness;   /* multiplies the returned indirect light (default 1) */
     int max_trace_level; /* pre-pass depth; 0: the scene's */
+    int prepass_stride;  /* the pre-pass traces every Nth pixel in x and y; the pixels between take
+                            their hit from the flat piece their coarse neighbours all hit, or are
+                            traced (gi_particle.c, coarse_hit). 0: the default (2); 1: every pixel */
+    int leak_per_hit;    /* 1: the light-leak guard tests every hit's 3 radiance particles; 0 (default):
+                            once per interpolation cell, hits in clear cells skip it (gi_particle.c
+                            cell_clear) */
     uint64_t seed;
     int threads;         /* <= 0: all cores */
     const char *cl_device; /* NULL/"auto", "c", "P:D" or part of a name (gi_cl.h) */
@@ -133,13 +139,19 @@ typedef struct {
     long sources;           /* particles that emit or reflect direct light */
     long shadow_rays;
     long prepass_rays, found, used;  /* last prepare_view: new radiance / area particles */
+    long prepass_planar;    /* last prepare_view: pixels whose hit was found on their coarse
+                               neighbours' flat piece, without a ray (prepass_stride) */
     long lookups, lookups_late, lookups_none, discarded;
     long lookups_onthefly;  /* hits on surfaces without radiance particles (no grid): estimated at the hit */
-    long visibility_rays;   /* gi_visible tests: estimation list entries and radiance particles at hits */
+    long visibility_rays;   /* gi_visible tests: estimation list entries, radiance particles at hits, cells */
+    long late_radiance, late_area; /* radiance particles estimated in the hook (the pre-pass missed
+                                      them) and area particles gathered there (C build, on the CPU) */
+    long cells, cells_clear; /* interpolation cells tested by the light-leak guard, of them clear */
+    long lookups_clear;     /* hook lookups in clear cells (no visibility rays) */
     long skipped_objects;
     double flux_direct, flux_emitted, flux_scattered; /* sums over particles (grey) */
     /* memory, bytes */
-    size_t bytes_particles, bytes_links, bytes_lists, bytes_surfaces, bytes_device, bytes_total;
+    size_t bytes_particles, bytes_links, bytes_lists, bytes_surfaces, bytes_device, bytes_cells, bytes_total;
     double spacing, tess, radius;
     int bounces;
     char device[256];

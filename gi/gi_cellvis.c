@@ -1,0 +1,94 @@
+/* gi_cellvis.c - lock-free cell verdict cache (see gi_cellvis.h). */
+#include "gi_cellvis.h"
+#include <stdatomic.h>
+#include <stdlib.h>
+
+#define CELLVIS_PROBES 32 /* longest probe run before giving up (get and put) */
+
+struct gi_cellvis {
+    _Atomic uint64_t *slot;
+    uint64_t mask;
+    long limit;       /* put stops storing past this count (3/4 of the slots) */
+    atomic_long count;
+};
+
+gi_cellvis *gi_cellvis_new(long slots)
+{
+    uint64_t n = 1024;
+    while ((long)n < slots && n < ((uint64_t)1 << 40)) n <<= 1;
+    gi_cellvis *c = malloc(sizeof *c);
+    if (!c) return NULL;
+    c->slot = calloc((size_t)n, sizeof *c->slot);
+    if (!c->slot) {
+        free(c);
+        return NULL;
+    }
+    for (uint64_t i = 0; i < n; i++) atomic_init(&c->slot[i], 0);
+    c->mask = n - 1;
+    c->limit = (long)(n / 4 * 3);
+    atomic_init(&c->count, 0);
+    return c;
+}
+
+void gi_cellvis_free(gi_cellvis *c)
+{
+    if (!c) return;
+    free((void *)c->slot);
+    free(c);
+}
+
+uint64_t gi_cellvis_key(const long rp[3])
+{
+    long a = rp[0], b = rp[1], d = rp[2], t;
+    if (a > b) t = a, a = b, b = t;
+    if (b > d) t = b, b = d, d = t;
+    if (a > b) t = a, a = b, b = t;
+    if (a < 0 || a > 0xffffffffL || b - a >= (1L << 15) || d - a >= (1L << 15)) return 0;
+    /* 0 only for the degenerate cell (0, 0, 0): not cached */
+    return (uint64_t)a << 30 | (uint64_t)(b - a) << 15 | (uint64_t)(d - a);
+}
+
+/* splitmix64's finaliser: spreads neighbouring keys over the table */
+static uint64_t mix(uint64_t x)
+{
+    x ^= x >> 30;
+    x *= 0xbf58476d1ce4e5b9ULL;
+    x ^= x >> 27;
+    x *= 0x94d049bb133111ebULL;
+    return x ^ (x >> 31);
+}
+
+int gi_cellvis_get(const gi_cellvis *c, uint64_t key)
+{
+    if (!c || !key) return GI_CELL_UNKNOWN;
+    uint64_t h = mix(key);
+    for (int k = 0; k < CELLVIS_PROBES; k++) {
+        uint64_t v = atomic_load_explicit(&c->slot[(h + (uint64_t)k) & c->mask], memory_order_relaxed);
+        if (v == 0) return GI_CELL_UNKNOWN;
+        if (v >> 2 == key) return (int)(v & 3u);
+    }
+    return GI_CELL_UNKNOWN;
+}
+
+void gi_cellvis_put(gi_cellvis *c, uint64_t key, int verdict)
+{
+    if (!c || !key || (verdict != GI_CELL_CLEAR && verdict != GI_CELL_BLOCKED)) return;
+    if (atomic_load_explicit(&c->count, memory_order_relaxed) >= c->limit) return;
+    uint64_t h = mix(key), want = key << 2 | (uint64_t)verdict;
+    for (int k = 0; k < CELLVIS_PROBES; k++) {
+        _Atomic uint64_t *s = &c->slot[(h + (uint64_t)k) & c->mask];
+        uint64_t v = atomic_load_explicit(s, memory_order_relaxed);
+        if (v == 0) {
+            if (atomic_compare_exchange_strong_explicit(s, &v, want, memory_order_relaxed, memory_order_relaxed)) {
+                atomic_fetch_add_explicit(&c->count, 1, memory_order_relaxed);
+                return;
+            }
+            /* v now holds what another thread stored there */
+        }
+        if (v >> 2 == key) return; /* stored already (the same verdict: the test is deterministic) */
+    }
+}
+
+long gi_cellvis_count(const gi_cellvis *c) { return c ? atomic_load_explicit(&c->count, memory_order_relaxed) : 0; }
+
+size_t gi_cellvis_bytes(const gi_cellvis *c) { return c ? sizeof *c + (size_t)(c->mask + 1) * sizeof(uint64_t) : 0; }
