@@ -984,7 +984,8 @@ static int flat_pieces(const scene_object *o)
 /* The rays the Whitted pass will trace (shade.c): primary, then reflected
  * and transmitted ones; shadow rays are not needed. Marks the radiance
  * particles around every diffuse hit. rec (may be NULL): the first hit, when
- * it is on a flat piece and spawns no further rays. */
+ * it is on a flat piece and spawns no further rays. Returns the rays
+ * traced. */
 static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_level, double eps, coarse_hit *rec)
 {
     accel_hit h;
@@ -1170,6 +1171,7 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
     if (J.max_level < 1) J.max_level = 1;
     double sc = accel_eps_scale(gp->a);
     J.eps = (sc > 0.0 && isfinite(sc) ? sc : 1.0) * 1e-6;
+    double c0 = cpu_now();
     J.stride = gp->set.prepass_stride > 0 ? gp->set.prepass_stride : 2;
     J.ncx = coarse_count(J.stride, w);
     J.ncy = coarse_count(J.stride, h);
@@ -1192,6 +1194,7 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
     S->prepass_rays = atomic_load(&J.rays);
     S->prepass_planar = atomic_load(&J.planar);
     S->t_prepass = timer_now() - t0;
+    S->c_prepass = cpu_now() - c0;
 
     /* found radiance particles (not yet estimated) and the area particles
      * their lists need (not yet gathered on the device) */

@@ -131,6 +131,7 @@ typedef struct {
     double t_visibility, t_emit, t_scatter;
     double t_view;          /* whole last prepare_view */
     double t_prepass, t_gather, t_estimate;
+    double c_prepass;       /* process CPU seconds of the last pre-pass */
     /* counts */
     long candidates, particles, pruned, probed_out;
     long radiance_particles, list_entries, lists_widened, lists_empty;
