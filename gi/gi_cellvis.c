@@ -9,11 +9,14 @@ struct gi_cellvis {
     _Atomic uint64_t *slot;
     uint64_t mask;
     long limit;       /* put stops storing past this count (3/4 of the slots) */
+    int base_bits, off_bits; /* key layout (gi_cellvis.h) */
     atomic_long count;
 };
 
-gi_cellvis *gi_cellvis_new(long slots)
+gi_cellvis *gi_cellvis_new(long slots, long nrp)
 {
+    int b = 1;
+    while (b < 60 && (1L << b) < nrp) b++;
     uint64_t n = 1024;
     while ((long)n < slots && n < ((uint64_t)1 << 40)) n <<= 1;
     gi_cellvis *c = malloc(sizeof *c);
@@ -26,6 +29,8 @@ gi_cellvis *gi_cellvis_new(long slots)
     for (uint64_t i = 0; i < n; i++) atomic_init(&c->slot[i], 0);
     c->mask = n - 1;
     c->limit = (long)(n / 4 * 3);
+    c->base_bits = b;
+    c->off_bits = (62 - b) / 2;
     atomic_init(&c->count, 0);
     return c;
 }
@@ -37,15 +42,17 @@ void gi_cellvis_free(gi_cellvis *c)
     free(c);
 }
 
-uint64_t gi_cellvis_key(const long rp[3])
+uint64_t gi_cellvis_key(const gi_cellvis *c, const long rp[3])
 {
+    if (!c) return 0;
     long a = rp[0], b = rp[1], d = rp[2], t;
     if (a > b) t = a, a = b, b = t;
     if (b > d) t = b, b = d, d = t;
     if (a > b) t = a, a = b, b = t;
-    if (a < 0 || a > 0xffffffffL || b - a >= (1L << 15) || d - a >= (1L << 15)) return 0;
+    int ob = c->off_bits;
+    if (a < 0 || a >= (1L << c->base_bits) || b - a >= (1L << ob) || d - a >= (1L << ob)) return 0;
     /* 0 only for the degenerate cell (0, 0, 0): not cached */
-    return (uint64_t)a << 30 | (uint64_t)(b - a) << 15 | (uint64_t)(d - a);
+    return (uint64_t)a << (2 * ob) | (uint64_t)(b - a) << ob | (uint64_t)(d - a);
 }
 
 /* splitmix64's finaliser: spreads neighbouring keys over the table */

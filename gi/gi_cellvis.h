@@ -10,9 +10,11 @@
  * and normals and the objects around them), so it holds across frames,
  * cameras and relighting; a new geometry stage makes a new cache.
  *
- * Keys: the 3 radiance-particle indices sorted, packed into 62 bits (the
- * smallest index < 2^32, the two others within 2^15 of it; a cell whose
- * indices are further apart gets key 0: not cacheable, tested per hit).
+ * Keys: the 3 radiance-particle indices sorted, packed into 62 bits: the
+ * smallest in b bits (b = the bits of the radiance-particle count), the
+ * two others as offsets from it in (62 - b) / 2 bits each (21 bits up to 2^20
+ * radiance particles: every cell fits; beyond, a cell whose indices lie
+ * further apart gets key 0: not cacheable, tested per hit).
  * The key names the cell exactly (no hashing of the identity), so a
  * verdict is never applied to another cell.
  *
@@ -32,12 +34,13 @@ typedef struct gi_cellvis gi_cellvis;
 enum { GI_CELL_UNKNOWN = 0, GI_CELL_CLEAR = 1, GI_CELL_BLOCKED = 2 };
 
 /* A table of at least `slots` slots (rounded up to a power of two, at least
- * 1024). NULL when out of memory (the caller then tests every hit). */
-gi_cellvis *gi_cellvis_new(long slots);
+ * 1024) for cells of radiance particles 0 .. nrp - 1. NULL when out of
+ * memory (the caller then tests every hit). */
+gi_cellvis *gi_cellvis_new(long slots, long nrp);
 void gi_cellvis_free(gi_cellvis *c);
 /* The key of the cell with radiance particles rp[0..2] (any order, may
- * repeat), or 0 when it cannot be packed. */
-uint64_t gi_cellvis_key(const long rp[3]);
+ * repeat), or 0 when it cannot be packed (or c is NULL). */
+uint64_t gi_cellvis_key(const gi_cellvis *c, const long rp[3]);
 /* The stored verdict, GI_CELL_UNKNOWN when absent (or c NULL, key 0). */
 int gi_cellvis_get(const gi_cellvis *c, uint64_t key);
 /* Stores a verdict (GI_CELL_CLEAR or GI_CELL_BLOCKED) unless the table is

@@ -504,7 +504,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
          * 4M slots (32 MiB): more cells than a 1920x1080 frame's hits.
          * Without a table (out of memory) every hit is tested. */
         long slots = 4 * (long)nrp;
-        if (!set->leak_per_hit) gp->cells = gi_cellvis_new(slots < (1L << 22) ? slots : (1L << 22));
+        if (!set->leak_per_hit) gp->cells = gi_cellvis_new(slots < (1L << 22) ? slots : (1L << 22), (long)nrp);
     }
 
     /* incoming scattering links, sources ascending (FULL scattering) */
@@ -1398,9 +1398,9 @@ static int side_value(gi_particle *gp, const accel_hit *hit, vec3 n, thread_coun
      * A clear cell (cell_clear) sees all three from everywhere; the other
      * cells test them from the hit. */
     double wsum = 0.0;
-    uint64_t key = gi_cellvis_key(rp);
+    uint64_t key = gi_cellvis_key(gp->cells, rp);
     int verdict = gi_cellvis_get(gp->cells, key);
-    if (verdict == GI_CELL_UNKNOWN && gp->cells && key) {
+    if (verdict == GI_CELL_UNKNOWN && key) {
         verdict = cell_clear(gp, rp, hit->obj, tc) ? GI_CELL_CLEAR : GI_CELL_BLOCKED;
         gi_cellvis_put(gp->cells, key, verdict);
     }
