@@ -393,8 +393,9 @@ int main(int argc, char **argv)
            o.reps, (double)x->lookups / o.reps, (double)x->lookups_late / o.reps, (double)x->late_radiance / o.reps,
            (double)x->late_area / o.reps, (double)x->lookups_none / o.reps, (double)x->discarded / o.reps,
            (double)(x->visibility_rays - gs.visibility_rays) / o.reps);
-    printf("  pre-pass (last frame): %.1f ms CPU; stride %d, %ld rays, %ld pixels on their neighbours' plane\n",
-           1e3 * x->c_prepass, o.stride > 0 ? o.stride : 2, x->prepass_rays, x->prepass_planar);
+    printf("  pre-pass (last frame): %.1f ms CPU; stride %d, %ld rays, %ld pixels on their neighbours' plane, %ld "
+           "between misses\n",
+           1e3 * x->c_prepass, o.stride > 0 ? o.stride : 2, x->prepass_rays, x->prepass_planar, x->prepass_missed);
     printf("  light-leak guard: %s; %ld cells tested (%ld clear, %.1f%%), %.1f%% of lookups in clear cells, "
            "table %.1f MiB\n",
            o.per_hit ? "per hit" : "per cell", x->cells, x->cells_clear, 100.0 * x->cells_clear / fmax(1, x->cells),

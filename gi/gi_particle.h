@@ -142,6 +142,8 @@ typedef struct {
     long prepass_rays, found, used;  /* last prepare_view: new radiance / area particles */
     long prepass_planar;    /* last prepare_view: pixels whose hit was found on their coarse
                                neighbours' flat piece, without a ray (prepass_stride) */
+    long prepass_missed;    /* last prepare_view: pixels not traced because their coarse
+                               neighbours all left the scene */
     long lookups, lookups_late, lookups_none, discarded;
     long lookups_onthefly;  /* hits on surfaces without radiance particles (no grid): estimated at the hit */
     long visibility_rays;   /* gi_visible tests: estimation list entries, radiance particles at hits, cells */
