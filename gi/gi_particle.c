@@ -933,8 +933,9 @@ void gi_particle_set_scattering(gi_particle *gp, int bounces, int scatter)
  * or transmitted rays from it), the pixel's ray meets that piece too (the
  * block's pixels lie inside the corners' convex hull, and so does their hit
  * on a convex piece), so its hit is the ray's intersection with the
- * piece's plane and no ray is traced; when they all left the scene (the
- * background), neither is it; else the pixel is traced as in step 1. What
+ * piece's plane and no ray is traced (nor located, when they all lie in
+ * one cell of the piece); when they all left the scene (the background),
+ * neither is it; else the pixel is traced as in step 1. What
  * this misses: something smaller than the block standing in front of the
  * piece, or in the background, between the coarse pixels, or a hole cut
  * into the piece by CSG there; the radiance particles of those hits are
@@ -944,6 +945,8 @@ typedef struct {
     int miss;                /* the ray left the scene */
     unsigned prim;
     int diffuse;             /* the piece has diffuse > 0 (its hits are marked) */
+    int located;             /* cell holds the radiance particles marked for this hit */
+    long cell[3];
     vec3 p, ng, n;           /* the hit, its geometric normal, the viewer-side normal mark_hit took */
 } coarse_hit;
 
@@ -958,12 +961,14 @@ typedef struct {
     atomic_long rays, planar, missed;
 } view_job;
 
-static void mark_hit(gi_particle *gp, const accel_hit *h, vec3 n)
+/* Marks the 3 radiance particles around the hit; returns 1 and them in
+ * rp, or 0 when the hit has none. */
+static int mark_hit(gi_particle *gp, const accel_hit *h, vec3 n, long rp[3])
 {
-    long rp[3];
     double w[3];
-    if (!gi_surface_locate(gp->surf, h, n, rp, w)) return;
+    if (!gi_surface_locate(gp->surf, h, n, rp, w)) return 0;
     for (int k = 0; k < 3; k++) atomic_store_explicit(&gp->mark[rp[k]], 1, memory_order_relaxed);
+    return 1;
 }
 
 /* Objects whose surface pieces (hit->prim) are flat and convex. */
@@ -1006,7 +1011,8 @@ static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_
     int entering = v3_dot(dir, ng) < 0.0;
     if (v3_dot(dir, n) > 0.0) n = v3_neg(n);
     if (!entering) ng = v3_neg(ng);
-    if (f->diffuse > 0.0) mark_hit(gp, &h, n);
+    long cell[3];
+    int located = f->diffuse > 0.0 && mark_hit(gp, &h, n, cell);
     int refl = fmax(f->reflection_max.r, fmax(f->reflection_max.g, f->reflection_max.b)) > 0.0 ||
                fmax(f->reflection_min.r, fmax(f->reflection_min.g, f->reflection_min.b)) > 0.0;
     const colour5 *pc = &tex->pigment.colour;
@@ -1015,6 +1021,8 @@ static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_
         rec->obj = h.obj;
         rec->prim = h.prim;
         rec->diffuse = f->diffuse > 0.0;
+        rec->located = located;
+        for (int k = 0; k < 3; k++) rec->cell[k] = located ? cell[k] : -1;
         rec->p = h.p;
         rec->ng = h.ng;
         rec->n = n;
@@ -1142,6 +1150,17 @@ static void fill_row(void *ctx, int y, int thread)
             missed++;
             continue;
         }
+        /* all in one cell of one piece: so is the pixel (a cell is a convex
+         * part of the piece), whose radiance particles are marked already */
+        int one_cell = c[0]->obj && c[0]->located;
+        for (int k = 1; k < nc && one_cell; k++)
+            one_cell = c[k]->obj == c[0]->obj && c[k]->prim == c[0]->prim && c[k]->located &&
+                       c[k]->cell[0] == c[0]->cell[0] && c[k]->cell[1] == c[0]->cell[1] &&
+                       c[k]->cell[2] == c[0]->cell[2];
+        if (one_cell) {
+            planar++;
+            continue;
+        }
         vec3 org, dir;
         scene_camera_ray(J->cam, x + 0.5, y + 0.5, J->w, J->h, &org, &dir);
         double t;
@@ -1157,7 +1176,8 @@ static void fill_row(void *ctx, int y, int thread)
                 hh.ns = b->ng;
                 hh.obj = b->obj;
                 hh.prim = b->prim;
-                mark_hit(gp, &hh, b->n);
+                long rp[3];
+                mark_hit(gp, &hh, b->n, rp);
             }
             continue;
         }
