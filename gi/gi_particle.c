@@ -946,6 +946,7 @@ typedef struct {
     unsigned prim;
     int diffuse;             /* the piece has diffuse > 0 (its hits are marked) */
     int located;             /* cell holds the radiance particles marked for this hit */
+    int whole;               /* located on a mesh triangle of one cell (gi_surface_one_cell) */
     long cell[3];
     vec3 p, ng, n;           /* the hit, its geometric normal, the viewer-side normal mark_hit took */
 } coarse_hit;
@@ -1022,6 +1023,7 @@ static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_
         rec->prim = h.prim;
         rec->diffuse = f->diffuse > 0.0;
         rec->located = located;
+        rec->whole = located && gi_surface_one_cell(gp->surf, &h);
         for (int k = 0; k < 3; k++) rec->cell[k] = located ? cell[k] : -1;
         rec->p = h.p;
         rec->ng = h.ng;
@@ -1167,7 +1169,9 @@ static void fill_row(void *ctx, int y, int thread)
         const coarse_hit *b = piece_hit(c, nc, org, dir, &t);
         if (b) {
             planar++;
-            if (b->diffuse) {
+            /* on a triangle of one cell, seen from b's side (the hit takes
+             * b's ng and n): locate would give b's 3, marked already */
+            if (b->diffuse && !(b->located && b->whole)) {
                 accel_hit hh;
                 memset(&hh, 0, sizeof hh);
                 hh.t = t;

@@ -2012,6 +2012,16 @@ static int locate_tri(const gi_surface *g, int first, int count, const accel_hit
     return 1;
 }
 
+int gi_surface_one_cell(const gi_surface *g, const accel_hit *hit)
+{
+    if (!hit || !hit->obj) return 0;
+    const obj_rec *o = find_obj(g, hit->obj);
+    if (!o || o->kind != SHAPE_MESH || hit->prim >= (unsigned)o->count) return 0;
+    int i = o->first + (int)hit->prim;
+    /* a mesh triangle is one patch (count 1 in locate): k = 1 puts a = b = 0 */
+    return g->p[i].kind == PATCH_TRI && (g->tl ? g->tl[i].k : g->p[i].k) == 1;
+}
+
 int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, long rp[3], double w[3])
 {
     if (!hit || !hit->obj) return 0;

@@ -128,6 +128,11 @@ int gi_surface_rp_side(const gi_surface *g, long rp);
  * n_view is the shading normal facing the viewer (shade.c's n); it picks the
  * side. Returns 1, or 0 when the hit is on a surface without particles. */
 int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, long rp[3], double w[3]);
+/* 1 when every hit on the hit's piece locates the same 3 radiance
+ * particles on a side (a mesh triangle not sub-tessellated: k = 1), so a
+ * hit elsewhere on that triangle, seen from the same side, marks nothing
+ * new; else 0. */
+int gi_surface_one_cell(const gi_surface *g, const accel_hit *hit);
 
 /* Whether the hit object carries area particles (it may have no radiance
  * particles when its grid failed; gi_particle then estimates at the hit). */
