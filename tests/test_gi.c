@@ -63,6 +63,7 @@
 #include "shade.h"
 #include "shade_texture.h"
 #include "pm_path.h"
+#include "test_util.h"
 
 typedef struct {
     scene *sc;
@@ -121,6 +122,17 @@ static const char *const device_c = "c";
 
 static int g_scatter = GI_PARTICLE_SCATTER_WALK;
 
+/* Build the particles of f's scene with settings s and light them. */
+static gi_particle *build_with(fixture *f, const gi_particle_settings *s)
+{
+    pt_status st;
+    gi_particle *gp = gi_particle_build(f->sc, f->a, s, NULL, f->d, &st);
+    if (!gp) print_diag(f->d);
+    assert_non_null(gp);
+    assert_int_equal(gi_particle_light(gp, f->d), PT_OK);
+    return gp;
+}
+
 static gi_particle *build(fixture *f, long count, int nb, const char *device, uint64_t seed)
 {
     gi_particle_settings s;
@@ -131,12 +143,7 @@ static gi_particle *build(fixture *f, long count, int nb, const char *device, ui
     s.threads = 2;
     s.seed = seed;
     s.cl_device = device;
-    pt_status st;
-    gi_particle *gp = gi_particle_build(f->sc, f->a, &s, NULL, f->d, &st);
-    if (!gp) print_diag(f->d);
-    assert_non_null(gp);
-    assert_int_equal(gi_particle_light(gp, f->d), PT_OK);
-    return gp;
+    return build_with(f, &s);
 }
 
 /* A closed cube (mesh, 12 triangles) of uniform reflectance with a point
@@ -846,19 +853,6 @@ static void test_torus_grid(void **state)
  * path tracer (64 spp): mean luminance of the whole 24x24 image and of the
  * pixels on the CSG within CSG_TOL. */
 #define CSG_TOL 0.04
-static double luminance_mean(const framebuffer *fb, const unsigned char *mask)
-{
-    double s = 0.0;
-    long n = 0;
-    for (int i = 0; i < fb->width * fb->height; i++) {
-        if (mask && !mask[i]) continue;
-        const float *p = fb->rgb + 3 * (size_t)i;
-        s += 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
-        n++;
-    }
-    return n > 0 ? s / n : 0.0;
-}
-
 static void test_csg_members(void **state)
 {
     (void)state;
@@ -911,8 +905,8 @@ static void test_csg_members(void **state)
             nblob += on[y * W + x] && h.obj->kind == SHAPE_BLOB;
             nsphere += on[y * W + x] && h.obj->kind == SHAPE_SPHERE;
         }
-    double lp = luminance_mean(fp, NULL), lr = luminance_mean(fr, NULL);
-    double cp = luminance_mean(fp, on), cr = luminance_mean(fr, on);
+    double lp = tu_luminance_mean(fp, NULL), lr = tu_luminance_mean(fr, NULL);
+    double cp = tu_luminance_mean(fp, on), cr = tu_luminance_mean(fr, on);
     printf("  CSG: %ld particles (%ld probed out), lookups without particles %ld, estimated at the hit %ld; "
            "mean luminance particle %.5f vs path %.5f (%+.2f%%), on the CSG (%d pixels, %d on the sphere, %d on "
            "the blob) %.5f vs %.5f (%+.2f%%)\n",
@@ -1173,7 +1167,7 @@ static double fine_wall(int n, int w, int h, float *out, unsigned char *on)
             const float *p = fb->rgb + 3 * (size_t)i;
             out[i] = (float)(0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]);
         }
-    double m = luminance_mean(fb, on);
+    double m = tu_luminance_mean(fb, on);
     fb_free(fb);
     gi_particle_free(gp);
     unload(&f);
@@ -1455,12 +1449,7 @@ static gi_particle *build_leak(fixture *f, const char *light, int per_hit)
     s.seed = 11;
     s.cl_device = device_c;
     s.leak_per_hit = per_hit;
-    pt_status st;
-    gi_particle *gp = gi_particle_build(f->sc, f->a, &s, NULL, f->d, &st);
-    if (!gp) print_diag(f->d);
-    assert_non_null(gp);
-    assert_int_equal(gi_particle_light(gp, f->d), PT_OK);
-    return gp;
+    return build_with(f, &s);
 }
 
 /* The hook's green value at the probes of a grid of rays straight down. */

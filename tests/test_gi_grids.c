@@ -31,6 +31,7 @@
 #include "gi_surface.h"
 #include "pm_path.h"
 #include "shade.h"
+#include "test_util.h"
 #include "test_world.h"
 
 enum { GRID_W = 32, GRID_PARTICLES = 8000, GRID_SPP = 128 };
@@ -102,19 +103,6 @@ static void render_particle(tu_world *w, gi_particle *gp, framebuffer *fb)
     assert_int_equal(shade_render(w->s, w->a, &ss, fb, &sst, w->d), PT_OK);
 }
 
-static double luminance_mean(const framebuffer *fb, const unsigned char *mask)
-{
-    double s = 0.0;
-    long n = 0;
-    for (int i = 0; i < fb->width * fb->height; i++) {
-        if (mask && !mask[i]) continue;
-        const float *p = fb->rgb + 3 * (size_t)i;
-        s += 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
-        n++;
-    }
-    return n > 0 ? s / n : 0.0;
-}
-
 /* Radiance particles on objects of kind k, laid out as the particle GI
  * does at tessellation bound tess. */
 static long shape_rp(tu_world *w, double tess, shape_kind k)
@@ -159,8 +147,8 @@ static void check_shape(const grid_shape *g, int fallback)
             on[y * GRID_W + x] = accel_intersect(w.a, org, dir, 0.0, INFINITY, &h) && h.obj->kind == g->kind;
             non += on[y * GRID_W + x];
         }
-    double lp = luminance_mean(fp, NULL), lr = luminance_mean(fr, NULL);
-    double cp = luminance_mean(fp, on), cr = luminance_mean(fr, on);
+    double lp = tu_luminance_mean(fp, NULL), lr = tu_luminance_mean(fr, NULL);
+    double cp = tu_luminance_mean(fp, on), cr = tu_luminance_mean(fr, on);
     printf("  %-12s: %ld radiance particles on it, %ld lookups (%ld at the hit, %ld without particles); "
            "mean luminance particle vs path: image %+.2f%%, shape (%d px) %+.2f%%\n",
            g->name, rp, look, otf, none, 100.0 * (lp / lr - 1.0), non, 100.0 * (cp / cr - 1.0));

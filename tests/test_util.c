@@ -144,3 +144,16 @@ double tu_crosscheck(const char *partray_bin, const char *dir, const char *scene
     fb_free(b);
     return mad;
 }
+
+double tu_luminance_mean(const framebuffer *fb, const unsigned char *mask)
+{
+    double s = 0.0;
+    long n = 0;
+    for (int i = 0; i < fb->width * fb->height; i++) {
+        if (mask && !mask[i]) continue;
+        const float *p = fb->rgb + 3 * (size_t)i;
+        s += 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+        n++;
+    }
+    return n > 0 ? s / n : 0.0;
+}

@@ -34,6 +34,11 @@ int tu_finish(int rc, const char *dir);
  * box-downsampled images (same size, sRGB-encoded values in 0..1). */
 double tu_downsampled_mad(const framebuffer *a, const framebuffer *b, int f);
 
+/* Mean Rec. 709 luminance (0.2126 R + 0.7152 G + 0.0722 B) of the linear
+ * framebuffer over the pixels with mask[i] != 0 (mask NULL: all); 0 when
+ * none. */
+double tu_luminance_mean(const framebuffer *fb, const unsigned char *mask);
+
 /* Copy `scene_path` into `dir`, render it there with Debian's povray and
  * with `partray_bin` at w x h, +A0.3, both to sRGB PNG; `decl` is NAME=VALUE
  * (passed as Declare= / -D) or NULL. Returns the 4x4-downsampled mean
