@@ -78,6 +78,9 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     gs.threads = o->threads;
     if (o->cl_device) gs.cl_device = o->cl_device;
     gs.cl_max_bytes = o->cl_max_bytes;
+    /* camera rays through pixel centres (no fixed supersampling): the
+     * pre-pass's hits serve the render (gi_particle_primary_hit) */
+    gs.keep_hits = o->antialias != 2;
     pt_status st = PT_OK;
     double t0 = timer_now();
     gi_particle *gp = gi_particle_build(sc, a, &gs, &r->particle, d, &st);
@@ -96,6 +99,10 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
         ss.use_ambient = gs.ambient_emits > 0 || (gs.ambient_emits < 0 && sc->global.radiosity.enabled);
         ss.indirect = gi_particle_indirect;
         ss.indirect_ctx = gp;
+        if (gs.keep_hits) {
+            ss.primary = gi_particle_primary_hit;
+            ss.primary_ctx = gp;
+        }
         t0 = timer_now();
         double c0 = cpu_now();
         /* view preparation (pre-pass, gathering, estimation) belongs to the frame */

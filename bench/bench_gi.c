@@ -13,7 +13,10 @@
  * per particle per area light (0: the whole grid). --per-hit makes the
  * hook's light-leak guard test every hit (leak_per_hit) instead of caching
  * a verdict per cell. --stride N: the view pre-pass traces every Nth pixel
- * in x and y (prepass_stride; 0 the default).
+ * in x and y (prepass_stride; 0 the default). --no-keep: the render traces
+ * its own camera rays (keep_hits 0, the coarse pre-pass); by default, at 1
+ * spp, the pre-pass traces every pixel and the render takes its hits
+ * (keep_hits, gi_particle_primary_hit).
  * --spp N renders N stratified samples per pixel (shade.c fixed
  * supersampling) in both modes, for image comparisons against references.
  * --out PREFIX writes PREFIX_none.exr and PREFIX_particle.exr. --sweep runs
@@ -45,7 +48,7 @@
 
 typedef struct {
     const char *scene;
-    int size, threads, nb, reps, sweep, spp, full, area_samples, ref_spp, per_hit, stride;
+    int size, threads, nb, reps, sweep, spp, full, area_samples, ref_spp, per_hit, stride, no_keep;
     long count;
     const char *device, *out, *ref;
 } opts;
@@ -112,6 +115,8 @@ static double render(const scene *sc, const accel *a, int size, int threads, gi_
         s.use_ambient = 0;
         s.indirect = gi_particle_indirect;
         s.indirect_ctx = gp;
+        s.primary = gi_particle_primary_hit; /* kept hits, when keep_hits (else it declines) */
+        s.primary_ctx = gp;
     }
     double t0 = timer_now();
     shade_render(sc, a, &s, fb, ss, d);
@@ -227,7 +232,7 @@ static long time_moves(gi_particle *gp, scene *sc, int nmove, int reps, double *
 
 int main(int argc, char **argv)
 {
-    opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 1, 0, -1, 0, 0, 0, 50000, NULL, NULL, NULL};
+    opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 1, 0, -1, 0, 0, 0, 0, 50000, NULL, NULL, NULL};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -244,6 +249,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--spp") && v) { o.spp = atoi(v); i++; }
         else if (!strcmp(a, "--full")) o.full = 1;
         else if (!strcmp(a, "--per-hit")) o.per_hit = 1;
+        else if (!strcmp(a, "--no-keep")) o.no_keep = 1;
         else if (!strcmp(a, "--stride") && v) { o.stride = atoi(v); i++; }
         else if (!strcmp(a, "--area-samples") && v) { o.area_samples = atoi(v); i++; }
         else if (a[0] != '-') o.scene = a;
@@ -289,6 +295,7 @@ int main(int argc, char **argv)
     if (o.area_samples >= 0) s.area_samples = o.area_samples;
     s.leak_per_hit = o.per_hit;
     s.prepass_stride = o.stride;
+    s.keep_hits = !o.no_keep && o.spp <= 1;
     gi_particle_stats gs;
     double c0 = cpu_now();
     gi_particle *gp = gi_particle_build(sc, a, &s, &gs, d, &st);
@@ -394,8 +401,9 @@ int main(int argc, char **argv)
            (double)x->late_area / o.reps, (double)x->lookups_none / o.reps, (double)x->discarded / o.reps,
            (double)(x->visibility_rays - gs.visibility_rays) / o.reps);
     printf("  pre-pass (last frame): %.1f ms CPU; stride %d, %ld rays, %ld pixels on their neighbours' plane, %ld "
-           "between misses\n",
-           1e3 * x->c_prepass, o.stride > 0 ? o.stride : 2, x->prepass_rays, x->prepass_planar, x->prepass_missed);
+           "between misses; %ld hits kept for the render, %.1f%% of lookups took their cell from one\n",
+           1e3 * x->c_prepass, o.stride > 0 ? o.stride : (s.keep_hits ? 1 : 2), x->prepass_rays, x->prepass_planar,
+           x->prepass_missed, x->prepass_kept, 100.0 * x->lookups_kept / fmax(1, x->lookups));
     printf("  light-leak guard: %s; %ld cells tested (%ld clear, %.1f%%), %.1f%% of lookups in clear cells, "
            "table %.1f MiB\n",
            o.per_hit ? "per hit" : "per cell", x->cells, x->cells_clear, 100.0 * x->cells_clear / fmax(1, x->cells),

@@ -19,11 +19,13 @@
 #include "timer.h"
 
 #define GI_MAX_THREADS 256
+#define VIEW_REC_MAX_BYTES ((size_t)256 << 20) /* keep_hits: at most this much of view_rec */
 
 typedef struct {
     long lookups, late, none, discarded, onthefly, vis_rays;
     long late_rp, late_area;        /* radiance / area particles computed in the hook (late_rp) */
     long cells, cells_clear, clear; /* cells tested, of them clear; lookups in clear cells */
+    long kept;                      /* lookups whose cell came from a kept hit (view_rec) */
     int *buf; /* on-the-fly estimation list */
     long len, cap;
     char pad[8];
@@ -64,6 +66,10 @@ struct gi_particle {
     atomic_uchar *rp_state;
     atomic_uchar *mark;
     gi_cellvis *cells; /* per-cell verdicts of the light-leak guard (side_value); NULL: per hit */
+    struct view_rec *vrec; /* keep_hits: one per pixel of the last prepare_view (vw x vh), NULL: none */
+    size_t vrec_cap;       /* records allocated */
+    int vw, vh;
+    double veps;           /* the pre-pass's tmin */
     float bg[3];
     double vis_eps; /* gi_visible's eps: 1e-6 x accel_eps_scale */
     thread_count tc[GI_MAX_THREADS];
@@ -144,13 +150,14 @@ static void fill_stats(gi_particle *gp, gi_particle_stats *out)
 {
     update_bytes(gp);
     long look = 0, late = 0, none = 0, disc = 0, otf = 0, vis = gp->lists.vis_rays;
-    long lrp = 0, larea = 0, cells = 0, cclear = 0, clear = 0;
+    long lrp = 0, larea = 0, cells = 0, cclear = 0, clear = 0, kept = 0;
     for (int t = 0; t < GI_MAX_THREADS; t++) {
         lrp += gp->tc[t].late_rp;
         larea += gp->tc[t].late_area;
         cells += gp->tc[t].cells;
         cclear += gp->tc[t].cells_clear;
         clear += gp->tc[t].clear;
+        kept += gp->tc[t].kept;
         vis += gp->tc[t].vis_rays;
         otf += gp->tc[t].onthefly;
         look += gp->tc[t].lookups;
@@ -169,6 +176,7 @@ static void fill_stats(gi_particle *gp, gi_particle_stats *out)
     gp->st.cells = cells;
     gp->st.cells_clear = cclear;
     gp->st.lookups_clear = clear;
+    gp->st.lookups_kept = kept;
     if (out && out != &gp->st) *out = gp->st;
 }
 
@@ -569,6 +577,7 @@ void gi_particle_free(gi_particle *gp)
     free(gp->rp_val);
     free(gp->rp_state);
     free(gp->mark);
+    free(gp->vrec);
     free(gp);
 }
 
@@ -951,6 +960,18 @@ typedef struct {
     vec3 p, ng, n;           /* the hit, its geometric normal, the viewer-side normal mark_hit took */
 } coarse_hit;
 
+/* keep_hits: what the pre-pass found at one pixel's camera ray, for the
+ * render (gi_particle_primary_hit) and its hook (side_value). */
+typedef struct view_rec {
+    accel_hit h;           /* first member: the hook knows &rec->h as a kept hit */
+    vec3 org, dir;         /* the ray, compared bit for bit with the render's */
+    double w[3];           /* gi_surface_locate's answer for side `side` */
+    long rp[3];
+    unsigned char kind;    /* 0 nothing kept (the render traces), 1 a miss, 2 a hit */
+    unsigned char located; /* rp, w hold locate's answer */
+    unsigned char side;    /* the side located: dot(n_view, h.ng) >= 0 */
+} view_rec;
+
 typedef struct {
     gi_particle *gp;
     const scene_camera *cam;
@@ -959,14 +980,14 @@ typedef struct {
     int ncx, ncy;   /* coarse grid */
     coarse_hit *ch; /* ncx x ncy, NULL: step 2 traces every pixel */
     double eps;
-    atomic_long rays, planar, missed;
+    view_rec *rec;  /* keep_hits: w x h records, NULL: none kept */
+    atomic_long rays, planar, missed, kept;
 } view_job;
 
 /* Marks the 3 radiance particles around the hit; returns 1 and them in
- * rp, or 0 when the hit has none. */
-static int mark_hit(gi_particle *gp, const accel_hit *h, vec3 n, long rp[3])
+ * rp (their weights in w), or 0 when the hit has none. */
+static int mark_hit(gi_particle *gp, const accel_hit *h, vec3 n, long rp[3], double w[3])
 {
-    double w[3];
     if (!gi_surface_locate(gp->surf, h, n, rp, w)) return 0;
     for (int k = 0; k < 3; k++) atomic_store_explicit(&gp->mark[rp[k]], 1, memory_order_relaxed);
     return 1;
@@ -994,15 +1015,25 @@ static int flat_pieces(const scene_object *o)
  * particles around every diffuse hit. rec (may be NULL): the first hit, when
  * it is on a flat piece and spawns no further rays. Returns the rays
  * traced. */
-static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_level, double eps, coarse_hit *rec)
+static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_level, double eps, coarse_hit *rec,
+                        view_rec *vr)
 {
     accel_hit h;
     if (rec) {
         rec->obj = NULL;
         rec->miss = 0;
     }
+    if (vr) {
+        vr->kind = 0;
+        vr->located = 0;
+    }
     if (!accel_intersect(gp->a, org, dir, eps, INFINITY, &h)) {
         if (rec) rec->miss = 1;
+        if (vr) {
+            vr->org = org;
+            vr->dir = dir;
+            vr->kind = 1;
+        }
         return 1;
     }
     long rays = 1;
@@ -1013,7 +1044,22 @@ static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_
     if (v3_dot(dir, n) > 0.0) n = v3_neg(n);
     if (!entering) ng = v3_neg(ng);
     long cell[3];
-    int located = f->diffuse > 0.0 && mark_hit(gp, &h, n, cell);
+    double cw[3];
+    int located = f->diffuse > 0.0 && mark_hit(gp, &h, n, cell, cw);
+    if (vr && !(h.flags & OBJ_NO_IMAGE)) {
+        /* the render's camera ray would stop here too (it steps past
+         * no_image surfaces only) */
+        vr->h = h;
+        vr->org = org;
+        vr->dir = dir;
+        vr->kind = 2;
+        vr->located = (unsigned char)located;
+        vr->side = v3_dot(n, h.ng) >= 0.0;
+        for (int k = 0; k < 3; k++) {
+            vr->rp[k] = located ? cell[k] : -1;
+            vr->w[k] = located ? cw[k] : 0.0;
+        }
+    }
     int refl = fmax(f->reflection_max.r, fmax(f->reflection_max.g, f->reflection_max.b)) > 0.0 ||
                fmax(f->reflection_min.r, fmax(f->reflection_min.g, f->reflection_min.b)) > 0.0;
     const colour5 *pc = &tex->pigment.colour;
@@ -1032,7 +1078,7 @@ static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_
     if (level >= max_level) return rays;
     double cos_i = -v3_dot(dir, n);
     vec3 p = v3_madd(h.p, ng, eps);
-    if (refl) rays += prepass_ray(gp, p, v3_madd(dir, n, 2.0 * cos_i), level + 1, max_level, eps, NULL);
+    if (refl) rays += prepass_ray(gp, p, v3_madd(dir, n, 2.0 * cos_i), level + 1, max_level, eps, NULL, NULL);
     if (trans) {
         const scene_interior *in = h.obj->interior;
         double rel = 1.0;
@@ -1042,10 +1088,10 @@ static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_
         if (fabs(rel - 1.0) > 1e-9) {
             double eta = 1.0 / rel, k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
             if (k < 0.0)
-                return rays + prepass_ray(gp, p, v3_madd(dir, n, 2.0 * cos_i), level + 1, max_level, eps, NULL);
+                return rays + prepass_ray(gp, p, v3_madd(dir, n, 2.0 * cos_i), level + 1, max_level, eps, NULL, NULL);
             td = v3_norm(v3_add(v3_scale(dir, eta), v3_scale(n, eta * cos_i - sqrt(k))));
         }
-        rays += prepass_ray(gp, q, td, level + 1, max_level, eps, NULL);
+        rays += prepass_ray(gp, q, td, level + 1, max_level, eps, NULL, NULL);
     }
     return rays;
 }
@@ -1059,15 +1105,18 @@ static void coarse_row(void *ctx, int j, int thread)
 {
     (void)thread;
     view_job *J = ctx;
-    long rays = 0;
+    long rays = 0, kept = 0;
     int y = coarse_at(j, J->stride, J->h);
     for (int i = 0; i < J->ncx; i++) {
         int x = coarse_at(i, J->stride, J->w);
         vec3 org, dir;
         scene_camera_ray(J->cam, x + 0.5, y + 0.5, J->w, J->h, &org, &dir);
-        rays += prepass_ray(J->gp, org, dir, 1, J->max_level, J->eps, J->ch ? &J->ch[(size_t)j * J->ncx + i] : NULL);
+        view_rec *vr = J->rec ? &J->rec[(size_t)y * J->w + x] : NULL;
+        rays += prepass_ray(J->gp, org, dir, 1, J->max_level, J->eps, J->ch ? &J->ch[(size_t)j * J->ncx + i] : NULL, vr);
+        kept += vr && vr->kind;
     }
     atomic_fetch_add(&J->rays, rays);
+    atomic_fetch_add(&J->kept, kept);
 }
 
 /* Whether world point p lies in triangle `prim` of mesh object o (its
@@ -1125,12 +1174,14 @@ static void fill_row(void *ctx, int y, int thread)
     (void)thread;
     view_job *J = ctx;
     gi_particle *gp = J->gp;
-    long rays = 0, planar = 0, missed = 0;
+    long rays = 0, planar = 0, missed = 0, kept = 0;
     int s = J->stride, j = y == J->h - 1 ? J->ncy - 1 : y / s, on_row = y % s == 0 || y == J->h - 1;
     int j1 = j + 1 < J->ncy ? j + 1 : j;
     for (int x = 0; x < J->w; x++) {
         int i = x == J->w - 1 ? J->ncx - 1 : x / s, on_col = x % s == 0 || x == J->w - 1;
         if (on_row && on_col) continue; /* a coarse pixel */
+        view_rec *vr = J->rec ? &J->rec[(size_t)y * J->w + x] : NULL;
+        if (vr) vr->kind = 0; /* unless traced below */
         int i1 = i + 1 < J->ncx ? i + 1 : i;
         const coarse_hit *c[4];
         int nc = 0;
@@ -1181,13 +1232,16 @@ static void fill_row(void *ctx, int y, int thread)
                 hh.obj = b->obj;
                 hh.prim = b->prim;
                 long rp[3];
-                mark_hit(gp, &hh, b->n, rp);
+                double w[3];
+                mark_hit(gp, &hh, b->n, rp, w);
             }
             continue;
         }
-        rays += prepass_ray(gp, org, dir, 1, J->max_level, J->eps, NULL);
+        rays += prepass_ray(gp, org, dir, 1, J->max_level, J->eps, NULL, vr);
+        kept += vr && vr->kind;
     }
     atomic_fetch_add(&J->rays, rays);
+    atomic_fetch_add(&J->kept, kept);
     atomic_fetch_add(&J->planar, planar);
     atomic_fetch_add(&J->missed, missed);
 }
@@ -1211,13 +1265,25 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
     double sc = accel_eps_scale(gp->a);
     J.eps = (sc > 0.0 && isfinite(sc) ? sc : 1.0) * 1e-6;
     double c0 = cpu_now();
-    J.stride = gp->set.prepass_stride > 0 ? gp->set.prepass_stride : 2;
+    J.stride = gp->set.prepass_stride > 0 ? gp->set.prepass_stride : (gp->set.keep_hits ? 1 : 2);
     J.ncx = coarse_count(J.stride, w);
     J.ncy = coarse_count(J.stride, h);
     J.ch = NULL;
+    J.rec = NULL;
     atomic_init(&J.rays, 0);
     atomic_init(&J.planar, 0);
     atomic_init(&J.missed, 0);
+    atomic_init(&J.kept, 0);
+    gp->vw = gp->vh = 0; /* no kept hits while the pre-pass runs, nor after it fails */
+    if (gp->set.keep_hits && w > 0 && h > 0 && (size_t)w * (size_t)h <= VIEW_REC_MAX_BYTES / sizeof(view_rec)) {
+        size_t need = (size_t)w * (size_t)h;
+        if (gp->vrec_cap < need) {
+            free(gp->vrec);
+            gp->vrec = malloc(need * sizeof *gp->vrec);
+            gp->vrec_cap = gp->vrec ? need : 0;
+        }
+        J.rec = gp->vrec;
+    }
     if (w > 0 && h > 0) {
         /* step 1, then step 2; every pixel traced (step 1 alone, without
          * records) at stride 1 or when the grid's memory is not there */
@@ -1234,6 +1300,12 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
     S->prepass_rays = atomic_load(&J.rays);
     S->prepass_planar = atomic_load(&J.planar);
     S->prepass_missed = atomic_load(&J.missed);
+    S->prepass_kept = atomic_load(&J.kept);
+    if (J.rec) {
+        gp->vw = w;
+        gp->vh = h;
+        gp->veps = J.eps;
+    }
     S->t_prepass = timer_now() - t0;
     S->c_prepass = cpu_now() - c0;
 
@@ -1298,6 +1370,32 @@ done:
 }
 
 /* ------------------------------------------------------------------ the hook */
+
+int gi_particle_primary_hit(void *ctx, const accel *a, double px, double py, vec3 org, vec3 dir, double tmin,
+                            const accel_hit **hit)
+{
+    const gi_particle *gp = ctx;
+    if (!gp || !gp->vrec || gp->vw <= 0 || a != gp->a || tmin != gp->veps) return 0;
+    double fx = floor(px), fy = floor(py);
+    if (px != fx + 0.5 || py != fy + 0.5 || fx < 0.0 || fy < 0.0 || fx >= gp->vw || fy >= gp->vh) return 0;
+    const view_rec *r = &gp->vrec[(size_t)fy * (size_t)gp->vw + (size_t)fx];
+    if (!r->kind || r->org.x != org.x || r->org.y != org.y || r->org.z != org.z || r->dir.x != dir.x ||
+        r->dir.y != dir.y || r->dir.z != dir.z)
+        return 0;
+    *hit = r->kind == 2 ? &r->h : NULL;
+    return 1;
+}
+
+/* The kept record whose hit this is (the render passes the pointer
+ * gi_particle_primary_hit gave it on to the hook), or NULL. */
+static const view_rec *kept_rec(const gi_particle *gp, const accel_hit *hit)
+{
+    if (!gp->vrec || gp->vw <= 0) return NULL;
+    uintptr_t off = (uintptr_t)hit - (uintptr_t)gp->vrec;
+    size_t n = (size_t)gp->vw * (size_t)gp->vh;
+    if ((uintptr_t)hit < (uintptr_t)gp->vrec || off >= n * sizeof(view_rec) || off % sizeof(view_rec)) return NULL;
+    return (const view_rec *)((const char *)gp->vrec + off);
+}
 
 /* Claim a state slot: returns 1 if the caller must compute it, 0 once it is
  * done (waiting while another thread computes). */
@@ -1442,8 +1540,18 @@ static int side_value(gi_particle *gp, const accel_hit *hit, vec3 n, thread_coun
     long rp[3];
     double w[3];
     out->r = out->g = out->b = 0.0;
-    if (!gi_surface_locate(gp->surf, hit, n, rp, w))
+    const view_rec *kr = kept_rec(gp, hit);
+    if (kr && kr->located && kr->side == (v3_dot(n, hit->ng) >= 0.0)) {
+        /* the pre-pass located this very hit on this side (locate reads
+         * only the hit and the side of n) */
+        for (int k = 0; k < 3; k++) {
+            rp[k] = kr->rp[k];
+            w[k] = kr->w[k];
+        }
+        tc->kept++;
+    } else if (!gi_surface_locate(gp->surf, hit, n, rp, w)) {
         return gi_surface_has_particles(gp->surf, hit) && onthefly(gp, hit, n, tc, out);
+    }
     /* only radiance particles the hit sees (gi_visible): one under a box
      * standing on the floor must not lend its light to the floor outside.
      * A clear cell (cell_clear) sees all three from everywhere; the other

@@ -108,6 +108,14 @@ typedef struct {
     int prepass_stride;  /* the pre-pass traces every Nth pixel in x and y; the pixels between take
                             their hit from the flat piece their coarse neighbours all hit, or are
                             traced (gi_particle.c, coarse_hit). 0: the default (2); 1: every pixel */
+    int keep_hits;       /* 1: the pre-pass keeps each traced pixel's first hit, and the radiance
+                            particles it located there, for the render: gi_particle_primary_hit as
+                            shade_settings.primary gives the render those hits instead of its own
+                            camera rays, and the hook takes their cell from the record (same values:
+                            the same image). Then stride 0 means 1 (every pixel traced once, by the
+                            pre-pass). Only for renders whose camera rays go through pixel centres
+                            (no fixed supersampling); none kept beyond 256 MiB of records. 0
+                            (default): nothing kept */
     int leak_per_hit;    /* 1: the light-leak guard tests every hit's 3 radiance particles; 0 (default):
                             once per interpolation cell, hits in clear cells skip it (gi_particle.c
                             cell_clear) */
@@ -151,6 +159,8 @@ typedef struct {
                                       them) and area particles gathered there (C build, on the CPU) */
     long cells, cells_clear; /* interpolation cells tested by the light-leak guard, of them clear */
     long lookups_clear;     /* hook lookups in clear cells (no visibility rays) */
+    long prepass_kept;      /* last prepare_view: pixels whose first hit was kept (keep_hits) */
+    long lookups_kept;      /* hook lookups that took their cell from a kept hit (no locate) */
     long skipped_objects;
     double flux_direct, flux_emitted, flux_scattered; /* sums over particles (grey) */
     /* memory, bytes */
@@ -194,6 +204,14 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
  * the gi_particle. Thread-safe; `thread` < 256. Radiance particles the
  * pre-pass missed are computed on the spot with the C build of the kernels. */
 rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread);
+/* The shade_settings.primary provider (signature of shade_primary_fn): ctx
+ * is the gi_particle. With settings.keep_hits, the first hit the last
+ * prepare_view found for the camera ray (org, dir) through pixel centre
+ * (px, py) of its w x h image, when that ray is bit-identical, was traced on
+ * `a` with the same tmin and hit no no_image object; else 0 (the render
+ * traces it). The hit stays valid until the next prepare_view or free. */
+int gi_particle_primary_hit(void *ctx, const accel *a, double px, double py, vec3 org, vec3 dir, double tmin,
+                            const accel_hit **hit);
 const gi_particle_stats *gi_particle_get_stats(gi_particle *gp);
 void gi_particle_free(gi_particle *gp);
 

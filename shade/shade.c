@@ -470,7 +470,19 @@ static rgb primary_ray(render_ctx *c, int thread, double px, double py, vec3 org
         dir = v3_norm(normal_perturb(c->sc->camera.normal, dir, sp, NULL, &pc));
     }
     c->ts[thread].primary++;
-    rgb v = trace_ray(c, thread, org, dir, 1, 1.0, OBJ_NO_IMAGE, 0.0f, r, &c->cam_in);
+    rgb v;
+    const accel_hit *known;
+    if (c->s->primary && c->max_level >= 1 && c->s->primary(c->s->primary_ctx, c->a, px, py, org, dir, c->eps, &known)) {
+        /* trace_ray's first hit, found already (shade_primary_fn) */
+        if (known)
+            v = along_ray(c, thread, org, dir, known->t,
+                          shade_hit(c, thread, known, dir, 1, 1.0, OBJ_NO_IMAGE, 0.0f, r, &c->cam_in), r, &c->cam_in,
+                          known->obj);
+        else
+            v = along_ray(c, thread, org, dir, INFINITY, atmos_sky(c->sc, dir), r, &c->cam_in, NULL);
+    } else {
+        v = trace_ray(c, thread, org, dir, 1, 1.0, OBJ_NO_IMAGE, 0.0f, r, &c->cam_in);
+    }
     if (!isfinite(v.r) || !isfinite(v.g) || !isfinite(v.b)) {
         c->ts[thread].discarded++;
         return rgb_make(0, 0, 0);

@@ -1589,6 +1589,131 @@ static void test_prepass_grid(void **state)
     assert_true(labs(found[1] - found[0]) * 200 <= found[0]);
 }
 
+/* ------------------------------------------------------------------ kept hits */
+
+/* keep_hits: the pre-pass keeps every pixel's first hit and its located
+ * cell, the render takes them (gi_particle_primary_hit as
+ * shade_settings.primary) instead of tracing its camera rays, the hook
+ * takes the cell instead of locating. The image must be bit for bit the
+ * one of the same pre-pass (stride 1) without them: a mesh floor, a box, a
+ * mirror sphere (reflected rays are traced), a no_image sphere (those
+ * pixels are traced: the render steps past it), background pixels (misses
+ * kept). Then the camera moved in place without a new pre-pass (no ray
+ * matches: every one traced) and a 4-spp render (no ray through a pixel
+ * centre) must equal renders without the provider. */
+static const char *const kept_scene =
+    "camera { location <0.3, 2.2, -4> look_at <0, 0.4, 0> }\n"
+    "light_source { <-1.5, 3, -2> color rgb 1 }\n"
+    "mesh { triangle { <-2, 0, -2>, <2, 0, -2>, <2, 0, 2> } triangle { <-2, 0, -2>, <2, 0, 2>, <-2, 0, 2> }\n"
+    "  pigment { rgb 0.8 } finish { ambient 0 diffuse 0.8 } }\n"
+    "box { <-0.5, 0, -0.5>, <0.5, 1, 0.5> rotate y*30 pigment { rgb <0.7, 0.5, 0.4> } finish { ambient 0 diffuse 0.8 } }\n"
+    "sphere { <1.1, 0.5, 0.6>, 0.5 pigment { rgb 0.3 } finish { ambient 0 diffuse 0.3 reflection 0.6 } }\n"
+    "sphere { <-1.0, 0.5, -1.0>, 0.3 pigment { rgb 0.9 } finish { ambient 0 diffuse 0.8 } no_image }\n";
+
+static framebuffer *kept_render(fixture *f, gi_particle *gp, int provider, int spp, shade_stats *sst)
+{
+    enum { KW = 48 };
+    shade_settings ss;
+    shade_default_settings(&ss);
+    ss.width = ss.height = KW;
+    ss.threads = 2;
+    ss.use_ambient = 0;
+    ss.indirect = gi_particle_indirect;
+    ss.indirect_ctx = gp;
+    if (spp > 1) {
+        ss.antialias = 2;
+        ss.spp = spp;
+    }
+    if (provider) {
+        ss.primary = gi_particle_primary_hit;
+        ss.primary_ctx = gp;
+    }
+    framebuffer *fb = fb_new(KW, KW);
+    assert_int_equal(shade_render(f->sc, f->a, &ss, fb, sst, f->d), PT_OK);
+    return fb;
+}
+
+static int fb_same(const framebuffer *a, const framebuffer *b)
+{
+    return a->width == b->width && a->height == b->height &&
+           !memcmp(a->rgb, b->rgb, (size_t)a->width * a->height * 3 * sizeof *a->rgb);
+}
+
+static void test_kept_hits(void **state)
+{
+    (void)state;
+    enum { KW = 48 };
+    fixture f;
+    load(&f, kept_scene);
+    gi_particle *gp[2];
+    for (int k = 0; k < 2; k++) {
+        gi_particle_settings s;
+        gi_particle_default_settings(&s);
+        s.count = 4000;
+        s.bounces = 3;
+        s.threads = 2;
+        s.seed = 3;
+        s.cl_device = device_c;
+        s.prepass_stride = 1;
+        s.keep_hits = k;
+        gp[k] = build_with(&f, &s);
+        assert_int_equal(gi_particle_prepare_view(gp[k], &f.sc->camera, KW, KW, f.d), PT_OK);
+    }
+    shade_stats s0, s1;
+    framebuffer *a = kept_render(&f, gp[0], 0, 1, &s0), *b = kept_render(&f, gp[1], 1, 1, &s1);
+    const gi_particle_stats *x = gi_particle_get_stats(gp[1]);
+    long kept = x->prepass_kept, lk = x->lookups_kept, look = x->lookups;
+    int misses = 0, noimg = 0;
+    for (int y = 0; y < KW; y++)
+        for (int i = 0; i < KW; i++) {
+            vec3 org, dir;
+            scene_camera_ray(&f.sc->camera, i + 0.5, y + 0.5, KW, KW, &org, &dir);
+            const accel_hit *h;
+            if (!gi_particle_primary_hit(gp[1], f.a, i + 0.5, y + 0.5, org, dir, 1e-6 * accel_eps_scale(f.a), &h)) {
+                noimg++;
+                continue;
+            }
+            misses += h == NULL;
+        }
+    printf("  %d x %d: %ld hits kept (%d misses, %d pixels not kept: no_image), %ld of %ld lookups took a kept cell; "
+           "primary rays %ld / %ld, mean %.6f / %.6f, identical %d\n",
+           KW, KW, kept, misses, noimg, lk, look, s0.primary_rays, s1.primary_rays, fb_mean(a, -1), fb_mean(b, -1),
+           fb_same(a, b));
+    assert_true(fb_same(a, b));
+    assert_int_equal(s0.primary_rays, s1.primary_rays);
+    assert_int_equal(kept + noimg, KW * KW);
+    assert_true(noimg > 10 && misses > 10);
+    assert_true(lk * 10 >= look * 7); /* the rest: reflected rays' hits */
+    assert_true(lk < look);
+    assert_int_equal(gi_particle_get_stats(gp[0])->prepass_kept, 0);
+    fb_free(a);
+    fb_free(b);
+
+    /* the camera moved in place, no new pre-pass: nothing matches */
+    f.sc->camera.location.x += 0.01;
+    a = kept_render(&f, gp[0], 0, 1, &s0);
+    b = kept_render(&f, gp[1], 1, 1, &s1);
+    long lk2 = gi_particle_get_stats(gp[1])->lookups_kept;
+    printf("  camera moved: identical %d, kept lookups %ld -> %ld\n", fb_same(a, b), lk, lk2);
+    assert_true(fb_same(a, b));
+    assert_int_equal(lk2, lk);
+    fb_free(a);
+    fb_free(b);
+    f.sc->camera.location.x -= 0.01;
+    /* 4 spp: no camera ray through a pixel centre */
+    a = kept_render(&f, gp[0], 0, 4, &s0);
+    b = kept_render(&f, gp[1], 1, 4, &s1);
+    lk2 = gi_particle_get_stats(gp[1])->lookups_kept;
+    printf("  4 spp: identical %d, kept lookups %ld -> %ld\n", fb_same(a, b), lk, lk2);
+    assert_true(fb_same(a, b));
+    assert_int_equal(lk2, lk);
+    fb_free(a);
+    fb_free(b);
+    gi_particle_free(gp[0]);
+    gi_particle_free(gp[1]);
+    unload(&f);
+}
+
 int main(int argc, char **argv)
 {
     /* test_gi NAME runs the tests matching NAME (cmocka's filter) */
@@ -1617,6 +1742,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_thin_slab),
         cmocka_unit_test(test_cell_cache),
         cmocka_unit_test(test_prepass_grid),
+        cmocka_unit_test(test_kept_hits),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
