@@ -100,6 +100,7 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
         ss.indirect = gi_particle_indirect;
         ss.indirect_ctx = gp;
         if (gs.keep_hits) {
+            ss.primary_begin = gi_particle_primary_begin;
             ss.primary = gi_particle_primary_hit;
             ss.primary_ctx = gp;
         }

@@ -115,7 +115,8 @@ static double render(const scene *sc, const accel *a, int size, int threads, gi_
         s.use_ambient = 0;
         s.indirect = gi_particle_indirect;
         s.indirect_ctx = gp;
-        s.primary = gi_particle_primary_hit; /* kept hits, when keep_hits (else it declines) */
+        s.primary_begin = gi_particle_primary_begin; /* kept hits, when keep_hits (else it declines) */
+        s.primary = gi_particle_primary_hit;
         s.primary_ctx = gp;
     }
     double t0 = timer_now();

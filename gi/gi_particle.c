@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include "camera.h"
 #include "gi_cellvis.h"
 #include "gi_cl.h"
 #include "gi_cl_c.h"
@@ -67,6 +68,7 @@ struct gi_particle {
     atomic_uchar *mark;
     gi_cellvis *cells; /* per-cell verdicts of the light-leak guard (side_value); NULL: per hit */
     struct view_rec *vrec; /* keep_hits: one per pixel of the last prepare_view (vw x vh), NULL: none */
+    scene_camera vcam;     /* its camera */
     size_t vrec_cap;       /* records allocated */
     int vw, vh;
     double veps;           /* the pre-pass's tmin */
@@ -970,7 +972,44 @@ typedef struct view_rec {
     unsigned char kind;    /* 0 nothing kept (the render traces), 1 a miss, 2 a hit */
     unsigned char located; /* rp, w hold locate's answer */
     unsigned char side;    /* the side located: dot(n_view, h.ng) >= 0 */
+    unsigned char verdict; /* the light-leak guard's verdict on that cell (GI_CELL_*, UNKNOWN: the hook decides) */
 } view_rec;
+
+/* One pre-pass thread's row of kept hits: its counters (cell tests) and
+ * the last cell's key and verdict (neighbouring pixels often share a cell:
+ * no table probe). */
+typedef struct {
+    thread_count *tc;
+    uint64_t key;
+    int verdict;
+} view_memo;
+
+static int cell_clear(gi_particle *gp, const long rp[3], const scene_object *own, thread_count *tc);
+
+/* The verdict side_value would take for the cell rp of a hit on `own`
+ * (tested now when the table has none): the same test, moved to the
+ * pre-pass. Before the table (a cache miss a probe), the previous pixel's
+ * cell and what this pixel's record held from an earlier frame (rp and
+ * verdict are written together, a verdict depends on the cell alone). */
+static int kept_verdict(gi_particle *gp, const long rp[3], const scene_object *own, view_memo *m, const view_rec *old)
+{
+    uint64_t key = gi_cellvis_key(gp->cells, rp);
+    if (!key) return GI_CELL_UNKNOWN;
+    if (key == m->key) return m->verdict;
+    if (old->verdict != GI_CELL_UNKNOWN && old->rp[0] == rp[0] && old->rp[1] == rp[1] && old->rp[2] == rp[2]) {
+        m->key = key;
+        m->verdict = old->verdict;
+        return old->verdict;
+    }
+    int verdict = gi_cellvis_get(gp->cells, key);
+    if (verdict == GI_CELL_UNKNOWN) {
+        verdict = cell_clear(gp, rp, own, m->tc) ? GI_CELL_CLEAR : GI_CELL_BLOCKED;
+        gi_cellvis_put(gp->cells, key, verdict);
+    }
+    m->key = key;
+    m->verdict = verdict;
+    return verdict;
+}
 
 typedef struct {
     gi_particle *gp;
@@ -1016,7 +1055,7 @@ static int flat_pieces(const scene_object *o)
  * it is on a flat piece and spawns no further rays. Returns the rays
  * traced. */
 static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_level, double eps, coarse_hit *rec,
-                        view_rec *vr)
+                        view_rec *vr, view_memo *m)
 {
     accel_hit h;
     if (rec) {
@@ -1049,12 +1088,14 @@ static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_
     if (vr && !(h.flags & OBJ_NO_IMAGE)) {
         /* the render's camera ray would stop here too (it steps past
          * no_image surfaces only) */
+        int verdict = located && gp->cells ? kept_verdict(gp, cell, h.obj, m, vr) : GI_CELL_UNKNOWN;
         vr->h = h;
         vr->org = org;
         vr->dir = dir;
         vr->kind = 2;
         vr->located = (unsigned char)located;
         vr->side = v3_dot(n, h.ng) >= 0.0;
+        vr->verdict = (unsigned char)verdict;
         for (int k = 0; k < 3; k++) {
             vr->rp[k] = located ? cell[k] : -1;
             vr->w[k] = located ? cw[k] : 0.0;
@@ -1078,7 +1119,7 @@ static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_
     if (level >= max_level) return rays;
     double cos_i = -v3_dot(dir, n);
     vec3 p = v3_madd(h.p, ng, eps);
-    if (refl) rays += prepass_ray(gp, p, v3_madd(dir, n, 2.0 * cos_i), level + 1, max_level, eps, NULL, NULL);
+    if (refl) rays += prepass_ray(gp, p, v3_madd(dir, n, 2.0 * cos_i), level + 1, max_level, eps, NULL, NULL, NULL);
     if (trans) {
         const scene_interior *in = h.obj->interior;
         double rel = 1.0;
@@ -1088,10 +1129,10 @@ static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_
         if (fabs(rel - 1.0) > 1e-9) {
             double eta = 1.0 / rel, k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
             if (k < 0.0)
-                return rays + prepass_ray(gp, p, v3_madd(dir, n, 2.0 * cos_i), level + 1, max_level, eps, NULL, NULL);
+                return rays + prepass_ray(gp, p, v3_madd(dir, n, 2.0 * cos_i), level + 1, max_level, eps, NULL, NULL, NULL);
             td = v3_norm(v3_add(v3_scale(dir, eta), v3_scale(n, eta * cos_i - sqrt(k))));
         }
-        rays += prepass_ray(gp, q, td, level + 1, max_level, eps, NULL, NULL);
+        rays += prepass_ray(gp, q, td, level + 1, max_level, eps, NULL, NULL, NULL);
     }
     return rays;
 }
@@ -1103,16 +1144,19 @@ static int coarse_count(int stride, int n) { return n > 0 ? (n - 1 + stride - 1)
 
 static void coarse_row(void *ctx, int j, int thread)
 {
-    (void)thread;
     view_job *J = ctx;
+    view_memo m = {&J->gp->tc[thread < GI_MAX_THREADS ? thread : 0], 0, GI_CELL_UNKNOWN};
     long rays = 0, kept = 0;
     int y = coarse_at(j, J->stride, J->h);
     for (int i = 0; i < J->ncx; i++) {
         int x = coarse_at(i, J->stride, J->w);
         vec3 org, dir;
-        scene_camera_ray(J->cam, x + 0.5, y + 0.5, J->w, J->h, &org, &dir);
         view_rec *vr = J->rec ? &J->rec[(size_t)y * J->w + x] : NULL;
-        rays += prepass_ray(J->gp, org, dir, 1, J->max_level, J->eps, J->ch ? &J->ch[(size_t)j * J->ncx + i] : NULL, vr);
+        int cam = camera_ray(J->cam, x + 0.5, y + 0.5, J->w, J->h, 0.0, 0.0, &org, &dir);
+        if (!cam) scene_camera_ray(J->cam, x + 0.5, y + 0.5, J->w, J->h, &org, &dir);
+        rays += prepass_ray(J->gp, org, dir, 1, J->max_level, J->eps, J->ch ? &J->ch[(size_t)j * J->ncx + i] : NULL,
+                            cam ? vr : NULL, &m);
+        if (vr && !cam) vr->kind = 0; /* the render shows no ray there */
         kept += vr && vr->kind;
     }
     atomic_fetch_add(&J->rays, rays);
@@ -1171,9 +1215,9 @@ static const coarse_hit *piece_hit(const coarse_hit *const *c, int nc, vec3 org,
 
 static void fill_row(void *ctx, int y, int thread)
 {
-    (void)thread;
     view_job *J = ctx;
     gi_particle *gp = J->gp;
+    view_memo m = {&gp->tc[thread < GI_MAX_THREADS ? thread : 0], 0, GI_CELL_UNKNOWN};
     long rays = 0, planar = 0, missed = 0, kept = 0;
     int s = J->stride, j = y == J->h - 1 ? J->ncy - 1 : y / s, on_row = y % s == 0 || y == J->h - 1;
     int j1 = j + 1 < J->ncy ? j + 1 : j;
@@ -1215,7 +1259,9 @@ static void fill_row(void *ctx, int y, int thread)
             continue;
         }
         vec3 org, dir;
-        scene_camera_ray(J->cam, x + 0.5, y + 0.5, J->w, J->h, &org, &dir);
+        int cam = camera_ray(J->cam, x + 0.5, y + 0.5, J->w, J->h, 0.0, 0.0, &org, &dir);
+        if (!cam) scene_camera_ray(J->cam, x + 0.5, y + 0.5, J->w, J->h, &org, &dir);
+        if (!cam) vr = NULL; /* the render shows no ray there: nothing kept */
         double t;
         const coarse_hit *b = piece_hit(c, nc, org, dir, &t);
         if (b) {
@@ -1237,7 +1283,7 @@ static void fill_row(void *ctx, int y, int thread)
             }
             continue;
         }
-        rays += prepass_ray(gp, org, dir, 1, J->max_level, J->eps, NULL, vr);
+        rays += prepass_ray(gp, org, dir, 1, J->max_level, J->eps, NULL, vr, &m);
         kept += vr && vr->kind;
     }
     atomic_fetch_add(&J->rays, rays);
@@ -1279,7 +1325,8 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
         size_t need = (size_t)w * (size_t)h;
         if (gp->vrec_cap < need) {
             free(gp->vrec);
-            gp->vrec = malloc(need * sizeof *gp->vrec);
+            /* zero: no record holds a verdict yet (kept_verdict) */
+            gp->vrec = calloc(need, sizeof *gp->vrec);
             gp->vrec_cap = gp->vrec ? need : 0;
         }
         J.rec = gp->vrec;
@@ -1305,6 +1352,7 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
         gp->vw = w;
         gp->vh = h;
         gp->veps = J.eps;
+        memcpy(&gp->vcam, c, sizeof gp->vcam); /* bytes, padding too: primary_begin compares them */
     }
     S->t_prepass = timer_now() - t0;
     S->c_prepass = cpu_now() - c0;
@@ -1371,17 +1419,24 @@ done:
 
 /* ------------------------------------------------------------------ the hook */
 
-int gi_particle_primary_hit(void *ctx, const accel *a, double px, double py, vec3 org, vec3 dir, double tmin,
-                            const accel_hit **hit)
+int gi_particle_primary_begin(void *ctx, const scene *sc, const accel *a, int w, int h, double tmin)
 {
     const gi_particle *gp = ctx;
-    if (!gp || !gp->vrec || gp->vw <= 0 || a != gp->a || tmin != gp->veps) return 0;
-    double fx = floor(px), fy = floor(py);
-    if (px != fx + 0.5 || py != fy + 0.5 || fx < 0.0 || fy < 0.0 || fx >= gp->vw || fy >= gp->vh) return 0;
-    const view_rec *r = &gp->vrec[(size_t)fy * (size_t)gp->vw + (size_t)fx];
-    if (!r->kind || r->org.x != org.x || r->org.y != org.y || r->org.z != org.z || r->dir.x != dir.x ||
-        r->dir.y != dir.y || r->dir.z != dir.z)
-        return 0;
+    /* the camera compared byte for byte with the pre-pass's copy: every
+     * field camera_ray reads is held in the struct (the pointers it holds,
+     * a camera normal and mesh_camera's meshes, are not used here) */
+    return gp && sc && gp->vrec && gp->vw > 0 && gp->vw == w && gp->vh == h && a == gp->a && tmin == gp->veps &&
+           !memcmp(&sc->camera, &gp->vcam, sizeof gp->vcam);
+}
+
+int gi_particle_primary_hit(void *ctx, int x, int y, vec3 *org, vec3 *dir, const accel_hit **hit)
+{
+    const gi_particle *gp = ctx;
+    if ((unsigned)x >= (unsigned)gp->vw || (unsigned)y >= (unsigned)gp->vh) return 0;
+    const view_rec *r = &gp->vrec[(size_t)y * (size_t)gp->vw + (size_t)x];
+    if (!r->kind) return 0;
+    *org = r->org;
+    *dir = r->dir;
     *hit = r->kind == 2 ? &r->h : NULL;
     return 1;
 }
@@ -1541,7 +1596,8 @@ static int side_value(gi_particle *gp, const accel_hit *hit, vec3 n, thread_coun
     double w[3];
     out->r = out->g = out->b = 0.0;
     const view_rec *kr = kept_rec(gp, hit);
-    if (kr && kr->located && kr->side == (v3_dot(n, hit->ng) >= 0.0)) {
+    if (kr && !(kr->located && kr->side == (v3_dot(n, hit->ng) >= 0.0))) kr = NULL;
+    if (kr) {
         /* the pre-pass located this very hit on this side (locate reads
          * only the hit and the side of n) */
         for (int k = 0; k < 3; k++) {
@@ -1557,8 +1613,12 @@ static int side_value(gi_particle *gp, const accel_hit *hit, vec3 n, thread_coun
      * A clear cell (cell_clear) sees all three from everywhere; the other
      * cells test them from the hit. */
     double wsum = 0.0;
-    uint64_t key = gi_cellvis_key(gp->cells, rp);
-    int verdict = gi_cellvis_get(gp->cells, key);
+    int verdict = GI_CELL_UNKNOWN;
+    uint64_t key = 0;
+    if (kr && kr->verdict != GI_CELL_UNKNOWN)
+        verdict = kr->verdict; /* decided in the pre-pass (kept_verdict) */
+    else
+        verdict = gi_cellvis_get(gp->cells, key = gi_cellvis_key(gp->cells, rp));
     if (verdict == GI_CELL_UNKNOWN && key) {
         verdict = cell_clear(gp, rp, hit->obj, tc) ? GI_CELL_CLEAR : GI_CELL_BLOCKED;
         gi_cellvis_put(gp->cells, key, verdict);

@@ -109,9 +109,9 @@ typedef struct {
                             their hit from the flat piece their coarse neighbours all hit, or are
                             traced (gi_particle.c, coarse_hit). 0: the default (2); 1: every pixel */
     int keep_hits;       /* 1: the pre-pass keeps each traced pixel's first hit, and the radiance
-                            particles it located there, for the render: gi_particle_primary_hit as
-                            shade_settings.primary gives the render those hits instead of its own
-                            camera rays, and the hook takes their cell from the record (same values:
+                            particles it located there, for the render: gi_particle_primary_begin
+                            and _hit as shade_settings.primary_begin and .primary give the render
+                            those rays and hits instead of its own camera rays, and the hook takes their cell from the record (same values:
                             the same image). Then stride 0 means 1 (every pixel traced once, by the
                             pre-pass). Only for renders whose camera rays go through pixel centres
                             (no fixed supersampling); none kept beyond 256 MiB of records. 0
@@ -204,14 +204,16 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
  * the gi_particle. Thread-safe; `thread` < 256. Radiance particles the
  * pre-pass missed are computed on the spot with the C build of the kernels. */
 rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread);
-/* The shade_settings.primary provider (signature of shade_primary_fn): ctx
- * is the gi_particle. With settings.keep_hits, the first hit the last
- * prepare_view found for the camera ray (org, dir) through pixel centre
- * (px, py) of its w x h image, when that ray is bit-identical, was traced on
- * `a` with the same tmin and hit no no_image object; else 0 (the render
- * traces it). The hit stays valid until the next prepare_view or free. */
-int gi_particle_primary_hit(void *ctx, const accel *a, double px, double py, vec3 org, vec3 dir, double tmin,
-                            const accel_hit **hit);
+/* The shade_settings.primary_begin and .primary providers (signatures of
+ * shade_primary_begin_fn and shade_primary_fn): ctx is the gi_particle.
+ * With settings.keep_hits, begin says whether the last prepare_view's
+ * camera (compared whole), size, accel and tmin are the render's; then
+ * primary gives pixel (x, y)'s camera ray (camera_ray through its centre)
+ * and first hit, or 0 where none was kept (a no_image surface first, no
+ * camera ray there). The hits stay valid until the next prepare_view or
+ * free. */
+int gi_particle_primary_begin(void *ctx, const scene *sc, const accel *a, int w, int h, double tmin);
+int gi_particle_primary_hit(void *ctx, int x, int y, vec3 *org, vec3 *dir, const accel_hit **hit);
 const gi_particle_stats *gi_particle_get_stats(gi_particle *gp);
 void gi_particle_free(gi_particle *gp);
 

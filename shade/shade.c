@@ -66,6 +66,7 @@ typedef struct {
     int media;
     media_inside cam_in;
     const struct hit_frame *frame[SHADE_MAX_THREADS];
+    int primary_on;      /* s->primary holds this render's centre rays (shade_primary_begin_fn) */
 } render_ctx;
 
 /* The hit tex_shade is working on, for its callbacks: the containers of
@@ -470,24 +471,36 @@ static rgb primary_ray(render_ctx *c, int thread, double px, double py, vec3 org
         dir = v3_norm(normal_perturb(c->sc->camera.normal, dir, sp, NULL, &pc));
     }
     c->ts[thread].primary++;
-    rgb v;
-    const accel_hit *known;
-    if (c->s->primary && c->max_level >= 1 && c->s->primary(c->s->primary_ctx, c->a, px, py, org, dir, c->eps, &known)) {
-        /* trace_ray's first hit, found already (shade_primary_fn) */
-        if (known)
-            v = along_ray(c, thread, org, dir, known->t,
-                          shade_hit(c, thread, known, dir, 1, 1.0, OBJ_NO_IMAGE, 0.0f, r, &c->cam_in), r, &c->cam_in,
-                          known->obj);
-        else
-            v = along_ray(c, thread, org, dir, INFINITY, atmos_sky(c->sc, dir), r, &c->cam_in, NULL);
-    } else {
-        v = trace_ray(c, thread, org, dir, 1, 1.0, OBJ_NO_IMAGE, 0.0f, r, &c->cam_in);
-    }
+    rgb v = trace_ray(c, thread, org, dir, 1, 1.0, OBJ_NO_IMAGE, 0.0f, r, &c->cam_in);
     if (!isfinite(v.r) || !isfinite(v.g) || !isfinite(v.b)) {
         c->ts[thread].discarded++;
         return rgb_make(0, 0, 0);
     }
     return v;
+}
+
+/* The centre sample of pixel (x, y) when the render's primary provider
+ * holds its ray and first hit (shade_primary_fn): what sample() gives
+ * (sample_ray, primary_ray and trace_ray's first step) without tracing;
+ * 0 when it holds none. */
+static int sample_known(render_ctx *c, int thread, int x, int y, rng *r, rgb *out)
+{
+    vec3 org, dir;
+    const accel_hit *h;
+    if (!c->s->primary(c->s->primary_ctx, x, y, &org, &dir, &h)) return 0;
+    c->ts[thread].primary++;
+    rgb v;
+    if (h)
+        v = along_ray(c, thread, org, dir, h->t, shade_hit(c, thread, h, dir, 1, 1.0, OBJ_NO_IMAGE, 0.0f, r, &c->cam_in),
+                      r, &c->cam_in, h->obj);
+    else
+        v = along_ray(c, thread, org, dir, INFINITY, atmos_sky(c->sc, dir), r, &c->cam_in, NULL);
+    if (!isfinite(v.r) || !isfinite(v.g) || !isfinite(v.b)) {
+        c->ts[thread].discarded++;
+        v = rgb_make(0, 0, 0);
+    }
+    *out = v;
+    return 1;
 }
 
 static rgb sample(render_ctx *c, int thread, double px, double py, rng *r)
@@ -536,7 +549,7 @@ static void tile_first_pass(void *ctx, int tile, int thread)
             pixel_rng(&r, c->s->seed, x, y, 0);
             rgb acc = {0, 0, 0};
             if (n == 1) {
-                acc = sample(c, thread, x + 0.5, y + 0.5, &r);
+                if (!c->primary_on || !sample_known(c, thread, x, y, &r, &acc)) acc = sample(c, thread, x + 0.5, y + 0.5, &r);
             } else {
                 for (int j = 0; j < n; j++)
                     for (int i = 0; i < n; i++) {
@@ -627,6 +640,11 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     /* the camera's containers matter to media and to fog (not in non-hollow objects) */
     if (c.media || sc->fogs || sc->rainbows) media_inside_at(sc, sc->camera.location, &c.cam_in);
     int ntiles = c.tiles_x * c.tiles_y;
+    /* hits found before the render serve the centre rays of plain cameras
+     * (primary_ray perturbs a camera normal's rays, sample() blurs) */
+    const scene_camera *cam = &sc->camera;
+    c.primary_on = s->primary && s->primary_begin && cam->kind != CAMERA_MESH && !camera_focal_blur(cam) &&
+                   !cam->normal && s->primary_begin(s->primary_ctx, sc, a, s->width, s->height, c.eps);
 
     pool_run(threads, ntiles, tile_first_pass, &c);
 

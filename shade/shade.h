@@ -18,15 +18,19 @@
 typedef rgb (*shade_indirect_fn)(void *ctx, const accel_hit *hit, vec3 n, int thread);
 
 /* Primary hits found before the render (the particle GI's view pre-pass
- * traces the same camera rays): returns 1 when it holds the first hit of
- * the camera ray (org, dir) through image point (px, py), traced on `a`
- * with accel_intersect(a, org, dir, tmin, INFINITY) on a surface without
- * OBJ_NO_IMAGE; *hit is that hit (NULL: the ray left the scene). shade.c
- * then shades it as if it had traced the ray, and passes that same pointer
- * on to the indirect hook (which may recognise its own record). 0: the
- * render traces the ray itself. Called from every render thread. */
-typedef int (*shade_primary_fn)(void *ctx, const accel *a, double px, double py, vec3 org, vec3 dir, double tmin,
-                                const accel_hit **hit);
+ * traces the same camera rays). primary_begin is asked once per render:
+ * 1 when the hits it holds are those of this camera (sc->camera, compared
+ * whole), image size and accel, traced with accel_intersect(a, org, dir,
+ * tmin, INFINITY). Then, for the camera ray through the centre of pixel
+ * (x, y) (camera_ray's org and dir: *org, *dir), primary returns 1 when it
+ * holds its first hit on a surface without OBJ_NO_IMAGE: *hit (NULL: the
+ * ray left the scene); shade.c shades it as if it had traced the ray, and
+ * passes that same pointer on to the indirect hook (which may recognise its
+ * own record). 0: the render computes and traces the ray itself. Used for
+ * the first sample of a pixel at its centre only (no focal blur, camera
+ * normal or mesh camera); primary is called from every render thread. */
+typedef int (*shade_primary_begin_fn)(void *ctx, const scene *sc, const accel *a, int w, int h, double tmin);
+typedef int (*shade_primary_fn)(void *ctx, int x, int y, vec3 *org, vec3 *dir, const accel_hit **hit);
 
 typedef struct {
     int width, height;
@@ -40,7 +44,8 @@ typedef struct {
     int use_ambient;        /* 1: add finish ambient * ambient_light (no GI); 0: GI supplies it */
     shade_indirect_fn indirect;
     void *indirect_ctx;
-    shade_primary_fn primary;  /* NULL: every camera ray is traced */
+    shade_primary_begin_fn primary_begin; /* both NULL: every camera ray is traced */
+    shade_primary_fn primary;
     void *primary_ctx;
     volatile int *cancel;   /* set non-zero to stop early (SIGINT) */
 } shade_settings;

@@ -1625,6 +1625,7 @@ static framebuffer *kept_render(fixture *f, gi_particle *gp, int provider, int s
         ss.spp = spp;
     }
     if (provider) {
+        ss.primary_begin = gi_particle_primary_begin;
         ss.primary = gi_particle_primary_hit;
         ss.primary_ctx = gp;
     }
@@ -1664,12 +1665,13 @@ static void test_kept_hits(void **state)
     const gi_particle_stats *x = gi_particle_get_stats(gp[1]);
     long kept = x->prepass_kept, lk = x->lookups_kept, look = x->lookups;
     int misses = 0, noimg = 0;
+    assert_true(gi_particle_primary_begin(gp[1], f.sc, f.a, KW, KW, 1e-6 * accel_eps_scale(f.a)));
+    assert_false(gi_particle_primary_begin(gp[0], f.sc, f.a, KW, KW, 1e-6 * accel_eps_scale(f.a)));
     for (int y = 0; y < KW; y++)
         for (int i = 0; i < KW; i++) {
             vec3 org, dir;
-            scene_camera_ray(&f.sc->camera, i + 0.5, y + 0.5, KW, KW, &org, &dir);
             const accel_hit *h;
-            if (!gi_particle_primary_hit(gp[1], f.a, i + 0.5, y + 0.5, org, dir, 1e-6 * accel_eps_scale(f.a), &h)) {
+            if (!gi_particle_primary_hit(gp[1], i, y, &org, &dir, &h)) {
                 noimg++;
                 continue;
             }
