@@ -335,6 +335,65 @@ static pt_status build_walk(gi_particle *gp, int nwalk, diag *d)
     return gi_dev_set_walk(gp->dev, gp->woff, gp->wsrc, gp->nwalk, d);
 }
 
+/* Catchment areas. A link ends on the area particle nearest its hit, so
+ * particle j receives scattered flux, and is read by gathering links, in
+ * proportion to the area V_j of the surface nearer to it than to any other
+ * particle (its Voronoi cell on the surface), not to the nominal dA = A/N it
+ * was sampled with. With L_j = rho phi_j / (pi dA) a gather then meets
+ * phi_j ~ E V_j with probability ~ V_j: the scattered light reads high by
+ * E[V^2] / (dA E[V]) = 1 + the squared coefficient of variation of the
+ * cells' areas (cbox, 50K particles: 1.104, measured by 64 stratified
+ * points per dA; the image +1.4% at n_b 8; test_gi's integrating sphere
+ * +2.5% at 1K particles). The direct and emitted parts of L are not
+ * affected (evaluated at the particle, they cancel dA). With V_j as the
+ * particle's area, emission and the first bounce send E V_j (a Voronoi
+ * quadrature) and the estimation lists weight by V_j too.
+ *
+ * V_j is estimated from the gathering links already traced, by reciprocity:
+ * every particle casts ng cosine-distributed rays, and particles stand at a
+ * uniform density 1/dA, so the links ending per unit area at x number
+ * (ng / dA) times the cosine-weighted fraction c(x) of x's hemisphere
+ * covered by surfaces with particles (integral of cos cos / (pi r^2) over
+ * those surfaces); c at particle j is the fraction r_j / ng of its own links
+ * that resolved. With g_j the links ending on j:
+ *   V_j ~ dA g_j / r_j,
+ * taken as dA (g_j + k) / (r_j + k) with k = CATCH_PRIOR links: where few
+ * links resolve (a floor under the open sky) the estimate stays near dA
+ * instead of following a ratio of small counts. Relative noise about
+ * 1/sqrt(g_j), so the noise's own bias E[V / V^] - 1 is about 1/ng
+ * (0.4% of the scattered light at 256 links). Where every link resolves
+ * (a closed room) the areas sum exactly to N dA (every link ends on one
+ * particle: sum g = sum r); elsewhere they follow the area the links
+ * reach (cbox 1.0001 N dA, maze 1.0025). */
+#define CATCH_PRIOR 8.0
+static pt_status catchment_areas(gi_particles *ps, const int *glink, int ng)
+{
+    int n = ps->n;
+    if (n <= 0 || ng <= 0) return PT_OK;
+    pt_status st = PT_OK;
+    int *g = xcalloc((size_t)n, sizeof(int), &st), *r = xcalloc((size_t)n, sizeof(int), &st);
+    if (st != PT_OK) {
+        free(g);
+        free(r);
+        return st;
+    }
+    for (int i = 0; i < n; i++) {
+        const int *lk = glink + (size_t)i * (size_t)ng;
+        for (int k = 0; k < ng; k++)
+            if (lk[k] >= 0) {
+                g[lk[k]]++;
+                r[i]++;
+            }
+    }
+    for (int j = 0; j < n; j++) {
+        double v = ps->dA * ((double)g[j] + CATCH_PRIOR) / ((double)r[j] + CATCH_PRIOR);
+        if (isfinite(v) && v > 0.0) ps->p[j].area = (float)v;
+    }
+    free(g);
+    free(r);
+    return PT_OK;
+}
+
 gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particle_settings *s,
                                gi_particle_stats *stats, diag *d, pt_status *status)
 {
@@ -477,6 +536,8 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         S->link_rays = ls.rays;
         S->link_misses = ls.misses;
         S->link_unresolved = ls.unresolved;
+        if (!set->nominal_areas) st = catchment_areas(&gp->ps, gp->glink, gp->ng);
+        if (st != PT_OK) goto fail;
     }
 
     /* radiance particles and estimation lists */

@@ -116,6 +116,9 @@ typedef struct {
                             pre-pass). Only for renders whose camera rays go through pixel centres
                             (no fixed supersampling); none kept beyond 256 MiB of records. 0
                             (default): nothing kept */
+    int nominal_areas;   /* 1: every area particle keeps the nominal dA = A/N (before 22 Nov 2026: reads
+                            ~1% bright, see gi_particle.c catchment_areas); 0 (default): each particle's
+                            area is its catchment, estimated from the gathering links that end on it */
     int leak_per_hit;    /* 1: the light-leak guard tests every hit's 3 radiance particles; 0 (default):
                             once per interpolation cell, hits in clear cells skip it (gi_particle.c
                             cell_clear) */
