@@ -33,6 +33,8 @@ _Static_assert(offsetof(gi_dev_light, falloff) == 60, "falloff");
 _Static_assert(offsetof(gi_dev_light, fade_distance) == 64, "fade_distance");
 _Static_assert(offsetof(gi_dev_light, fade_power) == 68, "fade_power");
 _Static_assert(offsetof(gi_dev_light, shadowless) == 72, "shadowless");
+_Static_assert(sizeof(gi_walk_entry) == 16 && offsetof(gi_walk_entry, w) == 4, "gi_walk_entry is 16 bytes");
+_Static_assert(GI_BOUNCE_CHUNK % 32 == 0, "gi_k_bounce writes whole mask words");
 _Static_assert(sizeof(gi_i64) == 8 && sizeof(gi_u32) == 4 && sizeof(float) == 4 && sizeof(int) == 4,
                "scalar sizes match OpenCL C");
 
@@ -49,7 +51,7 @@ extern const int gi_kernel_nfiles;
 /* gi_k_bounce work-items (GI_BOUNCE_CHUNK particles each) per work-group */
 #define GI_BOUNCE_LOCAL 4
 
-enum { KE_EMIT, KE_BOUNCE, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_COUNT };
+enum { KE_EMIT, KE_BOUNCE, KE_WALK, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_COUNT };
 
 struct gi_dev {
     int is_cl;
@@ -62,13 +64,17 @@ struct gi_dev {
     const gi_dev_particle *part;
     int n, ns2, ng, nrp;
     float *rho4;   /* n x 4: the particles' reflectances (gi_k_bounce) */
+    unsigned *emits; /* (n + 31) / 32 words: particles with emission (gi_k_emit) */
+    size_t nmask;    /* words of a particle mask, (n + 63) / 64 * 2 */
     const int *slink, *glink, *list_off, *list_idx, *rin_off, *rin_src;
-    const int *woff, *wsrc; /* WALK bounce lists (gi_dev_set_walk) */
+    const int *woff;            /* WALK path table (gi_dev_set_walk): n + 1 offsets */
+    const gi_walk_entry *went;  /* and woff[n] entries */
     int nwalk;
     float *tally;  /* nb x 3 floats per gi_k_bounce work-item (read back) */
     size_t tally_cap;
     /* C build scratch */
     float *edir, *src, *bin, *bout, *total;
+    unsigned *mask_src, *mask_a, *mask_b; /* source masks (gi_k_emit, gi_k_bounce) */
     const float *lout_host;  /* last scatter's output (C build reads it in gather) */
     const float *eind_host;  /* last gather's output (C build reads it in estimate) */
 #ifdef PARTRAY_HAVE_OPENCL
@@ -78,8 +84,9 @@ struct gi_dev {
     cl_kernel k[KE_COUNT];
     cl_mem b_part, b_slink, b_glink, b_off, b_idx, b_rho;
     cl_mem b_lights, b_vis, b_edir, b_src, b_tally, b_lout, b_phi, b_eind, b_list, b_vout;
-    cl_mem b_rin_off, b_rin_src, b_bin, b_bout, b_total, b_woff, b_wsrc;
-    size_t sz_lights, sz_vis, sz_tally, sz_list, sz_vout;
+    cl_mem b_rin_off, b_rin_src, b_bin, b_bout, b_total, b_woff, b_went;
+    cl_mem b_emits, b_mask_src, b_mask_a, b_mask_b;
+    size_t sz_lights, sz_vis, sz_tally, sz_list, sz_vout, sz_woff, sz_went;
     float *tmp;  /* n*4 readback scratch */
 #endif
 };
@@ -315,8 +322,8 @@ static pt_status cl_open(gi_dev *dv, const gi_dev_options *o, diag *d)
         free(log);
         return PT_ERR_DEVICE;
     }
-    static const char *const names[KE_COUNT] = {"gi_k_emit", "gi_k_bounce", "gi_k_resolve", "gi_k_gather",
-                                                "gi_k_estimate"};
+    static const char *const names[KE_COUNT] = {"gi_k_emit", "gi_k_bounce", "gi_k_walk", "gi_k_resolve",
+                                                "gi_k_gather", "gi_k_estimate"};
     for (int k = 0; k < KE_COUNT; k++) {
         dv->k[k] = clCreateKernel(dv->prog, names[k], &e);
         if (!dv->k[k]) return cl_fail(d, names[k], e);
@@ -474,7 +481,8 @@ void gi_dev_free(gi_dev *dv)
         cl_mem *ms[] = {&dv->b_part, &dv->b_rho, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
                         &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_tally, &dv->b_lout, &dv->b_phi,
                         &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off, &dv->b_rin_src, &dv->b_bin,
-                        &dv->b_bout, &dv->b_total, &dv->b_woff, &dv->b_wsrc};
+                        &dv->b_bout, &dv->b_total, &dv->b_woff, &dv->b_went,
+                        &dv->b_emits, &dv->b_mask_src, &dv->b_mask_a, &dv->b_mask_b};
         for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
         for (int k = 0; k < KE_COUNT; k++)
             if (dv->k[k]) clReleaseKernel(dv->k[k]);
@@ -489,7 +497,11 @@ void gi_dev_free(gi_dev *dv)
     free(dv->bin);
     free(dv->bout);
     free(dv->total);
+    free(dv->mask_src);
+    free(dv->mask_a);
+    free(dv->mask_b);
     free(dv->rho4);
+    free(dv->emits);
     free(dv->tally);
     free(dv);
 }
@@ -509,19 +521,34 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     if (!dv->rho4) return PT_ERR_NOMEM;
     for (int i = 0; i < n; i++)
         for (int c = 0; c < 3; c++) dv->rho4[4 * (size_t)i + c] = part[i].rho[c];
+    /* masks: whole 64-particle chunks (gi_k_bounce writes 2 words each) */
+    dv->nmask = (nn + 63) / 64 * 2;
+    free(dv->emits);
+    dv->emits = calloc(dv->nmask, sizeof(unsigned));
+    if (!dv->emits) return PT_ERR_NOMEM;
+    for (int i = 0; i < n; i++)
+        if (part[i].le[0] != 0.0f || part[i].le[1] != 0.0f || part[i].le[2] != 0.0f) dv->emits[i >> 5] |= 1u << (i & 31);
     if (!dv->is_cl) {
         free(dv->edir);
         free(dv->src);
         free(dv->bin);
         free(dv->bout);
         free(dv->total);
+        free(dv->mask_src);
+        free(dv->mask_a);
+        free(dv->mask_b);
         dv->edir = calloc(nn * 4, sizeof(float));
         dv->src = calloc(nn * 4, sizeof(float));
         dv->bin = calloc(nn * 4, sizeof(float));
         dv->bout = calloc(nn * 4, sizeof(float));
         dv->total = calloc(nn * 4, sizeof(float));
-        dv->bytes = nn * 6 * 16;
-        if (!dv->edir || !dv->src || !dv->bin || !dv->bout || !dv->total) return PT_ERR_NOMEM;
+        dv->mask_src = calloc(dv->nmask, sizeof(unsigned));
+        dv->mask_a = calloc(dv->nmask, sizeof(unsigned));
+        dv->mask_b = calloc(dv->nmask, sizeof(unsigned));
+        dv->bytes = nn * 6 * 16 + 4 * dv->nmask * sizeof(unsigned);
+        if (!dv->edir || !dv->src || !dv->bin || !dv->bout || !dv->total || !dv->mask_src || !dv->mask_a ||
+            !dv->mask_b)
+            return PT_ERR_NOMEM;
         return PT_OK;
     }
 #ifdef PARTRAY_HAVE_OPENCL
@@ -531,9 +558,10 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     cl_mem *ms[] = {&dv->b_part, &dv->b_rho, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
                     &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_tally, &dv->b_lout, &dv->b_phi,
                     &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off, &dv->b_rin_src, &dv->b_bin,
-                    &dv->b_bout, &dv->b_total, &dv->b_woff, &dv->b_wsrc};
+                    &dv->b_bout, &dv->b_total, &dv->b_woff, &dv->b_went,
+                    &dv->b_emits, &dv->b_mask_src, &dv->b_mask_a, &dv->b_mask_b};
     for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
-    dv->sz_lights = dv->sz_vis = dv->sz_tally = dv->sz_list = dv->sz_vout = 0;
+    dv->sz_lights = dv->sz_vis = dv->sz_tally = dv->sz_list = dv->sz_vout = dv->sz_woff = dv->sz_went = 0;
     dv->bytes = 0;
     /* the real count: with no particles the arrays may be NULL (buffers get a
      * minimal size, nothing is written) */
@@ -545,6 +573,14 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     if ((st = upload(dv, &dv->b_slink, &have, slink, nr * (size_t)ns2 * sizeof(int), d)) != PT_OK) return st;
     have = 0;
     if ((st = upload(dv, &dv->b_glink, &have, glink, nr * (size_t)ng * sizeof(int), d)) != PT_OK) return st;
+    have = 0;
+    if ((st = upload(dv, &dv->b_emits, &have, dv->emits, dv->nmask * sizeof(unsigned), d)) != PT_OK) return st;
+    cl_mem *mb[] = {&dv->b_mask_src, &dv->b_mask_a, &dv->b_mask_b};
+    for (int k = 0; k < 3; k++) {
+        have = 0;
+        if ((st = ensure(dv, mb[k], &have, dv->nmask * sizeof(unsigned), d)) != PT_OK) return st;
+        if ((st = zero(dv, *mb[k], dv->nmask * sizeof(unsigned), d)) != PT_OK) return st;
+    }
     size_t f4 = nn * 4 * sizeof(float);
     have = 0;
     if ((st = ensure(dv, &dv->b_edir, &have, f4, d)) != PT_OK) return st;
@@ -610,20 +646,22 @@ pt_status gi_dev_set_reverse(gi_dev *dv, const int *rin_off, const int *rin_src,
 #endif
 }
 
-pt_status gi_dev_set_walk(gi_dev *dv, const int *woff, const int *wsrc, int nwalk, diag *d)
+pt_status gi_dev_set_walk(gi_dev *dv, const int *woff, const gi_walk_entry *went, int nwalk, diag *d)
 {
     dv->woff = woff;
-    dv->wsrc = wsrc;
+    dv->went = went;
     dv->nwalk = nwalk;
     if (!dv->is_cl) return PT_OK;
 #ifdef PARTRAY_HAVE_OPENCL
+    if (dv->b_woff) dv->bytes -= dv->sz_woff;
+    if (dv->b_went) dv->bytes -= dv->sz_went;
     rel(&dv->b_woff);
-    rel(&dv->b_wsrc);
-    size_t have = 0, nr = (size_t)(dv->n > 0 ? dv->n : 0), k = (size_t)(nwalk > 0 ? nwalk : 0);
-    pt_status st = upload(dv, &dv->b_woff, &have, woff, k * (nr + 1) * sizeof(int), d);
+    rel(&dv->b_went);
+    dv->sz_woff = dv->sz_went = 0;
+    size_t nr = (size_t)(dv->n > 0 ? dv->n : 0);
+    pt_status st = upload(dv, &dv->b_woff, &dv->sz_woff, woff, (nr + 1) * sizeof(int), d);
     if (st != PT_OK) return st;
-    have = 0;
-    return upload(dv, &dv->b_wsrc, &have, wsrc, k * nr * sizeof(int), d);
+    return upload(dv, &dv->b_went, &dv->sz_went, went, (size_t)woff[nr] * sizeof *went, d);
 #else
     (void)d;
     return PT_ERR_INTERNAL;
@@ -643,7 +681,6 @@ static void sum_bounces(const float *tally, size_t items, int nb, double *bounce
 }
 
 static int cancelled(volatile int *cancel) { return cancel && *cancel; }
-
 pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, const float *vis, int mode, int nb,
                           volatile int *cancel, float *edir, float *lout, float *phi, double *bounce_flux, int *done,
                           double times[2], diag *d)
@@ -660,8 +697,14 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
         err(d, "particle GI: %s", "the walk lists are shorter than the bounce count (gi_dev_set_walk)");
         return PT_ERR_INTERNAL;
     }
+    /* WALK: bounce 0 (gi_k_bounce), then bounces 1 .. nb - 1 and the
+     * radiance in one gi_k_walk; FULL (or nb 0): every bounce by
+     * gi_k_bounce, then gi_k_resolve */
+    int fused = walk && nb > 0;
+    int nbounce = fused ? 1 : nb;
     float w_fan = 1.0f / (float)ns2;
     size_t items = (nn + GI_BOUNCE_CHUNK - 1) / GI_BOUNCE_CHUNK;
+    size_t eitems = (nn + GI_EMIT_CHUNK - 1) / GI_EMIT_CHUNK;
     size_t tcount = (size_t)(nb > 0 ? nb : 1) * 3 * (items > 0 ? items : 1);
     if (tcount > dv->tally_cap) {
         free(dv->tally);
@@ -671,23 +714,30 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
     }
     if (!dv->is_cl) {
         if (cancelled(cancel)) return PT_OK;
-        gi_c_emit(dv->threads, dv->part, n, lights, nlights, vis, dv->edir, dv->src);
+        gi_c_emit(dv->threads, dv->part, n, lights, nlights, vis, dv->emits, dv->edir, dv->src, dv->mask_src);
         t1 = timer_now();
         const float *bin = dv->src;
-        for (int b = 0; b < nb; b++) {
+        const unsigned *min = dv->mask_src;
+        for (int b = 0; b < nbounce; b++) {
             if (cancelled(cancel)) return PT_OK;
-            int wb = walk && b > 0;
-            gi_c_bounce(dv->threads, n, wb ? dv->woff : dv->rin_off, wb ? (b - 1) * (n + 1) : 0,
-                        wb ? dv->wsrc : dv->rin_src, wb ? (b - 1) * n : 0, wb ? 1.0f : w_fan, bin, dv->rho4, b == 0,
-                        dv->bout, dv->total, dv->tally, b * 3 * (int)items);
+            gi_c_bounce(dv->threads, n, dv->rin_off, 0, dv->rin_src, 0, w_fan, bin, min, dv->rho4, b == 0, dv->bout,
+                        dv->mask_a, dv->total, dv->tally, b * 3 * (int)items);
             float *t = dv->bin;
             dv->bin = dv->bout;
             dv->bout = t;
             bin = dv->bin;
+            unsigned *tm = dv->mask_b;
+            dv->mask_b = dv->mask_a;
+            dv->mask_a = tm;
+            min = dv->mask_b;
         }
         if (cancelled(cancel)) return PT_OK;
         /* from here on the results are written: not cancelled any more */
-        gi_c_resolve(dv->threads, dv->part, n, dv->edir, nb > 0, dv->total, lout, phi);
+        if (fused)
+            gi_c_walk(dv->threads, dv->part, n, dv->edir, dv->total, min, dv->woff, dv->went, nb - 1, lout, phi,
+                      dv->tally, (int)items);
+        else
+            gi_c_resolve(dv->threads, dv->part, n, dv->edir, nb > 0, dv->total, lout, phi);
         memcpy(edir, dv->edir, nn * 4 * sizeof(float));
         sum_bounces(dv->tally, items, nb, bounce_flux);
         dv->lout_host = lout;
@@ -706,32 +756,42 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
         return st;
     if ((st = upload(dv, &dv->b_vis, &dv->sz_vis, vis, nn * (size_t)nlights * sizeof(float), d)) != PT_OK) return st;
     if ((st = ensure(dv, &dv->b_tally, &dv->sz_tally, tcount * sizeof(float), d)) != PT_OK) return st;
-    karg a[] = {KMEM(dv->b_part), KINT(n), KMEM(dv->b_lights), KINT(nlights), KMEM(dv->b_vis), KMEM(dv->b_edir),
-                KMEM(dv->b_src)};
-    if ((st = run_kernel(dv, KE_EMIT, nn, a, 7, d)) != PT_OK) return st;
+    karg a[] = {KMEM(dv->b_part), KINT(n),          KMEM(dv->b_lights), KINT(nlights),     KMEM(dv->b_vis),
+                KMEM(dv->b_emits), KMEM(dv->b_edir), KMEM(dv->b_src),    KMEM(dv->b_mask_src)};
+    if ((st = run_kernel(dv, KE_EMIT, eitems, a, 9, d)) != PT_OK) return st;
     t1 = timer_now();
-    cl_mem bin = dv->b_src;
-    for (int b = 0; b < nb; b++) {
+    cl_mem bin = dv->b_src, min = dv->b_mask_src;
+    for (int b = 0; b < nbounce; b++) {
         if (cancelled(cancel)) return PT_OK;
-        int wb = walk && b > 0;
-        int obase = wb ? (b - 1) * (n + 1) : 0, sbase = wb ? (b - 1) * n : 0, first = b == 0;
+        int obase = 0, sbase = 0, first = b == 0;
         int tbase = b * 3 * (int)items;
-        float w_in = wb ? 1.0f : w_fan;
-        cl_mem off = wb ? dv->b_woff : dv->b_rin_off, from = wb ? dv->b_wsrc : dv->b_rin_src;
-        karg k[] = {KINT(n),    KMEM(off),  KINT(obase),     KMEM(from),        KINT(sbase),      KF(w_in),    KMEM(bin),
-                    KMEM(dv->b_rho), KINT(first), KMEM(dv->b_bout), KMEM(dv->b_total), KMEM(dv->b_tally), KINT(tbase)};
-        if ((st = run_kernel_local(dv, KE_BOUNCE, items, GI_BOUNCE_LOCAL, k, 13, d)) != PT_OK) return st;
+        karg k[] = {KINT(n),         KMEM(dv->b_rin_off), KINT(obase),         KMEM(dv->b_rin_src), KINT(sbase),
+                    KF(w_fan),       KMEM(bin),           KMEM(min),           KMEM(dv->b_rho),     KINT(first),
+                    KMEM(dv->b_bout), KMEM(dv->b_mask_a), KMEM(dv->b_total),   KMEM(dv->b_tally),   KINT(tbase)};
+        if ((st = run_kernel_local(dv, KE_BOUNCE, items, GI_BOUNCE_LOCAL, k, 15, d)) != PT_OK) return st;
         cl_mem t = dv->b_bin;
         dv->b_bin = dv->b_bout;
         dv->b_bout = t;
         bin = dv->b_bin;
+        t = dv->b_mask_b;
+        dv->b_mask_b = dv->b_mask_a;
+        dv->b_mask_a = t;
+        min = dv->b_mask_b;
     }
     if (cancelled(cancel)) return PT_OK;
     /* from here on the results are written: not cancelled any more */
-    int scattered = nb > 0;
-    karg r[] = {KMEM(dv->b_part), KINT(n), KMEM(dv->b_edir), KINT(scattered), KMEM(dv->b_total), KMEM(dv->b_lout),
-                KMEM(dv->b_phi)};
-    if ((st = run_kernel(dv, KE_RESOLVE, nn, r, 7, d)) != PT_OK) return st;
+    if (fused) {
+        int nwalk = nb - 1, it = (int)items;
+        karg w[] = {KMEM(dv->b_part), KINT(n),           KMEM(dv->b_edir), KMEM(dv->b_total), KMEM(min),
+                    KMEM(dv->b_woff), KMEM(dv->b_went),  KINT(nwalk),      KMEM(dv->b_lout),  KMEM(dv->b_phi),
+                    KMEM(dv->b_tally), KINT(it)};
+        if ((st = run_kernel_local(dv, KE_WALK, items, GI_BOUNCE_LOCAL, w, 12, d)) != PT_OK) return st;
+    } else {
+        int scattered = nb > 0;
+        karg r[] = {KMEM(dv->b_part), KINT(n),          KMEM(dv->b_edir), KINT(scattered), KMEM(dv->b_total),
+                    KMEM(dv->b_lout), KMEM(dv->b_phi)};
+        if ((st = run_kernel(dv, KE_RESOLVE, nn, r, 7, d)) != PT_OK) return st;
+    }
     if ((st = download(dv, dv->b_lout, lout, f4, d)) != PT_OK) return st;
     if ((st = download(dv, dv->b_phi, phi, f4, d)) != PT_OK) return st;
     if ((st = download(dv, dv->b_edir, edir, f4, d)) != PT_OK) return st;

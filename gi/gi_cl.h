@@ -57,10 +57,10 @@ pt_status gi_dev_set_lists(gi_dev *dv, const int *list_off, int nrp, const int *
 /* Incoming scattering links (CSR by target, sources ascending): the first
  * bounce, and every bounce of the "full" mode. */
 pt_status gi_dev_set_reverse(gi_dev *dv, const int *rin_off, const int *rin_src, diag *d);
-/* The WALK mode's bounces 1..nwalk (gi_k_bounce): table b - 1 lists, per
- * target, the particles whose chosen link of bounce b ends there:
- * woff[(b-1)(n+1) + j .. + j + 1) indexes wsrc[(b-1) n + ...]. */
-pt_status gi_dev_set_walk(gi_dev *dv, const int *woff, const int *wsrc, int nwalk, diag *d);
+/* The WALK mode's bounces 1..nwalk (gi_k_walk): the path table, per target
+ * particle k the entries went[woff[k] .. woff[k + 1]) (origin j, bounce b,
+ * weight; sorted by b, then j), n + 1 offsets. */
+pt_status gi_dev_set_walk(gi_dev *dv, const int *woff, const gi_walk_entry *went, int nwalk, diag *d);
 
 /* Lighting stage (gi_lighting.cl): emission from the lights with vis
  * (n x nlights: attenuation times visibility fraction), nb scattering bounces (mode

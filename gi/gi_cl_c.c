@@ -28,13 +28,16 @@ typedef struct {
     const float *total;
     float *ftot, *tally;
     const int *off, *from;
-    int obase, sbase, first, tbase, scattered;
+    int obase, sbase, first, tbase, scattered, nwalk, items;
     float w_in;
     const float *rho4;
+    const unsigned *mask_in, *emits;
+    unsigned *mask_out;
+    const gi_walk_entry *went;
     size_t chunk;  /* work-items per pool job (0: GI_C_CHUNK) */
 } c_launch;
 
-enum { K_EMIT, K_BOUNCE, K_RESOLVE, K_GATHER, K_ESTIMATE };
+enum { K_EMIT, K_BOUNCE, K_WALK, K_RESOLVE, K_GATHER, K_ESTIMATE };
 
 static void run_chunk(void *ctx, int chunk, int thread)
 {
@@ -45,10 +48,16 @@ static void run_chunk(void *ctx, int chunk, int thread)
     for (size_t g = lo; g < hi; g++) {
         gi_shim_gid = g;
         switch (a->kernel) {
-        case K_EMIT: gi_k_emit(a->part, a->np, a->lights, a->nlights, a->vis, a->fout, a->fout2); break;
+        case K_EMIT:
+            gi_k_emit(a->part, a->np, a->lights, a->nlights, a->vis, a->emits, a->fout, a->fout2, a->mask_out);
+            break;
         case K_BOUNCE:
-            gi_k_bounce(a->np, a->off, a->obase, a->from, a->sbase, a->w_in, a->src, a->rho4, a->first, a->fout,
-                        a->ftot, a->tally, a->tbase);
+            gi_k_bounce(a->np, a->off, a->obase, a->from, a->sbase, a->w_in, a->src, a->mask_in, a->rho4, a->first,
+                        a->fout, a->mask_out, a->ftot, a->tally, a->tbase);
+            break;
+        case K_WALK:
+            gi_k_walk(a->part, a->np, a->edir, a->src, a->mask_in, a->off, a->went, a->nwalk, a->fout, a->fout2,
+                      a->tally, a->items);
             break;
         case K_RESOLVE: gi_k_resolve(a->part, a->np, a->edir, a->scattered, a->total, a->fout, a->fout2); break;
         case K_GATHER:
@@ -72,21 +81,35 @@ static void launch(int threads, c_launch *a)
 }
 
 void gi_c_emit(int threads, const gi_dev_particle *part, int n, const gi_dev_light *lights, int nlights,
-               const float *vis, float *edir, float *src)
+               const float *vis, const unsigned *emits, float *edir, float *src, unsigned *srcmask)
 {
-    c_launch a = {.kernel = K_EMIT, .n = (size_t)n, .part = part, .np = n, .lights = lights, .nlights = nlights,
-                  .vis = vis, .fout = edir, .fout2 = src};
+    /* one work-item per GI_EMIT_CHUNK particles, 16 work-items per pool job */
+    size_t items = ((size_t)n + GI_EMIT_CHUNK - 1) / GI_EMIT_CHUNK;
+    c_launch a = {.kernel = K_EMIT, .n = items, .part = part, .np = n, .lights = lights, .nlights = nlights,
+                  .vis = vis, .emits = emits, .fout = edir, .fout2 = src, .mask_out = srcmask, .chunk = 16};
     launch(threads, &a);
 }
 
 void gi_c_bounce(int threads, int n, const int *off, int obase, const int *from, int sbase, float w_in,
-                 const float *bin, const float *rho4, int first, float *bout, float *total, float *tally, int tbase)
+                 const float *bin, const unsigned *mask_in, const float *rho4, int first, float *bout,
+                 unsigned *mask_out, float *total, float *tally, int tbase)
 {
     /* one work-item per GI_BOUNCE_CHUNK particles, 4 work-items per pool job */
     size_t items = ((size_t)n + GI_BOUNCE_CHUNK - 1) / GI_BOUNCE_CHUNK;
     c_launch a = {.kernel = K_BOUNCE, .n = items, .np = n, .off = off, .obase = obase, .from = from, .sbase = sbase,
-                  .w_in = w_in, .src = bin, .rho4 = rho4, .first = first, .fout = bout, .ftot = total,
-                  .tally = tally, .tbase = tbase, .chunk = 4};
+                  .w_in = w_in, .src = bin, .mask_in = mask_in, .rho4 = rho4, .first = first, .fout = bout,
+                  .mask_out = mask_out, .ftot = total, .tally = tally, .tbase = tbase, .chunk = 4};
+    launch(threads, &a);
+}
+
+void gi_c_walk(int threads, const gi_dev_particle *part, int n, const float *edir, const float *recv0,
+               const unsigned *live, const int *woff, const gi_walk_entry *went, int nwalk, float *lout, float *phi,
+               float *tally, int items)
+{
+    size_t wi = ((size_t)n + GI_BOUNCE_CHUNK - 1) / GI_BOUNCE_CHUNK;
+    c_launch a = {.kernel = K_WALK, .n = wi, .part = part, .np = n, .edir = edir, .src = recv0, .mask_in = live,
+                  .off = woff, .went = went, .nwalk = nwalk, .fout = lout, .fout2 = phi, .tally = tally,
+                  .items = items, .chunk = 4};
     launch(threads, &a);
 }
 

@@ -8,12 +8,19 @@
 #define PT_GI_CL_C_H
 #include "kernels/gi_types.h"
 
+/* gi_k_emit: ceil(n / GI_EMIT_CHUNK) work-items, one srcmask word each. */
 void gi_c_emit(int threads, const gi_dev_particle *part, int n, const gi_dev_light *lights, int nlights,
-               const float *vis, float *edir, float *src);
+               const float *vis, const unsigned *emits, float *edir, float *src, unsigned *srcmask);
 /* gi_k_bounce: ceil(n / GI_BOUNCE_CHUNK) work-items; tally gets 3 floats
  * per work-item from tbase. */
 void gi_c_bounce(int threads, int n, const int *off, int obase, const int *from, int sbase, float w_in,
-                 const float *bin, const float *rho4, int first, float *bout, float *total, float *tally, int tbase);
+                 const float *bin, const unsigned *mask_in, const float *rho4, int first, float *bout,
+                 unsigned *mask_out, float *total, float *tally, int tbase);
+/* gi_k_walk: ceil(n / GI_BOUNCE_CHUNK) work-items (`items` of them: the
+ * tally's stride per bounce). */
+void gi_c_walk(int threads, const gi_dev_particle *part, int n, const float *edir, const float *recv0,
+               const unsigned *live, const int *woff, const gi_walk_entry *went, int nwalk, float *lout, float *phi,
+               float *tally, int items);
 void gi_c_resolve(int threads, const gi_dev_particle *part, int n, const float *edir, int scattered,
                   const float *total, float *lout, float *phi);
 void gi_c_gather(int threads, const int *glink, int ng, const float *lout, const int *used, int nused,

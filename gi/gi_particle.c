@@ -43,7 +43,8 @@ struct gi_particle {
     int ns2, ng;
     int *slink, *glink;
     int *rin_off, *rin_src; /* incoming scattering links (first bounce, FULL mode) */
-    int *woff, *wsrc;       /* WALK bounces' incoming lists (build_walk) */
+    int *woff;              /* WALK bounces' path table (build_walk): n + 1 offsets */
+    gi_walk_entry *went;    /* and its entries */
     int nwalk;
     gi_lists lists;
     gi_grid *rgrid; /* particles by list radius: estimates on surfaces without radiance particles */
@@ -138,7 +139,7 @@ static void update_bytes(gi_particle *gp)
     s->bytes_particles = n * (sizeof(gi_dev_particle) + 1) + n * 4 * sizeof(float) * 4 + n * 2 +
                          (size_t)gp->nlights * n * sizeof(float);
     s->bytes_links = n * (size_t)(2 * gp->ns2 + gp->ng) * sizeof(int) + (n + 2) * sizeof(int) +
-                     (size_t)gp->nwalk * (2 * n + 1) * sizeof(int);
+                     (gp->woff ? (n + 1) * sizeof(int) + (size_t)gp->woff[n] * sizeof(gi_walk_entry) : 0);
     s->bytes_lists = (nrp + 1) * sizeof(int) + (gp->lists.off ? (size_t)gp->lists.off[nrp] : 0) * sizeof(int) +
                      nrp * (4 * sizeof(float) + 2);
     s->bytes_surfaces = gp->surf ? gi_surface_bytes(gp->surf) : 0;
@@ -284,55 +285,95 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
     return st;
 }
 
-/* The WALK mode's bounces after the first (gi_k_bounce, the paper's
+/* The WALK mode's bounces after the first (gi_k_walk, the paper's
  * single-link random bounces): in bounce b (1 <= b <= nwalk) particle i
  * sends all it received along its scattering link c(i, b), drawn here once
  * with probability 1/ns2 each (a hash of the seed, i and b; links of -1
- * lose the flux, as a packet leaving the scene). Table b - 1 lists per
- * target the particles sending to it, sources ascending: woff (n + 1) and
- * wsrc (n) per bounce, 8 bytes per particle and bounce. Uploaded to the
- * device; kept until the bounce count grows (gi_particle_set_scattering). */
+ * lose the flux, as a packet leaving the scene). So what particle j
+ * received in bounce 0 follows a fixed path, P_0 = j, P_b = c(P_(b-1), b),
+ * and reaches P_b in bounce b times w_b = rho(P_0) rho(P_1) ... rho(P_(b-1))
+ * (per colour, float products in that order). The table lists per target k
+ * the entries (j, b, w_b) with P_b(j) = k, sorted by b, then j (a fixed
+ * summation order for gi_k_walk); a path ends at a -1 link or where w_b is
+ * 0 in every colour (it carries nothing on). 16 bytes per entry, at most n
+ * per bounce, plus n + 1 offsets. Uploaded to the device; kept until the
+ * bounce count grows (gi_particle_set_scattering): gi_k_walk stops at the
+ * bounce count it is given. */
 static pt_status build_walk(gi_particle *gp, int nwalk, diag *d)
 {
     if (nwalk < 0) nwalk = 0;
     if (gp->woff && nwalk <= gp->nwalk) return PT_OK;
     pt_status st = PT_OK;
     int n = gp->ps.n, k = gp->ns2;
-    size_t nn = (size_t)(n > 0 ? n : 0), nw = (size_t)nwalk;
-    int *woff = xcalloc(nw * (nn + 1), sizeof(int), &st);
-    int *wsrc = xcalloc(nw * nn, sizeof(int), &st);
-    int *tgt = xcalloc(nn, sizeof(int), &st);
-    int *cur = xcalloc(nn + 1, sizeof(int), &st);
+    if ((gi_u32)n > GI_WALK_MASK + 1u || nwalk > GI_MAX_BOUNCES - 1) {
+        src_loc nowhere = {0};
+        diag_report(d, DIAG_ERROR, nowhere, NULL,
+                    "particle GI: %d particles and %d random bounces are more than the walk table holds (%u, %d)", n,
+                    nwalk, GI_WALK_MASK + 1u, GI_MAX_BOUNCES - 1);
+        return PT_ERR_UNSUPPORTED;
+    }
+    size_t nn = (size_t)(n > 0 ? n : 0);
+    int *woff = xcalloc(nn + 1, sizeof(int), &st);
+    int *pos = xcalloc(nn, sizeof(int), &st);
+    float *w = xcalloc(nn * 3, sizeof(float), &st);
     if (st != PT_OK) {
         free(woff);
-        free(wsrc);
-        free(tgt);
-        free(cur);
+        free(pos);
+        free(w);
         return st;
     }
     gi_u32 seed = (gi_u32)(gp->set.seed * 2654435761u + 12345u);
-    for (int b = 1; b <= nwalk; b++) {
-        int *off = woff + (size_t)(b - 1) * (nn + 1), *src = wsrc + (size_t)(b - 1) * nn;
-        gi_u32 hb = gi_hash((gi_u32)b);
-        for (int i = 0; i < n; i++) {
-            gi_u32 h = gi_hash(seed ^ gi_hash((gi_u32)i ^ hb));
-            int t = gp->slink[(size_t)i * (size_t)k + (size_t)(h % (gi_u32)k)];
-            tgt[i] = t;
-            if (t >= 0) off[t + 1]++;
+    gi_walk_entry *went = NULL;
+    /* pass 0 counts the entries per target, pass 1 writes them (woff[t] is
+     * target t's write cursor there, shifted back to offsets after) */
+    for (int pass = 0; pass < 2 && st == PT_OK; pass++) {
+        for (int j = 0; j < n; j++) {
+            pos[j] = j;
+            w[3 * (size_t)j] = w[3 * (size_t)j + 1] = w[3 * (size_t)j + 2] = 1.0f;
         }
-        for (int j = 0; j < n; j++) off[j + 1] += off[j];
-        memcpy(cur, off, (nn + 1) * sizeof(int));
-        for (int i = 0; i < n; i++)
-            if (tgt[i] >= 0) src[cur[tgt[i]]++] = i;
+        for (int b = 1; b <= nwalk; b++) {
+            gi_u32 hb = gi_hash((gi_u32)b);
+            for (int j = 0; j < n; j++) {
+                int p = pos[j];
+                if (p < 0) continue;
+                gi_u32 h = gi_hash(seed ^ gi_hash((gi_u32)p ^ hb));
+                int t = gp->slink[(size_t)p * (size_t)k + (size_t)(h % (gi_u32)k)];
+                float *wj = &w[3 * (size_t)j];
+                for (int c = 0; c < 3; c++) wj[c] *= gp->ps.p[p].rho[c];
+                if (t < 0 || (wj[0] == 0.0f && wj[1] == 0.0f && wj[2] == 0.0f)) {
+                    pos[j] = -1;
+                    continue;
+                }
+                pos[j] = t;
+                if (pass == 0) {
+                    woff[t + 1]++;
+                } else {
+                    gi_walk_entry *e = &went[woff[t]++];
+                    e->jb = (gi_u32)j | (gi_u32)(b - 1) << GI_WALK_SHIFT;
+                    for (int c = 0; c < 3; c++) e->w[c] = wj[c];
+                }
+            }
+        }
+        if (pass == 0) {
+            for (int j = 0; j < n; j++) woff[j + 1] += woff[j];
+            went = xcalloc((size_t)woff[nn], sizeof *went, &st);
+        }
     }
-    free(tgt);
-    free(cur);
+    free(pos);
+    free(w);
+    if (st != PT_OK) {
+        free(woff);
+        free(went);
+        return st;
+    }
+    for (int j = n; j > 0; j--) woff[j] = woff[j - 1];
+    woff[0] = 0;
     free(gp->woff);
-    free(gp->wsrc);
+    free(gp->went);
     gp->woff = woff;
-    gp->wsrc = wsrc;
+    gp->went = went;
     gp->nwalk = nwalk;
-    return gi_dev_set_walk(gp->dev, gp->woff, gp->wsrc, gp->nwalk, d);
+    return gi_dev_set_walk(gp->dev, gp->woff, gp->went, gp->nwalk, d);
 }
 
 /* Catchment areas. A link ends on the area particle nearest its hit, so
@@ -634,7 +675,7 @@ void gi_particle_free(gi_particle *gp)
     free(gp->lout);
     free(gp->eind);
     free(gp->woff);
-    free(gp->wsrc);
+    free(gp->went);
     free(gp->e_state);
     free(gp->dev_gathered);
     free(gp->rp_val);

@@ -39,6 +39,22 @@ typedef double gi_wide; /* what pow returns */
 #define GI_MAX_BOUNCES 64
 #define GI_MAX_SCATTER 16
 #define GI_BOUNCE_CHUNK 64
+/* Particles per work-item of gi_k_emit: one 32-bit word of the source mask
+ * (bit i % 32 of word i / 32: particle i sends light in the first bounce). */
+#define GI_EMIT_CHUNK 32
+
+/* One entry of the WALK bounces' path table (gi_k_walk, built on the host
+ * from the per-particle link choices): the flux that origin particle j
+ * received in the first bounce reaches this entry's target particle in
+ * random bounce b (1 <= b <= 63) times w (per colour, the product of the
+ * reflectances along the path). jb = j | (b - 1) << GI_WALK_SHIFT, so j <
+ * 2^26. 16 bytes. */
+#define GI_WALK_SHIFT 26
+#define GI_WALK_MASK 0x3ffffffu
+typedef struct {
+    gi_u32 jb;
+    float w[3];
+} gi_walk_entry;
 
 /* One area particle (paper section 4.2.1: position p, normal n, area dA,
  * diffuse reflectance rho_d; the BRDF is rho_d/pi). `n` is the normal of the
