@@ -1643,6 +1643,19 @@ const scene_object *accel_rtc_object(const accel *a, unsigned geom, unsigned pri
     return NULL;
 }
 
+unsigned accel_rtc_ngeoms(const accel *a) { return a ? a->nginfo : 0; }
+
+long accel_rtc_triangles(const accel *a, unsigned geom, const float **v, const unsigned **idx)
+{
+    if (!a || geom >= a->nginfo || a->ginfo[geom].kind != GEOM_TRI) return 0;
+    RTCGeometry g = rtcGetGeometry(a->root, geom);
+    if (!g) return 0;
+    *v = rtcGetGeometryBufferData(g, RTC_BUFFER_TYPE_VERTEX, 0);
+    *idx = rtcGetGeometryBufferData(g, RTC_BUFFER_TYPE_INDEX, 0);
+    if (!*v || !*idx) return 0;
+    return (long)a->tri[a->ginfo[geom].idx].nt;
+}
+
 int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax)
 {
     if (!a || !ray_ok(org, dir)) return 0;

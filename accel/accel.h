@@ -107,6 +107,14 @@ void accel_rtc_link_scene_free(void *scene);
  * give it; NULL when the record alone does not tell (a member of a CSG) or
  * the ids are invalid. */
 const scene_object *accel_rtc_object(const accel *a, unsigned geom, unsigned prim, unsigned inst);
+/* Embree geometry ids run over [0, accel_rtc_ngeoms). For a geometry of
+ * world-space triangles (the ids rtcIntersect on accel_rtc_scene or
+ * accel_rtc_link_scene reports with an invalid instID), its triangle count,
+ * with *v its vertices (3 floats each) and *idx its vertex indices (3 per
+ * triangle; Embree's u, v of a hit weight vertices idx[1] and idx[2]);
+ * else 0 (user geometry, instances). The arrays live as long as `a`. */
+unsigned accel_rtc_ngeoms(const accel *a);
+long accel_rtc_triangles(const accel *a, unsigned geom, const float **v, const unsigned **idx);
 /* The smallest ray parameter queries accept (see the self-intersection rule). */
 double accel_epsilon(const accel *a, vec3 org, vec3 dir);
 

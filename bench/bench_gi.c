@@ -6,7 +6,7 @@
  *   bench_gi [SCENE.pov] [--size N] [--count N] [--nb N] [--threads N]
  *            [--device SPEC] [--reps N] [--out PREFIX] [--sweep] [--spp N] [--full]
  *            [--area-samples N] [--ref REF.exr] [--ref-spp N] [--per-hit]
- *            [--stride N]
+ *            [--stride N] [--grid-links]
  *
  * --full scatters along all links every bounce (GI_PARTICLE_SCATTER_FULL)
  * instead of the paper's random walks; --area-samples N caps the shadow rays
@@ -16,7 +16,9 @@
  * in x and y (prepass_stride; 0 the default). --no-keep: the render traces
  * its own camera rays (keep_hits 0, the coarse pre-pass); by default, at 1
  * spp, the pre-pass traces every pixel and the render takes its hits
- * (keep_hits, gi_particle_primary_hit).
+ * (keep_hits, gi_particle_primary_hit). --grid-links resolves every link hit
+ * with the 3D grid (link_lookup 1) instead of the hit triangle's list (the
+ * same links).
  * --spp N renders N stratified samples per pixel (shade.c fixed
  * supersampling) in both modes, for image comparisons against references.
  * --out PREFIX writes PREFIX_none.exr and PREFIX_particle.exr. --sweep runs
@@ -48,7 +50,7 @@
 
 typedef struct {
     const char *scene;
-    int size, threads, nb, reps, sweep, spp, full, area_samples, ref_spp, per_hit, stride, no_keep;
+    int size, threads, nb, reps, sweep, spp, full, area_samples, ref_spp, per_hit, stride, no_keep, grid_links;
     long count;
     const char *device, *out, *ref;
 } opts;
@@ -233,7 +235,7 @@ static long time_moves(gi_particle *gp, scene *sc, int nmove, int reps, double *
 
 int main(int argc, char **argv)
 {
-    opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 1, 0, -1, 0, 0, 0, 0, 50000, NULL, NULL, NULL};
+    opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 1, 0, -1, 0, 0, 0, 0, 0, 50000, NULL, NULL, NULL};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -251,6 +253,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--full")) o.full = 1;
         else if (!strcmp(a, "--per-hit")) o.per_hit = 1;
         else if (!strcmp(a, "--no-keep")) o.no_keep = 1;
+        else if (!strcmp(a, "--grid-links")) o.grid_links = 1;
         else if (!strcmp(a, "--stride") && v) { o.stride = atoi(v); i++; }
         else if (!strcmp(a, "--area-samples") && v) { o.area_samples = atoi(v); i++; }
         else if (a[0] != '-') o.scene = a;
@@ -295,6 +298,7 @@ int main(int argc, char **argv)
     if (o.full) s.scatter = GI_PARTICLE_SCATTER_FULL;
     if (o.area_samples >= 0) s.area_samples = o.area_samples;
     s.leak_per_hit = o.per_hit;
+    s.link_lookup = o.grid_links;
     s.prepass_stride = o.stride;
     s.keep_hits = !o.no_keep && o.spp <= 1;
     gi_particle_stats gs;
@@ -322,6 +326,10 @@ int main(int argc, char **argv)
            gs.link_rays, 100.0 * gs.link_misses / fmax(1, gs.link_rays), 100.0 * gs.link_unresolved / fmax(1, gs.link_rays),
            gs.radiance_particles, gs.radiance_slots, gs.list_entries, (double)gs.list_entries / fmax(1, gs.radiance_particles),
            gs.lists_widened, gs.lists_empty);
+    printf("  link hits by the hit triangle's list %ld (%.1f%% of the rays), left to the grid %ld; %ld lists, %ld "
+           "entries, %.1f MiB\n",
+           gs.link_tri, 100.0 * gs.link_tri / fmax(1, gs.link_rays), gs.link_tri_fallback, gs.trilook_lists,
+           gs.trilook_entries, gs.bytes_trilook / 1048576.0);
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
     printf("  memory %.1f MiB: particles %.1f, links %.1f, lists %.1f, surfaces %.1f, device %.1f; peak RSS %.1f MiB "

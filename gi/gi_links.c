@@ -40,13 +40,15 @@ typedef struct {
     int n, nside, k, per_job;
     uint64_t seed;
     const gi_lookup *grid;
+    const gi_trilook *tl;
     double maxdist;
     int *links;
     unsigned char *anyhit;
     struct RTCRayHit **buf; /* per thread */
     vec3 **hp;
     long **cell;
-    atomic_long misses, unresolved, other;
+    long **tcell; /* the hit's gi_trilook list, -1 none */
+    atomic_long misses, unresolved, other, tri_ok, tri_fb;
     const void *const *pobj;
     const unsigned char *pin;
     double off, scale;
@@ -87,7 +89,7 @@ static inline void direction_f(const float t[3], const float b[3], const float n
     for (int k = 0; k < 3; k++) out[k] = t[k] * x + b[k] * y + nrm[k] * z;
 }
 
-#define AGREE 0.3
+#define AGREE GI_LINKS_AGREE
 
 /* Particle t moved a little along its normal, inside solid o? */
 static int inside_lifted(const scene_object *o, const gi_dev_particle *t)
@@ -103,7 +105,7 @@ static void job(void *ctx, int index, int thread)
     struct RTCRayHit *rh = J->buf[thread];
     int i0 = index * J->per_job, i1 = i0 + J->per_job < J->n ? i0 + J->per_job : J->n;
     int m = 0;
-    long miss = 0, unres = 0, other = 0;
+    long miss = 0, unres = 0, other = 0, tri_ok = 0, tri_fb = 0;
     for (int i = i0; i < i1; i++) {
         const gi_dev_particle *pt = &J->p[i];
         vec3 pos = v3(pt->p[0], pt->p[1], pt->p[2]);
@@ -155,14 +157,30 @@ static void job(void *ctx, int index, int thread)
     /* hit points and their lookup cells; the lookups are bound by memory
      * latency, so the whole batch prefetches first (gi_particles.h) */
     vec3 *hp = J->hp[thread];
-    long *cell = J->cell[thread];
+    long *cell = J->cell[thread], *tcell = J->tcell[thread];
+    /* hits on a triangle gi_trilook lists take its list (cell -3: no grid
+     * cell, unless the list cannot decide) */
+    const gi_trilook *tl = J->tl && J->grid && J->links && J->pobj ? J->tl : NULL;
     for (int t = 0; t < m; t++) {
         const struct RTCRayHit *h = &rh[t];
         int hit = h->hit.geomID != RTC_INVALID_GEOMETRY_ID && isfinite(h->ray.tfar);
         hp[t] = v3(h->ray.org_x + h->ray.tfar * h->ray.dir_x, h->ray.org_y + h->ray.tfar * h->ray.dir_y,
                    h->ray.org_z + h->ray.tfar * h->ray.dir_z);
         cell[t] = hit ? -1 : -2;
+        tcell[t] = -1;
+        if (hit && tl && h->hit.instID[0] == RTC_INVALID_GEOMETRY_ID) {
+            const float d[3] = {h->ray.dir_x, h->ray.dir_y, h->ray.dir_z};
+            tcell[t] = gi_trilook_cell(tl, h->hit.geomID, h->hit.primID, h->hit.u, h->hit.v, d);
+            if (tcell[t] >= 0) {
+                cell[t] = -3;
+                gi_trilook_prefetch(tl, tcell[t], 0);
+            }
+        }
     }
+    if (tl)
+        for (int st = 1; st <= 2; st++)
+            for (int t = 0; t < m; t++)
+                if (tcell[t] >= 0) gi_trilook_prefetch(tl, tcell[t], st);
     if (J->grid && J->links) gi_lookup_cells(J->grid, m, hp, cell);
     m = 0;
     const void *last_obj = NULL;
@@ -182,7 +200,10 @@ static void job(void *ctx, int index, int thread)
              * object, and the lookup would first search to maxdist for one
              * (10 blobs without particles, 20K particles: gather links
              * 11.7 -> 6.6 s). Same links, without the search. */
-            const void *hobj = hit && J->grid && J->pobj
+            /* (a hit on a triangle the lists cover is on an object with
+             * particles: its object is needed only if the list leaves the
+             * hit to the grid) */
+            const void *hobj = hit && J->grid && J->pobj && cell[m] != -3
                                    ? accel_rtc_object(J->a, rh[m].hit.geomID, rh[m].hit.primID, rh[m].hit.instID[0])
                                    : NULL;
             /* consecutive hits are often on one object: its id once */
@@ -198,9 +219,26 @@ static void job(void *ctx, int index, int thread)
                 vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
                 vec3 o = v3(h->ray.org_x, h->ray.org_y, h->ray.org_z);
                 float tn[3];
-                int tobj;
-                target = gi_lookup_nearest_in2(J->grid, cell[m], hp[m], d, o, J->maxdist, tn, &tobj);
-                if (target >= 0 && J->pobj) {
+                int tobj, fast = 0;
+                if (cell[m] == -3) {
+                    /* the hit triangle's list: the nearest particle on the
+                     * object and side hit (gi_trilook.h), or -2 */
+                    const float qf[3] = {(float)hp[m].x, (float)hp[m].y, (float)hp[m].z};
+                    const float df[3] = {h->ray.dir_x, h->ray.dir_y, h->ray.dir_z};
+                    const float of[3] = {h->ray.org_x, h->ray.org_y, h->ray.org_z};
+                    target = gi_trilook_nearest(tl, tcell[m], qf, df, of);
+                    if (target >= -1) {
+                        fast = 1;
+                        tri_ok++;
+                    } else {
+                        tri_fb++;
+                        cell[m] = gi_lookup_cell(J->grid, hp[m]);
+                        hobj = accel_rtc_object(J->a, h->hit.geomID, h->hit.primID, h->hit.instID[0]);
+                        hid = gi_lookup_object_id(J->grid, hobj);
+                    }
+                }
+                if (!fast) target = gi_lookup_nearest_in2(J->grid, cell[m], hp[m], d, o, J->maxdist, tn, &tobj);
+                if (!fast && target >= 0 && J->pobj) {
                     /* the answer must lie on the object hit: near a contact
                      * (a sphere on the floor) or where a box stands on the
                      * floor the nearest particle can be another object's,
@@ -281,11 +319,14 @@ static void job(void *ctx, int index, int thread)
     atomic_fetch_add(&J->misses, miss);
     atomic_fetch_add(&J->unresolved, unres);
     atomic_fetch_add(&J->other, other);
+    atomic_fetch_add(&J->tri_ok, tri_ok);
+    atomic_fetch_add(&J->tri_fb, tri_fb);
 }
 
-pt_status gi_links_build(const accel *a, const gi_dev_particle *p, const void *const *pobj,
+pt_status gi_links_build(const accel *a, void *scene, const gi_dev_particle *p, const void *const *pobj,
                          const unsigned char *pin, int n, int nside, uint64_t seed, const gi_lookup *grid,
-                         double maxdist, int threads, int *links, unsigned char *anyhit, gi_link_stats *st)
+                         const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
+                         gi_link_stats *st)
 {
     if (threads <= 0) threads = pool_default_threads();
     link_job J;
@@ -294,8 +335,8 @@ pt_status gi_links_build(const accel *a, const gi_dev_particle *p, const void *c
     /* the link scene (accel.h): on cbox, 50K particles, it saves 13% of
      * the link building's instructions (callgrind, 10K particles: 2304 ->
      * 2014 a link ray); the main scene is the fallback */
-    void *lscene = accel_rtc_link_scene(a);
-    J.scene = lscene ? (RTCScene)lscene : (RTCScene)accel_rtc_scene(a);
+    void *lscene = scene ? NULL : accel_rtc_link_scene(a);
+    J.scene = scene ? (RTCScene)scene : lscene ? (RTCScene)lscene : (RTCScene)accel_rtc_scene(a);
     J.p = p;
     J.pobj = pobj;
     J.pin = pobj ? pin : NULL;
@@ -337,6 +378,7 @@ pt_status gi_links_build(const accel *a, const gi_dev_particle *p, const void *c
     J.per_job = J.k >= RAYS_PER_CALL ? 1 : RAYS_PER_CALL / J.k;
     J.seed = seed;
     J.grid = grid;
+    J.tl = tl;
     J.maxdist = maxdist;
     J.links = links;
     J.anyhit = anyhit;
@@ -345,28 +387,34 @@ pt_status gi_links_build(const accel *a, const gi_dev_particle *p, const void *c
     atomic_init(&J.misses, 0);
     atomic_init(&J.unresolved, 0);
     atomic_init(&J.other, 0);
+    atomic_init(&J.tri_ok, 0);
+    atomic_init(&J.tri_fb, 0);
     J.buf = calloc((size_t)threads, sizeof *J.buf);
     J.hp = calloc((size_t)threads, sizeof *J.hp);
     J.cell = calloc((size_t)threads, sizeof *J.cell);
+    J.tcell = calloc((size_t)threads, sizeof *J.tcell);
     pt_status rc = PT_OK;
-    if (!J.buf || !J.hp || !J.cell) rc = PT_ERR_NOMEM;
+    if (!J.buf || !J.hp || !J.cell || !J.tcell) rc = PT_ERR_NOMEM;
     size_t rays = (size_t)J.per_job * (size_t)J.k;
     size_t bytes = rays * sizeof(struct RTCRayHit);
     for (int t = 0; rc == PT_OK && t < threads; t++) {
         J.buf[t] = aligned_alloc(64, (bytes + 63) / 64 * 64);
         J.hp[t] = malloc(rays * sizeof(vec3));
         J.cell[t] = malloc(rays * sizeof(long));
-        if (!J.buf[t] || !J.hp[t] || !J.cell[t]) rc = PT_ERR_NOMEM;
+        J.tcell[t] = malloc(rays * sizeof(long));
+        if (!J.buf[t] || !J.hp[t] || !J.cell[t] || !J.tcell[t]) rc = PT_ERR_NOMEM;
     }
     if (rc == PT_OK && n > 0) pool_run(threads, (n + J.per_job - 1) / J.per_job, job, &J);
     for (int t = 0; t < threads; t++) {
         if (J.buf) free(J.buf[t]);
         if (J.hp) free(J.hp[t]);
         if (J.cell) free(J.cell[t]);
+        if (J.tcell) free(J.tcell[t]);
     }
     free(J.buf);
     free(J.hp);
     free(J.cell);
+    free(J.tcell);
     free(J.order);
     free(J.su0);
     free(J.sv0);
@@ -376,6 +424,8 @@ pt_status gi_links_build(const accel *a, const gi_dev_particle *p, const void *c
         st->misses += atomic_load(&J.misses);
         st->unresolved += atomic_load(&J.unresolved);
         st->other_object += atomic_load(&J.other);
+        st->tri_answered += atomic_load(&J.tri_ok);
+        st->tri_fallback += atomic_load(&J.tri_fb);
     }
     return rc;
 }

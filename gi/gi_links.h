@@ -11,12 +11,15 @@
 #include "accel.h"
 #include "gi_particles.h"
 #include "gi_surface.h"
+#include "gi_trilook.h"
 
 typedef struct {
     long rays;       /* traced */
     long misses;     /* left the scene */
     long unresolved; /* hit, but no particle near the hit on that side */
     long other_object; /* the nearest particle lay on another object than the one hit: searched again */
+    long tri_answered; /* hits answered by the hit triangle's list (gi_trilook) */
+    long tri_fallback; /* hits on a listed triangle that the list could not decide (grid path) */
 } gi_link_stats;
 
 /* links: n * nside^2 ints (may be NULL when only anyhit is wanted);
@@ -29,10 +32,17 @@ typedef struct {
  * particles on the inside of a closed sphere or box (their links end
  * inside it), [n, 2n) 1 for particles buried in another closed sphere or
  * box (the floor under a box standing on it: only rays from inside that
- * solid end on them). */
-pt_status gi_links_build(const accel *a, const gi_dev_particle *p, const void *const *pobj,
+ * solid end on them). tl (may be NULL; needs grid and pobj, built with
+ * the same particles, pobj, pin + n as buried flags, GI_LINKS_AGREE and
+ * maxdist): hits on its triangles take its answer when it has one (the
+ * same answer, gi_trilook.h), else the grid path. scene (may be NULL):
+ * the RTCScene to trace (accel_rtc_link_scene's, built once by the
+ * caller); NULL: the link scene is built and freed here. */
+#define GI_LINKS_AGREE 0.3
+pt_status gi_links_build(const accel *a, void *scene, const gi_dev_particle *p, const void *const *pobj,
                          const unsigned char *pin, int n, int nside, uint64_t seed, const gi_lookup *grid,
-                         double maxdist, int threads, int *links, unsigned char *anyhit, gi_link_stats *st);
+                         const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
+                         gi_link_stats *st);
 
 /* Direction j of the n x n stratified cosine-weighted set around unit
  * normal nrm, from uniform numbers (u1, u2) in [0,1): Malley's method on

@@ -42,6 +42,8 @@ struct gi_particle {
     gi_particles ps;
     int ns2, ng;
     int *slink, *glink;
+    void *lscene;   /* accel_rtc_link_scene, for the three link passes (freed after them) */
+    gi_trilook *tl; /* the 4x4 pass's lookup by hit triangle, compacted for the 16x16 pass */
     int *rin_off, *rin_src; /* incoming scattering links (first bounce, FULL mode) */
     int *woff;              /* WALK bounces' path table (build_walk): n + 1 offsets */
     gi_walk_entry *went;    /* and its entries */
@@ -240,8 +242,10 @@ static const void **particle_objects(const gi_particle *gp, const gi_particles *
     return o;
 }
 
+/* use_tl: build gp->tl for these particles (kept, compacted, for the
+ * gathering links); the pilot's particles take the grid path. */
 static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t seed, int **links_out,
-                                 gi_link_stats *ls)
+                                 gi_link_stats *ls, int use_tl)
 {
     pt_status st = PT_OK;
     int n = ps->n, k = gp->ns2;
@@ -255,9 +259,15 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
     const void **pobj = particle_objects(gp, ps, &pin, &st);
     if (!grid) st = PT_ERR_NOMEM;
     if (st == PT_OK) st = gi_lookup_set_objects(grid, (const void *const *)pobj);
+    if (st == PT_OK && !gp->lscene) gp->lscene = accel_rtc_link_scene(gp->a);
+    gi_trilook_free(gp->tl);
+    gp->tl = NULL;
+    if (st == PT_OK && use_tl && gp->set.link_lookup == 0)
+        gp->tl = gi_trilook_build(gp->a, ps->p, n, (const void *const *)pobj, pin + n, ps->spacing, GI_LINKS_AGREE,
+                                  3.0 * ps->spacing, gp->threads, &st);
     if (st == PT_OK)
-        st = gi_links_build(gp->a, ps->p, pobj, pin, n, gp->set.scatter_side, seed, grid, 3.0 * ps->spacing, gp->threads,
-                            links, keep, ls);
+        st = gi_links_build(gp->a, gp->lscene, ps->p, pobj, pin, n, gp->set.scatter_side, seed, grid, gp->tl,
+                            3.0 * ps->spacing, gp->threads, links, keep, ls);
     gi_lookup_free(grid);
     free(pobj);
     free(pin);
@@ -274,6 +284,7 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
             }
         }
         st = gi_particles_compact(ps, keep);
+        gi_trilook_compact(gp->tl, remap, ps->p, ps->n);
     }
     free(keep);
     free(remap);
@@ -495,7 +506,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         long pc = set->count / 4 > 500 ? set->count / 4 : 500;
         st = gi_particles_sample(&pilot, gp->surf, a, sc, pc, set->seed ^ 0x9170ULL, gp->ambient_emits, NULL, NULL, d);
         int *pl = NULL;
-        if (st == PT_OK) st = trace_and_prune(gp, &pilot, set->seed ^ 0x5eedULL, &pl, NULL);
+        if (st == PT_OK) st = trace_and_prune(gp, &pilot, set->seed ^ 0x5eedULL, &pl, NULL, 0);
         free(pl);
         if (st == PT_OK) {
             /* pilot.patch/side now list the survivors; count them per side */
@@ -550,7 +561,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         gi_link_stats ls = {0};
         tg = timer_now();
         cg = cpu_now();
-        st = trace_and_prune(gp, &gp->ps, set->seed ^ 0x51ULL, &gp->slink, &ls);
+        st = trace_and_prune(gp, &gp->ps, set->seed ^ 0x51ULL, &gp->slink, &ls, 1);
         S->t_scatter_links = timer_now() - tg;
         S->c_scatter_links = cpu_now() - cg;
         if (st != PT_OK) goto fail;
@@ -566,14 +577,23 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         tg = timer_now();
         cg = cpu_now();
         if (st == PT_OK)
-            st = gi_links_build(a, gp->ps.p, pobj, pin, n, set->gather_side, set->seed ^ 0x6a7ULL, grid, 3.0 * spacing,
-                                gp->threads, gp->glink, NULL, &ls);
+            st = gi_links_build(a, gp->lscene, gp->ps.p, pobj, pin, n, set->gather_side, set->seed ^ 0x6a7ULL, grid,
+                                gp->tl, 3.0 * spacing, gp->threads, gp->glink, NULL, &ls);
         S->t_gather_links = timer_now() - tg;
         S->c_gather_links = cpu_now() - cg;
         gi_lookup_free(grid);
         free(pobj);
         free(pin);
+        S->bytes_trilook = gi_trilook_bytes(gp->tl);
+        S->trilook_entries = gi_trilook_entries(gp->tl);
+        S->trilook_lists = gi_trilook_cells(gp->tl);
+        gi_trilook_free(gp->tl);
+        gp->tl = NULL;
+        accel_rtc_link_scene_free(gp->lscene);
+        gp->lscene = NULL;
         if (st != PT_OK) goto fail;
+        S->link_tri = ls.tri_answered;
+        S->link_tri_fallback = ls.tri_fallback;
         S->link_rays = ls.rays;
         S->link_misses = ls.misses;
         S->link_unresolved = ls.unresolved;
@@ -656,6 +676,8 @@ void gi_particle_free(gi_particle *gp)
 {
     if (!gp) return;
     gi_dev_free(gp->dev);
+    gi_trilook_free(gp->tl);
+    accel_rtc_link_scene_free(gp->lscene);
     gi_surface_free(gp->surf);
     gi_particles_free(&gp->ps);
     gi_lists_free(&gp->lists);
@@ -1805,6 +1827,15 @@ int gi_particle_debug(const gi_particle *gp, const float **edir, const float **p
     if (lout) *lout = gp->lout;
     if (bounce_flux) *bounce_flux = gp->bounce_flux;
     if (nbounces) *nbounces = gp->nbounce_flux;
+    return gp->ps.n;
+}
+
+int gi_particle_debug_links(const gi_particle *gp, const int **slink, int *ns2, const int **glink, int *ng)
+{
+    if (slink) *slink = gp->slink;
+    if (ns2) *ns2 = gp->ns2;
+    if (glink) *glink = gp->glink;
+    if (ng) *ng = gp->ng;
     return gp->ps.n;
 }
 

@@ -119,6 +119,9 @@ typedef struct {
     int nominal_areas;   /* 1: every area particle keeps the nominal dA = A/N (before 22 Nov 2026: reads
                             ~1% bright, see gi_particle.c catchment_areas); 0 (default): each particle's
                             area is its catchment, estimated from the gathering links that end on it */
+    int link_lookup;     /* the link builder's nearest-particle lookup: 0 (default) by the hit triangle
+                            (gi_trilook.h) where it decides, else the 3D grid; 1: the 3D grid only
+                            (the same links; tests compare the two) */
     int leak_per_hit;    /* 1: the light-leak guard tests every hit's 3 radiance particles; 0 (default):
                             once per interpolation cell, hits in clear cells skip it (gi_particle.c
                             cell_clear) */
@@ -148,6 +151,9 @@ typedef struct {
     long radiance_particles, list_entries, lists_widened, lists_empty;
     long radiance_slots;    /* radiance particles before patches shared them (gi_surface_rp_slots) */
     long link_rays, link_misses, link_unresolved;
+    long link_tri, link_tri_fallback; /* link hits answered by the hit triangle's list, and those it left to the grid */
+    long trilook_lists, trilook_entries; /* its lists (2 per triangle cell) and their particles (4x4 pass; fewer after pruning) */
+    size_t bytes_trilook;   /* its memory (freed after the link passes, not in bytes_total) */
     long sources;           /* particles that emit or reflect direct light */
     long shadow_rays;
     long prepass_rays, found, used;  /* last prepare_view: new radiance / area particles */
@@ -226,6 +232,8 @@ void gi_particle_free(gi_particle *gp);
  * last scattering (grey sums, fixed point converted to flux). */
 int gi_particle_debug(const gi_particle *gp, const float **edir, const float **phi, const float **lout,
                       const double **bounce_flux, int *nbounces);
+/* The scattering (n x ns2) and gathering (n x ng) links, n returned (tests). */
+int gi_particle_debug_links(const gi_particle *gp, const int **slink, int *ns2, const int **glink, int *ng);
 /* Area, reflectance and position of particle i (tests). */
 void gi_particle_debug_particle(const gi_particle *gp, int i, double *area, double rho[3], vec3 *pos, vec3 *nrm);
 

@@ -1,0 +1,869 @@
+/* gi_trilook.c - nearest area particle by the hit triangle (see gi_trilook.h). */
+#include "gi_trilook.h"
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include "pool.h"
+
+/* a cell's edge is at most CELL_FAC particle spacings (k = ceil(longest
+ * edge / (CELL_FAC spacing)), at most MAX_K). cbox, 50K particles (CPU of
+ * the 4x4 pass with the build / the 16x16 pass, s): 0.7: 0.90 / 4.04,
+ * 1.0: 0.71 / 4.26, 1.4: 0.66 / 4.43 (one run each, load 6) */
+#define CELL_FAC 1.0
+#define MAX_K 64
+/* particles whose n . N lies within AGREE_SLACK of the threshold are
+ * "uncertain" (gi_links compares Embree's Ng, not this N) */
+#define AGREE_SLACK 1e-3
+/* relative widening of the list radius and narrowing of the certificate */
+#define REL 1e-4
+#define UNCERTAIN 0x80000000u
+
+/* a particle as the scan reads it (32 bytes, two 16-byte loads; the
+ * lists hold indices; one more at infinity pads the scan's last lanes) */
+typedef struct {
+    float x, y, z, nx, ny, nz, pad[2];
+} tl_pp;
+
+typedef struct {
+    float n[3]; /* unit normal (v1 - v0) x (v2 - v0) */
+    int k;      /* cells per edge; 0: not covered */
+    long cell0; /* first cell (2 lists each) */
+} tl_tri;
+
+/* A list in e[]: a header word (entry count | COMPLETE: the list holds
+ * every particle of the side within maxdist, so no answer means none),
+ * the certificate (float bits: an answer at squared distance <= it is
+ * exact), then its entries (particle | UNCERTAIN), ascending. */
+#define COMPLETE 0x80000000u
+/* shared headers of empty lists */
+#define EMPTY_COMPLETE 0u
+#define EMPTY_OPEN 2u
+#define SHARED_WORDS 4u
+/* during the build: an offset into the list's chunk */
+#define LOCAL 0x80000000u
+
+struct gi_trilook {
+    unsigned ngeom;
+    tl_tri **tri; /* per geometry (NULL: none) */
+    long *ntri;
+    unsigned *loff; /* per list: its offset in e; 2 per cell: side 0 (+N), side 1 (-N) */
+    long ncell;     /* lists */
+    unsigned *e;
+    long ne;
+    long entries;
+    tl_pp *pp; /* the particles */
+    int n;
+    float start2; /* scan radius squared: maxdist (1 + REL), squared */
+};
+
+/* ------------------------------------------------------------------ build */
+
+typedef struct {
+    double h, inv;
+    double o[3];
+    long dim[3];
+    int *start; /* ncells + 1 */
+    int *ord;   /* particles by cell */
+} bgrid;
+
+static void bgrid_free(bgrid *g)
+{
+    free(g->start);
+    free(g->ord);
+}
+
+static int bgrid_build(bgrid *g, const gi_dev_particle *p, int n, double h)
+{
+    memset(g, 0, sizeof *g);
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], p[i].p[k]);
+            hi[k] = fmax(hi[k], p[i].p[k]);
+        }
+    if (!(h > 0.0)) h = 1.0;
+    for (;;) {
+        double cells = 1.0;
+        for (int k = 0; k < 3; k++) cells *= floor((hi[k] - lo[k]) / h) + 1.0;
+        if (cells <= 4.0 * n + 4096.0) break;
+        h *= 1.25;
+    }
+    g->h = h;
+    g->inv = 1.0 / h;
+    for (int k = 0; k < 3; k++) {
+        g->o[k] = lo[k];
+        g->dim[k] = (long)floor((hi[k] - lo[k]) / h) + 1;
+    }
+    long nc = g->dim[0] * g->dim[1] * g->dim[2];
+    g->start = calloc((size_t)nc + 2, sizeof *g->start);
+    g->ord = malloc((size_t)(n > 0 ? n : 1) * sizeof *g->ord);
+    long *key = malloc((size_t)(n > 0 ? n : 1) * sizeof *key);
+    if (!g->start || !g->ord || !key) {
+        free(key);
+        bgrid_free(g);
+        return 0;
+    }
+    for (int i = 0; i < n; i++) {
+        long c[3];
+        for (int k = 0; k < 3; k++) {
+            long ci = (long)((p[i].p[k] - g->o[k]) * g->inv);
+            c[k] = ci < 0 ? 0 : (ci >= g->dim[k] ? g->dim[k] - 1 : ci);
+        }
+        key[i] = (c[2] * g->dim[1] + c[1]) * g->dim[0] + c[0];
+        g->start[key[i] + 2]++;
+    }
+    for (long c = 0; c <= nc; c++) g->start[c + 1] += g->start[c];
+    for (int i = 0; i < n; i++) g->ord[g->start[key[i] + 1]++] = i; /* ascending within a cell */
+    free(key);
+    return 1;
+}
+
+/* squared distance from point x to triangle (a, b, c): the closest point
+ * by the Voronoi regions of the vertices, edges and face (the region tests
+ * of Ericson, Real-Time Collision Detection, 2005, section 5.1.5) */
+static double dist2_tri(const double x[3], const double a[3], const double b[3], const double c[3])
+{
+    double ab[3], ac[3], ax[3];
+    for (int k = 0; k < 3; k++) {
+        ab[k] = b[k] - a[k];
+        ac[k] = c[k] - a[k];
+        ax[k] = x[k] - a[k];
+    }
+#define DOT(u, v) ((u)[0] * (v)[0] + (u)[1] * (v)[1] + (u)[2] * (v)[2])
+    double d1 = DOT(ab, ax), d2 = DOT(ac, ax);
+    double s, t; /* closest = a + s ab + t ac */
+    if (d1 <= 0.0 && d2 <= 0.0) {
+        s = 0.0, t = 0.0;
+    } else {
+        double bx[3], cx[3];
+        for (int k = 0; k < 3; k++) {
+            bx[k] = x[k] - b[k];
+            cx[k] = x[k] - c[k];
+        }
+        double d3 = DOT(ab, bx), d4 = DOT(ac, bx), d5 = DOT(ab, cx), d6 = DOT(ac, cx);
+        double vc = d1 * d4 - d3 * d2, vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
+        if (d3 >= 0.0 && d4 <= d3) {
+            s = 1.0, t = 0.0;
+        } else if (d6 >= 0.0 && d5 <= d6) {
+            s = 0.0, t = 1.0;
+        } else if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+            s = d1 / (d1 - d3), t = 0.0;
+        } else if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+            s = 0.0, t = d2 / (d2 - d6);
+        } else if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+            double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+            s = 1.0 - w, t = w;
+        } else {
+            double den = 1.0 / (va + vb + vc);
+            s = vb * den, t = vc * den;
+        }
+    }
+#undef DOT
+    double r2 = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double e = a[k] + s * ab[k] + t * ac[k] - x[k];
+        r2 += e * e;
+    }
+    return r2;
+}
+
+typedef struct {
+    unsigned geom;
+    const float *v;
+    const unsigned *idx;
+} tl_geo;
+
+typedef struct {
+    gi_trilook *t;
+    const gi_dev_particle *p;
+    const int *pobjid; /* object id of each particle */
+    const unsigned char *buried;
+    const tl_geo *geo;
+    const long *gbase; /* first flattened triangle of each geometry */
+    const int *tobj;   /* object id of each flattened triangle */
+    unsigned ngeo;
+    long ntris;
+    int chunks;
+    bgrid g;
+    double spacing, agree, maxdist, delta;
+    /* per chunk output */
+    unsigned **ce;
+    long *cne, *ccap;
+    int *fail;
+} tl_build;
+
+/* candidates of one triangle: particles of its object with a normal on
+ * either side of the agreement threshold's slack (each list is sorted by
+ * index when written) */
+typedef struct {
+    int *ix;
+    float *px; /* position, 3 each */
+    signed char *side; /* 0 (+N) or 1 (-N) */
+    unsigned char *unc;
+    long n, cap;
+    double *cd; /* per cell: max distance to the cell's corners */
+    double *pc; /* per cell: distance to the cell's centre */
+} tl_scratch;
+
+static int scratch_grow(tl_scratch *s, long need)
+{
+    if (need <= s->cap) return 1;
+    long nc = s->cap ? s->cap : 256;
+    while (nc < need) nc *= 2;
+    int *ix = realloc(s->ix, (size_t)nc * sizeof *ix);
+    if (!ix) return 0;
+    s->ix = ix;
+    float *px = realloc(s->px, (size_t)nc * 3 * sizeof *px);
+    if (!px) return 0;
+    s->px = px;
+    signed char *sd = realloc(s->side, (size_t)nc);
+    if (!sd) return 0;
+    s->side = sd;
+    unsigned char *u = realloc(s->unc, (size_t)nc);
+    if (!u) return 0;
+    s->unc = u;
+    double *cd = realloc(s->cd, (size_t)nc * sizeof *cd);
+    if (!cd) return 0;
+    s->cd = cd;
+    double *pc = realloc(s->pc, (size_t)nc * sizeof *pc);
+    if (!pc) return 0;
+    s->pc = pc;
+    s->cap = nc;
+    return 1;
+}
+
+/* particles of object oid within r of centre c */
+static int gather(const tl_build *B, tl_scratch *s, int oid, const double c[3], double r, const double nrm[3])
+{
+    const bgrid *g = &B->g;
+    long lo[3], hi[3];
+    for (int k = 0; k < 3; k++) {
+        double a = (c[k] - r - g->o[k]) * g->inv, b = (c[k] + r - g->o[k]) * g->inv;
+        lo[k] = a < 0.0 ? 0 : (long)a;
+        hi[k] = b < 0.0 ? -1 : (b >= (double)(g->dim[k] - 1) ? g->dim[k] - 1 : (long)b);
+    }
+    s->n = 0;
+    double r2 = r * r;
+    for (long z = lo[2]; z <= hi[2]; z++)
+        for (long y = lo[1]; y <= hi[1]; y++) {
+            long row = (z * g->dim[1] + y) * g->dim[0];
+            for (int e = g->start[row + lo[0]]; e < g->start[row + hi[0] + 1]; e++) {
+                int i = g->ord[e];
+                if (B->pobjid[i] != oid) continue;
+                const float *pp = B->p[i].p;
+                double dd = 0.0;
+                for (int k = 0; k < 3; k++) dd += (pp[k] - c[k]) * (pp[k] - c[k]);
+                if (dd > r2) continue;
+                if (!scratch_grow(s, s->n + 1)) return 0;
+                s->ix[s->n++] = i;
+            }
+        }
+    double lo_ag = B->agree - AGREE_SLACK, hi_ag = B->agree + AGREE_SLACK;
+    long m = 0;
+    for (long a = 0; a < s->n; a++) {
+        int i = s->ix[a];
+        const gi_dev_particle *p = &B->p[i];
+        double ag = p->n[0] * nrm[0] + p->n[1] * nrm[1] + p->n[2] * nrm[2];
+        int side = ag >= lo_ag ? 0 : (-ag >= lo_ag ? 1 : -1);
+        if (side < 0) continue;
+        s->ix[m] = i;
+        for (int k = 0; k < 3; k++) s->px[3 * m + k] = p->p[k];
+        s->side[m] = (signed char)side;
+        double av = side ? -ag : ag;
+        s->unc[m] = (unsigned char)(av < hi_ag || (B->buried && B->buried[i]));
+        m++;
+    }
+    s->n = m;
+    return 1;
+}
+
+static unsigned *chunk_words(tl_build *B, int ch, long more)
+{
+    if (B->cne[ch] + more > B->ccap[ch]) {
+        long nc = B->ccap[ch] ? B->ccap[ch] : 256;
+        while (nc < B->cne[ch] + more) nc *= 2;
+        unsigned *ne = realloc(B->ce[ch], (size_t)nc * sizeof *ne);
+        if (!ne) return NULL;
+        B->ce[ch] = ne;
+        B->ccap[ch] = nc;
+    }
+    return B->ce[ch] + B->cne[ch];
+}
+
+static void build_job(void *ctx, int ch, int thread)
+{
+    (void)thread;
+    tl_build *B = ctx;
+    gi_trilook *t = B->t;
+    long t0 = B->ntris * ch / B->chunks, t1 = B->ntris * (ch + 1) / B->chunks;
+    tl_scratch s = {0};
+    unsigned gi = 0;
+    const double full = B->maxdist * (1.0 + REL) + B->delta;
+    for (long ft = t0; ft < t1; ft++) {
+        while (gi + 1 < B->ngeo && B->gbase[gi + 1] <= ft) gi++;
+        const tl_geo *G = &B->geo[gi];
+        long prim = ft - B->gbase[gi];
+        const tl_tri *T = &t->tri[G->geom][prim];
+        if (T->k == 0) continue;
+        int oid = B->tobj[ft], k = T->k;
+        double v[3][3];
+        for (int q = 0; q < 3; q++)
+            for (int c = 0; c < 3; c++) v[q][c] = G->v[3 * G->idx[3 * prim + q] + c];
+        double e1[3], e2[3], nrm[3] = {T->n[0], T->n[1], T->n[2]}, ct[3], rt = 0.0;
+        for (int c = 0; c < 3; c++) {
+            e1[c] = v[1][c] - v[0][c];
+            e2[c] = v[2][c] - v[0][c];
+            ct[c] = (v[0][c] + v[1][c] + v[2][c]) / 3.0;
+        }
+        for (int q = 0; q < 3; q++) {
+            double e = 0.0;
+            for (int c = 0; c < 3; c++) e += (v[q][c] - ct[c]) * (v[q][c] - ct[c]);
+            rt = fmax(rt, sqrt(e));
+        }
+        /* the candidates cover every point within rg - rt of the triangle;
+         * gathered again wider when a cell's list needs more */
+        double rg = rt + fmin(1.5 * B->spacing, full);
+        long ncell = (long)k * (k + 1) / 2, tri_start = B->cne[ch];
+        for (int pass = 0; pass < 2; pass++) {
+            if (!gather(B, &s, oid, ct, rg, nrm)) {
+                B->fail[ch] = 1;
+                goto out;
+            }
+            double needed = 0.0;
+            long cell = T->cell0;
+            for (int i = 0; i < k; i++)
+                for (int j = 0; j + i < k; j++, cell++) {
+                    /* corners (i, j), (i+1, j), (i, j+1) [, (i+1, j+1)] in units of 1/k */
+                    double uv[4][2] = {{i, j}, {i + 1, j}, {i, j + 1}, {i + 1, j + 1}};
+                    int nv = i + j < k - 1 ? 4 : 3;
+                    double cv[4][3], c[3] = {0, 0, 0};
+                    for (int q = 0; q < nv; q++)
+                        for (int a = 0; a < 3; a++) {
+                            cv[q][a] = v[0][a] + uv[q][0] / k * e1[a] + uv[q][1] / k * e2[a];
+                            c[a] += cv[q][a] / nv;
+                        }
+                    double rc = 0.0;
+                    for (int q = 0; q < nv; q++) {
+                        double e = 0.0;
+                        for (int a = 0; a < 3; a++) e += (cv[q][a] - c[a]) * (cv[q][a] - c[a]);
+                        rc = fmax(rc, sqrt(e));
+                    }
+                    /* R: the least max corner distance of a certain
+                     * candidate; the one nearest the centre first (its
+                     * bound prunes the rest: max corner distance >= pc - rc) */
+                    double R[2] = {INFINITY, INFINITY}, pmin[2] = {INFINITY, INFINITY};
+                    long first[2] = {-1, -1};
+                    for (long m = 0; m < s.n; m++) {
+                        const float *px = &s.px[3 * m];
+                        double pc = 0.0;
+                        for (int a = 0; a < 3; a++) pc += (px[a] - c[a]) * (px[a] - c[a]);
+                        s.pc[m] = sqrt(pc);
+                        int sd = s.side[m];
+                        if (!s.unc[m] && s.pc[m] < pmin[sd]) {
+                            pmin[sd] = s.pc[m];
+                            first[sd] = m;
+                        }
+                    }
+                    for (int pass2 = 0; pass2 < 2; pass2++)
+                        for (long m = 0; m < s.n; m++) {
+                            int sd = s.side[m];
+                            if (pass2 == 0 ? m != first[sd] : (s.unc[m] || m == first[sd] || s.pc[m] - rc >= R[sd]))
+                                continue;
+                            const float *px = &s.px[3 * m];
+                            double mx = 0.0;
+                            for (int q = 0; q < nv; q++) {
+                                double e2q = 0.0;
+                                for (int a = 0; a < 3; a++) e2q += (px[a] - cv[q][a]) * (px[a] - cv[q][a]);
+                                if (e2q > mx) mx = e2q;
+                            }
+                            mx = sqrt(mx);
+                            if (mx < R[sd]) R[sd] = mx;
+                        }
+                    for (int sd = 0; sd < 2; sd++)
+                        if (R[sd] > B->maxdist) R[sd] = B->maxdist;
+                    double rl[2] = {R[0] * (1.0 + REL) + B->delta, R[1] * (1.0 + REL) + B->delta};
+                    needed = fmax(needed, fmax(rl[0], rl[1]));
+                    /* (the second pass gathered every cell's need) */
+                    if (pass == 0 && needed > rg - rt) continue; /* gathered again */
+                    for (int sd = 0; sd < 2; sd++) {
+                        double rl2 = rl[sd] * rl[sd];
+                        /* membership: dist(p, cell) <= rl; the centre distance
+                         * bounds it: pc - rc <= dist <= pc */
+                        long cnt = 0;
+                        for (long m = 0; m < s.n; m++) {
+                            s.cd[m] = -1.0;
+                            if (s.side[m] != sd || s.pc[m] - rc > rl[sd]) continue;
+                            if (s.pc[m] > rl[sd]) {
+                                double px[3] = {s.px[3 * m], s.px[3 * m + 1], s.px[3 * m + 2]};
+                                double d2 = dist2_tri(px, cv[0], cv[1], cv[2]);
+                                if (nv == 4 && d2 > rl2) d2 = fmin(d2, dist2_tri(px, cv[1], cv[3], cv[2]));
+                                if (d2 > rl2) continue;
+                            }
+                            s.cd[m] = 1.0;
+                            cnt++;
+                        }
+                        int complete = R[sd] >= B->maxdist;
+                        double cert = complete ? B->maxdist * (1.0 - REL) : R[sd];
+                        float cert2 = (float)(cert * cert * (1.0 - 1e-6));
+                        if (cnt == 0) {
+                            /* a shared header (offsets below the chunks') */
+                            t->loff[2 * cell + sd] = complete ? EMPTY_COMPLETE : EMPTY_OPEN;
+                            continue;
+                        }
+                        unsigned *w = chunk_words(B, ch, cnt + 2);
+                        if (!w) {
+                            B->fail[ch] = 1;
+                            goto out;
+                        }
+                        t->loff[2 * cell + sd] = (unsigned)B->cne[ch] | LOCAL;
+                        w[0] = (unsigned)cnt | (complete ? COMPLETE : 0u);
+                        memcpy(&w[1], &cert2, sizeof cert2);
+                        long q = 2;
+                        for (long m = 0; m < s.n; m++) {
+                            if (s.cd[m] < 0.0) continue;
+                            /* ascending particle index (insertion: lists are short) */
+                            unsigned id = (unsigned)s.ix[m] | (s.unc[m] ? UNCERTAIN : 0u);
+                            long b = q++;
+                            while (b > 2 && (w[b - 1] & ~UNCERTAIN) > (id & ~UNCERTAIN)) {
+                                w[b] = w[b - 1];
+                                b--;
+                            }
+                            w[b] = id;
+                        }
+                        B->cne[ch] += cnt + 2;
+                    }
+                }
+            (void)ncell;
+            if (pass == 0 && needed <= rg - rt) break; /* every cell written */
+            if (pass == 1) break;
+            /* some cell needs more: drop this triangle's lists written so
+             * far (the chunk's last words) and gather wider */
+            B->cne[ch] = tri_start;
+            rg = rt + needed * (1.0 + 1e-9);
+        }
+    }
+out:
+    free(s.ix);
+    free(s.px);
+    free(s.side);
+    free(s.unc);
+    free(s.cd);
+    free(s.pc);
+}
+
+static unsigned ptr_hash(const void *p)
+{
+    uint64_t v = (uint64_t)(uintptr_t)p;
+    v ^= v >> 33;
+    v *= 0xff51afd7ed558ccdULL;
+    v ^= v >> 33;
+    return (unsigned)v;
+}
+
+void gi_trilook_free(gi_trilook *t)
+{
+    if (!t) return;
+    if (t->tri)
+        for (unsigned g = 0; g < t->ngeom; g++) free(t->tri[g]);
+    free(t->tri);
+    free(t->ntri);
+    free(t->loff);
+    free(t->e);
+    free(t->pp);
+    free(t);
+}
+
+gi_trilook *gi_trilook_build(const accel *a, const gi_dev_particle *p, int n, const void *const *pobj,
+                             const unsigned char *buried, double spacing, double agree, double maxdist, int threads,
+                             pt_status *st)
+{
+    *st = PT_OK;
+    if (!a || !p || !pobj || n <= 0 || !(spacing > 0.0) || !(maxdist > 0.0)) return NULL;
+    if (threads <= 0) threads = pool_default_threads();
+    /* object ids */
+    unsigned size = 64;
+    while (size < 4u * (unsigned)(n < (1 << 28) ? n : (1 << 28))) size *= 2;
+    if (size > (1u << 20)) size = 1u << 20;
+    const void **okey = NULL;
+    int *pobjid = malloc((size_t)n * sizeof *pobjid);
+    gi_trilook *t = calloc(1, sizeof *t);
+    tl_geo *geo = NULL;
+    long *gbase = NULL;
+    int *tobj = NULL;
+    tl_build B;
+    memset(&B, 0, sizeof B);
+    if (!pobjid || !t) goto nomem;
+    int distinct = 0;
+    for (;;) {
+        okey = calloc(size, sizeof *okey);
+        if (!okey) goto nomem;
+        distinct = 0;
+        int full = 0;
+        for (int i = 0; i < n && !full; i++) {
+            pobjid[i] = -1;
+            if (!pobj[i]) continue;
+            unsigned h = ptr_hash(pobj[i]) & (size - 1);
+            while (okey[h] && okey[h] != pobj[i]) h = (h + 1) & (size - 1);
+            if (!okey[h]) {
+                okey[h] = pobj[i];
+                if (2u * (unsigned)++distinct > size) full = 1;
+            }
+            pobjid[i] = (int)h;
+        }
+        if (!full) break;
+        free(okey);
+        okey = NULL;
+        size *= 4;
+    }
+    double pmag = 0.0;
+    for (int i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) pmag = fmax(pmag, fabs(p[i].p[k]));
+    /* triangles */
+    t->ngeom = accel_rtc_ngeoms(a);
+    t->tri = calloc(t->ngeom ? t->ngeom : 1, sizeof *t->tri);
+    t->ntri = calloc(t->ngeom ? t->ngeom : 1, sizeof *t->ntri);
+    geo = calloc(t->ngeom ? t->ngeom : 1, sizeof *geo);
+    gbase = calloc((size_t)t->ngeom + 1, sizeof *gbase);
+    if (!t->tri || !t->ntri || !geo || !gbase) goto nomem;
+    unsigned ngeo = 0;
+    long ntris = 0;
+    for (unsigned g = 0; g < t->ngeom; g++) {
+        const float *v;
+        const unsigned *ix;
+        long nt = accel_rtc_triangles(a, g, &v, &ix);
+        if (nt <= 0) continue;
+        t->tri[g] = calloc((size_t)nt, sizeof **t->tri);
+        if (!t->tri[g]) goto nomem;
+        t->ntri[g] = nt;
+        geo[ngeo] = (tl_geo){g, v, ix};
+        gbase[ngeo] = ntris;
+        ngeo++;
+        ntris += nt;
+    }
+    gbase[ngeo] = ntris;
+    tobj = malloc((size_t)(ntris > 0 ? ntris : 1) * sizeof *tobj);
+    if (!tobj) goto nomem;
+    long ncell = 0;
+    double tmag = pmag;
+    for (unsigned q = 0; q < ngeo; q++) {
+        const tl_geo *G = &geo[q];
+        for (long pr = 0; pr < t->ntri[G->geom]; pr++) {
+            tl_tri *T = &t->tri[G->geom][pr];
+            long ft = gbase[q] + pr;
+            tobj[ft] = -1;
+            const scene_object *o = accel_rtc_object(a, G->geom, (unsigned)pr, RTC_INVALID_GEOMETRY_ID);
+            if (!o) continue;
+            unsigned h = ptr_hash(o) & (size - 1);
+            while (okey[h] && okey[h] != (const void *)o) h = (h + 1) & (size - 1);
+            if (!okey[h]) continue; /* no particle on it */
+            tobj[ft] = (int)h;
+            double v[3][3];
+            for (int k = 0; k < 3; k++)
+                for (int c = 0; c < 3; c++) {
+                    v[k][c] = G->v[3 * G->idx[3 * pr + k] + c];
+                    tmag = fmax(tmag, fabs(v[k][c]));
+                }
+            double e1[3], e2[3], e3[3];
+            for (int c = 0; c < 3; c++) {
+                e1[c] = v[1][c] - v[0][c];
+                e2[c] = v[2][c] - v[0][c];
+                e3[c] = v[2][c] - v[1][c];
+            }
+            double nn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+            double l1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+            double l2 = sqrt(e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]);
+            double l3 = sqrt(e3[0] * e3[0] + e3[1] * e3[1] + e3[2] * e3[2]);
+            double ln = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+            double le = fmax(l1, fmax(l2, l3));
+            /* slivers (the normal's direction unsure) and non-finite ones stay on the grid path */
+            if (!(ln > 1e-6 * le * le) || !isfinite(ln)) continue;
+            double kk = ceil(le / (CELL_FAC * spacing));
+            int k = kk < 1.0 ? 1 : (kk > MAX_K ? MAX_K : (int)kk);
+            for (int c = 0; c < 3; c++) T->n[c] = (float)(nn[c] / ln);
+            T->k = k;
+            T->cell0 = ncell;
+            ncell += (long)k * (k + 1) / 2;
+        }
+    }
+    free(okey);
+    okey = NULL;
+    if (ncell == 0 || ncell > (1L << 29)) {
+        /* nothing to cover (or too much): the grid path answers everything */
+        free(pobjid);
+        free(geo);
+        free(gbase);
+        free(tobj);
+        gi_trilook_free(t);
+        return NULL;
+    }
+    t->ncell = 2 * ncell;
+    t->loff = calloc((size_t)t->ncell, sizeof *t->loff);
+    t->pp = aligned_alloc(64, ((size_t)n + 1) * sizeof *t->pp + 64);
+    if (!t->loff || !t->pp) goto nomem;
+    t->n = n;
+    for (int i = 0; i < n; i++)
+        t->pp[i] = (tl_pp){p[i].p[0], p[i].p[1], p[i].p[2], p[i].n[0], p[i].n[1], p[i].n[2], {0, 0}};
+    t->pp[n] = (tl_pp){INFINITY, INFINITY, INFINITY, 0, 0, 0, {0, 0}};
+    float md = (float)(maxdist * (1.0 + REL));
+    t->start2 = md * md;
+    B.t = t;
+    B.p = p;
+    B.pobjid = pobjid;
+    B.buried = buried;
+    B.geo = geo;
+    B.gbase = gbase;
+    B.tobj = tobj;
+    B.ngeo = ngeo;
+    B.ntris = ntris;
+    B.spacing = spacing;
+    B.agree = agree;
+    B.maxdist = maxdist;
+    /* the hit point's distance to its cell: float rounding of Embree's
+     * (u, v) and of org + t dir, a few ulps of the coordinates */
+    B.delta = 1e-3 * spacing + 1e-5 * tmag;
+    B.chunks = (int)(ntris / 64 + 1);
+    if (B.chunks > 4096) B.chunks = 4096;
+    B.ce = calloc((size_t)B.chunks, sizeof *B.ce);
+    B.cne = calloc((size_t)B.chunks, sizeof *B.cne);
+    B.ccap = calloc((size_t)B.chunks, sizeof *B.ccap);
+    B.fail = calloc((size_t)B.chunks, sizeof *B.fail);
+    if (!B.ce || !B.cne || !B.ccap || !B.fail || !bgrid_build(&B.g, p, n, spacing)) goto nomem;
+    pool_run(threads, B.chunks, build_job, &B);
+    long ne = SHARED_WORDS;
+    long *base = malloc((size_t)B.chunks * sizeof *base);
+    if (!base) goto nomem;
+    for (int ch = 0; ch < B.chunks; ch++) {
+        if (B.fail[ch]) {
+            free(base);
+            goto nomem;
+        }
+        base[ch] = ne;
+        ne += B.cne[ch];
+    }
+    if (ne >= (long)LOCAL) {
+        free(base);
+        goto nomem;
+    }
+    /* (a padding line after the end: prefetches) */
+    t->e = malloc((size_t)(ne + 16) * sizeof *t->e);
+    if (!t->e) {
+        free(base);
+        goto nomem;
+    }
+    t->ne = ne;
+    float zero = 0.0f;
+    t->e[EMPTY_COMPLETE] = COMPLETE;
+    memcpy(&t->e[EMPTY_COMPLETE + 1], &zero, sizeof zero);
+    t->e[EMPTY_OPEN] = 0u;
+    memcpy(&t->e[EMPTY_OPEN + 1], &zero, sizeof zero);
+    memset(t->e + ne, 0, 16 * sizeof *t->e);
+    /* concatenate the chunks' lists; a list's offset was chunk-local */
+    for (int ch = 0; ch < B.chunks; ch++) {
+        if (B.cne[ch]) memcpy(t->e + base[ch], B.ce[ch], (size_t)B.cne[ch] * sizeof *t->e);
+        long t0 = ntris * ch / B.chunks, t1 = ntris * (ch + 1) / B.chunks;
+        unsigned gi = 0;
+        for (long ft = t0; ft < t1; ft++) {
+            while (gi + 1 < ngeo && gbase[gi + 1] <= ft) gi++;
+            const tl_tri *T = &t->tri[geo[gi].geom][ft - gbase[gi]];
+            if (T->k == 0) continue;
+            long nc = (long)T->k * (T->k + 1) / 2;
+            for (long c = 2 * T->cell0; c < 2 * (T->cell0 + nc); c++)
+                if (t->loff[c] & LOCAL) t->loff[c] = (unsigned)((t->loff[c] & ~LOCAL) + base[ch]);
+        }
+    }
+    for (long c = 0; c < t->ncell; c++)
+        if (t->loff[c] >= SHARED_WORDS) t->entries += t->e[t->loff[c]] & ~COMPLETE;
+    free(base);
+    goto done;
+nomem:
+    *st = PT_ERR_NOMEM;
+    gi_trilook_free(t);
+    t = NULL;
+done:
+    if (B.ce)
+        for (int ch = 0; ch < B.chunks; ch++) free(B.ce[ch]);
+    free(B.ce);
+    free(B.cne);
+    free(B.ccap);
+    free(B.fail);
+    bgrid_free(&B.g);
+    free(okey);
+    free(pobjid);
+    free(geo);
+    free(gbase);
+    free(tobj);
+    return t;
+}
+
+void gi_trilook_compact(gi_trilook *t, const int *remap, const gi_dev_particle *p, int n)
+{
+    if (!t) return;
+    long entries = 0;
+    for (long c = 0; c < t->ncell; c++) {
+        unsigned o = t->loff[c];
+        if (o < SHARED_WORDS) continue;
+        unsigned *L = t->e + o, cnt = L[0] & ~COMPLETE, w = 0;
+        for (unsigned r = 0; r < cnt; r++) {
+            unsigned id = L[2 + r];
+            int ni = remap[id & ~UNCERTAIN];
+            if (ni >= 0) L[2 + w++] = (unsigned)ni | (id & UNCERTAIN);
+        }
+        /* the certificate stays: the list still holds every remaining
+         * particle within its radius */
+        L[0] = w | (L[0] & COMPLETE);
+        entries += w;
+    }
+    t->entries = entries;
+    /* the particles, renumbered */
+    if (n <= t->n) {
+        for (int i = 0; i < n; i++)
+            t->pp[i] = (tl_pp){p[i].p[0], p[i].p[1], p[i].p[2], p[i].n[0], p[i].n[1], p[i].n[2], {0, 0}};
+        t->pp[n] = (tl_pp){INFINITY, INFINITY, INFINITY, 0, 0, 0, {0, 0}};
+        t->n = n;
+    }
+}
+
+size_t gi_trilook_bytes(const gi_trilook *t)
+{
+    if (!t) return 0;
+    size_t b = sizeof *t + (size_t)t->ncell * sizeof *t->loff + (size_t)(t->ne + 16) * sizeof *t->e +
+               (size_t)(t->n + 1) * sizeof *t->pp + (size_t)t->ngeom * (sizeof(tl_tri *) + sizeof(long));
+    for (unsigned g = 0; g < t->ngeom; g++) b += (size_t)t->ntri[g] * sizeof(tl_tri);
+    return b;
+}
+
+long gi_trilook_entries(const gi_trilook *t) { return t ? t->entries : 0; }
+long gi_trilook_cells(const gi_trilook *t) { return t ? t->ncell : 0; }
+
+/* ------------------------------------------------------------------ query */
+
+long gi_trilook_cell(const gi_trilook *t, unsigned geom, unsigned prim, float u, float v, const float dir[3])
+{
+    if (geom >= t->ngeom || !t->tri[geom] || (long)prim >= t->ntri[geom]) return -1;
+    const tl_tri *T = &t->tri[geom][prim];
+    int k = T->k;
+    if (k == 0) return -1;
+    float s = T->n[0] * dir[0] + T->n[1] * dir[1] + T->n[2] * dir[2];
+    /* gi_links turns Embree's Ng against the ray; a ray this close to the
+     * plane might be turned the other way there */
+    if (!(fabsf(s) >= 1e-4f)) return -1;
+    float fu = u * (float)k, fv = v * (float)k;
+    int i = fu > 0.0f ? (int)fu : 0, j = fv > 0.0f ? (int)fv : 0;
+    if (i > k - 1) i = k - 1;
+    if (j > k - 1) j = k - 1;
+    if (i + j > k - 1) j = k - 1 - i;
+    long c = T->cell0 + (long)i * k - (long)i * (i - 1) / 2 + j;
+    return 2 * c + (s > 0.0f);
+}
+
+void gi_trilook_prefetch(const gi_trilook *t, long cell, int stage)
+{
+    if (stage == 0) {
+        __builtin_prefetch(&t->loff[cell]);
+    } else if (stage == 1) {
+        __builtin_prefetch(t->e + t->loff[cell]);
+    } else {
+        const unsigned *L = t->e + t->loff[cell];
+        unsigned cnt = L[0] & ~COMPLETE;
+        for (unsigned r = 0; r < cnt; r++) __builtin_prefetch(&t->pp[L[2 + r] & ~UNCERTAIN]);
+    }
+}
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+int gi_trilook_nearest(const gi_trilook *t, long cell, const float q[3], const float dir[3], const float org[3])
+{
+    const unsigned *L = t->e + t->loff[cell];
+    unsigned cnt = L[0] & ~COMPLETE;
+    /* gi_lookup's filters in its float arithmetic (scan_runs4: the same
+     * operations in the same order): the normal faces against the ray,
+     * the origin lies in front of the particle, the hit lies near its
+     * tangent plane. A tie with the best is left to the grid path, which
+     * breaks ties its own way (by grid slot when its first answer stands,
+     * by particle index when it searched again). */
+#if defined(__SSE2__)
+    /* 4 entries at a time, branch-free (the filters' outcomes are
+     * unpredictable); lanes past the list read the particle at infinity */
+    const __m128 zero = _mm_setzero_ps(), vnp = _mm_set1_ps(0.25f);
+    const __m128 qx = _mm_set1_ps(q[0]), qy = _mm_set1_ps(q[1]), qz = _mm_set1_ps(q[2]);
+    const __m128 dx = _mm_set1_ps(dir[0]), dy = _mm_set1_ps(dir[1]), dz = _mm_set1_ps(dir[2]);
+    const __m128 ox = _mm_set1_ps(org[0]), oy = _mm_set1_ps(org[1]), oz = _mm_set1_ps(org[2]);
+    __m128 best = _mm_set1_ps(t->start2);
+    __m128i slot = _mm_set1_epi32(-1), tie = _mm_setzero_si128();
+    __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
+    const __m128i four = _mm_set1_epi32(4);
+    const tl_pp *pp = t->pp;
+    for (unsigned r = 0; r < cnt; r += 4, lane = _mm_add_epi32(lane, four)) {
+        unsigned i0 = L[2 + r] & ~UNCERTAIN;
+        unsigned i1 = r + 1 < cnt ? L[3 + r] & ~UNCERTAIN : (unsigned)t->n;
+        unsigned i2 = r + 2 < cnt ? L[4 + r] & ~UNCERTAIN : (unsigned)t->n;
+        unsigned i3 = r + 3 < cnt ? L[5 + r] & ~UNCERTAIN : (unsigned)t->n;
+        __m128 x = _mm_load_ps(&pp[i0].x), y = _mm_load_ps(&pp[i1].x), z = _mm_load_ps(&pp[i2].x),
+               nx = _mm_load_ps(&pp[i3].x);
+        _MM_TRANSPOSE4_PS(x, y, z, nx);
+        __m128 ny = _mm_load_ps(&pp[i0].ny), nz = _mm_load_ps(&pp[i1].ny), c = _mm_load_ps(&pp[i2].ny),
+               dd = _mm_load_ps(&pp[i3].ny);
+        _MM_TRANSPOSE4_PS(ny, nz, c, dd);
+        __m128 ex = _mm_sub_ps(x, qx), ey = _mm_sub_ps(y, qy), ez = _mm_sub_ps(z, qz);
+        __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(ex, ex), _mm_mul_ps(ey, ey)), _mm_mul_ps(ez, ez));
+        __m128 f = _mm_add_ps(_mm_add_ps(_mm_mul_ps(nx, dx), _mm_mul_ps(ny, dy)), _mm_mul_ps(nz, dz));
+        __m128 hh = _mm_add_ps(_mm_add_ps(_mm_mul_ps(nx, _mm_sub_ps(ox, x)), _mm_mul_ps(ny, _mm_sub_ps(oy, y))),
+                               _mm_mul_ps(nz, _mm_sub_ps(oz, z)));
+        __m128 pe = _mm_add_ps(_mm_add_ps(_mm_mul_ps(nx, ex), _mm_mul_ps(ny, ey)), _mm_mul_ps(nz, ez));
+        __m128 filt = _mm_and_ps(_mm_and_ps(_mm_cmplt_ps(f, zero), _mm_cmpgt_ps(hh, zero)),
+                                 _mm_cmple_ps(_mm_mul_ps(pe, pe), _mm_mul_ps(vnp, d2)));
+        __m128 ok = _mm_and_ps(filt, _mm_cmplt_ps(d2, best));
+        __m128i oki = _mm_castps_si128(ok);
+        tie = _mm_or_si128(_mm_andnot_si128(oki, tie), _mm_castps_si128(_mm_and_ps(filt, _mm_cmpeq_ps(d2, best))));
+        best = _mm_or_ps(_mm_and_ps(ok, d2), _mm_andnot_ps(ok, best));
+        slot = _mm_or_si128(_mm_and_si128(oki, lane), _mm_andnot_si128(oki, slot));
+    }
+    __m128i has = _mm_cmpgt_epi32(slot, _mm_set1_epi32(-1));
+    if (!_mm_movemask_ps(_mm_castsi128_ps(has))) return (L[0] & COMPLETE) ? -1 : -2;
+    /* lanes without a slot hold start2, above every lane with one */
+    __m128 m = _mm_min_ps(best, _mm_shuffle_ps(best, best, _MM_SHUFFLE(1, 0, 3, 2)));
+    m = _mm_min_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
+    __m128 eq = _mm_and_ps(_mm_castsi128_ps(has), _mm_cmpeq_ps(best, m));
+    int em = _mm_movemask_ps(eq), tm = _mm_movemask_ps(_mm_castsi128_ps(tie));
+    if ((em & (em - 1)) || (em & tm)) return -2; /* a tie */
+    int sl[4];
+    _mm_storeu_si128((__m128i *)sl, slot);
+    unsigned win = L[2 + sl[__builtin_ctz((unsigned)em)]];
+    float bestd = _mm_cvtss_f32(m);
+#else
+    const float qx = q[0], qy = q[1], qz = q[2], dx = dir[0], dy = dir[1], dz = dir[2];
+    const float ox = org[0], oy = org[1], oz = org[2];
+    float bestd = t->start2;
+    unsigned win = 0;
+    int found = 0, tie = 0;
+    for (unsigned r = 0; r < cnt; r++) {
+        unsigned id = L[2 + r];
+        const tl_pp *e = &t->pp[id & ~UNCERTAIN];
+        float ex = e->x - qx, ey = e->y - qy, ez = e->z - qz;
+        float d2 = ex * ex + ey * ey + ez * ez;
+        if (d2 > bestd) continue;
+        float f = e->nx * dx + e->ny * dy + e->nz * dz;
+        float hh = e->nx * (ox - e->x) + e->ny * (oy - e->y) + e->nz * (oz - e->z);
+        float pe = e->nx * ex + e->ny * ey + e->nz * ez;
+        if (!(f < 0.0f) || !(hh > 0.0f) || !(pe * pe <= 0.25f * d2)) continue;
+        if (d2 < bestd) {
+            bestd = d2;
+            win = id;
+            found = 1;
+            tie = 0;
+        } else {
+            tie = found; /* d2 == best */
+        }
+    }
+    if (!found) return (L[0] & COMPLETE) ? -1 : -2;
+    if (tie) return -2;
+#endif
+    float cert2;
+    memcpy(&cert2, &L[1], sizeof cert2);
+    if (bestd > cert2 || (win & UNCERTAIN)) return -2;
+    return (int)win;
+}
