@@ -3,7 +3,9 @@
  * Two PNGs are compared as displayed images: their encoded sRGB values, with
  * LDR-FLIP. Anything involving EXR or PFM is compared on linear values with
  * HDR-FLIP (exposure range from the reference). --ldr/--hdr force a mode; --ldr
- * on linear files encodes them with the sRGB curve (clamped) first. */
+ * on linear files encodes them with the sRGB curve (clamped) first. Both
+ * print the mean Rec.709 luminance of the two images (of linear values) and
+ * the test's relative to the reference's. */
 #include "cmd_compare.h"
 #include <math.h>
 #include <stdio.h>
@@ -110,6 +112,11 @@ int cmd_compare(int argc, char **argv)
             stats_int(&js, "exposures", r.nexposures);
         }
         stats_obj_end(&js);
+        stats_obj_begin(&js, "luminance");
+        stats_num(&js, "reference", r.lum_ref);
+        stats_num(&js, "test", r.lum_test);
+        stats_num(&js, "relative", r.lum_ref > 0.0 ? r.lum_test / r.lum_ref - 1.0 : 0.0);
+        stats_obj_end(&js);
         static const char *ch[3] = {"r", "g", "b"};
         stats_obj_begin(&js, "channels");
         for (int c = 0; c < 3; c++) {
@@ -132,6 +139,9 @@ int cmd_compare(int argc, char **argv)
         printf("PSNR    %10.3f dB\n", r.psnr);
         printf("FLIP    mean %.6f, weighted median %.6f", r.flip_mean, r.flip_wmedian);
         if (hdr) printf(" (exposures %.4f to %.4f, %d)", r.exp_start, r.exp_stop, r.nexposures);
+        printf("\n");
+        printf("mean luminance  reference %.6f, test %.6f", r.lum_ref, r.lum_test);
+        if (r.lum_ref > 0.0) printf(" (%+.2f%%)", 100.0 * (r.lum_test / r.lum_ref - 1.0));
         printf("\n");
         if (heatmap) printf("heat map  %s\n", heatmap);
     }

@@ -230,18 +230,6 @@ static void mean_abs_diff(const framebuffer *a, const framebuffer *b, double *pl
     *down = s / (3.0 * w * h);
 }
 
-/* Mean Rec.709 luminance of the sRGB-decoded display values. */
-static double mean_luminance(const framebuffer *fb)
-{
-    size_t n = (size_t)fb->width * (size_t)fb->height;
-    double s = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        const float *p = fb->rgb + 3 * i;
-        s += 0.2126 * img_srgb_decode(p[0]) + 0.7152 * img_srgb_decode(p[1]) + 0.0722 * img_srgb_decode(p[2]);
-    }
-    return n ? s / (double)n : 0.0;
-}
-
 /* Absolute path of `p` (relative to the current directory). */
 static void absolute(const char *p, char *buf, size_t n)
 {
@@ -477,7 +465,7 @@ int cmd_crosscheck(int argc, char **argv)
     }
     double mad = 0, mad4 = 0;
     mean_abs_diff(a, b, &mad, &mad4);
-    double lum_pov = mean_luminance(a), lum_pt = mean_luminance(b);
+    double lum_pov = img_mean_luminance(a, 1), lum_pt = img_mean_luminance(b, 1);
     double ratio = lum_pov > 0 ? lum_pt / lum_pov : (lum_pt > 0 ? INFINITY : 1.0);
     if (!o.quiet) print_diags(d);
     if (o.json) {

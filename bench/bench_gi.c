@@ -70,14 +70,6 @@ static double cpu_now(void)
     return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
 }
 
-static double mean_lum(const framebuffer *fb)
-{
-    double s = 0.0;
-    size_t n = (size_t)fb->width * fb->height;
-    for (size_t i = 0; i < n; i++) s += 0.2126 * fb->rgb[3 * i] + 0.7152 * fb->rgb[3 * i + 1] + 0.0722 * fb->rgb[3 * i + 2];
-    return s / (double)n;
-}
-
 static int ref_error(const framebuffer *fb, double *flip, double *rmse, double *lum, diag *d)
 {
     *flip = *rmse = *lum = NAN;
@@ -86,8 +78,8 @@ static int ref_error(const framebuffer *fb, double *flip, double *rmse, double *
     if (img_compare(g_ref, fb, 1, &r, NULL, d) != PT_OK) return 0;
     *flip = r.flip_mean;
     *rmse = r.rmse;
-    double lr = mean_lum(g_ref);
-    *lum = lr > 0.0 ? mean_lum(fb) / lr - 1.0 : NAN;
+    double lr = img_mean_luminance(g_ref, 0);
+    *lum = lr > 0.0 ? img_mean_luminance(fb, 0) / lr - 1.0 : NAN;
     return 1;
 }
 
@@ -186,7 +178,7 @@ static void sweep(const scene *sc, const accel *a, const opts *o, diag *d)
             gi_particle_set_scattering(gp, nbs[bi], s.scatter);
             double tl, tv, tr;
             double tf = gi_frame(sc, a, o, gp, fb, &tl, &tv, &tr, d);
-            means[ci][bi] = mean_lum(fb);
+            means[ci][bi] = img_mean_luminance(fb, 0);
             rows[ci][bi][0] = st.t_geometry;
             rows[ci][bi][1] = cg;
             rows[ci][bi][2] = tl;
@@ -417,7 +409,7 @@ int main(int argc, char **argv)
            "table %.1f MiB\n",
            o.per_hit ? "per hit" : "per cell", x->cells, x->cells_clear, 100.0 * x->cells_clear / fmax(1, x->cells),
            100.0 * x->lookups_clear / fmax(1, x->lookups), x->bytes_cells / 1048576.0);
-    printf("mean luminance: none %.5f, particle %.5f\n", mean_lum(fb_none), mean_lum(fb_gi));
+    printf("mean luminance: none %.5f, particle %.5f\n", img_mean_luminance(fb_none, 0), img_mean_luminance(fb_gi, 0));
     {
         double fl, rm, lu;
         if (ref_error(fb_gi, &fl, &rm, &lu, d))

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "img_flip.h"
+#include "img_io.h"
 #include "pool.h"
 
 static double fin(float v)
@@ -410,6 +411,21 @@ pt_status img_abs_error_map(const framebuffer *ref, const framebuffer *test, dou
 
 /* ---- everything at once ---- */
 
+double img_mean_luminance(const framebuffer *fb, int srgb)
+{
+    size_t n = (size_t)fb->width * (size_t)fb->height;
+    double s = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double c[3];
+        for (int k = 0; k < 3; k++) {
+            double v = fb->rgb[3 * i + (size_t)k];
+            c[k] = srgb ? img_srgb_decode(v) : v;
+        }
+        s += 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    }
+    return n ? s / (double)n : 0.0;
+}
+
 pt_status img_compare(const framebuffer *ref, const framebuffer *test, int hdr,
                       img_compare_result *r, framebuffer **flip_map_out, diag *d)
 {
@@ -421,6 +437,8 @@ pt_status img_compare(const framebuffer *ref, const framebuffer *test, int hdr,
     if ((st = img_relmse(ref, test, &r->relmse, r->relmse_ch, d)) != PT_OK) return st;
     if ((st = img_psnr(ref, test, &r->psnr, d)) != PT_OK) return st;
     if ((st = img_ssim(ref, test, &r->ssim, r->ssim_ch, d)) != PT_OK) return st;
+    r->lum_ref = img_mean_luminance(ref, !hdr);
+    r->lum_test = img_mean_luminance(test, !hdr);
 
     size_t n = (size_t)ref->width * (size_t)ref->height;
     float *err = malloc(n * sizeof *err);

@@ -30,7 +30,13 @@ typedef struct {
     int flip_hdr;                   /* 1: HDR-FLIP was used */
     double exp_start, exp_stop;     /* HDR-FLIP exposure range (0 for LDR) */
     int nexposures;                 /* HDR-FLIP exposure count (0 for LDR) */
+    double lum_ref, lum_test;       /* mean Rec.709 luminance of the linear values (img_mean_luminance) */
 } img_compare_result;
+
+/* Mean Rec.709 luminance Y = 0.2126 R + 0.7152 G + 0.0722 B (ITU-R BT.709
+ * primaries, the sRGB ones) over all pixels, of linear values; srgb = 1:
+ * the framebuffer holds sRGB-encoded values, decoded first. */
+double img_mean_luminance(const framebuffer *fb, int srgb);
 
 /* All metrics at once.
  * hdr = 0: both images hold display-encoded (sRGB) values in [0,1], as a PNG

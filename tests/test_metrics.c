@@ -424,6 +424,32 @@ static double lin(double e)
     return e <= 0.04045 ? e / 12.92 : pow((e + 0.055) / 1.055, 2.4);
 }
 
+/* Mean luminance: Rec.709 weights on linear values; on sRGB-encoded values
+ * decoded first (encoded 0.5 decodes to ((0.5 + 0.055) / 1.055)^2.4 =
+ * 0.2140411, IEC 61966-2-1); img_compare reports both images' means. */
+static void test_mean_luminance(void **st)
+{
+    (void)st;
+    framebuffer *r = fb_new(2, 1), *t = fb_new(2, 1);
+    float px[6] = {1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.5f};
+    for (int i = 0; i < 6; i++) {
+        r->rgb[i] = px[i];
+        t->rgb[i] = 1.1f * px[i];
+    }
+    double want = 0.5 * (0.2126 + 0.7152 + 0.0722 * 0.5);
+    assert_true(fabs(img_mean_luminance(r, 0) - want) < 1e-12);
+    diag *d = diag_new();
+    img_compare_result res;
+    assert_int_equal(img_compare(r, t, 1, &res, NULL, d), PT_OK);
+    assert_true(fabs(res.lum_ref - want) < 1e-12);
+    assert_true(fabs(res.lum_test / res.lum_ref - 1.1) < 1e-6);
+    for (int i = 0; i < 6; i++) r->rgb[i] = 0.5f;
+    assert_true(fabs(img_mean_luminance(r, 1) - 0.2140411) < 1e-6);
+    diag_free(d);
+    fb_free(r);
+    fb_free(t);
+}
+
 static void test_heatmap(void **st)
 {
     (void)st;
@@ -489,6 +515,7 @@ int main(void)
         cmocka_unit_test(test_flip_readme_ldr),
         cmocka_unit_test(test_flip_readme_hdr),
         cmocka_unit_test(test_heatmap),
+        cmocka_unit_test(test_mean_luminance),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
