@@ -80,6 +80,14 @@ struct gi_dev {
     int nwalk;
     float *tally;  /* nb x 3 floats per gi_k_bounce work-item (read back) */
     size_t tally_cap;
+    float *dsum;   /* gi_k_emit's direct flux per work-item (read back) */
+    unsigned *srcmask_host; /* gi_k_emit's source mask (OpenCL: read back) */
+    double emitted; /* grey emitted flux (gi_dev_sums), fixed by the particles */
+    /* edir and phi of the last completed stage go to these when asked
+     * (gi_dev_fetch); stale: not written yet */
+    float *edir_host, *phi_host;
+    int stale;
+    int vis_ok; /* the device's vis holds the last call's (OpenCL) */
     /* C build scratch */
     float *edir, *src, *bin, *bout, *total;
     unsigned *mask_src, *mask_a, *mask_b; /* source masks (gi_k_emit, gi_k_bounce) */
@@ -94,6 +102,7 @@ struct gi_dev {
     cl_mem b_lights, b_vis, b_edir, b_src, b_tally, b_lout, b_phi, b_eind, b_list, b_vout;
     cl_mem b_rin_off, b_rin_src, b_bin, b_bout, b_total, b_woff, b_went;
     cl_mem b_emits, b_mask_src, b_mask_a, b_mask_b, b_cin_off, b_cin_src;
+    cl_mem b_enew, b_dsum; /* gi_k_emit's edir (swapped with b_edir when a stage completes), direct sums */
     size_t sz_lights, sz_vis, sz_tally, sz_list, sz_vout, sz_woff, sz_went, sz_cin_off, sz_cin_src;
     float *tmp;  /* n*4 readback scratch */
 #endif
@@ -491,7 +500,7 @@ void gi_dev_free(gi_dev *dv)
                         &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off, &dv->b_rin_src, &dv->b_bin,
                         &dv->b_bout, &dv->b_total, &dv->b_woff, &dv->b_went,
                         &dv->b_emits, &dv->b_mask_src, &dv->b_mask_a, &dv->b_mask_b, &dv->b_cin_off,
-                        &dv->b_cin_src};
+                        &dv->b_cin_src, &dv->b_enew, &dv->b_dsum};
         for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
         for (int k = 0; k < KE_COUNT; k++)
             if (dv->k[k]) clReleaseKernel(dv->k[k]);
@@ -516,6 +525,8 @@ void gi_dev_free(gi_dev *dv)
     free(dv->cin_off);
     free(dv->cin_src);
     free(dv->tally);
+    free(dv->dsum);
+    free(dv->srcmask_host);
     free(dv);
 }
 
@@ -545,9 +556,19 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     dv->cand = calloc(dv->nmask, sizeof(unsigned));
     dv->cand_new = calloc(dv->nmask, sizeof(unsigned));
     dv->cin_off = calloc(nn + 1, sizeof(int));
-    if (!dv->emits || !dv->cand || !dv->cand_new || !dv->cin_off) return PT_ERR_NOMEM;
-    for (int i = 0; i < n; i++)
+    free(dv->dsum);
+    free(dv->srcmask_host);
+    dv->dsum = calloc(dv->nmask, sizeof(float));
+    dv->srcmask_host = calloc(dv->nmask, sizeof(unsigned));
+    if (!dv->emits || !dv->cand || !dv->cand_new || !dv->cin_off || !dv->dsum || !dv->srcmask_host)
+        return PT_ERR_NOMEM;
+    dv->emitted = 0.0;
+    for (int i = 0; i < n; i++) {
         if (part[i].le[0] != 0.0f || part[i].le[1] != 0.0f || part[i].le[2] != 0.0f) dv->emits[i >> 5] |= 1u << (i & 31);
+        for (int c = 0; c < 3; c++) dv->emitted += 3.14159265358979323846 * part[i].le[c] * part[i].area / 3.0;
+    }
+    dv->stale = 0;
+    dv->vis_ok = 0;
     if (!dv->is_cl) {
         free(dv->edir);
         free(dv->src);
@@ -580,7 +601,7 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
                     &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off, &dv->b_rin_src, &dv->b_bin,
                     &dv->b_bout, &dv->b_total, &dv->b_woff, &dv->b_went,
                     &dv->b_emits, &dv->b_mask_src, &dv->b_mask_a, &dv->b_mask_b, &dv->b_cin_off,
-                    &dv->b_cin_src};
+                    &dv->b_cin_src, &dv->b_enew, &dv->b_dsum};
     for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
     dv->sz_lights = dv->sz_vis = dv->sz_tally = dv->sz_list = dv->sz_vout = dv->sz_woff = dv->sz_went = 0;
     dv->sz_cin_off = dv->sz_cin_src = 0;
@@ -608,6 +629,10 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     if ((st = ensure(dv, &dv->b_edir, &have, f4, d)) != PT_OK) return st;
     have = 0;
     if ((st = ensure(dv, &dv->b_src, &have, f4, d)) != PT_OK) return st;
+    have = 0;
+    if ((st = ensure(dv, &dv->b_enew, &have, f4, d)) != PT_OK) return st;
+    have = 0;
+    if ((st = ensure(dv, &dv->b_dsum, &have, dv->nmask * sizeof(float), d)) != PT_OK) return st;
     have = 0;
     if ((st = ensure(dv, &dv->b_lout, &have, f4, d)) != PT_OK) return st;
     have = 0;
@@ -749,10 +774,11 @@ static void cin_chunk(void *ctx, int chunk, int thread)
  * (a colour change, or a frame relit with nothing changed), and reused while
  * the set stays; a stage after a move gathers over rin with the mask.
  * cand holds the previous stage's set. */
-static pt_status compact_sources(gi_dev *dv, const float *vis, int nlights, diag *d)
+static pt_status compact_sources(gi_dev *dv, const float *vis, int nlights, int vis_changed, diag *d)
 {
     int n = dv->n;
     size_t words = ((size_t)n + 31) / 32;
+    if (!vis_changed && dv->cand_seen) goto same; /* the same vis: the same set */
     memcpy(dv->cand_new, dv->emits, words * sizeof(unsigned));
     for (int i = 0; i < n; i++) {
         const float *v = vis + (size_t)i * (size_t)nlights;
@@ -768,6 +794,7 @@ static pt_status compact_sources(gi_dev *dv, const float *vis, int nlights, diag
         dv->cin_valid = 0; /* a new set: gather over rin this time */
         return PT_OK;
     }
+same:
     if (dv->cin_valid) return PT_OK;
     int chunks = (n + CIN_CHUNK - 1) / CIN_CHUNK;
     cin_job J = {dv, 0};
@@ -809,9 +836,27 @@ static void sum_bounces(const float *tally, size_t items, int nb, double *bounce
 }
 
 static int cancelled(volatile int *cancel) { return cancel && *cancel; }
-pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, const float *vis, int mode, int nb,
-                          volatile int *cancel, float *edir, float *lout, float *phi, double *bounce_flux, int *done,
-                          double times[2], diag *d)
+/* What gi_dev_sums reports, from the per-work-item sums and masks. */
+static void fill_sums(const gi_dev *dv, size_t eitems, int nb, const double *bounce_flux, gi_dev_sums *sums)
+{
+    if (!sums) return;
+    double dsum = 0.0;
+    long nsrc = 0;
+    for (size_t g = 0; g < eitems; g++) {
+        dsum += dv->dsum[g];
+        nsrc += __builtin_popcount(dv->srcmask_host[g]);
+    }
+    sums->direct = dsum / 3.0;
+    sums->emitted = dv->emitted;
+    sums->sources = nsrc;
+    double sc = 0.0;
+    for (int b = 0; b < nb && bounce_flux; b++) sc += bounce_flux[b];
+    sums->scattered = sc;
+}
+
+pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, const float *vis, int vis_changed,
+                          int mode, int nb, volatile int *cancel, float *edir, float *lout, float *phi,
+                          double *bounce_flux, gi_dev_sums *sums, int *done, double times[2], diag *d)
 {
     double t0 = timer_now(), t1 = t0;
     size_t nn = (size_t)dv->n;
@@ -840,13 +885,18 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
         dv->tally_cap = dv->tally ? tcount : 0;
         if (!dv->tally) return PT_ERR_NOMEM;
     }
+#ifdef PARTRAY_HAVE_OPENCL
+    /* the device's vis is the last call's only if that one uploaded it */
+    if (dv->is_cl && !dv->vis_ok) vis_changed = 1;
+#endif
     if (nb > 0) {
-        pt_status cs = compact_sources(dv, vis, nlights, d);
+        pt_status cs = compact_sources(dv, vis, nlights, vis_changed, d);
         if (cs != PT_OK) return cs;
     }
     if (!dv->is_cl) {
         if (cancelled(cancel)) return PT_OK;
-        gi_c_emit(dv->threads, dv->part, n, lights, nlights, vis, dv->emits, dv->edir, dv->src, dv->mask_src);
+        gi_c_emit(dv->threads, dv->part, n, lights, nlights, vis, dv->emits, dv->edir, dv->src, dv->mask_src,
+                  dv->dsum);
         t1 = timer_now();
         const float *bin = dv->src;
         const unsigned *min = dv->mask_src;
@@ -873,8 +923,11 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
         else
             gi_c_resolve(dv->threads, dv->part, n, dv->edir, nb > 0, dv->total, lout, phi);
         memcpy(edir, dv->edir, nn * 4 * sizeof(float));
+        memcpy(dv->srcmask_host, dv->mask_src, eitems * sizeof(unsigned));
         sum_bounces(dv->tally, items, nb, bounce_flux);
+        fill_sums(dv, eitems, nb, bounce_flux, sums);
         dv->lout_host = lout;
+        dv->stale = 0;
         *done = 1;
         if (times) {
             times[0] = t1 - t0;
@@ -888,11 +941,17 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
     if (cancelled(cancel)) return PT_OK;
     if ((st = upload(dv, &dv->b_lights, &dv->sz_lights, lights, (size_t)nlights * sizeof *lights, d)) != PT_OK)
         return st;
-    if ((st = upload(dv, &dv->b_vis, &dv->sz_vis, vis, nn * (size_t)nlights * sizeof(float), d)) != PT_OK) return st;
+    if (vis_changed) {
+        dv->vis_ok = 0;
+        if ((st = upload(dv, &dv->b_vis, &dv->sz_vis, vis, nn * (size_t)nlights * sizeof(float), d)) != PT_OK)
+            return st;
+        dv->vis_ok = 1;
+    }
     if ((st = ensure(dv, &dv->b_tally, &dv->sz_tally, tcount * sizeof(float), d)) != PT_OK) return st;
-    karg a[] = {KMEM(dv->b_part), KINT(n),          KMEM(dv->b_lights), KINT(nlights),     KMEM(dv->b_vis),
-                KMEM(dv->b_emits), KMEM(dv->b_edir), KMEM(dv->b_src),    KMEM(dv->b_mask_src)};
-    if ((st = run_kernel(dv, KE_EMIT, eitems, a, 9, d)) != PT_OK) return st;
+    /* emission into b_enew: b_edir keeps the last completed stage's (gi_dev_fetch) */
+    karg a[] = {KMEM(dv->b_part),  KINT(n),          KMEM(dv->b_lights), KINT(nlights),        KMEM(dv->b_vis),
+                KMEM(dv->b_emits), KMEM(dv->b_enew), KMEM(dv->b_src),    KMEM(dv->b_mask_src), KMEM(dv->b_dsum)};
+    if ((st = run_kernel(dv, KE_EMIT, eitems, a, 10, d)) != PT_OK) return st;
     t1 = timer_now();
     cl_mem bin = dv->b_src, min = dv->b_mask_src;
     for (int b = 0; b < nbounce; b++) {
@@ -918,22 +977,31 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
     /* from here on the results are written: not cancelled any more */
     if (fused) {
         int nwalk = nb - 1, it = (int)items;
-        karg w[] = {KMEM(dv->b_part), KINT(n),           KMEM(dv->b_edir), KMEM(dv->b_total), KMEM(min),
+        karg w[] = {KMEM(dv->b_part), KINT(n),           KMEM(dv->b_enew), KMEM(dv->b_total), KMEM(min),
                     KMEM(dv->b_woff), KMEM(dv->b_went),  KINT(nwalk),      KMEM(dv->b_lout),  KMEM(dv->b_phi),
                     KMEM(dv->b_tally), KINT(it)};
         if ((st = run_kernel_local(dv, KE_WALK, items, GI_BOUNCE_LOCAL, w, 12, d)) != PT_OK) return st;
     } else {
         int scattered = nb > 0;
-        karg r[] = {KMEM(dv->b_part), KINT(n),          KMEM(dv->b_edir), KINT(scattered), KMEM(dv->b_total),
+        karg r[] = {KMEM(dv->b_part), KINT(n),          KMEM(dv->b_enew), KINT(scattered), KMEM(dv->b_total),
                     KMEM(dv->b_lout), KMEM(dv->b_phi)};
         if ((st = run_kernel(dv, KE_RESOLVE, nn, r, 7, d)) != PT_OK) return st;
     }
+    cl_mem te = dv->b_edir;
+    dv->b_edir = dv->b_enew;
+    dv->b_enew = te;
+    dv->edir_host = edir;
+    dv->phi_host = phi;
+    dv->stale = 1;
+    /* edir and phi stay on the device until gi_dev_fetch (only stats and
+     * tests read them); lout is the gather's input on the host too */
     if ((st = download(dv, dv->b_lout, lout, f4, d)) != PT_OK) return st;
-    if ((st = download(dv, dv->b_phi, phi, f4, d)) != PT_OK) return st;
-    if ((st = download(dv, dv->b_edir, edir, f4, d)) != PT_OK) return st;
+    if ((st = download(dv, dv->b_dsum, dv->dsum, eitems * sizeof(float), d)) != PT_OK) return st;
+    if ((st = download(dv, dv->b_mask_src, dv->srcmask_host, eitems * sizeof(unsigned), d)) != PT_OK) return st;
     if (nb > 0 && (st = download(dv, dv->b_tally, dv->tally, (size_t)nb * 3 * items * sizeof(float), d)) != PT_OK)
         return st;
     sum_bounces(dv->tally, items, nb, bounce_flux);
+    fill_sums(dv, eitems, nb, bounce_flux, sums);
     *done = 1;
     if (times) {
         times[0] = t1 - t0;
@@ -943,6 +1011,21 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
 #else
     return PT_ERR_INTERNAL;
 #endif
+}
+
+pt_status gi_dev_fetch(gi_dev *dv, diag *d)
+{
+    if (!dv || !dv->stale) return PT_OK;
+#ifdef PARTRAY_HAVE_OPENCL
+    size_t f4 = (size_t)dv->n * 4 * sizeof(float);
+    pt_status st = download(dv, dv->b_edir, dv->edir_host, f4, d);
+    if (st == PT_OK) st = download(dv, dv->b_phi, dv->phi_host, f4, d);
+    if (st != PT_OK) return st;
+#else
+    (void)d;
+#endif
+    dv->stale = 0;
+    return PT_OK;
 }
 
 pt_status gi_dev_gather(gi_dev *dv, const int *used, int nused, const float bg[3], float *eind, diag *d)

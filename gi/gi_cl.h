@@ -63,20 +63,33 @@ pt_status gi_dev_set_reverse(gi_dev *dv, const int *rin_off, const int *rin_src,
 pt_status gi_dev_set_walk(gi_dev *dv, const int *woff, const gi_walk_entry *went, int nwalk, diag *d);
 
 /* Lighting stage (gi_lighting.cl): emission from the lights with vis
- * (n x nlights: attenuation times visibility fraction), nb scattering bounces (mode
- * GI_SCATTER_WALK: the first along all links, then the walk lists;
- * GI_SCATTER_FULL: all along all links), then the reflected radiance. The
- * host arrays edir (direct E/pi), lout (radiance) and phi (received flux),
- * n*4 floats each, and bounce_flux (nb grey sums of what each bounce
- * delivered; may be NULL) are written only at the end, and *done set to 1.
- * While *cancel (may be NULL) is non-zero the stage stops before its next
- * kernel, writes nothing the caller reads and returns PT_OK with *done 0:
- * the previous results stay in place (on the device too). times (may be
- * NULL): seconds of emission (uploads included) and of the rest. */
+ * (n x nlights: attenuation times visibility fraction; vis_changed 0: the
+ * same values as the previous call's, not uploaded again), nb scattering
+ * bounces (mode GI_SCATTER_WALK: the first along all links, then the walk
+ * table; GI_SCATTER_FULL: all along all links), then the reflected
+ * radiance. The host array lout (radiance, n*4 floats), bounce_flux (nb grey
+ * sums of what each bounce delivered; may be NULL) and sums (may be NULL)
+ * are written only at the end, and *done set to 1. edir (direct E/pi) and
+ * phi (received flux), n*4 floats each, are written by the time
+ * gi_dev_fetch returns (OpenCL keeps them on the device until asked; they
+ * must stay valid until then). While *cancel (may be NULL) is non-zero the
+ * stage stops before its next kernel, writes nothing the caller reads and
+ * returns PT_OK with *done 0: the previous results stay in place (on the
+ * device too). times (may be NULL): seconds of emission (uploads included)
+ * and of the rest. */
 enum { GI_SCATTER_WALK = 0, GI_SCATTER_FULL = 1 };
-pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, const float *vis, int mode, int nb,
-                          volatile int *cancel, float *edir, float *lout, float *phi, double *bounce_flux, int *done,
-                          double times[2], diag *d);
+typedef struct {
+    double direct;    /* direct flux, grey (mean of the colours) */
+    double emitted;   /* emitted flux, grey */
+    double scattered; /* flux the bounces delivered, grey (sum of bounce_flux) */
+    long sources;     /* particles sending light in the first bounce */
+} gi_dev_sums;
+pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, const float *vis, int vis_changed,
+                          int mode, int nb, volatile int *cancel, float *edir, float *lout, float *phi,
+                          double *bounce_flux, gi_dev_sums *sums, int *done, double times[2], diag *d);
+/* Writes the last completed lighting stage's edir and phi into the arrays
+ * it was given (nothing when they are written already). d may be NULL. */
+pt_status gi_dev_fetch(gi_dev *dv, diag *d);
 /* Ray-tracing stage. gather: E~/pi of the used particles, written into the
  * device's copy and into eind[4*used[t]] on the host. estimate: radiance
  * particles found[t] into vout[4*t] (compact). */

@@ -49,7 +49,8 @@ static void run_chunk(void *ctx, int chunk, int thread)
         gi_shim_gid = g;
         switch (a->kernel) {
         case K_EMIT:
-            gi_k_emit(a->part, a->np, a->lights, a->nlights, a->vis, a->emits, a->fout, a->fout2, a->mask_out);
+            gi_k_emit(a->part, a->np, a->lights, a->nlights, a->vis, a->emits, a->fout, a->fout2, a->mask_out,
+                      a->tally);
             break;
         case K_BOUNCE:
             gi_k_bounce(a->np, a->off, a->obase, a->from, a->sbase, a->w_in, a->src, a->mask_in, a->rho4, a->first,
@@ -81,12 +82,13 @@ static void launch(int threads, c_launch *a)
 }
 
 void gi_c_emit(int threads, const gi_dev_particle *part, int n, const gi_dev_light *lights, int nlights,
-               const float *vis, const unsigned *emits, float *edir, float *src, unsigned *srcmask)
+               const float *vis, const unsigned *emits, float *edir, float *src, unsigned *srcmask, float *dsum)
 {
     /* one work-item per GI_EMIT_CHUNK particles, 16 work-items per pool job */
     size_t items = ((size_t)n + GI_EMIT_CHUNK - 1) / GI_EMIT_CHUNK;
     c_launch a = {.kernel = K_EMIT, .n = items, .part = part, .np = n, .lights = lights, .nlights = nlights,
-                  .vis = vis, .emits = emits, .fout = edir, .fout2 = src, .mask_out = srcmask, .chunk = 16};
+                  .vis = vis, .emits = emits, .fout = edir, .fout2 = src, .mask_out = srcmask, .tally = dsum,
+                  .chunk = 16};
     launch(threads, &a);
 }
 

@@ -8,9 +8,9 @@
 #define PT_GI_CL_C_H
 #include "kernels/gi_types.h"
 
-/* gi_k_emit: ceil(n / GI_EMIT_CHUNK) work-items, one srcmask word each. */
+/* gi_k_emit: ceil(n / GI_EMIT_CHUNK) work-items, one srcmask word and dsum float each. */
 void gi_c_emit(int threads, const gi_dev_particle *part, int n, const gi_dev_light *lights, int nlights,
-               const float *vis, const unsigned *emits, float *edir, float *src, unsigned *srcmask);
+               const float *vis, const unsigned *emits, float *edir, float *src, unsigned *srcmask, float *dsum);
 /* gi_k_bounce: ceil(n / GI_BOUNCE_CHUNK) work-items; tally gets 3 floats
  * per work-item from tbase. */
 void gi_c_bounce(int threads, int n, const int *off, int obase, const int *from, int sbase, float w_in,

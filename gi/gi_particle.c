@@ -1008,36 +1008,23 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
     }
     double kt[2] = {0.0, 0.0};
     int done = 0;
-    st = gi_dev_lighting(gp->dev, gp->lights, gp->nlights, gp->vis, full ? GI_SCATTER_FULL : GI_SCATTER_WALK, nb,
-                      gp->cancel, gp->edir, gp->lout, gp->phi, gp->bounce_flux, &done, kt, d);
+    /* stats sums (direct, emitted and scattered flux, grey; the particles
+     * that send light in the first bounce) come from the kernels' partial
+     * sums: no pass over the particles here. The device keeps edir and phi
+     * until gi_particle_debug asks (gi_dev_fetch). */
+    gi_dev_sums sums;
+    st = gi_dev_lighting(gp->dev, gp->lights, gp->nlights, gp->vis, ndirty > 0,
+                         full ? GI_SCATTER_FULL : GI_SCATTER_WALK, nb, gp->cancel, gp->edir, gp->lout, gp->phi,
+                         gp->bounce_flux, &sums, &done, kt, d);
     if (st != PT_OK) return st;
     if (!done) return PT_OK; /* cancelled: the previous lighting stays */
     S->t_emit = kt[0];
     S->t_scatter = kt[1];
     gp->nbounce_flux = nb;
-    /* sums for the stats: direct, emitted and scattered flux (grey), and the
-     * particles that send light in the first bounce */
-    double ts = timer_now();
-    long nsrc = 0;
-    double fd = 0.0, fe = 0.0, fs = 0.0;
-    for (int i = 0; i < n; i++) {
-        const gi_dev_particle *p = &gp->ps.p[i];
-        const float *e = &gp->edir[4 * (size_t)i], *f = &gp->phi[4 * (size_t)i];
-        int source = 0;
-        for (int c = 0; c < 3; c++) {
-            double direct = M_PI * e[c] * p->area, emitted = M_PI * p->le[c] * p->area;
-            fd += direct / 3.0;
-            fe += emitted / 3.0;
-            fs += (f[c] - direct) / 3.0;
-            source |= p->rho[c] * direct + emitted != 0.0;
-        }
-        nsrc += source;
-    }
-    S->sources = nsrc;
-    S->flux_direct = fd;
-    S->flux_emitted = fe;
-    S->flux_scattered = fs;
-    S->t_scatter += timer_now() - ts;
+    S->sources = sums.sources;
+    S->flux_direct = sums.direct;
+    S->flux_emitted = sums.emitted;
+    S->flux_scattered = sums.scattered;
     reset_view(gp);
     gp->lit = 1;
     S->t_lighting = timer_now() - t0;
@@ -1822,6 +1809,7 @@ rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
 int gi_particle_debug(const gi_particle *gp, const float **edir, const float **phi, const float **lout,
                       const double **bounce_flux, int *nbounces)
 {
+    if (edir || phi) gi_dev_fetch(gp->dev, NULL); /* the last lighting stage's, kept on the device until now */
     if (edir) *edir = gp->edir;
     if (phi) *phi = gp->phi;
     if (lout) *lout = gp->lout;

@@ -27,16 +27,18 @@
  * bounce reads only those; the paper runs one scattering thread per directly
  * lit particle, Fig. 5). emits (word per 32 particles, built on the host)
  * marks the particles with emission: a particle no light reaches (every vis
- * 0) and without it gets zeros without reading its record. */
+ * 0) and without it gets zeros without reading its record. dsum[g]: the
+ * direct flux of the work-item's particles, summed over colours (stats). */
 __kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global const gi_dev_light *lights, int nlights,
                         __global const float *vis, __global const uint *emits, __global float *edir,
-                        __global float *src, __global uint *srcmask)
+                        __global float *src, __global uint *srcmask, __global float *dsum)
 {
     int g = (int)get_global_id(0);
     int i0 = g * GI_EMIT_CHUNK;
     if (i0 >= n) return;
     int i1 = n - i0 < GI_EMIT_CHUNK ? n : i0 + GI_EMIT_CHUNK;
     uint em = emits[g], bits = 0u;
+    float ds = 0.0f;
     for (int i = i0; i < i1; i++) {
         int lit = 0;
         for (int l = 0; l < nlights; l++) lit |= vis[(long)i * nlights + l] > 0.0f;
@@ -66,6 +68,7 @@ __kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global co
             if (!isfinite(e[c])) e[c] = 0.0f;
             float phid = GI_PI_F * e[c] * pt->area;
             float sv = pt->rho[c] * phid + GI_PI_F * pt->le[c] * pt->area;
+            ds += phid;
             edir[4 * i + c] = e[c];
             src[4 * i + c] = sv;
             any |= sv != 0.0f;
@@ -75,6 +78,7 @@ __kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global co
         if (any) bits |= 1u << (i - i0);
     }
     srcmask[g] = bits;
+    dsum[g] = ds;
 }
 
 /* Reflected radiance of every area particle after scattering (section 4.2.2,
