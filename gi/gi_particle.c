@@ -1212,8 +1212,10 @@ static long prepass_ray(gi_particle *gp, vec3 org, vec3 dir, int level, int max_
             vr->w[k] = located ? cw[k] : 0.0;
         }
     }
-    int refl = fmax(f->reflection_max.r, fmax(f->reflection_max.g, f->reflection_max.b)) > 0.0 ||
-               fmax(f->reflection_min.r, fmax(f->reflection_min.g, f->reflection_min.b)) > 0.0;
+    /* any channel > 0 (fmax's answer, without its libm calls: a NaN
+     * channel counts as not > 0 either way) */
+    int refl = f->reflection_max.r > 0.0 || f->reflection_max.g > 0.0 || f->reflection_max.b > 0.0 ||
+               f->reflection_min.r > 0.0 || f->reflection_min.g > 0.0 || f->reflection_min.b > 0.0;
     const colour5 *pc = &tex->pigment.colour;
     int trans = pc->f > 0.0 || pc->t > 0.0;
     if (rec && h.obj && flat_pieces(h.obj) && ((!refl && !trans) || level >= max_level)) {
