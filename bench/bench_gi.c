@@ -402,9 +402,9 @@ int main(int argc, char **argv)
            (double)x->late_area / o.reps, (double)x->lookups_none / o.reps, (double)x->discarded / o.reps,
            (double)(x->visibility_rays - gs.visibility_rays) / o.reps);
     printf("  pre-pass (last frame): %.1f ms CPU; stride %d, %ld rays, %ld pixels on their neighbours' plane, %ld "
-           "between misses; %ld hits kept for the render, %.1f%% of lookups took their cell from one\n",
+           "between misses; %ld hits kept for the render (%.1f MiB), %.1f%% of lookups took their cell from one\n",
            1e3 * x->c_prepass, o.stride > 0 ? o.stride : (s.keep_hits ? 1 : 2), x->prepass_rays, x->prepass_planar,
-           x->prepass_missed, x->prepass_kept, 100.0 * x->lookups_kept / fmax(1, x->lookups));
+           x->prepass_missed, x->prepass_kept, x->bytes_view / 1048576.0, 100.0 * x->lookups_kept / fmax(1, x->lookups));
     printf("  light-leak guard: %s; %ld cells tested (%ld clear, %.1f%%), %.1f%% of lookups in clear cells, "
            "table %.1f MiB\n",
            o.per_hit ? "per hit" : "per cell", x->cells, x->cells_clear, 100.0 * x->cells_clear / fmax(1, x->cells),

@@ -1424,9 +1424,6 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
     double sc = accel_eps_scale(gp->a);
     J.eps = (sc > 0.0 && isfinite(sc) ? sc : 1.0) * 1e-6;
     double c0 = cpu_now();
-    J.stride = gp->set.prepass_stride > 0 ? gp->set.prepass_stride : (gp->set.keep_hits ? 1 : 2);
-    J.ncx = coarse_count(J.stride, w);
-    J.ncy = coarse_count(J.stride, h);
     J.ch = NULL;
     J.rec = NULL;
     atomic_init(&J.rays, 0);
@@ -1444,6 +1441,11 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
         }
         J.rec = gp->vrec;
     }
+    /* kept hits: every pixel traced (unless told otherwise); none (too
+     * large, no memory): the coarse pre-pass */
+    J.stride = gp->set.prepass_stride > 0 ? gp->set.prepass_stride : (J.rec ? 1 : 2);
+    J.ncx = coarse_count(J.stride, w);
+    J.ncy = coarse_count(J.stride, h);
     if (w > 0 && h > 0) {
         /* step 1, then step 2; every pixel traced (step 1 alone, without
          * records) at stride 1 or when the grid's memory is not there */
@@ -1461,6 +1463,7 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
     S->prepass_planar = atomic_load(&J.planar);
     S->prepass_missed = atomic_load(&J.missed);
     S->prepass_kept = atomic_load(&J.kept);
+    S->bytes_view = gp->vrec_cap * sizeof(view_rec);
     if (J.rec) {
         gp->vw = w;
         gp->vh = h;

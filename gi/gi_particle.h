@@ -111,10 +111,12 @@ typedef struct {
     int keep_hits;       /* 1: the pre-pass keeps each traced pixel's first hit, and the radiance
                             particles it located there, for the render: gi_particle_primary_begin
                             and _hit as shade_settings.primary_begin and .primary give the render
-                            those rays and hits instead of its own camera rays, and the hook takes their cell from the record (same values:
-                            the same image). Then stride 0 means 1 (every pixel traced once, by the
-                            pre-pass). Only for renders whose camera rays go through pixel centres
-                            (no fixed supersampling); none kept beyond 256 MiB of records. 0
+                            those rays and hits instead of its own camera rays, and the hook
+                            takes their cell and the light-leak guard's verdict from the record
+                            (same values: the same image). Then stride 0 means 1 (every pixel
+                            traced once, by the pre-pass). Only for renders whose camera rays go through pixel centres
+                            (no fixed supersampling); beyond 256 MiB of records (248 bytes a pixel) or
+                            without the memory none are kept and the coarse pre-pass runs. 0
                             (default): nothing kept */
     int nominal_areas;   /* 1: every area particle keeps the nominal dA = A/N (before 22 Nov 2026: reads
                             ~1% bright, see gi_particle.c catchment_areas); 0 (default): each particle's
@@ -170,6 +172,7 @@ typedef struct {
     long lookups_clear;     /* hook lookups in clear cells (no visibility rays) */
     long prepass_kept;      /* last prepare_view: pixels whose first hit was kept (keep_hits) */
     long lookups_kept;      /* hook lookups that took their cell from a kept hit (no locate) */
+    size_t bytes_view;      /* keep_hits: the kept hits' records (not in bytes_total) */
     long skipped_objects;
     double flux_direct, flux_emitted, flux_scattered; /* sums over particles (grey) */
     /* memory, bytes */
