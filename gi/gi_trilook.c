@@ -381,13 +381,30 @@ static void build_job(void *ctx, int ch, int thread)
                             mx = sqrt(mx);
                             if (mx < R[sd]) R[sd] = mx;
                         }
-                    for (int sd = 0; sd < 2; sd++)
+                    /* a side without a certain particle near the triangle
+                     * (a side facing the void, the inside of a closed
+                     * mesh) is left to the grid path: its list would have
+                     * to reach maxdist, and few rays hit it (cbox 50K: 5,993
+                     * of 8,180 triangles gathered again out to maxdist for
+                     * such a side; 4x4 links with the build 0.78 -> 0.73 s
+                     * CPU, two runs each) */
+                    int cov[2];
+                    for (int sd = 0; sd < 2; sd++) {
+                        cov[sd] = R[sd] < INFINITY;
                         if (R[sd] > B->maxdist) R[sd] = B->maxdist;
+                    }
                     double rl[2] = {R[0] * (1.0 + REL) + B->delta, R[1] * (1.0 + REL) + B->delta};
-                    needed = fmax(needed, fmax(rl[0], rl[1]));
-                    /* (the second pass gathered every cell's need) */
+                    for (int sd = 0; sd < 2; sd++) {
+                        if (cov[sd] && pass == 0) needed = fmax(needed, rl[sd]);
+                        /* (the second pass gathered every need the first one saw) */
+                        if (pass == 1 && rl[sd] > rg - rt) cov[sd] = 0;
+                    }
                     if (pass == 0 && needed > rg - rt) continue; /* gathered again */
                     for (int sd = 0; sd < 2; sd++) {
+                        if (!cov[sd]) {
+                            t->loff[2 * cell + sd] = EMPTY_OPEN;
+                            continue;
+                        }
                         double rl2 = rl[sd] * rl[sd];
                         /* membership: dist(p, cell) <= rl; the centre distance
                          * bounds it: pc - rc <= dist <= pc */

@@ -16,7 +16,8 @@
  * R from every point of C) and W is not "uncertain" (buried in a closed
  * solid, or with a normal within 1e-3 of gi_links' agreement threshold,
  * whose membership the grid path decides with its own arithmetic).
- * Otherwise the caller takes the grid path. Internal to gi/. */
+ * Otherwise the caller takes the grid path, as for the sides of a triangle
+ * with no such particle near it. Internal to gi/. */
 #ifndef PT_GI_TRILOOK_H
 #define PT_GI_TRILOOK_H
 #include <stddef.h>
