@@ -617,7 +617,7 @@ gi_trilook *gi_trilook_build(const accel *a, const gi_dev_particle *p, int n, co
     }
     t->ncell = 2 * ncell;
     t->loff = calloc((size_t)t->ncell, sizeof *t->loff);
-    t->pp = aligned_alloc(64, ((size_t)n + 1) * sizeof *t->pp + 64);
+    t->pp = aligned_alloc(64, (((size_t)n + 1) * sizeof *t->pp + 63) / 64 * 64); /* (a multiple of the alignment, as C11 asks) */
     if (!t->loff || !t->pp) goto nomem;
     t->n = n;
     for (int i = 0; i < n; i++)
