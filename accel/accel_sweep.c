@@ -1508,10 +1508,31 @@ static int cells_for(double len, double cell, int lo)
     return !(c >= lo) ? lo : (c > 4096.0 ? 4096 : (int)c);
 }
 
-int accel_sweep_grid_cell(const accel_shape *sh, double cell, accel_grid_fn fn, void *ctx)
+/* How far (radians) the normal of segment k turns along it: the angles
+ * between successive normals at s + 1 points (the sweep's first position:
+ * a lathe's or sor's profile normal turns alike at every angle). */
+static double seg_turn(const sw_data *w, int k, int s)
+{
+    double turn = 0.0;
+    vec3 p, n0, n1;
+    grid_point(w, 2 + k, 0.0, 0.0, &p, &n0);
+    for (int i = 1; i <= s; i++) {
+        grid_point(w, 2 + k, (double)i / s, 0.0, &p, &n1);
+        double l0 = v3_len(n0), l1 = v3_len(n1);
+        if (l0 > 0.0 && l1 > 0.0) {
+            double c = v3_dot(n0, n1) / (l0 * l1);
+            if (isfinite(c)) turn += acos(c > 1.0 ? 1.0 : (c < -1.0 ? -1.0 : c));
+        }
+        n0 = n1;
+    }
+    return turn;
+}
+
+int accel_sweep_grid_cell(const accel_shape *sh, double cell, double turn, accel_grid_fn fn, void *ctx)
 {
     const sw_data *w = sh->data;
     if (!w || w->type == SW_POLYGON || !(cell > 0.0) || !isfinite(cell)) return 0;
+    if (!(turn > 0.0) || !isfinite(turn)) turn = INFINITY;
     double c = cell / w->L; /* the bound in local units */
     enum { S = 32 };
     int *na = malloc(sizeof *na * (size_t)(w->nseg > 0 ? w->nseg : 1));
@@ -1535,6 +1556,10 @@ int accel_sweep_grid_cell(const accel_shape *sh, double cell, accel_grid_fn fn, 
             if (w->type != SW_PRISM) break;
         }
         na[k] = cells_for(arc, c, 1);
+        if (isfinite(turn)) {
+            double t = ceil(seg_turn(w, k, S) / turn);
+            if (t > na[k]) na[k] = t > 4096.0 ? 4096 : (int)t;
+        }
         if (w->type == SW_PRISM) {
             for (int i = 0; i <= 4; i++) {
                 vec3 a, b, nn;
@@ -1546,6 +1571,8 @@ int accel_sweep_grid_cell(const accel_shape *sh, double cell, accel_grid_fn fn, 
     }
     if (w->type == SW_SOR) rmax = fmax(rmax, sqrt(fmax(w->base_r2, w->cap_r2)));
     int nb = w->type == SW_PRISM ? cells_for(around, c, 1) : cells_for(2.0 * M_PI * rmax, c, 3);
+    if (w->type != SW_PRISM && isfinite(turn) && nb < 2.0 * M_PI / turn)
+        nb = 2.0 * M_PI / turn >= 4096.0 ? 4096 : (int)ceil(2.0 * M_PI / turn);
     int nr = cells_for(sqrt(fmax(w->base_r2, w->cap_r2)), c, 1);
     int r = grid_sized(w, na, nb, nr, fn, ctx);
     free(na);

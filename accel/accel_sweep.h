@@ -50,8 +50,11 @@ int accel_sweep_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx);
  * each profile segment (by its arc length) and around (lathe, sor: the
  * widest circle, at least 3) or along the sweep (prism, text); sor caps
  * by their radius; prism and text caps from the curves polygonised as their
- * sides (their trapezoids may be longer: GI splits them). 0 for polygons. */
-int accel_sweep_grid_cell(const accel_shape *sh, double cell, accel_grid_fn fn, void *ctx);
+ * sides (their trapezoids may be longer: GI splits them). Where the normal
+ * turns faster, cells of at most `turn` radians of it: along a segment (its
+ * normal's total turning / turn cells) and around a lathe or sor (at least
+ * 2 pi / turn); turn <= 0 or infinite: by length alone. 0 for polygons. */
+int accel_sweep_grid_cell(const accel_shape *sh, double cell, double turn, accel_grid_fn fn, void *ctx);
 
 /* Polygon: its even-odd region as object-space triangles (trapezoids of
  * the slabs between vertex heights, two triangles each; exact for simple

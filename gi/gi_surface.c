@@ -1278,6 +1278,18 @@ static int split_grid(shape_kind k)
  * curved parts every split puts a vertex on a chord, off the surface). */
 #define SPLIT_FACTOR 1.5
 
+/* Sweep cells (lathe, sor, prism and text sides) span at most this much
+ * turning of the normal, acos(0.9) = 25.8 degrees: the estimation lists'
+ * default normal threshold (gi_particle.h normal_cos), so that the three
+ * radiance particles a hit interpolates face within a list's cone of each
+ * other. Cells sized by length alone (the bound) spanned up to 58 degrees
+ * on test_gi_grids' lathe at 8,000 particles (the rim of its top: two cells
+ * over 116 degrees), and a hit on the lit top interpolated radiance
+ * particles of the dark side below the rim, which faces down: the lathe read -7.9% and the sor -6.4% (means of
+ * particle seeds 11-14 against path 1024 spp); with this bound -2.4% and
+ * -0.4% (docs/gi.md, "Sweep cells and the normal's turning"). */
+#define SWEEP_TURN 0.4510268117962624
+
 static int split_grid_build(const accel_shape *sh, double tess, mesh_ctx *m)
 {
     double s = max_stretch(sh);
@@ -1296,7 +1308,7 @@ static int split_grid_build(const accel_shape *sh, double tess, mesh_ctx *m)
         return accel_hfield_coarse_grid(sh, sx, sz, mesh_tri, m);
     }
     case SHAPE_POLYGON: return accel_shape_grid(sh, 1, mesh_tri, m);
-    default: return accel_sweep_grid_cell(sh, tess / s, mesh_tri, m);
+    default: return accel_sweep_grid_cell(sh, tess / s, SWEEP_TURN, mesh_tri, m);
     }
 }
 
