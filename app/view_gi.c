@@ -124,9 +124,6 @@ static pt_status particle_open(void **ctx, const scene *sc, const accel *a, cons
     if (o->particles > 0) s.count = o->particles;
     if (o->bounces > 0) s.bounces = o->bounces;
     if (o->cl_device) s.cl_device = o->cl_device;
-    /* every pass's first samples go through pixel centres (adaptive
-     * antialiasing adds its own): the render takes the pre-pass's hits */
-    s.keep_hits = 1;
     pt_status st = PT_OK;
     c->gp = gi_particle_build(sc, a, &s, &c->stats, d, &st);
     if (!c->gp || st != PT_OK) {
@@ -202,9 +199,6 @@ static pt_status particle_render(void *ctx, const view_gi_pass *p, framebuffer *
     ss.use_ambient = 0;
     ss.indirect = gi_particle_indirect;
     ss.indirect_ctx = gp;
-    ss.primary_begin = gi_particle_primary_begin;
-    ss.primary = gi_particle_primary_hit;
-    ss.primary_ctx = gp;
     double t0 = timer_now();
     st = shade_render(c->sc, c->a, &ss, fb, NULL, d);
     t->render = timer_now() - t0;
