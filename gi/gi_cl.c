@@ -70,11 +70,10 @@ struct gi_dev {
     /* the first bounce's incoming lists cut to the candidate sources (rin
      * entries whose source has emission or some vis > 0; compact_sources),
      * rebuilt when that set changes */
-    unsigned *cand, *cand_new; /* nmask words: this stage's set, scratch (the previous stage's after the swap) */
+    unsigned *cand, *cand_new; /* nmask words: the set cin is built for, scratch */
     int *cin_off, *cin_src;    /* n + 1 offsets, entries */
     size_t cin_cap;
     int cin_valid;  /* cin is built for the set in cand */
-    int cand_seen;  /* cand holds a previous stage's set */
     const int *woff;            /* WALK path table (gi_dev_set_walk): n + 1 offsets */
     const gi_walk_entry *went;  /* and woff[n] entries */
     int nwalk;
@@ -551,7 +550,7 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     free(dv->cand);
     free(dv->cand_new);
     free(dv->cin_off);
-    dv->cin_valid = dv->cand_seen = 0;
+    dv->cin_valid = 0;
     dv->emits = calloc(dv->nmask, sizeof(unsigned));
     dv->cand = calloc(dv->nmask, sizeof(unsigned));
     dv->cand_new = calloc(dv->nmask, sizeof(unsigned));
@@ -716,69 +715,21 @@ pt_status gi_dev_set_walk(gi_dev *dv, const int *woff, const gi_walk_entry *went
 #endif
 }
 
-/* compact_sources: targets per pool job */
-#define CIN_CHUNK 4096
-
-typedef struct {
-    gi_dev *dv;
-    int pass; /* 0: count per target into cin_off[j + 1], 1: fill */
-} cin_job;
-
-static void cin_chunk(void *ctx, int chunk, int thread)
-{
-    (void)thread;
-    const cin_job *J = ctx;
-    gi_dev *dv = J->dv;
-    const unsigned *cand = dv->cand;
-    int j0 = chunk * CIN_CHUNK, j1 = j0 + CIN_CHUNK < dv->n ? j0 + CIN_CHUNK : dv->n;
-    /* without branches on the bits (about a quarter set on maze: a branch
-     * per link mispredicts often): pass 1 writes every entry and advances
-     * past the kept ones; a dropped entry is overwritten by the next kept
-     * one, or by the next target's first (this thread's, but for the
-     * chunk's last target: there, branches) */
-    for (int j = j0; j < j1; j++) {
-        int q0 = dv->rin_off[j], q1 = dv->rin_off[j + 1];
-        if (!J->pass) {
-            int c = 0;
-            for (int q = q0; q < q1; q++) {
-                int i = dv->rin_src[q];
-                c += (int)((cand[i >> 5] >> (i & 31)) & 1u);
-            }
-            dv->cin_off[j + 1] = c;
-        } else if (j + 1 < j1) {
-            int w = dv->cin_off[j];
-            for (int q = q0; q < q1; q++) {
-                int i = dv->rin_src[q];
-                dv->cin_src[w] = i;
-                w += (int)((cand[i >> 5] >> (i & 31)) & 1u);
-            }
-        } else {
-            int w = dv->cin_off[j];
-            for (int q = q0; q < q1; q++) {
-                int i = dv->rin_src[q];
-                if ((cand[i >> 5] >> (i & 31)) & 1u) dv->cin_src[w++] = i;
-            }
-        }
-    }
-}
-
 /* The first bounce reads only particles that send light (gi_k_emit's source
- * mask), but a gather over every incoming link still reads every link and
- * tests its source's bit. cin holds the incoming links (rin, the same order)
- * of the candidate sources only: particles with emission or some vis > 0,
- * the ones gi_k_emit may give a non-zero src (the others get 0, and adding a
- * 0 changes no float sum: the same sums as over rin, bit for bit). The set
- * changes only with the visibility (a light moved). Building cin costs
- * about twice the bounce it saves (maze: ~8.7 ms CPU against ~4), so it is
- * built only when a lighting stage finds the same set as the one before
- * (a colour change, or a frame relit with nothing changed), and reused while
- * the set stays; a stage after a move gathers over rin with the mask.
- * cand holds the previous stage's set. */
+ * mask), but a gather over every incoming link (rin) still reads every link
+ * and tests its source's bit. cin holds the incoming links of the candidate
+ * sources only: particles with emission or some vis > 0, the ones gi_k_emit
+ * may give a non-zero src (the others get 0, and adding a 0 changes no
+ * float sum: the same sums as over rin, bit for bit). It is a counting sort
+ * of the candidates' own scattering links (slink) by target, candidates
+ * ascending: per target the same entries in the same order as rin's. The
+ * set changes only with the visibility (vis_changed: a light moved), so a
+ * colour change reuses it. */
 static pt_status compact_sources(gi_dev *dv, const float *vis, int nlights, int vis_changed, diag *d)
 {
-    int n = dv->n;
+    int n = dv->n, ns2 = dv->ns2;
     size_t words = ((size_t)n + 31) / 32;
-    if (!vis_changed && dv->cand_seen) goto same; /* the same vis: the same set */
+    if (!vis_changed && dv->cin_valid) return PT_OK; /* the same vis: the same set */
     memcpy(dv->cand_new, dv->emits, words * sizeof(unsigned));
     for (int i = 0; i < n; i++) {
         const float *v = vis + (size_t)i * (size_t)nlights;
@@ -789,30 +740,37 @@ static pt_status compact_sources(gi_dev *dv, const float *vis, int nlights, int 
     unsigned *t = dv->cand;
     dv->cand = dv->cand_new;
     dv->cand_new = t;
-    if (!dv->cand_seen || memcmp(dv->cand_new, dv->cand, words * sizeof(unsigned)) != 0) {
-        dv->cand_seen = 1;
-        dv->cin_valid = 0; /* a new set: gather over rin this time */
-        return PT_OK;
-    }
-same:
-    if (dv->cin_valid) return PT_OK;
-    int chunks = (n + CIN_CHUNK - 1) / CIN_CHUNK;
-    cin_job J = {dv, 0};
-    dv->cin_off[0] = 0;
-    if (chunks > 0) pool_run(dv->threads, chunks, cin_chunk, &J);
-    for (int j = 0; j < n; j++) dv->cin_off[j + 1] += dv->cin_off[j];
-    size_t m = (size_t)dv->cin_off[n];
+    if (dv->cin_valid && memcmp(dv->cand_new, dv->cand, words * sizeof(unsigned)) == 0) return PT_OK;
+    dv->cin_valid = 0;
+    int *off = dv->cin_off;
+    memset(off, 0, ((size_t)n + 1) * sizeof(int));
+    for (size_t w = 0; w < words; w++)
+        for (unsigned bits = dv->cand[w]; bits; bits &= bits - 1) {
+            const int *lk = dv->slink + ((size_t)w * 32 + (size_t)__builtin_ctz(bits)) * (size_t)ns2;
+            for (int k = 0; k < ns2; k++)
+                if (lk[k] >= 0) off[lk[k] + 1]++;
+        }
+    for (int j = 0; j < n; j++) off[j + 1] += off[j];
+    size_t m = (size_t)off[n];
     if (m > dv->cin_cap || !dv->cin_src) {
         free(dv->cin_src);
-        dv->cin_src = malloc((m + 1) * sizeof(int)); /* + 1: pass 1 may write one past the last kept */
+        dv->cin_src = malloc((m > 0 ? m : 1) * sizeof(int));
         dv->cin_cap = dv->cin_src ? m : 0;
         if (!dv->cin_src) return PT_ERR_NOMEM;
     }
-    J.pass = 1;
-    if (chunks > 0) pool_run(dv->threads, chunks, cin_chunk, &J);
+    /* off[t] is target t's write cursor, then shifted back to offsets */
+    for (size_t w = 0; w < words; w++)
+        for (unsigned bits = dv->cand[w]; bits; bits &= bits - 1) {
+            int i = (int)(w * 32) + __builtin_ctz(bits);
+            const int *lk = dv->slink + (size_t)i * (size_t)ns2;
+            for (int k = 0; k < ns2; k++)
+                if (lk[k] >= 0) dv->cin_src[off[lk[k]]++] = i;
+        }
+    for (int j = n; j > 0; j--) off[j] = off[j - 1];
+    off[0] = 0;
 #ifdef PARTRAY_HAVE_OPENCL
     if (dv->is_cl) {
-        pt_status st = upload(dv, &dv->b_cin_off, &dv->sz_cin_off, dv->cin_off, ((size_t)n + 1) * sizeof(int), d);
+        pt_status st = upload(dv, &dv->b_cin_off, &dv->sz_cin_off, off, ((size_t)n + 1) * sizeof(int), d);
         if (st == PT_OK) st = upload(dv, &dv->b_cin_src, &dv->sz_cin_src, dv->cin_src, m * sizeof(int), d);
         if (st != PT_OK) return st;
     }
