@@ -729,7 +729,9 @@ pt_status gi_dev_set_walk(gi_dev *dv, const int *woff, const gi_walk_entry *went
  * ~4.4; conference, 55% candidates, more than it saves), so a stage whose
  * set differs from the previous stage's gathers over rin with the mask, and
  * the lists are built when a stage finds the same set again (a colour
- * change, a frame relit with nothing moved) and reused while it stays. */
+ * change, a frame relit with nothing moved) and reused while it stays. The
+ * first stage after gi_dev_set_particles (every light traced, the sort a
+ * small part of it) builds them at once. */
 static pt_status compact_sources(gi_dev *dv, const float *vis, int nlights, int vis_changed, diag *d)
 {
     int n = dv->n, ns2 = dv->ns2;
@@ -745,11 +747,11 @@ static pt_status compact_sources(gi_dev *dv, const float *vis, int nlights, int 
     unsigned *t = dv->cand;
     dv->cand = dv->cand_new;
     dv->cand_new = t;
-    if (!dv->cand_seen || memcmp(dv->cand_new, dv->cand, words * sizeof(unsigned)) != 0) {
-        dv->cand_seen = 1;
+    if (dv->cand_seen && memcmp(dv->cand_new, dv->cand, words * sizeof(unsigned)) != 0) {
         dv->cin_valid = 0; /* a new set: this stage gathers over rin */
         return PT_OK;
     }
+    dv->cand_seen = 1; /* the first stage builds at once: it traces every light anyway */
 same:
     if (dv->cin_valid) return PT_OK;
     int *off = dv->cin_off;
