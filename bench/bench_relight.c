@@ -137,6 +137,8 @@ int main(int argc, char **argv)
     }
     printf("%s: %ld particles, n_b %d, %s scattering, device %s\n", scene_path, gs.particles, nb,
            full ? "full" : "walk", gs.device);
+    printf("memory after the geometry stage: links %.1f MiB (walk tables included), device %.1f MiB, total %.1f MiB\n",
+           gs.bytes_links / 1048576.0, gs.bytes_device / 1048576.0, gs.bytes_total / 1048576.0);
     gi_particle_relight(gp, d); /* the first: visibility traced */
     double *tw = calloc((size_t)reps, sizeof *tw), *tc = calloc((size_t)reps, sizeof *tc);
     double *tk = calloc((size_t)reps, sizeof *tk);

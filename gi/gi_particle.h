@@ -79,13 +79,15 @@ typedef struct gi_particle gi_particle;
  * was found. */
 typedef int (*gi_pigment_fn)(const scene *sc, const scene_texture *tex, const accel_hit *h, colour5 *out);
 
-/* How flux is scattered after emission (gi_lighting.cl, gi_k_bounce; every
- * bounce a gather over incoming links, no atomics, deterministic):
+/* How flux is scattered after emission (gi_lighting.cl; every bounce a
+ * gather, no atomics, deterministic):
  *  WALK  the paper's (section 4.2.2, Fig. 5): the first bounce along all
- *        n_s x n_s links, then n_b - 1 bounces along one random link of
- *        each particle, drawn once per particle and bounce at geometry time
- *        (the same expected flux as the paper's per-packet choice; 8 bytes
- *        per particle and bounce for the lists);
+ *        n_s x n_s links (gi_k_bounce), then n_b - 1 bounces along one
+ *        random link of each particle, drawn once per particle and bounce
+ *        at geometry time (the same expected flux as the paper's
+ *        per-packet choice), all run at once over the paths those draws
+ *        fix (gi_k_walk; at most 16 bytes per particle and bounce for the
+ *        path table);
  *  FULL  every bounce along all links: no random-walk noise, the same
  *        expected flux, about n_s^2 times the gathers of a WALK bounce. */
 typedef enum { GI_PARTICLE_SCATTER_WALK = 0, GI_PARTICLE_SCATTER_FULL = 1 } gi_particle_scatter;
