@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "accel_shapes.h"
+#include "hash.h"
 #include "rng.h"
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -467,19 +468,10 @@ struct gi_lookup {
     int omask;
 };
 
-static unsigned ptr_hash(const void *p)
-{
-    uint64_t v = (uint64_t)(uintptr_t)p;
-    v ^= v >> 33;
-    v *= 0xff51afd7ed558ccdULL;
-    v ^= v >> 33;
-    return (unsigned)v;
-}
-
 int gi_lookup_object_id(const gi_lookup *g, const void *obj)
 {
     if (!g->okey || !obj) return -1;
-    for (unsigned h = ptr_hash(obj) & (unsigned)g->omask;; h = (h + 1) & (unsigned)g->omask) {
+    for (unsigned h = pt_ptr_hash(obj) & (unsigned)g->omask;; h = (h + 1) & (unsigned)g->omask) {
         if (g->okey[h] == obj) return (int)h;
         if (!g->okey[h]) return -1;
     }
@@ -502,7 +494,7 @@ pt_status gi_lookup_set_objects(gi_lookup *g, const void *const *pobj)
         int full = 0;
         for (int i = 0; i < g->n && !full; i++) {
             if (!pobj[i]) continue;
-            unsigned h = ptr_hash(pobj[i]) & (unsigned)g->omask;
+            unsigned h = pt_ptr_hash(pobj[i]) & (unsigned)g->omask;
             while (g->okey[h] && g->okey[h] != pobj[i]) h = (h + 1) & (unsigned)g->omask;
             if (!g->okey[h]) {
                 g->okey[h] = pobj[i];

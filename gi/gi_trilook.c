@@ -5,6 +5,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include "hash.h"
 #include "pool.h"
 
 /* a cell's edge is at most CELL_FAC particle spacings (k = ceil(longest
@@ -470,15 +471,6 @@ out:
     free(s.pc);
 }
 
-static unsigned ptr_hash(const void *p)
-{
-    uint64_t v = (uint64_t)(uintptr_t)p;
-    v ^= v >> 33;
-    v *= 0xff51afd7ed558ccdULL;
-    v ^= v >> 33;
-    return (unsigned)v;
-}
-
 void gi_trilook_free(gi_trilook *t)
 {
     if (!t) return;
@@ -521,7 +513,7 @@ gi_trilook *gi_trilook_build(const accel *a, const gi_dev_particle *p, int n, co
         for (int i = 0; i < n && !full; i++) {
             pobjid[i] = -1;
             if (!pobj[i]) continue;
-            unsigned h = ptr_hash(pobj[i]) & (size - 1);
+            unsigned h = pt_ptr_hash(pobj[i]) & (size - 1);
             while (okey[h] && okey[h] != pobj[i]) h = (h + 1) & (size - 1);
             if (!okey[h]) {
                 okey[h] = pobj[i];
@@ -572,7 +564,7 @@ gi_trilook *gi_trilook_build(const accel *a, const gi_dev_particle *p, int n, co
             tobj[ft] = -1;
             const scene_object *o = accel_rtc_object(a, G->geom, (unsigned)pr, RTC_INVALID_GEOMETRY_ID);
             if (!o) continue;
-            unsigned h = ptr_hash(o) & (size - 1);
+            unsigned h = pt_ptr_hash(o) & (size - 1);
             while (okey[h] && okey[h] != (const void *)o) h = (h + 1) & (size - 1);
             if (!okey[h]) continue; /* no particle on it */
             tobj[ft] = (int)h;

@@ -1,0 +1,18 @@
+/* hash.h - integer and pointer hashes for open-addressing tables. */
+#ifndef PT_HASH_H
+#define PT_HASH_H
+#include <stdint.h>
+
+/* 32 bits of a pointer, mixed: the first half of MurmurHash3's 64-bit
+ * finalizer (fmix64: xor-shift 33, multiply by 0xff51afd7ed558ccd,
+ * xor-shift 33; Appleby, MurmurHash3). Mask the low bits for a table. */
+static inline unsigned pt_ptr_hash(const void *p)
+{
+    uint64_t v = (uint64_t)(uintptr_t)p;
+    v ^= v >> 33;
+    v *= 0xff51afd7ed558ccdULL;
+    v ^= v >> 33;
+    return (unsigned)v;
+}
+
+#endif
