@@ -36,6 +36,7 @@
 #include <string.h>
 #include <sys/resource.h>
 #include "accel.h"
+#include "bench_util.h"
 #include "gi_particle.h"
 #include "img_io.h"
 #include "img_metrics.h"
@@ -60,16 +61,6 @@ static framebuffer *g_ref;
 /* Error against the reference: mean FLIP, RMSE, mean luminance ratio - 1. */
 static int ref_error(const framebuffer *fb, double *flip, double *rmse, double *lum, diag *d);
 
-/* CPU seconds of the whole process (all threads, PoCL's included): on a
- * shared machine this says more than wall time, which other processes'
- * load stretches. */
-static double cpu_now(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
-}
-
 static int ref_error(const framebuffer *fb, double *flip, double *rmse, double *lum, diag *d)
 {
     *flip = *rmse = *lum = NAN;
@@ -81,15 +72,6 @@ static int ref_error(const framebuffer *fb, double *flip, double *rmse, double *
     double lr = img_mean_luminance(g_ref, 0);
     *lum = lr > 0.0 ? img_mean_luminance(fb, 0) / lr - 1.0 : NAN;
     return 1;
-}
-
-static void report_diag(diag *d)
-{
-    for (int i = 0; i < diag_count(d); i++) {
-        char *m = diag_format(diag_get(d, i));
-        if (m) fprintf(stderr, "%s\n", m);
-        free(m);
-    }
 }
 
 static int g_spp = 1;
@@ -116,18 +98,6 @@ static double render(const scene *sc, const accel *a, int size, int threads, gi_
     double t0 = timer_now();
     shade_render(sc, a, &s, fb, ss, d);
     return timer_now() - t0;
-}
-
-static int cmp_d(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_d);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 /* One full GI frame: lighting + view + render. Returns the frame time. */
@@ -167,11 +137,11 @@ static void sweep(const scene *sc, const accel *a, const opts *o, diag *d)
         if (o->area_samples >= 0) s.area_samples = o->area_samples;
         gi_particle_stats st;
         pt_status status;
-        double c0 = cpu_now();
+        double c0 = bench_cpu_now();
         gi_particle *gp = gi_particle_build(sc, a, &s, &st, d, &status);
-        double cg = cpu_now() - c0;
+        double cg = bench_cpu_now() - c0;
         if (!gp) {
-            report_diag(d);
+            bench_report_diag(d);
             continue;
         }
         for (int bi = 0; bi < 4; bi++) {
@@ -220,9 +190,9 @@ static long time_moves(gi_particle *gp, scene *sc, int nmove, int reps, double *
     long rays = 0;
     for (int r = 0; r < reps; r++) {
         for (int l = 0; l < nmove; l++) sc->lights[l].position.x += (r % 2 ? -1e-4 : 1e-4);
-        double cc = cpu_now();
+        double cc = bench_cpu_now();
         gi_particle_relight(gp, d);
-        tmc[r] = cpu_now() - cc;
+        tmc[r] = bench_cpu_now() - cc;
         const gi_particle_stats *x = gi_particle_get_stats(gp);
         tm[r] = x->t_lighting;
         rays = x->shadow_rays;
@@ -263,7 +233,7 @@ int main(int argc, char **argv)
     g_spp = o.spp;
     diag *d = diag_new();
     if (o.ref && img_read(o.ref, 0, &g_ref, d) != PT_OK) {
-        report_diag(d);
+        bench_report_diag(d);
         return 1;
     }
     sdl_options so;
@@ -272,7 +242,7 @@ int main(int argc, char **argv)
     scene *sc = NULL;
     double t0 = timer_now();
     if (sdl_parse_file(o.scene, &so, &sc, d) != PT_OK) {
-        report_diag(d);
+        bench_report_diag(d);
         return 1;
     }
     double t_parse = timer_now() - t0;
@@ -280,7 +250,7 @@ int main(int argc, char **argv)
     t0 = timer_now();
     accel *a = accel_build(sc, o.threads, d, &st);
     if (!a) {
-        report_diag(d);
+        bench_report_diag(d);
         return 1;
     }
     double t_accel = timer_now() - t0;
@@ -302,11 +272,11 @@ int main(int argc, char **argv)
     s.prepass_stride = o.stride;
     s.keep_hits = !o.no_keep && o.spp <= 1;
     gi_particle_stats gs;
-    double c0 = cpu_now();
+    double c0 = bench_cpu_now();
     gi_particle *gp = gi_particle_build(sc, a, &s, &gs, d, &st);
-    double cpu_geom = cpu_now() - c0;
+    double cpu_geom = bench_cpu_now() - c0;
     if (!gp) {
-        report_diag(d);
+        bench_report_diag(d);
         fprintf(stderr, "bench_gi: GI build failed: %s\n", pt_status_name(st));
         return 1;
     }
@@ -344,9 +314,9 @@ int main(int argc, char **argv)
     double *tcpu = calloc((size_t)o.reps, sizeof *tcpu);
     long colour_rays = 0;
     for (int r = 0; r < o.reps; r++) {
-        double cc = cpu_now();
+        double cc = bench_cpu_now();
         gi_particle_relight(gp, d);
-        tcpu[r] = cpu_now() - cc;
+        tcpu[r] = bench_cpu_now() - cc;
         colour_rays = gi_particle_get_stats(gp)->shadow_rays;
         const gi_particle_stats *x = gi_particle_get_stats(gp);
         tl[r] = x->t_lighting;
@@ -358,21 +328,21 @@ int main(int argc, char **argv)
     long moved_rays = time_moves(gp, sc, sc->nlights, o.reps, tm, tmc, d);
     printf("lighting stage after a light moved (all lights moved; median of %d): %.2f ms wall, %.2f ms CPU, %ld "
            "shadow rays\n",
-           o.reps, 1e3 * median(tm, o.reps), 1e3 * median(tmc, o.reps), moved_rays);
+           o.reps, 1e3 * bench_median(tm, o.reps), 1e3 * bench_median(tmc, o.reps), moved_rays);
     /* the same moving the first light only: the others keep their visibility */
     if (sc->nlights > 1) {
         moved_rays = time_moves(gp, sc, 1, o.reps, tm, tmc, d);
         printf("  the first of the %d lights moved alone: %.2f ms wall, %.2f ms CPU, %ld shadow rays\n", sc->nlights,
-               1e3 * median(tm, o.reps), 1e3 * median(tmc, o.reps), moved_rays);
+               1e3 * bench_median(tm, o.reps), 1e3 * bench_median(tmc, o.reps), moved_rays);
     }
     free(tm);
     free(tmc);
     const gi_particle_stats *x = gi_particle_get_stats(gp);
     printf("lighting stage, colour change only (n_b %d, %s scattering, median of %d): %.2f ms = visibility %.2f ms "
            "(%ld shadow rays) + emission and scattering kernels %.2f ms; %ld sources\n",
-           x->bounces, s.scatter == GI_PARTICLE_SCATTER_FULL ? "full" : "walk", o.reps, 1e3 * median(tl, o.reps),
-           1e3 * median(tvis, o.reps), colour_rays, 1e3 * median(tk, o.reps), x->sources);
-    printf("  CPU time per lighting stage %.2f ms (all threads, median)\n", 1e3 * median(tcpu, o.reps));
+           x->bounces, s.scatter == GI_PARTICLE_SCATTER_FULL ? "full" : "walk", o.reps, 1e3 * bench_median(tl, o.reps),
+           1e3 * bench_median(tvis, o.reps), colour_rays, 1e3 * bench_median(tk, o.reps), x->sources);
+    printf("  CPU time per lighting stage %.2f ms (all threads, median)\n", 1e3 * bench_median(tcpu, o.reps));
     printf("  flux: direct %.4g, emitted %.4g, scattered %.4g\n", x->flux_direct, x->flux_emitted, x->flux_scattered);
 
     framebuffer *fb_none = fb_new(o.size, o.size), *fb_gi = fb_new(o.size, o.size);
@@ -382,28 +352,28 @@ int main(int argc, char **argv)
     double *cn = calloc((size_t)o.reps, sizeof *cn), *cf = calloc((size_t)o.reps, sizeof *cf);
     shade_stats ss;
     for (int r = 0; r < o.reps; r++) {
-        double c = cpu_now();
+        double c = bench_cpu_now();
         tn[r] = render(sc, a, o.size, o.threads, NULL, fb_none, &ss, d);
-        cn[r] = cpu_now() - c;
-        c = cpu_now();
+        cn[r] = bench_cpu_now() - c;
+        c = bench_cpu_now();
         tf[r] = gi_frame(sc, a, &o, gp, fb_gi, &tfl[r], &tfv[r], &tfr[r], d);
-        cf[r] = cpu_now() - c;
+        cf[r] = bench_cpu_now() - c;
     }
     x = gi_particle_get_stats(gp);
     /* the first frame also tests the light-leak guard's cells (kept for the
      * frames after it): printed apart, before the medians sort the arrays */
     double first_w = tf[0], first_c = cf[0], first_r = tfr[0];
-    double mn = median(tn, o.reps), mf = median(tf, o.reps);
+    double mn = bench_median(tn, o.reps), mf = bench_median(tf, o.reps);
     printf("frame --gi none: %.1f ms (%ld primary, %ld shadow rays)\n", 1e3 * mn, ss.primary_rays, ss.shadow_rays);
     printf("frame --gi particle: %.1f ms = lighting %.1f + view %.1f (pre-pass %.1f, gather %.1f, estimate %.1f; "
            "found %ld radiance, used %ld area particles) + render %.1f; ratio %.2f\n",
-           1e3 * mf, 1e3 * median(tfl, o.reps), 1e3 * median(tfv, o.reps), 1e3 * x->t_prepass, 1e3 * x->t_gather,
-           1e3 * x->t_estimate, x->found, x->used, 1e3 * median(tfr, o.reps), mf / mn);
+           1e3 * mf, 1e3 * bench_median(tfl, o.reps), 1e3 * bench_median(tfv, o.reps), 1e3 * x->t_prepass, 1e3 * x->t_gather,
+           1e3 * x->t_estimate, x->found, x->used, 1e3 * bench_median(tfr, o.reps), mf / mn);
     printf("  CPU time per frame (all threads, median): none %.1f ms, particle %.1f ms; ratio %.2f\n",
-           1e3 * median(cn, o.reps), 1e3 * median(cf, o.reps), median(cf, o.reps) / median(cn, o.reps));
+           1e3 * bench_median(cn, o.reps), 1e3 * bench_median(cf, o.reps), bench_median(cf, o.reps) / bench_median(cn, o.reps));
     printf("  first particle frame: %.1f ms wall (render %.1f), %.1f ms CPU; ratio to the median none frame %.2f wall, "
            "%.2f CPU\n",
-           1e3 * first_w, 1e3 * first_r, 1e3 * first_c, first_w / mn, first_c / median(cn, o.reps));
+           1e3 * first_w, 1e3 * first_r, 1e3 * first_c, first_w / mn, first_c / bench_median(cn, o.reps));
     printf("  hook, per frame (mean of %d): %.0f lookups, %.0f late (%.0f radiance, %.0f area particles computed in "
            "the hook), %.0f without particles, %.0f discarded; %.0f visibility rays\n",
            o.reps, (double)x->lookups / o.reps, (double)x->lookups_late / o.reps, (double)x->late_radiance / o.reps,
@@ -435,9 +405,9 @@ int main(int argc, char **argv)
             int keep = g_spp;
             g_spp = o.ref_spp > 0 ? o.ref_spp : o.spp;
             framebuffer *fq = fb_new(oq.size, oq.size);
-            double q1, q2, q3, cq = cpu_now();
+            double q1, q2, q3, cq = bench_cpu_now();
             double tq = gi_frame(sc, a, &oq, gp, fq, &q1, &q2, &q3, d);
-            cq = cpu_now() - cq;
+            cq = bench_cpu_now() - cq;
             double fl, rm, lu;
             if (ref_error(fq, &fl, &rm, &lu, d))
                 printf("against %s (%dx%d frame, %d spp, %.2f s wall, %.2f s CPU): mean FLIP %.4f, RMSE %.5f, mean "
@@ -466,7 +436,7 @@ int main(int argc, char **argv)
         img_write(path, fb_gi, &wo, d);
     }
     if (o.sweep) sweep(sc, a, &o, d);
-    report_diag(d);
+    bench_report_diag(d);
     free(tl);
     free(tk);
     free(tvis);

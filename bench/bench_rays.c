@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "accel.h"
+#include "bench_util.h"
 #include "pool.h"
 #include "scene.h"
 #include "timer.h"
@@ -227,12 +228,6 @@ static void row_bare(void *p, int y, int thread)
     c->shadowed[y] = shadowed;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : (x > y);
-}
-
 static void totals(const bench_ctx *c, long *hits, long *shadowed)
 {
     *hits = *shadowed = 0;
@@ -240,12 +235,6 @@ static void totals(const bench_ctx *c, long *hits, long *shadowed)
         *hits += c->hits[y];
         *shadowed += c->shadowed[y];
     }
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof(double), cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 /* Renderer and bare runs alternate, so both see the same machine load; the
@@ -270,7 +259,7 @@ static void run_pair(bench_ctx *c, int threads, size_t nprimary)
     }
     printf("  threads %2d: renderer %7.2f Mrays/s  bare Embree %7.2f Mrays/s  ratio %.3f"
            "  (hits %ld/%ld, shadowed %ld/%ld)\n",
-           threads, median(mr, reps), median(mb, reps), median(ratio, reps), h1, h2, s1, s2);
+           threads, bench_median(mr, reps), bench_median(mb, reps), bench_median(ratio, reps), h1, h2, s1, s2);
     free(mr);
 }
 

@@ -22,6 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "accel.h"
+#include "bench_util.h"
 #include "accel_surface.h"
 #include "pm.h"
 #include "pm_fg.h"
@@ -37,18 +38,6 @@
 #ifndef BENCH_SCENE_DIR
 #define BENCH_SCENE_DIR "scenes"
 #endif
-
-static int cmp_d(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_d);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 /* ------------------------------------------------------------ bare Embree */
 
@@ -161,7 +150,7 @@ int main(int argc, char **argv)
         pm_kdtree_free(kd);
         free(pr.caustic);
     }
-    double tp = median(t, reps), tk = median(tb, reps);
+    double tp = bench_median(t, reps), tk = bench_median(tb, reps);
     printf("  photons:   %ld paths, %ld segments, %ld stored (global) in %.3f s: %.3f M paths/s, %.3f M segments/s, "
            "%.3f M stored/s; kd-tree build %.3f s (%.2f M photons/s)\n",
            pr.emitted, pr.rays, pr.nglobal, tp, pr.emitted / tp * 1e-6, pr.rays / tp * 1e-6, pr.nglobal / tp * 1e-6,
@@ -184,7 +173,7 @@ int main(int argc, char **argv)
         t[r] = fs.t_render;
         tb[r] = fs.t_irradiance;
     }
-    double tg = median(t, reps), ti = median(tb, reps);
+    double tg = bench_median(t, reps), ti = bench_median(tb, reps);
     long all = fs.camera_rays + fs.bsdf_rays + fs.gather_rays + fs.shadow_rays;
     gather_rate = fs.gather_rays / tg;
     printf("  gather:    %dx%d, %d rays/pixel: %ld gather rays (+%ld shadow, %ld other) in %.3f s: %.3f M gather rays/s, "
@@ -206,7 +195,7 @@ int main(int argc, char **argv)
         fb_free(fb);
         t[r] = pst.t_render;
     }
-    double tpath = median(t, reps);
+    double tpath = bench_median(t, reps);
     long prays = pst.camera_rays + pst.bsdf_rays + pst.shadow_rays;
     double sample_rate = pst.samples / tpath;
     printf("  path:      %dx%d, %d spp: %ld samples, %ld rays in %.3f s: %.3f M samples/s, %.3f M rays/s "
@@ -238,7 +227,7 @@ int main(int argc, char **argv)
             pool_run(threads, (int)((n + RAY_BLOCK - 1) / RAY_BLOCK), ray_block, &j);
             t[r] = timer_now() - t0;
         }
-        tr[bare] = median(t, reps);
+        tr[bare] = bench_median(t, reps);
         hc[bare] = 0;
         for (int k = 0; k < threads; k++) hc[bare] += hits[k];
     }

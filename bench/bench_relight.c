@@ -20,8 +20,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 #include "accel.h"
+#include "bench_util.h"
 #include "gi_particle.h"
 #include "sdl.h"
 #include "shade_texture.h"
@@ -30,34 +30,6 @@
 #ifndef BENCH_SCENE_DIR
 #define BENCH_SCENE_DIR "scenes"
 #endif
-
-static double cpu_now(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
-}
-
-static int cmp_d(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_d);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-static void report_diag(diag *d)
-{
-    for (int i = 0; i < diag_count(d); i++) {
-        char *m = diag_format(diag_get(d, i));
-        if (m) fprintf(stderr, "%s\n", m);
-        free(m);
-    }
-}
 
 /* Largest relative difference per particle between a and b (n x 4 floats,
  * 3 colours), the particles that differ, and the summed values' difference. */
@@ -111,13 +83,13 @@ int main(int argc, char **argv)
     sdl_default_options(&so);
     scene *sc = NULL;
     if (sdl_parse_file(scene_path, &so, &sc, d) != PT_OK) {
-        report_diag(d);
+        bench_report_diag(d);
         return 1;
     }
     pt_status st;
     accel *a = accel_build(sc, threads, d, &st);
     if (!a) {
-        report_diag(d);
+        bench_report_diag(d);
         return 1;
     }
     gi_particle_settings s;
@@ -131,7 +103,7 @@ int main(int argc, char **argv)
     gi_particle_stats gs;
     gi_particle *gp = gi_particle_build(sc, a, &s, &gs, d, &st);
     if (!gp) {
-        report_diag(d);
+        bench_report_diag(d);
         fprintf(stderr, "bench_relight: GI build failed: %s\n", pt_status_name(st));
         return 1;
     }
@@ -144,9 +116,9 @@ int main(int argc, char **argv)
     double *tk = calloc((size_t)reps, sizeof *tk);
     long moved_rays = 0;
     for (int r = 0; r < reps; r++) {
-        double c0 = cpu_now();
+        double c0 = bench_cpu_now();
         gi_particle_relight(gp, d);
-        tc[r] = cpu_now() - c0;
+        tc[r] = bench_cpu_now() - c0;
         const gi_particle_stats *x = gi_particle_get_stats(gp);
         tw[r] = x->t_lighting;
         tk[r] = x->t_emit + x->t_scatter;
@@ -159,13 +131,13 @@ int main(int argc, char **argv)
     }
     printf("colour change (median of %d): %.2f ms wall (kernels %.2f ms), %.2f ms CPU; least %.2f ms wall, %.2f ms "
            "CPU; %ld sources\n",
-           reps, 1e3 * median(tw, reps), 1e3 * median(tk, reps), 1e3 * median(tc, reps), 1e3 * mw, 1e3 * mc,
+           reps, 1e3 * bench_median(tw, reps), 1e3 * bench_median(tk, reps), 1e3 * bench_median(tc, reps), 1e3 * mw, 1e3 * mc,
            x->sources);
     for (int r = 0; r < reps; r++) {
         for (int l = 0; l < sc->nlights; l++) sc->lights[l].position.x += (r % 2 ? -1e-4 : 1e-4);
-        double c0 = cpu_now();
+        double c0 = bench_cpu_now();
         gi_particle_relight(gp, d);
-        tc[r] = cpu_now() - c0;
+        tc[r] = bench_cpu_now() - c0;
         tw[r] = gi_particle_get_stats(gp)->t_lighting;
         moved_rays = gi_particle_get_stats(gp)->shadow_rays;
     }
@@ -173,7 +145,7 @@ int main(int argc, char **argv)
         for (int l = 0; l < sc->nlights; l++) sc->lights[l].position.x -= 1e-4;
     gi_particle_relight(gp, d);
     printf("all lights moved (median of %d): %.2f ms wall, %.2f ms CPU, %ld shadow rays\n", reps,
-           1e3 * median(tw, reps), 1e3 * median(tc, reps), moved_rays);
+           1e3 * bench_median(tw, reps), 1e3 * bench_median(tc, reps), moved_rays);
     x = gi_particle_get_stats(gp);
     printf("flux: direct %.9g, emitted %.9g, scattered %.9g\n", x->flux_direct, x->flux_emitted, x->flux_scattered);
     const float *edir, *phi, *lout;
