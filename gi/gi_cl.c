@@ -738,7 +738,8 @@ static pt_status compact_sources(gi_dev *dv, const float *vis, int nlights, int 
     size_t words = ((size_t)n + 31) / 32;
     if (!vis_changed && dv->cand_seen) goto same; /* the same vis: the same set */
     memcpy(dv->cand_new, dv->emits, words * sizeof(unsigned));
-    for (int i = 0; i < n; i++) {
+    /* no lights: vis may be NULL (no offset from it, C11 6.5.6) */
+    for (int i = 0; nlights > 0 && i < n; i++) {
         const float *v = vis + (size_t)i * (size_t)nlights;
         int lit = 0;
         for (int l = 0; l < nlights; l++) lit |= v[l] > 0.0f;
