@@ -1937,6 +1937,21 @@ static inline double max0(double x) { return x > 0.0 ? x : 0.0; }
 static inline double clamp01(double x) { return x > 0.0 ? (x < 1.0 ? x : 1.0) : 0.0; }
 static inline int floor_nonneg(double x) { return (int)x; }
 
+/* The end of every locate: the cell's slots to radiance particles, its
+ * weights clamped into [0, 1] (tiny negatives from rounding) and
+ * normalised. */
+static void cell_finish(const gi_surface *g, long rp[3], double w[3])
+{
+    double sum = 0.0;
+    for (int q = 0; q < 3; q++) {
+        rp[q] = slot_rp(g, rp[q]);
+        w[q] = clamp01(w[q]);
+        sum += w[q];
+    }
+    if (sum > 0.0)
+        for (int q = 0; q < 3; q++) w[q] /= sum;
+}
+
 /* gi_surface_locate on triangle patches first .. first + count - 1 (a mesh
  * triangle, a triangle, a box's or clipped plane's triangles): the one
  * the point lies in (or nearest to), its side and sub-triangle. Reads the
@@ -2012,15 +2027,7 @@ static int locate_tri(const gi_surface *g, int first, int count, const accel_hit
         w[1] = 1.0 - y;
         w[2] = 1.0 - x;
     }
-    /* clamp tiny negative weights from rounding; slots to radiance particles */
-    double sum = 0.0;
-    for (int q = 0; q < 3; q++) {
-        rp[q] = slot_rp(g, rp[q]);
-        w[q] = clamp01(w[q]);
-        sum += w[q];
-    }
-    if (sum > 0.0)
-        for (int q = 0; q < 3; q++) w[q] /= sum;
+    cell_finish(g, rp, w);
     return 1;
 }
 
@@ -2120,14 +2127,6 @@ int gi_surface_locate(const gi_surface *g, const accel_hit *hit, vec3 n_view, lo
             w[2] = 1.0 - x;
         }
     }
-    /* clamp tiny negative weights from rounding; slots to radiance particles */
-    double sum = 0.0;
-    for (int k = 0; k < 3; k++) {
-        rp[k] = slot_rp(g, rp[k]);
-        w[k] = fmin(1.0, fmax(0.0, w[k]));
-        sum += w[k];
-    }
-    if (sum > 0.0)
-        for (int k = 0; k < 3; k++) w[k] /= sum;
+    cell_finish(g, rp, w);
     return 1;
 }
