@@ -1097,6 +1097,19 @@ typedef struct {
 
 static int cell_clear(gi_particle *gp, const long rp[3], const scene_object *own, thread_count *tc);
 
+/* The light-leak guard's verdict on cell rp (key: gi_cellvis_key) of a hit
+ * on `own`: the table's, else tested now (cell_clear) and put in the table;
+ * GI_CELL_UNKNOWN without a key (no table: the caller tests per hit). */
+static int cell_verdict(gi_particle *gp, uint64_t key, const long rp[3], const scene_object *own, thread_count *tc)
+{
+    int verdict = gi_cellvis_get(gp->cells, key);
+    if (verdict == GI_CELL_UNKNOWN && key) {
+        verdict = cell_clear(gp, rp, own, tc) ? GI_CELL_CLEAR : GI_CELL_BLOCKED;
+        gi_cellvis_put(gp->cells, key, verdict);
+    }
+    return verdict;
+}
+
 /* The verdict side_value would take for the cell rp of a hit on `own`
  * (tested now when the table has none): the same test, moved to the
  * pre-pass. Before the table (a cache miss a probe), the previous pixel's
@@ -1112,11 +1125,7 @@ static int kept_verdict(gi_particle *gp, const long rp[3], const scene_object *o
         m->verdict = old->verdict;
         return old->verdict;
     }
-    int verdict = gi_cellvis_get(gp->cells, key);
-    if (verdict == GI_CELL_UNKNOWN) {
-        verdict = cell_clear(gp, rp, own, m->tc) ? GI_CELL_CLEAR : GI_CELL_BLOCKED;
-        gi_cellvis_put(gp->cells, key, verdict);
-    }
+    int verdict = cell_verdict(gp, key, rp, own, m->tc);
     m->key = key;
     m->verdict = verdict;
     return verdict;
@@ -1729,16 +1738,11 @@ static int side_value(gi_particle *gp, const accel_hit *hit, vec3 n, thread_coun
      * A clear cell (cell_clear) sees all three from everywhere; the other
      * cells test them from the hit. */
     double wsum = 0.0;
-    int verdict = GI_CELL_UNKNOWN;
-    uint64_t key = 0;
+    int verdict;
     if (kr && kr->verdict != GI_CELL_UNKNOWN)
         verdict = kr->verdict; /* decided in the pre-pass (kept_verdict) */
     else
-        verdict = gi_cellvis_get(gp->cells, key = gi_cellvis_key(gp->cells, rp));
-    if (verdict == GI_CELL_UNKNOWN && key) {
-        verdict = cell_clear(gp, rp, hit->obj, tc) ? GI_CELL_CLEAR : GI_CELL_BLOCKED;
-        gi_cellvis_put(gp->cells, key, verdict);
-    }
+        verdict = cell_verdict(gp, gi_cellvis_key(gp->cells, rp), rp, hit->obj, tc);
     if (verdict == GI_CELL_CLEAR) tc->clear++;
     vec3 ngv = v3_dot(n, hit->ng) >= 0.0 ? hit->ng : v3_neg(hit->ng);
     for (int k = 0; k < 3; k++) {
