@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "gi_cl_c.h"
+#include "gi_links.h"
 #include "pool.h"
 #include "timer.h"
 
@@ -71,7 +72,7 @@ struct gi_dev {
      * entries whose source has emission or some vis > 0; compact_sources),
      * rebuilt when that set changes */
     unsigned *cand, *cand_new; /* nmask words: the last stage's set (cin's when valid), scratch */
-    int *cin_off, *cin_src;    /* n + 1 offsets, entries */
+    int *cin_off, *cin_src;    /* n + 1 offsets (n + 2 ints), entries */
     size_t cin_cap;
     int cin_valid;  /* cin is built for the set in cand */
     int cand_seen;  /* cand holds a stage's set */
@@ -555,7 +556,7 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     dv->emits = calloc(dv->nmask, sizeof(unsigned));
     dv->cand = calloc(dv->nmask, sizeof(unsigned));
     dv->cand_new = calloc(dv->nmask, sizeof(unsigned));
-    dv->cin_off = calloc(nn + 1, sizeof(int));
+    dv->cin_off = calloc(nn + 2, sizeof(int)); /* gi_links_reverse_count */
     free(dv->dsum);
     free(dv->srcmask_host);
     dv->dsum = calloc(dv->nmask, sizeof(float));
@@ -756,31 +757,14 @@ static pt_status compact_sources(gi_dev *dv, const float *vis, int nlights, int 
 same:
     if (dv->cin_valid) return PT_OK;
     int *off = dv->cin_off;
-    memset(off, 0, ((size_t)n + 1) * sizeof(int));
-    for (size_t w = 0; w < words; w++)
-        for (unsigned bits = dv->cand[w]; bits; bits &= bits - 1) {
-            const int *lk = dv->slink + ((size_t)w * 32 + (size_t)__builtin_ctz(bits)) * (size_t)ns2;
-            for (int k = 0; k < ns2; k++)
-                if (lk[k] >= 0) off[lk[k] + 1]++;
-        }
-    for (int j = 0; j < n; j++) off[j + 1] += off[j];
-    size_t m = (size_t)off[n];
+    size_t m = gi_links_reverse_count(dv->slink, n, ns2, dv->cand, off);
     if (m > dv->cin_cap || !dv->cin_src) {
         free(dv->cin_src);
         dv->cin_src = malloc((m > 0 ? m : 1) * sizeof(int));
         dv->cin_cap = dv->cin_src ? m : 0;
         if (!dv->cin_src) return PT_ERR_NOMEM;
     }
-    /* off[t] is target t's write cursor, then shifted back to offsets */
-    for (size_t w = 0; w < words; w++)
-        for (unsigned bits = dv->cand[w]; bits; bits &= bits - 1) {
-            int i = (int)(w * 32) + __builtin_ctz(bits);
-            const int *lk = dv->slink + (size_t)i * (size_t)ns2;
-            for (int k = 0; k < ns2; k++)
-                if (lk[k] >= 0) dv->cin_src[off[lk[k]]++] = i;
-        }
-    for (int j = n; j > 0; j--) off[j] = off[j - 1];
-    off[0] = 0;
+    gi_links_reverse_fill(dv->slink, n, ns2, dv->cand, off, dv->cin_src);
 #ifdef PARTRAY_HAVE_OPENCL
     if (dv->is_cl) {
         pt_status st = upload(dv, &dv->b_cin_off, &dv->sz_cin_off, off, ((size_t)n + 1) * sizeof(int), d);

@@ -323,6 +323,40 @@ static void job(void *ctx, int index, int thread)
     atomic_fetch_add(&J->tri_fb, tri_fb);
 }
 
+/* the sources of gi_links_reverse_*: i ascending, in mask */
+static int next_source(const unsigned *mask, int n, int i)
+{
+    for (i++; i < n; i++) {
+        if (!mask) return i;
+        unsigned wd = mask[i >> 5] >> (i & 31);
+        if (wd) return i + __builtin_ctz(wd);
+        i |= 31; /* the rest of this word is clear */
+    }
+    return n;
+}
+
+size_t gi_links_reverse_count(const int *links, int n, int k, const unsigned *mask, int *off)
+{
+    memset(off, 0, ((size_t)n + 2) * sizeof(int));
+    for (int i = next_source(mask, n, -1); i < n; i = next_source(mask, n, i)) {
+        const int *lk = links + (size_t)i * (size_t)k;
+        for (int j = 0; j < k; j++)
+            if (lk[j] >= 0) off[lk[j] + 2]++;
+    }
+    for (int t = 0; t < n; t++) off[t + 2] += off[t + 1];
+    return (size_t)off[n + 1];
+}
+
+void gi_links_reverse_fill(const int *links, int n, int k, const unsigned *mask, int *off, int *src)
+{
+    /* off[t + 1] is target t's write cursor; it ends at t's end, t + 1's start */
+    for (int i = next_source(mask, n, -1); i < n; i = next_source(mask, n, i)) {
+        const int *lk = links + (size_t)i * (size_t)k;
+        for (int j = 0; j < k; j++)
+            if (lk[j] >= 0) src[off[lk[j] + 1]++] = i;
+    }
+}
+
 pt_status gi_links_build(const accel *a, void *scene, const gi_dev_particle *p, const void *const *pobj,
                          const unsigned char *pin, int n, int nside, uint64_t seed, const gi_lookup *grid,
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,

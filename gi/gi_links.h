@@ -44,6 +44,14 @@ pt_status gi_links_build(const accel *a, void *scene, const gi_dev_particle *p, 
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
                          gi_link_stats *st);
 
+/* Incoming links, a counting sort by target: the sources i < n in mask
+ * (bit i of word i / 32; NULL: all) whose links[i * k + j] are >= 0, per
+ * target in ascending order of i (then j). count fills off (n + 2 ints)
+ * and returns the number of entries; fill writes them to src, after which
+ * target t's sources are src[off[t] .. off[t + 1] - 1] (off[0..n]). */
+size_t gi_links_reverse_count(const int *links, int n, int k, const unsigned *mask, int *off);
+void gi_links_reverse_fill(const int *links, int n, int k, const unsigned *mask, int *off, int *src);
+
 /* Direction j of the n x n stratified cosine-weighted set around unit
  * normal nrm, from uniform numbers (u1, u2) in [0,1): Malley's method on
  * Shirley and Chiu's concentric disk map (JGT 2(3), 1997). */

@@ -646,11 +646,8 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         gp->rin_off = xcalloc((size_t)n + 2, sizeof(int), &st);
         gp->rin_src = xcalloc(nl, sizeof(int), &st);
         if (st != PT_OK) goto fail;
-        for (size_t q = 0; q < nl; q++)
-            if (gp->slink[q] >= 0) gp->rin_off[gp->slink[q] + 2]++;
-        for (int j = 0; j < n; j++) gp->rin_off[j + 2] += gp->rin_off[j + 1];
-        for (size_t q = 0; q < nl; q++)
-            if (gp->slink[q] >= 0) gp->rin_src[gp->rin_off[gp->slink[q] + 1]++] = (int)(q / (size_t)gp->ns2);
+        gi_links_reverse_count(gp->slink, n, gp->ns2, NULL, gp->rin_off);
+        gi_links_reverse_fill(gp->slink, n, gp->ns2, NULL, gp->rin_off, gp->rin_src);
     }
 
     tg = timer_now();
