@@ -206,12 +206,13 @@ static void job(void *ctx, int index, int thread)
             const void *hobj = hit && J->grid && J->pobj && cell[m] != -3
                                    ? accel_rtc_object(J->a, rh[m].hit.geomID, rh[m].hit.primID, rh[m].hit.instID[0])
                                    : NULL;
-            /* consecutive hits are often on one object: its id once */
-            if (hobj != last_obj) {
+            /* consecutive hits are often on one object: its id once (hits
+             * the triangle lists answer, hobj NULL, leave the cache be) */
+            if (hobj && hobj != last_obj) {
                 last_obj = hobj;
-                last_hid = hobj ? gi_lookup_object_id(J->grid, hobj) : -1;
+                last_hid = gi_lookup_object_id(J->grid, hobj);
             }
-            int hid = last_hid;
+            int hid = hobj ? last_hid : -1;
             if (hobj && hid < 0) {
                 unres++;
             } else if (hit && J->grid) {

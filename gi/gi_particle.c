@@ -263,7 +263,7 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
     gi_trilook_free(gp->tl);
     gp->tl = NULL;
     if (st == PT_OK && use_tl && gp->set.link_lookup == 0)
-        gp->tl = gi_trilook_build(gp->a, ps->p, n, (const void *const *)pobj, pin + n, ps->spacing, GI_LINKS_AGREE,
+        gp->tl = gi_trilook_build(gp->a, ps->p, n, (const void *const *)pobj, grid, pin + n, ps->spacing, GI_LINKS_AGREE,
                                   3.0 * ps->spacing, gp->threads, &st);
     if (st == PT_OK)
         st = gi_links_build(gp->a, gp->lscene, ps->p, pobj, pin, n, gp->set.scatter_side, seed, grid, gp->tl,

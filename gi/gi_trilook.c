@@ -5,7 +5,6 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include "hash.h"
 #include "pool.h"
 
 /* a cell's edge is at most CELL_FAC particle spacings (k = ceil(longest
@@ -326,7 +325,7 @@ static void build_job(void *ctx, int ch, int thread)
         /* the candidates cover every point within rg - rt of the triangle;
          * gathered again wider when a cell's list needs more */
         double rg = rt + fmin(1.5 * B->spacing, full);
-        long ncell = (long)k * (k + 1) / 2, tri_start = B->cne[ch];
+        long tri_start = B->cne[ch];
         for (int pass = 0; pass < 2; pass++) {
             if (!gather(B, &s, oid, ct, rg, nrm)) {
                 B->fail[ch] = 1;
@@ -453,7 +452,6 @@ static void build_job(void *ctx, int ch, int thread)
                         B->cne[ch] += cnt + 2;
                     }
                 }
-            (void)ncell;
             if (pass == 0 && needed <= rg - rt) break; /* every cell written */
             if (pass == 1) break;
             /* some cell needs more: drop this triangle's lists written so
@@ -485,17 +483,12 @@ void gi_trilook_free(gi_trilook *t)
 }
 
 gi_trilook *gi_trilook_build(const accel *a, const gi_dev_particle *p, int n, const void *const *pobj,
-                             const unsigned char *buried, double spacing, double agree, double maxdist, int threads,
-                             pt_status *st)
+                             const gi_lookup *grid, const unsigned char *buried, double spacing, double agree,
+                             double maxdist, int threads, pt_status *st)
 {
     *st = PT_OK;
-    if (!a || !p || !pobj || n <= 0 || !(spacing > 0.0) || !(maxdist > 0.0)) return NULL;
+    if (!a || !p || !pobj || !grid || n <= 0 || !(spacing > 0.0) || !(maxdist > 0.0)) return NULL;
     if (threads <= 0) threads = pool_default_threads();
-    /* object ids */
-    unsigned size = 64;
-    while (size < 4u * (unsigned)(n < (1 << 28) ? n : (1 << 28))) size *= 2;
-    if (size > (1u << 20)) size = 1u << 20;
-    const void **okey = NULL;
     int *pobjid = malloc((size_t)n * sizeof *pobjid);
     gi_trilook *t = calloc(1, sizeof *t);
     tl_geo *geo = NULL;
@@ -504,28 +497,8 @@ gi_trilook *gi_trilook_build(const accel *a, const gi_dev_particle *p, int n, co
     tl_build B;
     memset(&B, 0, sizeof B);
     if (!pobjid || !t) goto nomem;
-    int distinct = 0;
-    for (;;) {
-        okey = calloc(size, sizeof *okey);
-        if (!okey) goto nomem;
-        distinct = 0;
-        int full = 0;
-        for (int i = 0; i < n && !full; i++) {
-            pobjid[i] = -1;
-            if (!pobj[i]) continue;
-            unsigned h = pt_ptr_hash(pobj[i]) & (size - 1);
-            while (okey[h] && okey[h] != pobj[i]) h = (h + 1) & (size - 1);
-            if (!okey[h]) {
-                okey[h] = pobj[i];
-                if (2u * (unsigned)++distinct > size) full = 1;
-            }
-            pobjid[i] = (int)h;
-        }
-        if (!full) break;
-        free(okey);
-        okey = NULL;
-        size *= 4;
-    }
+    /* object ids: the grid's (gi_lookup_set_objects) */
+    for (int i = 0; i < n; i++) pobjid[i] = gi_lookup_object_id(grid, pobj[i]);
     double pmag = 0.0;
     for (int i = 0; i < n; i++)
         for (int k = 0; k < 3; k++) pmag = fmax(pmag, fabs(p[i].p[k]));
@@ -563,11 +536,9 @@ gi_trilook *gi_trilook_build(const accel *a, const gi_dev_particle *p, int n, co
             long ft = gbase[q] + pr;
             tobj[ft] = -1;
             const scene_object *o = accel_rtc_object(a, G->geom, (unsigned)pr, RTC_INVALID_GEOMETRY_ID);
-            if (!o) continue;
-            unsigned h = pt_ptr_hash(o) & (size - 1);
-            while (okey[h] && okey[h] != (const void *)o) h = (h + 1) & (size - 1);
-            if (!okey[h]) continue; /* no particle on it */
-            tobj[ft] = (int)h;
+            int oid = o ? gi_lookup_object_id(grid, o) : -1;
+            if (oid < 0) continue; /* no particle on it */
+            tobj[ft] = oid;
             double v[3][3];
             for (int k = 0; k < 3; k++)
                 for (int c = 0; c < 3; c++) {
@@ -596,8 +567,6 @@ gi_trilook *gi_trilook_build(const accel *a, const gi_dev_particle *p, int n, co
             ncell += (long)k * (k + 1) / 2;
         }
     }
-    free(okey);
-    okey = NULL;
     if (ncell == 0 || ncell > (1L << 29)) {
         /* nothing to cover (or too much): the grid path answers everything */
         free(pobjid);
@@ -698,7 +667,6 @@ done:
     free(B.ccap);
     free(B.fail);
     bgrid_free(&B.g);
-    free(okey);
     free(pobjid);
     free(geo);
     free(gbase);

@@ -22,18 +22,20 @@
 #define PT_GI_TRILOOK_H
 #include <stddef.h>
 #include "accel.h"
+#include "gi_particles.h"
 #include "kernels/gi_types.h"
 
 typedef struct gi_trilook gi_trilook;
 
 /* p: n particles; pobj: the object of each (as accel_rtc_object gives it
- * for a hit on it); buried (may be NULL): n flags, particles buried in a
- * closed solid; agree: gi_links' threshold on n . N (0.3); maxdist: the
- * lookup radius. NULL with *st set on failure (PT_OK and NULL when no
- * triangle carries particles). */
+ * for a hit on it); grid: the same particles' lookup, its object ids set
+ * from pobj (gi_lookup_set_objects); buried (may be NULL): n flags,
+ * particles buried in a closed solid; agree: gi_links' threshold on n . N
+ * (0.3); maxdist: the lookup radius. NULL with *st set on failure (PT_OK
+ * and NULL when no triangle carries particles). */
 gi_trilook *gi_trilook_build(const accel *a, const gi_dev_particle *p, int n, const void *const *pobj,
-                             const unsigned char *buried, double spacing, double agree, double maxdist, int threads,
-                             pt_status *st);
+                             const gi_lookup *grid, const unsigned char *buried, double spacing, double agree,
+                             double maxdist, int threads, pt_status *st);
 /* The particles were renumbered: remap[i] is particle i's new index, -1
  * when it was dropped (indices keep their order); p: the n kept ones. */
 void gi_trilook_compact(gi_trilook *t, const int *remap, const gi_dev_particle *p, int n);
