@@ -1501,7 +1501,8 @@ int accel_sweep_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
     return r;
 }
 
-/* Cells for a length: ceil(len / cell) within [lo, 4096]. */
+/* Cells for a length, or for an angle with cell the most turn of one cell:
+ * ceil(len / cell) within [lo, 4096]. */
 static int cells_for(double len, double cell, int lo)
 {
     double c = ceil(len / cell);
@@ -1557,8 +1558,8 @@ int accel_sweep_grid_cell(const accel_shape *sh, double cell, double turn, accel
         }
         na[k] = cells_for(arc, c, 1);
         if (isfinite(turn)) {
-            double t = ceil(seg_turn(w, k, S) / turn);
-            if (t > na[k]) na[k] = t > 4096.0 ? 4096 : (int)t;
+            int t = cells_for(seg_turn(w, k, S), turn, 1);
+            if (t > na[k]) na[k] = t;
         }
         if (w->type == SW_PRISM) {
             for (int i = 0; i <= 4; i++) {
@@ -1571,8 +1572,10 @@ int accel_sweep_grid_cell(const accel_shape *sh, double cell, double turn, accel
     }
     if (w->type == SW_SOR) rmax = fmax(rmax, sqrt(fmax(w->base_r2, w->cap_r2)));
     int nb = w->type == SW_PRISM ? cells_for(around, c, 1) : cells_for(2.0 * M_PI * rmax, c, 3);
-    if (w->type != SW_PRISM && isfinite(turn) && nb < 2.0 * M_PI / turn)
-        nb = 2.0 * M_PI / turn >= 4096.0 ? 4096 : (int)ceil(2.0 * M_PI / turn);
+    if (w->type != SW_PRISM && isfinite(turn)) {
+        int t = cells_for(2.0 * M_PI, turn, 3);
+        if (t > nb) nb = t;
+    }
     int nr = cells_for(sqrt(fmax(w->base_r2, w->cap_r2)), c, 1);
     int r = grid_sized(w, na, nb, nr, fn, ctx);
     free(na);
