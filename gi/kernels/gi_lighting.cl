@@ -40,20 +40,15 @@ __kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global co
     uint em = emits[g], bits = 0u;
     float ds = 0.0f;
     for (int i = i0; i < i1; i++) {
-        int lit = 0;
-        for (int l = 0; l < nlights; l++) lit |= vis[(long)i * nlights + l] > 0.0f;
-        if (!lit && !((em >> (i - i0)) & 1u)) {
-            for (int c = 0; c < 4; c++) {
-                edir[4 * i + c] = 0.0f;
-                src[4 * i + c] = 0.0f;
-            }
-            continue;
-        }
+        /* one pass over the particle's row of vis: its record is read only
+         * once a light reaches it (lit) */
         __global const gi_dev_particle *pt = &part[i];
         float e[3] = {0.0f, 0.0f, 0.0f};
+        int lit = 0;
         for (int l = 0; l < nlights; l++) {
             float v = vis[(long)i * nlights + l];
             if (!(v > 0.0f)) continue;
+            lit = 1;
             __global const gi_dev_light *lt = &lights[l];
             float d[3];
             gi_light_ray(lt, lt->pos[0], lt->pos[1], lt->pos[2], pt->p[0], pt->p[1], pt->p[2], d);
@@ -62,6 +57,13 @@ __kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global co
             float intensity = pt->brilliance != 1.0f ? pow(ci, pt->brilliance) : ci;
             float w = intensity * v; /* v = att * V */
             for (int c = 0; c < 3; c++) e[c] += lt->colour[c] * w;
+        }
+        if (!lit && !((em >> (i - i0)) & 1u)) {
+            for (int c = 0; c < 4; c++) {
+                edir[4 * i + c] = 0.0f;
+                src[4 * i + c] = 0.0f;
+            }
+            continue;
         }
         int any = 0;
         for (int c = 0; c < 3; c++) {
