@@ -406,11 +406,28 @@ static pt_status upload(gi_dev *dv, cl_mem *m, size_t *have, const void *data, s
     return e == CL_SUCCESS ? PT_OK : cl_fail(d, "clEnqueueWriteBuffer", e);
 }
 
-static pt_status download(gi_dev *dv, cl_mem m, void *data, size_t size, diag *d)
+/* A read of m into data: waited for (blocking), or only enqueued (the queue
+ * is in order: a later blocking read or settle() waits for it too). */
+static pt_status read_buf(gi_dev *dv, cl_mem m, void *data, size_t size, cl_bool blocking, diag *d)
 {
     if (size == 0) return PT_OK;
-    cl_int e = clEnqueueReadBuffer(dv->q, m, CL_TRUE, 0, size, data, 0, NULL, NULL);
+    cl_int e = clEnqueueReadBuffer(dv->q, m, blocking, 0, size, data, 0, NULL, NULL);
     return e == CL_SUCCESS ? PT_OK : cl_fail(d, "clEnqueueReadBuffer", e);
+}
+
+static pt_status download(gi_dev *dv, cl_mem m, void *data, size_t size, diag *d)
+{
+    return read_buf(dv, m, data, size, CL_TRUE, d);
+}
+
+/* Waits for what the queue holds (the reads read_buf only enqueued), also
+ * after a failed enqueue, so that no read lands in host memory after the
+ * call returned; st: the status so far, kept when it is an error. */
+static pt_status settle(gi_dev *dv, pt_status st, diag *d)
+{
+    cl_int e = clFinish(dv->q);
+    if (st != PT_OK) return st;
+    return e == CL_SUCCESS ? PT_OK : cl_fail(d, "clFinish", e);
 }
 
 static pt_status zero(gi_dev *dv, cl_mem m, size_t size, diag *d)
@@ -950,11 +967,12 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
     dv->stale = 1;
     /* edir and phi stay on the device until gi_dev_fetch (only stats and
      * tests read them); lout is the gather's input on the host too */
-    if ((st = download(dv, dv->b_lout, lout, f4, d)) != PT_OK) return st;
-    if ((st = download(dv, dv->b_dsum, dv->dsum, eitems * sizeof(float), d)) != PT_OK) return st;
-    if ((st = download(dv, dv->b_mask_src, dv->srcmask_host, eitems * sizeof(unsigned), d)) != PT_OK) return st;
-    if (nb > 0 && (st = download(dv, dv->b_tally, dv->tally, (size_t)nb * 3 * items * sizeof(float), d)) != PT_OK)
-        return st;
+    st = read_buf(dv, dv->b_lout, lout, f4, CL_FALSE, d);
+    if (st == PT_OK) st = read_buf(dv, dv->b_dsum, dv->dsum, eitems * sizeof(float), CL_FALSE, d);
+    if (st == PT_OK) st = read_buf(dv, dv->b_mask_src, dv->srcmask_host, eitems * sizeof(unsigned), CL_FALSE, d);
+    if (st == PT_OK && nb > 0)
+        st = read_buf(dv, dv->b_tally, dv->tally, (size_t)nb * 3 * items * sizeof(float), CL_FALSE, d);
+    if ((st = settle(dv, st, d)) != PT_OK) return st; /* one wait for the four reads */
     sum_bounces(dv->tally, items, nb, bounce_flux);
     fill_sums(dv, eitems, nb, bounce_flux, sums);
     *done = 1;
@@ -973,9 +991,9 @@ pt_status gi_dev_fetch(gi_dev *dv, diag *d)
     if (!dv || !dv->stale) return PT_OK;
 #ifdef PARTRAY_HAVE_OPENCL
     size_t f4 = (size_t)dv->n * 4 * sizeof(float);
-    pt_status st = download(dv, dv->b_edir, dv->edir_host, f4, d);
-    if (st == PT_OK) st = download(dv, dv->b_phi, dv->phi_host, f4, d);
-    if (st != PT_OK) return st;
+    pt_status st = read_buf(dv, dv->b_edir, dv->edir_host, f4, CL_FALSE, d);
+    if (st == PT_OK) st = read_buf(dv, dv->b_phi, dv->phi_host, f4, CL_FALSE, d);
+    if ((st = settle(dv, st, d)) != PT_OK) return st;
 #else
     (void)d;
 #endif
