@@ -181,28 +181,6 @@ static void sweep(const scene *sc, const accel *a, const opts *o, diag *d)
     fb_free(fb);
 }
 
-/* Relight reps times, each after moving the first nmove lights by 1e-4 in
- * x (back and forth, so visibility is traced again), recording the stage's
- * wall (tm) and CPU (tmc) times; the lights end where they started, relit.
- * Returns the last relight's shadow rays. */
-static long time_moves(gi_particle *gp, scene *sc, int nmove, int reps, double *tm, double *tmc, diag *d)
-{
-    long rays = 0;
-    for (int r = 0; r < reps; r++) {
-        for (int l = 0; l < nmove; l++) sc->lights[l].position.x += (r % 2 ? -1e-4 : 1e-4);
-        double cc = bench_cpu_now();
-        gi_particle_relight(gp, d);
-        tmc[r] = bench_cpu_now() - cc;
-        const gi_particle_stats *x = gi_particle_get_stats(gp);
-        tm[r] = x->t_lighting;
-        rays = x->shadow_rays;
-    }
-    if (reps % 2)
-        for (int l = 0; l < nmove; l++) sc->lights[l].position.x -= 1e-4;
-    gi_particle_relight(gp, d);
-    return rays;
-}
-
 int main(int argc, char **argv)
 {
     opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 1, 0, -1, 0, 0, 0, 0, 0, 50000, NULL, NULL, NULL};
@@ -325,13 +303,13 @@ int main(int argc, char **argv)
     }
     /* the same after moving the lights a little: visibility traced again */
     double *tm = calloc((size_t)o.reps, sizeof *tm), *tmc = calloc((size_t)o.reps, sizeof *tmc);
-    long moved_rays = time_moves(gp, sc, sc->nlights, o.reps, tm, tmc, d);
+    long moved_rays = bench_time_moves(gp, sc, sc->nlights, o.reps, tm, tmc, d);
     printf("lighting stage after a light moved (all lights moved; median of %d): %.2f ms wall, %.2f ms CPU, %ld "
            "shadow rays\n",
            o.reps, 1e3 * bench_median(tm, o.reps), 1e3 * bench_median(tmc, o.reps), moved_rays);
     /* the same moving the first light only: the others keep their visibility */
     if (sc->nlights > 1) {
-        moved_rays = time_moves(gp, sc, 1, o.reps, tm, tmc, d);
+        moved_rays = bench_time_moves(gp, sc, 1, o.reps, tm, tmc, d);
         printf("  the first of the %d lights moved alone: %.2f ms wall, %.2f ms CPU, %ld shadow rays\n", sc->nlights,
                1e3 * bench_median(tm, o.reps), 1e3 * bench_median(tmc, o.reps), moved_rays);
     }

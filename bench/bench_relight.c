@@ -114,7 +114,6 @@ int main(int argc, char **argv)
     gi_particle_relight(gp, d); /* the first: visibility traced */
     double *tw = calloc((size_t)reps, sizeof *tw), *tc = calloc((size_t)reps, sizeof *tc);
     double *tk = calloc((size_t)reps, sizeof *tk);
-    long moved_rays = 0;
     for (int r = 0; r < reps; r++) {
         double c0 = bench_cpu_now();
         gi_particle_relight(gp, d);
@@ -133,17 +132,7 @@ int main(int argc, char **argv)
            "CPU; %ld sources\n",
            reps, 1e3 * bench_median(tw, reps), 1e3 * bench_median(tk, reps), 1e3 * bench_median(tc, reps), 1e3 * mw, 1e3 * mc,
            x->sources);
-    for (int r = 0; r < reps; r++) {
-        for (int l = 0; l < sc->nlights; l++) sc->lights[l].position.x += (r % 2 ? -1e-4 : 1e-4);
-        double c0 = bench_cpu_now();
-        gi_particle_relight(gp, d);
-        tc[r] = bench_cpu_now() - c0;
-        tw[r] = gi_particle_get_stats(gp)->t_lighting;
-        moved_rays = gi_particle_get_stats(gp)->shadow_rays;
-    }
-    if (reps % 2)
-        for (int l = 0; l < sc->nlights; l++) sc->lights[l].position.x -= 1e-4;
-    gi_particle_relight(gp, d);
+    long moved_rays = bench_time_moves(gp, sc, sc->nlights, reps, tw, tc, d);
     printf("all lights moved (median of %d): %.2f ms wall, %.2f ms CPU, %ld shadow rays\n", reps,
            1e3 * bench_median(tw, reps), 1e3 * bench_median(tc, reps), moved_rays);
     x = gi_particle_get_stats(gp);

@@ -1,7 +1,10 @@
-/* bench_util.h - what every benchmark in bench/ prints its figures with. */
+/* bench_util.h - what every benchmark in bench/ prints its figures with,
+ * and the particle-GI relight timing bench_gi and bench_relight share. */
 #ifndef PT_BENCH_UTIL_H
 #define PT_BENCH_UTIL_H
 #include "diag.h"
+#include "gi_particle.h"
+#include "scene.h"
 
 /* CPU seconds of the whole process (getrusage: all threads, PoCL's and
  * Embree's included); on a shared machine this says more than wall time,
@@ -14,5 +17,12 @@ double bench_median(double *v, int n);
 
 /* Every diagnostic of d on stderr. */
 void bench_report_diag(const diag *d);
+
+/* Relights gp reps times, each after moving the first nmove lights of sc by
+ * 1e-4 in x (back and forth, so visibility is traced again), recording the
+ * stage's wall (tm[r], its own timer) and CPU (tmc[r], bench_cpu_now) times;
+ * the lights end where they started, relit. Returns the last relight's
+ * shadow rays. */
+long bench_time_moves(gi_particle *gp, scene *sc, int nmove, int reps, double *tm, double *tmc, diag *d);
 
 #endif
