@@ -355,6 +355,19 @@ static void rel(cl_mem *m)
     *m = NULL;
 }
 
+/* Every device buffer of dv released (gi_dev_free, and gi_dev_set_particles
+ * before a new geometry's): the one list of them. */
+static void release_buffers(gi_dev *dv)
+{
+    cl_mem *ms[] = {&dv->b_part, &dv->b_rho, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
+                    &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_tally, &dv->b_lout, &dv->b_phi,
+                    &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off, &dv->b_rin_src, &dv->b_bin,
+                    &dv->b_bout, &dv->b_total, &dv->b_woff, &dv->b_went,
+                    &dv->b_emits, &dv->b_mask_src, &dv->b_mask_a, &dv->b_mask_b, &dv->b_cin_off,
+                    &dv->b_cin_src, &dv->b_enew, &dv->b_dsum};
+    for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
+}
+
 static const char *mib(size_t n, char *buf, size_t cap)
 {
     snprintf(buf, cap, "%.1f MiB", (double)n / (1024.0 * 1024.0));
@@ -472,6 +485,20 @@ static pt_status run_kernel_local(gi_dev *dv, int which, size_t n, size_t local,
 }
 #endif /* PARTRAY_HAVE_OPENCL */
 
+/* The C build's work buffers (gi_dev_set_particles allocates them; an
+ * OpenCL device has its own on the device). */
+static void free_c_work(gi_dev *dv)
+{
+    free(dv->edir);
+    free(dv->src);
+    free(dv->bin);
+    free(dv->bout);
+    free(dv->total);
+    free(dv->mask_src);
+    free(dv->mask_a);
+    free(dv->mask_b);
+}
+
 /* ------------------------------------------------------------------ common */
 
 gi_dev *gi_dev_open(const gi_dev_options *o, diag *d, pt_status *status)
@@ -513,13 +540,7 @@ void gi_dev_free(gi_dev *dv)
     if (!dv) return;
 #ifdef PARTRAY_HAVE_OPENCL
     if (dv->is_cl) {
-        cl_mem *ms[] = {&dv->b_part, &dv->b_rho, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
-                        &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_tally, &dv->b_lout, &dv->b_phi,
-                        &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off, &dv->b_rin_src, &dv->b_bin,
-                        &dv->b_bout, &dv->b_total, &dv->b_woff, &dv->b_went,
-                        &dv->b_emits, &dv->b_mask_src, &dv->b_mask_a, &dv->b_mask_b, &dv->b_cin_off,
-                        &dv->b_cin_src, &dv->b_enew, &dv->b_dsum};
-        for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
+        release_buffers(dv);
         for (int k = 0; k < KE_COUNT; k++)
             if (dv->k[k]) clReleaseKernel(dv->k[k]);
         if (dv->prog) clReleaseProgram(dv->prog);
@@ -528,14 +549,7 @@ void gi_dev_free(gi_dev *dv)
         free(dv->tmp);
     }
 #endif
-    free(dv->edir);
-    free(dv->src);
-    free(dv->bin);
-    free(dv->bout);
-    free(dv->total);
-    free(dv->mask_src);
-    free(dv->mask_a);
-    free(dv->mask_b);
+    free_c_work(dv);
     free(dv->rho4);
     free(dv->emits);
     free(dv->cand);
@@ -588,14 +602,7 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     dv->stale = 0;
     dv->vis_ok = 0;
     if (!dv->is_cl) {
-        free(dv->edir);
-        free(dv->src);
-        free(dv->bin);
-        free(dv->bout);
-        free(dv->total);
-        free(dv->mask_src);
-        free(dv->mask_a);
-        free(dv->mask_b);
+        free_c_work(dv);
         dv->edir = calloc(nn * 4, sizeof(float));
         dv->src = calloc(nn * 4, sizeof(float));
         dv->bin = calloc(nn * 4, sizeof(float));
@@ -614,13 +621,7 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     size_t have = 0;
     pt_status st;
     /* a new geometry: drop every buffer and start the byte count again */
-    cl_mem *ms[] = {&dv->b_part, &dv->b_rho, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
-                    &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_tally, &dv->b_lout, &dv->b_phi,
-                    &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off, &dv->b_rin_src, &dv->b_bin,
-                    &dv->b_bout, &dv->b_total, &dv->b_woff, &dv->b_went,
-                    &dv->b_emits, &dv->b_mask_src, &dv->b_mask_a, &dv->b_mask_b, &dv->b_cin_off,
-                    &dv->b_cin_src, &dv->b_enew, &dv->b_dsum};
-    for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
+    release_buffers(dv);
     dv->sz_lights = dv->sz_vis = dv->sz_tally = dv->sz_list = dv->sz_vout = dv->sz_woff = dv->sz_went = 0;
     dv->sz_cin_off = dv->sz_cin_src = 0;
     dv->bytes = 0;
