@@ -30,20 +30,6 @@ typedef struct {
     double complex ca, cb; /* c as the complex pair (hypercomplex) */
 } jf_data;
 
-static int put_hit(accel_shape_hit *out, int n, int max, double t, int part)
-{
-    if (max <= 0) return 0;
-    if (n == max && !(t < out[n - 1].t)) return n;
-    int i = n < max ? n++ : n - 1;
-    while (i > 0 && out[i - 1].t > t) {
-        out[i] = out[i - 1];
-        i--;
-    }
-    out[i].t = t;
-    out[i].part = part;
-    return n;
-}
-
 /* The slice: z0 = (x, y, z, w(x, y, z)). */
 static void lift(const jf_data *f, vec3 p, double q[4])
 {
@@ -244,7 +230,7 @@ int accel_fractal_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, doubl
                 else hi = m;
             }
             double t = a + 0.5 * (lo + hi) / s;
-            if (t > tmin && t < tmax) n = put_hit(out, n, max, t, 0);
+            if (t > tmin && t < tmax) n = accel_shape_hit_put(out, n, max, t, 0);
         }
         tau = tn;
         cur = next;

@@ -32,20 +32,6 @@ static double H_at(const hf_data *f, int i, int j)
     return v > f->water ? v : f->water;
 }
 
-static int put_hit(accel_shape_hit *out, int n, int max, double t, int part)
-{
-    if (max <= 0) return 0;
-    if (n == max && !(t < out[n - 1].t)) return n;
-    int i = n < max ? n++ : n - 1;
-    while (i > 0 && out[i - 1].t > t) {
-        out[i] = out[i - 1];
-        i--;
-    }
-    out[i].t = t;
-    out[i].part = part;
-    return n;
-}
-
 int accel_hfield_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
 {
     const scene_height_field *s = o->u.height_field;
@@ -201,7 +187,7 @@ static void walk(hf_walk *w, int lev, int ix, int iz)
             double t;
             cell_tri(f, ix, iz, tri, &a, &b, &c);
             if (tri_hit(w->o, w->d, a, b, c, &t) && t > w->tmin && t < w->tmax) {
-                w->n = put_hit(w->out, w->n, w->max, t, (int)(2 * ((size_t)iz * f->nx + ix) + tri));
+                w->n = accel_shape_hit_put(w->out, w->n, w->max, t, (int)(2 * ((size_t)iz * f->nx + ix) + tri));
                 if (w->n == w->max) w->tmax = fmin(w->tmax, w->out[w->max - 1].t);
             }
         }

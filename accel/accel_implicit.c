@@ -54,21 +54,6 @@ static const func_env *volatile g_func_env;
 
 void accel_set_function_env(const func_env *env) { g_func_env = env; }
 
-static int put_hit(accel_shape_hit *out, int n, int max, double t, int part)
-{
-    if (max <= 0) return 0;
-    if (n == max && !(t < out[n - 1].t)) return n;
-    int i = n < max ? n++ : n - 1;
-    while (i > 0 && out[i - 1].t > t) {
-        out[i] = out[i - 1];
-        i--;
-    }
-    out[i].t = t;
-    out[i].part = part;
-    return n;
-}
-
-
 /* ------------------------------------------------------------ superellipsoid */
 
 /* N(v) = ((|x|^p + |y|^p)^(q/p) + |z|^q)^(1/q), evaluated with the largest
@@ -218,7 +203,7 @@ static int se_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, a
     int n = 0;
     for (int i = 0; i < nr; i++) {
         double t = t0 + roots[i] / s;
-        if (t > tmin && t < tmax) n = put_hit(out, n, max, t, 0);
+        if (t > tmin && t < tmax) n = accel_shape_hit_put(out, n, max, t, 0);
     }
     return n;
 }
@@ -254,7 +239,7 @@ static int quadric_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tm
     int n = 0;
     for (int i = 0; i < nr; i++) {
         double t = t0 + roots[i] / s;
-        if (t > tmin && t < tmax) n = put_hit(out, n, max, t, 0);
+        if (t > tmin && t < tmax) n = accel_shape_hit_put(out, n, max, t, 0);
     }
     return n;
 }
@@ -375,7 +360,7 @@ static int poly_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax,
     int nh = 0;
     for (int i = 0; i < nr; i++) {
         double t = t0 + roots[i] / s;
-        if (t > tmin && t < tmax) nh = put_hit(out, nh, max, t, 0);
+        if (t > tmin && t < tmax) nh = accel_shape_hit_put(out, nh, max, t, 0);
     }
     return nh;
 }
@@ -534,7 +519,7 @@ static int blob_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax,
                 int nr = accel_poly_solve(c, 4, a, b, roots, m->sturm);
                 for (int i = 0; i < nr; i++) {
                     double t = t0 + roots[i] / s;
-                    if (t > tmin && t < tmax) n = put_hit(out, n, max, t, 0);
+                    if (t > tmin && t < tmax) n = accel_shape_hit_put(out, n, max, t, 0);
                 }
             }
         }
@@ -675,8 +660,8 @@ static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, 
     double len = (b - a) * s;
     int n = 0;
     if (!m->open) {
-        if (ca > tmin && ca < tmax && iso_f(m, v3_madd(o, d, ca)) < 0.0) n = put_hit(out, n, max, ca, 1);
-        if (cb > tmin && cb < tmax && iso_f(m, v3_madd(o, d, cb)) < 0.0) n = put_hit(out, n, max, cb, 1);
+        if (ca > tmin && ca < tmax && iso_f(m, v3_madd(o, d, ca)) < 0.0) n = accel_shape_hit_put(out, n, max, ca, 1);
+        if (cb > tmin && cb < tmax && iso_f(m, v3_madd(o, d, cb)) < 0.0) n = accel_shape_hit_put(out, n, max, cb, 1);
     }
     double tau = 0.0, v0 = iso_f(m, p0);
     double minstep = fmax(m->acc, 1e-9 * m->size);
@@ -694,7 +679,7 @@ static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, 
                 if ((fm < 0.0) == (flo < 0.0)) { lo = mid; flo = fm; } else hi = mid;
             }
             double t = a + 0.5 * (lo + hi) / s;
-            if (t > tmin && t < tmax) n = put_hit(out, n, max, t, 0);
+            if (t > tmin && t < tmax) n = accel_shape_hit_put(out, n, max, t, 0);
         }
         tau = t1;
         v0 = v1;

@@ -316,20 +316,6 @@ static int in_range(double t, double tmin, double tmax) { return t > tmin && t <
 /* Each hits_* function writes up to `max` crossings with t in (tmin, tmax),
  * in ascending order, and returns how many. */
 
-/* Insert a candidate into an ascending list of at most `max` entries. */
-static int push_hit(accel_shape_hit *out, int n, int max, double t, int part)
-{
-    if (n == max && !(t < out[n - 1].t)) return n;
-    int i = n < max ? n++ : n - 1;
-    while (i > 0 && out[i - 1].t > t) {
-        out[i] = out[i - 1];
-        i--;
-    }
-    out[i].t = t;
-    out[i].part = part;
-    return n;
-}
-
 static int hits_sphere(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
 {
     vec3 oc = v3_sub(o, sh->g.sphere.c);
@@ -344,8 +330,8 @@ static int hits_sphere(const accel_shape *sh, vec3 o, vec3 d, double tmin, doubl
     double t0 = q / a, t1 = (q != 0.0) ? c / q : t0;
     if (t0 > t1) { double t = t0; t0 = t1; t1 = t; }
     int n = 0;
-    if (in_range(t0, tmin, tmax)) n = push_hit(out, n, max, t0, 0);
-    if (in_range(t1, tmin, tmax) && t1 > t0) n = push_hit(out, n, max, t1, 0);
+    if (in_range(t0, tmin, tmax)) n = accel_shape_hit_put(out, n, max, t0, 0);
+    if (in_range(t1, tmin, tmax) && t1 > t0) n = accel_shape_hit_put(out, n, max, t1, 0);
     return n;
 }
 
@@ -386,8 +372,8 @@ static int hits_box(const accel_shape *sh, vec3 o, vec3 d, double tmin, double t
     double t0, t1;
     int f0, f1, n = 0;
     if (!slabs(o, d, sh->g.box.lo, sh->g.box.hi, &t0, &f0, &t1, &f1)) return 0;
-    if (in_range(t0, tmin, tmax)) n = push_hit(out, n, max, t0, f0);
-    if (in_range(t1, tmin, tmax) && t1 > t0) n = push_hit(out, n, max, t1, f1);
+    if (in_range(t0, tmin, tmax)) n = accel_shape_hit_put(out, n, max, t0, f0);
+    if (in_range(t1, tmin, tmax) && t1 > t0) n = accel_shape_hit_put(out, n, max, t1, f1);
     return n;
 }
 
@@ -404,7 +390,7 @@ static int hits_plane(const accel_shape *sh, vec3 o, vec3 d, vec3 worg, vec3 wdi
     double t = (sh->g.plane.d - v3_dot(sh->g.plane.n, o)) / den;
     if (!in_range(t, tmin, tmax)) return 0;
     if (sh->clipped && !in_box(v3_madd(worg, wdir, t), sh->clip_lo, sh->clip_hi)) return 0;
-    return push_hit(out, 0, max, t, 0);
+    return accel_shape_hit_put(out, 0, max, t, 0);
 }
 
 static int hits_cone(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
@@ -426,7 +412,7 @@ static int hits_cone(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
         if (!in_range(t, tmin, tmax) || (i == 1 && t == ts[0])) continue;
         double z = oz + t * dz;
         if (z < 0.0 || z > H) continue;
-        n = push_hit(out, n, max, t, ACCEL_PART_CONE_SIDE);
+        n = accel_shape_hit_put(out, n, max, t, ACCEL_PART_CONE_SIDE);
     }
     if (!sh->open && dz != 0.0) {
         for (int e = 0; e < 2; e++) {
@@ -436,7 +422,7 @@ static int hits_cone(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
             if (!in_range(t, tmin, tmax)) continue;
             double x = ox + t * dx, y = oy + t * dy;
             if (x * x + y * y > rc * rc) continue;
-            n = push_hit(out, n, max, t, e ? ACCEL_PART_CONE_CAP : ACCEL_PART_CONE_BASE);
+            n = accel_shape_hit_put(out, n, max, t, e ? ACCEL_PART_CONE_CAP : ACCEL_PART_CONE_BASE);
         }
     }
     return n;
@@ -450,7 +436,7 @@ static int hits_disc(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
     if (!in_range(t, tmin, tmax)) return 0;
     double r2 = v3_len2(v3_sub(v3_madd(o, d, t), sh->g.disc.c));
     if (r2 > sh->g.disc.r2 || r2 < sh->g.disc.h2) return 0;
-    return push_hit(out, 0, max, t, 0);
+    return accel_shape_hit_put(out, 0, max, t, 0);
 }
 
 /* Double-precision Moller-Trumbore (Moller & Trumbore 1997). */
@@ -470,7 +456,7 @@ static int hits_triangle(const accel_shape *sh, vec3 o, vec3 d, double tmin, dou
     if (v < 0.0 || u + v > 1.0) return 0;
     double t = v3_dot(e2, qv) * inv;
     if (!in_range(t, tmin, tmax)) return 0;
-    return push_hit(out, 0, max, t, 0);
+    return accel_shape_hit_put(out, 0, max, t, 0);
 }
 
 static int hits_torus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
@@ -509,7 +495,7 @@ static int hits_torus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double
         double tau = lo + roots[i];
         if (!(tau > ta && tau < tb)) continue;
         double t = tau / sk;
-        if (in_range(t, tmin, tmax)) n = push_hit(out, n, max, t, 0);
+        if (in_range(t, tmin, tmax)) n = accel_shape_hit_put(out, n, max, t, 0);
     }
     return n;
 }
@@ -583,7 +569,7 @@ static int hits_ovus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
         double tau = lo + cand[i];
         if (!(tau > ta && tau < tb)) continue;
         double t = tau / sk;
-        if (in_range(t, tmin, tmax)) n = push_hit(out, n, max, t, part[i]);
+        if (in_range(t, tmin, tmax)) n = accel_shape_hit_put(out, n, max, t, part[i]);
     }
     return n;
 }

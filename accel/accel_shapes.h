@@ -53,6 +53,24 @@ typedef struct {
     int part;
 } accel_shape_hit;
 
+/* Puts the crossing (t, part) into out[0..n-1], kept ascending and at most
+ * max long (when full, the farthest gives way to a nearer t; an equal or
+ * farther t is dropped): returns the new count. Every shape's hits list
+ * (accel_shapes.c, fractal, height field, isosurface family, sweeps). */
+static inline int accel_shape_hit_put(accel_shape_hit *out, int n, int max, double t, int part)
+{
+    if (max <= 0) return 0;
+    if (n == max && !(t < out[n - 1].t)) return n;
+    int i = n < max ? n++ : n - 1;
+    while (i > 0 && out[i - 1].t > t) {
+        out[i] = out[i - 1];
+        i--;
+    }
+    out[i].t = t;
+    out[i].part = part;
+    return n;
+}
+
 /* Fill `sh` from a leaf object of an analytic kind (triangles and smooth
  * triangles too: they are intersected here when they belong to a CSG
  * intersection/difference; otherwise Embree handles them). Returns 0 on success, -1

@@ -68,21 +68,6 @@ typedef struct {
 
 /* ------------------------------------------------------------ small helpers */
 
-static int put_hit(accel_shape_hit *out, int n, int max, double t, int part)
-{
-    if (max <= 0) return 0;
-    if (n == max && !(t < out[n - 1].t)) return n;
-    int i = n < max ? n++ : n - 1;
-    while (i > 0 && out[i - 1].t > t) {
-        out[i] = out[i - 1];
-        i--;
-    }
-    out[i].t = t;
-    out[i].part = part;
-    return n;
-}
-
-
 static vec3 from_local_axes(const int ax[3], double u, double w, double v)
 {
     double r[3];
@@ -430,7 +415,7 @@ static int lathe_hits(const sw_data *w, const lray *r, double tmin, double tmax,
             lathe_polish(s, r, &t, &tau);
             if (t < -T_SLACK || t > 1.0 + T_SLACK) continue;
             double tt = lray_t(r, tau);
-            if (tt > tmin && tt < tmax) n = put_hit(out, n, max, tt, 2 + k);
+            if (tt > tmin && tt < tmax) n = accel_shape_hit_put(out, n, max, tt, 2 + k);
         }
     }
     return n;
@@ -476,7 +461,7 @@ static int sor_hits(const sw_data *w, const lray *r, double tmin, double tmax, a
         int nr = accel_poly_solve(c, 3, ta, tb, roots, w->sturm);
         for (int i = 0; i < nr; i++) {
             double tt = lray_t(r, roots[i]);
-            if (tt > tmin && tt < tmax) n = put_hit(out, n, max, tt, 2 + k);
+            if (tt > tmin && tt < tmax) n = accel_shape_hit_put(out, n, max, tt, 2 + k);
         }
     }
     if (!w->open && e.y != 0.0) {
@@ -487,7 +472,7 @@ static int sor_hits(const sw_data *w, const lray *r, double tmin, double tmax, a
             double x = P.x + tau * e.x, z = P.z + tau * e.z;
             if (x * x + z * z > r2[c]) continue;
             double tt = lray_t(r, tau);
-            if (tt > tmin && tt < tmax) n = put_hit(out, n, max, tt, c);
+            if (tt > tmin && tt < tmax) n = accel_shape_hit_put(out, n, max, tt, c);
         }
     }
     return n;
@@ -555,7 +540,7 @@ static int prism_hits(const sw_data *w, const lray *r, double tmin, double tmax,
             if (w->conic) { u /= hh[c]; v /= hh[c]; }
             if (!in_curve(w, u, v)) continue;
             double tt = lray_t(r, tau);
-            if (tt > tmin && tt < tmax) n = put_hit(out, n, max, tt, c);
+            if (tt > tmin && tt < tmax) n = accel_shape_hit_put(out, n, max, tt, c);
         }
     }
     if (fabs(eu) < 1e-12 && fabs(ev) < 1e-12 && !w->conic) return n; /* along the sweep axis */
@@ -608,7 +593,7 @@ static int prism_hits(const sw_data *w, const lray *r, double tmin, double tmax,
             double hw = Pw + tau * ew;
             if (hw < w->h1 || hw > w->h2) continue;
             double tt = lray_t(r, tau);
-            if (tt > tmin && tt < tmax) n = put_hit(out, n, max, tt, 2 + k);
+            if (tt > tmin && tt < tmax) n = accel_shape_hit_put(out, n, max, tt, 2 + k);
         }
     }
     return n;
@@ -624,7 +609,7 @@ static int polygon_hits(const sw_data *w, vec3 o, vec3 d, double tmin, double tm
     if (!(t > tmin && t < tmax)) return 0;
     vec3 q = v3_sub(v3_madd(o, d, t), w->p0);
     if (!in_curve(w, v3_dot(q, w->pu) / w->L, v3_dot(q, w->pv) / w->L)) return 0;
-    return put_hit(out, 0, max, t, 2);
+    return accel_shape_hit_put(out, 0, max, t, 2);
 }
 
 /* ------------------------------------------------------------ setup */
