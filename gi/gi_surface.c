@@ -419,20 +419,26 @@ static double grid_jac(const gi_surface *g, const patch *p, double u, double v)
     return p->jobj * p->detm * v3_len(xform_normal(x, no));
 }
 
+/* Cells for a length at the tessellation bound tess: ceil(len / tess)
+ * within [lo, hi]. */
+static int grid_count(double len, double tess, int lo, int hi)
+{
+    double c = ceil(len / tess);
+    return c < lo ? lo : (c > hi ? hi : (int)c);
+}
+
 /* Sub-tessellation / grid resolution from the tessellation bound. */
 static void set_resolution(const gi_surface *g, patch *p)
 {
     if (p->kind == PATCH_PIECE) return; /* rp_count: its grid's vertices (build_meshes) */
     if (p->kind == PATCH_TRI) {
         if (p->nsides == 0) return;
-        double k = ceil(p->lu / g->tess);
-        p->k = k < 1.0 ? 1 : (k > 2048.0 ? 2048 : (int)k);
+        p->k = grid_count(p->lu, g->tess, 1, 2048);
         p->rp_count = (long)(p->k + 1) * (p->k + 2) / 2;
         return;
     }
-    double nu = ceil(p->lu / g->tess), nv = ceil(p->lv / g->tess);
-    p->nu = nu < 3.0 ? 3 : (nu > 4096.0 ? 4096 : (int)nu);
-    p->nv = nv < 1.0 ? 1 : (nv > 4096.0 ? 4096 : (int)nv);
+    p->nu = grid_count(p->lu, g->tess, 3, 4096);
+    p->nv = grid_count(p->lv, g->tess, 1, 4096);
     p->rp_count = (long)(p->nu + 1) * (p->nv + 1);
 }
 
@@ -1143,16 +1149,12 @@ static int mesh_add(mesh_ctx *m, const vec3 w[3], const vec3 nw[3])
 
 /* Parametric grids of the analytic shapes accel_shape_grid leaves to GI
  * (cylinder, cone, torus), in object space, n_* cells from the tessellation
- * bound (object lengths times the transform's largest stretch): the side of
- * a cone/cylinder by angle and height, its end caps by angle and radius (not
- * on open ones; their rim vertices are separate from the side's, each with
- * its own normal), a torus by its two angles. Vertices lie on the exact
- * surface with its exact outward normals. */
-static int grid_count(double len, double tess, int lo)
-{
-    double c = ceil(len / tess);
-    return c < lo ? lo : (c > 256.0 ? 256 : (int)c);
-}
+ * bound (grid_count, at most 256 a side; object lengths times the
+ * transform's largest stretch): the side of a cone/cylinder by angle and
+ * height, its end caps by angle and radius (not on open ones; their rim
+ * vertices are separate from the side's, each with its own normal), a torus
+ * by its two angles. Vertices lie on the exact surface with its exact
+ * outward normals. */
 
 /* World length of the shape's object axis c (its transform's column c). */
 static double axis_stretch(const accel_shape *sh, int c)
@@ -1175,7 +1177,7 @@ static int analytic_grid(const accel_shape *sh, double tess, accel_grid_fn fn, v
     double t = tess / s; /* the bound in object units */
     if (sh->kind == SHAPE_TORUS) {
         double R = sh->g.torus.R, r = sh->g.torus.r;
-        int nu = grid_count(2.0 * M_PI * (R + r), t, 3), nv = grid_count(2.0 * M_PI * r, t, 3);
+        int nu = grid_count(2.0 * M_PI * (R + r), t, 3, 256), nv = grid_count(2.0 * M_PI * r, t, 3, 256);
         for (int j = 0; j < nv; j++)
             for (int i = 0; i < nu; i++) {
                 vec3 P[4], N[4];
@@ -1194,7 +1196,7 @@ static int analytic_grid(const accel_shape *sh, double tess, accel_grid_fn fn, v
     if (sh->kind != SHAPE_CYLINDER && sh->kind != SHAPE_CONE) return 0;
     vec3 base = sh->g.cone.base, U = sh->g.cone.u, V = sh->g.cone.v, W = sh->g.cone.w;
     double H = sh->g.cone.h, r0 = sh->g.cone.r0, r1 = sh->g.cone.r1, k = sh->g.cone.k;
-    int nu = grid_count(2.0 * M_PI * fmax(r0, r1), t, 3), nv = grid_count(H, t, 1);
+    int nu = grid_count(2.0 * M_PI * fmax(r0, r1), t, 3, 256), nv = grid_count(H, t, 1, 256);
     int count = 0;
     /* side: z = H v, radius r0 + k z; normal (x u + y v) - w k rz, normalised */
     for (int j = 0; j < nv; j++)
@@ -1219,7 +1221,7 @@ static int analytic_grid(const accel_shape *sh, double tess, accel_grid_fn fn, v
         double rr = e ? r1 : r0;
         if (!(rr > 0.0)) continue;
         vec3 c = e ? v3_add(base, v3_scale(W, H)) : base, nn = e ? W : v3_neg(W);
-        int nr = grid_count(rr, t, 1);
+        int nr = grid_count(rr, t, 1, 256);
         for (int j = 0; j < nr; j++)
             for (int i = 0; i < nu; i++) {
                 vec3 P[4], N[3] = {nn, nn, nn};
@@ -1350,8 +1352,7 @@ static void build_meshes(gi_surface *g)
         if (!p->sh || !has_grid(g->o[p->obj].kind) || p->nsides == 0) continue;
         double ext = v3_maxc(v3_sub(p->sh->hi, p->sh->lo));
         if (!(ext > 0.0) || !isfinite(ext)) continue;
-        double nn = ceil(ext / g->tess);
-        int n = nn < 2.0 ? 2 : (nn > 128.0 ? 128 : (int)nn);
+        int n = grid_count(ext, g->tess, 2, 128);
         mesh_ctx m = {g, i, p->sh, NULL, 0, 0, 0.0};
         shape_kind kind = g->o[p->obj].kind;
         int r = kind == SHAPE_CYLINDER || kind == SHAPE_CONE || kind == SHAPE_TORUS
