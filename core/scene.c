@@ -1,6 +1,7 @@
 /* scene.c - scene IR construction helpers and POV-Ray 3.7 defaults. */
 #include "scene.h"
 #include "camera.h"
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -198,4 +199,31 @@ void scene_camera_ray(const scene_camera *c, double px, double py, int w, int h,
         *org = c->location;
         *dir = v3_norm(c->direction);
     }
+}
+
+vec3 scene_light_area_point(const scene_light *l, vec3 ax1, vec3 ax2, int u, int v, rng *r)
+{
+    double ju = u, jv = v;
+    if (l->jitter) {
+        ju += rng_f64(r) - 0.5;
+        jv += rng_f64(r) - 0.5;
+    }
+    if (l->circular && l->size1 > 1 && l->size2 > 1) {
+        ju = ju / (l->size1 - 1) - 0.5 + 0.001;
+        jv = jv / (l->size2 - 1) - 0.5 + 0.001;
+        double sf = fmax(fabs(ju), fabs(jv)) / sqrt(ju * ju + jv * jv);
+        return v3_add(v3_scale(ax1, ju * sf), v3_scale(ax2, jv * sf));
+    }
+    vec3 o = v3(0, 0, 0);
+    if (l->size1 > 1) o = v3_add(o, v3_scale(ax1, ju / (l->size1 - 1) - 0.5));
+    if (l->size2 > 1) o = v3_add(o, v3_scale(ax2, jv / (l->size2 - 1) - 0.5));
+    return o;
+}
+
+void scene_light_orient_axes(const scene_light *l, vec3 dir, vec3 *ax1, vec3 *ax2)
+{
+    double len = v3_len(l->axis1);
+    vec3 helper = fabs(fabs(dir.z) - 1.0) < 0.01 ? v3(0, 1, 0) : v3(0, 0, 1);
+    *ax1 = v3_scale(v3_norm(v3_cross(dir, helper)), len);
+    *ax2 = v3_scale(v3_norm(v3_cross(dir, v3_norm(*ax1))), len);
 }

@@ -9,6 +9,7 @@
 #include <stddef.h>
 #include "arena.h"
 #include "diag.h"
+#include "rng.h"
 #include "vec.h"
 #include "xform.h"
 #include "scene_pattern.h"
@@ -397,6 +398,18 @@ static inline int scene_light_reaches(const scene_light *l, const scene_object *
     if (!o) return l->group == 0;
     return l->group ? o->light_group == l->group : !o->no_global_lights;
 }
+
+/* Offset of grid point (u, v) of area light l from its position (POV-Ray's
+ * layout: points span -axis/2 .. +axis/2, an axis with size 1 contributes
+ * nothing; `jitter` moves each by up to half a cell; `circular` maps the
+ * square onto a disc). Uses r only when the light jitters. The Whitted
+ * pass's area lights (shade_light.c) and the particle GI's (gi_particle.c). */
+vec3 scene_light_area_point(const scene_light *l, vec3 ax1, vec3 ax2, int u, int v, rng *r);
+
+/* The axes of an `orient` area light l seen along unit dir (from the lit
+ * point towards the light): axis1's length on both, turned to face dir
+ * (POV-Ray's rule). */
+void scene_light_orient_axes(const scene_light *l, vec3 dir, vec3 *ax1, vec3 *ax2);
 
 /* ---------------------------------------------------------------- camera */
 typedef enum {

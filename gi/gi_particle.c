@@ -739,27 +739,6 @@ static void pack_light(const scene_light *l, gi_dev_light *o)
     o->shadowless = l->shadowless;
 }
 
-/* Grid point (u, v) of an area light, as shade.c area_point lays them out
- * (jittered by up to half a cell when `jitter` is set). */
-static vec3 area_point(const scene_light *l, vec3 ax1, vec3 ax2, int u, int v, rng *r)
-{
-    double ju = u, jv = v;
-    if (l->jitter) {
-        ju += rng_f64(r) - 0.5;
-        jv += rng_f64(r) - 0.5;
-    }
-    if (l->circular && l->size1 > 1 && l->size2 > 1) {
-        ju = ju / (l->size1 - 1) - 0.5 + 0.001;
-        jv = jv / (l->size2 - 1) - 0.5 + 0.001;
-        double sf = fmax(fabs(ju), fabs(jv)) / sqrt(ju * ju + jv * jv);
-        return v3_add(v3_scale(ax1, ju * sf), v3_scale(ax2, jv * sf));
-    }
-    vec3 o = v3(0, 0, 0);
-    if (l->size1 > 1) o = v3_add(o, v3_scale(ax1, ju / (l->size1 - 1) - 0.5));
-    if (l->size2 > 1) o = v3_add(o, v3_scale(ax2, jv / (l->size2 - 1) - 0.5));
-    return o;
-}
-
 typedef struct {
     gi_particle *gp;
     double eps;
@@ -875,13 +854,7 @@ static void vis_chunk(void *ctx, int chunk, int thread)
                 seen[o] = 1.0f;
             } else if (l->area && l->size1 * l->size2 > 1) {
                 vec3 ax1 = l->axis1, ax2 = l->axis2;
-                if (l->orient) {
-                    vec3 dir = v3(d[0], d[1], d[2]);
-                    double len = v3_len(l->axis1);
-                    vec3 helper = fabs(fabs(dir.z) - 1.0) < 0.01 ? v3(0, 1, 0) : v3(0, 0, 1);
-                    ax1 = v3_scale(v3_norm(v3_cross(dir, helper)), len);
-                    ax2 = v3_scale(v3_norm(v3_cross(dir, v3_norm(ax1))), len);
-                }
+                if (l->orient) scene_light_orient_axes(l, v3(d[0], d[1], d[2]), &ax1, &ax2);
                 rng r;
                 rng_seed(&r, gp->set.seed ^ 0xa11ULL, (uint64_t)i * 131u + (uint64_t)li);
                 int total = l->size1 * l->size2;
@@ -892,7 +865,7 @@ static void vis_chunk(void *ctx, int chunk, int thread)
                     int g = m == total ? k : (int)(start + k * stride);
                     if (g >= total) g = total - 1;
                     int u = g % l->size1, vv = g / l->size1;
-                    vec3 c = v3_add(l->position, area_point(l, ax1, ax2, u, vv, &r));
+                    vec3 c = v3_add(l->position, scene_light_area_point(l, ax1, ax2, u, vv, &r));
                     float dd[3];
                     float dep = gi_light_ray(dl, (float)c.x, (float)c.y, (float)c.z, pt->p[0], pt->p[1], pt->p[2], dd);
                     seen[o] += (float)shadow_ray(&B, org, v3(dd[0], dd[1], dd[2]), dep, J->eps, o, gp->a);

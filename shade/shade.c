@@ -169,7 +169,7 @@ static rgb area_sample(area_job *j, int u, int v)
 {
     rgb *g = &j->grid[u * j->l->size2 + v];
     if (g->r >= 0.0) return *g;
-    vec3 centre = v3_add(j->l->position, light_area_point(j->l, j->ax1, j->ax2, u, v, j->r));
+    vec3 centre = v3_add(j->l->position, scene_light_area_point(j->l, j->ax1, j->ax2, u, v, j->r));
     vec3 dir;
     double depth;
     light_ray(j->l, centre, j->p, &dir, &depth);
@@ -272,7 +272,7 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
             rgb sample_lc = rgb_scale(l->colour, 1.0 / n);
             for (int v = 0; v < l->size2; v++) {
                 for (int u = 0; u < l->size1; u++) {
-                    vec3 q = v3_add(l->position, light_area_point(l, l->axis1, l->axis2, u, v, r));
+                    vec3 q = v3_add(l->position, scene_light_area_point(l, l->axis1, l->axis2, u, v, r));
                     vec3 d2;
                     double dep2;
                     light_ray(l, q, p, &d2, &dep2);

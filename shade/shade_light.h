@@ -11,7 +11,8 @@
  * direct light is POV-Ray's.
  *
  * What moved here from shade.c (behaviour unchanged): the spotlight falloff
- * curve, light_attenuation, light_ray, the area-light grid point layout, the
+ * curve, light_attenuation, light_ray, the area-light grid point layout (since
+ * in core/scene.c, shared with gi/), the
  * metallic tint, the diffuse/phong/specular terms of one light and the
  * Fresnel reflectance used by `reflection { fresnel }`. New: light_nee, a
  * continuous direct-light estimator for the GI modes. */
@@ -38,14 +39,10 @@ double light_attenuation(const scene_light *l, vec3 p, vec3 dir, double depth);
  * along it). */
 void light_ray(const scene_light *l, vec3 centre, vec3 p, vec3 *dir, double *depth);
 
-/* Offset of grid point (u, v) of an area light from its position (POV-Ray's
- * layout: points span -axis/2 .. +axis/2, an axis with size 1 contributes
- * nothing; `jitter` moves each by up to half a cell; `circular` maps the
- * square onto a disc). Uses `r` only when the light jitters. */
-vec3 light_area_point(const scene_light *l, vec3 ax1, vec3 ax2, int u, int v, rng *r);
+/* The grid point layout of an area light: scene_light_area_point (core/scene.h). */
 
 /* Axes of an area light as seen from p: the light's own, or for `orient`
- * the same lengths turned to face p (POV-Ray's rule). */
+ * the same lengths turned to face p (POV-Ray's rule, scene_light_orient_axes). */
 void light_area_axes(const scene_light *l, vec3 p, vec3 *ax1, vec3 *ax2);
 /* 1 when l is an area light whose points do not all coincide: an axis with
  * more than one sample and a non-zero length. An area light with zero axes
