@@ -9,7 +9,6 @@
 #include "render_gi.h"
 #include <stdio.h>
 #include <string.h>
-#include <sys/resource.h>
 #include <unistd.h>
 #include "gi.h"
 #include "img_io.h"
@@ -57,15 +56,6 @@ static pt_status render_none(const scene *sc, const accel *a, const render_gi_op
     return st;
 }
 
-/* CPU seconds of the whole process (every thread): on a shared machine
- * they say more than wall time. */
-static double cpu_now(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * (double)(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
-}
-
 static pt_status render_particle(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
                                  render_gi_result *r, diag *d)
 {
@@ -105,12 +95,12 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
             ss.primary_ctx = gp;
         }
         t0 = timer_now();
-        double c0 = cpu_now();
+        double c0 = timer_cpu_now();
         /* view preparation (pre-pass, gathering, estimation) belongs to the frame */
         st = gi_particle_prepare_view(gp, &sc->camera, o->width, o->height, d);
         if (st == PT_OK) st = shade_render(sc, a, &ss, fb, &r->shade, d);
         r->t_render = timer_now() - t0;
-        r->c_render = cpu_now() - c0;
+        r->c_render = timer_cpu_now() - c0;
         if (st == PT_OK) st = render_aovs(sc, a, o, &ss, r, d);
     }
     r->particle = *gi_particle_get_stats(gp);

@@ -137,9 +137,9 @@ static void sweep(const scene *sc, const accel *a, const opts *o, diag *d)
         if (o->area_samples >= 0) s.area_samples = o->area_samples;
         gi_particle_stats st;
         pt_status status;
-        double c0 = bench_cpu_now();
+        double c0 = timer_cpu_now();
         gi_particle *gp = gi_particle_build(sc, a, &s, &st, d, &status);
-        double cg = bench_cpu_now() - c0;
+        double cg = timer_cpu_now() - c0;
         if (!gp) {
             bench_report_diag(d);
             continue;
@@ -250,9 +250,9 @@ int main(int argc, char **argv)
     s.prepass_stride = o.stride;
     s.keep_hits = !o.no_keep && o.spp <= 1;
     gi_particle_stats gs;
-    double c0 = bench_cpu_now();
+    double c0 = timer_cpu_now();
     gi_particle *gp = gi_particle_build(sc, a, &s, &gs, d, &st);
-    double cpu_geom = bench_cpu_now() - c0;
+    double cpu_geom = timer_cpu_now() - c0;
     if (!gp) {
         bench_report_diag(d);
         fprintf(stderr, "bench_gi: GI build failed: %s\n", pt_status_name(st));
@@ -292,9 +292,9 @@ int main(int argc, char **argv)
     double *tcpu = calloc((size_t)o.reps, sizeof *tcpu);
     long colour_rays = 0;
     for (int r = 0; r < o.reps; r++) {
-        double cc = bench_cpu_now();
+        double cc = timer_cpu_now();
         gi_particle_relight(gp, d);
-        tcpu[r] = bench_cpu_now() - cc;
+        tcpu[r] = timer_cpu_now() - cc;
         colour_rays = gi_particle_get_stats(gp)->shadow_rays;
         const gi_particle_stats *x = gi_particle_get_stats(gp);
         tl[r] = x->t_lighting;
@@ -330,12 +330,12 @@ int main(int argc, char **argv)
     double *cn = calloc((size_t)o.reps, sizeof *cn), *cf = calloc((size_t)o.reps, sizeof *cf);
     shade_stats ss;
     for (int r = 0; r < o.reps; r++) {
-        double c = bench_cpu_now();
+        double c = timer_cpu_now();
         tn[r] = render(sc, a, o.size, o.threads, NULL, fb_none, &ss, d);
-        cn[r] = bench_cpu_now() - c;
-        c = bench_cpu_now();
+        cn[r] = timer_cpu_now() - c;
+        c = timer_cpu_now();
         tf[r] = gi_frame(sc, a, &o, gp, fb_gi, &tfl[r], &tfv[r], &tfr[r], d);
-        cf[r] = bench_cpu_now() - c;
+        cf[r] = timer_cpu_now() - c;
     }
     x = gi_particle_get_stats(gp);
     /* the first frame also tests the light-leak guard's cells (kept for the
@@ -383,9 +383,9 @@ int main(int argc, char **argv)
             int keep = g_spp;
             g_spp = o.ref_spp > 0 ? o.ref_spp : o.spp;
             framebuffer *fq = fb_new(oq.size, oq.size);
-            double q1, q2, q3, cq = bench_cpu_now();
+            double q1, q2, q3, cq = timer_cpu_now();
             double tq = gi_frame(sc, a, &oq, gp, fq, &q1, &q2, &q3, d);
-            cq = bench_cpu_now() - cq;
+            cq = timer_cpu_now() - cq;
             double fl, rm, lu;
             if (ref_error(fq, &fl, &rm, &lu, d))
                 printf("against %s (%dx%d frame, %d spp, %.2f s wall, %.2f s CPU): mean FLIP %.4f, RMSE %.5f, mean "

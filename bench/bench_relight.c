@@ -115,9 +115,9 @@ int main(int argc, char **argv)
     double *tw = calloc((size_t)reps, sizeof *tw), *tc = calloc((size_t)reps, sizeof *tc);
     double *tk = calloc((size_t)reps, sizeof *tk);
     for (int r = 0; r < reps; r++) {
-        double c0 = bench_cpu_now();
+        double c0 = timer_cpu_now();
         gi_particle_relight(gp, d);
-        tc[r] = bench_cpu_now() - c0;
+        tc[r] = timer_cpu_now() - c0;
         const gi_particle_stats *x = gi_particle_get_stats(gp);
         tw[r] = x->t_lighting;
         tk[r] = x->t_emit + x->t_scatter;

@@ -2,15 +2,7 @@
 #include "bench_util.h"
 #include <stdio.h>
 #include <stdlib.h>
-#include <sys/resource.h>
-
-double bench_cpu_now(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)ru.ru_utime.tv_sec + (double)ru.ru_stime.tv_sec +
-           1e-6 * (double)(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
-}
+#include "timer.h"
 
 static int cmp_d(const void *a, const void *b)
 {
@@ -39,9 +31,9 @@ long bench_time_moves(gi_particle *gp, scene *sc, int nmove, int reps, double *t
     long rays = 0;
     for (int r = 0; r < reps; r++) {
         for (int l = 0; l < nmove; l++) sc->lights[l].position.x += (r % 2 ? -1e-4 : 1e-4);
-        double cc = bench_cpu_now();
+        double cc = timer_cpu_now();
         gi_particle_relight(gp, d);
-        tmc[r] = bench_cpu_now() - cc;
+        tmc[r] = timer_cpu_now() - cc;
         const gi_particle_stats *x = gi_particle_get_stats(gp);
         tm[r] = x->t_lighting;
         rays = x->shadow_rays;

@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 #include "camera.h"
 #include "gi_cellvis.h"
 #include "gi_cl.h"
@@ -118,14 +117,6 @@ void gi_particle_settings_from_scene(gi_particle_settings *s, const scene *sc)
 }
 
 /* ------------------------------------------------------------------ build */
-
-/* CPU seconds of the whole process (every thread). */
-static double cpu_now(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * (double)(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
-}
 
 static void *xcalloc(size_t n, size_t size, pt_status *st)
 {
@@ -487,7 +478,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     S->t_kernel_build = gi_dev_build_seconds(gp->dev);
     snprintf(S->device, sizeof S->device, "%s", gi_dev_name(gp->dev));
 
-    double c0 = cpu_now();
+    double c0 = timer_cpu_now();
     double tg = timer_now();
     gp->surf = gi_surface_build(sc, a, 1e30, d, &st);
     if (!gp->surf) goto fail;
@@ -497,7 +488,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     /* pilot: a quarter of the particles on every side, to learn which sides
      * are needed (see keep_needed) and what fraction of each survives */
     tg = timer_now();
-    double cg = cpu_now();
+    double cg = timer_cpu_now();
     int np = gi_surface_npatches(gp->surf);
     float *frac = xcalloc(2 * (size_t)np + 2, sizeof(float), &st);
     if (!frac) goto fail;
@@ -530,7 +521,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         goto fail;
     }
     S->t_prune = timer_now() - tg;
-    S->c_prune = cpu_now() - cg;
+    S->c_prune = timer_cpu_now() - cg;
 
     /* the area particles */
     tg = timer_now();
@@ -560,10 +551,10 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     {
         gi_link_stats ls = {0};
         tg = timer_now();
-        cg = cpu_now();
+        cg = timer_cpu_now();
         st = trace_and_prune(gp, &gp->ps, set->seed ^ 0x51ULL, &gp->slink, &ls, 1);
         S->t_scatter_links = timer_now() - tg;
-        S->c_scatter_links = cpu_now() - cg;
+        S->c_scatter_links = timer_cpu_now() - cg;
         if (st != PT_OK) goto fail;
         S->pruned = S->candidates - gp->ps.n;
         S->particles = gp->ps.n;
@@ -575,12 +566,12 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         if (!grid) st = PT_ERR_NOMEM;
         if (st == PT_OK) st = gi_lookup_set_objects(grid, (const void *const *)pobj);
         tg = timer_now();
-        cg = cpu_now();
+        cg = timer_cpu_now();
         if (st == PT_OK)
             st = gi_links_build(a, gp->lscene, gp->ps.p, pobj, pin, n, set->gather_side, set->seed ^ 0x6a7ULL, grid,
                                 gp->tl, 3.0 * spacing, gp->threads, gp->glink, NULL, &ls);
         S->t_gather_links = timer_now() - tg;
-        S->c_gather_links = cpu_now() - cg;
+        S->c_gather_links = timer_cpu_now() - cg;
         gi_lookup_free(grid);
         free(pobj);
         free(pin);
@@ -603,7 +594,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
 
     /* radiance particles and estimation lists */
     tg = timer_now();
-    cg = cpu_now();
+    cg = timer_cpu_now();
     st = gi_radiance_lists(&gp->lists, gp->surf, &gp->ps, gp->a, S->radius, set->normal_cos, gp->threads, d);
     if (st != PT_OK) goto fail;
     S->radiance_particles = gp->lists.nrp;
@@ -617,7 +608,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         goto fail;
     }
     S->t_lists = timer_now() - tg;
-    S->c_lists = cpu_now() - cg;
+    S->c_lists = timer_cpu_now() - cg;
 
     /* host state */
     {
@@ -658,7 +649,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     if (st != PT_OK) goto fail;
     S->t_upload = timer_now() - tg;
     S->t_geometry = timer_now() - t0 - S->t_kernel_build;
-    S->c_geometry = cpu_now() - c0;
+    S->c_geometry = timer_cpu_now() - c0;
     fill_stats(gp, stats);
     *status = PT_OK;
     return gp;
@@ -1402,7 +1393,7 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
     if (J.max_level < 1) J.max_level = 1;
     double sc = accel_eps_scale(gp->a);
     J.eps = (sc > 0.0 && isfinite(sc) ? sc : 1.0) * 1e-6;
-    double c0 = cpu_now();
+    double c0 = timer_cpu_now();
     J.ch = NULL;
     J.rec = NULL;
     atomic_init(&J.rays, 0);
@@ -1450,7 +1441,7 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
         memcpy(&gp->vcam, c, sizeof gp->vcam); /* bytes, padding too: primary_begin compares them */
     }
     S->t_prepass = timer_now() - t0;
-    S->c_prepass = cpu_now() - c0;
+    S->c_prepass = timer_cpu_now() - c0;
 
     /* found radiance particles (not yet estimated) and the area particles
      * their lists need (not yet gathered on the device) */
