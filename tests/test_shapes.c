@@ -673,7 +673,13 @@ static void test_height_field_gif(void **st)
 {
     (void)st;
     unsigned char px[8] = {0, 1, 2, 3, 4, 5, 6, 7};
-    const char *gif = "/tmp/test_shapes_hf.gif", *pot = "/tmp/test_shapes_hf.pot";
+    /* a directory of its own: concurrent runs (ctest -j, two checkouts) must
+     * not share the files */
+    char dir[] = "/tmp/test_shapes_gifXXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char gif[64], pot[64];
+    snprintf(gif, sizeof gif, "%s/hf.gif", dir);
+    snprintf(pot, sizeof pot, "%s/hf.pot", dir);
     write_gif(gif, 4, 2, px);
     write_gif(pot, 4, 2, px);
     char src[256];
@@ -699,6 +705,7 @@ static void test_height_field_gif(void **st)
     done(&w);
     unlink(gif);
     unlink(pot);
+    rmdir(dir);
 }
 
 /* the distribution's plasma3.png is a palette image: heights = index * 256 */
