@@ -328,19 +328,35 @@ int main(int argc, char **argv)
     double *tfl = calloc((size_t)o.reps, sizeof *tfl), *tfv = calloc((size_t)o.reps, sizeof *tfv);
     double *tfr = calloc((size_t)o.reps, sizeof *tfr);
     double *cn = calloc((size_t)o.reps, sizeof *cn), *cf = calloc((size_t)o.reps, sizeof *cf);
+    /* per particle frame: pre-pass CPU, gather wall, cells tested, page
+     * faults (minor) of the frame; none frame's page faults */
+    double *fpc = calloc((size_t)o.reps, sizeof *fpc), *fga = calloc((size_t)o.reps, sizeof *fga);
+    double *fcl = calloc((size_t)o.reps, sizeof *fcl), *fpf = calloc((size_t)o.reps, sizeof *fpf);
+    double *npf = calloc((size_t)o.reps, sizeof *npf);
     shade_stats ss;
     for (int r = 0; r < o.reps; r++) {
+        long f0 = bench_minflt_now();
         double c = timer_cpu_now();
         tn[r] = render(sc, a, o.size, o.threads, NULL, fb_none, &ss, d);
         cn[r] = timer_cpu_now() - c;
+        npf[r] = (double)(bench_minflt_now() - f0);
+        long cells0 = gi_particle_get_stats(gp)->cells;
+        f0 = bench_minflt_now();
         c = timer_cpu_now();
         tf[r] = gi_frame(sc, a, &o, gp, fb_gi, &tfl[r], &tfv[r], &tfr[r], d);
         cf[r] = timer_cpu_now() - c;
+        fpf[r] = (double)(bench_minflt_now() - f0);
+        const gi_particle_stats *y = gi_particle_get_stats(gp);
+        fpc[r] = y->c_prepass;
+        fga[r] = y->t_gather;
+        fcl[r] = (double)(y->cells - cells0);
     }
     x = gi_particle_get_stats(gp);
     /* the first frame also tests the light-leak guard's cells (kept for the
      * frames after it): printed apart, before the medians sort the arrays */
     double first_w = tf[0], first_c = cf[0], first_r = tfr[0];
+    double first_l = tfl[0], first_v = tfv[0], first_pc = fpc[0], first_ga = fga[0], first_cl = fcl[0];
+    double first_pf = fpf[0], first_npf = npf[0];
     double mn = bench_median(tn, o.reps), mf = bench_median(tf, o.reps);
     printf("frame --gi none: %.1f ms (%ld primary, %ld shadow rays)\n", 1e3 * mn, ss.primary_rays, ss.shadow_rays);
     printf("frame --gi particle: %.1f ms = lighting %.1f + view %.1f (pre-pass %.1f, gather %.1f, estimate %.1f; "
@@ -352,6 +368,14 @@ int main(int argc, char **argv)
     printf("  first particle frame: %.1f ms wall (render %.1f), %.1f ms CPU; ratio to the median none frame %.2f wall, "
            "%.2f CPU\n",
            1e3 * first_w, 1e3 * first_r, 1e3 * first_c, first_w / mn, first_c / bench_median(cn, o.reps));
+    printf("    first frame: lighting %.1f + view %.1f ms wall (pre-pass %.1f ms CPU, gather %.1f ms wall, %.0f cells "
+           "tested), %.0f page faults (first none frame %.0f)\n",
+           1e3 * first_l, 1e3 * first_v, 1e3 * first_pc, 1e3 * first_ga, first_cl, first_pf, first_npf);
+    printf("    median frame: lighting %.1f + view %.1f ms wall (pre-pass %.1f ms CPU, gather %.1f ms wall, %.0f cells "
+           "tested), %.0f page faults (none frame %.0f)\n",
+           1e3 * bench_median(tfl, o.reps), 1e3 * bench_median(tfv, o.reps), 1e3 * bench_median(fpc, o.reps),
+           1e3 * bench_median(fga, o.reps), bench_median(fcl, o.reps), bench_median(fpf, o.reps),
+           bench_median(npf, o.reps));
     printf("  hook, per frame (mean of %d): %.0f lookups, %.0f late (%.0f radiance, %.0f area particles computed in "
            "the hook), %.0f without particles, %.0f discarded; %.0f visibility rays\n",
            o.reps, (double)x->lookups / o.reps, (double)x->lookups_late / o.reps, (double)x->late_radiance / o.reps,
@@ -423,6 +447,11 @@ int main(int argc, char **argv)
     free(tf);
     free(cn);
     free(cf);
+    free(fpc);
+    free(fga);
+    free(fcl);
+    free(fpf);
+    free(npf);
     free(tfl);
     free(tfv);
     free(tfr);

@@ -2,7 +2,15 @@
 #include "bench_util.h"
 #include <stdio.h>
 #include <stdlib.h>
+#include <sys/resource.h>
 #include "timer.h"
+
+long bench_minflt_now(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return ru.ru_minflt;
+}
 
 static int cmp_d(const void *a, const void *b)
 {

@@ -7,6 +7,10 @@
 #include "gi_particle.h"
 #include "scene.h"
 
+/* Minor page faults of the whole process so far (getrusage): first touches
+ * of fresh memory. */
+long bench_minflt_now(void);
+
 /* Median of v[0..n-1] (sorts v in place; the mean of the two middle values
  * when n is even). */
 double bench_median(double *v, int n);
