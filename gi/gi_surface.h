@@ -116,6 +116,9 @@ int gi_surface_sample(const gi_surface *g, int patch, double u, double v, rng *r
 long gi_surface_nrp(const gi_surface *g);
 long gi_surface_rp_slots(const gi_surface *g);
 void gi_surface_rp(const gi_surface *g, long rp, vec3 *pos, vec3 *nrm);
+/* Starts loading what gi_surface_rp(g, rp) reads first (the radiance
+ * particle's slot and patch maps), for callers that look up many at once. */
+void gi_surface_rp_prefetch(const gi_surface *g, long rp);
 /* Patch and side (0 front, 1 back) of the first patch side that laid the
  * radiance particle out (every other one sharing it is on the same object
  * and faces the same way). */
