@@ -1743,6 +1743,65 @@ void accel_occluded_n(const accel *a, int n, const vec3 *org, const vec3 *dir, c
     }
 }
 
+void accel_hit_any_n(const accel *a, int n, const vec3 *org, const vec3 *dir, const double *tmin,
+                     const double *tmax, unsigned char *out)
+{
+    for (int k0 = 0; k0 < n; k0 += 16) {
+        int m = n - k0 < 16 ? n - k0 : 16;
+        struct RTCRayHit16 r;
+        RTC_ALIGN(64) int valid[16];
+        int any = 0;
+        for (int k = 0; k < 16; k++) {
+            valid[k] = 0;
+            r.ray.org_x[k] = r.ray.org_y[k] = r.ray.org_z[k] = 0.0f;
+            r.ray.dir_x[k] = r.ray.dir_y[k] = 0.0f;
+            r.ray.dir_z[k] = 1.0f;
+            r.ray.tnear[k] = 0.0f;
+            r.ray.tfar[k] = 0.0f;
+            r.ray.time[k] = 0.0f;
+            r.ray.mask[k] = 0xFFFFFFFFu;
+            r.ray.id[k] = (unsigned)k;
+            r.ray.flags[k] = 0;
+            r.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+            r.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
+            r.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+            if (k >= m) continue;
+            int i = k0 + k;
+            out[i] = 0;
+            if (!a || !ray_ok(org[i], dir[i])) continue;
+            /* the same effective interval as accel_intersect */
+            double t0 = eps_rule(a->eps_scale, org[i], v3_len(dir[i]));
+            if (tmin[i] > t0) t0 = tmin[i];
+            if (!(tmax[i] > t0)) continue;
+            struct RTCRay one;
+            fill_rtc_ray(&one, org[i], dir[i], t0, tmax[i]);
+            r.ray.org_x[k] = one.org_x;
+            r.ray.org_y[k] = one.org_y;
+            r.ray.org_z[k] = one.org_z;
+            r.ray.dir_x[k] = one.dir_x;
+            r.ray.dir_y[k] = one.dir_y;
+            r.ray.dir_z[k] = one.dir_z;
+            r.ray.tnear[k] = one.tnear;
+            r.ray.tfar[k] = one.tfar;
+            valid[k] = -1;
+            any = 1;
+        }
+        if (!any) continue;
+        struct RTCIntersectContext c;
+        rtcInitIntersectContext(&c);
+        c.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        /* no accel_query: user geometry takes the packet's float rays */
+        accel_query *saved = tls_query;
+        tls_query = NULL;
+        /* the nearest-hit query: an occlusion query would skip no_shadow
+         * objects (and measured no faster on maze's cell segments) */
+        rtcIntersect16(valid, a->root, &c, &r);
+        tls_query = saved;
+        for (int k = 0; k < m; k++)
+            if (valid[k]) out[k0 + k] = r.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
+    }
+}
+
 void accel_bounds(const accel *a, vec3 *lo, vec3 *hi)
 {
     if (lo) *lo = a ? a->lo : v3s(0.0);

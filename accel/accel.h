@@ -80,6 +80,15 @@ int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax)
  * the packet's float rays (accel_occluded passes them its double ray). */
 void accel_occluded_n(const accel *a, int n, const vec3 *org, const vec3 *dir, const double *tmin,
                       const double *tmax, unsigned char *out);
+/* Whether accel_intersect could find a hit for each of n rays, traced
+ * together (Embree packets of 16, flagged coherent): out[k] = 0 when ray k
+ * meets nothing in accel_intersect's effective interval (every object, the
+ * no_shadow ones too: an intersection query runs no filter), 1 when it meets
+ * something (then accel_intersect tells what). Triangles see the same float
+ * ray as accel_intersect's; analytic shapes see the packet's float rays
+ * where accel_intersect gives them its double ray. */
+void accel_hit_any_n(const accel *a, int n, const vec3 *org, const vec3 *dir, const double *tmin,
+                     const double *tmax, unsigned char *out);
 /* World bounds of finite geometry (infinite planes excluded) and a scene
  * scale (bounding-box diagonal) for epsilons. */
 void accel_bounds(const accel *a, vec3 *lo, vec3 *hi);

@@ -77,6 +77,11 @@ int gi_cellvis_get(const gi_cellvis *c, uint64_t key)
     return GI_CELL_UNKNOWN;
 }
 
+void gi_cellvis_prefetch(const gi_cellvis *c, uint64_t key)
+{
+    if (c && key) __builtin_prefetch((const void *)&c->slot[mix(key) & c->mask]);
+}
+
 void gi_cellvis_put(gi_cellvis *c, uint64_t key, int verdict)
 {
     if (!c || !key || (verdict != GI_CELL_CLEAR && verdict != GI_CELL_BLOCKED)) return;

@@ -43,6 +43,9 @@ void gi_cellvis_free(gi_cellvis *c);
 uint64_t gi_cellvis_key(const gi_cellvis *c, const long rp[3]);
 /* The stored verdict, GI_CELL_UNKNOWN when absent (or c NULL, key 0). */
 int gi_cellvis_get(const gi_cellvis *c, uint64_t key);
+/* Starts loading the slot where key's probe begins (a cache miss, overlapped
+ * with others before their gi_cellvis_get). */
+void gi_cellvis_prefetch(const gi_cellvis *c, uint64_t key);
 /* Stores a verdict (GI_CELL_CLEAR or GI_CELL_BLOCKED) unless the table is
  * full; thread-safe. */
 void gi_cellvis_put(gi_cellvis *c, uint64_t key, int verdict);

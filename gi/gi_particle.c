@@ -28,7 +28,7 @@ typedef struct {
     long kept;                      /* lookups whose cell came from a kept hit (view_rec) */
     int *buf; /* on-the-fly estimation list */
     long len, cap;
-    char pad[8];
+    struct cell_batch *cb; /* the pre-pass's cell tests waiting for the row's end (cell_batch) */
 } thread_count;
 
 struct gi_particle {
@@ -79,6 +79,8 @@ struct gi_particle {
     thread_count tc[GI_MAX_THREADS];
     gi_particle_stats st;
 };
+
+static void cell_batch_free(struct cell_batch *b);
 
 /* ------------------------------------------------------------------ settings */
 
@@ -671,7 +673,10 @@ void gi_particle_free(gi_particle *gp)
     gi_lists_free(&gp->lists);
     gi_grid_free(gp->rgrid);
     gi_cellvis_free(gp->cells);
-    for (int t = 0; t < GI_MAX_THREADS; t++) free(gp->tc[t].buf);
+    for (int t = 0; t < GI_MAX_THREADS; t++) {
+        free(gp->tc[t].buf);
+        cell_batch_free(gp->tc[t].cb);
+    }
     free(gp->slink);
     free(gp->glink);
     free(gp->rin_off);
@@ -1047,16 +1052,90 @@ typedef struct view_rec {
     unsigned char verdict; /* the light-leak guard's verdict on that cell (GI_CELL_*, UNKNOWN: the hook decides) */
 } view_rec;
 
+/* The first frame's cell tests, batched (kept hits). The pre-pass meets
+ * most cells for the first time in the first frame after a geometry stage
+ * (maze: ~49,000 cells, 6 segments each, traced one by one with
+ * accel_intersect). A pre-pass thread instead collects the untested cells
+ * of its row here (each once: a small hash by key) with the records that
+ * lie in them, and at the row's end traces the six segments of all of
+ * them together as coherent packets (accel_hit_any_n: neighbouring cells'
+ * short segments) that only ask whether anything lies on a segment. A
+ * segment with nothing on it is visible (gi_visible traces no further);
+ * one with something gets gi_visible's own test (gi_visible_along, the
+ * same ray and rule as cell_clear's). So every verdict is cell_clear's; it
+ * is written into the row's records, put in the table and in the thread's
+ * small cache of recent verdicts (seen: the next rows meet most of these
+ * cells again, and a table probe is a cache and TLB miss). A cell not in
+ * that cache goes into the batch, which asks the table first (all the
+ * row's probes prefetched together: cells another thread tested). Rows go
+ * to the threads in bands (VIEW_BAND), so the row after a row is mostly the
+ * same thread's. */
+#define BATCH_HASH 512 /* slots of a row's hash of cells (a row of maze at 512 pixels meets ~100 new ones) */
+#define BATCH_SEEN 4096 /* the thread's verdicts of the last rows, direct-mapped (32 KiB) */
+typedef struct {
+    uint64_t key;
+    long rp[3];
+    const scene_object *own;
+    int verdict; /* tested (or the table's) */
+    int known;   /* the table's verdict (another thread's test), UNKNOWN: tested here */
+} batch_cell_t;
+
+typedef struct {
+    view_rec *vr;
+    int cell;
+} batch_pix_t;
+
+struct cell_batch {
+    batch_cell_t *cell;
+    int ncell, capcell;
+    batch_pix_t *pix;
+    int npix, cappix;
+    int slot[BATCH_HASH]; /* 1 + index in cell, 0: empty; more cells than slots/2: no hash, linear */
+    uint64_t seen[BATCH_SEEN]; /* key << 2 | verdict of cells this thread tested (the next rows meet
+                                  them again): no probe of the table (a cache miss each) */
+    /* the segments of a test: ray k is segment sg[k] of cell owner[k] */
+    gi_segment *sg;
+    vec3 *org, *dir;
+    double *tmin, *tmax;
+    unsigned char *hit;
+    int *owner;
+    int capray;
+};
+
 /* One pre-pass thread's row of kept hits: its counters (cell tests) and
  * the last cell's key and verdict (neighbouring pixels often share a cell:
- * no table probe). */
+ * no table probe); b: the thread's batch of cells to test at the row's end
+ * (NULL: each is tested when met), and pend the last cell's place in it
+ * when its verdict is CELL_PENDING. */
 typedef struct {
     thread_count *tc;
     uint64_t key;
     int verdict;
+    struct cell_batch *b;
+    int pend;
 } view_memo;
 
+/* kept_verdict's answer for a cell in the row's batch (never stored in a
+ * record or the table: the batch writes the verdict at the row's end) */
+#define CELL_PENDING 3
+
 static int cell_clear(gi_particle *gp, const long rp[3], const scene_object *own, thread_count *tc);
+static int batch_cell(gi_particle *gp, struct cell_batch *b, uint64_t key, const long rp[3], const scene_object *own);
+static unsigned batch_seen_slot(uint64_t key) { return (unsigned)((key * 0x9e3779b97f4a7c15ULL) >> 52); }
+static int batch_pixel(struct cell_batch *b, view_rec *vr, int cell);
+static void batch_test(gi_particle *gp, struct cell_batch *b, thread_count *tc);
+
+/* The memo of a pre-pass row; with kept hits and the table, the thread's
+ * batch of cell tests (NULL when out of memory: tested when met). */
+static view_memo row_memo(gi_particle *gp, const view_rec *rec, int thread)
+{
+    view_memo m = {&gp->tc[thread < GI_MAX_THREADS ? thread : 0], 0, GI_CELL_UNKNOWN, NULL, -1};
+    if (rec && gp->cells) {
+        if (!m.tc->cb) m.tc->cb = calloc(1, sizeof *m.tc->cb);
+        m.b = m.tc->cb;
+    }
+    return m;
+}
 
 /* The light-leak guard's verdict on cell rp (key: gi_cellvis_key) of a hit
  * on `own`: the table's, else tested now (cell_clear) and put in the table;
@@ -1076,17 +1155,43 @@ static int cell_verdict(gi_particle *gp, uint64_t key, const long rp[3], const s
  * pre-pass. Before the table (a cache miss a probe), the previous pixel's
  * cell and what this pixel's record held from an earlier frame (rp and
  * verdict are written together, a verdict depends on the cell alone). */
-static int kept_verdict(gi_particle *gp, const long rp[3], const scene_object *own, view_memo *m, const view_rec *old)
+static int kept_verdict(gi_particle *gp, const long rp[3], const scene_object *own, view_memo *m, view_rec *old)
 {
     uint64_t key = gi_cellvis_key(gp->cells, rp);
     if (!key) return GI_CELL_UNKNOWN;
-    if (key == m->key) return m->verdict;
+    if (key == m->key) {
+        /* a cell waiting in the batch: this record gets its verdict too */
+        if (m->verdict == CELL_PENDING)
+            return batch_pixel(m->b, old, m->pend) ? GI_CELL_UNKNOWN : cell_verdict(gp, key, rp, own, m->tc);
+        return m->verdict;
+    }
     if (old->verdict != GI_CELL_UNKNOWN && old->rp[0] == rp[0] && old->rp[1] == rp[1] && old->rp[2] == rp[2]) {
         m->key = key;
         m->verdict = old->verdict;
         return old->verdict;
     }
-    int verdict = cell_verdict(gp, key, rp, own, m->tc);
+    int verdict = GI_CELL_UNKNOWN;
+    if (m->b) {
+        uint64_t v = m->b->seen[batch_seen_slot(key)];
+        if (v >> 2 == key) verdict = (int)(v & 3u);
+    }
+    if (verdict == GI_CELL_UNKNOWN && m->b) {
+        /* not tested by this thread lately: into the row's batch
+         * (cell_batch), which asks the table first; the record's verdict
+         * is written when the batch is done */
+        int i = batch_cell(gp, m->b, key, rp, own);
+        if (i >= 0 && batch_pixel(m->b, old, i)) {
+            m->key = key;
+            m->verdict = CELL_PENDING;
+            m->pend = i;
+            return GI_CELL_UNKNOWN;
+        }
+    }
+    if (verdict == GI_CELL_UNKNOWN) verdict = gi_cellvis_get(gp->cells, key);
+    if (verdict == GI_CELL_UNKNOWN) {
+        verdict = cell_clear(gp, rp, own, m->tc) ? GI_CELL_CLEAR : GI_CELL_BLOCKED;
+        gi_cellvis_put(gp->cells, key, verdict);
+    }
     m->key = key;
     m->verdict = verdict;
     return verdict;
@@ -1228,7 +1333,7 @@ static int coarse_count(int stride, int n) { return n > 0 ? (n - 1 + stride - 1)
 static void coarse_row(void *ctx, int j, int thread)
 {
     view_job *J = ctx;
-    view_memo m = {&J->gp->tc[thread < GI_MAX_THREADS ? thread : 0], 0, GI_CELL_UNKNOWN};
+    view_memo m = row_memo(J->gp, J->rec, thread);
     long rays = 0, kept = 0;
     int y = coarse_at(j, J->stride, J->h);
     for (int i = 0; i < J->ncx; i++) {
@@ -1242,6 +1347,7 @@ static void coarse_row(void *ctx, int j, int thread)
         if (vr && !cam) vr->kind = 0; /* the render shows no ray there */
         kept += vr && vr->kind;
     }
+    batch_test(J->gp, m.b, m.tc);
     atomic_fetch_add(&J->rays, rays);
     atomic_fetch_add(&J->kept, kept);
 }
@@ -1300,7 +1406,7 @@ static void fill_row(void *ctx, int y, int thread)
 {
     view_job *J = ctx;
     gi_particle *gp = J->gp;
-    view_memo m = {&gp->tc[thread < GI_MAX_THREADS ? thread : 0], 0, GI_CELL_UNKNOWN};
+    view_memo m = row_memo(gp, J->rec, thread);
     long rays = 0, planar = 0, missed = 0, kept = 0;
     int s = J->stride, j = y == J->h - 1 ? J->ncy - 1 : y / s, on_row = y % s == 0 || y == J->h - 1;
     int j1 = j + 1 < J->ncy ? j + 1 : j;
@@ -1369,10 +1475,26 @@ static void fill_row(void *ctx, int y, int thread)
         rays += prepass_ray(gp, org, dir, 1, J->max_level, J->eps, NULL, vr, &m);
         kept += vr && vr->kind;
     }
+    batch_test(gp, m.b, m.tc);
     atomic_fetch_add(&J->rays, rays);
     atomic_fetch_add(&J->kept, kept);
     atomic_fetch_add(&J->planar, planar);
     atomic_fetch_add(&J->missed, missed);
+}
+
+/* The pre-pass's rows go to the threads in bands of VIEW_BAND rows, top
+ * down: a cell's next row is mostly the same thread's (cell_batch). */
+#define VIEW_BAND 8
+static void coarse_band(void *ctx, int b, int thread)
+{
+    const view_job *J = ctx;
+    for (int j = b * VIEW_BAND; j < J->ncy && j < (b + 1) * VIEW_BAND; j++) coarse_row(ctx, j, thread);
+}
+
+static void fill_band(void *ctx, int b, int thread)
+{
+    const view_job *J = ctx;
+    for (int y = b * VIEW_BAND; y < J->h && y < (b + 1) * VIEW_BAND; y++) fill_row(ctx, y, thread);
 }
 
 pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w, int h, diag *d)
@@ -1425,8 +1547,8 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
             J.ncx = w;
             J.ncy = h;
         }
-        pool_run(gp->threads, J.ncy, coarse_row, &J);
-        if (J.ch) pool_run(gp->threads, h, fill_row, &J);
+        pool_run(gp->threads, (J.ncy + VIEW_BAND - 1) / VIEW_BAND, coarse_band, &J);
+        if (J.ch) pool_run(gp->threads, (h + VIEW_BAND - 1) / VIEW_BAND, fill_band, &J);
         free(J.ch);
     }
     S->prepass_rays = atomic_load(&J.rays);
@@ -1651,9 +1773,14 @@ static int onthefly(gi_particle *gp, const accel_hit *h, vec3 n, thread_count *t
  * hit (cbox's mean luminance -0.02%). Given up with it: an occluder within
  * that margin of the edge, parallel to it. */
 #define CELL_SHRINK 1e-3
-static int cell_clear(gi_particle *gp, const long rp[3], const scene_object *own, thread_count *tc)
+
+/* The ends of cell rp's six segments: its vertices q (moved CELL_SHRINK of
+ * the way to the centroid) with their normals nq, the centroid c with the
+ * vertices' mean normal nc. Segment 2k is the edge q[k] -> q[k+1 mod 3],
+ * 2k+1 the spoke c -> q[k]. */
+static void cell_ends(const gi_particle *gp, const long rp[3], vec3 q[3], vec3 nq[3], vec3 *cp, vec3 *ncp)
 {
-    vec3 q[3], nq[3], c = v3(0, 0, 0), nc = v3(0, 0, 0);
+    vec3 c = v3(0, 0, 0), nc = v3(0, 0, 0);
     for (int k = 0; k < 3; k++) {
         gi_surface_rp(gp->surf, rp[k], &q[k], &nq[k]);
         c = v3_madd(c, q[k], 1.0 / 3.0);
@@ -1661,6 +1788,14 @@ static int cell_clear(gi_particle *gp, const long rp[3], const scene_object *own
     }
     nc = v3_len2(nc) > 0.0 ? v3_norm(nc) : nq[0];
     for (int k = 0; k < 3; k++) q[k] = v3_madd(q[k], v3_sub(c, q[k]), CELL_SHRINK);
+    *cp = c;
+    *ncp = nc;
+}
+
+static int cell_clear(gi_particle *gp, const long rp[3], const scene_object *own, thread_count *tc)
+{
+    vec3 q[3], nq[3], c, nc;
+    cell_ends(gp, rp, q, nq, &c, &nc);
     tc->cells++;
     for (int k = 0; k < 3; k++) {
         int j = k + 1 < 3 ? k + 1 : 0;
@@ -1671,6 +1806,154 @@ static int cell_clear(gi_particle *gp, const long rp[3], const scene_object *own
     }
     tc->cells_clear++;
     return 1;
+}
+
+static void cell_batch_free(struct cell_batch *b)
+{
+    if (!b) return;
+    free(b->cell);
+    free(b->pix);
+    free(b->sg);
+    free(b->org);
+    free(b->dir);
+    free(b->tmin);
+    free(b->tmax);
+    free(b->hit);
+    free(b->owner);
+    free(b);
+}
+
+static int grow(void **p, int *cap, int need, size_t size)
+{
+    if (need <= *cap) return 1;
+    int n = *cap > 0 ? *cap : 64;
+    while (n < need) n *= 2;
+    void *q = realloc(*p, (size_t)n * size);
+    if (!q) return 0;
+    *p = q;
+    *cap = n;
+    return 1;
+}
+
+/* The batch's index of cell key (added when new), -1 out of memory. */
+static int batch_cell(gi_particle *gp, struct cell_batch *b, uint64_t key, const long rp[3], const scene_object *own)
+{
+    (void)gp;
+    unsigned h = (unsigned)((key * 0x9e3779b97f4a7c15ULL) >> 55) & (BATCH_HASH - 1);
+    int hashed = b->ncell < BATCH_HASH / 2;
+    if (hashed) {
+        for (unsigned k = h;; k = (k + 1) & (BATCH_HASH - 1)) {
+            int i = b->slot[k] - 1;
+            if (i < 0) break;
+            if (b->cell[i].key == key) return i;
+        }
+    } else {
+        for (int i = b->ncell - 1; i >= 0; i--)
+            if (b->cell[i].key == key) return i;
+    }
+    if (!grow((void **)&b->cell, &b->capcell, b->ncell + 1, sizeof *b->cell)) return -1;
+    int i = b->ncell++;
+    b->cell[i].key = key;
+    for (int k = 0; k < 3; k++) b->cell[i].rp[k] = rp[k];
+    b->cell[i].own = own;
+    b->cell[i].verdict = GI_CELL_CLEAR;
+    b->cell[i].known = GI_CELL_UNKNOWN;
+    if (hashed) {
+        unsigned k = h;
+        while (b->slot[k]) k = (k + 1) & (BATCH_HASH - 1);
+        b->slot[k] = i + 1;
+    }
+    return i;
+}
+
+/* Record vr lies in the batch's cell: 1, or 0 out of memory. */
+static int batch_pixel(struct cell_batch *b, view_rec *vr, int cell)
+{
+    if (!grow((void **)&b->pix, &b->cappix, b->npix + 1, sizeof *b->pix)) return 0;
+    b->pix[b->npix].vr = vr;
+    b->pix[b->npix].cell = cell;
+    b->npix++;
+    return 1;
+}
+
+/* Tests the batch's cells (the verdicts cell_clear gives), stores them in
+ * the table and the waiting records; empties the batch. */
+static void batch_test(gi_particle *gp, struct cell_batch *b, thread_count *tc)
+{
+    if (!b || b->ncell == 0) return;
+    int nr = 0, ok = 1;
+    int need = 6 * b->ncell;
+    if (need > b->capray) {
+        int cap = b->capray;
+        ok = grow((void **)&b->sg, &cap, need, sizeof *b->sg);
+        cap = b->capray;
+        ok = ok && grow((void **)&b->org, &cap, need, sizeof *b->org);
+        cap = b->capray;
+        ok = ok && grow((void **)&b->dir, &cap, need, sizeof *b->dir);
+        cap = b->capray;
+        ok = ok && grow((void **)&b->tmin, &cap, need, sizeof *b->tmin);
+        cap = b->capray;
+        ok = ok && grow((void **)&b->tmax, &cap, need, sizeof *b->tmax);
+        cap = b->capray;
+        ok = ok && grow((void **)&b->hit, &cap, need, sizeof *b->hit);
+        cap = b->capray;
+        ok = ok && grow((void **)&b->owner, &cap, need, sizeof *b->owner);
+        if (ok) b->capray = cap;
+    }
+    if (ok) {
+        /* the table's verdicts first (cells another thread tested): all the
+         * probes' cache misses at once, as are the radiance particles' */
+        for (int c = 0; c < b->ncell; c++) {
+            gi_cellvis_prefetch(gp->cells, b->cell[c].key);
+            for (int k = 0; k < 3; k++) gi_surface_rp_prefetch(gp->surf, b->cell[c].rp[k]);
+        }
+        for (int c = 0; c < b->ncell; c++) {
+            b->cell[c].known = gi_cellvis_get(gp->cells, b->cell[c].key);
+            if (b->cell[c].known != GI_CELL_UNKNOWN) b->cell[c].verdict = b->cell[c].known;
+        }
+        for (int c = 0; c < b->ncell; c++) {
+            if (b->cell[c].known != GI_CELL_UNKNOWN) continue;
+            vec3 q[3], nq[3], ctr, nc;
+            cell_ends(gp, b->cell[c].rp, q, nq, &ctr, &nc);
+            for (int k = 0; k < 3; k++) {
+                int j = k + 1 < 3 ? k + 1 : 0;
+                /* cell_clear's order: the edge from q[k], the spoke to q[k] */
+                if (gi_visible_segment(gp->a, gp->vis_eps, q[k], nq[k], q[j], nq[j], &b->sg[nr])) b->owner[nr++] = c;
+                if (gi_visible_segment(gp->a, gp->vis_eps, ctr, nc, q[k], nq[k], &b->sg[nr])) b->owner[nr++] = c;
+            }
+        }
+        for (int r = 0; r < nr; r++) {
+            b->org[r] = b->sg[r].p;
+            b->dir[r] = b->sg[r].d;
+            b->tmin[r] = 0.0;
+            b->tmax[r] = b->sg[r].len;
+        }
+        accel_hit_any_n(gp->a, nr, b->org, b->dir, b->tmin, b->tmax, b->hit);
+        for (int r = 0; r < nr; r++) {
+            batch_cell_t *bc = &b->cell[b->owner[r]];
+            if (!b->hit[r] || bc->verdict != GI_CELL_CLEAR) continue;
+            if (!gi_visible_along(gp->a, gp->vis_eps, &b->sg[r], bc->own)) bc->verdict = GI_CELL_BLOCKED;
+        }
+        tc->vis_rays += nr;
+        for (int c = 0; c < b->ncell; c++) {
+            if (b->cell[c].known != GI_CELL_UNKNOWN) continue;
+            tc->cells++;
+            tc->cells_clear += b->cell[c].verdict == GI_CELL_CLEAR;
+            gi_cellvis_put(gp->cells, b->cell[c].key, b->cell[c].verdict);
+        }
+        for (int c = 0; c < b->ncell; c++)
+            b->seen[batch_seen_slot(b->cell[c].key)] = b->cell[c].key << 2 | (uint64_t)b->cell[c].verdict;
+    } else {
+        /* no memory for the rays: one cell at a time */
+        for (int c = 0; c < b->ncell; c++) {
+            b->cell[c].verdict = cell_clear(gp, b->cell[c].rp, b->cell[c].own, tc) ? GI_CELL_CLEAR : GI_CELL_BLOCKED;
+            gi_cellvis_put(gp->cells, b->cell[c].key, b->cell[c].verdict);
+        }
+    }
+    for (int k = 0; k < b->npix; k++) b->pix[k].vr->verdict = (unsigned char)b->cell[b->pix[k].cell].verdict;
+    b->ncell = 0;
+    b->npix = 0;
+    memset(b->slot, 0, sizeof b->slot);
 }
 
 /* E/pi on the side of the hit that n faces: barycentric interpolation of

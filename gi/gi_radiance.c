@@ -24,7 +24,7 @@ typedef struct {
     atomic_int oom;
 } list_job;
 
-int gi_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, const scene_object *own)
+int gi_visible_segment(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, gi_segment *sg)
 {
     /* both ends lifted off their surfaces by more than accel's
      * self-intersection epsilon at x (accel.h), so that a segment leaving
@@ -33,17 +33,25 @@ int gi_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, con
     vec3 p = v3_madd(x, nx, lift), q = v3_madd(y, ny, lift);
     vec3 d = v3_sub(q, p);
     double len = v3_len(d);
-    if (!(len > 2.0 * lift)) return 1;
-    d = v3_scale(d, 1.0 / len);
-    double tmin = 0.0;
+    if (!(len > 2.0 * lift)) return 0;
+    sg->p = p;
+    sg->d = v3_scale(d, 1.0 / len);
+    sg->len = len;
+    sg->lift = lift;
+    return 1;
+}
+
+int gi_visible_along(const accel *a, double eps, const gi_segment *sg, const scene_object *own)
+{
+    double tmin = 0.0, len = sg->len;
     int crossings = 0;
     for (int k = 0; k < 8; k++) {
         accel_hit h;
-        if (!accel_intersect(a, p, d, tmin, len, &h)) break;
+        if (!accel_intersect(a, sg->p, sg->d, tmin, len, &h)) break;
         if (h.obj != own) return 0;
         /* not where the segment ends: a radiance particle on an edge,
          * lifted, lies in the plane of the face across the edge */
-        if (h.t < len - lift) crossings++;
+        if (h.t < len - sg->lift) crossings++;
         tmin = h.t + fmax(eps, h.t * 1e-7);
     }
     /* `own` may be crossed only an even number of times: a chord of a
@@ -53,6 +61,12 @@ int gi_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, con
      * within one list radius of the upper face: same object, same patch
      * side, same normal) lent its dark inside to the top's estimates */
     return (crossings & 1) == 0;
+}
+
+int gi_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, const scene_object *own)
+{
+    gi_segment sg;
+    return !gi_visible_segment(a, eps, x, nx, y, ny, &sg) || gi_visible_along(a, eps, &sg, own);
 }
 
 static int visible(const list_job *J, vec3 q, vec3 nq, int i, const scene_object *obj)

@@ -48,6 +48,18 @@ int gi_same_surface(const gi_surface *g, const gi_particles *ps, int i, const sc
  * side's. Used for the estimation lists and for the radiance particles a
  * shading hit interpolates (gi_particle.c). */
 int gi_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, const scene_object *own);
+/* gi_visible in two steps, for callers that trace many segments together
+ * (gi_particle.c's cell tests, accel_hit_any_n): the lifted segment from x
+ * to y (0 when the points are closer than twice the lift: visible, no ray),
+ * then gi_visible's rule along it. gi_visible = !segment || along. A segment
+ * whose ray from p along d over [0, len] meets nothing is visible. */
+typedef struct {
+    vec3 p, d;   /* from the lifted x along the unit direction to the lifted y */
+    double len;  /* its length */
+    double lift; /* how far both ends were lifted */
+} gi_segment;
+int gi_visible_segment(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, gi_segment *sg);
+int gi_visible_along(const accel *a, double eps, const gi_segment *sg, const scene_object *own);
 
 pt_status gi_radiance_lists(gi_lists *L, const gi_surface *g, const gi_particles *ps, const accel *a, double r,
                             double cos_thr, int threads, diag *d);

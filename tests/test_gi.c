@@ -1711,6 +1711,12 @@ static void test_kept_hits(void **state)
            "primary rays %ld / %ld, mean %.6f / %.6f, identical %d\n",
            KW, KW, kept, misses, noimg, lk, look, s0.primary_rays, s1.primary_rays, fb_mean(a, -1), fb_mean(b, -1),
            fb_same(a, b));
+    /* the kept pre-pass tests its cells in batches at each row's end (the
+     * hook of gp[0] one by one): the same verdicts, blocked ones among them
+     * (the floor cells across the box's foot), or the images would differ */
+    long cells = x->cells, clear = x->cells_clear;
+    printf("  cells tested in the kept pre-pass's batches: %ld (%ld clear)\n", cells, clear);
+    assert_true(cells > 0 && clear < cells);
     assert_true(fb_same(a, b));
     assert_int_equal(s0.primary_rays, s1.primary_rays);
     assert_int_equal(kept + noimg, KW * KW);
