@@ -831,6 +831,23 @@ static unsigned prim_flags(const accel *a, unsigned prim)
                                        : a->csgs[prim - (unsigned)a->nshapes].flags;
 }
 
+/* Ray i of an Embree packet of N (SoA) as the user callbacks read it: the
+ * exact double-precision ray of q when the query is a single exact one (q
+ * not NULL), else the packet's floats. */
+static inline void user_ray(const accel_query *q, const void *ray, unsigned N, unsigned i, vec3 *o, vec3 *d,
+                            double *tmin)
+{
+    if (q) {
+        *o = q->org;
+        *d = q->dir;
+        *tmin = q->tmin;
+    } else {
+        *o = v3(SOA_F(ray, N, i, 0), SOA_F(ray, N, i, 1), SOA_F(ray, N, i, 2));
+        *d = v3(SOA_F(ray, N, i, 4), SOA_F(ray, N, i, 5), SOA_F(ray, N, i, 6));
+        *tmin = SOA_F(ray, N, i, 3);
+    }
+}
+
 static void user_intersect(const struct RTCIntersectFunctionNArguments *args)
 {
     const accel *a = args->geometryUserPtr;
@@ -845,15 +862,7 @@ static void user_intersect(const struct RTCIntersectFunctionNArguments *args)
         float tfar = SOA_F(ray, N, i, 8);
         vec3 o, d;
         double tmin;
-        if (exact) {
-            o = q->org;
-            d = q->dir;
-            tmin = q->tmin;
-        } else {
-            o = v3(SOA_F(ray, N, i, 0), SOA_F(ray, N, i, 1), SOA_F(ray, N, i, 2));
-            d = v3(SOA_F(ray, N, i, 4), SOA_F(ray, N, i, 5), SOA_F(ray, N, i, 6));
-            tmin = SOA_F(ray, N, i, 3);
-        }
+        user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
         accel_csg_hit h;
         if (!prim_hit(a, args->primID, o, d, tmin, (double)tfar, &h)) continue;
         SOA_F(ray, N, i, 8) = (float)h.t;
@@ -894,15 +903,7 @@ static void user_occluded(const struct RTCOccludedFunctionNArguments *args)
         if (args->valid[i] != -1 || user_box_missed(a, args->primID, ray, N, i)) continue;
         vec3 o, d;
         double tmin;
-        if (exact) {
-            o = q->org;
-            d = q->dir;
-            tmin = q->tmin;
-        } else {
-            o = v3(SOA_F(ray, N, i, 0), SOA_F(ray, N, i, 1), SOA_F(ray, N, i, 2));
-            d = v3(SOA_F(ray, N, i, 4), SOA_F(ray, N, i, 5), SOA_F(ray, N, i, 6));
-            tmin = SOA_F(ray, N, i, 3);
-        }
+        user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
         accel_csg_hit h;
         if (prim_hit(a, args->primID, o, d, tmin, (double)SOA_F(ray, N, i, 8), &h)) SOA_F(ray, N, i, 8) = -INFINITY;
     }
