@@ -375,6 +375,20 @@ typedef struct {
     double r2, s;
 } blob_span;
 
+/* The span [a, b] of component c with the quadratic q0 + q1 tau + q2 tau^2. */
+static blob_span span_of(const blob_comp *c, double a, double b, double q0, double q1, double q2)
+{
+    blob_span sp;
+    sp.a = a;
+    sp.b = b;
+    sp.q[0] = q0;
+    sp.q[1] = q1;
+    sp.q[2] = q2;
+    sp.r2 = c->r2;
+    sp.s = c->s;
+    return sp;
+}
+
 /* Quadratic |o + tau d - c|^2 and, for a cylinder body, distance to the
  * axis line; spans where the component reaches (d^2 < r^2). */
 static int blob_spans(const blob_comp *c, vec3 p, vec3 e, double ta, double tb, blob_span *sp)
@@ -405,14 +419,7 @@ static int blob_spans(const blob_comp *c, vec3 p, vec3 e, double ta, double tb, 
         a = fmax(a, ta);
         b = fmin(b, tb);
         if (!(a < b)) continue;
-        sp[n].a = a;
-        sp[n].b = b;
-        sp[n].q[0] = q0;
-        sp[n].q[1] = q1;
-        sp[n].q[2] = q2;
-        sp[n].r2 = c->r2;
-        sp[n].s = c->s;
-        n++;
+        sp[n++] = span_of(c, a, b, q0, q1, q2);
     }
     if (c->cylinder) {
         /* body: distance to the axis line while 0 <= w <= len */
@@ -442,14 +449,7 @@ static int blob_spans(const blob_comp *c, vec3 p, vec3 e, double ta, double tb, 
         a = fmax(a, ta);
         b = fmin(b, tb);
         if (a < b) {
-            sp[n].a = a;
-            sp[n].b = b;
-            sp[n].q[0] = q0;
-            sp[n].q[1] = q1;
-            sp[n].q[2] = q2;
-            sp[n].r2 = c->r2;
-            sp[n].s = c->s;
-            n++;
+            sp[n++] = span_of(c, a, b, q0, q1, q2);
         }
     }
     return n;
