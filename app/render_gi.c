@@ -68,6 +68,7 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     gs.threads = o->threads;
     if (o->cl_device) gs.cl_device = o->cl_device;
     gs.cl_max_bytes = o->cl_max_bytes;
+    gs.cancel = o->cancel; /* Ctrl-C stops the geometry stage too */
     /* camera rays through pixel centres (no fixed supersampling): the
      * pre-pass's hits serve the render (gi_particle_primary_hit) */
     gs.keep_hits = o->antialias != 2;
@@ -75,8 +76,11 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     double t0 = timer_now();
     gi_particle *gp = gi_particle_build(sc, a, &gs, &r->particle, d, &st);
     r->t_gi_geometry = timer_now() - t0;
-    if (!gp) return st == PT_OK ? PT_ERR_INTERNAL : st;
+    /* cancelled: nothing rendered, the caller sees its flag (as in the
+     * other modes, which stop at a tile) */
+    if (!gp) return st == PT_CANCELLED ? PT_OK : (st == PT_OK ? PT_ERR_INTERNAL : st);
     r->has_particle = 1;
+    gi_particle_set_cancel(gp, o->cancel);
     t0 = timer_now();
     st = gi_particle_light(gp, d);
     r->t_gi_lighting = timer_now() - t0;

@@ -23,6 +23,7 @@ const char *pt_status_name(pt_status s)
     case PT_ERR_DEVICE: return "device error";
     case PT_ERR_USAGE: return "usage error";
     case PT_ERR_INTERNAL: return "internal error";
+    case PT_CANCELLED: return "cancelled";
     }
     return "unknown";
 }

@@ -13,7 +13,8 @@ typedef enum {
     PT_ERR_NOMEM,
     PT_ERR_DEVICE,      /* Embree/OpenCL failure */
     PT_ERR_USAGE,       /* bad command line: exit 2 */
-    PT_ERR_INTERNAL
+    PT_ERR_INTERNAL,
+    PT_CANCELLED /* stopped by the caller's cancel flag (Ctrl-C): not an error */
 } pt_status;
 
 const char *pt_status_name(pt_status s);

@@ -10,6 +10,8 @@ typedef struct {
     void *ctx;
     int n;
     atomic_int next;
+    volatile int *cancel;
+    atomic_int stopped;
 } pool_state;
 
 typedef struct {
@@ -21,6 +23,10 @@ static void *worker(void *p)
 {
     worker_arg *w = p;
     for (;;) {
+        if (w->st->cancel && *w->st->cancel) {
+            atomic_store(&w->st->stopped, 1);
+            break;
+        }
         int i = atomic_fetch_add(&w->st->next, 1);
         if (i >= w->st->n) break;
         w->st->job(w->st->ctx, i, w->thread);
@@ -34,21 +40,22 @@ int pool_default_threads(void)
     return n > 0 ? (int)n : 1;
 }
 
-void pool_run(int threads, int n, pool_job job, void *ctx)
+void pool_run(int threads, int n, pool_job job, void *ctx) { (void)pool_run_cancel(threads, n, job, ctx, NULL); }
+
+int pool_run_cancel(int threads, int n, pool_job job, void *ctx, volatile int *cancel)
 {
     if (threads <= 0) threads = pool_default_threads();
     if (threads > n) threads = n;
-    pool_state st = {job, ctx, n, 0};
-    if (threads <= 1) {
-        for (int i = 0; i < n; i++) job(ctx, i, 0);
-        return;
-    }
-    pthread_t *tid = malloc(sizeof(pthread_t) * (size_t)threads);
-    worker_arg *args = malloc(sizeof(worker_arg) * (size_t)threads);
+    pool_state st = {job, ctx, n, 0, cancel, 0};
+    pthread_t *tid = threads > 1 ? malloc(sizeof(pthread_t) * (size_t)threads) : NULL;
+    worker_arg *args = threads > 1 ? malloc(sizeof(worker_arg) * (size_t)threads) : NULL;
     if (!tid || !args) {
-        free(tid); free(args);
-        for (int i = 0; i < n; i++) job(ctx, i, 0);
-        return;
+        /* one thread (or no memory for more): this one */
+        free(tid);
+        free(args);
+        worker_arg w = {&st, 0};
+        worker(&w);
+        return !atomic_load(&st.stopped);
     }
     int started = 0;
     for (int t = 1; t < threads; t++) {
@@ -63,4 +70,5 @@ void pool_run(int threads, int n, pool_job job, void *ctx)
     for (int t = 1; t <= started; t++) pthread_join(tid[t], NULL);
     free(tid);
     free(args);
+    return !atomic_load(&st.stopped);
 }

@@ -42,7 +42,7 @@ typedef struct {
 pt_status gi_links_build(const accel *a, void *scene, const gi_dev_particle *p, const void *const *pobj,
                          const unsigned char *pin, int n, int nside, uint64_t seed, const gi_lookup *grid,
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
-                         gi_link_stats *st);
+                         gi_link_stats *st, volatile int *cancel);
 
 /* Incoming links, a counting sort by target: the sources i < n in mask
  * (bit i of word i / 32; NULL: all) whose links[i * k + j] are >= 0, per

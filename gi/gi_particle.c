@@ -257,10 +257,10 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
     gp->tl = NULL;
     if (st == PT_OK && use_tl && gp->set.link_lookup == 0)
         gp->tl = gi_trilook_build(gp->a, ps->p, n, (const void *const *)pobj, grid, pin + n, ps->spacing, GI_LINKS_AGREE,
-                                  3.0 * ps->spacing, gp->threads, &st);
+                                  3.0 * ps->spacing, gp->threads, gp->set.cancel, &st);
     if (st == PT_OK)
         st = gi_links_build(gp->a, gp->lscene, ps->p, pobj, pin, n, gp->set.scatter_side, seed, grid, gp->tl,
-                            3.0 * ps->spacing, gp->threads, links, keep, ls);
+                            3.0 * ps->spacing, gp->threads, links, keep, ls, gp->set.cancel);
     gi_lookup_free(grid);
     free(pobj);
     free(pin);
@@ -524,6 +524,10 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     }
     S->t_prune = timer_now() - tg;
     S->c_prune = timer_cpu_now() - cg;
+    if (set->cancel && *set->cancel) {
+        st = PT_CANCELLED;
+        goto fail;
+    }
 
     /* the area particles */
     tg = timer_now();
@@ -571,7 +575,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         cg = timer_cpu_now();
         if (st == PT_OK)
             st = gi_links_build(a, gp->lscene, gp->ps.p, pobj, pin, n, set->gather_side, set->seed ^ 0x6a7ULL, grid,
-                                gp->tl, 3.0 * spacing, gp->threads, gp->glink, NULL, &ls);
+                                gp->tl, 3.0 * spacing, gp->threads, gp->glink, NULL, &ls, set->cancel);
         S->t_gather_links = timer_now() - tg;
         S->c_gather_links = timer_cpu_now() - cg;
         gi_lookup_free(grid);
@@ -595,9 +599,14 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     }
 
     /* radiance particles and estimation lists */
+    if (set->cancel && *set->cancel) {
+        st = PT_CANCELLED;
+        goto fail;
+    }
     tg = timer_now();
     cg = timer_cpu_now();
-    st = gi_radiance_lists(&gp->lists, gp->surf, &gp->ps, gp->a, S->radius, set->normal_cos, gp->threads, d);
+    st = gi_radiance_lists(&gp->lists, gp->surf, &gp->ps, gp->a, S->radius, set->normal_cos, gp->threads, set->cancel,
+                           d);
     if (st != PT_OK) goto fail;
     S->radiance_particles = gp->lists.nrp;
     S->radiance_slots = gi_surface_rp_slots(gp->surf);

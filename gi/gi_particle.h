@@ -134,6 +134,9 @@ typedef struct {
     const char *cl_device; /* NULL/"auto", "c", "P:D" or part of a name (gi_cl.h) */
     const char *cl_source; /* NULL: the built-in kernels; tests pass broken text here */
     size_t cl_max_bytes;   /* OpenCL device memory the GI may hold; 0 = the device's (gi_dev_options.max_bytes) */
+    volatile int *cancel;  /* non-zero stops the geometry stage at its next chunk of work (link rays of a few
+                              particles, lists of a chunk of radiance particles): gi_particle_build then returns
+                              NULL with PT_CANCELLED. NULL (the default): never. */
     gi_pigment_fn pigment; /* particles' pigment at their position; NULL: each texture's base colour */
 } gi_particle_settings;
 

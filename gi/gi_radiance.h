@@ -62,7 +62,7 @@ int gi_visible_segment(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3
 int gi_visible_along(const accel *a, double eps, const gi_segment *sg, const scene_object *own);
 
 pt_status gi_radiance_lists(gi_lists *L, const gi_surface *g, const gi_particles *ps, const accel *a, double r,
-                            double cos_thr, int threads, diag *d);
+                            double cos_thr, int threads, volatile int *cancel, diag *d);
 void gi_lists_free(gi_lists *L);
 
 #endif

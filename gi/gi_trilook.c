@@ -484,7 +484,7 @@ void gi_trilook_free(gi_trilook *t)
 
 gi_trilook *gi_trilook_build(const accel *a, const gi_dev_particle *p, int n, const void *const *pobj,
                              const gi_lookup *grid, const unsigned char *buried, double spacing, double agree,
-                             double maxdist, int threads, pt_status *st)
+                             double maxdist, int threads, volatile int *cancel, pt_status *st)
 {
     *st = PT_OK;
     if (!a || !p || !pobj || !grid || n <= 0 || !(spacing > 0.0) || !(maxdist > 0.0)) return NULL;
@@ -608,7 +608,12 @@ gi_trilook *gi_trilook_build(const accel *a, const gi_dev_particle *p, int n, co
     B.ccap = calloc((size_t)B.chunks, sizeof *B.ccap);
     B.fail = calloc((size_t)B.chunks, sizeof *B.fail);
     if (!B.ce || !B.cne || !B.ccap || !B.fail || !bgrid_build(&B.g, p, n, spacing)) goto nomem;
-    pool_run(threads, B.chunks, build_job, &B);
+    if (!pool_run_cancel(threads, B.chunks, build_job, &B, cancel)) {
+        *st = PT_CANCELLED;
+        gi_trilook_free(t);
+        t = NULL;
+        goto done;
+    }
     long ne = SHARED_WORDS;
     long *base = malloc((size_t)B.chunks * sizeof *base);
     if (!base) goto nomem;

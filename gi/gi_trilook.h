@@ -27,7 +27,7 @@
 
 typedef struct gi_trilook gi_trilook;
 
-/* p: n particles; pobj: the object of each (as accel_rtc_object gives it
+/* (cancel non-zero: NULL with *st PT_CANCELLED) p: n particles; pobj: the object of each (as accel_rtc_object gives it
  * for a hit on it); grid: the same particles' lookup, its object ids set
  * from pobj (gi_lookup_set_objects); buried (may be NULL): n flags,
  * particles buried in a closed solid; agree: gi_links' threshold on n . N
@@ -35,7 +35,7 @@ typedef struct gi_trilook gi_trilook;
  * and NULL when no triangle carries particles). */
 gi_trilook *gi_trilook_build(const accel *a, const gi_dev_particle *p, int n, const void *const *pobj,
                              const gi_lookup *grid, const unsigned char *buried, double spacing, double agree,
-                             double maxdist, int threads, pt_status *st);
+                             double maxdist, int threads, volatile int *cancel, pt_status *st);
 /* The particles were renumbered: remap[i] is particle i's new index, -1
  * when it was dropped (indices keep their order); p: the n kept ones. */
 void gi_trilook_compact(gi_trilook *t, const int *remap, const gi_dev_particle *p, int n);

@@ -10,6 +10,7 @@
 #include "arena.h"
 #include "diag.h"
 #include "framebuffer.h"
+#include "pool.h"
 #include "scene.h"
 #include "xform.h"
 
@@ -86,6 +87,35 @@ static void test_arena_diag(void **st)
     diag_free(d);
 }
 
+/* pool_run_cancel: job 5 sets the flag; on one thread no job after it
+ * runs and the call says it stopped; without a flag every job runs */
+typedef struct {
+    volatile int cancel;
+    int ran;
+} cancel_ctx;
+
+static void cancel_job(void *ctx, int index, int thread)
+{
+    (void)thread;
+    cancel_ctx *c = ctx;
+    c->ran++;
+    if (index == 5) c->cancel = 1;
+}
+
+static void test_pool_cancel(void **st)
+{
+    (void)st;
+    cancel_ctx c = {0, 0};
+    assert_int_equal(pool_run_cancel(1, 100, cancel_job, &c, &c.cancel), 0);
+    assert_int_equal(c.ran, 6);
+    cancel_ctx d = {0, 0};
+    assert_int_equal(pool_run_cancel(1, 100, cancel_job, &d, NULL), 1);
+    assert_int_equal(d.ran, 100);
+    cancel_ctx e = {1, 0}; /* set before: nothing runs */
+    assert_int_equal(pool_run_cancel(2, 100, cancel_job, &e, &e.cancel), 0);
+    assert_int_equal(e.ran, 0);
+}
+
 static void test_fb_sanitize(void **st)
 {
     (void)st;
@@ -109,6 +139,7 @@ int main(void)
         cmocka_unit_test(test_matrix),
         cmocka_unit_test(test_arena_diag),
         cmocka_unit_test(test_fb_sanitize),
+        cmocka_unit_test(test_pool_cancel),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

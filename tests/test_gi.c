@@ -665,6 +665,24 @@ static void test_cancel(void **state)
     (void)state;
     cancel_check(device_c);
     if (have_opencl()) cancel_check(NULL);
+    /* the geometry stage (Ctrl-C in partray render): a set flag stops it
+     * with PT_CANCELLED, no particles, no diagnostic */
+    fixture f;
+    load(&f, cube_scene);
+    gi_particle_settings s;
+    gi_particle_default_settings(&s);
+    s.count = 2000;
+    s.threads = 2;
+    s.cl_device = device_c;
+    volatile int cancel = 1;
+    s.cancel = &cancel;
+    gi_particle_stats stats;
+    pt_status st = PT_OK;
+    gi_particle *gp = gi_particle_build(f.sc, f.a, &s, &stats, f.d, &st);
+    assert_null(gp);
+    assert_int_equal(st, PT_CANCELLED);
+    assert_int_equal(diag_errors(f.d), 0);
+    unload(&f);
 }
 
 /* A cylinder and a prism: their indirect light must be close to that of
