@@ -36,6 +36,7 @@
 #include <string.h>
 #include <sys/resource.h>
 #include "accel.h"
+#include "bench_gi_util.h"
 #include "bench_util.h"
 #include "gi_particle.h"
 #include "img_io.h"

@@ -21,6 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "accel.h"
+#include "bench_gi_util.h"
 #include "bench_util.h"
 #include "gi_particle.h"
 #include "sdl.h"
