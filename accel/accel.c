@@ -1690,6 +1690,48 @@ int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax)
     return r.tfar == -INFINITY;
 }
 
+/* Rays k0 .. k0 + 15 of a batch (the first m of them real) as a packet of
+ * 16, each with the same effective interval as accel_occluded /
+ * accel_intersect; out[] of the real ones cleared. Returns whether any lane
+ * is valid. */
+static int fill_packet16(const accel *a, int k0, int m, const vec3 *org, const vec3 *dir, const double *tmin,
+                         const double *tmax, struct RTCRay16 *r, int *valid, unsigned char *out)
+{
+    int any = 0;
+    for (int k = 0; k < 16; k++) {
+        valid[k] = 0;
+        r->org_x[k] = r->org_y[k] = r->org_z[k] = 0.0f;
+        r->dir_x[k] = r->dir_y[k] = 0.0f;
+        r->dir_z[k] = 1.0f;
+        r->tnear[k] = 0.0f;
+        r->tfar[k] = 0.0f;
+        r->time[k] = 0.0f;
+        r->mask[k] = 0xFFFFFFFFu;
+        r->id[k] = (unsigned)k;
+        r->flags[k] = 0;
+        if (k >= m) continue;
+        int i = k0 + k;
+        out[i] = 0;
+        if (!a || !ray_ok(org[i], dir[i])) continue;
+        double t0 = eps_rule(a->eps_scale, org[i], v3_len(dir[i]));
+        if (tmin[i] > t0) t0 = tmin[i];
+        if (!(tmax[i] > t0)) continue;
+        struct RTCRay one;
+        fill_rtc_ray(&one, org[i], dir[i], t0, tmax[i]);
+        r->org_x[k] = one.org_x;
+        r->org_y[k] = one.org_y;
+        r->org_z[k] = one.org_z;
+        r->dir_x[k] = one.dir_x;
+        r->dir_y[k] = one.dir_y;
+        r->dir_z[k] = one.dir_z;
+        r->tnear[k] = one.tnear;
+        r->tfar[k] = one.tfar;
+        valid[k] = -1;
+        any = 1;
+    }
+    return any;
+}
+
 void accel_occluded_n(const accel *a, int n, const vec3 *org, const vec3 *dir, const double *tmin,
                       const double *tmax, unsigned char *out)
 {
@@ -1697,40 +1739,7 @@ void accel_occluded_n(const accel *a, int n, const vec3 *org, const vec3 *dir, c
         int m = n - k0 < 16 ? n - k0 : 16;
         struct RTCRay16 r;
         RTC_ALIGN(64) int valid[16];
-        int any = 0;
-        for (int k = 0; k < 16; k++) {
-            valid[k] = 0;
-            r.org_x[k] = r.org_y[k] = r.org_z[k] = 0.0f;
-            r.dir_x[k] = r.dir_y[k] = 0.0f;
-            r.dir_z[k] = 1.0f;
-            r.tnear[k] = 0.0f;
-            r.tfar[k] = 0.0f;
-            r.time[k] = 0.0f;
-            r.mask[k] = 0xFFFFFFFFu;
-            r.id[k] = (unsigned)k;
-            r.flags[k] = 0;
-            if (k >= m) continue;
-            int i = k0 + k;
-            out[i] = 0;
-            if (!a || !ray_ok(org[i], dir[i])) continue;
-            /* the same effective interval as accel_occluded */
-            double t0 = eps_rule(a->eps_scale, org[i], v3_len(dir[i]));
-            if (tmin[i] > t0) t0 = tmin[i];
-            if (!(tmax[i] > t0)) continue;
-            struct RTCRay one;
-            fill_rtc_ray(&one, org[i], dir[i], t0, tmax[i]);
-            r.org_x[k] = one.org_x;
-            r.org_y[k] = one.org_y;
-            r.org_z[k] = one.org_z;
-            r.dir_x[k] = one.dir_x;
-            r.dir_y[k] = one.dir_y;
-            r.dir_z[k] = one.dir_z;
-            r.tnear[k] = one.tnear;
-            r.tfar[k] = one.tfar;
-            valid[k] = -1;
-            any = 1;
-        }
-        if (!any) continue;
+        if (!fill_packet16(a, k0, m, org, dir, tmin, tmax, &r, valid, out)) continue;
         struct RTCIntersectContext c;
         rtcInitIntersectContext(&c);
         c.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
@@ -1751,43 +1760,12 @@ void accel_hit_any_n(const accel *a, int n, const vec3 *org, const vec3 *dir, co
         int m = n - k0 < 16 ? n - k0 : 16;
         struct RTCRayHit16 r;
         RTC_ALIGN(64) int valid[16];
-        int any = 0;
+        if (!fill_packet16(a, k0, m, org, dir, tmin, tmax, &r.ray, valid, out)) continue;
         for (int k = 0; k < 16; k++) {
-            valid[k] = 0;
-            r.ray.org_x[k] = r.ray.org_y[k] = r.ray.org_z[k] = 0.0f;
-            r.ray.dir_x[k] = r.ray.dir_y[k] = 0.0f;
-            r.ray.dir_z[k] = 1.0f;
-            r.ray.tnear[k] = 0.0f;
-            r.ray.tfar[k] = 0.0f;
-            r.ray.time[k] = 0.0f;
-            r.ray.mask[k] = 0xFFFFFFFFu;
-            r.ray.id[k] = (unsigned)k;
-            r.ray.flags[k] = 0;
             r.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
             r.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
             r.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-            if (k >= m) continue;
-            int i = k0 + k;
-            out[i] = 0;
-            if (!a || !ray_ok(org[i], dir[i])) continue;
-            /* the same effective interval as accel_intersect */
-            double t0 = eps_rule(a->eps_scale, org[i], v3_len(dir[i]));
-            if (tmin[i] > t0) t0 = tmin[i];
-            if (!(tmax[i] > t0)) continue;
-            struct RTCRay one;
-            fill_rtc_ray(&one, org[i], dir[i], t0, tmax[i]);
-            r.ray.org_x[k] = one.org_x;
-            r.ray.org_y[k] = one.org_y;
-            r.ray.org_z[k] = one.org_z;
-            r.ray.dir_x[k] = one.dir_x;
-            r.ray.dir_y[k] = one.dir_y;
-            r.ray.dir_z[k] = one.dir_z;
-            r.ray.tnear[k] = one.tnear;
-            r.ray.tfar[k] = one.tfar;
-            valid[k] = -1;
-            any = 1;
         }
-        if (!any) continue;
         struct RTCIntersectContext c;
         rtcInitIntersectContext(&c);
         c.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
