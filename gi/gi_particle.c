@@ -1129,7 +1129,7 @@ typedef struct {
 #define CELL_PENDING 3
 
 static int cell_clear(gi_particle *gp, const long rp[3], const scene_object *own, thread_count *tc);
-static int batch_cell(gi_particle *gp, struct cell_batch *b, uint64_t key, const long rp[3], const scene_object *own);
+static int batch_cell(struct cell_batch *b, uint64_t key, const long rp[3], const scene_object *own);
 static unsigned batch_seen_slot(uint64_t key) { return (unsigned)((key * 0x9e3779b97f4a7c15ULL) >> 52); }
 static int batch_pixel(struct cell_batch *b, view_rec *vr, int cell);
 static void batch_test(gi_particle *gp, struct cell_batch *b, thread_count *tc);
@@ -1188,7 +1188,7 @@ static int kept_verdict(gi_particle *gp, const long rp[3], const scene_object *o
         /* not tested by this thread lately: into the row's batch
          * (cell_batch), which asks the table first; the record's verdict
          * is written when the batch is done */
-        int i = batch_cell(gp, m->b, key, rp, own);
+        int i = batch_cell(m->b, key, rp, own);
         if (i >= 0 && batch_pixel(m->b, old, i)) {
             m->key = key;
             m->verdict = CELL_PENDING;
@@ -1196,11 +1196,7 @@ static int kept_verdict(gi_particle *gp, const long rp[3], const scene_object *o
             return GI_CELL_UNKNOWN;
         }
     }
-    if (verdict == GI_CELL_UNKNOWN) verdict = gi_cellvis_get(gp->cells, key);
-    if (verdict == GI_CELL_UNKNOWN) {
-        verdict = cell_clear(gp, rp, own, m->tc) ? GI_CELL_CLEAR : GI_CELL_BLOCKED;
-        gi_cellvis_put(gp->cells, key, verdict);
-    }
+    if (verdict == GI_CELL_UNKNOWN) verdict = cell_verdict(gp, key, rp, own, m->tc);
     m->key = key;
     m->verdict = verdict;
     return verdict;
@@ -1845,9 +1841,8 @@ static int grow(void **p, int *cap, int need, size_t size)
 }
 
 /* The batch's index of cell key (added when new), -1 out of memory. */
-static int batch_cell(gi_particle *gp, struct cell_batch *b, uint64_t key, const long rp[3], const scene_object *own)
+static int batch_cell(struct cell_batch *b, uint64_t key, const long rp[3], const scene_object *own)
 {
-    (void)gp;
     unsigned h = (unsigned)((key * 0x9e3779b97f4a7c15ULL) >> 55) & (BATCH_HASH - 1);
     int hashed = b->ncell < BATCH_HASH / 2;
     if (hashed) {
@@ -1954,10 +1949,8 @@ static void batch_test(gi_particle *gp, struct cell_batch *b, thread_count *tc)
             b->seen[batch_seen_slot(b->cell[c].key)] = b->cell[c].key << 2 | (uint64_t)b->cell[c].verdict;
     } else {
         /* no memory for the rays: one cell at a time */
-        for (int c = 0; c < b->ncell; c++) {
-            b->cell[c].verdict = cell_clear(gp, b->cell[c].rp, b->cell[c].own, tc) ? GI_CELL_CLEAR : GI_CELL_BLOCKED;
-            gi_cellvis_put(gp->cells, b->cell[c].key, b->cell[c].verdict);
-        }
+        for (int c = 0; c < b->ncell; c++)
+            b->cell[c].verdict = cell_verdict(gp, b->cell[c].key, b->cell[c].rp, b->cell[c].own, tc);
     }
     for (int k = 0; k < b->npix; k++) b->pix[k].vr->verdict = (unsigned char)b->cell[b->pix[k].cell].verdict;
     b->ncell = 0;

@@ -1538,8 +1538,6 @@ static long mesh_locate(const gi_surface *g, int pi, vec3 q, vec3 ng, double w[3
 #define SHARE_TOL 1e-9
 #define SHARE_COS 0.99984769515639127 /* cos(1 degree) */
 
-/* Slot -> its patch (the last patch whose slots start at or before it:
- * patches without slots share slot_first with the next one). */
 /* The patch holding slot `slot`: the last one whose slots start at or
  * before it (patches without slots start where the next one does). */
 static int slot_patch(const gi_surface *g, long slot)
