@@ -1,9 +1,9 @@
 /* render_gi.c - render a scene with one GI mode and collect its figures.
  *
- *  none      Whitted (shade_render) with POV-Ray's ambient term.
+ *  none      Whitted (shade_render) with POV-Ray's ambient term (radiosity off).
  *  particle  seed 000: geometry stage, lighting stage, view preparation,
  *            then the Whitted pass with the particles' indirect light
- *            (ambient is replaced by GI, as POV-Ray does with radiosity).
+ *            (ambient under POV-Ray's rules with radiosity on, radrules.h).
  *  pmfg      photon map + final gathering (reference/pm_fg.h).
  *  path      path tracer (reference/pm_path.h). */
 #include "render_gi.h"
@@ -14,6 +14,7 @@
 #include "img_io.h"
 #include "pm_fg.h"
 #include "pm_path.h"
+#include "radrules.h"
 #include "shade_texture.h"
 #include "timer.h"
 
@@ -48,7 +49,7 @@ static pt_status render_none(const scene *sc, const accel *a, const render_gi_op
 {
     shade_settings ss;
     fill_shade(&ss, o);
-    ss.use_ambient = 1;
+    ss.use_ambient = radrules_of(sc, 0).ambient; /* radiosity off: always */
     double t0 = timer_now();
     pt_status st = shade_render(sc, a, &ss, fb, &r->shade, d);
     r->t_render = timer_now() - t0;
@@ -87,10 +88,10 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     if (st == PT_OK) {
         shade_settings ss;
         fill_shade(&ss, o);
-        /* With radiosity{} on, `ambient` is an emitter (DESIGN.md): the
-         * particles carry its light to other surfaces, and a surface seen
-         * directly shows it, as in the path tracer. Otherwise GI replaces it. */
-        ss.use_ambient = gs.ambient_emits > 0 || (gs.ambient_emits < 0 && sc->global.radiosity.enabled);
+        /* POV-Ray's rule under radiosity (core/radrules.h): a surface seen
+         * directly shows ambient only in scenes below #version 3.7, where
+         * the particles also carry it to other surfaces. */
+        ss.use_ambient = radrules_of(sc, 1).ambient;
         ss.indirect = gi_particle_indirect;
         ss.indirect_ctx = gp;
         if (gs.keep_hits) {

@@ -9,6 +9,7 @@
 #include "timer.h"
 #include "gi_particle.h"
 #include "pm_fg.h"
+#include "radrules.h"
 #include "pm_path.h"
 
 typedef struct {
@@ -196,7 +197,7 @@ static pt_status particle_render(void *ctx, const view_gi_pass *p, framebuffer *
     if (st != PT_OK) return st;
     shade_settings ss;
     whitted_settings(&ss, p);
-    ss.use_ambient = 0;
+    ss.use_ambient = radrules_of(c->sc, 1).ambient; /* as render_gi.c */
     ss.indirect = gi_particle_indirect;
     ss.indirect_ctx = gp;
     double t0 = timer_now();

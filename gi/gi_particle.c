@@ -36,7 +36,6 @@ struct gi_particle {
     const accel *a;
     gi_particle_settings set;
     int threads;
-    int ambient_emits;
     gi_surface *surf;
     gi_particles ps;
     int ns2, ng;
@@ -96,7 +95,6 @@ void gi_particle_default_settings(gi_particle_settings *s)
     s->radius = 0.0;
     s->radius_factor = 3.0;
     s->normal_cos = 0.9;
-    s->ambient_emits = -1;
     s->area_samples = 0;
     s->brightness = 1.0;
     s->seed = 0;
@@ -463,7 +461,6 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     if (!(set->brightness > 0.0)) set->brightness = 1.0;
     gp->threads = set->threads > 0 ? set->threads : pool_default_threads();
     if (gp->threads > GI_MAX_THREADS) gp->threads = GI_MAX_THREADS;
-    gp->ambient_emits = set->ambient_emits >= 0 ? set->ambient_emits : sc->global.radiosity.enabled;
     gp->ns2 = set->scatter_side * set->scatter_side;
     gp->ng = set->gather_side * set->gather_side;
     gp->bg[0] = (float)sc->background.r;
@@ -497,14 +494,14 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     {
         gi_particles pilot;
         long pc = set->count / 4 > 500 ? set->count / 4 : 500;
-        st = gi_particles_sample(&pilot, gp->surf, a, sc, pc, set->seed ^ 0x9170ULL, gp->ambient_emits, NULL, NULL, d);
+        st = gi_particles_sample(&pilot, gp->surf, a, sc, pc, set->seed ^ 0x9170ULL, NULL, NULL, d);
         int *pl = NULL;
         if (st == PT_OK) st = trace_and_prune(gp, &pilot, set->seed ^ 0x5eedULL, &pl, NULL, 0);
         free(pl);
         if (st == PT_OK) {
             /* pilot.patch/side now list the survivors; count them per side */
             gi_particles all;
-            st = gi_particles_sample(&all, gp->surf, a, sc, pc, set->seed ^ 0x9170ULL, gp->ambient_emits, NULL, NULL, d);
+            st = gi_particles_sample(&all, gp->surf, a, sc, pc, set->seed ^ 0x9170ULL, NULL, NULL, d);
             if (st == PT_OK) {
                 float *tot = xcalloc(2 * (size_t)np + 2, sizeof(float), &st);
                 if (tot) {
@@ -531,7 +528,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
 
     /* the area particles */
     tg = timer_now();
-    st = gi_particles_sample(&gp->ps, gp->surf, a, sc, set->count, set->seed, gp->ambient_emits, frac, set->pigment, d);
+    st = gi_particles_sample(&gp->ps, gp->surf, a, sc, set->count, set->seed, frac, set->pigment, d);
     free(frac);
     if (st != PT_OK) goto fail;
     S->candidates = gp->ps.n;

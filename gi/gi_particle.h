@@ -43,9 +43,9 @@
  * light and reaches everything.
  *
  * What counts as emitted light: light_sources (every kind, with shade.c's
- * attenuation and shadow rays), finish emission, and finish ambient *
- * ambient_light when `ambient_emits` (default: when the scene has
- * radiosity{}, as POV-Ray 3.7 does). Rays that leave the scene see the
+ * attenuation and shadow rays) and finish emission, with finish ambient *
+ * ambient_light only in scenes below #version 3.7 (POV-Ray's rules under
+ * radiosity, core/radrules.h). Rays that leave the scene see the
  * background colour (sky_sphere is ignored). Only diffuse interreflection is
  * simulated (as in the paper): no caustics; reflective and refractive
  * surfaces take part through the Whitted pass only.
@@ -103,7 +103,6 @@ typedef struct {
     double radius;       /* estimation list radius; <= 0: radius_factor * spacing */
     double radius_factor;/* default 3 */
     double normal_cos;   /* list normal threshold: n_m . n_q > normal_cos (default 0.9, 25.8 degrees) */
-    int ambient_emits;   /* -1: from the scene (radiosity{} on), 0 no, 1 yes */
     int area_samples;    /* shadow rays per particle per area light; 0: the whole grid (default 0) */
     double brightness;   /* multiplies the returned indirect light (default 1) */
     int max_trace_level; /* pre-pass depth; 0: the scene's */

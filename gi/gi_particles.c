@@ -5,6 +5,7 @@
 #include <string.h>
 #include "accel_shapes.h"
 #include "hash.h"
+#include "radrules.h"
 #include "rng.h"
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -24,7 +25,7 @@ static double frac(double x) { return x - floor(x); }
 static double grey(double r, double g, double b) { return 0.297 * r + 0.589 * g + 0.114 * b; }
 
 /* c: the pigment (NULL: the texture's base colour). */
-static void material(const scene *sc, const scene_texture *tex, const colour5 *c, int ambient_emits,
+static void material(const scene *sc, const scene_texture *tex, const colour5 *c, const radrules *rr,
                      gi_dev_particle *p)
 {
     if (!tex) tex = &sc->default_texture;
@@ -33,12 +34,8 @@ static void material(const scene *sc, const scene_texture *tex, const colour5 *c
     double tr = c->f * c->r + c->t, tg = c->f * c->g + c->t, tb = c->f * c->b + c->t;
     double opacity = 1.0 - fmin(1.0, fmax(0.0, grey(tr, tg, tb)));
     double pig[3] = {c->r, c->g, c->b};
-    double em[3] = {f->emission.r, f->emission.g, f->emission.b};
-    if (ambient_emits) {
-        em[0] += f->ambient.r * sc->global.ambient_light.r;
-        em[1] += f->ambient.g * sc->global.ambient_light.g;
-        em[2] += f->ambient.b * sc->global.ambient_light.b;
-    }
+    const rgb e = radrules_emission(rr, sc, f);
+    double em[3] = {e.r, e.g, e.b};
     for (int k = 0; k < 3; k++) {
         double rho = f->diffuse * pig[k] * opacity;
         double le = pig[k] * em[k] * opacity;
@@ -94,8 +91,9 @@ static int probe_ok(const accel *a, const scene_object *o, vec3 pos, vec3 nrm)
 }
 
 pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel *a, const scene *sc, long count,
-                              uint64_t seed, int ambient_emits, const float *side_frac, gi_pigment_fn pig, diag *d)
+                              uint64_t seed, const float *side_frac, gi_pigment_fn pig, diag *d)
 {
+    const radrules rr = radrules_of(sc, 1);
     memset(ps, 0, sizeof *ps);
     int np = gi_surface_npatches(g);
     double total = 0.0;
@@ -131,7 +129,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
         proto.area = (float)ps->dA;
         const scene_texture *tex = gi_surface_texture(g, i);
         if (!tex) tex = &sc->default_texture;
-        material(sc, tex, NULL, ambient_emits, &proto);
+        material(sc, tex, NULL, &rr, &proto);
         int probe = gi_surface_probe(g, i), mask = gi_surface_side_mask(g, i);
         /* uv_mapping: the pigment is read at the particle's UV (accel_shape_uv;
          * world x, y for meshes and the shapes it does not know, as accel.c) */
@@ -159,7 +157,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
                 colour5 c;
                 if (pig(sc, tex, &h, &c) && isfinite(c.r) && isfinite(c.g) && isfinite(c.b) && isfinite(c.f) &&
                     isfinite(c.t))
-                    material(sc, tex, &c, ambient_emits, &mat);
+                    material(sc, tex, &c, &rr, &mat);
             }
             for (int s = 0; s < sides; s++) {
                 if (side_frac && side_frac[2 * i + s] <= 0.0f) continue;

@@ -30,12 +30,12 @@ typedef struct {
  * each side's particles that will be kept (from a pilot run): the density
  * is set so that about `count` are kept, and sides of fraction 0 get none.
  * Materials:
- * rho = diffuse * pigment * opacity, le = pigment * (emission + [ambient *
- * ambient_light if ambient_emits]) * opacity, as shade.c's terms; the
+ * rho = diffuse * pigment * opacity, le = pigment * E * opacity with E
+ * POV-Ray's emission under radiosity (core/radrules.h), as shade.c's terms; the
  * pigment is `pig`'s at the particle (patterns, image maps, texture maps),
  * or with pig NULL the texture's base colour. */
 pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel *a, const scene *sc, long count,
-                              uint64_t seed, int ambient_emits, const float *side_frac, gi_pigment_fn pig, diag *d);
+                              uint64_t seed, const float *side_frac, gi_pigment_fn pig, diag *d);
 /* Keep the particles with keep[i] != 0, in order. */
 pt_status gi_particles_compact(gi_particles *ps, const unsigned char *keep);
 void gi_particles_free(gi_particles *ps);

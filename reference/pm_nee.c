@@ -12,6 +12,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "radrules.h"
 #include "shade_light.h"
 
 struct pm_lights {
@@ -32,12 +33,8 @@ static double emit_weight(void *ctx, const scene_object *leaf, const scene_textu
     double w = fmax(fabs(e.r), fmax(fabs(e.g), fabs(e.b)));
     if (mat_texture_varies(tex)) {
         /* the fallback colour says little: weigh by the finish alone */
-        rgb f = tex->finish.emission;
-        if (sc->global.radiosity.enabled) {
-            f.r += tex->finish.ambient.r;
-            f.g += tex->finish.ambient.g;
-            f.b += tex->finish.ambient.b;
-        }
+        const radrules rr = radrules_of(sc, 1);
+        rgb f = radrules_emission(&rr, sc, &tex->finish);
         w = fmax(w, fmax(fabs(f.r), fmax(fabs(f.g), fabs(f.b))));
     }
     return w;

@@ -7,8 +7,8 @@
  *
  * POV-Ray lights are invisible to camera and BSDF rays (looks_like is
  * ignored): they are reached by next-event estimation only. Emissive
- * surfaces (pigment * emission, plus ambient under radiosity{}, see
- * shade_material.h) are found both ways. */
+ * surfaces (pigment * emission, plus ambient in scenes below #version 3.7:
+ * core/radrules.h) are found both ways. */
 #ifndef PT_PM_NEE_H
 #define PT_PM_NEE_H
 #include "accel.h"

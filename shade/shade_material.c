@@ -11,6 +11,7 @@
  * 1.5 a photon keeps 1/2.25 of kt, leaving it gets 2.25: a round trip is kt^2,
  * and surfaces inside a medium receive what the camera-side transport sees. */
 #include "shade_material.h"
+#include "radrules.h"
 #include <math.h>
 #include <string.h>
 #include "shade_texture.h"
@@ -50,14 +51,8 @@ static double opacity_of(rgb pig, double filt, double transm)
 
 static rgb emission_of(const scene *sc, const scene_texture *tex, rgb pig, double op)
 {
-    const scene_finish *f = &tex->finish;
-    rgb e = f->emission;
-    if (sc->global.radiosity.enabled) {
-        rgb al = sc->global.ambient_light;
-        e.r += f->ambient.r * al.r;
-        e.g += f->ambient.g * al.g;
-        e.b += f->ambient.b * al.b;
-    }
+    const radrules rr = radrules_of(sc, 1); /* the reference modes gather light */
+    rgb e = radrules_emission(&rr, sc, &tex->finish);
     return mrgb(pig.r * e.r * op, pig.g * e.g * op, pig.b * e.b * op);
 }
 

@@ -14,7 +14,7 @@
  *                                                        channel), ior from the interior;
  *                                                        total internal reflection adds kt to
  *                                                        the mirror direction, as shade.c
- *   Le      = pigment * opacity * (emission + ambient * ambient_light [radiosity{} only])
+ *   Le      = pigment * opacity * (emission [+ ambient * ambient_light: #version < 3.7])
  *
  * The pigment is evaluated at the hit (patterns, image maps, texture maps:
  * shade_texture.h's tex_pigment_at, the top layer's colour) and the finish
@@ -27,14 +27,12 @@
  * of direct light only). Phong and specular highlights are not part of f:
  * they are not energy-conserving and are added for light arriving straight
  * from light sources only, by light_terms/light_nee (shade_light.h), exactly
- * as shade.c computes them; so `--gi none` (with ambient 0 or radiosity on)
- * is the direct part (first vertex) of the path tracer. Emission is the same
+ * as shade.c computes them; so `--gi none` (with ambient 0; it shows ambient,
+ * being radiosity off) is the direct part (first vertex) of the path tracer. Emission is the same
  * on both sides of a surface (POV-Ray turns normals towards the viewer).
- * The `ambient` rule is DESIGN.md's: with radiosity{} on, ambient makes a
- * surface a light source for GI (the Cornell example's light patch is
- * `ambient 0.78`). POV-Ray 3.7 itself ignores ambient when radiosity is on
- * in #version 3.7 scenes and uses `emission` only; without radiosity{} the
- * GI modes drop ambient (the GI replaces that constant term).
+ * Emission follows POV-Ray 3.7's rules with radiosity on (core/radrules.h):
+ * `ambient * ambient_light` is part of it only in scenes whose effective
+ * #version is below 3.7; in 3.7 scenes only `emission` gives off light.
  * reflection_exponent and conserve_energy are not modelled (the exponent is
  * non-linear in the reflected radiance); interior fade (absorption) neither,
  * as in shade.c. The weights need not sum to 1 (POV-Ray finishes are not
