@@ -9,9 +9,12 @@
  * or its own files (+D, -D, +P, +V, +J...) are accepted and ignored. */
 #include "cli.h"
 #include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 static int parse_int(const char *s, int *out)
 {
@@ -136,14 +139,19 @@ static int has_value(const char *opt, const char *next, char *err, int errlen)
     return 0;
 }
 
+/* WxH, each a positive integer; how large an image may be is checked later
+ * (main.c: check_image_size), which says why a size is refused. */
 static int parse_size(const char *v, cli_render *o)
 {
-    int w, h;
-    char x;
-    if (sscanf(v, "%d%c%d", &w, &x, &h) != 3 || (x != 'x' && x != 'X') || w <= 0 || h <= 0 || w > 65536 || h > 65536)
-        return 0;
-    o->width = w;
-    o->height = h;
+    char *end;
+    errno = 0;
+    long w = strtol(v, &end, 10);
+    if (errno || end == v || (*end != 'x' && *end != 'X') || w <= 0 || w > 2147483647L) return 0;
+    const char *hv = end + 1;
+    long h = strtol(hv, &end, 10);
+    if (errno || end == hv || *end || h <= 0 || h > 2147483647L) return 0;
+    o->width = (int)w;
+    o->height = (int)h;
     return 1;
 }
 
@@ -351,3 +359,161 @@ int cli_animation(const cli_render *o, sdl_options *so, char *err, int errlen)
     }
     return 0;
 }
+
+const char cli_exit_codes[] =
+    "Exit codes (every command):\n"
+    "  0    done\n"
+    "  1    scene error: the scene's text, or a file it names (include, image, font,\n"
+    "       data file), is wrong or missing (file:line:col: error: ...)\n"
+    "  2    usage: a bad command line (nothing was read or written)\n"
+    "  3    I/O: the scene file named on the command line cannot be read, or an\n"
+    "       output cannot be written (checked before the scene is parsed)\n"
+    "  130  interrupted (Ctrl-C); 143 terminated (SIGTERM): what was rendered is\n"
+    "       kept as NAME.partial.EXT\n";
+
+int cli_exit_status(pt_status st)
+{
+    switch (st) {
+    case PT_OK: return CLI_EXIT_OK;
+    case PT_ERR_IO: return CLI_EXIT_IO;
+    case PT_ERR_USAGE: return CLI_EXIT_USAGE;
+    default: return CLI_EXIT_SCENE;
+    }
+}
+
+int cli_wants_help(int argc, char **argv)
+{
+    for (int i = 0; i < argc; i++)
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) return 1;
+    return 0;
+}
+
+int cli_check_output(const char *path, char *err, int errlen)
+{
+    struct stat st;
+    if (!path || !*path) {
+        snprintf(err, (size_t)errlen, "an output name is empty");
+        return CLI_EXIT_IO;
+    }
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+        snprintf(err, (size_t)errlen, "cannot write '%s': it is a directory", path);
+        return CLI_EXIT_IO;
+    }
+    size_t n = strlen(path);
+    char *dir = malloc(n + 2);
+    if (!dir) {
+        snprintf(err, (size_t)errlen, "out of memory");
+        return CLI_EXIT_IO;
+    }
+    const char *slash = strrchr(path, '/');
+    if (!slash) {
+        strcpy(dir, ".");
+    } else if (slash == path) {
+        strcpy(dir, "/");
+    } else {
+        memcpy(dir, path, (size_t)(slash - path));
+        dir[slash - path] = 0;
+    }
+    int rc = 0;
+    if (stat(dir, &st) != 0) {
+        snprintf(err, (size_t)errlen, "cannot write '%s': directory '%s' %s", path, dir,
+                 errno == ENOENT ? "does not exist" : strerror(errno));
+        rc = CLI_EXIT_IO;
+    } else if (!S_ISDIR(st.st_mode)) {
+        snprintf(err, (size_t)errlen, "cannot write '%s': '%s' is not a directory", path, dir);
+        rc = CLI_EXIT_IO;
+    } else {
+        /* The writers create a temporary file in this directory and rename
+         * it (io/img_io.h): probe exactly that, rather than trust access(2)
+         * (read-only mounts, ACLs, root). */
+        size_t pn = strlen(dir) + 64;
+        char *probe = malloc(pn);
+        int fd = -1;
+        if (probe) {
+            snprintf(probe, pn, "%s/.partray-probe-%ld", dir, (long)getpid());
+            fd = open(probe, O_WRONLY | O_CREAT | O_EXCL, 0600);
+        }
+        if (fd < 0) {
+            snprintf(err, (size_t)errlen, "cannot write '%s': cannot create a file in '%s': %s", path, dir,
+                     probe ? strerror(errno) : "out of memory");
+            rc = CLI_EXIT_IO;
+        } else {
+            close(fd);
+            unlink(probe);
+        }
+        free(probe);
+    }
+    free(dir);
+    return rc;
+}
+
+const char cli_parse_help[] =
+    "usage: partray parse SCENE.pov [options]\n"
+    "Parses the scene and prints a summary (objects, lights, triangles, what is not\n"
+    "modelled) or the first error with its location and include/macro chain.\n"
+    "  -D NAME=VALUE                 declare NAME before the scene is read (POV-Ray's Declare=)\n"
+    "  -L DIR, +LDIR                 add DIR to the include path\n"
+    "  --clock V, +KV                the clock of a still\n"
+    "  +KFIn +KFFn +KIv +KFv +KC     an animation's frames and clocks; --frame N (+SFn +EFn) picks one\n"
+    "  --max-loop N --max-include-depth N --max-macro-depth N --max-tokens N\n"
+    "  --max-memory MIB --max-string BYTES --max-array N --max-image-pixels N\n"
+    "                                the parser's limits (README: Reliability)\n"
+    "  -q, --quiet                   errors only\n";
+
+const char cli_render_help[] =
+    "usage: partray render SCENE.pov [options]      (also: partray SCENE.pov +W640 +H480 ...)\n"
+    "Renders SCENE.pov. Without -o (or +O) it writes SCENE.png in the current directory;\n"
+    "without a size, 320x240 (POV-Ray's default). Both are stated when used.\n"
+    "\n"
+    "Output\n"
+    "  -o OUT, +OOUT          output file, .exr (scene-linear), .png (sRGB or an OCIO view),\n"
+    "                         .pfm (linear float); repeat for several outputs of one render.\n"
+    "                         +O without an extension takes the +F type's (POV-Ray)\n"
+    "  +FN[16] +FE +FP        output type of +O: PNG (16 bits), OpenEXR, PFM\n"
+    "  +UA                    alpha: background pixels transparent (PNG RGBA, EXR A)\n"
+    "  --float                32-bit EXR (default half)\n"
+    "  --exr-compression none|zip|piz    --png16   16-bit PNG\n"
+    "  --stats FILE.json      stage times, ray counts, what was built\n"
+    "\n"
+    "Image\n"
+    "  --size WxH, +Wn +Hn    image size (at most 65536 a side, 2^28 pixels)\n"
+    "  +A[t], -A              adaptive antialiasing, threshold t (default 0.3); +Rn its depth (1-9)\n"
+    "  +Qn                    POV-Ray's quality level 0-11 (default 9; see the user guide)\n"
+    "  --spp N                samples per pixel (fixed supersampling; path/pmfg: per pixel)\n"
+    "  --seed N               random seed (renders are repeatable for a seed)\n"
+    "  --threads N, +WTn      worker threads (default: every CPU)\n"
+    "\n"
+    "Global illumination\n"
+    "  --gi MODE              none (direct light + Whitted, POV-Ray's model), particle,\n"
+    "                         path (path tracer), pmfg (photon map + final gather);\n"
+    "                         default: particle when the scene has radiosity{}, else none\n"
+    "  --particles N --nb N   particle: particles, bounces\n"
+    "  --cl-device NAME --cl-max-memory MIB    particle: OpenCL device and its memory\n"
+    "  --max-depth N          path: vertices per path\n"
+    "  --fg-rays N --photons N    pmfg: final-gather rays per pixel, photon paths\n"
+    "\n"
+    "Colour and light (docs/colour.md, docs/units.md)\n"
+    "  --display NAME --view NAME --look NAME --exposure STOPS --working-space NAME\n"
+    "  --ocio-config FILE     OCIO display/view for PNG (default: the shipped config)\n"
+    "  --false-color OUT.png  false-colour image of luminance or illuminance\n"
+    "  --false-color-range LO,HI   --false-color-quantity luminance|illuminance\n"
+    "  --aovs LIST            EXR layers: direct,indirect,albedo,normal,depth,illuminance\n"
+    "  --units m|cm|mm|ft|METRES  scene units: lights in photometric units\n"
+    "\n"
+    "Scene\n"
+    "  -D NAME=VALUE          declare NAME before the scene is read\n"
+    "  -L DIR, +LDIR          include path (POV-Ray's include directory is on it)\n"
+    "  +IFILE                 the scene file\n"
+    "  --clock V, +KV         clock of a still; +KFIn +KFFn +KIv +KFv +KC an animation,\n"
+    "  --frame N, +SFn +EFn   one frame of it per run\n"
+    "  --max-loop N --max-include-depth N --max-macro-depth N --max-tokens N --max-memory MIB\n"
+    "  --max-string BYTES --max-array N --max-image-pixels N    limits (README: Reliability)\n"
+    "\n"
+    "Messages\n"
+    "  -q, --quiet            no progress and no summary: errors only\n"
+    "  A progress bar per stage (parse, accel, GI stages, render) is redrawn on a\n"
+    "  terminal; elsewhere a plain line every few seconds. The scene's #debug and\n"
+    "  #warning text appears as the parse produces it.\n"
+    "  POV-Ray switches about its own display and files (+D -D +P +V +X +GA ...) are\n"
+    "  accepted and ignored.\n"
+    "\n";

@@ -7,6 +7,34 @@
 
 #define CLI_MAX_LIST 64
 
+/* Exit codes of every partray command: the one list (README's "Exit codes"
+ * and `partray --help` print cli_exit_codes). A file the scene names
+ * (include, image, font, data file) that cannot be read is a scene error
+ * (1) like any other; 3 is for the files the command line names: the scene
+ * file itself, outputs, stats. */
+enum {
+    CLI_EXIT_OK = 0,
+    CLI_EXIT_SCENE = 1,
+    CLI_EXIT_USAGE = 2,
+    CLI_EXIT_IO = 3,
+    CLI_EXIT_INTERRUPTED = 130, /* 128 + SIGINT */
+    CLI_EXIT_TERMINATED = 143   /* 128 + SIGTERM */
+};
+extern const char cli_exit_codes[];
+/* The exit code for a status: PT_OK 0, PT_ERR_IO 3, PT_ERR_USAGE 2, else 1. */
+int cli_exit_status(pt_status st);
+/* 1 when argv holds --help or -h (a command then prints its help on stdout
+ * and exits 0, whatever else is on the line). */
+int cli_wants_help(int argc, char **argv);
+/* Whether `path` can be written, checked before any work is done: its
+ * directory exists and takes a new file (a probe file is created there and
+ * removed), and the path is not a directory. Returns 0, or writes why into
+ * err and returns CLI_EXIT_IO. */
+int cli_check_output(const char *path, char *err, int errlen);
+/* Help texts: `partray render --help`, `partray parse --help`. */
+extern const char cli_render_help[];
+extern const char cli_parse_help[];
+
 typedef struct {
     const char *scene;
     const char *outputs[8];

@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "cli.h"
 #include "diag.h"
 #include "framebuffer.h"
 #include "img_io.h"
@@ -38,12 +39,26 @@ static void encode_srgb(framebuffer *fb)
     }
 }
 
-static int exit_for(pt_status st) { return st == PT_ERR_IO ? 3 : (st == PT_ERR_USAGE ? 2 : 1); }
+static const char compare_help[] =
+    "usage: partray compare REF TEST [--heatmap OUT.png|.exr|.pfm] [--json] [--ldr|--hdr]\n"
+    "Compares TEST with REF (same size; EXR, PNG or PFM): RMSE, relMSE, PSNR, SSIM,\n"
+    "FLIP (mean and weighted median) and mean luminance of each.\n"
+    "  --heatmap OUT   FLIP's per-pixel error as an image\n"
+    "  --json          the figures as JSON on stdout\n"
+    "  --ldr, --hdr    compare as display-referred (sRGB) or scene-linear values\n"
+    "                  (default: LDR when both are PNG, else HDR)\n";
+
+static int exit_for(pt_status st) { return cli_exit_status(st); }
 
 int cmd_compare(int argc, char **argv)
 {
     const char *ref_path = NULL, *test_path = NULL, *heatmap = NULL;
     int json = 0, force = -1; /* -1 auto, 0 ldr, 1 hdr */
+    if (cli_wants_help(argc, argv)) {
+        fputs(compare_help, stdout);
+        fputs(cli_exit_codes, stdout);
+        return CLI_EXIT_OK;
+    }
     for (int i = 0; i < argc; i++) {
         if (strcmp(argv[i], "--json") == 0) json = 1;
         else if (strcmp(argv[i], "--ldr") == 0) force = 0;
@@ -66,6 +81,11 @@ int cmd_compare(int argc, char **argv)
     if (heatmap && img_format_from_path(heatmap) == IMG_FMT_UNKNOWN) {
         fprintf(stderr, "partray compare: heat map '%s': unknown format (use .png, .exr or .pfm)\n", heatmap);
         return 2;
+    }
+    char werr[512];
+    if (heatmap && cli_check_output(heatmap, werr, sizeof werr)) {
+        fprintf(stderr, "partray compare: %s\n", werr);
+        return CLI_EXIT_IO;
     }
     int both_png = img_format_from_path(ref_path) == IMG_FMT_PNG && img_format_from_path(test_path) == IMG_FMT_PNG;
     int hdr = force >= 0 ? force : !both_png;

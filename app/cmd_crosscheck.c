@@ -35,6 +35,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include "cli.h"
 #include "diag.h"
 #include "framebuffer.h"
 #include "img_io.h"
@@ -254,6 +255,13 @@ static void on_stop(int sig)
 int cmd_crosscheck(int argc, char **argv)
 {
     xc_opts o;
+    if (cli_wants_help(argc, argv)) {
+        fputs(usage, stdout);
+        fputs("Renders SCENE.pov with partray and with POV-Ray 3.7 at the same size and\n"
+              "antialiasing, and compares the two (docs/measuring.md).\n", stdout);
+        fputs(cli_exit_codes, stdout);
+        return CLI_EXIT_OK;
+    }
     if (!parse_args(argc, argv, &o)) {
         fputs(usage, stderr);
         return 2;

@@ -47,6 +47,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include "cli.h"
 #include "diag.h"
 #include "framebuffer.h"
 #include "img_io.h"
@@ -148,7 +149,7 @@ static void print_diags(const diag *d, int *printed)
     *printed = diag_count(d);
 }
 
-static int exit_for(pt_status st) { return st == PT_ERR_IO ? 3 : (st == PT_ERR_USAGE ? 2 : 1); }
+static int exit_for(pt_status st) { return cli_exit_status(st); }
 
 static int parse_wxh(const char *v, int *w, int *h)
 {
@@ -590,6 +591,14 @@ int cmd_sweep(int argc, char **argv)
     diag *d = diag_new();
     int printed = 0;
 
+    if (cli_wants_help(argc, argv)) {
+        fputs(usage, stdout);
+        fputs("Writes DIR/sweep.csv, DIR/plot.png (metric against time, one curve per mode)\n"
+              "and DIR/index.html; docs/measuring.md describes them.\n", stdout);
+        fputs(cli_exit_codes, stdout);
+        diag_free(d);
+        return CLI_EXIT_OK;
+    }
     if (argc < 1 || argv[0][0] == '-' || argv[0][0] == '+') {
         fprintf(stderr, "partray sweep: the scene file comes first\n%s", usage);
         rc = 2;

@@ -1,5 +1,5 @@
-/* main.c - the `partray` command: render, parse, compare, view.
- * Exit codes (DESIGN.md): 0 ok, 1 scene error, 2 usage, 3 I/O, 130 interrupted. */
+/* main.c - the `partray` command: render, parse, compare, sweep, crosscheck,
+ * view. Exit codes: cli.h (CLI_EXIT_*), one list for every command. */
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -32,7 +32,13 @@
 #define PARTRAY_VERSION "0.0.0"
 #endif
 
-enum { EXIT_OK = 0, EXIT_SCENE = 1, EXIT_USAGE = 2, EXIT_IO = 3, EXIT_INTERRUPTED = 130 };
+enum {
+    EXIT_OK = CLI_EXIT_OK,
+    EXIT_SCENE = CLI_EXIT_SCENE,
+    EXIT_USAGE = CLI_EXIT_USAGE,
+    EXIT_IO = CLI_EXIT_IO,
+    EXIT_INTERRUPTED = CLI_EXIT_INTERRUPTED
+};
 
 static volatile int g_cancel = 0;
 
@@ -67,9 +73,10 @@ static const char *usage_text =
     "  partray view SCENE.pov\n"
     "  partray --help | --version\n"
     "\n"
+    "\n"
     "GI modes: none (direct light + Whitted), particle, pmfg, path.\n"
     "Without --gi a scene with radiosity{} asks for particle GI, otherwise none.\n"
-    "Exit codes: 0 ok, 1 scene error, 2 usage, 3 I/O, 130 interrupted (143 terminated).\n";
+    "`partray COMMAND --help` lists a command's options; docs/guide.md is the user guide.\n";
 
 /* Print every message in d to stderr; returns the number of errors. */
 static int print_diags(const diag *d, int quiet)
@@ -86,13 +93,16 @@ static int print_diags(const diag *d, int quiet)
     return diag_errors(d);
 }
 
-static int status_exit(pt_status st)
+static int status_exit(pt_status st) { return cli_exit_status(st); }
+
+/* POV-Ray warns about a scene without objects and renders its background
+ * (POV-Ray 3.7 source, parser.cpp: "No objects in scene."); so does this. */
+static void warn_if_empty(const scene *sc, diag *d)
 {
-    switch (st) {
-    case PT_OK: return EXIT_OK;
-    case PT_ERR_IO: return EXIT_IO;
-    case PT_ERR_USAGE: return EXIT_USAGE;
-    default: return EXIT_SCENE;
+    scene_counts c = scene_count(sc);
+    if (c.objects == 0) {
+        src_loc none = {NULL, 0, 0};
+        diag_report(d, DIAG_WARNING, none, NULL, "no objects in scene: the image shows only the background");
     }
 }
 
@@ -149,10 +159,14 @@ static int check_image_size(int w, int h, unsigned long long limit)
 
 static int cmd_parse(int argc, char **argv)
 {
+    if (cli_wants_help(argc, argv)) {
+        fputs(cli_parse_help, stdout);
+        return EXIT_OK;
+    }
     cli_render o;
     char err[512];
     if (cli_parse_render(argc, argv, &o, err, sizeof err)) {
-        fprintf(stderr, "partray parse: %s\n%s", err, usage_text);
+        fprintf(stderr, "partray parse: %s\n%s", err, cli_parse_help);
         return EXIT_USAGE;
     }
     sdl_options so;
@@ -162,7 +176,8 @@ static int cmd_parse(int argc, char **argv)
     double t0 = timer_now();
     pt_status st = sdl_parse_file(o.scene, &so, &sc, d);
     double t1 = timer_now();
-    print_diags(d, 0);
+    if (st == PT_OK) warn_if_empty(sc, d);
+    print_diags(d, o.quiet);
     if (st != PT_OK) {
         diag_free(d);
         return status_exit(st);
@@ -235,10 +250,15 @@ static int write_false_color(const cli_render *o, const framebuffer *fb, const l
 static int cmd_render(int argc, char **argv)
 {
     double t_start = timer_now();
+    if (cli_wants_help(argc, argv)) {
+        fputs(cli_render_help, stdout);
+        fputs(cli_exit_codes, stdout);
+        return EXIT_OK;
+    }
     cli_render o;
     char err[512];
     if (cli_parse_render(argc, argv, &o, err, sizeof err)) {
-        fprintf(stderr, "partray render: %s\n%s", err, usage_text);
+        fprintf(stderr, "partray render: %s\n(partray render --help lists the options)\n", err);
         return EXIT_USAGE;
     }
     for (int i = 0; i < o.noutputs; i++) {
@@ -287,6 +307,29 @@ static int cmd_render(int argc, char **argv)
         default_out = default_output(o.scene);
         o.outputs[o.noutputs++] = default_out;
     }
+    /* Fail fast: every file this render will write is checked before the
+     * scene is read, so a long render is never lost to a typo. */
+    const char *writes[12];
+    int nwrites = 0;
+    for (int i = 0; i < o.noutputs; i++) writes[nwrites++] = o.outputs[i];
+    if (o.stats) writes[nwrites++] = o.stats;
+    if (o.false_color) writes[nwrites++] = o.false_color;
+    for (int i = 0; i < nwrites; i++) {
+        int wrc = cli_check_output(writes[i], err, sizeof err);
+        if (wrc) {
+            fprintf(stderr, "partray render: %s\n", err);
+            free(default_out);
+            img_ocio_close(oc);
+            lighting_free(&ls);
+            return wrc;
+        }
+    }
+    if (!o.quiet && default_out) fprintf(stderr, "partray: no output given (-o or +O): writing %s\n", default_out);
+    if (!o.quiet && (o.width <= 0 || o.height <= 0))
+        fprintf(stderr, "partray: %s (--size WxH or +W +H): %dx%d%s\n",
+                o.width <= 0 && o.height <= 0 ? "no size given" : (o.width <= 0 ? "no width given" : "no height given"),
+                o.width > 0 ? o.width : 320, o.height > 0 ? o.height : 240,
+                o.width <= 0 && o.height <= 0 ? ", POV-Ray's default" : " (POV-Ray's default 320x240 for the side not given)");
 
     sdl_options so;
     fill_sdl_options(&so, &o);
@@ -302,6 +345,7 @@ static int cmd_render(int argc, char **argv)
         img_ocio_close(oc);
         return status_exit(st);
     }
+    warn_if_empty(sc, d);
     lighting_apply_units(&ls, sc, d); /* photometric lights; warns about fade */
     if (!o.gi && sc->global.radiosity.enabled) gi = GI_PARTICLE;
     const char *gi_used = gi_mode_name(gi);
@@ -483,6 +527,8 @@ int main(int argc, char **argv)
     const char *cmd = argv[1];
     if (strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0 || strcmp(cmd, "help") == 0) {
         fputs(usage_text, stdout);
+        fputs("\n", stdout);
+        fputs(cli_exit_codes, stdout);
         return EXIT_OK;
     }
     if (strcmp(cmd, "--version") == 0) {

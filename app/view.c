@@ -24,7 +24,7 @@
 #include "view_render.h"
 #include "view_script.h"
 
-enum { EXIT_OK = 0, EXIT_SCENE = 1, EXIT_USAGE = 2, EXIT_IO = 3 };
+enum { EXIT_OK = CLI_EXIT_OK, EXIT_SCENE = CLI_EXIT_SCENE, EXIT_USAGE = CLI_EXIT_USAGE, EXIT_IO = CLI_EXIT_IO };
 
 #define MAX_LATENCIES 4096
 
@@ -136,15 +136,7 @@ static void flush_messages(viewer *v)
     diag_free(d);
 }
 
-static int status_exit(pt_status st)
-{
-    switch (st) {
-    case PT_OK: return EXIT_OK;
-    case PT_ERR_IO: return EXIT_IO;
-    case PT_ERR_USAGE: return EXIT_USAGE;
-    default: return EXIT_SCENE;
-    }
-}
+static int status_exit(pt_status st) { return cli_exit_status(st); }
 
 /* "dir/cbox.pov" -> "cbox" */
 static void scene_stem(const char *path, char *out, size_t n)

@@ -63,8 +63,9 @@ int sdl_set_frame(sdl_options *o, int initial_frame, int final_frame, double ini
 
 /* Parse a file. On success *out holds a new scene (caller frees with
  * scene_free). On error, messages with locations and the include/macro chain
- * are in `d`, *out is NULL and the status says why (PT_ERR_SYNTAX, PT_ERR_IO,
- * PT_ERR_LIMIT...). Warnings (e.g. unsupported features) go to `d` too. */
+ * are in `d`, *out is NULL and the status says why (PT_ERR_SYNTAX, PT_ERR_LIMIT...;
+ * PT_ERR_IO only when the scene file itself cannot be read: a file the scene
+ * names that is missing is PT_ERR_SYNTAX, a scene error). Warnings (e.g. unsupported features) go to `d` too. */
 pt_status sdl_parse_file(const char *path, const sdl_options *opt, scene **out, diag *d);
 /* Same, from a string in memory; `name` is used in locations. */
 pt_status sdl_parse_string(const char *name, const char *text, const sdl_options *opt, scene **out, diag *d);

@@ -16,6 +16,11 @@
 void sdl_error(sdl_parser *p, src_loc loc, pt_status st, const char *fmt, ...)
 {
     if (!sdl_ok(p)) return;
+    /* A file the scene's text names (include, image, font, density or user
+     * file: reported at the line naming it) that cannot be read is a scene
+     * error like any other; PT_ERR_IO is kept for the scene file itself
+     * (no line), so the command exits 1 or 3 as cli.h's list says. */
+    if (st == PT_ERR_IO && loc.line > 0) st = PT_ERR_SYNTAX;
     p->status = st;
     char *chain = sdl_chain(p);
     va_list ap;

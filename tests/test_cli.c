@@ -93,6 +93,106 @@ static void test_usage(void **st)
     assert_non_null(strstr(tu_out, "partray render"));
 }
 
+/* Every command answers --help (or -h) with its own options on stdout,
+ * exit 0, whatever else is on the line; `partray --help` and `render
+ * --help` list the exit codes. */
+static void test_help(void **st)
+{
+    (void)st;
+    struct { const char *cmd, *option; } c[] = {
+        {"render", "--gi MODE"}, {"parse", "--max-loop"}, {"compare", "--heatmap"}, {"sweep", "--vary"},
+        {"crosscheck", "--povray"}, {"view", "--script"},
+    };
+    char cmd[1024];
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+        snprintf(cmd, sizeof cmd, "'%s' %s --help 2>/dev/null", PARTRAY_BIN, c[i].cmd);
+        assert_int_equal(tu_run_stdout(cmd), 0);
+        if (!strstr(tu_out, c[i].option)) fail_msg("%s --help lacks %s:\n%s", c[i].cmd, c[i].option, tu_out);
+        snprintf(cmd, sizeof cmd, "'%s' %s some.pov -h 2>/dev/null", PARTRAY_BIN, c[i].cmd);
+        assert_int_equal(tu_run_stdout(cmd), 0);
+        assert_non_null(strstr(tu_out, c[i].option));
+    }
+    snprintf(cmd, sizeof cmd, "'%s' --help", PARTRAY_BIN);
+    assert_int_equal(tu_run_stdout(cmd), 0);
+    assert_non_null(strstr(tu_out, "130  interrupted"));
+    snprintf(cmd, sizeof cmd, "'%s' render --help", PARTRAY_BIN);
+    assert_int_equal(tu_run_stdout(cmd), 0);
+    assert_non_null(strstr(tu_out, "3    I/O"));
+}
+
+/* Exit codes as cli.h lists them: a missing include is a scene error (1)
+ * like a syntax error; a missing output directory is I/O (3) and is found
+ * before the scene is parsed (the scene here is broken too: 3 wins, and no
+ * parse error is printed); a size too large says why (2). */
+static void test_exit_codes(void **st)
+{
+    (void)st;
+    char needle[600];
+    snprintf(needle, sizeof needle, "%s/bad.pov:2:1: error: cannot find include file \"no_such.inc\"", tmpdir);
+    expect_failure("// a scene\n#include \"no_such.inc\"\n", 1, needle);
+
+    char scene[512], cmd[2048];
+    snprintf(scene, sizeof scene, "%s/broken.pov", tmpdir);
+    tu_write_file(scene, "sphere { 0, 1 \n");
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' -o '%s/no_dir/x.png' --size 8x8", PARTRAY_BIN, scene, tmpdir);
+    assert_int_equal(tu_run_capture(cmd), 3);
+    assert_non_null(strstr(tu_out, "no_dir' does not exist"));
+    assert_null(strstr(tu_out, "error:")); /* the scene was never read */
+    /* the same for --stats and a path that is a directory */
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' -o '%s/x.png' --stats '%s/no_dir/s.json' --size 8x8", PARTRAY_BIN, scene,
+             tmpdir, tmpdir);
+    assert_int_equal(tu_run_capture(cmd), 3);
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s/dir.png' && '%s' render '%s' -o '%s/dir.png' --size 8x8", tmpdir, PARTRAY_BIN,
+             scene, tmpdir);
+    assert_int_equal(tu_run_capture(cmd), 3);
+    assert_non_null(strstr(tu_out, "is a directory"));
+
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 100000x100000", PARTRAY_BIN, scene);
+    assert_int_equal(tu_run_capture(cmd), 2);
+    assert_non_null(strstr(tu_out, "image size 100000x100000: a side is larger than 65536 pixels"));
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 30000x30000", PARTRAY_BIN, scene);
+    assert_int_equal(tu_run_capture(cmd), 2);
+    assert_non_null(strstr(tu_out, "900000000 pixels, more than the 268435456 an image may have"));
+}
+
+/* A scene without objects warns, as POV-Ray does, and renders its
+ * background: every pixel is the background colour (0.25 0.5 0.75 linear,
+ * PFM). Without -o and a size, the default name and size are stated and
+ * used: SCENE.png, 320x240, in the current directory. */
+static void test_empty_scene_and_defaults(void **st)
+{
+    (void)st;
+    char scene[512], cmd[2048], out[512];
+    snprintf(scene, sizeof scene, "%s/empty.pov", tmpdir);
+    tu_write_file(scene, "global_settings { assumed_gamma 1 }\ncamera { location -5*z look_at 0 }\n"
+                         "light_source { <0, 5, -5> rgb 1 }\nbackground { rgb <0.25, 0.5, 0.75> }\n");
+    snprintf(out, sizeof out, "%s/empty.pfm", tmpdir);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' -o '%s' --size 8x6", PARTRAY_BIN, scene, out);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    assert_non_null(strstr(tu_out, "warning: no objects in scene"));
+    framebuffer *fb = NULL;
+    assert_int_equal(img_read(out, 0, &fb, NULL), PT_OK);
+    for (int y = 0; y < fb->height; y++)
+        for (int x = 0; x < fb->width; x++) {
+            const float *p = fb_px(fb, x, y);
+            assert_true(fabs(p[0] - 0.25) < 1e-6 && fabs(p[1] - 0.5) < 1e-6 && fabs(p[2] - 0.75) < 1e-6);
+        }
+    fb_free(fb);
+    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' parse empty.pov", tmpdir, PARTRAY_BIN);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    assert_non_null(strstr(tu_out, "warning: no objects in scene"));
+
+    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' render empty.pov", tmpdir, PARTRAY_BIN);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    assert_non_null(strstr(tu_out, "no output given (-o or +O): writing empty.png"));
+    assert_non_null(strstr(tu_out, "no size given (--size WxH or +W +H): 320x240"));
+    snprintf(out, sizeof out, "%s/empty.png", tmpdir);
+    assert_int_equal(img_read(out, 0, &fb, NULL), PT_OK);
+    assert_int_equal(fb->width, 320);
+    assert_int_equal(fb->height, 240);
+    fb_free(fb);
+}
+
 /* --clock, +K and the animation switches: the predeclared identifiers as
  * POV-Ray 3.7.0 gives them (each expected pair printed by
  * `povray +Ik.pov -F -D +W8 +H6 OPTIONS` with the same scene). */
@@ -280,6 +380,9 @@ int main(void)
         cmocka_unit_test(test_unterminated_block),
         cmocka_unit_test(test_include_chain),
         cmocka_unit_test(test_usage),
+        cmocka_unit_test(test_help),
+        cmocka_unit_test(test_exit_codes),
+        cmocka_unit_test(test_empty_scene_and_defaults),
         cmocka_unit_test(test_animation),
         cmocka_unit_test(test_mesh_camera),
         cmocka_unit_test(test_render_outputs_and_stats),

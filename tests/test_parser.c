@@ -854,7 +854,7 @@ static void test_error_files(void **st)
     /* missing include file */
     d = diag_new();
     snprintf(path, sizeof path, "%s/missing.pov", tmpdir);
-    assert_int_equal(sdl_parse_file(path, NULL, &s, d), PT_ERR_IO);
+    assert_int_equal(sdl_parse_file(path, NULL, &s, d), PT_ERR_SYNTAX); /* a scene error: exit 1 */
     assert_null(s);
     m = diag_get(d, 0);
     assert_int_equal(m->loc.line, 2);
@@ -884,7 +884,7 @@ static void test_error_files(void **st)
     diag_free(d);
     /* no default library: colors.inc is not found */
     d = diag_new();
-    assert_int_equal(sdl_parse_string("x.pov", "#include \"colors.inc\"", &o, &s, d), PT_ERR_IO);
+    assert_int_equal(sdl_parse_string("x.pov", "#include \"colors.inc\"", &o, &s, d), PT_ERR_SYNTAX);
     diag_free(d);
     /* include depth limit */
     write_file("self.inc", "#include \"self.inc\"\n");

@@ -330,8 +330,8 @@ static void test_read_image_limit(void **st)
     write_image("hf16.png", 16, 16, png, sizeof png);
     snprintf(text, sizeof text, "%slight_source { <0, 5, -5> rgb 1 }\nheight_field { png \"hf16.png\" }\n", camera);
     assert_int_equal(render("hf.pov", text, "--max-image-pixels 256"), 0);
-    /* exit 3: the scene is fine, a file it reads is not (as a missing one) */
-    expect("hf.pov", text, "--max-image-pixels 255", 3,
+    /* exit 1: a file the scene reads is refused, a scene error like a missing one */
+    expect("hf.pov", text, "--max-image-pixels 255", 1,
            "hf.pov:3:1: error: height_field image 'hf16.png': image size 16x16 exceeds the limit (65536 per side, 255 pixels in all)");
 }
 
