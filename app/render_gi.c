@@ -15,6 +15,7 @@
 #include "pm_fg.h"
 #include "pm_path.h"
 #include "radrules.h"
+#include "shade_atmos.h"
 #include "shade_texture.h"
 #include "timer.h"
 
@@ -63,6 +64,7 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     gi_particle_settings gs;
     gi_particle_settings_from_scene(&gs, sc);
     gs.pigment = tex_pigment_at; /* particles reflect the pigment where they are */
+    gs.sky = atmos_sky; /* what escaping rays see (shade_atmos.h) */
     if (o->particles > 0) gs.count = o->particles;
     if (o->bounces > 0) gs.bounces = o->bounces;
     gs.seed = o->seed;

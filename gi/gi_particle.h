@@ -79,6 +79,12 @@ typedef struct gi_particle gi_particle;
  * was found. */
 typedef int (*gi_pigment_fn)(const scene *sc, const scene_texture *tex, const accel_hit *h, colour5 *out);
 
+/* Radiance arriving from the sky along unit direction -dir for a ray that
+ * leaves the scene along dir: sky_sphere pigments over the background
+ * (POV-Ray's rule for gathering rays, core/radrules.h rule 4). The
+ * signature of shade_atmos.h's atmos_sky, which the app passes. */
+typedef rgb (*gi_sky_fn)(const scene *sc, vec3 dir);
+
 /* How flux is scattered after emission (gi_lighting.cl; every bounce a
  * gather, no atomics, deterministic):
  *  WALK  the paper's (section 4.2.2, Fig. 5): the first bounce along all
@@ -137,6 +143,7 @@ typedef struct {
                               particles, lists of a chunk of radiance particles): gi_particle_build then returns
                               NULL with PT_CANCELLED. NULL (the default): never. */
     gi_pigment_fn pigment; /* particles' pigment at their position; NULL: each texture's base colour */
+    gi_sky_fn sky;         /* radiance of rays leaving the scene; NULL: the background colour */
 } gi_particle_settings;
 
 typedef struct {

@@ -19,6 +19,7 @@
  *    BOUND_HUGE). Shadow rays of lights with media_attenuation on are
  *    dimmed by the attenuation part (POV-Ray's ComputeShadowMedia). */
 #include "shade_atmos.h"
+#include "radrules.h"
 #include <math.h>
 #include "shade_noise.h"
 #include "shade_pattern.h"
@@ -60,7 +61,7 @@ rgb atmos_sky(const scene *sc, vec3 dir)
 {
     rgb col = {0, 0, 0}, fil = {1, 1, 1};
     const scene_sky_sphere *sky = sc->sky_sphere;
-    if (sky && sky->npigments > 0 && sc->version_major > 0 && sc->version_major + sc->version_minor / 10.0 < 3.65)
+    if (sky && sky->npigments > 0 && radrules_legacy(sc))
         return sky_legacy(sc, sky, dir);
     if (sky && sky->npigments > 0) {
         vec3 p = xform_inv_point(&sky->transform, dir);
