@@ -6,9 +6,9 @@
  *     objects that cast shadows, one for no_shadow objects. A per-primitive
  *     table leads back to the leaf object and the triangle index within it.
  *   - one user geometry (RTC_GEOMETRY_TYPE_USER) whose primitives are the
- *     analytic shapes (accel_shapes.c), intersected exactly in double
+ *     analytic shapes (geom_shape.c), intersected exactly in double
  *     precision, followed by one primitive per CSG intersection, difference
- *     or merge (accel_csg.c; unions are flattened, and a CSG with a mesh
+ *     or merge (geom_csg.c; unions are flattened, and a CSG with a mesh
  *     member falls back to a union with a warning).
  *   - one instance geometry per object that references a shared mesh: a mesh
  *     used by more than one object is built once as its own RTCScene in
@@ -57,8 +57,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "accel_csg.h"
-#include "accel_shapes.h"
+#include "geom_csg.h"
+#include "geom_shape.h"
 #include "timer.h"
 
 #define PLANE_EXTENT_FACTOR 1e4
@@ -114,12 +114,12 @@ struct accel {
     accel_leaf *leaves;
     int nleaves, capleaves;
     tri_batch tri[2]; /* 0: casts shadows, 1: no_shadow */
-    accel_shape *shapes;
+    geom_shape *shapes;
     unsigned *shape_leaf;
     int nshapes, capshapes;
     mesh_group *groups;
     int ngroups;
-    accel_csg *csgs;              /* user primitives nshapes .. nshapes + ncsgs - 1 */
+    geom_csg *csgs;              /* user primitives nshapes .. nshapes + ncsgs - 1 */
     int ncsgs, capcsgs;
     float *ubox;                  /* 6 floats per user primitive: its box as user_bounds gives it */
     geom_info *ginfo;
@@ -129,7 +129,7 @@ struct accel {
     double eps_scale;  /* working scale of the epsilon rule (see the top) */
     double *diags;     /* leaf bounding-box diagonals, during the build */
     int ndiags, capdiags;
-    accel_shape *bshapes;         /* bounding objects (bounded_by), world space */
+    geom_shape *bshapes;         /* bounding objects (bounded_by), world space */
     int nbshapes, capbshapes;
     int *csg_b0, *csg_bn;         /* per CSG primitive, as accel_leaf.b0/bn */
     const bound_chain *cur_chain; /* during collect(): the bounds above the current object */
@@ -299,10 +299,10 @@ static int keeps_bound(const scene_object *o, int top)
     case SHAPE_POLY: case SHAPE_TEXT:
         return 1;
     case SHAPE_QUADRIC: {
-        accel_shape sh;
-        if (accel_shape_init(&sh, o) != 0) return 0;
+        geom_shape sh;
+        if (geom_shape_init(&sh, o) != 0) return 0;
         int inf = sh.infinite;
-        accel_shape_release(&sh);
+        geom_shape_release(&sh);
         return inf;
     }
     default:
@@ -314,7 +314,7 @@ static int push_bshape(accel *a)
 {
     if (a->nbshapes < a->capbshapes) return 1;
     size_t cap = (size_t)a->capbshapes;
-    if (!grow((void **)&a->bshapes, &cap, (size_t)a->nbshapes + 1, sizeof(accel_shape))) return 0;
+    if (!grow((void **)&a->bshapes, &cap, (size_t)a->nbshapes + 1, sizeof(geom_shape))) return 0;
     a->capbshapes = (int)cap;
     return 1;
 }
@@ -343,27 +343,27 @@ static int add_bound_objects(accel *a, diag *d, const scene_object *host, int bo
         moved.transform = xform_then(k->transform, host->transform);
         if (!push_bshape(a)) return 0;
         if (moved.kind == SHAPE_MESH || moved.kind == SHAPE_UNSUPPORTED ||
-            accel_shape_init(&a->bshapes[a->nbshapes], &moved) != 0) {
+            geom_shape_init(&a->bshapes[a->nbshapes], &moved) != 0) {
             diag_warn_once(d, k->loc, "this bounding object is not evaluated: the bound is ignored");
             continue;
         }
-        accel_shape *b = &a->bshapes[a->nbshapes];
+        geom_shape *b = &a->bshapes[a->nbshapes];
         if (box_only) {
             if (!b->infinite && b->kind != SHAPE_PLANE && !(k->flags & OBJ_INVERSE)) {
                 blo = v3_max(blo, b->lo);
                 bhi = v3_min(bhi, b->hi);
             }
-            accel_shape_release(b);
+            geom_shape_release(b);
             continue;
         }
-        if (b->infinite) accel_shape_clip_plane(b, v3s(-INFINITY), v3s(INFINITY));
+        if (b->infinite) geom_shape_clip_plane(b, v3s(-INFINITY), v3s(INFINITY));
         a->nbshapes++;
     }
     if (box_only && v3_finite(blo) && v3_finite(bhi)) {
-        accel_shape own;
-        if (accel_shape_init(&own, host) != 0) return 1;
+        geom_shape own;
+        if (geom_shape_init(&own, host) != 0) return 1;
         double vo = own.infinite || own.kind == SHAPE_PLANE ? INFINITY : box_volume(own.lo, own.hi);
-        accel_shape_release(&own);
+        geom_shape_release(&own);
         if (!(box_volume(blo, bhi) < vo)) return 1;
         scene_object box;
         memset(&box, 0, sizeof box);
@@ -372,7 +372,7 @@ static int add_bound_objects(accel *a, diag *d, const scene_object *host, int bo
         box.u.box.c1 = blo;
         box.u.box.c2 = v3_max(blo, bhi);
         if (!push_bshape(a)) return 0;
-        if (accel_shape_init(&a->bshapes[a->nbshapes], &box) == 0) a->nbshapes++;
+        if (geom_shape_init(&a->bshapes[a->nbshapes], &box) == 0) a->nbshapes++;
     }
     return 1;
 }
@@ -394,10 +394,10 @@ static int collect_bounds(accel *a, diag *d, const scene_object *o, int own, int
 static int ray_in_bound(const accel *a, int b0, int bn, vec3 o, vec3 d, double tmin)
 {
     for (int i = 0; i < bn; i++) {
-        const accel_shape *b = &a->bshapes[b0 + i];
-        accel_shape_hit h;
-        if (accel_shape_inside(b, o)) continue;
-        if (!accel_shape_intersect(b, o, d, tmin, INFINITY, &h)) return 0;
+        const geom_shape *b = &a->bshapes[b0 + i];
+        geom_shape_hit h;
+        if (geom_shape_inside(b, o)) continue;
+        if (!geom_shape_intersect(b, o, d, tmin, INFINITY, &h)) return 0;
     }
     return 1;
 }
@@ -432,23 +432,23 @@ static int csg_leaf_count(const scene_object *o, int depth)
  * their host) is applied after the member's own transform; `nosurf` marks
  * leaves that only take part in inside tests; `clip_done` says o's own
  * clipped_by has been wrapped around it already. */
-static pt_status csg_member_ex(accel *a, diag *d, accel_csg *c, const scene_object *o, const scene_texture *ptex,
+static pt_status csg_member_ex(accel *a, diag *d, geom_csg *c, const scene_object *o, const scene_texture *ptex,
                                unsigned pflags, int parent, int depth, const xform *post, int nosurf, int clip_done);
 
-static pt_status csg_member(accel *a, diag *d, accel_csg *c, const scene_object *o, const scene_texture *ptex,
+static pt_status csg_member(accel *a, diag *d, geom_csg *c, const scene_object *o, const scene_texture *ptex,
                             unsigned pflags, int parent, int depth)
 {
     return csg_member_ex(a, d, c, o, ptex, pflags, parent, depth, NULL, 0, 0);
 }
 
-static pt_status csg_member_ex(accel *a, diag *d, accel_csg *c, const scene_object *o, const scene_texture *ptex,
+static pt_status csg_member_ex(accel *a, diag *d, geom_csg *c, const scene_object *o, const scene_texture *ptex,
                                unsigned pflags, int parent, int depth, const xform *post, int nosurf, int clip_done)
 {
     if (!o) return PT_OK;
     const scene_texture *tex = o->texture ? o->texture : ptex;
     unsigned flags = o->flags | (pflags & INHERITED_FLAGS);
     int inverse = (o->flags & OBJ_INVERSE) != 0;
-    accel_csg_op parent_op = parent >= 0 ? c->nodes[parent].op : CSG_UNION;
+    geom_csg_op parent_op = parent >= 0 ? c->nodes[parent].op : GEOM_CSG_UNION;
     if (o->clip && !clip_done) {
         /* clipped_by: an intersection of the object with its clip solids,
          * whose surfaces do not count (issue 4) */
@@ -456,7 +456,7 @@ static pt_status csg_member_ex(accel *a, diag *d, accel_csg *c, const scene_obje
             diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", MAX_CSG_DEPTH);
             return PT_ERR_LIMIT;
         }
-        int node = accel_csg_add_node(c, CSG_INTERSECTION, 0, parent);
+        int node = geom_csg_add_node(c, GEOM_CSG_INTERSECTION, 0, parent);
         if (node < 0) return PT_ERR_NOMEM;
         pt_status st = csg_member_ex(a, d, c, o, ptex, pflags, node, depth + 1, post, nosurf, 1);
         if (st != PT_OK) return st;
@@ -468,10 +468,10 @@ static pt_status csg_member_ex(accel *a, diag *d, accel_csg *c, const scene_obje
             diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", MAX_CSG_DEPTH);
             return PT_ERR_LIMIT;
         }
-        accel_csg_op op = o->kind == SHAPE_UNION ? CSG_UNION
-                        : o->kind == SHAPE_MERGE ? CSG_MERGE
-                        : o->kind == SHAPE_INTERSECTION ? CSG_INTERSECTION : CSG_DIFFERENCE;
-        int node = accel_csg_add_node(c, op, inverse, parent);
+        geom_csg_op op = o->kind == SHAPE_UNION ? GEOM_CSG_UNION
+                        : o->kind == SHAPE_MERGE ? GEOM_CSG_MERGE
+                        : o->kind == SHAPE_INTERSECTION ? GEOM_CSG_INTERSECTION : GEOM_CSG_DIFFERENCE;
+        int node = geom_csg_add_node(c, op, inverse, parent);
         if (node < 0) return PT_ERR_NOMEM;
         for (int i = 0; i < o->u.csg.nkids; i++) {
             pt_status st = csg_member_ex(a, d, c, o->u.csg.kids[i], tex, flags, node, depth + 1, post, nosurf, 0);
@@ -480,7 +480,7 @@ static pt_status csg_member_ex(accel *a, diag *d, accel_csg *c, const scene_obje
         return PT_OK;
     }
     int ok = 0;
-    accel_shape sh;
+    geom_shape sh;
     scene_object moved;
     const scene_object *src = o;
     if (post) {
@@ -494,7 +494,7 @@ static pt_status csg_member_ex(accel *a, diag *d, accel_csg *c, const scene_obje
     case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_SUPERELLIPSOID:
     case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_HEIGHT_FIELD: case SHAPE_TEXT: case SHAPE_ISOSURFACE:
     case SHAPE_JULIA: case SHAPE_OVUS:
-        ok = accel_shape_init(&sh, src) == 0;
+        ok = geom_shape_init(&sh, src) == 0;
         if (!ok)
             diag_warn_once(d, o->loc, "degenerate %s ignored (zero size, singular transform or non-finite numbers)",
                            o->name ? o->name : "shape");
@@ -508,18 +508,18 @@ static pt_status csg_member_ex(accel *a, diag *d, accel_csg *c, const scene_obje
         /* A skipped member of an intersection is left out; elsewhere it holds
          * its place as an empty set (a difference whose first member is gone
          * is empty, as in POV-Ray). */
-        if (parent_op == CSG_INTERSECTION) return PT_OK;
-        return accel_csg_add_node(c, CSG_UNION, inverse, parent) < 0 ? PT_ERR_NOMEM : PT_OK;
+        if (parent_op == GEOM_CSG_INTERSECTION) return PT_OK;
+        return geom_csg_add_node(c, GEOM_CSG_UNION, inverse, parent) < 0 ? PT_ERR_NOMEM : PT_OK;
     }
     int li = add_leaf(a, o, tex, flags);
     if (li < 0) {
-        accel_shape_release(&sh);
+        geom_shape_release(&sh);
         return PT_ERR_NOMEM;
     }
     a->leaves[li].in_csg = 1;
-    int leaf = accel_csg_add_leaf(c, &sh, (unsigned)li, inverse, parent);
+    int leaf = geom_csg_add_leaf(c, &sh, (unsigned)li, inverse, parent);
     if (leaf < 0) {
-        accel_shape_release(&sh);
+        geom_shape_release(&sh);
         return PT_ERR_NOMEM;
     }
     c->nodes[leaf].nosurf = nosurf;
@@ -533,10 +533,10 @@ static pt_status build_csg(accel *a, diag *d, const scene_object *o, const scene
 {
     if (a->ncsgs == a->capcsgs) {
         size_t cap = (size_t)a->capcsgs;
-        if (!grow((void **)&a->csgs, &cap, (size_t)a->ncsgs + 1, sizeof(accel_csg))) return PT_ERR_NOMEM;
+        if (!grow((void **)&a->csgs, &cap, (size_t)a->ncsgs + 1, sizeof(geom_csg))) return PT_ERR_NOMEM;
         a->capcsgs = (int)cap;
     }
-    accel_csg *c = &a->csgs[a->ncsgs];
+    geom_csg *c = &a->csgs[a->ncsgs];
     memset(c, 0, sizeof *c);
     c->flags = o->flags | (pflags & INHERITED_FLAGS);
     int cb0 = 0, cbn = 0;
@@ -555,11 +555,11 @@ static pt_status build_csg(accel *a, diag *d, const scene_object *o, const scene
     }
     pt_status st = csg_member(a, d, c, o, ptex, pflags, -1, depth);
     if (st != PT_OK) {
-        accel_csg_free(c);
+        geom_csg_free(c);
         return st;
     }
-    if (!accel_csg_finish(c)) { /* provably empty */
-        accel_csg_free(c);
+    if (!geom_csg_finish(c)) { /* provably empty */
+        geom_csg_free(c);
         return PT_OK;
     }
     a->ncsgs++;
@@ -802,11 +802,11 @@ static int user_box_missed(const accel *a, unsigned prim, void *ray, unsigned N,
 }
 
 /* One user primitive against a ray: an analytic shape or a CSG tree. */
-static int prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, double tmax, accel_csg_hit *h)
+static int prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, double tmax, geom_csg_hit *h)
 {
     if (prim < (unsigned)a->nshapes) {
-        accel_shape_hit sh;
-        if (!accel_shape_intersect(&a->shapes[prim], o, d, tmin, tmax, &sh)) return 0;
+        geom_shape_hit sh;
+        if (!geom_shape_intersect(&a->shapes[prim], o, d, tmin, tmax, &sh)) return 0;
         const accel_leaf *l = &a->leaves[a->shape_leaf[prim]];
         if (l->bn && !ray_in_bound(a, l->b0, l->bn, o, d, tmin)) return 0;
         h->t = sh.t;
@@ -816,11 +816,11 @@ static int prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, 
         return 1;
     }
     unsigned ci = prim - (unsigned)a->nshapes;
-    if (!accel_csg_intersect(&a->csgs[ci], o, d, tmin, tmax, h)) return 0;
+    if (!geom_csg_intersect(&a->csgs[ci], o, d, tmin, tmax, h)) return 0;
     return !a->csg_bn[ci] || ray_in_bound(a, a->csg_b0[ci], a->csg_bn[ci], o, d, tmin);
 }
 
-static const accel_shape *prim_shape(const accel *a, unsigned prim, int member)
+static const geom_shape *prim_shape(const accel *a, unsigned prim, int member)
 {
     return prim < (unsigned)a->nshapes ? &a->shapes[prim] : &a->csgs[prim - (unsigned)a->nshapes].shapes[member];
 }
@@ -863,7 +863,7 @@ static void user_intersect(const struct RTCIntersectFunctionNArguments *args)
         vec3 o, d;
         double tmin;
         user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
-        accel_csg_hit h;
+        geom_csg_hit h;
         if (!prim_hit(a, args->primID, o, d, tmin, (double)tfar, &h)) continue;
         SOA_F(ray, N, i, 8) = (float)h.t;
         vec3 ng = v3(0, 0, 0);
@@ -876,7 +876,7 @@ static void user_intersect(const struct RTCIntersectFunctionNArguments *args)
             q->uprim = args->primID;
             q->uhit = 1;
         } else {
-            accel_shape_surface(prim_shape(a, args->primID, h.shape), v3_madd(o, d, h.t), h.part, &ng, &u, &v);
+            geom_shape_surface(prim_shape(a, args->primID, h.shape), v3_madd(o, d, h.t), h.part, &ng, &u, &v);
             if (h.flip) ng = v3_neg(ng);
         }
         SOA_F(hit, N, i, 0) = (float)ng.x;
@@ -904,7 +904,7 @@ static void user_occluded(const struct RTCOccludedFunctionNArguments *args)
         vec3 o, d;
         double tmin;
         user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
-        accel_csg_hit h;
+        geom_csg_hit h;
         if (prim_hit(a, args->primID, o, d, tmin, (double)SOA_F(ray, N, i, 8), &h)) SOA_F(ray, N, i, 8) = -INFINITY;
     }
 }
@@ -1147,8 +1147,8 @@ static pt_status build_shapes(accel *a, diag *d)
         if (o->kind == SHAPE_TRIANGLE || o->kind == SHAPE_SMOOTH_TRIANGLE || o->kind == SHAPE_MESH ||
             a->leaves[i].in_csg)
             continue;
-        accel_shape *sh = &a->shapes[a->nshapes];
-        if (accel_shape_init(sh, o) != 0) {
+        geom_shape *sh = &a->shapes[a->nshapes];
+        if (geom_shape_init(sh, o) != 0) {
             diag_warn_once(d, o->loc, "degenerate %s ignored (zero size, singular transform or non-finite numbers)",
                            o->name ? o->name : "shape");
             continue;
@@ -1164,7 +1164,7 @@ static pt_status build_shapes(accel *a, diag *d)
 }
 
 /* Clip boxes for planes (see the comment at the top) and the scene scale. */
-static double plane_distance(const accel_shape *sh, vec3 c)
+static double plane_distance(const geom_shape *sh, vec3 c)
 {
     vec3 nw = sh->identity ? sh->g.plane.n : v3_norm(xform_normal(&sh->x, sh->g.plane.n));
     vec3 p0 = v3_scale(sh->g.plane.n, sh->g.plane.d);
@@ -1190,23 +1190,23 @@ static void finish_bounds(accel *a)
     double diag_e = have_e ? v3_len(v3_sub(ehi, elo)) : 0.0;
     double far_plane = 0.0;
     for (int i = 0; i < a->nshapes; i++) {
-        accel_shape *sh = &a->shapes[i];
+        geom_shape *sh = &a->shapes[i];
         if (sh->kind != SHAPE_PLANE && !sh->infinite) continue;
         double dist = sh->kind == SHAPE_PLANE ? plane_distance(sh, c) : 0.0;
         double hsz = PLANE_EXTENT_FACTOR * fmax(diag_e, dist);
         if (!(hsz > 0.0)) hsz = PLANE_EXTENT_FACTOR;
-        accel_shape_clip_plane(sh, v3_sub(c, v3s(hsz)), v3_add(c, v3s(hsz)));
+        geom_shape_clip_plane(sh, v3_sub(c, v3s(hsz)), v3_add(c, v3s(hsz)));
         far_plane = fmax(far_plane, dist);
     }
     /* CSG primitives: one cube for all their planes, the largest one needs */
     for (int i = 0; i < a->ncsgs; i++) {
-        accel_csg *cs = &a->csgs[i];
+        geom_csg *cs = &a->csgs[i];
         double dist = 0.0;
         for (int k = 0; k < cs->nshapes; k++)
             if (cs->shapes[k].kind == SHAPE_PLANE) dist = fmax(dist, plane_distance(&cs->shapes[k], c));
         double hsz = PLANE_EXTENT_FACTOR * fmax(diag_e, dist);
         if (!(hsz > 0.0)) hsz = PLANE_EXTENT_FACTOR;
-        accel_csg_clip(cs, v3_sub(c, v3s(hsz)), v3_add(c, v3s(hsz)));
+        geom_csg_clip(cs, v3_sub(c, v3s(hsz)), v3_add(c, v3s(hsz)));
         far_plane = fmax(far_plane, dist);
     }
     if (a->lo.x <= a->hi.x) {
@@ -1365,14 +1365,14 @@ void accel_free(accel *a)
         free(a->tri[k].refs);
     }
     free(a->leaves);
-    for (int i = 0; i < a->nshapes; i++) accel_shape_release(&a->shapes[i]);
+    for (int i = 0; i < a->nshapes; i++) geom_shape_release(&a->shapes[i]);
     free(a->shapes);
     free(a->shape_leaf);
     free(a->diags);
     free(a->groups);
-    for (int i = 0; i < a->ncsgs; i++) accel_csg_free(&a->csgs[i]);
+    for (int i = 0; i < a->ncsgs; i++) geom_csg_free(&a->csgs[i]);
     free(a->csgs);
-    for (int i = 0; i < a->nbshapes; i++) accel_shape_release(&a->bshapes[i]);
+    for (int i = 0; i < a->nbshapes; i++) geom_shape_release(&a->bshapes[i]);
     free(a->bshapes);
     free(a->csg_b0);
     free(a->csg_bn);
@@ -1388,6 +1388,8 @@ static inline double eps_rule(double scale, vec3 org, double dirlen)
     m = m > az ? m : az;
     return ACCEL_EPS_REL * (scale + m) / dirlen;
 }
+
+void accel_set_function_env(const struct func_env *env) { geom_set_function_env(env); }
 
 double accel_epsilon(const accel *a, vec3 org, vec3 dir)
 {
@@ -1536,7 +1538,7 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
         const tri_ref *r = &a->tri[a->ginfo[gid].idx].refs[prim];
         fill_triangle(a, &a->leaves[r->leaf], r->local, rh.hit.u, rh.hit.v, rh.ray.tfar, org, dir, hit);
     } else if (gid < a->nginfo && a->ginfo[gid].kind == GEOM_USER && prim < (unsigned)(a->nshapes + a->ncsgs)) {
-        accel_csg_hit h;
+        geom_csg_hit h;
         if (q.uhit && q.uprim == prim) {
             h.t = q.ut;
             h.part = q.upart;
@@ -1545,15 +1547,15 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
         } else if (!prim_hit(a, prim, org, dir, t0, tmax, &h)) {
             return 0;
         }
-        const accel_shape *sh = prim_shape(a, prim, h.shape);
+        const geom_shape *sh = prim_shape(a, prim, h.shape);
         unsigned li = prim < (unsigned)a->nshapes ? a->shape_leaf[prim]
                                                   : a->csgs[prim - (unsigned)a->nshapes].shape_leaf[h.shape];
         const accel_leaf *l = &a->leaves[li];
         hit->t = h.t;
         hit->p = v3_madd(org, dir, h.t);
-        accel_shape_surface(sh, hit->p, h.part, &hit->ng, &hit->u, &hit->v);
+        geom_shape_surface(sh, hit->p, h.part, &hit->ng, &hit->u, &hit->v);
         if (l->want_uv) {
-            accel_shape_uv(sh, hit->p, h.part, hit->uv);
+            geom_shape_uv(sh, hit->p, h.part, hit->uv);
         } else {
             hit->uv[0] = hit->p.x;
             hit->uv[1] = hit->p.y;
@@ -1562,11 +1564,11 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
         /* triangles intersected here (CSG members): POV-Ray's normal as in fill_triangle */
         hit->pov_flip = (sh->kind == SHAPE_TRIANGLE || sh->kind == SHAPE_SMOOTH_TRIANGLE) && sh->g.tri.wind > 0.0;
         if (h.flip) hit->pov_flip = !hit->pov_flip;
-        accel_shape_shading(sh, hit->p, hit->ng, &hit->ns);
+        geom_shape_shading(sh, hit->p, hit->ng, &hit->ns);
         hit->obj = l->obj;
         hit->texture = l->texture;
         if (sh->kind == SHAPE_BLOB) {
-            const scene_texture *bt = accel_shape_texture(sh, hit->p);
+            const scene_texture *bt = geom_shape_texture(sh, hit->p);
             if (bt) hit->texture = bt;
         }
         hit->prim = (unsigned)h.part;

@@ -20,7 +20,7 @@ typedef struct {
     const scene_texture *texture; /* effective texture (per-triangle mesh textures resolved) */
     unsigned prim;                /* primitive index within the object: triangle index for meshes,
                                      the part for analytic shapes (box face, cone side/base/cap:
-                                     ACCEL_PART_* in accel_shapes.h), else 0 */
+                                     GEOM_PART_* in geom_shape.h), else 0 */
     unsigned flags;               /* effective OBJ_* flags: obj->flags plus no_shadow/no_image/
                                      no_reflection/no_radiosity inherited from CSG parents */
     double uv[2];                 /* POV-Ray 3.7's UV coordinates of the hit (ObjectBase::UVCoord and
@@ -128,9 +128,8 @@ long accel_rtc_triangles(const accel *a, unsigned geom, const float **v, const u
 double accel_epsilon(const accel *a, vec3 org, vec3 dir);
 
 /* Evaluators (POV-Ray noise, pigment functions) that isosurface functions
- * may need, from the renderer (core/func.h). Process-wide; set it before
- * rendering. Without it such functions are NaN and those isosurfaces stay
- * empty. */
+ * may need, from the renderer (core/func.h): geom_set_function_env
+ * (geom/geom_shape.h). Process-wide; set it before rendering. */
 struct func_env;
 void accel_set_function_env(const struct func_env *env);
 

@@ -1,5 +1,5 @@
 /* accel_query.h - the parser's parse-time geometry queries (core/geom_env.h)
- * answered by accel_shape (accel_shapes.h): one intersector for rendering and
+ * answered by geom_shape (geom_shape.h): one intersector for rendering and
  * for trace()/inside(). Unbounded shapes (poly, quadric) are clipped to a
  * cube of half side ACCEL_QUERY_EXTENT around the origin, and their hits are
  * searched in windows of t that grow from ACCEL_QUERY_WINDOW by 4x: the

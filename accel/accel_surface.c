@@ -5,14 +5,14 @@
  * constant; for curved parts its maximum over all n is |det A| sigma_max(A^-1),
  * the bound used for rejection. */
 #include "accel_surface.h"
-#include "accel_hfield.h"
-#include "accel_sweep.h"
+#include "geom_hfield.h"
+#include "geom_sweep.h"
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include "accel_shapes.h"
-#include "accel_tess.h"
+#include "geom_shape.h"
+#include "geom_tess.h"
 
 enum { INHERITED = OBJ_NO_SHADOW | OBJ_NO_IMAGE | OBJ_NO_REFLECTION | OBJ_NO_RADIOSITY };
 #define MAX_DEPTH 256
@@ -23,7 +23,7 @@ typedef struct {
 } tri_geo;
 
 typedef struct {
-    accel_shape sh;
+    geom_shape sh;
     int similar;           /* J constant over the shape */
     double jmax;           /* bound on J for rejection */
     int nparts;
@@ -32,8 +32,8 @@ typedef struct {
     vec3 poly[12];
     double tri_cdf[12];
     vec3 clip_lo, clip_hi;
-    int crofton;           /* sampled by random lines (accel_tess.h) */
-    accel_tess_sampler cro; /* its sh pointer is set at each use (the array moves) */
+    int crofton;           /* sampled by random lines (geom_tess.h) */
+    geom_tess_sampler cro; /* its sh pointer is set at each use (the array moves) */
 } shape_geo;
 
 /* Crofton sampling: the relative standard error asked of the area estimate,
@@ -158,7 +158,7 @@ static vec3 sphere_normal(double u1, double u2)
     return v3(s * cos(phi), s * sin(phi), z);
 }
 
-static vec3 cone_side_normal(const accel_shape *sh, double phi)
+static vec3 cone_side_normal(const geom_shape *sh, double phi)
 {
     vec3 er = v3_add(v3_scale(sh->g.cone.u, cos(phi)), v3_scale(sh->g.cone.v, sin(phi)));
     return v3_norm(v3_sub(er, v3_scale(sh->g.cone.w, sh->g.cone.k)));
@@ -172,7 +172,7 @@ static vec3 torus_normal(double u, double v)
 /* World areas of the parts; fills part_cdf. Returns the total. */
 static double shape_area(shape_geo *g)
 {
-    accel_shape *sh = &g->sh;
+    geom_shape *sh = &g->sh;
     const xform *x = &sh->x;
     double parts[6] = {0};
     g->nparts = 1;
@@ -242,8 +242,8 @@ static double shape_area(shape_geo *g)
         break;
     }
     case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
-        /* uniform in object space (accel_sweep), so only under similarities */
-        if (g->similar) parts[0] = accel_sweep_area(sh) * jac(x, v3(0, 1, 0));
+        /* uniform in object space (geom_sweep), so only under similarities */
+        if (g->similar) parts[0] = geom_sweep_area(sh) * jac(x, v3(0, 1, 0));
         break;
     default:
         break;
@@ -260,7 +260,7 @@ static double shape_area(shape_geo *g)
 
 /* Shapes sampled by random lines: those without a parametrisation of their
  * own, and the sweeps where theirs is not uniform (non-similar transforms,
- * conic prisms: accel_sweep_area 0). */
+ * conic prisms: geom_sweep_area 0). */
 static int use_crofton(const shape_geo *g)
 {
     switch (g->sh.kind) {
@@ -268,7 +268,7 @@ static int use_crofton(const shape_geo *g)
     case SHAPE_JULIA: case SHAPE_OVUS:
         return 1;
     case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
-        return !g->similar || !(accel_sweep_area(&g->sh) > 0.0);
+        return !g->similar || !(geom_sweep_area(&g->sh) > 0.0);
     default:
         return 0;
     }
@@ -277,7 +277,7 @@ static int use_crofton(const shape_geo *g)
 /* Plane clipped to the box [lo, hi]: convex polygon, fan-triangulated. */
 static double plane_polygon(shape_geo *g, vec3 lo, vec3 hi)
 {
-    accel_shape *sh = &g->sh;
+    geom_shape *sh = &g->sh;
     vec3 p0 = xform_point(&sh->x, v3_scale(sh->g.plane.n, sh->g.plane.d));
     vec3 n = v3_norm(xform_normal(&sh->x, sh->g.plane.n));
     vec3 c[8];
@@ -406,7 +406,7 @@ static int add_leaf(accel_surf *as, const scene_object *o, const scene_texture *
     if (!grow((void **)&as->shapes, &as->capshapes, as->nshapes + 1, sizeof(shape_geo))) return 0;
     shape_geo *g = &as->shapes[as->nshapes];
     memset(g, 0, sizeof *g);
-    if (accel_shape_init(&g->sh, o) != 0) return 1;
+    if (geom_shape_init(&g->sh, o) != 0) return 1;
     double area;
     if (o->kind == SHAPE_PLANE) {
         if (!as->have_bounds) return 1;
@@ -421,10 +421,10 @@ static int add_leaf(accel_surf *as, const scene_object *o, const scene_texture *
              * distribution); unbounded ones within the scene's extent */
             if (g->sh.infinite) {
                 if (!as->have_bounds) {
-                    accel_shape_release(&g->sh);
+                    geom_shape_release(&g->sh);
                     return 1;
                 }
-                accel_shape_clip_plane(&g->sh, as->lo, as->hi);
+                geom_shape_clip_plane(&g->sh, as->lo, as->hi);
                 g->clip_lo = as->lo;
                 g->clip_hi = as->hi;
             }
@@ -434,11 +434,11 @@ static int add_leaf(accel_surf *as, const scene_object *o, const scene_texture *
         }
     }
     if (!(area > 0.0) || !isfinite(area)) {
-        accel_shape_release(&g->sh);
+        geom_shape_release(&g->sh);
         return 1;
     }
     if (!add_piece(as, o, tex, flags, ACCEL_SURF_ANY, area, w, 1, as->nshapes)) {
-        accel_shape_release(&g->sh);
+        geom_shape_release(&g->sh);
         return 0;
     }
     as->nshapes++;
@@ -467,21 +467,21 @@ static int add_issue4(accel_surf *as, const scene_object *o, const scene_texture
 {
     double w = weight_of(as, o, tex, flags);
     if (w <= 0.0) return 1;
-    accel_shape sh;
-    if (accel_shape_init(&sh, o) != 0) return 1;
+    geom_shape sh;
+    if (geom_shape_init(&sh, o) != 0) return 1;
     int ok = 1;
     if (o->kind == SHAPE_POLYGON) {
         tri_sink k = {as, o, tex, flags, w};
-        ok = accel_polygon_triangles(&sh, sink_tri, &k) >= 0;
+        ok = geom_polygon_triangles(&sh, sink_tri, &k) >= 0;
     } else {
-        int n = accel_hfield_ntriangles(&sh);
+        int n = geom_hfield_ntriangles(&sh);
         for (int i = 0; i < n && ok; i++) {
             vec3 a, b, c;
-            accel_hfield_triangle(&sh, i, &a, &b, &c);
+            geom_hfield_triangle(&sh, i, &a, &b, &c);
             ok = add_triangle(as, o, tex, flags, (unsigned)i, a, b, c, w);
         }
     }
-    accel_shape_release(&sh);
+    geom_shape_release(&sh);
     return ok;
 }
 
@@ -524,7 +524,7 @@ static void finish_crofton(accel_surf *as)
         if (!p->is_shape) continue;
         shape_geo *g = &as->shapes[p->idx];
         if (!g->crofton) continue;
-        double area = accel_tess_sampler_init(&g->cro, &g->sh, NULL, NULL, CROFTON_REL_ERR, lines);
+        double area = geom_tess_sampler_init(&g->cro, &g->sh, NULL, NULL, CROFTON_REL_ERR, lines);
         if (!(area > 0.0) || !isfinite(area)) {
             /* no surface found: never chosen, pdf 0 */
             p->pub.area = 0.0;
@@ -620,7 +620,7 @@ void accel_surf_free(accel_surf *as)
     if (!as) return;
     free(as->pieces);
     free(as->tris);
-    for (int i = 0; i < as->nshapes; i++) accel_shape_release(&as->shapes[i].sh); /* issue-4 shapes' data */
+    for (int i = 0; i < as->nshapes; i++) geom_shape_release(&as->shapes[i].sh); /* issue-4 shapes' data */
     free(as->shapes);
     free(as->cdf);
     free(as->tab);
@@ -656,14 +656,14 @@ static double rescale(const double *cdf, int i, double u)
 
 static void sample_shape(const shape_geo *g, double u1, double u2, rng *r, vec3 *p, vec3 *n, unsigned *part)
 {
-    const accel_shape *sh = &g->sh;
+    const geom_shape *sh = &g->sh;
     const xform *x = &sh->x;
     vec3 po = v3s(0.0), no = v3(0, 0, 1);
     *part = 0;
     if (g->crofton) {
-        accel_tess_sampler cs = g->cro;
+        geom_tess_sampler cs = g->cro;
         cs.sh = sh;
-        if (!accel_tess_sample(&cs, u1, u2, r, p, n, part)) {
+        if (!geom_tess_sample(&cs, u1, u2, r, p, n, part)) {
             *p = cs.c;
             *n = v3(0, 1, 0);
         }
@@ -693,7 +693,7 @@ static void sample_shape(const shape_geo *g, double u1, double u2, rng *r, vec3 
         double nn[3] = {0, 0, 0};
         nn[axis] = (f & 1) ? 1.0 : -1.0;
         no = v3(nn[0], nn[1], nn[2]);
-        *part = (unsigned)f; /* ACCEL_PART_BOX_NX.. order: -x, +x, -y, +y, -z, +z */
+        *part = (unsigned)f; /* GEOM_PART_BOX_NX.. order: -x, +x, -y, +y, -z, +z */
         break;
     }
     case SHAPE_CYLINDER:
@@ -721,14 +721,14 @@ static void sample_shape(const shape_geo *g, double u1, double u2, rng *r, vec3 
             double rad = r0 + (r1 - r0) * t / h;
             po = v3_add(v3_madd(sh->g.cone.base, w, t),
                         v3_add(v3_scale(bu, rad * cos(phi)), v3_scale(bv, rad * sin(phi))));
-            *part = ACCEL_PART_CONE_SIDE;
+            *part = GEOM_PART_CONE_SIDE;
         } else {
             double rad = part_i == 1 ? r0 : r1;
             double rho = rad * sqrt(u1), phi = 2.0 * M_PI * u2;
             vec3 c = part_i == 1 ? sh->g.cone.base : v3_madd(sh->g.cone.base, w, h);
             po = v3_add(c, v3_add(v3_scale(bu, rho * cos(phi)), v3_scale(bv, rho * sin(phi))));
             no = part_i == 1 ? v3_neg(w) : w;
-            *part = part_i == 1 ? ACCEL_PART_CONE_BASE : ACCEL_PART_CONE_CAP;
+            *part = part_i == 1 ? GEOM_PART_CONE_BASE : GEOM_PART_CONE_CAP;
         }
         break;
     }
@@ -767,7 +767,7 @@ static void sample_shape(const shape_geo *g, double u1, double u2, rng *r, vec3 
         return;
     }
     case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
-        accel_sweep_sample(sh, u1, u2, r, &po, &no, part);
+        geom_sweep_sample(sh, u1, u2, r, &po, &no, part);
         break;
     default:
         break;

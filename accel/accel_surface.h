@@ -30,10 +30,10 @@
  * CSG inside rules remove), unsupported shapes, degenerate objects and
  * objects with clipped_by. Polygons (their region cut into triangles) and
  * height fields (their cells' triangles) are sampled exactly; lathe, sor,
- * linear prism and text uniformly by area (accel_sweep_sample) under
+ * linear prism and text uniformly by area (geom_sweep_sample) under
  * similarities. Superellipsoid, quadric, poly, blob, isosurface,
  * julia_fractal, conic prisms and the sweeps under other transforms are
- * sampled by random lines (accel_tess.h: Crofton's formula, exact in
+ * sampled by random lines (geom_tess.h: Crofton's formula, exact in
  * distribution; their area is a quasi-Monte Carlo estimate to 0.1%
  * standard error or 65536 lines, within 2^19 lines per scene); quadric and
  * poly within the scene's finite bounds, as planes.
@@ -67,7 +67,7 @@ typedef struct {
     const scene_object *obj;
     const scene_texture *texture;
     unsigned flags;
-    unsigned prim;     /* as accel_hit.prim: triangle of a mesh, part of a box/cone (accel_shapes.h) */
+    unsigned prim;     /* as accel_hit.prim: triangle of a mesh, part of a box/cone (geom_shape.h) */
     int piece;
     double pdf_area;   /* density per unit world area over the whole set */
 } accel_surf_sample;

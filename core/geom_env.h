@@ -3,7 +3,7 @@
  *
  * The parser's trace() and inside() need them at parse time but depend on
  * core/ only; the application passes accel_geom_env() (accel/accel_query.h),
- * the same accel_shape code that renders the shape, so a parse-time answer
+ * the same geom_shape code that renders the shape, so a parse-time answer
  * and the rendered surface agree. */
 #ifndef PT_GEOM_ENV_H
 #define PT_GEOM_ENV_H

@@ -3,7 +3,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include "accel_shapes.h"
+#include "geom_shape.h"
 #include "hash.h"
 #include "radrules.h"
 #include "rng.h"
@@ -131,10 +131,10 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
         if (!tex) tex = &sc->default_texture;
         material(sc, tex, NULL, &rr, &proto);
         int probe = gi_surface_probe(g, i), mask = gi_surface_side_mask(g, i);
-        /* uv_mapping: the pigment is read at the particle's UV (accel_shape_uv;
+        /* uv_mapping: the pigment is read at the particle's UV (geom_shape_uv;
          * world x, y for meshes and the shapes it does not know, as accel.c) */
-        accel_shape ush;
-        int have_ush = pig && o->uv_mapping && accel_shape_init(&ush, o) == 0;
+        geom_shape ush;
+        int have_ush = pig && o->uv_mapping && geom_shape_init(&ush, o) == 0;
         long got = 0, tries = 0, limit = 64 * m + 64;
         for (long q = 0; got < m && tries < limit; q++, tries++) {
             double u = frac(su + (double)q * R2_A1), v = frac(sv + (double)q * R2_A2);
@@ -153,7 +153,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
                 h.flags = o->flags;
                 h.uv[0] = pos.x;
                 h.uv[1] = pos.y;
-                if (have_ush) accel_shape_uv(&ush, pos, 0, h.uv);
+                if (have_ush) geom_shape_uv(&ush, pos, 0, h.uv);
                 colour5 c;
                 if (pig(sc, tex, &h, &c) && isfinite(c.r) && isfinite(c.g) && isfinite(c.b) && isfinite(c.f) &&
                     isfinite(c.t))
@@ -175,7 +175,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
                 p.n[1] = (float)nn.y;
                 p.n[2] = (float)nn.z;
                 if (!push(&b, &p, i, s)) {
-                    if (have_ush) accel_shape_release(&ush);
+                    if (have_ush) geom_shape_release(&ush);
                     free(b.p);
                     free(b.patch);
                     free(b.side);
@@ -183,7 +183,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
                 }
             }
         }
-        if (have_ush) accel_shape_release(&ush);
+        if (have_ush) geom_shape_release(&ush);
         if (b.n > 2147483000L) {
             diag_report(d, DIAG_ERROR, (src_loc){0}, NULL, "particle GI: too many particles");
             free(b.p);

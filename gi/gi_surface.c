@@ -1,11 +1,11 @@
 /* gi_surface.c - surface patches for particle GI (see gi_surface.h). */
 #include "gi_surface.h"
 #include <math.h>
-#include "accel_shapes.h"
-#include "accel_hfield.h"
+#include "geom_shape.h"
+#include "geom_hfield.h"
 #include "accel_surface.h"
-#include "accel_sweep.h"
-#include "accel_tess.h"
+#include "geom_sweep.h"
+#include "geom_tess.h"
 #include <limits.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -40,7 +40,7 @@ typedef struct {
     unsigned char mask; /* sides that get particles (bit s: side s); CSG members: the visible one */
     int cnode;        /* CSG member: its node (csg_node), -1 otherwise */
     /* PIECE: the shape (for its grid) and, for CSG members, its own sampler */
-    accel_shape *sh;
+    geom_shape *sh;
     int own_sh;
     struct keep_sampler *ks;
     /* PIECE with a grid: vertices mv[vfirst .. vfirst + rp_count), triangles mt[tfirst .. tfirst + nt) */
@@ -67,11 +67,11 @@ _Static_assert(sizeof(tri_loc) == 128, "tri_loc: two cache lines (aligned_alloc 
 typedef struct {
     const scene_object *o;
     int parent, first, nkids;
-    accel_shape *sh;  /* leaves: their shape (NULL: no inside) */
+    geom_shape *sh;  /* leaves: their shape (NULL: no inside) */
 } csg_node;
 
 typedef struct keep_sampler {
-    accel_tess_sampler cs;
+    geom_tess_sampler cs;
     const struct gi_surface *g;
     int node;
 } keep_sampler;
@@ -207,12 +207,12 @@ static double det3(const xform *x)
 /* ------------------------------------------------------------ CSG members
  *
  * A member of merge, intersection or difference has particles only where
- * its surface is the CSG result's surface: POV-Ray's rule (as accel_csg.h),
+ * its surface is the CSG result's surface: POV-Ray's rule (as geom_csg.h),
  * applied at every level from the member up to the root: intersection keeps
  * a point inside all siblings, merge outside all of them, difference the
  * first member's points outside all the others and a subtracted member's
  * inside the first and outside the rest; union keeps everything. Inside
- * tests are the members' own (accel_shape_inside, POV-Ray's Inside_Object:
+ * tests are the members' own (geom_shape_inside, POV-Ray's Inside_Object:
  * union/merge any, intersection all, difference the first and none of the
  * others, inverse negating). */
 
@@ -254,9 +254,9 @@ static pt_status build_cnodes(gi_surface *g, int at, int depth)
             pt_status st = build_cnodes(g, first + i, depth + 1);
             if (st != PT_OK) return st;
         } else {
-            accel_shape *sh = malloc(sizeof *sh);
+            geom_shape *sh = malloc(sizeof *sh);
             if (!sh) return PT_ERR_NOMEM;
-            if (accel_shape_init(sh, k) != 0) {
+            if (geom_shape_init(sh, k) != 0) {
                 free(sh);
                 continue;
             }
@@ -283,14 +283,14 @@ static int csg_inside(const gi_surface *g, int node, vec3 p)
         for (int i = 1; i < c->nkids && in; i++) in = !csg_inside(g, c->first + i, p);
         break;
     default:
-        in = c->sh ? accel_shape_inside(c->sh, p) : 0;
+        in = c->sh ? geom_shape_inside(c->sh, p) : 0;
         break;
     }
     return (c->o->flags & OBJ_INVERSE) ? !in : in;
 }
 
 /* An odd number of inversions on the node and its ancestors, a subtracted
- * member of a difference counting as one (accel_csg.c's inv_odd). */
+ * member of a difference counting as one (geom_csg.c's inv_odd). */
 static int csg_inv_odd(const gi_surface *g, int node)
 {
     int odd = 0;
@@ -310,7 +310,7 @@ static int csg_keep(const gi_surface *g, int node, vec3 p)
         int i = n - P->first;
         shape_kind op = P->o->kind;
         /* an inverted union is POV-Ray's intersection of inverted members
-         * (De Morgan): its surfaces are a merge's, as accel_csg.c keeps them */
+         * (De Morgan): its surfaces are a merge's, as geom_csg.c keeps them */
         if (op == SHAPE_UNION && csg_inv_odd(g, g->cn[n].parent)) op = SHAPE_MERGE;
         if (op == SHAPE_UNION) continue;
         for (int j = 0; j < P->nkids; j++) {
@@ -603,7 +603,7 @@ static void piece_range(const gi_surface *g, const scene_object *o, int *first, 
 /* Sides of a PIECE patch: sheets (polygons, height fields, lathe and sor,
  * whose ends may be open, unbounded quadric/poly clipped like planes) and
  * open or inverse objects get both; closed solids their outside, plus the
- * inside when the camera or a light is in them (accel_shape_inside). */
+ * inside when the camera or a light is in them (geom_shape_inside). */
 static int piece_sides(const gi_surface *g, const scene_object *o)
 {
     if (o->flags & (OBJ_OPEN | OBJ_INVERSE)) return 2;
@@ -612,19 +612,19 @@ static int piece_sides(const gi_surface *g, const scene_object *o)
     case SHAPE_POLYGON: case SHAPE_HEIGHT_FIELD: case SHAPE_LATHE: case SHAPE_SOR: return 2;
     default: break;
     }
-    accel_shape sh;
-    if (accel_shape_init(&sh, o) != 0) return 1;
+    geom_shape sh;
+    if (geom_shape_init(&sh, o) != 0) return 1;
     int sides = sh.infinite ? 2 : 1;
     const scene *s = g->sc;
-    if (sides == 1 && s->camera_set && accel_shape_inside(&sh, s->camera.location)) sides = 2;
+    if (sides == 1 && s->camera_set && geom_shape_inside(&sh, s->camera.location)) sides = 2;
     for (int i = 0; sides == 1 && i < s->nlights; i++)
-        if (accel_shape_inside(&sh, s->lights[i].position)) sides = 2;
-    accel_shape_release(&sh);
+        if (geom_shape_inside(&sh, s->lights[i].position)) sides = 2;
+    geom_shape_release(&sh);
     return sides;
 }
 
 /* Shapes whose radiance particles are the vertices of their grid
- * (accel_shape_grid: marching tetrahedra, vertices on the exact surface;
+ * (geom_shape_grid: marching tetrahedra, vertices on the exact surface;
  * superellipsoids their own parametric grid). */
 static int has_grid(shape_kind k)
 {
@@ -633,7 +633,7 @@ static int has_grid(shape_kind k)
     case SHAPE_SUPERELLIPSOID: case SHAPE_OVUS:
     case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_TORUS: /* analytic_grid */
     case SHAPE_POLYGON: case SHAPE_HEIGHT_FIELD: /* their triangles, split (split_grid) */
-    case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT: /* accel_sweep_grid_cell */
+    case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT: /* geom_sweep_grid_cell */
         return 1;
     default: return 0;
     }
@@ -641,7 +641,7 @@ static int has_grid(shape_kind k)
 
 static void free_patch(patch *p)
 {
-    if (p->sh && p->own_sh == 1) accel_shape_release(p->sh);
+    if (p->sh && p->own_sh == 1) geom_shape_release(p->sh);
     if (p->own_sh) free(p->sh);
     p->sh = NULL;
     free(p->ks);
@@ -652,7 +652,7 @@ static void free_patch(patch *p)
  * own shape, keeping the crossings on the result's surface. */
 static pt_status add_member_piece(gi_surface *g, const scene_object *o, const scene_texture *tex)
 {
-    const accel_shape *nsh = g->cn[g->cur_node].sh;
+    const geom_shape *nsh = g->cn[g->cur_node].sh;
     if (!nsh) {
         g->skipped++;
         diag_warn_once(g->d, o->loc, "particle GI: no particles on %s objects in CSG (they get no indirect light)",
@@ -678,11 +678,11 @@ static pt_status add_member_piece(gi_surface *g, const scene_object *o, const sc
     }
     *p.sh = *nsh;
     p.own_sh = 2;
-    if (p.sh->infinite) accel_shape_clip_plane(p.sh, g->lo, g->hi);
+    if (p.sh->infinite) geom_shape_clip_plane(p.sh, g->lo, g->hi);
     p.ks->g = g;
     p.ks->node = g->cur_node;
     /* accel_surface's accuracy for its own Crofton shapes: 0.1%, 65536 lines */
-    double area = accel_tess_sampler_init(&p.ks->cs, p.sh, keep_fn, p.ks, 1e-3, 65536);
+    double area = geom_tess_sampler_init(&p.ks->cs, p.sh, keep_fn, p.ks, 1e-3, 65536);
     if (!(area > 0.0) || !isfinite(area)) {
         /* nothing of it is on the result's surface */
         free_patch(&p);
@@ -719,7 +719,7 @@ static pt_status add_leaf(gi_surface *g, const scene_object *o, const scene_text
          * cylinders, cones, tori; polygons and height fields (their
          * triangles); lathe, sor, prism, text; and the implicit shapes
          * (quadric, poly, blob, isosurface, julia_fractal, ovus,
-         * superellipsoid) by Crofton lines (accel_tess.h). Area particles;
+         * superellipsoid) by Crofton lines (geom_tess.h). Area particles;
          * radiance particles on the implicit shapes' grids (build_mesh);
          * the others are estimated at the hit. CSG members: their own
          * Crofton sampler keeping only the result's surface (csg_keep). */
@@ -765,12 +765,12 @@ static pt_status add_leaf(gi_surface *g, const scene_object *o, const scene_text
         if (has_grid(o->kind)) {
             p.sh = malloc(sizeof *p.sh);
             if (!p.sh) return PT_ERR_NOMEM;
-            if (accel_shape_init(p.sh, o) != 0) {
+            if (geom_shape_init(p.sh, o) != 0) {
                 free(p.sh);
                 p.sh = NULL;
             } else {
                 p.own_sh = 1;
-                if (p.sh->infinite) accel_shape_clip_plane(p.sh, g->lo, g->hi);
+                if (p.sh->infinite) geom_shape_clip_plane(p.sh, g->lo, g->hi);
             }
         }
         if (add_patch(g, &p) < 0) {
@@ -1005,7 +1005,7 @@ gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *
 typedef struct {
     gi_surface *g;
     int pi;
-    const accel_shape *sh;
+    const geom_shape *sh;
     long *vh;         /* vertex hash: global vertex index, -1 empty */
     long vcap;
     int oom;
@@ -1148,7 +1148,7 @@ static int mesh_add(mesh_ctx *m, const vec3 w[3], const vec3 nw[3])
     return 1;
 }
 
-/* Parametric grids of the analytic shapes accel_shape_grid leaves to GI
+/* Parametric grids of the analytic shapes geom_shape_grid leaves to GI
  * (cylinder, cone, torus), in object space, n_* cells from the tessellation
  * bound (grid_count, at most 256 a side; object lengths times the
  * transform's largest stretch): the side of a cone/cylinder by angle and
@@ -1158,7 +1158,7 @@ static int mesh_add(mesh_ctx *m, const vec3 w[3], const vec3 nw[3])
  * outward normals. */
 
 /* World length of the shape's object axis c (its transform's column c). */
-static double axis_stretch(const accel_shape *sh, int c)
+static double axis_stretch(const geom_shape *sh, int c)
 {
     if (sh->identity) return 1.0;
     const double (*m)[4] = sh->x.m;
@@ -1166,12 +1166,12 @@ static double axis_stretch(const accel_shape *sh, int c)
 }
 
 /* The transform's largest stretch (1 for none). */
-static double max_stretch(const accel_shape *sh)
+static double max_stretch(const geom_shape *sh)
 {
     return fmax(axis_stretch(sh, 0), fmax(axis_stretch(sh, 1), axis_stretch(sh, 2)));
 }
 
-static int analytic_grid(const accel_shape *sh, double tess, accel_grid_fn fn, void *ctx)
+static int analytic_grid(const geom_shape *sh, double tess, geom_grid_fn fn, void *ctx)
 {
     double s = max_stretch(sh);
     if (!(s > 0.0) || !isfinite(s)) return 0;
@@ -1267,7 +1267,7 @@ static int cmp_cell(const void *a, const void *b)
 /* Shapes whose grid is split to the tessellation bound (mesh_split):
  * polygons (their even-odd region's triangles), height fields (their cells,
  * or a coarser grid of every s-th point where the cells are smaller than
- * the bound), lathe, sor, prism and text (accel_sweep_grid_cell: profile
+ * the bound), lathe, sor, prism and text (geom_sweep_grid_cell: profile
  * segments by arc length, around or along the sweep; prism and text caps
  * are long trapezoids between vertex heights, split here). */
 static int split_grid(shape_kind k)
@@ -1293,7 +1293,7 @@ static int split_grid(shape_kind k)
  * -0.4% (docs/gi.md, "Sweep cells and the normal's turning"). */
 #define SWEEP_TURN 0.4510268117962624
 
-static int split_grid_build(const accel_shape *sh, double tess, mesh_ctx *m)
+static int split_grid_build(const geom_shape *sh, double tess, mesh_ctx *m)
 {
     double s = max_stretch(sh);
     if (!(s > 0.0) || !isfinite(s)) return 0;
@@ -1303,15 +1303,15 @@ static int split_grid_build(const accel_shape *sh, double tess, mesh_ctx *m)
         /* strides: every s-th grid point where a cell is shorter than the
          * bound in world space (x = i / nx, z = j / nz in object space) */
         int nx, nz;
-        accel_hfield_cells(sh, &nx, &nz);
+        geom_hfield_cells(sh, &nx, &nz);
         if (nx < 1 || nz < 1) return 0;
         double cx = axis_stretch(sh, 0) / nx, cz = axis_stretch(sh, 2) / nz;
         double fx = cx > 0.0 ? floor(tess / cx) : 1.0, fz = cz > 0.0 ? floor(tess / cz) : 1.0;
         int sx = !(fx >= 1.0) ? 1 : (fx > nx ? nx : (int)fx), sz = !(fz >= 1.0) ? 1 : (fz > nz ? nz : (int)fz);
-        return accel_hfield_coarse_grid(sh, sx, sz, mesh_tri, m);
+        return geom_hfield_coarse_grid(sh, sx, sz, mesh_tri, m);
     }
-    case SHAPE_POLYGON: return accel_shape_grid(sh, 1, mesh_tri, m);
-    default: return accel_sweep_grid_cell(sh, tess / s, SWEEP_TURN, mesh_tri, m);
+    case SHAPE_POLYGON: return geom_shape_grid(sh, 1, mesh_tri, m);
+    default: return geom_sweep_grid_cell(sh, tess / s, SWEEP_TURN, mesh_tri, m);
     }
 }
 
@@ -1359,7 +1359,7 @@ static void build_meshes(gi_surface *g)
         int r = kind == SHAPE_CYLINDER || kind == SHAPE_CONE || kind == SHAPE_TORUS
                     ? analytic_grid(p->sh, g->tess, mesh_tri, &m)
                     : split_grid(kind) ? split_grid_build(p->sh, g->tess, &m)
-                                       : accel_shape_grid(p->sh, n, mesh_tri, &m);
+                                       : geom_shape_grid(p->sh, n, mesh_tri, &m);
         free(m.vh);
         if (r < 0 || m.oom) {
             g->nmv = p->vfirst;
@@ -1834,7 +1834,7 @@ void gi_surface_free(gi_surface *g)
     accel_surf_free(g->as);
     for (int i = 0; i < g->np; i++) free_patch(&g->p[i]);
     for (int i = 0; i < g->ncn; i++) {
-        if (g->cn[i].sh) accel_shape_release(g->cn[i].sh);
+        if (g->cn[i].sh) geom_shape_release(g->cn[i].sh);
         free(g->cn[i].sh);
     }
     free(g->cn);
@@ -1921,7 +1921,7 @@ int gi_surface_sample(const gi_surface *g, int i, double u, double v, rng *r, ve
     if (p->ks) {
         /* CSG member: its own lines, keeping the result's surface */
         unsigned part;
-        if (!accel_tess_sample(&p->ks->cs, v, u, r, pos, nrm, &part)) return 0;
+        if (!geom_tess_sample(&p->ks->cs, v, u, r, pos, nrm, &part)) return 0;
         return v3_finite(*pos) && v3_finite(*nrm);
     }
     if (p->kind == PATCH_PIECE) return 0;

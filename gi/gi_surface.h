@@ -26,8 +26,8 @@
  * polygons and height fields (their triangles, a piece chosen by area),
  * lathe, sor, prism, text, and the implicit shapes (quadric, poly, blob,
  * isosurface, julia_fractal, ovus, superellipsoid; Crofton lines,
- * accel_tess.h). The implicit shapes get radiance particles at the
- * vertices of their grid (accel_shape_grid: marching tetrahedra, vertices
+ * geom_tess.h). The implicit shapes get radiance particles at the
+ * vertices of their grid (geom_shape_grid: marching tetrahedra, vertices
  * on the exact surface, n = ceil(world extent / tess) cells along the
  * longest side, within [2, 128]); gi_surface_locate takes the grid
  * triangle nearest the hit (a hash of cells, each triangle in those its box
@@ -36,7 +36,7 @@
  * (angle x height, caps by angle x radius; the torus's two angles) with
  * the same locate. Polygons (their even-odd region's triangles), height
  * fields (their cells' triangles, or every s-th grid point where cells are
- * shorter than tess), lathe, sor, prism and text (accel_sweep_grid_cell:
+ * shorter than tess), lathe, sor, prism and text (geom_sweep_grid_cell:
  * cells of at most tess along each profile segment's arc and around or
  * along the sweep; prism/text caps as trapezoids) get grids whose
  * triangles are split at the midpoint of their longest edge until no edge
@@ -55,7 +55,7 @@
  * member to the root (intersection: inside all siblings; merge: outside
  * all; difference: the first member outside the others, a subtracted one
  * inside the first and outside the rest), with the members' own inside
- * tests (accel_shape_inside). Spheres, boxes, discs, planes and triangles
+ * tests (geom_shape_inside). Spheres, boxes, discs, planes and triangles
  * are sampled on their whole surface and marked `probe` (gi_particles keeps
  * a particle only if a short probe ray finds the result's surface there);
  * the other shapes get their own Crofton sampler whose keep filter is that

@@ -29,7 +29,7 @@
 #include "shade_noise.h"
 #include "shade_tiling.h"
 #include "shade_pavement.h"
-#include "accel_shapes.h"
+#include "geom_shape.h"
 
 #define PAT_EPSILON 1.0e-10
 #define COORD_LIMIT 1.0e17
@@ -793,9 +793,9 @@ static int object_inside(const scene_object *o, vec3 p, int depth)
         for (int i = 1; i < o->u.csg.nkids && in; i++) in = !object_inside(o->u.csg.kids[i], p, depth + 1);
         break;
     default: {
-        accel_shape sh;
-        if (accel_shape_init(&sh, o) == 0) in = accel_shape_inside(&sh, p);
-        accel_shape_release(&sh);
+        geom_shape sh;
+        if (geom_shape_init(&sh, o) == 0) in = geom_shape_inside(&sh, p);
+        geom_shape_release(&sh);
         break;
     }
     }

@@ -14,7 +14,7 @@
 #include <string.h>
 #include <embree3/rtcore.h>
 #include "accel.h"
-#include "accel_shapes.h"
+#include "geom_shape.h"
 #include "diag.h"
 #include "pool.h"
 #include "rng.h"
@@ -170,9 +170,9 @@ static void test_box_faces(void **st)
     accel *a = build(s, d);
     accel_hit h;
     expect_hit(a, v3(-10, 0.5, 0.5), v3(1, 0, 0), 9.0, v3(-1, 0, 0), 1e-12, 0, &h);
-    assert_int_equal(h.prim, ACCEL_PART_BOX_NX);
+    assert_int_equal(h.prim, GEOM_PART_BOX_NX);
     expect_hit(a, v3(10, 0.5, 0.5), v3(-1, 0, 0), 9.0, v3(1, 0, 0), 1e-12, 0, &h);
-    assert_int_equal(h.prim, ACCEL_PART_BOX_PX);
+    assert_int_equal(h.prim, GEOM_PART_BOX_PX);
     expect_hit(a, v3(0.5, -10, 0.5), v3(0, 1, 0), 8.0, v3(0, -1, 0), 1e-12, 0, NULL);
     expect_hit(a, v3(0.5, 10, 0.5), v3(0, -1, 0), 8.0, v3(0, 1, 0), 1e-12, 0, NULL);
     expect_hit(a, v3(0.5, 0.5, -10), v3(0, 0, 1), 7.0, v3(0, 0, -1), 1e-12, 0, NULL);
@@ -536,11 +536,11 @@ static void test_cylinder_cone(void **st)
     accel *a = build(s, d);
     accel_hit h;
     expect_hit(a, v3(-5, 1, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12, &h);
-    assert_int_equal(h.prim, ACCEL_PART_CONE_SIDE);
+    assert_int_equal(h.prim, GEOM_PART_CONE_SIDE);
     expect_hit(a, v3(0.5, 5, 0), v3(0, -1, 0), 3.0, v3(0, 1, 0), 1e-12, 1e-12, &h);
-    assert_int_equal(h.prim, ACCEL_PART_CONE_CAP);
+    assert_int_equal(h.prim, GEOM_PART_CONE_CAP);
     expect_hit(a, v3(0.5, -5, 0), v3(0, 1, 0), 5.0, v3(0, -1, 0), 1e-12, 1e-12, &h);
-    assert_int_equal(h.prim, ACCEL_PART_CONE_BASE);
+    assert_int_equal(h.prim, GEOM_PART_CONE_BASE);
     /* from inside: the side at the exit */
     expect_hit(a, v3(0, 1, 0), v3(0, 0, 1), 1.0, v3(0, 0, 1), 1e-12, 1e-12, NULL);
     /* diagonal through side and cap: from (0,1,-3) towards (0,3,1)... enters side at z=-1, y=1.5 */
@@ -634,19 +634,19 @@ static void test_poly_roots(void **st)
     (void)st;
     /* (x-1)(x-2)(x-3)(x-4) = x^4 - 10x^3 + 35x^2 - 50x + 24 */
     double c[5] = {24, -50, 35, -10, 1}, r[4];
-    int n = accel_poly_roots(c, 4, 0.0, 5.0, r);
+    int n = geom_poly_roots(c, 4, 0.0, 5.0, r);
     assert_int_equal(n, 4);
     for (int i = 0; i < 4; i++) assert_near(r[i], i + 1.0, 1e-12);
-    assert_int_equal(accel_poly_roots(c, 4, 1.5, 3.5, r), 2);
+    assert_int_equal(geom_poly_roots(c, 4, 1.5, 3.5, r), 2);
     assert_near(r[0], 2.0, 1e-12);
     /* (x^2 + 1)(x^2 + 2): no real roots */
     double c2[5] = {2, 0, 3, 0, 1};
-    assert_int_equal(accel_poly_roots(c2, 4, -10, 10, r), 0);
+    assert_int_equal(geom_poly_roots(c2, 4, -10, 10, r), 0);
     /* close roots 1 and 1 + 1e-6 */
     double e = 1e-6;
     double c3[3] = {1 + e, -(2 + e), 1};
     double c4[5] = {0, 0, c3[0], c3[1], c3[2]}; /* x^2 (x-1)(x-1-e) */
-    n = accel_poly_roots(c4, 4, 0.5, 2.0, r);
+    n = geom_poly_roots(c4, 4, 0.5, 2.0, r);
     assert_int_equal(n, 2);
     assert_near(r[0], 1.0, 1e-9);
     assert_near(r[1], 1.0 + e, 1e-9);

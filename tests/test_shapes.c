@@ -17,8 +17,8 @@
 #include <string.h>
 #include <unistd.h>
 #include "accel.h"
-#include "accel_poly.h"
-#include "accel_shapes.h"
+#include "geom_poly.h"
+#include "geom_shape.h"
 #include "accel_surface.h"
 #include "rng.h"
 #include "diag.h"
@@ -64,27 +64,27 @@ static void expect_miss(const world *w, vec3 o, vec3 d)
 }
 
 /* The only leaf shape of the scene (first object, or its first kid). */
-static accel_shape shape_of(const world *w)
+static geom_shape shape_of(const world *w)
 {
     const scene_object *o = w->s->objects[0];
-    accel_shape sh;
-    assert_int_equal(accel_shape_init(&sh, o), 0);
+    geom_shape sh;
+    assert_int_equal(geom_shape_init(&sh, o), 0);
     return sh;
 }
 
 /* Brute force: the first change of the inside test along o + t d for t in
  * (t0, t1], marched in n steps and bisected. */
-static double march(const accel_shape *sh, vec3 o, vec3 d, double t0, double t1, int n)
+static double march(const geom_shape *sh, vec3 o, vec3 d, double t0, double t1, int n)
 {
-    int in0 = accel_shape_inside(sh, v3_madd(o, d, t0));
+    int in0 = geom_shape_inside(sh, v3_madd(o, d, t0));
     double prev = t0;
     for (int i = 1; i <= n; i++) {
         double t = t0 + (t1 - t0) * i / n;
-        if (accel_shape_inside(sh, v3_madd(o, d, t)) != in0) {
+        if (geom_shape_inside(sh, v3_madd(o, d, t)) != in0) {
             double a = prev, b = t;
             for (int k = 0; k < 80; k++) {
                 double m = 0.5 * (a + b);
-                if (accel_shape_inside(sh, v3_madd(o, d, m)) != in0) b = m;
+                if (geom_shape_inside(sh, v3_madd(o, d, m)) != in0) b = m;
                 else a = m;
             }
             return 0.5 * (a + b);
@@ -107,9 +107,9 @@ static void test_poly_roots(void **st)
     }
     for (int sturm = 0; sturm < 2; sturm++) {
         double out[5];
-        assert_int_equal(accel_poly_solve(c, 5, 0.0, 1.0, out, sturm), 5);
+        assert_int_equal(geom_poly_solve(c, 5, 0.0, 1.0, out, sturm), 5);
         for (int i = 0; i < 5; i++) assert_near(out[i], r[i], 1e-12);
-        assert_int_equal(accel_poly_solve(c, 5, 0.25, 0.45, out, sturm), 2);
+        assert_int_equal(geom_poly_solve(c, 5, 0.25, 0.45, out, sturm), 2);
         assert_near(out[0], 0.3, 1e-12);
     }
     /* degree 12: roots 1..12 scaled by 1/16 (Wilkinson-like clustering) */
@@ -121,7 +121,7 @@ static void test_poly_roots(void **st)
     }
     for (int sturm = 0; sturm < 2; sturm++) {
         double out[12];
-        int n = accel_poly_solve(w, 12, 0.0, 1.0, out, sturm);
+        int n = geom_poly_solve(w, 12, 0.0, 1.0, out, sturm);
         assert_int_equal(n, 12);
         for (int i = 0; i < 12; i++) assert_near(out[i], (i + 1) / 16.0, 1e-7);
     }
@@ -132,7 +132,7 @@ static void test_poly_roots(void **st)
     g[2] = -1.0 + 3.0;   /* 2 */
     g[3] = 1.0;
     double out[3];
-    int n = accel_poly_solve(g, 3, 0.0, 1.0, out, 0);
+    int n = geom_poly_solve(g, 3, 0.0, 1.0, out, 0);
     assert_true(n >= 1);
     assert_near(out[0], 0.5, 1e-7);
 }
@@ -178,11 +178,11 @@ static void test_lathe_linear(void **st)
     /* starting on the side, going in: the far side */
     double xs = sqrt(0.99);
     expect_hit(&w, v3(-xs, 0.5, 0.1), v3(1, 0, 0), 2 * xs, v3(xs, 0, 0.1), 1e-12, 1e-12);
-    accel_shape sh = shape_of(&w);
-    assert_true(accel_shape_inside(&sh, v3(0.5, 0.5, 0.1)));
-    assert_false(accel_shape_inside(&sh, v3(1.5, 0.5, 0)));
-    assert_false(accel_shape_inside(&sh, v3(0.5, 1.5, 0)));
-    accel_shape_release(&sh);
+    geom_shape sh = shape_of(&w);
+    assert_true(geom_shape_inside(&sh, v3(0.5, 0.5, 0.1)));
+    assert_false(geom_shape_inside(&sh, v3(1.5, 0.5, 0)));
+    assert_false(geom_shape_inside(&sh, v3(0.5, 1.5, 0)));
+    geom_shape_release(&sh);
     done(&w);
 }
 
@@ -235,7 +235,7 @@ static void test_lathe_brute(void **st)
     (void)st;
     /* a vase-like closed Catmull-Rom profile: first hit = inside-test march */
     world w = build("lathe { cubic_spline 8, <0,-0.2>, <0,0>, <1,0.2>, <0.5,0.6>, <0.8,1.2>, <0.6,1.6>, <0,1.7>, <-0.3,1.8> sturm }");
-    accel_shape sh = shape_of(&w);
+    geom_shape sh = shape_of(&w);
     int checked = 0;
     for (int i = 0; i < 40; i++) {
         double y = 0.05 + 1.6 * i / 40.0, a = 0.3 * i;
@@ -253,7 +253,7 @@ static void test_lathe_brute(void **st)
         checked++;
     }
     assert_true(checked > 20);
-    accel_shape_release(&sh);
+    geom_shape_release(&sh);
     done(&w);
 }
 
@@ -280,7 +280,7 @@ static void test_sor_brute(void **st)
 {
     (void)st;
     world w = build("sor { 6, <0.5,-0.5>, <1,0>, <0.4,0.5>, <0.8,1.3>, <0.2,1.6>, <0.3,2> }");
-    accel_shape sh = shape_of(&w);
+    geom_shape sh = shape_of(&w);
     int checked = 0;
     for (int i = 0; i < 30; i++) {
         double a = 0.21 * i;
@@ -298,7 +298,7 @@ static void test_sor_brute(void **st)
         checked++;
     }
     assert_true(checked > 10);
-    accel_shape_release(&sh);
+    geom_shape_release(&sh);
     done(&w);
 }
 
@@ -347,7 +347,7 @@ static void test_prism_brute(void **st)
     };
     for (int s = 0; s < 4; s++) {
         world w = build(src[s]);
-        accel_shape sh = shape_of(&w);
+        geom_shape sh = shape_of(&w);
         int checked = 0;
         for (int i = 0; i < 30; i++) {
             double a = 0.37 * i;
@@ -365,7 +365,7 @@ static void test_prism_brute(void **st)
             checked++;
         }
         if (checked < 3) fail_msg("shape %d: only %d rays hit", s, checked);
-        accel_shape_release(&sh);
+        geom_shape_release(&sh);
         done(&w);
     }
 }
@@ -382,7 +382,7 @@ static void test_text(void **st)
     assert_true(o->u.text->nsegments > 8);
     int nseg = o->u.text->nsegments;
     /* the front face lies in z = 0 (up to POV-Ray's 0.001 degree turn), the back in z = 0.25 */
-    accel_shape sh = shape_of(&w);
+    geom_shape sh = shape_of(&w);
     vec3 lo = sh.lo, hi = sh.hi;
     assert_near(lo.z, 0.0, 1e-4);
     assert_near(hi.z, 0.25, 1e-4);
@@ -392,7 +392,7 @@ static void test_text(void **st)
         double x = lo.x + (hi.x - lo.x) * (i + 0.5) / 200.0, y = 0.3;
         accel_hit h;
         vec3 org = v3(x, y, -2);
-        int in = accel_shape_inside(&sh, v3(x, y, 0.125));
+        int in = geom_shape_inside(&sh, v3(x, y, 0.125));
         int got = hit(&w, org, v3(0, 0, 1), &h);
         assert_int_equal(in, got);
         if (got) {
@@ -413,7 +413,7 @@ static void test_text(void **st)
         assert_true(got);
         assert_near(h.t, tb, 1e-8);
     }
-    accel_shape_release(&sh);
+    geom_shape_release(&sh);
     done(&w);
     /* POV-Ray's built-in font 1 is timrom.ttf: the same outline */
     w = build("text { internal 1 \"I-I\" 0.25, 0 }");
@@ -454,7 +454,7 @@ static void test_superellipsoid(void **st)
     done(&w);
     /* <0.5, 3> (not convex in z: sampled), against the inside march */
     w = build("superellipsoid { <0.5, 3> }");
-    accel_shape sh = shape_of(&w);
+    geom_shape sh = shape_of(&w);
     for (int i = 0; i < 20; i++) {
         vec3 o = v3(-3, -0.9 + 0.09 * i, 0.3 - 0.05 * i);
         vec3 d = v3_norm(v3(1, 0.05, 0.1 * sin(i)));
@@ -465,7 +465,7 @@ static void test_superellipsoid(void **st)
         assert_true(got);
         assert_near(h.t, tb, 1e-9);
     }
-    accel_shape_release(&sh);
+    geom_shape_release(&sh);
     done(&w);
 }
 
@@ -483,10 +483,10 @@ static void test_quadric(void **st)
     w = build("quadric { <1,0,1>, <0,0,0>, <0,0,0>, -1 } sphere { <0,0,0>, 0.1 }");
     expect_hit(&w, v3(-5, 1e3, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-9, 1e-9);
     expect_hit(&w, v3(0.5, 3, 0), v3(1, 0, 0), 0.5, v3(1, 0, 0), 1e-12, 1e-12);
-    accel_shape sh = shape_of(&w);
-    assert_true(accel_shape_inside(&sh, v3(0.2, 1e6, 0.2)));
-    assert_false(accel_shape_inside(&sh, v3(1.2, 0, 0)));
-    accel_shape_release(&sh);
+    geom_shape sh = shape_of(&w);
+    assert_true(geom_shape_inside(&sh, v3(0.2, 1e6, 0.2)));
+    assert_false(geom_shape_inside(&sh, v3(1.2, 0, 0)));
+    geom_shape_release(&sh);
     done(&w);
     /* clipped_by { bounded_by }: the cylinder between y = -1 and 1 */
     w = build("quadric { <1,0,1>, <0,0,0>, <0,0,0>, -1 bounded_by { box { <-2,-1,-2>, <2,1,2> } } clipped_by { bounded_by } }");
@@ -565,9 +565,9 @@ static void test_blob(void **st)
     expect_hit(&w, v3(2, 2, -5), v3(0, 0, 1), 5 - d, v3(0, 0, -1), 1e-10, 1e-9);
     expect_hit(&w, v3(2, 10, 0), v3(0, -1, 0), 6 - d, v3(0, 1, 0), 1e-10, 1e-9);
     expect_miss(&w, v3(0, 0, -5), v3(0, 0, 1));
-    accel_shape sh = shape_of(&w);
-    assert_true(accel_shape_inside(&sh, v3(2, 1, 0)));
-    assert_false(accel_shape_inside(&sh, v3(0, 0, 0)));
+    geom_shape sh = shape_of(&w);
+    assert_true(geom_shape_inside(&sh, v3(2, 1, 0)));
+    assert_false(geom_shape_inside(&sh, v3(0, 0, 0)));
     /* a general ray against the march */
     for (int i = 0; i < 10; i++) {
         vec3 o = v3(-6, -1 + 0.3 * i, 0.2);
@@ -579,7 +579,7 @@ static void test_blob(void **st)
         assert_true(got);
         assert_near(h.t, tb, 1e-9);
     }
-    accel_shape_release(&sh);
+    geom_shape_release(&sh);
     done(&w);
 }
 
@@ -622,12 +622,12 @@ static void test_height_field(void **st)
     accel_hit h;
     assert_true(hit(&w, v3(-0.5, 1.0, 0.2), d, &h));
     assert_near(h.p.y, h.p.x * top, 1e-6);
-    accel_shape sh = shape_of(&w);
-    assert_true(accel_shape_inside(&sh, v3(0.5, 0.1, 0.5)));
-    assert_true(accel_shape_inside(&sh, v3(0.5, -10, 0.5)));
-    assert_false(accel_shape_inside(&sh, v3(0.5, 0.9, 0.5)));
-    assert_false(accel_shape_inside(&sh, v3(1.5, 0.1, 0.5)));
-    accel_shape_release(&sh);
+    geom_shape sh = shape_of(&w);
+    assert_true(geom_shape_inside(&sh, v3(0.5, 0.1, 0.5)));
+    assert_true(geom_shape_inside(&sh, v3(0.5, -10, 0.5)));
+    assert_false(geom_shape_inside(&sh, v3(0.5, 0.9, 0.5)));
+    assert_false(geom_shape_inside(&sh, v3(1.5, 0.1, 0.5)));
+    geom_shape_release(&sh);
     done(&w);
     /* water_level raises the low part */
     snprintf(src, sizeof src, "height_field { pgm \"%s\" water_level 0.5 smooth }", path);
@@ -806,11 +806,11 @@ static void test_isosurface(void **st)
     expect_hit(&w, v3(0.3, 5, 0.2), v3(0, -1, 0), 5.0, v3(0, 1, 0), 1e-10, 1e-6);
     expect_hit(&w, v3(-5, -0.5, 0.2), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12);
     expect_miss(&w, v3(-5, 0.5, 0.2), v3(1, 0, 0));
-    accel_shape sh = shape_of(&w);
-    assert_true(accel_shape_inside(&sh, v3(0.2, -0.3, 0.1)));
-    assert_false(accel_shape_inside(&sh, v3(0.2, 0.3, 0.1)));
-    assert_false(accel_shape_inside(&sh, v3(0.2, -1.3, 0.1)));
-    accel_shape_release(&sh);
+    geom_shape sh = shape_of(&w);
+    assert_true(geom_shape_inside(&sh, v3(0.2, -0.3, 0.1)));
+    assert_false(geom_shape_inside(&sh, v3(0.2, 0.3, 0.1)));
+    assert_false(geom_shape_inside(&sh, v3(0.2, -1.3, 0.1)));
+    geom_shape_release(&sh);
     done(&w);
     w = build("isosurface { function { y } open contained_by { sphere { 0, 1 } } threshold 0.25 }");
     expect_miss(&w, v3(-5, -0.5, 0.0), v3(1, 0, 0));
@@ -849,10 +849,10 @@ static void test_julia(void **st)
         expect_hit(&w, v3(-5, y, 0.1), v3(1, 0, 0), 5 - sqrt(x * x - 0.01), v3(-sqrt(x * x - 0.01), y, 0.1), 1e-5, 1e-3);
     }
     expect_miss(&w, v3(-5, 1.01, 0), v3(1, 0, 0));
-    accel_shape sh = shape_of(&w);
-    assert_true(accel_shape_inside(&sh, v3(0.3, 0.4, 0.5)));
-    assert_false(accel_shape_inside(&sh, v3(0.7, 0.6, 0.5)));
-    accel_shape_release(&sh);
+    geom_shape sh = shape_of(&w);
+    assert_true(geom_shape_inside(&sh, v3(0.3, 0.4, 0.5)));
+    assert_false(geom_shape_inside(&sh, v3(0.7, 0.6, 0.5)));
+    geom_shape_release(&sh);
     done(&w);
     w = build("julia_fractal { <0,0,0,0> hypercomplex sqr }");
     expect_hit(&w, v3(-5, 0, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-5, 1e-3);
@@ -1157,7 +1157,7 @@ static void check_sampled(const char *src, double area, unsigned side_lo, unsign
     accel_surf *as = accel_surf_build(w.s, w.a, NULL, NULL, w.d, &ps);
     assert_non_null(as);
     assert_near(accel_surf_total_area(as), area, 1e-9 * area);
-    accel_shape sh = shape_of(&w);
+    geom_shape sh = shape_of(&w);
     rng r;
     rng_seed(&r, 11, 3);
     int side = 0, n = 4000;
@@ -1166,12 +1166,12 @@ static void check_sampled(const char *src, double area, unsigned side_lo, unsign
         assert_true(accel_surf_sample_point(as, rng_f64(&r), rng_f64(&r), rng_f64(&r), &r, &sm));
         assert_near(sm.pdf_area, 1.0 / area, 1e-9 / area);
         double e = 1e-6 * sqrt(area);
-        assert_true(accel_shape_inside(&sh, v3_madd(sm.p, sm.n, -e)));
-        assert_false(accel_shape_inside(&sh, v3_madd(sm.p, sm.n, e)));
+        assert_true(geom_shape_inside(&sh, v3_madd(sm.p, sm.n, -e)));
+        assert_false(geom_shape_inside(&sh, v3_madd(sm.p, sm.n, e)));
         if (sm.prim >= side_lo && sm.prim <= side_hi) side++;
     }
     assert_near((double)side / n, side_fraction, 0.03);
-    accel_shape_release(&sh);
+    geom_shape_release(&sh);
     accel_surf_free(as);
     done(&w);
 }
@@ -1199,7 +1199,7 @@ static void test_sweep_sampling(void **st)
     done(&w);
 }
 
-/* GI sampling of the implicit shapes by random lines (accel_tess.h):
+/* GI sampling of the implicit shapes by random lines (geom_tess.h):
  * the area estimate against closed forms, points on the surface with
  * outward normals, uniform by area (Archimedes: z uniform on a sphere).
  * The estimate's standard error is asked at 0.1% (CROFTON_REL_ERR);
@@ -1230,9 +1230,9 @@ static void check_crofton(const char *src, shape_kind kind, double area, double 
     const scene_object *o = NULL;
     for (int i = 0; i < w.s->nobjects; i++)
         if (w.s->objects[i]->kind == kind) o = w.s->objects[i];
-    accel_shape sh;
-    assert_int_equal(accel_shape_init(&sh, o), 0);
-    if (sh.infinite) accel_shape_clip_plane(&sh, v3s(-1e3), v3s(1e3));
+    geom_shape sh;
+    assert_int_equal(geom_shape_init(&sh, o), 0);
+    if (sh.infinite) geom_shape_clip_plane(&sh, v3s(-1e3), v3s(1e3));
     rng r;
     rng_seed(&r, 5, 9);
     int n = 4000, band = 0;
@@ -1241,7 +1241,7 @@ static void check_crofton(const char *src, shape_kind kind, double area, double 
         assert_true(accel_surf_sample_point(as, rng_f64(&r), rng_f64(&r), rng_f64(&r), &r, &sm));
         assert_near(sm.pdf_area, 1.0 / got, 1e-9 / got);
         double e = 1e-6 * sqrt(area);
-        if (!accel_shape_inside(&sh, v3_madd(sm.p, sm.n, -e)) || accel_shape_inside(&sh, v3_madd(sm.p, sm.n, e)))
+        if (!geom_shape_inside(&sh, v3_madd(sm.p, sm.n, -e)) || geom_shape_inside(&sh, v3_madd(sm.p, sm.n, e)))
             fail_msg("%s: sample %d not on the surface with an outward normal", src, i);
         if (sm.p.z > zlo && sm.p.z < zhi) band++;
         /* the sample's own hit gets the same density */
@@ -1252,7 +1252,7 @@ static void check_crofton(const char *src, shape_kind kind, double area, double 
     /* binomial: 4 standard deviations */
     double sd = sqrt(zfrac * (1 - zfrac) / n);
     if (fabs((double)band / n - zfrac) > 4 * sd) fail_msg("%s: band holds %.4f, expected %.4f", src, (double)band / n, zfrac);
-    accel_shape_release(&sh);
+    geom_shape_release(&sh);
     accel_surf_free(as);
     done(&w);
 }
@@ -1287,7 +1287,7 @@ static void test_implicit_sampling(void **st)
 /* parametric grids for GI: vertices on the surface with outward normals,
  * total area close to the exact one */
 typedef struct {
-    const accel_shape *sh;
+    const geom_shape *sh;
     double area;
     int bad, inside_checks, verts;
 } grid_check;
@@ -1301,7 +1301,7 @@ static int grid_cb(void *ctx, const vec3 p[3], const vec3 n[3])
         if (fabs(v3_len(n[k]) - 1.0) > 1e-9) g->bad += 1000;
         if (g->inside_checks == 2) {
             /* the vertex on the surface to 1e-9, the normal outward */
-            if (!accel_shape_inside(g->sh, v3_madd(p[k], n[k], -1e-9)) || accel_shape_inside(g->sh, v3_madd(p[k], n[k], 1e-9)))
+            if (!geom_shape_inside(g->sh, v3_madd(p[k], n[k], -1e-9)) || geom_shape_inside(g->sh, v3_madd(p[k], n[k], 1e-9)))
                 g->bad++;
         } else if (g->inside_checks) {
             /* back along the normal from just outside: the surface at the vertex */
@@ -1309,8 +1309,8 @@ static int grid_cb(void *ctx, const vec3 p[3], const vec3 n[3])
             vec3 c = v3_scale(v3_add(v3_add(p[0], p[1]), p[2]), 1.0 / 3.0);
             vec3 q = v3_madd(p[k], v3_sub(c, p[k]), 1e-6);
             double e = 1e-3;
-            accel_shape_hit h;
-            if (!accel_shape_intersect(g->sh, v3_madd(q, n[k], e), v3_neg(n[k]), 0.0, 1.0, &h) || fabs(h.t - e) > 1e-8)
+            geom_shape_hit h;
+            if (!geom_shape_intersect(g->sh, v3_madd(q, n[k], e), v3_neg(n[k]), 0.0, 1.0, &h) || fabs(h.t - e) > 1e-8)
                 g->bad++;
         }
     }
@@ -1320,14 +1320,14 @@ static int grid_cb(void *ctx, const vec3 p[3], const vec3 n[3])
 static void check_grid(const char *src, int inside_checks, double area, double rel)
 {
     world w = build(src);
-    accel_shape sh = shape_of(&w);
+    geom_shape sh = shape_of(&w);
     grid_check g = {&sh, 0.0, 0, inside_checks, 0};
-    int nt = accel_shape_grid(&sh, 16, grid_cb, &g);
+    int nt = geom_shape_grid(&sh, 16, grid_cb, &g);
     if (nt <= 0) fail_msg("%s: no grid", src);
     /* (a vertex exactly on a cap's rim may miss the cap by rounding) */
     if (g.bad > g.verts / 100) fail_msg("%s: %d of %d vertices off the surface", src, g.bad, g.verts);
     assert_near(g.area, area, rel * area);
-    accel_shape_release(&sh);
+    geom_shape_release(&sh);
     done(&w);
 }
 
@@ -1345,7 +1345,7 @@ static void test_grid(void **st)
     check_grid("polygon { 10, <-2,-2>, <2,-2>, <2,2>, <-2,2>, <-2,-2>, <-1,-1>, <1,-1>, <1,1>, <-1,1>, <-1,-1> }", 0,
                12.0, 1e-12);
     check_grid("superellipsoid { <1, 1> }", 1, 4 * M_PI, 5e-3);
-    /* marching tetrahedra (accel_tess.h), 16 cells across: the inscribed
+    /* marching tetrahedra (geom_tess.h), 16 cells across: the inscribed
      * triangles' area falls short by O(h^2); 2% at this resolution */
     double d = 2.0 * sqrt(1.0 - sqrt(0.5));
     check_grid("blob { threshold 0.5 sphere { <0,0,0>, 2, 1 } }", 2, 4 * M_PI * d * d, 2e-2);
@@ -1354,11 +1354,11 @@ static void test_grid(void **st)
     check_grid("julia_fractal { <0,0,0,0> quaternion sqr max_iteration 20 precision 50 }", 2, 4 * M_PI, 2e-2);
     if (access("/usr/share/povray-3.7/include/timrom.ttf", R_OK) == 0) {
         world w = build("text { ttf \"timrom.ttf\" \"O\" 0.2, 0 }");
-        accel_shape sh = shape_of(&w);
+        geom_shape sh = shape_of(&w);
         grid_check g = {&sh, 0.0, 0, 0, 0};
-        assert_true(accel_shape_grid(&sh, 8, grid_cb, &g) > 10);
+        assert_true(geom_shape_grid(&sh, 8, grid_cb, &g) > 10);
         assert_int_equal(g.bad, 0);
-        accel_shape_release(&sh);
+        geom_shape_release(&sh);
         done(&w);
     }
 }
@@ -1405,12 +1405,12 @@ static void test_ovus(void **st)
         done(&w);
     }
     w = build("ovus { 1, 0.65 }");
-    accel_shape sh = shape_of(&w);
-    assert_true(accel_shape_inside(&sh, v3(0, 1.5, 0)));
-    assert_true(accel_shape_inside(&sh, v3(0.9, 0.3, 0)));
-    assert_false(accel_shape_inside(&sh, v3(0, 1.66, 0)));
-    assert_false(accel_shape_inside(&sh, v3(0.9, 1.0, 0)));
-    accel_shape_release(&sh);
+    geom_shape sh = shape_of(&w);
+    assert_true(geom_shape_inside(&sh, v3(0, 1.5, 0)));
+    assert_true(geom_shape_inside(&sh, v3(0.9, 0.3, 0)));
+    assert_false(geom_shape_inside(&sh, v3(0, 1.66, 0)));
+    assert_false(geom_shape_inside(&sh, v3(0.9, 1.0, 0)));
+    geom_shape_release(&sh);
     done(&w);
     double u1 = yb - v, u2 = yt - v;
     double area = 2 * M_PI * rb * (yb + rb) + 2 * M_PI * rt * (rb + rt - yt) +

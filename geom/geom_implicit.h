@@ -1,4 +1,4 @@
-/* accel_implicit.h - shapes given by a function f(p) whose sign is the
+/* geom_implicit.h - shapes given by a function f(p) whose sign is the
  * inside test, intersected in double precision in object space:
  *   superellipsoid  ((|x|^(2/e) + |y|^(2/e))^(e/n) + |z|^(2/n))^(n/2) - 1
  *                   (POV-Ray's function raised to the power n/2, which
@@ -15,33 +15,33 @@
  *                   (POV-Ray's rule), sign changes bisected to rounding; the
  *                   container's surface shows where it is inside (not `open`)
  * Quadric, poly and blob are polynomials along a ray (degree 2, order, and 4
- * between consecutive component boundaries), solved with accel_poly
+ * between consecutive component boundaries), solved with geom_poly
  * (`sturm` honoured); the superellipsoid is convex for e, n <= 2, where its
  * two crossings are bracketed around the minimum along the ray, and sampled
  * finely otherwise. Inside means f < 0. */
-#ifndef PT_ACCEL_IMPLICIT_H
-#define PT_ACCEL_IMPLICIT_H
-#include "accel_shapes.h"
+#ifndef PT_GEOM_IMPLICIT_H
+#define PT_GEOM_IMPLICIT_H
+#include "geom_shape.h"
 
 /* Set up sh from o (kinds SHAPE_SUPERELLIPSOID, QUADRIC, POLY, BLOB, ISOSURFACE);
  * object-space bounds in lo/hi, infinite components for unbounded
  * surfaces. May allocate sh->data. -1 when degenerate. */
-int accel_implicit_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
-void accel_implicit_free(void *data);
+int geom_implicit_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
+void geom_implicit_free(void *data);
 /* Object-space ray o + t d, crossings with t in (tmin, tmax), ascending. */
-int accel_implicit_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out,
+int geom_implicit_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out,
                         int max);
-int accel_implicit_inside(const accel_shape *sh, vec3 q);
+int geom_implicit_inside(const geom_shape *sh, vec3 q);
 /* Object-space gradient (outward normal, not unit); part 1 of an
  * isosurface is its container's surface. */
-vec3 accel_implicit_normal(const accel_shape *sh, vec3 q, int part);
+vec3 geom_implicit_normal(const geom_shape *sh, vec3 q, int part);
 /* 1 when the inside is bounded by the shape's own box. */
-int accel_implicit_solid_bounded(const accel_shape *sh);
+int geom_implicit_solid_bounded(const geom_shape *sh);
 /* Blob: the texture of the component contributing most at q (object
  * space), NULL when the blob's own texture applies. */
-const scene_texture *accel_blob_texture(const accel_shape *sh, vec3 q);
+const scene_texture *geom_blob_texture(const geom_shape *sh, vec3 q);
 
-/* Grid triangles (accel_shape_grid) of a superellipsoid; 0 for the others. */
-int accel_implicit_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx);
+/* Grid triangles (geom_shape_grid) of a superellipsoid; 0 for the others. */
+int geom_implicit_grid(const geom_shape *sh, int n, geom_grid_fn fn, void *ctx);
 
 #endif

@@ -1,4 +1,4 @@
-/* accel_csg.c - CSG intersection/difference along a ray (rules in accel_csg.h).
+/* geom_csg.c - CSG intersection/difference along a ray (rules in geom_csg.h).
  *
  * Bounds: every node gets two boxes, S (where its surface can be) and V
  * (where its inside can be), with infinite sides where half-spaces leave
@@ -9,7 +9,7 @@
  * V. difference: S is S_0 plus the subtracted S_k clipped by V_0, V is V_0.
  * The root's S bounds the primitive; an intersection of six planes gets a
  * tight box this way. */
-#include "accel_csg.h"
+#include "geom_csg.h"
 #include <stdlib.h>
 #include <string.h>
 
@@ -33,10 +33,10 @@ static int grow(void **p, int *cap, int need, size_t elem)
     return 1;
 }
 
-int accel_csg_add_node(accel_csg *c, accel_csg_op op, int inverse, int parent)
+int geom_csg_add_node(geom_csg *c, geom_csg_op op, int inverse, int parent)
 {
-    if (!grow((void **)&c->nodes, &c->capnodes, c->nnodes + 1, sizeof(accel_csg_node))) return -1;
-    accel_csg_node *n = &c->nodes[c->nnodes];
+    if (!grow((void **)&c->nodes, &c->capnodes, c->nnodes + 1, sizeof(geom_csg_node))) return -1;
+    geom_csg_node *n = &c->nodes[c->nnodes];
     memset(n, 0, sizeof *n);
     n->op = op;
     n->inverse = inverse != 0;
@@ -45,9 +45,9 @@ int accel_csg_add_node(accel_csg *c, accel_csg_op op, int inverse, int parent)
     return c->nnodes++;
 }
 
-int accel_csg_add_leaf(accel_csg *c, const accel_shape *sh, unsigned tag, int inverse, int parent)
+int geom_csg_add_leaf(geom_csg *c, const geom_shape *sh, unsigned tag, int inverse, int parent)
 {
-    if (!grow((void **)&c->shapes, &c->capshapes, c->nshapes + 1, sizeof(accel_shape))) return -1;
+    if (!grow((void **)&c->shapes, &c->capshapes, c->nshapes + 1, sizeof(geom_shape))) return -1;
     int cap = c->capshapes;
     /* shape_leaf and shape_node follow the capacity of shapes */
     unsigned *sl = realloc(c->shape_leaf, (size_t)cap * sizeof *sl);
@@ -56,7 +56,7 @@ int accel_csg_add_leaf(accel_csg *c, const accel_shape *sh, unsigned tag, int in
     int *sn = realloc(c->shape_node, (size_t)cap * sizeof *sn);
     if (!sn) return -1;
     c->shape_node = sn;
-    int node = accel_csg_add_node(c, CSG_LEAF, inverse, parent);
+    int node = geom_csg_add_node(c, GEOM_CSG_LEAF, inverse, parent);
     if (node < 0) return -1;
     c->shapes[c->nshapes] = *sh;
     c->shape_leaf[c->nshapes] = tag;
@@ -81,7 +81,7 @@ static bbox half_space(vec3 n, vec3 p0)
     return b;
 }
 
-static void leaf_boxes(const accel_shape *sh, int inverse, bbox *s, bbox *v)
+static void leaf_boxes(const geom_shape *sh, int inverse, bbox *s, bbox *v)
 {
     const xform *x = &sh->x;
     bbox own = {sh->lo, sh->hi};
@@ -116,13 +116,13 @@ static void leaf_boxes(const accel_shape *sh, int inverse, bbox *s, bbox *v)
     default:
         /* issue 4 shapes: unbounded surfaces and solids get infinite boxes */
         *s = sh->infinite ? bb_all() : own;
-        *v = accel_shape_solid_bounded(sh) ? own : bb_all();
+        *v = geom_shape_solid_bounded(sh) ? own : bb_all();
         break;
     }
     if (inverse) *v = bb_all();
 }
 
-int accel_csg_finish(accel_csg *c)
+int geom_csg_finish(geom_csg *c)
 {
     if (c->nnodes == 0) return 0;
     /* member lists, in insertion order */
@@ -142,19 +142,19 @@ int accel_csg_finish(accel_csg *c)
         pos += count[i];
     }
     for (int i = 1; i < c->nnodes; i++) {
-        accel_csg_node *p = &c->nodes[c->nodes[i].parent];
+        geom_csg_node *p = &c->nodes[c->nodes[i].parent];
         c->kids[p->first + p->nkids++] = i;
     }
     /* inverse parity, parents before children (parents have smaller
      * indices); a subtracted member counts as inverted (POV-Ray's
      * difference is an intersection with its other members inverted) */
     for (int i = 0; i < c->nnodes; i++) {
-        accel_csg_node *nd = &c->nodes[i];
+        geom_csg_node *nd = &c->nodes[i];
         int odd = nd->inverse;
         if (nd->parent >= 0) {
-            const accel_csg_node *p = &c->nodes[nd->parent];
+            const geom_csg_node *p = &c->nodes[nd->parent];
             odd ^= p->inv_odd;
-            if (p->op == CSG_DIFFERENCE && c->kids[p->first] != i) odd ^= 1;
+            if (p->op == GEOM_CSG_DIFFERENCE && c->kids[p->first] != i) odd ^= 1;
         }
         nd->inv_odd = odd;
     }
@@ -162,34 +162,34 @@ int accel_csg_finish(accel_csg *c)
     for (int s = 0; s < c->nshapes; s++) {
         int flip = 0;
         for (int n = c->shape_node[s]; n >= 0; n = c->nodes[n].parent) {
-            const accel_csg_node *nd = &c->nodes[n];
+            const geom_csg_node *nd = &c->nodes[n];
             if (nd->inverse) flip ^= 1;
             if (nd->parent >= 0) {
-                const accel_csg_node *p = &c->nodes[nd->parent];
-                if (p->op == CSG_DIFFERENCE && c->kids[p->first] != n) flip ^= 1;
+                const geom_csg_node *p = &c->nodes[nd->parent];
+                if (p->op == GEOM_CSG_DIFFERENCE && c->kids[p->first] != n) flip ^= 1;
             }
         }
         c->nodes[c->shape_node[s]].flip = flip;
     }
     /* bounds, children before parents (children have larger indices) */
     for (int i = c->nnodes - 1; i >= 0; i--) {
-        accel_csg_node *nd = &c->nodes[i];
+        geom_csg_node *nd = &c->nodes[i];
         const int *k = c->kids + nd->first;
         int n = nd->nkids;
         bbox s = bb_empty(), v = bb_empty();
         switch (nd->op) {
-        case CSG_LEAF:
+        case GEOM_CSG_LEAF:
             leaf_boxes(&c->shapes[nd->shape], nd->inverse, &s, &v);
             if (nd->nosurf) s = bb_empty();
             break;
-        case CSG_UNION:
-        case CSG_MERGE:
+        case GEOM_CSG_UNION:
+        case GEOM_CSG_MERGE:
             for (int j = 0; j < n; j++) {
                 s = bb_union(s, S[k[j]]);
                 v = bb_union(v, V[k[j]]);
             }
             break;
-        case CSG_INTERSECTION:
+        case GEOM_CSG_INTERSECTION:
             v = n > 0 ? bb_all() : bb_empty();
             for (int j = 0; j < n; j++) {
                 v = bb_inter(v, V[k[j]]);
@@ -199,7 +199,7 @@ int accel_csg_finish(accel_csg *c)
                 s = bb_union(s, sj);
             }
             break;
-        case CSG_DIFFERENCE:
+        case GEOM_CSG_DIFFERENCE:
             if (n > 0) {
                 s = S[k[0]];
                 v = V[k[0]];
@@ -207,7 +207,7 @@ int accel_csg_finish(accel_csg *c)
             }
             break;
         }
-        if (nd->op != CSG_LEAF && nd->inverse) v = bb_all();
+        if (nd->op != GEOM_CSG_LEAF && nd->inverse) v = bb_all();
         /* normalise empty boxes so unions with them stay neutral */
         S[i] = bb_empty_p(s) ? bb_empty() : s;
         V[i] = bb_empty_p(v) ? bb_empty() : v;
@@ -221,18 +221,18 @@ int accel_csg_finish(accel_csg *c)
     return ok;
 }
 
-void accel_csg_clip(accel_csg *c, vec3 lo, vec3 hi)
+void geom_csg_clip(geom_csg *c, vec3 lo, vec3 hi)
 {
     for (int i = 0; i < c->nshapes; i++)
-        if (c->shapes[i].kind == SHAPE_PLANE || c->shapes[i].infinite) accel_shape_clip_plane(&c->shapes[i], lo, hi);
+        if (c->shapes[i].kind == SHAPE_PLANE || c->shapes[i].infinite) geom_shape_clip_plane(&c->shapes[i], lo, hi);
     c->lo = v3_max(c->lo, lo);
     c->hi = v3_min(c->hi, hi);
 }
 
-void accel_csg_free(accel_csg *c)
+void geom_csg_free(geom_csg *c)
 {
     if (!c) return;
-    for (int i = 0; i < c->nshapes; i++) accel_shape_release(&c->shapes[i]);
+    for (int i = 0; i < c->nshapes; i++) geom_shape_release(&c->shapes[i]);
     free(c->nodes);
     free(c->kids);
     free(c->shapes);
@@ -241,55 +241,55 @@ void accel_csg_free(accel_csg *c)
     memset(c, 0, sizeof *c);
 }
 
-int accel_csg_inside(const accel_csg *c, int node, vec3 p)
+int geom_csg_inside(const geom_csg *c, int node, vec3 p)
 {
-    const accel_csg_node *nd = &c->nodes[node];
+    const geom_csg_node *nd = &c->nodes[node];
     const int *k = c->kids + nd->first;
     int r = 0;
     switch (nd->op) {
-    case CSG_LEAF:
-        r = accel_shape_inside(&c->shapes[nd->shape], p);
+    case GEOM_CSG_LEAF:
+        r = geom_shape_inside(&c->shapes[nd->shape], p);
         break;
-    case CSG_UNION:
-    case CSG_MERGE:
-        for (int j = 0; j < nd->nkids && !r; j++) r = accel_csg_inside(c, k[j], p);
+    case GEOM_CSG_UNION:
+    case GEOM_CSG_MERGE:
+        for (int j = 0; j < nd->nkids && !r; j++) r = geom_csg_inside(c, k[j], p);
         break;
-    case CSG_INTERSECTION:
+    case GEOM_CSG_INTERSECTION:
         r = nd->nkids > 0;
-        for (int j = 0; j < nd->nkids && r; j++) r = accel_csg_inside(c, k[j], p);
+        for (int j = 0; j < nd->nkids && r; j++) r = geom_csg_inside(c, k[j], p);
         break;
-    case CSG_DIFFERENCE:
-        r = nd->nkids > 0 && accel_csg_inside(c, k[0], p);
-        for (int j = 1; j < nd->nkids && r; j++) r = !accel_csg_inside(c, k[j], p);
+    case GEOM_CSG_DIFFERENCE:
+        r = nd->nkids > 0 && geom_csg_inside(c, k[0], p);
+        for (int j = 1; j < nd->nkids && r; j++) r = !geom_csg_inside(c, k[j], p);
         break;
     }
     return r ^ nd->inverse;
 }
 
 /* Does a crossing of leaf `node`'s surface at p belong to the result? */
-static int kept(const accel_csg *c, int node, vec3 p)
+static int kept(const geom_csg *c, int node, vec3 p)
 {
     int child = node;
     for (int par = c->nodes[child].parent; par >= 0; child = par, par = c->nodes[par].parent) {
-        const accel_csg_node *P = &c->nodes[par];
+        const geom_csg_node *P = &c->nodes[par];
         const int *k = c->kids + P->first;
-        accel_csg_op op = P->op;
+        geom_csg_op op = P->op;
         /* an inverted union is POV-Ray's intersection of inverted members:
-         * its surfaces are a merge's (accel_csg.h) */
-        if (op == CSG_UNION && P->inv_odd) op = CSG_MERGE;
+         * its surfaces are a merge's (geom_csg.h) */
+        if (op == GEOM_CSG_UNION && P->inv_odd) op = GEOM_CSG_MERGE;
         switch (op) {
-        case CSG_MERGE:
+        case GEOM_CSG_MERGE:
             for (int j = 0; j < P->nkids; j++)
-                if (k[j] != child && accel_csg_inside(c, k[j], p)) return 0;
+                if (k[j] != child && geom_csg_inside(c, k[j], p)) return 0;
             break;
-        case CSG_INTERSECTION:
+        case GEOM_CSG_INTERSECTION:
             for (int j = 0; j < P->nkids; j++)
-                if (k[j] != child && !accel_csg_inside(c, k[j], p)) return 0;
+                if (k[j] != child && !geom_csg_inside(c, k[j], p)) return 0;
             break;
-        case CSG_DIFFERENCE:
-            if (k[0] != child && !accel_csg_inside(c, k[0], p)) return 0;
+        case GEOM_CSG_DIFFERENCE:
+            if (k[0] != child && !geom_csg_inside(c, k[0], p)) return 0;
             for (int j = 1; j < P->nkids; j++)
-                if (k[j] != child && accel_csg_inside(c, k[j], p)) return 0;
+                if (k[j] != child && geom_csg_inside(c, k[j], p)) return 0;
             break;
         default:
             break;
@@ -303,7 +303,7 @@ static int kept(const accel_csg *c, int node, vec3 p)
  * nearest kept crossing over all members is the answer. */
 #define CSG_CHUNK 8
 
-int accel_csg_intersect(const accel_csg *c, vec3 org, vec3 dir, double tmin, double tmax, accel_csg_hit *h)
+int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, geom_csg_hit *h)
 {
     int found = 0;
     double best = tmax;
@@ -312,8 +312,8 @@ int accel_csg_intersect(const accel_csg *c, vec3 org, vec3 dir, double tmin, dou
         if (c->nodes[node].nosurf) continue;
         double from = tmin;
         for (int guard = 0; guard < 1000; guard++) {
-            accel_shape_hit tmp[CSG_CHUNK];
-            int k = accel_shape_hits(&c->shapes[s], org, dir, from, best, tmp, CSG_CHUNK);
+            geom_shape_hit tmp[CSG_CHUNK];
+            int k = geom_shape_hits(&c->shapes[s], org, dir, from, best, tmp, CSG_CHUNK);
             int kept_one = 0;
             for (int j = 0; j < k; j++) {
                 if (kept(c, node, v3_madd(org, dir, tmp[j].t))) {

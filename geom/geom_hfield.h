@@ -1,4 +1,4 @@
-/* accel_hfield.h - POV-Ray height_field intersected exactly as its
+/* geom_hfield.h - POV-Ray height_field intersected exactly as its
  * triangles, in double precision, by a front-to-back walk of a min/max
  * quadtree over the grid cells (each node: the cells it covers and their
  * height range).
@@ -11,31 +11,31 @@
  * point is inside when it lies over the square and below the surface.
  * `smooth` interpolates vertex normals (central differences of the grid)
  * for shading. Part = 2 * cell + triangle. */
-#ifndef PT_ACCEL_HFIELD_H
-#define PT_ACCEL_HFIELD_H
-#include "accel_shapes.h"
+#ifndef PT_GEOM_HFIELD_H
+#define PT_GEOM_HFIELD_H
+#include "geom_shape.h"
 
-int accel_hfield_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
-void accel_hfield_free(void *data);
-int accel_hfield_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max);
-int accel_hfield_inside(const accel_shape *sh, vec3 q);
+int geom_hfield_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
+void geom_hfield_free(void *data);
+int geom_hfield_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max);
+int geom_hfield_inside(const geom_shape *sh, vec3 q);
 /* Object-space geometric normal of the triangle `part` and (u, v) = (x, z). */
-void accel_hfield_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v);
+void geom_hfield_surface(const geom_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v);
 /* Object-space smooth shading normal at q (0 when the field is not smooth). */
-vec3 accel_hfield_shading(const accel_shape *sh, vec3 q);
+vec3 geom_hfield_shading(const geom_shape *sh, vec3 q);
 
 /* Triangle count (2 per cell) and triangle `part` in object space. */
-int accel_hfield_ntriangles(const accel_shape *sh);
-void accel_hfield_triangle(const accel_shape *sh, int part, vec3 *a, vec3 *b, vec3 *c);
+int geom_hfield_ntriangles(const geom_shape *sh);
+void geom_hfield_triangle(const geom_shape *sh, int part, vec3 *a, vec3 *b, vec3 *c);
 
 /* Cells along x and z (0 when the field has no data). */
-void accel_hfield_cells(const accel_shape *sh, int *nx, int *nz);
+void geom_hfield_cells(const geom_shape *sh, int *nx, int *nz);
 /* A coarser grid for GI's radiance particles (gi_surface): the grid points
  * every sx-th along x and sz-th along z (and the last ones), split along
  * the same diagonal as the cells; vertices on the exact surface, object
  * normals from central differences over the coarse neighbours. Strides 1
  * give the field's own triangles. Calls fn per triangle; returns their
  * number, -1 when fn returned 0. */
-int accel_hfield_coarse_grid(const accel_shape *sh, int sx, int sz, accel_grid_fn fn, void *ctx);
+int geom_hfield_coarse_grid(const geom_shape *sh, int sx, int sz, geom_grid_fn fn, void *ctx);
 
 #endif

@@ -1,4 +1,4 @@
-/* accel_fractal.h - julia_fractal: 4-D Julia sets (quaternion or
+/* geom_fractal.h - julia_fractal: 4-D Julia sets (quaternion or
  * hypercomplex) cut by a 3-D slice, as POV-Ray 3.7 defines them.
  *
  * Inside = the iterates z -> f(z) + c of the sliced point stay within the
@@ -11,14 +11,14 @@
  * gradient of |z_N|^2 at the crossing's inside point, by forward-mode
  * derivatives through the iteration (quaternion products; hypercomplex
  * numbers as two complex numbers, where any analytic f applies). */
-#ifndef PT_ACCEL_FRACTAL_H
-#define PT_ACCEL_FRACTAL_H
-#include "accel_shapes.h"
+#ifndef PT_GEOM_FRACTAL_H
+#define PT_GEOM_FRACTAL_H
+#include "geom_shape.h"
 
-int accel_fractal_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
-void accel_fractal_free(void *data);
-int accel_fractal_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max);
-int accel_fractal_inside(const accel_shape *sh, vec3 q);
-vec3 accel_fractal_normal(const accel_shape *sh, vec3 q);
+int geom_fractal_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
+void geom_fractal_free(void *data);
+int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max);
+int geom_fractal_inside(const geom_shape *sh, vec3 q);
+vec3 geom_fractal_normal(const geom_shape *sh, vec3 q);
 
 #endif

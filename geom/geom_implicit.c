@@ -1,4 +1,4 @@
-/* accel_implicit.c - superellipsoid, quadric, poly and blob (accel_implicit.h).
+/* geom_implicit.c - superellipsoid, quadric, poly and blob (geom_implicit.h).
  *
  * Rays are moved to the start of their interval with a unit direction
  * before polynomial coefficients are formed, so the coefficients stay O(size)
@@ -7,12 +7,12 @@
  * a cylinder component is the capsule around its axis segment (hemispherical
  * ends); the surface is where the sum equals the threshold, the inside where
  * it exceeds it. */
-#include "accel_implicit.h"
+#include "geom_implicit.h"
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include "accel_poly.h"
+#include "geom_poly.h"
 #include "func.h"
 
 enum { IM_SUPER, IM_QUADRIC, IM_POLY, IM_BLOB, IM_ISO };
@@ -52,7 +52,7 @@ typedef struct {
 /* The renderer's evaluators for functions (noise, pigments); process-wide. */
 static const func_env *volatile g_func_env;
 
-void accel_set_function_env(const func_env *env) { g_func_env = env; }
+void geom_set_function_env(const func_env *env) { g_func_env = env; }
 
 /* ------------------------------------------------------------ superellipsoid */
 
@@ -152,7 +152,7 @@ static int se_piece(const im_data *m, vec3 o, vec3 d, double a, double b, double
     return nr;
 }
 
-static int se_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+static int se_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     double t0, t1;
     if (!v3_slab(o, d, v3s(-1.0 - 1e-9), v3s(1.0 + 1e-9), &t0, &t1)) return 0;
@@ -203,7 +203,7 @@ static int se_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, a
     int n = 0;
     for (int i = 0; i < nr; i++) {
         double t = t0 + roots[i] / s;
-        if (t > tmin && t < tmax) n = accel_shape_hit_put(out, n, max, t, 0);
+        if (t > tmin && t < tmax) n = geom_shape_hit_put(out, n, max, t, 0);
     }
     return n;
 }
@@ -222,11 +222,11 @@ static vec3 quadric_grad(const double *a, vec3 p)
               2.0 * a[2] * p.z + a[4] * p.x + a[5] * p.y + a[8]);
 }
 
-static int quadric_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+static int quadric_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     if (!isfinite(tmin)) tmin = -1e300;
     double t0 = tmin;
-    if (!isfinite(tmax)) return 0; /* unbounded ranges come clipped by accel_shapes */
+    if (!isfinite(tmax)) return 0; /* unbounded ranges come clipped by geom_shape_clip_plane */
     double s = v3_len(d);
     vec3 e = v3_scale(d, 1.0 / s), p = v3_madd(o, d, t0);
     const double *a = m->a;
@@ -235,11 +235,11 @@ static int quadric_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tm
     vec3 g = quadric_grad(a, p);
     double B = v3_dot(g, e), C = quadric_eval(a, p);
     double c[3] = {C, B, A}, roots[2];
-    int nr = accel_poly_solve(c, 2, 0.0, (tmax - t0) * s, roots, 0);
+    int nr = geom_poly_solve(c, 2, 0.0, (tmax - t0) * s, roots, 0);
     int n = 0;
     for (int i = 0; i < nr; i++) {
         double t = t0 + roots[i] / s;
-        if (t > tmin && t < tmax) n = accel_shape_hit_put(out, n, max, t, 0);
+        if (t > tmin && t < tmax) n = geom_shape_hit_put(out, n, max, t, 0);
     }
     return n;
 }
@@ -290,7 +290,7 @@ static double ipow(double x, int n)
 
 static double poly_eval3(const im_data *m, vec3 p)
 {
-    double xs[ACCEL_POLY_MAX + 1], ys[ACCEL_POLY_MAX + 1], zs[ACCEL_POLY_MAX + 1];
+    double xs[GEOM_POLY_MAX + 1], ys[GEOM_POLY_MAX + 1], zs[GEOM_POLY_MAX + 1];
     xs[0] = ys[0] = zs[0] = 1.0;
     for (int i = 1; i <= m->order; i++) {
         xs[i] = xs[i - 1] * p.x;
@@ -319,7 +319,7 @@ static vec3 poly_grad(const im_data *m, vec3 p)
 }
 
 /* Coefficients of (a + b t)^i for i = 0..n: row i, entry j = C(i,j) a^(i-j) b^j. */
-static void lin_powers(double a, double b, int n, double P[][ACCEL_POLY_MAX + 1])
+static void lin_powers(double a, double b, int n, double P[][GEOM_POLY_MAX + 1])
 {
     P[0][0] = 1.0;
     for (int i = 1; i <= n; i++) {
@@ -332,19 +332,19 @@ static void lin_powers(double a, double b, int n, double P[][ACCEL_POLY_MAX + 1]
     }
 }
 
-static int poly_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+static int poly_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     if (!isfinite(tmax) || !isfinite(tmin)) return 0;
     double t0 = tmin;
     double s = v3_len(d);
     vec3 e = v3_scale(d, 1.0 / s), p = v3_madd(o, d, t0);
     int n = m->order;
-    static _Thread_local double X[ACCEL_POLY_MAX + 1][ACCEL_POLY_MAX + 1], Y[ACCEL_POLY_MAX + 1][ACCEL_POLY_MAX + 1],
-        Z[ACCEL_POLY_MAX + 1][ACCEL_POLY_MAX + 1];
+    static _Thread_local double X[GEOM_POLY_MAX + 1][GEOM_POLY_MAX + 1], Y[GEOM_POLY_MAX + 1][GEOM_POLY_MAX + 1],
+        Z[GEOM_POLY_MAX + 1][GEOM_POLY_MAX + 1];
     lin_powers(p.x, e.x, n, X);
     lin_powers(p.y, e.y, n, Y);
     lin_powers(p.z, e.z, n, Z);
-    double c[ACCEL_POLY_MAX + 1] = {0}, xy[2 * ACCEL_POLY_MAX + 1];
+    double c[GEOM_POLY_MAX + 1] = {0}, xy[2 * GEOM_POLY_MAX + 1];
     for (int t = 0; t < m->nterms; t++) {
         double cf = m->coef[t];
         if (cf == 0.0) continue;
@@ -355,12 +355,12 @@ static int poly_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax,
         for (int a = 0; a <= i + j; a++)
             for (int b = 0; b <= k; b++) c[a + b] += cf * xy[a] * Z[k][b];
     }
-    double roots[ACCEL_POLY_MAX];
-    int nr = accel_poly_solve(c, n, 0.0, (tmax - t0) * s, roots, m->sturm);
+    double roots[GEOM_POLY_MAX];
+    int nr = geom_poly_solve(c, n, 0.0, (tmax - t0) * s, roots, m->sturm);
     int nh = 0;
     for (int i = 0; i < nr; i++) {
         double t = t0 + roots[i] / s;
-        if (t > tmin && t < tmax) nh = accel_shape_hit_put(out, nh, max, t, 0);
+        if (t > tmin && t < tmax) nh = geom_shape_hit_put(out, nh, max, t, 0);
     }
     return nh;
 }
@@ -401,7 +401,7 @@ static int blob_spans(const blob_comp *c, vec3 p, vec3 e, double ta, double tb, 
         vec3 rel = v3_sub(oc, ctr);
         double q2 = v3_dot(dc, dc), q1 = 2.0 * v3_dot(rel, dc), q0 = v3_dot(rel, rel);
         double qc[3] = {q0 - c->r2, q1, q2}, r[2];
-        if (accel_poly_solve(qc, 2, -INFINITY, INFINITY, r, 0) < 2) continue;
+        if (geom_poly_solve(qc, 2, -INFINITY, INFINITY, r, 0) < 2) continue;
         double a = r[0], b = r[1];
         if (c->cylinder) {
             /* hemispheres: the part beyond the end along the axis */
@@ -430,7 +430,7 @@ static int blob_spans(const blob_comp *c, vec3 p, vec3 e, double ta, double tb, 
         double a, b;
         if (q2 > 0.0) {
             double qc[3] = {q0 - c->r2, q1, q2}, r[2];
-            if (accel_poly_solve(qc, 2, -INFINITY, INFINITY, r, 0) < 2) return n;
+            if (geom_poly_solve(qc, 2, -INFINITY, INFINITY, r, 0) < 2) return n;
             a = r[0];
             b = r[1];
         } else {
@@ -466,7 +466,7 @@ static int cmp_event(const void *x, const void *y)
     return a->t < b->t ? -1 : (a->t > b->t);
 }
 
-static int blob_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+static int blob_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     double b0, b1;
     if (!v3_slab(o, d, m->blo, m->bhi, &b0, &b1)) return 0;
@@ -516,10 +516,10 @@ static int blob_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax,
                     c[4] += q->s * u2 * u2;
                 }
                 double roots[4];
-                int nr = accel_poly_solve(c, 4, a, b, roots, m->sturm);
+                int nr = geom_poly_solve(c, 4, a, b, roots, m->sturm);
                 for (int i = 0; i < nr; i++) {
                     double t = t0 + roots[i] / s;
-                    if (t > tmin && t < tmax) n = accel_shape_hit_put(out, n, max, t, 0);
+                    if (t > tmin && t < tmax) n = geom_shape_hit_put(out, n, max, t, 0);
                 }
             }
         }
@@ -633,7 +633,7 @@ static int iso_container(const im_data *m, vec3 o, vec3 d, double *a, double *b)
     if (!m->iso_sphere) return v3_slab(o, d, m->ic1, m->ic2, a, b);
     vec3 oc = v3_sub(o, m->ic1);
     double qc[3] = {v3_dot(oc, oc) - m->ir * m->ir, 2.0 * v3_dot(oc, d), v3_dot(d, d)}, r[2];
-    if (accel_poly_solve(qc, 2, -INFINITY, INFINITY, r, 0) < 2) return 0;
+    if (geom_poly_solve(qc, 2, -INFINITY, INFINITY, r, 0) < 2) return 0;
     *a = r[0];
     *b = r[1];
     return 1;
@@ -649,7 +649,7 @@ static int iso_in_container(const im_data *m, vec3 q)
  * crossing cannot be jumped while max_gradient bounds the slope, POV-Ray's
  * rule), at least `accuracy`; each sign change bisected to rounding. The
  * container's surface counts where it is inside (unless `open`). */
-static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     double ca, cb;
     if (!iso_container(m, o, d, &ca, &cb)) return 0;
@@ -660,8 +660,8 @@ static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, 
     double len = (b - a) * s;
     int n = 0;
     if (!m->open) {
-        if (ca > tmin && ca < tmax && iso_f(m, v3_madd(o, d, ca)) < 0.0) n = accel_shape_hit_put(out, n, max, ca, 1);
-        if (cb > tmin && cb < tmax && iso_f(m, v3_madd(o, d, cb)) < 0.0) n = accel_shape_hit_put(out, n, max, cb, 1);
+        if (ca > tmin && ca < tmax && iso_f(m, v3_madd(o, d, ca)) < 0.0) n = geom_shape_hit_put(out, n, max, ca, 1);
+        if (cb > tmin && cb < tmax && iso_f(m, v3_madd(o, d, cb)) < 0.0) n = geom_shape_hit_put(out, n, max, cb, 1);
     }
     double tau = 0.0, v0 = iso_f(m, p0);
     double minstep = fmax(m->acc, 1e-9 * m->size);
@@ -679,7 +679,7 @@ static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, 
                 if ((fm < 0.0) == (flo < 0.0)) { lo = mid; flo = fm; } else hi = mid;
             }
             double t = a + 0.5 * (lo + hi) / s;
-            if (t > tmin && t < tmax) n = accel_shape_hit_put(out, n, max, t, 0);
+            if (t > tmin && t < tmax) n = geom_shape_hit_put(out, n, max, t, 0);
         }
         tau = t1;
         v0 = v1;
@@ -727,7 +727,7 @@ static const int *poly_powers_alloc(im_data *m, int order, int nterms)
     return idx == nterms ? &m->pw[0][0] : NULL;
 }
 
-int accel_implicit_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
+int geom_implicit_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
 {
     im_data *m = calloc(1, sizeof *m);
     if (!m) return -1;
@@ -770,7 +770,7 @@ int accel_implicit_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *
     }
     case SHAPE_POLY: {
         const scene_poly *pl = o->u.poly;
-        if (!pl || pl->order < 1 || pl->order > ACCEL_POLY_MAX || !pl->coefs) break;
+        if (!pl || pl->order < 1 || pl->order > GEOM_POLY_MAX || !pl->coefs) break;
         m->type = IM_POLY;
         m->order = pl->order;
         m->nterms = pl->ncoefs;
@@ -823,14 +823,14 @@ int accel_implicit_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *
         break;
     }
     if (st != 0) {
-        accel_implicit_free(m);
+        geom_implicit_free(m);
         return -1;
     }
     sh->data = m;
     return 0;
 }
 
-void accel_implicit_free(void *data)
+void geom_implicit_free(void *data)
 {
     im_data *m = data;
     if (!m) return;
@@ -839,7 +839,7 @@ void accel_implicit_free(void *data)
     free(m);
 }
 
-int accel_implicit_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out,
+int geom_implicit_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out,
                         int max)
 {
     const im_data *m = sh->data;
@@ -853,7 +853,7 @@ int accel_implicit_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, doub
     }
 }
 
-int accel_implicit_inside(const accel_shape *sh, vec3 q)
+int geom_implicit_inside(const geom_shape *sh, vec3 q)
 {
     const im_data *m = sh->data;
     if (!m) return 0;
@@ -866,7 +866,7 @@ int accel_implicit_inside(const accel_shape *sh, vec3 q)
     }
 }
 
-vec3 accel_implicit_normal(const accel_shape *sh, vec3 q, int part)
+vec3 geom_implicit_normal(const geom_shape *sh, vec3 q, int part)
 {
     const im_data *m = sh->data;
     if (!m) return v3(0, 1, 0);
@@ -883,13 +883,13 @@ vec3 accel_implicit_normal(const accel_shape *sh, vec3 q, int part)
     }
 }
 
-int accel_implicit_solid_bounded(const accel_shape *sh)
+int geom_implicit_solid_bounded(const geom_shape *sh)
 {
     const im_data *m = sh->data;
     return m && m->solid_bounded;
 }
 
-const scene_texture *accel_blob_texture(const accel_shape *sh, vec3 q)
+const scene_texture *geom_blob_texture(const geom_shape *sh, vec3 q)
 {
     const im_data *m = sh->data;
     if (!m || m->type != IM_BLOB) return NULL;
@@ -911,7 +911,7 @@ const scene_texture *accel_blob_texture(const accel_shape *sh, vec3 q)
 
 static double spow(double x, double p) { return copysign(pow(fabs(x), p), x); }
 
-int accel_implicit_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
+int geom_implicit_grid(const geom_shape *sh, int n, geom_grid_fn fn, void *ctx)
 {
     const im_data *m = sh->data;
     if (!m || m->type != IM_SUPER) return 0;

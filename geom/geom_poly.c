@@ -1,4 +1,4 @@
-/* accel_poly.c - polynomial roots in an interval (accel_poly.h).
+/* geom_poly.c - polynomial roots in an interval (geom_poly.h).
  *
  * Derivative brackets: between consecutive critical points a polynomial is
  * monotonic, so a sign change there brackets exactly one root (the
@@ -10,12 +10,12 @@
  * Sturm: Sturm's theorem (the number of distinct real roots in (a, b] is
  * V(a) - V(b), V the sign changes of the sequence p, p', -rem(p, p'), ...),
  * with bisection until every interval isolates one root. */
-#include "accel_poly.h"
+#include "geom_poly.h"
 #include <float.h>
 #include <math.h>
 #include <string.h>
 
-double accel_poly_eval(const double *c, int n, double x)
+double geom_poly_eval(const double *c, int n, double x)
 {
     double f = c[n];
     for (int i = n - 1; i >= 0; i--) f = f * x + c[i];
@@ -86,7 +86,7 @@ static int solve_brackets(const double *c, int n, double a, double b, double *ro
         if (disc < 0.0) {
             /* touching within rounding: the vertex */
             double xv = -B / (2.0 * A);
-            if (xv >= a && xv <= b && fabs(accel_poly_eval(c, 2, xv)) <= eval_bound(c, 2, xv)) {
+            if (xv >= a && xv <= b && fabs(geom_poly_eval(c, 2, xv)) <= eval_bound(c, 2, xv)) {
                 roots[0] = xv;
                 return 1;
             }
@@ -100,7 +100,7 @@ static int solve_brackets(const double *c, int n, double a, double b, double *ro
         if (r1 >= a && r1 <= b && (nr == 0 || r1 > roots[0])) roots[nr++] = r1;
         return nr;
     }
-    double d[ACCEL_POLY_MAX + 1], crit[ACCEL_POLY_MAX + 1], xs[ACCEL_POLY_MAX + 2];
+    double d[GEOM_POLY_MAX + 1], crit[GEOM_POLY_MAX + 1], xs[GEOM_POLY_MAX + 2];
     for (int i = 0; i < n; i++) d[i] = (double)(i + 1) * c[i + 1];
     int nc = solve_brackets(d, n - 1, a, b, crit);
     xs[0] = a;
@@ -109,18 +109,18 @@ static int solve_brackets(const double *c, int n, double a, double b, double *ro
         if (crit[i] > xs[m - 1] && crit[i] < b) xs[m++] = crit[i];
     xs[m++] = b;
     int nr = 0;
-    double f0 = accel_poly_eval(c, n, a);
+    double f0 = geom_poly_eval(c, n, a);
     if (f0 == 0.0) nr = push_root(roots, nr, a);
     for (int j = 0; j + 1 < m; j++) {
         double x0 = xs[j], x1 = xs[j + 1];
-        double f1 = accel_poly_eval(c, n, x1);
+        double f1 = geom_poly_eval(c, n, x1);
         if (f1 == 0.0) {
             nr = push_root(roots, nr, x1);
         } else if (f0 != 0.0 && (f0 < 0.0) != (f1 < 0.0)) {
             nr = push_root(roots, nr, refine(c, n, x0, x1, f0));
         } else if (j + 2 < m && fabs(f1) <= eval_bound(c, n, x1)) {
             /* an interior critical point touching zero: a double root */
-            double f2 = accel_poly_eval(c, n, xs[j + 2]);
+            double f2 = geom_poly_eval(c, n, xs[j + 2]);
             if ((f0 < 0.0) == (f1 < 0.0) && (f2 < 0.0) == (f1 < 0.0)) nr = push_root(roots, nr, x1);
         }
         f0 = f1;
@@ -131,8 +131,8 @@ static int solve_brackets(const double *c, int n, double a, double b, double *ro
 /* ------------------------------------------------------------ Sturm */
 
 typedef struct {
-    double c[ACCEL_POLY_MAX + 2][ACCEL_POLY_MAX + 1];
-    int deg[ACCEL_POLY_MAX + 2];
+    double c[GEOM_POLY_MAX + 2][GEOM_POLY_MAX + 1];
+    int deg[GEOM_POLY_MAX + 2];
     int len;
 } sturm_seq;
 
@@ -143,10 +143,10 @@ static void sturm_build(sturm_seq *s, const double *c, int n)
     for (int i = 0; i < n; i++) s->c[1][i] = (double)(i + 1) * c[i + 1] / n;
     s->deg[1] = n - 1;
     s->len = 2;
-    while (s->deg[s->len - 1] > 0 && s->len < ACCEL_POLY_MAX + 2) {
+    while (s->deg[s->len - 1] > 0 && s->len < GEOM_POLY_MAX + 2) {
         const double *u = s->c[s->len - 2], *v = s->c[s->len - 1];
         int du = s->deg[s->len - 2], dv = s->deg[s->len - 1];
-        double r[ACCEL_POLY_MAX + 1];
+        double r[GEOM_POLY_MAX + 1];
         memcpy(r, u, sizeof(double) * (size_t)(du + 1));
         /* r = u mod v */
         for (int k = du - dv; k >= 0; k--) {
@@ -172,7 +172,7 @@ static int sturm_changes(const sturm_seq *s, double x)
     int changes = 0;
     double last = 0.0;
     for (int i = 0; i < s->len; i++) {
-        double f = accel_poly_eval(s->c[i], s->deg[i], x);
+        double f = geom_poly_eval(s->c[i], s->deg[i], x);
         if (f == 0.0) continue;
         if (last != 0.0 && (f < 0.0) != (last < 0.0)) changes++;
         last = f;
@@ -185,7 +185,7 @@ static int sturm_isolate(const sturm_seq *s, const double *c, int n, double a, d
 {
     int count = va - vb;
     if (count <= 0) return nr;
-    double fa = accel_poly_eval(c, n, a), fb = accel_poly_eval(c, n, b);
+    double fa = geom_poly_eval(c, n, a), fb = geom_poly_eval(c, n, b);
     if (count == 1 && fa != 0.0 && fb != 0.0 && (fa < 0.0) != (fb < 0.0))
         return push_root(roots, nr, refine(c, n, a, b, fa));
     double m = 0.5 * (a + b);
@@ -205,13 +205,13 @@ static int solve_sturm(const double *c, int n, double a, double b, double *roots
     sturm_seq s;
     sturm_build(&s, c, n);
     int nr = 0;
-    if (accel_poly_eval(c, n, a) == 0.0) nr = push_root(roots, nr, a);
+    if (geom_poly_eval(c, n, a) == 0.0) nr = push_root(roots, nr, a);
     return sturm_isolate(&s, c, n, a, b, sturm_changes(&s, a), sturm_changes(&s, b), roots, nr, 0);
 }
 
-int accel_poly_solve(const double *c, int n, double a, double b, double *roots, int sturm)
+int geom_poly_solve(const double *c, int n, double a, double b, double *roots, int sturm)
 {
-    if (n > ACCEL_POLY_MAX || n < 0 || !(a <= b)) return 0;
+    if (n > GEOM_POLY_MAX || n < 0 || !(a <= b)) return 0;
     for (int i = 0; i <= n; i++)
         if (!isfinite(c[i])) return 0;
     return sturm ? solve_sturm(c, n, a, b, roots) : solve_brackets(c, n, a, b, roots);

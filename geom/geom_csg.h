@@ -1,6 +1,6 @@
-/* accel_csg.h - POV-Ray CSG intersection and difference (with any unions,
+/* geom_csg.h - POV-Ray CSG intersection and difference (with any unions,
  * merges and inverses nested in them) evaluated exactly along a ray, over
- * analytic shapes and triangles (accel_shapes.h).
+ * analytic shapes and triangles (geom_shape.h).
  *
  * The rule is POV-Ray's: a crossing of a member's surface belongs to the
  * result when the point passes the inside tests of that member's siblings,
@@ -16,59 +16,59 @@
  * merge does; the other operations keep the same surfaces either way. The result's inside test combines the members' tests the same way
  * (inverse negates it). accel.c turns each tree into one user-geometry
  * primitive. */
-#ifndef PT_ACCEL_CSG_H
-#define PT_ACCEL_CSG_H
-#include "accel_shapes.h"
+#ifndef PT_GEOM_CSG_H
+#define PT_GEOM_CSG_H
+#include "geom_shape.h"
 
-typedef enum { CSG_LEAF, CSG_UNION, CSG_MERGE, CSG_INTERSECTION, CSG_DIFFERENCE } accel_csg_op;
+typedef enum { GEOM_CSG_LEAF, GEOM_CSG_UNION, GEOM_CSG_MERGE, GEOM_CSG_INTERSECTION, GEOM_CSG_DIFFERENCE } geom_csg_op;
 
 typedef struct {
-    accel_csg_op op;
+    geom_csg_op op;
     int inverse;      /* inside test negated */
     int parent;       /* -1 at the root */
     int first, nkids; /* members: kids[first .. first + nkids) */
-    int shape;        /* CSG_LEAF: index into shapes */
-    int flip;         /* CSG_LEAF: normal points into the result's outside when negated */
-    int nosurf;       /* CSG_LEAF: takes part in inside tests only (a clipped_by
+    int shape;        /* GEOM_CSG_LEAF: index into shapes */
+    int flip;         /* GEOM_CSG_LEAF: normal points into the result's outside when negated */
+    int nosurf;       /* GEOM_CSG_LEAF: takes part in inside tests only (a clipped_by
                          solid); set by the caller after adding the leaf */
     int inv_odd;      /* an odd number of inversions on the node and its
                          ancestors, a subtracted member of a difference
-                         counting as one (set by accel_csg_finish) */
-} accel_csg_node;
+                         counting as one (set by geom_csg_finish) */
+} geom_csg_node;
 
 typedef struct {
-    accel_csg_node *nodes;
+    geom_csg_node *nodes;
     int nnodes, capnodes;
     int *kids;
     int nkids, capkids;
-    accel_shape *shapes;
+    geom_shape *shapes;
     unsigned *shape_leaf;  /* caller's tag per shape (accel.c: its leaf record) */
     int *shape_node;
     int nshapes, capshapes;
     vec3 lo, hi;           /* world bounds of the result's surface (may be infinite before clipping) */
     unsigned flags;        /* caller's tag (accel.c: effective object flags of the root) */
-} accel_csg;
+} geom_csg;
 
 typedef struct {
     double t;
     int shape, part, flip;
-} accel_csg_hit;
+} geom_csg_hit;
 
 /* Building: nodes are added parent first; returns the node index or -1 on
  * out-of-memory. Leaves take a copy of `sh`. */
-int accel_csg_add_node(accel_csg *c, accel_csg_op op, int inverse, int parent);
-int accel_csg_add_leaf(accel_csg *c, const accel_shape *sh, unsigned tag, int inverse, int parent);
+int geom_csg_add_node(geom_csg *c, geom_csg_op op, int inverse, int parent);
+int geom_csg_add_leaf(geom_csg *c, const geom_shape *sh, unsigned tag, int inverse, int parent);
 /* After all nodes are in: fixes the member lists, the normal flips and the
  * bounds (infinite where half-spaces leave it open). Returns 0 when the
  * result is provably empty or has no members. */
-int accel_csg_finish(accel_csg *c);
+int geom_csg_finish(geom_csg *c);
 /* Limit infinite parts (planes, unbounded quadrics and polys) to the world box [lo, hi] and clip the bounds to it. */
-void accel_csg_clip(accel_csg *c, vec3 lo, vec3 hi);
-/* Frees the members' shape data too (accel_shape_release). */
-void accel_csg_free(accel_csg *c);
+void geom_csg_clip(geom_csg *c, vec3 lo, vec3 hi);
+/* Frees the members' shape data too (geom_shape_release). */
+void geom_csg_free(geom_csg *c);
 
 /* Nearest crossing of the result with t in (tmin, tmax). */
-int accel_csg_intersect(const accel_csg *c, vec3 org, vec3 dir, double tmin, double tmax, accel_csg_hit *h);
-int accel_csg_inside(const accel_csg *c, int node, vec3 p);
+int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, geom_csg_hit *h);
+int geom_csg_inside(const geom_csg *c, int node, vec3 p);
 
 #endif

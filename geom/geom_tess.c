@@ -1,5 +1,5 @@
-/* accel_tess.c - surface grids and area sampling for shapes known only
- * through their inside test and their ray crossings (accel_tess.h).
+/* geom_tess.c - surface grids and area sampling for shapes known only
+ * through their inside test and their ray crossings (geom_tess.h).
  *
  * Grid: marching tetrahedra over a lattice of cubes, each cube cut into the
  * six tetrahedra of Kuhn's (Freudenthal's) triangulation (the paths
@@ -20,7 +20,7 @@
  * Probability", 1976, ch. 14), and taking one of a line's k crossings with
  * probability 1 / kmax (accepting the line with probability k / kmax) gives
  * a point whose density is uniform by area. */
-#include "accel_tess.h"
+#include "geom_tess.h"
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -31,7 +31,7 @@
 /* ------------------------------------------------------------ lattice space */
 
 typedef struct {
-    const accel_shape *sh;
+    const geom_shape *sh;
     int world;          /* lattice in world space (unbounded shapes), else object space */
     vec3 lo, step;
     int nx, ny, nz;
@@ -47,7 +47,7 @@ static vec3 to_world(const tess *t, vec3 q) { return t->world || t->sh->identity
 static vec3 to_object(const tess *t, vec3 w) { return t->sh->identity ? w : xform_inv_point(&t->sh->x, w); }
 
 /* Object-space unit normal from a world one: n_o ~ A^T n_w. */
-static vec3 normal_to_object(const accel_shape *sh, vec3 nw)
+static vec3 normal_to_object(const geom_shape *sh, vec3 nw)
 {
     if (sh->identity) return nw;
     const double (*m)[4] = sh->x.m;
@@ -103,10 +103,10 @@ static int cache_grow(tess *t)
 /* The crossing on the lattice edge from a (inside) to b (outside). */
 static void find_crossing(const tess *t, vec3 a, vec3 b, int a_inside, vec3 *p, vec3 *n)
 {
-    const accel_shape *sh = t->sh;
+    const geom_shape *sh = t->sh;
     vec3 wa = to_world(t, a), wb = to_world(t, b);
-    accel_shape_hit h[TESS_MAX_HITS];
-    int nh = accel_shape_hits(sh, wa, v3_sub(wb, wa), 0.0, 1.0, h, TESS_MAX_HITS);
+    geom_shape_hit h[TESS_MAX_HITS];
+    int nh = geom_shape_hits(sh, wa, v3_sub(wb, wa), 0.0, 1.0, h, TESS_MAX_HITS);
     vec3 wp;
     int part = 0;
     if (nh > 0) {
@@ -121,19 +121,19 @@ static void find_crossing(const tess *t, vec3 a, vec3 b, int a_inside, vec3 *p, 
         double lo = 0.0, hi = 1.0;
         for (int it = 0; it < 60; it++) {
             double mid = 0.5 * (lo + hi);
-            int in = accel_shape_inside(sh, v3_madd(wa, v3_sub(wb, wa), mid));
+            int in = geom_shape_inside(sh, v3_madd(wa, v3_sub(wb, wa), mid));
             if (in == a_inside) lo = mid;
             else hi = mid;
         }
         wp = v3_madd(wa, v3_sub(wb, wa), 0.5 * (lo + hi));
         /* part of the nearest crossing of a short probe through the point */
         vec3 d = v3_sub(wb, wa);
-        int np = accel_shape_hits(sh, v3_madd(wp, d, -1e-3), d, 0.0, 2e-3, h, 1);
+        int np = geom_shape_hits(sh, v3_madd(wp, d, -1e-3), d, 0.0, 2e-3, h, 1);
         part = np > 0 ? h[0].part : 0;
     }
     vec3 ng;
     double u, v;
-    accel_shape_surface(sh, wp, part, &ng, &u, &v);
+    geom_shape_surface(sh, wp, part, &ng, &u, &v);
     *p = to_object(t, wp);
     *n = normal_to_object(sh, ng);
 }
@@ -164,7 +164,7 @@ static int edge_crossing(tess *t, int i, int j, int k, int dir, vec3 *p, vec3 *n
 }
 
 /* Emit a triangle, wound so its normal points from `inside_c` to `outside_c`. */
-static int emit(accel_grid_fn fn, void *ctx, vec3 a, vec3 b, vec3 c, vec3 na, vec3 nb, vec3 nc, vec3 inside_c,
+static int emit(geom_grid_fn fn, void *ctx, vec3 a, vec3 b, vec3 c, vec3 na, vec3 nb, vec3 nc, vec3 inside_c,
                 vec3 outside_c, int *count)
 {
     vec3 cr = v3_cross(v3_sub(b, a), v3_sub(c, a));
@@ -179,7 +179,7 @@ static int emit(accel_grid_fn fn, void *ctx, vec3 a, vec3 b, vec3 c, vec3 na, ve
     return 1;
 }
 
-int accel_tess_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
+int geom_tess_grid(const geom_shape *sh, int n, geom_grid_fn fn, void *ctx)
 {
     if (n < 1) return 0;
     tess t;
@@ -214,7 +214,7 @@ int accel_tess_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
     for (int k = 0; k <= t.nz; k++)
         for (int j = 0; j <= t.ny; j++)
             for (int i = 0; i <= t.nx; i++)
-                t.in[lattice_index(&t, i, j, k)] = (unsigned char)(accel_shape_inside(sh, to_world(&t, lattice_point(&t, i, j, k))) != 0);
+                t.in[lattice_index(&t, i, j, k)] = (unsigned char)(geom_shape_inside(sh, to_world(&t, lattice_point(&t, i, j, k))) != 0);
     static const int perm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
     int count = 0, fail = 0;
     for (int k = 0; k < t.nz && !fail; k++)
@@ -294,9 +294,9 @@ static void random_line(vec3 c, double R, double u1, double u2, double u3, doubl
     *dir = w;
 }
 
-static int line_hits(const accel_tess_sampler *cs, vec3 org, vec3 dir, accel_shape_hit *h)
+static int line_hits(const geom_tess_sampler *cs, vec3 org, vec3 dir, geom_shape_hit *h)
 {
-    int k = accel_shape_hits(cs->sh, org, dir, 0.0, 2.0002 * cs->R, h, TESS_MAX_HITS);
+    int k = geom_shape_hits(cs->sh, org, dir, 0.0, 2.0002 * cs->R, h, TESS_MAX_HITS);
     if (!cs->keep) return k;
     int m = 0;
     for (int i = 0; i < k; i++)
@@ -316,7 +316,7 @@ static double radical_inverse(uint64_t i, unsigned b)
     return r;
 }
 
-double accel_tess_sampler_init(accel_tess_sampler *cs, const accel_shape *sh, accel_tess_keep_fn keep,
+double geom_tess_sampler_init(geom_tess_sampler *cs, const geom_shape *sh, geom_tess_keep_fn keep,
                                void *keep_ctx, double rel_err, int max_lines)
 {
     memset(cs, 0, sizeof *cs);
@@ -352,7 +352,7 @@ double accel_tess_sampler_init(accel_tess_sampler *cs, const accel_shape *sh, ac
     double sum = 0.0, sum2 = 0.0;
     int nb = 0, kmax = 0;
     uint64_t idx = 1;
-    accel_shape_hit h[TESS_MAX_HITS];
+    geom_shape_hit h[TESS_MAX_HITS];
     for (int lines = 0; lines < max_lines; lines += BATCH) {
         double bs = 0.0;
         for (int i = 0; i < BATCH; i++, idx++) {
@@ -379,7 +379,7 @@ double accel_tess_sampler_init(accel_tess_sampler *cs, const accel_shape *sh, ac
     return cs->area;
 }
 
-int accel_tess_sample(const accel_tess_sampler *cs, double u1, double u2, rng *r, vec3 *p, vec3 *n, unsigned *part)
+int geom_tess_sample(const geom_tess_sampler *cs, double u1, double u2, rng *r, vec3 *p, vec3 *n, unsigned *part)
 {
     if (!(cs->area > 0.0) || cs->kmax < 1) return 0;
     rng local;
@@ -388,7 +388,7 @@ int accel_tess_sample(const accel_tess_sampler *cs, double u1, double u2, rng *r
         rng_seed(&local, mix(a ^ mix(b)), 17);
         r = &local;
     }
-    accel_shape_hit h[TESS_MAX_HITS];
+    geom_shape_hit h[TESS_MAX_HITS];
     for (int tries = 0; tries < 1 << 16; tries++) {
         vec3 org, dir;
         random_line(cs->c, cs->R, u1, u2, rng_f64(r), rng_f64(r), &org, &dir);
@@ -399,7 +399,7 @@ int accel_tess_sample(const accel_tess_sampler *cs, double u1, double u2, rng *r
             if (j >= k) j = k - 1;
             *p = v3_madd(org, dir, h[j].t);
             double u, v;
-            accel_shape_surface(cs->sh, *p, h[j].part, n, &u, &v);
+            geom_shape_surface(cs->sh, *p, h[j].part, n, &u, &v);
             *part = (unsigned)h[j].part;
             return 1;
         }

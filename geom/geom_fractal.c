@@ -1,11 +1,11 @@
-/* accel_fractal.c - julia_fractal (accel_fractal.h).
+/* geom_fractal.c - julia_fractal (geom_fractal.h).
  *
  * Hypercomplex numbers x + y i + z j + w k (POV-Ray's commutative algebra:
  * its square is (x2 + w2 - y2 - z2, 2(xy - zw), 2(xz - wy), 2(xw + yz)))
  * are handled as the pair of complex numbers a = (x - w) + i (y + z),
  * b = (x + w) + i (y - z): products act on a and b separately, so
  * f(x + y i + z j + w k) is (f(a), f(b)) for any analytic f. */
-#include "accel_fractal.h"
+#include "geom_fractal.h"
 #include <complex.h>
 #include <float.h>
 #include <math.h>
@@ -166,7 +166,7 @@ static int jf_inside(const jf_data *f, vec3 p, vec3 e, double *de)
     return 1;
 }
 
-int accel_fractal_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
+int geom_fractal_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
 {
     const scene_julia *j = o->u.julia;
     if (!j) return -1;
@@ -199,9 +199,9 @@ int accel_fractal_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *h
     return 0;
 }
 
-void accel_fractal_free(void *data) { free(data); }
+void geom_fractal_free(void *data) { free(data); }
 
-int accel_fractal_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     const jf_data *f = sh->data;
     if (!f || max <= 0) return 0;
@@ -230,7 +230,7 @@ int accel_fractal_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, doubl
                 else hi = m;
             }
             double t = a + 0.5 * (lo + hi) / s;
-            if (t > tmin && t < tmax) n = accel_shape_hit_put(out, n, max, t, 0);
+            if (t > tmin && t < tmax) n = geom_shape_hit_put(out, n, max, t, 0);
         }
         tau = tn;
         cur = next;
@@ -239,7 +239,7 @@ int accel_fractal_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, doubl
     return n;
 }
 
-int accel_fractal_inside(const accel_shape *sh, vec3 q)
+int geom_fractal_inside(const geom_shape *sh, vec3 q)
 {
     const jf_data *f = sh->data;
     if (!f || v3_len2(q) > f->R * f->R) return 0;
@@ -247,7 +247,7 @@ int accel_fractal_inside(const accel_shape *sh, vec3 q)
 }
 
 /* Gradient of |z_N|^2 with respect to (x, y, z): z0 moves along the slice. */
-vec3 accel_fractal_normal(const accel_shape *sh, vec3 p)
+vec3 geom_fractal_normal(const geom_shape *sh, vec3 p)
 {
     const jf_data *f = sh->data;
     if (!f) return v3(0, 1, 0);

@@ -1,4 +1,4 @@
-/* accel_hfield.c - height_field (accel_hfield.h).
+/* geom_hfield.c - height_field (geom_hfield.h).
  *
  * Work happens in grid coordinates (X, Y, Z) = (x (W-1), y, z (H-1)), where
  * cells are unit squares; the ray parameter is the same in both. Node
@@ -6,7 +6,7 @@
  * [iz 2^l, (iz+1) 2^l) and stores their height range; children are visited
  * in the order given by the signs of the ray direction, which is front to
  * back for a monotonic 2-D walk, so the search can stop at the first hit. */
-#include "accel_hfield.h"
+#include "geom_hfield.h"
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -32,7 +32,7 @@ static double H_at(const hf_data *f, int i, int j)
     return v > f->water ? v : f->water;
 }
 
-int accel_hfield_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
+int geom_hfield_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
 {
     const scene_height_field *s = o->u.height_field;
     if (!s || !s->heights || s->width < 2 || s->height < 2) return -1;
@@ -54,7 +54,7 @@ int accel_hfield_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi
         f->mx[lev] = malloc(sizeof(float) * (size_t)lw * (size_t)lh);
         if (!f->mn[lev] || !f->mx[lev]) {
             f->nlev = lev + 1;
-            accel_hfield_free(f);
+            geom_hfield_free(f);
             return -1;
         }
         for (int j = 0; j < lh; j++)
@@ -95,7 +95,7 @@ int accel_hfield_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi
     return 0;
 }
 
-void accel_hfield_free(void *data)
+void geom_hfield_free(void *data)
 {
     hf_data *f = data;
     if (!f) return;
@@ -141,7 +141,7 @@ typedef struct {
     const hf_data *f;
     vec3 o, d;      /* grid space */
     double tmin;
-    accel_shape_hit *out;
+    geom_shape_hit *out;
     int n, max;
     double tmax;    /* shrinks once `max` hits are held */
 } hf_walk;
@@ -187,7 +187,7 @@ static void walk(hf_walk *w, int lev, int ix, int iz)
             double t;
             cell_tri(f, ix, iz, tri, &a, &b, &c);
             if (tri_hit(w->o, w->d, a, b, c, &t) && t > w->tmin && t < w->tmax) {
-                w->n = accel_shape_hit_put(w->out, w->n, w->max, t, (int)(2 * ((size_t)iz * f->nx + ix) + tri));
+                w->n = geom_shape_hit_put(w->out, w->n, w->max, t, (int)(2 * ((size_t)iz * f->nx + ix) + tri));
                 if (w->n == w->max) w->tmax = fmin(w->tmax, w->out[w->max - 1].t);
             }
         }
@@ -200,7 +200,7 @@ static void walk(hf_walk *w, int lev, int ix, int iz)
     }
 }
 
-int accel_hfield_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+int geom_hfield_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     const hf_data *f = sh->data;
     if (!f || max <= 0) return 0;
@@ -229,7 +229,7 @@ static void locate(const hf_data *f, double X, double Z, int *i, int *j, double 
     *fz = Z - b;
 }
 
-int accel_hfield_inside(const accel_shape *sh, vec3 q)
+int geom_hfield_inside(const geom_shape *sh, vec3 q)
 {
     const hf_data *f = sh->data;
     if (!f) return 0;
@@ -247,7 +247,7 @@ int accel_hfield_inside(const accel_shape *sh, vec3 q)
     return v3_dot(v3_sub(v3(X, q.y, Z), a), n) < 0.0;
 }
 
-void accel_hfield_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v)
+void geom_hfield_surface(const geom_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v)
 {
     const hf_data *f = sh->data;
     *n = v3(0, 1, 0);
@@ -278,7 +278,7 @@ static vec3 vertex_normal(const hf_data *f, int i, int j)
     return v3_norm(v3(-dx * f->nx, 1.0, -dz * f->nz));
 }
 
-vec3 accel_hfield_shading(const accel_shape *sh, vec3 q)
+vec3 geom_hfield_shading(const geom_shape *sh, vec3 q)
 {
     const hf_data *f = sh->data;
     if (!f || !f->smooth) return v3s(0.0);
@@ -300,13 +300,13 @@ vec3 accel_hfield_shading(const accel_shape *sh, vec3 q)
     return n;
 }
 
-int accel_hfield_ntriangles(const accel_shape *sh)
+int geom_hfield_ntriangles(const geom_shape *sh)
 {
     const hf_data *f = sh->data;
     return f ? 2 * f->nx * f->nz : 0;
 }
 
-void accel_hfield_triangle(const accel_shape *sh, int part, vec3 *a, vec3 *b, vec3 *c)
+void geom_hfield_triangle(const geom_shape *sh, int part, vec3 *a, vec3 *b, vec3 *c)
 {
     const hf_data *f = sh->data;
     int cell = part / 2, i = cell % f->nx, j = cell / f->nx;
@@ -316,7 +316,7 @@ void accel_hfield_triangle(const accel_shape *sh, int part, vec3 *a, vec3 *b, ve
     a->z /= f->nz; b->z /= f->nz; c->z /= f->nz;
 }
 
-void accel_hfield_cells(const accel_shape *sh, int *nx, int *nz)
+void geom_hfield_cells(const geom_shape *sh, int *nx, int *nz)
 {
     const hf_data *f = sh->data;
     *nx = f ? f->nx : 0;
@@ -326,7 +326,7 @@ void accel_hfield_cells(const accel_shape *sh, int *nx, int *nz)
 /* Index of coarse line k of a field with n cells at stride s (the last one n). */
 static int coarse_at(int k, int s, int n) { return k * s < n ? k * s : n; }
 
-int accel_hfield_coarse_grid(const accel_shape *sh, int sx, int sz, accel_grid_fn fn, void *ctx)
+int geom_hfield_coarse_grid(const geom_shape *sh, int sx, int sz, geom_grid_fn fn, void *ctx)
 {
     const hf_data *f = sh->data;
     if (!f || f->nx < 1 || f->nz < 1) return 0;

@@ -1,4 +1,4 @@
-/* accel_shapes.c - double-precision intersection of analytic shapes.
+/* geom_shape.c - double-precision intersection of analytic shapes.
  *
  * Quadratics are solved in the cancellation-free form (roots q/a and c/q with
  * q = -(b + sign(b) sqrt(disc)), Press et al., Numerical Recipes 5.6). For the
@@ -10,26 +10,26 @@
  * (the approach of Yuksel, "High-Performance Polynomial Root Finding for
  * Graphics", HPG 2022), after moving the ray origin to the torus' bounding
  * box and scaling the torus to unit size, so coefficients stay O(1). */
-#include "accel_shapes.h"
+#include "geom_shape.h"
 #include <float.h>
 #include <math.h>
 #include <string.h>
-#include "accel_fractal.h"
-#include "accel_hfield.h"
-#include "accel_implicit.h"
-#include "accel_poly.h"
-#include "accel_sweep.h"
-#include "accel_tess.h"
+#include "geom_fractal.h"
+#include "geom_hfield.h"
+#include "geom_implicit.h"
+#include "geom_poly.h"
+#include "geom_sweep.h"
+#include "geom_tess.h"
 
 #define TWO_PI 6.283185307179586476925
 
 /* ------------------------------------------------------------ polynomials */
 
-/* Real roots in [a, b], ascending: accel_poly.c's derivative-bracket solver
+/* Real roots in [a, b], ascending: geom_poly.c's derivative-bracket solver
  * (one root finder for every shape). */
-int accel_poly_roots(const double *c, int n, double a, double b, double *roots)
+int geom_poly_roots(const double *c, int n, double a, double b, double *roots)
 {
-    return accel_poly_solve(c, n, a, b, roots, 0);
+    return geom_poly_solve(c, n, a, b, roots, 0);
 }
 
 /* Real roots of a t^2 + 2 b t + c = 0 (note the half b), ascending. */
@@ -59,7 +59,7 @@ static double det3(const double m[3][4])
          + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
 }
 
-static void world_bounds(accel_shape *sh, vec3 lo, vec3 hi)
+static void world_bounds(geom_shape *sh, vec3 lo, vec3 hi)
 {
     vec3 wl = v3s(INFINITY), wh = v3s(-INFINITY);
     for (int i = 0; i < 8; i++) {
@@ -81,7 +81,7 @@ static vec3 disc_extent(vec3 n, double r)
 
 static int finite_d(double x) { return isfinite(x); }
 
-int accel_shape_init(accel_shape *sh, const scene_object *o)
+int geom_shape_init(geom_shape *sh, const scene_object *o)
 {
     memset(sh, 0, sizeof *sh);
     sh->kind = o->kind;
@@ -118,7 +118,7 @@ int accel_shape_init(accel_shape *sh, const scene_object *o)
         if (!(l > 0.0) || !finite_d(l) || !finite_d(o->u.plane.offset)) return -1;
         sh->g.plane.n = v3_scale(n, 1.0 / l);
         sh->g.plane.d = o->u.plane.offset / l;
-        /* bounds come from accel_shape_clip_plane */
+        /* bounds come from geom_shape_clip_plane */
         sh->lo = v3s(-1.0);
         sh->hi = v3s(1.0);
         return 0;
@@ -215,22 +215,22 @@ int accel_shape_init(accel_shape *sh, const scene_object *o)
         break;
     }
     case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
-        if (accel_sweep_init(sh, o, &lo, &hi) != 0) return -1;
+        if (geom_sweep_init(sh, o, &lo, &hi) != 0) return -1;
         break;
     case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
-        if (accel_implicit_init(sh, o, &lo, &hi) != 0) return -1;
+        if (geom_implicit_init(sh, o, &lo, &hi) != 0) return -1;
         if (sh->infinite) {
-            /* bounds come from accel_shape_clip_plane, as for planes */
+            /* bounds come from geom_shape_clip_plane, as for planes */
             sh->lo = v3s(-1.0);
             sh->hi = v3s(1.0);
             return 0;
         }
         break;
     case SHAPE_HEIGHT_FIELD:
-        if (accel_hfield_init(sh, o, &lo, &hi) != 0) return -1;
+        if (geom_hfield_init(sh, o, &lo, &hi) != 0) return -1;
         break;
     case SHAPE_JULIA:
-        if (accel_fractal_init(sh, o, &lo, &hi) != 0) return -1;
+        if (geom_fractal_init(sh, o, &lo, &hi) != 0) return -1;
         break;
     default:
         return -1;
@@ -239,27 +239,27 @@ int accel_shape_init(accel_shape *sh, const scene_object *o)
     sh->ohi = hi;
     world_bounds(sh, lo, hi);
     if (!v3_finite(sh->lo) || !v3_finite(sh->hi)) {
-        accel_shape_release(sh);
+        geom_shape_release(sh);
         return -1;
     }
     return 0;
 }
 
-void accel_shape_release(accel_shape *sh)
+void geom_shape_release(geom_shape *sh)
 {
     if (!sh || !sh->data) return;
     switch (sh->kind) {
     case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
-        accel_sweep_free(sh->data);
+        geom_sweep_free(sh->data);
         break;
     case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
-        accel_implicit_free(sh->data);
+        geom_implicit_free(sh->data);
         break;
     case SHAPE_HEIGHT_FIELD:
-        accel_hfield_free(sh->data);
+        geom_hfield_free(sh->data);
         break;
     case SHAPE_JULIA:
-        accel_fractal_free(sh->data);
+        geom_fractal_free(sh->data);
         break;
     default:
         break;
@@ -267,26 +267,26 @@ void accel_shape_release(accel_shape *sh)
     sh->data = NULL;
 }
 
-int accel_shape_solid_bounded(const accel_shape *sh)
+int geom_shape_solid_bounded(const geom_shape *sh)
 {
     switch (sh->kind) {
     case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_TORUS:
     case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT: case SHAPE_JULIA: case SHAPE_OVUS:
         return 1;
     case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
-        return !sh->infinite && accel_implicit_solid_bounded(sh);
+        return !sh->infinite && geom_implicit_solid_bounded(sh);
     default:
         return 0;
     }
 }
 
-const scene_texture *accel_shape_texture(const accel_shape *sh, vec3 p)
+const scene_texture *geom_shape_texture(const geom_shape *sh, vec3 p)
 {
     if (sh->kind != SHAPE_BLOB) return NULL;
-    return accel_blob_texture(sh, sh->identity ? p : xform_inv_point(&sh->x, p));
+    return geom_blob_texture(sh, sh->identity ? p : xform_inv_point(&sh->x, p));
 }
 
-void accel_shape_clip_plane(accel_shape *sh, vec3 lo, vec3 hi)
+void geom_shape_clip_plane(geom_shape *sh, vec3 lo, vec3 hi)
 {
     sh->clipped = 1;
     sh->clip_lo = lo;
@@ -316,7 +316,7 @@ static int in_range(double t, double tmin, double tmax) { return t > tmin && t <
 /* Each hits_* function writes up to `max` crossings with t in (tmin, tmax),
  * in ascending order, and returns how many. */
 
-static int hits_sphere(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+static int hits_sphere(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     vec3 oc = v3_sub(o, sh->g.sphere.c);
     double r = sh->g.sphere.r;
@@ -330,8 +330,8 @@ static int hits_sphere(const accel_shape *sh, vec3 o, vec3 d, double tmin, doubl
     double t0 = q / a, t1 = (q != 0.0) ? c / q : t0;
     if (t0 > t1) { double t = t0; t0 = t1; t1 = t; }
     int n = 0;
-    if (in_range(t0, tmin, tmax)) n = accel_shape_hit_put(out, n, max, t0, 0);
-    if (in_range(t1, tmin, tmax) && t1 > t0) n = accel_shape_hit_put(out, n, max, t1, 0);
+    if (in_range(t0, tmin, tmax)) n = geom_shape_hit_put(out, n, max, t0, 0);
+    if (in_range(t1, tmin, tmax) && t1 > t0) n = geom_shape_hit_put(out, n, max, t1, 0);
     return n;
 }
 
@@ -367,13 +367,13 @@ static int slabs(vec3 o, vec3 d, vec3 lo, vec3 hi, double *tn, int *fn, double *
     return 1;
 }
 
-static int hits_box(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+static int hits_box(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     double t0, t1;
     int f0, f1, n = 0;
     if (!slabs(o, d, sh->g.box.lo, sh->g.box.hi, &t0, &f0, &t1, &f1)) return 0;
-    if (in_range(t0, tmin, tmax)) n = accel_shape_hit_put(out, n, max, t0, f0);
-    if (in_range(t1, tmin, tmax) && t1 > t0) n = accel_shape_hit_put(out, n, max, t1, f1);
+    if (in_range(t0, tmin, tmax)) n = geom_shape_hit_put(out, n, max, t0, f0);
+    if (in_range(t1, tmin, tmax) && t1 > t0) n = geom_shape_hit_put(out, n, max, t1, f1);
     return n;
 }
 
@@ -382,18 +382,18 @@ static int in_box(vec3 p, vec3 lo, vec3 hi)
     return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
 }
 
-static int hits_plane(const accel_shape *sh, vec3 o, vec3 d, vec3 worg, vec3 wdir, double tmin, double tmax,
-                      accel_shape_hit *out, int max)
+static int hits_plane(const geom_shape *sh, vec3 o, vec3 d, vec3 worg, vec3 wdir, double tmin, double tmax,
+                      geom_shape_hit *out, int max)
 {
     double den = v3_dot(sh->g.plane.n, d);
     if (den == 0.0) return 0;
     double t = (sh->g.plane.d - v3_dot(sh->g.plane.n, o)) / den;
     if (!in_range(t, tmin, tmax)) return 0;
     if (sh->clipped && !in_box(v3_madd(worg, wdir, t), sh->clip_lo, sh->clip_hi)) return 0;
-    return accel_shape_hit_put(out, 0, max, t, 0);
+    return geom_shape_hit_put(out, 0, max, t, 0);
 }
 
-static int hits_cone(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+static int hits_cone(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     vec3 rel = v3_sub(o, sh->g.cone.base);
     double ox = v3_dot(rel, sh->g.cone.u), oy = v3_dot(rel, sh->g.cone.v), oz = v3_dot(rel, sh->g.cone.w);
@@ -412,7 +412,7 @@ static int hits_cone(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
         if (!in_range(t, tmin, tmax) || (i == 1 && t == ts[0])) continue;
         double z = oz + t * dz;
         if (z < 0.0 || z > H) continue;
-        n = accel_shape_hit_put(out, n, max, t, ACCEL_PART_CONE_SIDE);
+        n = geom_shape_hit_put(out, n, max, t, GEOM_PART_CONE_SIDE);
     }
     if (!sh->open && dz != 0.0) {
         for (int e = 0; e < 2; e++) {
@@ -422,13 +422,13 @@ static int hits_cone(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
             if (!in_range(t, tmin, tmax)) continue;
             double x = ox + t * dx, y = oy + t * dy;
             if (x * x + y * y > rc * rc) continue;
-            n = accel_shape_hit_put(out, n, max, t, e ? ACCEL_PART_CONE_CAP : ACCEL_PART_CONE_BASE);
+            n = geom_shape_hit_put(out, n, max, t, e ? GEOM_PART_CONE_CAP : GEOM_PART_CONE_BASE);
         }
     }
     return n;
 }
 
-static int hits_disc(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+static int hits_disc(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     double den = v3_dot(sh->g.disc.n, d);
     if (den == 0.0) return 0;
@@ -436,11 +436,11 @@ static int hits_disc(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
     if (!in_range(t, tmin, tmax)) return 0;
     double r2 = v3_len2(v3_sub(v3_madd(o, d, t), sh->g.disc.c));
     if (r2 > sh->g.disc.r2 || r2 < sh->g.disc.h2) return 0;
-    return accel_shape_hit_put(out, 0, max, t, 0);
+    return geom_shape_hit_put(out, 0, max, t, 0);
 }
 
 /* Double-precision Moller-Trumbore (Moller & Trumbore 1997). */
-static int hits_triangle(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out,
+static int hits_triangle(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out,
                          int max)
 {
     vec3 e1 = sh->g.tri.e1, e2 = sh->g.tri.e2;
@@ -456,10 +456,10 @@ static int hits_triangle(const accel_shape *sh, vec3 o, vec3 d, double tmin, dou
     if (v < 0.0 || u + v > 1.0) return 0;
     double t = v3_dot(e2, qv) * inv;
     if (!in_range(t, tmin, tmax)) return 0;
-    return accel_shape_hit_put(out, 0, max, t, 0);
+    return geom_shape_hit_put(out, 0, max, t, 0);
 }
 
-static int hits_torus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+static int hits_torus(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     double s = v3_len(d);
     if (!(s > 0.0) || !isfinite(s)) return 0;
@@ -490,12 +490,12 @@ static int hits_torus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double
     c[1] = 4.0 * f * G - 8.0 * R1 * R1 * B;
     c[0] = G * G - 4.0 * R1 * R1 * C;
     double roots[4];
-    int nr = accel_poly_roots(c, 4, 0.0, hi - lo, roots), n = 0;
+    int nr = geom_poly_roots(c, 4, 0.0, hi - lo, roots), n = 0;
     for (int i = 0; i < nr && n < max; i++) {
         double tau = lo + roots[i];
         if (!(tau > ta && tau < tb)) continue;
         double t = tau / sk;
-        if (in_range(t, tmin, tmax)) n = accel_shape_hit_put(out, n, max, t, 0);
+        if (in_range(t, tmin, tmax)) n = geom_shape_hit_put(out, n, max, t, 0);
     }
     return n;
 }
@@ -504,7 +504,7 @@ static int hits_torus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double
  * padded box; each sphere's roots where that sphere is the surface, the
  * spindle torus' quartic (the torus equation with major radius h, tube rc,
  * centred at y = v) where the lemon is, on the lemon's branch. */
-static int hits_ovus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+static int hits_ovus(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     double s = v3_len(d);
     if (!(s > 0.0) || !isfinite(s)) return 0;
@@ -538,7 +538,7 @@ static int hits_ovus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
             double y = q.y + e.y * rr[i];
             if (sp ? y > yt : y < yb) {
                 cand[nc] = rr[i];
-                part[nc++] = sp ? ACCEL_PART_OVUS_TOP : ACCEL_PART_OVUS_BOTTOM;
+                part[nc++] = sp ? GEOM_PART_OVUS_TOP : GEOM_PART_OVUS_BOTTOM;
             }
         }
     }
@@ -553,7 +553,7 @@ static int hits_ovus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
     c[1] = 4.0 * f * G - 8.0 * H * H * B;
     c[0] = G * G - 4.0 * H * H * C;
     double roots[4];
-    int nr = accel_poly_roots(c, 4, 0.0, hi - lo, roots);
+    int nr = geom_poly_roots(c, 4, 0.0, hi - lo, roots);
     for (int i = 0; i < nr; i++) {
         vec3 p = v3_madd(q, e, roots[i]);
         if (!(p.y > yb && p.y < yt)) continue;
@@ -561,7 +561,7 @@ static int hits_ovus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
         double inner = (hh + H) * (hh + H) + dy * dy - rc * rc, outer = (hh - H) * (hh - H) + dy * dy - rc * rc;
         if (fabs(inner) <= fabs(outer)) {
             cand[nc] = roots[i];
-            part[nc++] = ACCEL_PART_OVUS_LEMON;
+            part[nc++] = GEOM_PART_OVUS_LEMON;
         }
     }
     int n = 0;
@@ -569,13 +569,13 @@ static int hits_ovus(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
         double tau = lo + cand[i];
         if (!(tau > ta && tau < tb)) continue;
         double t = tau / sk;
-        if (in_range(t, tmin, tmax)) n = accel_shape_hit_put(out, n, max, t, part[i]);
+        if (in_range(t, tmin, tmax)) n = geom_shape_hit_put(out, n, max, t, part[i]);
     }
     return n;
 }
 
 /* Parameter interval of a ray inside a box. */
-int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, accel_shape_hit *out,
+int geom_shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
                      int max)
 {
     if (max <= 0) return 0;
@@ -614,16 +614,16 @@ int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, dou
     int n;
     switch (sh->kind) {
     case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
-        n = accel_sweep_hits(sh, o, d, a, b, out, max);
+        n = geom_sweep_hits(sh, o, d, a, b, out, max);
         break;
     case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
-        n = accel_implicit_hits(sh, o, d, a, b, out, max);
+        n = geom_implicit_hits(sh, o, d, a, b, out, max);
         break;
     case SHAPE_HEIGHT_FIELD:
-        n = accel_hfield_hits(sh, o, d, a, b, out, max);
+        n = geom_hfield_hits(sh, o, d, a, b, out, max);
         break;
     case SHAPE_JULIA:
-        n = accel_fractal_hits(sh, o, d, a, b, out, max);
+        n = geom_fractal_hits(sh, o, d, a, b, out, max);
         break;
     default:
         return 0;
@@ -636,9 +636,9 @@ int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, dou
 }
 
 typedef struct {
-    accel_grid_fn fn;
+    geom_grid_fn fn;
     void *ctx;
-    const accel_shape *sh;
+    const geom_shape *sh;
 } grid_poly;
 
 static int grid_poly_tri(void *ctx, vec3 a, vec3 b, vec3 c)
@@ -646,36 +646,36 @@ static int grid_poly_tri(void *ctx, vec3 a, vec3 b, vec3 c)
     grid_poly *g = ctx;
     vec3 p[3] = {a, b, c}, nn;
     double u, v;
-    accel_sweep_surface(g->sh, a, 2, &nn, &u, &v);
+    geom_sweep_surface(g->sh, a, 2, &nn, &u, &v);
     vec3 n[3] = {nn, nn, nn};
     return g->fn(g->ctx, p, n);
 }
 
-int accel_shape_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
+int geom_shape_grid(const geom_shape *sh, int n, geom_grid_fn fn, void *ctx)
 {
-    if (sh->kind == SHAPE_OVUS) return accel_tess_grid(sh, n, fn, ctx);
+    if (sh->kind == SHAPE_OVUS) return geom_tess_grid(sh, n, fn, ctx);
     if (!sh->data || n < 1) return 0;
     switch (sh->kind) {
     case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
-        return accel_sweep_grid(sh, n, fn, ctx);
+        return geom_sweep_grid(sh, n, fn, ctx);
     case SHAPE_POLYGON: {
         grid_poly g = {fn, ctx, sh};
-        return accel_polygon_triangles(sh, grid_poly_tri, &g);
+        return geom_polygon_triangles(sh, grid_poly_tri, &g);
     }
     case SHAPE_SUPERELLIPSOID:
-        return accel_implicit_grid(sh, n, fn, ctx);
+        return geom_implicit_grid(sh, n, fn, ctx);
     case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE: case SHAPE_JULIA: case SHAPE_OVUS:
-        /* no parametrisation of their own: marching tetrahedra (accel_tess.h) */
-        return accel_tess_grid(sh, n, fn, ctx);
+        /* no parametrisation of their own: marching tetrahedra (geom_tess.h) */
+        return geom_tess_grid(sh, n, fn, ctx);
     case SHAPE_HEIGHT_FIELD: {
-        int nt = accel_hfield_ntriangles(sh), count = 0;
+        int nt = geom_hfield_ntriangles(sh), count = 0;
         for (int i = 0; i < nt; i++) {
             vec3 p[3], nn[3], g;
             double u, v;
-            accel_hfield_triangle(sh, i, &p[0], &p[1], &p[2]);
-            accel_hfield_surface(sh, p[0], i, &g, &u, &v);
+            geom_hfield_triangle(sh, i, &p[0], &p[1], &p[2]);
+            geom_hfield_surface(sh, p[0], i, &g, &u, &v);
             for (int k = 0; k < 3; k++) {
-                vec3 s = accel_hfield_shading(sh, p[k]);
+                vec3 s = geom_hfield_shading(sh, p[k]);
                 nn[k] = v3_len2(s) > 0.0 ? s : g;
             }
             if (!fn(ctx, p, nn)) return -1;
@@ -688,13 +688,13 @@ int accel_shape_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
     }
 }
 
-int accel_shape_intersect(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
-                          accel_shape_hit *h)
+int geom_shape_intersect(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
+                          geom_shape_hit *h)
 {
-    return accel_shape_hits(sh, org, dir, tmin, tmax, h, 1);
+    return geom_shape_hits(sh, org, dir, tmin, tmax, h, 1);
 }
 
-int accel_shape_inside(const accel_shape *sh, vec3 p)
+int geom_shape_inside(const geom_shape *sh, vec3 p)
 {
     vec3 q = sh->identity ? p : xform_inv_point(&sh->x, p);
     switch (sh->kind) {
@@ -732,13 +732,13 @@ int accel_shape_inside(const accel_shape *sh, vec3 p)
         return hh * hh + dy * dy < sh->g.ovus.rc * sh->g.ovus.rc;
     }
     case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
-        return accel_sweep_inside(sh, q);
+        return geom_sweep_inside(sh, q);
     case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
-        return accel_implicit_inside(sh, q);
+        return geom_implicit_inside(sh, q);
     case SHAPE_HEIGHT_FIELD:
-        return accel_hfield_inside(sh, q);
+        return geom_hfield_inside(sh, q);
     case SHAPE_JULIA:
-        return accel_fractal_inside(sh, q);
+        return geom_fractal_inside(sh, q);
     default:
         return 0; /* triangles and polygons have no inside */
     }
@@ -756,7 +756,7 @@ static double wrap01(double a)
 static double clamp01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : (isfinite(x) ? x : 0.0)); }
 
 /* Barycentrics (weights of v1 and v2) of an object-space point in the triangle's plane. */
-static void tri_bary(const accel_shape *sh, vec3 po, double *u, double *v)
+static void tri_bary(const geom_shape *sh, vec3 po, double *u, double *v)
 {
     vec3 e1 = sh->g.tri.e1, e2 = sh->g.tri.e2, w = v3_sub(po, sh->g.tri.v0);
     double d11 = v3_dot(e1, e1), d12 = v3_dot(e1, e2), d22 = v3_dot(e2, e2);
@@ -766,11 +766,11 @@ static void tri_bary(const accel_shape *sh, vec3 po, double *u, double *v)
     *v = den != 0.0 ? clamp01((d11 * w2 - d12 * w1) / den) : 0.0;
 }
 
-void accel_shape_shading(const accel_shape *sh, vec3 p, vec3 ng, vec3 *ns)
+void geom_shape_shading(const geom_shape *sh, vec3 p, vec3 ng, vec3 *ns)
 {
     *ns = ng;
     if (sh->kind == SHAPE_HEIGHT_FIELD) {
-        vec3 n = accel_hfield_shading(sh, sh->identity ? p : xform_inv_point(&sh->x, p));
+        vec3 n = geom_hfield_shading(sh, sh->identity ? p : xform_inv_point(&sh->x, p));
         if (!(v3_len2(n) > 0.0)) return;
         if (!sh->identity) n = xform_normal(&sh->x, n);
         double l = v3_len(n);
@@ -791,7 +791,7 @@ void accel_shape_shading(const accel_shape *sh, vec3 p, vec3 ng, vec3 *ns)
     *ns = v3_dot(n, ng) < 0.0 ? v3_neg(n) : n;
 }
 
-void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, double *u, double *v)
+void geom_shape_surface(const geom_shape *sh, vec3 p, int part, vec3 *ng, double *u, double *v)
 {
     vec3 po = sh->identity ? p : xform_inv_point(&sh->x, p);
     vec3 n = v3(0, 1, 0);
@@ -823,10 +823,10 @@ void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, doub
         vec3 rel = v3_sub(po, sh->g.cone.base);
         double x = v3_dot(rel, sh->g.cone.u), y = v3_dot(rel, sh->g.cone.v), z = v3_dot(rel, sh->g.cone.w);
         su = wrap01(atan2(y, x));
-        if (part == ACCEL_PART_CONE_BASE) {
+        if (part == GEOM_PART_CONE_BASE) {
             n = v3_neg(sh->g.cone.w);
             sv = sh->g.cone.r0 > 0 ? clamp01(sqrt(x * x + y * y) / sh->g.cone.r0) : 0.0;
-        } else if (part == ACCEL_PART_CONE_CAP) {
+        } else if (part == GEOM_PART_CONE_CAP) {
             n = sh->g.cone.w;
             sv = sh->g.cone.r1 > 0 ? clamp01(sqrt(x * x + y * y) / sh->g.cone.r1) : 0.0;
         } else {
@@ -864,9 +864,9 @@ void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, doub
         tri_bary(sh, po, &su, &sv);
         break;
     case SHAPE_OVUS: {
-        if (part == ACCEL_PART_OVUS_BOTTOM) {
+        if (part == GEOM_PART_OVUS_BOTTOM) {
             n = po;
-        } else if (part == ACCEL_PART_OVUS_TOP) {
+        } else if (part == GEOM_PART_OVUS_TOP) {
             n = v3(po.x, po.y - sh->g.ovus.rb, po.z);
         } else {
             /* away from the generating circle's centre on the far side of the axis */
@@ -879,16 +879,16 @@ void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, doub
         break;
     }
     case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
-        accel_sweep_surface(sh, po, part, &n, &su, &sv);
+        geom_sweep_surface(sh, po, part, &n, &su, &sv);
         break;
     case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
-        n = accel_implicit_normal(sh, po, part);
+        n = geom_implicit_normal(sh, po, part);
         break;
     case SHAPE_HEIGHT_FIELD:
-        accel_hfield_surface(sh, po, part, &n, &su, &sv);
+        geom_hfield_surface(sh, po, part, &n, &su, &sv);
         break;
     case SHAPE_JULIA:
-        n = accel_fractal_normal(sh, po);
+        n = geom_fractal_normal(sh, po);
         break;
     default:
         break;
@@ -931,7 +931,7 @@ static int pov_sphere_uv(vec3 d, double uv[2])
     return 1;
 }
 
-void accel_shape_uv(const accel_shape *sh, vec3 p, int part, double uv[2])
+void geom_shape_uv(const geom_shape *sh, vec3 p, int part, double uv[2])
 {
     /* ObjectBase::UVCoord, for every shape without its own: world x and y */
     uv[0] = p.x;
@@ -948,11 +948,11 @@ void accel_shape_uv(const accel_shape *sh, vec3 p, int part, double uv[2])
         double x = ext.x != 0.0 ? f.x / ext.x : 0.0, y = ext.y != 0.0 ? f.y / ext.y : 0.0,
                z = ext.z != 0.0 ? f.z / ext.z : 0.0;
         switch (part) {
-        case ACCEL_PART_BOX_NX: uv[0] = z / 4.0; uv[1] = (1.0 + y) / 3.0; break;
-        case ACCEL_PART_BOX_PX: uv[0] = 0.75 - z / 4.0; uv[1] = (1.0 + y) / 3.0; break;
-        case ACCEL_PART_BOX_NY: uv[0] = 0.25 + x / 4.0; uv[1] = z / 3.0; break;
-        case ACCEL_PART_BOX_PY: uv[0] = 0.25 + x / 4.0; uv[1] = 1.0 - z / 3.0; break;
-        case ACCEL_PART_BOX_NZ: uv[0] = 1.0 - x / 4.0; uv[1] = (1.0 + y) / 3.0; break;
+        case GEOM_PART_BOX_NX: uv[0] = z / 4.0; uv[1] = (1.0 + y) / 3.0; break;
+        case GEOM_PART_BOX_PX: uv[0] = 0.75 - z / 4.0; uv[1] = (1.0 + y) / 3.0; break;
+        case GEOM_PART_BOX_NY: uv[0] = 0.25 + x / 4.0; uv[1] = z / 3.0; break;
+        case GEOM_PART_BOX_PY: uv[0] = 0.25 + x / 4.0; uv[1] = 1.0 - z / 3.0; break;
+        case GEOM_PART_BOX_NZ: uv[0] = 1.0 - x / 4.0; uv[1] = (1.0 + y) / 3.0; break;
         default: uv[0] = 0.25 + x / 4.0; uv[1] = (1.0 + y) / 3.0; break;
         }
         break;
@@ -969,7 +969,7 @@ void accel_shape_uv(const accel_shape *sh, vec3 p, int part, double uv[2])
         if (!pov_sphere_uv(v3(po.x, po.y - sh->g.ovus.rt / 2.0, po.z), uv)) uv[0] = uv[1] = 0.0;
         break;
     case SHAPE_LATHE: case SHAPE_SOR:
-        accel_sweep_uv(sh, po, part, uv);
+        geom_sweep_uv(sh, po, part, uv);
         break;
     default:
         break;

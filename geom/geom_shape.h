@@ -1,23 +1,23 @@
-/* accel_shapes.h - exact double-precision ray intersection with the analytic
+/* geom_shape.h - exact double-precision ray intersection with the analytic
  * POV-Ray shapes (sphere, box, plane, cylinder, cone, disc, torus; and, in
- * their own modules, polygon, lathe, sor, prism, text (accel_sweep.h),
- * superellipsoid, quadric, poly, blob (accel_implicit.h) and height_field
- * (accel_hfield.h)). Pure math: no Embree here; accel.c wraps these as
+ * their own modules, polygon, lathe, sor, prism, text (geom_sweep.h),
+ * superellipsoid, quadric, poly, blob (geom_implicit.h) and height_field
+ * (geom_hfield.h)). Pure math: no Embree here; accel.c wraps these as
  * Embree user geometry.
  *
  * Every shape is intersected in its object space: the world ray is mapped by
  * the object's `inv` (direction not renormalised, so t is the same parameter
  * in both spaces) and normals go back with the inverse transpose. */
-#ifndef PT_ACCEL_SHAPES_H
-#define PT_ACCEL_SHAPES_H
+#ifndef PT_GEOM_SHAPE_H
+#define PT_GEOM_SHAPE_H
 #include "scene.h"
 
-/* Parts reported in accel_shape_hit.part (and accel_hit.prim). */
+/* Parts reported in geom_shape_hit.part (and accel_hit.prim). */
 enum {
-    ACCEL_PART_BOX_NX = 0, ACCEL_PART_BOX_PX, ACCEL_PART_BOX_NY,
-    ACCEL_PART_BOX_PY, ACCEL_PART_BOX_NZ, ACCEL_PART_BOX_PZ,
-    ACCEL_PART_CONE_SIDE = 0, ACCEL_PART_CONE_BASE = 1, ACCEL_PART_CONE_CAP = 2,
-    ACCEL_PART_OVUS_BOTTOM = 0, ACCEL_PART_OVUS_TOP = 1, ACCEL_PART_OVUS_LEMON = 2
+    GEOM_PART_BOX_NX = 0, GEOM_PART_BOX_PX, GEOM_PART_BOX_NY,
+    GEOM_PART_BOX_PY, GEOM_PART_BOX_NZ, GEOM_PART_BOX_PZ,
+    GEOM_PART_CONE_SIDE = 0, GEOM_PART_CONE_BASE = 1, GEOM_PART_CONE_CAP = 2,
+    GEOM_PART_OVUS_BOTTOM = 0, GEOM_PART_OVUS_TOP = 1, GEOM_PART_OVUS_LEMON = 2
 };
 
 typedef struct {
@@ -43,21 +43,21 @@ typedef struct {
     vec3 lo, hi;       /* world bounds (planes: the clip box) */
     vec3 clip_lo, clip_hi;
     /* issue 4 shapes */
-    void *data;        /* derived data owned by the shape (accel_shape_release frees it) */
+    void *data;        /* derived data owned by the shape (geom_shape_release frees it) */
     int infinite;      /* unbounded surface (quadric, poly): clipped like planes */
     vec3 olo, ohi;     /* object-space bounds of the finite ones */
-} accel_shape;
+} geom_shape;
 
 typedef struct {
     double t;
     int part;
-} accel_shape_hit;
+} geom_shape_hit;
 
 /* Puts the crossing (t, part) into out[0..n-1], kept ascending and at most
  * max long (when full, the farthest gives way to a nearer t; an equal or
  * farther t is dropped): returns the new count. Every shape's hits list
- * (accel_shapes.c, fractal, height field, isosurface family, sweeps). */
-static inline int accel_shape_hit_put(accel_shape_hit *out, int n, int max, double t, int part)
+ * (geom_shape.c, fractal, height field, isosurface family, sweeps). */
+static inline int geom_shape_hit_put(geom_shape_hit *out, int n, int max, double t, int part)
 {
     if (max <= 0) return 0;
     if (n == max && !(t < out[n - 1].t)) return n;
@@ -76,60 +76,67 @@ static inline int accel_shape_hit_put(accel_shape_hit *out, int n, int max, doub
  * intersection/difference; otherwise Embree handles them). Returns 0 on success, -1
  * when the object is degenerate (zero radius, singular transform, non-finite
  * numbers) and should be skipped. World bounds are computed for finite shapes;
- * planes get them from accel_shape_clip_plane. */
-int accel_shape_init(accel_shape *sh, const scene_object *o);
+ * planes get them from geom_shape_clip_plane. */
+int geom_shape_init(geom_shape *sh, const scene_object *o);
 /* Planes are infinite: limit one to the world box [lo, hi] (see accel.c for
  * how that box is chosen) and set its bounds to the part of the box it can
  * touch. Also used for the other unbounded shapes (sh->infinite). */
-void accel_shape_clip_plane(accel_shape *sh, vec3 lo, vec3 hi);
-/* Free what accel_shape_init allocated (the shape may be copied before:
+void geom_shape_clip_plane(geom_shape *sh, vec3 lo, vec3 hi);
+/* Free what geom_shape_init allocated (the shape may be copied before:
  * exactly one copy is released). */
-void accel_shape_release(accel_shape *sh);
+void geom_shape_release(geom_shape *sh);
 /* 1 when the shape's inside lies within its bounds (CSG bounding); 0 for
  * half-spaces, unbounded solids and shapes without an inside. */
-int accel_shape_solid_bounded(const accel_shape *sh);
+int geom_shape_solid_bounded(const geom_shape *sh);
 /* Blob components with their own textures: the one that dominates at the
  * world point p; NULL otherwise. */
-const scene_texture *accel_shape_texture(const accel_shape *sh, vec3 p);
+const scene_texture *geom_shape_texture(const geom_shape *sh, vec3 p);
 /* Nearest intersection with t in (tmin, tmax) of the world ray org + t*dir.
  * Returns 1 and fills `h` on a hit. Never produces NaN for finite input. */
-int accel_shape_intersect(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
-                          accel_shape_hit *h);
+int geom_shape_intersect(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
+                          geom_shape_hit *h);
 /* All crossings with t in (tmin, tmax), ascending, at most `max` of them
  * (the `max` nearest; a torus has up to 4, the quadrics up to 2, the issue-4
  * shapes any number). */
-int accel_shape_hits(const accel_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, accel_shape_hit *out,
+int geom_shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
                      int max);
 /* Whether the world point p is strictly inside the solid, as POV-Ray defines
  * it for CSG: planes and discs are half-spaces (the side against the normal),
  * open cylinders and cones are their closed solids, triangles have no inside. */
-int accel_shape_inside(const accel_shape *sh, vec3 p);
+int geom_shape_inside(const geom_shape *sh, vec3 p);
 /* Surface data at world point p (on the shape, `part` from the hit): unit
  * outward world normal and natural surface parameters in [0,1] (triangles:
  * barycentrics, normal by world winding; `ns` gets the interpolated normal
  * of smooth triangles, else the geometric one; it may be NULL). */
-void accel_shape_surface(const accel_shape *sh, vec3 p, int part, vec3 *ng, double *u, double *v);
-void accel_shape_shading(const accel_shape *sh, vec3 p, vec3 ng, vec3 *ns);
+void geom_shape_surface(const geom_shape *sh, vec3 p, int part, vec3 *ng, double *u, double *v);
+void geom_shape_shading(const geom_shape *sh, vec3 p, vec3 ng, vec3 *ns);
 /* POV-Ray 3.7's UV coordinates at world point p (accel_hit.uv): sphere,
  * box, torus, ovus, lathe and sor in object space, every other shape the
  * world x and y (ObjectBase::UVCoord). Always finite. */
-void accel_shape_uv(const accel_shape *sh, vec3 p, int part, double uv[2]);
+void geom_shape_uv(const geom_shape *sh, vec3 p, int part, double uv[2]);
 
 /* Parametric grid for radiance particles (DESIGN.md) on the issue-4
  * shapes: object-space triangles whose vertices lie on the exact surface,
  * with the exact outward normals there, about n x n per part (polygon and
  * height_field: their own triangles; quadric, poly, blob, isosurface and
  * julia_fractal: marching tetrahedra on n cells along the longest side of
- * their bounds, accel_tess.h; the unbounded quadric and poly within their
- * clip box, so clip them first with accel_shape_clip_plane). Calls fn per
+ * their bounds, geom_tess.h; the unbounded quadric and poly within their
+ * clip box, so clip them first with geom_shape_clip_plane). Calls fn per
  * triangle; returns the number of triangles, 0 when the shape has no grid
  * (the original shapes, which GI parametrises itself), -1 when fn returned
  * 0 or memory ran out. */
-typedef int (*accel_grid_fn)(void *ctx, const vec3 p[3], const vec3 n[3]);
-int accel_shape_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx);
+typedef int (*geom_grid_fn)(void *ctx, const vec3 p[3], const vec3 n[3]);
+int geom_shape_grid(const geom_shape *sh, int n, geom_grid_fn fn, void *ctx);
+
+/* Evaluators (POV-Ray noise, pigment functions) that isosurface functions
+ * may need, from the renderer (core/func.h). Process-wide; set it before
+ * the shapes are queried. Without it such functions are NaN and those
+ * isosurfaces stay empty. */
+struct func_env;
+void geom_set_function_env(const struct func_env *env);
 
 /* Real roots of c[0] + c[1] x + ... + c[n] x^n (n <= 4) inside [a, b], in
  * ascending order; returns their number. Exposed for the unit tests. */
-int accel_poly_roots(const double *c, int n, double a, double b, double *roots);
+int geom_poly_roots(const double *c, int n, double a, double b, double *roots);
 
 #endif

@@ -1,4 +1,4 @@
-/* accel_poly.h - real roots of univariate polynomials in an interval, for
+/* geom_poly.h - real roots of univariate polynomials in an interval, for
  * the shapes whose ray equation is a polynomial (lathe, sor, prism, blob,
  * poly/cubic/quartic, quadric).
  *
@@ -11,16 +11,16 @@
  *     roots in an interval is counted from sign changes of the sequence and
  *     intervals are bisected until each holds one root.
  * Coefficients are c[0] + c[1] x + ... + c[n] x^n. */
-#ifndef PT_ACCEL_POLY_H
-#define PT_ACCEL_POLY_H
+#ifndef PT_GEOM_POLY_H
+#define PT_GEOM_POLY_H
 
-#define ACCEL_POLY_MAX 35 /* POV-Ray's highest poly order */
+#define GEOM_POLY_MAX 35 /* POV-Ray's highest poly order */
 
 /* Real roots in [a, b], ascending, at most n; returns their number. A
  * multiple root (even multiplicity) is found where the polynomial touches
  * zero within rounding. */
-int accel_poly_solve(const double *c, int n, double a, double b, double *roots, int sturm);
+int geom_poly_solve(const double *c, int n, double a, double b, double *roots, int sturm);
 /* Horner evaluation. */
-double accel_poly_eval(const double *c, int n, double x);
+double geom_poly_eval(const double *c, int n, double x);
 
 #endif

@@ -1,4 +1,4 @@
-/* accel_sweep.c - lathe, sor, prism, text and polygon (accel_sweep.h).
+/* geom_sweep.c - lathe, sor, prism, text and polygon (geom_sweep.h).
  *
  * Conditioning: every shape is moved to local coordinates q' = (q - c) / L
  * (c the centre of its extent, L its size; conic prisms keep their apex at
@@ -16,12 +16,12 @@
  * parser/sdl_shape.c). A sor segment i fits r^2 as a cubic in y through
  * P[i+1] and P[i+2] with the slopes of the chords P[i]P[i+2] and
  * P[i+1]P[i+3] (POV-Ray's sor.cpp Hermite conditions). */
-#include "accel_sweep.h"
+#include "geom_sweep.h"
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include "accel_poly.h"
+#include "geom_poly.h"
 
 #define TWO_PI 6.283185307179586476925
 #define T_SLACK 1e-9   /* roots this far outside [0,1] still belong to a segment */
@@ -111,7 +111,7 @@ static void seg_set(sw_seg *s, const double a[2], const double b[2], const doubl
         double lo = fmin(e0[k], e1[k]), hi = fmax(e0[k], e1[k]);
         if (deg > 1) {
             double dc[3] = {c[k], 2.0 * b[k], 3.0 * a[k]}, r[2];
-            int nr = accel_poly_solve(dc, 2, 0.0, 1.0, r, 0);
+            int nr = geom_poly_solve(dc, 2, 0.0, 1.0, r, 0);
             for (int i = 0; i < nr; i++) {
                 double p[2];
                 seg_eval(s, r[i], p, NULL);
@@ -187,7 +187,7 @@ static int seg_crossings(const sw_seg *s, double u, double v)
     seg_poly(s, 1, pv);
     pv[0] -= v;
     double dc[3] = {pv[1], 2.0 * pv[2], 3.0 * pv[3]}, crit[2];
-    int nc = accel_poly_solve(dc, 2, 0.0, 1.0, crit, 0);
+    int nc = geom_poly_solve(dc, 2, 0.0, 1.0, crit, 0);
     double ts[4];
     int m = 0;
     ts[m++] = 0.0;
@@ -196,13 +196,13 @@ static int seg_crossings(const sw_seg *s, double u, double v)
     ts[m++] = 1.0;
     int count = 0;
     for (int j = 0; j + 1 < m; j++) {
-        double fa = j == 0 ? s->e0[1] - v : accel_poly_eval(pv, 3, ts[j]);
-        double fb = j + 2 == m ? s->e1[1] - v : accel_poly_eval(pv, 3, ts[j + 1]);
+        double fa = j == 0 ? s->e0[1] - v : geom_poly_eval(pv, 3, ts[j]);
+        double fb = j + 2 == m ? s->e1[1] - v : geom_poly_eval(pv, 3, ts[j + 1]);
         if ((fa >= 0.0) == (fb >= 0.0)) continue;
         /* one crossing in the monotonic piece: bisection */
         double lo = ts[j], hi = ts[j + 1], flo = fa;
         for (int it = 0; it < 60 && hi - lo > 1e-15; it++) {
-            double mid = 0.5 * (lo + hi), fm = accel_poly_eval(pv, 3, mid);
+            double mid = 0.5 * (lo + hi), fm = geom_poly_eval(pv, 3, mid);
             if ((fm >= 0.0) == (flo >= 0.0)) { lo = mid; flo = fm; } else hi = mid;
         }
         double p[2];
@@ -345,7 +345,7 @@ static void lathe_polish(const sw_seg *s, const lray *r, double *pt, double *pta
     }
 }
 
-static int lathe_hits(const sw_data *w, const lray *r, double tmin, double tmax, accel_shape_hit *out, int n,
+static int lathe_hits(const sw_data *w, const lray *r, double tmin, double tmax, geom_shape_hit *out, int n,
                       int max)
 {
     vec3 P = r->o, e = r->e;
@@ -387,22 +387,22 @@ static int lathe_hits(const sw_data *w, const lray *r, double tmin, double tmax,
             for (int i = 0; i < 4; i++) G[i] += 2.0 * e.y * m * Y[i];
             G[0] += e.y * e.y * P2;
             double roots[6];
-            int nr = accel_poly_solve(G, s->deg == 1 ? 2 : 6, -T_SLACK, 1.0 + T_SLACK, roots, w->sturm);
+            int nr = geom_poly_solve(G, s->deg == 1 ? 2 : 6, -T_SLACK, 1.0 + T_SLACK, roots, w->sturm);
             for (int i = 0; i < nr; i++) {
                 cand_t[nc] = roots[i];
-                cand_tau[nc] = accel_poly_eval(Y, 3, roots[i]) / e.y;
+                cand_tau[nc] = geom_poly_eval(Y, 3, roots[i]) / e.y;
                 nc++;
             }
         } else {
             /* nearly horizontal: heights first, then the circle at that height */
             double roots[3];
-            int nr = accel_poly_solve(Y, s->deg == 1 ? 1 : 3, -T_SLACK, 1.0 + T_SLACK, roots, w->sturm);
+            int nr = geom_poly_solve(Y, s->deg == 1 ? 1 : 3, -T_SLACK, 1.0 + T_SLACK, roots, w->sturm);
             for (int i = 0; i < nr && rxz > 0.0; i++) {
                 double p[2];
                 seg_eval(s, roots[i], p, NULL);
                 double tq[2];
                 double qc[3] = {P2 - p[0] * p[0], 2.0 * m, rxz};
-                int nq = accel_poly_solve(qc, 2, -INFINITY, INFINITY, tq, 0);
+                int nq = geom_poly_solve(qc, 2, -INFINITY, INFINITY, tq, 0);
                 for (int j = 0; j < nq; j++) {
                     cand_t[nc] = roots[i];
                     cand_tau[nc] = tq[j];
@@ -415,7 +415,7 @@ static int lathe_hits(const sw_data *w, const lray *r, double tmin, double tmax,
             lathe_polish(s, r, &t, &tau);
             if (t < -T_SLACK || t > 1.0 + T_SLACK) continue;
             double tt = lray_t(r, tau);
-            if (tt > tmin && tt < tmax) n = accel_shape_hit_put(out, n, max, tt, 2 + k);
+            if (tt > tmin && tt < tmax) n = geom_shape_hit_put(out, n, max, tt, 2 + k);
         }
     }
     return n;
@@ -423,7 +423,7 @@ static int lathe_hits(const sw_data *w, const lray *r, double tmin, double tmax,
 
 /* ------------------------------------------------------------ sor */
 
-static int sor_hits(const sw_data *w, const lray *r, double tmin, double tmax, accel_shape_hit *out, int n, int max)
+static int sor_hits(const sw_data *w, const lray *r, double tmin, double tmax, geom_shape_hit *out, int n, int max)
 {
     vec3 P = r->o, e = r->e;
     double rxz = e.x * e.x + e.z * e.z, m = P.x * e.x + P.z * e.z, P2 = P.x * P.x + P.z * P.z;
@@ -458,10 +458,10 @@ static int sor_hits(const sw_data *w, const lray *r, double tmin, double tmax, a
             memcpy(pw, nw, sizeof pw);
         }
         double roots[3];
-        int nr = accel_poly_solve(c, 3, ta, tb, roots, w->sturm);
+        int nr = geom_poly_solve(c, 3, ta, tb, roots, w->sturm);
         for (int i = 0; i < nr; i++) {
             double tt = lray_t(r, roots[i]);
-            if (tt > tmin && tt < tmax) n = accel_shape_hit_put(out, n, max, tt, 2 + k);
+            if (tt > tmin && tt < tmax) n = geom_shape_hit_put(out, n, max, tt, 2 + k);
         }
     }
     if (!w->open && e.y != 0.0) {
@@ -472,7 +472,7 @@ static int sor_hits(const sw_data *w, const lray *r, double tmin, double tmax, a
             double x = P.x + tau * e.x, z = P.z + tau * e.z;
             if (x * x + z * z > r2[c]) continue;
             double tt = lray_t(r, tau);
-            if (tt > tmin && tt < tmax) n = accel_shape_hit_put(out, n, max, tt, c);
+            if (tt > tmin && tt < tmax) n = geom_shape_hit_put(out, n, max, tt, c);
         }
     }
     return n;
@@ -524,7 +524,7 @@ static void prism_polish(const sw_data *w, const sw_seg *s, double Pu, double Pw
     }
 }
 
-static int prism_hits(const sw_data *w, const lray *r, double tmin, double tmax, accel_shape_hit *out, int n,
+static int prism_hits(const sw_data *w, const lray *r, double tmin, double tmax, geom_shape_hit *out, int n,
                       int max)
 {
     double Pu = v3_idx(r->o, w->ax[0]), Pw = v3_idx(r->o, w->ax[1]), Pv = v3_idx(r->o, w->ax[2]);
@@ -540,7 +540,7 @@ static int prism_hits(const sw_data *w, const lray *r, double tmin, double tmax,
             if (w->conic) { u /= hh[c]; v /= hh[c]; }
             if (!in_curve(w, u, v)) continue;
             double tt = lray_t(r, tau);
-            if (tt > tmin && tt < tmax) n = accel_shape_hit_put(out, n, max, tt, c);
+            if (tt > tmin && tt < tmax) n = geom_shape_hit_put(out, n, max, tt, c);
         }
     }
     if (fabs(eu) < 1e-12 && fabs(ev) < 1e-12 && !w->conic) return n; /* along the sweep axis */
@@ -576,7 +576,7 @@ static int prism_hits(const sw_data *w, const lray *r, double tmin, double tmax,
             f[0] += Pv * eu - Pu * ev;
         }
         double roots[3];
-        int nr = accel_poly_solve(f, s->deg == 1 ? 1 : 3, -T_SLACK, 1.0 + T_SLACK, roots, w->sturm);
+        int nr = geom_poly_solve(f, s->deg == 1 ? 1 : 3, -T_SLACK, 1.0 + T_SLACK, roots, w->sturm);
         for (int i = 0; i < nr; i++) {
             double t = roots[i], p[2];
             seg_eval(s, t, p, NULL);
@@ -593,7 +593,7 @@ static int prism_hits(const sw_data *w, const lray *r, double tmin, double tmax,
             double hw = Pw + tau * ew;
             if (hw < w->h1 || hw > w->h2) continue;
             double tt = lray_t(r, tau);
-            if (tt > tmin && tt < tmax) n = accel_shape_hit_put(out, n, max, tt, 2 + k);
+            if (tt > tmin && tt < tmax) n = geom_shape_hit_put(out, n, max, tt, 2 + k);
         }
     }
     return n;
@@ -601,7 +601,7 @@ static int prism_hits(const sw_data *w, const lray *r, double tmin, double tmax,
 
 /* ------------------------------------------------------------ polygon */
 
-static int polygon_hits(const sw_data *w, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+static int polygon_hits(const sw_data *w, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     double den = v3_dot(w->pn, d);
     if (den == 0.0) return 0;
@@ -609,7 +609,7 @@ static int polygon_hits(const sw_data *w, vec3 o, vec3 d, double tmin, double tm
     if (!(t > tmin && t < tmax)) return 0;
     vec3 q = v3_sub(v3_madd(o, d, t), w->p0);
     if (!in_curve(w, v3_dot(q, w->pu) / w->L, v3_dot(q, w->pv) / w->L)) return 0;
-    return accel_shape_hit_put(out, 0, max, t, 2);
+    return geom_shape_hit_put(out, 0, max, t, 2);
 }
 
 /* ------------------------------------------------------------ setup */
@@ -699,8 +699,8 @@ static int setup_sor(sw_data *w, const scene_lathe *l)
         s->y0 = y0;
         s->y1 = y1;
         double mx = fmax(v0, v1), dc[3] = {s->g[1], 2.0 * s->g[2], 3.0 * s->g[3]}, rr[2];
-        int nr = accel_poly_solve(dc, 2, 0.0, 1.0, rr, 0);
-        for (int j = 0; j < nr; j++) mx = fmax(mx, accel_poly_eval(s->g, 3, rr[j]));
+        int nr = geom_poly_solve(dc, 2, 0.0, 1.0, rr, 0);
+        for (int j = 0; j < nr; j++) mx = fmax(mx, geom_poly_eval(s->g, 3, rr[j]));
         s->rmax2 = mx;
         rmax2 = fmax(rmax2, mx);
         ylo = fmin(ylo, y0);
@@ -986,7 +986,7 @@ static void setup_areas(sw_data *w)
     w->total_area = isfinite(tot) ? tot * w->L * w->L : 0.0;
 }
 
-double accel_sweep_area(const accel_shape *sh)
+double geom_sweep_area(const geom_shape *sh)
 {
     const sw_data *w = sh->data;
     return w && w->nparts ? w->total_area : 0.0;
@@ -1000,7 +1000,7 @@ static double next_rand(rng *r, int *k, double u)
     return v - floor(v);
 }
 
-void accel_sweep_sample(const accel_shape *sh, double u1, double u2, rng *r, vec3 *p, vec3 *n, unsigned *part)
+void geom_sweep_sample(const geom_shape *sh, double u1, double u2, rng *r, vec3 *p, vec3 *n, unsigned *part)
 {
     const sw_data *w = sh->data;
     *p = v3s(0.0);
@@ -1067,7 +1067,7 @@ void accel_sweep_sample(const accel_shape *sh, double u1, double u2, rng *r, vec
     *n = v3_norm(ln);
 }
 
-int accel_sweep_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
+int geom_sweep_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
 {
     sw_data *w = calloc(1, sizeof *w);
     if (!w) return -1;
@@ -1083,7 +1083,7 @@ int accel_sweep_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
     default: break;
     }
     if (st != 0) {
-        accel_sweep_free(w);
+        geom_sweep_free(w);
         return -1;
     }
     if (w->type != SW_POLYGON) {
@@ -1095,7 +1095,7 @@ int accel_sweep_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
     return 0;
 }
 
-void accel_sweep_free(void *data)
+void geom_sweep_free(void *data)
 {
     sw_data *w = data;
     if (!w) return;
@@ -1107,7 +1107,7 @@ void accel_sweep_free(void *data)
     free(w);
 }
 
-int accel_sweep_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max)
+int geom_sweep_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     const sw_data *w = sh->data;
     if (!w || max <= 0) return 0;
@@ -1121,7 +1121,7 @@ int accel_sweep_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double 
     }
 }
 
-int accel_sweep_inside(const accel_shape *sh, vec3 q)
+int geom_sweep_inside(const geom_shape *sh, vec3 q)
 {
     const sw_data *w = sh->data;
     if (!w || w->type == SW_POLYGON) return 0;
@@ -1149,7 +1149,7 @@ int accel_sweep_inside(const accel_shape *sh, vec3 q)
     }
 }
 
-void accel_sweep_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v)
+void geom_sweep_surface(const geom_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v)
 {
     const sw_data *w = sh->data;
     *n = v3(0, 1, 0);
@@ -1224,12 +1224,12 @@ void accel_sweep_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, doubl
  * its curve parameter) / segments (at most 1); sor v = (segment + height
  * fraction in it) / segments on the curve, r / base radius - 1 on the base
  * (-1..0) and 2 - r / cap radius on the cap (1..2). */
-void accel_sweep_uv(const accel_shape *sh, vec3 q, int part, double uv[2])
+void geom_sweep_uv(const geom_shape *sh, vec3 q, int part, double uv[2])
 {
     const sw_data *w = sh->data;
     vec3 n;
     double u = 0.0, v = 0.0;
-    accel_sweep_surface(sh, q, part, &n, &u, &v);
+    geom_sweep_surface(sh, q, part, &n, &u, &v);
     if (w && w->type == SW_SOR && (part == 0 || part == 1)) {
         vec3 l = v3_scale(v3_sub(q, w->c), 1.0 / w->L);
         double r = sqrt(l.x * l.x + l.z * l.z), r2 = part == 0 ? w->base_r2 : w->cap_r2;
@@ -1256,7 +1256,7 @@ static int cmp_edge(const void *a, const void *b)
     return x->um < y->um ? -1 : (x->um > y->um);
 }
 
-int accel_polygon_triangles(const accel_shape *sh, int (*emit)(void *ctx, vec3 a, vec3 b, vec3 c), void *ctx)
+int geom_polygon_triangles(const geom_shape *sh, int (*emit)(void *ctx, vec3 a, vec3 b, vec3 c), void *ctx)
 {
     const sw_data *w = sh->data;
     if (!w || w->type != SW_POLYGON || w->nseg < 1) return 0;
@@ -1317,7 +1317,7 @@ int accel_polygon_triangles(const accel_shape *sh, int (*emit)(void *ctx, vec3 a
 
 typedef struct {
     const sw_data *w;
-    accel_grid_fn fn;
+    geom_grid_fn fn;
     void *ctx;
     int count;
 } grid_out;
@@ -1383,7 +1383,7 @@ static void grid_point(const sw_data *w, int part, double a, double b, vec3 *p, 
 /* Grid with na[k] cells along segment k, nb around (lathe, sor) or along
  * the sweep (prism), nr along the radius of a sor's caps; prism caps from
  * the curves polygonised into na[k] pieces each. */
-static int grid_sized(const sw_data *w, const int *na, int nb, int nr, accel_grid_fn fn, void *ctx)
+static int grid_sized(const sw_data *w, const int *na, int nb, int nr, geom_grid_fn fn, void *ctx)
 {
     grid_out g = {w, fn, ctx, 0};
     for (int k = 0; k < w->nseg; k++) {
@@ -1474,7 +1474,7 @@ static int grid_sized(const sw_data *w, const int *na, int nb, int nr, accel_gri
     return g.count;
 }
 
-int accel_sweep_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx)
+int geom_sweep_grid(const geom_shape *sh, int n, geom_grid_fn fn, void *ctx)
 {
     const sw_data *w = sh->data;
     if (!w || n < 1) return 0;
@@ -1514,7 +1514,7 @@ static double seg_turn(const sw_data *w, int k, int s)
     return turn;
 }
 
-int accel_sweep_grid_cell(const accel_shape *sh, double cell, double turn, accel_grid_fn fn, void *ctx)
+int geom_sweep_grid_cell(const geom_shape *sh, double cell, double turn, geom_grid_fn fn, void *ctx)
 {
     const sw_data *w = sh->data;
     if (!w || w->type == SW_POLYGON || !(cell > 0.0) || !isfinite(cell)) return 0;

@@ -1,4 +1,4 @@
-/* accel_sweep.h - shapes made from 2-D spline curves, intersected exactly
+/* geom_sweep.h - shapes made from 2-D spline curves, intersected exactly
  * in double precision in object space: lathe (curve revolved about y),
  * sor (POV-Ray's r^2 = cubic(y) surface of revolution), prism (curve swept
  * along y, linearly or conically), text (glyph outlines swept along z) and
@@ -8,30 +8,30 @@
  * t in [0,1], built from the points by POV-Ray's spline rules (linear,
  * quadratic and Catmull-Rom cubic interpolation, Bezier). The ray equation
  * per segment is a polynomial in t (lathe: degree 2 x spline degree, prism:
- * spline degree) or in the ray parameter (sor: 3), solved with accel_poly
+ * spline degree) or in the ray parameter (sor: 3), solved with geom_poly
  * and polished by Newton steps on the original two-equation system, so hits
  * are exact to rounding. Insides follow POV-Ray: a point is inside a lathe,
  * prism or glyph when a ray from it in +x (+r) crosses the curve an odd
  * number of times (evaluated on monotonic pieces with the segments' exact end
  * points, so a vertex is counted once); inside a sor when r^2 <= f(y).
  *
- * Parts (accel_shape_hit.part): 0 base cap, 1 top cap, 2 + k segment k. */
-#ifndef PT_ACCEL_SWEEP_H
-#define PT_ACCEL_SWEEP_H
-#include "accel_shapes.h"
+ * Parts (geom_shape_hit.part): 0 base cap, 1 top cap, 2 + k segment k. */
+#ifndef PT_GEOM_SWEEP_H
+#define PT_GEOM_SWEEP_H
+#include "geom_shape.h"
 #include "rng.h"
 
 /* Set up sh (kind SHAPE_LATHE, SOR, PRISM, TEXT or POLYGON) from o; object
  * space bounds in lo/hi. Allocates sh->data. -1 when degenerate. */
-int accel_sweep_init(accel_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
-void accel_sweep_free(void *data);
+int geom_sweep_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
+void geom_sweep_free(void *data);
 /* Object-space ray o + t d; crossings with t in (tmin, tmax), ascending. */
-int accel_sweep_hits(const accel_shape *sh, vec3 o, vec3 d, double tmin, double tmax, accel_shape_hit *out, int max);
-int accel_sweep_inside(const accel_shape *sh, vec3 q);
+int geom_sweep_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max);
+int geom_sweep_inside(const geom_shape *sh, vec3 q);
 /* Object-space outward normal (not unit) and surface parameters at q. */
-void accel_sweep_surface(const accel_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v);
+void geom_sweep_surface(const geom_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v);
 /* POV-Ray's UV coordinates (uv_mapping) of a lathe or sor at q. */
-void accel_sweep_uv(const accel_shape *sh, vec3 q, int part, double uv[2]);
+void geom_sweep_uv(const geom_shape *sh, vec3 q, int part, double uv[2]);
 /* GI sampling (lathe, sor, linear-sweep prism, text): the object-space
  * surface area (0 when not supported: conic prisms, polygons), and a point
  * uniform by object-space area with its outward object-space normal and
@@ -41,11 +41,11 @@ void accel_sweep_uv(const accel_shape *sh, vec3 q, int part, double uv[2]);
  * the density taken from dense samples with a 10 % margin, caps by rejection
  * against the even-odd test. With r NULL the first candidate is taken
  * (u1 picks the part and the curve parameter, u2 the angle or height). */
-double accel_sweep_area(const accel_shape *sh);
-void accel_sweep_sample(const accel_shape *sh, double u1, double u2, rng *r, vec3 *p, vec3 *n, unsigned *part);
+double geom_sweep_area(const geom_shape *sh);
+void geom_sweep_sample(const geom_shape *sh, double u1, double u2, rng *r, vec3 *p, vec3 *n, unsigned *part);
 
-/* Grid triangles (accel_shape_grid) of a lathe, sor, prism, text or polygon. */
-int accel_sweep_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx);
+/* Grid triangles (geom_shape_grid) of a lathe, sor, prism, text or polygon. */
+int geom_sweep_grid(const geom_shape *sh, int n, geom_grid_fn fn, void *ctx);
 /* The same grid sized by length: cells of at most `cell` object units along
  * each profile segment (by its arc length) and around (lathe, sor: the
  * widest circle, at least 3) or along the sweep (prism, text); sor caps
@@ -54,12 +54,12 @@ int accel_sweep_grid(const accel_shape *sh, int n, accel_grid_fn fn, void *ctx);
  * turns faster, cells of at most `turn` radians of it: along a segment (its
  * normal's total turning / turn cells) and around a lathe or sor (at least
  * 2 pi / turn); turn <= 0 or infinite: by length alone. 0 for polygons. */
-int accel_sweep_grid_cell(const accel_shape *sh, double cell, double turn, accel_grid_fn fn, void *ctx);
+int geom_sweep_grid_cell(const geom_shape *sh, double cell, double turn, geom_grid_fn fn, void *ctx);
 
 /* Polygon: its even-odd region as object-space triangles (trapezoids of
  * the slabs between vertex heights, two triangles each; exact for simple
  * and holed polygons). Calls emit(ctx, a, b, c) per triangle; returns the
  * number emitted, or -1 when emit failed. */
-int accel_polygon_triangles(const accel_shape *sh, int (*emit)(void *ctx, vec3 a, vec3 b, vec3 c), void *ctx);
+int geom_polygon_triangles(const geom_shape *sh, int (*emit)(void *ctx, vec3 a, vec3 b, vec3 c), void *ctx);
 
 #endif
