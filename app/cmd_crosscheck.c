@@ -1,6 +1,7 @@
 /* cmd_crosscheck.c - `partray crosscheck SCENE.pov [--size WxH | +Wn +Hn]
  *     [+A[t] | -A] [+Rn] [--threads N | +WTn] [-D NAME=VALUE] [-L DIR]
- *     [--gi MODE] [--out DIR] [--json] [--povray PATH] [--quiet]`
+ *     [--gi MODE] [--out DIR] [--json] [--povray PATH] [--quiet]
+ *     [--converged [--cache DIR] [--converged-timeout SECONDS]]`
  *
  * Renders the scene with POV-Ray 3.7 and with partray (its default GI
  * choice unless --gi is given) at the same size (default 320x240, POV-Ray's)
@@ -23,6 +24,15 @@
  * DIR; otherwise they are removed. POV-Ray is `povray` on PATH, or
  * $PARTRAY_POVRAY, or --povray PATH.
  *
+ * --converged adds POV-Ray's converged render of a radiosity scene (its
+ * radiosity block at 4x the count and 0.4x the error_bound) as the
+ * reference for both renders: LDR-FLIP and mean luminance of POV-Ray's
+ * default render and of partray's against it, and partray's time over
+ * POV-Ray's. It is cached (--cache DIR, default $XDG_CACHE_HOME or
+ * ~/.cache, partray/crosscheck) under a key of the scene's text and the
+ * options; a render that runs past --converged-timeout (default 1800 s) is
+ * recorded as such and POV-Ray's default render stays the reference.
+ *
  * Exit: 0 when both renders were made and compared (this reports; it does
  * not judge); 1 when either renderer failed on the scene; 2 usage; 3 when
  * POV-Ray is missing or a file cannot be read or written; 130 (143) after
@@ -31,6 +41,7 @@
 #include <limits.h>
 #include <math.h>
 #include <signal.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -51,10 +62,13 @@
 
 static const char *usage =
     "usage: partray crosscheck SCENE.pov [--size WxH] [+A0.3 | -A] [+R3] [--threads N] [-D NAME=VALUE] [-L DIR]\n"
-    "                          [--gi MODE] [--out DIR] [--json] [--povray PATH] [--quiet]\n";
+    "                          [--gi MODE] [--out DIR] [--json] [--povray PATH] [--quiet]\n"
+    "                          [--converged [--cache DIR] [--converged-timeout SECONDS]]\n";
 
 typedef struct {
-    const char *scene, *out_dir, *povray, *gi;
+    const char *scene, *out_dir, *povray, *gi, *cache_dir;
+    int converged;       /* also render POV-Ray's converged radiosity reference */
+    double converged_timeout; /* seconds; past it the default render is the reference */
     int width, height;
     int aa;           /* 0 off, 1 on */
     double aa_threshold;
@@ -94,11 +108,12 @@ static int parse_args(int argc, char **argv, xc_opts *o)
     o->height = 240;
     o->aa_threshold = 0.3;
     o->aa_depth = 3;
+    o->converged_timeout = 1800.0;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         int takes = strcmp(a, "--size") == 0 || strcmp(a, "--threads") == 0 || strcmp(a, "--out") == 0 ||
                     strcmp(a, "--povray") == 0 || strcmp(a, "--gi") == 0 || strcmp(a, "-L") == 0 ||
-                    strcmp(a, "-D") == 0;
+                    strcmp(a, "-D") == 0 || strcmp(a, "--cache") == 0 || strcmp(a, "--converged-timeout") == 0;
         if (takes && !next) {
             fprintf(stderr, "partray crosscheck: option '%s' needs a value\n", a);
             return 0;
@@ -123,6 +138,18 @@ static int parse_args(int argc, char **argv, xc_opts *o)
             o->povray = argv[++i];
         } else if (strcmp(a, "--gi") == 0) {
             o->gi = argv[++i];
+        } else if (strcmp(a, "--converged") == 0) {
+            o->converged = 1;
+        } else if (strcmp(a, "--cache") == 0) {
+            o->cache_dir = argv[++i];
+        } else if (strcmp(a, "--converged-timeout") == 0) {
+            char *end;
+            o->converged_timeout = strtod(next, &end);
+            if (*end || !(o->converged_timeout > 0)) {
+                fprintf(stderr, "partray crosscheck: --converged-timeout wants seconds > 0\n");
+                return 0;
+            }
+            i++;
         } else if (strcmp(a, "--json") == 0) {
             o->json = 1;
         } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
@@ -243,6 +270,200 @@ static void absolute(const char *p, char *buf, size_t n)
     snprintf(buf, n, "%s/%s", cwd, p);
 }
 
+/* Runs POV-Ray on `input` (a file in `work`) at the options' size,
+ * antialiasing, threads, library paths and declarations, writing the sRGB PNG
+ * `out_name` in `work`. timeout > 0 runs it under coreutils' timeout(1)
+ * (exit 124 when it ran out). Returns subproc_run's status. */
+static int run_povray(const xc_opts *o, const char *povray, const char *work, const char *input, const char *out_name,
+                      const char *scene_dir, const char *log, double timeout, double *secs, diag *d)
+{
+    char(*args)[4200] = malloc(XC_MAX_ARGS * sizeof *args);
+    if (!args) return -1;
+    const char *argvv[XC_MAX_ARGS + 1];
+    int n = 0;
+    if (timeout > 0) {
+        snprintf(args[n++], sizeof args[0], "timeout");
+        snprintf(args[n++], sizeof args[0], "%.0f", timeout);
+    }
+    snprintf(args[n++], sizeof args[0], "%s", povray);
+    snprintf(args[n++], sizeof args[0], "+I%s", input);
+    snprintf(args[n++], sizeof args[0], "+O%s", out_name);
+    snprintf(args[n++], sizeof args[0], "+W%d", o->width);
+    snprintf(args[n++], sizeof args[0], "+H%d", o->height);
+    if (o->aa) {
+        snprintf(args[n++], sizeof args[0], "+A%g", o->aa_threshold);
+        snprintf(args[n++], sizeof args[0], "+R%d", o->aa_depth);
+    } else {
+        snprintf(args[n++], sizeof args[0], "-A");
+    }
+    snprintf(args[n++], sizeof args[0], "-D");
+    snprintf(args[n++], sizeof args[0], "-V");
+    snprintf(args[n++], sizeof args[0], "-P");
+    snprintf(args[n++], sizeof args[0], "+FN");
+    snprintf(args[n++], sizeof args[0], "-UA");
+    snprintf(args[n++], sizeof args[0], "File_Gamma=sRGB");
+    if (o->threads > 0) snprintf(args[n++], sizeof args[0], "+WT%d", o->threads);
+    snprintf(args[n++], sizeof args[0], "+L%s", scene_dir);
+    for (int i = 0; i < o->nlibs; i++) {
+        char lib[4096];
+        absolute(o->libs[i], lib, sizeof lib);
+        snprintf(args[n++], sizeof args[0], "+L%s", lib);
+    }
+    for (int i = 0; i < o->ndefines; i++) snprintf(args[n++], sizeof args[0], "Declare=%s", o->defines[i]);
+    for (int i = 0; i < n; i++) argvv[i] = args[i];
+    argvv[n] = NULL;
+    int prc = subproc_run(argvv, work, log, secs, d);
+    free(args);
+    return prc;
+}
+
+/* The converged reference: POV-Ray with the scene's radiosity at
+ * XC_CONVERGED_COUNT times its count and XC_CONVERGED_BOUND times its
+ * error_bound. POV-Ray merges a later radiosity{} block into the settings
+ * already made (a second block that sets only count keeps the first block's
+ * error_bound; checked with povray 3.7.0.10's sample statistics), so the
+ * scene is rendered with one global_settings block appended, whatever macros
+ * set the original values. */
+#define XC_CONVERGED_COUNT 4
+#define XC_CONVERGED_BOUND 0.4
+typedef struct {
+    int made;             /* a converged image exists (else the default render is the reference) */
+    int cached;           /* taken from the cache */
+    int timed_out;        /* the render ran past --converged-timeout (now or on an earlier run) */
+    double seconds;       /* its render time (from the cache's record when cached) */
+    int count;
+    double error_bound;
+    char png[8400];
+} xc_converged;
+
+static uint64_t fnv1a(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 0x100000001b3ULL;
+    return h;
+}
+
+static uint64_t fnv1a_str(uint64_t h, const char *s)
+{
+    return fnv1a(h, s, strlen(s) + 1);
+}
+
+/* Renders (or finds in the cache) the converged reference into c->png. The
+ * cache key covers the scene's text, the POV-Ray binary's path, size,
+ * antialiasing, library paths and declarations, not the scene's include
+ * files. Returns 0, or an exit status for the command. */
+static int converged_reference(const xc_opts *o, const char *povray, const char *work, const char *base,
+                               const char *scene_dir, const char *out, int count, double error_bound,
+                               xc_converged *c, diag *d)
+{
+    c->count = count * XC_CONVERGED_COUNT;
+    c->error_bound = error_bound * XC_CONVERGED_BOUND;
+    char cache[4096];
+    const char *env = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
+    if (o->cache_dir) snprintf(cache, sizeof cache, "%s", o->cache_dir);
+    else if (env && *env) snprintf(cache, sizeof cache, "%s/partray/crosscheck", env);
+    else snprintf(cache, sizeof cache, "%s/.cache/partray/crosscheck", home && *home ? home : "/tmp");
+    if (!subproc_mkdirs(cache)) {
+        fprintf(stderr, "partray crosscheck: cannot create cache directory '%s'\n", cache);
+        return 3;
+    }
+    size_t len = 0;
+    char *text = subproc_read_text(o->scene, &len);
+    if (!text) {
+        fprintf(stderr, "partray crosscheck: cannot read scene '%s'\n", o->scene);
+        return 3;
+    }
+    uint64_t h = 0xcbf29ce484222325ULL;
+    h = fnv1a(h, text, len);
+    char num[256];
+    snprintf(num, sizeof num, "converged/%d/%g|%dx%d|aa %d %g %d", XC_CONVERGED_COUNT, XC_CONVERGED_BOUND, o->width,
+             o->height, o->aa, o->aa_threshold, o->aa_depth);
+    h = fnv1a_str(h, num);
+    h = fnv1a_str(h, povray);
+    for (int i = 0; i < o->nlibs; i++) h = fnv1a_str(h, o->libs[i]);
+    for (int i = 0; i < o->ndefines; i++) h = fnv1a_str(h, o->defines[i]);
+    char stem[1024];
+    snprintf(stem, sizeof stem, "%s", base);
+    char *dot = strrchr(stem, '.');
+    if (dot && dot != stem) *dot = 0;
+    char key[8192], record[8400], timeout_mark[8400];
+    snprintf(key, sizeof key, "%s/%s-%016llx", cache, stem, (unsigned long long)h);
+    snprintf(c->png, sizeof c->png, "%s.png", key);
+    snprintf(record, sizeof record, "%s.txt", key);
+    snprintf(timeout_mark, sizeof timeout_mark, "%s.timeout", key);
+    if (access(c->png, R_OK) == 0) {
+        char *r = subproc_read_text(record, NULL);
+        if (r) c->seconds = strtod(r, NULL);
+        free(r);
+        free(text);
+        c->made = c->cached = 1;
+        return 0;
+    }
+    if (access(timeout_mark, R_OK) == 0) {
+        char *r = subproc_read_text(timeout_mark, NULL);
+        double limit = r ? strtod(r, NULL) : 0.0;
+        free(r);
+        if (limit >= o->converged_timeout) {
+            free(text);
+            c->timed_out = 1;
+            return 0;
+        }
+    }
+    /* The scene with the converged settings appended, beside the copy. */
+    char input[1200], path[4300], made_name[1200], made[4300], log[4300];
+    snprintf(input, sizeof input, "%s_converged.pov", stem);
+    snprintf(path, sizeof path, "%s/%s", work, input);
+    snprintf(made_name, sizeof made_name, "%s_converged.png", stem);
+    snprintf(made, sizeof made, "%s/%s", work, made_name);
+    snprintf(log, sizeof log, "%s/povray_converged.log", out);
+    FILE *f = fopen(path, "wb");
+    int ok = f && fwrite(text, 1, len, f) == len &&
+             fprintf(f, "\nglobal_settings { radiosity { count %d error_bound %.9g } }\n", c->count, c->error_bound) > 0;
+    if (f) ok = (fclose(f) == 0) && ok;
+    free(text);
+    if (!ok) {
+        fprintf(stderr, "partray crosscheck: cannot write %s\n", path);
+        remove(path);
+        return 3;
+    }
+    remove(log);
+    int prc = run_povray(o, povray, work, input, made_name, scene_dir, log, o->converged_timeout, &c->seconds, d);
+    remove(path);
+    if (prc == 124) {
+        remove(made);
+        FILE *m = fopen(timeout_mark, "wb");
+        if (m) {
+            fprintf(m, "%.0f\n", o->converged_timeout);
+            fclose(m);
+        }
+        c->timed_out = 1;
+        return 0;
+    }
+    if (prc != 0 || access(made, R_OK) != 0) {
+        fprintf(stderr, "partray crosscheck: POV-Ray's converged render failed on %s (exit %d)\n", o->scene, prc);
+        print_log_tail(log, "POV-Ray converged");
+        remove(made);
+        return prc < 0 ? 3 : 1;
+    }
+    /* Into the cache under a temporary name, then renamed (atomic). */
+    char tmp[8500];
+    snprintf(tmp, sizeof tmp, "%s.tmp%d", c->png, (int)getpid());
+    if (!copy_file(made, tmp) || rename(tmp, c->png) != 0) {
+        remove(tmp);
+        remove(made);
+        fprintf(stderr, "partray crosscheck: cannot write %s\n", c->png);
+        return 3;
+    }
+    remove(made);
+    FILE *r = fopen(record, "wb");
+    if (r) {
+        fprintf(r, "%.6f seconds, count %d, error_bound %.9g\n", c->seconds, c->count, c->error_bound);
+        fclose(r);
+    }
+    c->made = 1;
+    return 0;
+}
+
 /* Ctrl-C / SIGTERM stop the running renderer (same process group); the
  * command then cleans up its temporary directory and exits 130 / 143. */
 static volatile sig_atomic_t g_stop = 0;
@@ -301,6 +522,8 @@ int cmd_crosscheck(int argc, char **argv)
         return st == PT_ERR_IO ? 3 : (st == PT_ERR_USAGE ? 2 : 1);
     }
     int radiosity = sc->global.radiosity.enabled != 0;
+    int rad_count = sc->global.radiosity.count;
+    double rad_error_bound = sc->global.radiosity.error_bound;
     scene_free(sc);
 
     /* Directories: POV-Ray's working one, and where the results go. */
@@ -344,9 +567,11 @@ int cmd_crosscheck(int argc, char **argv)
     snprintf(flip_png, sizeof flip_png, "%s/flip.png", out);
     int rc = 0;
     char(*xc_args)[4200] = malloc(XC_MAX_ARGS * sizeof *xc_args);
-    framebuffer *a = NULL, *b = NULL, *map = NULL;
+    framebuffer *a = NULL, *b = NULL, *map = NULL, *ref = NULL;
     double t_pov = 0, t_pt = 0;
     char gi_used[64] = "?";
+    xc_converged conv;
+    memset(&conv, 0, sizeof conv);
     if (!xc_args) {
         rc = 1;
         goto done;
@@ -361,39 +586,9 @@ int cmd_crosscheck(int argc, char **argv)
     signal(SIGINT, on_stop);
     signal(SIGTERM, on_stop);
 
-    /* POV-Ray. */
+    /* POV-Ray at the scene's own settings (the default render). */
     {
-        char(*args)[4200] = xc_args;
-        const char *argvv[XC_MAX_ARGS + 1];
-        int n = 0;
-        snprintf(args[n++], sizeof args[0], "%s", povray);
-        snprintf(args[n++], sizeof args[0], "+I%s", base);
-        snprintf(args[n++], sizeof args[0], "+O%s", pov_out);
-        snprintf(args[n++], sizeof args[0], "+W%d", o.width);
-        snprintf(args[n++], sizeof args[0], "+H%d", o.height);
-        if (o.aa) {
-            snprintf(args[n++], sizeof args[0], "+A%g", o.aa_threshold);
-            snprintf(args[n++], sizeof args[0], "+R%d", o.aa_depth);
-        } else {
-            snprintf(args[n++], sizeof args[0], "-A");
-        }
-        snprintf(args[n++], sizeof args[0], "-D");
-        snprintf(args[n++], sizeof args[0], "-V");
-        snprintf(args[n++], sizeof args[0], "-P");
-        snprintf(args[n++], sizeof args[0], "+FN");
-        snprintf(args[n++], sizeof args[0], "-UA");
-        snprintf(args[n++], sizeof args[0], "File_Gamma=sRGB");
-        if (o.threads > 0) snprintf(args[n++], sizeof args[0], "+WT%d", o.threads);
-        snprintf(args[n++], sizeof args[0], "+L%s", scene_dir);
-        for (int i = 0; i < o.nlibs; i++) {
-            char lib[4096];
-            absolute(o.libs[i], lib, sizeof lib);
-            snprintf(args[n++], sizeof args[0], "+L%s", lib);
-        }
-        for (int i = 0; i < o.ndefines; i++) snprintf(args[n++], sizeof args[0], "Declare=%s", o.defines[i]);
-        for (int i = 0; i < n; i++) argvv[i] = args[i];
-        argvv[n] = NULL;
-        int prc = subproc_run(argvv, work, pov_log, &t_pov, d);
+        int prc = run_povray(&o, povray, work, base, pov_out, scene_dir, pov_log, 0.0, &t_pov, d);
         char made[4300];
         snprintf(made, sizeof made, "%s/%s", work, pov_out);
         if (prc != 0 || access(made, R_OK) != 0) {
@@ -406,6 +601,16 @@ int cmd_crosscheck(int argc, char **argv)
         if (strcmp(made, pov_png) != 0 && rename(made, pov_png) != 0 && !copy_file(made, pov_png)) {
             fprintf(stderr, "partray crosscheck: cannot write %s\n", pov_png);
             rc = 3;
+            goto done;
+        }
+    }
+
+    /* POV-Ray's converged radiosity reference (cached). */
+    if (o.converged && radiosity) {
+        int crc = converged_reference(&o, povray, work, base, scene_dir, out, rad_count, rad_error_bound, &conv, d);
+        if (crc != 0) {
+            print_diags(d);
+            rc = crc;
             goto done;
         }
     }
@@ -475,6 +680,27 @@ int cmd_crosscheck(int argc, char **argv)
     mean_abs_diff(a, b, &mad, &mad4);
     double lum_pov = img_mean_luminance(a, 1), lum_pt = img_mean_luminance(b, 1);
     double ratio = lum_pov > 0 ? lum_pt / lum_pov : (lum_pt > 0 ? INFINITY : 1.0);
+    /* Against the converged reference: both renders' error, luminance and time. */
+    img_compare_result rc_pov, rc_pt;
+    memset(&rc_pov, 0, sizeof rc_pov);
+    memset(&rc_pt, 0, sizeof rc_pt);
+    double lum_ref = 0;
+    if (conv.made) {
+        st = img_read(conv.png, 1, &ref, d);
+        if (st == PT_OK && (ref->width != a->width || ref->height != a->height)) {
+            fprintf(stderr, "partray crosscheck: the cached reference %s has another size\n", conv.png);
+            rc = 1;
+            goto done;
+        }
+        if (st == PT_OK) st = img_compare(ref, a, 0, &rc_pov, NULL, d);
+        if (st == PT_OK) st = img_compare(ref, b, 0, &rc_pt, NULL, d);
+        if (st != PT_OK) {
+            print_diags(d);
+            rc = st == PT_ERR_IO ? 3 : 1;
+            goto done;
+        }
+        lum_ref = img_mean_luminance(ref, 1);
+    }
     if (!o.quiet) print_diags(d);
     if (o.json) {
         stats_json js;
@@ -510,6 +736,24 @@ int cmd_crosscheck(int argc, char **argv)
         stats_num(&js, "partray", lum_pt);
         stats_num(&js, "ratio", ratio);
         stats_obj_end(&js);
+        if (o.converged && radiosity) {
+            stats_obj_begin(&js, "converged");
+            stats_int(&js, "made", conv.made);
+            stats_int(&js, "cached", conv.cached);
+            stats_int(&js, "timed_out", conv.timed_out);
+            stats_num(&js, "seconds", conv.seconds);
+            stats_int(&js, "count", conv.count);
+            stats_num(&js, "error_bound", conv.error_bound);
+            if (conv.made) {
+                stats_str(&js, "image", conv.png);
+                stats_num(&js, "luminance", lum_ref);
+                stats_num(&js, "povray_flip", rc_pov.flip_mean);
+                stats_num(&js, "partray_flip", rc_pt.flip_mean);
+                stats_num(&js, "povray_luminance_ratio", lum_ref > 0 ? lum_pov / lum_ref : 1.0);
+                stats_num(&js, "partray_luminance_ratio", lum_ref > 0 ? lum_pt / lum_ref : 1.0);
+            }
+            stats_obj_end(&js);
+        }
         fputs(stats_end(&js), stdout);
         stats_free(&js);
     } else {
@@ -529,6 +773,19 @@ int cmd_crosscheck(int argc, char **argv)
         printf("mean |diff| %.6f (after 4x4 downsample %.6f)\n", mad, mad4);
         printf("luminance   povray %.6f, partray %.6f, ratio partray/povray %.4f\n", lum_pov, lum_pt, ratio);
         if (o.out_dir) printf("heat map    %s\n", flip_png);
+        if (o.converged && radiosity && conv.made) {
+            printf("converged   POV-Ray at count %d, error_bound %g: %.3f s%s, %s\n", conv.count, conv.error_bound,
+                   conv.seconds, conv.cached ? " (cached)" : "", conv.png);
+            printf("  against it  LDR-FLIP povray %.6f, partray %.6f; luminance ratio povray %.4f, partray %.4f\n",
+                   rc_pov.flip_mean, rc_pt.flip_mean, lum_ref > 0 ? lum_pov / lum_ref : 1.0,
+                   lum_ref > 0 ? lum_pt / lum_ref : 1.0);
+            printf("  time ratio  partray/povray %.3f\n", t_pov > 0 ? t_pt / t_pov : 0.0);
+        } else if (o.converged && radiosity) {
+            printf("converged   not made: POV-Ray's converged render ran past %.0f s; POV-Ray's default render is the reference\n",
+                   o.converged_timeout);
+        } else if (o.converged) {
+            printf("converged   no radiosity{}: POV-Ray's default render is the reference\n");
+        }
     }
 
 done:
@@ -536,6 +793,7 @@ done:
     fb_free(a);
     fb_free(b);
     fb_free(map);
+    fb_free(ref);
     diag_free(d);
     /* POV-Ray's working directory always goes; with no --out it held everything. */
     {
@@ -550,6 +808,9 @@ done:
             remove(pt_log);
             remove(pt_json);
             remove(flip_png);
+            char conv_log[4300];
+            snprintf(conv_log, sizeof conv_log, "%s/povray_converged.log", out);
+            remove(conv_log);
         }
         if (rmdir(work) != 0 && !o.quiet && rc == 0)
             fprintf(stderr, "partray crosscheck: left files in %s\n", work);
