@@ -46,6 +46,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include "accel_query.h"
 #include "cli.h"
 #include "diag.h"
 #include "framebuffer.h"
@@ -53,6 +54,7 @@
 #include "img_metrics.h"
 #include "scene.h"
 #include "sdl.h"
+#include "shade_funcenv.h"
 #include "stats_json.h"
 #include "stats_read.h"
 #include "subproc.h"
@@ -514,6 +516,8 @@ int cmd_crosscheck(int argc, char **argv)
     so.ndefines = o.ndefines;
     so.image_width = o.width;
     so.image_height = o.height;
+    so.func_env = shade_func_env(); /* as render parses: pattern functions, trace() of every shape */
+    so.geom_env = accel_geom_env();
     scene *sc = NULL;
     pt_status st = sdl_parse_file(o.scene, &so, &sc, d);
     if (st != PT_OK) {
