@@ -3,10 +3,12 @@
  * POV-Ray style switches accepted (POV-Ray 3.7 reference, "Command-line
  * options"): +Wn +Hn (size), +Ofile (output), +Ifile (input), +A[t] / -A
  * (antialiasing with threshold t, default 0.3), +Rn (AA depth), +Lpath
- * (library path), +FE/+FN (format, implied by the output name here), +WTn
- * (work threads), +Kc (clock), +KFIn +KFFn +KIc +KFc +KC (animation frames
- * and clocks, cyclic), +SFn +EFn (frame subset). Switches that only concern POV-Ray's display
- * or its own files (+D, -D, +P, +V, +J...) are accepted and ignored. */
+ * (library path), +FE/+FN (format of an output named without extension),
+ * +WTn (work threads), +Kc (clock), +KFIn +KFFn +KIc +KFc +KC (animation
+ * frames and clocks, cyclic), +SFn +EFn (frame subset), +SCn +ECn +SRn +ERn
+ * (render window). Switches that only concern POV-Ray's display or its own
+ * files (+D, -D, +P, +V, +J...) are accepted and ignored. INI files and
+ * Key=value options are expanded into these switches first (ini.h). */
 #include "cli.h"
 #include <errno.h>
 #include <fcntl.h>
@@ -111,20 +113,29 @@ static int pov_switch(const char *arg, cli_render *o, char *err, int errlen)
             return 0;
         }
         break;
-    case 'S': case 'E': /* +SFn / +EFn: subset of frames; +SR +SC +ER +EC (render window) are ignored */
-        if (v[0] == 'F' || v[0] == 'f') {
-            int *f = c == 'S' ? &o->sf : &o->ef;
-            if (parse_int(v + 1, f)) {
-                if (c == 'S') o->sf_given = 1;
-                else o->ef_given = 1;
-                return 0;
-            }
-            break;
+    case 'S': case 'E': { /* +SFn +EFn: subset of frames (n in (0,1): a fraction); +SC +EC +SR +ER: render window */
+        char w = (char)(v[0] >= 'a' && v[0] <= 'z' ? v[0] - 32 : v[0]);
+        double *dst = NULL;
+        int *given = NULL;
+        if (w == 'F') { dst = c == 'S' ? &o->sf : &o->ef; given = c == 'S' ? &o->sf_given : &o->ef_given; }
+        else if (w == 'C') { dst = c == 'S' ? &o->sc : &o->ec; given = c == 'S' ? &o->sc_given : &o->ec_given; }
+        else if (w == 'R') { dst = c == 'S' ? &o->sr : &o->er; given = c == 'S' ? &o->sr_given : &o->er_given; }
+        if (dst && parse_double(v + 1, dst) && *dst >= 0) {
+            *given = 1;
+            return 0;
         }
-        if (v[0] == 'R' || v[0] == 'r' || v[0] == 'C' || v[0] == 'c') return 0;
         break;
-    case 'F': case 'D': case 'P': case 'V': case 'J': case 'X': case 'Q': case 'G': case 'B': case 'C':
-        return 0; /* format (from the file name), display, pause, verbose, jitter...: ignored */
+    }
+    case 'F': /* +F[type][bits]: N PNG (+FN16: 16 bits), E OpenEXR; others are POV-Ray formats partray does not write */
+        if (!*v) return 0;
+        if (v[0] == 'N' || v[0] == 'n' || v[0] == 'E' || v[0] == 'e') {
+            o->format = (char)(v[0] == 'n' || v[0] == 'N' ? 'N' : 'E');
+            if (o->format == 'N' && strcmp(v + 1, "16") == 0) o->png16 = 1;
+            return 0;
+        }
+        break;
+    case 'D': case 'P': case 'V': case 'J': case 'X': case 'Q': case 'G': case 'B': case 'C':
+        return 0; /* display, pause, verbose, jitter...: ignored */
     default:
         break;
     }
@@ -256,10 +267,20 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
             i++;
         } else if (strcmp(a, "--frame") == 0) {
             if (!has_value(a, next, err, errlen)) return 2;
-            if (!parse_int(next, &o->sf)) { snprintf(err, (size_t)errlen, "--frame wants an integer"); return 2; }
-            o->ef = o->sf;
+            int fr;
+            if (!parse_int(next, &fr) || fr < 0) { snprintf(err, (size_t)errlen, "--frame wants a frame number"); return 2; }
+            o->sf = o->ef = fr;
             o->sf_given = o->ef_given = 1;
             i++;
+        } else if (strcmp(a, "--aa-threshold") == 0 || strncmp(a, "--aa-threshold=", 15) == 0) {
+            /* INI Antialias_Threshold: the threshold without switching +A on or off */
+            const char *v = a[14] == '=' ? a + 15 : next;
+            if (!v) { snprintf(err, (size_t)errlen, "option '%s' needs a value", a); return 2; }
+            if (!parse_double(v, &o->aa_threshold) || o->aa_threshold < 0) {
+                snprintf(err, (size_t)errlen, "--aa-threshold wants a non-negative number");
+                return 2;
+            }
+            if (a[14] != '=') i++;
         } else if (strcmp(a, "--float") == 0) {
             o->exr_float = 1;
         } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
@@ -329,34 +350,46 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
         snprintf(err, (size_t)errlen, "no scene file given");
         return 2;
     }
-    sdl_options check; /* frame options are checked here, applied by the caller */
-    sdl_default_options(&check);
-    return cli_animation(o, &check, err, errlen);
+    anim_plan plan;
+    return cli_frames(o, &plan, err, errlen);
 }
 
-int cli_animation(const cli_render *o, sdl_options *so, char *err, int errlen)
+int cli_frames(const cli_render *o, anim_plan *p, char *err, int errlen)
 {
-    int kfi = o->kfi, kff = o->kff;
-    if (o->kfi_given && !o->kff_given && kff < kfi) kff = kfi; /* +KFI3 alone: frames 3..3 (POV-Ray) */
-    int anim = (o->kfi_given || o->kff_given) && !(kfi == 1 && kff == 1 && !o->cyclic);
-    if (!anim) {
-        if (o->sf_given || o->ef_given) {
-            snprintf(err, (size_t)errlen, "+SF/+EF/--frame need an animation (+KFI and +KFF)");
-            return 2;
-        }
-        if (o->clock_given) sdl_set_still_clock(so, o->clock);
-        return 0;
-    }
-    int sf = o->sf_given ? o->sf : kfi;
-    int ef = o->ef_given ? o->ef : (o->sf_given ? sf : kfi);
-    if (sf != ef) {
-        snprintf(err, (size_t)errlen, "partray parses and renders one frame per run: choose it with --frame N (or +SFn +EFn with n equal), not frames %d..%d", sf, ef);
+    if (anim_plan_make(p, o->kfi, o->kfi_given, o->kff, o->kff_given, o->ki, o->kf, o->cyclic, o->sf_given ? o->sf : -1,
+                       o->ef_given ? o->ef : -1, err, errlen))
+        return 2;
+    return 0;
+}
+
+void cli_frame_options(const cli_render *o, const anim_plan *p, int frame, sdl_options *so)
+{
+    if (p->animated) anim_frame_options(p, frame, so);
+    else if (o->clock_given) sdl_set_still_clock(so, o->clock);
+}
+
+int cli_window(const cli_render *o, int w, int h, int win[4], char *err, int errlen)
+{
+    /* POV-Ray keeps these as POVMSFloat (32-bit float): +SR0.7 of 10 rows
+     * is int(10 * 0.7f) - 1 = 5, not 6 */
+    double sc = (float)(o->sc_given ? o->sc : 1.0), sr = (float)(o->sr_given ? o->sr : 1.0);
+    double ec = (float)(o->ec_given ? o->ec : w), er = (float)(o->er_given ? o->er : h);
+    int x0 = sc < 1.0 ? (int)(w * sc) : (int)sc - 1;
+    int y0 = sr < 1.0 ? (int)(h * sr) : (int)sr - 1;
+    int x1 = ec <= 1.0 ? (int)(w * ec) - 1 : (int)ec - 1;
+    int y1 = er <= 1.0 ? (int)(h * er) - 1 : (int)er - 1;
+    if (x0 < 0 || y0 < 0 || x0 >= w || y0 >= h) {
+        snprintf(err, (size_t)errlen, "start column/row (+SC/+SR) outside the %dx%d image", w, h);
         return 2;
     }
-    if (sdl_set_frame(so, kfi, kff, o->ki, o->kf, o->cyclic, sf) != 0) {
-        snprintf(err, (size_t)errlen, "frame %d is outside the animation's frames %d..%d", sf, kfi, kff);
+    if (x1 >= w || y1 >= h || x1 < x0 || y1 < y0) {
+        snprintf(err, (size_t)errlen, "end column/row (+EC/+ER) outside the %dx%d image or before the start", w, h);
         return 2;
     }
+    win[0] = x0;
+    win[1] = y0;
+    win[2] = x1 + 1;
+    win[3] = y1 + 1;
     return 0;
 }
 

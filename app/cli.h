@@ -3,6 +3,7 @@
 #ifndef PT_CLI_H
 #define PT_CLI_H
 #include <stdint.h>
+#include "anim.h"
 #include "sdl.h"
 
 #define CLI_MAX_LIST 64
@@ -84,15 +85,29 @@ typedef struct {
     int kfi_given, kff_given;
     double ki, kf;          /* initial/final clock (default 0, 1) */
     int cyclic;
-    int sf, ef;             /* subset start/end frame (--frame N sets both) */
+    double sf, ef;          /* subset start/end frame (--frame N sets both); in (0,1): a fraction */
     int sf_given, ef_given;
+    /* render window (POV-Ray 3.7 +SC +EC +SR +ER): a value in [0,1) (start)
+     * or [0,1] (end) is a fraction of the width or height, others a 1-based
+     * pixel (cli_window) */
+    double sc, ec, sr, er;
+    int sc_given, ec_given, sr_given, er_given;
+    char format;            /* +F: 'N' PNG, 'E' EXR, 0 = from the output name */
 } cli_render;
 
-/* The animation the options ask for, applied to the parser's options
- * (sdl_options clock, frame_number...): a still with +K, or one frame of an
- * animation (partray parses and renders one frame per run: +SF/+EF or
- * --frame choose it, default the first). Returns 0, or 2 with a message. */
-int cli_animation(const cli_render *o, sdl_options *so, char *err, int errlen);
+/* The render window the options ask for, as pixels [x0,x1) x [y0,y1) of a
+ * w x h image (POV-Ray 3.7 backend/scene/view.cpp: start v in [0,1) ->
+ * int(w v), else int(v) - 1; end v in [0,1] -> int(w v) - 1, else
+ * int(v) - 1, inclusive). Returns 0 (the whole image when no bound is
+ * given), or 2 with a message when the window is empty or outside. */
+int cli_window(const cli_render *o, int w, int h, int win[4], char *err, int errlen);
+
+/* The frames the options ask for (anim.h): a still, or the frames of an
+ * animation (+SF/+EF or --frame choose a subset). Returns 0, or 2 with a
+ * message. */
+int cli_frames(const cli_render *o, anim_plan *p, char *err, int errlen);
+/* The parser's options for frame `frame` of plan p (a still: +K's clock). */
+void cli_frame_options(const cli_render *o, const anim_plan *p, int frame, sdl_options *so);
 
 /* Parses argv (after the subcommand). Returns 0 on success, otherwise writes
  * a message into err and returns 2 (usage). */

@@ -9,6 +9,7 @@
 #include "cli.h"
 #include "cmd_compare.h"
 #include "cmd_crosscheck.h"
+#include "cmd_merge.h"
 #include "cmd_sweep.h"
 #include "diag.h"
 #include "accel_query.h"
@@ -17,6 +18,7 @@
 #include "img_falsecolor.h"
 #include "img_io.h"
 #include "img_ocio.h"
+#include "ini.h"
 #include "lighting.h"
 #include "pool.h"
 #include "render_gi.h"
@@ -67,6 +69,7 @@ static const char *usage_text =
     "                 [--clock V | +KV] [+KFIn +KFFn +KIv +KFv +KC] [--frame N | +SFn +EFn]\n"
     "  partray parse SCENE.pov [-D NAME=VALUE] [-L DIR] [--clock V] [frame options as render]\n"
     "  partray compare REF TEST [--heatmap OUT.png] [--json]\n"
+    "  partray merge OUT.exr TILE.exr...   # tiles of a frame (render windows) into one image\n"
     "  partray sweep SCENE.pov --ref REF.exr [--gi MODE[,MODE...]] --vary [MODE/]KEY=v1,v2,... [--out DIR]\n"
     "                [--size WxH] [--metric relmse|rmse|flip|psnr|ssim] [--time total|render|wall] [render options]\n"
     "  partray crosscheck SCENE.pov [--size WxH] [+A0.3] [--threads N] [--out DIR] [--json] [--povray PATH]\n"
@@ -106,7 +109,7 @@ static void warn_if_empty(const scene *sc, diag *d)
     }
 }
 
-static void fill_sdl_options(sdl_options *so, const cli_render *o)
+static void fill_sdl_options(sdl_options *so, const cli_render *o, const anim_plan *plan, int frame)
 {
     sdl_default_options(so);
     so->lib_paths = o->libs;
@@ -125,8 +128,7 @@ static void fill_sdl_options(sdl_options *so, const cli_render *o)
     if (o->max_image_pixels > 0) so->max_image_pixels = o->max_image_pixels;
     so->func_env = shade_func_env(); /* pattern/pigment functions, noise, vturbulence while parsing */
     so->geom_env = accel_geom_env();  /* trace()/inside() of the shapes the parser does not intersect */
-    char err[256];
-    cli_animation(o, so, err, sizeof err); /* checked by cli_parse_render already */
+    cli_frame_options(o, plan, frame, so);
 }
 
 /* The image size must fit what the writers accept and the memory there is:
@@ -157,6 +159,26 @@ static int check_image_size(int w, int h, unsigned long long limit)
     return 1;
 }
 
+/* The render options after INI files are expanded (ini.h); warnings
+ * printed. Returns 0, or the exit code. *ia keeps o's strings alive. */
+static int read_options(const char *cmd, int argc, char **argv, cli_render *o, ini_args **ia)
+{
+    diag *d = diag_new();
+    pt_status st = ini_expand(argc, argv, ia, d);
+    print_diags(d, 0);
+    diag_free(d);
+    if (st != PT_OK) return st == PT_ERR_IO ? EXIT_IO : EXIT_USAGE;
+    char err[512];
+    if (cli_parse_render(ini_argc(*ia), ini_argv(*ia), o, err, sizeof err)) {
+        if (strcmp(cmd, "parse") == 0) fprintf(stderr, "partray parse: %s\n%s", err, cli_parse_help);
+        else fprintf(stderr, "partray %s: %s\n(partray %s --help lists the options)\n", cmd, err, cmd);
+        ini_free(*ia);
+        *ia = NULL;
+        return EXIT_USAGE;
+    }
+    return 0;
+}
+
 static int cmd_parse(int argc, char **argv)
 {
     if (cli_wants_help(argc, argv)) {
@@ -164,30 +186,36 @@ static int cmd_parse(int argc, char **argv)
         return EXIT_OK;
     }
     cli_render o;
-    char err[512];
-    if (cli_parse_render(argc, argv, &o, err, sizeof err)) {
-        fprintf(stderr, "partray parse: %s\n%s", err, cli_parse_help);
-        return EXIT_USAGE;
-    }
-    sdl_options so;
-    fill_sdl_options(&so, &o);
-    diag *d = diag_new();
-    scene *sc = NULL;
-    double t0 = timer_now();
-    pt_status st = sdl_parse_file(o.scene, &so, &sc, d);
-    double t1 = timer_now();
-    if (st == PT_OK) warn_if_empty(sc, d);
-    print_diags(d, o.quiet);
-    if (st != PT_OK) {
+    ini_args *ia = NULL;
+    int rc = read_options("parse", argc, argv, &o, &ia);
+    if (rc) return rc;
+    anim_plan plan;
+    char err[256];
+    cli_frames(&o, &plan, err, sizeof err); /* checked by cli_parse_render */
+    for (int f = plan.first; f <= plan.last && rc == EXIT_OK; f++) {
+        sdl_options so;
+        fill_sdl_options(&so, &o, &plan, f);
+        diag *d = diag_new();
+        scene *sc = NULL;
+        double t0 = timer_now();
+        pt_status st = sdl_parse_file(o.scene, &so, &sc, d);
+        double t1 = timer_now();
+        if (st == PT_OK) warn_if_empty(sc, d);
+        print_diags(d, o.quiet);
         diag_free(d);
-        return status_exit(st);
+        if (st != PT_OK) {
+            rc = status_exit(st);
+            break;
+        }
+        scene_counts c = scene_count(sc);
+        char frame[32] = "";
+        if (plan.animated) snprintf(frame, sizeof frame, " frame %d", f);
+        printf("%s%s: %ld objects (%ld CSG nodes), %ld lights, %ld triangles in %ld meshes, %ld unsupported, %d files, %.3f s\n",
+               o.scene, frame, c.objects, c.csg, c.lights, c.triangles, c.meshes, c.unsupported, sc->nfiles, t1 - t0);
+        scene_free(sc);
     }
-    scene_counts c = scene_count(sc);
-    printf("%s: %ld objects (%ld CSG nodes), %ld lights, %ld triangles in %ld meshes, %ld unsupported, %d files, %.3f s\n",
-           o.scene, c.objects, c.csg, c.lights, c.triangles, c.meshes, c.unsupported, sc->nfiles, t1 - t0);
-    scene_free(sc);
-    diag_free(d);
-    return EXIT_OK;
+    ini_free(ia);
+    return rc;
 }
 
 /* "out.png" -> "out.partial.png" */
@@ -247,110 +275,62 @@ static int write_false_color(const cli_render *o, const framebuffer *fb, const l
     return status_exit(st);
 }
 
-static int cmd_render(int argc, char **argv)
-{
-    double t_start = timer_now();
-    if (cli_wants_help(argc, argv)) {
-        fputs(cli_render_help, stdout);
-        fputs(cli_exit_codes, stdout);
-        return EXIT_OK;
-    }
-    cli_render o;
-    char err[512];
-    if (cli_parse_render(argc, argv, &o, err, sizeof err)) {
-        fprintf(stderr, "partray render: %s\n(partray render --help lists the options)\n", err);
-        return EXIT_USAGE;
-    }
-    for (int i = 0; i < o.noutputs; i++) {
-        if (img_format_from_path(o.outputs[i]) == IMG_FMT_UNKNOWN) {
-            fprintf(stderr, "partray render: output '%s': unknown format (use .exr, .png or .pfm)\n", o.outputs[i]);
-            return EXIT_USAGE;
-        }
-    }
-    if (!check_image_size(o.width > 0 ? o.width : 320, o.height > 0 ? o.height : 240,
-                          (unsigned long long)o.max_image_pixels)) return EXIT_USAGE;
-    int gi = GI_NONE;
-    if (o.gi) {
-        gi = gi_mode_parse(o.gi);
-        if (gi < 0) {
-            fprintf(stderr, "partray render: unknown --gi mode '%s' (none, particle, pmfg, path)\n", o.gi);
-            return EXIT_USAGE;
-        }
-    }
-    /* Colour management: check the names before spending time on a render. */
-    img_ocio *oc = NULL;
-    int want_ocio = o.display || o.view || o.look || o.working_space || o.ocio_config;
-    if (want_ocio) {
-        diag *od = diag_new();
-        pt_status os = img_ocio_open(o.ocio_config, &oc, od);
-        if (os == PT_OK) os = img_ocio_check(oc, o.working_space, o.display, o.view, o.look, od);
-        print_diags(od, 0);
-        diag_free(od);
-        if (os != PT_OK) {
-            img_ocio_close(oc);
-            return status_exit(os == PT_ERR_IO ? PT_ERR_IO : PT_ERR_USAGE);
-        }
-    }
-    /* Lighting studies: --units, --aovs, --false-color-quantity (lighting.h). */
-    lighting_study ls;
-    diag *ld = diag_new();
-    pt_status lst = lighting_setup(&ls, o.units, o.aovs, o.fc_quantity, ld);
-    if (lst == PT_OK) lighting_check_outputs(&ls, o.outputs, o.noutputs, ld);
-    print_diags(ld, 0);
-    diag_free(ld);
-    if (lst != PT_OK) {
-        img_ocio_close(oc);
-        return EXIT_USAGE;
-    }
-    char *default_out = NULL;
-    if (o.noutputs == 0) {
-        default_out = default_output(o.scene);
-        o.outputs[o.noutputs++] = default_out;
-    }
-    /* Fail fast: every file this render will write is checked before the
-     * scene is read, so a long render is never lost to a typo. */
-    const char *writes[12];
-    int nwrites = 0;
-    for (int i = 0; i < o.noutputs; i++) writes[nwrites++] = o.outputs[i];
-    if (o.stats) writes[nwrites++] = o.stats;
-    if (o.false_color) writes[nwrites++] = o.false_color;
-    for (int i = 0; i < nwrites; i++) {
-        int wrc = cli_check_output(writes[i], err, sizeof err);
-        if (wrc) {
-            fprintf(stderr, "partray render: %s\n", err);
-            free(default_out);
-            img_ocio_close(oc);
-            lighting_free(&ls);
-            return wrc;
-        }
-    }
-    if (!o.quiet && default_out) fprintf(stderr, "partray: no output given (-o or +O): writing %s\n", default_out);
-    if (!o.quiet && (o.width <= 0 || o.height <= 0))
-        fprintf(stderr, "partray: %s (--size WxH or +W +H): %dx%d%s\n",
-                o.width <= 0 && o.height <= 0 ? "no size given" : (o.width <= 0 ? "no width given" : "no height given"),
-                o.width > 0 ? o.width : 320, o.height > 0 ? o.height : 240,
-                o.width <= 0 && o.height <= 0 ? ", POV-Ray's default" : " (POV-Ray's default 320x240 for the side not given)");
+/* What stays the same from frame to frame of one `partray render`. */
+typedef struct {
+    cli_render *o;
+    img_ocio *oc;
+    lighting_study *ls;
+    int win[4];             /* the render window (cli_window) */
+    int tile;               /* 1: a window smaller than the image was asked for */
+    uint64_t scene_hash;    /* FNV-1a 64 of the scene file's bytes */
+    double t_start;
+} render_run;
 
+/* FNV-1a 64 of a file's bytes (0 when unreadable: the parser reports it). */
+static uint64_t file_hash(const char *path)
+{
+    uint64_t h = 0xcbf29ce484222325ULL;
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0;
+    unsigned char buf[65536];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0)
+        for (size_t i = 0; i < n; i++) h = (h ^ buf[i]) * 0x100000001b3ULL;
+    fclose(f);
+    return h;
+}
+
+/* Frame `frame` of the plan (a still: frame 0), written to outputs[]. */
+static int render_frame(render_run *run, const anim_plan *plan, int frame, char **outputs, int noutputs)
+{
+    cli_render *o = run->o;
+    lighting_study *ls = run->ls;
+    double t_frame = timer_now();
     sdl_options so;
-    fill_sdl_options(&so, &o);
+    fill_sdl_options(&so, o, plan, frame);
     diag *d = diag_new();
     scene *sc = NULL;
     double t0 = timer_now();
-    pt_status st = sdl_parse_file(o.scene, &so, &sc, d);
+    pt_status st = sdl_parse_file(o->scene, &so, &sc, d);
     double t_parse = timer_now() - t0;
     if (st != PT_OK) {
         print_diags(d, 0);
         diag_free(d);
-        free(default_out);
-        img_ocio_close(oc);
         return status_exit(st);
     }
     warn_if_empty(sc, d);
-    lighting_apply_units(&ls, sc, d); /* photometric lights; warns about fade */
-    if (!o.gi && sc->global.radiosity.enabled) gi = GI_PARTICLE;
+    lighting_apply_units(ls, sc, d); /* photometric lights; warns about fade */
+    int gi = o->gi ? gi_mode_parse(o->gi) : GI_NONE;
+    if (!o->gi && sc->global.radiosity.enabled) gi = GI_PARTICLE;
     const char *gi_used = gi_mode_name(gi);
+    if (run->tile && (gi == GI_PATH || gi == GI_PMFG)) {
+        fprintf(stderr, "partray render: a render window (+SC/+EC/+SR/+ER) needs --gi none or particle, not %s\n", gi_used);
+        scene_free(sc);
+        diag_free(d);
+        return EXIT_USAGE;
+    }
 
-    int threads = o.threads > 0 ? o.threads : pool_default_threads();
+    int threads = o->threads > 0 ? o->threads : pool_default_threads();
     accel_set_function_env(shade_func_env()); /* isosurface functions: noise, pigment functions (issue 4) */
     t0 = timer_now();
     accel *acc = accel_build(sc, threads, d, &st);
@@ -359,81 +339,87 @@ static int cmd_render(int argc, char **argv)
         print_diags(d, 0);
         scene_free(sc);
         diag_free(d);
-        free(default_out);
-        img_ocio_close(oc);
         return status_exit(st == PT_OK ? PT_ERR_DEVICE : st);
     }
 
     render_gi_opts ss;
     memset(&ss, 0, sizeof ss);
     ss.mode = gi;
-    ss.width = o.width > 0 ? o.width : 320;
-    ss.height = o.height > 0 ? o.height : 240;
+    ss.width = o->width > 0 ? o->width : 320;
+    ss.height = o->height > 0 ? o->height : 240;
     ss.threads = threads;
-    ss.seed = o.seed;
-    ss.antialias = o.antialias ? 1 : (o.spp > 1 ? 2 : 0);
-    ss.aa_threshold = o.aa_threshold;
-    ss.aa_depth = o.aa_depth;
-    ss.spp = o.spp;
-    ss.particles = o.particles;
-    ss.bounces = o.bounces;
-    ss.fg_rays = o.fg_rays;
-    ss.photons = o.photons;
-    ss.max_depth = o.max_depth;
-    ss.cl_device = o.cl_device;
-    ss.cl_max_bytes = o.cl_max_memory_mib > 0 ? (size_t)o.cl_max_memory_mib << 20 : 0;
-    ss.progress = !o.quiet;
+    ss.seed = o->seed;
+    ss.antialias = o->antialias ? 1 : (o->spp > 1 ? 2 : 0);
+    ss.aa_threshold = o->aa_threshold;
+    ss.aa_depth = o->aa_depth;
+    ss.spp = o->spp;
+    ss.particles = o->particles;
+    ss.bounces = o->bounces;
+    ss.fg_rays = o->fg_rays;
+    ss.photons = o->photons;
+    ss.max_depth = o->max_depth;
+    ss.cl_device = o->cl_device;
+    ss.cl_max_bytes = o->cl_max_memory_mib > 0 ? (size_t)o->cl_max_memory_mib << 20 : 0;
+    ss.progress = !o->quiet;
     ss.cancel = &g_cancel;
+    if (run->tile) memcpy(ss.window, run->win, sizeof ss.window);
     char *progressive = NULL;
-    if ((gi == GI_PATH || gi == GI_PMFG) && o.noutputs > 0 && img_format_from_path(o.outputs[0]) != IMG_FMT_UNKNOWN) {
-        progressive = partial_name(o.outputs[0]);
+    if ((gi == GI_PATH || gi == GI_PMFG) && noutputs > 0 && img_format_from_path(outputs[0]) != IMG_FMT_UNKNOWN) {
+        progressive = partial_name(outputs[0]);
         ss.progressive_path = progressive;
     }
     framebuffer *fb = fb_new(ss.width, ss.height);
     render_gi_result sst;
     memset(&sst, 0, sizeof sst);
-    signal(SIGINT, on_sigint);
-    signal(SIGTERM, on_sigint); /* kill, systemd, timeout(1): stop like Ctrl-C */
     t0 = timer_now();
-    lst = lighting_alloc(&ls, ss.width, ss.height, d);
-    ss.aov = ls.aov;
+    pt_status lst = ls->aov ? PT_OK : lighting_alloc(ls, ss.width, ss.height, d);
+    ss.aov = ls->aov;
     st = fb && lst == PT_OK ? render_gi(sc, acc, &ss, fb, &sst, d) : PT_ERR_NOMEM;
     double t_render = sst.t_render > 0 ? sst.t_render : timer_now() - t0;
     /* the progressive image of a finished render is no longer needed */
     if (progressive && !g_cancel) remove(progressive);
     free(progressive);
-    print_diags(d, o.quiet);
+    print_diags(d, o->quiet);
 
     int rc = EXIT_OK;
     img_write_opts wo;
     img_default_write_opts(&wo);
-    wo.exr_float = o.exr_float;
-    if (o.exr_compression >= 0) wo.exr_compression = o.exr_compression;
-    wo.png_16bit = o.png16;
-    wo.ocio = oc;
-    wo.working_space = o.working_space;
-    wo.display = o.display;
-    wo.view = o.view;
-    wo.look = o.look;
-    wo.exposure = o.exposure;
-    lighting_write_opts(&ls, &wo);
-    char tbuf[64], timings[160], settings[256];
+    wo.exr_float = o->exr_float;
+    if (o->exr_compression >= 0) wo.exr_compression = o->exr_compression;
+    wo.png_16bit = o->png16;
+    wo.ocio = run->oc;
+    wo.working_space = o->working_space;
+    wo.display = o->display;
+    wo.view = o->view;
+    wo.look = o->look;
+    wo.exposure = o->exposure;
+    lighting_write_opts(ls, &wo);
+    char tbuf[64], timings[160], settings[320], hash[40], framestr[32], window[96];
     snprintf(tbuf, sizeof tbuf, "%.3f", t_render);
     snprintf(timings, sizeof timings, "parse %.3f s, accel %.3f s, gi_geometry %.3f s, gi_lighting %.3f s, render %.3f s",
              t_parse, t_accel, sst.t_gi_geometry, sst.t_gi_lighting, t_render);
-    snprintf(settings, sizeof settings, "size %dx%d, antialias %s threshold %.3g depth %d, spp %d, seed %llu, threads %d",
+    /* what a merged image's tiles must share (partray merge): no thread
+     * count, which does not change the pixels */
+    snprintf(settings, sizeof settings,
+             "size %dx%d, antialias %s threshold %.17g depth %d, spp %d, seed %llu, gi %s, particles %ld, bounces %d",
              ss.width, ss.height, ss.antialias == 1 ? "adaptive" : (ss.antialias == 2 ? "fixed" : "off"), ss.aa_threshold,
-             ss.aa_depth, ss.spp, (unsigned long long)ss.seed, threads);
+             ss.aa_depth, ss.spp, (unsigned long long)ss.seed, gi_used, o->particles, o->bounces);
+    snprintf(hash, sizeof hash, "%016llx", (unsigned long long)run->scene_hash);
+    snprintf(framestr, sizeof framestr, "%d clock %.17g", frame, so.clock);
+    snprintf(window, sizeof window, "%d %d %d %d", run->win[0], run->win[1], run->win[2], run->win[3]);
     const char *keys[] = {"partray:scene", "partray:gi", "partray:version", "partray:render_seconds", "partray:timings",
-                          "partray:settings", "partray:units", "partray:aovs"};
-    const char *vals[] = {o.scene, gi_used, PARTRAY_VERSION, tbuf, timings, settings, ls.units_text, ls.aovs_text};
+                          "partray:settings", "partray:scene_hash", "partray:frame", "partray:window",
+                          "partray:units", "partray:aovs"};
+    const char *vals[] = {o->scene, gi_used, PARTRAY_VERSION, tbuf, timings, settings, hash, framestr, window,
+                          ls->units_text, ls->aovs_text};
     wo.meta_keys = keys;
     wo.meta_values = vals;
-    wo.nmeta = ls.aovs_text[0] ? 8 : 7;
+    wo.nmeta = ls->aovs_text[0] ? 11 : 10;
+    if (run->tile) memcpy(wo.window, run->win, sizeof wo.window);
     if (st == PT_OK && g_cancel) {
         /* Interrupted: keep what was rendered under a clearly partial name. */
-        for (int i = 0; i < o.noutputs; i++) {
-            char *pn = partial_name(o.outputs[i]);
+        for (int i = 0; i < noutputs; i++) {
+            char *pn = partial_name(outputs[i]);
             diag *wd = diag_new();
             if (pn && img_write(pn, fb, &wo, wd) == PT_OK) fprintf(stderr, "partray: interrupted; partial image in %s\n", pn);
             print_diags(wd, 0);
@@ -444,17 +430,17 @@ static int cmd_render(int argc, char **argv)
     } else if (st != PT_OK) {
         rc = status_exit(st);
     } else {
-        for (int i = 0; i < o.noutputs && rc == EXIT_OK; i++) {
+        for (int i = 0; i < noutputs && rc == EXIT_OK; i++) {
             diag *wd = diag_new();
-            pt_status ws = img_write(o.outputs[i], fb, &wo, wd);
+            pt_status ws = img_write(outputs[i], fb, &wo, wd);
             print_diags(wd, 0);
             diag_free(wd);
             if (ws != PT_OK) rc = status_exit(ws);
         }
-        if (rc == EXIT_OK && o.false_color) rc = write_false_color(&o, fb, &ls);
+        if (rc == EXIT_OK && o->false_color) rc = write_false_color(o, fb, ls);
     }
-    double t_total = timer_now() - t_start;
-    if (o.stats && rc == EXIT_OK) {
+    double t_total = timer_now() - t_frame;
+    if (o->stats && rc == EXIT_OK) {
         accel_stats as = accel_get_stats(acc);
         scene_counts cnt = scene_count(sc);
         stats_json js;
@@ -465,9 +451,10 @@ static int cmd_render(int argc, char **argv)
         stats_num(&js, "gi_geometry", sst.t_gi_geometry);
         stats_num(&js, "gi_lighting", sst.t_gi_lighting);
         stats_num(&js, "render", t_render);
-        if (ls.aov) stats_num(&js, "aov", sst.t_aov);
-        stats_num(&js, "total", t_total);
+        if (ls->aov) stats_num(&js, "aov", sst.t_aov);
+        stats_num(&js, "total", plan->animated ? t_total : timer_now() - run->t_start);
         stats_obj_end(&js);
+        if (plan->animated) stats_int(&js, "frame", frame);
         stats_int(&js, "rays", sst.primary_rays + sst.shadow_rays + sst.secondary_rays + sst.other_rays);
         stats_int(&js, "primary_rays", sst.primary_rays);
         stats_int(&js, "shadow_rays", sst.shadow_rays);
@@ -478,8 +465,8 @@ static int cmd_render(int argc, char **argv)
         stats_int(&js, "height", ss.height);
         stats_int(&js, "threads", threads);
         stats_str(&js, "gi", gi_used);
-        stats_str(&js, "gi_requested", o.gi ? o.gi : (sc->global.radiosity.enabled ? "particle" : "none"));
-        stats_str(&js, "scene", o.scene);
+        stats_str(&js, "gi_requested", o->gi ? o->gi : (sc->global.radiosity.enabled ? "particle" : "none"));
+        stats_str(&js, "scene", o->scene);
         stats_obj_begin(&js, "scene_counts");
         stats_int(&js, "objects", cnt.objects);
         stats_int(&js, "lights", cnt.lights);
@@ -493,25 +480,165 @@ static int cmd_render(int argc, char **argv)
         stats_int(&js, "triangles", as.triangles);
         stats_int(&js, "user_prims", as.user_prims);
         stats_obj_end(&js);
-        int ok = stats_write(&js, o.stats);
+        /* an animation's stats file holds its last frame's figures */
+        int ok = stats_write(&js, o->stats);
         if (!ok) {
-            fprintf(stderr, "partray: cannot write stats file '%s'\n", o.stats);
+            fprintf(stderr, "partray: cannot write stats file '%s'\n", o->stats);
             rc = EXIT_IO;
         }
     }
-    if (!o.quiet && rc == EXIT_OK)
-        fprintf(stderr, "partray: %dx%d, gi %s, parse %.3f s, accel %.3f s, render %.3f s, %.2f Mrays/s\n", ss.width,
+    if (!o->quiet && rc == EXIT_OK) {
+        char fr[32] = "";
+        if (plan->animated) snprintf(fr, sizeof fr, "frame %d: ", frame);
+        fprintf(stderr, "partray: %s%dx%d, gi %s, parse %.3f s, accel %.3f s, render %.3f s, %.2f Mrays/s\n", fr, ss.width,
                 ss.height, gi_used, t_parse, t_accel, t_render,
                 t_render > 0 ? (sst.primary_rays + sst.shadow_rays + sst.secondary_rays) / t_render * 1e-6 : 0.0);
-    if (!o.quiet && rc == EXIT_OK && (sst.t_gi_geometry > 0 || sst.t_gi_lighting > 0))
-        fprintf(stderr, "partray: gi %s: geometry %.3f s, lighting %.3f s\n", gi_used, sst.t_gi_geometry, sst.t_gi_lighting);
+        if (sst.t_gi_geometry > 0 || sst.t_gi_lighting > 0)
+            fprintf(stderr, "partray: %sgi %s: geometry %.3f s, lighting %.3f s\n", fr, gi_used, sst.t_gi_geometry,
+                    sst.t_gi_lighting);
+    }
     fb_free(fb);
-    lighting_free(&ls);
-    img_ocio_close(oc);
     accel_free(acc);
     scene_free(sc);
     diag_free(d);
-    free(default_out);
+    return rc;
+}
+
+/* The output name POV-Ray makes from +O (imageprocessing.cpp
+ * GetOutputFilename): none -> the scene's stem; a directory (ending in '/')
+ * -> the scene's stem in it; no known extension -> +F's (.png unless +FE). */
+static char *output_base(const char *out, const char *scene, char format)
+{
+    const char *ext = format == 'E' ? ".exr" : ".png";
+    if (out && *out && out[strlen(out) - 1] != '/') {
+        if (img_format_from_path(out) != IMG_FMT_UNKNOWN) return strdup(out);
+        size_t n = strlen(out) + 8;
+        char *s = malloc(n);
+        if (s) snprintf(s, n, "%s%s", out, ext);
+        return s;
+    }
+    char *stem = default_output(scene); /* "scene.png" */
+    if (!stem) return NULL;
+    char *dot = strrchr(stem, '.');
+    if (dot) *dot = 0;
+    size_t n = (out ? strlen(out) : 0) + strlen(stem) + 8;
+    char *s = malloc(n);
+    if (s) snprintf(s, n, "%s%s%s", out ? out : "", stem, ext);
+    free(stem);
+    return s;
+}
+
+static int cmd_render(int argc, char **argv)
+{
+    double t_start = timer_now();
+    if (cli_wants_help(argc, argv)) {
+        fputs(cli_render_help, stdout);
+        fputs(cli_exit_codes, stdout);
+        return EXIT_OK;
+    }
+    cli_render o;
+    ini_args *ia = NULL;
+    int rc = read_options("render", argc, argv, &o, &ia);
+    if (rc) return rc;
+    char *bases[8];
+    int nbases = o.noutputs > 0 ? o.noutputs : 1;
+    for (int i = 0; i < nbases; i++) bases[i] = output_base(o.noutputs > 0 ? o.outputs[i] : NULL, o.scene, o.format);
+    for (int i = 0; i < nbases && rc == EXIT_OK; i++) {
+        if (!bases[i]) rc = EXIT_IO;
+        else if (img_format_from_path(bases[i]) == IMG_FMT_UNKNOWN) {
+            fprintf(stderr, "partray render: output '%s': unknown format (use .exr, .png or .pfm)\n", bases[i]);
+            rc = EXIT_USAGE;
+        }
+    }
+    int w = o.width > 0 ? o.width : 320, h = o.height > 0 ? o.height : 240;
+    if (rc == EXIT_OK && !check_image_size(w, h, (unsigned long long)o.max_image_pixels)) rc = EXIT_USAGE;
+    if (rc == EXIT_OK && o.gi && gi_mode_parse(o.gi) < 0) {
+        fprintf(stderr, "partray render: unknown --gi mode '%s' (none, particle, pmfg, path)\n", o.gi);
+        rc = EXIT_USAGE;
+    }
+    render_run run;
+    memset(&run, 0, sizeof run);
+    run.o = &o;
+    run.t_start = t_start;
+    char err[256];
+    if (rc == EXIT_OK && cli_window(&o, w, h, run.win, err, sizeof err)) {
+        fprintf(stderr, "partray render: %s\n", err);
+        rc = EXIT_USAGE;
+    }
+    run.tile = !(run.win[0] == 0 && run.win[1] == 0 && run.win[2] == w && run.win[3] == h);
+    /* Colour management: check the names before spending time on a render. */
+    img_ocio *oc = NULL;
+    int want_ocio = o.display || o.view || o.look || o.working_space || o.ocio_config;
+    if (rc == EXIT_OK && want_ocio) {
+        diag *od = diag_new();
+        pt_status os = img_ocio_open(o.ocio_config, &oc, od);
+        if (os == PT_OK) os = img_ocio_check(oc, o.working_space, o.display, o.view, o.look, od);
+        print_diags(od, 0);
+        diag_free(od);
+        if (os != PT_OK) rc = status_exit(os == PT_ERR_IO ? PT_ERR_IO : PT_ERR_USAGE);
+    }
+    /* Lighting studies: --units, --aovs, --false-color-quantity (lighting.h). */
+    lighting_study ls;
+    memset(&ls, 0, sizeof ls);
+    if (rc == EXIT_OK) {
+        diag *ld = diag_new();
+        pt_status lst = lighting_setup(&ls, o.units, o.aovs, o.fc_quantity, ld);
+        if (lst == PT_OK) lighting_check_outputs(&ls, (const char **)bases, nbases, ld);
+        print_diags(ld, 0);
+        diag_free(ld);
+        if (lst != PT_OK) rc = EXIT_USAGE;
+    }
+    anim_plan plan;
+    cli_frames(&o, &plan, err, sizeof err); /* checked by cli_parse_render */
+    /* Fail fast: every file this render will write is checked before the
+     * scene is read, so a long render is never lost to a typo (an
+     * animation's frames go where its first frame goes). */
+    char *first_names[8] = {0};
+    const char *writes[12];
+    int nwrites = 0;
+    for (int i = 0; i < nbases && rc == EXIT_OK; i++) {
+        first_names[i] = anim_output_name(bases[i], plan.first, plan.animated ? plan.digits : 0);
+        writes[nwrites++] = first_names[i] ? first_names[i] : bases[i];
+    }
+    if (o.stats) writes[nwrites++] = o.stats;
+    if (o.false_color) writes[nwrites++] = o.false_color;
+    for (int i = 0; i < nwrites && rc == EXIT_OK; i++) {
+        int wrc = cli_check_output(writes[i], err, sizeof err);
+        if (wrc) {
+            fprintf(stderr, "partray render: %s\n", err);
+            rc = wrc;
+        }
+    }
+    for (int i = 0; i < nbases; i++) free(first_names[i]);
+    if (rc == EXIT_OK && !o.quiet && o.noutputs == 0)
+        fprintf(stderr, "partray: no output given (-o or +O): writing %s\n", bases[0]);
+    if (rc == EXIT_OK && !o.quiet && (o.width <= 0 || o.height <= 0))
+        fprintf(stderr, "partray: %s (--size WxH or +W +H): %dx%d%s\n",
+                o.width <= 0 && o.height <= 0 ? "no size given" : (o.width <= 0 ? "no width given" : "no height given"),
+                o.width > 0 ? o.width : 320, o.height > 0 ? o.height : 240,
+                o.width <= 0 && o.height <= 0 ? ", POV-Ray's default" : " (POV-Ray's default 320x240 for the side not given)");
+    run.oc = oc;
+    run.ls = &ls;
+    run.scene_hash = file_hash(o.scene);
+    signal(SIGINT, on_sigint);
+    signal(SIGTERM, on_sigint); /* kill, systemd, timeout(1): stop like Ctrl-C */
+    int nframes = plan.last - plan.first + 1;
+    for (int f = plan.first; f <= plan.last && rc == EXIT_OK && !g_cancel; f++) {
+        char *names[8];
+        int ok = 1;
+        for (int i = 0; i < nbases; i++) ok &= (names[i] = anim_output_name(bases[i], f, plan.animated ? plan.digits : 0)) != NULL;
+        if (!o.quiet && plan.animated)
+            fprintf(stderr, "partray: frame %d (%d of %d) -> %s\n", f, f - plan.first + 1, nframes, names[0]);
+        rc = ok ? render_frame(&run, &plan, f, names, nbases) : EXIT_IO;
+        for (int i = 0; i < nbases; i++) free(names[i]);
+    }
+    if (rc == EXIT_OK && g_cancel) rc = g_cancel == SIGTERM ? 128 + SIGTERM : EXIT_INTERRUPTED;
+    if (!o.quiet && rc == EXIT_OK && plan.animated)
+        fprintf(stderr, "partray: %d frames in %.3f s\n", nframes, timer_now() - t_start);
+    for (int i = 0; i < nbases; i++) free(bases[i]);
+    lighting_free(&ls);
+    img_ocio_close(oc);
+    ini_free(ia);
     return rc;
 }
 
@@ -538,11 +665,12 @@ int main(int argc, char **argv)
     if (strcmp(cmd, "render") == 0) return cmd_render(argc - 2, argv + 2);
     if (strcmp(cmd, "parse") == 0) return cmd_parse(argc - 2, argv + 2);
     if (strcmp(cmd, "compare") == 0) return cmd_compare(argc - 2, argv + 2);
+    if (strcmp(cmd, "merge") == 0) return cmd_merge(argc - 2, argv + 2);
     if (strcmp(cmd, "sweep") == 0) return cmd_sweep(argc - 2, argv + 2);
     if (strcmp(cmd, "crosscheck") == 0) return cmd_crosscheck(argc - 2, argv + 2);
     if (strcmp(cmd, "view") == 0) return cmd_view(argc - 2, argv + 2);
     /* POV-Ray habit: `partray scene.pov +W..` means render. */
-    if (strstr(cmd, ".pov") || cmd[0] == '+') return cmd_render(argc - 1, argv + 1);
+    if (strstr(cmd, ".pov") || strstr(cmd, ".ini") || cmd[0] == '+') return cmd_render(argc - 1, argv + 1);
     fprintf(stderr, "partray: unknown command '%s'\n%s", cmd, usage_text);
     return EXIT_USAGE;
 }

@@ -31,6 +31,7 @@ static void fill_shade(shade_settings *ss, const render_gi_opts *o)
     ss->aa_depth = o->aa_depth;
     ss->spp = o->spp;
     ss->cancel = o->cancel;
+    memcpy(ss->window, o->window, sizeof ss->window);
 }
 
 /* The AOV pass (shade_aov.h) with the Whitted settings of the render and,

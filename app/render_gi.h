@@ -32,6 +32,7 @@ typedef struct {
     volatile int *cancel;
     int progress;             /* 1: progress bar on stderr (reference modes) */
     const char *progressive_path; /* reference modes: write the image so far here every few seconds */
+    int window[4];            /* none/particle: render window x0,y0,x1,y1 (shade_settings.window); 0 = all */
     shade_aov *aov;           /* non-NULL: fill these AOVs after the render (shade_aov.h); the indirect
                                  AOV comes from particle GI only (0 for none, pmfg, path) */
 } render_gi_opts;

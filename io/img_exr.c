@@ -247,6 +247,19 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
     init.write_fn = on_write;
 
     const int w = fb->width, h = fb->height;
+    /* the data window (a tile) inside the display window (fb) */
+    int wx0 = 0, wy0 = 0, wx1 = w, wy1 = h;
+    if (o && o->window[2] > o->window[0] && o->window[3] > o->window[1]) {
+        if (o->window[0] < 0 || o->window[1] < 0 || o->window[2] > w || o->window[3] > h) {
+            diag_error(d, "cannot write '%s': data window outside the %dx%d image", name, w, h);
+            return PT_ERR_INTERNAL;
+        }
+        wx0 = o->window[0];
+        wy0 = o->window[1];
+        wx1 = o->window[2];
+        wy1 = o->window[3];
+    }
+    const int ww = wx1 - wx0;
     const int use_float = o && o->exr_float;
     out_channel *ch = NULL;
     const int nch = list_channels(fb, o, use_float, &ch);
@@ -266,8 +279,22 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
 
     what = "cannot set up EXR header";
     rv = exr_add_part(ctx, NULL, EXR_STORAGE_SCANLINE, &part);
-    if (rv == EXR_ERR_SUCCESS)
-        rv = exr_initialize_required_attr_simple(ctx, part, w, h, compression_of(o ? o->exr_compression : 1));
+    if (rv == EXR_ERR_SUCCESS) {
+        exr_attr_box2i_t disp, data;
+        disp.min.x = 0;
+        disp.min.y = 0;
+        disp.max.x = w - 1;
+        disp.max.y = h - 1;
+        data.min.x = wx0;
+        data.min.y = wy0;
+        data.max.x = wx1 - 1;
+        data.max.y = wy1 - 1;
+        exr_attr_v2f_t centre;
+        centre.x = 0.0f;
+        centre.y = 0.0f;
+        rv = exr_initialize_required_attr(ctx, part, &disp, &data, 1.0f, &centre, 1.0f, EXR_LINEORDER_INCREASING_Y,
+                                          compression_of(o ? o->exr_compression : 1));
+    }
     /* Channel order in the file is alphabetical whatever the add order. */
     for (int c = 0; c < nch && rv == EXR_ERR_SUCCESS; c++)
         rv = exr_add_channel(ctx, part, ch[c].name, ch[c].use_float ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF,
@@ -300,7 +327,7 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
     if (rv != EXR_ERR_SUCCESS) goto fail;
     if (lpc < 1) lpc = 1;
     /* One block of sanitized floats, channel after channel (planar). */
-    const size_t plane = (size_t)w * (size_t)lpc;
+    const size_t plane = (size_t)ww * (size_t)lpc;
     buf = malloc(sizeof(float) * plane * (size_t)nch);
     if (!buf) {
         exr_finish(&ctx);
@@ -308,16 +335,16 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
         diag_error(d, "cannot write '%s': out of memory", name);
         return PT_ERR_NOMEM;
     }
-    for (int y0 = 0; y0 < h; y0 += lpc) {
+    for (int y0 = wy0; y0 < wy1; y0 += lpc) {
         exr_chunk_info_t ci;
         rv = exr_write_scanline_chunk_info(ctx, part, y0, &ci);
         if (rv != EXR_ERR_SUCCESS) goto fail;
         for (int c = 0; c < nch; c++) {
             const float lim = ch[c].use_float ? INFINITY : HALF_MAX;
             for (int y = 0; y < ci.height; y++) {
-                const float *src = ch[c].src + (size_t)(y0 + y) * (size_t)w * (size_t)ch[c].stride;
-                float *dst = buf + (size_t)c * plane + (size_t)y * (size_t)w;
-                for (int x = 0; x < w; x++) {
+                const float *src = ch[c].src + ((size_t)(y0 + y) * (size_t)w + (size_t)wx0) * (size_t)ch[c].stride;
+                float *dst = buf + (size_t)c * plane + (size_t)y * (size_t)ww;
+                for (int x = 0; x < ww; x++) {
                     float v = src[(size_t)x * (size_t)ch[c].stride];
                     if (!isfinite(v)) v = 0.0f;
                     if (v > lim) v = lim;
@@ -336,7 +363,7 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
             ec->user_data_type = EXR_PIXEL_FLOAT;
             ec->user_bytes_per_element = 4;
             ec->user_pixel_stride = (int32_t)sizeof(float);
-            ec->user_line_stride = (int32_t)(sizeof(float) * (size_t)w);
+            ec->user_line_stride = (int32_t)(sizeof(float) * (size_t)ww);
             ec->encode_from_ptr = (const uint8_t *)(buf + (size_t)slot * plane);
         }
         if (!enc_init) {
@@ -813,4 +840,56 @@ done:
     close(s.fd);
     free(ls.data);
     return st;
+}
+
+pt_status img_exr_info(const char *path, int *disp_w, int *disp_h, int win[4], const char *const *keys, int nkeys,
+                       char **vals, diag *d)
+{
+    for (int i = 0; i < nkeys; i++) vals[i] = NULL;
+    exr_msg[0] = '\0';
+    exr_stream s = {-1, 0};
+    s.fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (s.fd < 0) {
+        diag_error(d, "cannot read '%s': %s", path, strerror(errno));
+        return PT_ERR_IO;
+    }
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = on_error;
+    init.user_data = &s;
+    init.read_fn = on_read;
+    init.size_fn = on_size;
+    init.max_image_width = IMG_MAX_SIDE;
+    init.max_image_height = IMG_MAX_SIDE;
+    init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
+    exr_context_t ctx = NULL;
+    exr_attr_box2i_t dw, vw;
+    exr_result_t rv = exr_start_read(&ctx, path, &init);
+    if (rv == EXR_ERR_SUCCESS) rv = exr_get_data_window(ctx, 0, &dw);
+    if (rv == EXR_ERR_SUCCESS) rv = exr_get_display_window(ctx, 0, &vw);
+    if (rv != EXR_ERR_SUCCESS) {
+        diag_error(d, "cannot read '%s': not a readable EXR header: %s", path, reason(&s, rv));
+        if (ctx) exr_finish(&ctx);
+        close(s.fd);
+        return PT_ERR_IO;
+    }
+    *disp_w = vw.max.x - vw.min.x + 1;
+    *disp_h = vw.max.y - vw.min.y + 1;
+    win[0] = dw.min.x - vw.min.x;
+    win[1] = dw.min.y - vw.min.y;
+    win[2] = dw.max.x - vw.min.x + 1;
+    win[3] = dw.max.y - vw.min.y + 1;
+    for (int i = 0; i < nkeys; i++) {
+        int32_t len = 0;
+        const char *str = NULL;
+        if (exr_attr_get_string(ctx, 0, keys[i], &len, &str) == EXR_ERR_SUCCESS && str && len >= 0) {
+            vals[i] = malloc((size_t)len + 1);
+            if (vals[i]) {
+                memcpy(vals[i], str, (size_t)len);
+                vals[i][len] = 0;
+            }
+        }
+    }
+    exr_finish(&ctx);
+    close(s.fd);
+    return PT_OK;
 }

@@ -33,4 +33,10 @@ pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, cons
 /* At most max_pixels pixels (img_read_limited). */
 pt_status img_exr_read(const char *path, uint64_t max_pixels, framebuffer **out, diag *d);
 
+/* The header of part 0 of an EXR file: the display window's size, the
+ * data window (x0,y0,x1,y1 with x1,y1 exclusive, in display coordinates)
+ * and the string attributes named in keys (vals[i] malloc'd, NULL when the
+ * file has none of that name). PT_ERR_IO when unreadable. */
+pt_status img_exr_info(const char *path, int *disp_w, int *disp_h, int win[4], const char *const *keys, int nkeys,
+                       char **vals, diag *d);
 #endif

@@ -56,6 +56,9 @@ typedef struct {
     const img_layer *layers;   /* extra layers of the same size as fb (AOVs); ignored by PNG and PFM */
     int nlayers;
     double white_luminance;    /* > 0: the standard `whiteLuminance` attribute, cd/m^2 of RGB (1,1,1) */
+    /* EXR only: a tile. x0,y0,x1,y1 (x1,y1 exclusive) of fb written as the
+     * data window, fb's whole size as the display window; all 0 = all of fb. */
+    int window[4];
 } img_write_opts;
 
 void img_default_write_opts(img_write_opts *o);

@@ -8,7 +8,8 @@ libembree-dev libopenexr-dev libopencolorio-dev libpng-dev
 ocl-icd-opencl-dev opencl-headers pocl-opencl-icd
 libcmocka-dev libsdl2-dev libfreetype-dev libjpeg-dev libtiff-dev libgif-dev
 povray povray-includes povray-examples
-xvfb clang libclang-rt-14-dev valgrind"
+xvfb clang libclang-rt-14-dev valgrind
+slurmctld slurmd slurm-client munge parallel"
 
 missing=""
 for p in $PKGS; do

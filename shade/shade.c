@@ -67,6 +67,8 @@ typedef struct {
     media_inside cam_in;
     const struct hit_frame *frame[SHADE_MAX_THREADS];
     int primary_on;      /* s->primary holds this render's centre rays (shade_primary_begin_fn) */
+    int win[4];          /* the pixels rendered (shade_settings.window) */
+    int first_win[4];    /* the first pass's: win and, with +A, a one-pixel apron */
 } render_ctx;
 
 /* The hit tex_shade is working on, for its callbacks: the containers of
@@ -521,13 +523,18 @@ static rgb sample(render_ctx *c, int thread, double px, double py, rng *r)
     return rgb_scale(acc, 1.0 / n);
 }
 
-static void tile_bounds(const render_ctx *c, int tile, int *x0, int *y0, int *x1, int *y1)
+/* Tile `tile` of the image clipped to the rectangle win (x0,y0,x1,y1). */
+static void tile_bounds(const render_ctx *c, int tile, const int *win, int *x0, int *y0, int *x1, int *y1)
 {
     int tx = tile % c->tiles_x, ty = tile / c->tiles_x;
     *x0 = tx * TILE;
     *y0 = ty * TILE;
     *x1 = *x0 + TILE < c->s->width ? *x0 + TILE : c->s->width;
     *y1 = *y0 + TILE < c->s->height ? *y0 + TILE : c->s->height;
+    if (*x0 < win[0]) *x0 = win[0];
+    if (*y0 < win[1]) *y0 = win[1];
+    if (*x1 > win[2]) *x1 = win[2];
+    if (*y1 > win[3]) *y1 = win[3];
 }
 
 /* Pass 1: one ray per pixel centre (or a fixed n x n stratified grid). */
@@ -536,7 +543,7 @@ static void tile_first_pass(void *ctx, int tile, int thread)
     render_ctx *c = ctx;
     if (c->s->cancel && *c->s->cancel) return;
     int x0, y0, x1, y1;
-    tile_bounds(c, tile, &x0, &y0, &x1, &y1);
+    tile_bounds(c, tile, c->first_win, &x0, &y0, &x1, &y1);
     int n = 1;
     if (c->s->antialias == 2) {
         n = (int)floor(sqrt((double)(c->s->spp > 1 ? c->s->spp : 1)) + 0.5);
@@ -584,7 +591,7 @@ static void tile_supersample(void *ctx, int tile, int thread)
     render_ctx *c = ctx;
     if (c->s->cancel && *c->s->cancel) return;
     int x0, y0, x1, y1;
-    tile_bounds(c, tile, &x0, &y0, &x1, &y1);
+    tile_bounds(c, tile, c->win, &x0, &y0, &x1, &y1);
     int d = c->s->aa_depth > 0 ? c->s->aa_depth : 3;
     double step = 1.0 / d;
     for (int y = y0; y < y1; y++) {
@@ -640,6 +647,19 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     /* the camera's containers matter to media and to fog (not in non-hollow objects) */
     if (c.media || sc->fogs || sc->rainbows) media_inside_at(sc, sc->camera.location, &c.cam_in);
     int ntiles = c.tiles_x * c.tiles_y;
+    const int *sw = s->window;
+    int whole = !(sw[2] > sw[0] && sw[3] > sw[1]);
+    if (!whole && (sw[0] < 0 || sw[1] < 0 || sw[2] > s->width || sw[3] > s->height)) {
+        diag_report(d, DIAG_ERROR, (src_loc){0}, NULL, "shade_render: window outside the image");
+        free(ts);
+        return PT_ERR_INTERNAL;
+    }
+    for (int i = 0; i < 4; i++) c.win[i] = whole ? (i == 2 ? s->width : i == 3 ? s->height : 0) : sw[i];
+    int apron = s->antialias == 1 ? 1 : 0;
+    c.first_win[0] = c.win[0] - apron > 0 ? c.win[0] - apron : 0;
+    c.first_win[1] = c.win[1] - apron > 0 ? c.win[1] - apron : 0;
+    c.first_win[2] = c.win[2] + apron < s->width ? c.win[2] + apron : s->width;
+    c.first_win[3] = c.win[3] + apron < s->height ? c.win[3] + apron : s->height;
     /* hits found before the render serve the centre rays of plain cameras
      * (primary_ray perturbs a camera normal's rays, sample() blurs) */
     const scene_camera *cam = &sc->camera;
@@ -651,12 +671,14 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     if (s->antialias == 1 && !(s->cancel && *s->cancel)) {
         c.flag = calloc((size_t)s->width * (size_t)s->height, 1);
         if (!c.flag) { projection_free(c.proj); free(ts); return PT_ERR_NOMEM; }
-        for (int y = 0; y < s->height; y++) {
-            for (int x = 0; x < s->width; x++) {
+        /* the pairs inside the first pass's rectangle: every pair a window
+         * pixel belongs to, as in the whole image */
+        for (int y = c.first_win[1]; y < c.first_win[3]; y++) {
+            for (int x = c.first_win[0]; x < c.first_win[2]; x++) {
                 rgb cur = aa_encode(fb_px(fb, x, y));
-                if (x > 0 && shade_colour_distance(aa_encode(fb_px(fb, x - 1, y)), cur) >= s->aa_threshold)
+                if (x > c.first_win[0] && shade_colour_distance(aa_encode(fb_px(fb, x - 1, y)), cur) >= s->aa_threshold)
                     c.flag[(size_t)y * s->width + x] = c.flag[(size_t)y * s->width + x - 1] = 1;
-                if (y > 0 && shade_colour_distance(aa_encode(fb_px(fb, x, y - 1)), cur) >= s->aa_threshold)
+                if (y > c.first_win[1] && shade_colour_distance(aa_encode(fb_px(fb, x, y - 1)), cur) >= s->aa_threshold)
                     c.flag[(size_t)y * s->width + x] = c.flag[(size_t)(y - 1) * s->width + x] = 1;
             }
         }
@@ -664,6 +686,13 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
         free(c.flag);
     }
 
+    if (!whole) /* the apron is not part of the window */
+        for (int y = 0; y < s->height; y++)
+            for (int x = 0; x < s->width; x++)
+                if (x < c.win[0] || x >= c.win[2] || y < c.win[1] || y >= c.win[3]) {
+                    float *px = fb_px(fb, x, y);
+                    px[0] = px[1] = px[2] = 0.0f;
+                }
     gamma_fb_to_linear(sc, fb); /* assumed_gamma: working space -> linear (shade_gamma.c) */
     long fixed = fb_sanitize(fb);
     if (st) {

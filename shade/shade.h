@@ -48,6 +48,13 @@ typedef struct {
     shade_primary_fn primary;
     void *primary_ctx;
     volatile int *cancel;   /* set non-zero to stop early (SIGINT) */
+    /* The render window x0,y0,x1,y1 (x1,y1 exclusive; all 0 = the whole
+     * image): only these pixels are rendered, the others are 0. Every pixel
+     * has its own random streams and the +A decisions of a pixel look at its
+     * four neighbours' first-pass colours, so the first pass also covers a
+     * one-pixel apron around the window: a window's pixels equal the whole
+     * image's, bit for bit. */
+    int window[4];
 } shade_settings;
 
 typedef struct {
