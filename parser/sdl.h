@@ -3,6 +3,7 @@
 #ifndef PT_SDL_H
 #define PT_SDL_H
 #include "diag.h"
+#include "progress.h"
 #include "scene.h"
 
 typedef struct {
@@ -44,6 +45,8 @@ typedef struct {
                                      polynomial), text, julia_fractal, polygon and
                                      height_field through the renderer's intersector
                                      (core/geom_env.h); NULL: located PT_ERR_UNSUPPORTED */
+    progress *progress;           /* stage "parse": bytes of the scene file read (its
+                                     position outside includes and macro bodies); NULL: none */
 } sdl_options;
 
 void sdl_default_options(sdl_options *o);
