@@ -62,7 +62,7 @@
 #include "timer.h"
 
 #define PLANE_EXTENT_FACTOR 1e4
-#define MAX_CSG_DEPTH 512
+#define MAX_CSG_DEPTH GEOM_CSG_MAX_DEPTH
 #define MAX_MERGE_MEMBERS 64
 
 enum { GEOM_NONE = 0, GEOM_TRI, GEOM_USER, GEOM_INSTANCE };
@@ -428,102 +428,13 @@ static int csg_leaf_count(const scene_object *o, int depth)
     return n;
 }
 
-/* A CSG member. `post` (clipped_by solids, whose transforms are relative to
- * their host) is applied after the member's own transform; `nosurf` marks
- * leaves that only take part in inside tests; `clip_done` says o's own
- * clipped_by has been wrapped around it already. */
-static pt_status csg_member_ex(accel *a, diag *d, geom_csg *c, const scene_object *o, const scene_texture *ptex,
-                               unsigned pflags, int parent, int depth, const xform *post, int nosurf, int clip_done);
-
-static pt_status csg_member(accel *a, diag *d, geom_csg *c, const scene_object *o, const scene_texture *ptex,
-                            unsigned pflags, int parent, int depth)
+/* geom_csg_build's leaf callback: the member's leaf record. */
+static int csg_leaf(void *ctx, const scene_object *o, const scene_texture *tex, unsigned flags)
 {
-    return csg_member_ex(a, d, c, o, ptex, pflags, parent, depth, NULL, 0, 0);
-}
-
-static pt_status csg_member_ex(accel *a, diag *d, geom_csg *c, const scene_object *o, const scene_texture *ptex,
-                               unsigned pflags, int parent, int depth, const xform *post, int nosurf, int clip_done)
-{
-    if (!o) return PT_OK;
-    const scene_texture *tex = o->texture ? o->texture : ptex;
-    unsigned flags = o->flags | (pflags & INHERITED_FLAGS);
-    int inverse = (o->flags & OBJ_INVERSE) != 0;
-    geom_csg_op parent_op = parent >= 0 ? c->nodes[parent].op : GEOM_CSG_UNION;
-    if (o->clip && !clip_done) {
-        /* clipped_by: an intersection of the object with its clip solids,
-         * whose surfaces do not count (issue 4) */
-        if (depth >= MAX_CSG_DEPTH) {
-            diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", MAX_CSG_DEPTH);
-            return PT_ERR_LIMIT;
-        }
-        int node = geom_csg_add_node(c, GEOM_CSG_INTERSECTION, 0, parent);
-        if (node < 0) return PT_ERR_NOMEM;
-        pt_status st = csg_member_ex(a, d, c, o, ptex, pflags, node, depth + 1, post, nosurf, 1);
-        if (st != PT_OK) return st;
-        xform host = post ? xform_then(o->transform, *post) : o->transform;
-        return csg_member_ex(a, d, c, o->clip, tex, flags, node, depth + 1, &host, 1, 0);
-    }
-    if (is_csg_kind(o->kind)) {
-        if (depth >= MAX_CSG_DEPTH) {
-            diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", MAX_CSG_DEPTH);
-            return PT_ERR_LIMIT;
-        }
-        geom_csg_op op = o->kind == SHAPE_UNION ? GEOM_CSG_UNION
-                        : o->kind == SHAPE_MERGE ? GEOM_CSG_MERGE
-                        : o->kind == SHAPE_INTERSECTION ? GEOM_CSG_INTERSECTION : GEOM_CSG_DIFFERENCE;
-        int node = geom_csg_add_node(c, op, inverse, parent);
-        if (node < 0) return PT_ERR_NOMEM;
-        for (int i = 0; i < o->u.csg.nkids; i++) {
-            pt_status st = csg_member_ex(a, d, c, o->u.csg.kids[i], tex, flags, node, depth + 1, post, nosurf, 0);
-            if (st != PT_OK) return st;
-        }
-        return PT_OK;
-    }
-    int ok = 0;
-    geom_shape sh;
-    scene_object moved;
-    const scene_object *src = o;
-    if (post) {
-        moved = *o;
-        moved.transform = xform_then(o->transform, *post);
-        src = &moved;
-    }
-    switch (o->kind) {
-    case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_PLANE: case SHAPE_TRIANGLE: case SHAPE_SMOOTH_TRIANGLE:
-    case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC: case SHAPE_TORUS:
-    case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_SUPERELLIPSOID:
-    case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_HEIGHT_FIELD: case SHAPE_TEXT: case SHAPE_ISOSURFACE:
-    case SHAPE_JULIA: case SHAPE_OVUS:
-        ok = geom_shape_init(&sh, src) == 0;
-        if (!ok)
-            diag_warn_once(d, o->loc, "degenerate %s ignored (zero size, singular transform or non-finite numbers)",
-                           o->name ? o->name : "shape");
-        break;
-    default:
-        a->stats.unsupported++;
-        diag_warn_once(d, o->loc, "%s is not rendered yet", o->name ? o->name : "this shape");
-        break;
-    }
-    if (!ok) {
-        /* A skipped member of an intersection is left out; elsewhere it holds
-         * its place as an empty set (a difference whose first member is gone
-         * is empty, as in POV-Ray). */
-        if (parent_op == GEOM_CSG_INTERSECTION) return PT_OK;
-        return geom_csg_add_node(c, GEOM_CSG_UNION, inverse, parent) < 0 ? PT_ERR_NOMEM : PT_OK;
-    }
+    accel *a = ctx;
     int li = add_leaf(a, o, tex, flags);
-    if (li < 0) {
-        geom_shape_release(&sh);
-        return PT_ERR_NOMEM;
-    }
-    a->leaves[li].in_csg = 1;
-    int leaf = geom_csg_add_leaf(c, &sh, (unsigned)li, inverse, parent);
-    if (leaf < 0) {
-        geom_shape_release(&sh);
-        return PT_ERR_NOMEM;
-    }
-    c->nodes[leaf].nosurf = nosurf;
-    return PT_OK;
+    if (li >= 0) a->leaves[li].in_csg = 1;
+    return li;
 }
 
 /* An intersection or difference (with everything below it) becomes one
@@ -553,7 +464,9 @@ static pt_status build_csg(accel *a, diag *d, const scene_object *o, const scene
         a->csg_b0[a->ncsgs] = cb0;
         a->csg_bn[a->ncsgs] = cbn;
     }
-    pt_status st = csg_member(a, d, c, o, ptex, pflags, -1, depth);
+    geom_csg_builder b = {csg_leaf, a, INHERITED_FLAGS, 0, d, 0};
+    pt_status st = geom_csg_build(c, o, ptex, pflags, -1, depth, &b);
+    a->stats.unsupported += b.unsupported;
     if (st != PT_OK) {
         geom_csg_free(c);
         return st;

@@ -46,7 +46,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
-#include "accel_query.h"
 #include "cli.h"
 #include "diag.h"
 #include "framebuffer.h"
@@ -516,8 +515,7 @@ int cmd_crosscheck(int argc, char **argv)
     so.ndefines = o.ndefines;
     so.image_width = o.width;
     so.image_height = o.height;
-    so.func_env = shade_func_env(); /* as render parses: pattern functions, trace() of every shape */
-    so.geom_env = accel_geom_env();
+    so.func_env = shade_func_env(); /* as render parses: pattern functions, isosurfaces in trace() */
     scene *sc = NULL;
     pt_status st = sdl_parse_file(o.scene, &so, &sc, d);
     if (st != PT_OK) {

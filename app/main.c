@@ -12,7 +12,6 @@
 #include "cmd_merge.h"
 #include "cmd_sweep.h"
 #include "diag.h"
-#include "accel_query.h"
 #include "framebuffer.h"
 #include "gi.h"
 #include "img_falsecolor.h"
@@ -21,8 +20,6 @@
 #include "ini.h"
 #include "lighting.h"
 #include "pool.h"
-#include "progress.h"
-#include "progress_bar.h"
 #include "render_gi.h"
 #include "scene.h"
 #include "sdl.h"
@@ -129,7 +126,6 @@ static void fill_sdl_options(sdl_options *so, const cli_render *o, const anim_pl
     if (o->max_array > 0) so->max_array_elements = o->max_array;
     if (o->max_image_pixels > 0) so->max_image_pixels = o->max_image_pixels;
     so->func_env = shade_func_env(); /* pattern/pigment functions, noise, vturbulence while parsing */
-    so->geom_env = accel_geom_env();  /* trace()/inside() of the shapes the parser does not intersect */
     cli_frame_options(o, plan, frame, so);
 }
 
@@ -197,20 +193,14 @@ static int cmd_parse(int argc, char **argv)
     for (int f = plan.first; f <= plan.last && rc == EXIT_OK; f++) {
         sdl_options so;
         fill_sdl_options(&so, &o, &plan, f);
-        progress *prog = progress_new();
-        pbar *bar = pbar_start(prog, o.quiet);
-        so.progress = prog;
         diag *d = diag_new();
-        diag_set_sink(d, pbar_diag_sink, bar); /* #debug text as the parse produces it */
         scene *sc = NULL;
         double t0 = timer_now();
         pt_status st = sdl_parse_file(o.scene, &so, &sc, d);
         double t1 = timer_now();
-        pbar_stop(bar);
         if (st == PT_OK) warn_if_empty(sc, d);
+        print_diags(d, o.quiet);
         diag_free(d);
-        pbar_free(bar);
-        progress_free(prog);
         if (st != PT_OK) {
             rc = status_exit(st);
             break;
@@ -316,21 +306,14 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     double t_frame = timer_now();
     sdl_options so;
     fill_sdl_options(&so, o, plan, frame);
-    /* Progress of every stage, drawn by its own thread; the scene's
-     * messages (#debug, #warning, errors) print as they are recorded. */
-    progress *prog = progress_new();
-    pbar *bar = pbar_start(prog, o->quiet);
-    so.progress = prog;
     diag *d = diag_new();
-    diag_set_sink(d, pbar_diag_sink, bar);
     scene *sc = NULL;
     double t0 = timer_now();
     pt_status st = sdl_parse_file(o->scene, &so, &sc, d);
     double t_parse = timer_now() - t0;
     if (st != PT_OK) {
+        print_diags(d, 0);
         diag_free(d);
-        pbar_free(bar);
-        progress_free(prog);
         return status_exit(st);
     }
     warn_if_empty(sc, d);
@@ -339,25 +322,21 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     if (!o->gi && sc->global.radiosity.enabled) gi = GI_PARTICLE;
     const char *gi_used = gi_mode_name(gi);
     if (run->tile && (gi == GI_PATH || gi == GI_PMFG)) {
-        pbar_free(bar);
         fprintf(stderr, "partray render: a render window (+SC/+EC/+SR/+ER) needs --gi none or particle, not %s\n", gi_used);
         scene_free(sc);
         diag_free(d);
-        progress_free(prog);
         return EXIT_USAGE;
     }
 
     int threads = o->threads > 0 ? o->threads : pool_default_threads();
     accel_set_function_env(shade_func_env()); /* isosurface functions: noise, pigment functions (issue 4) */
     t0 = timer_now();
-    progress_stage(prog, "accel", 0);
     accel *acc = accel_build(sc, threads, d, &st);
     double t_accel = timer_now() - t0;
     if (!acc || st != PT_OK) {
+        print_diags(d, 0);
         scene_free(sc);
         diag_free(d);
-        pbar_free(bar);
-        progress_free(prog);
         return status_exit(st == PT_OK ? PT_ERR_DEVICE : st);
     }
 
@@ -379,8 +358,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     ss.max_depth = o->max_depth;
     ss.cl_device = o->cl_device;
     ss.cl_max_bytes = o->cl_max_memory_mib > 0 ? (size_t)o->cl_max_memory_mib << 20 : 0;
-    ss.progress = prog;
-    ss.notes = d;
+    ss.progress = !o->quiet;
     ss.cancel = &g_cancel;
     if (run->tile) memcpy(ss.window, run->win, sizeof ss.window);
     char *progressive = NULL;
@@ -399,8 +377,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     /* the progressive image of a finished render is no longer needed */
     if (progressive && !g_cancel) remove(progressive);
     free(progressive);
-    /* the bar ends with the render; what follows prints plainly */
-    pbar_stop(bar);
+    print_diags(d, o->quiet);
 
     int rc = EXIT_OK;
     img_write_opts wo;
@@ -437,13 +414,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     wo.meta_values = vals;
     wo.nmeta = ls->aovs_text[0] ? 11 : 10;
     if (run->tile) memcpy(wo.window, run->win, sizeof wo.window);
-    if (st == PT_OK && g_cancel && !sst.image_begun) {
-        /* Interrupted before the image pass (parse, accel or a GI stage):
-         * no pixel was rendered, and a black "partial" image would say
-         * otherwise. */
-        fprintf(stderr, "partray: interrupted before any pixel was rendered: no partial image\n");
-        rc = g_cancel == SIGTERM ? 128 + SIGTERM : EXIT_INTERRUPTED;
-    } else if (st == PT_OK && g_cancel) {
+    if (st == PT_OK && g_cancel) {
         /* Interrupted: keep what was rendered under a clearly partial name. */
         for (int i = 0; i < noutputs; i++) {
             char *pn = partial_name(outputs[i]);
@@ -528,8 +499,6 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     accel_free(acc);
     scene_free(sc);
     diag_free(d);
-    pbar_free(bar);
-    progress_free(prog);
     return rc;
 }
 

@@ -334,3 +334,99 @@ int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, doubl
     }
     return found;
 }
+
+/* ------------------------------------------------------------ building */
+
+static int is_csg_kind(shape_kind k)
+{
+    return k == SHAPE_UNION || k == SHAPE_MERGE || k == SHAPE_INTERSECTION || k == SHAPE_DIFFERENCE;
+}
+
+/* `post` (clipped_by solids, whose transforms are relative to their host)
+ * is applied after the member's own transform; `nosurf` marks leaves that
+ * only take part in inside tests; `clip_done` says o's own clipped_by has
+ * been wrapped around it already. */
+static pt_status build(geom_csg *c, const scene_object *o, const scene_texture *ptex, unsigned pflags, int parent,
+                       int depth, geom_csg_builder *b, const xform *post, int nosurf, int clip_done)
+{
+    if (!o) return PT_OK;
+    const scene_texture *tex = o->texture ? o->texture : ptex;
+    unsigned flags = o->flags | (pflags & b->inherit);
+    int inverse = (o->flags & OBJ_INVERSE) != 0;
+    geom_csg_op parent_op = parent >= 0 ? c->nodes[parent].op : GEOM_CSG_UNION;
+    if ((o->clip && !clip_done) || is_csg_kind(o->kind)) {
+        if (depth >= GEOM_CSG_MAX_DEPTH) {
+            if (b->d) diag_report(b->d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", GEOM_CSG_MAX_DEPTH);
+            return PT_ERR_LIMIT;
+        }
+    }
+    if (o->clip && !clip_done) {
+        int node = geom_csg_add_node(c, GEOM_CSG_INTERSECTION, 0, parent);
+        if (node < 0) return PT_ERR_NOMEM;
+        pt_status st = build(c, o, ptex, pflags, node, depth + 1, b, post, nosurf, 1);
+        if (st != PT_OK) return st;
+        xform host = post ? xform_then(o->transform, *post) : o->transform;
+        return build(c, o->clip, tex, flags, node, depth + 1, b, &host, 1, 0);
+    }
+    if (is_csg_kind(o->kind)) {
+        geom_csg_op op = o->kind == SHAPE_UNION ? GEOM_CSG_UNION
+                       : o->kind == SHAPE_MERGE ? GEOM_CSG_MERGE
+                       : o->kind == SHAPE_INTERSECTION ? GEOM_CSG_INTERSECTION : GEOM_CSG_DIFFERENCE;
+        int node = geom_csg_add_node(c, op, inverse, parent);
+        if (node < 0) return PT_ERR_NOMEM;
+        for (int i = 0; i < o->u.csg.nkids; i++) {
+            pt_status st = build(c, o->u.csg.kids[i], tex, flags, node, depth + 1, b, post, nosurf, 0);
+            if (st != PT_OK) return st;
+        }
+        return PT_OK;
+    }
+    int ok = 0;
+    geom_shape sh;
+    scene_object moved;
+    const scene_object *src = o;
+    if (post) {
+        moved = *o;
+        moved.transform = xform_then(o->transform, *post);
+        src = &moved;
+    }
+    switch (o->kind) {
+    case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_PLANE: case SHAPE_TRIANGLE: case SHAPE_SMOOTH_TRIANGLE:
+    case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC: case SHAPE_TORUS:
+    case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_SUPERELLIPSOID:
+    case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_HEIGHT_FIELD: case SHAPE_TEXT: case SHAPE_ISOSURFACE:
+    case SHAPE_JULIA: case SHAPE_OVUS:
+        ok = geom_shape_init(&sh, src) == 0;
+        break;
+    case SHAPE_MESH:
+        if (!b->meshes) goto unsupported;
+        ok = geom_shape_init_mesh(&sh, src) == 0;
+        break;
+    default:
+    unsupported:
+        b->unsupported++;
+        if (b->d) diag_warn_once(b->d, o->loc, "%s is not rendered yet", o->name ? o->name : "this shape");
+        if (parent_op == GEOM_CSG_INTERSECTION) return PT_OK;
+        return geom_csg_add_node(c, GEOM_CSG_UNION, inverse, parent) < 0 ? PT_ERR_NOMEM : PT_OK;
+    }
+    if (!ok) {
+        if (b->d)
+            diag_warn_once(b->d, o->loc, "degenerate %s ignored (zero size, singular transform or non-finite numbers)",
+                           o->name ? o->name : "shape");
+        if (parent_op == GEOM_CSG_INTERSECTION) return PT_OK;
+        return geom_csg_add_node(c, GEOM_CSG_UNION, inverse, parent) < 0 ? PT_ERR_NOMEM : PT_OK;
+    }
+    int tag = b->leaf ? b->leaf(b->ctx, o, tex, flags) : 0;
+    int leaf = tag < 0 ? -1 : geom_csg_add_leaf(c, &sh, (unsigned)tag, inverse, parent);
+    if (leaf < 0) {
+        geom_shape_release(&sh);
+        return PT_ERR_NOMEM;
+    }
+    c->nodes[leaf].nosurf = nosurf;
+    return PT_OK;
+}
+
+pt_status geom_csg_build(geom_csg *c, const scene_object *o, const scene_texture *tex, unsigned flags, int parent,
+                         int depth, geom_csg_builder *b)
+{
+    return build(c, o, tex, flags, parent, depth, b, NULL, 0, 0);
+}

@@ -13,12 +13,19 @@
  * merge; a difference is an intersection with its subtracted members
  * inverted), so a union under an odd number of inversions (its own
  * included) keeps a member's surface only outside all its siblings, as a
- * merge does; the other operations keep the same surfaces either way. The result's inside test combines the members' tests the same way
- * (inverse negates it). accel.c turns each tree into one user-geometry
- * primitive. */
+ * merge does; the other operations keep the same surfaces either way. The
+ * result's inside test combines the members' tests the same way (inverse
+ * negates it). geom_csg_build makes the tree of an IR object: accel.c turns
+ * each into one user-geometry primitive, the parser's trace() and inside()
+ * query it, gi keeps the CSG members' particles where it keeps their
+ * surface. */
 #ifndef PT_GEOM_CSG_H
 #define PT_GEOM_CSG_H
+#include "diag.h"
 #include "geom_shape.h"
+
+/* Deepest CSG nesting an object may have (an error beyond it). */
+#define GEOM_CSG_MAX_DEPTH 512
 
 typedef enum { GEOM_CSG_LEAF, GEOM_CSG_UNION, GEOM_CSG_MERGE, GEOM_CSG_INTERSECTION, GEOM_CSG_DIFFERENCE } geom_csg_op;
 
@@ -66,6 +73,33 @@ int geom_csg_finish(geom_csg *c);
 void geom_csg_clip(geom_csg *c, vec3 lo, vec3 hi);
 /* Frees the members' shape data too (geom_shape_release). */
 void geom_csg_free(geom_csg *c);
+
+/* Per leaf object that becomes a member: the caller's tag for it (kept in
+ * geom_csg.shape_leaf), or -1 when out of memory. `tex` is the effective
+ * texture (o's own, else the nearest parent's; may be NULL) and `flags` o's
+ * flags plus its parents' `inherit` bits. */
+typedef int (*geom_csg_leaf_fn)(void *ctx, const scene_object *o, const scene_texture *tex, unsigned flags);
+
+typedef struct {
+    geom_csg_leaf_fn leaf; /* NULL: every tag 0 */
+    void *ctx;
+    unsigned inherit;      /* OBJ_* flags members take from their parents */
+    int meshes;            /* mesh members as geom_mesh shapes; else they count as unsupported */
+    diag *d;               /* warnings (degenerate and unsupported members) and errors; may be NULL */
+    long unsupported;      /* out: members of kinds geom does not model */
+} geom_csg_builder;
+
+/* The tree of object o (any kind: a leaf gives a one-member tree) with its
+ * clipped_by solids (an intersection with them, their surfaces not
+ * counted), added under node `parent` (-1: the root) of c; `tex` and
+ * `flags` are what o inherits. A degenerate member (zero size, singular
+ * transform, non-finite numbers) or one geom does not model is left out of
+ * an intersection and is an empty set elsewhere (a difference whose first
+ * member is gone is empty, as in POV-Ray). PT_ERR_LIMIT beyond
+ * GEOM_CSG_MAX_DEPTH (reported in b->d), PT_ERR_NOMEM. Call
+ * geom_csg_finish afterwards. */
+pt_status geom_csg_build(geom_csg *c, const scene_object *o, const scene_texture *tex, unsigned flags, int parent,
+                         int depth, geom_csg_builder *b);
 
 /* Nearest crossing of the result with t in (tmin, tmax). */
 int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, geom_csg_hit *h);

@@ -17,6 +17,7 @@
 #include "geom_fractal.h"
 #include "geom_hfield.h"
 #include "geom_implicit.h"
+#include "geom_mesh.h"
 #include "geom_poly.h"
 #include "geom_sweep.h"
 #include "geom_tess.h"
@@ -81,7 +82,7 @@ static vec3 disc_extent(vec3 n, double r)
 
 static int finite_d(double x) { return isfinite(x); }
 
-int geom_shape_init(geom_shape *sh, const scene_object *o)
+static int init_shape(geom_shape *sh, const scene_object *o, int meshes)
 {
     memset(sh, 0, sizeof *sh);
     sh->kind = o->kind;
@@ -232,6 +233,11 @@ int geom_shape_init(geom_shape *sh, const scene_object *o)
     case SHAPE_JULIA:
         if (geom_fractal_init(sh, o, &lo, &hi) != 0) return -1;
         break;
+    case SHAPE_MESH:
+        if (!meshes || geom_mesh_init(sh, o) != 0) return -1;
+        lo = sh->olo;
+        hi = sh->ohi;
+        break;
     default:
         return -1;
     }
@@ -244,6 +250,10 @@ int geom_shape_init(geom_shape *sh, const scene_object *o)
     }
     return 0;
 }
+
+int geom_shape_init(geom_shape *sh, const scene_object *o) { return init_shape(sh, o, 0); }
+
+int geom_shape_init_mesh(geom_shape *sh, const scene_object *o) { return init_shape(sh, o, 1); }
 
 void geom_shape_release(geom_shape *sh)
 {
@@ -260,6 +270,9 @@ void geom_shape_release(geom_shape *sh)
         break;
     case SHAPE_JULIA:
         geom_fractal_free(sh->data);
+        break;
+    case SHAPE_MESH:
+        geom_mesh_free(sh->data);
         break;
     default:
         break;
@@ -625,6 +638,9 @@ int geom_shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, doubl
     case SHAPE_JULIA:
         n = geom_fractal_hits(sh, o, d, a, b, out, max);
         break;
+    case SHAPE_MESH:
+        n = geom_mesh_hits(sh, o, d, a, b, out, max);
+        break;
     default:
         return 0;
     }
@@ -739,6 +755,8 @@ int geom_shape_inside(const geom_shape *sh, vec3 p)
         return geom_hfield_inside(sh, q);
     case SHAPE_JULIA:
         return geom_fractal_inside(sh, q);
+    case SHAPE_MESH:
+        return geom_mesh_inside(sh, q);
     default:
         return 0; /* triangles and polygons have no inside */
     }
@@ -766,6 +784,21 @@ static void tri_bary(const geom_shape *sh, vec3 po, double *u, double *v)
     *v = den != 0.0 ? clamp01((d11 * w2 - d12 * w1) / den) : 0.0;
 }
 
+/* A smooth triangle's interpolated world normal at p, unit, as given (not
+ * oriented); 0 where it vanishes. */
+static int smooth_normal(const geom_shape *sh, vec3 p, vec3 *out)
+{
+    double u, v;
+    tri_bary(sh, sh->identity ? p : xform_inv_point(&sh->x, p), &u, &v);
+    vec3 n = v3_add(v3_add(v3_scale(sh->g.tri.n[0], 1.0 - u - v), v3_scale(sh->g.tri.n[1], u)),
+                    v3_scale(sh->g.tri.n[2], v));
+    if (!sh->identity) n = xform_normal(&sh->x, n);
+    double l = v3_len(n);
+    if (!(l > 0.0) || !isfinite(l)) return 0;
+    *out = v3_scale(n, 1.0 / l);
+    return 1;
+}
+
 void geom_shape_shading(const geom_shape *sh, vec3 p, vec3 ng, vec3 *ns)
 {
     *ns = ng;
@@ -780,15 +813,38 @@ void geom_shape_shading(const geom_shape *sh, vec3 p, vec3 ng, vec3 *ns)
         return;
     }
     if ((sh->kind != SHAPE_SMOOTH_TRIANGLE) || !sh->g.tri.smooth) return;
-    double u, v;
-    tri_bary(sh, sh->identity ? p : xform_inv_point(&sh->x, p), &u, &v);
-    vec3 n = v3_add(v3_add(v3_scale(sh->g.tri.n[0], 1.0 - u - v), v3_scale(sh->g.tri.n[1], u)),
-                    v3_scale(sh->g.tri.n[2], v));
-    if (!sh->identity) n = xform_normal(&sh->x, n);
-    double l = v3_len(n);
-    if (!(l > 0.0) || !isfinite(l)) return;
-    n = v3_scale(n, 1.0 / l);
+    vec3 n;
+    if (!smooth_normal(sh, p, &n)) return;
     *ns = v3_dot(n, ng) < 0.0 ? v3_neg(n) : n;
+}
+
+vec3 geom_shape_pov_normal(const geom_shape *sh, vec3 p, int part)
+{
+    vec3 ng, ns;
+    double u, v;
+    geom_shape_surface(sh, p, part, &ng, &u, &v);
+    if (sh->kind == SHAPE_TRIANGLE || sh->kind == SHAPE_SMOOTH_TRIANGLE) {
+        /* POV-Ray's (P1 - P2) x (P3 - P2) is against the winding normal
+         * (accel.c's pov_flip) */
+        if (sh->g.tri.smooth) {
+            /* POV-Ray interpolates its unit vertex normals (each placed by
+             * the transform and normalised) */
+            double u1, u2;
+            tri_bary(sh, sh->identity ? p : xform_inv_point(&sh->x, p), &u1, &u2);
+            double w[3] = {1.0 - u1 - u2, u1, u2};
+            vec3 n = v3(0, 0, 0);
+            for (int k = 0; k < 3; k++) {
+                vec3 nk = sh->identity ? sh->g.tri.n[k] : xform_normal(&sh->x, sh->g.tri.n[k]);
+                double l = v3_len(nk);
+                if (l > 0.0 && isfinite(l)) n = v3_madd(n, nk, w[k] / l);
+            }
+            double l = v3_len(n);
+            if (l > 0.0 && isfinite(l)) return v3_scale(n, 1.0 / l);
+        }
+        return sh->g.tri.wind > 0.0 ? v3_neg(ng) : ng;
+    }
+    geom_shape_shading(sh, p, ng, &ns);
+    return ns;
 }
 
 void geom_shape_surface(const geom_shape *sh, vec3 p, int part, vec3 *ng, double *u, double *v)
@@ -889,6 +945,9 @@ void geom_shape_surface(const geom_shape *sh, vec3 p, int part, vec3 *ng, double
         break;
     case SHAPE_JULIA:
         n = geom_fractal_normal(sh, po);
+        break;
+    case SHAPE_MESH:
+        n = geom_mesh_normal(sh, po, part);
         break;
     default:
         break;

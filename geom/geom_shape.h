@@ -78,6 +78,8 @@ static inline int geom_shape_hit_put(geom_shape_hit *out, int n, int max, double
  * numbers) and should be skipped. World bounds are computed for finite shapes;
  * planes get them from geom_shape_clip_plane. */
 int geom_shape_init(geom_shape *sh, const scene_object *o);
+/* geom_shape_init that also takes meshes (geom_mesh.h: parse-time queries). */
+int geom_shape_init_mesh(geom_shape *sh, const scene_object *o);
 /* Planes are infinite: limit one to the world box [lo, hi] (see accel.c for
  * how that box is chosen) and set its bounds to the part of the box it can
  * touch. Also used for the other unbounded shapes (sh->infinite). */
@@ -110,6 +112,11 @@ int geom_shape_inside(const geom_shape *sh, vec3 p);
  * of smooth triangles, else the geometric one; it may be NULL). */
 void geom_shape_surface(const geom_shape *sh, vec3 p, int part, vec3 *ng, double *u, double *v);
 void geom_shape_shading(const geom_shape *sh, vec3 p, vec3 ng, vec3 *ns);
+/* POV-Ray's own unit normal at p (its Normal(): what trace() reports): the
+ * shading normal, except that triangles give (P1 - P2) x (P3 - P2) and
+ * smooth triangles and meshes their interpolated normal, none of them
+ * oriented by the winding. */
+vec3 geom_shape_pov_normal(const geom_shape *sh, vec3 p, int part);
 /* POV-Ray 3.7's UV coordinates at world point p (accel_hit.uv): sphere,
  * box, torus, ovus, lathe and sor in object space, every other shape the
  * world x and y (ObjectBase::UVCoord). Always finite. */

@@ -126,11 +126,8 @@ static void seg_set(sw_seg *s, const double a[2], const double b[2], const doubl
 }
 
 /* Segment `type` from points P (P[0..3] as the spline rule needs). */
-static void seg_from_points(sw_seg *s, scene_spline type, const double (*P)[2])
+void geom_sweep_coeffs(scene_spline type, const double (*P)[2], double a[2], double b[2], double c[2], double d[2])
 {
-    double a[2], b[2], c[2], d[2];
-    const double *e0, *e1;
-    int deg = 3;
     for (int k = 0; k < 2; k++) {
         switch (type) {
         case SPLINE_LINEAR:
@@ -158,6 +155,14 @@ static void seg_from_points(sw_seg *s, scene_spline type, const double (*P)[2])
             break;
         }
     }
+}
+
+static void seg_from_points(sw_seg *s, scene_spline type, const double (*P)[2])
+{
+    double a[2], b[2], c[2], d[2];
+    const double *e0, *e1;
+    int deg = 3;
+    geom_sweep_coeffs(type, P, a, b, c, d);
     switch (type) {
     case SPLINE_LINEAR: e0 = P[0]; e1 = P[1]; deg = 1; break;
     case SPLINE_QUADRATIC: e0 = P[1]; e1 = P[2]; break;

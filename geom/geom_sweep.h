@@ -62,4 +62,9 @@ int geom_sweep_grid_cell(const geom_shape *sh, double cell, double turn, geom_gr
  * number emitted, or -1 when emit failed. */
 int geom_polygon_triangles(const geom_shape *sh, int (*emit)(void *ctx, vec3 a, vec3 b, vec3 c), void *ctx);
 
+/* One curve segment of POV-Ray 3.7's lathe and prism splines from the
+ * points starting at P (linear 2, quadratic 3, cubic and bezier 4):
+ * (u, v)(w) = a w^3 + b w^2 + c w + d for w in [0, 1], per coordinate. */
+void geom_sweep_coeffs(scene_spline type, const double (*P)[2], double a[2], double b[2], double c[2], double d[2]);
+
 #endif

@@ -3,7 +3,6 @@
 #ifndef PT_SDL_H
 #define PT_SDL_H
 #include "diag.h"
-#include "progress.h"
 #include "scene.h"
 
 typedef struct {
@@ -41,12 +40,6 @@ typedef struct {
     const struct func_env *func_env; /* evaluators for pigment/pattern functions, noise and
                                      vturbulence at parse time (core/func.h); NULL: such
                                      calls are located PT_ERR_UNSUPPORTED errors */
-    const struct geom_env *geom_env; /* trace()/inside() of sor, poly (cubic, quartic,
-                                     polynomial), text, julia_fractal, polygon and
-                                     height_field through the renderer's intersector
-                                     (core/geom_env.h); NULL: located PT_ERR_UNSUPPORTED */
-    progress *progress;           /* stage "parse": bytes of the scene file read (its
-                                     position outside includes and macro bodies); NULL: none */
 } sdl_options;
 
 void sdl_default_options(sdl_options *o);

@@ -56,7 +56,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include "accel_query.h"
+#include "geom_shape.h"
 #include "shade_atmos.h"
 #include "shade_pattern.h"
 #include "shade_texture.h"
@@ -127,27 +127,27 @@ void media_inside_cross(media_inside *in, const scene_object *o)
     if (in->n < MEDIA_MAX_INSIDE) in->obj[in->n++] = o;
 }
 
-static int leaf_inside(const geom_env *g, const scene_object *o, vec3 p)
+/* A degenerate shape (the renderer skips it too) is never inside. */
+static int leaf_inside(const scene_object *o, vec3 p)
 {
-    int nomem = 0;
-    void *sh = g->prepare(o, &nomem);
-    if (!sh) return 0;
-    int r = g->inside(sh, p);
-    g->release(sh);
+    geom_shape sh;
+    if (geom_shape_init(&sh, o) != 0) return 0;
+    int r = geom_shape_inside(&sh, p);
+    geom_shape_release(&sh);
     return (o->flags & OBJ_INVERSE) ? !r : r;
 }
 
-static void inside_at(const geom_env *g, const scene_object *o, vec3 p, media_inside *in, int depth)
+static void inside_at(const scene_object *o, vec3 p, media_inside *in, int depth)
 {
     if (depth > 32) return;
     if (o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE) {
-        for (int k = 0; k < o->u.csg.nkids; k++) inside_at(g, o->u.csg.kids[k], p, in, depth + 1);
+        for (int k = 0; k < o->u.csg.nkids; k++) inside_at(o->u.csg.kids[k], p, in, depth + 1);
         return;
     }
     if (o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE || o->kind == SHAPE_UNSUPPORTED) return;
     int matters = !(o->flags & OBJ_HOLLOW) || (o->interior && o->interior->nmedia > 0);
     if (!matters || o->clip) return;
-    if (!leaf_inside(g, o, p)) return;
+    if (!leaf_inside(o, p)) return;
     for (int i = 0; i < in->n; i++)
         if (key_of(in->obj[i]) == key_of(o)) return;
     if (in->n < MEDIA_MAX_INSIDE) in->obj[in->n++] = o;
@@ -156,8 +156,7 @@ static void inside_at(const geom_env *g, const scene_object *o, vec3 p, media_in
 void media_inside_at(const scene *sc, vec3 p, media_inside *in)
 {
     in->n = 0;
-    const geom_env *g = accel_geom_env();
-    for (int i = 0; i < sc->nobjects; i++) inside_at(g, sc->objects[i], p, in, 0);
+    for (int i = 0; i < sc->nobjects; i++) inside_at(sc->objects[i], p, in, 0);
 }
 
 /* ------------------------------------------------------------ coefficients */

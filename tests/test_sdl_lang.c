@@ -19,7 +19,6 @@
 #include "scene.h"
 #include "sdl.h"
 #include "shade_funcenv.h"
-#include "accel_query.h"
 
 #ifndef PT_TESTS_DIR
 #define PT_TESTS_DIR "tests"
@@ -153,27 +152,17 @@ static void test_strings(void **st)
 }
 
 /* trace() and inside() of sor, poly/cubic/quartic, text, julia_fractal,
- * polygon and height_field through the renderer's intersector
- * (accel_geom_env), and of triangles, meshes (flat and smooth triangles),
- * bicubic_patch and sphere_sweep through the parser's own:
- * each #debug line within 1e-5 of POV-Ray 3.7.0's
- * (tests/sdl/trace_shapes.expected). Without the environment they are a
- * located PT_ERR_UNSUPPORTED error. */
+ * polygon, height_field, triangles, meshes (flat and smooth triangles),
+ * bicubic_patch and sphere_sweep through geom/, the code that renders
+ * them: each #debug line within 1e-5 of POV-Ray 3.7.0's
+ * (tests/sdl/trace_shapes.expected). */
 static void test_trace_shapes(void **st)
 {
     (void)st;
     sdl_options o;
     sdl_default_options(&o);
     o.func_env = shade_func_env();
-    o.geom_env = accel_geom_env();
     check_debug_lines("trace_shapes", &o, 1e-5, 29, 0);
-
-    diag *d;
-    d = parse_text("#declare S = sor { 4, <0,0>, <1,0>, <0.5,1>, <0,2> }\n#declare P = trace(S, 3*x, -x);\n", NULL,
-                   PT_ERR_UNSUPPORTED, NULL);
-    assert_non_null(strstr(first_error(d), "trace: shape 'sor' is not supported"));
-    assert_int_equal(diag_get(d, 0)->loc.line, 2);
-    diag_free(d);
 }
 
 /* ------------------------------------------------------------ arrays and macros */
@@ -562,7 +551,6 @@ static void test_example_sweep(void **st)
     sdl_default_options(&o);
     o.write_dir = dir;
     o.func_env = shade_func_env();
-    o.geom_env = accel_geom_env();
     int n = 0, ok = 0, unlocated = 0;
     if (!sweep("/usr/share/povray-3.7/scenes", &o, &n, &ok, &unlocated) || n == 0) skip();
     print_message("example scenes: %d of %d parse (%.1f%%)\n", ok, n, 100.0 * ok / n);

@@ -1,5 +1,5 @@
 // trace() and inside() on the shapes whose parse-time answers come from the
-// renderer's own intersector (accel_query): every #debug line is compared
+// renderer's own geometry (geom/): every #debug line is compared
 // with POV-Ray 3.7.0's output (trace_shapes.expected, made by
 // `povray +Itrace_shapes.pov +W8 +H6 -F -D -GR -GS -GW +GDtrace_shapes.expected`).
 #version 3.7;

@@ -1,0 +1,248 @@
+/* geom_mesh.c - meshes as geom shapes (see geom_mesh.h): a median-split BVH
+ * over the triangles' boxes, built once per shape. */
+#include "geom_mesh.h"
+#include <assert.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MESH_LEAF 4
+#define MESH_MAX_DEPTH 60
+#define MESH_STACK 128
+/* POV-Ray's shapes ignore crossings closer than this (DEPTH_TOLERANCE):
+ * the inside_vector parity starts just off the point. */
+#define MESH_DEPTH_TOLERANCE 1e-6
+
+typedef struct {
+    vec3 lo, hi;
+    int left, right;  /* children; -1 for a leaf */
+    int first, count; /* leaf: range in `order` */
+} bvh_node;
+
+typedef struct {
+    const scene_mesh *m;
+    vec3 inside_vector;
+    int has_inside;
+    bvh_node *nodes;
+    int nnodes, capnodes;
+    int *order;
+    vec3 *cen; /* triangle box centres (build time only) */
+} mesh_data;
+
+static vec3 vert(const scene_mesh *m, int i) { return v3(m->verts[i][0], m->verts[i][1], m->verts[i][2]); }
+
+static void tri_box(const scene_mesh *m, int t, vec3 *lo, vec3 *hi)
+{
+    vec3 a = vert(m, m->tris[t][0]), b = vert(m, m->tris[t][1]), c = vert(m, m->tris[t][2]);
+    *lo = v3_min(a, v3_min(b, c));
+    *hi = v3_max(a, v3_max(b, c));
+}
+
+static int node_new(mesh_data *md)
+{
+    if (md->nnodes == md->capnodes) {
+        int nc = md->capnodes ? md->capnodes * 2 : 64;
+        bvh_node *nn = realloc(md->nodes, sizeof *nn * (size_t)nc);
+        if (!nn) return -1;
+        md->nodes = nn;
+        md->capnodes = nc;
+    }
+    return md->nnodes++;
+}
+
+/* Median split on the longest axis of the centres; the depth is about
+ * log2(ntris), capped so the query stack cannot overflow. */
+static int split(mesh_data *md, int first, int count, int depth)
+{
+    int id = node_new(md);
+    if (id < 0) return -1;
+    vec3 lo = v3s(INFINITY), hi = v3s(-INFINITY), clo = v3s(INFINITY), chi = v3s(-INFINITY);
+    for (int i = first; i < first + count; i++) {
+        vec3 tl, th;
+        tri_box(md->m, md->order[i], &tl, &th);
+        lo = v3_min(lo, tl);
+        hi = v3_max(hi, th);
+        clo = v3_min(clo, md->cen[md->order[i]]);
+        chi = v3_max(chi, md->cen[md->order[i]]);
+    }
+    md->nodes[id].lo = lo;
+    md->nodes[id].hi = hi;
+    md->nodes[id].left = md->nodes[id].right = -1;
+    md->nodes[id].first = first;
+    md->nodes[id].count = count;
+    if (count <= MESH_LEAF || depth > MESH_MAX_DEPTH) return id;
+    vec3 ext = v3_sub(chi, clo);
+    int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+    if (v3_idx(ext, axis) <= 0) return id;
+    /* nth element around the median by repeated partition */
+    int lo_i = first, hi_i = first + count - 1, mid = first + count / 2;
+    while (lo_i < hi_i) {
+        double pivot = v3_idx(md->cen[md->order[(lo_i + hi_i) / 2]], axis);
+        int i = lo_i, j = hi_i;
+        while (i <= j) {
+            while (v3_idx(md->cen[md->order[i]], axis) < pivot) i++;
+            while (v3_idx(md->cen[md->order[j]], axis) > pivot) j--;
+            if (i <= j) {
+                int tmp = md->order[i];
+                md->order[i] = md->order[j];
+                md->order[j] = tmp;
+                i++;
+                j--;
+            }
+        }
+        if (mid <= j) hi_i = j;
+        else if (mid >= i) lo_i = i;
+        else break;
+    }
+    int left = split(md, first, mid - first, depth + 1);
+    int right = left < 0 ? -1 : split(md, mid, first + count - mid, depth + 1);
+    if (right < 0) return -1;
+    md->nodes[id].left = left;
+    md->nodes[id].right = right;
+    return id;
+}
+
+void geom_mesh_free(void *data)
+{
+    mesh_data *md = data;
+    if (!md) return;
+    free(md->nodes);
+    free(md->order);
+    free(md->cen);
+    free(md);
+}
+
+int geom_mesh_init(geom_shape *sh, const scene_object *o)
+{
+    const scene_mesh *m = o->u.mesh.mesh;
+    if (!m || m->ntris <= 0) return -1;
+    for (int t = 0; t < m->ntris; t++)
+        for (int k = 0; k < 3; k++)
+            if (m->tris[t][k] < 0 || m->tris[t][k] >= m->nverts) return -1;
+    mesh_data *md = calloc(1, sizeof *md);
+    if (!md) return -1;
+    md->m = m;
+    md->has_inside = o->u.mesh.inside_vector_set;
+    md->inside_vector = o->u.mesh.inside_vector;
+    md->order = malloc(sizeof *md->order * (size_t)m->ntris);
+    md->cen = malloc(sizeof *md->cen * (size_t)m->ntris);
+    if (!md->order || !md->cen) {
+        geom_mesh_free(md);
+        return -1;
+    }
+    vec3 lo = v3s(INFINITY), hi = v3s(-INFINITY);
+    for (int i = 0; i < m->ntris; i++) {
+        vec3 tl, th;
+        tri_box(m, i, &tl, &th);
+        md->cen[i] = v3_scale(v3_add(tl, th), 0.5);
+        md->order[i] = i;
+        lo = v3_min(lo, tl);
+        hi = v3_max(hi, th);
+    }
+    if (!v3_finite(lo) || !v3_finite(hi) || split(md, 0, m->ntris, 0) < 0) {
+        geom_mesh_free(md);
+        return -1;
+    }
+    free(md->cen);
+    md->cen = NULL;
+    sh->data = md;
+    sh->olo = lo;
+    sh->ohi = hi;
+    return 0;
+}
+
+/* Moller-Trumbore in double precision; barycentrics of v1 and v2 in *u, *v. */
+static int tri_hit(vec3 org, vec3 dir, vec3 a, vec3 b, vec3 c, double *t, double *u, double *v)
+{
+    vec3 e1 = v3_sub(b, a), e2 = v3_sub(c, a), pv = v3_cross(dir, e2);
+    double det = v3_dot(e1, pv);
+    if (fabs(det) < 1e-300) return 0;
+    double inv = 1.0 / det;
+    vec3 tv = v3_sub(org, a);
+    *u = v3_dot(tv, pv) * inv;
+    if (*u < 0 || *u > 1) return 0;
+    vec3 qv = v3_cross(tv, e1);
+    *v = v3_dot(dir, qv) * inv;
+    if (*v < 0 || *u + *v > 1) return 0;
+    *t = v3_dot(e2, qv) * inv;
+    return 1;
+}
+
+int geom_mesh_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
+{
+    const mesh_data *md = sh->data;
+    if (!md || md->nnodes == 0) return 0;
+    const scene_mesh *m = md->m;
+    int stack[MESH_STACK], sp = 0, n = 0;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const bvh_node *nd = &md->nodes[stack[--sp]];
+        /* the node's box padded so that a crossing on its faces is not
+         * lost to rounding */
+        vec3 pad = v3s(1e-9 * v3_maxc(v3_sub(nd->hi, nd->lo)) + 1e-300);
+        double t0, t1;
+        if (!v3_slab(o, d, v3_sub(nd->lo, pad), v3_add(nd->hi, pad), &t0, &t1) || t1 < tmin || t0 > tmax) continue;
+        if (nd->left < 0) {
+            for (int i = nd->first; i < nd->first + nd->count; i++) {
+                int t = md->order[i];
+                assert(t >= 0 && t < m->ntris);
+                double tt, u, v;
+                if (tri_hit(o, d, vert(m, m->tris[t][0]), vert(m, m->tris[t][1]), vert(m, m->tris[t][2]), &tt, &u, &v) &&
+                    tt > tmin && tt < tmax)
+                    n = geom_shape_hit_put(out, n, max, tt, t);
+            }
+            continue;
+        }
+        /* the depth cap keeps the stack within MESH_STACK */
+        assert(sp + 2 <= MESH_STACK);
+        stack[sp++] = nd->left;
+        stack[sp++] = nd->right;
+    }
+    return n;
+}
+
+int geom_mesh_inside(const geom_shape *sh, vec3 q)
+{
+    const mesh_data *md = sh->data;
+    if (!md || !md->has_inside) return 0;
+    geom_shape_hit h[64];
+    int crossings = 0;
+    double from = MESH_DEPTH_TOLERANCE;
+    /* walk the crossings a chunk at a time: the parity needs them all */
+    for (;;) {
+        int k = geom_mesh_hits(sh, q, md->inside_vector, from, INFINITY, h, 64);
+        crossings += k;
+        if (k < 64 || !(h[k - 1].t > from)) break;
+        from = h[k - 1].t;
+    }
+    return crossings & 1;
+}
+
+vec3 geom_mesh_normal(const geom_shape *sh, vec3 q, int part)
+{
+    const mesh_data *md = sh->data;
+    const scene_mesh *m = md->m;
+    assert(part >= 0 && part < m->ntris);
+    vec3 a = vert(m, m->tris[part][0]), b = vert(m, m->tris[part][1]), c = vert(m, m->tris[part][2]);
+    vec3 n = v3_cross(v3_sub(c, a), v3_sub(b, a)); /* POV-Ray's mesh triangle normal */
+    /* normals per corner (tri_normals), or per vertex when there are as many
+     * (bicubic_patch meshes), as the renderer reads them */
+    const int *ni = m->normals ? (m->tri_normals ? m->tri_normals[part] : (m->nnormals == m->nverts ? m->tris[part] : NULL)) : NULL;
+    if (ni) {
+        /* barycentrics of q in the triangle's plane */
+        vec3 e1 = v3_sub(b, a), e2 = v3_sub(c, a), w = v3_sub(q, a);
+        double d11 = v3_dot(e1, e1), d12 = v3_dot(e1, e2), d22 = v3_dot(e2, e2), w1 = v3_dot(w, e1), w2 = v3_dot(w, e2);
+        double den = d11 * d22 - d12 * d12, u = 0, v = 0;
+        if (den != 0) {
+            u = (d22 * w1 - d12 * w2) / den;
+            v = (d11 * w2 - d12 * w1) / den;
+        }
+        vec3 s = v3(0, 0, 0);
+        double wt[3] = {1 - u - v, u, v};
+        for (int i = 0; i < 3; i++)
+            if (ni[i] >= 0 && ni[i] < m->nnormals) /* POV-Ray keeps mesh normals normalised */
+                s = v3_madd(s, v3_norm(v3(m->normals[ni[i]][0], m->normals[ni[i]][1], m->normals[ni[i]][2])), wt[i]);
+        if (v3_len2(s) > 0) n = s;
+    }
+    return n;
+}
