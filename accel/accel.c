@@ -32,8 +32,8 @@
  * rounded to float (relative error 6e-8), so a ray leaving a surface sits up
  * to about one float ulp of |org| off it, and a spurious re-hit lies at a
  * distance of that offset / sin(angle to the surface). The rule covers angles
- * down to about 0.3 degrees (measured on the Cornell box: 1e-6 left float
- * hit points self-shadowing below ~2 degrees) while losing only contacts
+ * down to about 0.3 degrees (a relative 1e-6 is too small: float hit points
+ * then shadow themselves at grazing angles of a few degrees) while losing only contacts
  * closer than 1e-5 of the scene size, and it scales with the scene, so the
  * same scene scaled by 1e-4 or 1e5 behaves identically. Analytic shapes are
  * intersected in double precision from the caller's double ray (passed to
@@ -1191,11 +1191,9 @@ accel *accel_build(const scene *s, int threads, diag *d, pt_status *status)
     }
     /* frequency_level=simd256: Embree 3.13 defaults to simd128 on CPUs with
      * AVX-512 (Skylake-SP and later, to keep their clock up), which makes it
-     * build 4-wide BVHs; simd256 lets it use its 8-wide BVH8 kernels.
-     * Measured on this project's 2-core Xeon (AVX-512), cbox 50K particles,
-     * geometry stage CPU seconds, 6 runs each interleaved, min/median:
-     * default 5.13/5.24, simd256 4.61/4.70 (16x16 links 4.10 -> 3.62). An
-     * extra Embree config (PARTRAY_EMBREE_CONFIG, e.g. "isa=avx2" or
+     * build 4-wide BVHs; simd256 lets it use its 8-wide BVH8 kernels, which
+     * trace the GI geometry stage's incoherent link rays faster
+     * (docs/gi.md, bench/bench_gi). An extra Embree config (PARTRAY_EMBREE_CONFIG, e.g. "isa=avx2" or
      * "verbose=2") is appended for measurements. */
     char cfg[256];
     int len = snprintf(cfg, sizeof cfg, "frequency_level=simd256");
@@ -1223,8 +1221,9 @@ accel *accel_build(const scene *s, int threads, diag *d, pt_status *status)
         goto fail;
     }
     /* Robust mode: watertight triangle tests and conservative traversal, so
-     * rays do not slip through shared edges (closed rooms must not leak).
-     * Measured cost on the Cornell box benchmark: about 25% of throughput. */
+     * rays do not slip through shared edges (closed rooms must not leak);
+     * it costs throughput (bench/bench_rays), which a leak-free image is
+     * worth. */
     rtcSetSceneFlags(a->root, RTC_SCENE_FLAG_ROBUST);
 
     for (int i = 0; i < s->nobjects && st == PT_OK; i++) st = collect(a, d, s->objects[i], NULL, 0u, 0);
@@ -1518,7 +1517,7 @@ void *accel_rtc_link_scene(const accel *a)
     if (!s) return NULL;
     /* no RTC_SCENE_FLAG_ROBUST: a link ray that slips through a crack
      * between two triangles ends further on or misses, which at 16 or 256
-     * rays a particle is noise, not a leak (measured in gi_links.c) */
+     * rays a particle is noise, not a leak (gi_links.c) */
     rtcSetSceneFlags(s, RTC_SCENE_FLAG_NONE);
     unsigned np = (unsigned)(a->nshapes + a->ncsgs);
     for (unsigned id = 0; id < a->nginfo; id++) {
@@ -1688,7 +1687,7 @@ void accel_hit_any_n(const accel *a, int n, const vec3 *org, const vec3 *dir, co
         accel_query *saved = tls_query;
         tls_query = NULL;
         /* the nearest-hit query: an occlusion query would skip no_shadow
-         * objects (and measured no faster on maze's cell segments) */
+         * objects, which block the cells' segments too */
         rtcIntersect16(valid, a->root, &c, &r);
         tls_query = saved;
         for (int k = 0; k < m; k++)

@@ -445,7 +445,7 @@ static int add_leaf(accel_surf *as, const scene_object *o, const scene_texture *
     return 1;
 }
 
-/* Issue 4 shapes whose surfaces are exactly triangles: polygon (its
+/* Further shapes whose surfaces are exactly triangles: polygon (its
  * even-odd region cut into trapezoids) and height_field (its cells). The
  * curved ones (lathe, sor, prism, text, superellipsoid, quadric, poly,
  * blob) are not sampled yet: pdf 0, which keeps MIS unbiased. */

@@ -1,4 +1,4 @@
-/* lighting.h - the lighting-study options of `partray render` (issue 9):
+/* lighting.h - the lighting-study options of `partray render`:
  * --units (photometric lights, docs/units.md), --aovs (extra EXR layers,
  * shade/shade_aov.h) and --false-color-quantity (luminance or illuminance
  * map). main.c parses them here before the scene, applies the units after

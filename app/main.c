@@ -329,7 +329,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     }
 
     int threads = o->threads > 0 ? o->threads : pool_default_threads();
-    accel_set_function_env(shade_func_env()); /* isosurface functions: noise, pigment functions (issue 4) */
+    accel_set_function_env(shade_func_env()); /* isosurface functions: noise, pigment functions */
     t0 = timer_now();
     accel *acc = accel_build(sc, threads, d, &st);
     double t_accel = timer_now() - t0;

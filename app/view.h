@@ -1,4 +1,4 @@
-/* view.h - `partray view`: the interactive viewer (issue 10).
+/* view.h - `partray view`: the interactive viewer.
  *
  *   partray view SCENE.pov [--size WxH] [--gi MODE] [--threads N] [--seed N]
  *                [--script FILE] [--preview D] [--verbose] [-D NAME=VALUE] [-L DIR]

@@ -1,5 +1,5 @@
 /* bench_parse.c - parse time of the SDL parser beside POV-Ray 3.7's own
- * "Parse Time" for the same files (issue 3):
+ * "Parse Time" for the same files:
  *   1. a generated mesh2 of N triangles (default 1,000,000),
  *   2. a macro-heavy scene: a #while of M iterations (default 100,000) that
  *      calls a macro building one textured sphere each time.

@@ -1,4 +1,4 @@
-/* bench_reference.c - throughput of the reference renderers (issue 6) on the
+/* bench_reference.c - throughput of the reference renderers on the
  * Cornell box, beside a bare Embree loop on comparable rays:
  *
  *  - photon tracing: photon paths emitted per second, segments (rays) per

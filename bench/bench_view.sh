@@ -1,5 +1,5 @@
 #!/bin/sh
-# bench_view.sh - the interactive viewer's figures (issue 10): images per
+# bench_view.sh - the interactive viewer's figures: images per
 # second while the camera orbits, and the time from a light move to the
 # relit image, per GI mode. Figures, not a pass/fail test.
 #

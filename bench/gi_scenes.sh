@@ -1,5 +1,5 @@
 #!/bin/sh
-# gi_scenes.sh - issue 7's per-scene report of the particle GI on its four
+# gi_scenes.sh - per-scene report of the particle GI on its four
 # benchmark scenes (scenes/cbox.pov, the distribution's radiosity/cornell.pov,
 # scenes/maze.pov, scenes/conference.pov). Figures, never pass/fail.
 #

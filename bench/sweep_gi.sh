@@ -1,5 +1,5 @@
 #!/bin/sh
-# sweep_gi.sh - issue 7's particle sweep: particle counts 50K/100K/200K/400K
+# sweep_gi.sh - particle sweep: particle counts 50K/100K/200K/400K
 # x n_b 1/3/6/9 on a scene, each frame's error against a converged --gi path
 # reference (mean FLIP, RMSE, mean luminance) beside its lighting and frame
 # times, as one table (bench_gi --sweep --ref). Figures, not a test.

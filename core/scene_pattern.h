@@ -102,7 +102,7 @@ typedef struct {
     int filter_all_set, transmit_all_set;
     double major_radius;        /* torus map */
     int material;               /* a material_map (texture chosen by palette index / red) */
-    /* appended (issue 5): `repeat <u, v>` scales the mapped size (0 = 1);
+    /* `repeat <u, v>` scales the mapped size (0 = 1);
      * `offset <u, v>` shifts the image, kept in pixels as POV-Ray keeps it
      * (-u * width, -v * height); use_index: bump_map heights from palette
      * indices */
@@ -151,7 +151,7 @@ typedef struct scene_pattern {
     const struct scene_density *density; /* PAT_DENSITY (NULL: file not read, evaluates to 0) */
     int density_interpolate;       /* 0 none, 1 trilinear, 2 tricubic */
     const struct scene_object *object;   /* PAT_OBJECT: inside 1, outside 0 */
-    /* `pigment/normal { uv_mapping ... }` (appended, issue 5): evaluated at
+    /* `pigment/normal { uv_mapping ... }`: evaluated at
      * the hit's <u, v, 0> instead of the point it is given (POV-Ray's
      * UV_MAP_PATTERN: the transforms of the enclosing texture and object
      * do not apply, the pattern's own do) */

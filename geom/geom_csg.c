@@ -114,7 +114,7 @@ static void leaf_boxes(const geom_shape *sh, int inverse, bbox *s, bbox *v)
         *v = own;
         break;
     default:
-        /* issue 4 shapes: unbounded surfaces and solids get infinite boxes */
+        /* the other shapes: unbounded surfaces and solids get infinite boxes */
         *s = sh->infinite ? bb_all() : own;
         *v = geom_shape_solid_bounded(sh) ? own : bb_all();
         break;
@@ -299,7 +299,7 @@ static int kept(const geom_csg *c, int node, vec3 p)
 }
 
 /* Each member's crossings are walked in order, a chunk at a time (shapes
- * of issue 4 may have many), until one that the inside rules keep; the
+ * the sweeps and implicit shapes may have many), until one that the inside rules keep; the
  * nearest kept crossing over all members is the answer. */
 #define CSG_CHUNK 8
 

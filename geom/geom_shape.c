@@ -611,7 +611,7 @@ int geom_shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, doubl
     case SHAPE_SMOOTH_TRIANGLE: return hits_triangle(sh, o, d, tmin, tmax, out, max);
     default: break;
     }
-    /* issue 4 shapes: the interval narrowed to the clip box (unbounded
+    /* the other shapes: the interval narrowed to the clip box (unbounded
      * shapes: hits outside it are rejected, as for planes) or to the
      * object-space bounds, padded */
     double a = tmin, b = tmax, t0, t1;

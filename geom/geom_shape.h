@@ -42,7 +42,7 @@ typedef struct {
     } g;
     vec3 lo, hi;       /* world bounds (planes: the clip box) */
     vec3 clip_lo, clip_hi;
-    /* issue 4 shapes */
+    /* sweeps, implicit shapes, height field, fractal, mesh */
     void *data;        /* derived data owned by the shape (geom_shape_release frees it) */
     int infinite;      /* unbounded surface (quadric, poly): clipped like planes */
     vec3 olo, ohi;     /* object-space bounds of the finite ones */

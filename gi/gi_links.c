@@ -145,13 +145,10 @@ static void job(void *ctx, int index, int thread)
     }
     struct RTCIntersectContext c;
     rtcInitIntersectContext(&c);
-    /* incoherent: measured against COHERENT on cbox (50K particles, the
-     * same batches traced both ways in turn, thread CPU time): 4x4 links
-     * 0.36 against 0.59 s, 16x16 links 4.55 against 4.75 s; rtcIntersect16
-     * per 4x4 block of strata (4.71 s) and rtcIntersect1 (4.88 s) were no
-     * better. Instructions (callgrind, cbox 10K particles, the link scene,
-     * whole link build): this 3.05 G, rtcIntersect1 per ray 3.41 G,
-     * rtcIntersect8 per half 4x4 block (coherent) 3.33 G. */
+    /* incoherent: a batch's rays start at many particles and spread over
+     * the hemisphere, so Embree's stream mode for incoherent rays beats
+     * coherent packets (per 4x4 block of strata) and single rays on them
+     * (docs/gi.md; bench/bench_gi prints the link stage's time). */
     c.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     rtcIntersect1M(J->scene, &c, rh, (unsigned)m, sizeof *rh);
     /* hit points and their lookup cells; the lookups are bound by memory
@@ -367,9 +364,8 @@ pt_status gi_links_build(const accel *a, void *scene, const gi_dev_particle *p, 
     link_job J;
     memset(&J, 0, sizeof J);
     J.a = a;
-    /* the link scene (accel.h): on cbox, 50K particles, it saves 13% of
-     * the link building's instructions (callgrind, 10K particles: 2304 ->
-     * 2014 a link ray); the main scene is the fallback */
+    /* the link scene (accel.h): without the main scene's robust mode and
+     * filters it is cheaper per link ray; the main scene is the fallback */
     void *lscene = scene ? NULL : accel_rtc_link_scene(a);
     J.scene = scene ? (RTCScene)scene : lscene ? (RTCScene)lscene : (RTCScene)accel_rtc_scene(a);
     J.p = p;

@@ -52,7 +52,7 @@ typedef struct {
      * unrecognised display -> none. Ignored for EXR and PFM. */
     const char *display, *view, *look;
     double exposure;           /* PNG only: values x 2^exposure before the view or the sRGB encoding */
-    /* EXR only (appended for lighting studies, issue 9). */
+    /* EXR only (lighting studies). */
     const img_layer *layers;   /* extra layers of the same size as fb (AOVs); ignored by PNG and PFM */
     int nlayers;
     double white_luminance;    /* > 0: the standard `whiteLuminance` attribute, cd/m^2 of RGB (1,1,1) */

@@ -49,7 +49,7 @@ void sdl_set_still_clock(sdl_options *o, double clock);
 /* Frame `frame` of the animation +KFI<initial_frame> +KFF<final_frame>
  * +KI<initial_clock> +KF<final_clock> [+KC]: clock_delta = (KF - KI) /
  * (KFF - KFI), or / (KFF - KFI + 1) and final_frame = KFF + 1 when cyclic;
- * clock = KI + (frame - KFI) * clock_delta (measured against povray 3.7.0,
+ * clock = KI + (frame - KFI) * clock_delta (as povray 3.7.0 computes it,
  * tests/test_sdl_lang.c). A single frame 1..1 is a still, as in POV-Ray; any
  * other single frame gets clock = KI (POV-Ray divides by zero there).
  * Returns 0, or -1 (nothing changed) when frame is outside KFI..KFF or

@@ -686,7 +686,7 @@ static void keyword_rvalue(sdl_parser *p, sdl_value *out)
     default:
         break;
     }
-    if (opaque && sdl_parse_look_value(p, k, out)) return; /* maps, fog, sky_sphere (issue 5) */
+    if (opaque && sdl_parse_look_value(p, k, out)) return; /* maps, fog, sky_sphere */
     if (opaque) {
         sdl_warn_once(p, kt.tk.loc, "'%s' is not supported yet and is ignored", opaque);
         if (sdl_begin_block(p, opaque)) sdl_skip_block(p);

@@ -466,7 +466,7 @@ int sdl_parse_look_value(sdl_parser *p, sdl_kw k, sdl_value *out)
     case KW_NORMAL_MAP: name = "normal_map"; break;
     case KW_SLOPE_MAP: name = "slope_map"; break;
     case KW_TEXTURE_MAP: name = "texture_map"; break;
-    case KW_MEDIA: case KW_DENSITY: /* sdl_media.c (issue 5) */
+    case KW_MEDIA: case KW_DENSITY: /* sdl_media.c */
         memset(out, 0, sizeof *out);
         out->kind = VAL_OPAQUE;
         out->str = k == KW_MEDIA ? "media" : "density";

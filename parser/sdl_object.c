@@ -211,7 +211,7 @@ void sdl_obj_add_to_scene(sdl_parser *p, sdl_obj *o)
     for (int i = 0; i < o->nlights; i++) {
         if (o->lights[i].looks_like) {
             post_process(p, (scene_object *)o->lights[i].looks_like, NULL, deflt);
-            /* POV-Ray renders the looks_like object with the scene (issue 5) */
+            /* POV-Ray renders the looks_like object with the scene */
             if (scene_add_object(p->s, (scene_object *)o->lights[i].looks_like) != PT_OK)
                 sdl_error(p, o->lights[i].loc, PT_ERR_NOMEM, "out of memory");
         }
@@ -437,7 +437,7 @@ void sdl_object_mods(sdl_parser *p, sdl_obj *so)
             return;
         }
         sdl_tok t = sdl_next(p);
-        if (t.tk.kw == KW_CLIPPED_BY || t.tk.kw == KW_BOUNDED_BY) { /* issue 4: sdl_shape.c */
+        if (t.tk.kw == KW_CLIPPED_BY || t.tk.kw == KW_BOUNDED_BY) { /* sdl_shape.c */
             if (t.tk.kw == KW_CLIPPED_BY) sdl_shape_clipped_by(p, so);
             else sdl_shape_bounded_by(p, so);
             continue;
@@ -1043,7 +1043,7 @@ static void shape_args(sdl_parser *p, sdl_kw k, sdl_obj *so, src_loc loc)
     case KW_MESH: mesh_body(p, so, loc); break;
     case KW_MESH2: mesh2_body(p, so, loc); break;
     default:
-        if (sdl_shape_handles(k)) sdl_shape_args(p, k, so, loc); /* issue 4 shapes */
+        if (sdl_shape_handles(k)) sdl_shape_args(p, k, so, loc); /* further shapes */
         else csg_body(p, so);
         break;
     }

@@ -123,7 +123,7 @@ typedef struct sdl_parser {
     int default_texture_set;
     src_loc last_loc;     /* last token returned (for end-of-file locations) */
     void *geom_cache;     /* sdl_geom: the objects' trees prepared for trace/inside */
-    int nlight_groups;    /* light_group ids handed out (issue 5) */
+    int nlight_groups;    /* light_group ids handed out */
     void *files;          /* sdl_file: every #fopen'ed file (closed at the end) */
     long long ntokens;    /* tokens read so far (opt.max_tokens) */
     size_t build_bytes;   /* malloc'd work memory outside the arena (meshes being

@@ -148,7 +148,7 @@ static int camera_item(sdl_parser *p, scene_camera *c, camera_said *said)
     case KW_FOCAL_POINT: c->focal_point = sdl_vector(p); said->had_focal = 1; break;
     case KW_CONFIDENCE: case KW_VARIANCE: sdl_float(p); break;
     case KW_NORMAL:
-        c->normal = sdl_parse_normal(p); /* issue 5: shade.c perturbs the primary rays */
+        c->normal = sdl_parse_normal(p); /* shade.c perturbs the primary rays */
         break;
     case KW_BOKEH:
         sdl_warn_once(p, t.tk.loc, "camera %s is not supported yet and is ignored", sdl_kw_text(t.tk.kw));
@@ -617,9 +617,9 @@ static void statement(sdl_parser *p)
     case KW_GLOBAL_SETTINGS: global_settings(p); return;
     case KW_DEFAULT: sdl_parse_default(p); return;
     case KW_BACKGROUND: background(p); return;
-    case KW_FOG: case KW_SKY_SPHERE: sdl_atmos_statement(p, t.tk.kw); return; /* sdl_atmos.c (issue 5) */
-    case KW_RAINBOW: sdl_atmos_statement(p, t.tk.kw); return; /* sdl_atmos.c (issue 5) */
-    case KW_MEDIA: sdl_media_statement(p); return; /* atmospheric media (sdl_media.c, issue 5) */
+    case KW_FOG: case KW_SKY_SPHERE: sdl_atmos_statement(p, t.tk.kw); return; /* sdl_atmos.c */
+    case KW_RAINBOW: sdl_atmos_statement(p, t.tk.kw); return; /* sdl_atmos.c */
+    case KW_MEDIA: sdl_media_statement(p); return; /* atmospheric media (sdl_media.c) */
     default: break;
     }
     if (t.tk.kind == TOK_IDENT && t.val.kind == VAL_NONE)

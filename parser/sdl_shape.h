@@ -1,4 +1,4 @@
-/* sdl_shape.h - grammar of POV-Ray's further shapes (issue 4): polygon,
+/* sdl_shape.h - grammar of POV-Ray's further shapes: polygon,
  * lathe, sor, prism, superellipsoid, quadric, poly/cubic/quartic/polynomial,
  * blob, height_field, text, sphere_sweep, bicubic_patch, and the clipped_by /
  * bounded_by object modifiers. sdl_object.c hands a shape keyword over after

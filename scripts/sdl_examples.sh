@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# sdl_examples.sh - issue 3's coverage measure: `partray parse` on every
+# sdl_examples.sh - the parser's coverage: `partray parse` on every
 # distribution example scene (Debian povray-examples), each run from a copy
 # of its own directory (scenes read and write files beside themselves, as
 # in POV-Ray). A scene with a .ini of the same name that sets up an

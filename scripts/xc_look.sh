@@ -1,7 +1,7 @@
 #!/bin/sh
-# xc_look.sh - issue 5's measure: every POV-Ray 3.7 distribution example in
+# xc_look.sh - the appearance cross-check: every POV-Ray 3.7 distribution example in
 # textures/, lights/, camera/ and interior/ (with their subdirectories;
-# camera/mesh_camera is issue 3's), advanced/diffract.pov, incdemo/glasses/glass.pov and
+# camera/mesh_camera is the parser's: tests/test_sdl_lang.c), advanced/diffract.pov, incdemo/glasses/glass.pov and
 # qtvr/qtvrpanorama.pov (where installed), rendered at 160x120 by partray and by
 # povray, compared as scripts/xc_shapes.py does (mean absolute sRGB
 # difference after a 4x4 downsample, agreement <= 0.02; a scene counts as
@@ -12,7 +12,7 @@
 # fraction of supported scenes that agree.
 here=$(dirname "$0")
 scenes=/usr/share/povray-3.7/scenes
-# examples elsewhere whose features issue 5 added (irid, dispersion) and
+# examples elsewhere that use appearance features (irid, dispersion) and
 # the panorama example Debian ships apart from the scenes
 extra="$scenes/advanced/diffract.pov $scenes/incdemo/glasses/glass.pov"
 qtvr=/usr/share/doc/povray/examples/qtvr/qtvrpanorama.pov

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""xc_shapes.py - issue 4's cross-check against POV-Ray 3.7.
+"""xc_shapes.py - cross-check against POV-Ray 3.7.
 
 Renders every example in the given scene directories (default: POV-Ray's
 objects/, objects/quartic/, objects/csg/) at 160x120 with partray and with

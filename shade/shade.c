@@ -60,7 +60,7 @@ typedef struct {
     int tiles_x, tiles_y;
     int transparent;     /* some surface lets light through: filtered shadows */
     light_projection *proj; /* projected_through lights (shade_project.c), NULL = none */
-    /* Media (issue 5, shade_media.c): whether the scene has any, the
+    /* Media (shade_media.c): whether the scene has any, the
      * containers of the camera's location, and per thread the hit being
      * shaded (its incoming ray's containers) for the rays it spawns. */
     int media;

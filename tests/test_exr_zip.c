@@ -1,5 +1,5 @@
 /* test_exr_zip.c - a float EXR chunk whose zlib stream comes out exactly as
- * long as its raw data must still read back unchanged (issue 8: found as a
+ * long as its raw data must still read back unchanged (found as a
  * corrupt reference image in a sweep; OpenEXRCore 3.1 keeps the zlib bytes
  * and readers take them as raw, OpenEXR issue #2306; io/img_exr.c stores such
  * chunks raw).

@@ -1,5 +1,5 @@
 /* test_gi_grids.c - radiance particles on polygon, height_field, lathe,
- * sor, prism and text (issue 7: radiance particles "at the vertices of a
+ * sor, prism and text (radiance particles "at the vertices of a
  * sub-tessellation of each surface"; gi_surface.c split_grid).
  *
  * Each shape stands in a closed room (an inverse box) lit only indirectly:

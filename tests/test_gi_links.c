@@ -1,5 +1,5 @@
 /* test_gi_links.c - the link builder's two nearest-particle lookups give the
- * same links (issue 7, geometry stage speed): the lookup by the hit
+ * same links (geometry stage speed): the lookup by the hit
  * triangle (gi_trilook, link_lookup 0, the default) against the 3D grid
  * alone (link_lookup 1), on scenes/cbox.pov and on a maze-like scene made
  * to hit the rules' corners: a tessellated floor with a primitive box

@@ -1,4 +1,4 @@
-/* test_look.c - issue 5's appearance features rendered by partray (--gi
+/* test_look.c - appearance features rendered by partray (--gi
  * none) and by POV-Ray 3.7 itself, compared as test_crosscheck does: both
  * at 160x120 with +A0.3, sRGB PNGs box-downsampled 4x4, mean absolute
  * difference over all channels in 0..1 of white.
@@ -60,7 +60,7 @@ static void test_irid(void **st) { (void)st; check("xl_irid", NULL, "irid", 0.00
 static void test_light_group(void **st) { (void)st; check("xl_lightgroup", NULL, "light_group", 0.002); }
 /* uv_mapping on spheres: measured 0.0006 when added */
 static void test_uv_mapping(void **st) { (void)st; check("xl_uv", NULL, "uv_mapping", 0.003); }
-/* uv_mapping on every shape POV-Ray 3.7 gives UV coordinates (issue 5):
+/* uv_mapping on every shape POV-Ray 3.7 gives UV coordinates:
  * measured when added: shapes 0.0011, meshes/lathe/sor/bicubic 0.0014,
  * pigment/normal/texture-level and image_map 0.0010 (before, with the
  * patterns evaluated in 3D: 0.034, 0.0073 and no image at all). */

@@ -1,4 +1,4 @@
-/* test_measure.c - the measuring commands end to end (issue 8):
+/* test_measure.c - the measuring commands end to end:
  * `partray sweep` (CSV rows, plot picture, HTML page and the files it links)
  * and `partray crosscheck` (POV-Ray 3.7 against partray: metrics, exit codes). */
 #include <setjmp.h>

@@ -1,4 +1,4 @@
-/* test_media.c - participating media (issue 5, shade/shade_media.c).
+/* test_media.c - participating media (shade/shade_media.c).
  *
  * Closed forms, along single rays through shade_trace (relative error
  * bound TOL below):

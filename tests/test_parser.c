@@ -556,7 +556,7 @@ static void test_textures(void **st)
     assert_near(t5->finish.reflection_max.g, 0.5, 0);
     assert_near(t5->finish.reflection_falloff, 2, 0);
     const scene_texture *t6 = s->objects[5]->texture;
-    assert_int_equal(t6->pigment.kind, PIGMENT_PATTERN); /* evaluated by shade_pattern (issue 5) */
+    assert_int_equal(t6->pigment.kind, PIGMENT_PATTERN); /* evaluated by shade_pattern */
     assert_string_equal(t6->pigment.pattern, "checker");
     assert_near(t6->pigment.colour.r, 1, 0);
     assert_near(t6->pigment.colour.g, 0, 0);

@@ -1,4 +1,4 @@
-/* test_pattern.c - pattern values against POV-Ray 3.7 itself (issue 5).
+/* test_pattern.c - pattern values against POV-Ray 3.7 itself.
  *
  * Every pattern is shown through a grey colour_map on its own tile (a
  * polygon) seen by an orthographic camera with ambient 1, diffuse 0, so each

@@ -1,10 +1,10 @@
-/* test_reference.c - the reference renderers (issue 6) and their parts.
+/* test_reference.c - the reference renderers and their parts.
  *
  * Numbers and tolerances (each test prints what it measured):
  *  - furnace: camera inside a closed unit sphere, surface emission Le = 1
  *    (pigment 1, emission 1, ambient 0), albedo rho = diffuse. Every pixel
  *    converges to Le / (1 - rho). 16x16 pixels. The image mean must be
- *    within 1% (rho 0.5) / 2% (rho 0.9), as issue 6 asks, and every pixel
+ *    within 1% (rho 0.5) / 2% (rho 0.9), as the design asks, and every pixel
  *    within the same bound (path: enough samples that the per-pixel noise,
  *    printed, is far below it).
  *  - point-light furnace: the same sphere without emission and a POV-Ray

@@ -1,4 +1,4 @@
-/* test_reliability.c - the partray command under limits and failures (issue 11):
+/* test_reliability.c - the partray command under limits and failures:
  * every parser limit is settable and stops with a located error and exit 1;
  * image sizes beyond the writers' limits are usage errors (exit 2) found
  * before parsing; a failed write (file size limit, unwritable directory)

@@ -1,4 +1,4 @@
-/* test_shapes.c - issue 4 shapes end to end (SDL -> IR -> accel): hit
+/* test_shapes.c - further shapes end to end (SDL -> IR -> accel): hit
  * distances and normals against closed-form answers, grazing rays, rays
  * starting on the surface, scales 1e-4 to 1e5, inside tests, clipped_by;
  * where no closed form exists (Catmull-Rom lathe, sor, Bezier prism, text)

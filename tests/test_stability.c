@@ -1,4 +1,4 @@
-/* test_stability.c - numerical-stability suite (issue 8).
+/* test_stability.c - numerical-stability suite.
  *
  * One small scene - a closed box room with a sphere, a block and one light,
  * seen from inside - is rendered by the partray binary at 64x64 (no

@@ -1,4 +1,4 @@
-/* test_units.c - photometric units and AOVs (issue 9, docs/units.md), end to
+/* test_units.c - photometric units and AOVs (docs/units.md), end to
  * end through the partray binary: a point light of I candela at height d
  * over a white Lambertian plane gives E = I/d^2 lux at the foot (the
  * illuminance AOV, and read back from the false-colour PNG) and luminance

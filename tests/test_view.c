@@ -1,4 +1,4 @@
-/* test_view.c - `partray view` (issue 10).
+/* test_view.c - `partray view`.
  *
  * Headless run under Xvfb (started here on a free display with -displayfd,
  * so neither xvfb-run nor xauth is needed): a plane, two spheres and a point

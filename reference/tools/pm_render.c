@@ -1,4 +1,4 @@
-/* pm_render.c - standalone driver for the reference renderers (issue 6),
+/* pm_render.c - standalone driver for the reference renderers,
  * until `partray render --gi path|pmfg` is wired: parse a scene, build the
  * Embree scene, render with the path tracer or photon map + final gather,
  * write the image (progressively during long renders, atomically through
