@@ -9,6 +9,7 @@
 #include "cli.h"
 #include "cmd_compare.h"
 #include "cmd_crosscheck.h"
+#include "cmd_farm.h"
 #include "cmd_merge.h"
 #include "cmd_sweep.h"
 #include "diag.h"
@@ -69,6 +70,7 @@ static const char *usage_text =
     "  partray parse SCENE.pov [-D NAME=VALUE] [-L DIR] [--clock V] [frame options as render]\n"
     "  partray compare REF TEST [--heatmap OUT.png] [--json]\n"
     "  partray merge OUT.exr TILE.exr...   # tiles of a frame (render windows) into one image\n"
+    "  partray farm SCENE.pov|anim.ini [render options] -o OUT --dir DIR [--tiles N] [--engine parallel|slurm]\n"
     "  partray sweep SCENE.pov --ref REF.exr [--gi MODE[,MODE...]] --vary [MODE/]KEY=v1,v2,... [--out DIR]\n"
     "                [--size WxH] [--metric relmse|rmse|flip|psnr|ssim] [--time total|render|wall] [render options]\n"
     "  partray crosscheck SCENE.pov [--size WxH] [+A0.3] [--threads N] [--out DIR] [--json] [--povray PATH]\n"
@@ -414,7 +416,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     wo.meta_values = vals;
     wo.nmeta = ls->aovs_text[0] ? 11 : 10;
     if (run->tile) memcpy(wo.window, run->win, sizeof wo.window);
-    if (st == PT_OK && g_cancel) {
+    if ((st == PT_OK || st == PT_CANCELLED) && g_cancel) {
         /* Interrupted: keep what was rendered under a clearly partial name. */
         for (int i = 0; i < noutputs; i++) {
             char *pn = partial_name(outputs[i]);
@@ -664,6 +666,7 @@ int main(int argc, char **argv)
     if (strcmp(cmd, "parse") == 0) return cmd_parse(argc - 2, argv + 2);
     if (strcmp(cmd, "compare") == 0) return cmd_compare(argc - 2, argv + 2);
     if (strcmp(cmd, "merge") == 0) return cmd_merge(argc - 2, argv + 2);
+    if (strcmp(cmd, "farm") == 0) return cmd_farm(argc - 2, argv + 2);
     if (strcmp(cmd, "sweep") == 0) return cmd_sweep(argc - 2, argv + 2);
     if (strcmp(cmd, "crosscheck") == 0) return cmd_crosscheck(argc - 2, argv + 2);
     if (strcmp(cmd, "view") == 0) return cmd_view(argc - 2, argv + 2);
