@@ -21,6 +21,8 @@
 #include "ini.h"
 #include "lighting.h"
 #include "pool.h"
+#include "progress.h"
+#include "progress_bar.h"
 #include "render_gi.h"
 #include "scene.h"
 #include "sdl.h"
@@ -195,14 +197,20 @@ static int cmd_parse(int argc, char **argv)
     for (int f = plan.first; f <= plan.last && rc == EXIT_OK; f++) {
         sdl_options so;
         fill_sdl_options(&so, &o, &plan, f);
+        progress *prog = progress_new();
+        pbar *bar = pbar_start(prog, o.quiet);
+        so.progress = prog;
         diag *d = diag_new();
+        diag_set_sink(d, pbar_diag_sink, bar); /* #debug text as the parse produces it */
         scene *sc = NULL;
         double t0 = timer_now();
         pt_status st = sdl_parse_file(o.scene, &so, &sc, d);
         double t1 = timer_now();
+        pbar_stop(bar);
         if (st == PT_OK) warn_if_empty(sc, d);
-        print_diags(d, o.quiet);
         diag_free(d);
+        pbar_free(bar);
+        progress_free(prog);
         if (st != PT_OK) {
             rc = status_exit(st);
             break;
@@ -308,14 +316,21 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     double t_frame = timer_now();
     sdl_options so;
     fill_sdl_options(&so, o, plan, frame);
+    /* Progress of every stage, drawn by its own thread; the scene's
+     * messages (#debug, #warning, errors) print as they are recorded. */
+    progress *prog = progress_new();
+    pbar *bar = pbar_start(prog, o->quiet);
+    so.progress = prog;
     diag *d = diag_new();
+    diag_set_sink(d, pbar_diag_sink, bar);
     scene *sc = NULL;
     double t0 = timer_now();
     pt_status st = sdl_parse_file(o->scene, &so, &sc, d);
     double t_parse = timer_now() - t0;
     if (st != PT_OK) {
-        print_diags(d, 0);
         diag_free(d);
+        pbar_free(bar);
+        progress_free(prog);
         return status_exit(st);
     }
     warn_if_empty(sc, d);
@@ -324,21 +339,25 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     if (!o->gi && sc->global.radiosity.enabled) gi = GI_PARTICLE;
     const char *gi_used = gi_mode_name(gi);
     if (run->tile && (gi == GI_PATH || gi == GI_PMFG)) {
+        pbar_free(bar);
         fprintf(stderr, "partray render: a render window (+SC/+EC/+SR/+ER) needs --gi none or particle, not %s\n", gi_used);
         scene_free(sc);
         diag_free(d);
+        progress_free(prog);
         return EXIT_USAGE;
     }
 
     int threads = o->threads > 0 ? o->threads : pool_default_threads();
     accel_set_function_env(shade_func_env()); /* isosurface functions: noise, pigment functions */
     t0 = timer_now();
+    progress_stage(prog, "accel", 0);
     accel *acc = accel_build(sc, threads, d, &st);
     double t_accel = timer_now() - t0;
     if (!acc || st != PT_OK) {
-        print_diags(d, 0);
         scene_free(sc);
         diag_free(d);
+        pbar_free(bar);
+        progress_free(prog);
         return status_exit(st == PT_OK ? PT_ERR_DEVICE : st);
     }
 
@@ -360,7 +379,8 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     ss.max_depth = o->max_depth;
     ss.cl_device = o->cl_device;
     ss.cl_max_bytes = o->cl_max_memory_mib > 0 ? (size_t)o->cl_max_memory_mib << 20 : 0;
-    ss.progress = !o->quiet;
+    ss.progress = prog;
+    ss.notes = d;
     ss.cancel = &g_cancel;
     if (run->tile) memcpy(ss.window, run->win, sizeof ss.window);
     char *progressive = NULL;
@@ -379,7 +399,8 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     /* the progressive image of a finished render is no longer needed */
     if (progressive && !g_cancel) remove(progressive);
     free(progressive);
-    print_diags(d, o->quiet);
+    /* the bar ends with the render; what follows prints plainly */
+    pbar_stop(bar);
 
     int rc = EXIT_OK;
     img_write_opts wo;
@@ -416,7 +437,13 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     wo.meta_values = vals;
     wo.nmeta = ls->aovs_text[0] ? 11 : 10;
     if (run->tile) memcpy(wo.window, run->win, sizeof wo.window);
-    if ((st == PT_OK || st == PT_CANCELLED) && g_cancel) {
+    if ((st == PT_OK || st == PT_CANCELLED) && g_cancel && !sst.image_begun) {
+        /* Interrupted before the image pass (parse, accel or a GI stage):
+         * no pixel was rendered, and a black "partial" image would say
+         * otherwise. */
+        fprintf(stderr, "partray: interrupted before any pixel was rendered: no partial image\n");
+        rc = g_cancel == SIGTERM ? 128 + SIGTERM : EXIT_INTERRUPTED;
+    } else if ((st == PT_OK || st == PT_CANCELLED) && g_cancel) {
         /* Interrupted: keep what was rendered under a clearly partial name. */
         for (int i = 0; i < noutputs; i++) {
             char *pn = partial_name(outputs[i]);
@@ -501,6 +528,8 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     accel_free(acc);
     scene_free(sc);
     diag_free(d);
+    pbar_free(bar);
+    progress_free(prog);
     return rc;
 }
 

@@ -32,6 +32,7 @@ static void fill_shade(shade_settings *ss, const render_gi_opts *o)
     ss->spp = o->spp;
     ss->cancel = o->cancel;
     memcpy(ss->window, o->window, sizeof ss->window);
+    ss->progress = o->progress;
 }
 
 /* The AOV pass (shade_aov.h) with the Whitted settings of the render and,
@@ -53,6 +54,7 @@ static pt_status render_none(const scene *sc, const accel *a, const render_gi_op
     fill_shade(&ss, o);
     ss.use_ambient = radrules_of(sc, 0).ambient; /* radiosity off: always */
     double t0 = timer_now();
+    r->image_begun = 1;
     pt_status st = shade_render(sc, a, &ss, fb, &r->shade, d);
     r->t_render = timer_now() - t0;
     if (st == PT_OK) st = render_aovs(sc, a, o, &ss, r, d);
@@ -73,6 +75,7 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     if (o->cl_device) gs.cl_device = o->cl_device;
     gs.cl_max_bytes = o->cl_max_bytes;
     gs.cancel = o->cancel; /* Ctrl-C stops the geometry stage too */
+    gs.progress = o->progress;
     /* camera rays through pixel centres (no fixed supersampling): the
      * pre-pass's hits serve the render (gi_particle_primary_hit) */
     gs.keep_hits = o->antialias != 2;
@@ -106,7 +109,11 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
         double c0 = timer_cpu_now();
         /* view preparation (pre-pass, gathering, estimation) belongs to the frame */
         st = gi_particle_prepare_view(gp, &sc->camera, o->width, o->height, d);
-        if (st == PT_OK) st = shade_render(sc, a, &ss, fb, &r->shade, d);
+        /* prepare_view returns PT_OK when cancelled: the render then stops at once */
+        if (st == PT_OK && !(o->cancel && *o->cancel)) {
+            r->image_begun = 1;
+            st = shade_render(sc, a, &ss, fb, &r->shade, d);
+        }
         r->t_render = timer_now() - t0;
         r->c_render = timer_cpu_now() - c0;
         if (st == PT_OK) st = render_aovs(sc, a, o, &ss, r, d);
@@ -119,6 +126,9 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
 typedef struct {
     const char *path;
     double last;
+    diag *notes;
+    progress *progress;
+    int *image_begun;
 } progressive_ctx;
 
 static void on_image(void *ctx, const framebuffer *fb, int done, int total)
@@ -128,19 +138,17 @@ static void on_image(void *ctx, const framebuffer *fb, int done, int total)
     diag *d = diag_new();
     img_write_opts wo;
     img_default_write_opts(&wo);
-    if (img_write(p->path, fb, &wo, d) == PT_OK && isatty(2))
-        fprintf(stderr, "\rpartray: %d/%d samples per pixel written to %s\n", done, total, p->path);
+    if (img_write(p->path, fb, &wo, d) == PT_OK && p->notes)
+        diag_report(p->notes, DIAG_NOTE, (src_loc){0}, NULL, "%d/%d samples per pixel written to %s", done, total, p->path);
     diag_free(d);
 }
 
+/* the reference renderers report the fraction of their image loop done */
 static void on_progress(void *ctx, double f)
 {
-    (void)ctx;
-    int n = (int)(f * 40.0 + 0.5);
-    char bar[41];
-    for (int i = 0; i < 40; i++) bar[i] = i < n ? '#' : '.';
-    bar[40] = 0;
-    fprintf(stderr, "\r[%s] %5.1f%%%s", bar, f * 100.0, f >= 1.0 ? "\n" : "");
+    progressive_ctx *p = ctx;
+    *p->image_begun = 1;
+    progress_set(p->progress, (long long)(f * 1000.0 + 0.5));
 }
 
 static void fill_common(pm_common *c, const render_gi_opts *o, progressive_ctx *pc)
@@ -156,16 +164,18 @@ static void fill_common(pm_common *c, const render_gi_opts *o, progressive_ctx *
         c->on_image = on_image;
         c->image_ctx = pc;
     }
-    if (o->progress && isatty(2)) c->on_progress = on_progress;
+    c->on_progress = on_progress;
+    c->progress_ctx = pc;
 }
 
 static pt_status render_reference(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
                                   render_gi_result *r, diag *d)
 {
-    progressive_ctx pc = {o->progressive_path, 0.0};
+    progressive_ctx pc = {o->progressive_path, 0.0, o->notes, o->progress, &r->image_begun};
     pt_status st;
     r->has_pm = 1;
     double t0 = timer_now();
+    progress_stage(o->progress, o->mode == GI_PATH ? "path tracing" : "photon map + final gather", 1000);
     if (o->mode == GI_PATH) {
         pm_path_settings ps;
         pm_path_default_settings(&ps);

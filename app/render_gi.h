@@ -30,7 +30,8 @@ typedef struct {
     const char *cl_device;    /* particle: OpenCL device choice (gi_cl.h), NULL = auto */
     size_t cl_max_bytes;      /* particle: OpenCL device memory it may use, 0 = the device's */
     volatile int *cancel;
-    int progress;             /* 1: progress bar on stderr (reference modes) */
+    progress *progress;       /* stages and counts of every step (core/progress.h); NULL: none */
+    diag *notes;              /* reference modes: a note each time the progressive image is written */
     const char *progressive_path; /* reference modes: write the image so far here every few seconds */
     int window[4];            /* none/particle: render window x0,y0,x1,y1 (shade_settings.window); 0 = all */
     shade_aov *aov;           /* non-NULL: fill these AOVs after the render (shade_aov.h); the indirect
@@ -47,6 +48,8 @@ typedef struct {
     pm_stats pm;
     double t_aov;             /* the AOV pass, seconds (not in t_render) */
     double c_render;          /* particle: process CPU seconds of prepare_view + the Whitted pass */
+    int image_begun;          /* the pass that writes the image began: a cancelled render's
+                                 framebuffer holds what it rendered (before: nothing) */
 } render_gi_result;
 
 pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb, render_gi_result *r,

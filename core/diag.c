@@ -9,7 +9,16 @@ struct diag {
     int n, cap, nerr;
     char **strs;
     int nstr, capstr;
+    diag_sink_fn sink;
+    void *sink_ctx;
 };
+
+void diag_set_sink(diag *d, diag_sink_fn fn, void *ctx)
+{
+    if (!d) return;
+    d->sink = fn;
+    d->sink_ctx = ctx;
+}
 
 const char *pt_status_name(pt_status s)
 {
@@ -81,6 +90,7 @@ void diag_vreport(diag *d, diag_severity sev, src_loc loc, const char *chain, co
     d->msgs[d->n].text = text;
     d->n++;
     if (sev == DIAG_ERROR) d->nerr++;
+    if (d->sink) d->sink(d->sink_ctx, &d->msgs[d->n - 1]);
 }
 
 void diag_report(diag *d, diag_severity sev, src_loc loc, const char *chain, const char *fmt, ...)

@@ -58,6 +58,11 @@ void diag_error(diag *d, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
+/* A sink sees each message as it is recorded, on the reporting thread (the
+ * app prints a scene's #debug text while the parse runs); fn NULL removes
+ * it. The message stays in the context as before. */
+typedef void (*diag_sink_fn)(void *ctx, const diag_msg *m);
+void diag_set_sink(diag *d, diag_sink_fn fn, void *ctx);
 int diag_count(const diag *d);
 int diag_errors(const diag *d);
 const diag_msg *diag_get(const diag *d, int i);

@@ -1,6 +1,7 @@
 /* pool.c - minimal parallel-for on pthreads with an atomic work counter. */
 #include "pool.h"
 #include <pthread.h>
+#include "progress.h"
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <unistd.h>
@@ -12,6 +13,7 @@ typedef struct {
     atomic_int next;
     volatile int *cancel;
     atomic_int stopped;
+    progress *progress;
 } pool_state;
 
 typedef struct {
@@ -30,6 +32,7 @@ static void *worker(void *p)
         int i = atomic_fetch_add(&w->st->next, 1);
         if (i >= w->st->n) break;
         w->st->job(w->st->ctx, i, w->thread);
+        progress_add(w->st->progress, 1);
     }
     return NULL;
 }
@@ -40,13 +43,19 @@ int pool_default_threads(void)
     return n > 0 ? (int)n : 1;
 }
 
-void pool_run(int threads, int n, pool_job job, void *ctx) { (void)pool_run_cancel(threads, n, job, ctx, NULL); }
+void pool_run(int threads, int n, pool_job job, void *ctx) { (void)pool_run_counted(threads, n, job, ctx, NULL, NULL); }
 
 int pool_run_cancel(int threads, int n, pool_job job, void *ctx, volatile int *cancel)
 {
+    return pool_run_counted(threads, n, job, ctx, cancel, NULL);
+}
+
+int pool_run_counted(int threads, int n, pool_job job, void *ctx, volatile int *cancel, progress *p)
+{
     if (threads <= 0) threads = pool_default_threads();
     if (threads > n) threads = n;
-    pool_state st = {job, ctx, n, 0, cancel, 0};
+    progress_set_total(p, n);
+    pool_state st = {job, ctx, n, 0, cancel, 0, p};
     pthread_t *tid = threads > 1 ? malloc(sizeof(pthread_t) * (size_t)threads) : NULL;
     worker_arg *args = threads > 1 ? malloc(sizeof(worker_arg) * (size_t)threads) : NULL;
     if (!tid || !args) {

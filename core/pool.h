@@ -10,6 +10,10 @@ void pool_run(int threads, int n, pool_job job, void *ctx);
 /* The same, handing out no further index once *cancel is non-zero (cancel
  * may be NULL: never); returns 1 when every job ran, 0 when it stopped. */
 int pool_run_cancel(int threads, int n, pool_job job, void *ctx, volatile int *cancel);
+/* The same, counting each finished index on `p` (core/progress.h), whose
+ * current stage's total becomes n; p may be NULL. */
+struct progress;
+int pool_run_counted(int threads, int n, pool_job job, void *ctx, volatile int *cancel, struct progress *p);
 int pool_default_threads(void);
 
 #endif

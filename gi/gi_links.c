@@ -358,7 +358,7 @@ void gi_links_reverse_fill(const int *links, int n, int k, const unsigned *mask,
 pt_status gi_links_build(const accel *a, void *scene, const gi_dev_particle *p, const void *const *pobj,
                          const unsigned char *pin, int n, int nside, uint64_t seed, const gi_lookup *grid,
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
-                         gi_link_stats *st, volatile int *cancel)
+                         gi_link_stats *st, volatile int *cancel, progress *prog)
 {
     if (threads <= 0) threads = pool_default_threads();
     link_job J;
@@ -435,7 +435,7 @@ pt_status gi_links_build(const accel *a, void *scene, const gi_dev_particle *p, 
         J.tcell[t] = malloc(rays * sizeof(long));
         if (!J.buf[t] || !J.hp[t] || !J.cell[t] || !J.tcell[t]) rc = PT_ERR_NOMEM;
     }
-    if (rc == PT_OK && n > 0 && !pool_run_cancel(threads, (n + J.per_job - 1) / J.per_job, job, &J, cancel))
+    if (rc == PT_OK && n > 0 && !pool_run_counted(threads, (n + J.per_job - 1) / J.per_job, job, &J, cancel, prog))
         rc = PT_CANCELLED;
     for (int t = 0; t < threads; t++) {
         if (J.buf) free(J.buf[t]);

@@ -12,6 +12,7 @@
 #include "gi_particles.h"
 #include "gi_surface.h"
 #include "gi_trilook.h"
+#include "progress.h"
 
 typedef struct {
     long rays;       /* traced */
@@ -37,12 +38,13 @@ typedef struct {
  * maxdist): hits on its triangles take its answer when it has one (the
  * same answer, gi_trilook.h), else the grid path. scene (may be NULL):
  * the RTCScene to trace (accel_rtc_link_scene's, built once by the
- * caller); NULL: the link scene is built and freed here. */
+ * caller); NULL: the link scene is built and freed here. prog (may be
+ * NULL): its current stage counts the chunks of particles traced. */
 #define GI_LINKS_AGREE 0.3
 pt_status gi_links_build(const accel *a, void *scene, const gi_dev_particle *p, const void *const *pobj,
                          const unsigned char *pin, int n, int nside, uint64_t seed, const gi_lookup *grid,
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
-                         gi_link_stats *st, volatile int *cancel);
+                         gi_link_stats *st, volatile int *cancel, progress *prog);
 
 /* Incoming links, a counting sort by target: the sources i < n in mask
  * (bit i of word i / 32; NULL: all) whose links[i * k + j] are >= 0, per

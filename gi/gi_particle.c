@@ -258,7 +258,7 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
                                   3.0 * ps->spacing, gp->threads, gp->set.cancel, &st);
     if (st == PT_OK)
         st = gi_links_build(gp->a, gp->lscene, ps->p, pobj, pin, n, gp->set.scatter_side, seed, grid, gp->tl,
-                            3.0 * ps->spacing, gp->threads, links, keep, ls, gp->set.cancel);
+                            3.0 * ps->spacing, gp->threads, links, keep, ls, gp->set.cancel, gp->set.progress);
     gi_lookup_free(grid);
     free(pobj);
     free(pin);
@@ -478,6 +478,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     snprintf(S->device, sizeof S->device, "%s", gi_dev_name(gp->dev));
 
     double c0 = timer_cpu_now();
+    progress_stage(set->progress, "gi geometry: surfaces", 0);
     double tg = timer_now();
     gp->surf = gi_surface_build(sc, a, 1e30, d, &st);
     if (!gp->surf) goto fail;
@@ -486,6 +487,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
 
     /* pilot: a quarter of the particles on every side, to learn which sides
      * are needed (see keep_needed) and what fraction of each survives */
+    progress_stage(set->progress, "gi geometry: pilot", 0);
     tg = timer_now();
     double cg = timer_cpu_now();
     int np = gi_surface_npatches(gp->surf);
@@ -527,6 +529,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     }
 
     /* the area particles */
+    progress_stage(set->progress, "gi geometry: particles", 0);
     tg = timer_now();
     st = gi_particles_sample(&gp->ps, gp->surf, a, sc, set->count, set->seed, frac, set->pigment, d);
     free(frac);
@@ -553,6 +556,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
      * directions would be the same 16 rays. */
     {
         gi_link_stats ls = {0};
+        progress_stage(set->progress, "gi geometry: scatter links", 0);
         tg = timer_now();
         cg = timer_cpu_now();
         st = trace_and_prune(gp, &gp->ps, set->seed ^ 0x51ULL, &gp->slink, &ls, 1);
@@ -568,11 +572,12 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         const void **pobj = particle_objects(gp, &gp->ps, &pin, &st);
         if (!grid) st = PT_ERR_NOMEM;
         if (st == PT_OK) st = gi_lookup_set_objects(grid, (const void *const *)pobj);
+        progress_stage(set->progress, "gi geometry: gather links", 0);
         tg = timer_now();
         cg = timer_cpu_now();
         if (st == PT_OK)
             st = gi_links_build(a, gp->lscene, gp->ps.p, pobj, pin, n, set->gather_side, set->seed ^ 0x6a7ULL, grid,
-                                gp->tl, 3.0 * spacing, gp->threads, gp->glink, NULL, &ls, set->cancel);
+                                gp->tl, 3.0 * spacing, gp->threads, gp->glink, NULL, &ls, set->cancel, set->progress);
         S->t_gather_links = timer_now() - tg;
         S->c_gather_links = timer_cpu_now() - cg;
         gi_lookup_free(grid);
@@ -600,6 +605,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         st = PT_CANCELLED;
         goto fail;
     }
+    progress_stage(set->progress, "gi geometry: lists", 0);
     tg = timer_now();
     cg = timer_cpu_now();
     st = gi_radiance_lists(&gp->lists, gp->surf, &gp->ps, gp->a, S->radius, set->normal_cos, gp->threads, set->cancel,
@@ -926,6 +932,7 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
     /* lights and visibility (host, Embree shadow rays); a light whose
      * geometry did not change since the last lighting stage (only its
      * colour, say) keeps its visibility */
+    progress_stage(gp->set.progress, "gi lighting: visibility", 0);
     double tv = timer_now();
     int nl = sc->nlights;
     if (nl != gp->nlights) {
@@ -985,6 +992,7 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
      * sums: no pass over the particles here. The device keeps edir and phi
      * until gi_particle_debug asks (gi_dev_fetch). */
     gi_dev_sums sums;
+    progress_stage(gp->set.progress, "gi lighting: emit and scatter", 0);
     st = gi_dev_lighting(gp->dev, gp->lights, gp->nlights, gp->vis, ndirty > 0,
                          full ? GI_SCATTER_FULL : GI_SCATTER_WALK, nb, gp->cancel, gp->edir, gp->lout, gp->phi,
                          gp->bounce_flux, &sums, &done, kt, d);
@@ -1508,6 +1516,7 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
         st = gi_particle_light(gp, d);
         if (st != PT_OK || !gp->lit) return st; /* !lit: cancelled (gi_particle_set_cancel) */
     }
+    progress_stage(gp->set.progress, "gi view: pre-pass", 0);
     view_job J;
     J.gp = gp;
     J.cam = c;
@@ -1567,6 +1576,7 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
     S->t_prepass = timer_now() - t0;
     S->c_prepass = timer_cpu_now() - c0;
 
+    progress_stage(gp->set.progress, "gi view: gather", 0);
     /* found radiance particles (not yet estimated) and the area particles
      * their lists need (not yet gathered on the device) */
     double tg = timer_now();
@@ -1602,6 +1612,7 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
     }
     S->t_gather = timer_now() - tg;
 
+    progress_stage(gp->set.progress, "gi view: estimate", 0);
     double te = timer_now();
     vout = malloc((size_t)(nfound > 0 ? nfound : 1) * 4 * sizeof *vout);
     if (!vout) {

@@ -69,6 +69,7 @@
 #include <stdint.h>
 #include "accel.h"
 #include "diag.h"
+#include "progress.h"
 #include "scene.h"
 
 typedef struct gi_particle gi_particle;
@@ -144,6 +145,7 @@ typedef struct {
                               NULL with PT_CANCELLED. NULL (the default): never. */
     gi_pigment_fn pigment; /* particles' pigment at their position; NULL: each texture's base colour */
     gi_sky_fn sky;         /* radiance of rays leaving the scene; NULL: the background colour */
+    progress *progress;    /* names each step of the geometry, lighting and view stages (NULL: none) */
 } gi_particle_settings;
 
 typedef struct {

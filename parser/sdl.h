@@ -3,6 +3,7 @@
 #ifndef PT_SDL_H
 #define PT_SDL_H
 #include "diag.h"
+#include "progress.h"
 #include "scene.h"
 
 typedef struct {
@@ -40,6 +41,8 @@ typedef struct {
     const struct func_env *func_env; /* evaluators for pigment/pattern functions, noise and
                                      vturbulence at parse time (core/func.h); NULL: such
                                      calls are located PT_ERR_UNSUPPORTED errors */
+    progress *progress;           /* stage "parse": bytes of the scene file read (its
+                                     position outside includes and macro bodies); NULL: none */
 } sdl_options;
 
 void sdl_default_options(sdl_options *o);

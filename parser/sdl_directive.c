@@ -215,6 +215,7 @@ pt_status sdl_open_main(sdl_parser *p, const char *path, const char *text)
         if (sdl_ok(p)) sdl_error(p, none, PT_ERR_NOMEM, "out of memory");
         return p->status;
     }
+    progress_stage(p->opt.progress, "parse", (long long)len);
     return PT_OK;
 }
 

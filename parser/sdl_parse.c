@@ -224,6 +224,9 @@ int sdl_memory_ok(sdl_parser *p, size_t extra, src_loc loc, const char *what)
 
 int sdl_count_token(sdl_parser *p, src_loc loc)
 {
+    /* the scene file's position: a loop or a macro holds it where it is */
+    if ((p->ntokens & 1023) == 0 && p->opt.progress && p->nframes > 0 && p->frames[0].kind == FRAME_FILE)
+        progress_set(p->opt.progress, (long long)p->frames[0].sc.at.pos);
     if (++p->ntokens <= p->opt.max_tokens) return 1;
     sdl_error(p, loc, PT_ERR_LIMIT, "scene reads more than %lld tokens, loop repeats and macro calls included (--max-tokens)",
               p->opt.max_tokens);

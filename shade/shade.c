@@ -570,6 +570,7 @@ static void tile_first_pass(void *ctx, int tile, int thread)
             px[1] = (float)acc.g;
             px[2] = (float)acc.b;
         }
+        progress_add(c->s->progress, x1 - x0);
     }
 }
 
@@ -596,6 +597,8 @@ static void tile_supersample(void *ctx, int tile, int thread)
     double step = 1.0 / d;
     for (int y = y0; y < y1; y++) {
         if (c->s->cancel && *c->s->cancel) return;
+        int nflag = 0;
+        for (int x = x0; x < x1; x++) nflag += c->flag[(size_t)y * c->s->width + x];
         for (int x = x0; x < x1; x++) {
             if (!c->flag[(size_t)y * c->s->width + x]) continue;
             rng r;
@@ -615,6 +618,7 @@ static void tile_supersample(void *ctx, int tile, int thread)
             px[1] = (float)acc.g;
             px[2] = (float)acc.b;
         }
+        progress_add(c->s->progress, nflag);
     }
 }
 
@@ -666,6 +670,8 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     c.primary_on = s->primary && s->primary_begin && cam->kind != CAMERA_MESH && !camera_focal_blur(cam) &&
                    !cam->normal && s->primary_begin(s->primary_ctx, sc, a, s->width, s->height, c.eps);
 
+    progress_stage(s->progress, "render",
+                   (long long)(c.first_win[2] - c.first_win[0]) * (long long)(c.first_win[3] - c.first_win[1]));
     pool_run(threads, ntiles, tile_first_pass, &c);
 
     if (s->antialias == 1 && !(s->cancel && *s->cancel)) {
@@ -682,6 +688,10 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
                     c.flag[(size_t)y * s->width + x] = c.flag[(size_t)(y - 1) * s->width + x] = 1;
             }
         }
+        long long nflag = 0;
+        for (int y = c.win[1]; y < c.win[3]; y++)
+            for (int x = c.win[0]; x < c.win[2]; x++) nflag += c.flag[(size_t)y * s->width + x];
+        progress_stage(s->progress, "antialias", nflag);
         pool_run(threads, ntiles, tile_supersample, &c);
         free(c.flag);
     }

@@ -8,6 +8,7 @@
 #include "accel.h"
 #include "diag.h"
 #include "framebuffer.h"
+#include "progress.h"
 #include "rng.h"
 #include "scene.h"
 #include "shade_light.h"
@@ -55,6 +56,7 @@ typedef struct {
      * one-pixel apron around the window: a window's pixels equal the whole
      * image's, bit for bit. */
     int window[4];
+    progress *progress;     /* stages "render" and "antialias" count pixels (NULL: none) */
 } shade_settings;
 
 typedef struct {

@@ -371,6 +371,101 @@ static void test_sigint_partial(void **st)
     fb_free(fb);
 }
 
+static const char progress_scene[] =
+    "#debug \"debug text from the parse\\n\"\n"
+    "camera { location <0, 3, -6> look_at 0 }\n"
+    "light_source { <0, 5, 0> rgb 1 area_light 2*x, 2*z, 16, 16 jitter }\n"
+    "plane { y, 0 pigment { rgb 1 } }\n"
+    "sphere { <0, 1, 0>, 1 pigment { rgb 0.5 } }\n";
+
+/* On a terminal (script(1) gives the render one) a bar per stage is
+ * redrawn in place: the render's percent rises through several values,
+ * an ETA is shown, and the stage ends with its time. The scene's #debug
+ * text appears before the render's first bar, i.e. while it runs, not
+ * at exit. */
+static void test_progress_terminal(void **st)
+{
+    (void)st;
+    char scene[512], cmd[2048];
+    snprintf(scene, sizeof scene, "%s/progress.pov", tmpdir);
+    tu_write_file(scene, progress_scene);
+    snprintf(cmd, sizeof cmd, "script -q -e -c \"'%s' render '%s' --size 640x480 --threads 2 -o '%s/progress.png'\" /dev/null",
+             PARTRAY_BIN, scene, tmpdir);
+    int rc = tu_run_capture(cmd);
+    assert_int_equal(rc, 0);
+    const char *debug = strstr(tu_out, "progress.pov:1:1: note: debug text from the parse");
+    const char *bar = strstr(tu_out, "\033[Krender ");
+    assert_non_null(debug);
+    assert_non_null(bar);
+    assert_true(debug < bar);
+    /* the percents drawn, in order: at least three distinct, never falling */
+    int last = -1, distinct = 0, eta = 0;
+    for (const char *p = bar; (p = strstr(p, "\033[Krender ")) != NULL; p++) {
+        const char *close = strchr(p, ']');
+        int pct;
+        if (!close || sscanf(close + 1, "%d%%", &pct) != 1) continue;
+        assert_true(pct >= last);
+        if (pct != last) distinct++;
+        last = pct;
+        const char *eol = strchr(p + 1, '\r');
+        const char *e = strstr(p, "ETA ");
+        if (e && (!eol || e < eol)) eta = 1;
+    }
+    printf("render bar: %d distinct percents, last %d%%, ETA shown %d\n", distinct, last, eta);
+    assert_true(distinct >= 3);
+    assert_true(eta);
+    assert_non_null(strstr(tu_out, "render                       done in"));
+}
+
+/* Not on a terminal: no bar, a plain line now and then for a stage that
+ * runs long ($PARTRAY_PROGRESS_SECONDS apart); -q: nothing at all on a
+ * render that succeeds. */
+static void test_progress_plain_and_quiet(void **st)
+{
+    (void)st;
+    char scene[512], cmd[2048];
+    snprintf(scene, sizeof scene, "%s/progress.pov", tmpdir);
+    tu_write_file(scene, progress_scene);
+    snprintf(cmd, sizeof cmd, "PARTRAY_PROGRESS_SECONDS=0.2 '%s' render '%s' --size 640x480 --threads 2 -o '%s/progress.png'",
+             PARTRAY_BIN, scene, tmpdir);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    printf("%s", tu_out);
+    assert_null(strstr(tu_out, "\033[K"));
+    int pct = -1;
+    const char *p = strstr(tu_out, "partray: render ");
+    assert_non_null(p);
+    assert_int_equal(sscanf(p, "partray: render %d%% after", &pct), 1);
+    assert_true(pct >= 0 && pct <= 100);
+    snprintf(cmd, sizeof cmd, "PARTRAY_PROGRESS_SECONDS=0.2 '%s' render '%s' --size 320x240 --threads 2 -q -o '%s/progress.png'",
+             PARTRAY_BIN, scene, tmpdir);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    assert_string_equal(tu_out, "");
+}
+
+/* Ctrl-C during the particle GI's geometry stage, before any pixel was
+ * rendered: exit 130, and no partial image (it would be black); the
+ * message says why. */
+static void test_sigint_during_gi(void **st)
+{
+    (void)st;
+    char scene[512], out[512], partial[512], cmd[2048];
+    snprintf(scene, sizeof scene, "%s/gi_slow.pov", tmpdir);
+    snprintf(out, sizeof out, "%s/gi_slow.png", tmpdir);
+    snprintf(partial, sizeof partial, "%s/gi_slow.partial.png", tmpdir);
+    tu_write_file(scene, "camera { location <0, 3, -6> look_at 0 }\nlight_source { <0, 5, 0> rgb 1 }\n"
+                         "plane { y, 0 pigment { rgb 1 } }\nsphere { <0, 1, 0>, 1 pigment { rgb 0.5 } }\n");
+    snprintf(cmd, sizeof cmd,
+             "('%s' render '%s' -o '%s' --gi particle --particles 1000000 --size 64x48 --threads 2 & pid=$!; sleep 1.5; "
+             "kill -INT $pid; wait $pid; echo rc=$?)",
+             PARTRAY_BIN, scene, out);
+    tu_run_capture(cmd);
+    printf("%s", tu_out);
+    assert_non_null(strstr(tu_out, "rc=130"));
+    assert_non_null(strstr(tu_out, "interrupted before any pixel was rendered: no partial image"));
+    assert_false(tu_exists(partial));
+    assert_false(tu_exists(out));
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/partray-cli-XXXXXX");
@@ -388,6 +483,9 @@ int main(void)
         cmocka_unit_test(test_mesh_camera),
         cmocka_unit_test(test_render_outputs_and_stats),
         cmocka_unit_test(test_sigint_partial),
+        cmocka_unit_test(test_progress_terminal),
+        cmocka_unit_test(test_progress_plain_and_quiet),
+        cmocka_unit_test(test_sigint_during_gi),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     char cmd[600];

@@ -1,0 +1,34 @@
+/* progress_bar.h - draws a core/progress on stderr from its own thread.
+ *
+ * On a terminal: one line per stage (parse, accel, each GI step, render,
+ * antialias), redrawn in place about ten times a second with a bar, the
+ * percent, the time spent and an estimate of the time left; a finished
+ * stage keeps its line with its time. Elsewhere (a log, a pipe): a plain
+ * line now and then for a stage that runs long (every
+ * $PARTRAY_PROGRESS_SECONDS, default 10). Messages go through
+ * pbar_message (or the diag sink pbar_diag_sink) so a bar never hides
+ * them. Quiet: no bar, and the sink prints errors only. */
+#ifndef PT_PROGRESS_BAR_H
+#define PT_PROGRESS_BAR_H
+#include "diag.h"
+#include "progress.h"
+
+typedef struct pbar pbar;
+
+/* Starts drawing `p` (not owned). quiet: draw nothing. NULL when out of memory. */
+pbar *pbar_start(progress *p, int quiet);
+/* Print one line of text (no newline at its end) above the bar. */
+void pbar_message(pbar *b, const char *text);
+/* A diag_sink_fn (core/diag.h) that prints each message as it is recorded
+ * through pbar_message (ctx: the pbar); quiet: errors only. */
+void pbar_diag_sink(void *ctx, const diag_msg *m);
+/* Ends the last stage's line and stops drawing; messages still print
+ * (plainly) until pbar_free. */
+void pbar_stop(pbar *b);
+void pbar_free(pbar *b);
+
+/* The line drawn for a state `elapsed` seconds into its stage, into buf
+ * (for tests: the format is the contract). tty: with a bar. */
+void pbar_format(const progress_state *s, double elapsed, int tty, char *buf, int n);
+
+#endif
