@@ -6,7 +6,7 @@
  * (library path), +FE/+FN (format of an output named without extension),
  * +WTn (work threads), +Kc (clock), +KFIn +KFFn +KIc +KFc +KC (animation
  * frames and clocks, cyclic), +SFn +EFn (frame subset), +SCn +ECn +SRn +ERn
- * (render window). Switches that only concern POV-Ray's display or its own
+ * (render window), +Qn (quality 0-11, shade.h). Switches that only concern
  * files (+D, -D, +P, +V, +J...) are accepted and ignored. INI files and
  * Key=value options are expanded into these switches first (ini.h). */
 #include "cli.h"
@@ -134,7 +134,17 @@ static int pov_switch(const char *arg, cli_render *o, char *err, int errlen)
             return 0;
         }
         break;
-    case 'D': case 'P': case 'V': case 'J': case 'X': case 'Q': case 'G': case 'B': case 'C':
+    case 'Q': { /* +Qn, POV-Ray 3.7 view.cpp: clip(Quality, 0, 9) */
+        int q;
+        if (parse_int(v, &q) && q >= 0 && q <= 11) {
+            o->quality = q > 9 ? 9 : q;
+            o->quality_given = 1;
+            return 0;
+        }
+        snprintf(err, (size_t)errlen, "+Q wants a quality level 0 to 11, got '%s'", arg);
+        return 2;
+    }
+    case 'D': case 'P': case 'V': case 'J': case 'X': case 'G': case 'B': case 'C':
         return 0; /* display, pause, verbose, jitter...: ignored */
     default:
         break;
@@ -173,6 +183,7 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
     o->kf = 1;
     o->aa_threshold = 0.3;
     o->aa_depth = 3;
+    o->quality = 9;
     o->spp = 1;
     o->exr_compression = -1;
     for (int i = 0; i < argc; i++) {
@@ -511,7 +522,10 @@ const char cli_render_help[] =
     "Image\n"
     "  --size WxH, +Wn +Hn    image size (at most 65536 a side, 2^28 pixels)\n"
     "  +A[t], -A              adaptive antialiasing, threshold t (default 0.3); +Rn its depth (1-9)\n"
-    "  +Qn                    POV-Ray's quality level 0-11 (default 9; see the user guide)\n"
+    "  +Qn                    POV-Ray's quality 0-11 (default 9): 0-1 pigment colour only,\n"
+    "                         2-3 no shadows, 4 shadows (area lights as points), 5 area\n"
+    "                         lights, 6-7 refraction, 8 reflection and normals, 9-11 media\n"
+    "                         and radiosity (10, 11 are 9); quick colours are not modelled\n"
     "  --spp N                samples per pixel (fixed supersampling; path/pmfg: per pixel)\n"
     "  --seed N               random seed (renders are repeatable for a seed)\n"
     "  --threads N, +WTn      worker threads (default: every CPU)\n"

@@ -93,6 +93,8 @@ typedef struct {
     double sc, ec, sr, er;
     int sc_given, ec_given, sr_given, er_given;
     char format;            /* +F: 'N' PNG, 'E' EXR, 0 = from the output name */
+    int quality;            /* +Qn: POV-Ray's quality 0..9 (default 9; 10 and 11 are 9, as POV-Ray clips) */
+    int quality_given;
 } cli_render;
 
 /* The render window the options ask for, as pixels [x0,x1) x [y0,y1) of a

@@ -336,7 +336,19 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     warn_if_empty(sc, d);
     lighting_apply_units(ls, sc, d); /* photometric lights; warns about fade */
     int gi = o->gi ? gi_mode_parse(o->gi) : GI_NONE;
-    if (!o->gi && sc->global.radiosity.enabled) gi = GI_PARTICLE;
+    /* below +Q9 POV-Ray turns radiosity off (view.cpp: Q_ADVANCED_LIGHT) */
+    if (!o->gi && sc->global.radiosity.enabled && o->quality >= 9) gi = GI_PARTICLE;
+    if (o->quality_given && o->quality < 9) {
+        src_loc none = {NULL, 0, 0};
+        if (gi == GI_PATH || gi == GI_PMFG)
+            diag_report(d, DIAG_WARNING, none, NULL, "+Q%d: quality levels apply to --gi none and particle; --gi %s renders everything",
+                        o->quality, gi_mode_name(gi));
+        else if (o->quality <= 5)
+            diag_report(d, DIAG_WARNING, none, NULL, "+Q%d: quick colours (levels 0-5) are not modelled: pigments are evaluated in full",
+                        o->quality);
+        if (sc->global.radiosity.enabled && !o->gi)
+            diag_report(d, DIAG_NOTE, none, NULL, "+Q%d: radiosity is off below +Q9, as in POV-Ray", o->quality);
+    }
     const char *gi_used = gi_mode_name(gi);
     if (run->tile && (gi == GI_PATH || gi == GI_PMFG)) {
         pbar_free(bar);
@@ -371,6 +383,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     ss.antialias = o->antialias ? 1 : (o->spp > 1 ? 2 : 0);
     ss.aa_threshold = o->aa_threshold;
     ss.aa_depth = o->aa_depth;
+    ss.quality = o->quality;
     ss.spp = o->spp;
     ss.particles = o->particles;
     ss.bounces = o->bounces;

@@ -33,6 +33,7 @@ static void fill_shade(shade_settings *ss, const render_gi_opts *o)
     ss->cancel = o->cancel;
     memcpy(ss->window, o->window, sizeof ss->window);
     ss->progress = o->progress;
+    ss->quality = o->quality;
 }
 
 /* The AOV pass (shade_aov.h) with the Whitted settings of the render and,

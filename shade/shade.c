@@ -109,6 +109,7 @@ void shade_default_settings(shade_settings *s)
     s->aa_depth = 3;       /* +R default 3 */
     s->spp = 1;
     s->use_ambient = 1;
+    s->quality = 9;
 }
 
 /* ------------------------------------------------------------------ lights */
@@ -259,7 +260,9 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
         light_ray(l, l->position, p, &dir, &depth);
         double sdepth = depth; /* shadows are tested up to a projected_through object */
         if (l->projected_through && !projection_pass(c->proj, i, p, dir, depth, &sdepth)) continue;
-        int full_area = l->area && l->area_illumination && l->size1 * l->size2 > 0;
+        /* +Q: area lights from level 5, shadows from 4 (POV-Ray's Q_AREA_LIGHT, Q_SHADOW) */
+        int area_on = c->s->quality >= 5, shadows_on = c->s->quality >= 4;
+        int full_area = area_on && l->area && l->area_illumination && l->size1 * l->size2 > 0;
         double att = full_area ? 1.0 : light_attenuation(l, p, dir, depth);
         rgb lc = rgb_scale(l->colour, att);
         if (rgb_near_zero(lc)) continue;
@@ -284,7 +287,7 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
                         if (s->f->diffuse_back != 0.0) back2 = 1;
                         else continue;
                     }
-                    if (!l->shadowless) {
+                    if (!l->shadowless && shadows_on) {
                         slc = rgb_mul(slc, shadow_rgb(c, thread, p, d2, dep2, l, in));
                         if (rgb_near_zero(slc)) continue;
                     }
@@ -293,9 +296,9 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
             }
             continue;
         }
-        if (!l->shadowless) {
+        if (!l->shadowless && shadows_on) {
             rgb vis;
-            if (l->area && l->size1 * l->size2 > 1)
+            if (area_on && l->area && l->size1 * l->size2 > 1)
                 vis = area_visibility(c, thread, l, p, r, in);
             else
                 vis = shadow_rgb(c, thread, p, dir, sdepth, l, in);
@@ -360,7 +363,7 @@ static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, in
                      float wavelength, rng *r, const media_inside *in)
 {
     tex_env e = {c->sc, c->eps, c->s->use_ambient, c->max_level, c, thread, r, tex_cb_trace, tex_cb_direct,
-                 c->s->indirect ? tex_cb_indirect : NULL, &c->ts[thread].unsupported};
+                 c->s->indirect ? tex_cb_indirect : NULL, &c->ts[thread].unsupported, c->s->quality};
     hit_frame f = {h, dir, in};
     const hit_frame *outer = c->frame[thread];
     c->frame[thread] = &f;
@@ -377,7 +380,7 @@ static rgb along_ray(render_ctx *c, int thread, vec3 org, vec3 dir, double depth
 {
     int hollow = media_inside_hollow(in);
     if (!hollow) return col;
-    if (c->media) {
+    if (c->media && c->s->quality >= 9) { /* +Q: media from level 9 (Q_VOLUME) */
         media_env me = {c->sc, c, thread, r, media_light, hit};
         if (isfinite(depth) && in->n > 0 && media_inside_has_media(in))
             col = media_segment(&me, MEDIA_INTERIOR, in, org, dir, depth, col, 0);

@@ -57,6 +57,13 @@ typedef struct {
      * image's, bit for bit. */
     int window[4];
     progress *progress;     /* stages "render" and "antialias" count pixels (NULL: none) */
+    /* POV-Ray's +Q quality level, 0..9 (default 9: everything), as POV-Ray
+     * 3.7's QUALITY_n flags (povrayold.h): 0-1 pigment colour only, no
+     * lighting; 2-3 diffuse and ambient light without shadows; 4 shadows;
+     * 5 area lights (below: a point light at the centre); 6-7 refraction and
+     * transmission; 8 reflection and normal perturbation; 9 media. Quick
+     * colours (levels 0-5) are not modelled: pigments are evaluated. */
+    int quality;
 } shade_settings;
 
 typedef struct {

@@ -291,7 +291,8 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
 
     for (const scene_texture *layer = tex; layer && trans > bail && nl < MAX_LAYERS; layer = layer->next) {
         const scene_finish *f = &layer->finish;
-        vec3 ln = layer_normal(hi, layer, point, pf, npf);
+        /* +Q: normal perturbation from level 8 (POV-Ray's Q_NORMAL) */
+        vec3 ln = e->quality >= 8 ? layer_normal(hi, layer, point, pf, npf) : hi->raw;
         if (nl == 0) top = ln;
         double new_weight = weight * trans;
         colour5 lc = {0, 0, 0, 0, 0};
@@ -310,6 +311,14 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
         light_metallic_tint(&L->reflec, f->reflection_metallic, pig, cos_i);
 
         double att = hi->version < 3.7 ? 1.0 - (lc.f * tmax3(pig) + lc.t) : 1.0 - lc.f - lc.t;
+        if (e->quality <= 1) {
+            /* +Q0, +Q1 (Q_FULL_AMBIENT): the pigment's colour, unlit and
+             * opaque (POV-Ray 3.7 trace.cpp, ComputeLightedTexture) */
+            result = pig;
+            if (found) filcol = tmul(filcol, trgb(lc.r * lc.f + lc.t, lc.g * lc.f + lc.t, lc.b * lc.f + lc.t));
+            trans = fmin(1.0, fabs(GREY(filcol)));
+            continue;
+        }
         rgb tmp = {0, 0, 0};
         if (e->indirect && f->diffuse > 0.0) tmp = tadd(tmp, tscale(tmul(pig, e->indirect(e->ctx, e->thread, hi->h, ln)), f->diffuse * att));
         if (e->use_ambient) tmp = tadd(tmp, tscale(tmul(pig, tmul(f->ambient, sc->global.ambient_light)), att));
@@ -329,7 +338,7 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
     }
 
     int tir = 0;
-    if (trans > bail) {
+    if (trans > bail && e->quality >= 6) { /* +Q: refraction and transmission from level 6 (Q_REFRACT) */
         double w1 = fmax(fabs(filcol.r), fmax(fabs(filcol.g), fabs(filcol.b)));
         rgb rfr;
         tir = refraction(hi, top, weight * w1, &rfr);
@@ -339,7 +348,7 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
         else result = tadd(result, tmul(tmul(att, rfr), filcol));
     }
 
-    for (int i = 0; i < nl; i++) {
+    for (int i = 0; i < nl && e->quality >= 8; i++) { /* +Q: reflection from level 8 (Q_REFLECT) */
         if (tir && fabs(top.x - lr[i].normal.x) <= TEX_EPSILON && fabs(top.y - lr[i].normal.y) <= TEX_EPSILON &&
             fabs(top.z - lr[i].normal.z) <= TEX_EPSILON)
             continue;

@@ -38,6 +38,7 @@ typedef struct {
     /* GI indirect irradiance-like term at a diffuse layer (NULL = none). */
     rgb (*indirect)(void *ctx, int thread, const accel_hit *h, vec3 n);
     long *unsupported;   /* incremented when a hit uses something not evaluated (may be NULL) */
+    int quality;         /* POV-Ray's +Q level (shade_settings.quality): 9 everything */
 } tex_env;
 
 /* Colour seen along unit `dir` at hit h (the ray's level and weight as in

@@ -466,6 +466,79 @@ static void test_sigint_during_gi(void **st)
     assert_false(tu_exists(out));
 }
 
+/* Red (c 0) or blue (c 2) of pixel (x, y) of a PFM (rows stored bottom-up). */
+static double pfm_px(const char *path, int x, int y, int c)
+{
+    framebuffer *fb = NULL;
+    assert_int_equal(img_read(path, 0, &fb, NULL), PT_OK);
+    double v = fb_px(fb, x, y)[c];
+    fb_free(fb);
+    return v;
+}
+
+/* Lambert at a plane point (x, 0, z) under the light at (-3, 9, 0):
+ * ambient 0.1 + diffuse 0.5 * cos (POV-Ray: no distance fall-off). */
+static double plane_lit(double x, double z)
+{
+    double dx = -3 - x, dy = 9, dz = -z;
+    return 0.1 + 0.5 * dy / sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+/* +Q0..+Q11 as POV-Ray 3.7's quality flags (povrayold.h QUALITY_n): a
+ * white plane (ambient 0.1, diffuse 0.5, reflection 0.5) seen from above
+ * (orthographic, 8 x 6 units on 64 x 48 pixels), a red sphere shadowing it
+ * from an area light, a fully transparent sphere, a blue background. Pixel
+ * centres: O (16, 24) at (-1.9375, -0.0625) lit; S (44, 24) at (1.5625,
+ * -0.0625) in the red sphere's shadow; T (16, 8) on the transparent sphere
+ * over (-1.9375, 1.9375). Expected: 0-1 the pigment's colour, unlit; 2-3
+ * Lambert without shadows; 4 shadows, the area light as a point light at its
+ * centre (the image equals the point light's); 5 the area light's soft
+ * shadow; 6 the transparent sphere shows the plane; 8 the plane reflects the
+ * background (blue + 0.5); 10 and 11 are 9 (POV-Ray clips), 12 is refused. */
+static void test_quality_levels(void **st)
+{
+    (void)st;
+    char scene[512], cmd[4096], out[600];
+    snprintf(scene, sizeof scene, "%s/q.pov", tmpdir);
+    tu_write_file(scene, "global_settings { assumed_gamma 1 }\n"
+                         "camera { orthographic location <0, 10, 0> direction -y right 8*x up 6*z }\n"
+                         "background { rgb <0, 0, 1> }\n"
+                         "#ifndef (Point) #declare Point = 0; #end\n"
+                         "light_source { <-3, 9, 0> rgb 1 #if (!Point) area_light 2*x, 2*z, 5, 5 #end }\n"
+                         "plane { y, 0 pigment { rgb 1 } finish { ambient 0.1 diffuse 0.5 reflection 0.5 } }\n"
+                         "sphere { <0, 3, 0>, 0.5 pigment { rgb <1, 0, 0> } }\n"
+                         "sphere { <-2, 2, 2>, 0.5 pigment { rgbt <1, 1, 1, 1> } }\n");
+    const double o_lit = plane_lit(-1.9375, -0.0625), s_lit = plane_lit(1.5625, -0.0625), t_lit = plane_lit(-1.9375, 1.9375);
+    for (int q = 0; q <= 11; q++) {
+        snprintf(out, sizeof out, "%s/q%d.pfm", tmpdir, q);
+        snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 64x48 --threads 2 +Q%d -o '%s'", PARTRAY_BIN, scene, q, out);
+        assert_int_equal(tu_run_capture(cmd), 0);
+        if (q <= 5) assert_non_null(strstr(tu_out, "quick colours (levels 0-5) are not modelled"));
+        double O = pfm_px(out, 16, 24, 0), Ob = pfm_px(out, 16, 24, 2), S = pfm_px(out, 44, 24, 0), T = pfm_px(out, 16, 8, 0);
+        printf("+Q%d: O %.5f (blue %.5f), S %.5f, T %.5f\n", q, O, Ob, S, T);
+        double eO = q <= 1 ? 1.0 : o_lit;
+        double eOb = q <= 1 ? 1.0 : (q >= 8 ? o_lit + 0.5 : o_lit);
+        double eT = q <= 1 ? 1.0 : (q >= 6 ? t_lit : 0.0);
+        assert_true(fabs(O - eO) < 1e-4);
+        assert_true(fabs(Ob - eOb) < 1e-4);
+        assert_true(fabs(T - eT) < 1e-4);
+        if (q <= 1) assert_true(fabs(S - 1.0) < 1e-4);
+        else if (q <= 3) assert_true(fabs(S - s_lit) < 1e-4);
+        else if (q == 4) assert_true(fabs(S - 0.1) < 1e-4);
+        else assert_true(S > 0.1 + 1e-3 && S < s_lit); /* part of the area light reaches S */
+    }
+    /* +Q4: the area light is its centre point */
+    snprintf(out, sizeof out, "%s/p4.pfm", tmpdir);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 64x48 --threads 2 +Q4 -D Point=1 -q -o '%s' && cmp '%s' '%s/q4.pfm'",
+             PARTRAY_BIN, scene, out, out, tmpdir);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    snprintf(cmd, sizeof cmd, "cmp '%s/q9.pfm' '%s/q11.pfm'", tmpdir, tmpdir);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 64x48 +Q12", PARTRAY_BIN, scene);
+    assert_int_equal(tu_run_capture(cmd), 2);
+    assert_non_null(strstr(tu_out, "+Q wants a quality level 0 to 11"));
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/partray-cli-XXXXXX");
@@ -486,6 +559,7 @@ int main(void)
         cmocka_unit_test(test_progress_terminal),
         cmocka_unit_test(test_progress_plain_and_quiet),
         cmocka_unit_test(test_sigint_during_gi),
+        cmocka_unit_test(test_quality_levels),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     char cmd[600];
