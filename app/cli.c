@@ -6,8 +6,8 @@
  * (library path), +FE/+FN (format of an output named without extension),
  * +WTn (work threads), +Kc (clock), +KFIn +KFFn +KIc +KFc +KC (animation
  * frames and clocks, cyclic), +SFn +EFn (frame subset), +SCn +ECn +SRn +ERn
- * (render window), +Qn (quality 0-11, shade.h). Switches that only concern
- * files (+D, -D, +P, +V, +J...) are accepted and ignored. INI files and
+ * (render window), +Qn (quality 0-11, shade.h). Switches that only
+ * concern POV-Ray's display or its own files (+D, -D, +P, +V, +J...) are accepted and ignored. INI files and
  * Key=value options are expanded into these switches first (ini.h). */
 #include "cli.h"
 #include <errno.h>
