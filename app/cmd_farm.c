@@ -258,7 +258,7 @@ static void survey(const farm_plan *p, int merge, farm_state *s)
     }
 }
 
-static void progress(const farm_plan *p, const farm_state *s, double t0, int *last)
+static void farm_report(const farm_plan *p, const farm_state *s, double t0, int *last)
 {
     int key = s->frames_done * 100000 + s->tiles_done;
     if (key == *last) return;
@@ -381,7 +381,7 @@ static int run_with_progress(const farm_plan *p, char *const *argv, double t0, i
         if (g_stop) kill(pid, SIGTERM);
         farm_state s;
         survey(p, 0, &s);
-        progress(p, &s, t0, last);
+        farm_report(p, &s, t0, last);
         usleep(200000);
     }
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
@@ -392,7 +392,7 @@ static int run_parallel(const farm_plan *p, double t0)
     int last = -1;
     farm_state s0;
     survey(p, 1, &s0);
-    progress(p, &s0, t0, &last);
+    farm_report(p, &s0, t0, &last);
     if (s0.frames_done == p->last - p->first + 1) return 0;
     for (int round = 1; round <= p->max_rounds && !g_stop; round++) {
         char joblog[2200], tasks[2200], jobs[32], retries[32], rp[2200];
@@ -424,7 +424,7 @@ static int run_parallel(const farm_plan *p, double t0)
         fprintf(stderr, "farm: round %d: GNU parallel exit %d\n", round, rc);
         farm_state s;
         survey(p, 1, &s);
-        progress(p, &s, t0, &last);
+        farm_report(p, &s, t0, &last);
         if (s.frames_done == p->last - p->first + 1) return 0;
         if (s.failed && !s.nretry) {
             fprintf(stderr, "farm: %s\n", s.why);
@@ -479,14 +479,14 @@ static int run_slurm(const farm_plan *p, double t0)
             return 130;
         }
         survey(p, 0, &s);
-        progress(p, &s, t0, &last);
+        farm_report(p, &s, t0, &last);
         char *t = subproc_read_text(state, NULL);
         if (t) {
             int done = strncmp(t, "done", 4) == 0;
             if (!done) fprintf(stderr, "farm: %s", t);
             free(t);
             survey(p, 0, &s);
-            progress(p, &s, t0, &last);
+            farm_report(p, &s, t0, &last);
             return done ? 0 : 1;
         }
         if (p->timeout > 0 && timer_now() - t0 > p->timeout) {
