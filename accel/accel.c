@@ -1417,12 +1417,9 @@ static void fill_triangle(const accel *a, const accel_leaf *l, unsigned local, d
     hit->flags = l->flags;
 }
 
-int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, accel_hit *hit)
+/* accel_intersect with the effective tmin t0 as given. */
+static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tmax, accel_hit *hit)
 {
-    if (!a || !ray_ok(org, dir)) return 0;
-    double t0 = eps_rule(a->eps_scale, org, v3_len(dir));
-    if (tmin > t0) t0 = tmin;
-    if (!(tmax > t0)) return 0;
     accel_query q;
     rtcInitIntersectContext(&q.rtc);
     q.org = org;
@@ -1491,6 +1488,66 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
     return isfinite(hit->t) && v3_finite(hit->p);
 }
 
+int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, accel_hit *hit)
+{
+    if (!a || !ray_ok(org, dir)) return 0;
+    double t0 = eps_rule(a->eps_scale, org, v3_len(dir));
+    if (tmin > t0) t0 = tmin;
+    if (!(tmax > t0)) return 0;
+    return intersect_at(a, org, dir, t0, tmax, hit);
+}
+
+/* Contacts (accel_intersect_from): inside the self-intersection distance
+ * t_eps a hit counts unless it is on the surface left (same object and
+ * part or triangle) or on a surface parallel to it within CONTACT_COS,
+ * where a float re-hit of the surface or of its coplanar neighbour (the
+ * other triangle of a quad) can fall; `skip` flags also pass. Searches
+ * from CONTACT_REL * t_eps on. */
+#define CONTACT_COS 0.99
+#define CONTACT_REL 1e-4
+static int contact_hit(const accel *a, const accel_from *f, vec3 org, vec3 dir, double t_eps, unsigned skip,
+                       accel_hit *hit)
+{
+    double lo = CONTACT_REL * t_eps;
+    for (int k = 0; k < 8 && lo < t_eps; k++) {
+        if (!intersect_at(a, org, dir, lo, t_eps, hit)) return 0;
+        int own = hit->obj == f->obj && hit->prim == f->prim;
+        double c = v3_dot(hit->ng, f->ng);
+        double nn = v3_len(hit->ng) * v3_len(f->ng);
+        int parallel = nn > 0.0 && fabs(c) > CONTACT_COS * nn;
+        if (!own && !parallel && !(hit->flags & skip)) return 1;
+        lo = hit->t + fmax(lo, hit->t * 1e-7);
+    }
+    return 0;
+}
+
+void accel_from_hit(accel_from *f, const accel_hit *h)
+{
+    f->obj = h->obj;
+    f->prim = h->prim;
+    f->ng = h->ng;
+}
+
+int accel_intersect_from(const accel *a, const accel_from *f, vec3 org, vec3 dir, double tmin, double tmax,
+                         accel_hit *hit)
+{
+    if (!a || !ray_ok(org, dir)) return 0;
+    double t0 = eps_rule(a->eps_scale, org, v3_len(dir));
+    if (tmin > t0) t0 = tmin;
+    if (f && contact_hit(a, f, org, dir, fmin(t0, tmax), 0u, hit)) return 1;
+    return accel_intersect(a, org, dir, tmin, tmax, hit);
+}
+
+int accel_occluded_from(const accel *a, const accel_from *f, vec3 org, vec3 dir, double tmin, double tmax)
+{
+    if (!a || !ray_ok(org, dir)) return 0;
+    double t0 = eps_rule(a->eps_scale, org, v3_len(dir));
+    if (tmin > t0) t0 = tmin;
+    accel_hit h;
+    if (f && contact_hit(a, f, org, dir, fmin(t0, tmax), OBJ_NO_SHADOW, &h)) return 1;
+    return accel_occluded(a, org, dir, tmin, tmax);
+}
+
 int accel_mutually_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, accel_same_fn same,
                            const void *ctx)
 {
@@ -1500,6 +1557,17 @@ int accel_mutually_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, 
     double len = v3_len(d);
     if (!(len > 2.0 * lift)) return 1;
     d = v3_scale(d, 1.0 / len);
+    /* within the self-intersection distance of p: an object that is not
+     * "same" blocks unless it lies parallel to x's surface (contacts, as
+     * accel_intersect_from) */
+    double t_eps = fmin(eps_rule(a->eps_scale, p, 1.0), len);
+    for (double lo = CONTACT_REL * t_eps; lo < t_eps;) {
+        accel_hit h;
+        if (!intersect_at(a, p, d, lo, t_eps, &h)) break;
+        double c = v3_dot(h.ng, nx), nn = v3_len(h.ng) * v3_len(nx);
+        if (!same(h.obj, ctx) && !(nn > 0.0 && fabs(c) > CONTACT_COS * nn)) return 0;
+        lo = h.t + fmax(lo, h.t * 1e-7);
+    }
     double tmin = 0.0;
     for (int k = 0; k < 8; k++) {
         accel_hit h;

@@ -66,14 +66,33 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
 /* Mutual visibility of two surface points for density estimates: 1 when
  * the segment from x + lift*nx to y + lift*ny (lift = 16 eps) crosses no
  * object for which same(obj, ctx) is 0; crossings of "same" objects are
- * stepped over (at most 8). Points closer than twice the lift count as
- * visible. Used by particle GI's estimation lists and pmfg's photon
+ * stepped over (at most 8); inside the self-intersection distance only
+ * objects parallel to x's surface pass (contacts, see accel_intersect_from).
+ * Points closer than twice the lift count as visible. Used by particle GI's estimation lists and pmfg's photon
  * gathering, so neither reaches across a wall. */
 typedef int (*accel_same_fn)(const scene_object *obj, const void *ctx);
 int accel_mutually_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, accel_same_fn same,
                            const void *ctx);
 /* Any hit in (tmin, tmax) by an object that casts shadows (not no_shadow). */
 int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax);
+
+/* The surface a ray leaves: the hit it starts from. */
+typedef struct {
+    const scene_object *obj;
+    unsigned prim;
+    vec3 ng;
+} accel_from;
+void accel_from_hit(accel_from *f, const accel_hit *h);
+/* accel_intersect and accel_occluded for a ray leaving surface f (NULL:
+ * the plain queries) at a point moved off it: within the self-intersection
+ * distance (the rule above) other surfaces are hit too, so a point at a
+ * contact (a floor point at the foot of a box standing on it) is not lit
+ * through the box, nor do its rays pass into it; only the surface left and
+ * surfaces parallel to it (within about 8 degrees: a float re-hit of a
+ * coplanar neighbour) are passed there, as before. */
+int accel_intersect_from(const accel *a, const accel_from *f, vec3 org, vec3 dir, double tmin, double tmax,
+                         accel_hit *hit);
+int accel_occluded_from(const accel *a, const accel_from *f, vec3 org, vec3 dir, double tmin, double tmax);
 /* accel_occluded for n rays at once (Embree packets of 16, flagged
  * coherent: shadow rays towards one light from neighbouring points): out[k]
  * = 1 when ray k is blocked. Same effective tmin rule; analytic shapes see

@@ -186,8 +186,9 @@ static pt_status render_reference(const scene *sc, const accel *a, const render_
     } else {
         pm_fg_settings fs;
         pm_fg_default_settings(&fs);
+        const int eye_spp = fs.c.spp;
         fill_common(&fs.c, o, &pc);
-        if (o->spp <= 1) fs.c.spp = 1;
+        if (o->spp <= 1) fs.c.spp = eye_spp; /* --spp 1 (the CLI's default): pmfg's own (pm_fg.h) */
         if (o->fg_rays > 0) fs.fg_rays = o->fg_rays;
         if (o->photons > 0) fs.photons = o->photons;
         st = pm_fg_render(sc, a, &fs, fb, &r->pm, d);

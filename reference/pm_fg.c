@@ -23,6 +23,7 @@
 #include "pm_nee.h"
 #include "pm_photon.h"
 #include "pool.h"
+#include "radrules.h"
 #include "shade_material.h"
 #include "timer.h"
 
@@ -35,7 +36,11 @@ void pm_fg_default_settings(pm_fg_settings *s)
 {
     memset(s, 0, sizeof *s);
     pm_common_defaults(&s->c);
-    s->c.spp = 1;
+    /* 16 eye samples per pixel, the gather rays split over them: with one
+     * jittered eye sample a pixel on a silhouette or a contact takes one
+     * side only (black and bright pixels along the room's edges and block
+     * tops of radiosity/cornell.pov against an antialiased path image) */
+    s->c.spp = 16;
     s->photons = 1000000;
     s->fg_rays = 4096;
     s->k_global = 64;
@@ -60,6 +65,8 @@ typedef struct {
     int k_global, k_caustic;
     int fg_per_sample;
     pm_neighbour *scratch; /* KMAX per thread */
+    radrules rr;           /* POV-Ray's rules for gathered light (core/radrules.h) */
+    int gathers;           /* recursion_limit: gathering steps from the eye */
 } fg_ctx;
 
 static inline rgb frgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
@@ -71,11 +78,11 @@ static inline void acc_add(rgb *a, rgb t, rgb v)
 }
 static inline double fmax3(rgb t) { return fmax(t.r, fmax(t.g, t.b)); }
 
-static int trace_skip(const fg_ctx *c, vec3 org, vec3 dir, unsigned skip, accel_hit *h)
+static int trace_skip(const fg_ctx *c, const accel_from *from, vec3 org, vec3 dir, unsigned skip, accel_hit *h)
 {
     double tmin = c->eps;
     for (int k = 0; k < SKIP_MAX; k++) {
-        if (!accel_intersect(c->a, org, dir, tmin, INFINITY, h)) return 0;
+        if (!accel_intersect_from(c->a, k == 0 ? from : NULL, org, dir, tmin, INFINITY, h)) return 0;
         if (!(h->flags & skip)) return 1;
         tmin = h->t + fmax(c->eps, h->t * 1e-7);
     }
@@ -201,11 +208,13 @@ static rgb gather_hit(const fg_ctx *c, const mat_bsdf *b, uint32_t surf, int lev
         L.g += d.g;
         L.b += d.b;
     }
-    if (b->m[MAT_LOBE_DIFFUSE] > 0.0 || b->m[MAT_LOBE_BACK] > 0.0) {
+    /* the gather hit gathers in its turn (emitters, photon irradiance) only
+     * within recursion_limit; emitters' light is gathered light: brightness */
+    if (c->gathers >= 2 && (b->m[MAT_LOBE_DIFFUSE] > 0.0 || b->m[MAT_LOBE_BACK] > 0.0)) {
         rgb d = pm_direct_emitters(c->L, b, 1, 0.0, 0.0, r, &cnt->shadow);
-        L.r += d.r;
-        L.g += d.g;
-        L.b += d.b;
+        L.r += d.r * c->rr.brightness;
+        L.g += d.g * c->rr.brightness;
+        L.b += d.b * c->rr.brightness;
         if (b->m[MAT_LOBE_DIFFUSE] > 0.0) {
             rgb e = global_irradiance(c, b->p, b->n, surf, thread, &cnt->shadow);
             acc_add(&L, b->k[MAT_LOBE_DIFFUSE], frgb(e.r / M_PI, e.g / M_PI, e.b / M_PI));
@@ -227,11 +236,13 @@ static rgb gather_hit(const fg_ctx *c, const mat_bsdf *b, uint32_t surf, int lev
             vec3 dir = lobe == MAT_LOBE_REFLECT ? b->refl_dir : b->trans_dir;
             cnt->bsdf++;
             accel_hit h;
-            if (!trace_skip(c, org, dir, lobe == MAT_LOBE_REFLECT ? OBJ_NO_REFLECTION : 0u, &h)) {
+            unsigned skip = OBJ_NO_RADIOSITY | (lobe == MAT_LOBE_REFLECT ? OBJ_NO_REFLECTION : 0u);
+            if (!trace_skip(c, &b->from, org, dir, skip, &h)) {
                 acc_add(&L, w, pm_sky(c->sc, dir));
             } else {
                 mat_bsdf b2;
                 mat_setup(&b2, c->sc, &h, dir, c->eps, r);
+                b2.gathered = 1;
                 acc_add(&L, w, b2.emission);
                 acc_add(&L, w, gather_hit(c, &b2, pm_surface_key(h.obj, b2.entering), level + 1, thread, r, cnt));
             }
@@ -263,7 +274,7 @@ static rgb gather_lobe(const fg_ctx *c, const mat_bsdf *b, vec3 axis, vec3 org, 
         if (front ? cg <= 0.0 : cg >= 0.0) continue;
         cnt->gather++;
         accel_hit h;
-        if (!accel_intersect(c->a, org, w, c->eps, INFINITY, &h)) {
+        if (!trace_skip(c, &b->from, org, w, OBJ_NO_RADIOSITY, &h)) {
             rgb bg = pm_sky(c->sc, w);
             sum.r += bg.r;
             sum.g += bg.g;
@@ -272,6 +283,7 @@ static rgb gather_lobe(const fg_ctx *c, const mat_bsdf *b, vec3 axis, vec3 org, 
         }
         mat_bsdf b2;
         mat_setup(&b2, c->sc, &h, w, c->eps, r);
+        b2.gathered = 1;
         rgb le = b2.emission;
         if (le.r != 0.0 || le.g != 0.0 || le.b != 0.0) {
             double cosx = fabs(v3_dot(w, b->n));
@@ -289,12 +301,12 @@ static rgb gather_lobe(const fg_ctx *c, const mat_bsdf *b, vec3 axis, vec3 org, 
     return frgb(sum.r / n, sum.g / n, sum.b / n);
 }
 
-static void eye_trace(const fg_ctx *c, vec3 org, vec3 dir, unsigned skip, rgb T, int depth, int thread, rng *r,
-                      pm_counts *cnt, rgb *L)
+static void eye_trace(const fg_ctx *c, const accel_from *from, vec3 org, vec3 dir, unsigned skip, rgb T, int depth,
+                      int thread, rng *r, pm_counts *cnt, rgb *L)
 {
     if (depth >= c->s->max_eye_depth) return;
     accel_hit h;
-    if (!trace_skip(c, org, dir, skip, &h)) {
+    if (!trace_skip(c, from, org, dir, skip, &h)) {
         acc_add(L, T, pm_sky(c->sc, dir));
         return;
     }
@@ -312,7 +324,10 @@ static void eye_trace(const fg_ctx *c, vec3 org, vec3 dir, unsigned skip, rgb T,
         int nb = mb > 0.0 ? ng - nf : 0;
         if (md > 0.0 && nf < 1) nf = 1;
         if (mb > 0.0 && nb < 1) nb = 1;
-        acc_add(L, T, pm_direct_emitters(c->L, &b, c->s->emitter_samples, nf, nb, r, &cnt->shadow));
+        /* gathered light (emitters, the final gather) is scaled by brightness */
+        const double br = c->rr.brightness;
+        const rgb Tg = frgb(T.r * br, T.g * br, T.b * br);
+        acc_add(L, Tg, pm_direct_emitters(c->L, &b, c->s->emitter_samples, nf, nb, r, &cnt->shadow));
         if (c->caustic && pm_kdtree_size(c->caustic) > 0) {
             pm_neighbour *sc = c->scratch + (size_t)thread * KMAX;
             uint32_t key = pm_surface_key(h.obj, b.entering);
@@ -332,12 +347,12 @@ static void eye_trace(const fg_ctx *c, vec3 org, vec3 dir, unsigned skip, rgb T,
         cnt->gather_points++;
         if (nf > 0) {
             rgb g = gather_lobe(c, &b, b.n, b.p_out, 1, nf, nf, nb, thread, r, cnt);
-            acc_add(L, T, frgb(b.k[MAT_LOBE_DIFFUSE].r * g.r, b.k[MAT_LOBE_DIFFUSE].g * g.g,
+            acc_add(L, Tg, frgb(b.k[MAT_LOBE_DIFFUSE].r * g.r, b.k[MAT_LOBE_DIFFUSE].g * g.g,
                                b.k[MAT_LOBE_DIFFUSE].b * g.b));
         }
         if (nb > 0) {
             rgb g = gather_lobe(c, &b, v3_neg(b.n), b.p_in, 0, nb, nf, nb, thread, r, cnt);
-            acc_add(L, T, frgb(b.k[MAT_LOBE_BACK].r * g.r, b.k[MAT_LOBE_BACK].g * g.g, b.k[MAT_LOBE_BACK].b * g.b));
+            acc_add(L, Tg, frgb(b.k[MAT_LOBE_BACK].r * g.r, b.k[MAT_LOBE_BACK].g * g.g, b.k[MAT_LOBE_BACK].b * g.b));
         }
     }
     /* specular lobes: both followed (Whitted-style), small weights by roulette */
@@ -353,9 +368,9 @@ static void eye_trace(const fg_ctx *c, vec3 org, vec3 dir, unsigned skip, rgb T,
         }
         cnt->bsdf++;
         if (lobe == MAT_LOBE_REFLECT)
-            eye_trace(c, b.p_out, b.refl_dir, OBJ_NO_REFLECTION, T2, depth + 1, thread, r, cnt, L);
+            eye_trace(c, &b.from, b.p_out, b.refl_dir, OBJ_NO_REFLECTION, T2, depth + 1, thread, r, cnt, L);
         else
-            eye_trace(c, b.p_in, b.trans_dir, skip, T2, depth + 1, thread, r, cnt, L);
+            eye_trace(c, &b.from, b.p_in, b.trans_dir, skip, T2, depth + 1, thread, r, cnt, L);
     }
 }
 
@@ -366,7 +381,7 @@ static rgb fg_sample(void *ctx, double px, double py, int thread, rng *r, pm_cou
     scene_camera_ray(&c->sc->camera, px, py, c->s->c.width, c->s->c.height, &org, &dir);
     cnt->camera++;
     rgb L = {0, 0, 0}, T = {1, 1, 1};
-    eye_trace(c, org, dir, OBJ_NO_IMAGE, T, 0, thread, r, cnt, &L);
+    eye_trace(c, NULL, org, dir, OBJ_NO_IMAGE, T, 0, thread, r, cnt, &L);
     return L;
 }
 
@@ -420,6 +435,8 @@ pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s,
     c.s = s;
     c.L = L;
     c.eps = pm_lights_eps(L);
+    c.rr = radrules_of(sc, 1);
+    c.gathers = c.rr.recursion_limit > 0 ? c.rr.recursion_limit : 1 << 20;
     double scale = accel_scale(a);
     if (!(scale > 0.0) || !isfinite(scale)) scale = 1.0;
     c.r_global = s->radius_global > 0.0 ? s->radius_global : 0.1 * scale;

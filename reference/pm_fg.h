@@ -30,7 +30,7 @@
 #include "pm.h"
 
 typedef struct {
-    pm_common c;             /* c.spp: eye samples per pixel (default 1) */
+    pm_common c;             /* c.spp: eye samples per pixel (default 16, stratified: edges antialiased) */
     long photons;            /* photon paths emitted (default 1,000,000) */
     int fg_rays;             /* final-gather rays per pixel (default 4096), split evenly over the
                                 eye samples; fewer at eye vertices behind weak specular lobes */

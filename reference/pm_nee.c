@@ -27,7 +27,9 @@ struct pm_lights {
 static double emit_weight(void *ctx, const scene_object *leaf, const scene_texture *tex, unsigned flags)
 {
     (void)leaf;
-    (void)flags;
+    /* emissive surfaces light others only through gathering rays, which
+     * no_radiosity objects do not meet (core/radrules.h rule 3) */
+    if (!radrules_gathers(flags)) return 0.0;
     const scene *sc = ctx;
     rgb e = mat_texture_emission(sc, tex);
     double w = fmax(fabs(e.r), fmax(fabs(e.g), fabs(e.b)));
@@ -174,8 +176,9 @@ rgb pm_direct_one_light(const pm_lights *L, const mat_bsdf *b, rng *r, long *sha
 }
 
 /* Visibility of y from o: nothing in between (emitters are found by BSDF
- * rays with accel_intersect, so no_shadow objects block here too). */
-static int visible(const pm_lights *L, vec3 o, vec3 y, vec3 *dir, double *dist)
+ * rays with accel_intersect, so no_shadow objects block here too), except
+ * no_radiosity objects, which gathering rays pass (radrules.h rule 3). */
+static int visible(const pm_lights *L, const accel_from *from, vec3 o, vec3 y, vec3 *dir, double *dist)
 {
     vec3 d = v3_sub(y, o);
     double len = v3_len(d);
@@ -185,7 +188,14 @@ static int visible(const pm_lights *L, vec3 o, vec3 y, vec3 *dir, double *dist)
     double tmax = len - fmax(L->eps, len * 1e-5);
     if (tmax <= L->eps) return 1;
     accel_hit h;
-    return !accel_intersect(L->a, o, *dir, L->eps, tmax, &h);
+    double tmin = L->eps;
+    for (int k = 0; k < 64; k++) {
+        if (!accel_intersect_from(L->a, k == 0 ? from : NULL, o, *dir, tmin, tmax, &h)) return 1;
+        if (radrules_gathers(h.flags)) return 0;
+        tmin = h.t + fmax(L->eps, h.t * 1e-7);
+        if (tmin >= tmax) return 1;
+    }
+    return 0;
 }
 
 rgb pm_direct_emitters(const pm_lights *L, const mat_bsdf *b, int n_light, double bsdf_front, double bsdf_back, rng *r,
@@ -220,7 +230,7 @@ rgb pm_direct_emitters(const pm_lights *L, const mat_bsdf *b, int n_light, doubl
         double cos_y = fabs(v3_dot(s.n, wi));
         if (!(cos_y > 1e-12)) continue;
         if (shadow_rays) (*shadow_rays)++;
-        if (!visible(L, o, s.p, &wi, &dist)) continue;
+        if (!visible(L, &b->from, o, s.p, &wi, &dist)) continue;
         double p_l = s.pdf_area * dist * dist / cos_y;
         double cos_x = fabs(v3_dot(b->n, wi));
         double c_b = (v3_dot(b->n, wi) > 0.0 ? bsdf_front : bsdf_back) * cos_x / M_PI;

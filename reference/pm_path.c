@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "pm_nee.h"
+#include "radrules.h"
 #include "shade_material.h"
 #include "timer.h"
 
@@ -38,14 +39,16 @@ typedef struct {
     const pm_lights *L;
     double eps;
     int max_depth;
+    radrules rr;
+    int gathers;       /* diffuse bounces a path may take (the radiosity recursion_limit) */
 } path_ctx;
 
 /* Nearest hit not carrying any of the `skip` flags. */
-static int trace_skip(const path_ctx *c, vec3 org, vec3 dir, unsigned skip, accel_hit *h)
+static int trace_skip(const path_ctx *c, const accel_from *from, vec3 org, vec3 dir, unsigned skip, accel_hit *h)
 {
     double tmin = c->eps;
     for (int k = 0; k < SKIP_MAX; k++) {
-        if (!accel_intersect(c->a, org, dir, tmin, INFINITY, h)) return 0;
+        if (!accel_intersect_from(c->a, k == 0 ? from : NULL, org, dir, tmin, INFINITY, h)) return 0;
         if (!(h->flags & skip)) return 1;
         tmin = h->t + fmax(c->eps, h->t * 1e-7);
     }
@@ -59,17 +62,22 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
     (void)thread;
     const path_ctx *c = ctx;
     const scene *sc = c->sc;
+    const double bright = c->rr.brightness;
     vec3 org, dir;
     scene_camera_ray(&sc->camera, px, py, c->s->c.width, c->s->c.height, &org, &dir);
     cnt->camera++;
     rgb L = {0, 0, 0}, T = {1, 1, 1};
     unsigned skip = OBJ_NO_IMAGE;
+    unsigned gskip = 0; /* OBJ_NO_RADIOSITY once the path has gathered (radrules rule 3) */
+    int nd = 0;         /* diffuse bounces so far */
     int prev_spec = 1;
     double prev_cb = 0.0;
     vec3 prev_org = org;
+    accel_from from; /* the surface the ray leaves (contacts, accel_intersect_from) */
+    const accel_from *fromp = NULL;
     for (int depth = 0;; depth++) {
         accel_hit h;
-        if (!trace_skip(c, org, dir, skip, &h)) {
+        if (!trace_skip(c, fromp, org, dir, skip | gskip, &h)) {
             rgb sky = pm_sky(sc, dir); /* background and sky_sphere */
             L.r += T.r * sky.r;
             L.g += T.g * sky.g;
@@ -78,6 +86,7 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
         }
         mat_bsdf b;
         mat_setup(&b, sc, &h, dir, c->eps, r);
+        b.gathered = nd > 0;
         if (b.unsupported) cnt->unsupported++;
         rgb le = b.emission;
         if (le.r != 0.0 || le.g != 0.0 || le.b != 0.0) {
@@ -88,22 +97,32 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
             L.b += T.b * le.b * w;
         }
         int last = depth + 1 >= c->max_depth;
+        int gather = nd < c->gathers; /* this vertex may gather (diffuse lobes continue) */
         if (b.nee) {
             rgb d = pm_direct_lights(c->L, &b, c->s->area_samples, r, &cnt->shadow);
             L.r += T.r * d.r;
             L.g += T.g * d.g;
             L.b += T.b * d.b;
         }
-        if ((b.m[MAT_LOBE_DIFFUSE] > 0.0 || b.m[MAT_LOBE_BACK] > 0.0) && b.msum > 0.0) {
+        if (gather && (b.m[MAT_LOBE_DIFFUSE] > 0.0 || b.m[MAT_LOBE_BACK] > 0.0) && b.msum > 0.0) {
+            /* emissive surfaces light others as gathered light: brightness applies */
             double bf = last ? 0.0 : b.m[MAT_LOBE_DIFFUSE] / b.msum, bb = last ? 0.0 : b.m[MAT_LOBE_BACK] / b.msum;
             rgb d = pm_direct_emitters(c->L, &b, 1, bf, bb, r, &cnt->shadow);
-            L.r += T.r * d.r;
-            L.g += T.g * d.g;
-            L.b += T.b * d.b;
+            L.r += T.r * d.r * bright;
+            L.g += T.g * d.g * bright;
+            L.b += T.b * d.b * bright;
         }
         if (last) break;
         mat_scatter s;
         if (!mat_sample(&b, r, 0, &s)) break;
+        if (!s.specular) {
+            if (!gather) break; /* past recursion_limit: only the specular lobes go on */
+            T.r *= bright;
+            T.g *= bright;
+            T.b *= bright;
+            nd++;
+            gskip = OBJ_NO_RADIOSITY;
+        }
         T.r *= s.weight.r;
         T.g *= s.weight.g;
         T.b *= s.weight.b;
@@ -129,6 +148,8 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
         org = s.org;
         dir = s.dir;
         prev_org = s.org;
+        from = b.from;
+        fromp = &from;
         cnt->bsdf++;
     }
     return L;
@@ -148,7 +169,8 @@ pt_status pm_path_render(const scene *sc, const accel *a, const pm_path_settings
     st->emitter_pieces = accel_surf_count(pm_lights_emitters(L));
     double t1 = timer_now();
     st->t_lights = t1 - t0;
-    path_ctx c = {sc, a, s, L, pm_lights_eps(L), s->max_depth > 0 ? s->max_depth : HARD_DEPTH};
+    path_ctx c = {sc, a, s, L, pm_lights_eps(L), s->max_depth > 0 ? s->max_depth : HARD_DEPTH, radrules_of(sc, 1), 0};
+    c.gathers = c.rr.recursion_limit > 0 ? c.rr.recursion_limit : HARD_DEPTH;
     if (c.max_depth > HARD_DEPTH) c.max_depth = HARD_DEPTH;
     status = pm_image_render(sc, &s->c, 16, fb, path_sample, &c, st);
     double t2 = timer_now();

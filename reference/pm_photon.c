@@ -6,12 +6,8 @@
  * density p(w) (per solid angle), N of them; the number landing on a patch
  * dA at distance d with cosine cos is N p(w) dA cos / d^2, so giving each
  * the power Phi = pi C att d^2 / (N p(w)) makes the flux density
- * Phi * N p(w) cos / d^2 = pi C att cos = E. For a point on an area light
- * (uniform over the parallelogram) the same holds per point, with the
- * attenuation evaluated from that point (as `area_illumination on` does;
- * shade.c otherwise takes the spot/fade factor from the light's centre, a
- * difference of second order in the light's size that only reaches the
- * indirect light). Parallel and cylinder lights send photons along their
+ * Phi * N p(w) cos / d^2 = pi C att cos = E. An area light shoots from
+ * its centre, as POV-Ray's photons and its radiosity rays see it. Parallel and cylinder lights send photons along their
  * fixed direction from a disc of area A perpendicular to it: flux density
  * per unit perpendicular area N/A, so Phi = pi C att A / N. Emissive surfaces
  * of radiance Le (both sides): point y with area density p_A, side 1/2,
@@ -32,6 +28,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "pool.h"
+#include "radrules.h"
 #include "shade_light.h"
 #include "shade_material.h"
 
@@ -84,6 +81,8 @@ typedef struct {
     int targets;       /* some object has photons { target }: caustic paths bounce on targets only */
     vec3 centre;       /* bounding sphere of finite geometry */
     double radius;
+    radrules rr;       /* POV-Ray's rules for gathered light (core/radrules.h) */
+    int gathers;       /* recursion_limit: gathering steps light may take to the eye */
 } trace_ctx;
 
 static inline rgb crgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
@@ -122,14 +121,16 @@ static vec3 disc_point(vec3 c, vec3 axis, double radius, double u1, double u2)
 /* photons { pass_through }: photons go through the object unchanged. */
 static int pass_through(const accel_hit *h) { return h->obj && h->obj->photons && h->obj->photons->pass_through; }
 
-/* Next hit of a photon, past pass_through objects. */
-static int photon_intersect(const trace_ctx *c, vec3 o, vec3 w, accel_hit *h, long *rays)
+/* Next hit of a photon, past pass_through objects and objects with any of
+ * the `skip` flags. */
+static int photon_intersect(const trace_ctx *c, const accel_from *from, vec3 o, vec3 w, unsigned skip, accel_hit *h,
+                            long *rays)
 {
     double tmin = c->eps;
     for (int k = 0; k < SKIP_MAX; k++) {
         (*rays)++;
-        if (!accel_intersect(c->a, o, w, tmin, INFINITY, h)) return 0;
-        if (!pass_through(h)) return 1;
+        if (!accel_intersect_from(c->a, k == 0 ? from : NULL, o, w, tmin, INFINITY, h)) return 0;
+        if (!pass_through(h) && !(h->flags & skip)) return 1;
         tmin = h->t + fmax(c->eps, h->t * 1e-7);
     }
     return 0;
@@ -206,17 +207,10 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
             *phi = crgb(C.r * k, C.g * k, C.b * k);
             return 1;
         }
+        /* an area light shoots from its centre: POV-Ray's photons do
+         * (photons.cpp: the area only with the light's photons { area_light }),
+         * and so does the direct light its gathering rays see (radrules.h) */
         vec3 q = l->position;
-        if (light_extended(l)) {
-            double u = rng_f64(r), v = rng_f64(r);
-            vec3 e1 = l->size1 > 1 ? l->axis1 : v3s(0.0), e2 = l->size2 > 1 ? l->axis2 : v3s(0.0);
-            if (l->circular && l->size1 > 1 && l->size2 > 1) {
-                double rho = 0.5 * sqrt(u), ph = 2.0 * M_PI * v;
-                q = v3_add(q, v3_add(v3_scale(e1, rho * cos(ph)), v3_scale(e2, rho * sin(ph))));
-            } else {
-                q = v3_add(q, v3_add(v3_scale(e1, u - 0.5), v3_scale(e2, v - 0.5)));
-            }
-        }
         vec3 axis = v3(0, 0, 1);
         double cos_max = src->cos_max;
         if (l->kind == LIGHT_SPOT) axis = v3_norm(v3_sub(l->point_at, l->position));
@@ -242,7 +236,7 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         double u4 = rng_f64(r), u5 = rng_f64(r);
         *w = mat_cosine_dir(ns, u4, u5);
         vec3 o = v3_madd(s.p, ns, c->eps);
-        if (!photon_intersect(c, o, *w, h, rays)) return 0;
+        if (!photon_intersect(c, NULL, o, *w, OBJ_NO_RADIOSITY, h, rays)) return 0;
         rgb le = pm_lights_piece_emission(c->L, &s);
         double k = 2.0 * M_PI / (n * s.pdf_area);
         *phi = crgb(le.r * k, le.g * k, le.b * k);
@@ -255,7 +249,7 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
     double u3 = rng_f64(r), u4 = rng_f64(r);
     vec3 o = disc_point(v3_madd(c->centre, wd, -R * 1.001), wd, R, u3, u4);
     *w = wd;
-    if (!photon_intersect(c, o, wd, h, rays)) return 0;
+    if (!photon_intersect(c, NULL, o, wd, OBJ_NO_RADIOSITY, h, rays)) return 0;
     /* it arrives from the sky in direction -wd */
     rgb bg = pm_sky(c->sc, v3_neg(wd));
     double k = 4.0 * M_PI * M_PI * R * R / n;
@@ -280,16 +274,27 @@ static void trace_one(const trace_ctx *c, const source *src, long index, chunk_o
      * there (shade.c); after the first bounce the light is indirect and
      * reaches everything */
     if (from_light && !scene_light_reaches(src->l, h.obj)) return;
+    /* POV-Ray's rules (radrules.h): what a no_radiosity object reflects
+     * reaches no gathering ray; light that has been gathered g times (g
+     * diffuse bounces of a light's photon; one more for emitted and sky
+     * light, which reach any surface only by gathering) is scaled by
+     * brightness^g, and reaches the eye (one more gathering) only while
+     * g + 1 <= recursion_limit. */
+    if (!radrules_gathers(h.flags)) return;
+    int nd = 0;
     for (int bounce = 0;; bounce++) {
         mat_bsdf b;
         mat_setup(&b, c->sc, &h, w, c->eps, &r);
         int lambert = b.m[MAT_LOBE_DIFFUSE] > 0.0 || b.m[MAT_LOBE_BACK] > 0.0;
         int collect = !(h.obj && h.obj->photons && !h.obj->photons->collect); /* photons { collect off } */
-        if (lambert && collect && (bounce >= 1 || store_first) && cmax(phi) > 0.0) {
+        int g = from_light ? nd : nd + 1;
+        if (lambert && collect && (bounce >= 1 || store_first) && g + 1 <= c->gathers && cmax(phi) > 0.0) {
             /* stored on the side of the object it arrived at (pm_kdtree.h) */
             uint32_t key = pm_surface_key(h.obj, b.entering);
             if (out->ng + out->nc >= out->cap) { out->dropped++; return; }
-            if (!push(&out->g, &out->ng, &out->cg, h.p, phi, b.ng, key)) { out->oom = 1; return; }
+            double bk = g > 0 ? pow(c->rr.brightness, g) : 1.0;
+            rgb pg = crgb(phi.r * bk, phi.g * bk, phi.b * bk);
+            if (!push(&out->g, &out->ng, &out->cg, h.p, pg, b.ng, key)) { out->oom = 1; return; }
             if (c->s->caustics && from_light && spec_only && bounce >= 1)
                 if (!push(&out->c, &out->nc, &out->cc, h.p, phi, b.ng, key)) { out->oom = 1; return; }
         }
@@ -298,7 +303,11 @@ static void trace_one(const trace_ctx *c, const source *src, long index, chunk_o
         if (!mat_sample(&b, &r, 1, &s)) return;
         if (s.specular && bounce == 0 && from_light && !c->s->caustics) return;
         if (s.specular && from_light && spec_only && c->targets && !caustic_bounce_ok(&h, s.lobe)) return;
-        if (!s.specular) spec_only = 0;
+        if (!s.specular) {
+            spec_only = 0;
+            nd++;
+            if ((from_light ? nd : nd + 1) + 1 > c->gathers) return; /* never stored again */
+        }
         double k = s.eta2;
         /* Only where the material's own roulette hardly ends paths (total
          * lobe size near 1): elsewhere it would add variance for nothing
@@ -311,7 +320,9 @@ static void trace_one(const trace_ctx *c, const source *src, long index, chunk_o
         phi = crgb(phi.r * s.weight.r * k, phi.g * s.weight.g * k, phi.b * s.weight.b * k);
         if (!(cmax(phi) > 0.0) || !isfinite(phi.r + phi.g + phi.b)) return;
         w = s.dir;
-        if (!photon_intersect(c, s.org, w, &h, &out->rays)) return;
+        /* gathered light passes no_radiosity objects; a light's caustic path does not */
+        if (!photon_intersect(c, &b.from, s.org, w, from_light && spec_only ? 0u : OBJ_NO_RADIOSITY, &h, &out->rays))
+            return;
     }
 }
 
@@ -347,6 +358,8 @@ pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, 
     c.L = L;
     c.s = s;
     c.eps = pm_lights_eps(L);
+    c.rr = radrules_of(sc, 1);
+    c.gathers = c.rr.recursion_limit > 0 ? c.rr.recursion_limit : 1 << 20;
     for (int i = 0; i < sc->nobjects && !c.targets; i++) c.targets = any_target(sc->objects[i]);
     out->targets = c.targets;
     vec3 lo, hi;

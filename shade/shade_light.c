@@ -178,13 +178,14 @@ static rgb light_terms_plain(const light_surface *s, vec3 l, rgb lc, int backsid
 
 /* ------------------------------------------------------------ GI direct light */
 
-/* The same test as shade.c's shadow_blocked. */
+/* shade.c's shadow_blocked, and contacts: the ray leaves c->from
+ * (accel_occluded_from). */
 static int blocked(const light_ctx *c, vec3 p, vec3 dir, double depth)
 {
     if (c->shadow_rays) (*c->shadow_rays)++;
     double tmax = depth - fmax(c->eps, depth * 1e-6);
     if (tmax <= c->eps) return 0;
-    return accel_occluded(c->a, p, dir, c->eps, tmax);
+    return accel_occluded_from(c->a, c->from, p, dir, c->eps, tmax);
 }
 
 int light_extended(const scene_light *l)

@@ -89,6 +89,7 @@ typedef struct {
     const accel *a;
     double eps;          /* scene distance epsilon (shade.c's: accel_scale * 1e-6) */
     long *shadow_rays;   /* incremented per shadow ray; may be NULL */
+    const accel_from *from; /* the surface the shadow rays leave (accel_occluded_from); NULL: none */
 } light_ctx;
 
 /* Direct light from one POV-Ray light source at the surface point p (already

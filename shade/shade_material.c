@@ -79,6 +79,7 @@ void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, doubl
     double filt, transm;
     rgb pig = texture_pigment(sc, tex, h, &filt, &transm, &b->unsupported);
     b->obj = h->obj;
+    accel_from_hit(&b->from, h);
     b->tex = tex;
     b->pigment = pig;
     b->dir = dir;
@@ -249,5 +250,19 @@ rgb mat_light_nee(const mat_bsdf *b, const light_ctx *c, const scene_light *l, i
 {
     light_surface ls = b->ls;
     ls.r = r;
+    light_ctx cf = *c;
+    cf.from = &b->from;
+    c = &cf;
+    if (b->gathered) {
+        scene_finish f = *ls.f;
+        f.phong = f.specular = 0.0;
+        ls.f = &f;
+        if (l->area) {
+            scene_light pl = *l;
+            pl.area = 0;
+            return light_nee(c, &pl, &ls, b->p_out, b->double_illum, 1, r);
+        }
+        return light_nee(c, l, &ls, b->p_out, b->double_illum, nsamples, r);
+    }
     return light_nee(c, l, &ls, b->p_out, b->double_illum, nsamples, r);
 }

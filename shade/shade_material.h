@@ -74,6 +74,11 @@ typedef struct {
     int unsupported;   /* a pigment pattern the shader cannot evaluate (its colour is used) */
     light_surface ls;  /* for light_terms / light_nee */
     const scene_object *obj; /* the hit object: light_group decides which lights reach it (scene_light_reaches) */
+    accel_from from;   /* the hit's surface, for rays leaving it (accel_intersect_from) */
+    int gathered;      /* set by the integrator: the hit of a gathering (radiosity) ray, where POV-Ray
+                          computes no phong/specular highlights and takes area lights as point lights
+                          at their centre (trace.cpp's IsRadiosityRay tests, radiosity.cpp's
+                          GetRadiosityQualityFlags); mat_light_nee follows it */
 } mat_bsdf;
 
 typedef struct {
@@ -119,7 +124,8 @@ int mat_sample(const mat_bsdf *b, rng *r, int absorb, mat_scatter *s);
  * uniform on the disc, projected up); pdf cos/pi. */
 vec3 mat_cosine_dir(vec3 n, double u1, double u2);
 
-/* Direct light of one POV-Ray light at the hit (light_nee at p_out). */
+/* Direct light of one POV-Ray light at the hit (light_nee at p_out; see
+ * `gathered`). */
 rgb mat_light_nee(const mat_bsdf *b, const light_ctx *c, const scene_light *l, int nsamples, rng *r);
 
 #endif
