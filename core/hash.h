@@ -15,4 +15,14 @@ static inline unsigned pt_ptr_hash(const void *p)
     return (unsigned)v;
 }
 
+/* A 64-bit mix with full avalanche: SplitMix64's output function (Steele,
+ * Lea and Flood, "Fast Splittable Pseudorandom Number Generators", OOPSLA
+ * 2014; the shifts and multipliers of Vigna's splitmix64.c). */
+static inline uint64_t pt_mix64(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
 #endif

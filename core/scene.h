@@ -403,7 +403,7 @@ static inline int scene_light_reaches(const scene_light *l, const scene_object *
  * layout: points span -axis/2 .. +axis/2, an axis with size 1 contributes
  * nothing; `jitter` moves each by up to half a cell; `circular` maps the
  * square onto a disc). Uses r only when the light jitters. The Whitted
- * pass's area lights (shade_light.c) and the particle GI's (gi_particle.c). */
+ * pass's area lights (shade_light.c) and the particle GI's (gi_particle_light.c). */
 vec3 scene_light_area_point(const scene_light *l, vec3 ax1, vec3 ax2, int u, int v, rng *r);
 
 /* The axes of an `orient` area light l seen along unit dir (from the lit

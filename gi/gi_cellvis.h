@@ -1,5 +1,5 @@
 /* gi_cellvis.h - a lock-free cache of one verdict per interpolation cell for
- * the shading hook's light-leak guard (gi_particle.c, side_value).
+ * the shading hook's light-leak guard (gi_particle_hook.c, side_value).
  *
  * A cell is the sub-triangle of 3 radiance particles that gi_surface_locate
  * returns for a hit. The hook may interpolate a radiance particle only if

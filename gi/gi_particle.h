@@ -115,7 +115,7 @@ typedef struct {
     int max_trace_level; /* pre-pass depth; 0: the scene's */
     int prepass_stride;  /* the pre-pass traces every Nth pixel in x and y; the pixels between take
                             their hit from the flat piece their coarse neighbours all hit, or are
-                            traced (gi_particle.c, coarse_hit). 0: the default (2); 1: every pixel */
+                            traced (gi_particle_view.c, coarse_hit). 0: the default (2); 1: every pixel */
     int keep_hits;       /* 1: the pre-pass keeps each traced pixel's first hit, and the radiance
                             particles it located there, for the render: gi_particle_primary_begin
                             and _hit as shade_settings.primary_begin and .primary give the render
@@ -133,7 +133,7 @@ typedef struct {
                             (gi_trilook.h) where it decides, else the 3D grid; 1: the 3D grid only
                             (the same links; tests compare the two) */
     int leak_per_hit;    /* 1: the light-leak guard tests every hit's 3 radiance particles; 0 (default):
-                            once per interpolation cell, hits in clear cells skip it (gi_particle.c
+                            once per interpolation cell, hits in clear cells skip it (gi_particle_cells.c
                             cell_clear) */
     uint64_t seed;
     int threads;         /* <= 0: all cores */

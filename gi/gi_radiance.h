@@ -46,10 +46,10 @@ int gi_same_surface(const gi_surface *g, const gi_particles *ps, int i, const sc
  * took the particles (and radiance particles) of the floor under the box,
  * lit by a light inside the box; the dark side of a thin wall took the lit
  * side's. Used for the estimation lists and for the radiance particles a
- * shading hit interpolates (gi_particle.c). */
+ * shading hit interpolates (gi_particle_hook.c). */
 int gi_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, const scene_object *own);
 /* gi_visible in two steps, for callers that trace many segments together
- * (gi_particle.c's cell tests, accel_hit_any_n): the lifted segment from x
+ * (gi_particle_cells.c's cell tests, accel_hit_any_n): the lifted segment from x
  * to y (0 when the points are closer than twice the lift: visible, no ray),
  * then gi_visible's rule along it. gi_visible = !segment || along. A segment
  * whose ray from p along d over [0, len] meets nothing is visible. */

@@ -688,7 +688,7 @@ static void test_cancel(void **state)
 /* A cylinder and a prism: their indirect light must be close to that of
  * the floor next to them (all see the same room). Both have radiance
  * particles (the cylinder a parametric grid, the prism its sweep grid,
- * gi_surface.c split_grid) and are interpolated, none estimated at the hit
+ * gi_surface_mesh.c split_grid) and are interpolated, none estimated at the hit
  * (the fallback for surfaces without grids: test_gi_grids). */
 static void test_cylinder_prism(void **state)
 {
@@ -1459,7 +1459,7 @@ static void test_light_on_ceiling(void **state)
 /* ------------------------------------------------------------------ light-leak guard per cell */
 
 /* The hook's light-leak guard decides once per interpolation cell whether
- * every point of it sees the cell's 3 radiance particles (gi_particle.c
+ * every point of it sees the cell's 3 radiance particles (gi_particle_cells.c
  * cell_clear) and tests per hit only in the other cells. A block (rotated
  * 30 degrees, so no radiance particle lies on its walls) stands on a floor
  * box, a sphere rests on the floor beside it.
@@ -1580,7 +1580,7 @@ static void test_cell_cache(void **state)
 
 /* The pre-pass traces every 2nd pixel in x and y and takes the hits of the
  * pixels between from the flat piece their coarse neighbours share
- * (gi_particle.c, coarse_hit). Inside the mesh cube at 64 x 64 it must mark
+ * (gi_particle_view.c, coarse_hit). Inside the mesh cube at 64 x 64 it must mark
  * the radiance particles tracing every pixel marks (the same set, but for
  * ties on cell edges: at most 0.5% differ, measured 0), with at most 40%
  * of the rays; a render after it computes no radiance particle late. */

@@ -1,6 +1,6 @@
 /* test_gi_grids.c - radiance particles on polygon, height_field, lathe,
  * sor, prism and text (radiance particles "at the vertices of a
- * sub-tessellation of each surface"; gi_surface.c split_grid).
+ * sub-tessellation of each surface"; gi_surface_mesh.c split_grid).
  *
  * Each shape stands in a closed room (an inverse box) lit only indirectly:
  * a spotlight below the ceiling points up at it, so every other surface
@@ -40,7 +40,7 @@ enum { GRID_W = 32, GRID_PARTICLES = 8000, GRID_SPP = 128 };
  * uncovered the lathe's own deficit (-5.56% -> -8.22%), then 0.10. That
  * deficit was sweep cells spanning up to 58 degrees of normal turning (the
  * lit top's hits interpolated the dark underside's radiance particles);
- * since cells span at most the lists' normal cone (gi_surface.c
+ * since cells span at most the lists' normal cone (gi_surface_mesh.c
  * SWEEP_TURN) the six shapes read -2.2..+1.2% (lathe -2.03%, sor +1.18%;
  * particle seeds 11-14 against path 1024 spp: lathe -0.4..-3.5%, was
  * -3.9..-10.5%; sor -1.1..+0.4%, was -4.3..-8.0%): 0.05, which the old

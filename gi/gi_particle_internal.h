@@ -1,0 +1,125 @@
+/* gi_particle_internal.h - the particle GI mode's state, shared by the
+ * files of its stages (gi_particle.c: settings, geometry stage, stats and
+ * debug access; gi_particle_light.c: the lighting stage; gi_particle_view.c:
+ * the view pre-pass; gi_particle_cells.c: the light-leak guard's cell tests;
+ * gi_particle_hook.c: the render's hooks). Not for use outside them. */
+#ifndef PT_GI_PARTICLE_INTERNAL_H
+#define PT_GI_PARTICLE_INTERNAL_H
+#include <stdatomic.h>
+#include <stdint.h>
+#include "gi_cellvis.h"
+#include "gi_cl.h"
+#include "gi_links.h"
+#include "gi_particle.h"
+#include "gi_particles.h"
+#include "gi_radiance.h"
+#include "gi_surface.h"
+
+#define GI_MAX_THREADS 256
+
+typedef struct {
+    long lookups, late, none, discarded, onthefly, vis_rays;
+    long late_rp, late_area;        /* radiance / area particles computed in the hook (late_rp) */
+    long cells, cells_clear, clear; /* cells tested, of them clear; lookups in clear cells */
+    long kept;                      /* lookups whose cell came from a kept hit (view_rec) */
+    int *buf; /* on-the-fly estimation list */
+    long len, cap;
+    struct cell_batch *cb; /* the pre-pass's cell tests waiting for the row's end (cell_batch) */
+} thread_count;
+
+struct gi_particle {
+    const scene *sc;
+    const accel *a;
+    gi_particle_settings set;
+    int threads;
+    gi_surface *surf;
+    gi_particles ps;
+    int ns2, ng;
+    int *slink, *glink;
+    void *lscene;   /* accel_rtc_link_scene, for the three link passes (freed after them) */
+    gi_trilook *tl; /* the 4x4 pass's lookup by hit triangle, compacted for the 16x16 pass */
+    int *rin_off, *rin_src; /* incoming scattering links (first bounce, FULL mode) */
+    int *woff;              /* WALK bounces' path table (gi_particle_build_walk): n + 1 offsets */
+    gi_walk_entry *went;    /* and its entries */
+    int nwalk;
+    gi_lists lists;
+    gi_grid *rgrid; /* particles by list radius: estimates on surfaces without radiance particles */
+    gi_dev *dev;
+    /* lighting */
+    int nlights;
+    gi_dev_light *lights;
+    float *vis;               /* n x nlights: attenuation x visibility fraction (gi_k_emit) */
+    scene_light *vis_lights; /* the lights vis was traced for (colour aside) */
+    unsigned char *dirty;
+    float *edir, *phi, *lout;
+    double bounce_flux[GI_MAX_BOUNCES];
+    int nbounce_flux;
+    int lit;
+    volatile int *cancel; /* gi_particle_set_cancel: non-zero stops the lighting stage */
+    /* view */
+    float *eind;                 /* n*4: gathered E~/pi */
+    atomic_uchar *e_state;       /* 0 none, 1 being computed, 2 done */
+    unsigned char *dev_gathered; /* the device's eind holds it */
+    float *rp_val;               /* nrp*4: estimated E/pi at radiance particles */
+    atomic_uchar *rp_state;
+    atomic_uchar *mark;
+    gi_cellvis *cells; /* per-cell verdicts of the light-leak guard (side_value); NULL: per hit */
+    struct view_rec *vrec; /* keep_hits: one per pixel of the last prepare_view (vw x vh), NULL: none */
+    scene_camera vcam;     /* its camera */
+    size_t vrec_cap;       /* records allocated */
+    int vw, vh;
+    double veps;           /* the pre-pass's tmin */
+    float bg[3];
+    double vis_eps; /* gi_visible's eps: 1e-6 x accel_eps_scale */
+    thread_count tc[GI_MAX_THREADS];
+    gi_particle_stats st;
+};
+
+/* keep_hits: what the pre-pass found at one pixel's camera ray, for the
+ * render (gi_particle_primary_hit) and its hook (side_value). */
+typedef struct view_rec {
+    accel_hit h;           /* first member: the hook knows &rec->h as a kept hit */
+    vec3 org, dir;         /* the ray, compared bit for bit with the render's */
+    double w[3];           /* gi_surface_locate's answer for side `side` */
+    long rp[3];
+    unsigned char kind;    /* 0 nothing kept (the render traces), 1 a miss, 2 a hit */
+    unsigned char located; /* rp, w hold locate's answer */
+    unsigned char side;    /* the side located: dot(n_view, h.ng) >= 0 */
+    unsigned char verdict; /* the light-leak guard's verdict on that cell (GI_CELL_*, UNKNOWN: the hook decides) */
+} view_rec;
+
+
+/* One pre-pass thread's row of kept hits: its counters (cell tests) and
+ * the last cell's key and verdict (neighbouring pixels often share a cell:
+ * no table probe); b: the thread's batch of cells to test at the row's end
+ * (NULL: each is tested when met), and pend the last cell's place in it
+ * when its verdict is CELL_PENDING. */
+typedef struct {
+    thread_count *tc;
+    uint64_t key;
+    int verdict;
+    struct cell_batch *b;
+    int pend;
+} view_memo;
+
+/* The light-leak guard (gi_particle_cells.c). */
+struct cell_batch;
+/* The memo of a pre-pass row; with kept hits and the table, the thread's
+ * batch of cell tests (NULL when out of memory: tested when met). */
+view_memo gi_particle_row_memo(gi_particle *gp, const view_rec *rec, int thread);
+/* The verdict the hook would take for the cell rp of a hit on `own`, moved
+ * to the pre-pass (GI_CELL_UNKNOWN: waiting in the row's batch, or no key). */
+int gi_particle_kept_verdict(gi_particle *gp, const long rp[3], const scene_object *own, view_memo *m, view_rec *old);
+/* Tests the row's batched cells and writes their verdicts (b may be NULL). */
+void gi_particle_batch_test(gi_particle *gp, struct cell_batch *b, thread_count *tc);
+/* The table's verdict on cell rp (key: gi_cellvis_key), else tested now and
+ * put in the table; GI_CELL_UNKNOWN without a key. */
+int gi_particle_cell_verdict(gi_particle *gp, uint64_t key, const long rp[3], const scene_object *own, thread_count *tc);
+void gi_particle_cell_batch_free(struct cell_batch *b);
+
+/* Geometry stage helpers the lighting stage uses (gi_particle.c). */
+/* calloc of n (at least 1) elements; sets *st to PT_ERR_NOMEM on failure. */
+void *gi_particle_calloc(size_t n, size_t size, pt_status *st);
+/* The WALK bounces' path table for nwalk bounces (gp->woff, gp->went). */
+pt_status gi_particle_build_walk(gi_particle *gp, int nwalk, diag *d);
+#endif
