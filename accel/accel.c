@@ -50,6 +50,7 @@
  * and triangles live in their own BVH). Hits outside the cube are rejected,
  * so the answer does not depend on how the BVH culls. */
 #include "accel.h"
+#include <assert.h>
 #include <embree3/rtcore.h>
 #include <float.h>
 #include <stdatomic.h>
@@ -717,9 +718,12 @@ static int user_box_missed(const accel *a, unsigned prim, void *ray, unsigned N,
 /* One user primitive against a ray: an analytic shape or a CSG tree. */
 static int prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, double tmax, geom_csg_hit *h)
 {
+    assert(prim < (unsigned)(a->nshapes + a->ncsgs));
     if (prim < (unsigned)a->nshapes) {
         geom_shape_hit sh;
         if (!geom_shape_intersect(&a->shapes[prim], o, d, tmin, tmax, &sh)) return 0;
+        assert(sh.t > tmin && sh.t < tmax);
+        assert(a->shape_leaf[prim] < (unsigned)a->nleaves);
         const accel_leaf *l = &a->leaves[a->shape_leaf[prim]];
         if (l->bn && !ray_in_bound(a, l->b0, l->bn, o, d, tmin)) return 0;
         h->t = sh.t;
@@ -730,11 +734,14 @@ static int prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, 
     }
     unsigned ci = prim - (unsigned)a->nshapes;
     if (!geom_csg_intersect(&a->csgs[ci], o, d, tmin, tmax, h)) return 0;
+    assert(h->t > tmin && h->t < tmax && h->shape >= 0 && h->shape < a->csgs[ci].nshapes);
     return !a->csg_bn[ci] || ray_in_bound(a, a->csg_b0[ci], a->csg_bn[ci], o, d, tmin);
 }
 
 static const geom_shape *prim_shape(const accel *a, unsigned prim, int member)
 {
+    assert(prim < (unsigned)(a->nshapes + a->ncsgs));
+    assert(prim < (unsigned)a->nshapes || (member >= 0 && member < a->csgs[prim - (unsigned)a->nshapes].nshapes));
     return prim < (unsigned)a->nshapes ? &a->shapes[prim] : &a->csgs[prim - (unsigned)a->nshapes].shapes[member];
 }
 
@@ -1307,7 +1314,9 @@ double accel_epsilon(const accel *a, vec3 org, vec3 dir)
 {
     double l = v3_len(dir);
     if (!(l > 0.0) || !v3_finite(org)) return INFINITY;
-    return eps_rule(a ? a->eps_scale : 1.0, org, l);
+    double e = eps_rule(a ? a->eps_scale : 1.0, org, l);
+    assert(e >= 0.0 && isfinite(e)); /* a finite origin, a non-zero direction */
+    return e;
 }
 
 static int ray_ok(vec3 org, vec3 dir) { return v3_finite(org) && v3_finite(dir) && v3_len2(dir) > 0.0; }
@@ -1444,7 +1453,9 @@ static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tm
         if (inst >= a->nginfo || a->ginfo[inst].kind != GEOM_INSTANCE) return 0;
         fill_triangle(a, &a->leaves[a->ginfo[inst].idx], prim, rh.hit.u, rh.hit.v, rh.ray.tfar, org, dir, hit);
     } else if (gid < a->nginfo && a->ginfo[gid].kind == GEOM_TRI) {
+        assert(a->ginfo[gid].idx < 2 && prim < a->tri[a->ginfo[gid].idx].nt);
         const tri_ref *r = &a->tri[a->ginfo[gid].idx].refs[prim];
+        assert(r->leaf < (unsigned)a->nleaves);
         fill_triangle(a, &a->leaves[r->leaf], r->local, rh.hit.u, rh.hit.v, rh.ray.tfar, org, dir, hit);
     } else if (gid < a->nginfo && a->ginfo[gid].kind == GEOM_USER && prim < (unsigned)(a->nshapes + a->ncsgs)) {
         geom_csg_hit h;
@@ -1459,6 +1470,7 @@ static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tm
         const geom_shape *sh = prim_shape(a, prim, h.shape);
         unsigned li = prim < (unsigned)a->nshapes ? a->shape_leaf[prim]
                                                   : a->csgs[prim - (unsigned)a->nshapes].shape_leaf[h.shape];
+        assert(li < (unsigned)a->nleaves);
         const accel_leaf *l = &a->leaves[li];
         hit->t = h.t;
         hit->p = v3_madd(org, dir, h.t);
@@ -1485,6 +1497,15 @@ static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tm
     } else {
         return 0;
     }
+    /* what every caller relies on: a hit inside the query's interval (up
+     * to the epsilon rule's distance: triangle distances are refined in
+     * double from Embree's float hit), unit normals on one side, the leaf
+     * and its effective texture */
+    assert(!(hit->t < t0 - eps_rule(a->eps_scale, org, v3_len(dir))) &&
+           !(hit->t > tmax + eps_rule(a->eps_scale, org, v3_len(dir))));
+    assert(fabs(v3_len2(hit->ng) - 1.0) < 1e-6 && fabs(v3_len2(hit->ns) - 1.0) < 1e-6);
+    assert(v3_dot(hit->ng, hit->ns) >= 0.0);
+    assert(hit->obj && hit->texture);
     return isfinite(hit->t) && v3_finite(hit->p);
 }
 

@@ -5,6 +5,7 @@
  * constant; for curved parts its maximum over all n is |det A| sigma_max(A^-1),
  * the bound used for rejection. */
 #include "accel_surface.h"
+#include <assert.h>
 #include "geom_hfield.h"
 #include "geom_sweep.h"
 #include <math.h>
@@ -785,7 +786,10 @@ int accel_surf_sample_piece(const accel_surf *as, int piece, double u1, double u
     out->flags = pr->pub.flags;
     out->piece = piece;
     out->pdf_area = pr->pub.weight / as->total_w;
+    assert(u1 >= 0.0 && u1 <= 1.0 && u2 >= 0.0 && u2 <= 1.0);
+    assert(out->pdf_area > 0.0 && isfinite(out->pdf_area));
     if (!pr->is_shape) {
+        assert(pr->idx >= 0 && pr->idx < as->ntris);
         const tri_geo *t = &as->tris[pr->idx];
         double su = sqrt(u1);
         double b1 = su * (1.0 - u2), b2 = su * u2;
@@ -794,6 +798,7 @@ int accel_surf_sample_piece(const accel_surf *as, int piece, double u1, double u
         out->prim = pr->pub.prim == ACCEL_SURF_ANY ? 0u : pr->pub.prim;
         return 1;
     }
+    assert(pr->idx >= 0 && pr->idx < as->nshapes);
     sample_shape(&as->shapes[pr->idx], u1, u2, r, &out->p, &out->n, &out->prim);
     return 1;
 }
@@ -808,6 +813,7 @@ int accel_surf_sample_point(const accel_surf *as, double u0, double u1, double u
         if (target < as->cdf[mid]) hi = mid;
         else lo = mid + 1;
     }
+    assert(lo >= 0 && lo < as->npieces);
     return accel_surf_sample_piece(as, lo, u1, u2, r, out);
 }
 
@@ -827,6 +833,7 @@ double accel_surf_pdf(const accel_surf *as, const accel_hit *h)
 {
     int i = accel_surf_find(as, h->obj, h->prim);
     if (i < 0) return 0.0;
+    assert(i < as->npieces);
     const piece_rec *pr = &as->pieces[i];
     if (pr->is_shape && (as->shapes[pr->idx].sh.kind == SHAPE_PLANE || as->shapes[pr->idx].sh.infinite)) {
         const shape_geo *g = &as->shapes[pr->idx];

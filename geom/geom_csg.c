@@ -10,6 +10,7 @@
  * The root's S bounds the primitive; an intersection of six planes gets a
  * tight box this way. */
 #include "geom_csg.h"
+#include <assert.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -332,6 +333,7 @@ int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, doubl
             from = tmp[k - 1].t;
         }
     }
+    assert(!found || (h->t > tmin && h->t < tmax && h->shape >= 0 && h->shape < c->nshapes));
     return found;
 }
 

@@ -1,5 +1,6 @@
 /* sdl_array.c - arrays: declaration, initialisers, subscripts, elements. */
 #include "sdl_array.h"
+#include <assert.h>
 #include <string.h>
 #include "sdl_directive.h"
 #include "sdl_expr.h"
@@ -58,6 +59,7 @@ void sdl_array_set(sdl_parser *p, sdl_array *a, long i, const sdl_value *v, src_
         sdl_error(p, loc, PT_ERR_SYNTAX, "cannot store an uninitialised value in an array");
         return;
     }
+    assert(a->elems && a->total > 0);
     int dim = numeric(v->kind) ? v->dim : 0;
     if (a->kind == VAL_NONE) {
         a->kind = v->kind;
@@ -112,6 +114,7 @@ static void initialiser(sdl_parser *p, sdl_array *a, int d, long base)
             src_loc at = t->tk.loc;
             sdl_value v;
             sdl_rvalue(p, &v);
+            assert(base + i < a->total);
             sdl_array_set(p, a, base + i, &v, at);
             sdl_accept(p, TOK_COMMA);
         }
@@ -192,6 +195,8 @@ long sdl_array_subscripts(sdl_parser *p, const sdl_array *a, src_loc loc)
         }
         index += k * stride(a, d);
     }
+    /* every subscript checked against its dimension: in the array */
+    assert(!sdl_ok(p) || (index >= 0 && index < a->total));
     (void)loc;
     return sdl_ok(p) ? index : -1;
 }

@@ -1,5 +1,6 @@
 /* sdl_scan.c - POV-Ray SDL scanner. */
 #include "sdl_scan.h"
+#include <assert.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -39,7 +40,10 @@ sdl_kw sdl_kw_lookup(const char *s, size_t n)
     while (lo <= hi) {
         int mid = (lo + hi) / 2;
         int c = word_cmp(s, n, mid);
-        if (c == 0) return (sdl_kw)mid;
+        if (c == 0) {
+            assert(mid > KW_NONE && mid < SDL_KW_LIMIT);
+            return (sdl_kw)mid;
+        }
         if (c < 0) hi = mid - 1;
         else lo = mid + 1;
     }
@@ -59,7 +63,11 @@ void sdl_scan_init(sdl_scanner *s, const char *file, const char *text, size_t le
 }
 
 sdl_scan_pos sdl_scan_tell(const sdl_scanner *s) { return s->at; }
-void sdl_scan_seek(sdl_scanner *s, sdl_scan_pos p) { s->at = p; }
+void sdl_scan_seek(sdl_scanner *s, sdl_scan_pos p)
+{
+    assert(p.pos <= s->len && p.line >= 1 && p.col >= 1); /* a position sdl_scan_tell gave */
+    s->at = p;
+}
 
 static int peek_char(const sdl_scanner *s, size_t ahead)
 {
@@ -313,6 +321,9 @@ sdl_token sdl_scan_next(sdl_scanner *s)
     } else {
         scan_punct(s, &t, c);
     }
+    /* a token never reaches past the text, and the scan moves on */
+    assert(s->at.pos <= s->len);
+    assert(t.kind == TOK_EOF || t.kind == TOK_ERROR || s->at.pos > 0);
     return t;
 }
 

@@ -1,5 +1,6 @@
 /* sdl_symtab.c - chained hash table with a per-scope list for cheap pops. */
 #include "sdl_symtab.h"
+#include <assert.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -103,6 +104,7 @@ int sdl_symtab_push(sdl_symtab *t)
         t->cap = nc;
     }
     t->scopes[++t->depth] = NULL;
+    assert(t->depth < t->cap);
     t->ids[t->depth] = t->next_id++;
     return 1;
 }
@@ -115,6 +117,7 @@ void sdl_symtab_pop(sdl_symtab *t)
         unlink_entry(t, e);
         free_entry(e);
     }
+    assert(t->scopes[t->depth] == NULL); /* unlink_entry took every entry of the scope */
     t->depth--;
 }
 
@@ -128,7 +131,12 @@ static sym_entry *find_entry(const sdl_symtab *t, const char *name, size_t n)
 /* The entry an alias stands for (the entry itself if it is no alias). */
 static sym_entry *resolve(sym_entry *e)
 {
-    while (e && e->alias) e = e->alias;
+    /* aliases (macro parameters by reference) point to outer scopes, so
+     * the chain ends */
+    for (int guard = 0; e && e->alias; guard++) {
+        assert(guard < 1 << 20);
+        e = e->alias;
+    }
     return e;
 }
 

@@ -27,6 +27,7 @@
  */
 #include "shade.h"
 #include "camera.h"
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -394,6 +395,7 @@ static rgb along_ray(render_ctx *c, int thread, vec3 org, vec3 dir, double depth
 static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, float wavelength,
                      rng *r, const media_inside *in)
 {
+    assert(level >= 1 && thread >= 0 && thread < SHADE_MAX_THREADS);
     if (level > c->max_level) return rgb_make(0, 0, 0);
     accel_hit h;
     double tmin = c->eps;
@@ -469,6 +471,7 @@ static rgb sample_mesh_rays(render_ctx *c, int thread, double px, double py, rng
 
 static rgb primary_ray(render_ctx *c, int thread, double px, double py, vec3 org, vec3 dir, rng *r)
 {
+    assert(v3_finite(org) && v3_finite(dir));
     if (c->sc->camera.normal) {
         /* camera normal: POV-Ray perturbs the direction at the screen point <x0, y0, 0> */
         pattern_ctx pc = pattern_ctx_plain(c->sc);
@@ -526,6 +529,15 @@ static rgb sample(render_ctx *c, int thread, double px, double py, rng *r)
     return rgb_scale(acc, 1.0 / n);
 }
 
+#ifndef NDEBUG
+static int fb_all_finite(const framebuffer *fb)
+{
+    for (size_t i = 0; i < (size_t)fb->width * (size_t)fb->height * 3u; i++)
+        if (!isfinite(fb->rgb[i])) return 0;
+    return 1;
+}
+#endif
+
 /* Tile `tile` of the image clipped to the rectangle win (x0,y0,x1,y1). */
 static void tile_bounds(const render_ctx *c, int tile, const int *win, int *x0, int *y0, int *x1, int *y1)
 {
@@ -538,6 +550,8 @@ static void tile_bounds(const render_ctx *c, int tile, const int *win, int *x0, 
     if (*y0 < win[1]) *y0 = win[1];
     if (*x1 > win[2]) *x1 = win[2];
     if (*y1 > win[3]) *y1 = win[3];
+    /* an empty tile (x1 <= x0) is allowed; a non-empty one lies in the image */
+    assert(*x0 >= 0 && *y0 >= 0 && (*x1 <= *x0 || *x1 <= c->s->width) && (*y1 <= *y0 || *y1 <= c->s->height));
 }
 
 /* Pass 1: one ray per pixel centre (or a fixed n x n stratified grid). */
@@ -568,6 +582,8 @@ static void tile_first_pass(void *ctx, int tile, int thread)
                     }
                 acc = rgb_scale(acc, 1.0 / (n * n));
             }
+            /* primary_ray and sample_known discard non-finite samples */
+            assert(isfinite(acc.r) && isfinite(acc.g) && isfinite(acc.b));
             float *px = fb_px(c->fb, x, y);
             px[0] = (float)acc.r;
             px[1] = (float)acc.g;
@@ -708,6 +724,7 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
                 }
     gamma_fb_to_linear(sc, fb); /* assumed_gamma: working space -> linear (shade_gamma.c) */
     long fixed = fb_sanitize(fb);
+    assert(fb_all_finite(fb)); /* no NaN or Inf reaches a framebuffer */
     if (st) {
         memset(st, 0, sizeof *st);
         for (int i = 0; i < SHADE_MAX_THREADS; i++) {

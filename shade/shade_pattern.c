@@ -21,6 +21,7 @@
  *    agate, brick, hexagon, checker, square, triangular, cubic; grey ramp
  *    for the rest). */
 #include "shade_pattern.h"
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -946,6 +947,8 @@ const scene_blend_map *pattern_default_map(pattern_kind k)
 
 void blend_map_search(const scene_blend_map *m, double v, int *prev, int *cur)
 {
+    /* a map has at least one entry (the parser refuses an empty one) */
+    assert(m->n >= 1 && m->e);
     int last = m->n - 1, p, c;
     if (v >= m->e[last].value) {
         p = c = last;
@@ -954,6 +957,7 @@ void blend_map_search(const scene_blend_map *m, double v, int *prev, int *cur)
         while (v > m->e[c].value) p = c++;
     }
     if (v == m->e[c].value) p = c;
+    assert(0 <= p && p <= c && c <= last);
     *prev = p;
     *cur = c;
 }
