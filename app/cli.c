@@ -6,7 +6,7 @@
  * (library path), +FE/+FN (format of an output named without extension),
  * +WTn (work threads), +Kc (clock), +KFIn +KFFn +KIc +KFc +KC (animation
  * frames and clocks, cyclic), +SFn +EFn (frame subset), +SCn +ECn +SRn +ERn
- * (render window), +Qn (quality 0-11, shade.h). Switches that only
+ * (render window), +Qn (quality 0-11, shade.h), +UA (alpha). Switches that only
  * concern POV-Ray's display or its own files (+D, -D, +P, +V, +J...) are accepted and ignored. INI files and
  * Key=value options are expanded into these switches first (ini.h). */
 #include "cli.h"
@@ -144,6 +144,13 @@ static int pov_switch(const char *arg, cli_render *o, char *err, int errlen)
         snprintf(err, (size_t)errlen, "+Q wants a quality level 0 to 11, got '%s'", arg);
         return 2;
     }
+    case 'U': /* +UA alpha (Output_Alpha); +UD +UL +UV +UR +UO: POV-Ray's vista, light buffers, bounds: nothing here */
+        if ((v[0] == 'A' || v[0] == 'a') && !v[1]) {
+            o->alpha = on;
+            return 0;
+        }
+        if (v[0] && !v[1] && strchr("DdLlVvRrOo", v[0])) return 0;
+        break;
     case 'D': case 'P': case 'V': case 'J': case 'X': case 'G': case 'B': case 'C':
         return 0; /* display, pause, verbose, jitter...: ignored */
     default:
@@ -514,7 +521,9 @@ const char cli_render_help[] =
     "                         .pfm (linear float); repeat for several outputs of one render.\n"
     "                         +O without an extension takes the +F type's (POV-Ray)\n"
     "  +FN[16] +FE +FP        output type of +O: PNG (16 bits), OpenEXR, PFM\n"
-    "  +UA                    alpha: background pixels transparent (PNG RGBA, EXR A)\n"
+    "  +UA                    alpha channel (PNG RGBA straight, EXR A associated): each\n"
+    "                         pixel's coverage; the background is clear unless a 3.7\n"
+    "                         scene declares an opaque background{}\n"
     "  --float                32-bit EXR (default half)\n"
     "  --exr-compression none|zip|piz    --png16   16-bit PNG\n"
     "  --stats FILE.json      stage times, ray counts, what was built\n"

@@ -27,6 +27,7 @@
 #include "scene.h"
 #include "sdl.h"
 #include "shade.h"
+#include "shade_aov.h"
 #include "shade_funcenv.h"
 #include "stats_json.h"
 #include "timer.h"
@@ -294,6 +295,23 @@ typedef struct {
     double t_start;
 } render_run;
 
+/* A copy of fb with straight alpha: colour / alpha where alpha > 0. */
+static framebuffer *straight_alpha(const framebuffer *fb)
+{
+    framebuffer *c = fb_new(fb->width, fb->height);
+    if (!c) return NULL;
+    size_t n = (size_t)fb->width * (size_t)fb->height;
+    c->alpha = malloc(sizeof(float) * n);
+    if (!c->alpha) {
+        fb_free(c);
+        return NULL;
+    }
+    memcpy(c->alpha, fb->alpha, sizeof(float) * n);
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) c->rgb[i * 3 + k] = fb->alpha[i] > 0 ? fb->rgb[i * 3 + k] / fb->alpha[i] : fb->rgb[i * 3 + k];
+    return c;
+}
+
 /* FNV-1a 64 of a file's bytes (0 when unreadable: the parser reports it). */
 static uint64_t file_hash(const char *path)
 {
@@ -408,6 +426,23 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     pt_status lst = ls->aov ? PT_OK : lighting_alloc(ls, ss.width, ss.height, d);
     ss.aov = ls->aov;
     st = fb && lst == PT_OK ? render_gi(sc, acc, &ss, fb, &sst, d) : PT_ERR_NOMEM;
+    if (st == PT_OK && o->alpha && !g_cancel) {
+        /* +UA: each pixel's coverage (shade_aov.h); the colour stays
+         * associated (premultiplied: a clear background adds nothing) */
+        fb->alpha = malloc(sizeof(float) * (size_t)ss.width * (size_t)ss.height);
+        if (!fb->alpha) {
+            st = PT_ERR_NOMEM;
+        } else {
+            shade_settings as;
+            shade_default_settings(&as);
+            as.width = ss.width;
+            as.height = ss.height;
+            as.threads = threads;
+            as.antialias = ss.antialias;
+            as.cancel = &g_cancel;
+            shade_alpha(sc, acc, &as, fb->alpha);
+        }
+    }
     double t_render = sst.t_render > 0 ? sst.t_render : timer_now() - t0;
     /* the progressive image of a finished render is no longer needed */
     if (progressive && !g_cancel) remove(progressive);
@@ -472,7 +507,12 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     } else {
         for (int i = 0; i < noutputs && rc == EXIT_OK; i++) {
             diag *wd = diag_new();
-            pt_status ws = img_write(outputs[i], fb, &wo, wd);
+            /* PNG's alpha is straight (PNG spec 12.8), EXR's associated */
+            framebuffer *straight = fb->alpha && img_format_from_path(outputs[i]) == IMG_FMT_PNG ? straight_alpha(fb) : NULL;
+            if (fb->alpha && img_format_from_path(outputs[i]) == IMG_FMT_PFM)
+                diag_warn_once(wd, (src_loc){0}, "+UA: PFM has no alpha channel: %s is written without it", outputs[i]);
+            pt_status ws = img_write(outputs[i], straight ? straight : fb, &wo, wd);
+            fb_free(straight);
             print_diags(wd, 0);
             diag_free(wd);
             if (ws != PT_OK) rc = status_exit(ws);

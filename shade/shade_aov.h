@@ -63,4 +63,16 @@ void shade_aov_free(shade_aov *a);
  * indices below s->threads as in shade_render). */
 pt_status shade_aov_render(const scene *sc, const accel *a, const shade_settings *s, shade_aov *out, diag *d);
 
+/* +UA (POV-Ray's Output_Alpha): each pixel's opacity into alpha
+ * (s->width * s->height floats), the fraction of n x n stratified camera
+ * rays (n = 3 with antialiasing, else 1: the centre) that meet an object the
+ * camera sees. A ray that leaves the scene counts 1 - the background's
+ * transmit, as POV-Ray 3.7 composes it (parse.cpp, scene.cpp): with
+ * #version 3.7 a background{} without transmit is opaque and no background
+ * (the default <0,0,0,0,1>) is clear; before 3.7 (or without #version) the
+ * background is clear. A sky_sphere is taken as opaque, and so are
+ * transparent surfaces (POV-Ray lets a clear background show through
+ * them: not modelled). */
+void shade_alpha(const scene *sc, const accel *a, const shade_settings *s, float *alpha);
+
 #endif
