@@ -126,14 +126,28 @@ static int pov_switch(const char *arg, cli_render *o, char *err, int errlen)
         }
         break;
     }
-    case 'F': /* +F[type][bits]: N PNG (+FN16: 16 bits), E OpenEXR; others are POV-Ray formats partray does not write */
+    case 'F': { /* +F[type][bits] (POV-Ray 3.7 "Output File Type"): N PNG, E OpenEXR, S the system's
+                   format (PNG on Unix); +FNn: n bits per colour (above 8: 16-bit PNG) */
+        char t = (char)(v[0] >= 'a' && v[0] <= 'z' ? v[0] - 32 : v[0]);
         if (!*v) return 0;
-        if (v[0] == 'N' || v[0] == 'n' || v[0] == 'E' || v[0] == 'e') {
-            o->format = (char)(v[0] == 'n' || v[0] == 'N' ? 'N' : 'E');
-            if (o->format == 'N' && strcmp(v + 1, "16") == 0) o->png16 = 1;
-            return 0;
+        if (t == 'N' || t == 'S' || t == 'E') {
+            o->format = t == 'E' ? 'E' : 'N';
+            if (!v[1]) return 0;
+            int bits;
+            if (o->format == 'N' && parse_int(v + 1, &bits) && bits >= 1 && bits <= 16) {
+                o->png16 = bits > 8;
+                return 0;
+            }
+            break;
+        }
+        const char *name = t == 'C' || t == 'T' ? "Targa" : t == 'P' ? "PPM" : t == 'B' ? "BMP" : t == 'J' ? "JPEG" : t == 'H' ? "Radiance HDR" : NULL;
+        if (name) {
+            snprintf(err, (size_t)errlen, "%s: %s output is not written; +FN (PNG), +FE (OpenEXR) or an output named .pfm are", arg,
+                     name);
+            return 2;
         }
         break;
+    }
     case 'Q': { /* +Qn, POV-Ray 3.7 view.cpp: clip(Quality, 0, 9) */
         int q;
         if (parse_int(v, &q) && q >= 0 && q <= 11) {

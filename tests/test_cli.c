@@ -614,6 +614,53 @@ static void test_alpha_output(void **st)
     fb_free(fb);
 }
 
+/* PNG bit depth: IHDR byte 24 of the file. */
+static int png_bit_depth(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return -1;
+    unsigned char b[32];
+    size_t n = fread(b, 1, sizeof b, f);
+    fclose(f);
+    return n >= 25 ? b[24] : -1;
+}
+
+/* +O and +F as POV-Ray 3.7 names outputs (imageprocessing.cpp,
+ * GetOutputFilename): +O without an extension takes the +F type's (PNG
+ * unless +FE), +O ending in '/' writes SCENE.EXT there; +FN16 is a 16-bit
+ * PNG, +FN8 an 8-bit one; +FC and the other types partray does not write
+ * are refused by name. */
+static void test_output_names_and_types(void **st)
+{
+    (void)st;
+    char scene[512], dir[512], cmd[4096], path[700];
+    snprintf(scene, sizeof scene, "%s/names.pov", tmpdir);
+    snprintf(dir, sizeof dir, "%s/names_out", tmpdir);
+    tu_write_file(scene, "camera { location -5*z look_at 0 } light_source { -5*z, 1 } sphere { 0, 1 pigment { rgb 1 } }\n");
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s' && '%s' render '%s' --size 16x12 -q +O%s/pov2", dir, PARTRAY_BIN, scene, dir);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    snprintf(path, sizeof path, "%s/pov2.png", dir);
+    assert_int_equal(png_bit_depth(path), 8);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 16x12 -q +FE +O%s/pov2", PARTRAY_BIN, scene, dir);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    snprintf(path, sizeof path, "%s/pov2.exr", dir);
+    framebuffer *fb = NULL;
+    assert_int_equal(img_read(path, 0, &fb, NULL), PT_OK);
+    assert_int_equal(fb->width, 16);
+    fb_free(fb);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 16x12 -q +FN16 +O%s/pov3", PARTRAY_BIN, scene, dir);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    snprintf(path, sizeof path, "%s/pov3.png", dir);
+    assert_int_equal(png_bit_depth(path), 16);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 16x12 -q +FN8 +O%s/", PARTRAY_BIN, scene, dir);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    snprintf(path, sizeof path, "%s/names.png", dir);
+    assert_int_equal(png_bit_depth(path), 8);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 16x12 +FC +O%s/pov4", PARTRAY_BIN, scene, dir);
+    assert_int_equal(tu_run_capture(cmd), 2);
+    assert_non_null(strstr(tu_out, "+FC: Targa output is not written"));
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/partray-cli-XXXXXX");
@@ -636,6 +683,7 @@ int main(void)
         cmocka_unit_test(test_sigint_during_gi),
         cmocka_unit_test(test_quality_levels),
         cmocka_unit_test(test_alpha_output),
+        cmocka_unit_test(test_output_names_and_types),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     char cmd[600];
