@@ -284,6 +284,83 @@ static int write_false_color(const cli_render *o, const framebuffer *fb, const l
     return status_exit(st);
 }
 
+/* Particle GI kept from one frame of an animation to the next: the scene
+ * and accel its geometry stage was built from, and the hashes of the
+ * stages' inputs it was built with (stage_hashes). */
+typedef struct {
+    scene *sc;
+    accel *acc;
+    gi_particle *gp;
+    uint64_t h_geom, h_light;
+} gi_keep;
+
+static void gi_keep_free(gi_keep *k)
+{
+    gi_particle_free(k->gp);
+    accel_free(k->acc);
+    scene_free(k->sc);
+    memset(k, 0, sizeof *k);
+}
+
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 0x100000001b3ULL;
+    return h;
+}
+#define FNV(h, field) fnv((h), &(field), sizeof(field))
+
+/* The hashes of the GI stages' inputs in the IR.
+ *  - geometry (and everything else but the camera and the lights: objects,
+ *    materials, media, global settings): the scene file's bytes and the
+ *    options, which are the same in every frame of one run, and the frame
+ *    number when the parser saw a per-frame value read outside camera{} and
+ *    light_source{} (sdl_options.frame_dependent), when a light carries
+ *    geometry (looks_like, projected_through) or the camera does (normal,
+ *    mesh_camera); and the number of lights (the lighting stage edits
+ *    lights in place);
+ *  - lighting: every light's fields;
+ *  - view: the camera, which the view stage always takes as given. */
+static void stage_hashes(const scene *sc, uint64_t file_hash, int frame_dependent, int frame, uint64_t *h_geom,
+                         uint64_t *h_light)
+{
+    uint64_t g = 0xcbf29ce484222325ULL, l = g;
+    int dep = frame_dependent || sc->camera.normal || sc->camera.nmeshes > 0;
+    for (int i = 0; i < sc->nlights; i++) {
+        const scene_light *li = &sc->lights[i];
+        if (li->looks_like || li->projected_through) dep = 1;
+        l = FNV(l, li->kind);
+        l = FNV(l, li->position);
+        l = FNV(l, li->colour);
+        l = FNV(l, li->point_at);
+        l = FNV(l, li->radius);
+        l = FNV(l, li->falloff);
+        l = FNV(l, li->tightness);
+        l = FNV(l, li->parallel);
+        l = FNV(l, li->area);
+        l = FNV(l, li->axis1);
+        l = FNV(l, li->axis2);
+        l = FNV(l, li->size1);
+        l = FNV(l, li->size2);
+        l = FNV(l, li->adaptive);
+        l = FNV(l, li->jitter);
+        l = FNV(l, li->circular);
+        l = FNV(l, li->orient);
+        l = FNV(l, li->area_illumination);
+        l = FNV(l, li->fade_distance);
+        l = FNV(l, li->fade_power);
+        l = FNV(l, li->shadowless);
+        l = FNV(l, li->media_interaction);
+        l = FNV(l, li->media_attenuation);
+        l = FNV(l, li->group);
+    }
+    g = FNV(g, file_hash);
+    g = FNV(g, sc->nlights);
+    if (dep) g = FNV(g, frame);
+    *h_geom = g;
+    *h_light = l ^ g;
+}
+
 /* What stays the same from frame to frame of one `partray render`. */
 typedef struct {
     cli_render *o;
@@ -293,6 +370,7 @@ typedef struct {
     int tile;               /* 1: a window smaller than the image was asked for */
     uint64_t scene_hash;    /* FNV-1a 64 of the scene file's bytes */
     double t_start;
+    gi_keep keep;           /* particle GI of the previous frame */
 } render_run;
 
 /* A copy of fb with straight alpha: colour / alpha where alpha > 0. */
@@ -339,6 +417,8 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     progress *prog = progress_new();
     pbar *bar = pbar_start(prog, o->quiet);
     so.progress = prog;
+    int frame_dependent = 1;
+    so.frame_dependent = &frame_dependent;
     diag *d = diag_new();
     diag_set_sink(d, pbar_diag_sink, bar);
     scene *sc = NULL;
@@ -378,11 +458,35 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     }
 
     int threads = o->threads > 0 ? o->threads : pool_default_threads();
+    /* GI across an animation's frames: each stage runs again only when the
+     * hash of its inputs changed (stage_hashes); the frame then renders the
+     * kept scene with this frame's camera and lights. */
+    int reuse = 0, relight = 0, keep_gi = gi == GI_PARTICLE && plan->animated && !run->tile;
+    uint64_t h_geom = 0, h_light = 0;
+    if (keep_gi) {
+        stage_hashes(sc, run->scene_hash, frame_dependent, frame, &h_geom, &h_light);
+        if (run->keep.gp && h_geom == run->keep.h_geom) {
+            reuse = 1;
+            relight = h_light != run->keep.h_light;
+            scene *ks = run->keep.sc;
+            ks->camera = sc->camera; /* no pointers: a camera with any makes h_geom per frame */
+            for (int i = 0; i < sc->nlights && relight; i++) {
+                src_loc keep_loc = ks->lights[i].loc; /* the kept scene's file name */
+                ks->lights[i] = sc->lights[i];        /* looks_like, projected_through NULL (stage_hashes) */
+                ks->lights[i].loc = keep_loc;
+            }
+            run->keep.h_light = h_light;
+            scene_free(sc);
+            sc = ks;
+        } else if (run->keep.gp) {
+            gi_keep_free(&run->keep);
+        }
+    }
     accel_set_function_env(shade_func_env()); /* isosurface functions: noise, pigment functions */
     t0 = timer_now();
-    progress_stage(prog, "accel", 0);
-    accel *acc = accel_build(sc, threads, d, &st);
-    double t_accel = timer_now() - t0;
+    if (!reuse) progress_stage(prog, "accel", 0);
+    accel *acc = reuse ? run->keep.acc : accel_build(sc, threads, d, &st);
+    double t_accel = reuse ? 0.0 : timer_now() - t0;
     if (!acc || st != PT_OK) {
         scene_free(sc);
         diag_free(d);
@@ -413,6 +517,9 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     ss.progress = prog;
     ss.notes = d;
     ss.cancel = &g_cancel;
+    ss.reuse = reuse ? run->keep.gp : NULL;
+    ss.relight = relight;
+    ss.keep = keep_gi;
     if (run->tile) memcpy(ss.window, run->win, sizeof ss.window);
     char *progressive = NULL;
     if ((gi == GI_PATH || gi == GI_PMFG) && noutputs > 0 && img_format_from_path(outputs[0]) != IMG_FMT_UNKNOWN) {
@@ -535,6 +642,10 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
         stats_num(&js, "total", plan->animated ? t_total : timer_now() - run->t_start);
         stats_obj_end(&js);
         if (plan->animated) stats_int(&js, "frame", frame);
+        if (keep_gi) {
+            stats_int(&js, "gi_geometry_ran", sst.ran_geometry);
+            stats_int(&js, "gi_lighting_ran", sst.ran_lighting);
+        }
         stats_int(&js, "rays", sst.primary_rays + sst.shadow_rays + sst.secondary_rays + sst.other_rays);
         stats_int(&js, "primary_rays", sst.primary_rays);
         stats_int(&js, "shadow_rays", sst.shadow_rays);
@@ -576,10 +687,22 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
         if (sst.t_gi_geometry > 0 || sst.t_gi_lighting > 0)
             fprintf(stderr, "partray: %sgi %s: geometry %.3f s, lighting %.3f s\n", fr, gi_used, sst.t_gi_geometry,
                     sst.t_gi_lighting);
+        if (keep_gi)
+            fprintf(stderr, "partray: %sgi stages run: %s%sview\n", fr, sst.ran_geometry ? "geometry, " : "",
+                    sst.ran_lighting ? "lighting, " : "");
     }
     fb_free(fb);
-    accel_free(acc);
-    scene_free(sc);
+    if (keep_gi && sst.kept && !reuse) {
+        /* this frame's GI, scene and accel serve the next frames */
+        run->keep.sc = sc;
+        run->keep.acc = acc;
+        run->keep.gp = sst.kept;
+        run->keep.h_geom = h_geom;
+        run->keep.h_light = h_light;
+    } else if (!reuse) {
+        accel_free(acc);
+        scene_free(sc);
+    }
     diag_free(d);
     pbar_free(bar);
     progress_free(prog);
@@ -718,6 +841,7 @@ static int cmd_render(int argc, char **argv)
     if (!o.quiet && rc == EXIT_OK && plan.animated)
         fprintf(stderr, "partray: %d frames in %.3f s\n", nframes, timer_now() - t_start);
     for (int i = 0; i < nbases; i++) free(bases[i]);
+    gi_keep_free(&run.keep);
     lighting_free(&ls);
     img_ocio_close(oc);
     ini_free(ia);

@@ -82,16 +82,23 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     gs.keep_hits = o->antialias != 2;
     pt_status st = PT_OK;
     double t0 = timer_now();
-    gi_particle *gp = gi_particle_build(sc, a, &gs, &r->particle, d, &st);
-    r->t_gi_geometry = timer_now() - t0;
-    /* cancelled: nothing rendered, the caller sees its flag (as in the
-     * other modes, which stop at a tile) */
-    if (!gp) return st == PT_CANCELLED ? PT_OK : (st == PT_OK ? PT_ERR_INTERNAL : st);
+    gi_particle *gp = o->reuse;
+    if (!gp) {
+        gp = gi_particle_build(sc, a, &gs, &r->particle, d, &st);
+        r->t_gi_geometry = timer_now() - t0;
+        /* cancelled: nothing rendered, the caller sees its flag (as in the
+         * other modes, which stop at a tile) */
+        if (!gp) return st == PT_CANCELLED ? PT_OK : (st == PT_OK ? PT_ERR_INTERNAL : st);
+        r->ran_geometry = 1;
+    }
     r->has_particle = 1;
     gi_particle_set_cancel(gp, o->cancel);
-    t0 = timer_now();
-    st = gi_particle_light(gp, d);
-    r->t_gi_lighting = timer_now() - t0;
+    if (!o->reuse || o->relight) {
+        t0 = timer_now();
+        st = o->reuse ? gi_particle_relight(gp, d) : gi_particle_light(gp, d);
+        r->t_gi_lighting = timer_now() - t0;
+        r->ran_lighting = 1;
+    }
     if (st == PT_OK) {
         shade_settings ss;
         fill_shade(&ss, o);
@@ -120,7 +127,8 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
         if (st == PT_OK) st = render_aovs(sc, a, o, &ss, r, d);
     }
     r->particle = *gi_particle_get_stats(gp);
-    gi_particle_free(gp);
+    if (o->keep && st == PT_OK) r->kept = gp;
+    else if (!o->reuse) gi_particle_free(gp);
     return st;
 }
 

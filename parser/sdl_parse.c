@@ -394,6 +394,7 @@ static pt_status run(const char *name, const char *text, const sdl_options *opt,
         sdl_parse_scene(&p);
         sdl_check_closed(&p);
     }
+    if (p.opt.frame_dependent) *p.opt.frame_dependent = p.frame_dependent;
     sdl_close_inputs(&p);
     sdl_geom_free(&p);
     sdl_files_close(&p);
