@@ -93,6 +93,7 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     }
     r->has_particle = 1;
     gi_particle_set_cancel(gp, o->cancel);
+    gi_particle_set_progress(gp, o->progress);
     if (!o->reuse || o->relight) {
         t0 = timer_now();
         st = o->reuse ? gi_particle_relight(gp, d) : gi_particle_light(gp, d);
@@ -127,6 +128,7 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
         if (st == PT_OK) st = render_aovs(sc, a, o, &ss, r, d);
     }
     r->particle = *gi_particle_get_stats(gp);
+    gi_particle_set_progress(gp, NULL); /* o->progress ends with this render */
     if (o->keep && st == PT_OK) r->kept = gp;
     else if (!o->reuse) gi_particle_free(gp);
     return st;

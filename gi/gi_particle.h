@@ -220,6 +220,10 @@ pt_status gi_particle_relight(gi_particle *gp, diag *d);
  * end. The caller tells a cancelled stage by its own flag. NULL (the
  * default): never cancelled. */
 void gi_particle_set_cancel(gi_particle *gp, volatile int *cancel);
+/* Where the later stages (lighting, view) report their steps from now on
+ * (settings.progress is the build's); NULL: nowhere. A GI kept across an
+ * animation's frames reports to each frame's own. */
+void gi_particle_set_progress(gi_particle *gp, progress *p);
 /* Change n_b and the scattering mode; takes effect at the next
  * gi_particle_relight (no geometry work). */
 void gi_particle_set_scattering(gi_particle *gp, int bounces, int scatter);
