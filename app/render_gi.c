@@ -15,6 +15,7 @@
 #include "pm_fg.h"
 #include "pm_path.h"
 #include "radrules.h"
+#include "shade_media.h"
 #include "shade_atmos.h"
 #include "shade_texture.h"
 #include "timer.h"
@@ -221,10 +222,36 @@ static pt_status render_reference(const scene *sc, const accel *a, const render_
     return st;
 }
 
+/* What render_gi_result's nm_* say, counted and warned once. */
+static void light_not_modelled(const scene *sc, int mode, render_gi_result *r, diag *d)
+{
+    const int media = media_scene_has(sc), fog = sc->fogs != NULL, rainbow = sc->rainbows != NULL;
+    const char *who = mode == GI_PATH ? "path" : mode == GI_PMFG ? "pmfg" : "particle";
+    if (mode == GI_PATH || mode == GI_PMFG) {
+        r->nm_media = media;
+        r->nm_rainbow = rainbow;
+    } else if (mode == GI_PARTICLE && radrules_of(sc, 1).media) {
+        /* `media on`: POV-Ray's gathering rays see media, fog and rainbows */
+        r->nm_media = media;
+        r->nm_fog = fog;
+        r->nm_rainbow = rainbow;
+    }
+    src_loc nowhere = {0};
+    if (r->nm_media)
+        diag_report(d, DIAG_WARNING, nowhere, NULL, "--gi %s: participating media are not modelled%s; the image lacks their light",
+                    who, mode == GI_PARTICLE ? " along gathering rays (radiosity media on)" : "");
+    if (r->nm_fog)
+        diag_report(d, DIAG_WARNING, nowhere, NULL, "--gi %s: fog is not modelled along gathering rays (radiosity media on)", who);
+    if (r->nm_rainbow)
+        diag_report(d, DIAG_WARNING, nowhere, NULL, "--gi %s: rainbow is not modelled%s", who,
+                    mode == GI_PARTICLE ? " along gathering rays (radiosity media on)" : "");
+}
+
 pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb, render_gi_result *r,
                     diag *d)
 {
     memset(r, 0, sizeof *r);
+    light_not_modelled(sc, o->mode, r, d);
     pt_status st;
     switch (o->mode) {
     case GI_PARTICLE: st = render_particle(sc, a, o, fb, r, d); break;
@@ -245,6 +272,11 @@ pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, fr
 
 void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
 {
+    stats_obj_begin(js, "light_not_modelled");
+    stats_int(js, "media", r->nm_media);
+    stats_int(js, "fog", r->nm_fog);
+    stats_int(js, "rainbow", r->nm_rainbow);
+    stats_obj_end(js);
     if (r->has_particle) {
         const gi_particle_stats *p = &r->particle;
         stats_obj_begin(js, "particle");

@@ -61,6 +61,11 @@ typedef struct {
                                  framebuffer holds what it rendered (before: nothing) */
     int ran_geometry, ran_lighting; /* particle: the stages this render ran (the view stage always runs) */
     gi_particle *kept;        /* particle with opts.keep: the GI, the caller frees it */
+    /* Light the scene uses that the mode does not carry (each also warned
+     * once): 1 where it is left out. path, pmfg: participating media
+     * (atmospheric or in objects) and rainbows on every ray; particle: with
+     * radiosity's `media on`, media, fog and rainbows along gathering rays. */
+    int nm_media, nm_fog, nm_rainbow;
 } render_gi_result;
 
 pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb, render_gi_result *r,
