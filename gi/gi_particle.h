@@ -126,15 +126,6 @@ typedef struct {
                             (no fixed supersampling); beyond 256 MiB of records (248 bytes a pixel) or
                             without the memory none are kept and the coarse pre-pass runs. 0
                             (default): nothing kept */
-    int nominal_areas;   /* 1: every area particle keeps the nominal dA = A/N (before 22 Nov 2026: reads
-                            ~1% bright, see gi_particle.c catchment_areas); 0 (default): each particle's
-                            area is its catchment, estimated from the gathering links that end on it */
-    int link_lookup;     /* the link builder's nearest-particle lookup: 0 (default) by the hit triangle
-                            (gi_trilook.h) where it decides, else the 3D grid; 1: the 3D grid only
-                            (the same links; tests compare the two) */
-    int leak_per_hit;    /* 1: the light-leak guard tests every hit's 3 radiance particles; 0 (default):
-                            once per interpolation cell, hits in clear cells skip it (gi_particle_cells.c
-                            cell_clear) */
     uint64_t seed;
     int threads;         /* <= 0: all cores */
     const char *cl_device; /* NULL/"auto", "c", "P:D" or part of a name (gi_cl.h) */
