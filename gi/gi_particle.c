@@ -672,15 +672,6 @@ int gi_particle_debug(const gi_particle *gp, const float **edir, const float **p
     return gp->ps.n;
 }
 
-int gi_particle_debug_links(const gi_particle *gp, const int **slink, int *ns2, const int **glink, int *ng)
-{
-    if (slink) *slink = gp->slink;
-    if (ns2) *ns2 = gp->ns2;
-    if (glink) *glink = gp->glink;
-    if (ng) *ng = gp->ng;
-    return gp->ps.n;
-}
-
 void gi_particle_debug_particle(const gi_particle *gp, int i, double *area, double rho[3], vec3 *pos, vec3 *nrm)
 {
     const gi_dev_particle *p = &gp->ps.p[i];

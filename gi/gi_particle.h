@@ -243,8 +243,6 @@ void gi_particle_free(gi_particle *gp);
  * last scattering (grey sums, fixed point converted to flux). */
 int gi_particle_debug(const gi_particle *gp, const float **edir, const float **phi, const float **lout,
                       const double **bounce_flux, int *nbounces);
-/* The scattering (n x ns2) and gathering (n x ng) links, n returned (tests). */
-int gi_particle_debug_links(const gi_particle *gp, const int **slink, int *ns2, const int **glink, int *ng);
 /* Area, reflectance and position of particle i (tests). */
 void gi_particle_debug_particle(const gi_particle *gp, int i, double *area, double rho[3], vec3 *pos, vec3 *nrm);
 

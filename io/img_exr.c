@@ -191,14 +191,6 @@ static exr_compression_t compression_of(int c)
     }
 }
 
-pt_status img_exr_write(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
-                        img_primaries prim, diag *d)
-{
-    float xy[8];
-    img_exr_primaries(prim, xy);
-    return img_exr_write_xy(fd, name, fb, o, xy, d);
-}
-
 /* One channel of the file: where its floats come from. */
 typedef struct {
     char name[80];

@@ -11,7 +11,7 @@
  * direct light by shadow rays (one POV-Ray light picked in proportion to its
  * unoccluded intensity, one emitter sample) + k_y/pi E_ind(y) + specular
  * lobes, where
- * E_ind is the photon irradiance estimate (pm_kdtree_irradiance; the maps
+ * E_ind is the photon irradiance estimate (vis_irradiance; the maps
  * hold only light that made at least one bounce, pm_photon.h).
  *
  * The caustic map adds at x: kd/pi E_c(x, n) + kb/pi E_c(x, -n). */
@@ -128,9 +128,13 @@ static int vis_filter(const fg_ctx *c, const pm_kdtree *t, vec3 x, vec3 nx, uint
 }
 
 /* Irradiance on the side nx of x from the k nearest photons of key surf
- * that x sees (vis_ok): the k-1 rule of pm_kdtree_irradiance over the
- * visible ones, the distance of the farthest visible one as the radius
- * (fewer than k in reach: all of them over pi max_r^2). */
+ * that x sees (vis_ok): the sum of the k-1 nearest visible powers over
+ * pi r_k^2, r_k the distance of the k-th (fewer than k in reach: all of
+ * them over pi max_r^2). The k-1 rule is unbiased for a uniform (Poisson)
+ * photon density: given r_k, the k-1 photons inside are uniform in the
+ * disc, and E[(k-1)/(pi r_k^2)] equals the density (r_k^2 is Gamma(k)
+ * distributed); Jensen's sum of all k over pi r_k^2 overestimates by
+ * k/(k-1). */
 static int vis_irradiance(const fg_ctx *c, const pm_kdtree *t, vec3 x, vec3 nx, uint32_t surf, int k, double max_r,
                           pm_neighbour *scratch, long *rays, rgb *e)
 {

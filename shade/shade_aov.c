@@ -14,7 +14,7 @@
 static const char *const aov_names[AOV_COUNT] = {"direct", "indirect", "albedo", "normal", "depth", "illuminance"};
 
 const char *shade_aov_name(int k) { return k >= 0 && k < AOV_COUNT ? aov_names[k] : NULL; }
-int shade_aov_channels(int k) { return k == AOV_DEPTH ? 1 : 3; }
+static int shade_aov_channels(int k) { return k == AOV_DEPTH ? 1 : 3; }
 const char *shade_aov_suffixes(int k) { return k == AOV_DEPTH ? "Z" : (k == AOV_NORMAL ? "XYZ" : "RGB"); }
 int shade_aov_is_colour(int k) { return k == AOV_DIRECT || k == AOV_INDIRECT || k == AOV_ALBEDO || k == AOV_ILLUMINANCE; }
 

@@ -45,7 +45,6 @@ typedef struct {
 } shade_aov;
 
 const char *shade_aov_name(int k);     /* "direct", ..., NULL out of range */
-int shade_aov_channels(int k);         /* 3, or 1 for depth */
 const char *shade_aov_suffixes(int k); /* channel name suffixes, one letter each: "RGB", "XYZ" or "Z" */
 int shade_aov_is_colour(int k);        /* 1: RGB in the render's colour space (direct, indirect, albedo, illuminance) */
 

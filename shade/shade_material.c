@@ -221,15 +221,6 @@ rgb mat_eval(const mat_bsdf *b, vec3 wi)
     return mrgb(0, 0, 0);
 }
 
-double mat_pdf(const mat_bsdf *b, vec3 wi)
-{
-    if (!(b->msum > 0.0)) return 0.0;
-    double cn = v3_dot(wi, b->n), cg = v3_dot(wi, b->ng);
-    if (cn > 0.0 && cg > 0.0) return b->m[MAT_LOBE_DIFFUSE] / b->msum * cn / M_PI;
-    if (cn < 0.0 && cg < 0.0) return b->m[MAT_LOBE_BACK] / b->msum * -cn / M_PI;
-    return 0.0;
-}
-
 vec3 mat_cosine_dir(vec3 n, double u1, double u2)
 {
     double r = sqrt(u1), phi = 2.0 * M_PI * u2;
@@ -239,7 +230,14 @@ vec3 mat_cosine_dir(vec3 n, double u1, double u2)
     return v3_add(v3_add(v3_scale(t, x), v3_scale(bt, y)), v3_scale(n, z));
 }
 
-int mat_sample_lobe(const mat_bsdf *b, double u_lobe, double u1, double u2, int absorb, mat_scatter *s)
+/* Sample a lobe and a direction. absorb = 0: a lobe is always chosen, with
+ * probability m_k / sum m (path tracer; Russian roulette is separate).
+ * absorb = 1: probability m_k (scaled down when sum m > 1), else the particle
+ * is absorbed (photon Russian roulette, seed 002 appendix A step 2(b)-(d),
+ * with the max channel as scatter probability so powers never grow).
+ * Returns 0 when nothing is sampled (absorbed, black, or a diffuse direction
+ * that the shading normal allows but the geometric normal does not). */
+static int mat_sample_lobe(const mat_bsdf *b, double u_lobe, double u1, double u2, int absorb, mat_scatter *s)
 {
     memset(s, 0, sizeof *s);
     s->eta2 = 1.0;

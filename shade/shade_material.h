@@ -116,18 +116,6 @@ void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, doubl
  * from); 0 where wi and the geometric normal disagree about the side. */
 rgb mat_eval(const mat_bsdf *b, vec3 wi);
 
-/* Density with which mat_sample(absorb = 0) picks the direction wi (solid
- * angle; delta lobes excluded). */
-double mat_pdf(const mat_bsdf *b, vec3 wi);
-
-/* Sample a lobe and a direction. absorb = 0: a lobe is always chosen, with
- * probability m_k / sum m (path tracer; Russian roulette is separate).
- * absorb = 1: probability m_k (scaled down when sum m > 1), else the particle
- * is absorbed (photon Russian roulette, seed 002 appendix A step 2(b)-(d),
- * with the max channel as scatter probability so powers never grow).
- * Returns 0 when nothing is sampled (absorbed, black, or a diffuse direction
- * that the shading normal allows but the geometric normal does not). */
-int mat_sample_lobe(const mat_bsdf *b, double u_lobe, double u1, double u2, int absorb, mat_scatter *s);
 int mat_sample(const mat_bsdf *b, rng *r, int absorb, mat_scatter *s);
 
 /* Cosine-weighted direction about unit n for (u1, u2) in [0,1)^2 (Malley:
