@@ -592,10 +592,12 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     wo.meta_values = vals;
     wo.nmeta = ls->aovs_text[0] ? 11 : 10;
     if (run->tile) memcpy(wo.window, run->win, sizeof wo.window);
-    if ((st == PT_OK || st == PT_CANCELLED) && g_cancel && !sst.image_begun) {
+    if (g_cancel && (!sst.image_begun || (st != PT_OK && st != PT_CANCELLED))) {
         /* Interrupted before the image pass (parse, accel or a GI stage):
          * no pixel was rendered, and a black "partial" image would say
-         * otherwise. */
+         * otherwise. A stage that failed because it was cut short (an
+         * OpenCL kernel build interrupted by SIGTERM) is an interruption
+         * too (130/143, which a farm runs again), not an error. */
         fprintf(stderr, "partray: interrupted before any pixel was rendered: no partial image\n");
         rc = g_cancel == SIGTERM ? 128 + SIGTERM : EXIT_INTERRUPTED;
     } else if ((st == PT_OK || st == PT_CANCELLED) && g_cancel) {
