@@ -562,7 +562,7 @@ const char cli_render_help[] =
     "  --max-depth N          path: vertices per path\n"
     "  --fg-rays N --photons N    pmfg: final-gather rays per pixel, photon paths\n"
     "\n"
-    "Colour and light (docs/colour.md, docs/units.md)\n"
+    "Colour and light (docs/guide.md, docs/units.md)\n"
     "  --display NAME --view NAME --look NAME --exposure STOPS --working-space NAME\n"
     "  --ocio-config FILE     OCIO display/view for PNG (default: the shipped config)\n"
     "  --false-color OUT.png  false-colour image of luminance or illuminance\n"
