@@ -63,8 +63,6 @@
 #include "timer.h"
 
 #define PLANE_EXTENT_FACTOR 1e4
-#define MAX_CSG_DEPTH GEOM_CSG_MAX_DEPTH
-#define MAX_MERGE_MEMBERS 64
 
 enum { GEOM_NONE = 0, GEOM_TRI, GEOM_USER, GEOM_INSTANCE };
 enum { INHERITED_FLAGS = OBJ_NO_SHADOW | OBJ_NO_IMAGE | OBJ_NO_REFLECTION | OBJ_NO_RADIOSITY };
@@ -280,11 +278,6 @@ static int add_leaf(accel *a, const scene_object *o, const scene_texture *tex, u
 
 /* ------------------------------------------------------------ bounded_by */
 
-static int is_csg_kind_early(shape_kind k)
-{
-    return k == SHAPE_UNION || k == SHAPE_MERGE || k == SHAPE_INTERSECTION || k == SHAPE_DIFFERENCE;
-}
-
 /* POV-Ray 3.7's Link_To_Frame drops the bound of a top-level object that is
  * cheap to intersect (remove_bounds, on by default): it keeps those of
  * unions, intersections/differences, merges, polys, text and quadrics
@@ -336,7 +329,7 @@ static int add_bound_objects(accel *a, diag *d, const scene_object *host, int bo
     for (int i = 0; list && i < list->u.csg.nkids; i++) {
         const scene_object *k = list->u.csg.kids[i];
         if (!k) continue;
-        if (is_csg_kind_early(k->kind) || k->clip) {
+        if (geom_csg_is_op(k->kind) || k->clip) {
             diag_warn_once(d, k->loc, "a CSG bounding object is not evaluated: the bound is ignored");
             continue;
         }
@@ -405,30 +398,6 @@ static int ray_in_bound(const accel *a, int b0, int bn, vec3 o, vec3 d, double t
 
 /* ------------------------------------------------------------ CSG */
 
-static int is_csg_kind(shape_kind k)
-{
-    return k == SHAPE_UNION || k == SHAPE_MERGE || k == SHAPE_INTERSECTION || k == SHAPE_DIFFERENCE;
-}
-
-static int csg_has_mesh(const scene_object *o, int depth)
-{
-    if (!o || depth > MAX_CSG_DEPTH) return 0;
-    if (o->kind == SHAPE_MESH) return 1;
-    if (is_csg_kind(o->kind))
-        for (int i = 0; i < o->u.csg.nkids; i++)
-            if (csg_has_mesh(o->u.csg.kids[i], depth + 1)) return 1;
-    return 0;
-}
-
-static int csg_leaf_count(const scene_object *o, int depth)
-{
-    if (!o || depth > MAX_CSG_DEPTH) return 0;
-    if (!is_csg_kind(o->kind)) return 1;
-    int n = 0;
-    for (int i = 0; i < o->u.csg.nkids; i++) n += csg_leaf_count(o->u.csg.kids[i], depth + 1);
-    return n;
-}
-
 /* geom_csg_build's leaf callback: the member's leaf record. */
 static int csg_leaf(void *ctx, const scene_object *o, const scene_texture *tex, unsigned flags)
 {
@@ -493,21 +462,21 @@ static pt_status collect(accel *a, diag *d, const scene_object *o, const scene_t
     unsigned flags = o->flags | (pflags & INHERITED_FLAGS);
     if (o->clip && o->kind != SHAPE_UNSUPPORTED) {
         /* clipped_by: one CSG primitive (exact) unless meshes are involved */
-        if (depth >= MAX_CSG_DEPTH) {
-            diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", MAX_CSG_DEPTH);
+        if (depth >= GEOM_CSG_MAX_DEPTH) {
+            diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", GEOM_CSG_MAX_DEPTH);
             return PT_ERR_LIMIT;
         }
-        if (!csg_has_mesh(o, depth) && !csg_has_mesh(o->clip, depth)) return build_csg(a, d, o, ptex, pflags, depth);
+        if (!geom_csg_has_mesh(o, depth) && !geom_csg_has_mesh(o->clip, depth)) return build_csg(a, d, o, ptex, pflags, depth);
         diag_warn_once(d, o->loc, "clipped_by with a mesh is not evaluated yet: the object is not clipped");
     }
     switch (o->kind) {
     case SHAPE_INTERSECTION:
     case SHAPE_DIFFERENCE: {
-        if (depth >= MAX_CSG_DEPTH) {
-            diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", MAX_CSG_DEPTH);
+        if (depth >= GEOM_CSG_MAX_DEPTH) {
+            diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", GEOM_CSG_MAX_DEPTH);
             return PT_ERR_LIMIT;
         }
-        if (!csg_has_mesh(o, depth)) return build_csg(a, d, o, ptex, pflags, depth);
+        if (!geom_csg_has_mesh(o, depth)) return build_csg(a, d, o, ptex, pflags, depth);
         diag_warn_once(d, o->loc,
                        "CSG intersection/difference with a mesh member is not evaluated yet: its parts are rendered as a union");
     }
@@ -515,14 +484,14 @@ static pt_status collect(accel *a, diag *d, const scene_object *o, const scene_t
     case SHAPE_MERGE:
         /* merge drops the members' internal surfaces (matters for
          * transparency): evaluated as a CSG primitive while small */
-        if (depth < MAX_CSG_DEPTH && !csg_has_mesh(o, depth) && csg_leaf_count(o, depth) <= MAX_MERGE_MEMBERS)
+        if (depth < GEOM_CSG_MAX_DEPTH && !geom_csg_has_mesh(o, depth) && geom_csg_leaf_count(o, depth) <= GEOM_CSG_MAX_MERGE)
             return build_csg(a, d, o, ptex, pflags, depth);
         diag_warn_once(d, o->loc, "merge with a mesh or more than %d members keeps its internal surfaces",
-                       MAX_MERGE_MEMBERS);
+                       GEOM_CSG_MAX_MERGE);
         /* fall through */
     case SHAPE_UNION: {
-        if (depth >= MAX_CSG_DEPTH) {
-            diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", MAX_CSG_DEPTH);
+        if (depth >= GEOM_CSG_MAX_DEPTH) {
+            diag_report(d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", GEOM_CSG_MAX_DEPTH);
             return PT_ERR_LIMIT;
         }
         /* the members keep the union's bound */

@@ -267,9 +267,9 @@ int geom_csg_inside(const geom_csg *c, int node, vec3 p)
     return r ^ nd->inverse;
 }
 
-/* Does a crossing of leaf `node`'s surface at p belong to the result? */
-static int kept(const geom_csg *c, int node, vec3 p)
+int geom_csg_kept(const geom_csg *c, int node, vec3 p)
 {
+    assert(node >= 0 && node < c->nnodes && c->nodes[node].op == GEOM_CSG_LEAF);
     int child = node;
     for (int par = c->nodes[child].parent; par >= 0; child = par, par = c->nodes[par].parent) {
         const geom_csg_node *P = &c->nodes[par];
@@ -317,7 +317,7 @@ int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, doubl
             int k = geom_shape_hits(&c->shapes[s], org, dir, from, best, tmp, CSG_CHUNK);
             int kept_one = 0;
             for (int j = 0; j < k; j++) {
-                if (kept(c, node, v3_madd(org, dir, tmp[j].t))) {
+                if (geom_csg_kept(c, node, v3_madd(org, dir, tmp[j].t))) {
                     best = tmp[j].t;
                     h->t = tmp[j].t;
                     h->shape = s;
@@ -339,9 +339,28 @@ int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, doubl
 
 /* ------------------------------------------------------------ building */
 
-static int is_csg_kind(shape_kind k)
+int geom_csg_is_op(shape_kind k)
 {
     return k == SHAPE_UNION || k == SHAPE_MERGE || k == SHAPE_INTERSECTION || k == SHAPE_DIFFERENCE;
+}
+
+int geom_csg_has_mesh(const scene_object *o, int depth)
+{
+    if (!o || depth > GEOM_CSG_MAX_DEPTH) return 0;
+    if (o->kind == SHAPE_MESH) return 1;
+    if (geom_csg_is_op(o->kind))
+        for (int i = 0; i < o->u.csg.nkids; i++)
+            if (geom_csg_has_mesh(o->u.csg.kids[i], depth + 1)) return 1;
+    return 0;
+}
+
+long geom_csg_leaf_count(const scene_object *o, int depth)
+{
+    if (!o || depth > GEOM_CSG_MAX_DEPTH) return 0;
+    if (!geom_csg_is_op(o->kind)) return 1;
+    long n = 0;
+    for (int i = 0; i < o->u.csg.nkids; i++) n += geom_csg_leaf_count(o->u.csg.kids[i], depth + 1);
+    return n;
 }
 
 /* `post` (clipped_by solids, whose transforms are relative to their host)
@@ -356,7 +375,7 @@ static pt_status build(geom_csg *c, const scene_object *o, const scene_texture *
     unsigned flags = o->flags | (pflags & b->inherit);
     int inverse = (o->flags & OBJ_INVERSE) != 0;
     geom_csg_op parent_op = parent >= 0 ? c->nodes[parent].op : GEOM_CSG_UNION;
-    if ((o->clip && !clip_done) || is_csg_kind(o->kind)) {
+    if ((o->clip && !clip_done) || geom_csg_is_op(o->kind)) {
         if (depth >= GEOM_CSG_MAX_DEPTH) {
             if (b->d) diag_report(b->d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", GEOM_CSG_MAX_DEPTH);
             return PT_ERR_LIMIT;
@@ -370,7 +389,7 @@ static pt_status build(geom_csg *c, const scene_object *o, const scene_texture *
         xform host = post ? xform_then(o->transform, *post) : o->transform;
         return build(c, o->clip, tex, flags, node, depth + 1, b, &host, 1, 0);
     }
-    if (is_csg_kind(o->kind)) {
+    if (geom_csg_is_op(o->kind)) {
         geom_csg_op op = o->kind == SHAPE_UNION ? GEOM_CSG_UNION
                        : o->kind == SHAPE_MERGE ? GEOM_CSG_MERGE
                        : o->kind == SHAPE_INTERSECTION ? GEOM_CSG_INTERSECTION : GEOM_CSG_DIFFERENCE;

@@ -26,6 +26,17 @@
 
 /* Deepest CSG nesting an object may have (an error beyond it). */
 #define GEOM_CSG_MAX_DEPTH 512
+/* A merge with more leaves is rendered as a union (accel.c): each member's
+ * inside tests would cost more than the internal surfaces they remove. */
+#define GEOM_CSG_MAX_MERGE 64
+
+/* union, merge, intersection or difference */
+int geom_csg_is_op(shape_kind k);
+/* o, or a member of it at any level, is a mesh (depth: o's nesting level;
+ * nothing deeper than GEOM_CSG_MAX_DEPTH counts). */
+int geom_csg_has_mesh(const scene_object *o, int depth);
+/* The leaves of o (1 for a leaf), as far as GEOM_CSG_MAX_DEPTH. */
+long geom_csg_leaf_count(const scene_object *o, int depth);
 
 typedef enum { GEOM_CSG_LEAF, GEOM_CSG_UNION, GEOM_CSG_MERGE, GEOM_CSG_INTERSECTION, GEOM_CSG_DIFFERENCE } geom_csg_op;
 
@@ -104,5 +115,8 @@ pt_status geom_csg_build(geom_csg *c, const scene_object *o, const scene_texture
 /* Nearest crossing of the result with t in (tmin, tmax). */
 int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, geom_csg_hit *h);
 int geom_csg_inside(const geom_csg *c, int node, vec3 p);
+/* Does a point p on the surface of leaf `node` belong to the result's
+ * surface (the member rules at every level up to the root)? */
+int geom_csg_kept(const geom_csg *c, int node, vec3 p);
 
 #endif

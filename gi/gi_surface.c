@@ -635,11 +635,7 @@ void gi_surface_free(gi_surface *g)
     if (!g) return;
     accel_surf_free(g->as);
     for (int i = 0; i < g->np; i++) gi_surface_free_patch(&g->p[i]);
-    for (int i = 0; i < g->ncn; i++) {
-        if (g->cn[i].sh) geom_shape_release(g->cn[i].sh);
-        free(g->cn[i].sh);
-    }
-    free(g->cn);
+    gi_surface_csg_free(g);
     free(g->mv);
     free(g->mn);
     free(g->mt);
@@ -664,6 +660,7 @@ int gi_surface_side_mask(const gi_surface *g, int i) { return g->p[i].mask ? g->
 int gi_surface_csg_member(const gi_surface *g, int i) { return g->p[i].cnode >= 0; }
 const scene_object *gi_surface_object(const gi_surface *g, int i) { return g->o[g->p[i].obj].obj; }
 const scene_texture *gi_surface_texture(const gi_surface *g, int i) { return g->p[i].tex; }
+double gi_surface_total_area(const gi_surface *g) { return g->total_area; }
 long gi_surface_nrp(const gi_surface *g) { return g->nrp; }
 long gi_surface_rp_slots(const gi_surface *g) { return g->nslot; }
 long gi_surface_skipped(const gi_surface *g) { return g->skipped; }
@@ -677,7 +674,7 @@ int gi_surface_has_particles(const gi_surface *g, const accel_hit *hit)
 size_t gi_surface_bytes(const gi_surface *g)
 {
     return (size_t)g->capp * sizeof(patch) + (size_t)g->capo * sizeof(obj_rec) + (size_t)g->hcap * sizeof(int) +
-           (size_t)g->capcdf * sizeof(double) + (size_t)g->capcn * sizeof(csg_node) +
+           (size_t)g->capcdf * sizeof(double) + (size_t)g->capct * sizeof(geom_csg) + (size_t)g->capcm * sizeof(csg_member) +
            (size_t)g->capmv * 2 * sizeof(vec3) + (size_t)g->capmt * 4 * sizeof(int) +
            (size_t)g->nce * sizeof(cell_entry) + (g->slot_rp ? (size_t)(g->nslot + g->nrp) * sizeof(int) : 0) +
            (g->rp_patch ? (size_t)g->nrp * sizeof(int) : 0) +

@@ -1,6 +1,7 @@
 /* gi_surface_csg.c - particles on members of CSG: only where a member's
  * surface is the result's surface. */
 #include "gi_surface_internal.h"
+#include <assert.h>
 #include <math.h>
 #include "geom_shape.h"
 #include "geom_hfield.h"
@@ -15,134 +16,26 @@
 /* ------------------------------------------------------------ CSG members
  *
  * A member of merge, intersection or difference has particles only where
- * its surface is the CSG result's surface: POV-Ray's rule (as geom_csg.h),
- * applied at every level from the member up to the root: intersection keeps
- * a point inside all siblings, merge outside all of them, difference the
- * first member's points outside all the others and a subtracted member's
- * inside the first and outside the rest; union keeps everything. Inside
- * tests are the members' own (geom_shape_inside, POV-Ray's Inside_Object:
- * union/merge any, intersection all, difference the first and none of the
- * others, inverse negating). */
+ * its surface is the CSG result's surface: the renderer's tree of the
+ * object (geom_csg_build, clipped_by solids included) and its member rule
+ * (geom_csg_kept: POV-Ray's, at every level from the member up to the
+ * root). */
 
-static int add_cnode(gi_surface *g, const scene_object *o, int parent)
-{
-    if (g->ncn == g->capcn) {
-        int nc = g->capcn ? 2 * g->capcn : 64;
-        csg_node *nn = realloc(g->cn, (size_t)nc * sizeof *nn);
-        if (!nn) return -1;
-        g->cn = nn;
-        g->capcn = nc;
-    }
-    csg_node *c = &g->cn[g->ncn];
-    memset(c, 0, sizeof *c);
-    c->o = o;
-    c->parent = parent;
-    c->first = -1;
-    return g->ncn++;
-}
-
-static int is_csg_kind(shape_kind k)
-{
-    return k == SHAPE_UNION || k == SHAPE_MERGE || k == SHAPE_INTERSECTION || k == SHAPE_DIFFERENCE;
-}
-
-/* Kids of node `at` (a CSG object), consecutive, then their subtrees. */
-static pt_status build_cnodes(gi_surface *g, int at, int depth)
-{
-    const scene_object *o = g->cn[at].o;
-    if (depth > 512) return PT_ERR_LIMIT;
-    int first = g->ncn;
-    for (int i = 0; i < o->u.csg.nkids; i++)
-        if (add_cnode(g, o->u.csg.kids[i], at) < 0) return PT_ERR_NOMEM;
-    g->cn[at].first = first;
-    g->cn[at].nkids = o->u.csg.nkids;
-    for (int i = 0; i < o->u.csg.nkids; i++) {
-        const scene_object *k = o->u.csg.kids[i];
-        if (is_csg_kind(k->kind)) {
-            pt_status st = build_cnodes(g, first + i, depth + 1);
-            if (st != PT_OK) return st;
-        } else {
-            geom_shape *sh = malloc(sizeof *sh);
-            if (!sh) return PT_ERR_NOMEM;
-            if (geom_shape_init(sh, k) != 0) {
-                free(sh);
-                continue;
-            }
-            g->cn[first + i].sh = sh;
-        }
-    }
-    return PT_OK;
-}
-
-static int csg_inside(const gi_surface *g, int node, vec3 p)
-{
-    const csg_node *c = &g->cn[node];
-    int in = 0;
-    switch (c->o->kind) {
-    case SHAPE_UNION: case SHAPE_MERGE:
-        for (int i = 0; i < c->nkids && !in; i++) in = csg_inside(g, c->first + i, p);
-        break;
-    case SHAPE_INTERSECTION:
-        in = c->nkids > 0;
-        for (int i = 0; i < c->nkids && in; i++) in = csg_inside(g, c->first + i, p);
-        break;
-    case SHAPE_DIFFERENCE:
-        in = c->nkids > 0 && csg_inside(g, c->first, p);
-        for (int i = 1; i < c->nkids && in; i++) in = !csg_inside(g, c->first + i, p);
-        break;
-    default:
-        in = c->sh ? geom_shape_inside(c->sh, p) : 0;
-        break;
-    }
-    return (c->o->flags & OBJ_INVERSE) ? !in : in;
-}
-
-/* An odd number of inversions on the node and its ancestors, a subtracted
- * member of a difference counting as one (geom_csg.c's inv_odd). */
-static int csg_inv_odd(const gi_surface *g, int node)
-{
-    int odd = 0;
-    for (int n = node; n >= 0; n = g->cn[n].parent) {
-        odd ^= (g->cn[n].o->flags & OBJ_INVERSE) != 0;
-        int par = g->cn[n].parent;
-        if (par >= 0 && g->cn[par].o->kind == SHAPE_DIFFERENCE && n != g->cn[par].first) odd ^= 1;
-    }
-    return odd;
-}
-
-/* Is world point p (on the surface of member `node`) on the CSG result's surface? */
 int gi_surface_csg_keep(const gi_surface *g, int node, vec3 p)
 {
-    for (int n = node; g->cn[n].parent >= 0; n = g->cn[n].parent) {
-        const csg_node *P = &g->cn[g->cn[n].parent];
-        int i = n - P->first;
-        shape_kind op = P->o->kind;
-        /* an inverted union is POV-Ray's intersection of inverted members
-         * (De Morgan): its surfaces are a merge's, as geom_csg.c keeps them */
-        if (op == SHAPE_UNION && csg_inv_odd(g, g->cn[n].parent)) op = SHAPE_MERGE;
-        if (op == SHAPE_UNION) continue;
-        for (int j = 0; j < P->nkids; j++) {
-            if (j == i) continue;
-            int in = csg_inside(g, P->first + j, p);
-            int need_in = op == SHAPE_INTERSECTION || (op == SHAPE_DIFFERENCE && i > 0 && j == 0);
-            if (in != need_in) return 0;
-        }
-    }
-    return 1;
+    assert(node >= 0 && node < g->ncm);
+    const csg_member *m = &g->cm[node];
+    return geom_csg_kept(&g->ct[m->tree], m->node, p);
 }
 
-/* The side of member `node` that faces out of the result: 1 (its inside)
- * when it is inverse, or subtracted in a difference, or under an inverse
- * CSG an odd number of times in all. */
-static int csg_flip(const gi_surface *g, int node)
+void gi_surface_csg_free(gi_surface *g)
 {
-    int flip = (g->cn[node].o->flags & OBJ_INVERSE) != 0;
-    for (int n = node; g->cn[n].parent >= 0; n = g->cn[n].parent) {
-        const csg_node *P = &g->cn[g->cn[n].parent];
-        if (P->o->kind == SHAPE_DIFFERENCE && n - P->first > 0) flip ^= 1;
-        if (P->o->flags & OBJ_INVERSE) flip ^= 1;
-    }
-    return flip;
+    for (int i = 0; i < g->nct; i++) geom_csg_free(&g->ct[i]);
+    free(g->ct);
+    free(g->cm);
+    g->ct = NULL;
+    g->cm = NULL;
+    g->nct = g->capct = g->ncm = g->capcm = 0;
 }
 
 static int keep_fn(void *ctx, vec3 p)
@@ -155,13 +48,9 @@ static int keep_fn(void *ctx, vec3 p)
  * own shape, keeping the crossings on the result's surface. */
 pt_status gi_surface_csg_add_piece(gi_surface *g, const scene_object *o, const scene_texture *tex)
 {
-    const geom_shape *nsh = g->cn[g->cur_node].sh;
-    if (!nsh) {
-        g->skipped++;
-        diag_warn_once(g->d, o->loc, "particle GI: no particles on %s objects in CSG (they get no indirect light)",
-                       o->name ? o->name : "these");
-        return PT_OK;
-    }
+    assert(g->cur_node >= 0 && g->cur_node < g->ncm);
+    const csg_member *m = &g->cm[g->cur_node];
+    const geom_shape *nsh = &g->ct[m->tree].shapes[m->shape];
     patch p;
     memset(&p, 0, sizeof p);
     p.kind = PATCH_PIECE;
@@ -207,44 +96,85 @@ pt_status gi_surface_csg_add_piece(gi_surface *g, const scene_object *o, const s
 }
 
 
-static int has_mesh_member(const scene_object *o, int depth)
-{
-    if (!o || depth > 512) return 0;
-    if (o->kind == SHAPE_MESH) return 1;
-    if (!is_csg_kind(o->kind)) return 0;
-    for (int i = 0; i < o->u.csg.nkids; i++)
-        if (has_mesh_member(o->u.csg.kids[i], depth + 1)) return 1;
-    return 0;
-}
+/* geom_csg_build's leaf callback: the members in the order they are added. */
+typedef struct {
+    const scene_object *o;
+    const scene_texture *tex;
+    unsigned flags;
+} leaf_rec;
 
-static long leaf_count(const scene_object *o, int depth)
-{
-    if (!o || depth > 512) return 0;
-    if (!is_csg_kind(o->kind)) return 1;
-    long n = 0;
-    for (int i = 0; i < o->u.csg.nkids; i++) n += leaf_count(o->u.csg.kids[i], depth + 1);
-    return n;
-}
+typedef struct {
+    leaf_rec *l;
+    int n, cap;
+} leaf_list;
 
-/* Members of a CSG tree built by build_cnodes; both: the camera or a light
- * is inside the result, so the members get both sides. */
-static pt_status walk_member(gi_surface *g, int node, const scene_texture *tex, int both)
+static int list_leaf(void *ctx, const scene_object *o, const scene_texture *tex, unsigned flags)
 {
-    const scene_object *o = g->cn[node].o;
-    if (o->texture) tex = o->texture;
-    if (o->flags & OBJ_NO_RADIOSITY) return PT_OK;
-    if (is_csg_kind(o->kind)) {
-        int first = g->cn[node].first, nk = g->cn[node].nkids;
-        for (int i = 0; i < nk; i++) {
-            pt_status st = walk_member(g, first + i, tex, both);
-            if (st != PT_OK) return st;
-        }
-        return PT_OK;
+    leaf_list *ll = ctx;
+    if (ll->n == ll->cap) {
+        int nc = ll->cap ? 2 * ll->cap : 16;
+        leaf_rec *nl = realloc(ll->l, (size_t)nc * sizeof *nl);
+        if (!nl) return -1;
+        ll->l = nl;
+        ll->cap = nc;
     }
-    g->cur_node = node;
-    g->cur_mask = both ? 3 : (unsigned char)(1u << csg_flip(g, node));
-    pt_status st = gi_surface_add_leaf(g, o, tex, 1);
-    g->cur_node = -1;
+    ll->l[ll->n].o = o;
+    ll->l[ll->n].tex = tex;
+    ll->l[ll->n].flags = flags;
+    return ll->n++;
+}
+
+/* The tree of CSG object o (the renderer's: geom_csg_build, clipped_by
+ * solids included), then particles on each member with a surface: on the
+ * side facing out of the result (the member's flip), or on both when the
+ * camera or a light is inside the result. */
+static pt_status walk_tree(gi_surface *g, const scene_object *o, const scene_texture *tex)
+{
+    if (g->nct == g->capct) {
+        int nc = g->capct ? 2 * g->capct : 8;
+        geom_csg *nt = realloc(g->ct, (size_t)nc * sizeof *nt);
+        if (!nt) return PT_ERR_NOMEM;
+        g->ct = nt;
+        g->capct = nc;
+    }
+    int tree = g->nct++;
+    geom_csg *c = &g->ct[tree];
+    memset(c, 0, sizeof *c);
+    leaf_list ll = {NULL, 0, 0};
+    geom_csg_builder b = {list_leaf, &ll, OBJ_NO_RADIOSITY, 0, NULL, 0};
+    pt_status st = geom_csg_build(c, o, tex, 0, -1, 0, &b);
+    if (st != PT_OK || !geom_csg_finish(c)) {
+        free(ll.l);
+        return st; /* an empty result has no particles */
+    }
+    const scene *s = g->sc;
+    int both = s->camera_set && geom_csg_inside(c, 0, s->camera.location);
+    for (int i = 0; i < s->nlights && !both; i++) both = geom_csg_inside(c, 0, s->lights[i].position);
+    for (int k = 0; k < c->nshapes && st == PT_OK; k++) {
+        int node = c->shape_node[k];
+        assert(c->shape_leaf[k] < (unsigned)ll.n);
+        const leaf_rec *lr = &ll.l[c->shape_leaf[k]];
+        if (c->nodes[node].nosurf) continue; /* a clipped_by solid */
+        if (lr->flags & OBJ_NO_RADIOSITY) continue;
+        if (g->ncm == g->capcm) {
+            int nc = g->capcm ? 2 * g->capcm : 64;
+            csg_member *nm = realloc(g->cm, (size_t)nc * sizeof *nm);
+            if (!nm) {
+                st = PT_ERR_NOMEM;
+                break;
+            }
+            g->cm = nm;
+            g->capcm = nc;
+        }
+        g->cm[g->ncm].tree = tree;
+        g->cm[g->ncm].node = node;
+        g->cm[g->ncm].shape = k;
+        g->cur_node = g->ncm++;
+        g->cur_mask = both ? 3 : (unsigned char)(1u << c->nodes[node].flip);
+        st = gi_surface_add_leaf(g, lr->o, lr->tex, 1);
+        g->cur_node = -1;
+    }
+    free(ll.l);
     return st;
 }
 
@@ -252,14 +182,8 @@ int gi_surface_csg_walk(gi_surface *g, const scene_object *o, const scene_textur
 {
     /* accel renders CSG with a mesh member, and merges of more than 64
      * members, as unions (accel.c) */
-    if (o->kind == SHAPE_UNION || has_mesh_member(o, 0) || (o->kind == SHAPE_MERGE && leaf_count(o, 0) > 64)) return 0;
-    int root = add_cnode(g, o, -1);
-    *status = root < 0 ? PT_ERR_NOMEM : build_cnodes(g, root, 0);
-    if (*status != PT_OK) return 1;
-    const scene *s = g->sc;
-    int both = s->camera_set && csg_inside(g, root, s->camera.location);
-    for (int i = 0; i < s->nlights && !both; i++) both = csg_inside(g, root, s->lights[i].position);
-    for (int i = 0; i < g->cn[root].nkids && *status == PT_OK; i++)
-        *status = walk_member(g, g->cn[root].first + i, tex, both);
+    if (o->kind == SHAPE_UNION || geom_csg_has_mesh(o, 0) || (o->kind == SHAPE_MERGE && geom_csg_leaf_count(o, 0) > GEOM_CSG_MAX_MERGE))
+        return 0;
+    *status = walk_tree(g, o, tex);
     return 1;
 }

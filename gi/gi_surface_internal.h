@@ -8,6 +8,7 @@
 #include <stdint.h>
 #include "geom_shape.h"
 #include "accel_surface.h"
+#include "geom_csg.h"
 #include "geom_tess.h"
 #include "hash.h"
 #include "gi_surface.h"
@@ -39,7 +40,7 @@ typedef struct {
     long cdf0;        /* PIECE with npieces > 1: their cumulative areas at cdf[cdf0..] */
     const scene_texture *tex;
     unsigned char mask; /* sides that get particles (bit s: side s); CSG members: the visible one */
-    int cnode;        /* CSG member: its node (csg_node), -1 otherwise */
+    int cnode;        /* CSG member: its index in gi_surface.cm, -1 otherwise */
     /* PIECE: the shape (for its grid) and, for CSG members, its own sampler */
     geom_shape *sh;
     int own_sh;
@@ -64,12 +65,11 @@ typedef struct {
 } tri_loc;
 _Static_assert(sizeof(tri_loc) == 128, "tri_loc: two cache lines (aligned_alloc size)");
 
-/* CSG trees of members with particles: node kids are consecutive. */
+/* A member of a CSG tree with particles: its tree (gi_surface.ct), its
+ * leaf node and shape there. */
 typedef struct {
-    const scene_object *o;
-    int parent, first, nkids;
-    geom_shape *sh;  /* leaves: their shape (NULL: no inside) */
-} csg_node;
+    int tree, node, shape;
+} csg_member;
 
 typedef struct keep_sampler {
     geom_tess_sampler cs;
@@ -105,9 +105,11 @@ struct gi_surface {
     accel_surf *as;   /* area sampling shared with reference/ (accel_surface.h) */
     double *cdf;      /* PIECE patches of several pieces (polygons, height fields) */
     long ncdf, capcdf;
-    csg_node *cn;     /* CSG trees (gi_surface_csg_keep) */
-    int ncn, capcn;
-    int cur_node;     /* while walking CSG members: the member's node, else -1 */
+    geom_csg *ct;     /* CSG trees (geom_csg_build) of the objects walked with the CSG rule */
+    int nct, capct;
+    csg_member *cm;   /* their members (gi_surface_csg_keep) */
+    int ncm, capcm;
+    int cur_node;     /* while walking CSG members: the member's index in cm, else -1 */
     unsigned char cur_mask;
     /* grids of implicit shapes (PIECE patches): world vertices and normals,
      * triangles (local vertex indices), and the locate hash (sorted cells) */
@@ -155,6 +157,8 @@ int gi_surface_csg_walk(gi_surface *g, const scene_object *o, const scene_textur
 pt_status gi_surface_csg_add_piece(gi_surface *g, const scene_object *o, const scene_texture *tex);
 /* Is world point p (on the surface of member `node`) on the CSG result's surface? */
 int gi_surface_csg_keep(const gi_surface *g, int node, vec3 p);
+/* Frees the trees. */
+void gi_surface_csg_free(gi_surface *g);
 
 /* Grids of implicit shapes (gi_surface_mesh.c). */
 void gi_surface_build_meshes(gi_surface *g);
