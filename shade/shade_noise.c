@@ -179,8 +179,7 @@ static void init_all(void)
     init_waves();
 }
 
-/* Build the tables (idempotent, thread-safe). */
-static void noise_init(void) { pthread_once(&init_once, init_all); }
+void noise_init(void) { pthread_once(&init_once, init_all); }
 
 /* ------------------------------------------------------------ lattice noise */
 

@@ -556,7 +556,6 @@ rgb tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir)
 /* ------------------------------------------------------------ shadows */
 
 static int pigment_transparent(const scene_pigment *pg, int depth);
-static int tex_transparent(const scene_texture *t);
 
 static int map_transparent(const scene_blend_map *m, int depth)
 {
@@ -582,7 +581,7 @@ static int pigment_transparent(const scene_pigment *pg, int depth)
     return map_transparent(pg->map, depth);
 }
 
-static int tex_transparent(const scene_texture *t)
+int tex_transparent(const scene_texture *t)
 {
     for (; t; t = t->next) {
         if (t->pat && t->map) {

@@ -22,7 +22,7 @@
 
 #define SIZE 160
 #define TOLERANCE 0.01
-/* Our own regression bound: measured values are 0.0002-0.0012; the issue's
+/* Our own regression bound, a margin over the printed differences: the
  * acceptance bound above is loose enough to miss a small missing feature. */
 #define REGRESSION 0.004
 
