@@ -6,7 +6,7 @@
  * (library path), +FE/+FN (format of an output named without extension),
  * +WTn (work threads), +Kc (clock), +KFIn +KFFn +KIc +KFc +KC (animation
  * frames and clocks, cyclic), +SFn +EFn (frame subset), +SCn +ECn +SRn +ERn
- * (render window), +Qn (quality 0-11, shade.h). Switches that only
+ * (render window), +Qn (quality 0-11, shade.h), +UA (alpha). Switches that only
  * concern POV-Ray's display or its own files (+D, -D, +P, +V, +J...) are accepted and ignored. INI files and
  * Key=value options are expanded into these switches first (ini.h). */
 #include "cli.h"
@@ -126,14 +126,28 @@ static int pov_switch(const char *arg, cli_render *o, char *err, int errlen)
         }
         break;
     }
-    case 'F': /* +F[type][bits]: N PNG (+FN16: 16 bits), E OpenEXR; others are POV-Ray formats partray does not write */
+    case 'F': { /* +F[type][bits] (POV-Ray 3.7 "Output File Type"): N PNG, E OpenEXR, S the system's
+                   format (PNG on Unix); +FNn: n bits per colour (above 8: 16-bit PNG) */
+        char t = (char)(v[0] >= 'a' && v[0] <= 'z' ? v[0] - 32 : v[0]);
         if (!*v) return 0;
-        if (v[0] == 'N' || v[0] == 'n' || v[0] == 'E' || v[0] == 'e') {
-            o->format = (char)(v[0] == 'n' || v[0] == 'N' ? 'N' : 'E');
-            if (o->format == 'N' && strcmp(v + 1, "16") == 0) o->png16 = 1;
-            return 0;
+        if (t == 'N' || t == 'S' || t == 'E') {
+            o->format = t == 'E' ? 'E' : 'N';
+            if (!v[1]) return 0;
+            int bits;
+            if (o->format == 'N' && parse_int(v + 1, &bits) && bits >= 1 && bits <= 16) {
+                o->png16 = bits > 8;
+                return 0;
+            }
+            break;
+        }
+        const char *name = t == 'C' || t == 'T' ? "Targa" : t == 'P' ? "PPM" : t == 'B' ? "BMP" : t == 'J' ? "JPEG" : t == 'H' ? "Radiance HDR" : NULL;
+        if (name) {
+            snprintf(err, (size_t)errlen, "%s: %s output is not written; +FN (PNG), +FE (OpenEXR) or an output named .pfm are", arg,
+                     name);
+            return 2;
         }
         break;
+    }
     case 'Q': { /* +Qn, POV-Ray 3.7 view.cpp: clip(Quality, 0, 9) */
         int q;
         if (parse_int(v, &q) && q >= 0 && q <= 11) {
@@ -144,6 +158,13 @@ static int pov_switch(const char *arg, cli_render *o, char *err, int errlen)
         snprintf(err, (size_t)errlen, "+Q wants a quality level 0 to 11, got '%s'", arg);
         return 2;
     }
+    case 'U': /* +UA alpha (Output_Alpha); +UD +UL +UV +UR +UO: POV-Ray's vista, light buffers, bounds: nothing here */
+        if ((v[0] == 'A' || v[0] == 'a') && !v[1]) {
+            o->alpha = on;
+            return 0;
+        }
+        if (v[0] && !v[1] && strchr("DdLlVvRrOo", v[0])) return 0;
+        break;
     case 'D': case 'P': case 'V': case 'J': case 'X': case 'G': case 'B': case 'C':
         return 0; /* display, pause, verbose, jitter...: ignored */
     default:
@@ -514,7 +535,9 @@ const char cli_render_help[] =
     "                         .pfm (linear float); repeat for several outputs of one render.\n"
     "                         +O without an extension takes the +F type's (POV-Ray)\n"
     "  +FN[16] +FE +FP        output type of +O: PNG (16 bits), OpenEXR, PFM\n"
-    "  +UA                    alpha: background pixels transparent (PNG RGBA, EXR A)\n"
+    "  +UA                    alpha channel (PNG RGBA straight, EXR A associated): each\n"
+    "                         pixel's coverage; the background is clear unless a 3.7\n"
+    "                         scene declares an opaque background{}\n"
     "  --float                32-bit EXR (default half)\n"
     "  --exr-compression none|zip|piz    --png16   16-bit PNG\n"
     "  --stats FILE.json      stage times, ray counts, what was built\n"
@@ -539,7 +562,7 @@ const char cli_render_help[] =
     "  --max-depth N          path: vertices per path\n"
     "  --fg-rays N --photons N    pmfg: final-gather rays per pixel, photon paths\n"
     "\n"
-    "Colour and light (docs/colour.md, docs/units.md)\n"
+    "Colour and light (docs/guide.md, docs/units.md)\n"
     "  --display NAME --view NAME --look NAME --exposure STOPS --working-space NAME\n"
     "  --ocio-config FILE     OCIO display/view for PNG (default: the shipped config)\n"
     "  --false-color OUT.png  false-colour image of luminance or illuminance\n"

@@ -95,6 +95,7 @@ typedef struct {
     char format;            /* +F: 'N' PNG, 'E' EXR, 0 = from the output name */
     int quality;            /* +Qn: POV-Ray's quality 0..9 (default 9; 10 and 11 are 9, as POV-Ray clips) */
     int quality_given;
+    int alpha;              /* +UA: an alpha channel in PNG and EXR outputs (shade_alpha) */
 } cli_render;
 
 /* The render window the options ask for, as pixels [x0,x1) x [y0,y1) of a

@@ -27,6 +27,7 @@
  * comes from the files in DIR, whatever engine runs the tasks. */
 #include "cmd_farm.h"
 #include <errno.h>
+#include <limits.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -45,7 +46,7 @@
 #define FARM_MAX_TILES 256
 
 typedef struct {
-    char dir[2048];        /* absolute */
+    char dir[1024];        /* absolute */
     char partray[2048];    /* this binary */
     int first, last, digits, animated;
     int tiles, width, height;
@@ -131,7 +132,7 @@ static int write_text(const char *path, const char *text)
 
 static int save_plan(const farm_plan *p)
 {
-    char path[2100], text[8192];
+    char path[2100], text[16384];
     snprintf(text, sizeof text,
              "partray_farm 1\ndir %s\npartray %s\nframes %d %d %d %d\ntiles %d %d %d\noutput %s\nengine %s\n"
              "max_rounds %d\nsshloginfile %s\njobs %d\nretries %d\n",
@@ -192,7 +193,7 @@ typedef struct {
     int retry[FARM_MAX_TILES * 64]; /* task indices to run again */
     int nretry;
     int failed;                     /* tasks that failed for good */
-    char why[512];
+    char why[1200];
 } farm_state;
 
 /* Looks at DIR: frames merged, tiles there; merges every frame whose tiles
@@ -350,7 +351,7 @@ static int merge_step(const char *dir)
         return 1;
     }
     if (s.failed || strcmp(p.engine, "slurm") == 0) {
-        char t[700];
+        char t[1300];
         snprintf(t, sizeof t, "failed: %s\n", s.why[0] ? s.why : "frames missing");
         write_text(path, t);
         return 1;
@@ -602,11 +603,14 @@ int cmd_farm(int argc, char **argv)
     p.last = plan.last;
     p.digits = plan.digits;
     p.animated = plan.animated;
-    if (!subproc_mkdirs(dir) || !realpath(dir, p.dir) || !subproc_self_exe(p.partray, sizeof p.partray)) {
+    char real[PATH_MAX];
+    if (!subproc_mkdirs(dir) || !realpath(dir, real) || strlen(real) >= sizeof p.dir ||
+        !subproc_self_exe(p.partray, sizeof p.partray)) {
         fprintf(stderr, "partray farm: cannot make the work directory '%s': %s\n", dir, strerror(errno));
         ini_free(ia);
         return 3;
     }
+    memcpy(p.dir, real, strlen(real) + 1);
     char cwd[2048];
     if (!getcwd(cwd, sizeof cwd)) cwd[0] = 0;
     if (!out) snprintf(p.output, sizeof p.output, "%s/frame.exr", p.dir);
@@ -618,11 +622,12 @@ int cmd_farm(int argc, char **argv)
         return 2;
     }
     if (sshlogin) {
-        if (!realpath(sshlogin, p.sshloginfile)) {
+        if (!realpath(sshlogin, real) || strlen(real) >= sizeof p.sshloginfile) {
             fprintf(stderr, "partray farm: --sshloginfile '%s': %s\n", sshlogin, strerror(errno));
             ini_free(ia);
             return 3;
         }
+        memcpy(p.sshloginfile, real, strlen(real) + 1);
     } else {
         snprintf(p.sshloginfile, sizeof p.sshloginfile, "%s/sshloginfile", p.dir);
         write_text(p.sshloginfile, ":\n"); /* this machine */

@@ -70,6 +70,7 @@ static const ini_key keys[] = {
     {"Output_File_Type", K_FTYPE, "+F%s", NULL},
     {"Declare", K_DECLARE, "-D%s", NULL},
     {"Quality", K_INT, "+Q%d", NULL},
+    {"Output_Alpha", K_BOOL, "+UA", "-UA"},
     {"Work_Threads", K_INT, "+WT%d", NULL},
 };
 
@@ -83,7 +84,7 @@ static const char *const pov_keys[] = {
     "Draw_Vistas", "Fatal_Console", "Fatal_Error_Command", "Fatal_Error_Return", "Fatal_File", "Field_Render",
     "File_Gamma", "Frame_Step", "Grayscale_Output", "Greyscale_Output", "High_Reproducibility", "Histogram_Name",
     "Histogram_Grid_Size", "Histogram_Type", "Include_Header", "Include_Ini", "Jitter_Amount", "Jitter",
-    "Light_Buffer", "Max_Image_Buffer_Memory", "Odd_Field", "Output_Alpha", "Output_To_File", "Palette",
+    "Light_Buffer", "Max_Image_Buffer_Memory", "Odd_Field", "Output_To_File", "Palette",
     "Pause_When_Done", "Post_Frame_Command", "Post_Frame_Return", "Post_Scene_Command", "Post_Scene_Return",
     "Preview_End_Size", "Preview_Start_Size", "Pre_Frame_Command", "Pre_Frame_Return", "Pre_Scene_Command",
     "Pre_Scene_Return", "Radiosity_File_Name", "Radiosity_From_File", "Radiosity_To_File",

@@ -27,6 +27,7 @@
 #include "scene.h"
 #include "sdl.h"
 #include "shade.h"
+#include "shade_aov.h"
 #include "shade_funcenv.h"
 #include "stats_json.h"
 #include "timer.h"
@@ -283,6 +284,83 @@ static int write_false_color(const cli_render *o, const framebuffer *fb, const l
     return status_exit(st);
 }
 
+/* Particle GI kept from one frame of an animation to the next: the scene
+ * and accel its geometry stage was built from, and the hashes of the
+ * stages' inputs it was built with (stage_hashes). */
+typedef struct {
+    scene *sc;
+    accel *acc;
+    gi_particle *gp;
+    uint64_t h_geom, h_light;
+} gi_keep;
+
+static void gi_keep_free(gi_keep *k)
+{
+    gi_particle_free(k->gp);
+    accel_free(k->acc);
+    scene_free(k->sc);
+    memset(k, 0, sizeof *k);
+}
+
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 0x100000001b3ULL;
+    return h;
+}
+#define FNV(h, field) fnv((h), &(field), sizeof(field))
+
+/* The hashes of the GI stages' inputs in the IR.
+ *  - geometry (and everything else but the camera and the lights: objects,
+ *    materials, media, global settings): the scene file's bytes and the
+ *    options, which are the same in every frame of one run, and the frame
+ *    number when the parser saw a per-frame value read outside camera{} and
+ *    light_source{} (sdl_options.frame_dependent), when a light carries
+ *    geometry (looks_like, projected_through) or the camera does (normal,
+ *    mesh_camera); and the number of lights (the lighting stage edits
+ *    lights in place);
+ *  - lighting: every light's fields;
+ *  - view: the camera, which the view stage always takes as given. */
+static void stage_hashes(const scene *sc, uint64_t file_hash, int frame_dependent, int frame, uint64_t *h_geom,
+                         uint64_t *h_light)
+{
+    uint64_t g = 0xcbf29ce484222325ULL, l = g;
+    int dep = frame_dependent || sc->camera.normal || sc->camera.nmeshes > 0;
+    for (int i = 0; i < sc->nlights; i++) {
+        const scene_light *li = &sc->lights[i];
+        if (li->looks_like || li->projected_through) dep = 1;
+        l = FNV(l, li->kind);
+        l = FNV(l, li->position);
+        l = FNV(l, li->colour);
+        l = FNV(l, li->point_at);
+        l = FNV(l, li->radius);
+        l = FNV(l, li->falloff);
+        l = FNV(l, li->tightness);
+        l = FNV(l, li->parallel);
+        l = FNV(l, li->area);
+        l = FNV(l, li->axis1);
+        l = FNV(l, li->axis2);
+        l = FNV(l, li->size1);
+        l = FNV(l, li->size2);
+        l = FNV(l, li->adaptive);
+        l = FNV(l, li->jitter);
+        l = FNV(l, li->circular);
+        l = FNV(l, li->orient);
+        l = FNV(l, li->area_illumination);
+        l = FNV(l, li->fade_distance);
+        l = FNV(l, li->fade_power);
+        l = FNV(l, li->shadowless);
+        l = FNV(l, li->media_interaction);
+        l = FNV(l, li->media_attenuation);
+        l = FNV(l, li->group);
+    }
+    g = FNV(g, file_hash);
+    g = FNV(g, sc->nlights);
+    if (dep) g = FNV(g, frame);
+    *h_geom = g;
+    *h_light = l ^ g;
+}
+
 /* What stays the same from frame to frame of one `partray render`. */
 typedef struct {
     cli_render *o;
@@ -292,7 +370,25 @@ typedef struct {
     int tile;               /* 1: a window smaller than the image was asked for */
     uint64_t scene_hash;    /* FNV-1a 64 of the scene file's bytes */
     double t_start;
+    gi_keep keep;           /* particle GI of the previous frame */
 } render_run;
+
+/* A copy of fb with straight alpha: colour / alpha where alpha > 0. */
+static framebuffer *straight_alpha(const framebuffer *fb)
+{
+    framebuffer *c = fb_new(fb->width, fb->height);
+    if (!c) return NULL;
+    size_t n = (size_t)fb->width * (size_t)fb->height;
+    c->alpha = malloc(sizeof(float) * n);
+    if (!c->alpha) {
+        fb_free(c);
+        return NULL;
+    }
+    memcpy(c->alpha, fb->alpha, sizeof(float) * n);
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) c->rgb[i * 3 + k] = fb->alpha[i] > 0 ? fb->rgb[i * 3 + k] / fb->alpha[i] : fb->rgb[i * 3 + k];
+    return c;
+}
 
 /* FNV-1a 64 of a file's bytes (0 when unreadable: the parser reports it). */
 static uint64_t file_hash(const char *path)
@@ -321,6 +417,8 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     progress *prog = progress_new();
     pbar *bar = pbar_start(prog, o->quiet);
     so.progress = prog;
+    int frame_dependent = 1;
+    so.frame_dependent = &frame_dependent;
     diag *d = diag_new();
     diag_set_sink(d, pbar_diag_sink, bar);
     scene *sc = NULL;
@@ -360,11 +458,35 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     }
 
     int threads = o->threads > 0 ? o->threads : pool_default_threads();
+    /* GI across an animation's frames: each stage runs again only when the
+     * hash of its inputs changed (stage_hashes); the frame then renders the
+     * kept scene with this frame's camera and lights. */
+    int reuse = 0, relight = 0, keep_gi = gi == GI_PARTICLE && plan->animated && !run->tile;
+    uint64_t h_geom = 0, h_light = 0;
+    if (keep_gi) {
+        stage_hashes(sc, run->scene_hash, frame_dependent, frame, &h_geom, &h_light);
+        if (run->keep.gp && h_geom == run->keep.h_geom) {
+            reuse = 1;
+            relight = h_light != run->keep.h_light;
+            scene *ks = run->keep.sc;
+            ks->camera = sc->camera; /* no pointers: a camera with any makes h_geom per frame */
+            for (int i = 0; i < sc->nlights && relight; i++) {
+                src_loc keep_loc = ks->lights[i].loc; /* the kept scene's file name */
+                ks->lights[i] = sc->lights[i];        /* looks_like, projected_through NULL (stage_hashes) */
+                ks->lights[i].loc = keep_loc;
+            }
+            run->keep.h_light = h_light;
+            scene_free(sc);
+            sc = ks;
+        } else if (run->keep.gp) {
+            gi_keep_free(&run->keep);
+        }
+    }
     accel_set_function_env(shade_func_env()); /* isosurface functions: noise, pigment functions */
     t0 = timer_now();
-    progress_stage(prog, "accel", 0);
-    accel *acc = accel_build(sc, threads, d, &st);
-    double t_accel = timer_now() - t0;
+    if (!reuse) progress_stage(prog, "accel", 0);
+    accel *acc = reuse ? run->keep.acc : accel_build(sc, threads, d, &st);
+    double t_accel = reuse ? 0.0 : timer_now() - t0;
     if (!acc || st != PT_OK) {
         scene_free(sc);
         diag_free(d);
@@ -395,6 +517,9 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     ss.progress = prog;
     ss.notes = d;
     ss.cancel = &g_cancel;
+    ss.reuse = reuse ? run->keep.gp : NULL;
+    ss.relight = relight;
+    ss.keep = keep_gi;
     if (run->tile) memcpy(ss.window, run->win, sizeof ss.window);
     char *progressive = NULL;
     if ((gi == GI_PATH || gi == GI_PMFG) && noutputs > 0 && img_format_from_path(outputs[0]) != IMG_FMT_UNKNOWN) {
@@ -408,6 +533,23 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     pt_status lst = ls->aov ? PT_OK : lighting_alloc(ls, ss.width, ss.height, d);
     ss.aov = ls->aov;
     st = fb && lst == PT_OK ? render_gi(sc, acc, &ss, fb, &sst, d) : PT_ERR_NOMEM;
+    if (st == PT_OK && o->alpha && !g_cancel) {
+        /* +UA: each pixel's coverage (shade_aov.h); the colour stays
+         * associated (premultiplied: a clear background adds nothing) */
+        fb->alpha = malloc(sizeof(float) * (size_t)ss.width * (size_t)ss.height);
+        if (!fb->alpha) {
+            st = PT_ERR_NOMEM;
+        } else {
+            shade_settings as;
+            shade_default_settings(&as);
+            as.width = ss.width;
+            as.height = ss.height;
+            as.threads = threads;
+            as.antialias = ss.antialias;
+            as.cancel = &g_cancel;
+            shade_alpha(sc, acc, &as, fb->alpha);
+        }
+    }
     double t_render = sst.t_render > 0 ? sst.t_render : timer_now() - t0;
     /* the progressive image of a finished render is no longer needed */
     if (progressive && !g_cancel) remove(progressive);
@@ -450,10 +592,12 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     wo.meta_values = vals;
     wo.nmeta = ls->aovs_text[0] ? 11 : 10;
     if (run->tile) memcpy(wo.window, run->win, sizeof wo.window);
-    if ((st == PT_OK || st == PT_CANCELLED) && g_cancel && !sst.image_begun) {
+    if (g_cancel && (!sst.image_begun || (st != PT_OK && st != PT_CANCELLED))) {
         /* Interrupted before the image pass (parse, accel or a GI stage):
          * no pixel was rendered, and a black "partial" image would say
-         * otherwise. */
+         * otherwise. A stage that failed because it was cut short (an
+         * OpenCL kernel build interrupted by SIGTERM) is an interruption
+         * too (130/143, which a farm runs again), not an error. */
         fprintf(stderr, "partray: interrupted before any pixel was rendered: no partial image\n");
         rc = g_cancel == SIGTERM ? 128 + SIGTERM : EXIT_INTERRUPTED;
     } else if ((st == PT_OK || st == PT_CANCELLED) && g_cancel) {
@@ -472,7 +616,12 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     } else {
         for (int i = 0; i < noutputs && rc == EXIT_OK; i++) {
             diag *wd = diag_new();
-            pt_status ws = img_write(outputs[i], fb, &wo, wd);
+            /* PNG's alpha is straight (PNG spec 12.8), EXR's associated */
+            framebuffer *straight = fb->alpha && img_format_from_path(outputs[i]) == IMG_FMT_PNG ? straight_alpha(fb) : NULL;
+            if (fb->alpha && img_format_from_path(outputs[i]) == IMG_FMT_PFM)
+                diag_warn_once(wd, (src_loc){0}, "+UA: PFM has no alpha channel: %s is written without it", outputs[i]);
+            pt_status ws = img_write(outputs[i], straight ? straight : fb, &wo, wd);
+            fb_free(straight);
             print_diags(wd, 0);
             diag_free(wd);
             if (ws != PT_OK) rc = status_exit(ws);
@@ -495,6 +644,10 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
         stats_num(&js, "total", plan->animated ? t_total : timer_now() - run->t_start);
         stats_obj_end(&js);
         if (plan->animated) stats_int(&js, "frame", frame);
+        if (keep_gi) {
+            stats_int(&js, "gi_geometry_ran", sst.ran_geometry);
+            stats_int(&js, "gi_lighting_ran", sst.ran_lighting);
+        }
         stats_int(&js, "rays", sst.primary_rays + sst.shadow_rays + sst.secondary_rays + sst.other_rays);
         stats_int(&js, "primary_rays", sst.primary_rays);
         stats_int(&js, "shadow_rays", sst.shadow_rays);
@@ -536,10 +689,22 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
         if (sst.t_gi_geometry > 0 || sst.t_gi_lighting > 0)
             fprintf(stderr, "partray: %sgi %s: geometry %.3f s, lighting %.3f s\n", fr, gi_used, sst.t_gi_geometry,
                     sst.t_gi_lighting);
+        if (keep_gi)
+            fprintf(stderr, "partray: %sgi stages run: %s%sview\n", fr, sst.ran_geometry ? "geometry, " : "",
+                    sst.ran_lighting ? "lighting, " : "");
     }
     fb_free(fb);
-    accel_free(acc);
-    scene_free(sc);
+    if (keep_gi && sst.kept && !reuse) {
+        /* this frame's GI, scene and accel serve the next frames */
+        run->keep.sc = sc;
+        run->keep.acc = acc;
+        run->keep.gp = sst.kept;
+        run->keep.h_geom = h_geom;
+        run->keep.h_light = h_light;
+    } else if (!reuse) {
+        accel_free(acc);
+        scene_free(sc);
+    }
     diag_free(d);
     pbar_free(bar);
     progress_free(prog);
@@ -678,6 +843,7 @@ static int cmd_render(int argc, char **argv)
     if (!o.quiet && rc == EXIT_OK && plan.animated)
         fprintf(stderr, "partray: %d frames in %.3f s\n", nframes, timer_now() - t_start);
     for (int i = 0; i < nbases; i++) free(bases[i]);
+    gi_keep_free(&run.keep);
     lighting_free(&ls);
     img_ocio_close(oc);
     ini_free(ia);

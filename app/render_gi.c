@@ -15,6 +15,7 @@
 #include "pm_fg.h"
 #include "pm_path.h"
 #include "radrules.h"
+#include "shade_media.h"
 #include "shade_atmos.h"
 #include "shade_texture.h"
 #include "timer.h"
@@ -82,16 +83,24 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     gs.keep_hits = o->antialias != 2;
     pt_status st = PT_OK;
     double t0 = timer_now();
-    gi_particle *gp = gi_particle_build(sc, a, &gs, &r->particle, d, &st);
-    r->t_gi_geometry = timer_now() - t0;
-    /* cancelled: nothing rendered, the caller sees its flag (as in the
-     * other modes, which stop at a tile) */
-    if (!gp) return st == PT_CANCELLED ? PT_OK : (st == PT_OK ? PT_ERR_INTERNAL : st);
+    gi_particle *gp = o->reuse;
+    if (!gp) {
+        gp = gi_particle_build(sc, a, &gs, &r->particle, d, &st);
+        r->t_gi_geometry = timer_now() - t0;
+        /* cancelled: nothing rendered, the caller sees its flag (as in the
+         * other modes, which stop at a tile) */
+        if (!gp) return st == PT_CANCELLED ? PT_OK : (st == PT_OK ? PT_ERR_INTERNAL : st);
+        r->ran_geometry = 1;
+    }
     r->has_particle = 1;
     gi_particle_set_cancel(gp, o->cancel);
-    t0 = timer_now();
-    st = gi_particle_light(gp, d);
-    r->t_gi_lighting = timer_now() - t0;
+    gi_particle_set_progress(gp, o->progress);
+    if (!o->reuse || o->relight) {
+        t0 = timer_now();
+        st = o->reuse ? gi_particle_relight(gp, d) : gi_particle_light(gp, d);
+        r->t_gi_lighting = timer_now() - t0;
+        r->ran_lighting = 1;
+    }
     if (st == PT_OK) {
         shade_settings ss;
         fill_shade(&ss, o);
@@ -120,7 +129,9 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
         if (st == PT_OK) st = render_aovs(sc, a, o, &ss, r, d);
     }
     r->particle = *gi_particle_get_stats(gp);
-    gi_particle_free(gp);
+    gi_particle_set_progress(gp, NULL); /* o->progress ends with this render */
+    if (o->keep && st == PT_OK) r->kept = gp;
+    else if (!o->reuse) gi_particle_free(gp);
     return st;
 }
 
@@ -211,10 +222,36 @@ static pt_status render_reference(const scene *sc, const accel *a, const render_
     return st;
 }
 
+/* What render_gi_result's nm_* say, counted and warned once. */
+static void light_not_modelled(const scene *sc, int mode, render_gi_result *r, diag *d)
+{
+    const int media = media_scene_has(sc), fog = sc->fogs != NULL, rainbow = sc->rainbows != NULL;
+    const char *who = mode == GI_PATH ? "path" : mode == GI_PMFG ? "pmfg" : "particle";
+    if (mode == GI_PATH || mode == GI_PMFG) {
+        r->nm_media = media;
+        r->nm_rainbow = rainbow;
+    } else if (mode == GI_PARTICLE && radrules_of(sc, 1).media) {
+        /* `media on`: POV-Ray's gathering rays see media, fog and rainbows */
+        r->nm_media = media;
+        r->nm_fog = fog;
+        r->nm_rainbow = rainbow;
+    }
+    src_loc nowhere = {0};
+    if (r->nm_media)
+        diag_report(d, DIAG_WARNING, nowhere, NULL, "--gi %s: participating media are not modelled%s; the image lacks their light",
+                    who, mode == GI_PARTICLE ? " along gathering rays (radiosity media on)" : "");
+    if (r->nm_fog)
+        diag_report(d, DIAG_WARNING, nowhere, NULL, "--gi %s: fog is not modelled along gathering rays (radiosity media on)", who);
+    if (r->nm_rainbow)
+        diag_report(d, DIAG_WARNING, nowhere, NULL, "--gi %s: rainbow is not modelled%s", who,
+                    mode == GI_PARTICLE ? " along gathering rays (radiosity media on)" : "");
+}
+
 pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb, render_gi_result *r,
                     diag *d)
 {
     memset(r, 0, sizeof *r);
+    light_not_modelled(sc, o->mode, r, d);
     pt_status st;
     switch (o->mode) {
     case GI_PARTICLE: st = render_particle(sc, a, o, fb, r, d); break;
@@ -235,6 +272,11 @@ pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, fr
 
 void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
 {
+    stats_obj_begin(js, "light_not_modelled");
+    stats_int(js, "media", r->nm_media);
+    stats_int(js, "fog", r->nm_fog);
+    stats_int(js, "rainbow", r->nm_rainbow);
+    stats_obj_end(js);
     if (r->has_particle) {
         const gi_particle_stats *p = &r->particle;
         stats_obj_begin(js, "particle");

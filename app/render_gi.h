@@ -34,6 +34,14 @@ typedef struct {
     progress *progress;       /* stages and counts of every step (core/progress.h); NULL: none */
     diag *notes;              /* reference modes: a note each time the progressive image is written */
     const char *progressive_path; /* reference modes: write the image so far here every few seconds */
+    /* particle: GI kept from an earlier frame of the same scene (its
+     * geometry stage; the scene and accel it was built with are the ones
+     * given). relight: the lights changed since, run the lighting stage
+     * again; otherwise only the view stage runs. keep: hand the GI back in
+     * render_gi_result.kept instead of freeing it. */
+    gi_particle *reuse;
+    int relight;
+    int keep;
     int window[4];            /* none/particle: render window x0,y0,x1,y1 (shade_settings.window); 0 = all */
     shade_aov *aov;           /* non-NULL: fill these AOVs after the render (shade_aov.h); the indirect
                                  AOV comes from particle GI only (0 for none, pmfg, path) */
@@ -51,6 +59,13 @@ typedef struct {
     double c_render;          /* particle: process CPU seconds of prepare_view + the Whitted pass */
     int image_begun;          /* the pass that writes the image began: a cancelled render's
                                  framebuffer holds what it rendered (before: nothing) */
+    int ran_geometry, ran_lighting; /* particle: the stages this render ran (the view stage always runs) */
+    gi_particle *kept;        /* particle with opts.keep: the GI, the caller frees it */
+    /* Light the scene uses that the mode does not carry (each also warned
+     * once): 1 where it is left out. path, pmfg: participating media
+     * (atmospheric or in objects) and rainbows on every ray; particle: with
+     * radiosity's `media on`, media, fog and rainbows along gathering rays. */
+    int nm_media, nm_fog, nm_rainbow;
 } render_gi_result;
 
 pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb, render_gi_result *r,

@@ -374,13 +374,6 @@ static const gi_backend *find(int mode)
     return NULL;
 }
 
-int view_gi_modes(int *modes, int n)
-{
-    int k = 0;
-    for (int i = 0; i < NBACKENDS && k < n; i++) modes[k++] = backends[i].mode;
-    return k;
-}
-
 int view_gi_available(int mode) { return find(mode) != NULL; }
 
 int view_gi_next(int mode)
@@ -430,7 +423,6 @@ pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a,
     return PT_OK;
 }
 
-int view_gi_mode(const view_gi *g) { return g->b->mode; }
 scene *view_gi_scene(view_gi *g) { return &g->sc; }
 int view_gi_last_level(const view_gi *g) { return g->last_level; }
 

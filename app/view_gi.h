@@ -65,9 +65,6 @@ typedef struct {
     int coarse;             /* set by view_gi_render: the pass uses the preview lighting */
 } view_gi_pass;
 
-/* The modes (gi.h's gi_mode values) the viewer can switch to, in the order
- * `G` cycles them. Returns the count written into modes[] (at most n). */
-int view_gi_modes(int *modes, int n);
 int view_gi_available(int mode);
 /* The mode after `mode` in the cycle. */
 int view_gi_next(int mode);
@@ -77,7 +74,6 @@ const char *view_gi_name(int mode);
  * outlive the instance): runs whatever the mode precomputes. */
 pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t,
                        diag *d);
-int view_gi_mode(const view_gi *g);
 /* The instance's scene: set its camera and lights before a pass. */
 scene *view_gi_scene(view_gi *g);
 /* The last level of the refinement (none/particle 2, path/pmfg 1 + log2 ref_spp). */

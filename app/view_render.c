@@ -85,14 +85,6 @@ static void lut_init(void)
     }
 }
 
-uint8_t view_render_srgb8(float v)
-{
-    pthread_once(&lut_once, lut_init);
-    if (!(v > 0.0f)) return 0; /* also NaN */
-    if (v >= 1.0f) return 255;
-    return srgb_lut[(int)(v * SRGB_LUT + 0.5f)];
-}
-
 
 /* Upsample src (w x h) into dst (W x H) bilinearly (pixel centres aligned);
  * a copy when the sizes agree. */

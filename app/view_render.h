@@ -109,7 +109,4 @@ void view_render_messages(view_render *vr, diag *d);
 /* Stops the thread (cancelling the pass) and frees everything but the scene. */
 void view_render_stop(view_render *vr);
 
-/* Linear -> sRGB 8-bit (clamped), the conversion used for the window. */
-uint8_t view_render_srgb8(float v);
-
 #endif

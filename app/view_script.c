@@ -323,8 +323,6 @@ void view_script_start(view_script *vs, double now)
     vs->origin = now;
 }
 
-int view_script_started(const view_script *vs) { return vs->started; }
-
 int view_script_next(view_script *vs, double now, int idle, view_action *a)
 {
     if (!vs->started) return 0;

@@ -104,7 +104,6 @@ void view_script_free(view_script *vs);
 
 /* Starts the clock (call when the first image is on screen). */
 void view_script_start(view_script *vs, double now);
-int view_script_started(const view_script *vs);
 /* The next due event at wall time `now`: returns 1 and fills *a, or 0 when
  * nothing is due yet (or a wait-idle holds: `idle` is the renderer's state). */
 int view_script_next(view_script *vs, double now, int idle, view_action *a);

@@ -5,20 +5,15 @@
  *
  *   bench_gi [SCENE.pov] [--size N] [--count N] [--nb N] [--threads N]
  *            [--device SPEC] [--reps N] [--out PREFIX] [--sweep] [--spp N] [--full]
- *            [--area-samples N] [--ref REF.exr] [--ref-spp N] [--per-hit]
- *            [--stride N] [--grid-links]
+ *            [--area-samples N] [--ref REF.exr] [--ref-spp N] [--stride N] [--no-keep]
  *
  * --full scatters along all links every bounce (GI_PARTICLE_SCATTER_FULL)
  * instead of the paper's random walks; --area-samples N caps the shadow rays
- * per particle per area light (0: the whole grid). --per-hit makes the
- * hook's light-leak guard test every hit (leak_per_hit) instead of caching
- * a verdict per cell. --stride N: the view pre-pass traces every Nth pixel
+ * per particle per area light (0: the whole grid). --stride N: the view pre-pass traces every Nth pixel
  * in x and y (prepass_stride; 0 the default). --no-keep: the render traces
  * its own camera rays (keep_hits 0, the coarse pre-pass); by default, at 1
  * spp, the pre-pass traces every pixel and the render takes its hits
- * (keep_hits, gi_particle_primary_hit). --grid-links resolves every link hit
- * with the 3D grid (link_lookup 1) instead of the hit triangle's list (the
- * same links).
+ * (keep_hits, gi_particle_primary_hit).
  * --spp N renders N stratified samples per pixel (shade.c fixed
  * supersampling) in both modes, for image comparisons against references.
  * --out PREFIX writes PREFIX_none.exr and PREFIX_particle.exr. --sweep runs
@@ -52,7 +47,7 @@
 
 typedef struct {
     const char *scene;
-    int size, threads, nb, reps, sweep, spp, full, area_samples, ref_spp, per_hit, stride, no_keep, grid_links;
+    int size, threads, nb, reps, sweep, spp, full, area_samples, ref_spp, stride, no_keep;
     long count;
     const char *device, *out, *ref;
 } opts;
@@ -184,7 +179,7 @@ static void sweep(const scene *sc, const accel *a, const opts *o, diag *d)
 
 int main(int argc, char **argv)
 {
-    opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 1, 0, -1, 0, 0, 0, 0, 0, 50000, NULL, NULL, NULL};
+    opts o = {BENCH_SCENE_DIR "/cbox.pov", 512, 0, 8, 3, 0, 1, 0, -1, 0, 0, 0, 50000, NULL, NULL, NULL};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -200,9 +195,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--ref-spp") && v) { o.ref_spp = atoi(v); i++; }
         else if (!strcmp(a, "--spp") && v) { o.spp = atoi(v); i++; }
         else if (!strcmp(a, "--full")) o.full = 1;
-        else if (!strcmp(a, "--per-hit")) o.per_hit = 1;
         else if (!strcmp(a, "--no-keep")) o.no_keep = 1;
-        else if (!strcmp(a, "--grid-links")) o.grid_links = 1;
         else if (!strcmp(a, "--stride") && v) { o.stride = atoi(v); i++; }
         else if (!strcmp(a, "--area-samples") && v) { o.area_samples = atoi(v); i++; }
         else if (a[0] != '-') o.scene = a;
@@ -246,8 +239,6 @@ int main(int argc, char **argv)
     s.cl_device = o.device;
     if (o.full) s.scatter = GI_PARTICLE_SCATTER_FULL;
     if (o.area_samples >= 0) s.area_samples = o.area_samples;
-    s.leak_per_hit = o.per_hit;
-    s.link_lookup = o.grid_links;
     s.prepass_stride = o.stride;
     s.keep_hits = !o.no_keep && o.spp <= 1;
     gi_particle_stats gs;
@@ -386,9 +377,9 @@ int main(int argc, char **argv)
            "between misses; %ld hits kept for the render (%.1f MiB), %.1f%% of lookups took their cell from one\n",
            1e3 * x->c_prepass, o.stride > 0 ? o.stride : (s.keep_hits ? 1 : 2), x->prepass_rays, x->prepass_planar,
            x->prepass_missed, x->prepass_kept, x->bytes_view / 1048576.0, 100.0 * x->lookups_kept / fmax(1, x->lookups));
-    printf("  light-leak guard: %s; %ld cells tested (%ld clear, %.1f%%), %.1f%% of lookups in clear cells, "
+    printf("  light-leak guard: %ld cells tested (%ld clear, %.1f%%), %.1f%% of lookups in clear cells, "
            "table %.1f MiB\n",
-           o.per_hit ? "per hit" : "per cell", x->cells, x->cells_clear, 100.0 * x->cells_clear / fmax(1, x->cells),
+           x->cells, x->cells_clear, 100.0 * x->cells_clear / fmax(1, x->cells),
            100.0 * x->lookups_clear / fmax(1, x->lookups), x->bytes_cells / 1048576.0);
     printf("mean luminance: none %.5f, particle %.5f\n", img_mean_luminance(fb_none, 0), img_mean_luminance(fb_gi, 0));
     {

@@ -737,7 +737,8 @@ static const internal_entry table[FUNC_INTERNAL_COUNT] = {
 int func_internal_params(int n) { return n >= 0 && n < FUNC_INTERNAL_COUNT ? table[n].params : -1; }
 const char *func_internal_name(int n) { return n >= 0 && n < FUNC_INTERNAL_COUNT ? table[n].name : NULL; }
 
-int func_internal_available(int n, int have_noise)
+/* 1 if internal(n) is implemented here (with `noise` given for the noise ones). */
+static int func_internal_available(int n, int have_noise)
 {
     if (n < 0 || n >= FUNC_INTERNAL_COUNT || !table[n].fn) return 0;
     return !table[n].noise || have_noise;

@@ -16,8 +16,6 @@
 int func_internal_params(int n);
 /* The functions.inc name ("f_sphere"), or NULL. */
 const char *func_internal_name(int n);
-/* 1 if internal(n) is implemented here (with `noise` given for the noise ones). */
-int func_internal_available(int n, int have_noise);
 /* Evaluate internal(n) at a[0..params). Returns 0 (and sets *out to 0) when
  * it cannot (unknown n, noise needed but env has none). */
 int func_internal_eval(int n, const double *a, const func_env *env, double *out);

@@ -36,4 +36,12 @@ rgb radrules_emission(const radrules *r, const scene *sc, const scene_finish *f)
     return e;
 }
 
+int radrules_gather_level(int k) { return k > 0 ? (int)(1.5 * k) : 0; }
+
+int radrules_level_limit(const scene *sc, int gather_level)
+{
+    int m = sc->global.max_trace_level > 0 ? sc->global.max_trace_level : 5;
+    return gather_level > 0 && m < gather_level + 1 ? gather_level + 1 : m;
+}
+
 int radrules_gathers(unsigned obj_flags) { return !(obj_flags & OBJ_NO_RADIOSITY); }

@@ -43,7 +43,14 @@
  *    weight below which gathering rays stop recursing) and `max_sample`
  *    set the accuracy and bias of POV-Ray's irradiance cache, not the
  *    light the scene converges to; a mode that estimates without a cache
- *    has nothing to take from them. */
+ *    has nothing to take from them.
+ * 7. Trace levels (trace.cpp TraceRay; radiosity.cpp GetRecursionSettings):
+ *    a ray at level >= max_trace_level returns black. A camera ray is at
+ *    level 0 and each reflected or refracted ray one above its parent; the
+ *    rays of the k-th gathering step (k = 1, 2, ...) start at int(1.5 k),
+ *    with the limit raised to at least that + 1. This is what bounds light
+ *    trapped in glass (total internal reflection adds the transmitted weight
+ *    to the mirror, so a POV-Ray finish can return more than it receives). */
 #ifndef PT_RADRULES_H
 #define PT_RADRULES_H
 #include "scene.h"
@@ -66,6 +73,11 @@ int radrules_legacy(const scene *sc);
 
 /* E of rule 1 for finish f (multiply by pigment * opacity for Le). */
 rgb radrules_emission(const radrules *r, const scene *sc, const scene_finish *f);
+
+/* Rule 7: the level of the rays of gathering step k >= 1, and the level
+ * limit there for a scene limit of max_trace_level. */
+int radrules_gather_level(int k);
+int radrules_level_limit(const scene *sc, int gather_level);
 
 /* Rule 3: 1 when a gathering ray may hit an object with these flags. */
 int radrules_gathers(unsigned obj_flags);

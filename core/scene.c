@@ -66,7 +66,7 @@ void scene_default_light(scene_light *l)
     l->media_attenuation = 0;
 }
 
-void scene_default_global(scene_global *g)
+static void scene_default_global(scene_global *g)
 {
     memset(g, 0, sizeof *g);
     g->ambient_light = (rgb){1, 1, 1};

@@ -101,6 +101,4 @@ void gi_cellvis_put(gi_cellvis *c, uint64_t key, int verdict)
     }
 }
 
-long gi_cellvis_count(const gi_cellvis *c) { return c ? atomic_load_explicit(&c->count, memory_order_relaxed) : 0; }
-
 size_t gi_cellvis_bytes(const gi_cellvis *c) { return c ? sizeof *c + (size_t)(c->mask + 1) * sizeof(uint64_t) : 0; }

@@ -49,8 +49,6 @@ void gi_cellvis_prefetch(const gi_cellvis *c, uint64_t key);
 /* Stores a verdict (GI_CELL_CLEAR or GI_CELL_BLOCKED) unless the table is
  * full; thread-safe. */
 void gi_cellvis_put(gi_cellvis *c, uint64_t key, int verdict);
-/* Cells stored, and bytes held. */
-long gi_cellvis_count(const gi_cellvis *c);
 size_t gi_cellvis_bytes(const gi_cellvis *c);
 
 #endif

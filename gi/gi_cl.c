@@ -119,7 +119,6 @@ int gi_dev_opencl_built(void)
 }
 
 const char *gi_dev_name(const gi_dev *dv) { return dv ? dv->name : "none"; }
-int gi_dev_is_opencl(const gi_dev *dv) { return dv && dv->is_cl; }
 double gi_dev_build_seconds(const gi_dev *dv) { return dv ? dv->build_seconds : 0.0; }
 size_t gi_dev_bytes(const gi_dev *dv) { return dv ? dv->bytes : 0; }
 

@@ -42,7 +42,6 @@ typedef struct {
 gi_dev *gi_dev_open(const gi_dev_options *o, diag *d, pt_status *status);
 void gi_dev_free(gi_dev *dv);
 const char *gi_dev_name(const gi_dev *dv);
-int gi_dev_is_opencl(const gi_dev *dv);
 double gi_dev_build_seconds(const gi_dev *dv); /* program build (0 for the C build) */
 size_t gi_dev_bytes(const gi_dev *dv);          /* device buffers held (OpenCL) or scratch (C) */
 /* Whether this binary was built with OpenCL (PARTRAY_OPENCL=ON). */

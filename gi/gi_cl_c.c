@@ -10,8 +10,6 @@
 #include "gi_cl_c.h"
 #include "pool.h"
 
-_Thread_local size_t gi_shim_gid;
-
 #define GI_C_CHUNK 256
 
 typedef struct {

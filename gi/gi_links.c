@@ -11,28 +11,6 @@
 /* particles per job: about 256 rays per rtcIntersect1M call */
 #define RAYS_PER_CALL 256
 
-vec3 gi_links_direction(vec3 nrm, int nside, int j, double u1, double u2)
-{
-    double su = 2.0 * ((j % nside) + u1) / nside - 1.0;
-    double sv = 2.0 * ((j / nside) + u2) / nside - 1.0;
-    double r, th;
-    if (su == 0.0 && sv == 0.0) {
-        r = 0.0;
-        th = 0.0;
-    } else if (fabs(su) > fabs(sv)) {
-        r = su;
-        th = (M_PI / 4.0) * (sv / su);
-    } else {
-        r = sv;
-        th = M_PI / 2.0 - (M_PI / 4.0) * (su / sv);
-    }
-    double x = r * cos(th), y = r * sin(th);
-    double z = sqrt(fmax(0.0, 1.0 - x * x - y * y));
-    vec3 t, b;
-    v3_basis(nrm, &t, &b);
-    return v3_norm(v3_add(v3_add(v3_scale(t, x), v3_scale(b, y)), v3_scale(nrm, z)));
-}
-
 typedef struct {
     const accel *a;
     RTCScene scene;
@@ -69,9 +47,10 @@ static inline void sincos_octant(float t, float *s, float *c)
     *c = 1.0f + a2 * (-0.5f + a2 * (1.0f / 24.0f + a2 * (-1.0f / 720.0f + a2 * (1.0f / 40320.0f))));
 }
 
-/* Float version of gi_links_direction for the hot loop (the same map:
- * Shirley and Chiu's concentric square-to-disk map lifted to the
- * hemisphere, Malley's method), with the frame (t, b, nrm) built once per
+/* Direction j of the n x n stratified cosine-weighted set around a unit
+ * normal, in float for the hot loop: Shirley and Chiu's concentric
+ * square-to-disk map (JGT 2(3), 1997) lifted to the hemisphere (Malley's
+ * method), with the frame (t, b, nrm) built once per
  * particle and the stratum's corner (su0, sv0) and width (w, in the
  * [-1, 1]^2 square) once per link. On |su| > |sv|, r = su and
  * theta = (pi/4) sv/su, so (x, y) = r (cos, sin)(pi/4 sv/su); otherwise
@@ -400,7 +379,7 @@ pt_status gi_links_build(const accel *a, void *scene, const gi_dev_particle *p, 
         accel_rtc_link_scene_free(lscene);
         return PT_ERR_NOMEM;
     }
-    /* su = 2 (jx + u1) / nside - 1 = su0 + sw u1, as gi_links_direction */
+    /* su = 2 (jx + u1) / nside - 1 = su0 + sw u1, as direction_f takes it */
     J.sw = 2.0f / (float)nside;
     for (int j = 0; j < J.k; j++) {
         J.su0[j] = 2.0f * (float)(J.order[j] % nside) / (float)nside - 1.0f;

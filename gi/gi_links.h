@@ -54,9 +54,4 @@ pt_status gi_links_build(const accel *a, void *scene, const gi_dev_particle *p, 
 size_t gi_links_reverse_count(const int *links, int n, int k, const unsigned *mask, int *off);
 void gi_links_reverse_fill(const int *links, int n, int k, const unsigned *mask, int *off, int *src);
 
-/* Direction j of the n x n stratified cosine-weighted set around unit
- * normal nrm, from uniform numbers (u1, u2) in [0,1): Malley's method on
- * Shirley and Chiu's concentric disk map (JGT 2(3), 1997). */
-vec3 gi_links_direction(vec3 nrm, int nside, int j, double u1, double u2);
-
 #endif

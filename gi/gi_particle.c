@@ -192,7 +192,7 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
     if (st == PT_OK && !gp->lscene) gp->lscene = accel_rtc_link_scene(gp->a);
     gi_trilook_free(gp->tl);
     gp->tl = NULL;
-    if (st == PT_OK && use_tl && gp->set.link_lookup == 0)
+    if (st == PT_OK && use_tl)
         gp->tl = gi_trilook_build(gp->a, ps->p, n, (const void *const *)pobj, grid, pin + n, ps->spacing, GI_LINKS_AGREE,
                                   3.0 * ps->spacing, gp->threads, gp->set.cancel, &st);
     if (st == PT_OK)
@@ -535,7 +535,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         S->link_rays = ls.rays;
         S->link_misses = ls.misses;
         S->link_unresolved = ls.unresolved;
-        if (!set->nominal_areas) st = catchment_areas(&gp->ps, gp->glink, gp->ng);
+        st = catchment_areas(&gp->ps, gp->glink, gp->ng);
         if (st != PT_OK) goto fail;
     }
 
@@ -580,7 +580,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
          * 4M slots (32 MiB): more cells than a 1920x1080 frame's hits.
          * Without a table (out of memory) every hit is tested. */
         long slots = 4 * (long)nrp;
-        if (!set->leak_per_hit) gp->cells = gi_cellvis_new(slots < (1L << 22) ? slots : (1L << 22), (long)nrp);
+        gp->cells = gi_cellvis_new(slots < (1L << 22) ? slots : (1L << 22), (long)nrp);
     }
 
     /* incoming scattering links, sources ascending (FULL scattering) */
@@ -669,15 +669,6 @@ int gi_particle_debug(const gi_particle *gp, const float **edir, const float **p
     if (lout) *lout = gp->lout;
     if (bounce_flux) *bounce_flux = gp->bounce_flux;
     if (nbounces) *nbounces = gp->nbounce_flux;
-    return gp->ps.n;
-}
-
-int gi_particle_debug_links(const gi_particle *gp, const int **slink, int *ns2, const int **glink, int *ng)
-{
-    if (slink) *slink = gp->slink;
-    if (ns2) *ns2 = gp->ns2;
-    if (glink) *glink = gp->glink;
-    if (ng) *ng = gp->ng;
     return gp->ps.n;
 }
 

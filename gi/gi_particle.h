@@ -126,15 +126,6 @@ typedef struct {
                             (no fixed supersampling); beyond 256 MiB of records (248 bytes a pixel) or
                             without the memory none are kept and the coarse pre-pass runs. 0
                             (default): nothing kept */
-    int nominal_areas;   /* 1: every area particle keeps the nominal dA = A/N (before 22 Nov 2026: reads
-                            ~1% bright, see gi_particle.c catchment_areas); 0 (default): each particle's
-                            area is its catchment, estimated from the gathering links that end on it */
-    int link_lookup;     /* the link builder's nearest-particle lookup: 0 (default) by the hit triangle
-                            (gi_trilook.h) where it decides, else the 3D grid; 1: the 3D grid only
-                            (the same links; tests compare the two) */
-    int leak_per_hit;    /* 1: the light-leak guard tests every hit's 3 radiance particles; 0 (default):
-                            once per interpolation cell, hits in clear cells skip it (gi_particle_cells.c
-                            cell_clear) */
     uint64_t seed;
     int threads;         /* <= 0: all cores */
     const char *cl_device; /* NULL/"auto", "c", "P:D" or part of a name (gi_cl.h) */
@@ -220,6 +211,10 @@ pt_status gi_particle_relight(gi_particle *gp, diag *d);
  * end. The caller tells a cancelled stage by its own flag. NULL (the
  * default): never cancelled. */
 void gi_particle_set_cancel(gi_particle *gp, volatile int *cancel);
+/* Where the later stages (lighting, view) report their steps from now on
+ * (settings.progress is the build's); NULL: nowhere. A GI kept across an
+ * animation's frames reports to each frame's own. */
+void gi_particle_set_progress(gi_particle *gp, progress *p);
 /* Change n_b and the scattering mode; takes effect at the next
  * gi_particle_relight (no geometry work). */
 void gi_particle_set_scattering(gi_particle *gp, int bounces, int scatter);
@@ -248,8 +243,6 @@ void gi_particle_free(gi_particle *gp);
  * last scattering (grey sums, fixed point converted to flux). */
 int gi_particle_debug(const gi_particle *gp, const float **edir, const float **phi, const float **lout,
                       const double **bounce_flux, int *nbounces);
-/* The scattering (n x ns2) and gathering (n x ng) links, n returned (tests). */
-int gi_particle_debug_links(const gi_particle *gp, const int **slink, int *ns2, const int **glink, int *ng);
 /* Area, reflectance and position of particle i (tests). */
 void gi_particle_debug_particle(const gi_particle *gp, int i, double *area, double rho[3], vec3 *pos, vec3 *nrm);
 

@@ -313,6 +313,8 @@ pt_status gi_particle_relight(gi_particle *gp, diag *d) { return gi_particle_lig
 
 void gi_particle_set_cancel(gi_particle *gp, volatile int *cancel) { gp->cancel = cancel; }
 
+void gi_particle_set_progress(gi_particle *gp, progress *p) { gp->set.progress = p; }
+
 void gi_particle_set_scattering(gi_particle *gp, int bounces, int scatter)
 {
     gp->set.bounces = bounces < 0 ? 0 : (bounces > GI_MAX_BOUNCES ? GI_MAX_BOUNCES : bounces);

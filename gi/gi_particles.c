@@ -302,11 +302,6 @@ void gi_grid_free(gi_grid *g)
     free(g);
 }
 
-size_t gi_grid_bytes(const gi_grid *g)
-{
-    return g ? ((size_t)g->mask + 3) * sizeof(int) + (size_t)g->n * sizeof(gentry) : 0;
-}
-
 /* A nearest-particle answer must also lie near the hit's tangent plane as
  * the particle sees it: |n.(p - q)| <= 0.5 |p - q| (within 30 degrees of
  * its plane; on a sphere, within 60 degrees of arc). Without it a ray that
@@ -315,13 +310,19 @@ size_t gi_grid_bytes(const gi_grid *g)
  * origin too), and light from a lamp inside the sphere leaked out. */
 #define NEAR_PLANE2 0.25f
 
+static int gi_grid_nearest_on(const gi_grid *g, vec3 q, vec3 dir, vec3 org, double maxdist, const void *const *pobj,
+                              const void *obj, vec3 agree, double min_agree, const unsigned char *skip);
+
 int gi_grid_nearest(const gi_grid *g, vec3 q, vec3 dir, vec3 org, double maxdist)
 {
     return gi_grid_nearest_on(g, q, dir, org, maxdist, NULL, NULL, v3s(0.0), 0.0, NULL);
 }
 
-int gi_grid_nearest_on(const gi_grid *g, vec3 q, vec3 dir, vec3 org, double maxdist, const void *const *pobj,
-                       const void *obj, vec3 agree, double min_agree, const unsigned char *skip)
+/* As gi_grid_nearest, among the particles i with pobj[i] == obj only
+ * (pobj NULL: all) whose normal n has n.agree >= min_agree (agree = 0:
+ * any normal) and skip[i] == 0 (skip may be NULL). */
+static int gi_grid_nearest_on(const gi_grid *g, vec3 q, vec3 dir, vec3 org, double maxdist, const void *const *pobj,
+                              const void *obj, vec3 agree, double min_agree, const unsigned char *skip)
 {
     float ax = (float)agree.x, ay = (float)agree.y, az = (float)agree.z;
     float amin = agree.x == 0.0 && agree.y == 0.0 && agree.z == 0.0 ? -2.0f : (float)min_agree;
@@ -618,13 +619,6 @@ void gi_lookup_free(gi_lookup *g)
     free(g);
 }
 
-size_t gi_lookup_bytes(const gi_lookup *g)
-{
-    return g ? ((size_t)(g->dim[0] * g->dim[1] * g->dim[2]) + 2) * sizeof(int) +
-                   (size_t)g->ne / LK_W * sizeof(lblock) + gi_grid_bytes(g->fallback)
-             : 0;
-}
-
 /* The lowest corner cell of the 2x2x2 block a query at q reads. (Per link
  * ray: no floor() calls; a coordinate past the grid, or NaN, is clamped
  * before the conversion.) */
@@ -639,24 +633,6 @@ long gi_lookup_cell(const gi_lookup *g, vec3 q)
         c[k] = !(t >= 0.0) ? 0 : (t >= top ? g->dim[k] - 2 : (long)t); /* NaN: 0 */
     }
     return (c[2] * g->dim[1] + c[1]) * g->dim[0] + c[0];
-}
-
-void gi_lookup_prefetch(const gi_lookup *g, long cell, int stage)
-{
-    if (g->n == 0) return;
-    long d0 = g->dim[0], d01 = g->dim[0] * g->dim[1];
-    long rows[4] = {cell, cell + d0, cell + d01, cell + d01 + d0};
-    for (int r = 0; r < 4; r++) {
-        if (stage == 0) {
-            __builtin_prefetch(&g->start[rows[r]]);
-        } else {
-            int k = g->start[rows[r]];
-            if (k < g->ne) {
-                __builtin_prefetch(&g->b[k / LK_W]);
-                __builtin_prefetch((const char *)&g->b[k / LK_W] + 64);
-            }
-        }
-    }
 }
 
 void gi_lookup_cells(const gi_lookup *g, int n, const vec3 *q, long *cell)
@@ -690,12 +666,6 @@ void gi_lookup_cells(const gi_lookup *g, int n, const vec3 *q, long *cell)
             __builtin_prefetch((const char *)&g->b[k / LK_W] + 64);
         }
     }
-}
-
-int gi_lookup_nearest(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double maxdist)
-{
-    if (g->n == 0 || !v3_finite(q)) return -1;
-    return gi_lookup_nearest_in(g, gi_lookup_cell(g, q), q, dir, org, maxdist);
 }
 
 int gi_lookup_nearest_on(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double maxdist, const void *const *pobj,
@@ -753,11 +723,6 @@ int gi_lookup_nearest_on(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double 
             }
     }
     return bi;
-}
-
-int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist)
-{
-    return gi_lookup_nearest_in2(g, cell, q, dir, org, maxdist, NULL, NULL);
 }
 
 /* GCC/Clang vector extensions: 4 lanes (SSE2 on x86-64) */

@@ -47,7 +47,6 @@ typedef struct gi_grid gi_grid;
  * tests. */
 gi_grid *gi_grid_build(const gi_dev_particle *p, int n, double cell);
 void gi_grid_free(gi_grid *g);
-size_t gi_grid_bytes(const gi_grid *g);
 /* Nearest particle to q, within maxdist, on the side a ray from org along
  * dir arrives at: its normal faces against dir (n.dir < 0) and org lies in
  * front of it (n.(org - p) > 0; this keeps a ray that hits near its own
@@ -55,11 +54,6 @@ size_t gi_grid_bytes(const gi_grid *g);
  * and q lies near its tangent plane (|n.(p - q)| <= |p - q| / 2).
  * -1 if none. */
 int gi_grid_nearest(const gi_grid *g, vec3 q, vec3 dir, vec3 org, double maxdist);
-/* As gi_grid_nearest, among the particles i with pobj[i] == obj only
- * (pobj NULL: all) whose normal n has n.agree >= min_agree (agree = 0:
- * any normal) and skip[i] == 0 (skip may be NULL). */
-int gi_grid_nearest_on(const gi_grid *g, vec3 q, vec3 dir, vec3 org, double maxdist, const void *const *pobj,
-                       const void *obj, vec3 agree, double min_agree, const unsigned char *skip);
 /* Particles within r of q with n.nq > cos_thr, in increasing index order,
  * appended to *out (grown with realloc); returns how many, -1 on OOM. */
 long gi_grid_radius(const gi_grid *g, vec3 q, vec3 nq, double r, double cos_thr, int **out, long *len, long *cap);
@@ -73,15 +67,10 @@ long gi_grid_radius(const gi_grid *g, vec3 q, vec3 nq, double r, double cos_thr,
 typedef struct gi_lookup gi_lookup;
 gi_lookup *gi_lookup_build(const gi_particles *ps, double cell);
 void gi_lookup_free(gi_lookup *g);
-size_t gi_lookup_bytes(const gi_lookup *g);
-/* As gi_grid_nearest. */
-int gi_lookup_nearest(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double maxdist);
-/* The same in steps, for batches (a batch first computes every query's
- * block, prefetches stage 0 (the block's list heads) for all, then stage 1
- * (the lists), then queries). */
+/* Queries run in steps, for batches: a batch first computes every query's
+ * block (gi_lookup_cell), prefetches stage 0 (the block's list heads) for
+ * all, then stage 1 (the lists), then queries (gi_lookup_nearest_in2). */
 long gi_lookup_cell(const gi_lookup *g, vec3 q);
-void gi_lookup_prefetch(const gi_lookup *g, long cell, int stage);
-int gi_lookup_nearest_in(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist);
 /* The same first steps for a batch of n queries in one call: cell[i] =
  * gi_lookup_cell(g, q[i]) for every i with cell[i] >= -1 on entry (others
  * are left alone), then both prefetch stages. */
@@ -90,12 +79,16 @@ void gi_lookup_cells(const gi_lookup *g, int n, const vec3 *q, long *cell);
 pt_status gi_lookup_set_objects(gi_lookup *g, const void *const *pobj);
 /* The id of an object (-1: no particle of the lookup lies on it). */
 int gi_lookup_object_id(const gi_lookup *g, const void *obj);
-/* As gi_lookup_nearest_in, also giving the answer's normal and object id, read from the lookup's own copy; *obj = -2 when
- * they are not known (the answer came from the ring search, or none). */
+/* Nearest particle to q by gi_grid_nearest's rules, from q's block `cell`;
+ * also the answer's normal and object id (nrm, obj may be NULL), read from
+ * the lookup's own copy; *obj = -2 when they are not known (the answer
+ * came from the ring search, or none). */
 int gi_lookup_nearest_in2(const gi_lookup *g, long cell, vec3 q, vec3 dir, vec3 org, double maxdist, float nrm[3],
                           int *obj);
-/* As gi_lookup_nearest with gi_grid_nearest_on's filters (a ring search:
- * the slow path for answers on the wrong object or side). */
+/* Nearest particle to q by gi_grid_nearest's rules among the particles i
+ * with pobj[i] == obj only (pobj NULL: all) whose normal n has n.agree >=
+ * min_agree (agree = 0: any normal) and skip[i] == 0 (skip may be NULL): a
+ * ring search, the slow path for answers on the wrong object or side. */
 int gi_lookup_nearest_on(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double maxdist, const void *const *pobj,
                          const void *obj, vec3 agree, double min_agree, const unsigned char *skip);
 

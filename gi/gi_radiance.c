@@ -75,6 +75,20 @@ static int visible(const list_job *J, vec3 q, vec3 nq, int i, const scene_object
     return gi_visible(J->a, J->eps, q, nq, v3(pt->p[0], pt->p[1], pt->p[2]), v3(pt->n[0], pt->n[1], pt->n[2]), obj);
 }
 
+/* 1 when area particle i lies on object `obj`, on side `side` (0: the
+ * patches' front normal, 1: the opposite). Estimation lists hold only
+ * particles of the radiance particle's own object and side: the normal test
+ * alone let particles on the inside of a closed sphere or box (which exist
+ * when a light or the camera is inside it) count for the outside of its
+ * opposite wall, and the inner bottom of a box standing on the floor count
+ * for the floor around it (test_stability, light_inside). The estimate is
+ * an area-weighted mean, so fewer entries only smooth less; they bias
+ * nothing. */
+static int gi_same_surface(const gi_surface *g, const gi_particles *ps, int i, const scene_object *obj, int side)
+{
+    return gi_surface_object(g, ps->patch[i]) == obj && ps->side[i] == side;
+}
+
 /* Keeps, of the m entries just appended to buf[0, *len), those on the
  * radiance particle's own object and side (gi_same_surface); returns how
  * many are left (m < 0: out of memory, passed on). */
@@ -90,11 +104,6 @@ static long same_surface(const list_job *J, const scene_object *obj, int side, v
     }
     *len = w;
     return w - first;
-}
-
-int gi_same_surface(const gi_surface *g, const gi_particles *ps, int i, const scene_object *obj, int side)
-{
-    return gi_surface_object(g, ps->patch[i]) == obj && ps->side[i] == side;
 }
 
 static void job(void *ctx, int chunk, int thread)

@@ -25,17 +25,6 @@ typedef struct {
     long vis_rays;   /* visibility tests of list entries (gi_radiance.c visible) */
 } gi_lists;
 
-/* 1 when area particle i lies on object `obj`, on side `side` (0: the
- * patches' front normal, 1: the opposite). Estimation lists hold only
- * particles of the radiance particle's own object and side: the normal test
- * alone let particles on the inside of a closed sphere or box (which exist
- * when a light or the camera is inside it) count for the outside of its
- * opposite wall, and the inner bottom of a box standing on the floor count
- * for the floor around it (test_stability, light_inside). The estimate is
- * an area-weighted mean, so fewer entries only smooth less; they bias
- * nothing. */
-int gi_same_surface(const gi_surface *g, const gi_particles *ps, int i, const scene_object *obj, int side);
-
 /* Whether a sample at y (normal ny) may stand for light at x (normal nx) on
  * object `own`: the segment between the two, lifted off the surface by
  * 16 eps along their normals (accel_mutually_visible), crosses no other object, and

@@ -660,7 +660,6 @@ int gi_surface_side_mask(const gi_surface *g, int i) { return g->p[i].mask ? g->
 int gi_surface_csg_member(const gi_surface *g, int i) { return g->p[i].cnode >= 0; }
 const scene_object *gi_surface_object(const gi_surface *g, int i) { return g->o[g->p[i].obj].obj; }
 const scene_texture *gi_surface_texture(const gi_surface *g, int i) { return g->p[i].tex; }
-double gi_surface_total_area(const gi_surface *g) { return g->total_area; }
 long gi_surface_nrp(const gi_surface *g) { return g->nrp; }
 long gi_surface_rp_slots(const gi_surface *g) { return g->nslot; }
 long gi_surface_skipped(const gi_surface *g) { return g->skipped; }

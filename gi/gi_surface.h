@@ -96,7 +96,6 @@ int gi_surface_side_mask(const gi_surface *g, int patch);
 int gi_surface_csg_member(const gi_surface *g, int patch);
 const scene_object *gi_surface_object(const gi_surface *g, int patch);
 const scene_texture *gi_surface_texture(const gi_surface *g, int patch);
-double gi_surface_total_area(const gi_surface *g);
 
 /* Map (u, v) in [0,1)^2 to a point of the patch, uniformly by area; r
  * drives rejection steps (curved shapes under non-similarity transforms);

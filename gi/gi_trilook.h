@@ -52,7 +52,7 @@ long gi_trilook_cell(const gi_trilook *t, unsigned geom, unsigned prim, float u,
  * batch: 0 its offset, 1 its first entries, 2 its particles. */
 void gi_trilook_prefetch(const gi_trilook *t, long cell, int stage);
 /* The nearest particle to hit point q (the ray from org along dir) on the
- * hit object and side, within maxdist, with gi_lookup_nearest's filters:
+ * hit object and side, within maxdist, with gi_grid_nearest's rules:
  * >= 0 the particle, -1 none, -2 not decided here (take the grid path). */
 int gi_trilook_nearest(const gi_trilook *t, long cell, const float q[3], const float dir[3], const float org[3]);
 

@@ -191,14 +191,6 @@ static exr_compression_t compression_of(int c)
     }
 }
 
-pt_status img_exr_write(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
-                        img_primaries prim, diag *d)
-{
-    float xy[8];
-    img_exr_primaries(prim, xy);
-    return img_exr_write_xy(fd, name, fb, o, xy, d);
-}
-
 /* One channel of the file: where its floats come from. */
 typedef struct {
     char name[80];
@@ -503,28 +495,40 @@ static exr_result_t decode_chunk(exr_context_t ctx, const exr_chunk_info_t *ci, 
     return exr_decoding_run(ctx, 0, dec);
 }
 
-pt_status img_exr_read(const char *path, uint64_t max_pixels, framebuffer **out, diag *d)
+/* Opens path for reading into s (the caller closes s->fd when it is >= 0)
+ * and starts an OpenEXR read context on it (*rv: exr_start_read's result).
+ * 0, with a message, when the file cannot be opened. */
+static int start_read(const char *path, exr_stream *s, exr_context_t *ctx, exr_result_t *rv, diag *d)
 {
-    *out = NULL;
     exr_msg[0] = '\0';
-    exr_stream s = {-1, 0};
-    s.fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (s.fd < 0) {
+    s->fd = open(path, O_RDONLY | O_CLOEXEC);
+    s->err = 0;
+    if (s->fd < 0) {
         diag_error(d, "cannot read '%s': %s", path, strerror(errno));
-        return PT_ERR_IO;
+        return 0;
     }
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.error_handler_fn = on_error;
-    init.user_data = &s;
+    init.user_data = s;
     init.read_fn = on_read;
     init.size_fn = on_size;
     init.max_image_width = IMG_MAX_SIDE;
     init.max_image_height = IMG_MAX_SIDE;
     /* A damaged chunk table is an error, not something to guess around. */
     init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
+    *rv = exr_start_read(ctx, path, &init);
+    return 1;
+}
+
+pt_status img_exr_read(const char *path, uint64_t max_pixels, framebuffer **out, diag *d)
+{
+    *out = NULL;
+    exr_stream s = {-1, 0};
+    exr_context_t ctx = NULL;
+    exr_result_t rv;
+    if (!start_read(path, &s, &ctx, &rv, d)) return PT_ERR_IO;
 
     pt_status st = PT_ERR_IO;
-    exr_context_t ctx = NULL;
     exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
     int dec_init = 0;
     exr_scratch scratch = {NULL, 0};
@@ -532,7 +536,6 @@ pt_status img_exr_read(const char *path, uint64_t max_pixels, framebuffer **out,
     float *grey = NULL;
     const char *what = "not a readable EXR file";
 
-    exr_result_t rv = exr_start_read(&ctx, path, &init);
     if (rv != EXR_ERR_SUCCESS) goto libfail;
 
     exr_storage_t storage;
@@ -731,28 +734,15 @@ pt_status img_read_exr_layer(const char *path, const char *layer, const char *su
         if (layer && *layer) snprintf(ls.names[k], sizeof ls.names[k], "%s.%c", layer, suffixes[k]);
         else snprintf(ls.names[k], sizeof ls.names[k], "%c", suffixes[k]);
     }
-    exr_msg[0] = '\0';
     exr_stream s = {-1, 0};
-    s.fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (s.fd < 0) {
-        diag_error(d, "cannot read '%s': %s", path, strerror(errno));
-        return PT_ERR_IO;
-    }
-    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = on_error;
-    init.user_data = &s;
-    init.read_fn = on_read;
-    init.size_fn = on_size;
-    init.max_image_width = IMG_MAX_SIDE;
-    init.max_image_height = IMG_MAX_SIDE;
-    init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
-    pt_status st = PT_ERR_IO;
     exr_context_t ctx = NULL;
+    exr_result_t rv;
+    if (!start_read(path, &s, &ctx, &rv, d)) return PT_ERR_IO;
+    pt_status st = PT_ERR_IO;
     exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
     int dec_init = 0;
     exr_scratch scratch = {NULL, 0};
     const char *what = "not a readable EXR file";
-    exr_result_t rv = exr_start_read(&ctx, path, &init);
     if (rv != EXR_ERR_SUCCESS) goto libfail;
     exr_storage_t storage;
     exr_attr_box2i_t dw;
@@ -846,24 +836,11 @@ pt_status img_exr_info(const char *path, int *disp_w, int *disp_h, int win[4], c
                        char **vals, diag *d)
 {
     for (int i = 0; i < nkeys; i++) vals[i] = NULL;
-    exr_msg[0] = '\0';
     exr_stream s = {-1, 0};
-    s.fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (s.fd < 0) {
-        diag_error(d, "cannot read '%s': %s", path, strerror(errno));
-        return PT_ERR_IO;
-    }
-    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = on_error;
-    init.user_data = &s;
-    init.read_fn = on_read;
-    init.size_fn = on_size;
-    init.max_image_width = IMG_MAX_SIDE;
-    init.max_image_height = IMG_MAX_SIDE;
-    init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
     exr_context_t ctx = NULL;
     exr_attr_box2i_t dw, vw;
-    exr_result_t rv = exr_start_read(&ctx, path, &init);
+    exr_result_t rv;
+    if (!start_read(path, &s, &ctx, &rv, d)) return PT_ERR_IO;
     if (rv == EXR_ERR_SUCCESS) rv = exr_get_data_window(ctx, 0, &dw);
     if (rv == EXR_ERR_SUCCESS) rv = exr_get_display_window(ctx, 0, &vw);
     if (rv != EXR_ERR_SUCCESS) {

@@ -18,12 +18,9 @@ void img_exr_primaries(img_primaries prim, float xy[8]);
  * then the channels "name.X" of every layer in o->layers (AOVs; float when
  * the layer asks for it), and whiteLuminance when o->white_luminance > 0;
  * non-finite values are written as 0 and, for half channels, finite values
- * are clamped to +-65504 (the largest half) so no Inf ever reaches the file. */
-pt_status img_exr_write(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
-                        img_primaries prim, diag *d);
-
-/* As img_exr_write with the chromaticities given as rx ry gx gy bx by wx wy;
- * xy == NULL writes no chromaticities attribute. */
+ * are clamped to +-65504 (the largest half) so no Inf ever reaches the file.
+ * xy: the chromaticities as rx ry gx gy bx by wx wy (img_exr_primaries);
+ * NULL writes no chromaticities attribute. */
 pt_status img_exr_write_xy(int fd, const char *name, const framebuffer *fb, const img_write_opts *o,
                            const float *xy, diag *d);
 

@@ -112,7 +112,8 @@ static void text(framebuffer *fb, int x, int y, int s, const char *t, const floa
 
 /* ---- axes ------------------------------------------------------------------- */
 
-void img_plot_label(double v, char *buf, int n)
+/* A short tick label: "0.25", "120", "1e-4", "2e6", "-3". */
+static void img_plot_label(double v, char *buf, int n)
 {
     if (n <= 0) return;
     double a = fabs(v);
@@ -142,7 +143,14 @@ void img_plot_label(double v, char *buf, int n)
 
 static double clean_zero(double t, double step) { return fabs(t) < step * 1e-9 ? 0.0 : t; }
 
-int img_plot_axis(double lo, double hi, int log_scale, double *axis_lo, double *axis_hi, double *ticks, int max)
+/* Axis range and ticks for data in [lo, hi] (lo <= hi, both finite; > 0 for
+ * log). The range is padded by 5% of its span (measured in decades on a log
+ * axis, at least 0.05 decade there); a single value gets +-10% of itself
+ * (+-1 at 0) or +-half a decade. Ticks are chosen at
+ * 1, 2, 5 x 10^k (linear) or at decades, with 2 and 5 added when the range
+ * spans fewer than two decades (log). Writes at most `max` ticks inside
+ * [*axis_lo, *axis_hi], returns their number. */
+static int img_plot_axis(double lo, double hi, int log_scale, double *axis_lo, double *axis_hi, double *ticks, int max)
 {
     int nt = 0;
     if (log_scale) {

@@ -38,16 +38,4 @@ pt_status img_plot(const img_plot_series *s, int ns, const img_plot_opts *o, fra
 /* The display sRGB colour of series i (a colour-blind-safe cycle of 7). */
 void img_plot_color(int i, float srgb[3]);
 
-/* Axis range and ticks for data in [lo, hi] (lo <= hi, both finite; > 0 for
- * log). The range is padded by 5% of its span (measured in decades on a log
- * axis, at least 0.05 decade there); a single value gets +-10% of itself
- * (+-1 at 0) or +-half a decade. Ticks are chosen at
- * 1, 2, 5 x 10^k (linear) or at decades, with 2 and 5 added when the range
- * spans fewer than two decades (log). Writes at most `max` ticks inside
- * [*axis_lo, *axis_hi], returns their number. */
-int img_plot_axis(double lo, double hi, int log_scale, double *axis_lo, double *axis_hi, double *ticks, int max);
-
-/* A short tick label: "0.25", "120", "1e-4", "2e6", "-3". */
-void img_plot_label(double v, char *buf, int n);
-
 #endif

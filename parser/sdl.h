@@ -43,6 +43,13 @@ typedef struct {
                                      calls are located PT_ERR_UNSUPPORTED errors */
     progress *progress;           /* stage "parse": bytes of the scene file read (its
                                      position outside includes and macro bodies); NULL: none */
+    /* Out (NULL = not wanted): set to 1 when a value that changes from
+     * frame to frame (clock, frame_number, now) was read anywhere but
+     * inside a camera{} or light_source{} block, else 0. With 0 the scene
+     * apart from its camera and lights is the same in every frame of the
+     * animation (same files, same options): what an animation's renders
+     * may keep from frame to frame (GI reused across frames). */
+    int *frame_dependent;
 } sdl_options;
 
 void sdl_default_options(sdl_options *o);

@@ -8,7 +8,8 @@
 /* POV-Ray truncates sizes and subscripts after adding this epsilon. */
 #define SUBSCRIPT_EPSILON 1e-10
 
-const char *sdl_value_type_name(sdl_val_kind k, int dim)
+/* Human name of a value's type for messages ("float", "vector", "object"...). */
+static const char *sdl_value_type_name(sdl_val_kind k, int dim)
 {
     switch (k) {
     case VAL_NONE: return "uninitialised value";

@@ -40,7 +40,5 @@ sdl_array *sdl_array_copy(sdl_parser *p, const sdl_array *a);
 /* defined_param := '(' identifier { '[' float ']' } ')' for #ifdef, #ifndef
  * and defined(): 1 if the identifier is declared (an element: initialised). */
 int sdl_defined_param(sdl_parser *p);
-/* Human name of a value's type for messages ("float", "vector", "object"...). */
-const char *sdl_value_type_name(sdl_val_kind k, int dim);
 
 #endif

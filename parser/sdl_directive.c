@@ -1177,6 +1177,7 @@ static int fresh_token(sdl_parser *p, sdl_tok *t)
     case TOK_IDENT: {
         const sdl_value *v = sdl_symtab_find(p->sym, t->tk.text, (size_t)t->tk.len);
         if (v) t->val = *v;
+        if (t->tk.len == 12 && memcmp(t->tk.text, "frame_number", 12) == 0) sdl_note_frame_value(p);
         if (v && v->kind == VAL_MACRO && p->hold_macros == 0 && p->defer == 0) {
             macro_call(p, t);
             return 0;

@@ -420,10 +420,11 @@ static double float_function(sdl_parser *p, sdl_kw k, src_loc loc)
     case KW_PI: return M_PI;
     case KW_TRUE: case KW_YES: case KW_ON: return 1;
     case KW_FALSE: case KW_NO: case KW_OFF: return 0;
-    case KW_CLOCK: return p->opt.clock;
+    case KW_CLOCK: sdl_note_frame_value(p); return p->opt.clock;
     case KW_CLOCK_ON: return p->opt.clock_on;
     case KW_VERSION: return p->version;
     case KW_NOW: {
+        p->frame_dependent = 1; /* the time of day, anywhere */
         /* days since 2000-01-01 00:00 UTC, to the microsecond (POV-Ray 3.7) */
         struct timespec ts;
         timespec_get(&ts, TIME_UTC);

@@ -296,7 +296,7 @@ static int keyword_operand(fn_build *b, const sdl_tok *t)
     case KW_Y: case KW_V: return register_node(b, 1);
     case KW_Z: return register_node(b, 2);
     case KW_PI: return const_node(b, M_PI);
-    case KW_CLOCK: return const_node(b, p->opt.clock);
+    case KW_CLOCK: sdl_note_frame_value(p); return const_node(b, p->opt.clock);
     case KW_INTERNAL:
         sdl_error(p, t->tk.loc, PT_ERR_SYNTAX, "internal(N) must be the whole function body");
         return -1;

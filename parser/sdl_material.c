@@ -104,7 +104,8 @@ scene_texture *sdl_copy_texture(sdl_parser *p, const scene_texture *t)
     return head;
 }
 
-void sdl_transform_texture(scene_texture *t, const xform *x)
+/* Apply x after a texture's current transform, every layer. */
+static void sdl_transform_texture(scene_texture *t, const xform *x)
 {
     for (; t; t = t->next) t->transform = xform_then(t->transform, *x);
 }

@@ -50,8 +50,6 @@ int sdl_parse_look_value(sdl_parser *p, sdl_kw k, sdl_value *out);
 
 /* Deep copy of a texture layer list (NULL stays NULL). */
 scene_texture *sdl_copy_texture(sdl_parser *p, const scene_texture *t);
-/* Apply x after a texture's current transform, every layer. */
-void sdl_transform_texture(scene_texture *t, const xform *x);
 /* A transform from outside the texture (object, material): layers with
  * uv_mapping keep theirs (POV-Ray transforms the UV_MAP_PATTERN wrapper,
  * which its evaluation ignores). */

@@ -93,7 +93,7 @@ static void node_transform(scene_object *o, const xform *x)
         for (int i = 0; i < o->u.csg.nkids; i++) node_transform(o->u.csg.kids[i], x);
 }
 
-void sdl_light_transform(scene_light *l, const xform *x)
+static void sdl_light_transform(scene_light *l, const xform *x)
 {
     l->position = xform_point(x, l->position);
     l->point_at = xform_point(x, l->point_at);

@@ -21,7 +21,6 @@ sdl_obj *sdl_parse_object_body(sdl_parser *p);
 /* Deep copy (textures copied, meshes shared). */
 sdl_obj *sdl_copy_obj(sdl_parser *p, const sdl_obj *o);
 void sdl_obj_transform(sdl_obj *o, const xform *x);
-void sdl_light_transform(scene_light *l, const xform *x);
 /* Resolve inheritance and add the object and its lights to the scene. */
 void sdl_obj_add_to_scene(sdl_parser *p, sdl_obj *o);
 /* Object modifiers up to (not including) the closing '}'. */

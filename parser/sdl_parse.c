@@ -379,6 +379,9 @@ static pt_status run(const char *name, const char *text, const sdl_options *opt,
     p.version = 3.7;
     set_options(&p, opt);
     p.s = scene_new();
+    /* POV-Ray 3.7's default background is <0,0,0,0,1>, clear under +UA
+     * (scene.cpp); background{} replaces it */
+    if (p.s) p.s->background.t = 1.0;
     p.sym = sdl_symtab_new();
     if (!p.s || !p.sym) {
         scene_free(p.s);
@@ -391,6 +394,7 @@ static pt_status run(const char *name, const char *text, const sdl_options *opt,
         sdl_parse_scene(&p);
         sdl_check_closed(&p);
     }
+    if (p.opt.frame_dependent) *p.opt.frame_dependent = p.frame_dependent;
     sdl_close_inputs(&p);
     sdl_geom_free(&p);
     sdl_files_close(&p);

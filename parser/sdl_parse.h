@@ -94,6 +94,8 @@ typedef struct {
 } sdl_block;
 
 typedef struct sdl_parser {
+    int view_depth;      /* inside camera{} or light_source{} blocks (sdl_note_frame_value) */
+    int frame_dependent; /* sdl_options.frame_dependent */
     scene *s;
     diag *d;
     sdl_options opt;
@@ -195,5 +197,13 @@ int sdl_memory_ok(sdl_parser *p, size_t extra, src_loc loc, const char *what);
 /* Count one token read (opt.max_tokens); 0 with an error when over. */
 int sdl_count_token(sdl_parser *p, src_loc loc);
 char *sdl_strndup(sdl_parser *p, const char *s, size_t n);
+
+/* A value that changes from frame to frame (clock, frame_number, now) was
+ * read: outside camera{} and light_source{} it makes the rest of the scene
+ * frame-dependent (sdl_options.frame_dependent). */
+static inline void sdl_note_frame_value(sdl_parser *p)
+{
+    if (p->view_depth == 0) p->frame_dependent = 1;
+}
 
 #endif

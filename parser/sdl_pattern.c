@@ -47,7 +47,8 @@ static int uchar_of(double v) { return (int)(unsigned char)sdl_to_int(v); }
 
 /* ------------------------------------------------------------ records */
 
-void sdl_pattern_default_normal(scene_normal *nm)
+/* The default normal (amount 0.5, accuracy 0.02, no pattern). */
+static void sdl_pattern_default_normal(scene_normal *nm)
 {
     memset(nm, 0, sizeof *nm);
     nm->amount = 0.5;

@@ -31,7 +31,5 @@ const scene_blend_map *sdl_pattern_map(sdl_parser *p, sdl_kw k);
 /* A rainbow's pigment: after 'colour_map' (not yet read), a gradient x
  * pigment through that map (POV-Ray's Parse_Rainbow). */
 void sdl_pattern_rainbow_pigment(sdl_parser *p, scene_pigment *pg);
-/* The default normal (amount 0.5, accuracy 0.02, no pattern). */
-void sdl_pattern_default_normal(scene_normal *nm);
 
 #endif

@@ -260,7 +260,9 @@ scene_camera *sdl_parse_camera_new(sdl_parser *p)
     scene_camera *c = sdl_alloc(p, sizeof *c);
     if (!c) return NULL;
     scene_default_camera(c);
+    p->view_depth++;
     camera_block(p, c);
+    p->view_depth--;
     return c;
 }
 
@@ -387,6 +389,9 @@ static int light_item(sdl_parser *p, sdl_obj *so)
 sdl_obj *sdl_parse_light(sdl_parser *p, src_loc loc)
 {
     if (!sdl_begin_block(p, "light_source")) return NULL;
+    /* a light's values may change per frame without the rest of the scene
+     * (looks_like and projected_through are geometry: the app checks those) */
+    p->view_depth++;
     sdl_obj *so = NULL;
     const sdl_tok *t = sdl_peek(p);
     if (t->tk.kind == TOK_IDENT && t->val.kind == VAL_OBJECT) {
@@ -396,7 +401,10 @@ sdl_obj *sdl_parse_light(sdl_parser *p, src_loc loc)
     } else {
         so = sdl_alloc(p, sizeof *so);
         scene_light *l = sdl_alloc(p, sizeof *l);
-        if (!so || !l) return NULL;
+        if (!so || !l) {
+            p->view_depth--;
+            return NULL;
+        }
         scene_default_light(l);
         l->loc = loc;
         so->lights = l;
@@ -408,6 +416,7 @@ sdl_obj *sdl_parse_light(sdl_parser *p, src_loc loc)
         if (sdl_ok(p) && l->circular && (l->size1 <= 1 || l->size2 <= 1))
             sdl_error(p, loc, PT_ERR_SYNTAX, "circular area light must have more than 1 point per axis");
     }
+    p->view_depth--;
     if (!sdl_end_block(p)) return NULL;
     return so;
 }

@@ -89,8 +89,6 @@ void sdl_symtab_free(sdl_symtab *t)
     free(t);
 }
 
-int sdl_symtab_depth(const sdl_symtab *t) { return t->depth; }
-
 int sdl_symtab_push(sdl_symtab *t)
 {
     if (t->depth + 1 >= t->cap) {
@@ -249,12 +247,6 @@ int sdl_symtab_alias_elem(sdl_symtab *t, const char *name, size_t n, sdl_value *
     e->owner = owner;
     e->index = index;
     return 1;
-}
-
-int sdl_symtab_scope_of(const sdl_symtab *t, const char *name, size_t n)
-{
-    sym_entry *e = find_entry(t, name, n);
-    return e ? e->depth : -1;
 }
 
 sdl_symtarget sdl_symtab_target(const sdl_symtab *t, const char *name, size_t n, int local)

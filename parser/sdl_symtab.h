@@ -44,8 +44,6 @@ typedef struct sdl_symtab sdl_symtab;
 
 sdl_symtab *sdl_symtab_new(void);
 void sdl_symtab_free(sdl_symtab *t);
-/* Scope depth: 0 = only the global scope. */
-int sdl_symtab_depth(const sdl_symtab *t);
 /* Returns 0 on out-of-memory. */
 int sdl_symtab_push(sdl_symtab *t);
 void sdl_symtab_pop(sdl_symtab *t);
@@ -87,7 +85,5 @@ sdl_symtarget sdl_symtab_target(const sdl_symtab *t, const char *name, size_t n,
 /* Assign v to the target: 1 done, 0 out of memory, -1 the target's scope has
  * ended meanwhile (nothing assigned). */
 int sdl_symtab_assign(sdl_symtab *t, const sdl_symtarget *tg, const char *name, size_t n, const sdl_value *v);
-/* Scope depth of the innermost visible entry, -1 if none. */
-int sdl_symtab_scope_of(const sdl_symtab *t, const char *name, size_t n);
 
 #endif

@@ -11,8 +11,6 @@
 #define TILE 16
 #define MAX_THREADS 256
 
-int pm_available(void) { return 1; }
-
 void pm_common_defaults(pm_common *c)
 {
     memset(c, 0, sizeof *c);
@@ -39,7 +37,8 @@ int pm_threads(int requested)
     return t > MAX_THREADS ? MAX_THREADS : (t < 1 ? 1 : t);
 }
 
-void pm_counts_add(pm_stats *st, const pm_counts *cnt, int n)
+/* Sum of counters into st. */
+static void pm_counts_add(pm_stats *st, const pm_counts *cnt, int n)
 {
     for (int i = 0; i < n; i++) {
         st->camera_rays += cnt[i].camera;

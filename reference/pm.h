@@ -16,9 +16,6 @@
 #include "rng.h"
 #include "scene.h"
 
-/* 1 when the reference renderers are built (they are). */
-int pm_available(void);
-
 typedef struct {
     /* stage times in seconds */
     double t_lights;        /* light set: emitter surfaces, photon sources */
@@ -96,9 +93,6 @@ typedef rgb (*pm_sample_fn)(void *ctx, double px, double py, int thread, rng *r,
  * counted. */
 pt_status pm_image_render(const scene *sc, const pm_common *c, int max_pass, framebuffer *fb, pm_sample_fn fn,
                           void *ctx, pm_stats *st);
-
-/* Sum of counters into st. */
-void pm_counts_add(pm_stats *st, const pm_counts *cnt, int n);
 
 /* Helpers shared by the renderers. */
 uint64_t pm_mix64(uint64_t z);

@@ -11,7 +11,7 @@
  * direct light by shadow rays (one POV-Ray light picked in proportion to its
  * unoccluded intensity, one emitter sample) + k_y/pi E_ind(y) + specular
  * lobes, where
- * E_ind is the photon irradiance estimate (pm_kdtree_irradiance; the maps
+ * E_ind is the photon irradiance estimate (vis_irradiance; the maps
  * hold only light that made at least one bounce, pm_photon.h).
  *
  * The caustic map adds at x: kd/pi E_c(x, n) + kb/pi E_c(x, -n). */
@@ -24,6 +24,7 @@
 #include "pm_photon.h"
 #include "pool.h"
 #include "radrules.h"
+#include "shade_atmos.h"
 #include "shade_material.h"
 #include "timer.h"
 
@@ -67,6 +68,8 @@ typedef struct {
     pm_neighbour *scratch; /* KMAX per thread */
     radrules rr;           /* POV-Ray's rules for gathered light (core/radrules.h) */
     int gathers;           /* recursion_limit: gathering steps from the eye */
+    int eye_levels;        /* eye rays: levels 0 .. eye_levels - 1 (max_trace_level, radrules.h rule 7) */
+    int gather_specular;   /* specular bounces after a gather hit within the level limit */
 } fg_ctx;
 
 static inline rgb frgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
@@ -125,9 +128,13 @@ static int vis_filter(const fg_ctx *c, const pm_kdtree *t, vec3 x, vec3 nx, uint
 }
 
 /* Irradiance on the side nx of x from the k nearest photons of key surf
- * that x sees (vis_ok): the k-1 rule of pm_kdtree_irradiance over the
- * visible ones, the distance of the farthest visible one as the radius
- * (fewer than k in reach: all of them over pi max_r^2). */
+ * that x sees (vis_ok): the sum of the k-1 nearest visible powers over
+ * pi r_k^2, r_k the distance of the k-th (fewer than k in reach: all of
+ * them over pi max_r^2). The k-1 rule is unbiased for a uniform (Poisson)
+ * photon density: given r_k, the k-1 photons inside are uniform in the
+ * disc, and E[(k-1)/(pi r_k^2)] equals the density (r_k^2 is Gamma(k)
+ * distributed); Jensen's sum of all k over pi r_k^2 overestimates by
+ * k/(k-1). */
 static int vis_irradiance(const fg_ctx *c, const pm_kdtree *t, vec3 x, vec3 nx, uint32_t surf, int k, double max_r,
                           pm_neighbour *scratch, long *rays, rgb *e)
 {
@@ -225,7 +232,7 @@ static rgb gather_hit(const fg_ctx *c, const mat_bsdf *b, uint32_t surf, int lev
         }
     }
     double ms = b->m[MAT_LOBE_REFLECT] + b->m[MAT_LOBE_TRANSMIT];
-    if (ms > 0.0 && level < c->s->max_gather_depth) {
+    if (ms > 0.0 && level < c->s->max_gather_depth && level < c->gather_specular) {
         double q = fmin(1.0, ms);
         if (rng_f64(r) < q) {
             int lobe = rng_f64(r) * ms < b->m[MAT_LOBE_REFLECT] ? MAT_LOBE_REFLECT : MAT_LOBE_TRANSMIT;
@@ -274,11 +281,21 @@ static rgb gather_lobe(const fg_ctx *c, const mat_bsdf *b, vec3 axis, vec3 org, 
         if (front ? cg <= 0.0 : cg >= 0.0) continue;
         cnt->gather++;
         accel_hit h;
-        if (!trace_skip(c, &b->from, org, w, OBJ_NO_RADIOSITY, &h)) {
+        int hit = trace_skip(c, &b->from, org, w, OBJ_NO_RADIOSITY, &h);
+        rgb fa = {1, 1, 1};
+        if (c->rr.media && c->sc->fogs) {
+            /* `media on`: gathering rays see fog too (radrules.h rule 5) */
+            rgb fc;
+            atmos_fog_affine(c->sc, org, w, hit ? h.t : INFINITY, &fa, &fc);
+            sum.r += fc.r;
+            sum.g += fc.g;
+            sum.b += fc.b;
+        }
+        if (!hit) {
             rgb bg = pm_sky(c->sc, w);
-            sum.r += bg.r;
-            sum.g += bg.g;
-            sum.b += bg.b;
+            sum.r += fa.r * bg.r;
+            sum.g += fa.g * bg.g;
+            sum.b += fa.b * bg.b;
             continue;
         }
         mat_bsdf b2;
@@ -289,14 +306,14 @@ static rgb gather_lobe(const fg_ctx *c, const mat_bsdf *b, vec3 axis, vec3 org, 
             double cosx = fabs(v3_dot(w, b->n));
             double cb = (front ? nf : nb) * cosx / M_PI;
             double wt = pm_mis(cb, pm_emitter_density(c->L, &h, org, c->s->emitter_samples));
-            sum.r += le.r * wt;
-            sum.g += le.g * wt;
-            sum.b += le.b * wt;
+            sum.r += fa.r * le.r * wt;
+            sum.g += fa.g * le.g * wt;
+            sum.b += fa.b * le.b * wt;
         }
         rgb lr = gather_hit(c, &b2, pm_surface_key(h.obj, b2.entering), 0, thread, r, cnt);
-        sum.r += lr.r;
-        sum.g += lr.g;
-        sum.b += lr.b;
+        sum.r += fa.r * lr.r;
+        sum.g += fa.g * lr.g;
+        sum.b += fa.b * lr.b;
     }
     return frgb(sum.r / n, sum.g / n, sum.b / n);
 }
@@ -304,9 +321,17 @@ static rgb gather_lobe(const fg_ctx *c, const mat_bsdf *b, vec3 axis, vec3 org, 
 static void eye_trace(const fg_ctx *c, const accel_from *from, vec3 org, vec3 dir, unsigned skip, rgb T, int depth,
                       int thread, rng *r, pm_counts *cnt, rgb *L)
 {
-    if (depth >= c->s->max_eye_depth) return;
+    if (depth >= c->s->max_eye_depth || depth >= c->eye_levels) return;
     accel_hit h;
-    if (!trace_skip(c, from, org, dir, skip, &h)) {
+    int hit = trace_skip(c, from, org, dir, skip, &h);
+    if (c->sc->fogs) {
+        /* fog on eye segments (gathering rays see it only with `media on`) */
+        rgb fa, fc;
+        atmos_fog_affine(c->sc, org, dir, hit ? h.t : INFINITY, &fa, &fc);
+        acc_add(L, T, fc);
+        T = frgb(T.r * fa.r, T.g * fa.g, T.b * fa.b);
+    }
+    if (!hit) {
         acc_add(L, T, pm_sky(c->sc, dir));
         return;
     }
@@ -437,6 +462,10 @@ pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s,
     c.eps = pm_lights_eps(L);
     c.rr = radrules_of(sc, 1);
     c.gathers = c.rr.recursion_limit > 0 ? c.rr.recursion_limit : 1 << 20;
+    c.eye_levels = radrules_level_limit(sc, 0);
+    /* a gather ray is at level g1, its hit's specular rays at g1 + 1, ... */
+    const int g1 = radrules_gather_level(1);
+    c.gather_specular = radrules_level_limit(sc, g1) - g1 - 1;
     double scale = accel_scale(a);
     if (!(scale > 0.0) || !isfinite(scale)) scale = 1.0;
     c.r_global = s->radius_global > 0.0 ? s->radius_global : 0.1 * scale;

@@ -288,38 +288,3 @@ int pm_kdtree_knn(const pm_kdtree *t, vec3 p, vec3 n, uint32_t surf, double min_
     return s.count;
 }
 
-int pm_kdtree_irradiance(const pm_kdtree *t, vec3 p, vec3 n, uint32_t surf, double min_dot, int k, double max_r,
-                         pm_neighbour *scratch, rgb *e)
-{
-    e->r = e->g = e->b = 0.0;
-    if (k < 2) k = 2;
-    int c = pm_kdtree_knn(t, p, n, surf, min_dot, k, max_r * max_r, scratch);
-    if (c == 0) return 0;
-    double sr = 0, sg = 0, sb = 0, area;
-    int first = 0;
-    if (c == k) {
-        /* drop the k-th (the heap root); its distance is the radius */
-        first = 1;
-        area = M_PI * scratch[0].d2;
-    } else {
-        area = M_PI * max_r * max_r;
-    }
-    for (int i = first; i < c; i++) {
-        const pm_photon *ph = &t->ph[scratch[i].idx];
-        sr += ph->power[0];
-        sg += ph->power[1];
-        sb += ph->power[2];
-    }
-    if (!(area > 0.0)) return 0;
-    e->r = sr / area;
-    e->g = sg / area;
-    e->b = sb / area;
-    return c - first;
-}
-
-long pm_kdtree_nearest(const pm_kdtree *t, vec3 p, vec3 n, uint32_t surf, double min_dot, double max_r2)
-{
-    pm_neighbour one;
-    int c = pm_kdtree_knn(t, p, n, surf, min_dot, 1, max_r2, &one);
-    return c ? one.idx : -1;
-}

@@ -59,18 +59,4 @@ typedef struct {
 int pm_kdtree_knn(const pm_kdtree *t, vec3 p, vec3 n, uint32_t surf, double min_dot, int k, double max_r2,
                   pm_neighbour *out);
 
-/* Density estimate of the irradiance at p on the side n from the k nearest
- * compatible photons: sum of the k-1 nearest powers / (pi r_k^2), r_k the
- * distance of the k-th; with fewer than k photons inside max_r, sum of all /
- * (pi max_r^2). The k-1 rule is unbiased for a uniform (Poisson) photon
- * density: given r_k, the k-1 photons inside are uniform in the disc, and
- * E[(k-1)/(pi r_k^2)] equals the density (r_k^2 is Gamma(k) distributed);
- * Jensen's sum of all k over pi r_k^2 overestimates by k/(k-1). `scratch`
- * has room for k entries. Returns the number of photons used. */
-int pm_kdtree_irradiance(const pm_kdtree *t, vec3 p, vec3 n, uint32_t surf, double min_dot, int k, double max_r,
-                         pm_neighbour *scratch, rgb *e);
-
-/* The nearest compatible photon within max_r2, or -1. */
-long pm_kdtree_nearest(const pm_kdtree *t, vec3 p, vec3 n, uint32_t surf, double min_dot, double max_r2);
-
 #endif

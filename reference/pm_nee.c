@@ -115,11 +115,6 @@ rgb pm_sky(const scene *sc, vec3 dir)
     return c;
 }
 
-int pm_lights_any(const pm_lights *L)
-{
-    return L->sc->nlights > 0 || accel_surf_count(L->emit) > 0 || pm_sky_any(L->sc);
-}
-
 rgb pm_direct_lights(const pm_lights *L, const mat_bsdf *b, int area_samples, rng *r, long *shadow_rays)
 {
     rgb total = {0, 0, 0};

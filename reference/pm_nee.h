@@ -27,7 +27,6 @@ const accel_surf *pm_lights_emitters(const pm_lights *L); /* may be empty */
 /* Le at an emitter sample (evaluated at the point when the texture varies). */
 rgb pm_lights_piece_emission(const pm_lights *L, const accel_surf_sample *s);
 double pm_lights_eps(const pm_lights *L);                  /* distance epsilon (shade.c's) */
-int pm_lights_any(const pm_lights *L);                     /* POV lights, emitters, a background or sky_sphere */
 /* Radiance arriving along a ray of direction dir (any length) that leaves
  * the scene: the sky_sphere over the background, evaluated by shade's
  * atmos_sky (the code --gi none uses; fog and rainbow are not applied). It

@@ -15,6 +15,7 @@
 #include <string.h>
 #include "pm_nee.h"
 #include "radrules.h"
+#include "shade_atmos.h"
 #include "shade_material.h"
 #include "timer.h"
 
@@ -75,9 +76,24 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
     vec3 prev_org = org;
     accel_from from; /* the surface the ray leaves (contacts, accel_intersect_from) */
     const accel_from *fromp = NULL;
+    int level = 0, max_level = radrules_level_limit(sc, 0); /* POV-Ray's trace levels (radrules.h rule 7) */
     for (int depth = 0;; depth++) {
+        if (level >= max_level) break;
         accel_hit h;
-        if (!trace_skip(c, fromp, org, dir, skip | gskip, &h)) {
+        int hit = trace_skip(c, fromp, org, dir, skip | gskip, &h);
+        if (sc->fogs && (nd == 0 || c->rr.media)) {
+            /* fog on the segment: on camera and specular rays, on gathering
+             * rays only with radiosity's `media on` (radrules.h rule 5) */
+            rgb fa, fc;
+            atmos_fog_affine(sc, org, dir, hit ? h.t : INFINITY, &fa, &fc);
+            L.r += T.r * fc.r;
+            L.g += T.g * fc.g;
+            L.b += T.b * fc.b;
+            T.r *= fa.r;
+            T.g *= fa.g;
+            T.b *= fa.b;
+        }
+        if (!hit) {
             rgb sky = pm_sky(sc, dir); /* background and sky_sphere */
             L.r += T.r * sky.r;
             L.g += T.g * sky.g;
@@ -122,6 +138,10 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
             T.b *= bright;
             nd++;
             gskip = OBJ_NO_RADIOSITY;
+            level = radrules_gather_level(nd);
+            max_level = radrules_level_limit(sc, level);
+        } else {
+            level++;
         }
         T.r *= s.weight.r;
         T.g *= s.weight.g;

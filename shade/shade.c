@@ -96,7 +96,9 @@ static inline int rgb_near_zero(rgb a) { return fabs(a.r) < 1e-10 && fabs(a.g) <
 /* POV-Ray's greyscale weights (0.297, 0.589, 0.114). */
 static inline double rgb_grey(rgb a) { return 0.297 * a.r + 0.589 * a.g + 0.114 * a.b; }
 
-double shade_colour_distance(rgb a, rgb b) { return fabs(a.r - b.r) + fabs(a.g - b.g) + fabs(a.b - b.b); }
+/* POV-Ray's colour distance used for antialiasing decisions: sum of the
+ * absolute channel differences. */
+static double shade_colour_distance(rgb a, rgb b) { return fabs(a.r - b.r) + fabs(a.g - b.g) + fabs(a.b - b.b); }
 
 void shade_default_settings(shade_settings *s)
 {

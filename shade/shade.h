@@ -77,9 +77,6 @@ void shade_default_settings(shade_settings *s);
 pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s, framebuffer *fb, shade_stats *st, diag *d);
 /* Radiance along one ray (for tests and other integrators). */
 rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 org, vec3 dir, int thread, rng *r);
-/* POV-Ray's colour distance used for antialiasing decisions: sum of the
- * absolute channel differences. */
-double shade_colour_distance(rgb a, rgb b);
 /* The Whitted direct term (every light, its attenuation, area grid and
  * shadows: what tex_shade's direct callback gets) of surface s at hit h,
  * shaded from p (off the surface on the viewer's side). For shade_aov.c. */

@@ -14,7 +14,7 @@
 static const char *const aov_names[AOV_COUNT] = {"direct", "indirect", "albedo", "normal", "depth", "illuminance"};
 
 const char *shade_aov_name(int k) { return k >= 0 && k < AOV_COUNT ? aov_names[k] : NULL; }
-int shade_aov_channels(int k) { return k == AOV_DEPTH ? 1 : 3; }
+static int shade_aov_channels(int k) { return k == AOV_DEPTH ? 1 : 3; }
 const char *shade_aov_suffixes(int k) { return k == AOV_DEPTH ? "Z" : (k == AOV_NORMAL ? "XYZ" : "RGB"); }
 int shade_aov_is_colour(int k) { return k == AOV_DIRECT || k == AOV_INDIRECT || k == AOV_ALBEDO || k == AOV_ILLUMINANCE; }
 
@@ -193,4 +193,53 @@ pt_status shade_aov_render(const scene *sc, const accel *a, const shade_settings
     if (threads > 256) threads = 256;
     pool_run(threads, out->height, aov_row, &c);
     return PT_OK;
+}
+
+typedef struct {
+    const scene *sc;
+    const accel *a;
+    const shade_settings *s;
+    float *alpha;
+    double eps, miss; /* opacity of a ray that leaves the scene */
+    int n;
+} alpha_ctx;
+
+static int alpha_hit(const alpha_ctx *c, double px, double py)
+{
+    vec3 org, dir;
+    if (!camera_ray(&c->sc->camera, px, py, c->s->width, c->s->height, 0.0, 0.0, &org, &dir)) return 0;
+    accel_hit h;
+    double tmin = c->eps;
+    for (int k = 0; k < 64; k++) {
+        if (!accel_intersect(c->a, org, dir, tmin, INFINITY, &h)) return 0;
+        if (!(h.flags & OBJ_NO_IMAGE)) return 1;
+        tmin = h.t + fmax(c->eps, h.t * 1e-7);
+    }
+    return 0;
+}
+
+static void alpha_row(void *ctx, int y, int thread)
+{
+    (void)thread;
+    alpha_ctx *c = ctx;
+    if (c->s->cancel && *c->s->cancel) return;
+    for (int x = 0; x < c->s->width; x++) {
+        double sum = 0.0;
+        for (int j = 0; j < c->n; j++)
+            for (int i = 0; i < c->n; i++)
+                sum += alpha_hit(c, x + (i + 0.5) / c->n, y + (j + 0.5) / c->n) ? 1.0 : c->miss;
+        c->alpha[(size_t)y * (size_t)c->s->width + (size_t)x] = (float)(sum / (c->n * c->n));
+    }
+}
+
+void shade_alpha(const scene *sc, const accel *a, const shade_settings *s, float *alpha)
+{
+    alpha_ctx c = {sc, a, s, alpha, 1e-6, 0.0, s->antialias ? 3 : 1};
+    double scale = accel_scale(a);
+    if (scale > 0.0 && isfinite(scale)) c.eps = scale * 1e-6;
+    int v37 = sc->version_major > 3 || (sc->version_major == 3 && sc->version_minor >= 7);
+    if (sc->sky_sphere) c.miss = 1.0;
+    else if (v37) c.miss = fmin(1.0, fmax(0.0, 1.0 - sc->background.t));
+    int threads = s->threads > 0 ? s->threads : pool_default_threads();
+    pool_run(threads, s->height, alpha_row, &c);
 }

@@ -45,7 +45,6 @@ typedef struct {
 } shade_aov;
 
 const char *shade_aov_name(int k);     /* "direct", ..., NULL out of range */
-int shade_aov_channels(int k);         /* 3, or 1 for depth */
 const char *shade_aov_suffixes(int k); /* channel name suffixes, one letter each: "RGB", "XYZ" or "Z" */
 int shade_aov_is_colour(int k);        /* 1: RGB in the render's colour space (direct, indirect, albedo, illuminance) */
 
@@ -62,5 +61,17 @@ void shade_aov_free(shade_aov *a);
  * seed; s->indirect is the GI hook for the indirect AOV, called with thread
  * indices below s->threads as in shade_render). */
 pt_status shade_aov_render(const scene *sc, const accel *a, const shade_settings *s, shade_aov *out, diag *d);
+
+/* +UA (POV-Ray's Output_Alpha): each pixel's opacity into alpha
+ * (s->width * s->height floats), the fraction of n x n stratified camera
+ * rays (n = 3 with antialiasing, else 1: the centre) that meet an object the
+ * camera sees. A ray that leaves the scene counts 1 - the background's
+ * transmit, as POV-Ray 3.7 composes it (parse.cpp, scene.cpp): with
+ * #version 3.7 a background{} without transmit is opaque and no background
+ * (the default <0,0,0,0,1>) is clear; before 3.7 (or without #version) the
+ * background is clear. A sky_sphere is taken as opaque, and so are
+ * transparent surfaces (POV-Ray lets a clear background show through
+ * them: not modelled). */
+void shade_alpha(const scene *sc, const accel *a, const shade_settings *s, float *alpha);
 
 #endif

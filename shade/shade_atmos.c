@@ -177,6 +177,14 @@ rgb atmos_fog(const scene *sc, vec3 org, vec3 dir, double depth, rgb c)
     return r;
 }
 
+void atmos_fog_affine(const scene *sc, vec3 org, vec3 dir, double depth, rgb *att, rgb *add)
+{
+    rgb one = {1, 1, 1}, zero = {0, 0, 0};
+    *att = one;
+    *add = zero;
+    if (sc->fogs) fog_sums(sc, org, dir, depth, att, add);
+}
+
 rgb atmos_fog_attenuation(const scene *sc, vec3 org, vec3 dir, double depth)
 {
     rgb satt = {1, 1, 1}, scol;

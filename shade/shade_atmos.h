@@ -11,6 +11,10 @@ rgb atmos_sky(const scene *sc, vec3 dir);
  * after the scene's rainbows and fogs (in POV-Ray's order). Returns c
  * unchanged without them. */
 rgb atmos_fog(const scene *sc, vec3 org, vec3 dir, double depth, rgb c);
+/* The fogs over a segment as an affine map of the colour behind them,
+ * seen = add + att * c (atmos_fog without rainbows): for integrators that
+ * carry a throughput. */
+void atmos_fog_affine(const scene *sc, vec3 org, vec3 dir, double depth, rgb *att, rgb *add);
 /* The fogs' attenuation alone over a segment (a light with
  * media_attenuation on sees its light dimmed so along shadow rays). */
 rgb atmos_fog_attenuation(const scene *sc, vec3 org, vec3 dir, double depth);

@@ -5,7 +5,10 @@
 #include "shade_gamma.h"
 #include <math.h>
 
-double gamma_working(const scene *sc)
+/* assumed_gamma when given; 1 for #version 3.7 scenes without it; 0 for
+ * older scenes without it (POV-Ray then turns gamma handling off: computed
+ * values are written to the file as they are). */
+static double gamma_working(const scene *sc)
 {
     if (sc->global.assumed_gamma > 0.0) return sc->global.assumed_gamma;
     double v = sc->version_major > 0 ? sc->version_major + sc->version_minor / 10.0 : 3.7;

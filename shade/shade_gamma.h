@@ -6,11 +6,6 @@
 #include "framebuffer.h"
 #include "scene.h"
 
-/* assumed_gamma when given; 1 for #version 3.7 scenes without it; 0 for
- * older scenes without it (POV-Ray then turns gamma handling off: computed
- * values are written to the file as they are). */
-double gamma_working(const scene *sc);
-
 /* Convert a rendered framebuffer from the working space to linear values
  * (v^gamma; for gamma handling off, the sRGB decoding, so that the usual
  * sRGB encoding of a PNG writes the computed values unchanged). No-op for

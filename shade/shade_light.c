@@ -13,7 +13,8 @@ static inline rgb lrgb_mul(rgb a, rgb b) { return lrgb(a.r * b.r, a.g * b.g, a.b
 static inline rgb lrgb_scale(rgb a, double s) { return lrgb(a.r * s, a.g * s, a.b * s); }
 static inline int lrgb_near_zero(rgb a) { return fabs(a.r) < 1e-10 && fabs(a.g) < 1e-10 && fabs(a.b) < 1e-10; }
 
-double light_cubic_step(double low, double high, double x)
+/* POV-Ray's spotlight falloff: 0 below low, 1 above high, (3-2t)t^2 between. */
+static double light_cubic_step(double low, double high, double x)
 {
     if (x <= low) return 0.0;
     if (x >= high) return 1.0;
@@ -188,7 +189,12 @@ static int blocked(const light_ctx *c, vec3 p, vec3 dir, double depth)
     return accel_occluded_from(c->a, c->from, p, dir, c->eps, tmax);
 }
 
-int light_extended(const scene_light *l)
+/* 1 when l is an area light whose points do not all coincide: an axis with
+ * more than one sample and a non-zero length. An area light with zero axes
+ * (or a 1x1 grid) is the point light at its position; the Monte Carlo
+ * renderers sample it as one, so it draws no random numbers of its own and
+ * gives the point light's image exactly. */
+static int light_extended(const scene_light *l)
 {
     if (!l->area) return 0;
     int e1 = l->size1 > 1 && v3_dot(l->axis1, l->axis1) > 0.0;
@@ -288,8 +294,6 @@ rgb light_nee(const light_ctx *c, const scene_light *l, const light_surface *s, 
 }
 
 /* ------------------------------------------------------ photometric units */
-
-double light_luminance(rgb c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
 
 pt_status light_units_apply(scene *sc, double metres_per_unit, diag *d)
 {

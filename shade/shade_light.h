@@ -23,9 +23,6 @@
 #include "rng.h"
 #include "scene.h"
 
-/* POV-Ray's spotlight falloff: 0 below low, 1 above high, (3-2t)t^2 between. */
-double light_cubic_step(double low, double high, double x);
-
 /* Angle- and distance-based attenuation of `l` seen from `p` along unit `dir`
  * (towards the light) at distance `depth`: spotlight cos^tightness with the
  * cubic falloff between cos(radius) and cos(falloff), cylinder lights (radius
@@ -44,12 +41,6 @@ void light_ray(const scene_light *l, vec3 centre, vec3 p, vec3 *dir, double *dep
 /* Axes of an area light as seen from p: the light's own, or for `orient`
  * the same lengths turned to face p (POV-Ray's rule, scene_light_orient_axes). */
 void light_area_axes(const scene_light *l, vec3 p, vec3 *ax1, vec3 *ax2);
-/* 1 when l is an area light whose points do not all coincide: an axis with
- * more than one sample and a non-zero length. An area light with zero axes
- * (or a 1x1 grid) is the point light at its position; the Monte Carlo
- * renderers sample it as one, so it draws no random numbers of its own and
- * gives the point light's image exactly. */
-int light_extended(const scene_light *l);
 
 /* POV-Ray's empirical metallic tint of a highlight or reflection colour:
  * F(x) = 0.014567225/(x-1.12)^2 - 0.011612903 with x = angle/(pi/2). */
@@ -110,12 +101,9 @@ rgb light_nee(const light_ctx *c, const scene_light *l, const light_surface *s, 
 
 /* ------------------------------------------------------ photometric units */
 
-/* Rec.709 luminance weights (the Y row of the linear sRGB -> XYZ matrix). */
-double light_luminance(rgb c);
-
 /* Photometric light units for lighting studies (docs/units.md): one scene
  * unit is `metres_per_unit` metres; a light's colour C has luminance
- * I = light_luminance(C). Point and spot lights (and area lights, whose
+ * I = 0.2126 R + 0.7152 G + 0.0722 B (Rec.709 weights). Point and spot lights (and area lights, whose
  * intensity is spread over their grid as POV-Ray spreads it) become
  * isotropic sources of I candela (on the axis for spotlights) with
  * inverse-square falloff, E = I cos / d^2 lux, d in metres; parallel,

@@ -19,8 +19,6 @@
 static inline rgb mrgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
 static inline rgb mrgb_scale(rgb a, double s) { return mrgb(a.r * s, a.g * s, a.b * s); }
 static inline double mrgb_max(rgb a) { return fmax(a.r, fmax(a.g, a.b)); }
-/* POV-Ray's greyscale weights (0.297, 0.589, 0.114), as shade.c. */
-static inline double mrgb_grey(rgb a) { return 0.297 * a.r + 0.589 * a.g + 0.114 * a.b; }
 
 /* Pigment at a hit: patterns, image maps and texture maps through
  * shade_texture's tex_pigment_at (the colour `shade.c` would see on the top
@@ -43,25 +41,67 @@ static rgb texture_pigment(const scene *sc, const scene_texture *tex, const acce
     return mrgb(pg->colour.r, pg->colour.g, pg->colour.b);
 }
 
-static double opacity_of(rgb pig, double filt, double transm)
+/* One layer of a texture as POV-Ray shades it (trace.cpp
+ * ComputeLightedTexture): its finish, pigment, opacity att (1 - filter -
+ * transmit; before #version 3.7 1 - (filter * max channel + transmit), as
+ * shade_texture.c) and the filter colour `fil` of the layers above it. */
+typedef struct {
+    const scene_finish *f;
+    rgb pig, fil;
+    double att;
+} layer;
+
+/* The layers of tex from the top down (at most MAT_MAX_LAYERS, and none
+ * once the layers above pass no light, as POV-Ray stops); *through: the
+ * colour that passes them all (filter * pigment + transmit, multiplied). */
+static int texture_layers(const scene *sc, const scene_texture *tex, const accel_hit *h, layer *L, rgb *through,
+                          int *unsupported)
 {
-    rgb tc = {filt * pig.r + transm, filt * pig.g + transm, filt * pig.b + transm};
-    return 1.0 - fmin(1.0, fmax(0.0, mrgb_grey(tc)));
+    const int legacy = radrules_legacy(sc);
+    rgb fil = {1, 1, 1};
+    int n = 0;
+    for (const scene_texture *t = tex; t && n < MAT_MAX_LAYERS; t = t->next) {
+        double filt, transm;
+        int uns = 0;
+        rgb pig = texture_pigment(sc, t, h, &filt, &transm, &uns);
+        if (unsupported && uns) *unsupported = 1;
+        layer *l = &L[n++];
+        l->f = &t->finish;
+        l->pig = pig;
+        l->fil = fil;
+        l->att = legacy ? 1.0 - (filt * mrgb_max(pig) + transm) : 1.0 - filt - transm;
+        fil = mrgb(fil.r * (filt * pig.r + transm), fil.g * (filt * pig.g + transm), fil.b * (filt * pig.b + transm));
+        if (!(mrgb_max(fil) > 1e-7)) {
+            fil = mrgb(0, 0, 0);
+            break;
+        }
+    }
+    *through = fil;
+    return n;
 }
 
-static rgb emission_of(const scene *sc, const scene_texture *tex, rgb pig, double op)
+/* Le: each layer's pigment * att * E (core/radrules.h, the reference modes
+ * gather light) through the layers above it. */
+static rgb emission_of(const scene *sc, const layer *L, int n)
 {
-    const radrules rr = radrules_of(sc, 1); /* the reference modes gather light */
-    rgb e = radrules_emission(&rr, sc, &tex->finish);
-    return mrgb(pig.r * e.r * op, pig.g * e.g * op, pig.b * e.b * op);
+    const radrules rr = radrules_of(sc, 1);
+    rgb le = {0, 0, 0};
+    for (int k = 0; k < n; k++) {
+        rgb e = radrules_emission(&rr, sc, L[k].f);
+        le.r += L[k].fil.r * L[k].pig.r * e.r * L[k].att;
+        le.g += L[k].fil.g * L[k].pig.g * e.g * L[k].att;
+        le.b += L[k].fil.b * L[k].pig.b * e.b * L[k].att;
+    }
+    return le;
 }
 
 rgb mat_emission_at(const scene *sc, const scene_texture *tex, const accel_hit *h)
 {
     if (!tex) tex = h && h->texture ? h->texture : &sc->default_texture;
-    double filt, transm;
-    rgb pig = texture_pigment(sc, tex, h, &filt, &transm, NULL);
-    return emission_of(sc, tex, pig, opacity_of(pig, filt, transm));
+    layer L[MAT_MAX_LAYERS];
+    rgb through;
+    int n = texture_layers(sc, tex, h, L, &through, NULL);
+    return emission_of(sc, L, n);
 }
 
 rgb mat_texture_emission(const scene *sc, const scene_texture *tex) { return mat_emission_at(sc, tex, NULL); }
@@ -76,8 +116,10 @@ void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, doubl
     memset(b, 0, sizeof *b);
     const scene_texture *tex = h->texture ? h->texture : &sc->default_texture;
     const scene_finish *f = &tex->finish;
-    double filt, transm;
-    rgb pig = texture_pigment(sc, tex, h, &filt, &transm, &b->unsupported);
+    layer L[MAT_MAX_LAYERS];
+    rgb tc;
+    int nl = texture_layers(sc, tex, h, L, &tc, &b->unsupported);
+    rgb pig = L[0].pig;
     b->obj = h->obj;
     accel_from_hit(&b->from, h);
     b->tex = tex;
@@ -95,17 +137,30 @@ void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, doubl
     b->p_out = v3_madd(h->p, ng, eps);
     b->p_in = v3_madd(h->p, ng, -eps);
 
-    rgb tc = {filt * pig.r + transm, filt * pig.g + transm, filt * pig.b + transm};
-    double opacity = 1.0 - fmin(1.0, fmax(0.0, mrgb_grey(tc)));
+    double opacity = L[0].att;
     b->opacity = opacity;
-    b->emission = emission_of(sc, tex, pig, opacity);
+    b->emission = emission_of(sc, L, nl);
     b->double_illum = (h->obj && (h->obj->flags & OBJ_DOUBLE_ILLUMINATE)) || (h->flags & OBJ_DOUBLE_ILLUMINATE);
 
-    double kd = f->diffuse * opacity;
-    double kb = (b->double_illum ? f->diffuse : f->diffuse_back) * opacity;
-    b->k[MAT_LOBE_DIFFUSE] = mrgb_scale(pig, kd);
-    b->k[MAT_LOBE_BACK] = mrgb_scale(pig, kb);
-    b->nee = f->diffuse != 0.0 || f->diffuse_back != 0.0 || f->phong != 0.0 || f->specular != 0.0;
+    /* Lambertian terms and direct light of every layer, each through the
+     * layers above it (POV-Ray sums the layers' shading so) */
+    rgb kd = {0, 0, 0}, kb = {0, 0, 0};
+    b->nee = 0;
+    b->nlayers = nl;
+    for (int k = 0; k < nl; k++) {
+        const scene_finish *lf = L[k].f;
+        double d = lf->diffuse * L[k].att, db = (b->double_illum ? lf->diffuse : lf->diffuse_back) * L[k].att;
+        kd = mrgb(kd.r + L[k].fil.r * L[k].pig.r * d, kd.g + L[k].fil.g * L[k].pig.g * d, kd.b + L[k].fil.b * L[k].pig.b * d);
+        kb = mrgb(kb.r + L[k].fil.r * L[k].pig.r * db, kb.g + L[k].fil.g * L[k].pig.g * db,
+                  kb.b + L[k].fil.b * L[k].pig.b * db);
+        int lit = lf->diffuse != 0.0 || lf->diffuse_back != 0.0 || lf->phong != 0.0 || lf->specular != 0.0;
+        b->nee |= lit;
+        light_surface lls = {lf, L[k].pig, n, dir, L[k].att, r};
+        b->layer_ls[k] = lls;
+        b->layer_fil[k] = lit ? L[k].fil : mrgb(0, 0, 0);
+    }
+    b->k[MAT_LOBE_DIFFUSE] = kd;
+    b->k[MAT_LOBE_BACK] = kb;
 
     double cos_i = -v3_dot(dir, n);
     const scene_interior *in = h->obj ? h->obj->interior : NULL;
@@ -155,8 +210,7 @@ void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, doubl
         b->m[i] = m > 0.0 && isfinite(m) ? m : 0.0;
         b->msum += b->m[i];
     }
-    light_surface ls = {f, pig, n, dir, opacity, r};
-    b->ls = ls;
+    b->ls = b->layer_ls[0];
 }
 
 rgb mat_eval(const mat_bsdf *b, vec3 wi)
@@ -165,15 +219,6 @@ rgb mat_eval(const mat_bsdf *b, vec3 wi)
     if (cn > 0.0 && cg > 0.0) return mrgb_scale(b->k[MAT_LOBE_DIFFUSE], 1.0 / M_PI);
     if (cn < 0.0 && cg < 0.0) return mrgb_scale(b->k[MAT_LOBE_BACK], 1.0 / M_PI);
     return mrgb(0, 0, 0);
-}
-
-double mat_pdf(const mat_bsdf *b, vec3 wi)
-{
-    if (!(b->msum > 0.0)) return 0.0;
-    double cn = v3_dot(wi, b->n), cg = v3_dot(wi, b->ng);
-    if (cn > 0.0 && cg > 0.0) return b->m[MAT_LOBE_DIFFUSE] / b->msum * cn / M_PI;
-    if (cn < 0.0 && cg < 0.0) return b->m[MAT_LOBE_BACK] / b->msum * -cn / M_PI;
-    return 0.0;
 }
 
 vec3 mat_cosine_dir(vec3 n, double u1, double u2)
@@ -185,7 +230,14 @@ vec3 mat_cosine_dir(vec3 n, double u1, double u2)
     return v3_add(v3_add(v3_scale(t, x), v3_scale(bt, y)), v3_scale(n, z));
 }
 
-int mat_sample_lobe(const mat_bsdf *b, double u_lobe, double u1, double u2, int absorb, mat_scatter *s)
+/* Sample a lobe and a direction. absorb = 0: a lobe is always chosen, with
+ * probability m_k / sum m (path tracer; Russian roulette is separate).
+ * absorb = 1: probability m_k (scaled down when sum m > 1), else the particle
+ * is absorbed (photon Russian roulette, seed 002 appendix A step 2(b)-(d),
+ * with the max channel as scatter probability so powers never grow).
+ * Returns 0 when nothing is sampled (absorbed, black, or a diffuse direction
+ * that the shading normal allows but the geometric normal does not). */
+static int mat_sample_lobe(const mat_bsdf *b, double u_lobe, double u1, double u2, int absorb, mat_scatter *s)
 {
     memset(s, 0, sizeof *s);
     s->eta2 = 1.0;
@@ -248,21 +300,31 @@ int mat_sample(const mat_bsdf *b, rng *r, int absorb, mat_scatter *s)
 
 rgb mat_light_nee(const mat_bsdf *b, const light_ctx *c, const scene_light *l, int nsamples, rng *r)
 {
-    light_surface ls = b->ls;
-    ls.r = r;
     light_ctx cf = *c;
     cf.from = &b->from;
-    c = &cf;
-    if (b->gathered) {
-        scene_finish f = *ls.f;
-        f.phong = f.specular = 0.0;
-        ls.f = &f;
-        if (l->area) {
-            scene_light pl = *l;
-            pl.area = 0;
-            return light_nee(c, &pl, &ls, b->p_out, b->double_illum, 1, r);
-        }
-        return light_nee(c, l, &ls, b->p_out, b->double_illum, nsamples, r);
+    scene_light pl;
+    if (b->gathered && l->area) {
+        /* gathering rays see area lights as points at their centre */
+        pl = *l;
+        pl.area = 0;
+        l = &pl;
+        nsamples = 1;
     }
-    return light_nee(c, l, &ls, b->p_out, b->double_illum, nsamples, r);
+    rgb total = {0, 0, 0};
+    for (int k = 0; k < b->nlayers; k++) {
+        rgb fil = b->layer_fil[k];
+        if (!(mrgb_max(fil) > 0.0)) continue;
+        light_surface ls = b->layer_ls[k];
+        ls.r = r;
+        scene_finish f;
+        if (b->gathered) {
+            /* no highlights at the hits of gathering rays */
+            f = *ls.f;
+            f.phong = f.specular = 0.0;
+            ls.f = &f;
+        }
+        rgb v = light_nee(&cf, l, &ls, b->p_out, b->double_illum, nsamples, r);
+        total = mrgb(total.r + fil.r * v.r, total.g + fil.g * v.g, total.b + fil.b * v.b);
+    }
+    return total;
 }

@@ -3,7 +3,8 @@
  * path tracer, the photon mapper and (later) the particle GI.
  *
  * At a hit seen along unit `dir` (n = shading normal turned towards the
- * viewer, opacity = 1 - grey(filter*pigment + transmit) as in shade.c):
+ * viewer, opacity = 1 - filter - transmit, before #version 3.7
+ * 1 - (filter * max channel + transmit), as shade_texture.c):
  *
  *   f(wi) = kd/pi   for wi on the viewer's side    kd = diffuse * opacity * pigment
  *         + kb/pi   for wi on the other side        kb = diffuse_back * opacity * pigment
@@ -17,11 +18,15 @@
  *   Le      = pigment * opacity * (emission [+ ambient * ambient_light: #version < 3.7])
  *
  * The pigment is evaluated at the hit (patterns, image maps, texture maps:
- * shade_texture.h's tex_pigment_at, the top layer's colour) and the finish
- * is the hit texture's. Approximations for now: layered textures use the
- * top layer only, and normal{} perturbation is not applied to the GI
- * BSDF (shade.c applies both), so `--gi none` equals the direct part of
- * the path tracer only for scenes without layers and normal{}.
+ * shade_texture.h's tex_pigment_at) and the finish is the hit texture's.
+ * Layered textures as POV-Ray shades them: every layer's emission,
+ * Lambertian terms and direct light count, times its opacity and the filter
+ * colour of the layers above (pigment * filter + transmit, multiplied), and
+ * what passes all layers is the transmitted colour; the reflection is the
+ * top layer's (an approximation), and normal{} perturbation is not applied
+ * to the GI BSDF (shade.c applies it), so `--gi none` equals the direct
+ * part of the path tracer only for scenes without normal{} and layered
+ * reflection.
  *
  * Lambertian terms ignore brilliance and crand (they are POV-Ray's shaping
  * of direct light only). Phong and specular highlights are not part of f:
@@ -50,6 +55,8 @@
 #include "scene.h"
 #include "shade_light.h"
 
+#define MAT_MAX_LAYERS 8
+
 enum { MAT_LOBE_DIFFUSE = 0, MAT_LOBE_BACK = 1, MAT_LOBE_REFLECT = 2, MAT_LOBE_TRANSMIT = 3, MAT_NLOBES = 4 };
 
 typedef struct {
@@ -72,7 +79,10 @@ typedef struct {
     int nee;           /* direct light applies (diffuse, diffuse_back, phong or specular) */
     int double_illum;
     int unsupported;   /* a pigment pattern the shader cannot evaluate (its colour is used) */
-    light_surface ls;  /* for light_terms / light_nee */
+    light_surface ls;  /* for light_terms / light_nee: the top layer */
+    int nlayers;       /* layers of the texture (MAT_MAX_LAYERS at most), each shaded through those above */
+    light_surface layer_ls[MAT_MAX_LAYERS];
+    rgb layer_fil[MAT_MAX_LAYERS]; /* filter colour of the layers above (0: the layer takes no direct light) */
     const scene_object *obj; /* the hit object: light_group decides which lights reach it (scene_light_reaches) */
     accel_from from;   /* the hit's surface, for rays leaving it (accel_intersect_from) */
     int gathered;      /* set by the integrator: the hit of a gathering (radiosity) ray, where POV-Ray
@@ -106,18 +116,6 @@ void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, doubl
  * from); 0 where wi and the geometric normal disagree about the side. */
 rgb mat_eval(const mat_bsdf *b, vec3 wi);
 
-/* Density with which mat_sample(absorb = 0) picks the direction wi (solid
- * angle; delta lobes excluded). */
-double mat_pdf(const mat_bsdf *b, vec3 wi);
-
-/* Sample a lobe and a direction. absorb = 0: a lobe is always chosen, with
- * probability m_k / sum m (path tracer; Russian roulette is separate).
- * absorb = 1: probability m_k (scaled down when sum m > 1), else the particle
- * is absorbed (photon Russian roulette, seed 002 appendix A step 2(b)-(d),
- * with the max channel as scatter probability so powers never grow).
- * Returns 0 when nothing is sampled (absorbed, black, or a diffuse direction
- * that the shading normal allows but the geometric normal does not). */
-int mat_sample_lobe(const mat_bsdf *b, double u_lobe, double u1, double u2, int absorb, mat_scatter *s);
 int mat_sample(const mat_bsdf *b, rng *r, int absorb, mat_scatter *s);
 
 /* Cosine-weighted direction about unit n for (u1, u2) in [0,1)^2 (Malley:

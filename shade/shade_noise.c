@@ -179,7 +179,8 @@ static void init_all(void)
     init_waves();
 }
 
-void noise_init(void) { pthread_once(&init_once, init_all); }
+/* Build the tables (idempotent, thread-safe). */
+static void noise_init(void) { pthread_once(&init_once, init_all); }
 
 /* ------------------------------------------------------------ lattice noise */
 

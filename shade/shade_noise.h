@@ -23,9 +23,6 @@ static inline int noise_to_int(double x)
     return (x > -2147483649.0 && x < 2147483648.0) ? (int)x : INT_MIN;
 }
 
-/* Build the tables (idempotent, thread-safe). */
-void noise_init(void);
-
 /* POV-Ray's Noise(p, generator): a value in [0, 1]. generator 1..3. */
 double noise_value(vec3 p, int generator);
 /* POV-Ray's DNoise(p): vector noise, components roughly in [-1, 1]. */

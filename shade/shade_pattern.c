@@ -40,6 +40,8 @@
 /* POV-Ray's greyscale weights. */
 #define GREY(r, g, b) (0.297 * (r) + 0.589 * (g) + 0.114 * (b))
 
+static int pattern_image_colour(const scene_image_map *im, vec3 tp, colour5 *out);
+
 static inline double pov_floor(double x) { return x >= 0.0 ? floor(x) : (0.0 - floor(0.0 - x) - 1.0); }
 
 pattern_ctx pattern_ctx_plain(const scene *sc)
@@ -223,7 +225,8 @@ vec3 pattern_warp(const scene_pattern *pat, vec3 p)
     return p;
 }
 
-const scene_warp *pattern_classic_turb(const scene_pattern *pat)
+/* The classic turbulence warp of a pattern (the last warp), or NULL. */
+static const scene_warp *pattern_classic_turb(const scene_pattern *pat)
 {
     if (pat->nwarps == 0) return NULL;
     const scene_warp *w = &pat->warps[pat->nwarps - 1];
@@ -927,7 +930,8 @@ static const scene_blend_map cubic_map = {MAP_COLOUR, 6, cubic_e};
 static const scene_blend_map mandel_map = {MAP_COLOUR, 5, mandel_e};
 static const scene_blend_map square_map = {MAP_COLOUR, 4, cubic_e};   /* likewise the cubic entries */
 
-const scene_blend_map *pattern_default_map(pattern_kind k)
+/* POV-Ray's default colour map for a pattern kind (bozo, wood, radial...). */
+static const scene_blend_map *pattern_default_map(pattern_kind k)
 {
     switch (k) {
     case PAT_BOZO: return &bozo_map;
@@ -1139,7 +1143,9 @@ int pattern_image_pos(const scene_image_map *im, vec3 tp, double *x, double *y)
     return 1;
 }
 
-int pattern_image_colour(const scene_image_map *im, vec3 tp, colour5 *out)
+/* Image-map colour at a warped point (POV-Ray's image_map); 0 outside a
+ * `once` image (then *out is clear: transmit 1). */
+static int pattern_image_colour(const scene_image_map *im, vec3 tp, colour5 *out)
 {
     colour5 clear = {1, 1, 1, 0, 1};
     double xc, yc;

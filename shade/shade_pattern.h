@@ -32,23 +32,16 @@ vec3 pattern_warp(const scene_pattern *pat, vec3 p);
 /* Pattern value at an already warped point, with frequency, phase and the
  * wave type applied (POV-Ray's Evaluate_TPat). */
 double pattern_value(const scene_pattern *pat, vec3 tp, const pattern_ctx *c);
-/* The classic turbulence warp of a pattern (the last warp), or NULL. */
-const scene_warp *pattern_classic_turb(const scene_pattern *pat);
 
 /* Blend-map lookup (POV-Ray's Search_Blend_Map): indices of the entries
  * below and above v (equal when v is on or outside an end). */
 void blend_map_search(const scene_blend_map *m, double v, int *prev, int *cur);
-/* POV-Ray's default colour map for a pattern kind (bozo, wood, radial...). */
-const scene_blend_map *pattern_default_map(pattern_kind k);
 
 /* Pigment colour (rgb, filter, transmit) at p in the pigment's owner space
  * (texture space for a texture's pigment). Returns 0 when no colour was
  * found (outside an image_map used `once`), POV-Ray's Compute_Pigment. */
 int pigment_eval(const scene_pigment *pg, vec3 p, const pattern_ctx *c, colour5 *out);
 
-/* Image-map colour at a warped point (POV-Ray's image_map); 0 outside a
- * `once` image (then *out is clear: transmit 1). */
-int pattern_image_colour(const scene_image_map *im, vec3 tp, colour5 *out);
 /* The image coordinates (pixels, wrapped, row 0 at the top) of a warped
  * point (POV-Ray's map_pos); 0 outside a `once` image or without pixels. */
 int pattern_image_pos(const scene_image_map *im, vec3 tp, double *x, double *y);

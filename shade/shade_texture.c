@@ -556,6 +556,7 @@ rgb tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir)
 /* ------------------------------------------------------------ shadows */
 
 static int pigment_transparent(const scene_pigment *pg, int depth);
+static int tex_transparent(const scene_texture *t);
 
 static int map_transparent(const scene_blend_map *m, int depth)
 {
@@ -581,7 +582,7 @@ static int pigment_transparent(const scene_pigment *pg, int depth)
     return map_transparent(pg->map, depth);
 }
 
-int tex_transparent(const scene_texture *t)
+static int tex_transparent(const scene_texture *t)
 {
     for (; t; t = t->next) {
         if (t->pat && t->map) {

@@ -68,6 +68,5 @@ rgb tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, double tmi
  * in its textures, image maps with alpha or `once`)? When not, shadows are
  * plain occlusion tests. */
 int tex_scene_transparent(const scene *sc);
-int tex_transparent(const scene_texture *t);
 
 #endif

@@ -933,8 +933,6 @@ static double penrose1_tiles(vec3 p)
 }
 
 
-int tiling_supported(int n) { return n >= 1 && n <= 27; }
-
 double tiling_value(int n, vec3 p)
 {
     /* cell indices are ints: beyond 1e9 units (and for NaN) they would

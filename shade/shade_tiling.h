@@ -6,8 +6,6 @@
 #define PT_SHADE_TILING_H
 #include "vec.h"
 
-/* Tilings modelled: 1 to 27, all of POV-Ray 3.7's. */
-int tiling_supported(int n);
 /* Value of tiling n at p, in [0, 1]. */
 double tiling_value(int n, vec3 p);
 

@@ -286,6 +286,57 @@ static void test_tiles_merge(void **st)
     assert_false(tu_exists(m));
 }
 
+/* GI across an animation's frames: with only the camera moving, the
+ * geometry and lighting stages run once; with a light moving, geometry
+ * once and lighting every frame; with an object moving, every stage every
+ * frame. Every frame is byte-identical (PFM) to the frame rendered alone. */
+static void test_gi_reuse(void **st)
+{
+    (void)st;
+    static const struct {
+        const char *name, *camera, *light, *sphere, *stages2;
+    } cases[] = {
+        {"cam", "<0.4 * clock, 1, -3.2>", "<0, 1.8, -0.5>", "<-0.6, 0.4, -0.3>", "gi stages run: view"},
+        {"light", "<0, 1, -3.2>", "<0.5 * clock, 1.8, -0.5>", "<-0.6, 0.4, -0.3>", "gi stages run: lighting, view"},
+        {"object", "<0, 1, -3.2>", "<0, 1.8, -0.5>", "<-0.6 + 0.5 * clock, 0.4, -0.3>",
+         "gi stages run: geometry, lighting, view"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char scene[600], text[2048], cmd[4096], out[600], one[600];
+        snprintf(scene, sizeof scene, "%s/reuse_%s.pov", tmpdir, cases[i].name);
+        snprintf(text, sizeof text,
+                 "#version 3.7;\nglobal_settings { radiosity { count 50 } }\n"
+                 "camera { location %s look_at <0, 0.8, 0> angle 60 }\n"
+                 "light_source { %s rgb 1 }\n"
+                 "box { <-1.5, 0, -4>, <1.5, 2, 1.5> hollow pigment { rgb 0.8 } finish { diffuse 0.8 ambient 0 } }\n"
+                 "sphere { %s, 0.4 pigment { rgb <0.9, 0.3, 0.2> } finish { diffuse 0.8 ambient 0 } }\n",
+                 cases[i].camera, cases[i].light, cases[i].sphere);
+        tu_write_file(scene, text);
+        snprintf(out, sizeof out, "%s/reuse_%s_.pfm", tmpdir, cases[i].name);
+        snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 48x36 --particles 5000 +KFI1 +KFF3 -o '%s'", PARTRAY_BIN, scene,
+                 out);
+        assert_int_equal(tu_run_capture(cmd), 0);
+        printf("%s:\n%s", cases[i].name, tu_out);
+        assert_non_null(strstr(tu_out, "frame 1: gi stages run: geometry, lighting, view"));
+        char want[128];
+        for (int f = 2; f <= 3; f++) {
+            snprintf(want, sizeof want, "frame %d: %s\n", f, cases[i].stages2);
+            assert_non_null(strstr(tu_out, want));
+        }
+        for (int f = 2; f <= 3; f++) {
+            snprintf(one, sizeof one, "%s/one_%s_.pfm", tmpdir, cases[i].name);
+            snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 48x36 --particles 5000 +KFI1 +KFF3 --frame %d -q -o '%s'",
+                     PARTRAY_BIN, scene, f, one);
+            assert_int_equal(tu_run_capture(cmd), 0);
+            snprintf(cmd, sizeof cmd, "cmp '%s/reuse_%s_%d.pfm' '%s/one_%s_%d.pfm'", tmpdir, cases[i].name, f, tmpdir,
+                     cases[i].name, f);
+            int rc = tu_run_capture(cmd);
+            printf("frame %d in one run vs alone: %s\n", f, rc == 0 ? "identical" : tu_out);
+            assert_int_equal(rc, 0);
+        }
+    }
+}
+
 int main(void)
 {
     if (tu_mkdtemp(tmpdir, sizeof tmpdir, "partray-anim")) return 1;
@@ -294,6 +345,7 @@ int main(void)
         cmocka_unit_test(test_ini),
         cmocka_unit_test(test_window_as_povray),
         cmocka_unit_test(test_tiles_merge),
+        cmocka_unit_test(test_gi_reuse),
     };
     return tu_finish(cmocka_run_group_tests(tests, NULL, NULL), tmpdir);
 }

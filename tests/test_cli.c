@@ -538,6 +538,128 @@ static void test_quality_levels(void **st)
     assert_non_null(strstr(tu_out, "+Q wants a quality level 0 to 11"));
 }
 
+/* The fraction of pixel (x, y)'s 3 x 3 stratified sample points inside the
+ * disc of radius 2 at the centre of an 8 x 6 unit orthographic view on
+ * 64 x 48 pixels. */
+static double disc_coverage(int x, int y)
+{
+    int in = 0;
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 3; i++) {
+            double wx = -4 + (x + (i + 0.5) / 3) / 8, wy = 3 - (y + (j + 0.5) / 3) / 8;
+            in += wx * wx + wy * wy < 4;
+        }
+    return in / 9.0;
+}
+
+/* +UA (Output_Alpha): PNG (RGBA) and EXR (A) carry each pixel's coverage:
+ * with +A the fraction of 3 x 3 stratified rays meeting the sphere, where a
+ * ray leaving the scene is clear without background{} (POV-Ray 3.7's
+ * default <0,0,0,0,1>) and opaque with an opaque background{}; before
+ * #version 3.7 the background is clear under +UA. Compared with the disc's
+ * analytic coverage at every pixel (PNG 8-bit: 0.5/255; EXR half: 1e-3). */
+static void test_alpha_output(void **st)
+{
+    (void)st;
+    char scene[512], cmd[4096], png[600], exr[600];
+    snprintf(scene, sizeof scene, "%s/ua.pov", tmpdir);
+    snprintf(png, sizeof png, "%s/ua.png", tmpdir);
+    snprintf(exr, sizeof exr, "%s/ua.exr", tmpdir);
+    const char *body = "global_settings { assumed_gamma 1 }\n"
+                       "camera { orthographic location <0, 0, -10> look_at 0 right 8*x up 6*y }\n"
+                       "light_source { <0, 0, -10> rgb 1 }\n"
+                       "#ifdef (Bg) background { rgb 0.5 } #end\n"
+                       "sphere { 0, 2 pigment { rgb <1, 0.5, 0.25> } }\n";
+    char text[1024];
+    snprintf(text, sizeof text, "#version 3.7;\n%s", body);
+    tu_write_file(scene, text);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 64x48 +A +UA -q -o '%s' -o '%s'", PARTRAY_BIN, scene, png, exr);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    const char *paths[] = {png, exr};
+    const double tol[] = {0.5 / 255 + 1e-6, 1e-3};
+    int partial = 0;
+    for (int k = 0; k < 2; k++) {
+        framebuffer *fb = NULL;
+        assert_int_equal(img_read(paths[k], 0, &fb, NULL), PT_OK);
+        assert_non_null(fb->alpha);
+        for (int y = 0; y < 48; y++)
+            for (int x = 0; x < 64; x++) {
+                double want = disc_coverage(x, y), got = fb->alpha[y * 64 + x];
+                if (fabs(got - want) > tol[k]) fail_msg("%s pixel %d,%d alpha %.4f, want %.4f", paths[k], x, y, got, want);
+                partial += k == 0 && want > 0 && want < 1;
+            }
+        fb_free(fb);
+    }
+    assert_true(partial > 20); /* the edge has fractional coverage */
+    /* an opaque background{}: opaque everywhere; before 3.7: clear again */
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 64x48 +UA -D Bg=1 -q -o '%s'", PARTRAY_BIN, scene, png);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    framebuffer *fb = NULL;
+    assert_int_equal(img_read(png, 0, &fb, NULL), PT_OK);
+    assert_non_null(fb->alpha);
+    assert_true(fb->alpha[0] == 1.0f && fb->alpha[24 * 64 + 32] == 1.0f);
+    fb_free(fb);
+    snprintf(text, sizeof text, "#version 3.6;\n%s", body);
+    tu_write_file(scene, text);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    assert_int_equal(img_read(png, 0, &fb, NULL), PT_OK);
+    assert_true(fb->alpha[0] == 0.0f && fb->alpha[24 * 64 + 32] == 1.0f);
+    fb_free(fb);
+    /* without +UA: no alpha channel */
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 64x48 -q -o '%s'", PARTRAY_BIN, scene, png);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    assert_int_equal(img_read(png, 0, &fb, NULL), PT_OK);
+    assert_null(fb->alpha);
+    fb_free(fb);
+}
+
+/* PNG bit depth: IHDR byte 24 of the file. */
+static int png_bit_depth(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return -1;
+    unsigned char b[32];
+    size_t n = fread(b, 1, sizeof b, f);
+    fclose(f);
+    return n >= 25 ? b[24] : -1;
+}
+
+/* +O and +F as POV-Ray 3.7 names outputs (imageprocessing.cpp,
+ * GetOutputFilename): +O without an extension takes the +F type's (PNG
+ * unless +FE), +O ending in '/' writes SCENE.EXT there; +FN16 is a 16-bit
+ * PNG, +FN8 an 8-bit one; +FC and the other types partray does not write
+ * are refused by name. */
+static void test_output_names_and_types(void **st)
+{
+    (void)st;
+    char scene[512], dir[512], cmd[4096], path[700];
+    snprintf(scene, sizeof scene, "%s/names.pov", tmpdir);
+    snprintf(dir, sizeof dir, "%s/names_out", tmpdir);
+    tu_write_file(scene, "camera { location -5*z look_at 0 } light_source { -5*z, 1 } sphere { 0, 1 pigment { rgb 1 } }\n");
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s' && '%s' render '%s' --size 16x12 -q +O%s/pov2", dir, PARTRAY_BIN, scene, dir);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    snprintf(path, sizeof path, "%s/pov2.png", dir);
+    assert_int_equal(png_bit_depth(path), 8);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 16x12 -q +FE +O%s/pov2", PARTRAY_BIN, scene, dir);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    snprintf(path, sizeof path, "%s/pov2.exr", dir);
+    framebuffer *fb = NULL;
+    assert_int_equal(img_read(path, 0, &fb, NULL), PT_OK);
+    assert_int_equal(fb->width, 16);
+    fb_free(fb);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 16x12 -q +FN16 +O%s/pov3", PARTRAY_BIN, scene, dir);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    snprintf(path, sizeof path, "%s/pov3.png", dir);
+    assert_int_equal(png_bit_depth(path), 16);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 16x12 -q +FN8 +O%s/", PARTRAY_BIN, scene, dir);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    snprintf(path, sizeof path, "%s/names.png", dir);
+    assert_int_equal(png_bit_depth(path), 8);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --size 16x12 +FC +O%s/pov4", PARTRAY_BIN, scene, dir);
+    assert_int_equal(tu_run_capture(cmd), 2);
+    assert_non_null(strstr(tu_out, "+FC: Targa output is not written"));
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/partray-cli-XXXXXX");
@@ -559,6 +681,8 @@ int main(void)
         cmocka_unit_test(test_progress_plain_and_quiet),
         cmocka_unit_test(test_sigint_during_gi),
         cmocka_unit_test(test_quality_levels),
+        cmocka_unit_test(test_alpha_output),
+        cmocka_unit_test(test_output_names_and_types),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     char cmd[600];

@@ -22,7 +22,17 @@
  *  - accel_surface: world areas against closed forms (spheroid, sheared box,
  *    torus) to 1e-6, the clipped plane to 1e-4 (padded clip box), uniformity of spheroid samples per z band
  *    against the exact band areas (within 5 sigma), pdf lookup at hits.
- *  - kd-tree: k nearest equal to brute force. */
+ *  - kd-tree: k nearest equal to brute force.
+ *  - POV-Ray's rules for light entering radiosity (core/radrules.h), both
+ *    modes, image means within 1% of the closed forms: the furnace with
+ *    ambient 1 under #version 3.7 (0; with emission 1: 2), 3.6 (4) and none
+ *    (2); brightness 1.2 (E / (1 - rho B), recursion_limit 20), recursion_limit
+ *    2 (1.75); no_radiosity (a black ceiling hidden from gathering: 0.4
+ *    within 1e-3; seen: black); the white furnace under a sky_sphere or
+ *    background of radiance L (L). POV-Ray 3.7's own renders of the same
+ *    scenes (16x16, radiosity count 400, error_bound 0.2, Radiance HDR):
+ *    1.984, 3.969, 1.984, 0, 2.484, 1.750, 0.398, 0, 0.999, 0.999 (RGBE
+ *    rounds down by up to 1/128). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -40,7 +50,9 @@
 #include "pm_kdtree.h"
 #include "pm_path.h"
 #include "sdl.h"
+#include "radrules.h"
 #include "shade.h"
+#include "test_world.h"
 
 #define THREADS 2
 
@@ -226,6 +238,146 @@ static void test_sky_sphere(void **state)
         sky_case(m, "rgb 0.5", 0.4, 1e-4);
         sky_case(m, sky_gradient, 0.8 * 2.0 / 3.0, 5e-3);
     }
+}
+
+/* ------------------------------------------------------------ POV-Ray's rules for light entering radiosity */
+
+/* Mean over an S x S image of `text` by path (quality = spp) or pmfg
+ * (quality = gather rays per pixel, 50,000 photons). */
+#define RULES_SIZE 8
+static double rules_mean(const char *text, int pmfg, int quality)
+{
+    scene *sc = parse(text);
+    accel *a = build(sc);
+    framebuffer *fb = fb_new(RULES_SIZE, RULES_SIZE);
+    pm_stats st;
+    if (pmfg) {
+        pm_fg_settings s;
+        pm_fg_default_settings(&s);
+        s.c.width = s.c.height = RULES_SIZE;
+        s.c.threads = THREADS;
+        s.c.seed = 13;
+        s.fg_rays = quality;
+        s.photons = 50000;
+        assert_int_equal(pm_fg_render(sc, a, &s, fb, &st, NULL), PT_OK);
+    } else {
+        pm_path_settings s;
+        pm_path_default_settings(&s);
+        s.c.width = s.c.height = RULES_SIZE;
+        s.c.threads = THREADS;
+        s.c.seed = 13;
+        s.c.spp = quality;
+        assert_int_equal(pm_path_render(sc, a, &s, fb, &st, NULL), PT_OK);
+    }
+    double mean, maxdev, sd;
+    image_stats(fb, 1.0, &mean, &maxdev, &sd);
+    fb_free(fb);
+    accel_free(a);
+    scene_free(sc);
+    return mean;
+}
+
+/* The furnace of the top (camera inside a closed sphere, pigment 1,
+ * diffuse rho) with finish ambient A and emission E, under `version`
+ * ("" none) and global settings `gs`; both reference modes must give
+ * `expect` within tol (relative; expect 0: below 1e-9). */
+static void rules_case(const char *what, const char *version, const char *gs, double A, double E, double rho,
+                       double expect, double tol)
+{
+    char text[1024];
+    snprintf(text, sizeof text,
+             "%s%s%s"
+             "global_settings { assumed_gamma 1.0 %s }\n"
+             "camera { perspective location <0,0,0> look_at <0,0,1> angle 90 }\n"
+             "sphere { <0,0,0>, 1 pigment { rgb 1 } finish { ambient %g diffuse %g emission %g } }\n",
+             version[0] ? "#version " : "", version, version[0] ? ";\n" : "", gs, A, rho, E);
+    for (int m = 0; m <= 1; m++) {
+        double mean = rules_mean(text, m, m ? 1024 : 256);
+        printf("rules %-34s %-4s mean %.5f (expect %.5f, rel err %+.4f, tol %.3f)\n", what, m ? "pmfg" : "path", mean,
+               expect, expect > 0.0 ? mean / expect - 1.0 : mean, tol);
+        if (expect > 0.0) assert_true(fabs(mean / expect - 1.0) <= tol);
+        else assert_true(fabs(mean) < 1e-9);
+    }
+}
+
+/* Ambient per #version (trace.cpp: ambient * ambient_light is light only
+ * with radiosity off or below 3.7; no #version is 3.62). POV-Ray's own
+ * renders of these furnaces with radiosity {}: see reference/README.md. */
+static void test_rules_ambient(void **state)
+{
+    (void)state;
+    /* the rule itself: radiosity off always shows ambient */
+    const char *v[3] = {"#version 3.7;\n", "#version 3.6;\n", ""};
+    for (int i = 0; i < 3; i++) {
+        char text[256];
+        snprintf(text, sizeof text, "%scamera { location 0 look_at z } sphere { 0, 1 }\n", v[i]);
+        scene *sc = parse(text);
+        radrules off = radrules_of(sc, 0), on = radrules_of(sc, 1);
+        assert_int_equal(off.ambient, 1);
+        assert_int_equal(on.ambient, i > 0); /* 3.7: no; 3.6 and none: yes */
+        scene_free(sc);
+    }
+    rules_case("3.7 ambient 1, no emission", "3.7", "", 1.0, 0.0, 0.5, 0.0, 0.0);
+    rules_case("3.7 ambient 1, emission 1", "3.7", "", 1.0, 1.0, 0.5, 2.0, 0.01);
+    rules_case("3.6 ambient 1, emission 1", "3.6", "", 1.0, 1.0, 0.5, 4.0, 0.01);
+    rules_case("no #version ambient 1", "", "", 1.0, 0.0, 0.5, 2.0, 0.01);
+}
+
+/* brightness scales gathered light at every bounce: L = E + rho B L,
+ * L = E (1 - (rho B)^(n+1)) / (1 - rho B) with n = recursion_limit
+ * bounces; recursion_limit alone: L = E (1 + rho + ... + rho^n). */
+static void test_rules_brightness(void **state)
+{
+    (void)state;
+    double q = 0.5 * 1.2;
+    rules_case("brightness 1.2, recursion_limit 20", "3.7", "radiosity { brightness 1.2 recursion_limit 20 }", 0.0,
+               1.0, 0.5, (1.0 - pow(q, 21)) / (1.0 - q), 0.01);
+    rules_case("recursion_limit 2", "3.7", "radiosity { recursion_limit 2 }", 0.0, 1.0, 0.5, 1.75, 0.01);
+}
+
+/* no_radiosity: a black ceiling that gathering rays do not see leaves the
+ * floor under the sky (kd L = 0.8 * 0.5, the sky_sphere case above); seen,
+ * it hides the sky and the floor is black (less than 5% of 0.4 comes in
+ * under the ceiling's clipped edge). */
+static void test_rules_no_radiosity(void **state)
+{
+    (void)state;
+    for (int nr = 0; nr <= 1; nr++) {
+        char text[1024];
+        snprintf(text, sizeof text,
+                 "#version 3.7;\n"
+                 "global_settings { assumed_gamma 1.0 }\n"
+                 "camera { location <0, 1, -1> look_at <0, 0, 0> angle 30 }\n"
+                 "sky_sphere { pigment { rgb 0.5 } }\n"
+                 "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 0.8 } }\n"
+                 "plane { y, 3 pigment { rgb 0 } finish { ambient 0 diffuse 0 } %s }\n",
+                 nr ? "no_radiosity" : "");
+        for (int m = 0; m <= 1; m++) {
+            double mean = rules_mean(text, m, m ? 256 : 64);
+            printf("rules no_radiosity %d %-4s mean %.5f (expect %s)\n", nr, m ? "pmfg" : "path", mean,
+                   nr ? "0.4 within 1e-3" : "below 0.02");
+            if (nr) assert_true(fabs(mean / 0.4 - 1.0) <= 1e-3);
+            else assert_true(mean < 0.02);
+        }
+    }
+}
+
+/* White furnace under the sky (tu_sky_furnace): sky_sphere and background
+ * of radiance 1 and 2.5; every mode's image mean within 1%. */
+static void test_rules_sky_furnace(void **state)
+{
+    (void)state;
+    static const double L[2] = {1.0, 2.5};
+    for (int bg = 0; bg <= 1; bg++)
+        for (int k = 0; k < 2; k++)
+            for (int m = 0; m <= 1; m++) {
+                char text[1024];
+                tu_sky_furnace(text, sizeof text, L[k], bg, 1);
+                double mean = rules_mean(text, m, m ? 256 : 64);
+                printf("rules sky furnace %-10s L %.1f %-4s mean %.6f (rel err %+.2e, tol 0.01)\n",
+                       bg ? "background" : "sky_sphere", L[k], m ? "pmfg" : "path", mean, mean / L[k] - 1.0);
+                assert_true(fabs(mean / L[k] - 1.0) <= 0.01);
+            }
 }
 
 /* ------------------------------------------------------------ photons { } per object */
@@ -857,6 +1009,10 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_furnace_point_path),
         cmocka_unit_test(test_furnace_point_fg),
         cmocka_unit_test(test_sky_sphere),
+        cmocka_unit_test(test_rules_ambient),
+        cmocka_unit_test(test_rules_brightness),
+        cmocka_unit_test(test_rules_no_radiosity),
+        cmocka_unit_test(test_rules_sky_furnace),
         cmocka_unit_test(test_photons_block_ir),
         cmocka_unit_test(test_photons_targets),
     };

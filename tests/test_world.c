@@ -29,6 +29,21 @@ tu_world tu_world_build(const char *name, const char *src)
     return w;
 }
 
+const char *tu_sky_furnace(char *buf, size_t n, double L, int background, int radiosity)
+{
+    char sky[128];
+    if (background) snprintf(sky, sizeof sky, "background { rgb %.17g }", L);
+    else snprintf(sky, sizeof sky, "sky_sphere { pigment { rgb %.17g } }", L);
+    snprintf(buf, n,
+             "#version 3.7;\n"
+             "global_settings { assumed_gamma 1.0 %s }\n"
+             "camera { location <0, 0, -3> look_at <0, 0, 0> angle 20 }\n"
+             "%s\n"
+             "sphere { 0, 1 pigment { rgb 1 } finish { ambient 0 diffuse 1 } }\n",
+             radiosity ? "radiosity { }" : "", sky);
+    return buf;
+}
+
 void tu_world_free(tu_world *w)
 {
     accel_free(w->a);

@@ -2,7 +2,7 @@
  * build without OpenCL (PARTRAY_OPENCL=OFF, or the "c" device) runs the very
  * same kernel code. Only the small subset the kernels use is mapped:
  * address-space qualifiers vanish, get_global_id(0) reads a thread-local
- * index set by the launcher (gi_cl_c.c), atom_add and atomic_add are relaxed
+ * index set by the launcher (gi_cl_c.c, this header's only includer), atom_add and atomic_add are relaxed
  * atomic adds,
  * prefetch a write prefetch.
  * Math calls (pow, sqrt, fabs, rint) resolve to the C library's double
@@ -17,7 +17,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define __kernel
+/* the kernels are file-local to gi_cl_c.c, their one includer */
+#define __kernel static
 #define __global
 #define __constant const
 #define __local
@@ -25,7 +26,7 @@
 
 typedef unsigned int uint;
 
-extern _Thread_local size_t gi_shim_gid;
+static _Thread_local size_t gi_shim_gid;
 #define get_global_id(dim) ((void)(dim), gi_shim_gid)
 #define atom_add(p, v) __atomic_fetch_add((p), (v), __ATOMIC_RELAXED)
 #define atomic_add(p, v) __atomic_fetch_add((p), (v), __ATOMIC_RELAXED)
