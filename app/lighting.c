@@ -79,7 +79,7 @@ void lighting_check_outputs(const lighting_study *ls, const char *const *outputs
 pt_status lighting_apply_units(lighting_study *ls, scene *sc, diag *d)
 {
     if (!(ls->metres_per_unit > 0.0)) return PT_OK;
-    return light_units_apply(sc, ls->metres_per_unit, d);
+    return shade_light_units_apply(sc, ls->metres_per_unit, d);
 }
 
 pt_status lighting_alloc(lighting_study *ls, int w, int h, diag *d)

@@ -36,7 +36,7 @@ int lighting_parse_units(const char *s, double *mpu);
 void lighting_check_outputs(const lighting_study *ls, const char *const *outputs, int n, diag *d);
 
 /* After parsing: make the lights photometric when --units was given
- * (light_units_apply; warnings into d). */
+ * (shade_light_units_apply; warnings into d). */
 pt_status lighting_apply_units(lighting_study *ls, scene *sc, diag *d);
 
 /* AOV buffers for a w x h render, when any are wanted (ls->aov stays NULL

@@ -68,8 +68,8 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
 {
     gi_particle_settings gs;
     gi_particle_settings_from_scene(&gs, sc);
-    gs.pigment = tex_pigment_at; /* particles reflect the pigment where they are */
-    gs.sky = atmos_sky; /* what escaping rays see (shade_atmos.h) */
+    gs.pigment = shade_tex_pigment_at; /* particles reflect the pigment where they are */
+    gs.sky = shade_atmos_sky; /* what escaping rays see (shade_atmos.h) */
     if (o->particles > 0) gs.count = o->particles;
     if (o->bounces > 0) gs.bounces = o->bounces;
     gs.seed = o->seed;
@@ -225,7 +225,7 @@ static pt_status render_reference(const scene *sc, const accel *a, const render_
 /* What render_gi_result's nm_* say, counted and warned once. */
 static void light_not_modelled(const scene *sc, int mode, render_gi_result *r, diag *d)
 {
-    const int media = media_scene_has(sc), fog = sc->fogs != NULL, rainbow = sc->rainbows != NULL;
+    const int media = shade_media_scene_has(sc), fog = sc->fogs != NULL, rainbow = sc->rainbows != NULL;
     const char *who = mode == GI_PATH ? "path" : mode == GI_PMFG ? "pmfg" : "particle";
     if (mode == GI_PATH || mode == GI_PMFG) {
         r->nm_media = media;

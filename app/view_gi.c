@@ -121,8 +121,8 @@ static pt_status particle_open(void **ctx, const scene *sc, const accel *a, cons
     c->a = a;
     gi_particle_settings s;
     gi_particle_settings_from_scene(&s, sc);
-    s.pigment = tex_pigment_at; /* particles reflect the pigment where they are */
-    s.sky = atmos_sky; /* what escaping rays see (shade_atmos.h) */
+    s.pigment = shade_tex_pigment_at; /* particles reflect the pigment where they are */
+    s.sky = shade_atmos_sky; /* what escaping rays see (shade_atmos.h) */
     s.threads = o->threads;
     if (o->particles > 0) s.count = o->particles;
     if (o->bounces > 0) s.bounces = o->bounces;

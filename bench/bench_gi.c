@@ -125,7 +125,7 @@ static void sweep(const scene *sc, const accel *a, const opts *o, diag *d)
     for (int ci = 0; ci < 4; ci++) {
         gi_particle_settings s;
         gi_particle_settings_from_scene(&s, sc);
-        s.pigment = tex_pigment_at;
+        s.pigment = shade_tex_pigment_at;
         s.count = counts[ci];
         s.threads = o->threads;
         s.cl_device = o->device;
@@ -232,7 +232,7 @@ int main(int argc, char **argv)
 
     gi_particle_settings s;
     gi_particle_settings_from_scene(&s, sc);
-    s.pigment = tex_pigment_at;
+    s.pigment = shade_tex_pigment_at;
     s.count = o.count;
     s.bounces = o.nb;
     s.threads = o.threads;

@@ -95,7 +95,7 @@ int main(int argc, char **argv)
     }
     gi_particle_settings s;
     gi_particle_settings_from_scene(&s, sc);
-    s.pigment = tex_pigment_at;
+    s.pigment = shade_tex_pigment_at;
     s.count = count;
     s.bounces = nb;
     s.threads = threads;

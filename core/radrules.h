@@ -31,7 +31,7 @@
  * 4. Gathering rays that leave the scene see the sky: sky_sphere pigments
  *    (times its emission) over the background colour, alpha ignored
  *    (GatherLight clears alphaBackground). shade/ evaluates it
- *    (atmos_sky); gi/ receives it as a callback from app/.
+ *    (shade_atmos_sky); gi/ receives it as a callback from app/.
  * 5. `media on` lets gathering rays see media (default off:
  *    GetRadiosityQualityFlags drops media); `normal on` gathers about the
  *    perturbed normal (default off: the raw normal).

@@ -31,7 +31,7 @@
  *
  * Reflectance of a particle: diffuse * pigment * opacity (gi_particles.h),
  * the pigment evaluated at the particle's position when settings.pigment is
- * set (the app passes shade's tex_pigment_at: checkers, image maps and
+ * set (the app passes shade's shade_tex_pigment_at: checkers, image maps and
  * texture maps reflect their own colours), else the texture's base colour.
  * finish { diffuse A, B } (3.7's backside diffuse): the hook adds the other
  * side's E/pi times B / A (shade.c multiplies the hook by A), where the
@@ -75,7 +75,7 @@
 typedef struct gi_particle gi_particle;
 
 /* Pigment colour of texture `tex` at a surface point h (h->p, h->ng = h->ns,
- * h->obj, h->texture): the signature of shade_texture.h's tex_pigment_at,
+ * h->obj, h->texture): the signature of shade_texture.h's shade_tex_pigment_at,
  * which the app passes (gi does not link shade/). Returns 0 when no colour
  * was found. */
 typedef int (*gi_pigment_fn)(const scene *sc, const scene_texture *tex, const accel_hit *h, colour5 *out);
@@ -83,7 +83,7 @@ typedef int (*gi_pigment_fn)(const scene *sc, const scene_texture *tex, const ac
 /* Radiance arriving from the sky along unit direction -dir for a ray that
  * leaves the scene along dir: sky_sphere pigments over the background
  * (POV-Ray's rule for gathering rays, core/radrules.h rule 4). The
- * signature of shade_atmos.h's atmos_sky, which the app passes. */
+ * signature of shade_atmos.h's shade_atmos_sky, which the app passes. */
 typedef rgb (*gi_sky_fn)(const scene *sc, vec3 dir);
 
 /* How flux is scattered after emission (gi_lighting.cl; every bounce a

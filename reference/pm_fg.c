@@ -206,7 +206,7 @@ static rgb global_irradiance(const fg_ctx *c, vec3 p, vec3 n, uint32_t surf, int
 
 /* Reflected radiance at a gather hit (not its emission); surf: the key of
  * the side the gather ray arrived at (pm_surface_key). */
-static rgb gather_hit(const fg_ctx *c, const mat_bsdf *b, uint32_t surf, int level, int thread, rng *r, pm_counts *cnt)
+static rgb gather_hit(const fg_ctx *c, const shade_mat_bsdf *b, uint32_t surf, int level, int thread, rng *r, pm_counts *cnt)
 {
     rgb L = {0, 0, 0};
     if (b->nee) {
@@ -217,38 +217,38 @@ static rgb gather_hit(const fg_ctx *c, const mat_bsdf *b, uint32_t surf, int lev
     }
     /* the gather hit gathers in its turn (emitters, photon irradiance) only
      * within recursion_limit; emitters' light is gathered light: brightness */
-    if (c->gathers >= 2 && (b->m[MAT_LOBE_DIFFUSE] > 0.0 || b->m[MAT_LOBE_BACK] > 0.0)) {
+    if (c->gathers >= 2 && (b->m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 || b->m[SHADE_MAT_LOBE_BACK] > 0.0)) {
         rgb d = pm_direct_emitters(c->L, b, 1, 0.0, 0.0, r, &cnt->shadow);
         L.r += d.r * c->rr.brightness;
         L.g += d.g * c->rr.brightness;
         L.b += d.b * c->rr.brightness;
-        if (b->m[MAT_LOBE_DIFFUSE] > 0.0) {
+        if (b->m[SHADE_MAT_LOBE_DIFFUSE] > 0.0) {
             rgb e = global_irradiance(c, b->p, b->n, surf, thread, &cnt->shadow);
-            acc_add(&L, b->k[MAT_LOBE_DIFFUSE], frgb(e.r / M_PI, e.g / M_PI, e.b / M_PI));
+            acc_add(&L, b->k[SHADE_MAT_LOBE_DIFFUSE], frgb(e.r / M_PI, e.g / M_PI, e.b / M_PI));
         }
-        if (b->m[MAT_LOBE_BACK] > 0.0) {
+        if (b->m[SHADE_MAT_LOBE_BACK] > 0.0) {
             rgb e = global_irradiance(c, b->p, v3_neg(b->n), surf ^ 1u, thread, &cnt->shadow);
-            acc_add(&L, b->k[MAT_LOBE_BACK], frgb(e.r / M_PI, e.g / M_PI, e.b / M_PI));
+            acc_add(&L, b->k[SHADE_MAT_LOBE_BACK], frgb(e.r / M_PI, e.g / M_PI, e.b / M_PI));
         }
     }
-    double ms = b->m[MAT_LOBE_REFLECT] + b->m[MAT_LOBE_TRANSMIT];
+    double ms = b->m[SHADE_MAT_LOBE_REFLECT] + b->m[SHADE_MAT_LOBE_TRANSMIT];
     if (ms > 0.0 && level < c->s->max_gather_depth && level < c->gather_specular) {
         double q = fmin(1.0, ms);
         if (rng_f64(r) < q) {
-            int lobe = rng_f64(r) * ms < b->m[MAT_LOBE_REFLECT] ? MAT_LOBE_REFLECT : MAT_LOBE_TRANSMIT;
+            int lobe = rng_f64(r) * ms < b->m[SHADE_MAT_LOBE_REFLECT] ? SHADE_MAT_LOBE_REFLECT : SHADE_MAT_LOBE_TRANSMIT;
             double p = q * b->m[lobe] / ms;
             rgb w = b->k[lobe];
             w = frgb(w.r / p, w.g / p, w.b / p);
-            vec3 org = lobe == MAT_LOBE_REFLECT ? b->p_out : b->p_in;
-            vec3 dir = lobe == MAT_LOBE_REFLECT ? b->refl_dir : b->trans_dir;
+            vec3 org = lobe == SHADE_MAT_LOBE_REFLECT ? b->p_out : b->p_in;
+            vec3 dir = lobe == SHADE_MAT_LOBE_REFLECT ? b->refl_dir : b->trans_dir;
             cnt->bsdf++;
             accel_hit h;
-            unsigned skip = OBJ_NO_RADIOSITY | (lobe == MAT_LOBE_REFLECT ? OBJ_NO_REFLECTION : 0u);
+            unsigned skip = OBJ_NO_RADIOSITY | (lobe == SHADE_MAT_LOBE_REFLECT ? OBJ_NO_REFLECTION : 0u);
             if (!trace_skip(c, &b->from, org, dir, skip, &h)) {
                 acc_add(&L, w, pm_sky(c->sc, dir));
             } else {
-                mat_bsdf b2;
-                mat_setup(&b2, c->sc, &h, dir, c->eps, r);
+                shade_mat_bsdf b2;
+                shade_mat_setup(&b2, c->sc, &h, dir, c->eps, r);
                 b2.gathered = 1;
                 acc_add(&L, w, b2.emission);
                 acc_add(&L, w, gather_hit(c, &b2, pm_surface_key(h.obj, b2.entering), level + 1, thread, r, cnt));
@@ -259,7 +259,7 @@ static rgb gather_hit(const fg_ctx *c, const mat_bsdf *b, uint32_t surf, int lev
 }
 
 /* (1/n) sum of radiance over n stratified cosine directions about `axis`. */
-static rgb gather_lobe(const fg_ctx *c, const mat_bsdf *b, vec3 axis, vec3 org, int front, int n, int nf, int nb,
+static rgb gather_lobe(const fg_ctx *c, const shade_mat_bsdf *b, vec3 axis, vec3 org, int front, int n, int nf, int nb,
                        int thread, rng *r, pm_counts *cnt)
 {
     rgb sum = {0, 0, 0};
@@ -276,7 +276,7 @@ static rgb gather_lobe(const fg_ctx *c, const mat_bsdf *b, vec3 axis, vec3 org, 
             u1 = rng_f64(r);
             u2 = rng_f64(r);
         }
-        vec3 w = mat_cosine_dir(axis, u1, u2);
+        vec3 w = shade_mat_cosine_dir(axis, u1, u2);
         double cg = v3_dot(w, b->ng);
         if (front ? cg <= 0.0 : cg >= 0.0) continue;
         cnt->gather++;
@@ -286,7 +286,7 @@ static rgb gather_lobe(const fg_ctx *c, const mat_bsdf *b, vec3 axis, vec3 org, 
         if (c->rr.media && c->sc->fogs) {
             /* `media on`: gathering rays see fog too (radrules.h rule 5) */
             rgb fc;
-            atmos_fog_affine(c->sc, org, w, hit ? h.t : INFINITY, &fa, &fc);
+            shade_atmos_fog_affine(c->sc, org, w, hit ? h.t : INFINITY, &fa, &fc);
             sum.r += fc.r;
             sum.g += fc.g;
             sum.b += fc.b;
@@ -298,8 +298,8 @@ static rgb gather_lobe(const fg_ctx *c, const mat_bsdf *b, vec3 axis, vec3 org, 
             sum.b += fa.b * bg.b;
             continue;
         }
-        mat_bsdf b2;
-        mat_setup(&b2, c->sc, &h, w, c->eps, r);
+        shade_mat_bsdf b2;
+        shade_mat_setup(&b2, c->sc, &h, w, c->eps, r);
         b2.gathered = 1;
         rgb le = b2.emission;
         if (le.r != 0.0 || le.g != 0.0 || le.b != 0.0) {
@@ -327,7 +327,7 @@ static void eye_trace(const fg_ctx *c, const accel_from *from, vec3 org, vec3 di
     if (c->sc->fogs) {
         /* fog on eye segments (gathering rays see it only with `media on`) */
         rgb fa, fc;
-        atmos_fog_affine(c->sc, org, dir, hit ? h.t : INFINITY, &fa, &fc);
+        shade_atmos_fog_affine(c->sc, org, dir, hit ? h.t : INFINITY, &fa, &fc);
         acc_add(L, T, fc);
         T = frgb(T.r * fa.r, T.g * fa.g, T.b * fa.b);
     }
@@ -335,12 +335,12 @@ static void eye_trace(const fg_ctx *c, const accel_from *from, vec3 org, vec3 di
         acc_add(L, T, pm_sky(c->sc, dir));
         return;
     }
-    mat_bsdf b;
-    mat_setup(&b, c->sc, &h, dir, c->eps, r);
+    shade_mat_bsdf b;
+    shade_mat_setup(&b, c->sc, &h, dir, c->eps, r);
     if (b.unsupported) cnt->unsupported++;
     acc_add(L, T, b.emission);
     if (b.nee) acc_add(L, T, pm_direct_lights(c->L, &b, c->s->area_samples, r, &cnt->shadow));
-    double md = b.m[MAT_LOBE_DIFFUSE], mb = b.m[MAT_LOBE_BACK];
+    double md = b.m[SHADE_MAT_LOBE_DIFFUSE], mb = b.m[SHADE_MAT_LOBE_BACK];
     if (md > 0.0 || mb > 0.0) {
         double scale = depth == 0 ? 1.0 : fmin(1.0, fmax3(T));
         int ng = (int)lround(c->fg_per_sample * scale);
@@ -359,29 +359,29 @@ static void eye_trace(const fg_ctx *c, const accel_from *from, vec3 org, vec3 di
             rgb e;
             if (md > 0.0) {
                 vis_irradiance(c, c->caustic, b.p, b.n, key, c->k_caustic, c->r_caustic, sc, &cnt->shadow, &e);
-                acc_add(L, T, frgb(b.k[MAT_LOBE_DIFFUSE].r * e.r / M_PI, b.k[MAT_LOBE_DIFFUSE].g * e.g / M_PI,
-                                   b.k[MAT_LOBE_DIFFUSE].b * e.b / M_PI));
+                acc_add(L, T, frgb(b.k[SHADE_MAT_LOBE_DIFFUSE].r * e.r / M_PI, b.k[SHADE_MAT_LOBE_DIFFUSE].g * e.g / M_PI,
+                                   b.k[SHADE_MAT_LOBE_DIFFUSE].b * e.b / M_PI));
             }
             if (mb > 0.0) {
                 vis_irradiance(c, c->caustic, b.p, v3_neg(b.n), key ^ 1u, c->k_caustic, c->r_caustic, sc, &cnt->shadow,
                                &e);
-                acc_add(L, T, frgb(b.k[MAT_LOBE_BACK].r * e.r / M_PI, b.k[MAT_LOBE_BACK].g * e.g / M_PI,
-                                   b.k[MAT_LOBE_BACK].b * e.b / M_PI));
+                acc_add(L, T, frgb(b.k[SHADE_MAT_LOBE_BACK].r * e.r / M_PI, b.k[SHADE_MAT_LOBE_BACK].g * e.g / M_PI,
+                                   b.k[SHADE_MAT_LOBE_BACK].b * e.b / M_PI));
             }
         }
         cnt->gather_points++;
         if (nf > 0) {
             rgb g = gather_lobe(c, &b, b.n, b.p_out, 1, nf, nf, nb, thread, r, cnt);
-            acc_add(L, Tg, frgb(b.k[MAT_LOBE_DIFFUSE].r * g.r, b.k[MAT_LOBE_DIFFUSE].g * g.g,
-                               b.k[MAT_LOBE_DIFFUSE].b * g.b));
+            acc_add(L, Tg, frgb(b.k[SHADE_MAT_LOBE_DIFFUSE].r * g.r, b.k[SHADE_MAT_LOBE_DIFFUSE].g * g.g,
+                               b.k[SHADE_MAT_LOBE_DIFFUSE].b * g.b));
         }
         if (nb > 0) {
             rgb g = gather_lobe(c, &b, v3_neg(b.n), b.p_in, 0, nb, nf, nb, thread, r, cnt);
-            acc_add(L, Tg, frgb(b.k[MAT_LOBE_BACK].r * g.r, b.k[MAT_LOBE_BACK].g * g.g, b.k[MAT_LOBE_BACK].b * g.b));
+            acc_add(L, Tg, frgb(b.k[SHADE_MAT_LOBE_BACK].r * g.r, b.k[SHADE_MAT_LOBE_BACK].g * g.g, b.k[SHADE_MAT_LOBE_BACK].b * g.b));
         }
     }
     /* specular lobes: both followed (Whitted-style), small weights by roulette */
-    for (int lobe = MAT_LOBE_REFLECT; lobe <= MAT_LOBE_TRANSMIT; lobe++) {
+    for (int lobe = SHADE_MAT_LOBE_REFLECT; lobe <= SHADE_MAT_LOBE_TRANSMIT; lobe++) {
         if (b.m[lobe] <= 0.0) continue;
         rgb T2 = frgb(T.r * b.k[lobe].r, T.g * b.k[lobe].g, T.b * b.k[lobe].b);
         double mt = fmax3(T2);
@@ -392,7 +392,7 @@ static void eye_trace(const fg_ctx *c, const accel_from *from, vec3 org, vec3 di
             T2 = frgb(T2.r / q, T2.g / q, T2.b / q);
         }
         cnt->bsdf++;
-        if (lobe == MAT_LOBE_REFLECT)
+        if (lobe == SHADE_MAT_LOBE_REFLECT)
             eye_trace(c, &b.from, b.p_out, b.refl_dir, OBJ_NO_REFLECTION, T2, depth + 1, thread, r, cnt, L);
         else
             eye_trace(c, &b.from, b.p_in, b.trans_dir, skip, T2, depth + 1, thread, r, cnt, L);

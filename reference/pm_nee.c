@@ -31,9 +31,9 @@ static double emit_weight(void *ctx, const scene_object *leaf, const scene_textu
      * no_radiosity objects do not meet (core/radrules.h rule 3) */
     if (!radrules_gathers(flags)) return 0.0;
     const scene *sc = ctx;
-    rgb e = mat_texture_emission(sc, tex);
+    rgb e = shade_mat_texture_emission(sc, tex);
     double w = fmax(fabs(e.r), fmax(fabs(e.g), fabs(e.b)));
-    if (mat_texture_varies(tex)) {
+    if (shade_mat_texture_varies(tex)) {
         /* the fallback colour says little: weigh by the finish alone */
         const radrules rr = radrules_of(sc, 1);
         rgb f = radrules_emission(&rr, sc, &tex->finish);
@@ -70,8 +70,8 @@ pm_lights *pm_lights_new(const scene *sc, const accel *a, diag *d, pt_status *st
     }
     for (int i = 0; i < n; i++) {
         const scene_texture *t = accel_surf_piece_at(L->emit, i)->texture;
-        L->le[i] = mat_texture_emission(sc, t);
-        L->varies[i] = (unsigned char)mat_texture_varies(t);
+        L->le[i] = shade_mat_texture_emission(sc, t);
+        L->varies[i] = (unsigned char)shade_mat_texture_varies(t);
     }
     return L;
 }
@@ -97,7 +97,7 @@ rgb pm_lights_piece_emission(const pm_lights *L, const accel_surf_sample *s)
     eh.texture = s->texture;
     eh.prim = s->prim;
     eh.flags = s->flags;
-    return mat_emission_at(L->sc, s->texture, &eh);
+    return shade_mat_emission_at(L->sc, s->texture, &eh);
 }
 double pm_lights_eps(const pm_lights *L) { return L->eps; }
 
@@ -110,19 +110,19 @@ int pm_sky_any(const scene *sc)
 rgb pm_sky(const scene *sc, vec3 dir)
 {
     double l = v3_len(dir);
-    rgb c = atmos_sky(sc, l > 0.0 ? v3_scale(dir, 1.0 / l) : v3(0, 0, 1));
+    rgb c = shade_atmos_sky(sc, l > 0.0 ? v3_scale(dir, 1.0 / l) : v3(0, 0, 1));
     if (!(isfinite(c.r) && isfinite(c.g) && isfinite(c.b))) c.r = c.g = c.b = 0.0;
     return c;
 }
 
-rgb pm_direct_lights(const pm_lights *L, const mat_bsdf *b, int area_samples, rng *r, long *shadow_rays)
+rgb pm_direct_lights(const pm_lights *L, const shade_mat_bsdf *b, int area_samples, rng *r, long *shadow_rays)
 {
     rgb total = {0, 0, 0};
     if (!b->nee) return total;
-    light_ctx c = {L->a, L->eps, shadow_rays};
+    shade_light_ctx c = {L->a, L->eps, shadow_rays};
     for (int i = 0; i < L->sc->nlights; i++) {
         if (!scene_light_reaches(&L->sc->lights[i], b->obj)) continue; /* light_group, as shade.c */
-        rgb v = mat_light_nee(b, &c, &L->sc->lights[i], area_samples, r);
+        rgb v = shade_mat_light_nee(b, &c, &L->sc->lights[i], area_samples, r);
         total.r += v.r;
         total.g += v.g;
         total.b += v.b;
@@ -130,7 +130,7 @@ rgb pm_direct_lights(const pm_lights *L, const mat_bsdf *b, int area_samples, rn
     return total;
 }
 
-rgb pm_direct_one_light(const pm_lights *L, const mat_bsdf *b, rng *r, long *shadow_rays)
+rgb pm_direct_one_light(const pm_lights *L, const shade_mat_bsdf *b, rng *r, long *shadow_rays)
 {
     rgb zero = {0, 0, 0};
     int n = L->sc->nlights;
@@ -143,8 +143,8 @@ rgb pm_direct_one_light(const pm_lights *L, const mat_bsdf *b, rng *r, long *sha
         const scene_light *l = &L->sc->lights[i];
         vec3 dir;
         double depth;
-        light_ray(l, l->position, b->p_out, &dir, &depth);
-        double att = l->area && l->area_illumination ? 1.0 : light_attenuation(l, b->p_out, dir, depth);
+        shade_light_ray(l, l->position, b->p_out, &dir, &depth);
+        double att = l->area && l->area_illumination ? 1.0 : shade_light_attenuation(l, b->p_out, dir, depth);
         double c = fmax(fabs(l->colour.r), fmax(fabs(l->colour.g), fabs(l->colour.b)));
         w[i] = isfinite(att * c) && att * c > 0.0 ? att * c : 0.0;
         if (!scene_light_reaches(l, b->obj)) w[i] = 0.0; /* light_group: never picked */
@@ -160,8 +160,8 @@ rgb pm_direct_one_light(const pm_lights *L, const mat_bsdf *b, rng *r, long *sha
         }
         while (pick > 0 && w[pick] <= 0.0) pick--;
         double p = w[pick] / wsum;
-        light_ctx c = {L->a, L->eps, shadow_rays};
-        rgb v = mat_light_nee(b, &c, &L->sc->lights[pick], 1, r);
+        shade_light_ctx c = {L->a, L->eps, shadow_rays};
+        rgb v = shade_mat_light_nee(b, &c, &L->sc->lights[pick], 1, r);
         out.r = v.r / p;
         out.g = v.g / p;
         out.b = v.b / p;
@@ -193,12 +193,12 @@ static int visible(const pm_lights *L, const accel_from *from, vec3 o, vec3 y, v
     return 0;
 }
 
-rgb pm_direct_emitters(const pm_lights *L, const mat_bsdf *b, int n_light, double bsdf_front, double bsdf_back, rng *r,
+rgb pm_direct_emitters(const pm_lights *L, const shade_mat_bsdf *b, int n_light, double bsdf_front, double bsdf_back, rng *r,
                        long *shadow_rays)
 {
     rgb total = {0, 0, 0};
     if (n_light < 1 || accel_surf_count(L->emit) == 0) return total;
-    if (b->m[MAT_LOBE_DIFFUSE] <= 0.0 && b->m[MAT_LOBE_BACK] <= 0.0) return total;
+    if (b->m[SHADE_MAT_LOBE_DIFFUSE] <= 0.0 && b->m[SHADE_MAT_LOBE_BACK] <= 0.0) return total;
     int g = (int)floor(sqrt((double)n_light));
     for (int k = 0; k < n_light; k++) {
         double u1, u2;
@@ -220,7 +220,7 @@ rgb pm_direct_emitters(const pm_lights *L, const mat_bsdf *b, int n_light, doubl
         double l0 = v3_len(d0);
         if (!(l0 > 0.0)) continue;
         wi = v3_scale(d0, 1.0 / l0);
-        rgb f = mat_eval(b, wi);
+        rgb f = shade_mat_eval(b, wi);
         if (f.r == 0.0 && f.g == 0.0 && f.b == 0.0) continue;
         double cos_y = fabs(v3_dot(s.n, wi));
         if (!(cos_y > 1e-12)) continue;

@@ -1,5 +1,5 @@
 /* pm_nee.h - next-event estimation shared by the path tracer and the final
- * gatherer: POV-Ray light sources (shade_light.h's light_nee: the same terms
+ * gatherer: POV-Ray light sources (shade_light.h's shade_light_nee: the same terms
  * and attenuation as shade.c, area lights sampled continuously) and emissive
  * surfaces (sampled by area with accel_surface.h, combined with BSDF
  * sampling by multiple importance sampling, Veach & Guibas 1995, power
@@ -29,7 +29,7 @@ rgb pm_lights_piece_emission(const pm_lights *L, const accel_surf_sample *s);
 double pm_lights_eps(const pm_lights *L);                  /* distance epsilon (shade.c's) */
 /* Radiance arriving along a ray of direction dir (any length) that leaves
  * the scene: the sky_sphere over the background, evaluated by shade's
- * atmos_sky (the code --gi none uses; fog and rainbow are not applied). It
+ * shade_atmos_sky (the code --gi none uses; fog and rainbow are not applied). It
  * is emitted radiance of the environment, reached by camera, BSDF and
  * gather rays that escape, and the source of environment photons. */
 rgb pm_sky(const scene *sc, vec3 dir);
@@ -38,13 +38,13 @@ int pm_sky_any(const scene *sc);
 
 /* Direct light of all POV-Ray light sources at b (diffuse, diffuse_back,
  * phong, specular), area lights with `area_samples` stratified samples. */
-rgb pm_direct_lights(const pm_lights *L, const mat_bsdf *b, int area_samples, rng *r, long *shadow_rays);
+rgb pm_direct_lights(const pm_lights *L, const shade_mat_bsdf *b, int area_samples, rng *r, long *shadow_rays);
 
 /* The same estimated with one light chosen at random, with probability
  * proportional to max-channel(colour) * attenuation seen from b (spot,
  * cylinder and fade factors; unoccluded), one shadow ray: unbiased, for
  * places that take many samples anyway (final-gather hits). */
-rgb pm_direct_one_light(const pm_lights *L, const mat_bsdf *b, rng *r, long *shadow_rays);
+rgb pm_direct_one_light(const pm_lights *L, const shade_mat_bsdf *b, rng *r, long *shadow_rays);
 
 /* Direct light of the emissive surfaces at b through its Lambertian lobes,
  * `n_light` samples by area. MIS against a BSDF strategy whose
@@ -55,7 +55,7 @@ rgb pm_direct_one_light(const pm_lights *L, const mat_bsdf *b, rng *r, long *sha
  * final gather: N_front and N_back gather rays); pass 0, 0 for no MIS (the
  * BSDF strategy does not count emission). Each light sample gets weight
  * (n p_l)^2 / ((n p_l)^2 + c_b^2). */
-rgb pm_direct_emitters(const pm_lights *L, const mat_bsdf *b, int n_light, double bsdf_front, double bsdf_back, rng *r,
+rgb pm_direct_emitters(const pm_lights *L, const shade_mat_bsdf *b, int n_light, double bsdf_front, double bsdf_back, rng *r,
                        long *shadow_rays);
 
 /* Count-weighted light-sampling density n_light * p_l (solid angle, seen

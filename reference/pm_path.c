@@ -85,7 +85,7 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
             /* fog on the segment: on camera and specular rays, on gathering
              * rays only with radiosity's `media on` (radrules.h rule 5) */
             rgb fa, fc;
-            atmos_fog_affine(sc, org, dir, hit ? h.t : INFINITY, &fa, &fc);
+            shade_atmos_fog_affine(sc, org, dir, hit ? h.t : INFINITY, &fa, &fc);
             L.r += T.r * fc.r;
             L.g += T.g * fc.g;
             L.b += T.b * fc.b;
@@ -100,8 +100,8 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
             L.b += T.b * sky.b;
             break;
         }
-        mat_bsdf b;
-        mat_setup(&b, sc, &h, dir, c->eps, r);
+        shade_mat_bsdf b;
+        shade_mat_setup(&b, sc, &h, dir, c->eps, r);
         b.gathered = nd > 0;
         if (b.unsupported) cnt->unsupported++;
         rgb le = b.emission;
@@ -120,17 +120,17 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
             L.g += T.g * d.g;
             L.b += T.b * d.b;
         }
-        if (gather && (b.m[MAT_LOBE_DIFFUSE] > 0.0 || b.m[MAT_LOBE_BACK] > 0.0) && b.msum > 0.0) {
+        if (gather && (b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 || b.m[SHADE_MAT_LOBE_BACK] > 0.0) && b.msum > 0.0) {
             /* emissive surfaces light others as gathered light: brightness applies */
-            double bf = last ? 0.0 : b.m[MAT_LOBE_DIFFUSE] / b.msum, bb = last ? 0.0 : b.m[MAT_LOBE_BACK] / b.msum;
+            double bf = last ? 0.0 : b.m[SHADE_MAT_LOBE_DIFFUSE] / b.msum, bb = last ? 0.0 : b.m[SHADE_MAT_LOBE_BACK] / b.msum;
             rgb d = pm_direct_emitters(c->L, &b, 1, bf, bb, r, &cnt->shadow);
             L.r += T.r * d.r * bright;
             L.g += T.g * d.g * bright;
             L.b += T.b * d.b * bright;
         }
         if (last) break;
-        mat_scatter s;
-        if (!mat_sample(&b, r, 0, &s)) break;
+        shade_mat_scatter s;
+        if (!shade_mat_sample(&b, r, 0, &s)) break;
         if (!s.specular) {
             if (!gather) break; /* past recursion_limit: only the specular lobes go on */
             T.r *= bright;
@@ -159,7 +159,7 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
         }
         if (s.specular) {
             prev_spec = 1;
-            if (s.lobe == MAT_LOBE_REFLECT) skip = OBJ_NO_REFLECTION;
+            if (s.lobe == SHADE_MAT_LOBE_REFLECT) skip = OBJ_NO_REFLECTION;
         } else {
             prev_spec = 0;
             prev_cb = s.pdf;

@@ -143,7 +143,7 @@ static int caustic_bounce_ok(const accel_hit *h, int lobe)
 {
     const scene_obj_photons *ph = h->obj ? h->obj->photons : NULL;
     if (!ph || !ph->target) return 0;
-    return lobe == MAT_LOBE_REFLECT ? ph->reflection : ph->refraction;
+    return lobe == SHADE_MAT_LOBE_REFLECT ? ph->reflection : ph->refraction;
 }
 
 static int any_target(const scene_object *o)
@@ -185,8 +185,8 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
             if (!light_first_hit(c, o, axis, h, rays)) return 0;
             vec3 dl;
             double depth;
-            light_ray(l, l->position, h->p, &dl, &depth);
-            double att = light_attenuation(l, h->p, dl, depth);
+            shade_light_ray(l, l->position, h->p, &dl, &depth);
+            double att = shade_light_attenuation(l, h->p, dl, depth);
             double k = M_PI * att * M_PI * R * R / n;
             *phi = crgb(C.r * k, C.g * k, C.b * k);
             return 1;
@@ -201,8 +201,8 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
             if (!light_first_hit(c, o, *w, h, rays)) return 0;
             vec3 dl;
             double depth;
-            light_ray(l, l->position, h->p, &dl, &depth);
-            double att = light_attenuation(l, h->p, dl, depth);
+            shade_light_ray(l, l->position, h->p, &dl, &depth);
+            double att = shade_light_attenuation(l, h->p, dl, depth);
             double k = M_PI * att * M_PI * R * R / n;
             *phi = crgb(C.r * k, C.g * k, C.b * k);
             return 1;
@@ -220,8 +220,8 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         if (!light_first_hit(c, q, *w, h, rays)) return 0;
         vec3 dl;
         double depth;
-        light_ray(l, q, h->p, &dl, &depth);
-        double att = light_attenuation(l, h->p, dl, depth);
+        shade_light_ray(l, q, h->p, &dl, &depth);
+        double att = shade_light_attenuation(l, h->p, dl, depth);
         double d = v3_len(v3_sub(h->p, q));
         double k = M_PI * att * d * d / (n * pdf);
         *phi = crgb(C.r * k, C.g * k, C.b * k);
@@ -234,7 +234,7 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         if (!accel_surf_sample_point(es, u1, u2, u3, r, &s)) return 0;
         vec3 ns = rng_f64(r) < 0.5 ? s.n : v3_neg(s.n);
         double u4 = rng_f64(r), u5 = rng_f64(r);
-        *w = mat_cosine_dir(ns, u4, u5);
+        *w = shade_mat_cosine_dir(ns, u4, u5);
         vec3 o = v3_madd(s.p, ns, c->eps);
         if (!photon_intersect(c, NULL, o, *w, OBJ_NO_RADIOSITY, h, rays)) return 0;
         rgb le = pm_lights_piece_emission(c->L, &s);
@@ -283,9 +283,9 @@ static void trace_one(const trace_ctx *c, const source *src, long index, chunk_o
     if (!radrules_gathers(h.flags)) return;
     int nd = 0;
     for (int bounce = 0;; bounce++) {
-        mat_bsdf b;
-        mat_setup(&b, c->sc, &h, w, c->eps, &r);
-        int lambert = b.m[MAT_LOBE_DIFFUSE] > 0.0 || b.m[MAT_LOBE_BACK] > 0.0;
+        shade_mat_bsdf b;
+        shade_mat_setup(&b, c->sc, &h, w, c->eps, &r);
+        int lambert = b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 || b.m[SHADE_MAT_LOBE_BACK] > 0.0;
         int collect = !(h.obj && h.obj->photons && !h.obj->photons->collect); /* photons { collect off } */
         int g = from_light ? nd : nd + 1;
         if (lambert && collect && (bounce >= 1 || store_first) && g + 1 <= c->gathers && cmax(phi) > 0.0) {
@@ -299,8 +299,8 @@ static void trace_one(const trace_ctx *c, const source *src, long index, chunk_o
                 if (!push(&out->c, &out->nc, &out->cc, h.p, phi, b.ng, key)) { out->oom = 1; return; }
         }
         if (bounce >= c->s->max_bounces) return;
-        mat_scatter s;
-        if (!mat_sample(&b, &r, 1, &s)) return;
+        shade_mat_scatter s;
+        if (!shade_mat_sample(&b, &r, 1, &s)) return;
         if (s.specular && bounce == 0 && from_light && !c->s->caustics) return;
         if (s.specular && from_light && spec_only && c->targets && !caustic_bounce_ok(&h, s.lobe)) return;
         if (!s.specular) {
@@ -312,7 +312,7 @@ static void trace_one(const trace_ctx *c, const source *src, long index, chunk_o
         /* Only where the material's own roulette hardly ends paths (total
          * lobe size near 1): elsewhere it would add variance for nothing
          * (the rho = 0.9 furnace's worst pixel went from 0.55% to 3%). */
-        double mass = b.m[MAT_LOBE_DIFFUSE] + b.m[MAT_LOBE_BACK] + b.m[MAT_LOBE_REFLECT] + b.m[MAT_LOBE_TRANSMIT];
+        double mass = b.m[SHADE_MAT_LOBE_DIFFUSE] + b.m[SHADE_MAT_LOBE_BACK] + b.m[SHADE_MAT_LOBE_REFLECT] + b.m[SHADE_MAT_LOBE_TRANSMIT];
         if (bounce + 1 >= RR_BOUNCES && mass > RR_MASS) {
             if (rng_f64(&r) >= RR_SURVIVE) return;
             k /= RR_SURVIVE;

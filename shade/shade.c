@@ -60,29 +60,29 @@ typedef struct {
     unsigned char *flag; /* per pixel: needs supersampling */
     int tiles_x, tiles_y;
     int transparent;     /* some surface lets light through: filtered shadows */
-    light_projection *proj; /* projected_through lights (shade_project.c), NULL = none */
+    shade_light_projection *proj; /* projected_through lights (shade_project.c), NULL = none */
     /* Media (shade_media.c): whether the scene has any, the
      * containers of the camera's location, and per thread the hit being
      * shaded (its incoming ray's containers) for the rays it spawns. */
     int media;
-    media_inside cam_in;
+    shade_media_inside cam_in;
     const struct hit_frame *frame[SHADE_MAX_THREADS];
     int primary_on;      /* s->primary holds this render's centre rays (shade_primary_begin_fn) */
     int win[4];          /* the pixels rendered (shade_settings.window) */
     int first_win[4];    /* the first pass's: win and, with +A, a one-pixel apron */
 } render_ctx;
 
-/* The hit tex_shade is working on, for its callbacks: the containers of
+/* The hit shade_tex_shade is working on, for its callbacks: the containers of
  * the ray that reached it. */
 typedef struct hit_frame {
     const accel_hit *h;
     vec3 dir;
-    const media_inside *in;
+    const shade_media_inside *in;
 } hit_frame;
 
-static const media_inside no_containers = {0, {0}};
+static const shade_media_inside no_containers = {0, {0}};
 
-static const media_inside *frame_inside(const render_ctx *c, int thread)
+static const shade_media_inside *frame_inside(const render_ctx *c, int thread)
 {
     return c->frame[thread] ? c->frame[thread]->in : &no_containers;
 }
@@ -133,7 +133,7 @@ static int shadow_blocked(render_ctx *c, int thread, vec3 p, vec3 dir, double de
     return accel_occluded(c->a, p, dir, c->eps, tmax);
 }
 
-static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, const media_inside *in, vec3 *to_light);
+static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, const shade_media_inside *in, vec3 *to_light);
 
 /* Media along shadow rays (shade_media.c): the light's media_attenuation
  * through the atmosphere and fog, the containers' media on the way. */
@@ -145,7 +145,7 @@ static int media_shadows(const render_ctx *c, const scene_light *l)
 /* Light reaching p along a shadow ray: 0 or 1 in scenes without transparent
  * surfaces or media, else filtered by the surfaces crossed
  * (shade_texture.c) and attenuated by the media on the way. */
-static rgb shadow_rgb(render_ctx *c, int thread, vec3 p, vec3 dir, double depth, const scene_light *l, const media_inside *in)
+static rgb shadow_rgb(render_ctx *c, int thread, vec3 p, vec3 dir, double depth, const scene_light *l, const shade_media_inside *in)
 {
     int media = media_shadows(c, l);
     if (!media && !c->transparent)
@@ -154,10 +154,10 @@ static rgb shadow_rgb(render_ctx *c, int thread, vec3 p, vec3 dir, double depth,
     double tmax = shadow_tmax(c, depth);
     if (tmax <= c->eps) return rgb_make(1, 1, 1);
     if (media) {
-        media_env me = {c->sc, c, thread, NULL, media_light, NULL};
-        return media_shadow_ray(c->sc, c->a, &me, l, p, dir, c->eps, tmax, in ? in : &no_containers);
+        shade_media_env me = {c->sc, c, thread, NULL, media_light, NULL};
+        return shade_media_shadow_ray(c->sc, c->a, &me, l, p, dir, c->eps, tmax, in ? in : &no_containers);
     }
-    return tex_shadow_ray(c->sc, c->a, p, dir, c->eps, tmax);
+    return shade_tex_shadow_ray(c->sc, c->a, p, dir, c->eps, tmax);
 }
 
 /* Visibility (0..1) of the rectangle [u1,u2]x[v1,v2] of the grid, adaptively. */
@@ -168,7 +168,7 @@ typedef struct {
     rgb *grid; /* size1*size2, r < 0 = not sampled */
     rng *r;
     int thread;
-    const media_inside *in;
+    const shade_media_inside *in;
 } area_job;
 
 static rgb area_sample(area_job *j, int u, int v)
@@ -178,7 +178,7 @@ static rgb area_sample(area_job *j, int u, int v)
     vec3 centre = v3_add(j->l->position, scene_light_area_point(j->l, j->ax1, j->ax2, u, v, j->r));
     vec3 dir;
     double depth;
-    light_ray(j->l, centre, j->p, &dir, &depth);
+    shade_light_ray(j->l, centre, j->p, &dir, &depth);
     *g = shadow_rgb(j->c, j->thread, j->p, dir, depth, j->l, j->in);
     return *g;
 }
@@ -202,7 +202,7 @@ static rgb area_subset(area_job *j, int u1, int v1, int u2, int v2, int level)
     return rgb_scale(rgb_add(rgb_add(s[0], s[1]), rgb_add(s[2], s[3])), 0.25);
 }
 
-static rgb area_visibility(render_ctx *c, int thread, const scene_light *l, vec3 p, rng *r, const media_inside *in)
+static rgb area_visibility(render_ctx *c, int thread, const scene_light *l, vec3 p, rng *r, const shade_media_inside *in)
 {
     rgb stack_grid[256];
     int n = l->size1 * l->size2;
@@ -210,7 +210,7 @@ static rgb area_visibility(render_ctx *c, int thread, const scene_light *l, vec3
     if (!grid) return rgb_make(1, 1, 1);
     for (int i = 0; i < n; i++) grid[i].r = -1.0;
     area_job j = {c, l, p, l->axis1, l->axis2, grid, r, thread, in};
-    light_area_axes(l, p, &j.ax1, &j.ax2);
+    shade_light_area_axes(l, p, &j.ax1, &j.ax2);
     rgb vis = area_subset(&j, 0, 0, l->size1 - 1, l->size2 - 1, 0);
     if (grid != stack_grid) free(grid);
     return vis;
@@ -219,17 +219,17 @@ static rgb area_visibility(render_ctx *c, int thread, const scene_light *l, vec3
 /* Light of l reaching a media sample at p (POV-Ray's TestShadow): its
  * attenuation there, then unless shadowless the shadow ray (area grid
  * included) from the sampled ray's containers. */
-static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, const media_inside *in, vec3 *to_light)
+static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, const shade_media_inside *in, vec3 *to_light)
 {
     render_ctx *c = ctx;
     vec3 dir;
     double depth;
-    light_ray(l, l->position, p, &dir, &depth);
+    shade_light_ray(l, l->position, p, &dir, &depth);
     *to_light = dir;
     double sdepth = depth;
-    if (l->projected_through && !projection_pass(c->proj, (int)(l - c->sc->lights), p, dir, depth, &sdepth))
+    if (l->projected_through && !shade_projection_pass(c->proj, (int)(l - c->sc->lights), p, dir, depth, &sdepth))
         return rgb_make(0, 0, 0);
-    rgb lc = rgb_scale(l->colour, light_attenuation(l, p, dir, depth));
+    rgb lc = rgb_scale(l->colour, shade_light_attenuation(l, p, dir, depth));
     if (rgb_near_zero(lc) || l->shadowless) return lc;
     rgb vis;
     if (l->area && l->size1 * l->size2 > 1) {
@@ -250,23 +250,23 @@ static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, cons
 
 /* --------------------------------------------------------------- BRDF terms */
 
-static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const accel_hit *h, vec3 p, rng *r)
+static rgb direct_light(render_ctx *c, int thread, const shade_light_surface *s, const accel_hit *h, vec3 p, rng *r)
 {
     rgb total = {0, 0, 0};
-    const media_inside *in = frame_inside(c, thread);
+    const shade_media_inside *in = frame_inside(c, thread);
     int double_illum = (h->obj->flags & OBJ_DOUBLE_ILLUMINATE) != 0;
     for (int i = 0; i < c->sc->nlights; i++) {
         const scene_light *l = &c->sc->lights[i];
         if (!scene_light_reaches(l, h->obj)) continue; /* light_group */
         vec3 dir;
         double depth;
-        light_ray(l, l->position, p, &dir, &depth);
+        shade_light_ray(l, l->position, p, &dir, &depth);
         double sdepth = depth; /* shadows are tested up to a projected_through object */
-        if (l->projected_through && !projection_pass(c->proj, i, p, dir, depth, &sdepth)) continue;
+        if (l->projected_through && !shade_projection_pass(c->proj, i, p, dir, depth, &sdepth)) continue;
         /* +Q: area lights from level 5, shadows from 4 (POV-Ray's Q_AREA_LIGHT, Q_SHADOW) */
         int area_on = c->s->quality >= 5, shadows_on = c->s->quality >= 4;
         int full_area = area_on && l->area && l->area_illumination && l->size1 * l->size2 > 0;
-        double att = full_area ? 1.0 : light_attenuation(l, p, dir, depth);
+        double att = full_area ? 1.0 : shade_light_attenuation(l, p, dir, depth);
         rgb lc = rgb_scale(l->colour, att);
         if (rgb_near_zero(lc)) continue;
         int backside = 0;
@@ -283,8 +283,8 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
                     vec3 q = v3_add(l->position, scene_light_area_point(l, l->axis1, l->axis2, u, v, r));
                     vec3 d2;
                     double dep2;
-                    light_ray(l, q, p, &d2, &dep2);
-                    rgb slc = rgb_scale(sample_lc, light_attenuation(l, p, d2, dep2));
+                    shade_light_ray(l, q, p, &d2, &dep2);
+                    rgb slc = rgb_scale(sample_lc, shade_light_attenuation(l, p, d2, dep2));
                     int back2 = 0;
                     if (!double_illum && v3_dot(s->n, d2) < 1e-10) {
                         if (s->f->diffuse_back != 0.0) back2 = 1;
@@ -294,7 +294,7 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
                         slc = rgb_mul(slc, shadow_rgb(c, thread, p, d2, dep2, l, in));
                         if (rgb_near_zero(slc)) continue;
                     }
-                    total = rgb_add(total, light_terms(s, d2, slc, back2));
+                    total = rgb_add(total, shade_light_terms(s, d2, slc, back2));
                 }
             }
             continue;
@@ -310,18 +310,18 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
             /* media_attenuation: fog dims the light on its way (shade_atmos.c;
              * with media, per segment in shadow_rgb) */
             if (l->media_attenuation && l->media_interaction && c->sc->fogs && !media_shadows(c, l))
-                lc = rgb_mul(lc, atmos_fog_attenuation(c->sc, p, dir, depth));
+                lc = rgb_mul(lc, shade_atmos_fog_attenuation(c->sc, p, dir, depth));
         }
         if (l->shadowless && (s->f->phong != 0.0 || s->f->specular != 0.0)) {
             /* POV-Ray: fill lights (shadowless) add no highlights */
             scene_finish ff = *s->f;
             ff.phong = ff.specular = 0.0;
-            light_surface fs = *s;
+            shade_light_surface fs = *s;
             fs.f = &ff;
-            total = rgb_add(total, light_terms(&fs, dir, lc, backside));
+            total = rgb_add(total, shade_light_terms(&fs, dir, lc, backside));
             continue;
         }
-        total = rgb_add(total, light_terms(s, dir, lc, backside));
+        total = rgb_add(total, shade_light_terms(s, dir, lc, backside));
     }
     return total;
 }
@@ -332,7 +332,7 @@ static rgb direct_light(render_ctx *c, int thread, const light_surface *s, const
  * for camera rays, no_reflection for reflected rays); `in`: the objects the
  * ray starts inside (shade_media.h). */
 static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, float wavelength,
-                     rng *r, const media_inside *in);
+                     rng *r, const shade_media_inside *in);
 
 /* The surface model (patterns, layers, normals, reflection, refraction,
  * interior fade) is POV-Ray's ComputeLightedTexture in shade_texture.c; it
@@ -346,12 +346,12 @@ static rgb tex_cb_trace(void *ctx, int thread, vec3 org, vec3 dir, int level, do
     if (!f) return trace_ray(c, thread, org, dir, level, weight, skip, wavelength, r, &no_containers);
     /* a ray going on through the surface (refracted or straight) enters or
      * leaves the object; a reflected one stays where the incoming ray was */
-    media_inside in = *f->in;
-    if (v3_dot(dir, f->h->ng) * v3_dot(f->dir, f->h->ng) > 0.0) media_inside_cross(&in, f->h->obj);
+    shade_media_inside in = *f->in;
+    if (v3_dot(dir, f->h->ng) * v3_dot(f->dir, f->h->ng) > 0.0) shade_media_inside_cross(&in, f->h->obj);
     return trace_ray(c, thread, org, dir, level, weight, skip, wavelength, r, &in);
 }
 
-static rgb tex_cb_direct(void *ctx, int thread, const light_surface *s, const accel_hit *h, vec3 p, rng *r)
+static rgb tex_cb_direct(void *ctx, int thread, const shade_light_surface *s, const accel_hit *h, vec3 p, rng *r)
 {
     return direct_light(ctx, thread, s, h, p, r);
 }
@@ -363,14 +363,14 @@ static rgb tex_cb_indirect(void *ctx, int thread, const accel_hit *h, vec3 n)
 }
 
 static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip,
-                     float wavelength, rng *r, const media_inside *in)
+                     float wavelength, rng *r, const shade_media_inside *in)
 {
-    tex_env e = {c->sc, c->eps, c->s->use_ambient, c->max_level, c, thread, r, tex_cb_trace, tex_cb_direct,
+    shade_tex_env e = {c->sc, c->eps, c->s->use_ambient, c->max_level, c, thread, r, tex_cb_trace, tex_cb_direct,
                  c->s->indirect ? tex_cb_indirect : NULL, &c->ts[thread].unsupported, c->s->quality};
     hit_frame f = {h, dir, in};
     const hit_frame *outer = c->frame[thread];
     c->frame[thread] = &f;
-    rgb col = tex_shade(&e, h, dir, level, weight, skip, wavelength);
+    rgb col = shade_tex_shade(&e, h, dir, level, weight, skip, wavelength);
     c->frame[thread] = outer;
     return col;
 }
@@ -378,24 +378,24 @@ static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, in
 /* What the ray sees besides the surface at depth (INFINITY: none), in
  * POV-Ray's TraceRay order: the containers' media (with a surface), then
  * for a hollow ray the atmosphere's media, rainbows and fog. */
-static rgb along_ray(render_ctx *c, int thread, vec3 org, vec3 dir, double depth, rgb col, rng *r, const media_inside *in,
+static rgb along_ray(render_ctx *c, int thread, vec3 org, vec3 dir, double depth, rgb col, rng *r, const shade_media_inside *in,
                      const scene_object *hit)
 {
-    int hollow = media_inside_hollow(in);
+    int hollow = shade_media_inside_hollow(in);
     if (!hollow) return col;
     if (c->media && c->s->quality >= 9) { /* +Q: media from level 9 (Q_VOLUME) */
-        media_env me = {c->sc, c, thread, r, media_light, hit};
-        if (isfinite(depth) && in->n > 0 && media_inside_has_media(in))
-            col = media_segment(&me, MEDIA_INTERIOR, in, org, dir, depth, col, 0);
+        shade_media_env me = {c->sc, c, thread, r, media_light, hit};
+        if (isfinite(depth) && in->n > 0 && shade_media_inside_has_media(in))
+            col = shade_media_segment(&me, SHADE_MEDIA_INTERIOR, in, org, dir, depth, col, 0);
         if (c->sc->natmosphere > 0)
-            col = media_segment(&me, MEDIA_ATMOSPHERE, in, org, dir, isfinite(depth) ? depth : 2.0e10 /* POV-Ray's BOUND_HUGE */,
+            col = shade_media_segment(&me, SHADE_MEDIA_ATMOSPHERE, in, org, dir, isfinite(depth) ? depth : 2.0e10 /* POV-Ray's BOUND_HUGE */,
                                 col, 0);
     }
-    return atmos_fog(c->sc, org, dir, depth, col);
+    return shade_atmos_fog(c->sc, org, dir, depth, col);
 }
 
 static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, float wavelength,
-                     rng *r, const media_inside *in)
+                     rng *r, const shade_media_inside *in)
 {
     assert(level >= 1 && thread >= 0 && thread < SHADE_MAX_THREADS);
     if (level > c->max_level) return rgb_make(0, 0, 0);
@@ -409,7 +409,7 @@ static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, d
             return along_ray(c, thread, org, dir, h.t, shade_hit(c, thread, &h, dir, level, weight, skip, wavelength, r, in), r, in, h.obj);
         tmin = h.t + fmax(c->eps, h.t * 1e-7);
     }
-    return along_ray(c, thread, org, dir, INFINITY, atmos_sky(c->sc, dir), r, in, NULL);
+    return along_ray(c, thread, org, dir, INFINITY, shade_atmos_sky(c->sc, dir), r, in, NULL);
 }
 
 static double scene_eps(const accel *a)
@@ -427,7 +427,7 @@ rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 o
     thread_stats ts[1];
     memset(ts, 0, sizeof ts);
     render_ctx c = {sc, a, s, scene_eps(a), s->max_trace_level > 0 ? s->max_trace_level : sc->global.max_trace_level, ts, NULL, NULL, 0, 0, 1};
-    c.media = media_scene_has(sc);
+    c.media = shade_media_scene_has(sc);
     return trace_ray(&c, 0, org, v3_norm(dir), 1, 1.0, OBJ_NO_IMAGE, 0.0f, r, &no_containers);
 }
 
@@ -476,9 +476,9 @@ static rgb primary_ray(render_ctx *c, int thread, double px, double py, vec3 org
     assert(v3_finite(org) && v3_finite(dir));
     if (c->sc->camera.normal) {
         /* camera normal: POV-Ray perturbs the direction at the screen point <x0, y0, 0> */
-        pattern_ctx pc = pattern_ctx_plain(c->sc);
+        shade_pattern_ctx pc = shade_pattern_ctx_plain(c->sc);
         vec3 sp = v3(px / c->s->width - 0.5, 0.5 - py / c->s->height, 0.0);
-        dir = v3_norm(normal_perturb(c->sc->camera.normal, dir, sp, NULL, &pc));
+        dir = v3_norm(shade_normal_perturb(c->sc->camera.normal, dir, sp, NULL, &pc));
     }
     c->ts[thread].primary++;
     rgb v = trace_ray(c, thread, org, dir, 1, 1.0, OBJ_NO_IMAGE, 0.0f, r, &c->cam_in);
@@ -504,7 +504,7 @@ static int sample_known(render_ctx *c, int thread, int x, int y, rng *r, rgb *ou
         v = along_ray(c, thread, org, dir, h->t, shade_hit(c, thread, h, dir, 1, 1.0, OBJ_NO_IMAGE, 0.0f, r, &c->cam_in),
                       r, &c->cam_in, h->obj);
     else
-        v = along_ray(c, thread, org, dir, INFINITY, atmos_sky(c->sc, dir), r, &c->cam_in, NULL);
+        v = along_ray(c, thread, org, dir, INFINITY, shade_atmos_sky(c->sc, dir), r, &c->cam_in, NULL);
     if (!isfinite(v.r) || !isfinite(v.g) || !isfinite(v.b)) {
         c->ts[thread].discarded++;
         v = rgb_make(0, 0, 0);
@@ -666,11 +666,11 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     c.fb = fb;
     c.tiles_x = (s->width + TILE - 1) / TILE;
     c.tiles_y = (s->height + TILE - 1) / TILE;
-    c.transparent = tex_scene_transparent(sc);
-    c.proj = projection_build(sc, d);
-    c.media = media_scene_has(sc);
+    c.transparent = shade_tex_scene_transparent(sc);
+    c.proj = shade_projection_build(sc, d);
+    c.media = shade_media_scene_has(sc);
     /* the camera's containers matter to media and to fog (not in non-hollow objects) */
-    if (c.media || sc->fogs || sc->rainbows) media_inside_at(sc, sc->camera.location, &c.cam_in);
+    if (c.media || sc->fogs || sc->rainbows) shade_media_inside_at(sc, sc->camera.location, &c.cam_in);
     int ntiles = c.tiles_x * c.tiles_y;
     const int *sw = s->window;
     int whole = !(sw[2] > sw[0] && sw[3] > sw[1]);
@@ -697,7 +697,7 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
 
     if (s->antialias == 1 && !(s->cancel && *s->cancel)) {
         c.flag = calloc((size_t)s->width * (size_t)s->height, 1);
-        if (!c.flag) { projection_free(c.proj); free(ts); return PT_ERR_NOMEM; }
+        if (!c.flag) { shade_projection_free(c.proj); free(ts); return PT_ERR_NOMEM; }
         /* the pairs inside the first pass's rectangle: every pair a window
          * pixel belongs to, as in the whole image */
         for (int y = c.first_win[1]; y < c.first_win[3]; y++) {
@@ -724,7 +724,7 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
                     float *px = fb_px(fb, x, y);
                     px[0] = px[1] = px[2] = 0.0f;
                 }
-    gamma_fb_to_linear(sc, fb); /* assumed_gamma: working space -> linear (shade_gamma.c) */
+    shade_gamma_fb_to_linear(sc, fb); /* assumed_gamma: working space -> linear (shade_gamma.c) */
     long fixed = fb_sanitize(fb);
     assert(fb_all_finite(fb)); /* no NaN or Inf reaches a framebuffer */
     if (st) {
@@ -739,14 +739,14 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
         st->discarded_samples += fixed;
         st->seconds = timer_now() - t0;
     }
-    projection_free(c.proj);
+    shade_projection_free(c.proj);
     free(ts);
     return PT_OK;
 }
 
 /* ------------------------------------------------------ for shade_aov.c */
 
-rgb shade_direct(const scene *sc, const accel *a, const light_surface *s, const accel_hit *h, vec3 p, rng *r)
+rgb shade_direct(const scene *sc, const accel *a, const shade_light_surface *s, const accel_hit *h, vec3 p, rng *r)
 {
     thread_stats ts[1];
     memset(ts, 0, sizeof ts);

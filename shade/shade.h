@@ -78,8 +78,8 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
 /* Radiance along one ray (for tests and other integrators). */
 rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 org, vec3 dir, int thread, rng *r);
 /* The Whitted direct term (every light, its attenuation, area grid and
- * shadows: what tex_shade's direct callback gets) of surface s at hit h,
+ * shadows: what shade_tex_shade's direct callback gets) of surface s at hit h,
  * shaded from p (off the surface on the viewer's side). For shade_aov.c. */
-rgb shade_direct(const scene *sc, const accel *a, const light_surface *s, const accel_hit *h, vec3 p, rng *r);
+rgb shade_direct(const scene *sc, const accel *a, const shade_light_surface *s, const accel_hit *h, vec3 p, rng *r);
 
 #endif

@@ -134,7 +134,7 @@ static void aov_pixel(aov_ctx *c, int x, int y, int thread)
     const scene_texture *tex = h.texture ? h.texture : &sc->default_texture;
     const scene_finish *f = &tex->finish;
     colour5 pc = {0, 0, 0, 0, 0};
-    if (!tex_pigment_at(sc, NULL, &h, &pc)) memset(&pc, 0, sizeof pc);
+    if (!shade_tex_pigment_at(sc, NULL, &h, &pc)) memset(&pc, 0, sizeof pc);
     rgb pig = {pc.r, pc.g, pc.b};
     double att = 1.0 - pc.f - pc.t;
 
@@ -142,7 +142,7 @@ static void aov_pixel(aov_ctx *c, int x, int y, int thread)
     put3(o, AOV_NORMAL, i, n.x, n.y, n.z);
     put3(o, AOV_ALBEDO, i, pig.r * f->diffuse, pig.g * f->diffuse, pig.b * f->diffuse);
     if (o->buf[AOV_DIRECT] && (f->diffuse != 0.0 || f->diffuse_back != 0.0 || f->specular != 0.0 || f->phong != 0.0)) {
-        light_surface ls = {f, pig, n, dir, att, &r};
+        shade_light_surface ls = {f, pig, n, dir, att, &r};
         put_rgb(o, AOV_DIRECT, i, shade_direct(sc, c->a, &ls, &h, p_out, &r));
     }
     if (o->buf[AOV_INDIRECT] && c->s->indirect && f->diffuse > 0.0) {
@@ -152,7 +152,7 @@ static void aov_pixel(aov_ctx *c, int x, int y, int thread)
     }
     if (o->buf[AOV_ILLUMINANCE]) {
         rgb white = {1, 1, 1};
-        light_surface ls = {&c->white, white, n, dir, 1.0, &r};
+        shade_light_surface ls = {&c->white, white, n, dir, 1.0, &r};
         rgb e = shade_direct(sc, c->a, &ls, &h, p_out, &r);
         put3(o, AOV_ILLUMINANCE, i, M_PI * e.r, M_PI * e.g, M_PI * e.b);
     }

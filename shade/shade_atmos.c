@@ -36,10 +36,10 @@ static rgb sky_legacy(const scene *sc, const scene_sky_sphere *sky, vec3 dir)
     double fc[5] = {1, 1, 1, 1, 1}, trans = 1.0;
     rgb col = {0, 0, 0};
     vec3 p = xform_inv_point(&sky->transform, dir);
-    pattern_ctx pc = pattern_ctx_plain(sc);
+    shade_pattern_ctx pc = shade_pattern_ctx_plain(sc);
     for (int i = sky->npigments - 1; i >= 0; i--) {
         colour5 c;
-        pigment_eval(sky->pigments[i], p, &pc, &c);
+        shade_pigment_eval(sky->pigments[i], p, &pc, &c);
         double att = trans * (1.0 - c.f - c.t);
         col.r += c.r * att;
         col.g += c.g * att;
@@ -57,7 +57,7 @@ static rgb sky_legacy(const scene *sc, const scene_sky_sphere *sky, vec3 dir)
     return out;
 }
 
-rgb atmos_sky(const scene *sc, vec3 dir)
+rgb shade_atmos_sky(const scene *sc, vec3 dir)
 {
     rgb col = {0, 0, 0}, fil = {1, 1, 1};
     const scene_sky_sphere *sky = sc->sky_sphere;
@@ -65,10 +65,10 @@ rgb atmos_sky(const scene *sc, vec3 dir)
         return sky_legacy(sc, sky, dir);
     if (sky && sky->npigments > 0) {
         vec3 p = xform_inv_point(&sky->transform, dir);
-        pattern_ctx pc = pattern_ctx_plain(sc);
+        shade_pattern_ctx pc = shade_pattern_ctx_plain(sc);
         for (int i = sky->npigments - 1; i >= 0; i--) {
             colour5 c;
-            pigment_eval(sky->pigments[i], p, &pc, &c);
+            shade_pigment_eval(sky->pigments[i], p, &pc, &c);
             double att = 1.0 - c.f - c.t;
             col.r += c.r * att * fil.r * sky->emission[0];
             col.g += c.g * att * fil.g * sky->emission[1];
@@ -88,7 +88,7 @@ static double fog_turb(const scene *sc, const scene_fog *f, vec3 p)
 {
     p = v3_mul(p, f->turbulence);
     int g = sc->global.noise_generator >= 1 && sc->global.noise_generator <= 3 ? sc->global.noise_generator : 2;
-    return noise_turbulence(p, f->octaves, f->omega, f->lambda, g);
+    return shade_noise_turbulence(p, f->octaves, f->omega, f->lambda, g);
 }
 
 static double fog_att(const scene *sc, const scene_fog *f, vec3 org, vec3 dir, double width)
@@ -130,7 +130,7 @@ static rgb rainbow(const scene *sc, vec3 dir, double depth, rgb c)
 {
     rgb ct = {0, 0, 0};
     int n = 0;
-    pattern_ctx pc = pattern_ctx_plain(sc);
+    shade_pattern_ctx pc = shade_pattern_ctx_plain(sc);
     for (const scene_rainbow *r = sc->rainbows; r; r = r->next) {
         if (!r->pigment || r->distance == 0.0 || r->width == 0.0) continue;
         double x = v3_dot(dir, r->right), y = v3_dot(dir, r->up), l = x * x + y * y;
@@ -144,11 +144,11 @@ static rgb rainbow(const scene *sc, vec3 dir, double depth, rgb c)
             /* POV-Ray draws a random number; a hash of the direction here */
             unsigned long h = (unsigned long)(fabs(dir.x) * 1e9) * 2654435761ul ^ (unsigned long)(fabs(dir.y) * 1e9) * 40503ul ^
                               (unsigned long)(fabs(dir.z) * 1e9);
-            index += (2.0 * noise_pattern_rand(h) - 1.0) * r->jitter;
+            index += (2.0 * shade_noise_pattern_rand(h) - 1.0) * r->jitter;
         }
         if (index < 0.0 || index > 1.0 - ATM_EPSILON) continue;
         colour5 cr;
-        pigment_eval(r->pigment, v3(index, 0, 0), &pc, &cr);
+        shade_pigment_eval(r->pigment, v3(index, 0, 0), &pc, &cr);
         double fade = 0.0;
         if (r->falloff_width > 0.0 && angle > r->falloff_angle) {
             fade = (angle - r->falloff_angle) / r->falloff_width;
@@ -167,7 +167,7 @@ static rgb rainbow(const scene *sc, vec3 dir, double depth, rgb c)
     return out;
 }
 
-rgb atmos_fog(const scene *sc, vec3 org, vec3 dir, double depth, rgb c)
+rgb shade_atmos_fog(const scene *sc, vec3 org, vec3 dir, double depth, rgb c)
 {
     if (sc->rainbows) c = rainbow(sc, dir, isfinite(depth) ? depth : BOUND_HUGE, c);
     if (!sc->fogs) return c;
@@ -177,7 +177,7 @@ rgb atmos_fog(const scene *sc, vec3 org, vec3 dir, double depth, rgb c)
     return r;
 }
 
-void atmos_fog_affine(const scene *sc, vec3 org, vec3 dir, double depth, rgb *att, rgb *add)
+void shade_atmos_fog_affine(const scene *sc, vec3 org, vec3 dir, double depth, rgb *att, rgb *add)
 {
     rgb one = {1, 1, 1}, zero = {0, 0, 0};
     *att = one;
@@ -185,7 +185,7 @@ void atmos_fog_affine(const scene *sc, vec3 org, vec3 dir, double depth, rgb *at
     if (sc->fogs) fog_sums(sc, org, dir, depth, att, add);
 }
 
-rgb atmos_fog_attenuation(const scene *sc, vec3 org, vec3 dir, double depth)
+rgb shade_atmos_fog_attenuation(const scene *sc, vec3 org, vec3 dir, double depth)
 {
     rgb satt = {1, 1, 1}, scol;
     if (sc->fogs) fog_sums(sc, org, dir, depth, &satt, &scol);

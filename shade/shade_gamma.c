@@ -21,7 +21,7 @@ static float srgb_decode(float v)
     return v <= 0.04045f ? v / 12.92f : (float)pow((v + 0.055) / 1.055, 2.4);
 }
 
-void gamma_fb_to_linear(const scene *sc, framebuffer *fb)
+void shade_gamma_fb_to_linear(const scene *sc, framebuffer *fb)
 {
     double g = gamma_working(sc);
     if (g == 1.0) return;

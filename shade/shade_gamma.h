@@ -10,6 +10,6 @@
  * (v^gamma; for gamma handling off, the sRGB decoding, so that the usual
  * sRGB encoding of a PNG writes the computed values unchanged). No-op for
  * gamma 1. */
-void gamma_fb_to_linear(const scene *sc, framebuffer *fb);
+void shade_gamma_fb_to_linear(const scene *sc, framebuffer *fb);
 
 #endif

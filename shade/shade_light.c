@@ -22,7 +22,7 @@ static double light_cubic_step(double low, double high, double x)
     return (3.0 - 2.0 * t) * t * t;
 }
 
-double light_attenuation(const scene_light *l, vec3 p, vec3 dir, double depth)
+double shade_light_attenuation(const scene_light *l, vec3 p, vec3 dir, double depth)
 {
     double att = 1.0;
     if (l->kind == LIGHT_SPOT) {
@@ -54,7 +54,7 @@ double light_attenuation(const scene_light *l, vec3 p, vec3 dir, double depth)
     return att;
 }
 
-void light_ray(const scene_light *l, vec3 centre, vec3 p, vec3 *dir, double *depth)
+void shade_light_ray(const scene_light *l, vec3 centre, vec3 p, vec3 *dir, double *depth)
 {
     if (l->kind == LIGHT_CYLINDER) {
         vec3 d = v3_sub(centre, l->point_at);
@@ -74,19 +74,19 @@ void light_ray(const scene_light *l, vec3 centre, vec3 p, vec3 *dir, double *dep
     }
 }
 
-void light_area_axes(const scene_light *l, vec3 p, vec3 *ax1, vec3 *ax2)
+void shade_light_area_axes(const scene_light *l, vec3 p, vec3 *ax1, vec3 *ax2)
 {
     *ax1 = l->axis1;
     *ax2 = l->axis2;
     if (l->orient) {
         vec3 dir;
         double depth;
-        light_ray(l, l->position, p, &dir, &depth);
+        shade_light_ray(l, l->position, p, &dir, &depth);
         scene_light_orient_axes(l, dir, ax1, ax2);
     }
 }
 
-void light_metallic_tint(rgb *cs, double metallic, rgb pigment, double cos_angle)
+void shade_light_metallic_tint(rgb *cs, double metallic, rgb pigment, double cos_angle)
 {
     if (metallic == 0.0) return;
     double x = fabs(acos(fmax(-1.0, fmin(1.0, cos_angle)))) / (M_PI / 2.0);
@@ -99,7 +99,7 @@ void light_metallic_tint(rgb *cs, double metallic, rgb pigment, double cos_angle
 }
 
 /* The standard dielectric formula in the form POV-Ray documents for `fresnel`. */
-double light_fresnel(double cos_i, double n)
+double shade_light_fresnel(double cos_i, double n)
 {
     double g2 = n * n + cos_i * cos_i - 1.0;
     if (g2 <= 0.0) return 1.0;
@@ -110,15 +110,15 @@ double light_fresnel(double cos_i, double n)
     return fmin(1.0, fmax(0.0, f));
 }
 
-static rgb light_terms_plain(const light_surface *s, vec3 l, rgb lc, int backside);
+static rgb light_terms_plain(const shade_light_surface *s, vec3 l, rgb lc, int backside);
 
-rgb light_irid(const scene_finish *f, vec3 l, vec3 e, vec3 n, vec3 ipoint, const scene_global *g)
+rgb shade_light_irid(const scene_finish *f, vec3 l, vec3 e, vec3 n, vec3 ipoint, const scene_global *g)
 {
     double thickness = f->irid_thickness;
     int gen = g && g->noise_generator ? g->noise_generator : 2;
     if (f->irid_turb != 0.0) {
         /* fixed octaves 5, omega 0.5, lambda 2 (POV-Ray 3.7 trace.cpp) */
-        double nz = noise_turbulence(ipoint, 5, 0.5, 2.0, gen);
+        double nz = shade_noise_turbulence(ipoint, 5, 0.5, 2.0, gen);
         thickness *= 1.0 + (2.0 * nz - 1.0) * f->irid_turb;
     }
     /* default wavelengths 0.70, 0.52, 0.48 (POV-Ray 3.7 scene.cpp; kept as floats) */
@@ -129,14 +129,14 @@ rgb light_irid(const scene_finish *f, vec3 l, vec3 e, vec3 n, vec3 ipoint, const
     return lrgb(1.0 + f->irid * cos(phase / wl[0]), 1.0 + f->irid * cos(phase / wl[1]), 1.0 + f->irid * cos(phase / wl[2]));
 }
 
-rgb light_terms(const light_surface *s, vec3 l, rgb lc, int backside)
+rgb shade_light_terms(const shade_light_surface *s, vec3 l, rgb lc, int backside)
 {
     rgb out = light_terms_plain(s, l, lc, backside);
-    if (s->f->irid > 0.0) out = lrgb_mul(out, light_irid(s->f, l, s->eye, s->n, s->ipoint, s->global));
+    if (s->f->irid > 0.0) out = lrgb_mul(out, shade_light_irid(s->f, l, s->eye, s->n, s->ipoint, s->global));
     return out;
 }
 
-static rgb light_terms_plain(const light_surface *s, vec3 l, rgb lc, int backside)
+static rgb light_terms_plain(const shade_light_surface *s, vec3 l, rgb lc, int backside)
 {
     const scene_finish *f = s->f;
     rgb out = {0, 0, 0};
@@ -155,7 +155,7 @@ static rgb light_terms_plain(const light_surface *s, vec3 l, rgb lc, int backsid
         if (ca > 0.0 && (f->phong_size < 60 || ca > 0.0008)) {
             double intensity = f->phong * pow(ca, f->phong_size);
             rgb cs = {1, 1, 1};
-            light_metallic_tint(&cs, f->metallic, s->pigment, v3_dot(s->n, l));
+            shade_light_metallic_tint(&cs, f->metallic, s->pigment, v3_dot(s->n, l));
             out = lrgb_add(out, lrgb_scale(lrgb_mul(lc, cs), intensity));
         }
     }
@@ -169,7 +169,7 @@ static rgb light_terms_plain(const light_surface *s, vec3 l, rgb lc, int backsid
                 double rough = f->roughness > 0.0 ? f->roughness : 0.05;
                 double intensity = f->specular * pow(ca, 1.0 / rough);
                 rgb cs = {1, 1, 1};
-                light_metallic_tint(&cs, f->metallic, s->pigment, v3_dot(h, l) / hl);
+                shade_light_metallic_tint(&cs, f->metallic, s->pigment, v3_dot(h, l) / hl);
                 out = lrgb_add(out, lrgb_scale(lrgb_mul(lc, cs), intensity));
             }
         }
@@ -181,7 +181,7 @@ static rgb light_terms_plain(const light_surface *s, vec3 l, rgb lc, int backsid
 
 /* shade.c's shadow_blocked, and contacts: the ray leaves c->from
  * (accel_occluded_from). */
-static int blocked(const light_ctx *c, vec3 p, vec3 dir, double depth)
+static int blocked(const shade_light_ctx *c, vec3 p, vec3 dir, double depth)
 {
     if (c->shadow_rays) (*c->shadow_rays)++;
     double tmax = depth - fmax(c->eps, depth * 1e-6);
@@ -231,14 +231,14 @@ static void stratum(int k, int n, rng *r, double *u, double *v)
     }
 }
 
-rgb light_nee(const light_ctx *c, const scene_light *l, const light_surface *s, vec3 p, int double_illum,
+rgb shade_light_nee(const shade_light_ctx *c, const scene_light *l, const shade_light_surface *s, vec3 p, int double_illum,
               int nsamples, rng *r)
 {
     rgb zero = {0, 0, 0};
     if (nsamples < 1) nsamples = 1;
     vec3 dir;
     double depth;
-    light_ray(l, l->position, p, &dir, &depth);
+    shade_light_ray(l, l->position, p, &dir, &depth);
     int full_area = l->area && l->area_illumination && l->size1 * l->size2 > 0;
     if (full_area) {
         /* area_illumination: every point of the light shades on its own. */
@@ -249,19 +249,19 @@ rgb light_nee(const light_ctx *c, const scene_light *l, const light_surface *s, 
             vec3 q = v3_add(l->position, area_offset(l, l->axis1, l->axis2, u, v));
             vec3 d2;
             double dep2;
-            light_ray(l, q, p, &d2, &dep2);
-            rgb slc = lrgb_scale(l->colour, light_attenuation(l, p, d2, dep2));
+            shade_light_ray(l, q, p, &d2, &dep2);
+            rgb slc = lrgb_scale(l->colour, shade_light_attenuation(l, p, d2, dep2));
             int back2 = 0;
             if (!double_illum && v3_dot(s->n, d2) < 1e-10) {
                 if (s->f->diffuse_back != 0.0) back2 = 1;
                 else continue;
             }
             if (!l->shadowless && blocked(c, p, d2, dep2)) continue;
-            total = lrgb_add(total, light_terms(s, d2, slc, back2));
+            total = lrgb_add(total, shade_light_terms(s, d2, slc, back2));
         }
         return lrgb_scale(total, 1.0 / nsamples);
     }
-    rgb lc = lrgb_scale(l->colour, light_attenuation(l, p, dir, depth));
+    rgb lc = lrgb_scale(l->colour, shade_light_attenuation(l, p, dir, depth));
     if (lrgb_near_zero(lc)) return zero;
     int backside = 0;
     if (!double_illum && v3_dot(s->n, dir) < 1e-10) {
@@ -272,7 +272,7 @@ rgb light_nee(const light_ctx *c, const scene_light *l, const light_surface *s, 
         double vis;
         if (light_extended(l)) {
             vec3 ax1, ax2;
-            light_area_axes(l, p, &ax1, &ax2);
+            shade_light_area_axes(l, p, &ax1, &ax2);
             int seen = 0;
             for (int k = 0; k < nsamples; k++) {
                 double u, v;
@@ -280,7 +280,7 @@ rgb light_nee(const light_ctx *c, const scene_light *l, const light_surface *s, 
                 vec3 q = v3_add(l->position, area_offset(l, ax1, ax2, u, v));
                 vec3 d2;
                 double dep2;
-                light_ray(l, q, p, &d2, &dep2);
+                shade_light_ray(l, q, p, &d2, &dep2);
                 if (!blocked(c, p, d2, dep2)) seen++;
             }
             vis = (double)seen / nsamples;
@@ -290,12 +290,12 @@ rgb light_nee(const light_ctx *c, const scene_light *l, const light_surface *s, 
         if (vis <= 0.0) return zero;
         lc = lrgb_scale(lc, vis);
     }
-    return light_terms(s, dir, lc, backside);
+    return shade_light_terms(s, dir, lc, backside);
 }
 
 /* ------------------------------------------------------ photometric units */
 
-pt_status light_units_apply(scene *sc, double metres_per_unit, diag *d)
+pt_status shade_light_units_apply(scene *sc, double metres_per_unit, diag *d)
 {
     if (!(metres_per_unit > 0.0) || !isfinite(metres_per_unit)) {
         diag_error(d, "units: %g metres per scene unit is not a positive number", metres_per_unit);

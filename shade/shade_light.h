@@ -11,10 +11,10 @@
  * direct light is POV-Ray's.
  *
  * What moved here from shade.c (behaviour unchanged): the spotlight falloff
- * curve, light_attenuation, light_ray, the area-light grid point layout (since
+ * curve, shade_light_attenuation, shade_light_ray, the area-light grid point layout (since
  * in core/scene.c, shared with gi/), the
  * metallic tint, the diffuse/phong/specular terms of one light and the
- * Fresnel reflectance used by `reflection { fresnel }`. New: light_nee, a
+ * Fresnel reflectance used by `reflection { fresnel }`. New: shade_light_nee, a
  * continuous direct-light estimator for the GI modes. */
 #ifndef PT_SHADE_LIGHT_H
 #define PT_SHADE_LIGHT_H
@@ -28,26 +28,26 @@
  * cubic falloff between cos(radius) and cos(falloff), cylinder lights (radius
  * and falloff are distances from the axis), fade 2/(1+(d/fade_distance)^fade_power)
  * (or d^-fade_power with fade_distance 0). */
-double light_attenuation(const scene_light *l, vec3 p, vec3 dir, double depth);
+double shade_light_attenuation(const scene_light *l, vec3 p, vec3 dir, double depth);
 
 /* Unit direction from p towards the light point `centre` (the light's
  * position or a point of its area) and the distance to it, with POV-Ray's
  * handling of cylinder and parallel lights (fixed direction, depth measured
  * along it). */
-void light_ray(const scene_light *l, vec3 centre, vec3 p, vec3 *dir, double *depth);
+void shade_light_ray(const scene_light *l, vec3 centre, vec3 p, vec3 *dir, double *depth);
 
 /* The grid point layout of an area light: scene_light_area_point (core/scene.h). */
 
 /* Axes of an area light as seen from p: the light's own, or for `orient`
  * the same lengths turned to face p (POV-Ray's rule, scene_light_orient_axes). */
-void light_area_axes(const scene_light *l, vec3 p, vec3 *ax1, vec3 *ax2);
+void shade_light_area_axes(const scene_light *l, vec3 p, vec3 *ax1, vec3 *ax2);
 
 /* POV-Ray's empirical metallic tint of a highlight or reflection colour:
  * F(x) = 0.014567225/(x-1.12)^2 - 0.011612903 with x = angle/(pi/2). */
-void light_metallic_tint(rgb *cs, double metallic, rgb pigment, double cos_angle);
+void shade_light_metallic_tint(rgb *cs, double metallic, rgb pigment, double cos_angle);
 
 /* Fresnel reflectance for unpolarised light at relative ior n. */
-double light_fresnel(double cos_i, double n);
+double shade_light_fresnel(double cos_i, double n);
 
 /* The surface a light shines on. */
 typedef struct {
@@ -61,27 +61,27 @@ typedef struct {
      * wavelengths, noise generator); NULL: POV-Ray's defaults */
     vec3 ipoint;
     const scene_global *global;
-} light_surface;
+} shade_light_surface;
 
 /* POV-Ray 3.7's iridescence factor (ComputeIridColour) of a finish with
  * irid > 0: per channel 1 + irid * cos(2 pi d (|n.l| + |n.e|) / wavelength),
  * d the film thickness varied by turbulence at ipoint; l, e unit. */
-rgb light_irid(const scene_finish *f, vec3 l, vec3 e, vec3 n, vec3 ipoint, const scene_global *g);
+rgb shade_light_irid(const scene_finish *f, vec3 l, vec3 e, vec3 n, vec3 ipoint, const scene_global *g);
 
 /* Diffuse + phong + specular response to a light of colour `lc` arriving
  * along unit `l` (towards the light); `backside` uses diffuse_back and no
  * highlights. */
-rgb light_terms(const light_surface *s, vec3 l, rgb lc, int backside);
+rgb shade_light_terms(const shade_light_surface *s, vec3 l, rgb lc, int backside);
 
 /* ------------------------------------------------------------ GI direct light */
 
-/* Everything light_nee needs besides the light. */
+/* Everything shade_light_nee needs besides the light. */
 typedef struct {
     const accel *a;
     double eps;          /* scene distance epsilon (shade.c's: accel_scale * 1e-6) */
     long *shadow_rays;   /* incremented per shadow ray; may be NULL */
     const accel_from *from; /* the surface the shadow rays leave (accel_occluded_from); NULL: none */
-} light_ctx;
+} shade_light_ctx;
 
 /* Direct light from one POV-Ray light source at the surface point p (already
  * offset off the surface on the viewer's side), estimated with `nsamples`
@@ -96,7 +96,7 @@ typedef struct {
  * double_illuminate flag. Shadows: accel_occluded (no_shadow objects do not
  * block; every other object is opaque, as in shade.c). Unbiased for the
  * continuous light. */
-rgb light_nee(const light_ctx *c, const scene_light *l, const light_surface *s, vec3 p, int double_illum,
+rgb shade_light_nee(const shade_light_ctx *c, const scene_light *l, const shade_light_surface *s, vec3 p, int double_illum,
               int nsamples, rng *r);
 
 /* ------------------------------------------------------ photometric units */
@@ -114,15 +114,15 @@ rgb light_nee(const light_ctx *c, const scene_light *l, const light_surface *s, 
  *
  * The model is applied by rewriting the lights once, after parsing, into
  * the POV-Ray terms every integrator already evaluates: colour scaled by
- * 1/(pi m^2) with fade_distance 0 and fade_power 2 (light_attenuation's
+ * 1/(pi m^2) with fade_distance 0 and fade_power 2 (shade_light_attenuation's
  * d^-fade_power branch, d in scene units), or colour / pi with no fade for
  * the parallel kinds. So shade.c (Whitted), gi/ (particle GI: the OpenCL
  * kernels' gi_light_attenuation in gi/kernels/gi_types.h, a copy of
- * light_attenuation) and reference/ (light_nee, light_attenuation and the
+ * shade_light_attenuation) and reference/ (shade_light_nee, shade_light_attenuation and the
  * photon powers of pm_photon.c) all see the same falloff.
  * A light's own fade_distance/fade_power are replaced; each such light
  * gets a warning in d. PT_ERR_USAGE when metres_per_unit is not a positive
  * finite number. Applying it twice scales twice: call it once. */
-pt_status light_units_apply(scene *sc, double metres_per_unit, diag *d);
+pt_status shade_light_units_apply(scene *sc, double metres_per_unit, diag *d);
 
 #endif

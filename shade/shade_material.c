@@ -1,6 +1,6 @@
 /* shade_material.c - POV-Ray finish -> BSDF + emission (model in the header).
  *
- * Photon weight through refraction (used by mat_scatter.eta2). Camera-side
+ * Photon weight through refraction (used by shade_mat_scatter.eta2). Camera-side
  * transport is L(x, wo) = kt L(y, T(wo)), T the refraction map (no radiance
  * scaling, as shade.c). As a BSDF: f(wi, wo) = kt delta(wi - T(wo)) / |cos wi|.
  * A particle carrying flux uses the adjoint: arriving along wi it leaves along
@@ -21,7 +21,7 @@ static inline rgb mrgb_scale(rgb a, double s) { return mrgb(a.r * s, a.g * s, a.
 static inline double mrgb_max(rgb a) { return fmax(a.r, fmax(a.g, a.b)); }
 
 /* Pigment at a hit: patterns, image maps and texture maps through
- * shade_texture's tex_pigment_at (the colour `shade.c` would see on the top
+ * shade_texture's shade_tex_pigment_at (the colour `shade.c` would see on the top
  * layer); solid colours directly. h NULL: the texture's fallback colour. */
 static rgb texture_pigment(const scene *sc, const scene_texture *tex, const accel_hit *h, double *filt, double *transm,
                            int *unsupported)
@@ -30,7 +30,7 @@ static rgb texture_pigment(const scene *sc, const scene_texture *tex, const acce
     if (unsupported) *unsupported = pg->kind == PIGMENT_OTHER;
     if (h && (pg->kind == PIGMENT_PATTERN || tex->pat)) {
         colour5 c;
-        if (tex_pigment_at(sc, tex, h, &c)) {
+        if (shade_tex_pigment_at(sc, tex, h, &c)) {
             *filt = c.f;
             *transm = c.t;
             return mrgb(c.r, c.g, c.b);
@@ -51,7 +51,7 @@ typedef struct {
     double att;
 } layer;
 
-/* The layers of tex from the top down (at most MAT_MAX_LAYERS, and none
+/* The layers of tex from the top down (at most SHADE_MAT_MAX_LAYERS, and none
  * once the layers above pass no light, as POV-Ray stops); *through: the
  * colour that passes them all (filter * pigment + transmit, multiplied). */
 static int texture_layers(const scene *sc, const scene_texture *tex, const accel_hit *h, layer *L, rgb *through,
@@ -60,7 +60,7 @@ static int texture_layers(const scene *sc, const scene_texture *tex, const accel
     const int legacy = radrules_legacy(sc);
     rgb fil = {1, 1, 1};
     int n = 0;
-    for (const scene_texture *t = tex; t && n < MAT_MAX_LAYERS; t = t->next) {
+    for (const scene_texture *t = tex; t && n < SHADE_MAT_MAX_LAYERS; t = t->next) {
         double filt, transm;
         int uns = 0;
         rgb pig = texture_pigment(sc, t, h, &filt, &transm, &uns);
@@ -95,28 +95,28 @@ static rgb emission_of(const scene *sc, const layer *L, int n)
     return le;
 }
 
-rgb mat_emission_at(const scene *sc, const scene_texture *tex, const accel_hit *h)
+rgb shade_mat_emission_at(const scene *sc, const scene_texture *tex, const accel_hit *h)
 {
     if (!tex) tex = h && h->texture ? h->texture : &sc->default_texture;
-    layer L[MAT_MAX_LAYERS];
+    layer L[SHADE_MAT_MAX_LAYERS];
     rgb through;
     int n = texture_layers(sc, tex, h, L, &through, NULL);
     return emission_of(sc, L, n);
 }
 
-rgb mat_texture_emission(const scene *sc, const scene_texture *tex) { return mat_emission_at(sc, tex, NULL); }
+rgb shade_mat_texture_emission(const scene *sc, const scene_texture *tex) { return shade_mat_emission_at(sc, tex, NULL); }
 
-int mat_texture_varies(const scene_texture *tex)
+int shade_mat_texture_varies(const scene_texture *tex)
 {
     return tex && (tex->pigment.kind == PIGMENT_PATTERN || tex->pat);
 }
 
-void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r)
+void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r)
 {
     memset(b, 0, sizeof *b);
     const scene_texture *tex = h->texture ? h->texture : &sc->default_texture;
     const scene_finish *f = &tex->finish;
-    layer L[MAT_MAX_LAYERS];
+    layer L[SHADE_MAT_MAX_LAYERS];
     rgb tc;
     int nl = texture_layers(sc, tex, h, L, &tc, &b->unsupported);
     rgb pig = L[0].pig;
@@ -155,12 +155,12 @@ void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, doubl
                   kb.b + L[k].fil.b * L[k].pig.b * db);
         int lit = lf->diffuse != 0.0 || lf->diffuse_back != 0.0 || lf->phong != 0.0 || lf->specular != 0.0;
         b->nee |= lit;
-        light_surface lls = {lf, L[k].pig, n, dir, L[k].att, r};
+        shade_light_surface lls = {lf, L[k].pig, n, dir, L[k].att, r};
         b->layer_ls[k] = lls;
         b->layer_fil[k] = lit ? L[k].fil : mrgb(0, 0, 0);
     }
-    b->k[MAT_LOBE_DIFFUSE] = kd;
-    b->k[MAT_LOBE_BACK] = kb;
+    b->k[SHADE_MAT_LOBE_DIFFUSE] = kd;
+    b->k[SHADE_MAT_LOBE_BACK] = kb;
 
     double cos_i = -v3_dot(dir, n);
     const scene_interior *in = h->obj ? h->obj->interior : NULL;
@@ -174,7 +174,7 @@ void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, doubl
     rgb refl = {0, 0, 0};
     if (mrgb_max(rmax) > 0.0 || mrgb_max(rmin) > 0.0) {
         if (f->fresnel) {
-            double fr = light_fresnel(cos_i, rel_ior);
+            double fr = shade_light_fresnel(cos_i, rel_ior);
             refl = mrgb(rmax.r * fr + rmin.r * (1.0 - fr), rmax.g * fr + rmin.g * (1.0 - fr),
                         rmax.b * fr + rmin.b * (1.0 - fr));
         } else {
@@ -182,7 +182,7 @@ void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, doubl
             refl = mrgb(rmax.r * frac + rmin.r * (1.0 - frac), rmax.g * frac + rmin.g * (1.0 - frac),
                         rmax.b * frac + rmin.b * (1.0 - frac));
         }
-        light_metallic_tint(&refl, f->reflection_metallic, pig, cos_i);
+        shade_light_metallic_tint(&refl, f->reflection_metallic, pig, cos_i);
     }
     /* Transmission: straight through, or refracted when an ior is given. */
     rgb trans = {0, 0, 0};
@@ -202,10 +202,10 @@ void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, doubl
             }
         }
     }
-    b->k[MAT_LOBE_REFLECT] = refl;
-    b->k[MAT_LOBE_TRANSMIT] = trans;
+    b->k[SHADE_MAT_LOBE_REFLECT] = refl;
+    b->k[SHADE_MAT_LOBE_TRANSMIT] = trans;
     b->msum = 0.0;
-    for (int i = 0; i < MAT_NLOBES; i++) {
+    for (int i = 0; i < SHADE_MAT_NLOBES; i++) {
         double m = mrgb_max(b->k[i]);
         b->m[i] = m > 0.0 && isfinite(m) ? m : 0.0;
         b->msum += b->m[i];
@@ -213,15 +213,15 @@ void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, doubl
     b->ls = b->layer_ls[0];
 }
 
-rgb mat_eval(const mat_bsdf *b, vec3 wi)
+rgb shade_mat_eval(const shade_mat_bsdf *b, vec3 wi)
 {
     double cn = v3_dot(wi, b->n), cg = v3_dot(wi, b->ng);
-    if (cn > 0.0 && cg > 0.0) return mrgb_scale(b->k[MAT_LOBE_DIFFUSE], 1.0 / M_PI);
-    if (cn < 0.0 && cg < 0.0) return mrgb_scale(b->k[MAT_LOBE_BACK], 1.0 / M_PI);
+    if (cn > 0.0 && cg > 0.0) return mrgb_scale(b->k[SHADE_MAT_LOBE_DIFFUSE], 1.0 / M_PI);
+    if (cn < 0.0 && cg < 0.0) return mrgb_scale(b->k[SHADE_MAT_LOBE_BACK], 1.0 / M_PI);
     return mrgb(0, 0, 0);
 }
 
-vec3 mat_cosine_dir(vec3 n, double u1, double u2)
+vec3 shade_mat_cosine_dir(vec3 n, double u1, double u2)
 {
     double r = sqrt(u1), phi = 2.0 * M_PI * u2;
     double x = r * cos(phi), y = r * sin(phi), z = sqrt(fmax(0.0, 1.0 - u1));
@@ -237,7 +237,7 @@ vec3 mat_cosine_dir(vec3 n, double u1, double u2)
  * with the max channel as scatter probability so powers never grow).
  * Returns 0 when nothing is sampled (absorbed, black, or a diffuse direction
  * that the shading normal allows but the geometric normal does not). */
-static int mat_sample_lobe(const mat_bsdf *b, double u_lobe, double u1, double u2, int absorb, mat_scatter *s)
+static int mat_sample_lobe(const shade_mat_bsdf *b, double u_lobe, double u1, double u2, int absorb, shade_mat_scatter *s)
 {
     memset(s, 0, sizeof *s);
     s->eta2 = 1.0;
@@ -245,7 +245,7 @@ static int mat_sample_lobe(const mat_bsdf *b, double u_lobe, double u1, double u
     double scale = absorb ? (b->msum > 1.0 ? 1.0 / b->msum : 1.0) : 1.0 / b->msum;
     int lobe = -1;
     double acc = 0.0, p = 0.0;
-    for (int i = 0; i < MAT_NLOBES; i++) {
+    for (int i = 0; i < SHADE_MAT_NLOBES; i++) {
         if (b->m[i] <= 0.0) continue;
         acc += b->m[i] * scale;
         if (u_lobe < acc) {
@@ -257,26 +257,26 @@ static int mat_sample_lobe(const mat_bsdf *b, double u_lobe, double u1, double u
     if (lobe < 0) {
         if (absorb) return 0;
         /* rounding at the top end: take the last non-empty lobe */
-        for (int i = MAT_NLOBES - 1; i >= 0; i--)
+        for (int i = SHADE_MAT_NLOBES - 1; i >= 0; i--)
             if (b->m[i] > 0.0) { lobe = i; p = b->m[i] * scale; break; }
         if (lobe < 0) return 0;
     }
     s->lobe = lobe;
     s->weight = mrgb_scale(b->k[lobe], 1.0 / p);
     switch (lobe) {
-    case MAT_LOBE_DIFFUSE:
-        s->dir = mat_cosine_dir(b->n, u1, u2);
+    case SHADE_MAT_LOBE_DIFFUSE:
+        s->dir = shade_mat_cosine_dir(b->n, u1, u2);
         if (v3_dot(s->dir, b->ng) <= 0.0) return 0;
         s->org = b->p_out;
         s->pdf = p * v3_dot(s->dir, b->n) / M_PI;
         break;
-    case MAT_LOBE_BACK:
-        s->dir = mat_cosine_dir(v3_neg(b->n), u1, u2);
+    case SHADE_MAT_LOBE_BACK:
+        s->dir = shade_mat_cosine_dir(v3_neg(b->n), u1, u2);
         if (v3_dot(s->dir, b->ng) >= 0.0) return 0;
         s->org = b->p_in;
         s->pdf = p * -v3_dot(s->dir, b->n) / M_PI;
         break;
-    case MAT_LOBE_REFLECT:
+    case SHADE_MAT_LOBE_REFLECT:
         s->dir = b->refl_dir;
         s->org = b->p_out;
         s->specular = 1;
@@ -292,15 +292,15 @@ static int mat_sample_lobe(const mat_bsdf *b, double u_lobe, double u1, double u
     return 1;
 }
 
-int mat_sample(const mat_bsdf *b, rng *r, int absorb, mat_scatter *s)
+int shade_mat_sample(const shade_mat_bsdf *b, rng *r, int absorb, shade_mat_scatter *s)
 {
     double ul = rng_f64(r), u1 = rng_f64(r), u2 = rng_f64(r);
     return mat_sample_lobe(b, ul, u1, u2, absorb, s);
 }
 
-rgb mat_light_nee(const mat_bsdf *b, const light_ctx *c, const scene_light *l, int nsamples, rng *r)
+rgb shade_mat_light_nee(const shade_mat_bsdf *b, const shade_light_ctx *c, const scene_light *l, int nsamples, rng *r)
 {
-    light_ctx cf = *c;
+    shade_light_ctx cf = *c;
     cf.from = &b->from;
     scene_light pl;
     if (b->gathered && l->area) {
@@ -314,7 +314,7 @@ rgb mat_light_nee(const mat_bsdf *b, const light_ctx *c, const scene_light *l, i
     for (int k = 0; k < b->nlayers; k++) {
         rgb fil = b->layer_fil[k];
         if (!(mrgb_max(fil) > 0.0)) continue;
-        light_surface ls = b->layer_ls[k];
+        shade_light_surface ls = b->layer_ls[k];
         ls.r = r;
         scene_finish f;
         if (b->gathered) {
@@ -323,7 +323,7 @@ rgb mat_light_nee(const mat_bsdf *b, const light_ctx *c, const scene_light *l, i
             f.phong = f.specular = 0.0;
             ls.f = &f;
         }
-        rgb v = light_nee(&cf, l, &ls, b->p_out, b->double_illum, nsamples, r);
+        rgb v = shade_light_nee(&cf, l, &ls, b->p_out, b->double_illum, nsamples, r);
         total = mrgb(total.r + fil.r * v.r, total.g + fil.g * v.g, total.b + fil.b * v.b);
     }
     return total;

@@ -18,7 +18,7 @@
  *   Le      = pigment * opacity * (emission [+ ambient * ambient_light: #version < 3.7])
  *
  * The pigment is evaluated at the hit (patterns, image maps, texture maps:
- * shade_texture.h's tex_pigment_at) and the finish is the hit texture's.
+ * shade_texture.h's shade_tex_pigment_at) and the finish is the hit texture's.
  * Layered textures as POV-Ray shades them: every layer's emission,
  * Lambertian terms and direct light count, times its opacity and the filter
  * colour of the layers above (pigment * filter + transmit, multiplied), and
@@ -31,7 +31,7 @@
  * Lambertian terms ignore brilliance and crand (they are POV-Ray's shaping
  * of direct light only). Phong and specular highlights are not part of f:
  * they are not energy-conserving and are added for light arriving straight
- * from light sources only, by light_terms/light_nee (shade_light.h), exactly
+ * from light sources only, by shade_light_terms/shade_light_nee (shade_light.h), exactly
  * as shade.c computes them; so `--gi none` (with ambient 0; it shows ambient,
  * being radiosity off) is the direct part (first vertex) of the path tracer. Emission is the same
  * on both sides of a surface (POV-Ray turns normals towards the viewer).
@@ -46,7 +46,7 @@
  *
  * Radiance through refraction is not scaled by the squared ior ratio (shade.c
  * does not); the adjoint rule for particles carrying flux (photons) is then a
- * factor (eta_i/eta_t)^2 per refraction, given in mat_scatter.eta2 (derivation
+ * factor (eta_i/eta_t)^2 per refraction, given in shade_mat_scatter.eta2 (derivation
  * in shade_material.c). */
 #ifndef PT_SHADE_MATERIAL_H
 #define PT_SHADE_MATERIAL_H
@@ -55,9 +55,9 @@
 #include "scene.h"
 #include "shade_light.h"
 
-#define MAT_MAX_LAYERS 8
+#define SHADE_MAT_MAX_LAYERS 8
 
-enum { MAT_LOBE_DIFFUSE = 0, MAT_LOBE_BACK = 1, MAT_LOBE_REFLECT = 2, MAT_LOBE_TRANSMIT = 3, MAT_NLOBES = 4 };
+enum { SHADE_MAT_LOBE_DIFFUSE = 0, SHADE_MAT_LOBE_BACK = 1, SHADE_MAT_LOBE_REFLECT = 2, SHADE_MAT_LOBE_TRANSMIT = 3, SHADE_MAT_NLOBES = 4 };
 
 typedef struct {
     const scene_texture *tex;
@@ -71,25 +71,25 @@ typedef struct {
     vec3 ng;           /* geometric normal facing the viewer */
     int entering;      /* the ray hits the outside (geometric normal against it) */
     rgb emission;      /* Le */
-    rgb k[MAT_NLOBES]; /* kd, kb, kr, kt */
+    rgb k[SHADE_MAT_NLOBES]; /* kd, kb, kr, kt */
     vec3 refl_dir, trans_dir;
     double eta2;       /* (eta_i/eta_t)^2 of the refraction, 1 without */
-    double m[MAT_NLOBES]; /* lobe sizes: max channel of k (>= 0) */
+    double m[SHADE_MAT_NLOBES]; /* lobe sizes: max channel of k (>= 0) */
     double msum;
     int nee;           /* direct light applies (diffuse, diffuse_back, phong or specular) */
     int double_illum;
     int unsupported;   /* a pigment pattern the shader cannot evaluate (its colour is used) */
-    light_surface ls;  /* for light_terms / light_nee: the top layer */
-    int nlayers;       /* layers of the texture (MAT_MAX_LAYERS at most), each shaded through those above */
-    light_surface layer_ls[MAT_MAX_LAYERS];
-    rgb layer_fil[MAT_MAX_LAYERS]; /* filter colour of the layers above (0: the layer takes no direct light) */
+    shade_light_surface ls;  /* for shade_light_terms / shade_light_nee: the top layer */
+    int nlayers;       /* layers of the texture (SHADE_MAT_MAX_LAYERS at most), each shaded through those above */
+    shade_light_surface layer_ls[SHADE_MAT_MAX_LAYERS];
+    rgb layer_fil[SHADE_MAT_MAX_LAYERS]; /* filter colour of the layers above (0: the layer takes no direct light) */
     const scene_object *obj; /* the hit object: light_group decides which lights reach it (scene_light_reaches) */
     accel_from from;   /* the hit's surface, for rays leaving it (accel_intersect_from) */
     int gathered;      /* set by the integrator: the hit of a gathering (radiosity) ray, where POV-Ray
                           computes no phong/specular highlights and takes area lights as point lights
                           at their centre (trace.cpp's IsRadiosityRay tests, radiosity.cpp's
-                          GetRadiosityQualityFlags); mat_light_nee follows it */
-} mat_bsdf;
+                          GetRadiosityQualityFlags); shade_mat_light_nee follows it */
+} shade_mat_bsdf;
 
 typedef struct {
     vec3 org, dir;     /* continuation ray (origin off the right side of the surface) */
@@ -98,32 +98,32 @@ typedef struct {
     int lobe;
     int specular;      /* a delta lobe */
     double eta2;       /* photons: multiply flux by this as well (refraction), else 1 */
-} mat_scatter;
+} shade_mat_scatter;
 
 /* Emission Le (both sides) under the scene's rules above: at a hit (h may
  * be NULL; tex NULL = the hit's texture), or the texture's fallback colour. */
-rgb mat_emission_at(const scene *sc, const scene_texture *tex, const accel_hit *h);
-rgb mat_texture_emission(const scene *sc, const scene_texture *tex);
+rgb shade_mat_emission_at(const scene *sc, const scene_texture *tex, const accel_hit *h);
+rgb shade_mat_texture_emission(const scene *sc, const scene_texture *tex);
 /* 1 if the texture's colour varies over the surface (pattern, texture map). */
-int mat_texture_varies(const scene_texture *tex);
+int shade_mat_texture_varies(const scene_texture *tex);
 
 /* Set up the BSDF at hit `h` for a ray of unit direction `dir`. `eps` is the
  * distance the origins are moved off the surface (shade.c's rule: accel_scale
- * * 1e-6). `r` feeds crand in light_terms. */
-void mat_setup(mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r);
+ * * 1e-6). `r` feeds crand in shade_light_terms. */
+void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r);
 
 /* Lambertian part of f (no cosine) for unit wi (towards where light comes
  * from); 0 where wi and the geometric normal disagree about the side. */
-rgb mat_eval(const mat_bsdf *b, vec3 wi);
+rgb shade_mat_eval(const shade_mat_bsdf *b, vec3 wi);
 
-int mat_sample(const mat_bsdf *b, rng *r, int absorb, mat_scatter *s);
+int shade_mat_sample(const shade_mat_bsdf *b, rng *r, int absorb, shade_mat_scatter *s);
 
 /* Cosine-weighted direction about unit n for (u1, u2) in [0,1)^2 (Malley:
  * uniform on the disc, projected up); pdf cos/pi. */
-vec3 mat_cosine_dir(vec3 n, double u1, double u2);
+vec3 shade_mat_cosine_dir(vec3 n, double u1, double u2);
 
-/* Direct light of one POV-Ray light at the hit (light_nee at p_out; see
+/* Direct light of one POV-Ray light at the hit (shade_light_nee at p_out; see
  * `gathered`). */
-rgb mat_light_nee(const mat_bsdf *b, const light_ctx *c, const scene_light *l, int nsamples, rng *r);
+rgb shade_mat_light_nee(const shade_mat_bsdf *b, const shade_light_ctx *c, const scene_light *l, int nsamples, rng *r);
 
 #endif

@@ -80,7 +80,7 @@ static inline double dist3(rgb a, rgb b) { return fabs(a.r - b.r) + fabs(a.g - b
 
 static const void *key_of(const scene_object *o) { return o->interior ? (const void *)o->interior : (const void *)o; }
 
-int media_scene_has(const scene *sc)
+int shade_media_scene_has(const scene *sc)
 {
     if (sc->natmosphere > 0) return 1;
     /* interior media: any object's (CSG members included) */
@@ -99,21 +99,21 @@ int media_scene_has(const scene *sc)
     return 0;
 }
 
-int media_inside_hollow(const media_inside *in)
+int shade_media_inside_hollow(const shade_media_inside *in)
 {
     for (int i = 0; i < in->n; i++)
         if (!(in->obj[i]->flags & OBJ_HOLLOW)) return 0;
     return 1;
 }
 
-int media_inside_has_media(const media_inside *in)
+int shade_media_inside_has_media(const shade_media_inside *in)
 {
     for (int i = 0; i < in->n; i++)
         if (in->obj[i]->interior && in->obj[i]->interior->nmedia > 0) return 1;
     return 0;
 }
 
-void media_inside_cross(media_inside *in, const scene_object *o)
+void shade_media_inside_cross(shade_media_inside *in, const scene_object *o)
 {
     if (!o) return;
     const void *k = key_of(o);
@@ -124,7 +124,7 @@ void media_inside_cross(media_inside *in, const scene_object *o)
             return;
         }
     }
-    if (in->n < MEDIA_MAX_INSIDE) in->obj[in->n++] = o;
+    if (in->n < SHADE_MEDIA_MAX_INSIDE) in->obj[in->n++] = o;
 }
 
 /* A degenerate shape (the renderer skips it too) is never inside. */
@@ -137,7 +137,7 @@ static int leaf_inside(const scene_object *o, vec3 p)
     return (o->flags & OBJ_INVERSE) ? !r : r;
 }
 
-static void inside_at(const scene_object *o, vec3 p, media_inside *in, int depth)
+static void inside_at(const scene_object *o, vec3 p, shade_media_inside *in, int depth)
 {
     if (depth > 32) return;
     if (o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE) {
@@ -150,10 +150,10 @@ static void inside_at(const scene_object *o, vec3 p, media_inside *in, int depth
     if (!leaf_inside(o, p)) return;
     for (int i = 0; i < in->n; i++)
         if (key_of(in->obj[i]) == key_of(o)) return;
-    if (in->n < MEDIA_MAX_INSIDE) in->obj[in->n++] = o;
+    if (in->n < SHADE_MEDIA_MAX_INSIDE) in->obj[in->n++] = o;
 }
 
-void media_inside_at(const scene *sc, vec3 p, media_inside *in)
+void shade_media_inside_at(const scene *sc, vec3 p, shade_media_inside *in)
 {
     in->n = 0;
     for (int i = 0; i < sc->nobjects; i++) inside_at(sc->objects[i], p, in, 0);
@@ -170,7 +170,7 @@ typedef struct {
     rgb ext, emit, scat;
 } coeffs;
 
-static rgb density_at(const media_ref *r, vec3 p, const pattern_ctx *pc)
+static rgb density_at(const media_ref *r, vec3 p, const shade_pattern_ctx *pc)
 {
     const scene_media *m = r->m;
     if (m->ndensity == 0) return mk(1, 1, 1);
@@ -179,13 +179,13 @@ static rgb density_at(const media_ref *r, vec3 p, const pattern_ctx *pc)
     rgb d = {1, 1, 1};
     for (int i = 0; i < m->ndensity; i++) {
         colour5 c = {0, 0, 0, 0, 0};
-        pigment_eval(m->density[i], q, pc, &c);
+        shade_pigment_eval(m->density[i], q, pc, &c);
         d = mul(d, mk(c.r, c.g, c.b));
     }
     return d;
 }
 
-static coeffs coeffs_at(const media_ref *refs, int n, vec3 p, int shadow, const pattern_ctx *pc)
+static coeffs coeffs_at(const media_ref *refs, int n, vec3 p, int shadow, const shade_pattern_ctx *pc)
 {
     coeffs c = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
     for (int i = 0; i < n; i++) {
@@ -326,15 +326,15 @@ static int cmp_double(const void *a, const void *b)
 /* ------------------------------------------------------------ sampling */
 
 typedef struct {
-    const media_env *e;
+    const shade_media_env *e;
     const media_ref *refs;
     int nrefs;
     vec3 org, dir;
     int shadow, use_scattering;
     const lit_light *lights;
     int nlights;
-    const media_inside *in;
-    pattern_ctx pc;
+    const shade_media_inside *in;
+    shade_pattern_ctx pc;
 } sampler;
 
 /* One sample at fraction d of interval iv: its emitted (and in-scattered)
@@ -369,7 +369,7 @@ static void one_sample(const sampler *s, interval *iv, double d, int method, rgb
     iv->samples++;
 }
 
-static double rnd(const media_env *e) { return e->r ? rng_f64(e->r) : 0.5; }
+static double rnd(const shade_media_env *e) { return e->r ? rng_f64(e->r) : 0.5; }
 
 /* POV-Ray's recursive adaptive sample between fractions d1 and d3. */
 static void recursive_sample(const sampler *s, interval *iv, double d1, double d3, rgb c1, rgb c3, rgb od1, rgb od3,
@@ -487,10 +487,10 @@ static rgb sample_variance(const interval *iv)
     return scl(add(scl(iv->te2, n), scl(mul(m, m), -1.0)), n);
 }
 
-static int collect_refs(const media_env *e, int which, const media_inside *in, media_ref *refs)
+static int collect_refs(const shade_media_env *e, int which, const shade_media_inside *in, media_ref *refs)
 {
     int n = 0;
-    if (which == MEDIA_ATMOSPHERE) {
+    if (which == SHADE_MEDIA_ATMOSPHERE) {
         for (int i = 0; i < e->sc->natmosphere && n < MAX_REFS; i++) {
             refs[n].m = e->sc->atmosphere[i];
             refs[n].obj = NULL;
@@ -516,7 +516,7 @@ static int light_acts(const scene_light *l, const scene_object *hit)
     return scene_light_reaches(l, hit);
 }
 
-rgb media_segment(const media_env *e, int which, const media_inside *in, vec3 org, vec3 dir, double depth, rgb c,
+rgb shade_media_segment(const shade_media_env *e, int which, const shade_media_inside *in, vec3 org, vec3 dir, double depth, rgb c,
                   int shadow)
 {
     media_ref refs[MAX_REFS];
@@ -635,7 +635,7 @@ rgb media_segment(const media_env *e, int which, const media_inside *in, vec3 or
     s.lights = lights;
     s.nlights = nl;
     s.in = in;
-    s.pc = pattern_ctx_plain(e->sc);
+    s.pc = shade_pattern_ctx_plain(e->sc);
 
     int nmin = im->min_samples > 0 ? im->min_samples : 1;
     for (int i = 0; i < niv; i++) {
@@ -682,11 +682,11 @@ rgb media_segment(const media_env *e, int which, const media_inside *in, vec3 or
 
 /* ------------------------------------------------------------ shadow rays */
 
-rgb media_shadow_ray(const scene *sc, const accel *a, const media_env *e, const scene_light *l, vec3 p, vec3 dir,
-                     double tmin, double tmax, const media_inside *in0)
+rgb shade_media_shadow_ray(const scene *sc, const accel *a, const shade_media_env *e, const scene_light *l, vec3 p, vec3 dir,
+                     double tmin, double tmax, const shade_media_inside *in0)
 {
     rgb c = {1, 1, 1};
-    media_inside in = *in0;
+    shade_media_inside in = *in0;
     int atmos = l && l->media_interaction && l->media_attenuation;
     accel_hit h;
     double t0 = tmin, prev = 0.0; /* prev: where the current segment starts */
@@ -696,31 +696,31 @@ rgb media_shadow_ray(const scene *sc, const accel *a, const media_env *e, const 
         if (!(h.flags & OBJ_NO_SHADOW)) {
             accel_hit hh = h;
             hh.t = h.t - (t0 > tmin ? t0 - fmax(tmin, t0 * 1e-7) : 0.0);
-            rgb f = tex_shadow_filter(sc, &hh, dir);
+            rgb f = shade_tex_shadow_filter(sc, &hh, dir);
             if (fabs(f.r) < MEDIA_EPSILON && fabs(f.g) < MEDIA_EPSILON && fabs(f.b) < MEDIA_EPSILON) return mk(0, 0, 0);
             vec3 q = v3_madd(p, dir, prev);
             double len = h.t - prev;
-            int hollow = media_inside_hollow(&in);
+            int hollow = shade_media_inside_hollow(&in);
             /* the containers' media over the segment (a hollow ray) */
-            if (in.n > 0 && hollow && media_inside_has_media(&in)) f = media_segment(e, MEDIA_INTERIOR, &in, q, dir, len, f, 1);
+            if (in.n > 0 && hollow && shade_media_inside_has_media(&in)) f = shade_media_segment(e, SHADE_MEDIA_INTERIOR, &in, q, dir, len, f, 1);
             c = mul(c, f);
             /* POV-Ray applies the atmosphere before every surface crossed
              * (each object has an interior there); fog only while hollow */
             if (atmos && !is_zero(c)) {
-                if (sc->natmosphere) c = media_segment(e, MEDIA_ATMOSPHERE, &in, q, dir, len, c, 1);
-                if (sc->fogs && hollow) c = mul(c, atmos_fog_attenuation(sc, q, dir, len));
+                if (sc->natmosphere) c = shade_media_segment(e, SHADE_MEDIA_ATMOSPHERE, &in, q, dir, len, c, 1);
+                if (sc->fogs && hollow) c = mul(c, shade_atmos_fog_attenuation(sc, q, dir, len));
             }
             if (fabs(c.r) < MEDIA_EPSILON && fabs(c.g) < MEDIA_EPSILON && fabs(c.b) < MEDIA_EPSILON) return mk(0, 0, 0);
-            media_inside_cross(&in, h.obj);
+            shade_media_inside_cross(&in, h.obj);
             prev = h.t;
         }
         t0 = next;
     }
     /* the rest of the way to the light: the atmosphere (a hollow ray) */
-    if (atmos && media_inside_hollow(&in) && tmax > prev) {
+    if (atmos && shade_media_inside_hollow(&in) && tmax > prev) {
         vec3 q = v3_madd(p, dir, prev);
-        if (sc->natmosphere) c = media_segment(e, MEDIA_ATMOSPHERE, &in, q, dir, tmax - prev, c, 1);
-        if (sc->fogs) c = mul(c, atmos_fog_attenuation(sc, q, dir, tmax - prev));
+        if (sc->natmosphere) c = shade_media_segment(e, SHADE_MEDIA_ATMOSPHERE, &in, q, dir, tmax - prev, c, 1);
+        if (sc->fogs) c = mul(c, shade_atmos_fog_attenuation(sc, q, dir, tmax - prev));
     }
     return c;
 }

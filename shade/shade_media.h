@@ -7,7 +7,7 @@
  * list. A ray is "hollow" while every container is `hollow`: only then do
  * interior media, atmospheric media and fog act on it (POV-Ray 3.7).
  *
- * media_segment applies the media on one ray segment (origin to the next
+ * shade_media_segment applies the media on one ray segment (origin to the next
  * surface) to the colour seen at its end: colour * exp(-optical depth) +
  * the light emitted and in-scattered along the segment, sampled with the
  * media's method (3: POV-Ray's adaptive sampling; 1 and 2: stratified
@@ -18,29 +18,29 @@
 #include "rng.h"
 #include "scene.h"
 
-#define MEDIA_MAX_INSIDE 16
+#define SHADE_MEDIA_MAX_INSIDE 16
 
 typedef struct {
     int n;
-    const scene_object *obj[MEDIA_MAX_INSIDE]; /* leaf objects (their interior, their transform) */
-} media_inside;
+    const scene_object *obj[SHADE_MEDIA_MAX_INSIDE]; /* leaf objects (their interior, their transform) */
+} shade_media_inside;
 
 /* Any media in the scene (interior or atmospheric)? */
-int media_scene_has(const scene *sc);
+int shade_media_scene_has(const scene *sc);
 /* Is the ray hollow (every container hollow)? */
-int media_inside_hollow(const media_inside *in);
+int shade_media_inside_hollow(const shade_media_inside *in);
 /* Do the containers hold any media? */
-int media_inside_has_media(const media_inside *in);
+int shade_media_inside_has_media(const shade_media_inside *in);
 /* The ray crosses object o's surface: leave it if inside, else enter it. */
-void media_inside_cross(media_inside *in, const scene_object *o);
+void shade_media_inside_cross(shade_media_inside *in, const scene_object *o);
 /* The objects holding point p (the camera's location) that matter to the
  * list: those with media or not hollow (POV-Ray's containing interiors). */
-void media_inside_at(const scene *sc, vec3 p, media_inside *in);
+void shade_media_inside_at(const scene *sc, vec3 p, shade_media_inside *in);
 
 /* Light of l reaching p (attenuated, shadowed, filtered) and the unit
  * direction from p towards it; 0 when none. `in` = the sampled ray's
  * containers (the shadow ray starts inside them). */
-typedef rgb (*media_light_fn)(void *ctx, int thread, const scene_light *l, vec3 p, const media_inside *in,
+typedef rgb (*shade_media_light_fn)(void *ctx, int thread, const scene_light *l, vec3 p, const shade_media_inside *in,
                               vec3 *to_light);
 
 typedef struct {
@@ -48,27 +48,27 @@ typedef struct {
     void *ctx;
     int thread;
     rng *r;
-    media_light_fn light;   /* scattering's light (NULL: no in-scattering) */
+    shade_media_light_fn light;   /* scattering's light (NULL: no in-scattering) */
     const scene_object *hit; /* the surface ending the segment (its light group), NULL = none */
-} media_env;
+} shade_media_env;
 
-enum { MEDIA_INTERIOR = 0, MEDIA_ATMOSPHERE = 1 };
+enum { SHADE_MEDIA_INTERIOR = 0, SHADE_MEDIA_ATMOSPHERE = 1 };
 
 /* Colour c seen at distance depth along org + t dir (unit dir) after the
- * interior media of the containers `in` (which = MEDIA_INTERIOR) or the
- * scene's atmosphere (MEDIA_ATMOSPHERE). shadow: extinction only (a shadow
+ * interior media of the containers `in` (which = SHADE_MEDIA_INTERIOR) or the
+ * scene's atmosphere (SHADE_MEDIA_ATMOSPHERE). shadow: extinction only (a shadow
  * ray). The caller checks hollowness. */
-rgb media_segment(const media_env *e, int which, const media_inside *in, vec3 org, vec3 dir, double depth, rgb c,
+rgb shade_media_segment(const shade_media_env *e, int which, const shade_media_inside *in, vec3 org, vec3 dir, double depth, rgb c,
                   int shadow);
 
 /* Light left along a shadow ray from p (unit dir, over (tmin, tmax)) for
  * light l, starting inside `in`, as POV-Ray's TraceShadowRay with media:
- * at each surface crossed the filter colour (tex_shadow_filter), the
+ * at each surface crossed the filter colour (shade_tex_shadow_filter), the
  * interior media of the containers over the segment before it (a hollow
  * ray) and, for a light with media_interaction and media_attenuation, the
  * atmospheric media (and fog on hollow segments); after the last surface
  * the atmosphere and fog alone. no_shadow objects are passed through. */
-rgb media_shadow_ray(const scene *sc, const accel *a, const media_env *e, const scene_light *l, vec3 p, vec3 dir,
-                     double tmin, double tmax, const media_inside *in);
+rgb shade_media_shadow_ray(const scene *sc, const accel *a, const shade_media_env *e, const scene_light *l, vec3 p, vec3 dir,
+                     double tmin, double tmax, const shade_media_inside *in);
 
 #endif

@@ -58,8 +58,8 @@ static double rtab[267];
 static int solid_perm[2 * (SOLID_N + 1)];
 static vec3 solid_grad[2 * (SOLID_N + 1)];
 static double pattern_rands[RANDS_N];
-static vec3 wave_src[NOISE_MAX_WAVES];
-static double wave_freq[NOISE_MAX_WAVES];
+static vec3 wave_src[SHADE_NOISE_MAX_WAVES];
+static double wave_freq[SHADE_NOISE_MAX_WAVES];
 static pthread_once_t init_once = PTHREAD_ONCE_INIT;
 
 /* POV-Ray's LCG step on a 32-bit int; returns the 15 bits it uses. */
@@ -164,7 +164,7 @@ static vec3 dnoise(vec3 p);
 static void init_waves(void)
 {
     uint32_t r = (uint32_t)-560851967;
-    for (int i = 0; i < NOISE_MAX_WAVES; i++) {
+    for (int i = 0; i < SHADE_NOISE_MAX_WAVES; i++) {
         wave_src[i] = v3_norm(dnoise(v3((double)i, 0.0, 0.0)));
         wave_freq[i] = (double)lcg15(&r) * 0.000030518509476 + 0.01;
     }
@@ -189,7 +189,7 @@ static inline double scurve(double a) { return a * a * (3.0 - 2.0 * a); }
 /* Cell index (12 bits) and fraction along one axis, POV-Ray's way. */
 static inline void lattice(double x, int *i, double *f)
 {
-    int t = x >= 0 ? noise_to_int(x) : noise_to_int(x - (1 - NOISE_EPSILON));
+    int t = x >= 0 ? shade_noise_to_int(x) : shade_noise_to_int(x - (1 - NOISE_EPSILON));
     *i = (t - LATTICE_MIN) & 0xFFF;
     *f = x - t;
 }
@@ -205,7 +205,7 @@ static inline double term(int k, double s, double x, double y, double z)
 
 static double solid_noise(vec3 p);
 
-double noise_value(vec3 p, int generator)
+double shade_noise_value(vec3 p, int generator)
 {
     noise_init();
     if (generator == 3) {
@@ -246,7 +246,7 @@ static inline void dterm(vec3 *r, int k, double s, double x, double y, double z)
     r->z += term(k + 8, s, x, y, z);
 }
 
-vec3 noise_dvector(vec3 p)
+vec3 shade_noise_dvector(vec3 p)
 {
     noise_init();
     return dnoise(p);
@@ -285,7 +285,7 @@ static vec3 dnoise(vec3 p)
 static inline void solid_setup(double v, int *b0, int *b1, double *r0, double *r1)
 {
     double t = v + ROLLOVER;
-    int it = noise_to_int(floor(t));
+    int it = shade_noise_to_int(floor(t));
     *b0 = it & (SOLID_N - 1);
     *b1 = (*b0 + 1) & (SOLID_N - 1);
     *r0 = t - it;
@@ -325,20 +325,20 @@ static double solid_noise(vec3 p)
 
 /* ------------------------------------------------------------ fractal sums */
 
-double noise_turbulence(vec3 p, int octaves, double omega, double lambda, int generator)
+double shade_noise_turbulence(vec3 p, int octaves, double omega, double lambda, int generator)
 {
     double value;
     if (generator > 1) {
-        value = 2.0 * noise_value(p, generator) - 0.5;
+        value = 2.0 * shade_noise_value(p, generator) - 0.5;
         value = fmin(fmax(value, 0.0), 1.0);
     } else {
-        value = noise_value(p, generator);
+        value = shade_noise_value(p, generator);
     }
     double l = lambda, o = omega;
     for (int i = 2; i <= octaves; i++) {
         vec3 t = v3_scale(p, l);
-        if (generator > 1) value += o * (2.0 * noise_value(t, generator) - 0.5);
-        else value += o * noise_value(t, generator);
+        if (generator > 1) value += o * (2.0 * shade_noise_value(t, generator) - 0.5);
+        else value += o * shade_noise_value(t, generator);
         if (i < octaves) {
             l *= lambda;
             o *= omega;
@@ -347,12 +347,12 @@ double noise_turbulence(vec3 p, int octaves, double omega, double lambda, int ge
     return value;
 }
 
-vec3 noise_dturbulence(vec3 p, int octaves, double omega, double lambda)
+vec3 shade_noise_dturbulence(vec3 p, int octaves, double omega, double lambda)
 {
-    vec3 r = noise_dvector(p);
+    vec3 r = shade_noise_dvector(p);
     double l = lambda, o = omega;
     for (int i = 2; i <= octaves; i++) {
-        vec3 v = noise_dvector(v3_scale(p, l));
+        vec3 v = shade_noise_dvector(v3_scale(p, l));
         r.x += o * v.x;
         r.y += o * v.y;
         r.z += o * v.z;
@@ -366,37 +366,37 @@ vec3 noise_dturbulence(vec3 p, int octaves, double omega, double lambda)
 
 /* ------------------------------------------------------------ waves */
 
-double noise_cycloidal(double x)
+double shade_noise_cycloidal(double x)
 {
     if (x >= 0.0) return sin(((x - floor(x)) * 50000.0) / 50000.0 * TWO_PI);
     return 0.0 - sin(((0.0 - (x + floor(0.0 - x))) * 50000.0) / 50000.0 * TWO_PI);
 }
 
-double noise_triangle_wave(double x)
+double shade_noise_triangle_wave(double x)
 {
     double off = x >= 0.0 ? x - floor(x) : x + 1.0 + floor(fabs(x));
     return off >= 0.5 ? 2.0 * (1.0 - off) : 2.0 * off;
 }
 
-int noise_hash3d(int a, int b, int c)
+int shade_noise_hash3d(int a, int b, int c)
 {
     noise_init();
     return hash_table[hash_table[hash_table[a & 0xfff] ^ (b & 0xfff)] ^ (c & 0xfff)];
 }
 
-double noise_pattern_rand(unsigned long i)
+double shade_noise_pattern_rand(unsigned long i)
 {
     noise_init();
     return pattern_rands[i % RANDS_N];
 }
 
-vec3 noise_wave_source(int i)
+vec3 shade_noise_wave_source(int i)
 {
     noise_init();
     return wave_src[i];
 }
 
-double noise_wave_frequency(int i)
+double shade_noise_wave_frequency(int i)
 {
     noise_init();
     return wave_freq[i];

@@ -7,8 +7,8 @@
  *
  * The tables are generated at first use exactly as POV-Ray defines them
  * (see shade_noise.c for each rule); nothing here is copied from POV-Ray's
- * sources. All functions are thread-safe after noise_init() (called
- * implicitly; cheap after the first call). */
+ * sources. All functions are thread-safe: the tables are built once, on
+ * first use (pthread_once). */
 #ifndef PT_SHADE_NOISE_H
 #define PT_SHADE_NOISE_H
 #include <limits.h>
@@ -18,37 +18,37 @@
  * (cvttsd2si): NaN and values outside int's range give INT_MIN. Patterns use
  * it where coordinates can be arbitrarily large (far points of infinite
  * planes), where a plain C cast would be undefined. */
-static inline int noise_to_int(double x)
+static inline int shade_noise_to_int(double x)
 {
     return (x > -2147483649.0 && x < 2147483648.0) ? (int)x : INT_MIN;
 }
 
 /* POV-Ray's Noise(p, generator): a value in [0, 1]. generator 1..3. */
-double noise_value(vec3 p, int generator);
+double shade_noise_value(vec3 p, int generator);
 /* POV-Ray's DNoise(p): vector noise, components roughly in [-1, 1]. */
-vec3 noise_dvector(vec3 p);
+vec3 shade_noise_dvector(vec3 p);
 
 /* Fractal sums (POV-Ray's Turbulence and DTurbulence) with the given
  * octaves, omega and lambda. */
-double noise_turbulence(vec3 p, int octaves, double omega, double lambda, int generator);
-vec3 noise_dturbulence(vec3 p, int octaves, double omega, double lambda);
+double shade_noise_turbulence(vec3 p, int octaves, double omega, double lambda, int generator);
+vec3 shade_noise_dturbulence(vec3 p, int octaves, double omega, double lambda);
 
 /* sin(2 pi x) as POV-Ray computes it (fraction quantised to 1/50000), and
  * the triangle wave 0..1..0 of period 1. */
-double noise_cycloidal(double x);
-double noise_triangle_wave(double x);
+double shade_noise_cycloidal(double x);
+double shade_noise_triangle_wave(double x);
 
 /* POV-Ray's Hash3d lattice hash (each argument masked to 12 bits): 0..4095. */
-int noise_hash3d(int a, int b, int c);
+int shade_noise_hash3d(int a, int b, int c);
 /* POV-Ray's PatternRands(i): 32768 uniform doubles in [0,1) (mt19937 with its
  * default seed, divided by 2^32), index taken modulo 32768. */
-double noise_pattern_rand(unsigned long i);
+double shade_noise_pattern_rand(unsigned long i);
 
 /* The ripples/waves sources (POV-Ray's number_of_waves, default 10; up to
- * NOISE_MAX_WAVES are generated). */
-#define NOISE_WAVES 10
-#define NOISE_MAX_WAVES 1000
-vec3 noise_wave_source(int i);
-double noise_wave_frequency(int i);
+ * SHADE_NOISE_MAX_WAVES are generated). */
+#define SHADE_NOISE_WAVES 10
+#define SHADE_NOISE_MAX_WAVES 1000
+vec3 shade_noise_wave_source(int i);
+double shade_noise_wave_frequency(int i);
 
 #endif

@@ -29,19 +29,19 @@ static const vec3 pyramid[4] = {{0.942809041, -0.333333333, 0.0},
 
 static inline double pov_floor(double x) { return x >= 0.0 ? floor(x) : (0.0 - floor(0.0 - x) - 1.0); }
 
-vec3 normal_warp(vec3 n, const xform *xf, const xform *outer, const scene_pattern *pat, int dont_scale)
+vec3 shade_normal_warp(vec3 n, const xform *xf, const xform *outer, const scene_pattern *pat, int dont_scale)
 {
     if (!dont_scale) n = v3_norm(n);
-    if (xf) n = pattern_normal_to_pattern(xf, n);
-    if (outer) n = pattern_normal_to_pattern(outer, n);
+    if (xf) n = shade_pattern_normal_to_pattern(xf, n);
+    if (outer) n = shade_pattern_normal_to_pattern(outer, n);
     if (pat)
         for (int i = 0; i < pat->nwarps; i++)
-            if (pat->warps[i].kind == WARP_TRANSFORM) n = pattern_normal_to_pattern(&pat->warps[i].transform, n);
+            if (pat->warps[i].kind == WARP_TRANSFORM) n = shade_pattern_normal_to_pattern(&pat->warps[i].transform, n);
     if (!dont_scale) n = v3_norm(n);
     return n;
 }
 
-vec3 normal_unwarp(vec3 n, const xform *xf, const xform *outer, const scene_pattern *pat, int dont_scale)
+vec3 shade_normal_unwarp(vec3 n, const xform *xf, const xform *outer, const scene_pattern *pat, int dont_scale)
 {
     if (!dont_scale) n = v3_norm(n);
     if (pat)
@@ -66,7 +66,7 @@ static double slope_map(double v, const scene_blend_map *m)
 {
     if (!m || m->kind != MAP_SLOPE) return v;
     int ip, ic;
-    blend_map_search(m, v, &ip, &ic);
+    shade_blend_map_search(m, v, &ip, &ic);
     if (ip == ic) return m->e[ic].height;
     double t = (v - m->e[ip].value) / (m->e[ic].value - m->e[ip].value);
     return hermite(t, m->e[ip].height, m->e[ip].slope, m->e[ic].height, m->e[ic].slope);
@@ -76,22 +76,22 @@ static vec3 waves_normal(const scene_normal *nm, vec3 p, vec3 n, int ripples, in
 {
     const scene_pattern *pat = nm->pat;
     for (int i = 0; i < nw; i++) {
-        vec3 d = v3_sub(p, noise_wave_source(i));
+        vec3 d = v3_sub(p, shade_noise_wave_source(i));
         double len = v3_len(d);
         if (len == 0.0) len = 1.0;
         double s;
         if (ripples) {
-            s = noise_cycloidal(len * pat->frequency + pat->phase) * nm->amount;
+            s = shade_noise_cycloidal(len * pat->frequency + pat->phase) * nm->amount;
         } else {
-            double f = noise_wave_frequency(i);
-            s = noise_cycloidal(len * pat->frequency * f + pat->phase) * nm->amount / f;
+            double f = shade_noise_wave_frequency(i);
+            s = shade_noise_cycloidal(len * pat->frequency * f + pat->phase) * nm->amount / f;
         }
         n = v3_madd(n, d, s / (len * (double)nw));
     }
     return n;
 }
 
-static vec3 perturb(const scene_normal *nm, vec3 n, vec3 p, const xform *xf, const pattern_ctx *c);
+static vec3 perturb(const scene_normal *nm, vec3 n, vec3 p, const xform *xf, const shade_pattern_ctx *c);
 
 /* The bump patterns proper (POV-Ray's normal-only patterns). */
 static int is_bump_pattern(pattern_kind k)
@@ -116,16 +116,16 @@ static vec3 bump_map(const scene_normal *nm, vec3 n, vec3 tp)
 {
     const scene_image_map *im = &nm->pat->image;
     double xc, yc;
-    if (!pattern_image_pos(im, tp, &xc, &yc)) return n;
+    if (!shade_pattern_image_pos(im, tp, &xc, &yc)) return n;
     double w = im->image->width, h = im->image->height, a = nm->amount;
     /* use_index on a palette image: heights are the palette indices */
     int by_index = im->use_index && im->image->indices;
-    double h1 = a * (by_index ? pattern_image_index(im, xc, yc) : grey(pattern_image_at(im, xc, yc)));
+    double h1 = a * (by_index ? shade_pattern_image_index(im, xc, yc) : grey(shade_pattern_image_at(im, xc, yc)));
     xc = wrap_coord(xc - 1.0, w);
     yc = wrap_coord(yc + 1.0, h);
-    double h2 = a * (by_index ? pattern_image_index(im, xc, yc) : grey(pattern_image_at(im, xc, yc)));
+    double h2 = a * (by_index ? shade_pattern_image_index(im, xc, yc) : grey(shade_pattern_image_at(im, xc, yc)));
     xc = wrap_coord(xc + 2.0, w);
-    double h3 = a * (by_index ? pattern_image_index(im, xc, yc) : grey(pattern_image_at(im, xc, yc)));
+    double h3 = a * (by_index ? shade_pattern_image_index(im, xc, yc) : grey(shade_pattern_image_at(im, xc, yc)));
     vec3 p1 = v3(0, h1, 0), p2 = v3(-1, h2, 1), p3 = v3(1, h3, 1);
     vec3 bn = v3_norm(v3_cross(v3_sub(p3, p2), v3_sub(p1, p2)));
     vec3 yp = n, xp = v3_cross(yp, v3(0, 1, 0));
@@ -160,9 +160,9 @@ static vec3 facets(const scene_pattern *pat, vec3 n, vec3 tp)
             for (int az = -2; az <= 2; az++) {
                 if ((abs(ax) == 2) + (abs(ay) == 2) + (abs(az) == 2) > 1) continue;
                 double fx = floor(tv.x + ax - 1.0e-10), fy = floor(tv.y + ay - 1.0e-10), fz = floor(tv.z + az - 1.0e-10);
-                unsigned long seed = (unsigned long)noise_hash3d(noise_to_int(fx) & 0xFFF, noise_to_int(fy) & 0xFFF,
-                                                                 noise_to_int(fz) & 0xFFF);
-                vec3 cp = v3(fx + noise_pattern_rand(seed), fy + noise_pattern_rand(seed + 1), fz + noise_pattern_rand(seed + 2));
+                unsigned long seed = (unsigned long)shade_noise_hash3d(shade_noise_to_int(fx) & 0xFFF, shade_noise_to_int(fy) & 0xFFF,
+                                                                 shade_noise_to_int(fz) & 0xFFF);
+                vec3 cp = v3(fx + shade_noise_pattern_rand(seed), fy + shade_noise_pattern_rand(seed + 1), fz + shade_noise_pattern_rand(seed + 2));
                 vec3 d = v3_sub(cp, tv);
                 double sum;
                 if (metric == 2) sum = d.x * d.x + d.y * d.y + d.z * d.z;
@@ -175,28 +175,28 @@ static vec3 facets(const scene_pattern *pat, vec3 n, vec3 tp)
                 }
             }
     if (pat->facets_coords == 0.0) return pick;
-    vec3 pert = noise_dvector(pick);
+    vec3 pert = shade_noise_dvector(pick);
     pert = v3_sub(pert, v3_scale(n, v3_dot(pert, n)));
     return v3_madd(n, pert, pat->facets_coords);
 }
 
-static vec3 bump_pattern(const scene_normal *nm, vec3 n, vec3 tp, const pattern_ctx *c)
+static vec3 bump_pattern(const scene_normal *nm, vec3 n, vec3 tp, const shade_pattern_ctx *c)
 {
     const scene_pattern *pat = nm->pat;
     int gen = pat->noise_generator ? pat->noise_generator : c->noise_generator;
     switch (pat->kind) {
-    case PAT_BUMPS: return v3_madd(n, noise_dvector(tp), nm->amount);
+    case PAT_BUMPS: return v3_madd(n, shade_noise_dvector(tp), nm->amount);
     case PAT_DENTS: {
-        double v = noise_value(tp, gen);
-        return v3_madd(n, noise_dvector(tp), v * v * v * nm->amount);
+        double v = shade_noise_value(tp, gen);
+        return v3_madd(n, shade_noise_dvector(tp), v * v * v * nm->amount);
     }
-    case PAT_RIPPLES: return waves_normal(nm, tp, n, 1, c->nwaves > 0 ? c->nwaves : NOISE_WAVES);
-    case PAT_WAVES: return waves_normal(nm, tp, n, 0, c->nwaves > 0 ? c->nwaves : NOISE_WAVES);
+    case PAT_RIPPLES: return waves_normal(nm, tp, n, 1, c->nwaves > 0 ? c->nwaves : SHADE_NOISE_WAVES);
+    case PAT_WAVES: return waves_normal(nm, tp, n, 0, c->nwaves > 0 ? c->nwaves : SHADE_NOISE_WAVES);
     case PAT_WRINKLES: {
         vec3 r = v3(0, 0, 0);
         double scale = 1.0;
         for (int i = 0; i < 10; scale *= 2.0, i++) {
-            vec3 v = noise_dvector(v3_scale(tp, scale));
+            vec3 v = shade_noise_dvector(v3_scale(tp, scale));
             r.x += fabs(v.x / scale);
             r.y += fabs(v.y / scale);
             r.z += fabs(v.z / scale);
@@ -229,7 +229,7 @@ static vec3 bump_pattern(const scene_normal *nm, vec3 n, vec3 tp, const pattern_
     }
 }
 
-static vec3 perturb(const scene_normal *nm, vec3 n, vec3 p, const xform *xf, const pattern_ctx *c)
+static vec3 perturb(const scene_normal *nm, vec3 n, vec3 p, const xform *xf, const shade_pattern_ctx *c)
 {
     const scene_pattern *pat = nm->pat;
     if (!pat || pat->kind == PAT_PLAIN) return n;
@@ -244,11 +244,11 @@ static vec3 perturb(const scene_normal *nm, vec3 n, vec3 p, const xform *xf, con
     vec3 q = outer ? xform_inv_point(outer, p) : p;
     const scene_blend_map *m = nm->map;
     if (m && m->kind == MAP_NORMAL && pat->kind != PAT_AVERAGE) {
-        vec3 tp = pattern_warp(pat, q);
-        double v = pattern_value(pat, tp, c);
+        vec3 tp = shade_pattern_warp(pat, q);
+        double v = shade_pattern_value(pat, tp, c);
         int ip, ic;
-        blend_map_search(m, v, &ip, &ic);
-        n = normal_warp(n, xf, outer, pat, ds);
+        shade_blend_map_search(m, v, &ip, &ic);
+        n = shade_normal_warp(n, xf, outer, pat, ds);
         vec3 p1 = n;
         if (m->e[ic].normal) n = perturb(m->e[ic].normal, n, tp, NULL, c);
         if (ip != ic) {
@@ -257,28 +257,28 @@ static vec3 perturb(const scene_normal *nm, vec3 n, vec3 p, const xform *xf, con
             double v1 = 1.0 - v2;
             n = v3_add(v3_scale(p1, v1), v3_scale(n, v2));
         }
-        n = normal_unwarp(n, xf, outer, pat, ds);
+        n = shade_normal_unwarp(n, xf, outer, pat, ds);
         return v3_norm(n);
     }
     if (is_bump_pattern(pat->kind)) {
-        n = normal_warp(n, xf, outer, pat, ds);
-        vec3 tp = pattern_warp(pat, q);
+        n = shade_normal_warp(n, xf, outer, pat, ds);
+        vec3 tp = shade_pattern_warp(pat, q);
         n = bump_pattern(nm, n, tp, c);
-        return normal_unwarp(n, xf, outer, pat, ds);
+        return shade_normal_unwarp(n, xf, outer, pat, ds);
     }
-    n = normal_warp(n, xf, outer, pat, ds);
+    n = shade_normal_warp(n, xf, outer, pat, ds);
     double amount = nm->amount * -5.0;
     amount *= 0.02 / nm->delta;
-    vec3 tp = pattern_warp(pat, q);
+    vec3 tp = shade_pattern_warp(pat, q);
     for (int i = 0; i < 4; i++) {
         vec3 p1 = v3_madd(tp, pyramid[i], nm->delta);
-        double v = slope_map(pattern_value(pat, p1, c), m);
+        double v = slope_map(shade_pattern_value(pat, p1, c), m);
         n = v3_madd(n, pyramid[i], v * amount);
     }
-    return normal_unwarp(n, xf, outer, pat, ds);
+    return shade_normal_unwarp(n, xf, outer, pat, ds);
 }
 
-vec3 normal_perturb(const scene_normal *nm, vec3 n, vec3 p, const xform *xf, const pattern_ctx *c)
+vec3 shade_normal_perturb(const scene_normal *nm, vec3 n, vec3 p, const xform *xf, const shade_pattern_ctx *c)
 {
     if (!nm) return n;
     return perturb(nm, n, p, xf, c);

@@ -13,13 +13,13 @@
  * to p: normals go into pattern space through it (NULL = none). The result
  * is normalised unless no_bump_scale is set (POV-Ray's Perturb_Normal; the
  * caller normalises after it in that case, as POV-Ray does). */
-vec3 normal_perturb(const scene_normal *nm, vec3 n, vec3 p, const xform *xf, const pattern_ctx *c);
+vec3 shade_normal_perturb(const scene_normal *nm, vec3 n, vec3 p, const xform *xf, const shade_pattern_ctx *c);
 
 /* POV-Ray's Warp_Normal / UnWarp_Normal: a normal into / out of the space of
  * a pattern through the owner transform `xf` (may be NULL), an outermost
  * transform `outer` (may be NULL) and the pattern's transform warps (pat may
  * be NULL). Normalised before and after unless dont_scale. */
-vec3 normal_warp(vec3 n, const xform *xf, const xform *outer, const scene_pattern *pat, int dont_scale);
-vec3 normal_unwarp(vec3 n, const xform *xf, const xform *outer, const scene_pattern *pat, int dont_scale);
+vec3 shade_normal_warp(vec3 n, const xform *xf, const xform *outer, const scene_pattern *pat, int dont_scale);
+vec3 shade_normal_unwarp(vec3 n, const xform *xf, const xform *outer, const scene_pattern *pat, int dont_scale);
 
 #endif

@@ -44,20 +44,20 @@ static int pattern_image_colour(const scene_image_map *im, vec3 tp, colour5 *out
 
 static inline double pov_floor(double x) { return x >= 0.0 ? floor(x) : (0.0 - floor(0.0 - x) - 1.0); }
 
-pattern_ctx pattern_ctx_plain(const scene *sc)
+shade_pattern_ctx shade_pattern_ctx_plain(const scene *sc)
 {
-    pattern_ctx c;
+    shade_pattern_ctx c;
     memset(&c, 0, sizeof c);
     int g = sc ? sc->global.noise_generator : 2;
     /* POV-Ray defaults to the original noise for #version < 3.5 scenes */
     if (sc && g == 2 && sc->version_major > 0 && sc->version_major + sc->version_minor / 10.0 < 3.45) g = 1;
     c.noise_generator = g >= 1 && g <= 3 ? g : 2;
     int nw = sc ? sc->global.number_of_waves : 0;
-    c.nwaves = nw <= 0 ? NOISE_WAVES : (nw > NOISE_MAX_WAVES ? NOISE_MAX_WAVES : nw);
+    c.nwaves = nw <= 0 ? SHADE_NOISE_WAVES : (nw > SHADE_NOISE_MAX_WAVES ? SHADE_NOISE_MAX_WAVES : nw);
     return c;
 }
 
-vec3 pattern_normal_to_pattern(const xform *x, vec3 n)
+vec3 shade_pattern_normal_to_pattern(const xform *x, vec3 n)
 {
     /* m^T n: the forward matrix transposed (POV-Ray's row-vector matrix times n). */
     return v3(x->m[0][0] * n.x + x->m[1][0] * n.y + x->m[2][0] * n.z,
@@ -159,7 +159,7 @@ static vec3 warp_repeat(const scene_warp *w, vec3 p)
     int a = w->axis;
     float blk = (float)floor(c[a] / w->width); /* POV-Ray keeps the block number as SNGL */
     r[a] = c[a] - blk * w->width;
-    if (noise_to_int(blk) & 1) {
+    if (shade_noise_to_int(blk) & 1) {
         r[0] *= w->flip.x;
         r[1] *= w->flip.y;
         r[2] *= w->flip.z;
@@ -173,14 +173,14 @@ static vec3 warp_black_hole(const scene_warp *w, vec3 p)
     vec3 centre = w->centre;
     if (w->bh_repeat) {
         int bx = 0, by = 0, bz = 0;
-        if (w->repeat_vec.x >= PAT_EPSILON) bx = noise_to_int(floor(p.x / w->repeat_vec.x));
-        if (w->repeat_vec.y >= PAT_EPSILON) by = noise_to_int(floor(p.y / w->repeat_vec.y));
-        if (w->repeat_vec.z >= PAT_EPSILON) bz = noise_to_int(floor(p.z / w->repeat_vec.z));
+        if (w->repeat_vec.x >= PAT_EPSILON) bx = shade_noise_to_int(floor(p.x / w->repeat_vec.x));
+        if (w->repeat_vec.y >= PAT_EPSILON) by = shade_noise_to_int(floor(p.y / w->repeat_vec.y));
+        if (w->repeat_vec.z >= PAT_EPSILON) bz = shade_noise_to_int(floor(p.z / w->repeat_vec.z));
         if (w->uncertain) {
-            int seed = noise_hash3d(bx, by, bz);
-            centre.x += noise_pattern_rand((unsigned long)seed) * w->uncertainty.x;
-            centre.y += noise_pattern_rand((unsigned long)seed + 1) * w->uncertainty.y;
-            centre.z += noise_pattern_rand((unsigned long)seed + 2) * w->uncertainty.z;
+            int seed = shade_noise_hash3d(bx, by, bz);
+            centre.x += shade_noise_pattern_rand((unsigned long)seed) * w->uncertainty.x;
+            centre.y += shade_noise_pattern_rand((unsigned long)seed + 1) * w->uncertainty.y;
+            centre.z += shade_noise_pattern_rand((unsigned long)seed + 2) * w->uncertainty.z;
         }
         centre.x += w->repeat_vec.x * bx;
         centre.y += w->repeat_vec.y * by;
@@ -195,7 +195,7 @@ static vec3 warp_black_hole(const scene_warp *w, vec3 p)
     return v3_add(p, v3_scale(d, w->inverted ? -s : s));
 }
 
-vec3 pattern_warp(const scene_pattern *pat, vec3 p)
+vec3 shade_pattern_warp(const scene_pattern *pat, vec3 p)
 {
     for (int i = 0; i < pat->nwarps; i++) {
         const scene_warp *w = &pat->warps[i];
@@ -203,7 +203,7 @@ vec3 pattern_warp(const scene_pattern *pat, vec3 p)
         case WARP_TURBULENCE:
             if (w->classic && (pat->kind == PAT_MARBLE || pat->kind == PAT_WOOD || pat->kind == PAT_PLAIN)) break;
             {
-                vec3 t = noise_dturbulence(p, w->octaves, w->omega, w->lambda);
+                vec3 t = shade_noise_dturbulence(p, w->octaves, w->omega, w->lambda);
                 p.x += t.x * w->turbulence.x;
                 p.y += t.y * w->turbulence.y;
                 p.z += t.z * w->turbulence.z;
@@ -238,16 +238,16 @@ static const scene_warp *pattern_classic_turb(const scene_pattern *pat)
 static double turb_scalar(const scene_pattern *pat, vec3 p, int gen)
 {
     const scene_warp *t = pattern_classic_turb(pat);
-    return t ? t->turbulence.x * noise_turbulence(p, t->octaves, t->omega, t->lambda, gen) : 0.0;
+    return t ? t->turbulence.x * shade_noise_turbulence(p, t->octaves, t->omega, t->lambda, gen) : 0.0;
 }
 
 static double agate(const scene_pattern *pat, vec3 p, int gen)
 {
     const scene_warp *t = pattern_classic_turb(pat);
     /* agate always has a classic turbulence record (octaves etc.), default turbulence 0 */
-    double tv = pat->agate_turb * (t ? noise_turbulence(p, t->octaves, t->omega, t->lambda, gen)
-                                     : noise_turbulence(p, 6, 0.5, 2.0, gen));
-    double n = 0.5 * (noise_cycloidal(1.3 * tv + 1.1 * p.z) + 1.0);
+    double tv = pat->agate_turb * (t ? shade_noise_turbulence(p, t->octaves, t->omega, t->lambda, gen)
+                                     : shade_noise_turbulence(p, 6, 0.5, 2.0, gen));
+    double n = 0.5 * (shade_noise_cycloidal(1.3 * tv + 1.1 * p.z) + 1.0);
     if (n < 0.0) return 0.0;
     n = fmin(1.0, n);
     return pow(n, 0.77);
@@ -263,26 +263,26 @@ static double brick(const scene_pattern *pat, vec3 p)
     double bw = pat->brick_size.x, bh = pat->brick_size.y, bd = pat->brick_size.z;
     double mw = pat->mortar / bw, mh = pat->mortar / bh, md = pat->mortar / bd;
     double by = y / bh;
-    by -= (double)noise_to_int(by);
+    by -= (double)shade_noise_to_int(by);
     if (by < 0.0) by += 1.0;
     if (by <= mh) return 0.0;
     by = (y / bh) * 0.5;
-    by -= (double)noise_to_int(by);
+    by -= (double)shade_noise_to_int(by);
     if (by < 0.0) by += 1.0;
     double bx = x / bw;
-    bx -= (double)noise_to_int(bx);
+    bx -= (double)shade_noise_to_int(bx);
     if (bx < 0.0) bx += 1.0;
     if (bx <= mw && by <= 0.5) return 0.0;
     bx = (x / bw) + 0.5;
-    bx -= (double)noise_to_int(bx);
+    bx -= (double)shade_noise_to_int(bx);
     if (bx < 0.0) bx += 1.0;
     if (bx <= mw && by > 0.5) return 0.0;
     double bz = z / bd;
-    bz -= (double)noise_to_int(bz);
+    bz -= (double)shade_noise_to_int(bz);
     if (bz < 0.0) bz += 1.0;
     if (bz <= md && by > 0.5) return 0.0;
     bz = (z / bd) + 0.5;
-    bz -= (double)noise_to_int(bz);
+    bz -= (double)shade_noise_to_int(bz);
     if (bz < 0.0) bz += 1.0;
     if (bz <= md && by <= 0.5) return 0.0;
     return 1.0;
@@ -290,22 +290,22 @@ static double brick(const scene_pattern *pat, vec3 p)
 
 static double cells(vec3 p)
 {
-    int h = noise_hash3d(noise_to_int(floor(p.x + PAT_EPSILON)), noise_to_int(floor(p.y + PAT_EPSILON)),
-                         noise_to_int(floor(p.z + PAT_EPSILON)));
-    return fmin(noise_pattern_rand((unsigned long)h), 1.0);
+    int h = shade_noise_hash3d(shade_noise_to_int(floor(p.x + PAT_EPSILON)), shade_noise_to_int(floor(p.y + PAT_EPSILON)),
+                         shade_noise_to_int(floor(p.z + PAT_EPSILON)));
+    return fmin(shade_noise_pattern_rand((unsigned long)h), 1.0);
 }
 
 static double checker(vec3 p)
 {
-    int v = noise_to_int(floor(p.x + PAT_EPSILON) + floor(p.y + PAT_EPSILON) + floor(p.z + PAT_EPSILON));
+    int v = shade_noise_to_int(floor(p.x + PAT_EPSILON) + floor(p.y + PAT_EPSILON) + floor(p.z + PAT_EPSILON));
     return (v & 1) ? 1.0 : 0.0;
 }
 
 /* One random point in the unit cube at integer corner (x, y, z). */
 static vec3 cube_point(int x, int y, int z)
 {
-    unsigned long seed = (unsigned long)noise_hash3d(x & 0xFFF, y & 0xFFF, z & 0xFFF);
-    return v3(x + noise_pattern_rand(seed), y + noise_pattern_rand(seed + 1), z + noise_pattern_rand(seed + 2));
+    unsigned long seed = (unsigned long)shade_noise_hash3d(x & 0xFFF, y & 0xFFF, z & 0xFFF);
+    return v3(x + shade_noise_pattern_rand(seed), y + shade_noise_pattern_rand(seed + 1), z + shade_noise_pattern_rand(seed + 2));
 }
 
 static double metric_sum(vec3 d, double metric)
@@ -317,8 +317,8 @@ static double metric_sum(vec3 d, double metric)
 
 static double crackle(const scene_pattern *pat, vec3 p, int gen)
 {
-    int fx = noise_to_int(floor(p.x - PAT_EPSILON)), fy = noise_to_int(floor(p.y - PAT_EPSILON)),
-        fz = noise_to_int(floor(p.z - PAT_EPSILON));
+    int fx = shade_noise_to_int(floor(p.x - PAT_EPSILON)), fy = shade_noise_to_int(floor(p.y - PAT_EPSILON)),
+        fz = shade_noise_to_int(floor(p.z - PAT_EPSILON));
     double metric = pat->crackle_metric;
     /* The 81 cubes within a "3D knight move" (offsets -2..2 with at most one
      * coordinate of magnitude 2), in POV-Ray's table order. */
@@ -358,7 +358,7 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
         m3 += a;
     }
     vec3 f = pat->crackle_form;
-    if (pat->crackle_solid) t = noise_value(pts[mi], gen);
+    if (pat->crackle_solid) t = shade_noise_value(pts[mi], gen);
     else if (metric == 2) t = f.x * sqrt(m1) + f.y * sqrt(m2) + f.z * sqrt(m3);
     else if (metric == 1) t = f.x * m1 + f.y * m2 + f.z * m3;
     else t = f.x * pow(m1, 1.0 / metric) + f.y * pow(m2, 1.0 / metric) + f.z * pow(m3, 1.0 / metric);
@@ -373,9 +373,9 @@ static double granite(vec3 p, int gen)
         vec3 tv2 = v3_scale(tv1, freq);
         double t;
         if (gen == 1) {
-            t = fabs(0.5 - noise_value(tv2, gen));
+            t = fabs(0.5 - shade_noise_value(tv2, gen));
         } else {
-            t = fabs(1.0 - 2.0 * noise_value(tv2, gen));
+            t = fabs(1.0 - 2.0 * shade_noise_value(tv2, gen));
             if (t > 0.5) t = 0.5;
         }
         noise += t / freq;
@@ -391,7 +391,7 @@ static double hexagon(vec3 p)
     double xs = x / xf, zs = z / zf;
     xs -= floor(xs / 6.0) * 6.0;
     zs -= floor(zs / 6.0) * 6.0;
-    int xm = noise_to_int(pov_floor(xs)) % 6, zm = noise_to_int(pov_floor(zs)) % 6;
+    int xm = shade_noise_to_int(pov_floor(xs)) % 6, zm = shade_noise_to_int(pov_floor(zs)) % 6;
     double v = 0.0;
     switch (xm) {
     case 0: case 5:
@@ -414,7 +414,7 @@ static double hexagon(vec3 p)
 
 static double square_pat(vec3 p)
 {
-    int vx = noise_to_int(floor(p.x)), vz = noise_to_int(floor(p.z));
+    int vx = shade_noise_to_int(floor(p.x)), vz = shade_noise_to_int(floor(p.z));
     if (vx & 1) return (vz & 1) ? 2.0 : 3.0;
     return (vz & 1) ? 1.0 : 0.0;
 }
@@ -423,7 +423,7 @@ static double triangular(vec3 p)
 {
     const double sqrt3 = 1.7320508075688772935274463415059, sqrt3_2 = 0.86602540378443864676372317075294;
     double xs = p.x - 3.0 * floor(p.x / 3.0), zs = p.z - sqrt3 * floor(p.z / sqrt3);
-    int a = noise_to_int(floor(xs));
+    int a = shade_noise_to_int(floor(xs));
     xs -= a;
     int b = zs < sqrt3_2 ? 0 : 1;
     if (b) zs = sqrt3 - zs;
@@ -478,9 +478,9 @@ static double ripples(const scene_pattern *pat, vec3 p, int nw)
 {
     double s = 0.0;
     for (int i = 0; i < nw; i++) {
-        double len = v3_len(v3_sub(p, noise_wave_source(i)));
+        double len = v3_len(v3_sub(p, shade_noise_wave_source(i)));
         if (len == 0.0) len = 1.0;
-        s += noise_cycloidal(len * pat->frequency + pat->phase);
+        s += shade_noise_cycloidal(len * pat->frequency + pat->phase);
     }
     return 0.5 * (1.0 + (s / (double)nw));
 }
@@ -489,10 +489,10 @@ static double waves(const scene_pattern *pat, vec3 p, int nw)
 {
     double s = 0.0;
     for (int i = 0; i < nw; i++) {
-        double len = v3_len(v3_sub(p, noise_wave_source(i)));
+        double len = v3_len(v3_sub(p, shade_noise_wave_source(i)));
         if (len == 0.0) len = 1.0;
-        double f = noise_wave_frequency(i);
-        s += noise_cycloidal(len * pat->frequency * f + pat->phase) / f;
+        double f = shade_noise_wave_frequency(i);
+        s += shade_noise_cycloidal(len * pat->frequency * f + pat->phase) / f;
     }
     return 0.2 * (2.5 + (s / (double)nw));
 }
@@ -516,8 +516,8 @@ static double spiral2(const scene_pattern *pat, vec3 p, int gen)
     double tv = turb_scalar(pat, p, gen);
     double rad = sqrt(p.x * p.x + p.y * p.y);
     double phi = spiral_phi(p.x, p.y, rad);
-    tv = noise_triangle_wave(p.z + rad + (double)pat->arms * phi / TWO_PI + tv);
-    return noise_triangle_wave(rad) + tv;
+    tv = shade_noise_triangle_wave(p.z + rad + (double)pat->arms * phi / TWO_PI + tv);
+    return shade_noise_triangle_wave(rad) + tv;
 }
 
 static double wood(const scene_pattern *pat, vec3 p)
@@ -525,9 +525,9 @@ static double wood(const scene_pattern *pat, vec3 p)
     const scene_warp *t = pattern_classic_turb(pat);
     double px = 0.0, py = 0.0;
     if (t) {
-        vec3 wt = noise_dturbulence(p, t->octaves, t->omega, t->lambda);
-        px = noise_cycloidal((p.x + wt.x) * t->turbulence.x);
-        py = noise_cycloidal((p.y + wt.y) * t->turbulence.y);
+        vec3 wt = shade_noise_dturbulence(p, t->octaves, t->omega, t->lambda);
+        px = shade_noise_cycloidal((p.x + wt.x) * t->turbulence.x);
+        py = shade_noise_cycloidal((p.y + wt.y) * t->turbulence.y);
     }
     px += p.x;
     py += p.y;
@@ -537,12 +537,12 @@ static double wood(const scene_pattern *pat, vec3 p)
 static double wrinkles(vec3 p, int gen)
 {
     double lambda = 2.0, omega = 0.5, value;
-    if (gen > 1) value = fmin(fmax(noise_value(p, gen) * 2.0 - 0.5, 0.0), 1.0);
-    else value = noise_value(p, gen);
+    if (gen > 1) value = fmin(fmax(shade_noise_value(p, gen) * 2.0 - 0.5, 0.0), 1.0);
+    else value = shade_noise_value(p, gen);
     for (int i = 1; i < 10; i++) {
         vec3 t = v3_scale(p, lambda);
-        if (gen > 1) value += omega * fmin(fmax(noise_value(t, gen) * 2.0 - 0.5, 0.0), 1.0);
-        else value += omega * noise_value(t, gen);
+        if (gen > 1) value += omega * fmin(fmax(shade_noise_value(t, gen) * 2.0 - 0.5, 0.0), 1.0);
+        else value += omega * shade_noise_value(t, gen);
         lambda *= 2.0;
         omega *= 0.5;
     }
@@ -677,7 +677,7 @@ static double magnet(const scene_pattern *pat, vec3 p)
     return fractal_interior(pat, a, b, mindist2);
 }
 
-static double slope(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
+static double slope(const scene_pattern *pat, vec3 p, const shade_pattern_ctx *c)
 {
     if (!c->has_hit) return 0.0;
     double v;
@@ -699,7 +699,7 @@ static double slope(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
     return value < 0.0 ? 1.0 + fmod(value, 1.0) : fmod(value, 1.0);
 }
 
-static double aoi(const pattern_ctx *c)
+static double aoi(const shade_pattern_ctx *c)
 {
     if (!c->has_hit) return 0.0;
     double ca = v3_dot(v3_norm(c->normal), v3_norm(c->dir));
@@ -806,12 +806,12 @@ static int object_inside(const scene_object *o, vec3 p, int depth)
     return (o->flags & OBJ_INVERSE) ? !in : in;
 }
 
-static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
+static double raw_value(const scene_pattern *pat, vec3 p, const shade_pattern_ctx *c)
 {
     int gen = pat->noise_generator ? pat->noise_generator : c->noise_generator;
     switch (pat->kind) {
     case PAT_AGATE: return agate(pat, p, gen);
-    case PAT_BOZO: case PAT_SPOTTED: case PAT_BUMPS: return noise_value(p, gen);
+    case PAT_BOZO: case PAT_SPOTTED: case PAT_BUMPS: return shade_noise_value(p, gen);
     case PAT_BRICK: return brick(pat, p);
     case PAT_CELLS: return cells(p);
     case PAT_CHECKER: return checker(p);
@@ -835,11 +835,11 @@ static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
     case PAT_SPIRAL1: return spiral1(pat, p, gen);
     case PAT_SPIRAL2: return spiral2(pat, p, gen);
     case PAT_WOOD: return wood(pat, p);
-    case PAT_WAVES: return waves(pat, p, c->nwaves > 0 ? c->nwaves : NOISE_WAVES);
-    case PAT_RIPPLES: return ripples(pat, p, c->nwaves > 0 ? c->nwaves : NOISE_WAVES);
+    case PAT_WAVES: return waves(pat, p, c->nwaves > 0 ? c->nwaves : SHADE_NOISE_WAVES);
+    case PAT_RIPPLES: return ripples(pat, p, c->nwaves > 0 ? c->nwaves : SHADE_NOISE_WAVES);
     case PAT_WRINKLES: return wrinkles(p, gen);
     case PAT_DENTS: {
-        double n = noise_value(p, gen);
+        double n = shade_noise_value(p, gen);
         return n * n * n;
     }
     case PAT_QUILTED: return quilted(pat, p);
@@ -849,7 +849,7 @@ static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
     case PAT_CYLINDRICAL: return clip_density(sqrt(p.x * p.x + p.z * p.z));
     case PAT_PIGMENT: {
         colour5 col;
-        if (!pat->pigment || !pigment_eval(pat->pigment, p, c, &col)) return 0.0;
+        if (!pat->pigment || !shade_pigment_eval(pat->pigment, p, c, &col)) return 0.0;
         return GREY(col.r, col.g, col.b);
     }
     case PAT_IMAGE: {
@@ -870,11 +870,11 @@ static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
     case PAT_SLOPE: return slope(pat, p, c);
     case PAT_MANDEL: case PAT_JULIA: return pat->magnet ? magnet(pat, p) : mandel_julia(pat, p);
     case PAT_AOI: return aoi(c);
-    case PAT_TILING: return tiling_value(pat->tiling, p);
+    case PAT_TILING: return shade_tiling_value(pat->tiling, p);
     case PAT_PAVEMENT: {
-        pavement_params pv = {pat->pave_sides, pat->pave_tiles, pat->pave_number,
+        shade_pavement_params pv = {pat->pave_sides, pat->pave_tiles, pat->pave_number,
                               pat->pave_exterior, pat->pave_interior, pat->pave_form};
-        return pavement_value(&pv, p);
+        return shade_pavement_value(&pv, p);
     }
     case PAT_DENSITY: return density(pat, p);
     case PAT_OBJECT: return pat->object && object_inside(pat->object, p, 0) ? 1.0 : 0.0;
@@ -882,16 +882,16 @@ static double raw_value(const scene_pattern *pat, vec3 p, const pattern_ctx *c)
     }
 }
 
-double pattern_value(const scene_pattern *pat, vec3 tp, const pattern_ctx *c)
+double shade_pattern_value(const scene_pattern *pat, vec3 tp, const shade_pattern_ctx *c)
 {
     double v = raw_value(pat, tp, c);
     if (pat->frequency != 0.0) v = fmod(v * pat->frequency + pat->phase, 1.00001);
     if (v < 0.0) v -= floor(v);
     switch (pat->wave) {
     case WAVE_RAMP: break;
-    case WAVE_SINE: v = (1.0 + noise_cycloidal(v)) * 0.5; break;
-    case WAVE_TRIANGLE: v = noise_triangle_wave(v); break;
-    case WAVE_SCALLOP: v = fabs(noise_cycloidal(v * 0.5)); break;
+    case WAVE_SINE: v = (1.0 + shade_noise_cycloidal(v)) * 0.5; break;
+    case WAVE_TRIANGLE: v = shade_noise_triangle_wave(v); break;
+    case WAVE_SCALLOP: v = fabs(shade_noise_cycloidal(v * 0.5)); break;
     case WAVE_CUBIC: v = v * v * ((-2.0 * v) + 3.0); break;
     case WAVE_POLY: v = pow(v, pat->exponent); break;
     }
@@ -949,7 +949,7 @@ static const scene_blend_map *pattern_default_map(pattern_kind k)
     }
 }
 
-void blend_map_search(const scene_blend_map *m, double v, int *prev, int *cur)
+void shade_blend_map_search(const scene_blend_map *m, double v, int *prev, int *cur)
 {
     /* a map has at least one entry (the parser refuses an empty one) */
     assert(m->n >= 1 && m->e);
@@ -981,7 +981,7 @@ static colour5 entry_colour(const scene_map_entry *e)
     return c;
 }
 
-int pigment_eval(const scene_pigment *pg, vec3 p, const pattern_ctx *c, colour5 *out)
+int shade_pigment_eval(const scene_pigment *pg, vec3 p, const shade_pattern_ctx *c, colour5 *out)
 {
     if (pg->kind != PIGMENT_PATTERN || !pg->pat) {
         *out = pg->colour;
@@ -992,7 +992,7 @@ int pigment_eval(const scene_pigment *pg, vec3 p, const pattern_ctx *c, colour5 
      * pigment at the hit's <u, v, 0> (pigment.cpp), its own transforms only */
     if (pat->uv_mapping && c && c->has_uv) p = v3(c->uv[0], c->uv[1], 0.0);
     vec3 q = xform_is_identity(&pg->transform) ? p : xform_inv_point(&pg->transform, p);
-    vec3 tp = pattern_warp(pat, q);
+    vec3 tp = shade_pattern_warp(pat, q);
     if (pat->kind == PAT_IMAGE && !pg->map) return pattern_image_colour(&pat->image, tp, out);
     const scene_blend_map *m = pg->map ? pg->map : pattern_default_map(pat->kind);
     if (!pg->map && pat->kind == PAT_MANDEL && (pat->magnet || pat->fractal_exponent != 2)) m = &grey_map;
@@ -1002,7 +1002,7 @@ int pigment_eval(const scene_pigment *pg, vec3 p, const pattern_ctx *c, colour5 
         for (int i = 0; i < m->n; i++) {
             colour5 lc = {0, 0, 0, 0, 0};
             float w = (float)m->e[i].value;
-            if (m->kind == MAP_PIGMENT && m->e[i].pigment) pigment_eval(m->e[i].pigment, tp, c, &lc);
+            if (m->kind == MAP_PIGMENT && m->e[i].pigment) shade_pigment_eval(m->e[i].pigment, tp, c, &lc);
             else lc = entry_colour(&m->e[i]);
             acc.r += lc.r * w; acc.g += lc.g * w; acc.b += lc.b * w; acc.f += lc.f * w; acc.t += lc.t * w;
             total += w;
@@ -1013,20 +1013,20 @@ int pigment_eval(const scene_pigment *pg, vec3 p, const pattern_ctx *c, colour5 
         *out = acc;
         return 1;
     }
-    double v = pattern_value(pat, tp, c);
+    double v = shade_pattern_value(pat, tp, c);
     int ip, ic;
-    blend_map_search(m, v, &ip, &ic);
+    shade_blend_map_search(m, v, &ip, &ic);
     int found = 0;
     colour5 col = {0, 0, 0, 0, 0}, prev = {0, 0, 0, 0, 0};
     if (m->kind == MAP_PIGMENT) {
-        if (m->e[ic].pigment && pigment_eval(m->e[ic].pigment, tp, c, &col)) found = 1;
+        if (m->e[ic].pigment && shade_pigment_eval(m->e[ic].pigment, tp, c, &col)) found = 1;
     } else {
         col = entry_colour(&m->e[ic]);
         found = 1;
     }
     if (ip != ic) {
         if (m->kind == MAP_PIGMENT) {
-            if (m->e[ip].pigment && pigment_eval(m->e[ip].pigment, tp, c, &prev)) found = 1;
+            if (m->e[ip].pigment && shade_pigment_eval(m->e[ip].pigment, tp, c, &prev)) found = 1;
         } else {
             prev = entry_colour(&m->e[ip]);
         }
@@ -1104,11 +1104,11 @@ static colour5 pixel(const scene_image_map *im, double xc, double yc)
     const scene_image *img = im->image;
     int ix, iy;
     if (im->once) {
-        ix = xc < 0.0 ? 0 : (xc >= img->width ? img->width - 1 : noise_to_int(xc));
-        iy = yc < 0.0 ? 0 : (yc >= img->height ? img->height - 1 : noise_to_int(yc));
+        ix = xc < 0.0 ? 0 : (xc >= img->width ? img->width - 1 : shade_noise_to_int(xc));
+        iy = yc < 0.0 ? 0 : (yc >= img->height ? img->height - 1 : shade_noise_to_int(yc));
     } else {
-        ix = noise_to_int(wrap_to(xc, img->width));
-        iy = noise_to_int(wrap_to(yc, img->height));
+        ix = shade_noise_to_int(wrap_to(xc, img->width));
+        iy = shade_noise_to_int(wrap_to(yc, img->height));
     }
     if (ix < 0 || ix >= img->width) ix = 0; /* NaN coordinates */
     if (iy < 0 || iy >= img->height) iy = 0;
@@ -1119,17 +1119,17 @@ static colour5 pixel(const scene_image_map *im, double xc, double yc)
     return c;
 }
 
-int pattern_image_index(const scene_image_map *im, double xc, double yc)
+int shade_pattern_image_index(const scene_image_map *im, double xc, double yc)
 {
     const scene_image *img = im->image;
     if (!img || !img->indices) return -1;
-    int ix = noise_to_int(wrap_to(xc, img->width)), iy = noise_to_int(wrap_to(yc, img->height));
+    int ix = shade_noise_to_int(wrap_to(xc, img->width)), iy = shade_noise_to_int(wrap_to(yc, img->height));
     if (ix < 0 || ix >= img->width) ix = 0;
     if (iy < 0 || iy >= img->height) iy = 0;
     return img->indices[(size_t)iy * img->width + ix];
 }
 
-int pattern_image_pos(const scene_image_map *im, vec3 tp, double *x, double *y)
+int shade_pattern_image_pos(const scene_image_map *im, vec3 tp, double *x, double *y)
 {
     if (!im->image || !im->image->pixels) return 0;
     double xc = 0.0, yc = 0.0;
@@ -1149,11 +1149,11 @@ static int pattern_image_colour(const scene_image_map *im, vec3 tp, colour5 *out
 {
     colour5 clear = {1, 1, 1, 0, 1};
     double xc, yc;
-    if (!pattern_image_pos(im, tp, &xc, &yc)) {
+    if (!shade_pattern_image_pos(im, tp, &xc, &yc)) {
         *out = clear;
         return 0;
     }
-    *out = pattern_image_at(im, xc, yc);
+    *out = shade_pattern_image_at(im, xc, yc);
     return 1;
 }
 
@@ -1168,12 +1168,12 @@ static void cubic_weights(double x, double f[4])
     f[3] = -0.5 * q * p * p;
 }
 
-colour5 pattern_image_at(const scene_image_map *im, double xc, double yc)
+colour5 shade_pattern_image_at(const scene_image_map *im, double xc, double yc)
 {
     if (im->interpolate == 3) {
         xc += 0.5;
         yc += 0.5;
-        int ix = noise_to_int(xc), iy = noise_to_int(yc);
+        int ix = shade_noise_to_int(xc), iy = shade_noise_to_int(yc);
         double fx[4], fy[4];
         cubic_weights(xc, fx);
         cubic_weights(yc, fy);
@@ -1191,7 +1191,7 @@ colour5 pattern_image_at(const scene_image_map *im, double xc, double yc)
     if (im->interpolate != 2 && im->interpolate != 4) return pixel(im, xc, yc);
     xc += 0.5;
     yc += 0.5;
-    int ix = noise_to_int(xc), iy = noise_to_int(yc);
+    int ix = shade_noise_to_int(xc), iy = shade_noise_to_int(yc);
     colour5 cc[4] = {pixel(im, ix, iy), pixel(im, ix - 1.0, iy), pixel(im, ix, iy - 1.0), pixel(im, ix - 1.0, iy - 1.0)};
     double pp = xc - ix, q = yc - iy, f[4];
     if (im->interpolate == 2) {

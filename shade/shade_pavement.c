@@ -123,7 +123,7 @@ static const struct { double x, y; int bit; } sq_corner[4] = {
 };
 
 /* Value inside a square cell from its code; (x, y) in [0, 1)^2. */
-static double square_cell(int how, double x, double y, const pavement_params *pv)
+static double square_cell(int how, double x, double y, const shade_pavement_params *pv)
 {
     /* `form`: a cell with two adjacent border edges and the opposite
      * corner concave is where a one-cell-wide tile turns; its value is
@@ -307,7 +307,7 @@ static int hexagon_code(int tiles, int num, long xv, long zv)
 /* Value inside the folded triangle from its code. `hex` enables the
  * polyhex corner bits and disables `exterior` (POV-Ray's polyhexes have
  * none). */
-static double triangle_cell(int how, double x, double z, const pavement_params *pv, int hex)
+static double triangle_cell(int how, double x, double z, const shade_pavement_params *pv, int hex)
 {
     double r = 0.0;
     if (how & 0x01) r = fmax(r, 1.0 - fabs(R3 * x - z) * R3);
@@ -389,7 +389,7 @@ static double triangle_cell(int how, double x, double z, const pavement_params *
 
 /* ------------------------------------------------------------------ entry */
 
-double pavement_value(const pavement_params *pv, vec3 p)
+double shade_pavement_value(const shade_pavement_params *pv, vec3 p)
 {
     /* lattice indices are longs: beyond 1e9 units (and for NaN) they would
      * overflow; POV-Ray's result is undefined there, this gives 0 */

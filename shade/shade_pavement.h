@@ -12,10 +12,10 @@ typedef struct {
     int exterior; /* convex corners: 0 sharp, 1 cut, 2 rounded */
     int interior; /* concave corners: 0 sharp, 1 cut, 2 rounded */
     int form;     /* turning cells: 0 sharp, 1 cut, 2 rounded, 3 none */
-} pavement_params;
+} shade_pavement_params;
 
 /* Value of the pavement at p, in [0, 1]; 0 for a pattern number that does
  * not exist for the sides and tiles given (the parser reports those). */
-double pavement_value(const pavement_params *pv, vec3 p);
+double shade_pavement_value(const shade_pavement_params *pv, vec3 p);
 
 #endif

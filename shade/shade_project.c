@@ -6,26 +6,26 @@
 #include <string.h>
 #include "accel.h"
 
-struct light_projection {
+struct shade_light_projection {
     int nlights;
     accel **acc;    /* per light, NULL without projected_through */
     scene *copies;  /* per light: the one-object scenes the accels point into */
     scene_object **objs;
 };
 
-light_projection *projection_build(const scene *sc, diag *d)
+shade_light_projection *shade_projection_build(const scene *sc, diag *d)
 {
     int any = 0;
     for (int i = 0; i < sc->nlights; i++) any |= sc->lights[i].projected_through != NULL;
     if (!any) return NULL;
-    light_projection *lp = calloc(1, sizeof *lp);
+    shade_light_projection *lp = calloc(1, sizeof *lp);
     if (!lp) return NULL;
     lp->nlights = sc->nlights;
     lp->acc = calloc((size_t)sc->nlights, sizeof *lp->acc);
     lp->copies = calloc((size_t)sc->nlights, sizeof *lp->copies);
     lp->objs = calloc((size_t)sc->nlights, sizeof *lp->objs);
     if (!lp->acc || !lp->copies || !lp->objs) {
-        projection_free(lp);
+        shade_projection_free(lp);
         return NULL;
     }
     for (int i = 0; i < sc->nlights; i++) {
@@ -44,7 +44,7 @@ light_projection *projection_build(const scene *sc, diag *d)
     return lp;
 }
 
-void projection_free(light_projection *lp)
+void shade_projection_free(shade_light_projection *lp)
 {
     if (!lp) return;
     if (lp->acc)
@@ -55,7 +55,7 @@ void projection_free(light_projection *lp)
     free(lp);
 }
 
-int projection_pass(const light_projection *lp, int light, vec3 p, vec3 dir, double depth, double *shadow_depth)
+int shade_projection_pass(const shade_light_projection *lp, int light, vec3 p, vec3 dir, double depth, double *shadow_depth)
 {
     *shadow_depth = depth;
     if (!lp || light < 0 || light >= lp->nlights || !lp->acc[light]) return 1;

@@ -7,17 +7,17 @@
 #include "diag.h"
 #include "scene.h"
 
-typedef struct light_projection light_projection;
+typedef struct shade_light_projection shade_light_projection;
 
 /* One Embree scene per projected_through object of the scene's lights;
  * NULL when no light has one (or on failure, with a warning in d). */
-light_projection *projection_build(const scene *sc, diag *d);
-void projection_free(light_projection *lp);
+shade_light_projection *shade_projection_build(const scene *sc, diag *d);
+void shade_projection_free(shade_light_projection *lp);
 
 /* Light `light` seen from p along unit dir, the light at distance depth:
  * returns 0 when the projected object is not crossed before the light (no
  * light arrives), else 1 with *shadow_depth the distance shadows are tested
  * over (the first crossing for a projected light, depth for the others). */
-int projection_pass(const light_projection *lp, int light, vec3 p, vec3 dir, double depth, double *shadow_depth);
+int shade_projection_pass(const shade_light_projection *lp, int light, vec3 p, vec3 dir, double depth, double *shadow_depth);
 
 #endif

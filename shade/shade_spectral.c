@@ -80,7 +80,7 @@ static void build_hue_table(void)
     }
 }
 
-rgb spectral_hue_integral(double wavelength)
+rgb shade_spectral_hue_integral(double wavelength)
 {
     pthread_once(&hue_once, build_hue_table);
     double off = (wavelength - HUE_BASE) / HUE_STEP;
@@ -95,24 +95,24 @@ rgb spectral_hue_integral(double wavelength)
     return c;
 }
 
-spectral_band spectral_band_of(unsigned i, unsigned n)
+shade_spectral_band shade_spectral_band_of(unsigned i, unsigned n)
 {
-    spectral_band b;
+    shade_spectral_band b;
     b.wavelength = (float)(SPEC_VIOLET + SPEC_WIDTH * (((float)i + 0.5) / (float)n));
     b.bandwidth = (float)(SPEC_WIDTH / (float)n);
     return b;
 }
 
-double spectral_ior(float wavelength, double ior, double disp)
+double shade_spectral_ior(float wavelength, double ior, double disp)
 {
     return ior * pow(disp, -((double)wavelength - SPEC_CENTRE) / SPEC_WIDTH);
 }
 
-rgb spectral_hue(spectral_band b)
+rgb shade_spectral_hue(shade_spectral_band b)
 {
     float half = b.bandwidth / 2.0f;
-    rgb hi = spectral_hue_integral((double)(b.wavelength + half));
-    rgb lo = spectral_hue_integral((double)(b.wavelength - half));
+    rgb hi = shade_spectral_hue_integral((double)(b.wavelength + half));
+    rgb lo = shade_spectral_hue_integral((double)(b.wavelength - half));
     double s = SPEC_WIDTH / (double)b.bandwidth;
     rgb c = {(hi.r - lo.r) * s, (hi.g - lo.g) * s, (hi.b - lo.b) * s};
     return c;

@@ -11,20 +11,20 @@
 typedef struct {
     float wavelength;
     float bandwidth;
-} spectral_band;
+} shade_spectral_band;
 
 /* Element i (0 = violet end) of n equal bands of 380..730 nm. */
-spectral_band spectral_band_of(unsigned i, unsigned n);
+shade_spectral_band shade_spectral_band_of(unsigned i, unsigned n);
 
 /* The ior ratio `ior` (outside/inside as the refraction uses it) corrected
  * for a band of the given wavelength with the dispersion ratio `disp`. */
-double spectral_ior(float wavelength, double ior, double disp);
+double shade_spectral_ior(float wavelength, double ior, double disp);
 
 /* The RGB weight of a band: the hue integral over the band, scaled so that
  * the bands of a full set average to (nearly) white. */
-rgb spectral_hue(spectral_band b);
+rgb shade_spectral_hue(shade_spectral_band b);
 
 /* The cumulative hue table value at a wavelength (exposed for tests). */
-rgb spectral_hue_integral(double wavelength);
+rgb shade_spectral_hue_integral(double wavelength);
 
 #endif

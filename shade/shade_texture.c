@@ -66,7 +66,7 @@ typedef struct {
 
 /* What stays the same for every texture evaluated at one hit. */
 typedef struct {
-    const tex_env *e;
+    const shade_tex_env *e;
     const accel_hit *h;
     vec3 dir;
     vec3 raw;        /* raw normal facing the viewer */
@@ -78,7 +78,7 @@ typedef struct {
     unsigned skip;
     float wavelength; /* the incoming ray's band, 0 = all colours */
     double version;
-    pattern_ctx pc;
+    shade_pattern_ctx pc;
 } hit_info;
 
 static double scene_version(const scene *sc)
@@ -96,7 +96,7 @@ static vec3 texture_point(const accel_hit *h)
     return h->p;
 }
 
-static void ctx_from_hit(pattern_ctx *pc, const accel_hit *h)
+static void ctx_from_hit(shade_pattern_ctx *pc, const accel_hit *h)
 {
     pc->ipoint = h->p;
     pc->has_hit = 1;
@@ -108,7 +108,7 @@ static void ctx_from_hit(pattern_ctx *pc, const accel_hit *h)
 /* A texture's point in its own space; `texture { uv_mapping .. }` (or a
  * patterned texture whose pattern has uv_mapping) starts from the hit's
  * <u, v, 0> instead (POV-Ray's UV_MAP_PATTERN in trace.cpp). */
-static vec3 to_texture_space_at(const scene_texture *t, vec3 p, const pattern_ctx *pc)
+static vec3 to_texture_space_at(const scene_texture *t, vec3 p, const shade_pattern_ctx *pc)
 {
     if ((t->uv_mapping || (t->pat && t->pat->uv_mapping)) && pc && pc->has_uv) p = v3(pc->uv[0], pc->uv[1], 0.0);
     return xform_is_identity(&t->transform) ? p : xform_inv_point(&t->transform, p);
@@ -120,19 +120,19 @@ static vec3 layer_normal(const hit_info *hi, const scene_texture *layer, vec3 po
 {
     vec3 n = hi->raw;
     if (!layer->normal || !layer->normal->pat || layer->normal->pat->kind == PAT_PLAIN) return n;
-    for (int i = 0; i < npf; i++) n = normal_warp(n, pf[i].xf, NULL, pf[i].pat, 0);
+    for (int i = 0; i < npf; i++) n = shade_normal_warp(n, pf[i].xf, NULL, pf[i].pat, 0);
     vec3 tp = to_texture_space_at(layer, point, &hi->pc);
-    n = normal_perturb(layer->normal, n, tp, xform_is_identity(&layer->transform) ? NULL : &layer->transform, &hi->pc);
+    n = shade_normal_perturb(layer->normal, n, tp, xform_is_identity(&layer->transform) ? NULL : &layer->transform, &hi->pc);
     if (layer->normal->no_bump_scale) n = v3_norm(n);
-    for (int i = npf - 1; i >= 0; i--) n = normal_unwarp(n, pf[i].xf, NULL, pf[i].pat, 0);
+    for (int i = npf - 1; i >= 0; i--) n = shade_normal_unwarp(n, pf[i].xf, NULL, pf[i].pat, 0);
     return v3_norm(n);
 }
 
 static int layer_pigment(const hit_info *hi, const scene_texture *layer, vec3 point, vec3 n, colour5 *out)
 {
-    pattern_ctx pc = hi->pc;
+    shade_pattern_ctx pc = hi->pc;
     pc.normal = n;
-    return pigment_eval(&layer->pigment, to_texture_space_at(layer, point, &hi->pc), &pc, out);
+    return shade_pigment_eval(&layer->pigment, to_texture_space_at(layer, point, &hi->pc), &pc, out);
 }
 
 /* POV-Ray's ComputeReflection direction: mirror about n, fixed with the raw
@@ -152,11 +152,11 @@ static vec3 reflect_dir(vec3 d, vec3 n, vec3 raw)
  * 3.7's ComputeReflection does (f may be NULL). */
 static rgb trace_reflection(const hit_info *hi, vec3 n, double weight, const scene_finish *f)
 {
-    const tex_env *e = hi->e;
+    const shade_tex_env *e = hi->e;
     if (weight < e->sc->global.adc_bailout) return trgb(0, 0, 0);
     vec3 rd = reflect_dir(hi->dir, n, hi->raw);
     rgb c = e->trace(e->ctx, e->thread, hi->p_out, rd, hi->level + 1, weight, OBJ_NO_REFLECTION, hi->wavelength, e->r);
-    if (f && f->irid > 0.0) c = tmul(c, light_irid(f, rd, hi->dir, n, hi->pc.ipoint, &e->sc->global));
+    if (f && f->irid > 0.0) c = tmul(c, shade_light_irid(f, rd, hi->dir, n, hi->pc.ipoint, &e->sc->global));
     return c;
 }
 
@@ -199,7 +199,7 @@ static rgb reflectivity(const hit_info *hi, const scene_finish *f, double cos_i,
 static int refract_one(const hit_info *hi, vec3 top, double eta, double n, vec3 local, double weight, float wavelength,
                        rgb *colour)
 {
-    const tex_env *e = hi->e;
+    const shade_tex_env *e = hi->e;
     double t = 1.0 + eta * eta * (n * n - 1.0);
     if (t < 0.0) {
         *colour = trace_reflection(hi, top, weight, NULL);
@@ -216,7 +216,7 @@ static int refract_one(const hit_info *hi, vec3 top, double eta, double n, vec3 
  * total internal reflection (colour then holds the reflected radiance). */
 static int refraction(const hit_info *hi, vec3 top, double weight, rgb *colour)
 {
-    const tex_env *e = hi->e;
+    const shade_tex_env *e = hi->e;
     const scene_interior *in = hi->interior;
     double ior = interior_ior(in);
     /* the interior keeps dispersion in single precision as POV-Ray does */
@@ -241,14 +241,14 @@ static int refraction(const hit_info *hi, vec3 top, double weight, rgb *colour)
     }
     if (fabs(dr - 1.0) < TEX_EPSILON) return refract_one(hi, top, eta, n, local, weight, hi->wavelength, colour);
     if (hi->wavelength > 0.0f)
-        return refract_one(hi, top, spectral_ior(hi->wavelength, eta, dr), n, local, weight, hi->wavelength, colour);
+        return refract_one(hi, top, shade_spectral_ior(hi->wavelength, eta, dr), n, local, weight, hi->wavelength, colour);
     unsigned nb = in && in->dispersion_samples >= 2 ? (unsigned)in->dispersion_samples : 7u;
     rgb sum = {0, 0, 0};
     for (unsigned i = 0; i < nb; i++) {
-        spectral_band b = spectral_band_of(i, nb);
+        shade_spectral_band b = shade_spectral_band_of(i, nb);
         rgb c;
-        refract_one(hi, top, spectral_ior(b.wavelength, eta, dr), n, local, weight, b.wavelength, &c);
-        sum = tadd(sum, tmul(c, spectral_hue(b)));
+        refract_one(hi, top, shade_spectral_ior(b.wavelength, eta, dr), n, local, weight, b.wavelength, &c);
+        sum = tadd(sum, tmul(c, shade_spectral_hue(b)));
     }
     *colour = tscale(sum, 1.0 / nb);
     return 0;
@@ -280,7 +280,7 @@ typedef struct {
 
 static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, const parent_frame *pf, int npf, double weight)
 {
-    const tex_env *e = hi->e;
+    const shade_tex_env *e = hi->e;
     const scene *sc = e->sc;
     double bail = sc->global.adc_bailout;
     rgb result = {0, 0, 0}, filcol = {1, 1, 1};
@@ -308,7 +308,7 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
         L->f = f;
         double cos_i = -v3_dot(hi->dir, ln);
         L->reflec = reflectivity(hi, f, cos_i, &L->weight);
-        light_metallic_tint(&L->reflec, f->reflection_metallic, pig, cos_i);
+        shade_light_metallic_tint(&L->reflec, f->reflection_metallic, pig, cos_i);
 
         double att = hi->version < 3.7 ? 1.0 - (lc.f * tmax3(pig) + lc.t) : 1.0 - lc.f - lc.t;
         if (e->quality <= 1) {
@@ -324,7 +324,7 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
         if (e->use_ambient) tmp = tadd(tmp, tscale(tmul(pig, tmul(f->ambient, sc->global.ambient_light)), att));
         tmp = tadd(tmp, tscale(tmul(pig, f->emission), att));
         if (f->diffuse != 0.0 || f->diffuse_back != 0.0 || f->specular != 0.0 || f->phong != 0.0) {
-            light_surface s = {f, pig, ln, hi->dir, att, e->r, hi->pc.ipoint, &sc->global};
+            shade_light_surface s = {f, pig, ln, hi->dir, att, e->r, hi->pc.ipoint, &sc->global};
             tmp = tadd(tmp, e->direct(e->ctx, e->thread, &s, hi->h, hi->p_out, e->r));
         }
         result = tadd(result, tmul(tmp, filcol));
@@ -369,15 +369,15 @@ static int material_index(const scene_image_map *im, vec3 tp, int n)
 {
     double x, y;
     int k = 0;
-    if (pattern_image_pos(im, tp, &x, &y)) {
+    if (shade_pattern_image_pos(im, tp, &x, &y)) {
         const scene_image *img = im->image;
         if (img->indices) {
-            int ix = noise_to_int(x), iy = noise_to_int(y);
+            int ix = shade_noise_to_int(x), iy = shade_noise_to_int(y);
             if (ix >= img->width || ix < 0) ix = ix < 0 ? 0 : img->width - 1;
             if (iy >= img->height || iy < 0) iy = iy < 0 ? 0 : img->height - 1;
             k = img->indices[(size_t)iy * img->width + ix];
         } else {
-            k = (int)(pattern_image_at(im, x, y).r * 255.0);
+            k = (int)(shade_pattern_image_at(im, x, y).r * 255.0);
         }
     }
     if (k > n) k %= n;
@@ -390,7 +390,7 @@ static rgb one_texture(const hit_info *hi, const scene_texture *tex, vec3 point,
     if (!tex->pat || !tex->map || tex->map->n == 0 || npf >= MAX_PARENTS) return lighted(hi, tex, point, pf, npf, weight);
     const scene_pattern *pat = tex->pat;
     const scene_blend_map *m = tex->map;
-    vec3 tp = pattern_warp(pat, to_texture_space_at(tex, point, &hi->pc));
+    vec3 tp = shade_pattern_warp(pat, to_texture_space_at(tex, point, &hi->pc));
     pf[npf].xf = xform_is_identity(&tex->transform) ? NULL : &tex->transform;
     pf[npf].pat = pat;
     if (pat->kind == PAT_AVERAGE) {
@@ -407,10 +407,10 @@ static rgb one_texture(const hit_info *hi, const scene_texture *tex, vec3 point,
         int k = material_index(&pat->image, tp, m->n);
         return m->e[k].texture ? one_texture(hi, m->e[k].texture, tp, pf, npf + 1, weight) : trgb(0, 0, 0);
     }
-    pattern_ctx pc = hi->pc;
-    double v = pattern_value(pat, tp, &pc);
+    shade_pattern_ctx pc = hi->pc;
+    double v = shade_pattern_value(pat, tp, &pc);
     int ip, ic;
-    blend_map_search(m, v, &ip, &ic);
+    shade_blend_map_search(m, v, &ip, &ic);
     rgb c = m->e[ic].texture ? one_texture(hi, m->e[ic].texture, tp, pf, npf + 1, weight) : trgb(0, 0, 0);
     if (ip != ic) {
         rgb c2 = m->e[ip].texture ? one_texture(hi, m->e[ip].texture, tp, pf, npf + 1, weight) : trgb(0, 0, 0);
@@ -428,7 +428,7 @@ static const scene_texture *hit_texture(const scene *sc, const accel_hit *h, int
     return h->texture ? h->texture : &sc->default_texture;
 }
 
-rgb tex_shade(const tex_env *e, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip, float wavelength)
+rgb shade_tex_shade(const shade_tex_env *e, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip, float wavelength)
 {
     hit_info hi;
     memset(&hi, 0, sizeof hi);
@@ -448,7 +448,7 @@ rgb tex_shade(const tex_env *e, const accel_hit *h, vec3 dir, int level, double 
     hi.p_out = v3_madd(h->p, ng, e->eps);
     hi.p_in = v3_madd(h->p, ng, -e->eps);
     hi.interior = h->obj ? h->obj->interior : NULL;
-    hi.pc = pattern_ctx_plain(e->sc);
+    hi.pc = shade_pattern_ctx_plain(e->sc);
     ctx_from_hit(&hi.pc, h);
     hi.pc.normal = n;
     hi.pc.dir = dir;
@@ -459,18 +459,18 @@ rgb tex_shade(const tex_env *e, const accel_hit *h, vec3 dir, int level, double 
 /* ------------------------------------------------------------ colour only */
 
 
-static int texture_colour(const scene_texture *tex, vec3 point, const pattern_ctx *pc, colour5 *out, int depth)
+static int texture_colour(const scene_texture *tex, vec3 point, const shade_pattern_ctx *pc, colour5 *out, int depth)
 {
     if (tex->pat && tex->map && tex->map->n > 0 && depth < MAX_PARENTS) {
         const scene_blend_map *m = tex->map;
-        vec3 tp = pattern_warp(tex->pat, to_texture_space_at(tex, point, pc));
+        vec3 tp = shade_pattern_warp(tex->pat, to_texture_space_at(tex, point, pc));
         if (tex->pat->kind == PAT_IMAGE && tex->pat->image.material) {
             const scene_texture *st = m->e[material_index(&tex->pat->image, tp, m->n)].texture;
             return st ? texture_colour(st, tp, pc, out, depth + 1) : 0;
         }
-        double v = pattern_value(tex->pat, tp, pc);
+        double v = shade_pattern_value(tex->pat, tp, pc);
         int ip, ic;
-        blend_map_search(m, v, &ip, &ic);
+        shade_blend_map_search(m, v, &ip, &ic);
         colour5 a = {0, 0, 0, 0, 0}, b = {0, 0, 0, 0, 0};
         int found = m->e[ic].texture ? texture_colour(m->e[ic].texture, tp, pc, &a, depth + 1) : 0;
         if (ip != ic && m->e[ip].texture) {
@@ -485,31 +485,31 @@ static int texture_colour(const scene_texture *tex, vec3 point, const pattern_ct
         *out = a;
         return found;
     }
-    return pigment_eval(&tex->pigment, to_texture_space_at(tex, point, pc), pc, out);
+    return shade_pigment_eval(&tex->pigment, to_texture_space_at(tex, point, pc), pc, out);
 }
 
-int tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_hit *h, colour5 *out)
+int shade_tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_hit *h, colour5 *out)
 {
     if (!tex) tex = h->texture ? h->texture : &sc->default_texture;
-    pattern_ctx pc = pattern_ctx_plain(sc);
+    shade_pattern_ctx pc = shade_pattern_ctx_plain(sc);
     ctx_from_hit(&pc, h);
     pc.normal = h->ns;
     return texture_colour(tex, texture_point(h), &pc, out, 0);
 }
 
-static rgb shadow_layers(const scene_texture *tex, vec3 point, const pattern_ctx *pc, int depth, double caustics, vec3 raw,
+static rgb shadow_layers(const scene_texture *tex, vec3 point, const shade_pattern_ctx *pc, int depth, double caustics, vec3 raw,
                          vec3 dir)
 {
     if (tex->pat && tex->map && tex->map->n > 0 && depth < MAX_PARENTS) {
         const scene_blend_map *m = tex->map;
-        vec3 tp = pattern_warp(tex->pat, to_texture_space_at(tex, point, pc));
+        vec3 tp = shade_pattern_warp(tex->pat, to_texture_space_at(tex, point, pc));
         if (tex->pat->kind == PAT_IMAGE && tex->pat->image.material) {
             const scene_texture *st = m->e[material_index(&tex->pat->image, tp, m->n)].texture;
             return st ? shadow_layers(st, tp, pc, depth + 1, caustics, raw, dir) : trgb(0, 0, 0);
         }
-        double v = pattern_value(tex->pat, tp, pc);
+        double v = shade_pattern_value(tex->pat, tp, pc);
         int ip, ic;
-        blend_map_search(m, v, &ip, &ic);
+        shade_blend_map_search(m, v, &ip, &ic);
         rgb a = m->e[ic].texture ? shadow_layers(m->e[ic].texture, tp, pc, depth + 1, caustics, raw, dir) : trgb(0, 0, 0);
         if (ip != ic) {
             rgb b = m->e[ip].texture ? shadow_layers(m->e[ip].texture, tp, pc, depth + 1, caustics, raw, dir) : trgb(0, 0, 0);
@@ -521,13 +521,13 @@ static rgb shadow_layers(const scene_texture *tex, vec3 point, const pattern_ctx
     rgb c = {1, 1, 1};
     for (const scene_texture *l = tex; l; l = l->next) {
         colour5 lc;
-        if (pigment_eval(&l->pigment, to_texture_space_at(l, point, pc), pc, &lc))
+        if (shade_pigment_eval(&l->pigment, to_texture_space_at(l, point, pc), pc, &lc))
             c = tmul(c, trgb(lc.r * lc.f + lc.t, lc.g * lc.f + lc.t, lc.b * lc.f + lc.t));
         if (caustics != 0.0) {
             /* POV-Ray's faked caustics: 1 + |n.d|^caustics per layer (layer normal) */
             vec3 n = raw;
             if (l->normal && l->normal->pat && l->normal->pat->kind != PAT_PLAIN) {
-                n = normal_perturb(l->normal, n, to_texture_space_at(l, point, pc),
+                n = shade_normal_perturb(l->normal, n, to_texture_space_at(l, point, pc),
                                    xform_is_identity(&l->transform) ? NULL : &l->transform, pc);
                 n = v3_norm(n);
             }
@@ -537,11 +537,11 @@ static rgb shadow_layers(const scene_texture *tex, vec3 point, const pattern_ctx
     return c;
 }
 
-rgb tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir)
+rgb shade_tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir)
 {
     int entering = v3_dot(dir, h->ng) < 0.0;
     const scene_texture *tex = hit_texture(sc, h, entering);
-    pattern_ctx pc = pattern_ctx_plain(sc);
+    shade_pattern_ctx pc = shade_pattern_ctx_plain(sc);
     ctx_from_hit(&pc, h);
     pc.normal = h->ns;
     pc.dir = dir;
@@ -614,7 +614,7 @@ static int object_transparent(const scene_object *o, int depth)
     }
 }
 
-int tex_scene_transparent(const scene *sc)
+int shade_tex_scene_transparent(const scene *sc)
 {
     if (tex_transparent(&sc->default_texture)) return 1;
     for (int i = 0; i < sc->nobjects; i++)
@@ -622,7 +622,7 @@ int tex_scene_transparent(const scene *sc)
     return 0;
 }
 
-rgb tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, double tmin, double tmax)
+rgb shade_tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, double tmin, double tmax)
 {
     rgb c = {1, 1, 1};
     accel_hit h;
@@ -634,7 +634,7 @@ rgb tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, double tmi
             /* distance inside the object: from the previous crossing */
             accel_hit hh = h;
             hh.t = h.t - (t0 > tmin ? t0 - fmax(tmin, t0 * 1e-7) : 0.0);
-            c = tmul(c, tex_shadow_filter(sc, &hh, dir));
+            c = tmul(c, shade_tex_shadow_filter(sc, &hh, dir));
             if (fabs(c.r) < TEX_EPSILON && fabs(c.g) < TEX_EPSILON && fabs(c.b) < TEX_EPSILON) return trgb(0, 0, 0);
         }
         t0 = next;

@@ -9,7 +9,7 @@
  * indirect term through callbacks, so this module owns the surface model
  * and nothing about rays or lights.
  *
- * For the GI modes: tex_pigment_at gives the pigment colour of a surface at a
+ * For the GI modes: shade_tex_pigment_at gives the pigment colour of a surface at a
  * hit (patterns, image maps, texture maps resolved), the colour to use as
  * albedo where pigments vary over a surface. */
 #ifndef PT_SHADE_TEXTURE_H
@@ -30,43 +30,43 @@ typedef struct {
     /* Radiance along a ray (level = the new ray's level; skip = OBJ_* flags
      * of objects the ray does not see; wavelength = the ray's spectral band
      * in nm once a dispersive surface split it, 0 for a ray of all colours:
-     * pass it back to tex_shade for the ray's hits). */
+     * pass it back to shade_tex_shade for the ray's hits). */
     rgb (*trace)(void *ctx, int thread, vec3 org, vec3 dir, int level, double weight, unsigned skip, float wavelength,
                  rng *r);
     /* Direct light of every light source on the layer surface s at p. */
-    rgb (*direct)(void *ctx, int thread, const light_surface *s, const accel_hit *h, vec3 p, rng *r);
+    rgb (*direct)(void *ctx, int thread, const shade_light_surface *s, const accel_hit *h, vec3 p, rng *r);
     /* GI indirect irradiance-like term at a diffuse layer (NULL = none). */
     rgb (*indirect)(void *ctx, int thread, const accel_hit *h, vec3 n);
     long *unsupported;   /* incremented when a hit uses something not evaluated (may be NULL) */
     int quality;         /* POV-Ray's +Q level (shade_settings.quality): 9 everything */
-} tex_env;
+} shade_tex_env;
 
 /* Colour seen along unit `dir` at hit h (the ray's level and weight as in
  * POV-Ray's TraceRay; skip and wavelength as for trace). */
-rgb tex_shade(const tex_env *e, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip, float wavelength);
+rgb shade_tex_shade(const shade_tex_env *e, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip, float wavelength);
 
 /* Pigment colour (r g b filter transmit) of the top layer of the texture at
  * a hit: texture transforms applied, texture maps blended. `tex` NULL = the
  * hit's effective texture. Returns 0 if no colour was found (outside an
  * image map used `once`). */
-int tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_hit *h, colour5 *out);
+int shade_tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_hit *h, colour5 *out);
 
 /* Filter colour of a surface for a shadow ray crossing it at h (POV-Ray's
  * ComputeShadowTexture: rgb*filter + transmit of the layers, multiplied,
  * with the interior's faked caustics and fade; 0 for opaque surfaces).
  * h->t is taken as the distance travelled inside the object when the ray
  * leaves it. */
-rgb tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir);
+rgb shade_tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir);
 
 /* Light left along a shadow ray from p (unit dir) over (tmin, tmax): 0 when
  * an opaque surface blocks it, else the product of the filter colours of the
  * (transparent) surfaces crossed; no_shadow objects are ignored (POV-Ray's
  * TracePointLightShadowRay). */
-rgb tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, double tmin, double tmax);
+rgb shade_tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, double tmin, double tmax);
 
 /* Can any surface of the scene let light through (filter/transmit anywhere
  * in its textures, image maps with alpha or `once`)? When not, shadows are
  * plain occlusion tests. */
-int tex_scene_transparent(const scene *sc);
+int shade_tex_scene_transparent(const scene *sc);
 
 #endif

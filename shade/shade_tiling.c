@@ -933,7 +933,7 @@ static double penrose1_tiles(vec3 p)
 }
 
 
-double tiling_value(int n, vec3 p)
+double shade_tiling_value(int n, vec3 p)
 {
     /* cell indices are ints: beyond 1e9 units (and for NaN) they would
      * overflow; POV-Ray's result is undefined there, this gives 0 */

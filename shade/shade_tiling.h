@@ -7,6 +7,6 @@
 #include "vec.h"
 
 /* Value of tiling n at p, in [0, 1]. */
-double tiling_value(int n, vec3 p);
+double shade_tiling_value(int n, vec3 p);
 
 #endif

@@ -1061,7 +1061,7 @@ static void test_diffuse_back(void **state)
 }
 
 /* Particles take the pigment where they lie (settings.pigment =
- * tex_pigment_at): a room whose walls are a checker of two colours
+ * shade_tex_pigment_at): a room whose walls are a checker of two colours
  * (scale 0.25, walls at -0.1 and 1.1 so no wall lies on a check boundary).
  * Every particle's reflectance is diffuse * the check's colour at its
  * position (float rounding: 1e-6); the averages over each colour's
@@ -1086,7 +1086,7 @@ static void test_checker_particles(void **state)
         s.bounces = 2;
         s.threads = 2;
         s.cl_device = device_c;
-        s.pigment = with ? tex_pigment_at : NULL;
+        s.pigment = with ? shade_tex_pigment_at : NULL;
         pt_status st;
         gi_particle *gp = gi_particle_build(f.sc, f.a, &s, NULL, f.d, &st);
         assert_non_null(gp);

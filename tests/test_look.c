@@ -139,19 +139,19 @@ static void test_spectral(void **st)
         {740, 1, 1, 1},
     };
     for (size_t i = 0; i < sizeof pov / sizeof pov[0]; i++) {
-        rgb c = spectral_hue_integral(pov[i].wl);
+        rgb c = shade_spectral_hue_integral(pov[i].wl);
         assert_true(fabs(c.r - pov[i].r) < 1e-9 && fabs(c.g - pov[i].g) < 1e-9 && fabs(c.b - pov[i].b) < 1e-9);
     }
     /* linear between entries, clamped outside 375..740 */
-    rgb m = spectral_hue_integral(437.5), lo = spectral_hue_integral(300), hi = spectral_hue_integral(800);
+    rgb m = shade_spectral_hue_integral(437.5), lo = shade_spectral_hue_integral(300), hi = shade_spectral_hue_integral(800);
     assert_true(fabs(m.b - 0.5 * (0.2412 + 0.2753)) < 1e-9 && lo.b == 0.0 && hi.r == 1.0);
     /* element i of n: 380 + 350 (i + 0.5) / n nm, 350 / n wide; the n hues
      * average to I(730) - I(380) = (0.9938, 1, 0.9962) */
-    spectral_band b0 = spectral_band_of(0, 7);
+    shade_spectral_band b0 = shade_spectral_band_of(0, 7);
     assert_true(fabs(b0.wavelength - 405.0f) < 1e-4f && fabs(b0.bandwidth - 50.0f) < 1e-4f);
     rgb avg = {0, 0, 0};
     for (unsigned i = 0; i < 7; i++) {
-        rgb h = spectral_hue(spectral_band_of(i, 7));
+        rgb h = shade_spectral_hue(shade_spectral_band_of(i, 7));
         avg.r += h.r / 7;
         avg.g += h.g / 7;
         avg.b += h.b / 7;
@@ -159,7 +159,7 @@ static void test_spectral(void **st)
     assert_true(fabs(avg.r - 0.9938) < 1e-6 && fabs(avg.g - 1.0) < 1e-6 && fabs(avg.b - 0.9962) < 1e-6);
     /* ior * disp^(-(wl - 555) / 350): violet (405 nm) entering ior 1.5,
      * dispersion 1.3 sees 1.5 * 1.3^(150/350) */
-    assert_true(fabs(1.0 / spectral_ior(405.0f, 1.0 / 1.5, 1.0 / 1.3) - 1.5 * pow(1.3, 150.0 / 350.0)) < 1e-9);
+    assert_true(fabs(1.0 / shade_spectral_ior(405.0f, 1.0 / 1.5, 1.0 / 1.3) - 1.5 * pow(1.3, 150.0 / 350.0)) < 1e-9);
 }
 
 int main(void)

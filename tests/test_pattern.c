@@ -186,7 +186,7 @@ static int run_tiles(const pattern_case *cs, int ncases, const char *tag)
     assert_int_equal(chdir(cwd), 0);
     assert_int_equal(st, PT_OK);
     assert_int_equal(sc->nobjects, ncases);
-    pattern_ctx pc = pattern_ctx_plain(sc);
+    shade_pattern_ctx pc = shade_pattern_ctx_plain(sc);
     int failed = 0;
     for (int i = 0; i < ncases; i++) {
         const scene_texture *tex = sc->objects[i]->texture;
@@ -197,7 +197,7 @@ static int run_tiles(const pattern_case *cs, int ncases, const char *tag)
             for (int x = tx + 1; x < tx + TILE - 1; x++) {
                 vec3 p = v3((x + 0.5) / w * ww, -(y + 0.5) / h * wh, 0.0);
                 colour5 c;
-                pigment_eval(&tex->pigment, xform_inv_point(&tex->transform, p), &pc, &c);
+                shade_pigment_eval(&tex->pigment, xform_inv_point(&tex->transform, p), &pc, &c);
                 double k = 1.0 - c.f - c.t;
                 const float *px = fb_px(fb, x, y);
                 /* the PNG holds 0..1 (bicubic images overshoot) */
@@ -297,12 +297,12 @@ static void test_pavement_errors(void **st)
         }
         diag_free(d);
     }
-    pavement_params pv = {4, 6, 35, 2, 2, 2};
-    assert_true(pavement_value(&pv, v3(NAN, 0, 1)) == 0.0);
-    assert_true(pavement_value(&pv, v3(1e300, 0, -1e300)) == 0.0);
+    shade_pavement_params pv = {4, 6, 35, 2, 2, 2};
+    assert_true(shade_pavement_value(&pv, v3(NAN, 0, 1)) == 0.0);
+    assert_true(shade_pavement_value(&pv, v3(1e300, 0, -1e300)) == 0.0);
     for (int t = 1; t <= 27; t++) {
-        assert_true(tiling_value(t, v3(INFINITY, 0, 1)) == 0.0);
-        double v = tiling_value(t, v3(123456.7, 0, -98765.4));
+        assert_true(shade_tiling_value(t, v3(INFINITY, 0, 1)) == 0.0);
+        double v = shade_tiling_value(t, v3(123456.7, 0, -98765.4));
         assert_true(v >= 0.0 && v <= 1.0 + 1e-6); /* 8, 9, ...: POV-Ray nudges edges past 1 by 1e-7 */
     }
 }
@@ -449,38 +449,38 @@ static void test_noise_closed_form(void **st)
         double lo = 1, hi = 0;
         for (int i = 0; i < 20000; i++) {
             vec3 p = v3(i * 0.137 - 700.0, i * 0.0731 + 3.0, i * 0.311 - 9.0);
-            double v = noise_value(p, g);
+            double v = shade_noise_value(p, g);
             assert_true(v >= 0.0 && v <= 1.0);
             lo = fmin(lo, v);
             hi = fmax(hi, v);
-            assert_true(v == noise_value(p, g)); /* deterministic */
+            assert_true(v == shade_noise_value(p, g)); /* deterministic */
         }
         assert_true(hi - lo > 0.5);
     }
     /* generator 1 and 2 are the same lattice sum, rescaled: n2 = (n1 - 0.5 + 1.05242) * 0.48985582 unclamped */
     vec3 p = v3(1.3, -2.7, 0.4);
-    double n1 = noise_value(p, 1), n2 = noise_value(p, 2);
+    double n1 = shade_noise_value(p, 1), n2 = shade_noise_value(p, 2);
     assert_true(fabs(n2 - (n1 - 0.5 + 1.05242) * 0.48985582) < 1e-12);
-    assert_true(fabs(noise_cycloidal(0.25) - 1.0) < 1e-12);
-    assert_true(fabs(noise_triangle_wave(0.25) - 0.5) < 1e-12);
-    assert_true(fabs(noise_triangle_wave(-0.25) - 0.5) < 1e-12);
+    assert_true(fabs(shade_noise_cycloidal(0.25) - 1.0) < 1e-12);
+    assert_true(fabs(shade_noise_triangle_wave(0.25) - 0.5) < 1e-12);
+    assert_true(fabs(shade_noise_triangle_wave(-0.25) - 0.5) < 1e-12);
     scene_map_entry e[3] = {{0.2, {0}, 0, 0, 0, 0, 0}, {0.5, {0}, 0, 0, 0, 0, 0}, {0.5, {0}, 0, 0, 0, 0, 0}};
     scene_blend_map m = {MAP_COLOUR, 3, e};
     int ip, ic;
-    blend_map_search(&m, 0.1, &ip, &ic);
+    shade_blend_map_search(&m, 0.1, &ip, &ic);
     assert_int_equal(ip, 0);
     assert_int_equal(ic, 0);
-    blend_map_search(&m, 0.3, &ip, &ic);
+    shade_blend_map_search(&m, 0.3, &ip, &ic);
     assert_int_equal(ip, 0);
     assert_int_equal(ic, 1);
-    blend_map_search(&m, 0.5, &ip, &ic); /* at or past the last value: the last entry */
+    shade_blend_map_search(&m, 0.5, &ip, &ic); /* at or past the last value: the last entry */
     assert_int_equal(ip, 2);
     assert_int_equal(ic, 2);
     e[2].value = 0.7;
-    blend_map_search(&m, 0.5, &ip, &ic); /* on an inner value: that entry alone */
+    shade_blend_map_search(&m, 0.5, &ip, &ic); /* on an inner value: that entry alone */
     assert_int_equal(ip, 1);
     assert_int_equal(ic, 1);
-    blend_map_search(&m, 0.9, &ip, &ic);
+    shade_blend_map_search(&m, 0.9, &ip, &ic);
     assert_int_equal(ip, 2);
     assert_int_equal(ic, 2);
 }

@@ -280,8 +280,8 @@ static void test_povray_units_and_fade(void **st)
     assert_float_equal(layer_y("fade.exr", "illuminance", 16, 16) / (I_CD / (D_M * D_M)), 1.0, 0.01);
 }
 
-/* The reference path tracer sees the same photometric light (its light_nee
- * and light_attenuation): the centre pixel agrees with Whitted. */
+/* The reference path tracer sees the same photometric light (its shade_light_nee
+ * and shade_light_attenuation): the centre pixel agrees with Whitted. */
 static void test_path_agrees(void **st)
 {
     (void)st;

@@ -92,7 +92,7 @@ typedef struct {
 
 /* Direction from p towards the light point (cx, cy, cz) (the light's
  * position, or a point of an area light) and the distance along it.
- * Mirrors shade.c light_ray: cylinder lights shine along their axis,
+ * Mirrors shade.c shade_light_ray: cylinder lights shine along their axis,
  * `parallel` lights along position - point_at. Returns the depth. */
 static inline float gi_light_ray(GI_GLOBAL const gi_dev_light *l, float cx, float cy, float cz, float px, float py,
                                  float pz, float *d)
@@ -144,7 +144,7 @@ static inline float gi_cubic_step(float low, float high, float x)
 }
 
 /* Angle and distance attenuation of light l seen from p along unit d at
- * distance depth. Mirrors shade.c light_attenuation (spot cos^tightness with
+ * distance depth. Mirrors shade.c shade_light_attenuation (spot cos^tightness with
  * a cubic falloff, cylinder lights, fade 2/(1+(d/fade_distance)^fade_power)). */
 static inline float gi_light_attenuation(GI_GLOBAL const gi_dev_light *l, float px, float py, float pz,
                                          const float *d, float depth)
