@@ -74,7 +74,7 @@ typedef struct {
     long photons;
     const char *cl_device;  /* particle GI: OpenCL device (NULL/"auto", "c", "P:D" or part of a name) */
     long long cl_max_memory_mib; /* particle GI: OpenCL device memory it may use (0 = the device's) */
-    /* lighting studies (app/lighting.h, docs/units.md) */
+    /* lighting studies (app/lighting_study.h, docs/units.md) */
     const char *aovs;       /* --aovs LIST: extra EXR layers */
     const char *units;      /* --units m|cm|mm|ft|...|METRES: photometric lights */
     const char *fc_quantity;/* --false-color-quantity luminance|illuminance */

@@ -19,7 +19,7 @@
 #include "img_io.h"
 #include "img_ocio.h"
 #include "ini.h"
-#include "lighting.h"
+#include "lighting_study.h"
 #include "pool.h"
 #include "progress.h"
 #include "progress_bar.h"
@@ -784,7 +784,7 @@ static int cmd_render(int argc, char **argv)
         diag_free(od);
         if (os != PT_OK) rc = status_exit(os == PT_ERR_IO ? PT_ERR_IO : PT_ERR_USAGE);
     }
-    /* Lighting studies: --units, --aovs, --false-color-quantity (lighting.h). */
+    /* Lighting studies: --units, --aovs, --false-color-quantity (lighting_study.h). */
     lighting_study ls;
     memset(&ls, 0, sizeof ls);
     if (rc == EXIT_OK) {

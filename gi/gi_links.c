@@ -131,7 +131,7 @@ static void job(void *ctx, int index, int thread)
     c.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     rtcIntersect1M(J->scene, &c, rh, (unsigned)m, sizeof *rh);
     /* hit points and their lookup cells; the lookups are bound by memory
-     * latency, so the whole batch prefetches first (gi_particles.h) */
+     * latency, so the whole batch prefetches first (gi_area_particles.h) */
     vec3 *hp = J->hp[thread];
     long *cell = J->cell[thread], *tcell = J->tcell[thread];
     /* hits on a triangle gi_trilook lists take its list (cell -3: no grid

@@ -9,7 +9,7 @@
 #define PT_GI_LINKS_H
 #include <stdint.h>
 #include "accel.h"
-#include "gi_particles.h"
+#include "gi_area_particles.h"
 #include "gi_surface.h"
 #include "gi_trilook.h"
 #include "progress.h"

@@ -13,7 +13,7 @@
 #include "gi_cl.h"
 #include "gi_cl_c.h"
 #include "gi_links.h"
-#include "gi_particles.h"
+#include "gi_area_particles.h"
 #include "gi_radiance.h"
 #include "gi_surface.h"
 #include "pool.h"

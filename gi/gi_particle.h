@@ -29,7 +29,7 @@
  * with the BRDF rho/pi and a light delivering E = pi*colour*cos converges
  * to the same image.
  *
- * Reflectance of a particle: diffuse * pigment * opacity (gi_particles.h),
+ * Reflectance of a particle: diffuse * pigment * opacity (gi_area_particles.h),
  * the pigment evaluated at the particle's position when settings.pigment is
  * set (the app passes shade's shade_tex_pigment_at: checkers, image maps and
  * texture maps reflect their own colours), else the texture's base colour.

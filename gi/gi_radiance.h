@@ -12,7 +12,7 @@
  * Internal to gi/. */
 #ifndef PT_GI_RADIANCE_H
 #define PT_GI_RADIANCE_H
-#include "gi_particles.h"
+#include "gi_area_particles.h"
 #include "gi_surface.h"
 
 typedef struct {

@@ -22,7 +22,7 @@
 #define PT_GI_TRILOOK_H
 #include <stddef.h>
 #include "accel.h"
-#include "gi_particles.h"
+#include "gi_area_particles.h"
 #include "kernels/gi_types.h"
 
 typedef struct gi_trilook gi_trilook;

@@ -1,6 +1,6 @@
 /* shade_aov.h - arbitrary output variables (AOVs) for lighting studies:
  * per-pixel quantities at the first surface the camera sees, written as
- * extra EXR layers beside the beauty image (`--aovs`, app/lighting.c).
+ * extra EXR layers beside the beauty image (`--aovs`, app/lighting_study.c).
  *
  * Sampling: one camera ray through each pixel centre (the lens centre when
  * the camera has focal blur), in a pass of its own after the beauty render;

@@ -26,7 +26,7 @@
 #include "framebuffer.h"
 #include "img_falsecolor.h"
 #include "img_io.h"
-#include "lighting.h"
+#include "lighting_study.h"
 
 static char tmpdir[256];
 static char out_text[65536];
@@ -326,7 +326,7 @@ static void test_povray_reads_layers(void **st)
     assert_true(worst < 2e-3);
 }
 
-/* Option parsing (lighting.h) and usage errors from the command line. */
+/* Option parsing (lighting_study.h) and usage errors from the command line. */
 static void test_options(void **st)
 {
     (void)st;

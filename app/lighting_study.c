@@ -1,6 +1,6 @@
-/* lighting.c - lighting-study options: photometric units, AOV layers and
- * the quantity of the false-colour map (see lighting.h, docs/units.md). */
-#include "lighting.h"
+/* lighting_study.c - lighting-study options: photometric units, AOV layers and
+ * the quantity of the false-colour map (see lighting_study.h, docs/units.md). */
+#include "lighting_study.h"
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>

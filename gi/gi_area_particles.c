@@ -1,5 +1,5 @@
-/* gi_particles.c - area particle sampling and the particle hash grid. */
-#include "gi_particles.h"
+/* gi_area_particles.c - area particles: sampling, the hash grid and the link lookup. */
+#include "gi_area_particles.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

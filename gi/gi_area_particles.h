@@ -1,11 +1,11 @@
-/* gi_particles.h - area particles (paper section 3.1): samples distributed
+/* gi_area_particles.h - area particles (paper section 3.1): samples distributed
  * uniformly by area over every surface patch, each standing for the same
  * area dA = A/N when sampled (gi_particle.c then sets each one's area to its
  * catchment, catchment_areas), with normal, diffuse reflectance and emission; and a
  * hashed uniform grid over them for the nearest-particle lookups of the link
  * builder and the radius queries of the estimation lists. Internal to gi/. */
-#ifndef PT_GI_PARTICLES_H
-#define PT_GI_PARTICLES_H
+#ifndef PT_GI_AREA_PARTICLES_H
+#define PT_GI_AREA_PARTICLES_H
 #include <stdint.h>
 #include "accel.h"
 #include "gi_particle.h"

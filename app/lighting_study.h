@@ -1,10 +1,10 @@
-/* lighting.h - the lighting-study options of `partray render`:
+/* lighting_study.h - the lighting-study options of `partray render`:
  * --units (photometric lights, docs/units.md), --aovs (extra EXR layers,
  * shade/shade_aov.h) and --false-color-quantity (luminance or illuminance
  * map). main.c parses them here before the scene, applies the units after
  * parsing, hands the AOV buffers to render_gi and the layers to img_write. */
-#ifndef PT_LIGHTING_H
-#define PT_LIGHTING_H
+#ifndef PT_LIGHTING_STUDY_H
+#define PT_LIGHTING_STUDY_H
 #include "diag.h"
 #include "framebuffer.h"
 #include "img_io.h"
