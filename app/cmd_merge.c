@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "cli.h"
 #include "framebuffer.h"
 #include "img_exr.h"
 #include "img_io.h"
@@ -132,11 +133,27 @@ pt_status merge_tiles(const char *out, const char *const *tiles, int ntiles, dia
     return st;
 }
 
+static const char merge_help[] =
+    "usage: partray merge OUT.exr|.png|.pfm TILE.exr...\n"
+    "Puts the EXR tiles of one frame (renders with +SC/+EC/+SR/+ER) into OUT, after\n"
+    "checking that they come from the same scene, frame and settings and cover the\n"
+    "frame once. docs/farm.md describes tiles, merging and the farm.\n";
+
 int cmd_merge(int argc, char **argv)
 {
+    if (cli_wants_help(argc, argv)) {
+        fputs(merge_help, stdout);
+        fputs(cli_exit_codes, stdout);
+        return CLI_EXIT_OK;
+    }
     if (argc < 2) {
-        fprintf(stderr, "usage: partray merge OUT.exr|.png|.pfm TILE.exr...\n");
-        return 2;
+        fputs(merge_help, stderr);
+        return CLI_EXIT_USAGE;
+    }
+    char err[512];
+    if (img_format_from_path(argv[0]) != IMG_FMT_UNKNOWN && cli_check_output(argv[0], err, sizeof err)) {
+        fprintf(stderr, "partray merge: %s\n", err);
+        return CLI_EXIT_IO;
     }
     diag *d = diag_new();
     pt_status st = merge_tiles(argv[0], (const char *const *)(argv + 1), argc - 1, d);

@@ -101,7 +101,7 @@ static void test_help(void **st)
     (void)st;
     struct { const char *cmd, *option; } c[] = {
         {"render", "--gi MODE"}, {"parse", "--max-loop"}, {"compare", "--heatmap"}, {"sweep", "--vary"},
-        {"crosscheck", "--povray"}, {"view", "--script"},
+        {"crosscheck", "--povray"}, {"view", "--script"}, {"merge", "TILE.exr"}, {"farm", "--tiles"},
     };
     char cmd[1024];
     for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
