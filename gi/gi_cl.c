@@ -743,8 +743,8 @@ pt_status gi_dev_set_walk(gi_dev *dv, const int *woff, const gi_walk_entry *went
  * of the candidates' own scattering links (slink) by target, candidates
  * ascending: per target the same entries in the same order as rin's. The
  * set changes only with the visibility (vis_changed: a light moved). The
- * sort costs about what it saves in one bounce (maze: ~5 ms CPU against
- * ~4.4; conference, 55% candidates, more than it saves), so a stage whose
+ * sort costs about what it saves in one bounce (more when most particles
+ * are candidates; bench/bench_gi prints the lighting stage), so a stage whose
  * set differs from the previous stage's gathers over rin with the mask, and
  * the lists are built when a stage finds the same set again (a colour
  * change, a frame relit with nothing moved) and reused while it stays. The

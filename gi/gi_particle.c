@@ -324,9 +324,9 @@ pt_status gi_particle_build_walk(gi_particle *gp, int nwalk, diag *d)
  * was sampled with. With L_j = rho phi_j / (pi dA) a gather then meets
  * phi_j ~ E V_j with probability ~ V_j: the scattered light reads high by
  * E[V^2] / (dA E[V]) = 1 + the squared coefficient of variation of the
- * cells' areas (cbox, 50K particles: 1.104, measured by 64 stratified
- * points per dA; the image +1.4% at n_b 8; test_gi's integrating sphere
- * +2.5% at 1K particles). The direct and emitted parts of L are not
+ * cells' areas (random points leave that variation well above zero;
+ * test_gi's integrating sphere tells the two apart). The direct and
+ * emitted parts of L are not
  * affected (evaluated at the particle, they cancel dA). With V_j as the
  * particle's area, emission and the first bounce send E V_j (a Voronoi
  * quadrature) and the estimation lists weight by V_j too.

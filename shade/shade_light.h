@@ -57,7 +57,7 @@ typedef struct {
     vec3 eye;     /* incoming (viewing) ray direction, unit */
     double att;   /* opacity of the layer: 1 - grey(filter*pigment + transmit) */
     rng *r;       /* for crand */
-    /* irid (appended): the surface point and the scene's settings (irid
+    /* irid: the surface point and the scene's settings (irid
      * wavelengths, noise generator); NULL: POV-Ray's defaults */
     vec3 ipoint;
     const scene_global *global;
