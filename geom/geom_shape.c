@@ -472,6 +472,20 @@ static int hits_triangle(const geom_shape *sh, vec3 o, vec3 d, double tmin, doub
     return geom_shape_hit_put(out, 0, max, t, 0);
 }
 
+/* The torus (|p|^2 + R^2 - r^2)^2 = 4 R^2 (x^2 + z^2) along q + tau e (e
+ * unit): c[0] + c[1] tau + ... + c[4] tau^4 (the torus and the ovus's
+ * lemon, a spindle torus). */
+static void torus_quartic(vec3 q, vec3 e, double R, double r, double c[5])
+{
+    double G = v3_dot(q, q) + R * R - r * r, f = v3_dot(q, e);
+    double A = e.x * e.x + e.z * e.z, B = q.x * e.x + q.z * e.z, C = q.x * q.x + q.z * q.z;
+    c[4] = 1.0;
+    c[3] = 4.0 * f;
+    c[2] = 4.0 * f * f + 2.0 * G - 4.0 * R * R * A;
+    c[1] = 4.0 * f * G - 8.0 * R * R * B;
+    c[0] = G * G - 4.0 * R * R * C;
+}
+
 static int hits_torus(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     double s = v3_len(d);
@@ -494,14 +508,8 @@ static int hits_torus(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
     double lo = fmax(ta, b0), hi = fmin(tb, b1);
     if (!(lo < hi)) return 0;
     vec3 q = v3_madd(o1, e, lo);
-    double G = v3_dot(q, q) + R1 * R1 - r1 * r1, f = v3_dot(q, e);
-    double A = e.x * e.x + e.z * e.z, B = q.x * e.x + q.z * e.z, C = q.x * q.x + q.z * q.z;
     double c[5];
-    c[4] = 1.0;
-    c[3] = 4.0 * f;
-    c[2] = 4.0 * f * f + 2.0 * G - 4.0 * R1 * R1 * A;
-    c[1] = 4.0 * f * G - 8.0 * R1 * R1 * B;
-    c[0] = G * G - 4.0 * R1 * R1 * C;
+    torus_quartic(q, e, R1, r1, c);
     double roots[4];
     int nr = geom_poly_roots(c, 4, 0.0, hi - lo, roots), n = 0;
     for (int i = 0; i < nr && n < max; i++) {
@@ -557,14 +565,8 @@ static int hits_ovus(const geom_shape *sh, vec3 o, vec3 d, double tmin, double t
     }
     /* lemon: ((x^2+z^2) + (y-V)^2 + H^2 - rc^2)^2 = 4 H^2 (x^2+z^2) */
     vec3 qt = v3(q.x, q.y - V, q.z);
-    double G = v3_dot(qt, qt) + H * H - rc * rc, f = v3_dot(qt, e);
-    double A = e.x * e.x + e.z * e.z, B = qt.x * e.x + qt.z * e.z, C = qt.x * qt.x + qt.z * qt.z;
     double c[5];
-    c[4] = 1.0;
-    c[3] = 4.0 * f;
-    c[2] = 4.0 * f * f + 2.0 * G - 4.0 * H * H * A;
-    c[1] = 4.0 * f * G - 8.0 * H * H * B;
-    c[0] = G * G - 4.0 * H * H * C;
+    torus_quartic(qt, e, H, rc, c);
     double roots[4];
     int nr = geom_poly_roots(c, 4, 0.0, hi - lo, roots);
     for (int i = 0; i < nr; i++) {
