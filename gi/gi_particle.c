@@ -548,7 +548,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     tg = timer_now();
     cg = timer_cpu_now();
     st = gi_radiance_lists(&gp->lists, gp->surf, &gp->ps, gp->a, S->radius, set->normal_cos, gp->threads, set->cancel,
-                           d);
+                           set->progress, d);
     if (st != PT_OK) goto fail;
     S->radiance_particles = gp->lists.nrp;
     S->radiance_slots = gi_surface_rp_slots(gp->surf);

@@ -259,7 +259,8 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
     J.gp = gp;
     J.eps = 1e-6 * (accel_eps_scale(gp->a) > 0.0 ? accel_eps_scale(gp->a) : 1.0);
     atomic_init(&J.rays, 0);
-    if (ndirty > 0 && n > 0) pool_run(gp->threads, (n + VIS_CHUNK - 1) / VIS_CHUNK, vis_chunk, &J);
+    if (ndirty > 0 && n > 0)
+        pool_run_counted(gp->threads, (n + VIS_CHUNK - 1) / VIS_CHUNK, vis_chunk, &J, NULL, gp->set.progress);
     if (gp->cancel && *gp->cancel) {
         /* cancelled during (or before) the visibility pass: nothing the
          * indirect hook reads has changed yet (edir, src, lout, phi, the

@@ -400,7 +400,8 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
             J.ncx = w;
             J.ncy = h;
         }
-        pool_run(gp->threads, (J.ncy + VIEW_BAND - 1) / VIEW_BAND, coarse_band, &J);
+        /* the progress counts the coarse bands; the fill between them is short */
+        pool_run_counted(gp->threads, (J.ncy + VIEW_BAND - 1) / VIEW_BAND, coarse_band, &J, NULL, gp->set.progress);
         if (J.ch) pool_run(gp->threads, (h + VIEW_BAND - 1) / VIEW_BAND, fill_band, &J);
         free(J.ch);
     }

@@ -167,7 +167,7 @@ static void job(void *ctx, int chunk, int thread)
 }
 
 pt_status gi_radiance_lists(gi_lists *L, const gi_surface *g, const gi_particles *ps, const accel *a, double r,
-                            double cos_thr, int threads, volatile int *cancel, diag *d)
+                            double cos_thr, int threads, volatile int *cancel, progress *prog, diag *d)
 {
     memset(L, 0, sizeof *L);
     L->nrp = gi_surface_nrp(g);
@@ -220,7 +220,7 @@ pt_status gi_radiance_lists(gi_lists *L, const gi_surface *g, const gi_particles
     L->off = malloc(((size_t)L->nrp + 1) * sizeof *L->off);
     pt_status st = PT_OK;
     if (!J.grid || !J.fine || !alive || !J.out || !J.outlen || !J.count || !L->off) st = PT_ERR_NOMEM;
-    if (st == PT_OK && chunks > 0 && !pool_run_cancel(threads, chunks, job, &J, cancel)) st = PT_CANCELLED;
+    if (st == PT_OK && chunks > 0 && !pool_run_counted(threads, chunks, job, &J, cancel, prog)) st = PT_CANCELLED;
     if (st == PT_OK && atomic_load(&J.oom)) st = PT_ERR_NOMEM;
     long total = 0;
     if (st == PT_OK) {

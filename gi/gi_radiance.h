@@ -14,6 +14,7 @@
 #define PT_GI_RADIANCE_H
 #include "gi_area_particles.h"
 #include "gi_surface.h"
+#include "progress.h"
 
 typedef struct {
     long nrp;
@@ -50,8 +51,10 @@ typedef struct {
 int gi_visible_segment(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, gi_segment *sg);
 int gi_visible_along(const accel *a, double eps, const gi_segment *sg, const scene_object *own);
 
+/* prog (may be NULL): its current stage counts the chunks of radiance
+ * particles whose lists are done. */
 pt_status gi_radiance_lists(gi_lists *L, const gi_surface *g, const gi_particles *ps, const accel *a, double r,
-                            double cos_thr, int threads, volatile int *cancel, diag *d);
+                            double cos_thr, int threads, volatile int *cancel, progress *prog, diag *d);
 void gi_lists_free(gi_lists *L);
 
 #endif
