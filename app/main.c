@@ -186,6 +186,7 @@ static int cmd_parse(int argc, char **argv)
 {
     if (cli_wants_help(argc, argv)) {
         fputs(cli_parse_help, stdout);
+        fputs(cli_exit_codes, stdout);
         return EXIT_OK;
     }
     cli_render o;

@@ -302,7 +302,7 @@ static int split_grid(shape_kind k)
  * over 116 degrees), and a hit on the lit top interpolated radiance
  * particles of the dark side below the rim, which faces down: the lathe read -7.9% and the sor -6.4% (means of
  * particle seeds 11-14 against path 1024 spp); with this bound -2.4% and
- * -0.4% (docs/gi.md, "Sweep cells and the normal's turning"). */
+ * -0.4% (test_gi_grids' lathe and sor). */
 #define SWEEP_TURN 0.4510268117962624
 
 static int split_grid_build(const geom_shape *sh, double tess, mesh_ctx *m)
