@@ -428,7 +428,11 @@ static int converged_reference(const xc_opts *o, const char *povray, const char 
         return 3;
     }
     remove(log);
+    if (!o->quiet)
+        fprintf(stderr, "partray crosscheck: POV-Ray's converged render (count %d, error_bound %g; at most %.0f s)...\n",
+                c->count, c->error_bound, o->converged_timeout);
     int prc = run_povray(o, povray, work, input, made_name, scene_dir, log, o->converged_timeout, &c->seconds, d);
+    if (!o->quiet && prc == 0) fprintf(stderr, "partray crosscheck: converged render done in %.1f s\n", c->seconds);
     remove(path);
     if (prc == 124) {
         remove(made);
@@ -588,9 +592,12 @@ int cmd_crosscheck(int argc, char **argv)
     signal(SIGINT, on_stop);
     signal(SIGTERM, on_stop);
 
-    /* POV-Ray at the scene's own settings (the default render). */
+    /* POV-Ray at the scene's own settings (the default render). Each child
+     * writes to its log; a line before and after each says what runs. */
     {
+        if (!o.quiet) fprintf(stderr, "partray crosscheck: POV-Ray rendering %s at %dx%d...\n", o.scene, o.width, o.height);
         int prc = run_povray(&o, povray, work, base, pov_out, scene_dir, pov_log, 0.0, &t_pov, d);
+        if (!o.quiet && prc == 0) fprintf(stderr, "partray crosscheck: POV-Ray done in %.1f s\n", t_pov);
         char made[4300];
         snprintf(made, sizeof made, "%s/%s", work, pov_out);
         if (prc != 0 || access(made, R_OK) != 0) {
@@ -647,7 +654,9 @@ int cmd_crosscheck(int argc, char **argv)
         snprintf(args[n++], sizeof args[0], "%s", pt_json);
         for (int i = 0; i < n; i++) argvv[i] = args[i];
         argvv[n] = NULL;
+        if (!o.quiet) fprintf(stderr, "partray crosscheck: partray rendering %s at %dx%d...\n", o.scene, o.width, o.height);
         int prc = subproc_run(argvv, NULL, pt_log, &t_pt, d);
+        if (!o.quiet && prc == 0) fprintf(stderr, "partray crosscheck: partray done in %.1f s\n", t_pt);
         if (prc != 0) {
             print_diags(d);
             fprintf(stderr, "partray crosscheck: partray render failed (exit %d)\n", prc);
