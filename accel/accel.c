@@ -1277,7 +1277,6 @@ static inline double eps_rule(double scale, vec3 org, double dirlen)
     return ACCEL_EPS_REL * (scale + m) / dirlen;
 }
 
-void accel_set_function_env(const struct func_env *env) { geom_set_function_env(env); }
 
 double accel_epsilon(const accel *a, vec3 org, vec3 dir)
 {

@@ -146,10 +146,4 @@ long accel_rtc_triangles(const accel *a, unsigned geom, const float **v, const u
 /* The smallest ray parameter queries accept (see the self-intersection rule). */
 double accel_epsilon(const accel *a, vec3 org, vec3 dir);
 
-/* Evaluators (POV-Ray noise, pigment functions) that isosurface functions
- * may need, from the renderer (core/func.h): geom_set_function_env
- * (geom/geom_shape.h). Process-wide; set it before rendering. */
-struct func_env;
-void accel_set_function_env(const struct func_env *env);
-
 #endif

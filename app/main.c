@@ -483,7 +483,6 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
             gi_keep_free(&run->keep);
         }
     }
-    accel_set_function_env(shade_func_env()); /* isosurface functions: noise, pigment functions */
     t0 = timer_now();
     if (!reuse) progress_stage(prog, "accel", 0);
     accel *acc = reuse ? run->keep.acc : accel_build(sc, threads, d, &st);

@@ -935,7 +935,6 @@ int cmd_view(int argc, char **argv)
     v.gi_mode = gi;
 
     diag *ad = diag_new();
-    accel_set_function_env(shade_func_env()); /* isosurface functions */
     accel *acc = accel_build(sc, v.threads, ad, &st);
     print_diags(ad);
     diag_free(ad);

@@ -124,9 +124,13 @@ typedef struct { int nsegments; double (*segments)[8]; double depth; } scene_tex
 
 /* isosurface: function(x, y, z) = threshold inside a box or sphere
  * (contained_by, default box { -1, 1 }); inside where the function is below
- * the threshold. The function is core/func.h's scene_function. */
+ * the threshold. The function is core/func.h's scene_function; env the
+ * evaluators it may call (POV-Ray noise, pigment functions: the parse's
+ * sdl_options.func_env), NULL: core/func.h's own functions only (then a
+ * function needing more is NaN and the isosurface empty). */
 typedef struct {
     const struct scene_function *fn;
+    const struct func_env *env;
     int sphere;            /* container: 0 box c1..c2, 1 sphere centre c1 radius */
     vec3 c1, c2;
     double radius;

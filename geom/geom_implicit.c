@@ -44,15 +44,11 @@ typedef struct {
     vec3 blo, bhi;
     /* isosurface */
     const scene_function *fn;
+    const func_env *env; /* the function's evaluators (scene_isosurface.env) */
     int iso_sphere, open;
     vec3 ic1, ic2;
     double ir, thr, acc, grad, size;
 } im_data;
-
-/* The renderer's evaluators for functions (noise, pigments); process-wide. */
-static const func_env *volatile g_func_env;
-
-void geom_set_function_env(const func_env *env) { g_func_env = env; }
 
 /* ------------------------------------------------------------ superellipsoid */
 
@@ -625,7 +621,7 @@ static int blob_setup(im_data *m, const scene_blob *b, vec3 *lo, vec3 *hi)
 static double iso_f(const im_data *m, vec3 p)
 {
     double args[FUNC_MAX_SLOTS] = {p.x, p.y, p.z};
-    return func_eval_float(m->fn, args, (const func_env *)g_func_env) - m->thr;
+    return func_eval_float(m->fn, args, m->env) - m->thr;
 }
 
 static int iso_container(const im_data *m, vec3 o, vec3 d, double *a, double *b)
@@ -797,6 +793,7 @@ int geom_implicit_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi
         if (!is || !is->fn) break;
         m->type = IM_ISO;
         m->fn = is->fn;
+        m->env = is->env;
         m->iso_sphere = is->sphere;
         m->ic1 = is->c1;
         m->ic2 = is->c2;

@@ -135,13 +135,6 @@ void geom_shape_uv(const geom_shape *sh, vec3 p, int part, double uv[2]);
 typedef int (*geom_grid_fn)(void *ctx, const vec3 p[3], const vec3 n[3]);
 int geom_shape_grid(const geom_shape *sh, int n, geom_grid_fn fn, void *ctx);
 
-/* Evaluators (POV-Ray noise, pigment functions) that isosurface functions
- * may need, from the renderer (core/func.h). Process-wide; set it before
- * the shapes are queried. Without it such functions are NaN and those
- * isosurfaces stay empty. */
-struct func_env;
-void geom_set_function_env(const struct func_env *env);
-
 /* Real roots of c[0] + c[1] x + ... + c[n] x^n (n <= 4) inside [a, b], in
  * ascending order; returns their number. Exposed for the unit tests. */
 int geom_poly_roots(const double *c, int n, double a, double b, double *roots);

@@ -91,9 +91,6 @@ static query *query_get(sdl_parser *p, const scene_object *o)
     query *q = calloc(1, sizeof *q);
     if (!q) return NULL;
     q->o = o;
-    /* geom's isosurfaces evaluate their functions with the process-wide
-     * evaluators: the parse's own */
-    if (p->opt.func_env) geom_set_function_env(p->opt.func_env);
     geom_csg_builder bld = {NULL, NULL, 0, 1, NULL, 0};
     if (geom_csg_build(&q->c, o, NULL, 0, -1, 0, &bld) != PT_OK) {
         geom_csg_free(&q->c);

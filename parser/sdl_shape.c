@@ -1050,6 +1050,7 @@ static void isosurface_args(sdl_parser *p, scene_object *o, src_loc loc)
     iso->accuracy = 0.001;
     iso->max_gradient = 1.1;
     iso->max_trace = 1;
+    iso->env = p->opt.func_env;
     while (sdl_ok(p)) {
         const sdl_tok *t = sdl_peek(p);
         if (t->tk.kind != TOK_KEYWORD) break;
