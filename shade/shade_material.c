@@ -184,6 +184,12 @@ void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec
         }
         shade_light_metallic_tint(&refl, f->reflection_metallic, pig, cos_i);
     }
+    /* conserve_energy: what the reflection takes is not transmitted
+     * (trace.cpp: filCol *= min(1, 1 - reflectivity), as shade_texture.c);
+     * without it a glass of reflection 1 and transmit 1 returns up to twice
+     * what it receives at every bounce */
+    if (f->conserve_energy)
+        tc = mrgb(tc.r * fmin(1.0, 1.0 - refl.r), tc.g * fmin(1.0, 1.0 - refl.g), tc.b * fmin(1.0, 1.0 - refl.b));
     /* Transmission: straight through, or refracted when an ior is given. */
     rgb trans = {0, 0, 0};
     if (mrgb_max(tc) > 0.0) {

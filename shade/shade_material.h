@@ -38,9 +38,10 @@
  * Emission follows POV-Ray 3.7's rules with radiosity on (core/radrules.h):
  * `ambient * ambient_light` is part of it only in scenes whose effective
  * #version is below 3.7; in 3.7 scenes only `emission` gives off light.
- * reflection_exponent and conserve_energy are not modelled (the exponent is
- * non-linear in the reflected radiance); interior fade (absorption) neither,
- * as in shade.c. The weights need not sum to 1 (POV-Ray finishes are not
+ * conserve_energy takes the reflected part from the transmitted one (the
+ * top layer's reflection, as POV-Ray does per layer). reflection_exponent is
+ * not modelled (it is non-linear in the reflected radiance); interior fade
+ * (absorption) neither, as in shade.c. The weights need not sum to 1 (POV-Ray finishes are not
  * energy-conserving); estimators stay unbiased, Russian roulette bounds the
  * cost.
  *
