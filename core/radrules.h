@@ -32,9 +32,10 @@
  *    (times its emission) over the background colour, alpha ignored
  *    (GatherLight clears alphaBackground). shade/ evaluates it
  *    (shade_atmos_sky); gi/ receives it as a callback from app/.
- * 5. `media on` lets gathering rays see media (default off:
- *    GetRadiosityQualityFlags drops media); `normal on` gathers about the
- *    perturbed normal (default off: the raw normal).
+ * 5. `media on` lets gathering rays see media, and with them fog and
+ *    rainbows (default off: GetRadiosityQualityFlags drops the media
+ *    quality flag, which TraceRay asks before all three); `normal on`
+ *    gathers about the perturbed normal (default off: the raw normal).
  * 6. `recursion_limit` is how many bounces of gathered light POV-Ray
  *    follows; `count`, `error_bound`, `pretrace_*`, `nearest_count`,
  *    `minimum_reuse`, `maximum_reuse`, `low_error_factor`,
@@ -50,7 +51,10 @@
  *    rays of the k-th gathering step (k = 1, 2, ...) start at int(1.5 k),
  *    with the limit raised to at least that + 1. This is what bounds light
  *    trapped in glass (total internal reflection adds the transmitted weight
- *    to the mirror, so a POV-Ray finish can return more than it receives). */
+ *    to the mirror, so a POV-Ray finish can return more than it receives).
+ * 8. At the hits of gathering rays POV-Ray adds no phong or specular
+ *    highlights (trace.cpp's IsRadiosityRay tests) and takes area lights as
+ *    points at their centre (GetRadiosityQualityFlags clears areaLights). */
 #ifndef PT_RADRULES_H
 #define PT_RADRULES_H
 #include "scene.h"
