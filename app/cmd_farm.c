@@ -55,6 +55,7 @@ typedef struct {
     int max_rounds;
     /* parallel */
     char sshloginfile[2048];
+    char sbatch_opts[1024]; /* slurm: extra sbatch options (partition, time limit...), as given */
     int jobs, retries;
     double timeout;        /* seconds the driver waits, 0 = no limit */
 } farm_plan;
@@ -135,9 +136,9 @@ static int save_plan(const farm_plan *p)
     char path[2100], text[16384];
     snprintf(text, sizeof text,
              "partray_farm 1\ndir %s\npartray %s\nframes %d %d %d %d\ntiles %d %d %d\noutput %s\nengine %s\n"
-             "max_rounds %d\nsshloginfile %s\njobs %d\nretries %d\n",
+             "max_rounds %d\nsshloginfile %s\njobs %d\nretries %d\nsbatch_opts %s\n",
              p->dir, p->partray, p->first, p->last, p->digits, p->animated, p->tiles, p->width, p->height, p->output,
-             p->engine, p->max_rounds, p->sshloginfile, p->jobs, p->retries);
+             p->engine, p->max_rounds, p->sshloginfile, p->jobs, p->retries, p->sbatch_opts);
     snprintf(path, sizeof path, "%s/plan", p->dir);
     return write_text(path, text);
 }
@@ -165,6 +166,7 @@ static int load_plan(const char *dir, farm_plan *p)
         else if (!strcmp(line, "sshloginfile")) snprintf(p->sshloginfile, sizeof p->sshloginfile, "%s", v);
         else if (!strcmp(line, "jobs")) p->jobs = atoi(v);
         else if (!strcmp(line, "retries")) p->retries = atoi(v);
+        else if (!strcmp(line, "sbatch_opts")) snprintf(p->sbatch_opts, sizeof p->sbatch_opts, "%s", v);
     }
     free(t);
     return ok && p->tiles > 0 && p->last >= p->first;
@@ -294,16 +296,16 @@ static int slurm_submit(const farm_plan *p, const int *idx, int n)
         snprintf(s, sizeof s, "%s%d", i ? "," : "", idx[i]);
         append(list, sizeof list, s);
     }
-    snprintf(cmd, sizeof cmd, "sbatch --parsable --requeue -J partray-tiles --array=%s -o '%s/logs/task-%%A_%%a.log' '%s/task.sh'",
-             list, p->dir, p->dir);
+    snprintf(cmd, sizeof cmd, "sbatch --parsable --requeue %s -J partray-tiles --array=%s -o '%s/logs/task-%%A_%%a.log' '%s/task.sh'",
+             p->sbatch_opts, list, p->dir, p->dir);
     if (run_capture(cmd, out, sizeof out) != 0) {
         fprintf(stderr, "farm: sbatch failed: %s", out);
         return -1;
     }
     int job = atoi(out);
     snprintf(cmd, sizeof cmd,
-             "sbatch --parsable -J partray-merge --dependency=afterany:%d -o '%s/logs/merge-%%j.log' '%s/merge.sh'", job,
-             p->dir, p->dir);
+             "sbatch --parsable %s -J partray-merge --dependency=afterany:%d -o '%s/logs/merge-%%j.log' '%s/merge.sh'",
+             p->sbatch_opts, job, p->dir, p->dir);
     if (run_capture(cmd, out, sizeof out) != 0) {
         fprintf(stderr, "farm: sbatch of the merge job failed: %s", out);
         return -1;
@@ -503,7 +505,7 @@ static int run_slurm(const farm_plan *p, double t0)
 static const char *farm_help =
     "usage: partray farm SCENE.pov|anim.ini [render options] -o OUT.exr|.png|.pfm --dir DIR [--tiles N]\n"
     "                    [--engine parallel|slurm] [--sshloginfile FILE] [--jobs N] [--retries N]\n"
-    "                    [--max-rounds N] [--timeout SECONDS]\n"
+    "                    [--max-rounds N] [--timeout SECONDS] [--sbatch-opts STR]\n"
     "Splits the frames (+KFI +KFF ... as render reads them) into N horizontal tiles each, one\n"
     "idempotent `partray render` task per frame x tile (DIR/tasks.txt), runs them with GNU parallel\n"
     "(--sshloginfile, ':' = this machine, the default) or Slurm (a job array and a merge job),\n"
@@ -515,7 +517,8 @@ static const char *farm_help =
     "  --jobs N           parallel: tasks at once per host (default 2)\n"
     "  --retries N        parallel: tries of a task within a round (default 2)\n"
     "  --max-rounds N     rounds of running what is missing (default 3)\n"
-    "  --timeout S        slurm: stop waiting after S seconds (the jobs go on)\n";
+    "  --timeout S        slurm: stop waiting after S seconds (the jobs go on)\n"
+    "  --sbatch-opts STR  slurm: more sbatch options for every job, e.g. '-p render --time=1:00:00'\n";
 
 int cmd_farm(int argc, char **argv)
 {
@@ -538,7 +541,8 @@ int cmd_farm(int argc, char **argv)
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         int takes = !strcmp(a, "--tiles") || !strcmp(a, "--dir") || !strcmp(a, "--engine") || !strcmp(a, "--jobs") ||
                     !strcmp(a, "--retries") || !strcmp(a, "--max-rounds") || !strcmp(a, "--sshloginfile") ||
-                    !strcmp(a, "--timeout") || !strcmp(a, "--inject-fault") || !strcmp(a, "-o") || !strcmp(a, "--output");
+                    !strcmp(a, "--timeout") || !strcmp(a, "--inject-fault") || !strcmp(a, "-o") || !strcmp(a, "--output") ||
+                    !strcmp(a, "--sbatch-opts");
         if (takes && !v) {
             fprintf(stderr, "partray farm: option '%s' needs a value\n", a);
             free(rest);
@@ -552,6 +556,16 @@ int cmd_farm(int argc, char **argv)
         else if (!strcmp(a, "--max-rounds")) p.max_rounds = atoi(v);
         else if (!strcmp(a, "--sshloginfile")) sshlogin = v;
         else if (!strcmp(a, "--timeout")) p.timeout = atof(v);
+        else if (!strcmp(a, "--sbatch-opts")) {
+            /* given to sbatch through sh: the words of one option list, no
+             * quotes or shell characters (the plan file holds one line) */
+            if (strpbrk(v, "'\"`$;&|<>\n\\") || strlen(v) >= sizeof p.sbatch_opts) {
+                fprintf(stderr, "partray farm: --sbatch-opts wants plain sbatch options (no quotes or shell characters)\n");
+                free(rest);
+                return 2;
+            }
+            snprintf(p.sbatch_opts, sizeof p.sbatch_opts, "%s", v);
+        }
         /* for tests of the recovery: the first run of task F:T (frame,
          * tile) is sent SIGTERM shortly after it starts, as a preempted
          * job is; the real render then stops with exit 143 */

@@ -834,8 +834,14 @@ static int cmd_render(int argc, char **argv)
         char *names[8];
         int ok = 1;
         for (int i = 0; i < nbases; i++) ok &= (names[i] = anim_output_name(bases[i], f, plan.animated ? plan.digits : 0)) != NULL;
-        if (!o.quiet && plan.animated)
-            fprintf(stderr, "partray: frame %d (%d of %d) -> %s\n", f, f - plan.first + 1, nframes, names[0]);
+        if (!o.quiet && plan.animated) {
+            /* the ETA from the frames so far (the first frame builds what
+             * later ones may keep, so it is an upper bound then) */
+            int done = f - plan.first;
+            char eta[48] = "";
+            if (done > 0) snprintf(eta, sizeof eta, ", ETA %.1f s", (timer_now() - t_start) / done * (nframes - done));
+            fprintf(stderr, "partray: frame %d (%d of %d%s) -> %s\n", f, done + 1, nframes, eta, names[0]);
+        }
         rc = ok ? render_frame(&run, &plan, f, names, nbases) : EXIT_IO;
         for (int i = 0; i < nbases; i++) free(names[i]);
     }
