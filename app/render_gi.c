@@ -139,7 +139,6 @@ typedef struct {
     const char *path;
     double last;
     diag *notes;
-    progress *progress;
     int *image_begun;
 } progressive_ctx;
 
@@ -155,12 +154,14 @@ static void on_image(void *ctx, const framebuffer *fb, int done, int total)
     diag_free(d);
 }
 
-/* the reference renderers report the fraction of their image loop done */
+/* the reference renderers report the fraction of their image loop done:
+ * from the first report on, the framebuffer holds rendered pixels (their
+ * stages count on the progress themselves, pm_common.progress) */
 static void on_progress(void *ctx, double f)
 {
+    (void)f;
     progressive_ctx *p = ctx;
     *p->image_begun = 1;
-    progress_set(p->progress, (long long)(f * 1000.0 + 0.5));
 }
 
 static void fill_common(pm_common *c, const render_gi_opts *o, progressive_ctx *pc)
@@ -178,16 +179,16 @@ static void fill_common(pm_common *c, const render_gi_opts *o, progressive_ctx *
     }
     c->on_progress = on_progress;
     c->progress_ctx = pc;
+    c->progress = o->progress;
 }
 
 static pt_status render_reference(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
                                   render_gi_result *r, diag *d)
 {
-    progressive_ctx pc = {o->progressive_path, 0.0, o->notes, o->progress, &r->image_begun};
+    progressive_ctx pc = {o->progressive_path, 0.0, o->notes, &r->image_begun};
     pt_status st;
     r->has_pm = 1;
     double t0 = timer_now();
-    progress_stage(o->progress, o->mode == GI_PATH ? "path tracing" : "photon map + final gather", 1000);
     if (o->mode == GI_PATH) {
         pm_path_settings ps;
         pm_path_default_settings(&ps);

@@ -140,7 +140,7 @@ int main(int argc, char **argv)
     pm_photon_result pr;
     memset(&pr, 0, sizeof pr);
     for (int r = 0; r < reps; r++) {
-        pm_photon_settings ps = {photons, 0, 256, 1, threads, NULL};
+        pm_photon_settings ps = {photons, 0, 256, 1, threads, NULL, NULL};
         double t0 = timer_now();
         if (pm_photons_trace(sc, a, L, &ps, &pr) != PT_OK) return 1;
         t[r] = timer_now() - t0;

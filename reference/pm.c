@@ -129,6 +129,7 @@ static void tile_job(void *p, int tile, int thread)
     L->tile_spp[tile] = L->s1;
     long done = atomic_fetch_add(&L->done, (long)(x1 - x0) * (y1 - y0) * (L->s1 - L->s0)) +
                 (long)(x1 - x0) * (y1 - y0) * (L->s1 - L->s0);
+    progress_add(c->progress, (long long)(x1 - x0) * (y1 - y0) * (L->s1 - L->s0));
     if (c->on_progress) {
         double now = timer_now();
         if (now - L->last_progress >= 0.1 && pthread_mutex_trylock(&L->mu) == 0) {
@@ -179,6 +180,7 @@ pt_status pm_image_render(const scene *sc, const pm_common *c, int max_pass, fra
     pthread_mutex_init(&L.mu, NULL);
     L.total = (long)c->width * c->height * spp;
     atomic_init(&L.done, 0);
+    progress_stage(c->progress, "render", L.total);
     double last_image = timer_now();
     int passes = 0, pass = 1, s = 0;
     while (s < spp) {

@@ -13,6 +13,7 @@
 #include <stdint.h>
 #include "diag.h"
 #include "framebuffer.h"
+#include "progress.h"
 #include "rng.h"
 #include "scene.h"
 
@@ -70,6 +71,8 @@ typedef struct {
     double image_interval;  /* seconds between on_image calls (default 10) */
     pm_progress_fn on_progress;
     void *progress_ctx;
+    progress *progress;     /* the render's stages (pmfg: photons, irradiance; both: "render", the image
+                               loop's samples) with their counts (core/progress.h); NULL: none */
 } pm_common;
 
 void pm_common_defaults(pm_common *c);

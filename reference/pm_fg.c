@@ -488,7 +488,8 @@ pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s,
 
     /* 1. photons */
     pm_photon_settings ps = {s->photons, caustics, s->max_photon_bounces > 0 ? s->max_photon_bounces : 256, s->c.seed,
-                             threads, s->c.cancel};
+                             threads, s->c.cancel, s->c.progress};
+    progress_stage(s->c.progress, "pmfg: photons", 0);
     pm_photon_result pr;
     status = pm_photons_trace(sc, a, L, &ps, &pr);
     double t2 = timer_now();
@@ -511,6 +512,7 @@ pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s,
     }
 
     /* 2. maps */
+    progress_stage(s->c.progress, "pmfg: photon maps", 0);
     c.global = pm_kdtree_build(pr.global, pr.nglobal, threads);
     c.caustic = pm_kdtree_build(pr.caustic, pr.ncaustic, threads);
     st->caustic_map = caustics && pr.ncaustic > 0;
@@ -528,7 +530,8 @@ pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s,
         } else {
             long *vrays = calloc((size_t)threads, sizeof *vrays);
             irr_job j = {&c, pm_kdtree_photons(c.global), n, stride, pts, c.scratch, vrays};
-            if (vrays) pool_run(threads, (int)((n + IRR_BLOCK - 1) / IRR_BLOCK), irr_block, &j);
+            progress_stage(s->c.progress, "pmfg: irradiance", 0);
+            if (vrays) pool_run_counted(threads, (int)((n + IRR_BLOCK - 1) / IRR_BLOCK), irr_block, &j, NULL, s->c.progress);
             else status = PT_ERR_NOMEM;
             for (int t = 0; vrays && t < threads; t++) st->shadow_rays += vrays[t]; /* visibility tests (vis_ok) */
             free(vrays);

@@ -444,7 +444,7 @@ pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, 
         long i0 = (long)i * CHUNK, i1 = i0 + CHUNK < total ? i0 + CHUNK : total;
         c.chunks[i].cap = (long)ceil(cap * (double)(i1 - i0) / (double)total);
     }
-    pool_run(pm_threads(s->threads), c.nchunks, chunk_job, &c);
+    pool_run_counted(pm_threads(s->threads), c.nchunks, chunk_job, &c, NULL, s->progress);
 
     long ng = 0, nc = 0;
     int oom = 0;

@@ -53,6 +53,7 @@ typedef struct {
     uint64_t seed;
     int threads;
     volatile int *cancel;
+    progress *progress;  /* its current stage counts the chunks of photon paths traced (NULL: none) */
 } pm_photon_settings;
 
 typedef struct {
