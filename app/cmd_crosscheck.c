@@ -53,7 +53,7 @@
 #include "img_metrics.h"
 #include "scene.h"
 #include "sdl.h"
-#include "shade_funcenv.h"
+#include "pipeline.h"
 #include "stats_json.h"
 #include "stats_read.h"
 #include "subproc.h"
@@ -512,16 +512,13 @@ int cmd_crosscheck(int argc, char **argv)
     /* Does the scene use radiosity? (partray's parser; errors stop here.) */
     diag *d = diag_new();
     sdl_options so;
-    sdl_default_options(&so);
+    pipeline_sdl_options(&so, NULL, o.width, o.height); /* as render parses (pipeline.h) */
     so.lib_paths = o.libs;
     so.nlib_paths = o.nlibs;
     so.defines = o.defines;
     so.ndefines = o.ndefines;
-    so.image_width = o.width;
-    so.image_height = o.height;
-    so.func_env = shade_func_env(); /* as render parses: pattern functions, isosurfaces in trace() */
     scene *sc = NULL;
-    pt_status st = sdl_parse_file(o.scene, &so, &sc, d);
+    pt_status st = pipeline_parse(o.scene, &so, &sc, d, NULL);
     if (st != PT_OK) {
         print_diags(d);
         diag_free(d);

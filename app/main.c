@@ -20,6 +20,7 @@
 #include "img_ocio.h"
 #include "ini.h"
 #include "lighting_study.h"
+#include "pipeline.h"
 #include "pool.h"
 #include "progress.h"
 #include "progress_bar.h"
@@ -28,7 +29,6 @@
 #include "sdl.h"
 #include "shade.h"
 #include "shade_aov.h"
-#include "shade_funcenv.h"
 #include "stats_json.h"
 #include "timer.h"
 #include "view.h"
@@ -102,35 +102,9 @@ static int print_diags(const diag *d, int quiet)
 
 static int status_exit(pt_status st) { return cli_exit_status(st); }
 
-/* POV-Ray warns about a scene without objects and renders its background
- * (POV-Ray 3.7 source, parser.cpp: "No objects in scene."); so does this. */
-static void warn_if_empty(const scene *sc, diag *d)
-{
-    scene_counts c = scene_count(sc);
-    if (c.objects == 0) {
-        src_loc none = {NULL, 0, 0};
-        diag_report(d, DIAG_WARNING, none, NULL, "no objects in scene: the image shows only the background");
-    }
-}
-
 static void fill_sdl_options(sdl_options *so, const cli_render *o, const anim_plan *plan, int frame)
 {
-    sdl_default_options(so);
-    so->lib_paths = o->libs;
-    so->nlib_paths = o->nlibs;
-    so->defines = o->defines;
-    so->ndefines = o->ndefines;
-    so->image_width = o->width > 0 ? o->width : 320;
-    so->image_height = o->height > 0 ? o->height : 240;
-    if (o->max_loop > 0) so->max_loop_iterations = o->max_loop;
-    if (o->max_include_depth > 0) so->max_include_depth = o->max_include_depth;
-    if (o->max_macro_depth > 0) so->max_macro_depth = o->max_macro_depth;
-    if (o->max_tokens > 0) so->max_tokens = o->max_tokens;
-    if (o->max_memory_mib > 0) so->max_memory = o->max_memory_mib > (1LL << 40) ? (1LL << 60) : o->max_memory_mib << 20;
-    if (o->max_string > 0) so->max_string_length = o->max_string;
-    if (o->max_array > 0) so->max_array_elements = o->max_array;
-    if (o->max_image_pixels > 0) so->max_image_pixels = o->max_image_pixels;
-    so->func_env = shade_func_env(); /* pattern/pigment functions, noise, vturbulence while parsing */
+    pipeline_sdl_options(so, o, o->width > 0 ? o->width : 320, o->height > 0 ? o->height : 240);
     cli_frame_options(o, plan, frame, so);
 }
 
@@ -205,11 +179,9 @@ static int cmd_parse(int argc, char **argv)
         diag *d = diag_new();
         diag_set_sink(d, pbar_diag_sink, bar); /* #debug text as the parse produces it */
         scene *sc = NULL;
-        double t0 = timer_now();
-        pt_status st = sdl_parse_file(o.scene, &so, &sc, d);
-        double t1 = timer_now();
+        double t_parse = 0.0;
+        pt_status st = pipeline_parse(o.scene, &so, &sc, d, &t_parse);
         pbar_stop(bar);
-        if (st == PT_OK) warn_if_empty(sc, d);
         diag_free(d);
         pbar_free(bar);
         progress_free(prog);
@@ -221,7 +193,7 @@ static int cmd_parse(int argc, char **argv)
         char frame[32] = "";
         if (plan.animated) snprintf(frame, sizeof frame, " frame %d", f);
         printf("%s%s: %ld objects (%ld CSG nodes), %ld lights, %ld triangles in %ld meshes, %ld unsupported, %d files, %.3f s\n",
-               o.scene, frame, c.objects, c.csg, c.lights, c.triangles, c.meshes, c.unsupported, sc->nfiles, t1 - t0);
+               o.scene, frame, c.objects, c.csg, c.lights, c.triangles, c.meshes, c.unsupported, sc->nfiles, t_parse);
         scene_free(sc);
     }
     ini_free(ia);
@@ -423,20 +395,17 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     diag *d = diag_new();
     diag_set_sink(d, pbar_diag_sink, bar);
     scene *sc = NULL;
-    double t0 = timer_now();
-    pt_status st = sdl_parse_file(o->scene, &so, &sc, d);
-    double t_parse = timer_now() - t0;
+    double t_parse = 0.0;
+    pt_status st = pipeline_parse(o->scene, &so, &sc, d, &t_parse);
     if (st != PT_OK) {
         diag_free(d);
         pbar_free(bar);
         progress_free(prog);
         return status_exit(st);
     }
-    warn_if_empty(sc, d);
     lighting_apply_units(ls, sc, d); /* photometric lights; warns about fade */
-    int gi = o->gi ? gi_mode_parse(o->gi) : GI_NONE;
     /* below +Q9 POV-Ray turns radiosity off (view.cpp: Q_ADVANCED_LIGHT) */
-    if (!o->gi && sc->global.radiosity.enabled && o->quality >= 9) gi = GI_PARTICLE;
+    int gi = pipeline_gi_mode(o->gi, sc, o->quality);
     if (o->quality_given && o->quality < 9) {
         src_loc none = {NULL, 0, 0};
         if (gi == GI_PATH || gi == GI_PMFG)
@@ -483,10 +452,9 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
             gi_keep_free(&run->keep);
         }
     }
-    t0 = timer_now();
     if (!reuse) progress_stage(prog, "accel", 0);
-    accel *acc = reuse ? run->keep.acc : accel_build(sc, threads, d, &st);
-    double t_accel = reuse ? 0.0 : timer_now() - t0;
+    double t_accel = 0.0;
+    accel *acc = reuse ? run->keep.acc : pipeline_accel(sc, threads, d, &st, &t_accel);
     if (!acc || st != PT_OK) {
         scene_free(sc);
         diag_free(d);
@@ -529,7 +497,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     framebuffer *fb = fb_new(ss.width, ss.height);
     render_gi_result sst;
     memset(&sst, 0, sizeof sst);
-    t0 = timer_now();
+    double t0 = timer_now();
     pt_status lst = ls->aov ? PT_OK : lighting_alloc(ls, ss.width, ss.height, d);
     ss.aov = ls->aov;
     st = fb && lst == PT_OK ? render_gi(sc, acc, &ss, fb, &sst, d) : PT_ERR_NOMEM;

@@ -13,10 +13,10 @@
 #include "diag.h"
 #include "gi.h"
 #include "img_io.h"
+#include "pipeline.h"
 #include "pool.h"
 #include "scene.h"
 #include "sdl.h"
-#include "shade_funcenv.h"
 #include "timer.h"
 #include "view_camera.h"
 #include "view_gi.h"
@@ -906,20 +906,13 @@ int cmd_view(int argc, char **argv)
         }
     }
 
+    /* the scene opened as `partray render` opens it (pipeline.h): the same
+     * options, limits and function evaluators */
     sdl_options so;
-    sdl_default_options(&so);
-    so.lib_paths = o.libs;
-    so.nlib_paths = o.nlibs;
-    so.defines = o.defines;
-    so.ndefines = o.ndefines;
-    so.image_width = v.width;
-    so.image_height = v.height;
-    if (o.max_loop > 0) so.max_loop_iterations = o.max_loop;
-    if (o.max_include_depth > 0) so.max_include_depth = o.max_include_depth;
-    if (o.max_macro_depth > 0) so.max_macro_depth = o.max_macro_depth;
+    pipeline_sdl_options(&so, &o, v.width, v.height);
     scene *sc = NULL;
     diag *pd = diag_new();
-    pt_status st = sdl_parse_file(o.scene, &so, &sc, pd);
+    pt_status st = pipeline_parse(o.scene, &so, &sc, pd, NULL);
     print_diags(pd);
     diag_free(pd);
     if (st != PT_OK) {
@@ -927,7 +920,10 @@ int cmd_view(int argc, char **argv)
         diag_free(d);
         return status_exit(st);
     }
-    if (gi < 0) gi = sc->global.radiosity.enabled && view_gi_available(GI_PARTICLE) ? GI_PARTICLE : GI_NONE;
+    if (gi < 0) {
+        gi = pipeline_gi_mode(NULL, sc, 9);
+        if (!view_gi_available(gi)) gi = GI_NONE;
+    }
     if (!view_gi_available(gi)) {
         fprintf(stderr, "partray view: GI mode '%s' is not available in the viewer; using none\n", gi_mode_name(gi));
         gi = GI_NONE;
@@ -935,14 +931,14 @@ int cmd_view(int argc, char **argv)
     v.gi_mode = gi;
 
     diag *ad = diag_new();
-    accel *acc = accel_build(sc, v.threads, ad, &st);
+    accel *acc = pipeline_accel(sc, v.threads, ad, &st, NULL);
     print_diags(ad);
     diag_free(ad);
-    if (!acc || st != PT_OK) {
+    if (!acc) {
         scene_free(sc);
         view_script_free(v.script);
         diag_free(d);
-        return status_exit(st == PT_OK ? PT_ERR_DEVICE : st);
+        return status_exit(st);
     }
     v.scale = accel_scale(acc);
     if (!(v.scale > 0) || !isfinite(v.scale)) v.scale = 10;

@@ -40,6 +40,7 @@
 #include "shade.h"
 #include "shade_texture.h"
 #include "timer.h"
+#include "pipeline.h"
 
 #ifndef BENCH_SCENE_DIR
 #define BENCH_SCENE_DIR "scenes"
@@ -209,23 +210,16 @@ int main(int argc, char **argv)
         return 1;
     }
     sdl_options so;
-    sdl_default_options(&so);
-    so.image_width = so.image_height = o.size;
-    scene *sc = NULL;
-    double t0 = timer_now();
-    if (sdl_parse_file(o.scene, &so, &sc, d) != PT_OK) {
+    pipeline_sdl_options(&so, NULL, o.size, o.size);
+    pipeline pl;
+    if (pipeline_open(&pl, o.scene, &so, o.threads, d) != PT_OK) {
         bench_report_diag(d);
         return 1;
     }
-    double t_parse = timer_now() - t0;
-    pt_status st;
-    t0 = timer_now();
-    accel *a = accel_build(sc, o.threads, d, &st);
-    if (!a) {
-        bench_report_diag(d);
-        return 1;
-    }
-    double t_accel = timer_now() - t0;
+    scene *sc = pl.sc;
+    accel *a = pl.acc;
+    double t_parse = pl.t_parse, t_accel = pl.t_accel;
+    pt_status st = PT_OK;
     scene_counts cnt = scene_count(sc);
     printf("scene %s: %ld objects, %ld triangles, %ld lights; parse %.3f s, accel %.3f s; %dx%d\n", o.scene, cnt.objects,
            cnt.triangles, cnt.lights, t_parse, t_accel, o.size, o.size);
@@ -450,8 +444,7 @@ int main(int argc, char **argv)
     fb_free(fb_none);
     fb_free(fb_gi);
     gi_particle_free(gp);
-    accel_free(a);
-    scene_free(sc);
+    pipeline_close(&pl);
     fb_free(g_ref);
     diag_free(d);
     return 0;

@@ -16,6 +16,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include "arena.h"
+#include "pipeline.h"
 #include "scene.h"
 #include "sdl.h"
 #include "timer.h"
@@ -75,9 +76,10 @@ static double time_parse(const char *path, int runs, size_t *ir_bytes, long *rss
         long before = peak_rss_kib();
         diag *d = diag_new();
         scene *s = NULL;
-        double t0 = timer_now();
-        pt_status st = sdl_parse_file(path, NULL, &s, d);
-        double t = timer_now() - t0;
+        sdl_options so;
+        pipeline_sdl_options(&so, NULL, 320, 240);
+        double t = 0.0;
+        pt_status st = pipeline_parse(path, &so, &s, d, &t);
         if (st != PT_OK) {
             for (int i = 0; i < diag_count(d); i++) {
                 char *m = diag_format(diag_get(d, i));

@@ -34,6 +34,7 @@
 #include "sdl.h"
 #include "shade_material.h"
 #include "timer.h"
+#include "pipeline.h"
 
 #ifndef BENCH_SCENE_DIR
 #define BENCH_SCENE_DIR "scenes"
@@ -116,19 +117,17 @@ int main(int argc, char **argv)
         if (f) fclose(f);
     }
     sdl_options so;
-    sdl_default_options(&so);
+    pipeline_sdl_options(&so, NULL, 320, 240);
     diag *d = diag_new();
-    scene *sc = NULL;
-    pt_status st = sdl_parse_file(scene_path, &so, &sc, d);
+    pipeline pl;
+    pt_status st = pipeline_open(&pl, scene_path, &so, threads, d);
     if (st != PT_OK) {
-        fprintf(stderr, "bench_reference: cannot parse %s\n", scene_path);
+        fprintf(stderr, "bench_reference: cannot open %s\n", scene_path);
+        bench_report_diag(d);
         return 1;
     }
-    accel *a = accel_build(sc, threads, d, &st);
-    if (!a || st != PT_OK) {
-        fprintf(stderr, "bench_reference: accel build failed\n");
-        return 1;
-    }
+    scene *sc = pl.sc;
+    accel *a = pl.acc;
     pm_lights *L = pm_lights_new(sc, a, d, &st);
     if (!L) return 1;
     printf("bench_reference: %s, %d threads, %d reps (median), %d lights, %d emitter pieces, radiosity %s\n",
@@ -257,8 +256,7 @@ int main(int argc, char **argv)
     free(tb);
     accel_surf_free(all_s);
     pm_lights_free(L);
-    accel_free(a);
-    scene_free(sc);
+    pipeline_close(&pl);
     diag_free(d);
     return 0;
 }

@@ -27,6 +27,7 @@
 #include "sdl.h"
 #include "shade_texture.h"
 #include "timer.h"
+#include "pipeline.h"
 
 #ifndef BENCH_SCENE_DIR
 #define BENCH_SCENE_DIR "scenes"
@@ -81,18 +82,15 @@ int main(int argc, char **argv)
     if (reps < 1) reps = 1;
     diag *d = diag_new();
     sdl_options so;
-    sdl_default_options(&so);
-    scene *sc = NULL;
-    if (sdl_parse_file(scene_path, &so, &sc, d) != PT_OK) {
+    pipeline_sdl_options(&so, NULL, 320, 240);
+    pipeline pl;
+    pt_status st = pipeline_open(&pl, scene_path, &so, threads, d);
+    if (st != PT_OK) {
         bench_report_diag(d);
         return 1;
     }
-    pt_status st;
-    accel *a = accel_build(sc, threads, d, &st);
-    if (!a) {
-        bench_report_diag(d);
-        return 1;
-    }
+    scene *sc = pl.sc;
+    accel *a = pl.acc;
     gi_particle_settings s;
     gi_particle_settings_from_scene(&s, sc);
     s.pigment = shade_tex_pigment_at;
@@ -173,8 +171,7 @@ int main(int argc, char **argv)
     free(tc);
     free(tk);
     gi_particle_free(gp);
-    accel_free(a);
-    scene_free(sc);
+    pipeline_close(&pl);
     diag_free(d);
     return 0;
 }

@@ -488,6 +488,111 @@ static void test_viewer_overlay_reference(void **st)
     diag_free(d);
 }
 
+/* ------------------------------------- functions at parse time, with a display */
+
+/* The viewer opens a scene as `partray render` does (app/pipeline.h): a
+ * scene whose parse calls vturbulence (POV-Ray's noise) and trace() on a
+ * sor places a sphere against the sor where the traced ray met it. Asserted:
+ * the viewer renders it (a parse without the evaluators stops at
+ * vturbulence with an error), its last refinement level equals `partray
+ * render`'s image of the same scene at the same size (mean absolute
+ * difference below FN_MEAN; under 2% of the pixels, the
+ * edges, differ by more than FN_EDGE; the sphere covers the same pixels to
+ * 10%), and the parse limits reach the viewer (--max-tokens 20 stops this
+ * scene's parse). */
+#define FN_MEAN 0.004
+#define FN_EDGE 0.05
+static const char *functions_pov =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 }\n"
+    "camera { location <0, 2.5, -6> look_at <0, 0.9, 0> }\n"
+    "light_source { <-4, 8, -5> color rgb 1 }\n"
+    "plane { y, 0 pigment { rgb 0.8 } finish { ambient 0 diffuse 0.8 } }\n"
+    "#declare S = sor { 5, <0, -0.5>, <1, 0>, <0.7, 1.2>, <0.3, 2>, <0, 2.5>\n"
+    "  pigment { rgb <0.9, 0.5, 0.2> } finish { ambient 0 diffuse 0.8 } }\n"
+    "object { S }\n"
+    "#declare N = <0, 0, 0>;\n"
+    "#declare P = trace(S, <3, 1, 0>, <-1, 0, 0>, N);\n"
+    "#declare V = vturbulence(2, 0.5, 6, <0.3, 0.2, 0.1>);\n"
+    "sphere { P + 0.35 * N + <0, 0.05 * V.y, 0>, 0.35 pigment { rgb <0.2, 0.4, 0.9> } finish { ambient 0 diffuse 0.8 } }\n";
+
+static void test_viewer_functions(void **st)
+{
+    (void)st;
+    if (!have_program("Xvfb")) {
+        printf("Xvfb not found on PATH: the viewer cannot be run headless here\n");
+        skip();
+    }
+    enum { FW = 96, FH = 96 };
+    char scene_path[512], script[512], cmd[4096], path[600], text[1024];
+    snprintf(scene_path, sizeof scene_path, "%s/fn.pov", tmpdir);
+    snprintf(script, sizeof script, "%s/fn.txt", tmpdir);
+    write_file(scene_path, functions_pov);
+    snprintf(text, sizeof text, "0.0 wait-idle\n0.1 screenshot %s/fn_view.exr\n0.2 quit\n", tmpdir);
+    write_file(script, text);
+    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' render '%s' -o '%s/fn_render.exr' --size %dx%d --gi none --threads 2 --quiet",
+             tmpdir, PARTRAY_BIN, scene_path, tmpdir, FW, FH);
+    assert_int_equal(run_capture(cmd), 0);
+    assert_true(start_xvfb());
+    snprintf(cmd, sizeof cmd,
+             "cd '%s' && ASAN_OPTIONS=detect_leaks=0 DISPLAY=%s timeout 120 '%s' view '%s' --size %dx%d --gi none --threads 2 "
+             "--script '%s'",
+             tmpdir, display, PARTRAY_BIN, scene_path, FW, FH, script);
+    int rc = run_capture(cmd);
+    printf("exit %d:\n%s", rc, out_text);
+    assert_int_equal(rc, 0);
+    /* the limits the command line gives reach the parse */
+    snprintf(cmd, sizeof cmd,
+             "cd '%s' && ASAN_OPTIONS=detect_leaks=0 DISPLAY=%s timeout 120 '%s' view '%s' --size %dx%d --gi none --threads 2 "
+             "--max-tokens 20 --script '%s'",
+             tmpdir, display, PARTRAY_BIN, scene_path, FW, FH, script);
+    int rc_limit = run_capture(cmd);
+    stop_xvfb();
+    printf("with --max-tokens 20: exit %d:\n%s", rc_limit, out_text);
+    assert_int_equal(rc_limit, 1);
+
+    framebuffer *r = NULL, *v = NULL;
+    diag *d = diag_new();
+    snprintf(path, sizeof path, "%s/fn_render.exr", tmpdir);
+    assert_int_equal(img_read(path, 0, &r, d), PT_OK);
+    snprintf(path, sizeof path, "%s/fn_view.exr", tmpdir);
+    assert_int_equal(img_read(path, 0, &v, d), PT_OK);
+    assert_int_equal(v->width, FW);
+    assert_int_equal(v->height, FH);
+    /* The viewer's camera is rebuilt from the scene's (view_camera.h), so
+     * its rays differ from render's in the last bits: edges and the far
+     * plane at the horizon land in neighbouring pixels. Compared: the mean
+     * difference, the pixels that differ by more than FN_EDGE, and the
+     * sphere's pixels (blue clearly above red) in each image. */
+    double sum_r = 0.0, sum_e = 0.0;
+    long edge = 0, sphere_r = 0, sphere_v = 0;
+    for (size_t p = 0; p < (size_t)FW * FH; p++) {
+        double e = 0.0;
+        for (int c = 0; c < 3; c++) {
+            assert_true(isfinite(v->rgb[3 * p + c]));
+            double ec = fabs((double)v->rgb[3 * p + c] - (double)r->rgb[3 * p + c]);
+            e = fmax(e, ec);
+            sum_e += ec;
+            sum_r += r->rgb[3 * p + c];
+        }
+        edge += e > FN_EDGE;
+        sphere_r += r->rgb[3 * p + 2] > 2.0 * r->rgb[3 * p] + 0.02;
+        sphere_v += v->rgb[3 * p + 2] > 2.0 * v->rgb[3 * p] + 0.02;
+    }
+    double mean_e = sum_e / (FW * FH * 3.0);
+    printf("view against render: mean |difference| %.5f (bound %.3f), %ld of %d pixels differ by more than %.2f; sphere "
+           "pixels %ld (render) and %ld (view); image mean %.4f\n",
+           mean_e, FN_MEAN, edge, FW * FH, FN_EDGE, sphere_r, sphere_v, sum_r / (FW * FH * 3.0));
+    assert_true(sum_r > 0.05 * FW * FH * 3.0); /* lit, not black */
+    assert_true(sphere_r > 50);                /* the traced placement put the sphere in view */
+    assert_true(labs(sphere_v - sphere_r) <= sphere_r / 10);
+    assert_true(mean_e < FN_MEAN);
+    assert_true(edge * 50 < FW * FH); /* under 2%: edges only */
+    fb_free(r);
+    fb_free(v);
+    diag_free(d);
+}
+
 /* ------------------------------------- particle relight, no display */
 
 static framebuffer *gi_pass(view_gi *g, int w, int h)
@@ -925,6 +1030,7 @@ int main(void)
         cmocka_unit_test(test_particle_relight_cancel),
         cmocka_unit_test(test_viewer_script),
         cmocka_unit_test(test_viewer_overlay_reference),
+        cmocka_unit_test(test_viewer_functions),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     stop_xvfb();
