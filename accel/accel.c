@@ -50,118 +50,11 @@
  * and triangles live in their own BVH). Hits outside the cube are rejected,
  * so the answer does not depend on how the BVH culls. */
 #include "accel.h"
-#include <assert.h>
-#include <embree3/rtcore.h>
-#include <float.h>
-#include <stdatomic.h>
-#include <stdint.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include "geom_csg.h"
-#include "geom_shape.h"
-#include "timer.h"
+#include "accel_internal.h"
 
-#define PLANE_EXTENT_FACTOR 1e4
-
-enum { GEOM_NONE = 0, GEOM_TRI, GEOM_USER, GEOM_INSTANCE };
-enum { INHERITED_FLAGS = OBJ_NO_SHADOW | OBJ_NO_IMAGE | OBJ_NO_REFLECTION | OBJ_NO_RADIOSITY };
-
-typedef struct {
-    const scene_object *obj;
-    const scene_texture *texture; /* effective, never NULL */
-    unsigned flags;               /* effective: CSG parents' no_* flags included */
-    double wind;                  /* -1 when the transform mirrors, else 1 */
-    int identity;                 /* transform is the identity */
-    int in_csg;                   /* member of a CSG primitive, built there */
-    int group;                    /* shared-mesh group, -1 if none */
-    int b0, bn;                   /* bounded_by: a->bshapes[b0 .. b0+bn) (analytic leaves) */
-    int want_uv;                  /* uv_mapping on the object or in its textures: analytic hits
-                                     compute POV-Ray's UV (else hit.uv is the world x, y) */
-} accel_leaf;
-
-/* bounded_by of the objects above a leaf (unions are flattened into their
- * members, which keep the union's bound, as POV-Ray's CSG union checks it
- * before its children). Lives on the stack during collect(). */
-typedef struct bound_chain {
-    const scene_object *host;
-    const struct bound_chain *up;
-} bound_chain;
-
-typedef struct { unsigned leaf, local; } tri_ref;
-
-typedef struct {
-    float *v;       /* xyz per vertex (build time only) */
-    size_t nv, capv;
-    unsigned *idx;  /* 3 per triangle (build time only) */
-    tri_ref *refs;  /* per triangle (kept) */
-    size_t nt, capi, capr;
-} tri_batch;
-
-typedef struct { int kind; unsigned idx; } geom_info;
-
-typedef struct {
-    const scene_mesh *mesh;
-    RTCScene scene;
-    int any_no_shadow;
-} mesh_group;
-
-struct accel {
-    RTCDevice dev;
-    RTCScene root;
-    const scene *s;
-    accel_leaf *leaves;
-    int nleaves, capleaves;
-    tri_batch tri[2]; /* 0: casts shadows, 1: no_shadow */
-    geom_shape *shapes;
-    unsigned *shape_leaf;
-    int nshapes, capshapes;
-    mesh_group *groups;
-    int ngroups;
-    geom_csg *csgs;              /* user primitives nshapes .. nshapes + ncsgs - 1 */
-    int ncsgs, capcsgs;
-    float *ubox;                  /* 6 floats per user primitive: its box as user_bounds gives it */
-    geom_info *ginfo;
-    unsigned nginfo;
-    vec3 lo, hi;
-    double scale;
-    double eps_scale;  /* working scale of the epsilon rule (see the top) */
-    double *diags;     /* leaf bounding-box diagonals, during the build */
-    int ndiags, capdiags;
-    geom_shape *bshapes;         /* bounding objects (bounded_by), world space */
-    int nbshapes, capbshapes;
-    int *csg_b0, *csg_bn;         /* per CSG primitive, as accel_leaf.b0/bn */
-    const bound_chain *cur_chain; /* during collect(): the bounds above the current object */
-    accel_stats stats;
-    atomic_int err;
-    char errmsg[512];
-};
-
-/* Our intersect context: Embree passes the context pointer unchanged to the
- * user-geometry callbacks (documented for RTCIntersectContext), which lets
- * them use the caller's double ray. The callbacks recognise it by comparing
- * with a thread-local pointer, so a plain context (bare Embree use, as in the
- * benchmark) falls back to the float ray safely. */
-typedef struct {
-    struct RTCIntersectContext rtc; /* first member */
-    vec3 org, dir;
-    double tmin;
-    double ut;               /* last accepted user-geometry hit */
-    int upart, ushape, uflip; /* ushape, uflip: CSG member */
-    unsigned uprim;
-    int uhit;
-} accel_query;
-
-static _Thread_local accel_query *tls_query;
+_Thread_local accel_query *accel_tls_query;
 
 static void leaf_diag(accel *a, vec3 lo, vec3 hi);
-
-/* Embree's SoA ray/hit packets (rtcore_ray.h: RTCRayN/RTCHitN layout; the
- * accessors there are C++ only). Ray fields: org 0-2, tnear 3, dir 4-6, time
- * 7, tfar 8, mask 9, id 10, flags 11; hit fields: Ng 0-2, u 3, v 4, primID 5,
- * geomID 6, instID 7. A RTCRayHitN holds the ray then the hit at 12*N. */
-#define SOA_F(p, N, i, k) (((float *)(p))[(size_t)(k) * (N) + (i)])
-#define SOA_U(p, N, i, k) (((unsigned *)(p))[(size_t)(k) * (N) + (i)])
 
 /* ------------------------------------------------------------ errors */
 
@@ -200,7 +93,7 @@ static int embree_failed(accel *a, diag *d, const char *stage)
 
 /* ------------------------------------------------------------ build helpers */
 
-static int grow(void **p, size_t *cap, size_t need, size_t elem)
+int accel_grow(void **p, size_t *cap, size_t need, size_t elem)
 {
     if (need <= *cap) return 1;
     size_t nc = *cap ? *cap : 64;
@@ -257,7 +150,7 @@ static int add_leaf(accel *a, const scene_object *o, const scene_texture *tex, u
 {
     if (a->nleaves == a->capleaves) {
         size_t cap = (size_t)a->capleaves;
-        if (!grow((void **)&a->leaves, &cap, (size_t)a->nleaves + 1, sizeof(accel_leaf))) return -1;
+        if (!accel_grow((void **)&a->leaves, &cap, (size_t)a->nleaves + 1, sizeof(accel_leaf))) return -1;
         a->capleaves = (int)cap;
     }
     accel_leaf *l = &a->leaves[a->nleaves];
@@ -276,125 +169,6 @@ static int add_leaf(accel *a, const scene_object *o, const scene_texture *tex, u
     return a->nleaves++;
 }
 
-/* ------------------------------------------------------------ bounded_by */
-
-/* POV-Ray 3.7's Link_To_Frame drops the bound of a top-level object that is
- * cheap to intersect (remove_bounds, on by default): it keeps those of
- * unions, intersections/differences, merges, polys, text and quadrics
- * without automatic (finite) bounds. Bounds below a CSG object stay. But
- * its Parse_Object_Mods has already given the object the bounding objects'
- * box when that is smaller than its own, and rays missing that box skip the
- * object; so a dropped bound still culls by its box. */
-static int keeps_bound(const scene_object *o, int top)
-{
-    if (!top) return 1;
-    switch (o->kind) {
-    case SHAPE_UNION: case SHAPE_MERGE: case SHAPE_INTERSECTION: case SHAPE_DIFFERENCE:
-    case SHAPE_POLY: case SHAPE_TEXT:
-        return 1;
-    case SHAPE_QUADRIC: {
-        geom_shape sh;
-        if (geom_shape_init(&sh, o) != 0) return 0;
-        int inf = sh.infinite;
-        geom_shape_release(&sh);
-        return inf;
-    }
-    default:
-        return 0;
-    }
-}
-
-static int push_bshape(accel *a)
-{
-    if (a->nbshapes < a->capbshapes) return 1;
-    size_t cap = (size_t)a->capbshapes;
-    if (!grow((void **)&a->bshapes, &cap, (size_t)a->nbshapes + 1, sizeof(geom_shape))) return 0;
-    a->capbshapes = (int)cap;
-    return 1;
-}
-
-static double box_volume(vec3 lo, vec3 hi)
-{
-    vec3 e = v3_sub(hi, lo);
-    return e.x > 0 && e.y > 0 && e.z > 0 ? e.x * e.y * e.z : 0.0;
-}
-
-/* The bounding objects of `host` as shapes in a->bshapes; with `box_only`,
- * one box: the intersection of their (non-inverted) world boxes, kept only
- * when smaller than the host's own box (POV-Ray's rule). */
-static int add_bound_objects(accel *a, diag *d, const scene_object *host, int box_only)
-{
-    const scene_object *list = host->bound;
-    vec3 blo = v3s(-INFINITY), bhi = v3s(INFINITY);
-    for (int i = 0; list && i < list->u.csg.nkids; i++) {
-        const scene_object *k = list->u.csg.kids[i];
-        if (!k) continue;
-        if (geom_csg_is_op(k->kind) || k->clip) {
-            diag_warn_once(d, k->loc, "a CSG bounding object is not evaluated: the bound is ignored");
-            continue;
-        }
-        scene_object moved = *k;
-        moved.transform = xform_then(k->transform, host->transform);
-        if (!push_bshape(a)) return 0;
-        if (moved.kind == SHAPE_MESH || moved.kind == SHAPE_UNSUPPORTED ||
-            geom_shape_init(&a->bshapes[a->nbshapes], &moved) != 0) {
-            diag_warn_once(d, k->loc, "this bounding object is not evaluated: the bound is ignored");
-            continue;
-        }
-        geom_shape *b = &a->bshapes[a->nbshapes];
-        if (box_only) {
-            if (!b->infinite && b->kind != SHAPE_PLANE && !(k->flags & OBJ_INVERSE)) {
-                blo = v3_max(blo, b->lo);
-                bhi = v3_min(bhi, b->hi);
-            }
-            geom_shape_release(b);
-            continue;
-        }
-        if (b->infinite) geom_shape_clip_plane(b, v3s(-INFINITY), v3s(INFINITY));
-        a->nbshapes++;
-    }
-    if (box_only && v3_finite(blo) && v3_finite(bhi)) {
-        geom_shape own;
-        if (geom_shape_init(&own, host) != 0) return 1;
-        double vo = own.infinite || own.kind == SHAPE_PLANE ? INFINITY : box_volume(own.lo, own.hi);
-        geom_shape_release(&own);
-        if (!(box_volume(blo, bhi) < vo)) return 1;
-        scene_object box;
-        memset(&box, 0, sizeof box);
-        box.kind = SHAPE_BOX;
-        box.transform = xform_identity();
-        box.u.box.c1 = blo;
-        box.u.box.c2 = v3_max(blo, bhi);
-        if (!push_bshape(a)) return 0;
-        if (geom_shape_init(&a->bshapes[a->nbshapes], &box) == 0) a->nbshapes++;
-    }
-    return 1;
-}
-
-/* The bounds applying to object o (whose own bound counts in full if `own`,
- * else by its box), as a range of a->bshapes. 0 on out-of-memory. */
-static int collect_bounds(accel *a, diag *d, const scene_object *o, int own, int *b0, int *bn)
-{
-    *b0 = a->nbshapes;
-    for (const bound_chain *c = a->cur_chain; c; c = c->up)
-        if (!add_bound_objects(a, d, c->host, 0)) return 0;
-    if (o->bound && !add_bound_objects(a, d, o, !own)) return 0;
-    *bn = a->nbshapes - *b0;
-    return 1;
-}
-
-/* POV-Ray's Ray_In_Bound: the ray meets every bound ahead of its origin or
- * starts inside it. */
-static int ray_in_bound(const accel *a, int b0, int bn, vec3 o, vec3 d, double tmin)
-{
-    for (int i = 0; i < bn; i++) {
-        const geom_shape *b = &a->bshapes[b0 + i];
-        geom_shape_hit h;
-        if (geom_shape_inside(b, o)) continue;
-        if (!geom_shape_intersect(b, o, d, tmin, INFINITY, &h)) return 0;
-    }
-    return 1;
-}
 
 /* ------------------------------------------------------------ CSG */
 
@@ -414,14 +188,14 @@ static pt_status build_csg(accel *a, diag *d, const scene_object *o, const scene
 {
     if (a->ncsgs == a->capcsgs) {
         size_t cap = (size_t)a->capcsgs;
-        if (!grow((void **)&a->csgs, &cap, (size_t)a->ncsgs + 1, sizeof(geom_csg))) return PT_ERR_NOMEM;
+        if (!accel_grow((void **)&a->csgs, &cap, (size_t)a->ncsgs + 1, sizeof(geom_csg))) return PT_ERR_NOMEM;
         a->capcsgs = (int)cap;
     }
     geom_csg *c = &a->csgs[a->ncsgs];
     memset(c, 0, sizeof *c);
     c->flags = o->flags | (pflags & INHERITED_FLAGS);
     int cb0 = 0, cbn = 0;
-    if (!collect_bounds(a, d, o, keeps_bound(o, depth == 0), &cb0, &cbn))
+    if (!accel_collect_bounds(a, d, o, accel_keeps_bound(o, depth == 0), &cb0, &cbn))
         return PT_ERR_NOMEM;
     {
         size_t cap = (size_t)a->capcsgs;
@@ -512,7 +286,7 @@ static pt_status collect(accel *a, diag *d, const scene_object *o, const scene_t
         if (li < 0) return PT_ERR_NOMEM;
         if (o->kind != SHAPE_TRIANGLE && o->kind != SHAPE_SMOOTH_TRIANGLE && o->kind != SHAPE_MESH) {
             int b0, bn;
-            if (!collect_bounds(a, d, o, keeps_bound(o, depth == 0), &b0, &bn)) return PT_ERR_NOMEM;
+            if (!accel_collect_bounds(a, d, o, accel_keeps_bound(o, depth == 0), &b0, &bn)) return PT_ERR_NOMEM;
             a->leaves[li].b0 = b0;
             a->leaves[li].bn = bn;
         }
@@ -551,7 +325,7 @@ static void leaf_diag(accel *a, vec3 lo, vec3 hi)
 
 static int batch_add_vertex(tri_batch *b, vec3 p)
 {
-    if (!grow((void **)&b->v, &b->capv, (b->nv + 1) * 3, sizeof(float))) return 0;
+    if (!accel_grow((void **)&b->v, &b->capv, (b->nv + 1) * 3, sizeof(float))) return 0;
     b->v[b->nv * 3 + 0] = (float)p.x;
     b->v[b->nv * 3 + 1] = (float)p.y;
     b->v[b->nv * 3 + 2] = (float)p.z;
@@ -561,8 +335,8 @@ static int batch_add_vertex(tri_batch *b, vec3 p)
 
 static int batch_add_tri(tri_batch *b, unsigned i0, unsigned i1, unsigned i2, unsigned leaf, unsigned local)
 {
-    if (!grow((void **)&b->idx, &b->capi, (b->nt + 1) * 3, sizeof(unsigned))) return 0;
-    if (!grow((void **)&b->refs, &b->capr, b->nt + 1, sizeof(tri_ref))) return 0;
+    if (!accel_grow((void **)&b->idx, &b->capi, (b->nt + 1) * 3, sizeof(unsigned))) return 0;
+    if (!accel_grow((void **)&b->refs, &b->capr, b->nt + 1, sizeof(tri_ref))) return 0;
     b->idx[b->nt * 3 + 0] = i0;
     b->idx[b->nt * 3 + 1] = i1;
     b->idx[b->nt * 3 + 2] = i2;
@@ -600,223 +374,6 @@ static int set_ginfo(accel *a, unsigned id, int kind, unsigned idx)
     return 1;
 }
 
-/* ------------------------------------------------------------ callbacks */
-
-/* The box of user primitive prim (lower xyz, upper xyz), padded outwards. */
-static void user_box(const accel *a, unsigned prim, float out[6])
-{
-    vec3 lo, hi;
-    if (prim < (unsigned)a->nshapes) {
-        lo = a->shapes[prim].lo;
-        hi = a->shapes[prim].hi;
-    } else {
-        lo = a->csgs[prim - (unsigned)a->nshapes].lo;
-        hi = a->csgs[prim - (unsigned)a->nshapes].hi;
-    }
-    double ext = v3_maxc(v3_sub(hi, lo));
-    for (int i = 0; i < 3; i++) {
-        double l = v3_idx(lo, i), h = v3_idx(hi, i);
-        double pad = 1e-6 * (fabs(l) + fabs(h) + ext);
-        out[i] = nextafterf((float)(l - pad), -INFINITY);
-        out[3 + i] = nextafterf((float)(h + pad), INFINITY);
-    }
-}
-
-static void user_bounds(const struct RTCBoundsFunctionArguments *args)
-{
-    const accel *a = args->geometryUserPtr;
-    float out[6];
-    user_box(a, args->primID, out);
-    struct RTCBounds *b = args->bounds_o;
-    b->lower_x = out[0]; b->lower_y = out[1]; b->lower_z = out[2];
-    b->upper_x = out[3]; b->upper_y = out[4]; b->upper_z = out[5];
-}
-
-/* The link scene's user geometry (accel_rtc_link_scene): the primitives
- * as user_bounds gives them, then one empty primitive, a box of 1e-6 of
- * the scene's size placed 4 scene sizes beyond the upper corner of the
- * scene's bounds (the user boxes included), where no link ray starts and
- * hardly any passes; user_intersect answers it with no hit. */
-static void user_bounds_link(const struct RTCBoundsFunctionArguments *args)
-{
-    const accel *a = args->geometryUserPtr;
-    float out[6];
-    unsigned np = (unsigned)(a->nshapes + a->ncsgs);
-    if (args->primID < np) {
-        user_box(a, args->primID, out);
-    } else {
-        float hi[3] = {(float)a->hi.x, (float)a->hi.y, (float)a->hi.z}, ext = (float)(a->scale > 0.0 ? a->scale : 1.0);
-        for (unsigned p = 0; p < np; p++)
-            for (int k = 0; k < 3; k++) hi[k] = fmaxf(hi[k], a->ubox[6 * (size_t)p + 3 + k]);
-        for (int k = 0; k < 3; k++) {
-            out[k] = hi[k] + 4.0f * ext;
-            out[3 + k] = out[k] + 1e-6f * ext;
-        }
-    }
-    struct RTCBounds *b = args->bounds_o;
-    b->lower_x = out[0]; b->lower_y = out[1]; b->lower_z = out[2];
-    b->upper_x = out[3]; b->upper_y = out[4]; b->upper_z = out[5];
-}
-
-/* Does lane i of an SOA ray miss user primitive prim's box within its
- * [tnear, tfar]? Embree tests a primitive's box only from a BVH node
- * above it, and a user geometry of one primitive is a lone leaf: every ray
- * then called prim_hit (cbox's light patch: 2.07 M calls for 1.85 M link
- * rays, 9% of the particle GI geometry stage's instructions). Conservative:
- * a NaN slab (a zero direction component starting on a face) constrains
- * nothing, and the interval must be empty by more than float rounding. */
-static int user_box_missed(const accel *a, unsigned prim, void *ray, unsigned N, unsigned i)
-{
-    if (!a->ubox) return 0;
-    const float *b = a->ubox + 6 * (size_t)prim;
-    float tn = SOA_F(ray, N, i, 3), tf = SOA_F(ray, N, i, 8);
-    for (int k = 0; k < 3; k++) {
-        float o = SOA_F(ray, N, i, k), inv = 1.0f / SOA_F(ray, N, i, 4 + k);
-        float t0 = (b[k] - o) * inv, t1 = (b[3 + k] - o) * inv;
-        if (t0 > t1) {
-            float t = t0;
-            t0 = t1;
-            t1 = t;
-        }
-        if (t0 > tn) tn = t0;
-        if (t1 < tf) tf = t1;
-    }
-    return tn > tf + 1e-5f * fabsf(tf) + 1e-30f;
-}
-
-/* One user primitive against a ray: an analytic shape or a CSG tree. */
-static int prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, double tmax, geom_csg_hit *h)
-{
-    assert(prim < (unsigned)(a->nshapes + a->ncsgs));
-    if (prim < (unsigned)a->nshapes) {
-        geom_shape_hit sh;
-        if (!geom_shape_intersect(&a->shapes[prim], o, d, tmin, tmax, &sh)) return 0;
-        assert(sh.t > tmin && sh.t < tmax);
-        assert(a->shape_leaf[prim] < (unsigned)a->nleaves);
-        const accel_leaf *l = &a->leaves[a->shape_leaf[prim]];
-        if (l->bn && !ray_in_bound(a, l->b0, l->bn, o, d, tmin)) return 0;
-        h->t = sh.t;
-        h->part = sh.part;
-        h->shape = 0;
-        h->flip = 0;
-        return 1;
-    }
-    unsigned ci = prim - (unsigned)a->nshapes;
-    if (!geom_csg_intersect(&a->csgs[ci], o, d, tmin, tmax, h)) return 0;
-    assert(h->t > tmin && h->t < tmax && h->shape >= 0 && h->shape < a->csgs[ci].nshapes);
-    return !a->csg_bn[ci] || ray_in_bound(a, a->csg_b0[ci], a->csg_bn[ci], o, d, tmin);
-}
-
-static const geom_shape *prim_shape(const accel *a, unsigned prim, int member)
-{
-    assert(prim < (unsigned)(a->nshapes + a->ncsgs));
-    assert(prim < (unsigned)a->nshapes || (member >= 0 && member < a->csgs[prim - (unsigned)a->nshapes].nshapes));
-    return prim < (unsigned)a->nshapes ? &a->shapes[prim] : &a->csgs[prim - (unsigned)a->nshapes].shapes[member];
-}
-
-static unsigned prim_flags(const accel *a, unsigned prim)
-{
-    return prim < (unsigned)a->nshapes ? a->leaves[a->shape_leaf[prim]].flags
-                                       : a->csgs[prim - (unsigned)a->nshapes].flags;
-}
-
-/* Ray i of an Embree packet of N (SoA) as the user callbacks read it: the
- * exact double-precision ray of q when the query is a single exact one (q
- * not NULL), else the packet's floats. */
-static inline void user_ray(const accel_query *q, const void *ray, unsigned N, unsigned i, vec3 *o, vec3 *d,
-                            double *tmin)
-{
-    if (q) {
-        *o = q->org;
-        *d = q->dir;
-        *tmin = q->tmin;
-    } else {
-        *o = v3(SOA_F(ray, N, i, 0), SOA_F(ray, N, i, 1), SOA_F(ray, N, i, 2));
-        *d = v3(SOA_F(ray, N, i, 4), SOA_F(ray, N, i, 5), SOA_F(ray, N, i, 6));
-        *tmin = SOA_F(ray, N, i, 3);
-    }
-}
-
-static void user_intersect(const struct RTCIntersectFunctionNArguments *args)
-{
-    const accel *a = args->geometryUserPtr;
-    accel_query *q = tls_query;
-    unsigned N = args->N;
-    int exact = q && (void *)q == (void *)args->context && N == 1;
-    void *ray = args->rayhit;
-    float *hit = (float *)args->rayhit + 12 * (size_t)N;
-    if (args->primID >= (unsigned)(a->nshapes + a->ncsgs)) return; /* the link scene's empty primitive */
-    for (unsigned i = 0; i < N; i++) {
-        if (args->valid[i] != -1 || user_box_missed(a, args->primID, ray, N, i)) continue;
-        float tfar = SOA_F(ray, N, i, 8);
-        vec3 o, d;
-        double tmin;
-        user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
-        geom_csg_hit h;
-        if (!prim_hit(a, args->primID, o, d, tmin, (double)tfar, &h)) continue;
-        SOA_F(ray, N, i, 8) = (float)h.t;
-        vec3 ng = v3(0, 0, 0);
-        double u = 0, v = 0;
-        if (exact) {
-            q->ut = h.t;
-            q->upart = h.part;
-            q->ushape = h.shape;
-            q->uflip = h.flip;
-            q->uprim = args->primID;
-            q->uhit = 1;
-        } else {
-            geom_shape_surface(prim_shape(a, args->primID, h.shape), v3_madd(o, d, h.t), h.part, &ng, &u, &v);
-            if (h.flip) ng = v3_neg(ng);
-        }
-        SOA_F(hit, N, i, 0) = (float)ng.x;
-        SOA_F(hit, N, i, 1) = (float)ng.y;
-        SOA_F(hit, N, i, 2) = (float)ng.z;
-        SOA_F(hit, N, i, 3) = (float)u;
-        SOA_F(hit, N, i, 4) = (float)v;
-        SOA_U(hit, N, i, 5) = args->primID;
-        SOA_U(hit, N, i, 6) = args->geomID;
-        SOA_U(hit, N, i, 7) = args->context->instID[0];
-    }
-}
-
-static void user_occluded(const struct RTCOccludedFunctionNArguments *args)
-{
-    const accel *a = args->geometryUserPtr;
-    if (args->primID >= (unsigned)(a->nshapes + a->ncsgs)) return; /* the link scene's empty primitive */
-    if (prim_flags(a, args->primID) & OBJ_NO_SHADOW) return;
-    accel_query *q = tls_query;
-    unsigned N = args->N;
-    int exact = q && (void *)q == (void *)args->context && N == 1;
-    void *ray = args->ray;
-    for (unsigned i = 0; i < N; i++) {
-        if (args->valid[i] != -1 || user_box_missed(a, args->primID, ray, N, i)) continue;
-        vec3 o, d;
-        double tmin;
-        user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
-        geom_csg_hit h;
-        if (prim_hit(a, args->primID, o, d, tmin, (double)SOA_F(ray, N, i, 8), &h)) SOA_F(ray, N, i, 8) = -INFINITY;
-    }
-}
-
-/* Occlusion filter of the no_shadow triangle geometry: nothing there occludes. */
-static void filter_reject_all(const struct RTCFilterFunctionNArguments *args)
-{
-    for (unsigned i = 0; i < args->N; i++) args->valid[i] = 0;
-}
-
-/* Occlusion filter of a shared mesh with some no_shadow instances. */
-static void filter_instance_no_shadow(const struct RTCFilterFunctionNArguments *args)
-{
-    const accel *a = args->geometryUserPtr;
-    unsigned N = args->N;
-    for (unsigned i = 0; i < N; i++) {
-        if (args->valid[i] == 0) continue;
-        unsigned inst = SOA_U(args->hit, N, i, 7);
-        if (inst < a->nginfo && a->ginfo[inst].kind == GEOM_INSTANCE &&
-            (a->leaves[a->ginfo[inst].idx].flags & OBJ_NO_SHADOW))
-            args->valid[i] = 0;
-    }
-}
 
 /* ------------------------------------------------------------ geometry */
 
@@ -884,7 +441,7 @@ static pt_status build_batches(accel *a)
         if (b->nt == 0) continue;
         RTCGeometry g = new_triangle_geometry(a, b->v, b->nv, b->idx, b->nt);
         if (!g) return PT_ERR_DEVICE;
-        if (k == 1) rtcSetGeometryOccludedFilterFunction(g, filter_reject_all);
+        if (k == 1) rtcSetGeometryOccludedFilterFunction(g, accel_filter_reject_all);
         rtcCommitGeometry(g);
         unsigned id = rtcAttachGeometry(a->root, g);
         rtcReleaseGeometry(g);
@@ -938,7 +495,7 @@ static pt_status build_mesh_group(accel *a, diag *d, mesh_group *gr, const int *
         if (a->leaves[leaves[i]].flags & OBJ_NO_SHADOW) gr->any_no_shadow = 1;
     if (gr->any_no_shadow) {
         rtcSetGeometryUserData(g, a);
-        rtcSetGeometryOccludedFilterFunction(g, filter_instance_no_shadow);
+        rtcSetGeometryOccludedFilterFunction(g, accel_filter_instance_no_shadow);
     }
     rtcCommitGeometry(g);
     rtcAttachGeometry(gr->scene, g);
@@ -1108,7 +665,7 @@ static void finish_bounds(accel *a)
     if (!(a->scale > 0.0) || !isfinite(a->scale)) a->scale = far_plane;
     if (!(a->scale > 0.0) || !isfinite(a->scale)) a->scale = 1.0;
     /* Epsilon scale: the median leaf diagonal, so one far or huge object
-     * does not grow the epsilon beyond the other objects' details; it scales
+     * does not accel_grow the epsilon beyond the other objects' details; it scales
      * with the scene like the diagonal does. */
     a->eps_scale = a->scale;
     if (a->ndiags > 0) {
@@ -1129,12 +686,12 @@ static pt_status build_user_geometry(accel *a)
     unsigned np = (unsigned)(a->nshapes + a->ncsgs);
     a->ubox = malloc((size_t)np * 6 * sizeof *a->ubox);
     if (!a->ubox) return PT_ERR_NOMEM;
-    for (unsigned p = 0; p < np; p++) user_box(a, p, a->ubox + 6 * (size_t)p);
+    for (unsigned p = 0; p < np; p++) accel_user_box(a, p, a->ubox + 6 * (size_t)p);
     rtcSetGeometryUserPrimitiveCount(g, (unsigned)(a->nshapes + a->ncsgs));
     rtcSetGeometryUserData(g, a);
-    rtcSetGeometryBoundsFunction(g, user_bounds, a);
-    rtcSetGeometryIntersectFunction(g, user_intersect);
-    rtcSetGeometryOccludedFunction(g, user_occluded);
+    rtcSetGeometryBoundsFunction(g, accel_user_bounds, a);
+    rtcSetGeometryIntersectFunction(g, accel_user_intersect);
+    rtcSetGeometryOccludedFunction(g, accel_user_occluded);
     rtcCommitGeometry(g);
     unsigned id = rtcAttachGeometry(a->root, g);
     rtcReleaseGeometry(g);
@@ -1411,10 +968,10 @@ static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tm
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    accel_query *saved = tls_query;
-    tls_query = &q;
+    accel_query *saved = accel_tls_query;
+    accel_tls_query = &q;
     rtcIntersect1(a->root, &q.rtc, &rh);
-    tls_query = saved;
+    accel_tls_query = saved;
     unsigned gid = rh.hit.geomID, inst = rh.hit.instID[0], prim = rh.hit.primID;
     if (gid == RTC_INVALID_GEOMETRY_ID) return 0;
     if (inst != RTC_INVALID_GEOMETRY_ID) {
@@ -1432,10 +989,10 @@ static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tm
             h.part = q.upart;
             h.shape = q.ushape;
             h.flip = q.uflip;
-        } else if (!prim_hit(a, prim, org, dir, t0, tmax, &h)) {
+        } else if (!accel_prim_hit(a, prim, org, dir, t0, tmax, &h)) {
             return 0;
         }
-        const geom_shape *sh = prim_shape(a, prim, h.shape);
+        const geom_shape *sh = accel_prim_shape(a, prim, h.shape);
         unsigned li = prim < (unsigned)a->nshapes ? a->shape_leaf[prim]
                                                   : a->csgs[prim - (unsigned)a->nshapes].shape_leaf[h.shape];
         assert(li < (unsigned)a->nleaves);
@@ -1589,9 +1146,9 @@ void *accel_rtc_link_scene(const accel *a)
             if (!g) continue;
             rtcSetGeometryUserPrimitiveCount(g, np + 1);
             rtcSetGeometryUserData(g, (void *)a);
-            rtcSetGeometryBoundsFunction(g, user_bounds_link, (void *)a);
-            rtcSetGeometryIntersectFunction(g, user_intersect);
-            rtcSetGeometryOccludedFunction(g, user_occluded);
+            rtcSetGeometryBoundsFunction(g, accel_user_bounds_link, (void *)a);
+            rtcSetGeometryIntersectFunction(g, accel_user_intersect);
+            rtcSetGeometryOccludedFunction(g, accel_user_occluded);
             rtcCommitGeometry(g);
             rtcAttachGeometryByID(s, g, id);
             rtcReleaseGeometry(g);
@@ -1654,10 +1211,10 @@ int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax)
     q.uhit = 0;
     struct RTCRay r;
     fill_rtc_ray(&r, org, dir, t0, tmax);
-    accel_query *saved = tls_query;
-    tls_query = &q;
+    accel_query *saved = accel_tls_query;
+    accel_tls_query = &q;
     rtcOccluded1(a->root, &q.rtc, &r);
-    tls_query = saved;
+    accel_tls_query = saved;
     return r.tfar == -INFINITY;
 }
 
@@ -1715,10 +1272,10 @@ void accel_occluded_n(const accel *a, int n, const vec3 *org, const vec3 *dir, c
         rtcInitIntersectContext(&c);
         c.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
         /* no accel_query: user geometry takes the packet's float rays */
-        accel_query *saved = tls_query;
-        tls_query = NULL;
+        accel_query *saved = accel_tls_query;
+        accel_tls_query = NULL;
         rtcOccluded16(valid, a->root, &c, &r);
-        tls_query = saved;
+        accel_tls_query = saved;
         for (int k = 0; k < m; k++)
             if (valid[k]) out[k0 + k] = r.tfar[k] == -INFINITY;
     }
@@ -1741,12 +1298,12 @@ void accel_hit_any_n(const accel *a, int n, const vec3 *org, const vec3 *dir, co
         rtcInitIntersectContext(&c);
         c.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
         /* no accel_query: user geometry takes the packet's float rays */
-        accel_query *saved = tls_query;
-        tls_query = NULL;
+        accel_query *saved = accel_tls_query;
+        accel_tls_query = NULL;
         /* the nearest-hit query: an occlusion query would skip no_shadow
          * objects, which block the cells' segments too */
         rtcIntersect16(valid, a->root, &c, &r);
-        tls_query = saved;
+        accel_tls_query = saved;
         for (int k = 0; k < m; k++)
             if (valid[k]) out[k0 + k] = r.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
     }

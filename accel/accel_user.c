@@ -1,0 +1,344 @@
+/* accel_user.c - bounded_by (the bounding objects a ray must enter) and the
+ * Embree callbacks of the user geometry over geom/ (bounds, intersect,
+ * occluded, the no_shadow filters); see accel.c for the layout of the
+ * Embree scene and the epsilon rule. */
+#include "accel_internal.h"
+
+/* ------------------------------------------------------------ bounded_by */
+
+/* POV-Ray 3.7's Link_To_Frame drops the bound of a top-level object that is
+ * cheap to intersect (remove_bounds, on by default): it keeps those of
+ * unions, intersections/differences, merges, polys, text and quadrics
+ * without automatic (finite) bounds. Bounds below a CSG object stay. But
+ * its Parse_Object_Mods has already given the object the bounding objects'
+ * box when that is smaller than its own, and rays missing that box skip the
+ * object; so a dropped bound still culls by its box. */
+int accel_keeps_bound(const scene_object *o, int top)
+{
+    if (!top) return 1;
+    switch (o->kind) {
+    case SHAPE_UNION: case SHAPE_MERGE: case SHAPE_INTERSECTION: case SHAPE_DIFFERENCE:
+    case SHAPE_POLY: case SHAPE_TEXT:
+        return 1;
+    case SHAPE_QUADRIC: {
+        geom_shape sh;
+        if (geom_shape_init(&sh, o) != 0) return 0;
+        int inf = sh.infinite;
+        geom_shape_release(&sh);
+        return inf;
+    }
+    default:
+        return 0;
+    }
+}
+
+static int push_bshape(accel *a)
+{
+    if (a->nbshapes < a->capbshapes) return 1;
+    size_t cap = (size_t)a->capbshapes;
+    if (!accel_grow((void **)&a->bshapes, &cap, (size_t)a->nbshapes + 1, sizeof(geom_shape))) return 0;
+    a->capbshapes = (int)cap;
+    return 1;
+}
+
+static double box_volume(vec3 lo, vec3 hi)
+{
+    vec3 e = v3_sub(hi, lo);
+    return e.x > 0 && e.y > 0 && e.z > 0 ? e.x * e.y * e.z : 0.0;
+}
+
+/* The bounding objects of `host` as shapes in a->bshapes; with `box_only`,
+ * one box: the intersection of their (non-inverted) world boxes, kept only
+ * when smaller than the host's own box (POV-Ray's rule). */
+static int add_bound_objects(accel *a, diag *d, const scene_object *host, int box_only)
+{
+    const scene_object *list = host->bound;
+    vec3 blo = v3s(-INFINITY), bhi = v3s(INFINITY);
+    for (int i = 0; list && i < list->u.csg.nkids; i++) {
+        const scene_object *k = list->u.csg.kids[i];
+        if (!k) continue;
+        if (geom_csg_is_op(k->kind) || k->clip) {
+            diag_warn_once(d, k->loc, "a CSG bounding object is not evaluated: the bound is ignored");
+            continue;
+        }
+        scene_object moved = *k;
+        moved.transform = xform_then(k->transform, host->transform);
+        if (!push_bshape(a)) return 0;
+        if (moved.kind == SHAPE_MESH || moved.kind == SHAPE_UNSUPPORTED ||
+            geom_shape_init(&a->bshapes[a->nbshapes], &moved) != 0) {
+            diag_warn_once(d, k->loc, "this bounding object is not evaluated: the bound is ignored");
+            continue;
+        }
+        geom_shape *b = &a->bshapes[a->nbshapes];
+        if (box_only) {
+            if (!b->infinite && b->kind != SHAPE_PLANE && !(k->flags & OBJ_INVERSE)) {
+                blo = v3_max(blo, b->lo);
+                bhi = v3_min(bhi, b->hi);
+            }
+            geom_shape_release(b);
+            continue;
+        }
+        if (b->infinite) geom_shape_clip_plane(b, v3s(-INFINITY), v3s(INFINITY));
+        a->nbshapes++;
+    }
+    if (box_only && v3_finite(blo) && v3_finite(bhi)) {
+        geom_shape own;
+        if (geom_shape_init(&own, host) != 0) return 1;
+        double vo = own.infinite || own.kind == SHAPE_PLANE ? INFINITY : box_volume(own.lo, own.hi);
+        geom_shape_release(&own);
+        if (!(box_volume(blo, bhi) < vo)) return 1;
+        scene_object box;
+        memset(&box, 0, sizeof box);
+        box.kind = SHAPE_BOX;
+        box.transform = xform_identity();
+        box.u.box.c1 = blo;
+        box.u.box.c2 = v3_max(blo, bhi);
+        if (!push_bshape(a)) return 0;
+        if (geom_shape_init(&a->bshapes[a->nbshapes], &box) == 0) a->nbshapes++;
+    }
+    return 1;
+}
+
+/* The bounds applying to object o (whose own bound counts in full if `own`,
+ * else by its box), as a range of a->bshapes. 0 on out-of-memory. */
+int accel_collect_bounds(accel *a, diag *d, const scene_object *o, int own, int *b0, int *bn)
+{
+    *b0 = a->nbshapes;
+    for (const bound_chain *c = a->cur_chain; c; c = c->up)
+        if (!add_bound_objects(a, d, c->host, 0)) return 0;
+    if (o->bound && !add_bound_objects(a, d, o, !own)) return 0;
+    *bn = a->nbshapes - *b0;
+    return 1;
+}
+
+/* POV-Ray's Ray_In_Bound: the ray meets every bound ahead of its origin or
+ * starts inside it. */
+static int ray_in_bound(const accel *a, int b0, int bn, vec3 o, vec3 d, double tmin)
+{
+    for (int i = 0; i < bn; i++) {
+        const geom_shape *b = &a->bshapes[b0 + i];
+        geom_shape_hit h;
+        if (geom_shape_inside(b, o)) continue;
+        if (!geom_shape_intersect(b, o, d, tmin, INFINITY, &h)) return 0;
+    }
+    return 1;
+}
+
+
+/* ------------------------------------------------------------ callbacks */
+
+/* The box of user primitive prim (lower xyz, upper xyz), padded outwards. */
+void accel_user_box(const accel *a, unsigned prim, float out[6])
+{
+    vec3 lo, hi;
+    if (prim < (unsigned)a->nshapes) {
+        lo = a->shapes[prim].lo;
+        hi = a->shapes[prim].hi;
+    } else {
+        lo = a->csgs[prim - (unsigned)a->nshapes].lo;
+        hi = a->csgs[prim - (unsigned)a->nshapes].hi;
+    }
+    double ext = v3_maxc(v3_sub(hi, lo));
+    for (int i = 0; i < 3; i++) {
+        double l = v3_idx(lo, i), h = v3_idx(hi, i);
+        double pad = 1e-6 * (fabs(l) + fabs(h) + ext);
+        out[i] = nextafterf((float)(l - pad), -INFINITY);
+        out[3 + i] = nextafterf((float)(h + pad), INFINITY);
+    }
+}
+
+void accel_user_bounds(const struct RTCBoundsFunctionArguments *args)
+{
+    const accel *a = args->geometryUserPtr;
+    float out[6];
+    accel_user_box(a, args->primID, out);
+    struct RTCBounds *b = args->bounds_o;
+    b->lower_x = out[0]; b->lower_y = out[1]; b->lower_z = out[2];
+    b->upper_x = out[3]; b->upper_y = out[4]; b->upper_z = out[5];
+}
+
+/* The link scene's user geometry (accel_rtc_link_scene): the primitives
+ * as accel_user_bounds gives them, then one empty primitive, a box of 1e-6 of
+ * the scene's size placed 4 scene sizes beyond the upper corner of the
+ * scene's bounds (the user boxes included), where no link ray starts and
+ * hardly any passes; accel_user_intersect answers it with no hit. */
+void accel_user_bounds_link(const struct RTCBoundsFunctionArguments *args)
+{
+    const accel *a = args->geometryUserPtr;
+    float out[6];
+    unsigned np = (unsigned)(a->nshapes + a->ncsgs);
+    if (args->primID < np) {
+        accel_user_box(a, args->primID, out);
+    } else {
+        float hi[3] = {(float)a->hi.x, (float)a->hi.y, (float)a->hi.z}, ext = (float)(a->scale > 0.0 ? a->scale : 1.0);
+        for (unsigned p = 0; p < np; p++)
+            for (int k = 0; k < 3; k++) hi[k] = fmaxf(hi[k], a->ubox[6 * (size_t)p + 3 + k]);
+        for (int k = 0; k < 3; k++) {
+            out[k] = hi[k] + 4.0f * ext;
+            out[3 + k] = out[k] + 1e-6f * ext;
+        }
+    }
+    struct RTCBounds *b = args->bounds_o;
+    b->lower_x = out[0]; b->lower_y = out[1]; b->lower_z = out[2];
+    b->upper_x = out[3]; b->upper_y = out[4]; b->upper_z = out[5];
+}
+
+/* Does lane i of an SOA ray miss user primitive prim's box within its
+ * [tnear, tfar]? Embree tests a primitive's box only from a BVH node
+ * above it, and a user geometry of one primitive is a lone leaf: every ray
+ * then called accel_prim_hit (cbox's light patch: 2.07 M calls for 1.85 M link
+ * rays, 9% of the particle GI geometry stage's instructions). Conservative:
+ * a NaN slab (a zero direction component starting on a face) constrains
+ * nothing, and the interval must be empty by more than float rounding. */
+static int user_box_missed(const accel *a, unsigned prim, void *ray, unsigned N, unsigned i)
+{
+    if (!a->ubox) return 0;
+    const float *b = a->ubox + 6 * (size_t)prim;
+    float tn = SOA_F(ray, N, i, 3), tf = SOA_F(ray, N, i, 8);
+    for (int k = 0; k < 3; k++) {
+        float o = SOA_F(ray, N, i, k), inv = 1.0f / SOA_F(ray, N, i, 4 + k);
+        float t0 = (b[k] - o) * inv, t1 = (b[3 + k] - o) * inv;
+        if (t0 > t1) {
+            float t = t0;
+            t0 = t1;
+            t1 = t;
+        }
+        if (t0 > tn) tn = t0;
+        if (t1 < tf) tf = t1;
+    }
+    return tn > tf + 1e-5f * fabsf(tf) + 1e-30f;
+}
+
+/* One user primitive against a ray: an analytic shape or a CSG tree. */
+int accel_prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, double tmax, geom_csg_hit *h)
+{
+    assert(prim < (unsigned)(a->nshapes + a->ncsgs));
+    if (prim < (unsigned)a->nshapes) {
+        geom_shape_hit sh;
+        if (!geom_shape_intersect(&a->shapes[prim], o, d, tmin, tmax, &sh)) return 0;
+        assert(sh.t > tmin && sh.t < tmax);
+        assert(a->shape_leaf[prim] < (unsigned)a->nleaves);
+        const accel_leaf *l = &a->leaves[a->shape_leaf[prim]];
+        if (l->bn && !ray_in_bound(a, l->b0, l->bn, o, d, tmin)) return 0;
+        h->t = sh.t;
+        h->part = sh.part;
+        h->shape = 0;
+        h->flip = 0;
+        return 1;
+    }
+    unsigned ci = prim - (unsigned)a->nshapes;
+    if (!geom_csg_intersect(&a->csgs[ci], o, d, tmin, tmax, h)) return 0;
+    assert(h->t > tmin && h->t < tmax && h->shape >= 0 && h->shape < a->csgs[ci].nshapes);
+    return !a->csg_bn[ci] || ray_in_bound(a, a->csg_b0[ci], a->csg_bn[ci], o, d, tmin);
+}
+
+const geom_shape *accel_prim_shape(const accel *a, unsigned prim, int member)
+{
+    assert(prim < (unsigned)(a->nshapes + a->ncsgs));
+    assert(prim < (unsigned)a->nshapes || (member >= 0 && member < a->csgs[prim - (unsigned)a->nshapes].nshapes));
+    return prim < (unsigned)a->nshapes ? &a->shapes[prim] : &a->csgs[prim - (unsigned)a->nshapes].shapes[member];
+}
+
+static unsigned prim_flags(const accel *a, unsigned prim)
+{
+    return prim < (unsigned)a->nshapes ? a->leaves[a->shape_leaf[prim]].flags
+                                       : a->csgs[prim - (unsigned)a->nshapes].flags;
+}
+
+/* Ray i of an Embree packet of N (SoA) as the user callbacks read it: the
+ * exact double-precision ray of q when the query is a single exact one (q
+ * not NULL), else the packet's floats. */
+static inline void user_ray(const accel_query *q, const void *ray, unsigned N, unsigned i, vec3 *o, vec3 *d,
+                            double *tmin)
+{
+    if (q) {
+        *o = q->org;
+        *d = q->dir;
+        *tmin = q->tmin;
+    } else {
+        *o = v3(SOA_F(ray, N, i, 0), SOA_F(ray, N, i, 1), SOA_F(ray, N, i, 2));
+        *d = v3(SOA_F(ray, N, i, 4), SOA_F(ray, N, i, 5), SOA_F(ray, N, i, 6));
+        *tmin = SOA_F(ray, N, i, 3);
+    }
+}
+
+void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
+{
+    const accel *a = args->geometryUserPtr;
+    accel_query *q = accel_tls_query;
+    unsigned N = args->N;
+    int exact = q && (void *)q == (void *)args->context && N == 1;
+    void *ray = args->rayhit;
+    float *hit = (float *)args->rayhit + 12 * (size_t)N;
+    if (args->primID >= (unsigned)(a->nshapes + a->ncsgs)) return; /* the link scene's empty primitive */
+    for (unsigned i = 0; i < N; i++) {
+        if (args->valid[i] != -1 || user_box_missed(a, args->primID, ray, N, i)) continue;
+        float tfar = SOA_F(ray, N, i, 8);
+        vec3 o, d;
+        double tmin;
+        user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
+        geom_csg_hit h;
+        if (!accel_prim_hit(a, args->primID, o, d, tmin, (double)tfar, &h)) continue;
+        SOA_F(ray, N, i, 8) = (float)h.t;
+        vec3 ng = v3(0, 0, 0);
+        double u = 0, v = 0;
+        if (exact) {
+            q->ut = h.t;
+            q->upart = h.part;
+            q->ushape = h.shape;
+            q->uflip = h.flip;
+            q->uprim = args->primID;
+            q->uhit = 1;
+        } else {
+            geom_shape_surface(accel_prim_shape(a, args->primID, h.shape), v3_madd(o, d, h.t), h.part, &ng, &u, &v);
+            if (h.flip) ng = v3_neg(ng);
+        }
+        SOA_F(hit, N, i, 0) = (float)ng.x;
+        SOA_F(hit, N, i, 1) = (float)ng.y;
+        SOA_F(hit, N, i, 2) = (float)ng.z;
+        SOA_F(hit, N, i, 3) = (float)u;
+        SOA_F(hit, N, i, 4) = (float)v;
+        SOA_U(hit, N, i, 5) = args->primID;
+        SOA_U(hit, N, i, 6) = args->geomID;
+        SOA_U(hit, N, i, 7) = args->context->instID[0];
+    }
+}
+
+void accel_user_occluded(const struct RTCOccludedFunctionNArguments *args)
+{
+    const accel *a = args->geometryUserPtr;
+    if (args->primID >= (unsigned)(a->nshapes + a->ncsgs)) return; /* the link scene's empty primitive */
+    if (prim_flags(a, args->primID) & OBJ_NO_SHADOW) return;
+    accel_query *q = accel_tls_query;
+    unsigned N = args->N;
+    int exact = q && (void *)q == (void *)args->context && N == 1;
+    void *ray = args->ray;
+    for (unsigned i = 0; i < N; i++) {
+        if (args->valid[i] != -1 || user_box_missed(a, args->primID, ray, N, i)) continue;
+        vec3 o, d;
+        double tmin;
+        user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
+        geom_csg_hit h;
+        if (accel_prim_hit(a, args->primID, o, d, tmin, (double)SOA_F(ray, N, i, 8), &h)) SOA_F(ray, N, i, 8) = -INFINITY;
+    }
+}
+
+/* Occlusion filter of the no_shadow triangle geometry: nothing there occludes. */
+void accel_filter_reject_all(const struct RTCFilterFunctionNArguments *args)
+{
+    for (unsigned i = 0; i < args->N; i++) args->valid[i] = 0;
+}
+
+/* Occlusion filter of a shared mesh with some no_shadow instances. */
+void accel_filter_instance_no_shadow(const struct RTCFilterFunctionNArguments *args)
+{
+    const accel *a = args->geometryUserPtr;
+    unsigned N = args->N;
+    for (unsigned i = 0; i < N; i++) {
+        if (args->valid[i] == 0) continue;
+        unsigned inst = SOA_U(args->hit, N, i, 7);
+        if (inst < a->nginfo && a->ginfo[inst].kind == GEOM_INSTANCE &&
+            (a->leaves[a->ginfo[inst].idx].flags & OBJ_NO_SHADOW))
+            args->valid[i] = 0;
+    }
+}
