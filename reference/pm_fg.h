@@ -30,7 +30,7 @@
 #include "pm.h"
 
 typedef struct {
-    pm_common c;             /* c.spp: eye samples per pixel (default 16, stratified: edges antialiased) */
+    pm_common c;             /* c.spp: eye samples per pixel (default 64, stratified: edges antialiased) */
     long photons;            /* photon paths emitted (default 1,000,000) */
     int fg_rays;             /* final-gather rays per pixel (default 4096), split evenly over the
                                 eye samples; fewer at eye vertices behind weak specular lobes */
@@ -41,8 +41,8 @@ typedef struct {
     int irradiance_stride;   /* precompute at every n-th global photon (default 4); 0 = full
                                 k-nearest estimate at every gather hit (slow, for checks) */
     int caustics;            /* -1 (default): on when the scene has a photons{} block; 0 off; 1 on */
-    int area_samples;        /* shadow rays per area light at an eye vertex (default 16) */
-    int emitter_samples;     /* emitter samples at an eye vertex (default 16) */
+    int area_samples;        /* shadow rays per area light at an eye vertex (default 4; 256 per pixel) */
+    int emitter_samples;     /* emitter samples at an eye vertex (default 4) */
     int max_eye_depth;       /* specular eye vertices (default 16) */
     int max_gather_depth;    /* specular bounces after a gather hit (default 8) */
     int max_photon_bounces;  /* default 256 */
