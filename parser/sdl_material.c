@@ -6,6 +6,7 @@
 #include "sdl_atmos.h"
 #include "sdl_expr.h"
 #include "sdl_media.h"
+#include "sdl_map.h"
 #include "sdl_pattern.h"
 
 /* ------------------------------------------------------------ transforms */
@@ -484,7 +485,7 @@ int sdl_parse_look_value(sdl_parser *p, sdl_kw k, sdl_value *out)
     memset(out, 0, sizeof *out);
     out->kind = VAL_OPAQUE;
     out->str = name;
-    out->ptr = (void *)sdl_pattern_map(p, k);
+    out->ptr = (void *)sdl_map_parse(p, k);
     return 1;
 }
 

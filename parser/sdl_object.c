@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "sdl_clip.h"
 #include "sdl_directive.h"
 #include "sdl_expr.h"
 #include "sdl_material.h"
@@ -438,8 +439,8 @@ void sdl_object_mods(sdl_parser *p, sdl_obj *so)
         }
         sdl_tok t = sdl_next(p);
         if (t.tk.kw == KW_CLIPPED_BY || t.tk.kw == KW_BOUNDED_BY) { /* sdl_shape.c */
-            if (t.tk.kw == KW_CLIPPED_BY) sdl_shape_clipped_by(p, so);
-            else sdl_shape_bounded_by(p, so);
+            if (t.tk.kw == KW_CLIPPED_BY) sdl_clip_clipped_by(p, so);
+            else sdl_clip_bounded_by(p, so);
             continue;
         }
         if (t.tk.kw == KW_PHOTONS) {

@@ -21,11 +21,11 @@
 #include "sdl_df3.h"
 #include "sdl_function.h"
 #include "sdl_image.h"
+#include "sdl_map.h"
 #include "sdl_material.h"
 #include "sdl_object.h"
 
 #define PAT_EPS 1.0e-10
-#define MAX_MAP_ENTRIES 256
 
 typedef enum { TGT_PIGMENT, TGT_NORMAL, TGT_TEXTURE } tgt_kind;
 
@@ -41,7 +41,6 @@ typedef struct {
     int uv;                         /* uv_mapping given: the pattern gets uv_mapping */
 } target;
 
-static double sngl(double v) { return (double)(float)v; }
 /* a number kept as POV-Ray keeps it in an unsigned char */
 static int uchar_of(double v) { return (int)(unsigned char)sdl_to_int(v); }
 
@@ -337,178 +336,6 @@ static void image_block(sdl_parser *p, scene_image_map *im, int kind, double *am
     sdl_end_block(p);
 }
 
-/* ------------------------------------------------------------ maps */
-
-static scene_map_entry *entries(sdl_parser *p, int n)
-{
-    scene_map_entry *e = sdl_alloc(p, sizeof *e * (size_t)(n > 0 ? n : 1));
-    return e;
-}
-
-static scene_blend_map *make_map(sdl_parser *p, map_kind k, scene_map_entry *e, int n)
-{
-    scene_blend_map *m = sdl_alloc(p, sizeof *m);
-    if (!m) return NULL;
-    m->kind = k;
-    m->n = n;
-    m->e = e;
-    return m;
-}
-
-static void colour_into(double c[5], colour5 v)
-{
-    c[0] = v.r;
-    c[1] = v.g;
-    c[2] = v.b;
-    c[3] = v.f;
-    c[4] = v.t;
-}
-
-/* A declared map used as `map { Id }`. */
-static const scene_blend_map *declared_map(sdl_parser *p, const char *what)
-{
-    sdl_tok id = sdl_next(p);
-    if (id.val.kind == VAL_OPAQUE && id.val.ptr && id.val.str && strcmp(id.val.str, what) == 0) return id.val.ptr;
-    sdl_warn_once(p, id.tk.loc, "declared %s '%.*s' is not available; the default map is used", what, id.tk.len, id.tk.text);
-    return NULL;
-}
-
-/* colour_map := '{' ( map_id | { '[' v [','] ( colour | v2 [','] colour colour ) ']' } ) '}' */
-static const scene_blend_map *colour_map(sdl_parser *p)
-{
-    if (!sdl_begin_block(p, "color_map")) return NULL;
-    if (sdl_is(sdl_peek(p), TOK_IDENT) && sdl_peek(p)->val.kind == VAL_OPAQUE) {
-        const scene_blend_map *m = declared_map(p, "colour_map");
-        sdl_end_block(p);
-        return m;
-    }
-    scene_map_entry *e = entries(p, MAX_MAP_ENTRIES);
-    int n = 0;
-    if (!e) return NULL;
-    while (sdl_ok(p) && sdl_accept(p, TOK_LBRACKET)) {
-        if (n + 2 > MAX_MAP_ENTRIES) {
-            sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_LIMIT, "too many entries in color_map (at most %d)", MAX_MAP_ENTRIES);
-            break;
-        }
-        double v = sngl(sdl_float(p));
-        sdl_accept(p, TOK_COMMA);
-        if (!sdl_starts_colour(sdl_peek(p))) {
-            /* old style [v1 v2 colour c1 colour c2] or [v <r,g,b,f,t>] */
-            sdl_value ex;
-            sdl_sum(p, &ex);
-            if (ex.dim == 5 || ex.kind == VAL_COLOUR) {
-                e[n].value = v;
-                for (int i = 0; i < 5; i++) e[n].c[i] = ex.v[i];
-                n++;
-            } else {
-                double v2 = sngl(ex.v[0]);
-                sdl_accept(p, TOK_COMMA);
-                e[n].value = v;
-                colour_into(e[n].c, sdl_colour(p, 1));
-                e[n + 1].value = v2;
-                colour_into(e[n + 1].c, sdl_colour(p, 1));
-                n += 2;
-            }
-        } else {
-            e[n].value = v;
-            colour_into(e[n].c, sdl_colour(p, 1));
-            n++;
-        }
-        sdl_expect(p, TOK_RBRACKET, "']' closing the color_map entry");
-    }
-    sdl_end_block(p);
-    if (n == 0) {
-        if (sdl_ok(p)) sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_SYNTAX, "must have at least one color in color map");
-        return NULL;
-    }
-    /* POV-Ray drops an entry identical to the one before it. */
-    int k = 0;
-    for (int i = 1; i < n; i++) {
-        if (memcmp(&e[k], &e[i], sizeof e[i]) == 0) continue;
-        e[++k] = e[i];
-    }
-    return make_map(p, MAP_COLOUR, e, k + 1);
-}
-
-static const char *map_name(map_kind k)
-{
-    switch (k) {
-    case MAP_PIGMENT: return "pigment_map";
-    case MAP_NORMAL: return "normal_map";
-    case MAP_TEXTURE: return "texture_map";
-    case MAP_SLOPE: return "slope_map";
-    default: return "colour_map";
-    }
-}
-
-/* blend_map := '{' ( map_id | { '[' v [','] entry ']' } ) '}'; `average`
- * allows the value to be omitted (weight 1). */
-static const scene_blend_map *blend_map(sdl_parser *p, map_kind k, int average)
-{
-    if (!sdl_begin_block(p, map_name(k))) return NULL;
-    if (sdl_is(sdl_peek(p), TOK_IDENT) && sdl_peek(p)->val.kind == VAL_OPAQUE) {
-        const scene_blend_map *m = declared_map(p, map_name(k));
-        sdl_end_block(p);
-        return m;
-    }
-    scene_map_entry *e = entries(p, MAX_MAP_ENTRIES);
-    int n = 0;
-    if (!e) return NULL;
-    while (sdl_ok(p) && sdl_accept(p, TOK_LBRACKET)) {
-        if (n >= MAX_MAP_ENTRIES) {
-            sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_LIMIT, "too many entries in map (at most %d)", MAX_MAP_ENTRIES);
-            break;
-        }
-        e[n].value = sngl(average ? sdl_allow_float(p, 1.0) : sdl_float(p));
-        sdl_accept(p, TOK_COMMA);
-        switch (k) {
-        case MAP_PIGMENT: {
-            scene_pigment *pg = sdl_alloc(p, sizeof *pg);
-            if (!pg) return NULL;
-            *pg = p->s->default_texture.pigment;
-            sdl_pattern_pigment_body(p, pg);
-            e[n].pigment = pg;
-            break;
-        }
-        case MAP_NORMAL:
-            e[n].normal = sdl_pattern_normal_body(p, p->s->default_texture.normal);
-            break;
-        case MAP_TEXTURE:
-            e[n].texture = sdl_parse_texture_body(p);
-            break;
-        case MAP_SLOPE: {
-            double hs[2];
-            sdl_vector_n(p, hs, 2);
-            e[n].height = hs[0];
-            e[n].slope = hs[1];
-            break;
-        }
-        default:
-            break;
-        }
-        n++;
-        sdl_expect(p, TOK_RBRACKET, "']' closing the map entry");
-    }
-    sdl_end_block(p);
-    if (n == 0) {
-        if (sdl_ok(p)) sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_SYNTAX, "must have at least one entry in map");
-        return NULL;
-    }
-    return make_map(p, k, e, n);
-}
-
-const scene_blend_map *sdl_pattern_map(sdl_parser *p, sdl_kw k)
-{
-    switch (k) {
-    case KW_COLOR_MAP: case KW_COLOUR_MAP: return colour_map(p);
-    case KW_PIGMENT_MAP: return blend_map(p, MAP_PIGMENT, 0);
-    case KW_NORMAL_MAP: return blend_map(p, MAP_NORMAL, 0);
-    case KW_SLOPE_MAP: return blend_map(p, MAP_SLOPE, 0);
-    case KW_TEXTURE_MAP: return blend_map(p, MAP_TEXTURE, 0);
-    default: return NULL;
-    }
-}
-
 /* ------------------------------------------------------------ blend lists */
 
 /* Default colours of the listed-pattern maps (POV-Ray's default maps). */
@@ -522,9 +349,9 @@ static colour5 list_default_colour(pattern_kind k, int i)
     if (k == PAT_BRICK) v = brk[i % 2];
     else if (k == PAT_CHECKER || k == PAT_HEXAGON) v = hex[i % 3];
     else v = cub[i % 6];
-    c.r = sngl(v[0]);
-    c.g = sngl(v[1]);
-    c.b = sngl(v[2]);
+    c.r = sdl_map_single(v[0]);
+    c.g = sdl_map_single(v[1]);
+    c.b = sdl_map_single(v[2]);
     return c;
 }
 
@@ -532,7 +359,7 @@ static colour5 list_default_colour(pattern_kind k, int i)
  *               { texture {..} [','] }, at most `count` items. */
 static void blend_list(sdl_parser *p, target *tg, int count)
 {
-    scene_map_entry *e = entries(p, count);
+    scene_map_entry *e = sdl_map_entries(p, count);
     if (!e) return;
     int n = 0;
     map_kind mk = MAP_COLOUR;
@@ -552,7 +379,7 @@ static void blend_list(sdl_parser *p, target *tg, int count)
                 e[n].pigment = pg;
             } else {
                 if (!(sdl_starts_colour(t) || sdl_starts_expr(t))) break;
-                colour_into(e[n].c, sdl_colour(p, 1));
+                sdl_map_colour_into(e[n].c, sdl_colour(p, 1));
             }
             sdl_accept(p, TOK_COMMA);
             n++;
@@ -583,7 +410,7 @@ static void blend_list(sdl_parser *p, target *tg, int count)
         e[i].value = i;
         if (i < n) continue;
         switch (mk) {
-        case MAP_COLOUR: colour_into(e[i].c, list_default_colour(tg->pat->kind, i)); break;
+        case MAP_COLOUR: sdl_map_colour_into(e[i].c, list_default_colour(tg->pat->kind, i)); break;
         case MAP_PIGMENT: {
             scene_pigment *pg = sdl_alloc(p, sizeof *pg);
             if (pg) *pg = p->s->default_texture.pigment;
@@ -600,7 +427,7 @@ static void blend_list(sdl_parser *p, target *tg, int count)
         default: break;
         }
     }
-    *tg->map = make_map(p, mk, e, count);
+    *tg->map = sdl_map_make(p, mk, e, count);
 }
 
 /* ------------------------------------------------------------ warps */
@@ -1099,22 +926,22 @@ static int modifier(sdl_parser *p, target *tg)
         warp_block(p, tg);
         return 1;
     case KW_COLOR_MAP: case KW_COLOUR_MAP:
-        *tg->map = colour_map(p);
+        *tg->map = sdl_map_colour(p);
         return 1;
     case KW_PIGMENT_MAP:
-        *tg->map = blend_map(p, MAP_PIGMENT, tg->pat && tg->pat->kind == PAT_AVERAGE);
+        *tg->map = sdl_map_blend(p, MAP_PIGMENT, tg->pat && tg->pat->kind == PAT_AVERAGE);
         return 1;
     case KW_NORMAL_MAP:
-        *tg->map = blend_map(p, MAP_NORMAL, tg->pat && tg->pat->kind == PAT_AVERAGE);
+        *tg->map = sdl_map_blend(p, MAP_NORMAL, tg->pat && tg->pat->kind == PAT_AVERAGE);
         return 1;
     case KW_SLOPE_MAP:
-        *tg->map = blend_map(p, MAP_SLOPE, 0);
+        *tg->map = sdl_map_blend(p, MAP_SLOPE, 0);
         return 1;
     case KW_TEXTURE_MAP:
-        *tg->map = blend_map(p, MAP_TEXTURE, tg->pat && tg->pat->kind == PAT_AVERAGE);
+        *tg->map = sdl_map_blend(p, MAP_TEXTURE, tg->pat && tg->pat->kind == PAT_AVERAGE);
         return 1;
     case KW_DENSITY_MAP: /* entries are density bodies: pigment bodies (sdl_media.c) */
-        *tg->map = blend_map(p, MAP_PIGMENT, tg->pat && tg->pat->kind == PAT_AVERAGE);
+        *tg->map = sdl_map_blend(p, MAP_PIGMENT, tg->pat && tg->pat->kind == PAT_AVERAGE);
         return 1;
     case KW_QUICK_COLOR: case KW_QUICK_COLOUR:
         sdl_colour(p, 1);
@@ -1334,7 +1161,7 @@ void sdl_pattern_pigment_body(sdl_parser *p, scene_pigment *pg)
         if (pg->map && pg->map->kind != MAP_COLOUR && pg->map->kind != MAP_PIGMENT) pg->map = NULL;
         const scene_blend_map *m = pg->map;
         if (!m && tg.pat->kind == PAT_BRICK) {
-            colour5 c = {sngl(0.5), sngl(0.5), sngl(0.5), 0, 0};
+            colour5 c = {sdl_map_single(0.5), sdl_map_single(0.5), sdl_map_single(0.5), 0, 0};
             pg->colour = c;
         } else if (m) {
             pg->colour = first_colour(m, pg->colour);
@@ -1350,7 +1177,7 @@ void sdl_pattern_rainbow_pigment(sdl_parser *p, scene_pigment *pg)
     pt->kind = PAT_GRADIENT;
     pt->name = "rainbow";
     pt->gradient = v3(1, 0, 0);
-    pg->map = sdl_pattern_map(p, k.tk.kw);
+    pg->map = sdl_map_parse(p, k.tk.kw);
     pg->pat = pt;
     pg->pattern = pt->name;
     pg->kind = PIGMENT_PATTERN;
@@ -1415,7 +1242,7 @@ static void tiles(sdl_parser *p, scene_texture *t, src_loc loc)
     sdl_end_block(p);
     if (!lists[0]) sdl_error(p, loc, PT_ERR_SYNTAX, "first texture missing from tiles");
     scene_pattern *pt = new_pattern(p, NULL);
-    scene_map_entry *e = entries(p, 2);
+    scene_map_entry *e = sdl_map_entries(p, 2);
     if (!pt || !e) return;
     pt->kind = PAT_CHECKER;
     pt->name = "tiles";
@@ -1425,7 +1252,7 @@ static void tiles(sdl_parser *p, scene_texture *t, src_loc loc)
     e[1].value = 1;
     e[1].texture = lists[1] ? lists[1] : sdl_copy_texture(p, &p->s->default_texture);
     t->pat = pt;
-    t->map = make_map(p, MAP_TEXTURE, e, 2);
+    t->map = sdl_map_make(p, MAP_TEXTURE, e, 2);
 }
 
 /* material_map := '{' image_spec { once | interpolate n | map_type n |
@@ -1435,7 +1262,7 @@ static void material_map(sdl_parser *p, scene_texture *t)
 {
     if (!sdl_begin_block(p, "material_map")) return;
     scene_pattern *pt = new_pattern(p, NULL);
-    scene_map_entry *e = entries(p, MAX_MAP_ENTRIES);
+    scene_map_entry *e = sdl_map_entries(p, SDL_MAP_MAX_ENTRIES);
     if (!pt || !e) return;
     pt->kind = PAT_IMAGE;
     pt->name = "material_map";
@@ -1457,8 +1284,8 @@ static void material_map(sdl_parser *p, scene_texture *t)
             break;
         }
         case KW_TEXTURE:
-            if (n >= MAX_MAP_ENTRIES) {
-                sdl_error(p, k.tk.loc, PT_ERR_LIMIT, "too many textures in material_map (at most %d)", MAX_MAP_ENTRIES);
+            if (n >= SDL_MAP_MAX_ENTRIES) {
+                sdl_error(p, k.tk.loc, PT_ERR_LIMIT, "too many textures in material_map (at most %d)", SDL_MAP_MAX_ENTRIES);
                 break;
             }
             e[n].value = n;
@@ -1476,7 +1303,7 @@ static void material_map(sdl_parser *p, scene_texture *t)
         return;
     }
     t->pat = pt;
-    t->map = make_map(p, MAP_TEXTURE, e, n);
+    t->map = sdl_map_make(p, MAP_TEXTURE, e, n);
 }
 
 static void fallback_look(scene_texture *t)

@@ -25,9 +25,6 @@ scene_normal *sdl_pattern_normal_body(sdl_parser *p, const scene_normal *base);
 void sdl_pattern_texture(sdl_parser *p, scene_texture *t);
 /* Is k a keyword that starts a pattern type (pigment/normal/texture)? */
 int sdl_pattern_is_type(sdl_kw k);
-/* After a map keyword (color_map, pigment_map, normal_map, slope_map,
- * texture_map): its block as a map (#declare right-hand sides). */
-const scene_blend_map *sdl_pattern_map(sdl_parser *p, sdl_kw k);
 /* A rainbow's pigment: after 'colour_map' (not yet read), a gradient x
  * pigment through that map (POV-Ray's Parse_Rainbow). */
 void sdl_pattern_rainbow_pigment(sdl_parser *p, scene_pigment *pg);

@@ -1,7 +1,7 @@
 /* sdl_shape.h - grammar of POV-Ray's further shapes: polygon,
  * lathe, sor, prism, superellipsoid, quadric, poly/cubic/quartic/polynomial,
- * blob, height_field, text, sphere_sweep, bicubic_patch, and the clipped_by /
- * bounded_by object modifiers. sdl_object.c hands a shape keyword over after
+ * blob, height_field, text, sphere_sweep, bicubic_patch (clipped_by and
+ * bounded_by: sdl_clip.h). sdl_object.c hands a shape keyword over after
  * its '{'; the functions here read the shape's own arguments (object
  * modifiers are left to sdl_object_mods) and fill the IR (core/scene.h).
  *
@@ -17,8 +17,5 @@
 int sdl_shape_handles(sdl_kw k);
 /* After `k '{'`: the shape's arguments into so->obj (kind and data set). */
 void sdl_shape_args(sdl_parser *p, sdl_kw k, sdl_obj *so, src_loc loc);
-/* After 'clipped_by' / 'bounded_by' (the keyword read, '{' next). */
-void sdl_shape_clipped_by(sdl_parser *p, sdl_obj *so);
-void sdl_shape_bounded_by(sdl_parser *p, sdl_obj *so);
 
 #endif
