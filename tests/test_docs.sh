@@ -7,6 +7,9 @@
 #    work-period name (git keeps the history);
 #  - every image a page shows names, in its paragraph, the bench/ command
 #    that makes it.
+# Also: the user guide names every display, view and look of the shipped
+# OCIO config, and `partray render --help` (app/cli.c's cli_render_help)
+# lists every GNU-style option app/cli.c parses.
 # Prints each offence as FILE:LINE: what; exit 1 when there is one.
 root=${1:-.}
 cd "$root" || exit 2
@@ -71,6 +74,16 @@ if [ -f io/ocio/config.ocio ] && [ -f docs/guide.md ]; then
     sed -n -e 's/.*!<View> {name: \([^,]*\),.*/\1/p' -e '/!<Look>/{n;s/^ *name: //p;}' -e '/^displays:/,/^[a-z]/s/^  \([A-Za-z0-9.]*\):$/\1/p' \
         io/ocio/config.ocio | sort -u | while IFS= read -r n; do
         grep -q -F "\`$n\`" docs/guide.md || echo "docs/guide.md: the OCIO name '$n' (io/ocio/config.ocio) is not listed"
+    done > /tmp/test_docs.$$
+    if [ -s /tmp/test_docs.$$ ]; then cat /tmp/test_docs.$$; bad=1; fi
+    rm -f /tmp/test_docs.$$
+fi
+
+# `partray render --help` lists every GNU-style option app/cli.c parses
+if [ -f app/cli.c ]; then
+    help=$(sed -n '/^const char cli_render_help/,/^;/p' app/cli.c)
+    grep -o 'strcmp(a, "--[a-z0-9-]*")' app/cli.c | sed 's/.*"\(--[a-z0-9-]*\)".*/\1/' | sort -u | while IFS= read -r o; do
+        printf '%s\n' "$help" | grep -q -e "$o" || echo "app/cli.c: option $o is missing from cli_render_help"
     done > /tmp/test_docs.$$
     if [ -s /tmp/test_docs.$$ ]; then cat /tmp/test_docs.$$; bad=1; fi
     rm -f /tmp/test_docs.$$
