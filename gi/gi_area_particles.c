@@ -45,6 +45,17 @@ static void material(const scene *sc, const scene_texture *tex, const colour5 *c
     p->brilliance = isfinite(f->brilliance) && f->brilliance > 0.0 ? (float)f->brilliance : 1.0f;
 }
 
+void gi_particles_material(const scene *sc, const scene_texture *tex, float rho[3], float le[3])
+{
+    const radrules rr = radrules_of(sc, 1);
+    gi_dev_particle p;
+    material(sc, tex, NULL, &rr, &p);
+    for (int k = 0; k < 3; k++) {
+        rho[k] = p.rho[k];
+        le[k] = p.le[k];
+    }
+}
+
 typedef struct {
     gi_dev_particle *p;
     int *patch;
@@ -90,19 +101,47 @@ static int probe_ok(const accel *a, const scene_object *o, vec3 pos, vec3 nrm)
     return 0;
 }
 
+/* Most candidates a side gets per survivor the pilot predicts there. */
+#define SIDE_INFLATION 8.0
+
+/* The fraction of patch i inside the clip box (gi_surface_in_clip), from
+ * CLIP_PROBES points of its own sampler: 1 and 0 exactly when all or none
+ * are in (a patch far from what the camera sees gets no particles). */
+#define CLIP_PROBES 16
+static float clip_fraction(const gi_surface *g, int i, uint64_t seed)
+{
+    rng r;
+    rng_seed(&r, seed ^ 0xc11bULL, (uint64_t)i);
+    int in = 0, n = 0;
+    for (int q = 0; q < CLIP_PROBES * 4 && n < CLIP_PROBES; q++) {
+        vec3 pos, nrm;
+        if (!gi_surface_sample(g, i, rng_f64(&r), rng_f64(&r), &r, &pos, &nrm)) continue;
+        n++;
+        in += gi_surface_in_clip(g, pos);
+    }
+    return n ? (float)in / (float)n : 1.0f;
+}
+
 pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel *a, const scene *sc, long count,
                               uint64_t seed, const float *side_frac, gi_pigment_fn pig, diag *d)
 {
     const radrules rr = radrules_of(sc, 1);
     memset(ps, 0, sizeof *ps);
     int np = gi_surface_npatches(g);
+    float *inclip = malloc((size_t)(np > 0 ? np : 1) * sizeof *inclip);
+    if (!inclip) return PT_ERR_NOMEM;
     double total = 0.0;
-    for (int i = 0; i < np; i++)
+    for (int i = 0; i < np; i++) {
+        inclip[i] = clip_fraction(g, i, seed);
         for (int s = 0; s < gi_surface_sides(g, i); s++)
             if (gi_surface_side_mask(g, i) >> s & 1)
-                total += gi_surface_area(g, i) * (side_frac ? side_frac[2 * i + s] : 1.0);
+                total += gi_surface_area(g, i) * inclip[i] * (side_frac ? side_frac[2 * i + s] : 1.0);
+    }
     if (count < 1) count = 1;
-    if (!(total > 0.0)) return PT_OK;
+    if (!(total > 0.0)) {
+        free(inclip);
+        return PT_OK;
+    }
     double density = (double)count / total;
     ps->dA = total / (double)count;
     ps->spacing = sqrt(ps->dA);
@@ -115,9 +154,22 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
         int sides = gi_surface_sides(g, i);
         if (sides == 0 || !(area > 0.0)) continue;
         if (side_frac && side_frac[2 * i] <= 0.0f && (sides < 2 || side_frac[2 * i + 1] <= 0.0f)) continue;
-        /* systematic sampling of the patch counts: exactly `count` over all */
+        if (!(inclip[i] > 0.0f)) continue;
+        /* systematic sampling of the patch counts: exactly `count` over all.
+         * A side the pilot found mostly unreached gets count * area / total
+         * candidates so that its survivors stand at the density asked; at
+         * most SIDE_INFLATION times the survivors expected, so that a large
+         * surface the links hardly reach cannot multiply the candidates
+         * (its survivors then stand sparser). */
+        double keep = 1.0;
+        if (side_frac) {
+            double fmax = 0.0;
+            for (int s = 0; s < sides && s < 2; s++)
+                if (gi_surface_side_mask(g, i) >> s & 1) fmax = fmax > side_frac[2 * i + s] ? fmax : side_frac[2 * i + s];
+            keep = fmin(1.0, SIDE_INFLATION * fmax);
+        }
         long before = (long)floor(cum * density + offset);
-        cum += area;
+        cum += area * inclip[i] * keep;
         long m = (long)floor(cum * density + offset) - before;
         if (m <= 0) continue;
         rng pr;
@@ -140,6 +192,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
             double u = frac(su + (double)q * R2_A1), v = frac(sv + (double)q * R2_A2);
             vec3 pos, nrm;
             if (!gi_surface_sample(g, i, u, v, &pr, &pos, &nrm)) continue;
+            if (inclip[i] < 1.0f && !gi_surface_in_clip(g, pos)) continue;
             got++;
             gi_dev_particle mat = proto;
             if (pig) {
@@ -176,6 +229,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
                 p.n[2] = (float)nn.z;
                 if (!push(&b, &p, i, s)) {
                     if (have_ush) geom_shape_release(&ush);
+                    free(inclip);
                     free(b.p);
                     free(b.patch);
                     free(b.side);
@@ -186,12 +240,14 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
         if (have_ush) geom_shape_release(&ush);
         if (b.n > 2147483000L) {
             diag_report(d, DIAG_ERROR, (src_loc){0}, NULL, "particle GI: too many particles");
+            free(inclip);
             free(b.p);
             free(b.patch);
             free(b.side);
             return PT_ERR_LIMIT;
         }
     }
+    free(inclip);
     ps->n = (int)b.n;
     ps->p = b.p;
     ps->patch = b.patch;

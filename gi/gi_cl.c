@@ -68,6 +68,7 @@ struct gi_dev {
     unsigned *emits; /* (n + 31) / 32 words: particles with emission (gi_k_emit) */
     size_t nmask;    /* words of a particle mask, (n + 63) / 64 * 2 */
     const int *slink, *glink, *list_off, *list_idx, *rin_off, *rin_src;
+    const float *esky; /* 4 floats a particle: the sky's share of its gather (gi_links.h) */
     /* the first bounce's incoming lists cut to the candidate sources (rin
      * entries whose source has emission or some vis > 0; compact_sources),
      * rebuilt when that set changes */
@@ -99,7 +100,7 @@ struct gi_dev {
     cl_command_queue q;
     cl_program prog;
     cl_kernel k[KE_COUNT];
-    cl_mem b_part, b_slink, b_glink, b_off, b_idx, b_rho;
+    cl_mem b_part, b_slink, b_glink, b_off, b_idx, b_rho, b_esky;
     cl_mem b_lights, b_vis, b_edir, b_src, b_tally, b_lout, b_phi, b_eind, b_list, b_vout;
     cl_mem b_rin_off, b_rin_src, b_bin, b_bout, b_total, b_woff, b_went;
     cl_mem b_emits, b_mask_src, b_mask_a, b_mask_b, b_cin_off, b_cin_src;
@@ -358,7 +359,7 @@ static void rel(cl_mem *m)
  * before a new geometry's): the one list of them. */
 static void release_buffers(gi_dev *dv)
 {
-    cl_mem *ms[] = {&dv->b_part, &dv->b_rho, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
+    cl_mem *ms[] = {&dv->b_part, &dv->b_rho, &dv->b_esky, &dv->b_slink, &dv->b_glink, &dv->b_off, &dv->b_idx, &dv->b_lights,
                     &dv->b_vis, &dv->b_edir, &dv->b_src, &dv->b_tally, &dv->b_lout, &dv->b_phi,
                     &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off, &dv->b_rin_src, &dv->b_bin,
                     &dv->b_bout, &dv->b_total, &dv->b_woff, &dv->b_went,
@@ -562,9 +563,10 @@ void gi_dev_free(gi_dev *dv)
 }
 
 pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, const int *slink, int ns2,
-                               const int *glink, int ng, diag *d)
+                               const int *glink, int ng, const float *esky, diag *d)
 {
     dv->part = part;
+    dv->esky = esky;
     dv->n = n;
     dv->slink = slink;
     dv->ns2 = ns2;
@@ -634,6 +636,8 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     if ((st = upload(dv, &dv->b_slink, &have, slink, nr * (size_t)ns2 * sizeof(int), d)) != PT_OK) return st;
     have = 0;
     if ((st = upload(dv, &dv->b_glink, &have, glink, nr * (size_t)ng * sizeof(int), d)) != PT_OK) return st;
+    have = 0;
+    if ((st = upload(dv, &dv->b_esky, &have, esky, nr * 4 * sizeof(float), d)) != PT_OK) return st;
     have = 0;
     if ((st = upload(dv, &dv->b_emits, &have, dv->emits, dv->nmask * sizeof(unsigned), d)) != PT_OK) return st;
     cl_mem *mb[] = {&dv->b_mask_src, &dv->b_mask_a, &dv->b_mask_b};
@@ -1001,10 +1005,10 @@ pt_status gi_dev_fetch(gi_dev *dv, diag *d)
     return PT_OK;
 }
 
-pt_status gi_dev_gather(gi_dev *dv, const int *used, int nused, const float bg[3], float *eind, diag *d)
+pt_status gi_dev_gather(gi_dev *dv, const int *used, int nused, float *eind, diag *d)
 {
     if (!dv->is_cl) {
-        gi_c_gather(dv->threads, dv->glink, dv->ng, dv->lout_host, used, nused, bg, eind);
+        gi_c_gather(dv->threads, dv->glink, dv->ng, dv->lout_host, used, nused, dv->esky, eind);
         dv->eind_host = eind;
         return PT_OK;
     }
@@ -1013,10 +1017,9 @@ pt_status gi_dev_gather(gi_dev *dv, const int *used, int nused, const float bg[3
     pt_status st;
     if ((st = upload(dv, &dv->b_list, &dv->sz_list, used, (size_t)nused * sizeof(int), d)) != PT_OK) return st;
     int ng = dv->ng;
-    float r = bg[0], g = bg[1], b = bg[2];
-    karg a[] = {KMEM(dv->b_glink), KINT(ng), KMEM(dv->b_lout), KMEM(dv->b_list), KINT(nused), KF(r), KF(g), KF(b),
+    karg a[] = {KMEM(dv->b_glink), KINT(ng), KMEM(dv->b_lout), KMEM(dv->b_list), KINT(nused), KMEM(dv->b_esky),
                 KMEM(dv->b_eind)};
-    if ((st = run_kernel(dv, KE_GATHER, (size_t)nused, a, 9, d)) != PT_OK) return st;
+    if ((st = run_kernel(dv, KE_GATHER, (size_t)nused, a, 7, d)) != PT_OK) return st;
     size_t nn = (size_t)dv->n;
     if ((st = download(dv, dv->b_eind, dv->tmp, nn * 4 * sizeof(float), d)) != PT_OK) return st;
     for (int t = 0; t < nused; t++) memcpy(&eind[4 * (size_t)used[t]], &dv->tmp[4 * (size_t)used[t]], 4 * sizeof(float));

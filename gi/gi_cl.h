@@ -48,10 +48,13 @@ size_t gi_dev_bytes(const gi_dev *dv);          /* device buffers held (OpenCL) 
 int gi_dev_opencl_built(void);
 
 /* Geometry stage results: n particles, ns2 scattering links and ng gathering
- * links per particle (-1 = miss), and the estimation lists (CSR: entries
- * list_idx[list_off[l] .. list_off[l+1]) of radiance particle l). */
+ * links per particle (-1 = miss), esky (4 floats a particle, gi_links.h:
+ * the sky's and the far field's share of its gather),
+ * and the estimation lists (CSR: entries list_idx[list_off[l] ..
+ * list_off[l+1]) of radiance particle l). The arrays must outlive dv's use
+ * of them (the C build reads them in place). */
 pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, const int *slink, int ns2,
-                               const int *glink, int ng, diag *d);
+                               const int *glink, int ng, const float *esky, diag *d);
 pt_status gi_dev_set_lists(gi_dev *dv, const int *list_off, int nrp, const int *list_idx, diag *d);
 /* Incoming scattering links (CSR by target, sources ascending): the first
  * bounce, and every bounce of the "full" mode. */
@@ -92,7 +95,7 @@ pt_status gi_dev_fetch(gi_dev *dv, diag *d);
 /* Ray-tracing stage. gather: E~/pi of the used particles, written into the
  * device's copy and into eind[4*used[t]] on the host. estimate: radiance
  * particles found[t] into vout[4*t] (compact). */
-pt_status gi_dev_gather(gi_dev *dv, const int *used, int nused, const float bg[3], float *eind, diag *d);
+pt_status gi_dev_gather(gi_dev *dv, const int *used, int nused, float *eind, diag *d);
 pt_status gi_dev_estimate(gi_dev *dv, const int *found, int nfound, float *vout, diag *d);
 
 #endif

@@ -19,7 +19,7 @@ typedef struct {
     int np;
     const gi_dev_light *lights;
     int nlights;
-    const float *vis, *src, *edir, *lout, *eind, *bg;
+    const float *vis, *src, *edir, *lout, *eind, *esky;
     float *fout, *fout2;
     const int *glink, *idx, *list_off, *list_idx;
     int ng;
@@ -60,7 +60,7 @@ static void run_chunk(void *ctx, int chunk, int thread)
             break;
         case K_RESOLVE: gi_k_resolve(a->part, a->np, a->edir, a->scattered, a->total, a->fout, a->fout2); break;
         case K_GATHER:
-            gi_k_gather(a->glink, a->ng, a->lout, a->idx, (int)a->n, a->bg[0], a->bg[1], a->bg[2], a->fout);
+            gi_k_gather(a->glink, a->ng, a->lout, a->idx, (int)a->n, a->esky, a->fout);
             break;
         case K_ESTIMATE: gi_k_estimate(a->part, a->list_off, a->list_idx, a->eind, a->idx, (int)a->n, a->fout); break;
         }
@@ -122,10 +122,10 @@ void gi_c_resolve(int threads, const gi_dev_particle *part, int n, const float *
 }
 
 void gi_c_gather(int threads, const int *glink, int ng, const float *lout, const int *used, int nused,
-                 const float bg[3], float *eind)
+                 const float *esky, float *eind)
 {
     c_launch a = {.kernel = K_GATHER, .n = (size_t)nused, .glink = glink, .ng = ng, .lout = lout, .idx = used,
-                  .bg = bg, .fout = eind};
+                  .esky = esky, .fout = eind};
     launch(threads, &a);
 }
 

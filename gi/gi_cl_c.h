@@ -24,7 +24,7 @@ void gi_c_walk(int threads, const gi_dev_particle *part, int n, const float *edi
 void gi_c_resolve(int threads, const gi_dev_particle *part, int n, const float *edir, int scattered,
                   const float *total, float *lout, float *phi);
 void gi_c_gather(int threads, const int *glink, int ng, const float *lout, const int *used, int nused,
-                 const float bg[3], float *eind);
+                 const float *esky, float *eind);
 void gi_c_estimate(int threads, const gi_dev_particle *part, const int *list_off, const int *list_idx,
                    const float *eind, const int *found, int nfound, float *vout);
 

@@ -32,7 +32,42 @@ typedef struct {
     double off, scale;
     int *order; /* stratum of the j-th ray of a particle */
     float *su0, *sv0, sw; /* the j-th ray's stratum corner in [-1, 1]^2 and the strata's width */
+    const gi_sky *sky;    /* with esky: what the rays that leave the scene see */
+    float *esky;
+    const scene *sc;      /* for the far field of unanswered hits */
+    float far_bounce;     /* brightness when the far field reflects the sky, else 0 */
 } link_job;
+
+/* The far field (beyond the paper, which leaves open scenes out): a link
+ * ray that hits a surface where no particle answers (an infinite plane
+ * beyond the geometry stage's clip box, a shape without particles) sees
+ * that surface's emission, plus, when the light has a bounce to spare
+ * (far_bounce > 0), the sky it reflects, taken as unoccluded: rho * b *
+ * E_sky(n)/pi about the hit's normal turned to the ray, at the texture's
+ * base colour. In a closed room under a black sky this is the emission
+ * alone. */
+static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3])
+{
+    out[0] = out[1] = out[2] = 0.0f;
+    const scene_object *o = accel_rtc_object(J->a, h->hit.geomID, h->hit.primID, h->hit.instID[0]);
+    if (!o) return;
+    float rho[3], le[3];
+    gi_particles_material(J->sc, o->texture, rho, le);
+    float irr[3] = {0.0f, 0.0f, 0.0f};
+    if (J->far_bounce > 0.0f) {
+        vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z), n = v3_neg(d);
+        if (h->hit.instID[0] == RTC_INVALID_GEOMETRY_ID) {
+            vec3 ng = v3(h->hit.Ng_x, h->hit.Ng_y, h->hit.Ng_z);
+            double l = v3_len(ng);
+            if (l > 0.0 && isfinite(l)) n = v3_dot(ng, d) > 0.0 ? v3_scale(ng, -1.0 / l) : v3_scale(ng, 1.0 / l);
+        }
+        gi_sky_irradiance(J->sky, n, irr);
+    }
+    for (int c = 0; c < 3; c++) {
+        float v = le[c] + rho[c] * J->far_bounce * irr[c];
+        out[c] = isfinite(v) && v > 0.0f ? v : 0.0f;
+    }
+}
 
 /* sin and cos of a = (pi/4) t for t in [-1, 1] (the concentric map's
  * angle within one octant) by their Taylor polynomials, sin to a^9 and cos
@@ -163,11 +198,20 @@ static void job(void *ctx, int index, int thread)
     int last_hid = -1;
     for (int i = i0; i < i1; i++) {
         int any = 0;
+        float sky[3] = {0.0f, 0.0f, 0.0f};
         const gi_dev_particle *pt_i = &J->p[i];
         for (int j = 0; j < J->k; j++, m++) {
             int hit = cell[m] != -2;
             any |= hit;
-            if (!hit) miss++;
+            if (!hit) {
+                miss++;
+                if (J->esky) {
+                    const float d[3] = {rh[m].ray.dir_x, rh[m].ray.dir_y, rh[m].ray.dir_z};
+                    float L[3];
+                    gi_sky_radiance(J->sky, d, L);
+                    for (int c = 0; c < 3; c++) sky[c] += L[c];
+                }
+            }
             if (!J->links) continue;
             int target = -1;
             /* a hit on an object that carries no particles (unsupported
@@ -287,11 +331,23 @@ static void job(void *ctx, int index, int thread)
                                                   v3_neg(d), 0.0, J->pin);
                     other++;
                 }
-                if (target < 0) unres++;
+                if (target < 0) {
+                    unres++;
+                    if (J->esky && hit) {
+                        float L[3];
+                        far_field(J, &rh[m], L);
+                        for (int c = 0; c < 3; c++) sky[c] += L[c];
+                    }
+                }
             }
             J->links[(size_t)i * J->k + J->order[j]] = target;
         }
         if (J->anyhit) J->anyhit[i] = (unsigned char)any;
+        if (J->esky) {
+            float *e = &J->esky[4 * (size_t)i];
+            for (int c = 0; c < 3; c++) e[c] = sky[c] / (float)J->k;
+            e[3] = 0.0f;
+        }
     }
     atomic_fetch_add(&J->misses, miss);
     atomic_fetch_add(&J->unresolved, unres);
@@ -334,19 +390,24 @@ void gi_links_reverse_fill(const int *links, int n, int k, const unsigned *mask,
     }
 }
 
-pt_status gi_links_build(const accel *a, void *scene, const gi_dev_particle *p, const void *const *pobj,
+pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle *p, const void *const *pobj,
                          const unsigned char *pin, int n, int nside, uint64_t seed, const gi_lookup *grid,
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
-                         gi_link_stats *st, volatile int *cancel, progress *prog)
+                         gi_link_stats *st, volatile int *cancel, progress *prog,
+                         const gi_sky *sky, float *esky, const scene *sc, double far_bounce)
 {
     if (threads <= 0) threads = pool_default_threads();
     link_job J;
     memset(&J, 0, sizeof J);
     J.a = a;
+    J.sky = sky;
+    J.esky = sky && sc ? esky : NULL;
+    J.sc = sc;
+    J.far_bounce = isfinite(far_bounce) && far_bounce > 0.0 ? (float)far_bounce : 0.0f;
     /* the link scene (accel.h): without the main scene's robust mode and
      * filters it is cheaper per link ray; the main scene is the fallback */
-    void *lscene = scene ? NULL : accel_rtc_link_scene(a);
-    J.scene = scene ? (RTCScene)scene : lscene ? (RTCScene)lscene : (RTCScene)accel_rtc_scene(a);
+    void *lscene = rtc_scene ? NULL : accel_rtc_link_scene(a);
+    J.scene = rtc_scene ? (RTCScene)rtc_scene : lscene ? (RTCScene)lscene : (RTCScene)accel_rtc_scene(a);
     J.p = p;
     J.pobj = pobj;
     J.pin = pobj ? pin : NULL;

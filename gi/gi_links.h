@@ -9,7 +9,9 @@
 #define PT_GI_LINKS_H
 #include <stdint.h>
 #include "accel.h"
+#include "scene.h"
 #include "gi_area_particles.h"
+#include "gi_sky.h"
 #include "gi_surface.h"
 #include "gi_trilook.h"
 #include "progress.h"
@@ -40,11 +42,18 @@ typedef struct {
  * the RTCScene to trace (accel_rtc_link_scene's, built once by the
  * caller); NULL: the link scene is built and freed here. prog (may be
  * NULL): its current stage counts the chunks of particles traced. */
+/* sky, esky and sc (all or none; NULL: none): esky receives 4 floats a
+ * particle (the fourth 0): the radiance its rays that leave the scene see
+ * (sky), plus the far field of those that hit where no particle answers
+ * (gi_links.c far_field, reflecting the sky times far_bounce), summed and
+ * divided by nside^2: their share of the cosine-weighted mean incoming
+ * radiance, in E/pi units. */
 #define GI_LINKS_AGREE 0.3
-pt_status gi_links_build(const accel *a, void *scene, const gi_dev_particle *p, const void *const *pobj,
+pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle *p, const void *const *pobj,
                          const unsigned char *pin, int n, int nside, uint64_t seed, const gi_lookup *grid,
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
-                         gi_link_stats *st, volatile int *cancel, progress *prog);
+                         gi_link_stats *st, volatile int *cancel, progress *prog,
+                         const gi_sky *sky, float *esky, const scene *sc, double far_bounce);
 
 /* Incoming links, a counting sort by target: the sources i < n in mask
  * (bit i of word i / 32; NULL: all) whose links[i * k + j] are >= 0, per

@@ -184,6 +184,7 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
     gi_lookup *grid = gi_lookup_build(ps, 2.0 * (ps->spacing > 0.0 ? ps->spacing : 1.0));
     int *links = gi_particle_calloc((size_t)n * (size_t)k, sizeof(int), &st);
     unsigned char *keep = gi_particle_calloc((size_t)n, 1, &st);
+    unsigned char *linked = gi_particle_calloc((size_t)n, 1, &st);
     int *remap = gi_particle_calloc((size_t)n, sizeof(int), &st);
     unsigned char *pin = NULL;
     const void **pobj = particle_objects(gp, ps, &pin, &st);
@@ -197,13 +198,36 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
                                   3.0 * ps->spacing, gp->threads, gp->set.cancel, &st);
     if (st == PT_OK)
         st = gi_links_build(gp->a, gp->lscene, ps->p, pobj, pin, n, gp->set.scatter_side, seed, grid, gp->tl,
-                            3.0 * ps->spacing, gp->threads, links, keep, ls, gp->set.cancel, gp->set.progress);
+                            3.0 * ps->spacing, gp->threads, links, keep, ls, gp->set.cancel, gp->set.progress, NULL,
+                            NULL, NULL, 0.0);
     gi_lookup_free(grid);
     free(pobj);
     free(pin);
     if (st == PT_OK) {
         for (size_t j = 0; j < (size_t)n * (size_t)k; j++)
-            if (links[j] >= 0) keep[links[j]] = 1;
+            if (links[j] >= 0) linked[links[j]] = 1;
+        /* linked: the particles some link ray ends on; keep: those with a
+         * ray that hit something (they receive indirect light). Of the
+         * latter only those the camera may see matter beyond the links:
+         * the ones facing the camera's position (a surface facing away
+         * from it is invisible to it; the underside of a ground plane).
+         * Under a sky that is not black, a particle facing the camera
+         * receives light even when all its rays leave the scene (the top
+         * of a box under the open sky). */
+        if (gp->sc->camera_set) {
+            const scene_camera *cam = &gp->sc->camera;
+            int sky = !gi_sky_black(gp->sky);
+            for (int i = 0; i < n; i++) {
+                if (linked[i]) continue;
+                const gi_dev_particle *t = &ps->p[i];
+                vec3 to = v3_sub(cam->location, v3(t->p[0], t->p[1], t->p[2]));
+                int faces = v3_dot(to, v3(t->n[0], t->n[1], t->n[2])) > 0.0;
+                keep[i] = faces && (keep[i] || sky);
+            }
+        } else if (!gi_sky_black(gp->sky)) {
+            memset(keep, 1, (size_t)n);
+        }
+        for (int i = 0; i < n; i++) keep[i] |= linked[i];
         int m = 0;
         for (int i = 0; i < n; i++) remap[i] = keep[i] ? m++ : -1;
         for (int i = 0; i < n; i++) {
@@ -217,6 +241,7 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
         gi_trilook_compact(gp->tl, remap, ps->p, ps->n);
     }
     free(keep);
+    free(linked);
     free(remap);
     if (st != PT_OK) {
         free(links);
@@ -376,6 +401,31 @@ static pt_status catchment_areas(gi_particles *ps, const int *glink, int ng)
     return PT_OK;
 }
 
+/* Sky light in the lighting stage (beyond the paper, which leaves open
+ * scenes out): what a particle's gathering links that left the scene saw
+ * (and the far field of those no particle answered) is light arriving at
+ * it, E/pi = esky (gi_links.h), which it reflects as rho * E / pi like
+ * light from a light_source. That reflected radiance is added to the
+ * particle's emitted radiance le, so emission (gi_k_emit) sends it along
+ * the scattering links and the gathering step reads it, with no further
+ * kernel input. The sky reaches surfaces only as gathered light, so it is
+ * scaled by brightness (core/radrules.h rule 2), and it is a bounce of
+ * gathered light: with no scattering bounce (recursion_limit 1) the sky
+ * reaches a surface only through its own gathering (gi_k_gather), not by
+ * way of another surface. */
+static void sky_as_emission(gi_particle *gp)
+{
+    if (gp->set.bounces < 1 || !gp->esky || gi_sky_black(gp->sky)) return;
+    float b = (float)gp->set.brightness;
+    for (int i = 0; i < gp->ps.n; i++) {
+        gi_dev_particle *p = &gp->ps.p[i];
+        for (int c = 0; c < 3; c++) {
+            float le = p->le[c] + p->rho[c] * b * gp->esky[4 * (size_t)i + c];
+            if (isfinite(le)) p->le[c] = le;
+        }
+    }
+}
+
 gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particle_settings *s,
                                gi_particle_stats *stats, diag *d, pt_status *status)
 {
@@ -402,9 +452,12 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     if (gp->threads > GI_MAX_THREADS) gp->threads = GI_MAX_THREADS;
     gp->ns2 = set->scatter_side * set->scatter_side;
     gp->ng = set->gather_side * set->gather_side;
-    gp->bg[0] = (float)sc->background.r;
-    gp->bg[1] = (float)sc->background.g;
-    gp->bg[2] = (float)sc->background.b;
+    gp->sky = gi_sky_new(sc, set->sky);
+    if (!gp->sky) {
+        *status = PT_ERR_NOMEM;
+        gi_particle_free(gp);
+        return NULL;
+    }
     gi_particle_stats *S = &gp->st;
     S->bounces = set->bounces;
 
@@ -514,9 +567,11 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         progress_stage(set->progress, "gi geometry: gather links", 0);
         tg = timer_now();
         cg = timer_cpu_now();
+        gp->esky = gi_particle_calloc((size_t)n * 4, sizeof(float), &st);
         if (st == PT_OK)
             st = gi_links_build(a, gp->lscene, gp->ps.p, pobj, pin, n, set->gather_side, set->seed ^ 0x6a7ULL, grid,
-                                gp->tl, 3.0 * spacing, gp->threads, gp->glink, NULL, &ls, set->cancel, set->progress);
+                                gp->tl, 3.0 * spacing, gp->threads, gp->glink, NULL, &ls, set->cancel, set->progress,
+                                gp->sky, gp->esky, sc, set->bounces >= 1 ? set->brightness : 0.0);
         S->t_gather_links = timer_now() - tg;
         S->c_gather_links = timer_cpu_now() - cg;
         gi_lookup_free(grid);
@@ -537,6 +592,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         S->link_unresolved = ls.unresolved;
         st = catchment_areas(&gp->ps, gp->glink, gp->ng);
         if (st != PT_OK) goto fail;
+        sky_as_emission(gp);
     }
 
     /* radiance particles and estimation lists */
@@ -595,7 +651,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     }
 
     tg = timer_now();
-    st = gi_dev_set_particles(gp->dev, gp->ps.p, gp->ps.n, gp->slink, gp->ns2, gp->glink, gp->ng, d);
+    st = gi_dev_set_particles(gp->dev, gp->ps.p, gp->ps.n, gp->slink, gp->ns2, gp->glink, gp->ng, gp->esky, d);
     if (st == PT_OK) st = gi_dev_set_lists(gp->dev, gp->lists.off, (int)gp->lists.nrp, gp->lists.idx, d);
     if (st == PT_OK) st = gi_dev_set_reverse(gp->dev, gp->rin_off, gp->rin_src, d);
     if (st == PT_OK && set->scatter != GI_PARTICLE_SCATTER_FULL) st = gi_particle_build_walk(gp, set->bounces - 1, d);
@@ -630,6 +686,8 @@ void gi_particle_free(gi_particle *gp)
     }
     free(gp->slink);
     free(gp->glink);
+    free(gp->esky);
+    gi_sky_free(gp->sky);
     free(gp->rin_off);
     free(gp->rin_src);
     free(gp->lights);

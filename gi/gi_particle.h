@@ -70,6 +70,7 @@
 #include "accel.h"
 #include "diag.h"
 #include "progress.h"
+#include "gi_sky.h"
 #include "scene.h"
 
 typedef struct gi_particle gi_particle;
@@ -80,11 +81,7 @@ typedef struct gi_particle gi_particle;
  * was found. */
 typedef int (*gi_pigment_fn)(const scene *sc, const scene_texture *tex, const accel_hit *h, colour5 *out);
 
-/* Radiance arriving from the sky along unit direction -dir for a ray that
- * leaves the scene along dir: sky_sphere pigments over the background
- * (POV-Ray's rule for gathering rays, core/radrules.h rule 4). The
- * signature of shade_atmos.h's shade_atmos_sky, which the app passes. */
-typedef rgb (*gi_sky_fn)(const scene *sc, vec3 dir);
+/* gi_sky_fn (gi_sky.h): the sky's radiance for rays that leave the scene. */
 
 /* How flux is scattered after emission (gi_lighting.cl; every bounce a
  * gather, no atomics, deterministic):

@@ -70,6 +70,19 @@ static int claim(atomic_uchar *s)
     }
 }
 
+/* A radiance particle whose estimation list is empty (no area particle
+ * near it on its object and side: a small object among few particles)
+ * takes the far field, the unoccluded sky about its normal (gi_sky.h;
+ * black under a black sky). */
+void gi_particle_rp_far_field(gi_particle *gp, long l)
+{
+    vec3 q, nq;
+    gi_surface_rp(gp->surf, l, &q, &nq);
+    float e[3];
+    gi_sky_irradiance(gp->sky, nq, e);
+    for (int c = 0; c < 3; c++) gp->rp_val[4 * l + c] = e[c];
+}
+
 static void late_rp(gi_particle *gp, long l, thread_count *tc)
 {
     if (!claim(&gp->rp_state[l])) return;
@@ -79,7 +92,7 @@ static void late_rp(gi_particle *gp, long l, thread_count *tc)
         int m = gp->lists.idx[q];
         if (claim(&gp->e_state[m])) {
             /* the gathering kernel, C build, on this thread */
-            gi_c_gather(1, gp->glink, gp->ng, gp->lout, &m, 1, gp->bg, gp->eind);
+            gi_c_gather(1, gp->glink, gp->ng, gp->lout, &m, 1, gp->esky, gp->eind);
             atomic_store_explicit(&gp->e_state[m], 2, memory_order_release);
             tc->late_area++;
         }
@@ -87,7 +100,9 @@ static void late_rp(gi_particle *gp, long l, thread_count *tc)
     int li = (int)l;
     float v[4];
     gi_c_estimate(1, gp->ps.p, gp->lists.off, gp->lists.idx, gp->eind, &li, 1, v);
-    for (int c = 0; c < 3; c++) gp->rp_val[4 * l + c] = lo == hi ? gp->bg[c] : v[c];
+    if (lo == hi) gi_particle_rp_far_field(gp, l);
+    else
+        for (int c = 0; c < 3; c++) gp->rp_val[4 * l + c] = v[c];
     atomic_store_explicit(&gp->rp_state[l], 2, memory_order_release);
 }
 
@@ -124,7 +139,7 @@ static int onthefly(gi_particle *gp, const accel_hit *h, vec3 n, thread_count *t
     for (long q = 0; q < m; q++) {
         int k = tc->buf[q];
         if (claim(&gp->e_state[k])) {
-            gi_c_gather(1, gp->glink, gp->ng, gp->lout, &k, 1, gp->bg, gp->eind);
+            gi_c_gather(1, gp->glink, gp->ng, gp->lout, &k, 1, gp->esky, gp->eind);
             atomic_store_explicit(&gp->e_state[k], 2, memory_order_release);
             tc->late_area++;
         }
@@ -210,10 +225,23 @@ rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
     rgb out = {0.0, 0.0, 0.0};
     thread_count *tc = &gp->tc[(unsigned)thread < GI_MAX_THREADS ? thread : 0];
     tc->lookups++;
-    if (!gp->lit || !side_value(gp, hit, n, tc, &out)) {
+    if (!gp->lit) {
         tc->none++;
-        out.r = out.g = out.b = 0.0;
         return out;
+    }
+    if (!gi_surface_in_clip(gp->surf, hit->p) || !side_value(gp, hit, n, tc, &out)) {
+        /* No particle answers here: a surface the geometry stage left out
+         * (an infinite plane beyond its clip box, an object far from what
+         * the camera sees, a shape without particles). The far field: what
+         * it would gather from a sky nothing occludes, E/pi about its
+         * normal (gi_sky.h); black under a black sky. */
+        tc->none++;
+        vec3 ngv = v3_dot(n, hit->ng) >= 0.0 ? hit->ng : v3_neg(hit->ng);
+        float e[3];
+        gi_sky_irradiance(gp->sky, ngv, e);
+        out.r = e[0];
+        out.g = e[1];
+        out.b = e[2];
     }
     /* finish { diffuse A, B } (3.7's backside diffuse, shade_material.h:
      * kb/pi for light arriving from the other side): shade.c multiplies the

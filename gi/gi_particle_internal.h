@@ -36,6 +36,8 @@ struct gi_particle {
     gi_particles ps;
     int ns2, ng;
     int *slink, *glink;
+    gi_sky *sky;    /* what links that leave the scene see */
+    float *esky;    /* n*4: the sky's and the far field's share of each particle's gather (gi_links.h) */
     void *lscene;   /* accel_rtc_link_scene, for the three link passes (freed after them) */
     gi_trilook *tl; /* the 4x4 pass's lookup by hit triangle, compacted for the 16x16 pass */
     int *rin_off, *rin_src; /* incoming scattering links (first bounce, FULL mode) */
@@ -69,7 +71,6 @@ struct gi_particle {
     size_t vrec_cap;       /* records allocated */
     int vw, vh;
     double veps;           /* the pre-pass's tmin */
-    float bg[3];
     double vis_eps; /* gi_visible's eps: 1e-6 x accel_eps_scale */
     thread_count tc[GI_MAX_THREADS];
     gi_particle_stats st;
@@ -122,4 +123,7 @@ void gi_particle_cell_batch_free(struct cell_batch *b);
 void *gi_particle_calloc(size_t n, size_t size, pt_status *st);
 /* The WALK bounces' path table for nwalk bounces (gp->woff, gp->went). */
 pt_status gi_particle_build_walk(gi_particle *gp, int nwalk, diag *d);
+/* The far field's E/pi at radiance particle l, for an empty estimation list. */
+void gi_particle_rp_far_field(gi_particle *gp, long l);
+
 #endif

@@ -447,7 +447,7 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
         if (umark[i]) used[nused++] = i;
     S->found = nfound;
     S->used = nused;
-    st = gi_dev_gather(gp->dev, used, nused, gp->bg, gp->eind, d);
+    st = gi_dev_gather(gp->dev, used, nused, gp->eind, d);
     if (st != PT_OK) goto done;
     for (int t = 0; t < nused; t++) {
         gp->dev_gathered[used[t]] = 1;
@@ -467,7 +467,9 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
     for (int t = 0; t < nfound; t++) {
         long l = found[t];
         int empty = gp->lists.off[l] == gp->lists.off[l + 1];
-        for (int c = 0; c < 3; c++) gp->rp_val[4 * l + c] = empty ? gp->bg[c] : vout[4 * t + c];
+        if (empty) gi_particle_rp_far_field(gp, l);
+        else
+            for (int c = 0; c < 3; c++) gp->rp_val[4 * l + c] = vout[4 * t + c];
         gp->rp_val[4 * l + 3] = 0.0f;
         atomic_store(&gp->rp_state[l], 2);
     }

@@ -9,8 +9,10 @@
 #include "accel_surface.h"
 #include "geom_sweep.h"
 #include "geom_tess.h"
+#include "camera.h"
 #include <limits.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -573,6 +575,59 @@ static pt_status walk(gi_surface *g, const scene_object *o, const scene_texture 
     }
 }
 
+/* What the camera sees bounds what gets particles: a 64 x 48 grid of
+ * camera rays; the box of the camera's position and the hits on finite
+ * objects (not planes, quadrics or polys; inside the finite bounds before
+ * they grew), grown by
+ * half its diagonal on every side, and [lo, hi] becomes its intersection
+ * with [lo, hi]. Objects far from everything the camera sees (a scene's
+ * stray blocks a kilometre away, the horizon of an infinite plane) then
+ * get no particles: a link or a pixel that reaches them takes the far
+ * field (gi_links.c, gi_particle_indirect). Rooms keep their walls behind
+ * the camera: the camera's position is in the box. No camera, or no
+ * finite hit: [lo, hi] stays. */
+#define VIEW_W 64
+#define VIEW_H 48
+static void view_clip(const scene *s, const accel *a, vec3 *lo, vec3 *hi)
+{
+    if (!s->camera_set) return;
+    vec3 flo, fhi;
+    accel_bounds(a, &flo, &fhi);
+    if (!(flo.x <= fhi.x)) return;
+    vec3 t = v3s(1e-6 * (1.0 + v3_len(v3_sub(fhi, flo))));
+    flo = v3_sub(flo, t);
+    fhi = v3_add(fhi, t);
+    vec3 vlo = s->camera.location, vhi = s->camera.location;
+    int any = 0;
+    for (int y = 0; y < VIEW_H; y++)
+        for (int x = 0; x < VIEW_W; x++) {
+            vec3 org, dir;
+            if (!camera_ray(&s->camera, x + 0.5, y + 0.5, VIEW_W, VIEW_H, 0.5, 0.5, &org, &dir)) continue;
+            accel_hit h;
+            if (!accel_intersect(a, org, dir, 0.0, INFINITY, &h)) continue;
+            vec3 p = h.p;
+            /* planes and the shapes that may be unbounded stand for the far
+             * ground and the horizon, not for what the view is about */
+            if (!h.obj || h.obj->kind == SHAPE_PLANE || h.obj->kind == SHAPE_QUADRIC || h.obj->kind == SHAPE_POLY)
+                continue;
+            if (!v3_finite(p) || p.x < flo.x || p.y < flo.y || p.z < flo.z || p.x > fhi.x || p.y > fhi.y ||
+                p.z > fhi.z)
+                continue;
+            vlo = v3_min(vlo, p);
+            vhi = v3_max(vhi, p);
+            any = 1;
+        }
+    if (!any || !v3_finite(vlo) || !v3_finite(vhi)) return;
+    vec3 m = v3s(0.5 * v3_len(v3_sub(vhi, vlo)));
+    vlo = v3_sub(vlo, m);
+    vhi = v3_add(vhi, m);
+    vec3 nlo = v3_max(*lo, vlo), nhi = v3_min(*hi, vhi);
+    if (nlo.x <= nhi.x && nlo.y <= nhi.y && nlo.z <= nhi.z) {
+        *lo = nlo;
+        *hi = nhi;
+    }
+}
+
 gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *d, pt_status *status)
 {
     pt_status dummy;
@@ -597,11 +652,18 @@ gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *
         g->lo = v3_sub(lo, v3s(e));
         g->hi = v3_add(hi, v3s(e));
     } else {
-        /* a little margin so planes under or behind the geometry cover its footprint */
-        vec3 m = v3s(1e-3 * v3_len(v3_sub(g->hi, g->lo)));
+        /* Infinite surfaces (planes, unbounded quadrics) are clipped to the
+         * finite geometry's bounds grown by half their diagonal on every
+         * side: the ground around the objects, where their shadows and
+         * their light fall, gets particles; beyond it an infinite surface
+         * is the far field (gi_surface_in_clip: the hook answers there from
+         * the unoccluded sky). The particle count then never depends on
+         * the size of a plane. */
+        vec3 m = v3s(0.5 * v3_len(v3_sub(g->hi, g->lo)));
         g->lo = v3_sub(g->lo, m);
         g->hi = v3_add(g->hi, m);
     }
+    view_clip(s, a, &g->lo, &g->hi);
     pt_status ast = PT_OK;
     g->as = accel_surf_build(s, a, NULL, NULL, d, &ast);
     if (!g->as) {
@@ -650,6 +712,13 @@ void gi_surface_free(gi_surface *g)
     free(g->o);
     free(g->hash);
     free(g);
+}
+
+int gi_surface_in_clip(const gi_surface *g, vec3 p)
+{
+    vec3 t = v3s(1e-6 * v3_len(v3_sub(g->hi, g->lo)));
+    return p.x >= g->lo.x - t.x && p.y >= g->lo.y - t.y && p.z >= g->lo.z - t.z && p.x <= g->hi.x + t.x &&
+           p.y <= g->hi.y + t.y && p.z <= g->hi.z + t.z;
 }
 
 int gi_surface_npatches(const gi_surface *g) { return g->np; }

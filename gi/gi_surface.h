@@ -83,6 +83,9 @@ void gi_surface_retess(gi_surface *g, double tess);
  * box; 0 for every other shape). */
 int gi_surface_inside_solid(const scene_object *o, vec3 q);
 
+/* 1 when p lies in the box infinite surfaces are clipped to (every finite
+ * object lies in it; an infinite surface has particles only there). */
+int gi_surface_in_clip(const gi_surface *g, vec3 p);
 int gi_surface_npatches(const gi_surface *g);
 double gi_surface_area(const gi_surface *g, int patch); /* one side */
 int gi_surface_sides(const gi_surface *g, int patch);

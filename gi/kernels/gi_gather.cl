@@ -8,32 +8,34 @@
  *   E~^(i) = (pi / N_gather) sum_k L_in(p^(i), w_k),   L_in ~ L^(k*),
  * where k* is the end particle of gathering link k. In E/pi units this is
  * the plain mean of L^(k*) (lout, which includes emission). A link of -1
- * (the ray left the scene) sees the background radiance bg. One work-item
- * per used area particle i = used[t]; the result goes to eind[i] (4 floats).
- * Reads only: no atomics. */
+ * either left the scene or hit where no particle answers. Beyond the paper,
+ * which leaves open scenes out: a link that left the scene sees the sky,
+ * and one that hit where no particle answers sees the far field; the
+ * geometry stage summed their share of the mean into esky[4i..4i+2]
+ * (gi_links.h).
+ * One work-item per used area particle i = used[t]; the result goes to
+ * eind[i] (4 floats). Reads only: no atomics. */
 __kernel void gi_k_gather(__global const int *glink, int ng, __global const float *lout, __global const int *used,
-                          int nused, float bg_r, float bg_g, float bg_b, __global float *eind)
+                          int nused, __global const float *esky, __global float *eind)
 {
     int t = (int)get_global_id(0);
     if (t >= nused) return;
     int i = used[t];
     float s[3] = {0.0f, 0.0f, 0.0f};
-    int miss = 0;
     __global const int *lk = &glink[(long)i * ng];
     for (int k = 0; k < ng; k++) {
         int j = lk[k];
-        if (j < 0) {
-            miss++;
-            continue;
-        }
+        if (j < 0) continue;
         s[0] += lout[4 * j];
         s[1] += lout[4 * j + 1];
         s[2] += lout[4 * j + 2];
     }
     float inv = 1.0f / (float)ng;
-    float e[3] = {(s[0] + bg_r * (float)miss) * inv, (s[1] + bg_g * (float)miss) * inv,
-                  (s[2] + bg_b * (float)miss) * inv};
-    for (int c = 0; c < 3; c++) eind[4 * i + c] = isfinite(e[c]) ? e[c] : 0.0f;
+    __global const float *sk = &esky[4 * (long)i];
+    for (int c = 0; c < 3; c++) {
+        float e = s[c] * inv + sk[c];
+        eind[4 * i + c] = isfinite(e) ? e : 0.0f;
+    }
     eind[4 * i + 3] = 0.0f;
 }
 
