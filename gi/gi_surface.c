@@ -578,9 +578,9 @@ static pt_status walk(gi_surface *g, const scene_object *o, const scene_texture 
 /* What the camera sees bounds what gets particles: a 64 x 48 grid of
  * camera rays; the box of the camera's position and the hits on finite
  * objects (not planes, quadrics or polys; inside the finite bounds before
- * they grew), grown by
- * half its diagonal on every side, and [lo, hi] becomes its intersection
- * with [lo, hi]. Objects far from everything the camera sees (a scene's
+ * they grew), grown by its diagonal on every side (a room seen from near
+ * one wall keeps the wall behind the camera), and [lo, hi] becomes its
+ * intersection with [lo, hi]. Objects far from everything the camera sees (a scene's
  * stray blocks a kilometre away, the horizon of an infinite plane) then
  * get no particles: a link or a pixel that reaches them takes the far
  * field (gi_links.c, gi_particle_indirect). Rooms keep their walls behind
@@ -618,7 +618,7 @@ static void view_clip(const scene *s, const accel *a, vec3 *lo, vec3 *hi)
             any = 1;
         }
     if (!any || !v3_finite(vlo) || !v3_finite(vhi)) return;
-    vec3 m = v3s(0.5 * v3_len(v3_sub(vhi, vlo)));
+    vec3 m = v3s(v3_len(v3_sub(vhi, vlo)));
     vlo = v3_sub(vlo, m);
     vhi = v3_add(vhi, m);
     vec3 nlo = v3_max(*lo, vlo), nhi = v3_min(*hi, vhi);
