@@ -292,6 +292,13 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
             else if (strcmp(a, "--fg-rays") == 0) o->fg_rays = v;
             else o->max_depth = v;
             i++;
+        } else if (strcmp(a, "--gi-quality") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (!parse_double(next, &o->gi_quality) || !(o->gi_quality > 0.0) || o->gi_quality > 64.0) {
+                snprintf(err, (size_t)errlen, "--gi-quality wants a number in (0, 64]");
+                return 2;
+            }
+            i++;
         } else if (strcmp(a, "--clock") == 0) {
             if (!has_value(a, next, err, errlen)) return 2;
             if (!parse_double(next, &o->clock)) { snprintf(err, (size_t)errlen, "--clock wants a number"); return 2; }
@@ -561,6 +568,8 @@ const char cli_render_help[] =
     "                         path (path tracer), pmfg (photon map + final gather);\n"
     "                         default: particle when the scene has radiosity{}, else none\n"
     "  --particles N --nb N   particle: particles, bounces\n"
+    "  --gi-quality Q         particle: Q times the particles the scene's radiosity{} asks for\n"
+    "                         (default 1; 0.5 faster and coarser, 2 or 4 slower and closer to converged)\n"
     "  --cl-device NAME --cl-max-memory MIB    particle: OpenCL device and its memory\n"
     "  --max-depth N          path: vertices per path\n"
     "  --fg-rays N --photons N    pmfg: final-gather rays per pixel, photon paths\n"

@@ -70,6 +70,7 @@ typedef struct {
     long max_string;
     /* GI settings (render_gi.h); 0 = the mode's default */
     long particles;
+    double gi_quality;      /* --gi-quality: scales the GI method's effort from the scene's settings (0 = 1) */
     int bounces, fg_rays, max_depth;
     long photons;
     const char *cl_device;  /* particle GI: OpenCL device (NULL/"auto", "c", "P:D" or part of a name) */

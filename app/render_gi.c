@@ -70,6 +70,7 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     gi_particle_settings_from_scene(&gs, sc);
     gs.pigment = shade_tex_pigment_at; /* particles reflect the pigment where they are */
     gs.sky = shade_atmos_sky; /* what escaping rays see (shade_atmos.h) */
+    gi_particle_scale_quality(&gs, o->gi_quality);
     if (o->particles > 0) gs.count = o->particles;
     if (o->bounces > 0) gs.bounces = o->bounces;
     gs.seed = o->seed;

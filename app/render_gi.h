@@ -24,6 +24,7 @@ typedef struct {
     int quality;              /* none, particle: POV-Ray's +Q level 0..9 (shade_settings.quality) */
     int spp;                  /* path: samples per pixel; pmfg: eye samples; none/particle: fixed AA */
     long particles;           /* particle: area particles (0 = from the scene/default) */
+    double gi_quality;        /* particle: multiplies the scene's particle count (0 = 1); --particles wins */
     int bounces;              /* particle: n_b (0 = default) */
     int fg_rays;              /* pmfg: final-gather rays per pixel (0 = default 4096) */
     long photons;             /* pmfg: photon paths (0 = default) */

@@ -45,14 +45,21 @@ void gi_particle_settings_from_scene(gi_particle_settings *s, const scene *sc)
     gi_particle_default_settings(s);
     const scene_radiosity *r = &sc->global.radiosity;
     if (!r->enabled) return;
-    long count = 500L * (r->count > 0 ? r->count : 35);
-    s->count = count < 10000 ? 10000 : (count > 1000000 ? 1000000 : count);
+    long count = GI_PARTICLES_PER_COUNT * (r->count > 0 ? r->count : 35);
+    s->count = count < GI_PARTICLES_MIN ? GI_PARTICLES_MIN : (count > GI_PARTICLES_MAX ? GI_PARTICLES_MAX : count);
     s->bounces = r->recursion_limit - 1 > 0 ? r->recursion_limit - 1 : 0;
     if (r->error_bound > 0.0) {
         double f = 3.0 * r->error_bound / 1.8;
         s->radius_factor = f < 2.0 ? 2.0 : (f > 5.0 ? 5.0 : f);
     }
     if (r->brightness > 0.0) s->brightness = r->brightness;
+}
+
+void gi_particle_scale_quality(gi_particle_settings *s, double q)
+{
+    if (!(q > 0.0) || !isfinite(q)) return;
+    double c = (double)s->count * q;
+    s->count = c < 500.0 ? 500 : (c > 4e6 ? 4000000 : (long)c);
 }
 
 /* ------------------------------------------------------------------ build */

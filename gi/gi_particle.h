@@ -51,9 +51,10 @@
  * surfaces take part through the Whitted pass only.
  *
  * radiosity{} -> settings (gi_particle_settings_from_scene):
- *   count            -> particle count = 500 * count, within [10000, 1000000]
- *                       (the default count 35 gives 17,500; cbox's 100 gives
- *                       the paper's 50,000)
+ *   count            -> particle count = 50 * count, within [5000, 200000]
+ *                       (the default count 35 gives 5,000, cornell.pov's 200
+ *                       10,000: POV-Ray's default accuracy at 160x120, see
+ *                       bench/gi_vs_povray.sh; --gi-quality scales it)
  *   recursion_limit  -> bounces n_b = recursion_limit - 1, at least 0
  *                       (POV-Ray counts diffuse bounces; here the gathering
  *                       step adds one to the n_b scattering bounces)
@@ -185,7 +186,14 @@ typedef struct {
 
 void gi_particle_default_settings(gi_particle_settings *s);
 /* Defaults, then the radiosity{} mapping above when the scene has one. */
+#define GI_PARTICLES_PER_COUNT 50L
+#define GI_PARTICLES_MIN 5000L
+#define GI_PARTICLES_MAX 200000L
 void gi_particle_settings_from_scene(gi_particle_settings *s, const scene *sc);
+
+/* The quality knob (--gi-quality): q times the particle count (q > 0;
+ * within [500, 4,000,000]); other values leave s as it is. */
+void gi_particle_scale_quality(gi_particle_settings *s, double q);
 
 /* Geometry stage. The scene and accel must outlive the result. `stats` may
  * be NULL; it is filled at the end (and again by the later stages, see
