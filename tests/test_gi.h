@@ -31,4 +31,7 @@ void test_cell_cache(void **state);
 void test_prepass_grid(void **state);
 void test_kept_hits(void **state);
 
+/* test_gi_sky.c */
+void test_sky_furnace(void **state);
+
 #endif
