@@ -16,8 +16,11 @@
  * the hook's E/pi is L at every point the camera sees, within 1%: a
  * background (the sky function NULL), and a sky_sphere through a sky
  * function; and a sky whose radiance varies, L(d) = 1 + 0.5 d.y, for which
- * the top of the sphere (normal +y, nothing occluding) gathers the
- * cosine-weighted mean over the upper hemisphere, 1 + 0.5 * 2/3. Both
+ * a point of the sphere with normal n (nothing occluding) gathers the
+ * cosine-weighted mean over the hemisphere about n, 1 + 0.5 * (2/3) n.y
+ * (probed on the upper cap, n.y >= 0.95; the estimation lists average E
+ * over normals within 25.8 degrees, a bias that shrinks with the count:
+ * 16,000 particles). Both
  * gathering (recursion_limit 1: n_b 0) and the sky's scattered bounce
  * (n_b 1: on a convex sphere no link ends on another particle, so the
  * result is the same) are exercised. */
@@ -35,14 +38,14 @@ static rgb sky_grad(const scene *sc, vec3 dir)
     return (rgb){v, v, v};
 }
 
-static void sky_case(const char *what, int background, double L, gi_sky_fn fn, int nb, int top_only, double expect)
+static void sky_case(const char *what, int background, double L, gi_sky_fn fn, int nb, int top_only, double L0)
 {
     fixture f;
     char text[1024];
     tg_load(&f, tu_sky_furnace(text, sizeof text, L, background, 1));
     gi_particle_settings s;
     gi_particle_settings_from_scene(&s, f.sc);
-    s.count = 4000;
+    s.count = top_only ? 16000 : 4000;
     s.bounces = nb;
     s.threads = 2;
     s.seed = 5;
@@ -62,14 +65,15 @@ static void sky_case(const char *what, int background, double L, gi_sky_fn fn, i
             if (top_only && n.y < 0.95) continue;
             rgb e = gi_particle_indirect(gp, &h, n, 0);
             assert_true(isfinite(e.r) && isfinite(e.g) && isfinite(e.b));
-            sum += e.g;
+            double expect = top_only ? L0 + 0.5 * (2.0 / 3.0) * n.y : L0;
+            sum += e.g / expect;
             worst = fmax(worst, fabs(e.g / expect - 1.0));
             m++;
         }
     assert_true(m > 20);
-    double mean = sum / m;
-    printf("  sky furnace %-22s n_b %d: %3d probes, mean E/pi %.5f (expect %.5f, rel err %+.4f), worst %.4f\n", what,
-           nb, m, mean, expect, mean / expect - 1.0, worst);
+    double mean = sum / m, expect = 1.0;
+    printf("  sky furnace %-22s n_b %d: %3d probes, mean E/pi over expected %.5f (rel err %+.4f), worst %.4f\n", what,
+           nb, m, mean, mean / expect - 1.0, worst);
     assert_true(fabs(mean / expect - 1.0) <= 0.01);
     gi_particle_free(gp);
     tg_unload(&f);
@@ -84,6 +88,6 @@ void test_sky_furnace(void **state)
         g_sky_L = 2.5;
         sky_case("sky function L 2.5", 0, 2.5, sky_const, nb, 0, 2.5);
     }
-    sky_case("1 + 0.5 y, top", 0, 1.0, sky_grad, 0, 1, 1.0 + 0.5 * 2.0 / 3.0);
+    sky_case("1 + 0.5 y, top", 0, 1.0, sky_grad, 0, 1, 1.0);
 }
 
