@@ -104,24 +104,6 @@ static int probe_ok(const accel *a, const scene_object *o, vec3 pos, vec3 nrm)
 /* Most candidates a side gets per survivor the pilot predicts there. */
 #define SIDE_INFLATION 8.0
 
-/* The fraction of patch i inside the clip box (gi_surface_in_clip), from
- * CLIP_PROBES points of its own sampler: 1 and 0 exactly when all or none
- * are in (a patch far from what the camera sees gets no particles). */
-#define CLIP_PROBES 16
-static float clip_fraction(const gi_surface *g, int i, uint64_t seed)
-{
-    rng r;
-    rng_seed(&r, seed ^ 0xc11bULL, (uint64_t)i);
-    int in = 0, n = 0;
-    for (int q = 0; q < CLIP_PROBES * 4 && n < CLIP_PROBES; q++) {
-        vec3 pos, nrm;
-        if (!gi_surface_sample(g, i, rng_f64(&r), rng_f64(&r), &r, &pos, &nrm)) continue;
-        n++;
-        in += gi_surface_in_clip(g, pos);
-    }
-    return n ? (float)in / (float)n : 1.0f;
-}
-
 pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel *a, const scene *sc, long count,
                               uint64_t seed, const float *side_frac, gi_pigment_fn pig, diag *d)
 {
@@ -132,7 +114,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
     if (!inclip) return PT_ERR_NOMEM;
     double total = 0.0;
     for (int i = 0; i < np; i++) {
-        inclip[i] = clip_fraction(g, i, seed);
+        inclip[i] = gi_surface_clip_fraction(g, i, seed);
         for (int s = 0; s < gi_surface_sides(g, i); s++)
             if (gi_surface_side_mask(g, i) >> s & 1)
                 total += gi_surface_area(g, i) * inclip[i] * (side_frac ? side_frac[2 * i + s] : 1.0);

@@ -10,6 +10,7 @@
 #include "geom_sweep.h"
 #include "geom_tess.h"
 #include "camera.h"
+#include "rng.h"
 #include <limits.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -719,6 +720,24 @@ int gi_surface_in_clip(const gi_surface *g, vec3 p)
     vec3 t = v3s(1e-6 * v3_len(v3_sub(g->hi, g->lo)));
     return p.x >= g->lo.x - t.x && p.y >= g->lo.y - t.y && p.z >= g->lo.z - t.z && p.x <= g->hi.x + t.x &&
            p.y <= g->hi.y + t.y && p.z <= g->hi.z + t.z;
+}
+
+/* The fraction of patch i inside the clip box (gi_surface_in_clip), from
+ * CLIP_PROBES points of its own sampler: 1 and 0 exactly when all or none
+ * are in (a patch far from what the camera sees gets no particles). */
+#define CLIP_PROBES 16
+float gi_surface_clip_fraction(const gi_surface *g, int i, uint64_t seed)
+{
+    rng r;
+    rng_seed(&r, seed ^ 0xc11bULL, (uint64_t)i);
+    int in = 0, n = 0;
+    for (int q = 0; q < CLIP_PROBES * 4 && n < CLIP_PROBES; q++) {
+        vec3 pos, nrm;
+        if (!gi_surface_sample(g, i, rng_f64(&r), rng_f64(&r), &r, &pos, &nrm)) continue;
+        n++;
+        in += gi_surface_in_clip(g, pos);
+    }
+    return n ? (float)in / (float)n : 1.0f;
 }
 
 int gi_surface_npatches(const gi_surface *g) { return g->np; }

@@ -86,6 +86,9 @@ int gi_surface_inside_solid(const scene_object *o, vec3 q);
 /* 1 when p lies in the box infinite surfaces are clipped to (every finite
  * object lies in it; an infinite surface has particles only there). */
 int gi_surface_in_clip(const gi_surface *g, vec3 p);
+/* The fraction of patch i in that box, from a few of its own samples
+ * (exactly 1 or 0 when all or none are in). */
+float gi_surface_clip_fraction(const gi_surface *g, int i, uint64_t seed);
 int gi_surface_npatches(const gi_surface *g);
 double gi_surface_area(const gi_surface *g, int patch); /* one side */
 int gi_surface_sides(const gi_surface *g, int patch);
