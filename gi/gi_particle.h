@@ -45,8 +45,10 @@
  * What counts as emitted light: light_sources (every kind, with shade.c's
  * attenuation and shadow rays) and finish emission, with finish ambient *
  * ambient_light only in scenes below #version 3.7 (POV-Ray's rules under
- * radiosity, core/radrules.h). Rays that leave the scene see the
- * background colour (sky_sphere is ignored). Only diffuse interreflection is
+ * radiosity, core/radrules.h). Rays that leave the scene see the sky
+ * (settings.sky: sky_sphere over background; gi_sky.h), which lights the
+ * particles; surfaces beyond what the camera sees are the far field
+ * (docs/gi.md "Open and sky-lit scenes"). Only diffuse interreflection is
  * simulated (as in the paper): no caustics; reflective and refractive
  * surfaces take part through the Whitted pass only.
  *
