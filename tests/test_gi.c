@@ -1297,8 +1297,12 @@ static void test_settings_from_radiosity(void **state)
              "sphere { 0, 1 }\n");
     gi_particle_settings s;
     gi_particle_settings_from_scene(&s, f.sc);
-    assert_int_equal(s.count, 50000);
+    assert_int_equal(s.count, 50 * 100); /* GI_PARTICLES_PER_COUNT x count */
     assert_int_equal(s.bounces, 2);
+    gi_particle_scale_quality(&s, 2.0);
+    assert_int_equal(s.count, 10000);
+    gi_particle_scale_quality(&s, 0.0); /* out of range: unchanged */
+    assert_int_equal(s.count, 10000);
     assert_true(fabs(s.radius_factor - 2.0) < 1e-12);
     assert_true(fabs(s.brightness - 1.5) < 1e-12);
     tg_unload(&f);
