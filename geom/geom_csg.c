@@ -34,7 +34,9 @@ static int grow(void **p, int *cap, int need, size_t elem)
     return 1;
 }
 
-int geom_csg_add_node(geom_csg *c, geom_csg_op op, int inverse, int parent)
+/* Building: nodes are added parent first; returns the node index or -1 on
+ * out-of-memory. Leaves take a copy of `sh`. */
+static int geom_csg_add_node(geom_csg *c, geom_csg_op op, int inverse, int parent)
 {
     if (!grow((void **)&c->nodes, &c->capnodes, c->nnodes + 1, sizeof(geom_csg_node))) return -1;
     geom_csg_node *n = &c->nodes[c->nnodes];
@@ -46,7 +48,7 @@ int geom_csg_add_node(geom_csg *c, geom_csg_op op, int inverse, int parent)
     return c->nnodes++;
 }
 
-int geom_csg_add_leaf(geom_csg *c, const geom_shape *sh, unsigned tag, int inverse, int parent)
+static int geom_csg_add_leaf(geom_csg *c, const geom_shape *sh, unsigned tag, int inverse, int parent)
 {
     if (!grow((void **)&c->shapes, &c->capshapes, c->nshapes + 1, sizeof(geom_shape))) return -1;
     int cap = c->capshapes;

@@ -72,10 +72,6 @@ typedef struct {
     int shape, part, flip;
 } geom_csg_hit;
 
-/* Building: nodes are added parent first; returns the node index or -1 on
- * out-of-memory. Leaves take a copy of `sh`. */
-int geom_csg_add_node(geom_csg *c, geom_csg_op op, int inverse, int parent);
-int geom_csg_add_leaf(geom_csg *c, const geom_shape *sh, unsigned tag, int inverse, int parent);
 /* After all nodes are in: fixes the member lists, the normal flips and the
  * bounds (infinite where half-spaces leave it open). Returns 0 when the
  * result is provably empty or has no members. */
