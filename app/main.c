@@ -173,9 +173,8 @@ static int cmd_parse(int argc, char **argv)
     for (int f = plan.first; f <= plan.last && rc == EXIT_OK; f++) {
         sdl_options so;
         fill_sdl_options(&so, &o, &plan, f);
-        progress *prog = progress_new();
-        pbar *bar = pbar_start(prog, o.quiet);
-        so.progress = prog;
+        pbar *bar = pbar_start(o.quiet);
+        so.progress = pbar_progress(bar);
         diag *d = diag_new();
         diag_set_sink(d, pbar_diag_sink, bar); /* #debug text as the parse produces it */
         scene *sc = NULL;
@@ -184,7 +183,6 @@ static int cmd_parse(int argc, char **argv)
         pbar_stop(bar);
         diag_free(d);
         pbar_free(bar);
-        progress_free(prog);
         if (st != PT_OK) {
             rc = status_exit(st);
             break;
@@ -387,8 +385,8 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     fill_sdl_options(&so, o, plan, frame);
     /* Progress of every stage, drawn by its own thread; the scene's
      * messages (#debug, #warning, errors) print as they are recorded. */
-    progress *prog = progress_new();
-    pbar *bar = pbar_start(prog, o->quiet);
+    pbar *bar = pbar_start(o->quiet);
+    progress *prog = pbar_progress(bar);
     so.progress = prog;
     int frame_dependent = 1;
     so.frame_dependent = &frame_dependent;
@@ -400,7 +398,6 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     if (st != PT_OK) {
         diag_free(d);
         pbar_free(bar);
-        progress_free(prog);
         return status_exit(st);
     }
     lighting_apply_units(ls, sc, d); /* photometric lights; warns about fade */
@@ -423,7 +420,6 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
         fprintf(stderr, "partray render: a render window (+SC/+EC/+SR/+ER) needs --gi none or particle, not %s\n", gi_used);
         scene_free(sc);
         diag_free(d);
-        progress_free(prog);
         return EXIT_USAGE;
     }
 
@@ -459,7 +455,6 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
         scene_free(sc);
         diag_free(d);
         pbar_free(bar);
-        progress_free(prog);
         return status_exit(st == PT_OK ? PT_ERR_DEVICE : st);
     }
 
@@ -676,7 +671,6 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     }
     diag_free(d);
     pbar_free(bar);
-    progress_free(prog);
     return rc;
 }
 

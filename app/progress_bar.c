@@ -135,10 +135,15 @@ static void *run(void *arg)
     return NULL;
 }
 
-pbar *pbar_start(progress *p, int quiet)
+pbar *pbar_start(int quiet)
 {
     pbar *b = calloc(1, sizeof *b);
     if (!b) return NULL;
+    progress *p = progress_new();
+    if (!p) {
+        free(b);
+        return NULL;
+    }
     b->p = p;
     b->quiet = quiet;
     b->tty = isatty(2);
@@ -147,9 +152,11 @@ pbar *pbar_start(progress *p, int quiet)
     if (e && atof(e) > 0) b->interval = atof(e);
     pthread_mutex_init(&b->mu, NULL);
     pthread_cond_init(&b->wake, NULL);
-    if (!quiet && p && pthread_create(&b->thread, NULL, run, b) == 0) b->running = 1;
+    if (!quiet && pthread_create(&b->thread, NULL, run, b) == 0) b->running = 1;
     return b;
 }
+
+progress *pbar_progress(pbar *b) { return b ? b->p : NULL; }
 
 void pbar_message(pbar *b, const char *text)
 {
@@ -197,5 +204,6 @@ void pbar_free(pbar *b)
     pbar_stop(b);
     pthread_cond_destroy(&b->wake);
     pthread_mutex_destroy(&b->mu);
+    progress_free(b->p);
     free(b);
 }

@@ -15,15 +15,19 @@
 
 typedef struct pbar pbar;
 
-/* Starts drawing `p` (not owned). quiet: draw nothing. NULL when out of memory. */
-pbar *pbar_start(progress *p, int quiet);
+/* A new progress (core/progress.h) and its drawing thread. quiet: draw
+ * nothing. NULL when out of memory (then every call here still works and
+ * pbar_progress is NULL, which counts nothing). */
+pbar *pbar_start(int quiet);
+/* The progress the render's stages count on (owned by b). */
+progress *pbar_progress(pbar *b);
 /* Print one line of text (no newline at its end) above the bar. */
 void pbar_message(pbar *b, const char *text);
 /* A diag_sink_fn (core/diag.h) that prints each message as it is recorded
  * through pbar_message (ctx: the pbar); quiet: errors only. */
 void pbar_diag_sink(void *ctx, const diag_msg *m);
 /* Ends the last stage's line and stops drawing; messages still print
- * (plainly) until pbar_free. */
+ * (plainly) until pbar_free, which frees the progress too. */
 void pbar_stop(pbar *b);
 void pbar_free(pbar *b);
 
