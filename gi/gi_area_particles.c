@@ -45,11 +45,11 @@ static void material(const scene *sc, const scene_texture *tex, const colour5 *c
     p->brilliance = isfinite(f->brilliance) && f->brilliance > 0.0 ? (float)f->brilliance : 1.0f;
 }
 
-void gi_particles_material(const scene *sc, const scene_texture *tex, float rho[3], float le[3])
+void gi_particles_material(const scene *sc, const scene_texture *tex, const colour5 *c, float rho[3], float le[3])
 {
     const radrules rr = radrules_of(sc, 1);
     gi_dev_particle p;
-    material(sc, tex, NULL, &rr, &p);
+    material(sc, tex, c, &rr, &p);
     for (int k = 0; k < 3; k++) {
         rho[k] = p.rho[k];
         le[k] = p.le[k];

@@ -93,8 +93,8 @@ int gi_lookup_nearest_on(const gi_lookup *g, vec3 q, vec3 dir, vec3 org, double 
                          const void *obj, vec3 agree, double min_agree, const unsigned char *skip);
 
 /* A particle's reflectance and emitted radiance for texture tex (NULL:
- * sc's default) at its base colour, as gi_particles_sample gives them
- * without a pigment function. */
-void gi_particles_material(const scene *sc, const scene_texture *tex, float rho[3], float le[3]);
+ * sc's default) with pigment colour c (NULL: the texture's base colour),
+ * as gi_particles_sample gives them. */
+void gi_particles_material(const scene *sc, const scene_texture *tex, const colour5 *c, float rho[3], float le[3]);
 
 #endif

@@ -35,6 +35,7 @@ typedef struct {
     const gi_sky *sky;    /* with esky: what the rays that leave the scene see */
     float *esky;
     const scene *sc;      /* for the far field of unanswered hits */
+    gi_pigment_fn pig;    /* and their pigment (NULL: base colours) */
     float far_bounce;     /* brightness when the far field reflects the sky, else 0 */
 } link_job;
 
@@ -51,18 +52,33 @@ static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3]
     out[0] = out[1] = out[2] = 0.0f;
     const scene_object *o = accel_rtc_object(J->a, h->hit.geomID, h->hit.primID, h->hit.instID[0]);
     if (!o) return;
-    float rho[3], le[3];
-    gi_particles_material(J->sc, o->texture, rho, le);
-    float irr[3] = {0.0f, 0.0f, 0.0f};
-    if (J->far_bounce > 0.0f) {
-        vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z), n = v3_neg(d);
-        if (h->hit.instID[0] == RTC_INVALID_GEOMETRY_ID) {
-            vec3 ng = v3(h->hit.Ng_x, h->hit.Ng_y, h->hit.Ng_z);
-            double l = v3_len(ng);
-            if (l > 0.0 && isfinite(l)) n = v3_dot(ng, d) > 0.0 ? v3_scale(ng, -1.0 / l) : v3_scale(ng, 1.0 / l);
-        }
-        gi_sky_irradiance(J->sky, n, irr);
+    vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z), n = v3_neg(d);
+    if (h->hit.instID[0] == RTC_INVALID_GEOMETRY_ID) {
+        vec3 ng = v3(h->hit.Ng_x, h->hit.Ng_y, h->hit.Ng_z);
+        double l = v3_len(ng);
+        if (l > 0.0 && isfinite(l)) n = v3_dot(ng, d) > 0.0 ? v3_scale(ng, -1.0 / l) : v3_scale(ng, 1.0 / l);
     }
+    /* the pigment where the ray hit (a sky dome's gradient, a terrain's
+     * colours), else the texture's base colour */
+    colour5 c, *cp = NULL;
+    if (J->pig) {
+        accel_hit ah;
+        memset(&ah, 0, sizeof ah);
+        ah.p = v3(h->ray.org_x + h->ray.tfar * d.x, h->ray.org_y + h->ray.tfar * d.y, h->ray.org_z + h->ray.tfar * d.z);
+        ah.ng = ah.ns = n;
+        ah.obj = o;
+        ah.texture = o->texture;
+        ah.flags = o->flags;
+        ah.uv[0] = ah.p.x;
+        ah.uv[1] = ah.p.y;
+        if (J->pig(J->sc, o->texture ? o->texture : &J->sc->default_texture, &ah, &c) && isfinite(c.r) &&
+            isfinite(c.g) && isfinite(c.b) && isfinite(c.f) && isfinite(c.t))
+            cp = &c;
+    }
+    float rho[3], le[3];
+    gi_particles_material(J->sc, o->texture, cp, rho, le);
+    float irr[3] = {0.0f, 0.0f, 0.0f};
+    if (J->far_bounce > 0.0f) gi_sky_irradiance(J->sky, n, irr);
     for (int c = 0; c < 3; c++) {
         float v = le[c] + rho[c] * J->far_bounce * irr[c];
         out[c] = isfinite(v) && v > 0.0f ? v : 0.0f;
@@ -235,6 +251,11 @@ static void job(void *ctx, int index, int thread)
             int hid = hobj ? last_hid : -1;
             if (hobj && hid < 0) {
                 unres++;
+                if (J->esky) {
+                    float L[3];
+                    far_field(J, &rh[m], L);
+                    for (int c = 0; c < 3; c++) sky[c] += L[c];
+                }
             } else if (hit && J->grid) {
                 const struct RTCRayHit *h = &rh[m];
                 vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
@@ -394,7 +415,7 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
                          const unsigned char *pin, int n, int nside, uint64_t seed, const gi_lookup *grid,
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
                          gi_link_stats *st, volatile int *cancel, progress *prog,
-                         const gi_sky *sky, float *esky, const scene *sc, double far_bounce)
+                         const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce)
 {
     if (threads <= 0) threads = pool_default_threads();
     link_job J;
@@ -403,6 +424,7 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
     J.sky = sky;
     J.esky = sky && sc ? esky : NULL;
     J.sc = sc;
+    J.pig = pig;
     J.far_bounce = isfinite(far_bounce) && far_bounce > 0.0 ? (float)far_bounce : 0.0f;
     /* the link scene (accel.h): without the main scene's robust mode and
      * filters it is cheaper per link ray; the main scene is the fallback */

@@ -45,7 +45,8 @@ typedef struct {
 /* sky, esky and sc (all or none; NULL: none): esky receives 4 floats a
  * particle (the fourth 0): the radiance its rays that leave the scene see
  * (sky), plus the far field of those that hit where no particle answers
- * (gi_links.c far_field, reflecting the sky times far_bounce), summed and
+ * (gi_links.c far_field: emission and the sky reflected times far_bounce,
+ * at the pigment pig gives where the ray hit, NULL: base colours), summed and
  * divided by nside^2: their share of the cosine-weighted mean incoming
  * radiance, in E/pi units. */
 #define GI_LINKS_AGREE 0.3
@@ -53,7 +54,7 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
                          const unsigned char *pin, int n, int nside, uint64_t seed, const gi_lookup *grid,
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
                          gi_link_stats *st, volatile int *cancel, progress *prog,
-                         const gi_sky *sky, float *esky, const scene *sc, double far_bounce);
+                         const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce);
 
 /* Incoming links, a counting sort by target: the sources i < n in mask
  * (bit i of word i / 32; NULL: all) whose links[i * k + j] are >= 0, per

@@ -589,6 +589,13 @@ static pt_status walk(gi_surface *g, const scene_object *o, const scene_texture 
  * finite hit: [lo, hi] stays. */
 #define VIEW_W 64
 #define VIEW_H 48
+#define VIEW_FAR 10.0
+static int cmp_double(const void *x, const void *y)
+{
+    double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
 static void view_clip(const scene *s, const accel *a, vec3 *lo, vec3 *hi)
 {
     if (!s->camera_set) return;
@@ -598,8 +605,15 @@ static void view_clip(const scene *s, const accel *a, vec3 *lo, vec3 *hi)
     vec3 t = v3s(1e-6 * (1.0 + v3_len(v3_sub(fhi, flo))));
     flo = v3_sub(flo, t);
     fhi = v3_add(fhi, t);
-    vec3 vlo = s->camera.location, vhi = s->camera.location;
-    int any = 0;
+    vec3 *hp = malloc((size_t)VIEW_W * VIEW_H * sizeof *hp);
+    double *dist = malloc((size_t)VIEW_W * VIEW_H * sizeof *dist), *sorted = malloc((size_t)VIEW_W * VIEW_H * sizeof *sorted);
+    if (!hp || !dist || !sorted) {
+        free(hp);
+        free(dist);
+        free(sorted);
+        return;
+    }
+    int n = 0;
     for (int y = 0; y < VIEW_H; y++)
         for (int x = 0; x < VIEW_W; x++) {
             vec3 org, dir;
@@ -614,10 +628,29 @@ static void view_clip(const scene *s, const accel *a, vec3 *lo, vec3 *hi)
             if (!v3_finite(p) || p.x < flo.x || p.y < flo.y || p.z < flo.z || p.x > fhi.x || p.y > fhi.y ||
                 p.z > fhi.z)
                 continue;
-            vlo = v3_min(vlo, p);
-            vhi = v3_max(vhi, p);
+            hp[n] = p;
+            dist[n] = sorted[n] = v3_len(v3_sub(p, s->camera.location));
+            n++;
+        }
+    /* A finite object far beyond the view's subject (a sky dome of radius
+     * 1e5, hills at the horizon) is the far field too: hits farther than
+     * VIEW_FAR times the nearer third of the hits' distance are left out */
+    double limit = INFINITY;
+    if (n > 0) {
+        qsort(sorted, (size_t)n, sizeof *sorted, cmp_double);
+        limit = VIEW_FAR * sorted[n / 3];
+    }
+    vec3 vlo = s->camera.location, vhi = s->camera.location;
+    int any = 0;
+    for (int i = 0; i < n; i++)
+        if (dist[i] <= limit) {
+            vlo = v3_min(vlo, hp[i]);
+            vhi = v3_max(vhi, hp[i]);
             any = 1;
         }
+    free(hp);
+    free(dist);
+    free(sorted);
     if (!any || !v3_finite(vlo) || !v3_finite(vhi)) return;
     vec3 m = v3s(v3_len(v3_sub(vhi, vlo)));
     vlo = v3_sub(vlo, m);

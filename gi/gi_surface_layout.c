@@ -292,6 +292,23 @@ static void tri_loc_fill(tri_loc *t, const patch *p)
 void gi_surface_layout(gi_surface *g)
 {
     gi_surface_build_meshes(g);
+    /* A triangle or grid patch wholly outside the clip box gets no area
+     * particles, and the hook answers on it from the far field: the
+     * coarsest resolution (a sky dome of radius 1e6 would otherwise take
+     * millions of radiance particles that are never read). */
+    for (int i = 0; i < g->np; i++) {
+        patch *p = &g->p[i];
+        if (p->kind == PATCH_PIECE || (p->kind == PATCH_TRI && p->nsides == 0)) continue;
+        if (gi_surface_clip_fraction(g, i, 0) > 0.0f) continue;
+        if (p->kind == PATCH_TRI) {
+            p->k = 1;
+            p->rp_count = 3;
+        } else {
+            p->nu = 3;
+            p->nv = 1;
+            p->rp_count = (long)(p->nu + 1) * (p->nv + 1);
+        }
+    }
     long ns = 0;
     for (int i = 0; i < g->np; i++) {
         g->p[i].slot_first = ns;
