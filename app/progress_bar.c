@@ -38,7 +38,9 @@ static void fmt_time(double t, char *buf, int n)
     else snprintf(buf, (size_t)n, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
 }
 
-void pbar_format(const progress_state *s, double elapsed, int tty, char *buf, int n)
+/* The line drawn for a state `elapsed` seconds into its stage, into buf.
+ * tty: with a bar. */
+static void pbar_format(const progress_state *s, double elapsed, int tty, char *buf, int n)
 {
     char el[32], eta[48] = "";
     fmt_time(elapsed, el, sizeof el);
@@ -158,7 +160,8 @@ pbar *pbar_start(int quiet)
 
 progress *pbar_progress(pbar *b) { return b ? b->p : NULL; }
 
-void pbar_message(pbar *b, const char *text)
+/* Prints one line of text (no newline at its end) above the bar. */
+static void pbar_message(pbar *b, const char *text)
 {
     if (!b) {
         fprintf(stderr, "%s\n", text);

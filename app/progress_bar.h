@@ -21,18 +21,12 @@ typedef struct pbar pbar;
 pbar *pbar_start(int quiet);
 /* The progress the render's stages count on (owned by b). */
 progress *pbar_progress(pbar *b);
-/* Print one line of text (no newline at its end) above the bar. */
-void pbar_message(pbar *b, const char *text);
-/* A diag_sink_fn (core/diag.h) that prints each message as it is recorded
- * through pbar_message (ctx: the pbar); quiet: errors only. */
+/* A diag_sink_fn (core/diag.h) that prints each message as it is recorded,
+ * one line above the bar (ctx: the pbar); quiet: errors only. */
 void pbar_diag_sink(void *ctx, const diag_msg *m);
 /* Ends the last stage's line and stops drawing; messages still print
  * (plainly) until pbar_free, which frees the progress too. */
 void pbar_stop(pbar *b);
 void pbar_free(pbar *b);
-
-/* The line drawn for a state `elapsed` seconds into its stage, into buf
- * (for tests: the format is the contract). tty: with a bar. */
-void pbar_format(const progress_state *s, double elapsed, int tty, char *buf, int n);
 
 #endif
