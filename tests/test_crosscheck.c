@@ -3,7 +3,7 @@
  * Each scene is rendered at 160x160 with +A0.3 by Debian's `povray` and by
  * partray; both sRGB PNGs are box-downsampled 4x4 (to absorb area-light and
  * antialiasing jitter) and the mean absolute difference over all channels
- * must be at most 0.01 of white (issue "Foundation"). The distribution's
+ * must be at most 0.01 of white. The distribution's
  * radiosity/cornell.pov is used with its radiosity block removed, since POV-Ray
  * would otherwise add its own GI. */
 #include <setjmp.h>
