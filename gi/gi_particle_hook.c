@@ -229,12 +229,18 @@ rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
         tc->none++;
         return out;
     }
-    if (!gi_surface_in_clip(gp->surf, hit->p) || !side_value(gp, hit, n, tc, &out)) {
+    /* Beyond the clip box an infinite plane has no particles. Under a sky
+     * the far field below answers there; under a black sky (the light
+     * comes from objects: an emissive dome, light_sources) the nearest
+     * point of the plane's clipped part stands for it (gi_surface_locate
+     * takes the triangle nearest to the hit). */
+    int far = !gi_sky_black(gp->sky) && !gi_surface_in_clip(gp->surf, hit->p);
+    if (far || !side_value(gp, hit, n, tc, &out)) {
         /* No particle answers here: a surface the geometry stage left out
-         * (an infinite plane beyond its clip box, an object far from what
-         * the camera sees, a shape without particles). The far field: what
-         * it would gather from a sky nothing occludes, E/pi about its
-         * normal (gi_sky.h); black under a black sky. */
+         * (beyond the clip box, an object far from what the camera sees, a
+         * shape without particles). The far field: what it would gather
+         * from a sky nothing occludes, E/pi about its normal (gi_sky.h);
+         * black under a black sky. */
         tc->none++;
         vec3 ngv = v3_dot(n, hit->ng) >= 0.0 ? hit->ng : v3_neg(hit->ng);
         float e[3];
