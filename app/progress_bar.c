@@ -38,6 +38,11 @@ static void fmt_time(double t, char *buf, int n)
     else snprintf(buf, (size_t)n, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
 }
 
+/* Seconds into a stage before an ETA is drawn (a rate measured over less
+ * says little); $PARTRAY_PROGRESS_ETA_AFTER sets it (tests: 0, so that a
+ * fast render still shows one). */
+static double g_eta_after = 0.5;
+
 /* The line drawn for a state `elapsed` seconds into its stage, into buf.
  * tty: with a bar. */
 static void pbar_format(const progress_state *s, double elapsed, int tty, char *buf, int n)
@@ -49,7 +54,7 @@ static void pbar_format(const progress_state *s, double elapsed, int tty, char *
         double f = (double)s->done / (double)s->total;
         if (f > 1) f = 1;
         /* time left from the rate so far, once there is a rate to go by */
-        if (s->done > 0 && elapsed >= 0.5 && f < 1) {
+        if (s->done > 0 && elapsed >= g_eta_after && f < 1) {
             char left[32];
             fmt_time(elapsed * (1 - f) / f, left, sizeof left);
             snprintf(eta, sizeof eta, ", ETA %s", left);
@@ -152,6 +157,8 @@ pbar *pbar_start(int quiet)
     b->interval = 10;
     const char *e = getenv("PARTRAY_PROGRESS_SECONDS");
     if (e && atof(e) > 0) b->interval = atof(e);
+    const char *ea = getenv("PARTRAY_PROGRESS_ETA_AFTER");
+    if (ea && atof(ea) >= 0) g_eta_after = atof(ea);
     pthread_mutex_init(&b->mu, NULL);
     pthread_cond_init(&b->wake, NULL);
     if (!quiet && pthread_create(&b->thread, NULL, run, b) == 0) b->running = 1;

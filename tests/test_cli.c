@@ -388,7 +388,9 @@ static void test_progress_terminal(void **st)
     char scene[512], cmd[2048];
     snprintf(scene, sizeof scene, "%s/progress.pov", tmpdir);
     tu_write_file(scene, progress_scene);
-    snprintf(cmd, sizeof cmd, "script -q -e -c \"'%s' render '%s' --size 640x480 --threads 2 -o '%s/progress.png'\" /dev/null",
+    snprintf(cmd, sizeof cmd,
+             "script -q -e -c \"PARTRAY_PROGRESS_ETA_AFTER=0 '%s' render '%s' --size 640x480 --threads 2 -o "
+             "'%s/progress.png'\" /dev/null",
              PARTRAY_BIN, scene, tmpdir);
     int rc = tu_run_capture(cmd);
     assert_int_equal(rc, 0);
