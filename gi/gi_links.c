@@ -46,10 +46,10 @@ typedef struct {
  * (far_bounce > 0), the sky it reflects, taken as unoccluded: rho * b *
  * E_sky(n)/pi about the hit's normal turned to the ray, at the texture's
  * base colour. In a closed room under a black sky this is the emission
- * alone. */
+ * alone. Adds it to out (nothing without esky). */
 static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3])
 {
-    out[0] = out[1] = out[2] = 0.0f;
+    if (!J->esky) return;
     const scene_object *o = accel_rtc_object(J->a, h->hit.geomID, h->hit.primID, h->hit.instID[0]);
     if (!o) return;
     vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z), n = v3_neg(d);
@@ -81,7 +81,7 @@ static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3]
     if (J->far_bounce > 0.0f) gi_sky_irradiance(J->sky, n, irr);
     for (int c = 0; c < 3; c++) {
         float v = le[c] + rho[c] * J->far_bounce * irr[c];
-        out[c] = isfinite(v) && v > 0.0f ? v : 0.0f;
+        if (isfinite(v) && v > 0.0f) out[c] += v;
     }
 }
 
@@ -251,11 +251,7 @@ static void job(void *ctx, int index, int thread)
             int hid = hobj ? last_hid : -1;
             if (hobj && hid < 0) {
                 unres++;
-                if (J->esky) {
-                    float L[3];
-                    far_field(J, &rh[m], L);
-                    for (int c = 0; c < 3; c++) sky[c] += L[c];
-                }
+                far_field(J, &rh[m], sky);
             } else if (hit && J->grid) {
                 const struct RTCRayHit *h = &rh[m];
                 vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
@@ -354,11 +350,7 @@ static void job(void *ctx, int index, int thread)
                 }
                 if (target < 0) {
                     unres++;
-                    if (J->esky && hit) {
-                        float L[3];
-                        far_field(J, &rh[m], L);
-                        for (int c = 0; c < 3; c++) sky[c] += L[c];
-                    }
+                    if (hit) far_field(J, &rh[m], sky);
                 }
             }
             J->links[(size_t)i * J->k + J->order[j]] = target;
