@@ -66,6 +66,27 @@ void scene_default_light(scene_light *l)
     l->media_attenuation = 0;
 }
 
+void scene_default_photons(scene_photons *p)
+{
+    /* POV-Ray 3.7 parser.cpp, global_settings photons: the values it sets
+     * before reading the block */
+    memset(p, 0, sizeof *p);
+    p->spacing = 1.0;
+    p->autostop = 0.5;
+    p->jitter = 0.4;
+    p->max_trace_level = -1;
+    p->adc_bailout = -1.0;
+    p->expand_tolerance = 0.2;
+    p->expand_min = 35;
+    p->gather_min = 20;
+    p->gather_max = 100;
+    p->radius[0] = -1.0;
+    p->radius[1] = 1.0;
+    p->radius[2] = -1.0;
+    p->radius[3] = 1.0;
+    p->media_factor = 1.0;
+}
+
 static void scene_default_global(scene_global *g)
 {
     memset(g, 0, sizeof *g);
@@ -89,6 +110,7 @@ static void scene_default_global(scene_global *g)
     r->max_sample = -1.0;
     r->maximum_reuse = 0.2;
     r->direction_pool = 1600; /* raised to `count` when that is larger */
+    scene_default_photons(&g->photons);
 }
 
 scene *scene_new(void)

@@ -51,6 +51,7 @@ void scene_default_finish(scene_finish *f);
 void scene_default_pigment(scene_pigment *p);
 void scene_default_camera(scene_camera *c);
 void scene_default_light(scene_light *l);
+void scene_default_photons(scene_photons *p);
 void scene_default_interior(scene_interior *i);
 scene_object *scene_new_object(scene *s, shape_kind kind, src_loc loc);
 scene_texture *scene_new_texture(scene *s);

@@ -30,7 +30,35 @@ typedef struct {
     const scene_object *looks_like;
     const scene_object *projected_through; /* light only through it (shade_project.c) */
     int group;              /* light_group id (lights only its objects), 0 = global */
+    /* photons { reflection on|off refraction on|off area_light } (POV-Ray
+     * 3.7): on/off flags as the object's (scene_obj_photons); area_light:
+     * photons leave every point of the area grid, not only the centre */
+    int ph_reflection, ph_reflection_off, ph_refraction, ph_refraction_off;
+    int ph_area_light;
 } scene_light;
+
+/* POV-Ray 3.7's photon rules for light l and a target's block o (NULL:
+ * none), photons.cpp and photonshootingtask.cpp:
+ *  - scene_photon_shoots: whether l shoots photons at target o at all: the
+ *    light's and target's flags merged, some lobe on and not off;
+ *  - scene_photon_lobe: whether a photon of l is reflected (refract 0) or
+ *    refracted (1) where it hits an object with block o: the object says
+ *    on and the light not off, or the light says on and the object not off. */
+static inline int scene_photon_shoots(const scene_light *l, const scene_obj_photons *o)
+{
+    if (!o || !o->target) return 0;
+    int rfr_on = l->ph_refraction || o->refraction, rfr_off = l->ph_refraction_off || o->refraction_off;
+    int rfl_on = l->ph_reflection || o->reflection, rfl_off = l->ph_reflection_off || o->reflection_off;
+    return (rfr_on && !rfr_off) || (rfl_on && !rfl_off);
+}
+static inline int scene_photon_lobe(const scene_light *l, const scene_obj_photons *o, int refract)
+{
+    int o_on = o ? (refract ? o->refraction : o->reflection) : 0;
+    int o_off = o ? (refract ? o->refraction_off : o->reflection_off) : 0;
+    int l_on = refract ? l->ph_refraction : l->ph_reflection;
+    int l_off = refract ? l->ph_refraction_off : l->ph_reflection_off;
+    return (o_on && !l_off) || (!o_off && l_on);
+}
 
 /* Whether light l lights object o (POV-Ray 3.7's light groups: a group's
  * lights light only its objects; global lights light everything else, and

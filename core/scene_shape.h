@@ -163,13 +163,16 @@ typedef struct {
 /* Per-object photons { } block (POV-Ray 3.7): which objects caustic photons
  * are shot at and what they do there. As POV-Ray's parser reads it:
  * `target [FLOAT]` (spacing multiplier, default 1; 0 or less: not a target),
- * `reflection on|off`, `refraction on|off` (each off unless said on),
- * `collect off` (photons are not stored on it), `pass_through [on|off]`. */
+ * `reflection on|off`, `refraction on|off` (POV-Ray keeps an "on" and an
+ * "off" flag each: neither set means "as the light says", see
+ * scene_photon_lobe in scene_light.h), `collect off` (photons are not
+ * stored on it), `pass_through [on|off]`. */
 typedef struct {
     src_loc loc;            /* the `photons` keyword */
     int target;
     double spacing;         /* target's multiplier of the global spacing */
-    int reflection, refraction;
+    int reflection, refraction;         /* said on */
+    int reflection_off, refraction_off; /* said off */
     int collect;            /* default 1 */
     int pass_through;
 } scene_obj_photons;

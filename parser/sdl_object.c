@@ -383,8 +383,10 @@ static void photons_mod(sdl_parser *p, scene_object *o, src_loc loc)
             ph->target = ph->spacing > 0.0;
         } else if (sdl_is_kw(&t, KW_REFLECTION)) {
             ph->reflection = sdl_float(p) != 0.0;
+            ph->reflection_off = !ph->reflection;
         } else if (sdl_is_kw(&t, KW_REFRACTION)) {
             ph->refraction = sdl_float(p) != 0.0;
+            ph->refraction_off = !ph->refraction;
         } else if (sdl_is_kw(&t, KW_COLLECT)) {
             ph->collect = sdl_allow_float(p, 1.0) != 0.0;
         } else if (sdl_is_kw(&t, KW_PASS_THROUGH)) {

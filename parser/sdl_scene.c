@@ -323,6 +323,31 @@ static void spot_param(sdl_parser *p, scene_light *l, const sdl_tok *t)
     }
 }
 
+/* light_photons := '{' { refraction b | reflection b | area_light } '}'
+ * (POV-Ray 3.7's light_source photons block, parser.cpp) */
+static void light_photons(sdl_parser *p, scene_light *l)
+{
+    if (!sdl_begin_block(p, "photons")) return;
+    while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
+        sdl_tok t = sdl_next(p);
+        if (sdl_is_kw(&t, KW_REFRACTION)) {
+            int on = sdl_float(p) != 0.0;
+            l->ph_refraction = on;
+            l->ph_refraction_off = !on;
+        } else if (sdl_is_kw(&t, KW_REFLECTION)) {
+            int on = sdl_float(p) != 0.0;
+            l->ph_reflection = on;
+            l->ph_reflection_off = !on;
+        } else if (sdl_is_kw(&t, KW_AREA_LIGHT)) {
+            l->ph_area_light = 1;
+        } else {
+            sdl_unexpected(p, &t, "refraction, reflection, area_light or '}'");
+            return;
+        }
+    }
+    sdl_end_block(p);
+}
+
 /* light_item := spotlight | cylinder | parallel | point_at v | radius f |
  *   falloff f | tightness f | area_light .. | jitter | adaptive f | circular |
  *   orient | area_illumination [b] | fade_distance f | fade_power f |
@@ -374,7 +399,9 @@ static int light_item(sdl_parser *p, sdl_obj *so)
             sdl_end_block(p);
         }
         break;
-    case KW_PHOTONS: case KW_COLOR_MAP: case KW_COLOUR_MAP:
+    case KW_PHOTONS: light_photons(p, l); break;
+    case KW_COLOR_MAP: case KW_COLOUR_MAP:
+        sdl_warn_once(p, t.tk.loc, "colour_map in light_source is undocumented POV-Ray syntax that does nothing; ignored");
         if (sdl_begin_block(p, sdl_kw_text(t.tk.kw))) sdl_skip_block(p);
         break;
     default:
@@ -494,19 +521,112 @@ static void radiosity_block(sdl_parser *p, scene_radiosity *r)
     sdl_end_block(p);
 }
 
-/* photons := '{' { spacing f | count n | ... } '}' (spacing and count kept) */
+/* photons := '{' { spacing f | count n | autostop f | jitter f |
+ *   max_trace_level n | adc_bailout f | expand_thresholds f, n |
+ *   gather n, n | radius [f] [, [f] [, [f] [, [f]]]] | media n [, f] |
+ *   save_file s | load_file s } '}'
+ * POV-Ray 3.7's global photons block (parser.cpp): every item into
+ * scene_photons, with its checks and warnings. */
 static void photons_block(sdl_parser *p, scene_global *g)
 {
-    g->photons = 1;
+    scene_photons *ph = &g->photons;
+    scene_default_photons(ph);
     if (!sdl_begin_block(p, "photons")) return;
     while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
         sdl_tok t = sdl_next(p);
-        if (sdl_is_kw(&t, KW_SPACING)) g->photons_spacing = sdl_float(p);
-        else if (sdl_is_kw(&t, KW_COUNT)) g->photons_count = sdl_to_int(sdl_float(p));
-        else if (t.tk.kind == TOK_KEYWORD) sdl_skip_item(p);
-        else if (t.tk.kind == TOK_EOF) sdl_unexpected(p, &t, "'}'");
+        if (t.tk.kind != TOK_KEYWORD) {
+            sdl_unexpected(p, &t, "a photons item or '}'");
+            return;
+        }
+        switch (t.tk.kw) {
+        case KW_SPACING:
+            ph->spacing = sdl_float(p);
+            ph->given |= SCENE_PH_SPACING;
+            break;
+        case KW_COUNT:
+            ph->count = sdl_to_int(sdl_float(p));
+            ph->given |= SCENE_PH_COUNT;
+            break;
+        case KW_AUTOSTOP:
+            ph->autostop = sdl_float(p);
+            ph->given |= SCENE_PH_AUTOSTOP;
+            break;
+        case KW_JITTER:
+            ph->jitter = sdl_float(p);
+            ph->given |= SCENE_PH_JITTER;
+            break;
+        case KW_MAX_TRACE_LEVEL:
+            ph->max_trace_level = sdl_to_int(sdl_float(p));
+            ph->given |= SCENE_PH_MAX_TRACE_LEVEL;
+            break;
+        case KW_ADC_BAILOUT:
+            ph->adc_bailout = sdl_float(p);
+            ph->given |= SCENE_PH_ADC_BAILOUT;
+            break;
+        case KW_EXPAND_THRESHOLDS:
+            ph->expand_tolerance = sdl_float(p);
+            sdl_accept(p, TOK_COMMA);
+            ph->expand_min = sdl_to_int(sdl_float(p));
+            if (ph->expand_tolerance < 0.0) {
+                sdl_warning(p, t.tk.loc, "the first parameter of expand_thresholds must be at least 0; using 0");
+                ph->expand_tolerance = 0.0;
+            }
+            if (ph->expand_min < 0) {
+                sdl_warning(p, t.tk.loc, "the second parameter of expand_thresholds must be at least 0; using 0");
+                ph->expand_min = 0;
+            }
+            ph->given |= SCENE_PH_EXPAND;
+            break;
+        case KW_GATHER:
+            ph->gather_min = sdl_to_int(sdl_float(p));
+            sdl_accept(p, TOK_COMMA);
+            ph->gather_max = sdl_to_int(sdl_float(p));
+            ph->given |= SCENE_PH_GATHER;
+            break;
+        case KW_RADIUS: {
+            static const double def[4] = {-1.0, 1.0, -1.0, 1.0};
+            for (int i = 0; i < 4; i++) {
+                if (i > 0) sdl_accept(p, TOK_COMMA);
+                ph->radius[i] = sdl_allow_float(p, def[i]);
+            }
+            ph->given |= SCENE_PH_RADIUS;
+            break;
+        }
+        case KW_MEDIA:
+            ph->media_steps = sdl_to_int(sdl_float(p));
+            sdl_accept(p, TOK_COMMA);
+            if (ph->media_steps < 0) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "photons: max media steps must be non-negative");
+            ph->media_factor = sdl_allow_float(p, 1.0);
+            if (ph->media_factor <= 0.0)
+                sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "photons: media spacing factor must be greater than zero");
+            ph->given |= SCENE_PH_MEDIA;
+            break;
+        case KW_SAVE_FILE:
+        case KW_LOAD_FILE: {
+            int load = t.tk.kw == KW_LOAD_FILE;
+            if (ph->file && ph->load != load)
+                sdl_warning(p, t.tk.loc, "photons: cannot both load and save a photon map; now %s", load ? "loading" : "saving");
+            ph->file = sdl_string(p);
+            ph->load = load;
+            ph->given |= load ? SCENE_PH_LOAD_FILE : SCENE_PH_SAVE_FILE;
+            break;
+        }
+        default:
+            sdl_unexpected(p, &t, "a photons item (spacing, count, autostop, jitter, max_trace_level, adc_bailout, "
+                                  "expand_thresholds, gather, radius, media, save_file, load_file) or '}'");
+            return;
+        }
     }
-    sdl_end_block(p);
+    if (!sdl_end_block(p)) return;
+    /* max gather count 0 means no photon maps (parser.cpp) */
+    ph->enabled = ph->gather_max > 0;
+    if (ph->enabled) {
+        if (ph->gather_min < 0) sdl_error(p, p->last_loc, PT_ERR_SYNTAX, "photons: min gather count cannot be negative");
+        else if (ph->gather_min > ph->gather_max)
+            sdl_error(p, p->last_loc, PT_ERR_SYNTAX, "photons: min gather count must be less than max gather count");
+    } else {
+        sdl_warning(p, p->last_loc, "photons: gather's maximum is 0: photons stay off");
+    }
 }
 
 /* global_item := assumed_gamma f | ambient_light c | max_trace_level n |

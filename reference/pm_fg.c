@@ -483,7 +483,7 @@ pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s,
         return PT_ERR_NOMEM;
     }
 
-    int caustics = s->caustics < 0 ? sc->global.photons != 0 : s->caustics != 0;
+    int caustics = s->caustics < 0 ? sc->global.photons.enabled : s->caustics != 0;
     st->caustic_reason = s->caustics < 0 ? (caustics ? "on: the scene has a photons{} block"
                                                      : "off: no photons{} block in the scene")
                                          : (caustics ? "on: requested" : "off: requested");

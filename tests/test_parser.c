@@ -645,6 +645,91 @@ static void test_mesh2(void **st)
     free(e);
 }
 
+/* POV-Ray 3.7's photon language into the IR: the global block's items and
+ * defaults (parser.cpp), the light's block, the object's on/off flags and
+ * POV-Ray's merged rules for which light shoots at which target and which
+ * lobe a photon takes there. */
+static void test_photons_language(void **st)
+{
+    (void)st;
+    scene *s = parse_ok("global_settings { photons { count 20000 autostop 0 jitter 0.3 max_trace_level 7\n"
+                        "  adc_bailout 0.02 expand_thresholds 0.1, 20 gather 15, 80 radius 0.5, 2, , 3\n"
+                        "  media 100, 2 save_file \"a.ph\" } }\n"
+                        "light_source { <0, 5, 0> rgb 1 photons { refraction on reflection off area_light } }\n"
+                        "light_source { <1, 5, 0> rgb 1 }\n"
+                        "sphere { 0, 1 photons { target 0.5 refraction on reflection off collect off } }\n"
+                        "sphere { 0, 1 photons { target } }\n");
+    const scene_photons *ph = &s->global.photons;
+    assert_true(ph->enabled);
+    assert_int_equal(ph->count, 20000);
+    assert_near(ph->spacing, 1.0, 0);
+    assert_near(ph->autostop, 0.0, 0);
+    assert_near(ph->jitter, 0.3, 1e-15);
+    assert_int_equal(ph->max_trace_level, 7);
+    assert_near(ph->adc_bailout, 0.02, 1e-15);
+    assert_near(ph->expand_tolerance, 0.1, 1e-15);
+    assert_int_equal(ph->expand_min, 20);
+    assert_int_equal(ph->gather_min, 15);
+    assert_int_equal(ph->gather_max, 80);
+    assert_near(ph->radius[0], 0.5, 0);
+    assert_near(ph->radius[1], 2.0, 0);
+    assert_near(ph->radius[2], -1.0, 0); /* left out: POV-Ray's default */
+    assert_near(ph->radius[3], 3.0, 0);
+    assert_int_equal(ph->media_steps, 100);
+    assert_near(ph->media_factor, 2.0, 0);
+    assert_string_equal(ph->file, "a.ph");
+    assert_int_equal(ph->load, 0);
+    unsigned all = SCENE_PH_COUNT | SCENE_PH_AUTOSTOP | SCENE_PH_JITTER | SCENE_PH_MAX_TRACE_LEVEL |
+                   SCENE_PH_ADC_BAILOUT | SCENE_PH_EXPAND | SCENE_PH_GATHER | SCENE_PH_RADIUS | SCENE_PH_MEDIA |
+                   SCENE_PH_SAVE_FILE;
+    assert_int_equal(ph->given, all);
+    const scene_light *l0 = &s->lights[0], *l1 = &s->lights[1];
+    assert_true(l0->ph_refraction && !l0->ph_refraction_off && !l0->ph_reflection && l0->ph_reflection_off);
+    assert_true(l0->ph_area_light);
+    assert_true(!l1->ph_refraction && !l1->ph_refraction_off && !l1->ph_reflection && !l1->ph_reflection_off);
+    const scene_obj_photons *a = s->objects[0]->photons, *b = s->objects[1]->photons;
+    assert_true(a->target && a->refraction && !a->refraction_off && !a->reflection && a->reflection_off && !a->collect);
+    /* merged rules: the first target refracts for both lights; the second
+     * (no flags) only for the light that says refraction on */
+    assert_true(scene_photon_shoots(l0, a) && scene_photon_shoots(l1, a));
+    assert_true(scene_photon_shoots(l0, b) && !scene_photon_shoots(l1, b));
+    assert_true(scene_photon_lobe(l0, b, 1) && !scene_photon_lobe(l0, b, 0));
+    assert_true(!scene_photon_lobe(l1, b, 1) && scene_photon_lobe(l1, a, 1) && !scene_photon_lobe(l1, a, 0));
+    assert_true(!scene_photon_lobe(l0, NULL, 0) && scene_photon_lobe(l0, NULL, 1));
+    scene_free(s);
+
+    /* defaults of a bare block; spacing alone */
+    s = parse_ok("global_settings { photons { spacing 0.02 } }\n");
+    ph = &s->global.photons;
+    assert_true(ph->enabled);
+    assert_int_equal(ph->given, SCENE_PH_SPACING);
+    assert_near(ph->spacing, 0.02, 1e-15);
+    assert_int_equal(ph->count, 0);
+    assert_near(ph->autostop, 0.5, 0);
+    assert_near(ph->jitter, 0.4, 0);
+    assert_int_equal(ph->max_trace_level, -1);
+    assert_true(ph->adc_bailout < 0 && ph->gather_min == 20 && ph->gather_max == 100 && ph->expand_min == 35);
+    assert_null(ph->file);
+    scene_free(s);
+    s = parse_ok("sphere { 0, 1 }\n");
+    assert_false(s->global.photons.enabled);
+    scene_free(s);
+
+    /* errors, located */
+    char *m = parse_err("global_settings { photons { gather 50, 10 } }\n", PT_ERR_SYNTAX);
+    assert_non_null(strstr(m, "min gather count"));
+    free(m);
+    m = parse_err("global_settings {\n photons { media -1 } }\n", PT_ERR_SYNTAX);
+    assert_prefix(m, "test.pov:2:");
+    free(m);
+    m = parse_err("global_settings { photons { bogus 1 } }\n", PT_ERR_SYNTAX);
+    assert_prefix(m, "test.pov:1:");
+    free(m);
+    m = parse_err("light_source { 0, 1 photons { target } }\n", PT_ERR_SYNTAX);
+    assert_prefix(m, "test.pov:1:");
+    free(m);
+}
+
 static void test_lights(void **st)
 {
     (void)st;
@@ -988,6 +1073,7 @@ int main(void)
         cmocka_unit_test(test_error_unterminated),
         cmocka_unit_test(test_error_loop_limit),
         cmocka_unit_test_setup(test_error_files, make_tmpdir),
+        cmocka_unit_test(test_photons_language),
         cmocka_unit_test(test_scene_sweep),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
