@@ -1,5 +1,6 @@
 /* scene.c - scene IR construction helpers and POV-Ray 3.7 defaults. */
 #include "scene.h"
+#include <stdatomic.h>
 #include "camera.h"
 #include <math.h>
 #include <stdlib.h>
@@ -119,6 +120,8 @@ scene *scene_new(void)
     if (!s) return NULL;
     s->mem = arena_new();
     if (!s->mem) { free(s); return NULL; }
+    static atomic_ulong next_serial = 1;
+    s->serial = atomic_fetch_add(&next_serial, 1);
     scene_default_global(&s->global);
     scene_default_camera(&s->camera);
     scene_default_pigment(&s->default_texture.pigment);

@@ -23,6 +23,7 @@
 /* ---------------------------------------------------------------- the scene */
 typedef struct {
     arena *mem;
+    unsigned long serial;   /* unique among this process's scenes, never reused: keys caches of derived data */
     scene_global global;
     scene_camera camera;
     int camera_set;

@@ -18,6 +18,7 @@
  * P[i+1]P[i+3] (POV-Ray's sor.cpp Hermite conditions). */
 #include "geom_sweep_internal.h"
 #include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -63,6 +64,24 @@ static void seg_set(sw_seg *s, const double a[2], const double b[2], const doubl
         s->lo[k] = lo;
         s->hi[k] = hi;
     }
+    s->nk = 0;
+    s->tk[0] = 0.0;
+    s->yk[0] = e0[1];
+    if (deg > 1) {
+        double dc[3] = {c[1], 2.0 * b[1], 3.0 * a[1]}, crit[2];
+        int nc = geom_poly_solve(dc, 2, 0.0, 1.0, crit, 0);
+        for (int i = 0; i < nc; i++)
+            if (crit[i] > s->tk[s->nk] && crit[i] < 1.0) {
+                double p[2];
+                seg_eval(s, crit[i], p, NULL);
+                s->nk++;
+                s->tk[s->nk] = crit[i];
+                s->yk[s->nk] = p[1];
+            }
+    }
+    s->nk++;
+    s->tk[s->nk] = 1.0;
+    s->yk[s->nk] = e1[1];
     s->out = 1.0;
 }
 
@@ -129,24 +148,19 @@ static int seg_crossings(const sw_seg *s, double u, double v)
         double x = s->e0[0] + t * (s->e1[0] - s->e0[0]);
         return x >= u;
     }
+    int count = 0, have_pv = 0;
     double pv[4];
-    seg_poly(s, 1, pv);
-    pv[0] -= v;
-    double dc[3] = {pv[1], 2.0 * pv[2], 3.0 * pv[3]}, crit[2];
-    int nc = geom_poly_solve(dc, 2, 0.0, 1.0, crit, 0);
-    double ts[4];
-    int m = 0;
-    ts[m++] = 0.0;
-    for (int i = 0; i < nc; i++)
-        if (crit[i] > ts[m - 1] && crit[i] < 1.0) ts[m++] = crit[i];
-    ts[m++] = 1.0;
-    int count = 0;
-    for (int j = 0; j + 1 < m; j++) {
-        double fa = j == 0 ? s->e0[1] - v : geom_poly_eval(pv, 3, ts[j]);
-        double fb = j + 2 == m ? s->e1[1] - v : geom_poly_eval(pv, 3, ts[j + 1]);
-        if ((fa >= 0.0) == (fb >= 0.0)) continue;
+    for (int j = 0; j < s->nk; j++) {
+        if ((s->yk[j] >= v) == (s->yk[j + 1] >= v)) continue;
+        /* the crossing lies on the segment, so at u' >= lo[0] */
+        if (u <= s->lo[0]) { count++; continue; }
+        if (!have_pv) {
+            seg_poly(s, 1, pv);
+            pv[0] -= v;
+            have_pv = 1;
+        }
         /* one crossing in the monotonic piece: bisection */
-        double lo = ts[j], hi = ts[j + 1], flo = fa;
+        double lo = s->tk[j], hi = s->tk[j + 1], flo = s->yk[j] - v;
         for (int it = 0; it < 60 && hi - lo > 1e-15; it++) {
             double mid = 0.5 * (lo + hi), fm = geom_poly_eval(pv, 3, mid);
             if ((fm >= 0.0) == (flo >= 0.0)) { lo = mid; flo = fm; } else hi = mid;
@@ -158,10 +172,57 @@ static int seg_crossings(const sw_seg *s, double u, double v)
     return count;
 }
 
+static int band_of(const sw_data *w, double v)
+{
+    int b = (int)((v - w->clo[1]) * w->band_inv);
+    return b < 0 ? 0 : (b >= w->nband ? w->nband - 1 : b);
+}
+
+/* The band index of in_curve (its bands cover the curve's v range). A
+ * segment is listed in every band from band_of(lo) to band_of(hi), and
+ * band_of is monotonic, so a query v in [lo, hi] finds it. Without memory,
+ * or for few segments, no index: in_curve then visits every segment. */
+static void band_index(sw_data *w)
+{
+    free(w->band_off);
+    free(w->band_seg);
+    w->band_off = w->band_seg = NULL;
+    w->nband = 0;
+    double h = w->chi[1] - w->clo[1];
+    if (w->nseg < 16 || !(h > 0.0)) return;
+    int nb = w->nseg;
+    w->nband = nb;
+    w->band_inv = nb / h;
+    long total = 0;
+    for (int i = 0; i < w->nseg; i++) total += band_of(w, w->seg[i].hi[1]) - band_of(w, w->seg[i].lo[1]) + 1;
+    w->band_off = calloc((size_t)nb + 1, sizeof *w->band_off);
+    w->band_seg = total <= INT_MAX ? malloc(sizeof *w->band_seg * (size_t)total) : NULL;
+    int *fill = calloc((size_t)nb, sizeof *fill);
+    if (!w->band_off || !w->band_seg || !fill) {
+        free(w->band_off);
+        free(w->band_seg);
+        w->band_off = w->band_seg = NULL;
+        w->nband = 0;
+    } else {
+        for (int i = 0; i < w->nseg; i++)
+            for (int b = band_of(w, w->seg[i].lo[1]); b <= band_of(w, w->seg[i].hi[1]); b++) w->band_off[b + 1]++;
+        for (int b = 0; b < nb; b++) w->band_off[b + 1] += w->band_off[b];
+        for (int i = 0; i < w->nseg; i++)
+            for (int b = band_of(w, w->seg[i].lo[1]); b <= band_of(w, w->seg[i].hi[1]); b++)
+                w->band_seg[w->band_off[b] + fill[b]++] = i;
+    }
+    free(fill);
+}
+
 static int in_curve(const sw_data *w, double u, double v)
 {
     if (u < w->clo[0] || u > w->chi[0] || v < w->clo[1] || v > w->chi[1]) return 0;
     int n = 0;
+    if (w->nband > 0) {
+        int b = band_of(w, v);
+        for (int k = w->band_off[b]; k < w->band_off[b + 1]; k++) n += seg_crossings(&w->seg[w->band_seg[k]], u, v);
+        return n & 1;
+    }
     for (int i = 0; i < w->nseg; i++) n += seg_crossings(&w->seg[i], u, v);
     return n & 1;
 }
@@ -219,6 +280,7 @@ static void curve_bounds(sw_data *w)
             w->clo[k] = fmin(w->clo[k], w->seg[i].lo[k]);
             w->chi[k] = fmax(w->chi[k], w->seg[i].hi[k]);
         }
+    band_index(w);
 }
 
 /* ------------------------------------------------------------ local rays */
@@ -1030,6 +1092,8 @@ void geom_sweep_free(void *data)
     free(w->part_max);
     free(w->seg);
     free(w->sor);
+    free(w->band_off);
+    free(w->band_seg);
     free(w);
 }
 

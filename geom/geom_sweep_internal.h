@@ -17,6 +17,11 @@ typedef struct {
     double e0[2], e1[2];           /* exact end points */
     double lo[2], hi[2];           /* bounds over t in [0,1] */
     int deg;                       /* 1 or 3 */
+    /* p_v's monotonic pieces: t bounds tk[0] = 0 < ... < tk[nk] = 1 (the
+     * critical points of p_v in between) and p_v there (yk; exact end points
+     * at 0 and 1). Independent of the query, so set once. */
+    double tk[4], yk[4];
+    int nk;
     double out;                    /* outward 2-D normal = out * (p1', -p0') */
 } sw_seg;
 
@@ -32,6 +37,13 @@ typedef struct {
     sw_seg *seg;
     sor_seg *sor;
     double clo[2], chi[2];  /* curve bounds (local) */
+    /* Bands of equal height over [clo[1], chi[1]]: band b lists (band_seg
+     * from band_off[b] to band_off[b + 1]) every segment whose v range meets
+     * it, so an inside test visits only the segments at its height. nband 0:
+     * no index (every segment is visited). */
+    int nband;
+    double band_inv;
+    int *band_off, *band_seg;
     vec3 c;                 /* object -> local: (q - c) / L */
     double L;
     vec3 blo, bhi;          /* local bounding box of the shape */

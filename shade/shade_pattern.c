@@ -25,6 +25,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <threads.h>
 #include "func.h"
 #include "shade_funcenv.h"
 #include "shade_noise.h"
@@ -54,6 +55,7 @@ shade_pattern_ctx shade_pattern_ctx_plain(const scene *sc)
     c.noise_generator = g >= 1 && g <= 3 ? g : 2;
     int nw = sc ? sc->global.number_of_waves : 0;
     c.nwaves = nw <= 0 ? SHADE_NOISE_WAVES : (nw > SHADE_NOISE_MAX_WAVES ? SHADE_NOISE_MAX_WAVES : nw);
+    c.scene_serial = sc ? sc->serial : 0;
     return c;
 }
 
@@ -775,31 +777,99 @@ static double density(const scene_pattern *pat, vec3 p)
     return v < 0.0 ? 0.0 : v;
 }
 
+/* Shapes of object patterns, built once per thread and scene: building a
+ * shape (a text's outline and its index, say) costs far more than one inside
+ * test, and the pattern asks for every shading point. Slots are keyed by the
+ * scene's serial, which is never reused, so a freed scene's slots never
+ * match; they are replaced round-robin and freed when the thread ends. */
+#define SHAPE_SLOTS 16
+typedef struct {
+    unsigned long serial;
+    const scene_object *o;
+    geom_shape sh;
+    int ok;
+} shape_slot;
+typedef struct {
+    shape_slot slot[SHAPE_SLOTS];
+    int next;
+} shape_slots;
+
+static tss_t slots_key;
+static int slots_key_ok;
+static once_flag slots_once = ONCE_FLAG_INIT;
+
+static void slots_free(void *p)
+{
+    shape_slots *c = p;
+    if (!c) return;
+    for (int i = 0; i < SHAPE_SLOTS; i++)
+        if (c->slot[i].serial) geom_shape_release(&c->slot[i].sh);
+    free(c);
+}
+
+static void slots_init(void) { slots_key_ok = tss_create(&slots_key, slots_free) == thrd_success; }
+
+/* The shape of leaf o, or NULL when none is cached (no serial, no memory). */
+static const geom_shape *cached_shape(const scene_object *o, unsigned long serial, int *ok)
+{
+    if (!serial) return NULL;
+    call_once(&slots_once, slots_init);
+    if (!slots_key_ok) return NULL;
+    shape_slots *c = tss_get(slots_key);
+    if (!c) {
+        c = calloc(1, sizeof *c);
+        if (!c || tss_set(slots_key, c) != thrd_success) {
+            free(c);
+            return NULL;
+        }
+    }
+    for (int i = 0; i < SHAPE_SLOTS; i++)
+        if (c->slot[i].serial == serial && c->slot[i].o == o) {
+            *ok = c->slot[i].ok;
+            return &c->slot[i].sh;
+        }
+    shape_slot *s = &c->slot[c->next];
+    c->next = (c->next + 1) % SHAPE_SLOTS;
+    if (s->serial) geom_shape_release(&s->sh);
+    memset(s, 0, sizeof *s);
+    s->serial = serial;
+    s->o = o;
+    s->ok = geom_shape_init(&s->sh, o) == 0;
+    *ok = s->ok;
+    return &s->sh;
+}
+
 /* The object pattern's inside test (POV-Ray's Inside_Object): CSG as
  * union/merge any, intersection all, difference the first and none of the
  * others, each node's `inverse` negating it; leaves by accel's shape test
  * (a shape accel cannot build, or a patch without inside, is outside).
  * Clipping objects are not applied. */
-static int object_inside(const scene_object *o, vec3 p, int depth)
+static int object_inside(const scene_object *o, vec3 p, unsigned long serial, int depth)
 {
     int in = 0;
     if (depth > 64) return 0;
     switch (o->kind) {
     case SHAPE_UNION: case SHAPE_MERGE:
-        for (int i = 0; i < o->u.csg.nkids && !in; i++) in = object_inside(o->u.csg.kids[i], p, depth + 1);
+        for (int i = 0; i < o->u.csg.nkids && !in; i++) in = object_inside(o->u.csg.kids[i], p, serial, depth + 1);
         break;
     case SHAPE_INTERSECTION:
         in = o->u.csg.nkids > 0;
-        for (int i = 0; i < o->u.csg.nkids && in; i++) in = object_inside(o->u.csg.kids[i], p, depth + 1);
+        for (int i = 0; i < o->u.csg.nkids && in; i++) in = object_inside(o->u.csg.kids[i], p, serial, depth + 1);
         break;
     case SHAPE_DIFFERENCE:
-        in = o->u.csg.nkids > 0 && object_inside(o->u.csg.kids[0], p, depth + 1);
-        for (int i = 1; i < o->u.csg.nkids && in; i++) in = !object_inside(o->u.csg.kids[i], p, depth + 1);
+        in = o->u.csg.nkids > 0 && object_inside(o->u.csg.kids[0], p, serial, depth + 1);
+        for (int i = 1; i < o->u.csg.nkids && in; i++) in = !object_inside(o->u.csg.kids[i], p, serial, depth + 1);
         break;
     default: {
-        geom_shape sh;
-        if (geom_shape_init(&sh, o) == 0) in = geom_shape_inside(&sh, p);
-        geom_shape_release(&sh);
+        int ok = 0;
+        const geom_shape *csh = cached_shape(o, serial, &ok);
+        if (csh) {
+            in = ok && geom_shape_inside(csh, p);
+        } else {
+            geom_shape sh;
+            if (geom_shape_init(&sh, o) == 0) in = geom_shape_inside(&sh, p);
+            geom_shape_release(&sh);
+        }
         break;
     }
     }
@@ -877,7 +947,7 @@ static double raw_value(const scene_pattern *pat, vec3 p, const shade_pattern_ct
         return shade_pavement_value(&pv, p);
     }
     case PAT_DENSITY: return density(pat, p);
-    case PAT_OBJECT: return pat->object && object_inside(pat->object, p, 0) ? 1.0 : 0.0;
+    case PAT_OBJECT: return pat->object && object_inside(pat->object, p, c->scene_serial, 0) ? 1.0 : 0.0;
     default: return 0.0;
     }
 }

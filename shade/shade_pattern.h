@@ -22,6 +22,7 @@ typedef struct {
      * a surface (they then use the point they are given). */
     int has_uv;
     double uv[2];
+    unsigned long scene_serial; /* the scene's serial (object patterns cache their shapes by it); 0: none */
 } shade_pattern_ctx;
 
 /* A context for evaluating patterns away from a surface. */

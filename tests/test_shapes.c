@@ -308,6 +308,52 @@ static void test_prism_brute(void **st)
     }
 }
 
+/* A prism with many segments (the inside test's band index is built from
+ * 16 on): a regular 64-gon with a regular 48-gon hole; a point is inside iff
+ * it lies within the outer polygon's apothem of every outer edge normal and
+ * outside the hole's, the closed form. Points closer than 1e-9 to an edge
+ * are skipped (either answer is right there). */
+static void test_prism_many_segments(void **st)
+{
+    (void)st;
+    char buf[16384];
+    int n = snprintf(buf, sizeof buf, "prism { linear_sweep linear_spline 0, 1, %d", 65 + 49);
+    const int ns[2] = {64, 48};
+    const double rs[2] = {1.0, 0.5};
+    for (int ring = 0; ring < 2; ring++)
+        for (int k = 0; k <= ns[ring]; k++) {
+            double a = 2.0 * M_PI * (k % ns[ring]) / ns[ring];
+            n += snprintf(buf + n, sizeof buf - (size_t)n, ", <%.17g,%.17g>", rs[ring] * cos(a), rs[ring] * sin(a));
+        }
+    snprintf(buf + n, sizeof buf - (size_t)n, " }");
+    world w = build(buf);
+    geom_shape sh = shape_of(&w);
+    int tested = 0, inside = 0;
+    for (int i = 0; i < 4000; i++) {
+        double x = -1.2 + 2.4 * ((i * 0.6180339887498949) - floor(i * 0.6180339887498949));
+        double z = -1.2 + 2.4 * ((i * 0.7548776662466927) - floor(i * 0.7548776662466927));
+        int in_ring[2];
+        double margin = INFINITY;
+        for (int ring = 0; ring < 2; ring++) {
+            in_ring[ring] = 1;
+            for (int k = 0; k < ns[ring]; k++) {
+                double a = 2.0 * M_PI * (k + 0.5) / ns[ring];
+                double dd = x * cos(a) + z * sin(a) - rs[ring] * cos(M_PI / ns[ring]);
+                if (dd > 0.0) in_ring[ring] = 0;
+                margin = fmin(margin, fabs(dd));
+            }
+        }
+        if (margin < 1e-9) continue;
+        int want = in_ring[0] && !in_ring[1];
+        if (geom_shape_inside(&sh, v3(x, 0.5, z)) != want) fail_msg("point %d (%g, %g): inside %d, want %d", i, x, z, !want, want);
+        tested++;
+        inside += want;
+    }
+    assert_true(tested > 3900 && inside > 1000);
+    geom_shape_release(&sh);
+    done(&w);
+}
+
 /* ------------------------------------------------------------ text */
 
 static void test_text(void **st)
@@ -1130,6 +1176,7 @@ int main(void)
         cmocka_unit_test(test_sor_brute),
         cmocka_unit_test(test_prism),
         cmocka_unit_test(test_prism_brute),
+        cmocka_unit_test(test_prism_many_segments),
         cmocka_unit_test(test_text),
         cmocka_unit_test(test_superellipsoid),
         cmocka_unit_test(test_quadric),
