@@ -169,8 +169,10 @@ static int light_first_hit(const trace_ctx *c, vec3 o, vec3 w, accel_hit *h, lon
     return 0;
 }
 
-/* Emit one photon of source `src`: fills the first hit and its power. */
-static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec3 *w, rgb *phi, long *rays)
+/* Emit one photon of source `src`: its origin *o and direction *w, the
+ * first hit and the photon's power. Returns 1 on a hit, 0 when the photon
+ * left the scene, -1 when no photon was emitted (no emitter sample). */
+static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec3 *o, vec3 *w, rgb *phi, long *rays)
 {
     double n = (double)src->n;
     if (src->kind == SRC_LIGHT) {
@@ -180,9 +182,9 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
             vec3 axis = v3_norm(v3_sub(l->point_at, l->position));
             double R = fabs(l->falloff);
             double u1 = rng_f64(r), u2 = rng_f64(r);
-            vec3 o = disc_point(l->position, axis, R, u1, u2);
+            *o = disc_point(l->position, axis, R, u1, u2);
             *w = axis;
-            if (!light_first_hit(c, o, axis, h, rays)) return 0;
+            if (!light_first_hit(c, *o, axis, h, rays)) return 0;
             vec3 dl;
             double depth;
             shade_light_ray(l, l->position, h->p, &dl, &depth);
@@ -196,9 +198,9 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
             vec3 cp = v3_sub(c->centre, v3_scale(to_light, v3_dot(v3_sub(c->centre, l->position), to_light)));
             double R = c->radius;
             double u1 = rng_f64(r), u2 = rng_f64(r);
-            vec3 o = disc_point(cp, to_light, R, u1, u2);
+            *o = disc_point(cp, to_light, R, u1, u2);
             *w = v3_neg(to_light);
-            if (!light_first_hit(c, o, *w, h, rays)) return 0;
+            if (!light_first_hit(c, *o, *w, h, rays)) return 0;
             vec3 dl;
             double depth;
             shade_light_ray(l, l->position, h->p, &dl, &depth);
@@ -217,6 +219,7 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         double u1 = rng_f64(r), u2 = rng_f64(r);
         *w = cone_dir(axis, cos_max, u1, u2);
         double pdf = 1.0 / (2.0 * M_PI * (1.0 - cos_max));
+        *o = q;
         if (!light_first_hit(c, q, *w, h, rays)) return 0;
         vec3 dl;
         double depth;
@@ -231,12 +234,12 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         const accel_surf *es = pm_lights_emitters(c->L);
         accel_surf_sample s;
         double u1 = rng_f64(r), u2 = rng_f64(r), u3 = rng_f64(r);
-        if (!accel_surf_sample_point(es, u1, u2, u3, r, &s)) return 0;
+        if (!accel_surf_sample_point(es, u1, u2, u3, r, &s)) return -1;
         vec3 ns = rng_f64(r) < 0.5 ? s.n : v3_neg(s.n);
         double u4 = rng_f64(r), u5 = rng_f64(r);
         *w = shade_mat_cosine_dir(ns, u4, u5);
-        vec3 o = v3_madd(s.p, ns, c->eps);
-        if (!photon_intersect(c, NULL, o, *w, OBJ_NO_RADIOSITY, h, rays)) return 0;
+        *o = v3_madd(s.p, ns, c->eps);
+        if (!photon_intersect(c, NULL, *o, *w, OBJ_NO_RADIOSITY, h, rays)) return 0;
         rgb le = pm_lights_piece_emission(c->L, &s);
         double k = 2.0 * M_PI / (n * s.pdf_area);
         *phi = crgb(le.r * k, le.g * k, le.b * k);
@@ -247,9 +250,9 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
     vec3 wd = cone_dir(v3(0, 0, 1), -1.0, u1, u2);
     double R = c->radius;
     double u3 = rng_f64(r), u4 = rng_f64(r);
-    vec3 o = disc_point(v3_madd(c->centre, wd, -R * 1.001), wd, R, u3, u4);
+    *o = disc_point(v3_madd(c->centre, wd, -R * 1.001), wd, R, u3, u4);
     *w = wd;
-    if (!photon_intersect(c, NULL, o, wd, OBJ_NO_RADIOSITY, h, rays)) return 0;
+    if (!photon_intersect(c, NULL, *o, wd, OBJ_NO_RADIOSITY, h, rays)) return 0;
     /* it arrives from the sky in direction -wd */
     rgb bg = pm_sky(c->sc, v3_neg(wd));
     double k = 4.0 * M_PI * M_PI * R * R / n;
@@ -257,43 +260,93 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
     return 1;
 }
 
-static void trace_one(const trace_ctx *c, const source *src, long index, chunk_out *out)
+static const source *source_of(const trace_ctx *c, long index)
 {
-    rng r;
-    rng_seed(&r, pm_mix64(c->s->seed ^ 0x70686f746f6e73ULL), (uint64_t)index);
+    int si = 0;
+    while (si < c->nsrc - 1 && index >= c->src[si].first + c->src[si].n) si++;
+    return &c->src[si];
+}
+
+/* Photon path `index`, from its source (resume NULL) or from a segment
+ * launched before (resume: a launch that fn saw, its `from` surface in
+ * this scene). Photons go into `out` (NULL: none stored); fn (NULL: none)
+ * sees every segment traced, with its hit (NULL: it left the scene) and the
+ * power a receiver crossed by it takes (after the first bounce, or from
+ * the start for the background's photons, scaled by brightness^g while the
+ * light may still be gathered: the rule the global map stores by; 0
+ * otherwise). The random stream of a path depends on the path's index
+ * only, and a resumed segment carries the stream's state, so resuming at
+ * segment k gives the path that tracing from the source would give when
+ * segments 0..k-1 hit the same surfaces. */
+static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume, chunk_out *out, pm_photon_seg_fn fn,
+                 void *fctx, long *rays)
+{
+    pm_photon_launch L;
     accel_hit h;
-    vec3 w;
-    rgb phi;
-    if (!emit(c, src, &r, &h, &w, &phi, &out->rays)) return;
+    rng r;
+    const rgb none = {0.0, 0.0, 0.0};
+    if (!resume || resume->bounce == 0) {
+        /* segment 0 is resumed by emitting again */
+        memset(&L, 0, sizeof L);
+        const source *s0 = source_of(c, index);
+        L.source = (int)(s0 - c->src);
+        L.spec_only = 1;
+        L.skip = OBJ_NO_RADIOSITY;
+        rng_seed(&r, pm_mix64(c->s->seed ^ 0x70686f746f6e73ULL), (uint64_t)index);
+        L.r = r;
+        int e = emit(c, s0, &r, &h, &L.o, &L.w, &L.phi, rays);
+        if (e < 0) return;
+        if (e == 0) {
+            if (fn) fn(fctx, index, &L, NULL, none);
+            return;
+        }
+    } else {
+        L = *resume;
+        r = L.r;
+        if (!photon_intersect(c, L.from.obj ? &L.from : NULL, L.o, L.w, L.skip, &h, rays)) {
+            if (fn) fn(fctx, index, &L, NULL, none);
+            return;
+        }
+    }
+    const source *src = &c->src[L.source];
+    vec3 w = L.w;
+    rgb phi = L.phi;
     int from_light = src->kind == SRC_LIGHT;
     int store_first = src->kind == SRC_ENV;
-    int spec_only = 1;
+    int spec_only = L.spec_only;
+    int nd = L.nd;
     /* light_group: a light's photons land only on what it lights (its
      * group's members, or for a global light what global_lights reaches);
      * elsewhere they end at once, as that light's direct light is absent
      * there (shade.c); after the first bounce the light is indirect and
      * reaches everything */
-    if (from_light && !scene_light_reaches(src->l, h.obj)) return;
     /* POV-Ray's rules (radrules.h): what a no_radiosity object reflects
      * reaches no gathering ray; light that has been gathered g times (g
      * diffuse bounces of a light's photon; one more for emitted and sky
      * light, which reach any surface only by gathering) is scaled by
      * brightness^g, and reaches the eye (one more gathering) only while
      * g + 1 <= recursion_limit. */
-    if (!radrules_gathers(h.flags)) return;
-    int nd = 0;
-    for (int bounce = 0;; bounce++) {
+    if (L.bounce == 0 && ((from_light && !scene_light_reaches(src->l, h.obj)) || !radrules_gathers(h.flags))) {
+        if (fn) fn(fctx, index, &L, &h, none);
+        return;
+    }
+    for (int bounce = L.bounce;; bounce++) {
         shade_mat_bsdf b;
         shade_mat_setup(&b, c->sc, &h, w, c->eps, &r);
         int lambert = b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 || b.m[SHADE_MAT_LOBE_BACK] > 0.0;
         int collect = !(h.obj && h.obj->photons && !h.obj->photons->collect); /* photons { collect off } */
         int g = from_light ? nd : nd + 1;
-        if (lambert && collect && (bounce >= 1 || store_first) && g + 1 <= c->gathers && cmax(phi) > 0.0) {
+        rgb pg = none;
+        int eligible = (bounce >= 1 || store_first) && g + 1 <= c->gathers && cmax(phi) > 0.0;
+        if (eligible) {
+            double bk = g > 0 ? pow(c->rr.brightness, g) : 1.0;
+            pg = crgb(phi.r * bk, phi.g * bk, phi.b * bk);
+        }
+        if (fn) fn(fctx, index, &L, &h, pg);
+        if (out && lambert && collect && eligible) {
             /* stored on the side of the object it arrived at (pm_kdtree.h) */
             uint32_t key = pm_surface_key(h.obj, b.entering);
             if (out->ng + out->nc >= out->cap) { out->dropped++; return; }
-            double bk = g > 0 ? pow(c->rr.brightness, g) : 1.0;
-            rgb pg = crgb(phi.r * bk, phi.g * bk, phi.b * bk);
             if (!push(&out->g, &out->ng, &out->cg, h.p, pg, b.ng, key)) { out->oom = 1; return; }
             if (c->s->caustics && from_light && spec_only && bounce >= 1)
                 if (!push(&out->c, &out->nc, &out->cc, h.p, phi, b.ng, key)) { out->oom = 1; return; }
@@ -320,9 +373,21 @@ static void trace_one(const trace_ctx *c, const source *src, long index, chunk_o
         phi = crgb(phi.r * s.weight.r * k, phi.g * s.weight.g * k, phi.b * s.weight.b * k);
         if (!(cmax(phi) > 0.0) || !isfinite(phi.r + phi.g + phi.b)) return;
         w = s.dir;
+        /* the next segment's launch: what resuming it needs */
+        L.o = s.org;
+        L.w = w;
+        L.phi = phi;
+        L.from = b.from;
         /* gathered light passes no_radiosity objects; a light's caustic path does not */
-        if (!photon_intersect(c, &b.from, s.org, w, from_light && spec_only ? 0u : OBJ_NO_RADIOSITY, &h, &out->rays))
+        L.skip = from_light && spec_only ? 0u : OBJ_NO_RADIOSITY;
+        L.r = r;
+        L.bounce = bounce + 1;
+        L.nd = nd;
+        L.spec_only = spec_only;
+        if (!photon_intersect(c, &b.from, s.org, w, L.skip, &h, rays)) {
+            if (fn) fn(fctx, index, &L, NULL, none);
             return;
+        }
     }
 }
 
@@ -333,11 +398,7 @@ static void chunk_job(void *ctx, int ci, int thread)
     if (c->s->cancel && *c->s->cancel) return;
     long i0 = (long)ci * CHUNK, i1 = i0 + CHUNK < c->total ? i0 + CHUNK : c->total;
     chunk_out *out = &c->chunks[ci];
-    int si = 0;
-    for (long i = i0; i < i1 && !out->oom && !(c->s->cancel && *c->s->cancel); i++) {
-        while (si < c->nsrc - 1 && i >= c->src[si].first + c->src[si].n) si++;
-        trace_one(c, &c->src[si], i, out);
-    }
+    for (long i = i0; i < i1 && !out->oom && !(c->s->cancel && *c->s->cancel); i++) walk(c, i, NULL, out, NULL, NULL, &out->rays);
 }
 
 static double fade_at(const scene_light *l, double d)
@@ -347,10 +408,13 @@ static double fade_at(const scene_light *l, double d)
     return pow(d, -l->fade_power);
 }
 
-pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, const pm_photon_settings *s,
-                           pm_photon_result *out)
+/* The sources and their shares of s->photons (c->src, c->nsrc, c->total;
+ * c->src NULL when there is nothing to trace). bounds (NULL: the accel's):
+ * the box the parallel lights' and the background's photons are aimed
+ * across and the allocation proxies are taken over. */
+static pt_status setup(trace_ctx *cp, const scene *sc, const accel *a, const pm_lights *L, const pm_photon_settings *s,
+                       const vec3 *bounds, int *sources, int *targets)
 {
-    memset(out, 0, sizeof *out);
     trace_ctx c;
     memset(&c, 0, sizeof c);
     c.sc = sc;
@@ -361,9 +425,14 @@ pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, 
     c.rr = radrules_of(sc, 1);
     c.gathers = c.rr.recursion_limit > 0 ? c.rr.recursion_limit : 1 << 20;
     for (int i = 0; i < sc->nobjects && !c.targets; i++) c.targets = any_target(sc->objects[i]);
-    out->targets = c.targets;
+    *targets = c.targets;
     vec3 lo, hi;
-    accel_bounds(a, &lo, &hi);
+    if (bounds) {
+        lo = bounds[0];
+        hi = bounds[1];
+    } else {
+        accel_bounds(a, &lo, &hi);
+    }
     c.centre = v3_scale(v3_add(lo, hi), 0.5);
     c.radius = 0.5 * v3_len(v3_sub(hi, lo)) * 1.01 + 1e-9;
     double D = 0.5 * v3_len(v3_sub(hi, lo));
@@ -413,9 +482,10 @@ pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, 
             ns++;
         }
     }
-    out->sources = ns;
+    *sources = ns;
     if (ns == 0 || s->photons <= 0) {
         free(src);
+        *cp = c;
         return PT_OK;
     }
     double ptotal = 0.0;
@@ -433,6 +503,19 @@ pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, 
     c.src = src;
     c.nsrc = ns;
     c.total = total;
+    *cp = c;
+    return PT_OK;
+}
+
+pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, const pm_photon_settings *s,
+                           pm_photon_result *out)
+{
+    memset(out, 0, sizeof *out);
+    trace_ctx c;
+    pt_status st = setup(&c, sc, a, L, s, NULL, &out->sources, &out->targets);
+    if (st != PT_OK || !c.src) return st;
+    source *src = c.src;
+    long total = c.total;
     c.nchunks = (int)((total + CHUNK - 1) / CHUNK);
     c.chunks = calloc((size_t)c.nchunks, sizeof(chunk_out));
     if (!c.chunks) {
@@ -482,4 +565,43 @@ pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, 
     out->ncaustic = nc;
     out->emitted = total;
     return PT_OK;
+}
+
+struct pm_photon_walker {
+    trace_ctx c;
+    pm_photon_settings s;
+};
+
+pm_photon_walker *pm_photon_walker_new(const scene *sc, const accel *a, const pm_lights *L, const pm_photon_settings *s,
+                                       const vec3 *bounds, long *paths, pt_status *st)
+{
+    pm_photon_walker *w = calloc(1, sizeof *w);
+    *paths = 0;
+    if (!w) {
+        *st = PT_ERR_NOMEM;
+        return NULL;
+    }
+    w->s = *s;
+    int sources, targets;
+    *st = setup(&w->c, sc, a, L, &w->s, bounds, &sources, &targets);
+    if (*st != PT_OK) {
+        free(w);
+        return NULL;
+    }
+    w->c.s = &w->s;
+    *paths = w->c.src ? w->c.total : 0;
+    return w;
+}
+
+void pm_photon_walk(const pm_photon_walker *w, long index, const pm_photon_launch *resume, pm_photon_seg_fn fn, void *ctx,
+                    long *rays)
+{
+    if (w->c.src && index >= 0 && index < w->c.total) walk(&w->c, index, resume, NULL, fn, ctx, rays);
+}
+
+void pm_photon_walker_free(pm_photon_walker *w)
+{
+    if (!w) return;
+    free(w->c.src);
+    free(w);
 }

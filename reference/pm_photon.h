@@ -74,4 +74,41 @@ typedef struct {
 pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, const pm_photon_settings *s,
                            pm_photon_result *out);
 
+/* Photon paths one at a time, for an estimator that keeps them (pm_detp.h).
+ * A launch is where a segment of a path starts, with all that tracing the
+ * path on from there needs; segment 0 (emission) is resumed by emitting
+ * path `index` again. */
+typedef struct {
+    vec3 o, w;        /* origin and unit direction */
+    rgb phi;          /* the path's power along it (segment 0: as emitted, known after its hit) */
+    rng r;            /* the path's random stream where the segment starts (segment 0: the seed) */
+    accel_from from;  /* the surface it leaves (obj NULL: none) */
+    unsigned skip;    /* OBJ_* flags of the objects it passes through */
+    int source;       /* which source emitted the path */
+    int bounce;       /* surfaces the path met before (0: emission) */
+    int nd;           /* diffuse bounces before */
+    int spec_only;    /* only specular bounces so far */
+} pm_photon_launch;
+/* One segment traced: its launch, its hit (NULL: left the scene) and the
+ * power a receiver it crosses takes: the power the global map would store
+ * at a Lambertian hit (after the first bounce, or from the start for the
+ * background's photons; brightness^g while the light may still be
+ * gathered), 0 otherwise. */
+typedef void (*pm_photon_seg_fn)(void *ctx, long index, const pm_photon_launch *l, const accel_hit *h, rgb carried);
+
+typedef struct pm_photon_walker pm_photon_walker;
+/* The sources of sc with s->photons shared among them as pm_photons_trace
+ * shares them; bounds (lo, hi; NULL: the accel's) fix the allocation
+ * proxies and where parallel lights' and the background's photons are aimed,
+ * so that a later frame can keep the first frame's. *paths: the paths
+ * [0, *paths) there are. The scene, accel and L must outlive it. */
+pm_photon_walker *pm_photon_walker_new(const scene *sc, const accel *a, const pm_lights *L, const pm_photon_settings *s,
+                                       const vec3 *bounds, long *paths, pt_status *st);
+/* Path `index` from its source (resume NULL) or from a launch fn saw (its
+ * `from` object in this walker's scene). Thread-safe; *rays counts the
+ * intersection queries. */
+void pm_photon_walk(const pm_photon_walker *w, long index, const pm_photon_launch *resume, pm_photon_seg_fn fn, void *ctx,
+                    long *rays);
+void pm_photon_walker_free(pm_photon_walker *w);
+
 #endif
