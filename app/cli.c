@@ -292,6 +292,15 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
             else if (strcmp(a, "--fg-rays") == 0) o->fg_rays = v;
             else o->max_depth = v;
             i++;
+        } else if (strcmp(a, "--detp-full") == 0) {
+            o->detp_full = 1;
+        } else if (strcmp(a, "--detp-radius") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (!parse_double(next, &o->detp_radius) || !(o->detp_radius > 0.0) || !isfinite(o->detp_radius)) {
+                snprintf(err, (size_t)errlen, "--detp-radius wants a positive number");
+                return 2;
+            }
+            i++;
         } else if (strcmp(a, "--gi-quality") == 0) {
             if (!has_value(a, next, err, errlen)) return 2;
             if (!parse_double(next, &o->gi_quality) || !(o->gi_quality > 0.0) || o->gi_quality > 64.0) {
@@ -565,7 +574,7 @@ const char cli_render_help[] =
     "\n"
     "Global illumination\n"
     "  --gi MODE              none (direct light + Whitted, POV-Ray's model), particle,\n"
-    "                         path (path tracer), pmfg (photon map + final gather);\n"
+    "                         path (path tracer), pmfg (photon map + final gather), detp;\n"
     "                         default: particle when the scene has radiosity{}, else none\n"
     "  --particles N --nb N   particle: particles, bounces\n"
     "  --gi-quality Q         particle: Q times the particles the scene's radiosity{} asks for\n"
@@ -573,6 +582,9 @@ const char cli_render_help[] =
     "  --cl-device NAME --cl-max-memory MIB    particle: OpenCL device and its memory\n"
     "  --max-depth N          path: vertices per path\n"
     "  --fg-rays N --photons N    pmfg: final-gather rays per pixel, photon paths\n"
+    "  --gi detp [--photons N] [--detp-radius R] [--detp-full]\n"
+    "                         incremental photon paths across an animation's frames, fixed-radius\n"
+    "                         estimate (docs/gi.md); --detp-full recomputes every frame\n"
     "\n"
     "Colour and light (docs/guide.md, docs/units.md)\n"
     "  --display NAME --view NAME --look NAME --exposure STOPS --working-space NAME\n"

@@ -73,6 +73,8 @@ typedef struct {
     double gi_quality;      /* --gi-quality: scales the GI method's effort from the scene's settings (0 = 1) */
     int bounces, fg_rays, max_depth;
     long photons;
+    double detp_radius;     /* --detp-radius: DETP disc radius, world units (0 = default) */
+    int detp_full;          /* --detp-full: every frame traces and estimates everything anew */
     const char *cl_device;  /* particle GI: OpenCL device (NULL/"auto", "c", "P:D" or part of a name) */
     long long cl_max_memory_mib; /* particle GI: OpenCL device memory it may use (0 = the device's) */
     /* lighting studies (app/lighting_study.h, docs/units.md) */

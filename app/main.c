@@ -342,6 +342,8 @@ typedef struct {
     uint64_t scene_hash;    /* FNV-1a 64 of the scene file's bytes */
     double t_start;
     gi_keep keep;           /* particle GI of the previous frame */
+    pm_detp *detp;          /* --gi detp: the photon paths of the previous frame */
+    uint64_t detp_h_geom, detp_l; /* and the stage hashes (stage_hashes) of that frame */
 } render_run;
 
 /* A copy of fb with straight alpha: colour / alpha where alpha > 0. */
@@ -415,7 +417,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
             diag_report(d, DIAG_NOTE, none, NULL, "+Q%d: radiosity is off below +Q9, as in POV-Ray", o->quality);
     }
     const char *gi_used = gi_mode_name(gi);
-    if (run->tile && (gi == GI_PATH || gi == GI_PMFG)) {
+    if (run->tile && (gi == GI_PATH || gi == GI_PMFG || gi == GI_DETP)) {
         pbar_free(bar);
         fprintf(stderr, "partray render: a render window (+SC/+EC/+SR/+ER) needs --gi none or particle, not %s\n", gi_used);
         scene_free(sc);
@@ -484,6 +486,22 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     ss.reuse = reuse ? run->keep.gp : NULL;
     ss.relight = relight;
     ss.keep = keep_gi;
+    ss.detp_radius = o->detp_radius;
+    ss.detp_full = o->detp_full;
+    if (gi == GI_DETP && plan->animated) {
+        /* the paths kept across frames: the pieces that changed are traced
+         * again (pm_detp.h); the IR's stage hashes say whether the lights
+         * changed and whether objects may have */
+        uint64_t hg, hl;
+        stage_hashes(sc, run->scene_hash, frame_dependent, frame, &hg, &hl);
+        int had = run->detp != NULL;
+        if (!run->detp) run->detp = render_gi_detp_new(&ss);
+        ss.detp = run->detp;
+        ss.detp_frame.lights_changed = had && (hl ^ hg) != run->detp_l;
+        ss.detp_frame.objects_may_change = !had || hg != run->detp_h_geom;
+        run->detp_h_geom = hg;
+        run->detp_l = hl ^ hg;
+    }
     if (run->tile) memcpy(ss.window, run->win, sizeof ss.window);
     char *progressive = NULL;
     if ((gi == GI_PATH || gi == GI_PMFG) && noutputs > 0 && img_format_from_path(outputs[0]) != IMG_FMT_UNKNOWN) {
@@ -813,6 +831,7 @@ static int cmd_render(int argc, char **argv)
         fprintf(stderr, "partray: %d frames in %.3f s\n", nframes, timer_now() - t_start);
     for (int i = 0; i < nbases; i++) free(bases[i]);
     gi_keep_free(&run.keep);
+    pm_detp_free(run.detp);
     lighting_free(&ls);
     img_ocio_close(oc);
     ini_free(ia);

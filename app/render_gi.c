@@ -5,7 +5,9 @@
  *            then the Whitted pass with the particles' indirect light
  *            (ambient under POV-Ray's rules with radiosity on, radrules.h).
  *  pmfg      photon map + final gathering (reference/pm_fg.h).
- *  path      path tracer (reference/pm_path.h). */
+ *  path      path tracer (reference/pm_path.h).
+ *  detp      incremental photon paths and the fixed-radius estimate
+ *            (reference/pm_detp.h) as the indirect hook of the Whitted pass. */
 #include "render_gi.h"
 #include <stdio.h>
 #include <string.h>
@@ -136,6 +138,46 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     return st;
 }
 
+pm_detp *render_gi_detp_new(const render_gi_opts *o)
+{
+    pm_detp_settings s;
+    pm_detp_default_settings(&s);
+    if (o->photons > 0) s.photons = o->photons;
+    s.radius = o->detp_radius;
+    s.full = o->detp_full;
+    s.seed = o->seed;
+    s.threads = o->threads;
+    s.cancel = o->cancel;
+    return pm_detp_new(&s);
+}
+
+static pt_status render_detp(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
+                             render_gi_result *r, diag *d)
+{
+    pm_detp *dp = o->detp ? o->detp : render_gi_detp_new(o);
+    if (!dp) return PT_ERR_NOMEM;
+    pm_detp_set_progress(dp, o->progress);
+    r->has_detp = 1;
+    pt_status st = pm_detp_frame(dp, sc, a, o->width, o->height, &o->detp_frame, &r->detp, d);
+    r->t_gi_geometry = r->detp.t_trace;
+    r->t_gi_lighting = r->detp.t_estimate;
+    if (st == PT_OK && !(o->cancel && *o->cancel)) {
+        shade_settings ss;
+        fill_shade(&ss, o);
+        ss.use_ambient = radrules_of(sc, 1).ambient; /* radiosity's rule, as particle */
+        ss.indirect = pm_detp_indirect;
+        ss.indirect_ctx = dp;
+        double t0 = timer_now();
+        r->image_begun = 1;
+        st = shade_render(sc, a, &ss, fb, &r->shade, d);
+        r->t_render = timer_now() - t0;
+        if (st == PT_OK) st = render_aovs(sc, a, o, &ss, r, d);
+    }
+    pm_detp_set_progress(dp, NULL);
+    if (!o->detp) pm_detp_free(dp);
+    return st == PT_CANCELLED ? PT_OK : st;
+}
+
 typedef struct {
     const char *path;
     double last;
@@ -257,6 +299,7 @@ pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, fr
     pt_status st;
     switch (o->mode) {
     case GI_PARTICLE: st = render_particle(sc, a, o, fb, r, d); break;
+    case GI_DETP: st = render_detp(sc, a, o, fb, r, d); break;
     case GI_PMFG:
     case GI_PATH: return render_reference(sc, a, o, fb, r, d);
     default: st = render_none(sc, a, o, fb, r, d); break;
@@ -265,6 +308,7 @@ pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, fr
     r->shadow_rays = r->shade.shadow_rays;
     r->secondary_rays = r->shade.secondary_rays;
     r->discarded = r->shade.discarded_samples;
+    if (r->has_detp) r->other_rays = r->detp.rays;
     if (r->has_particle) {
         r->other_rays = r->particle.link_rays + r->particle.shadow_rays + r->particle.prepass_rays;
         r->discarded += r->particle.discarded;
@@ -322,6 +366,29 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
         stats_num(js, "geometry", p->c_geometry);
         stats_num(js, "lists", p->c_lists);
         stats_num(js, "render", r->c_render);
+        stats_obj_end(js);
+        stats_obj_end(js);
+    }
+    if (r->has_detp) {
+        const pm_detp_stats *p = &r->detp;
+        stats_obj_begin(js, "detp");
+        stats_int(js, "paths", p->paths);
+        stats_int(js, "segments", p->segments);
+        stats_int(js, "paths_retraced", p->paths_retraced);
+        stats_num(js, "fraction_retraced", p->paths > 0 ? (double)p->paths_retraced / (double)p->paths : 0.0);
+        stats_int(js, "segments_old", p->segments_old);
+        stats_int(js, "segments_new", p->segments_new);
+        stats_int(js, "receivers", p->receivers);
+        stats_int(js, "receivers_full", p->receivers_full);
+        stats_int(js, "objects", p->objects);
+        stats_int(js, "moving_objects", p->moving_objects);
+        stats_int(js, "full_frame", p->full_frame);
+        stats_str(js, "full_reason", p->full_reason ? p->full_reason : "");
+        stats_int(js, "rays", p->rays);
+        stats_num(js, "radius", p->radius);
+        stats_obj_begin(js, "timings");
+        stats_num(js, "trace", p->t_trace);
+        stats_num(js, "estimate", p->t_estimate);
         stats_obj_end(js);
         stats_obj_end(js);
     }

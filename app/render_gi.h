@@ -9,6 +9,7 @@
 #include "framebuffer.h"
 #include "gi_particle.h"
 #include "pm.h"
+#include "pm_detp.h"
 #include "scene.h"
 #include "shade.h"
 #include "shade_aov.h"
@@ -43,6 +44,12 @@ typedef struct {
     gi_particle *reuse;
     int relight;
     int keep;
+    /* detp: the photon paths kept from the previous frame (render_gi_detp_new;
+     * NULL: a still, made and freed here) and what changed since */
+    pm_detp *detp;
+    pm_detp_frame_info detp_frame;
+    double detp_radius;       /* detp: disc radius (0 = default) */
+    int detp_full;            /* detp: recompute every frame */
     int window[4];            /* none/particle: render window x0,y0,x1,y1 (shade_settings.window); 0 = all */
     shade_aov *aov;           /* non-NULL: fill these AOVs after the render (shade_aov.h); the indirect
                                  AOV comes from particle GI only (0 for none, pmfg, path) */
@@ -61,6 +68,8 @@ typedef struct {
     int image_begun;          /* the pass that writes the image began: a cancelled render's
                                  framebuffer holds what it rendered (before: nothing) */
     int ran_geometry, ran_lighting; /* particle: the stages this render ran (the view stage always runs) */
+    int has_detp;
+    pm_detp_stats detp;
     gi_particle *kept;        /* particle with opts.keep: the GI, the caller frees it */
     /* Light the scene uses that the mode does not carry (each also warned
      * once): 1 where it is left out. path, pmfg: participating media
@@ -71,6 +80,9 @@ typedef struct {
 
 pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb, render_gi_result *r,
                     diag *d);
+/* The DETP state for the frames of one animation, with o's settings
+ * (photons, radius, seed, threads, full); NULL on no memory. */
+pm_detp *render_gi_detp_new(const render_gi_opts *o);
 /* Adds the method-specific object ("particle": {...}, "reference": {...}). */
 void render_gi_json(const render_gi_result *r, int mode, stats_json *js);
 

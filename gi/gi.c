@@ -2,13 +2,14 @@
 #include "gi.h"
 #include <string.h>
 
-static const char *const names[] = {"none", "particle", "pmfg", "path"};
+static const char *const names[] = {"none", "particle", "pmfg", "path", "detp"};
+#define NMODES ((int)(sizeof names / sizeof names[0]))
 
-const char *gi_mode_name(gi_mode m) { return (unsigned)m < 4u ? names[m] : "?"; }
+const char *gi_mode_name(gi_mode m) { return (unsigned)m < (unsigned)NMODES ? names[m] : "?"; }
 
 int gi_mode_parse(const char *s)
 {
-    for (int i = 0; i < 4; i++)
+    for (int i = 0; i < NMODES; i++)
         if (strcmp(s, names[i]) == 0) return i;
     return -1;
 }

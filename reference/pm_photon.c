@@ -312,7 +312,7 @@ static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume,
     vec3 w = L.w;
     rgb phi = L.phi;
     int from_light = src->kind == SRC_LIGHT;
-    int store_first = src->kind == SRC_ENV;
+    int store_first = src->kind == SRC_ENV || (src->kind == SRC_EMIT && c->s->emitters_first);
     int spec_only = L.spec_only;
     int nd = L.nd;
     /* light_group: a light's photons land only on what it lights (its

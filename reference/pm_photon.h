@@ -54,6 +54,8 @@ typedef struct {
     int threads;
     volatile int *cancel;
     progress *progress;  /* its current stage counts the chunks of photon paths traced (NULL: none) */
+    int emitters_first;  /* 1: emissive surfaces' photons carry light from their first hit, as the
+                            background's do (an estimator without next-event estimation of emitters) */
 } pm_photon_settings;
 
 typedef struct {

@@ -1,0 +1,974 @@
+/* pm_detp.c - incremental photon paths and the DETP estimator (see pm_detp.h).
+ *
+ * Per frame:
+ *  1. leaves: every leaf object (CSG members included) gets an index, the
+ *     same in every frame of one scene file while the object structure
+ *     does not change; each top-level object a hash of its geometry and
+ *     transform; "moving" = hash differs from the previous frame's.
+ *  2. receivers: the camera ray through every pixel centre; a pixel whose
+ *     hit has the same leaf, point and normal (bitwise) on an object that
+ *     did not move keeps its sum, every other one is estimated anew.
+ *  3. paths (seed 004, Fig 2.2): a path's segments are walked in order; a
+ *     segment is invalid when its stored hit is on a moving object or when
+ *     it now meets one (a query against an accel of the moving objects
+ *     only, up to the stored hit). The first invalid segment and the rest
+ *     of the path are old (their shares leave the kept receivers' sums);
+ *     the path is traced on from that segment's launch (pm_photon_walk) and
+ *     the new segments' shares enter the sums.
+ *  4. the receivers estimated anew take the shares of all segments.
+ *
+ * A segment's share at a receiver (x, n) is Phi / (pi r^2) per channel when
+ * it arrives at the front of n, crosses the tangent plane within its length
+ * (up to the stored hit, which lies on the receiver's surface for the
+ * segments that end there) and within r of x (seed 004 section 1.5; the
+ * paper's border correction is not applied). The share is quantised to an
+ * integer once (qscale), so sums are exact and independent of order.
+ *
+ * Segments and receivers meet through a uniform grid of the receivers'
+ * discs (seed 004 section 1.7, disc indexing): a segment walks the cells it
+ * crosses (Amanatides and Woo) and tests each receiver there once. The
+ * grid only proposes candidates: the test itself is the same whatever grid
+ * proposed them, which the exactness above needs. */
+#include "pm_detp.h"
+#include <math.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include "camera.h"
+#include "hash.h"
+#include "pm_nee.h"
+#include "pm_photon.h"
+#include "pool.h"
+#include "radrules.h"
+#include "shade_material.h"
+#include "timer.h"
+
+#define PATH_CHUNK 256
+#define SEG_CHUNK 4096
+#define MAX_CELLS (1 << 21)
+/* How far past its hit (in disc radii) a segment goes on for receivers on
+ * the object it hit: the same in share() and in the walk that proposes
+ * them, so that what a receiver takes does not depend on the grid */
+#define SAME_OBJECT_RUN 4.0
+
+/* One stored segment of a photon path. */
+typedef struct {
+    pm_photon_launch l;
+    double t;          /* distance to its hit; INFINITY: it left the scene */
+    rgb carried;       /* the power receivers it crosses take */
+    int hit_leaf;      /* leaf index of the hit, -1 none, -2 a leaf not enumerated */
+    int from_leaf;     /* leaf index of l.from.obj, -1 none, -2 not enumerated */
+} seg;
+
+typedef struct {
+    vec3 p, n;         /* hit point and the normal facing the camera */
+    int leaf;          /* -1: no hit (no receiver) */
+} receiver;
+
+/* Receivers' discs in a uniform grid (CSR cell lists). */
+typedef struct {
+    vec3 lo;
+    double cell;
+    int nx, ny, nz;
+    int *off, *idx;
+} rgrid;
+
+struct pm_detp {
+    pm_detp_settings s;
+    int have;                  /* a previous frame is kept */
+    int init;                  /* bounds, radius and the share scale are set (first frame) */
+    vec3 bounds[2];            /* first frame's: the photon sources' allocation */
+    double radius, qscale, eps;
+    /* the previous frame's objects */
+    uint64_t *obj_hash;
+    int nobj;
+    int nleaves;
+    /* paths: segments of path i are segs[poff[i] .. poff[i+1]) */
+    long npaths;
+    long *poff;
+    seg *segs;
+    /* receivers, one per pixel, and their sums */
+    int w, h;
+    receiver *rec;
+    _Atomic int64_t *E;
+    rgrid look;                /* all receivers: the hook's lookup */
+    const scene *sc;
+};
+
+/* ------------------------------------------------------------ objects */
+
+typedef struct {
+    const scene_object **leaf;
+    int *top;                 /* top-level object of each leaf */
+    int n, cap;
+    /* pointer -> leaf index, open addressing */
+    const scene_object **key;
+    int *val;
+    unsigned mask;
+} leaves;
+
+static int leaves_push(leaves *L, const scene_object *o, int top)
+{
+    if (L->n == L->cap) {
+        int nc = L->cap ? 2 * L->cap : 64;
+        const scene_object **nl = realloc(L->leaf, sizeof *nl * (size_t)nc);
+        if (!nl) return 0;
+        L->leaf = nl;
+        int *nt = realloc(L->top, sizeof *nt * (size_t)nc);
+        if (!nt) return 0;
+        L->top = nt;
+        L->cap = nc;
+    }
+    L->leaf[L->n] = o;
+    L->top[L->n] = top;
+    L->n++;
+    return 1;
+}
+
+static int is_csg(const scene_object *o)
+{
+    return o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE;
+}
+
+static int leaves_walk(leaves *L, const scene_object *o, int top)
+{
+    if (is_csg(o)) {
+        for (int i = 0; i < o->u.csg.nkids; i++)
+            if (!leaves_walk(L, o->u.csg.kids[i], top)) return 0;
+        return 1;
+    }
+    return leaves_push(L, o, top);
+}
+
+static int leaves_make(leaves *L, const scene *sc)
+{
+    memset(L, 0, sizeof *L);
+    for (int i = 0; i < sc->nobjects; i++)
+        if (!leaves_walk(L, sc->objects[i], i)) return 0;
+    unsigned sz = 16;
+    while (sz < 2u * (unsigned)L->n + 16u) sz <<= 1;
+    L->mask = sz - 1;
+    L->key = calloc(sz, sizeof *L->key);
+    L->val = malloc(sizeof *L->val * sz);
+    if (!L->key || !L->val) return 0;
+    for (int i = 0; i < L->n; i++) {
+        unsigned k = pt_ptr_hash(L->leaf[i]) & L->mask;
+        while (L->key[k] && L->key[k] != L->leaf[i]) k = (k + 1) & L->mask;
+        if (!L->key[k]) {
+            L->key[k] = L->leaf[i];
+            L->val[k] = i;
+        }
+    }
+    return 1;
+}
+
+static int leaves_find(const leaves *L, const scene_object *o)
+{
+    if (!o) return -1;
+    unsigned k = pt_ptr_hash(o) & L->mask;
+    while (L->key[k]) {
+        if (L->key[k] == o) return L->val[k];
+        k = (k + 1) & L->mask;
+    }
+    return -2;
+}
+
+static void leaves_free(leaves *L)
+{
+    free(L->leaf);
+    free(L->top);
+    free(L->key);
+    free(L->val);
+}
+
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 0x100000001b3ULL;
+    return h;
+}
+
+/* Hash of what decides where an object's surfaces are. *opaque is set when
+ * the shape keeps its data where this does not look (then the object can
+ * not be told unchanged). */
+static uint64_t obj_hash(uint64_t h, const scene_object *o, int *opaque)
+{
+    h = fnv(h, &o->kind, sizeof o->kind);
+    h = fnv(h, o->transform.m, sizeof o->transform.m);
+    h = fnv(h, &o->flags, sizeof o->flags);
+    switch (o->kind) {
+    case SHAPE_SPHERE: h = fnv(h, &o->u.sphere, sizeof o->u.sphere); break;
+    case SHAPE_BOX: h = fnv(h, &o->u.box, sizeof o->u.box); break;
+    case SHAPE_PLANE: h = fnv(h, &o->u.plane, sizeof o->u.plane); break;
+    case SHAPE_TRIANGLE:
+    case SHAPE_SMOOTH_TRIANGLE: h = fnv(h, &o->u.triangle, sizeof o->u.triangle); break;
+    case SHAPE_CYLINDER:
+    case SHAPE_CONE: h = fnv(h, &o->u.cone, sizeof o->u.cone); break;
+    case SHAPE_DISC: h = fnv(h, &o->u.disc, sizeof o->u.disc); break;
+    case SHAPE_TORUS: h = fnv(h, &o->u.torus, sizeof o->u.torus); break;
+    case SHAPE_SUPERELLIPSOID: h = fnv(h, &o->u.superellipsoid, sizeof o->u.superellipsoid); break;
+    case SHAPE_QUADRIC: h = fnv(h, &o->u.quadric, sizeof o->u.quadric); break;
+    case SHAPE_OVUS: h = fnv(h, &o->u.ovus, sizeof o->u.ovus); break;
+    case SHAPE_MESH: {
+        const scene_mesh *m = o->u.mesh.mesh;
+        if (!m) break;
+        h = fnv(h, &m->nverts, sizeof m->nverts);
+        h = fnv(h, &m->ntris, sizeof m->ntris);
+        if (m->verts) h = fnv(h, m->verts, sizeof *m->verts * (size_t)m->nverts);
+        if (m->tris) h = fnv(h, m->tris, sizeof *m->tris * (size_t)m->ntris);
+        if (m->normals) h = fnv(h, m->normals, sizeof *m->normals * (size_t)m->nnormals);
+        break;
+    }
+    case SHAPE_UNION:
+    case SHAPE_MERGE:
+    case SHAPE_INTERSECTION:
+    case SHAPE_DIFFERENCE:
+        h = fnv(h, &o->u.csg.nkids, sizeof o->u.csg.nkids);
+        for (int i = 0; i < o->u.csg.nkids; i++) h = obj_hash(h, o->u.csg.kids[i], opaque);
+        break;
+    default: *opaque = 1; break;
+    }
+    if (o->clip) h = obj_hash(h ^ 0x636c6970ULL, o->clip, opaque);
+    if (o->bound) h = obj_hash(h ^ 0x626f756eULL, o->bound, opaque);
+    return h;
+}
+
+/* Whether an object (or a member) emits light: it is then a light source
+ * of the photons, and moving it moves a light. */
+static int obj_emits(const scene *sc, const scene_object *o)
+{
+    if (is_csg(o)) {
+        for (int i = 0; i < o->u.csg.nkids; i++)
+            if (obj_emits(sc, o->u.csg.kids[i])) return 1;
+        return 0;
+    }
+    const scene_texture *t = o->texture ? o->texture : &sc->default_texture;
+    rgb e = shade_mat_texture_emission(sc, t);
+    if (e.r > 0.0 || e.g > 0.0 || e.b > 0.0) return 1;
+    if (o->kind == SHAPE_MESH && o->u.mesh.mesh)
+        for (int i = 0; i < o->u.mesh.mesh->ntextures; i++) {
+            rgb m = shade_mat_texture_emission(sc, o->u.mesh.mesh->textures[i]);
+            if (m.r > 0.0 || m.g > 0.0 || m.b > 0.0) return 1;
+        }
+    return 0;
+}
+
+/* ------------------------------------------------------------ receivers' grid */
+
+static void rgrid_free(rgrid *g)
+{
+    free(g->off);
+    free(g->idx);
+    memset(g, 0, sizeof *g);
+}
+
+static int clampi(double v, int n)
+{
+    if (!(v > 0.0)) return 0;
+    if (v >= (double)(n - 1)) return n - 1;
+    return (int)v;
+}
+
+/* The discs (radius r, plus a margin of a quarter cell so that a walk
+ * that rounds at a cell corner still finds them) of the receivers with
+ * pick[i] set (pick NULL: all with a hit). 0 on failure (no memory). */
+static int rgrid_build(rgrid *g, const receiver *rec, long n, const unsigned char *pick, double r)
+{
+    memset(g, 0, sizeof *g);
+    vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
+    long cnt = 0;
+    for (long i = 0; i < n; i++) {
+        if (rec[i].leaf < 0 || (pick && !pick[i])) continue;
+        lo = v3_min(lo, rec[i].p);
+        hi = v3_max(hi, rec[i].p);
+        cnt++;
+    }
+    if (cnt == 0) return 1;
+    double cell = 2.0 * r;
+    vec3 ext = v3_sub(hi, lo);
+    for (;;) {
+        double cells = (floor(ext.x / cell) + 3.0) * (floor(ext.y / cell) + 3.0) * (floor(ext.z / cell) + 3.0);
+        if (cells <= MAX_CELLS) break;
+        cell *= 1.25;
+    }
+    double m = r + 0.25 * cell;
+    g->cell = cell;
+    g->lo = v3_sub(lo, v3(m, m, m));
+    g->nx = (int)floor((ext.x + 2.0 * m) / cell) + 1;
+    g->ny = (int)floor((ext.y + 2.0 * m) / cell) + 1;
+    g->nz = (int)floor((ext.z + 2.0 * m) / cell) + 1;
+    size_t nc = (size_t)g->nx * g->ny * g->nz;
+    g->off = calloc(nc + 1, sizeof *g->off);
+    if (!g->off) return 0;
+    for (int pass = 0; pass < 2; pass++) {
+        for (long i = 0; i < n; i++) {
+            if (rec[i].leaf < 0 || (pick && !pick[i])) continue;
+            vec3 p = rec[i].p;
+            int x0 = clampi((p.x - m - g->lo.x) / cell, g->nx), x1 = clampi((p.x + m - g->lo.x) / cell, g->nx);
+            int y0 = clampi((p.y - m - g->lo.y) / cell, g->ny), y1 = clampi((p.y + m - g->lo.y) / cell, g->ny);
+            int z0 = clampi((p.z - m - g->lo.z) / cell, g->nz), z1 = clampi((p.z + m - g->lo.z) / cell, g->nz);
+            for (int z = z0; z <= z1; z++)
+                for (int y = y0; y <= y1; y++)
+                    for (int x = x0; x <= x1; x++) {
+                        size_t c = ((size_t)z * g->ny + y) * g->nx + x;
+                        if (pass == 0) g->off[c + 1]++;
+                        else g->idx[g->off[c]++] = (int)i;
+                    }
+        }
+        if (pass == 0) {
+            for (size_t c = 0; c < nc; c++) g->off[c + 1] += g->off[c];
+            g->idx = malloc(sizeof *g->idx * (size_t)(g->off[nc] > 0 ? g->off[nc] : 1));
+            if (!g->idx) return 0;
+        } else {
+            for (size_t c = nc; c > 0; c--) g->off[c] = g->off[c - 1];
+            g->off[0] = 0;
+        }
+    }
+    return 1;
+}
+
+/* ------------------------------------------------------------ shares */
+
+typedef struct {
+    const pm_detp *dp;
+    int sign;
+    unsigned *stamp;   /* per receiver: the last segment that tested it (this thread's) */
+    unsigned stamp_id;
+} applier;
+
+/* The share of segment s at receiver r, quantised; 0 when s does not cross
+ * r's disc. A function of the two alone. */
+static int share(const pm_detp *dp, const seg *s, const receiver *r, int64_t q[3])
+{
+    double dn = v3_dot(s->l.w, r->n);
+    if (!(dn < 0.0)) return 0;
+    double t = v3_dot(v3_sub(r->p, s->l.o), r->n) / dn;
+    /* a segment that ends on the receiver's own object goes on through it
+     * (seed 004 section 1.5, artifact control on concave surfaces: inside
+     * a curved surface the tangent plane lies beyond the surface) */
+    double tmax = s->t * (1.0 + 1e-6) + dp->eps + (s->hit_leaf == r->leaf ? SAME_OBJECT_RUN * dp->radius : 0.0);
+    if (!(t > 0.0) || !(t <= tmax)) return 0;
+    vec3 d = v3_sub(v3_madd(s->l.o, s->l.w, t), r->p);
+    if (!(v3_dot(d, d) < dp->radius * dp->radius)) return 0;
+    double k = dp->qscale / (M_PI * dp->radius * dp->radius);
+    q[0] = (int64_t)llround(s->carried.r * k);
+    q[1] = (int64_t)llround(s->carried.g * k);
+    q[2] = (int64_t)llround(s->carried.b * k);
+    return 1;
+}
+
+/* Adds sign * the share of s to every receiver of grid g it crosses. */
+static void apply_seg(applier *ap, const rgrid *g, const seg *s)
+{
+    const pm_detp *dp = ap->dp;
+    if (!g->off || !(s->carried.r > 0.0 || s->carried.g > 0.0 || s->carried.b > 0.0)) return;
+    if (++ap->stamp_id == 0) {
+        memset(ap->stamp, 0, sizeof *ap->stamp * (size_t)dp->w * dp->h);
+        ap->stamp_id = 1;
+    }
+    /* clip to the grid's box */
+    vec3 o = s->l.o, w = s->l.w;
+    /* past the hit only the hit object's own receivers take it (share),
+     * within the disc radius of where it crosses their planes */
+    double t0 = 0.0, t1 = s->t * (1.0 + 1e-6) + dp->eps;
+    if (s->hit_leaf >= 0) t1 += SAME_OBJECT_RUN * dp->radius;
+    double lo[3] = {g->lo.x, g->lo.y, g->lo.z};
+    double hi[3] = {g->lo.x + g->nx * g->cell, g->lo.y + g->ny * g->cell, g->lo.z + g->nz * g->cell};
+    double oo[3] = {o.x, o.y, o.z}, ww[3] = {w.x, w.y, w.z};
+    for (int k = 0; k < 3; k++) {
+        if (ww[k] == 0.0) {
+            if (oo[k] < lo[k] || oo[k] > hi[k]) return;
+            continue;
+        }
+        double a = (lo[k] - oo[k]) / ww[k], b = (hi[k] - oo[k]) / ww[k];
+        if (a > b) {
+            double tmp = a;
+            a = b;
+            b = tmp;
+        }
+        if (a > t0) t0 = a;
+        if (b < t1) t1 = b;
+    }
+    if (!(t0 <= t1)) return;
+    int n[3] = {g->nx, g->ny, g->nz}, c[3], step[3];
+    double tnext[3], tdelta[3];
+    for (int k = 0; k < 3; k++) {
+        double p = oo[k] + ww[k] * t0;
+        c[k] = clampi((p - lo[k]) / g->cell, n[k]);
+        if (ww[k] > 0.0) {
+            step[k] = 1;
+            tnext[k] = (lo[k] + (c[k] + 1) * g->cell - oo[k]) / ww[k];
+            tdelta[k] = g->cell / ww[k];
+        } else if (ww[k] < 0.0) {
+            step[k] = -1;
+            tnext[k] = (lo[k] + c[k] * g->cell - oo[k]) / ww[k];
+            tdelta[k] = -g->cell / ww[k];
+        } else {
+            step[k] = 0;
+            tnext[k] = INFINITY;
+            tdelta[k] = INFINITY;
+        }
+    }
+    for (;;) {
+        size_t ci = ((size_t)c[2] * g->ny + c[1]) * g->nx + c[0];
+        for (int q = g->off[ci]; q < g->off[ci + 1]; q++) {
+            int ri = g->idx[q];
+            if (ap->stamp[ri] == ap->stamp_id) continue;
+            ap->stamp[ri] = ap->stamp_id;
+            int64_t v[3];
+            if (!share(dp, s, &dp->rec[ri], v)) continue;
+            for (int k = 0; k < 3; k++) atomic_fetch_add_explicit(&dp->E[(size_t)ri * 3 + k], ap->sign * v[k], memory_order_relaxed);
+        }
+        int k = tnext[0] < tnext[1] ? (tnext[0] < tnext[2] ? 0 : 2) : (tnext[1] < tnext[2] ? 1 : 2);
+        if (tnext[k] > t1) break;
+        c[k] += step[k];
+        if (c[k] < 0 || c[k] >= n[k]) break;
+        tnext[k] += tdelta[k];
+    }
+}
+
+/* ------------------------------------------------------------ frame */
+
+typedef struct {
+    seg *v;
+    long n, cap;
+    int oom;
+} segvec;
+
+static void segvec_push(segvec *sv, const seg *s)
+{
+    if (sv->oom) return;
+    if (sv->n == sv->cap) {
+        long nc = sv->cap ? 2 * sv->cap : 64;
+        seg *nv = realloc(sv->v, sizeof *nv * (size_t)nc);
+        if (!nv) {
+            sv->oom = 1;
+            return;
+        }
+        sv->v = nv;
+        sv->cap = nc;
+    }
+    sv->v[sv->n++] = *s;
+}
+
+typedef struct {
+    pm_detp *dp;
+    const scene *sc;
+    const accel *a;
+    const accel *mob;             /* moving objects only (NULL: none) */
+    const pm_photon_walker *wk;
+    const leaves *lv;
+    const unsigned char *moving;  /* per leaf */
+    const seg *old;               /* previous frame's segments (NULL: a full frame) */
+    const long *old_off;
+    const rgrid *ginc;            /* receivers that keep their sums */
+    int nthreads;
+    applier *ap_minus, *ap_plus;  /* per thread */
+    segvec *out;                  /* per chunk */
+    long *path_n;                 /* segments of each path, this frame */
+    long chunks;
+    _Atomic long retraced, nold, nnew, rays;
+    /* filled while walking one path */
+} frame_ctx;
+
+typedef struct {
+    frame_ctx *fc;
+    segvec *out;
+    applier *plus;
+    long count;
+} walk_sink;
+
+static void on_seg(void *ctx, long index, const pm_photon_launch *l, const accel_hit *h, rgb carried)
+{
+    (void)index;
+    walk_sink *ws = ctx;
+    seg s;
+    memset(&s, 0, sizeof s);
+    s.l = *l;
+    s.t = h ? h->t : INFINITY;
+    s.carried = carried;
+    s.hit_leaf = h ? leaves_find(ws->fc->lv, h->obj) : -1;
+    s.from_leaf = l->from.obj ? leaves_find(ws->fc->lv, l->from.obj) : -1;
+    segvec_push(ws->out, &s);
+    ws->count++;
+    if (ws->plus) apply_seg(ws->plus, ws->fc->ginc, &s);
+}
+
+/* Whether stored segment s is still what tracing it now gives. */
+static int seg_valid(const frame_ctx *fc, const seg *s, long *rays)
+{
+    if (s->hit_leaf == -2 || s->from_leaf == -2) return 0;
+    if (s->hit_leaf >= 0 && fc->moving[s->hit_leaf]) return 0;
+    if (!fc->mob) return 1;
+    accel_hit h;
+    (*rays)++;
+    /* up to a little past the stored hit: a tie is taken as a change */
+    double tmax = isfinite(s->t) ? s->t * (1.0 + 1e-7) + fc->dp->eps : INFINITY;
+    if (s->l.from.obj && s->from_leaf >= 0) {
+        accel_from f = s->l.from;
+        f.obj = fc->lv->leaf[s->from_leaf];
+        return !accel_intersect_from(fc->mob, &f, s->l.o, s->l.w, 0.0, tmax, &h);
+    }
+    return !accel_intersect(fc->mob, s->l.o, s->l.w, 0.0, tmax, &h);
+}
+
+static void path_job(void *ctx, int ci, int thread)
+{
+    frame_ctx *fc = ctx;
+    if (fc->dp->s.cancel && *fc->dp->s.cancel) return;
+    long i0 = (long)ci * PATH_CHUNK, i1 = i0 + PATH_CHUNK < fc->dp->npaths ? i0 + PATH_CHUNK : fc->dp->npaths;
+    segvec *out = &fc->out[ci];
+    long rays = 0, retraced = 0, nold = 0, nnew = 0;
+    for (long i = i0; i < i1; i++) {
+        walk_sink ws = {fc, out, NULL, 0};
+        if (!fc->old) {
+            pm_photon_walk(fc->wk, i, NULL, on_seg, &ws, &rays);
+            fc->path_n[i] = ws.count;
+            retraced++;
+            continue;
+        }
+        const seg *ps = fc->old + fc->old_off[i];
+        long n = fc->old_off[i + 1] - fc->old_off[i], k = 0;
+        while (k < n && seg_valid(fc, &ps[k], &rays)) k++;
+        if (k < n) {
+            pm_photon_launch l = ps[k].l;
+            /* resumed at segment k, or traced again from the source (when
+             * k is 0, or its surface is not known in this frame) */
+            int resume = k > 0 && l.bounce > 0 && (!l.from.obj || ps[k].from_leaf >= 0);
+            if (!resume) k = 0;
+            if (l.from.obj && ps[k].from_leaf >= 0) l.from.obj = fc->lv->leaf[ps[k].from_leaf];
+            for (long j = 0; j < k; j++) {
+                segvec_push(out, &ps[j]);
+                /* the launch's surface in this frame's scene */
+                if (ps[j].from_leaf >= 0 && !out->oom) out->v[out->n - 1].l.from.obj = fc->lv->leaf[ps[j].from_leaf];
+            }
+            for (long j = k; j < n; j++) apply_seg(&fc->ap_minus[thread], fc->ginc, &ps[j]);
+            nold += n - k;
+            retraced++;
+            ws.plus = &fc->ap_plus[thread];
+            pm_photon_walk(fc->wk, i, resume ? &l : NULL, on_seg, &ws, &rays);
+            nnew += ws.count;
+            fc->path_n[i] = k + ws.count;
+        } else {
+            for (long j = 0; j < n; j++) {
+                segvec_push(out, &ps[j]);
+                if (ps[j].from_leaf >= 0 && !out->oom) out->v[out->n - 1].l.from.obj = fc->lv->leaf[ps[j].from_leaf];
+            }
+            fc->path_n[i] = n;
+        }
+    }
+    atomic_fetch_add(&fc->rays, rays);
+    atomic_fetch_add(&fc->retraced, retraced);
+    atomic_fetch_add(&fc->nold, nold);
+    atomic_fetch_add(&fc->nnew, nnew);
+}
+
+typedef struct {
+    pm_detp *dp;
+    const rgrid *g;
+    applier *ap;
+    long nsegs;
+} full_ctx;
+
+static void full_job(void *ctx, int ci, int thread)
+{
+    full_ctx *f = ctx;
+    long i0 = (long)ci * SEG_CHUNK, i1 = i0 + SEG_CHUNK < f->nsegs ? i0 + SEG_CHUNK : f->nsegs;
+    for (long i = i0; i < i1; i++) apply_seg(&f->ap[thread], f->g, &f->dp->segs[i]);
+}
+
+typedef struct {
+    const scene *sc;
+    const accel *a;
+    const leaves *lv;
+    receiver *rec;
+    int w, h;
+    double eps;
+    _Atomic long rays;
+} cam_ctx;
+
+static void cam_job(void *ctx, int y, int thread)
+{
+    (void)thread;
+    cam_ctx *c = ctx;
+    long rays = 0;
+    for (int x = 0; x < c->w; x++) {
+        receiver *r = &c->rec[(size_t)y * c->w + x];
+        r->leaf = -1;
+        vec3 org, dir;
+        if (!camera_ray(&c->sc->camera, x + 0.5, y + 0.5, c->w, c->h, 0.0, 0.0, &org, &dir)) continue;
+        accel_hit h;
+        rays++;
+        if (!accel_intersect(c->a, org, dir, c->eps, INFINITY, &h)) continue;
+        int leaf = leaves_find(c->lv, h.obj);
+        if (leaf < 0) continue;
+        r->p = h.p;
+        r->n = v3_dot(h.ng, dir) < 0.0 ? h.ng : v3_neg(h.ng);
+        r->leaf = leaf;
+    }
+    atomic_fetch_add(&c->rays, rays);
+}
+
+void pm_detp_default_settings(pm_detp_settings *s)
+{
+    memset(s, 0, sizeof *s);
+    s->photons = PM_DETP_PHOTONS;
+    s->max_bounces = 256;
+    s->seed = 1;
+}
+
+pm_detp *pm_detp_new(const pm_detp_settings *s)
+{
+    pm_detp *dp = calloc(1, sizeof *dp);
+    if (dp) dp->s = *s;
+    return dp;
+}
+
+static void drop_frame(pm_detp *dp)
+{
+    free(dp->segs);
+    free(dp->poff);
+    dp->segs = NULL;
+    dp->poff = NULL;
+    dp->npaths = 0;
+    dp->have = 0;
+}
+
+void pm_detp_free(pm_detp *dp)
+{
+    if (!dp) return;
+    drop_frame(dp);
+    free(dp->obj_hash);
+    free(dp->rec);
+    free((void *)dp->E);
+    rgrid_free(&dp->look);
+    free(dp);
+}
+
+void pm_detp_set_progress(pm_detp *dp, progress *p) { dp->s.progress = p; }
+
+const int64_t *pm_detp_sums(const pm_detp *dp, long *npixels, double *scale)
+{
+    *npixels = (long)dp->w * dp->h;
+    *scale = dp->qscale > 0.0 ? 1.0 / dp->qscale : 0.0;
+    return (const int64_t *)dp->E;
+}
+
+rgb pm_detp_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
+{
+    (void)thread;
+    const pm_detp *dp = ctx;
+    rgb z = {0.0, 0.0, 0.0};
+    const rgrid *g = &dp->look;
+    if (!g->off || !(dp->qscale > 0.0)) return z;
+    vec3 p = hit->p;
+    double fx = (p.x - g->lo.x) / g->cell, fy = (p.y - g->lo.y) / g->cell, fz = (p.z - g->lo.z) / g->cell;
+    if (!(fx >= 0.0 && fy >= 0.0 && fz >= 0.0) || fx >= g->nx || fy >= g->ny || fz >= g->nz) return z;
+    size_t ci = ((size_t)(int)fz * g->ny + (int)fy) * g->nx + (int)fx;
+    int best = -1;
+    double bd = dp->radius * dp->radius;
+    for (int q = g->off[ci]; q < g->off[ci + 1]; q++) {
+        const receiver *r = &dp->rec[g->idx[q]];
+        if (v3_dot(r->n, n) < 0.9) continue;
+        vec3 d = v3_sub(r->p, p);
+        double dd = v3_dot(d, d);
+        if (dd < bd || (dd == 0.0 && best < 0)) {
+            bd = dd;
+            best = g->idx[q];
+        }
+    }
+    if (best < 0) return z;
+    double k = 1.0 / (dp->qscale * M_PI);
+    const _Atomic int64_t *e = &dp->E[(size_t)best * 3];
+    rgb v = {(double)atomic_load_explicit(&e[0], memory_order_relaxed) * k,
+             (double)atomic_load_explicit(&e[1], memory_order_relaxed) * k,
+             (double)atomic_load_explicit(&e[2], memory_order_relaxed) * k};
+    return v;
+}
+
+pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width, int height,
+                        const pm_detp_frame_info *fi, pm_detp_stats *st, diag *d)
+{
+    memset(st, 0, sizeof *st);
+    pt_status status = PT_OK;
+    int nthreads = pm_threads(dp->s.threads);
+    leaves lv;
+    pm_lights *L = NULL;
+    pm_photon_walker *wk = NULL;
+    accel *mob = NULL;
+    unsigned char *moving = NULL, *pick = NULL;
+    uint64_t *hashes = NULL;
+    receiver *rec = NULL;
+    segvec *out = NULL;
+    long *path_n = NULL;
+    applier *aps = NULL;
+    unsigned *stamps = NULL;
+    rgrid ginc, gfull;
+    memset(&ginc, 0, sizeof ginc);
+    memset(&gfull, 0, sizeof gfull);
+    scene mobsc;
+    scene_object **mobobj = NULL;
+    double t0 = timer_now();
+    if (!leaves_make(&lv, sc)) {
+        leaves_free(&lv);
+        return PT_ERR_NOMEM;
+    }
+    st->objects = sc->nobjects;
+    /* 1. what moved */
+    const char *full = NULL;
+    if (!dp->have) full = "first frame";
+    else if (dp->s.full) full = "full recomputation asked for";
+    else if (fi && fi->lights_changed) full = "a light changed";
+    else if (sc->nobjects != dp->nobj || lv.n != dp->nleaves) full = "the objects changed in number";
+    hashes = malloc(sizeof *hashes * (size_t)(sc->nobjects > 0 ? sc->nobjects : 1));
+    moving = calloc((size_t)(lv.n > 0 ? lv.n : 1), 1);
+    mobobj = malloc(sizeof *mobobj * (size_t)(sc->nobjects > 0 ? sc->nobjects : 1));
+    if (!hashes || !moving || !mobobj) {
+        status = PT_ERR_NOMEM;
+        goto done;
+    }
+    int nmob = 0;
+    for (int i = 0; i < sc->nobjects; i++) {
+        int opaque = 0;
+        hashes[i] = obj_hash(0xcbf29ce484222325ULL, sc->objects[i], &opaque);
+        int mv = 0;
+        if (!full && fi && fi->objects_may_change) mv = opaque || hashes[i] != dp->obj_hash[i];
+        if (mv) {
+            mobobj[nmob++] = sc->objects[i];
+            if (obj_emits(sc, sc->objects[i])) full = "an emissive object moved";
+        }
+    }
+    for (int l = 0; l < lv.n; l++)
+        for (int k = 0; k < nmob; k++)
+            if (sc->objects[lv.top[l]] == mobobj[k]) moving[l] = 1;
+    st->moving_objects = nmob;
+    if (!full && nmob > 0) {
+        mobsc = *sc;
+        mobsc.objects = mobobj;
+        mobsc.nobjects = nmob;
+        diag *dq = diag_new();
+        pt_status ms = PT_OK;
+        mob = accel_build(&mobsc, dp->s.threads, dq, &ms);
+        diag_free(dq);
+        if (!mob) {
+            status = ms != PT_OK ? ms : PT_ERR_DEVICE;
+            goto done;
+        }
+    }
+    if (full) drop_frame(dp);
+    st->full_frame = full != NULL;
+    st->full_reason = full;
+
+    /* sources */
+    L = pm_lights_new(sc, a, d, &status);
+    if (!L) goto done;
+    if (!dp->init) {
+        dp->init = 1;
+        accel_bounds(a, &dp->bounds[0], &dp->bounds[1]);
+        double diag_len = v3_len(v3_sub(dp->bounds[1], dp->bounds[0]));
+        if (!(diag_len > 0.0) || !isfinite(diag_len)) diag_len = accel_scale(a);
+        dp->radius = dp->s.radius > 0.0 ? dp->s.radius : PM_DETP_RADIUS * diag_len;
+        dp->eps = 1e-7 * diag_len;
+    }
+    st->radius = dp->radius;
+    pm_photon_settings ps = {dp->s.photons, 0, dp->s.max_bounces > 0 ? dp->s.max_bounces : 256, dp->s.seed, dp->s.threads,
+                             dp->s.cancel, NULL, 1};
+    long npaths = 0;
+    wk = pm_photon_walker_new(sc, a, L, &ps, dp->bounds, &npaths, &status);
+    if (!wk) goto done;
+    if (dp->have && npaths != dp->npaths) {
+        full = "the photon sources changed";
+        st->full_frame = 1;
+        st->full_reason = full;
+        drop_frame(dp);
+    }
+
+    /* 2. receivers */
+    long np = (long)width * height;
+    rec = malloc(sizeof *rec * (size_t)(np > 0 ? np : 1));
+    pick = calloc((size_t)(np > 0 ? np : 1), 1);
+    if (!rec || !pick) {
+        status = PT_ERR_NOMEM;
+        goto done;
+    }
+    cam_ctx cc = {sc, a, &lv, rec, width, height, pm_lights_eps(L), 0};
+    pool_run(nthreads, height, cam_job, &cc);
+    st->rays += atomic_load(&cc.rays);
+    int same_image = dp->have && dp->w == width && dp->h == height && dp->E;
+    if (!same_image) {
+        free((void *)dp->E);
+        dp->E = calloc((size_t)(np > 0 ? np : 1) * 3, sizeof *dp->E);
+        if (!dp->E) {
+            status = PT_ERR_NOMEM;
+            goto done;
+        }
+    }
+    long nfull = 0, nrec = 0;
+    for (long i = 0; i < np; i++) {
+        receiver *r = &rec[i];
+        if (r->leaf < 0) {
+            for (int k = 0; k < 3; k++) atomic_store(&dp->E[i * 3 + k], 0);
+            continue;
+        }
+        nrec++;
+        int keep = same_image && dp->have && dp->rec[i].leaf == r->leaf && !moving[r->leaf] &&
+                   memcmp(&dp->rec[i].p, &r->p, sizeof r->p) == 0 && memcmp(&dp->rec[i].n, &r->n, sizeof r->n) == 0;
+        if (!keep) {
+            pick[i] = 1;
+            nfull++;
+            for (int k = 0; k < 3; k++) atomic_store(&dp->E[i * 3 + k], 0);
+        }
+    }
+    st->receivers = nrec;
+    st->receivers_full = nfull;
+    free(dp->rec);
+    dp->rec = rec;
+    rec = NULL;
+    dp->w = width;
+    dp->h = height;
+    if (dp->have) {
+        unsigned char *inc = malloc((size_t)(np > 0 ? np : 1));
+        if (!inc) {
+            status = PT_ERR_NOMEM;
+            goto done;
+        }
+        for (long i = 0; i < np; i++) inc[i] = !pick[i];
+        int ok = rgrid_build(&ginc, dp->rec, np, inc, dp->radius);
+        free(inc);
+        if (!ok) {
+            status = PT_ERR_NOMEM;
+            goto done;
+        }
+    }
+    if (nfull > 0 && !rgrid_build(&gfull, dp->rec, np, pick, dp->radius)) {
+        status = PT_ERR_NOMEM;
+        goto done;
+    }
+
+    /* 3. paths */
+    aps = calloc((size_t)nthreads * 3, sizeof *aps);
+    stamps = calloc((size_t)nthreads * 3 * (size_t)(np > 0 ? np : 1), sizeof *stamps);
+    path_n = calloc((size_t)(npaths > 0 ? npaths : 1), sizeof *path_n);
+    long nchunks = (npaths + PATH_CHUNK - 1) / PATH_CHUNK;
+    out = calloc((size_t)(nchunks > 0 ? nchunks : 1), sizeof *out);
+    if (!aps || !stamps || !path_n || !out) {
+        status = PT_ERR_NOMEM;
+        goto done;
+    }
+    for (int t = 0; t < nthreads * 3; t++) {
+        aps[t].dp = dp;
+        aps[t].sign = t < nthreads ? -1 : 1;
+        aps[t].stamp = stamps + (size_t)t * (size_t)(np > 0 ? np : 1);
+    }
+    frame_ctx fc;
+    memset(&fc, 0, sizeof fc);
+    fc.dp = dp;
+    fc.sc = sc;
+    fc.a = a;
+    fc.mob = mob;
+    fc.wk = wk;
+    fc.lv = &lv;
+    fc.moving = moving;
+    fc.old = dp->have ? dp->segs : NULL;
+    fc.old_off = dp->poff;
+    fc.ginc = &ginc;
+    fc.nthreads = nthreads;
+    fc.ap_minus = aps;
+    fc.ap_plus = aps + nthreads;
+    fc.out = out;
+    fc.path_n = path_n;
+    dp->npaths = npaths;
+    progress_stage(dp->s.progress, "detp: photon paths", nchunks);
+    pool_run_counted(nthreads, (int)nchunks, path_job, &fc, dp->s.cancel, dp->s.progress);
+    if (dp->s.cancel && *dp->s.cancel) {
+        status = PT_CANCELLED;
+        drop_frame(dp);
+        goto done;
+    }
+    long total = 0;
+    for (long c = 0; c < nchunks; c++) {
+        if (out[c].oom) status = PT_ERR_NOMEM;
+        total += out[c].n;
+    }
+    if (status != PT_OK) {
+        drop_frame(dp);
+        goto done;
+    }
+    seg *segs = malloc(sizeof *segs * (size_t)(total > 0 ? total : 1));
+    long *poff = malloc(sizeof *poff * (size_t)(npaths + 1));
+    if (!segs || !poff) {
+        free(segs);
+        free(poff);
+        status = PT_ERR_NOMEM;
+        drop_frame(dp);
+        goto done;
+    }
+    long k = 0;
+    for (long c = 0; c < nchunks; c++) {
+        if (out[c].n) memcpy(segs + k, out[c].v, sizeof *segs * (size_t)out[c].n);
+        k += out[c].n;
+    }
+    poff[0] = 0;
+    for (long i = 0; i < npaths; i++) poff[i + 1] = poff[i] + path_n[i];
+    free(dp->segs);
+    free(dp->poff);
+    dp->segs = segs;
+    dp->poff = poff;
+    st->paths = npaths;
+    st->segments = total;
+    st->paths_retraced = atomic_load(&fc.retraced);
+    st->segments_old = atomic_load(&fc.nold);
+    st->segments_new = atomic_load(&fc.nnew);
+    st->rays += atomic_load(&fc.rays);
+    st->t_trace = timer_now() - t0;
+
+    /* the share scale, fixed by the first frame's largest share */
+    if (!(dp->qscale > 0.0)) {
+        double mx = 0.0;
+        for (long i = 0; i < total; i++) mx = fmax(mx, fmax(segs[i].carried.r, fmax(segs[i].carried.g, segs[i].carried.b)));
+        double smax = mx / (M_PI * dp->radius * dp->radius);
+        dp->qscale = smax > 0.0 && isfinite(smax) ? ldexp(1.0, 32) / smax : 1.0;
+    }
+
+    /* 4. receivers estimated from all segments */
+    double t1 = timer_now();
+    if (nfull > 0) {
+        full_ctx fx = {dp, &gfull, aps + 2 * nthreads, total};
+        for (int t = 0; t < nthreads; t++) aps[2 * nthreads + t].sign = 1;
+        progress_stage(dp->s.progress, "detp: estimate", (total + SEG_CHUNK - 1) / SEG_CHUNK);
+        pool_run_counted(nthreads, (int)((total + SEG_CHUNK - 1) / SEG_CHUNK), full_job, &fx, dp->s.cancel, dp->s.progress);
+    }
+    st->t_estimate = timer_now() - t1;
+    rgrid_free(&dp->look);
+    if (!rgrid_build(&dp->look, dp->rec, np, NULL, dp->radius)) {
+        status = PT_ERR_NOMEM;
+        drop_frame(dp);
+        goto done;
+    }
+    free(dp->obj_hash);
+    dp->obj_hash = hashes;
+    hashes = NULL;
+    dp->nobj = sc->nobjects;
+    dp->nleaves = lv.n;
+    dp->sc = sc;
+    dp->have = 1;
+done:
+    if (out)
+        for (long c = 0; c < (npaths + PATH_CHUNK - 1) / PATH_CHUNK; c++) free(out[c].v);
+    free(out);
+    free(path_n);
+    free(aps);
+    free(stamps);
+    rgrid_free(&ginc);
+    rgrid_free(&gfull);
+    free(pick);
+    free(rec);
+    free(hashes);
+    free(moving);
+    free(mobobj);
+    pm_photon_walker_free(wk);
+    pm_lights_free(L);
+    accel_free(mob);
+    leaves_free(&lv);
+    return status;
+}
