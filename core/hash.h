@@ -1,6 +1,7 @@
 /* hash.h - integer and pointer hashes for open-addressing tables. */
 #ifndef PT_HASH_H
 #define PT_HASH_H
+#include <stddef.h>
 #include <stdint.h>
 
 /* 32 bits of a pointer, mixed: the first half of MurmurHash3's 64-bit
@@ -23,6 +24,16 @@ static inline uint64_t pt_mix64(uint64_t z)
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
     return z ^ (z >> 31);
+}
+
+/* FNV-1a 64 (Fowler, Noll and Vo: offset basis 0xcbf29ce484222325, prime
+ * 0x100000001b3) of n bytes, continuing from h (PT_FNV1A_BASIS to start). */
+#define PT_FNV1A_BASIS 0xcbf29ce484222325ULL
+static inline uint64_t pt_fnv1a(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 0x100000001b3ULL;
+    return h;
 }
 
 #endif

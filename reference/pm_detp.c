@@ -181,12 +181,7 @@ static void leaves_free(leaves *L)
     free(L->val);
 }
 
-static uint64_t fnv(uint64_t h, const void *p, size_t n)
-{
-    const unsigned char *b = p;
-    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 0x100000001b3ULL;
-    return h;
-}
+#define fnv pt_fnv1a
 
 /* Hash of what decides where an object's surfaces are. *opaque is set when
  * the shape keeps its data where this does not look (then the object can
@@ -730,7 +725,7 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     int nmob = 0;
     for (int i = 0; i < sc->nobjects; i++) {
         int opaque = 0;
-        hashes[i] = obj_hash(0xcbf29ce484222325ULL, sc->objects[i], &opaque);
+        hashes[i] = obj_hash(PT_FNV1A_BASIS, sc->objects[i], &opaque);
         int mv = 0;
         if (!full && fi && fi->objects_may_change) mv = opaque || hashes[i] != dp->obj_hash[i];
         if (mv) {
