@@ -207,8 +207,10 @@ static rgb global_irradiance(const fg_ctx *c, vec3 p, vec3 n, uint32_t surf, int
 }
 
 /* Reflected radiance at a gather hit (not its emission); surf: the key of
- * the side the gather ray arrived at (pm_surface_key). */
-static rgb gather_hit(const fg_ctx *c, const shade_mat_bsdf *b, uint32_t surf, int level, int thread, rng *r, pm_counts *cnt)
+ * the side the gather ray arrived at (pm_surface_key); ng: the gathering
+ * steps taken to reach it (1 for the hit of a gather ray from the eye). */
+static rgb gather_hit(const fg_ctx *c, const shade_mat_bsdf *b, uint32_t surf, int level, int ng, int thread, rng *r,
+                      pm_counts *cnt)
 {
     rgb L = {0, 0, 0};
     if (b->nee) {
@@ -217,13 +219,24 @@ static rgb gather_hit(const fg_ctx *c, const shade_mat_bsdf *b, uint32_t surf, i
         L.g += d.g;
         L.b += d.b;
     }
-    /* the gather hit gathers in its turn (emitters, photon irradiance) only
-     * within recursion_limit; emitters' light is gathered light: brightness */
-    if (c->gathers >= 2 && (b->m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 || b->m[SHADE_MAT_LOBE_BACK] > 0.0)) {
-        rgb d = pm_direct_emitters(c->L, b, 1, 0.0, 0.0, r, &cnt->shadow);
-        L.r += d.r * c->rr.brightness;
-        L.g += d.g * c->rr.brightness;
-        L.b += d.b * c->rr.brightness;
+    /* The hit gathers in its turn (emitters, photon irradiance, its glossy
+     * lobe) only within recursion_limit. Its specular lobes and, when it may
+     * gather, its glossy lobe are followed by one ray chosen by Russian
+     * roulette; pg is the probability that the glossy one is, the density
+     * the emitter samples are weighted against (pm_nee.h). */
+    const int can_gather = ng + 1 <= c->gathers;
+    const double mg = can_gather ? b->m[SHADE_MAT_LOBE_GLOSSY] : 0.0;
+    const double ms = b->m[SHADE_MAT_LOBE_REFLECT] + b->m[SHADE_MAT_LOBE_TRANSMIT] + mg;
+    const int follow = ms > 0.0 && level < c->s->max_gather_depth && level < c->gather_specular;
+    const double q = fmin(1.0, ms);
+    const double pg = follow ? q * mg / ms : 0.0;
+    const double br = c->rr.brightness;
+    if (can_gather && (b->m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 || b->m[SHADE_MAT_LOBE_BACK] > 0.0 || mg > 0.0)) {
+        /* emitters' light is gathered light: brightness */
+        rgb d = pm_direct_emitters(c->L, b, 1, 0.0, 0.0, pg, r, &cnt->shadow);
+        L.r += d.r * br;
+        L.g += d.g * br;
+        L.b += d.b * br;
         if (b->m[SHADE_MAT_LOBE_DIFFUSE] > 0.0) {
             rgb e = global_irradiance(c, b->p, b->n, surf, thread, &cnt->shadow);
             acc_add(&L, b->k[SHADE_MAT_LOBE_DIFFUSE], frgb(e.r / M_PI, e.g / M_PI, e.b / M_PI));
@@ -233,31 +246,91 @@ static rgb gather_hit(const fg_ctx *c, const shade_mat_bsdf *b, uint32_t surf, i
             acc_add(&L, b->k[SHADE_MAT_LOBE_BACK], frgb(e.r / M_PI, e.g / M_PI, e.b / M_PI));
         }
     }
-    double ms = b->m[SHADE_MAT_LOBE_REFLECT] + b->m[SHADE_MAT_LOBE_TRANSMIT];
-    if (ms > 0.0 && level < c->s->max_gather_depth && level < c->gather_specular) {
-        double q = fmin(1.0, ms);
-        if (rng_f64(r) < q) {
-            int lobe = rng_f64(r) * ms < b->m[SHADE_MAT_LOBE_REFLECT] ? SHADE_MAT_LOBE_REFLECT : SHADE_MAT_LOBE_TRANSMIT;
-            double p = q * b->m[lobe] / ms;
-            rgb w = b->k[lobe];
-            w = frgb(w.r / p, w.g / p, w.b / p);
-            vec3 org = lobe == SHADE_MAT_LOBE_REFLECT ? b->p_out : b->p_in;
-            vec3 dir = lobe == SHADE_MAT_LOBE_REFLECT ? b->refl_dir : b->trans_dir;
-            cnt->bsdf++;
-            accel_hit h;
-            unsigned skip = OBJ_NO_RADIOSITY | (lobe == SHADE_MAT_LOBE_REFLECT ? OBJ_NO_REFLECTION : 0u);
-            if (!trace_skip(c, &b->from, org, dir, skip, &h)) {
-                acc_add(&L, w, pm_sky(c->sc, dir));
-            } else {
-                shade_mat_bsdf b2;
-                shade_mat_setup(&b2, c->sc, &h, dir, c->eps, r);
-                b2.gathered = 1;
-                acc_add(&L, w, b2.emission);
-                acc_add(&L, w, gather_hit(c, &b2, pm_surface_key(h.obj, b2.entering), level + 1, thread, r, cnt));
-            }
+    if (follow && rng_f64(r) < q) {
+        double u = rng_f64(r) * ms;
+        int lobe = u < b->m[SHADE_MAT_LOBE_REFLECT] ? SHADE_MAT_LOBE_REFLECT
+                   : u < b->m[SHADE_MAT_LOBE_REFLECT] + b->m[SHADE_MAT_LOBE_TRANSMIT] ? SHADE_MAT_LOBE_TRANSMIT
+                                                                                    : SHADE_MAT_LOBE_GLOSSY;
+        if (b->m[lobe] <= 0.0) return L; /* rounding at an interval's end */
+        double p = lobe == SHADE_MAT_LOBE_GLOSSY ? pg : q * b->m[lobe] / ms;
+        rgb w = b->k[lobe];
+        vec3 org = lobe == SHADE_MAT_LOBE_TRANSMIT ? b->p_in : b->p_out;
+        vec3 dir = lobe == SHADE_MAT_LOBE_REFLECT ? b->refl_dir : b->trans_dir;
+        double pdf = 0.0;
+        if (lobe == SHADE_MAT_LOBE_GLOSSY) {
+            shade_mat_scatter s;
+            if (!shade_mat_sample_glossy(b, rng_f64(r), rng_f64(r), rng_f64(r), &s)) return L;
+            w = frgb(s.weight.r * br, s.weight.g * br, s.weight.b * br);
+            org = s.org;
+            dir = s.dir;
+            pdf = s.pdf;
+        }
+        w = frgb(w.r / p, w.g / p, w.b / p);
+        cnt->bsdf++;
+        accel_hit h;
+        unsigned skip = OBJ_NO_RADIOSITY | (lobe == SHADE_MAT_LOBE_REFLECT ? OBJ_NO_REFLECTION : 0u);
+        if (!trace_skip(c, &b->from, org, dir, skip, &h)) {
+            acc_add(&L, w, pm_sky(c->sc, dir));
+        } else {
+            shade_mat_bsdf b2;
+            shade_mat_setup(&b2, c->sc, &h, dir, c->eps, r);
+            b2.gathered = 1;
+            double we = lobe == SHADE_MAT_LOBE_GLOSSY ? pm_mis(pg * pdf, pm_emitter_density(c->L, &h, org, 1)) : 1.0;
+            acc_add(&L, w, frgb(b2.emission.r * we, b2.emission.g * we, b2.emission.b * we));
+            acc_add(&L, w, gather_hit(c, &b2, pm_surface_key(h.obj, b2.entering), level + 1,
+                                      lobe == SHADE_MAT_LOBE_GLOSSY ? ng + 1 : ng, thread, r, cnt));
         }
     }
     return L;
+}
+
+/* Radiance arriving at an eye vertex along the gather ray (org, w): its
+ * emission, weighted against the emitter samples taken there by the power
+ * heuristic (cb: the gather strategy's count-weighted density of w), plus
+ * what the hit reflects (gather_hit). */
+static rgb gather_ray(const fg_ctx *c, const shade_mat_bsdf *b, vec3 org, vec3 w, double cb, int thread, rng *r,
+                      pm_counts *cnt)
+{
+    rgb sum = {0, 0, 0};
+    cnt->gather++;
+    accel_hit h;
+    int hit = trace_skip(c, &b->from, org, w, OBJ_NO_RADIOSITY, &h);
+    rgb fa = {1, 1, 1};
+    if (c->rr.media && c->sc->fogs) {
+        /* `media on`: gathering rays see fog too (radrules.h rule 5) */
+        rgb fc;
+        shade_atmos_fog_affine(c->sc, org, w, hit ? h.t : INFINITY, &fa, &fc);
+        sum = fc;
+    }
+    if (!hit) {
+        acc_add(&sum, fa, pm_sky(c->sc, w));
+        return sum;
+    }
+    shade_mat_bsdf b2;
+    shade_mat_setup(&b2, c->sc, &h, w, c->eps, r);
+    b2.gathered = 1;
+    rgb le = b2.emission;
+    if (le.r != 0.0 || le.g != 0.0 || le.b != 0.0) {
+        double wt = pm_mis(cb, pm_emitter_density(c->L, &h, org, c->s->emitter_samples));
+        acc_add(&sum, fa, frgb(le.r * wt, le.g * wt, le.b * wt));
+    }
+    acc_add(&sum, fa, gather_hit(c, &b2, pm_surface_key(h.obj, b2.entering), 0, 1, thread, r, cnt));
+    return sum;
+}
+
+/* Stratum i of n on a g1 x g2 grid of the unit square (the remainder uniform). */
+static void gather_stratum(int i, int n, rng *r, double *u1, double *u2)
+{
+    int g1 = (int)floor(sqrt((double)n));
+    if (g1 < 1) g1 = 1;
+    int g2 = n / g1;
+    if (i < g1 * g2) {
+        *u1 = ((i % g1) + rng_f64(r)) / g1;
+        *u2 = ((i / g1) + rng_f64(r)) / g2;
+    } else {
+        *u1 = rng_f64(r);
+        *u2 = rng_f64(r);
+    }
 }
 
 /* (1/n) sum of radiance over n stratified cosine directions about `axis`. */
@@ -266,56 +339,33 @@ static rgb gather_lobe(const fg_ctx *c, const shade_mat_bsdf *b, vec3 axis, vec3
 {
     rgb sum = {0, 0, 0};
     if (n <= 0) return sum;
-    int g1 = (int)floor(sqrt((double)n));
-    if (g1 < 1) g1 = 1;
-    int g2 = n / g1;
     for (int i = 0; i < n; i++) {
         double u1, u2;
-        if (i < g1 * g2) {
-            u1 = ((i % g1) + rng_f64(r)) / g1;
-            u2 = ((i / g1) + rng_f64(r)) / g2;
-        } else {
-            u1 = rng_f64(r);
-            u2 = rng_f64(r);
-        }
+        gather_stratum(i, n, r, &u1, &u2);
         vec3 w = shade_mat_cosine_dir(axis, u1, u2);
         double cg = v3_dot(w, b->ng);
         if (front ? cg <= 0.0 : cg >= 0.0) continue;
-        cnt->gather++;
-        accel_hit h;
-        int hit = trace_skip(c, &b->from, org, w, OBJ_NO_RADIOSITY, &h);
-        rgb fa = {1, 1, 1};
-        if (c->rr.media && c->sc->fogs) {
-            /* `media on`: gathering rays see fog too (radrules.h rule 5) */
-            rgb fc;
-            shade_atmos_fog_affine(c->sc, org, w, hit ? h.t : INFINITY, &fa, &fc);
-            sum.r += fc.r;
-            sum.g += fc.g;
-            sum.b += fc.b;
-        }
-        if (!hit) {
-            rgb bg = pm_sky(c->sc, w);
-            sum.r += fa.r * bg.r;
-            sum.g += fa.g * bg.g;
-            sum.b += fa.b * bg.b;
-            continue;
-        }
-        shade_mat_bsdf b2;
-        shade_mat_setup(&b2, c->sc, &h, w, c->eps, r);
-        b2.gathered = 1;
-        rgb le = b2.emission;
-        if (le.r != 0.0 || le.g != 0.0 || le.b != 0.0) {
-            double cosx = fabs(v3_dot(w, b->n));
-            double cb = (front ? nf : nb) * cosx / M_PI;
-            double wt = pm_mis(cb, pm_emitter_density(c->L, &h, org, c->s->emitter_samples));
-            sum.r += fa.r * le.r * wt;
-            sum.g += fa.g * le.g * wt;
-            sum.b += fa.b * le.b * wt;
-        }
-        rgb lr = gather_hit(c, &b2, pm_surface_key(h.obj, b2.entering), 0, thread, r, cnt);
-        sum.r += fa.r * lr.r;
-        sum.g += fa.g * lr.g;
-        sum.b += fa.b * lr.b;
+        double cb = (front ? nf : nb) * fabs(v3_dot(w, b->n)) / M_PI;
+        rgb v = gather_ray(c, b, org, w, cb, thread, r, cnt);
+        sum.r += v.r;
+        sum.g += v.g;
+        sum.b += v.b;
+    }
+    return frgb(sum.r / n, sum.g / n, sum.b / n);
+}
+
+/* The glossy lobe's part: (1/n) sum of f_g cos / pdf * L over n directions
+ * sampled from the lobe (stratified in the lobe's two direction numbers). */
+static rgb gather_glossy(const fg_ctx *c, const shade_mat_bsdf *b, int n, int thread, rng *r, pm_counts *cnt)
+{
+    rgb sum = {0, 0, 0};
+    if (n <= 0) return sum;
+    for (int i = 0; i < n; i++) {
+        double u1, u2;
+        gather_stratum(i, n, r, &u1, &u2);
+        shade_mat_scatter s;
+        if (!shade_mat_sample_glossy(b, rng_f64(r), u1, u2, &s)) continue;
+        acc_add(&sum, s.weight, gather_ray(c, b, s.org, s.dir, n * s.pdf, thread, r, cnt));
     }
     return frgb(sum.r / n, sum.g / n, sum.b / n);
 }
@@ -342,19 +392,22 @@ static void eye_trace(const fg_ctx *c, const accel_from *from, vec3 org, vec3 di
     if (b.unsupported) cnt->unsupported++;
     acc_add(L, T, b.emission);
     if (b.nee) acc_add(L, T, pm_direct_lights(c->L, &b, c->s->area_samples, r, &cnt->shadow));
-    double md = b.m[SHADE_MAT_LOBE_DIFFUSE], mb = b.m[SHADE_MAT_LOBE_BACK];
-    if (md > 0.0 || mb > 0.0) {
+    double md = b.m[SHADE_MAT_LOBE_DIFFUSE], mb = b.m[SHADE_MAT_LOBE_BACK], mg = b.m[SHADE_MAT_LOBE_GLOSSY];
+    if (md > 0.0 || mb > 0.0 || mg > 0.0) {
         double scale = depth == 0 ? 1.0 : fmin(1.0, fmax3(T));
         int ng = (int)lround(c->fg_per_sample * scale);
         if (ng < 4) ng = 4; /* 2 x 2 strata at least */
-        int nf = md > 0.0 ? (int)lround(ng * md / (md + mb)) : 0;
-        int nb = mb > 0.0 ? ng - nf : 0;
+        /* the gather rays split over the lobes in proportion to their size */
+        int nf = md > 0.0 ? (int)lround(ng * md / (md + mb + mg)) : 0;
+        int nb = mb > 0.0 ? (int)lround(ng * mb / (md + mb + mg)) : 0;
         if (md > 0.0 && nf < 1) nf = 1;
         if (mb > 0.0 && nb < 1) nb = 1;
+        int ngl = mg > 0.0 ? ng - nf - nb : 0;
+        if (mg > 0.0 && ngl < 1) ngl = 1;
         /* gathered light (emitters, the final gather) is scaled by brightness */
         const double br = c->rr.brightness;
         const rgb Tg = frgb(T.r * br, T.g * br, T.b * br);
-        acc_add(L, Tg, pm_direct_emitters(c->L, &b, c->s->emitter_samples, nf, nb, r, &cnt->shadow));
+        acc_add(L, Tg, pm_direct_emitters(c->L, &b, c->s->emitter_samples, nf, nb, ngl, r, &cnt->shadow));
         if (c->caustic && pm_kdtree_size(c->caustic) > 0) {
             pm_neighbour *sc = c->scratch + (size_t)thread * KMAX;
             uint32_t key = pm_surface_key(h.obj, b.entering);
@@ -381,6 +434,7 @@ static void eye_trace(const fg_ctx *c, const accel_from *from, vec3 org, vec3 di
             rgb g = gather_lobe(c, &b, v3_neg(b.n), b.p_in, 0, nb, nf, nb, thread, r, cnt);
             acc_add(L, Tg, frgb(b.k[SHADE_MAT_LOBE_BACK].r * g.r, b.k[SHADE_MAT_LOBE_BACK].g * g.g, b.k[SHADE_MAT_LOBE_BACK].b * g.b));
         }
+        if (ngl > 0) acc_add(L, Tg, gather_glossy(c, &b, ngl, thread, r, cnt));
     }
     /* specular lobes: both followed (Whitted-style), small weights by roulette */
     for (int lobe = SHADE_MAT_LOBE_REFLECT; lobe <= SHADE_MAT_LOBE_TRANSMIT; lobe++) {

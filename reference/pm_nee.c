@@ -193,12 +193,13 @@ static int visible(const pm_lights *L, const accel_from *from, vec3 o, vec3 y, v
     return 0;
 }
 
-rgb pm_direct_emitters(const pm_lights *L, const shade_mat_bsdf *b, int n_light, double bsdf_front, double bsdf_back, rng *r,
-                       long *shadow_rays)
+rgb pm_direct_emitters(const pm_lights *L, const shade_mat_bsdf *b, int n_light, double bsdf_front, double bsdf_back,
+                       double bsdf_glossy, rng *r, long *shadow_rays)
 {
     rgb total = {0, 0, 0};
     if (n_light < 1 || accel_surf_count(L->emit) == 0) return total;
-    if (b->m[SHADE_MAT_LOBE_DIFFUSE] <= 0.0 && b->m[SHADE_MAT_LOBE_BACK] <= 0.0) return total;
+    if (b->m[SHADE_MAT_LOBE_DIFFUSE] <= 0.0 && b->m[SHADE_MAT_LOBE_BACK] <= 0.0 && b->m[SHADE_MAT_LOBE_GLOSSY] <= 0.0)
+        return total;
     int g = (int)floor(sqrt((double)n_light));
     for (int k = 0; k < n_light; k++) {
         double u1, u2;
@@ -220,8 +221,8 @@ rgb pm_direct_emitters(const pm_lights *L, const shade_mat_bsdf *b, int n_light,
         double l0 = v3_len(d0);
         if (!(l0 > 0.0)) continue;
         wi = v3_scale(d0, 1.0 / l0);
-        rgb f = shade_mat_eval(b, wi);
-        if (f.r == 0.0 && f.g == 0.0 && f.b == 0.0) continue;
+        rgb f = shade_mat_eval(b, wi), fg = shade_mat_eval_glossy(b, wi);
+        if (f.r == 0.0 && f.g == 0.0 && f.b == 0.0 && fg.r == 0.0 && fg.g == 0.0 && fg.b == 0.0) continue;
         double cos_y = fabs(v3_dot(s.n, wi));
         if (!(cos_y > 1e-12)) continue;
         if (shadow_rays) (*shadow_rays)++;
@@ -230,11 +231,14 @@ rgb pm_direct_emitters(const pm_lights *L, const shade_mat_bsdf *b, int n_light,
         double cos_x = fabs(v3_dot(b->n, wi));
         double c_b = (v3_dot(b->n, wi) > 0.0 ? bsdf_front : bsdf_back) * cos_x / M_PI;
         double w = pm_mis(n_light * p_l, c_b);
+        double wg = fg.r != 0.0 || fg.g != 0.0 || fg.b != 0.0
+                        ? pm_mis(n_light * p_l, bsdf_glossy > 0.0 ? bsdf_glossy * shade_mat_pdf_glossy(b, wi) : 0.0)
+                        : 0.0;
         rgb le = pm_lights_piece_emission(L, &s);
-        double k_ = w * cos_x / p_l;
-        total.r += f.r * le.r * k_;
-        total.g += f.g * le.g * k_;
-        total.b += f.b * le.b * k_;
+        double k_ = cos_x / p_l;
+        total.r += (f.r * w + fg.r * wg) * le.r * k_;
+        total.g += (f.g * w + fg.g * wg) * le.g * k_;
+        total.b += (f.b * w + fg.b * wg) * le.b * k_;
     }
     total.r /= n_light;
     total.g /= n_light;

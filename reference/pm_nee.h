@@ -46,17 +46,18 @@ rgb pm_direct_lights(const pm_lights *L, const shade_mat_bsdf *b, int area_sampl
  * places that take many samples anyway (final-gather hits). */
 rgb pm_direct_one_light(const pm_lights *L, const shade_mat_bsdf *b, rng *r, long *shadow_rays);
 
-/* Direct light of the emissive surfaces at b through its Lambertian lobes,
- * `n_light` samples by area. MIS against a BSDF strategy whose
- * count-weighted density for a direction wi is
- *     c_b(wi) = bsdf_front * cos(n, wi)/pi   (wi on the viewer's side)
- *             = bsdf_back * |cos(n, wi)|/pi  (other side)
- * (path tracer: 1 sample, bsdf_front = m_d/sum m, bsdf_back = m_b/sum m;
- * final gather: N_front and N_back gather rays); pass 0, 0 for no MIS (the
- * BSDF strategy does not count emission). Each light sample gets weight
- * (n p_l)^2 / ((n p_l)^2 + c_b^2). */
-rgb pm_direct_emitters(const pm_lights *L, const shade_mat_bsdf *b, int n_light, double bsdf_front, double bsdf_back, rng *r,
-                       long *shadow_rays);
+/* Direct light of the emissive surfaces at b through its Lambertian and
+ * glossy lobes, `n_light` samples by area. MIS, lobe by lobe, against BSDF
+ * strategies whose count-weighted densities for a direction wi are
+ *     c_b(wi) = bsdf_front * cos(n, wi)/pi   (Lambertian, wi on the viewer's side)
+ *             = bsdf_back * |cos(n, wi)|/pi  (Lambertian, other side)
+ *     c_g(wi) = bsdf_glossy * shade_mat_pdf_glossy(b, wi)   (glossy)
+ * (path tracer: 1 sample, bsdf_front = m_d/sum m, bsdf_back = m_b/sum m,
+ * bsdf_glossy = m_g/sum m; final gather: the numbers of gather rays of each
+ * lobe); 0 for a lobe whose BSDF strategy does not count emission. Each
+ * light sample of a lobe gets weight (n p_l)^2 / ((n p_l)^2 + c^2). */
+rgb pm_direct_emitters(const pm_lights *L, const shade_mat_bsdf *b, int n_light, double bsdf_front, double bsdf_back,
+                       double bsdf_glossy, rng *r, long *shadow_rays);
 
 /* Count-weighted light-sampling density n_light * p_l (solid angle, seen
  * from `from`) of the hit point h, 0 if h is not on a sampled emitter. */

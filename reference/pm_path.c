@@ -4,8 +4,10 @@
  * with throughput T_k = prod f cos / pdf over the sampled directions,
  *   L = sum_k T_k [ w_bsdf(x_k) Le(x_k) + NEE_lights(x_k) + NEE_emitters(x_k) ]
  * where Le at x_k counts fully after a camera or specular step and with the
- * power-heuristic weight against emitter sampling after a Lambertian step;
- * NEE_emitters carries the complementary weight. At the last vertex allowed
+ * power-heuristic weight against emitter sampling after a Lambertian or
+ * glossy step (one lobe is sampled per vertex, so the weights are per lobe);
+ * NEE_emitters carries the complementary weight. A glossy step is a
+ * gathering step, like a Lambertian one (brightness, recursion_limit). At the last vertex allowed
  * (max_depth) the emitter NEE is unweighted, since no BSDF step follows.
  * Russian roulette from vertex rr_depth on survives with q = min(1, max(T) / t)
  * (t = rr_threshold) and divides T by q (unbiased for any q > 0). */
@@ -120,10 +122,12 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
             L.g += T.g * d.g;
             L.b += T.b * d.b;
         }
-        if (gather && (b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 || b.m[SHADE_MAT_LOBE_BACK] > 0.0) && b.msum > 0.0) {
+        if (gather && (b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 || b.m[SHADE_MAT_LOBE_BACK] > 0.0 || b.m[SHADE_MAT_LOBE_GLOSSY] > 0.0) &&
+            b.msum > 0.0) {
             /* emissive surfaces light others as gathered light: brightness applies */
             double bf = last ? 0.0 : b.m[SHADE_MAT_LOBE_DIFFUSE] / b.msum, bb = last ? 0.0 : b.m[SHADE_MAT_LOBE_BACK] / b.msum;
-            rgb d = pm_direct_emitters(c->L, &b, 1, bf, bb, r, &cnt->shadow);
+            double bg = last ? 0.0 : b.m[SHADE_MAT_LOBE_GLOSSY] / b.msum;
+            rgb d = pm_direct_emitters(c->L, &b, 1, bf, bb, bg, r, &cnt->shadow);
             L.r += T.r * d.r * bright;
             L.g += T.g * d.g * bright;
             L.b += T.b * d.b * bright;

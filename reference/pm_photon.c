@@ -365,7 +365,8 @@ static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume,
         /* Only where the material's own roulette hardly ends paths (total
          * lobe size near 1): elsewhere it would add variance for nothing
          * (the rho = 0.9 furnace's worst pixel went from 0.55% to 3%). */
-        double mass = b.m[SHADE_MAT_LOBE_DIFFUSE] + b.m[SHADE_MAT_LOBE_BACK] + b.m[SHADE_MAT_LOBE_REFLECT] + b.m[SHADE_MAT_LOBE_TRANSMIT];
+        double mass = b.m[SHADE_MAT_LOBE_DIFFUSE] + b.m[SHADE_MAT_LOBE_BACK] + b.m[SHADE_MAT_LOBE_REFLECT] + b.m[SHADE_MAT_LOBE_TRANSMIT] +
+                      b.m[SHADE_MAT_LOBE_GLOSSY];
         if (bounce + 1 >= RR_BOUNCES && mass > RR_MASS) {
             if (rng_f64(&r) >= RR_SURVIVE) return;
             k /= RR_SURVIVE;

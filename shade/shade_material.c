@@ -111,6 +111,39 @@ int shade_mat_texture_varies(const scene_texture *tex)
     return tex && (tex->pigment.kind == PIGMENT_PATTERN || tex->pat);
 }
 
+/* The glossy lobe of the top layer's finish f (model in the header): phong
+ * (exponent phong_size) and specular (exponent 1/(4 roughness), glossy.h),
+ * their weights scaled down together to what the other lobes leave. */
+static void setup_glossy(shade_mat_bsdf *b, const scene_finish *f)
+{
+    b->nglossy = 0;
+    b->k[SHADE_MAT_LOBE_GLOSSY] = mrgb(0, 0, 0);
+    double w[2] = {f->phong > 0.0 && isfinite(f->phong) ? f->phong : 0.0,
+                   f->specular > 0.0 && isfinite(f->specular) ? f->specular : 0.0};
+    double e[2] = {f->phong_size, 1.0 / (4.0 * (f->roughness > 0.0 ? f->roughness : 0.05))};
+    double wsum = w[0] + w[1];
+    if (!(wsum > 0.0)) return;
+    double used = 0.0;
+    for (int i = 0; i < SHADE_MAT_LOBE_GLOSSY; i++) {
+        double m = mrgb_max(b->k[i]);
+        if (m > 0.0 && isfinite(m)) used += m;
+    }
+    double room = fmin(wsum, fmax(0.0, 1.0 - used));
+    if (!(room > 0.0)) return;
+    for (int i = 0; i < 2; i++) {
+        if (!(w[i] > 0.0)) continue;
+        const glossy_table *t = glossy_table_for(e[i]);
+        if (!t) continue;
+        b->gl[b->nglossy] = t;
+        b->gl_w[b->nglossy] = w[i] * room / wsum;
+        b->nglossy++;
+    }
+    double kg = 0.0;
+    for (int i = 0; i < b->nglossy; i++) kg += b->gl_w[i];
+    b->k[SHADE_MAT_LOBE_GLOSSY] = mrgb(kg, kg, kg);
+    b->gl_metallic = f->metallic;
+}
+
 void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r)
 {
     memset(b, 0, sizeof *b);
@@ -210,6 +243,7 @@ void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec
     }
     b->k[SHADE_MAT_LOBE_REFLECT] = refl;
     b->k[SHADE_MAT_LOBE_TRANSMIT] = trans;
+    setup_glossy(b, f);
     b->msum = 0.0;
     for (int i = 0; i < SHADE_MAT_NLOBES; i++) {
         double m = mrgb_max(b->k[i]);
@@ -225,6 +259,67 @@ rgb shade_mat_eval(const shade_mat_bsdf *b, vec3 wi)
     if (cn > 0.0 && cg > 0.0) return mrgb_scale(b->k[SHADE_MAT_LOBE_DIFFUSE], 1.0 / M_PI);
     if (cn < 0.0 && cg < 0.0) return mrgb_scale(b->k[SHADE_MAT_LOBE_BACK], 1.0 / M_PI);
     return mrgb(0, 0, 0);
+}
+
+/* The glossy sub-lobes' sum, tinted by metallic (shade_light_metallic_tint, at
+ * the mean cosine of wi and wo: symmetric); 0 unless wi is on the viewer's
+ * side by both normals. */
+rgb shade_mat_eval_glossy(const shade_mat_bsdf *b, vec3 wi)
+{
+    rgb out = {0, 0, 0};
+    if (b->nglossy == 0 || !(v3_dot(wi, b->ng) > 0.0)) return out;
+    vec3 wo = v3_neg(b->dir);
+    double f = 0.0;
+    for (int i = 0; i < b->nglossy; i++) f += b->gl_w[i] * glossy_eval(b->gl[i], b->n, wo, wi);
+    if (!(f > 0.0)) return out;
+    out = mrgb(f, f, f);
+    if (b->gl_metallic != 0.0)
+        shade_light_metallic_tint(&out, b->gl_metallic, b->pigment, 0.5 * (v3_dot(wi, b->n) + v3_dot(wo, b->n)));
+    return out;
+}
+
+double shade_mat_pdf_glossy(const shade_mat_bsdf *b, vec3 wi)
+{
+    if (b->nglossy == 0 || !(v3_dot(wi, b->ng) > 0.0)) return 0.0;
+    double kg = b->k[SHADE_MAT_LOBE_GLOSSY].r, p = 0.0;
+    if (!(kg > 0.0)) return 0.0;
+    vec3 wo = v3_neg(b->dir);
+    for (int i = 0; i < b->nglossy; i++) p += b->gl_w[i] / kg * glossy_pdf(b->gl[i], b->n, wo, wi);
+    return p;
+}
+
+/* A sub-lobe is chosen in proportion to its weight (u0 picks it, then is
+ * reused, rescaled, for glossy_sample's own choice); the weight is the whole
+ * lobe's f cos over the mixture density, so MIS sees one strategy. */
+int shade_mat_sample_glossy(const shade_mat_bsdf *b, double u0, double u1, double u2, shade_mat_scatter *s)
+{
+    memset(s, 0, sizeof *s);
+    s->eta2 = 1.0;
+    s->lobe = SHADE_MAT_LOBE_GLOSSY;
+    double kg = b->k[SHADE_MAT_LOBE_GLOSSY].r;
+    if (b->nglossy == 0 || !(kg > 0.0)) return 0;
+    int j = 0;
+    double acc = 0.0;
+    for (; j < b->nglossy - 1; j++) {
+        double pj = b->gl_w[j] / kg;
+        if (u0 < acc + pj) break;
+        acc += pj;
+    }
+    double pj = b->gl_w[j] / kg;
+    double uu = pj > 0.0 ? fmin(fmax((u0 - acc) / pj, 0.0), 0.999999999) : 0.5;
+    vec3 wi;
+    double pdf1, w1;
+    if (!glossy_sample(b->gl[j], b->n, v3_neg(b->dir), uu, u1, u2, &wi, &pdf1, &w1)) return 0;
+    if (!(v3_dot(wi, b->ng) > 0.0)) return 0;
+    double pdf = shade_mat_pdf_glossy(b, wi);
+    rgb f = shade_mat_eval_glossy(b, wi);
+    if (!(pdf > 0.0)) return 0;
+    double k = v3_dot(wi, b->n) / pdf;
+    s->dir = wi;
+    s->org = b->p_out;
+    s->pdf = pdf;
+    s->weight = mrgb_scale(f, k);
+    return isfinite(k) && k > 0.0;
 }
 
 vec3 shade_mat_cosine_dir(vec3 n, double u1, double u2)
@@ -266,6 +361,14 @@ static int mat_sample_lobe(const shade_mat_bsdf *b, double u_lobe, double u1, do
         for (int i = SHADE_MAT_NLOBES - 1; i >= 0; i--)
             if (b->m[i] > 0.0) { lobe = i; p = b->m[i] * scale; break; }
         if (lobe < 0) return 0;
+    }
+    if (lobe == SHADE_MAT_LOBE_GLOSSY) {
+        /* u_lobe within the lobe's interval, rescaled: a fresh uniform */
+        double u0 = fmin(fmax((u_lobe - (acc - p)) / p, 0.0), 0.999999999);
+        if (!shade_mat_sample_glossy(b, u0, u1, u2, s)) return 0;
+        s->weight = mrgb_scale(s->weight, 1.0 / p);
+        s->pdf *= p;
+        return 1;
     }
     s->lobe = lobe;
     s->weight = mrgb_scale(b->k[lobe], 1.0 / p);

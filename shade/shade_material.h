@@ -29,11 +29,22 @@
  * reflection.
  *
  * Lambertian terms ignore brilliance and crand (they are POV-Ray's shaping
- * of direct light only). Phong and specular highlights are not part of f:
- * they are not energy-conserving and are added for light arriving straight
- * from light sources only, by shade_light_terms/shade_light_nee (shade_light.h), exactly
- * as shade.c computes them; so `--gi none` (with ambient 0; it shows ambient,
- * being radiosity off) is the direct part (first vertex) of the path tracer. Emission is the same
+ * of direct light only). Phong and specular highlights: for light arriving
+ * straight from POV-Ray light sources they are POV-Ray's own (unnormalised)
+ * terms, added by shade_light_terms/shade_light_nee (shade_light.h) exactly
+ * as shade.c computes them, so `--gi none` (with ambient 0; it shows ambient,
+ * being radiosity off) is the direct part (first vertex) of the path tracer.
+ * For all other light (emitters, sky, other surfaces) the top layer's phong
+ * and specular are one glossy lobe of f (core/glossy.h, normalisation
+ * there), each tinted by `metallic` as shade.c tints highlights (at the
+ * mean of cos(n, wi) and cos(n, wo), which keeps it reciprocal):
+ *
+ *   + kg f_glossy(wi, wo)   kg = phong + specular, but at most what the
+ *                           finish leaves: 1 - (max kd + max kb + max kr + max kt)
+ *
+ * POV-Ray finishes often sum past 1 (diffuse 0.6 + phong 1; glass with
+ * transmit 1 and specular 1); the glossy lobe yields there, since POV-Ray
+ * renders the other terms itself and has no glossy transport. Emission is the same
  * on both sides of a surface (POV-Ray turns normals towards the viewer).
  * Emission follows POV-Ray 3.7's rules with radiosity on (core/radrules.h):
  * `ambient * ambient_light` is part of it only in scenes whose effective
@@ -52,13 +63,22 @@
 #ifndef PT_SHADE_MATERIAL_H
 #define PT_SHADE_MATERIAL_H
 #include "accel.h"
+#include "glossy.h"
 #include "rng.h"
 #include "scene.h"
 #include "shade_light.h"
 
 #define SHADE_MAT_MAX_LAYERS 8
 
-enum { SHADE_MAT_LOBE_DIFFUSE = 0, SHADE_MAT_LOBE_BACK = 1, SHADE_MAT_LOBE_REFLECT = 2, SHADE_MAT_LOBE_TRANSMIT = 3, SHADE_MAT_NLOBES = 4 };
+enum {
+    SHADE_MAT_LOBE_DIFFUSE = 0,
+    SHADE_MAT_LOBE_BACK = 1,
+    SHADE_MAT_LOBE_REFLECT = 2,
+    SHADE_MAT_LOBE_TRANSMIT = 3,
+    SHADE_MAT_LOBE_GLOSSY = 4,
+    SHADE_MAT_NLOBES = 5
+};
+#define SHADE_MAT_MAX_GLOSSY 2
 
 typedef struct {
     const scene_texture *tex;
@@ -72,11 +92,15 @@ typedef struct {
     vec3 ng;           /* geometric normal facing the viewer */
     int entering;      /* the ray hits the outside (geometric normal against it) */
     rgb emission;      /* Le */
-    rgb k[SHADE_MAT_NLOBES]; /* kd, kb, kr, kt */
+    rgb k[SHADE_MAT_NLOBES]; /* kd, kb, kr, kt, kg (kg: the glossy weights' sum, untinted) */
     vec3 refl_dir, trans_dir;
     double eta2;       /* (eta_i/eta_t)^2 of the refraction, 1 without */
     double m[SHADE_MAT_NLOBES]; /* lobe sizes: max channel of k (>= 0) */
     double msum;
+    int nglossy;       /* glossy sub-lobes (phong, specular) of the top layer */
+    const glossy_table *gl[SHADE_MAT_MAX_GLOSSY];
+    double gl_w[SHADE_MAT_MAX_GLOSSY];  /* weight of each (sums to kg) */
+    double gl_metallic;                 /* the finish's highlight `metallic` */
     int nee;           /* direct light applies (diffuse, diffuse_back, phong or specular) */
     int double_illum;
     int unsupported;   /* a pigment pattern the shader cannot evaluate (its colour is used) */
@@ -116,6 +140,15 @@ void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec
 /* Lambertian part of f (no cosine) for unit wi (towards where light comes
  * from); 0 where wi and the geometric normal disagree about the side. */
 rgb shade_mat_eval(const shade_mat_bsdf *b, vec3 wi);
+
+/* The glossy lobe (see the model above): f_g(wi) without cosine, and the
+ * solid-angle density with which the glossy lobe samples wi (without the
+ * lobe's selection probability); both 0 off the viewer's side. */
+rgb shade_mat_eval_glossy(const shade_mat_bsdf *b, vec3 wi);
+double shade_mat_pdf_glossy(const shade_mat_bsdf *b, vec3 wi);
+/* Sample the glossy lobe alone: s->weight = f_g cos / pdf, s->pdf the
+ * density; 0 when the direction falls off the viewer's side. */
+int shade_mat_sample_glossy(const shade_mat_bsdf *b, double u0, double u1, double u2, shade_mat_scatter *s);
 
 int shade_mat_sample(const shade_mat_bsdf *b, rng *r, int absorb, shade_mat_scatter *s);
 
