@@ -12,6 +12,7 @@
  * taken by the midpoint rule on 256 points. */
 #include "glossy.h"
 #include <math.h>
+#include "glossy_lobe.h"
 #include <stdatomic.h>
 #include <stdlib.h>
 
@@ -19,7 +20,7 @@
 #define Q_MIN (-6 * Q_PER_OCTAVE)
 #define Q_MAX (20 * Q_PER_OCTAVE)
 #define NQ (Q_MAX - Q_MIN + 1)
-#define NMU 65       /* E at mu = (k / 64)^2: denser towards grazing, where E changes */
+#define NMU GLOSSY_NMU /* E at mu = (k / 64)^2: denser towards grazing, where E changes */
 #define NT 256       /* radial quadrature points */
 #define NAVG 2048    /* quadrature points for Eavg over the interpolated table */
 
@@ -53,14 +54,7 @@ double glossy_albedo_exact(double e, double mu)
     return sum / NT / (2.0 * M_PI);
 }
 
-static double table_lookup(const double *tab, double mu)
-{
-    double s = sqrt(fmin(1.0, fmax(0.0, mu))) * (NMU - 1);
-    int i = (int)s;
-    if (i >= NMU - 1) return tab[NMU - 1];
-    double f = s - i;
-    return tab[i] * (1.0 - f) + tab[i + 1] * f;
-}
+static double table_lookup(const double *tab, double mu) { return glossy_lobe_albedo(tab, mu); }
 
 static glossy_table *table_build(double e)
 {
@@ -104,19 +98,13 @@ const glossy_table *glossy_table_for(double e)
 double glossy_exponent(const glossy_table *t) { return t->e; }
 double glossy_table_albedo(const glossy_table *t, double mu) { return table_lookup(t->tab, mu); }
 double glossy_table_eavg(const glossy_table *t) { return t->eavg; }
+const double *glossy_table_values(const glossy_table *t) { return t->tab; }
 
 static inline vec3 mirror(vec3 n, vec3 wo) { return v3_sub(v3_scale(n, 2.0 * v3_dot(n, wo)), wo); }
 
 double glossy_eval(const glossy_table *t, vec3 n, vec3 wo, vec3 wi)
 {
-    double mi = v3_dot(n, wi), mo = v3_dot(n, wo);
-    if (!(mi > 0.0) || !(mo > 0.0)) return 0.0;
-    double c = v3_dot(mirror(n, wo), wi);
-    double g = c > 0.0 ? (t->e + 1.0) / (2.0 * M_PI) * pow(fmin(c, 1.0), t->e) / fmax(mi, mo) : 0.0;
-    double ms = 0.0;
-    if (t->eavg < 1.0 - 1e-9)
-        ms = (1.0 - table_lookup(t->tab, mi)) * (1.0 - table_lookup(t->tab, mo)) / (M_PI * (1.0 - t->eavg));
-    return g + ms;
+    return glossy_lobe_f(t->e, t->tab, t->eavg, v3_dot(n, wi), v3_dot(n, wo), v3_dot(mirror(n, wo), wi));
 }
 
 double glossy_pdf(const glossy_table *t, vec3 n, vec3 wo, vec3 wi)

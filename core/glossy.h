@@ -53,6 +53,9 @@ double glossy_exponent(const glossy_table *t);
 /* E(mu) as tabulated (the albedo of g alone) and Eavg. */
 double glossy_table_albedo(const glossy_table *t, double mu);
 double glossy_table_eavg(const glossy_table *t);
+/* The GLOSSY_NMU values E(mu_k) of glossy_lobe.h's table (for copies into
+ * device memory: the kernels evaluate the lobe with glossy_lobe.h too). */
+const double *glossy_table_values(const glossy_table *t);
 
 /* f(wi, wo) (no cosine); 0 unless both are on n's side. */
 double glossy_eval(const glossy_table *t, vec3 n, vec3 wo, vec3 wi);
