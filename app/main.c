@@ -671,6 +671,14 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
         if (sst.t_gi_geometry > 0 || sst.t_gi_lighting > 0)
             fprintf(stderr, "partray: %sgi %s: geometry %.3f s, lighting %.3f s\n", fr, gi_used, sst.t_gi_geometry,
                     sst.t_gi_lighting);
+        if (sst.has_detp) {
+            const pm_detp_stats *p = &sst.detp;
+            fprintf(stderr, "partray: %sdetp: %s, %ld of %ld objects moved, %ld of %ld paths re-traced (%.2f%%), "
+                    "segments -%ld +%ld of %ld, %ld of %ld receivers estimated anew\n", fr,
+                    p->full_frame ? p->full_reason : "incremental", p->moving_objects, p->objects, p->paths_retraced,
+                    p->paths, p->paths > 0 ? 100.0 * (double)p->paths_retraced / (double)p->paths : 0.0, p->segments_old,
+                    p->segments_new, p->segments, p->receivers_full, p->receivers);
+        }
         if (keep_gi)
             fprintf(stderr, "partray: %sgi stages run: %s%sview\n", fr, sst.ran_geometry ? "geometry, " : "",
                     sst.ran_lighting ? "lighting, " : "");

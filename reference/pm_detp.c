@@ -264,10 +264,12 @@ static int clampi(double v, int n)
     return (int)v;
 }
 
-/* The discs (radius r, plus a margin of a quarter cell so that a walk
- * that rounds at a cell corner still finds them) of the receivers with
- * pick[i] set (pick NULL: all with a hit). 0 on failure (no memory). */
-static int rgrid_build(rgrid *g, const receiver *rec, long n, const unsigned char *pick, double r)
+/* The receivers with pick[i] set (pick NULL: all with a hit) in the cells
+ * that their discs (radius r, tight: the disc's own box, grown by a
+ * hundredth of a cell so that a walk that rounds at a cell face still
+ * finds them) or their spheres of radius r (not tight: the hook's lookup
+ * of points near a curved surface) meet. 0 on failure (no memory). */
+static int rgrid_build(rgrid *g, const receiver *rec, long n, const unsigned char *pick, double r, int tight)
 {
     memset(g, 0, sizeof *g);
     vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
@@ -286,7 +288,7 @@ static int rgrid_build(rgrid *g, const receiver *rec, long n, const unsigned cha
         if (cells <= MAX_CELLS) break;
         cell *= 1.25;
     }
-    double m = r + 0.25 * cell;
+    double m = r + 0.01 * cell;
     g->cell = cell;
     g->lo = v3_sub(lo, v3(m, m, m));
     g->nx = (int)floor((ext.x + 2.0 * m) / cell) + 1;
@@ -298,10 +300,14 @@ static int rgrid_build(rgrid *g, const receiver *rec, long n, const unsigned cha
     for (int pass = 0; pass < 2; pass++) {
         for (long i = 0; i < n; i++) {
             if (rec[i].leaf < 0 || (pick && !pick[i])) continue;
-            vec3 p = rec[i].p;
-            int x0 = clampi((p.x - m - g->lo.x) / cell, g->nx), x1 = clampi((p.x + m - g->lo.x) / cell, g->nx);
-            int y0 = clampi((p.y - m - g->lo.y) / cell, g->ny), y1 = clampi((p.y + m - g->lo.y) / cell, g->ny);
-            int z0 = clampi((p.z - m - g->lo.z) / cell, g->nz), z1 = clampi((p.z + m - g->lo.z) / cell, g->nz);
+            vec3 p = rec[i].p, nn = rec[i].n;
+            /* a disc of normal n spans r sqrt(1 - n_k^2) along axis k */
+            double ex = tight ? r * sqrt(fmax(0.0, 1.0 - nn.x * nn.x)) + 0.01 * cell : m;
+            double ey = tight ? r * sqrt(fmax(0.0, 1.0 - nn.y * nn.y)) + 0.01 * cell : m;
+            double ez = tight ? r * sqrt(fmax(0.0, 1.0 - nn.z * nn.z)) + 0.01 * cell : m;
+            int x0 = clampi((p.x - ex - g->lo.x) / cell, g->nx), x1 = clampi((p.x + ex - g->lo.x) / cell, g->nx);
+            int y0 = clampi((p.y - ey - g->lo.y) / cell, g->ny), y1 = clampi((p.y + ey - g->lo.y) / cell, g->ny);
+            int z0 = clampi((p.z - ez - g->lo.z) / cell, g->nz), z1 = clampi((p.z + ez - g->lo.z) / cell, g->nz);
             for (int z = z0; z <= z1; z++)
                 for (int y = y0; y <= y1; y++)
                     for (int x = x0; x <= x1; x++) {
@@ -451,6 +457,8 @@ typedef struct {
     const scene *sc;
     const accel *a;
     const accel *mob;             /* moving objects only (NULL: none) */
+    int mob_boxed;                /* 1: the moving objects' surfaces lie in mob_lo..mob_hi */
+    vec3 mob_lo, mob_hi;
     const pm_photon_walker *wk;
     const leaves *lv;
     const unsigned char *moving;  /* per leaf */
@@ -489,6 +497,45 @@ static void on_seg(void *ctx, long index, const pm_photon_launch *l, const accel
     if (ws->plus) apply_seg(ws->plus, ws->fc->ginc, &s);
 }
 
+/* Whether the segment o + t w, t in [0, tmax], meets the box lo..hi. */
+static int box_meets(vec3 lo, vec3 hi, vec3 o, vec3 w, double tmax)
+{
+    double t0 = 0.0, t1 = tmax;
+    double l[3] = {lo.x, lo.y, lo.z}, h[3] = {hi.x, hi.y, hi.z}, oo[3] = {o.x, o.y, o.z}, ww[3] = {w.x, w.y, w.z};
+    for (int k = 0; k < 3; k++) {
+        if (ww[k] == 0.0) {
+            if (oo[k] < l[k] || oo[k] > h[k]) return 0;
+            continue;
+        }
+        double a = (l[k] - oo[k]) / ww[k], b = (h[k] - oo[k]) / ww[k];
+        if (a > b) {
+            double tmp = a;
+            a = b;
+            b = tmp;
+        }
+        if (a > t0) t0 = a;
+        if (b < t1) t1 = b;
+        if (t0 > t1) return 0;
+    }
+    return 1;
+}
+
+/* Shapes whose surfaces lie within accel_bounds (infinite ones do not). */
+static int finite_shape(const scene_object *o)
+{
+    if (is_csg(o)) {
+        for (int i = 0; i < o->u.csg.nkids; i++)
+            if (!finite_shape(o->u.csg.kids[i])) return 0;
+        return 1;
+    }
+    switch (o->kind) {
+    case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_TRIANGLE: case SHAPE_SMOOTH_TRIANGLE: case SHAPE_MESH:
+    case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC: case SHAPE_TORUS: case SHAPE_SUPERELLIPSOID:
+    case SHAPE_OVUS: return 1;
+    default: return 0;
+    }
+}
+
 /* Whether stored segment s is still what tracing it now gives. */
 static int seg_valid(const frame_ctx *fc, const seg *s, long *rays)
 {
@@ -496,9 +543,10 @@ static int seg_valid(const frame_ctx *fc, const seg *s, long *rays)
     if (s->hit_leaf >= 0 && fc->moving[s->hit_leaf]) return 0;
     if (!fc->mob) return 1;
     accel_hit h;
-    (*rays)++;
     /* up to a little past the stored hit: a tie is taken as a change */
     double tmax = isfinite(s->t) ? s->t * (1.0 + 1e-7) + fc->dp->eps : INFINITY;
+    if (fc->mob_boxed && !box_meets(fc->mob_lo, fc->mob_hi, s->l.o, s->l.w, tmax)) return 1;
+    (*rays)++;
     if (s->l.from.obj && s->from_leaf >= 0) {
         accel_from f = s->l.from;
         f.obj = fc->lv->leaf[s->from_leaf];
@@ -703,6 +751,8 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     memset(&gfull, 0, sizeof gfull);
     scene mobsc;
     scene_object **mobobj = NULL;
+    int mob_boxed = 0;
+    vec3 mob_lo = v3(0, 0, 0), mob_hi = v3(0, 0, 0);
     double t0 = timer_now();
     if (!leaves_make(&lv, sc)) {
         leaves_free(&lv);
@@ -748,6 +798,17 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
         if (!mob) {
             status = ms != PT_OK ? ms : PT_ERR_DEVICE;
             goto done;
+        }
+        /* a box around them, grown by a scene epsilon, answers most
+         * segments before Embree is asked */
+        mob_boxed = 1;
+        for (int k = 0; k < nmob; k++) mob_boxed &= finite_shape(mobobj[k]);
+        if (mob_boxed) {
+            accel_bounds(mob, &mob_lo, &mob_hi);
+            double g = 1e-6 * v3_len(v3_sub(mob_hi, mob_lo)) + 1e-9;
+            mob_lo = v3_sub(mob_lo, v3(g, g, g));
+            mob_hi = v3_add(mob_hi, v3(g, g, g));
+            mob_boxed = mob_lo.x <= mob_hi.x && isfinite(mob_lo.x) && isfinite(mob_hi.x);
         }
     }
     if (full) drop_frame(dp);
@@ -828,14 +889,14 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
             goto done;
         }
         for (long i = 0; i < np; i++) inc[i] = !pick[i];
-        int ok = rgrid_build(&ginc, dp->rec, np, inc, dp->radius);
+        int ok = rgrid_build(&ginc, dp->rec, np, inc, dp->radius, 1);
         free(inc);
         if (!ok) {
             status = PT_ERR_NOMEM;
             goto done;
         }
     }
-    if (nfull > 0 && !rgrid_build(&gfull, dp->rec, np, pick, dp->radius)) {
+    if (nfull > 0 && !rgrid_build(&gfull, dp->rec, np, pick, dp->radius, 1)) {
         status = PT_ERR_NOMEM;
         goto done;
     }
@@ -861,6 +922,9 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     fc.sc = sc;
     fc.a = a;
     fc.mob = mob;
+    fc.mob_boxed = mob_boxed;
+    fc.mob_lo = mob_lo;
+    fc.mob_hi = mob_hi;
     fc.wk = wk;
     fc.lv = &lv;
     fc.moving = moving;
@@ -935,7 +999,7 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     }
     st->t_estimate = timer_now() - t1;
     rgrid_free(&dp->look);
-    if (!rgrid_build(&dp->look, dp->rec, np, NULL, dp->radius)) {
+    if (!rgrid_build(&dp->look, dp->rec, np, NULL, dp->radius, 0)) {
         status = PT_ERR_NOMEM;
         drop_frame(dp);
         goto done;
