@@ -38,6 +38,7 @@
 #include "hash.h"
 #include "pm_nee.h"
 #include "pm_photon.h"
+#include "scene_leaves.h"
 #include "pool.h"
 #include "radrules.h"
 #include "shade_material.h"
@@ -97,142 +98,11 @@ struct pm_detp {
 
 /* ------------------------------------------------------------ objects */
 
-typedef struct {
-    const scene_object **leaf;
-    int *top;                 /* top-level object of each leaf */
-    int n, cap;
-    /* pointer -> leaf index, open addressing */
-    const scene_object **key;
-    int *val;
-    unsigned mask;
-} leaves;
-
-static int leaves_push(leaves *L, const scene_object *o, int top)
-{
-    if (L->n == L->cap) {
-        int nc = L->cap ? 2 * L->cap : 64;
-        const scene_object **nl = realloc(L->leaf, sizeof *nl * (size_t)nc);
-        if (!nl) return 0;
-        L->leaf = nl;
-        int *nt = realloc(L->top, sizeof *nt * (size_t)nc);
-        if (!nt) return 0;
-        L->top = nt;
-        L->cap = nc;
-    }
-    L->leaf[L->n] = o;
-    L->top[L->n] = top;
-    L->n++;
-    return 1;
-}
-
-static int is_csg(const scene_object *o)
-{
-    return o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE;
-}
-
-static int leaves_walk(leaves *L, const scene_object *o, int top)
-{
-    if (is_csg(o)) {
-        for (int i = 0; i < o->u.csg.nkids; i++)
-            if (!leaves_walk(L, o->u.csg.kids[i], top)) return 0;
-        return 1;
-    }
-    return leaves_push(L, o, top);
-}
-
-static int leaves_make(leaves *L, const scene *sc)
-{
-    memset(L, 0, sizeof *L);
-    for (int i = 0; i < sc->nobjects; i++)
-        if (!leaves_walk(L, sc->objects[i], i)) return 0;
-    unsigned sz = 16;
-    while (sz < 2u * (unsigned)L->n + 16u) sz <<= 1;
-    L->mask = sz - 1;
-    L->key = calloc(sz, sizeof *L->key);
-    L->val = malloc(sizeof *L->val * sz);
-    if (!L->key || !L->val) return 0;
-    for (int i = 0; i < L->n; i++) {
-        unsigned k = pt_ptr_hash(L->leaf[i]) & L->mask;
-        while (L->key[k] && L->key[k] != L->leaf[i]) k = (k + 1) & L->mask;
-        if (!L->key[k]) {
-            L->key[k] = L->leaf[i];
-            L->val[k] = i;
-        }
-    }
-    return 1;
-}
-
-static int leaves_find(const leaves *L, const scene_object *o)
-{
-    if (!o) return -1;
-    unsigned k = pt_ptr_hash(o) & L->mask;
-    while (L->key[k]) {
-        if (L->key[k] == o) return L->val[k];
-        k = (k + 1) & L->mask;
-    }
-    return -2;
-}
-
-static void leaves_free(leaves *L)
-{
-    free(L->leaf);
-    free(L->top);
-    free(L->key);
-    free(L->val);
-}
-
-#define fnv pt_fnv1a
-
-/* Hash of what decides where an object's surfaces are. *opaque is set when
- * the shape keeps its data where this does not look (then the object can
- * not be told unchanged). */
-static uint64_t obj_hash(uint64_t h, const scene_object *o, int *opaque)
-{
-    h = fnv(h, &o->kind, sizeof o->kind);
-    h = fnv(h, o->transform.m, sizeof o->transform.m);
-    h = fnv(h, &o->flags, sizeof o->flags);
-    switch (o->kind) {
-    case SHAPE_SPHERE: h = fnv(h, &o->u.sphere, sizeof o->u.sphere); break;
-    case SHAPE_BOX: h = fnv(h, &o->u.box, sizeof o->u.box); break;
-    case SHAPE_PLANE: h = fnv(h, &o->u.plane, sizeof o->u.plane); break;
-    case SHAPE_TRIANGLE:
-    case SHAPE_SMOOTH_TRIANGLE: h = fnv(h, &o->u.triangle, sizeof o->u.triangle); break;
-    case SHAPE_CYLINDER:
-    case SHAPE_CONE: h = fnv(h, &o->u.cone, sizeof o->u.cone); break;
-    case SHAPE_DISC: h = fnv(h, &o->u.disc, sizeof o->u.disc); break;
-    case SHAPE_TORUS: h = fnv(h, &o->u.torus, sizeof o->u.torus); break;
-    case SHAPE_SUPERELLIPSOID: h = fnv(h, &o->u.superellipsoid, sizeof o->u.superellipsoid); break;
-    case SHAPE_QUADRIC: h = fnv(h, &o->u.quadric, sizeof o->u.quadric); break;
-    case SHAPE_OVUS: h = fnv(h, &o->u.ovus, sizeof o->u.ovus); break;
-    case SHAPE_MESH: {
-        const scene_mesh *m = o->u.mesh.mesh;
-        if (!m) break;
-        h = fnv(h, &m->nverts, sizeof m->nverts);
-        h = fnv(h, &m->ntris, sizeof m->ntris);
-        if (m->verts) h = fnv(h, m->verts, sizeof *m->verts * (size_t)m->nverts);
-        if (m->tris) h = fnv(h, m->tris, sizeof *m->tris * (size_t)m->ntris);
-        if (m->normals) h = fnv(h, m->normals, sizeof *m->normals * (size_t)m->nnormals);
-        break;
-    }
-    case SHAPE_UNION:
-    case SHAPE_MERGE:
-    case SHAPE_INTERSECTION:
-    case SHAPE_DIFFERENCE:
-        h = fnv(h, &o->u.csg.nkids, sizeof o->u.csg.nkids);
-        for (int i = 0; i < o->u.csg.nkids; i++) h = obj_hash(h, o->u.csg.kids[i], opaque);
-        break;
-    default: *opaque = 1; break;
-    }
-    if (o->clip) h = obj_hash(h ^ 0x636c6970ULL, o->clip, opaque);
-    if (o->bound) h = obj_hash(h ^ 0x626f756eULL, o->bound, opaque);
-    return h;
-}
-
 /* Whether an object (or a member) emits light: it is then a light source
  * of the photons, and moving it moves a light. */
 static int obj_emits(const scene *sc, const scene_object *o)
 {
-    if (is_csg(o)) {
+    if (scene_object_is_csg(o)) {
         for (int i = 0; i < o->u.csg.nkids; i++)
             if (obj_emits(sc, o->u.csg.kids[i])) return 1;
         return 0;
@@ -460,7 +330,7 @@ typedef struct {
     int mob_boxed;                /* 1: the moving objects' surfaces lie in mob_lo..mob_hi */
     vec3 mob_lo, mob_hi;
     const pm_photon_walker *wk;
-    const leaves *lv;
+    const scene_leaves *lv;
     const unsigned char *moving;  /* per leaf */
     const seg *old;               /* previous frame's segments (NULL: a full frame) */
     const long *old_off;
@@ -490,8 +360,8 @@ static void on_seg(void *ctx, long index, const pm_photon_launch *l, const accel
     s.l = *l;
     s.t = h ? h->t : INFINITY;
     s.carried = carried;
-    s.hit_leaf = h ? leaves_find(ws->fc->lv, h->obj) : -1;
-    s.from_leaf = l->from.obj ? leaves_find(ws->fc->lv, l->from.obj) : -1;
+    s.hit_leaf = h ? scene_leaves_find(ws->fc->lv, h->obj) : -1;
+    s.from_leaf = l->from.obj ? scene_leaves_find(ws->fc->lv, l->from.obj) : -1;
     segvec_push(ws->out, &s);
     ws->count++;
     if (ws->plus) apply_seg(ws->plus, ws->fc->ginc, &s);
@@ -520,22 +390,6 @@ static int box_meets(vec3 lo, vec3 hi, vec3 o, vec3 w, double tmax)
     return 1;
 }
 
-/* Shapes whose surfaces lie within accel_bounds (infinite ones do not). */
-static int finite_shape(const scene_object *o)
-{
-    if (is_csg(o)) {
-        for (int i = 0; i < o->u.csg.nkids; i++)
-            if (!finite_shape(o->u.csg.kids[i])) return 0;
-        return 1;
-    }
-    switch (o->kind) {
-    case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_TRIANGLE: case SHAPE_SMOOTH_TRIANGLE: case SHAPE_MESH:
-    case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC: case SHAPE_TORUS: case SHAPE_SUPERELLIPSOID:
-    case SHAPE_OVUS: return 1;
-    default: return 0;
-    }
-}
-
 /* Whether stored segment s is still what tracing it now gives. */
 static int seg_valid(const frame_ctx *fc, const seg *s, long *rays)
 {
@@ -549,7 +403,7 @@ static int seg_valid(const frame_ctx *fc, const seg *s, long *rays)
     (*rays)++;
     if (s->l.from.obj && s->from_leaf >= 0) {
         accel_from f = s->l.from;
-        f.obj = fc->lv->leaf[s->from_leaf];
+        f.obj = scene_leaves_get(fc->lv, s->from_leaf);
         return !accel_intersect_from(fc->mob, &f, s->l.o, s->l.w, 0.0, tmax, &h);
     }
     return !accel_intersect(fc->mob, s->l.o, s->l.w, 0.0, tmax, &h);
@@ -579,11 +433,11 @@ static void path_job(void *ctx, int ci, int thread)
              * k is 0, or its surface is not known in this frame) */
             int resume = k > 0 && l.bounce > 0 && (!l.from.obj || ps[k].from_leaf >= 0);
             if (!resume) k = 0;
-            if (l.from.obj && ps[k].from_leaf >= 0) l.from.obj = fc->lv->leaf[ps[k].from_leaf];
+            if (l.from.obj && ps[k].from_leaf >= 0) l.from.obj = scene_leaves_get(fc->lv, ps[k].from_leaf);
             for (long j = 0; j < k; j++) {
                 segvec_push(out, &ps[j]);
                 /* the launch's surface in this frame's scene */
-                if (ps[j].from_leaf >= 0 && !out->oom) out->v[out->n - 1].l.from.obj = fc->lv->leaf[ps[j].from_leaf];
+                if (ps[j].from_leaf >= 0 && !out->oom) out->v[out->n - 1].l.from.obj = scene_leaves_get(fc->lv, ps[j].from_leaf);
             }
             for (long j = k; j < n; j++) apply_seg(&fc->ap_minus[thread], fc->ginc, &ps[j]);
             nold += n - k;
@@ -595,7 +449,7 @@ static void path_job(void *ctx, int ci, int thread)
         } else {
             for (long j = 0; j < n; j++) {
                 segvec_push(out, &ps[j]);
-                if (ps[j].from_leaf >= 0 && !out->oom) out->v[out->n - 1].l.from.obj = fc->lv->leaf[ps[j].from_leaf];
+                if (ps[j].from_leaf >= 0 && !out->oom) out->v[out->n - 1].l.from.obj = scene_leaves_get(fc->lv, ps[j].from_leaf);
             }
             fc->path_n[i] = n;
         }
@@ -623,7 +477,7 @@ static void full_job(void *ctx, int ci, int thread)
 typedef struct {
     const scene *sc;
     const accel *a;
-    const leaves *lv;
+    const scene_leaves *lv;
     receiver *rec;
     int w, h;
     double eps;
@@ -643,7 +497,7 @@ static void cam_job(void *ctx, int y, int thread)
         accel_hit h;
         rays++;
         if (!accel_intersect(c->a, org, dir, c->eps, INFINITY, &h)) continue;
-        int leaf = leaves_find(c->lv, h.obj);
+        int leaf = scene_leaves_find(c->lv, h.obj);
         if (leaf < 0) continue;
         r->p = h.p;
         r->n = v3_dot(h.ng, dir) < 0.0 ? h.ng : v3_neg(h.ng);
@@ -735,7 +589,7 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     memset(st, 0, sizeof *st);
     pt_status status = PT_OK;
     int nthreads = pm_threads(dp->s.threads);
-    leaves lv;
+    scene_leaves *lv = NULL;
     pm_lights *L = NULL;
     pm_photon_walker *wk = NULL;
     accel *mob = NULL;
@@ -754,19 +608,18 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     int mob_boxed = 0;
     vec3 mob_lo = v3(0, 0, 0), mob_hi = v3(0, 0, 0);
     double t0 = timer_now();
-    if (!leaves_make(&lv, sc)) {
-        leaves_free(&lv);
-        return PT_ERR_NOMEM;
-    }
+    lv = scene_leaves_new(sc);
+    if (!lv) return PT_ERR_NOMEM;
+    int nlv = scene_leaves_count(lv);
     st->objects = sc->nobjects;
     /* 1. what moved */
     const char *full = NULL;
     if (!dp->have) full = "first frame";
     else if (dp->s.full) full = "full recomputation asked for";
     else if (fi && fi->lights_changed) full = "a light changed";
-    else if (sc->nobjects != dp->nobj || lv.n != dp->nleaves) full = "the objects changed in number";
+    else if (sc->nobjects != dp->nobj || nlv != dp->nleaves) full = "the objects changed in number";
     hashes = malloc(sizeof *hashes * (size_t)(sc->nobjects > 0 ? sc->nobjects : 1));
-    moving = calloc((size_t)(lv.n > 0 ? lv.n : 1), 1);
+    moving = calloc((size_t)(nlv > 0 ? nlv : 1), 1);
     mobobj = malloc(sizeof *mobobj * (size_t)(sc->nobjects > 0 ? sc->nobjects : 1));
     if (!hashes || !moving || !mobobj) {
         status = PT_ERR_NOMEM;
@@ -775,7 +628,7 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     int nmob = 0;
     for (int i = 0; i < sc->nobjects; i++) {
         int opaque = 0;
-        hashes[i] = obj_hash(PT_FNV1A_BASIS, sc->objects[i], &opaque);
+        hashes[i] = scene_object_hash(PT_FNV1A_BASIS, sc->objects[i], &opaque);
         int mv = 0;
         if (!full && fi && fi->objects_may_change) mv = opaque || hashes[i] != dp->obj_hash[i];
         if (mv) {
@@ -783,9 +636,9 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
             if (obj_emits(sc, sc->objects[i])) full = "an emissive object moved";
         }
     }
-    for (int l = 0; l < lv.n; l++)
+    for (int l = 0; l < nlv; l++)
         for (int k = 0; k < nmob; k++)
-            if (sc->objects[lv.top[l]] == mobobj[k]) moving[l] = 1;
+            if (sc->objects[scene_leaves_top(lv, l)] == mobobj[k]) moving[l] = 1;
     st->moving_objects = nmob;
     if (!full && nmob > 0) {
         mobsc = *sc;
@@ -802,7 +655,7 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
         /* a box around them, grown by a scene epsilon, answers most
          * segments before Embree is asked */
         mob_boxed = 1;
-        for (int k = 0; k < nmob; k++) mob_boxed &= finite_shape(mobobj[k]);
+        for (int k = 0; k < nmob; k++) mob_boxed &= scene_object_finite(mobobj[k]);
         if (mob_boxed) {
             accel_bounds(mob, &mob_lo, &mob_hi);
             double g = 1e-6 * v3_len(v3_sub(mob_hi, mob_lo)) + 1e-9;
@@ -847,7 +700,7 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
         status = PT_ERR_NOMEM;
         goto done;
     }
-    cam_ctx cc = {sc, a, &lv, rec, width, height, pm_lights_eps(L), 0};
+    cam_ctx cc = {sc, a, lv, rec, width, height, pm_lights_eps(L), 0};
     pool_run(nthreads, height, cam_job, &cc);
     st->rays += atomic_load(&cc.rays);
     int same_image = dp->have && dp->w == width && dp->h == height && dp->E;
@@ -926,7 +779,7 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     fc.mob_lo = mob_lo;
     fc.mob_hi = mob_hi;
     fc.wk = wk;
-    fc.lv = &lv;
+    fc.lv = lv;
     fc.moving = moving;
     fc.old = dp->have ? dp->segs : NULL;
     fc.old_off = dp->poff;
@@ -1008,7 +861,7 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     dp->obj_hash = hashes;
     hashes = NULL;
     dp->nobj = sc->nobjects;
-    dp->nleaves = lv.n;
+    dp->nleaves = nlv;
     dp->sc = sc;
     dp->have = 1;
 done:
@@ -1028,6 +881,6 @@ done:
     pm_photon_walker_free(wk);
     pm_lights_free(L);
     accel_free(mob);
-    leaves_free(&lv);
+    scene_leaves_free(lv);
     return status;
 }
