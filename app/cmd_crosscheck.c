@@ -49,6 +49,7 @@
 #include "cli.h"
 #include "diag.h"
 #include "framebuffer.h"
+#include "hash.h"
 #include "img_io.h"
 #include "img_metrics.h"
 #include "scene.h"
@@ -337,16 +338,9 @@ typedef struct {
     char png[8400];
 } xc_converged;
 
-static uint64_t fnv1a(uint64_t h, const void *p, size_t n)
-{
-    const unsigned char *b = p;
-    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 0x100000001b3ULL;
-    return h;
-}
-
 static uint64_t fnv1a_str(uint64_t h, const char *s)
 {
-    return fnv1a(h, s, strlen(s) + 1);
+    return pt_fnv1a(h, s, strlen(s) + 1);
 }
 
 /* Renders (or finds in the cache) the converged reference into c->png. The
@@ -374,8 +368,7 @@ static int converged_reference(const xc_opts *o, const char *povray, const char 
         fprintf(stderr, "partray crosscheck: cannot read scene '%s'\n", o->scene);
         return 3;
     }
-    uint64_t h = 0xcbf29ce484222325ULL;
-    h = fnv1a(h, text, len);
+    uint64_t h = pt_fnv1a(PT_FNV1A_BASIS, text, len);
     char num[256];
     snprintf(num, sizeof num, "converged/%d/%g|%dx%d|aa %d %g %d", XC_CONVERGED_COUNT, XC_CONVERGED_BOUND, o->width,
              o->height, o->aa, o->aa_threshold, o->aa_depth);

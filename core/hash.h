@@ -1,4 +1,5 @@
-/* hash.h - integer and pointer hashes for open-addressing tables. */
+/* hash.h - integer and pointer hashes for open-addressing tables, and the
+ * one byte-string hash (FNV-1a 64) for keys of files and settings. */
 #ifndef PT_HASH_H
 #define PT_HASH_H
 #include <stddef.h>

@@ -2,6 +2,7 @@
 #include "scene.h"
 #include <stdatomic.h>
 #include "camera.h"
+#include "hash.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -122,6 +123,7 @@ scene *scene_new(void)
     if (!s->mem) { free(s); return NULL; }
     static atomic_ulong next_serial = 1;
     s->serial = atomic_fetch_add(&next_serial, 1);
+    s->input_hash = PT_FNV1A_BASIS;
     scene_default_global(&s->global);
     scene_default_camera(&s->camera);
     scene_default_pigment(&s->default_texture.pigment);

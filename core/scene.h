@@ -12,6 +12,7 @@
 #ifndef PT_SCENE_H
 #define PT_SCENE_H
 #include <stddef.h>
+#include <stdint.h>
 #include "arena.h"
 #include "diag.h"
 #include "scene_camera.h"
@@ -35,6 +36,10 @@ typedef struct {
     scene_texture default_texture;
     int version_major, version_minor; /* from #version; 0 if absent */
     int nfiles;             /* files read (scene + includes) */
+    uint64_t input_hash;    /* FNV-1a 64 (hash.h) of every file the parse read, in the order read: the
+                               scene, its includes, #read data files, images, height fields and density
+                               files, each as its length then its bytes (sdl_hash_input); what the GI
+                               cache and a tile's header name the scene by */
     double clock;
     /* atmosphere (scene_pattern.h) */
     const scene_fog *fogs;  /* linked through `next`; NULL = none */

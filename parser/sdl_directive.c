@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include "fileio.h"
 #include "sdl_array.h"
 #include "sdl_expr.h"
 #include "sdl_file.h"
@@ -22,50 +23,6 @@ static void directive(sdl_parser *p, const sdl_token *hash);
 
 /* ------------------------------------------------------------ sources */
 
-/* The whole file, or NULL with errno set. Only regular files when
- * `regular_only` (an #include of /dev/zero or a FIFO must not hang the
- * parse); never more than `max` bytes (EFBIG). */
-static char *read_file(const char *path, int regular_only, size_t max, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    struct stat st;
-    if (fstat(fileno(f), &st) != 0 || (regular_only && !S_ISREG(st.st_mode))) {
-        fclose(f);
-        errno = EINVAL;
-        return NULL;
-    }
-    size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap);
-    while (buf) {
-        size_t got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (n < cap) break;
-        if (cap > max) {
-            free(buf);
-            fclose(f);
-            errno = EFBIG;
-            return NULL;
-        }
-        char *nb = realloc(buf, cap * 2);
-        if (!nb) {
-            free(buf);
-            buf = NULL;
-            break;
-        }
-        buf = nb;
-        cap *= 2;
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        free(buf);
-        return NULL;
-    }
-    *len = n;
-    return buf;
-}
-
 static sdl_source *add_source(sdl_parser *p, const char *path, char *text, size_t len)
 {
     sdl_source *s = calloc(1, sizeof *s);
@@ -80,6 +37,7 @@ static sdl_source *add_source(sdl_parser *p, const char *path, char *text, size_
     s->next = p->sources;
     p->sources = s;
     p->s->nfiles++;
+    sdl_hash_input(p, text, len);
     return s;
 }
 
@@ -199,7 +157,7 @@ pt_status sdl_open_main(sdl_parser *p, const char *path, const char *text)
         buf = malloc(len + 1);
         if (buf) memcpy(buf, text, len + 1);
     } else {
-        buf = read_file(path, 0, (size_t)p->opt.max_memory, &len);
+        buf = pt_read_file(path, 0, (size_t)p->opt.max_memory, &len);
         if (!buf) {
             src_loc at = {path, 0, 0};
             sdl_error(p, at, PT_ERR_IO, "cannot read scene file: %s", strerror(errno ? errno : ENOENT));
@@ -875,7 +833,7 @@ static void include_directive(sdl_parser *p, src_loc loc)
         return;
     }
     size_t len = 0;
-    char *text = read_file(path, 1, (size_t)p->opt.max_memory, &len);
+    char *text = pt_read_file(path, 1, (size_t)p->opt.max_memory, &len);
     if (!text) {
         sdl_error(p, loc, PT_ERR_IO, "cannot read include file \"%s\": %s", path,
                   errno == EINVAL ? "not a regular file" : strerror(errno));

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include "fileio.h"
 #include "sdl_array.h"
 #include "sdl_directive.h"
 #include "sdl_expr.h"
@@ -136,39 +137,6 @@ static sdl_file *new_file(sdl_parser *p, char *path, const char *given)
     return f;
 }
 
-static char *slurp(const char *path, size_t *len)
-{
-    FILE *fp = fopen(path, "rb");
-    if (!fp) return NULL;
-    /* regular files only: /dev/zero would be read forever, a FIFO or
-     * /dev/stdin could block the parse */
-    struct stat sb;
-    if (fstat(fileno(fp), &sb) != 0 || !S_ISREG(sb.st_mode)) {
-        fclose(fp);
-        return NULL;
-    }
-    size_t cap = 4096, n = 0;
-    char *buf = malloc(cap);
-    while (buf) {
-        size_t got = fread(buf + n, 1, cap - n, fp);
-        n += got;
-        if (got == 0) break;
-        if (n == cap) {
-            char *nb = realloc(buf, cap * 2);
-            if (!nb) {
-                free(buf);
-                buf = NULL;
-                break;
-            }
-            buf = nb;
-            cap *= 2;
-        }
-    }
-    fclose(fp);
-    *len = n;
-    return buf;
-}
-
 void sdl_fopen_directive(sdl_parser *p, src_loc loc)
 {
     p->hold_macros++;
@@ -192,7 +160,9 @@ void sdl_fopen_directive(sdl_parser *p, src_loc loc)
     if (mode.tk.kw == KW_READ) {
         char *path = find_read(p, name);
         size_t len = 0;
-        char *text = path ? slurp(path, &len) : NULL;
+        /* regular files only: /dev/zero would be read forever, a FIFO or
+         * /dev/stdin could block the parse */
+        char *text = path ? pt_read_file(path, 1, (size_t)-1, &len) : NULL;
         if (!text) {
             sdl_error(p, nloc, PT_ERR_IO, "cannot open user file \"%s\" for reading", name);
             free(path);
@@ -206,6 +176,7 @@ void sdl_fopen_directive(sdl_parser *p, src_loc loc)
         }
         f->text = text;
         f->reading = 1;
+        sdl_hash_input(p, text, len);
         sdl_scan_init(&f->sc, f->name, f->text, len);
     } else {
         char *path = place_write(p, name, nloc);

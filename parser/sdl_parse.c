@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include "hash.h"
 #include "sdl_directive.h"
 #include "sdl_expr.h"
 #include "sdl_file.h"
@@ -12,6 +13,32 @@
 #include "sdl_scene.h"
 
 /* ------------------------------------------------------------ errors */
+
+void sdl_hash_input(sdl_parser *p, const void *bytes, size_t n)
+{
+    uint64_t len = n; /* the length first: "ab" + "c" and "a" + "bc" differ */
+    p->s->input_hash = pt_fnv1a(pt_fnv1a(p->s->input_hash, &len, sizeof len), bytes, n);
+}
+
+void sdl_hash_file(sdl_parser *p, const char *path)
+{
+    FILE *f = path ? fopen(path, "rb") : NULL;
+    if (!f) {
+        if (path) sdl_hash_input(p, path, strlen(path));
+        return;
+    }
+    /* length-prefixed like sdl_hash_input: the length is known only at
+     * the end, so the bytes are hashed first, then the length */
+    uint64_t h = p->s->input_hash, len = 0;
+    unsigned char buf[65536];
+    size_t got;
+    while ((got = fread(buf, 1, sizeof buf, f)) > 0) {
+        h = pt_fnv1a(h, buf, got);
+        len += got;
+    }
+    fclose(f);
+    p->s->input_hash = pt_fnv1a(h, &len, sizeof len);
+}
 
 void sdl_error(sdl_parser *p, src_loc loc, pt_status st, const char *fmt, ...)
 {

@@ -146,6 +146,14 @@ static inline int sdl_to_int(double v)
 int sdl_enter(sdl_parser *p, src_loc loc);
 static inline void sdl_leave(sdl_parser *p) { p->depth--; }
 
+/* --- the scene's inputs (scene.input_hash; sdl_parse.c) --- */
+/* Adds n bytes the parse read (a file's contents) to scene.input_hash. */
+void sdl_hash_input(sdl_parser *p, const void *bytes, size_t n);
+/* Adds the contents of the file at path (read again: images and density
+ * files are decoded by their own readers); an unreadable file adds its
+ * path's bytes, so the hash still differs from a scene without it. */
+void sdl_hash_file(sdl_parser *p, const char *path);
+
 /* --- errors and warnings (sdl_parse.c) --- */
 static inline int sdl_ok(const sdl_parser *p) { return p->status == PT_OK; }
 void sdl_error(sdl_parser *p, src_loc loc, pt_status st, const char *fmt, ...)

@@ -232,6 +232,7 @@ static scene_image *image_spec(sdl_parser *p, int data)
     /* assumed_gamma in a pre-3.7 scene: files default to the working gamma (sdl_image.h) */
     if (p->s->global.assumed_gamma > 0.0 && p->version < 3.65) wg = -wg;
     if (data) wg = 0.0;
+    sdl_hash_file(p, img->path);
     if (sdl_image_load(img, p->s->mem, wg, (unsigned long long)p->opt.max_image_pixels, why, sizeof why) != 0) {
         sdl_warning(p, loc, "%s; the image is transparent", why);
         return NULL;
@@ -810,6 +811,7 @@ static int pattern_type(sdl_parser *p, target *tg)
         }
         scene_density *d = sdl_alloc(p, sizeof *d);
         char why[512];
+        sdl_hash_file(p, path);
         if (d && sdl_df3_load(d, path, p->s->mem, why, sizeof why) != 0) {
             sdl_error(p, floc, PT_ERR_IO, "%s", why);
             break;

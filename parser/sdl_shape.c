@@ -686,6 +686,7 @@ static void height_field_args(sdl_parser *p, scene_object *o, src_loc loc)
         }
         char why[256] = "";
         int r = sdl_hf_read(path, (unsigned long long)p->opt.max_image_pixels, &img, why, sizeof why);
+        sdl_hash_file(p, path);
         free(path);
         if (r == SDL_HF_UNSUPPORTED) {
             o->kind = SHAPE_UNSUPPORTED;

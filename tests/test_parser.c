@@ -891,6 +891,48 @@ static int make_tmpdir(void **st)
     return mkdtemp(tmpdir) ? 0 : -1;
 }
 
+static uint64_t input_hash_of(const char *name)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s", tmpdir, name);
+    diag *d = diag_new();
+    scene *s = NULL;
+    assert_int_equal(sdl_parse_file(path, NULL, &s, d), PT_OK);
+    uint64_t h = s->input_hash;
+    scene_free(s);
+    diag_free(d);
+    return h;
+}
+
+/* scene.input_hash covers every file the parse read: an edit of an
+ * #include'd file or of a #read data file changes it (the GI cache and a
+ * tile's header name the scene by it), parsing again does not, and a
+ * byte moved from one file to the other does (each file is hashed with its
+ * length). */
+static void test_input_hash(void **st)
+{
+    (void)st;
+    write_file("hash.inc", "#declare R = 2;\n");
+    write_file("hash.dat", "3,\n");
+    write_file("hash.pov", "#include \"hash.inc\"\n#fopen F \"hash.dat\" read\n#read (F, V)\n"
+                           "sphere { 0, R + V }\n");
+    uint64_t h0 = input_hash_of("hash.pov");
+    assert_true(h0 == input_hash_of("hash.pov"));
+    write_file("hash.inc", "#declare R = 3;\n");
+    uint64_t h1 = input_hash_of("hash.pov");
+    assert_true(h1 != h0);
+    write_file("hash.dat", "4,\n");
+    uint64_t h2 = input_hash_of("hash.pov");
+    assert_true(h2 != h1 && h2 != h0);
+    write_file("hash.inc", "#declare R = 2;\n");
+    write_file("hash.dat", "3,\n");
+    assert_true(input_hash_of("hash.pov") == h0);
+    /* "#declare R = 2;\n" + "3,\n" against "#declare R = 2;" + "\n3,\n": same bytes in all */
+    write_file("hash.inc", "#declare R = 2;");
+    write_file("hash.dat", "\n3,\n");
+    assert_true(input_hash_of("hash.pov") != h0);
+}
+
 static void test_error_files(void **st)
 {
     (void)st;
@@ -1074,6 +1116,7 @@ int main(void)
         cmocka_unit_test(test_error_loop_limit),
         cmocka_unit_test_setup(test_error_files, make_tmpdir),
         cmocka_unit_test(test_photons_language),
+        cmocka_unit_test_setup(test_input_hash, make_tmpdir),
         cmocka_unit_test(test_scene_sweep),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
