@@ -238,9 +238,10 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
             if (errno || *end || end == next) { snprintf(err, (size_t)errlen, "--seed wants an integer"); return 2; }
             o->seed = s;
             i++;
-        } else if (strcmp(a, "--stats") == 0) {
+        } else if (strcmp(a, "--stats") == 0 || strcmp(a, "--gi-cache") == 0) {
             if (!has_value(a, next, err, errlen)) return 2;
-            o->stats = next;
+            if (strcmp(a, "--stats") == 0) o->stats = next;
+            else o->gi_cache = next;
             i++;
         } else if (strcmp(a, "--display") == 0 || strcmp(a, "--view") == 0 || strcmp(a, "--look") == 0 ||
                    strcmp(a, "--working-space") == 0 || strcmp(a, "--ocio-config") == 0 ||
@@ -580,6 +581,8 @@ const char cli_render_help[] =
     "  --gi-quality Q         particle: Q times the particles the scene's radiosity{} asks for\n"
     "                         (default 1; 0.5 faster and coarser, 2 or 4 slower and closer to converged)\n"
     "  --cl-device NAME --cl-max-memory MIB    particle: OpenCL device and its memory\n"
+    "  --gi-cache FILE        particle: read the geometry stage from FILE when it exists (refused\n"
+    "                         when made for another scene or settings), else compute and save it\n"
     "  --max-depth N          path: vertices per path\n"
     "  --fg-rays N --photons N    pmfg: final-gather rays per pixel, photon paths\n"
     "  --gi detp [--photons N] [--detp-radius R] [--detp-full]\n"

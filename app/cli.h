@@ -77,6 +77,8 @@ typedef struct {
     int detp_full;          /* --detp-full: every frame traces and estimates everything anew */
     const char *cl_device;  /* particle GI: OpenCL device (NULL/"auto", "c", "P:D" or part of a name) */
     long long cl_max_memory_mib; /* particle GI: OpenCL device memory it may use (0 = the device's) */
+    const char *gi_cache;   /* --gi-cache FILE: particle GI's geometry stage read from FILE when it
+                               exists, else computed and saved there (gi_particle_save) */
     /* lighting studies (app/lighting_study.h, docs/units.md) */
     const char *aovs;       /* --aovs LIST: extra EXR layers */
     const char *units;      /* --units m|cm|mm|ft|...|METRES: photometric lights */

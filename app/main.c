@@ -15,6 +15,7 @@
 #include "diag.h"
 #include "framebuffer.h"
 #include "gi.h"
+#include "hash.h"
 #include "img_falsecolor.h"
 #include "img_io.h"
 #include "img_ocio.h"
@@ -273,18 +274,13 @@ static void gi_keep_free(gi_keep *k)
     memset(k, 0, sizeof *k);
 }
 
-static uint64_t fnv(uint64_t h, const void *p, size_t n)
-{
-    const unsigned char *b = p;
-    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 0x100000001b3ULL;
-    return h;
-}
-#define FNV(h, field) fnv((h), &(field), sizeof(field))
+#define FNV(h, field) pt_fnv1a((h), &(field), sizeof(field))
 
 /* The hashes of the GI stages' inputs in the IR.
  *  - geometry (and everything else but the camera and the lights: objects,
- *    materials, media, global settings): the scene file's bytes and the
- *    options, which are the same in every frame of one run, and the frame
+ *    materials, media, global settings): the bytes of every file the parse
+ *    read (scene.input_hash) and the options, which are the same in every
+ *    frame of one run, and the frame
  *    number when the parser saw a per-frame value read outside camera{} and
  *    light_source{} (sdl_options.frame_dependent), when a light carries
  *    geometry (looks_like, projected_through) or the camera does (normal,
@@ -292,10 +288,9 @@ static uint64_t fnv(uint64_t h, const void *p, size_t n)
  *    lights in place);
  *  - lighting: every light's fields;
  *  - view: the camera, which the view stage always takes as given. */
-static void stage_hashes(const scene *sc, uint64_t file_hash, int frame_dependent, int frame, uint64_t *h_geom,
-                         uint64_t *h_light)
+static void stage_hashes(const scene *sc, int frame_dependent, int frame, uint64_t *h_geom, uint64_t *h_light)
 {
-    uint64_t g = 0xcbf29ce484222325ULL, l = g;
+    uint64_t g = PT_FNV1A_BASIS, l = g;
     int dep = frame_dependent || sc->camera.normal || sc->camera.nmeshes > 0;
     for (int i = 0; i < sc->nlights; i++) {
         const scene_light *li = &sc->lights[i];
@@ -325,11 +320,35 @@ static void stage_hashes(const scene *sc, uint64_t file_hash, int frame_dependen
         l = FNV(l, li->media_attenuation);
         l = FNV(l, li->group);
     }
-    g = FNV(g, file_hash);
+    g = FNV(g, sc->input_hash);
     g = FNV(g, sc->nlights);
     if (dep) g = FNV(g, frame);
     *h_geom = g;
     *h_light = l ^ g;
+}
+
+/* The key a GI cache is checked against (--gi-cache, gi_particle_save):
+ * the geometry stage's inputs as stage_hashes sees them, and what one run
+ * keeps the same from frame to frame but another process may not: the
+ * declarations (-D, Declare=), the image size (image_width and
+ * image_height are scene values), the animation values when the scene read
+ * them outside the camera and lights, the camera's position (the geometry
+ * stage keeps the particles that face it, gi_particle.c trace_and_prune),
+ * and this partray's version. The GI settings are checked by the cache
+ * itself. */
+static uint64_t gi_cache_key(const scene *sc, uint64_t h_geom, const sdl_options *so, int frame_dependent)
+{
+    uint64_t k = FNV(PT_FNV1A_BASIS, h_geom);
+    for (int i = 0; i < so->ndefines; i++) k = pt_fnv1a(k, so->defines[i], strlen(so->defines[i]) + 1);
+    k = FNV(k, so->image_width);
+    k = FNV(k, so->image_height);
+    if (frame_dependent) {
+        k = FNV(k, so->clock);
+        k = FNV(k, so->clock_delta);
+        k = FNV(k, so->frame_number);
+    }
+    if (sc->camera_set) k = FNV(k, sc->camera.location);
+    return pt_fnv1a(k, PARTRAY_VERSION, strlen(PARTRAY_VERSION));
 }
 
 /* What stays the same from frame to frame of one `partray render`. */
@@ -339,7 +358,6 @@ typedef struct {
     lighting_study *ls;
     int win[4];             /* the render window (cli_window) */
     int tile;               /* 1: a window smaller than the image was asked for */
-    uint64_t scene_hash;    /* FNV-1a 64 of the scene file's bytes */
     double t_start;
     gi_keep keep;           /* particle GI of the previous frame */
     pm_detp *detp;          /* --gi detp: the photon paths of the previous frame */
@@ -361,20 +379,6 @@ static framebuffer *straight_alpha(const framebuffer *fb)
     for (size_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++) c->rgb[i * 3 + k] = fb->alpha[i] > 0 ? fb->rgb[i * 3 + k] / fb->alpha[i] : fb->rgb[i * 3 + k];
     return c;
-}
-
-/* FNV-1a 64 of a file's bytes (0 when unreadable: the parser reports it). */
-static uint64_t file_hash(const char *path)
-{
-    uint64_t h = 0xcbf29ce484222325ULL;
-    FILE *f = fopen(path, "rb");
-    if (!f) return 0;
-    unsigned char buf[65536];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, f)) > 0)
-        for (size_t i = 0; i < n; i++) h = (h ^ buf[i]) * 0x100000001b3ULL;
-    fclose(f);
-    return h;
 }
 
 /* Frame `frame` of the plan (a still: frame 0), written to outputs[]. */
@@ -430,9 +434,17 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
      * hash of its inputs changed (stage_hashes); the frame then renders the
      * kept scene with this frame's camera and lights. */
     int reuse = 0, relight = 0, keep_gi = gi == GI_PARTICLE && plan->animated && !run->tile;
-    uint64_t h_geom = 0, h_light = 0;
+    uint64_t h_geom = 0, h_light = 0, scene_hash = sc->input_hash;
+    if (gi == GI_PARTICLE) stage_hashes(sc, frame_dependent, frame, &h_geom, &h_light);
+    /* an animation's frames have a cache each, numbered as the outputs
+     * (frames that keep the GI of an earlier one in this run write none) */
+    char *gi_cache_frame = gi == GI_PARTICLE && o->gi_cache && plan->animated
+                               ? anim_output_name(o->gi_cache, frame, plan->digits) : NULL;
+    const char *gi_cache = gi_cache_frame ? gi_cache_frame : (gi == GI_PARTICLE ? o->gi_cache : NULL);
+    uint64_t cache_key = gi_cache ? gi_cache_key(sc, h_geom, &so, frame_dependent) : 0;
+    if (o->gi_cache && !gi_cache)
+        diag_warn_once(d, (src_loc){0}, "--gi-cache applies to --gi particle, not %s: ignored", gi_used);
     if (keep_gi) {
-        stage_hashes(sc, run->scene_hash, frame_dependent, frame, &h_geom, &h_light);
         if (run->keep.gp && h_geom == run->keep.h_geom) {
             reuse = 1;
             relight = h_light != run->keep.h_light;
@@ -454,6 +466,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     double t_accel = 0.0;
     accel *acc = reuse ? run->keep.acc : pipeline_accel(sc, threads, d, &st, &t_accel);
     if (!acc || st != PT_OK) {
+        free(gi_cache_frame);
         scene_free(sc);
         diag_free(d);
         pbar_free(bar);
@@ -493,7 +506,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
          * again (pm_detp.h); the IR's stage hashes say whether the lights
          * changed and whether objects may have */
         uint64_t hg, hl;
-        stage_hashes(sc, run->scene_hash, frame_dependent, frame, &hg, &hl);
+        stage_hashes(sc, frame_dependent, frame, &hg, &hl);
         int had = run->detp != NULL;
         if (!run->detp) run->detp = render_gi_detp_new(&ss);
         ss.detp = run->detp;
@@ -502,6 +515,9 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
         run->detp_h_geom = hg;
         run->detp_l = hl ^ hg;
     }
+    ss.gi_cache = gi_cache;
+    ss.gi_cache_load = gi_cache && access(gi_cache, F_OK) == 0;
+    ss.gi_cache_key = cache_key;
     if (run->tile) memcpy(ss.window, run->win, sizeof ss.window);
     char *progressive = NULL;
     if ((gi == GI_PATH || gi == GI_PMFG) && noutputs > 0 && img_format_from_path(outputs[0]) != IMG_FMT_UNKNOWN) {
@@ -562,7 +578,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
              "size %dx%d, antialias %s threshold %.17g depth %d, spp %d, seed %llu, gi %s, particles %ld, bounces %d",
              ss.width, ss.height, ss.antialias == 1 ? "adaptive" : (ss.antialias == 2 ? "fixed" : "off"), ss.aa_threshold,
              ss.aa_depth, ss.spp, (unsigned long long)ss.seed, gi_used, o->particles, o->bounces);
-    snprintf(hash, sizeof hash, "%016llx", (unsigned long long)run->scene_hash);
+    snprintf(hash, sizeof hash, "%016llx", (unsigned long long)scene_hash);
     snprintf(framestr, sizeof framestr, "%d clock %.17g", frame, so.clock);
     snprintf(window, sizeof window, "%d %d %d %d", run->win[0], run->win[1], run->win[2], run->win[3]);
     const char *keys[] = {"partray:scene", "partray:gi", "partray:version", "partray:render_seconds", "partray:timings",
@@ -626,6 +642,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
         stats_num(&js, "total", plan->animated ? t_total : timer_now() - run->t_start);
         stats_obj_end(&js);
         if (plan->animated) stats_int(&js, "frame", frame);
+        if (gi_cache) stats_str(&js, "gi_cache", sst.gi_cache_loaded ? "loaded" : "saved");
         if (keep_gi) {
             stats_int(&js, "gi_geometry_ran", sst.ran_geometry);
             stats_int(&js, "gi_lighting_ran", sst.ran_lighting);
@@ -679,11 +696,14 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
                     p->paths, p->paths > 0 ? 100.0 * (double)p->paths_retraced / (double)p->paths : 0.0, p->segments_old,
                     p->segments_new, p->segments, p->receivers_full, p->receivers);
         }
+        if (gi_cache && (sst.ran_geometry || sst.gi_cache_loaded))
+            fprintf(stderr, "partray: %sgi cache %s: %s\n", fr, gi_cache, sst.gi_cache_loaded ? "loaded" : "saved");
         if (keep_gi)
             fprintf(stderr, "partray: %sgi stages run: %s%sview\n", fr, sst.ran_geometry ? "geometry, " : "",
                     sst.ran_lighting ? "lighting, " : "");
     }
     fb_free(fb);
+    free(gi_cache_frame);
     if (keep_gi && sst.kept && !reuse) {
         /* this frame's GI, scene and accel serve the next frames */
         run->keep.sc = sc;
@@ -815,7 +835,6 @@ static int cmd_render(int argc, char **argv)
                 o.width <= 0 && o.height <= 0 ? ", POV-Ray's default" : " (POV-Ray's default 320x240 for the side not given)");
     run.oc = oc;
     run.ls = &ls;
-    run.scene_hash = file_hash(o.scene);
     signal(SIGINT, on_sigint);
     signal(SIGTERM, on_sigint); /* kill, systemd, timeout(1): stop like Ctrl-C */
     int nframes = plan.last - plan.first + 1;

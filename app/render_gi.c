@@ -88,12 +88,19 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     double t0 = timer_now();
     gi_particle *gp = o->reuse;
     if (!gp) {
-        gp = gi_particle_build(sc, a, &gs, &r->particle, d, &st);
+        int load = o->gi_cache && o->gi_cache_load;
+        gp = load ? gi_particle_load(sc, a, &gs, o->gi_cache, o->gi_cache_key, &r->particle, d, &st)
+                  : gi_particle_build(sc, a, &gs, &r->particle, d, &st);
         r->t_gi_geometry = timer_now() - t0;
         /* cancelled: nothing rendered, the caller sees its flag (as in the
          * other modes, which stop at a tile) */
         if (!gp) return st == PT_CANCELLED ? PT_OK : (st == PT_OK ? PT_ERR_INTERNAL : st);
-        r->ran_geometry = 1;
+        r->ran_geometry = !load;
+        r->gi_cache_loaded = load;
+        if (o->gi_cache && !load && (st = gi_particle_save(gp, o->gi_cache, o->gi_cache_key, d)) != PT_OK) {
+            gi_particle_free(gp);
+            return st;
+        }
     }
     r->has_particle = 1;
     gi_particle_set_cancel(gp, o->cancel);

@@ -50,6 +50,13 @@ typedef struct {
     pm_detp_frame_info detp_frame;
     double detp_radius;       /* detp: disc radius (0 = default) */
     int detp_full;            /* detp: recompute every frame */
+    /* particle: the geometry stage's file (gi_particle_save/_load), NULL:
+     * none. gi_cache_load: read it (a mismatch or a bad file is the
+     * render's error), else build and save it. gi_cache_key: the scene's
+     * key it is checked against. */
+    const char *gi_cache;
+    int gi_cache_load;
+    uint64_t gi_cache_key;
     int window[4];            /* none/particle: render window x0,y0,x1,y1 (shade_settings.window); 0 = all */
     shade_aov *aov;           /* non-NULL: fill these AOVs after the render (shade_aov.h); the indirect
                                  AOV comes from particle GI only (0 for none, pmfg, path) */
@@ -70,6 +77,7 @@ typedef struct {
     int ran_geometry, ran_lighting; /* particle: the stages this render ran (the view stage always runs) */
     int has_detp;
     pm_detp_stats detp;
+    int gi_cache_loaded;      /* particle: the geometry stage came from opts.gi_cache */
     gi_particle *kept;        /* particle with opts.keep: the GI, the caller frees it */
     /* Light the scene uses that the mode does not carry (each also warned
      * once): 1 where it is left out. path, pmfg: participating media

@@ -433,11 +433,10 @@ static void sky_as_emission(gi_particle *gp)
     }
 }
 
-gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particle_settings *s,
-                               gi_particle_stats *stats, diag *d, pt_status *status)
+gi_particle *gi_particle_begin(const scene *sc, const accel *a, const gi_particle_settings *s, diag *d,
+                               pt_status *status)
 {
-    pt_status dummy, st = PT_OK;
-    if (!status) status = &dummy;
+    pt_status st = PT_OK;
     gi_particle *gp = calloc(1, sizeof *gp);
     if (!gp) {
         *status = PT_ERR_NOMEM;
@@ -469,20 +468,41 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     S->bounces = set->bounces;
 
     /* the device first: a missing OpenCL driver should fail before seconds of ray tracing */
-    double t0 = timer_now();
     gi_dev_options o = {set->cl_device, set->cl_source, gp->threads, set->cl_max_bytes};
     gp->dev = gi_dev_open(&o, d, &st);
-    if (!gp->dev) goto fail;
+    if (!gp->dev) {
+        *status = st == PT_OK ? PT_ERR_INTERNAL : st;
+        gi_particle_free(gp);
+        return NULL;
+    }
     S->t_kernel_build = gi_dev_build_seconds(gp->dev);
     snprintf(S->device, sizeof S->device, "%s", gi_dev_name(gp->dev));
 
-    double c0 = timer_cpu_now();
     progress_stage(set->progress, "gi geometry: surfaces", 0);
     double tg = timer_now();
     gp->surf = gi_surface_build(sc, a, 1e30, d, &st);
-    if (!gp->surf) goto fail;
+    if (!gp->surf) {
+        *status = st == PT_OK ? PT_ERR_INTERNAL : st;
+        gi_particle_free(gp);
+        return NULL;
+    }
     S->skipped_objects = gi_surface_skipped(gp->surf);
     S->t_surfaces = timer_now() - tg;
+    *status = PT_OK;
+    return gp;
+}
+
+gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particle_settings *s,
+                               gi_particle_stats *stats, diag *d, pt_status *status)
+{
+    pt_status dummy, st = PT_OK;
+    if (!status) status = &dummy;
+    double t0 = timer_now(), c0 = timer_cpu_now();
+    gi_particle *gp = gi_particle_begin(sc, a, s, d, status);
+    if (!gp) return NULL;
+    gi_particle_settings *set = &gp->set;
+    gi_particle_stats *S = &gp->st;
+    double tg;
 
     /* pilot: a quarter of the particles on every side, to learn which sides
      * are needed (see keep_needed) and what fraction of each survives */
@@ -615,17 +635,34 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
                            set->progress, d);
     if (st != PT_OK) goto fail;
     S->radiance_particles = gp->lists.nrp;
-    S->radiance_slots = gi_surface_rp_slots(gp->surf);
     S->list_entries = gp->lists.off[gp->lists.nrp];
     S->lists_widened = gp->lists.widened;
     S->lists_empty = gp->lists.empty;
-    gp->rgrid = gi_grid_build(gp->ps.p, gp->ps.n, S->radius);
-    if (!gp->rgrid) {
-        st = PT_ERR_NOMEM;
-        goto fail;
-    }
     S->t_lists = timer_now() - tg;
     S->c_lists = timer_cpu_now() - cg;
+    st = gi_particle_finish(gp, d);
+    if (st != PT_OK) goto fail;
+    S->t_geometry = timer_now() - t0 - S->t_kernel_build;
+    S->c_geometry = timer_cpu_now() - c0;
+    fill_stats(gp, stats);
+    *status = PT_OK;
+    return gp;
+fail:
+    if (st == PT_OK) st = PT_ERR_INTERNAL;
+    *status = st;
+    gi_particle_free(gp);
+    return NULL;
+}
+
+pt_status gi_particle_finish(gi_particle *gp, diag *d)
+{
+    pt_status st = PT_OK;
+    gi_particle_stats *S = &gp->st;
+    S->radiance_slots = gi_surface_rp_slots(gp->surf);
+    double tg = timer_now();
+    gp->rgrid = gi_grid_build(gp->ps.p, gp->ps.n, S->radius);
+    if (!gp->rgrid) return PT_ERR_NOMEM;
+    S->t_lists += timer_now() - tg;
 
     /* host state */
     {
@@ -639,7 +676,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         gp->rp_val = gi_particle_calloc(nrp * 4, sizeof(float), &st);
         gp->rp_state = gi_particle_calloc(nrp, sizeof(atomic_uchar), &st);
         gp->mark = gi_particle_calloc(nrp, sizeof(atomic_uchar), &st);
-        if (st != PT_OK) goto fail;
+        if (st != PT_OK) return st;
         /* about 2 cells per radiance particle; room for twice that, within
          * 4M slots (32 MiB): more cells than a 1920x1080 frame's hits.
          * Without a table (out of memory) every hit is tested. */
@@ -653,7 +690,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         size_t nl = (size_t)n * (size_t)gp->ns2;
         gp->rin_off = gi_particle_calloc((size_t)n + 2, sizeof(int), &st);
         gp->rin_src = gi_particle_calloc(nl, sizeof(int), &st);
-        if (st != PT_OK) goto fail;
+        if (st != PT_OK) return st;
         gi_links_reverse_count(gp->slink, n, gp->ns2, NULL, gp->rin_off);
         gi_links_reverse_fill(gp->slink, n, gp->ns2, NULL, gp->rin_off, gp->rin_src);
     }
@@ -662,19 +699,14 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     st = gi_dev_set_particles(gp->dev, gp->ps.p, gp->ps.n, gp->slink, gp->ns2, gp->glink, gp->ng, gp->esky, d);
     if (st == PT_OK) st = gi_dev_set_lists(gp->dev, gp->lists.off, (int)gp->lists.nrp, gp->lists.idx, d);
     if (st == PT_OK) st = gi_dev_set_reverse(gp->dev, gp->rin_off, gp->rin_src, d);
-    if (st == PT_OK && set->scatter != GI_PARTICLE_SCATTER_FULL) st = gi_particle_build_walk(gp, set->bounces - 1, d);
-    if (st != PT_OK) goto fail;
+    if (st == PT_OK && gp->set.scatter != GI_PARTICLE_SCATTER_FULL) st = gi_particle_build_walk(gp, gp->set.bounces - 1, d);
     S->t_upload = timer_now() - tg;
-    S->t_geometry = timer_now() - t0 - S->t_kernel_build;
-    S->c_geometry = timer_cpu_now() - c0;
-    fill_stats(gp, stats);
-    *status = PT_OK;
-    return gp;
-fail:
-    if (st == PT_OK) st = PT_ERR_INTERNAL;
-    *status = st;
-    gi_particle_free(gp);
-    return NULL;
+    return st;
+}
+
+void gi_particle_fill_stats(gi_particle *gp, gi_particle_stats *out)
+{
+    fill_stats(gp, out);
 }
 
 void gi_particle_free(gi_particle *gp)

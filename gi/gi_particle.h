@@ -244,6 +244,23 @@ int gi_particle_primary_hit(void *ctx, int x, int y, vec3 *org, vec3 *dir, const
 const gi_particle_stats *gi_particle_get_stats(gi_particle *gp);
 void gi_particle_free(gi_particle *gp);
 
+/* The geometry stage in a file (--gi-cache; gi_particle_cache.c has the
+ * layout): save writes gp's geometry stage (lighting and view are not
+ * stored) under scene_key, the caller's hash of everything the stage read
+ * of the scene; written whole or not at all (a temporary name, then
+ * rename). load is gi_particle_build with the particles, links and lists
+ * read from the file: the same bits, so the same image. It refuses (NULL,
+ * a located error `PATH: error: ...` in d, *status PT_ERR_SYNTAX) a file
+ * that is not a cache, of another format version or byte order, truncated
+ * or altered (checksum), made under another scene_key or with other
+ * geometry settings (count, links, bounces, seed, radii), or whose
+ * particles do not fit this scene's surfaces; an unreadable file is
+ * PT_ERR_IO. */
+#define GI_PARTICLE_CACHE_VERSION 1
+pt_status gi_particle_save(gi_particle *gp, const char *path, uint64_t scene_key, diag *d);
+gi_particle *gi_particle_load(const scene *sc, const accel *a, const gi_particle_settings *s, const char *path,
+                              uint64_t scene_key, gi_particle_stats *stats, diag *d, pt_status *status);
+
 /* For tests and tools: the particles' state after the lighting stage.
  * Returns the count; arrays are owned by gp (n*4 floats: E/pi direct,
  * received flux phi, reflected radiance L), and the per-bounce tally of the

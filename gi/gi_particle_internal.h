@@ -118,6 +118,21 @@ void gi_particle_batch_test(gi_particle *gp, struct cell_batch *b, thread_count 
 int gi_particle_cell_verdict(gi_particle *gp, uint64_t key, const long rp[3], const scene_object *own, thread_count *tc);
 void gi_particle_cell_batch_free(struct cell_batch *b);
 
+/* The geometry stage in parts (gi_particle.c), shared by gi_particle_build
+ * and gi_particle_load (gi_particle_cache.c):
+ *  begin: settings clamped, sky, OpenCL device, surfaces (not yet
+ *         re-tessellated); NULL with *status set on failure;
+ *  then the particles (gp->ps), links (slink, glink, esky), stats
+ *  spacing/tess/radius, the re-tessellation and the estimation lists
+ *  (gp->lists), built or read;
+ *  finish: everything derived from those (the particle grid, host state,
+ *         reverse links, device upload, the WALK path table). */
+gi_particle *gi_particle_begin(const scene *sc, const accel *a, const gi_particle_settings *s, diag *d,
+                               pt_status *status);
+pt_status gi_particle_finish(gi_particle *gp, diag *d);
+/* The stats with the per-thread counters summed, copied to out (may be NULL). */
+void gi_particle_fill_stats(gi_particle *gp, gi_particle_stats *out);
+
 /* Geometry stage helpers the lighting stage uses (gi_particle.c). */
 /* calloc of n (at least 1) elements; sets *st to PT_ERR_NOMEM on failure. */
 void *gi_particle_calloc(size_t n, size_t size, pt_status *st);

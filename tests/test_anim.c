@@ -337,6 +337,81 @@ static void test_gi_reuse(void **st)
     }
 }
 
+/* --gi-cache: a render saves its particle GI's geometry stage; another
+ * process (other thread count) loads it and gives the same image, byte for
+ * byte (PFM), as does a render without the cache. A cache is refused (exit
+ * 1, `FILE: error: ...`, no image written) after an edit of an #include'd
+ * file, with other GI settings, of another format version, or altered. */
+static void test_gi_cache(void **st)
+{
+    (void)st;
+    char scene[600], inc[600], cache[600], a[600], b[600], c[600], x[600], cmd[4096];
+    snprintf(scene, sizeof scene, "%s/cache.pov", tmpdir);
+    snprintf(inc, sizeof inc, "%s/cache_room.inc", tmpdir);
+    snprintf(cache, sizeof cache, "%s/cache.gic", tmpdir);
+    snprintf(a, sizeof a, "%s/cache_a.pfm", tmpdir);
+    snprintf(b, sizeof b, "%s/cache_b.pfm", tmpdir);
+    snprintf(c, sizeof c, "%s/cache_c.pfm", tmpdir);
+    snprintf(x, sizeof x, "%s/cache_x.pfm", tmpdir);
+    tu_write_file(scene, "#version 3.7;\nglobal_settings { radiosity { count 50 } }\n"
+                         "camera { location <0.3, 1, -3.2> look_at <0, 0.8, 0> angle 60 }\n"
+                         "light_source { <0, 1.8, -0.5> rgb 1 }\n#include \"cache_room.inc\"\n"
+                         "sphere { <-0.6, 0.4, -0.3>, 0.4 pigment { rgb <0.9, 0.3, 0.2> } finish { diffuse 0.8 ambient 0 } }\n");
+    tu_write_file(inc, "box { <-1.5, 0, -4>, <1.5, 2, 1.5> hollow pigment { rgb 0.8 } finish { diffuse 0.8 ambient 0 } }\n");
+    const char *opts = "--size 48x36 --particles 5000";
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' %s --threads 2 --gi-cache '%s' -o '%s'", PARTRAY_BIN, scene, opts, cache, a);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    assert_non_null(strstr(tu_out, "cache.gic: saved"));
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' %s --threads 1 --gi-cache '%s' -o '%s'", PARTRAY_BIN, scene, opts, cache, b);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    assert_non_null(strstr(tu_out, "cache.gic: loaded"));
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' %s -q -o '%s'", PARTRAY_BIN, scene, opts, c);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    snprintf(cmd, sizeof cmd, "cmp '%s' '%s' && cmp '%s' '%s'", a, b, a, c);
+    int rc = tu_run_capture(cmd);
+    printf("saved, loaded in another process, no cache: %s\n", rc == 0 ? "identical" : tu_out);
+    assert_int_equal(rc, 0);
+
+    /* refusals: exit 1, the cache's name first, no image */
+    static const struct {
+        const char *what, *extra, *want;
+    } bad[] = {
+        {"include edited", "", "made for another scene"},
+        {"other settings", "--particles 6000", "another particle count"},
+        {"format version", "", "format version 9"},
+        {"altered", "", "checksum"},
+    };
+    char saved[600];
+    snprintf(saved, sizeof saved, "%s/cache_saved.gic", tmpdir);
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s'", cache, saved);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        snprintf(cmd, sizeof cmd, "cp '%s' '%s'", saved, cache);
+        assert_int_equal(tu_run_capture(cmd), 0);
+        if (i == 0)
+            tu_write_file(inc, "box { <-1.5, 0, -4>, <1.5, 2, 1.5> hollow pigment { rgb 0.7 } finish { diffuse 0.8 ambient 0 } }\n");
+        else
+            tu_write_file(inc, "box { <-1.5, 0, -4>, <1.5, 2, 1.5> hollow pigment { rgb 0.8 } finish { diffuse 0.8 ambient 0 } }\n");
+        if (i == 2 || i == 3) {
+            /* byte 17 is the version's low byte (little-endian), 100000 inside the links */
+            snprintf(cmd, sizeof cmd, "printf '%s' | dd of='%s' bs=1 seek=%d conv=notrunc 2>/dev/null", i == 2 ? "\\011" : "\\125",
+                     cache, i == 2 ? 17 : 100000);
+            assert_int_equal(tu_run_capture(cmd), 0);
+        }
+        remove(x);
+        snprintf(cmd, sizeof cmd, "'%s' render '%s' %s %s --gi-cache '%s' -o '%s'", PARTRAY_BIN, scene, opts, bad[i].extra,
+                 cache, x);
+        rc = tu_run_capture(cmd);
+        printf("%s: exit %d: %s", bad[i].what, rc, tu_out);
+        assert_int_equal(rc, 1);
+        char want[700];
+        snprintf(want, sizeof want, "%s: error: ", cache);
+        assert_non_null(strstr(tu_out, want));
+        assert_non_null(strstr(tu_out, bad[i].want));
+        assert_false(tu_exists(x));
+    }
+}
+
 int main(void)
 {
     if (tu_mkdtemp(tmpdir, sizeof tmpdir, "partray-anim")) return 1;
@@ -346,6 +421,7 @@ int main(void)
         cmocka_unit_test(test_window_as_povray),
         cmocka_unit_test(test_tiles_merge),
         cmocka_unit_test(test_gi_reuse),
+        cmocka_unit_test(test_gi_cache),
     };
     return tu_finish(cmocka_run_group_tests(tests, NULL, NULL), tmpdir);
 }
