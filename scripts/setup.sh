@@ -9,7 +9,7 @@ ocl-icd-opencl-dev opencl-headers pocl-opencl-icd
 libcmocka-dev libsdl2-dev libfreetype-dev libjpeg-dev libtiff-dev libgif-dev
 povray povray-includes povray-examples
 xvfb clang libclang-rt-14-dev valgrind
-slurmctld slurmd slurm-client munge parallel"
+slurmctld slurmd slurm-client munge parallel openssh-server openssh-client"
 
 missing=""
 for p in $PKGS; do

@@ -11,6 +11,11 @@
 #  2. GNU parallel on this machine (sshloginfile ":"), another task made to
 #     fail the same way, recovered by --retries; frames identical again.
 #  3. The parallel farm run again on the same directory renders nothing.
+#  4. GNU parallel over ssh: an sshd started here on 127.0.0.1 at a free high
+#     port (a fixture: its own host key, a user key made here, no PAM, no
+#     password), two ssh logins to it (127.0.0.1 and localhost) in the
+#     sshloginfile, a task made to fail on its first run; both logins run
+#     tasks, the frames are identical again, and the sshd is stopped by PID.
 set -u
 BIN=$1
 SRC=$2
@@ -20,9 +25,11 @@ SL="$T/slurm"
 pids=""
 cleanup() {
     "$SRC/scripts/slurm_local.sh" stop "$SL" >/dev/null 2>&1 || true
+    [ -f "$T/ssh/sshd.pid" ] && kill "$(cat "$T/ssh/sshd.pid")" 2>/dev/null
+    true
 }
 trap cleanup EXIT INT TERM
-for b in parallel sbatch slurmctld slurmd munged; do
+for b in parallel sbatch slurmctld slurmd munged sshd ssh ssh-keygen; do
     command -v "$b" >/dev/null 2>&1 || [ -x "/usr/sbin/$b" ] || fail "$b missing (scripts/setup.sh installs it)"
 done
 cp "$SRC/tests/scenes/farm_gi.pov" "$T/" || fail "copy scene"
@@ -86,6 +93,55 @@ for i in 0 1 2 3 4 5 6 7; do
 done
 same_frames par
 echo "ok: the second run on the same directory rendered nothing (joblog $lines lines before)"
+
+# ---- 4. GNU parallel over ssh ---------------------------------------------
+t0=$(date +%s)
+K="$T/ssh"
+mkdir -p "$K" /run/sshd 2>/dev/null
+ssh-keygen -q -t ed25519 -N '' -f "$K/host_key" || fail "ssh-keygen host key"
+ssh-keygen -q -t ed25519 -N '' -f "$K/user_key" || fail "ssh-keygen user key"
+cp "$K/user_key.pub" "$K/authorized_keys"
+SSHD=$(command -v sshd || echo /usr/sbin/sshd)
+port=""
+for try in 1 2 3 4 5; do
+    p=$(( 20000 + ($$ * 7 + try * 131) % 20000 ))
+    cat >"$K/sshd_config" <<EOF
+Port $p
+ListenAddress 127.0.0.1
+HostKey $K/host_key
+PidFile $K/sshd.pid
+AuthorizedKeysFile $K/authorized_keys
+PasswordAuthentication no
+KbdInteractiveAuthentication no
+UsePAM no
+StrictModes no
+PermitRootLogin prohibit-password
+EOF
+    "$SSHD" -f "$K/sshd_config" -E "$K/sshd.log" || continue
+    for i in 1 2 3 4 5 6 7 8 9 10; do [ -s "$K/sshd.pid" ] && break; sleep 0.2; done
+    [ -s "$K/sshd.pid" ] && { port=$p; break; }
+done
+[ -n "$port" ] || { cat "$K/sshd.log"; fail "sshd did not start"; }
+sshd_pid=$(cat "$K/sshd.pid")
+S="ssh -p $port -i $K/user_key -o StrictHostKeyChecking=no -o UserKnownHostsFile=$K/known_hosts -o BatchMode=yes -o LogLevel=ERROR"
+$S 127.0.0.1 true || { cat "$K/sshd.log"; fail "ssh to 127.0.0.1:$port"; }
+printf '1/%s 127.0.0.1\n1/%s localhost\n' "$S" "$S" >sshhosts
+"$BIN" farm farm_gi.pov $OPTS --tiles 2 --dir wssh -o ssh.pfm --engine parallel --sshloginfile sshhosts --jobs 1 \
+    --retries 2 --inject-fault 4:1 || fail "farm --engine parallel over ssh"
+hist=$(tr '\n' ' ' <wssh/status/7.history)
+echo "task 7 (frame 4, tile 1) exits over ssh: $hist"
+[ "$hist" = "143 0 " ] || fail "the faulted ssh task should have exited 143, then 0 (got: $hist)"
+for h in 127.0.0.1 localhost; do
+    n=$(awk -F'\t' -v h="$h" 'NR > 1 && $2 ~ (" " h "$") { c++ } END { print c + 0 }' wssh/joblog)
+    echo "tasks run through the ssh login to $h: $n"
+    [ "$n" -ge 1 ] || fail "no task ran through the ssh login to $h"
+done
+same_frames ssh
+kill "$sshd_pid"
+for i in 1 2 3 4 5 6 7 8 9 10; do kill -0 "$sshd_pid" 2>/dev/null || break; sleep 0.2; done
+kill -0 "$sshd_pid" 2>/dev/null && fail "sshd $sshd_pid still running after kill"
+rm -f "$K/sshd.pid"
+echo "ok: parallel over ssh (port $port) in $(( $(date +%s) - t0 )) s, sshd $sshd_pid stopped"
 cd /
 rm -rf "$T"
 echo PASS
