@@ -52,7 +52,7 @@ extern const int gi_kernel_nfiles;
 /* gi_k_bounce work-items (GI_BOUNCE_CHUNK particles each) per work-group */
 #define GI_BOUNCE_LOCAL 4
 
-enum { KE_EMIT, KE_BOUNCE, KE_WALK, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_COUNT };
+enum { KE_EMIT, KE_BOUNCE, KE_WALK, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_VPL, KE_COUNT };
 
 struct gi_dev {
     int is_cl;
@@ -106,6 +106,8 @@ struct gi_dev {
     cl_mem b_emits, b_mask_src, b_mask_a, b_mask_b, b_cin_off, b_cin_src;
     cl_mem b_enew, b_dsum; /* gi_k_emit's edir (swapped with b_edir when a stage completes), direct sums */
     size_t sz_lights, sz_vis, sz_tally, sz_list, sz_vout, sz_woff, sz_went, sz_cin_off, sz_cin_src;
+    cl_mem b_vpts, b_vnodes, b_vtabs, b_vres, b_visits; /* gi_dev_vpl_gather */
+    size_t sz_vpts, sz_vnodes, sz_vtabs, sz_vres, sz_visits;
     float *tmp;  /* n*4 readback scratch */
 #endif
 };
@@ -341,7 +343,7 @@ static pt_status cl_open(gi_dev *dv, const gi_dev_options *o, diag *d)
         return PT_ERR_DEVICE;
     }
     static const char *const names[KE_COUNT] = {"gi_k_emit", "gi_k_bounce", "gi_k_walk", "gi_k_resolve",
-                                                "gi_k_gather", "gi_k_estimate"};
+                                                "gi_k_gather", "gi_k_estimate", "gi_k_vpl_gather"};
     for (int k = 0; k < KE_COUNT; k++) {
         dv->k[k] = clCreateKernel(dv->prog, names[k], &e);
         if (!dv->k[k]) return cl_fail(d, names[k], e);
@@ -364,7 +366,8 @@ static void release_buffers(gi_dev *dv)
                     &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off, &dv->b_rin_src, &dv->b_bin,
                     &dv->b_bout, &dv->b_total, &dv->b_woff, &dv->b_went,
                     &dv->b_emits, &dv->b_mask_src, &dv->b_mask_a, &dv->b_mask_b, &dv->b_cin_off,
-                    &dv->b_cin_src, &dv->b_enew, &dv->b_dsum};
+                    &dv->b_cin_src, &dv->b_enew, &dv->b_dsum, &dv->b_vpts, &dv->b_vnodes, &dv->b_vtabs,
+                    &dv->b_vres, &dv->b_visits};
     for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
 }
 
@@ -1044,6 +1047,36 @@ pt_status gi_dev_estimate(gi_dev *dv, const int *found, int nfound, float *vout,
                 KMEM(dv->b_vout)};
     if ((st = run_kernel(dv, KE_ESTIMATE, (size_t)nfound, a, 7, d)) != PT_OK) return st;
     return download(dv, dv->b_vout, vout, (size_t)nfound * 4 * sizeof(float), d);
+#else
+    return PT_ERR_INTERNAL;
+#endif
+}
+
+pt_status gi_dev_vpl_gather(gi_dev *dv, const gi_dev_vpl_point *pts, int npts, const gi_dev_vpl_node *nodes, int nnodes,
+                            const float *tabs, int ntabs, float thr, int mode, float *out, int *visits, diag *d)
+{
+    if (npts <= 0) return PT_OK;
+    if (!dv->is_cl) {
+        gi_c_vpl_gather(dv->threads, pts, npts, nodes, nnodes, tabs, thr, mode, out, visits);
+        return PT_OK;
+    }
+#ifdef PARTRAY_HAVE_OPENCL
+    pt_status st;
+    size_t per = mode == GI_VPL_EYE ? 4 : 12;
+    if ((st = upload(dv, &dv->b_vpts, &dv->sz_vpts, pts, (size_t)npts * sizeof *pts, d)) != PT_OK) return st;
+    if ((st = upload(dv, &dv->b_vnodes, &dv->sz_vnodes, nodes, (size_t)(nnodes > 0 ? nnodes : 1) * sizeof *nodes, d)) !=
+        PT_OK)
+        return st;
+    if ((st = upload(dv, &dv->b_vtabs, &dv->sz_vtabs, tabs, (size_t)(ntabs > 0 ? ntabs : 1) * GI_VPL_TAB * sizeof(float),
+                     d)) != PT_OK)
+        return st;
+    if ((st = ensure(dv, &dv->b_vres, &dv->sz_vres, (size_t)npts * per * sizeof(float), d)) != PT_OK) return st;
+    if ((st = ensure(dv, &dv->b_visits, &dv->sz_visits, (size_t)npts * sizeof(int), d)) != PT_OK) return st;
+    karg a[] = {KMEM(dv->b_vpts), KINT(npts), KMEM(dv->b_vnodes), KINT(nnodes), KMEM(dv->b_vtabs), KF(thr), KINT(mode),
+                KMEM(dv->b_vres), KMEM(dv->b_visits)};
+    if ((st = run_kernel(dv, KE_VPL, (size_t)npts, a, 9, d)) != PT_OK) return st;
+    if ((st = download(dv, dv->b_vres, out, (size_t)npts * per * sizeof(float), d)) != PT_OK) return st;
+    return download(dv, dv->b_visits, visits, (size_t)npts * sizeof(int), d);
 #else
     return PT_ERR_INTERNAL;
 #endif

@@ -26,6 +26,7 @@
 #include <stddef.h>
 #include "diag.h"
 #include "kernels/gi_types.h"
+#include "kernels/gi_vpl_types.h"
 
 typedef struct gi_dev gi_dev;
 
@@ -97,5 +98,11 @@ pt_status gi_dev_fetch(gi_dev *dv, diag *d);
  * particles found[t] into vout[4*t] (compact). */
 pt_status gi_dev_gather(gi_dev *dv, const int *used, int nused, float *eind, diag *d);
 pt_status gi_dev_estimate(gi_dev *dv, const int *found, int nfound, float *vout, diag *d);
+/* VPL reflectance filtering (gi_vpl.cl's gi_k_vpl_gather): npts points
+ * against the node array (ntabs E(mu) tables of GI_VPL_TAB floats); out
+ * gets 4 (GI_VPL_EYE) or 12 (GI_VPL_BOUNCE) floats a point, visits one int.
+ * Needs no particles (any device from gi_dev_open). */
+pt_status gi_dev_vpl_gather(gi_dev *dv, const gi_dev_vpl_point *pts, int npts, const gi_dev_vpl_node *nodes, int nnodes,
+                            const float *tabs, int ntabs, float thr, int mode, float *out, int *visits, diag *d);
 
 #endif

@@ -6,6 +6,10 @@
 #include "kernels/gi_types.h"
 #include "kernels/gi_lighting.cl"
 #include "kernels/gi_gather.cl"
+#include "kernels/gi_vpl_types.h"
+#include "kernels/gi_vpl_real.h"
+#include "glossy_lobe.h"
+#include "kernels/gi_vpl.cl"
 /* (gi_shim.h must come first; this header only declares the launchers.) */
 #include "gi_cl_c.h"
 #include "pool.h"
@@ -33,9 +37,15 @@ typedef struct {
     unsigned *mask_out;
     const gi_walk_entry *went;
     size_t chunk;  /* work-items per pool job (0: GI_C_CHUNK) */
+    const gi_dev_vpl_point *vpts;  /* gi_k_vpl_gather */
+    const gi_dev_vpl_node *vnodes;
+    int nvnodes, vmode;
+    const float *vtabs;
+    float vthr;
+    int *visits;
 } c_launch;
 
-enum { K_EMIT, K_BOUNCE, K_WALK, K_RESOLVE, K_GATHER, K_ESTIMATE };
+enum { K_EMIT, K_BOUNCE, K_WALK, K_RESOLVE, K_GATHER, K_ESTIMATE, K_VPL };
 
 static void run_chunk(void *ctx, int chunk, int thread)
 {
@@ -63,6 +73,9 @@ static void run_chunk(void *ctx, int chunk, int thread)
             gi_k_gather(a->glink, a->ng, a->lout, a->idx, (int)a->n, a->esky, a->fout);
             break;
         case K_ESTIMATE: gi_k_estimate(a->part, a->list_off, a->list_idx, a->eind, a->idx, (int)a->n, a->fout); break;
+        case K_VPL:
+            gi_k_vpl_gather(a->vpts, (int)a->n, a->vnodes, a->nvnodes, a->vtabs, a->vthr, a->vmode, a->fout, a->visits);
+            break;
         }
     }
 }
@@ -134,5 +147,13 @@ void gi_c_estimate(int threads, const gi_dev_particle *part, const int *list_off
 {
     c_launch a = {.kernel = K_ESTIMATE, .n = (size_t)nfound, .part = part, .list_off = list_off,
                   .list_idx = list_idx, .eind = eind, .idx = found, .fout = vout};
+    launch(threads, &a);
+}
+
+void gi_c_vpl_gather(int threads, const gi_dev_vpl_point *pts, int npts, const gi_dev_vpl_node *nodes, int nnodes,
+                     const float *tabs, float thr, int mode, float *out, int *visits)
+{
+    c_launch a = {.kernel = K_VPL, .n = (size_t)npts, .vpts = pts, .vnodes = nodes, .nvnodes = nnodes, .vtabs = tabs,
+                  .vthr = thr, .vmode = mode, .fout = out, .visits = visits, .chunk = 16};
     launch(threads, &a);
 }

@@ -7,6 +7,7 @@
 #ifndef PT_GI_CL_C_H
 #define PT_GI_CL_C_H
 #include "kernels/gi_types.h"
+#include "kernels/gi_vpl_types.h"
 
 /* gi_k_emit: ceil(n / GI_EMIT_CHUNK) work-items, one srcmask word and dsum float each. */
 void gi_c_emit(int threads, const gi_dev_particle *part, int n, const gi_dev_light *lights, int nlights,
@@ -27,5 +28,8 @@ void gi_c_gather(int threads, const int *glink, int ng, const float *lout, const
                  const float *esky, float *eind);
 void gi_c_estimate(int threads, const gi_dev_particle *part, const int *list_off, const int *list_idx,
                    const float *eind, const int *found, int nfound, float *vout);
+/* gi_k_vpl_gather: one work-item per point (gi_vpl.cl). */
+void gi_c_vpl_gather(int threads, const gi_dev_vpl_point *pts, int npts, const gi_dev_vpl_node *nodes, int nnodes,
+                     const float *tabs, float thr, int mode, float *out, int *visits);
 
 #endif
