@@ -293,6 +293,25 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
             else if (strcmp(a, "--fg-rays") == 0) o->fg_rays = v;
             else o->max_depth = v;
             i++;
+        } else if (strcmp(a, "--vpls") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            int v;
+            if (!parse_int(next, &v) || v < 1) { snprintf(err, (size_t)errlen, "--vpls wants a positive integer"); return 2; }
+            o->vpls = v;
+            i++;
+        } else if (strcmp(a, "--vpl-cut") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (strcmp(next, "minmax") == 0) o->vpl_cut = 0;
+            else if (strcmp(next, "full") == 0) o->vpl_cut = 1;
+            else if (strcmp(next, "brute") == 0) o->vpl_cut = 2;
+            else { snprintf(err, (size_t)errlen, "--vpl-cut wants minmax, full or brute"); return 2; }
+            i++;
+        } else if (strcmp(a, "--vpl-adaptive") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (strcmp(next, "on") == 0) o->vpl_adaptive = 1;
+            else if (strcmp(next, "off") == 0) o->vpl_adaptive = 2;
+            else { snprintf(err, (size_t)errlen, "--vpl-adaptive wants on or off"); return 2; }
+            i++;
         } else if (strcmp(a, "--detp-full") == 0) {
             o->detp_full = 1;
         } else if (strcmp(a, "--detp-radius") == 0) {
@@ -575,7 +594,7 @@ const char cli_render_help[] =
     "\n"
     "Global illumination\n"
     "  --gi MODE              none (direct light + Whitted, POV-Ray's model), particle,\n"
-    "                         path (path tracer), pmfg (photon map + final gather), detp;\n"
+    "                         path (path tracer), pmfg (photon map + final gather), detp, vpl;\n"
     "                         default: particle when the scene has radiosity{}, else none\n"
     "  --particles N --nb N   particle: particles, bounces\n"
     "  --gi-quality Q         particle: Q times the particles the scene's radiosity{} asks for\n"
@@ -588,6 +607,9 @@ const char cli_render_help[] =
     "  --gi detp [--photons N] [--detp-radius R] [--detp-full]\n"
     "                         incremental photon paths across an animation's frames, fixed-radius\n"
     "                         estimate (docs/gi.md); --detp-full recomputes every frame\n"
+    "  --gi vpl [--vpls N] [--nb N] [--vpl-cut minmax|full|brute] [--vpl-adaptive on|off]\n"
+    "                         VPL reflectance filtering (glossy interreflection, docs/gi.md): VPL count\n"
+    "                         (16384), bounces at the VPLs (1), the cut walked per pixel, adaptive sampling\n"
     "\n"
     "Colour and light (docs/guide.md, docs/units.md)\n"
     "  --display NAME --view NAME --look NAME --exposure STOPS --working-space NAME\n"

@@ -75,6 +75,9 @@ typedef struct {
     long photons;
     double detp_radius;     /* --detp-radius: DETP disc radius, world units (0 = default) */
     int detp_full;          /* --detp-full: every frame traces and estimates everything anew */
+    long vpls;              /* --vpls: VPL count (render_vpl.h; 0 = default) */
+    int vpl_cut;            /* --vpl-cut minmax|full|brute: RENDER_VPL_* */
+    int vpl_adaptive;       /* --vpl-adaptive on|off: 1 on (default), 2 off */
     const char *cl_device;  /* particle GI: OpenCL device (NULL/"auto", "c", "P:D" or part of a name) */
     long long cl_max_memory_mib; /* particle GI: OpenCL device memory it may use (0 = the device's) */
     const char *gi_cache;   /* --gi-cache FILE: particle GI's geometry stage read from FILE when it

@@ -421,7 +421,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
             diag_report(d, DIAG_NOTE, none, NULL, "+Q%d: radiosity is off below +Q9, as in POV-Ray", o->quality);
     }
     const char *gi_used = gi_mode_name(gi);
-    if (run->tile && (gi == GI_PATH || gi == GI_PMFG || gi == GI_DETP)) {
+    if (run->tile && (gi == GI_PATH || gi == GI_PMFG || gi == GI_DETP || gi == GI_VPL)) {
         pbar_free(bar);
         fprintf(stderr, "partray render: a render window (+SC/+EC/+SR/+ER) needs --gi none or particle, not %s\n", gi_used);
         scene_free(sc);
@@ -501,6 +501,9 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     ss.keep = keep_gi;
     ss.detp_radius = o->detp_radius;
     ss.detp_full = o->detp_full;
+    ss.vpls = o->vpls;
+    ss.vpl_cut = o->vpl_cut;
+    ss.vpl_adaptive = o->vpl_adaptive;
     if (gi == GI_DETP && plan->animated) {
         /* the paths kept across frames: the pieces that changed are traced
          * again (pm_detp.h); the IR's stage hashes say whether the lights

@@ -273,6 +273,39 @@ static pt_status render_reference(const scene *sc, const accel *a, const render_
     return st;
 }
 
+static pt_status render_vpl_mode(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
+                                 render_gi_result *r, diag *d)
+{
+    render_vpl_settings vs;
+    render_vpl_default_settings(&vs);
+    vs.width = o->width;
+    vs.height = o->height;
+    vs.threads = o->threads;
+    vs.seed = o->seed;
+    if (o->spp > 1) vs.spp = o->spp; /* --spp 1 (the CLI's default): vpl's own */
+    if (o->vpls > 0) vs.vpls = o->vpls;
+    if (o->bounces > 0) vs.bounces = o->bounces;
+    vs.cut = o->vpl_cut;
+    if (o->vpl_adaptive) vs.adaptive = o->vpl_adaptive == 1;
+    vs.cl_device = o->cl_device;
+    vs.cl_max_bytes = o->cl_max_bytes;
+    vs.cancel = o->cancel;
+    r->has_vpl = 1;
+    r->image_begun = 1;
+    pt_status st = render_vpl(sc, a, &vs, fb, &r->vpl, d);
+    r->t_gi_lighting = r->vpl.t_vpls + r->vpl.t_tree + r->vpl.t_bounce;
+    r->t_render = r->vpl.t_trace + r->vpl.t_gather;
+    r->primary_rays = r->vpl.camera_rays;
+    r->shadow_rays = r->vpl.shadow_rays;
+    r->secondary_rays = r->vpl.secondary_rays;
+    if (st == PT_OK && o->aov) {
+        shade_settings ss;
+        fill_shade(&ss, o);
+        st = render_aovs(sc, a, o, &ss, r, d);
+    }
+    return st;
+}
+
 /* What render_gi_result's nm_* say, counted and warned once. */
 static void light_not_modelled(const scene *sc, int mode, render_gi_result *r, diag *d)
 {
@@ -307,6 +340,7 @@ pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, fr
     switch (o->mode) {
     case GI_PARTICLE: st = render_particle(sc, a, o, fb, r, d); break;
     case GI_DETP: st = render_detp(sc, a, o, fb, r, d); break;
+    case GI_VPL: return render_vpl_mode(sc, a, o, fb, r, d);
     case GI_PMFG:
     case GI_PATH: return render_reference(sc, a, o, fb, r, d);
     default: st = render_none(sc, a, o, fb, r, d); break;
@@ -373,6 +407,32 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
         stats_num(js, "geometry", p->c_geometry);
         stats_num(js, "lists", p->c_lists);
         stats_num(js, "render", r->c_render);
+        stats_obj_end(js);
+        stats_obj_end(js);
+    }
+    if (r->has_vpl) {
+        const render_vpl_stats *p = &r->vpl;
+        stats_obj_begin(js, "vpl");
+        stats_str(js, "device", p->device);
+        stats_int(js, "vpls", p->vpls);
+        stats_int(js, "tree_nodes", p->tree_nodes);
+        stats_int(js, "cut_nodes", p->cut_nodes);
+        stats_int(js, "bounces", p->bounces);
+        stats_int(js, "pixels", p->pixels);
+        stats_int(js, "pixels_valid", p->pixels_valid);
+        stats_int(js, "pixels_sampled", p->pixels_sampled);
+        stats_num(js, "fraction_sampled", p->pixels_valid > 0 ? (double)p->pixels_sampled / (double)p->pixels_valid : 0.0);
+        stats_int(js, "secondary_points", p->secondary_points);
+        stats_num(js, "visits_mean", p->visits_mean);
+        stats_int(js, "visits_min", p->visits_min);
+        stats_int(js, "visits_max", p->visits_max);
+        stats_obj_begin(js, "timings");
+        stats_num(js, "vpls", p->t_vpls);
+        stats_num(js, "tree", p->t_tree);
+        stats_num(js, "bounce", p->t_bounce);
+        stats_num(js, "trace", p->t_trace);
+        stats_num(js, "gather", p->t_gather);
+        stats_num(js, "total", p->t_total);
         stats_obj_end(js);
         stats_obj_end(js);
     }

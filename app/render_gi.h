@@ -10,6 +10,7 @@
 #include "gi_particle.h"
 #include "pm.h"
 #include "pm_detp.h"
+#include "render_vpl.h"
 #include "scene.h"
 #include "shade.h"
 #include "shade_aov.h"
@@ -57,6 +58,9 @@ typedef struct {
     const char *gi_cache;
     int gi_cache_load;
     uint64_t gi_cache_key;
+    long vpls;                /* vpl: VPL count (0 = default) */
+    int vpl_cut;              /* vpl: RENDER_VPL_* (render_vpl.h) */
+    int vpl_adaptive;         /* vpl: 0 default (on), 1 on, 2 off */
     int window[4];            /* none/particle: render window x0,y0,x1,y1 (shade_settings.window); 0 = all */
     shade_aov *aov;           /* non-NULL: fill these AOVs after the render (shade_aov.h); the indirect
                                  AOV comes from particle GI only (0 for none, pmfg, path) */
@@ -75,6 +79,8 @@ typedef struct {
     int image_begun;          /* the pass that writes the image began: a cancelled render's
                                  framebuffer holds what it rendered (before: nothing) */
     int ran_geometry, ran_lighting; /* particle: the stages this render ran (the view stage always runs) */
+    int has_vpl;
+    render_vpl_stats vpl;
     int has_detp;
     pm_detp_stats detp;
     int gi_cache_loaded;      /* particle: the geometry stage came from opts.gi_cache */

@@ -1056,6 +1056,11 @@ pt_status gi_dev_vpl_gather(gi_dev *dv, const gi_dev_vpl_point *pts, int npts, c
                             const float *tabs, int ntabs, float thr, int mode, float *out, int *visits, diag *d)
 {
     if (npts <= 0) return PT_OK;
+    static const float no_tables[GI_VPL_TAB]; /* points without glossy lobes read none */
+    if (!tabs || ntabs <= 0) {
+        tabs = no_tables;
+        ntabs = 1;
+    }
     if (!dv->is_cl) {
         gi_c_vpl_gather(dv->threads, pts, npts, nodes, nnodes, tabs, thr, mode, out, visits);
         return PT_OK;
