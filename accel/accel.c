@@ -664,13 +664,14 @@ static void finish_bounds(accel *a)
     if (!(a->scale > 0.0) || !isfinite(a->scale)) a->scale = diag_e;
     if (!(a->scale > 0.0) || !isfinite(a->scale)) a->scale = far_plane;
     if (!(a->scale > 0.0) || !isfinite(a->scale)) a->scale = 1.0;
-    /* Epsilon scale: the median leaf diagonal, so one far or huge object
-     * does not accel_grow the epsilon beyond the other objects' details; it scales
-     * with the scene like the diagonal does. */
+    /* Epsilon scale: the lower median leaf diagonal, so one far or huge
+     * object does not grow the epsilon beyond the other objects' details
+     * (the lower one: of a sky dome of radius 1e4 and one building, the
+     * building's); it scales with the scene like the diagonal does. */
     a->eps_scale = a->scale;
     if (a->ndiags > 0) {
         qsort(a->diags, (size_t)a->ndiags, sizeof *a->diags, cmp_double);
-        double med = a->diags[a->ndiags / 2];
+        double med = a->diags[(a->ndiags - 1) / 2];
         if (med < a->eps_scale) a->eps_scale = med;
     }
     free(a->diags);

@@ -87,10 +87,17 @@ static int push(pbuf *b, const gi_dev_particle *p, int patch, int side)
 
 /* Does the rendered surface of `o` pass through pos (a CSG member's surface
  * may be cut away)? A short ray towards the surface along -nrm must hit o
- * near pos. */
-static int probe_ok(const accel *a, const scene_object *o, vec3 pos, vec3 nrm)
+ * near pos. The ray's length is a quarter of the particle spacing
+ * (`spacing`), not a part of the scene's size: a sky dome of radius 1e4
+ * around a courtyard made it longer than the walls are thick, and a
+ * cut-away face then found its member's own surface elsewhere and passed.
+ * A quarter spacing still covers the distance of a tessellated patch's
+ * points from the exact surface, and it stays beyond the ray's epsilon. */
+static int probe_ok(const accel *a, const scene_object *o, vec3 pos, vec3 nrm, double spacing)
 {
-    double delta = 1e-3 * (accel_scale(a) + fmax(fabs(pos.x), fmax(fabs(pos.y), fabs(pos.z))));
+    double mag = fmax(fabs(pos.x), fmax(fabs(pos.y), fabs(pos.z)));
+    double delta = fmin(1e-3 * (accel_scale(a) + mag), 0.25 * spacing);
+    delta = fmax(delta, 4.0 * accel_epsilon(a, pos, nrm));
     for (int s = 0; s < 2; s++) {
         vec3 nn = s ? v3_neg(nrm) : nrm;
         accel_hit h;
@@ -198,7 +205,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
                 if (side_frac && side_frac[2 * i + s] <= 0.0f) continue;
                 if (!(mask >> s & 1)) continue;
                 vec3 nn = s ? v3_neg(nrm) : nrm;
-                if (probe && !probe_ok(a, o, pos, nn)) {
+                if (probe && !probe_ok(a, o, pos, nn, sqrt(ps->dA))) {
                     ps->probed_out++;
                     continue;
                 }

@@ -161,6 +161,27 @@ static void test_sphere(void **st)
     scene_free(s);
 }
 
+/* One huge object beside one small one (a sky dome of radius 1e4 around a
+ * 20-unit building): the ray epsilon follows the small one's size, so a
+ * ray starting 0.01 from the building still hits it (1e-5 of the dome's
+ * diameter would be 0.2). */
+static void test_epsilon_small_beside_huge(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    sphere(s, v3(0, 0, 0), 1e4);
+    scene_object *b = box(s, v3(-10, -0.1, -10), v3(10, 4, 10));
+    accel *a = build(s, d);
+    accel_hit h;
+    expect_hit(a, v3(-10.01, 1.9, -4.5), v3(1, 0, 0), 0.01, v3(-1, 0, 0), 1e-9, 1e-12, &h);
+    assert_ptr_equal(h.obj, b);
+    assert_true(accel_epsilon(a, v3(-10.01, 1.9, -4.5), v3(1, 0, 0)) < 1e-3);
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
 static void test_box_faces(void **st)
 {
     (void)st;
@@ -1370,6 +1391,7 @@ int main(void)
         cmocka_unit_test(test_torus_brute),
         cmocka_unit_test(test_bare_embree),
         cmocka_unit_test(test_threads),
+        cmocka_unit_test(test_epsilon_small_beside_huge),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
