@@ -138,9 +138,15 @@ static int check_image_size(int w, int h, unsigned long long limit)
 }
 
 /* The render options after INI files are expanded (ini.h); warnings
- * printed. Returns 0, or the exit code. *ia keeps o's strings alive. */
-static int read_options(const char *cmd, int argc, char **argv, cli_render *o, ini_args **ia)
+ * printed. Returns 0, -1 when --help was asked for (help and the exit
+ * codes printed), or the exit code. *ia keeps o's strings alive. */
+static int read_options(const char *cmd, const char *help, int argc, char **argv, cli_render *o, ini_args **ia)
 {
+    if (cli_wants_help(argc, argv)) {
+        fputs(help, stdout);
+        fputs(cli_exit_codes, stdout);
+        return -1;
+    }
     diag *d = diag_new();
     pt_status st = ini_expand(argc, argv, ia, d);
     print_diags(d, 0);
@@ -159,15 +165,10 @@ static int read_options(const char *cmd, int argc, char **argv, cli_render *o, i
 
 static int cmd_parse(int argc, char **argv)
 {
-    if (cli_wants_help(argc, argv)) {
-        fputs(cli_parse_help, stdout);
-        fputs(cli_exit_codes, stdout);
-        return EXIT_OK;
-    }
     cli_render o;
     ini_args *ia = NULL;
-    int rc = read_options("parse", argc, argv, &o, &ia);
-    if (rc) return rc;
+    int rc = read_options("parse", cli_parse_help, argc, argv, &o, &ia);
+    if (rc) return rc < 0 ? EXIT_OK : rc;
     anim_plan plan;
     char err[256];
     cli_frames(&o, &plan, err, sizeof err); /* checked by cli_parse_render */
@@ -750,15 +751,10 @@ static char *output_base(const char *out, const char *scene, char format)
 static int cmd_render(int argc, char **argv)
 {
     double t_start = timer_now();
-    if (cli_wants_help(argc, argv)) {
-        fputs(cli_render_help, stdout);
-        fputs(cli_exit_codes, stdout);
-        return EXIT_OK;
-    }
     cli_render o;
     ini_args *ia = NULL;
-    int rc = read_options("render", argc, argv, &o, &ia);
-    if (rc) return rc;
+    int rc = read_options("render", cli_render_help, argc, argv, &o, &ia);
+    if (rc) return rc < 0 ? EXIT_OK : rc;
     char *bases[8];
     int nbases = o.noutputs > 0 ? o.noutputs : 1;
     for (int i = 0; i < nbases; i++) bases[i] = output_base(o.noutputs > 0 ? o.outputs[i] : NULL, o.scene, o.format);

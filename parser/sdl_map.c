@@ -44,23 +44,48 @@ static const scene_blend_map *declared_map(sdl_parser *p, const char *what)
     return NULL;
 }
 
+/* The head every map shares: its block `block` opened, then either a
+ * declared map of kind `kind` (*declared set, block closed: returns NULL
+ * with *declared possibly NULL too) or the array of entries to fill. */
+static scene_map_entry *map_begin(sdl_parser *p, const char *block, const char *kind, const scene_blend_map **declared)
+{
+    *declared = NULL;
+    if (!sdl_begin_block(p, block)) return NULL;
+    if (sdl_is(sdl_peek(p), TOK_IDENT) && sdl_peek(p)->val.kind == VAL_OPAQUE) {
+        *declared = declared_map(p, kind);
+        sdl_end_block(p);
+        return NULL;
+    }
+    return sdl_map_entries(p, SDL_MAP_MAX_ENTRIES);
+}
+
+/* The next entry, '[', when n entries and `need` more fit; past the limit
+ * a located error naming the map (`what`). */
+static int map_next(sdl_parser *p, int n, int need, const char *what)
+{
+    if (!sdl_ok(p) || !sdl_accept(p, TOK_LBRACKET)) return 0;
+    if (n + need <= SDL_MAP_MAX_ENTRIES) return 1;
+    sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_LIMIT, "too many entries in %s (at most %d)", what, SDL_MAP_MAX_ENTRIES);
+    return 0;
+}
+
+/* The block closed; 0, with POV-Ray's error `empty`, when no entry was read. */
+static int map_end(sdl_parser *p, int n, const char *empty)
+{
+    sdl_end_block(p);
+    if (n > 0) return 1;
+    if (sdl_ok(p)) sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_SYNTAX, "%s", empty);
+    return 0;
+}
+
 /* colour_map := '{' ( map_id | { '[' v [','] ( colour | v2 [','] colour colour ) ']' } ) '}' */
 const scene_blend_map *sdl_map_colour(sdl_parser *p)
 {
-    if (!sdl_begin_block(p, "color_map")) return NULL;
-    if (sdl_is(sdl_peek(p), TOK_IDENT) && sdl_peek(p)->val.kind == VAL_OPAQUE) {
-        const scene_blend_map *m = declared_map(p, "colour_map");
-        sdl_end_block(p);
-        return m;
-    }
-    scene_map_entry *e = sdl_map_entries(p, SDL_MAP_MAX_ENTRIES);
+    const scene_blend_map *declared;
+    scene_map_entry *e = map_begin(p, "color_map", "colour_map", &declared);
+    if (!e) return declared;
     int n = 0;
-    if (!e) return NULL;
-    while (sdl_ok(p) && sdl_accept(p, TOK_LBRACKET)) {
-        if (n + 2 > SDL_MAP_MAX_ENTRIES) {
-            sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_LIMIT, "too many entries in color_map (at most %d)", SDL_MAP_MAX_ENTRIES);
-            break;
-        }
+    while (map_next(p, n, 2, "color_map")) {
         double v = sdl_map_single(sdl_float(p));
         sdl_accept(p, TOK_COMMA);
         if (!sdl_starts_colour(sdl_peek(p))) {
@@ -87,11 +112,7 @@ const scene_blend_map *sdl_map_colour(sdl_parser *p)
         }
         sdl_expect(p, TOK_RBRACKET, "']' closing the color_map entry");
     }
-    sdl_end_block(p);
-    if (n == 0) {
-        if (sdl_ok(p)) sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_SYNTAX, "must have at least one color in color map");
-        return NULL;
-    }
+    if (!map_end(p, n, "must have at least one color in color map")) return NULL;
     /* POV-Ray drops an entry identical to the one before it. */
     int k = 0;
     for (int i = 1; i < n; i++) {
@@ -116,20 +137,11 @@ static const char *map_name(map_kind k)
  * allows the value to be omitted (weight 1). */
 const scene_blend_map *sdl_map_blend(sdl_parser *p, map_kind k, int average)
 {
-    if (!sdl_begin_block(p, map_name(k))) return NULL;
-    if (sdl_is(sdl_peek(p), TOK_IDENT) && sdl_peek(p)->val.kind == VAL_OPAQUE) {
-        const scene_blend_map *m = declared_map(p, map_name(k));
-        sdl_end_block(p);
-        return m;
-    }
-    scene_map_entry *e = sdl_map_entries(p, SDL_MAP_MAX_ENTRIES);
+    const scene_blend_map *declared;
+    scene_map_entry *e = map_begin(p, map_name(k), map_name(k), &declared);
+    if (!e) return declared;
     int n = 0;
-    if (!e) return NULL;
-    while (sdl_ok(p) && sdl_accept(p, TOK_LBRACKET)) {
-        if (n >= SDL_MAP_MAX_ENTRIES) {
-            sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_LIMIT, "too many entries in map (at most %d)", SDL_MAP_MAX_ENTRIES);
-            break;
-        }
+    while (map_next(p, n, 1, "map")) {
         e[n].value = sdl_map_single(average ? sdl_allow_float(p, 1.0) : sdl_float(p));
         sdl_accept(p, TOK_COMMA);
         switch (k) {
@@ -160,11 +172,7 @@ const scene_blend_map *sdl_map_blend(sdl_parser *p, map_kind k, int average)
         n++;
         sdl_expect(p, TOK_RBRACKET, "']' closing the map entry");
     }
-    sdl_end_block(p);
-    if (n == 0) {
-        if (sdl_ok(p)) sdl_error(p, sdl_peek(p)->tk.loc, PT_ERR_SYNTAX, "must have at least one entry in map");
-        return NULL;
-    }
+    if (!map_end(p, n, "must have at least one entry in map")) return NULL;
     return sdl_map_make(p, k, e, n);
 }
 
