@@ -138,8 +138,8 @@ static void fill_stats(gi_particle *gp, gi_particle_stats *out)
  * another closed sphere or box, facing its inside (moved a little along its
  * normal the particle is inside it, moved back it is not: the floor under a
  * box standing on it; tested against the first MAX_BURY_SOLIDS of them). */
-static const void **particle_objects(const gi_particle *gp, const gi_particles *ps, unsigned char **pin,
-                                     pt_status *st)
+const void **gi_particle_objects(const gi_particle *gp, const gi_particles *ps, unsigned char **pin,
+                                 pt_status *st)
 {
     int n = ps->n, np = gi_surface_npatches(gp->surf), ns = 0;
     const void **o = gi_particle_calloc(2 * (size_t)n, sizeof *o, st);
@@ -194,7 +194,7 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
     unsigned char *linked = gi_particle_calloc((size_t)n, 1, &st);
     int *remap = gi_particle_calloc((size_t)n, sizeof(int), &st);
     unsigned char *pin = NULL;
-    const void **pobj = particle_objects(gp, ps, &pin, &st);
+    const void **pobj = gi_particle_objects(gp, ps, &pin, &st);
     if (!grid) st = PT_ERR_NOMEM;
     if (st == PT_OK) st = gi_lookup_set_objects(grid, (const void *const *)pobj);
     if (st == PT_OK && !gp->lscene) gp->lscene = accel_rtc_link_scene(gp->a);
@@ -588,7 +588,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         gi_lookup *grid = gi_lookup_build(&gp->ps, 2.0 * spacing);
         gp->glink = gi_particle_calloc((size_t)n * (size_t)gp->ng, sizeof(int), &st);
         unsigned char *pin = NULL;
-        const void **pobj = particle_objects(gp, &gp->ps, &pin, &st);
+        const void **pobj = gi_particle_objects(gp, &gp->ps, &pin, &st);
         if (!grid) st = PT_ERR_NOMEM;
         if (st == PT_OK) st = gi_lookup_set_objects(grid, (const void *const *)pobj);
         progress_stage(set->progress, "gi geometry: gather links", 0);

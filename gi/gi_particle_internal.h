@@ -133,6 +133,14 @@ pt_status gi_particle_finish(gi_particle *gp, diag *d);
 /* The stats with the per-thread counters summed, copied to out (may be NULL). */
 void gi_particle_fill_stats(gi_particle *gp, gi_particle_stats *out);
 
+/* The object of each of ps's particles and the closed solid it is buried
+ * in (2n pointers), and the 2n inside/buried flags (*pin), as
+ * gi_links_build and gi_trilook_build take them (gi_particle.c; the
+ * geometry stage, and tests/test_gi_links.c comparing the two lookups).
+ * NULL with *st set when out of memory. */
+const void **gi_particle_objects(const gi_particle *gp, const gi_particles *ps, unsigned char **pin,
+                                 pt_status *st);
+
 /* Geometry stage helpers the lighting stage uses (gi_particle.c). */
 /* calloc of n (at least 1) elements; sets *st to PT_ERR_NOMEM on failure. */
 void *gi_particle_calloc(size_t n, size_t size, pt_status *st);
