@@ -362,6 +362,8 @@ typedef struct {
     double t_start;
     gi_keep keep;           /* particle GI of the previous frame */
     pm_detp *detp;          /* --gi detp: the photon paths of the previous frame */
+    gi_vlinks *links;       /* --gi links: the vertex links of the previous frame */
+    uint64_t links_h_geom;  /* and its geometry stage hash (stage_hashes) */
     uint64_t detp_h_geom, detp_l; /* and the stage hashes (stage_hashes) of that frame */
 } render_run;
 
@@ -422,7 +424,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
             diag_report(d, DIAG_NOTE, none, NULL, "+Q%d: radiosity is off below +Q9, as in POV-Ray", o->quality);
     }
     const char *gi_used = gi_mode_name(gi);
-    if (run->tile && (gi == GI_PATH || gi == GI_PMFG || gi == GI_DETP || gi == GI_VPL)) {
+    if (run->tile && (gi == GI_PATH || gi == GI_PMFG || gi == GI_DETP || gi == GI_VPL || gi == GI_LINKS)) {
         pbar_free(bar);
         fprintf(stderr, "partray render: a render window (+SC/+EC/+SR/+ER) needs --gi none or particle, not %s\n", gi_used);
         scene_free(sc);
@@ -518,6 +520,17 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
         ss.detp_frame.objects_may_change = !had || hg != run->detp_h_geom;
         run->detp_h_geom = hg;
         run->detp_l = hl ^ hg;
+    }
+    if (gi == GI_LINKS && plan->animated) {
+        /* the links kept across frames: only what moved is linked again
+         * (gi_vlinks.h) */
+        uint64_t hg, hl;
+        stage_hashes(sc, frame_dependent, frame, &hg, &hl);
+        int had = run->links != NULL;
+        if (!run->links) run->links = render_gi_links_new(&ss);
+        ss.links = run->links;
+        ss.links_objects_may_change = !had || hg != run->links_h_geom;
+        run->links_h_geom = hg;
     }
     ss.gi_cache = gi_cache;
     ss.gi_cache_load = gi_cache && access(gi_cache, F_OK) == 0;
@@ -692,6 +705,14 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
         if (sst.t_gi_geometry > 0 || sst.t_gi_lighting > 0)
             fprintf(stderr, "partray: %sgi %s: geometry %.3f s, lighting %.3f s\n", fr, gi_used, sst.t_gi_geometry,
                     sst.t_gi_lighting);
+        if (sst.has_links) {
+            const gi_vlinks_stats *p = &sst.links;
+            fprintf(stderr, "partray: %slinks: %s, %ld of %ld objects moved, %ld of %ld elements linked again, "
+                    "links %ld raw, %ld merged (%.2fx), %ld link rays\n", fr, p->full ? "full" : "incremental",
+                    p->objects_moved, (long)sc->nobjects, p->elements_linked, p->elements, p->raw_links,
+                    p->merged_links, p->merged_links > 0 ? (double)p->raw_links / (double)p->merged_links : 0.0,
+                    p->link_rays);
+        }
         if (sst.has_detp) {
             const pm_detp_stats *p = &sst.detp;
             fprintf(stderr, "partray: %sdetp: %s, %ld of %ld objects moved, %ld of %ld paths re-traced (%.2f%%), "
@@ -858,6 +879,7 @@ static int cmd_render(int argc, char **argv)
     for (int i = 0; i < nbases; i++) free(bases[i]);
     gi_keep_free(&run.keep);
     pm_detp_free(run.detp);
+    gi_vlinks_free(run.links);
     lighting_free(&ls);
     img_ocio_close(oc);
     ini_free(ia);

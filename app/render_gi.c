@@ -6,6 +6,8 @@
  *            (ambient under POV-Ray's rules with radiosity on, radrules.h).
  *  pmfg      photon map + final gathering (reference/pm_fg.h).
  *  path      path tracer (reference/pm_path.h).
+ *  links     vertex links over the meshes' vertices (gi/gi_vlinks.h) as the
+ *            indirect hook of the Whitted pass.
  *  detp      incremental photon paths and the fixed-radius estimate
  *            (reference/pm_detp.h) as the indirect hook of the Whitted pass. */
 #include "render_gi.h"
@@ -185,6 +187,44 @@ static pt_status render_detp(const scene *sc, const accel *a, const render_gi_op
     return st == PT_CANCELLED ? PT_OK : st;
 }
 
+gi_vlinks *render_gi_links_new(const render_gi_opts *o)
+{
+    gi_vlinks_settings s;
+    gi_vlinks_default_settings(&s);
+    if (o->bounces > 0) s.bounces = o->bounces;
+    s.threads = o->threads;
+    s.cancel = o->cancel;
+    s.pigment = shade_tex_pigment_at; /* vertices reflect the pigment where they are */
+    return gi_vlinks_new(&s);
+}
+
+static pt_status render_links(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
+                              render_gi_result *r, diag *d)
+{
+    gi_vlinks *v = o->links ? o->links : render_gi_links_new(o);
+    if (!v) return PT_ERR_NOMEM;
+    gi_vlinks_set_progress(v, o->progress);
+    r->has_links = 1;
+    pt_status st = gi_vlinks_frame(v, sc, a, o->links ? o->links_objects_may_change : 1, &r->links, d);
+    r->t_gi_geometry = r->links.t_links;
+    r->t_gi_lighting = r->links.t_light + r->links.t_bounces + r->links.t_smooth;
+    if (st == PT_OK && !(o->cancel && *o->cancel)) {
+        shade_settings ss;
+        fill_shade(&ss, o);
+        ss.use_ambient = radrules_of(sc, 1).ambient; /* radiosity's rule, as particle */
+        ss.indirect = gi_vlinks_indirect;
+        ss.indirect_ctx = v;
+        double t0 = timer_now();
+        r->image_begun = 1;
+        st = shade_render(sc, a, &ss, fb, &r->shade, d);
+        r->t_render = timer_now() - t0;
+        if (st == PT_OK) st = render_aovs(sc, a, o, &ss, r, d);
+    }
+    gi_vlinks_set_progress(v, NULL);
+    if (!o->links) gi_vlinks_free(v);
+    return st == PT_CANCELLED ? PT_OK : st;
+}
+
 typedef struct {
     const char *path;
     double last;
@@ -341,6 +381,7 @@ pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, fr
     case GI_PARTICLE: st = render_particle(sc, a, o, fb, r, d); break;
     case GI_DETP: st = render_detp(sc, a, o, fb, r, d); break;
     case GI_VPL: return render_vpl_mode(sc, a, o, fb, r, d);
+    case GI_LINKS: st = render_links(sc, a, o, fb, r, d); break;
     case GI_PMFG:
     case GI_PATH: return render_reference(sc, a, o, fb, r, d);
     default: st = render_none(sc, a, o, fb, r, d); break;
@@ -350,6 +391,7 @@ pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, fr
     r->secondary_rays = r->shade.secondary_rays;
     r->discarded = r->shade.discarded_samples;
     if (r->has_detp) r->other_rays = r->detp.rays;
+    if (r->has_links) r->other_rays = r->links.link_rays + r->links.light_rays;
     if (r->has_particle) {
         r->other_rays = r->particle.link_rays + r->particle.shadow_rays + r->particle.prepass_rays;
         r->discarded += r->particle.discarded;
@@ -433,6 +475,29 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
         stats_num(js, "trace", p->t_trace);
         stats_num(js, "gather", p->t_gather);
         stats_num(js, "total", p->t_total);
+        stats_obj_end(js);
+        stats_obj_end(js);
+    }
+    if (r->has_links) {
+        const gi_vlinks_stats *p = &r->links;
+        stats_obj_begin(js, "links");
+        stats_int(js, "vertices", p->vertices);
+        stats_int(js, "elements", p->elements);
+        stats_int(js, "meshes", p->meshes);
+        stats_int(js, "full", p->full);
+        stats_int(js, "objects_moved", p->objects_moved);
+        stats_int(js, "meshes_moved", p->meshes_moved);
+        stats_int(js, "elements_linked", p->elements_linked);
+        stats_int(js, "raw_links", p->raw_links);
+        stats_int(js, "merged_links", p->merged_links);
+        stats_int(js, "link_rays", p->link_rays);
+        stats_int(js, "light_rays", p->light_rays);
+        stats_int(js, "hits_other", p->hits_other);
+        stats_obj_begin(js, "timings");
+        stats_num(js, "links", p->t_links);
+        stats_num(js, "light", p->t_light);
+        stats_num(js, "bounces", p->t_bounces);
+        stats_num(js, "smooth", p->t_smooth);
         stats_obj_end(js);
         stats_obj_end(js);
     }

@@ -8,6 +8,7 @@
 #include "diag.h"
 #include "framebuffer.h"
 #include "gi_particle.h"
+#include "gi_vlinks.h"
 #include "pm.h"
 #include "pm_detp.h"
 #include "render_vpl.h"
@@ -50,6 +51,10 @@ typedef struct {
     pm_detp *detp;
     pm_detp_frame_info detp_frame;
     double detp_radius;       /* detp: disc radius (0 = default) */
+    /* links: the vertex links kept from the previous frame (render_gi_links_new;
+     * NULL: a still, made and freed here); objects may have changed since */
+    gi_vlinks *links;
+    int links_objects_may_change;
     int detp_full;            /* detp: recompute every frame */
     /* particle: the geometry stage's file (gi_particle_save/_load), NULL:
      * none. gi_cache_load: read it (a mismatch or a bad file is the
@@ -84,6 +89,8 @@ typedef struct {
     int has_detp;
     pm_detp_stats detp;
     int gi_cache_loaded;      /* particle: the geometry stage came from opts.gi_cache */
+    int has_links;
+    gi_vlinks_stats links;
     gi_particle *kept;        /* particle with opts.keep: the GI, the caller frees it */
     /* Light the scene uses that the mode does not carry (each also warned
      * once): 1 where it is left out. path, pmfg: participating media
@@ -97,6 +104,9 @@ pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, fr
 /* The DETP state for the frames of one animation, with o's settings
  * (photons, radius, seed, threads, full); NULL on no memory. */
 pm_detp *render_gi_detp_new(const render_gi_opts *o);
+/* The vertex links' state for the frames of one animation, with o's
+ * settings (bounces, threads); NULL on no memory. */
+gi_vlinks *render_gi_links_new(const render_gi_opts *o);
 /* Adds the method-specific object ("particle": {...}, "reference": {...}). */
 void render_gi_json(const render_gi_result *r, int mode, stats_json *js);
 

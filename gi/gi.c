@@ -2,7 +2,7 @@
 #include "gi.h"
 #include <string.h>
 
-static const char *const names[] = {"none", "particle", "pmfg", "path", "detp", "vpl"};
+static const char *const names[] = {"none", "particle", "pmfg", "path", "detp", "vpl", "links"};
 #define NMODES ((int)(sizeof names / sizeof names[0]))
 
 const char *gi_mode_name(gi_mode m) { return (unsigned)m < (unsigned)NMODES ? names[m] : "?"; }

@@ -148,5 +148,8 @@ void *gi_particle_calloc(size_t n, size_t size, pt_status *st);
 pt_status gi_particle_build_walk(gi_particle *gp, int nwalk, diag *d);
 /* The far field's E/pi at radiance particle l, for an empty estimation list. */
 void gi_particle_rp_far_field(gi_particle *gp, long l);
+/* A scene light as the kernels read it (gi_types.h: gi_light_ray,
+ * gi_light_attenuation); the vertex links (gi_vlinks.c) light with it too. */
+void gi_light_pack(const scene_light *l, gi_dev_light *o);
 
 #endif

@@ -18,7 +18,7 @@
 #include "rng.h"
 #include "timer.h"
 
-static void pack_light(const scene_light *l, gi_dev_light *o)
+void gi_light_pack(const scene_light *l, gi_dev_light *o)
 {
     memset(o, 0, sizeof *o);
     o->pos[0] = (float)l->position.x;
@@ -251,7 +251,7 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
     }
     int ndirty = 0;
     for (int l = 0; l < nl; l++) {
-        pack_light(&sc->lights[l], &gp->lights[l]);
+        gi_light_pack(&sc->lights[l], &gp->lights[l]);
         if (!gp->dirty[l] && !same_geometry(&gp->vis_lights[l], &sc->lights[l])) gp->dirty[l] = 1;
         ndirty += gp->dirty[l];
     }

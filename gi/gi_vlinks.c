@@ -1,0 +1,867 @@
+/* gi_vlinks.c - vertex links (see gi_vlinks.h).
+ *
+ * Per frame:
+ *  1. leaves and meshes (core/scene_leaves.h): every mesh leaf's vertices
+ *     become elements; top-level objects whose hash changed moved;
+ *  2. vertex positions and normals of the meshes (all on a full frame,
+ *     the moved ones otherwise), and each element's reflectance;
+ *  3. links of the elements that need them (all; or those of moved meshes
+ *     and those with a ray that ended on a moved object or now meets one):
+ *     n_C rays, three links a hit on a mesh, merged per peer;
+ *  4. light links (every element, every light: a shadow ray);
+ *  5. gathering sweeps and smoothing (gi_vlinks.cl). */
+#include "gi_vlinks.h"
+#include <math.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include "gi_particle_internal.h"
+#include "hash.h"
+#include "gi_vlinks_c.h"
+#include "pool.h"
+#include "radrules.h"
+#include "scene_leaves.h"
+#include "timer.h"
+
+#define LINK_CHUNK 16
+#define LIGHT_CHUNK 256
+
+typedef struct {
+    int leaf;      /* leaf index */
+    int top;       /* top-level object */
+    long vbase;    /* first vertex (global numbering) */
+    int nverts, ntris;
+} vmesh;
+
+typedef struct {
+    int n, raw;    /* merged links, raw links */
+    int *peer;
+    float *w;
+} elinks;
+
+struct gi_vlinks {
+    gi_vlinks_settings s;
+    int have;
+    /* structure: the previous frame's */
+    int nobj, nleaves;
+    uint64_t *obj_hash;
+    vmesh *mesh;
+    int nmesh;
+    int *leaf_mesh;          /* leaf -> mesh, -1: not a mesh */
+    long nv, ne;             /* vertices, elements (2 a vertex) */
+    vec3 *pos, *nrm;         /* per vertex: world position, unit winding normal */
+    float *rho;              /* per element, 4 floats */
+    elinks *lk;              /* per element */
+    int nc;                  /* rays per element */
+    vec3 *dirs;              /* the n_C directions in the unit hemisphere about +z */
+    float *ray_t;            /* per element and ray: hit distance (INFINITY: none) */
+    int *ray_leaf;           /* per element and ray: leaf hit (-1 none, -2 unknown) */
+    double off;              /* origin offset along the normal */
+    /* kernels' arrays */
+    int *off_csr, *peer_csr;
+    float *w_csr;
+    int *adj_off, *adj;
+    float *edir, *b0, *b1, *itot, *ism;
+    /* the frame the hook reads */
+    const scene *sc;
+    scene_leaves *lv;
+    atomic_long lookups_other;
+};
+
+/* ---------------------------------------------------------------- directions */
+
+/* Shirley and Chiu's concentric map of the unit square to the unit disc. */
+static void concentric(double u, double v, double *x, double *y)
+{
+    double a = 2.0 * u - 1.0, b = 2.0 * v - 1.0, r, phi;
+    if (a == 0.0 && b == 0.0) {
+        *x = *y = 0.0;
+        return;
+    }
+    if (fabs(a) > fabs(b)) {
+        r = a;
+        phi = (M_PI / 4.0) * (b / a);
+    } else {
+        r = b;
+        phi = M_PI / 2.0 - (M_PI / 4.0) * (a / b);
+    }
+    *x = r * cos(phi);
+    *y = r * sin(phi);
+}
+
+/* nside x nside cell centres of the unit square, taken block by block (4 x 4
+ * cells a block, blocks row by row: neighbouring rays of one element are
+ * traced together, the paper's coherent blocks), mapped to the disc and
+ * projected up to the hemisphere (cosine-weighted: Malley's method). */
+static vec3 *make_dirs(int nside)
+{
+    vec3 *d = malloc(sizeof *d * (size_t)nside * nside);
+    if (!d) return NULL;
+    int k = 0, nb = nside / 4;
+    for (int by = 0; by < nb; by++)
+        for (int bx = 0; bx < nb; bx++)
+            for (int j = 0; j < 4; j++)
+                for (int i = 0; i < 4; i++) {
+                    double u = (bx * 4 + i + 0.5) / nside, v = (by * 4 + j + 0.5) / nside, x, y;
+                    concentric(u, v, &x, &y);
+                    d[k++] = v3(x, y, sqrt(fmax(0.0, 1.0 - x * x - y * y)));
+                }
+    return d;
+}
+
+/* ---------------------------------------------------------------- elements */
+
+static vec3 vload(const float *f) { return v3(f[0], f[1], f[2]); }
+
+/* World positions and area-weighted winding normals of mesh m's vertices. */
+static void mesh_geometry(gi_vlinks *v, const scene_object *o, const vmesh *m)
+{
+    const scene_mesh *sm = o->u.mesh.mesh;
+    vec3 *P = v->pos + m->vbase, *N = v->nrm + m->vbase;
+    for (int i = 0; i < m->nverts; i++) {
+        P[i] = xform_point(&o->transform, vload(sm->verts[i]));
+        N[i] = v3(0, 0, 0);
+    }
+    for (int t = 0; t < m->ntris; t++) {
+        const int *tr = sm->tris[t];
+        if (tr[0] < 0 || tr[1] < 0 || tr[2] < 0 || tr[0] >= m->nverts || tr[1] >= m->nverts || tr[2] >= m->nverts)
+            continue;
+        vec3 f = v3_cross(v3_sub(P[tr[1]], P[tr[0]]), v3_sub(P[tr[2]], P[tr[0]]));
+        for (int c = 0; c < 3; c++) N[tr[c]] = v3_add(N[tr[c]], f);
+    }
+    for (int i = 0; i < m->nverts; i++) {
+        double l = v3_len(N[i]);
+        N[i] = l > 0.0 ? v3_scale(N[i], 1.0 / l) : v3(0, 0, 1);
+    }
+}
+
+/* Reflectance (finish diffuse times the pigment at the vertex) of mesh m's
+ * elements; both sides take the texture of the vertex's first triangle. */
+static void mesh_rho(gi_vlinks *v, const scene *sc, const scene_object *o, const vmesh *m)
+{
+    const scene_mesh *sm = o->u.mesh.mesh;
+    int *first = malloc(sizeof *first * (size_t)(m->nverts > 0 ? m->nverts : 1));
+    int *corner = malloc(sizeof *corner * (size_t)(m->nverts > 0 ? m->nverts : 1));
+    if (!first || !corner) {
+        free(first);
+        free(corner);
+        return;
+    }
+    for (int i = 0; i < m->nverts; i++) first[i] = -1;
+    for (int t = m->ntris - 1; t >= 0; t--)
+        for (int c = 0; c < 3; c++) {
+            int vi = sm->tris[t][c];
+            if (vi >= 0 && vi < m->nverts) {
+                first[vi] = t;
+                corner[vi] = c;
+            }
+        }
+    for (int i = 0; i < m->nverts; i++) {
+        const scene_texture *tex = o->texture ? o->texture : &sc->default_texture;
+        int t = first[i];
+        if (t >= 0 && sm->tri_texture && sm->tri_texture[t] >= 0 && sm->tri_texture[t] < sm->ntextures)
+            tex = sm->textures[sm->tri_texture[t]];
+        accel_hit h;
+        memset(&h, 0, sizeof h);
+        long g = m->vbase + i;
+        h.p = v->pos[g];
+        h.ng = h.ns = v->nrm[g];
+        h.obj = o;
+        h.texture = tex;
+        h.prim = t >= 0 ? (unsigned)t : 0u;
+        if (t >= 0) {
+            int c = corner[i];
+            h.u = c == 1 ? 1.0 : 0.0;
+            h.v = c == 2 ? 1.0 : 0.0;
+            if (sm->tri_uvs && sm->uvs) {
+                int ui = sm->tri_uvs[t][c];
+                if (ui >= 0 && ui < sm->nuvs) {
+                    h.uv[0] = sm->uvs[ui][0];
+                    h.uv[1] = sm->uvs[ui][1];
+                }
+            }
+        }
+        colour5 c5 = tex->pigment.colour;
+        if (v->s.pigment && !v->s.pigment(sc, tex, &h, &c5)) c5 = tex->pigment.colour;
+        double d = tex->finish.diffuse;
+        float rgbv[3] = {(float)(c5.r * d), (float)(c5.g * d), (float)(c5.b * d)};
+        for (int side = 0; side < 2; side++) {
+            float *r = &v->rho[(size_t)(2 * g + side) * 4];
+            for (int k = 0; k < 3; k++) r[k] = isfinite(rgbv[k]) && rgbv[k] > 0.0f ? rgbv[k] : 0.0f;
+            r[3] = 0.0f;
+        }
+    }
+    free(first);
+    free(corner);
+}
+
+/* ---------------------------------------------------------------- links */
+
+typedef struct {
+    gi_vlinks *v;
+    const scene *sc;
+    const accel *a;
+    const scene_leaves *lv;
+    const long *todo;            /* elements to link */
+    long ntodo;
+    int nthreads;
+    float **acc;                 /* per thread: weight per peer element (dense) */
+    int **touched;               /* per thread: peers touched */
+    atomic_long rays, other, raw;
+    int oom;
+} link_job;
+
+static void link_chunk(void *ctx, int ci, int thread)
+{
+    link_job *J = ctx;
+    gi_vlinks *v = J->v;
+    if (v->s.cancel && *v->s.cancel) return;
+    long i0 = (long)ci * LINK_CHUNK, i1 = i0 + LINK_CHUNK < J->ntodo ? i0 + LINK_CHUNK : J->ntodo;
+    float *acc = J->acc[thread];
+    int *touched = J->touched[thread];
+    long rays = 0, other = 0, rawsum = 0;
+    const float inv = 1.0f / (float)v->nc;
+    for (long q = i0; q < i1; q++) {
+        long e = J->todo[q], vx = e / 2;
+        int side = (int)(e % 2);
+        vec3 n = side ? v3_neg(v->nrm[vx]) : v->nrm[vx];
+        vec3 t, b;
+        v3_basis(n, &t, &b);
+        vec3 org = v3_madd(v->pos[vx], n, v->off);
+        int nt = 0, raw = 0;
+        for (int k = 0; k < v->nc; k++) {
+            vec3 l = v->dirs[k];
+            vec3 dir = v3_add(v3_add(v3_scale(t, l.x), v3_scale(b, l.y)), v3_scale(n, l.z));
+            accel_hit h;
+            rays++;
+            size_t r = (size_t)e * v->nc + k;
+            if (!accel_intersect(J->a, org, dir, 0.0, INFINITY, &h)) {
+                v->ray_t[r] = INFINITY;
+                v->ray_leaf[r] = -1;
+                continue;
+            }
+            int leaf = scene_leaves_find(J->lv, h.obj);
+            v->ray_t[r] = (float)h.t;
+            v->ray_leaf[r] = leaf;
+            int mi = leaf >= 0 ? v->leaf_mesh[leaf] : -1;
+            if (mi < 0) {
+                other++;
+                continue;
+            }
+            const vmesh *m = &v->mesh[mi];
+            const scene_mesh *sm = h.obj->u.mesh.mesh;
+            if (h.prim >= (unsigned)m->ntris) continue;
+            const int *tr = sm->tris[h.prim];
+            if (tr[0] < 0 || tr[1] < 0 || tr[2] < 0 || tr[0] >= m->nverts || tr[1] >= m->nverts || tr[2] >= m->nverts)
+                continue;
+            long g[3] = {m->vbase + tr[0], m->vbase + tr[1], m->vbase + tr[2]};
+            vec3 f = v3_cross(v3_sub(v->pos[g[1]], v->pos[g[0]]), v3_sub(v->pos[g[2]], v->pos[g[0]]));
+            int hs = v3_dot(dir, f) < 0.0 ? 0 : 1; /* the side the ray arrives at */
+            /* accel_hit's barycentrics: p = (1 - u - v) v0 + u v1 + v v2 */
+            double bw[3] = {1.0 - h.u - h.v, h.u, h.v};
+            for (int c = 0; c < 3; c++) {
+                float wv = (float)bw[c] * inv;
+                if (!(wv > 0.0f)) continue;
+                int p = (int)(2 * g[c] + hs);
+                if (acc[p] == 0.0f) touched[nt++] = p;
+                acc[p] += wv;
+                raw++;
+            }
+        }
+        elinks *L = &v->lk[e];
+        free(L->peer);
+        free(L->w);
+        L->peer = malloc(sizeof *L->peer * (size_t)(nt > 0 ? nt : 1));
+        L->w = malloc(sizeof *L->w * (size_t)(nt > 0 ? nt : 1));
+        if (!L->peer || !L->w) {
+            J->oom = 1;
+            L->n = 0;
+            for (int k = 0; k < nt; k++) acc[touched[k]] = 0.0f;
+            continue;
+        }
+        for (int k = 0; k < nt; k++) {
+            L->peer[k] = touched[k];
+            L->w[k] = acc[touched[k]];
+            acc[touched[k]] = 0.0f;
+        }
+        L->n = nt;
+        L->raw = raw;
+        rawsum += raw;
+    }
+    atomic_fetch_add(&J->rays, rays);
+    atomic_fetch_add(&J->other, other);
+    atomic_fetch_add(&J->raw, rawsum);
+}
+
+/* ---------------------------------------------------------------- light */
+
+typedef struct {
+    gi_vlinks *v;
+    const scene *sc;
+    const accel *a;
+    const gi_dev_light *dl;
+    atomic_long rays;
+} light_job;
+
+static void light_chunk(void *ctx, int ci, int thread)
+{
+    (void)thread;
+    light_job *J = ctx;
+    gi_vlinks *v = J->v;
+    const scene *sc = J->sc;
+    long e0 = (long)ci * LIGHT_CHUNK, e1 = e0 + LIGHT_CHUNK < v->ne ? e0 + LIGHT_CHUNK : v->ne;
+    long rays = 0;
+    for (long e = e0; e < e1; e++) {
+        long vx = e / 2;
+        int side = (int)(e % 2);
+        vec3 n = side ? v3_neg(v->nrm[vx]) : v->nrm[vx];
+        vec3 p = v->pos[vx];
+        const vmesh *m = NULL;
+        for (int k = 0; k < v->nmesh && !m; k++)
+            if (vx >= v->mesh[k].vbase && vx < v->mesh[k].vbase + v->mesh[k].nverts) m = &v->mesh[k];
+        const scene_object *obj = m ? scene_leaves_get(v->lv, m->leaf) : NULL;
+        float E[3] = {0.0f, 0.0f, 0.0f};
+        for (int li = 0; li < sc->nlights; li++) {
+            const scene_light *l = &sc->lights[li];
+            const gi_dev_light *dl = &J->dl[li];
+            float d[3];
+            float depth = gi_light_ray(dl, dl->pos[0], dl->pos[1], dl->pos[2], (float)p.x, (float)p.y, (float)p.z, d);
+            double ci2 = n.x * d[0] + n.y * d[1] + n.z * d[2];
+            if (!(ci2 > 1e-10)) continue;
+            float att = gi_light_attenuation(dl, (float)p.x, (float)p.y, (float)p.z, d, depth);
+            if (!(att > 0.0f) || (obj && !scene_light_reaches(l, obj))) continue;
+            if (!l->shadowless) {
+                rays++;
+                if (accel_occluded(J->a, v3_madd(p, n, v->off), v3(d[0], d[1], d[2]), 0.0, depth)) continue;
+            }
+            for (int c = 0; c < 3; c++) E[c] += dl->colour[c] * att * (float)ci2;
+        }
+        for (int c = 0; c < 3; c++) v->edir[e * 4 + c] = isfinite(E[c]) ? E[c] : 0.0f;
+        v->edir[e * 4 + 3] = 0.0f;
+    }
+    atomic_fetch_add(&J->rays, rays);
+}
+
+/* ---------------------------------------------------------------- frame */
+
+void gi_vlinks_default_settings(gi_vlinks_settings *s)
+{
+    memset(s, 0, sizeof *s);
+    s->nside = 16;
+    s->bounces = 3;
+    s->feature_deg = 30.0;
+}
+
+gi_vlinks *gi_vlinks_new(const gi_vlinks_settings *s)
+{
+    gi_vlinks *v = calloc(1, sizeof *v);
+    if (!v) return NULL;
+    v->s = *s;
+    if (v->s.nside < 4) v->s.nside = 4;
+    v->s.nside = (v->s.nside + 3) / 4 * 4;
+    if (v->s.bounces < 1) v->s.bounces = 1;
+    v->nc = v->s.nside * v->s.nside;
+    v->dirs = make_dirs(v->s.nside);
+    if (!v->dirs) {
+        free(v);
+        return NULL;
+    }
+    return v;
+}
+
+static void free_structure(gi_vlinks *v)
+{
+    for (long e = 0; e < v->ne && v->lk; e++) {
+        free(v->lk[e].peer);
+        free(v->lk[e].w);
+    }
+    free(v->lk);
+    free(v->mesh);
+    free(v->leaf_mesh);
+    free(v->pos);
+    free(v->nrm);
+    free(v->rho);
+    free(v->ray_t);
+    free(v->ray_leaf);
+    free(v->edir);
+    free(v->b0);
+    free(v->b1);
+    free(v->itot);
+    free(v->ism);
+    free(v->off_csr);
+    free(v->peer_csr);
+    free(v->w_csr);
+    free(v->adj_off);
+    free(v->adj);
+    v->lk = NULL;
+    v->mesh = NULL;
+    v->leaf_mesh = NULL;
+    v->pos = v->nrm = NULL;
+    v->rho = v->ray_t = v->edir = v->b0 = v->b1 = v->itot = v->ism = v->w_csr = NULL;
+    v->ray_leaf = v->off_csr = v->peer_csr = v->adj_off = v->adj = NULL;
+    v->ne = v->nv = 0;
+    v->nmesh = 0;
+    v->have = 0;
+}
+
+void gi_vlinks_free(gi_vlinks *v)
+{
+    if (!v) return;
+    free_structure(v);
+    free(v->obj_hash);
+    free(v->dirs);
+    scene_leaves_free(v->lv);
+    free(v);
+}
+
+void gi_vlinks_set_progress(gi_vlinks *v, progress *p) { v->s.progress = p; }
+
+long gi_vlinks_count(const gi_vlinks *v) { return v->ne; }
+
+rgb gi_vlinks_element(const gi_vlinks *v, long i, vec3 *p, vec3 *nrm)
+{
+    rgb z = {0, 0, 0};
+    if (i < 0 || i >= v->ne || !v->ism) return z;
+    long vx = i / 2;
+    if (p) *p = v->pos[vx];
+    if (nrm) *nrm = i % 2 ? v3_neg(v->nrm[vx]) : v->nrm[vx];
+    rgb r = {v->ism[i * 4], v->ism[i * 4 + 1], v->ism[i * 4 + 2]};
+    return r;
+}
+
+/* The structure of sc's meshes: leaf -> mesh and vertex numbering. 0 on no
+ * memory. */
+static int make_structure(gi_vlinks *v, const scene *sc, const scene_leaves *lv)
+{
+    int nl = scene_leaves_count(lv);
+    v->leaf_mesh = malloc(sizeof *v->leaf_mesh * (size_t)(nl > 0 ? nl : 1));
+    v->mesh = malloc(sizeof *v->mesh * (size_t)(nl > 0 ? nl : 1));
+    if (!v->leaf_mesh || !v->mesh) return 0;
+    long nv = 0;
+    v->nmesh = 0;
+    for (int i = 0; i < nl; i++) {
+        const scene_object *o = scene_leaves_get(lv, i);
+        v->leaf_mesh[i] = -1;
+        if (o->kind != SHAPE_MESH || !o->u.mesh.mesh || o->u.mesh.mesh->nverts <= 0) continue;
+        vmesh *m = &v->mesh[v->nmesh];
+        m->leaf = i;
+        m->top = scene_leaves_top(lv, i);
+        m->vbase = nv;
+        m->nverts = o->u.mesh.mesh->nverts;
+        m->ntris = o->u.mesh.mesh->ntris;
+        v->leaf_mesh[i] = v->nmesh++;
+        nv += m->nverts;
+    }
+    (void)sc;
+    v->nv = nv;
+    v->ne = 2 * nv;
+    size_t ne = (size_t)(v->ne > 0 ? v->ne : 1);
+    v->pos = malloc(sizeof *v->pos * (size_t)(nv > 0 ? nv : 1));
+    v->nrm = malloc(sizeof *v->nrm * (size_t)(nv > 0 ? nv : 1));
+    v->rho = calloc(ne * 4, sizeof *v->rho);
+    v->lk = calloc(ne, sizeof *v->lk);
+    v->ray_t = malloc(sizeof *v->ray_t * ne * (size_t)v->nc);
+    v->ray_leaf = malloc(sizeof *v->ray_leaf * ne * (size_t)v->nc);
+    v->edir = calloc(ne * 4, sizeof(float));
+    v->b0 = calloc(ne * 4, sizeof(float));
+    v->b1 = calloc(ne * 4, sizeof(float));
+    v->itot = calloc(ne * 4, sizeof(float));
+    v->ism = calloc(ne * 4, sizeof(float));
+    v->off_csr = calloc(ne + 1, sizeof(int));
+    v->adj_off = calloc(ne + 1, sizeof(int));
+    return v->pos && v->nrm && v->rho && v->lk && v->ray_t && v->ray_leaf && v->edir && v->b0 && v->b1 && v->itot &&
+           v->ism && v->off_csr && v->adj_off;
+}
+
+/* One-ring neighbours of every element on the same side within the
+ * feature angle (CSR adj_off/adj). */
+static int make_adjacency(gi_vlinks *v, const scene_leaves *lv)
+{
+    double cf = cos(v->s.feature_deg * M_PI / 180.0);
+    /* vertex adjacency: every triangle edge both ways, duplicates removed per vertex */
+    long *cnt = calloc((size_t)v->nv + 1, sizeof *cnt);
+    if (!cnt) return 0;
+    for (int mi = 0; mi < v->nmesh; mi++) {
+        const vmesh *m = &v->mesh[mi];
+        const scene_mesh *sm = scene_leaves_get(lv, m->leaf)->u.mesh.mesh;
+        for (int t = 0; t < m->ntris; t++)
+            for (int c = 0; c < 3; c++) {
+                int a = sm->tris[t][c];
+                if (a >= 0 && a < m->nverts) cnt[m->vbase + a + 1] += 2;
+            }
+    }
+    for (long i = 0; i < v->nv; i++) cnt[i + 1] += cnt[i];
+    long total = cnt[v->nv];
+    long *vn = malloc(sizeof *vn * (size_t)(total > 0 ? total : 1));
+    long *fill = malloc(sizeof *fill * (size_t)(v->nv > 0 ? v->nv : 1));
+    if (!vn || !fill) {
+        free(cnt);
+        free(vn);
+        free(fill);
+        return 0;
+    }
+    for (long i = 0; i < v->nv; i++) fill[i] = cnt[i];
+    for (int mi = 0; mi < v->nmesh; mi++) {
+        const vmesh *m = &v->mesh[mi];
+        const scene_mesh *sm = scene_leaves_get(lv, m->leaf)->u.mesh.mesh;
+        for (int t = 0; t < m->ntris; t++) {
+            const int *tr = sm->tris[t];
+            if (tr[0] < 0 || tr[1] < 0 || tr[2] < 0 || tr[0] >= m->nverts || tr[1] >= m->nverts || tr[2] >= m->nverts)
+                continue;
+            for (int c = 0; c < 3; c++) {
+                long a = m->vbase + tr[c];
+                vn[fill[a]++] = m->vbase + tr[(c + 1) % 3];
+                vn[fill[a]++] = m->vbase + tr[(c + 2) % 3];
+            }
+        }
+    }
+    /* per element: its vertex's distinct neighbours within the angle */
+    free(v->adj);
+    v->adj = malloc(sizeof *v->adj * (size_t)(2 * total > 0 ? 2 * total : 1));
+    if (!v->adj) {
+        free(cnt);
+        free(vn);
+        free(fill);
+        return 0;
+    }
+    long k = 0;
+    for (long e = 0; e < v->ne; e++) {
+        long a = e / 2;
+        int side = (int)(e % 2);
+        v->adj_off[e] = (int)k;
+        long k0 = k;
+        for (long q = cnt[a]; q < fill[a]; q++) {
+            long b = vn[q];
+            if (b == a || v3_dot(v->nrm[a], v->nrm[b]) <= cf) continue;
+            int peer = (int)(2 * b + side), dup = 0;
+            for (long z = k0; z < k && !dup; z++) dup = v->adj[z] == peer;
+            if (!dup) v->adj[k++] = peer;
+        }
+    }
+    v->adj_off[v->ne] = (int)k;
+    free(cnt);
+    free(vn);
+    free(fill);
+    return 1;
+}
+
+/* CSR of the links (off_csr/peer_csr/w_csr) from the per-element lists. */
+static int make_csr(gi_vlinks *v, long *merged, long *raw)
+{
+    long total = 0, r = 0;
+    for (long e = 0; e < v->ne; e++) {
+        total += v->lk[e].n;
+        r += v->lk[e].raw;
+    }
+    free(v->peer_csr);
+    free(v->w_csr);
+    v->peer_csr = malloc(sizeof *v->peer_csr * (size_t)(total > 0 ? total : 1));
+    v->w_csr = malloc(sizeof *v->w_csr * (size_t)(total > 0 ? total : 1));
+    if (!v->peer_csr || !v->w_csr) return 0;
+    long k = 0;
+    for (long e = 0; e < v->ne; e++) {
+        v->off_csr[e] = (int)k;
+        if (v->lk[e].n) {
+            memcpy(v->peer_csr + k, v->lk[e].peer, sizeof(int) * (size_t)v->lk[e].n);
+            memcpy(v->w_csr + k, v->lk[e].w, sizeof(float) * (size_t)v->lk[e].n);
+        }
+        k += v->lk[e].n;
+    }
+    v->off_csr[v->ne] = (int)k;
+    *merged = total;
+    *raw = r;
+    return 1;
+}
+
+/* Whether the ray o + t d, t in [0, tmax], meets the box lo..hi. */
+static int box_meets(vec3 lo, vec3 hi, vec3 o, vec3 d, double tmax)
+{
+    double t0, t1;
+    return v3_slab(o, d, lo, hi, &t0, &t1) && t1 >= 0.0 && t0 <= tmax;
+}
+
+typedef struct {
+    gi_vlinks *v;
+    const accel *mob;
+    int boxed;
+    vec3 lo, hi;
+    const unsigned char *moved_leaf;
+    unsigned char *need;
+} stale_job;
+
+/* Marks the elements with a ray that ended on a moved object or that now
+ * meets one. */
+static void stale_chunk(void *ctx, int ci, int thread)
+{
+    (void)thread;
+    stale_job *J = ctx;
+    gi_vlinks *v = J->v;
+    long e0 = (long)ci * LIGHT_CHUNK, e1 = e0 + LIGHT_CHUNK < v->ne ? e0 + LIGHT_CHUNK : v->ne;
+    for (long e = e0; e < e1; e++) {
+        if (J->need[e]) continue;
+        long vx = e / 2;
+        int side = (int)(e % 2);
+        vec3 n = side ? v3_neg(v->nrm[vx]) : v->nrm[vx];
+        vec3 t, b;
+        v3_basis(n, &t, &b);
+        vec3 org = v3_madd(v->pos[vx], n, v->off);
+        for (int k = 0; k < v->nc && !J->need[e]; k++) {
+            size_t r = (size_t)e * v->nc + k;
+            int lf = v->ray_leaf[r];
+            if (lf == -2 || (lf >= 0 && J->moved_leaf[lf])) {
+                J->need[e] = 1;
+                break;
+            }
+            if (!J->mob) continue;
+            vec3 l = v->dirs[k];
+            vec3 dir = v3_add(v3_add(v3_scale(t, l.x), v3_scale(b, l.y)), v3_scale(n, l.z));
+            double tmax = isfinite(v->ray_t[r]) ? v->ray_t[r] * (1.0 + 1e-6) : INFINITY;
+            if (J->boxed && !box_meets(J->lo, J->hi, org, dir, tmax)) continue;
+            accel_hit h;
+            if (accel_intersect(J->mob, org, dir, 0.0, tmax, &h)) J->need[e] = 1;
+        }
+    }
+}
+
+pt_status gi_vlinks_frame(gi_vlinks *v, const scene *sc, const accel *a, int objects_may_change, gi_vlinks_stats *st,
+                          diag *d)
+{
+    (void)d;
+    memset(st, 0, sizeof *st);
+    pt_status status = PT_OK;
+    int nthreads = pool_default_threads();
+    if (v->s.threads > 0) nthreads = v->s.threads;
+    scene_leaves *lv = scene_leaves_new(sc);
+    if (!lv) return PT_ERR_NOMEM;
+    int nl = scene_leaves_count(lv);
+    uint64_t *hash = malloc(sizeof *hash * (size_t)(sc->nobjects > 0 ? sc->nobjects : 1));
+    unsigned char *moved_top = calloc((size_t)(sc->nobjects > 0 ? sc->nobjects : 1), 1);
+    unsigned char *moved_leaf = calloc((size_t)(nl > 0 ? nl : 1), 1);
+    unsigned char *need = NULL;
+    long *todo = NULL;
+    accel *mob = NULL;
+    scene_object **mobobj = malloc(sizeof *mobobj * (size_t)(sc->nobjects > 0 ? sc->nobjects : 1));
+    gi_dev_light *dl = NULL;
+    link_job J;
+    memset(&J, 0, sizeof J);
+    if (!hash || !moved_top || !moved_leaf || !mobobj) {
+        status = PT_ERR_NOMEM;
+        goto done;
+    }
+    /* 1. structure and what moved */
+    int full = !v->have || sc->nobjects != v->nobj || nl != v->nleaves;
+    for (int i = 0; i < sc->nobjects; i++) {
+        int opaque = 0;
+        hash[i] = scene_object_hash(PT_FNV1A_BASIS, sc->objects[i], &opaque);
+        if (!full && objects_may_change) moved_top[i] = opaque || hash[i] != v->obj_hash[i];
+    }
+    if (!full)
+        for (int mi = 0; mi < v->nmesh && !full; mi++) {
+            const scene_object *o = scene_leaves_get(lv, v->mesh[mi].leaf);
+            full = o->kind != SHAPE_MESH || !o->u.mesh.mesh || o->u.mesh.mesh->nverts != v->mesh[mi].nverts ||
+                   o->u.mesh.mesh->ntris != v->mesh[mi].ntris;
+        }
+    if (full) {
+        free_structure(v);
+        if (!make_structure(v, sc, lv)) {
+            status = PT_ERR_NOMEM;
+            free_structure(v);
+            goto done;
+        }
+        vec3 lo, hi;
+        accel_bounds(a, &lo, &hi);
+        double sz = v3_len(v3_sub(hi, lo));
+        v->off = 1e-6 * (sz > 0.0 && isfinite(sz) ? sz : accel_scale(a));
+    }
+    int nmob = 0;
+    for (int i = 0; i < sc->nobjects; i++)
+        if (moved_top[i]) mobobj[nmob++] = sc->objects[i];
+    for (int l = 0; l < nl; l++) moved_leaf[l] = moved_top[scene_leaves_top(lv, l)];
+    st->objects_moved = nmob;
+    st->full = full;
+    /* 2. geometry of the meshes that need it */
+    for (int mi = 0; mi < v->nmesh; mi++) {
+        const vmesh *m = &v->mesh[mi];
+        if (!full && !moved_leaf[m->leaf]) continue;
+        if (!full) st->meshes_moved++;
+        const scene_object *o = scene_leaves_get(lv, m->leaf);
+        mesh_geometry(v, o, m);
+    }
+    /* reflectance: every frame (textures are not hashed) */
+    for (int mi = 0; mi < v->nmesh; mi++) mesh_rho(v, sc, scene_leaves_get(lv, v->mesh[mi].leaf), &v->mesh[mi]);
+    st->vertices = v->nv;
+    st->elements = v->ne;
+    st->meshes = v->nmesh;
+    scene_leaves_free(v->lv);
+    v->lv = lv;
+    lv = NULL;
+    v->sc = sc;
+
+    /* 3. links */
+    double t0 = timer_now();
+    need = calloc((size_t)(v->ne > 0 ? v->ne : 1), 1);
+    todo = malloc(sizeof *todo * (size_t)(v->ne > 0 ? v->ne : 1));
+    if (!need || !todo) {
+        status = PT_ERR_NOMEM;
+        goto done;
+    }
+    if (full) {
+        memset(need, 1, (size_t)v->ne);
+    } else if (nmob > 0) {
+        for (int mi = 0; mi < v->nmesh; mi++)
+            if (moved_leaf[v->mesh[mi].leaf]) memset(need + 2 * v->mesh[mi].vbase, 1, (size_t)(2 * v->mesh[mi].nverts));
+        scene mobsc = *sc;
+        mobsc.objects = mobobj;
+        mobsc.nobjects = nmob;
+        diag *dq = diag_new();
+        pt_status ms = PT_OK;
+        mob = accel_build(&mobsc, v->s.threads, dq, &ms);
+        diag_free(dq);
+        stale_job S = {v, mob, 1, v3(0, 0, 0), v3(0, 0, 0), moved_leaf, need};
+        for (int k = 0; k < nmob; k++) S.boxed &= scene_object_finite(mobobj[k]);
+        if (mob && S.boxed) {
+            accel_bounds(mob, &S.lo, &S.hi);
+            double g = 1e-6 * v3_len(v3_sub(S.hi, S.lo)) + v->off;
+            S.lo = v3_sub(S.lo, v3(g, g, g));
+            S.hi = v3_add(S.hi, v3(g, g, g));
+        } else {
+            S.boxed = 0;
+        }
+        if (!mob) memset(need, 1, (size_t)v->ne); /* no moved-objects accel: everything again */
+        else pool_run(nthreads, (int)((v->ne + LIGHT_CHUNK - 1) / LIGHT_CHUNK), stale_chunk, &S);
+    }
+    long ntodo = 0;
+    for (long e = 0; e < v->ne; e++)
+        if (need[e]) todo[ntodo++] = e;
+    st->elements_linked = ntodo;
+    if (ntodo > 0) {
+        J.v = v;
+        J.sc = sc;
+        J.a = a;
+        J.lv = v->lv;
+        J.todo = todo;
+        J.ntodo = ntodo;
+        J.nthreads = nthreads;
+        J.acc = calloc((size_t)nthreads, sizeof *J.acc);
+        J.touched = calloc((size_t)nthreads, sizeof *J.touched);
+        if (!J.acc || !J.touched) {
+            status = PT_ERR_NOMEM;
+            goto done;
+        }
+        for (int t = 0; t < nthreads; t++) {
+            J.acc[t] = calloc((size_t)v->ne, sizeof(float));
+            J.touched[t] = malloc(sizeof(int) * (size_t)v->nc * 3 + sizeof(int));
+            if (!J.acc[t] || !J.touched[t]) {
+                status = PT_ERR_NOMEM;
+                goto done;
+            }
+        }
+        progress_stage(v->s.progress, "links: link rays", (ntodo + LINK_CHUNK - 1) / LINK_CHUNK);
+        pool_run_counted(nthreads, (int)((ntodo + LINK_CHUNK - 1) / LINK_CHUNK), link_chunk, &J, v->s.cancel,
+                         v->s.progress);
+        if (v->s.cancel && *v->s.cancel) {
+            status = PT_CANCELLED;
+            v->have = 0;
+            goto done;
+        }
+        if (J.oom) {
+            status = PT_ERR_NOMEM;
+            v->have = 0;
+            goto done;
+        }
+        st->link_rays = atomic_load(&J.rays);
+        st->hits_other = atomic_load(&J.other);
+    }
+    if (!make_csr(v, &st->merged_links, &st->raw_links) || !make_adjacency(v, v->lv)) {
+        status = PT_ERR_NOMEM;
+        v->have = 0;
+        goto done;
+    }
+    st->t_links = timer_now() - t0;
+
+    /* 4. light links */
+    t0 = timer_now();
+    dl = calloc((size_t)(sc->nlights > 0 ? sc->nlights : 1), sizeof *dl);
+    if (!dl) {
+        status = PT_ERR_NOMEM;
+        goto done;
+    }
+    for (int li = 0; li < sc->nlights; li++) gi_light_pack(&sc->lights[li], &dl[li]);
+    light_job L = {v, sc, a, dl, 0};
+    progress_stage(v->s.progress, "links: light", 0);
+    pool_run(nthreads, (int)((v->ne + LIGHT_CHUNK - 1) / LIGHT_CHUNK), light_chunk, &L);
+    st->light_rays = atomic_load(&L.rays);
+    st->t_light = timer_now() - t0;
+
+    /* 5. gathering sweeps, smoothing */
+    t0 = timer_now();
+    size_t n4 = (size_t)v->ne * 4;
+    memset(v->itot, 0, sizeof(float) * n4);
+    for (size_t i = 0; i < n4; i++) v->b0[i] = v->rho[i] * v->edir[i];
+    progress_stage(v->s.progress, "links: bounces", 0);
+    for (int b = 0; b < v->s.bounces; b++) {
+        gi_c_vgather(nthreads, v->off_csr, v->peer_csr, v->w_csr, v->b0, v->rho, (int)v->ne, v->b1, v->itot);
+        float *tmp = v->b0;
+        v->b0 = v->b1;
+        v->b1 = tmp;
+    }
+    st->t_bounces = timer_now() - t0;
+    t0 = timer_now();
+    gi_c_vsmooth(nthreads, v->adj_off, v->adj, v->itot, (int)v->ne, v->ism);
+    st->t_smooth = timer_now() - t0;
+    free(v->obj_hash);
+    v->obj_hash = hash;
+    hash = NULL;
+    v->nobj = sc->nobjects;
+    v->nleaves = nl;
+    v->have = 1;
+    atomic_store(&v->lookups_other, 0);
+done:
+    if (J.acc)
+        for (int t = 0; t < nthreads; t++) free(J.acc[t]);
+    if (J.touched)
+        for (int t = 0; t < nthreads; t++) free(J.touched[t]);
+    free(J.acc);
+    free(J.touched);
+    free(dl);
+    accel_free(mob);
+    free(mobobj);
+    free(todo);
+    free(need);
+    free(moved_leaf);
+    free(moved_top);
+    free(hash);
+    scene_leaves_free(lv);
+    if (status != PT_OK) v->have = 0;
+    return status;
+}
+
+rgb gi_vlinks_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
+{
+    (void)thread;
+    gi_vlinks *v = ctx;
+    rgb z = {0.0, 0.0, 0.0};
+    if (!v->have || !v->lv) return z;
+    int leaf = scene_leaves_find(v->lv, hit->obj);
+    int mi = leaf >= 0 ? v->leaf_mesh[leaf] : -1;
+    if (mi < 0) {
+        atomic_fetch_add_explicit(&v->lookups_other, 1, memory_order_relaxed);
+        return z;
+    }
+    const vmesh *m = &v->mesh[mi];
+    const scene_mesh *sm = hit->obj->u.mesh.mesh;
+    if (hit->prim >= (unsigned)m->ntris) return z;
+    const int *tr = sm->tris[hit->prim];
+    if (tr[0] < 0 || tr[1] < 0 || tr[2] < 0 || tr[0] >= m->nverts || tr[1] >= m->nverts || tr[2] >= m->nverts) return z;
+    long g[3] = {m->vbase + tr[0], m->vbase + tr[1], m->vbase + tr[2]};
+    vec3 f = v3_cross(v3_sub(v->pos[g[1]], v->pos[g[0]]), v3_sub(v->pos[g[2]], v->pos[g[0]]));
+    int side = v3_dot(n, f) >= 0.0 ? 0 : 1;
+    double bw[3] = {1.0 - hit->u - hit->v, hit->u, hit->v};
+    double s[3] = {0.0, 0.0, 0.0};
+    for (int c = 0; c < 3; c++) {
+        const float *e = &v->ism[(size_t)(2 * g[c] + side) * 4];
+        for (int k = 0; k < 3; k++) s[k] += bw[c] * e[k];
+    }
+    rgb r = {s[0], s[1], s[2]};
+    return r;
+}

@@ -1,0 +1,84 @@
+/* gi_vlinks.h - vertex links (`--gi links`, seed 001: Schmitz, Tavenrath
+ * and Kobbelt, "Interactive Global Illumination for Deformable Geometry in
+ * CUDA"): diffuse interreflection between the vertices of the scene's
+ * meshes (mesh, mesh2 and what the parser builds as meshes).
+ *
+ *  - elements: every mesh vertex, one element per side of the surface
+ *    (side 0 along the winding normal, averaged over the vertex's
+ *    triangles by area; side 1 against it), at the vertex's world position;
+ *  - links: nside x nside cosine-weighted directions per element (16 x 16,
+ *    the paper's), a fixed set taken in 4 x 4 blocks of the unit square
+ *    (Shirley-Chiu concentric map to the disc, projected to the
+ *    hemisphere), rotated into the element's frame; a ray's hit on a mesh
+ *    triangle gives three links, to the triangle's vertices on the side
+ *    the ray arrives at, weighted by the hit's barycentrics / n_C; links to
+ *    one peer are merged (the raw and merged counts are in the stats);
+ *  - light links: a shadow ray from every element to every light
+ *    (POV-Ray's attenuation, spot and cylinder cones, fade; area lights
+ *    from their centre);
+ *  - gathering: `bounces` Jacobi sweeps over the links (gi_vlinks.cl), then
+ *    one-ring smoothing between vertices whose normals are within the
+ *    feature angle;
+ *  - the hook: the smoothed indirect E/pi of the hit triangle's three
+ *    elements, interpolated by the hit's barycentrics.
+ *
+ * Across the frames of an animation (gi_vlinks_frame with the previous
+ * frame's state): objects whose geometry or transform changed
+ * (scene_object_hash) are "moved"; only the elements of moved meshes, and
+ * the elements one of whose rays ended on a moved object or now meets one
+ * (a query against the moved objects only, up to the stored hit), trace
+ * their rays again; the light links and gathering run every frame.
+ *
+ * Surfaces of other objects (spheres, boxes, planes, ...) block rays and
+ * get no vertices: their indirect light is 0 (counted in the stats). Rays
+ * that leave the scene bring nothing (no sky light). Emission and
+ * POV-Ray's radiosity brightness are not carried. */
+#ifndef PT_GI_VLINKS_H
+#define PT_GI_VLINKS_H
+#include <stdint.h>
+#include "accel.h"
+#include "diag.h"
+#include "gi_particle.h"
+#include "progress.h"
+#include "scene.h"
+
+typedef struct gi_vlinks gi_vlinks;
+
+typedef struct {
+    int nside;             /* directions per element: nside^2, nside a multiple of 4 (16) */
+    int bounces;           /* Jacobi sweeps (3: the paper's Table 2) */
+    double feature_deg;    /* smoothing takes one-ring neighbours within this angle (30) */
+    int threads;           /* <= 0: all cores */
+    gi_pigment_fn pigment; /* pigment at a vertex; NULL: each texture's base colour */
+    volatile int *cancel;
+    progress *progress;
+} gi_vlinks_settings;
+
+typedef struct {
+    long vertices, elements, meshes;
+    long meshes_moved, objects_moved; /* since the previous frame */
+    long elements_linked;  /* elements that traced their rays this frame */
+    long raw_links, merged_links; /* over all elements: before and after merging per peer */
+    long link_rays, light_rays;
+    long hits_other;       /* link rays of this frame that ended on a surface without vertices */
+    long lookups_other;    /* hook calls on surfaces without vertices */
+    int full;              /* every element linked (first frame, structure changed) */
+    double t_links, t_light, t_bounces, t_smooth; /* seconds */
+} gi_vlinks_stats;
+
+void gi_vlinks_default_settings(gi_vlinks_settings *s);
+gi_vlinks *gi_vlinks_new(const gi_vlinks_settings *s);
+void gi_vlinks_free(gi_vlinks *v);
+void gi_vlinks_set_progress(gi_vlinks *v, progress *p);
+/* One frame: sc and a must stay alive until the next frame or free (the
+ * hook reads them). objects_may_change 0: the caller knows that nothing
+ * but the camera and lights changed since the previous frame. */
+pt_status gi_vlinks_frame(gi_vlinks *v, const scene *sc, const accel *a, int objects_may_change, gi_vlinks_stats *st,
+                          diag *d);
+/* shade_indirect_fn: the indirect E/pi at a hit on a mesh (0 elsewhere). */
+rgb gi_vlinks_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread);
+/* Element i's indirect E/pi after smoothing (tests); n: the count. */
+rgb gi_vlinks_element(const gi_vlinks *v, long i, vec3 *p, vec3 *nrm);
+long gi_vlinks_count(const gi_vlinks *v);
+
+#endif

@@ -1,0 +1,166 @@
+/* test_links.c - vertex links (gi/gi_vlinks.h, --gi links):
+ *  - integrating sphere: inside a tessellated Lambertian sphere (rho 0.5)
+ *    around an off-centre point light, the elements' mean indirect E/pi
+ *    after 10 sweeps against the closed form (1 - a^2/3) sum_{k<=10} rho^k
+ *    (test_gi.c's furnace), and the merged links fewer than the raw ones;
+ *  - incremental = full: on tests/scenes/detp_cbox.pov (a block moving with
+ *    the clock) a frame that links again only the elements the motion
+ *    touches gives every element the value a fresh build of that frame
+ *    gives, bit for bit. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "accel.h"
+#include "diag.h"
+#include "gi_vlinks.h"
+#include "sdl.h"
+
+typedef struct {
+    scene *sc;
+    accel *a;
+    diag *d;
+} frame;
+
+static void load(frame *f, const char *path, const char *text, int fr, int nframes)
+{
+    f->d = diag_new();
+    sdl_options o;
+    sdl_default_options(&o);
+    if (nframes > 1) assert_int_equal(sdl_set_frame(&o, 1, nframes, 0.0, 1.0, 0, fr), 0);
+    pt_status st = text ? sdl_parse_string("test.pov", text, &o, &f->sc, f->d) : sdl_parse_file(path, &o, &f->sc, f->d);
+    if (st != PT_OK)
+        for (int i = 0; i < diag_count(f->d); i++) {
+            char *m = diag_format(diag_get(f->d, i));
+            fprintf(stderr, "  diag: %s\n", m);
+            free(m);
+        }
+    assert_int_equal(st, PT_OK);
+    f->a = accel_build(f->sc, 2, f->d, &st);
+    assert_non_null(f->a);
+}
+
+static void unload(frame *f)
+{
+    accel_free(f->a);
+    scene_free(f->sc);
+    diag_free(f->d);
+}
+
+static gi_vlinks *make(int bounces)
+{
+    gi_vlinks_settings s;
+    gi_vlinks_default_settings(&s);
+    s.bounces = bounces;
+    s.threads = 2;
+    gi_vlinks *v = gi_vlinks_new(&s);
+    assert_non_null(v);
+    return v;
+}
+
+/* A unit sphere as a mesh2 of 40 x 80 latitude-longitude cells. */
+static const char *sphere_scene =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 }\n"
+    "camera { location <0, 0, 0> look_at <0, 0, 1> }\n"
+    "light_source { <0.3, 0.2, 0.1> color rgb 1 }\n"
+    "#declare NT = 40; #declare NP = 80;\n"
+    "mesh2 {\n"
+    "  vertex_vectors { (NT + 1) * NP,\n"
+    "    #for (J, 0, NT) #for (I, 0, NP - 1)\n"
+    "      #local T = pi * J / NT; #local P = 2 * pi * I / NP;\n"
+    "      <sin(T) * cos(P), cos(T), sin(T) * sin(P)>,\n"
+    "    #end #end }\n"
+    "  face_indices { 2 * NT * NP,\n"
+    "    #for (J, 0, NT - 1) #for (I, 0, NP - 1)\n"
+    "      #local A = J * NP + I; #local B = J * NP + mod(I + 1, NP);\n"
+    "      <A, B, B + NP>, <A, B + NP, A + NP>,\n"
+    "    #end #end }\n"
+    "  pigment { rgb 1 } finish { ambient 0 diffuse 0.5 }\n"
+    "}\n";
+
+static void test_sphere(void **state)
+{
+    (void)state;
+    frame f;
+    load(&f, NULL, sphere_scene, 1, 1);
+    gi_vlinks *v = make(10);
+    gi_vlinks_stats st;
+    assert_int_equal(gi_vlinks_frame(v, f.sc, f.a, 1, &st, f.d), PT_OK);
+    double a2 = 0.3 * 0.3 + 0.2 * 0.2 + 0.1 * 0.1, sum = 0.0, pk = 1.0;
+    for (int k = 1; k <= 10; k++) {
+        pk *= 0.5;
+        sum += pk;
+    }
+    double expected = (1.0 - a2 / 3.0) * sum;
+    /* the inner side's elements: their normal points at the centre */
+    double mean = 0.0, m2 = 0.0;
+    long m = 0;
+    for (long i = 0; i < gi_vlinks_count(v); i++) {
+        vec3 p, n;
+        rgb e = gi_vlinks_element(v, i, &p, &n);
+        if (v3_dot(p, n) > 0.0) continue;
+        mean += e.g;
+        m2 += e.g * e.g;
+        m++;
+    }
+    assert_true(m > 3000);
+    mean /= m;
+    double rms = sqrt(fmax(0.0, m2 / m - mean * mean)) / expected;
+    printf("  links sphere: %ld vertices, raw links %ld, merged %ld (%.2fx), %ld link rays: mean E_ind/pi %.5f, "
+           "expected %.5f (%+.2f%%), spread %.2f%%\n",
+           st.vertices, st.raw_links, st.merged_links, (double)st.raw_links / (double)st.merged_links, st.link_rays,
+           mean, expected, 100.0 * (mean / expected - 1.0), 100.0 * rms);
+    assert_true(fabs(mean / expected - 1.0) < 0.03);
+    assert_true(rms < 0.1);
+    assert_true(st.merged_links < st.raw_links);
+    gi_vlinks_free(v);
+    unload(&f);
+}
+
+static void test_incremental_equals_full(void **state)
+{
+    (void)state;
+    const int nframes = 4;
+    gi_vlinks *inc = make(3);
+    for (int fr = 1; fr <= nframes; fr++) {
+        frame f;
+        load(&f, PT_SOURCE_DIR "/tests/scenes/detp_cbox.pov", NULL, fr, nframes);
+        gi_vlinks_stats si, sf;
+        assert_int_equal(gi_vlinks_frame(inc, f.sc, f.a, 1, &si, f.d), PT_OK);
+        gi_vlinks *fresh = make(3);
+        assert_int_equal(gi_vlinks_frame(fresh, f.sc, f.a, 1, &sf, f.d), PT_OK);
+        long n = gi_vlinks_count(inc), differ = 0;
+        assert_int_equal(n, gi_vlinks_count(fresh));
+        for (long i = 0; i < n; i++) {
+            rgb a = gi_vlinks_element(inc, i, NULL, NULL), b = gi_vlinks_element(fresh, i, NULL, NULL);
+            differ += a.r != b.r || a.g != b.g || a.b != b.b;
+        }
+        printf("  links cbox frame %d: %s, %ld objects moved, %ld of %ld elements linked again, "
+               "elements differing from a fresh build: %ld\n",
+               fr, si.full ? "full" : "incremental", si.objects_moved, si.elements_linked, si.elements, differ);
+        assert_int_equal(differ, 0);
+        assert_int_equal(si.merged_links, sf.merged_links);
+        if (fr > 1) {
+            assert_int_equal(si.full, 0);
+            assert_int_equal(si.objects_moved, 1);
+            assert_true(si.elements_linked > 0 && si.elements_linked < si.elements);
+        }
+        gi_vlinks_free(fresh);
+        unload(&f);
+    }
+    gi_vlinks_free(inc);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_sphere),
+        cmocka_unit_test(test_incremental_equals_full),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
