@@ -11,6 +11,11 @@
 #     the clock): 30 frames in one run; the geometry stage runs once; the
 #     total against one frame's geometry stage plus the 30 frames' view
 #     stages (prepare_view + the Whitted pass).
+#  3. --gi-cache on scenes/cbox.pov at FLY_SIZE with CACHE_PARTICLES
+#     (default 50000, the particle mode's own default): the geometry stage run and
+#     saved, then read by a second process; both processes' wall time, the
+#     geometry stage's time against the read's, the file's size, and whether
+#     the two images are the same bytes.
 # Figures are wall seconds on whatever else the machine runs: compare the
 # ratios within one run. SIZE (default 160x120) and FLY_SIZE (128x96) set
 # the image sizes.
@@ -68,3 +73,19 @@ printf "view stages, 30 frames:            %8.2f s\n" "$view"
 printf "total / (geometry + 30 views):     %8.3f (asked: <= 1.5)\n" "$(echo "$fly / ($geo + $view)" | bc -l)"
 echo "frames by the GI stages they ran:"
 grep "gi stages run" fly.log | sed 's/.*gi stages run: //' | sort | uniq -c
+
+echo
+CP=${CACHE_PARTICLES:-50000}
+echo "== --gi-cache: scenes/cbox.pov at $FLY_SIZE, $CP particles, the geometry stage saved, then read by another process"
+t0=$(now)
+"$P" render "$SRC/scenes/cbox.pov" --size "$FLY_SIZE" --gi particle --particles "$CP" --gi-cache cbox.gic -o save.pfm 2>save.log
+t1=$(now)
+"$P" render "$SRC/scenes/cbox.pov" --size "$FLY_SIZE" --gi particle --particles "$CP" --gi-cache cbox.gic -o load.pfm 2>load.log
+t2=$(now)
+gsave=$(grep "gi particle: geometry" save.log | sed 's/.*geometry \([0-9.]*\) s.*/\1/')
+gload=$(grep "gi particle: geometry" load.log | sed 's/.*geometry \([0-9.]*\) s.*/\1/')
+printf "saving run:                        %8.2f s (geometry stage %.2f s)\n" "$(secs "$t0" "$t1")" "$gsave"
+printf "loading run:                       %8.2f s (cache read %.2f s; read / geometry = %.3f)\n" "$(secs "$t1" "$t2")" \
+    "$gload" "$(echo "$gload / $gsave" | bc -l)"
+printf "cache file:                        %8.1f MiB\n" "$(echo "$(stat -c %s cbox.gic) / 1048576" | bc -l)"
+if cmp -s save.pfm load.pfm; then echo "images: byte-identical"; else echo "images: DIFFER"; fi
