@@ -1,4 +1,4 @@
-// Benchmark scene CONFERENCE (issue 7, as seed 000's CONFERENCE): a
+// Benchmark scene CONFERENCE (as seed 000's CONFERENCE): a
 // conference room of four tables and 24 chairs, 187,808 triangles,
 // lit by four point lights, with radiosity{} so that partray's default is
 // --gi particle.

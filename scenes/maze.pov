@@ -1,4 +1,4 @@
-// Benchmark scene MAZE (issue 7, as seed 000's MAZE): a procedural maze of
+// Benchmark scene MAZE (as seed 000's MAZE): a procedural maze of
 // 242,160 triangles (121 mesh2) lit by two point lights, with radiosity{}
 // so that partray's default is --gi particle.
 //

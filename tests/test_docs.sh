@@ -7,6 +7,8 @@
 #    work-period name (git keeps the history);
 #  - every image a page shows names, in its paragraph, the bench/ command
 #    that makes it.
+# The sources' comments (code, build files, scripts, scenes) carry no date,
+# clock time, issue, session or work-period name either.
 # Also: the user guide names every display, view and look of the shipped
 # OCIO config, and `partray render --help` (app/cli.c's cli_render_help)
 # lists every GNU-style option app/cli.c parses.
@@ -54,6 +56,21 @@ for f in $files; do
     grep -n -o -E '(^|[^0-9A-Za-z_x])[0-9a-f]{7,40}([^0-9A-Za-z_]|$)' "$f" |
         grep -E ':.*[0-9].*' | grep -E ':.*[a-f]' | grep -v -E ':[^0-9a-f]*[0-9]{7,40}[^0-9a-f]*$' |
         sed "s|^|$f:|; s|$| <- a commit hash?|"
+done > /tmp/test_docs.$$
+if [ -s /tmp/test_docs.$$ ]; then cat /tmp/test_docs.$$; bad=1; fi
+rm -f /tmp/test_docs.$$
+
+# the same dates, clock times and issue, session or period names in the
+# sources' comments (code, build files, scripts, scenes): comments state
+# invariants and reasons. An upstream project's issue ("OpenEXR issue
+# #2306") and POV-Ray's datetime epochs (2000-01-01, 1970-01-01) are facts
+# of the world, not history.
+srcs=$(git ls-files '*.c' '*.h' '*.cl' '*.cpp' '*.sh' '*.py' '*CMakeLists.txt' '*.cmake' '*.pov' '*.inc' '*.ini' 2>/dev/null ||
+    find . -name '*.[ch]' -o -name '*.cl' -o -name '*.cpp' -o -name '*.sh' -o -name '*.pov' -o -name CMakeLists.txt)
+for f in $srcs; do
+    [ "$f" = tests/test_docs.sh ] && continue
+    grep -n -E "$pat_date|$pat_time|$pat_issue" "$f" | grep -v -E 'OpenEXR issue #|(2000|1970)-01-01' |
+        sed "s|^|$f:|; s|$| <- a date, clock time, issue, session or period in a comment|"
 done > /tmp/test_docs.$$
 if [ -s /tmp/test_docs.$$ ]; then cat /tmp/test_docs.$$; bad=1; fi
 rm -f /tmp/test_docs.$$

@@ -35,16 +35,12 @@
 #include "test_world.h"
 
 enum { GRID_W = 32, GRID_PARTICLES = 8000, GRID_SPP = 128 };
-/* 0.08 until the catchment areas (gi_particle.c catchment_areas, 22 Nov
- * 2026) took away the particle GI's ~2.5% excess on these rooms and
- * uncovered the lathe's own deficit (-5.56% -> -8.22%), then 0.10. That
- * deficit was sweep cells spanning up to 58 degrees of normal turning (the
- * lit top's hits interpolated the dark underside's radiance particles);
- * since cells span at most the lists' normal cone (gi_surface_mesh.c
- * SWEEP_TURN) the six shapes read -2.2..+1.2% (lathe -2.03%, sor +1.18%;
- * particle seeds 11-14 against path 1024 spp: lathe -0.4..-3.5%, was
- * -3.9..-10.5%; sor -1.1..+0.4%, was -4.3..-8.0%): 0.05, which the old
- * lathe fails (-8.22%). */
+/* GRID_SHAPE_TOL: with sweep cells spanning at most the lists' normal
+ * cone (gi_surface_mesh.c SWEEP_TURN) the six shapes read -2.2..+1.2%
+ * (particle seeds 11-14 against path 1024 spp: lathe -0.4..-3.5%, sor
+ * -1.1..+0.4%). A lathe whose cells span up to 58 degrees of normal
+ * turning (the lit top's hits interpolating the dark underside's radiance
+ * particles) reads -8.22% and fails it. */
 #define GRID_SHAPE_TOL 0.05
 #define GRID_IMAGE_TOL 0.06
 

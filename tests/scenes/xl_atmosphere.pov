@@ -1,4 +1,4 @@
-// Cross-check (issue 5): sky_sphere (layered pigments), ground and
+// Cross-check: sky_sphere (layered pigments), ground and
 // constant fog with turbulence, a light dimmed by fog (media_attenuation).
 #version 3.7;
 global_settings { assumed_gamma 1.0 }

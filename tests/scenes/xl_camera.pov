@@ -1,4 +1,4 @@
-// Cross-check (issue 5): a non-perspective camera (declared by the test:
+// Cross-check: a non-perspective camera (declared by the test:
 // CAM = 1 fisheye, 2 panoramic, 3 spherical, 4 cylinder 1, 5 ultra_wide_angle).
 #version 3.7;
 global_settings { assumed_gamma 1.0 }

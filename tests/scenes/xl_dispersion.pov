@@ -1,4 +1,4 @@
-// Cross-check (issue 5): interior dispersion as POV-Ray 3.7 renders it.
+// Cross-check: interior dispersion as POV-Ray 3.7 renders it.
 // A glass prism (default 7 dispersion_samples) and a sphere
 // (dispersion_samples 12) in front of white bars on black: the bars
 // seen through them split into colour fringes.

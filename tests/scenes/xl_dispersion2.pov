@@ -1,4 +1,4 @@
-// Cross-check (issue 5): rays split by one dispersive object stay
+// Cross-check: rays split by one dispersive object stay
 // monochromatic through the next (a slab of 5 bands in front of a sphere
 // of 9): the sphere bends each band with its own ior and does not split
 // it again, as POV-Ray 3.7's ComputeRefraction does.

@@ -1,4 +1,4 @@
-// Cross-check (issue 5): the facets normal (normal snapped to random cell
+// Cross-check: the facets normal (normal snapped to random cell
 // points; with coords, the point's noise gradient), three metrics, size.
 #version 3.7;
 global_settings { assumed_gamma 1.0 }

@@ -1,4 +1,4 @@
-// Cross-check (issue 5): assumed_gamma 2.2 (working gamma), a pre-3.7 scene
+// Cross-check: assumed_gamma 2.2 (working gamma), a pre-3.7 scene
 // with noise_generator 1 by default, image_map from a PNG the test writes
 // (xl_image.png, planar/spherical/cylindrical maps, once, interpolate).
 #version 3.1;

@@ -1,4 +1,4 @@
-// Cross-check (issue 5): interior ior (refraction, total internal
+// Cross-check: interior ior (refraction, total internal
 // reflection), fade_distance/fade_power/fade_colour, faked caustics,
 // filtered shadows, fresnel reflection, conserve_energy.
 #version 3.7;

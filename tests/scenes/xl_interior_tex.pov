@@ -1,4 +1,4 @@
-// Cross-check (issue 5): texture vs interior_texture on flat meshes of both windings, chosen by POV-Ray's own triangle normal (P1-P2)x(P3-P2), the opposite of the winding normal
+// Cross-check: texture vs interior_texture on flat meshes of both windings, chosen by POV-Ray's own triangle normal (P1-P2)x(P3-P2), the opposite of the winding normal
 #version 3.7;
 global_settings { assumed_gamma 1.0 }
 camera { location <0, 0.5, -4> look_at <0, 0, 0> angle 50 }

@@ -1,4 +1,4 @@
-// Cross-check (issue 5): finish irid (thin-film tint of each light's
+// Cross-check: finish irid (thin-film tint of each light's
 // diffuse + highlights and of the reflected ray), with and without
 // turbulence, default and scene irid_wavelength.
 #version 3.7;

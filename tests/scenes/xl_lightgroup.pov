@@ -1,4 +1,4 @@
-// Cross-check (issue 5): light_group: a group's lights light only its
+// Cross-check: light_group: a group's lights light only its
 // objects (shadows cast by every object); global lights light the rest and
 // a group's objects only with global_lights on; nested groups keep their own.
 #version 3.7;

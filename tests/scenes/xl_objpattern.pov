@@ -1,4 +1,4 @@
-// Cross-check (issue 5): the object pattern (1 inside, 0 outside) with
+// Cross-check: the object pattern (1 inside, 0 outside) with
 // CSG (union, difference, an inverse member) and pattern transforms.
 #version 3.7;
 global_settings { assumed_gamma 1.0 }

@@ -1,4 +1,4 @@
-// Cross-check (issue 5): patterns with colour/pigment maps, listed pigments,
+// Cross-check: patterns with colour/pigment maps, listed pigments,
 // turbulence and warps, layered textures, texture_map, normals (bump
 // patterns, slope-sampled patterns, normal_map, slope_map), no_bump_scale.
 #version 3.7;

@@ -1,4 +1,4 @@
-// Cross-check (issue 5): object uv_mapping on spheres (POV-Ray 3.7's
+// Cross-check: object uv_mapping on spheres (POV-Ray 3.7's
 // Sphere::UVCoord; the texture does not follow the object's transforms).
 #version 3.7;
 global_settings { assumed_gamma 1.0 }

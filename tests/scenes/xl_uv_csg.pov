@@ -1,4 +1,4 @@
-// Cross-check (issue 5): uv_mapping on a transformed union: members inherit it (also the sphere with its own texture, whose texture the union's transforms still move, as POV-Ray 3.7's Post_Process does)
+// Cross-check: uv_mapping on a transformed union: members inherit it (also the sphere with its own texture, whose texture the union's transforms still move, as POV-Ray 3.7's Post_Process does)
 #version 3.7;
 global_settings { assumed_gamma 1.0 }
 camera { location <0, 3, -7> look_at <0, 0.6, 0> angle 50 }

@@ -1,4 +1,4 @@
-// Cross-check (issue 5): uv_mapping in pigment, normal and texture blocks, image_map (xl_image.png, written by test_look), a texture pattern, layered textures on mesh2
+// Cross-check: uv_mapping in pigment, normal and texture blocks, image_map (xl_image.png, written by test_look), a texture pattern, layered textures on mesh2
 #version 3.7;
 global_settings { assumed_gamma 1.0 }
 camera { location <0, 3, -7> look_at <0, 0.6, 0> angle 50 }

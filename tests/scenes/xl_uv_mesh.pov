@@ -1,4 +1,4 @@
-// Cross-check (issue 5): uv_mapping on lathe, sor, mesh/mesh2 uv_vectors + uv_indices, bicubic_patch uv_vectors; cylinder and disc use world x, y
+// Cross-check: uv_mapping on lathe, sor, mesh/mesh2 uv_vectors + uv_indices, bicubic_patch uv_vectors; cylinder and disc use world x, y
 #version 3.7;
 global_settings { assumed_gamma 1.0 }
 camera { location <0, 3, -7> look_at <0, 0.6, 0> angle 55 }

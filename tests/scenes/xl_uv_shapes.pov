@@ -1,4 +1,4 @@
-// Cross-check (issue 5): object uv_mapping on sphere, box (cube net), torus, ovus (POV-Ray 3.7 UVCoord)
+// Cross-check: object uv_mapping on sphere, box (cube net), torus, ovus (POV-Ray 3.7 UVCoord)
 #version 3.7;
 global_settings { assumed_gamma 1.0 }
 camera { location <0, 3, -7> look_at <0, 0.6, 0> angle 50 }

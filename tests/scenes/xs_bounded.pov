@@ -1,4 +1,4 @@
-// issue 4: bounded_by as POV-Ray 3.7 culls with it: an unbounded quartic
+// Shape cross-check: bounded_by as POV-Ray 3.7 culls with it: an unbounded quartic
 // cylinder seen only along rays that cross its bounding sphere (also
 // outside the sphere), a union bound, a top-level sphere whose bound
 // POV-Ray drops

@@ -1,4 +1,4 @@
-// issue 4: a height field from a function against POV-Ray 3.7; with
+// Shape cross-check: a height field from a function against POV-Ray 3.7; with
 // HF_FILE declared, the scene around a height field from an image file
 // that the including scene adds (test_shapes_xc: TGA, JPEG, PPM written by
 // POV-Ray first)

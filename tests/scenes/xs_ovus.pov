@@ -1,4 +1,4 @@
-// issue 4: ovus against POV-Ray 3.7 (bottom > top, top > bottom, in CSG)
+// Shape cross-check: ovus against POV-Ray 3.7 (bottom > top, top > bottom, in CSG)
 #version 3.7;
 global_settings { assumed_gamma 1.0 }
 camera { location <0, 1.2, -5> look_at <0, 0.6, 0> angle 40 }
