@@ -14,8 +14,8 @@
  *    the tasks ended) running `partray farm --merge-step DIR`, which merges
  *    every frame whose tiles are all there and resubmits the tasks that are
  *    missing with a new merge job, up to --max-rounds. Slurm's own requeue
- *    of a task makes it eligible again only after a delay (about 121 s
- *    measured with Slurm 22.05 here) and an `afterok` dependency is never
+ *    of a task makes it eligible again only after a delay of minutes (Slurm
+ *    22.05; docs/farm.md) and an `afterok` dependency is never
  *    satisfied once a task failed, hence resubmission and afterany.
  *  - parallel: GNU parallel runs the lines of tasks.txt on the hosts of
  *    --sshloginfile (":" is this machine) with --retries, --joblog and, from

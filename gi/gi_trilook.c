@@ -8,9 +8,10 @@
 #include "pool.h"
 
 /* a cell's edge is at most CELL_FAC particle spacings (k = ceil(longest
- * edge / (CELL_FAC spacing)), at most MAX_K). cbox, 50K particles (CPU of
- * the 4x4 pass with the build / the 16x16 pass, s): 0.7: 0.90 / 4.04,
- * 1.0: 0.71 / 4.26, 1.4: 0.66 / 4.43 (one run each, load 6) */
+ * edge / (CELL_FAC spacing)), at most MAX_K). Smaller cells cost more to
+ * build (the 4x4 pass), larger ones longer lists to scan (the 16x16 pass);
+ * 1 spacing gave the least CPU time for the two passes together on cbox
+ * among 0.7, 1.0 and 1.4 (bench_gi's link pass timings). */
 #define CELL_FAC 1.0
 #define MAX_K 64
 /* particles whose n . N lies within AGREE_SLACK of the threshold are
