@@ -30,10 +30,6 @@ void tu_rm_rf(const char *dir);
  * files were kept; returns rc. */
 int tu_finish(int rc, const char *dir);
 
-/* Mean absolute difference over all channels of the `f`x`f`
- * box-downsampled images (same size, sRGB-encoded values in 0..1). */
-double tu_downsampled_mad(const framebuffer *a, const framebuffer *b, int f);
-
 /* Mean Rec. 709 luminance (0.2126 R + 0.7152 G + 0.0722 B) of the linear
  * framebuffer over the pixels with mask[i] != 0 (mask NULL: all); 0 when
  * none. */
