@@ -10,6 +10,7 @@
  * The root's S bounds the primitive; an intersection of six planes gets a
  * tight box this way. */
 #include "geom_csg.h"
+#include "geom_implicit.h"
 #include <assert.h>
 #include <stdlib.h>
 #include <string.h>
@@ -194,8 +195,20 @@ int geom_csg_finish(geom_csg *c)
             break;
         case GEOM_CSG_INTERSECTION:
             v = n > 0 ? bb_all() : bb_empty();
+            for (int j = 0; j < n; j++) v = bb_inter(v, V[k[j]]);
+            /* an unbounded quadric member: the box of its inside within the
+             * others' box (POV-Ray bounds quadrics last, within what the
+             * other members leave); its surface lies in that box too */
             for (int j = 0; j < n; j++) {
-                v = bb_inter(v, V[k[j]]);
+                const geom_csg_node *kj = &c->nodes[k[j]];
+                if (kj->op != GEOM_CSG_LEAF || kj->inverse || !c->shapes[kj->shape].infinite) continue;
+                bbox q;
+                if (!geom_quadric_solid_box(&c->shapes[kj->shape], v.lo, v.hi, &q.lo, &q.hi)) continue;
+                V[k[j]] = bb_inter(V[k[j]], q);
+                S[k[j]] = bb_inter(S[k[j]], q);
+                v = bb_inter(v, q);
+            }
+            for (int j = 0; j < n; j++) {
                 bbox sj = S[k[j]];
                 for (int m = 0; m < n; m++)
                     if (m != j) sj = bb_inter(sj, V[k[m]]);

@@ -271,6 +271,111 @@ static int quadric_bounds(im_data *m, vec3 *lo, vec3 *hi)
     return 1;
 }
 
+/* min over x in [l, h] (either may be infinite) of A x^2 + B x */
+static double quad_min(double A, double B, double l, double h)
+{
+    double m = INFINITY;
+    if (A < 0.0 || (A == 0.0 && B > 0.0)) {
+        if (!isfinite(l)) return -INFINITY;
+    }
+    if (A < 0.0 || (A == 0.0 && B < 0.0)) {
+        if (!isfinite(h)) return -INFINITY;
+    }
+    if (isfinite(l)) m = fmin(m, A * l * l + B * l);
+    if (isfinite(h)) m = fmin(m, A * h * h + B * h);
+    if (A > 0.0) {
+        double v = -B / (2.0 * A);
+        if (v >= l && v <= h) m = fmin(m, A * v * v + B * v);
+    }
+    if (A == 0.0 && B == 0.0) m = 0.0;
+    return m;
+}
+
+/* Hull of {x in [l, h] : A x^2 + B x < R}; 0 when empty. */
+static int quad_below(double A, double B, double R, double l, double h, double *lo, double *hi)
+{
+    if (R == INFINITY) { *lo = l; *hi = h; return l <= h; }
+    double a = l, b = h;
+    if (A == 0.0) {
+        if (B > 0.0) b = fmin(h, R / B);
+        else if (B < 0.0) a = fmax(l, R / B);
+        else if (!(0.0 < R)) return 0;
+    } else {
+        double disc = B * B + 4.0 * A * R;
+        if (A > 0.0) {
+            if (!(disc > 0.0)) return 0;
+            double sq = sqrt(disc);
+            a = fmax(l, (-B - sq) / (2.0 * A));
+            b = fmin(h, (-B + sq) / (2.0 * A));
+        } else if (disc > 0.0) {
+            /* outside the two roots: the hull within [l, h] */
+            double sq = sqrt(disc), r1 = (-B + sq) / (2.0 * A), r2 = (-B - sq) / (2.0 * A); /* r1 < r2 */
+            int left = l < r1, right = h > r2;
+            if (!left && !right) return 0;
+            if (!left) a = fmax(l, r2);
+            if (!right) b = fmin(h, r1);
+        }
+    }
+    *lo = a;
+    *hi = b;
+    return a <= b;
+}
+
+int geom_quadric_solid_box(const geom_shape *sh, vec3 clo, vec3 chi, vec3 *lo, vec3 *hi)
+{
+    if (sh->kind != SHAPE_QUADRIC || !sh->data) return 0;
+    const im_data *m = sh->data;
+    const double *a = m->a;
+    /* world form: with y = L p + c (the world -> object map),
+     * f = y'Q y + b.y + J = p'(L'QL)p + (2 L'Q c + L'b).p + (c'Qc + b.c + J) */
+    double Q[3][3] = {{a[0], 0.5 * a[3], 0.5 * a[4]}, {0.5 * a[3], a[1], 0.5 * a[5]}, {0.5 * a[4], 0.5 * a[5], a[2]}};
+    double b[3] = {a[6], a[7], a[8]}, L[3][3], c[3];
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) L[i][j] = sh->x.inv[i][j];
+        c[i] = sh->x.inv[i][3];
+    }
+    double QL[3][3], W[3][3], w[3], Qc[3], J = a[9];
+    for (int i = 0; i < 3; i++) {
+        Qc[i] = Q[i][0] * c[0] + Q[i][1] * c[1] + Q[i][2] * c[2];
+        J += c[i] * Qc[i] + b[i] * c[i];
+        for (int j = 0; j < 3; j++) QL[i][j] = Q[i][0] * L[0][j] + Q[i][1] * L[1][j] + Q[i][2] * L[2][j];
+    }
+    double big = 0.0;
+    for (int i = 0; i < 3; i++) {
+        w[i] = 0.0;
+        for (int k = 0; k < 3; k++) w[i] += L[k][i] * (2.0 * Qc[k] + b[k]);
+        for (int j = 0; j < 3; j++) {
+            W[i][j] = L[0][i] * QL[0][j] + L[1][i] * QL[1][j] + L[2][i] * QL[2][j];
+            big = fmax(big, fabs(W[i][j]));
+        }
+    }
+    if (!(big > 0.0) || !isfinite(big) || !isfinite(J)) return 0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            if (i != j && fabs(W[i][j]) > 1e-12 * big) return 0; /* mixed terms */
+    /* separable: f = sum_k (W_kk x_k^2 + w_k x_k) + J; along axis k the
+     * others contribute at least their minimum over the box */
+    double l[3] = {clo.x, clo.y, clo.z}, h[3] = {chi.x, chi.y, chi.z}, mn[3], out_lo[3], out_hi[3];
+    for (int k = 0; k < 3; k++) {
+        double A = fabs(W[k][k]) > 1e-12 * big ? W[k][k] : 0.0;
+        mn[k] = quad_min(A, w[k], l[k], h[k]);
+    }
+    for (int k = 0; k < 3; k++) {
+        double rest = J;
+        for (int j = 0; j < 3; j++)
+            if (j != k) rest += mn[j];
+        double A = fabs(W[k][k]) > 1e-12 * big ? W[k][k] : 0.0;
+        double R = isnan(rest) ? INFINITY : -rest;
+        if (!quad_below(A, w[k], R, l[k], h[k], &out_lo[k], &out_hi[k])) return 0;
+        double pad = 1e-7 * (fabs(out_lo[k]) + fabs(out_hi[k])) + 1e-12;
+        if (isfinite(out_lo[k])) out_lo[k] -= pad;
+        if (isfinite(out_hi[k])) out_hi[k] += pad;
+    }
+    *lo = v3(out_lo[0], out_lo[1], out_lo[2]);
+    *hi = v3(out_hi[0], out_hi[1], out_hi[2]);
+    return 1;
+}
+
 /* ------------------------------------------------------------ poly */
 
 static double ipow(double x, int n)

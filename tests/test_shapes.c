@@ -17,6 +17,8 @@
 #include <string.h>
 #include <unistd.h>
 #include "accel.h"
+#include "geom_csg.h"
+#include "geom_implicit.h"
 #include "geom_poly.h"
 #include "geom_shape.h"
 #include "accel_surface.h"
@@ -476,6 +478,60 @@ static void test_quadric(void **st)
     w = build("quadric { <1,0,1>, <0,0,0>, <0,0,0>, -1 bounded_by { box { <-2,-1,-2>, <2,1,2> } } clipped_by { bounded_by } }");
     expect_hit(&w, v3(-5, 0.5, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12);
     expect_miss(&w, v3(-5, 1.5, 0), v3(1, 0, 0));
+    done(&w);
+}
+
+/* The box of an unbounded quadric's inside within the other members of an
+ * intersection (POV-Ray's CSG bounding): the one-sheet hyperboloid
+ * 4x2 + 4z2 - (y-5)2 < 1 (shapes.inc's Hyperboloid_Y scaled <0.5,1,0.5>,
+ * moved up 5) between y = 2.5 and 5.5 reaches |x|, |z| < 0.5 sqrt(1 + 2.5^2). */
+static void test_quadric_csg_box(void **st)
+{
+    (void)st;
+    const char *src = "intersection { plane { y, 5.5 } quadric { <1,-1,1>, <0,0,0>, <0,0,0>, -1 translate 5*y scale <0.5,1,0.5> }"
+                      " plane { -y, -2.5 } }";
+    world w = build(src);
+    double r = 0.5 * sqrt(1.0 + 2.5 * 2.5);
+    geom_csg c;
+    memset(&c, 0, sizeof c);
+    geom_csg_builder b = {NULL, NULL, 0, 0, NULL, 0};
+    assert_int_equal(geom_csg_build(&c, w.s->objects[0], NULL, 0, -1, 0, &b), PT_OK);
+    assert_true(geom_csg_finish(&c));
+    assert_near(c.lo.x, -r, 1e-6);
+    assert_near(c.hi.x, r, 1e-6);
+    assert_near(c.lo.z, -r, 1e-6);
+    assert_near(c.hi.z, r, 1e-6);
+    assert_near(c.lo.y, 2.5, 1e-6);
+    assert_near(c.hi.y, 5.5, 1e-6);
+    /* the surface is still found at the box's edge: the widest ring at y = 2.5 + 1e-3 */
+    double y = 2.5 + 1e-3, rx = 0.5 * sqrt(1.0 + (y - 5.0) * (y - 5.0));
+    expect_hit(&w, v3(-5, y, 0), v3(1, 0, 0), 5.0 - rx, v3_norm(v3(-8.0 * rx, -2.0 * (y - 5.0), 0)), 1e-9, 1e-9);
+    geom_csg_free(&c);
+    done(&w);
+    /* turned 45 degrees about z: mixed terms, no box (left to the clip cube) */
+    w = build("quadric { <1,-1,1>, <0,0,0>, <0,0,0>, -1 rotate 45*z }");
+    geom_shape sh = shape_of(&w);
+    vec3 lo, hi;
+    assert_false(geom_quadric_solid_box(&sh, v3(-1, -1, -1), v3(1, 1, 1), &lo, &hi));
+    geom_shape_release(&sh);
+    done(&w);
+    /* a quarter turn about x: the cylinder x2 + y2 < 1 along z, within |z| < 3 */
+    w = build("quadric { <1,0,1>, <0,0,0>, <0,0,0>, -1 rotate 90*x }");
+    sh = shape_of(&w);
+    assert_true(geom_quadric_solid_box(&sh, v3(-INFINITY, -INFINITY, -3), v3(INFINITY, INFINITY, 3), &lo, &hi));
+    assert_near(lo.x, -1.0, 1e-6);
+    assert_near(hi.y, 1.0, 1e-6);
+    assert_near(hi.z, 3.0, 1e-6);
+    /* the paraboloid's inside x2 + z2 < y under y = 4: |x| < 2, y > 0 */
+    geom_shape_release(&sh);
+    done(&w);
+    w = build("quadric { <1,0,1>, <0,0,0>, <0,-1,0>, 0 }");
+    sh = shape_of(&w);
+    assert_true(geom_quadric_solid_box(&sh, v3s(-INFINITY), v3(INFINITY, 4, INFINITY), &lo, &hi));
+    assert_near(lo.x, -2.0, 1e-6);
+    assert_near(hi.z, 2.0, 1e-6);
+    assert_near(lo.y, 0.0, 1e-6);
+    geom_shape_release(&sh);
     done(&w);
 }
 
@@ -1180,6 +1236,7 @@ int main(void)
         cmocka_unit_test(test_text),
         cmocka_unit_test(test_superellipsoid),
         cmocka_unit_test(test_quadric),
+        cmocka_unit_test(test_quadric_csg_box),
         cmocka_unit_test(test_poly),
         cmocka_unit_test(test_blob),
         cmocka_unit_test(test_height_field),
