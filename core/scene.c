@@ -50,6 +50,9 @@ void scene_default_camera(scene_camera *c)
     c->sky = v3(0, 1, 0);
     c->look_at = v3(0, 0, 1);
     c->blur_samples = 0;
+    c->blur_samples_min = 0;
+    c->confidence = 0.9;        /* POV-Ray 3.7 camera.cpp */
+    c->variance = 1.0 / 10000.0;
 }
 
 void scene_default_light(scene_light *l)

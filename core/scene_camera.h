@@ -21,7 +21,13 @@ typedef struct {
     vec3 location, direction, up, right, sky, look_at;
     double angle;           /* horizontal field of view in degrees, 0 = unset */
     double aperture;        /* focal blur, 0 = off */
-    int blur_samples;
+    int blur_samples;       /* at most this many rays per sample */
+    /* POV-Ray's stopping rule for focal blur (blur_samples MIN, MAX;
+     * confidence; variance): after at least blur_samples_min rays, a
+     * sample stops once the variance of its mean is under a threshold
+     * (shade_focal.h). Defaults 0, 0.9, 1/10000 (POV-Ray 3.7's camera.cpp). */
+    int blur_samples_min;
+    double confidence, variance;
     vec3 focal_point;
     double v_angle;         /* spherical camera: vertical field of view in degrees, 0 = angle/2 */
     double focal_distance;  /* focal blur: distance to the focal plane; 0 = |direction| */

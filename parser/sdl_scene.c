@@ -139,14 +139,32 @@ static int camera_item(sdl_parser *p, scene_camera *c, camera_said *said)
     case KW_LOOK_AT: c->look_at = sdl_vector(p); said->had_look_at = 1; break;
     case KW_APERTURE: c->aperture = sdl_float(p); break;
     case KW_BLUR_SAMPLES:
+        /* blur_samples MAX, or blur_samples MIN, MAX (POV-Ray 3.7's Parse_Camera) */
         c->blur_samples = sdl_to_int(sdl_float(p));
+        c->blur_samples_min = 0;
         if (sdl_accept(p, TOK_COMMA)) {
             double mx = sdl_allow_float(p, 0.0);
-            if (mx > 0) c->blur_samples = (int)mx;
+            if (mx > 0) {
+                c->blur_samples_min = c->blur_samples;
+                c->blur_samples = (int)mx;
+                if (c->blur_samples_min > c->blur_samples)
+                    sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "focal blur samples minimum must not be larger than maximum");
+            }
         }
         break;
     case KW_FOCAL_POINT: c->focal_point = sdl_vector(p); said->had_focal = 1; break;
-    case KW_CONFIDENCE: case KW_VARIANCE: sdl_float(p); break;
+    case KW_CONFIDENCE: {
+        double k = sdl_float(p);
+        if (k > 0.0 && k < 1.0) c->confidence = k;
+        else sdl_warning(p, t.tk.loc, "illegal confidence value %g (0 < confidence < 1); the default 0.9 is used", k);
+        break;
+    }
+    case KW_VARIANCE: {
+        double k = sdl_float(p);
+        if (k >= 0.0 && k <= 1.0) c->variance = k;
+        else sdl_warning(p, t.tk.loc, "illegal variance value %g (0 <= variance <= 1); the default is used", k);
+        break;
+    }
     case KW_NORMAL:
         c->normal = sdl_parse_normal(p); /* shade.c perturbs the primary rays */
         break;

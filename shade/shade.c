@@ -33,6 +33,7 @@
 #include <string.h>
 #include "pool.h"
 #include "shade_atmos.h"
+#include "shade_focal.h"
 #include "shade_gamma.h"
 #include "shade_light.h"
 #include "shade_media.h"
@@ -70,6 +71,7 @@ typedef struct {
     int primary_on;      /* s->primary holds this render's centre rays (shade_primary_begin_fn) */
     int win[4];          /* the pixels rendered (shade_settings.window) */
     int first_win[4];    /* the first pass's: win and, with +A, a one-pixel apron */
+    shade_focal focal;   /* focal blur's budget (camera_focal_blur) */
 } render_ctx;
 
 /* The hit shade_tex_shade is working on, for its callbacks: the containers of
@@ -518,17 +520,25 @@ static rgb sample(render_ctx *c, int thread, double px, double py, rng *r)
     const scene_camera *cam = &c->sc->camera;
     if (cam->kind == CAMERA_MESH && cam->mesh_rays_per_pixel > 1) return sample_mesh_rays(c, thread, px, py, r);
     if (!camera_focal_blur(cam)) return sample_ray(c, thread, px, py, 0.0, 0.0, r);
-    /* Focal blur: blur_samples rays over the lens disc (stratified in area
-     * and angle) and over the pixel, averaged (POV-Ray jitters both). */
-    int n = cam->blur_samples;
-    rgb acc = {0, 0, 0};
-    for (int i = 0; i < n; i++) {
-        double rad = 0.5 * sqrt((i + rng_f64(r)) / n);
-        double phi = 2.0 * M_PI * (i * 0.6180339887498949 + rng_f64(r) / n);
-        double jx = rng_f64(r), jy = rng_f64(r); /* in this order (arguments are evaluated in any order) */
-        acc = rgb_add(acc, sample_ray(c, thread, px + jx - 0.5, py + jy - 0.5, rad * cos(phi), rad * sin(phi), r));
+    /* Focal blur: rays over the lens and the pixel in POV-Ray's batches
+     * until the mean is known well enough (shade_focal.h) */
+    const shade_focal *f = &c->focal;
+    double ou = rng_f64(r), ov = rng_f64(r); /* this sample's shift of the lens sequence */
+    double s1[3] = {0, 0, 0}, s2[3] = {0, 0, 0};
+    int n = 0;
+    for (int level = 0; n < f->max; level++) {
+        int m = shade_focal_batch(f, level);
+        for (int i = 0; i < m && n < f->max; i++, n++) {
+            double lu, lv;
+            shade_focal_lens(n, ou, ov, &lu, &lv);
+            double jx = rng_f64(r), jy = rng_f64(r); /* in this order (arguments are evaluated in any order) */
+            rgb v = sample_ray(c, thread, px + jx - 0.5, py + jy - 0.5, lu, lv, r);
+            s1[0] += v.r; s1[1] += v.g; s1[2] += v.b;
+            s2[0] += v.r * v.r; s2[1] += v.g * v.g; s2[2] += v.b * v.b;
+        }
+        if (shade_focal_done(f, n, s1, s2)) break;
     }
-    return rgb_scale(acc, 1.0 / n);
+    return rgb_make(s1[0] / n, s1[1] / n, s1[2] / n);
 }
 
 #ifndef NDEBUG
@@ -669,6 +679,7 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     c.transparent = shade_tex_scene_transparent(sc);
     c.proj = shade_projection_build(sc, d);
     c.media = shade_media_scene_has(sc);
+    if (camera_focal_blur(&sc->camera)) shade_focal_init(&c.focal, &sc->camera);
     /* the camera's containers matter to media and to fog (not in non-hollow objects) */
     if (c.media || sc->fogs || sc->rainbows) shade_media_inside_at(sc, sc->camera.location, &c.cam_in);
     int ntiles = c.tiles_x * c.tiles_y;
@@ -676,6 +687,8 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     int whole = !(sw[2] > sw[0] && sw[3] > sw[1]);
     if (!whole && (sw[0] < 0 || sw[1] < 0 || sw[2] > s->width || sw[3] > s->height)) {
         diag_report(d, DIAG_ERROR, (src_loc){0}, NULL, "shade_render: window outside the image");
+        shade_projection_free(c.proj);
+        shade_focal_release(&c.focal);
         free(ts);
         return PT_ERR_INTERNAL;
     }
@@ -697,7 +710,7 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
 
     if (s->antialias == 1 && !(s->cancel && *s->cancel)) {
         c.flag = calloc((size_t)s->width * (size_t)s->height, 1);
-        if (!c.flag) { shade_projection_free(c.proj); free(ts); return PT_ERR_NOMEM; }
+        if (!c.flag) { shade_projection_free(c.proj); shade_focal_release(&c.focal); free(ts); return PT_ERR_NOMEM; }
         /* the pairs inside the first pass's rectangle: every pair a window
          * pixel belongs to, as in the whole image */
         for (int y = c.first_win[1]; y < c.first_win[3]; y++) {
@@ -740,6 +753,7 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
         st->seconds = timer_now() - t0;
     }
     shade_projection_free(c.proj);
+    shade_focal_release(&c.focal);
     free(ts);
     return PT_OK;
 }
