@@ -323,13 +323,24 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
         fz = shade_noise_to_int(floor(p.z - PAT_EPSILON));
     double metric = pat->crackle_metric;
     /* The 81 cubes within a "3D knight move" (offsets -2..2 with at most one
-     * coordinate of magnitude 2), in POV-Ray's table order. */
-    vec3 pts[81];
-    int n = 0;
-    for (int ax = -2; ax <= 2; ax++)
-        for (int ay = -2; ay <= 2; ay++)
-            for (int az = -2; az <= 2; az++)
-                if ((abs(ax) == 2) + (abs(ay) == 2) + (abs(az) == 2) <= 1) pts[n++] = cube_point(fx + ax, fy + ay, fz + az);
+     * coordinate of magnitude 2), in POV-Ray's table order; kept per thread
+     * for the last few cubes visited (they depend on the cube alone), as
+     * POV-Ray's crackle cache does: a ray marching an isosurface or a
+     * pixel's neighbours stay in one cube for many evaluations. */
+    static _Thread_local struct { int valid, fx, fy, fz; vec3 pts[81]; } cache[8];
+    unsigned slot = ((unsigned)fx * 73856093u ^ (unsigned)fy * 19349663u ^ (unsigned)fz * 83492791u) & 7u;
+    vec3 *pts = cache[slot].pts;
+    if (!cache[slot].valid || cache[slot].fx != fx || cache[slot].fy != fy || cache[slot].fz != fz) {
+        int n = 0;
+        for (int ax = -2; ax <= 2; ax++)
+            for (int ay = -2; ay <= 2; ay++)
+                for (int az = -2; az <= 2; az++)
+                    if ((abs(ax) == 2) + (abs(ay) == 2) + (abs(az) == 2) <= 1) pts[n++] = cube_point(fx + ax, fy + ay, fz + az);
+        cache[slot].valid = 1;
+        cache[slot].fx = fx;
+        cache[slot].fy = fy;
+        cache[slot].fz = fz;
+    }
     double m1 = metric_sum(v3_sub(pts[0], p), metric);
     double m2 = metric_sum(v3_sub(pts[1], p), metric);
     double m3 = metric_sum(v3_sub(pts[2], p), metric);
