@@ -131,12 +131,37 @@ static int ray_in_bound(const accel *a, int b0, int bn, vec3 o, vec3 d, double t
 void accel_user_box(const accel *a, unsigned prim, float out[6])
 {
     vec3 lo, hi;
+    int b0, bn;
     if (prim < (unsigned)a->nshapes) {
         lo = a->shapes[prim].lo;
         hi = a->shapes[prim].hi;
+        const accel_leaf *l = &a->leaves[a->shape_leaf[prim]];
+        b0 = l->b0;
+        bn = l->bn;
     } else {
         lo = a->csgs[prim - (unsigned)a->nshapes].lo;
         hi = a->csgs[prim - (unsigned)a->nshapes].hi;
+        b0 = a->csg_b0[prim - (unsigned)a->nshapes];
+        bn = a->csg_bn[prim - (unsigned)a->nshapes];
+    }
+    /* A ray that hits the primitive crosses its own box, and (ray_in_bound)
+     * starts inside or meets every bounding object: a bounding solid whose
+     * inside lies within its box is crossed too. The smallest of these
+     * boxes culls the same rays as the test it stands for (POV-Ray gives a
+     * bounded object its bound's box when that is smaller), so an
+     * unbounded poly inside a bounded union is only asked by the rays that
+     * cross the bound. */
+    double vol = box_volume(lo, hi);
+    if (!(vol > 0.0) || !isfinite(vol)) vol = INFINITY;
+    for (int i = 0; i < bn; i++) {
+        const geom_shape *b = &a->bshapes[b0 + i];
+        if (b->infinite || b->kind == SHAPE_PLANE || !geom_shape_solid_bounded(b)) continue;
+        double v = box_volume(b->lo, b->hi);
+        if (v > 0.0 && v < vol) {
+            vol = v;
+            lo = b->lo;
+            hi = b->hi;
+        }
     }
     double ext = v3_maxc(v3_sub(hi, lo));
     for (int i = 0; i < 3; i++) {
@@ -214,12 +239,13 @@ int accel_prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, d
 {
     assert(prim < (unsigned)(a->nshapes + a->ncsgs));
     if (prim < (unsigned)a->nshapes) {
-        geom_shape_hit sh;
-        if (!geom_shape_intersect(&a->shapes[prim], o, d, tmin, tmax, &sh)) return 0;
-        assert(sh.t > tmin && sh.t < tmax);
+        /* the bound first: it is the cheaper test, and both must pass */
         assert(a->shape_leaf[prim] < (unsigned)a->nleaves);
         const accel_leaf *l = &a->leaves[a->shape_leaf[prim]];
         if (l->bn && !ray_in_bound(a, l->b0, l->bn, o, d, tmin)) return 0;
+        geom_shape_hit sh;
+        if (!geom_shape_intersect(&a->shapes[prim], o, d, tmin, tmax, &sh)) return 0;
+        assert(sh.t > tmin && sh.t < tmax);
         h->t = sh.t;
         h->part = sh.part;
         h->shape = 0;
@@ -227,9 +253,10 @@ int accel_prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, d
         return 1;
     }
     unsigned ci = prim - (unsigned)a->nshapes;
+    if (a->csg_bn[ci] && !ray_in_bound(a, a->csg_b0[ci], a->csg_bn[ci], o, d, tmin)) return 0;
     if (!geom_csg_intersect(&a->csgs[ci], o, d, tmin, tmax, h)) return 0;
     assert(h->t > tmin && h->t < tmax && h->shape >= 0 && h->shape < a->csgs[ci].nshapes);
-    return !a->csg_bn[ci] || ray_in_bound(a, a->csg_b0[ci], a->csg_bn[ci], o, d, tmin);
+    return 1;
 }
 
 const geom_shape *accel_prim_shape(const accel *a, unsigned prim, int member)
