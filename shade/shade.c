@@ -523,15 +523,15 @@ static rgb sample(render_ctx *c, int thread, double px, double py, rng *r)
     /* Focal blur: rays over the lens and the pixel in POV-Ray's batches
      * until the mean is known well enough (shade_focal.h) */
     const shade_focal *f = &c->focal;
-    double ou = rng_f64(r), ov = rng_f64(r); /* this sample's shift of the lens sequence */
+    double shift[4]; /* this sample's shift of the lens and pixel sequence */
+    for (int k = 0; k < 4; k++) shift[k] = rng_f64(r);
     double s1[3] = {0, 0, 0}, s2[3] = {0, 0, 0};
     int n = 0;
     for (int level = 0; n < f->max; level++) {
         int m = shade_focal_batch(f, level);
         for (int i = 0; i < m && n < f->max; i++, n++) {
-            double lu, lv;
-            shade_focal_lens(n, ou, ov, &lu, &lv);
-            double jx = rng_f64(r), jy = rng_f64(r); /* in this order (arguments are evaluated in any order) */
+            double lu, lv, jx, jy;
+            shade_focal_point(n, shift, &lu, &lv, &jx, &jy);
             rgb v = sample_ray(c, thread, px + jx - 0.5, py + jy - 0.5, lu, lv, r);
             s1[0] += v.r; s1[1] += v.g; s1[2] += v.b;
             s2[0] += v.r * v.r; s2[1] += v.g * v.g; s2[2] += v.b * v.b;

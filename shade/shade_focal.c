@@ -102,16 +102,20 @@ int shade_focal_done(const shade_focal *f, int n, const double s1[3], const doub
     return 1;
 }
 
-void shade_focal_lens(int i, double ou, double ov, double *lu, double *lv)
+void shade_focal_point(int i, const double shift[4], double *lu, double *lv, double *jx, double *jy)
 {
-    /* R2: the plastic number's powers as the two irrational steps
-     * (Roberts 2018, "The unreasonable effectiveness of quasirandom
-     * sequences"); polar map keeps area uniform */
-    const double a1 = 0.7548776662466927, a2 = 0.5698402909980532;
-    double u = ou + a1 * i, v = ov + a2 * i;
-    u -= floor(u);
-    v -= floor(v);
-    double r = 0.5 * sqrt(u), phi = 2.0 * M_PI * v;
+    /* R4: the powers of the root of x^5 = x + 1 as the four irrational
+     * steps (Roberts 2018, "The unreasonable effectiveness of quasirandom
+     * sequences"); the polar map keeps the lens area uniform */
+    const double a[4] = {0.8566748838545029, 0.7338918566271260, 0.6287067210378087, 0.5385972572236101};
+    double u[4];
+    for (int k = 0; k < 4; k++) {
+        u[k] = shift[k] + a[k] * i;
+        u[k] -= floor(u[k]);
+    }
+    double r = 0.5 * sqrt(u[0]), phi = 2.0 * M_PI * u[1];
     *lu = r * cos(phi);
     *lv = r * sin(phi);
+    *jx = u[2];
+    *jy = u[3];
 }

@@ -28,11 +28,12 @@ void shade_focal_release(shade_focal *f);
 int shade_focal_batch(const shade_focal *f, int level);
 /* After n rays whose channel sums are s1[3] and squared sums s2[3]: stop? */
 int shade_focal_done(const shade_focal *f, int n, const double s1[3], const double s2[3]);
-/* Lens point of ray i in the unit-diameter disc (|(lu, lv)| <= 0.5): a
- * sequence whose every prefix covers the disc evenly (R2 low-discrepancy
- * points, shifted by the sample's own (ou, ov) in [0,1)^2), so a sample
- * that stops early has still seen the whole lens. */
-void shade_focal_lens(int i, double ou, double ov, double *lu, double *lv);
+/* Ray i of a sample: its lens point in the unit-diameter disc
+ * (|(lu, lv)| <= 0.5) and its place in the pixel (jx, jy in [0, 1)), from
+ * a 4-D low-discrepancy sequence shifted by the sample's own shift[4] in
+ * [0,1)^4, so every prefix covers lens and pixel evenly and a sample that
+ * stops early has still seen the whole lens. */
+void shade_focal_point(int i, const double shift[4], double *lu, double *lv, double *jx, double *jy);
 /* Cephes' chdtri: x with P(chi^2_df > x) = y (0 < y < 1, df > 0). */
 double shade_focal_chi2inv(double df, double y);
 
