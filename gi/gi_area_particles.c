@@ -111,6 +111,51 @@ static int probe_ok(const accel *a, const scene_object *o, vec3 pos, vec3 nrm, d
 /* Most candidates a side gets per survivor the pilot predicts there. */
 #define SIDE_INFLATION 8.0
 
+/* Particles by what the view shows, beyond the paper (which spreads them
+ * uniformly by area): VIEW_SHARE of the count is what an object at least
+ * gets in proportion to the part of the image it covers
+ * (gi_surface_view_share), so that the columns of a courtyard or the blocks
+ * on a sky-lit ground get particles enough to resolve their light where a
+ * uniform spread gives them one or two and the ground the rest. POV-Ray
+ * places its radiosity samples by the image, too. The rest goes by area.
+ * Each object's weight w >= 1 multiplies its density; a particle on it
+ * stands for dA / w of surface, so every estimate (area-weighted) stays
+ * unbiased. At most VIEW_MAX_WEIGHT. */
+#define VIEW_SHARE 0.5
+#define VIEW_MAX_WEIGHT 256.0
+
+static float *view_weights(const gi_surface *g, const float *inclip, const float *side_frac)
+{
+    int np = gi_surface_npatches(g), no = gi_surface_nobjs(g);
+    float *vw = malloc((size_t)(np > 0 ? np : 1) * sizeof *vw);
+    double *ao = calloc((size_t)(no > 0 ? no : 1), sizeof *ao);
+    if (!vw || !ao) {
+        free(vw);
+        free(ao);
+        return NULL;
+    }
+    double total = 0.0;
+    for (int i = 0; i < np; i++) {
+        vw[i] = 1.0f;
+        double a = 0.0;
+        for (int s = 0; s < gi_surface_sides(g, i); s++)
+            if (gi_surface_side_mask(g, i) >> s & 1)
+                a += gi_surface_area(g, i) * inclip[i] * (side_frac ? side_frac[2 * i + s] : 1.0);
+        ao[gi_surface_obj_index(g, i)] += a;
+        total += a;
+    }
+    if (total > 0.0)
+        for (int i = 0; i < np; i++) {
+            int k = gi_surface_obj_index(g, i);
+            if (!(ao[k] > 0.0)) continue;
+            /* uniform: count * ao / total particles; by view: VIEW_SHARE * count * share */
+            double w = VIEW_SHARE * gi_surface_view_share(g, k) * total / ao[k];
+            vw[i] = (float)fmin(VIEW_MAX_WEIGHT, fmax(1.0, w));
+        }
+    free(ao);
+    return vw;
+}
+
 pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel *a, const scene *sc, long count,
                               uint64_t seed, const float *side_frac, gi_pigment_fn pig, diag *d)
 {
@@ -119,16 +164,21 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
     int np = gi_surface_npatches(g);
     float *inclip = malloc((size_t)(np > 0 ? np : 1) * sizeof *inclip);
     if (!inclip) return PT_ERR_NOMEM;
+    for (int i = 0; i < np; i++) inclip[i] = gi_surface_clip_fraction(g, i, seed);
+    float *vw = view_weights(g, inclip, side_frac);
+    if (!vw) {
+        free(inclip);
+        return PT_ERR_NOMEM;
+    }
     double total = 0.0;
-    for (int i = 0; i < np; i++) {
-        inclip[i] = gi_surface_clip_fraction(g, i, seed);
+    for (int i = 0; i < np; i++)
         for (int s = 0; s < gi_surface_sides(g, i); s++)
             if (gi_surface_side_mask(g, i) >> s & 1)
-                total += gi_surface_area(g, i) * inclip[i] * (side_frac ? side_frac[2 * i + s] : 1.0);
-    }
+                total += gi_surface_area(g, i) * inclip[i] * vw[i] * (side_frac ? side_frac[2 * i + s] : 1.0);
     if (count < 1) count = 1;
     if (!(total > 0.0)) {
         free(inclip);
+        free(vw);
         return PT_OK;
     }
     double density = (double)count / total;
@@ -158,7 +208,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
             keep = fmin(1.0, SIDE_INFLATION * fmax);
         }
         long before = (long)floor(cum * density + offset);
-        cum += area * inclip[i] * keep;
+        cum += area * inclip[i] * vw[i] * keep;
         long m = (long)floor(cum * density + offset) - before;
         if (m <= 0) continue;
         rng pr;
@@ -167,7 +217,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
         const scene_object *o = gi_surface_object(g, i);
         gi_dev_particle proto;
         memset(&proto, 0, sizeof proto);
-        proto.area = (float)ps->dA;
+        proto.area = (float)(ps->dA / vw[i]);
         const scene_texture *tex = gi_surface_texture(g, i);
         if (!tex) tex = &sc->default_texture;
         material(sc, tex, NULL, &rr, &proto);
@@ -219,6 +269,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
                 if (!push(&b, &p, i, s)) {
                     if (have_ush) geom_shape_release(&ush);
                     free(inclip);
+                    free(vw);
                     free(b.p);
                     free(b.patch);
                     free(b.side);
@@ -230,6 +281,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
         if (b.n > 2147483000L) {
             diag_report(d, DIAG_ERROR, (src_loc){0}, NULL, "particle GI: too many particles");
             free(inclip);
+            free(vw);
             free(b.p);
             free(b.patch);
             free(b.side);
@@ -237,6 +289,7 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
         }
     }
     free(inclip);
+    free(vw);
     ps->n = (int)b.n;
     ps->p = b.p;
     ps->patch = b.patch;

@@ -204,7 +204,11 @@ static int side_value(gi_particle *gp, const accel_hit *hit, vec3 n, thread_coun
         }
         wsum += w[k];
     }
-    if (!(wsum > 0.0)) return 0;
+    /* None of the three is visible from the hit (a post's grid vertices at
+     * its ends, buried in the base it stands in): the estimate at the hit
+     * from the area particles around it on its own object, as for surfaces
+     * without radiance particles. */
+    if (!(wsum > 0.0)) return gi_surface_has_particles(gp->surf, hit) && onthefly(gp, hit, n, tc, out);
     for (int k = 0; k < 3; k++) {
         if (!(w[k] > 0.0)) continue;
         if (atomic_load_explicit(&gp->rp_state[rp[k]], memory_order_acquire) != 2) {

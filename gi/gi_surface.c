@@ -662,6 +662,31 @@ static void view_clip(const scene *s, const accel *a, vec3 *lo, vec3 *hi)
     }
 }
 
+/* What the camera sees of each object: the probe of view_clip again, each
+ * ray's first hit credited to its object's record. Without a camera, or
+ * without memory, every share stays 0 (particles then go by area alone). */
+static void view_coverage(gi_surface *g, const accel *a)
+{
+    const scene *s = g->sc;
+    if (!s->camera_set || g->no <= 0) return;
+    g->view = calloc((size_t)g->no, sizeof *g->view);
+    if (!g->view) return;
+    const double w = 1.0 / ((double)VIEW_W * VIEW_H);
+    for (int y = 0; y < VIEW_H; y++)
+        for (int x = 0; x < VIEW_W; x++) {
+            vec3 org, dir;
+            if (!camera_ray(&s->camera, x + 0.5, y + 0.5, VIEW_W, VIEW_H, 0.5, 0.5, &org, &dir)) continue;
+            accel_hit h;
+            if (!accel_intersect(a, org, dir, 0.0, INFINITY, &h) || !h.obj) continue;
+            const obj_rec *r = gi_surface_find_obj(g, h.obj);
+            if (r) g->view[r - g->o] += (float)w;
+        }
+}
+
+int gi_surface_nobjs(const gi_surface *g) { return g->no; }
+int gi_surface_obj_index(const gi_surface *g, int i) { return g->p[i].obj; }
+double gi_surface_view_share(const gi_surface *g, int k) { return g->view && k >= 0 && k < g->no ? g->view[k] : 0.0; }
+
 gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *d, pt_status *status)
 {
     pt_status dummy;
@@ -721,6 +746,7 @@ gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *
     }
     for (int i = 0; i < g->np; i++) g->total_area += g->p[i].area;
     gi_surface_layout(g);
+    view_coverage(g, a);
     *status = PT_OK;
     return g;
 }
@@ -730,6 +756,7 @@ void gi_surface_free(gi_surface *g)
 {
     if (!g) return;
     accel_surf_free(g->as);
+    free(g->view);
     for (int i = 0; i < g->np; i++) gi_surface_free_patch(&g->p[i]);
     gi_surface_csg_free(g);
     free(g->mv);

@@ -89,6 +89,13 @@ int gi_surface_in_clip(const gi_surface *g, vec3 p);
 /* The fraction of patch i in that box, from a few of its own samples
  * (exactly 1 or 0 when all or none are in). */
 float gi_surface_clip_fraction(const gi_surface *g, int i, uint64_t seed);
+/* The objects (records) the patches belong to: nobjs of them; patch i's is
+ * gi_surface_obj_index(g, i). gi_surface_view_share: the fraction of a
+ * probe of camera rays (VIEW_W x VIEW_H over the image) that hit object
+ * record k first; 0 without a camera. */
+int gi_surface_nobjs(const gi_surface *g);
+int gi_surface_obj_index(const gi_surface *g, int patch);
+double gi_surface_view_share(const gi_surface *g, int k);
 int gi_surface_npatches(const gi_surface *g);
 double gi_surface_area(const gi_surface *g, int patch); /* one side */
 int gi_surface_sides(const gi_surface *g, int patch);

@@ -93,6 +93,7 @@ struct gi_surface {
     int np, capp;
     obj_rec *o;
     int no, capo;
+    float *view;      /* per object record: the fraction of the view's probe rays that hit it first */
     int *hash;        /* open addressing: object pointer -> record, -1 empty */
     int hcap;
     long nrp;
