@@ -51,6 +51,12 @@ static inline int v3_slab(vec3 o, vec3 d, vec3 lo, vec3 hi, double *t0, double *
     *t1 = b;
     return 1;
 }
+/* Whether the segment o + t d, t in [0, tmax], meets the box [lo, hi]. */
+static inline int v3_segment_meets_box(vec3 o, vec3 d, vec3 lo, vec3 hi, double tmax)
+{
+    double t0, t1;
+    return v3_slab(o, d, lo, hi, &t0, &t1) && t1 >= 0.0 && t0 <= tmax;
+}
 /* Build an orthonormal basis (t, b) around unit vector n (Duff et al. 2017). */
 static inline void v3_basis(vec3 n, vec3 *t, vec3 *b)
 {

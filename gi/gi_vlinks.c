@@ -573,13 +573,6 @@ static int make_csr(gi_vlinks *v, long *merged, long *raw)
     return 1;
 }
 
-/* Whether the ray o + t d, t in [0, tmax], meets the box lo..hi. */
-static int box_meets(vec3 lo, vec3 hi, vec3 o, vec3 d, double tmax)
-{
-    double t0, t1;
-    return v3_slab(o, d, lo, hi, &t0, &t1) && t1 >= 0.0 && t0 <= tmax;
-}
-
 typedef struct {
     gi_vlinks *v;
     const accel *mob;
@@ -616,7 +609,7 @@ static void stale_chunk(void *ctx, int ci, int thread)
             vec3 l = v->dirs[k];
             vec3 dir = v3_add(v3_add(v3_scale(t, l.x), v3_scale(b, l.y)), v3_scale(n, l.z));
             double tmax = isfinite(v->ray_t[r]) ? v->ray_t[r] * (1.0 + 1e-6) : INFINITY;
-            if (J->boxed && !box_meets(J->lo, J->hi, org, dir, tmax)) continue;
+            if (J->boxed && !v3_segment_meets_box(org, dir, J->lo, J->hi, tmax)) continue;
             accel_hit h;
             if (accel_intersect(J->mob, org, dir, 0.0, tmax, &h)) J->need[e] = 1;
         }

@@ -239,28 +239,15 @@ static void apply_seg(applier *ap, const rgrid *g, const seg *s)
     }
     /* clip to the grid's box */
     vec3 o = s->l.o, w = s->l.w;
-    /* past the hit only the hit object's own receivers take it (share),
-     * within the disc radius of where it crosses their planes */
-    double t0 = 0.0, t1 = s->t * (1.0 + 1e-6) + dp->eps;
+    double t1 = s->t * (1.0 + 1e-6) + dp->eps;
     if (s->hit_leaf >= 0) t1 += SAME_OBJECT_RUN * dp->radius;
-    double lo[3] = {g->lo.x, g->lo.y, g->lo.z};
-    double hi[3] = {g->lo.x + g->nx * g->cell, g->lo.y + g->ny * g->cell, g->lo.z + g->nz * g->cell};
-    double oo[3] = {o.x, o.y, o.z}, ww[3] = {w.x, w.y, w.z};
-    for (int k = 0; k < 3; k++) {
-        if (ww[k] == 0.0) {
-            if (oo[k] < lo[k] || oo[k] > hi[k]) return;
-            continue;
-        }
-        double a = (lo[k] - oo[k]) / ww[k], b = (hi[k] - oo[k]) / ww[k];
-        if (a > b) {
-            double tmp = a;
-            a = b;
-            b = tmp;
-        }
-        if (a > t0) t0 = a;
-        if (b < t1) t1 = b;
-    }
+    vec3 ghi = v3_add(g->lo, v3(g->nx * g->cell, g->ny * g->cell, g->nz * g->cell));
+    double b0, b1;
+    if (!v3_slab(o, w, g->lo, ghi, &b0, &b1)) return;
+    double t0 = fmax(0.0, b0);
+    t1 = fmin(t1, b1);
     if (!(t0 <= t1)) return;
+    double lo[3] = {g->lo.x, g->lo.y, g->lo.z}, oo[3] = {o.x, o.y, o.z}, ww[3] = {w.x, w.y, w.z};
     int n[3] = {g->nx, g->ny, g->nz}, c[3], step[3];
     double tnext[3], tdelta[3];
     for (int k = 0; k < 3; k++) {
@@ -367,29 +354,6 @@ static void on_seg(void *ctx, long index, const pm_photon_launch *l, const accel
     if (ws->plus) apply_seg(ws->plus, ws->fc->ginc, &s);
 }
 
-/* Whether the segment o + t w, t in [0, tmax], meets the box lo..hi. */
-static int box_meets(vec3 lo, vec3 hi, vec3 o, vec3 w, double tmax)
-{
-    double t0 = 0.0, t1 = tmax;
-    double l[3] = {lo.x, lo.y, lo.z}, h[3] = {hi.x, hi.y, hi.z}, oo[3] = {o.x, o.y, o.z}, ww[3] = {w.x, w.y, w.z};
-    for (int k = 0; k < 3; k++) {
-        if (ww[k] == 0.0) {
-            if (oo[k] < l[k] || oo[k] > h[k]) return 0;
-            continue;
-        }
-        double a = (l[k] - oo[k]) / ww[k], b = (h[k] - oo[k]) / ww[k];
-        if (a > b) {
-            double tmp = a;
-            a = b;
-            b = tmp;
-        }
-        if (a > t0) t0 = a;
-        if (b < t1) t1 = b;
-        if (t0 > t1) return 0;
-    }
-    return 1;
-}
-
 /* Whether stored segment s is still what tracing it now gives. */
 static int seg_valid(const frame_ctx *fc, const seg *s, long *rays)
 {
@@ -399,7 +363,7 @@ static int seg_valid(const frame_ctx *fc, const seg *s, long *rays)
     accel_hit h;
     /* up to a little past the stored hit: a tie is taken as a change */
     double tmax = isfinite(s->t) ? s->t * (1.0 + 1e-7) + fc->dp->eps : INFINITY;
-    if (fc->mob_boxed && !box_meets(fc->mob_lo, fc->mob_hi, s->l.o, s->l.w, tmax)) return 1;
+    if (fc->mob_boxed && !v3_segment_meets_box(s->l.o, s->l.w, fc->mob_lo, fc->mob_hi, tmax)) return 1;
     (*rays)++;
     if (s->l.from.obj && s->from_leaf >= 0) {
         accel_from f = s->l.from;
