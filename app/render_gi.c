@@ -147,6 +147,24 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     return st;
 }
 
+/* The Whitted pass with a GI mode's indirect hook under radiosity's rule
+ * for ambient (as particle), then the AOVs. */
+static pt_status render_with_hook(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
+                                  render_gi_result *r, diag *d, shade_indirect_fn fn, void *ctx)
+{
+    shade_settings ss;
+    fill_shade(&ss, o);
+    ss.use_ambient = radrules_of(sc, 1).ambient;
+    ss.indirect = fn;
+    ss.indirect_ctx = ctx;
+    double t0 = timer_now();
+    r->image_begun = 1;
+    pt_status st = shade_render(sc, a, &ss, fb, &r->shade, d);
+    r->t_render = timer_now() - t0;
+    if (st == PT_OK) st = render_aovs(sc, a, o, &ss, r, d);
+    return st;
+}
+
 pm_detp *render_gi_detp_new(const render_gi_opts *o)
 {
     pm_detp_settings s;
@@ -170,18 +188,7 @@ static pt_status render_detp(const scene *sc, const accel *a, const render_gi_op
     pt_status st = pm_detp_frame(dp, sc, a, o->width, o->height, &o->detp_frame, &r->detp, d);
     r->t_gi_geometry = r->detp.t_trace;
     r->t_gi_lighting = r->detp.t_estimate;
-    if (st == PT_OK && !(o->cancel && *o->cancel)) {
-        shade_settings ss;
-        fill_shade(&ss, o);
-        ss.use_ambient = radrules_of(sc, 1).ambient; /* radiosity's rule, as particle */
-        ss.indirect = pm_detp_indirect;
-        ss.indirect_ctx = dp;
-        double t0 = timer_now();
-        r->image_begun = 1;
-        st = shade_render(sc, a, &ss, fb, &r->shade, d);
-        r->t_render = timer_now() - t0;
-        if (st == PT_OK) st = render_aovs(sc, a, o, &ss, r, d);
-    }
+    if (st == PT_OK && !(o->cancel && *o->cancel)) st = render_with_hook(sc, a, o, fb, r, d, pm_detp_indirect, dp);
     pm_detp_set_progress(dp, NULL);
     if (!o->detp) pm_detp_free(dp);
     return st == PT_CANCELLED ? PT_OK : st;
@@ -208,18 +215,7 @@ static pt_status render_links(const scene *sc, const accel *a, const render_gi_o
     pt_status st = gi_vlinks_frame(v, sc, a, o->links ? o->links_objects_may_change : 1, &r->links, d);
     r->t_gi_geometry = r->links.t_links;
     r->t_gi_lighting = r->links.t_light + r->links.t_bounces + r->links.t_smooth;
-    if (st == PT_OK && !(o->cancel && *o->cancel)) {
-        shade_settings ss;
-        fill_shade(&ss, o);
-        ss.use_ambient = radrules_of(sc, 1).ambient; /* radiosity's rule, as particle */
-        ss.indirect = gi_vlinks_indirect;
-        ss.indirect_ctx = v;
-        double t0 = timer_now();
-        r->image_begun = 1;
-        st = shade_render(sc, a, &ss, fb, &r->shade, d);
-        r->t_render = timer_now() - t0;
-        if (st == PT_OK) st = render_aovs(sc, a, o, &ss, r, d);
-    }
+    if (st == PT_OK && !(o->cancel && *o->cancel)) st = render_with_hook(sc, a, o, fb, r, d, gi_vlinks_indirect, v);
     gi_vlinks_set_progress(v, NULL);
     if (!o->links) gi_vlinks_free(v);
     return st == PT_CANCELLED ? PT_OK : st;

@@ -1,6 +1,6 @@
 // A reduced Cornell box (scenes/cbox.pov with coarser tessellation) whose
 // short block moves with the clock: the incremental photon paths' test
-// scene (--gi detp, tests/test_detp.c) and bench/motion.sh's.
+// scene (tests/test_motion.c) and bench/motion.sh's.
 #version 3.7;
 global_settings { assumed_gamma 1.0 radiosity { count 100 recursion_limit 9 } }
 #declare Matte = finish { ambient 0 diffuse 0.75 }

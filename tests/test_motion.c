@@ -1,5 +1,6 @@
-/* test_detp.c - incremental photon paths and the DETP estimator
- * (reference/pm_detp.h):
+/* test_motion.c - GI that follows motion (docs/motion.md).
+ *
+ * Incremental photon paths and the DETP estimator (reference/pm_detp.h):
  *  - integrating sphere: the receivers' mean indirect irradiance inside a
  *    Lambertian sphere (rho 0.5) around an off-centre point light against
  *    its closed form (test_gi.c's: E_ind / pi = (1 - a^2/3) sum rho^k);
@@ -7,7 +8,14 @@
  *    the clock) every frame's integer sums equal those of tracing every
  *    path and estimating every receiver anew with the same streams, bit for
  *    bit, while the incremental frames re-trace a small share of the paths;
- *  - a frame where nothing moved re-traces nothing and keeps every sum. */
+ *  - a frame where nothing moved re-traces nothing and keeps every sum.
+ * Vertex links (gi/gi_vlinks.h, --gi links):
+ *  - integrating sphere: inside a tessellated Lambertian sphere the
+ *    elements' mean indirect E/pi after 10 sweeps against the closed form,
+ *    and the merged links fewer than the raw ones;
+ *  - incremental = full: on detp_cbox.pov a frame that links again only the
+ *    elements the motion touches gives every element the value a fresh
+ *    build of that frame gives, bit for bit. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -18,6 +26,7 @@
 #include <string.h>
 #include "accel.h"
 #include "diag.h"
+#include "gi_vlinks.h"
 #include "pm_detp.h"
 #include "sdl.h"
 
@@ -76,7 +85,7 @@ static const char *sphere_scene =
     "light_source { <0.3, 0.2, 0.1> color rgb 1 }\n"
     "sphere { 0, 1 pigment { rgb 1 } finish { ambient 0 diffuse 0.5 } }\n";
 
-static void test_sphere(void **state)
+static void test_detp_sphere(void **state)
 {
     (void)state;
     frame f;
@@ -119,7 +128,7 @@ static void test_sphere(void **state)
     unload(&f);
 }
 
-static void test_incremental_equals_full(void **state)
+static void test_detp_incremental(void **state)
 {
     (void)state;
     const int nframes = 6, w = 64, h = 48;
@@ -164,7 +173,7 @@ static void test_incremental_equals_full(void **state)
     pm_detp_free(full);
 }
 
-static void test_static_frame(void **state)
+static void test_detp_static_frame(void **state)
 {
     (void)state;
     pm_detp *dp = make(20000, 0);
@@ -195,12 +204,119 @@ static void test_static_frame(void **state)
     pm_detp_free(dp);
 }
 
+static gi_vlinks *make_links(int bounces)
+{
+    gi_vlinks_settings s;
+    gi_vlinks_default_settings(&s);
+    s.bounces = bounces;
+    s.threads = 2;
+    gi_vlinks *v = gi_vlinks_new(&s);
+    assert_non_null(v);
+    return v;
+}
+
+/* A unit sphere as a mesh2 of 40 x 80 latitude-longitude cells. */
+static const char *mesh_sphere_scene =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 }\n"
+    "camera { location <0, 0, 0> look_at <0, 0, 1> }\n"
+    "light_source { <0.3, 0.2, 0.1> color rgb 1 }\n"
+    "#declare NT = 40; #declare NP = 80;\n"
+    "mesh2 {\n"
+    "  vertex_vectors { (NT + 1) * NP,\n"
+    "    #for (J, 0, NT) #for (I, 0, NP - 1)\n"
+    "      #local T = pi * J / NT; #local P = 2 * pi * I / NP;\n"
+    "      <sin(T) * cos(P), cos(T), sin(T) * sin(P)>,\n"
+    "    #end #end }\n"
+    "  face_indices { 2 * NT * NP,\n"
+    "    #for (J, 0, NT - 1) #for (I, 0, NP - 1)\n"
+    "      #local A = J * NP + I; #local B = J * NP + mod(I + 1, NP);\n"
+    "      <A, B, B + NP>, <A, B + NP, A + NP>,\n"
+    "    #end #end }\n"
+    "  pigment { rgb 1 } finish { ambient 0 diffuse 0.5 }\n"
+    "}\n";
+
+static void test_links_sphere(void **state)
+{
+    (void)state;
+    frame f;
+    load(&f, NULL, mesh_sphere_scene, 1, 1);
+    gi_vlinks *v = make_links(10);
+    gi_vlinks_stats st;
+    assert_int_equal(gi_vlinks_frame(v, f.sc, f.a, 1, &st, f.d), PT_OK);
+    double a2 = 0.3 * 0.3 + 0.2 * 0.2 + 0.1 * 0.1, sum = 0.0, pk = 1.0;
+    for (int k = 1; k <= 10; k++) {
+        pk *= 0.5;
+        sum += pk;
+    }
+    double expected = (1.0 - a2 / 3.0) * sum;
+    /* the inner side's elements: their normal points at the centre */
+    double mean = 0.0, m2 = 0.0;
+    long m = 0;
+    for (long i = 0; i < gi_vlinks_count(v); i++) {
+        vec3 p, n;
+        rgb e = gi_vlinks_element(v, i, &p, &n);
+        if (v3_dot(p, n) > 0.0) continue;
+        mean += e.g;
+        m2 += e.g * e.g;
+        m++;
+    }
+    assert_true(m > 3000);
+    mean /= m;
+    double rms = sqrt(fmax(0.0, m2 / m - mean * mean)) / expected;
+    printf("  links sphere: %ld vertices, raw links %ld, merged %ld (%.2fx), %ld link rays: mean E_ind/pi %.5f, "
+           "expected %.5f (%+.2f%%), spread %.2f%%\n",
+           st.vertices, st.raw_links, st.merged_links, (double)st.raw_links / (double)st.merged_links, st.link_rays,
+           mean, expected, 100.0 * (mean / expected - 1.0), 100.0 * rms);
+    assert_true(fabs(mean / expected - 1.0) < 0.03);
+    assert_true(rms < 0.1);
+    assert_true(st.merged_links < st.raw_links);
+    gi_vlinks_free(v);
+    unload(&f);
+}
+
+static void test_links_incremental(void **state)
+{
+    (void)state;
+    const int nframes = 4;
+    gi_vlinks *inc = make_links(3);
+    for (int fr = 1; fr <= nframes; fr++) {
+        frame f;
+        load(&f, PT_SOURCE_DIR "/tests/scenes/detp_cbox.pov", NULL, fr, nframes);
+        gi_vlinks_stats si, sf;
+        assert_int_equal(gi_vlinks_frame(inc, f.sc, f.a, 1, &si, f.d), PT_OK);
+        gi_vlinks *fresh = make_links(3);
+        assert_int_equal(gi_vlinks_frame(fresh, f.sc, f.a, 1, &sf, f.d), PT_OK);
+        long n = gi_vlinks_count(inc), differ = 0;
+        assert_int_equal(n, gi_vlinks_count(fresh));
+        for (long i = 0; i < n; i++) {
+            rgb a = gi_vlinks_element(inc, i, NULL, NULL), b = gi_vlinks_element(fresh, i, NULL, NULL);
+            differ += a.r != b.r || a.g != b.g || a.b != b.b;
+        }
+        printf("  links cbox frame %d: %s, %ld objects moved, %ld of %ld elements linked again, "
+               "elements differing from a fresh build: %ld\n",
+               fr, si.full ? "full" : "incremental", si.objects_moved, si.elements_linked, si.elements, differ);
+        assert_int_equal(differ, 0);
+        assert_int_equal(si.merged_links, sf.merged_links);
+        if (fr > 1) {
+            assert_int_equal(si.full, 0);
+            assert_int_equal(si.objects_moved, 1);
+            assert_true(si.elements_linked > 0 && si.elements_linked < si.elements);
+        }
+        gi_vlinks_free(fresh);
+        unload(&f);
+    }
+    gi_vlinks_free(inc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_sphere),
-        cmocka_unit_test(test_incremental_equals_full),
-        cmocka_unit_test(test_static_frame),
+        cmocka_unit_test(test_detp_sphere),
+        cmocka_unit_test(test_detp_incremental),
+        cmocka_unit_test(test_detp_static_frame),
+        cmocka_unit_test(test_links_sphere),
+        cmocka_unit_test(test_links_incremental),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
