@@ -288,8 +288,10 @@ static void gi_keep_free(gi_keep *k)
  *    mesh_camera); and the number of lights (the lighting stage edits
  *    lights in place);
  *  - lighting: every light's fields;
- *  - view: the camera, which the view stage always takes as given. */
-static void stage_hashes(const scene *sc, int frame_dependent, int frame, uint64_t *h_geom, uint64_t *h_light)
+ *  - view: the camera, which the view stage always takes as given (an
+ *    animation's geometry stage does not read it: view_independent).
+ * Returns 1 when h_geom holds the frame number. */
+static int stage_hashes(const scene *sc, int frame_dependent, int frame, uint64_t *h_geom, uint64_t *h_light)
 {
     uint64_t g = PT_FNV1A_BASIS, l = g;
     int dep = frame_dependent || sc->camera.normal || sc->camera.nmeshes > 0;
@@ -326,6 +328,7 @@ static void stage_hashes(const scene *sc, int frame_dependent, int frame, uint64
     if (dep) g = FNV(g, frame);
     *h_geom = g;
     *h_light = l ^ g;
+    return dep;
 }
 
 /* The key a GI cache is checked against (--gi-cache, gi_particle_save):
@@ -333,11 +336,12 @@ static void stage_hashes(const scene *sc, int frame_dependent, int frame, uint64
  * keeps the same from frame to frame but another process may not: the
  * declarations (-D, Declare=), the image size (image_width and
  * image_height are scene values), the animation values when the scene read
- * them outside the camera and lights, the camera's position (the geometry
- * stage keeps the particles that face it, gi_particle.c trace_and_prune),
- * and this partray's version. The GI settings are checked by the cache
- * itself. */
-static uint64_t gi_cache_key(const scene *sc, uint64_t h_geom, const sdl_options *so, int frame_dependent)
+ * them outside the camera and lights, a still's camera position (its
+ * geometry stage keeps the particles that face it, gi_particle.c
+ * trace_and_prune; an animation's does not read the camera), and this
+ * partray's version. The GI settings are checked by the cache itself. */
+static uint64_t gi_cache_key(const scene *sc, uint64_t h_geom, const sdl_options *so, int frame_dependent,
+                             int view_independent)
 {
     uint64_t k = FNV(PT_FNV1A_BASIS, h_geom);
     for (int i = 0; i < so->ndefines; i++) k = pt_fnv1a(k, so->defines[i], strlen(so->defines[i]) + 1);
@@ -348,7 +352,7 @@ static uint64_t gi_cache_key(const scene *sc, uint64_t h_geom, const sdl_options
         k = FNV(k, so->clock_delta);
         k = FNV(k, so->frame_number);
     }
-    if (sc->camera_set) k = FNV(k, sc->camera.location);
+    if (sc->camera_set && !view_independent) k = FNV(k, sc->camera.location);
     return pt_fnv1a(k, PARTRAY_VERSION, strlen(PARTRAY_VERSION));
 }
 
@@ -438,13 +442,17 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
      * kept scene with this frame's camera and lights. */
     int reuse = 0, relight = 0, keep_gi = gi == GI_PARTICLE && plan->animated && !run->tile;
     uint64_t h_geom = 0, h_light = 0, scene_hash = sc->input_hash;
-    if (gi == GI_PARTICLE) stage_hashes(sc, frame_dependent, frame, &h_geom, &h_light);
-    /* an animation's frames have a cache each, numbered as the outputs
-     * (frames that keep the GI of an earlier one in this run write none) */
-    char *gi_cache_frame = gi == GI_PARTICLE && o->gi_cache && plan->animated
+    int per_frame = gi == GI_PARTICLE && stage_hashes(sc, frame_dependent, frame, &h_geom, &h_light);
+    /* An animation's geometry stage does not read the camera, so that a
+     * frame that keeps an earlier frame's GI renders what it would alone
+     * (and so would a tile of it on a farm). Its frames share one cache;
+     * when the geometry changes from frame to frame each has its own,
+     * numbered as the outputs (a frame that keeps an earlier one's GI in
+     * this run writes none). */
+    char *gi_cache_frame = gi == GI_PARTICLE && o->gi_cache && plan->animated && per_frame
                                ? anim_output_name(o->gi_cache, frame, plan->digits) : NULL;
     const char *gi_cache = gi_cache_frame ? gi_cache_frame : (gi == GI_PARTICLE ? o->gi_cache : NULL);
-    uint64_t cache_key = gi_cache ? gi_cache_key(sc, h_geom, &so, frame_dependent) : 0;
+    uint64_t cache_key = gi_cache ? gi_cache_key(sc, h_geom, &so, frame_dependent, plan->animated) : 0;
     if (o->gi_cache && !gi_cache)
         diag_warn_once(d, (src_loc){0}, "--gi-cache applies to --gi particle, not %s: ignored", gi_used);
     if (keep_gi) {
@@ -535,6 +543,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     ss.gi_cache = gi_cache;
     ss.gi_cache_load = gi_cache && access(gi_cache, F_OK) == 0;
     ss.gi_cache_key = cache_key;
+    ss.view_independent = plan->animated;
     if (run->tile) memcpy(ss.window, run->win, sizeof ss.window);
     char *progressive = NULL;
     if ((gi == GI_PATH || gi == GI_PMFG) && noutputs > 0 && img_format_from_path(outputs[0]) != IMG_FMT_UNKNOWN) {

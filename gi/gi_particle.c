@@ -221,7 +221,7 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
          * Under a sky that is not black, a particle facing the camera
          * receives light even when all its rays leave the scene (the top
          * of a box under the open sky). */
-        if (gp->sc->camera_set) {
+        if (gp->sc->camera_set && !gp->set.view_independent) {
             const scene_camera *cam = &gp->sc->camera;
             int sky = !gi_sky_black(gp->sky);
             for (int i = 0; i < n; i++) {

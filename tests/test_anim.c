@@ -337,6 +337,44 @@ static void test_gi_reuse(void **st)
     }
 }
 
+/* An animation's geometry stage does not read the camera: a free-standing
+ * wall under a sky, the camera going round it from the front to the back.
+ * The back's particles are linked by no ray (nothing faces them), so a
+ * still keeps them only when the camera faces them; frame 3 rendered in
+ * the run that built the GI at frame 1 (camera in front) must equal frame 3
+ * rendered alone (camera behind), byte for byte. With --gi-cache the
+ * frames share one file (the geometry does not change from frame to
+ * frame), and frame 3 rendered alone from it is the same again. */
+static void test_gi_reuse_behind(void **st)
+{
+    (void)st;
+    char scene[600], cmd[4096], cache[600];
+    snprintf(scene, sizeof scene, "%s/behind.pov", tmpdir);
+    snprintf(cache, sizeof cache, "%s/behind.gic", tmpdir);
+    tu_write_file(scene, "#version 3.7;\nglobal_settings { radiosity { count 50 } }\n"
+                         "camera { location <3 * sin(clock * pi), 1, -3 * cos(clock * pi)> look_at <0, 1, 0> angle 60 }\n"
+                         "light_source { <-2, 4, -3> rgb 1 }\nsky_sphere { pigment { rgb <0.6, 0.7, 1.0> } }\n"
+                         "box { <-1, 0, -0.05>, <1, 2, 0.05> pigment { rgb 0.8 } finish { diffuse 0.8 ambient 0 } }\n");
+    const char *opts = "--size 48x36 --particles 5000 +KFI1 +KFF3";
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' %s --gi-cache '%s' -o '%s/behind_.pfm'", PARTRAY_BIN, scene, opts, cache,
+             tmpdir);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    printf("%s", tu_out);
+    assert_non_null(strstr(tu_out, "frame 3: gi stages run: view\n"));
+    assert_true(tu_exists(cache));
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' %s --frame 3 -q -o '%s/alone_.pfm'", PARTRAY_BIN, scene, opts, tmpdir);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' %s --frame 3 --gi-cache '%s' -o '%s/cached_.pfm'", PARTRAY_BIN, scene,
+             opts, cache, tmpdir);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    assert_non_null(strstr(tu_out, "behind.gic: loaded"));
+    snprintf(cmd, sizeof cmd, "cmp '%s/behind_3.pfm' '%s/alone_3.pfm' && cmp '%s/behind_3.pfm' '%s/cached_3.pfm'", tmpdir,
+             tmpdir, tmpdir, tmpdir);
+    int rc = tu_run_capture(cmd);
+    printf("frame 3 in one run, alone, alone from the shared cache: %s\n", rc == 0 ? "identical" : tu_out);
+    assert_int_equal(rc, 0);
+}
+
 /* --gi-cache: a render saves its particle GI's geometry stage; another
  * process (other thread count) loads it and gives the same image, byte for
  * byte (PFM), as does a render without the cache. A cache is refused (exit
@@ -421,6 +459,7 @@ int main(void)
         cmocka_unit_test(test_window_as_povray),
         cmocka_unit_test(test_tiles_merge),
         cmocka_unit_test(test_gi_reuse),
+        cmocka_unit_test(test_gi_reuse_behind),
         cmocka_unit_test(test_gi_cache),
     };
     return tu_finish(cmocka_run_group_tests(tests, NULL, NULL), tmpdir);
