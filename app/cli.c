@@ -328,6 +328,13 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
                 return 2;
             }
             i++;
+        } else if (strcmp(a, "--photon-scale") == 0) {
+            if (!has_value(a, next, err, errlen)) return 2;
+            if (!parse_double(next, &o->photon_scale) || !(o->photon_scale > 0.0) || o->photon_scale > 1024.0) {
+                snprintf(err, (size_t)errlen, "--photon-scale wants a number in (0, 1024]");
+                return 2;
+            }
+            i++;
         } else if (strcmp(a, "--clock") == 0) {
             if (!has_value(a, next, err, errlen)) return 2;
             if (!parse_double(next, &o->clock)) { snprintf(err, (size_t)errlen, "--clock wants a number"); return 2; }
@@ -610,6 +617,8 @@ const char cli_render_help[] =
     "  --gi vpl [--vpls N] [--nb N] [--vpl-cut minmax|full|brute] [--vpl-adaptive on|off]\n"
     "                         VPL reflectance filtering (glossy interreflection, docs/gi.md): VPL count\n"
     "                         (16384), bounces at the VPLs (1), the cut walked per pixel, adaptive sampling\n"
+    "  --photon-scale F       none, particle: F times the photons the scene's photons{} asks for\n"
+    "                         (caustic layer, docs/caustics.md; default 1)\n"
     "\n"
     "Colour and light (docs/guide.md, docs/units.md)\n"
     "  --display NAME --view NAME --look NAME --exposure STOPS --working-space NAME\n"

@@ -498,6 +498,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     ss.spp = o->spp;
     ss.particles = o->particles;
     ss.gi_quality = o->gi_quality;
+    ss.photon_scale = o->photon_scale;
     ss.bounces = o->bounces;
     ss.fg_rays = o->fg_rays;
     ss.photons = o->photons;

@@ -60,8 +60,14 @@ static pt_status render_none(const scene *sc, const accel *a, const render_gi_op
     fill_shade(&ss, o);
     ss.use_ambient = radrules_of(sc, 0).ambient; /* radiosity off: always */
     double t0 = timer_now();
+    pt_status st = caustics_build(&r->caus, sc, a, o->width, o->height, o->threads, o->seed, o->cl_device,
+                                  o->cl_max_bytes, o->photon_scale, o->cancel, d);
+    r->t_gi_lighting = timer_now() - t0;
+    if (st != PT_OK) return st;
+    caustics_attach(&r->caus, &ss);
+    t0 = timer_now();
     r->image_begun = 1;
-    pt_status st = shade_render(sc, a, &ss, fb, &r->shade, d);
+    st = shade_render(sc, a, &ss, fb, &r->shade, d);
     r->t_render = timer_now() - t0;
     if (st == PT_OK) st = render_aovs(sc, a, o, &ss, r, d);
     return st;
@@ -115,6 +121,13 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
         r->ran_lighting = 1;
     }
     if (st == PT_OK) {
+        /* the caustic layer of the scene's photons{} (caustics.h) */
+        double tc = timer_now();
+        st = caustics_build(&r->caus, sc, a, o->width, o->height, o->threads, o->seed, o->cl_device, o->cl_max_bytes,
+                            o->photon_scale, o->cancel, d);
+        r->t_gi_lighting += timer_now() - tc;
+    }
+    if (st == PT_OK) {
         shade_settings ss;
         fill_shade(&ss, o);
         /* POV-Ray's rule under radiosity (core/radrules.h): a surface seen
@@ -123,6 +136,7 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
         ss.use_ambient = radrules_of(sc, 1).ambient;
         ss.indirect = gi_particle_indirect;
         ss.indirect_ctx = gp;
+        caustics_attach(&r->caus, &ss);
         if (gs.keep_hits) {
             ss.primary_begin = gi_particle_primary_begin;
             ss.primary = gi_particle_primary_hit;
@@ -383,6 +397,7 @@ pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, fr
     case GI_PATH: return render_reference(sc, a, o, fb, r, d);
     default: st = render_none(sc, a, o, fb, r, d); break;
     }
+    caustics_free(&r->caus);
     r->primary_rays = r->shade.primary_rays;
     r->shadow_rays = r->shade.shadow_rays;
     r->secondary_rays = r->shade.secondary_rays;
@@ -398,6 +413,7 @@ pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, fr
 
 void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
 {
+    caustics_json((caustics *)&r->caus, js);
     stats_obj_begin(js, "light_not_modelled");
     stats_int(js, "media", r->nm_media);
     stats_int(js, "fog", r->nm_fog);

@@ -5,6 +5,7 @@
 #define PT_RENDER_GI_H
 #include <stdint.h>
 #include "accel.h"
+#include "caustics.h"
 #include "diag.h"
 #include "framebuffer.h"
 #include "gi_particle.h"
@@ -27,6 +28,7 @@ typedef struct {
     int quality;              /* none, particle: POV-Ray's +Q level 0..9 (shade_settings.quality) */
     int spp;                  /* path: samples per pixel; pmfg: eye samples; none/particle: fixed AA */
     long particles;           /* particle: area particles (0 = from the scene/default) */
+    double photon_scale;      /* none, particle: the caustic layer's photons times this (0 = 1) */
     double gi_quality;        /* particle: multiplies the scene's particle count (0 = 1); --particles wins */
     int bounces;              /* particle: n_b (0 = default) */
     int fg_rays;              /* pmfg: final-gather rays per pixel (0 = default 4096) */
@@ -99,6 +101,9 @@ typedef struct {
      * (atmospheric or in objects) and rainbows on every ray; particle: with
      * radiosity's `media on`, media, fog and rainbows along gathering rays. */
     int nm_media, nm_fog, nm_rainbow;
+    /* none, particle: the caustic layer of the scene's photons{} (its
+     * layer is freed when render_gi returns; the figures stay) */
+    caustics caus;
 } render_gi_result;
 
 pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb, render_gi_result *r,

@@ -35,6 +35,12 @@ _Static_assert(offsetof(gi_dev_light, fade_distance) == 64, "fade_distance");
 _Static_assert(offsetof(gi_dev_light, fade_power) == 68, "fade_power");
 _Static_assert(offsetof(gi_dev_light, shadowless) == 72, "shadowless");
 _Static_assert(sizeof(gi_walk_entry) == 16 && offsetof(gi_walk_entry, w) == 4, "gi_walk_entry is 16 bytes");
+_Static_assert(sizeof(gi_caus_photon) == 64 && offsetof(gi_caus_photon, r_xy) == 12 && offsetof(gi_caus_photon, n) == 16 &&
+                   offsetof(gi_caus_photon, r_z) == 28 && offsetof(gi_caus_photon, w) == 32 &&
+                   offsetof(gi_caus_photon, phi) == 48,
+               "gi_caus_photon is 64 bytes");
+_Static_assert(sizeof(gi_caus_pixel) == 32 && offsetof(gi_caus_pixel, valid) == 12 && offsetof(gi_caus_pixel, n) == 16,
+               "gi_caus_pixel is 32 bytes");
 _Static_assert(GI_BOUNCE_CHUNK % 32 == 0, "gi_k_bounce writes whole mask words");
 _Static_assert(sizeof(gi_i64) == 8 && sizeof(gi_u32) == 4 && sizeof(float) == 4 && sizeof(int) == 4,
                "scalar sizes match OpenCL C");
@@ -52,7 +58,7 @@ extern const int gi_kernel_nfiles;
 /* gi_k_bounce work-items (GI_BOUNCE_CHUNK particles each) per work-group */
 #define GI_BOUNCE_LOCAL 4
 
-enum { KE_EMIT, KE_BOUNCE, KE_WALK, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_VPL, KE_COUNT };
+enum { KE_EMIT, KE_BOUNCE, KE_WALK, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_VPL, KE_CAUSTIC, KE_COUNT };
 
 struct gi_dev {
     int is_cl;
@@ -105,6 +111,8 @@ struct gi_dev {
     cl_mem b_rin_off, b_rin_src, b_bin, b_bout, b_total, b_woff, b_went;
     cl_mem b_emits, b_mask_src, b_mask_a, b_mask_b, b_cin_off, b_cin_src;
     cl_mem b_enew, b_dsum; /* gi_k_emit's edir (swapped with b_edir when a stage completes), direct sums */
+    cl_mem b_cph, b_ctoff, b_ctidx, b_cpix, b_ce; /* gi_k_caustic_splat's photons, tile lists, G-buffer, output */
+    size_t sz_cph, sz_ctoff, sz_ctidx, sz_cpix, sz_ce;
     size_t sz_lights, sz_vis, sz_tally, sz_list, sz_vout, sz_woff, sz_went, sz_cin_off, sz_cin_src;
     cl_mem b_vpts, b_vnodes, b_vtabs, b_vres, b_visits; /* gi_dev_vpl_gather */
     size_t sz_vpts, sz_vnodes, sz_vtabs, sz_vres, sz_visits;
@@ -343,7 +351,8 @@ static pt_status cl_open(gi_dev *dv, const gi_dev_options *o, diag *d)
         return PT_ERR_DEVICE;
     }
     static const char *const names[KE_COUNT] = {"gi_k_emit", "gi_k_bounce", "gi_k_walk", "gi_k_resolve",
-                                                "gi_k_gather", "gi_k_estimate", "gi_k_vpl_gather"};
+                                                "gi_k_gather", "gi_k_estimate", "gi_k_vpl_gather",
+                                                "gi_k_caustic_splat"};
     for (int k = 0; k < KE_COUNT; k++) {
         dv->k[k] = clCreateKernel(dv->prog, names[k], &e);
         if (!dv->k[k]) return cl_fail(d, names[k], e);
@@ -367,7 +376,7 @@ static void release_buffers(gi_dev *dv)
                     &dv->b_bout, &dv->b_total, &dv->b_woff, &dv->b_went,
                     &dv->b_emits, &dv->b_mask_src, &dv->b_mask_a, &dv->b_mask_b, &dv->b_cin_off,
                     &dv->b_cin_src, &dv->b_enew, &dv->b_dsum, &dv->b_vpts, &dv->b_vnodes, &dv->b_vtabs,
-                    &dv->b_vres, &dv->b_visits};
+                    &dv->b_vres, &dv->b_visits, &dv->b_cph, &dv->b_ctoff, &dv->b_ctidx, &dv->b_cpix, &dv->b_ce};
     for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
 }
 
@@ -1083,6 +1092,36 @@ pt_status gi_dev_vpl_gather(gi_dev *dv, const gi_dev_vpl_point *pts, int npts, c
     if ((st = download(dv, dv->b_vres, out, (size_t)npts * per * sizeof(float), d)) != PT_OK) return st;
     return download(dv, dv->b_visits, visits, (size_t)npts * sizeof(int), d);
 #else
+    return PT_ERR_INTERNAL;
+#endif
+}
+
+pt_status gi_dev_caustic_splat(gi_dev *dv, const gi_caus_photon *ph, int nph, const int *tile_off, int ntiles,
+                               const int *tile_idx, const gi_caus_pixel *gbuf, int w, int h, int tiles_x, float *e,
+                               diag *d)
+{
+    if (!dv->is_cl) {
+        gi_c_caustic_splat(dv->threads, ph, tile_off, tile_idx, gbuf, w, h, tiles_x, e);
+        return PT_OK;
+    }
+#ifdef PARTRAY_HAVE_OPENCL
+    size_t npx = (size_t)w * (size_t)h;
+    if (npx == 0) return PT_OK;
+    pt_status st;
+    size_t nidx = (size_t)tile_off[ntiles];
+    if ((st = upload(dv, &dv->b_cph, &dv->sz_cph, ph, (size_t)nph * sizeof *ph, d)) != PT_OK) return st;
+    if ((st = upload(dv, &dv->b_ctoff, &dv->sz_ctoff, tile_off, (size_t)(ntiles + 1) * sizeof(int), d)) != PT_OK)
+        return st;
+    if ((st = upload(dv, &dv->b_ctidx, &dv->sz_ctidx, tile_idx, nidx * sizeof(int), d)) != PT_OK) return st;
+    if ((st = upload(dv, &dv->b_cpix, &dv->sz_cpix, gbuf, npx * sizeof *gbuf, d)) != PT_OK) return st;
+    if ((st = ensure(dv, &dv->b_ce, &dv->sz_ce, npx * 4 * sizeof(float), d)) != PT_OK) return st;
+    karg a[] = {KMEM(dv->b_cph), KMEM(dv->b_ctoff), KMEM(dv->b_ctidx), KMEM(dv->b_cpix), KINT(w), KINT(h),
+                KINT(tiles_x), KMEM(dv->b_ce)};
+    if ((st = run_kernel(dv, KE_CAUSTIC, npx, a, 8, d)) != PT_OK) return st;
+    return download(dv, dv->b_ce, e, npx * 4 * sizeof(float), d);
+#else
+    (void)nph;
+    (void)ntiles;
     return PT_ERR_INTERNAL;
 #endif
 }

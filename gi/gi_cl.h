@@ -104,5 +104,12 @@ pt_status gi_dev_estimate(gi_dev *dv, const int *found, int nfound, float *vout,
  * Needs no particles (any device from gi_dev_open). */
 pt_status gi_dev_vpl_gather(gi_dev *dv, const gi_dev_vpl_point *pts, int npts, const gi_dev_vpl_node *nodes, int nnodes,
                             const float *tabs, int ntabs, float thr, int mode, float *out, int *visits, diag *d);
+/* Caustic layer (gi_caustic.cl, seed 002 step 4): the photon volumes ph
+ * (nph) scattered over the w x h G-buffer gbuf through the tile lists
+ * (ntiles tiles in rows of tiles_x; CSR tile_off, ntiles + 1 offsets, and
+ * tile_idx); e gets 4 floats a pixel. Independent of the particle data. */
+pt_status gi_dev_caustic_splat(gi_dev *dv, const gi_caus_photon *ph, int nph, const int *tile_off, int ntiles,
+                               const int *tile_idx, const gi_caus_pixel *gbuf, int w, int h, int tiles_x, float *e,
+                               diag *d);
 
 #endif

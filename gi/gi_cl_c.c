@@ -10,6 +10,7 @@
 #include "kernels/gi_vpl_real.h"
 #include "glossy_lobe.h"
 #include "kernels/gi_vpl.cl"
+#include "kernels/gi_caustic.cl"
 /* (gi_shim.h must come first; this header only declares the launchers.) */
 #include "gi_cl_c.h"
 #include "pool.h"
@@ -36,6 +37,9 @@ typedef struct {
     const unsigned *mask_in, *emits;
     unsigned *mask_out;
     const gi_walk_entry *went;
+    const gi_caus_photon *cph;
+    const gi_caus_pixel *cpix;
+    int w, h, tiles_x;
     size_t chunk;  /* work-items per pool job (0: GI_C_CHUNK) */
     const gi_dev_vpl_point *vpts;  /* gi_k_vpl_gather */
     const gi_dev_vpl_node *vnodes;
@@ -45,7 +49,7 @@ typedef struct {
     int *visits;
 } c_launch;
 
-enum { K_EMIT, K_BOUNCE, K_WALK, K_RESOLVE, K_GATHER, K_ESTIMATE, K_VPL };
+enum { K_EMIT, K_BOUNCE, K_WALK, K_RESOLVE, K_GATHER, K_ESTIMATE, K_VPL, K_CAUSTIC };
 
 static void run_chunk(void *ctx, int chunk, int thread)
 {
@@ -76,6 +80,7 @@ static void run_chunk(void *ctx, int chunk, int thread)
         case K_VPL:
             gi_k_vpl_gather(a->vpts, (int)a->n, a->vnodes, a->nvnodes, a->vtabs, a->vthr, a->vmode, a->fout, a->visits);
             break;
+        case K_CAUSTIC: gi_k_caustic_splat(a->cph, a->off, a->idx, a->cpix, a->w, a->h, a->tiles_x, a->fout); break;
         }
     }
 }
@@ -156,4 +161,17 @@ void gi_c_vpl_gather(int threads, const gi_dev_vpl_point *pts, int npts, const g
     c_launch a = {.kernel = K_VPL, .n = (size_t)npts, .vpts = pts, .vnodes = nodes, .nvnodes = nnodes, .vtabs = tabs,
                   .vthr = thr, .vmode = mode, .fout = out, .visits = visits, .chunk = 16};
     launch(threads, &a);
+}
+void gi_c_caustic_splat(int threads, const gi_caus_photon *ph, const int *tile_off, const int *tile_idx,
+                        const gi_caus_pixel *gbuf, int w, int h, int tiles_x, float *e)
+{
+    c_launch a = {.kernel = K_CAUSTIC, .n = (size_t)w * (size_t)h, .cph = ph, .off = tile_off, .idx = tile_idx,
+                  .cpix = gbuf, .w = w, .h = h, .tiles_x = tiles_x, .fout = e};
+    launch(threads, &a);
+}
+
+void gi_c_caustic_at(const gi_caus_photon *ph, const int *idx, int n, const float s[3], const float nrm[3], float e[3])
+{
+    e[0] = e[1] = e[2] = 0.0f;
+    for (int k = 0; k < n; k++) gi_caus_add(&ph[idx ? idx[k] : k], s[0], s[1], s[2], nrm[0], nrm[1], nrm[2], e);
 }

@@ -31,5 +31,13 @@ void gi_c_estimate(int threads, const gi_dev_particle *part, const int *list_off
 /* gi_k_vpl_gather: one work-item per point (gi_vpl.cl). */
 void gi_c_vpl_gather(int threads, const gi_dev_vpl_point *pts, int npts, const gi_dev_vpl_node *nodes, int nnodes,
                      const float *tabs, float thr, int mode, float *out, int *visits);
+ 
+/* gi_k_caustic_splat (gi_caustic.cl): w x h work-items. */
+void gi_c_caustic_splat(int threads, const gi_caus_photon *ph, const int *tile_off, const int *tile_idx,
+                        const gi_caus_pixel *gbuf, int w, int h, int tiles_x, float *e);
+/* The same photon volume sum (gi_caus_add) at one receiver point s with
+ * normal nrm, over photons idx[0 .. n) (idx NULL: photons 0 .. n), on the
+ * calling thread: the caustic layer's lookups away from the G-buffer. */
+void gi_c_caustic_at(const gi_caus_photon *ph, const int *idx, int n, const float s[3], const float nrm[3], float e[3]);
 
 #endif

@@ -159,7 +159,10 @@ static rgb shadow_rgb(render_ctx *c, int thread, vec3 p, vec3 dir, double depth,
         shade_media_env me = {c->sc, c, thread, NULL, media_light, NULL};
         return shade_media_shadow_ray(c->sc, c->a, &me, l, p, dir, c->eps, tmax, in ? in : &no_containers);
     }
-    return shade_tex_shadow_ray(c->sc, c->a, p, dir, c->eps, tmax);
+    const scene_light *pl = c->s->photon_shadows ? l : NULL;
+    const accel_hit *lit = c->frame[thread] ? c->frame[thread]->h : NULL;
+    if (lit && lit->obj && lit->obj->photons && !lit->obj->photons->collect) pl = NULL;
+    return shade_tex_shadow_ray(c->sc, c->a, p, dir, c->eps, tmax, pl);
 }
 
 /* Visibility (0..1) of the rectangle [u1,u2]x[v1,v2] of the grid, adaptively. */

@@ -64,6 +64,11 @@ typedef struct {
      * transmission; 8 reflection and normal perturbation; 9 media. Quick
      * colours (levels 0-5) are not modelled: pigments are evaluated. */
     int quality;
+    /* 1 when a caustic layer carries the photons of the scene's lights
+     * (the indirect hook adds it): shadow rays follow POV-Ray's photon
+     * rule (shade_tex_shadow_ray's photon_light), except for surfaces with
+     * photons { collect off }, which take no photons */
+    int photon_shadows;
 } shade_settings;
 
 typedef struct {

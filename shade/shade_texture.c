@@ -622,7 +622,8 @@ int shade_tex_scene_transparent(const scene *sc)
     return 0;
 }
 
-rgb shade_tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, double tmin, double tmax)
+rgb shade_tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, double tmin, double tmax,
+                         const scene_light *photon_light)
 {
     rgb c = {1, 1, 1};
     accel_hit h;
@@ -631,6 +632,8 @@ rgb shade_tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, doub
         if (!accel_intersect(a, p, dir, t0, tmax, &h)) return c;
         double next = h.t + fmax(tmin, h.t * 1e-7);
         if (!(h.flags & OBJ_NO_SHADOW)) {
+            const scene_obj_photons *ph = h.obj ? h.obj->photons : NULL;
+            if (photon_light && ph && ph->target && scene_photon_lobe(photon_light, ph, 1)) return trgb(0, 0, 0);
             /* distance inside the object: from the previous crossing */
             accel_hit hh = h;
             hh.t = h.t - (t0 > tmin ? t0 - fmax(tmin, t0 * 1e-7) : 0.0);

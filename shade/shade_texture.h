@@ -61,8 +61,12 @@ rgb shade_tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir);
 /* Light left along a shadow ray from p (unit dir) over (tmin, tmax): 0 when
  * an opaque surface blocks it, else the product of the filter colours of the
  * (transparent) surfaces crossed; no_shadow objects are ignored (POV-Ray's
- * TracePointLightShadowRay). */
-rgb shade_tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, double tmin, double tmax);
+ * TracePointLightShadowRay). photon_light: NULL, or the light when the
+ * caustic layer carries its photons (POV-Ray 3.7 trace.cpp: a photon
+ * target that refracts that light's photons, scene_photon_lobe, casts a
+ * full shadow: the light through it arrives as photons). */
+rgb shade_tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, double tmin, double tmax,
+                         const scene_light *photon_light);
 
 /* Can any surface of the scene let light through (filter/transmit anywhere
  * in its textures, image maps with alpha or `once`)? When not, shadows are

@@ -201,4 +201,39 @@ static inline gi_u32 gi_hash(gi_u32 v)
     return (word >> 22u) ^ word;
 }
 
+/* Image-space photon mapping (McGuire and Luebke 2009, seed 002): the
+ * caustic layer's records (gi_caustic.cl, gi/gi_caustic.h).
+ *
+ * One stored photon as the paper's photon map holds it (section 3's table:
+ * position x, hit normal n_p, incoming direction w_i, power Phi) with the
+ * kernel's two radii beside them: r_xy, the major radii in the plane of the
+ * photon's surface, and r_z <= r_xy along n_p (section 2.5 of the digest,
+ * Fig. 4). w points back towards where the light came from. phi is in the
+ * "E/pi units" above times area: sum phi * kappa is a POV-Ray light colour
+ * (E/pi) that the diffuse term multiplies by diffuse * pigment. 64 bytes. */
+typedef struct {
+    float x[3];
+    float r_xy;
+    float n[3];
+    float r_z;
+    float w[3];
+    float pad0;
+    float phi[3];
+    float pad1;
+} gi_caus_photon;
+
+/* One eye G-buffer texel (paper step 2): the world position s and normal n
+ * of the camera's first receiving hit through the pixel's centre, n turned
+ * towards the camera; valid 0 where the pixel sees no receiver. 32 bytes. */
+typedef struct {
+    float s[3];
+    float valid;
+    float n[3];
+    float pad;
+} gi_caus_pixel;
+
+/* Tile edge (pixels) of the splat's binning: a photon is listed in every
+ * tile whose G-buffer bounds its kernel ellipsoid's sphere reaches. */
+#define GI_CAUS_TILE 16
+
 #endif

@@ -1,0 +1,188 @@
+/* caustics.c - the caustic layer wired to the shader (see caustics.h). */
+#include "caustics.h"
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include "shade_light.h"
+#include "shade_material.h"
+
+/* The caustic layer's material hook: shade_material's BSDF at the hit;
+ * Russian roulette over its lobes (shade_mat_sample with absorption, seed
+ * 002 appendix A) continues a photon only along a specular lobe. */
+static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, rng *r, gi_caustic_step *step)
+{
+    const caustics *c = ctx;
+    shade_mat_bsdf b;
+    shade_mat_setup(&b, c->sc, h, dir, c->eps, r);
+    int out = b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 ? GI_CAUSTIC_RECEIVES : 0;
+    if (!step) return out;
+    shade_mat_scatter s;
+    if (!shade_mat_sample(&b, r, 1, &s) || !s.specular) return out;
+    step->org = s.org;
+    step->dir = s.dir;
+    step->weight = (rgb){s.weight.r * s.eta2, s.weight.g * s.eta2, s.weight.b * s.eta2};
+    step->rho = b.m[s.lobe];
+    step->refract = s.lobe == SHADE_MAT_LOBE_TRANSMIT;
+    step->from = b.from;
+    return out | GI_CAUSTIC_CONTINUES;
+}
+
+/* Spot and cylinder attenuation seen from the photon's first hit p, fade at
+ * the photon's whole path length (POV-Ray's addSurfacePhoton). */
+static double hook_attenuation(void *ctx, const scene_light *l, vec3 p, double depth)
+{
+    (void)ctx;
+    vec3 dir;
+    double dd;
+    shade_light_ray(l, l->position, p, &dir, &dd);
+    return shade_light_attenuation(l, p, dir, depth);
+}
+
+static int interior_has_media(const scene_object *o)
+{
+    if (o->interior && o->interior->nmedia > 0) return 1;
+    if (o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE)
+        for (int i = 0; i < o->u.csg.nkids; i++)
+            if (interior_has_media(o->u.csg.kids[i])) return 1;
+    return 0;
+}
+
+static int target_disperses(const scene_object *o)
+{
+    if (o->photons && o->photons->target && o->interior && o->interior->dispersion != 1.0) return 1;
+    if (o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE)
+        for (int i = 0; i < o->u.csg.nkids; i++)
+            if (target_disperses(o->u.csg.kids[i])) return 1;
+    return 0;
+}
+
+/* What the scene's photon settings ask that the layer leaves out. */
+static void not_modelled(caustics *c, const scene *sc, diag *d)
+{
+    const scene_photons *p = &sc->global.photons;
+    caustics_not_modelled *nm = &c->nm;
+    nm->gather = (p->given & SCENE_PH_GATHER) != 0;
+    nm->radius = (p->given & SCENE_PH_RADIUS) != 0;
+    nm->expand_thresholds = (p->given & SCENE_PH_EXPAND) != 0;
+    nm->autostop = (p->given & SCENE_PH_AUTOSTOP) != 0 && p->autostop > 0.0;
+    nm->media = p->media_steps > 0;
+    nm->save_file = (p->given & SCENE_PH_SAVE_FILE) != 0 && p->file && !p->load;
+    nm->load_file = (p->given & SCENE_PH_LOAD_FILE) != 0 && p->file && p->load;
+    for (int i = 0; i < sc->nobjects; i++) {
+        nm->dispersion |= target_disperses(sc->objects[i]);
+        nm->media_objects |= interior_has_media(sc->objects[i]);
+    }
+    src_loc nowhere = {0};
+    const char *why = "the caustic layer sizes its photon volumes itself (docs/caustics.md)";
+    if (nm->gather) diag_warn_once(d, nowhere, "photons: gather is not modelled: %s", why);
+    if (nm->radius) diag_warn_once(d, nowhere, "photons: radius is not modelled: %s", why);
+    if (nm->expand_thresholds) diag_warn_once(d, nowhere, "photons: expand_thresholds is not modelled: %s", why);
+    if (nm->autostop)
+        diag_warn_once(d, nowhere, "photons: autostop is not modelled: every direction towards a target is shot");
+    if (nm->media) diag_warn_once(d, nowhere, "photons: media photons are not modelled; media get no caustic light");
+    if (nm->save_file) diag_warn_once(d, nowhere, "photons: save_file is not modelled: no photon file is written");
+    if (nm->load_file)
+        diag_warn_once(d, nowhere, "photons: load_file is not modelled: the photons are shot again, not read");
+    if (nm->dispersion)
+        diag_warn_once(d, nowhere, "photons: dispersion is not modelled: photons through a dispersive target are white");
+    if (nm->media_objects)
+        diag_warn_once(d, nowhere, "photons: media inside objects neither take nor dim photons in the caustic layer");
+}
+
+pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width, int height, int threads,
+                         uint64_t seed, const char *cl_device, size_t cl_max_bytes, double count_scale,
+                         volatile int *cancel, diag *d)
+{
+    memset(c, 0, sizeof *c);
+    c->asked = sc->global.photons.enabled;
+    if (!c->asked) return PT_OK;
+    not_modelled(c, sc, d);
+    c->sc = sc;
+    c->eps = accel_scale(a) * 1e-6;
+    gi_caustic_hooks hk = {hook_surface, hook_attenuation, c};
+    gi_caustic_settings s = {width, height, threads, seed, cl_device, cl_max_bytes, count_scale, cancel};
+    pt_status st = PT_OK;
+    c->layer = gi_caustic_build(sc, a, &s, &hk, d, &st);
+    if (c->layer) gi_caustic_get_stats(c->layer, &c->st);
+    else if (st == PT_OK) {
+        src_loc nowhere = {0};
+        diag_warn_once(d, nowhere, "photons: no light shoots photons at a photons { target } object: no caustics");
+    }
+    return st;
+}
+
+static rgb chained(void *ctx, const accel_hit *h, vec3 n, int thread)
+{
+    caustics *c = ctx;
+    rgb e = gi_caustic_at(c->layer, h, n, thread);
+    if (c->next) {
+        rgb f = c->next(c->next_ctx, h, n, thread);
+        e.r += f.r;
+        e.g += f.g;
+        e.b += f.b;
+    }
+    return e;
+}
+
+void caustics_attach(caustics *c, shade_settings *ss)
+{
+    if (!c->layer) return;
+    c->next = ss->indirect;
+    c->next_ctx = ss->indirect_ctx;
+    ss->indirect = chained;
+    ss->indirect_ctx = c;
+    ss->photon_shadows = 1;
+}
+
+void caustics_free(caustics *c)
+{
+    if (c->layer) gi_caustic_get_stats(c->layer, &c->st);
+    gi_caustic_free(c->layer);
+    c->layer = NULL;
+}
+
+void caustics_json(caustics *c, stats_json *js)
+{
+    if (!c->asked) return;
+    if (c->layer) gi_caustic_get_stats(c->layer, &c->st);
+    const gi_caustic_stats *s = &c->st;
+    stats_obj_begin(js, "caustics");
+    stats_str(js, "device", s->device);
+    stats_int(js, "pairs", s->combos);
+    stats_num(js, "spacing", s->spacing);
+    stats_int(js, "emitted", s->emitted);
+    stats_int(js, "first_hits", s->first_hits);
+    stats_int(js, "absorbed_at_bounce_map", s->absorbed_first);
+    stats_obj_begin(js, "alive_after_bounce");
+    for (int b = 1; b <= s->max_bounce; b++) {
+        char k[16];
+        snprintf(k, sizeof k, "%d", b);
+        stats_int(js, k, s->alive[b]);
+    }
+    stats_obj_end(js);
+    stats_int(js, "stored", s->stored);
+    stats_num(js, "r_median", s->r_median);
+    stats_int(js, "rays", s->rays);
+    stats_int(js, "tile_entries", s->tile_entries);
+    stats_int(js, "lookups_gbuffer", s->lookups_gbuffer);
+    stats_int(js, "lookups_photons", s->lookups_photons);
+    stats_obj_begin(js, "seconds");
+    stats_num(js, "trace", s->t_trace);
+    stats_num(js, "gbuffer", s->t_gbuffer);
+    stats_num(js, "bin", s->t_bin);
+    stats_num(js, "splat", s->t_splat);
+    stats_obj_end(js);
+    stats_obj_begin(js, "not_modelled");
+    const caustics_not_modelled *nm = &c->nm;
+    stats_int(js, "gather", nm->gather);
+    stats_int(js, "radius", nm->radius);
+    stats_int(js, "expand_thresholds", nm->expand_thresholds);
+    stats_int(js, "autostop", nm->autostop);
+    stats_int(js, "media", nm->media);
+    stats_int(js, "save_file", nm->save_file);
+    stats_int(js, "load_file", nm->load_file);
+    stats_int(js, "dispersion", nm->dispersion);
+    stats_int(js, "media_objects", nm->media_objects);
+    stats_obj_end(js);
+    stats_obj_end(js);
+}

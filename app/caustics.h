@@ -1,0 +1,49 @@
+/* caustics.h - the caustic layer (gi/gi_caustic.h) wired to the shader: its
+ * material and light hooks from shade/ (the one BSDF of shade_material.h,
+ * shade_light_attenuation), what the scene's photon settings ask that is
+ * not modelled (counted and warned once), and the indirect hook that adds
+ * the layer to `--gi none` and `--gi particle`. */
+#ifndef PT_CAUSTICS_H
+#define PT_CAUSTICS_H
+#include "accel.h"
+#include "diag.h"
+#include "gi_caustic.h"
+#include "scene.h"
+#include "shade.h"
+#include "stats_json.h"
+
+/* Photon settings a scene uses that the caustic layer does not model: 1
+ * where used (each also warned once by caustics_build). */
+typedef struct {
+    int gather, radius, expand_thresholds, autostop, media, save_file, load_file;
+    int dispersion;     /* a target's interior has dispersion (photons carry no wavelength) */
+    int media_objects;  /* photons would cross media in objects (not deposited or attenuated) */
+} caustics_not_modelled;
+
+typedef struct {
+    gi_caustic *layer;  /* NULL: the scene shoots no photons (or the mode takes none) */
+    gi_caustic_stats st;
+    caustics_not_modelled nm;
+    int asked;          /* the scene has an enabled global photons block */
+    /* the indirect hook chained behind the layer's (particle GI), NULL none */
+    shade_indirect_fn next;
+    void *next_ctx;
+    const scene *sc;    /* the hooks' scene and offset epsilon (shade.c's rule) */
+    double eps;
+} caustics;
+
+/* Builds the layer (c must stay where it is while the layer is used: it
+ * is the hooks' context) for a w x h image when the scene asks for photons;
+ * fills c (c->layer NULL when nothing shoots). count_scale: photons times
+ * this (0: the scene's). */
+pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width, int height, int threads,
+                         uint64_t seed, const char *cl_device, size_t cl_max_bytes, double count_scale,
+                         volatile int *cancel, diag *d);
+/* Puts the layer into shade settings: its indirect hook (after whatever
+ * hook ss has: that one is kept and summed) and POV-Ray's photon shadows. */
+void caustics_attach(caustics *c, shade_settings *ss);
+void caustics_free(caustics *c);
+/* "caustics": {...} in the stats (nothing when the scene asked for none). */
+void caustics_json(caustics *c, stats_json *js);
+
+#endif

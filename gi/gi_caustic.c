@@ -1,0 +1,926 @@
+/* gi_caustic.c - the caustic layer (see gi_caustic.h). */
+#include "gi_caustic.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "geom_extent.h"
+#include "gi_cl.h"
+#include "gi_cl_c.h"
+#include "pool.h"
+#include "timer.h"
+
+#define SKIP_MAX 64
+#define GBUF_LAYERS 8
+/* k of r_xy = k s_D / sqrt(rho_p): sqrt(20 / pi), so that an unfocused
+ * beam puts POV-Ray's default minimum gather count (20) within r_xy */
+#define RADIUS_K 2.5231325220201604
+#define CHUNK 2048
+
+static inline rgb crgb(double r, double g, double b)
+{
+    rgb c = {r, g, b};
+    return c;
+}
+static inline rgb cscale(rgb a, double k) { return crgb(a.r * k, a.g * k, a.b * k); }
+
+/* ------------------------------------------------------------ hash grid */
+
+/* Items (spheres) binned into cubic cells of edge `cell`: each item is
+ * listed in every cell its sphere's box touches, or in `big` when that is
+ * more than BIG_CELLS cells. Cells are found by hashing their integer
+ * coordinates; a collision only adds candidates that the exact tests drop. */
+#define BIG_CELLS 64
+typedef struct {
+    uint64_t key;
+    int id;
+} cell_entry;
+typedef struct {
+    double cell;
+    cell_entry *e;
+    long n;
+    int *big;
+    long nbig;
+} hgrid;
+
+static uint64_t cell_key(long ix, long iy, long iz)
+{
+    uint64_t h = (uint64_t)ix * 0x9E3779B97F4A7C15ULL ^ (uint64_t)iy * 0xC2B2AE3D27D4EB4FULL ^
+                 (uint64_t)iz * 0x165667B19E3779F9ULL;
+    h ^= h >> 29;
+    h *= 0xBF58476D1CE4E5B9ULL;
+    return h ^ (h >> 32);
+}
+
+static int entry_cmp(const void *a, const void *b)
+{
+    const cell_entry *x = a, *y = b;
+    if (x->key != y->key) return x->key < y->key ? -1 : 1;
+    return x->id - y->id;
+}
+
+static long cidx(double v, double cell) { return (long)floor(v / cell); }
+
+/* centres c (stride floats apart, 3 coordinates at c + i*stride) with radii r */
+static int hgrid_build(hgrid *g, double cell, long n, const float *c, size_t stride, const float *r, size_t rstride)
+{
+    memset(g, 0, sizeof *g);
+    g->cell = cell;
+    long cap = 0;
+    for (long i = 0; i < n; i++) {
+        const float *p = c + (size_t)i * stride;
+        double rad = r[(size_t)i * rstride];
+        long nx = cidx(p[0] + rad, cell) - cidx(p[0] - rad, cell) + 1;
+        long ny = cidx(p[1] + rad, cell) - cidx(p[1] - rad, cell) + 1;
+        long nz = cidx(p[2] + rad, cell) - cidx(p[2] - rad, cell) + 1;
+        long k = nx * ny * nz;
+        if (k > BIG_CELLS) g->nbig++;
+        else cap += k;
+    }
+    g->e = malloc(sizeof(cell_entry) * (size_t)(cap > 0 ? cap : 1));
+    g->big = malloc(sizeof(int) * (size_t)(g->nbig > 0 ? g->nbig : 1));
+    if (!g->e || !g->big) return 0;
+    g->nbig = 0;
+    for (long i = 0; i < n; i++) {
+        const float *p = c + (size_t)i * stride;
+        double rad = r[(size_t)i * rstride];
+        long x0 = cidx(p[0] - rad, cell), x1 = cidx(p[0] + rad, cell);
+        long y0 = cidx(p[1] - rad, cell), y1 = cidx(p[1] + rad, cell);
+        long z0 = cidx(p[2] - rad, cell), z1 = cidx(p[2] + rad, cell);
+        if ((x1 - x0 + 1) * (y1 - y0 + 1) * (z1 - z0 + 1) > BIG_CELLS) {
+            g->big[g->nbig++] = (int)i;
+            continue;
+        }
+        for (long x = x0; x <= x1; x++)
+            for (long y = y0; y <= y1; y++)
+                for (long z = z0; z <= z1; z++) g->e[g->n++] = (cell_entry){cell_key(x, y, z), (int)i};
+    }
+    qsort(g->e, (size_t)g->n, sizeof *g->e, entry_cmp);
+    return 1;
+}
+
+static void hgrid_free(hgrid *g)
+{
+    free(g->e);
+    free(g->big);
+    memset(g, 0, sizeof *g);
+}
+
+/* The entries of cell (x, y, z): [*lo, *hi). */
+static void hgrid_cell(const hgrid *g, long x, long y, long z, long *lo, long *hi)
+{
+    uint64_t k = cell_key(x, y, z);
+    long a = 0, b = g->n;
+    while (a < b) {
+        long m = (a + b) / 2;
+        if (g->e[m].key < k) a = m + 1;
+        else b = m;
+    }
+    long e = a;
+    while (e < g->n && g->e[e].key == k) e++;
+    *lo = a;
+    *hi = e;
+}
+
+/* ------------------------------------------------------------ the layer */
+
+typedef struct {
+    const scene_light *l;
+    const scene_object *target;
+    const scene_object **leaves; /* the target's leaf objects, sorted by address */
+    int nleaves;
+    int parallel;
+    vec3 origin;       /* light position (point-like) */
+    vec3 axis;         /* towards the target's centre / the parallel direction */
+    vec3 ctr;
+    double rad;
+    double cos_max;    /* cone of directions (point-like) */
+    int m;             /* bounce map: m x m cells */
+    double cell;       /* solid angle (point-like) or area (parallel) of a cell */
+    rgb phi0;          /* colour x cell */
+    long first;        /* index of its first cell among all */
+} combo;
+
+struct gi_caustic {
+    const scene *sc;
+    const accel *a;
+    gi_caustic_settings s;
+    gi_caustic_hooks hk;
+    double eps;
+    combo *cb;
+    int ncb;
+    long total;        /* bounce-map cells of all combos */
+    int max_level;
+    double adc;
+    double r_max;
+    /* photons */
+    gi_caus_photon *ph;
+    long nph;
+    hgrid pgrid;
+    /* G-buffer */
+    int w, h;
+    gi_caus_pixel *gb;
+    const scene_object **gobj;
+    float *grad;       /* per pixel footprint radius (0: invalid) */
+    hgrid ggrid;
+    float *img;        /* splat result, 4 floats a pixel */
+    int *tile_off, *tile_idx;
+    int tiles_x, tiles_y;
+    gi_dev *dev;
+    gi_caustic_stats st;
+};
+
+static int ptr_cmp(const void *a, const void *b)
+{
+    const void *x = *(const void *const *)a, *y = *(const void *const *)b;
+    return x < y ? -1 : x > y;
+}
+
+static int is_csg(const scene_object *o)
+{
+    return o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION ||
+           o->kind == SHAPE_DIFFERENCE;
+}
+
+static int count_leaves(const scene_object *o)
+{
+    if (!is_csg(o)) return 1;
+    int n = 0;
+    for (int i = 0; i < o->u.csg.nkids; i++) n += count_leaves(o->u.csg.kids[i]);
+    return n;
+}
+
+static void add_leaves(const scene_object *o, const scene_object **out, int *n)
+{
+    if (!is_csg(o)) {
+        out[(*n)++] = o;
+        return;
+    }
+    for (int i = 0; i < o->u.csg.nkids; i++) add_leaves(o->u.csg.kids[i], out, n);
+}
+
+static int in_target(const combo *c, const scene_object *o)
+{
+    return o && bsearch(&o, c->leaves, (size_t)c->nleaves, sizeof *c->leaves, ptr_cmp) != NULL;
+}
+
+static double cmax3(rgb c) { return fmax(c.r, fmax(c.g, c.b)); }
+
+/* POV-Ray's shooting targets (photonestimationtask.cpp
+ * SearchThroughObjectsEstimatePhotons): a target object as a whole, else
+ * the members of a CSG; objects with global lights off get no photons. */
+static int collect_targets(const scene_object *o, const scene_object ***list, int *n, int *cap)
+{
+    if (o->photons && o->photons->target) {
+        if (o->no_global_lights) return 1;
+        if (*n == *cap) {
+            int nc = *cap ? *cap * 2 : 16;
+            const scene_object **nl = realloc(*list, sizeof **list * (size_t)nc);
+            if (!nl) return 0;
+            *list = nl;
+            *cap = nc;
+        }
+        (*list)[(*n)++] = o;
+        return 1;
+    }
+    if (is_csg(o))
+        for (int i = 0; i < o->u.csg.nkids; i++)
+            if (!collect_targets(o->u.csg.kids[i], list, n, cap)) return 0;
+    return 1;
+}
+
+static int light_parallel(const scene_light *l) { return l->parallel || l->kind == LIGHT_PARALLEL || l->kind == LIGHT_CYLINDER; }
+
+/* POV-Ray's estimate of the photons one light-target pair shoots
+ * (photonestimationtask.cpp EstimatePhotonsForObjectAndLight), for spacing s. */
+static double pov_estimate(const scene_light *l, const scene_obj_photons *t, double rad, double s)
+{
+    double x = rad / (t->spacing * s);
+    x = x * x * M_PI;
+    int rfr = (l->ph_refraction || t->refraction) && !(l->ph_refraction_off || t->refraction_off);
+    int rfl = (l->ph_reflection || t->reflection) && !(l->ph_reflection_off || t->reflection_off);
+    if (rfr && rfl) x *= 1.5;
+    if (t->collect && rfr) x *= rfl ? 3.0 : 2.0;
+    return x * 0.5;
+}
+
+/* Equal-area map of [0,1)^2 onto the unit disc (Shirley and Chiu's
+ * concentric map): (rho, phi). */
+static void concentric(double u, double v, double *rho, double *phi)
+{
+    double a = 2.0 * u - 1.0, b = 2.0 * v - 1.0;
+    if (a == 0.0 && b == 0.0) {
+        *rho = 0.0;
+        *phi = 0.0;
+    } else if (fabs(a) > fabs(b)) {
+        *rho = a;
+        *phi = (M_PI / 4.0) * (b / a);
+    } else {
+        *rho = b;
+        *phi = M_PI / 2.0 - (M_PI / 4.0) * (a / b);
+    }
+    if (*rho < 0.0) {
+        *rho = -*rho;
+        *phi += M_PI;
+    }
+}
+
+typedef struct {
+    gi_caus_photon *p;
+    long n, cap;
+    long rays, first_hits, absorbed_first;
+    long alive[GI_CAUSTIC_MAX_BOUNCES + 1];
+    int oom;
+} chunk_out;
+
+static int push_photon(chunk_out *o, const gi_caus_photon *q)
+{
+    if (o->n == o->cap) {
+        long nc = o->cap ? o->cap * 2 : 256;
+        gi_caus_photon *np = realloc(o->p, sizeof *np * (size_t)nc);
+        if (!np) return 0;
+        o->p = np;
+        o->cap = nc;
+    }
+    o->p[o->n++] = *q;
+    return 1;
+}
+
+/* Next hit of a photon ray: no_shadow objects are invisible to photon rays
+ * (POV-Ray trace.cpp: a photon ray skips NO_SHADOW objects) and
+ * pass_through objects let it through unchanged. */
+static int photon_hit(const gi_caustic *c, const accel_from *from, vec3 o, vec3 w, accel_hit *h, long *rays)
+{
+    double tmin = c->eps;
+    for (int k = 0; k < SKIP_MAX; k++) {
+        (*rays)++;
+        if (!accel_intersect_from(c->a, k == 0 ? from : NULL, o, w, tmin, INFINITY, h)) return 0;
+        int pass = (h->flags & OBJ_NO_SHADOW) || (h->obj && h->obj->photons && h->obj->photons->pass_through);
+        if (!pass) return 1;
+        tmin = h->t + fmax(c->eps, h->t * 1e-7);
+    }
+    return 0;
+}
+
+/* One bounce-map cell: the photon's direction (and origin), then its path. */
+static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_out *out)
+{
+    const scene_light *l = cb->l;
+    rng r;
+    rng_seed(&r, c->s.seed ^ 0x6361757374696373ULL, (uint64_t)(cb->first + cell));
+    int i = (int)(cell % cb->m), j = (int)(cell / cb->m);
+    double jit = c->sc->global.photons.jitter;
+    double u = (i + 0.5 + jit * (rng_f64(&r) - 0.5)) / cb->m, v = (j + 0.5 + jit * (rng_f64(&r) - 0.5)) / cb->m;
+    u = fmin(fmax(u, 0.0), 1.0 - 1e-12);
+    v = fmin(fmax(v, 0.0), 1.0 - 1e-12);
+    double rho, ang;
+    concentric(u, v, &rho, &ang);
+    vec3 t, b;
+    v3_basis(cb->axis, &t, &b);
+    vec3 o, w;
+    if (cb->parallel) {
+        vec3 q = v3_add(cb->ctr, v3_add(v3_scale(t, cb->rad * rho * cos(ang)), v3_scale(b, cb->rad * rho * sin(ang))));
+        o = v3_sub(q, v3_scale(cb->axis, v3_dot(v3_sub(q, l->position), cb->axis)));
+        w = cb->axis;
+    } else {
+        /* equal area: the cap fraction (1 - cos) / (1 - cos_max) is rho^2 */
+        double ct = 1.0 - rho * rho * (1.0 - cb->cos_max), st = sqrt(fmax(0.0, 1.0 - ct * ct));
+        w = v3_add(v3_add(v3_scale(t, st * cos(ang)), v3_scale(b, st * sin(ang))), v3_scale(cb->axis, ct));
+        o = cb->origin;
+        if (l->area && l->ph_area_light && l->size1 * l->size2 > 1) {
+            /* photons { area_light }: POV-Ray shoots every grid point per
+             * direction with 1/(size1 size2) of the colour; one point per
+             * cell here, in turn, with the full colour: the same density */
+            int np = l->size1 * l->size2, k = (int)((cb->first + cell) % np);
+            o = v3_add(o, scene_light_area_point(l, l->axis1, l->axis2, k / l->size2, k % l->size2, &r));
+        }
+    }
+    accel_hit h;
+    accel_from from, *fp = NULL;
+    double depth = 0.0, rho_p = 1.0;
+    rgb tr = {1, 1, 1};
+    vec3 p_first = o;
+    for (int level = 0;; level++) {
+        if (!photon_hit(c, fp, o, w, &h, &out->rays)) return;
+        depth += h.t;
+        if (level == 0) {
+            /* the first hit must be the target (POV-Ray's PhotonTrace) */
+            if (!in_target(cb, h.obj)) return;
+            out->first_hits++;
+            p_first = h.p;
+        }
+        gi_caustic_step step;
+        int sf = c->hk.surface(c->hk.ctx, &h, w, &r, &step);
+        const scene_obj_photons *ph = h.obj ? h.obj->photons : NULL;
+        if (level >= 1 && (sf & GI_CAUSTIC_RECEIVES) && !(ph && !ph->collect) && scene_light_reaches(l, h.obj)) {
+            /* store the photon before this bounce (paper, step 1(d)) */
+            double att = c->hk.attenuation(c->hk.ctx, l, p_first, depth);
+            double k = att * (cb->parallel ? 1.0 : depth * depth);
+            double sd = cb->parallel ? sqrt(cb->cell) : depth * sqrt(cb->cell);
+            double rxy = fmin(RADIUS_K * sd / sqrt(rho_p), c->r_max);
+            vec3 np = v3_dot(h.ng, w) < 0.0 ? h.ng : v3_neg(h.ng);
+            gi_caus_photon q = {{(float)h.p.x, (float)h.p.y, (float)h.p.z},
+                                (float)rxy,
+                                {(float)np.x, (float)np.y, (float)np.z},
+                                (float)(0.25 * rxy),
+                                {(float)-w.x, (float)-w.y, (float)-w.z},
+                                0.0f,
+                                {(float)(cb->phi0.r * tr.r * k), (float)(cb->phi0.g * tr.g * k), (float)(cb->phi0.b * tr.b * k)},
+                                0.0f};
+            if (rxy > 0.0 && isfinite(q.phi[0] + q.phi[1] + q.phi[2]) && cmax3(crgb(q.phi[0], q.phi[1], q.phi[2])) > 0.0)
+                if (!push_photon(out, &q)) {
+                    out->oom = 1;
+                    return;
+                }
+        }
+        if (level + 1 >= c->max_level || level >= GI_CAUSTIC_MAX_BOUNCES) return;
+        if (!(sf & GI_CAUSTIC_CONTINUES)) {
+            /* absorbed by the roulette, or its Lambertian lobe was chosen */
+            if (level == 0) out->absorbed_first++;
+            return;
+        }
+        if (!scene_photon_lobe(l, ph, step.refract)) return;
+        tr = crgb(tr.r * step.weight.r, tr.g * step.weight.g, tr.b * step.weight.b);
+        rho_p *= fmin(1.0, fmax(step.rho, 1e-6));
+        if (!(cmax3(tr) >= c->adc) || !isfinite(tr.r + tr.g + tr.b)) return;
+        out->alive[level + 1]++;
+        o = step.org;
+        w = step.dir;
+        from = step.from;
+        fp = &from;
+    }
+}
+
+typedef struct {
+    gi_caustic *c;
+    chunk_out *outs;
+} trace_job;
+
+static void trace_chunk(void *ctx, int ci, int thread)
+{
+    (void)thread;
+    trace_job *tj = ctx;
+    gi_caustic *c = tj->c;
+    if (c->s.cancel && *c->s.cancel) return;
+    long i0 = (long)ci * CHUNK, i1 = i0 + CHUNK < c->total ? i0 + CHUNK : c->total;
+    int k = 0;
+    for (long i = i0; i < i1 && !tj->outs[ci].oom; i++) {
+        while (k < c->ncb - 1 && i >= c->cb[k + 1].first) k++;
+        trace_cell(c, &c->cb[k], i - c->cb[k].first, &tj->outs[ci]);
+    }
+}
+
+/* ------------------------------------------------------------ setup */
+
+static pt_status make_combos(gi_caustic *c, diag *d)
+{
+    const scene *sc = c->sc;
+    const scene_object **tg = NULL;
+    int nt = 0, cap = 0;
+    for (int i = 0; i < sc->nobjects; i++)
+        if (!collect_targets(sc->objects[i], &tg, &nt, &cap)) {
+            free(tg);
+            return PT_ERR_NOMEM;
+        }
+    c->cb = calloc((size_t)(nt * sc->nlights + 1), sizeof *c->cb);
+    if (!c->cb) {
+        free(tg);
+        return PT_ERR_NOMEM;
+    }
+    src_loc nowhere = {0};
+    for (int li = 0; li < sc->nlights; li++) {
+        const scene_light *l = &sc->lights[li];
+        if (cmax3(l->colour) <= 0.0) continue;
+        for (int ti = 0; ti < nt; ti++) {
+            const scene_object *t = tg[ti];
+            if (!scene_photon_shoots(l, t->photons)) continue;
+            vec3 lo, hi;
+            const char *what = NULL;
+            if (geom_extent(t, &lo, &hi, &what) != 0 || !(fabs(lo.x) < 1e9 && fabs(hi.x) < 1e9 && fabs(lo.y) < 1e9 &&
+                                                         fabs(hi.y) < 1e9 && fabs(lo.z) < 1e9 && fabs(hi.z) < 1e9)) {
+                diag_warn_once(d, t->photons->loc, "photons: target without a finite bounding box (%s) gets no photons",
+                               what ? what : t->name);
+                continue;
+            }
+            combo *cb = &c->cb[c->ncb];
+            cb->l = l;
+            cb->target = t;
+            cb->ctr = v3_scale(v3_add(lo, hi), 0.5);
+            cb->rad = 0.5 * v3_len(v3_sub(hi, lo));
+            cb->parallel = light_parallel(l);
+            int n = count_leaves(t);
+            cb->leaves = malloc(sizeof *cb->leaves * (size_t)n);
+            if (!cb->leaves) {
+                free(tg);
+                return PT_ERR_NOMEM;
+            }
+            add_leaves(t, cb->leaves, &cb->nleaves);
+            qsort(cb->leaves, (size_t)cb->nleaves, sizeof *cb->leaves, ptr_cmp);
+            c->ncb++;
+        }
+    }
+    free(tg);
+    (void)nowhere;
+    return PT_OK;
+}
+
+/* The global spacing (POV-Ray: `count` rescales it from the estimate of
+ * all pairs), then each pair's bounce map. */
+static void size_combos(gi_caustic *c)
+{
+    const scene_photons *ps = &c->sc->global.photons;
+    double s = ps->spacing > 0.0 ? ps->spacing : 1.0;
+    if (ps->count > 0) {
+        double est = 0.0;
+        for (int i = 0; i < c->ncb; i++) est += pov_estimate(c->cb[i].l, c->cb[i].target->photons, c->cb[i].rad, s);
+        if (est > 0.0) s *= sqrt(est / ps->count);
+    }
+    if (c->s.count_scale > 0.0) s /= sqrt(c->s.count_scale);
+    c->st.spacing = s;
+    long total = 0;
+    for (int i = 0; i < c->ncb; i++) {
+        combo *cb = &c->cb[i];
+        const scene_light *l = cb->l;
+        double spread = cb->target->photons->spacing * s;
+        double n;
+        if (cb->parallel) {
+            cb->axis = v3_norm(v3_sub(l->point_at, l->position));
+            n = M_PI * cb->rad * cb->rad / (spread * spread);
+        } else {
+            cb->origin = l->position;
+            vec3 to = v3_sub(cb->ctr, l->position);
+            double dist = v3_len(to);
+            cb->axis = dist > 0.0 ? v3_scale(to, 1.0 / dist) : v3(0, 0, 1);
+            if (dist > cb->rad) {
+                double sa = cb->rad / dist;
+                cb->cos_max = sqrt(fmax(0.0, 1.0 - sa * sa));
+            } else {
+                cb->cos_max = -1.0;
+                dist = cb->rad;
+            }
+            /* POV-Ray's angular step atan(spread / dist) in both angles */
+            double dt = atan(spread / dist);
+            n = 2.0 * M_PI * (1.0 - cb->cos_max) / (dt * dt);
+        }
+        int m = (int)ceil(sqrt(fmin(fmax(n, 1.0), 4e8)));
+        cb->m = m;
+        long cells = (long)m * m;
+        cb->cell = cb->parallel ? M_PI * cb->rad * cb->rad / cells : 2.0 * M_PI * (1.0 - cb->cos_max) / cells;
+        cb->phi0 = cscale(l->colour, cb->cell);
+        cb->first = total;
+        total += cells;
+    }
+    c->total = total;
+}
+
+/* ------------------------------------------------------------ G-buffer */
+
+typedef struct {
+    gi_caustic *c;
+} gb_job;
+
+static void gbuf_row(void *ctx, int y, int thread)
+{
+    (void)thread;
+    gi_caustic *c = ((gb_job *)ctx)->c;
+    const scene *sc = c->sc;
+    for (int x = 0; x < c->w; x++) {
+        size_t k = (size_t)y * c->w + x;
+        gi_caus_pixel *px = &c->gb[k];
+        memset(px, 0, sizeof *px);
+        c->gobj[k] = NULL;
+        c->grad[k] = 0.0f;
+        vec3 o, d, o1, d1, o2, d2;
+        scene_camera_ray(&sc->camera, x + 0.5, y + 0.5, c->w, c->h, &o, &d);
+        scene_camera_ray(&sc->camera, x + 1.5, y + 0.5, c->w, c->h, &o1, &d1);
+        scene_camera_ray(&sc->camera, x + 0.5, y + 1.5, c->w, c->h, &o2, &d2);
+        rng r;
+        rng_seed(&r, c->s.seed ^ 0x67627566ULL, k);
+        double tmin = c->eps;
+        accel_hit h;
+        for (int layer = 0; layer < GBUF_LAYERS; layer++) {
+            if (!accel_intersect(c->a, o, d, tmin, INFINITY, &h)) break;
+            tmin = h.t + fmax(c->eps, h.t * 1e-7);
+            if (h.flags & OBJ_NO_IMAGE) continue;
+            const scene_obj_photons *ph = h.obj ? h.obj->photons : NULL;
+            if (ph && !ph->collect) continue;
+            if (!(c->hk.surface(c->hk.ctx, &h, d, &r, NULL) & GI_CAUSTIC_RECEIVES)) continue;
+            vec3 n = v3_dot(h.ng, d) < 0.0 ? h.ng : v3_neg(h.ng);
+            px->s[0] = (float)h.p.x;
+            px->s[1] = (float)h.p.y;
+            px->s[2] = (float)h.p.z;
+            px->valid = 1.0f;
+            px->n[0] = (float)n.x;
+            px->n[1] = (float)n.y;
+            px->n[2] = (float)n.z;
+            c->gobj[k] = h.obj;
+            /* footprint: the neighbouring pixels' rays at the same distance */
+            double t = h.t;
+            double f1 = v3_len(v3_sub(v3_madd(o1, d1, t), h.p)), f2 = v3_len(v3_sub(v3_madd(o2, d2, t), h.p));
+            c->grad[k] = (float)fmax(1.5 * fmax(f1, f2), 1e-6 * (t + 1.0));
+            break;
+        }
+    }
+}
+
+/* ------------------------------------------------------------ binning and splat */
+
+static int int_cmp(const void *a, const void *b) { return *(const int *)a - *(const int *)b; }
+
+typedef struct {
+    gi_caustic *c;
+    int **lists;
+    int *counts;
+    int *stamps;   /* threads x nph */
+} bin_job;
+
+static void bin_tile(void *ctx, int t, int thread)
+{
+    bin_job *bj = ctx;
+    gi_caustic *c = bj->c;
+    int tx = t % c->tiles_x, ty = t / c->tiles_x;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    int any = 0;
+    for (int y = ty * GI_CAUS_TILE; y < (ty + 1) * GI_CAUS_TILE && y < c->h; y++)
+        for (int x = tx * GI_CAUS_TILE; x < (tx + 1) * GI_CAUS_TILE && x < c->w; x++) {
+            const gi_caus_pixel *px = &c->gb[(size_t)y * c->w + x];
+            if (!(px->valid > 0.0f)) continue;
+            any = 1;
+            for (int k = 0; k < 3; k++) {
+                lo[k] = fmin(lo[k], px->s[k]);
+                hi[k] = fmax(hi[k], px->s[k]);
+            }
+        }
+    bj->lists[t] = NULL;
+    bj->counts[t] = 0;
+    if (!any || c->nph == 0) return;
+    int *stamp = bj->stamps + (size_t)thread * (size_t)c->nph;
+    int n = 0, cap = 0;
+    int *list = NULL;
+    double cell = c->pgrid.cell;
+    long x0 = cidx(lo[0], cell), x1 = cidx(hi[0], cell), y0 = cidx(lo[1], cell), y1 = cidx(hi[1], cell);
+    long z0 = cidx(lo[2], cell), z1 = cidx(hi[2], cell);
+    double ncells = (double)(x1 - x0 + 1) * (double)(y1 - y0 + 1) * (double)(z1 - z0 + 1);
+    int brute = ncells > (double)c->nph;
+    /* candidates: every photon (brute), or the photons of the cells the box
+     * touches and the big ones; exact test: the kernel sphere meets the box */
+    for (int pass = 0; pass < 2; pass++) {
+        long nbig = pass == 0 ? c->pgrid.nbig : 0;
+        if (pass == 1 && brute) break;
+        for (long xi = pass ? x0 : 0; pass ? xi <= x1 : xi < 1; xi++)
+            for (long yi = pass ? y0 : 0; pass ? yi <= y1 : yi < 1; yi++)
+                for (long zi = pass ? z0 : 0; pass ? zi <= z1 : zi < 1; zi++) {
+                    long a = 0, b = 0;
+                    if (pass) hgrid_cell(&c->pgrid, xi, yi, zi, &a, &b);
+                    long m = pass ? b - a : (brute ? c->nph : nbig);
+                    for (long q = 0; q < m; q++) {
+                        int id = pass ? c->pgrid.e[a + q].id : (brute ? (int)q : c->pgrid.big[q]);
+                        if (stamp[id] == t + 1) continue;
+                        stamp[id] = t + 1;
+                        const gi_caus_photon *p = &c->ph[id];
+                        double dd = 0.0;
+                        for (int k = 0; k < 3; k++) {
+                            double e = p->x[k] < lo[k] ? lo[k] - p->x[k] : (p->x[k] > hi[k] ? p->x[k] - hi[k] : 0.0);
+                            dd += e * e;
+                        }
+                        if (dd > (double)p->r_xy * p->r_xy) continue;
+                        if (n == cap) {
+                            int nc = cap ? cap * 2 : 256;
+                            int *nl = realloc(list, sizeof(int) * (size_t)nc);
+                            if (!nl) {
+                                free(list);
+                                bj->counts[t] = -1;
+                                return;
+                            }
+                            list = nl;
+                            cap = nc;
+                        }
+                        list[n++] = id;
+                    }
+                }
+    }
+    /* ascending photon order: the sums do not depend on the binning */
+    if (n > 1) qsort(list, (size_t)n, sizeof(int), int_cmp);
+    bj->lists[t] = list;
+    bj->counts[t] = n;
+}
+
+static pt_status bin_and_splat(gi_caustic *c, diag *d)
+{
+    double t0 = timer_now();
+    int nt = c->tiles_x * c->tiles_y;
+    int threads = c->s.threads > 0 ? c->s.threads : pool_default_threads();
+    bin_job bj = {c, calloc((size_t)nt, sizeof(int *)), calloc((size_t)nt, sizeof(int)),
+                  calloc((size_t)threads * (size_t)(c->nph > 0 ? c->nph : 1), sizeof(int))};
+    free(c->tile_off);
+    free(c->tile_idx);
+    c->tile_off = malloc(sizeof(int) * (size_t)(nt + 1));
+    pt_status st = PT_OK;
+    if (!bj.lists || !bj.counts || !bj.stamps || !c->tile_off) st = PT_ERR_NOMEM;
+    if (st == PT_OK) {
+        pool_run(threads, nt, bin_tile, &bj);
+        long tot = 0;
+        for (int t = 0; t < nt; t++) {
+            if (bj.counts[t] < 0) st = PT_ERR_NOMEM;
+            c->tile_off[t] = (int)tot;
+            tot += bj.counts[t] > 0 ? bj.counts[t] : 0;
+        }
+        c->tile_off[nt] = (int)tot;
+        c->st.tile_entries = tot;
+        c->tile_idx = malloc(sizeof(int) * (size_t)(tot > 0 ? tot : 1));
+        if (!c->tile_idx) st = PT_ERR_NOMEM;
+        for (int t = 0; t < nt && st == PT_OK; t++)
+            if (bj.counts[t] > 0) memcpy(c->tile_idx + c->tile_off[t], bj.lists[t], sizeof(int) * (size_t)bj.counts[t]);
+    } else {
+        c->tile_idx = NULL;
+    }
+    if (bj.lists)
+        for (int t = 0; t < nt; t++) free(bj.lists[t]);
+    free(bj.lists);
+    free(bj.counts);
+    free(bj.stamps);
+    c->st.t_bin = timer_now() - t0;
+    if (st != PT_OK) return st;
+    t0 = timer_now();
+    st = gi_dev_caustic_splat(c->dev, c->ph, (int)c->nph, c->tile_off, nt, c->tile_idx, c->gb, c->w, c->h, c->tiles_x,
+                              c->img, d);
+    c->st.t_splat = timer_now() - t0;
+    return st;
+}
+
+/* ------------------------------------------------------------ build */
+
+static int float_cmp(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double median_of(const float *v, long n, size_t stride)
+{
+    if (n <= 0) return 0.0;
+    float *t = malloc(sizeof(float) * (size_t)n);
+    if (!t) return v[0];
+    long m = 0;
+    for (long i = 0; i < n; i++)
+        if (v[(size_t)i * stride] > 0.0f) t[m++] = v[(size_t)i * stride];
+    double r = 0.0;
+    if (m > 0) {
+        qsort(t, (size_t)m, sizeof(float), float_cmp);
+        r = t[m / 2];
+    }
+    free(t);
+    return r;
+}
+
+gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_settings *s, const gi_caustic_hooks *hk,
+                             diag *d, pt_status *status)
+{
+    *status = PT_OK;
+    if (!sc->global.photons.enabled) return NULL;
+    gi_caustic *c = calloc(1, sizeof *c);
+    if (!c) {
+        *status = PT_ERR_NOMEM;
+        return NULL;
+    }
+    c->sc = sc;
+    c->a = a;
+    c->s = *s;
+    c->hk = *hk;
+    c->eps = accel_scale(a) * 1e-6;
+    c->r_max = 0.05 * accel_scale(a);
+    const scene_photons *ps = &sc->global.photons;
+    c->max_level = ps->max_trace_level >= 0 ? ps->max_trace_level : sc->global.max_trace_level;
+    c->adc = ps->adc_bailout >= 0.0 ? ps->adc_bailout : sc->global.adc_bailout;
+    pt_status st = make_combos(c, d);
+    if (st != PT_OK || c->ncb == 0) {
+        gi_caustic_free(c);
+        *status = st;
+        return NULL;
+    }
+    size_combos(c);
+    c->st.combos = c->ncb;
+    c->st.emitted = c->total;
+
+    /* steps 1 and 2: bounce map and world-space bounces */
+    double t0 = timer_now();
+    int threads = s->threads > 0 ? s->threads : pool_default_threads();
+    int nchunks = (int)((c->total + CHUNK - 1) / CHUNK);
+    trace_job tj = {c, calloc((size_t)(nchunks > 0 ? nchunks : 1), sizeof(chunk_out))};
+    if (!tj.outs) st = PT_ERR_NOMEM;
+    if (st == PT_OK) pool_run(threads, nchunks, trace_chunk, &tj);
+    long nph = 0;
+    for (int i = 0; tj.outs && i < nchunks; i++) {
+        if (tj.outs[i].oom) st = PT_ERR_NOMEM;
+        nph += tj.outs[i].n;
+        c->st.rays += tj.outs[i].rays;
+        c->st.first_hits += tj.outs[i].first_hits;
+        c->st.absorbed_first += tj.outs[i].absorbed_first;
+        for (int b = 0; b <= GI_CAUSTIC_MAX_BOUNCES; b++) c->st.alive[b] += tj.outs[i].alive[b];
+    }
+    if (st == PT_OK) {
+        c->ph = malloc(sizeof *c->ph * (size_t)(nph > 0 ? nph : 1));
+        if (!c->ph) st = PT_ERR_NOMEM;
+    }
+    for (int i = 0; tj.outs && i < nchunks; i++) {
+        if (st == PT_OK && tj.outs[i].n) memcpy(c->ph + c->nph, tj.outs[i].p, sizeof *c->ph * (size_t)tj.outs[i].n);
+        if (st == PT_OK) c->nph += tj.outs[i].n;
+        free(tj.outs[i].p);
+    }
+    free(tj.outs);
+    for (int b = 1; b <= GI_CAUSTIC_MAX_BOUNCES; b++)
+        if (c->st.alive[b] > 0) c->st.max_bounce = b;
+    c->st.stored = c->nph;
+    c->st.t_trace = timer_now() - t0;
+    if (st != PT_OK || (s->cancel && *s->cancel)) {
+        gi_caustic_free(c);
+        *status = st;
+        return NULL;
+    }
+    c->st.r_median = median_of(&c->ph[0].r_xy, c->nph, sizeof(gi_caus_photon) / sizeof(float));
+    double pcell = 2.0 * (c->st.r_median > 0.0 ? c->st.r_median : accel_scale(a) * 1e-3);
+    if (!hgrid_build(&c->pgrid, pcell, c->nph, c->ph[0].x, sizeof(gi_caus_photon) / sizeof(float), &c->ph[0].r_xy,
+                     sizeof(gi_caus_photon) / sizeof(float))) {
+        gi_caustic_free(c);
+        *status = PT_ERR_NOMEM;
+        return NULL;
+    }
+
+    /* step 2 of the paper's frame: the eye G-buffer */
+    t0 = timer_now();
+    c->w = s->width;
+    c->h = s->height;
+    size_t npx = (size_t)c->w * (size_t)c->h;
+    c->gb = calloc(npx ? npx : 1, sizeof *c->gb);
+    c->gobj = calloc(npx ? npx : 1, sizeof *c->gobj);
+    c->grad = calloc(npx ? npx : 1, sizeof *c->grad);
+    c->img = calloc(npx ? npx * 4 : 4, sizeof *c->img);
+    c->tiles_x = (c->w + GI_CAUS_TILE - 1) / GI_CAUS_TILE;
+    c->tiles_y = (c->h + GI_CAUS_TILE - 1) / GI_CAUS_TILE;
+    if (!c->gb || !c->gobj || !c->grad || !c->img) {
+        gi_caustic_free(c);
+        *status = PT_ERR_NOMEM;
+        return NULL;
+    }
+    gb_job gj = {c};
+    pool_run(threads, c->h, gbuf_row, &gj);
+    double gcell = 2.0 * median_of(c->grad, (long)npx, 1);
+    if (!(gcell > 0.0)) gcell = accel_scale(a) * 1e-3;
+    if (!hgrid_build(&c->ggrid, gcell, (long)npx, c->gb[0].s, sizeof(gi_caus_pixel) / sizeof(float), c->grad, 1)) {
+        gi_caustic_free(c);
+        *status = PT_ERR_NOMEM;
+        return NULL;
+    }
+    c->st.t_gbuffer = timer_now() - t0;
+
+    /* step 4: photon volumes over the G-buffer, on the GI device */
+    gi_dev_options o = {s->cl_device, NULL, s->threads, s->cl_max_bytes};
+    c->dev = gi_dev_open(&o, d, &st);
+    if (c->dev) snprintf(c->st.device, sizeof c->st.device, "%s", gi_dev_name(c->dev));
+    if (st == PT_OK) st = bin_and_splat(c, d);
+    if (st != PT_OK) {
+        gi_caustic_free(c);
+        *status = st;
+        return NULL;
+    }
+    return c;
+}
+
+pt_status gi_caustic_resplat(gi_caustic *c, double *t_bin, double *t_splat, diag *d)
+{
+    pt_status st = bin_and_splat(c, d);
+    if (t_bin) *t_bin = c->st.t_bin;
+    if (t_splat) *t_splat = c->st.t_splat;
+    return st;
+}
+
+void gi_caustic_free(gi_caustic *c)
+{
+    if (!c) return;
+    for (int i = 0; i < c->ncb; i++) free(c->cb[i].leaves);
+    free(c->cb);
+    free(c->ph);
+    hgrid_free(&c->pgrid);
+    hgrid_free(&c->ggrid);
+    free(c->gb);
+    free(c->gobj);
+    free(c->grad);
+    free(c->img);
+    free(c->tile_off);
+    free(c->tile_idx);
+    gi_dev_free(c->dev);
+    free(c);
+}
+
+void gi_caustic_get_stats(const gi_caustic *c, gi_caustic_stats *st)
+{
+    *st = c->st;
+    st->lookups_gbuffer = __atomic_load_n(&c->st.lookups_gbuffer, __ATOMIC_RELAXED);
+    st->lookups_photons = __atomic_load_n(&c->st.lookups_photons, __ATOMIC_RELAXED);
+}
+
+const gi_caus_photon *gi_caustic_photons(const gi_caustic *c, long *n)
+{
+    *n = c->nph;
+    return c->ph;
+}
+const float *gi_caustic_image(const gi_caustic *c) { return c->img; }
+const gi_caus_pixel *gi_caustic_gbuffer(const gi_caustic *c) { return c->gb; }
+
+/* ------------------------------------------------------------ lookups */
+
+rgb gi_caustic_at(void *ctx, const accel_hit *h, vec3 n, int thread)
+{
+    (void)thread;
+    gi_caustic *c = ctx;
+    rgb e = {0, 0, 0};
+    if (!h || !h->obj || (h->obj->photons && !h->obj->photons->collect)) return e;
+    vec3 p = h->p;
+    /* the G-buffer points of the same surface whose footprint holds p */
+    long lo, hi;
+    double cell = c->ggrid.cell;
+    hgrid_cell(&c->ggrid, cidx(p.x, cell), cidx(p.y, cell), cidx(p.z, cell), &lo, &hi);
+    double ws = 0.0;
+    for (int pass = 0; pass < 2; pass++) {
+        long m = pass ? c->ggrid.nbig : hi - lo;
+        for (long q = 0; q < m; q++) {
+            int i = pass ? c->ggrid.big[q] : c->ggrid.e[lo + q].id;
+            if (c->gobj[i] != h->obj) continue;
+            const gi_caus_pixel *px = &c->gb[i];
+            if (px->n[0] * n.x + px->n[1] * n.y + px->n[2] * n.z < 0.7) continue;
+            double dx = px->s[0] - p.x, dy = px->s[1] - p.y, dz = px->s[2] - p.z;
+            double dist = sqrt(dx * dx + dy * dy + dz * dz), r = c->grad[i];
+            if (dist >= r) continue;
+            double wgt = 1.0 - dist / r;
+            const float *v = &c->img[4 * (size_t)i];
+            e.r += wgt * v[0];
+            e.g += wgt * v[1];
+            e.b += wgt * v[2];
+            ws += wgt;
+        }
+    }
+    if (ws > 0.0) {
+        __atomic_fetch_add(&c->st.lookups_gbuffer, 1, __ATOMIC_RELAXED);
+        return cscale(e, 1.0 / ws);
+    }
+    /* elsewhere: the same photon volumes, summed at p */
+    __atomic_fetch_add(&c->st.lookups_photons, 1, __ATOMIC_RELAXED);
+    float s[3] = {(float)p.x, (float)p.y, (float)p.z}, nn[3] = {(float)n.x, (float)n.y, (float)n.z}, acc[3] = {0, 0, 0};
+    cell = c->pgrid.cell;
+    hgrid_cell(&c->pgrid, cidx(p.x, cell), cidx(p.y, cell), cidx(p.z, cell), &lo, &hi);
+    for (long q = lo; q < hi; q++) {
+        float one[3];
+        gi_c_caustic_at(c->ph, &c->pgrid.e[q].id, 1, s, nn, one);
+        acc[0] += one[0];
+        acc[1] += one[1];
+        acc[2] += one[2];
+    }
+    if (c->pgrid.nbig) {
+        float one[3];
+        gi_c_caustic_at(c->ph, c->pgrid.big, (int)c->pgrid.nbig, s, nn, one);
+        acc[0] += one[0];
+        acc[1] += one[1];
+        acc[2] += one[2];
+    }
+    return crgb(acc[0], acc[1], acc[2]);
+}

@@ -1,0 +1,141 @@
+/* gi_caustic.h - the caustic layer: POV-Ray's photons{} rendered by
+ * image-space photon mapping (McGuire and Luebke, HPG 2009, seed 002).
+ *
+ * What the scene asks for (POV-Ray 3.7 semantics, core/scene_settings.h and
+ * scene_light.h): every light shoots photons at every object marked
+ * photons { target } for which their merged flags allow reflection or
+ * refraction (scene_photon_shoots); a photon's first hit must be that
+ * target (pass_through objects and no_shadow objects are passed; any other
+ * object ends it), later hits reflect or refract where scene_photon_lobe
+ * allows, and every hit after the first on a surface with a Lambertian
+ * term and `collect` on stores a photon. Photon count: the global spacing
+ * (times the target's multiplier) is the distance between neighbouring
+ * photons at the target, as POV-Ray's shooting grid spaces them; `count N`
+ * scales the spacing so that POV-Ray's own estimate of the number shot is
+ * N (photonestimationtask.cpp). Power: POV-Ray's lights do not fall off with
+ * distance, so a photon carries the light's colour times the area its
+ * direction cell covers at its path length D (colour x solid angle x D^2,
+ * times fade at D and the spot/cylinder attenuation), POV-Ray's
+ * addSurfacePhoton rule; parallel lights colour x cell area.
+ *
+ * The method (the paper's algorithm, section 2 of the digest):
+ *  1. bounce map, per light and target: one photon per cell of a grid over
+ *     the cone of directions that holds the target's bounding sphere
+ *     (POV-Ray's box, geom_extent), equal solid angle per cell (so no
+ *     inverse-cosine correction is needed), jittered by the scene's
+ *     `jitter`; Embree finds the first hit; Russian roulette picks the
+ *     specular lobe (appendix A, through the hooks: the one BSDF of
+ *     shade_material.h) or absorbs the photon (power 0, counted);
+ *  2. world-space tracing of the further bounces, storing a photon before
+ *     each bounce on a receiving surface (bounce-map photons are not
+ *     stored), Russian roulette at each, up to the photons' max_trace_level
+ *     and adc_bailout;
+ *  3. path density rho_p, the product over bounces of the lobe's
+ *     reflectance (the paper's factor rho_S for mirror and refraction
+ *     bounces; caustic paths have no other), sets the photon volume's
+ *     radius: r_xy = k s_D / sqrt(rho_p), with s_D the spacing of the
+ *     photon's direction cell at its path length (the distance to its
+ *     neighbours had nothing focused it) and k = sqrt(20 / pi) (20 photons
+ *     within r_xy, POV-Ray's default minimum gather count); r_z = r_xy / 4;
+ *  4. eye G-buffer (paper step 2): the first receiving surface through each
+ *     pixel centre (non-receiving surfaces, e.g. clear glass, are passed
+ *     straight, so what lies behind them is in the buffer too);
+ *  5. the photon volumes scattered over the G-buffer (paper step 4,
+ *     equations 1-3) by the OpenCL kernel gi_k_caustic_splat
+ *     (gi/kernels/gi_caustic.cl; the C build runs the same code).
+ * The shader asks gi_caustic_at at every diffuse hit: a hit near a G-buffer
+ * point of the same object takes the splatted value of the nearest such
+ * points (weighted by distance within their pixel footprint); elsewhere
+ * (caustics seen in mirrors or through glass away from the G-buffer) the
+ * same photon volume sum is evaluated at the hit from the photon grid.
+ * Both counts are in the stats.
+ *
+ * Not modelled (the caller reports what the scene uses): photons in media,
+ * dispersion, the gather/radius/expand_thresholds/autostop settings (the
+ * radius comes from the heuristic above; the bounce map covers the whole
+ * cone, so autostop has nothing to cut short), save_file/load_file, light
+ * groups beyond scene_light_reaches at the storing surface. */
+#ifndef PT_GI_CAUSTIC_H
+#define PT_GI_CAUSTIC_H
+#include <stdint.h>
+#include "accel.h"
+#include "diag.h"
+#include "rng.h"
+#include "scene.h"
+#include "kernels/gi_types.h"
+
+typedef struct gi_caustic gi_caustic;
+
+/* A specular bounce chosen by Russian roulette. */
+typedef struct {
+    vec3 org, dir;   /* continuation ray, origin off the right side */
+    rgb weight;      /* flux multiplier: the lobe's colour / its probability (and the flux's ior factor) */
+    double rho;      /* the lobe's reflectance (max channel), for the path density */
+    int refract;     /* 1 refraction, 0 reflection */
+    accel_from from; /* the surface left */
+} gi_caustic_step;
+
+enum { GI_CAUSTIC_RECEIVES = 1, GI_CAUSTIC_CONTINUES = 2 };
+
+/* The material and light model, from app/ (gi/ cannot reach shade/). */
+typedef struct {
+    /* The surface at h for a photon or eye ray arriving along unit dir:
+     * GI_CAUSTIC_RECEIVES when it has a Lambertian term (photons light it);
+     * with step non-NULL, Russian roulette over its lobes (seed 002 appendix
+     * A): GI_CAUSTIC_CONTINUES and *step when a specular lobe is chosen. */
+    int (*surface)(void *ctx, const accel_hit *h, vec3 dir, rng *r, gi_caustic_step *step);
+    /* Light l's angle and distance attenuation at point p (first hit of a
+     * photon) for path length depth (shade_light_attenuation). */
+    double (*attenuation)(void *ctx, const scene_light *l, vec3 p, double depth);
+    void *ctx;
+} gi_caustic_hooks;
+
+typedef struct {
+    int width, height;      /* the G-buffer: the image's size */
+    int threads;            /* <= 0: all cores */
+    uint64_t seed;
+    const char *cl_device;  /* gi_cl.h's device choice (NULL: auto) */
+    size_t cl_max_bytes;
+    double count_scale;     /* photons times this (spacing / sqrt); 0 or 1: the scene's */
+    volatile int *cancel;
+} gi_caustic_settings;
+
+#define GI_CAUSTIC_MAX_BOUNCES 16
+typedef struct {
+    int combos;             /* light-target pairs that shoot */
+    long emitted;           /* bounce-map cells (photons shot) */
+    long first_hits;        /* photons whose first hit was their target */
+    long absorbed_first;    /* of those, absorbed at the bounce map's roulette (power 0) */
+    long alive[GI_CAUSTIC_MAX_BOUNCES + 1]; /* still travelling after bounce b (b = 1: the bounce map) */
+    int max_bounce;         /* highest b with alive[b] > 0 */
+    long stored;            /* photon volumes */
+    long rays;
+    double spacing;         /* the global spacing used (count and count_scale applied) */
+    double r_median;        /* median r_xy */
+    long tile_entries;      /* (photon, tile) pairs the splat visits */
+    long lookups_gbuffer, lookups_photons; /* gi_caustic_at answers from the G-buffer / from the photons */
+    double t_trace, t_gbuffer, t_bin, t_splat; /* seconds */
+    char device[300];
+} gi_caustic_stats;
+
+/* NULL with *status PT_OK when the scene shoots no photons (no enabled
+ * global photons block, or no light-target pair). */
+gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_settings *s, const gi_caustic_hooks *hk,
+                             diag *d, pt_status *status);
+void gi_caustic_free(gi_caustic *c);
+/* The stats so far (lookups keep counting during the render). */
+void gi_caustic_get_stats(const gi_caustic *c, gi_caustic_stats *st);
+/* Irradiance (E/pi units: what diffuse * pigment multiplies) of the caustic
+ * layer at hit h, n facing the viewer; shade_indirect_fn-compatible with c
+ * as the context. Thread-safe. */
+rgb gi_caustic_at(void *c, const accel_hit *h, vec3 n, int thread);
+/* The stored photon volumes. */
+const gi_caus_photon *gi_caustic_photons(const gi_caustic *c, long *n);
+/* The splat's result: 4 floats per G-buffer pixel (row-major, y down), and
+ * the G-buffer. */
+const float *gi_caustic_image(const gi_caustic *c);
+const gi_caus_pixel *gi_caustic_gbuffer(const gi_caustic *c);
+/* The tile binning and the splat run again (bench: their time, seconds). */
+pt_status gi_caustic_resplat(gi_caustic *c, double *t_bin, double *t_splat, diag *d);
+
+#endif
