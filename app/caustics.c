@@ -161,6 +161,7 @@ void caustics_json(caustics *c, stats_json *js)
     }
     stats_obj_end(js);
     stats_int(js, "stored", s->stored);
+    stats_num(js, "flux", s->flux);
     stats_num(js, "r_median", s->r_median);
     stats_int(js, "rays", s->rays);
     stats_int(js, "tile_entries", s->tile_entries);

@@ -41,6 +41,7 @@ enum {
 };
 typedef struct {
     int enabled;            /* a photons{} block was present (and gather max > 0) */
+    src_loc loc;            /* its `photons` keyword */
     unsigned given;         /* SCENE_PH_* bits */
     double spacing;         /* surface separation, default 1 (count 0: it decides) */
     int count;              /* 0 = none: spacing decides; else the spacing is scaled to give ~count */

@@ -16,6 +16,8 @@
  * beam puts POV-Ray's default minimum gather count (20) within r_xy */
 #define RADIUS_K 2.5231325220201604
 #define CHUNK 2048
+/* most photons shot in all (memory and time stay bounded whatever the scene asks) */
+#define MAX_CELLS 4194304.0
 
 static inline rgb crgb(double r, double g, double b)
 {
@@ -464,9 +466,34 @@ static pt_status make_combos(gi_caustic *c, diag *d)
     return PT_OK;
 }
 
+/* Sets cb's direction frame; the photons it asks for at global spacing s. */
+static double combo_cells(combo *cb, double s)
+{
+    const scene_light *l = cb->l;
+    double spread = cb->target->photons->spacing * s;
+    if (cb->parallel) {
+        cb->axis = v3_norm(v3_sub(l->point_at, l->position));
+        return M_PI * cb->rad * cb->rad / (spread * spread);
+    }
+    cb->origin = l->position;
+    vec3 to = v3_sub(cb->ctr, l->position);
+    double dist = v3_len(to);
+    cb->axis = dist > 0.0 ? v3_scale(to, 1.0 / dist) : v3(0, 0, 1);
+    if (dist > cb->rad) {
+        double sa = cb->rad / dist;
+        cb->cos_max = sqrt(fmax(0.0, 1.0 - sa * sa));
+    } else {
+        cb->cos_max = -1.0;
+        dist = cb->rad;
+    }
+    /* POV-Ray's angular step atan(spread / dist) in both angles */
+    double dt = atan(spread / dist);
+    return 2.0 * M_PI * (1.0 - cb->cos_max) / (dt * dt);
+}
+
 /* The global spacing (POV-Ray: `count` rescales it from the estimate of
  * all pairs), then each pair's bounce map. */
-static void size_combos(gi_caustic *c)
+static void size_combos(gi_caustic *c, diag *d)
 {
     const scene_photons *ps = &c->sc->global.photons;
     double s = ps->spacing > 0.0 ? ps->spacing : 1.0;
@@ -476,33 +503,26 @@ static void size_combos(gi_caustic *c)
         if (est > 0.0) s *= sqrt(est / ps->count);
     }
     if (c->s.count_scale > 0.0) s /= sqrt(c->s.count_scale);
+    /* at most MAX_CELLS photons in all: a larger request (a tiny spacing, a
+     * huge count) is scaled down, with a warning */
+    for (int pass = 0; pass < 2; pass++) {
+        double want = 0.0;
+        for (int i = 0; i < c->ncb; i++) want += combo_cells(&c->cb[i], s);
+        if (pass == 0 && want > MAX_CELLS) {
+            diag_warn_once(d, c->sc->global.photons.loc, "photons: %.3g photons asked for; shooting %.3g (the caustic layer's limit)",
+                           want, (double)MAX_CELLS);
+            s *= sqrt(want / MAX_CELLS) * 1.0001;
+        } else {
+            break;
+        }
+    }
     c->st.spacing = s;
     long total = 0;
     for (int i = 0; i < c->ncb; i++) {
         combo *cb = &c->cb[i];
         const scene_light *l = cb->l;
-        double spread = cb->target->photons->spacing * s;
-        double n;
-        if (cb->parallel) {
-            cb->axis = v3_norm(v3_sub(l->point_at, l->position));
-            n = M_PI * cb->rad * cb->rad / (spread * spread);
-        } else {
-            cb->origin = l->position;
-            vec3 to = v3_sub(cb->ctr, l->position);
-            double dist = v3_len(to);
-            cb->axis = dist > 0.0 ? v3_scale(to, 1.0 / dist) : v3(0, 0, 1);
-            if (dist > cb->rad) {
-                double sa = cb->rad / dist;
-                cb->cos_max = sqrt(fmax(0.0, 1.0 - sa * sa));
-            } else {
-                cb->cos_max = -1.0;
-                dist = cb->rad;
-            }
-            /* POV-Ray's angular step atan(spread / dist) in both angles */
-            double dt = atan(spread / dist);
-            n = 2.0 * M_PI * (1.0 - cb->cos_max) / (dt * dt);
-        }
-        int m = (int)ceil(sqrt(fmin(fmax(n, 1.0), 4e8)));
+        double n = combo_cells(cb, s);
+        int m = (int)ceil(sqrt(fmin(fmax(n, 1.0), MAX_CELLS)));
         cb->m = m;
         long cells = (long)m * m;
         cb->cell = cb->parallel ? M_PI * cb->rad * cb->rad / cells : 2.0 * M_PI * (1.0 - cb->cos_max) / cells;
@@ -738,7 +758,7 @@ gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_s
         *status = st;
         return NULL;
     }
-    size_combos(c);
+    size_combos(c, d);
     c->st.combos = c->ncb;
     c->st.emitted = c->total;
 
@@ -771,6 +791,7 @@ gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_s
     for (int b = 1; b <= GI_CAUSTIC_MAX_BOUNCES; b++)
         if (c->st.alive[b] > 0) c->st.max_bounce = b;
     c->st.stored = c->nph;
+    for (long i = 0; i < c->nph; i++) c->st.flux += (c->ph[i].phi[0] + c->ph[i].phi[1] + c->ph[i].phi[2]) / 3.0;
     c->st.t_trace = timer_now() - t0;
     if (st != PT_OK || (s->cancel && *s->cancel)) {
         gi_caustic_free(c);

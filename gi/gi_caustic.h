@@ -109,6 +109,7 @@ typedef struct {
     long alive[GI_CAUSTIC_MAX_BOUNCES + 1]; /* still travelling after bounce b (b = 1: the bounce map) */
     int max_bounce;         /* highest b with alive[b] > 0 */
     long stored;            /* photon volumes */
+    double flux;            /* their power, summed (grey: mean of the channels) */
     long rays;
     double spacing;         /* the global spacing used (count and count_scale applied) */
     double r_median;        /* median r_xy */

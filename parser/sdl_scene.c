@@ -545,10 +545,11 @@ static void radiosity_block(sdl_parser *p, scene_radiosity *r)
  *   save_file s | load_file s } '}'
  * POV-Ray 3.7's global photons block (parser.cpp): every item into
  * scene_photons, with its checks and warnings. */
-static void photons_block(sdl_parser *p, scene_global *g)
+static void photons_block(sdl_parser *p, scene_global *g, src_loc loc)
 {
     scene_photons *ph = &g->photons;
     scene_default_photons(ph);
+    ph->loc = loc;
     if (!sdl_begin_block(p, "photons")) return;
     while (sdl_ok(p) && !sdl_is(sdl_peek(p), TOK_RBRACE)) {
         sdl_tok t = sdl_next(p);
@@ -678,7 +679,7 @@ static int global_item(sdl_parser *p, scene_global *g)
         break;
     }
     case KW_RADIOSITY: radiosity_block(p, &g->radiosity); break;
-    case KW_PHOTONS: photons_block(p, g); break;
+    case KW_PHOTONS: photons_block(p, g, t.tk.loc); break;
     case KW_CHARSET: { /* ascii | utf8 | sys: how string literals' bytes are read */
         sdl_tok k = sdl_next(p);
         if (k.tk.kind == TOK_KEYWORD && k.tk.kw == KW_ASCII) p->charset = 0;

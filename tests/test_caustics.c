@@ -1,0 +1,305 @@
+/* test_caustics.c - the caustic layer (gi/gi_caustic.h, app/caustics.h):
+ * its irradiance against the path tracer in a glass sphere's focus, against
+ * the closed form behind a mirror, the splat against the brute-force sum of
+ * the same photon volumes, OpenCL against the C build, determinism, and the
+ * photon settings that are counted and warned about as not modelled. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "accel.h"
+#include "caustics.h"
+#include "framebuffer.h"
+#include "gi_cl.h"
+#include "gi_cl_c.h"
+#include "pm_path.h"
+#include "sdl.h"
+
+#define THREADS 2
+
+static scene *parse(const char *text)
+{
+    sdl_options so;
+    sdl_default_options(&so);
+    diag *d = diag_new();
+    scene *sc = NULL;
+    pt_status st = sdl_parse_string("test.pov", text, &so, &sc, d);
+    if (st != PT_OK)
+        for (int i = 0; i < diag_count(d); i++) {
+            char *m = diag_format(diag_get(d, i));
+            fprintf(stderr, "%s\n", m ? m : "?");
+            free(m);
+        }
+    diag_free(d);
+    assert_int_equal(st, PT_OK);
+    return sc;
+}
+
+static accel *build(const scene *sc)
+{
+    diag *d = diag_new();
+    pt_status st;
+    accel *a = accel_build(sc, THREADS, d, &st);
+    diag_free(d);
+    assert_int_equal(st, PT_OK);
+    return a;
+}
+
+/* The layer of scene `text` over a w x h G-buffer on device dev (NULL auto). */
+static void layer(caustics *c, const scene *sc, const accel *a, int w, int h, const char *dev, int threads, diag *d)
+{
+    assert_int_equal(caustics_build(c, sc, a, w, h, threads, 1, dev, 0, 0.0, NULL, d), PT_OK);
+    assert_non_null(c->layer);
+}
+
+/* Mean green of the central cw x ch pixels of a w-wide image of `stride`
+ * floats a pixel. */
+static double centre_mean(const float *img, int stride, int w, int h, int cw, int ch)
+{
+    double s = 0.0;
+    for (int y = (h - ch) / 2; y < (h + ch) / 2; y++)
+        for (int x = (w - cw) / 2; x < (w + cw) / 2; x++) s += img[((size_t)y * w + x) * stride + 1];
+    return s / (cw * ch);
+}
+
+/* A glass sphere (radius 0.5, ior 1.5) 0.8 above a white floor under a
+ * point light 10 above the floor that falls off as 1/d^2 (colour 50,
+ * fade_distance 0.1, fade_power 2: 2/(1 + (d/0.1)^2) = 0.02/d^2 within
+ * 1e-4). The camera looks straight down (orthographic, 0.3 x 0.3) at the
+ * focus; the sphere is no_image, so the image is the floor's irradiance.
+ * The path tracer cannot reach a point light through glass, so its scene
+ * has an emissive sphere of radius 0.3 and radiance 1/0.3^2 in its place:
+ * the same 1/d^2 intensity (E = pi L (r/d)^2 cos, E/pi units). Compared:
+ * the mean irradiance over the central 0.2 x 0.2 square (the focus and the
+ * inner part of its aberration halo: about 70% of the flux through the
+ * sphere, by geometric optics). The layer's G-buffer is 150 x 150 (pixels
+ * of 0.002, finer than the photon volumes' radius 0.0055, so that its
+ * point samples integrate the focused spike); the path tracer's pixels
+ * integrate their area, 15 x 15 at 4096 samples. */
+static const char *focus_fmt =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 max_trace_level 10 %s }\n"
+    "camera { orthographic location <0, 5, 0> look_at <0, 0, 0> sky z right x*0.3 up z*0.3 }\n"
+    "%s\n"
+    "sphere { <0, 0.8, 0>, 0.5 pigment { rgbf 1 } finish { ambient 0 diffuse 0 } interior { ior 1.5 } no_image %s }\n"
+    "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 1 } }\n";
+
+static void test_focus_vs_path(void **state)
+{
+    (void)state;
+    char text[2048];
+    snprintf(text, sizeof text, focus_fmt, "photons { spacing 0.002 }",
+             "light_source { <0, 10, 0> color rgb 50 fade_distance 0.1 fade_power 2 }",
+             "photons { target refraction on reflection off }");
+    scene *sc = parse(text);
+    accel *a = build(sc);
+    diag *d = diag_new();
+    caustics c;
+    layer(&c, sc, a, 150, 150, NULL, THREADS, d);
+    double e_layer = centre_mean(gi_caustic_image(c.layer), 4, 150, 150, 100, 100);
+    gi_caustic_stats st;
+    gi_caustic_get_stats(c.layer, &st);
+    caustics_free(&c);
+    diag_free(d);
+    accel_free(a);
+    scene_free(sc);
+
+    snprintf(text, sizeof text, focus_fmt, "",
+             "sphere { <0, 10, 0>, 0.3 pigment { rgb 1 } finish { ambient 0 diffuse 0 emission 11.111111111 } }", "");
+    sc = parse(text);
+    a = build(sc);
+    pm_path_settings ps;
+    pm_path_default_settings(&ps);
+    ps.c.width = ps.c.height = 15;
+    ps.c.threads = THREADS;
+    ps.c.spp = getenv("PT_CAUSTIC_SPP") ? atoi(getenv("PT_CAUSTIC_SPP")) : 4096;
+    ps.c.seed = 11;
+    framebuffer *fb = fb_new(15, 15);
+    pm_stats pst;
+    assert_int_equal(pm_path_render(sc, a, &ps, fb, &pst, NULL), PT_OK);
+    double e_path = centre_mean(fb->rgb, 3, 15, 15, 10, 10);
+    printf("glass sphere focus, mean irradiance over 0.2 x 0.2: caustic layer %.6f (%ld photons, r_xy median %.4f, "
+           "%.2f s trace, %.3f s splat), path %.6f (%d spp, %.1f s): ratio %.4f (tol 0.05)\n",
+           e_layer, st.stored, st.r_median, st.t_trace, st.t_splat, e_path, ps.c.spp, pst.t_total, e_layer / e_path);
+    assert_true(fabs(e_layer / e_path - 1.0) <= 0.05);
+    fb_free(fb);
+    accel_free(a);
+    scene_free(sc);
+}
+
+/* A mirror wall (x = 1, reflection 1) beside a point light of colour 1 at
+ * <-2, 5, 0>: at the floor's origin the reflected light comes from the
+ * mirror image <4, 5, 0>, and a POV-Ray light gives E/pi = C cos at any
+ * distance, so the caustic layer must give 5 / sqrt(41) = 0.78087 (mean
+ * over 0.4 x 0.4, where cos varies by under 1%). */
+static void test_mirror_closed_form(void **state)
+{
+    (void)state;
+    scene *sc = parse("#version 3.7;\n"
+                      "global_settings { assumed_gamma 1.0 photons { spacing 0.01 } }\n"
+                      "camera { orthographic location <0, 5, 0> look_at <0, 0, 0> sky z right x*0.4 up z*0.4 }\n"
+                      "light_source { <-2, 5, 0> color rgb 1 }\n"
+                      "box { <1, -1, -3>, <1.1, 3, 3> pigment { rgb 0 } finish { ambient 0 diffuse 0 reflection 1 } "
+                      "photons { target reflection on } }\n"
+                      "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 1 } }\n");
+    accel *a = build(sc);
+    diag *d = diag_new();
+    caustics c;
+    layer(&c, sc, a, 32, 32, NULL, THREADS, d);
+    double e = centre_mean(gi_caustic_image(c.layer), 4, 32, 32, 32, 32), want = 5.0 / sqrt(41.0);
+    printf("mirror: caustic layer %.5f, closed form %.5f (rel err %+.4f, tol 0.02)\n", e, want, e / want - 1.0);
+    assert_true(fabs(e / want - 1.0) <= 0.02);
+    caustics_free(&c);
+    diag_free(d);
+    accel_free(a);
+    scene_free(sc);
+}
+
+static const char *ball =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 max_trace_level 10 photons { spacing 0.01 } }\n"
+    "camera { location <0, 3, -4> look_at <0, 0.3, 0> angle 40 }\n"
+    "light_source { <1, 6, -1> color rgb 1 }\n"
+    "sphere { <0, 0.8, 0>, 0.5 pigment { rgbf <1, 0.9, 0.8, 0.9> } finish { ambient 0 diffuse 0.05 reflection 0.1 } "
+    "interior { ior 1.5 } photons { target refraction on reflection on } }\n"
+    "box { <0.7, 0, 0.5>, <1.2, 1, 1> pigment { rgb 0.5 } finish { reflection 0.8 } photons { target reflection on } }\n"
+    "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 0.8 } }\n";
+
+/* The splat (tiles, kernel) gives at every G-buffer pixel the sum of every
+ * photon volume there, computed brute force over all photons. */
+static void test_splat_equals_sum(void **state)
+{
+    (void)state;
+    scene *sc = parse(ball);
+    accel *a = build(sc);
+    diag *d = diag_new();
+    caustics c;
+    layer(&c, sc, a, 64, 48, NULL, THREADS, d);
+    long n;
+    const gi_caus_photon *ph = gi_caustic_photons(c.layer, &n);
+    const gi_caus_pixel *gb = gi_caustic_gbuffer(c.layer);
+    const float *img = gi_caustic_image(c.layer);
+    double maxe = 0.0, maxd = 0.0;
+    int lit = 0;
+    for (int i = 0; i < 64 * 48; i++) {
+        if (!(gb[i].valid > 0.0f)) continue;
+        float e[3];
+        gi_c_caustic_at(ph, NULL, (int)n, gb[i].s, gb[i].n, e);
+        for (int k = 0; k < 3; k++) {
+            maxe = fmax(maxe, e[k]);
+            maxd = fmax(maxd, fabs(e[k] - img[4 * i + k]));
+        }
+        lit += e[1] > 0.0f;
+    }
+    printf("splat vs brute-force sum: %ld photons, %d pixels lit, largest value %.5f, largest difference %.3g\n", n, lit,
+           maxe, maxd);
+    assert_true(n > 1000 && lit > 50);
+    assert_true(maxd <= 1e-5 * maxe + 1e-7);
+    caustics_free(&c);
+    diag_free(d);
+    accel_free(a);
+    scene_free(sc);
+}
+
+/* OpenCL (PoCL here) and the C build of gi_k_caustic_splat, and 1 against
+ * 2 threads: the same photons, the same image within float rounding. */
+static void test_devices_and_threads(void **state)
+{
+    (void)state;
+    scene *sc = parse(ball);
+    accel *a = build(sc);
+    diag *d = diag_new();
+    caustics c1, c2;
+    layer(&c1, sc, a, 64, 48, "c", 1, d);
+    layer(&c2, sc, a, 64, 48, NULL, THREADS, d);
+    long n1, n2;
+    const gi_caus_photon *p1 = gi_caustic_photons(c1.layer, &n1), *p2 = gi_caustic_photons(c2.layer, &n2);
+    assert_int_equal(n1, n2);
+    assert_memory_equal(p1, p2, sizeof *p1 * (size_t)n1);
+    const float *i1 = gi_caustic_image(c1.layer), *i2 = gi_caustic_image(c2.layer);
+    double maxe = 0.0, maxd = 0.0;
+    for (int i = 0; i < 64 * 48 * 4; i++) {
+        maxe = fmax(maxe, i1[i]);
+        maxd = fmax(maxd, fabs(i1[i] - i2[i]));
+    }
+    printf("C build, 1 thread vs %s, %d threads: %ld photons identical, image largest difference %.3g of %.4f\n",
+           c2.st.device, THREADS, n1, maxd, maxe);
+    assert_true(maxd <= 1e-5 * maxe);
+    caustics_free(&c1);
+    caustics_free(&c2);
+    diag_free(d);
+    accel_free(a);
+    scene_free(sc);
+}
+
+/* Photon settings the layer does not model are counted and warned about,
+ * each once; a scene without any target warns that nothing shoots. */
+static void test_not_modelled(void **state)
+{
+    (void)state;
+    scene *sc = parse("#version 3.7;\n"
+                      "global_settings { photons { count 2000 gather 10, 50 radius 0.1 media 20 autostop 0.2 "
+                      "expand_thresholds 0.1, 10 save_file \"x.ph\" } }\n"
+                      "camera { location <0, 3, -4> look_at 0 }\n"
+                      "light_source { <0, 5, 0> rgb 1 }\n"
+                      "sphere { <0, 1, 0>, 0.5 pigment { rgbf 1 } interior { ior 1.5 dispersion 1.1 } "
+                      "photons { target refraction on } }\n"
+                      "plane { y, 0 pigment { rgb 1 } }\n");
+    accel *a = build(sc);
+    diag *d = diag_new();
+    caustics c;
+    layer(&c, sc, a, 16, 12, NULL, THREADS, d);
+    caustics_not_modelled *nm = &c.nm;
+    assert_true(nm->gather && nm->radius && nm->media && nm->autostop && nm->expand_thresholds && nm->save_file &&
+                nm->dispersion && !nm->load_file && !nm->media_objects);
+    int warned = diag_count(d);
+    printf("not modelled: %d warnings:\n", warned);
+    for (int i = 0; i < warned; i++) {
+        char *m = diag_format(diag_get(d, i));
+        printf("  %s\n", m ? m : "?");
+        free(m);
+    }
+    assert_int_equal(warned, 7);
+    /* count 2000: POV-Ray's estimate over the one light-target pair sets
+     * the spacing, and about that many photons are shot at the target */
+    printf("count 2000: spacing %.5f, %ld shot\n", c.st.spacing, c.st.emitted);
+    assert_true(c.st.spacing > 0.0);
+    caustics_free(&c);
+    /* again: the same warnings are not repeated into the same context */
+    layer(&c, sc, a, 16, 12, NULL, THREADS, d);
+    assert_int_equal(diag_count(d), warned);
+    caustics_free(&c);
+    diag_free(d);
+    accel_free(a);
+    scene_free(sc);
+
+    sc = parse("global_settings { photons { spacing 0.1 } }\n"
+               "light_source { <0, 5, 0> rgb 1 }\n"
+               "sphere { <0, 1, 0>, 0.5 pigment { rgbf 1 } interior { ior 1.5 } }\n");
+    a = build(sc);
+    d = diag_new();
+    assert_int_equal(caustics_build(&c, sc, a, 8, 8, THREADS, 1, NULL, 0, 0.0, NULL, d), PT_OK);
+    assert_null(c.layer);
+    assert_int_equal(diag_count(d), 1);
+    caustics_free(&c);
+    diag_free(d);
+    accel_free(a);
+    scene_free(sc);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_mirror_closed_form),
+        cmocka_unit_test(test_splat_equals_sum),
+        cmocka_unit_test(test_devices_and_threads),
+        cmocka_unit_test(test_not_modelled),
+        cmocka_unit_test(test_focus_vs_path),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
