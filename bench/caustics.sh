@@ -1,0 +1,156 @@
+#!/bin/sh
+# POV-Ray's photon scenes: partray's caustic layer (docs/caustics.md)
+# against POV-Ray. For every distribution scene with a photons{} block, at
+# SIZE +A0.3 with THREADS threads, partray's default render (its GI mode:
+# none, or particle under radiosity{}) and POV-Ray's default render in the
+# same run, both measured against POV-Ray at 4x the scene's photon count
+# (its global photons block with count x4 or spacing / 2; cached). Prints:
+# mean luminance of partray's render over that reference's, LDR-FLIP of
+# POV-Ray's default and of partray's render against it, the sRGB mean
+# absolute difference of partray's render from POV-Ray's default after a
+# 4x4 box downsample, both wall times and their ratio, and whether the
+# render meets the bounds (luminance within 5%, FLIP no worse than POV-Ray's
+# default, time no longer); then, per scene, bench_caustics' splat-versus-
+# kd-tree-gather times and Russian-roulette attrition. Prints figures; not
+# a test.
+#
+# usage: bench/caustics.sh [SIZE] [THREADS] [REF_TIMEOUT] [SCENE...]
+#   SIZE default 160x120, THREADS 2, REF_TIMEOUT 1200 s (a 4x render that
+#   takes longer is not made; the line says so and POV-Ray's default render
+#   is the reference). Scenes relative to the examples directory, default
+#   the 7 with photons{}. PARTRAY, BENCH_CAUSTICS, CAUSTICS_CACHE override
+#   the binaries and the reference cache.
+set -u
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+PARTRAY=${PARTRAY:-$ROOT/build/partray}
+BENCH=${BENCH_CAUSTICS:-$ROOT/build/bench/bench_caustics}
+SIZE=${1:-160x120}
+THREADS=${2:-2}
+RTIMEOUT=${3:-1200}
+[ $# -gt 3 ] && shift 3 || set --
+EX=/usr/share/doc/povray/examples
+CACHE=${CAUSTICS_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/partray/caustics}
+W=${SIZE%x*}; H=${SIZE#*x}
+if [ $# -eq 0 ]; then
+    set -- lights/phot_met_glass.pov lights/glassthing.pov advanced/optics.pov advanced/grenadine/grenadine.pov \
+           advanced/balcony/balcony.pov advanced/benchmark/benchmark.pov advanced/diffuse_back.pov
+fi
+mkdir -p "$CACHE"
+TMP=$(mktemp -d /tmp/caustics_bench.XXXXXX)
+trap 'rm -rf "$TMP"' EXIT
+POVOPTS="+W$W +H$H +A0.3 +R3 -D -V -P +FN -UA +WT$THREADS"
+
+# wall time of a command in seconds (its output is dropped)
+wall() {
+    python3 -c 'import subprocess, sys, time
+t = time.time(); subprocess.call(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+print("%.3f" % (time.time() - t))' "$@"
+}
+
+# The scene with its global photons block at 4x the photons: count x4, or
+# spacing / 2 (POV-Ray's photon count goes as 1 / spacing^2); a block with
+# neither gets spacing 0.5 (the default spacing 1, halved).
+photons4x() {
+    python3 - "$1" "$2" <<'EOF'
+import re, sys
+src, dst = sys.argv[1], sys.argv[2]
+text = open(src, encoding='latin-1').read()
+out, i, done = [], 0, False
+for m in re.finditer(r'\bphotons\s*\{', text):
+    # the block's text up to its closing brace
+    j, depth = m.end(), 1
+    while j < len(text) and depth:
+        depth += {'{': 1, '}': -1}.get(text[j], 0); j += 1
+    body = text[m.end():j - 1]
+    code = re.sub(r'//[^\n]*', lambda c: ' ' * len(c.group(0)), body)
+    if not re.search(r'\b(spacing|count)\b', code) and not re.search(r'\b(autostop|jitter|gather)\b', code):
+        continue  # an object's or a light's block
+    def count4(c): return c.group(1) + str(4 * int(float(c.group(2))))
+    def spacing2(c): return c.group(1) + repr(float(c.group(2)) / 2)
+    new = code
+    if re.search(r'\bcount\b', code):
+        new = re.sub(r'(\bcount\s+)([0-9.eE+]+)', count4, code)
+    elif re.search(r'\bspacing\b', code):
+        new = re.sub(r'(\bspacing\s+)([0-9.eE+-]+)', spacing2, code)
+    else:
+        new = ' spacing 0.5 ' + code
+    out.append(text[i:m.end()]); out.append(new); i = j - 1; done = True
+out.append(text[i:])
+open(dst, 'w', encoding='latin-1').write(''.join(out))
+print('ok' if done else 'none')
+EOF
+}
+
+printf '%-34s %7s %8s %8s %8s %8s %8s %6s  %s\n' scene lum_pt flip_pov flip_pt mad4_pt t_pov t_pt t_rat "bounds (lum flip time)"
+for rel in "$@"; do
+    dir=$(dirname "$rel"); base=$(basename "$rel"); stem=${base%.pov}
+    work="$TMP/$dir"; mkdir -p "$work" && cp -r "$EX/$dir/." "$work/"
+    key=$(cat "$EX/$rel" | md5sum | cut -c1-12)
+    ref="$CACHE/${stem}_${key}_${W}x${H}_4x.png"
+    note=""
+    if [ ! -f "$ref" ] && [ ! -f "$ref.timedout" ]; then
+        if [ "$(photons4x "$work/$base" "$work/${stem}_4x.pov")" = ok ]; then
+            (cd "$work" && timeout "$RTIMEOUT" povray +I"${stem}_4x.pov" +O"${stem}_4x.png" $POVOPTS +L"$work" >/dev/null 2>&1)
+            if [ -f "$work/${stem}_4x.png" ]; then cp "$work/${stem}_4x.png" "$ref"; else touch "$ref.timedout"; fi
+        fi
+    fi
+    t_pov=$(cd "$work" && wall povray +I"$base" +O"${stem}_pov.png" $POVOPTS +L"$work")
+    t_pt=$(cd "$work" && wall "$PARTRAY" render "$base" --size "$SIZE" +A0.3 --threads "$THREADS" -o "${stem}_pt.png" \
+           --stats "${stem}.json" --quiet)
+    if [ ! -f "$work/${stem}_pt.png" ] || [ ! -f "$work/${stem}_pov.png" ]; then
+        printf '%-34s failed (partray or POV-Ray made no image)\n' "$rel"; continue
+    fi
+    if [ -f "$ref" ]; then refimg=$ref; else refimg="$work/${stem}_pov.png"; note=" [ref: POV-Ray default, 4x not made]"; fi
+    fpov=$("$PARTRAY" compare "$refimg" "$work/${stem}_pov.png" --json 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin)["flip"]["mean"])')
+    js=$("$PARTRAY" compare "$refimg" "$work/${stem}_pt.png" --json 2>/dev/null)
+    mad=$(python3 - "$work/${stem}_pov.png" "$work/${stem}_pt.png" <<'EOF'
+import struct, sys, zlib
+def read(path):
+    d = open(path, 'rb').read(); i = 8; idat = b''
+    while i < len(d):
+        n, = struct.unpack('>I', d[i:i + 4]); t = d[i + 4:i + 8]; c = d[i + 8:i + 8 + n]; i += 12 + n
+        if t == b'IHDR': w, h, bd, ct = struct.unpack('>IIBB', c[:10])
+        elif t == b'IDAT': idat += c
+    ch = {2: 3, 6: 4, 0: 1, 4: 2}[ct]; bpp = ch * (bd // 8); raw = zlib.decompress(idat); st = w * bpp
+    prev = [0] * st; p = 0; img = []
+    for y in range(h):
+        f = raw[p]; row = raw[p + 1:p + 1 + st]; p += 1 + st; r = [0] * st
+        for x in range(st):
+            a = r[x - bpp] if x >= bpp else 0; b = prev[x]; c = prev[x - bpp] if x >= bpp else 0
+            pr = 0 if f == 0 else a if f == 1 else b if f == 2 else (a + b) // 2 if f == 3 else \
+                (a if abs(b - c) <= abs(a - c) and abs(b - c) <= abs(a + b - 2 * c) else b if abs(a - c) <= abs(a + b - 2 * c) else c)
+            r[x] = (row[x] + pr) & 255
+        prev = r
+        img.append([[r[x * bpp + k * (bd // 8)] / 255.0 for k in range(3)] for x in range(w)])
+    return img, w, h
+a, w, h = read(sys.argv[1]); b, _, _ = read(sys.argv[2])
+s = n = 0
+for y in range(h // 4):
+    for x in range(w // 4):
+        for k in range(3):
+            va = sum(a[4 * y + j][4 * x + i][k] for j in range(4) for i in range(4)) / 16
+            vb = sum(b[4 * y + j][4 * x + i][k] for j in range(4) for i in range(4)) / 16
+            s += abs(va - vb); n += 1
+print("%.4f" % (s / n))
+EOF
+)
+    printf '%s\n' "$js" | python3 -c '
+import json, sys
+j = json.load(sys.stdin); rel, fpov, mad, tp, tt, note = sys.argv[1], float(sys.argv[2]), sys.argv[3], float(sys.argv[4]), float(sys.argv[5]), sys.argv[6]
+lum = j["luminance"]["test"] / j["luminance"]["reference"] if j["luminance"]["reference"] > 0 else 0
+fpt = j["flip"]["mean"]
+ok = lambda b: "ok" if b else "NO"
+print("%-34s %7.4f %8.4f %8.4f %8s %8.2f %8.2f %6.3f  %s %s %s%s" % (rel, lum, fpov, fpt, mad, tp, tt, tt / tp if tp > 0 else 0,
+      ok(abs(lum - 1) <= 0.05), ok(fpt <= fpov) if fpov > 0 else "--", ok(tt <= tp), note))
+print("RATIO %.6f" % (tt / tp if tp > 0 else 1), file=sys.stderr)
+' "$rel" "$fpov" "$mad" "$t_pov" "$t_pt" "$note" 2>>"$TMP/ratios"
+    (cd "$work" && "$BENCH" "$base" --size "$SIZE" --threads "$THREADS" --reps 3 > "$TMP/${stem}.bench" 2>&1)
+done
+awk '/^RATIO/ { n++; s += log($2) } END { if (n) printf "geometric mean of partray/POV-Ray wall time over %d scenes: %.3f\n", n, exp(s / n) }' "$TMP/ratios"
+echo
+echo "splat (photon volumes) vs pmfg's kd-tree gather over the same photons; Russian-roulette attrition:"
+for f in "$TMP"/*.bench; do
+    [ -f "$f" ] || continue
+    echo "--- $(head -1 "$f")"
+    sed -n '2,$p' "$f" | grep -v '^stages'
+done
