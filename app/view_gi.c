@@ -9,6 +9,7 @@
 #include "shade_texture.h"
 #include "timer.h"
 #include "gi_particle.h"
+#include "gi_vlinks.h"
 #include "pm_fg.h"
 #include "radrules.h"
 #include "pm_path.h"
@@ -229,6 +230,85 @@ static void particle_close(void *ctx)
     free(c);
 }
 
+/* ----------------------------------------------------------------- links */
+/* Vertex links (gi_vlinks.h): open links every mesh vertex and gathers;
+ * a light edit (relight) keeps the links and runs the light links and the
+ * sweeps again on the render thread, while the window stays live. */
+typedef struct {
+    const scene *sc;
+    const accel *a;
+    gi_vlinks *v;
+    gi_vlinks_stats st;
+} links_ctx;
+
+static pt_status links_run(links_ctx *c, int objects_may_change, volatile int *cancel, view_gi_times *t, diag *d)
+{
+    double t0 = timer_now();
+    gi_vlinks_set_cancel(c->v, cancel);
+    gi_vlinks_stats st;
+    pt_status s = gi_vlinks_frame(c->v, c->sc, c->a, objects_may_change, &st, d);
+    gi_vlinks_set_cancel(c->v, NULL);
+    if (s == PT_OK) c->st = st;
+    t->build = st.t_links;
+    t->light = timer_now() - t0 - st.t_links;
+    return s == PT_CANCELLED ? PT_OK : s;
+}
+
+static pt_status links_open(void **ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
+{
+    links_ctx *c = calloc(1, sizeof *c);
+    if (!c) return PT_ERR_NOMEM;
+    c->sc = sc;
+    c->a = a;
+    gi_vlinks_settings s;
+    gi_vlinks_default_settings(&s);
+    s.threads = o->threads;
+    if (o->bounces > 0) s.bounces = o->bounces;
+    s.pigment = shade_tex_pigment_at; /* vertices reflect the pigment where they are */
+    c->v = gi_vlinks_new(&s);
+    if (!c->v) {
+        free(c);
+        return PT_ERR_NOMEM;
+    }
+    *ctx = c;
+    return links_run(c, 1, NULL, t, d);
+}
+
+static pt_status links_relight(void *ctx, volatile int *cancel, view_gi_times *t, diag *d)
+{
+    return links_run(ctx, 0, cancel, t, d);
+}
+
+static pt_status links_render(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
+{
+    links_ctx *c = ctx;
+    shade_settings ss;
+    whitted_settings(&ss, p);
+    ss.use_ambient = radrules_of(c->sc, 1).ambient; /* as render_gi.c */
+    ss.indirect = gi_vlinks_indirect;
+    ss.indirect_ctx = c->v;
+    double t0 = timer_now();
+    pt_status st = shade_render(c->sc, c->a, &ss, fb, NULL, d);
+    t->render = timer_now() - t0;
+    return st;
+}
+
+static void links_describe(void *ctx, char *buf, int n)
+{
+    links_ctx *c = ctx;
+    const gi_vlinks_stats *s = &c->st;
+    snprintf(buf, (size_t)n, "%ld vertices, %ld links (%ld raw), light %.0f ms, sweeps %.0f ms", s->vertices,
+             s->merged_links, s->raw_links, s->t_light * 1e3, s->t_bounces * 1e3);
+}
+
+static void links_close(void *ctx)
+{
+    links_ctx *c = ctx;
+    if (!c) return;
+    gi_vlinks_free(c->v);
+    free(c);
+}
+
 /* ------------------------------------------------- reference previews */
 /* path and pmfg: each pass its own samples (its own seed), averaged at full
  * resolution: level 0 a preview at 1 sample per pixel, level 1 the full
@@ -362,6 +442,7 @@ static const gi_backend backends[] = {
     {GI_NONE, 0, whitted_last_level, none_open, none_relight, NULL, NULL, none_render, none_describe, none_close},
     {GI_PARTICLE, 1, whitted_last_level, particle_open, particle_relight, particle_has_preview, particle_relight_preview,
      particle_render, particle_describe, particle_close},
+    {GI_LINKS, 0, whitted_last_level, links_open, links_relight, NULL, NULL, links_render, links_describe, links_close},
     {GI_PATH, 0, ref_last_level, path_open, ref_relight, NULL, NULL, ref_render, ref_describe, ref_close},
     {GI_PMFG, 0, ref_last_level, pmfg_open, ref_relight, NULL, NULL, ref_render, ref_describe, ref_close},
 };

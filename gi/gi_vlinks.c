@@ -416,6 +416,8 @@ void gi_vlinks_free(gi_vlinks *v)
 
 void gi_vlinks_set_progress(gi_vlinks *v, progress *p) { v->s.progress = p; }
 
+void gi_vlinks_set_cancel(gi_vlinks *v, volatile int *cancel) { v->s.cancel = cancel; }
+
 long gi_vlinks_count(const gi_vlinks *v) { return v->ne; }
 
 rgb gi_vlinks_element(const gi_vlinks *v, long i, vec3 *p, vec3 *nrm)

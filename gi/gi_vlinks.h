@@ -70,6 +70,9 @@ void gi_vlinks_default_settings(gi_vlinks_settings *s);
 gi_vlinks *gi_vlinks_new(const gi_vlinks_settings *s);
 void gi_vlinks_free(gi_vlinks *v);
 void gi_vlinks_set_progress(gi_vlinks *v, progress *p);
+/* While *cancel (NULL: never) is non-zero a frame stops at its next chunk
+ * of link rays or light links and returns PT_CANCELLED. */
+void gi_vlinks_set_cancel(gi_vlinks *v, volatile int *cancel);
 /* One frame: sc and a must stay alive until the next frame or free (the
  * hook reads them). objects_may_change 0: the caller knows that nothing
  * but the camera and lights changed since the previous frame. */
