@@ -29,6 +29,7 @@ typedef struct {
     int type, sturm;
     /* superellipsoid: exponents p = 2/e (x, y), q = 2/n (the z blend) */
     double p, q;
+    int pint, qint;   /* p, q when they are whole numbers (powers by multiplication), else 0 */
     int convex;
     /* quadric */
     double a[10];
@@ -52,17 +53,39 @@ typedef struct {
 
 /* ------------------------------------------------------------ superellipsoid */
 
+/* x^n for a whole n >= 1 by repeated squaring: |x|^p for the common
+ * exponents (e = 0.05 gives p = 40) costs a few products, not a pow(). */
+static double ipow(double x, int n)
+{
+    double r = 1.0;
+    while (n > 0) {
+        if (n & 1) r *= x;
+        x *= x;
+        n >>= 1;
+    }
+    return r;
+}
+
+static double se_pow(double x, double p, int pint) { return pint ? ipow(x, pint) : pow(x, p); }
+
 /* N(v) = ((|x|^p + |y|^p)^(q/p) + |z|^q)^(1/q), evaluated with the largest
- * term factored out so huge exponents neither overflow nor underflow. */
+ * term factored out so huge exponents neither overflow nor underflow; for
+ * p = q it is (|x|^p + |y|^p + |z|^p)^(1/p), one root instead of two. */
 static double se_norm(const im_data *m, vec3 v, double *pa)
 {
     double ax = fabs(v.x), ay = fabs(v.y), az = fabs(v.z);
+    if (!pa && m->p == m->q) {
+        double mm = fmax(fmax(ax, ay), az);
+        if (!(mm > 0.0)) return 0.0;
+        double s = se_pow(ax / mm, m->p, m->pint) + se_pow(ay / mm, m->p, m->pint) + se_pow(az / mm, m->p, m->pint);
+        return mm * pow(s, 1.0 / m->p);
+    }
     double mxy = fmax(ax, ay), a = 0.0;
-    if (mxy > 0.0) a = mxy * pow(pow(ax / mxy, m->p) + pow(ay / mxy, m->p), 1.0 / m->p);
+    if (mxy > 0.0) a = mxy * pow(se_pow(ax / mxy, m->p, m->pint) + se_pow(ay / mxy, m->p, m->pint), 1.0 / m->p);
     if (pa) *pa = a;
     double mm = fmax(a, az);
     if (!(mm > 0.0)) return 0.0;
-    return mm * pow(pow(a / mm, m->q) + pow(az / mm, m->q), 1.0 / m->q);
+    return mm * pow(se_pow(a / mm, m->q, m->qint) + se_pow(az / mm, m->q, m->qint), 1.0 / m->q);
 }
 
 static vec3 se_grad(const im_data *m, vec3 v)
@@ -377,17 +400,6 @@ int geom_quadric_solid_box(const geom_shape *sh, vec3 clo, vec3 chi, vec3 *lo, v
 }
 
 /* ------------------------------------------------------------ poly */
-
-static double ipow(double x, int n)
-{
-    double r = 1.0;
-    while (n > 0) {
-        if (n & 1) r *= x;
-        x *= x;
-        n >>= 1;
-    }
-    return r;
-}
 
 static double poly_eval3(const im_data *m, vec3 p)
 {
@@ -841,6 +853,11 @@ int geom_implicit_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi
         m->type = IM_SUPER;
         m->p = 2.0 / e;
         m->q = 2.0 / n;
+        /* whole exponents (to rounding) are multiplied out exactly */
+        if (fabs(m->p - nearbyint(m->p)) <= 1e-12 * m->p && m->p <= 4096.0) m->pint = (int)nearbyint(m->p);
+        if (fabs(m->q - nearbyint(m->q)) <= 1e-12 * m->q && m->q <= 4096.0) m->qint = (int)nearbyint(m->q);
+        if (m->pint) m->p = m->pint;
+        if (m->qint) m->q = m->qint;
         m->convex = e <= 2.0 && n <= 2.0;
         m->solid_bounded = 1;
         *lo = v3s(-1.0);
