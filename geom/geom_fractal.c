@@ -18,6 +18,8 @@
 #define CMPLX(x, y) __builtin_complex((double)(x), (double)(y))
 #endif
 
+#define FRACTAL_TOLERANCE 1e-7
+
 typedef struct {
     double c[4];
     int hyper;
@@ -224,7 +226,10 @@ int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
         int next = jf_inside(f, v3_madd(p0, e, tn), e, &den);
         if (next != cur) {
             double lo = tau, hi = tn;
-            for (int it = 0; it < 200 && hi - lo > 1e-15 * (len + hi); it++) {
+            /* POV-Ray polishes the crossing by bisection to Fractal_Tolerance
+             * (1e-7 in the fractal's space, fractal.cpp), far finer than the
+             * set's detail at any usable precision */
+            for (int it = 0; it < 200 && hi - lo > FRACTAL_TOLERANCE; it++) {
                 double m = 0.5 * (lo + hi);
                 if (jf_inside(f, v3_madd(p0, e, m), e, NULL) == cur) lo = m;
                 else hi = m;
