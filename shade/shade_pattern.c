@@ -317,6 +317,7 @@ static double metric_sum(vec3 d, double metric)
     return pow(fabs(d.x), metric) + pow(fabs(d.y), metric) + pow(fabs(d.z), metric);
 }
 
+#define CRACKLE_SLOTS 64u /* per thread, 81 points each: 124 KiB */
 static double crackle(const scene_pattern *pat, vec3 p, int gen)
 {
     int fx = shade_noise_to_int(floor(p.x - PAT_EPSILON)), fy = shade_noise_to_int(floor(p.y - PAT_EPSILON)),
@@ -327,8 +328,8 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
      * for the last few cubes visited (they depend on the cube alone), as
      * POV-Ray's crackle cache does: a ray marching an isosurface or a
      * pixel's neighbours stay in one cube for many evaluations. */
-    static _Thread_local struct { int valid, fx, fy, fz; vec3 pts[81]; } cache[8];
-    unsigned slot = ((unsigned)fx * 73856093u ^ (unsigned)fy * 19349663u ^ (unsigned)fz * 83492791u) & 7u;
+    static _Thread_local struct { int valid, fx, fy, fz; vec3 pts[81]; } cache[CRACKLE_SLOTS];
+    unsigned slot = ((unsigned)fx * 73856093u ^ (unsigned)fy * 19349663u ^ (unsigned)fz * 83492791u) % CRACKLE_SLOTS;
     vec3 *pts = cache[slot].pts;
     if (!cache[slot].valid || cache[slot].fx != fx || cache[slot].fy != fy || cache[slot].fz != fz) {
         int n = 0;
