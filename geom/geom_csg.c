@@ -12,6 +12,7 @@
 #include "geom_csg.h"
 #include "geom_implicit.h"
 #include <assert.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -22,6 +23,24 @@ static bbox bb_empty(void) { bbox b = {v3s(INFINITY), v3s(-INFINITY)}; return b;
 static bbox bb_union(bbox a, bbox b) { bbox r = {v3_min(a.lo, b.lo), v3_max(a.hi, b.hi)}; return r; }
 static bbox bb_inter(bbox a, bbox b) { bbox r = {v3_max(a.lo, b.lo), v3_min(a.hi, b.hi)}; return r; }
 static int bb_empty_p(bbox b) { return !(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z); }
+/* outwards by 1e-7 of the box's size and coordinates (infinite sides stay) */
+static bbox pad_box(bbox b)
+{
+    if (bb_empty_p(b)) return b;
+    for (int i = 0; i < 3; i++) {
+        double l = v3_idx(b.lo, i), h = v3_idx(b.hi, i);
+        double ext = isfinite(h - l) ? h - l : 0.0;
+        double pad = 1e-7 * ((isfinite(l) ? fabs(l) : 0.0) + (isfinite(h) ? fabs(h) : 0.0) + ext) + 1e-300;
+        if (i == 0) { b.lo.x = l - pad; b.hi.x = h + pad; }
+        if (i == 1) { b.lo.y = l - pad; b.hi.y = h + pad; }
+        if (i == 2) { b.lo.z = l - pad; b.hi.z = h + pad; }
+    }
+    return b;
+}
+static int in_box(const vec3 *b, vec3 p)
+{
+    return p.x >= b[0].x && p.x <= b[1].x && p.y >= b[0].y && p.y <= b[1].y && p.z >= b[0].z && p.z <= b[1].z;
+}
 
 static int grow(void **p, int *cap, int need, size_t elem)
 {
@@ -231,6 +250,43 @@ int geom_csg_finish(geom_csg *c)
     c->lo = S[0].lo;
     c->hi = S[0].hi;
     int ok = !bb_empty_p(S[0]) && c->nshapes > 0;
+    /* the boxes kept for rays and inside tests, padded against rounding */
+    free(c->keep_box);
+    free(c->inside_box);
+    c->keep_box = malloc((size_t)(c->nshapes > 0 ? c->nshapes : 1) * 2 * sizeof(vec3));
+    c->inside_box = malloc((size_t)c->nnodes * 2 * sizeof(vec3));
+    if (c->keep_box && c->inside_box) {
+        for (int i = 0; i < c->nnodes; i++) {
+            bbox v = pad_box(V[i]);
+            c->inside_box[2 * i] = v.lo;
+            c->inside_box[2 * i + 1] = v.hi;
+        }
+        for (int sh = 0; sh < c->nshapes; sh++) {
+            int node = c->shape_node[sh];
+            bbox kb = S[node];
+            /* a crossing is kept only inside an intersection's other members
+             * and, for a subtracted member, inside the first one
+             * (geom_csg_kept) */
+            for (int child = node, par = c->nodes[node].parent; par >= 0 && !bb_empty_p(kb);
+                 child = par, par = c->nodes[par].parent) {
+                const geom_csg_node *P = &c->nodes[par];
+                const int *k = c->kids + P->first;
+                if (P->op == GEOM_CSG_INTERSECTION) {
+                    for (int j = 0; j < P->nkids; j++)
+                        if (k[j] != child) kb = bb_inter(kb, V[k[j]]);
+                } else if (P->op == GEOM_CSG_DIFFERENCE && P->nkids > 0 && k[0] != child) {
+                    kb = bb_inter(kb, V[k[0]]);
+                }
+            }
+            kb = bb_empty_p(kb) ? bb_empty() : pad_box(kb);
+            c->keep_box[2 * sh] = kb.lo;
+            c->keep_box[2 * sh + 1] = kb.hi;
+        }
+    } else {
+        free(c->keep_box);
+        free(c->inside_box);
+        c->keep_box = c->inside_box = NULL;
+    }
     free(count);
     free(S);
     free(V);
@@ -254,12 +310,16 @@ void geom_csg_free(geom_csg *c)
     free(c->shapes);
     free(c->shape_leaf);
     free(c->shape_node);
+    free(c->keep_box);
+    free(c->inside_box);
     memset(c, 0, sizeof *c);
 }
 
 int geom_csg_inside(const geom_csg *c, int node, vec3 p)
 {
     const geom_csg_node *nd = &c->nodes[node];
+    /* outside the box of its inside (an inverse node's box is everything) */
+    if (c->inside_box && !in_box(c->inside_box + 2 * node, p)) return 0;
     const int *k = c->kids + nd->first;
     int r = 0;
     switch (nd->op) {
@@ -327,6 +387,12 @@ int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, doubl
         int node = c->shape_node[s];
         if (c->nodes[node].nosurf) continue;
         double from = tmin;
+        if (c->keep_box) {
+            /* the ray must cross where this member's crossings can be kept */
+            const vec3 *kb = c->keep_box + 2 * s;
+            double t0, t1;
+            if (!(kb[0].x <= kb[1].x) || !v3_slab(org, dir, kb[0], kb[1], &t0, &t1) || t1 < tmin || t0 > best) continue;
+        }
         for (int guard = 0; guard < 1000; guard++) {
             geom_shape_hit tmp[CSG_CHUNK];
             int k = geom_shape_hits(&c->shapes[s], org, dir, from, best, tmp, CSG_CHUNK);

@@ -64,6 +64,11 @@ typedef struct {
     int *shape_node;
     int nshapes, capshapes;
     vec3 lo, hi;           /* world bounds of the result's surface (may be infinite before clipping) */
+    /* From geom_csg_finish (NULL before): per shape, the box (lo, hi) where
+     * a crossing of it can be kept (its own box within the boxes of the
+     * siblings that must contain it, up to the root), and per node the box
+     * of its inside; rays and inside tests skip what lies outside them. */
+    vec3 *keep_box, *inside_box;
     unsigned flags;        /* caller's tag (accel.c: effective object flags of the root) */
 } geom_csg;
 
