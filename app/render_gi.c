@@ -498,6 +498,7 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
         stats_int(js, "elements", p->elements);
         stats_int(js, "meshes", p->meshes);
         stats_int(js, "full", p->full);
+        stats_int(js, "sweeps", p->sweeps);
         stats_int(js, "objects_moved", p->objects_moved);
         stats_int(js, "meshes_moved", p->meshes_moved);
         stats_int(js, "elements_linked", p->elements_linked);

@@ -104,7 +104,7 @@ echo "== 1. --gi links (seed 001): bench/scenes/mesh_room.pov at $SIZE"
 field still.json "'vertices %d (elements %d, two sides), meshes %d' % (j['links']['vertices'], j['links']['elements'], j['links']['meshes'])"
 field still.json "'links raw %d, merged %d: ratio %.2f (paper Table 1: 3-5x)' % (j['links']['raw_links'], j['links']['merged_links'], j['links']['raw_links'] / max(1, j['links']['merged_links']))"
 field still.json "'link rays %d in %.3f s: %.2f M rays/s, %.1f us per vertex (both sides)' % (j['links']['link_rays'], j['links']['timings']['links'], j['links']['link_rays'] / max(1e-9, j['links']['timings']['links']) * 1e-6, j['links']['timings']['links'] / max(1, j['links']['vertices']) * 1e6)"
-field still.json "'first full solution %.3f s (links %.3f, light %.3f, %d sweeps %.3f, smoothing %.3f)' % (sum(j['links']['timings'].values()), j['links']['timings']['links'], j['links']['timings']['light'], 3, j['links']['timings']['bounces'], j['links']['timings']['smooth'])"
+field still.json "'first full solution %.3f s (links %.3f, light %.3f, %d sweeps %.3f, smoothing %.3f)' % (sum(j['links']['timings'].values()), j['links']['timings']['links'], j['links']['timings']['light'], j['links']['sweeps'], j['links']['timings']['bounces'], j['links']['timings']['smooth'])"
 "$P" render mesh_room.pov +L"$TPL" --gi links --size "$SIZE" +KFI1 +KFF"$LINK_FRAMES" +KC -o la.pfm 2>la.log
 python3 parse.py la.log > la.json
 python3 - <<EOF

@@ -348,7 +348,7 @@ void gi_vlinks_default_settings(gi_vlinks_settings *s)
 {
     memset(s, 0, sizeof *s);
     s->nside = 16;
-    s->bounces = 3;
+    s->bounces = 0;
     s->feature_deg = 30.0;
 }
 
@@ -359,7 +359,6 @@ gi_vlinks *gi_vlinks_new(const gi_vlinks_settings *s)
     v->s = *s;
     if (v->s.nside < 4) v->s.nside = 4;
     v->s.nside = (v->s.nside + 3) / 4 * 4;
-    if (v->s.bounces < 1) v->s.bounces = 1;
     v->nc = v->s.nside * v->s.nside;
     v->dirs = make_dirs(v->s.nside);
     if (!v->dirs) {
@@ -794,8 +793,17 @@ pt_status gi_vlinks_frame(gi_vlinks *v, const scene *sc, const accel *a, int obj
     memset(v->itot, 0, sizeof(float) * n4);
     for (size_t i = 0; i < n4; i++) v->b0[i] = v->rho[i] * v->edir[i];
     progress_stage(v->s.progress, "links: bounces", 0);
-    for (int b = 0; b < v->s.bounces; b++) {
+    /* POV-Ray's recursion_limit counts the bounces of gathered light
+     * (radrules.h rule 6): one sweep each; brightness scales every one */
+    radrules rr = radrules_of(sc, 1);
+    int sweeps = v->s.bounces > 0 ? v->s.bounces : (rr.recursion_limit > 0 ? rr.recursion_limit : 3);
+    st->sweeps = sweeps;
+    if (rr.brightness != 1.0)
+        for (long i = 0; i < (long)n4; i++) v->b0[i] *= (float)rr.brightness;
+    for (int b = 0; b < sweeps; b++) {
         gi_c_vgather(nthreads, v->off_csr, v->peer_csr, v->w_csr, v->b0, v->rho, (int)v->ne, v->b1, v->itot);
+        if (rr.brightness != 1.0)
+            for (long i = 0; i < (long)n4; i++) v->b1[i] *= (float)rr.brightness;
         float *tmp = v->b0;
         v->b0 = v->b1;
         v->b1 = tmp;

@@ -16,7 +16,8 @@
  *  - light links: a shadow ray from every element to every light
  *    (POV-Ray's attenuation, spot and cylinder cones, fade; area lights
  *    from their centre);
- *  - gathering: `bounces` Jacobi sweeps over the links (gi_vlinks.cl), then
+ *  - gathering: `bounces` Jacobi sweeps over the links (gi_vlinks.cl; the
+ *    scene's recursion_limit by default, brightness applied per bounce), then
  *    one-ring smoothing between vertices whose normals are within the
  *    feature angle;
  *  - the hook: the smoothed indirect E/pi of the hit triangle's three
@@ -31,8 +32,8 @@
  *
  * Surfaces of other objects (spheres, boxes, planes, ...) block rays and
  * get no vertices: their indirect light is 0 (counted in the stats). Rays
- * that leave the scene bring nothing (no sky light). Emission and
- * POV-Ray's radiosity brightness are not carried. */
+ * that leave the scene bring nothing (no sky light). Emission is not
+ * carried; both sides of a vertex take the texture (not interior_texture). */
 #ifndef PT_GI_VLINKS_H
 #define PT_GI_VLINKS_H
 #include <stdint.h>
@@ -46,7 +47,8 @@ typedef struct gi_vlinks gi_vlinks;
 
 typedef struct {
     int nside;             /* directions per element: nside^2, nside a multiple of 4 (16) */
-    int bounces;           /* Jacobi sweeps (3: the paper's Table 2) */
+    int bounces;           /* Jacobi sweeps; 0: the scene's radiosity recursion_limit, 3 without
+                              one (the paper's Table 2) */
     double feature_deg;    /* smoothing takes one-ring neighbours within this angle (30) */
     int threads;           /* <= 0: all cores */
     gi_pigment_fn pigment; /* pigment at a vertex; NULL: each texture's base colour */
@@ -63,6 +65,7 @@ typedef struct {
     long hits_other;       /* link rays of this frame that ended on a surface without vertices */
     long lookups_other;    /* hook calls on surfaces without vertices */
     int full;              /* every element linked (first frame, structure changed) */
+    int sweeps;            /* gathering sweeps run */
     double t_links, t_light, t_bounces, t_smooth; /* seconds */
 } gi_vlinks_stats;
 

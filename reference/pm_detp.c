@@ -45,7 +45,6 @@
 #include "timer.h"
 
 #define PATH_CHUNK 256
-#define SEG_CHUNK 4096
 #define MAX_CELLS (1 << 21)
 /* How far past its hit (in disc radii) a segment goes on for receivers on
  * the object it hit: the same in share() and in the walk that proposes
@@ -60,6 +59,11 @@ typedef struct {
     int hit_leaf;      /* leaf index of the hit, -1 none, -2 a leaf not enumerated */
     int from_leaf;     /* leaf index of l.from.obj, -1 none, -2 not enumerated */
 } seg;
+
+typedef struct {
+    seg *v;
+    int n;
+} path;
 
 typedef struct {
     vec3 p, n;         /* hit point and the normal facing the camera */
@@ -80,14 +84,15 @@ struct pm_detp {
     int init;                  /* bounds, radius and the share scale are set (first frame) */
     vec3 bounds[2];            /* first frame's: the photon sources' allocation */
     double radius, qscale, eps;
+    double ray_eps;            /* first frame's pm_lights_eps: where photon rays start off surfaces */
     /* the previous frame's objects */
     uint64_t *obj_hash;
     int nobj;
     int nleaves;
-    /* paths: segments of path i are segs[poff[i] .. poff[i+1]) */
+    /* paths: each its own array of segments (a frame rewrites only the
+     * paths it re-traces) */
     long npaths;
-    long *poff;
-    seg *segs;
+    path *paths;
     /* receivers, one per pixel, and their sums */
     int w, h;
     receiver *rec;
@@ -319,15 +324,14 @@ typedef struct {
     const pm_photon_walker *wk;
     const scene_leaves *lv;
     const unsigned char *moving;  /* per leaf */
-    const seg *old;               /* previous frame's segments (NULL: a full frame) */
-    const long *old_off;
+    int incremental;              /* 0: a full frame (every path traced from its source) */
     const rgrid *ginc;            /* receivers that keep their sums */
     int nthreads;
     applier *ap_minus, *ap_plus;  /* per thread */
-    segvec *out;                  /* per chunk */
-    long *path_n;                 /* segments of each path, this frame */
+    segvec *scratch;              /* per thread: the path being traced */
     long chunks;
-    _Atomic long retraced, nold, nnew, rays;
+    _Atomic long retraced, nold, nnew, rays, nsegs;
+    atomic_int oom;
     /* filled while walking one path */
 } frame_ctx;
 
@@ -373,69 +377,82 @@ static int seg_valid(const frame_ctx *fc, const seg *s, long *rays)
     return !accel_intersect(fc->mob, s->l.o, s->l.w, 0.0, tmax, &h);
 }
 
+/* Path i's new array: its first k old segments, then what out holds. */
+static int path_store(path *p, const seg *old, long k, const segvec *out)
+{
+    long n = k + out->n;
+    seg *v = malloc(sizeof *v * (size_t)(n > 0 ? n : 1));
+    if (!v || out->oom) {
+        free(v);
+        return 0;
+    }
+    if (k) memcpy(v, old, sizeof *v * (size_t)k);
+    if (out->n) memcpy(v + k, out->v, sizeof *v * (size_t)out->n);
+    free(p->v);
+    p->v = v;
+    p->n = (int)n;
+    return 1;
+}
+
 static void path_job(void *ctx, int ci, int thread)
 {
     frame_ctx *fc = ctx;
     if (fc->dp->s.cancel && *fc->dp->s.cancel) return;
     long i0 = (long)ci * PATH_CHUNK, i1 = i0 + PATH_CHUNK < fc->dp->npaths ? i0 + PATH_CHUNK : fc->dp->npaths;
-    segvec *out = &fc->out[ci];
-    long rays = 0, retraced = 0, nold = 0, nnew = 0;
+    segvec *out = &fc->scratch[thread];
+    long rays = 0, retraced = 0, nold = 0, nnew = 0, nsegs = 0;
     for (long i = i0; i < i1; i++) {
+        path *p = &fc->dp->paths[i];
+        out->n = 0;
         walk_sink ws = {fc, out, NULL, 0};
-        if (!fc->old) {
+        if (!fc->incremental) {
             pm_photon_walk(fc->wk, i, NULL, on_seg, &ws, &rays);
-            fc->path_n[i] = ws.count;
+            if (!path_store(p, NULL, 0, out)) atomic_store(&fc->oom, 1);
             retraced++;
+            nsegs += p->n;
             continue;
         }
-        const seg *ps = fc->old + fc->old_off[i];
-        long n = fc->old_off[i + 1] - fc->old_off[i], k = 0;
+        const seg *ps = p->v;
+        long n = p->n, k = 0;
         while (k < n && seg_valid(fc, &ps[k], &rays)) k++;
         if (k < n) {
             pm_photon_launch l = ps[k].l;
             /* resumed at segment k, or traced again from the source (when
-             * k is 0, or its surface is not known in this frame) */
+             * k is 0, or its surface is not known in this frame); kept
+             * segments' `from` pointers are the frame's they were traced
+             * in: only a resumed launch's is read, set here */
             int resume = k > 0 && l.bounce > 0 && (!l.from.obj || ps[k].from_leaf >= 0);
             if (!resume) k = 0;
             if (l.from.obj && ps[k].from_leaf >= 0) l.from.obj = scene_leaves_get(fc->lv, ps[k].from_leaf);
-            for (long j = 0; j < k; j++) {
-                segvec_push(out, &ps[j]);
-                /* the launch's surface in this frame's scene */
-                if (ps[j].from_leaf >= 0 && !out->oom) out->v[out->n - 1].l.from.obj = scene_leaves_get(fc->lv, ps[j].from_leaf);
-            }
             for (long j = k; j < n; j++) apply_seg(&fc->ap_minus[thread], fc->ginc, &ps[j]);
             nold += n - k;
             retraced++;
             ws.plus = &fc->ap_plus[thread];
             pm_photon_walk(fc->wk, i, resume ? &l : NULL, on_seg, &ws, &rays);
             nnew += ws.count;
-            fc->path_n[i] = k + ws.count;
-        } else {
-            for (long j = 0; j < n; j++) {
-                segvec_push(out, &ps[j]);
-                if (ps[j].from_leaf >= 0 && !out->oom) out->v[out->n - 1].l.from.obj = scene_leaves_get(fc->lv, ps[j].from_leaf);
-            }
-            fc->path_n[i] = n;
+            if (!path_store(p, ps, k, out)) atomic_store(&fc->oom, 1);
         }
+        nsegs += p->n;
     }
     atomic_fetch_add(&fc->rays, rays);
     atomic_fetch_add(&fc->retraced, retraced);
     atomic_fetch_add(&fc->nold, nold);
     atomic_fetch_add(&fc->nnew, nnew);
+    atomic_fetch_add(&fc->nsegs, nsegs);
 }
 
 typedef struct {
     pm_detp *dp;
     const rgrid *g;
     applier *ap;
-    long nsegs;
 } full_ctx;
 
 static void full_job(void *ctx, int ci, int thread)
 {
     full_ctx *f = ctx;
-    long i0 = (long)ci * SEG_CHUNK, i1 = i0 + SEG_CHUNK < f->nsegs ? i0 + SEG_CHUNK : f->nsegs;
-    for (long i = i0; i < i1; i++) apply_seg(&f->ap[thread], f->g, &f->dp->segs[i]);
+    long i0 = (long)ci * PATH_CHUNK, i1 = i0 + PATH_CHUNK < f->dp->npaths ? i0 + PATH_CHUNK : f->dp->npaths;
+    for (long i = i0; i < i1; i++)
+        for (int k = 0; k < f->dp->paths[i].n; k++) apply_seg(&f->ap[thread], f->g, &f->dp->paths[i].v[k]);
 }
 
 typedef struct {
@@ -487,10 +504,9 @@ pm_detp *pm_detp_new(const pm_detp_settings *s)
 
 static void drop_frame(pm_detp *dp)
 {
-    free(dp->segs);
-    free(dp->poff);
-    dp->segs = NULL;
-    dp->poff = NULL;
+    for (long i = 0; i < dp->npaths && dp->paths; i++) free(dp->paths[i].v);
+    free(dp->paths);
+    dp->paths = NULL;
     dp->npaths = 0;
     dp->have = 0;
 }
@@ -507,6 +523,24 @@ void pm_detp_free(pm_detp *dp)
 }
 
 void pm_detp_set_progress(pm_detp *dp, progress *p) { dp->s.progress = p; }
+
+uint64_t pm_detp_paths_hash(const pm_detp *dp)
+{
+    uint64_t h = PT_FNV1A_BASIS;
+    if (!dp->paths) return h;
+    for (long i = 0; i < dp->npaths; i++) {
+        h = pt_fnv1a(h, &i, sizeof i);
+        for (int k = 0; k < dp->paths[i].n; k++) {
+            const seg *s = &dp->paths[i].v[k];
+            h = pt_fnv1a(h, &s->l.o, sizeof s->l.o);
+            h = pt_fnv1a(h, &s->l.w, sizeof s->l.w);
+            h = pt_fnv1a(h, &s->t, sizeof s->t);
+            h = pt_fnv1a(h, &s->hit_leaf, sizeof s->hit_leaf);
+            h = pt_fnv1a(h, &s->carried, sizeof s->carried);
+        }
+    }
+    return h;
+}
 
 const int64_t *pm_detp_sums(const pm_detp *dp, long *npixels, double *scale)
 {
@@ -560,8 +594,7 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     unsigned char *moving = NULL, *pick = NULL;
     uint64_t *hashes = NULL;
     receiver *rec = NULL;
-    segvec *out = NULL;
-    long *path_n = NULL;
+    segvec *scratch = NULL;
     applier *aps = NULL;
     unsigned *stamps = NULL;
     rgrid ginc, gfull;
@@ -642,12 +675,13 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
         if (!(diag_len > 0.0) || !isfinite(diag_len)) diag_len = accel_scale(a);
         dp->radius = dp->s.radius > 0.0 ? dp->s.radius : PM_DETP_RADIUS * diag_len;
         dp->eps = 1e-7 * diag_len;
+        dp->ray_eps = pm_lights_eps(L);
     }
     st->radius = dp->radius;
     pm_photon_settings ps = {dp->s.photons, 0, dp->s.max_bounces > 0 ? dp->s.max_bounces : 256, dp->s.seed, dp->s.threads,
                              dp->s.cancel, NULL, 1};
     long npaths = 0;
-    wk = pm_photon_walker_new(sc, a, L, &ps, dp->bounds, &npaths, &status);
+    wk = pm_photon_walker_new(sc, a, L, &ps, dp->bounds, dp->ray_eps, &npaths, &status);
     if (!wk) goto done;
     if (dp->have && npaths != dp->npaths) {
         full = "the photon sources changed";
@@ -664,7 +698,7 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
         status = PT_ERR_NOMEM;
         goto done;
     }
-    cam_ctx cc = {sc, a, lv, rec, width, height, pm_lights_eps(L), 0};
+    cam_ctx cc = {sc, a, lv, rec, width, height, dp->ray_eps, 0};
     pool_run(nthreads, height, cam_job, &cc);
     st->rays += atomic_load(&cc.rays);
     int same_image = dp->have && dp->w == width && dp->h == height && dp->E;
@@ -721,10 +755,13 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     /* 3. paths */
     aps = calloc((size_t)nthreads * 3, sizeof *aps);
     stamps = calloc((size_t)nthreads * 3 * (size_t)(np > 0 ? np : 1), sizeof *stamps);
-    path_n = calloc((size_t)(npaths > 0 ? npaths : 1), sizeof *path_n);
     long nchunks = (npaths + PATH_CHUNK - 1) / PATH_CHUNK;
-    out = calloc((size_t)(nchunks > 0 ? nchunks : 1), sizeof *out);
-    if (!aps || !stamps || !path_n || !out) {
+    scratch = calloc((size_t)nthreads, sizeof *scratch);
+    if (!dp->have) {
+        drop_frame(dp);
+        dp->paths = calloc((size_t)(npaths > 0 ? npaths : 1), sizeof *dp->paths);
+    }
+    if (!aps || !stamps || !scratch || !dp->paths) {
         status = PT_ERR_NOMEM;
         goto done;
     }
@@ -745,14 +782,12 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     fc.wk = wk;
     fc.lv = lv;
     fc.moving = moving;
-    fc.old = dp->have ? dp->segs : NULL;
-    fc.old_off = dp->poff;
+    fc.incremental = dp->have;
     fc.ginc = &ginc;
     fc.nthreads = nthreads;
     fc.ap_minus = aps;
     fc.ap_plus = aps + nthreads;
-    fc.out = out;
-    fc.path_n = path_n;
+    fc.scratch = scratch;
     dp->npaths = npaths;
     progress_stage(dp->s.progress, "detp: photon paths", nchunks);
     pool_run_counted(nthreads, (int)nchunks, path_job, &fc, dp->s.cancel, dp->s.progress);
@@ -761,35 +796,12 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
         drop_frame(dp);
         goto done;
     }
-    long total = 0;
-    for (long c = 0; c < nchunks; c++) {
-        if (out[c].oom) status = PT_ERR_NOMEM;
-        total += out[c].n;
-    }
-    if (status != PT_OK) {
-        drop_frame(dp);
-        goto done;
-    }
-    seg *segs = malloc(sizeof *segs * (size_t)(total > 0 ? total : 1));
-    long *poff = malloc(sizeof *poff * (size_t)(npaths + 1));
-    if (!segs || !poff) {
-        free(segs);
-        free(poff);
+    if (atomic_load(&fc.oom)) {
         status = PT_ERR_NOMEM;
         drop_frame(dp);
         goto done;
     }
-    long k = 0;
-    for (long c = 0; c < nchunks; c++) {
-        if (out[c].n) memcpy(segs + k, out[c].v, sizeof *segs * (size_t)out[c].n);
-        k += out[c].n;
-    }
-    poff[0] = 0;
-    for (long i = 0; i < npaths; i++) poff[i + 1] = poff[i] + path_n[i];
-    free(dp->segs);
-    free(dp->poff);
-    dp->segs = segs;
-    dp->poff = poff;
+    long total = atomic_load(&fc.nsegs);
     st->paths = npaths;
     st->segments = total;
     st->paths_retraced = atomic_load(&fc.retraced);
@@ -801,7 +813,11 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     /* the share scale, fixed by the first frame's largest share */
     if (!(dp->qscale > 0.0)) {
         double mx = 0.0;
-        for (long i = 0; i < total; i++) mx = fmax(mx, fmax(segs[i].carried.r, fmax(segs[i].carried.g, segs[i].carried.b)));
+        for (long i = 0; i < npaths; i++)
+            for (int k = 0; k < dp->paths[i].n; k++) {
+                rgb c = dp->paths[i].v[k].carried;
+                mx = fmax(mx, fmax(c.r, fmax(c.g, c.b)));
+            }
         double smax = mx / (M_PI * dp->radius * dp->radius);
         dp->qscale = smax > 0.0 && isfinite(smax) ? ldexp(1.0, 32) / smax : 1.0;
     }
@@ -809,10 +825,10 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     /* 4. receivers estimated from all segments */
     double t1 = timer_now();
     if (nfull > 0) {
-        full_ctx fx = {dp, &gfull, aps + 2 * nthreads, total};
+        full_ctx fx = {dp, &gfull, aps + 2 * nthreads};
         for (int t = 0; t < nthreads; t++) aps[2 * nthreads + t].sign = 1;
-        progress_stage(dp->s.progress, "detp: estimate", (total + SEG_CHUNK - 1) / SEG_CHUNK);
-        pool_run_counted(nthreads, (int)((total + SEG_CHUNK - 1) / SEG_CHUNK), full_job, &fx, dp->s.cancel, dp->s.progress);
+        progress_stage(dp->s.progress, "detp: estimate", nchunks);
+        pool_run_counted(nthreads, (int)nchunks, full_job, &fx, dp->s.cancel, dp->s.progress);
     }
     st->t_estimate = timer_now() - t1;
     rgrid_free(&dp->look);
@@ -829,10 +845,9 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     dp->sc = sc;
     dp->have = 1;
 done:
-    if (out)
-        for (long c = 0; c < (npaths + PATH_CHUNK - 1) / PATH_CHUNK; c++) free(out[c].v);
-    free(out);
-    free(path_n);
+    if (scratch)
+        for (int t = 0; t < nthreads; t++) free(scratch[t].v);
+    free(scratch);
     free(aps);
     free(stamps);
     rgrid_free(&ginc);

@@ -91,5 +91,8 @@ rgb pm_detp_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread);
 /* The receivers' integer sums, 3 per pixel (row by row; 0 without a
  * hit), and the scale that turns them into irradiance (E = sum * scale). */
 const int64_t *pm_detp_sums(const pm_detp *dp, long *npixels, double *scale);
+/* FNV-1a of every stored segment's origin, direction, hit distance, hit
+ * object and power, path by path (tests: the paths themselves equal). */
+uint64_t pm_detp_paths_hash(const pm_detp *dp);
 
 #endif

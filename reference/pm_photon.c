@@ -574,7 +574,7 @@ struct pm_photon_walker {
 };
 
 pm_photon_walker *pm_photon_walker_new(const scene *sc, const accel *a, const pm_lights *L, const pm_photon_settings *s,
-                                       const vec3 *bounds, long *paths, pt_status *st)
+                                       const vec3 *bounds, double eps, long *paths, pt_status *st)
 {
     pm_photon_walker *w = calloc(1, sizeof *w);
     *paths = 0;
@@ -590,6 +590,7 @@ pm_photon_walker *pm_photon_walker_new(const scene *sc, const accel *a, const pm
         return NULL;
     }
     w->c.s = &w->s;
+    if (eps > 0.0) w->c.eps = eps;
     *paths = w->c.src ? w->c.total : 0;
     return w;
 }

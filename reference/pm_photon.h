@@ -102,10 +102,12 @@ typedef struct pm_photon_walker pm_photon_walker;
 /* The sources of sc with s->photons shared among them as pm_photons_trace
  * shares them; bounds (lo, hi; NULL: the accel's) fix the allocation
  * proxies and where parallel lights' and the background's photons are aimed,
- * so that a later frame can keep the first frame's. *paths: the paths
- * [0, *paths) there are. The scene, accel and L must outlive it. */
+ * and eps (0: pm_lights_eps(L)) the distance rays start off surfaces, so
+ * that a later frame can keep the first frame's (both follow the scene's
+ * extent, which moving objects change). *paths: the paths [0, *paths)
+ * there are. The scene, accel and L must outlive it. */
 pm_photon_walker *pm_photon_walker_new(const scene *sc, const accel *a, const pm_lights *L, const pm_photon_settings *s,
-                                       const vec3 *bounds, long *paths, pt_status *st);
+                                       const vec3 *bounds, double eps, long *paths, pt_status *st);
 /* Path `index` from its source (resume NULL) or from a launch fn saw (its
  * `from` object in this walker's scene). Thread-safe; *rays counts the
  * intersection queries. */

@@ -156,6 +156,7 @@ static void test_detp_incremental(void **state)
                fr, si.full_frame ? "full" : "incremental", si.moving_objects, si.paths_retraced, si.paths, 100.0 * frac,
                si.segments_old, si.segments_new, si.receivers_full, si.receivers, differ, n1 * 3);
         assert_int_equal(differ, 0);
+        assert_true(pm_detp_paths_hash(inc) == pm_detp_paths_hash(full));
         assert_true(nonzero > n1);
         assert_int_equal(si.segments, sf.segments);
         assert_int_equal(sf.full_frame, 1);
@@ -167,6 +168,53 @@ static void test_detp_incremental(void **state)
             assert_true(frac > 0.0 && frac < 0.3);
             assert_true(si.receivers_full > 0 && si.receivers_full < si.receivers / 3);
         }
+        unload(&f);
+    }
+    pm_detp_free(inc);
+    pm_detp_free(full);
+}
+
+/* raddem.pov's set-up in small: a divider turning with the clock changes
+ * the scene's extent (and with it the distance rays start off surfaces):
+ * the paths stay those of the full recomputation. */
+static const char *turning_scene =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 radiosity { recursion_limit 4 } }\n"
+    "camera { location <-1.5, 2, -29.9> direction z * 1.75 look_at <0.5, -1, 0> }\n"
+    "light_source { <0, 9.5, 0> color rgb 0.45 fade_distance 15 fade_power 2 shadowless }\n"
+    "box { -1, 1 scale <10, 10, 30> pigment { rgb 1 } finish { ambient 0 } inverse }\n"
+    "box { -1, 1 scale <9, 8, 0.2> pigment { rgb <1, 0.2, 0.2> } finish { ambient 0 }\n"
+    "      rotate y * 90 rotate y * (clock * 360) translate z * 10 }\n";
+
+static void test_detp_turning(void **state)
+{
+    (void)state;
+    const int nframes = 5;
+    pm_detp *inc = make(20000, 0), *full = make(20000, 1);
+    for (int fr = 1; fr <= nframes; fr++) {
+        frame f;
+        f.d = diag_new();
+        sdl_options o;
+        sdl_default_options(&o);
+        assert_int_equal(sdl_set_frame(&o, 1, nframes, 0.0, 1.0, 1, fr), 0);
+        assert_int_equal(sdl_parse_string("turn.pov", turning_scene, &o, &f.sc, f.d), PT_OK);
+        pt_status st;
+        f.a = accel_build(f.sc, 2, f.d, &st);
+        assert_non_null(f.a);
+        pm_detp_frame_info fi = {0, 1};
+        pm_detp_stats si, sf;
+        assert_int_equal(pm_detp_frame(inc, f.sc, f.a, 40, 30, &fi, &si, f.d), PT_OK);
+        assert_int_equal(pm_detp_frame(full, f.sc, f.a, 40, 30, &fi, &sf, f.d), PT_OK);
+        long n;
+        double sc;
+        const int64_t *e1 = pm_detp_sums(inc, &n, &sc), *e2 = pm_detp_sums(full, &n, &sc);
+        int same_paths = pm_detp_paths_hash(inc) == pm_detp_paths_hash(full);
+        printf("  detp turning divider frame %d: %.2f%% of paths re-traced, paths %s, sums %s\n", fr,
+               100.0 * (double)si.paths_retraced / (double)si.paths, same_paths ? "equal" : "DIFFER",
+               memcmp(e1, e2, sizeof *e1 * (size_t)n * 3) == 0 ? "equal" : "DIFFER");
+        assert_true(same_paths);
+        assert_memory_equal(e1, e2, sizeof *e1 * (size_t)n * 3);
+        if (fr > 1) assert_int_equal(si.full_frame, 0);
         unload(&f);
     }
     pm_detp_free(inc);
@@ -314,6 +362,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_detp_sphere),
         cmocka_unit_test(test_detp_incremental),
+        cmocka_unit_test(test_detp_turning),
         cmocka_unit_test(test_detp_static_frame),
         cmocka_unit_test(test_links_sphere),
         cmocka_unit_test(test_links_incremental),
