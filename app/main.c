@@ -289,7 +289,8 @@ static void gi_keep_free(gi_keep *k)
  *    lights in place);
  *  - lighting: every light's fields;
  *  - view: the camera, which the view stage always takes as given (an
- *    animation's geometry stage does not read it: view_independent).
+ *    animation's geometry stage looks from its initial frame's camera
+ *    whatever the frame: geometry_camera).
  * Returns 1 when h_geom holds the frame number. */
 static int stage_hashes(const scene *sc, int frame_dependent, int frame, uint64_t *h_geom, uint64_t *h_light)
 {
@@ -336,12 +337,12 @@ static int stage_hashes(const scene *sc, int frame_dependent, int frame, uint64_
  * keeps the same from frame to frame but another process may not: the
  * declarations (-D, Declare=), the image size (image_width and
  * image_height are scene values), the animation values when the scene read
- * them outside the camera and lights, a still's camera position (its
- * geometry stage keeps the particles that face it, gi_particle.c
- * trace_and_prune; an animation's does not read the camera), and this
- * partray's version. The GI settings are checked by the cache itself. */
-static uint64_t gi_cache_key(const scene *sc, uint64_t h_geom, const sdl_options *so, int frame_dependent,
-                             int view_independent)
+ * them outside the camera and lights, the camera the geometry stage looks
+ * from (cam: the surfaces' sides and clip box, the particles placed by the
+ * view, the pruning; its projection, not its pointers or focal blur), and
+ * this partray's version. The GI settings are checked by the cache
+ * itself. */
+static uint64_t gi_cache_key(uint64_t h_geom, const sdl_options *so, int frame_dependent, const scene_camera *cam)
 {
     uint64_t k = FNV(PT_FNV1A_BASIS, h_geom);
     for (int i = 0; i < so->ndefines; i++) k = pt_fnv1a(k, so->defines[i], strlen(so->defines[i]) + 1);
@@ -352,7 +353,18 @@ static uint64_t gi_cache_key(const scene *sc, uint64_t h_geom, const sdl_options
         k = FNV(k, so->clock_delta);
         k = FNV(k, so->frame_number);
     }
-    if (sc->camera_set && !view_independent) k = FNV(k, sc->camera.location);
+    if (cam) {
+        k = FNV(k, cam->kind);
+        k = FNV(k, cam->cylinder_type);
+        k = FNV(k, cam->location);
+        k = FNV(k, cam->direction);
+        k = FNV(k, cam->up);
+        k = FNV(k, cam->right);
+        k = FNV(k, cam->sky);
+        k = FNV(k, cam->look_at);
+        k = FNV(k, cam->angle);
+        k = FNV(k, cam->v_angle);
+    }
     return pt_fnv1a(k, PARTRAY_VERSION, strlen(PARTRAY_VERSION));
 }
 
@@ -365,6 +377,8 @@ typedef struct {
     int tile;               /* 1: a window smaller than the image was asked for */
     double t_start;
     gi_keep keep;           /* particle GI of the previous frame */
+    scene_camera geo_cam;   /* an animation's initial frame's camera, pointers cleared (geometry_camera) */
+    int have_geo_cam;
     pm_detp *detp;          /* --gi detp: the photon paths of the previous frame */
     gi_vlinks *links;       /* --gi links: the vertex links of the previous frame */
     uint64_t links_h_geom;  /* and its geometry stage hash (stage_hashes) */
@@ -386,6 +400,49 @@ static framebuffer *straight_alpha(const framebuffer *fb)
     for (size_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++) c->rgb[i * 3 + k] = fb->alpha[i] > 0 ? fb->rgb[i * 3 + k] / fb->alpha[i] : fb->rgb[i * 3 + k];
     return c;
+}
+
+/* The camera an animation's particle GI geometry stage looks from in every
+ * frame when its geometry is the same in all of them (stage_hashes without
+ * the frame): the initial frame's (+KFI), so that a frame's GI is the same
+ * whether an earlier frame of the run built it or the frame is rendered
+ * alone (--frame N, a farm task). sc: this frame's scene (frame `frame`);
+ * another frame parses the scene at +KFI once. Its pointers (camera
+ * normal, mesh camera) are cleared: the stage's probe rays go through the
+ * pixel centres of the plain projection. NULL: the scene's own camera (a
+ * still, a mesh camera, or the initial frame failed to parse: an error in
+ * d and *st). */
+static const scene_camera *geometry_camera(render_run *run, const anim_plan *plan, int frame, const scene *sc, diag *d,
+                                           pt_status *st)
+{
+    if (!plan->animated || sc->camera.kind == CAMERA_MESH) return NULL;
+    if (!run->have_geo_cam) {
+        if (frame == plan->initial_frame) {
+            run->geo_cam = sc->camera;
+        } else {
+            sdl_options so;
+            fill_sdl_options(&so, run->o, plan, plan->initial_frame);
+            diag *pd = diag_new(); /* the scene's #debug text was shown by this frame's parse */
+            scene *s0 = NULL;
+            *st = pipeline_parse(run->o->scene, &so, &s0, pd, NULL);
+            if (*st != PT_OK) {
+                for (int i = 0; i < diag_count(pd); i++) {
+                    const diag_msg *m = diag_get(pd, i);
+                    if (m->severity == DIAG_ERROR) diag_report(d, DIAG_ERROR, m->loc, NULL, "%s", m->text);
+                }
+                diag_free(pd);
+                return NULL;
+            }
+            diag_free(pd);
+            run->geo_cam = s0->camera;
+            scene_free(s0);
+        }
+        run->geo_cam.normal = NULL;
+        run->geo_cam.meshes = NULL;
+        run->geo_cam.nmeshes = 0;
+        run->have_geo_cam = 1;
+    }
+    return &run->geo_cam;
 }
 
 /* Frame `frame` of the plan (a still: frame 0), written to outputs[]. */
@@ -443,16 +500,24 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     int reuse = 0, relight = 0, keep_gi = gi == GI_PARTICLE && plan->animated && !run->tile;
     uint64_t h_geom = 0, h_light = 0, scene_hash = sc->input_hash;
     int per_frame = gi == GI_PARTICLE && stage_hashes(sc, frame_dependent, frame, &h_geom, &h_light);
-    /* An animation's geometry stage does not read the camera, so that a
-     * frame that keeps an earlier frame's GI renders what it would alone
-     * (and so would a tile of it on a farm). Its frames share one cache;
-     * when the geometry changes from frame to frame each has its own,
-     * numbered as the outputs (a frame that keeps an earlier one's GI in
-     * this run writes none). */
+    /* An animation whose geometry is the same in every frame builds it from
+     * the initial frame's camera (geometry_camera), so that a frame that
+     * keeps an earlier frame's GI renders what it would alone (and so would
+     * a tile of it on a farm), and its frames share one cache. When the
+     * geometry changes from frame to frame, every frame builds its own from
+     * its own camera, with a cache each, numbered as the outputs. */
+    const scene_camera *geo_cam = gi == GI_PARTICLE && !per_frame ? geometry_camera(run, plan, frame, sc, d, &st) : NULL;
+    if (st != PT_OK) {
+        scene_free(sc);
+        diag_free(d);
+        pbar_free(bar);
+        return status_exit(st);
+    }
     char *gi_cache_frame = gi == GI_PARTICLE && o->gi_cache && plan->animated && per_frame
                                ? anim_output_name(o->gi_cache, frame, plan->digits) : NULL;
     const char *gi_cache = gi_cache_frame ? gi_cache_frame : (gi == GI_PARTICLE ? o->gi_cache : NULL);
-    uint64_t cache_key = gi_cache ? gi_cache_key(sc, h_geom, &so, frame_dependent, plan->animated) : 0;
+    uint64_t cache_key = gi_cache ? gi_cache_key(h_geom, &so, frame_dependent,
+                                                 geo_cam ? geo_cam : (sc->camera_set ? &sc->camera : NULL)) : 0;
     if (o->gi_cache && !gi_cache)
         diag_warn_once(d, (src_loc){0}, "--gi-cache applies to --gi particle, not %s: ignored", gi_used);
     if (keep_gi) {
@@ -544,7 +609,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     ss.gi_cache = gi_cache;
     ss.gi_cache_load = gi_cache && access(gi_cache, F_OK) == 0;
     ss.gi_cache_key = cache_key;
-    ss.view_independent = plan->animated;
+    ss.geometry_camera = geo_cam;
     if (run->tile) memcpy(ss.window, run->win, sizeof ss.window);
     char *progressive = NULL;
     if ((gi == GI_PATH || gi == GI_PMFG) && noutputs > 0 && img_format_from_path(outputs[0]) != IMG_FMT_UNKNOWN) {

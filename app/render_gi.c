@@ -92,7 +92,7 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     /* camera rays through pixel centres (no fixed supersampling): the
      * pre-pass's hits serve the render (gi_particle_primary_hit) */
     gs.keep_hits = o->antialias != 2;
-    gs.view_independent = o->view_independent;
+    gs.camera = o->geometry_camera;
     pt_status st = PT_OK;
     double t0 = timer_now();
     gi_particle *gp = o->reuse;

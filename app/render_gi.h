@@ -65,8 +65,8 @@ typedef struct {
     const char *gi_cache;
     int gi_cache_load;
     uint64_t gi_cache_key;
-    int view_independent;     /* particle: the geometry stage does not read the camera
-                                 (gi_particle_settings.view_independent; animations) */
+    const scene_camera *geometry_camera; /* particle: the camera of the geometry stage
+                                 (gi_particle_settings.camera); NULL: the scene's */
     long vpls;                /* vpl: VPL count (0 = default) */
     int vpl_cut;              /* vpl: RENDER_VPL_* (render_vpl.h) */
     int vpl_adaptive;         /* vpl: 0 default (on), 1 on, 2 off */

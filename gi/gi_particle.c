@@ -221,8 +221,8 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
          * Under a sky that is not black, a particle facing the camera
          * receives light even when all its rays leave the scene (the top
          * of a box under the open sky). */
-        if (gp->sc->camera_set && !gp->set.view_independent) {
-            const scene_camera *cam = &gp->sc->camera;
+        if (gp->set.camera || gp->sc->camera_set) {
+            const scene_camera *cam = gp->set.camera ? gp->set.camera : &gp->sc->camera;
             int sky = !gi_sky_black(gp->sky);
             for (int i = 0; i < n; i++) {
                 if (linked[i]) continue;
@@ -448,6 +448,14 @@ gi_particle *gi_particle_begin(const scene *sc, const accel *a, const gi_particl
     if (s) gp->set = *s;
     else gi_particle_default_settings(&gp->set);
     gi_particle_settings *set = &gp->set;
+    if (set->camera) {
+        /* the geometry stage sees the scene from settings.camera */
+        gp->gcam = *set->camera;
+        set->camera = &gp->gcam;
+        gp->gsc = *sc;
+        gp->gsc.camera = gp->gcam;
+        gp->gsc.camera_set = 1;
+    }
     if (set->scatter_side < 1) set->scatter_side = 1;
     if (set->scatter_side > 4) set->scatter_side = 4; /* GI_MAX_SCATTER links */
     if (set->gather_side < 1) set->gather_side = 1;
@@ -480,7 +488,7 @@ gi_particle *gi_particle_begin(const scene *sc, const accel *a, const gi_particl
 
     progress_stage(set->progress, "gi geometry: surfaces", 0);
     double tg = timer_now();
-    gp->surf = gi_surface_build(sc, a, 1e30, d, &st);
+    gp->surf = gi_surface_build(set->camera ? &gp->gsc : sc, a, 1e30, d, &st);
     if (!gp->surf) {
         *status = st == PT_OK ? PT_ERR_INTERNAL : st;
         gi_particle_free(gp);

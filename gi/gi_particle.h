@@ -126,11 +126,11 @@ typedef struct {
                             (no fixed supersampling); beyond 256 MiB of records (248 bytes a pixel) or
                             without the memory none are kept and the coarse pre-pass runs. 0
                             (default): nothing kept */
-    int view_independent; /* 1: the geometry stage does not read the camera: a particle no link ray
-                             ends on is kept when a ray of its own hit something (or under a sky),
-                             whichever way it faces; its result serves any camera (an animation's
-                             frames, a GI cache shared by them). 0 (default): such a particle is kept
-                             only when it faces the camera's position (trace_and_prune) */
+    const scene_camera *camera; /* the camera the geometry stage looks from: the surfaces' sides,
+                             bounds and clip box, the particles placed by what it shows, the pruning
+                             of particles that face away from it (trace_and_prune). NULL (default):
+                             the scene's. An animation gives every frame its initial frame's, so
+                             that a frame's geometry is the same in one run and rendered alone */
     uint64_t seed;
     int threads;         /* <= 0: all cores */
     const char *cl_device; /* NULL/"auto", "c", "P:D" or part of a name (gi_cl.h) */
@@ -261,7 +261,7 @@ void gi_particle_free(gi_particle *gp);
  * geometry settings (count, links, bounces, seed, radii), or whose
  * particles do not fit this scene's surfaces; an unreadable file is
  * PT_ERR_IO. */
-#define GI_PARTICLE_CACHE_VERSION 2
+#define GI_PARTICLE_CACHE_VERSION 3
 pt_status gi_particle_save(gi_particle *gp, const char *path, uint64_t scene_key, diag *d);
 gi_particle *gi_particle_load(const scene *sc, const accel *a, const gi_particle_settings *s, const char *path,
                               uint64_t scene_key, gi_particle_stats *stats, diag *d, pt_status *status);

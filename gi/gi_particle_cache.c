@@ -38,7 +38,7 @@ static const char cache_magic[17] = "partray GI cache\n";
  * asks for the same ones (the lighting and view settings may differ). */
 typedef struct {
     int64_t count;
-    int32_t scatter_side, gather_side, bounces, scatter, view_independent, pad;
+    int32_t scatter_side, gather_side, bounces, scatter;
     double tess, tess_factor, radius, radius_factor, normal_cos, brightness;
     uint64_t seed;
 } cache_settings;
@@ -62,7 +62,6 @@ static cache_settings settings_of(const gi_particle_settings *s)
     c.gather_side = s->gather_side;
     c.bounces = s->bounces;
     c.scatter = s->scatter;
-    c.view_independent = s->view_independent;
     c.tess = s->tess;
     c.tess_factor = s->tess_factor;
     c.radius = s->radius;
@@ -191,7 +190,6 @@ static const char *settings_differ(const cache_settings *a, const cache_settings
     if (a->bounces != b->bounces) return "bounces";
     if (a->scatter != b->scatter) return "scattering mode";
     if (a->seed != b->seed) return "seed";
-    if (a->view_independent != b->view_independent) return "camera rule (a still's cache in an animation, or the reverse)";
     if (memcmp(a, b, sizeof *a) != 0) return "tessellation, list radius, normal threshold or brightness";
     return NULL;
 }

@@ -29,6 +29,8 @@ typedef struct {
 
 struct gi_particle {
     const scene *sc;
+    scene gsc;          /* settings.camera given: *sc with that camera, for the geometry stage */
+    scene_camera gcam;  /* settings.camera's copy (set.camera points here) */
     const accel *a;
     gi_particle_settings set;
     int threads;
