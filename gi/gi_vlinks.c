@@ -702,27 +702,37 @@ pt_status gi_vlinks_frame(gi_vlinks *v, const scene *sc, const accel *a, int obj
     if (full) {
         memset(need, 1, (size_t)v->ne);
     } else if (nmob > 0) {
+        long nmoved = 0;
         for (int mi = 0; mi < v->nmesh; mi++)
-            if (moved_leaf[v->mesh[mi].leaf]) memset(need + 2 * v->mesh[mi].vbase, 1, (size_t)(2 * v->mesh[mi].nverts));
-        scene mobsc = *sc;
-        mobsc.objects = mobobj;
-        mobsc.nobjects = nmob;
-        diag *dq = diag_new();
-        pt_status ms = PT_OK;
-        mob = accel_build(&mobsc, v->s.threads, dq, &ms);
-        diag_free(dq);
-        stale_job S = {v, mob, 1, v3(0, 0, 0), v3(0, 0, 0), moved_leaf, need};
-        for (int k = 0; k < nmob; k++) S.boxed &= scene_object_finite(mobobj[k]);
-        if (mob && S.boxed) {
-            accel_bounds(mob, &S.lo, &S.hi);
-            double g = 1e-6 * v3_len(v3_sub(S.hi, S.lo)) + v->off;
-            S.lo = v3_sub(S.lo, v3(g, g, g));
-            S.hi = v3_add(S.hi, v3(g, g, g));
-        } else {
-            S.boxed = 0;
+            if (moved_leaf[v->mesh[mi].leaf]) {
+                memset(need + 2 * v->mesh[mi].vbase, 1, (size_t)(2 * v->mesh[mi].nverts));
+                nmoved += 2 * v->mesh[mi].nverts;
+            }
+        /* when the moved meshes hold half the elements or more, testing
+         * the rest's rays against them costs about what linking them
+         * again does: link everything */
+        if (2 * nmoved >= v->ne) memset(need, 1, (size_t)v->ne);
+        if (2 * nmoved < v->ne) {
+            scene mobsc = *sc;
+            mobsc.objects = mobobj;
+            mobsc.nobjects = nmob;
+            diag *dq = diag_new();
+            pt_status ms = PT_OK;
+            mob = accel_build(&mobsc, v->s.threads, dq, &ms);
+            diag_free(dq);
+            stale_job S = {v, mob, 1, v3(0, 0, 0), v3(0, 0, 0), moved_leaf, need};
+            for (int k = 0; k < nmob; k++) S.boxed &= scene_object_finite(mobobj[k]);
+            if (mob && S.boxed) {
+                accel_bounds(mob, &S.lo, &S.hi);
+                double g = 1e-6 * v3_len(v3_sub(S.hi, S.lo)) + v->off;
+                S.lo = v3_sub(S.lo, v3(g, g, g));
+                S.hi = v3_add(S.hi, v3(g, g, g));
+            } else {
+                S.boxed = 0;
+            }
+            if (!mob) memset(need, 1, (size_t)v->ne); /* no moved-objects accel: everything again */
+            else pool_run(nthreads, (int)((v->ne + LIGHT_CHUNK - 1) / LIGHT_CHUNK), stale_chunk, &S);
         }
-        if (!mob) memset(need, 1, (size_t)v->ne); /* no moved-objects accel: everything again */
-        else pool_run(nthreads, (int)((v->ne + LIGHT_CHUNK - 1) / LIGHT_CHUNK), stale_chunk, &S);
     }
     long ntodo = 0;
     for (long e = 0; e < v->ne; e++)
