@@ -385,25 +385,35 @@ static pt_status catchment_areas(gi_particles *ps, const int *glink, int ng)
     int n = ps->n;
     if (n <= 0 || ng <= 0) return PT_OK;
     pt_status st = PT_OK;
-    int *g = gi_particle_calloc((size_t)n, sizeof(int), &st), *r = gi_particle_calloc((size_t)n, sizeof(int), &st);
+    double *g = gi_particle_calloc((size_t)n, sizeof(double), &st), *a0 = gi_particle_calloc((size_t)n, sizeof(double), &st);
+    int *r = gi_particle_calloc((size_t)n, sizeof(int), &st);
     if (st != PT_OK) {
         free(g);
+        free(a0);
         free(r);
         return st;
     }
+    /* Where the particles stand at different densities (gi_particles_sample's
+     * view weights: dA / w_i each), the links ending per unit area at x come
+     * from senders of different densities, and each link stands for its
+     * sender's nominal area a_i: sum over the links ending on j of a_i is
+     * ng V_j c(x_j), so V_j ~ (sum a_i) / r_j, which is dA g_j / r_j when
+     * every a_i is dA. The prior is CATCH_PRIOR links of j's own area. */
+    for (int i = 0; i < n; i++) a0[i] = ps->p[i].area > 0.0f ? ps->p[i].area : ps->dA;
     for (int i = 0; i < n; i++) {
         const int *lk = glink + (size_t)i * (size_t)ng;
         for (int k = 0; k < ng; k++)
             if (lk[k] >= 0) {
-                g[lk[k]]++;
+                g[lk[k]] += a0[i];
                 r[i]++;
             }
     }
     for (int j = 0; j < n; j++) {
-        double v = ps->dA * ((double)g[j] + CATCH_PRIOR) / ((double)r[j] + CATCH_PRIOR);
+        double v = (g[j] + CATCH_PRIOR * a0[j]) / ((double)r[j] + CATCH_PRIOR);
         if (isfinite(v) && v > 0.0) ps->p[j].area = (float)v;
     }
     free(g);
+    free(a0);
     free(r);
     return PT_OK;
 }
