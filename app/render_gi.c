@@ -487,6 +487,7 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
         stats_num(js, "bounce", p->t_bounce);
         stats_num(js, "trace", p->t_trace);
         stats_num(js, "gather", p->t_gather);
+        stats_num(js, "gather_pixels", p->t_gather_pixels);
         stats_num(js, "total", p->t_total);
         stats_obj_end(js);
         stats_obj_end(js);

@@ -24,9 +24,12 @@
  *    then 8, 4, 2, 1 with the coherence error over the parents), the others
  *    reconstructed by bilateral upsampling from their 2 or 4 parents;
  *    at mirror and refraction hits gathered at every hit.
+ *  - The sky: at eye hits by one BSDF sample of the Lambertian and glossy
+ *    lobes per eye sample (counted when it escapes), at VPLs by SKY_RAYS
+ *    cosine rays through their Lambertian lobe.
  * Not modelled: visibility between gather points and VPLs (the paper's
- * limitation), the sky's light on surfaces (it reaches only mirror chains
- * that escape), caustics, glossy reflection of direct light at VPLs. */
+ * limitation), caustics, glossy reflection of direct light and of the sky
+ * at VPLs. */
 #include "render_vpl.h"
 #include <math.h>
 #include <stdio.h>
@@ -47,6 +50,7 @@
 #define SKIP_MAX 64
 #define EYE_RR 1e-3
 #define COARSE 16
+#define SKY_RAYS 16 /* sky rays per VPL side */
 
 void render_vpl_default_settings(render_vpl_settings *s)
 {
@@ -185,9 +189,25 @@ static void vpl_set_free(vpl_set *s)
     free(s->kappa);
 }
 
+/* A gathering ray from b's surface along w leaves the scene (it passes
+ * no_radiosity objects, radrules.h rule 3). */
+static int escapes(const accel *a, const shade_mat_bsdf *b, vec3 w, double eps)
+{
+    accel_hit h;
+    vec3 org = v3_dot(w, b->ng) > 0.0 ? b->p_out : b->p_in;
+    double tmin = eps;
+    for (int k = 0; k < SKIP_MAX; k++) {
+        if (!accel_intersect_from(a, k == 0 ? &b->from : NULL, org, w, tmin, INFINITY, &h)) return 1;
+        if (radrules_gathers(h.flags)) return 0;
+        tmin = h.t + fmax(eps, h.t * 1e-7);
+    }
+    return 0;
+}
+
 static pt_status make_vpls(const scene *sc, const accel *a, const pm_lights *L, long want, uint64_t seed, double bright,
                            vpl_set *out, long *shadow, diag *d)
 {
+    const int sky = pm_sky_any(sc);
     pt_status st = PT_OK;
     accel_surf *S = accel_surf_build(sc, a, vpl_weight, NULL, d, &st);
     if (!S) return st;
@@ -236,6 +256,21 @@ static pt_status make_vpls(const scene *sc, const accel *a, const pm_lights *L, 
             bl.m[SHADE_MAT_LOBE_GLOSSY] = 0.0;
             rgb em = pm_direct_emitters(L, &bl, 4, 0.0, 0.0, 0.0, &r, shadow);
             e = mk(e.r + em.r * bright, e.g + em.g * bright, e.b + em.b * bright);
+            if (sky) {
+                /* the sky's light through the Lambertian lobe: cosine
+                 * directions that escape (gathering rays pass no_radiosity) */
+                rgb ks = b.k[SHADE_MAT_LOBE_DIFFUSE], acc = {0, 0, 0};
+                for (int j = 0; j < SKY_RAYS; j++) {
+                    vec3 w = shade_mat_cosine_dir(b.n, (j + rng_f64(&r)) / SKY_RAYS, rng_f64(&r));
+                    if (v3_dot(w, b.ng) <= 0.0) continue;
+                    if (escapes(a, &b, w, eps)) {
+                        rgb c = pm_sky(sc, w);
+                        acc = mk(acc.r + c.r, acc.g + c.g, acc.b + c.b);
+                    }
+                }
+                e = mk(e.r + ks.r * acc.r / SKY_RAYS * bright, e.g + ks.g * acc.g / SKY_RAYS * bright,
+                       e.b + ks.b * acc.b / SKY_RAYS * bright);
+            }
             double l = lum(e) + (side ? 0.0 : 1e-30); /* ties: the front */
             if (!(l > best)) continue;
             best = l;
@@ -318,7 +353,7 @@ typedef struct {
     const render_vpl_settings *s;
     const pm_lights *L;
     double eps, lift, bright;
-    int levels;
+    int levels, sky;
     rgb *direct;       /* per pixel, summed over samples */
     gpoint *centre;    /* per pixel: the pixel-centre gather point */
     unsigned char *valid;
@@ -360,6 +395,18 @@ static void eye_trace(eye_ctx *c, int y, int pixel, const accel_from *from, vec3
     rgb em = pm_direct_emitters(c->L, &b, 1, 0.0, 0.0, 0.0, r, &c->shadow[y]);
     e = mk(e.r + em.r * c->bright, e.g + em.g * c->bright, e.b + em.b * c->bright);
     *L = mk(L->r + T.r * e.r, L->g + T.g * e.g, L->b + T.b * e.b);
+    if (c->sky) {
+        /* the sky through the Lambertian and glossy lobes: one BSDF sample
+         * (a delta lobe drawn adds nothing: the Whitted branches below
+         * carry those); surfaces it meets are the VPLs' part */
+        shade_mat_scatter sm;
+        if (shade_mat_sample(&b, r, 0, &sm) && !sm.specular && escapes(c->a, &b, sm.dir, c->eps)) {
+            rgb sky = pm_sky(c->sc, sm.dir);
+            double k = c->bright;
+            *L = mk(L->r + T.r * sm.weight.r * sky.r * k, L->g + T.g * sm.weight.g * sky.g * k,
+                    L->b + T.b * sm.weight.b * sky.b * k);
+        }
+    }
     if (depth > 0 && (b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 || b.m[SHADE_MAT_LOBE_GLOSSY] > 0.0)) {
         gpoint g;
         point_of(&b, c->lift, &g);
@@ -683,7 +730,7 @@ pt_status render_vpl(const scene *sc, const accel *a, const render_vpl_settings 
     }
 
     /* eye samples and the pixel-centre G-buffer */
-    eye_ctx ec = {sc, a, s, L, pm_lights_eps(L), lift, rr.brightness, radrules_level_limit(sc, 0)};
+    eye_ctx ec = {sc, a, s, L, pm_lights_eps(L), lift, rr.brightness, radrules_level_limit(sc, 0), pm_sky_any(sc)};
     ec.direct = calloc(np, sizeof *ec.direct);
     ec.centre = calloc(np, sizeof *ec.centre);
     ec.valid = calloc(np, 1);
@@ -717,6 +764,7 @@ pt_status render_vpl(const scene *sc, const accel *a, const render_vpl_settings 
         }
         if (status == PT_OK)
             status = pixel_indirect(&gc, s, ec.centre, ec.valid, diag_len / 2.0, ind, &st->pixels_sampled, d);
+        st->t_gather_pixels = gc.t_gather;
         if (status == PT_OK && all.n > 0) {
             sec = malloc(sizeof *sec * (size_t)all.n);
             status = sec ? gather_list(&gc, all.v, NULL, all.n, sec, 0, d) : PT_ERR_NOMEM;

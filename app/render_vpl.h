@@ -41,6 +41,7 @@ typedef struct {
     long visits_min, visits_max;
     long shadow_rays, camera_rays, secondary_rays;
     double t_vpls, t_tree, t_bounce, t_trace, t_gather, t_total; /* seconds; t_gather: the eye kernels */
+    double t_gather_pixels;   /* the part of t_gather at pixel centres (the rest: mirror and refraction hits) */
 } render_vpl_stats;
 
 void render_vpl_default_settings(render_vpl_settings *s);
