@@ -332,6 +332,35 @@ static void test_room_against_path(void **state)
     tu_world_free(&w);
 }
 
+/* A white glossy sphere under a white sky (the furnace of test_glossy):
+ * vpl's sky term (one BSDF sample per eye sample) shows the sky. */
+static void test_furnace(void **state)
+{
+    (void)state;
+    tu_world w = tu_world_build("vpl_furnace.pov", "#version 3.7;\n"
+                                                   "camera { location <0,0,-3> look_at 0 angle 40 }\n"
+                                                   "sky_sphere { pigment { rgb 1 } }\n"
+                                                   "sphere { 0, 1 pigment { rgb 1 } finish { ambient 0 diffuse 0.3 "
+                                                   "phong 0.7 phong_size 40 } }\n");
+    framebuffer *fb = fb_new(16, 12);
+    render_vpl_settings vs;
+    render_vpl_default_settings(&vs);
+    vs.width = 16;
+    vs.height = 12;
+    vs.threads = 2;
+    vs.spp = 64;
+    vs.vpls = 1024;
+    vs.cl_device = "c";
+    diag *d = diag_new();
+    assert_int_equal(render_vpl(w.s, w.a, &vs, fb, NULL, d), PT_OK);
+    diag_free(d);
+    double m = fb_lum(fb);
+    printf("vpl furnace (diffuse 0.3 + phong 0.7 under a white sky): mean %.5f (expect 1, tol 0.01)\n", m);
+    assert_true(fabs(m - 1.0) < 0.01);
+    fb_free(fb);
+    tu_world_free(&w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -339,6 +368,7 @@ int main(void)
         cmocka_unit_test(test_tree_exact_and_cuts),
         cmocka_unit_test(test_opencl_matches_c),
         cmocka_unit_test(test_room_against_path),
+        cmocka_unit_test(test_furnace),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
