@@ -4,8 +4,9 @@
  * converge where the method's approximations hold.
  *  - Eye samples (spp per pixel): emission, direct light of POV-Ray lights
  *    (pm_direct_lights: --gi none's terms, highlights included) and of
- *    emitters (pm_direct_emitters, gathered light: brightness), mirror and
- *    refraction lobes followed Whitted-style within POV-Ray's trace levels.
+ *    emitters (an area sample and a BSDF sample with MIS, as the path
+ *    tracer; gathered light: brightness), mirror and refraction lobes
+ *    followed Whitted-style within POV-Ray's trace levels.
  *  - VPLs: `vpls` points uniform by area over the surfaces gathering rays
  *    see (accel_surface.h), each on the side that receives more light, with
  *    the Lambertian radiance of its direct light as seen by a gathering ray
@@ -24,9 +25,12 @@
  *    then 8, 4, 2, 1 with the coherence error over the parents), the others
  *    reconstructed by bilateral upsampling from their 2 or 4 parents;
  *    at mirror and refraction hits gathered at every hit.
- *  - The sky: at eye hits by one BSDF sample of the Lambertian and glossy
- *    lobes per eye sample (counted when it escapes), at VPLs by SKY_RAYS
- *    cosine rays through their Lambertian lobe.
+ *  - Fog on camera and mirror/refraction segments (the pixel-centre ray's
+ *    transmittance scales the pixel's indirect light), as the path tracer.
+ *  - The sky: at eye hits by the same BSDF sample of the Lambertian and
+ *    glossy lobes (counted when it escapes), at VPLs by SKY_RAYS cosine
+ *    rays through their Lambertian lobe, which also find emitters (MIS with
+ *    4 area samples).
  * Not modelled: visibility between gather points and VPLs (the paper's
  * limitation), caustics, glossy reflection of direct light and of the sky
  * at VPLs. */
@@ -43,6 +47,7 @@
 #include "pool.h"
 #include "radrules.h"
 #include "rng.h"
+#include "shade_atmos.h"
 #include "shade_light.h"
 #include "shade_material.h"
 #include "timer.h"
@@ -50,7 +55,7 @@
 #define SKIP_MAX 64
 #define EYE_RR 1e-3
 #define COARSE 16
-#define SKY_RAYS 16 /* sky rays per VPL side */
+#define SKY_RAYS 16 /* gathering rays per VPL side for the sky and emitters */
 
 void render_vpl_default_settings(render_vpl_settings *s)
 {
@@ -189,25 +194,25 @@ static void vpl_set_free(vpl_set *s)
     free(s->kappa);
 }
 
-/* A gathering ray from b's surface along w leaves the scene (it passes
- * no_radiosity objects, radrules.h rule 3). */
-static int escapes(const accel *a, const shade_mat_bsdf *b, vec3 w, double eps)
+/* The hit of a gathering ray from b's surface along w (it passes
+ * no_radiosity objects, radrules.h rule 3); 0 when it leaves the scene. */
+static int gather_hit(const accel *a, const shade_mat_bsdf *b, vec3 w, double eps, accel_hit *h)
 {
-    accel_hit h;
     vec3 org = v3_dot(w, b->ng) > 0.0 ? b->p_out : b->p_in;
     double tmin = eps;
     for (int k = 0; k < SKIP_MAX; k++) {
-        if (!accel_intersect_from(a, k == 0 ? &b->from : NULL, org, w, tmin, INFINITY, &h)) return 1;
-        if (radrules_gathers(h.flags)) return 0;
-        tmin = h.t + fmax(eps, h.t * 1e-7);
+        if (!accel_intersect_from(a, k == 0 ? &b->from : NULL, org, w, tmin, INFINITY, h)) return 0;
+        if (radrules_gathers(h->flags)) return 1;
+        tmin = h->t + fmax(eps, h->t * 1e-7);
     }
-    return 0;
+    return 1;
 }
 
 static pt_status make_vpls(const scene *sc, const accel *a, const pm_lights *L, long want, uint64_t seed, double bright,
                            vpl_set *out, long *shadow, diag *d)
 {
-    const int sky = pm_sky_any(sc);
+    /* gathering rays at the VPLs find the sky and emitters */
+    const int gather = pm_sky_any(sc) || accel_surf_count(pm_lights_emitters(L)) > 0;
     pt_status st = PT_OK;
     accel_surf *S = accel_surf_build(sc, a, vpl_weight, NULL, d, &st);
     if (!S) return st;
@@ -254,23 +259,33 @@ static pt_status make_vpls(const scene *sc, const accel *a, const pm_lights *L, 
             shade_mat_bsdf bl = b; /* emitters through the Lambertian lobes only */
             bl.nglossy = 0;
             bl.m[SHADE_MAT_LOBE_GLOSSY] = 0.0;
-            rgb em = pm_direct_emitters(L, &bl, 4, 0.0, 0.0, 0.0, &r, shadow);
-            e = mk(e.r + em.r * bright, e.g + em.g * bright, e.b + em.b * bright);
-            if (sky) {
-                /* the sky's light through the Lambertian lobe: cosine
-                 * directions that escape (gathering rays pass no_radiosity) */
-                rgb ks = b.k[SHADE_MAT_LOBE_DIFFUSE], acc = {0, 0, 0};
+            rgb em = pm_direct_emitters(L, &bl, 4, gather ? SKY_RAYS : 0.0, 0.0, 0.0, &r, shadow);
+            if (gather) {
+                /* the sky and emitters through the Lambertian lobe by SKY_RAYS
+                 * cosine gathering rays (emitters weighted against the 4
+                 * area samples above, as the path tracer does) */
+                rgb acc = {0, 0, 0};
                 for (int j = 0; j < SKY_RAYS; j++) {
                     vec3 w = shade_mat_cosine_dir(b.n, (j + rng_f64(&r)) / SKY_RAYS, rng_f64(&r));
                     if (v3_dot(w, b.ng) <= 0.0) continue;
-                    if (escapes(a, &b, w, eps)) {
-                        rgb c = pm_sky(sc, w);
-                        acc = mk(acc.r + c.r, acc.g + c.g, acc.b + c.b);
+                    accel_hit gh;
+                    rgb c = {0, 0, 0};
+                    if (!gather_hit(a, &b, w, eps, &gh)) {
+                        c = pm_sky(sc, w);
+                    } else {
+                        rgb le = shade_mat_emission_at(sc, NULL, &gh);
+                        if (le.r != 0.0 || le.g != 0.0 || le.b != 0.0) {
+                            double cb = SKY_RAYS * v3_dot(w, b.n) / M_PI;
+                            double wt = pm_mis(cb, pm_emitter_density(L, &gh, b.p_out, 4));
+                            c = mk(le.r * wt, le.g * wt, le.b * wt);
+                        }
                     }
+                    acc = mk(acc.r + c.r, acc.g + c.g, acc.b + c.b);
                 }
-                e = mk(e.r + ks.r * acc.r / SKY_RAYS * bright, e.g + ks.g * acc.g / SKY_RAYS * bright,
-                       e.b + ks.b * acc.b / SKY_RAYS * bright);
+                rgb ks = b.k[SHADE_MAT_LOBE_DIFFUSE];
+                em = mk(em.r + ks.r * acc.r / SKY_RAYS, em.g + ks.g * acc.g / SKY_RAYS, em.b + ks.b * acc.b / SKY_RAYS);
             }
+            e = mk(e.r + em.r * bright, e.g + em.g * bright, e.b + em.b * bright);
             double l = lum(e) + (side ? 0.0 : 1e-30); /* ties: the front */
             if (!(l > best)) continue;
             best = l;
@@ -353,8 +368,9 @@ typedef struct {
     const render_vpl_settings *s;
     const pm_lights *L;
     double eps, lift, bright;
-    int levels, sky;
+    int levels;
     rgb *direct;       /* per pixel, summed over samples */
+    rgb *fog_t;        /* per pixel: the fog's transmittance to the pixel centre's hit */
     gpoint *centre;    /* per pixel: the pixel-centre gather point */
     unsigned char *valid;
     gvec *rows;        /* per row: the secondary gather points */
@@ -380,7 +396,15 @@ static void eye_trace(eye_ctx *c, int y, int pixel, const accel_from *from, vec3
 {
     if (depth >= c->levels) return;
     accel_hit h;
-    if (!trace_skip(c, from, org, dir, skip, &h)) {
+    int hit = trace_skip(c, from, org, dir, skip, &h);
+    if (c->sc->fogs) {
+        /* fog on camera and mirror/refraction segments, as the path tracer */
+        rgb fa, fc;
+        shade_atmos_fog_affine(c->sc, org, dir, hit ? h.t : INFINITY, &fa, &fc);
+        *L = mk(L->r + T.r * fc.r, L->g + T.g * fc.g, L->b + T.b * fc.b);
+        T = mk(T.r * fa.r, T.g * fa.g, T.b * fa.b);
+    }
+    if (!hit) {
         rgb sky = pm_sky(c->sc, dir);
         *L = mk(L->r + T.r * sky.r, L->g + T.g * sky.g, L->b + T.b * sky.b);
         return;
@@ -392,20 +416,34 @@ static void eye_trace(eye_ctx *c, int y, int pixel, const accel_from *from, vec3
         rgb dl = pm_direct_lights(c->L, &b, 1, r, &c->shadow[y]);
         e = mk(e.r + dl.r, e.g + dl.g, e.b + dl.b);
     }
-    rgb em = pm_direct_emitters(c->L, &b, 1, 0.0, 0.0, 0.0, r, &c->shadow[y]);
+    /* emitters: one sample by area and one BSDF sample, weighted by the
+     * power heuristic lobe by lobe as in the path tracer (the BSDF sample
+     * finds the parts of emitters the area sampling leaves out: planes
+     * beyond the scene's bounds); the same BSDF sample carries the sky
+     * through the Lambertian and glossy lobes. A delta lobe drawn adds
+     * nothing (the Whitted branches below carry those); surfaces without
+     * emission that it meets are the VPLs' part. */
+    const double ms = b.msum > 0.0 ? b.msum : 1.0;
+    rgb em = pm_direct_emitters(c->L, &b, 1, b.m[SHADE_MAT_LOBE_DIFFUSE] / ms, b.m[SHADE_MAT_LOBE_BACK] / ms,
+                                b.m[SHADE_MAT_LOBE_GLOSSY] / ms, r, &c->shadow[y]);
     e = mk(e.r + em.r * c->bright, e.g + em.g * c->bright, e.b + em.b * c->bright);
     *L = mk(L->r + T.r * e.r, L->g + T.g * e.g, L->b + T.b * e.b);
-    if (c->sky) {
-        /* the sky through the Lambertian and glossy lobes: one BSDF sample
-         * (a delta lobe drawn adds nothing: the Whitted branches below
-         * carry those); surfaces it meets are the VPLs' part */
-        shade_mat_scatter sm;
-        if (shade_mat_sample(&b, r, 0, &sm) && !sm.specular && escapes(c->a, &b, sm.dir, c->eps)) {
-            rgb sky = pm_sky(c->sc, sm.dir);
-            double k = c->bright;
-            *L = mk(L->r + T.r * sm.weight.r * sky.r * k, L->g + T.g * sm.weight.g * sky.g * k,
-                    L->b + T.b * sm.weight.b * sky.b * k);
+    shade_mat_scatter sm;
+    if (shade_mat_sample(&b, r, 0, &sm) && !sm.specular) {
+        accel_hit gh;
+        rgb in = {0, 0, 0};
+        if (!gather_hit(c->a, &b, sm.dir, c->eps, &gh)) {
+            in = pm_sky(c->sc, sm.dir);
+        } else {
+            rgb le = shade_mat_emission_at(c->sc, NULL, &gh);
+            if (le.r != 0.0 || le.g != 0.0 || le.b != 0.0) {
+                double w = pm_mis(sm.pdf, pm_emitter_density(c->L, &gh, sm.org, 1));
+                in = mk(le.r * w, le.g * w, le.b * w);
+            }
         }
+        const double k = c->bright;
+        *L = mk(L->r + T.r * sm.weight.r * in.r * k, L->g + T.g * sm.weight.g * in.g * k,
+                L->b + T.b * sm.weight.b * in.b * k);
     }
     if (depth > 0 && (b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 || b.m[SHADE_MAT_LOBE_GLOSSY] > 0.0)) {
         gpoint g;
@@ -464,7 +502,13 @@ static void eye_row(void *ctx, int y, int thread)
         scene_camera_ray(&c->sc->camera, x + 0.5, y + 0.5, W, H, &org, &dir);
         accel_hit h;
         c->valid[pixel] = 0;
-        if (trace_skip(c, NULL, org, dir, OBJ_NO_IMAGE, &h)) {
+        int hit = trace_skip(c, NULL, org, dir, OBJ_NO_IMAGE, &h);
+        c->fog_t[pixel] = mk(1, 1, 1);
+        if (hit && c->sc->fogs) {
+            rgb fc;
+            shade_atmos_fog_affine(c->sc, org, dir, h.t, &c->fog_t[pixel], &fc);
+        }
+        if (hit) {
             shade_mat_bsdf b;
             shade_mat_setup(&b, c->sc, &h, dir, c->eps, &r);
             if (b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 || b.m[SHADE_MAT_LOBE_GLOSSY] > 0.0) {
@@ -730,8 +774,9 @@ pt_status render_vpl(const scene *sc, const accel *a, const render_vpl_settings 
     }
 
     /* eye samples and the pixel-centre G-buffer */
-    eye_ctx ec = {sc, a, s, L, pm_lights_eps(L), lift, rr.brightness, radrules_level_limit(sc, 0), pm_sky_any(sc)};
+    eye_ctx ec = {sc, a, s, L, pm_lights_eps(L), lift, rr.brightness, radrules_level_limit(sc, 0)};
     ec.direct = calloc(np, sizeof *ec.direct);
+    ec.fog_t = calloc(np, sizeof *ec.fog_t);
     ec.centre = calloc(np, sizeof *ec.centre);
     ec.valid = calloc(np, 1);
     ec.rows = calloc((size_t)H, sizeof *ec.rows);
@@ -739,7 +784,7 @@ pt_status render_vpl(const scene *sc, const accel *a, const render_vpl_settings 
     ec.camera = calloc((size_t)H, sizeof(long));
     ec.secondary = calloc((size_t)H, sizeof(long));
     rgb *ind = calloc(np, sizeof *ind);
-    if (!ec.direct || !ec.centre || !ec.valid || !ec.rows || !ec.shadow || !ec.camera || !ec.secondary || !ind)
+    if (!ec.direct || !ec.fog_t || !ec.centre || !ec.valid || !ec.rows || !ec.shadow || !ec.camera || !ec.secondary || !ind)
         status = status == PT_OK ? PT_ERR_NOMEM : status;
     if (status == PT_OK) {
         t0 = timer_now();
@@ -774,7 +819,10 @@ pt_status render_vpl(const scene *sc, const accel *a, const render_vpl_settings 
         const int spp = s->spp > 0 ? s->spp : 1;
         for (size_t i = 0; i < np; i++) {
             rgb v = ec.direct[i];
-            if (ec.valid[i]) v = mk(v.r + ind[i].r * rr.brightness, v.g + ind[i].g * rr.brightness, v.b + ind[i].b * rr.brightness);
+            const rgb ft = ec.fog_t[i];
+            if (ec.valid[i])
+                v = mk(v.r + ind[i].r * rr.brightness * ft.r, v.g + ind[i].g * rr.brightness * ft.g,
+                       v.b + ind[i].b * rr.brightness * ft.b);
             ec.direct[i] = v;
         }
         for (int k = 0; sec && k < all.n; k++) {
@@ -803,6 +851,7 @@ pt_status render_vpl(const scene *sc, const accel *a, const render_vpl_settings 
     free(sec);
     free(ind);
     free(ec.direct);
+    free(ec.fog_t);
     free(ec.centre);
     free(ec.valid);
     free(ec.rows);

@@ -35,7 +35,8 @@
 #
 # BUILD=DIR (default build) holds partray; EXAMPLES=DIR (default
 # /usr/share/doc/povray/examples); OUT=DIR (default /tmp/glossy_bench)
-# keeps the images, stats and logs. PARTICLE=0 skips particle GI.
+# keeps the images, stats and logs. PARTICLE=0 skips particle GI;
+# KEEP_PATH=1 reuses path images already in OUT (chess2's takes minutes).
 set -eu
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
@@ -49,6 +50,7 @@ PATH_SPP=${PATH_SPP:-1024}
 EXAMPLES=${EXAMPLES:-/usr/share/doc/povray/examples}
 OUT=${OUT:-/tmp/glossy_bench}
 PARTICLE=${PARTICLE:-1}
+KEEP_PATH=${KEEP_PATH:-0}
 [ $# -gt 0 ] || set -- metals=incdemo/metals/golds.pov metrefl=textures/finishes/metallicreflection.pov \
     teapot=advanced/teapot/teapot.pov chess2=advanced/chess2.pov
 mkdir -p "$OUT"
@@ -88,7 +90,9 @@ for arg in "$@"; do
     [ "$name" = chess2 ] && size=$CHESS_SIZE
     rm -rf "${OUT:?}/$name"
     cp -r "$EXAMPLES/$(dirname "$path")" "$OUT/$name"
-    render "$name" path "$size" --gi path --spp "$PATH_SPP"
+    if [ "$KEEP_PATH" != 1 ] || [ ! -f "$OUT/$name.path.exr" ]; then
+        render "$name" path "$size" --gi path --spp "$PATH_SPP"
+    fi
     render "$name" vpl "$size" --gi vpl
     render "$name" vplfull "$size" --gi vpl --vpl-cut full
     render "$name" vplmm1 "$size" --gi vpl --vpl-adaptive off
