@@ -1185,6 +1185,16 @@ const scene_object *accel_rtc_object(const accel *a, unsigned geom, unsigned pri
     return NULL;
 }
 
+const scene_object *accel_rtc_object_tri(const accel *a, unsigned geom, unsigned prim, unsigned inst, unsigned *local)
+{
+    *local = 0;
+    const scene_object *o = accel_rtc_object(a, geom, prim, inst);
+    if (!o) return NULL;
+    if (inst != RTC_INVALID_GEOMETRY_ID) *local = prim; /* an instanced mesh: its own triangles */
+    else if (a->ginfo[geom].kind == GEOM_TRI) *local = a->tri[a->ginfo[geom].idx].refs[prim].local;
+    return o;
+}
+
 unsigned accel_rtc_ngeoms(const accel *a) { return a ? a->nginfo : 0; }
 
 long accel_rtc_triangles(const accel *a, unsigned geom, const float **v, const unsigned **idx)

@@ -135,6 +135,11 @@ void accel_rtc_link_scene_free(void *scene);
  * give it; NULL when the record alone does not tell (a member of a CSG) or
  * the ids are invalid. */
 const scene_object *accel_rtc_object(const accel *a, unsigned geom, unsigned prim, unsigned inst);
+/* accel_rtc_object, and for a hit on a triangle the triangle's index among
+ * the leaf's own (a mesh's tris[], what accel_hit.prim gives) in *local (0
+ * for other hits). Embree's u, v of such a hit weight the triangle's second
+ * and third vertices, as accel_hit's do. */
+const scene_object *accel_rtc_object_tri(const accel *a, unsigned geom, unsigned prim, unsigned inst, unsigned *local);
 /* Embree geometry ids run over [0, accel_rtc_ngeoms). For a geometry of
  * world-space triangles (the ids rtcIntersect on accel_rtc_scene or
  * accel_rtc_link_scene reports with an invalid instID), its triangle count,

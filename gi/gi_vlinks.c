@@ -11,6 +11,7 @@
  *  4. light links (every element, every light: a shadow ray);
  *  5. gathering sweeps and smoothing (gi_vlinks.cl). */
 #include "gi_vlinks.h"
+#include <embree3/rtcore.h>
 #include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -205,6 +206,8 @@ typedef struct {
     const long *todo;            /* elements to link */
     long ntodo;
     int nthreads;
+    void *scene;                 /* RTCScene the link rays are traced in (accel_rtc_link_scene) */
+    struct RTCRayHit **rh;       /* per thread: one element's rays */
     float **acc;                 /* per thread: weight per peer element (dense) */
     int **touched;               /* per thread: peers touched */
     atomic_long rays, other, raw;
@@ -229,13 +232,56 @@ static void link_chunk(void *ctx, int ci, int thread)
         v3_basis(n, &t, &b);
         vec3 org = v3_madd(v->pos[vx], n, v->off);
         int nt = 0, raw = 0;
+        /* the element's rays in one Embree stream, block by block (the
+         * directions run 4 x 4 block after block: coherent) */
+        struct RTCRayHit *rh = J->rh[thread];
+        float tnear = (float)accel_epsilon(J->a, org, n);
         for (int k = 0; k < v->nc; k++) {
             vec3 l = v->dirs[k];
             vec3 dir = v3_add(v3_add(v3_scale(t, l.x), v3_scale(b, l.y)), v3_scale(n, l.z));
-            accel_hit h;
-            rays++;
+            struct RTCRayHit *q = &rh[k];
+            q->ray.org_x = (float)org.x;
+            q->ray.org_y = (float)org.y;
+            q->ray.org_z = (float)org.z;
+            q->ray.tnear = tnear;
+            q->ray.dir_x = (float)dir.x;
+            q->ray.dir_y = (float)dir.y;
+            q->ray.dir_z = (float)dir.z;
+            q->ray.time = 0.0f;
+            q->ray.tfar = INFINITY;
+            q->ray.mask = 0xFFFFFFFFu;
+            q->ray.id = 0;
+            q->ray.flags = 0;
+            q->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            q->hit.primID = RTC_INVALID_GEOMETRY_ID;
+            q->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        }
+        struct RTCIntersectContext ictx;
+        rtcInitIntersectContext(&ictx);
+        ictx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        rtcIntersect1M((RTCScene)J->scene, &ictx, rh, (unsigned)v->nc, sizeof *rh);
+        rays += v->nc;
+        for (int k = 0; k < v->nc; k++) {
+            vec3 l = v->dirs[k];
+            vec3 dir = v3_add(v3_add(v3_scale(t, l.x), v3_scale(b, l.y)), v3_scale(n, l.z));
             size_t r = (size_t)e * v->nc + k;
-            if (!accel_intersect(J->a, org, dir, 0.0, INFINITY, &h)) {
+            const struct RTCRayHit *q = &rh[k];
+            if (q->hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+                v->ray_t[r] = INFINITY;
+                v->ray_leaf[r] = -1;
+                continue;
+            }
+            unsigned local = 0;
+            const scene_object *hobj = accel_rtc_object_tri(J->a, q->hit.geomID, q->hit.primID, q->hit.instID[0], &local);
+            accel_hit h;
+            if (hobj) {
+                h.obj = hobj;
+                h.prim = local;
+                h.u = q->hit.u;
+                h.v = q->hit.v;
+                h.t = q->ray.tfar;
+            } else if (!accel_intersect(J->a, org, dir, 0.0, INFINITY, &h)) {
+                /* the record alone does not tell (a CSG member): ask accel */
                 v->ray_t[r] = INFINITY;
                 v->ray_leaf[r] = -1;
                 continue;
@@ -748,14 +794,20 @@ pt_status gi_vlinks_frame(gi_vlinks *v, const scene *sc, const accel *a, int obj
         J.nthreads = nthreads;
         J.acc = calloc((size_t)nthreads, sizeof *J.acc);
         J.touched = calloc((size_t)nthreads, sizeof *J.touched);
-        if (!J.acc || !J.touched) {
+        J.rh = calloc((size_t)nthreads, sizeof *J.rh);
+        /* link rays tolerate a rare crack between triangles: the faster
+         * scene without Embree's robust mode (accel.h) */
+        J.scene = accel_rtc_link_scene(a);
+        if (!J.scene) J.scene = accel_rtc_scene(a);
+        if (!J.acc || !J.touched || !J.rh) {
             status = PT_ERR_NOMEM;
             goto done;
         }
         for (int t = 0; t < nthreads; t++) {
             J.acc[t] = calloc((size_t)v->ne, sizeof(float));
             J.touched[t] = malloc(sizeof(int) * (size_t)v->nc * 3 + sizeof(int));
-            if (!J.acc[t] || !J.touched[t]) {
+            J.rh[t] = malloc(sizeof(struct RTCRayHit) * (size_t)v->nc);
+            if (!J.acc[t] || !J.touched[t] || !J.rh[t]) {
                 status = PT_ERR_NOMEM;
                 goto done;
             }
@@ -834,8 +886,12 @@ done:
         for (int t = 0; t < nthreads; t++) free(J.acc[t]);
     if (J.touched)
         for (int t = 0; t < nthreads; t++) free(J.touched[t]);
+    if (J.rh)
+        for (int t = 0; t < nthreads; t++) free(J.rh[t]);
     free(J.acc);
     free(J.touched);
+    free(J.rh);
+    if (J.scene && J.scene != accel_rtc_scene(a)) accel_rtc_link_scene_free(J.scene);
     free(dl);
     accel_free(mob);
     free(mobobj);
