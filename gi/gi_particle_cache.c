@@ -251,8 +251,16 @@ gi_particle *gi_particle_load(const scene *sc, const accel *a, const gi_particle
         if (what) {
             diag_report(d, DIAG_ERROR, at, NULL, "GI cache made with another %s than this render asks for", what);
             why = "";
-        } else if (k.n < 0 || k.nrp < 0 || k.entries < 0 || k.ns2 != gp->ns2 || k.ng != gp->ng || k.entries > INT32_MAX) {
+        } else if (k.n < 0 || k.nrp < 0 || k.entries < 0 || k.ns2 != gp->ns2 || k.ng != gp->ng || k.entries > INT32_MAX ||
+                   k.nrp > INT32_MAX) {
             why = "inconsistent counts";
+        } else {
+            /* the arrays' sizes from the counts must be what is left of the
+             * file (nothing is allocated from counts the file cannot hold) */
+            uint64_t n = (uint64_t)k.n, per = sizeof(gi_dev_particle) + sizeof(int) + 1 +
+                                                   ((uint64_t)k.ns2 + (uint64_t)k.ng + 4) * sizeof(int);
+            uint64_t want = n * per + ((uint64_t)k.nrp + 1 + (uint64_t)k.entries) * sizeof(int);
+            if (want != (uint64_t)(r.n - r.at)) why = "arrays of the wrong size";
         }
     }
     if (!why) {
