@@ -38,8 +38,10 @@
 #include "anim.h"
 #include "cli.h"
 #include "cmd_merge.h"
+#include "gi.h"
 #include "img_io.h"
 #include "ini.h"
+#include "pipeline.h"
 #include "subproc.h"
 #include "timer.h"
 
@@ -606,6 +608,34 @@ int cmd_farm(int argc, char **argv)
         return 2;
     }
     if (o.noutputs > 0 && !out) out = o.outputs[0];
+    /* The scene's first frame parsed here: a scene error stops the farm
+     * before any task is planned, and with particle GI the tasks share its
+     * geometry stage through a GI cache in DIR (unless --gi-cache names
+     * one): the tasks that start after the first one's stage is saved
+     * (the other tiles of a frame; every task of a fly-through, whose
+     * frames share one cache) read it instead of running it. */
+    int auto_cache = 0;
+    {
+        sdl_options so;
+        pipeline_sdl_options(&so, &o, o.width > 0 ? o.width : 320, o.height > 0 ? o.height : 240);
+        cli_frame_options(&o, &plan, plan.first, &so);
+        diag *pd = diag_new();
+        scene *sc = NULL;
+        pt_status pst = pipeline_parse(o.scene, &so, &sc, pd, NULL);
+        for (int i = 0; i < diag_count(pd) && pst != PT_OK; i++) {
+            char *m = diag_format(diag_get(pd, i));
+            if (m && diag_get(pd, i)->severity == DIAG_ERROR) fprintf(stderr, "%s\n", m);
+            free(m);
+        }
+        diag_free(pd);
+        if (pst != PT_OK) {
+            fprintf(stderr, "partray farm: the scene does not parse (frame %d): nothing planned\n", plan.first);
+            ini_free(ia);
+            return pst == PT_ERR_IO ? 3 : 1;
+        }
+        auto_cache = !o.gi_cache && pipeline_gi_mode(o.gi, sc, o.quality) == GI_PARTICLE;
+        scene_free(sc);
+    }
     p.width = o.width > 0 ? o.width : 320;
     p.height = o.height > 0 ? o.height : 240;
     if (p.tiles > p.height || (p.tiles > 1 && p.height / p.tiles < 2)) {
@@ -671,6 +701,12 @@ int cmd_farm(int argc, char **argv)
         if ((a[0] == '+' || a[0] == '-') && (a[1] == 'O' || a[1] == 'o') && a[2]) continue;
         append(base, sizeof base, " ");
         quote(base, sizeof base, a);
+    }
+    if (auto_cache) {
+        char gc[2300];
+        snprintf(gc, sizeof gc, "%s/gi.gic", p.dir);
+        append(base, sizeof base, " --gi-cache ");
+        quote(base, sizeof base, gc);
     }
     for (int f = p.first; f <= p.last; f++) {
         for (int t = 0; t < p.tiles; t++) {

@@ -9,7 +9,9 @@
 #     the frame rendered whole in one process (RMSE 0); every daemon the
 #     script started is gone afterwards (checked by PID).
 #  2. GNU parallel on this machine (sshloginfile ":"), another task made to
-#     fail the same way, recovered by --retries; frames identical again.
+#     fail the same way, recovered by --retries; frames identical again
+#     (the tiles of a frame share a GI cache the farm names in its
+#     directory, one per frame as the sphere moves).
 #  3. The parallel farm run again on the same directory renders nothing.
 #  4. GNU parallel over ssh: an sshd started here on 127.0.0.1 at a free high
 #     port (a fixture: its own host key, a user key made here, no PAM, no
@@ -76,6 +78,7 @@ t0=$(date +%s)
 echo ":" >hosts
 "$BIN" farm farm_gi.pov $OPTS --tiles 2 --dir wp -o par.pfm --engine parallel --sshloginfile hosts --jobs 2 \
     --retries 2 --inject-fault 3:0 || fail "farm --engine parallel"
+ls wp/gi1.gic wp/gi4.gic >/dev/null || fail "no per-frame GI caches in wp/ (the farm's --gi-cache)"
 hist=$(tr '\n' ' ' <wp/status/4.history)
 echo "task 4 (frame 3, tile 0) exits: $hist"
 [ "$hist" = "143 0 " ] || fail "the faulted parallel task should have exited 143, then 0 (got: $hist)"
