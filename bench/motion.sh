@@ -26,7 +26,7 @@
 # Figures are seconds on whatever else the machine runs: compare ratios
 # within one run. SIZE (80x60), QSIZE (80x60), PATH_SPP (256), LINK_FRAMES
 # (4), CBOX_FRAMES (12), RADDEM_FRAMES (30) and PHOTONS (100000) set the
-# work.
+# work; PARTS (default "1 2 3") which parts run (3 needs 2's cbox frames).
 set -eu
 BUILD=${1:-build}
 P=$(cd "$BUILD" && pwd)/partray
@@ -38,6 +38,8 @@ LINK_FRAMES=${LINK_FRAMES:-4}
 CBOX_FRAMES=${CBOX_FRAMES:-12}
 RADDEM_FRAMES=${RADDEM_FRAMES:-30}
 PHOTONS=${PHOTONS:-100000}
+PARTS=${PARTS:-1 2 3}
+part() { case " $PARTS " in *" $1 "*) return 0 ;; esac; return 1; }
 TPL=/usr/share/doc/povray/examples/templates/Meshes_by_meshmaker_inc
 T=$(mktemp -d /tmp/partray-bench-motion-XXXXXX)
 trap 'rm -rf "$T"' EXIT
@@ -99,6 +101,7 @@ print("%.6f %.6f %.3f" % (sum(mads) / len(mads), max(mads), 100.0 * (sum(mads) /
 EOF
 field() { python3 -c "import json,sys; j=json.load(open('$1')); print($2)"; }
 
+if part 1; then
 echo "== 1. --gi links (seed 001): bench/scenes/mesh_room.pov at $SIZE"
 "$P" render mesh_room.pov +L"$TPL" --gi links --size "$SIZE" -o still.pfm --stats still.json 2>still.log
 field still.json "'vertices %d (elements %d, two sides), meshes %d' % (j['links']['vertices'], j['links']['elements'], j['links']['meshes'])"
@@ -133,6 +136,7 @@ for fr in 1 "$LINK_FRAMES"; do
     done
     rm -f q_*.pfm
 done
+fi
 
 detp_scene() {
     name=$1; scene=$2; frames=$3
@@ -167,9 +171,12 @@ if inc:
         mean(i, 'total'), mean(f, 'total'), mean(p, 'total')))
 EOF
 }
+if part 2; then
 detp_scene raddem raddem.pov "$RADDEM_FRAMES"
 detp_scene cbox detp_cbox.pov "$CBOX_FRAMES"
+fi
 
+part 3 || exit 0
 echo "== 3. flicker: detp_cbox.pov, $CBOX_FRAMES frames at $SIZE, top third (mean |frame k - frame k-1|, max, % of the region's mean)"
 "$P" render detp_cbox.pov --gi links --size "$SIZE" +KFI1 +KFF"$CBOX_FRAMES" -o cbox_l.pfm -q 2>/dev/null
 for m in particle:cbox_p links:cbox_l detp:cbox_i; do
