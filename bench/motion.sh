@@ -12,8 +12,10 @@
 #     (PATH_SPP samples, HDR-FLIP and mean luminance) beside --gi particle
 #     on the first and last frame at QSIZE.
 #  2. --gi detp (seed 004) on animations/raddem/raddem.pov (30 frames, a
-#     turning divider) and tests/scenes/detp_cbox.pov (CBOX_FRAMES frames,
-#     the Cornell box's short block sliding) at SIZE: the fraction of paths
+#     turning divider), bench/scenes/cbox_move.pov (scenes/cbox.pov with a
+#     sphere rolling across the floor, CBOX_FRAMES frames) and
+#     tests/scenes/detp_cbox.pov (the Cornell box, coarser, its short block
+#     sliding) at SIZE: the fraction of paths
 #     re-traced per frame, whether each frame's image equals --detp-full's
 #     (every path traced and every receiver estimated anew with the same
 #     random streams) byte for byte, and the GI time per frame (the stages
@@ -45,6 +47,9 @@ T=$(mktemp -d /tmp/partray-bench-motion-XXXXXX)
 trap 'rm -rf "$T"' EXIT
 cp /usr/share/doc/povray/examples/animations/raddem/raddem.pov "$T/"
 cp "$SRC/tests/scenes/detp_cbox.pov" "$SRC/bench/scenes/mesh_room.pov" "$T/"
+mkdir -p "$T/bench/scenes" "$T/scenes"
+cp "$SRC/bench/scenes/cbox_move.pov" "$T/bench/scenes/"
+cp "$SRC/scenes/cbox.pov" "$T/scenes/"
 cd "$T"
 
 # log parser: per frame, the seconds of parse, accel, GI stages and render,
@@ -173,6 +178,7 @@ EOF
 }
 if part 2; then
 detp_scene raddem raddem.pov "$RADDEM_FRAMES"
+detp_scene cboxmove bench/scenes/cbox_move.pov "$CBOX_FRAMES"
 detp_scene cbox detp_cbox.pov "$CBOX_FRAMES"
 fi
 
