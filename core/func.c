@@ -130,8 +130,11 @@ static pt_status eval_function(const scene_function *f, const double *args, doub
     case FUNC_FLOAT: {
         double slots[FUNC_MAX_SLOTS];
         int np = f->nparams < FUNC_MAX_SLOTS ? f->nparams : FUNC_MAX_SLOTS;
-        memset(slots, 0, sizeof slots);
+        /* only the slots the body uses (parameters, loop variables) are
+         * cleared: a call is evaluated per isosurface sample */
+        int ns = f->nslots > np ? (f->nslots < FUNC_MAX_SLOTS ? f->nslots : FUNC_MAX_SLOTS) : np;
         memcpy(slots, args, sizeof(double) * (size_t)np);
+        if (ns > np) memset(slots + np, 0, sizeof(double) * (size_t)(ns - np));
         out[0] = node_value(f, f->root, slots, c);
         break;
     }
