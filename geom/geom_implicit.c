@@ -794,6 +794,43 @@ static double iso_root(const im_data *m, vec3 p0, vec3 e, double lo, double hi, 
     return 0.5 * (lo + hi);
 }
 
+/* The crossings of f along p0 + tau e in a range, nearest first, by
+ * POV-Ray's rule for isosurfaces (isosurface.cpp Function_Find_Root_R):
+ * with max_gradient L, f cannot reach 0 inside [t1, t2] when
+ * f1 + f2 > L (t2 - t1) (values of one sign), so such a piece is dropped
+ * after its two ends; others are halved down to `accuracy`. A piece whose
+ * ends differ in sign holds exactly one crossing once L (t2 - t1) <=
+ * |f1| + |f2| (a second and third would need more variation than L allows);
+ * that crossing is polished by iso_root. */
+typedef struct {
+    const im_data *m;
+    vec3 p0, e;
+    double a, s, tmin, tmax, minstep;
+    geom_shape_hit *out;
+    int n, max;
+} iso_walk;
+
+static void iso_split(iso_walk *w, double t1, double f1, double t2, double f2, int depth)
+{
+    if (w->n == w->max && w->a + t1 / w->s > w->out[w->max - 1].t) return; /* nothing nearer can follow */
+    double len = t2 - t1, reach = w->m->grad * len;
+    int fine = len <= w->minstep || depth >= 60;
+    if (isfinite(f1) && isfinite(f2)) {
+        if ((f1 < 0.0) == (f2 < 0.0)) {
+            if (fabs(f1) + fabs(f2) > reach || fine) return;
+        } else if (fabs(f1) + fabs(f2) >= reach || fine) {
+            double t = w->a + iso_root(w->m, w->p0, w->e, t1, t2, f1, f2, 1e-15 * (fabs(t2) + len)) / w->s;
+            if (t > w->tmin && t < w->tmax) w->n = geom_shape_hit_put(w->out, w->n, w->max, t, 0);
+            return;
+        }
+    } else if (fine) {
+        return;
+    }
+    double mid = t1 + 0.5 * len, fm = iso_f(w->m, v3_madd(w->p0, w->e, mid));
+    iso_split(w, t1, f1, mid, fm, depth + 1);
+    iso_split(w, mid, fm, t2, f2, depth + 1);
+}
+
 static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     double ca, cb;
@@ -808,21 +845,10 @@ static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, 
         if (ca > tmin && ca < tmax && iso_f(m, v3_madd(o, d, ca)) < 0.0) n = geom_shape_hit_put(out, n, max, ca, 1);
         if (cb > tmin && cb < tmax && iso_f(m, v3_madd(o, d, cb)) < 0.0) n = geom_shape_hit_put(out, n, max, cb, 1);
     }
-    double tau = 0.0, v0 = iso_f(m, p0);
     double minstep = fmax(m->acc, 1e-9 * m->size);
-    int steps = 0;
-    while (tau < len && steps++ < 1000000) {
-        if (n == max && a + tau / s > out[max - 1].t) break;
-        double step = isfinite(v0) ? fmax(fabs(v0) / m->grad, minstep) : minstep;
-        double t1 = fmin(tau + step, len);
-        double v1 = iso_f(m, v3_madd(p0, e, t1));
-        if (isfinite(v0) && isfinite(v1) && (v0 < 0.0) != (v1 < 0.0)) {
-            double t = a + iso_root(m, p0, e, tau, t1, v0, v1, 1e-15 * (len + fabs(t1))) / s;
-            if (t > tmin && t < tmax) n = geom_shape_hit_put(out, n, max, t, 0);
-        }
-        tau = t1;
-        v0 = v1;
-    }
+    iso_walk w = {m, p0, e, a, s, tmin, tmax, minstep, out, n, max};
+    iso_split(&w, 0.0, iso_f(m, p0), len, iso_f(m, v3_madd(p0, e, len)), 0);
+    n = w.n;
     return n;
 }
 
