@@ -23,6 +23,8 @@ typedef struct {
     vec3 a, axis;     /* centre / first end and unit axis (component space) */
     double len, r2, s;
     const scene_texture *tex;
+    vec3 bc;          /* blob space: a sphere holding the component's reach */
+    double br2;       /* (its squared radius) */
 } blob_comp;
 
 typedef struct {
@@ -596,12 +598,20 @@ static int blob_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax,
         if (!sp) return 0;
     }
     int ns = 0;
-    for (int i = 0; i < m->ncomp; i++) ns += blob_spans(&m->comp[i], p, e, 0.0, L, sp + ns);
+    for (int i = 0; i < m->ncomp; i++) {
+        /* the ray must pass through the component's bounding sphere within [0, L] */
+        const blob_comp *c = &m->comp[i];
+        vec3 rel = v3_sub(p, c->bc);
+        double bq = v3_dot(rel, e), cq = v3_dot(rel, rel) - c->br2, disc = bq * bq - cq;
+        if (cq > 0.0 && (bq > 0.0 || disc < 0.0 || -bq - sqrt(disc) > L)) continue;
+        ns += blob_spans(c, p, e, 0.0, L, sp + ns);
+    }
     int n = 0;
     if (ns > 0) {
         blob_event lev[128];
         blob_event *ev = 2 * (size_t)ns > 128 ? malloc(sizeof *ev * 2 * (size_t)ns) : lev;
-        int *active = malloc(sizeof *active * (size_t)ns);
+        int lact[64];
+        int *active = ns > 64 ? malloc(sizeof *active * (size_t)ns) : lact;
         if (ev && active) {
             for (int i = 0; i < ns; i++) {
                 ev[2 * i] = (blob_event){sp[i].a, i, 1};
@@ -637,7 +647,7 @@ static int blob_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax,
             }
         }
         if (ev != lev) free(ev);
-        free(active);
+        if (active != lact) free(active);
     }
     if (sp != local) free(sp);
     return n;
@@ -707,6 +717,14 @@ static int blob_setup(im_data *m, const scene_blob *b, vec3 *lo, vec3 *hi)
             clo = v3_min(clo, v3_sub(sc->b, v3s(r)));
             chi = v3_max(chi, v3_add(sc->b, v3s(r)));
         }
+        /* the reach's bounding sphere in blob space: the component-space
+         * one stretched by at most the linear part's Frobenius norm */
+        double fro = 0.0;
+        for (int ii = 0; ii < 3; ii++)
+            for (int jj = 0; jj < 3; jj++) fro += c->x.m[ii][jj] * c->x.m[ii][jj];
+        double R0 = sc->cylinder ? 0.5 * c->len + r : r;
+        c->bc = xform_point(&c->x, sc->cylinder ? v3_scale(v3_add(sc->a, sc->b), 0.5) : sc->a);
+        c->br2 = R0 * R0 * fro * (1.0 + 1e-9);
         m->ncomp++;
         if (c->s <= 0.0 && m->threshold > 0.0) continue; /* cannot make surface on its own */
         for (int k = 0; k < 8; k++) {
