@@ -48,7 +48,9 @@ static double refine(const double *c, int n, double lo, double hi, double flo)
         if (!(xn > lo && xn < hi)) xn = 0.5 * (lo + hi);
         double step = fabs(xn - x);
         x = xn;
-        if (step <= 1e-16 * (fabs(x) + width) || hi - lo <= 2e-16 * (fabs(x) + width)) break;
+        /* a few ulps: below one ulp of x a Newton step at the root can
+         * alternate between neighbouring doubles for all 200 iterations */
+        if (step <= 4.0 * DBL_EPSILON * (fabs(x) + width) || hi - lo <= 4.0 * DBL_EPSILON * (fabs(x) + width)) break;
     }
     return x;
 }
