@@ -19,36 +19,9 @@
 #include "gi_cl_c.h"
 #include "pm_path.h"
 #include "sdl.h"
+#include "test_world.h"
 
 #define THREADS 2
-
-static scene *parse(const char *text)
-{
-    sdl_options so;
-    sdl_default_options(&so);
-    diag *d = diag_new();
-    scene *sc = NULL;
-    pt_status st = sdl_parse_string("test.pov", text, &so, &sc, d);
-    if (st != PT_OK)
-        for (int i = 0; i < diag_count(d); i++) {
-            char *m = diag_format(diag_get(d, i));
-            fprintf(stderr, "%s\n", m ? m : "?");
-            free(m);
-        }
-    diag_free(d);
-    assert_int_equal(st, PT_OK);
-    return sc;
-}
-
-static accel *build(const scene *sc)
-{
-    diag *d = diag_new();
-    pt_status st;
-    accel *a = accel_build(sc, THREADS, d, &st);
-    diag_free(d);
-    assert_int_equal(st, PT_OK);
-    return a;
-}
 
 /* The layer of scene `text` over a w x h G-buffer on device dev (NULL auto). */
 static void layer(caustics *c, const scene *sc, const accel *a, int w, int h, const char *dev, int threads, diag *d)
@@ -96,8 +69,9 @@ static void test_focus_vs_path(void **state)
     snprintf(text, sizeof text, focus_fmt, "photons { spacing 0.002 }",
              "light_source { <0, 10, 0> color rgb 50 fade_distance 0.1 fade_power 2 }",
              "photons { target refraction on reflection off }");
-    scene *sc = parse(text);
-    accel *a = build(sc);
+    tu_world w = tu_world_build("test.pov", text);
+    scene *sc = w.s;
+    accel *a = w.a;
     diag *d = diag_new();
     caustics c;
     layer(&c, sc, a, 150, 150, NULL, THREADS, d);
@@ -106,13 +80,13 @@ static void test_focus_vs_path(void **state)
     gi_caustic_get_stats(c.layer, &st);
     caustics_free(&c);
     diag_free(d);
-    accel_free(a);
-    scene_free(sc);
+    tu_world_free(&w);
 
     snprintf(text, sizeof text, focus_fmt, "",
              "sphere { <0, 10, 0>, 0.3 pigment { rgb 1 } finish { ambient 0 diffuse 0 emission 11.111111111 } }", "");
-    sc = parse(text);
-    a = build(sc);
+    w = tu_world_build("test.pov", text);
+    sc = w.s;
+    a = w.a;
     pm_path_settings ps;
     pm_path_default_settings(&ps);
     ps.c.width = ps.c.height = 15;
@@ -128,8 +102,7 @@ static void test_focus_vs_path(void **state)
            e_layer, st.stored, st.r_median, st.t_trace, st.t_splat, e_path, ps.c.spp, pst.t_total, e_layer / e_path);
     assert_true(fabs(e_layer / e_path - 1.0) <= 0.05);
     fb_free(fb);
-    accel_free(a);
-    scene_free(sc);
+    tu_world_free(&w);
 }
 
 /* A mirror wall (x = 1, reflection 1) beside a point light of colour 1 at
@@ -140,14 +113,15 @@ static void test_focus_vs_path(void **state)
 static void test_mirror_closed_form(void **state)
 {
     (void)state;
-    scene *sc = parse("#version 3.7;\n"
+    tu_world w = tu_world_build("test.pov", "#version 3.7;\n"
                       "global_settings { assumed_gamma 1.0 photons { spacing 0.01 } }\n"
                       "camera { orthographic location <0, 5, 0> look_at <0, 0, 0> sky z right x*0.4 up z*0.4 }\n"
                       "light_source { <-2, 5, 0> color rgb 1 }\n"
                       "box { <1, -1, -3>, <1.1, 3, 3> pigment { rgb 0 } finish { ambient 0 diffuse 0 reflection 1 } "
                       "photons { target reflection on } }\n"
                       "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 1 } }\n");
-    accel *a = build(sc);
+    scene *sc = w.s;
+    accel *a = w.a;
     diag *d = diag_new();
     caustics c;
     layer(&c, sc, a, 32, 32, NULL, THREADS, d);
@@ -156,8 +130,7 @@ static void test_mirror_closed_form(void **state)
     assert_true(fabs(e / want - 1.0) <= 0.02);
     caustics_free(&c);
     diag_free(d);
-    accel_free(a);
-    scene_free(sc);
+    tu_world_free(&w);
 }
 
 static const char *ball =
@@ -175,8 +148,9 @@ static const char *ball =
 static void test_splat_equals_sum(void **state)
 {
     (void)state;
-    scene *sc = parse(ball);
-    accel *a = build(sc);
+    tu_world w = tu_world_build("test.pov", ball);
+    scene *sc = w.s;
+    accel *a = w.a;
     diag *d = diag_new();
     caustics c;
     layer(&c, sc, a, 64, 48, NULL, THREADS, d);
@@ -202,8 +176,7 @@ static void test_splat_equals_sum(void **state)
     assert_true(maxd <= 1e-5 * maxe + 1e-7);
     caustics_free(&c);
     diag_free(d);
-    accel_free(a);
-    scene_free(sc);
+    tu_world_free(&w);
 }
 
 /* OpenCL (PoCL here) and the C build of gi_k_caustic_splat, and 1 against
@@ -211,8 +184,9 @@ static void test_splat_equals_sum(void **state)
 static void test_devices_and_threads(void **state)
 {
     (void)state;
-    scene *sc = parse(ball);
-    accel *a = build(sc);
+    tu_world w = tu_world_build("test.pov", ball);
+    scene *sc = w.s;
+    accel *a = w.a;
     diag *d = diag_new();
     caustics c1, c2;
     layer(&c1, sc, a, 64, 48, "c", 1, d);
@@ -233,8 +207,7 @@ static void test_devices_and_threads(void **state)
     caustics_free(&c1);
     caustics_free(&c2);
     diag_free(d);
-    accel_free(a);
-    scene_free(sc);
+    tu_world_free(&w);
 }
 
 /* Photon settings the layer does not model are counted and warned about,
@@ -242,7 +215,7 @@ static void test_devices_and_threads(void **state)
 static void test_not_modelled(void **state)
 {
     (void)state;
-    scene *sc = parse("#version 3.7;\n"
+    tu_world w = tu_world_build("test.pov", "#version 3.7;\n"
                       "global_settings { photons { count 2000 gather 10, 50 radius 0.1 media 20 autostop 0.2 "
                       "expand_thresholds 0.1, 10 save_file \"x.ph\" } }\n"
                       "camera { location <0, 3, -4> look_at 0 }\n"
@@ -250,7 +223,8 @@ static void test_not_modelled(void **state)
                       "sphere { <0, 1, 0>, 0.5 pigment { rgbf 1 } interior { ior 1.5 dispersion 1.1 } "
                       "photons { target refraction on } }\n"
                       "plane { y, 0 pigment { rgb 1 } }\n");
-    accel *a = build(sc);
+    scene *sc = w.s;
+    accel *a = w.a;
     diag *d = diag_new();
     caustics c;
     layer(&c, sc, a, 16, 12, NULL, THREADS, d);
@@ -275,21 +249,20 @@ static void test_not_modelled(void **state)
     assert_int_equal(diag_count(d), warned);
     caustics_free(&c);
     diag_free(d);
-    accel_free(a);
-    scene_free(sc);
+    tu_world_free(&w);
 
-    sc = parse("global_settings { photons { spacing 0.1 } }\n"
+    w = tu_world_build("test.pov", "global_settings { photons { spacing 0.1 } }\n"
                "light_source { <0, 5, 0> rgb 1 }\n"
                "sphere { <0, 1, 0>, 0.5 pigment { rgbf 1 } interior { ior 1.5 } }\n");
-    a = build(sc);
+    sc = w.s;
+    a = w.a;
     d = diag_new();
     assert_int_equal(caustics_build(&c, sc, a, 8, 8, THREADS, 1, NULL, 0, 0.0, NULL, d), PT_OK);
     assert_null(c.layer);
     assert_int_equal(diag_count(d), 1);
     caustics_free(&c);
     diag_free(d);
-    accel_free(a);
-    scene_free(sc);
+    tu_world_free(&w);
 }
 
 int main(void)
