@@ -372,6 +372,18 @@ static void light_not_modelled(const scene *sc, int mode, render_gi_result *r, d
         r->nm_rainbow = rainbow;
     }
     src_loc nowhere = {0};
+    if (sc->global.photons.enabled && mode != GI_NONE && mode != GI_PARTICLE) {
+        r->nm_photons = mode != GI_PMFG;
+        r->nm_photon_count = mode == GI_PMFG;
+        if (r->nm_photons)
+            diag_report(d, DIAG_WARNING, nowhere, NULL,
+                        "--gi %s: the scene's photons{} are not modelled: no caustics of its light sources (--gi none "
+                        "and particle have them)", gi_mode_name(mode));
+        else
+            diag_report(d, DIAG_WARNING, nowhere, NULL,
+                        "--gi pmfg: photons{} spacing and count are not used: its caustic map shoots --photons from "
+                        "every light");
+    }
     if (r->nm_media)
         diag_report(d, DIAG_WARNING, nowhere, NULL, "--gi %s: participating media are not modelled%s; the image lacks their light",
                     who, mode == GI_PARTICLE ? " along gathering rays (radiosity media on)" : "");
@@ -418,6 +430,8 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
     stats_int(js, "media", r->nm_media);
     stats_int(js, "fog", r->nm_fog);
     stats_int(js, "rainbow", r->nm_rainbow);
+    stats_int(js, "photons", r->nm_photons);
+    stats_int(js, "photon_count", r->nm_photon_count);
     stats_obj_end(js);
     if (r->has_particle) {
         const gi_particle_stats *p = &r->particle;

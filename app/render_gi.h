@@ -101,6 +101,11 @@ typedef struct {
      * (atmospheric or in objects) and rainbows on every ray; particle: with
      * radiosity's `media on`, media, fog and rainbows along gathering rays. */
     int nm_media, nm_fog, nm_rainbow;
+    /* The scene's photons{}: nm_photons 1 where the mode shows no caustics
+     * of POV-Ray's lights (every mode but none, particle and pmfg);
+     * nm_photon_count 1 for pmfg, whose caustic map shoots --photons from
+     * every light in all directions (not the scene's spacing or count) */
+    int nm_photons, nm_photon_count;
     /* none, particle: the caustic layer of the scene's photons{} (its
      * layer is freed when render_gi returns; the figures stay) */
     caustics caus;
