@@ -51,6 +51,7 @@ struct gi_vlinks {
     int *leaf_mesh;          /* leaf -> mesh, -1: not a mesh */
     long nv, ne;             /* vertices, elements (2 a vertex) */
     vec3 *pos, *nrm;         /* per vertex: world position, unit winding normal */
+    vec3 *org;               /* per vertex: where its rays start (see mesh_geometry) */
     float *rho;              /* per element, 4 floats */
     elinks *lk;              /* per element */
     int nc;                  /* rays per element */
@@ -114,26 +115,49 @@ static vec3 *make_dirs(int nside)
 
 static vec3 vload(const float *f) { return v3(f[0], f[1], f[2]); }
 
-/* World positions and area-weighted winding normals of mesh m's vertices. */
+/* World positions and area-weighted winding normals of mesh m's vertices,
+ * and where their rays start: a little off the surface along the normal
+ * (side 0; side 1 mirrors it), and moved in the tangent plane a hundredth
+ * of the way towards the mean of the vertex's one-ring neighbours. A vertex on the border of a
+ * mesh (a room's wall where it meets the next wall) would otherwise start
+ * its rays in the next wall's plane: half of them would pass behind it and
+ * leave the room. Inner vertices of an even mesh hardly move. */
 static void mesh_geometry(gi_vlinks *v, const scene_object *o, const vmesh *m)
 {
     const scene_mesh *sm = o->u.mesh.mesh;
-    vec3 *P = v->pos + m->vbase, *N = v->nrm + m->vbase;
+    vec3 *P = v->pos + m->vbase, *N = v->nrm + m->vbase, *O = v->org + m->vbase;
     for (int i = 0; i < m->nverts; i++) {
         P[i] = xform_point(&o->transform, vload(sm->verts[i]));
         N[i] = v3(0, 0, 0);
+        O[i] = v3(0, 0, 0); /* sum of one-ring neighbours (twice each) */
     }
     for (int t = 0; t < m->ntris; t++) {
         const int *tr = sm->tris[t];
         if (tr[0] < 0 || tr[1] < 0 || tr[2] < 0 || tr[0] >= m->nverts || tr[1] >= m->nverts || tr[2] >= m->nverts)
             continue;
         vec3 f = v3_cross(v3_sub(P[tr[1]], P[tr[0]]), v3_sub(P[tr[2]], P[tr[0]]));
-        for (int c = 0; c < 3; c++) N[tr[c]] = v3_add(N[tr[c]], f);
+        for (int c = 0; c < 3; c++) {
+            N[tr[c]] = v3_add(N[tr[c]], f);
+            O[tr[c]] = v3_add(O[tr[c]], v3_add(P[tr[(c + 1) % 3]], P[tr[(c + 2) % 3]]));
+        }
     }
+    int *cnt = calloc((size_t)(m->nverts > 0 ? m->nverts : 1), sizeof *cnt);
+    if (cnt)
+        for (int t = 0; t < m->ntris; t++) {
+            const int *tr = sm->tris[t];
+            if (tr[0] < 0 || tr[1] < 0 || tr[2] < 0 || tr[0] >= m->nverts || tr[1] >= m->nverts || tr[2] >= m->nverts)
+                continue;
+            for (int c = 0; c < 3; c++) cnt[tr[c]] += 2;
+        }
     for (int i = 0; i < m->nverts; i++) {
         double l = v3_len(N[i]);
         N[i] = l > 0.0 ? v3_scale(N[i], 1.0 / l) : v3(0, 0, 1);
+        vec3 c = cnt && cnt[i] > 0 ? v3_scale(O[i], 1.0 / cnt[i]) : P[i];
+        vec3 d = v3_sub(c, P[i]);
+        d = v3_sub(d, v3_scale(N[i], v3_dot(d, N[i]))); /* in the tangent plane: never through the surface */
+        O[i] = v3_add(P[i], v3_scale(d, 0.01));
     }
+    free(cnt);
 }
 
 /* Reflectance (finish diffuse times the pigment at the vertex) of mesh m's
@@ -230,7 +254,7 @@ static void link_chunk(void *ctx, int ci, int thread)
         vec3 n = side ? v3_neg(v->nrm[vx]) : v->nrm[vx];
         vec3 t, b;
         v3_basis(n, &t, &b);
-        vec3 org = v3_madd(v->pos[vx], n, v->off);
+        vec3 org = v3_madd(v->org[vx], n, v->off);
         int nt = 0, raw = 0;
         /* the element's rays in one Embree stream, block by block (the
          * directions run 4 x 4 block after block: coherent) */
@@ -378,7 +402,7 @@ static void light_chunk(void *ctx, int ci, int thread)
             if (!(att > 0.0f) || (obj && !scene_light_reaches(l, obj))) continue;
             if (!l->shadowless) {
                 rays++;
-                if (accel_occluded(J->a, v3_madd(p, n, v->off), v3(d[0], d[1], d[2]), 0.0, depth)) continue;
+                if (accel_occluded(J->a, v3_madd(v->org[vx], n, v->off), v3(d[0], d[1], d[2]), 0.0, depth)) continue;
             }
             for (int c = 0; c < 3; c++) E[c] += dl->colour[c] * att * (float)ci2;
         }
@@ -425,6 +449,7 @@ static void free_structure(gi_vlinks *v)
     free(v->leaf_mesh);
     free(v->pos);
     free(v->nrm);
+    free(v->org);
     free(v->rho);
     free(v->ray_t);
     free(v->ray_leaf);
@@ -441,7 +466,7 @@ static void free_structure(gi_vlinks *v)
     v->lk = NULL;
     v->mesh = NULL;
     v->leaf_mesh = NULL;
-    v->pos = v->nrm = NULL;
+    v->pos = v->nrm = v->org = NULL;
     v->rho = v->ray_t = v->edir = v->b0 = v->b1 = v->itot = v->ism = v->w_csr = NULL;
     v->ray_leaf = v->off_csr = v->peer_csr = v->adj_off = v->adj = NULL;
     v->ne = v->nv = 0;
@@ -505,6 +530,7 @@ static int make_structure(gi_vlinks *v, const scene *sc, const scene_leaves *lv)
     size_t ne = (size_t)(v->ne > 0 ? v->ne : 1);
     v->pos = malloc(sizeof *v->pos * (size_t)(nv > 0 ? nv : 1));
     v->nrm = malloc(sizeof *v->nrm * (size_t)(nv > 0 ? nv : 1));
+    v->org = malloc(sizeof *v->org * (size_t)(nv > 0 ? nv : 1));
     v->rho = calloc(ne * 4, sizeof *v->rho);
     v->lk = calloc(ne, sizeof *v->lk);
     v->ray_t = malloc(sizeof *v->ray_t * ne * (size_t)v->nc);
@@ -516,7 +542,7 @@ static int make_structure(gi_vlinks *v, const scene *sc, const scene_leaves *lv)
     v->ism = calloc(ne * 4, sizeof(float));
     v->off_csr = calloc(ne + 1, sizeof(int));
     v->adj_off = calloc(ne + 1, sizeof(int));
-    return v->pos && v->nrm && v->rho && v->lk && v->ray_t && v->ray_leaf && v->edir && v->b0 && v->b1 && v->itot &&
+    return v->pos && v->nrm && v->org && v->rho && v->lk && v->ray_t && v->ray_leaf && v->edir && v->b0 && v->b1 && v->itot &&
            v->ism && v->off_csr && v->adj_off;
 }
 
@@ -644,7 +670,7 @@ static void stale_chunk(void *ctx, int ci, int thread)
         vec3 n = side ? v3_neg(v->nrm[vx]) : v->nrm[vx];
         vec3 t, b;
         v3_basis(n, &t, &b);
-        vec3 org = v3_madd(v->pos[vx], n, v->off);
+        vec3 org = v3_madd(v->org[vx], n, v->off);
         for (int k = 0; k < v->nc && !J->need[e]; k++) {
             size_t r = (size_t)e * v->nc + k;
             int lf = v->ray_leaf[r];
