@@ -35,7 +35,9 @@
 #
 # BUILD=DIR (default build) holds partray; EXAMPLES=DIR (default
 # /usr/share/doc/povray/examples); OUT=DIR (default /tmp/glossy_bench)
-# keeps the images, stats and logs. PARTICLE=0 skips particle GI;
+# keeps the images, stats and logs. PARTICLE=0 skips particle GI; PMFG=1
+# also renders --gi pmfg (defaults; minutes a scene) and prints it against
+# path: the two references, glossy lobe and all, should agree;
 # KEEP_PATH=1 reuses path images already in OUT (chess2's takes minutes).
 set -eu
 cd "$(dirname "$0")/.."
@@ -51,6 +53,7 @@ EXAMPLES=${EXAMPLES:-/usr/share/doc/povray/examples}
 OUT=${OUT:-/tmp/glossy_bench}
 PARTICLE=${PARTICLE:-1}
 KEEP_PATH=${KEEP_PATH:-0}
+PMFG=${PMFG:-0}
 [ $# -gt 0 ] || set -- metals=incdemo/metals/golds.pov metrefl=textures/finishes/metallicreflection.pov \
     teapot=advanced/teapot/teapot.pov chess2=advanced/chess2.pov
 mkdir -p "$OUT"
@@ -98,10 +101,11 @@ for arg in "$@"; do
     render "$name" vplmm1 "$size" --gi vpl --vpl-adaptive off
     render "$name" vplbrute "$size" --gi vpl --vpl-cut brute --vpl-adaptive off
     [ "$PARTICLE" = 1 ] && render "$name" particle "$size" --gi particle
-    for mode in vpl particle; do [ -f "$OUT/$name.$mode.exr" ] && compare "$name" "$mode"; done
+    [ "$PMFG" = 1 ] && render "$name" pmfg "$size" --gi pmfg
+    for mode in vpl particle pmfg; do [ -f "$OUT/$name.$mode.exr" ] && compare "$name" "$mode"; done
     printf '%-8s %-6s %9.1f %10s %10.5f %9s\n' "$name" path "$(cat "$OUT/$name.path.time")" - \
         "$(json "$OUT/$name.vpl.cmp.json" luminance reference)" -
-    for mode in vpl particle; do
+    for mode in vpl particle pmfg; do
         [ -f "$OUT/$name.$mode.cmp.json" ] || continue
         printf '%-8s %-6s %9.1f %10.4f %10.5f %+8.2f%%\n' "$name" "$mode" "$(cat "$OUT/$name.$mode.time")" \
             "$(json "$OUT/$name.$mode.cmp.json" flip mean)" "$(json "$OUT/$name.$mode.cmp.json" luminance test)" \
