@@ -12,7 +12,11 @@
  *  - the density integrates to at most 1 over the sphere;
  *  - the furnace: white glossy spheres (phong, specular, metallic, mixed
  *    with diffuse) under a uniform white sky show the sky's radiance within
- *    1% in the path tracer and in pmfg. */
+ *    1% in the path tracer and in pmfg;
+ *  - where only direct light exists (one glossy metallic sphere, a point
+ *    light and a spotlight, black sky), the path tracer at full depth and
+ *    pmfg show --gi none's highlights exactly (POV-Ray's own formula for
+ *    light from light sources; the glossy lobe finds only the black sky). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -28,6 +32,7 @@
 #include "pm_fg.h"
 #include "pm_path.h"
 #include "rng.h"
+#include "shade.h"
 #include "test_world.h"
 
 static const double exponents[] = {0.5, 1, 2, 5, 10, 40, 100, 400, 2000, 20000};
@@ -235,6 +240,63 @@ static void test_furnace_pmfg(void **state)
     }
 }
 
+static void test_highlights_direct(void **state)
+{
+    (void)state;
+    tu_world w = tu_world_build("glossy_direct.pov",
+                                "#version 3.7;\n"
+                                "global_settings { assumed_gamma 1.0 }\n"
+                                "camera { location <0, 0.5, -4> look_at <0, 0, 0> angle 40 }\n"
+                                "light_source { <3, 4, -4> color rgb <1, 0.9, 0.8> }\n"
+                                "light_source { <-3, 3, -2> color rgb 0.6 spotlight point_at <0,0,0> radius 15 "
+                                "falloff 25 tightness 5 }\n"
+                                "sphere { 0, 1 pigment { rgb <0.9, 0.6, 0.3> } finish { ambient 0 diffuse 0.3 "
+                                "phong 0.6 phong_size 60 specular 0.4 roughness 0.01 metallic 1 } }\n");
+    const int W = 40, H = 30;
+    framebuffer *ref = fb_new(W, H), *fp = fb_new(W, H), *ff = fb_new(W, H);
+    shade_settings ss;
+    shade_default_settings(&ss);
+    ss.width = W;
+    ss.height = H;
+    ss.threads = 2;
+    ss.use_ambient = 0;
+    assert_int_equal(shade_render(w.s, w.a, &ss, ref, NULL, NULL), PT_OK);
+    pm_path_settings ps;
+    pm_path_default_settings(&ps);
+    ps.c.width = W;
+    ps.c.height = H;
+    ps.c.threads = 2;
+    ps.c.spp = 1;
+    ps.c.jitter = 0;
+    assert_int_equal(pm_path_render(w.s, w.a, &ps, fp, NULL, NULL), PT_OK);
+    pm_fg_settings fs;
+    pm_fg_default_settings(&fs);
+    fs.c.width = W;
+    fs.c.height = H;
+    fs.c.threads = 2;
+    fs.c.spp = 1;
+    fs.c.jitter = 0;
+    fs.fg_rays = 64;
+    fs.photons = 5000;
+    assert_int_equal(pm_fg_render(w.s, w.a, &fs, ff, NULL, NULL), PT_OK);
+    double dp = 0.0, df = 0.0, mx = 0.0;
+    for (int i = 0; i < W * H * 3; i++) {
+        dp = fmax(dp, fabs(fp->rgb[i] - ref->rgb[i]));
+        df = fmax(df, fabs(ff->rgb[i] - ref->rgb[i]));
+        mx = fmax(mx, ref->rgb[i]);
+    }
+    printf("glossy sphere, direct light only: max |path - none| %.3g, max |pmfg - none| %.3g (largest value %.3g, "
+           "tol 1e-5 relative)\n",
+           dp, df, mx);
+    assert_true(mx > 0.5); /* the highlights are there */
+    assert_true(dp <= 1e-5 * mx);
+    assert_true(df <= 1e-5 * mx);
+    fb_free(ref);
+    fb_free(fp);
+    fb_free(ff);
+    tu_world_free(&w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -243,6 +305,7 @@ int main(void)
         cmocka_unit_test(test_albedo_energy),
         cmocka_unit_test(test_furnace_path),
         cmocka_unit_test(test_furnace_pmfg),
+        cmocka_unit_test(test_highlights_direct),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
