@@ -629,7 +629,8 @@ int cmd_farm(int argc, char **argv)
         }
         diag_free(pd);
         if (pst != PT_OK) {
-            fprintf(stderr, "partray farm: the scene does not parse (frame %d): nothing planned\n", plan.first);
+            if (plan.animated) fprintf(stderr, "partray farm: the scene does not parse (frame %d): nothing planned\n", plan.first);
+            else fprintf(stderr, "partray farm: the scene does not parse: nothing planned\n");
             ini_free(ia);
             return pst == PT_ERR_IO ? 3 : 1;
         }
