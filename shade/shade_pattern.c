@@ -855,11 +855,14 @@ static const geom_shape *cached_shape(const scene_object *o, unsigned long seria
  * union/merge any, intersection all, difference the first and none of the
  * others, each node's `inverse` negating it; leaves by accel's shape test
  * (a shape accel cannot build, or a patch without inside, is outside).
- * Clipping objects are not applied. */
+ * A clipped_by solid must contain the point too, whatever the object's
+ * `inverse` (POV-Ray 3.7's Inside_Object tests the clip list first); its
+ * transform is relative to the object's space. */
 static int object_inside(const scene_object *o, vec3 p, unsigned long serial, int depth)
 {
     int in = 0;
     if (depth > 64) return 0;
+    if (o->clip && !object_inside(o->clip, xform_inv_point(&o->transform, p), serial, depth + 1)) return 0;
     switch (o->kind) {
     case SHAPE_UNION: case SHAPE_MERGE:
         for (int i = 0; i < o->u.csg.nkids && !in; i++) in = object_inside(o->u.csg.kids[i], p, serial, depth + 1);

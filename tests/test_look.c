@@ -78,8 +78,8 @@ static void test_uv_levels(void **st)
     write_image();
     check("xl_uv_levels", NULL, "uv_levels", 0.003);
 }
-/* object pattern */
-static void test_object_pattern(void **st) { (void)st; check("xl_objpattern", NULL, "object_pattern", 0.002); }
+/* object pattern (identical to POV-Ray; without clipped_by applied 0.0013) */
+static void test_object_pattern(void **st) { (void)st; check("xl_objpattern", NULL, "object_pattern", 0.0005); }
 static void test_cameras(void **st)
 {
     (void)st;
