@@ -314,6 +314,10 @@ static double metric_sum(vec3 d, double metric)
 {
     if (metric == 2) return d.x * d.x + d.y * d.y + d.z * d.z;
     if (metric == 1) return fabs(d.x) + fabs(d.y) + fabs(d.z);
+    if (metric == 3) {
+        double x = fabs(d.x), y = fabs(d.y), z = fabs(d.z);
+        return x * x * x + y * y * y + z * z * z;
+    }
     return pow(fabs(d.x), metric) + pow(fabs(d.y), metric) + pow(fabs(d.z), metric);
 }
 
@@ -350,8 +354,16 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
     if (m2 < m1) { t = m1; m1 = m2; m2 = t; mi = 1; }
     if (m3 < m1) { t = m1; m1 = m3; m3 = t; mi = 2; }
     if (m3 < m2) { t = m2; m2 = m3; m3 = t; }
+    /* other metrics: each term is at least the largest coordinate's, so a
+     * point whose largest |coordinate| exceeds m3^(1/metric) cannot be
+     * among the three nearest; that bound skips most of the pow()s */
+    int general = metric > 0.0 && metric != 2 && metric != 1;
+    double bound = general ? pow(m3, 1.0 / metric) * (1.0 + 1e-12) : INFINITY;
     for (int i = 3; i < 81; i++) {
-        double s = metric_sum(v3_sub(pts[i], p), metric);
+        vec3 d = v3_sub(pts[i], p);
+        if (general && fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))) > bound) continue;
+        double s = metric_sum(d, metric);
+        if (general && s < m3) bound = INFINITY; /* m3 changes below */
         if (s < m1) {
             m3 = m2;
             m2 = m1;
@@ -363,6 +375,7 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
         } else if (s < m3) {
             m3 = s;
         }
+        if (general && bound == INFINITY) bound = pow(m3, 1.0 / metric) * (1.0 + 1e-12);
     }
     double off = pat->crackle_offset;
     if (off != 0.0) {
