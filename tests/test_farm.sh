@@ -3,6 +3,7 @@
 #
 # 4 frames x 2 tiles of a particle-GI scene at 64x48 (tests/scenes/farm_gi.pov,
 # the camera and a sphere move with the clock):
+#  0. A scene that does not parse stops the farm before it plans (exit 1).
 #  1. Slurm: a two-node cluster on loopback started by scripts/slurm_local.sh,
 #     one task sent SIGTERM on its first run (--inject-fault: exit 143), the
 #     merge job resubmits it; every merged frame is byte-identical (PFM) to
@@ -37,6 +38,15 @@ done
 cp "$SRC/tests/scenes/farm_gi.pov" "$T/" || fail "copy scene"
 cd "$T" || fail "cd"
 OPTS="--size 64x48 --particles 10000 +KFI1 +KFF4"
+
+# a scene error stops the farm before it plans anything (exit 1, no DIR)
+printf 'camera { location -5 look_at 0 }\nsphere { 0, 1 oops }\n' >bad.pov
+"$BIN" farm bad.pov --size 32x24 --dir wbad -o bad.pfm 2>bad.log
+rc=$?
+[ $rc -eq 1 ] || fail "farm on a scene that does not parse: exit $rc, wanted 1"
+grep -q "bad.pov:2:.*error" bad.log || fail "farm on a bad scene: no located error: $(cat bad.log)"
+[ -e wbad ] && fail "farm on a bad scene made its directory"
+echo "ok: a scene error stops the farm before planning"
 
 # the frames rendered whole, one process each
 for f in 1 2 3 4; do
