@@ -113,6 +113,8 @@ field still.json "'vertices %d (elements %d, two sides), meshes %d' % (j['links'
 field still.json "'links raw %d, merged %d: ratio %.2f (paper Table 1: 3-5x)' % (j['links']['raw_links'], j['links']['merged_links'], j['links']['raw_links'] / max(1, j['links']['merged_links']))"
 field still.json "'link rays %d in %.3f s: %.2f M rays/s, %.1f us per vertex (both sides)' % (j['links']['link_rays'], j['links']['timings']['links'], j['links']['link_rays'] / max(1e-9, j['links']['timings']['links']) * 1e-6, j['links']['timings']['links'] / max(1, j['links']['vertices']) * 1e6)"
 field still.json "'first full solution %.3f s (links %.3f, light %.3f, %d sweeps %.3f, smoothing %.3f)' % (sum(j['links']['timings'].values()), j['links']['timings']['links'], j['links']['timings']['light'], j['links']['sweeps'], j['links']['timings']['bounces'], j['links']['timings']['smooth'])"
+"$P" render scenes/cbox.pov --gi links --size "$SIZE" -o cbox_still.pfm --stats cbox_still.json 2>/dev/null
+field cbox_still.json "'scenes/cbox.pov: %d vertices, links raw %d, merged %d: ratio %.2f; %.2f M link rays/s' % (j['links']['vertices'], j['links']['raw_links'], j['links']['merged_links'], j['links']['raw_links'] / max(1, j['links']['merged_links']), j['links']['link_rays'] / max(1e-9, j['links']['timings']['links']) * 1e-6)"
 "$P" render mesh_room.pov +L"$TPL" --gi links --size "$SIZE" +KFI1 +KFF"$LINK_FRAMES" +KC -o la.pfm 2>la.log
 python3 parse.py la.log > la.json
 python3 - <<EOF
