@@ -236,7 +236,7 @@ gi_particle *gi_particle_load(const scene *sc, const accel *a, const gi_particle
     if (!why && key != scene_key) {
         diag_report(d, DIAG_ERROR, at, NULL,
                     "GI cache made for another scene (scene key %016llx, this render's %016llx: the scene's files, "
-                    "declarations, camera position, size or frame differ); delete it or name another file",
+                    "declarations, camera, size or frame differ); delete it or name another file",
                     (unsigned long long)key, (unsigned long long)scene_key);
         why = "";
     }
