@@ -228,6 +228,10 @@ static pt_status render_links(const scene *sc, const accel *a, const render_gi_o
     gi_vlinks_set_progress(v, o->progress);
     r->has_links = 1;
     pt_status st = gi_vlinks_frame(v, sc, a, o->links ? o->links_objects_may_change : 1, &r->links, d);
+    if (st == PT_OK && r->links.other_objects > 0)
+        diag_report(d, DIAG_WARNING, (src_loc){0}, NULL,
+                    "--gi links: %ld objects are not meshes: they block light but neither receive nor pass on indirect light",
+                    r->links.other_objects);
     r->t_gi_geometry = r->links.t_links;
     r->t_gi_lighting = r->links.t_light + r->links.t_bounces + r->links.t_smooth;
     if (st == PT_OK && !(o->cancel && *o->cancel)) st = render_with_hook(sc, a, o, fb, r, d, gi_vlinks_indirect, v);
@@ -512,6 +516,7 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
         stats_int(js, "vertices", p->vertices);
         stats_int(js, "elements", p->elements);
         stats_int(js, "meshes", p->meshes);
+        stats_int(js, "other_objects", p->other_objects);
         stats_int(js, "full", p->full);
         stats_int(js, "sweeps", p->sweeps);
         stats_int(js, "objects_moved", p->objects_moved);

@@ -758,6 +758,7 @@ pt_status gi_vlinks_frame(gi_vlinks *v, const scene *sc, const accel *a, int obj
     st->vertices = v->nv;
     st->elements = v->ne;
     st->meshes = v->nmesh;
+    st->other_objects = nl - v->nmesh;
     scene_leaves_free(v->lv);
     v->lv = lv;
     lv = NULL;

@@ -58,6 +58,7 @@ typedef struct {
 
 typedef struct {
     long vertices, elements, meshes;
+    long other_objects;    /* leaf objects that are not meshes: no indirect light on them */
     long meshes_moved, objects_moved; /* since the previous frame */
     long elements_linked;  /* elements that traced their rays this frame */
     long raw_links, merged_links; /* over all elements: before and after merging per peer */
