@@ -513,6 +513,8 @@ static const char *farm_help =
     "(--sshloginfile, ':' = this machine, the default) or Slurm (a job array and a merge job),\n"
     "and merges each frame into OUT (numbered as render numbers frames). Tasks already done are\n"
     "skipped, so the same command on the same DIR resumes. A task ending with 130 or 143 is run again.\n"
+    "The scene is parsed first (an error stops the farm); with particle GI the tasks share the\n"
+    "geometry stage through DIR/gi.gic (--gi-cache, unless the render options name a cache).\n"
     "  --tiles N          tiles per frame (horizontal bands; default 1)\n"
     "  --dir DIR          work directory: plan, tasks, tiles, statuses, logs (default farm)\n"
     "  --engine E         parallel (default) or slurm (sbatch; SLURM_CONF as for sbatch)\n"
