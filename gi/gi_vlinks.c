@@ -53,6 +53,7 @@ struct gi_vlinks {
     vec3 *pos, *nrm;         /* per vertex: world position, unit winding normal */
     vec3 *org;               /* per vertex: where its rays start (see mesh_geometry) */
     float *rho;              /* per element, 4 floats */
+    float *le;               /* per element, 4 floats: emitted radiance (finish emission, POV-Ray's rules) */
     elinks *lk;              /* per element */
     int nc;                  /* rays per element */
     vec3 *dirs;              /* the n_C directions in the unit hemisphere about +z */
@@ -160,8 +161,10 @@ static void mesh_geometry(gi_vlinks *v, const scene_object *o, const vmesh *m)
     free(cnt);
 }
 
-/* Reflectance (finish diffuse times the pigment at the vertex) of mesh m's
- * elements; both sides take the texture of the vertex's first triangle. */
+/* Reflectance (finish diffuse times the pigment at the vertex) and emitted
+ * radiance (radrules.h rule 1 times the pigment and its opacity) of mesh
+ * m's elements; both sides take the texture of the vertex's first
+ * triangle. */
 static void mesh_rho(gi_vlinks *v, const scene *sc, const scene_object *o, const vmesh *m)
 {
     const scene_mesh *sm = o->u.mesh.mesh;
@@ -210,10 +213,19 @@ static void mesh_rho(gi_vlinks *v, const scene *sc, const scene_object *o, const
         if (v->s.pigment && !v->s.pigment(sc, tex, &h, &c5)) c5 = tex->pigment.colour;
         double d = tex->finish.diffuse;
         float rgbv[3] = {(float)(c5.r * d), (float)(c5.g * d), (float)(c5.b * d)};
+        radrules rr = radrules_of(sc, 1);
+        rgb em = radrules_emission(&rr, sc, &tex->finish);
+        double op = 1.0 - c5.f - c5.t;
+        if (op < 0.0) op = 0.0;
+        float lev[3] = {(float)(em.r * c5.r * op), (float)(em.g * c5.g * op), (float)(em.b * c5.b * op)};
         for (int side = 0; side < 2; side++) {
             float *r = &v->rho[(size_t)(2 * g + side) * 4];
-            for (int k = 0; k < 3; k++) r[k] = isfinite(rgbv[k]) && rgbv[k] > 0.0f ? rgbv[k] : 0.0f;
-            r[3] = 0.0f;
+            float *e = &v->le[(size_t)(2 * g + side) * 4];
+            for (int k = 0; k < 3; k++) {
+                r[k] = isfinite(rgbv[k]) && rgbv[k] > 0.0f ? rgbv[k] : 0.0f;
+                e[k] = isfinite(lev[k]) && lev[k] > 0.0f ? lev[k] : 0.0f;
+            }
+            r[3] = e[3] = 0.0f;
         }
     }
     free(first);
@@ -451,6 +463,7 @@ static void free_structure(gi_vlinks *v)
     free(v->nrm);
     free(v->org);
     free(v->rho);
+    free(v->le);
     free(v->ray_t);
     free(v->ray_leaf);
     free(v->edir);
@@ -467,7 +480,7 @@ static void free_structure(gi_vlinks *v)
     v->mesh = NULL;
     v->leaf_mesh = NULL;
     v->pos = v->nrm = v->org = NULL;
-    v->rho = v->ray_t = v->edir = v->b0 = v->b1 = v->itot = v->ism = v->w_csr = NULL;
+    v->rho = v->le = v->ray_t = v->edir = v->b0 = v->b1 = v->itot = v->ism = v->w_csr = NULL;
     v->ray_leaf = v->off_csr = v->peer_csr = v->adj_off = v->adj = NULL;
     v->ne = v->nv = 0;
     v->nmesh = 0;
@@ -532,6 +545,7 @@ static int make_structure(gi_vlinks *v, const scene *sc, const scene_leaves *lv)
     v->nrm = malloc(sizeof *v->nrm * (size_t)(nv > 0 ? nv : 1));
     v->org = malloc(sizeof *v->org * (size_t)(nv > 0 ? nv : 1));
     v->rho = calloc(ne * 4, sizeof *v->rho);
+    v->le = calloc(ne * 4, sizeof *v->le);
     v->lk = calloc(ne, sizeof *v->lk);
     v->ray_t = malloc(sizeof *v->ray_t * ne * (size_t)v->nc);
     v->ray_leaf = malloc(sizeof *v->ray_leaf * ne * (size_t)v->nc);
@@ -542,7 +556,7 @@ static int make_structure(gi_vlinks *v, const scene *sc, const scene_leaves *lv)
     v->ism = calloc(ne * 4, sizeof(float));
     v->off_csr = calloc(ne + 1, sizeof(int));
     v->adj_off = calloc(ne + 1, sizeof(int));
-    return v->pos && v->nrm && v->org && v->rho && v->lk && v->ray_t && v->ray_leaf && v->edir && v->b0 && v->b1 && v->itot &&
+    return v->pos && v->nrm && v->org && v->rho && v->le && v->lk && v->ray_t && v->ray_leaf && v->edir && v->b0 && v->b1 && v->itot &&
            v->ism && v->off_csr && v->adj_off;
 }
 
@@ -880,7 +894,10 @@ pt_status gi_vlinks_frame(gi_vlinks *v, const scene *sc, const accel *a, int obj
     t0 = timer_now();
     size_t n4 = (size_t)v->ne * 4;
     memset(v->itot, 0, sizeof(float) * n4);
-    for (size_t i = 0; i < n4; i++) v->b0[i] = v->rho[i] * v->edir[i];
+    /* what each element sends into the first sweep: its reflected direct
+     * light and its emission (which reaches other surfaces only by
+     * gathering, radrules.h rule 1) */
+    for (size_t i = 0; i < n4; i++) v->b0[i] = v->rho[i] * v->edir[i] + v->le[i];
     progress_stage(v->s.progress, "links: bounces", 0);
     /* POV-Ray's recursion_limit counts the bounces of gathered light
      * (radrules.h rule 6): one sweep each; brightness scales every one */

@@ -32,8 +32,9 @@
  *
  * Surfaces of other objects (spheres, boxes, planes, ...) block rays and
  * get no vertices: their indirect light is 0 (counted in the stats). Rays
- * that leave the scene bring nothing (no sky light). Emission is not
- * carried; both sides of a vertex take the texture (not interior_texture). */
+ * that leave the scene bring nothing (no sky light). Finish emission of a
+ * mesh is light its vertices send (POV-Ray's rules, radrules.h); both
+ * sides of a vertex take the texture (not interior_texture). */
 #ifndef PT_GI_VLINKS_H
 #define PT_GI_VLINKS_H
 #include <stdint.h>
