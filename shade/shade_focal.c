@@ -1,57 +1,9 @@
 /* shade_focal.c - focal blur's sampling budget (shade_focal.h). */
 #include "shade_focal.h"
+#include "shade_chi2.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* Regularised upper incomplete gamma Q(a, x) = Gamma(a, x) / Gamma(a):
- * the power series of P = 1 - Q below x = a + 1, the continued fraction
- * of Q above (both converge fast there; Abramowitz & Stegun 6.5.29 and
- * 6.5.31). */
-static double gamma_q(double a, double x)
-{
-    if (x <= 0.0) return 1.0;
-    double lead = exp(-x + a * log(x) - lgamma(a));
-    if (x < a + 1.0) {
-        double term = 1.0 / a, sum = term;
-        for (int n = 1; n < 1000; n++) {
-            term *= x / (a + n);
-            sum += term;
-            if (fabs(term) < fabs(sum) * 1e-15) break;
-        }
-        return 1.0 - sum * lead;
-    }
-    /* Lentz's evaluation of 1/(x+1-a- 1(1-a)/(x+3-a- 2(2-a)/(x+5-a- ...))) */
-    const double tiny = 1e-300;
-    double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
-    for (int i = 1; i < 1000; i++) {
-        double an = -i * (i - a);
-        b += 2.0;
-        d = an * d + b;
-        if (fabs(d) < tiny) d = tiny;
-        c = b + an / c;
-        if (fabs(c) < tiny) c = tiny;
-        d = 1.0 / d;
-        double del = d * c;
-        h *= del;
-        if (fabs(del - 1.0) < 1e-15) break;
-    }
-    return lead * h;
-}
-
-double shade_focal_chi2inv(double df, double y)
-{
-    if (!(df > 0.0) || !(y > 0.0) || !(y < 1.0)) return 0.0;
-    /* P(chi^2_df > x) = Q(df/2, x/2) falls from 1 at x = 0: bisect */
-    double lo = 0.0, hi = df + 10.0 * sqrt(2.0 * df) + 10.0;
-    while (gamma_q(0.5 * df, 0.5 * hi) > y && hi < 1e6) hi *= 2.0;
-    for (int it = 0; it < 200 && hi - lo > 1e-13 * hi; it++) {
-        double mid = 0.5 * (lo + hi);
-        if (gamma_q(0.5 * df, 0.5 * mid) > y) lo = mid;
-        else hi = mid;
-    }
-    return 0.5 * (lo + hi);
-}
 
 int shade_focal_init(shade_focal *f, const scene_camera *c)
 {
@@ -71,8 +23,8 @@ int shade_focal_init(shade_focal *f, const scene_camera *c)
     }
     if (f->max > 1) {
         /* a threshold of 0 for blur_samples 1: never met, as POV-Ray */
-        double t1 = c->variance / shade_focal_chi2inv(f->max - 1, c->confidence);
-        for (int i = 0; i < f->max; i++) f->threshold[i] = t1 * shade_focal_chi2inv(i + 1, c->confidence);
+        double t1 = c->variance / shade_chi2_inv_q(f->max - 1, c->confidence);
+        for (int i = 0; i < f->max; i++) f->threshold[i] = t1 * shade_chi2_inv_q(i + 1, c->confidence);
     }
     return 1;
 }

@@ -9,7 +9,7 @@
  * (S2/n - (S1/n)^2)/n per channel, is below
  *   threshold(n) = variance * chi2inv(n, confidence) / chi2inv(blur_samples - 1, confidence)
  * for every channel, chi2inv(df, y) being the x with P(chi^2_df > x) = y
- * (Cephes' chdtri); it never takes more than blur_samples rays. */
+ * (Cephes' chdtri, shade_chi2.h); it never takes more than blur_samples rays. */
 #ifndef PT_SHADE_FOCAL_H
 #define PT_SHADE_FOCAL_H
 #include "scene_camera.h"
@@ -34,7 +34,5 @@ int shade_focal_done(const shade_focal *f, int n, const double s1[3], const doub
  * [0,1)^4, so every prefix covers lens and pixel evenly and a sample that
  * stops early has still seen the whole lens. */
 void shade_focal_point(int i, const double shift[4], double *lu, double *lv, double *jx, double *jy);
-/* Cephes' chdtri: x with P(chi^2_df > x) = y (0 < y < 1, df > 0). */
-double shade_focal_chi2inv(double df, double y);
 
 #endif

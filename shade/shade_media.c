@@ -53,6 +53,7 @@
  *    take a single sample per interval.
  *  - Photons in media are not modelled. */
 #include "shade_media.h"
+#include "shade_chi2.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -434,51 +435,6 @@ static void adaptive(const sampler *s, interval *iv, const scene_media *im, doub
     iv->samples = sub;
 }
 
-/* Regularised upper incomplete gamma Q(a, x) = Gamma(a, x) / Gamma(a):
- * the power series of P = 1 - Q below x = a + 1, a continued fraction
- * (modified Lentz) above. */
-static double gamma_q(double a, double x)
-{
-    if (!(x > 0.0)) return 1.0;
-    double lead = exp(-x + a * log(x) - lgamma(a));
-    if (x < a + 1.0) {
-        double term = 1.0 / a, sum = term;
-        for (int n = 1; n < 500 && fabs(term) > fabs(sum) * 1e-15; n++) {
-            term *= x / (a + n);
-            sum += term;
-        }
-        return 1.0 - sum * lead;
-    }
-    double tiny = 1e-300, b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, f = d;
-    for (int n = 1; n < 500; n++) {
-        double an = -n * (n - a);
-        b += 2.0;
-        d = an * d + b;
-        if (fabs(d) < tiny) d = tiny;
-        c = b + an / c;
-        if (fabs(c) < tiny) c = tiny;
-        d = 1.0 / d;
-        double delta = d * c;
-        f *= delta;
-        if (fabs(delta - 1.0) < 1e-15) break;
-    }
-    return lead * f;
-}
-
-/* The chi-square value with k degrees of freedom exceeded with
- * probability y (Q(k/2, x/2) = y), by bisection (Q falls with x). */
-static double chi2_inv_q(double k, double y)
-{
-    double lo = 0.0, hi = 1.0;
-    while (gamma_q(0.5 * k, 0.5 * hi) > y && hi < 1e6) hi *= 2.0;
-    for (int i = 0; i < 200 && hi - lo > 1e-12 * hi; i++) {
-        double mid = 0.5 * (lo + hi);
-        if (gamma_q(0.5 * k, 0.5 * mid) > y) lo = mid;
-        else hi = mid;
-    }
-    return 0.5 * (lo + hi);
-}
-
 /* Variance of the mean of an interval's sample lights, per channel. */
 static rgb sample_variance(const interval *iv)
 {
@@ -595,7 +551,6 @@ rgb shade_media_segment(const shade_media_env *e, int which, const shade_media_i
     int want = im->intervals > nlit ? im->intervals : nlit;
     if (want > MAX_INTERVALS) want = MAX_INTERVALS;
     int constant = im->ndensity == 0;
-    memset(ivs, 0, sizeof ivs);
     if (nlit == 1) {
         if (!lit[0].lit && constant) {
             ivs[niv++] = (interval){0, lit[0].s0, lit[0].s1, lit[0].s1 - lit[0].s0, {0, 0, 0}, {0, 0, 0}, 0, {0, 0, 0}};
@@ -655,14 +610,14 @@ rgb shade_media_segment(const shade_media_env *e, int which, const shade_media_i
     }
     /* further samples where the view ray's samples vary too much */
     if (!shadow && im->method != 3 && im->max_samples > nmin) {
-        double t = chi2_inv_q(im->max_samples - 1, im->confidence);
+        double t = shade_chi2_inv_q(im->max_samples - 1, im->confidence);
         t = t > 0.0 ? im->variance / t : im->variance * MEDIA_EPSILON;
         for (int i = 0; i < niv; i++) {
             interval *iv = &ivs[i];
             if (iv->samples < 1 || iv->samples >= im->max_samples) continue;
             for (;;) {
                 rgb va = sample_variance(iv);
-                double thr = t * chi2_inv_q(iv->samples, im->confidence);
+                double thr = t * shade_chi2_inv_q(iv->samples, im->confidence);
                 if (fabs(va.r) < thr && fabs(va.g) < thr && fabs(va.b) < thr) break;
                 rgb col, od;
                 one_sample(&s, iv, rnd(e), 1, &col, &od);

@@ -10,6 +10,7 @@
 #include <math.h>
 #include <stdio.h>
 #include "shade.h"
+#include "shade_chi2.h"
 #include "shade_focal.h"
 #include "test_world.h"
 
@@ -23,12 +24,12 @@ static void assert_near(double got, double want, double tol)
 static void test_chi2inv(void **st)
 {
     (void)st;
-    assert_near(shade_focal_chi2inv(2, 0.9), -2.0 * log(0.9), 1e-10);
-    assert_near(shade_focal_chi2inv(2, 0.025), -2.0 * log(0.025), 1e-9);
-    assert_near(shade_focal_chi2inv(1, 0.95), 0.00393214, 1e-7);
-    assert_near(shade_focal_chi2inv(10, 0.95), 3.94030, 1e-5);
-    assert_near(shade_focal_chi2inv(30, 0.975), 16.7908, 1e-4);
-    assert_near(shade_focal_chi2inv(10, 0.05), 18.3070, 1e-4);
+    assert_near(shade_chi2_inv_q(2, 0.9), -2.0 * log(0.9), 1e-10);
+    assert_near(shade_chi2_inv_q(2, 0.025), -2.0 * log(0.025), 1e-9);
+    assert_near(shade_chi2_inv_q(1, 0.95), 0.00393214, 1e-7);
+    assert_near(shade_chi2_inv_q(10, 0.95), 3.94030, 1e-5);
+    assert_near(shade_chi2_inv_q(30, 0.975), 16.7908, 1e-4);
+    assert_near(shade_chi2_inv_q(10, 0.05), 18.3070, 1e-4);
 }
 
 /* Lens rays per pixel of a render of `camera_items` (no antialiasing) over
@@ -81,8 +82,8 @@ static void test_thresholds(void **st)
     c.variance = 1.0 / 128.0;
     shade_focal f;
     assert_true(shade_focal_init(&f, &c));
-    double t1 = c.variance / shade_focal_chi2inv(18, 0.9);
-    assert_near(f.threshold[6], t1 * shade_focal_chi2inv(7, 0.9), 1e-15);
+    double t1 = c.variance / shade_chi2_inv_q(18, 0.9);
+    assert_near(f.threshold[6], t1 * shade_chi2_inv_q(7, 0.9), 1e-15);
     assert_near(f.threshold[17], c.variance, 1e-15);
     /* after 7 rays: a variance of the mean just under the bound stops, just over goes on */
     double m = 0.5, var_mean = 0.999 * f.threshold[6], var = var_mean * 7.0;
