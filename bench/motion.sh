@@ -20,7 +20,9 @@
 #     (every path traced and every receiver estimated anew with the same
 #     random streams) byte for byte, and the GI time per frame (the stages
 #     before the Whitted pass) and the whole frame against --detp-full and
-#     --gi particle.
+#     --gi particle; and the first frame of cbox_move.pov against --gi path
+#     (PATH_SPP samples) for detp, particle and links (links lights the
+#     room's meshes only: the sphere gets direct light).
 #  3. Flicker: the mean absolute difference of consecutive frames (linear
 #     RGB) over the top third of the image (ceiling and upper walls, which
 #     the moving block does not cross) of detp_cbox.pov for particle, links
@@ -182,6 +184,13 @@ if part 2; then
 detp_scene raddem raddem.pov "$RADDEM_FRAMES"
 detp_scene cboxmove bench/scenes/cbox_move.pov "$CBOX_FRAMES"
 detp_scene cbox detp_cbox.pov "$CBOX_FRAMES"
+echo "quality of bench/scenes/cbox_move.pov's first frame at $QSIZE against --gi path $PATH_SPP spp (HDR-FLIP mean, mean luminance):"
+"$P" render bench/scenes/cbox_move.pov --gi path --spp "$PATH_SPP" --size "$QSIZE" +KFI1 +KFF"$CBOX_FRAMES" --frame 1 -o cq_path.pfm -q 2>/dev/null
+for m in detp particle links; do
+    "$P" render bench/scenes/cbox_move.pov --gi "$m" --size "$QSIZE" +KFI1 +KFF"$CBOX_FRAMES" --frame 1 -o "cq_$m.pfm" -q 2>/dev/null
+    "$P" compare "$(ls cq_path*.pfm | head -1)" "$(ls cq_"$m"*.pfm | head -1)" --hdr --json > "cq_$m.json" 2>/dev/null
+    field "cq_$m.json" "'  %-8s FLIP %.4f, mean luminance %+.2f%%' % ('$m', j['flip']['mean'], 100 * j['luminance']['relative'])"
+done
 fi
 
 part 3 || exit 0
