@@ -52,6 +52,7 @@ struct gi_vlinks {
     long nv, ne;             /* vertices, elements (2 a vertex) */
     vec3 *pos, *nrm;         /* per vertex: world position, unit winding normal */
     vec3 *org;               /* per vertex: where its rays start (see mesh_geometry) */
+    int *vmesh_of;           /* per vertex: its mesh */
     float *rho;              /* per element, 4 floats */
     float *le;               /* per element, 4 floats: emitted radiance (finish emission, POV-Ray's rules) */
     elinks *lk;              /* per element */
@@ -398,10 +399,8 @@ static void light_chunk(void *ctx, int ci, int thread)
         int side = (int)(e % 2);
         vec3 n = side ? v3_neg(v->nrm[vx]) : v->nrm[vx];
         vec3 p = v->pos[vx];
-        const vmesh *m = NULL;
-        for (int k = 0; k < v->nmesh && !m; k++)
-            if (vx >= v->mesh[k].vbase && vx < v->mesh[k].vbase + v->mesh[k].nverts) m = &v->mesh[k];
-        const scene_object *obj = m ? scene_leaves_get(v->lv, m->leaf) : NULL;
+        const vmesh *m = &v->mesh[v->vmesh_of[vx]];
+        const scene_object *obj = scene_leaves_get(v->lv, m->leaf);
         float E[3] = {0.0f, 0.0f, 0.0f};
         for (int li = 0; li < sc->nlights; li++) {
             const scene_light *l = &sc->lights[li];
@@ -462,6 +461,7 @@ static void free_structure(gi_vlinks *v)
     free(v->pos);
     free(v->nrm);
     free(v->org);
+    free(v->vmesh_of);
     free(v->rho);
     free(v->le);
     free(v->ray_t);
@@ -481,6 +481,7 @@ static void free_structure(gi_vlinks *v)
     v->leaf_mesh = NULL;
     v->pos = v->nrm = v->org = NULL;
     v->rho = v->le = v->ray_t = v->edir = v->b0 = v->b1 = v->itot = v->ism = v->w_csr = NULL;
+    v->vmesh_of = NULL;
     v->ray_leaf = v->off_csr = v->peer_csr = v->adj_off = v->adj = NULL;
     v->ne = v->nv = 0;
     v->nmesh = 0;
@@ -544,6 +545,10 @@ static int make_structure(gi_vlinks *v, const scene *sc, const scene_leaves *lv)
     v->pos = malloc(sizeof *v->pos * (size_t)(nv > 0 ? nv : 1));
     v->nrm = malloc(sizeof *v->nrm * (size_t)(nv > 0 ? nv : 1));
     v->org = malloc(sizeof *v->org * (size_t)(nv > 0 ? nv : 1));
+    v->vmesh_of = malloc(sizeof *v->vmesh_of * (size_t)(nv > 0 ? nv : 1));
+    if (v->vmesh_of)
+        for (int k = 0; k < v->nmesh; k++)
+            for (int i = 0; i < v->mesh[k].nverts; i++) v->vmesh_of[v->mesh[k].vbase + i] = k;
     v->rho = calloc(ne * 4, sizeof *v->rho);
     v->le = calloc(ne * 4, sizeof *v->le);
     v->lk = calloc(ne, sizeof *v->lk);
@@ -556,7 +561,7 @@ static int make_structure(gi_vlinks *v, const scene *sc, const scene_leaves *lv)
     v->ism = calloc(ne * 4, sizeof(float));
     v->off_csr = calloc(ne + 1, sizeof(int));
     v->adj_off = calloc(ne + 1, sizeof(int));
-    return v->pos && v->nrm && v->org && v->rho && v->le && v->lk && v->ray_t && v->ray_leaf && v->edir && v->b0 && v->b1 && v->itot &&
+    return v->pos && v->nrm && v->org && v->vmesh_of && v->rho && v->le && v->lk && v->ray_t && v->ray_leaf && v->edir && v->b0 && v->b1 && v->itot &&
            v->ism && v->off_csr && v->adj_off;
 }
 
