@@ -307,21 +307,6 @@ static int photon_hit(const gi_caustic *c, const accel_from *from, vec3 o, vec3 
     return 0;
 }
 
-/* Light through distance d of interior in: POV-Ray 3.7's fade for photon
- * rays (photons.cpp, PhotonTrace::ComputeLightedTexture): fade_power 1000
- * and more exponential, exp(-(1 - fade_colour) d / fade_distance), else
- * fade_colour + (1 - fade_colour) / (1 + (d / fade_distance)^fade_power). */
-static rgb fade(const scene_interior *in, double d, rgb c)
-{
-    if (!(in->fade_power > 0.0) || !(fabs(in->fade_distance) > 1e-10)) return c;
-    const rgb f = in->fade_colour;
-    if (in->fade_power >= 1000.0)
-        return crgb(c.r * exp(-(1.0 - f.r) * d / in->fade_distance), c.g * exp(-(1.0 - f.g) * d / in->fade_distance),
-                    c.b * exp(-(1.0 - f.b) * d / in->fade_distance));
-    double a = 1.0 + pow(d / in->fade_distance, in->fade_power);
-    return crgb(c.r * (f.r + (1.0 - f.r) / a), c.g * (f.g + (1.0 - f.g) / a), c.b * (f.b + (1.0 - f.b) / a));
-}
-
 /* One bounce-map cell: the photon's direction (and origin), then its path. */
 static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_out *out)
 {
@@ -360,11 +345,9 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
     double depth = 0.0, rho_p = 1.0;
     rgb tr = {1, 1, 1};
     vec3 p_first = o;
-    const scene_interior *inside = NULL; /* the interior the photon travels in (entered by refraction) */
     for (int level = 0;; level++) {
         if (!photon_hit(c, fp, o, w, &h, &out->rays)) return;
         depth += h.t;
-        if (inside) tr = fade(inside, h.t, tr);
         if (level == 0) {
             /* the first hit must be the target (POV-Ray's PhotonTrace) */
             if (!in_target(cb, h.obj)) return;
@@ -406,7 +389,6 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
         rho_p *= fmin(1.0, fmax(step.rho, 1e-6));
         if (!(cmax3(tr) >= c->adc) || !isfinite(tr.r + tr.g + tr.b)) return;
         out->alive[level + 1]++;
-        if (step.refract) inside = v3_dot(h.ng, w) < 0.0 && h.obj ? h.obj->interior : NULL;
         o = step.org;
         w = step.dir;
         from = step.from;
