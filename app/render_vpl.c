@@ -119,9 +119,10 @@ static void point_of(const shade_mat_bsdf *b, double lift, gpoint *g)
     g->dev.kd[1] = (float)kd.g;
     g->dev.kd[2] = (float)kd.b;
     g->dev.tab[0] = g->dev.tab[1] = -1;
-    for (int j = 0; j < b->nglossy && j < 2; j++) {
-        rgb c = mk(b->gl_w[j], b->gl_w[j], b->gl_w[j]);
-        if (b->gl_metallic != 0.0) shade_light_metallic_tint(&c, b->gl_metallic, b->pigment, v3_dot(wo, b->n));
+    for (int j = 0; j < b->nglossy && j < 2; j++) { /* the two first (blurred mirror, phong) */
+        rgb c = mk(b->gl_w[j] * b->gl_c[j].r, b->gl_w[j] * b->gl_c[j].g, b->gl_w[j] * b->gl_c[j].b);
+        if (b->gl_tint[j] && b->gl_metallic != 0.0)
+            shade_light_metallic_tint(&c, b->gl_metallic, b->pigment, v3_dot(wo, b->n));
         g->dev.kg[j][0] = (float)c.r;
         g->dev.kg[j][1] = (float)c.g;
         g->dev.kg[j][2] = (float)c.b;
@@ -258,6 +259,7 @@ static pt_status make_vpls(const scene *sc, const accel *a, const pm_lights *L, 
             rgb e = pm_direct_lights(L, &b, 1, &r, shadow);
             shade_mat_bsdf bl = b; /* emitters through the Lambertian lobes only */
             bl.nglossy = 0;
+            bl.gl_wsum = 0.0;
             bl.m[SHADE_MAT_LOBE_GLOSSY] = 0.0;
             rgb em = pm_direct_emitters(L, &bl, 4, gather ? SKY_RAYS : 0.0, 0.0, 0.0, &r, shadow);
             if (gather) {
@@ -300,7 +302,7 @@ static pt_status make_vpls(const scene *sc, const accel *a, const pm_lights *L, 
             out->kappa[k] = 0.0;
             double wbest = 0.0;
             for (int j = 0; j < b.nglossy; j++) {
-                out->kg[k] += b.gl_w[j];
+                out->kg[k] += b.gl_w[j] * lum(b.gl_c[j]);
                 if (b.gl_w[j] > wbest) {
                     wbest = b.gl_w[j];
                     out->kappa[k] = glossy_exponent(b.gl[j]);

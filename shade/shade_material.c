@@ -13,7 +13,11 @@
 #include "shade_material.h"
 #include "radrules.h"
 #include <math.h>
+#include <stdatomic.h>
+#include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
+#include "shade_normal.h"
 #include "shade_texture.h"
 
 static inline rgb mrgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
@@ -111,37 +115,126 @@ int shade_mat_texture_varies(const scene_texture *tex)
     return tex && (tex->pigment.kind == PIGMENT_PATTERN || tex->pat);
 }
 
-/* The glossy lobe of the top layer's finish f (model in the header): phong
- * (exponent phong_size) and specular (exponent 1/(4 roughness), glossy.h),
- * their weights scaled down together to what the other lobes leave. */
-static void setup_glossy(shade_mat_bsdf *b, const scene_finish *f)
+/* ------------------------------------------------ blurred reflection */
+
+#define BLUR_SLOTS 256
+#define BLUR_SAMPLES 256
+
+typedef struct {
+    const scene_normal *key;
+    double e; /* 0: not micro-scale */
+} blur_entry;
+
+static _Atomic(blur_entry *) blur_cache[BLUR_SLOTS];
+
+/* The Phong exponent that stands for nm's perturbation of a flat surface,
+ * or 0 when its normals still agree 2e-3 scene sizes apart (a visible
+ * bump pattern, which the BSDF ignores). Deterministic: fixed sample
+ * points (golden-ratio sequences) in texture space around the origin. */
+static double blur_measure(const scene *sc, const scene_normal *nm, double size)
+{
+    shade_pattern_ctx pc = shade_pattern_ctx_plain(sc);
+    const vec3 up = v3(0, 0, 1);
+    const double delta = 2e-3 * size;
+    double tilt = 0.0, near = 0.0, far = 0.0;
+    vec3 prev = up;
+    for (int k = 0; k < BLUR_SAMPLES; k++) {
+        double a = fmod((k + 0.5) * 0.6180339887498949, 1.0), b = fmod((k + 0.5) * 0.7548776662466927, 1.0),
+               c = fmod((k + 0.5) * 0.5698402909980532, 1.0);
+        vec3 p = v3_scale(v3(a - 0.5, b - 0.5, c - 0.5), 0.05 * size);
+        vec3 n1 = v3_norm(shade_normal_perturb(nm, up, p, NULL, &pc));
+        vec3 n2 = v3_norm(shade_normal_perturb(nm, up, v3_add(p, v3(delta * 0.6, delta * 0.8, 0.0)), NULL, &pc));
+        if (!v3_finite(n1) || !v3_finite(n2)) return 0.0;
+        tilt += 1.0 - fmin(1.0, v3_dot(n1, up));
+        near += 1.0 - fmin(1.0, v3_dot(n1, n2));
+        if (k > 0) far += 1.0 - fmin(1.0, v3_dot(n1, prev));
+        prev = n1;
+    }
+    tilt /= BLUR_SAMPLES;
+    near /= BLUR_SAMPLES;
+    far /= BLUR_SAMPLES - 1;
+    /* micro-scale: neighbours 2e-3 sizes apart differ as much as far points */
+    if (!(tilt > 1e-9) || !(far > 0.0) || near < 0.5 * far) return 0.0;
+    return fmin(1e5, fmax(1.0, 1.0 / (4.0 * tilt)));
+}
+
+static double blur_exponent(const scene *sc, const scene_normal *nm, double size)
+{
+    size_t h = ((size_t)(uintptr_t)nm >> 4) * 0x9E3779B97F4A7C15ULL;
+    for (int probe = 0; probe < BLUR_SLOTS; probe++) {
+        int i = (int)((h + (size_t)probe) % BLUR_SLOTS);
+        blur_entry *e = atomic_load_explicit(&blur_cache[i], memory_order_acquire);
+        if (e && e->key == nm) return e->e;
+        if (e) continue;
+        blur_entry *mine = malloc(sizeof *mine);
+        if (!mine) return blur_measure(sc, nm, size);
+        mine->key = nm;
+        mine->e = blur_measure(sc, nm, size);
+        blur_entry *expected = NULL;
+        if (atomic_compare_exchange_strong_explicit(&blur_cache[i], &expected, mine, memory_order_acq_rel,
+                                                    memory_order_acquire))
+            return mine->e;
+        double v = mine->e;
+        free(mine);
+        if (expected->key == nm) return expected->e;
+        (void)v;
+    }
+    return blur_measure(sc, nm, size); /* table full: measure every time */
+}
+
+/* The glossy lobe of the top layer's finish f (model in the header): the
+ * blurred mirror (when tex's normal is micro-scale), phong (exponent
+ * phong_size) and specular (exponent 1/(4 roughness), glossy.h), the
+ * highlights' weights scaled down together to what the other lobes leave. */
+static void setup_glossy(shade_mat_bsdf *b, const scene *sc, const scene_texture *tex, const scene_finish *f,
+                         double size)
 {
     b->nglossy = 0;
+    b->gl_wsum = 0.0;
     b->k[SHADE_MAT_LOBE_GLOSSY] = mrgb(0, 0, 0);
+    b->gl_metallic = f->metallic;
+    rgb kr = b->k[SHADE_MAT_LOBE_REFLECT];
+    const scene_normal *nm = tex->normal;
+    if (mrgb_max(kr) > 0.0 && nm && nm->pat && nm->pat->kind != PAT_PLAIN && size > 0.0) {
+        double e = blur_exponent(sc, nm, size);
+        const glossy_table *t = e > 0.0 ? glossy_table_for(e) : NULL;
+        if (t) {
+            double w = mrgb_max(kr);
+            b->gl[0] = t;
+            b->gl_w[0] = w;
+            b->gl_c[0] = mrgb(kr.r / w, kr.g / w, kr.b / w);
+            b->gl_tint[0] = 0;
+            b->nglossy = 1;
+            b->k[SHADE_MAT_LOBE_REFLECT] = mrgb(0, 0, 0); /* the mirror is blurred */
+        }
+    }
     double w[2] = {f->phong > 0.0 && isfinite(f->phong) ? f->phong : 0.0,
                    f->specular > 0.0 && isfinite(f->specular) ? f->specular : 0.0};
     double e[2] = {f->phong_size, 1.0 / (4.0 * (f->roughness > 0.0 ? f->roughness : 0.05))};
     double wsum = w[0] + w[1];
-    if (!(wsum > 0.0)) return;
     double used = 0.0;
     for (int i = 0; i < SHADE_MAT_LOBE_GLOSSY; i++) {
         double m = mrgb_max(b->k[i]);
         if (m > 0.0 && isfinite(m)) used += m;
     }
-    double room = fmin(wsum, fmax(0.0, 1.0 - used));
-    if (!(room > 0.0)) return;
-    for (int i = 0; i < 2; i++) {
+    if (b->nglossy) used += b->gl_w[0];
+    double room = wsum > 0.0 ? fmin(wsum, fmax(0.0, 1.0 - used)) : 0.0;
+    for (int i = 0; i < 2 && room > 0.0; i++) {
         if (!(w[i] > 0.0)) continue;
         const glossy_table *t = glossy_table_for(e[i]);
         if (!t) continue;
         b->gl[b->nglossy] = t;
         b->gl_w[b->nglossy] = w[i] * room / wsum;
+        b->gl_c[b->nglossy] = mrgb(1, 1, 1);
+        b->gl_tint[b->nglossy] = 1;
         b->nglossy++;
     }
-    double kg = 0.0;
-    for (int i = 0; i < b->nglossy; i++) kg += b->gl_w[i];
-    b->k[SHADE_MAT_LOBE_GLOSSY] = mrgb(kg, kg, kg);
-    b->gl_metallic = f->metallic;
+    rgb kg = {0, 0, 0};
+    for (int i = 0; i < b->nglossy; i++) {
+        b->gl_wsum += b->gl_w[i];
+        kg = mrgb(kg.r + b->gl_w[i] * b->gl_c[i].r, kg.g + b->gl_w[i] * b->gl_c[i].g, kg.b + b->gl_w[i] * b->gl_c[i].b);
+    }
+    b->k[SHADE_MAT_LOBE_GLOSSY] = kg;
 }
 
 void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r)
@@ -243,7 +336,7 @@ void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec
     }
     b->k[SHADE_MAT_LOBE_REFLECT] = refl;
     b->k[SHADE_MAT_LOBE_TRANSMIT] = trans;
-    setup_glossy(b, f);
+    setup_glossy(b, sc, tex, f, eps * 1e6); /* eps is the scene size * 1e-6 */
     b->msum = 0.0;
     for (int i = 0; i < SHADE_MAT_NLOBES; i++) {
         double m = mrgb_max(b->k[i]);
@@ -269,19 +362,23 @@ rgb shade_mat_eval_glossy(const shade_mat_bsdf *b, vec3 wi)
     rgb out = {0, 0, 0};
     if (b->nglossy == 0 || !(v3_dot(wi, b->ng) > 0.0)) return out;
     vec3 wo = v3_neg(b->dir);
-    double f = 0.0;
-    for (int i = 0; i < b->nglossy; i++) f += b->gl_w[i] * glossy_eval(b->gl[i], b->n, wo, wi);
-    if (!(f > 0.0)) return out;
-    out = mrgb(f, f, f);
+    rgb tinted = {0, 0, 0};
+    for (int i = 0; i < b->nglossy; i++) {
+        double f = b->gl_w[i] * glossy_eval(b->gl[i], b->n, wo, wi);
+        if (!(f > 0.0)) continue;
+        rgb c = mrgb_scale(b->gl_c[i], f);
+        if (b->gl_tint[i]) tinted = mrgb(tinted.r + c.r, tinted.g + c.g, tinted.b + c.b);
+        else out = mrgb(out.r + c.r, out.g + c.g, out.b + c.b);
+    }
     if (b->gl_metallic != 0.0)
-        shade_light_metallic_tint(&out, b->gl_metallic, b->pigment, 0.5 * (v3_dot(wi, b->n) + v3_dot(wo, b->n)));
-    return out;
+        shade_light_metallic_tint(&tinted, b->gl_metallic, b->pigment, 0.5 * (v3_dot(wi, b->n) + v3_dot(wo, b->n)));
+    return mrgb(out.r + tinted.r, out.g + tinted.g, out.b + tinted.b);
 }
 
 double shade_mat_pdf_glossy(const shade_mat_bsdf *b, vec3 wi)
 {
     if (b->nglossy == 0 || !(v3_dot(wi, b->ng) > 0.0)) return 0.0;
-    double kg = b->k[SHADE_MAT_LOBE_GLOSSY].r, p = 0.0;
+    double kg = b->gl_wsum, p = 0.0;
     if (!(kg > 0.0)) return 0.0;
     vec3 wo = v3_neg(b->dir);
     for (int i = 0; i < b->nglossy; i++) p += b->gl_w[i] / kg * glossy_pdf(b->gl[i], b->n, wo, wi);
@@ -296,7 +393,7 @@ int shade_mat_sample_glossy(const shade_mat_bsdf *b, double u0, double u1, doubl
     memset(s, 0, sizeof *s);
     s->eta2 = 1.0;
     s->lobe = SHADE_MAT_LOBE_GLOSSY;
-    double kg = b->k[SHADE_MAT_LOBE_GLOSSY].r;
+    double kg = b->gl_wsum;
     if (b->nglossy == 0 || !(kg > 0.0)) return 0;
     int j = 0;
     double acc = 0.0;

@@ -24,9 +24,9 @@
  * colour of the layers above (pigment * filter + transmit, multiplied), and
  * what passes all layers is the transmitted colour; the reflection is the
  * top layer's (an approximation), and normal{} perturbation is not applied
- * to the GI BSDF (shade.c applies it), so `--gi none` equals the direct
- * part of the path tracer only for scenes without normal{} and layered
- * reflection.
+ * to the GI BSDF (shade.c applies it; micro-scale normals under reflection
+ * become a blurred mirror, below), so `--gi none` equals the direct part of
+ * the path tracer only for scenes without normal{} and layered reflection.
  *
  * Lambertian terms ignore brilliance and crand (they are POV-Ray's shaping
  * of direct light only). Phong and specular highlights: for light arriving
@@ -44,7 +44,17 @@
  *
  * POV-Ray finishes often sum past 1 (diffuse 0.6 + phong 1; glass with
  * transmit 1 and specular 1); the glossy lobe yields there, since POV-Ray
- * renders the other terms itself and has no glossy transport. Emission is the same
+ * renders the other terms itself and has no glossy transport.
+ *
+ * Blurred reflection (POV-Ray's idiom: reflection with a normal{} pattern
+ * far finer than anything seen, averaged by antialiasing): when the top
+ * layer has reflection and a normal pattern whose perturbed normals are
+ * already uncorrelated 2e-3 scene sizes apart (sizes: the median object's),
+ * the mirror lobe becomes a
+ * glossy sub-lobe of colour kr whose exponent matches the spread of the
+ * perturbed normals, measured once per normal{} by shade_normal_perturb
+ * (glossy.h: e = 1 / (4 E[1 - cos theta]) for tilts theta of the normal,
+ * the reflected direction turning by twice the tilt). Emission is the same
  * on both sides of a surface (POV-Ray turns normals towards the viewer).
  * Emission follows POV-Ray 3.7's rules with radiosity on (core/radrules.h):
  * `ambient * ambient_light` is part of it only in scenes whose effective
@@ -78,7 +88,7 @@ enum {
     SHADE_MAT_LOBE_GLOSSY = 4,
     SHADE_MAT_NLOBES = 5
 };
-#define SHADE_MAT_MAX_GLOSSY 2
+#define SHADE_MAT_MAX_GLOSSY 3
 
 typedef struct {
     const scene_texture *tex;
@@ -97,9 +107,13 @@ typedef struct {
     double eta2;       /* (eta_i/eta_t)^2 of the refraction, 1 without */
     double m[SHADE_MAT_NLOBES]; /* lobe sizes: max channel of k (>= 0) */
     double msum;
-    int nglossy;       /* glossy sub-lobes (phong, specular) of the top layer */
+    int nglossy;       /* glossy sub-lobes of the top layer: blurred reflection (first, when there
+                          is one), phong, specular */
     const glossy_table *gl[SHADE_MAT_MAX_GLOSSY];
-    double gl_w[SHADE_MAT_MAX_GLOSSY];  /* weight of each (sums to kg) */
+    double gl_w[SHADE_MAT_MAX_GLOSSY];  /* weight of each (largest channel of its colour) */
+    rgb gl_c[SHADE_MAT_MAX_GLOSSY];     /* colour of each over its weight (1 1 1 for highlights) */
+    int gl_tint[SHADE_MAT_MAX_GLOSSY];  /* 1: tinted by the highlight `metallic` in eval */
+    double gl_wsum;                     /* sum of gl_w */
     double gl_metallic;                 /* the finish's highlight `metallic` */
     int nee;           /* direct light applies (diffuse, diffuse_back, phong or specular) */
     int double_illum;
