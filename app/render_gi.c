@@ -204,6 +204,7 @@ static pt_status render_detp(const scene *sc, const accel *a, const render_gi_op
     r->t_gi_geometry = r->detp.t_trace;
     r->t_gi_lighting = r->detp.t_estimate;
     if (st == PT_OK && !(o->cancel && *o->cancel)) st = render_with_hook(sc, a, o, fb, r, d, pm_detp_indirect, dp);
+    pm_detp_lookups(dp, &r->detp.lookups, &r->detp.lookups_none);
     pm_detp_set_progress(dp, NULL);
     if (!o->detp) pm_detp_free(dp);
     return st == PT_CANCELLED ? PT_OK : st;
@@ -235,6 +236,7 @@ static pt_status render_links(const scene *sc, const accel *a, const render_gi_o
     r->t_gi_geometry = r->links.t_links;
     r->t_gi_lighting = r->links.t_light + r->links.t_bounces + r->links.t_smooth;
     if (st == PT_OK && !(o->cancel && *o->cancel)) st = render_with_hook(sc, a, o, fb, r, d, gi_vlinks_indirect, v);
+    r->links.lookups_other = gi_vlinks_lookups_other(v);
     gi_vlinks_set_progress(v, NULL);
     if (!o->links) gi_vlinks_free(v);
     return st == PT_CANCELLED ? PT_OK : st;
@@ -527,6 +529,7 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
         stats_int(js, "link_rays", p->link_rays);
         stats_int(js, "light_rays", p->light_rays);
         stats_int(js, "hits_other", p->hits_other);
+        stats_int(js, "lookups_other", p->lookups_other);
         stats_obj_begin(js, "timings");
         stats_num(js, "links", p->t_links);
         stats_num(js, "light", p->t_light);
@@ -551,6 +554,8 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
         stats_int(js, "full_frame", p->full_frame);
         stats_str(js, "full_reason", p->full_reason ? p->full_reason : "");
         stats_int(js, "rays", p->rays);
+        stats_int(js, "lookups", p->lookups);
+        stats_int(js, "lookups_none", p->lookups_none);
         stats_num(js, "radius", p->radius);
         stats_obj_begin(js, "timings");
         stats_num(js, "trace", p->t_trace);

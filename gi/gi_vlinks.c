@@ -504,6 +504,8 @@ void gi_vlinks_set_cancel(gi_vlinks *v, volatile int *cancel) { v->s.cancel = ca
 
 long gi_vlinks_count(const gi_vlinks *v) { return v->ne; }
 
+long gi_vlinks_lookups_other(const gi_vlinks *v) { return atomic_load(&((gi_vlinks *)v)->lookups_other); }
+
 rgb gi_vlinks_element(const gi_vlinks *v, long i, vec3 *p, vec3 *nrm)
 {
     rgb z = {0, 0, 0};

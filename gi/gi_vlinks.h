@@ -65,7 +65,7 @@ typedef struct {
     long raw_links, merged_links; /* over all elements: before and after merging per peer */
     long link_rays, light_rays;
     long hits_other;       /* link rays of this frame that ended on a surface without vertices */
-    long lookups_other;    /* hook calls on surfaces without vertices */
+    long lookups_other;    /* hook calls on surfaces without vertices (gi_vlinks_lookups_other, after the render) */
     int full;              /* every element linked (first frame, structure changed) */
     int sweeps;            /* gathering sweeps run */
     double t_links, t_light, t_bounces, t_smooth; /* seconds */
@@ -88,5 +88,7 @@ rgb gi_vlinks_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread);
 /* Element i's indirect E/pi after smoothing (tests); n: the count. */
 rgb gi_vlinks_element(const gi_vlinks *v, long i, vec3 *p, vec3 *nrm);
 long gi_vlinks_count(const gi_vlinks *v);
+/* Hook calls since the last frame on surfaces without vertices (they got 0). */
+long gi_vlinks_lookups_other(const gi_vlinks *v);
 
 #endif

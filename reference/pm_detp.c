@@ -50,6 +50,11 @@
  * the object it hit: the same in share() and in the walk that proposes
  * them, so that what a receiver takes does not depend on the grid */
 #define SAME_OBJECT_RUN 4.0
+/* How far (in disc radii) the hook looks for the receiver nearest a hit
+ * that is not a pixel centre's (antialiasing samples, reflections): where
+ * the camera sees a surface at a grazing angle its receivers lie further
+ * apart than one radius */
+#define LOOKUP_RUN 3.0
 
 /* One stored segment of a photon path. */
 typedef struct {
@@ -98,6 +103,7 @@ struct pm_detp {
     receiver *rec;
     _Atomic int64_t *E;
     rgrid look;                /* all receivers: the hook's lookup */
+    atomic_long lookups, lookups_none;
     const scene *sc;
 };
 
@@ -142,8 +148,8 @@ static int clampi(double v, int n)
 /* The receivers with pick[i] set (pick NULL: all with a hit) in the cells
  * that their discs (radius r, tight: the disc's own box, grown by a
  * hundredth of a cell so that a walk that rounds at a cell face still
- * finds them) or their spheres of radius r (not tight: the hook's lookup
- * of points near a curved surface) meet. 0 on failure (no memory). */
+ * finds them) or their spheres of radius LOOKUP_RUN r (not tight: the
+ * hook's lookup of points near a curved surface) meet. 0 on failure (no memory). */
 static int rgrid_build(rgrid *g, const receiver *rec, long n, const unsigned char *pick, double r, int tight)
 {
     memset(g, 0, sizeof *g);
@@ -163,7 +169,7 @@ static int rgrid_build(rgrid *g, const receiver *rec, long n, const unsigned cha
         if (cells <= MAX_CELLS) break;
         cell *= 1.25;
     }
-    double m = r + 0.01 * cell;
+    double m = (tight ? r : LOOKUP_RUN * r) + 0.01 * cell;
     g->cell = cell;
     g->lo = v3_sub(lo, v3(m, m, m));
     g->nx = (int)floor((ext.x + 2.0 * m) / cell) + 1;
@@ -524,6 +530,13 @@ void pm_detp_free(pm_detp *dp)
 
 void pm_detp_set_progress(pm_detp *dp, progress *p) { dp->s.progress = p; }
 
+void pm_detp_lookups(const pm_detp *dp, long *lookups, long *none)
+{
+    pm_detp *m = (pm_detp *)dp; /* counters only */
+    *lookups = atomic_load(&m->lookups);
+    *none = atomic_load(&m->lookups_none);
+}
+
 uint64_t pm_detp_paths_hash(const pm_detp *dp)
 {
     uint64_t h = PT_FNV1A_BASIS;
@@ -552,16 +565,23 @@ const int64_t *pm_detp_sums(const pm_detp *dp, long *npixels, double *scale)
 rgb pm_detp_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
 {
     (void)thread;
-    const pm_detp *dp = ctx;
+    pm_detp *dp = ctx;
+    atomic_fetch_add_explicit(&dp->lookups, 1, memory_order_relaxed);
     rgb z = {0.0, 0.0, 0.0};
     const rgrid *g = &dp->look;
-    if (!g->off || !(dp->qscale > 0.0)) return z;
+    if (!g->off || !(dp->qscale > 0.0)) {
+        atomic_fetch_add_explicit(&dp->lookups_none, 1, memory_order_relaxed);
+        return z;
+    }
     vec3 p = hit->p;
     double fx = (p.x - g->lo.x) / g->cell, fy = (p.y - g->lo.y) / g->cell, fz = (p.z - g->lo.z) / g->cell;
-    if (!(fx >= 0.0 && fy >= 0.0 && fz >= 0.0) || fx >= g->nx || fy >= g->ny || fz >= g->nz) return z;
+    if (!(fx >= 0.0 && fy >= 0.0 && fz >= 0.0) || fx >= g->nx || fy >= g->ny || fz >= g->nz) {
+        atomic_fetch_add_explicit(&dp->lookups_none, 1, memory_order_relaxed);
+        return z;
+    }
     size_t ci = ((size_t)(int)fz * g->ny + (int)fy) * g->nx + (int)fx;
     int best = -1;
-    double bd = dp->radius * dp->radius;
+    double bd = LOOKUP_RUN * LOOKUP_RUN * dp->radius * dp->radius;
     for (int q = g->off[ci]; q < g->off[ci + 1]; q++) {
         const receiver *r = &dp->rec[g->idx[q]];
         if (v3_dot(r->n, n) < 0.9) continue;
@@ -572,7 +592,10 @@ rgb pm_detp_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
             best = g->idx[q];
         }
     }
-    if (best < 0) return z;
+    if (best < 0) {
+        atomic_fetch_add_explicit(&dp->lookups_none, 1, memory_order_relaxed);
+        return z;
+    }
     double k = 1.0 / (dp->qscale * M_PI);
     const _Atomic int64_t *e = &dp->E[(size_t)best * 3];
     rgb v = {(double)atomic_load_explicit(&e[0], memory_order_relaxed) * k,
@@ -844,6 +867,8 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
     dp->nleaves = nlv;
     dp->sc = sc;
     dp->have = 1;
+    atomic_store(&dp->lookups, 0);
+    atomic_store(&dp->lookups_none, 0);
 done:
     if (scratch)
         for (int t = 0; t < nthreads; t++) free(scratch[t].v);

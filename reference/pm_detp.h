@@ -63,6 +63,8 @@ typedef struct {
     int full_frame;                 /* 1: everything traced and estimated anew */
     const char *full_reason;        /* why (static text) */
     long rays;                      /* intersection queries (photons, validity tests, camera) */
+    long lookups, lookups_none;     /* hook calls, and those no receiver answered (they got 0;
+                                       pm_detp_lookups, after the render) */
     double radius;
     double t_trace, t_estimate;     /* seconds: paths (tests and tracing), the receivers' sums */
 } pm_detp_stats;
@@ -85,6 +87,8 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
                         const pm_detp_frame_info *fi, pm_detp_stats *st, diag *d);
 /* Where the stages report (NULL: nowhere); the settings' progress until set. */
 void pm_detp_set_progress(pm_detp *dp, progress *p);
+/* Hook calls since the frame began, and those no receiver answered. */
+void pm_detp_lookups(const pm_detp *dp, long *lookups, long *none);
 /* shade_indirect_fn: E / pi of the receiver that answers the hit (0 when
  * none does). */
 rgb pm_detp_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread);
