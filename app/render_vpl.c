@@ -209,8 +209,118 @@ static int gather_hit(const accel *a, const shade_mat_bsdf *b, vec3 w, double ep
     return 1;
 }
 
+typedef struct {
+    const scene *sc;
+    const accel *a;
+    const pm_lights *L;
+    const accel_surf *S;
+    int n, gather;
+    double bright, eps;
+    uint64_t seed;
+    vpl_set *out;
+    unsigned char *ok;
+    long *shadow; /* per block */
+} vpl_job;
+
+#define VPL_BLOCK 256
+
+/* VPL i into out slot i (1), or 0 when its sample failed. */
+static int make_one(const vpl_job *j, int i, rng *r, long *shadow)
+{
+    const scene *sc = j->sc;
+    const accel *a = j->a;
+    const pm_lights *L = j->L;
+    const accel_surf *S = j->S;
+    const int n = j->n, gather = j->gather, k = i;
+    const double bright = j->bright, eps = j->eps;
+    vpl_set *out = j->out;
+    accel_surf_sample s;
+    if (!accel_surf_sample_point(S, (i + rng_f64(r)) / n, rng_f64(r), rng_f64(r), r, &s)) return 0;
+    accel_hit h;
+    memset(&h, 0, sizeof h);
+    h.p = s.p;
+    h.ng = h.ns = s.n;
+    h.obj = s.obj;
+    h.texture = s.texture;
+    h.prim = s.prim;
+    h.flags = s.flags;
+    h.uv[0] = s.p.x;
+    h.uv[1] = s.p.y;
+    /* the side that receives more light */
+    double best = -1.0;
+    for (int side = 0; side < 2; side++) {
+        vec3 ns = side ? v3_neg(s.n) : s.n;
+        shade_mat_bsdf b;
+        shade_mat_setup(&b, sc, &h, v3_neg(ns), eps, r);
+        b.gathered = 1; /* what a gathering ray sees: no highlights, area lights at their centre */
+        rgb e = pm_direct_lights(L, &b, 1, r, shadow);
+        shade_mat_bsdf bl = b; /* emitters through the Lambertian lobes only */
+        bl.nglossy = 0;
+        bl.gl_wsum = 0.0;
+        bl.m[SHADE_MAT_LOBE_GLOSSY] = 0.0;
+        rgb em = pm_direct_emitters(L, &bl, 4, gather ? SKY_RAYS : 0.0, 0.0, 0.0, r, shadow);
+        if (gather) {
+            /* the sky and emitters through the Lambertian lobe by SKY_RAYS
+             * cosine gathering rays (emitters weighted against the 4
+             * area samples above, as the path tracer does) */
+            rgb acc = {0, 0, 0};
+            for (int j = 0; j < SKY_RAYS; j++) {
+                vec3 w = shade_mat_cosine_dir(b.n, (j + rng_f64(r)) / SKY_RAYS, rng_f64(r));
+                if (v3_dot(w, b.ng) <= 0.0) continue;
+                accel_hit gh;
+                rgb c = {0, 0, 0};
+                if (!gather_hit(a, &b, w, eps, &gh)) {
+                    c = pm_sky(sc, w);
+                } else {
+                    rgb le = shade_mat_emission_at(sc, NULL, &gh);
+                    if (le.r != 0.0 || le.g != 0.0 || le.b != 0.0) {
+                        double cb = SKY_RAYS * v3_dot(w, b.n) / M_PI;
+                        double wt = pm_mis(cb, pm_emitter_density(L, &gh, b.p_out, 4));
+                        c = mk(le.r * wt, le.g * wt, le.b * wt);
+                    }
+                }
+                acc = mk(acc.r + c.r, acc.g + c.g, acc.b + c.b);
+            }
+            rgb ks = b.k[SHADE_MAT_LOBE_DIFFUSE];
+            em = mk(em.r + ks.r * acc.r / SKY_RAYS, em.g + ks.g * acc.g / SKY_RAYS, em.b + ks.b * acc.b / SKY_RAYS);
+        }
+        e = mk(e.r + em.r * bright, e.g + em.g * bright, e.b + em.b * bright);
+        double l = lum(e) + (side ? 0.0 : 1e-30); /* ties: the front */
+        if (!(l > best)) continue;
+        best = l;
+        gi_vpl *v = &out->v[k];
+        v->p = s.p;
+        v->n = b.n;
+        v->area = s.pdf_area > 0.0 ? 1.0 / (n * s.pdf_area) : 0.0;
+        v->ld = mk(isfinite(e.r) ? e.r : 0.0, isfinite(e.g) ? e.g : 0.0, isfinite(e.b) ? e.b : 0.0);
+        v->kappa = 0.0;
+        out->kd[k] = b.k[SHADE_MAT_LOBE_DIFFUSE];
+        out->kg[k] = 0.0;
+        out->kappa[k] = 0.0;
+        double wbest = 0.0;
+        for (int j = 0; j < b.nglossy; j++) {
+            out->kg[k] += b.gl_w[j] * lum(b.gl_c[j]);
+            if (b.gl_w[j] > wbest) {
+                wbest = b.gl_w[j];
+                out->kappa[k] = glossy_exponent(b.gl[j]);
+            }
+        }
+    }
+    return 1;
+}
+
+static void vpl_block(void *ctx, int blk, int thread)
+{
+    (void)thread;
+    vpl_job *j = ctx;
+    rng r;
+    rng_seed(&r, j->seed ^ 0x5eed0003ULL, 3 + (uint64_t)blk);
+    int i1 = (blk + 1) * VPL_BLOCK < j->n ? (blk + 1) * VPL_BLOCK : j->n;
+    for (int i = blk * VPL_BLOCK; i < i1; i++) j->ok[i] = (unsigned char)make_one(j, i, &r, &j->shadow[blk]);
+}
+
 static pt_status make_vpls(const scene *sc, const accel *a, const pm_lights *L, long want, uint64_t seed, double bright,
-                           vpl_set *out, long *shadow, diag *d)
+                           int threads, vpl_set *out, long *shadow, diag *d)
 {
     /* gathering rays at the VPLs find the sky and emitters */
     const int gather = pm_sky_any(sc) || accel_surf_count(pm_lights_emitters(L)) > 0;
@@ -232,85 +342,30 @@ static pt_status make_vpls(const scene *sc, const accel *a, const pm_lights *L, 
         accel_surf_free(S);
         return PT_ERR_NOMEM;
     }
-    const double eps = pm_lights_eps(L);
-    rng r;
-    rng_seed(&r, seed ^ 0x5eed0003ULL, 3);
+    const int nblk = (n + VPL_BLOCK - 1) / VPL_BLOCK;
+    unsigned char *ok = calloc((size_t)n, 1);
+    long *sh = calloc((size_t)nblk, sizeof *sh);
+    if (!ok || !sh) {
+        free(ok);
+        free(sh);
+        vpl_set_free(out);
+        accel_surf_free(S);
+        return PT_ERR_NOMEM;
+    }
+    vpl_job job = {sc, a, L, S, n, gather, bright, pm_lights_eps(L), seed, out, ok, sh};
+    pool_run(threads > 0 ? threads : pool_default_threads(), nblk, vpl_block, &job);
     int k = 0;
     for (int i = 0; i < n; i++) {
-        accel_surf_sample s;
-        if (!accel_surf_sample_point(S, (i + rng_f64(&r)) / n, rng_f64(&r), rng_f64(&r), &r, &s)) continue;
-        accel_hit h;
-        memset(&h, 0, sizeof h);
-        h.p = s.p;
-        h.ng = h.ns = s.n;
-        h.obj = s.obj;
-        h.texture = s.texture;
-        h.prim = s.prim;
-        h.flags = s.flags;
-        h.uv[0] = s.p.x;
-        h.uv[1] = s.p.y;
-        /* the side that receives more light */
-        double best = -1.0;
-        for (int side = 0; side < 2; side++) {
-            vec3 ns = side ? v3_neg(s.n) : s.n;
-            shade_mat_bsdf b;
-            shade_mat_setup(&b, sc, &h, v3_neg(ns), eps, &r);
-            b.gathered = 1; /* what a gathering ray sees: no highlights, area lights at their centre */
-            rgb e = pm_direct_lights(L, &b, 1, &r, shadow);
-            shade_mat_bsdf bl = b; /* emitters through the Lambertian lobes only */
-            bl.nglossy = 0;
-            bl.gl_wsum = 0.0;
-            bl.m[SHADE_MAT_LOBE_GLOSSY] = 0.0;
-            rgb em = pm_direct_emitters(L, &bl, 4, gather ? SKY_RAYS : 0.0, 0.0, 0.0, &r, shadow);
-            if (gather) {
-                /* the sky and emitters through the Lambertian lobe by SKY_RAYS
-                 * cosine gathering rays (emitters weighted against the 4
-                 * area samples above, as the path tracer does) */
-                rgb acc = {0, 0, 0};
-                for (int j = 0; j < SKY_RAYS; j++) {
-                    vec3 w = shade_mat_cosine_dir(b.n, (j + rng_f64(&r)) / SKY_RAYS, rng_f64(&r));
-                    if (v3_dot(w, b.ng) <= 0.0) continue;
-                    accel_hit gh;
-                    rgb c = {0, 0, 0};
-                    if (!gather_hit(a, &b, w, eps, &gh)) {
-                        c = pm_sky(sc, w);
-                    } else {
-                        rgb le = shade_mat_emission_at(sc, NULL, &gh);
-                        if (le.r != 0.0 || le.g != 0.0 || le.b != 0.0) {
-                            double cb = SKY_RAYS * v3_dot(w, b.n) / M_PI;
-                            double wt = pm_mis(cb, pm_emitter_density(L, &gh, b.p_out, 4));
-                            c = mk(le.r * wt, le.g * wt, le.b * wt);
-                        }
-                    }
-                    acc = mk(acc.r + c.r, acc.g + c.g, acc.b + c.b);
-                }
-                rgb ks = b.k[SHADE_MAT_LOBE_DIFFUSE];
-                em = mk(em.r + ks.r * acc.r / SKY_RAYS, em.g + ks.g * acc.g / SKY_RAYS, em.b + ks.b * acc.b / SKY_RAYS);
-            }
-            e = mk(e.r + em.r * bright, e.g + em.g * bright, e.b + em.b * bright);
-            double l = lum(e) + (side ? 0.0 : 1e-30); /* ties: the front */
-            if (!(l > best)) continue;
-            best = l;
-            gi_vpl *v = &out->v[k];
-            v->p = s.p;
-            v->n = b.n;
-            v->area = s.pdf_area > 0.0 ? 1.0 / (n * s.pdf_area) : 0.0;
-            v->ld = mk(isfinite(e.r) ? e.r : 0.0, isfinite(e.g) ? e.g : 0.0, isfinite(e.b) ? e.b : 0.0);
-            v->kappa = 0.0;
-            out->kd[k] = b.k[SHADE_MAT_LOBE_DIFFUSE];
-            out->kg[k] = 0.0;
-            out->kappa[k] = 0.0;
-            double wbest = 0.0;
-            for (int j = 0; j < b.nglossy; j++) {
-                out->kg[k] += b.gl_w[j] * lum(b.gl_c[j]);
-                if (b.gl_w[j] > wbest) {
-                    wbest = b.gl_w[j];
-                    out->kappa[k] = glossy_exponent(b.gl[j]);
-                }
-            }
-        }
+        if (!ok[i]) continue;
+        out->v[k] = out->v[i];
+        out->kd[k] = out->kd[i];
+        out->kg[k] = out->kg[i];
+        out->kappa[k] = out->kappa[i];
         k++;
     }
+    for (int b = 0; b < nblk; b++) *shadow += sh[b];
+    free(ok);
+    free(sh);
     out->n = k;
     accel_surf_free(S);
     return PT_OK;
@@ -708,7 +763,7 @@ pt_status render_vpl(const scene *sc, const accel *a, const render_vpl_settings 
     /* VPLs and their direct light */
     double t0 = timer_now();
     vpl_set vs = {0};
-    status = make_vpls(sc, a, L, s->vpls, s->seed, rr.brightness, &vs, &st->shadow_rays, d);
+    status = make_vpls(sc, a, L, s->vpls, s->seed, rr.brightness, s->threads, &vs, &st->shadow_rays, d);
     st->t_vpls = timer_now() - t0;
     st->vpls = vs.n;
     gi_vpl_tree *tree = NULL;
