@@ -145,6 +145,11 @@ for fr in 1 "$LINK_FRAMES"; do
     done
     rm -f q_*.pfm
 done
+# the reference's own direct light against the Whitted pass's (POV-Ray's)
+"$P" render mesh_room.pov +L"$TPL" --gi path --spp "$PATH_SPP" --max-depth 2 --size "$QSIZE" -o d_path.pfm -q 2>/dev/null
+"$P" render mesh_room.pov +L"$TPL" --gi none --size "$QSIZE" -o d_none.pfm -q 2>/dev/null
+"$P" compare d_path.pfm d_none.pfm --hdr --json > d.json 2>/dev/null
+field d.json "'direct light only: --gi none (the lighting of POV-Ray) against --gi path --max-depth 2: mean luminance %+.2f%%' % (100 * j['luminance']['relative'])"
 fi
 
 detp_scene() {
