@@ -149,6 +149,15 @@ done
 "$P" render mesh_room.pov +L"$TPL" --gi path --spp "$PATH_SPP" --max-depth 2 --size "$QSIZE" -o d_path.pfm -q 2>/dev/null
 "$P" render mesh_room.pov +L"$TPL" --gi none --size "$QSIZE" -o d_none.pfm -q 2>/dev/null
 "$P" compare d_path.pfm d_none.pfm --hdr --json > d.json 2>/dev/null
+W=${QSIZE%x*}; H=${QSIZE#*x}
+if command -v povray >/dev/null 2>&1; then
+    povray +Imesh_room.pov +L"$TPL" +W"$W" +H"$H" +Q8 -D -GA +Od_pov.png >/dev/null 2>&1 || true
+    "$P" render mesh_room.pov +L"$TPL" --gi none --size "$QSIZE" -o d_none.png -q 2>/dev/null
+    if [ -f d_pov.png ]; then
+        "$P" compare d_pov.png d_none.png --json > dp.json 2>/dev/null
+        field dp.json "'direct light only: --gi none against POV-Ray +Q8 (radiosity off), PNG: mean luminance %+.2f%%' % (100 * j['luminance']['relative'])"
+    fi
+fi
 field d.json "'direct light only: --gi none (the lighting of POV-Ray) against --gi path --max-depth 2: mean luminance %+.2f%%' % (100 * j['luminance']['relative'])"
 fi
 
