@@ -157,6 +157,15 @@ if command -v povray >/dev/null 2>&1; then
         "$P" compare d_pov.png d_none.png --json > dp.json 2>/dev/null
         field dp.json "'direct light only: --gi none against POV-Ray +Q8 (radiosity off), PNG: mean luminance %+.2f%%' % (100 * j['luminance']['relative'])"
     fi
+    # POV-Ray's own radiosity (the scene's radiosity{}) as a second reference
+    povray +Imesh_room.pov +L"$TPL" +W"$W" +H"$H" +Q9 -D -GA +Or_pov.png >/dev/null 2>&1 || true
+    if [ -f r_pov.png ]; then
+        for m in links particle; do
+            "$P" render mesh_room.pov +L"$TPL" --gi "$m" --size "$QSIZE" -o "r_$m.png" -q 2>/dev/null
+            "$P" compare r_pov.png "r_$m.png" --json > "r_$m.json" 2>/dev/null
+            field "r_$m.json" "'  against POV-Ray radiosity (PNG) %-8s FLIP %.4f, mean luminance %+.2f%%' % ('$m', j['flip']['mean'], 100 * j['luminance']['relative'])"
+        done
+    fi
 fi
 field d.json "'direct light only: --gi none (the lighting of POV-Ray) against --gi path --max-depth 2: mean luminance %+.2f%%' % (100 * j['luminance']['relative'])"
 fi
