@@ -45,8 +45,17 @@
 #define SHADE_MAX_THREADS 256
 #define TILE 16
 
+#define LIGHT_CACHE 16 /* lights whose shadow result a hit keeps */
+
 typedef struct {
     long primary, shadow, secondary, discarded, unsupported;
+    /* The shadow results of the last hit lit, per light: every texture
+     * layer (and layered texture) at one hit sees the same shadow, so the
+     * test is done once per hit and light, as POV-Ray's lightColorCache. */
+    const void *lc_obj;
+    vec3 lc_p;
+    unsigned lc_valid;
+    rgb lc_vis[LIGHT_CACHE];
     char pad[64];
 } thread_stats;
 
@@ -260,6 +269,12 @@ static rgb direct_light(render_ctx *c, int thread, const shade_light_surface *s,
     rgb total = {0, 0, 0};
     const shade_media_inside *in = frame_inside(c, thread);
     int double_illum = (h->obj->flags & OBJ_DOUBLE_ILLUMINATE) != 0;
+    thread_stats *ts = &c->ts[thread];
+    if (ts->lc_obj != (const void *)h->obj || ts->lc_p.x != p.x || ts->lc_p.y != p.y || ts->lc_p.z != p.z) {
+        ts->lc_obj = h->obj;
+        ts->lc_p = p;
+        ts->lc_valid = 0;
+    }
     for (int i = 0; i < c->sc->nlights; i++) {
         const scene_light *l = &c->sc->lights[i];
         if (!scene_light_reaches(l, h->obj)) continue; /* light_group */
@@ -306,10 +321,18 @@ static rgb direct_light(render_ctx *c, int thread, const shade_light_surface *s,
         }
         if (!l->shadowless && shadows_on) {
             rgb vis;
-            if (area_on && l->area && l->size1 * l->size2 > 1)
-                vis = area_visibility(c, thread, l, p, r, in);
-            else
-                vis = shadow_rgb(c, thread, p, dir, sdepth, l, in);
+            if (i < LIGHT_CACHE && (ts->lc_valid >> i & 1u)) {
+                vis = ts->lc_vis[i];
+            } else {
+                if (area_on && l->area && l->size1 * l->size2 > 1)
+                    vis = area_visibility(c, thread, l, p, r, in);
+                else
+                    vis = shadow_rgb(c, thread, p, dir, sdepth, l, in);
+                if (i < LIGHT_CACHE) {
+                    ts->lc_vis[i] = vis;
+                    ts->lc_valid |= 1u << i;
+                }
+            }
             if (rgb_near_zero(vis)) continue;
             lc = rgb_mul(lc, vis);
             /* media_attenuation: fog dims the light on its way (shade_atmos.c;
