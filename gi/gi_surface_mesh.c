@@ -368,8 +368,17 @@ void gi_surface_build_meshes(gi_surface *g)
         int n = gi_surface_grid_count(ext, g->tess, 2, 128);
         mesh_ctx m = {g, i, p->sh, NULL, 0, 0, 0.0};
         shape_kind kind = g->o[p->obj].kind;
-        int r = kind == SHAPE_CYLINDER || kind == SHAPE_CONE || kind == SHAPE_TORUS
-                    ? analytic_grid(p->sh, g->tess, mesh_tri, &m)
+        /* A sweep, text, cylinder, cone or torus smaller than the bound (a
+         * baluster's spindle, a letter, a rod) gets no grid: its cells follow
+         * the normal bound (SWEEP_TURN, the analytic grids' three cells a
+         * turn) whatever its size, tens to hundreds of radiance particles
+         * whose lists, one list radius across, all hold the same few area
+         * particles; hits on it are estimated where they are (onthefly in
+         * gi_particle_hook.c), over those same particles. */
+        int analytic = kind == SHAPE_CYLINDER || kind == SHAPE_CONE || kind == SHAPE_TORUS;
+        if ((analytic || (split_grid(kind) && kind != SHAPE_POLYGON && kind != SHAPE_HEIGHT_FIELD)) && ext < g->tess)
+            continue;
+        int r = analytic ? analytic_grid(p->sh, g->tess, mesh_tri, &m)
                     : split_grid(kind) ? split_grid_build(p->sh, g->tess, &m)
                                        : geom_shape_grid(p->sh, n, mesh_tri, &m);
         free(m.vh);
