@@ -34,10 +34,21 @@ typedef struct {
     int nverts, ntris;
 } vmesh;
 
+/* A link ray's hit on an object that is not a mesh: what it reflects of
+ * the lights is light the element gathers (one bounce; the object has no
+ * vertices to carry more). */
+typedef struct {
+    vec3 p, n;     /* hit point, normal facing the element */
+    float rho[3];  /* its diffuse reflectance */
+    int leaf;
+} farhit;
+
 typedef struct {
     int n, raw;    /* merged links, raw links */
     int *peer;
     float *w;
+    int nfar;
+    farhit *far;
 } elinks;
 
 struct gi_vlinks {
@@ -65,7 +76,7 @@ struct gi_vlinks {
     int *off_csr, *peer_csr;
     float *w_csr;
     int *adj_off, *adj;
-    float *edir, *b0, *b1, *itot, *ism;
+    float *edir, *efar, *b0, *b1, *itot, *ism;
     /* the frame the hook reads */
     const scene *sc;
     scene_leaves *lv;
@@ -245,6 +256,7 @@ typedef struct {
     int nthreads;
     void *scene;                 /* RTCScene the link rays are traced in (accel_rtc_link_scene) */
     struct RTCRayHit **rh;       /* per thread: one element's rays */
+    farhit **far;                /* per thread: one element's hits on objects without vertices */
     float **acc;                 /* per thread: weight per peer element (dense) */
     int **touched;               /* per thread: peers touched */
     atomic_long rays, other, raw;
@@ -268,7 +280,8 @@ static void link_chunk(void *ctx, int ci, int thread)
         vec3 t, b;
         v3_basis(n, &t, &b);
         vec3 org = v3_madd(v->org[vx], n, v->off);
-        int nt = 0, raw = 0;
+        int nt = 0, raw = 0, nfar = 0;
+        farhit *far = J->far[thread];
         /* the element's rays in one Embree stream, block by block (the
          * directions run 4 x 4 block after block: coherent) */
         struct RTCRayHit *rh = J->rh[thread];
@@ -329,6 +342,27 @@ static void link_chunk(void *ctx, int ci, int thread)
             int mi = leaf >= 0 ? v->leaf_mesh[leaf] : -1;
             if (mi < 0) {
                 other++;
+                /* the full record (point, normal, texture) for its reflectance */
+                accel_hit fh;
+                if (leaf >= 0 && accel_intersect(J->a, org, dir, 0.0, INFINITY, &fh) && fh.obj == h.obj) {
+                    farhit *f = &far[nfar];
+                    f->p = fh.p;
+                    f->n = v3_dot(fh.ng, dir) < 0.0 ? fh.ng : v3_neg(fh.ng);
+                    f->leaf = leaf;
+                    const scene_texture *tex = fh.texture ? fh.texture : &J->sc->default_texture;
+                    colour5 c5 = tex->pigment.colour;
+                    accel_hit ph = fh;
+                    ph.ns = ph.ng = f->n;
+                    if (v->s.pigment && !v->s.pigment(J->sc, tex, &ph, &c5)) c5 = tex->pigment.colour;
+                    double dd = tex->finish.diffuse;
+                    float rr[3] = {(float)(c5.r * dd), (float)(c5.g * dd), (float)(c5.b * dd)};
+                    int any = 0;
+                    for (int c = 0; c < 3; c++) {
+                        f->rho[c] = isfinite(rr[c]) && rr[c] > 0.0f ? rr[c] : 0.0f;
+                        any |= f->rho[c] > 0.0f;
+                    }
+                    if (any) nfar++;
+                }
                 continue;
             }
             const vmesh *m = &v->mesh[mi];
@@ -354,6 +388,17 @@ static void link_chunk(void *ctx, int ci, int thread)
         elinks *L = &v->lk[e];
         free(L->peer);
         free(L->w);
+        free(L->far);
+        L->far = NULL;
+        L->nfar = 0;
+        if (nfar > 0) {
+            L->far = malloc(sizeof *L->far * (size_t)nfar);
+            if (!L->far) J->oom = 1;
+            else {
+                memcpy(L->far, far, sizeof *L->far * (size_t)nfar);
+                L->nfar = nfar;
+            }
+        }
         L->peer = malloc(sizeof *L->peer * (size_t)(nt > 0 ? nt : 1));
         L->w = malloc(sizeof *L->w * (size_t)(nt > 0 ? nt : 1));
         if (!L->peer || !L->w) {
@@ -386,12 +431,36 @@ typedef struct {
     atomic_long rays;
 } light_job;
 
+/* Direct E/pi at point p with normal n from every light (POV-Ray's
+ * attenuation, cones, fade; shadow rays from org; light groups by obj). */
+static void direct_at(const light_job *J, vec3 p, vec3 n, vec3 org, const scene_object *obj, float E[3], long *rays)
+{
+    const scene *sc = J->sc;
+    E[0] = E[1] = E[2] = 0.0f;
+    for (int li = 0; li < sc->nlights; li++) {
+        const scene_light *l = &sc->lights[li];
+        const gi_dev_light *dl = &J->dl[li];
+        float d[3];
+        float depth = gi_light_ray(dl, dl->pos[0], dl->pos[1], dl->pos[2], (float)p.x, (float)p.y, (float)p.z, d);
+        double ci2 = n.x * d[0] + n.y * d[1] + n.z * d[2];
+        if (!(ci2 > 1e-10)) continue;
+        float att = gi_light_attenuation(dl, (float)p.x, (float)p.y, (float)p.z, d, depth);
+        if (!(att > 0.0f) || (obj && !scene_light_reaches(l, obj))) continue;
+        if (!l->shadowless) {
+            (*rays)++;
+            if (accel_occluded(J->a, org, v3(d[0], d[1], d[2]), 0.0, depth)) continue;
+        }
+        for (int c = 0; c < 3; c++) E[c] += dl->colour[c] * att * (float)ci2;
+    }
+    for (int c = 0; c < 3; c++)
+        if (!isfinite(E[c])) E[c] = 0.0f;
+}
+
 static void light_chunk(void *ctx, int ci, int thread)
 {
     (void)thread;
     light_job *J = ctx;
     gi_vlinks *v = J->v;
-    const scene *sc = J->sc;
     long e0 = (long)ci * LIGHT_CHUNK, e1 = e0 + LIGHT_CHUNK < v->ne ? e0 + LIGHT_CHUNK : v->ne;
     long rays = 0;
     for (long e = e0; e < e1; e++) {
@@ -401,24 +470,26 @@ static void light_chunk(void *ctx, int ci, int thread)
         vec3 p = v->pos[vx];
         const vmesh *m = &v->mesh[v->vmesh_of[vx]];
         const scene_object *obj = scene_leaves_get(v->lv, m->leaf);
-        float E[3] = {0.0f, 0.0f, 0.0f};
-        for (int li = 0; li < sc->nlights; li++) {
-            const scene_light *l = &sc->lights[li];
-            const gi_dev_light *dl = &J->dl[li];
-            float d[3];
-            float depth = gi_light_ray(dl, dl->pos[0], dl->pos[1], dl->pos[2], (float)p.x, (float)p.y, (float)p.z, d);
-            double ci2 = n.x * d[0] + n.y * d[1] + n.z * d[2];
-            if (!(ci2 > 1e-10)) continue;
-            float att = gi_light_attenuation(dl, (float)p.x, (float)p.y, (float)p.z, d, depth);
-            if (!(att > 0.0f) || (obj && !scene_light_reaches(l, obj))) continue;
-            if (!l->shadowless) {
-                rays++;
-                if (accel_occluded(J->a, v3_madd(v->org[vx], n, v->off), v3(d[0], d[1], d[2]), 0.0, depth)) continue;
-            }
-            for (int c = 0; c < 3; c++) E[c] += dl->colour[c] * att * (float)ci2;
-        }
-        for (int c = 0; c < 3; c++) v->edir[e * 4 + c] = isfinite(E[c]) ? E[c] : 0.0f;
+        float E[3];
+        direct_at(J, p, n, v3_madd(v->org[vx], n, v->off), obj, E, &rays);
+        for (int c = 0; c < 3; c++) v->edir[e * 4 + c] = E[c];
         v->edir[e * 4 + 3] = 0.0f;
+        /* what the element's rays that end on objects without vertices
+         * gather: each such object's reflected direct light (rho E/pi),
+         * a share 1/n_C each */
+        float F[3] = {0.0f, 0.0f, 0.0f};
+        const elinks *L = &v->lk[e];
+        for (int k = 0; k < L->nfar; k++) {
+            const farhit *f = &L->far[k];
+            float Ef[3];
+            direct_at(J, f->p, f->n, v3_madd(f->p, f->n, v->off), scene_leaves_get(v->lv, f->leaf), Ef, &rays);
+            for (int c = 0; c < 3; c++) F[c] += f->rho[c] * Ef[c];
+        }
+        for (int c = 0; c < 3; c++) {
+            float fv = F[c] / (float)v->nc;
+            v->efar[e * 4 + c] = isfinite(fv) ? fv : 0.0f;
+        }
+        v->efar[e * 4 + 3] = 0.0f;
     }
     atomic_fetch_add(&J->rays, rays);
 }
@@ -454,6 +525,7 @@ static void free_structure(gi_vlinks *v)
     for (long e = 0; e < v->ne && v->lk; e++) {
         free(v->lk[e].peer);
         free(v->lk[e].w);
+        free(v->lk[e].far);
     }
     free(v->lk);
     free(v->mesh);
@@ -467,6 +539,7 @@ static void free_structure(gi_vlinks *v)
     free(v->ray_t);
     free(v->ray_leaf);
     free(v->edir);
+    free(v->efar);
     free(v->b0);
     free(v->b1);
     free(v->itot);
@@ -480,7 +553,7 @@ static void free_structure(gi_vlinks *v)
     v->mesh = NULL;
     v->leaf_mesh = NULL;
     v->pos = v->nrm = v->org = NULL;
-    v->rho = v->le = v->ray_t = v->edir = v->b0 = v->b1 = v->itot = v->ism = v->w_csr = NULL;
+    v->rho = v->le = v->ray_t = v->edir = v->efar = v->b0 = v->b1 = v->itot = v->ism = v->w_csr = NULL;
     v->vmesh_of = NULL;
     v->ray_leaf = v->off_csr = v->peer_csr = v->adj_off = v->adj = NULL;
     v->ne = v->nv = 0;
@@ -557,13 +630,14 @@ static int make_structure(gi_vlinks *v, const scene *sc, const scene_leaves *lv)
     v->ray_t = malloc(sizeof *v->ray_t * ne * (size_t)v->nc);
     v->ray_leaf = malloc(sizeof *v->ray_leaf * ne * (size_t)v->nc);
     v->edir = calloc(ne * 4, sizeof(float));
+    v->efar = calloc(ne * 4, sizeof(float));
     v->b0 = calloc(ne * 4, sizeof(float));
     v->b1 = calloc(ne * 4, sizeof(float));
     v->itot = calloc(ne * 4, sizeof(float));
     v->ism = calloc(ne * 4, sizeof(float));
     v->off_csr = calloc(ne + 1, sizeof(int));
     v->adj_off = calloc(ne + 1, sizeof(int));
-    return v->pos && v->nrm && v->org && v->vmesh_of && v->rho && v->le && v->lk && v->ray_t && v->ray_leaf && v->edir && v->b0 && v->b1 && v->itot &&
+    return v->pos && v->nrm && v->org && v->vmesh_of && v->rho && v->le && v->lk && v->ray_t && v->ray_leaf && v->edir && v->efar && v->b0 && v->b1 && v->itot &&
            v->ism && v->off_csr && v->adj_off;
 }
 
@@ -843,11 +917,12 @@ pt_status gi_vlinks_frame(gi_vlinks *v, const scene *sc, const accel *a, int obj
         J.acc = calloc((size_t)nthreads, sizeof *J.acc);
         J.touched = calloc((size_t)nthreads, sizeof *J.touched);
         J.rh = calloc((size_t)nthreads, sizeof *J.rh);
+        J.far = calloc((size_t)nthreads, sizeof *J.far);
         /* link rays tolerate a rare crack between triangles: the faster
          * scene without Embree's robust mode (accel.h) */
         J.scene = accel_rtc_link_scene(a);
         if (!J.scene) J.scene = accel_rtc_scene(a);
-        if (!J.acc || !J.touched || !J.rh) {
+        if (!J.acc || !J.touched || !J.rh || !J.far) {
             status = PT_ERR_NOMEM;
             goto done;
         }
@@ -855,7 +930,8 @@ pt_status gi_vlinks_frame(gi_vlinks *v, const scene *sc, const accel *a, int obj
             J.acc[t] = calloc((size_t)v->ne, sizeof(float));
             J.touched[t] = malloc(sizeof(int) * (size_t)v->nc * 3 + sizeof(int));
             J.rh[t] = malloc(sizeof(struct RTCRayHit) * (size_t)v->nc);
-            if (!J.acc[t] || !J.touched[t] || !J.rh[t]) {
+            J.far[t] = malloc(sizeof(farhit) * (size_t)v->nc);
+            if (!J.acc[t] || !J.touched[t] || !J.rh[t] || !J.far[t]) {
                 status = PT_ERR_NOMEM;
                 goto done;
             }
@@ -915,6 +991,14 @@ pt_status gi_vlinks_frame(gi_vlinks *v, const scene *sc, const accel *a, int obj
         for (long i = 0; i < (long)n4; i++) v->b0[i] *= (float)rr.brightness;
     for (int b = 0; b < sweeps; b++) {
         gi_c_vgather(nthreads, v->off_csr, v->peer_csr, v->w_csr, v->b0, v->rho, (int)v->ne, v->b1, v->itot);
+        if (b == 0)
+            /* the first bounce also gathers what objects without vertices
+             * reflect of the lights */
+            for (size_t i = 0; i < n4; i++) {
+                float g = v->efar[i] * (float)rr.brightness;
+                v->itot[i] += g;
+                v->b1[i] += v->rho[i] * g;
+            }
         if (rr.brightness != 1.0)
             for (long i = 0; i < (long)n4; i++) v->b1[i] *= (float)rr.brightness;
         float *tmp = v->b0;
@@ -939,6 +1023,9 @@ done:
         for (int t = 0; t < nthreads; t++) free(J.touched[t]);
     if (J.rh)
         for (int t = 0; t < nthreads; t++) free(J.rh[t]);
+    if (J.far)
+        for (int t = 0; t < nthreads; t++) free(J.far[t]);
+    free(J.far);
     free(J.acc);
     free(J.touched);
     free(J.rh);

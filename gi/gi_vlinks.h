@@ -30,9 +30,11 @@
  * (a query against the moved objects only, up to the stored hit), trace
  * their rays again; the light links and gathering run every frame.
  *
- * Surfaces of other objects (spheres, boxes, planes, ...) block rays and
- * get no vertices: their indirect light is 0 (counted in the stats). Rays
- * that leave the scene bring nothing (no sky light). Finish emission of a
+ * Surfaces of other objects (spheres, boxes, planes, ...) get no
+ * vertices: their indirect light is 0 (counted in the stats); a link ray
+ * that ends on one brings the light that surface reflects of the lights
+ * (one bounce, its direct light recomputed every frame). Rays that leave
+ * the scene bring nothing (no sky light). Finish emission of a
  * mesh is light its vertices send (POV-Ray's rules, radrules.h); both
  * sides of a vertex take the texture (not interior_texture). */
 #ifndef PT_GI_VLINKS_H
