@@ -42,6 +42,7 @@
 #include "shade_noise.h"
 #include <math.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -170,6 +171,8 @@ static void init_waves(void)
     }
 }
 
+static atomic_int tables_ready;
+
 static void init_all(void)
 {
     init_hash();
@@ -177,10 +180,16 @@ static void init_all(void)
     init_solid();
     init_rands();
     init_waves();
+    atomic_store_explicit(&tables_ready, 1, memory_order_release);
 }
 
-/* Build the tables (idempotent, thread-safe). */
-static void noise_init(void) { pthread_once(&init_once, init_all); }
+/* Build the tables (idempotent, thread-safe). Once built, one acquire load
+ * answers: the lattice lookups call this per evaluation, and pthread_once
+ * is a call into the C library every time. */
+static inline void noise_init(void)
+{
+    if (!atomic_load_explicit(&tables_ready, memory_order_acquire)) pthread_once(&init_once, init_all);
+}
 
 /* ------------------------------------------------------------ lattice noise */
 
