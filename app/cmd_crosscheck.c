@@ -64,11 +64,12 @@
 
 static const char *usage =
     "usage: partray crosscheck SCENE.pov [--size WxH] [+A0.3 | -A] [+R3] [--threads N] [-D NAME=VALUE] [-L DIR]\n"
-    "                          [--gi MODE] [--out DIR] [--json] [--povray PATH] [--quiet]\n"
+    "                          [--gi MODE] [--gi-quality Q] [--out DIR] [--json] [--povray PATH] [--quiet]\n"
     "                          [--converged [--cache DIR] [--converged-timeout SECONDS]]\n";
 
 typedef struct {
     const char *scene, *out_dir, *povray, *gi, *cache_dir;
+    const char *gi_quality; /* passed to partray render as --gi-quality (render checks it) */
     int converged;       /* also render POV-Ray's converged radiosity reference */
     double converged_timeout; /* seconds; past it the default render is the reference */
     int width, height;
@@ -114,7 +115,7 @@ static int parse_args(int argc, char **argv, xc_opts *o)
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         int takes = strcmp(a, "--size") == 0 || strcmp(a, "--threads") == 0 || strcmp(a, "--out") == 0 ||
-                    strcmp(a, "--povray") == 0 || strcmp(a, "--gi") == 0 || strcmp(a, "-L") == 0 ||
+                    strcmp(a, "--povray") == 0 || strcmp(a, "--gi") == 0 || strcmp(a, "--gi-quality") == 0 || strcmp(a, "-L") == 0 ||
                     strcmp(a, "-D") == 0 || strcmp(a, "--cache") == 0 || strcmp(a, "--converged-timeout") == 0;
         if (takes && !next) {
             fprintf(stderr, "partray crosscheck: option '%s' needs a value\n", a);
@@ -140,6 +141,14 @@ static int parse_args(int argc, char **argv, xc_opts *o)
             o->povray = argv[++i];
         } else if (strcmp(a, "--gi") == 0) {
             o->gi = argv[++i];
+        } else if (strcmp(a, "--gi-quality") == 0) {
+            char *end;
+            double q = strtod(next, &end);
+            if (*end || !(q > 0.0) || !isfinite(q)) {
+                fprintf(stderr, "partray crosscheck: --gi-quality wants a number > 0\n");
+                return 0;
+            }
+            o->gi_quality = argv[++i];
         } else if (strcmp(a, "--converged") == 0) {
             o->converged = 1;
         } else if (strcmp(a, "--cache") == 0) {
@@ -637,6 +646,10 @@ int cmd_crosscheck(int argc, char **argv)
         if (o.gi) {
             snprintf(args[n++], sizeof args[0], "--gi");
             snprintf(args[n++], sizeof args[0], "%s", o.gi);
+        }
+        if (o.gi_quality) {
+            snprintf(args[n++], sizeof args[0], "--gi-quality");
+            snprintf(args[n++], sizeof args[0], "%s", o.gi_quality);
         }
         for (int i = 0; i < o.nlibs; i++) snprintf(args[n++], sizeof args[0], "-L%s", o.libs[i]);
         for (int i = 0; i < o.ndefines; i++) snprintf(args[n++], sizeof args[0], "-D%s", o.defines[i]);
