@@ -613,7 +613,7 @@ const char cli_render_help[] =
     "  --fg-rays N --photons N    pmfg: final-gather rays per pixel, photon paths\n"
     "  --gi detp [--photons N] [--detp-radius R] [--detp-full]\n"
     "                         incremental photon paths across an animation's frames, fixed-radius\n"
-    "                         estimate (docs/gi.md); --detp-full recomputes every frame\n"
+    "                         estimate (docs/motion.md); --detp-full recomputes every frame\n"
     "  --gi vpl [--vpls N] [--nb N] [--vpl-cut minmax|full|brute] [--vpl-adaptive on|off]\n"
     "                         VPL reflectance filtering (glossy interreflection, docs/gi.md): VPL count\n"
     "                         (16384), bounces at the VPLs (1), the cut walked per pixel, adaptive sampling\n"
