@@ -572,6 +572,12 @@ static int build_table(accel_surf *as)
 accel_surf *accel_surf_build(const scene *s, const accel *a, accel_surf_weight_fn weight, void *ctx, diag *d,
                              pt_status *st)
 {
+    return accel_surf_build_in(s, a, NULL, NULL, weight, ctx, d, st);
+}
+
+accel_surf *accel_surf_build_in(const scene *s, const accel *a, const vec3 *lo, const vec3 *hi,
+                                accel_surf_weight_fn weight, void *ctx, diag *d, pt_status *st)
+{
     (void)d;
     *st = PT_OK;
     accel_surf *as = calloc(1, sizeof *as);
@@ -582,8 +588,13 @@ accel_surf *accel_surf_build(const scene *s, const accel *a, accel_surf_weight_f
     as->s = s;
     as->fn = weight;
     as->ctx = ctx;
-    if (a) {
-        accel_bounds(a, &as->lo, &as->hi);
+    if (a || (lo && hi)) {
+        if (lo && hi) {
+            as->lo = *lo;
+            as->hi = *hi;
+        } else {
+            accel_bounds(a, &as->lo, &as->hi);
+        }
         as->have_bounds = as->lo.x < as->hi.x || as->lo.y < as->hi.y || as->lo.z < as->hi.z;
         /* a hair larger, so planes lying on the bounds are kept */
         double pad = 1e-6 * (1.0 + v3_len(v3_sub(as->hi, as->lo)));

@@ -8,7 +8,9 @@
  *    tracer; gathered light: brightness), mirror and refraction lobes
  *    followed Whitted-style within POV-Ray's trace levels.
  *  - VPLs: `vpls` points uniform by area over the surfaces gathering rays
- *    see (accel_surface.h), each on the side that receives more light, with
+ *    see (accel_surface.h; infinite planes within the scene's finite bounds
+ *    grown to what a 32 x 32 grid of camera rays hits), each on the side
+ *    that receives more light, with
  *    the Lambertian radiance of its direct light as seen by a gathering ray
  *    (POV-Ray's rules: no highlights, area lights as points; emitters
  *    through the Lambertian lobes). Direct light reflected by a VPL's glossy
@@ -55,6 +57,7 @@
 #define SKIP_MAX 64
 #define EYE_RR 1e-3
 #define COARSE 16
+#define VIEW_GRID 32 /* camera rays per image side that bound the planes' VPLs */
 #define SKY_RAYS 16 /* gathering rays per VPL side for the sky and emitters */
 
 void render_vpl_default_settings(render_vpl_settings *s)
@@ -320,12 +323,27 @@ static void vpl_block(void *ctx, int blk, int thread)
 }
 
 static pt_status make_vpls(const scene *sc, const accel *a, const pm_lights *L, long want, uint64_t seed, double bright,
-                           int threads, vpl_set *out, long *shadow, diag *d)
+                           int threads, int width, int height, vpl_set *out, long *shadow, diag *d)
 {
     /* gathering rays at the VPLs find the sky and emitters */
     const int gather = pm_sky_any(sc) || accel_surf_count(pm_lights_emitters(L)) > 0;
     pt_status st = PT_OK;
-    accel_surf *S = accel_surf_build(sc, a, vpl_weight, NULL, d, &st);
+    /* planes: the scene's finite bounds grown to what a coarse grid of
+     * camera rays sees, so the floor and walls in view get VPLs */
+    vec3 lo, hi;
+    accel_bounds(a, &lo, &hi);
+    for (int y = 0; y < VIEW_GRID; y++)
+        for (int x = 0; x < VIEW_GRID; x++) {
+            vec3 org, dir;
+            scene_camera_ray(&sc->camera, (x + 0.5) / VIEW_GRID * width, (y + 0.5) / VIEW_GRID * height, width, height,
+                             &org, &dir);
+            accel_hit h;
+            if (accel_intersect(a, org, dir, pm_lights_eps(L), INFINITY, &h) && v3_finite(h.p)) {
+                lo = v3_min(lo, h.p);
+                hi = v3_max(hi, h.p);
+            }
+        }
+    accel_surf *S = accel_surf_build_in(sc, a, &lo, &hi, vpl_weight, NULL, d, &st);
     if (!S) return st;
     memset(out, 0, sizeof *out);
     if (accel_surf_count(S) == 0 || want < 1) {
@@ -763,7 +781,7 @@ pt_status render_vpl(const scene *sc, const accel *a, const render_vpl_settings 
     /* VPLs and their direct light */
     double t0 = timer_now();
     vpl_set vs = {0};
-    status = make_vpls(sc, a, L, s->vpls, s->seed, rr.brightness, s->threads, &vs, &st->shadow_rays, d);
+    status = make_vpls(sc, a, L, s->vpls, s->seed, rr.brightness, s->threads, W, H, &vs, &st->shadow_rays, d);
     st->t_vpls = timer_now() - t0;
     st->vpls = vs.n;
     gi_vpl_tree *tree = NULL;
