@@ -9,7 +9,8 @@
  *    followed Whitted-style within POV-Ray's trace levels.
  *  - VPLs: `vpls` points uniform by area over the surfaces gathering rays
  *    see (accel_surface.h; infinite planes within the scene's finite bounds
- *    grown to what a 32 x 32 grid of camera rays hits), each on the side
+ *    grown to what a 32 x 32 grid of camera rays hits within twice their
+ *    diagonal), each on the side
  *    that receives more light, with
  *    the Lambertian radiance of its direct light as seen by a gathering ray
  *    (POV-Ray's rules: no highlights, area lights as points; emitters
@@ -332,13 +333,18 @@ static pt_status make_vpls(const scene *sc, const accel *a, const pm_lights *L, 
      * camera rays sees, so the floor and walls in view get VPLs */
     vec3 lo, hi;
     accel_bounds(a, &lo, &hi);
+    /* only hits within twice the finite bounds' diagonal of their centre: a
+     * plane seen to the horizon would spread the VPLs thin */
+    const vec3 centre = v3_scale(v3_add(lo, hi), 0.5);
+    const double reach = 2.0 * v3_len(v3_sub(hi, lo));
     for (int y = 0; y < VIEW_GRID; y++)
         for (int x = 0; x < VIEW_GRID; x++) {
             vec3 org, dir;
             scene_camera_ray(&sc->camera, (x + 0.5) / VIEW_GRID * width, (y + 0.5) / VIEW_GRID * height, width, height,
                              &org, &dir);
             accel_hit h;
-            if (accel_intersect(a, org, dir, pm_lights_eps(L), INFINITY, &h) && v3_finite(h.p)) {
+            if (accel_intersect(a, org, dir, pm_lights_eps(L), INFINITY, &h) && v3_finite(h.p) &&
+                v3_len(v3_sub(h.p, centre)) <= reach) {
                 lo = v3_min(lo, h.p);
                 hi = v3_max(hi, h.p);
             }
@@ -790,7 +796,14 @@ pt_status render_vpl(const scene *sc, const accel *a, const render_vpl_settings 
     tables ts = {0};
     if (status == PT_OK && vs.n > 0) {
         t0 = timer_now();
-        tree = gi_vpl_tree_build(vs.v, vs.n, diag_len, 3);
+        /* eq. 5's D: the VPLs' own extent (planes reach past the finite bounds) */
+        vec3 vlo = vs.v[0].p, vhi = vs.v[0].p;
+        for (int i = 1; i < vs.n; i++) {
+            vlo = v3_min(vlo, vs.v[i].p);
+            vhi = v3_max(vhi, vs.v[i].p);
+        }
+        double vdiag = v3_len(v3_sub(vhi, vlo));
+        tree = gi_vpl_tree_build(vs.v, vs.n, vdiag > 0.0 ? vdiag : diag_len, 3);
         st->t_tree = timer_now() - t0;
         if (!tree) status = PT_ERR_NOMEM;
     }
