@@ -138,12 +138,13 @@ static int photon_intersect(const trace_ctx *c, const accel_from *from, vec3 o, 
 
 /* With targets in the scene (POV-Ray 3.7 semantics), a photon on a caustic
  * path (a POV-Ray light, specular bounces only so far) is reflected or
- * refracted only by a target whose photons block turns that on. */
-static int caustic_bounce_ok(const accel_hit *h, int lobe)
+ * refracted only by a target where the target's and light l's flags allow
+ * that lobe (scene_photon_lobe). */
+static int caustic_bounce_ok(const scene_light *l, const accel_hit *h, int lobe)
 {
     const scene_obj_photons *ph = h->obj ? h->obj->photons : NULL;
     if (!ph || !ph->target) return 0;
-    return lobe == SHADE_MAT_LOBE_REFLECT ? ph->reflection : ph->refraction;
+    return scene_photon_lobe(l, ph, lobe != SHADE_MAT_LOBE_REFLECT);
 }
 
 static int any_target(const scene_object *o)
@@ -355,7 +356,7 @@ static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume,
         shade_mat_scatter s;
         if (!shade_mat_sample(&b, &r, 1, &s)) return;
         if (s.specular && bounce == 0 && from_light && !c->s->caustics) return;
-        if (s.specular && from_light && spec_only && c->targets && !caustic_bounce_ok(&h, s.lobe)) return;
+        if (s.specular && from_light && spec_only && c->targets && !caustic_bounce_ok(src->l, &h, s.lobe)) return;
         if (!s.specular) {
             spec_only = 0;
             nd++;

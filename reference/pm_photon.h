@@ -30,8 +30,10 @@
  * paths are kept: pmfg then shows caustics that path cannot. Per-object
  * photons { } blocks (scene_obj_photons) as POV-Ray 3.7 reads them: when
  * any object is a `target`, a caustic path (POV-Ray light, specular bounces
- * only) reflects or refracts only at targets whose block says `reflection
- * on` / `refraction on` (other such photons end); without any target every
+ * only) reflects or refracts only at targets where the block and the
+ * light's photons { } allow that lobe (scene_photon_lobe: the object says
+ * on and the light not off, or the light on and the object not off; other
+ * such photons end); without any target every
  * specular surface acts as one (partray's choice, POV-Ray would shoot no
  * caustic photons). `collect off`: never stored on that object;
  * `pass_through`: photons go through it unchanged. Photons are still
