@@ -145,6 +145,85 @@ static void leaf_boxes(const geom_shape *sh, int inverse, bbox *s, bbox *v)
     if (inverse) *v = bb_all();
 }
 
+/* Where quadric q's inside can be in its own object space, from the
+ * members it is intersected with: gathered in lo/hi from node `node` (a
+ * member that must contain the point): an axis-aligned plane there bounds
+ * one side, an intersection passes on to its members, another member with
+ * a finite inside box carries that box over corner by corner. */
+static void local_limits(const geom_csg *c, const geom_shape *q, int node, const bbox *V, double *lo, double *hi, int depth)
+{
+    const geom_csg_node *nd = &c->nodes[node];
+    if (nd->inverse || depth > 64) return;
+    if (nd->op == GEOM_CSG_INTERSECTION) {
+        for (int i = 0; i < nd->nkids; i++) local_limits(c, q, c->kids[nd->first + i], V, lo, hi, depth + 1);
+        return;
+    }
+    if (nd->op == GEOM_CSG_LEAF && c->shapes[nd->shape].kind == SHAPE_PLANE) {
+        const geom_shape *pl = &c->shapes[nd->shape];
+        /* world n.p < d with p = A y + t: (A^T n).y < d - n.t */
+        vec3 nw = pl->identity ? pl->g.plane.n : v3_norm(xform_normal(&pl->x, pl->g.plane.n));
+        vec3 p0 = v3_scale(pl->g.plane.n, pl->g.plane.d);
+        if (!pl->identity) p0 = xform_point(&pl->x, p0);
+        double d = v3_dot(nw, p0), nl[3], big = 0.0;
+        for (int a = 0; a < 3; a++) {
+            nl[a] = q->x.m[0][a] * nw.x + q->x.m[1][a] * nw.y + q->x.m[2][a] * nw.z;
+            big = fmax(big, fabs(nl[a]));
+        }
+        int axis = -1, others = 0;
+        for (int a = 0; a < 3; a++)
+            if (fabs(nl[a]) > 1e-9 * big) {
+                if (axis < 0) axis = a;
+                else others = 1;
+            }
+        if (axis < 0 || others) return;
+        double bound = (d - (nw.x * q->x.m[0][3] + nw.y * q->x.m[1][3] + nw.z * q->x.m[2][3])) / nl[axis];
+        if (nl[axis] > 0.0) hi[axis] = fmin(hi[axis], bound);
+        else lo[axis] = fmax(lo[axis], bound);
+        return;
+    }
+    bbox b = V[node];
+    if (!v3_finite(b.lo) || !v3_finite(b.hi)) return;
+    vec3 blo = v3s(INFINITY), bhi = v3s(-INFINITY);
+    for (int corner = 0; corner < 8; corner++) {
+        vec3 w = v3(corner & 1 ? b.hi.x : b.lo.x, corner & 2 ? b.hi.y : b.lo.y, corner & 4 ? b.hi.z : b.lo.z);
+        vec3 y = xform_inv_point(&q->x, w);
+        blo = v3_min(blo, y);
+        bhi = v3_max(bhi, y);
+    }
+    lo[0] = fmax(lo[0], blo.x); lo[1] = fmax(lo[1], blo.y); lo[2] = fmax(lo[2], blo.z);
+    hi[0] = fmin(hi[0], bhi.x); hi[1] = fmin(hi[1], bhi.y); hi[2] = fmin(hi[2], bhi.z);
+}
+
+/* The world box of the inside of quadric leaf `leaf`, from everything it is
+ * intersected with (its siblings and, up through intersections, theirs),
+ * worked out in the quadric's own space and carried back to world: an
+ * object defined axis-aligned and turned as a whole (a clipped quadric the
+ * scene rotates) gets a finite box, as POV-Ray's box computed before the
+ * turn and transformed with it. 0 when nothing bounded comes out. */
+static int quadric_box_local(const geom_csg *c, int leaf, const bbox *V, bbox *out)
+{
+    const geom_shape *q = &c->shapes[c->nodes[leaf].shape];
+    double lo[3] = {-INFINITY, -INFINITY, -INFINITY}, hi[3] = {INFINITY, INFINITY, INFINITY};
+    for (int child = leaf, par = c->nodes[leaf].parent; par >= 0; child = par, par = c->nodes[par].parent) {
+        const geom_csg_node *P = &c->nodes[par];
+        if (P->op != GEOM_CSG_INTERSECTION || P->inverse) break;
+        for (int i = 0; i < P->nkids; i++)
+            if (c->kids[P->first + i] != child) local_limits(c, q, c->kids[P->first + i], V, lo, hi, 0);
+    }
+    vec3 ql, qh;
+    if (!geom_quadric_solid_box(q, 1, v3(lo[0], lo[1], lo[2]), v3(hi[0], hi[1], hi[2]), &ql, &qh)) return 0;
+    if (!v3_finite(ql) || !v3_finite(qh)) return 0;
+    bbox r = bb_empty();
+    for (int corner = 0; corner < 8; corner++) {
+        vec3 y = v3(corner & 1 ? qh.x : ql.x, corner & 2 ? qh.y : ql.y, corner & 4 ? qh.z : ql.z);
+        vec3 w = xform_point(&q->x, y);
+        r.lo = v3_min(r.lo, w);
+        r.hi = v3_max(r.hi, w);
+    }
+    *out = pad_box(r);
+    return 1;
+}
+
 int geom_csg_finish(geom_csg *c)
 {
     if (c->nnodes == 0) return 0;
@@ -222,7 +301,9 @@ int geom_csg_finish(geom_csg *c)
                 const geom_csg_node *kj = &c->nodes[k[j]];
                 if (kj->op != GEOM_CSG_LEAF || kj->inverse || !c->shapes[kj->shape].infinite) continue;
                 bbox q;
-                if (!geom_quadric_solid_box(&c->shapes[kj->shape], v.lo, v.hi, &q.lo, &q.hi)) continue;
+                if (!geom_quadric_solid_box(&c->shapes[kj->shape], 0, v.lo, v.hi, &q.lo, &q.hi) &&
+                    !quadric_box_local(c, k[j], V, &q))
+                    continue;
                 V[k[j]] = bb_inter(V[k[j]], q);
                 S[k[j]] = bb_inter(S[k[j]], q);
                 v = bb_inter(v, q);

@@ -346,18 +346,19 @@ static int quad_below(double A, double B, double R, double l, double h, double *
     return a <= b;
 }
 
-int geom_quadric_solid_box(const geom_shape *sh, vec3 clo, vec3 chi, vec3 *lo, vec3 *hi)
+int geom_quadric_solid_box(const geom_shape *sh, int local, vec3 clo, vec3 chi, vec3 *lo, vec3 *hi)
 {
     if (sh->kind != SHAPE_QUADRIC || !sh->data) return 0;
     const im_data *m = sh->data;
     const double *a = m->a;
     /* world form: with y = L p + c (the world -> object map),
-     * f = y'Q y + b.y + J = p'(L'QL)p + (2 L'Q c + L'b).p + (c'Qc + b.c + J) */
+     * f = y'Q y + b.y + J = p'(L'QL)p + (2 L'Q c + L'b).p + (c'Qc + b.c + J);
+     * in the object's own space L = I, c = 0 */
     double Q[3][3] = {{a[0], 0.5 * a[3], 0.5 * a[4]}, {0.5 * a[3], a[1], 0.5 * a[5]}, {0.5 * a[4], 0.5 * a[5], a[2]}};
     double b[3] = {a[6], a[7], a[8]}, L[3][3], c[3];
     for (int i = 0; i < 3; i++) {
-        for (int j = 0; j < 3; j++) L[i][j] = sh->x.inv[i][j];
-        c[i] = sh->x.inv[i][3];
+        for (int j = 0; j < 3; j++) L[i][j] = local ? (i == j) : sh->x.inv[i][j];
+        c[i] = local ? 0.0 : sh->x.inv[i][3];
     }
     double QL[3][3], W[3][3], w[3], Qc[3], J = a[9];
     for (int i = 0; i < 3; i++) {

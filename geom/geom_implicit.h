@@ -37,14 +37,14 @@ int geom_implicit_inside(const geom_shape *sh, vec3 q);
 vec3 geom_implicit_normal(const geom_shape *sh, vec3 q, int part);
 /* 1 when the inside is bounded by the shape's own box. */
 int geom_implicit_solid_bounded(const geom_shape *sh);
-/* Quadric: the world box of its inside (f < 0) within the world box
- * [clo, chi] (components may be infinite), when the quadric has no mixed
- * terms in world coordinates (axis-aligned: any scale, translation and
- * quarter turns); padded outwards. 1 with the box, 0 when it cannot say
+/* Quadric: the box of its inside (f < 0) within the box [clo, chi]
+ * (components may be infinite), in world coordinates, or with `local` in
+ * the quadric's own object space, when the quadric has no mixed terms in
+ * those coordinates; padded outwards. 1 with the box, 0 when it cannot say
  * (mixed terms, another shape, or no inside found within the box). POV-Ray
  * bounds a quadric inside a CSG intersection by the other members' box
  * the same way (csg.cpp CSG::Compute_BBox, quadric.cpp Compute_BBox). */
-int geom_quadric_solid_box(const geom_shape *sh, vec3 clo, vec3 chi, vec3 *lo, vec3 *hi);
+int geom_quadric_solid_box(const geom_shape *sh, int local, vec3 clo, vec3 chi, vec3 *lo, vec3 *hi);
 /* Blob: the texture of the component contributing most at q (object
  * space), NULL when the blob's own texture applies. */
 const scene_texture *geom_blob_texture(const geom_shape *sh, vec3 q);

@@ -31,11 +31,15 @@ static double eval_bound(const double *c, int n, double x)
     return 2.0 * (n + 1) * DBL_EPSILON * s;
 }
 
-/* f monotonic on [lo, hi] with f(lo), f(hi) of opposite signs. */
-static double refine(const double *c, int n, double lo, double hi, double flo)
+/* f monotonic on [lo, hi] with f(lo) = flo, f(hi) = fhi of opposite
+ * signs. Newton from the secant point (the chord's zero is inside the
+ * bracket and near the root when the bracket is wide, where the midpoint
+ * costs bisections first), bisecting when a step leaves the bracket. */
+static double refine(const double *c, int n, double lo, double hi, double flo, double fhi)
 {
     double width = hi - lo;
-    double x = 0.5 * (lo + hi);
+    double x = lo - flo * (hi - lo) / (fhi - flo);
+    if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
     for (int it = 0; it < 200; it++) {
         double f = c[n], df = 0.0;
         for (int i = n - 1; i >= 0; i--) {
@@ -119,7 +123,7 @@ static int solve_brackets(const double *c, int n, double a, double b, double *ro
         if (f1 == 0.0) {
             nr = push_root(roots, nr, x1);
         } else if (f0 != 0.0 && (f0 < 0.0) != (f1 < 0.0)) {
-            nr = push_root(roots, nr, refine(c, n, x0, x1, f0));
+            nr = push_root(roots, nr, refine(c, n, x0, x1, f0, f1));
         } else if (j + 2 < m && fabs(f1) <= eval_bound(c, n, x1)) {
             /* an interior critical point touching zero: a double root */
             double f2 = geom_poly_eval(c, n, xs[j + 2]);
@@ -189,7 +193,7 @@ static int sturm_isolate(const sturm_seq *s, const double *c, int n, double a, d
     if (count <= 0) return nr;
     double fa = geom_poly_eval(c, n, a), fb = geom_poly_eval(c, n, b);
     if (count == 1 && fa != 0.0 && fb != 0.0 && (fa < 0.0) != (fb < 0.0))
-        return push_root(roots, nr, refine(c, n, a, b, fa));
+        return push_root(roots, nr, refine(c, n, a, b, fa, fb));
     double m = 0.5 * (a + b);
     if (depth > 80 || !(m > a && m < b) || b - a <= 1e-15 * (fabs(a) + fabs(b))) {
         if (count == 1 && fb == 0.0) return push_root(roots, nr, b);

@@ -508,17 +508,33 @@ static void test_quadric_csg_box(void **st)
     expect_hit(&w, v3(-5, y, 0), v3(1, 0, 0), 5.0 - rx, v3_norm(v3(-8.0 * rx, -2.0 * (y - 5.0), 0)), 1e-9, 1e-9);
     geom_csg_free(&c);
     done(&w);
+    /* the same intersection turned as a whole (nested as clipped_by nests
+     * its solids): the box is worked out in the quadric's own space and
+     * carried back, so it is finite and holds the turned solid */
+    w = build("intersection { quadric { <1,-1,1>, <0,0,0>, <0,0,0>, -1 translate 5*y scale <0.5,1,0.5> }"
+              " intersection { plane { y, 5.5 } plane { -y, -2.5 } } rotate <-30, 0, 30> }");
+    memset(&c, 0, sizeof c);
+    assert_int_equal(geom_csg_build(&c, w.s->objects[0], NULL, 0, -1, 0, &b), PT_OK);
+    assert_true(geom_csg_finish(&c));
+    assert_true(v3_finite(c.lo) && v3_finite(c.hi));
+    /* every corner of the solid's own box (|x|, |z| <= r, 2.5 <= y <= 5.5)
+     * lies within R = sqrt(2 r^2 + 5.5^2) of the origin the turn keeps */
+    double R = sqrt(2.0 * r * r + 5.5 * 5.5);
+    assert_true(c.lo.x >= -R - 1e-6 && c.lo.y >= -R - 1e-6 && c.lo.z >= -R - 1e-6);
+    assert_true(c.hi.x <= R + 1e-6 && c.hi.y <= R + 1e-6 && c.hi.z <= R + 1e-6);
+    geom_csg_free(&c);
+    done(&w);
     /* turned 45 degrees about z: mixed terms, no box (left to the clip cube) */
     w = build("quadric { <1,-1,1>, <0,0,0>, <0,0,0>, -1 rotate 45*z }");
     geom_shape sh = shape_of(&w);
     vec3 lo, hi;
-    assert_false(geom_quadric_solid_box(&sh, v3(-1, -1, -1), v3(1, 1, 1), &lo, &hi));
+    assert_false(geom_quadric_solid_box(&sh, 0, v3(-1, -1, -1), v3(1, 1, 1), &lo, &hi));
     geom_shape_release(&sh);
     done(&w);
     /* a quarter turn about x: the cylinder x2 + y2 < 1 along z, within |z| < 3 */
     w = build("quadric { <1,0,1>, <0,0,0>, <0,0,0>, -1 rotate 90*x }");
     sh = shape_of(&w);
-    assert_true(geom_quadric_solid_box(&sh, v3(-INFINITY, -INFINITY, -3), v3(INFINITY, INFINITY, 3), &lo, &hi));
+    assert_true(geom_quadric_solid_box(&sh, 0, v3(-INFINITY, -INFINITY, -3), v3(INFINITY, INFINITY, 3), &lo, &hi));
     assert_near(lo.x, -1.0, 1e-6);
     assert_near(hi.y, 1.0, 1e-6);
     assert_near(hi.z, 3.0, 1e-6);
@@ -527,7 +543,7 @@ static void test_quadric_csg_box(void **st)
     done(&w);
     w = build("quadric { <1,0,1>, <0,0,0>, <0,-1,0>, 0 }");
     sh = shape_of(&w);
-    assert_true(geom_quadric_solid_box(&sh, v3s(-INFINITY), v3(INFINITY, 4, INFINITY), &lo, &hi));
+    assert_true(geom_quadric_solid_box(&sh, 0, v3s(-INFINITY), v3(INFINITY, 4, INFINITY), &lo, &hi));
     assert_near(lo.x, -2.0, 1e-6);
     assert_near(hi.z, 2.0, 1e-6);
     assert_near(lo.y, 0.0, 1e-6);
