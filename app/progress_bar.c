@@ -13,6 +13,7 @@ struct pbar {
     progress *p;
     int quiet, tty;
     double interval;        /* plain lines: seconds between two */
+    double period;          /* seconds between two looks at the progress (at most interval) */
     pthread_t thread;
     int running;
     pthread_mutex_t mu;     /* stderr, and the fields below */
@@ -131,8 +132,8 @@ static void *run(void *arg)
         draw(b, timer_now(), 0);
         struct timespec ts;
         clock_gettime(CLOCK_REALTIME, &ts);
-        ts.tv_nsec += 100 * 1000 * 1000;
-        if (ts.tv_nsec >= 1000000000L) {
+        ts.tv_nsec += (long)(b->period * 1e9);
+        while (ts.tv_nsec >= 1000000000L) {
             ts.tv_sec++;
             ts.tv_nsec -= 1000000000L;
         }
@@ -157,6 +158,12 @@ pbar *pbar_start(int quiet)
     b->interval = 10;
     const char *e = getenv("PARTRAY_PROGRESS_SECONDS");
     if (e && atof(e) > 0) b->interval = atof(e);
+    /* a look every 0.1 s ($PARTRAY_PROGRESS_REDRAW, at least 1 ms), and
+     * never fewer than the plain lines need */
+    b->period = 0.1;
+    const char *er = getenv("PARTRAY_PROGRESS_REDRAW");
+    if (er && atof(er) >= 0.001) b->period = atof(er);
+    if (b->interval < b->period) b->period = b->interval < 0.001 ? 0.001 : b->interval;
     const char *ea = getenv("PARTRAY_PROGRESS_ETA_AFTER");
     if (ea && atof(ea) >= 0) g_eta_after = atof(ea);
     pthread_mutex_init(&b->mu, NULL);

@@ -378,7 +378,8 @@ static const char progress_scene[] =
     "sphere { <0, 1, 0>, 1 pigment { rgb 0.5 } }\n";
 
 /* On a terminal (script(1) gives the render one) a bar per stage is
- * redrawn in place: the render's percent rises through several values,
+ * redrawn in place (every 2 ms here, $PARTRAY_PROGRESS_REDRAW, so that a
+ * render of a fraction of a second shows it too): the render's percent rises through several values,
  * an ETA is shown, and the stage ends with its time. The scene's #debug
  * text appears before the render's first bar, i.e. while it runs, not
  * at exit. */
@@ -389,7 +390,8 @@ static void test_progress_terminal(void **st)
     snprintf(scene, sizeof scene, "%s/progress.pov", tmpdir);
     tu_write_file(scene, progress_scene);
     snprintf(cmd, sizeof cmd,
-             "script -q -e -c \"PARTRAY_PROGRESS_ETA_AFTER=0 '%s' render '%s' --size 640x480 --threads 2 -o "
+             "script -q -e -c \"PARTRAY_PROGRESS_ETA_AFTER=0 PARTRAY_PROGRESS_REDRAW=0.002 '%s' render '%s' --size 640x480 "
+             "--threads 2 -o "
              "'%s/progress.png'\" /dev/null",
              PARTRAY_BIN, scene, tmpdir);
     int rc = tu_run_capture(cmd);
@@ -427,7 +429,7 @@ static void test_progress_plain_and_quiet(void **st)
     char scene[512], cmd[2048];
     snprintf(scene, sizeof scene, "%s/progress.pov", tmpdir);
     tu_write_file(scene, progress_scene);
-    snprintf(cmd, sizeof cmd, "PARTRAY_PROGRESS_SECONDS=0.2 '%s' render '%s' --size 640x480 --threads 2 -o '%s/progress.png'",
+    snprintf(cmd, sizeof cmd, "PARTRAY_PROGRESS_SECONDS=0.01 '%s' render '%s' --size 640x480 --threads 2 -o '%s/progress.png'",
              PARTRAY_BIN, scene, tmpdir);
     assert_int_equal(tu_run_capture(cmd), 0);
     printf("%s", tu_out);
