@@ -596,12 +596,15 @@ static int cmp_double(const void *x, const void *y)
     return (a > b) - (a < b);
 }
 
-static void view_clip(const scene *s, const accel *a, vec3 *lo, vec3 *hi)
+/* The camera probe: a VIEW_W x VIEW_H grid of camera rays. Each ray's first
+ * hit object goes to seen[] (view_coverage reads it); the finite hits bound
+ * the clip box. */
+static void view_clip(const scene *s, const accel *a, vec3 *lo, vec3 *hi, const scene_object **seen)
 {
     if (!s->camera_set) return;
     vec3 flo, fhi;
     accel_bounds(a, &flo, &fhi);
-    if (!(flo.x <= fhi.x)) return;
+    int bounded = flo.x <= fhi.x;
     vec3 t = v3s(1e-6 * (1.0 + v3_len(v3_sub(fhi, flo))));
     flo = v3_sub(flo, t);
     fhi = v3_add(fhi, t);
@@ -620,6 +623,8 @@ static void view_clip(const scene *s, const accel *a, vec3 *lo, vec3 *hi)
             if (!camera_ray(&s->camera, x + 0.5, y + 0.5, VIEW_W, VIEW_H, 0.5, 0.5, &org, &dir)) continue;
             accel_hit h;
             if (!accel_intersect(a, org, dir, 0.0, INFINITY, &h)) continue;
+            if (seen) seen[y * VIEW_W + x] = h.obj;
+            if (!bounded) continue;
             vec3 p = h.p;
             /* planes and the shapes that may be unbounded stand for the far
              * ground and the horizon, not for what the view is about */
@@ -662,25 +667,19 @@ static void view_clip(const scene *s, const accel *a, vec3 *lo, vec3 *hi)
     }
 }
 
-/* What the camera sees of each object: the probe of view_clip again, each
- * ray's first hit credited to its object's record. Without a camera, or
+/* What the camera sees of each object: each of view_clip's probe rays
+ * (seen) credited to its first hit's object record. Without a camera, or
  * without memory, every share stays 0 (particles then go by area alone). */
-static void view_coverage(gi_surface *g, const accel *a)
+static void view_coverage(gi_surface *g, const scene_object *const *seen)
 {
-    const scene *s = g->sc;
-    if (!s->camera_set || g->no <= 0) return;
+    if (!g->sc->camera_set || g->no <= 0 || !seen) return;
     g->view = calloc((size_t)g->no, sizeof *g->view);
     if (!g->view) return;
     const double w = 1.0 / ((double)VIEW_W * VIEW_H);
-    for (int y = 0; y < VIEW_H; y++)
-        for (int x = 0; x < VIEW_W; x++) {
-            vec3 org, dir;
-            if (!camera_ray(&s->camera, x + 0.5, y + 0.5, VIEW_W, VIEW_H, 0.5, 0.5, &org, &dir)) continue;
-            accel_hit h;
-            if (!accel_intersect(a, org, dir, 0.0, INFINITY, &h) || !h.obj) continue;
-            const obj_rec *r = gi_surface_find_obj(g, h.obj);
-            if (r) g->view[r - g->o] += (float)w;
-        }
+    for (int i = 0; i < VIEW_W * VIEW_H; i++) {
+        const obj_rec *r = seen[i] ? gi_surface_find_obj(g, seen[i]) : NULL;
+        if (r) g->view[r - g->o] += (float)w;
+    }
 }
 
 int gi_surface_nobjs(const gi_surface *g) { return g->no; }
@@ -722,10 +721,12 @@ gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *
         g->lo = v3_sub(g->lo, m);
         g->hi = v3_add(g->hi, m);
     }
-    view_clip(s, a, &g->lo, &g->hi);
+    const scene_object **seen = calloc((size_t)VIEW_W * VIEW_H, sizeof *seen);
+    view_clip(s, a, &g->lo, &g->hi, seen);
     pt_status ast = PT_OK;
     g->as = accel_surf_build(s, a, NULL, NULL, d, &ast);
     if (!g->as) {
+        free(seen);
         gi_surface_free(g);
         *status = ast != PT_OK ? ast : PT_ERR_NOMEM;
         return NULL;
@@ -734,19 +735,22 @@ gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *
     for (int i = 0; i < s->nobjects; i++) {
         pt_status st = walk(g, s->objects[i], deft, 0);
         if (st != PT_OK) {
+            free(seen);
             gi_surface_free(g);
             *status = st;
             return NULL;
         }
     }
     if (!build_hash(g)) {
+        free(seen);
         gi_surface_free(g);
         *status = PT_ERR_NOMEM;
         return NULL;
     }
     for (int i = 0; i < g->np; i++) g->total_area += g->p[i].area;
     gi_surface_layout(g);
-    view_coverage(g, a);
+    view_coverage(g, seen);
+    free(seen);
     *status = PT_OK;
     return g;
 }
