@@ -96,7 +96,6 @@ const glossy_table *glossy_table_for(double e)
 }
 
 double glossy_exponent(const glossy_table *t) { return t->e; }
-double glossy_table_albedo(const glossy_table *t, double mu) { return table_lookup(t->tab, mu); }
 double glossy_table_eavg(const glossy_table *t) { return t->eavg; }
 const double *glossy_table_values(const glossy_table *t) { return t->tab; }
 

@@ -50,8 +50,7 @@ typedef struct glossy_table glossy_table;
  * NULL only when out of memory. */
 const glossy_table *glossy_table_for(double e);
 double glossy_exponent(const glossy_table *t);
-/* E(mu) as tabulated (the albedo of g alone) and Eavg. */
-double glossy_table_albedo(const glossy_table *t, double mu);
+/* Eavg, the cosine-weighted mean of the tabulated albedo E(mu). */
 double glossy_table_eavg(const glossy_table *t);
 /* The GLOSSY_NMU values E(mu_k) of glossy_lobe.h's table (for copies into
  * device memory: the kernels evaluate the lobe with glossy_lobe.h too). */
