@@ -31,10 +31,11 @@ enum { EXIT_OK = CLI_EXIT_OK, EXIT_SCENE = CLI_EXIT_SCENE, EXIT_USAGE = CLI_EXIT
 static const char *view_usage =
     "usage: partray view SCENE.pov [--size WxH] [--gi none|particle|path|pmfg] [--threads N] [--seed N]\n"
     "                    [--script FILE] [--preview D] [--ref-spp N] [--preview-particles N] [--verbose]\n"
-    "                    [--particles N] [--nb N] [--cl-device DEV] [-D NAME=VALUE] [-L DIR]\n"
+    "                    [--particles N] [--nb N] [--cl-device DEV] [--clock V] [-D NAME=VALUE] [-L DIR]\n"
     "keys: WASD/QE fly, right drag look, left drag orbit, wheel zoom, R reset camera,\n"
     "      1-9/Tab select light, arrows/PgUp/PgDn move it, +/- brighten/dim it,\n"
-    "      G cycle GI mode, O overlay on/off, F12/P screenshot, C write camera, H help, Esc quit\n";
+    "      G cycle GI mode, [/] clock -/+ 0.05 (the scene evaluated again), O overlay on/off,\n"
+    "      F12/P screenshot, C write camera, H help, Esc quit\n";
 
 /* Figures for the exit summary and `mark`. */
 typedef struct {
@@ -71,6 +72,7 @@ typedef struct {
     light_kind *light_kinds;
     int selected;            /* 0-based */
     int gi_mode;
+    double clock;            /* the clock asked for (the image follows when the scene at it is ready) */
     double scale;            /* scene size, for step lengths */
     int dirty;               /* VIEW_CAUSE_* bits not yet submitted */
     /* window */
@@ -105,6 +107,7 @@ typedef struct {
     long last_gen_full;
     long last_gen_relit, last_gen_relit_full;
     series lat_light_first, lat_light_relit, lat_light_relit_full, lat_light_full, lat_camera_first;
+    long images_clock_busy;  /* images shown that were made while a new clock was being prepared */
     double title_time;
     diag *msgs;
 } viewer;
@@ -155,6 +158,7 @@ static view_state current_state(const viewer *v)
     view_camera_to_scene(&v->cam, &s.camera);
     s.gi_mode = v->gi_mode;
     s.lights = v->lights;
+    s.clock = v->clock;
     return s;
 }
 
@@ -387,6 +391,12 @@ static void apply(viewer *v, const view_action *a)
         v->raw_input = 1;
         break;
     }
+    case VIEW_ACT_CLOCK:
+        v->clock = a->mode ? v->clock + a->v[0] : a->v[0];
+        v->dirty |= VIEW_CAUSE_CLOCK;
+        printf("view: clock %g\n", v->clock);
+        fflush(stdout);
+        break;
     case VIEW_ACT_GI: {
         int m = a->mode < 0 ? view_gi_next(v->gi_mode) : a->mode;
         if (!view_gi_available(m)) {
@@ -434,6 +444,8 @@ static void on_key(viewer *v, const SDL_KeyboardEvent *k)
     case SDLK_p: a = act(VIEW_ACT_SCREENSHOT); break;
     case SDLK_c: a = act(VIEW_ACT_CAMERA_WRITE); break;
     case SDLK_g: a = act(VIEW_ACT_GI); a.mode = -1; break;
+    case SDLK_LEFTBRACKET: a = act3(VIEW_ACT_CLOCK, -0.05, 0, 0); a.mode = 1; break;
+    case SDLK_RIGHTBRACKET: a = act3(VIEW_ACT_CLOCK, 0.05, 0, 0); a.mode = 1; break;
     case SDLK_PLUS:
     case SDLK_EQUALS:
     case SDLK_KP_PLUS: a = act3(VIEW_ACT_LIGHT_SCALE, 1.25, 0, 0); break;
@@ -562,6 +574,7 @@ static int take_image(viewer *v, double now)
     v->info = in;
     v->images++;
     v->published = in.serial;
+    if (in.clock_busy) v->images_clock_busy++;
     if (v->verbose)
         printf("view: image %ld gen %ld L%d/%d %dx%d %s%s%s frame %.1f ms (build %.1f light %.1f view %.1f render %.1f) "
                "cpu %.1f ms (light %.1f) latency %.1f ms%s%s%s [%s]\n",
@@ -628,6 +641,8 @@ static int overlay_lines(viewer *v, double now, char lines[][128], int max)
                  in->level, in->last_level, k, work);
     snprintf(lines[n++], 128, "FRAME %.0f MS: BUILD %.0f LIGHT %.0f VIEW %.0f RENDER %.0f", in->frame * 1e3,
              in->times.build * 1e3, in->times.light * 1e3, in->times.view * 1e3, in->times.render * 1e3);
+    if (n < max && (in->clock != 0.0 || v->clock != 0.0 || in->clock_updates > 0))
+        snprintf(lines[n++], 128, "CLOCK %g%s", in->clock, in->clock != v->clock ? " (PREPARING THE NEW CLOCK)" : "");
     snprintf(lines[n++], 128, "LATENCY %.0f MS%s%s", in->latency * 1e3, in->gi_stale ? ", GI STALE (RELIGHTING)" : (in->gi_coarse ? ", PREVIEW GI (RELIGHTING)" : ""),
              in->complete ? ", DONE" : "");
     if (n < max && in->describe[0]) snprintf(lines[n++], 128, "%.80s", in->describe);
@@ -681,9 +696,9 @@ static void present(viewer *v)
         SDL_RenderCopy(v->ren, v->tex, &r, NULL);
     }
     if (v->overlay && v->otex) {
-        char lines[6][128];
-        const char *lp[6];
-        int n = overlay_lines(v, timer_now(), lines, 6);
+        char lines[7][128];
+        const char *lp[7];
+        int n = overlay_lines(v, timer_now(), lines, 7);
         for (int i = 0; i < n; i++) lp[i] = lines[i];
         int scale = v->width >= 900 ? 2 : 1;
         /* drawn at the top left of a cleared buffer the size of the box */
@@ -853,6 +868,32 @@ static int split_args(int argc, char **argv, char **rest, int *nrest, const char
     return 1;
 }
 
+/* The scene file at another clock, opened as at the start (the render
+ * thread's view_render_opts.scene_at; runs on the clock thread). */
+typedef struct {
+    const char *path;
+    sdl_options so;
+    int threads;
+} scene_source;
+
+static pt_status scene_at(void *ctx, double clock, scene **sc, accel **a, diag *d)
+{
+    const scene_source *src = ctx;
+    sdl_options so = src->so;
+    sdl_set_still_clock(&so, clock);
+    *sc = NULL;
+    *a = NULL;
+    pt_status st = pipeline_parse(src->path, &so, sc, d, NULL);
+    if (st != PT_OK) return st;
+    *a = pipeline_accel(*sc, src->threads, d, &st, NULL);
+    if (!*a) {
+        scene_free(*sc);
+        *sc = NULL;
+        return st;
+    }
+    return PT_OK;
+}
+
 int cmd_view(int argc, char **argv)
 {
     char err[512];
@@ -910,6 +951,9 @@ int cmd_view(int argc, char **argv)
      * options, limits and function evaluators */
     sdl_options so;
     pipeline_sdl_options(&so, &o, v.width, v.height);
+    if (o.clock_given) sdl_set_still_clock(&so, o.clock);
+    v.clock = o.clock_given ? o.clock : 0.0;
+    scene_source source = {o.scene, so, v.threads};
     scene *sc = NULL;
     diag *pd = diag_new();
     pt_status st = pipeline_parse(o.scene, &so, &sc, pd, NULL);
@@ -980,8 +1024,8 @@ int cmd_view(int argc, char **argv)
         }
     }
     if (rc == EXIT_OK) {
-        view_render_opts ro = {v.width, v.height, v.threads, o.seed, preview, ref_spp, o.particles, o.bounces, o.cl_device,
-                               preview_particles};
+        view_render_opts ro = {v.width,   v.height,          v.threads, o.seed,  preview, ref_spp, o.particles,
+                               o.bounces, o.cl_device,        preview_particles, scene_at, &source, v.clock};
         view_state s0 = current_state(&v);
         diag *rd = diag_new();
         st = view_render_start(&v.vr, sc, acc, &ro, &s0, rd);
@@ -1008,6 +1052,11 @@ int cmd_view(int argc, char **argv)
                 "resolution %.1f ms mean; camera move -> image %.1f ms mean (%d)\n",
                 v.published, v.images, span, span > 0 ? v.published / span : 0.0, v.t_first_image - v.t_start, lf * 1e3, lfm * 1e3,
                 v.lat_light_first.n, lr * 1e3, lrm * 1e3, v.lat_light_relit.n, lR * 1e3, lF * 1e3, cf * 1e3, v.lat_camera_first.n);
+        if (v.info.clock_updates > 0 || v.clock != v.info.clock)
+            fprintf(stderr, "view: clock %g shown (%g asked): %ld scene%s at a new clock taken over, the last after %.3f s; %ld "
+                            "images shown while one was prepared\n",
+                    v.info.clock, v.clock, v.info.clock_updates, v.info.clock_updates == 1 ? "" : "s", v.info.clock_update,
+                    v.images_clock_busy);
         view_render_stop(v.vr);
         v.vr = NULL;
     }

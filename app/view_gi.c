@@ -25,6 +25,9 @@ typedef struct {
     pt_status (*render)(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d);
     void (*describe)(void *ctx, char *buf, int n);
     void (*close)(void *ctx);
+    /* NULL: the mode cannot follow a new scene (view_gi_reframe) */
+    pt_status (*reframe)(void *ctx, const scene *sc, const accel *a, volatile int *cancel, view_gi_times *t, diag *d);
+    void (*adopt)(void *ctx);
 } gi_backend;
 
 struct view_gi {
@@ -38,6 +41,10 @@ struct view_gi {
     int last_coarse;      /* the last pass used the preview lighting */
     scene sc;             /* shallow copy: own camera and lights, shared objects */
     scene_light *lights;
+    /* the scene a reframe computed for, until view_gi_adopt */
+    scene next_sc;
+    scene_light *next_lights;
+    int reframed;
 };
 
 /* ------------------------------------------------------------------ none */
@@ -233,24 +240,47 @@ static void particle_close(void *ctx)
 /* ----------------------------------------------------------------- links */
 /* Vertex links (gi_vlinks.h): open links every mesh vertex and gathers;
  * a light edit (relight) keeps the links and runs the light links and the
- * sweeps again on the render thread, while the window stays live. */
+ * sweeps again on the render thread, while the window stays live. Passes
+ * read a shot of the last finished solution (gi_vlinks_shot), never the
+ * instance: a new scene (the clock changed, view_gi_reframe) is linked
+ * again on another thread, only where it deformed, while passes go on with
+ * the old scene and its shot; view_gi_adopt then swaps both in. */
 typedef struct {
     const scene *sc;
     const accel *a;
     gi_vlinks *v;
+    gi_vlinks_shot *shot;      /* what passes read */
     gi_vlinks_stats st;
+    /* a reframe's result until adopted */
+    gi_vlinks_shot *next_shot;
+    const accel *next_a;
+    gi_vlinks_stats next_st;
 } links_ctx;
 
-static pt_status links_run(links_ctx *c, int objects_may_change, volatile int *cancel, view_gi_times *t, diag *d)
+/* One gi_vlinks frame on (sc, a); on success *shot is its solution. */
+static pt_status links_frame(links_ctx *c, const scene *sc, const accel *a, int objects_may_change, volatile int *cancel,
+                             view_gi_times *t, gi_vlinks_stats *out, gi_vlinks_shot **shot, diag *d)
 {
     double t0 = timer_now();
     gi_vlinks_set_cancel(c->v, cancel);
     gi_vlinks_stats st;
-    pt_status s = gi_vlinks_frame(c->v, c->sc, c->a, objects_may_change, &st, d);
+    pt_status s = gi_vlinks_frame(c->v, sc, a, objects_may_change, &st, d);
     gi_vlinks_set_cancel(c->v, NULL);
-    if (s == PT_OK) c->st = st;
+    if (s == PT_OK) {
+        gi_vlinks_shot *n = gi_vlinks_shot_new(c->v);
+        if (!n) return PT_ERR_NOMEM;
+        gi_vlinks_shot_free(*shot);
+        *shot = n;
+        *out = st;
+    }
     t->build = st.t_links;
     t->light = timer_now() - t0 - st.t_links;
+    return s;
+}
+
+static pt_status links_run(links_ctx *c, int objects_may_change, volatile int *cancel, view_gi_times *t, diag *d)
+{
+    pt_status s = links_frame(c, c->sc, c->a, objects_may_change, cancel, t, &c->st, &c->shot, d);
     return s == PT_CANCELLED ? PT_OK : s;
 }
 
@@ -279,14 +309,37 @@ static pt_status links_relight(void *ctx, volatile int *cancel, view_gi_times *t
     return links_run(ctx, 0, cancel, t, d);
 }
 
+static pt_status links_reframe(void *ctx, const scene *sc, const accel *a, volatile int *cancel, view_gi_times *t, diag *d)
+{
+    links_ctx *c = ctx;
+    gi_vlinks_shot_free(c->next_shot);
+    c->next_shot = NULL;
+    pt_status s = links_frame(c, sc, a, 1, cancel, t, &c->next_st, &c->next_shot, d);
+    if (s == PT_OK) c->next_a = a;
+    return s;
+}
+
+static void links_adopt(void *ctx)
+{
+    links_ctx *c = ctx;
+    if (!c->next_shot) return;
+    gi_vlinks_shot_free(c->shot);
+    c->shot = c->next_shot;
+    c->next_shot = NULL;
+    c->a = c->next_a;
+    c->st = c->next_st;
+}
+
 static pt_status links_render(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
 {
     links_ctx *c = ctx;
     shade_settings ss;
     whitted_settings(&ss, p);
     ss.use_ambient = radrules_of(c->sc, 1).ambient; /* as render_gi.c */
-    ss.indirect = gi_vlinks_indirect;
-    ss.indirect_ctx = c->v;
+    if (c->shot) {
+        ss.indirect = gi_vlinks_shot_indirect;
+        ss.indirect_ctx = c->shot;
+    }
     double t0 = timer_now();
     pt_status st = shade_render(c->sc, c->a, &ss, fb, NULL, d);
     t->render = timer_now() - t0;
@@ -297,14 +350,17 @@ static void links_describe(void *ctx, char *buf, int n)
 {
     links_ctx *c = ctx;
     const gi_vlinks_stats *s = &c->st;
-    snprintf(buf, (size_t)n, "%ld vertices, %ld links (%ld raw), light %.0f ms, sweeps %.0f ms", s->vertices,
-             s->merged_links, s->raw_links, s->t_light * 1e3, s->t_bounces * 1e3);
+    snprintf(buf, (size_t)n, "%ld vertices, %ld links (%ld raw), %ld of %ld linked, light %.0f ms, sweeps %.0f ms",
+             s->vertices, s->merged_links, s->raw_links, s->elements_linked, s->elements, s->t_light * 1e3,
+             s->t_bounces * 1e3);
 }
 
 static void links_close(void *ctx)
 {
     links_ctx *c = ctx;
     if (!c) return;
+    gi_vlinks_shot_free(c->shot);
+    gi_vlinks_shot_free(c->next_shot);
     gi_vlinks_free(c->v);
     free(c);
 }
@@ -442,7 +498,8 @@ static const gi_backend backends[] = {
     {GI_NONE, 0, whitted_last_level, none_open, none_relight, NULL, NULL, none_render, none_describe, none_close},
     {GI_PARTICLE, 1, whitted_last_level, particle_open, particle_relight, particle_has_preview, particle_relight_preview,
      particle_render, particle_describe, particle_close},
-    {GI_LINKS, 0, whitted_last_level, links_open, links_relight, NULL, NULL, links_render, links_describe, links_close},
+    {GI_LINKS, 0, whitted_last_level, links_open, links_relight, NULL, NULL, links_render, links_describe, links_close,
+     links_reframe, links_adopt},
     {GI_PATH, 0, ref_last_level, path_open, ref_relight, NULL, NULL, ref_render, ref_describe, ref_close},
     {GI_PMFG, 0, ref_last_level, pmfg_open, ref_relight, NULL, NULL, ref_render, ref_describe, ref_close},
 };
@@ -561,10 +618,45 @@ void view_gi_describe(const view_gi *g, char *buf, int n)
     g->b->describe(g->ctx, buf, n);
 }
 
+int view_gi_can_reframe(const view_gi *g) { return g->b->reframe != NULL; }
+
+pt_status view_gi_reframe(view_gi *g, const scene *nsc, const accel *na, const scene_light *lights, volatile int *cancel,
+                          view_gi_times *t, diag *d)
+{
+    memset(t, 0, sizeof *t);
+    g->reframed = 0;
+    if (!g->b->reframe) return PT_ERR_UNSUPPORTED;
+    free(g->next_lights);
+    g->next_lights = malloc((size_t)(nsc->nlights > 0 ? nsc->nlights : 1) * sizeof *g->next_lights);
+    if (!g->next_lights) return PT_ERR_NOMEM;
+    if (nsc->nlights > 0) memcpy(g->next_lights, lights, (size_t)nsc->nlights * sizeof *g->next_lights);
+    g->next_sc = *nsc;
+    g->next_sc.lights = g->next_lights;
+    g->next_sc.cap_lights = nsc->nlights;
+    pt_status st = g->b->reframe(g->ctx, &g->next_sc, na, cancel, t, d);
+    g->reframed = st == PT_OK && !(cancel && *cancel);
+    return g->reframed ? PT_OK : (st == PT_OK ? PT_CANCELLED : st);
+}
+
+void view_gi_adopt(view_gi *g)
+{
+    if (!g->reframed) return;
+    scene_camera cam = g->sc.camera;
+    free(g->lights);
+    g->lights = g->next_lights;
+    g->next_lights = NULL;
+    g->sc = g->next_sc;
+    g->sc.lights = g->lights;
+    g->sc.camera = cam;
+    g->b->adopt(g->ctx);
+    g->reframed = 0;
+}
+
 void view_gi_close(view_gi *g)
 {
     if (!g) return;
     g->b->close(g->ctx);
     free(g->lights);
+    free(g->next_lights);
     free(g);
 }

@@ -102,6 +102,20 @@ pt_status view_gi_relight(view_gi *g, volatile int *cancel, view_gi_times *t, di
 /* One pass of the refinement into fb (p->width x p->height) with the
  * scene's current camera. */
 pt_status view_gi_render(view_gi *g, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d);
+/* A new scene (the same file at another clock: objects deformed or moved,
+ * the same lights) for a mode that can follow it (links: linked again only
+ * where it changed). view_gi_reframe computes the mode's solution for nsc
+ * and na with `lights` (nsc->nlights of them) on any thread while another
+ * keeps rendering passes with the old scene; PT_OK when it finished (not
+ * cancelled). view_gi_adopt, on the thread that renders, then makes the
+ * new scene, lights and solution the instance's (the camera stays); nsc's
+ * objects and na must outlive the instance or the next adopt. Modes
+ * without it (view_gi_can_reframe 0) are closed and opened again on the
+ * new scene. */
+int view_gi_can_reframe(const view_gi *g);
+pt_status view_gi_reframe(view_gi *g, const scene *nsc, const accel *na, const scene_light *lights, volatile int *cancel,
+                          view_gi_times *t, diag *d);
+void view_gi_adopt(view_gi *g);
 /* A line of mode-specific figures (particle counts, spp) for the title bar. */
 void view_gi_describe(const view_gi *g, char *buf, int n);
 void view_gi_close(view_gi *g);

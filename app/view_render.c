@@ -21,9 +21,14 @@
 #define RELIGHT_MAX_STALE 0.5
 
 struct view_render {
-    /* fixed after start */
+    /* the scene shown: changed only by the render thread, when no opener
+     * or clock thread runs */
     const scene *sc;           /* read only: every mode works on its own copy (view_gi.h) */
     const accel *a;
+    scene *own_sc;             /* sc and a when they came from scene_at (freed at the next clock and stop) */
+    accel *own_a;
+    double clock;              /* of sc */
+    /* fixed after start */
     view_render_opts o;
     int nlights;
     pthread_t thread;
@@ -56,6 +61,22 @@ struct view_render {
     view_gi *open_result;
     pt_status open_status;
     view_gi_times open_times;
+    /* the clock thread: the scene at a new clock and the solution of the
+     * mode that follows it, while the render thread goes on */
+    int geo_running, geo_done;
+    pthread_t geo;
+    double geo_clock;
+    int geo_mode;              /* the mode it reframes (-1: none) */
+    view_light *geo_edits;     /* the viewer's light edits when it started */
+    scene *geo_sc;             /* its result (NULL on failure) */
+    accel *geo_a;
+    pt_status geo_status;
+    double geo_t0, geo_secs;
+    volatile int geo_cancel;
+    int geo_failed;            /* failed_clock failed: not tried again until another clock is asked */
+    double failed_clock;
+    long clock_updates;
+    double clock_update;
 
     volatile int cancel;       /* written by both threads, read by the workers */
     int relighting;            /* the render thread runs a lighting stage (guarded by mu) */
@@ -296,6 +317,128 @@ static pt_status relight_step(view_render *vr, view_gi *g, int preview, view_gi_
     return st;
 }
 
+/* ------------------------------------------------------------ the clock */
+
+static void *geo_main(void *arg)
+{
+    view_render *vr = arg;
+    diag *d = diag_new();
+    scene *ns = NULL;
+    accel *na = NULL;
+    pt_status st = vr->o.scene_at(vr->o.scene_ctx, vr->geo_clock, &ns, &na, d);
+    if (st == PT_OK && ns->nlights != vr->nlights) {
+        diag_error(d, "view: at clock %g the scene has %d light%s, not %d: the viewer keeps clock %g", vr->geo_clock,
+                   ns->nlights, ns->nlights == 1 ? "" : "s", vr->nlights, vr->clock);
+        st = PT_ERR_UNSUPPORTED;
+    }
+    if (st == PT_OK && vr->geo_mode >= 0) {
+        /* the new scene's lights with the viewer's edits, as start_open */
+        scene_light *ls = malloc((size_t)(vr->nlights > 0 ? vr->nlights : 1) * sizeof *ls);
+        if (!ls) st = PT_ERR_NOMEM;
+        for (int i = 0; ls && i < vr->nlights; i++) {
+            ls[i] = ns->lights[i];
+            ls[i].position = vr->geo_edits[i].position;
+            ls[i].point_at = vr->geo_edits[i].point_at;
+            ls[i].colour = vr->geo_edits[i].colour;
+        }
+        view_gi_times t;
+        if (ls) st = view_gi_reframe(vr->opened[vr->geo_mode], ns, na, ls, &vr->geo_cancel, &t, d);
+        free(ls);
+    }
+    if (st != PT_OK) {
+        accel_free(na);
+        scene_free(ns);
+        ns = NULL;
+        na = NULL;
+    }
+    pthread_mutex_lock(&vr->mu);
+    copy_messages(vr->msgs, d);
+    vr->geo_sc = ns;
+    vr->geo_a = na;
+    vr->geo_status = st;
+    vr->geo_secs = timer_now() - vr->geo_t0;
+    vr->geo_done = 1;
+    pthread_cond_signal(&vr->cv);
+    pthread_mutex_unlock(&vr->mu);
+    diag_free(d);
+    return NULL;
+}
+
+/* Called with mu held: the posted clock differs from the scene's and can
+ * be prepared now. */
+static int clock_wanted(const view_render *vr, double clock)
+{
+    return vr->o.scene_at && clock != vr->clock && !(vr->geo_failed && clock == vr->failed_clock);
+}
+
+/* Called with mu held: start preparing the scene at cur->clock. */
+static void start_geo(view_render *vr, const view_state *cur)
+{
+    vr->geo_mode = -1;
+    /* the mode on screen follows the clock when it can, else another open
+     * one that can (the rest are closed when the new scene takes over) */
+    if (vr->opened[vr->shown_mode] && view_gi_can_reframe(vr->opened[vr->shown_mode])) vr->geo_mode = vr->shown_mode;
+    for (int m = 0; m < GI_MODES && vr->geo_mode < 0; m++)
+        if (vr->opened[m] && view_gi_can_reframe(vr->opened[m])) vr->geo_mode = m;
+    memcpy(vr->geo_edits, cur->lights, (size_t)vr->nlights * sizeof *vr->geo_edits);
+    vr->geo_clock = cur->clock;
+    vr->geo_cancel = 0;
+    vr->geo_done = 0;
+    vr->geo_t0 = timer_now();
+    vr->geo_running = pthread_create(&vr->geo, NULL, geo_main, vr) == 0;
+    if (!vr->geo_running) {
+        vr->geo_failed = 1;
+        vr->failed_clock = cur->clock;
+        diag_report(vr->msgs, DIAG_WARNING, (src_loc){0}, NULL, "view: cannot start the clock thread; keeping clock %g",
+                    vr->clock);
+    }
+}
+
+/* Called with mu held: take over a finished clock (joined: the thread is
+ * joined already). Returns 1 when one finished. */
+static int collect_geo(view_render *vr, int joined)
+{
+    if (!vr->geo_done) return 0;
+    if (!joined) pthread_join(vr->geo, NULL);
+    vr->geo_running = vr->geo_done = 0;
+    if (vr->geo_status == PT_OK && vr->geo_sc && vr->geo_a) {
+        for (int m = 0; m < GI_MODES; m++) {
+            if (!vr->opened[m]) continue;
+            if (m == vr->geo_mode) {
+                view_gi_adopt(vr->opened[m]);
+            } else {
+                view_gi_close(vr->opened[m]);
+                vr->opened[m] = NULL;
+            }
+        }
+        /* nothing refers to the old scene now: no mode is open on it, and
+         * neither an opener nor the clock thread runs */
+        accel_free(vr->own_a);
+        scene_free(vr->own_sc);
+        vr->own_sc = vr->geo_sc;
+        vr->own_a = vr->geo_a;
+        vr->sc = vr->geo_sc;
+        vr->a = vr->geo_a;
+        vr->clock = vr->geo_clock;
+        vr->clock_updates++;
+        vr->clock_update = vr->geo_secs;
+        vr->geo_failed = 0;
+        if (!vr->opened[vr->shown_mode]) vr->shown_mode = GI_NONE;
+    } else {
+        accel_free(vr->geo_a);
+        scene_free(vr->geo_sc);
+        if (vr->geo_status != PT_CANCELLED) {
+            vr->geo_failed = 1;
+            vr->failed_clock = vr->geo_clock;
+            diag_report(vr->msgs, DIAG_WARNING, (src_loc){0}, NULL, "view: the scene at clock %g failed (%s); showing clock %g",
+                        vr->geo_clock, pt_status_name(vr->geo_status), vr->clock);
+        }
+    }
+    vr->geo_sc = NULL;
+    vr->geo_a = NULL;
+    return 1;
+}
+
 #define QUIET 0.12 /* seconds without a submit before refinement passes start */
 
 static void *render_main(void *arg)
@@ -314,13 +457,15 @@ static void *render_main(void *arg)
 
     pthread_mutex_lock(&vr->mu);
     for (;;) {
-        while (!vr->stop && vr->posted_gen == work_gen && level > last_level && !vr->open_done) {
+        while (!vr->stop && vr->posted_gen == work_gen && level > last_level && !vr->open_done && !vr->geo_done) {
             vr->busy_level = -1;
             pthread_cond_wait(&vr->cv, &vr->mu);
         }
         if (vr->stop) break;
         /* a finished open (or failure) restarts the refinement */
         if (collect_open(vr, &opened_times, 0) >= 0) level = 0;
+        /* a finished clock: the new scene's passes from the preview on */
+        if (collect_geo(vr, 0)) level = 0;
         if (vr->posted_gen != work_gen) {
             work_gen = vr->posted_gen;
             cur = vr->posted;
@@ -341,6 +486,7 @@ static void *render_main(void *arg)
             level = 0;
             first_latency = full_latency = relit_latency = relit_full_latency = 0;
         }
+        if (clock_wanted(vr, cur.clock) && !vr->geo_running && vr->opening < 0) start_geo(vr, &cur);
         if (level > last_level) continue; /* an open finished for a mode not wanted now */
         /* refinement waits until the input has been quiet a moment */
         if (level >= 1) {
@@ -359,10 +505,14 @@ static void *render_main(void *arg)
         /* the mode: the wanted one when it is open, else open it in the
          * background and go on with the one on screen */
         int want = wanted_mode(vr, cur.gi_mode);
-        if (!vr->opened[want] && vr->opening < 0 && want != GI_NONE) start_open(vr, want, &cur);
+        if (!vr->opened[want] && vr->opening < 0 && !vr->geo_running && want != GI_NONE) start_open(vr, want, &cur);
         want = wanted_mode(vr, cur.gi_mode); /* start_open may have failed */
         int use = vr->opened[want] ? want : vr->shown_mode;
         int waiting_for_mode = use != want;
+        /* the mode the clock thread reframes is not relit meanwhile (it
+         * works on the same instance); its passes read the old solution */
+        int reframing = vr->geo_running ? vr->geo_mode : -1;
+        int clock_pending = clock_wanted(vr, cur.clock);
         vr->cancel = 0;
         vr->relighting = 0;
         vr->busy_level = level;
@@ -392,7 +542,7 @@ static void *render_main(void *arg)
                 view_gi_lights_changed(g);
                 quick_pending = view_gi_slow_light(g);
             }
-            if (view_gi_stale(g)) {
+            if (view_gi_stale(g) && use != reframing) {
                 if (quick_pending && level == 0) {
                     /* at once: the preview lighting relit (fast), or else
                      * the new lights' direct term over the old indirect
@@ -483,6 +633,11 @@ static void *render_main(void *arg)
         in->cause = cause;
         in->complete = level >= last_level && !waiting_for_mode && !stale && !coarse;
         memcpy(in->describe, desc, sizeof desc);
+        in->clock = vr->clock;
+        in->clock_busy = vr->geo_running;
+        in->clock_updates = vr->clock_updates;
+        in->clock_update = vr->clock_update;
+        if (clock_pending) in->complete = 0;
         if (in->complete) vr->idle_gen = work_gen;
         published = 1;
         if (!quick) level++; /* after a stale preview: the relit preview */
@@ -496,6 +651,15 @@ static void *render_main(void *arg)
         vr->open_done = 1;
         view_gi_times t;
         collect_open(vr, &t, 1);
+    }
+    if (vr->geo_running) {
+        /* the clock thread stops at its next chunk of link rays */
+        vr->geo_cancel = 1;
+        pthread_mutex_unlock(&vr->mu);
+        pthread_join(vr->geo, NULL);
+        pthread_mutex_lock(&vr->mu);
+        vr->geo_done = 1;
+        collect_geo(vr, 1);
     }
     pthread_mutex_unlock(&vr->mu);
     free(cur_lights);
@@ -516,6 +680,7 @@ pt_status view_render_start(view_render **out, const scene *sc, const accel *a, 
     vr->sc = sc;
     vr->a = a;
     vr->o = *o;
+    vr->clock = o->clock;
     vr->nlights = sc->nlights;
     vr->preview_div = o->preview_div > 0 ? o->preview_div : 4;
     vr->idle_gen = -1;
@@ -525,12 +690,13 @@ pt_status view_render_start(view_render **out, const scene *sc, const accel *a, 
     size_t nl = (size_t)(vr->nlights > 0 ? vr->nlights : 1);
     size_t npx = (size_t)o->width * (size_t)o->height;
     vr->posted_lights = calloc(nl, sizeof *vr->posted_lights);
+    vr->geo_edits = calloc(nl, sizeof *vr->geo_edits);
     vr->front = fb_new(o->width, o->height);
     vr->back = fb_new(o->width, o->height);
     vr->front8 = calloc(npx, 4);
     vr->back8 = calloc(npx, 4);
     vr->msgs = diag_new();
-    if (!vr->posted_lights || !vr->front || !vr->back || !vr->front8 || !vr->back8 || !vr->msgs) {
+    if (!vr->posted_lights || !vr->geo_edits || !vr->front || !vr->back || !vr->front8 || !vr->back8 || !vr->msgs) {
         view_render_stop(vr);
         return PT_ERR_NOMEM;
     }
@@ -552,6 +718,7 @@ pt_status view_render_start(view_render **out, const scene *sc, const accel *a, 
         free(vr->front8);
         free(vr->back8);
         free(vr->posted_lights);
+        free(vr->geo_edits);
         diag_free(vr->msgs);
         free(vr);
         return PT_ERR_INTERNAL;
@@ -658,6 +825,9 @@ void view_render_stop(view_render *vr)
         pthread_cond_destroy(&vr->cv);
     }
     for (int i = 0; i < GI_MODES; i++) view_gi_close(vr->opened[i]);
+    accel_free(vr->own_a);
+    scene_free(vr->own_sc);
+    free(vr->geo_edits);
     fb_free(vr->front);
     fb_free(vr->back);
     free(vr->front8);

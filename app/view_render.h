@@ -23,7 +23,15 @@
  * thread of its own (its geometry and lighting stages) while the render
  * thread goes on refining with the mode on screen (at the start: `none`);
  * the new mode takes over when it is ready. Opened modes stay open, so
- * switching back is immediate. Refinement passes start only after the input
+ * switching back is immediate. A new clock (view_state.clock, with
+ * view_render_opts.scene_at) is prepared on a thread of its own too: the
+ * scene evaluated at that clock, its acceleration structure, and for a
+ * mode that can follow it (view_gi_reframe: links, linked again only where
+ * the scene deformed) its new solution, while the render thread goes on
+ * with the old scene and solution; then the new scene takes over, and the
+ * other open modes are closed (opened again on the new scene when wanted).
+ * No mode is opened while a clock is prepared, and no clock is prepared
+ * while a mode is opened. Refinement passes start only after the input
  * has been quiet for 0.12 s (a pass that cannot be cancelled, such as the
  * particle GI's per-view stage, does not delay the next preview). */
 #ifndef PT_VIEW_RENDER_H
@@ -47,9 +55,10 @@ typedef struct {
     scene_camera camera;
     int gi_mode;
     const view_light *lights; /* the scene's light count of them (copied) */
+    double clock;             /* the scene's clock (used only with view_render_opts.scene_at) */
 } view_state;
 
-enum { VIEW_CAUSE_CAMERA = 1, VIEW_CAUSE_LIGHT = 2, VIEW_CAUSE_MODE = 4 };
+enum { VIEW_CAUSE_CAMERA = 1, VIEW_CAUSE_LIGHT = 2, VIEW_CAUSE_MODE = 4, VIEW_CAUSE_CLOCK = 8 };
 
 typedef struct {
     int width, height;      /* full image size */
@@ -61,6 +70,12 @@ typedef struct {
     int bounces;            /* particle GI: n_b (0: from the scene) */
     const char *cl_device;  /* particle GI: OpenCL device (NULL: auto) */
     long preview_particles; /* particle GI: preview instance's count (0: 1/8, < 0: none) */
+    /* The scene at another clock (NULL: the clock is fixed): the same file
+     * evaluated again, called on a thread of its own; *sc and *a become the
+     * render thread's (it frees them). */
+    pt_status (*scene_at)(void *ctx, double clock, scene **sc, accel **a, diag *d);
+    void *scene_ctx;
+    double clock;           /* the clock of the scene view_render_start gets */
 } view_render_opts;
 
 typedef struct {
@@ -85,6 +100,10 @@ typedef struct {
     int cause;              /* VIEW_CAUSE_* of the submits in its generation */
     int complete;           /* last level reached: the refinement is done */
     char describe[96];      /* view_gi_describe */
+    double clock;           /* the clock of the scene it shows */
+    int clock_busy;         /* made while the scene at a newer clock was being prepared */
+    long clock_updates;     /* scenes at a new clock taken over so far */
+    double clock_update;    /* seconds the last one took (parse, accel, the GI's reframe) */
 } view_frame_info;
 
 /* Starts the thread on the scene (read only; every mode works on its own

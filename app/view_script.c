@@ -124,6 +124,11 @@ static int parse_command(ctx *c, view_script *vs, word *w, int n, int eol_col, v
         for (int i = 0; i < 2; i++)
             if (!word_num(&w[2 + i], &a->v[i]) || fabs(a->v[i]) > 1e5) { err_at(c, w[2 + i].col, "expected a number of pixels%s", ""); return 0; }
         return 1;
+    } else if (word_is(&w[0], "clock")) {
+        a->kind = VIEW_ACT_CLOCK;
+        if (n != 2) { err_at(c, n > 2 ? w[2].col : eol_col, "clock takes one number%s", ""); return 0; }
+        if (!word_num(&w[1], &a->v[0]) || !(fabs(a->v[0]) <= 1e9)) { err_at(c, w[1].col, "expected the clock value%s", ""); return 0; }
+        return 1;
     } else if (word_is(&w[0], "wheel")) {
         a->kind = VIEW_ACT_WHEEL;
         if (n != 2) { err_at(c, n > 2 ? w[2].col : eol_col, "wheel takes one number of clicks%s", ""); return 0; }

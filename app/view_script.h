@@ -34,6 +34,11 @@
  *   camera write [PATH]        print the camera{} block and write it to
  *                              PATH (default: the next free SCENE-camera-NNNN.inc)
  *   gi MODE                    switch to none | particle | path | pmfg | next
+ *   clock V                    evaluate the scene again at clock V (as the
+ *                              [ and ] keys step it): the scene is parsed
+ *                              and, in --gi links, linked again where it
+ *                              deformed, off the UI and render threads;
+ *                              the image shows the old clock until then
  *   key NAME [HOLD]            press the key NAME (SDL key names: w, Left,
  *                              Page Up, F12, Tab, 1, ...; a name with a space
  *                              is written with '_': Page_Up) and release it
@@ -82,7 +87,8 @@ typedef enum {
     VIEW_ACT_KEY,          /* text: key name ('_' for spaces), v[0]: hold seconds */
     VIEW_ACT_DRAG,         /* mode: 1 left, 3 right button; v[0], v[1]: pixels */
     VIEW_ACT_WHEEL,        /* v[0]: clicks */
-    VIEW_ACT_WINDOW_SHOT   /* text: path (PNG) */
+    VIEW_ACT_WINDOW_SHOT,  /* text: path (PNG) */
+    VIEW_ACT_CLOCK         /* v[0]: the clock (mode 0) or a step added to it (mode 1) */
 } view_action_kind;
 
 typedef struct {

@@ -116,6 +116,16 @@ field still.json "'links raw %d, merged %d: ratio %.2f (paper Table 1: 3-5x)' % 
 field still.json "'link rays %d in %.3f s: %.2f M rays/s, %.1f us per vertex (both sides)' % (j['links']['link_rays'], j['links']['timings']['links'], j['links']['link_rays'] / max(1e-9, j['links']['timings']['links']) * 1e-6, j['links']['timings']['links'] / max(1, j['links']['vertices']) * 1e6)"
 field still.json "'link rays ending on objects that are not meshes (one bounce of light from them): %d of %d (%.1f%%), %d such objects' % (j['links']['hits_other'], j['links']['link_rays'], 100.0 * j['links']['hits_other'] / max(1, j['links']['link_rays']), j['links']['other_objects'])"
 field still.json "'first full solution %.3f s (links %.3f, light %.3f, %d sweeps %.3f, smoothing %.3f)' % (sum(j['links']['timings'].values()), j['links']['timings']['links'], j['links']['timings']['light'], j['links']['sweeps'], j['links']['timings']['bounces'], j['links']['timings']['smooth'])"
+field still.json "'per element: %.0f raw links, %.0f merged (paper Table 1: TEAROOM 563 and 168 per vertex, TORSO 479 and 113)' % (j['links']['raw_links'] / max(1, j['links']['elements']), j['links']['merged_links'] / max(1, j['links']['elements']))"
+# merging against the room's tessellation (NR cells a wall side; the
+# spline mesh stays 51 x 51): fewer, larger triangles take more of a
+# vertex's rays each, so more of its raw links share a peer
+for nr in 2 4 8 16; do
+    sed "s/^#declare NR = 16;/#declare NR = $nr;/" mesh_room.pov > mesh_room_nr.pov
+    "$P" render mesh_room_nr.pov +L"$TPL" --gi links --size 16x12 -o nr.pfm --stats nr.json 2>/dev/null
+    field nr.json "'  walls of $nr x $nr cells: %d vertices, links raw %d, merged %d: ratio %.2f, %.0f merged per element' % (j['links']['vertices'], j['links']['raw_links'], j['links']['merged_links'], j['links']['raw_links'] / max(1, j['links']['merged_links']), j['links']['merged_links'] / max(1, j['links']['elements']))"
+done
+rm -f mesh_room_nr.pov nr.pfm nr.json
 "$P" render scenes/cbox.pov --gi links --size "$SIZE" -o cbox_still.pfm --stats cbox_still.json 2>/dev/null
 field cbox_still.json "'scenes/cbox.pov: %d vertices, links raw %d, merged %d: ratio %.2f; %.2f M link rays/s' % (j['links']['vertices'], j['links']['raw_links'], j['links']['merged_links'], j['links']['raw_links'] / max(1, j['links']['merged_links']), j['links']['link_rays'] / max(1e-9, j['links']['timings']['links']) * 1e-6)"
 "$P" render mesh_room.pov +L"$TPL" --gi links --size "$SIZE" +KFI1 +KFF"$LINK_FRAMES" +KC -o la.pfm 2>la.log
@@ -146,9 +156,14 @@ for fr in 1 "$LINK_FRAMES"; do
     done
     rm -f q_*.pfm
 done
-# the reference's own direct light against the Whitted pass's (POV-Ray's)
-"$P" render mesh_room.pov +L"$TPL" --gi path --spp "$PATH_SPP" --max-depth 2 --size "$QSIZE" -o d_path.pfm -q 2>/dev/null
-"$P" render mesh_room.pov +L"$TPL" --gi none --size "$QSIZE" -o d_none.pfm -q 2>/dev/null
+# the reference's own direct light against the Whitted pass's (POV-Ray's):
+# --max-depth 1 is the camera's hit alone (2 would add one bounce of
+# indirect light); the template's textures keep POV-Ray's default ambient
+# 0.1, which --gi none adds and every GI mode drops (radiosity on,
+# core/radrules.h rule 1), so both render a copy with ambient 0
+sed 's|^#include "40_mesh_by_4_splines.txt"|#default { finish { ambient 0 } }\n&|' mesh_room.pov > mesh_room_a0.pov
+"$P" render mesh_room_a0.pov +L"$TPL" --gi path --spp "$PATH_SPP" --max-depth 1 --size "$QSIZE" -o d_path.pfm -q 2>/dev/null
+"$P" render mesh_room_a0.pov +L"$TPL" --gi none --size "$QSIZE" -o d_none.pfm -q 2>/dev/null
 "$P" compare d_path.pfm d_none.pfm --hdr --json > d.json 2>/dev/null
 W=${QSIZE%x*}; H=${QSIZE#*x}
 if command -v povray >/dev/null 2>&1; then
@@ -168,7 +183,8 @@ if command -v povray >/dev/null 2>&1; then
         done
     fi
 fi
-field d.json "'direct light only: --gi none (the lighting of POV-Ray) against --gi path --max-depth 2: mean luminance %+.2f%%' % (100 * j['luminance']['relative'])"
+field d.json "'direct light only (ambient 0): --gi none (the lighting of POV-Ray) against --gi path --max-depth 1: mean luminance %+.2f%%, HDR-FLIP %.4f' % (100 * j['luminance']['relative'], j['flip']['mean'])"
+rm -f mesh_room_a0.pov
 fi
 
 detp_scene() {

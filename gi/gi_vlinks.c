@@ -1043,32 +1043,103 @@ done:
     return status;
 }
 
+/* What the hook reads of a solution: the instance's own arrays, or a
+ * shot's copies of them. */
+typedef struct {
+    const scene_leaves *lv;
+    const int *leaf_mesh;
+    const vmesh *mesh;
+    const vec3 *pos;
+    const float *ism;
+    atomic_long *lookups_other;
+} vlook;
+
+static rgb vlook_indirect(const vlook *L, const accel_hit *hit, vec3 n)
+{
+    rgb z = {0.0, 0.0, 0.0};
+    int leaf = scene_leaves_find(L->lv, hit->obj);
+    int mi = leaf >= 0 ? L->leaf_mesh[leaf] : -1;
+    if (mi < 0) {
+        atomic_fetch_add_explicit(L->lookups_other, 1, memory_order_relaxed);
+        return z;
+    }
+    const vmesh *m = &L->mesh[mi];
+    const scene_mesh *sm = hit->obj->u.mesh.mesh;
+    if (hit->prim >= (unsigned)m->ntris) return z;
+    const int *tr = sm->tris[hit->prim];
+    if (tr[0] < 0 || tr[1] < 0 || tr[2] < 0 || tr[0] >= m->nverts || tr[1] >= m->nverts || tr[2] >= m->nverts) return z;
+    long g[3] = {m->vbase + tr[0], m->vbase + tr[1], m->vbase + tr[2]};
+    vec3 f = v3_cross(v3_sub(L->pos[g[1]], L->pos[g[0]]), v3_sub(L->pos[g[2]], L->pos[g[0]]));
+    int side = v3_dot(n, f) >= 0.0 ? 0 : 1;
+    double bw[3] = {1.0 - hit->u - hit->v, hit->u, hit->v};
+    double s[3] = {0.0, 0.0, 0.0};
+    for (int c = 0; c < 3; c++) {
+        const float *e = &L->ism[(size_t)(2 * g[c] + side) * 4];
+        for (int k = 0; k < 3; k++) s[k] += bw[c] * e[k];
+    }
+    rgb r = {s[0], s[1], s[2]};
+    return r;
+}
+
 rgb gi_vlinks_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
 {
     (void)thread;
     gi_vlinks *v = ctx;
     rgb z = {0.0, 0.0, 0.0};
     if (!v->have || !v->lv) return z;
-    int leaf = scene_leaves_find(v->lv, hit->obj);
-    int mi = leaf >= 0 ? v->leaf_mesh[leaf] : -1;
-    if (mi < 0) {
-        atomic_fetch_add_explicit(&v->lookups_other, 1, memory_order_relaxed);
-        return z;
+    vlook L = {v->lv, v->leaf_mesh, v->mesh, v->pos, v->ism, &v->lookups_other};
+    return vlook_indirect(&L, hit, n);
+}
+
+/* ---------------------------------------------------------------- shots */
+
+struct gi_vlinks_shot {
+    scene_leaves *lv;  /* of the frame's scene: hits are on its objects */
+    int *leaf_mesh;
+    vmesh *mesh;
+    vec3 *pos;
+    float *ism;
+    atomic_long lookups_other;
+};
+
+void gi_vlinks_shot_free(gi_vlinks_shot *s)
+{
+    if (!s) return;
+    scene_leaves_free(s->lv);
+    free(s->leaf_mesh);
+    free(s->mesh);
+    free(s->pos);
+    free(s->ism);
+    free(s);
+}
+
+gi_vlinks_shot *gi_vlinks_shot_new(const gi_vlinks *v)
+{
+    if (!v->have || !v->lv || !v->sc) return NULL;
+    gi_vlinks_shot *s = calloc(1, sizeof *s);
+    if (!s) return NULL;
+    s->lv = scene_leaves_new(v->sc);
+    int nl = s->lv ? scene_leaves_count(s->lv) : 0;
+    s->leaf_mesh = malloc(sizeof *s->leaf_mesh * (size_t)(nl > 0 ? nl : 1));
+    s->mesh = malloc(sizeof *s->mesh * (size_t)(v->nmesh > 0 ? v->nmesh : 1));
+    s->pos = malloc(sizeof *s->pos * (size_t)(v->nv > 0 ? v->nv : 1));
+    s->ism = malloc(sizeof(float) * 4 * (size_t)(v->ne > 0 ? v->ne : 1));
+    /* the leaves are numbered as the frame's (same scene, same walk) */
+    if (!s->lv || nl != v->nleaves || !s->leaf_mesh || !s->mesh || !s->pos || !s->ism) {
+        gi_vlinks_shot_free(s);
+        return NULL;
     }
-    const vmesh *m = &v->mesh[mi];
-    const scene_mesh *sm = hit->obj->u.mesh.mesh;
-    if (hit->prim >= (unsigned)m->ntris) return z;
-    const int *tr = sm->tris[hit->prim];
-    if (tr[0] < 0 || tr[1] < 0 || tr[2] < 0 || tr[0] >= m->nverts || tr[1] >= m->nverts || tr[2] >= m->nverts) return z;
-    long g[3] = {m->vbase + tr[0], m->vbase + tr[1], m->vbase + tr[2]};
-    vec3 f = v3_cross(v3_sub(v->pos[g[1]], v->pos[g[0]]), v3_sub(v->pos[g[2]], v->pos[g[0]]));
-    int side = v3_dot(n, f) >= 0.0 ? 0 : 1;
-    double bw[3] = {1.0 - hit->u - hit->v, hit->u, hit->v};
-    double s[3] = {0.0, 0.0, 0.0};
-    for (int c = 0; c < 3; c++) {
-        const float *e = &v->ism[(size_t)(2 * g[c] + side) * 4];
-        for (int k = 0; k < 3; k++) s[k] += bw[c] * e[k];
-    }
-    rgb r = {s[0], s[1], s[2]};
-    return r;
+    memcpy(s->leaf_mesh, v->leaf_mesh, sizeof *s->leaf_mesh * (size_t)nl);
+    memcpy(s->mesh, v->mesh, sizeof *s->mesh * (size_t)v->nmesh);
+    memcpy(s->pos, v->pos, sizeof *s->pos * (size_t)v->nv);
+    memcpy(s->ism, v->ism, sizeof(float) * 4 * (size_t)v->ne);
+    return s;
+}
+
+rgb gi_vlinks_shot_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
+{
+    (void)thread;
+    gi_vlinks_shot *s = ctx;
+    vlook L = {s->lv, s->leaf_mesh, s->mesh, s->pos, s->ism, &s->lookups_other};
+    return vlook_indirect(&L, hit, n);
 }

@@ -87,6 +87,17 @@ pt_status gi_vlinks_frame(gi_vlinks *v, const scene *sc, const accel *a, int obj
                           diag *d);
 /* shade_indirect_fn: the indirect E/pi at a hit on a mesh (0 elsewhere). */
 rgb gi_vlinks_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread);
+/* A finished solution kept apart from the instance: the hook on a shot
+ * reads only the shot, so passes can render with it on one thread while
+ * gi_vlinks_frame computes the next frame on another (the paper's
+ * asynchronous updates: the view shows the newest finished solution). The
+ * scene of the frame it was taken after must outlive it. NULL: no
+ * solution yet, or no memory. */
+typedef struct gi_vlinks_shot gi_vlinks_shot;
+gi_vlinks_shot *gi_vlinks_shot_new(const gi_vlinks *v);
+/* shade_indirect_fn on a shot (ctx: the shot), as gi_vlinks_indirect. */
+rgb gi_vlinks_shot_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread);
+void gi_vlinks_shot_free(gi_vlinks_shot *s);
 /* Element i's indirect E/pi after smoothing (tests); n: the count. */
 rgb gi_vlinks_element(const gi_vlinks *v, long i, vec3 *p, vec3 *nrm);
 long gi_vlinks_count(const gi_vlinks *v);

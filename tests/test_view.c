@@ -36,10 +36,13 @@
 #include <unistd.h>
 #include "accel.h"
 #include "gi.h"
+#include "gi_vlinks.h"
 #include "img_io.h"
+#include "radrules.h"
 #include "scene.h"
 #include "sdl.h"
 #include "shade.h"
+#include "shade_texture.h"
 #include "timer.h"
 #include "view_camera.h"
 #include "view_gi.h"
@@ -867,6 +870,215 @@ static void test_render_thread(void **st)
     diag_free(d);
 }
 
+/* ------------------------------------------------- the clock, no display */
+
+/* A room of mesh2 walls split by a mesh2 divider, and a mesh2 sheet on the
+ * floor of the left half whose middle rises with the clock (its vertices
+ * computed from `clock`): --gi links follows it. */
+static const char *sheet_room_pov =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 radiosity { recursion_limit 2 } }\n"
+    "camera { location <0.3, 1.6, -1.9> look_at <-0.2, 0.5, 1.5> angle 75 }\n"
+    "light_source { <-0.8, 2.2, -0.8> color rgb 1 }\n"
+    "#macro Quad(A, B, C, D, N, T)\n"
+    "  mesh2 {\n"
+    "    vertex_vectors { (N + 1) * (N + 1), #for (J, 0, N) #for (I, 0, N) #local U = I / N; #local V = J / N;\n"
+    "      (1 - V) * ((1 - U) * A + U * B) + V * ((1 - U) * D + U * C), #end #end }\n"
+    "    face_indices { 2 * N * N, #for (J, 0, N - 1) #for (I, 0, N - 1) #local K = J * (N + 1) + I;\n"
+    "      <K, K + 1, K + N + 2>, <K, K + N + 2, K + N + 1>, #end #end }\n"
+    "    texture { T }\n"
+    "  }\n"
+    "#end\n"
+    "#declare Wall = texture { pigment { rgb 0.75 } finish { ambient 0 diffuse 0.8 } }\n"
+    "#declare Red = texture { pigment { rgb <0.8, 0.25, 0.2> } finish { ambient 0 diffuse 0.8 } }\n"
+    "Quad(<-2, 0, -2>, <2, 0, -2>, <2, 0, 2>, <-2, 0, 2>, 6, Wall)\n"
+    "Quad(<-2, 2.5, -2>, <-2, 2.5, 2>, <2, 2.5, 2>, <2, 2.5, -2>, 6, Wall)\n"
+    "Quad(<-2, 0, 2>, <2, 0, 2>, <2, 2.5, 2>, <-2, 2.5, 2>, 6, Wall)\n"
+    "Quad(<-2, 0, -2>, <-2, 0, 2>, <-2, 2.5, 2>, <-2, 2.5, -2>, 6, Red)\n"
+    "Quad(<2, 0, -2>, <2, 2.5, -2>, <2, 2.5, 2>, <2, 0, 2>, 6, Wall)\n"
+    "Quad(<-2, 0, -2>, <-2, 2.5, -2>, <2, 2.5, -2>, <2, 0, -2>, 6, Wall)\n"
+    "Quad(<0.4, 0, -0.2>, <0.4, 0, 2>, <0.4, 2.5, 2>, <0.4, 2.5, -0.2>, 6, Wall)\n"
+    "#declare NS = 10;\n"
+    "mesh2 {\n"
+    "  vertex_vectors { (NS + 1) * (NS + 1), #for (J, 0, NS) #for (I, 0, NS) #local U = I / NS; #local V = J / NS;\n"
+    "    <-1.8 + 1.6 * U, 0.05 + 0.9 * clock * sin(pi * U) * sin(pi * V), 0.2 + 1.6 * V>, #end #end }\n"
+    "  face_indices { 2 * NS * NS, #for (J, 0, NS - 1) #for (I, 0, NS - 1) #local K = J * (NS + 1) + I;\n"
+    "    <K, K + 1, K + NS + 2>, <K, K + NS + 2, K + NS + 1>, #end #end }\n"
+    "  texture { pigment { rgb <0.3, 0.5, 0.9> } finish { ambient 0 diffuse 0.8 } }\n"
+    "}\n";
+
+static scene *sheet_scene(double clock, diag *d)
+{
+    sdl_options so;
+    sdl_default_options(&so);
+    sdl_set_still_clock(&so, clock);
+    scene *sc = NULL;
+    pt_status st = sdl_parse_string("sheet_room.pov", sheet_room_pov, &so, &sc, d);
+    for (int i = 0; i < diag_count(d); i++) printf("%s\n", diag_get(d, i)->text);
+    assert_int_equal(st, PT_OK);
+    return sc;
+}
+
+/* view_render_opts.scene_at for the sheet room; counts its calls. */
+static int sheet_calls;
+static pt_status sheet_at(void *ctx, double clock, scene **sc, accel **a, diag *d)
+{
+    (void)ctx;
+    sheet_calls++;
+    sdl_options so;
+    sdl_default_options(&so);
+    sdl_set_still_clock(&so, clock);
+    *sc = NULL;
+    *a = NULL;
+    pt_status st = sdl_parse_string("sheet_room.pov", sheet_room_pov, &so, sc, d);
+    if (st != PT_OK) return st;
+    *a = accel_build(*sc, 2, d, &st);
+    if (!*a) {
+        scene_free(*sc);
+        *sc = NULL;
+        return st == PT_OK ? PT_ERR_INTERNAL : st;
+    }
+    return PT_OK;
+}
+
+/* The clock in --gi links, through the render thread as the viewer drives
+ * it: after `clock 0.6` the scene is evaluated again and linked where it
+ * deformed on the clock thread while camera moves keep producing images
+ * of the old clock; the newest finished solution then takes over. Its
+ * refined image equals a fresh --gi links render of the scene at clock
+ * 0.6 (a new gi_vlinks instance, the same pass settings) within 1e-5 of
+ * the largest value (the incremental links equal a fresh build bit for
+ * bit, tests/test_motion.c), and fewer elements than all were linked. */
+static void test_render_thread_clock(void **st)
+{
+    (void)st;
+    diag *d = diag_new();
+    scene *sc = sheet_scene(0.0, d);
+    pt_status ps = PT_OK;
+    accel *acc = accel_build(sc, 2, d, &ps);
+    assert_non_null(acc);
+    const int w = 64, h = 48;
+    const double clock1 = 0.6;
+
+    /* the reference: a fresh links solution at the new clock, the viewer's
+     * last pass (view_gi.c: whitted_settings at level 2, links_render) */
+    scene *sc1 = sheet_scene(clock1, d);
+    accel *acc1 = accel_build(sc1, 2, d, &ps);
+    assert_non_null(acc1);
+    gi_vlinks_settings vs;
+    gi_vlinks_default_settings(&vs);
+    vs.threads = 2;
+    vs.pigment = shade_tex_pigment_at;
+    gi_vlinks *gv = gi_vlinks_new(&vs);
+    gi_vlinks_stats gst;
+    assert_int_equal(gi_vlinks_frame(gv, sc1, acc1, 1, &gst, d), PT_OK);
+    shade_settings ss;
+    shade_default_settings(&ss);
+    ss.width = w;
+    ss.height = h;
+    ss.threads = 2;
+    ss.antialias = 1;
+    ss.aa_threshold = 0.3;
+    ss.aa_depth = 3;
+    ss.use_ambient = radrules_of(sc1, 1).ambient;
+    ss.indirect = gi_vlinks_indirect;
+    ss.indirect_ctx = gv;
+    framebuffer *ref = fb_new(w, h);
+    assert_int_equal(shade_render(sc1, acc1, &ss, ref, NULL, d), PT_OK);
+    printf("fresh --gi links at clock %.1f: %ld elements, %ld links\n", clock1, gst.elements, gst.merged_links);
+
+    view_light lights[1] = {{sc->lights[0].position, sc->lights[0].point_at, sc->lights[0].colour}};
+    view_state s0 = {sc->camera, GI_LINKS, lights, 0.0};
+    view_render_opts ro = {w, h, 2, 0, 0, 0};
+    ro.scene_at = sheet_at;
+    ro.clock = 0.0;
+    view_render *vr = NULL;
+    assert_int_equal(view_render_start(&vr, sc, acc, &ro, &s0, d), PT_OK);
+    assert_true(wait_idle(vr, 120));
+    view_frame_info in;
+    framebuffer *a0 = view_render_snapshot(vr, &in);
+    assert_non_null(a0);
+    assert_int_equal(in.gi_mode, GI_LINKS);
+    assert_true(in.clock == 0.0);
+
+    /* the new clock, then camera moves while it is prepared */
+    view_state s1 = s0;
+    s1.clock = clock1;
+    view_render_submit(vr, &s1, VIEW_CAUSE_CLOCK);
+    view_camera vc;
+    view_camera_from_scene(&vc, &sc->camera, 3.5);
+    long serial = 0, busy_images = 0, images = 0;
+    uint8_t *rgba = malloc((size_t)w * h * 4);
+    double t0 = timer_now(), t_new = 0;
+    int k = 0;
+    while (timer_now() - t0 < 120) {
+        if (view_render_fetch(vr, &serial, rgba, &in)) {
+            images++;
+            if (in.clock_busy && in.clock == 0.0) busy_images++;
+            if (in.clock == clock1) {
+                t_new = timer_now() - t0;
+                break;
+            }
+        }
+        view_camera_orbit(&vc, (k++ % 2) ? -1.0 : 1.0, 0);
+        view_state s = s1;
+        view_camera_to_scene(&vc, &s.camera);
+        view_render_submit(vr, &s, VIEW_CAUSE_CAMERA);
+        usleep(15000);
+    }
+    printf("clock %.1f shown after %.3f s (the update took %.3f s); %ld images fetched meanwhile, %ld of the old clock made "
+           "while the update ran\n",
+           clock1, t_new, in.clock_update, images, busy_images);
+    assert_true(in.clock == clock1);
+    assert_int_equal(in.clock_updates, 1);
+    assert_true(busy_images >= 1);
+    assert_int_equal(sheet_calls, 1);
+
+    /* back to the scene's camera, refined */
+    view_render_submit(vr, &s1, VIEW_CAUSE_CAMERA);
+    assert_true(wait_idle(vr, 120));
+    framebuffer *b = view_render_snapshot(vr, &in);
+    assert_non_null(b);
+    long linked = -1, elements = -1;
+    const char *p = strstr(in.describe, "links (");
+    if (p) p = strchr(p, ',');
+    if (p) sscanf(p, ", %ld of %ld linked", &linked, &elements);
+    double e = 0, mx = 0, moved = 0;
+    for (size_t i = 0; i < (size_t)w * h * 3; i++) {
+        e = fmax(e, fabs(b->rgb[i] - ref->rgb[i]));
+        mx = fmax(mx, fabs(ref->rgb[i]));
+        moved += fabs(b->rgb[i] - a0->rgb[i]);
+    }
+    moved /= w * h * 3.0;
+    printf("refined at clock %.1f: level %d/%d, '%s'; largest difference to the fresh render %.3g (largest value %.3g); "
+           "mean |difference| to clock 0: %.4f\n",
+           in.clock, in.level, in.last_level, in.describe, e, mx, moved);
+    assert_true(in.complete);
+    assert_true(in.clock == clock1);
+    assert_true(mx > 0.1);
+    assert_true(e <= 1e-5 * mx);
+    assert_true(moved > 0.002); /* the sheet rose: the image changed */
+    assert_true(elements == gst.elements);
+    assert_true(linked > 0 && linked < elements);
+
+    diag *m = diag_new();
+    view_render_messages(vr, m);
+    for (int i = 0; i < diag_count(m); i++) printf("message: %s\n", diag_get(m, i)->text);
+    assert_int_equal(diag_count(m), 0);
+    diag_free(m);
+    view_render_stop(vr);
+    free(rgba);
+    fb_free(a0);
+    fb_free(b);
+    fb_free(ref);
+    gi_vlinks_free(gv);
+    accel_free(acc1);
+    scene_free(sc1);
+    accel_free(acc);
+    scene_free(sc);
+    diag_free(d);
+}
+
 /* ------------------------------------------------- camera, no display */
 
 static scene_camera parse_camera(const char *text)
@@ -1026,6 +1238,7 @@ int main(void)
         cmocka_unit_test(test_camera_roundtrip),
         cmocka_unit_test(test_script_grammar),
         cmocka_unit_test(test_render_thread),
+        cmocka_unit_test(test_render_thread_clock),
         cmocka_unit_test(test_overlay_font),
         cmocka_unit_test(test_particle_relight_cancel),
         cmocka_unit_test(test_viewer_script),
