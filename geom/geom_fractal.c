@@ -123,6 +123,31 @@ static int jf_inside(const jf_data *f, vec3 p, vec3 e, double *de)
     double q[4];
     lift(f, p, q);
     if (de) *de = 0.0;
+    if (!f->hyper && (f->func == JULIA_SQR || f->func == JULIA_CUBE)) {
+        /* q^2 + c and q^3 + c written out as POV-Ray's Iteration_Julia and
+         * Iteration_z3 do (quatern.cpp): with d = y^2 + z^2 + w^2,
+         * q^2 = (x^2 - d, 2x (y, z, w)), q^3 = (x (x^2 - 3d), (3x^2 - d) (y, z, w));
+         * the distance estimate's product of |z_j| is kept squared, one
+         * root at the escape */
+        const int cube = f->func == JULIA_CUBE;
+        const double k = cube ? 3.0 : 2.0;
+        double x = q[0], y = q[1], z = q[2], w = q[3], prod2 = 1.0, pw = 1.0;
+        for (int i = 1; i <= f->n; i++) {
+            double d = y * y + z * z + w * w, x2 = x * x, r2 = d + x2;
+            prod2 *= r2;
+            pw *= k;
+            if (r2 > f->exit) {
+                if (de && prod2 > 0.0) *de = sqrt(r2 / prod2) * log(r2) / pw;
+                return 0;
+            }
+            double s = cube ? 3.0 * x2 - d : 2.0 * x;
+            x = (cube ? x * (x2 - 3.0 * d) : x2 - d) + f->c[0];
+            y = s * y + f->c[1];
+            z = s * z + f->c[2];
+            w = s * w + f->c[3];
+        }
+        return 1;
+    }
     if (!f->hyper) {
         double k = f->func == JULIA_CUBE ? 3.0 : 2.0, prod = 1.0, pw = 1.0;
         for (int i = 1; i <= f->n; i++) {
@@ -145,6 +170,39 @@ static int jf_inside(const jf_data *f, vec3 p, vec3 e, double *de)
     if (de) {
         double dq[4] = {e.x, e.y, e.z, -(f->slice[0] * e.x + f->slice[1] * e.y + f->slice[2] * e.z) / f->slice[3]};
         to_pair(dq, &da, &db);
+    }
+    if (f->func == JULIA_SQR) {
+        /* the same iteration with the squares written out (no call per step) */
+        double ar = creal(a), ai = cimag(a), br = creal(b), bi = cimag(b);
+        double dar = creal(da), dai = cimag(da), dbr = creal(db), dbi = cimag(db);
+        const double car = creal(f->ca), cai = cimag(f->ca), cbr = creal(f->cb), cbi = cimag(f->cb);
+        for (int i = 1; i <= f->n; i++) {
+            double ar2 = ar * ar, ai2 = ai * ai, br2 = br * br, bi2 = bi * bi;
+            double r2 = 0.5 * (ar2 + ai2 + br2 + bi2);
+            if (!(r2 <= f->exit)) {
+                if (de) {
+                    double dF = (ar * dar + ai * dai) + (br * dbr + bi * dbi);
+                    if (dF < -1e-7) {
+                        double S = -2.0 * dF;
+                        if (r2 > f->step * S && r2 < 30.0 * f->step * S) *de = r2 / S;
+                    }
+                }
+                return 0;
+            }
+            if (de) { /* d(z^2) = 2 z dz */
+                double t = 2.0 * (dar * ar - dai * ai);
+                dai = 2.0 * (dar * ai + dai * ar);
+                dar = t;
+                t = 2.0 * (dbr * br - dbi * bi);
+                dbi = 2.0 * (dbr * bi + dbi * br);
+                dbr = t;
+            }
+            ai = 2.0 * ar * ai + cai;
+            ar = ar2 - ai2 + car;
+            bi = 2.0 * br * bi + cbi;
+            br = br2 - bi2 + cbr;
+        }
+        return 1;
     }
     for (int i = 1; i <= f->n; i++) {
         double r2 = 0.5 * (creal(a) * creal(a) + cimag(a) * cimag(a) + creal(b) * creal(b) + cimag(b) * cimag(b));
