@@ -1085,6 +1085,23 @@ int accel_intersect_from(const accel *a, const accel_from *f, vec3 org, vec3 dir
     return accel_intersect(a, org, dir, tmin, tmax, hit);
 }
 
+_Static_assert(OBJ_NO_RADIOSITY < ACCEL_SKIP_PASS_THROUGH, "ACCEL_SKIP_PASS_THROUGH lies above the OBJ_* flags");
+
+int accel_intersect_past(const accel *a, const accel_from *f, vec3 org, vec3 dir, double eps, unsigned skip,
+                         accel_hit *hit, long *rays)
+{
+    double tmin = eps;
+    for (int k = 0; k < ACCEL_PASS_MAX; k++) {
+        if (rays) (*rays)++;
+        if (!accel_intersect_from(a, k == 0 ? f : NULL, org, dir, tmin, INFINITY, hit)) return 0;
+        int pass = (hit->flags & skip) ||
+                   ((skip & ACCEL_SKIP_PASS_THROUGH) && hit->obj && hit->obj->photons && hit->obj->photons->pass_through);
+        if (!pass) return 1;
+        tmin = hit->t + fmax(eps, hit->t * 1e-7);
+    }
+    return -1;
+}
+
 int accel_occluded_from(const accel *a, const accel_from *f, vec3 org, vec3 dir, double tmin, double tmax)
 {
     if (!a || !ray_ok(org, dir)) return 0;

@@ -93,6 +93,19 @@ void accel_from_hit(accel_from *f, const accel_hit *h);
 int accel_intersect_from(const accel *a, const accel_from *f, vec3 org, vec3 dir, double tmin, double tmax,
                          accel_hit *hit);
 int accel_occluded_from(const accel *a, const accel_from *f, vec3 org, vec3 dir, double tmin, double tmax);
+/* accel_intersect_past's `skip` bit beside the OBJ_* flags: objects whose
+ * photons { pass_through } is on (photons go through them unchanged). */
+#define ACCEL_SKIP_PASS_THROUGH (1u << 31)
+/* The most hits one accel_intersect_past ray passes over. */
+#define ACCEL_PASS_MAX 64
+/* The nearest hit along a ray leaving surface f (NULL: none; as
+ * accel_intersect_from) past tmin eps that carries none of the `skip`
+ * flags (OBJ_* and ACCEL_SKIP_PASS_THROUGH): each passed hit moves tmin to
+ * just beyond it (by max(eps, 1e-7 t)). Each intersection adds one to
+ * *rays (NULL: not counted). Returns 1 with *hit the hit, 0 when the ray
+ * leaves the scene, -1 when it passed ACCEL_PASS_MAX hits (*hit: the last). */
+int accel_intersect_past(const accel *a, const accel_from *f, vec3 org, vec3 dir, double eps, unsigned skip,
+                         accel_hit *hit, long *rays);
 /* accel_occluded for n rays at once (Embree packets of 16, flagged
  * coherent: shadow rays towards one light from neighbouring points): out[k]
  * = 1 when ray k is blocked. Same effective tmin rule; analytic shapes see

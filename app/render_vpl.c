@@ -55,7 +55,6 @@
 #include "shade_material.h"
 #include "timer.h"
 
-#define SKIP_MAX 64
 #define EYE_RR 1e-3
 #define COARSE 16
 #define VIEW_GRID 32 /* camera rays per image side that bound the planes' VPLs */
@@ -204,13 +203,8 @@ static void vpl_set_free(vpl_set *s)
 static int gather_hit(const accel *a, const shade_mat_bsdf *b, vec3 w, double eps, accel_hit *h)
 {
     vec3 org = v3_dot(w, b->ng) > 0.0 ? b->p_out : b->p_in;
-    double tmin = eps;
-    for (int k = 0; k < SKIP_MAX; k++) {
-        if (!accel_intersect_from(a, k == 0 ? &b->from : NULL, org, w, tmin, INFINITY, h)) return 0;
-        if (radrules_gathers(h->flags)) return 1;
-        tmin = h->t + fmax(eps, h->t * 1e-7);
-    }
-    return 1;
+    /* a ray past ACCEL_PASS_MAX no_radiosity objects takes the last one */
+    return accel_intersect_past(a, &b->from, org, w, eps, OBJ_NO_RADIOSITY, h, NULL) != 0;
 }
 
 typedef struct {
@@ -459,17 +453,6 @@ typedef struct {
     int oom;
 } eye_ctx;
 
-static int trace_skip(const eye_ctx *c, const accel_from *from, vec3 org, vec3 dir, unsigned skip, accel_hit *h)
-{
-    double tmin = c->eps;
-    for (int k = 0; k < SKIP_MAX; k++) {
-        if (!accel_intersect_from(c->a, k == 0 ? from : NULL, org, dir, tmin, INFINITY, h)) return 0;
-        if (!(h->flags & skip)) return 1;
-        tmin = h->t + fmax(c->eps, h->t * 1e-7);
-    }
-    return 0;
-}
-
 /* One eye path: direct light into *L; gather points of mirror and
  * refraction hits (depth > 0) into the row's list with weight T. */
 static void eye_trace(eye_ctx *c, int y, int pixel, const accel_from *from, vec3 org, vec3 dir, unsigned skip, rgb T,
@@ -477,7 +460,7 @@ static void eye_trace(eye_ctx *c, int y, int pixel, const accel_from *from, vec3
 {
     if (depth >= c->levels) return;
     accel_hit h;
-    int hit = trace_skip(c, from, org, dir, skip, &h);
+    int hit = accel_intersect_past(c->a, from, org, dir, c->eps, skip, &h, NULL) > 0;
     if (c->sc->fogs) {
         /* fog on camera and mirror/refraction segments, as the path tracer */
         rgb fa, fc;
@@ -583,7 +566,7 @@ static void eye_row(void *ctx, int y, int thread)
         scene_camera_ray(&c->sc->camera, x + 0.5, y + 0.5, W, H, &org, &dir);
         accel_hit h;
         c->valid[pixel] = 0;
-        int hit = trace_skip(c, NULL, org, dir, OBJ_NO_IMAGE, &h);
+        int hit = accel_intersect_past(c->a, NULL, org, dir, c->eps, OBJ_NO_IMAGE, &h, NULL) > 0;
         c->fog_t[pixel] = mk(1, 1, 1);
         if (hit && c->sc->fogs) {
             rgb fc;

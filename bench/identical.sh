@@ -22,6 +22,11 @@
 #   maze_particle   scenes/maze.pov  128x128 --gi particle
 #   cbox_path       scenes/cbox.pov  48x48 --gi path --spp 4
 #   cbox_pmfg       scenes/cbox.pov  32x32 --gi pmfg --fg-rays 64 --photons 20000 --spp 1
+#   cbox_vpl        scenes/cbox.pov  48x48 --gi vpl
+#   photons_none    the distribution's lights/phot_met_glass.pov 64x48 --gi
+#                   none (its photons{} block: the caustic layer)
+#   photons_pmfg    the same, 32x24 --gi pmfg --fg-rays 64 --photons 20000
+#                   --spp 1 (the photon map's caustic photons)
 # Every render uses --seed 1. Scenes are copied to OUTDIR first (scenes may
 # write files beside themselves). Exit status of compare (and of the two-binary
 # form): 0 when every file is identical, 1 otherwise (each differing or
@@ -31,6 +36,7 @@ cd "$(dirname "$0")/.."
 ROOT=$(pwd)
 THREADS=${THREADS:-2}
 RADIOSITY_CORNELL=/usr/share/povray-3.7/scenes/radiosity/cornell.pov
+PHOTONS=/usr/share/doc/povray/examples/lights/phot_met_glass.pov
 
 # Copy $1 to $2 without its first radiosity{...} block, as test_crosscheck.c's
 # strip_radiosity does: from the keyword to the brace that closes its first {.
@@ -70,7 +76,7 @@ render_set() { # BIN DIR
         cp "$ROOT/tests/scenes/$s.pov" "$dir/"
     done
     strip_radiosity "$RADIOSITY_CORNELL" "$dir/xc_cornell_direct.pov"
-    cp "$ROOT/scenes/cbox.pov" "$ROOT/scenes/maze.pov" "$dir/"
+    cp "$ROOT/scenes/cbox.pov" "$ROOT/scenes/maze.pov" "$PHOTONS" "$dir/"
     echo "rendering with $bin into $dir"
     for s in xc_cornell_direct xc_point_phong xc_spot_specular xc_parallel_reflect xc_area_fade; do
         render_one "$bin" "$dir" "$s" "$s.pov" +W160 +H160 +A0.3 +R3 --gi none
@@ -79,6 +85,9 @@ render_set() { # BIN DIR
     render_one "$bin" "$dir" maze_particle maze.pov --size 128x128 --gi particle
     render_one "$bin" "$dir" cbox_path cbox.pov --size 48x48 --gi path --spp 4
     render_one "$bin" "$dir" cbox_pmfg cbox.pov --size 32x32 --gi pmfg --fg-rays 64 --photons 20000 --spp 1
+    render_one "$bin" "$dir" cbox_vpl cbox.pov --size 48x48 --gi vpl
+    render_one "$bin" "$dir" photons_none phot_met_glass.pov --size 64x48 --gi none
+    render_one "$bin" "$dir" photons_pmfg phot_met_glass.pov --size 32x24 --gi pmfg --fg-rays 64 --photons 20000 --spp 1
 }
 
 compare_sets() { # DIR_A DIR_B

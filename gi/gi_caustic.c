@@ -10,7 +10,9 @@
 #include "pool.h"
 #include "timer.h"
 
-#define SKIP_MAX 64
+/* A photon ray passes no_shadow objects (POV-Ray trace.cpp: a photon ray
+ * skips NO_SHADOW objects) and pass_through objects (unchanged). */
+#define PHOTON_SKIP (OBJ_NO_SHADOW | ACCEL_SKIP_PASS_THROUGH)
 #define GBUF_LAYERS 8
 /* k of r_xy = k s_D / sqrt(rho_p): 6 unfocused spacings, about 110
  * photons of an unfocused beam within r_xy. The paper gives no constant;
@@ -291,22 +293,6 @@ static int push_photon(chunk_out *o, const gi_caus_photon *q)
     return 1;
 }
 
-/* Next hit of a photon ray: no_shadow objects are invisible to photon rays
- * (POV-Ray trace.cpp: a photon ray skips NO_SHADOW objects) and
- * pass_through objects let it through unchanged. */
-static int photon_hit(const gi_caustic *c, const accel_from *from, vec3 o, vec3 w, accel_hit *h, long *rays)
-{
-    double tmin = c->eps;
-    for (int k = 0; k < SKIP_MAX; k++) {
-        (*rays)++;
-        if (!accel_intersect_from(c->a, k == 0 ? from : NULL, o, w, tmin, INFINITY, h)) return 0;
-        int pass = (h->flags & OBJ_NO_SHADOW) || (h->obj && h->obj->photons && h->obj->photons->pass_through);
-        if (!pass) return 1;
-        tmin = h->t + fmax(c->eps, h->t * 1e-7);
-    }
-    return 0;
-}
-
 /* One bounce-map cell: the photon's direction (and origin), then its path. */
 static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_out *out)
 {
@@ -346,7 +332,7 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
     rgb tr = {1, 1, 1};
     vec3 p_first = o;
     for (int level = 0;; level++) {
-        if (!photon_hit(c, fp, o, w, &h, &out->rays)) return;
+        if (accel_intersect_past(c->a, fp, o, w, c->eps, PHOTON_SKIP, &h, &out->rays) <= 0) return;
         depth += h.t;
         if (level == 0) {
             /* the first hit must be the target (POV-Ray's PhotonTrace) */

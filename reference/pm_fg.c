@@ -28,7 +28,6 @@
 #include "shade_material.h"
 #include "timer.h"
 
-#define SKIP_MAX 64
 #define KMAX 1024
 #define NORMAL_DOT 0.5   /* photons count for a query when their normals are within 60 degrees */
 #define EYE_RR 1e-3      /* eye branches below this weight go on by Russian roulette */
@@ -82,17 +81,6 @@ static inline void acc_add(rgb *a, rgb t, rgb v)
     a->b += t.b * v.b;
 }
 static inline double fmax3(rgb t) { return fmax(t.r, fmax(t.g, t.b)); }
-
-static int trace_skip(const fg_ctx *c, const accel_from *from, vec3 org, vec3 dir, unsigned skip, accel_hit *h)
-{
-    double tmin = c->eps;
-    for (int k = 0; k < SKIP_MAX; k++) {
-        if (!accel_intersect_from(c->a, k == 0 ? from : NULL, org, dir, tmin, INFINITY, h)) return 0;
-        if (!(h->flags & skip)) return 1;
-        tmin = h->t + fmax(c->eps, h->t * 1e-7);
-    }
-    return 0;
-}
 
 
 /* Whether the photon (or irradiance point) at y, normal ny, may stand for
@@ -269,7 +257,7 @@ static rgb gather_hit(const fg_ctx *c, const shade_mat_bsdf *b, uint32_t surf, i
         cnt->bsdf++;
         accel_hit h;
         unsigned skip = OBJ_NO_RADIOSITY | (lobe == SHADE_MAT_LOBE_REFLECT ? OBJ_NO_REFLECTION : 0u);
-        if (!trace_skip(c, &b->from, org, dir, skip, &h)) {
+        if (accel_intersect_past(c->a, &b->from, org, dir, c->eps, skip, &h, NULL) <= 0) {
             acc_add(&L, w, pm_sky(c->sc, dir));
         } else {
             shade_mat_bsdf b2;
@@ -294,7 +282,7 @@ static rgb gather_ray(const fg_ctx *c, const shade_mat_bsdf *b, vec3 org, vec3 w
     rgb sum = {0, 0, 0};
     cnt->gather++;
     accel_hit h;
-    int hit = trace_skip(c, &b->from, org, w, OBJ_NO_RADIOSITY, &h);
+    int hit = accel_intersect_past(c->a, &b->from, org, w, c->eps, OBJ_NO_RADIOSITY, &h, NULL) > 0;
     rgb fa = {1, 1, 1};
     if (c->rr.media && c->sc->fogs) {
         /* `media on`: gathering rays see fog too (radrules.h rule 5) */
@@ -375,7 +363,7 @@ static void eye_trace(const fg_ctx *c, const accel_from *from, vec3 org, vec3 di
 {
     if (depth >= c->s->max_eye_depth || depth >= c->eye_levels) return;
     accel_hit h;
-    int hit = trace_skip(c, from, org, dir, skip, &h);
+    int hit = accel_intersect_past(c->a, from, org, dir, c->eps, skip, &h, NULL) > 0;
     if (c->sc->fogs) {
         /* fog on eye segments (gathering rays see it only with `media on`) */
         rgb fa, fc;

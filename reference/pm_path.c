@@ -22,7 +22,6 @@
 #include "timer.h"
 
 #define HARD_DEPTH 1024
-#define SKIP_MAX 64
 
 void pm_path_default_settings(pm_path_settings *s)
 {
@@ -45,18 +44,6 @@ typedef struct {
     radrules rr;
     int gathers;       /* diffuse bounces a path may take (the radiosity recursion_limit) */
 } path_ctx;
-
-/* Nearest hit not carrying any of the `skip` flags. */
-static int trace_skip(const path_ctx *c, const accel_from *from, vec3 org, vec3 dir, unsigned skip, accel_hit *h)
-{
-    double tmin = c->eps;
-    for (int k = 0; k < SKIP_MAX; k++) {
-        if (!accel_intersect_from(c->a, k == 0 ? from : NULL, org, dir, tmin, INFINITY, h)) return 0;
-        if (!(h->flags & skip)) return 1;
-        tmin = h->t + fmax(c->eps, h->t * 1e-7);
-    }
-    return 0;
-}
 
 static inline double tmax3(rgb t) { return fmax(t.r, fmax(t.g, t.b)); }
 
@@ -82,7 +69,7 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
     for (int depth = 0;; depth++) {
         if (level >= max_level) break;
         accel_hit h;
-        int hit = trace_skip(c, fromp, org, dir, skip | gskip, &h);
+        int hit = accel_intersect_past(c->a, fromp, org, dir, c->eps, skip | gskip, &h, NULL) > 0;
         if (sc->fogs && (nd == 0 || c->rr.media)) {
             /* fog on the segment: on camera and specular rays, on gathering
              * rays only with radiosity's `media on` (radrules.h rule 5) */

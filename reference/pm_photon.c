@@ -33,7 +33,11 @@
 #include "shade_material.h"
 
 #define CHUNK 1024
-#define SKIP_MAX 64
+/* Photon rays pass photons { pass_through } objects (photons go through
+ * them unchanged); first hits seen from a POV-Ray light pass no_shadow
+ * objects too, as shade.c's shadow rays do. */
+#define PHOTON_SKIP ACCEL_SKIP_PASS_THROUGH
+#define LIGHT_SKIP (OBJ_NO_SHADOW | ACCEL_SKIP_PASS_THROUGH)
 /* Termination that does not depend on the albedo: from bounce RR_BOUNCES on,
  * a path survives each further bounce with probability RR_SURVIVE and its
  * power is divided by it (unbiased); with albedo 1 the material's roulette
@@ -118,24 +122,6 @@ static vec3 disc_point(vec3 c, vec3 axis, double radius, double u1, double u2)
     return v3_add(c, v3_add(v3_scale(t, rho * cos(phi)), v3_scale(b, rho * sin(phi))));
 }
 
-/* photons { pass_through }: photons go through the object unchanged. */
-static int pass_through(const accel_hit *h) { return h->obj && h->obj->photons && h->obj->photons->pass_through; }
-
-/* Next hit of a photon, past pass_through objects and objects with any of
- * the `skip` flags. */
-static int photon_intersect(const trace_ctx *c, const accel_from *from, vec3 o, vec3 w, unsigned skip, accel_hit *h,
-                            long *rays)
-{
-    double tmin = c->eps;
-    for (int k = 0; k < SKIP_MAX; k++) {
-        (*rays)++;
-        if (!accel_intersect_from(c->a, k == 0 ? from : NULL, o, w, tmin, INFINITY, h)) return 0;
-        if (!pass_through(h) && !(h->flags & skip)) return 1;
-        tmin = h->t + fmax(c->eps, h->t * 1e-7);
-    }
-    return 0;
-}
-
 /* With targets in the scene (POV-Ray 3.7 semantics), a photon on a caustic
  * path (a POV-Ray light, specular bounces only so far) is reflected or
  * refracted only by a target where the target's and light l's flags allow
@@ -156,20 +142,6 @@ static int any_target(const scene_object *o)
     return 0;
 }
 
-/* First hit seen from a POV-Ray light: no_shadow objects let it through, as
- * they do for shade.c's shadow rays. */
-static int light_first_hit(const trace_ctx *c, vec3 o, vec3 w, accel_hit *h, long *rays)
-{
-    double tmin = c->eps;
-    for (int k = 0; k < SKIP_MAX; k++) {
-        (*rays)++;
-        if (!accel_intersect(c->a, o, w, tmin, INFINITY, h)) return 0;
-        if (!(h->flags & OBJ_NO_SHADOW) && !pass_through(h)) return 1;
-        tmin = h->t + fmax(c->eps, h->t * 1e-7);
-    }
-    return 0;
-}
-
 /* Emit one photon of source `src`: its origin *o and direction *w, the
  * first hit and the photon's power. Returns 1 on a hit, 0 when the photon
  * left the scene, -1 when no photon was emitted (no emitter sample). */
@@ -185,7 +157,7 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
             double u1 = rng_f64(r), u2 = rng_f64(r);
             *o = disc_point(l->position, axis, R, u1, u2);
             *w = axis;
-            if (!light_first_hit(c, *o, axis, h, rays)) return 0;
+            if (accel_intersect_past(c->a, NULL, *o, axis, c->eps, LIGHT_SKIP, h, rays) <= 0) return 0;
             vec3 dl;
             double depth;
             shade_light_ray(l, l->position, h->p, &dl, &depth);
@@ -201,7 +173,7 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
             double u1 = rng_f64(r), u2 = rng_f64(r);
             *o = disc_point(cp, to_light, R, u1, u2);
             *w = v3_neg(to_light);
-            if (!light_first_hit(c, *o, *w, h, rays)) return 0;
+            if (accel_intersect_past(c->a, NULL, *o, *w, c->eps, LIGHT_SKIP, h, rays) <= 0) return 0;
             vec3 dl;
             double depth;
             shade_light_ray(l, l->position, h->p, &dl, &depth);
@@ -221,7 +193,7 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         *w = cone_dir(axis, cos_max, u1, u2);
         double pdf = 1.0 / (2.0 * M_PI * (1.0 - cos_max));
         *o = q;
-        if (!light_first_hit(c, q, *w, h, rays)) return 0;
+        if (accel_intersect_past(c->a, NULL, q, *w, c->eps, LIGHT_SKIP, h, rays) <= 0) return 0;
         vec3 dl;
         double depth;
         shade_light_ray(l, q, h->p, &dl, &depth);
@@ -240,7 +212,7 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         double u4 = rng_f64(r), u5 = rng_f64(r);
         *w = shade_mat_cosine_dir(ns, u4, u5);
         *o = v3_madd(s.p, ns, c->eps);
-        if (!photon_intersect(c, NULL, *o, *w, OBJ_NO_RADIOSITY, h, rays)) return 0;
+        if (accel_intersect_past(c->a, NULL, *o, *w, c->eps, OBJ_NO_RADIOSITY | PHOTON_SKIP, h, rays) <= 0) return 0;
         rgb le = pm_lights_piece_emission(c->L, &s);
         double k = 2.0 * M_PI / (n * s.pdf_area);
         *phi = crgb(le.r * k, le.g * k, le.b * k);
@@ -253,7 +225,7 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
     double u3 = rng_f64(r), u4 = rng_f64(r);
     *o = disc_point(v3_madd(c->centre, wd, -R * 1.001), wd, R, u3, u4);
     *w = wd;
-    if (!photon_intersect(c, NULL, *o, wd, OBJ_NO_RADIOSITY, h, rays)) return 0;
+    if (accel_intersect_past(c->a, NULL, *o, wd, c->eps, OBJ_NO_RADIOSITY | PHOTON_SKIP, h, rays) <= 0) return 0;
     /* it arrives from the sky in direction -wd */
     rgb bg = pm_sky(c->sc, v3_neg(wd));
     double k = 4.0 * M_PI * M_PI * R * R / n;
@@ -304,7 +276,7 @@ static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume,
     } else {
         L = *resume;
         r = L.r;
-        if (!photon_intersect(c, L.from.obj ? &L.from : NULL, L.o, L.w, L.skip, &h, rays)) {
+        if (accel_intersect_past(c->a, L.from.obj ? &L.from : NULL, L.o, L.w, c->eps, L.skip | PHOTON_SKIP, &h, rays) <= 0) {
             if (fn) fn(fctx, index, &L, NULL, none);
             return;
         }
@@ -386,7 +358,7 @@ static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume,
         L.bounce = bounce + 1;
         L.nd = nd;
         L.spec_only = spec_only;
-        if (!photon_intersect(c, &b.from, s.org, w, L.skip, &h, rays)) {
+        if (accel_intersect_past(c->a, &b.from, s.org, w, c->eps, L.skip | PHOTON_SKIP, &h, rays) <= 0) {
             if (fn) fn(fctx, index, &L, NULL, none);
             return;
         }

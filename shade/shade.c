@@ -428,15 +428,10 @@ static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, d
     assert(level >= 1 && thread >= 0 && thread < SHADE_MAX_THREADS);
     if (level > c->max_level) return rgb_make(0, 0, 0);
     accel_hit h;
-    double tmin = c->eps;
-    /* Step past objects this ray must not see (bounded: a pathological stack
-     * of such surfaces ends as background). */
-    for (int k = 0; k < 64; k++) {
-        if (!accel_intersect(c->a, org, dir, tmin, INFINITY, &h)) break;
-        if (!(h.flags & skip))
-            return along_ray(c, thread, org, dir, h.t, shade_hit(c, thread, &h, dir, level, weight, skip, wavelength, r, in), r, in, h.obj);
-        tmin = h.t + fmax(c->eps, h.t * 1e-7);
-    }
+    /* Past objects this ray must not see (bounded: a pathological stack of
+     * such surfaces ends as background). */
+    if (accel_intersect_past(c->a, NULL, org, dir, c->eps, skip, &h, NULL) > 0)
+        return along_ray(c, thread, org, dir, h.t, shade_hit(c, thread, &h, dir, level, weight, skip, wavelength, r, in), r, in, h.obj);
     return along_ray(c, thread, org, dir, INFINITY, shade_atmos_sky(c->sc, dir), r, in, NULL);
 }
 

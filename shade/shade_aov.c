@@ -113,17 +113,7 @@ static void aov_pixel(aov_ctx *c, int x, int y, int thread)
     vec3 org, dir;
     if (!camera_ray(&sc->camera, x + 0.5, y + 0.5, o->width, o->height, 0.0, 0.0, &org, &dir)) return;
     accel_hit h;
-    double tmin = c->eps;
-    int hit = 0;
-    for (int k = 0; k < 64; k++) {
-        if (!accel_intersect(c->a, org, dir, tmin, INFINITY, &h)) break;
-        if (!(h.flags & OBJ_NO_IMAGE)) {
-            hit = 1;
-            break;
-        }
-        tmin = h.t + fmax(c->eps, h.t * 1e-7);
-    }
-    if (!hit) return;
+    if (accel_intersect_past(c->a, NULL, org, dir, c->eps, OBJ_NO_IMAGE, &h, NULL) <= 0) return;
 
     rng r;
     rng_seed(&r, mix64(c->s->seed * 0x9e3779b97f4a7c15ULL + 0x616f76ULL), ((uint64_t)y << 32) | (uint64_t)x);
@@ -209,13 +199,7 @@ static int alpha_hit(const alpha_ctx *c, double px, double py)
     vec3 org, dir;
     if (!camera_ray(&c->sc->camera, px, py, c->s->width, c->s->height, 0.0, 0.0, &org, &dir)) return 0;
     accel_hit h;
-    double tmin = c->eps;
-    for (int k = 0; k < 64; k++) {
-        if (!accel_intersect(c->a, org, dir, tmin, INFINITY, &h)) return 0;
-        if (!(h.flags & OBJ_NO_IMAGE)) return 1;
-        tmin = h.t + fmax(c->eps, h.t * 1e-7);
-    }
-    return 0;
+    return accel_intersect_past(c->a, NULL, org, dir, c->eps, OBJ_NO_IMAGE, &h, NULL) > 0;
 }
 
 static void alpha_row(void *ctx, int y, int thread)
