@@ -246,3 +246,46 @@ vec3 geom_mesh_normal(const geom_shape *sh, vec3 q, int part)
     }
     return n;
 }
+
+/* Barycentrics of the point at t along the edge from vertex i to vertex j
+ * (t = 0: vertex i itself). */
+static void edge_point(double w[3], int i, int j, double t)
+{
+    w[0] = w[1] = w[2] = 0.0;
+    w[i] = 1.0 - t;
+    w[j] = t;
+}
+
+/* Ericson, Real-Time Collision Detection, 2005, 5.1.5: the Voronoi regions
+ * of the vertices, then of the edges, then the face. */
+double geom_tri_closest(vec3 q, vec3 a, vec3 b, vec3 c, double w[3])
+{
+    vec3 ab = v3_sub(b, a), ac = v3_sub(c, a), ap = v3_sub(q, a);
+    double d1 = v3_dot(ab, ap), d2 = v3_dot(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0) { edge_point(w, 0, 1, 0.0); goto out; }
+    vec3 bp = v3_sub(q, b);
+    double d3 = v3_dot(ab, bp), d4 = v3_dot(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) { edge_point(w, 1, 2, 0.0); goto out; }
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) { edge_point(w, 0, 1, d1 / (d1 - d3)); goto out; }
+    vec3 cp = v3_sub(q, c);
+    double d5 = v3_dot(ab, cp), d6 = v3_dot(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) { edge_point(w, 2, 0, 0.0); goto out; }
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) { edge_point(w, 0, 2, d2 / (d2 - d6)); goto out; }
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+        edge_point(w, 1, 2, (d4 - d3) / ((d4 - d3) + (d5 - d6)));
+        goto out;
+    }
+    {
+        double den = va + vb + vc;
+        if (!(fabs(den) > 0.0)) { edge_point(w, 0, 1, 0.0); goto out; }
+        w[1] = vb / den;
+        w[2] = vc / den;
+        w[0] = 1.0 - w[1] - w[2];
+    }
+out:;
+    vec3 r = v3_add(v3_add(v3_scale(a, w[0]), v3_scale(b, w[1])), v3_scale(c, w[2]));
+    return v3_len2(v3_sub(q, r));
+}

@@ -22,5 +22,9 @@ int geom_mesh_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tma
 int geom_mesh_inside(const geom_shape *sh, vec3 q);
 /* Object-space normal of triangle `part` at object-space point q. */
 vec3 geom_mesh_normal(const geom_shape *sh, vec3 q, int part);
+/* The point of triangle (a, b, c) closest to q, as barycentrics w (wa, wb,
+ * wc; a degenerate triangle gives vertex a); returns its squared distance
+ * from q. */
+double geom_tri_closest(vec3 q, vec3 a, vec3 b, vec3 c, double w[3]);
 
 #endif

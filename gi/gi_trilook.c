@@ -5,6 +5,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include "geom_mesh.h"
 #include "pool.h"
 
 /* a cell's edge is at most CELL_FAC particle spacings (k = ceil(longest
@@ -119,55 +120,6 @@ static int bgrid_build(bgrid *g, const gi_dev_particle *p, int n, double h)
     for (int i = 0; i < n; i++) g->ord[g->start[key[i] + 1]++] = i; /* ascending within a cell */
     free(key);
     return 1;
-}
-
-/* squared distance from point x to triangle (a, b, c): the closest point
- * by the Voronoi regions of the vertices, edges and face (the region tests
- * of Ericson, Real-Time Collision Detection, 2005, section 5.1.5) */
-static double dist2_tri(const double x[3], const double a[3], const double b[3], const double c[3])
-{
-    double ab[3], ac[3], ax[3];
-    for (int k = 0; k < 3; k++) {
-        ab[k] = b[k] - a[k];
-        ac[k] = c[k] - a[k];
-        ax[k] = x[k] - a[k];
-    }
-#define DOT(u, v) ((u)[0] * (v)[0] + (u)[1] * (v)[1] + (u)[2] * (v)[2])
-    double d1 = DOT(ab, ax), d2 = DOT(ac, ax);
-    double s, t; /* closest = a + s ab + t ac */
-    if (d1 <= 0.0 && d2 <= 0.0) {
-        s = 0.0, t = 0.0;
-    } else {
-        double bx[3], cx[3];
-        for (int k = 0; k < 3; k++) {
-            bx[k] = x[k] - b[k];
-            cx[k] = x[k] - c[k];
-        }
-        double d3 = DOT(ab, bx), d4 = DOT(ac, bx), d5 = DOT(ab, cx), d6 = DOT(ac, cx);
-        double vc = d1 * d4 - d3 * d2, vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
-        if (d3 >= 0.0 && d4 <= d3) {
-            s = 1.0, t = 0.0;
-        } else if (d6 >= 0.0 && d5 <= d6) {
-            s = 0.0, t = 1.0;
-        } else if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-            s = d1 / (d1 - d3), t = 0.0;
-        } else if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-            s = 0.0, t = d2 / (d2 - d6);
-        } else if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
-            double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-            s = 1.0 - w, t = w;
-        } else {
-            double den = 1.0 / (va + vb + vc);
-            s = vb * den, t = vc * den;
-        }
-    }
-#undef DOT
-    double r2 = 0.0;
-    for (int k = 0; k < 3; k++) {
-        double e = a[k] + s * ab[k] + t * ac[k] - x[k];
-        r2 += e * e;
-    }
-    return r2;
 }
 
 typedef struct {
@@ -345,6 +297,8 @@ static void build_job(void *ctx, int ch, int thread)
                             cv[q][a] = v[0][a] + uv[q][0] / k * e1[a] + uv[q][1] / k * e2[a];
                             c[a] += cv[q][a] / nv;
                         }
+                    vec3 cw[4]; /* the corners as vectors (geom_tri_closest) */
+                    for (int q = 0; q < nv; q++) cw[q] = v3(cv[q][0], cv[q][1], cv[q][2]);
                     double rc = 0.0;
                     for (int q = 0; q < nv; q++) {
                         double e = 0.0;
@@ -414,9 +368,10 @@ static void build_job(void *ctx, int ch, int thread)
                             s.cd[m] = -1.0;
                             if (s.side[m] != sd || s.pc[m] - rc > rl[sd]) continue;
                             if (s.pc[m] > rl[sd]) {
-                                double px[3] = {s.px[3 * m], s.px[3 * m + 1], s.px[3 * m + 2]};
-                                double d2 = dist2_tri(px, cv[0], cv[1], cv[2]);
-                                if (nv == 4 && d2 > rl2) d2 = fmin(d2, dist2_tri(px, cv[1], cv[3], cv[2]));
+                                vec3 px = v3(s.px[3 * m], s.px[3 * m + 1], s.px[3 * m + 2]);
+                                double w[3];
+                                double d2 = geom_tri_closest(px, cw[0], cw[1], cw[2], w);
+                                if (nv == 4 && d2 > rl2) d2 = fmin(d2, geom_tri_closest(px, cw[1], cw[3], cw[2], w));
                                 if (d2 > rl2) continue;
                             }
                             s.cd[m] = 1.0;
