@@ -8,6 +8,10 @@
 #     first full solution's time, GI updates per second over LINK_FRAMES
 #     frames of the deforming mesh (cyclic, +KC: the template's splines
 #     turn a whole turn over the clock 0..1, so clock 1 is clock 0 again),
+#     the merge ratio against the room's tessellation, `partray view`
+#     taking a new clock (the time until the deformed mesh's links are
+#     shown, and the images shown meanwhile while the camera orbits;
+#     needs a display or Xvfb),
 #     and quality against --gi path
 #     (PATH_SPP samples, HDR-FLIP and mean luminance) beside --gi particle
 #     on the first and last frame at QSIZE.
@@ -142,6 +146,44 @@ if inc:
     m = sum(inc) / len(inc)
     print('deforming mesh: %.2f GI updates/s over frames %d-%d (first frame %.3f s)' % (1 / m if m > 0 else 0, ks[1], ks[-1], f[str(ks[0])]['gi']))
 EOF
+# the viewer: `clock` in a script re-evaluates the scene and links it again
+# on a thread of its own while the camera keeps orbiting (under Xvfb when
+# there is no display)
+XPID=
+if [ -z "${DISPLAY:-}" ] && command -v Xvfb >/dev/null 2>&1; then
+    Xvfb -displayfd 3 -screen 0 1024x768x24 -nolisten tcp -noreset 3>xdisplay >/dev/null 2>&1 &
+    XPID=$!
+    i=0
+    while [ ! -s xdisplay ] && [ $i -lt 100 ]; do sleep 0.1; i=$((i + 1)); done
+    DISPLAY=:$(head -n1 xdisplay)
+    export DISPLAY
+fi
+if [ -n "${DISPLAY:-}" ]; then
+    python3 -c "
+print('0 wait-idle')
+print('0.1 mark before')
+print('0.2 clock 0.1')
+for k in range(80):
+    print('%.2f camera orbit %d 0' % (0.2 + 0.05 * k, 2 if k % 2 == 0 else -2))
+print('4.3 wait-idle')
+print('4.4 mark after')
+print('4.5 quit')" > clock.txt
+    "$P" view mesh_room.pov +L"$TPL" --gi links --size "${VIEW_SIZE:-320x240}" --script clock.txt >view.out 2>view.err || true
+    python3 - <<'EOF'
+import re
+err = open('view.err').read()
+m = re.search(r'view: clock (\S+) shown \((\S+) asked\): (\d+) scenes? at a new clock taken over, the last after ([0-9.]+) s; (\d+) images', err)
+if m:
+    t, n = float(m.group(4)), int(m.group(5))
+    print('view --gi links, clock 0 -> %s (the mesh deformed: parse, accel and links again on the clock thread): taken over after %.2f s; %d images shown meanwhile (%.1f/s) while the camera orbited' % (m.group(1), t, n, n / t if t > 0 else 0))
+else:
+    print('view: no clock summary (%s)' % err.strip().splitlines()[-1:])
+m = re.search(r'view: (\d+) images \((\d+) shown\) in ([0-9.]+) s \(([0-9.]+)/s\)', err)
+if m:
+    print('  whole run: %s images in %s s (%s/s)' % (m.group(1), m.group(3), m.group(4)))
+EOF
+fi
+if [ -n "$XPID" ]; then kill "$XPID" 2>/dev/null || true; unset DISPLAY; fi
 echo "quality at $QSIZE against --gi path $PATH_SPP spp (HDR-FLIP mean, mean luminance):"
 for fr in 1 "$LINK_FRAMES"; do
     "$P" render mesh_room.pov +L"$TPL" --gi path --spp "$PATH_SPP" --size "$QSIZE" +KFI1 +KFF"$LINK_FRAMES" +KC --frame "$fr" -o "q_path.pfm" -q 2>/dev/null
