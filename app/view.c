@@ -29,7 +29,7 @@ enum { EXIT_OK = CLI_EXIT_OK, EXIT_SCENE = CLI_EXIT_SCENE, EXIT_USAGE = CLI_EXIT
 #define MAX_LATENCIES 4096
 
 static const char *view_usage =
-    "usage: partray view SCENE.pov [--size WxH] [--gi none|particle|path|pmfg] [--threads N] [--seed N]\n"
+    "usage: partray view SCENE.pov [--size WxH] [--gi none|particle|links|path|pmfg] [--threads N] [--seed N]\n"
     "                    [--script FILE] [--preview D] [--ref-spp N] [--preview-particles N] [--verbose]\n"
     "                    [--particles N] [--nb N] [--cl-device DEV] [--clock V] [-D NAME=VALUE] [-L DIR]\n"
     "keys: WASD/QE fly, right drag look, left drag orbit, wheel zoom, R reset camera,\n"
@@ -920,7 +920,7 @@ int cmd_view(int argc, char **argv)
     if (o.gi) {
         gi = gi_mode_parse(o.gi);
         if (gi < 0) {
-            fprintf(stderr, "partray view: unknown --gi mode '%s' (none, particle, path, pmfg)\n", o.gi);
+            fprintf(stderr, "partray view: unknown --gi mode '%s' (none, particle, links, path, pmfg)\n", o.gi);
             return EXIT_USAGE;
         }
     }
