@@ -1185,6 +1185,25 @@ void accel_rtc_link_scene_free(void *scene)
     if (scene) rtcReleaseScene((RTCScene)scene);
 }
 
+void accel_rtc_rayhit_init(struct RTCRayHit *rh, const float o[3], float tnear, const float d[3])
+{
+    rh->ray.org_x = o[0];
+    rh->ray.org_y = o[1];
+    rh->ray.org_z = o[2];
+    rh->ray.tnear = tnear;
+    rh->ray.dir_x = d[0];
+    rh->ray.dir_y = d[1];
+    rh->ray.dir_z = d[2];
+    rh->ray.time = 0.0f;
+    rh->ray.tfar = INFINITY;
+    rh->ray.mask = 0xFFFFFFFFu;
+    rh->ray.id = 0;
+    rh->ray.flags = 0;
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
 const scene_object *accel_rtc_object(const accel *a, unsigned geom, unsigned prim, unsigned inst)
 {
     if (!a || geom == RTC_INVALID_GEOMETRY_ID) return NULL;

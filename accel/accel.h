@@ -143,6 +143,11 @@ void *accel_rtc_scene(const accel *a);
  * accel_rtc_link_scene_free releases it (before accel_free). */
 void *accel_rtc_link_scene(const accel *a);
 void accel_rtc_link_scene_free(void *scene);
+/* Fills one Embree ray-hit record (struct RTCRayHit) for rtcIntersect1M
+ * on either scene: origin o, direction d, the interval [tnear, inf), time
+ * 0, every mask bit, no hit yet. */
+struct RTCRayHit;
+void accel_rtc_rayhit_init(struct RTCRayHit *rh, const float o[3], float tnear, const float d[3]);
 /* The leaf object of a hit that rtcIntersect on accel_rtc_scene reported
  * (geomID, primID and instID[0] of its RTCHit), as accel_intersect would
  * give it; NULL when the record alone does not tell (a member of a CSG) or

@@ -23,6 +23,7 @@
 #   cbox_path       scenes/cbox.pov  48x48 --gi path --spp 4
 #   cbox_pmfg       scenes/cbox.pov  32x32 --gi pmfg --fg-rays 64 --photons 20000 --spp 1
 #   cbox_vpl        scenes/cbox.pov  48x48 --gi vpl
+#   cbox_links      scenes/cbox.pov  48x48 --gi links
 #   photons_none    the distribution's lights/phot_met_glass.pov 64x48 --gi
 #                   none (its photons{} block: the caustic layer)
 #   photons_pmfg    the same, 32x24 --gi pmfg --fg-rays 64 --photons 20000
@@ -86,6 +87,7 @@ render_set() { # BIN DIR
     render_one "$bin" "$dir" cbox_path cbox.pov --size 48x48 --gi path --spp 4
     render_one "$bin" "$dir" cbox_pmfg cbox.pov --size 32x32 --gi pmfg --fg-rays 64 --photons 20000 --spp 1
     render_one "$bin" "$dir" cbox_vpl cbox.pov --size 48x48 --gi vpl
+    render_one "$bin" "$dir" cbox_links cbox.pov --size 48x48 --gi links
     render_one "$bin" "$dir" photons_none phot_met_glass.pov --size 64x48 --gi none
     render_one "$bin" "$dir" photons_pmfg phot_met_glass.pov --size 32x24 --gi pmfg --fg-rays 64 --photons 20000 --spp 1
 }

@@ -148,29 +148,14 @@ static void job(void *ctx, int index, int thread)
         float t[3] = {(float)tv.x, (float)tv.y, (float)tv.z}, bb[3] = {(float)bv.x, (float)bv.y, (float)bv.z};
         float nf[3] = {(float)nrm.x, (float)nrm.y, (float)nrm.z};
         float tnear = (float)accel_epsilon(J->a, org, nrm);
-        float ox = (float)org.x, oy = (float)org.y, oz = (float)org.z;
+        const float of[3] = {(float)org.x, (float)org.y, (float)org.z};
         rng r;
         rng_seed(&r, J->seed, (uint64_t)i);
         for (int j = 0; j < J->k; j++) {
             float u1 = (float)rng_f64(&r), u2 = (float)rng_f64(&r);
             float d[3];
             direction_f(t, bb, nf, J->su0[j], J->sv0[j], J->sw, u1, u2, d);
-            struct RTCRayHit *h = &rh[m++];
-            h->ray.org_x = ox;
-            h->ray.org_y = oy;
-            h->ray.org_z = oz;
-            h->ray.tnear = tnear;
-            h->ray.dir_x = d[0];
-            h->ray.dir_y = d[1];
-            h->ray.dir_z = d[2];
-            h->ray.time = 0.0f;
-            h->ray.tfar = INFINITY;
-            h->ray.mask = 0xFFFFFFFFu;
-            h->ray.id = 0;
-            h->ray.flags = 0;
-            h->hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            h->hit.primID = RTC_INVALID_GEOMETRY_ID;
-            h->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            accel_rtc_rayhit_init(&rh[m++], of, tnear, d);
         }
     }
     struct RTCIntersectContext c;

@@ -289,22 +289,9 @@ static void link_chunk(void *ctx, int ci, int thread)
         for (int k = 0; k < v->nc; k++) {
             vec3 l = v->dirs[k];
             vec3 dir = v3_add(v3_add(v3_scale(t, l.x), v3_scale(b, l.y)), v3_scale(n, l.z));
-            struct RTCRayHit *q = &rh[k];
-            q->ray.org_x = (float)org.x;
-            q->ray.org_y = (float)org.y;
-            q->ray.org_z = (float)org.z;
-            q->ray.tnear = tnear;
-            q->ray.dir_x = (float)dir.x;
-            q->ray.dir_y = (float)dir.y;
-            q->ray.dir_z = (float)dir.z;
-            q->ray.time = 0.0f;
-            q->ray.tfar = INFINITY;
-            q->ray.mask = 0xFFFFFFFFu;
-            q->ray.id = 0;
-            q->ray.flags = 0;
-            q->hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            q->hit.primID = RTC_INVALID_GEOMETRY_ID;
-            q->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            const float of[3] = {(float)org.x, (float)org.y, (float)org.z};
+            const float df[3] = {(float)dir.x, (float)dir.y, (float)dir.z};
+            accel_rtc_rayhit_init(&rh[k], of, tnear, df);
         }
         struct RTCIntersectContext ictx;
         rtcInitIntersectContext(&ictx);
