@@ -163,8 +163,7 @@ void caustics_json(caustics *c, stats_json *js)
     stats_str(js, "device", s->device);
     stats_int(js, "pairs", s->combos);
     stats_num(js, "spacing", s->spacing);
-    stats_int(js, "emitted", s->emitted);
-    stats_int(js, "first_hits", s->first_hits);
+    STATS_INTS(js, s, emitted, first_hits);
     stats_int(js, "absorbed_at_bounce_map", s->absorbed_first);
     stats_obj_begin(js, "alive_after_bounce");
     for (int b = 1; b <= s->max_bounce; b++) {
@@ -173,30 +172,15 @@ void caustics_json(caustics *c, stats_json *js)
         stats_int(js, k, s->alive[b]);
     }
     stats_obj_end(js);
-    stats_int(js, "stored", s->stored);
-    stats_num(js, "flux", s->flux);
-    stats_num(js, "r_median", s->r_median);
-    stats_int(js, "rays", s->rays);
-    stats_int(js, "tile_entries", s->tile_entries);
-    stats_int(js, "lookups_gbuffer", s->lookups_gbuffer);
-    stats_int(js, "lookups_photons", s->lookups_photons);
+    STATS_INTS(js, s, stored);
+    STATS_NUMS(js, s, flux, r_median);
+    STATS_INTS(js, s, rays, tile_entries, lookups_gbuffer, lookups_photons);
     stats_obj_begin(js, "seconds");
-    stats_num(js, "trace", s->t_trace);
-    stats_num(js, "gbuffer", s->t_gbuffer);
-    stats_num(js, "bin", s->t_bin);
-    stats_num(js, "splat", s->t_splat);
+    STATS_NUMS_PRE(js, s, t_, trace, gbuffer, bin, splat);
     stats_obj_end(js);
     stats_obj_begin(js, "not_modelled");
-    const caustics_not_modelled *nm = &c->nm;
-    stats_int(js, "gather", nm->gather);
-    stats_int(js, "radius", nm->radius);
-    stats_int(js, "expand_thresholds", nm->expand_thresholds);
-    stats_int(js, "autostop", nm->autostop);
-    stats_int(js, "media", nm->media);
-    stats_int(js, "save_file", nm->save_file);
-    stats_int(js, "load_file", nm->load_file);
-    stats_int(js, "dispersion", nm->dispersion);
-    stats_int(js, "media_objects", nm->media_objects);
+    STATS_INTS(js, &c->nm, gather, radius, expand_thresholds, autostop, media, save_file, load_file, dispersion,
+               media_objects);
     stats_obj_end(js);
     stats_obj_end(js);
 }

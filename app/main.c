@@ -740,10 +740,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
             stats_int(&js, "gi_lighting_ran", sst.ran_lighting);
         }
         stats_int(&js, "rays", sst.primary_rays + sst.shadow_rays + sst.secondary_rays + sst.other_rays);
-        stats_int(&js, "primary_rays", sst.primary_rays);
-        stats_int(&js, "shadow_rays", sst.shadow_rays);
-        stats_int(&js, "secondary_rays", sst.secondary_rays);
-        stats_int(&js, "other_rays", sst.other_rays);
+        STATS_INTS(&js, &sst, primary_rays, shadow_rays, secondary_rays, other_rays);
         stats_int(&js, "discarded_samples", sst.discarded);
         stats_int(&js, "width", ss.width);
         stats_int(&js, "height", ss.height);
@@ -752,17 +749,11 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
         stats_str(&js, "gi_requested", o->gi ? o->gi : (sc->global.radiosity.enabled ? "particle" : "none"));
         stats_str(&js, "scene", o->scene);
         stats_obj_begin(&js, "scene_counts");
-        stats_int(&js, "objects", cnt.objects);
-        stats_int(&js, "lights", cnt.lights);
-        stats_int(&js, "triangles", cnt.triangles);
-        stats_int(&js, "unsupported", cnt.unsupported);
+        STATS_INTS(&js, &cnt, objects, lights, triangles, unsupported);
         stats_obj_end(&js);
         render_gi_json(&sst, gi, &js);
         stats_obj_begin(&js, "accel");
-        stats_int(&js, "geometries", as.geometries);
-        stats_int(&js, "instances", as.instances);
-        stats_int(&js, "triangles", as.triangles);
-        stats_int(&js, "user_prims", as.user_prims);
+        STATS_INTS(&js, &as, geometries, instances, triangles, user_prims);
         stats_obj_end(&js);
         /* an animation's stats file holds its last frame's figures */
         int ok = stats_write(&js, o->stats);
