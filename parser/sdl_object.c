@@ -163,10 +163,25 @@ static void merge_lights(sdl_parser *p, sdl_obj *to, const sdl_obj *from)
 
 enum { INHERITED_FLAGS = OBJ_NO_REFLECTION | OBJ_NO_RADIOSITY | OBJ_NO_IMAGE | OBJ_NO_SHADOW };
 
+/* An object's own copy of its interior: POV-Ray gives each object its own
+ * Interior (a declared material or interior is copied into every object
+ * that uses it, parser.cpp), and a ray's list of the objects it is inside
+ * tells them apart by it (shade_media.h). */
+static void own_interior(sdl_parser *p, scene_object *o)
+{
+    if (!o->interior) return;
+    scene_interior *in = sdl_alloc(p, sizeof *in);
+    if (!in) return;
+    *in = *o->interior;
+    o->interior = in;
+}
+
 /* POV-Ray's post-processing: kids take the parent's texture, interior
- * texture, interior and visibility flags when they have none. */
+ * texture, interior (the same one: parser.cpp's Post_Process) and
+ * visibility flags when they have none. */
 static void post_process(sdl_parser *p, scene_object *o, const scene_object *parent, const scene_texture *deflt)
 {
+    if (!parent || o->interior) own_interior(p, o);
     if (parent) {
         if (!o->texture) o->texture = parent->texture;
         if (!o->interior_texture) o->interior_texture = parent->interior_texture;

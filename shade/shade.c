@@ -394,7 +394,7 @@ static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, in
                      float wavelength, rng *r, const shade_media_inside *in)
 {
     shade_tex_env e = {c->sc, c->eps, c->s->use_ambient, c->max_level, c, thread, r, tex_cb_trace, tex_cb_direct,
-                 c->s->indirect ? tex_cb_indirect : NULL, &c->ts[thread].unsupported, c->s->quality};
+                 c->s->indirect ? tex_cb_indirect : NULL, &c->ts[thread].unsupported, c->s->quality, in};
     hit_frame f = {h, dir, in};
     const hit_frame *outer = c->frame[thread];
     c->frame[thread] = &f;
@@ -701,8 +701,9 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     c.proj = shade_projection_build(sc, d);
     c.media = shade_media_scene_has(sc);
     if (camera_focal_blur(&sc->camera)) shade_focal_init(&c.focal, &sc->camera);
-    /* the camera's containers matter to media and to fog (not in non-hollow objects) */
-    if (c.media || sc->fogs || sc->rainbows) shade_media_inside_at(sc, sc->camera.location, &c.cam_in);
+    /* the camera's containers: they set the ior ratios at the surfaces its
+     * rays meet, and media and fog act only in hollow ones */
+    shade_media_inside_at(sc, sc->camera.location, &c.cam_in);
     int ntiles = c.tiles_x * c.tiles_y;
     const int *sw = s->window;
     int whole = !(sw[2] > sw[0] && sw[3] > sw[1]);

@@ -114,6 +114,14 @@ int shade_media_inside_has_media(const shade_media_inside *in)
     return 0;
 }
 
+int shade_media_inside_find(const shade_media_inside *in, const scene_object *o)
+{
+    const void *k = key_of(o);
+    for (int i = 0; i < in->n; i++)
+        if (key_of(in->obj[i]) == k) return i;
+    return -1;
+}
+
 void shade_media_inside_cross(shade_media_inside *in, const scene_object *o)
 {
     if (!o) return;
@@ -146,8 +154,7 @@ static void inside_at(const scene_object *o, vec3 p, shade_media_inside *in, int
         return;
     }
     if (o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE || o->kind == SHAPE_UNSUPPORTED) return;
-    int matters = !(o->flags & OBJ_HOLLOW) || (o->interior && o->interior->nmedia > 0);
-    if (!matters || o->clip) return;
+    if (o->clip) return;
     if (!leaf_inside(o, p)) return;
     for (int i = 0; i < in->n; i++)
         if (key_of(in->obj[i]) == key_of(o)) return;

@@ -31,10 +31,14 @@ int shade_media_scene_has(const scene *sc);
 int shade_media_inside_hollow(const shade_media_inside *in);
 /* Do the containers hold any media? */
 int shade_media_inside_has_media(const shade_media_inside *in);
+/* Where o's interior is in the list (0 = outermost), -1 if the ray is not
+ * inside it. */
+int shade_media_inside_find(const shade_media_inside *in, const scene_object *o);
 /* The ray crosses object o's surface: leave it if inside, else enter it. */
 void shade_media_inside_cross(shade_media_inside *in, const scene_object *o);
-/* The objects holding point p (the camera's location) that matter to the
- * list: those with media or not hollow (POV-Ray's containing interiors). */
+/* The objects holding point p (the camera's location), POV-Ray's
+ * containing interiors (tracepixel.cpp's InitRayContainerState): every
+ * object, hollow or not, as each has an interior there. */
 void shade_media_inside_at(const scene *sc, vec3 p, shade_media_inside *in);
 
 /* Light of l reaching p (attenuated, shadowed, filtered) and the unit

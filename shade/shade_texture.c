@@ -74,6 +74,12 @@ typedef struct {
     int entering;
     vec3 p_out, p_in;
     const scene_interior *interior;
+    /* From the incoming ray's containers (POV-Ray's interior list): the
+     * refraction's ior and dispersion ratios (ComputeRefraction), the
+     * relative ior of the fresnel reflectivity (ComputeRelativeIOR) and
+     * whether the ray travelled inside this interior (its fade applies). */
+    double eta, disp_ratio, rel_ior;
+    int inside_interior;
     int level;
     unsigned skip;
     float wavelength; /* the incoming ray's band, 0 = all colours */
@@ -168,8 +174,7 @@ static rgb reflectivity(const hit_info *hi, const scene_finish *f, double cos_i,
 {
     rgb rmax = f->reflection_max, rmin = f->reflection_min, refl;
     if (f->fresnel) {
-        double ior = interior_ior(hi->interior);
-        if (!hi->entering) ior = 1.0 / ior;
+        double ior = hi->rel_ior;
         double sqx = ior * ior + cos_i * cos_i - 1.0;
         if (sqx > 0.0) {
             double g = sqrt(sqx);
@@ -218,13 +223,7 @@ static int refraction(const hit_info *hi, vec3 top, double weight, rgb *colour)
 {
     const shade_tex_env *e = hi->e;
     const scene_interior *in = hi->interior;
-    double ior = interior_ior(in);
-    /* the interior keeps dispersion in single precision as POV-Ray does */
-    double disp = in ? (double)(float)in->dispersion : 1.0;
-    /* POV-Ray's ratios: outside/inside entering, inside/outside leaving
-     * (the atmosphere's ior and dispersion being 1). */
-    double eta = hi->entering ? 1.0 / ior : ior;
-    double dr = hi->entering ? 1.0 / disp : disp;
+    double eta = hi->eta, dr = hi->disp_ratio;
     *colour = trgb(0, 0, 0);
     if (weight < e->sc->global.adc_bailout) return 0;
     if (fabs(eta - 1.0) < TEX_EPSILON && fabs(dr - 1.0) < TEX_EPSILON) {
@@ -343,7 +342,7 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
         rgb rfr;
         tir = refraction(hi, top, weight * w1, &rfr);
         rgb att = {1, 1, 1};
-        if (!hi->entering) att = fade(hi->interior, hi->h->t, 0);
+        if (hi->inside_interior) att = fade(hi->interior, hi->h->t, 0);
         if (tir || !one_colour_found) result = tadd(result, tmul(att, rfr));
         else result = tadd(result, tmul(tmul(att, rfr), filcol));
     }
@@ -428,6 +427,54 @@ static const scene_texture *hit_texture(const scene *sc, const accel_hit *h, int
     return h->texture ? h->texture : &sc->default_texture;
 }
 
+/* the interior keeps dispersion in single precision as POV-Ray does */
+static double interior_dispersion(const scene_interior *in) { return in ? (double)(float)in->dispersion : 1.0; }
+
+/* The ior ratios at a hit on object o from the containers of the incoming
+ * ray, as POV-Ray 3.7 derives them from the ray's interior list (trace.cpp;
+ * the atmosphere's ior and dispersion being 1). Refraction
+ * (ComputeRefraction): entering from the atmosphere outside/inside; leaving
+ * the innermost container inside/(the next container or 1); leaving an
+ * overlap 1; entering a nested object (the innermost container)/inside.
+ * Fresnel reflectivity (ComputeRelativeIOR), with its own rule for a ray
+ * inside two or more containers leaving one of them: the innermost
+ * container's ior over the object's, which is 1 when the object is the
+ * innermost (a glass object in a closed room reflects only its
+ * reflection_min from inside). Without a list (in NULL) the geometric side
+ * decides, as for a ray from the atmosphere. */
+static void ior_setup(hit_info *hi, const shade_media_inside *in, const scene_object *o)
+{
+    double ior = interior_ior(hi->interior), disp = interior_dispersion(hi->interior);
+    if (!in) {
+        hi->inside_interior = !hi->entering;
+        hi->eta = hi->entering ? 1.0 / ior : ior;
+        hi->disp_ratio = hi->entering ? 1.0 / disp : disp;
+        hi->rel_ior = hi->entering ? ior : 1.0 / ior;
+        return;
+    }
+    int n = in->n, at = o ? shade_media_inside_find(in, o) : -1;
+    const scene_interior *last = n > 0 ? in->obj[n - 1]->interior : NULL;
+    hi->inside_interior = at >= 0;
+    if (n == 0) {
+        hi->eta = 1.0 / ior;
+        hi->disp_ratio = 1.0 / disp;
+        hi->rel_ior = ior;
+    } else if (at == n - 1) {
+        const scene_interior *next = n > 1 ? in->obj[n - 2]->interior : NULL;
+        hi->eta = ior / interior_ior(next);
+        hi->disp_ratio = disp / interior_dispersion(next);
+        hi->rel_ior = n == 1 ? 1.0 / ior : interior_ior(last) / ior;
+    } else if (at >= 0) {
+        hi->eta = 1.0;
+        hi->disp_ratio = 1.0;
+        hi->rel_ior = interior_ior(last) / ior;
+    } else {
+        hi->eta = interior_ior(last) / ior;
+        hi->disp_ratio = interior_dispersion(last) / disp;
+        hi->rel_ior = ior / interior_ior(last);
+    }
+}
+
 rgb shade_tex_shade(const shade_tex_env *e, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip, float wavelength)
 {
     hit_info hi;
@@ -448,6 +495,7 @@ rgb shade_tex_shade(const shade_tex_env *e, const accel_hit *h, vec3 dir, int le
     hi.p_out = v3_madd(h->p, ng, e->eps);
     hi.p_in = v3_madd(h->p, ng, -e->eps);
     hi.interior = h->obj ? h->obj->interior : NULL;
+    ior_setup(&hi, e->inside, h->obj);
     hi.pc = shade_pattern_ctx_plain(e->sc);
     ctx_from_hit(&hi.pc, h);
     hi.pc.normal = n;

@@ -18,6 +18,7 @@
 #include "rng.h"
 #include "scene.h"
 #include "shade_light.h"
+#include "shade_media.h"
 
 typedef struct {
     const scene *sc;
@@ -39,6 +40,12 @@ typedef struct {
     rgb (*indirect)(void *ctx, int thread, const accel_hit *h, vec3 n);
     long *unsupported;   /* incremented when a hit uses something not evaluated (may be NULL) */
     int quality;         /* POV-Ray's +Q level (shade_settings.quality): 9 everything */
+    /* The containers of the ray being shaded (POV-Ray's interior list: the
+     * camera's, then toggled by each surface a transmitted ray crosses);
+     * they set the ior ratios and whether the interior's fade applies.
+     * NULL: the ray's side of the surface decides (a ray from the
+     * atmosphere). */
+    const shade_media_inside *inside;
 } shade_tex_env;
 
 /* Colour seen along unit `dir` at hit h (the ray's level and weight as in
