@@ -23,21 +23,35 @@ static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, rng *r, gi_caus
     step->dir = s.dir;
     step->weight = (rgb){s.weight.r * s.eta2, s.weight.g * s.eta2, s.weight.b * s.eta2};
     if (s.lobe == SHADE_MAT_LOBE_TRANSMIT && b.m[SHADE_MAT_LOBE_TRANSMIT] > 0.0) {
-        /* what a refracted photon keeps is what POV-Ray's filtered shadow
-         * keeps through that surface: the layers' filter and transmit and,
-         * leaving an object, the interior's fade over h->t, the straight
-         * path inside (shade_tex_shadow_filter; checked against POV-Ray 3.7:
-         * a glass slab with conserve_energy and fresnel reflection passes
-         * its photons and its filtered shadow alike, with no reflection
-         * loss); the lobe was chosen with probability m_t (mat_sample) */
+        /* what a refracted photon keeps: the layers' filter and transmit
+         * and, leaving an object, the interior's fade over h->t, the
+         * straight path inside (shade_tex_shadow_filter), times 1 - the
+         * top layer's reflectivity under conserve_energy (POV-Ray 3.7's
+         * photons.cpp, PhotonTrace::ComputeLightedTexture: FilCol *= 1 -
+         * reflec, the photon carrying LightCol * FilCol); the lobe was
+         * chosen with probability m_t (mat_sample) */
         double p = b.m[SHADE_MAT_LOBE_TRANSMIT] / (b.msum > 1.0 ? b.msum : 1.0);
         rgb f = shade_tex_shadow_filter(c->sc, h, dir);
+        if (b.ls.f && b.ls.f->conserve_energy) {
+            rgb kr = b.k[SHADE_MAT_LOBE_REFLECT];
+            f = (rgb){f.r * fmin(1.0, 1.0 - kr.r), f.g * fmin(1.0, 1.0 - kr.g), f.b * fmin(1.0, 1.0 - kr.b)};
+        }
         step->weight = (rgb){f.r * s.eta2 / p, f.g * s.eta2 / p, f.b * s.eta2 / p};
     }
     step->rho = b.m[s.lobe];
     step->refract = s.lobe == SHADE_MAT_LOBE_TRANSMIT;
     step->from = b.from;
     return out | GI_CAUSTIC_CONTINUES;
+}
+
+/* The brilliance of the top layer's finish at the hit (POV-Ray shades each
+ * photon through it; the caustic layer weights its photons so). */
+static double hook_brilliance(void *ctx, const accel_hit *h, vec3 dir)
+{
+    const caustics *c = ctx;
+    shade_mat_bsdf b;
+    shade_mat_setup(&b, c->sc, h, dir, c->eps, NULL);
+    return b.ls.f ? b.ls.f->brilliance : 1.0;
 }
 
 /* Spot and cylinder attenuation seen from the photon's first hit p, fade at
@@ -112,7 +126,7 @@ pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width
     not_modelled(c, sc, d);
     c->sc = sc;
     c->eps = accel_scale(a) * 1e-6;
-    gi_caustic_hooks hk = {hook_surface, hook_attenuation, c};
+    gi_caustic_hooks hk = {hook_surface, hook_attenuation, c, hook_brilliance};
     gi_caustic_settings s = {width, height, threads, seed, cl_device, cl_max_bytes, count_scale, cancel};
     pt_status st = PT_OK;
     c->layer = gi_caustic_build(sc, a, &s, &hk, d, &st);

@@ -562,6 +562,7 @@ static void gbuf_row(void *ctx, int y, int thread)
             px->n[0] = (float)n.x;
             px->n[1] = (float)n.y;
             px->n[2] = (float)n.z;
+            px->brilliance = c->hk.brilliance ? (float)c->hk.brilliance(c->hk.ctx, &h, d) : 1.0f;
             c->gobj[k] = h.obj;
             /* footprint: the neighbouring pixels' rays at the same distance */
             double t = h.t;
@@ -916,18 +917,19 @@ rgb gi_caustic_at(void *ctx, const accel_hit *h, vec3 n, int thread)
     /* elsewhere: the same photon volumes, summed at p */
     __atomic_fetch_add(&c->st.lookups_photons, 1, __ATOMIC_RELAXED);
     float s[3] = {(float)p.x, (float)p.y, (float)p.z}, nn[3] = {(float)n.x, (float)n.y, (float)n.z}, acc[3] = {0, 0, 0};
+    float b = c->hk.brilliance ? (float)c->hk.brilliance(c->hk.ctx, h, v3_neg(n)) : 1.0f;
     cell = c->pgrid.cell;
     hgrid_cell(&c->pgrid, cidx(p.x, cell), cidx(p.y, cell), cidx(p.z, cell), &lo, &hi);
     for (long q = lo; q < hi; q++) {
         float one[3];
-        gi_c_caustic_at(c->ph, &c->pgrid.e[q].id, 1, s, nn, one);
+        gi_c_caustic_at(c->ph, &c->pgrid.e[q].id, 1, s, nn, b, one);
         acc[0] += one[0];
         acc[1] += one[1];
         acc[2] += one[2];
     }
     if (c->pgrid.nbig) {
         float one[3];
-        gi_c_caustic_at(c->ph, c->pgrid.big, (int)c->pgrid.nbig, s, nn, one);
+        gi_c_caustic_at(c->ph, c->pgrid.big, (int)c->pgrid.nbig, s, nn, b, one);
         acc[0] += one[0];
         acc[1] += one[1];
         acc[2] += one[2];

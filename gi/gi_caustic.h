@@ -88,6 +88,9 @@ typedef struct {
      * photon) for path length depth (shade_light_attenuation). */
     double (*attenuation)(void *ctx, const scene_light *l, vec3 p, double depth);
     void *ctx;
+    /* The brilliance of the receiving finish at h seen along unit dir (the
+     * photons' weight, gi_caus_add); NULL: 1. */
+    double (*brilliance)(void *ctx, const accel_hit *h, vec3 dir);
 } gi_caustic_hooks;
 
 typedef struct {

@@ -36,19 +36,25 @@ static inline float gi_caus_kappa(GI_GLOBAL const gi_caus_photon *q, float sx, f
 }
 
 /* Equation 1 without the BSDF: what photon q adds to the receiver's
- * irradiance (E/pi units) at s with normal n facing the viewer,
- * Phi * kappa where the light arrives on n's side (max(0, w_i . n) > 0).
- * The paper's equation 1 also multiplies by w_i . n; the photon density
- * already carries that cosine (a beam of photons spreads over area / cos),
- * so the estimate here is Jensen's sum f Phi / area, as POV-Ray's gather
- * computes it too (trace.cpp divides its diffuse cosine back out). The BSDF
- * f is applied by the shader: diffuse * pigment times this value. */
+ * irradiance (E/pi units) at s with normal n facing the viewer, of finish
+ * brilliance b: Phi * kappa * g where the light arrives on n's side
+ * (c = w_i . n > 0). The paper's equation 1 multiplies by c; the photon
+ * density already carries that cosine (a beam of photons spreads over
+ * area / c), so the estimate is Jensen's sum f Phi / area, with POV-Ray's
+ * own weight g = c^b / max(c, 0.1): its gather shades each photon as a
+ * light through the finish's diffuse term, cos^brilliance, after dividing
+ * by the cosine, at most tenfold (trace.cpp, ComputePhotonDiffuseLight and
+ * ComputeDiffuseColour). g is 1 for brilliance 1 above c = 0.1. The BSDF's
+ * diffuse * pigment is applied by the shader. */
 static inline void gi_caus_add(GI_GLOBAL const gi_caus_photon *q, float sx, float sy, float sz, float nx, float ny,
-                               float nz, float *e)
+                               float nz, float b, float *e)
 {
-    if (q->w[0] * nx + q->w[1] * ny + q->w[2] * nz <= 0.0f) return;
+    float c = q->w[0] * nx + q->w[1] * ny + q->w[2] * nz;
+    if (c <= 0.0f) return;
     float k = gi_caus_kappa(q, sx, sy, sz);
     if (k <= 0.0f) return;
+    if (c > 1.0f) c = 1.0f;
+    k *= (b == 1.0f ? c : (float)pow(c, b)) / (c > 0.1f ? c : 0.1f);
     e[0] += q->phi[0] * k;
     e[1] += q->phi[1] * k;
     e[2] += q->phi[2] * k;
@@ -68,7 +74,7 @@ __kernel void gi_k_caustic_splat(__global const gi_caus_photon *ph, __global con
     if (px->valid > 0.0f) {
         int t = (g / w) / GI_CAUS_TILE * tiles_x + (g % w) / GI_CAUS_TILE;
         for (int k = tile_off[t]; k < tile_off[t + 1]; k++)
-            gi_caus_add(&ph[tile_idx[k]], px->s[0], px->s[1], px->s[2], px->n[0], px->n[1], px->n[2], acc);
+            gi_caus_add(&ph[tile_idx[k]], px->s[0], px->s[1], px->s[2], px->n[0], px->n[1], px->n[2], px->brilliance, acc);
     }
     for (int c = 0; c < 3; c++) e[4 * g + c] = isfinite(acc[c]) ? acc[c] : 0.0f;
     e[4 * g + 3] = 0.0f;

@@ -224,12 +224,13 @@ typedef struct {
 
 /* One eye G-buffer texel (paper step 2): the world position s and normal n
  * of the camera's first receiving hit through the pixel's centre, n turned
- * towards the camera; valid 0 where the pixel sees no receiver. 32 bytes. */
+ * towards the camera, and the brilliance of its finish (gi_caus_add);
+ * valid 0 where the pixel sees no receiver. 32 bytes. */
 typedef struct {
     float s[3];
     float valid;
     float n[3];
-    float pad;
+    float brilliance;
 } gi_caus_pixel;
 
 /* Tile edge (pixels) of the splat's binning: a photon is listed in every
