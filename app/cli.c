@@ -496,6 +496,18 @@ int cli_wants_help(int argc, char **argv)
     return 0;
 }
 
+int cli_print_diags(const diag *d, int from, int errors_only)
+{
+    for (int i = from; i < diag_count(d); i++) {
+        const diag_msg *m = diag_get(d, i);
+        if (errors_only && m->severity != DIAG_ERROR) continue;
+        char *s = diag_format(m);
+        if (s) fprintf(stderr, "%s\n", s);
+        free(s);
+    }
+    return diag_count(d);
+}
+
 int cli_check_output(const char *path, char *err, int errlen)
 {
     struct stat st;

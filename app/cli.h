@@ -32,6 +32,10 @@ int cli_wants_help(int argc, char **argv);
  * removed), and the path is not a directory. Returns 0, or writes why into
  * err and returns CLI_EXIT_IO. */
 int cli_check_output(const char *path, char *err, int errlen);
+/* Prints d's messages from index `from` on to stderr, one a line as
+ * diag_format writes them (errors_only: the errors alone); returns
+ * diag_count(d), the `from` of the next call. */
+int cli_print_diags(const diag *d, int from, int errors_only);
 /* Help texts: `partray render --help`, `partray parse --help`. */
 extern const char cli_render_help[];
 extern const char cli_parse_help[];

@@ -18,17 +18,6 @@
 #include "img_metrics.h"
 #include "stats_json.h"
 
-static void print_diags(const diag *d)
-{
-    for (int i = 0; i < diag_count(d); i++) {
-        char *s = diag_format(diag_get(d, i));
-        if (s) {
-            fprintf(stderr, "%s\n", s);
-            free(s);
-        }
-    }
-}
-
 static void encode_srgb(framebuffer *fb)
 {
     size_t n = (size_t)fb->width * (size_t)fb->height * 3u;
@@ -107,7 +96,7 @@ int cmd_compare(int argc, char **argv)
         img_default_write_opts(&wo);
         st = img_write(heatmap, map, &wo, d);
     }
-    print_diags(d);
+    cli_print_diags(d, 0, 0);
     int rc = 0;
     if (st != PT_OK) {
         rc = exit_for(st);

@@ -84,17 +84,6 @@ typedef struct {
     int nlibs;
 } xc_opts;
 
-static void print_diags(const diag *d)
-{
-    for (int i = 0; i < diag_count(d); i++) {
-        char *s = diag_format(diag_get(d, i));
-        if (s) {
-            fprintf(stderr, "%s\n", s);
-            free(s);
-        }
-    }
-}
-
 static int parse_int(const char *s, int *out)
 {
     char *end;
@@ -522,7 +511,7 @@ int cmd_crosscheck(int argc, char **argv)
     scene *sc = NULL;
     pt_status st = pipeline_parse(o.scene, &so, &sc, d, NULL);
     if (st != PT_OK) {
-        print_diags(d);
+        cli_print_diags(d, 0, 0);
         diag_free(d);
         return st == PT_ERR_IO ? 3 : (st == PT_ERR_USAGE ? 2 : 1);
     }
@@ -600,7 +589,7 @@ int cmd_crosscheck(int argc, char **argv)
         char made[4300];
         snprintf(made, sizeof made, "%s/%s", work, pov_out);
         if (prc != 0 || access(made, R_OK) != 0) {
-            print_diags(d);
+            cli_print_diags(d, 0, 0);
             fprintf(stderr, "partray crosscheck: POV-Ray failed on %s (exit %d)\n", o.scene, prc);
             print_log_tail(pov_log, "POV-Ray");
             rc = prc < 0 ? 3 : 1;
@@ -617,7 +606,7 @@ int cmd_crosscheck(int argc, char **argv)
     if (o.converged && radiosity) {
         int crc = converged_reference(&o, povray, work, base, scene_dir, out, rad_count, rad_error_bound, &conv, d);
         if (crc != 0) {
-            print_diags(d);
+            cli_print_diags(d, 0, 0);
             rc = crc;
             goto done;
         }
@@ -661,7 +650,7 @@ int cmd_crosscheck(int argc, char **argv)
         int prc = subproc_run(argvv, NULL, pt_log, &t_pt, d);
         if (!o.quiet && prc == 0) fprintf(stderr, "partray crosscheck: partray done in %.1f s\n", t_pt);
         if (prc != 0) {
-            print_diags(d);
+            cli_print_diags(d, 0, 0);
             fprintf(stderr, "partray crosscheck: partray render failed (exit %d)\n", prc);
             print_log_tail(pt_log, "partray");
             rc = prc < 0 ? 3 : prc;
@@ -686,7 +675,7 @@ int cmd_crosscheck(int argc, char **argv)
     if (st == PT_OK) st = img_compare(a, b, 0, &r, o.out_dir ? &map : NULL, d);
     if (st == PT_OK && map) st = img_write(flip_png, map, NULL, d);
     if (st != PT_OK) {
-        print_diags(d);
+        cli_print_diags(d, 0, 0);
         rc = st == PT_ERR_IO ? 3 : 1;
         goto done;
     }
@@ -709,13 +698,13 @@ int cmd_crosscheck(int argc, char **argv)
         if (st == PT_OK) st = img_compare(ref, a, 0, &rc_pov, NULL, d);
         if (st == PT_OK) st = img_compare(ref, b, 0, &rc_pt, NULL, d);
         if (st != PT_OK) {
-            print_diags(d);
+            cli_print_diags(d, 0, 0);
             rc = st == PT_ERR_IO ? 3 : 1;
             goto done;
         }
         lum_ref = img_mean_luminance(ref, 1);
     }
-    if (!o.quiet) print_diags(d);
+    if (!o.quiet) cli_print_diags(d, 0, 0);
     if (o.json) {
         stats_json js;
         stats_begin(&js);

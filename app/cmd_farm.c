@@ -239,11 +239,7 @@ static void survey(const farm_plan *p, int merge, farm_state *s)
             for (int t = 0; t < p->tiles; t++) names[t] = tiles[t];
             diag *d = diag_new();
             pt_status st = merge_tiles(out, names, p->tiles, d);
-            for (int i = 0; i < diag_count(d); i++) {
-                char *m = diag_format(diag_get(d, i));
-                if (m) fprintf(stderr, "%s\n", m);
-                free(m);
-            }
+            cli_print_diags(d, 0, 0);
             diag_free(d);
             if (st == PT_OK) {
                 s->frames_done++;
@@ -593,11 +589,7 @@ int cmd_farm(int argc, char **argv)
     diag *d = diag_new();
     ini_args *ia = NULL;
     pt_status st = ini_expand(nrest, rest, &ia, d);
-    for (int i = 0; i < diag_count(d); i++) {
-        char *m = diag_format(diag_get(d, i));
-        if (m) fprintf(stderr, "%s\n", m);
-        free(m);
-    }
+    cli_print_diags(d, 0, 0);
     diag_free(d);
     free(rest);
     if (st != PT_OK) return st == PT_ERR_IO ? 3 : 2;
@@ -624,11 +616,7 @@ int cmd_farm(int argc, char **argv)
         diag *pd = diag_new();
         scene *sc = NULL;
         pt_status pst = pipeline_parse(o.scene, &so, &sc, pd, NULL);
-        for (int i = 0; i < diag_count(pd) && pst != PT_OK; i++) {
-            char *m = diag_format(diag_get(pd, i));
-            if (m && diag_get(pd, i)->severity == DIAG_ERROR) fprintf(stderr, "%s\n", m);
-            free(m);
-        }
+        if (pst != PT_OK) cli_print_diags(pd, 0, 1);
         diag_free(pd);
         if (pst != PT_OK) {
             if (plan.animated) fprintf(stderr, "partray farm: the scene does not parse (frame %d): nothing planned\n", plan.first);

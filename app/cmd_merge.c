@@ -157,11 +157,7 @@ int cmd_merge(int argc, char **argv)
     }
     diag *d = diag_new();
     pt_status st = merge_tiles(argv[0], (const char *const *)(argv + 1), argc - 1, d);
-    for (int i = 0; i < diag_count(d); i++) {
-        char *s = diag_format(diag_get(d, i));
-        if (s) fprintf(stderr, "%s\n", s);
-        free(s);
-    }
+    cli_print_diags(d, 0, 0);
     diag_free(d);
     return st == PT_OK ? 0 : st == PT_ERR_IO ? 3 : st == PT_ERR_NOMEM ? 3 : 2;
 }

@@ -136,19 +136,6 @@ static void on_stop(int sig)
     subproc_forward_signal(sig);
 }
 
-/* Prints the messages recorded since the last call. */
-static void print_diags(const diag *d, int *printed)
-{
-    for (int i = *printed; i < diag_count(d); i++) {
-        char *s = diag_format(diag_get(d, i));
-        if (s) {
-            fprintf(stderr, "%s\n", s);
-            free(s);
-        }
-    }
-    *printed = diag_count(d);
-}
-
 static int exit_for(pt_status st) { return cli_exit_status(st); }
 
 static int parse_wxh(const char *v, int *w, int *h)
@@ -719,7 +706,7 @@ int cmd_sweep(int argc, char **argv)
     int hdr = rf != IMG_FMT_PNG;
     pt_status st = img_read(ref_path, !hdr, &ref, d);
     if (st != PT_OK) {
-        print_diags(d, &printed);
+        printed = cli_print_diags(d, printed, 0);
         rc = exit_for(st);
         goto done;
     }
@@ -799,7 +786,7 @@ int cmd_sweep(int argc, char **argv)
         st = show ? img_write(ref_png, show, NULL, d) : PT_ERR_NOMEM;
         if (show != ref) fb_free(show);
         if (st != PT_OK) {
-            print_diags(d, &printed);
+            printed = cli_print_diags(d, printed, 0);
             rc = exit_for(st);
             goto done;
         }
@@ -861,7 +848,7 @@ int cmd_sweep(int argc, char **argv)
             read_times(js, r);
             st = compare_run(out_dir, r, ref, hdr, d);
             if (st != PT_OK) {
-                print_diags(d, &printed);
+                printed = cli_print_diags(d, printed, 0);
                 if (!first_fail) first_fail = exit_for(st);
             }
         } else {
@@ -898,7 +885,7 @@ int cmd_sweep(int argc, char **argv)
     }
     st = write_plot(out_dir, runs, nruns, modes, nmodes, metric, tname, pw, ph, d);
     if (st != PT_OK) {
-        print_diags(d, &printed);
+        printed = cli_print_diags(d, printed, 0);
         rc = exit_for(st);
         goto done;
     }

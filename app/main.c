@@ -86,21 +86,6 @@ static const char *usage_text =
     "Without --gi a scene with radiosity{} asks for particle GI, otherwise none.\n"
     "`partray COMMAND --help` lists a command's options; docs/guide.md is the user guide.\n";
 
-/* Print every message in d to stderr; returns the number of errors. */
-static int print_diags(const diag *d, int quiet)
-{
-    for (int i = 0; i < diag_count(d); i++) {
-        const diag_msg *m = diag_get(d, i);
-        if (quiet && m->severity != DIAG_ERROR) continue;
-        char *s = diag_format(m);
-        if (s) {
-            fprintf(stderr, "%s\n", s);
-            free(s);
-        }
-    }
-    return diag_errors(d);
-}
-
 static int status_exit(pt_status st) { return cli_exit_status(st); }
 
 static void fill_sdl_options(sdl_options *so, const cli_render *o, const anim_plan *plan, int frame)
@@ -149,7 +134,7 @@ static int read_options(const char *cmd, const char *help, int argc, char **argv
     }
     diag *d = diag_new();
     pt_status st = ini_expand(argc, argv, ia, d);
-    print_diags(d, 0);
+    cli_print_diags(d, 0, 0);
     diag_free(d);
     if (st != PT_OK) return st == PT_ERR_IO ? EXIT_IO : EXIT_USAGE;
     char err[512];
@@ -250,7 +235,7 @@ static int write_false_color(const cli_render *o, const framebuffer *fb, const l
     if (st == PT_OK) st = img_write(o->false_color, out, NULL, d);
     if (st == PT_OK && !o->quiet) fprintf(stderr, "partray: false colour %s, %s %.4g to %.4g %s%s(log scale)\n", o->false_color,
                                           lighting_fc_name(ls), lo, hi, fo.unit ? fo.unit : "", fo.unit ? " " : "");
-    print_diags(d, 0);
+    cli_print_diags(d, 0, 0);
     diag_free(d);
     free(y);
     fb_free(out);
@@ -696,7 +681,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
             char *pn = partial_name(outputs[i]);
             diag *wd = diag_new();
             if (pn && img_write(pn, fb, &wo, wd) == PT_OK) fprintf(stderr, "partray: interrupted; partial image in %s\n", pn);
-            print_diags(wd, 0);
+            cli_print_diags(wd, 0, 0);
             diag_free(wd);
             free(pn);
         }
@@ -712,7 +697,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
                 diag_warn_once(wd, (src_loc){0}, "+UA: PFM has no alpha channel: %s is written without it", outputs[i]);
             pt_status ws = img_write(outputs[i], straight ? straight : fb, &wo, wd);
             fb_free(straight);
-            print_diags(wd, 0);
+            cli_print_diags(wd, 0, 0);
             diag_free(wd);
             if (ws != PT_OK) rc = status_exit(ws);
         }
@@ -875,7 +860,7 @@ static int cmd_render(int argc, char **argv)
         diag *od = diag_new();
         pt_status os = img_ocio_open(o.ocio_config, &oc, od);
         if (os == PT_OK) os = img_ocio_check(oc, o.working_space, o.display, o.view, o.look, od);
-        print_diags(od, 0);
+        cli_print_diags(od, 0, 0);
         diag_free(od);
         if (os != PT_OK) rc = status_exit(os == PT_ERR_IO ? PT_ERR_IO : PT_ERR_USAGE);
     }
@@ -886,7 +871,7 @@ static int cmd_render(int argc, char **argv)
         diag *ld = diag_new();
         pt_status lst = lighting_setup(&ls, o.units, o.aovs, o.fc_quantity, ld);
         if (lst == PT_OK) lighting_check_outputs(&ls, (const char **)bases, nbases, ld);
-        print_diags(ld, 0);
+        cli_print_diags(ld, 0, 0);
         diag_free(ld);
         if (lst != PT_OK) rc = EXIT_USAGE;
     }

@@ -120,22 +120,11 @@ static int file_exists(const char *path)
     return stat(path, &sb) == 0;
 }
 
-static void print_diags(diag *d)
-{
-    for (int i = 0; i < diag_count(d); i++) {
-        char *s = diag_format(diag_get(d, i));
-        if (s) {
-            fprintf(stderr, "%s\n", s);
-            free(s);
-        }
-    }
-}
-
 static void flush_messages(viewer *v)
 {
     diag *d = diag_new();
     view_render_messages(v->vr, d);
-    print_diags(d);
+    cli_print_diags(d, 0, 0);
     diag_free(d);
 }
 
@@ -189,7 +178,7 @@ static void write_image(viewer *v, const framebuffer *fb, const view_frame_info 
     diag *d = diag_new();
     if (img_write(path, fb, &wo, d) == PT_OK)
         printf("view: screenshot %s (%s, level %d/%d)\n", path, view_gi_name(in->gi_mode), in->level, in->last_level);
-    print_diags(d);
+    cli_print_diags(d, 0, 0);
     diag_free(d);
     fflush(stdout);
 }
@@ -675,7 +664,7 @@ static void save_window(viewer *v, const char *path)
         img_default_write_opts(&wo);
         diag *d = diag_new();
         if (img_write(path, fb, &wo, d) == PT_OK) printf("view: window %s (%dx%d, overlay %s)\n", path, w, h, v->overlay ? "on" : "off");
-        print_diags(d);
+        cli_print_diags(d, 0, 0);
         diag_free(d);
         fflush(stdout);
     } else {
@@ -940,7 +929,7 @@ int cmd_view(int argc, char **argv)
     diag *d = diag_new();
     if (script_path) {
         pt_status st = view_script_load(script_path, &v.script, d);
-        print_diags(d);
+        cli_print_diags(d, 0, 0);
         if (st != PT_OK) {
             diag_free(d);
             return status_exit(st);
@@ -957,7 +946,7 @@ int cmd_view(int argc, char **argv)
     scene *sc = NULL;
     diag *pd = diag_new();
     pt_status st = pipeline_parse(o.scene, &so, &sc, pd, NULL);
-    print_diags(pd);
+    cli_print_diags(pd, 0, 0);
     diag_free(pd);
     if (st != PT_OK) {
         view_script_free(v.script);
@@ -976,7 +965,7 @@ int cmd_view(int argc, char **argv)
 
     diag *ad = diag_new();
     accel *acc = pipeline_accel(sc, v.threads, ad, &st, NULL);
-    print_diags(ad);
+    cli_print_diags(ad, 0, 0);
     diag_free(ad);
     if (!acc) {
         scene_free(sc);
@@ -1029,7 +1018,7 @@ int cmd_view(int argc, char **argv)
         view_state s0 = current_state(&v);
         diag *rd = diag_new();
         st = view_render_start(&v.vr, sc, acc, &ro, &s0, rd);
-        print_diags(rd);
+        cli_print_diags(rd, 0, 0);
         diag_free(rd);
         if (st != PT_OK) rc = status_exit(st);
     }
