@@ -476,7 +476,7 @@ int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, doubl
         }
         for (int guard = 0; guard < 1000; guard++) {
             geom_shape_hit tmp[CSG_CHUNK];
-            int k = geom_shape_hits(&c->shapes[s], org, dir, from, best, tmp, CSG_CHUNK);
+            int k = geom_shape_ray_hits(&c->shapes[s], org, dir, from, best, tmp, CSG_CHUNK);
             int kept_one = 0;
             for (int j = 0; j < k; j++) {
                 if (geom_csg_kept(c, node, v3_madd(org, dir, tmp[j].t))) {

@@ -51,7 +51,12 @@ typedef struct {
     int iso_sphere, open;
     vec3 ic1, ic2;
     double ir, thr, acc, grad, size;
+    int max_trace; /* crossings per ray (POV-Ray's max_trace, 1 to ISO_MAX_TRACE) */
 } im_data;
+
+/* POV-Ray 3.7's ISOSURFACE_MAXTRACE (isosurf.h): the most crossings an
+ * isosurface reports per ray, all_intersections' count */
+#define ISO_MAX_TRACE 10
 
 /* ------------------------------------------------------------ superellipsoid */
 
@@ -850,7 +855,7 @@ static void iso_split(iso_walk *w, double t1, double f1, double t2, double f2, i
     iso_split(w, mid, fm, t2, f2, depth + 1);
 }
 
-static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
+static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max, int traced)
 {
     double ca, cb;
     if (!iso_container(m, o, d, &ca, &cb)) return 0;
@@ -859,15 +864,36 @@ static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, 
     double s = v3_len(d);
     vec3 e = v3_scale(d, 1.0 / s), p0 = v3_madd(o, d, a);
     double len = (b - a) * s;
-    int n = 0;
+    /* A traced ray: POV-Ray's max_trace (isosurface.cpp All_Intersections):
+     * at most max_trace crossings, the container's face where the ray enters
+     * it counting as one; the face where it leaves is added (not counted)
+     * only for a ray that starts inside the container. Otherwise every
+     * crossing and both faces where the inside reaches them. */
+    int n = 0, budget = traced ? m->max_trace : max;
     if (!m->open) {
-        if (ca > tmin && ca < tmax && iso_f(m, v3_madd(o, d, ca)) < 0.0) n = geom_shape_hit_put(out, n, max, ca, 1);
-        if (cb > tmin && cb < tmax && iso_f(m, v3_madd(o, d, cb)) < 0.0) n = geom_shape_hit_put(out, n, max, cb, 1);
+        if (!traced) {
+            if (ca > tmin && ca < tmax && iso_f(m, v3_madd(o, d, ca)) < 0.0) n = geom_shape_hit_put(out, n, max, ca, 1);
+            if (cb > tmin && cb < tmax && iso_f(m, v3_madd(o, d, cb)) < 0.0) n = geom_shape_hit_put(out, n, max, cb, 1);
+        } else if (ca > tmin) {
+            if (ca < tmax && iso_f(m, v3_madd(o, d, ca)) < 0.0) {
+                n = geom_shape_hit_put(out, n, max, ca, 1);
+                budget--;
+            }
+        } else if (cb < tmax && iso_f(m, v3_madd(o, d, cb)) < 0.0) {
+            n = geom_shape_hit_put(out, n, max, cb, 1);
+        }
     }
+    if (budget <= 0) return n;
     double minstep = fmax(m->acc, 1e-9 * m->size);
-    iso_walk w = {m, p0, e, a, s, tmin, tmax, minstep, out, n, max};
+    if (!traced) {
+        iso_walk w = {m, p0, e, a, s, tmin, tmax, minstep, out, n, max};
+        iso_split(&w, 0.0, iso_f(m, p0), len, iso_f(m, v3_madd(p0, e, len)), 0);
+        return w.n;
+    }
+    geom_shape_hit roots[ISO_MAX_TRACE];
+    iso_walk w = {m, p0, e, a, s, tmin, tmax, minstep, roots, 0, budget < max ? budget : max};
     iso_split(&w, 0.0, iso_f(m, p0), len, iso_f(m, v3_madd(p0, e, len)), 0);
-    n = w.n;
+    for (int i = 0; i < w.n; i++) n = geom_shape_hit_put(out, n, max, roots[i].t, roots[i].part);
     return n;
 }
 
@@ -995,6 +1021,9 @@ int geom_implicit_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi
         m->acc = is->accuracy > 0.0 ? is->accuracy : 0.001;
         m->grad = is->max_gradient > 0.0 ? is->max_gradient : 1.1;
         m->open = (o->flags & OBJ_OPEN) != 0;
+        /* max_trace below 1 is 1, above ISOSURFACE_MAXTRACE (10) is 10;
+         * all_intersections is 10 (POV-Ray 3.7 parse.cpp, isosurf.h) */
+        m->max_trace = is->max_trace == 0 ? ISO_MAX_TRACE : is->max_trace < 1 ? 1 : is->max_trace > ISO_MAX_TRACE ? ISO_MAX_TRACE : is->max_trace;
         m->solid_bounded = 1;
         if (m->iso_sphere) {
             if (!(m->ir > 0.0)) break;
@@ -1030,7 +1059,7 @@ void geom_implicit_free(void *data)
 }
 
 int geom_implicit_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out,
-                        int max)
+                        int max, int traced)
 {
     const im_data *m = sh->data;
     if (!m || max <= 0) return 0;
@@ -1038,7 +1067,7 @@ int geom_implicit_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double
     case IM_SUPER: return se_hits(m, o, d, tmin, tmax, out, max);
     case IM_QUADRIC: return quadric_hits(m, o, d, tmin, tmax, out, max);
     case IM_POLY: return poly_hits(m, o, d, tmin, tmax, out, max);
-    case IM_ISO: return iso_hits(m, o, d, tmin, tmax, out, max);
+    case IM_ISO: return iso_hits(m, o, d, tmin, tmax, out, max, traced);
     default: return blob_hits(m, o, d, tmin, tmax, out, max);
     }
 }

@@ -590,8 +590,8 @@ static int hits_ovus(const geom_shape *sh, vec3 o, vec3 d, double tmin, double t
 }
 
 /* Parameter interval of a ray inside a box. */
-int geom_shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
-                     int max)
+static int shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
+                      int max, int traced)
 {
     if (max <= 0) return 0;
     vec3 o = org, d = dir;
@@ -632,7 +632,7 @@ int geom_shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, doubl
         n = geom_sweep_hits(sh, o, d, a, b, out, max);
         break;
     case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
-        n = geom_implicit_hits(sh, o, d, a, b, out, max);
+        n = geom_implicit_hits(sh, o, d, a, b, out, max, traced);
         break;
     case SHAPE_HEIGHT_FIELD:
         n = geom_hfield_hits(sh, o, d, a, b, out, max);
@@ -651,6 +651,18 @@ int geom_shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, doubl
     for (int i = 0; i < n; i++)
         if (out[i].t > tmin && out[i].t < tmax && isfinite(out[i].t)) out[k++] = out[i];
     return k;
+}
+
+int geom_shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
+                     int max)
+{
+    return shape_hits(sh, org, dir, tmin, tmax, out, max, 0);
+}
+
+int geom_shape_ray_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
+                         int max)
+{
+    return shape_hits(sh, org, dir, tmin, tmax, out, max, 1);
 }
 
 typedef struct {
@@ -709,7 +721,7 @@ int geom_shape_grid(const geom_shape *sh, int n, geom_grid_fn fn, void *ctx)
 int geom_shape_intersect(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
                           geom_shape_hit *h)
 {
-    return geom_shape_hits(sh, org, dir, tmin, tmax, h, 1);
+    return geom_shape_ray_hits(sh, org, dir, tmin, tmax, h, 1);
 }
 
 int geom_shape_inside(const geom_shape *sh, vec3 p)

@@ -102,6 +102,12 @@ int geom_shape_intersect(const geom_shape *sh, vec3 org, vec3 dir, double tmin, 
  * shapes any number). */
 int geom_shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
                      int max);
+/* The crossings a traced ray gets (CSG members, geom_shape_intersect):
+ * geom_shape_hits under the scene's per-ray limits, as POV-Ray reports
+ * them: an isosurface gives at most its max_trace crossings (default 1).
+ * geom_shape_hits is the geometry's full set (tessellation, sampling). */
+int geom_shape_ray_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
+                         int max);
 /* Whether the world point p is strictly inside the solid, as POV-Ray defines
  * it for CSG: planes and discs are half-spaces (the side against the normal),
  * open cylinders and cones are their closed solids, triangles have no inside. */

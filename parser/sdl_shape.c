@@ -1105,7 +1105,9 @@ static void isosurface_args(sdl_parser *p, scene_object *o, src_loc loc)
             o->flags |= OBJ_OPEN;
         } else if (k == KW_MAX_TRACE) {
             sdl_next(p);
-            iso->max_trace = (int)sdl_float(p);
+            /* POV-Ray takes a count below 1 as 1 (0 here is all_intersections) */
+            double v = sdl_float(p);
+            iso->max_trace = v < 1.0 ? 1 : v > 1e6 ? 1000000 : (int)v;
         } else if (k == KW_ALL_INTERSECTIONS) {
             sdl_next(p);
             iso->max_trace = 0;
