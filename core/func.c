@@ -100,6 +100,20 @@ static double node_value(const scene_function *f, int i, double *slots, eval_ctx
     case FN_CALL: {
         double a[FUNC_MAX_SLOTS], r[5];
         for (int j = 0; j < n->nkids && j < FUNC_MAX_SLOTS; j++) a[j] = KID(j);
+        const scene_function *g = n->fn;
+        if (g->kind == FUNC_FLOAT && g->nodes[g->root].op == FN_INTERNAL && n->sub == 0) {
+            /* a body that is one built-in (functions.inc's f_rounded_box and
+             * the rest): the built-in reads the call's arguments directly,
+             * when the call gives it all of them */
+            int in = g->nodes[g->root].slot, np = func_internal_params(in);
+            if (np >= 0 && np <= n->nkids && np <= g->nparams) {
+                double v;
+                if (func_internal_eval(in, a, c->env, &v)) return v;
+                c->failed = 1;
+                c->why = func_internal_name(in);
+                return 0;
+            }
+        }
         if (eval_function(n->fn, a, r, c) != PT_OK) return 0;
         if (n->sub == 5) return 0.297 * r[0] + 0.589 * r[1] + 0.114 * r[2]; /* gray */
         return n->sub < n->fn->nterms ? r[n->sub] : 0.0;
@@ -133,8 +147,9 @@ static pt_status eval_function(const scene_function *f, const double *args, doub
         /* only the slots the body uses (parameters, loop variables) are
          * cleared: a call is evaluated per isosurface sample */
         int ns = f->nslots > np ? (f->nslots < FUNC_MAX_SLOTS ? f->nslots : FUNC_MAX_SLOTS) : np;
-        memcpy(slots, args, sizeof(double) * (size_t)np);
-        if (ns > np) memset(slots + np, 0, sizeof(double) * (size_t)(ns - np));
+        /* loops, not memcpy/memset: a handful of slots, per evaluation */
+        for (int i = 0; i < np; i++) slots[i] = args[i];
+        for (int i = np; i < ns; i++) slots[i] = 0.0;
         out[0] = node_value(f, f->root, slots, c);
         break;
     }
