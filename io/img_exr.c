@@ -478,21 +478,117 @@ static void bind_channels(exr_decode_pipeline_t *dec, framebuffer *fb, float *gr
     }
 }
 
-/* Decode one chunk described by ci into fb at (x0, y0). */
-static exr_result_t decode_chunk(exr_context_t ctx, const exr_chunk_info_t *ci, exr_decode_pipeline_t *dec,
-                                 int *dec_init, framebuffer *fb, float *grey, int x0, int y0, int use_y,
-                                 exr_scratch *scratch)
+typedef struct {
+    char names[4][80];
+    int n;
+    float *data; /* w*h*n */
+    int w;
+} layer_sink;
+
+static void bind_layer(exr_decode_pipeline_t *dec, const layer_sink *ls, int x0, int y0, exr_scratch *scratch)
 {
-    exr_result_t rv = *dec_init ? exr_decoding_update(ctx, 0, ci, dec) : exr_decoding_initialize(ctx, 0, ci, dec);
+    for (int c = 0; c < dec->channel_count; c++) {
+        exr_coding_channel_info_t *dc = &dec->channels[c];
+        int slot = -1;
+        for (int k = 0; k < ls->n && dc->channel_name; k++)
+            if (strcmp(dc->channel_name, ls->names[k]) == 0) slot = k;
+        dc->decode_to_ptr = NULL;
+        dc->user_pixel_stride = 0;
+        dc->user_line_stride = 0;
+        if (slot >= 0 && dc->x_samples == 1 && dc->y_samples == 1) {
+            size_t pix = (size_t)y0 * (size_t)ls->w + (size_t)x0;
+            dc->decode_to_ptr = (uint8_t *)(ls->data + pix * (size_t)ls->n + (size_t)slot);
+            dc->user_pixel_stride = (int32_t)(sizeof(float) * (size_t)ls->n);
+            dc->user_line_stride = (int32_t)(sizeof(float) * (size_t)ls->n * (size_t)ls->w);
+        }
+        dc->user_data_type = EXR_PIXEL_FLOAT;
+        dc->user_bytes_per_element = 4;
+        if (!dc->decode_to_ptr) bind_scratch(dc, scratch);
+    }
+}
+
+/* Where a read decodes to: the image (fb, and grey for a luminance-only
+ * file) or named channels (ls), with the decoding pipeline and the scratch
+ * block they share from chunk to chunk. */
+typedef struct {
+    exr_decode_pipeline_t dec;
+    int dec_init;
+    exr_scratch scratch;
+    framebuffer *fb;
+    float *grey;
+    int use_y;
+    const layer_sink *ls; /* non-NULL: named channels */
+} chunk_sink;
+
+/* Decode one chunk described by ci into the sink at (x0, y0). */
+static exr_result_t decode_chunk(exr_context_t ctx, const exr_chunk_info_t *ci, chunk_sink *k, int x0, int y0)
+{
+    exr_result_t rv = k->dec_init ? exr_decoding_update(ctx, 0, ci, &k->dec) : exr_decoding_initialize(ctx, 0, ci, &k->dec);
     if (rv != EXR_ERR_SUCCESS) return rv;
-    if (!scratch_fit(scratch, dec)) return EXR_ERR_OUT_OF_MEMORY;
-    bind_channels(dec, fb, grey, x0, y0, use_y, scratch);
-    if (!*dec_init) {
-        *dec_init = 1;
-        rv = exr_decoding_choose_default_routines(ctx, 0, dec);
+    if (!scratch_fit(&k->scratch, &k->dec)) return EXR_ERR_OUT_OF_MEMORY;
+    if (k->ls) bind_layer(&k->dec, k->ls, x0, y0, &k->scratch);
+    else bind_channels(&k->dec, k->fb, k->grey, x0, y0, k->use_y, &k->scratch);
+    if (!k->dec_init) {
+        k->dec_init = 1;
+        rv = exr_decoding_choose_default_routines(ctx, 0, &k->dec);
         if (rv != EXR_ERR_SUCCESS) return rv;
     }
-    return exr_decoding_run(ctx, 0, dec);
+    return exr_decoding_run(ctx, 0, &k->dec);
+}
+
+static void sink_free(exr_context_t ctx, chunk_sink *k)
+{
+    if (k->dec_init) exr_decoding_destroy(ctx, &k->dec);
+    free(k->scratch.p);
+}
+
+/* Decodes every chunk of part 0 of a w x h data window dw (scanline
+ * blocks, or the tiles of level 0) into k, each checked to lie inside the
+ * window. 1 when all are decoded; 0 with *rv the library's error, or with
+ * *rv EXR_ERR_SUCCESS when the chunk layout is inconsistent (reported in d). */
+static int decode_chunks(exr_context_t ctx, exr_storage_t storage, exr_attr_box2i_t dw, int w, int h, chunk_sink *k,
+                         const char *path, exr_result_t *rv, diag *d)
+{
+    if (storage == EXR_STORAGE_SCANLINE) {
+        int32_t lpc = 1;
+        if ((*rv = exr_get_scanlines_per_chunk(ctx, 0, &lpc)) != EXR_ERR_SUCCESS) return 0;
+        if (lpc < 1) lpc = 1;
+        for (int64_t y = dw.min.y; y <= dw.max.y; y += lpc) {
+            exr_chunk_info_t ci;
+            if ((*rv = exr_read_scanline_chunk_info(ctx, 0, (int)y, &ci)) != EXR_ERR_SUCCESS) return 0;
+            int row = ci.start_y - dw.min.y;
+            if (row < 0 || row + ci.height > h || ci.width != w) {
+                diag_error(d, "cannot read '%s': inconsistent scanline block at y=%d", path, ci.start_y);
+                return 0;
+            }
+            if ((*rv = decode_chunk(ctx, &ci, k, 0, row)) != EXR_ERR_SUCCESS) return 0;
+        }
+        return 1;
+    }
+    uint32_t tw = 0, th = 0;
+    exr_tile_level_mode_t lm;
+    exr_tile_round_mode_t rm;
+    if ((*rv = exr_get_tile_descriptor(ctx, 0, &tw, &th, &lm, &rm)) != EXR_ERR_SUCCESS) return 0;
+    int32_t lw = 0, lh = 0;
+    if ((*rv = exr_get_level_sizes(ctx, 0, 0, 0, &lw, &lh)) != EXR_ERR_SUCCESS) return 0;
+    if (tw == 0 || th == 0 || lw != w || lh != h) {
+        diag_error(d, "cannot read '%s': inconsistent tile description", path);
+        return 0;
+    }
+    int ntx = (int)(((uint32_t)w + tw - 1) / tw), nty = (int)(((uint32_t)h + th - 1) / th);
+    for (int ty = 0; ty < nty; ty++) {
+        for (int tx = 0; tx < ntx; tx++) {
+            exr_chunk_info_t ci;
+            if ((*rv = exr_read_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &ci)) != EXR_ERR_SUCCESS) return 0;
+            int x0 = tx * (int)tw, y0 = ty * (int)th;
+            if (ci.width <= 0 || ci.height <= 0 || x0 + ci.width > w || y0 + ci.height > h) {
+                diag_error(d, "cannot read '%s': inconsistent tile (%d,%d)", path, tx, ty);
+                return 0;
+            }
+            if ((*rv = decode_chunk(ctx, &ci, k, x0, y0)) != EXR_ERR_SUCCESS) return 0;
+        }
+    }
+    return 1;
 }
 
 /* Opens path for reading into s (the caller closes s->fd when it is >= 0)
@@ -529,9 +625,7 @@ pt_status img_exr_read(const char *path, uint64_t max_pixels, framebuffer **out,
     if (!start_read(path, &s, &ctx, &rv, d)) return PT_ERR_IO;
 
     pt_status st = PT_ERR_IO;
-    exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
-    int dec_init = 0;
-    exr_scratch scratch = {NULL, 0};
+    chunk_sink sink = {.dec = EXR_DECODE_PIPELINE_INITIALIZER};
     framebuffer *fb = NULL;
     float *grey = NULL;
     const char *what = "not a readable EXR file";
@@ -605,51 +699,12 @@ pt_status img_exr_read(const char *path, uint64_t max_pixels, framebuffer **out,
     }
 
     what = "cannot read EXR pixels";
-    if (storage == EXR_STORAGE_SCANLINE) {
-        int32_t lpc = 1;
-        rv = exr_get_scanlines_per_chunk(ctx, 0, &lpc);
+    sink.fb = fb;
+    sink.grey = grey;
+    sink.use_y = use_y;
+    if (!decode_chunks(ctx, storage, dw, w, h, &sink, path, &rv, d)) {
         if (rv != EXR_ERR_SUCCESS) goto libfail;
-        if (lpc < 1) lpc = 1;
-        for (int64_t y = dw.min.y; y <= dw.max.y; y += lpc) {
-            exr_chunk_info_t ci;
-            rv = exr_read_scanline_chunk_info(ctx, 0, (int)y, &ci);
-            if (rv != EXR_ERR_SUCCESS) goto libfail;
-            int row = ci.start_y - dw.min.y;
-            if (row < 0 || row + ci.height > h || ci.width != w) {
-                diag_error(d, "cannot read '%s': inconsistent scanline block at y=%d", path, ci.start_y);
-                goto done;
-            }
-            rv = decode_chunk(ctx, &ci, &dec, &dec_init, fb, grey, 0, row, use_y, &scratch);
-            if (rv != EXR_ERR_SUCCESS) goto libfail;
-        }
-    } else {
-        uint32_t tw = 0, th = 0;
-        exr_tile_level_mode_t lm;
-        exr_tile_round_mode_t rm;
-        rv = exr_get_tile_descriptor(ctx, 0, &tw, &th, &lm, &rm);
-        if (rv != EXR_ERR_SUCCESS) goto libfail;
-        int32_t lw = 0, lh = 0;
-        rv = exr_get_level_sizes(ctx, 0, 0, 0, &lw, &lh);
-        if (rv != EXR_ERR_SUCCESS) goto libfail;
-        if (tw == 0 || th == 0 || lw != w || lh != h) {
-            diag_error(d, "cannot read '%s': inconsistent tile description", path);
-            goto done;
-        }
-        int ntx = (int)(((uint32_t)w + tw - 1) / tw), nty = (int)(((uint32_t)h + th - 1) / th);
-        for (int ty = 0; ty < nty; ty++) {
-            for (int tx = 0; tx < ntx; tx++) {
-                exr_chunk_info_t ci;
-                rv = exr_read_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &ci);
-                if (rv != EXR_ERR_SUCCESS) goto libfail;
-                int x0 = tx * (int)tw, y0 = ty * (int)th;
-                if (ci.width <= 0 || ci.height <= 0 || x0 + ci.width > w || y0 + ci.height > h) {
-                    diag_error(d, "cannot read '%s': inconsistent tile (%d,%d)", path, tx, ty);
-                    goto done;
-                }
-                rv = decode_chunk(ctx, &ci, &dec, &dec_init, fb, grey, x0, y0, use_y, &scratch);
-                if (rv != EXR_ERR_SUCCESS) goto libfail;
-            }
-        }
+        goto done;
     }
     if (use_y) {
         size_t n = (size_t)w * (size_t)h;
@@ -664,8 +719,7 @@ libfail:
     diag_error(d, "cannot read '%s': %s: %s", path, what, reason(&s, rv));
     st = PT_ERR_IO;
 done:
-    if (dec_init) exr_decoding_destroy(ctx, &dec);
-    free(scratch.p);
+    sink_free(ctx, &sink);
     if (ctx) exr_finish(&ctx);
     close(s.fd);
     free(grey);
@@ -675,49 +729,6 @@ done:
 
 /* ---- reading named channels (AOV layers) ------------------------------- */
 
-typedef struct {
-    char names[4][80];
-    int n;
-    float *data; /* w*h*n */
-    int w;
-} layer_sink;
-
-static void bind_layer(exr_decode_pipeline_t *dec, const layer_sink *ls, int x0, int y0, exr_scratch *scratch)
-{
-    for (int c = 0; c < dec->channel_count; c++) {
-        exr_coding_channel_info_t *dc = &dec->channels[c];
-        int slot = -1;
-        for (int k = 0; k < ls->n && dc->channel_name; k++)
-            if (strcmp(dc->channel_name, ls->names[k]) == 0) slot = k;
-        dc->decode_to_ptr = NULL;
-        dc->user_pixel_stride = 0;
-        dc->user_line_stride = 0;
-        if (slot >= 0 && dc->x_samples == 1 && dc->y_samples == 1) {
-            size_t pix = (size_t)y0 * (size_t)ls->w + (size_t)x0;
-            dc->decode_to_ptr = (uint8_t *)(ls->data + pix * (size_t)ls->n + (size_t)slot);
-            dc->user_pixel_stride = (int32_t)(sizeof(float) * (size_t)ls->n);
-            dc->user_line_stride = (int32_t)(sizeof(float) * (size_t)ls->n * (size_t)ls->w);
-        }
-        dc->user_data_type = EXR_PIXEL_FLOAT;
-        dc->user_bytes_per_element = 4;
-        if (!dc->decode_to_ptr) bind_scratch(dc, scratch);
-    }
-}
-
-static exr_result_t decode_layer_chunk(exr_context_t ctx, const exr_chunk_info_t *ci, exr_decode_pipeline_t *dec,
-                                       int *dec_init, const layer_sink *ls, int x0, int y0, exr_scratch *scratch)
-{
-    exr_result_t rv = *dec_init ? exr_decoding_update(ctx, 0, ci, dec) : exr_decoding_initialize(ctx, 0, ci, dec);
-    if (rv != EXR_ERR_SUCCESS) return rv;
-    if (!scratch_fit(scratch, dec)) return EXR_ERR_OUT_OF_MEMORY;
-    bind_layer(dec, ls, x0, y0, scratch);
-    if (!*dec_init) {
-        *dec_init = 1;
-        rv = exr_decoding_choose_default_routines(ctx, 0, dec);
-        if (rv != EXR_ERR_SUCCESS) return rv;
-    }
-    return exr_decoding_run(ctx, 0, dec);
-}
 
 pt_status img_read_exr_layer(const char *path, const char *layer, const char *suffixes, float **out, int *width,
                              int *height, diag *d)
@@ -739,9 +750,7 @@ pt_status img_read_exr_layer(const char *path, const char *layer, const char *su
     exr_result_t rv;
     if (!start_read(path, &s, &ctx, &rv, d)) return PT_ERR_IO;
     pt_status st = PT_ERR_IO;
-    exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
-    int dec_init = 0;
-    exr_scratch scratch = {NULL, 0};
+    chunk_sink sink = {.dec = EXR_DECODE_PIPELINE_INITIALIZER, .ls = &ls};
     const char *what = "not a readable EXR file";
     if (rv != EXR_ERR_SUCCESS) goto libfail;
     exr_storage_t storage;
@@ -776,42 +785,9 @@ pt_status img_read_exr_layer(const char *path, const char *layer, const char *su
         goto done;
     }
     what = "cannot read EXR pixels";
-    if (storage == EXR_STORAGE_SCANLINE) {
-        int32_t lpc = 1;
-        if ((rv = exr_get_scanlines_per_chunk(ctx, 0, &lpc)) != EXR_ERR_SUCCESS) goto libfail;
-        if (lpc < 1) lpc = 1;
-        for (int64_t y = dw.min.y; y <= dw.max.y; y += lpc) {
-            exr_chunk_info_t ci;
-            if ((rv = exr_read_scanline_chunk_info(ctx, 0, (int)y, &ci)) != EXR_ERR_SUCCESS) goto libfail;
-            int row = ci.start_y - dw.min.y;
-            if (row < 0 || row + ci.height > h64 || ci.width != w64) {
-                diag_error(d, "cannot read '%s': inconsistent scanline block at y=%d", path, ci.start_y);
-                goto done;
-            }
-            if ((rv = decode_layer_chunk(ctx, &ci, &dec, &dec_init, &ls, 0, row, &scratch)) != EXR_ERR_SUCCESS) goto libfail;
-        }
-    } else {
-        uint32_t tw = 0, th = 0;
-        exr_tile_level_mode_t lm;
-        exr_tile_round_mode_t rm;
-        if ((rv = exr_get_tile_descriptor(ctx, 0, &tw, &th, &lm, &rm)) != EXR_ERR_SUCCESS) goto libfail;
-        if (tw == 0 || th == 0) {
-            diag_error(d, "cannot read '%s': inconsistent tile description", path);
-            goto done;
-        }
-        int ntx = (int)(((uint32_t)w64 + tw - 1) / tw), nty = (int)(((uint32_t)h64 + th - 1) / th);
-        for (int ty = 0; ty < nty; ty++) {
-            for (int tx = 0; tx < ntx; tx++) {
-                exr_chunk_info_t ci;
-                if ((rv = exr_read_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &ci)) != EXR_ERR_SUCCESS) goto libfail;
-                int x0 = tx * (int)tw, y0 = ty * (int)th;
-                if (ci.width <= 0 || ci.height <= 0 || x0 + ci.width > w64 || y0 + ci.height > h64) {
-                    diag_error(d, "cannot read '%s': inconsistent tile (%d,%d)", path, tx, ty);
-                    goto done;
-                }
-                if ((rv = decode_layer_chunk(ctx, &ci, &dec, &dec_init, &ls, x0, y0, &scratch)) != EXR_ERR_SUCCESS) goto libfail;
-            }
-        }
+    if (!decode_chunks(ctx, storage, dw, (int)w64, (int)h64, &sink, path, &rv, d)) {
+        if (rv != EXR_ERR_SUCCESS) goto libfail;
+        goto done;
     }
     *out = ls.data;
     ls.data = NULL;
@@ -824,8 +800,7 @@ libfail:
     diag_error(d, "cannot read '%s': %s: %s", path, what, reason(&s, rv));
     st = PT_ERR_IO;
 done:
-    if (dec_init) exr_decoding_destroy(ctx, &dec);
-    free(scratch.p);
+    sink_free(ctx, &sink);
     if (ctx) exr_finish(&ctx);
     close(s.fd);
     free(ls.data);
