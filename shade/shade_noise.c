@@ -212,6 +212,40 @@ static inline double term(int k, double s, double x, double y, double z)
     return s * ((rtab[k] * 0.5) + rtab[k + 1] * x + rtab[k + 2] * y + rtab[k + 3] * z);
 }
 
+/* The lattice cell of p as POV-Ray's Noise and DNoise set it up: p's
+ * offsets from the cell's low and high corners, the s-curve weights of the
+ * eight corners (products of the per-axis weights) and the hashes of the
+ * cell's four (x, y) columns. */
+typedef struct {
+    int iz;
+    double x0, y0, z0, x1, y1, z1, sz, tz;
+    double txty, sxty, txsy, sxsy;
+    int h00, h10, h01, h11;
+} noise_cell;
+
+static inline void cell_at(vec3 p, noise_cell *c)
+{
+    int ix, iy;
+    lattice(p.x, &ix, &c->x0);
+    lattice(p.y, &iy, &c->y0);
+    lattice(p.z, &c->iz, &c->z0);
+    c->x1 = c->x0 - 1;
+    c->y1 = c->y0 - 1;
+    c->z1 = c->z0 - 1;
+    double sx = scurve(c->x0), sy = scurve(c->y0);
+    c->sz = scurve(c->z0);
+    double tx = 1 - sx, ty = 1 - sy;
+    c->tz = 1 - c->sz;
+    c->txty = tx * ty;
+    c->sxty = sx * ty;
+    c->txsy = tx * sy;
+    c->sxsy = sx * sy;
+    c->h00 = hash2(ix, iy);
+    c->h10 = hash2(ix + 1, iy);
+    c->h01 = hash2(ix, iy + 1);
+    c->h11 = hash2(ix + 1, iy + 1);
+}
+
 static double solid_noise(vec3 p);
 
 double shade_noise_value(vec3 p, int generator)
@@ -221,24 +255,16 @@ double shade_noise_value(vec3 p, int generator)
         double sum = 0.5 * (1.59 * solid_noise(p) + 0.985);
         return sum < 0.0 ? 0.0 : (sum > 1.0 ? 1.0 : sum);
     }
-    int ix, iy, iz;
-    double x0, y0, z0;
-    lattice(p.x, &ix, &x0);
-    lattice(p.y, &iy, &y0);
-    lattice(p.z, &iz, &z0);
-    double x1 = x0 - 1, y1 = y0 - 1, z1 = z0 - 1;
-    double sx = scurve(x0), sy = scurve(y0), sz = scurve(z0);
-    double tx = 1 - sx, ty = 1 - sy, tz = 1 - sz;
-    double txty = tx * ty, sxty = sx * ty, txsy = tx * sy, sxsy = sx * sy;
-    int h00 = hash2(ix, iy), h10 = hash2(ix + 1, iy), h01 = hash2(ix, iy + 1), h11 = hash2(ix + 1, iy + 1);
-    double sum = term(rindex_of(h00, iz), txty * tz, x0, y0, z0);
-    sum += term(rindex_of(h10, iz), sxty * tz, x1, y0, z0);
-    sum += term(rindex_of(h01, iz), txsy * tz, x0, y1, z0);
-    sum += term(rindex_of(h11, iz), sxsy * tz, x1, y1, z0);
-    sum += term(rindex_of(h00, iz + 1), txty * sz, x0, y0, z1);
-    sum += term(rindex_of(h10, iz + 1), sxty * sz, x1, y0, z1);
-    sum += term(rindex_of(h01, iz + 1), txsy * sz, x0, y1, z1);
-    sum += term(rindex_of(h11, iz + 1), sxsy * sz, x1, y1, z1);
+    noise_cell c;
+    cell_at(p, &c);
+    double sum = term(rindex_of(c.h00, c.iz), c.txty * c.tz, c.x0, c.y0, c.z0);
+    sum += term(rindex_of(c.h10, c.iz), c.sxty * c.tz, c.x1, c.y0, c.z0);
+    sum += term(rindex_of(c.h01, c.iz), c.txsy * c.tz, c.x0, c.y1, c.z0);
+    sum += term(rindex_of(c.h11, c.iz), c.sxsy * c.tz, c.x1, c.y1, c.z0);
+    sum += term(rindex_of(c.h00, c.iz + 1), c.txty * c.sz, c.x0, c.y0, c.z1);
+    sum += term(rindex_of(c.h10, c.iz + 1), c.sxty * c.sz, c.x1, c.y0, c.z1);
+    sum += term(rindex_of(c.h01, c.iz + 1), c.txsy * c.sz, c.x0, c.y1, c.z1);
+    sum += term(rindex_of(c.h11, c.iz + 1), c.sxsy * c.sz, c.x1, c.y1, c.z1);
     if (generator == 2) {
         sum += 1.05242;
         sum *= 0.48985582;
@@ -263,27 +289,19 @@ vec3 shade_noise_dvector(vec3 p)
 
 static vec3 dnoise(vec3 p)
 {
-    int ix, iy, iz;
-    double x0, y0, z0;
-    lattice(p.x, &ix, &x0);
-    lattice(p.y, &iy, &y0);
-    lattice(p.z, &iz, &z0);
-    double x1 = x0 - 1, y1 = y0 - 1, z1 = z0 - 1;
-    double sx = scurve(x0), sy = scurve(y0), sz = scurve(z0);
-    double tx = 1 - sx, ty = 1 - sy, tz = 1 - sz;
-    double txty = tx * ty, sxty = sx * ty, txsy = tx * sy, sxsy = sx * sy;
-    int h00 = hash2(ix, iy), h10 = hash2(ix + 1, iy), h01 = hash2(ix, iy + 1), h11 = hash2(ix + 1, iy + 1);
+    noise_cell c;
+    cell_at(p, &c);
     /* The first corner initialises, the rest add (POV-Ray's corner order). */
-    int k = rindex_of(h00, iz);
-    double s = txty * tz;
-    vec3 r = v3(term(k, s, x0, y0, z0), term(k + 4, s, x0, y0, z0), term(k + 8, s, x0, y0, z0));
-    dterm(&r, rindex_of(h10, iz), sxty * tz, x1, y0, z0);
-    dterm(&r, rindex_of(h11, iz), sxsy * tz, x1, y1, z0);
-    dterm(&r, rindex_of(h01, iz), txsy * tz, x0, y1, z0);
-    dterm(&r, rindex_of(h01, iz + 1), txsy * sz, x0, y1, z1);
-    dterm(&r, rindex_of(h11, iz + 1), sxsy * sz, x1, y1, z1);
-    dterm(&r, rindex_of(h10, iz + 1), sxty * sz, x1, y0, z1);
-    dterm(&r, rindex_of(h00, iz + 1), txty * sz, x0, y0, z1);
+    int k = rindex_of(c.h00, c.iz);
+    double s = c.txty * c.tz;
+    vec3 r = v3(term(k, s, c.x0, c.y0, c.z0), term(k + 4, s, c.x0, c.y0, c.z0), term(k + 8, s, c.x0, c.y0, c.z0));
+    dterm(&r, rindex_of(c.h10, c.iz), c.sxty * c.tz, c.x1, c.y0, c.z0);
+    dterm(&r, rindex_of(c.h11, c.iz), c.sxsy * c.tz, c.x1, c.y1, c.z0);
+    dterm(&r, rindex_of(c.h01, c.iz), c.txsy * c.tz, c.x0, c.y1, c.z0);
+    dterm(&r, rindex_of(c.h01, c.iz + 1), c.txsy * c.sz, c.x0, c.y1, c.z1);
+    dterm(&r, rindex_of(c.h11, c.iz + 1), c.sxsy * c.sz, c.x1, c.y1, c.z1);
+    dterm(&r, rindex_of(c.h10, c.iz + 1), c.sxty * c.sz, c.x1, c.y0, c.z1);
+    dterm(&r, rindex_of(c.h00, c.iz + 1), c.txty * c.sz, c.x0, c.y0, c.z1);
     return r;
 }
 
