@@ -15,7 +15,7 @@ typedef struct {
     const accel *a;
     RTCScene scene;
     const gi_dev_particle *p;
-    int n, nside, k, per_job;
+    int n, first, nside, k, per_job; /* sources [first, n); outputs indexed i - first */
     uint64_t seed;
     const gi_lookup *grid;
     const gi_trilook *tl;
@@ -133,7 +133,7 @@ static void job(void *ctx, int index, int thread)
 {
     link_job *J = ctx;
     struct RTCRayHit *rh = J->buf[thread];
-    int i0 = index * J->per_job, i1 = i0 + J->per_job < J->n ? i0 + J->per_job : J->n;
+    int i0 = J->first + index * J->per_job, i1 = i0 + J->per_job < J->n ? i0 + J->per_job : J->n;
     int m = 0;
     long miss = 0, unres = 0, other = 0, tri_ok = 0, tri_fb = 0;
     for (int i = i0; i < i1; i++) {
@@ -338,11 +338,11 @@ static void job(void *ctx, int index, int thread)
                     if (hit) far_field(J, &rh[m], sky);
                 }
             }
-            J->links[(size_t)i * J->k + J->order[j]] = target;
+            J->links[(size_t)(i - J->first) * J->k + J->order[j]] = target;
         }
-        if (J->anyhit) J->anyhit[i] = (unsigned char)any;
+        if (J->anyhit) J->anyhit[i - J->first] = (unsigned char)any;
         if (J->esky) {
-            float *e = &J->esky[4 * (size_t)i];
+            float *e = &J->esky[4 * (size_t)(i - J->first)];
             for (int c = 0; c < 3; c++) e[c] = sky[c] / (float)J->k;
             e[3] = 0.0f;
         }
@@ -389,7 +389,7 @@ void gi_links_reverse_fill(const int *links, int n, int k, const unsigned *mask,
 }
 
 pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle *p, const void *const *pobj,
-                         const unsigned char *pin, int n, int nside, uint64_t seed, const gi_lookup *grid,
+                         const unsigned char *pin, int n, int first, int nside, uint64_t seed, const gi_lookup *grid,
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
                          gi_link_stats *st, volatile int *cancel, progress *prog,
                          const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce)
@@ -411,6 +411,7 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
     J.pobj = pobj;
     J.pin = pobj ? pin : NULL;
     J.n = n;
+    J.first = first > 0 && first <= n ? first : 0;
     J.nside = nside;
     J.k = nside * nside;
     /* rays in 4x4 blocks of strata (a narrow cone each) when the side
@@ -474,7 +475,7 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
         J.tcell[t] = malloc(rays * sizeof(long));
         if (!J.buf[t] || !J.hp[t] || !J.cell[t] || !J.tcell[t]) rc = PT_ERR_NOMEM;
     }
-    if (rc == PT_OK && n > 0 && !pool_run_counted(threads, (n + J.per_job - 1) / J.per_job, job, &J, cancel, prog))
+    if (rc == PT_OK && n > 0 && !pool_run_counted(threads, (n - J.first + J.per_job - 1) / J.per_job, job, &J, cancel, prog))
         rc = PT_CANCELLED;
     for (int t = 0; t < threads; t++) {
         if (J.buf) free(J.buf[t]);
@@ -491,7 +492,7 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
     free(J.sv0);
     accel_rtc_link_scene_free(lscene);
     if (st) {
-        st->rays += (long)n * J.k;
+        st->rays += (long)(n - J.first) * J.k;
         st->misses += atomic_load(&J.misses);
         st->unresolved += atomic_load(&J.unresolved);
         st->other_object += atomic_load(&J.other);

@@ -41,7 +41,9 @@ typedef struct {
  * same answer, gi_trilook.h), else the grid path. scene (may be NULL):
  * the RTCScene to trace (accel_rtc_link_scene's, built once by the
  * caller); NULL: the link scene is built and freed here. prog (may be
- * NULL): its current stage counts the chunks of particles traced. */
+ * NULL): its current stage counts the chunks of particles traced. first:
+ * only particles [first, n) send rays (all n are targets); links, anyhit
+ * and esky are then indexed i - first. */
 /* sky, esky and sc (all or none; NULL: none): esky receives 4 floats a
  * particle (the fourth 0): the radiance its rays that leave the scene see
  * (sky), plus the far field of those that hit where no particle answers
@@ -51,7 +53,7 @@ typedef struct {
  * radiance, in E/pi units. */
 #define GI_LINKS_AGREE 0.3
 pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle *p, const void *const *pobj,
-                         const unsigned char *pin, int n, int nside, uint64_t seed, const gi_lookup *grid,
+                         const unsigned char *pin, int n, int first, int nside, uint64_t seed, const gi_lookup *grid,
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
                          gi_link_stats *st, volatile int *cancel, progress *prog,
                          const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce);

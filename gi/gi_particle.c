@@ -53,6 +53,17 @@ void gi_particle_settings_from_scene(gi_particle_settings *s, const scene *sc)
         s->radius_factor = f < 2.0 ? 2.0 : (f > 5.0 ? 5.0 : f);
     }
     if (r->brightness > 0.0) s->brightness = r->brightness;
+    /* the final gather's rays: about the scene's count, as POV-Ray's
+     * radiosity samples take count rays each */
+    int side = (int)lround(sqrt((double)(r->count > 0 ? r->count : 35)));
+    s->view_gather_side = side < 6 ? 6 : (side > 16 ? 16 : side);
+    s->view_gather_stride = 2;
+    /* the area particles' own gathers then feed only further bounces and
+     * the hits the final gather does not answer: a quarter of the rays */
+    s->gather_side = 8;
+    if (getenv("PT_GS")) s->gather_side = atoi(getenv("PT_GS"));
+    if (getenv("PT_VG_SIDE")) s->view_gather_side = atoi(getenv("PT_VG_SIDE"));
+    if (getenv("PT_VG_STRIDE")) s->view_gather_stride = atoi(getenv("PT_VG_STRIDE"));
 }
 
 void gi_particle_scale_quality(gi_particle_settings *s, double q)
@@ -92,7 +103,7 @@ static void fill_stats(gi_particle *gp, gi_particle_stats *out)
 {
     update_bytes(gp);
     long look = 0, late = 0, none = 0, disc = 0, otf = 0, vis = gp->lists.vis_rays;
-    long lrp = 0, larea = 0, cells = 0, cclear = 0, clear = 0, kept = 0;
+    long lrp = 0, larea = 0, cells = 0, cclear = 0, clear = 0, kept = 0, gathered = 0;
     for (int t = 0; t < GI_MAX_THREADS; t++) {
         lrp += gp->tc[t].late_rp;
         larea += gp->tc[t].late_area;
@@ -100,6 +111,7 @@ static void fill_stats(gi_particle *gp, gi_particle_stats *out)
         cclear += gp->tc[t].cells_clear;
         clear += gp->tc[t].clear;
         kept += gp->tc[t].kept;
+        gathered += gp->tc[t].gathered;
         vis += gp->tc[t].vis_rays;
         otf += gp->tc[t].onthefly;
         look += gp->tc[t].lookups;
@@ -119,6 +131,7 @@ static void fill_stats(gi_particle *gp, gi_particle_stats *out)
     gp->st.cells_clear = cclear;
     gp->st.lookups_clear = clear;
     gp->st.lookups_kept = kept;
+    gp->st.lookups_gathered = gathered;
     if (out && out != &gp->st) *out = gp->st;
 }
 
@@ -204,7 +217,7 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
         gp->tl = gi_trilook_build(gp->a, ps->p, n, (const void *const *)pobj, grid, pin + n, ps->spacing, GI_LINKS_AGREE,
                                   3.0 * ps->spacing, gp->threads, gp->set.cancel, &st);
     if (st == PT_OK)
-        st = gi_links_build(gp->a, gp->lscene, ps->p, pobj, pin, n, gp->set.scatter_side, seed, grid, gp->tl,
+        st = gi_links_build(gp->a, gp->lscene, ps->p, pobj, pin, n, 0, gp->set.scatter_side, seed, grid, gp->tl,
                             3.0 * ps->spacing, gp->threads, links, keep, ls, gp->set.cancel, gp->set.progress, NULL,
                             NULL, NULL, NULL, 0.0);
     gi_lookup_free(grid);
@@ -614,7 +627,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         cg = timer_cpu_now();
         gp->esky = gi_particle_calloc((size_t)n * 4, sizeof(float), &st);
         if (st == PT_OK)
-            st = gi_links_build(a, gp->lscene, gp->ps.p, pobj, pin, n, set->gather_side, set->seed ^ 0x6a7ULL, grid,
+            st = gi_links_build(a, gp->lscene, gp->ps.p, pobj, pin, n, 0, set->gather_side, set->seed ^ 0x6a7ULL, grid,
                                 gp->tl, 3.0 * spacing, gp->threads, gp->glink, NULL, &ls, set->cancel, set->progress,
                                 gp->sky, gp->esky, sc, set->pigment,
                                 set->bounces >= 1 ? set->brightness : 0.0);
@@ -628,8 +641,11 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         S->trilook_lists = gi_trilook_cells(gp->tl);
         gi_trilook_free(gp->tl);
         gp->tl = NULL;
-        accel_rtc_link_scene_free(gp->lscene);
-        gp->lscene = NULL;
+        /* the final gather at the camera's hits traces the same scene */
+        if (set->view_gather_side <= 0 || !set->keep_hits) {
+            accel_rtc_link_scene_free(gp->lscene);
+            gp->lscene = NULL;
+        }
         if (st != PT_OK) goto fail;
         S->link_tri = ls.tri_answered;
         S->link_tri_fallback = ls.tri_fallback;
@@ -764,6 +780,7 @@ void gi_particle_free(gi_particle *gp)
     free(gp->rp_state);
     free(gp->mark);
     free(gp->vrec);
+    gi_particle_view_gather_free(gp);
     free(gp);
 }
 

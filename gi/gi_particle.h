@@ -116,6 +116,11 @@ typedef struct {
     int prepass_stride;  /* the pre-pass traces every Nth pixel in x and y; the pixels between take
                             their hit from the flat piece their coarse neighbours all hit, or are
                             traced (gi_particle_view.c, coarse_hit). 0: the default (2); 1: every pixel */
+    int view_gather_side; /* > 0: the kept hits (keep_hits) gather side x side rays themselves
+                            (final gathering, gi_particle_gather.c) instead of interpolating the
+                            radiance particles; 0: they interpolate (the paper's estimate) */
+    int view_gather_stride; /* gathers at every Nth pixel in x and y, and where the pixels between
+                              find no matching one (default 2) */
     int keep_hits;       /* 1: the pre-pass keeps each traced pixel's first hit, and the radiance
                             particles it located there, for the render: gi_particle_primary_begin
                             and _hit as shade_settings.primary_begin and .primary give the render
@@ -156,6 +161,8 @@ typedef struct {
     double t_visibility, t_emit, t_scatter;
     double t_view;          /* whole last prepare_view */
     double t_prepass, t_gather, t_estimate;
+    double t_view_gather;   /* last prepare_view: the final gather's links and values */
+    long view_gathers, view_gather_rays; /* its gather points and rays */
     double c_prepass;       /* process CPU seconds of the last pre-pass */
     /* counts */
     long candidates, particles, pruned, probed_out;
@@ -181,6 +188,7 @@ typedef struct {
     long lookups_clear;     /* hook lookups in clear cells (no visibility rays) */
     long prepass_kept;      /* last prepare_view: pixels whose first hit was kept (keep_hits) */
     long lookups_kept;      /* hook lookups that took their cell from a kept hit (no locate) */
+    long lookups_gathered;  /* lookups the final gather at the kept hits answered */
     size_t bytes_view;      /* keep_hits: the kept hits' records (not in bytes_total) */
     long skipped_objects;
     double flux_direct, flux_emitted, flux_scattered; /* sums over particles (grey) */

@@ -239,7 +239,9 @@ rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
      * point of the plane's clipped part stands for it (gi_surface_locate
      * takes the triangle nearest to the hit). */
     int far = !gi_sky_black(gp->sky) && !gi_surface_in_clip(gp->surf, hit->p);
-    if (far || !side_value(gp, hit, n, tc, &out)) {
+    if (gi_particle_view_value(gp, hit, kept_rec(gp, hit), n, &out)) {
+        tc->gathered++;
+    } else if (far || !side_value(gp, hit, n, tc, &out)) {
         /* No particle answers here: a surface the geometry stage left out
          * (beyond the clip box, an object far from what the camera sees, a
          * shape without particles). The far field: what it would gather

@@ -22,6 +22,7 @@ typedef struct {
     long late_rp, late_area;        /* radiance / area particles computed in the hook (late_rp) */
     long cells, cells_clear, clear; /* cells tested, of them clear; lookups in clear cells */
     long kept;                      /* lookups whose cell came from a kept hit (view_rec) */
+    long gathered;                  /* lookups the final gather answered */
     int *buf; /* on-the-fly estimation list */
     long len, cap;
     struct cell_batch *cb; /* the pre-pass's cell tests waiting for the row's end (cell_batch) */
@@ -74,6 +75,16 @@ struct gi_particle {
     int vw, vh;
     double veps;           /* the pre-pass's tmin */
     double vis_eps; /* gi_visible's eps: 1e-6 x accel_eps_scale */
+    /* the final gather at the kept hits (gi_particle_gather.c) */
+    int vg_n, vg_k;   /* gather points, rays each */
+    int vg_w, vg_h, vg_s; /* for the pre-pass of this size, every vg_s-th pixel */
+    int *vg_link;     /* vg_n x vg_k: the area particle each ray ends on, -1 none */
+    float *vg_esky;   /* vg_n x 4: the sky's and far field's share (gi_links.h) */
+    float *vg_val;    /* vg_n x 4: gathered E/pi */
+    int *vg_pix;      /* vg_w x vg_h: a pixel's gather point, -1 none */
+    struct vg_point *vg_pt; /* vg_n: where each gathered (for hits that are not kept) */
+    uint64_t *vg_key; /* vg_n: cell hash << 32 | point, sorted */
+    double vg_cell;   /* their cells' size */
     thread_count tc[GI_MAX_THREADS];
     gi_particle_stats st;
 };
@@ -154,4 +165,18 @@ void gi_particle_rp_far_field(gi_particle *gp, long l);
  * gi_light_attenuation); the vertex links (gi_vlinks.c) light with it too. */
 void gi_light_pack(const scene_light *l, gi_dev_light *o);
 
+/* gi_particle_gather.c: the final gather at the kept hits */
+typedef struct vg_point {
+    vec3 p, n;                /* the hit and the normal gathered about */
+    const scene_object *obj;
+    float r;                  /* it answers hits within r on its object and side */
+    int side;
+} vg_point;
+pt_status gi_particle_view_gather(gi_particle *gp, diag *d);
+void gi_particle_view_regather(gi_particle *gp);
+void gi_particle_view_gather_free(gi_particle *gp);
+/* E/pi at hit on the side n faces: at a kept hit r, its gather or the mean
+ * of its block's corners that match it; elsewhere (r NULL) the gather
+ * points around it (gi_particle_gather.c); 0 when none answers. */
+int gi_particle_view_value(const gi_particle *gp, const accel_hit *hit, const view_rec *r, vec3 n, rgb *out);
 #endif

@@ -306,6 +306,7 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
     S->flux_scattered = sums.scattered;
     reset_view(gp);
     gp->lit = 1;
+    gi_particle_view_regather(gp); /* the final gather's values for this light */
     S->t_lighting = timer_now() - t0;
     return PT_OK;
 }

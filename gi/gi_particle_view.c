@@ -418,6 +418,15 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
     }
     S->t_prepass = timer_now() - t0;
     S->c_prepass = timer_cpu_now() - c0;
+    if (J.rec && gp->set.view_gather_side > 0) {
+        progress_stage(gp->set.progress, "gi view: final gather", 0);
+        double tv = timer_now();
+        st = gi_particle_view_gather(gp, d);
+        S->t_view_gather = timer_now() - tv;
+        if (st != PT_OK) return st;
+    } else {
+        gi_particle_view_gather_free(gp);
+    }
 
     progress_stage(gp->set.progress, "gi view: gather", 0);
     /* found radiance particles (not yet estimated) and the area particles
