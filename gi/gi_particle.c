@@ -59,11 +59,9 @@ void gi_particle_settings_from_scene(gi_particle_settings *s, const scene *sc)
     s->view_gather_side = side < 6 ? 6 : (side > 16 ? 16 : side);
     s->view_gather_stride = 2;
     /* the area particles' own gathers then feed only further bounces and
-     * the hits the final gather does not answer: a quarter of the rays */
-    s->gather_side = 8;
-    if (getenv("PT_GS")) s->gather_side = atoi(getenv("PT_GS"));
-    if (getenv("PT_VG_SIDE")) s->view_gather_side = atoi(getenv("PT_VG_SIDE"));
-    if (getenv("PT_VG_STRIDE")) s->view_gather_stride = atoi(getenv("PT_VG_STRIDE"));
+     * the hits the final gather does not answer: a quarter of the rays,
+     * a sixteenth without further bounces */
+    s->gather_side = s->bounces >= 1 ? 8 : 4;
 }
 
 void gi_particle_scale_quality(gi_particle_settings *s, double q)
@@ -71,6 +69,11 @@ void gi_particle_scale_quality(gi_particle_settings *s, double q)
     if (!(q > 0.0) || !isfinite(q)) return;
     double c = (double)s->count * q;
     s->count = c < 500.0 ? 500 : (c > 4e6 ? 4000000 : (long)c);
+    /* and the final gather's rays */
+    if (s->view_gather_side > 0) {
+        double side = s->view_gather_side * sqrt(q);
+        s->view_gather_side = side < 4.0 ? 4 : (side > 32.0 ? 32 : (int)lround(side));
+    }
 }
 
 /* ------------------------------------------------------------------ build */
@@ -500,6 +503,13 @@ gi_particle *gi_particle_begin(const scene *sc, const accel *a, const gi_particl
 
     /* the device first: a missing OpenCL driver should fail before seconds of ray tracing */
     gi_dev_options o = {set->cl_device, set->cl_source, gp->threads, set->cl_max_bytes};
+    /* auto, and a scene asking for few particles: the kernels' C build. At
+     * that size the driver's start-up and program build cost more than
+     * the kernels themselves (bench/gi_vs_povray.sh's small scenes; the
+     * stats' kernel_build), and a GPU would not pay back its transfers. */
+    if ((!o.spec || !*o.spec || !strcmp(o.spec, "auto")) && set->count < GI_CL_AUTO_MIN_PARTICLES && !set->cl_source &&
+        !set->cl_max_bytes)
+        o.spec = "c";
     gp->dev = gi_dev_open(&o, d, &st);
     if (!gp->dev) {
         *status = st == PT_OK ? PT_ERR_INTERNAL : st;

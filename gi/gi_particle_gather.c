@@ -32,6 +32,7 @@
 #include <string.h>
 #include "gi_cl_c.h"
 #include "gi_links.h"
+#include "pool.h"
 #include "timer.h"
 
 #define DEPTH_TOL 0.05 /* relative depth a neighbour may differ by */
@@ -73,13 +74,18 @@ static int compatible(const view_rec *a, const view_rec *b)
 void gi_particle_view_gather_free(gi_particle *gp)
 {
     free(gp->vg_pt);
-    free(gp->vg_key);
+    free(gp->vg_ids);
+    free(gp->vg_tab);
     gp->vg_pt = NULL;
-    gp->vg_key = NULL;
+    gp->vg_ids = NULL;
+    gp->vg_tab = NULL;
+    gp->vg_levels = 0;
     free(gp->vg_link);
     free(gp->vg_esky);
     free(gp->vg_val);
     free(gp->vg_pix);
+    free(gp->vg_pixval);
+    gp->vg_pixval = NULL;
     gp->vg_link = NULL;
     gp->vg_esky = gp->vg_val = NULL;
     gp->vg_pix = NULL;
@@ -109,54 +115,86 @@ static int corners(int x, int y, int w, int h, int s, int cx[4], int cy[4], doub
 
 /* ---- the gather points by position, for hits that are not kept (the
  * antialiasing's extra rays, a reflection of a seen surface): a point
- * answers within its radius, stride pixels' footprint at its depth. Cells
- * of the largest radius (the 90th percentile; larger radii are cut to it),
- * each point in its own cell, sorted by cell key; a query visits the 27
- * cells around it. */
+ * answers within its radius r, stride pixels' footprint at its depth.
+ * Levels of cells, level L of size c0 2^L (c0 twice the smallest radius);
+ * a point lies in the one cell of the level where r <= size / 2 that holds
+ * it, so a query at p finds every point within reach in the 2 x 2 x 2
+ * cells of each level nearest to p (those overlapping the box p +- size/2).
+ * The cells are a hash table (open addressing) of runs in vg_ids. */
 
-static uint64_t cell_key(vec3 p, double c)
+#define VG_LEVELS 24
+
+static uint64_t cell_hash(int level, int64_t ix, int64_t iy, int64_t iz)
 {
-    int64_t ix = (int64_t)floor(p.x / c), iy = (int64_t)floor(p.y / c), iz = (int64_t)floor(p.z / c);
-    return ((uint64_t)(ix & 0x1fffff) << 42) | ((uint64_t)(iy & 0x1fffff) << 21) | (uint64_t)(iz & 0x1fffff);
+    uint64_t h = (uint64_t)level * 0x9E3779B97F4A7C15ULL;
+    h ^= (uint64_t)ix * 0xC2B2AE3D27D4EB4FULL;
+    h = (h << 31 | h >> 33) ^ (uint64_t)iy * 0x165667B19E3779F9ULL;
+    h = (h << 27 | h >> 37) ^ (uint64_t)iz * 0x94D049BB133111EBULL;
+    h ^= h >> 29;
+    return h | 1; /* 0 marks an empty slot */
 }
 
-static int cmp_key(const void *a, const void *b)
+static int point_level(const gi_particle *gp, double r)
 {
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return x < y ? -1 : x > y;
+    int L = 0;
+    while (L < VG_LEVELS - 1 && gp->vg_c0 * (double)(1u << L) < 2.0 * r) L++;
+    return L;
 }
 
-static int cmp_double(const void *a, const void *b)
+typedef struct {
+    uint64_t key;
+    int id;
+} keyed;
+
+static int cmp_keyed(const void *a, const void *b)
 {
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
+    const keyed *x = a, *y = b;
+    return x->key < y->key ? -1 : x->key > y->key ? 1 : (x->id > y->id) - (x->id < y->id);
 }
 
-/* key in the high bits of vg_key, the point in the low 32: one sort */
 static pt_status build_index(gi_particle *gp)
 {
     int m = gp->vg_n;
-    double *r = malloc((size_t)m * sizeof *r);
-    gp->vg_key = malloc((size_t)m * sizeof *gp->vg_key);
-    if (!r || !gp->vg_key) {
-        free(r);
+    double rmin = INFINITY;
+    for (int k = 0; k < m; k++)
+        if (gp->vg_pt[k].r > 0.0f && gp->vg_pt[k].r < rmin) rmin = gp->vg_pt[k].r;
+    if (!isfinite(rmin)) return PT_OK; /* no radii: kept hits only */
+    gp->vg_c0 = 2.0 * rmin;
+    keyed *kk = malloc((size_t)m * sizeof *kk);
+    size_t cap = 64;
+    while (cap < 2 * (size_t)m) cap *= 2;
+    gp->vg_ids = malloc((size_t)m * sizeof *gp->vg_ids);
+    gp->vg_tab = calloc(cap, sizeof *gp->vg_tab);
+    if (!kk || !gp->vg_ids || !gp->vg_tab) {
+        free(kk);
         return PT_ERR_NOMEM;
     }
-    for (int k = 0; k < m; k++) r[k] = gp->vg_pt[k].r;
-    qsort(r, (size_t)m, sizeof *r, cmp_double);
-    double c = r[(size_t)(0.9 * (m - 1))];
-    free(r);
-    if (!(c > 0.0) || !isfinite(c)) c = 1.0;
-    gp->vg_cell = c;
-    /* keys of 63 bits: cell coordinates 21 bits each hashed into 31 bits
-     * beside the 32-bit point (equal hashes of far cells only cost a
-     * distance test) */
+    gp->vg_tab_mask = cap - 1;
+    unsigned used = 0;
     for (int k = 0; k < m; k++) {
-        if (gp->vg_pt[k].r > c) gp->vg_pt[k].r = (float)c;
-        uint64_t h = cell_key(gp->vg_pt[k].p, c) * 0x9E3779B97F4A7C15ULL;
-        gp->vg_key[k] = ((h >> 33) << 32) | (uint64_t)(uint32_t)k;
+        const vg_point *pt = &gp->vg_pt[k];
+        int L = point_level(gp, pt->r);
+        used |= 1u << L;
+        double c = gp->vg_c0 * (double)(1u << L);
+        kk[k].key = cell_hash(L, (int64_t)floor(pt->p.x / c), (int64_t)floor(pt->p.y / c), (int64_t)floor(pt->p.z / c));
+        kk[k].id = k;
     }
-    qsort(gp->vg_key, (size_t)m, sizeof *gp->vg_key, cmp_key);
+    gp->vg_levels = used;
+    qsort(kk, (size_t)m, sizeof *kk, cmp_keyed);
+    for (int e = 0; e < m;) {
+        int f = e;
+        while (f < m && kk[f].key == kk[e].key) {
+            gp->vg_ids[f] = kk[f].id;
+            f++;
+        }
+        size_t slot = (size_t)kk[e].key & gp->vg_tab_mask;
+        while (gp->vg_tab[slot].key) slot = (slot + 1) & gp->vg_tab_mask;
+        gp->vg_tab[slot].key = kk[e].key;
+        gp->vg_tab[slot].start = e;
+        gp->vg_tab[slot].count = f - e;
+        e = f;
+    }
+    free(kk);
     return PT_OK;
 }
 
@@ -164,35 +202,37 @@ static pt_status build_index(gi_particle *gp)
  * object and side that face its way: weights 1 - d/r. 0: none. */
 static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, rgb *out)
 {
-    if (!gp->vg_key || !hit->obj) return 0;
+    if (!gp->vg_tab || !hit->obj) return 0;
     int side = v3_dot(n, hit->ng) >= 0.0;
     vec3 ng = side ? hit->ng : v3_neg(hit->ng);
-    double c = gp->vg_cell, s[3] = {0.0, 0.0, 0.0}, ws = 0.0;
-    for (int dz = -1; dz <= 1; dz++)
-        for (int dy = -1; dy <= 1; dy++)
-            for (int dx = -1; dx <= 1; dx++) {
-                vec3 q = v3(hit->p.x + dx * c, hit->p.y + dy * c, hit->p.z + dz * c);
-                uint64_t hk = (cell_key(q, c) * 0x9E3779B97F4A7C15ULL) >> 33;
-                /* the first entry of key hk */
-                size_t lo = 0, hi = (size_t)gp->vg_n;
-                while (lo < hi) {
-                    size_t mid = (lo + hi) / 2;
-                    if ((gp->vg_key[mid] >> 32) < hk) lo = mid + 1;
-                    else hi = mid;
-                }
-                for (size_t e = lo; e < (size_t)gp->vg_n && (gp->vg_key[e] >> 32) == hk; e++) {
-                    const vg_point *pt = &gp->vg_pt[(uint32_t)gp->vg_key[e]];
-                    if (pt->obj != hit->obj || pt->side != side) continue;
-                    vec3 dv = v3_sub(hit->p, pt->p);
-                    double d = v3_len(dv);
-                    if (!(d < pt->r) || fabs(v3_dot(dv, pt->n)) > 0.25 * pt->r) continue;
-                    if (v3_dot(pt->n, ng) < NORMAL_COS * v3_len(ng)) continue;
-                    double w = 1.0 - d / pt->r;
-                    const float *v = &gp->vg_val[4 * (size_t)(uint32_t)gp->vg_key[e]];
-                    for (int q3 = 0; q3 < 3; q3++) s[q3] += w * v[q3];
-                    ws += w;
-                }
+    double lg = v3_len(ng), s[3] = {0.0, 0.0, 0.0}, ws = 0.0;
+    for (int L = 0; L < VG_LEVELS; L++) {
+        if (!(gp->vg_levels >> L & 1u)) continue;
+        double c = gp->vg_c0 * (double)(1u << L);
+        /* the 2 cells per axis overlapping p +- c/2 */
+        int64_t i0[3];
+        const double pc[3] = {hit->p.x / c - 0.5, hit->p.y / c - 0.5, hit->p.z / c - 0.5};
+        for (int a = 0; a < 3; a++) i0[a] = (int64_t)floor(pc[a]);
+        for (int corner = 0; corner < 8; corner++) {
+            uint64_t key = cell_hash(L, i0[0] + (corner & 1), i0[1] + (corner >> 1 & 1), i0[2] + (corner >> 2 & 1));
+            size_t slot = (size_t)key & gp->vg_tab_mask;
+            while (gp->vg_tab[slot].key && gp->vg_tab[slot].key != key) slot = (slot + 1) & gp->vg_tab_mask;
+            if (!gp->vg_tab[slot].key) continue;
+            for (int e = gp->vg_tab[slot].start, end = e + gp->vg_tab[slot].count; e < end; e++) {
+                int id = gp->vg_ids[e];
+                const vg_point *pt = &gp->vg_pt[id];
+                if (pt->obj != hit->obj || pt->side != side) continue;
+                vec3 dv = v3_sub(hit->p, pt->p);
+                double d = v3_len(dv);
+                if (!(d < pt->r) || fabs(v3_dot(dv, pt->n)) > 0.25 * pt->r) continue;
+                if (v3_dot(pt->n, ng) < NORMAL_COS * lg) continue;
+                double w = 1.0 - d / pt->r;
+                const float *v = &gp->vg_val[4 * (size_t)id];
+                for (int q = 0; q < 3; q++) s[q] += w * v[q];
+                ws += w;
             }
+        }
+    }
     if (!(ws > 0.0)) return 0;
     out->r = s[0] / ws;
     out->g = s[1] / ws;
@@ -330,35 +370,18 @@ done:
     return st;
 }
 
-void gi_particle_view_regather(gi_particle *gp)
+/* E/pi at kept pixel i from the raw gathers: its own, or the bilinear
+ * mean of its block's corners that match it. 0: neither. */
+static int raw_value(const gi_particle *gp, size_t i, float out[3])
 {
-    if (gp->vg_n <= 0 || !gp->lout) return;
-    int *idx = malloc((size_t)gp->vg_n * sizeof *idx);
-    if (!idx) {
-        gi_particle_view_gather_free(gp);
-        return;
-    }
-    for (int i = 0; i < gp->vg_n; i++) idx[i] = i;
-    /* the gathering kernel's C build (equation 5 at the pixels) */
-    gi_c_gather(gp->threads, gp->vg_link, gp->vg_k, gp->lout, idx, gp->vg_n, gp->vg_esky, gp->vg_val);
-    free(idx);
-}
-
-int gi_particle_view_value(const gi_particle *gp, const accel_hit *hit, const view_rec *r, vec3 n, rgb *out)
-{
-    if (gp->vg_n <= 0 || gp->vg_w != gp->vw || gp->vg_h != gp->vh) return 0;
-    if (!r) return nearby_value(gp, hit, n, out);
-    if ((v3_dot(n, r->h.ng) >= 0.0) != r->side) return 0; /* the other side (diffuse_back) */
-    size_t i = (size_t)(r - gp->vrec);
-    int x = (int)(i % (size_t)gp->vw), y = (int)(i / (size_t)gp->vw);
     int k = gp->vg_pix[i];
     if (k >= 0) {
-        const float *v = &gp->vg_val[4 * (size_t)k];
-        out->r = v[0];
-        out->g = v[1];
-        out->b = v[2];
+        for (int c = 0; c < 3; c++) out[c] = gp->vg_val[4 * (size_t)k + c];
         return 1;
     }
+    const view_rec *r = &gp->vrec[i];
+    if (!gathers(gp, r)) return 0;
+    int x = (int)(i % (size_t)gp->vw), y = (int)(i / (size_t)gp->vw);
     int cx[4], cy[4];
     double cw[4], s[3] = {0.0, 0.0, 0.0}, ws = 0.0;
     int nc = corners(x, y, gp->vw, gp->vh, gp->vg_s, cx, cy, cw);
@@ -366,13 +389,109 @@ int gi_particle_view_value(const gi_particle *gp, const accel_hit *hit, const vi
         size_t j = (size_t)cy[c] * gp->vw + cx[c];
         int kc = gp->vg_pix[j];
         if (kc < 0 || !compatible(&gp->vrec[j], r)) continue;
-        const float *v = &gp->vg_val[4 * (size_t)kc];
-        for (int q = 0; q < 3; q++) s[q] += cw[c] * v[q];
+        for (int q = 0; q < 3; q++) s[q] += cw[c] * gp->vg_val[4 * (size_t)kc + q];
         ws += cw[c];
     }
-    if (!(ws > 0.0)) return nearby_value(gp, hit, n, out);
-    out->r = s[0] / ws;
-    out->g = s[1] / ws;
-    out->b = s[2] / ws;
+    if (!(ws > 0.0)) return 0;
+    for (int q = 0; q < 3; q++) out[q] = (float)(s[q] / ws);
+    return 1;
+}
+
+/* The edge-aware filter over the pixels' raw values: a Gaussian of
+ * FILTER_SIGMA pixels over the pixels that lie on the same object and
+ * side, face the same way and lie in the same plane (compatible, and the
+ * offset along the normal within DEPTH_TOL of the depth). It averages the
+ * gathers' noise over about (2 sigma / stride)^2 gathers, as an irradiance
+ * cache reuses a record over its radius, and stops at edges, creases and
+ * depth steps, where the light may change. */
+#define FILTER_SIGMA 2.0
+#define FILTER_RADIUS 4
+
+typedef struct {
+    gi_particle *gp;
+    const float *raw;
+    const unsigned char *ok;
+} filter_job;
+
+static void filter_row(void *ctx, int y, int thread)
+{
+    (void)thread;
+    filter_job *F = ctx;
+    gi_particle *gp = F->gp;
+    int w = gp->vw, h = gp->vh;
+    double g[FILTER_RADIUS + 1];
+    for (int d = 0; d <= FILTER_RADIUS; d++) g[d] = exp(-0.5 * d * d / (FILTER_SIGMA * FILTER_SIGMA));
+    for (int x = 0; x < w; x++) {
+        size_t i = (size_t)y * w + x;
+        float *o = &gp->vg_pixval[4 * i];
+        o[3] = 0.0f;
+        if (!F->ok[i]) continue;
+        const view_rec *r = &gp->vrec[i];
+        vec3 nr = view_normal(r);
+        double s[3] = {0.0, 0.0, 0.0}, ws = 0.0;
+        for (int dy = -FILTER_RADIUS; dy <= FILTER_RADIUS; dy++) {
+            int yy = y + dy;
+            if (yy < 0 || yy >= h) continue;
+            for (int dx = -FILTER_RADIUS; dx <= FILTER_RADIUS; dx++) {
+                int xx = x + dx;
+                if (xx < 0 || xx >= w) continue;
+                size_t j = (size_t)yy * w + xx;
+                if (!F->ok[j]) continue;
+                const view_rec *q = &gp->vrec[j];
+                if (j != i && (!compatible(q, r) || fabs(v3_dot(v3_sub(q->h.p, r->h.p), nr)) > DEPTH_TOL * r->h.t))
+                    continue;
+                double wt = g[dx < 0 ? -dx : dx] * g[dy < 0 ? -dy : dy];
+                for (int c = 0; c < 3; c++) s[c] += wt * F->raw[3 * j + c];
+                ws += wt;
+            }
+        }
+        for (int c = 0; c < 3; c++) o[c] = (float)(s[c] / ws);
+        o[3] = 1.0f;
+    }
+}
+
+void gi_particle_view_regather(gi_particle *gp)
+{
+    if (gp->vg_n <= 0 || !gp->lout) return;
+    size_t npix = (size_t)gp->vw * (size_t)gp->vh;
+    int *idx = malloc((size_t)gp->vg_n * sizeof *idx);
+    float *raw = malloc(npix * 3 * sizeof *raw);
+    unsigned char *ok = malloc(npix);
+    if (!gp->vg_pixval) gp->vg_pixval = malloc(npix * 4 * sizeof *gp->vg_pixval);
+    if (!idx || !raw || !ok || !gp->vg_pixval) {
+        free(idx);
+        free(raw);
+        free(ok);
+        gi_particle_view_gather_free(gp);
+        return;
+    }
+    for (int i = 0; i < gp->vg_n; i++) idx[i] = i;
+    /* the gathering kernel's C build (equation 5 at the pixels) */
+    gi_c_gather(gp->threads, gp->vg_link, gp->vg_k, gp->lout, idx, gp->vg_n, gp->vg_esky, gp->vg_val);
+    for (size_t i = 0; i < npix; i++) ok[i] = (unsigned char)raw_value(gp, i, &raw[3 * i]);
+    filter_job F = {gp, raw, ok};
+    pool_run(gp->threads, gp->vh, filter_row, &F);
+    /* the points answer hits that are not kept with the filtered value of
+     * their pixel too */
+    for (size_t i = 0; i < npix; i++) {
+        int k = gp->vg_pix[i];
+        if (k >= 0 && gp->vg_pixval[4 * i + 3] > 0.0f)
+            for (int c = 0; c < 3; c++) gp->vg_val[4 * (size_t)k + c] = gp->vg_pixval[4 * i + c];
+    }
+    free(idx);
+    free(raw);
+    free(ok);
+}
+
+int gi_particle_view_value(const gi_particle *gp, const accel_hit *hit, const view_rec *r, vec3 n, rgb *out)
+{
+    if (gp->vg_n <= 0 || gp->vg_w != gp->vw || gp->vg_h != gp->vh) return 0;
+    if (!r) return nearby_value(gp, hit, n, out);
+    if ((v3_dot(n, r->h.ng) >= 0.0) != r->side) return 0; /* the other side (diffuse_back) */
+    const float *v = &gp->vg_pixval[4 * (size_t)(r - gp->vrec)];
+    if (!(v[3] > 0.0f)) return nearby_value(gp, hit, n, out);
+    out->r = v[0];
+    out->g = v[1];
+    out->b = v[2];
     return 1;
 }

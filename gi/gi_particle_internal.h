@@ -82,9 +82,13 @@ struct gi_particle {
     float *vg_esky;   /* vg_n x 4: the sky's and far field's share (gi_links.h) */
     float *vg_val;    /* vg_n x 4: gathered E/pi */
     int *vg_pix;      /* vg_w x vg_h: a pixel's gather point, -1 none */
+    float *vg_pixval; /* vg_w x vg_h x 4: each kept pixel's filtered E/pi, [3] 1 where it has one */
     struct vg_point *vg_pt; /* vg_n: where each gathered (for hits that are not kept) */
-    uint64_t *vg_key; /* vg_n: cell hash << 32 | point, sorted */
-    double vg_cell;   /* their cells' size */
+    int *vg_ids;      /* vg_n: the points, by cell */
+    struct vg_cell *vg_tab; /* cells (hash table): runs of vg_ids */
+    size_t vg_tab_mask;
+    double vg_c0;     /* level 0's cell size */
+    unsigned vg_levels; /* bit L: level L has points */
     thread_count tc[GI_MAX_THREADS];
     gi_particle_stats st;
 };
@@ -166,6 +170,10 @@ void gi_particle_rp_far_field(gi_particle *gp, long l);
 void gi_light_pack(const scene_light *l, gi_dev_light *o);
 
 /* gi_particle_gather.c: the final gather at the kept hits */
+typedef struct vg_cell {
+    uint64_t key; /* 0: empty */
+    int start, count;
+} vg_cell;
 typedef struct vg_point {
     vec3 p, n;                /* the hit and the normal gathered about */
     const scene_object *obj;
