@@ -215,7 +215,9 @@ static inline double term(int k, double s, double x, double y, double z)
 /* The lattice cell of p as POV-Ray's Noise and DNoise set it up: p's
  * offsets from the cell's low and high corners, the s-curve weights of the
  * eight corners (products of the per-axis weights) and the hashes of the
- * cell's four (x, y) columns. */
+ * cell's four (x, y) columns. cell_at is forced inline: it runs once per
+ * noise value, in the innermost loop of every turbulent pattern, and as a
+ * call its results go through memory. */
 typedef struct {
     int iz;
     double x0, y0, z0, x1, y1, z1, sz, tz;
@@ -223,7 +225,7 @@ typedef struct {
     int h00, h10, h01, h11;
 } noise_cell;
 
-static inline void cell_at(vec3 p, noise_cell *c)
+__attribute__((always_inline)) static inline void cell_at(vec3 p, noise_cell *c)
 {
     int ix, iy;
     lattice(p.x, &ix, &c->x0);
