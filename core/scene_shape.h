@@ -186,6 +186,13 @@ struct scene_object {
     const scene_texture *texture;   /* NULL = default texture */
     const scene_texture *interior_texture;
     const scene_interior *interior; /* NULL = default interior */
+    /* The identity of POV-Ray's Interior this object uses, which a ray's
+     * list of containers compares (shade_media.h): its own interior, else
+     * the one its CSG parent's key names (the same Interior in POV-Ray's
+     * Post_Process, also where a member carries a copy rebased for its
+     * media), else the top-level object, whose default interior POV-Ray
+     * shares with its members. NULL: the interior, else the object. */
+    const void *medium;
     unsigned flags;
     union {
         struct { vec3 centre; double radius; } sphere;

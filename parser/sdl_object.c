@@ -181,6 +181,7 @@ static void own_interior(sdl_parser *p, scene_object *o)
  * visibility flags when they have none. */
 static void post_process(sdl_parser *p, scene_object *o, const scene_object *parent, const scene_texture *deflt)
 {
+    int own = o->interior != NULL;
     if (!parent || o->interior) own_interior(p, o);
     if (parent) {
         if (!o->texture) o->texture = parent->texture;
@@ -209,6 +210,7 @@ static void post_process(sdl_parser *p, scene_object *o, const scene_object *par
         }
         o->flags |= parent->flags & INHERITED_FLAGS;
     }
+    o->medium = own ? (const void *)o->interior : parent ? parent->medium : (const void *)o;
     if (!o->texture) o->texture = deflt;
     if (o->kind == SHAPE_MESH && o->u.mesh.mesh) ((scene_mesh *)o->u.mesh.mesh)->uses++;
     if (is_csg(o))

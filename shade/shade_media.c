@@ -79,7 +79,11 @@ static inline double dist3(rgb a, rgb b) { return fabs(a.r - b.r) + fabs(a.g - b
 
 /* ------------------------------------------------------------ containers */
 
-static const void *key_of(const scene_object *o) { return o->interior ? (const void *)o->interior : (const void *)o; }
+/* POV-Ray's Interior identity (scene_object.medium) */
+static const void *key_of(const scene_object *o)
+{
+    return o->medium ? o->medium : o->interior ? (const void *)o->interior : (const void *)o;
+}
 
 int shade_media_scene_has(const scene *sc)
 {
