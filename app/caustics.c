@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include "scene_leaves.h"
 #include "shade_light.h"
 #include "shade_material.h"
 #include "shade_texture.h"
@@ -65,22 +66,11 @@ static double hook_attenuation(void *ctx, const scene_light *l, vec3 p, double d
     return shade_light_attenuation(l, p, dir, depth);
 }
 
-static int interior_has_media(const scene_object *o)
-{
-    if (o->interior && o->interior->nmedia > 0) return 1;
-    if (o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE)
-        for (int i = 0; i < o->u.csg.nkids; i++)
-            if (interior_has_media(o->u.csg.kids[i])) return 1;
-    return 0;
-}
+static int has_media(const scene_object *o) { return o->interior && o->interior->nmedia > 0; }
 
-static int target_disperses(const scene_object *o)
+static int disperses(const scene_object *o)
 {
-    if (o->photons && o->photons->target && o->interior && o->interior->dispersion != 1.0) return 1;
-    if (o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE)
-        for (int i = 0; i < o->u.csg.nkids; i++)
-            if (target_disperses(o->u.csg.kids[i])) return 1;
-    return 0;
+    return o->photons && o->photons->target && o->interior && o->interior->dispersion != 1.0;
 }
 
 /* What the scene's photon settings ask that the layer leaves out. */
@@ -96,8 +86,8 @@ static void not_modelled(caustics *c, const scene *sc, diag *d)
     nm->save_file = (p->given & SCENE_PH_SAVE_FILE) != 0 && p->file && !p->load;
     nm->load_file = (p->given & SCENE_PH_LOAD_FILE) != 0 && p->file && p->load;
     for (int i = 0; i < sc->nobjects; i++) {
-        nm->dispersion |= target_disperses(sc->objects[i]);
-        nm->media_objects |= interior_has_media(sc->objects[i]);
+        nm->dispersion |= scene_object_any(sc->objects[i], disperses);
+        nm->media_objects |= scene_object_any(sc->objects[i], has_media);
     }
     src_loc nowhere = {0};
     const char *why = "the caustic layer sizes its photon volumes itself (docs/caustics.md)";

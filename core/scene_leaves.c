@@ -37,6 +37,15 @@ int scene_object_is_csg(const scene_object *o)
     return o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE;
 }
 
+int scene_object_any(const scene_object *o, int (*pred)(const scene_object *o))
+{
+    if (pred(o)) return 1;
+    if (scene_object_is_csg(o))
+        for (int i = 0; i < o->u.csg.nkids; i++)
+            if (scene_object_any(o->u.csg.kids[i], pred)) return 1;
+    return 0;
+}
+
 static int leaves_walk(scene_leaves *L, const scene_object *o, int top)
 {
     if (scene_object_is_csg(o)) {

@@ -33,5 +33,8 @@ uint64_t scene_object_hash(uint64_t h, const scene_object *o, int *opaque);
  * superellipsoids, ovus and CSG of them. */
 int scene_object_finite(const scene_object *o);
 int scene_object_is_csg(const scene_object *o);
+/* 1 when pred holds for o or for any member of it (CSG members, at any
+ * depth). */
+int scene_object_any(const scene_object *o, int (*pred)(const scene_object *o));
 
 #endif

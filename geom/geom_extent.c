@@ -1,5 +1,6 @@
 /* geom_extent.c - POV-Ray 3.7's bounding boxes (see geom_extent.h). */
 #include "geom_extent.h"
+#include "scene_leaves.h"
 #include <math.h>
 #include <stdlib.h>
 #include "geom_sweep.h"
@@ -15,11 +16,6 @@ typedef struct {
 typedef struct {
     const char *unsupported; /* first shape without a box */
 } extent_ctx;
-
-static int is_csg(const scene_object *o)
-{
-    return o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE;
-}
 
 static vec3 mesh_vert(const scene_mesh *m, int i) { return v3(m->verts[i][0], m->verts[i][1], m->verts[i][2]); }
 
@@ -280,12 +276,12 @@ static bbox leaf_box(extent_ctx *g, const scene_object *o)
 
 static bbox obj_box(extent_ctx *g, const scene_object *o)
 {
-    bbox b = is_csg(o) ? csg_box(g, o) : leaf_box(g, o);
+    bbox b = scene_object_is_csg(o) ? csg_box(g, o) : leaf_box(g, o);
     if (o->clip && !(o->flags & OBJ_INVERSE)) {
         /* a clipped object is bounded by its clipping solid too */
         scene_object c = *o->clip;
         c.transform = xform_then(o->clip->transform, o->transform);
-        if (!is_csg(&c)) {
+        if (!scene_object_is_csg(&c)) {
             bbox cb = obj_box(g, &c);
             bbox in = {v3_max(b.lo, cb.lo), v3_min(b.hi, cb.hi)};
             if (in.lo.x <= in.hi.x && in.lo.y <= in.hi.y && in.lo.z <= in.hi.z) b = in;

@@ -1,5 +1,6 @@
 /* gi_caustic.c - the caustic layer (see gi_caustic.h). */
 #include "gi_caustic.h"
+#include "scene_leaves.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -183,15 +184,9 @@ static int ptr_cmp(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-static int is_csg(const scene_object *o)
-{
-    return o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION ||
-           o->kind == SHAPE_DIFFERENCE;
-}
-
 static int count_leaves(const scene_object *o)
 {
-    if (!is_csg(o)) return 1;
+    if (!scene_object_is_csg(o)) return 1;
     int n = 0;
     for (int i = 0; i < o->u.csg.nkids; i++) n += count_leaves(o->u.csg.kids[i]);
     return n;
@@ -199,7 +194,7 @@ static int count_leaves(const scene_object *o)
 
 static void add_leaves(const scene_object *o, const scene_object **out, int *n)
 {
-    if (!is_csg(o)) {
+    if (!scene_object_is_csg(o)) {
         out[(*n)++] = o;
         return;
     }
@@ -230,7 +225,7 @@ static int collect_targets(const scene_object *o, const scene_object ***list, in
         (*list)[(*n)++] = o;
         return 1;
     }
-    if (is_csg(o))
+    if (scene_object_is_csg(o))
         for (int i = 0; i < o->u.csg.nkids; i++)
             if (!collect_targets(o->u.csg.kids[i], list, n, cap)) return 0;
     return 1;

@@ -1,6 +1,7 @@
 /* sdl_clip.c - clipped_by and bounded_by (sdl_shape.h): the clipping and
  * bounding objects of an object, made relative to its space (sdl_clip.h). */
 #include "sdl_clip.h"
+#include "scene_leaves.h"
 #include <stdlib.h>
 #include <string.h>
 #include "sdl_directive.h"
@@ -14,7 +15,7 @@ static void relativize(scene_object *c, const xform *host_inv, int depth)
 {
     if (!c || depth > 1000) return;
     c->transform = xform_then(c->transform, *host_inv);
-    if (c->kind == SHAPE_UNION || c->kind == SHAPE_MERGE || c->kind == SHAPE_INTERSECTION || c->kind == SHAPE_DIFFERENCE)
+    if (scene_object_is_csg(c))
         for (int i = 0; i < c->u.csg.nkids; i++) relativize(c->u.csg.kids[i], host_inv, depth + 1);
 }
 
@@ -72,7 +73,7 @@ static scene_object *copy_tree(sdl_parser *p, const scene_object *o, int depth)
     scene_object *c = sdl_alloc(p, sizeof *c);
     if (!c) return NULL;
     *c = *o;
-    if (o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE) {
+    if (scene_object_is_csg(o)) {
         c->u.csg.kids = o->u.csg.nkids ? sdl_alloc(p, sizeof *c->u.csg.kids * (size_t)o->u.csg.nkids) : NULL;
         for (int i = 0; i < o->u.csg.nkids && c->u.csg.kids; i++) c->u.csg.kids[i] = copy_tree(p, o->u.csg.kids[i], depth + 1);
     }

@@ -1,5 +1,6 @@
 /* sdl_object.c - shapes, CSG, meshes, object modifiers. */
 #include "sdl_object.h"
+#include "scene_leaves.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -61,11 +62,6 @@ static sdl_obj *new_obj(sdl_parser *p, shape_kind kind, const char *name, src_lo
 
 static scene_texture *own_texture(const scene_texture *t) { return (scene_texture *)t; }
 
-static int is_csg(const scene_object *o)
-{
-    return o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE;
-}
-
 /* POV-Ray 3.7's Post_Process (parse.cpp) gives a CSG member the parent's
  * UV flag when it copies the parent's texture or its interior_texture, so
  * every member without an interior_texture of its own gets it, even one
@@ -76,7 +72,7 @@ static int is_csg(const scene_object *o)
 static void set_uv_mapping(scene_object *o, int value)
 {
     if (o->uv_mapping != 1) o->uv_mapping = value;
-    if (is_csg(o))
+    if (scene_object_is_csg(o))
         for (int i = 0; i < o->u.csg.nkids; i++) {
             scene_object *k = o->u.csg.kids[i];
             if (!k->texture || !k->interior_texture) set_uv_mapping(k, 2);
@@ -90,7 +86,7 @@ static void node_transform(scene_object *o, const xform *x)
         sdl_transform_texture_outer(own_texture(o->texture), x);
         sdl_transform_texture_outer(own_texture(o->interior_texture), x);
     }
-    if (is_csg(o))
+    if (scene_object_is_csg(o))
         for (int i = 0; i < o->u.csg.nkids; i++) node_transform(o->u.csg.kids[i], x);
 }
 
@@ -117,7 +113,7 @@ static scene_object *copy_node(sdl_parser *p, const scene_object *o)
     *c = *o;
     c->texture = sdl_copy_texture(p, o->texture);
     c->interior_texture = sdl_copy_texture(p, o->interior_texture);
-    if (is_csg(o) && o->u.csg.nkids > 0) {
+    if (scene_object_is_csg(o) && o->u.csg.nkids > 0) {
         c->u.csg.kids = sdl_alloc(p, sizeof(scene_object *) * (size_t)o->u.csg.nkids);
         if (!c->u.csg.kids) return NULL;
         for (int i = 0; i < o->u.csg.nkids; i++) c->u.csg.kids[i] = copy_node(p, o->u.csg.kids[i]);
@@ -213,7 +209,7 @@ static void post_process(sdl_parser *p, scene_object *o, const scene_object *par
     o->medium = own ? (const void *)o->interior : parent ? parent->medium : (const void *)o;
     if (!o->texture) o->texture = deflt;
     if (o->kind == SHAPE_MESH && o->u.mesh.mesh) ((scene_mesh *)o->u.mesh.mesh)->uses++;
-    if (is_csg(o))
+    if (scene_object_is_csg(o))
         for (int i = 0; i < o->u.csg.nkids; i++) post_process(p, o->u.csg.kids[i], o, deflt);
 }
 
@@ -268,7 +264,7 @@ static void set_flag(scene_object *o, unsigned flag, int on, int recurse)
 {
     if (on) o->flags |= flag;
     else o->flags &= ~flag;
-    if (recurse && is_csg(o))
+    if (recurse && scene_object_is_csg(o))
         for (int i = 0; i < o->u.csg.nkids; i++) set_flag(o->u.csg.kids[i], flag, on, 1);
 }
 
@@ -368,7 +364,7 @@ static int material_mod(sdl_parser *p, scene_object *o, sdl_kw k)
 
 static void photons_to_members(scene_object *o, const scene_obj_photons *ph)
 {
-    if (!is_csg(o)) return;
+    if (!scene_object_is_csg(o)) return;
     for (int i = 0; i < o->u.csg.nkids; i++) {
         scene_object *k = o->u.csg.kids[i];
         if (!k->photons) {
@@ -1086,7 +1082,7 @@ static void mark_light_group(scene_object *o, int id, int no_global)
 {
     if (!o->light_group) o->light_group = id;
     o->no_global_lights = no_global;
-    if (is_csg(o))
+    if (scene_object_is_csg(o))
         for (int i = 0; i < o->u.csg.nkids; i++) mark_light_group(o->u.csg.kids[i], id, no_global);
 }
 

@@ -28,6 +28,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "pool.h"
+#include "scene_leaves.h"
 #include "radrules.h"
 #include "shade_light.h"
 #include "shade_material.h"
@@ -133,14 +134,7 @@ static int caustic_bounce_ok(const scene_light *l, const accel_hit *h, int lobe)
     return scene_photon_lobe(l, ph, lobe != SHADE_MAT_LOBE_REFLECT);
 }
 
-static int any_target(const scene_object *o)
-{
-    if (o->photons && o->photons->target) return 1;
-    if (o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE)
-        for (int i = 0; i < o->u.csg.nkids; i++)
-            if (any_target(o->u.csg.kids[i])) return 1;
-    return 0;
-}
+static int is_target(const scene_object *o) { return o->photons && o->photons->target; }
 
 /* Emit one photon of source `src`: its origin *o and direction *w, the
  * first hit and the photon's power. Returns 1 on a hit, 0 when the photon
@@ -398,7 +392,7 @@ static pt_status setup(trace_ctx *cp, const scene *sc, const accel *a, const pm_
     c.eps = pm_lights_eps(L);
     c.rr = radrules_of(sc, 1);
     c.gathers = c.rr.recursion_limit > 0 ? c.rr.recursion_limit : 1 << 20;
-    for (int i = 0; i < sc->nobjects && !c.targets; i++) c.targets = any_target(sc->objects[i]);
+    for (int i = 0; i < sc->nobjects && !c.targets; i++) c.targets = scene_object_any(sc->objects[i], is_target);
     *targets = c.targets;
     vec3 lo, hi;
     if (bounds) {

@@ -58,6 +58,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "geom_shape.h"
+#include "scene_leaves.h"
 #include "shade_atmos.h"
 #include "shade_pattern.h"
 #include "shade_texture.h"
@@ -85,22 +86,14 @@ static const void *key_of(const scene_object *o)
     return o->medium ? o->medium : o->interior ? (const void *)o->interior : (const void *)o;
 }
 
+static int has_interior_media(const scene_object *o) { return o->interior && o->interior->nmedia > 0; }
+
 int shade_media_scene_has(const scene *sc)
 {
     if (sc->natmosphere > 0) return 1;
     /* interior media: any object's (CSG members included) */
-    for (int i = 0; i < sc->nobjects; i++) {
-        const scene_object *stack[256];
-        int n = 0;
-        stack[n++] = sc->objects[i];
-        while (n > 0) {
-            const scene_object *o = stack[--n];
-            if (o->interior && o->interior->nmedia > 0) return 1;
-            if (o->kind == SHAPE_UNION || o->kind == SHAPE_MERGE || o->kind == SHAPE_INTERSECTION ||
-                o->kind == SHAPE_DIFFERENCE)
-                for (int k = 0; k < o->u.csg.nkids && n < 256; k++) stack[n++] = o->u.csg.kids[k];
-        }
-    }
+    for (int i = 0; i < sc->nobjects; i++)
+        if (scene_object_any(sc->objects[i], has_interior_media)) return 1;
     return 0;
 }
 
