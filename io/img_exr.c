@@ -536,11 +536,6 @@ static exr_result_t decode_chunk(exr_context_t ctx, const exr_chunk_info_t *ci, 
     return exr_decoding_run(ctx, 0, &k->dec);
 }
 
-static void sink_free(exr_context_t ctx, chunk_sink *k)
-{
-    if (k->dec_init) exr_decoding_destroy(ctx, &k->dec);
-    free(k->scratch.p);
-}
 
 /* Decodes every chunk of part 0 of a w x h data window dw (scanline
  * blocks, or the tiles of level 0) into k, each checked to lie inside the
@@ -614,6 +609,16 @@ static int start_read(const char *path, exr_stream *s, exr_context_t *ctx, exr_r
     init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
     *rv = exr_start_read(ctx, path, &init);
     return 1;
+}
+
+/* Ends what start_read began: the sink's decoder and scratch, the read
+ * context, the file. */
+static void finish_read(exr_stream *s, exr_context_t *ctx, chunk_sink *k)
+{
+    if (k->dec_init) exr_decoding_destroy(*ctx, &k->dec);
+    free(k->scratch.p);
+    if (*ctx) exr_finish(ctx);
+    close(s->fd);
 }
 
 pt_status img_exr_read(const char *path, uint64_t max_pixels, framebuffer **out, diag *d)
@@ -719,9 +724,7 @@ libfail:
     diag_error(d, "cannot read '%s': %s: %s", path, what, reason(&s, rv));
     st = PT_ERR_IO;
 done:
-    sink_free(ctx, &sink);
-    if (ctx) exr_finish(&ctx);
-    close(s.fd);
+    finish_read(&s, &ctx, &sink);
     free(grey);
     fb_free(fb);
     return st;
@@ -800,9 +803,7 @@ libfail:
     diag_error(d, "cannot read '%s': %s: %s", path, what, reason(&s, rv));
     st = PT_ERR_IO;
 done:
-    sink_free(ctx, &sink);
-    if (ctx) exr_finish(&ctx);
-    close(s.fd);
+    finish_read(&s, &ctx, &sink);
     free(ls.data);
     return st;
 }

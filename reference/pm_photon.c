@@ -136,6 +136,26 @@ static int caustic_bounce_ok(const scene_light *l, const accel_hit *h, int lobe)
 
 static int is_target(const scene_object *o) { return o->photons && o->photons->target; }
 
+/* A photon of a beam (a cylinder light, or a parallel light over the
+ * scene): from a uniform point of the disc of radius R about `centre`
+ * across `axis`, along `dir`; its first hit and its power (one of n over
+ * the disc's area, attenuated as the light's direct light is). */
+static int beam_photon(const trace_ctx *c, const scene_light *l, vec3 centre, vec3 axis, vec3 dir, double R, double n,
+                       rng *r, accel_hit *h, vec3 *o, vec3 *w, rgb *phi, long *rays)
+{
+    double u1 = rng_f64(r), u2 = rng_f64(r);
+    *o = disc_point(centre, axis, R, u1, u2);
+    *w = dir;
+    if (accel_intersect_past(c->a, NULL, *o, dir, c->eps, LIGHT_SKIP, h, rays) <= 0) return 0;
+    vec3 dl;
+    double depth;
+    shade_light_ray(l, l->position, h->p, &dl, &depth);
+    double att = shade_light_attenuation(l, h->p, dl, depth);
+    double k = M_PI * att * M_PI * R * R / n;
+    *phi = crgb(l->colour.r * k, l->colour.g * k, l->colour.b * k);
+    return 1;
+}
+
 /* Emit one photon of source `src`: its origin *o and direction *w, the
  * first hit and the photon's power. Returns 1 on a hit, 0 when the photon
  * left the scene, -1 when no photon was emitted (no emitter sample). */
@@ -147,34 +167,12 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         rgb C = l->colour;
         if (l->kind == LIGHT_CYLINDER) {
             vec3 axis = v3_norm(v3_sub(l->point_at, l->position));
-            double R = fabs(l->falloff);
-            double u1 = rng_f64(r), u2 = rng_f64(r);
-            *o = disc_point(l->position, axis, R, u1, u2);
-            *w = axis;
-            if (accel_intersect_past(c->a, NULL, *o, axis, c->eps, LIGHT_SKIP, h, rays) <= 0) return 0;
-            vec3 dl;
-            double depth;
-            shade_light_ray(l, l->position, h->p, &dl, &depth);
-            double att = shade_light_attenuation(l, h->p, dl, depth);
-            double k = M_PI * att * M_PI * R * R / n;
-            *phi = crgb(C.r * k, C.g * k, C.b * k);
-            return 1;
+            return beam_photon(c, l, l->position, axis, axis, fabs(l->falloff), n, r, h, o, w, phi, rays);
         }
         if (l->parallel || l->kind == LIGHT_PARALLEL) {
             vec3 to_light = v3_norm(v3_sub(l->position, l->point_at));
             vec3 cp = v3_sub(c->centre, v3_scale(to_light, v3_dot(v3_sub(c->centre, l->position), to_light)));
-            double R = c->radius;
-            double u1 = rng_f64(r), u2 = rng_f64(r);
-            *o = disc_point(cp, to_light, R, u1, u2);
-            *w = v3_neg(to_light);
-            if (accel_intersect_past(c->a, NULL, *o, *w, c->eps, LIGHT_SKIP, h, rays) <= 0) return 0;
-            vec3 dl;
-            double depth;
-            shade_light_ray(l, l->position, h->p, &dl, &depth);
-            double att = shade_light_attenuation(l, h->p, dl, depth);
-            double k = M_PI * att * M_PI * R * R / n;
-            *phi = crgb(C.r * k, C.g * k, C.b * k);
-            return 1;
+            return beam_photon(c, l, cp, to_light, v3_neg(to_light), c->radius, n, r, h, o, w, phi, rays);
         }
         /* an area light shoots from its centre: POV-Ray's photons do
          * (photons.cpp: the area only with the light's photons { area_light }),
