@@ -39,6 +39,21 @@ static const char compare_help[] =
 
 static int exit_for(pt_status st) { return cli_exit_status(st); }
 
+void cmd_compare_metrics_json(stats_json *js, const img_compare_result *r, int hdr)
+{
+    stats_str(js, "mode", hdr ? "hdr" : "ldr");
+    STATS_NUMS(js, r, rmse, relmse, psnr, ssim);
+    stats_obj_begin(js, "flip");
+    stats_num(js, "mean", r->flip_mean);
+    stats_num(js, "weighted_median", r->flip_wmedian);
+    if (hdr) {
+        stats_num(js, "exposure_start", r->exp_start);
+        stats_num(js, "exposure_stop", r->exp_stop);
+        stats_int(js, "exposures", r->nexposures);
+    }
+    stats_obj_end(js);
+}
+
 int cmd_compare(int argc, char **argv)
 {
     const char *ref_path = NULL, *test_path = NULL, *heatmap = NULL;
@@ -107,20 +122,7 @@ int cmd_compare(int argc, char **argv)
         stats_str(&js, "test", test_path);
         stats_int(&js, "width", ref->width);
         stats_int(&js, "height", ref->height);
-        stats_str(&js, "mode", hdr ? "hdr" : "ldr");
-        stats_num(&js, "rmse", r.rmse);
-        stats_num(&js, "relmse", r.relmse);
-        stats_num(&js, "psnr", r.psnr);
-        stats_num(&js, "ssim", r.ssim);
-        stats_obj_begin(&js, "flip");
-        stats_num(&js, "mean", r.flip_mean);
-        stats_num(&js, "weighted_median", r.flip_wmedian);
-        if (hdr) {
-            stats_num(&js, "exposure_start", r.exp_start);
-            stats_num(&js, "exposure_stop", r.exp_stop);
-            stats_int(&js, "exposures", r.nexposures);
-        }
-        stats_obj_end(&js);
+        cmd_compare_metrics_json(&js, &r, hdr);
         stats_obj_begin(&js, "luminance");
         stats_num(&js, "reference", r.lum_ref);
         stats_num(&js, "test", r.lum_test);

@@ -47,6 +47,7 @@
 #include <string.h>
 #include <unistd.h>
 #include "cli.h"
+#include "cmd_compare.h"
 #include "diag.h"
 #include "framebuffer.h"
 #include "hash.h"
@@ -723,15 +724,7 @@ int cmd_crosscheck(int argc, char **argv)
         stats_str(&js, "gi", gi_used);
         if (o.out_dir) stats_str(&js, "image", pt_png);
         stats_obj_end(&js);
-        stats_str(&js, "mode", "ldr");
-        stats_num(&js, "rmse", r.rmse);
-        stats_num(&js, "relmse", r.relmse);
-        stats_num(&js, "psnr", r.psnr);
-        stats_num(&js, "ssim", r.ssim);
-        stats_obj_begin(&js, "flip");
-        stats_num(&js, "mean", r.flip_mean);
-        stats_num(&js, "weighted_median", r.flip_wmedian);
-        stats_obj_end(&js);
+        cmd_compare_metrics_json(&js, &r, 0);
         stats_num(&js, "mean_abs_diff", mad);
         stats_num(&js, "mean_abs_diff_4x4", mad4);
         stats_obj_begin(&js, "luminance");
