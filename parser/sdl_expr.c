@@ -644,7 +644,7 @@ static void primary(sdl_parser *p, ex_val *out)
 }
 
 /* component := x | y | z | u | v | t | red | green | blue | filter | transmit | gray */
-static int component_index(const sdl_tok *t)
+int sdl_component_index(const sdl_tok *t)
 {
     if (t->tk.kind != TOK_KEYWORD) return -1;
     switch (t->tk.kw) {
@@ -664,7 +664,7 @@ static void factor(sdl_parser *p, ex_val *out)
     primary(p, out);
     if (!sdl_ok(p) || !sdl_accept(p, TOK_DOT)) return;
     sdl_tok c = sdl_next(p);
-    int i = component_index(&c);
+    int i = sdl_component_index(&c);
     if (i < 0) {
         sdl_unexpected(p, &c, "x, y, z or colour component");
         return;

@@ -44,6 +44,10 @@ int sdl_starts_expr(const sdl_tok *t);
 int sdl_starts_float(const sdl_tok *t);
 int sdl_starts_colour(const sdl_tok *t);
 int sdl_starts_string(const sdl_tok *t);
+/* The member a `.NAME` after a vector or colour selects: x/u/red 0,
+ * y/v/green 1, z/blue 2, t/filter 3, transmit 4, gray 5; -1 for any other
+ * token. */
+int sdl_component_index(const sdl_tok *t);
 
 /* Truth of a float as POV-Ray tests it (|x| > 1e-10). */
 int sdl_true(double x);

@@ -96,19 +96,9 @@ static int f_or(fn_build *b);
 static int member_index(sdl_parser *p)
 {
     sdl_tok t = sdl_next(p);
-    if (t.tk.kind == TOK_KEYWORD) {
-        switch (t.tk.kw) {
-        case KW_X: case KW_U: case KW_RED: return 0;
-        case KW_Y: case KW_V: case KW_GREEN: return 1;
-        case KW_Z: case KW_BLUE: return 2;
-        case KW_T: case KW_FILTER: return 3;
-        case KW_TRANSMIT: return 4;
-        case KW_GRAY: return 5;
-        default: break;
-        }
-    }
-    sdl_unexpected(p, &t, "colour or vector member (x, y, z, t, red, green, blue, filter, transmit, gray)");
-    return -1;
+    int i = sdl_component_index(&t);
+    if (i < 0) sdl_unexpected(p, &t, "colour or vector member (x, y, z, t, red, green, blue, filter, transmit, gray)");
+    return i;
 }
 
 /* args := '(' f_or { ',' f_or } ')' ; returns the count (kids in k) */
