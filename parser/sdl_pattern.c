@@ -70,6 +70,23 @@ static scene_pattern *new_pattern(sdl_parser *p, const scene_pattern *from)
     return pt;
 }
 
+/* A pattern block's target of `kind`: a mutable copy of the pattern it
+ * starts from (NULL: none yet; uv_mapping set when uv), the map and the
+ * transform it fills; the caller sets the pigment, normal or texture. */
+static target target_new(sdl_parser *p, tgt_kind kind, const scene_pattern *pat, const scene_blend_map **map,
+                         xform *outer, int uv)
+{
+    target tg;
+    memset(&tg, 0, sizeof tg);
+    tg.kind = kind;
+    tg.pat = pat ? new_pattern(p, pat) : NULL;
+    tg.map = map;
+    tg.outer = outer;
+    tg.uv = uv;
+    if (uv && tg.pat) tg.pat->uv_mapping = 1;
+    return tg;
+}
+
 static scene_warp default_turb(void)
 {
     scene_warp w;
@@ -1132,15 +1149,8 @@ void sdl_pattern_pigment_body(sdl_parser *p, scene_pigment *pg)
         *pg = *(const scene_pigment *)id.val.ptr;
         t = sdl_peek(p);
     }
-    target tg;
-    memset(&tg, 0, sizeof tg);
-    tg.kind = TGT_PIGMENT;
+    target tg = target_new(p, TGT_PIGMENT, pg->pat, &pg->map, &pg->transform, uv);
     tg.pg = pg;
-    tg.pat = pg->pat ? new_pattern(p, pg->pat) : NULL;
-    tg.map = &pg->map;
-    tg.outer = &pg->transform;
-    tg.uv = uv;
-    if (uv && tg.pat) tg.pat->uv_mapping = 1;
     if (sdl_starts_colour(t) || sdl_is(t, TOK_LT)) {
         pg->colour = sdl_colour(p, 1);
         pg->kind = PIGMENT_SOLID;
@@ -1199,15 +1209,8 @@ scene_normal *sdl_pattern_normal_body(sdl_parser *p, const scene_normal *base)
         sdl_tok id = sdl_next(p);
         if (id.val.ptr) *nm = *(const scene_normal *)id.val.ptr;
     }
-    target tg;
-    memset(&tg, 0, sizeof tg);
-    tg.kind = TGT_NORMAL;
+    target tg = target_new(p, TGT_NORMAL, nm->pat, &nm->map, &nm->transform, uv);
     tg.nm = nm;
-    tg.pat = nm->pat ? new_pattern(p, nm->pat) : NULL;
-    tg.map = &nm->map;
-    tg.outer = &nm->transform;
-    tg.uv = uv;
-    if (uv && tg.pat) tg.pat->uv_mapping = 1;
     if (pattern_type(p, &tg)) {
         /* POV-Ray: [','] [amount] after the pattern type */
         sdl_accept(p, TOK_COMMA);
@@ -1331,12 +1334,8 @@ void sdl_pattern_texture(sdl_parser *p, scene_texture *t)
     } else if (sdl_accept_kw(p, KW_MATERIAL_MAP)) {
         material_map(p, t);
     } else {
-        target tg;
-        memset(&tg, 0, sizeof tg);
-        tg.kind = TGT_TEXTURE;
+        target tg = target_new(p, TGT_TEXTURE, NULL, &t->map, &t->transform, 0);
         tg.tx = t;
-        tg.map = &t->map;
-        tg.outer = &t->transform;
         pattern_type(p, &tg);
         modifiers(p, &tg, "texture");
         t->pat = tg.pat;
