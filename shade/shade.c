@@ -626,16 +626,11 @@ static void tile_first_pass(void *ctx, int tile, int thread)
     }
 }
 
-/* POV-Ray compares gamma-encoded, clipped colours for antialiasing. */
-static rgb aa_encode(const float *px)
+/* The colour adaptive antialiasing compares (shade_gamma_aa_value:
+ * POV-Ray's Antialias_Gamma curve on the working-space values). */
+static rgb aa_encode(const scene *sc, const float *px)
 {
-    rgb c;
-    double v[3];
-    for (int i = 0; i < 3; i++) {
-        double l = fmin(1.0, fmax(0.0, px[i]));
-        v[i] = l <= 0.0031308 ? 12.92 * l : 1.055 * pow(l, 1.0 / 2.4) - 0.055;
-    }
-    c.r = v[0]; c.g = v[1]; c.b = v[2];
+    rgb c = {shade_gamma_aa_value(sc, px[0]), shade_gamma_aa_value(sc, px[1]), shade_gamma_aa_value(sc, px[2])};
     return c;
 }
 
@@ -737,10 +732,10 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
          * pixel belongs to, as in the whole image */
         for (int y = c.first_win[1]; y < c.first_win[3]; y++) {
             for (int x = c.first_win[0]; x < c.first_win[2]; x++) {
-                rgb cur = aa_encode(fb_px(fb, x, y));
-                if (x > c.first_win[0] && shade_colour_distance(aa_encode(fb_px(fb, x - 1, y)), cur) >= s->aa_threshold)
+                rgb cur = aa_encode(sc, fb_px(fb, x, y));
+                if (x > c.first_win[0] && shade_colour_distance(aa_encode(sc, fb_px(fb, x - 1, y)), cur) >= s->aa_threshold)
                     c.flag[(size_t)y * s->width + x] = c.flag[(size_t)y * s->width + x - 1] = 1;
-                if (y > c.first_win[1] && shade_colour_distance(aa_encode(fb_px(fb, x, y - 1)), cur) >= s->aa_threshold)
+                if (y > c.first_win[1] && shade_colour_distance(aa_encode(sc, fb_px(fb, x, y - 1)), cur) >= s->aa_threshold)
                     c.flag[(size_t)y * s->width + x] = c.flag[(size_t)(y - 1) * s->width + x] = 1;
             }
         }

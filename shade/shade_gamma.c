@@ -21,6 +21,14 @@ static float srgb_decode(float v)
     return v <= 0.04045f ? v / 12.92f : (float)pow((v + 0.055) / 1.055, 2.4);
 }
 
+double shade_gamma_aa_value(const scene *sc, double v)
+{
+    if (!(v > 0.0)) return 0.0;
+    /* PowerLawGammaCurve 2.5 after the working gamma's decoding: one power */
+    double g = gamma_working(sc);
+    return pow(v, (g > 0.0 ? g : 1.0) / 2.5);
+}
+
 void shade_gamma_fb_to_linear(const scene *sc, framebuffer *fb)
 {
     double g = gamma_working(sc);

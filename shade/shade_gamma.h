@@ -12,4 +12,10 @@
  * gamma 1. */
 void shade_gamma_fb_to_linear(const scene *sc, framebuffer *fb);
 
+/* A working-space channel value as POV-Ray 3.7's adaptive antialiasing
+ * compares it (tracetask.cpp with view.cpp's Antialias_Gamma default 2.5):
+ * decoded to linear (as it is with gamma handling off), then raised to
+ * 1/2.5, not clipped above 1; negative values count as 0. */
+double shade_gamma_aa_value(const scene *sc, double v);
+
 #endif
