@@ -36,12 +36,12 @@ for a in $libs; do
         awk '$2 ~ /^[TDBR]$/ && $3 ~ /^[A-Za-z][A-Za-z0-9_]*$/ { sub(/:[0-9a-f]+$/, "", $1); print $1, $3 }'
 done | sort -k2 > "$tmp/defs"
 
-# references: every undefined symbol of every object of the build (the
-# libraries' members and each executable's own objects)
+# references: every undefined symbol of every object of the build (each
+# library's members, test and bench libraries included, and each
+# executable's own objects)
 {
-    for a in $libs; do nm --undefined-only "$a"; done
-    find "$BUILD" -name '*.o' -path '*/CMakeFiles/*' -exec nm --undefined-only {} +
     for a in $(find "$BUILD" -name 'libpt_*.a'); do nm --undefined-only "$a"; done
+    find "$BUILD" -name '*.o' -path '*/CMakeFiles/*' -exec nm --undefined-only {} +
 } 2>/dev/null | awk '$1 == "U" { print $2 }' > "$tmp/uses.all"
 cat "$SRC"/tests/fuzz/*.c 2>/dev/null | grep -o '[A-Za-z_][A-Za-z0-9_]*' >> "$tmp/uses.all" || true
 sort -u "$tmp/uses.all" > "$tmp/uses"
