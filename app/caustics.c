@@ -8,9 +8,14 @@
 #include "shade_material.h"
 #include "shade_texture.h"
 
-/* The caustic layer's material hook: shade_material's BSDF at the hit;
- * Russian roulette over its lobes (shade_mat_sample with absorption, seed
- * 002 appendix A) continues a photon only along a specular lobe. */
+/* The caustic layer's material hook (gi_caustic_hooks.surface):
+ * shade_material's BSDF at the hit. Russian roulette (seed 002 appendix A)
+ * keeps the photon with probability p = (m_r + m_t) / max(1, sum of the
+ * lobe sizes), the specular lobes' share as shade_mat_sample(absorb = 1)
+ * would choose one of them; a kept photon goes on along each specular
+ * lobe the surface has, weighted by the lobe over p. Each branch carries
+ * p as its path-density factor (rho): split branches are as dense as the
+ * photons arriving, only the roulette thins them. */
 static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, rng *r, gi_caustic_step *step)
 {
     const caustics *c = ctx;
@@ -18,31 +23,32 @@ static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, rng *r, gi_caus
     shade_mat_setup(&b, c->sc, h, dir, c->eps, r);
     int out = b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 ? GI_CAUSTIC_RECEIVES : 0;
     if (!step) return out;
-    shade_mat_scatter s;
-    if (!shade_mat_sample(&b, r, 1, &s) || !s.specular) return out;
-    step->org = s.org;
-    step->dir = s.dir;
-    step->weight = (rgb){s.weight.r * s.eta2, s.weight.g * s.eta2, s.weight.b * s.eta2};
-    if (s.lobe == SHADE_MAT_LOBE_TRANSMIT && b.m[SHADE_MAT_LOBE_TRANSMIT] > 0.0) {
+    double mr = b.m[SHADE_MAT_LOBE_REFLECT], mt = b.m[SHADE_MAT_LOBE_TRANSMIT];
+    double p = (mr + mt) / (b.msum > 1.0 ? b.msum : 1.0);
+    if (!(p > 0.0) || rng_f64(r) >= p) return out;
+    int n = 0;
+    if (mr > 0.0) {
+        rgb k = b.k[SHADE_MAT_LOBE_REFLECT];
+        step[n] = (gi_caustic_step){b.p_out, b.refl_dir, {k.r / p, k.g / p, k.b / p}, p, 0, b.from};
+        n++;
+    }
+    if (mt > 0.0) {
         /* what a refracted photon keeps: the layers' filter and transmit
          * and, leaving an object, the interior's fade over h->t, the
          * straight path inside (shade_tex_shadow_filter), times 1 - the
          * top layer's reflectivity under conserve_energy (POV-Ray 3.7's
          * photons.cpp, PhotonTrace::ComputeLightedTexture: FilCol *= 1 -
-         * reflec, the photon carrying LightCol * FilCol); the lobe was
-         * chosen with probability m_t (mat_sample) */
-        double p = b.m[SHADE_MAT_LOBE_TRANSMIT] / (b.msum > 1.0 ? b.msum : 1.0);
+         * reflec, the photon carrying LightCol * FilCol) */
         rgb f = shade_tex_shadow_filter(c->sc, h, dir);
         if (b.ls.f && b.ls.f->conserve_energy) {
             rgb kr = b.k[SHADE_MAT_LOBE_REFLECT];
             f = (rgb){f.r * fmin(1.0, 1.0 - kr.r), f.g * fmin(1.0, 1.0 - kr.g), f.b * fmin(1.0, 1.0 - kr.b)};
         }
-        step->weight = (rgb){f.r * s.eta2 / p, f.g * s.eta2 / p, f.b * s.eta2 / p};
+        double k = b.eta2 / p;
+        step[n] = (gi_caustic_step){b.p_in, b.trans_dir, {f.r * k, f.g * k, f.b * k}, p, 1, b.from};
+        n++;
     }
-    step->rho = b.m[s.lobe];
-    step->refract = s.lobe == SHADE_MAT_LOBE_TRANSMIT;
-    step->from = b.from;
-    return out | GI_CAUSTIC_CONTINUES;
+    return out | GI_CAUSTIC_CONTINUES | (n == 2 ? GI_CAUSTIC_SPLIT : 0);
 }
 
 /* The brilliance of the top layer's finish at the hit (POV-Ray shades each

@@ -114,7 +114,7 @@ int main(int argc, char **argv)
            "map (%.1f%%)\n",
            s.first_hits, s.absorbed_first, s.first_hits ? 100.0 * s.absorbed_first / s.first_hits : 0.0);
     for (int b = 1; b <= s.max_bounce; b++)
-        printf("  still travelling after bounce %2d: %9ld  (%.1f%% of those at their target)\n", b, s.alive[b],
+        printf("  going on after bounce %2d: %9ld  (%.1f%% of those at their target; a split counts once)\n", b, s.alive[b],
                s.first_hits ? 100.0 * s.alive[b] / s.first_hits : 0.0);
     printf("stages: trace %.3f s, G-buffer %.3f s\n", s.t_trace, s.t_gbuffer);
 

@@ -321,37 +321,50 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
             o = v3_add(o, scene_light_area_point(l, l->axis1, l->axis2, k / l->size2, k % l->size2, &r));
         }
     }
-    accel_hit h;
-    accel_from from, *fp = NULL;
-    double depth = 0.0, rho_p = 1.0;
-    rgb tr = {1, 1, 1};
+    /* the photon's branches still to trace, depth first (a split pushes
+     * both; each level adds at most one pending branch) */
+    typedef struct {
+        vec3 o, w;
+        accel_from from;
+        int has_from, level;
+        double depth, rho_p;
+        rgb tr;
+    } branch;
+    branch stack[2 * GI_CAUSTIC_MAX_BOUNCES + 4];
+    int ns = 0;
+    stack[ns++] = (branch){o, w, {0}, 0, 0, 0.0, 1.0, {1, 1, 1}};
     vec3 p_first = o;
-    for (int level = 0;; level++) {
-        if (accel_intersect_past(c->a, fp, o, w, c->eps, PHOTON_SKIP, &h, &out->rays) <= 0) return;
-        depth += h.t;
+    while (ns > 0) {
+        branch br = stack[--ns];
+        accel_hit h;
+        if (accel_intersect_past(c->a, br.has_from ? &br.from : NULL, br.o, br.w, c->eps, PHOTON_SKIP, &h, &out->rays) <= 0)
+            continue;
+        int level = br.level;
+        double depth = br.depth + h.t;
         if (level == 0) {
             /* the first hit must be the target (POV-Ray's PhotonTrace) */
             if (!in_target(cb, h.obj)) return;
             out->first_hits++;
             p_first = h.p;
         }
-        gi_caustic_step step;
-        int sf = c->hk.surface(c->hk.ctx, &h, w, &r, &step);
+        gi_caustic_step step[2];
+        int sf = c->hk.surface(c->hk.ctx, &h, br.w, &r, step);
         const scene_obj_photons *ph = h.obj ? h.obj->photons : NULL;
         if (level >= 1 && (sf & GI_CAUSTIC_RECEIVES) && !(ph && !ph->collect) && scene_light_reaches(l, h.obj)) {
             /* store the photon before this bounce (paper, step 1(d)) */
             double att = c->hk.attenuation(c->hk.ctx, l, p_first, depth);
             double k = att * (cb->parallel ? 1.0 : depth * depth);
             double sd = cb->parallel ? sqrt(cb->cell) : depth * sqrt(cb->cell);
-            double rxy = fmin(RADIUS_K * sd / sqrt(rho_p), c->r_max);
-            vec3 np = v3_dot(h.ng, w) < 0.0 ? h.ng : v3_neg(h.ng);
+            double rxy = fmin(RADIUS_K * sd / sqrt(br.rho_p), c->r_max);
+            vec3 np = v3_dot(h.ng, br.w) < 0.0 ? h.ng : v3_neg(h.ng);
             gi_caus_photon q = {{(float)h.p.x, (float)h.p.y, (float)h.p.z},
                                 (float)rxy,
                                 {(float)np.x, (float)np.y, (float)np.z},
                                 (float)(0.25 * rxy),
-                                {(float)-w.x, (float)-w.y, (float)-w.z},
+                                {(float)-br.w.x, (float)-br.w.y, (float)-br.w.z},
                                 0.0f,
-                                {(float)(cb->phi0.r * tr.r * k), (float)(cb->phi0.g * tr.g * k), (float)(cb->phi0.b * tr.b * k)},
+                                {(float)(cb->phi0.r * br.tr.r * k), (float)(cb->phi0.g * br.tr.g * k),
+                                 (float)(cb->phi0.b * br.tr.b * k)},
                                 0.0f};
             if (rxy > 0.0 && isfinite(q.phi[0] + q.phi[1] + q.phi[2]) && cmax3(crgb(q.phi[0], q.phi[1], q.phi[2])) > 0.0)
                 if (!push_photon(out, &q)) {
@@ -359,21 +372,24 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
                     return;
                 }
         }
-        if (level + 1 >= c->max_level || level >= GI_CAUSTIC_MAX_BOUNCES) return;
+        if (level + 1 >= c->max_level || level >= GI_CAUSTIC_MAX_BOUNCES) continue;
         if (!(sf & GI_CAUSTIC_CONTINUES)) {
-            /* absorbed by the roulette, or its Lambertian lobe was chosen */
+            /* absorbed by the roulette, or only a Lambertian or glossy lobe */
             if (level == 0) out->absorbed_first++;
-            return;
+            continue;
         }
-        if (!scene_photon_lobe(l, ph, step.refract)) return;
-        tr = crgb(tr.r * step.weight.r, tr.g * step.weight.g, tr.b * step.weight.b);
-        rho_p *= fmin(1.0, fmax(step.rho, 1e-6));
-        if (!(cmax3(tr) >= c->adc) || !isfinite(tr.r + tr.g + tr.b)) return;
-        out->alive[level + 1]++;
-        o = step.org;
-        w = step.dir;
-        from = step.from;
-        fp = &from;
+        int nstep = sf & GI_CAUSTIC_SPLIT ? 2 : 1, went = 0;
+        for (int k = nstep - 1; k >= 0; k--) {
+            const gi_caustic_step *st = &step[k];
+            if (!scene_photon_lobe(l, ph, st->refract)) continue;
+            rgb tr = crgb(br.tr.r * st->weight.r, br.tr.g * st->weight.g, br.tr.b * st->weight.b);
+            if (!(cmax3(tr) >= c->adc) || !isfinite(tr.r + tr.g + tr.b)) continue;
+            if (ns >= (int)(sizeof stack / sizeof stack[0])) continue;
+            stack[ns++] = (branch){st->org, st->dir, st->from, 1, level + 1, depth,
+                                   br.rho_p * fmin(1.0, fmax(st->rho, 1e-6)), tr};
+            went = 1;
+        }
+        if (went) out->alive[level + 1]++;
     }
 }
 

@@ -66,23 +66,31 @@
 
 typedef struct gi_caustic gi_caustic;
 
-/* A specular bounce chosen by Russian roulette. */
+/* A specular bounce that the photon continues along. */
 typedef struct {
     vec3 org, dir;   /* continuation ray, origin off the right side */
-    rgb weight;      /* flux multiplier: the lobe's colour / its probability (and the flux's ior factor) */
-    double rho;      /* the lobe's reflectance (max channel), for the path density */
+    rgb weight;      /* flux multiplier: the lobe's colour / the probability of going on (and the flux's ior factor) */
+    double rho;      /* the photons' density factor of this bounce (the roulette's survival probability), for
+                        the path density */
     int refract;     /* 1 refraction, 0 reflection */
     accel_from from; /* the surface left */
 } gi_caustic_step;
 
-enum { GI_CAUSTIC_RECEIVES = 1, GI_CAUSTIC_CONTINUES = 2 };
+/* GI_CAUSTIC_CONTINUES: step[0] holds the bounce; GI_CAUSTIC_SPLIT as well:
+ * step[1] holds a second one (reflection and refraction both). */
+enum { GI_CAUSTIC_RECEIVES = 1, GI_CAUSTIC_CONTINUES = 2, GI_CAUSTIC_SPLIT = 4 };
 
 /* The material and light model, from app/ (gi/ cannot reach shade/). */
 typedef struct {
     /* The surface at h for a photon or eye ray arriving along unit dir:
      * GI_CAUSTIC_RECEIVES when it has a Lambertian term (photons light it);
-     * with step non-NULL, Russian roulette over its lobes (seed 002 appendix
-     * A): GI_CAUSTIC_CONTINUES and *step when a specular lobe is chosen. */
+     * with step non-NULL (room for 2), Russian roulette (seed 002 appendix
+     * A) between going on, with probability the specular lobes' share of
+     * the surface's albedo, and ending the photon (absorbed, or taken by a
+     * Lambertian or glossy lobe); going on, the photon splits into its
+     * mirror reflection and its refraction where the surface has both, as
+     * POV-Ray's photon tracer traces both (photons.cpp): a split has no
+     * roulette noise between the lobes. */
     int (*surface)(void *ctx, const accel_hit *h, vec3 dir, rng *r, gi_caustic_step *step);
     /* Light l's angle and distance attenuation at point p (first hit of a
      * photon) for path length depth (shade_light_attenuation). */
@@ -109,7 +117,8 @@ typedef struct {
     long emitted;           /* bounce-map cells (photons shot) */
     long first_hits;        /* photons whose first hit was their target */
     long absorbed_first;    /* of those, absorbed at the bounce map's roulette (power 0) */
-    long alive[GI_CAUSTIC_MAX_BOUNCES + 1]; /* still travelling after bounce b (b = 1: the bounce map) */
+    long alive[GI_CAUSTIC_MAX_BOUNCES + 1]; /* branches going on after bounce b (b = 1: the bounce map; a
+                                               split counts once, so later bounces can exceed the first) */
     int max_bounce;         /* highest b with alive[b] > 0 */
     long stored;            /* photon volumes */
     double flux;            /* their power, summed (grey: mean of the channels) */
