@@ -36,20 +36,29 @@ static pt_status check_pair(const framebuffer *ref, const framebuffer *test, con
 
 /* ---- RMSE, relMSE, PSNR ---- */
 
+/* Per-channel sums over the pixels of the squared error test - ref,
+ * divided by ref^2 + 0.01 when relative (relMSE). */
+static void error_sums(const framebuffer *ref, const framebuffer *test, int relative, double s[3])
+{
+    size_t n = (size_t)ref->width * (size_t)ref->height;
+    s[0] = s[1] = s[2] = 0.0;
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++) {
+            double r = fin(ref->rgb[3 * i + (size_t)c]);
+            double e = fin(test->rgb[3 * i + (size_t)c]) - r;
+            s[c] += relative ? e * e / (r * r + 0.01) : e * e;
+        }
+}
+
 pt_status img_rmse(const framebuffer *ref, const framebuffer *test, double *all, double ch[3], diag *d)
 {
     pt_status st = check_pair(ref, test, "RMSE", d);
     if (st != PT_OK) return st;
-    size_t n = (size_t)ref->width * (size_t)ref->height;
-    double s[3] = {0, 0, 0};
-    for (size_t i = 0; i < n; i++)
-        for (int c = 0; c < 3; c++) {
-            double e = fin(test->rgb[3 * i + (size_t)c]) - fin(ref->rgb[3 * i + (size_t)c]);
-            s[c] += e * e;
-        }
-    if (all) *all = sqrt((s[0] + s[1] + s[2]) / (3.0 * (double)n));
+    double n = (double)ref->width * (double)ref->height, s[3];
+    error_sums(ref, test, 0, s);
+    if (all) *all = sqrt((s[0] + s[1] + s[2]) / (3.0 * n));
     if (ch)
-        for (int c = 0; c < 3; c++) ch[c] = sqrt(s[c] / (double)n);
+        for (int c = 0; c < 3; c++) ch[c] = sqrt(s[c] / n);
     return PT_OK;
 }
 
@@ -57,17 +66,11 @@ pt_status img_relmse(const framebuffer *ref, const framebuffer *test, double *al
 {
     pt_status st = check_pair(ref, test, "relMSE", d);
     if (st != PT_OK) return st;
-    size_t n = (size_t)ref->width * (size_t)ref->height;
-    double s[3] = {0, 0, 0};
-    for (size_t i = 0; i < n; i++)
-        for (int c = 0; c < 3; c++) {
-            double r = fin(ref->rgb[3 * i + (size_t)c]);
-            double e = fin(test->rgb[3 * i + (size_t)c]) - r;
-            s[c] += e * e / (r * r + 0.01);
-        }
-    if (all) *all = (s[0] + s[1] + s[2]) / (3.0 * (double)n);
+    double n = (double)ref->width * (double)ref->height, s[3];
+    error_sums(ref, test, 1, s);
+    if (all) *all = (s[0] + s[1] + s[2]) / (3.0 * n);
     if (ch)
-        for (int c = 0; c < 3; c++) ch[c] = s[c] / (double)n;
+        for (int c = 0; c < 3; c++) ch[c] = s[c] / n;
     return PT_OK;
 }
 
