@@ -5,6 +5,7 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
+#include "gi_particle_internal.h"
 #include "pool.h"
 #include "rng.h"
 
@@ -37,6 +38,8 @@ typedef struct {
     const scene *sc;      /* for the far field of unanswered hits */
     gi_pigment_fn pig;    /* and their pigment (NULL: base colours) */
     float far_bounce;     /* brightness when the far field reflects the sky, else 0 */
+    gi_dev_light *lights; /* the scene's, for the far field's direct light */
+    int nlights;
 } link_job;
 
 /* The far field (beyond the paper, which leaves open scenes out): a link
@@ -79,8 +82,31 @@ static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3]
     gi_particles_material(J->sc, o->texture, cp, rho, le);
     float irr[3] = {0.0f, 0.0f, 0.0f};
     if (J->far_bounce > 0.0f) gi_sky_irradiance(J->sky, n, irr);
+    /* and the direct light it reflects (the particles' edir at the hit,
+     * gi_k_emit's sum, a shadow ray each; area lights from their centre):
+     * sunlit ground beyond the clip box is bright, not black. This is no
+     * further bounce: POV-Ray's radiosity rays see the direct light of
+     * what they hit at every recursion_limit. */
+    float dir[3] = {0.0f, 0.0f, 0.0f};
+    if (J->nlights > 0 && (rho[0] > 0.0f || rho[1] > 0.0f || rho[2] > 0.0f)) {
+        vec3 p = v3(h->ray.org_x + h->ray.tfar * d.x, h->ray.org_y + h->ray.tfar * d.y, h->ray.org_z + h->ray.tfar * d.z);
+        double eps = accel_epsilon(J->a, p, n);
+        for (int l = 0; l < J->nlights; l++) {
+            const gi_dev_light *lt = &J->lights[l];
+            float dl[3];
+            float depth = gi_light_ray(lt, lt->pos[0], lt->pos[1], lt->pos[2], (float)p.x, (float)p.y, (float)p.z, dl);
+            double ci = n.x * dl[0] + n.y * dl[1] + n.z * dl[2];
+            if (!(ci > 0.0)) continue;
+            float att = gi_light_attenuation(lt, (float)p.x, (float)p.y, (float)p.z, dl, depth);
+            if (!(att > 0.0f)) continue;
+            if (!lt->shadowless &&
+                accel_occluded(J->a, v3_madd(p, n, eps), v3(dl[0], dl[1], dl[2]), eps, depth > 0.0f ? depth : INFINITY))
+                continue;
+            for (int c = 0; c < 3; c++) dir[c] += lt->colour[c] * att * (float)ci;
+        }
+    }
     for (int c = 0; c < 3; c++) {
-        float v = le[c] + rho[c] * J->far_bounce * irr[c];
+        float v = le[c] + rho[c] * (J->far_bounce * irr[c] + dir[c]);
         if (isfinite(v) && v > 0.0f) out[c] += v;
     }
 }
@@ -466,6 +492,12 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
     J.tcell = calloc((size_t)threads, sizeof *J.tcell);
     pt_status rc = PT_OK;
     if (!J.buf || !J.hp || !J.cell || !J.tcell) rc = PT_ERR_NOMEM;
+    if (J.esky && sc->nlights > 0) {
+        J.lights = malloc((size_t)sc->nlights * sizeof *J.lights);
+        if (!J.lights) rc = PT_ERR_NOMEM;
+        for (int l = 0; J.lights && l < sc->nlights; l++) gi_light_pack(&sc->lights[l], &J.lights[l]);
+        J.nlights = J.lights ? sc->nlights : 0;
+    }
     size_t rays = (size_t)J.per_job * (size_t)J.k;
     size_t bytes = rays * sizeof(struct RTCRayHit);
     for (int t = 0; rc == PT_OK && t < threads; t++) {
@@ -490,6 +522,7 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
     free(J.order);
     free(J.su0);
     free(J.sv0);
+    free(J.lights);
     accel_rtc_link_scene_free(lscene);
     if (st) {
         st->rays += (long)(n - J.first) * J.k;
