@@ -1231,6 +1231,38 @@ const scene_object *accel_rtc_object_tri(const accel *a, unsigned geom, unsigned
     return o;
 }
 
+const scene_object *accel_rtc_leaf(const accel *a, unsigned geom, unsigned prim, unsigned inst, vec3 org, vec3 dir,
+                                   double t, const scene_texture **tex)
+{
+    *tex = NULL;
+    if (!a || geom == RTC_INVALID_GEOMETRY_ID) return NULL;
+    unsigned li;
+    if (inst != RTC_INVALID_GEOMETRY_ID) {
+        if (inst >= a->nginfo || a->ginfo[inst].kind != GEOM_INSTANCE) return NULL;
+        li = a->ginfo[inst].idx;
+    } else if (geom >= a->nginfo) {
+        return NULL;
+    } else if (a->ginfo[geom].kind == GEOM_TRI) {
+        const tri_batch *b = &a->tri[a->ginfo[geom].idx];
+        if ((size_t)prim >= b->nt) return NULL;
+        li = b->refs[prim].leaf;
+    } else if (a->ginfo[geom].kind == GEOM_USER && prim < (unsigned)a->nshapes) {
+        li = a->shape_leaf[prim];
+    } else if (a->ginfo[geom].kind == GEOM_USER && prim < (unsigned)(a->nshapes + a->ncsgs)) {
+        /* which member of the CSG: its hit again, about t (the record does
+         * not keep it) */
+        geom_csg_hit h;
+        double slack = 1e-4 * (fabs(t) + a->eps_scale);
+        if (!accel_prim_hit(a, prim, org, dir, t - slack > 0.0 ? t - slack : 0.0, t + slack, &h)) return NULL;
+        li = a->csgs[prim - (unsigned)a->nshapes].shape_leaf[h.shape];
+    } else {
+        return NULL;
+    }
+    if (li >= (unsigned)a->nleaves) return NULL;
+    *tex = a->leaves[li].texture;
+    return a->leaves[li].obj;
+}
+
 unsigned accel_rtc_ngeoms(const accel *a) { return a ? a->nginfo : 0; }
 
 long accel_rtc_triangles(const accel *a, unsigned geom, const float **v, const unsigned **idx)

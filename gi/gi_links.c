@@ -50,11 +50,13 @@ typedef struct {
  * E_sky(n)/pi about the hit's normal turned to the ray, at the texture's
  * base colour. In a closed room under a black sky this is the emission
  * alone. Adds it to out (nothing without esky). */
-static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3])
+/* The material where ray h hit object o: rho and le at the pigment there
+ * (a sky dome's gradient, a terrain's colours; the texture's base colour
+ * without a pigment function), the hit point and its normal turned to the
+ * ray. */
+static void hit_material(const link_job *J, const struct RTCRayHit *h, const scene_object *o,
+                         const scene_texture *tex, float rho[3], float le[3], vec3 *pt, vec3 *nrm)
 {
-    if (!J->esky) return;
-    const scene_object *o = accel_rtc_object(J->a, h->hit.geomID, h->hit.primID, h->hit.instID[0]);
-    if (!o) return;
     vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z), n = v3_neg(d);
     if (h->hit.instID[0] == RTC_INVALID_GEOMETRY_ID) {
         vec3 ng = v3(h->hit.Ng_x, h->hit.Ng_y, h->hit.Ng_z);
@@ -70,16 +72,58 @@ static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3]
         ah.p = v3(h->ray.org_x + h->ray.tfar * d.x, h->ray.org_y + h->ray.tfar * d.y, h->ray.org_z + h->ray.tfar * d.z);
         ah.ng = ah.ns = n;
         ah.obj = o;
-        ah.texture = o->texture;
+        ah.texture = tex;
         ah.flags = o->flags;
         ah.uv[0] = ah.p.x;
         ah.uv[1] = ah.p.y;
-        if (J->pig(J->sc, o->texture ? o->texture : &J->sc->default_texture, &ah, &c) && isfinite(c.r) &&
+        if (J->pig(J->sc, tex, &ah, &c) && isfinite(c.r) &&
             isfinite(c.g) && isfinite(c.b) && isfinite(c.f) && isfinite(c.t))
             cp = &c;
     }
+    gi_particles_material(J->sc, tex, cp, rho, le);
+    *pt = v3(h->ray.org_x + h->ray.tfar * d.x, h->ray.org_y + h->ray.tfar * d.y, h->ray.org_z + h->ray.tfar * d.z);
+    *nrm = n;
+}
+
+/* The emission where ray h hit o, added to out: links from view points
+ * (gi_links_build's first > 0) take it at the hit, not from the particle
+ * they end on. */
+/* The leaf a link ray hit and its effective texture (never NULL when the
+ * leaf is found), CSG members included. */
+static const scene_object *hit_leaf(const link_job *J, const struct RTCRayHit *h, const scene_texture **tex)
+{
+    const scene_object *o =
+        accel_rtc_leaf(J->a, h->hit.geomID, h->hit.primID, h->hit.instID[0], v3(h->ray.org_x, h->ray.org_y, h->ray.org_z),
+                       v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z), h->ray.tfar, tex);
+    if (o && !*tex) *tex = o->texture ? o->texture : &J->sc->default_texture;
+    return o;
+}
+
+static void hit_emission(const link_job *J, const struct RTCRayHit *h, float out[3])
+{
+    const scene_texture *tex;
+    const scene_object *o = hit_leaf(J, h, &tex);
+    if (!o) return;
     float rho[3], le[3];
-    gi_particles_material(J->sc, o->texture, cp, rho, le);
+    gi_particles_material(J->sc, tex, NULL, rho, le);
+    if (!(le[0] > 0.0f || le[1] > 0.0f || le[2] > 0.0f)) return; /* not emitting at its base colour */
+    vec3 p, n;
+    hit_material(J, h, o, tex, rho, le, &p, &n);
+    for (int c = 0; c < 3; c++)
+        if (isfinite(le[c]) && le[c] > 0.0f) out[c] += le[c];
+}
+
+static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3])
+{
+    if (!J->esky) return;
+    const scene_texture *tex;
+    const scene_object *o = hit_leaf(J, h, &tex);
+    if (!o) return;
+    float rho[3], le[3];
+    vec3 p, n;
+    hit_material(J, h, o, tex, rho, le, &p, &n);
+    vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
+    (void)d;
     float irr[3] = {0.0f, 0.0f, 0.0f};
     if (J->far_bounce > 0.0f) gi_sky_irradiance(J->sky, n, irr);
     /* and the direct light it reflects (the particles' edir at the hit,
@@ -89,7 +133,6 @@ static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3]
      * what they hit at every recursion_limit. */
     float dir[3] = {0.0f, 0.0f, 0.0f};
     if (J->nlights > 0 && (rho[0] > 0.0f || rho[1] > 0.0f || rho[2] > 0.0f)) {
-        vec3 p = v3(h->ray.org_x + h->ray.tfar * d.x, h->ray.org_y + h->ray.tfar * d.y, h->ray.org_z + h->ray.tfar * d.z);
         double eps = accel_epsilon(J->a, p, n);
         for (int l = 0; l < J->nlights; l++) {
             const gi_dev_light *lt = &J->lights[l];
@@ -362,6 +405,8 @@ static void job(void *ctx, int index, int thread)
                 if (target < 0) {
                     unres++;
                     if (hit) far_field(J, &rh[m], sky);
+                } else if (J->first > 0 && J->esky) {
+                    hit_emission(J, &rh[m], sky);
                 }
             }
             J->links[(size_t)(i - J->first) * J->k + J->order[j]] = target;

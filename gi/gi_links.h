@@ -43,7 +43,10 @@ typedef struct {
  * caller); NULL: the link scene is built and freed here. prog (may be
  * NULL): its current stage counts the chunks of particles traced. first:
  * only particles [first, n) send rays (all n are targets); links, anyhit
- * and esky are then indexed i - first. */
+ * and esky are then indexed i - first. first > 0 means those are points
+ * to gather at, not particles: a link that ends on a particle adds the
+ * emission where its ray hit to esky, so its gather must take the
+ * particles' reflected radiance (lout - le), not lout. */
 /* sky, esky and sc (all or none; NULL: none): esky receives 4 floats a
  * particle (the fourth 0): the radiance its rays that leave the scene see
  * (sky), plus the far field of those that hit where no particle answers

@@ -466,8 +466,26 @@ void gi_particle_view_regather(gi_particle *gp)
         return;
     }
     for (int i = 0; i < gp->vg_n; i++) idx[i] = i;
+    /* the particles' reflected radiance: the emission was taken where each
+     * ray hit (gi_links.h, first > 0) */
+    float *lrefl = malloc((size_t)gp->ps.n * 4 * sizeof *lrefl);
+    if (!lrefl) {
+        free(idx);
+        free(raw);
+        free(ok);
+        gi_particle_view_gather_free(gp);
+        return;
+    }
+    for (int t = 0; t < gp->ps.n; t++) {
+        for (int c = 0; c < 3; c++) {
+            float v = gp->lout[4 * (size_t)t + c] - gp->ps.p[t].le[c];
+            lrefl[4 * (size_t)t + c] = v > 0.0f ? v : 0.0f;
+        }
+        lrefl[4 * (size_t)t + 3] = 0.0f;
+    }
     /* the gathering kernel's C build (equation 5 at the pixels) */
-    gi_c_gather(gp->threads, gp->vg_link, gp->vg_k, gp->lout, idx, gp->vg_n, gp->vg_esky, gp->vg_val);
+    gi_c_gather(gp->threads, gp->vg_link, gp->vg_k, lrefl, idx, gp->vg_n, gp->vg_esky, gp->vg_val);
+    free(lrefl);
     for (size_t i = 0; i < npix; i++) ok[i] = (unsigned char)raw_value(gp, i, &raw[3 * i]);
     filter_job F = {gp, raw, ok};
     pool_run(gp->threads, gp->vh, filter_row, &F);
