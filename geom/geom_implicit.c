@@ -761,6 +761,12 @@ static int blob_setup(im_data *m, const scene_blob *b, vec3 *lo, vec3 *hi)
 /* f(p) - threshold; NaN where the function cannot be evaluated. */
 static double iso_f(const im_data *m, vec3 p)
 {
+    /* the function reads args[0..nparams): x, y, z and zeros; clearing
+     * all FUNC_MAX_SLOTS of them per evaluation was a 1 KiB memset */
+    if (m->fn->nparams <= 8) {
+        double args[8] = {p.x, p.y, p.z, 0, 0, 0, 0, 0};
+        return func_eval_float(m->fn, args, m->env) - m->thr;
+    }
     double args[FUNC_MAX_SLOTS] = {p.x, p.y, p.z};
     return func_eval_float(m->fn, args, m->env) - m->thr;
 }
