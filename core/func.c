@@ -46,13 +46,25 @@ static double math1(func_math m, double x)
     }
 }
 
+static double node_value(const scene_function *f, int i, double *slots, eval_ctx *c);
+
+/* A kid's value: constants and arguments (about half the nodes of a
+ * typical body) without a call. */
+static inline double kid_value(const scene_function *f, int i, double *slots, eval_ctx *c)
+{
+    const func_node *n = &f->nodes[i];
+    if (n->op == FN_CONST) return c->failed ? 0 : n->k;
+    if (n->op == FN_ARG) return c->failed ? 0 : slots[n->slot];
+    return node_value(f, i, slots, c);
+}
+
 /* One node's value; slots holds the parameters and loop variables. */
 static double node_value(const scene_function *f, int i, double *slots, eval_ctx *c)
 {
     const func_node *n = &f->nodes[i];
     const int *k = f->kids ? f->kids + n->kid : NULL; /* no kids: no NULL + 0 */
     if (c->failed) return 0;
-#define KID(j) node_value(f, k[j], slots, c)
+#define KID(j) kid_value(f, k[j], slots, c)
     switch ((func_op)n->op) {
     case FN_CONST: return n->k;
     case FN_ARG: return slots[n->slot];
