@@ -50,6 +50,7 @@
  * and triangles live in their own BVH). Hits outside the cube are rejected,
  * so the answer does not depend on how the BVH culls. */
 #include "accel.h"
+#include "grow.h"
 #include "accel_internal.h"
 
 _Thread_local accel_query *accel_tls_query;
@@ -92,18 +93,6 @@ static int embree_failed(accel *a, diag *d, const char *stage)
 }
 
 /* ------------------------------------------------------------ build helpers */
-
-int accel_grow(void **p, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap) return 1;
-    size_t nc = *cap ? *cap : 64;
-    while (nc < need) nc *= 2;
-    void *n = realloc(*p, nc * elem);
-    if (!n) return 0;
-    *p = n;
-    *cap = nc;
-    return 1;
-}
 
 /* Whether a pigment, normal or texture evaluates anything at the hit's UV
  * (uv_mapping in it or in its maps); deep nesting counts as yes. */
@@ -150,7 +139,7 @@ static int add_leaf(accel *a, const scene_object *o, const scene_texture *tex, u
 {
     if (a->nleaves == a->capleaves) {
         size_t cap = (size_t)a->capleaves;
-        if (!accel_grow((void **)&a->leaves, &cap, (size_t)a->nleaves + 1, sizeof(accel_leaf))) return -1;
+        if (!grow_array((void **)&a->leaves, &cap, (size_t)a->nleaves + 1, sizeof(accel_leaf))) return -1;
         a->capleaves = (int)cap;
     }
     accel_leaf *l = &a->leaves[a->nleaves];
@@ -188,7 +177,7 @@ static pt_status build_csg(accel *a, diag *d, const scene_object *o, const scene
 {
     if (a->ncsgs == a->capcsgs) {
         size_t cap = (size_t)a->capcsgs;
-        if (!accel_grow((void **)&a->csgs, &cap, (size_t)a->ncsgs + 1, sizeof(geom_csg))) return PT_ERR_NOMEM;
+        if (!grow_array((void **)&a->csgs, &cap, (size_t)a->ncsgs + 1, sizeof(geom_csg))) return PT_ERR_NOMEM;
         a->capcsgs = (int)cap;
     }
     geom_csg *c = &a->csgs[a->ncsgs];
@@ -325,7 +314,7 @@ static void leaf_diag(accel *a, vec3 lo, vec3 hi)
 
 static int batch_add_vertex(tri_batch *b, vec3 p)
 {
-    if (!accel_grow((void **)&b->v, &b->capv, (b->nv + 1) * 3, sizeof(float))) return 0;
+    if (!grow_array((void **)&b->v, &b->capv, (b->nv + 1) * 3, sizeof(float))) return 0;
     b->v[b->nv * 3 + 0] = (float)p.x;
     b->v[b->nv * 3 + 1] = (float)p.y;
     b->v[b->nv * 3 + 2] = (float)p.z;
@@ -335,8 +324,8 @@ static int batch_add_vertex(tri_batch *b, vec3 p)
 
 static int batch_add_tri(tri_batch *b, unsigned i0, unsigned i1, unsigned i2, unsigned leaf, unsigned local)
 {
-    if (!accel_grow((void **)&b->idx, &b->capi, (b->nt + 1) * 3, sizeof(unsigned))) return 0;
-    if (!accel_grow((void **)&b->refs, &b->capr, b->nt + 1, sizeof(tri_ref))) return 0;
+    if (!grow_array((void **)&b->idx, &b->capi, (b->nt + 1) * 3, sizeof(unsigned))) return 0;
+    if (!grow_array((void **)&b->refs, &b->capr, b->nt + 1, sizeof(tri_ref))) return 0;
     b->idx[b->nt * 3 + 0] = i0;
     b->idx[b->nt * 3 + 1] = i1;
     b->idx[b->nt * 3 + 2] = i2;

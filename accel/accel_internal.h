@@ -118,10 +118,6 @@ extern _Thread_local accel_query *accel_tls_query;
 #define SOA_F(p, N, i, k) (((float *)(p))[(size_t)(k) * (N) + (i)])
 #define SOA_U(p, N, i, k) (((unsigned *)(p))[(size_t)(k) * (N) + (i)])
 
-/* Grows *p (elements of `elem` bytes, capacity *cap) to hold `need`;
- * 0 when out of memory (accel.c). */
-int accel_grow(void **p, size_t *cap, size_t need, size_t elem);
-
 /* bounded_by (accel_user.c). */
 /* Whether o's bounded_by is kept (POV-Ray 3.7's remove_bounds rule; top: o
  * is a top-level object). */

@@ -5,6 +5,7 @@
  * constant; for curved parts its maximum over all n is |det A| sigma_max(A^-1),
  * the bound used for rejection. */
 #include "accel_surface.h"
+#include "grow.h"
 #include <assert.h>
 #include "geom_hfield.h"
 #include "geom_sweep.h"
@@ -76,18 +77,6 @@ struct accel_surf {
     accel_surf_weight_fn fn;
     void *ctx;
 };
-
-static int grow(void **p, int *cap, int need, size_t elem)
-{
-    if (need <= *cap) return 1;
-    int nc = *cap ? *cap : 64;
-    while (nc < need) nc *= 2;
-    void *n = realloc(*p, (size_t)nc * elem);
-    if (!n) return 0;
-    *p = n;
-    *cap = nc;
-    return 1;
-}
 
 /* ------------------------------------------------------------ linear algebra */
 
@@ -342,7 +331,7 @@ static double plane_polygon(shape_geo *g, vec3 lo, vec3 hi)
 static int add_piece(accel_surf *as, const scene_object *o, const scene_texture *tex, unsigned flags, unsigned prim,
                      double area, double w, int is_shape, int idx)
 {
-    if (!grow((void **)&as->pieces, &as->cappieces, as->npieces + 1, sizeof(piece_rec))) return 0;
+    if (!grow_array_int((void **)&as->pieces, &as->cappieces, as->npieces + 1, sizeof(piece_rec))) return 0;
     piece_rec *p = &as->pieces[as->npieces++];
     p->pub.obj = o;
     p->pub.texture = tex;
@@ -368,7 +357,7 @@ static int add_triangle(accel_surf *as, const scene_object *o, const scene_textu
     vec3 e1 = v3_sub(pb, pa), e2 = v3_sub(pc, pa), cr = v3_cross(e1, e2);
     double area = 0.5 * v3_len(cr);
     if (!(area > 0.0) || !isfinite(area)) return 1;
-    if (!grow((void **)&as->tris, &as->captris, as->ntris + 1, sizeof(tri_geo))) return 0;
+    if (!grow_array_int((void **)&as->tris, &as->captris, as->ntris + 1, sizeof(tri_geo))) return 0;
     tri_geo *t = &as->tris[as->ntris];
     t->v0 = pa;
     t->e1 = e1;
@@ -406,7 +395,7 @@ static int add_leaf(accel_surf *as, const scene_object *o, const scene_texture *
     if (o->kind == SHAPE_TRIANGLE || o->kind == SHAPE_SMOOTH_TRIANGLE)
         return add_triangle(as, o, tex, flags, ACCEL_SURF_ANY, o->u.triangle.v[0], o->u.triangle.v[1],
                             o->u.triangle.v[2], w);
-    if (!grow((void **)&as->shapes, &as->capshapes, as->nshapes + 1, sizeof(shape_geo))) return 0;
+    if (!grow_array_int((void **)&as->shapes, &as->capshapes, as->nshapes + 1, sizeof(shape_geo))) return 0;
     shape_geo *g = &as->shapes[as->nshapes];
     memset(g, 0, sizeof *g);
     if (geom_shape_init(&g->sh, o) != 0) return 1;

@@ -3,6 +3,7 @@
  * occluded, the no_shadow filters); see accel.c for the layout of the
  * Embree scene and the epsilon rule. */
 #include "accel_internal.h"
+#include "grow.h"
 
 /* ------------------------------------------------------------ bounded_by */
 
@@ -36,7 +37,7 @@ static int push_bshape(accel *a)
 {
     if (a->nbshapes < a->capbshapes) return 1;
     size_t cap = (size_t)a->capbshapes;
-    if (!accel_grow((void **)&a->bshapes, &cap, (size_t)a->nbshapes + 1, sizeof(geom_shape))) return 0;
+    if (!grow_array((void **)&a->bshapes, &cap, (size_t)a->nbshapes + 1, sizeof(geom_shape))) return 0;
     a->capbshapes = (int)cap;
     return 1;
 }

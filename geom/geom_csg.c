@@ -10,6 +10,7 @@
  * The root's S bounds the primitive; an intersection of six planes gets a
  * tight box this way. */
 #include "geom_csg.h"
+#include "grow.h"
 #include "geom_implicit.h"
 #include <assert.h>
 #include <math.h>
@@ -42,23 +43,11 @@ static int in_box(const vec3 *b, vec3 p)
     return p.x >= b[0].x && p.x <= b[1].x && p.y >= b[0].y && p.y <= b[1].y && p.z >= b[0].z && p.z <= b[1].z;
 }
 
-static int grow(void **p, int *cap, int need, size_t elem)
-{
-    if (need <= *cap) return 1;
-    int nc = *cap ? *cap : 8;
-    while (nc < need) nc *= 2;
-    void *n = realloc(*p, (size_t)nc * elem);
-    if (!n) return 0;
-    *p = n;
-    *cap = nc;
-    return 1;
-}
-
 /* Building: nodes are added parent first; returns the node index or -1 on
  * out-of-memory. Leaves take a copy of `sh`. */
 static int geom_csg_add_node(geom_csg *c, geom_csg_op op, int inverse, int parent)
 {
-    if (!grow((void **)&c->nodes, &c->capnodes, c->nnodes + 1, sizeof(geom_csg_node))) return -1;
+    if (!grow_array_int((void **)&c->nodes, &c->capnodes, c->nnodes + 1, sizeof(geom_csg_node))) return -1;
     geom_csg_node *n = &c->nodes[c->nnodes];
     memset(n, 0, sizeof *n);
     n->op = op;
@@ -70,7 +59,7 @@ static int geom_csg_add_node(geom_csg *c, geom_csg_op op, int inverse, int paren
 
 static int geom_csg_add_leaf(geom_csg *c, const geom_shape *sh, unsigned tag, int inverse, int parent)
 {
-    if (!grow((void **)&c->shapes, &c->capshapes, c->nshapes + 1, sizeof(geom_shape))) return -1;
+    if (!grow_array_int((void **)&c->shapes, &c->capshapes, c->nshapes + 1, sizeof(geom_shape))) return -1;
     int cap = c->capshapes;
     /* shape_leaf and shape_node follow the capacity of shapes */
     unsigned *sl = realloc(c->shape_leaf, (size_t)cap * sizeof *sl);

@@ -2,6 +2,7 @@
  * visibility tests of the radiance particles' interpolation cells, alone
  * or batched for a pre-pass row. */
 #include "gi_particle_internal.h"
+#include "grow.h"
 #include <math.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -221,18 +222,6 @@ void gi_particle_cell_batch_free(struct cell_batch *b)
     free(b);
 }
 
-static int grow(void **p, int *cap, int need, size_t size)
-{
-    if (need <= *cap) return 1;
-    int n = *cap > 0 ? *cap : 64;
-    while (n < need) n *= 2;
-    void *q = realloc(*p, (size_t)n * size);
-    if (!q) return 0;
-    *p = q;
-    *cap = n;
-    return 1;
-}
-
 /* The batch's index of cell key (added when new), -1 out of memory. */
 static int batch_cell(struct cell_batch *b, uint64_t key, const long rp[3], const scene_object *own)
 {
@@ -248,7 +237,7 @@ static int batch_cell(struct cell_batch *b, uint64_t key, const long rp[3], cons
         for (int i = b->ncell - 1; i >= 0; i--)
             if (b->cell[i].key == key) return i;
     }
-    if (!grow((void **)&b->cell, &b->capcell, b->ncell + 1, sizeof *b->cell)) return -1;
+    if (!grow_array_int((void **)&b->cell, &b->capcell, b->ncell + 1, sizeof *b->cell)) return -1;
     int i = b->ncell++;
     b->cell[i].key = key;
     for (int k = 0; k < 3; k++) b->cell[i].rp[k] = rp[k];
@@ -266,7 +255,7 @@ static int batch_cell(struct cell_batch *b, uint64_t key, const long rp[3], cons
 /* Record vr lies in the batch's cell: 1, or 0 out of memory. */
 static int batch_pixel(struct cell_batch *b, view_rec *vr, int cell)
 {
-    if (!grow((void **)&b->pix, &b->cappix, b->npix + 1, sizeof *b->pix)) return 0;
+    if (!grow_array_int((void **)&b->pix, &b->cappix, b->npix + 1, sizeof *b->pix)) return 0;
     b->pix[b->npix].vr = vr;
     b->pix[b->npix].cell = cell;
     b->npix++;
@@ -282,19 +271,19 @@ void gi_particle_batch_test(gi_particle *gp, struct cell_batch *b, thread_count 
     int need = 6 * b->ncell;
     if (need > b->capray) {
         int cap = b->capray;
-        ok = grow((void **)&b->sg, &cap, need, sizeof *b->sg);
+        ok = grow_array_int((void **)&b->sg, &cap, need, sizeof *b->sg);
         cap = b->capray;
-        ok = ok && grow((void **)&b->org, &cap, need, sizeof *b->org);
+        ok = ok && grow_array_int((void **)&b->org, &cap, need, sizeof *b->org);
         cap = b->capray;
-        ok = ok && grow((void **)&b->dir, &cap, need, sizeof *b->dir);
+        ok = ok && grow_array_int((void **)&b->dir, &cap, need, sizeof *b->dir);
         cap = b->capray;
-        ok = ok && grow((void **)&b->tmin, &cap, need, sizeof *b->tmin);
+        ok = ok && grow_array_int((void **)&b->tmin, &cap, need, sizeof *b->tmin);
         cap = b->capray;
-        ok = ok && grow((void **)&b->tmax, &cap, need, sizeof *b->tmax);
+        ok = ok && grow_array_int((void **)&b->tmax, &cap, need, sizeof *b->tmax);
         cap = b->capray;
-        ok = ok && grow((void **)&b->hit, &cap, need, sizeof *b->hit);
+        ok = ok && grow_array_int((void **)&b->hit, &cap, need, sizeof *b->hit);
         cap = b->capray;
-        ok = ok && grow((void **)&b->owner, &cap, need, sizeof *b->owner);
+        ok = ok && grow_array_int((void **)&b->owner, &cap, need, sizeof *b->owner);
         if (ok) b->capray = cap;
     }
     if (ok) {

@@ -1,5 +1,6 @@
 /* sdl_function.c - function { } bodies -> core/func.h trees; splines; calls. */
 #include "sdl_function.h"
+#include "grow.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,21 +27,9 @@ typedef struct {
     int reg[3];          /* slot of the x/u, y/v, z parameter, -1 = none (reads 0) */
 } fn_build;
 
-static int grow_array(void **a, int *cap, int need, size_t elem)
-{
-    if (need <= *cap) return 1;
-    int nc = *cap ? *cap * 2 : 32;
-    while (nc < need) nc *= 2;
-    void *n = realloc(*a, elem * (size_t)nc);
-    if (!n) return 0;
-    *a = n;
-    *cap = nc;
-    return 1;
-}
-
 static int new_node(fn_build *b, func_op op)
 {
-    if (!grow_array((void **)&b->nodes, &b->cap_nodes, b->nnodes + 1, sizeof *b->nodes)) {
+    if (!grow_array_int((void **)&b->nodes, &b->cap_nodes, b->nnodes + 1, sizeof *b->nodes)) {
         sdl_error(b->p, b->p->last_loc, PT_ERR_NOMEM, "out of memory");
         return -1;
     }
@@ -62,7 +51,7 @@ static int op_node(fn_build *b, func_op op, const int *kids, int n)
 {
     for (int j = 0; j < n; j++)
         if (kids[j] < 0) return -1;
-    if (!grow_array((void **)&b->kids, &b->cap_kids, b->nkids + n, sizeof *b->kids)) {
+    if (!grow_array_int((void **)&b->kids, &b->cap_kids, b->nkids + n, sizeof *b->kids)) {
         sdl_error(b->p, b->p->last_loc, PT_ERR_NOMEM, "out of memory");
         return -1;
     }

@@ -1,5 +1,6 @@
 /* sdl_object.c - shapes, CSG, meshes, object modifiers. */
 #include "sdl_object.h"
+#include "grow.h"
 #include "scene_leaves.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -576,19 +577,7 @@ typedef struct {
     size_t bytes;    /* this mesh's share of it */
 } mesh_build;
 
-static int grow(void **arr, int *cap, int need, size_t elem)
-{
-    if (need <= *cap) return 1;
-    int nc = *cap ? *cap * 2 : 64;
-    while (nc < need) nc *= 2;
-    void *n = realloc(*arr, elem * (size_t)nc);
-    if (!n) return 0;
-    *arr = n;
-    *cap = nc;
-    return 1;
-}
-
-/* grow() for a mesh's work arrays, within the parser's memory limit. */
+/* grow_array_int() for a mesh's work arrays, within the parser's memory limit. */
 static int mesh_grow(mesh_build *b, void **arr, int *cap, int need, size_t elem)
 {
     if (need <= *cap) return 1;
@@ -597,9 +586,9 @@ static int mesh_grow(mesh_build *b, void **arr, int *cap, int need, size_t elem)
         return 0;
     }
     int old = *cap;
-    size_t more = elem * (size_t)((old ? old * 2 : 64) < need ? need : (old ? old * 2 : 64));
+    size_t more = elem * grow_capacity((size_t)old, (size_t)need);
     if (!sdl_memory_ok(b->p, more, b->p->last_loc, "the mesh")) return 0;
-    if (!grow(arr, cap, need, elem)) return 0;
+    if (!grow_array_int(arr, cap, need, elem)) return 0;
     more = elem * (size_t)(*cap - old);
     b->bytes += more;
     b->p->build_bytes += more;
@@ -984,7 +973,7 @@ static void csg_body(sdl_parser *p, sdl_obj *so)
         if (!k) break;
         merge_lights(p, so, k);
         if (!k->obj) continue;
-        if (!grow((void **)&kids, &cap, n + 1, sizeof *kids)) {
+        if (!grow_array_int((void **)&kids, &cap, n + 1, sizeof *kids)) {
             sdl_error(p, k->obj->loc, PT_ERR_NOMEM, "out of memory");
             break;
         }
