@@ -1,5 +1,6 @@
 /* diag.c - diagnostics context. */
 #include "diag.h"
+#include "grow.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -54,13 +55,7 @@ const char *diag_intern(diag *d, const char *s)
     if (!s) return NULL;
     for (int i = 0; i < d->nstr; i++)
         if (strcmp(d->strs[i], s) == 0) return d->strs[i];
-    if (d->nstr == d->capstr) {
-        int nc = d->capstr ? d->capstr * 2 : 16;
-        char **ns = realloc(d->strs, sizeof(char *) * (size_t)nc);
-        if (!ns) return s;
-        d->strs = ns;
-        d->capstr = nc;
-    }
+    if (!grow_array_int((void **)&d->strs, &d->capstr, d->nstr + 1, sizeof *d->strs)) return s;
     d->strs[d->nstr] = strdup(s);
     return d->strs[d->nstr] ? d->strs[d->nstr++] : s;
 }
@@ -77,12 +72,9 @@ void diag_vreport(diag *d, diag_severity sev, src_loc loc, const char *chain, co
         snprintf(text, n, "%s\n%s", buf, chain);
     else
         snprintf(text, n, "%s", buf);
-    if (d->n == d->cap) {
-        int nc = d->cap ? d->cap * 2 : 16;
-        diag_msg *nm = realloc(d->msgs, sizeof(diag_msg) * (size_t)nc);
-        if (!nm) { free(text); return; }
-        d->msgs = nm;
-        d->cap = nc;
+    if (!grow_array_int((void **)&d->msgs, &d->cap, d->n + 1, sizeof *d->msgs)) {
+        free(text);
+        return;
     }
     loc.file = diag_intern(d, loc.file);
     d->msgs[d->n].severity = sev;

@@ -1,5 +1,6 @@
 /* scene.c - scene IR construction helpers and POV-Ray 3.7 defaults. */
 #include "scene.h"
+#include "grow.h"
 #include <stdatomic.h>
 #include "camera.h"
 #include "hash.h"
@@ -167,26 +168,14 @@ scene_mesh *scene_new_mesh(scene *s) { return arena_alloc(s->mem, sizeof(scene_m
 
 pt_status scene_add_object(scene *s, scene_object *o)
 {
-    if (s->nobjects == s->cap_objects) {
-        int nc = s->cap_objects ? s->cap_objects * 2 : 64;
-        scene_object **n = realloc(s->objects, sizeof(*n) * (size_t)nc);
-        if (!n) return PT_ERR_NOMEM;
-        s->objects = n;
-        s->cap_objects = nc;
-    }
+    if (!grow_array_int((void **)&s->objects, &s->cap_objects, s->nobjects + 1, sizeof *s->objects)) return PT_ERR_NOMEM;
     s->objects[s->nobjects++] = o;
     return PT_OK;
 }
 
 pt_status scene_add_light(scene *s, const scene_light *l)
 {
-    if (s->nlights == s->cap_lights) {
-        int nc = s->cap_lights ? s->cap_lights * 2 : 16;
-        scene_light *n = realloc(s->lights, sizeof(*n) * (size_t)nc);
-        if (!n) return PT_ERR_NOMEM;
-        s->lights = n;
-        s->cap_lights = nc;
-    }
+    if (!grow_array_int((void **)&s->lights, &s->cap_lights, s->nlights + 1, sizeof *s->lights)) return PT_ERR_NOMEM;
     s->lights[s->nlights++] = *l;
     return PT_OK;
 }

@@ -1,6 +1,7 @@
 /* geom_mesh.c - meshes as geom shapes (see geom_mesh.h): a median-split BVH
  * over the triangles' boxes, built once per shape. */
 #include "geom_mesh.h"
+#include "grow.h"
 #include <assert.h>
 #include <math.h>
 #include <stdlib.h>
@@ -40,13 +41,7 @@ static void tri_box(const scene_mesh *m, int t, vec3 *lo, vec3 *hi)
 
 static int node_new(mesh_data *md)
 {
-    if (md->nnodes == md->capnodes) {
-        int nc = md->capnodes ? md->capnodes * 2 : 64;
-        bvh_node *nn = realloc(md->nodes, sizeof *nn * (size_t)nc);
-        if (!nn) return -1;
-        md->nodes = nn;
-        md->capnodes = nc;
-    }
+    if (!grow_array_int((void **)&md->nodes, &md->capnodes, md->nnodes + 1, sizeof *md->nodes)) return -1;
     return md->nnodes++;
 }
 

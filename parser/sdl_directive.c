@@ -1,5 +1,6 @@
 /* sdl_directive.c - input stack, directives, conditionals, loops, macros. */
 #include "sdl_directive.h"
+#include "grow.h"
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -106,15 +107,9 @@ int sdl_file_exists(sdl_parser *p, const char *name)
 
 static int push_frame(sdl_parser *p, sdl_frame_kind kind, const sdl_source *src, src_loc from, const char *name)
 {
-    if (p->nframes == p->cap_frames) {
-        int nc = p->cap_frames ? p->cap_frames * 2 : 16;
-        sdl_frame *nf = realloc(p->frames, sizeof *nf * (size_t)nc);
-        if (!nf) {
-            sdl_error(p, from, PT_ERR_NOMEM, "out of memory");
-            return 0;
-        }
-        p->frames = nf;
-        p->cap_frames = nc;
+    if (!grow_array_int((void **)&p->frames, &p->cap_frames, p->nframes + 1, sizeof *p->frames)) {
+        sdl_error(p, from, PT_ERR_NOMEM, "out of memory");
+        return 0;
     }
     sdl_frame *f = &p->frames[p->nframes++];
     memset(f, 0, sizeof *f);
@@ -201,15 +196,9 @@ static sdl_cond *push_cond(sdl_parser *p, sdl_cond_kind kind, src_loc loc)
         sdl_error(p, loc, PT_ERR_LIMIT, "more than %d nested conditionals and macro calls", SDL_MAX_CONDITIONALS);
         return NULL;
     }
-    if (p->nconds == p->cap_conds) {
-        int nc = p->cap_conds ? p->cap_conds * 2 : 32;
-        sdl_cond *n = realloc(p->conds, sizeof *n * (size_t)nc);
-        if (!n) {
-            sdl_error(p, loc, PT_ERR_NOMEM, "out of memory");
-            return NULL;
-        }
-        p->conds = n;
-        p->cap_conds = nc;
+    if (!grow_array_int((void **)&p->conds, &p->cap_conds, p->nconds + 1, sizeof *p->conds)) {
+        sdl_error(p, loc, PT_ERR_NOMEM, "out of memory");
+        return NULL;
     }
     sdl_cond *c = &p->conds[p->nconds++];
     memset(c, 0, sizeof *c);

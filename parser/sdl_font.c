@@ -1,5 +1,6 @@
 /* sdl_font.c - text outlines through FreeType (sdl_font.h). */
 #include "sdl_font.h"
+#include "grow.h"
 #include <ft2build.h>
 #include FT_FREETYPE_H
 #include FT_OUTLINE_H
@@ -22,15 +23,9 @@ static void sink_add(outline_sink *s, double x0, double y0, double x1, double y1
 {
     if (s->oom) return;
     if (x0 == x3 && y0 == y3 && x1 == x0 && y1 == y0 && x2 == x0 && y2 == y0) return; /* empty */
-    if (s->n == s->cap) {
-        int nc = s->cap ? s->cap * 2 : 256;
-        double(*g)[8] = realloc(s->seg, sizeof *g * (size_t)nc);
-        if (!g) {
-            s->oom = 1;
-            return;
-        }
-        s->seg = g;
-        s->cap = nc;
+    if (!grow_array_int((void **)&s->seg, &s->cap, s->n + 1, sizeof *s->seg)) {
+        s->oom = 1;
+        return;
     }
     double *d = s->seg[s->n++];
     d[0] = x0; d[1] = y0; d[2] = x1; d[3] = y1; d[4] = x2; d[5] = y2; d[6] = x3; d[7] = y3;

@@ -1,5 +1,6 @@
 /* sdl_parse.c - public entry points (sdl.h), errors, token helpers. */
 #include "sdl_parse.h"
+#include "grow.h"
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -162,15 +163,9 @@ int sdl_begin_block(sdl_parser *p, const char *name)
         sdl_unexpected(p, &t, what);
         return 0;
     }
-    if (p->nblocks == p->cap_blocks) {
-        int nc = p->cap_blocks ? p->cap_blocks * 2 : 32;
-        sdl_block *nb = realloc(p->blocks, sizeof *nb * (size_t)nc);
-        if (!nb) {
-            sdl_error(p, t.tk.loc, PT_ERR_NOMEM, "out of memory");
-            return 0;
-        }
-        p->blocks = nb;
-        p->cap_blocks = nc;
+    if (!grow_array_int((void **)&p->blocks, &p->cap_blocks, p->nblocks + 1, sizeof *p->blocks)) {
+        sdl_error(p, t.tk.loc, PT_ERR_NOMEM, "out of memory");
+        return 0;
     }
     p->blocks[p->nblocks].name = name;
     p->blocks[p->nblocks].loc = t.tk.loc;

@@ -4,6 +4,7 @@
  * and closing rules are POV-Ray's (its parser is the reference for what a
  * scene means). EPSILON below is POV-Ray's 1e-10 for "the same point". */
 #include "sdl_shape.h"
+#include "grow.h"
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -467,15 +468,9 @@ typedef struct {
 
 static scene_blob_component *comp_add(sdl_parser *p, comp_list *l)
 {
-    if (l->n == l->cap) {
-        int nc = l->cap ? l->cap * 2 : 16;
-        scene_blob_component *c = realloc(l->c, sizeof *c * (size_t)nc);
-        if (!c) {
-            sdl_error(p, p->last_loc, PT_ERR_NOMEM, "out of memory");
-            return NULL;
-        }
-        l->c = c;
-        l->cap = nc;
+    if (!grow_array_int((void **)&l->c, &l->cap, l->n + 1, sizeof *l->c)) {
+        sdl_error(p, p->last_loc, PT_ERR_NOMEM, "out of memory");
+        return NULL;
     }
     scene_blob_component *c = &l->c[l->n++];
     memset(c, 0, sizeof *c);
