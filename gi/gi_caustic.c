@@ -1,5 +1,6 @@
 /* gi_caustic.c - the caustic layer (see gi_caustic.h). */
 #include "gi_caustic.h"
+#include "grow.h"
 #include "scene_leaves.h"
 #include <math.h>
 #include <stdio.h>
@@ -215,13 +216,7 @@ static int collect_targets(const scene_object *o, const scene_object ***list, in
 {
     if (o->photons && o->photons->target) {
         if (o->no_global_lights) return 1;
-        if (*n == *cap) {
-            int nc = *cap ? *cap * 2 : 16;
-            const scene_object **nl = realloc(*list, sizeof **list * (size_t)nc);
-            if (!nl) return 0;
-            *list = nl;
-            *cap = nc;
-        }
+        if (!grow_array_int((void **)list, cap, *n + 1, sizeof **list)) return 0;
         (*list)[(*n)++] = o;
         return 1;
     }
@@ -645,16 +640,10 @@ static void bin_tile(void *ctx, int t, int thread)
                             dd += e * e;
                         }
                         if (dd > (double)p->r_xy * p->r_xy) continue;
-                        if (n == cap) {
-                            int nc = cap ? cap * 2 : 256;
-                            int *nl = realloc(list, sizeof(int) * (size_t)nc);
-                            if (!nl) {
-                                free(list);
-                                bj->counts[t] = -1;
-                                return;
-                            }
-                            list = nl;
-                            cap = nc;
+                        if (!grow_array_int((void **)&list, &cap, n + 1, sizeof *list)) {
+                            free(list);
+                            bj->counts[t] = -1;
+                            return;
                         }
                         list[n++] = id;
                     }

@@ -3,6 +3,7 @@
  * implicit shapes and the layout are in gi_surface_csg.c, gi_surface_mesh.c
  * and gi_surface_layout.c (gi_surface_internal.h). */
 #include "gi_surface_internal.h"
+#include "grow.h"
 #include <math.h>
 #include "geom_shape.h"
 #include "geom_hfield.h"
@@ -21,26 +22,14 @@
 
 int gi_surface_add_patch(gi_surface *g, const patch *p)
 {
-    if (g->np == g->capp) {
-        int nc = g->capp ? g->capp * 2 : 256;
-        patch *np = realloc(g->p, (size_t)nc * sizeof *np);
-        if (!np) return -1;
-        g->p = np;
-        g->capp = nc;
-    }
+    if (!grow_array_int((void **)&g->p, &g->capp, g->np + 1, sizeof *g->p)) return -1;
     g->p[g->np] = *p;
     return g->np++;
 }
 
 int gi_surface_add_obj(gi_surface *g, const scene_object *o)
 {
-    if (g->no == g->capo) {
-        int nc = g->capo ? g->capo * 2 : 64;
-        obj_rec *no = realloc(g->o, (size_t)nc * sizeof *no);
-        if (!no) return -1;
-        g->o = no;
-        g->capo = nc;
-    }
+    if (!grow_array_int((void **)&g->o, &g->capo, g->no + 1, sizeof *g->o)) return -1;
     g->o[g->no].obj = o;
     g->o[g->no].first = g->np;
     g->o[g->no].count = 0;
