@@ -23,16 +23,19 @@
  *     the cone of directions that holds the target's bounding sphere
  *     (POV-Ray's box, geom_extent), equal solid angle per cell (so no
  *     inverse-cosine correction is needed), jittered by the scene's
- *     `jitter`; Embree finds the first hit; Russian roulette picks the
- *     specular lobe (appendix A, through the hooks: the one BSDF of
- *     shade_material.h) or absorbs the photon (power 0, counted);
+ *     `jitter`; Embree finds the first hit; Russian roulette keeps the
+ *     photon with the specular lobes' share of the surface's albedo or
+ *     absorbs it (appendix A, through the hooks: the one BSDF of
+ *     shade_material.h; counted), and a kept photon splits into its
+ *     reflection and refraction where the surface has both (POV-Ray's
+ *     photon tracer traces both);
  *  2. world-space tracing of the further bounces, storing a photon before
  *     each bounce on a receiving surface (bounce-map photons are not
- *     stored), Russian roulette at each, up to the photons' max_trace_level
- *     and adc_bailout;
- *  3. path density rho_p, the product over bounces of the lobe's
- *     reflectance (the paper's factor rho_S for mirror and refraction
- *     bounces; caustic paths have no other), sets the photon volume's
+ *     stored), roulette and splitting at each, up to the photons'
+ *     max_trace_level and adc_bailout;
+ *  3. path density rho_p, the product over bounces of the roulette's
+ *     survival probability (the paper's factor rho_S, which a roulette
+ *     over the lobes would give each lobe), sets the photon volume's
  *     radius: r_xy = k s_D / sqrt(rho_p), with s_D the spacing of the
  *     photon's direction cell at its path length (the distance to its
  *     neighbours had nothing focused it) and k = 6 (gi_caustic.c says
