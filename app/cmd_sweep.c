@@ -40,6 +40,7 @@
  * (outputs are still written for the others); 2 usage; 3 I/O; 130 (143)
  * after Ctrl-C (SIGTERM): the outputs then cover the renders done so far. */
 #include "cmd_sweep.h"
+#include "grow.h"
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -98,13 +99,8 @@ typedef struct {
 
 static void av_add(argvec *a, const char *s)
 {
-    if (a->n + 2 > a->cap) {
-        int nc = a->cap ? a->cap * 2 : 32;
-        char **nv = realloc(a->v, (size_t)nc * sizeof *nv);
-        if (!nv) return;
-        a->v = nv;
-        a->cap = nc;
-    }
+    /* room for s and the NULL after it */
+    if (!grow_array_int((void **)&a->v, &a->cap, a->n + 2, sizeof *a->v)) return;
     a->v[a->n] = strdup(s);
     if (a->v[a->n]) a->n++;
     a->v[a->n] = NULL;

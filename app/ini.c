@@ -19,6 +19,7 @@
  * file that names them (so `partray render dir/anim.ini` works from
  * anywhere). */
 #include "ini.h"
+#include "grow.h"
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -107,13 +108,8 @@ static const ini_key *find_key(const char *k, size_t n)
 
 static int push(ini_args *a, const char *s)
 {
-    if (a->n + 1 >= a->cap) {
-        int cap = a->cap ? a->cap * 2 : 32;
-        char **v = realloc(a->v, (size_t)cap * sizeof *v);
-        if (!v) return 0;
-        a->v = v;
-        a->cap = cap;
-    }
+    /* room for s and the NULL after it */
+    if (!grow_array_int((void **)&a->v, &a->cap, a->n + 2, sizeof *a->v)) return 0;
     char *c = strdup(s);
     if (!c) return 0;
     a->v[a->n++] = c;

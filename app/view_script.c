@@ -1,5 +1,6 @@
 /* view_script.c - reading and running `--script` files. */
 #include "view_script.h"
+#include "grow.h"
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -235,12 +236,9 @@ pt_status view_script_parse(const char *name, const char *text, view_script **ou
             else {
                 view_action a;
                 if (parse_command(&c, vs, w + 1, n - 1, eol_col, &a)) {
-                    if (vs->n == vs->cap) {
-                        int nc = vs->cap ? vs->cap * 2 : 32;
-                        script_event *ne = realloc(vs->ev, (size_t)nc * sizeof *ne);
-                        if (!ne) { view_script_free(vs); return PT_ERR_NOMEM; }
-                        vs->ev = ne;
-                        vs->cap = nc;
+                    if (!grow_array_int((void **)&vs->ev, &vs->cap, vs->n + 1, sizeof *vs->ev)) {
+                        view_script_free(vs);
+                        return PT_ERR_NOMEM;
                     }
                     vs->ev[vs->n].time = t;
                     vs->ev[vs->n].a = a;
