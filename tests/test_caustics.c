@@ -105,6 +105,18 @@ static void test_focus_vs_path(void **state)
     tu_world_free(&w);
 }
 
+/* The mirror scenes below: a camera looking straight down at the floor's
+ * 0.4 x 0.4 around the origin, a mirror wall at x = 1; %s: the global
+ * photons block, the light (or emitter), the mirror's photons block and the
+ * floor's finish items. */
+static const char *mirror_fmt =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 %s }\n"
+    "camera { orthographic location <0, 5, 0> look_at <0, 0, 0> sky z right x*0.4 up z*0.4 }\n"
+    "%s\n"
+    "box { <1, -1, -3>, <1.1, 3, 3> pigment { rgb 0 } finish { ambient 0 diffuse 0 reflection 1 } %s }\n"
+    "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 1 %s } }\n";
+
 /* The reference for mirror caustics: --gi path sees an emissive sphere
  * (radius 1 at <-4, 5, 0>, radiance 10) in a mirror wall at x = 1; an
  * opaque no_reflection block hides the sphere's direct light from the
@@ -120,14 +132,12 @@ static void test_focus_vs_path(void **state)
 static void test_path_mirror_closed_form(void **state)
 {
     (void)state;
-    tu_world w = tu_world_build("test.pov", "#version 3.7;\n"
-                      "global_settings { assumed_gamma 1.0 }\n"
-                      "camera { orthographic location <0, 5, 0> look_at <0, 0, 0> sky z right x*0.4 up z*0.4 }\n"
-                      "sphere { <-4, 5, 0>, 1 pigment { rgb 1 } finish { ambient 0 diffuse 0 emission 10 } no_image }\n"
-                      "box { <1, -1, -3>, <1.1, 3, 3> pigment { rgb 0 } finish { ambient 0 diffuse 0 reflection 1 } }\n"
-                      "box { <-1.3, 0.8, -1>, <-0.4, 1.2, 1> pigment { rgb 0 } finish { ambient 0 diffuse 0 } "
-                      "no_reflection }\n"
-                      "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 1 } }\n");
+    char text[1024];
+    snprintf(text, sizeof text, mirror_fmt, "",
+             "sphere { <-4, 5, 0>, 1 pigment { rgb 1 } finish { ambient 0 diffuse 0 emission 10 } no_image }\n"
+             "box { <-1.3, 0.8, -1>, <-0.4, 1.2, 1> pigment { rgb 0 } finish { ambient 0 diffuse 0 } no_reflection }",
+             "", "");
+    tu_world w = tu_world_build("test.pov", text);
     double want = 0.0;
     for (int i = 0; i < 40; i++)
         for (int j = 0; j < 40; j++) {
@@ -161,13 +171,10 @@ static void test_path_mirror_closed_form(void **state)
 static void test_mirror_closed_form(void **state)
 {
     (void)state;
-    tu_world w = tu_world_build("test.pov", "#version 3.7;\n"
-                      "global_settings { assumed_gamma 1.0 photons { spacing 0.01 } }\n"
-                      "camera { orthographic location <0, 5, 0> look_at <0, 0, 0> sky z right x*0.4 up z*0.4 }\n"
-                      "light_source { <-2, 5, 0> color rgb 1 }\n"
-                      "box { <1, -1, -3>, <1.1, 3, 3> pigment { rgb 0 } finish { ambient 0 diffuse 0 reflection 1 } "
-                      "photons { target reflection on } }\n"
-                      "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 1 } }\n");
+    char text[1024];
+    snprintf(text, sizeof text, mirror_fmt, "photons { spacing 0.01 }", "light_source { <-2, 5, 0> color rgb 1 }",
+             "photons { target reflection on }", "");
+    tu_world w = tu_world_build("test.pov", text);
     scene *sc = w.s;
     accel *a = w.a;
     diag *d = diag_new();
@@ -190,14 +197,10 @@ static void test_mirror_brilliance(void **state)
     (void)state;
     const double bs[2] = {0.5, 3.0};
     for (int i = 0; i < 2; i++) {
-        char text[1024];
-        snprintf(text, sizeof text, "#version 3.7;\n"
-                 "global_settings { assumed_gamma 1.0 photons { spacing 0.01 } }\n"
-                 "camera { orthographic location <0, 5, 0> look_at <0, 0, 0> sky z right x*0.4 up z*0.4 }\n"
-                 "light_source { <-2, 5, 0> color rgb 1 }\n"
-                 "box { <1, -1, -3>, <1.1, 3, 3> pigment { rgb 0 } finish { ambient 0 diffuse 0 reflection 1 } "
-                 "photons { target reflection on } }\n"
-                 "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 1 brilliance %g } }\n", bs[i]);
+        char text[1024], floor[64];
+        snprintf(floor, sizeof floor, "brilliance %g", bs[i]);
+        snprintf(text, sizeof text, mirror_fmt, "photons { spacing 0.01 }", "light_source { <-2, 5, 0> color rgb 1 }",
+                 "photons { target reflection on }", floor);
         tu_world w = tu_world_build("test.pov", text);
         diag *d = diag_new();
         caustics c;
