@@ -612,6 +612,21 @@ static void skip_args(sdl_parser *p)
     }
 }
 
+/* slope's and altitude's `v [, lo [, hi]]`: the vector, and in *lo and
+ * *hi the range's start and width (POV-Ray: an empty range, lo == hi != 0,
+ * is ignored: both 0). */
+static vec3 slope_range(sdl_parser *p, double *lo, double *hi)
+{
+    vec3 v = sdl_vector(p);
+    sdl_accept(p, TOK_COMMA);
+    *lo = sdl_allow_float(p, 0.0);
+    sdl_accept(p, TOK_COMMA);
+    *hi = sdl_allow_float(p, 0.0);
+    if (*hi != 0.0 && *hi == *lo) *lo = *hi = 0.0;
+    else *hi -= *lo;
+    return v;
+}
+
 /* pattern_type: the keyword is next. Returns 1 if one was parsed. */
 static int pattern_type(sdl_parser *p, target *tg)
 {
@@ -747,23 +762,10 @@ static int pattern_type(sdl_parser *p, target *tg)
         if (sdl_is(sdl_peek(p), TOK_LBRACE)) {
             sdl_begin_block(p, "slope");
             pt->slope_point_at = sdl_accept_kw(p, KW_POINT_AT);
-            sv = sdl_vector(p);
-            sdl_accept(p, TOK_COMMA);
-            pt->slope_lo = sdl_allow_float(p, 0.0);
-            sdl_accept(p, TOK_COMMA);
-            pt->slope_hi = sdl_allow_float(p, 0.0);
-            /* POV-Ray: an empty range is ignored, else hi holds its width */
-            if (pt->slope_hi != 0.0 && pt->slope_hi == pt->slope_lo) pt->slope_lo = pt->slope_hi = 0.0;
-            else pt->slope_hi -= pt->slope_lo;
+            sv = slope_range(p, &pt->slope_lo, &pt->slope_hi);
             if (sdl_accept_kw(p, KW_ALTITUDE)) {
                 if (pt->slope_point_at) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "'altitude' cannot be used with 'point_at' in slope pattern");
-                av = sdl_vector(p);
-                sdl_accept(p, TOK_COMMA);
-                pt->altit_lo = sdl_allow_float(p, 0.0);
-                sdl_accept(p, TOK_COMMA);
-                pt->altit_hi = sdl_allow_float(p, 0.0);
-                if (pt->altit_hi != 0.0 && pt->altit_hi == pt->altit_lo) pt->altit_lo = pt->altit_hi = 0.0;
-                else pt->altit_hi -= pt->altit_lo;
+                av = slope_range(p, &pt->altit_lo, &pt->altit_hi);
             }
             sdl_end_block(p);
         } else {
