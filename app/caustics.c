@@ -79,6 +79,15 @@ static int disperses(const scene_object *o)
     return o->photons && o->photons->target && o->interior && o->interior->dispersion != 1.0;
 }
 
+/* A layer of the object's own texture has a diffuse_back term (texture
+ * maps are not looked into). */
+static int lit_from_behind(const scene_object *o)
+{
+    for (const scene_texture *t = o->texture; t; t = t->next)
+        if (t->finish.diffuse_back > 0.0) return 1;
+    return 0;
+}
+
 /* What the scene's photon settings ask that the layer leaves out. */
 static void not_modelled(caustics *c, const scene *sc, diag *d)
 {
@@ -94,6 +103,7 @@ static void not_modelled(caustics *c, const scene *sc, diag *d)
     for (int i = 0; i < sc->nobjects; i++) {
         nm->dispersion |= scene_object_any(sc->objects[i], disperses);
         nm->media_objects |= scene_object_any(sc->objects[i], has_media);
+        nm->diffuse_back |= scene_object_any(sc->objects[i], lit_from_behind);
     }
     src_loc nowhere = {0};
     const char *why = "the caustic layer sizes its photon volumes itself (docs/caustics.md)";
@@ -108,6 +118,10 @@ static void not_modelled(caustics *c, const scene *sc, diag *d)
         diag_warn_once(d, nowhere, "photons: load_file is not modelled: the photons are shot again, not read");
     if (nm->dispersion)
         diag_warn_once(d, nowhere, "photons: dispersion is not modelled: photons through a dispersive target are white");
+    if (nm->diffuse_back)
+        diag_warn_once(d, nowhere,
+                       "photons: diffuse_back is not modelled in the caustic layer: photons arriving at the back of a "
+                       "surface do not light it");
     if (nm->media_objects)
         diag_warn_once(d, nowhere, "photons: media inside objects neither take nor dim photons in the caustic layer");
 }
@@ -190,7 +204,7 @@ void caustics_json(caustics *c, stats_json *js)
     stats_obj_end(js);
     stats_obj_begin(js, "not_modelled");
     STATS_INTS(js, &c->nm, gather, radius, expand_thresholds, autostop, media, save_file, load_file, dispersion,
-               media_objects);
+               media_objects, diffuse_back);
     stats_obj_end(js);
     stats_obj_end(js);
 }

@@ -353,7 +353,7 @@ static void test_not_modelled(void **state)
     layer(&c, sc, a, 16, 12, NULL, THREADS, d);
     caustics_not_modelled *nm = &c.nm;
     assert_true(nm->gather && nm->radius && nm->media && nm->autostop && nm->expand_thresholds && nm->save_file &&
-                nm->dispersion && !nm->load_file && !nm->media_objects);
+                nm->dispersion && !nm->load_file && !nm->media_objects && !nm->diffuse_back);
     int warned = diag_count(d);
     printf("not modelled: %d warnings:\n", warned);
     for (int i = 0; i < warned; i++) {
@@ -370,6 +370,19 @@ static void test_not_modelled(void **state)
     /* again: the same warnings are not repeated into the same context */
     layer(&c, sc, a, 16, 12, NULL, THREADS, d);
     assert_int_equal(diag_count(d), warned);
+    caustics_free(&c);
+    diag_free(d);
+    tu_world_free(&w);
+
+    /* a diffuse_back receiver: counted and warned once */
+    w = tu_world_build("test.pov", "global_settings { photons { spacing 0.1 } }\n"
+               "light_source { <0, 5, 0> rgb 1 }\n"
+               "sphere { <0, 1, 0>, 0.5 pigment { rgbf 1 } interior { ior 1.5 } photons { target refraction on } }\n"
+               "plane { y, 0 pigment { rgb 1 } finish { diffuse 0.6, 0.3 } }\n");
+    d = diag_new();
+    layer(&c, w.s, w.a, 8, 8, NULL, THREADS, d);
+    assert_true(c.nm.diffuse_back);
+    assert_int_equal(diag_count(d), 1);
     caustics_free(&c);
     diag_free(d);
     tu_world_free(&w);
