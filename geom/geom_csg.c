@@ -134,6 +134,69 @@ static void leaf_boxes(const geom_shape *sh, int inverse, bbox *s, bbox *v)
     if (inverse) *v = bb_all();
 }
 
+/* Plane pl's solid (n.p < d in world; `outside`: its complement, n.p >= d)
+ * in shape q's own object space: where it is a half-space along one of q's
+ * axes there, that axis's range in lo/hi is narrowed to it. */
+static void plane_limit(const geom_shape *q, const geom_shape *pl, int outside, double *lo, double *hi)
+{
+    /* world n.p < d with p = A y + t: (A^T n).y < d - n.t */
+    vec3 nw = pl->identity ? pl->g.plane.n : v3_norm(xform_normal(&pl->x, pl->g.plane.n));
+    vec3 p0 = v3_scale(pl->g.plane.n, pl->g.plane.d);
+    if (!pl->identity) p0 = xform_point(&pl->x, p0);
+    if (outside) nw = v3_neg(nw);
+    double d = v3_dot(nw, p0), nl[3], big = 0.0;
+    for (int a = 0; a < 3; a++) {
+        nl[a] = q->x.m[0][a] * nw.x + q->x.m[1][a] * nw.y + q->x.m[2][a] * nw.z;
+        big = fmax(big, fabs(nl[a]));
+    }
+    int axis = -1, others = 0;
+    for (int a = 0; a < 3; a++)
+        if (fabs(nl[a]) > 1e-9 * big) {
+            if (axis < 0) axis = a;
+            else others = 1;
+        }
+    if (axis < 0 || others) return;
+    double bound = (d - (nw.x * q->x.m[0][3] + nw.y * q->x.m[1][3] + nw.z * q->x.m[2][3])) / nl[axis];
+    if (nl[axis] > 0.0) hi[axis] = fmin(hi[axis], bound);
+    else lo[axis] = fmax(lo[axis], bound);
+}
+
+/* A difference whose first member is a bounded leaf and whose subtracted
+ * members include planes (a hull cut into quarters by the planes x = 0,
+ * z = 0 of its own frame and turned as a whole): the part of the first
+ * member that can remain is its object-space box with the subtracted
+ * half-spaces cut away there, carried to world. The first member's boxes
+ * (where it is inside, where its kept crossings lie) shrink to it; every
+ * point cut away is inside a subtracted member, so nothing kept is lost. */
+static void difference_cut(const geom_csg *c, const int *k, int n, bbox *S, bbox *V)
+{
+    const geom_csg_node *first = &c->nodes[k[0]];
+    if (first->op != GEOM_CSG_LEAF || first->inverse) return;
+    const geom_shape *q = &c->shapes[first->shape];
+    if (q->infinite || !v3_finite(q->olo) || !v3_finite(q->ohi) || q->kind == SHAPE_PLANE) return;
+    double lo[3] = {q->olo.x, q->olo.y, q->olo.z}, hi[3] = {q->ohi.x, q->ohi.y, q->ohi.z};
+    int cut = 0;
+    for (int j = 1; j < n; j++) {
+        const geom_csg_node *kj = &c->nodes[k[j]];
+        if (kj->op != GEOM_CSG_LEAF || c->shapes[kj->shape].kind != SHAPE_PLANE) continue;
+        /* what remains is outside the subtracted solid */
+        plane_limit(q, &c->shapes[kj->shape], !kj->inverse, lo, hi);
+        cut = 1;
+    }
+    if (!cut) return;
+    bbox r = bb_empty();
+    if (lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2])
+        for (int corner = 0; corner < 8; corner++) {
+            vec3 y = v3(corner & 1 ? hi[0] : lo[0], corner & 2 ? hi[1] : lo[1], corner & 4 ? hi[2] : lo[2]);
+            vec3 w = xform_point(&q->x, y);
+            r.lo = v3_min(r.lo, w);
+            r.hi = v3_max(r.hi, w);
+        }
+    r = bb_empty_p(r) ? bb_empty() : pad_box(r);
+    V[k[0]] = bb_inter(V[k[0]], r);
+    S[k[0]] = bb_inter(S[k[0]], r);
+}
+
 /* Where quadric q's inside can be in its own object space, from the
  * members it is intersected with: gathered in lo/hi from node `node` (a
  * member that must contain the point): an axis-aligned plane there bounds
@@ -148,26 +211,7 @@ static void local_limits(const geom_csg *c, const geom_shape *q, int node, const
         return;
     }
     if (nd->op == GEOM_CSG_LEAF && c->shapes[nd->shape].kind == SHAPE_PLANE) {
-        const geom_shape *pl = &c->shapes[nd->shape];
-        /* world n.p < d with p = A y + t: (A^T n).y < d - n.t */
-        vec3 nw = pl->identity ? pl->g.plane.n : v3_norm(xform_normal(&pl->x, pl->g.plane.n));
-        vec3 p0 = v3_scale(pl->g.plane.n, pl->g.plane.d);
-        if (!pl->identity) p0 = xform_point(&pl->x, p0);
-        double d = v3_dot(nw, p0), nl[3], big = 0.0;
-        for (int a = 0; a < 3; a++) {
-            nl[a] = q->x.m[0][a] * nw.x + q->x.m[1][a] * nw.y + q->x.m[2][a] * nw.z;
-            big = fmax(big, fabs(nl[a]));
-        }
-        int axis = -1, others = 0;
-        for (int a = 0; a < 3; a++)
-            if (fabs(nl[a]) > 1e-9 * big) {
-                if (axis < 0) axis = a;
-                else others = 1;
-            }
-        if (axis < 0 || others) return;
-        double bound = (d - (nw.x * q->x.m[0][3] + nw.y * q->x.m[1][3] + nw.z * q->x.m[2][3])) / nl[axis];
-        if (nl[axis] > 0.0) hi[axis] = fmin(hi[axis], bound);
-        else lo[axis] = fmax(lo[axis], bound);
+        plane_limit(q, &c->shapes[nd->shape], 0, lo, hi);
         return;
     }
     bbox b = V[node];
@@ -306,6 +350,7 @@ int geom_csg_finish(geom_csg *c)
             break;
         case GEOM_CSG_DIFFERENCE:
             if (n > 0) {
+                difference_cut(c, k, n, S, V);
                 s = S[k[0]];
                 v = V[k[0]];
                 for (int j = 1; j < n; j++) s = bb_union(s, bb_inter(S[k[j]], V[k[0]]));

@@ -524,6 +524,35 @@ static void test_quadric_csg_box(void **st)
     assert_true(c.hi.x <= R + 1e-6 && c.hi.y <= R + 1e-6 && c.hi.z <= R + 1e-6);
     geom_csg_free(&c);
     done(&w);
+    /* a blob with the half-spaces x < 0 and z > 0 of its own frame
+     * subtracted, turned 30 degrees about y (abyss's hull quarters): the box
+     * is the quarter's, worked out before the turn, about half as wide as
+     * the whole blob's turned box (2 R (cos 30 + sin 30) = 2.73 R), and the
+     * quarter is still hit */
+    w = build("difference { blob { threshold 0.5 sphere { 0, 2, 1 } } plane { x, 0 } plane { z, 0 inverse } rotate 30*y }");
+    memset(&c, 0, sizeof c);
+    assert_int_equal(geom_csg_build(&c, w.s->objects[0], NULL, 0, -1, 0, &b), PT_OK);
+    assert_true(geom_csg_finish(&c));
+    {
+        double Rb = fmax(v3_maxc(v3_neg(c.shapes[0].olo)), v3_maxc(c.shapes[0].ohi));
+        double k = cos(M_PI / 6) + sin(M_PI / 6);
+        printf("  turned blob quarter: box %.3f x %.3f x %.3f, blob reach %.3f\n", c.hi.x - c.lo.x, c.hi.y - c.lo.y,
+               c.hi.z - c.lo.z, Rb);
+        assert_true(Rb > 1.0 && Rb < 2.5);
+        assert_true(c.hi.x - c.lo.x <= Rb * k * (1 + 1e-6) && c.hi.z - c.lo.z <= Rb * k * (1 + 1e-6));
+        assert_true(c.hi.y - c.lo.y >= 2.0 * Rb * (1 - 1e-6) - 1e-9);
+    }
+    geom_csg_free(&c);
+    /* the kept quarter (object x > 0, z < 0) turned: POV-Ray's rotate 30*y
+     * takes object (1, 0, -1) to world (cos30 - sin30, 0, -sin30 - cos30) */
+    {
+        vec3 q = v3(cos(M_PI / 6) - sin(M_PI / 6), 0, -sin(M_PI / 6) - cos(M_PI / 6));
+        vec3 o = v3_scale(q, 10.0), dir = v3_norm(v3_neg(q));
+        accel_hit h;
+        assert_true(accel_intersect(w.a, o, dir, 0.0, INFINITY, &h));
+        assert_true(h.t < 10.0 * v3_len(q));
+    }
+    done(&w);
     /* turned 45 degrees about z: mixed terms, no box (left to the clip cube) */
     w = build("quadric { <1,-1,1>, <0,0,0>, <0,0,0>, -1 rotate 45*z }");
     geom_shape sh = shape_of(&w);
