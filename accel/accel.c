@@ -1328,53 +1328,48 @@ static int fill_packet16(const accel *a, int k0, int m, const vec3 *org, const v
     return any;
 }
 
-void accel_occluded_n(const accel *a, int n, const vec3 *org, const vec3 *dir, const double *tmin,
-                      const double *tmax, unsigned char *out)
-{
-    for (int k0 = 0; k0 < n; k0 += 16) {
-        int m = n - k0 < 16 ? n - k0 : 16;
-        struct RTCRay16 r;
-        RTC_ALIGN(64) int valid[16];
-        if (!fill_packet16(a, k0, m, org, dir, tmin, tmax, &r, valid, out)) continue;
-        struct RTCIntersectContext c;
-        rtcInitIntersectContext(&c);
-        c.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-        /* no accel_query: user geometry takes the packet's float rays */
-        accel_query *saved = accel_tls_query;
-        accel_tls_query = NULL;
-        rtcOccluded16(valid, a->root, &c, &r);
-        accel_tls_query = saved;
-        for (int k = 0; k < m; k++)
-            if (valid[k]) out[k0 + k] = r.tfar[k] == -INFINITY;
-    }
-}
-
-void accel_hit_any_n(const accel *a, int n, const vec3 *org, const vec3 *dir, const double *tmin,
-                     const double *tmax, unsigned char *out)
+/* accel_occluded_n (nearest 0: Embree's occlusion query) and
+ * accel_hit_any_n (nearest 1: the nearest-hit query, which an occlusion
+ * query's skipping of no_shadow objects would get wrong: they block the
+ * cells' segments too), in packets of 16. */
+static void query_n(const accel *a, int n, const vec3 *org, const vec3 *dir, const double *tmin, const double *tmax,
+                    unsigned char *out, int nearest)
 {
     for (int k0 = 0; k0 < n; k0 += 16) {
         int m = n - k0 < 16 ? n - k0 : 16;
         struct RTCRayHit16 r;
         RTC_ALIGN(64) int valid[16];
         if (!fill_packet16(a, k0, m, org, dir, tmin, tmax, &r.ray, valid, out)) continue;
-        for (int k = 0; k < 16; k++) {
-            r.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            r.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
-            r.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-        }
+        if (nearest)
+            for (int k = 0; k < 16; k++) {
+                r.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+                r.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
+                r.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+            }
         struct RTCIntersectContext c;
         rtcInitIntersectContext(&c);
         c.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
         /* no accel_query: user geometry takes the packet's float rays */
         accel_query *saved = accel_tls_query;
         accel_tls_query = NULL;
-        /* the nearest-hit query: an occlusion query would skip no_shadow
-         * objects, which block the cells' segments too */
-        rtcIntersect16(valid, a->root, &c, &r);
+        if (nearest) rtcIntersect16(valid, a->root, &c, &r);
+        else rtcOccluded16(valid, a->root, &c, &r.ray);
         accel_tls_query = saved;
         for (int k = 0; k < m; k++)
-            if (valid[k]) out[k0 + k] = r.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
+            if (valid[k]) out[k0 + k] = nearest ? r.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID : r.ray.tfar[k] == -INFINITY;
     }
+}
+
+void accel_occluded_n(const accel *a, int n, const vec3 *org, const vec3 *dir, const double *tmin,
+                      const double *tmax, unsigned char *out)
+{
+    query_n(a, n, org, dir, tmin, tmax, out, 0);
+}
+
+void accel_hit_any_n(const accel *a, int n, const vec3 *org, const vec3 *dir, const double *tmin,
+                     const double *tmax, unsigned char *out)
+{
+    query_n(a, n, org, dir, tmin, tmax, out, 1);
 }
 
 void accel_bounds(const accel *a, vec3 *lo, vec3 *hi)
