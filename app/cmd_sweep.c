@@ -261,30 +261,7 @@ static framebuffer *resample(const framebuffer *src, int w, int h)
 {
     if (src->width >= w && src->height >= h) return downsample(src, w, h);
     framebuffer *dst = fb_new(w, h);
-    if (!dst) return NULL;
-    double sx = (double)src->width / w, sy = (double)src->height / h;
-    for (int y = 0; y < h; y++) {
-        double fy = (y + 0.5) * sy - 0.5;
-        if (fy < 0) fy = 0;
-        if (fy > src->height - 1) fy = src->height - 1;
-        int y0 = (int)fy, y1 = y0 + 1 < src->height ? y0 + 1 : y0;
-        double ty = fy - y0;
-        for (int x = 0; x < w; x++) {
-            double fx = (x + 0.5) * sx - 0.5;
-            if (fx < 0) fx = 0;
-            if (fx > src->width - 1) fx = src->width - 1;
-            int x0 = (int)fx, x1 = x0 + 1 < src->width ? x0 + 1 : x0;
-            double tx = fx - x0;
-            float *o = fb_px(dst, x, y);
-            for (int c = 0; c < 3; c++) {
-                const float *r = src->rgb;
-                size_t W = (size_t)src->width;
-                double a = r[((size_t)y0 * W + (size_t)x0) * 3 + (size_t)c], b = r[((size_t)y0 * W + (size_t)x1) * 3 + (size_t)c];
-                double e = r[((size_t)y1 * W + (size_t)x0) * 3 + (size_t)c], f = r[((size_t)y1 * W + (size_t)x1) * 3 + (size_t)c];
-                o[c] = (float)((a * (1 - tx) + b * tx) * (1 - ty) + (e * (1 - tx) + f * tx) * ty);
-            }
-        }
-    }
+    if (dst) fb_resample_bilinear(src, dst);
     return dst;
 }
 

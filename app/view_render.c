@@ -107,36 +107,6 @@ static void lut_init(void)
 }
 
 
-/* Upsample src (w x h) into dst (W x H) bilinearly (pixel centres aligned);
- * a copy when the sizes agree. */
-static void upsample(const framebuffer *src, framebuffer *dst)
-{
-    int w = src->width, h = src->height, W = dst->width, H = dst->height;
-    if (w == W && h == H) {
-        memcpy(dst->rgb, src->rgb, (size_t)W * (size_t)H * 3u * sizeof(float));
-        return;
-    }
-    for (int y = 0; y < H; y++) {
-        double sy = (y + 0.5) * h / H - 0.5;
-        int y0 = (int)floor(sy);
-        double fy = sy - y0;
-        int ya = y0 < 0 ? 0 : (y0 >= h ? h - 1 : y0);
-        int yb = y0 + 1 < 0 ? 0 : (y0 + 1 >= h ? h - 1 : y0 + 1);
-        for (int x = 0; x < W; x++) {
-            double sx = (x + 0.5) * w / W - 0.5;
-            int x0 = (int)floor(sx);
-            double fx = sx - x0;
-            int xa = x0 < 0 ? 0 : (x0 >= w ? w - 1 : x0);
-            int xb = x0 + 1 < 0 ? 0 : (x0 + 1 >= w ? w - 1 : x0 + 1);
-            const float *p00 = src->rgb + ((size_t)ya * w + xa) * 3u, *p01 = src->rgb + ((size_t)ya * w + xb) * 3u;
-            const float *p10 = src->rgb + ((size_t)yb * w + xa) * 3u, *p11 = src->rgb + ((size_t)yb * w + xb) * 3u;
-            float *o = dst->rgb + ((size_t)y * W + x) * 3u;
-            for (int c = 0; c < 3; c++)
-                o[c] = (float)((p00[c] * (1 - fx) + p01[c] * fx) * (1 - fy) + (p10[c] * (1 - fx) + p11[c] * fx) * fy);
-        }
-    }
-}
-
 static inline uint8_t srgb8(float v)
 {
     if (!(v > 0.0f)) return 0; /* also NaN */
@@ -793,7 +763,7 @@ framebuffer *view_render_snapshot(view_render *vr, view_frame_info *info)
     pthread_mutex_lock(&vr->mu);
     if (vr->serial > 0) {
         fb = fb_new(vr->o.width, vr->o.height);
-        if (fb) upsample(vr->front, fb);
+        if (fb) fb_resample_bilinear(vr->front, fb);
         if (info) *info = vr->front_info;
     }
     pthread_mutex_unlock(&vr->mu);

@@ -16,5 +16,9 @@ static inline float *fb_px(framebuffer *fb, int x, int y) { return fb->rgb + ((s
  * (POV-Ray allows negative lights) are kept. */
 long fb_sanitize(framebuffer *fb);
 double fb_mean(const framebuffer *fb, int channel); /* channel -1 = mean of rgb */
+/* src's rgb resampled into dst (its own size) by bilinear interpolation,
+ * pixel centres aligned and edge pixels held; a copy when the sizes
+ * agree. Alpha is not touched. */
+void fb_resample_bilinear(const framebuffer *src, framebuffer *dst);
 
 #endif
