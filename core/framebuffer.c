@@ -48,6 +48,17 @@ double fb_mean(const framebuffer *fb, int channel)
     return npx ? s / (double)npx : 0.0;
 }
 
+/* Output pixel i of n along an axis of m source pixels: the two source
+ * pixels it lies between (held at the edges) and the weight of the second. */
+static void taps(int i, int n, int m, int *a, int *b, double *f)
+{
+    double s = (i + 0.5) * m / n - 0.5;
+    int i0 = (int)floor(s);
+    *f = s - i0;
+    *a = i0 < 0 ? 0 : (i0 >= m ? m - 1 : i0);
+    *b = i0 + 1 < 0 ? 0 : (i0 + 1 >= m ? m - 1 : i0 + 1);
+}
+
 void fb_resample_bilinear(const framebuffer *src, framebuffer *dst)
 {
     int w = src->width, h = src->height, W = dst->width, H = dst->height;
@@ -56,17 +67,13 @@ void fb_resample_bilinear(const framebuffer *src, framebuffer *dst)
         return;
     }
     for (int y = 0; y < H; y++) {
-        double sy = (y + 0.5) * h / H - 0.5;
-        int y0 = (int)floor(sy);
-        double fy = sy - y0;
-        int ya = y0 < 0 ? 0 : (y0 >= h ? h - 1 : y0);
-        int yb = y0 + 1 < 0 ? 0 : (y0 + 1 >= h ? h - 1 : y0 + 1);
+        int ya, yb;
+        double fy;
+        taps(y, H, h, &ya, &yb, &fy);
         for (int x = 0; x < W; x++) {
-            double sx = (x + 0.5) * w / W - 0.5;
-            int x0 = (int)floor(sx);
-            double fx = sx - x0;
-            int xa = x0 < 0 ? 0 : (x0 >= w ? w - 1 : x0);
-            int xb = x0 + 1 < 0 ? 0 : (x0 + 1 >= w ? w - 1 : x0 + 1);
+            int xa, xb;
+            double fx;
+            taps(x, W, w, &xa, &xb, &fx);
             const float *p00 = src->rgb + ((size_t)ya * w + xa) * 3u, *p01 = src->rgb + ((size_t)ya * w + xb) * 3u;
             const float *p10 = src->rgb + ((size_t)yb * w + xa) * 3u, *p11 = src->rgb + ((size_t)yb * w + xb) * 3u;
             float *o = dst->rgb + ((size_t)y * W + x) * 3u;
