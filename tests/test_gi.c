@@ -1446,6 +1446,8 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_full_scatter),
         cmocka_unit_test(test_integrating_sphere),
         cmocka_unit_test(test_sky_furnace),
+        cmocka_unit_test(test_sky_final_gather),
+        cmocka_unit_test(test_csg_emitter_gather),
         cmocka_unit_test(test_direct_matches_whitted),
         cmocka_unit_test(test_determinism),
         cmocka_unit_test(test_opencl_errors),

@@ -33,5 +33,7 @@ void test_kept_hits(void **state);
 
 /* test_gi_sky.c */
 void test_sky_furnace(void **state);
+void test_sky_final_gather(void **state);
+void test_csg_emitter_gather(void **state);
 
 #endif
