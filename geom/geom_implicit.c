@@ -688,8 +688,12 @@ static double blob_field(const im_data *m, vec3 q, vec3 *grad)
     double f = 0.0;
     vec3 g = v3s(0.0);
     for (int i = 0; i < m->ncomp; i++) {
+        /* a point outside a component's bounding sphere gets nothing from
+         * it (blob_hits skips rays the same way): no transform needed */
+        const blob_comp *c = &m->comp[i];
+        if (v3_len2(v3_sub(q, c->bc)) > c->br2) continue;
         vec3 gi;
-        f += blob_comp_field(&m->comp[i], q, grad ? &gi : NULL);
+        f += blob_comp_field(c, q, grad ? &gi : NULL);
         if (grad) g = v3_add(g, gi);
     }
     if (grad) *grad = g;
