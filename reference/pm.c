@@ -31,6 +31,8 @@ uint64_t pm_mix64(uint64_t z)
     return z ^ (z >> 31);
 }
 
+int pm_gathers(const radrules *rr) { return rr->recursion_limit > 0 ? rr->recursion_limit : 1 << 20; }
+
 int pm_threads(int requested)
 {
     int t = requested > 0 ? requested : pool_default_threads();

@@ -14,6 +14,7 @@
 #include "diag.h"
 #include "framebuffer.h"
 #include "progress.h"
+#include "radrules.h"
 #include "rng.h"
 #include "scene.h"
 
@@ -100,5 +101,9 @@ pt_status pm_image_render(const scene *sc, const pm_common *c, int max_pass, fra
 /* Helpers shared by the renderers. */
 uint64_t pm_mix64(uint64_t z);
 int pm_threads(int requested);
+/* How many diffuse (gathering) bounces a reference path may take: the
+ * radiosity recursion_limit (radrules.h rule 6), unbounded without a
+ * radiosity{} block (a converged reference). */
+int pm_gathers(const radrules *rr);
 
 #endif

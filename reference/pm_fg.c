@@ -505,7 +505,7 @@ pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s,
     c.L = L;
     c.eps = pm_lights_eps(L);
     c.rr = radrules_of(sc, 1);
-    c.gathers = c.rr.recursion_limit > 0 ? c.rr.recursion_limit : 1 << 20;
+    c.gathers = pm_gathers(&c.rr);
     c.eye_levels = radrules_level_limit(sc, 0);
     /* a gather ray is at level g1, its hit's specular rays at g1 + 1, ... */
     const int g1 = radrules_gather_level(1);

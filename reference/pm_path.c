@@ -181,7 +181,7 @@ pt_status pm_path_render(const scene *sc, const accel *a, const pm_path_settings
     double t1 = timer_now();
     st->t_lights = t1 - t0;
     path_ctx c = {sc, a, s, L, pm_lights_eps(L), s->max_depth > 0 ? s->max_depth : HARD_DEPTH, radrules_of(sc, 1), 0};
-    c.gathers = c.rr.recursion_limit > 0 ? c.rr.recursion_limit : HARD_DEPTH;
+    c.gathers = pm_gathers(&c.rr);
     if (c.max_depth > HARD_DEPTH) c.max_depth = HARD_DEPTH;
     status = pm_image_render(sc, &s->c, 16, fb, path_sample, &c, st);
     double t2 = timer_now();

@@ -389,7 +389,7 @@ static pt_status setup(trace_ctx *cp, const scene *sc, const accel *a, const pm_
     c.s = s;
     c.eps = pm_lights_eps(L);
     c.rr = radrules_of(sc, 1);
-    c.gathers = c.rr.recursion_limit > 0 ? c.rr.recursion_limit : 1 << 20;
+    c.gathers = pm_gathers(&c.rr);
     for (int i = 0; i < sc->nobjects && !c.targets; i++) c.targets = scene_object_any(sc->objects[i], is_target);
     *targets = c.targets;
     vec3 lo, hi;
