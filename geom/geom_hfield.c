@@ -144,20 +144,21 @@ typedef struct {
     geom_shape_hit *out;
     int n, max;
     double tmax;    /* shrinks once `max` hits are held */
+    double oa[3], inv[3]; /* o and 1/d by axis (inv 0 where d is 0), once per ray */
 } hf_walk;
 
 static int box_range(const hf_walk *w, double x0, double x1, double y0, double y1, double z0, double z1, double *ta,
                      double *tb)
 {
     double lo[3] = {x0, y0, z0}, hi[3] = {x1, y1, z1};
-    double o[3] = {w->o.x, w->o.y, w->o.z}, d[3] = {w->d.x, w->d.y, w->d.z};
+    const double *o = w->oa;
     double a = w->tmin, b = w->tmax;
     for (int k = 0; k < 3; k++) {
-        if (d[k] == 0.0) {
+        if (w->inv[k] == 0.0) {
             if (o[k] < lo[k] || o[k] > hi[k]) return 0;
             continue;
         }
-        double p = (lo[k] - o[k]) / d[k], q = (hi[k] - o[k]) / d[k];
+        double p = (lo[k] - o[k]) * w->inv[k], q = (hi[k] - o[k]) * w->inv[k];
         if (p > q) { double t = p; p = q; q = t; }
         /* a hair of slack so grid lines do not leak */
         double sl = 1e-12 * (fabs(p) + fabs(q)) + 1e-300;
@@ -213,6 +214,11 @@ int geom_hfield_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double t
     w.out = out;
     w.n = 0;
     w.max = max;
+    double dd[3] = {w.d.x, w.d.y, w.d.z};
+    w.oa[0] = w.o.x;
+    w.oa[1] = w.o.y;
+    w.oa[2] = w.o.z;
+    for (int k = 0; k < 3; k++) w.inv[k] = dd[k] != 0.0 ? 1.0 / dd[k] : 0.0;
     walk(&w, f->nlev - 1, 0, 0);
     return w.n;
 }
