@@ -1,5 +1,6 @@
 /* view_render.c - the render thread of the viewer. */
 #include "view_render.h"
+#include "img_io.h"
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
@@ -100,7 +101,7 @@ static void lut_init(void)
 {
     for (int i = 0; i <= SRGB_LUT; i++) {
         double l = (double)i / SRGB_LUT;
-        double e = l <= 0.0031308 ? 12.92 * l : 1.055 * pow(l, 1.0 / 2.4) - 0.055;
+        double e = img_srgb_encode(l);
         int v = (int)floor(e * 255.0 + 0.5);
         srgb_lut[i] = (uint8_t)(v < 0 ? 0 : (v > 255 ? 255 : v));
     }

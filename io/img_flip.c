@@ -46,6 +46,7 @@
  * clamped; LDR-FLIP is evaluated for each exposure, and the per-pixel
  * maximum is the HDR-FLIP value. */
 #include "img_flip.h"
+#include "img_io.h"
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -284,17 +285,12 @@ typedef struct {
     double scale; /* 2^c for FLIP_IN_TONED */
 } flip_input;
 
-static double srgb_decode(double e)
-{
-    return e <= 0.04045 ? e / 12.92 : pow((e + 0.055) / 1.055, 2.4);
-}
-
 static double input_linear(const flip_input *in, float v)
 {
     if (in->mode == FLIP_IN_SRGB) {
         double e = !isfinite(v) ? 0.0 : (v < 0.0f ? 0.0 : (v > 1.0f ? 1.0 : (double)v));
         /* sRGB transfer function, IEC 61966-2-1. */
-        return srgb_decode(e);
+        return img_srgb_decode(e);
     }
     /* Negative values count as 0: the rational tone curve is meant for
      * x >= 0 (it would turn x = -1 into 1.34). */

@@ -253,11 +253,6 @@ void img_magma(double t, float rgb[3])
         rgb[c] = (float)((1.0 - f) * magma_knots[k][c] + f * magma_knots[k + 1][c]);
 }
 
-static double srgb_to_linear(double e)
-{
-    return e <= 0.04045 ? e / 12.92 : pow((e + 0.055) / 1.055, 2.4);
-}
-
 /* A 3x5 pixel font for numeric labels: rows top to bottom, 3 bits each
  * (4 = left column). */
 static const char glyph_chars[] = "0123456789.-+e";
@@ -342,7 +337,7 @@ pt_status img_heatmap(const float *v, int w, int h, double vmin, double vmax, in
     for (int i = 0; i < 256; i++) {
         float c[3];
         img_magma(i / 255.0, c);
-        for (int k = 0; k < 3; k++) lut[i][k] = (float)srgb_to_linear(c[k]);
+        for (int k = 0; k < 3; k++) lut[i][k] = (float)img_srgb_decode(c[k]);
     }
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
@@ -353,7 +348,7 @@ pt_status img_heatmap(const float *v, int w, int h, double vmin, double vmax, in
     if (legend) {
         int sc = legend_scale(w, h);
         float bg[3], fg[3];
-        bg[0] = bg[1] = bg[2] = (float)srgb_to_linear(0.12);
+        bg[0] = bg[1] = bg[2] = (float)img_srgb_decode(0.12);
         fg[0] = fg[1] = fg[2] = 1.0f;
         for (int y = h; y < h + lh; y++)
             for (int x = 0; x < w; x++) put_px(fb, x, y, bg);

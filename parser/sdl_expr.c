@@ -10,6 +10,7 @@
 #include "sdl_directive.h"
 #include "sdl_function.h"
 #include "sdl_geom.h"
+#include "sdl_image.h"
 
 #define SDL_EPSILON 1e-10 /* POV-Ray's truth threshold for floats */
 
@@ -855,12 +856,6 @@ vec3 sdl_vector(sdl_parser *p)
 
 /* ------------------------------------------------------------ colours */
 
-/* sRGB transfer function decoded to linear (assumed_gamma 1 working space). */
-static double srgb_decode(double c)
-{
-    return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
-}
-
 /* colour_vector: the expression after rgb/rgbf/rgbt/rgbft/srgb..., into c */
 static void colour_vector(sdl_parser *p, sdl_kw k, double c[5])
 {
@@ -876,7 +871,7 @@ static void colour_vector(sdl_parser *p, sdl_kw k, double c[5])
         c[3] = 0;
     }
     if (k == KW_SRGB || k == KW_SRGBF || k == KW_SRGBT || k == KW_SRGBFT)
-        for (int i = 0; i < 3; i++) c[i] = srgb_decode(c[i]);
+        for (int i = 0; i < 3; i++) c[i] = sdl_srgb_decode(c[i]);
 }
 
 /* colour_body := { colour_key_item } where the first item may be a whole

@@ -14,7 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static double srgb_decode(double v) { return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4); }
+double sdl_srgb_decode(double v) { return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4); }
 
 int sdl_image_load(scene_image *img, arena *mem, double working_gamma, unsigned long long max_pixels, char *why,
                    size_t whycap)
@@ -56,7 +56,7 @@ int sdl_image_load(scene_image *img, arena *mem, double working_gamma, unsigned 
     }
     for (int i = 0; i < 65536; i++) {
         double v = i / 65535.0;
-        double lin = curve == 0 ? srgb_decode(v) : pow(v, exponent);
+        double lin = curve == 0 ? sdl_srgb_decode(v) : pow(v, exponent);
         if (legacy && !stated) {
             lin = v; /* decoded with the working gamma into the working space: the codes */
         } else if (working_gamma == 0.0) {

@@ -19,5 +19,8 @@
  * Returns 0 on success, else a reason in `why`. */
 int sdl_image_load(scene_image *img, arena *mem, double working_gamma, unsigned long long max_pixels, char *why,
                    size_t whycap);
+/* The sRGB transfer function decoded to linear as POV-Ray 3.7 decodes it
+ * (SRGBGammaCurve: knee at 0.04045), for images and srgb colours. */
+double sdl_srgb_decode(double v);
 
 #endif
