@@ -321,6 +321,22 @@ static double metric_sum(vec3 d, double metric)
     return pow(fabs(d.x), metric) + pow(fabs(d.y), metric) + pow(fabs(d.z), metric);
 }
 
+/* s (< m3) among the three smallest m1 <= m2 <= m3; mi: point of m1 */
+static inline void nearest3_put(double s, int i, double *m1, double *m2, double *m3, int *mi)
+{
+    if (s < *m1) {
+        *m3 = *m2;
+        *m2 = *m1;
+        *m1 = s;
+        *mi = i;
+    } else if (s < *m2) {
+        *m3 = *m2;
+        *m2 = s;
+    } else {
+        *m3 = s;
+    }
+}
+
 #define CRACKLE_SLOTS 64u /* per thread, 81 points each: 124 KiB */
 static double crackle(const scene_pattern *pat, vec3 p, int gen)
 {
@@ -364,36 +380,16 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
     for (int i = 3; metric == 2 && i < 81; i++) {
         double dx = pts[i].x - p.x, dy = pts[i].y - p.y, dz = pts[i].z - p.z;
         double s = dx * dx + dy * dy + dz * dz;
-        if (s >= m3) continue;
-        if (s < m1) {
-            m3 = m2;
-            m2 = m1;
-            m1 = s;
-            mi = i;
-        } else if (s < m2) {
-            m3 = m2;
-            m2 = s;
-        } else {
-            m3 = s;
-        }
+        if (s < m3) nearest3_put(s, i, &m1, &m2, &m3, &mi);
     }
     for (int i = 3; metric != 2 && i < 81; i++) {
         vec3 d = v3_sub(pts[i], p);
         if (general && fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))) > bound) continue;
         double s = metric_sum(d, metric);
-        if (general && s < m3) bound = INFINITY; /* m3 changes below */
-        if (s < m1) {
-            m3 = m2;
-            m2 = m1;
-            m1 = s;
-            mi = i;
-        } else if (s < m2) {
-            m3 = m2;
-            m2 = s;
-        } else if (s < m3) {
-            m3 = s;
+        if (s < m3) {
+            nearest3_put(s, i, &m1, &m2, &m3, &mi);
+            if (general) bound = pow(m3, 1.0 / metric) * (1.0 + 1e-12);
         }
-        if (general && bound == INFINITY) bound = pow(m3, 1.0 / metric) * (1.0 + 1e-12);
     }
     double off = pat->crackle_offset;
     if (off != 0.0) {
