@@ -375,7 +375,10 @@ static rgb tex_cb_trace(void *ctx, int thread, vec3 org, vec3 dir, int level, do
     /* a ray going on through the surface (refracted or straight) enters or
      * leaves the object; a reflected one stays where the incoming ray was */
     shade_media_inside in = *f->in;
-    if (v3_dot(dir, f->h->ng) * v3_dot(f->dir, f->h->ng) > 0.0) shade_media_inside_cross(&in, f->h->obj);
+    /* leaving an object the list does not hold (the camera inside a CSG
+     * result, shade_texture.c's ior_setup) does not put the ray inside it */
+    int leaving_unlisted = v3_dot(f->dir, f->h->ng) > 0.0 && shade_media_inside_find(&in, f->h->obj) < 0;
+    if (v3_dot(dir, f->h->ng) * v3_dot(f->dir, f->h->ng) > 0.0 && !leaving_unlisted) shade_media_inside_cross(&in, f->h->obj);
     return trace_ray(c, thread, org, dir, level, weight, skip, wavelength, r, &in);
 }
 

@@ -455,7 +455,15 @@ static void ior_setup(hit_info *hi, const shade_media_inside *in, const scene_ob
     int n = in->n, at = o ? shade_media_inside_find(in, o) : -1;
     const scene_interior *last = n > 0 ? in->obj[n - 1]->interior : NULL;
     hi->inside_interior = at >= 0;
-    if (n == 0) {
+    if (at < 0 && !hi->entering) {
+        /* leaving an object the list does not hold: the camera is inside
+         * a CSG result, which shade_media_inside_at cannot test (POV-Ray's
+         * list would hold it); leave it for the innermost container */
+        hi->inside_interior = 1;
+        hi->eta = ior / interior_ior(last);
+        hi->disp_ratio = disp / interior_dispersion(last);
+        hi->rel_ior = interior_ior(last) / ior;
+    } else if (n == 0) {
         hi->eta = 1.0 / ior;
         hi->disp_ratio = 1.0 / disp;
         hi->rel_ior = ior;
