@@ -1,5 +1,6 @@
 /* gi_area_particles.c - area particles: sampling, the hash grid and the link lookup. */
 #include "gi_area_particles.h"
+#include "grow.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -496,13 +497,7 @@ long gi_grid_radius(const gi_grid *g, vec3 q, vec3 nq, double r, double cos_thr,
                     double ex = e->x - q.x, ey = e->y - q.y, ez = e->z - q.z;
                     if (ex * ex + ey * ey + ez * ez > r2) continue;
                     if (e->nx * nq.x + e->ny * nq.y + e->nz * nq.z <= cos_thr) continue;
-                    if (*len == *cap) {
-                        long nc = *cap ? *cap * 2 : 1024;
-                        int *no = realloc(*out, (size_t)nc * sizeof *no);
-                        if (!no) return -1;
-                        *out = no;
-                        *cap = nc;
-                    }
+                    if (!grow_array_long((void **)out, cap, *len + 1, sizeof **out)) return -1;
                     (*out)[(*len)++] = e->idx;
                 }
             }

@@ -272,13 +272,7 @@ typedef struct {
 
 static int push_photon(chunk_out *o, const gi_caus_photon *q)
 {
-    if (o->n == o->cap) {
-        long nc = o->cap ? o->cap * 2 : 256;
-        gi_caus_photon *np = realloc(o->p, sizeof *np * (size_t)nc);
-        if (!np) return 0;
-        o->p = np;
-        o->cap = nc;
-    }
+    if (!grow_array_long((void **)&o->p, &o->cap, o->n + 1, sizeof *o->p)) return 0;
     o->p[o->n++] = *q;
     return 1;
 }

@@ -1,5 +1,6 @@
 /* gi_radiance.c - estimation lists for the radiance particles. */
 #include "gi_radiance.h"
+#include "grow.h"
 #include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -137,12 +138,7 @@ static void job(void *ctx, int chunk, int thread)
             int near = gi_grid_nearest(J->fine, q, v3_neg(nq), v3_madd(q, nq, 4.0 * J->r), 4.0 * J->r);
             if (near >= 0 && !(gi_same_surface(J->g, J->ps, near, obj, side) && visible(J, q, nq, near, obj))) near = -1;
             if (near >= 0) {
-                if (len == cap) {
-                    long nc = cap ? cap * 2 : 1024;
-                    int *nb = realloc(buf, (size_t)nc * sizeof *nb);
-                    if (!nb) m = -1;
-                    else { buf = nb; cap = nc; }
-                }
+                if (!grow_array_long((void **)&buf, &cap, len + 1, sizeof *buf)) m = -1;
                 if (m == 0) {
                     buf[len++] = near;
                     m = 1;

@@ -24,6 +24,7 @@
  * (scaled down if their sum exceeds 1), power times k_k / p_k (and
  * (eta_i/eta_t)^2 through refraction, see shade_material.c). */
 #include "pm_photon.h"
+#include "grow.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -95,13 +96,7 @@ static inline double cmax(rgb c) { return fmax(fabs(c.r), fmax(fabs(c.g), fabs(c
 
 static int push(pm_photon **arr, long *n, long *cap, vec3 p, rgb pw, vec3 nrm, uint32_t surf)
 {
-    if (*n == *cap) {
-        long nc = *cap ? *cap * 2 : 256;
-        pm_photon *na = realloc(*arr, sizeof(pm_photon) * (size_t)nc);
-        if (!na) return 0;
-        *arr = na;
-        *cap = nc;
-    }
+    if (!grow_array_long((void **)arr, cap, *n + 1, sizeof **arr)) return 0;
     pm_photon_set(&(*arr)[(*n)++], p, pw, nrm, surf);
     return 1;
 }
