@@ -3,6 +3,7 @@
  * occluded, the no_shadow filters); see accel.c for the layout of the
  * Embree scene and the epsilon rule. */
 #include "accel_internal.h"
+#include "scene_leaves.h"
 #include "grow.h"
 
 /* ------------------------------------------------------------ bounded_by */
@@ -58,7 +59,7 @@ static int add_bound_objects(accel *a, diag *d, const scene_object *host, int bo
     for (int i = 0; list && i < list->u.csg.nkids; i++) {
         const scene_object *k = list->u.csg.kids[i];
         if (!k) continue;
-        if (geom_csg_is_op(k->kind) || k->clip) {
+        if (scene_object_is_csg(k) || k->clip) {
             diag_warn_once(d, k->loc, "a CSG bounding object is not evaluated: the bound is ignored");
             continue;
         }

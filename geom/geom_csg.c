@@ -10,6 +10,7 @@
  * The root's S bounds the primitive; an intersection of six planes gets a
  * tight box this way. */
 #include "geom_csg.h"
+#include "scene_leaves.h"
 #include "grow.h"
 #include "geom_implicit.h"
 #include <assert.h>
@@ -535,16 +536,11 @@ int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, doubl
 
 /* ------------------------------------------------------------ building */
 
-int geom_csg_is_op(shape_kind k)
-{
-    return k == SHAPE_UNION || k == SHAPE_MERGE || k == SHAPE_INTERSECTION || k == SHAPE_DIFFERENCE;
-}
-
 int geom_csg_has_mesh(const scene_object *o, int depth)
 {
     if (!o || depth > GEOM_CSG_MAX_DEPTH) return 0;
     if (o->kind == SHAPE_MESH) return 1;
-    if (geom_csg_is_op(o->kind))
+    if (scene_object_is_csg(o))
         for (int i = 0; i < o->u.csg.nkids; i++)
             if (geom_csg_has_mesh(o->u.csg.kids[i], depth + 1)) return 1;
     return 0;
@@ -553,7 +549,7 @@ int geom_csg_has_mesh(const scene_object *o, int depth)
 long geom_csg_leaf_count(const scene_object *o, int depth)
 {
     if (!o || depth > GEOM_CSG_MAX_DEPTH) return 0;
-    if (!geom_csg_is_op(o->kind)) return 1;
+    if (!scene_object_is_csg(o)) return 1;
     long n = 0;
     for (int i = 0; i < o->u.csg.nkids; i++) n += geom_csg_leaf_count(o->u.csg.kids[i], depth + 1);
     return n;
@@ -571,7 +567,7 @@ static pt_status build(geom_csg *c, const scene_object *o, const scene_texture *
     unsigned flags = o->flags | (pflags & b->inherit);
     int inverse = (o->flags & OBJ_INVERSE) != 0;
     geom_csg_op parent_op = parent >= 0 ? c->nodes[parent].op : GEOM_CSG_UNION;
-    if ((o->clip && !clip_done) || geom_csg_is_op(o->kind)) {
+    if ((o->clip && !clip_done) || scene_object_is_csg(o)) {
         if (depth >= GEOM_CSG_MAX_DEPTH) {
             if (b->d) diag_report(b->d, DIAG_ERROR, o->loc, NULL, "CSG nesting deeper than %d levels", GEOM_CSG_MAX_DEPTH);
             return PT_ERR_LIMIT;
@@ -585,7 +581,7 @@ static pt_status build(geom_csg *c, const scene_object *o, const scene_texture *
         xform host = post ? xform_then(o->transform, *post) : o->transform;
         return build(c, o->clip, tex, flags, node, depth + 1, b, &host, 1, 0);
     }
-    if (geom_csg_is_op(o->kind)) {
+    if (scene_object_is_csg(o)) {
         geom_csg_op op = o->kind == SHAPE_UNION ? GEOM_CSG_UNION
                        : o->kind == SHAPE_MERGE ? GEOM_CSG_MERGE
                        : o->kind == SHAPE_INTERSECTION ? GEOM_CSG_INTERSECTION : GEOM_CSG_DIFFERENCE;

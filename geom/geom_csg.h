@@ -30,8 +30,6 @@
  * inside tests would cost more than the internal surfaces they remove. */
 #define GEOM_CSG_MAX_MERGE 64
 
-/* union, merge, intersection or difference */
-int geom_csg_is_op(shape_kind k);
 /* o, or a member of it at any level, is a mesh (depth: o's nesting level;
  * nothing deeper than GEOM_CSG_MAX_DEPTH counts). */
 int geom_csg_has_mesh(const scene_object *o, int depth);
