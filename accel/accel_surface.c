@@ -5,6 +5,7 @@
  * constant; for curved parts its maximum over all n is |det A| sigma_max(A^-1),
  * the bound used for rejection. */
 #include "accel_surface.h"
+#include "hash.h"
 #include "grow.h"
 #include <assert.h>
 #include "geom_hfield.h"
@@ -531,10 +532,7 @@ static void finish_crofton(accel_surf *as)
 
 static uint64_t hash_key(const scene_object *o, unsigned prim)
 {
-    uint64_t z = (uint64_t)(uintptr_t)o ^ ((uint64_t)prim * 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
+    return pt_mix64((uint64_t)(uintptr_t)o ^ ((uint64_t)prim * 0x9e3779b97f4a7c15ULL));
 }
 
 static unsigned key_prim(const scene_object *o, unsigned prim)

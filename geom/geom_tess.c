@@ -21,6 +21,7 @@
  * probability 1 / kmax (accepting the line with probability k / kmax) gives
  * a point whose density is uniform by area. */
 #include "geom_tess.h"
+#include "hash.h"
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -67,13 +68,6 @@ static size_t lattice_index(const tess *t, int i, int j, int k)
     return ((size_t)k * (size_t)(t->ny + 1) + (size_t)j) * (size_t)(t->nx + 1) + (size_t)i;
 }
 
-static uint64_t mix(uint64_t z)
-{
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-
 static int cache_grow(tess *t)
 {
     size_t nc = t->cap ? 2 * t->cap : 4096;
@@ -87,7 +81,7 @@ static int cache_grow(tess *t)
     for (size_t i = 0; i < nc; i++) keys[i] = UINT64_MAX;
     for (size_t i = 0; i < t->cap; i++) {
         if (t->keys[i] == UINT64_MAX) continue;
-        size_t h = (size_t)mix(t->keys[i]) & (nc - 1);
+        size_t h = (size_t)pt_mix64(t->keys[i]) & (nc - 1);
         while (keys[h] != UINT64_MAX) h = (h + 1) & (nc - 1);
         keys[h] = t->keys[i];
         pts[h] = t->pts[i];
@@ -143,7 +137,7 @@ static int edge_crossing(tess *t, int i, int j, int k, int dir, vec3 *p, vec3 *n
 {
     uint64_t key = (uint64_t)lattice_index(t, i, j, k) * 8u + (uint64_t)dir;
     if (2 * (t->used + 1) > t->cap && !cache_grow(t)) return 0;
-    size_t h = (size_t)mix(key) & (t->cap - 1);
+    size_t h = (size_t)pt_mix64(key) & (t->cap - 1);
     while (t->keys[h] != UINT64_MAX) {
         if (t->keys[h] == key) {
             *p = t->pts[h];
@@ -385,7 +379,7 @@ int geom_tess_sample(const geom_tess_sampler *cs, double u1, double u2, rng *r, 
     rng local;
     if (!r) {
         uint64_t a = (uint64_t)(u1 * 9007199254740992.0), b = (uint64_t)(u2 * 9007199254740992.0);
-        rng_seed(&local, mix(a ^ mix(b)), 17);
+        rng_seed(&local, pt_mix64(a ^ pt_mix64(b)), 17);
         r = &local;
     }
     geom_shape_hit h[TESS_MAX_HITS];

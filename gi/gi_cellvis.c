@@ -1,5 +1,6 @@
 /* gi_cellvis.c - lock-free cell verdict cache (see gi_cellvis.h). */
 #include "gi_cellvis.h"
+#include "hash.h"
 #include <stdatomic.h>
 #include <stdlib.h>
 
@@ -55,20 +56,10 @@ uint64_t gi_cellvis_key(const gi_cellvis *c, const long rp[3])
     return (uint64_t)a << (2 * ob) | (uint64_t)(b - a) << ob | (uint64_t)(d - a);
 }
 
-/* splitmix64's finaliser: spreads neighbouring keys over the table */
-static uint64_t mix(uint64_t x)
-{
-    x ^= x >> 30;
-    x *= 0xbf58476d1ce4e5b9ULL;
-    x ^= x >> 27;
-    x *= 0x94d049bb133111ebULL;
-    return x ^ (x >> 31);
-}
-
 int gi_cellvis_get(const gi_cellvis *c, uint64_t key)
 {
     if (!c || !key) return GI_CELL_UNKNOWN;
-    uint64_t h = mix(key);
+    uint64_t h = pt_mix64(key);
     for (int k = 0; k < CELLVIS_PROBES; k++) {
         uint64_t v = atomic_load_explicit(&c->slot[(h + (uint64_t)k) & c->mask], memory_order_relaxed);
         if (v == 0) return GI_CELL_UNKNOWN;
@@ -79,14 +70,14 @@ int gi_cellvis_get(const gi_cellvis *c, uint64_t key)
 
 void gi_cellvis_prefetch(const gi_cellvis *c, uint64_t key)
 {
-    if (c && key) __builtin_prefetch((const void *)&c->slot[mix(key) & c->mask]);
+    if (c && key) __builtin_prefetch((const void *)&c->slot[pt_mix64(key) & c->mask]);
 }
 
 void gi_cellvis_put(gi_cellvis *c, uint64_t key, int verdict)
 {
     if (!c || !key || (verdict != GI_CELL_CLEAR && verdict != GI_CELL_BLOCKED)) return;
     if (atomic_load_explicit(&c->count, memory_order_relaxed) >= c->limit) return;
-    uint64_t h = mix(key), want = key << 2 | (uint64_t)verdict;
+    uint64_t h = pt_mix64(key), want = key << 2 | (uint64_t)verdict;
     for (int k = 0; k < CELLVIS_PROBES; k++) {
         _Atomic uint64_t *s = &c->slot[(h + (uint64_t)k) & c->mask];
         uint64_t v = atomic_load_explicit(s, memory_order_relaxed);

@@ -1,5 +1,6 @@
 /* pm.c - the image loop shared by the reference renderers (see pm.h). */
 #include "pm.h"
+#include "hash.h"
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -23,13 +24,7 @@ void pm_common_defaults(pm_common *c)
     c->image_interval = 10.0;
 }
 
-uint64_t pm_mix64(uint64_t z)
-{
-    z += 0x9e3779b97f4a7c15ULL;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
+uint64_t pm_mix64(uint64_t z) { return pt_mix64(z + 0x9e3779b97f4a7c15ULL); }
 
 int pm_gathers(const radrules *rr) { return rr->recursion_limit > 0 ? rr->recursion_limit : 1 << 20; }
 

@@ -6,6 +6,7 @@
  * the top levels run one after another, then the 2^L subtrees in parallel on
  * core/pool, so the result does not depend on the thread count. */
 #include "pm_kdtree.h"
+#include "hash.h"
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -27,10 +28,7 @@ uint32_t pm_surface_key(const void *object, int outside)
 {
     /* splitmix64 finaliser of the address: distinct objects, distinct keys
      * (a collision would only merge two objects' photons, as before keys) */
-    uint64_t z = (uint64_t)(uintptr_t)object + 0x9e3779b97f4a7c15ULL;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    z ^= z >> 31;
+    uint64_t z = pt_mix64((uint64_t)(uintptr_t)object + 0x9e3779b97f4a7c15ULL);
     uint32_t k = (uint32_t)(z ^ (z >> 32)) & ~1u;
     if (k == 0) k = 2;
     return k | (outside ? 1u : 0u);

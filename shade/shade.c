@@ -26,6 +26,7 @@
  *    averaged with the first sample.
  */
 #include "shade.h"
+#include "hash.h"
 #include "camera.h"
 #include <assert.h>
 #include <math.h>
@@ -459,16 +460,9 @@ rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 o
 
 /* --------------------------------------------------------------- the image */
 
-static uint64_t mix64(uint64_t z)
-{
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-
 static void pixel_rng(rng *r, uint64_t seed, int x, int y, int pass)
 {
-    rng_seed(r, mix64(seed * 0x9e3779b97f4a7c15ULL + (uint64_t)pass), ((uint64_t)y << 32) | (uint64_t)x);
+    rng_seed(r, pt_mix64(seed * 0x9e3779b97f4a7c15ULL + (uint64_t)pass), ((uint64_t)y << 32) | (uint64_t)x);
 }
 
 static rgb primary_ray(render_ctx *c, int thread, double px, double py, vec3 org, vec3 dir, rng *r);

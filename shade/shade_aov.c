@@ -3,6 +3,7 @@
  * from shade.c's own direct-light loop (shade_direct), so they are exactly
  * the Whitted terms, area-light grids, spotlights and fade included. */
 #include "shade_aov.h"
+#include "hash.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -98,13 +99,6 @@ static void put3(shade_aov *o, int k, size_t i, double x, double y, double z)
 
 static void put_rgb(shade_aov *o, int k, size_t i, rgb c) { put3(o, k, i, c.r, c.g, c.b); }
 
-static uint64_t mix64(uint64_t z)
-{
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-
 static void aov_pixel(aov_ctx *c, int x, int y, int thread)
 {
     shade_aov *o = c->out;
@@ -116,7 +110,7 @@ static void aov_pixel(aov_ctx *c, int x, int y, int thread)
     if (accel_intersect_past(c->a, NULL, org, dir, c->eps, OBJ_NO_IMAGE, &h, NULL) <= 0) return;
 
     rng r;
-    rng_seed(&r, mix64(c->s->seed * 0x9e3779b97f4a7c15ULL + 0x616f76ULL), ((uint64_t)y << 32) | (uint64_t)x);
+    rng_seed(&r, pt_mix64(c->s->seed * 0x9e3779b97f4a7c15ULL + 0x616f76ULL), ((uint64_t)y << 32) | (uint64_t)x);
     vec3 n = h.ns, ng = h.ng;
     if (v3_dot(dir, n) > 0.0) n = v3_neg(n);
     if (v3_dot(dir, ng) > 0.0) ng = v3_neg(ng);
