@@ -126,11 +126,12 @@ static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3]
     (void)d;
     float irr[3] = {0.0f, 0.0f, 0.0f};
     if (J->far_bounce > 0.0f) gi_sky_irradiance(J->sky, n, irr);
-    /* and the direct light it reflects (the particles' edir at the hit,
-     * gi_k_emit's sum, a shadow ray each; area lights from their centre):
-     * sunlit ground beyond the clip box is bright, not black. This is no
-     * further bounce: POV-Ray's radiosity rays see the direct light of
-     * what they hit at every recursion_limit. */
+    /* and, for the final gather's links (J->lights), the direct light it
+     * reflects (the particles' edir at the hit, gi_k_emit's sum, a shadow
+     * ray each; area lights from their centre): sunlit ground beyond the
+     * clip box is bright, not black. This is no further bounce: POV-Ray's
+     * radiosity rays see the direct light of what they hit at every
+     * recursion_limit. */
     float dir[3] = {0.0f, 0.0f, 0.0f};
     if (J->nlights > 0 && (rho[0] > 0.0f || rho[1] > 0.0f || rho[2] > 0.0f)) {
         double eps = accel_epsilon(J->a, p, n);
@@ -537,7 +538,10 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
     J.tcell = calloc((size_t)threads, sizeof *J.tcell);
     pt_status rc = PT_OK;
     if (!J.buf || !J.hp || !J.cell || !J.tcell) rc = PT_ERR_NOMEM;
-    if (J.esky && sc->nlights > 0) {
+    /* the far field's direct light: only for the final gather's points,
+     * whose links are traced again for every view; the particles' links
+     * are geometry and outlive a change of the lights (relighting) */
+    if (J.esky && J.first > 0 && sc->nlights > 0) {
         J.lights = malloc((size_t)sc->nlights * sizeof *J.lights);
         if (!J.lights) rc = PT_ERR_NOMEM;
         for (int l = 0; J.lights && l < sc->nlights; l++) gi_light_pack(&sc->lights[l], &J.lights[l]);

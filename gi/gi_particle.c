@@ -675,8 +675,19 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     progress_stage(set->progress, "gi geometry: lists", 0);
     tg = timer_now();
     cg = timer_cpu_now();
-    st = gi_radiance_lists(&gp->lists, gp->surf, &gp->ps, gp->a, S->radius, set->normal_cos, gp->threads, set->cancel,
-                           set->progress, d);
+    /* with the final gather at the kept hits, the radiance particles would
+     * answer only the hits it does not (reflections, a few antialiasing
+     * rays): those take the estimate at the hit (gi_particle_hook.c,
+     * onthefly), and no list is built */
+    gp->no_rp = set->view_gather_side > 0 && set->keep_hits;
+    if (gp->no_rp) {
+        gp->lists.nrp = 0;
+        gp->lists.off = gi_particle_calloc(1, sizeof(int), &st);
+        gp->lists.idx = gi_particle_calloc(1, sizeof(int), &st);
+    } else {
+        st = gi_radiance_lists(&gp->lists, gp->surf, &gp->ps, gp->a, S->radius, set->normal_cos, gp->threads,
+                               set->cancel, set->progress, d);
+    }
     if (st != PT_OK) goto fail;
     S->radiance_particles = gp->lists.nrp;
     S->list_entries = gp->lists.off[gp->lists.nrp];

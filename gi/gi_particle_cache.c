@@ -41,6 +41,7 @@ typedef struct {
     int32_t scatter_side, gather_side, bounces, scatter;
     double tess, tess_factor, radius, radius_factor, normal_cos, brightness;
     uint64_t seed;
+    int32_t no_rp, pad; /* made without radiance particles (the final gather's runs) */
 } cache_settings;
 
 typedef struct {
@@ -69,6 +70,7 @@ static cache_settings settings_of(const gi_particle_settings *s)
     c.normal_cos = s->normal_cos;
     c.brightness = s->brightness;
     c.seed = s->seed;
+    c.no_rp = s->view_gather_side > 0 && s->keep_hits;
     return c;
 }
 
@@ -308,6 +310,7 @@ gi_particle *gi_particle_load(const scene *sc, const accel *a, const gi_particle
             gp->lists.empty = k.empty;
             gp->lists.dead = k.dead;
             gp->lists.vis_rays = k.vis_rays;
+            gp->no_rp = gp->set.view_gather_side > 0 && gp->set.keep_hits; /* as the key's settings say */
             S->candidates = k.candidates;
             S->probed_out = k.probed_out;
             S->pruned = k.pruned;

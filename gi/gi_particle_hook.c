@@ -164,6 +164,7 @@ static int side_value(gi_particle *gp, const accel_hit *hit, vec3 n, thread_coun
     long rp[3];
     double w[3];
     out->r = out->g = out->b = 0.0;
+    if (gp->no_rp) return gi_surface_has_particles(gp->surf, hit) && onthefly(gp, hit, n, tc, out);
     const view_rec *kr = kept_rec(gp, hit);
     if (kr && !(kr->located && kr->side == (v3_dot(n, hit->ng) >= 0.0))) kr = NULL;
     if (kr) {

@@ -48,6 +48,7 @@ struct gi_particle {
     gi_walk_entry *went;    /* and its entries */
     int nwalk;
     gi_lists lists;
+    int no_rp;      /* no radiance particles (the final gather answers the kept hits): lists empty */
     gi_grid *rgrid; /* particles by list radius: estimates on surfaces without radiance particles */
     gi_dev *dev;
     /* lighting */

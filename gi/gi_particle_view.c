@@ -65,7 +65,7 @@ typedef struct {
  * rp (their weights in w), or 0 when the hit has none. */
 static int mark_hit(gi_particle *gp, const accel_hit *h, vec3 n, long rp[3], double w[3])
 {
-    if (!gi_surface_locate(gp->surf, h, n, rp, w)) return 0;
+    if (gp->no_rp || !gi_surface_locate(gp->surf, h, n, rp, w)) return 0;
     for (int k = 0; k < 3; k++) atomic_store_explicit(&gp->mark[rp[k]], 1, memory_order_relaxed);
     return 1;
 }
