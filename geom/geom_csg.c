@@ -502,16 +502,23 @@ int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, doubl
     for (int s = 0; s < c->nshapes; s++) {
         int node = c->shape_node[s];
         if (c->nodes[node].nosurf) continue;
-        double from = tmin;
+        double from = tmin, upto = INFINITY;
         if (c->keep_box) {
-            /* the ray must cross where this member's crossings can be kept */
+            /* the ray must cross where this member's crossings can be kept,
+             * and only that stretch is searched (a clipped quartic's root
+             * finder then works on the clip box's chord, not the whole
+             * ray); an isosurface's crossings count from the ray's start
+             * (max_trace), so its search starts there */
             const vec3 *kb = c->keep_box + 2 * s;
             double t0, t1;
             if (!(kb[0].x <= kb[1].x) || !v3_slab(org, dir, kb[0], kb[1], &t0, &t1) || t1 < tmin || t0 > best) continue;
+            double pad = 1e-9 * (fabs(t0) + fabs(t1)) + 1e-300;
+            upto = t1 + pad;
+            if (c->shapes[s].kind != SHAPE_ISOSURFACE && t0 - pad > tmin) from = t0 - pad;
         }
         for (int guard = 0; guard < 1000; guard++) {
             geom_shape_hit tmp[CSG_CHUNK];
-            int k = geom_shape_ray_hits(&c->shapes[s], org, dir, from, best, tmp, CSG_CHUNK);
+            int k = geom_shape_ray_hits(&c->shapes[s], org, dir, from, fmin(best, upto), tmp, CSG_CHUNK);
             int kept_one = 0;
             for (int j = 0; j < k; j++) {
                 if (geom_csg_kept(c, node, v3_madd(org, dir, tmp[j].t))) {
