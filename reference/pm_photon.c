@@ -362,13 +362,6 @@ static void chunk_job(void *ctx, int ci, int thread)
     for (long i = i0; i < i1 && !out->oom && !(c->s->cancel && *c->s->cancel); i++) walk(c, i, NULL, out, NULL, NULL, &out->rays);
 }
 
-static double fade_at(const scene_light *l, double d)
-{
-    if (l->fade_power <= 0.0) return 1.0;
-    if (fabs(l->fade_distance) >= 1e-10) return 2.0 / (1.0 + pow(d / l->fade_distance, l->fade_power));
-    return pow(d, -l->fade_power);
-}
-
 /* The sources and their shares of s->photons (c->src, c->nsrc, c->total;
  * c->src NULL when there is nothing to trace). bounds (NULL: the accel's):
  * the box the parallel lights' and the background's photons are aimed
@@ -418,7 +411,7 @@ static pt_status setup(trace_ctx *cp, const scene *sc, const accel *a, const pm_
                 double cr = cos(l->radius * M_PI / 180.0), cf = cos(l->falloff * M_PI / 180.0);
                 q->cos_max = cr > 0.0 ? fmax(0.0, fmin(cf, cr)) : 0.0;
             }
-            q->power = cm * M_PI * 2.0 * M_PI * (1.0 - q->cos_max) * D * D * fade_at(l, D);
+            q->power = cm * M_PI * 2.0 * M_PI * (1.0 - q->cos_max) * D * D * shade_light_fade(l, D);
         }
         if (q->power > 0.0 && isfinite(q->power)) ns++;
     }

@@ -45,13 +45,15 @@ double shade_light_attenuation(const scene_light *l, vec3 p, vec3 dir, double de
         att = l->tightness != 0.0 ? pow(d, l->tightness) : 1.0;
         if (l->radius > 0.0 && len > l->radius) att *= light_cubic_step(0.0, 1.0 - l->radius / l->falloff, d);
     }
-    if (att > 0.0 && l->fade_power > 0.0) {
-        if (fabs(l->fade_distance) >= 1e-10)
-            att *= 2.0 / (1.0 + pow(depth / l->fade_distance, l->fade_power));
-        else
-            att *= pow(depth, -l->fade_power);
-    }
+    if (att > 0.0) att *= shade_light_fade(l, depth);
     return att;
+}
+
+double shade_light_fade(const scene_light *l, double depth)
+{
+    if (l->fade_power <= 0.0) return 1.0;
+    if (fabs(l->fade_distance) >= 1e-10) return 2.0 / (1.0 + pow(depth / l->fade_distance, l->fade_power));
+    return pow(depth, -l->fade_power);
 }
 
 void shade_light_ray(const scene_light *l, vec3 centre, vec3 p, vec3 *dir, double *depth)

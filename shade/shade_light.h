@@ -29,6 +29,10 @@
  * and falloff are distances from the axis), fade 2/(1+(d/fade_distance)^fade_power)
  * (or d^-fade_power with fade_distance 0). */
 double shade_light_attenuation(const scene_light *l, vec3 p, vec3 dir, double depth);
+/* The light's fade at distance depth: 2 / (1 + (depth / fade_distance)^
+ * fade_power), depth^-fade_power with fade_distance 0, 1 without
+ * fade_power (POV-Ray 3.7's Attenuate_Light). */
+double shade_light_fade(const scene_light *l, double depth);
 
 /* Unit direction from p towards the light point `centre` (the light's
  * position or a point of its area) and the distance to it, with POV-Ray's
