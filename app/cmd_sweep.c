@@ -40,7 +40,6 @@
  * (outputs are still written for the others); 2 usage; 3 I/O; 130 (143)
  * after Ctrl-C (SIGTERM): the outputs then cover the renders done so far. */
 #include "cmd_sweep.h"
-#include "grow.h"
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -49,6 +48,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include "cli.h"
+#include "ini.h"
 #include "diag.h"
 #include "framebuffer.h"
 #include "img_io.h"
@@ -92,35 +92,14 @@ typedef struct {
     img_compare_result r;
 } sweep_run;
 
-typedef struct {
-    char **v;
-    int n, cap;
-} argvec;
-
-static void av_add(argvec *a, const char *s)
-{
-    /* room for s and the NULL after it */
-    if (!grow_array_int((void **)&a->v, &a->cap, a->n + 2, sizeof *a->v)) return;
-    a->v[a->n] = strdup(s);
-    if (a->v[a->n]) a->n++;
-    a->v[a->n] = NULL;
-}
-
-static void av_addf(argvec *a, const char *fmt, ...)
+static void av_addf(ini_args *a, const char *fmt, ...)
 {
     char buf[4096];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(buf, sizeof buf, fmt, ap);
     va_end(ap);
-    av_add(a, buf);
-}
-
-static void av_free(argvec *a)
-{
-    for (int i = 0; i < a->n; i++) free(a->v[i]);
-    free(a->v);
-    memset(a, 0, sizeof *a);
+    ini_args_push(a, buf);
 }
 
 /* Ctrl-C / SIGTERM reach the running render too (same process group); the
@@ -198,24 +177,24 @@ static int parse_vary(const char *arg, sweep_vary *vy, char *err, size_t errn)
 }
 
 /* Appends the render option(s) for KEY=value. */
-static void add_setting(argvec *a, const char *key, const char *value)
+static void add_setting(ini_args *a, const char *key, const char *value)
 {
     if (strcmp(key, "size") == 0) {
-        av_add(a, "--size");
-        av_add(a, value);
+        ini_args_push(a, "--size");
+        ini_args_push(a, value);
     } else if (strcmp(key, "aa") == 0) {
         if (strcmp(value, "off") == 0 || strcmp(value, "none") == 0)
-            av_add(a, "-A");
+            ini_args_push(a, "-A");
         else
             av_addf(a, "+A%s", value);
     } else if (key[0] >= 'A' && key[0] <= 'Z' && key[1] == 0) {
         av_addf(a, "+%s%s", key, value);
     } else if (strncmp(key, "D:", 2) == 0 && key[2]) {
-        av_add(a, "-D");
+        ini_args_push(a, "-D");
         av_addf(a, "%s=%s", key + 2, value);
     } else {
         av_addf(a, "--%s", key);
-        av_add(a, value);
+        ini_args_push(a, value);
     }
 }
 
@@ -780,43 +759,47 @@ int cmd_sweep(int argc, char **argv)
         snprintf(log, sizeof log, "%s/%s.log", out_dir, r->base);
         remove(log);
         remove(js);
-        argvec a = {0};
-        av_add(&a, self);
-        av_add(&a, "render");
-        av_add(&a, scene);
+        ini_args *a = ini_args_new();
+        if (!a) {
+            rc = exit_for(PT_ERR_NOMEM);
+            goto done;
+        }
+        ini_args_push(a, self);
+        ini_args_push(a, "render");
+        ini_args_push(a, scene);
         if (strcmp(r->mode, "default") != 0) {
-            av_add(&a, "--gi");
-            av_add(&a, r->mode);
+            ini_args_push(a, "--gi");
+            ini_args_push(a, r->mode);
         }
         int size_varied = 0;
         for (int v = 0; v < nvary; v++)
             if (strcmp(vary[v].key, "size") == 0 && (!vary[v].mode || strcmp(vary[v].mode, r->mode) == 0)) size_varied = 1;
         if (!size_varied) {
-            av_add(&a, "--size");
-            if (size) av_add(&a, size);
-            else av_addf(&a, "%dx%d", ref->width, ref->height);
+            ini_args_push(a, "--size");
+            if (size) ini_args_push(a, size);
+            else av_addf(a, "%dx%d", ref->width, ref->height);
         }
-        av_add(&a, "-o");
-        av_add(&a, exr);
-        av_add(&a, "-o");
-        av_add(&a, png);
-        av_add(&a, "--float");
-        av_add(&a, "--stats");
-        av_add(&a, js);
-        av_add(&a, "--quiet");
-        for (int k = 0; k < npass; k++) av_add(&a, pass[k]);
+        ini_args_push(a, "-o");
+        ini_args_push(a, exr);
+        ini_args_push(a, "-o");
+        ini_args_push(a, png);
+        ini_args_push(a, "--float");
+        ini_args_push(a, "--stats");
+        ini_args_push(a, js);
+        ini_args_push(a, "--quiet");
+        for (int k = 0; k < npass; k++) ini_args_push(a, pass[k]);
         /* the settings of this run, in the order of the --vary options */
         for (int v = 0; v < nvary; v++)
-            if (!vary[v].mode || strcmp(vary[v].mode, r->mode) == 0) add_setting(&a, vary[v].key, vary[v].values[r->idx[v]]);
+            if (!vary[v].mode || strcmp(vary[v].mode, r->mode) == 0) add_setting(a, vary[v].key, vary[v].values[r->idx[v]]);
         FILE *lf = fopen(log, "wb");
         if (lf) {
             fputs("#", lf);
-            for (int k = 0; k < a.n; k++) fprintf(lf, " %s", a.v[k]);
+            for (int k = 0; k < ini_argc(a); k++) fprintf(lf, " %s", ini_argv(a)[k]);
             fputs("\n", lf);
             fclose(lf);
         }
-        r->exit_code = subproc_run((const char *const *)a.v, NULL, log, &r->wall_s, d);
-        av_free(&a);
+        r->exit_code = subproc_run((const char *const *)ini_argv(a), NULL, log, &r->wall_s, d);
+        ini_free(a);
         if (r->exit_code == 0) {
             read_times(js, r);
             st = compare_run(out_dir, r, ref, hdr, d);

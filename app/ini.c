@@ -106,8 +106,11 @@ static const ini_key *find_key(const char *k, size_t n)
     return NULL;
 }
 
-static int push(ini_args *a, const char *s)
+ini_args *ini_args_new(void) { return calloc(1, sizeof(ini_args)); }
+
+int ini_args_push(ini_args *a, const char *s)
 {
+    if (!a) return 0;
     /* room for s and the NULL after it */
     if (!grow_array_int((void **)&a->v, &a->cap, a->n + 2, sizeof *a->v)) return 0;
     char *c = strdup(s);
@@ -253,7 +256,7 @@ static pt_status option(reader *r, const char *k, size_t kn, int kcol, const cha
     default:
         return PT_OK;
     }
-    return push(r->a, sw) ? PT_OK : PT_ERR_NOMEM;
+    return ini_args_push(r->a, sw) ? PT_OK : PT_ERR_NOMEM;
 }
 
 /* A line holding a name only: a scene, a library path or an INI file. */
@@ -264,11 +267,11 @@ static pt_status plain_name(reader *r, const char *s, int col)
     const char *dot = strrchr(s, '.');
     if (dot && strcasecmp(dot, ".pov") == 0) {
         snprintf(sw, sizeof sw, "+I%s", beside(r, s, buf, sizeof buf));
-        return push(r->a, sw) ? PT_OK : PT_ERR_NOMEM;
+        return ini_args_push(r->a, sw) ? PT_OK : PT_ERR_NOMEM;
     }
     if (n && s[n - 1] == '/') {
         snprintf(sw, sizeof sw, "+L%s", s);
-        return push(r->a, sw) ? PT_OK : PT_ERR_NOMEM;
+        return ini_args_push(r->a, sw) ? PT_OK : PT_ERR_NOMEM;
     }
     if (r->depth + 1 >= INI_MAX_DEPTH) {
         err_at(r, col, "INI files include each other more than 16 deep at '%s'", s);
@@ -332,7 +335,7 @@ static pt_status read_line(reader *r, const char *line, const char *section, int
             while (*p && *p != ' ' && *p != '\t' && *p != ';' && *p != '#') p++;
             snprintf(val, sizeof val, "%.*s", (int)(p - s), s);
             if (val[0] == '+' || val[0] == '-') {
-                if (!push(r->a, val)) return PT_ERR_NOMEM;
+                if (!ini_args_push(r->a, val)) return PT_ERR_NOMEM;
             } else if (val[0]) {
                 err_at(r, (int)(s - line) + 1, "'%s' is not a switch (a switch starts with + or -)", val);
                 return PT_ERR_USAGE;
@@ -466,7 +469,7 @@ pt_status ini_expand(int argc, char **argv, ini_args **out, diag *d)
     *out = NULL;
     ini_args *a = calloc(1, sizeof *a);
     if (!a) return PT_ERR_NOMEM;
-    pt_status st = push(a, "") ? PT_OK : PT_ERR_NOMEM; /* keeps v non-NULL; dropped below */
+    pt_status st = ini_args_push(a, "") ? PT_OK : PT_ERR_NOMEM; /* keeps v non-NULL; dropped below */
     a->n = 0;
     free(a->v[0]);
     a->v[0] = NULL;
@@ -481,7 +484,7 @@ pt_status ini_expand(int argc, char **argv, ini_args **out, diag *d)
             reader r = {a, d, diag_intern(d, "<command line>"), "", 0, 0};
             st = read_text(&r, line, NULL);
             free(line);
-        } else if (!push(a, s)) {
+        } else if (!ini_args_push(a, s)) {
             st = PT_ERR_NOMEM;
         }
     }

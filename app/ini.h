@@ -22,6 +22,11 @@ pt_status ini_expand(int argc, char **argv, ini_args **out, diag *d);
 int ini_argc(const ini_args *a);
 /* The expanded arguments; they live as long as `a`. */
 char **ini_argv(const ini_args *a);
+/* An empty argument vector, for building a command line (ini_argv stays
+ * NULL-terminated); NULL when out of memory. */
+ini_args *ini_args_new(void);
+/* Appends a copy of s; 0 when out of memory (a NULL a included). */
+int ini_args_push(ini_args *a, const char *s);
 void ini_free(ini_args *a);
 
 #endif
