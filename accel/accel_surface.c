@@ -176,7 +176,7 @@ static double shape_area(shape_geo *g)
             /* midpoint rule in z (smooth: error ~ 1/nz^2, below 1e-5 of
              * the area here) x phi (periodic: spectral, exact to rounding
              * for this quadratic form's square root well before 64) */
-            int nz = 512, np = 64;
+            int nz = 1024, np = 64;
             double acc = 0.0;
             for (int i = 0; i < nz; i++)
                 for (int j = 0; j < np; j++) acc += jac(x, sphere_normal((i + 0.5) / nz, (j + 0.5) / np));

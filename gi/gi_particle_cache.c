@@ -192,6 +192,7 @@ static const char *settings_differ(const cache_settings *a, const cache_settings
     if (a->bounces != b->bounces) return "bounces";
     if (a->scatter != b->scatter) return "scattering mode";
     if (a->seed != b->seed) return "seed";
+    if (a->no_rp != b->no_rp) return "final gather (radiance particles)";
     if (memcmp(a, b, sizeof *a) != 0) return "tessellation, list radius, normal threshold or brightness";
     return NULL;
 }
@@ -331,7 +332,8 @@ gi_particle *gi_particle_load(const scene *sc, const accel *a, const gi_particle
             S->lists_widened = k.widened;
             S->lists_empty = k.empty;
             gi_surface_retess(gp->surf, S->tess);
-            if (gi_surface_nrp(gp->surf) != k.nrp) why = "radiance particles do not match this scene's surfaces";
+            /* (a cache made for the final gather has none: cs.no_rp, compared above) */
+            if (!cs.no_rp && gi_surface_nrp(gp->surf) != k.nrp) why = "radiance particles do not match this scene's surfaces";
         }
     }
     free(bytes);

@@ -199,8 +199,11 @@ static pt_status build_index(gi_particle *gp)
 }
 
 /* E/pi at a hit that is not kept, from the gather points around it on its
- * object and side that face its way: weights 1 - d/r. 0: none. */
-static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, rgb *out)
+ * object and side that face its way: weights 1 - d/r. relaxed: any
+ * object's points that face its way, within twice their radius (an
+ * antialiasing ray on a part too thin for a kept pixel of its own: the
+ * light of its neighbours, not the unoccluded sky). 0: none. */
+static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int relaxed, rgb *out)
 {
     if (!gp->vg_tab || !hit->obj) return 0;
     int side = v3_dot(n, hit->ng) >= 0.0;
@@ -209,24 +212,28 @@ static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, rgb
     for (int L = 0; L < VG_LEVELS; L++) {
         if (!(gp->vg_levels >> L & 1u)) continue;
         double c = gp->vg_c0 * (double)(1u << L);
-        /* the 2 cells per axis overlapping p +- c/2 */
+        /* the 2 cells per axis overlapping p +- c/2 (relaxed: the 3 around
+         * p's, which hold every point within c) */
         int64_t i0[3];
-        const double pc[3] = {hit->p.x / c - 0.5, hit->p.y / c - 0.5, hit->p.z / c - 0.5};
-        for (int a = 0; a < 3; a++) i0[a] = (int64_t)floor(pc[a]);
-        for (int corner = 0; corner < 8; corner++) {
-            uint64_t key = cell_hash(L, i0[0] + (corner & 1), i0[1] + (corner >> 1 & 1), i0[2] + (corner >> 2 & 1));
+        int span = relaxed ? 3 : 2, ncell = span * span * span;
+        const double sh = relaxed ? 0.0 : 0.5;
+        const double pc[3] = {hit->p.x / c - sh, hit->p.y / c - sh, hit->p.z / c - sh};
+        for (int a = 0; a < 3; a++) i0[a] = (int64_t)floor(pc[a]) - (relaxed ? 1 : 0);
+        for (int corner = 0; corner < ncell; corner++) {
+            uint64_t key = cell_hash(L, i0[0] + corner % span, i0[1] + corner / span % span, i0[2] + corner / (span * span));
             size_t slot = (size_t)key & gp->vg_tab_mask;
             while (gp->vg_tab[slot].key && gp->vg_tab[slot].key != key) slot = (slot + 1) & gp->vg_tab_mask;
             if (!gp->vg_tab[slot].key) continue;
             for (int e = gp->vg_tab[slot].start, end = e + gp->vg_tab[slot].count; e < end; e++) {
                 int id = gp->vg_ids[e];
                 const vg_point *pt = &gp->vg_pt[id];
-                if (pt->obj != hit->obj || pt->side != side) continue;
+                if (!relaxed && (pt->obj != hit->obj || pt->side != side)) continue;
+                double r = relaxed ? 2.0 * pt->r : pt->r;
                 vec3 dv = v3_sub(hit->p, pt->p);
                 double d = v3_len(dv);
-                if (!(d < pt->r) || fabs(v3_dot(dv, pt->n)) > 0.25 * pt->r) continue;
+                if (!(d < r) || (!relaxed && fabs(v3_dot(dv, pt->n)) > 0.25 * r)) continue;
                 if (v3_dot(pt->n, ng) < NORMAL_COS * lg) continue;
-                double w = 1.0 - d / pt->r;
+                double w = 1.0 - d / r;
                 const float *v = &gp->vg_val[4 * (size_t)id];
                 for (int q = 0; q < 3; q++) s[q] += w * v[q];
                 ws += w;
@@ -504,10 +511,10 @@ void gi_particle_view_regather(gi_particle *gp)
 int gi_particle_view_value(const gi_particle *gp, const accel_hit *hit, const view_rec *r, vec3 n, rgb *out)
 {
     if (gp->vg_n <= 0 || gp->vg_w != gp->vw || gp->vg_h != gp->vh) return 0;
-    if (!r) return nearby_value(gp, hit, n, out);
+    if (!r) return nearby_value(gp, hit, n, 0, out) || nearby_value(gp, hit, n, 1, out);
     if ((v3_dot(n, r->h.ng) >= 0.0) != r->side) return 0; /* the other side (diffuse_back) */
     const float *v = &gp->vg_pixval[4 * (size_t)(r - gp->vrec)];
-    if (!(v[3] > 0.0f)) return nearby_value(gp, hit, n, out);
+    if (!(v[3] > 0.0f)) return nearby_value(gp, hit, n, 0, out) || nearby_value(gp, hit, n, 1, out);
     out->r = v[0];
     out->g = v[1];
     out->b = v[2];
