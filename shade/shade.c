@@ -378,7 +378,7 @@ static rgb tex_cb_trace(void *ctx, int thread, vec3 org, vec3 dir, int level, do
     shade_media_inside in = *f->in;
     /* leaving an object the list does not hold (the camera inside a CSG
      * result, shade_texture.c's ior_setup) does not put the ray inside it */
-    int leaving_unlisted = v3_dot(f->dir, f->h->ng) > 0.0 && shade_media_inside_find(&in, f->h->obj) < 0;
+    int leaving_unlisted = in.n == 0 && v3_dot(f->dir, f->h->ng) > 0.0 && shade_media_inside_find(&in, f->h->obj) < 0;
     if (v3_dot(dir, f->h->ng) * v3_dot(f->dir, f->h->ng) > 0.0 && !leaving_unlisted) shade_media_inside_cross(&in, f->h->obj);
     return trace_ray(c, thread, org, dir, level, weight, skip, wavelength, r, &in);
 }

@@ -143,6 +143,32 @@ static int leaf_inside(const scene_object *o, vec3 p)
     return (o->flags & OBJ_INVERSE) ? !r : r;
 }
 
+/* Whether p is inside o's solid: CSG by its rule over the members (an
+ * inverse node turned around), leaves by their own test; clipped and
+ * unsupported objects never. */
+static int solid_inside(const scene_object *o, vec3 p, int depth)
+{
+    if (depth > 32 || o->clip || o->kind == SHAPE_UNSUPPORTED) return 0;
+    int r;
+    switch (o->kind) {
+    case SHAPE_UNION: case SHAPE_MERGE:
+        r = 0;
+        for (int k = 0; k < o->u.csg.nkids && !r; k++) r = solid_inside(o->u.csg.kids[k], p, depth + 1);
+        break;
+    case SHAPE_INTERSECTION:
+        r = o->u.csg.nkids > 0;
+        for (int k = 0; k < o->u.csg.nkids && r; k++) r = solid_inside(o->u.csg.kids[k], p, depth + 1);
+        break;
+    case SHAPE_DIFFERENCE:
+        r = o->u.csg.nkids > 0 && solid_inside(o->u.csg.kids[0], p, depth + 1);
+        for (int k = 1; k < o->u.csg.nkids && r; k++) r = !solid_inside(o->u.csg.kids[k], p, depth + 1);
+        break;
+    default:
+        return leaf_inside(o, p);
+    }
+    return (o->flags & OBJ_INVERSE) ? !r : r;
+}
+
 static void inside_at(const scene_object *o, vec3 p, shade_media_inside *in, int depth)
 {
     if (depth > 32) return;
@@ -150,9 +176,13 @@ static void inside_at(const scene_object *o, vec3 p, shade_media_inside *in, int
         for (int k = 0; k < o->u.csg.nkids; k++) inside_at(o->u.csg.kids[k], p, in, depth + 1);
         return;
     }
-    if (o->kind == SHAPE_INTERSECTION || o->kind == SHAPE_DIFFERENCE || o->kind == SHAPE_UNSUPPORTED) return;
+    if (o->kind == SHAPE_UNSUPPORTED) return;
     if (o->clip) return;
-    if (!leaf_inside(o, p)) return;
+    /* an intersection or difference holding p goes on the list as a whole
+     * (its members share its interior identity, scene_object.medium), as
+     * POV-Ray's InitRayContainerState tests the object and lists its
+     * interior */
+    if (!solid_inside(o, p, depth)) return;
     for (int i = 0; i < in->n; i++)
         if (key_of(in->obj[i]) == key_of(o)) return;
     if (in->n < SHADE_MEDIA_MAX_INSIDE) in->obj[in->n++] = o;

@@ -455,10 +455,13 @@ static void ior_setup(hit_info *hi, const shade_media_inside *in, const scene_ob
     int n = in->n, at = o ? shade_media_inside_find(in, o) : -1;
     const scene_interior *last = n > 0 ? in->obj[n - 1]->interior : NULL;
     hi->inside_interior = at >= 0;
-    if (at < 0 && !hi->entering) {
-        /* leaving an object the list does not hold: the camera is inside
-         * a CSG result, which shade_media_inside_at cannot test (POV-Ray's
-         * list would hold it); leave it for the innermost container */
+    if (at < 0 && !hi->entering && n == 0) {
+        /* leaving an object with nothing on the list: the ray started
+         * inside an object shade_media_inside_at could not test (a clipped
+         * one); POV-Ray's list would hold it. With anything on the list the
+         * list decides, as in POV-Ray: leaving a subtracted member's
+         * surface into the hollow it leaves enters that member's interior
+         * (glasschess), whatever the geometry says. */
         hi->inside_interior = 1;
         hi->eta = ior / interior_ior(last);
         hi->disp_ratio = disp / interior_dispersion(last);
