@@ -92,6 +92,26 @@ void test_sky_furnace(void **state)
 }
 
 
+/* A particle GI state of f's scene with the final gather on (256 rays a
+ * point, every 2nd pixel), no further bounce, its view prepared at w x h. */
+static gi_particle *gather_state(fixture *f, long count, uint64_t seed, gi_sky_fn fn, int w, int h)
+{
+    gi_particle_settings s;
+    gi_particle_settings_from_scene(&s, f->sc);
+    s.count = count;
+    s.bounces = 0;
+    s.threads = 2;
+    s.seed = seed;
+    s.cl_device = tg_device_c;
+    s.sky = fn;
+    s.keep_hits = 1;
+    s.view_gather_side = 16;
+    s.view_gather_stride = 2;
+    gi_particle *gp = tg_build_with(f, &s);
+    assert_int_equal(gi_particle_prepare_view(gp, &f->sc->camera, w, h, f->d), PT_OK);
+    return gp;
+}
+
 /* The final gather at the camera's hits (gi_particle_gather.c) in the same
  * furnaces: every kept pixel on the sphere gathers (or interpolates, or
  * takes the edge-aware filter of) side x side rays of its own, so under the
@@ -106,20 +126,8 @@ static void gather_case(const char *what, int background, double L, gi_sky_fn fn
     fixture f;
     char text[1024];
     tg_load(&f, tu_sky_furnace(text, sizeof text, L, background, 1));
-    gi_particle_settings s;
-    gi_particle_settings_from_scene(&s, f.sc);
-    s.count = 2000;
-    s.bounces = 0;
-    s.threads = 2;
-    s.seed = 5;
-    s.cl_device = tg_device_c;
-    s.sky = fn;
-    s.keep_hits = 1;
-    s.view_gather_side = 16;
-    s.view_gather_stride = 2;
-    gi_particle *gp = tg_build_with(&f, &s);
     const int W = 32, H = 32;
-    assert_int_equal(gi_particle_prepare_view(gp, &f.sc->camera, W, H, f.d), PT_OK);
+    gi_particle *gp = gather_state(&f, 2000, 5, fn, W, H);
     double sum = 0.0, worst = 0.0;
     int m = 0;
     for (int y = 0; y < H; y++)
@@ -182,18 +190,8 @@ void test_csg_emitter_gather(void **state)
                        "  pigment { rgb 1 } finish { emission 2 diffuse 0 } }\n"
                        "plane { y, 0 pigment { rgb 1 } finish { diffuse 1 } }\n";
     tg_load(&f, text);
-    gi_particle_settings s;
-    gi_particle_settings_from_scene(&s, f.sc);
-    s.count = 3000;
-    s.bounces = 0;
-    s.threads = 2;
-    s.seed = 7;
-    s.cl_device = tg_device_c;
-    s.keep_hits = 1;
-    s.view_gather_side = 16;
-    gi_particle *gp = tg_build_with(&f, &s);
     const int W = 40, H = 40;
-    assert_int_equal(gi_particle_prepare_view(gp, &f.sc->camera, W, H, f.d), PT_OK);
+    gi_particle *gp = gather_state(&f, 3000, 7, NULL, W, H);
     double sum = 0.0, worst = 0.0;
     int m = 0;
     for (int y = 0; y < H; y++)
