@@ -112,6 +112,16 @@ static gi_particle *gather_state(fixture *f, long count, uint64_t seed, gi_sky_f
     return gp;
 }
 
+/* Pixel i's kept hit (row-major in a view w wide) and its ray direction,
+ * NULL where it has none. */
+static const accel_hit *kept_hit(gi_particle *gp, int i, int w, vec3 *dir)
+{
+    vec3 org;
+    const accel_hit *h = NULL;
+    if (!gi_particle_primary_hit(gp, i % w, i / w, &org, dir, &h)) return NULL;
+    return h;
+}
+
 /* The final gather at the camera's hits (gi_particle_gather.c) in the same
  * furnaces: every kept pixel on the sphere gathers (or interpolates, or
  * takes the edge-aware filter of) side x side rays of its own, so under the
@@ -130,19 +140,18 @@ static void gather_case(const char *what, int background, double L, gi_sky_fn fn
     gi_particle *gp = gather_state(&f, 2000, 5, fn, W, H);
     double sum = 0.0, worst = 0.0;
     int m = 0;
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-            vec3 org, dir;
-            const accel_hit *h = NULL;
-            if (!gi_particle_primary_hit(gp, x, y, &org, &dir, &h) || !h) continue;
-            vec3 n = v3_dot(dir, h->ns) > 0.0 ? v3_neg(h->ns) : h->ns;
-            rgb e = gi_particle_indirect(gp, h, n, 0);
-            assert_true(isfinite(e.r) && isfinite(e.g) && isfinite(e.b));
-            double expect = gradient ? 1.0 + (1.0 / 3.0) * n.y : L;
-            sum += e.g / expect;
-            worst = fmax(worst, fabs(e.g / expect - 1.0));
-            m++;
-        }
+    for (int i = 0; i < W * H; i++) {
+        vec3 dir;
+        const accel_hit *h = kept_hit(gp, i, W, &dir);
+        if (!h) continue;
+        vec3 n = v3_dot(dir, h->ns) > 0.0 ? v3_neg(h->ns) : h->ns;
+        rgb e = gi_particle_indirect(gp, h, n, 0);
+        assert_true(isfinite(e.r) && isfinite(e.g) && isfinite(e.b));
+        double expect = gradient ? 1.0 + (1.0 / 3.0) * n.y : L;
+        sum += e.g / expect;
+        worst = fmax(worst, fabs(e.g / expect - 1.0));
+        m++;
+    }
     const gi_particle_stats *st = gi_particle_get_stats(gp);
     printf("  final gather %-20s: %3d pixels (%ld gathers, %ld rays), mean E/pi over expected %.5f, worst %.4f\n", what,
            m, st->view_gathers, st->view_gather_rays, sum / m, worst);
@@ -194,21 +203,20 @@ void test_csg_emitter_gather(void **state)
     gi_particle *gp = gather_state(&f, 3000, 7, NULL, W, H);
     double sum = 0.0, worst = 0.0;
     int m = 0;
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-            vec3 org, dir;
-            const accel_hit *h = NULL;
-            if (!gi_particle_primary_hit(gp, x, y, &org, &dir, &h) || !h) continue;
-            if (fabs(h->p.y) > 1e-6 || fabs(h->p.x) > 0.3 || fabs(h->p.z) > 0.3) continue;
-            rgb e = gi_particle_indirect(gp, h, v3(0, 1, 0), 0);
-            double px = h->p.x, pz = h->p.z;
-            double F = corner_ff(1.0 - px, 1.0 - pz) + corner_ff(1.0 + px, 1.0 - pz) + corner_ff(1.0 - px, 1.0 + pz) +
-                       corner_ff(1.0 + px, 1.0 + pz);
-            double expect = 2.0 * F;
-            sum += e.g / expect;
-            worst = fmax(worst, fabs(e.g / expect - 1.0));
-            m++;
-        }
+    for (int i = 0; i < W * H; i++) {
+        vec3 dir;
+        const accel_hit *h = kept_hit(gp, i, W, &dir);
+        if (!h) continue;
+        if (fabs(h->p.y) > 1e-6 || fabs(h->p.x) > 0.3 || fabs(h->p.z) > 0.3) continue;
+        rgb e = gi_particle_indirect(gp, h, v3(0, 1, 0), 0);
+        double px = h->p.x, pz = h->p.z;
+        double F = corner_ff(1.0 - px, 1.0 - pz) + corner_ff(1.0 + px, 1.0 - pz) + corner_ff(1.0 - px, 1.0 + pz) +
+                   corner_ff(1.0 + px, 1.0 + pz);
+        double expect = 2.0 * F;
+        sum += e.g / expect;
+        worst = fmax(worst, fabs(e.g / expect - 1.0));
+        m++;
+    }
     printf("  CSG emitter over a floor: %d pixels, mean E/pi over the form factor's %.5f, worst %.4f\n", m, sum / m,
            worst);
     assert_true(m > 30);
