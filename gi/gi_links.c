@@ -42,14 +42,6 @@ typedef struct {
     int nlights;
 } link_job;
 
-/* The far field (beyond the paper, which leaves open scenes out): a link
- * ray that hits a surface where no particle answers (an infinite plane
- * beyond the geometry stage's clip box, a shape without particles) sees
- * that surface's emission, plus, when the light has a bounce to spare
- * (far_bounce > 0), the sky it reflects, taken as unoccluded: rho * b *
- * E_sky(n)/pi about the hit's normal turned to the ray, at the texture's
- * base colour. In a closed room under a black sky this is the emission
- * alone. Adds it to out (nothing without esky). */
 /* The material where ray h hit object o: rho and le at the pigment there
  * (a sky dome's gradient, a terrain's colours; the texture's base colour
  * without a pigment function), the hit point and its normal turned to the
@@ -85,9 +77,6 @@ static void hit_material(const link_job *J, const struct RTCRayHit *h, const sce
     *nrm = n;
 }
 
-/* The emission where ray h hit o, added to out: links from view points
- * (gi_links_build's first > 0) take it at the hit, not from the particle
- * they end on. */
 /* The leaf a link ray hit and its effective texture (never NULL when the
  * leaf is found), CSG members included. */
 static const scene_object *hit_leaf(const link_job *J, const struct RTCRayHit *h, const scene_texture **tex)
@@ -99,6 +88,9 @@ static const scene_object *hit_leaf(const link_job *J, const struct RTCRayHit *h
     return o;
 }
 
+/* The emission where ray h hit, added to out: links from view points
+ * (gi_links_build's first > 0) take it at the hit, not from the particle
+ * they end on. */
 static void hit_emission(const link_job *J, const struct RTCRayHit *h, float out[3])
 {
     const scene_texture *tex;
@@ -113,6 +105,14 @@ static void hit_emission(const link_job *J, const struct RTCRayHit *h, float out
         if (isfinite(le[c]) && le[c] > 0.0f) out[c] += le[c];
 }
 
+/* The far field (beyond the paper, which leaves open scenes out): a link
+ * ray that hits a surface where no particle answers (an infinite plane
+ * beyond the geometry stage's clip box, a shape without particles) sees
+ * that surface's emission, plus, when the light has a bounce to spare
+ * (far_bounce > 0), the sky it reflects, taken as unoccluded: rho * b *
+ * E_sky(n)/pi about the hit's normal turned to the ray, at the texture's
+ * base colour. In a closed room under a black sky this is the emission
+ * alone. Adds it to out (nothing without esky). */
 static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3])
 {
     if (!J->esky) return;
@@ -122,8 +122,6 @@ static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3]
     float rho[3], le[3];
     vec3 p, n;
     hit_material(J, h, o, tex, rho, le, &p, &n);
-    vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
-    (void)d;
     float irr[3] = {0.0f, 0.0f, 0.0f};
     if (J->far_bounce > 0.0f) gi_sky_irradiance(J->sky, n, irr);
     /* and, for the final gather's links (J->lights), the direct light it

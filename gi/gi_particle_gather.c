@@ -32,6 +32,7 @@
 #include <string.h>
 #include "gi_cl_c.h"
 #include "gi_links.h"
+#include "hash.h"
 #include "pool.h"
 #include "timer.h"
 
@@ -63,12 +64,13 @@ static int gathers(const gi_particle *gp, const view_rec *r)
     return t->finish.diffuse > 0.0;
 }
 
-/* May pixel b take pixel a's gather? */
-static int compatible(const view_rec *a, const view_rec *b)
+/* May pixel j take pixel i's gather? (vg_nrm: their view_normal) */
+static int compatible(const gi_particle *gp, size_t i, size_t j)
 {
+    const view_rec *a = &gp->vrec[i], *b = &gp->vrec[j];
     if (a->h.obj != b->h.obj || a->side != b->side) return 0;
     if (!(fabs(a->h.t - b->h.t) <= DEPTH_TOL * b->h.t)) return 0;
-    return v3_dot(view_normal(a), view_normal(b)) > NORMAL_COS;
+    return v3_dot(gp->vg_nrm[i], gp->vg_nrm[j]) > NORMAL_COS;
 }
 
 void gi_particle_view_gather_free(gi_particle *gp)
@@ -85,7 +87,9 @@ void gi_particle_view_gather_free(gi_particle *gp)
     free(gp->vg_val);
     free(gp->vg_pix);
     free(gp->vg_pixval);
+    free(gp->vg_nrm);
     gp->vg_pixval = NULL;
+    gp->vg_nrm = NULL;
     gp->vg_link = NULL;
     gp->vg_esky = gp->vg_val = NULL;
     gp->vg_pix = NULL;
@@ -126,11 +130,10 @@ static int corners(int x, int y, int w, int h, int s, int cx[4], int cy[4], doub
 
 static uint64_t cell_hash(int level, int64_t ix, int64_t iy, int64_t iz)
 {
-    uint64_t h = (uint64_t)level * 0x9E3779B97F4A7C15ULL;
-    h ^= (uint64_t)ix * 0xC2B2AE3D27D4EB4FULL;
-    h = (h << 31 | h >> 33) ^ (uint64_t)iy * 0x165667B19E3779F9ULL;
-    h = (h << 27 | h >> 37) ^ (uint64_t)iz * 0x94D049BB133111EBULL;
-    h ^= h >> 29;
+    uint64_t h = pt_mix64((uint64_t)level);
+    h = pt_mix64(h ^ (uint64_t)ix);
+    h = pt_mix64(h ^ (uint64_t)iy);
+    h = pt_mix64(h ^ (uint64_t)iz);
     return h | 1; /* 0 marks an empty slot */
 }
 
@@ -259,7 +262,12 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
     /* vg_pix: the gather point of a pixel, -1 none (it interpolates or
      * takes the old estimate) */
     gp->vg_pix = malloc(npix * sizeof *gp->vg_pix);
-    if (!gp->vg_pix) return PT_ERR_NOMEM;
+    gp->vg_nrm = malloc(npix * sizeof *gp->vg_nrm);
+    if (!gp->vg_pix || !gp->vg_nrm) {
+        gi_particle_view_gather_free(gp);
+        return PT_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < npix; i++) gp->vg_nrm[i] = gp->vrec[i].kind == 2 ? view_normal(&gp->vrec[i]) : v3s(0.0);
     int m = 0;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
@@ -277,7 +285,7 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
             int nc = corners(x, y, w, h, s, cx, cy, cw), ok = 0;
             for (int k = 0; k < nc && !ok; k++) {
                 size_t c = (size_t)cy[k] * w + cx[k];
-                ok = gp->vg_pix[c] >= 0 && (cx[k] % s == 0 && cy[k] % s == 0) && compatible(&gp->vrec[c], &gp->vrec[i]);
+                ok = gp->vg_pix[c] >= 0 && compatible(gp, c, i);
             }
             if (!ok) gp->vg_pix[i] = m++;
         }
@@ -312,7 +320,7 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
         int k = gp->vg_pix[i];
         if (k < 0) continue;
         const view_rec *r = &gp->vrec[i];
-        vec3 nv = view_normal(r);
+        vec3 nv = gp->vg_nrm[i];
         gi_dev_particle *q = &cp[n + k];
         q->p[0] = (float)r->h.p.x;
         q->p[1] = (float)r->h.p.y;
@@ -395,7 +403,7 @@ static int raw_value(const gi_particle *gp, size_t i, float out[3])
     for (int c = 0; c < nc; c++) {
         size_t j = (size_t)cy[c] * gp->vw + cx[c];
         int kc = gp->vg_pix[j];
-        if (kc < 0 || !compatible(&gp->vrec[j], r)) continue;
+        if (kc < 0 || !compatible(gp, j, i)) continue;
         for (int q = 0; q < 3; q++) s[q] += cw[c] * gp->vg_val[4 * (size_t)kc + q];
         ws += cw[c];
     }
@@ -434,7 +442,7 @@ static void filter_row(void *ctx, int y, int thread)
         o[3] = 0.0f;
         if (!F->ok[i]) continue;
         const view_rec *r = &gp->vrec[i];
-        vec3 nr = view_normal(r);
+        vec3 nr = gp->vg_nrm[i];
         double s[3] = {0.0, 0.0, 0.0}, ws = 0.0;
         for (int dy = -FILTER_RADIUS; dy <= FILTER_RADIUS; dy++) {
             int yy = y + dy;
@@ -445,7 +453,7 @@ static void filter_row(void *ctx, int y, int thread)
                 size_t j = (size_t)yy * w + xx;
                 if (!F->ok[j]) continue;
                 const view_rec *q = &gp->vrec[j];
-                if (j != i && (!compatible(q, r) || fabs(v3_dot(v3_sub(q->h.p, r->h.p), nr)) > DEPTH_TOL * r->h.t))
+                if (j != i && (!compatible(gp, j, i) || fabs(v3_dot(v3_sub(q->h.p, r->h.p), nr)) > DEPTH_TOL * r->h.t))
                     continue;
                 double wt = g[dx < 0 ? -dx : dx] * g[dy < 0 ? -dy : dy];
                 for (int c = 0; c < 3; c++) s[c] += wt * F->raw[3 * j + c];

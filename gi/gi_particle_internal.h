@@ -84,6 +84,7 @@ struct gi_particle {
     float *vg_val;    /* vg_n x 4: gathered E/pi */
     int *vg_pix;      /* vg_w x vg_h: a pixel's gather point, -1 none */
     float *vg_pixval; /* vg_w x vg_h x 4: each kept pixel's filtered E/pi, [3] 1 where it has one */
+    vec3 *vg_nrm;     /* vg_w x vg_h: each kept hit's normal the gather takes (gi_particle_gather.c view_normal) */
     struct vg_point *vg_pt; /* vg_n: where each gathered (for hits that are not kept) */
     int *vg_ids;      /* vg_n: the points, by cell */
     struct vg_cell *vg_tab; /* cells (hash table): runs of vg_ids */
