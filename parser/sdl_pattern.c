@@ -1254,10 +1254,13 @@ static void tiles(sdl_parser *p, scene_texture *t, src_loc loc)
     pt->kind = PAT_CHECKER;
     pt->name = "tiles";
     pt->frequency = 0.0;
+    /* The first tile is the checker's value 1 and tile2 its value 0, as in
+     * POV-Ray 3.7's Parse_Tiles (parser_materials.cpp), kept from its older
+     * tiles: the first tile covers the cells whose floor sum is odd. */
     e[0].value = 0;
-    e[0].texture = lists[0];
+    e[0].texture = lists[1] ? lists[1] : sdl_copy_texture(p, &p->s->default_texture);
     e[1].value = 1;
-    e[1].texture = lists[1] ? lists[1] : sdl_copy_texture(p, &p->s->default_texture);
+    e[1].texture = lists[0];
     t->pat = pt;
     t->map = sdl_map_make(p, MAP_TEXTURE, e, 2);
 }

@@ -32,3 +32,8 @@ box { <2, 0, 2>, <3.5, 1.8, 2.5>
 cylinder { <-0.5, 0, -2>, <0.5, 0, -2>, 0.4
   pigment { spiral1 4 color_map { [0 rgb <1, 1, 0>] [1 rgb <0, 0.5, 1>] } scale 0.3 }
   normal { quilted 0.8 control0 0.3 control1 0.9 scale 0.2 no_bump_scale } }
+// tiles: the first tile on the cells whose checker value is 1
+box { <0.9, 0, -3.3>, <2.3, 0.3, -2.1>
+  texture { tiles { texture { pigment { rgb <0.9, 0.8, 0.2> } finish { phong 0.4 } }
+                    tile2 texture { pigment { rgb <0.1, 0.2, 0.6> } } }
+            scale 0.3 } }
