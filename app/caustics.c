@@ -28,8 +28,10 @@ static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, rng *r, gi_caus
     if (!(p > 0.0) || rng_f64(r) >= p) return out;
     int n = 0;
     if (mr > 0.0) {
-        rgb k = b.k[SHADE_MAT_LOBE_REFLECT];
-        step[n] = (gi_caustic_step){b.p_out, b.refl_dir, {k.r / p, k.g / p, k.b / p}, p, 0, b.from};
+        /* reflected inside an object, the photon has crossed it: its fade
+         * over the way (the refracted branch's filter below has it too) */
+        rgb fa = shade_tex_leaving_fade(h, dir), k = b.k[SHADE_MAT_LOBE_REFLECT];
+        step[n] = (gi_caustic_step){b.p_out, b.refl_dir, {fa.r * k.r / p, fa.g * k.g / p, fa.b * k.b / p}, p, 0, b.from};
         n++;
     }
     if (mt > 0.0) {
@@ -44,7 +46,12 @@ static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, rng *r, gi_caus
             rgb kr = b.k[SHADE_MAT_LOBE_REFLECT];
             f = (rgb){f.r * fmin(1.0, 1.0 - kr.r), f.g * fmin(1.0, 1.0 - kr.g), f.b * fmin(1.0, 1.0 - kr.b)};
         }
-        double k = b.eta2 / p;
+        /* no (eta_i/eta_t)^2 (b.eta2, the path tracer's adjoint rule):
+         * POV-Ray's photon keeps LightCol x FilCol through a refraction,
+         * so a surface inside a refracting object (a floor that a glass
+         * sinks into) gets the photons' full power; through a whole
+         * object the two factors cancel anyway */
+        double k = 1.0 / p;
         step[n] = (gi_caustic_step){b.p_in, b.trans_dir, {f.r * k, f.g * k, f.b * k}, p, 1, b.from};
         n++;
     }

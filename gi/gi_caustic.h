@@ -72,7 +72,7 @@ typedef struct gi_caustic gi_caustic;
 /* A specular bounce that the photon continues along. */
 typedef struct {
     vec3 org, dir;   /* continuation ray, origin off the right side */
-    rgb weight;      /* flux multiplier: the lobe's colour / the probability of going on (and the flux's ior factor) */
+    rgb weight;      /* flux multiplier: the lobe's colour (and fade, filter) / the probability of going on */
     double rho;      /* the photons' density factor of this bounce (the roulette's survival probability), for
                         the path density */
     int refract;     /* 1 refraction, 0 reflection */

@@ -608,8 +608,13 @@ rgb shade_tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir)
     vec3 raw = h->ns;
     if (v3_dot(raw, dir) > 0.0) raw = v3_neg(raw);
     rgb c = shadow_layers(tex, texture_point(h), &pc, 0, in ? in->caustics : 0.0, raw, dir);
-    if (!entering) c = tmul(c, fade(in, h->t, 1));
-    return c;
+    return tmul(c, shade_tex_leaving_fade(h, dir));
+}
+
+rgb shade_tex_leaving_fade(const accel_hit *h, vec3 dir)
+{
+    if (v3_dot(dir, h->ng) < 0.0) return trgb(1, 1, 1);
+    return fade(h->obj ? h->obj->interior : NULL, h->t, 1);
 }
 
 /* ------------------------------------------------------------ shadows */

@@ -64,6 +64,14 @@ int shade_tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_
  * h->t is taken as the distance travelled inside the object when the ray
  * leaves it. */
 rgb shade_tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir);
+/* The interior's fade over h->t for a ray along dir that leaves h's object
+ * there (dir along the geometric normal); 1 for a ray entering it. The
+ * fade shade_tex_shadow_filter applies, alone: a photon reflected inside
+ * an object has crossed it as well (POV-Ray 3.7 photons.cpp,
+ * PhotonTrace::ComputeLightedTexture attenuates the photon by the hit
+ * object's fade whenever it travelled inside that object, before it is
+ * reflected or refracted). */
+rgb shade_tex_leaving_fade(const accel_hit *h, vec3 dir);
 
 /* Light left along a shadow ray from p (unit dir) over (tmin, tmax): 0 when
  * an opaque surface blocks it, else the product of the filter colours of the
