@@ -97,8 +97,9 @@ static void hit_emission(const link_job *J, const struct RTCRayHit *h, float out
     const scene_object *o = hit_leaf(J, h, &tex);
     if (!o) return;
     float rho[3], le[3];
-    gi_particles_material(J->sc, tex, NULL, rho, le);
-    if (!(le[0] > 0.0f || le[1] > 0.0f || le[2] > 0.0f)) return; /* not emitting at its base colour */
+    const colour5 white = {1.0, 1.0, 1.0, 0.0, 0.0};
+    gi_particles_material(J->sc, tex, &white, rho, le);
+    if (!(le[0] > 0.0f || le[1] > 0.0f || le[2] > 0.0f)) return; /* its finish emits nothing */
     vec3 p, n;
     hit_material(J, h, o, tex, rho, le, &p, &n);
     for (int c = 0; c < 3; c++)
@@ -523,8 +524,12 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
     J.maxdist = maxdist;
     J.links = links;
     J.anyhit = anyhit;
+    /* origins leave the surface by 1e-6 of the working scale (the median
+     * object size, accel_eps_scale) plus the point's magnitude: the scene's
+     * diagonal would let one far object (a sky sphere of radius 1e6 around
+     * a room) lift every origin past the room's walls */
     J.off = 1e-6;
-    J.scale = accel_scale(a);
+    J.scale = accel_eps_scale(a);
     atomic_init(&J.misses, 0);
     atomic_init(&J.unresolved, 0);
     atomic_init(&J.other, 0);

@@ -553,7 +553,39 @@ int shade_tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_
     shade_pattern_ctx pc = shade_pattern_ctx_plain(sc);
     ctx_from_hit(&pc, h);
     pc.normal = h->ns;
-    return texture_colour(tex, texture_point(h), &pc, out, 0);
+    vec3 p = texture_point(h);
+    if (!tex->next) return texture_colour(tex, p, &pc, out, 0);
+    /* Layers, the first on top, as lighted() stacks them: layer l shows
+     * its pigment times att_l through the filter colour of the layers
+     * above, and passes on its own filter colour. The sum S is what the
+     * stack shows; what it passes, F, leaves as transmit (grey), so that
+     * colour * (1 - t), the reflectance and emission a GI mode takes
+     * (gi_area_particles.c's opacity, with f 0), is S. A sky sphere with a
+     * transparent cloud layer over its gradient then shows the gradient
+     * between the clouds, not the clouds' transparent colour. Every layer
+     * takes the top layer's finish here. */
+    const double version = scene_version(sc);
+    double S[3] = {0.0, 0.0, 0.0}, F[3] = {1.0, 1.0, 1.0};
+    int found = 0;
+    for (const scene_texture *l = tex; l && GREY(trgb(F[0], F[1], F[2])) > sc->global.adc_bailout; l = l->next) {
+        colour5 c;
+        if (!texture_colour(l, p, &pc, &c, 0)) continue;
+        found = 1;
+        const double pig[3] = {c.r, c.g, c.b};
+        double att = version < 3.7 ? 1.0 - (c.f * fmax(c.r, fmax(c.g, c.b)) + c.t) : 1.0 - c.f - c.t;
+        for (int k = 0; k < 3; k++) {
+            S[k] += F[k] * att * pig[k];
+            F[k] *= pig[k] * c.f + c.t;
+        }
+    }
+    if (!found) return 0;
+    double t = fmin(1.0, fmax(0.0, GREY(trgb(F[0], F[1], F[2])))), o = 1.0 - t;
+    out->r = o > 1e-9 ? S[0] / o : 0.0;
+    out->g = o > 1e-9 ? S[1] / o : 0.0;
+    out->b = o > 1e-9 ? S[2] / o : 0.0;
+    out->f = 0.0;
+    out->t = t;
+    return 1;
 }
 
 static rgb shadow_layers(const scene_texture *tex, vec3 point, const shade_pattern_ctx *pc, int depth, double caustics, vec3 raw,
