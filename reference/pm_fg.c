@@ -481,21 +481,16 @@ static void irr_block(void *ctx, int bi, int thread)
     }
 }
 
-pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s, framebuffer *fb, pm_stats *st,
-                       diag *d)
+static pt_status fg_run(const pm_job *j, const void *settings)
 {
-    double t0 = timer_now();
-    pm_stats local;
-    if (!st) st = &local;
-    memset(st, 0, sizeof *st);
-    if (!sc || !a || !s || !fb) return PT_ERR_INTERNAL;
-    int threads = pm_threads(s->c.threads);
-    pt_status status;
-    pm_lights *L = pm_lights_new(sc, a, d, &status);
-    if (!L) return status;
-    st->emitter_pieces = accel_surf_count(pm_lights_emitters(L));
+    const pm_fg_settings *s = settings;
+    const scene *sc = j->sc;
+    const accel *a = j->a;
+    const pm_lights *L = j->L;
+    pm_stats *st = j->st;
     double t1 = timer_now();
-    st->t_lights = t1 - t0;
+    int threads = pm_threads(s->c.threads);
+    pt_status status = PT_OK;
 
     fg_ctx c;
     memset(&c, 0, sizeof c);
@@ -520,10 +515,7 @@ pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s,
     c.fg_per_sample = (s->fg_rays + spp - 1) / spp;
     if (c.fg_per_sample < 1) c.fg_per_sample = 1;
     c.scratch = malloc(sizeof(pm_neighbour) * KMAX * (size_t)threads);
-    if (!c.scratch) {
-        pm_lights_free(L);
-        return PT_ERR_NOMEM;
-    }
+    if (!c.scratch) return PT_ERR_NOMEM;
 
     int caustics = s->caustics < 0 ? sc->global.photons.enabled : s->caustics != 0;
     st->caustic_reason = s->caustics < 0 ? (caustics ? "on: the scene has a photons{} block"
@@ -540,7 +532,6 @@ pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s,
     st->t_photons = t2 - t1;
     if (status != PT_OK) {
         free(c.scratch);
-        pm_lights_free(L);
         return status;
     }
     st->photons_emitted = pr.emitted;
@@ -550,7 +541,7 @@ pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s,
     st->photons_dropped = pr.dropped;
     if (pr.dropped > 0) {
         src_loc nowhere = {0};
-        diag_report(d, DIAG_WARNING, nowhere, NULL,
+        diag_report(j->d, DIAG_WARNING, nowhere, NULL,
                     "pmfg: %ld photons not stored, the cap on stored photons (memory) was reached; indirect light is "
                     "too dark (fewer --photons or a lower albedo)", pr.dropped);
     }
@@ -591,14 +582,18 @@ pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s,
 
     /* 4. eye pass */
     double t5 = timer_now();
-    if (status == PT_OK) status = pm_image_render(sc, &s->c, 1, fb, fg_sample, &c, st);
+    if (status == PT_OK) status = pm_image_render(sc, &s->c, 1, j->fb, fg_sample, &c, st);
     double t6 = timer_now();
     st->t_render = t6 - t5;
-    st->t_total = t6 - t0;
     pm_kdtree_free(c.global);
     pm_kdtree_free(c.caustic);
     pm_kdtree_free(c.irr);
     free(c.scratch);
-    pm_lights_free(L);
     return status;
+}
+
+pt_status pm_fg_render(const scene *sc, const accel *a, const pm_fg_settings *s, framebuffer *fb, pm_stats *st,
+                       diag *d)
+{
+    return pm_lights_run(sc, a, fb, st, d, fg_run, s);
 }

@@ -14,6 +14,7 @@
 #include <string.h>
 #include "radrules.h"
 #include "shade_light.h"
+#include "timer.h"
 
 struct pm_lights {
     const scene *sc;
@@ -74,6 +75,26 @@ pm_lights *pm_lights_new(const scene *sc, const accel *a, diag *d, pt_status *st
         L->varies[i] = (unsigned char)shade_mat_texture_varies(t);
     }
     return L;
+}
+
+pt_status pm_lights_run(const scene *sc, const accel *a, framebuffer *fb, pm_stats *st, diag *d, pm_run_fn run,
+                        const void *settings)
+{
+    double t0 = timer_now();
+    pm_stats local;
+    if (!st) st = &local;
+    memset(st, 0, sizeof *st);
+    if (!sc || !a || !fb || !settings) return PT_ERR_INTERNAL;
+    pt_status status;
+    pm_lights *L = pm_lights_new(sc, a, d, &status);
+    if (!L) return status;
+    st->emitter_pieces = accel_surf_count(L->emit);
+    st->t_lights = timer_now() - t0;
+    pm_job j = {sc, a, fb, d, L, st};
+    status = run(&j, settings);
+    st->t_total = timer_now() - t0;
+    pm_lights_free(L);
+    return status;
 }
 
 void pm_lights_free(pm_lights *L)

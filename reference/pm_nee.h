@@ -14,6 +14,7 @@
 #include "accel.h"
 #include "accel_surface.h"
 #include "diag.h"
+#include "pm.h"
 #include "rng.h"
 #include "scene.h"
 #include "shade_material.h"
@@ -22,6 +23,23 @@ typedef struct pm_lights pm_lights;
 
 pm_lights *pm_lights_new(const scene *sc, const accel *a, diag *d, pt_status *st);
 void pm_lights_free(pm_lights *L);
+
+/* What a reference renderer's stages after the light set work on. */
+typedef struct {
+    const scene *sc;
+    const accel *a;
+    framebuffer *fb;
+    diag *d;
+    const pm_lights *L;
+    pm_stats *st; /* zeroed, then emitter_pieces and t_lights filled */
+} pm_job;
+typedef pt_status (*pm_run_fn)(const pm_job *j, const void *settings);
+/* The frame of a reference render (pm_path.c, pm_fg.c): zeroes *st (a local
+ * one when st is NULL), builds the light set (st->emitter_pieces,
+ * st->t_lights), calls run, sets st->t_total and frees the light set.
+ * PT_ERR_INTERNAL when sc, a, fb or settings is NULL. */
+pt_status pm_lights_run(const scene *sc, const accel *a, framebuffer *fb, pm_stats *st, diag *d, pm_run_fn run,
+                        const void *settings);
 
 const accel_surf *pm_lights_emitters(const pm_lights *L); /* may be empty */
 /* Le at an emitter sample (evaluated at the point when the texture varies). */

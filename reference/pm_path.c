@@ -166,27 +166,21 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
     return L;
 }
 
+static pt_status path_run(const pm_job *j, const void *settings)
+{
+    const pm_path_settings *s = settings;
+    double t1 = timer_now();
+    path_ctx c = {j->sc, j->a, s, j->L, pm_lights_eps(j->L), s->max_depth > 0 ? s->max_depth : HARD_DEPTH,
+                  radrules_of(j->sc, 1), 0};
+    c.gathers = pm_gathers(&c.rr);
+    if (c.max_depth > HARD_DEPTH) c.max_depth = HARD_DEPTH;
+    pt_status status = pm_image_render(j->sc, &s->c, 16, j->fb, path_sample, &c, j->st);
+    j->st->t_render = timer_now() - t1;
+    return status;
+}
+
 pt_status pm_path_render(const scene *sc, const accel *a, const pm_path_settings *s, framebuffer *fb, pm_stats *st,
                          diag *d)
 {
-    double t0 = timer_now();
-    pm_stats local;
-    if (!st) st = &local;
-    memset(st, 0, sizeof *st);
-    if (!sc || !a || !s || !fb) return PT_ERR_INTERNAL;
-    pt_status status;
-    pm_lights *L = pm_lights_new(sc, a, d, &status);
-    if (!L) return status;
-    st->emitter_pieces = accel_surf_count(pm_lights_emitters(L));
-    double t1 = timer_now();
-    st->t_lights = t1 - t0;
-    path_ctx c = {sc, a, s, L, pm_lights_eps(L), s->max_depth > 0 ? s->max_depth : HARD_DEPTH, radrules_of(sc, 1), 0};
-    c.gathers = pm_gathers(&c.rr);
-    if (c.max_depth > HARD_DEPTH) c.max_depth = HARD_DEPTH;
-    status = pm_image_render(sc, &s->c, 16, fb, path_sample, &c, st);
-    double t2 = timer_now();
-    st->t_render = t2 - t1;
-    st->t_total = t2 - t0;
-    pm_lights_free(L);
-    return status;
+    return pm_lights_run(sc, a, fb, st, d, path_run, s);
 }
