@@ -621,6 +621,26 @@ static void finish_read(exr_stream *s, exr_context_t *ctx, chunk_sink *k)
     close(s->fd);
 }
 
+/* 1 when rv is success; otherwise reports "cannot read 'path': what: reason". */
+static int read_ok(const exr_stream *s, exr_result_t rv, const char *path, const char *what, diag *d)
+{
+    if (rv == EXR_ERR_SUCCESS) return 1;
+    diag_error(d, "cannot read '%s': %s: %s", path, what, reason(s, rv));
+    return 0;
+}
+
+/* The first part's storage, data window and channels, after start_read
+ * returned rv; 0 (reported) when the file or its header cannot be read. */
+static int read_header(exr_context_t ctx, const exr_stream *s, exr_result_t rv, const char *path,
+                       exr_storage_t *storage, exr_attr_box2i_t *dw, const exr_attr_chlist_t **chl, diag *d)
+{
+    const char *what = "cannot read EXR header";
+    return read_ok(s, rv, path, "not a readable EXR file", d) &&
+           read_ok(s, exr_get_storage(ctx, 0, storage), path, what, d) &&
+           read_ok(s, exr_get_data_window(ctx, 0, dw), path, what, d) &&
+           read_ok(s, exr_get_channels(ctx, 0, chl), path, what, d);
+}
+
 pt_status img_exr_read(const char *path, uint64_t max_pixels, framebuffer **out, diag *d)
 {
     *out = NULL;
@@ -633,21 +653,14 @@ pt_status img_exr_read(const char *path, uint64_t max_pixels, framebuffer **out,
     chunk_sink sink = {.dec = EXR_DECODE_PIPELINE_INITIALIZER};
     framebuffer *fb = NULL;
     float *grey = NULL;
-    const char *what = "not a readable EXR file";
-
-    if (rv != EXR_ERR_SUCCESS) goto libfail;
-
     exr_storage_t storage;
-    what = "cannot read EXR header";
-    rv = exr_get_storage(ctx, 0, &storage);
-    if (rv != EXR_ERR_SUCCESS) goto libfail;
+    exr_attr_box2i_t dw;
+    const exr_attr_chlist_t *chl = NULL;
+    if (!read_header(ctx, &s, rv, path, &storage, &dw, &chl, d)) goto done;
     if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED) {
         diag_error(d, "cannot read '%s': deep EXR images are not supported", path);
         goto done;
     }
-    exr_attr_box2i_t dw;
-    rv = exr_get_data_window(ctx, 0, &dw);
-    if (rv != EXR_ERR_SUCCESS) goto libfail;
     int64_t w64 = (int64_t)dw.max.x - dw.min.x + 1, h64 = (int64_t)dw.max.y - dw.min.y + 1;
     char why[256];
     if (w64 <= 0 || h64 <= 0 || imgcheck_size((uint64_t)w64, (uint64_t)h64, max_pixels, why, sizeof why)) {
@@ -657,9 +670,6 @@ pt_status img_exr_read(const char *path, uint64_t max_pixels, framebuffer **out,
     }
     const int w = (int)w64, h = (int)h64;
 
-    const exr_attr_chlist_t *chl = NULL;
-    rv = exr_get_channels(ctx, 0, &chl);
-    if (rv != EXR_ERR_SUCCESS) goto libfail;
     int have[NSLOTS] = {0};
     int chroma = 0, sub_y = 0;
     for (int i = 0; i < chl->num_channels; i++) {
@@ -703,12 +713,11 @@ pt_status img_exr_read(const char *path, uint64_t max_pixels, framebuffer **out,
         goto done;
     }
 
-    what = "cannot read EXR pixels";
     sink.fb = fb;
     sink.grey = grey;
     sink.use_y = use_y;
     if (!decode_chunks(ctx, storage, dw, w, h, &sink, path, &rv, d)) {
-        if (rv != EXR_ERR_SUCCESS) goto libfail;
+        read_ok(&s, rv, path, "cannot read EXR pixels", d);
         goto done;
     }
     if (use_y) {
@@ -718,11 +727,6 @@ pt_status img_exr_read(const char *path, uint64_t max_pixels, framebuffer **out,
     st = PT_OK;
     *out = fb;
     fb = NULL;
-    goto done;
-
-libfail:
-    diag_error(d, "cannot read '%s': %s: %s", path, what, reason(&s, rv));
-    st = PT_ERR_IO;
 done:
     finish_read(&s, &ctx, &sink);
     free(grey);
@@ -754,15 +758,10 @@ pt_status img_read_exr_layer(const char *path, const char *layer, const char *su
     if (!start_read(path, &s, &ctx, &rv, d)) return PT_ERR_IO;
     pt_status st = PT_ERR_IO;
     chunk_sink sink = {.dec = EXR_DECODE_PIPELINE_INITIALIZER, .ls = &ls};
-    const char *what = "not a readable EXR file";
-    if (rv != EXR_ERR_SUCCESS) goto libfail;
     exr_storage_t storage;
     exr_attr_box2i_t dw;
     const exr_attr_chlist_t *chl = NULL;
-    what = "cannot read EXR header";
-    if ((rv = exr_get_storage(ctx, 0, &storage)) != EXR_ERR_SUCCESS) goto libfail;
-    if ((rv = exr_get_data_window(ctx, 0, &dw)) != EXR_ERR_SUCCESS) goto libfail;
-    if ((rv = exr_get_channels(ctx, 0, &chl)) != EXR_ERR_SUCCESS) goto libfail;
+    if (!read_header(ctx, &s, rv, path, &storage, &dw, &chl, d)) goto done;
     int64_t w64 = (int64_t)dw.max.x - dw.min.x + 1, h64 = (int64_t)dw.max.y - dw.min.y + 1;
     if ((storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED) || w64 <= 0 || h64 <= 0 ||
         w64 > IMG_MAX_SIDE || h64 > IMG_MAX_SIDE || (uint64_t)w64 * (uint64_t)h64 > IMG_MAX_PIXELS) {
@@ -787,9 +786,8 @@ pt_status img_read_exr_layer(const char *path, const char *layer, const char *su
         st = PT_ERR_NOMEM;
         goto done;
     }
-    what = "cannot read EXR pixels";
     if (!decode_chunks(ctx, storage, dw, (int)w64, (int)h64, &sink, path, &rv, d)) {
-        if (rv != EXR_ERR_SUCCESS) goto libfail;
+        read_ok(&s, rv, path, "cannot read EXR pixels", d);
         goto done;
     }
     *out = ls.data;
@@ -797,11 +795,6 @@ pt_status img_read_exr_layer(const char *path, const char *layer, const char *su
     *width = (int)w64;
     *height = (int)h64;
     st = PT_OK;
-    goto done;
-
-libfail:
-    diag_error(d, "cannot read '%s': %s: %s", path, what, reason(&s, rv));
-    st = PT_ERR_IO;
 done:
     finish_read(&s, &ctx, &sink);
     free(ls.data);
