@@ -260,6 +260,21 @@ static double phase(const media_ref *refs, int n, double a)
 
 /* ------------------------------------------------------------ lit intervals */
 
+/* The crossings t1 <= t2 of a ray with a light's cone or cylinder,
+ * a t^2 + 2 b t + c = 0 with discriminant d = b^2 - a c > 0, and which of
+ * them lie ahead of the light along its axis (axial position k2 + t k1 > 0):
+ * bit 0 for t1, bit 1 for t2 (0: neither, the ray meets only the back half). */
+static int axial_roots(double a, double b, double d, double k1, double k2, double *t1, double *t2)
+{
+    d = sqrt(d);
+    double r1 = (-b + d) / a, r2 = (-b - d) / a;
+    if (r1 > r2) { double t = r1; r1 = r2; r2 = t; }
+    *t1 = r1;
+    *t2 = r2;
+    int ahead1 = !(k2 + r1 * k1 <= 0.0), ahead2 = !(k2 + r2 * k1 <= 0.0);
+    return ahead1 | ahead2 << 1;
+}
+
 /* Part of the ray org + t dir inside a spotlight's cone (half angle =
  * falloff): the quadric |X - C|^2 cos^2 = ((X - C).D)^2 solved for t, with
  * the branch rules for a ray starting inside the cone or meeting only its
@@ -278,19 +293,15 @@ static int spot_interval(vec3 org, vec3 dir, const scene_light *l, double *d1, d
     if (a != 0.0) {
         double d = b * b - a * c;
         if (d > MEDIA_EPSILON) {
-            d = sqrt(d);
-            double t1 = (-b + d) / a, t2 = (-b - d) / a;
-            if (t1 > t2) { double t = t1; t1 = t2; t2 = t; }
-            double l1 = k2 + t1 * k1, l2 = k2 + t2 * k1;
-            if (l1 <= 0.0 && l2 <= 0.0) return 0;
-            if (l1 <= 0.0 || l2 <= 0.0) {
-                if (l1 <= 0.0) {
-                    if (in_cone) { t1 = 0.0; t2 = t2 > 0.0 ? t2 : MEDIA_MAX_DISTANCE; }
-                    else { t1 = t2; t2 = MEDIA_MAX_DISTANCE; }
-                } else {
-                    if (in_cone) { t2 = t1; t1 = 0.0; }
-                    else t2 = MEDIA_MAX_DISTANCE;
-                }
+            double t1, t2;
+            int ahead = axial_roots(a, b, d, k1, k2, &t1, &t2);
+            if (!ahead) return 0;
+            if (ahead == 2) { /* t1 behind the light */
+                if (in_cone) { t1 = 0.0; t2 = t2 > 0.0 ? t2 : MEDIA_MAX_DISTANCE; }
+                else { t1 = t2; t2 = MEDIA_MAX_DISTANCE; }
+            } else if (ahead == 1) { /* t2 behind */
+                if (in_cone) { t2 = t1; t1 = 0.0; }
+                else t2 = MEDIA_MAX_DISTANCE;
             }
             *d1 = t1;
             *d2 = t2;
@@ -325,15 +336,11 @@ static int cylinder_interval(vec3 org, vec3 dir, const scene_light *l, double *d
     double b = k3 - k1 * k2, c = k4 - k2 * k2 - l->falloff * l->falloff;
     double d = b * b - a * c;
     if (!(d > MEDIA_EPSILON)) return 0;
-    d = sqrt(d);
-    double t1 = (-b + d) / a, t2 = (-b - d) / a;
-    if (t1 > t2) { double t = t1; t1 = t2; t2 = t; }
-    double l1 = k2 + t1 * k1, l2 = k2 + t2 * k1;
-    if (l1 <= 0.0 && l2 <= 0.0) return 0;
-    if (l1 <= 0.0 || l2 <= 0.0) {
-        if (l1 <= 0.0) t1 = 0.0;
-        else t2 = (MEDIA_MAX_DISTANCE - k2) / k1;
-    }
+    double t1, t2;
+    int ahead = axial_roots(a, b, d, k1, k2, &t1, &t2);
+    if (!ahead) return 0;
+    if (ahead == 2) t1 = 0.0;
+    else if (ahead == 1) t2 = (MEDIA_MAX_DISTANCE - k2) / k1;
     *d1 = t1;
     *d2 = t2;
     return 1;
