@@ -636,8 +636,7 @@ static void keyword_rvalue(sdl_parser *p, sdl_value *out)
     }
     if (opaque && sdl_parse_look_value(p, k, out)) return; /* maps, fog, sky_sphere */
     if (opaque) {
-        sdl_warn_once(p, kt.tk.loc, "'%s' is not supported yet and is ignored", opaque);
-        if (sdl_begin_block(p, opaque)) sdl_skip_block(p);
+        sdl_ignore_block(p, kt.tk.loc, opaque, "'%s' is not supported yet and is ignored", opaque);
         opaque_value(p, out, opaque);
         return;
     }

@@ -200,8 +200,8 @@ static void irid(sdl_parser *p, scene_finish *f)
 /* Skip a '{...}' finish sub-block (subsurface) with a warning. */
 static void skip_sub_block(sdl_parser *p, const sdl_tok *k)
 {
-    sdl_warn_once(p, k->tk.loc, "finish '%s' is not supported yet and is ignored", sdl_kw_text(k->tk.kw));
-    if (sdl_begin_block(p, sdl_kw_text(k->tk.kw))) sdl_skip_block(p);
+    const char *name = sdl_kw_text(k->tk.kw);
+    sdl_ignore_block(p, k->tk.loc, name, "finish '%s' is not supported yet and is ignored", name);
 }
 
 typedef struct { int diffuse, phong, specular; } albedo_flags;

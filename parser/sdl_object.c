@@ -425,8 +425,7 @@ static int skipped_mod(sdl_parser *p, const sdl_tok *t)
         return 1;
     }
     if (k == KW_CLIPPED_BY) {
-        sdl_warn_once(p, t->tk.loc, "clipped_by is not supported yet; objects are not clipped");
-        if (sdl_begin_block(p, "clipped_by")) sdl_skip_block(p);
+        sdl_ignore_block(p, t->tk.loc, "clipped_by", "clipped_by is not supported yet; objects are not clipped");
         return 1;
     }
     if (sdl_starts_colour(t)) {

@@ -85,14 +85,28 @@ void sdl_note(sdl_parser *p, src_loc loc, const char *fmt, ...)
     va_end(ap);
 }
 
-void sdl_warn_once(sdl_parser *p, src_loc loc, const char *fmt, ...)
+static void vwarn_once(sdl_parser *p, src_loc loc, const char *fmt, va_list ap)
 {
     char buf[1024];
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    diag_warn_once(p->d, loc, "%s", buf);
+}
+
+void sdl_warn_once(sdl_parser *p, src_loc loc, const char *fmt, ...)
+{
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
+    vwarn_once(p, loc, fmt, ap);
     va_end(ap);
-    diag_warn_once(p->d, loc, "%s", buf);
+}
+
+void sdl_ignore_block(sdl_parser *p, src_loc loc, const char *name, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vwarn_once(p, loc, fmt, ap);
+    va_end(ap);
+    if (sdl_begin_block(p, name)) sdl_skip_block(p);
 }
 
 void sdl_unexpected(sdl_parser *p, const sdl_tok *t, const char *expected)

@@ -194,6 +194,13 @@ int sdl_begin_block(sdl_parser *p, const char *name);
 int sdl_end_block(sdl_parser *p);
 /* After sdl_begin_block: skip to the matching '}' (directives still run). */
 void sdl_skip_block(sdl_parser *p);
+/* For syntax read but not modelled: warn once (fmt), then skip the
+ * '{...}' block named `name` that follows. */
+void sdl_ignore_block(sdl_parser *p, src_loc loc, const char *name, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
 /* Skip a keyword's optional '{...}' argument, or one expression if one follows. */
 void sdl_skip_item(sdl_parser *p);
 

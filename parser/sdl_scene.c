@@ -1,6 +1,7 @@
 /* sdl_scene.c - camera, lights, global settings, background, statements. */
 #include "sdl_scene.h"
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 #include "sdl_atmos.h"
 #include "sdl_directive.h"
@@ -169,8 +170,7 @@ static int camera_item(sdl_parser *p, scene_camera *c, camera_said *said)
         c->normal = sdl_parse_normal(p); /* shade.c perturbs the primary rays */
         break;
     case KW_BOKEH:
-        sdl_warn_once(p, t.tk.loc, "camera %s is not supported yet and is ignored", sdl_kw_text(t.tk.kw));
-        if (sdl_begin_block(p, sdl_kw_text(t.tk.kw))) sdl_skip_block(p);
+        sdl_ignore_block(p, t.tk.loc, "bokeh", "camera bokeh is not supported yet and is ignored");
         break;
     default:
         sdl_unget(p, &t);
@@ -419,8 +419,8 @@ static int light_item(sdl_parser *p, sdl_obj *so)
         break;
     case KW_PHOTONS: light_photons(p, l); break;
     case KW_COLOR_MAP: case KW_COLOUR_MAP:
-        sdl_warn_once(p, t.tk.loc, "colour_map in light_source is undocumented POV-Ray syntax that does nothing; ignored");
-        if (sdl_begin_block(p, sdl_kw_text(t.tk.kw))) sdl_skip_block(p);
+        sdl_ignore_block(p, t.tk.loc, sdl_kw_text(t.tk.kw),
+                         "colour_map in light_source is undocumented POV-Ray syntax that does nothing; ignored");
         break;
     default:
         sdl_unget(p, &t);
@@ -545,6 +545,37 @@ static void radiosity_block(sdl_parser *p, scene_radiosity *r)
  *   save_file s | load_file s } '}'
  * POV-Ray 3.7's global photons block (parser.cpp): every item into
  * scene_photons, with its checks and warnings. */
+/* The photons items that are one number stored as it is: the keyword, the
+ * field (an int field takes the number's integer part) and its given bit. */
+static const struct {
+    sdl_kw kw;
+    size_t off;
+    int is_int;
+    unsigned given;
+} photon_numbers[] = {
+    {KW_SPACING, offsetof(scene_photons, spacing), 0, SCENE_PH_SPACING},
+    {KW_COUNT, offsetof(scene_photons, count), 1, SCENE_PH_COUNT},
+    {KW_AUTOSTOP, offsetof(scene_photons, autostop), 0, SCENE_PH_AUTOSTOP},
+    {KW_JITTER, offsetof(scene_photons, jitter), 0, SCENE_PH_JITTER},
+    {KW_MAX_TRACE_LEVEL, offsetof(scene_photons, max_trace_level), 1, SCENE_PH_MAX_TRACE_LEVEL},
+    {KW_ADC_BAILOUT, offsetof(scene_photons, adc_bailout), 0, SCENE_PH_ADC_BAILOUT},
+};
+
+/* Reads the number of a photon_numbers item; 0 when kw is not one. */
+static int photon_number(sdl_parser *p, scene_photons *ph, sdl_kw kw)
+{
+    for (size_t i = 0; i < sizeof photon_numbers / sizeof photon_numbers[0]; i++) {
+        if (photon_numbers[i].kw != kw) continue;
+        char *field = (char *)ph + photon_numbers[i].off;
+        double v = sdl_float(p);
+        if (photon_numbers[i].is_int) *(int *)field = sdl_to_int(v);
+        else *(double *)field = v;
+        ph->given |= photon_numbers[i].given;
+        return 1;
+    }
+    return 0;
+}
+
 static void photons_block(sdl_parser *p, scene_global *g, src_loc loc)
 {
     scene_photons *ph = &g->photons;
@@ -557,31 +588,8 @@ static void photons_block(sdl_parser *p, scene_global *g, src_loc loc)
             sdl_unexpected(p, &t, "a photons item or '}'");
             return;
         }
+        if (photon_number(p, ph, t.tk.kw)) continue;
         switch (t.tk.kw) {
-        case KW_SPACING:
-            ph->spacing = sdl_float(p);
-            ph->given |= SCENE_PH_SPACING;
-            break;
-        case KW_COUNT:
-            ph->count = sdl_to_int(sdl_float(p));
-            ph->given |= SCENE_PH_COUNT;
-            break;
-        case KW_AUTOSTOP:
-            ph->autostop = sdl_float(p);
-            ph->given |= SCENE_PH_AUTOSTOP;
-            break;
-        case KW_JITTER:
-            ph->jitter = sdl_float(p);
-            ph->given |= SCENE_PH_JITTER;
-            break;
-        case KW_MAX_TRACE_LEVEL:
-            ph->max_trace_level = sdl_to_int(sdl_float(p));
-            ph->given |= SCENE_PH_MAX_TRACE_LEVEL;
-            break;
-        case KW_ADC_BAILOUT:
-            ph->adc_bailout = sdl_float(p);
-            ph->given |= SCENE_PH_ADC_BAILOUT;
-            break;
         case KW_EXPAND_THRESHOLDS:
             ph->expand_tolerance = sdl_float(p);
             sdl_accept(p, TOK_COMMA);
