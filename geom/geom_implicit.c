@@ -12,6 +12,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "geom_bvh.h"
 #include "geom_poly.h"
 #include "func.h"
 
@@ -44,6 +45,8 @@ typedef struct {
     double threshold;
     int ncomp;
     blob_comp *comp;
+    geom_bvh comp_bvh; /* over the components' blob-space boxes */
+    int comp_tex;      /* some component has its own texture */
     vec3 blo, bhi;
     /* isosurface */
     const scene_function *fn;
@@ -587,6 +590,67 @@ static int cmp_event(const void *x, const void *y)
     return a->t < b->t ? -1 : (a->t > b->t);
 }
 
+/* The components a query may meet, in ascending order (the order the
+ * field's terms are summed in, whichever leaves the hierarchy visits
+ * first). */
+typedef struct {
+    int *idx, n, cap;
+    int local[128];
+} blob_cands;
+
+static void cands_put(void *ctx, int item)
+{
+    blob_cands *c = ctx;
+    if (c->n == c->cap) {
+        int cap = 2 * c->cap;
+        int *p = c->idx == c->local ? malloc(sizeof *p * (size_t)cap) : realloc(c->idx, sizeof *p * (size_t)cap);
+        if (!p) return; /* the candidate is lost only when memory ran out */
+        if (c->idx == c->local) memcpy(p, c->local, sizeof c->local);
+        c->idx = p;
+        c->cap = cap;
+    }
+    c->idx[c->n++] = item;
+}
+
+static int cmp_int(const void *x, const void *y)
+{
+    int a = *(const int *)x, b = *(const int *)y;
+    return (a > b) - (a < b);
+}
+
+static void cands_init(blob_cands *c)
+{
+    c->idx = c->local;
+    c->n = 0;
+    c->cap = (int)(sizeof c->local / sizeof c->local[0]);
+}
+
+static void cands_sort(blob_cands *c)
+{
+    if (c->n > 32) {
+        qsort(c->idx, (size_t)c->n, sizeof *c->idx, cmp_int);
+        return;
+    }
+    for (int i = 1; i < c->n; i++) {
+        int v = c->idx[i], j = i;
+        for (; j > 0 && c->idx[j - 1] > v; j--) c->idx[j] = c->idx[j - 1];
+        c->idx[j] = v;
+    }
+}
+
+static void cands_free(blob_cands *c)
+{
+    if (c->idx != c->local) free(c->idx);
+}
+
+/* The components whose box holds blob-space point q, ascending. */
+static void cands_at(const im_data *m, vec3 q, blob_cands *c)
+{
+    cands_init(c);
+    geom_bvh_point(&m->comp_bvh, q, cands_put, c);
+    cands_sort(c);
+}
+
 static int blob_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     double b0, b1;
@@ -596,17 +660,24 @@ static int blob_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax,
     double s = v3_len(d);
     vec3 e = v3_scale(d, 1.0 / s), p = v3_madd(o, d, t0);
     double L = (t1 - t0) * s;
+    blob_cands cd;
+    cands_init(&cd);
+    geom_bvh_ray(&m->comp_bvh, p, e, 0.0, L, cands_put, &cd);
+    cands_sort(&cd);
     blob_span local[64];
     blob_span *sp = local;
-    size_t need = (size_t)m->ncomp * 3;
+    size_t need = (size_t)cd.n * 3;
     if (need > 64) {
         sp = malloc(need * sizeof *sp);
-        if (!sp) return 0;
+        if (!sp) {
+            cands_free(&cd);
+            return 0;
+        }
     }
     int ns = 0;
-    for (int i = 0; i < m->ncomp; i++) {
+    for (int k = 0; k < cd.n; k++) {
         /* the ray must pass through the component's bounding sphere within [0, L] */
-        const blob_comp *c = &m->comp[i];
+        const blob_comp *c = &m->comp[cd.idx[k]];
         vec3 rel = v3_sub(p, c->bc);
         double bq = v3_dot(rel, e), cq = v3_dot(rel, rel) - c->br2, disc = bq * bq - cq;
         if (cq > 0.0 && (bq > 0.0 || disc < 0.0 || -bq - sqrt(disc) > L)) continue;
@@ -623,7 +694,18 @@ static int blob_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax,
                 ev[2 * i] = (blob_event){sp[i].a, i, 1};
                 ev[2 * i + 1] = (blob_event){sp[i].b, i, 0};
             }
-            qsort(ev, 2 * (size_t)ns, sizeof *ev, cmp_event);
+            /* stable, as glibc's qsort (a merge sort) is on these sizes:
+             * events at equal t keep their order */
+            if (ns > 16) {
+                qsort(ev, 2 * (size_t)ns, sizeof *ev, cmp_event);
+            } else {
+                for (int i = 1; i < 2 * ns; i++) {
+                    blob_event v = ev[i];
+                    int j = i;
+                    for (; j > 0 && ev[j - 1].t > v.t; j--) ev[j] = ev[j - 1];
+                    ev[j] = v;
+                }
+            }
             int na = 0;
             for (int k = 0; k + 1 < 2 * ns; k++) {
                 if (ev[k].enter) active[na++] = ev[k].span;
@@ -656,6 +738,7 @@ static int blob_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax,
         if (active != lact) free(active);
     }
     if (sp != local) free(sp);
+    cands_free(&cd);
     return n;
 }
 
@@ -687,15 +770,18 @@ static double blob_field(const im_data *m, vec3 q, vec3 *grad)
 {
     double f = 0.0;
     vec3 g = v3s(0.0);
-    for (int i = 0; i < m->ncomp; i++) {
+    blob_cands cd;
+    cands_at(m, q, &cd);
+    for (int k = 0; k < cd.n; k++) {
         /* a point outside a component's bounding sphere gets nothing from
          * it (blob_hits skips rays the same way): no transform needed */
-        const blob_comp *c = &m->comp[i];
+        const blob_comp *c = &m->comp[cd.idx[k]];
         if (v3_len2(v3_sub(q, c->bc)) > c->br2) continue;
         vec3 gi;
         f += blob_comp_field(c, q, grad ? &gi : NULL);
         if (grad) g = v3_add(g, gi);
     }
+    cands_free(&cd);
     if (grad) *grad = g;
     return f;
 }
@@ -707,6 +793,13 @@ static int blob_setup(im_data *m, const scene_blob *b, vec3 *lo, vec3 *hi)
     if (!m->comp) return -1;
     m->threshold = b->threshold;
     vec3 blo = v3s(INFINITY), bhi = v3s(-INFINITY);
+    /* each kept component's blob-space box, for the hierarchy */
+    vec3 *clos = malloc(sizeof *clos * (size_t)b->ncomponents), *chis = malloc(sizeof *chis * (size_t)b->ncomponents);
+    if (!clos || !chis) {
+        free(clos);
+        free(chis);
+        return -1;
+    }
     for (int i = 0; i < b->ncomponents; i++) {
         const scene_blob_component *sc = &b->components[i];
         blob_comp *c = &m->comp[m->ncomp];
@@ -735,16 +828,30 @@ static int blob_setup(im_data *m, const scene_blob *b, vec3 *lo, vec3 *hi)
         double R0 = sc->cylinder ? 0.5 * c->len + r : r;
         c->bc = xform_point(&c->x, sc->cylinder ? v3_scale(v3_add(sc->a, sc->b), 0.5) : sc->a);
         c->br2 = R0 * R0 * fro * (1.0 + 1e-9);
-        m->ncomp++;
-        if (c->s <= 0.0 && m->threshold > 0.0) continue; /* cannot make surface on its own */
+        if (c->tex) m->comp_tex = 1;
+        /* the reach's box in blob space: the component-space box's corners
+         * carried over, within the bounding sphere's box */
+        vec3 wlo = v3s(INFINITY), whi = v3s(-INFINITY);
         for (int k = 0; k < 8; k++) {
             vec3 pk = v3(k & 1 ? chi.x : clo.x, k & 2 ? chi.y : clo.y, k & 4 ? chi.z : clo.z);
             vec3 w = xform_point(&c->x, pk);
-            blo = v3_min(blo, w);
-            bhi = v3_max(bhi, w);
+            wlo = v3_min(wlo, w);
+            whi = v3_max(whi, w);
         }
+        double br = sqrt(c->br2);
+        clos[m->ncomp] = v3_max(wlo, v3_sub(c->bc, v3s(br)));
+        chis[m->ncomp] = v3_min(whi, v3_add(c->bc, v3s(br)));
+        m->ncomp++;
+        if (c->s <= 0.0 && m->threshold > 0.0) continue; /* cannot make surface on its own */
+        blo = v3_min(blo, wlo);
+        bhi = v3_max(bhi, whi);
     }
-    if (m->ncomp == 0 || !(blo.x <= bhi.x)) return -1;
+    /* a few components per leaf: the sphere test in blob_hits and
+     * blob_field sorts them out */
+    int built = m->ncomp > 0 && geom_bvh_build(&m->comp_bvh, m->ncomp, clos, chis, 4) == 0;
+    free(clos);
+    free(chis);
+    if (!built || !(blo.x <= bhi.x)) return -1;
     if (!(m->threshold > 0.0)) {
         /* threshold <= 0: the surface can lie anywhere the field is
          * positive... or everywhere (0 > threshold far away); keep the
@@ -1065,6 +1172,7 @@ void geom_implicit_free(void *data)
     if (!m) return;
     free(m->pw);
     free(m->comp);
+    geom_bvh_free(&m->comp_bvh);
     free(m);
 }
 
@@ -1122,18 +1230,22 @@ const scene_texture *geom_blob_texture(const geom_shape *sh, vec3 q)
 {
     const im_data *m = sh->data;
     if (!m || m->type != IM_BLOB) return NULL;
+    if (!m->comp_tex) return NULL;
     double best = 0.0;
     const scene_texture *t = NULL;
-    int any = 0;
-    for (int i = 0; i < m->ncomp; i++) {
-        if (m->comp[i].tex) any = 1;
-        double f = blob_comp_field(&m->comp[i], q, NULL);
+    /* a component whose box does not hold q gives it no field */
+    blob_cands cd;
+    cands_at(m, q, &cd);
+    for (int k = 0; k < cd.n; k++) {
+        const blob_comp *c = &m->comp[cd.idx[k]];
+        double f = blob_comp_field(c, q, NULL);
         if (f > best) {
             best = f;
-            t = m->comp[i].tex;
+            t = c->tex;
         }
     }
-    return any ? t : NULL;
+    cands_free(&cd);
+    return t;
 }
 
 /* ------------------------------------------------------------ grid */

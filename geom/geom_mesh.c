@@ -1,33 +1,22 @@
 /* geom_mesh.c - meshes as geom shapes (see geom_mesh.h): a median-split BVH
  * over the triangles' boxes, built once per shape. */
 #include "geom_mesh.h"
-#include "grow.h"
+#include "geom_bvh.h"
 #include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define MESH_LEAF 4
-#define MESH_MAX_DEPTH 60
-#define MESH_STACK 128
 /* POV-Ray's shapes ignore crossings closer than this (DEPTH_TOLERANCE):
  * the inside_vector parity starts just off the point. */
 #define MESH_DEPTH_TOLERANCE 1e-6
 
 typedef struct {
-    vec3 lo, hi;
-    int left, right;  /* children; -1 for a leaf */
-    int first, count; /* leaf: range in `order` */
-} bvh_node;
-
-typedef struct {
     const scene_mesh *m;
     vec3 inside_vector;
     int has_inside;
-    bvh_node *nodes;
-    int nnodes, capnodes;
-    int *order;
-    vec3 *cen; /* triangle box centres (build time only) */
+    geom_bvh bvh; /* over the triangles' boxes */
 } mesh_data;
 
 static vec3 vert(const scene_mesh *m, int i) { return v3(m->verts[i][0], m->verts[i][1], m->verts[i][2]); }
@@ -39,71 +28,11 @@ static void tri_box(const scene_mesh *m, int t, vec3 *lo, vec3 *hi)
     *hi = v3_max(a, v3_max(b, c));
 }
 
-static int node_new(mesh_data *md)
-{
-    if (!grow_array_int((void **)&md->nodes, &md->capnodes, md->nnodes + 1, sizeof *md->nodes)) return -1;
-    return md->nnodes++;
-}
-
-/* Median split on the longest axis of the centres; the depth is about
- * log2(ntris), capped so the query stack cannot overflow. */
-static int split(mesh_data *md, int first, int count, int depth)
-{
-    int id = node_new(md);
-    if (id < 0) return -1;
-    vec3 lo = v3s(INFINITY), hi = v3s(-INFINITY), clo = v3s(INFINITY), chi = v3s(-INFINITY);
-    for (int i = first; i < first + count; i++) {
-        vec3 tl, th;
-        tri_box(md->m, md->order[i], &tl, &th);
-        lo = v3_min(lo, tl);
-        hi = v3_max(hi, th);
-        clo = v3_min(clo, md->cen[md->order[i]]);
-        chi = v3_max(chi, md->cen[md->order[i]]);
-    }
-    md->nodes[id].lo = lo;
-    md->nodes[id].hi = hi;
-    md->nodes[id].left = md->nodes[id].right = -1;
-    md->nodes[id].first = first;
-    md->nodes[id].count = count;
-    if (count <= MESH_LEAF || depth > MESH_MAX_DEPTH) return id;
-    vec3 ext = v3_sub(chi, clo);
-    int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
-    if (v3_idx(ext, axis) <= 0) return id;
-    /* nth element around the median by repeated partition */
-    int lo_i = first, hi_i = first + count - 1, mid = first + count / 2;
-    while (lo_i < hi_i) {
-        double pivot = v3_idx(md->cen[md->order[(lo_i + hi_i) / 2]], axis);
-        int i = lo_i, j = hi_i;
-        while (i <= j) {
-            while (v3_idx(md->cen[md->order[i]], axis) < pivot) i++;
-            while (v3_idx(md->cen[md->order[j]], axis) > pivot) j--;
-            if (i <= j) {
-                int tmp = md->order[i];
-                md->order[i] = md->order[j];
-                md->order[j] = tmp;
-                i++;
-                j--;
-            }
-        }
-        if (mid <= j) hi_i = j;
-        else if (mid >= i) lo_i = i;
-        else break;
-    }
-    int left = split(md, first, mid - first, depth + 1);
-    int right = left < 0 ? -1 : split(md, mid, first + count - mid, depth + 1);
-    if (right < 0) return -1;
-    md->nodes[id].left = left;
-    md->nodes[id].right = right;
-    return id;
-}
-
 void geom_mesh_free(void *data)
 {
     mesh_data *md = data;
     if (!md) return;
-    free(md->nodes);
-    free(md->order);
-    free(md->cen);
+    geom_bvh_free(&md->bvh);
     free(md);
 }
 
@@ -119,27 +48,21 @@ int geom_mesh_init(geom_shape *sh, const scene_object *o)
     md->m = m;
     md->has_inside = o->u.mesh.inside_vector_set;
     md->inside_vector = o->u.mesh.inside_vector;
-    md->order = malloc(sizeof *md->order * (size_t)m->ntris);
-    md->cen = malloc(sizeof *md->cen * (size_t)m->ntris);
-    if (!md->order || !md->cen) {
-        geom_mesh_free(md);
-        return -1;
-    }
+    vec3 *tlo = malloc(sizeof *tlo * (size_t)m->ntris), *thi = malloc(sizeof *thi * (size_t)m->ntris);
     vec3 lo = v3s(INFINITY), hi = v3s(-INFINITY);
-    for (int i = 0; i < m->ntris; i++) {
-        vec3 tl, th;
-        tri_box(m, i, &tl, &th);
-        md->cen[i] = v3_scale(v3_add(tl, th), 0.5);
-        md->order[i] = i;
-        lo = v3_min(lo, tl);
-        hi = v3_max(hi, th);
+    int ok = tlo && thi;
+    for (int i = 0; ok && i < m->ntris; i++) {
+        tri_box(m, i, &tlo[i], &thi[i]);
+        lo = v3_min(lo, tlo[i]);
+        hi = v3_max(hi, thi[i]);
     }
-    if (!v3_finite(lo) || !v3_finite(hi) || split(md, 0, m->ntris, 0) < 0) {
+    ok = ok && v3_finite(lo) && v3_finite(hi) && geom_bvh_build(&md->bvh, m->ntris, tlo, thi, MESH_LEAF) == 0;
+    free(tlo);
+    free(thi);
+    if (!ok) {
         geom_mesh_free(md);
         return -1;
     }
-    free(md->cen);
-    md->cen = NULL;
     sh->data = md;
     sh->olo = lo;
     sh->ohi = hi;
@@ -163,37 +86,32 @@ static int tri_hit(vec3 org, vec3 dir, vec3 a, vec3 b, vec3 c, double *t, double
     return 1;
 }
 
+typedef struct {
+    const scene_mesh *m;
+    vec3 o, d;
+    double tmin, tmax;
+    geom_shape_hit *out;
+    int max, n;
+} mesh_query;
+
+static void mesh_visit(void *ctx, int t)
+{
+    mesh_query *q = ctx;
+    const scene_mesh *m = q->m;
+    assert(t >= 0 && t < m->ntris);
+    double tt, u, v;
+    if (tri_hit(q->o, q->d, vert(m, m->tris[t][0]), vert(m, m->tris[t][1]), vert(m, m->tris[t][2]), &tt, &u, &v) &&
+        tt > q->tmin && tt < q->tmax)
+        q->n = geom_shape_hit_put(q->out, q->n, q->max, tt, t);
+}
+
 int geom_mesh_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     const mesh_data *md = sh->data;
-    if (!md || md->nnodes == 0) return 0;
-    const scene_mesh *m = md->m;
-    int stack[MESH_STACK], sp = 0, n = 0;
-    stack[sp++] = 0;
-    while (sp > 0) {
-        const bvh_node *nd = &md->nodes[stack[--sp]];
-        /* the node's box padded so that a crossing on its faces is not
-         * lost to rounding */
-        vec3 pad = v3s(1e-9 * v3_maxc(v3_sub(nd->hi, nd->lo)) + 1e-300);
-        double t0, t1;
-        if (!v3_slab(o, d, v3_sub(nd->lo, pad), v3_add(nd->hi, pad), &t0, &t1) || t1 < tmin || t0 > tmax) continue;
-        if (nd->left < 0) {
-            for (int i = nd->first; i < nd->first + nd->count; i++) {
-                int t = md->order[i];
-                assert(t >= 0 && t < m->ntris);
-                double tt, u, v;
-                if (tri_hit(o, d, vert(m, m->tris[t][0]), vert(m, m->tris[t][1]), vert(m, m->tris[t][2]), &tt, &u, &v) &&
-                    tt > tmin && tt < tmax)
-                    n = geom_shape_hit_put(out, n, max, tt, t);
-            }
-            continue;
-        }
-        /* the depth cap keeps the stack within MESH_STACK */
-        assert(sp + 2 <= MESH_STACK);
-        stack[sp++] = nd->left;
-        stack[sp++] = nd->right;
-    }
-    return n;
+    if (!md) return 0;
+    mesh_query q = {md->m, o, d, tmin, tmax, out, max, 0};
+    geom_bvh_ray(&md->bvh, o, d, tmin, tmax, mesh_visit, &q);
+    return q.n;
 }
 
 int geom_mesh_inside(const geom_shape *sh, vec3 q)
