@@ -306,9 +306,16 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
         vec3 o, d;
         double tmin;
         user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
+        /* the nearest hit so far is the exact one of the query: a float
+         * tfar rounded up past a second surface within an ulp (a liquid
+         * 1e-8 inside its glass) would let that farther surface win, and
+         * which one did would depend on the traversal order */
+        double tmax = (double)tfar;
+        if (exact && q->uhit && q->ut < tmax) tmax = q->ut;
         geom_csg_hit h;
-        if (!accel_prim_hit(a, args->primID, o, d, tmin, (double)tfar, &h)) continue;
-        SOA_F(ray, N, i, 8) = (float)h.t;
+        if (!accel_prim_hit(a, args->primID, o, d, tmin, tmax, &h)) continue;
+        /* rounded up: a nearer candidate within the ulp is still tried */
+        SOA_F(ray, N, i, 8) = exact ? nextafterf((float)h.t, INFINITY) : (float)h.t;
         vec3 ng = v3(0, 0, 0);
         double u = 0, v = 0;
         if (exact) {
