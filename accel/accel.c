@@ -794,26 +794,12 @@ void accel_free(accel *a)
     for (int i = 0; i < a->ngroups; i++)
         if (a->groups[i].scene) rtcReleaseScene(a->groups[i].scene);
     if (a->dev) rtcReleaseDevice(a->dev);
-    for (int k = 0; k < 2; k++) {
-        free(a->tri[k].v);
-        free(a->tri[k].idx);
-        free(a->tri[k].refs);
-    }
-    free(a->leaves);
+    for (int k = 0; k < 2; k++) GROW_FREE_ALL(a->tri[k].v, a->tri[k].idx, a->tri[k].refs);
     for (int i = 0; i < a->nshapes; i++) geom_shape_release(&a->shapes[i]);
-    free(a->shapes);
-    free(a->shape_leaf);
-    free(a->diags);
-    free(a->groups);
     for (int i = 0; i < a->ncsgs; i++) geom_csg_free(&a->csgs[i]);
-    free(a->csgs);
     for (int i = 0; i < a->nbshapes; i++) geom_shape_release(&a->bshapes[i]);
-    free(a->bshapes);
-    free(a->csg_b0);
-    free(a->csg_bn);
-    free(a->ubox);
-    free(a->ginfo);
-    free(a);
+    GROW_FREE_ALL(a->leaves, a->shapes, a->shape_leaf, a->diags, a->groups, a->csgs, a->bshapes, a->csg_b0, a->csg_bn,
+                  a->ubox, a->ginfo, a);
 }
 
 static inline double eps_rule(double scale, vec3 org, double dirlen)
@@ -941,18 +927,25 @@ static void fill_triangle(const accel *a, const accel_leaf *l, unsigned local, d
     hit->flags = l->flags;
 }
 
+/* The intersect context of a ray org + t dir from t0 (what the user-geometry
+ * callbacks read through accel_tls_query), with no user-geometry hit yet. */
+static void query_init(accel_query *q, vec3 org, vec3 dir, double t0)
+{
+    rtcInitIntersectContext(&q->rtc);
+    q->org = org;
+    q->dir = dir;
+    q->tmin = t0;
+    q->uhit = 0;
+    q->ut = 0.0;
+    q->upart = 0;
+    q->uprim = 0;
+}
+
 /* accel_intersect with the effective tmin t0 as given. */
 static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tmax, accel_hit *hit)
 {
     accel_query q;
-    rtcInitIntersectContext(&q.rtc);
-    q.org = org;
-    q.dir = dir;
-    q.tmin = t0;
-    q.uhit = 0;
-    q.ut = 0.0;
-    q.upart = 0;
-    q.uprim = 0;
+    query_init(&q, org, dir, t0);
     struct RTCRayHit rh;
     fill_rtc_ray(&rh.ray, org, dir, t0, tmax);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -1272,11 +1265,7 @@ int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax)
     if (tmin > t0) t0 = tmin;
     if (!(tmax > t0)) return 0;
     accel_query q;
-    rtcInitIntersectContext(&q.rtc);
-    q.org = org;
-    q.dir = dir;
-    q.tmin = t0;
-    q.uhit = 0;
+    query_init(&q, org, dir, t0);
     struct RTCRay r;
     fill_rtc_ray(&r, org, dir, t0, tmax);
     accel_query *saved = accel_tls_query;

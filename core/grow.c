@@ -10,6 +10,11 @@ size_t grow_capacity(size_t cap, size_t need)
     return nc;
 }
 
+void grow_free_all(void *const *blocks, size_t n)
+{
+    for (size_t i = 0; i < n; i++) free(blocks[i]);
+}
+
 int grow_realloc(void **p, size_t *cap, size_t need, size_t elem)
 {
     size_t nc = grow_capacity(*cap, need);

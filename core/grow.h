@@ -1,6 +1,7 @@
 /* grow.h - growable arrays: the one doubling rule every builder uses for
  * arrays it appends to. The checks are inline (appends run in inner
- * loops); only a growth calls out. */
+ * loops); only a growth calls out. And the arrays a structure owns, freed
+ * together (GROW_FREE_ALL). */
 #ifndef PT_GROW_H
 #define PT_GROW_H
 #include <limits.h>
@@ -41,5 +42,13 @@ static inline int grow_array_long(void **p, long *cap, long need, size_t elem)
     *cap = c > (size_t)LONG_MAX ? LONG_MAX : (long)c;
     return 1;
 }
+
+/* Frees each of the n blocks (free(NULL) does nothing): the arrays a
+ * structure owns, freed in one call. */
+void grow_free_all(void *const *blocks, size_t n);
+/* grow_free_all over the pointers listed: GROW_FREE_ALL(s->a, s->b, ...).
+ * Each is converted to void * as an initialiser (any object pointer). */
+#define GROW_FREE_ALL(...) \
+    grow_free_all((void *const[]){__VA_ARGS__}, sizeof((void *const[]){__VA_ARGS__}) / sizeof(void *))
 
 #endif

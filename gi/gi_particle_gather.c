@@ -32,6 +32,7 @@
 #include <string.h>
 #include "gi_cl_c.h"
 #include "gi_links.h"
+#include "grow.h"
 #include "hash.h"
 #include "pool.h"
 #include "timer.h"
@@ -75,24 +76,14 @@ static int compatible(const gi_particle *gp, size_t i, size_t j)
 
 void gi_particle_view_gather_free(gi_particle *gp)
 {
-    free(gp->vg_pt);
-    free(gp->vg_ids);
-    free(gp->vg_tab);
+    GROW_FREE_ALL(gp->vg_pt, gp->vg_ids, gp->vg_tab, gp->vg_link, gp->vg_esky, gp->vg_val, gp->vg_pix, gp->vg_pixval,
+                  gp->vg_nrm);
     gp->vg_pt = NULL;
-    gp->vg_ids = NULL;
     gp->vg_tab = NULL;
-    gp->vg_levels = 0;
-    free(gp->vg_link);
-    free(gp->vg_esky);
-    free(gp->vg_val);
-    free(gp->vg_pix);
-    free(gp->vg_pixval);
-    free(gp->vg_nrm);
-    gp->vg_pixval = NULL;
     gp->vg_nrm = NULL;
-    gp->vg_link = NULL;
-    gp->vg_esky = gp->vg_val = NULL;
-    gp->vg_pix = NULL;
+    gp->vg_ids = gp->vg_link = gp->vg_pix = NULL;
+    gp->vg_esky = gp->vg_val = gp->vg_pixval = NULL;
+    gp->vg_levels = 0;
     gp->vg_n = 0;
     gp->vg_w = gp->vg_h = 0;
 }

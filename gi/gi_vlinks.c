@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "gi_particle_internal.h"
+#include "grow.h"
 #include "hash.h"
 #include "gi_vlinks_c.h"
 #include "pool.h"
@@ -509,33 +510,10 @@ gi_vlinks *gi_vlinks_new(const gi_vlinks_settings *s)
 
 static void free_structure(gi_vlinks *v)
 {
-    for (long e = 0; e < v->ne && v->lk; e++) {
-        free(v->lk[e].peer);
-        free(v->lk[e].w);
-        free(v->lk[e].far);
-    }
-    free(v->lk);
-    free(v->mesh);
-    free(v->leaf_mesh);
-    free(v->pos);
-    free(v->nrm);
-    free(v->org);
-    free(v->vmesh_of);
-    free(v->rho);
-    free(v->le);
-    free(v->ray_t);
-    free(v->ray_leaf);
-    free(v->edir);
-    free(v->efar);
-    free(v->b0);
-    free(v->b1);
-    free(v->itot);
-    free(v->ism);
-    free(v->off_csr);
-    free(v->peer_csr);
-    free(v->w_csr);
-    free(v->adj_off);
-    free(v->adj);
+    for (long e = 0; e < v->ne && v->lk; e++) GROW_FREE_ALL(v->lk[e].peer, v->lk[e].w, v->lk[e].far);
+    GROW_FREE_ALL(v->lk, v->mesh, v->leaf_mesh, v->pos, v->nrm, v->org, v->vmesh_of, v->rho, v->le, v->ray_t,
+                  v->ray_leaf, v->edir, v->efar, v->b0, v->b1, v->itot, v->ism, v->off_csr, v->peer_csr, v->w_csr,
+                  v->adj_off, v->adj);
     v->lk = NULL;
     v->mesh = NULL;
     v->leaf_mesh = NULL;
