@@ -12,110 +12,56 @@ void scene_default_finish(scene_finish *f)
 {
     /* POV-Ray 3.7 reference, section "Finish": ambient 0.1, diffuse 0.6,
      * brilliance 1, phong_size 40, roughness 0.05, falloff/exponent 1. */
-    memset(f, 0, sizeof *f);
-    f->ambient = (rgb){0.1, 0.1, 0.1};
-    f->diffuse = 0.6;
-    f->brilliance = 1.0;
-    f->phong_size = 40.0;
-    f->roughness = 0.05;
-    f->reflection_falloff = 1.0;
-    f->reflection_exponent = 1.0;
+    *f = (scene_finish){.ambient = {0.1, 0.1, 0.1}, .diffuse = 0.6, .brilliance = 1.0, .phong_size = 40.0,
+                        .roughness = 0.05, .reflection_falloff = 1.0, .reflection_exponent = 1.0};
 }
 
 void scene_default_pigment(scene_pigment *p)
 {
     /* Default pigment is black (POV-Ray 3.7 reference, "Pigment"). */
-    memset(p, 0, sizeof *p);
-    p->kind = PIGMENT_SOLID;
-    p->transform = xform_identity();
+    *p = (scene_pigment){.kind = PIGMENT_SOLID, .transform = xform_identity()};
 }
 
 void scene_default_interior(scene_interior *i)
 {
-    memset(i, 0, sizeof *i);
-    i->ior = 1.0;
-    i->dispersion = 1.0;
-    i->dispersion_samples = 7;
-    i->fade_power = 0.0;
+    *i = (scene_interior){.ior = 1.0, .dispersion = 1.0, .dispersion_samples = 7};
 }
 
 void scene_default_camera(scene_camera *c)
 {
     /* POV-Ray 3.7 defaults: location <0,0,0>, direction <0,0,1>, up <0,1,0>,
-     * right <1.33,0,0>, sky <0,1,0>. */
-    memset(c, 0, sizeof *c);
-    c->kind = CAMERA_PERSPECTIVE;
-    c->direction = v3(0, 0, 1);
-    c->up = v3(0, 1, 0);
-    c->right = v3(1.33, 0, 0);
-    c->sky = v3(0, 1, 0);
-    c->look_at = v3(0, 0, 1);
-    c->blur_samples = 0;
-    c->blur_samples_min = 0;
-    c->confidence = 0.9;        /* POV-Ray 3.7 camera.cpp */
-    c->variance = 1.0 / 10000.0;
+     * right <1.33,0,0>, sky <0,1,0>; confidence and variance: camera.cpp. */
+    *c = (scene_camera){.kind = CAMERA_PERSPECTIVE, .direction = {0, 0, 1}, .up = {0, 1, 0}, .right = {1.33, 0, 0},
+                        .sky = {0, 1, 0}, .look_at = {0, 0, 1}, .confidence = 0.9, .variance = 1.0 / 10000.0};
 }
 
 void scene_default_light(scene_light *l)
 {
-    /* spotlight defaults: radius 30, falloff 45, tightness 0 (3.7 docs). */
-    memset(l, 0, sizeof *l);
-    l->kind = LIGHT_POINT;
-    l->colour = (rgb){1, 1, 1};
-    l->point_at = v3(0, 0, 1);
-    l->radius = 30.0;
-    l->falloff = 45.0;
-    l->tightness = 0.0;
-    l->adaptive = -1;
-    l->fade_power = 0.0;
-    l->media_interaction = 1;
-    l->media_attenuation = 0;
+    /* spotlight defaults: radius 30, falloff 45, tightness 0 (3.7 docs);
+     * adaptive -1: not given. */
+    *l = (scene_light){.kind = LIGHT_POINT, .colour = {1, 1, 1}, .point_at = {0, 0, 1}, .radius = 30.0,
+                       .falloff = 45.0, .adaptive = -1, .media_interaction = 1};
 }
 
 void scene_default_photons(scene_photons *p)
 {
     /* POV-Ray 3.7 parser.cpp, global_settings photons: the values it sets
      * before reading the block */
-    memset(p, 0, sizeof *p);
-    p->spacing = 1.0;
-    p->autostop = 0.5;
-    p->jitter = 0.4;
-    p->max_trace_level = -1;
-    p->adc_bailout = -1.0;
-    p->expand_tolerance = 0.2;
-    p->expand_min = 35;
-    p->gather_min = 20;
-    p->gather_max = 100;
-    p->radius[0] = -1.0;
-    p->radius[1] = 1.0;
-    p->radius[2] = -1.0;
-    p->radius[3] = 1.0;
-    p->media_factor = 1.0;
+    *p = (scene_photons){.spacing = 1.0, .autostop = 0.5, .jitter = 0.4, .max_trace_level = -1, .adc_bailout = -1.0,
+                         .expand_tolerance = 0.2, .expand_min = 35, .gather_min = 20, .gather_max = 100,
+                         .radius = {-1.0, 1.0, -1.0, 1.0}, .media_factor = 1.0};
 }
 
 static void scene_default_global(scene_global *g)
 {
-    memset(g, 0, sizeof *g);
-    g->ambient_light = (rgb){1, 1, 1};
-    g->max_trace_level = 5;
-    g->adc_bailout = 1.0 / 255.0;
-    g->noise_generator = 2;
-    scene_radiosity *r = &g->radiosity;
-    /* radiosity defaults, POV-Ray 3.7 reference "Radiosity". */
-    r->count = 35;
-    r->recursion_limit = 2;
-    r->error_bound = 1.8;
-    r->pretrace_start = 0.08;
-    r->pretrace_end = 0.04;
-    r->nearest_count = 5;
-    r->brightness = 1.0;
-    r->gray_threshold = 0.0;
-    r->low_error_factor = 0.5;
-    r->minimum_reuse = 0.015;
-    r->adc_bailout = 0.01;
-    r->max_sample = -1.0;
-    r->maximum_reuse = 0.2;
-    r->direction_pool = 1600; /* raised to `count` when that is larger */
+    *g = (scene_global){.ambient_light = {1, 1, 1}, .max_trace_level = 5, .adc_bailout = 1.0 / 255.0,
+                        .noise_generator = 2};
+    /* radiosity defaults, POV-Ray 3.7 reference "Radiosity"; the direction
+     * pool is raised to `count` when that is larger */
+    g->radiosity = (scene_radiosity){.count = 35, .recursion_limit = 2, .error_bound = 1.8, .pretrace_start = 0.08,
+                                     .pretrace_end = 0.04, .nearest_count = 5, .brightness = 1.0,
+                                     .low_error_factor = 0.5, .minimum_reuse = 0.015, .adc_bailout = 0.01,
+                                     .max_sample = -1.0, .maximum_reuse = 0.2, .direction_pool = 1600};
     scene_default_photons(&g->photons);
 }
 
