@@ -199,14 +199,9 @@ static int parse_size(const char *v, cli_render *o)
 
 int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen)
 {
-    memset(o, 0, sizeof *o);
-    o->kfi = o->kff = 1; /* POV-Ray's Initial_Frame, Final_Frame, Initial_Clock, Final_Clock */
-    o->kf = 1;
-    o->aa_threshold = 0.3;
-    o->aa_depth = 3;
-    o->quality = 9;
-    o->spp = 1;
-    o->exr_compression = -1;
+    /* POV-Ray's Initial_Frame, Final_Frame, Initial_Clock, Final_Clock, +A threshold, +R, +Q */
+    *o = (cli_render){.kfi = 1, .kff = 1, .kf = 1, .aa_threshold = 0.3, .aa_depth = 3, .quality = 9, .spp = 1,
+                      .exr_compression = -1};
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *next = i + 1 < argc ? argv[i + 1] : NULL;

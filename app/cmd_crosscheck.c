@@ -96,12 +96,7 @@ static int parse_int(const char *s, int *out)
 
 static int parse_args(int argc, char **argv, xc_opts *o)
 {
-    memset(o, 0, sizeof *o);
-    o->width = 320;
-    o->height = 240;
-    o->aa_threshold = 0.3;
-    o->aa_depth = 3;
-    o->converged_timeout = 1800.0;
+    *o = (xc_opts){.width = 320, .height = 240, .aa_threshold = 0.3, .aa_depth = 3, .converged_timeout = 1800.0};
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         int takes = strcmp(a, "--size") == 0 || strcmp(a, "--threads") == 0 || strcmp(a, "--out") == 0 ||

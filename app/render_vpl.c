@@ -62,17 +62,8 @@
 
 void render_vpl_default_settings(render_vpl_settings *s)
 {
-    memset(s, 0, sizeof *s);
-    s->spp = 16;
-    s->vpls = 16384;
-    s->bounces = 1;
-    s->threshold = 0.02;
-    s->cut = RENDER_VPL_MINMAX;
-    s->min_cut = 40.0;
-    s->max_cut = 9.0;
-    s->adaptive = 1;
-    s->epsilon = 0.3;
-    s->lambda = 16.0;
+    *s = (render_vpl_settings){.spp = 16, .vpls = 16384, .bounces = 1, .threshold = 0.02, .cut = RENDER_VPL_MINMAX,
+                               .min_cut = 40.0, .max_cut = 9.0, .adaptive = 1, .epsilon = 0.3, .lambda = 16.0};
 }
 
 static inline double lum(rgb c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }

@@ -24,20 +24,8 @@
 
 void gi_particle_default_settings(gi_particle_settings *s)
 {
-    memset(s, 0, sizeof *s);
-    s->count = 50000;
-    s->scatter_side = 4;
-    s->gather_side = 16;
-    s->bounces = 8;
-    s->tess = 0.0;
-    s->tess_factor = 3.0;
-    s->radius = 0.0;
-    s->radius_factor = 3.0;
-    s->normal_cos = 0.9;
-    s->area_samples = 0;
-    s->brightness = 1.0;
-    s->seed = 0;
-    s->threads = 0;
+    *s = (gi_particle_settings){.count = 50000, .scatter_side = 4, .gather_side = 16, .bounces = 8, .tess_factor = 3.0,
+                                .radius_factor = 3.0, .normal_cos = 0.9, .brightness = 1.0};
 }
 
 void gi_particle_settings_from_scene(gi_particle_settings *s, const scene *sc)

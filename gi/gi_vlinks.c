@@ -486,10 +486,7 @@ static void light_chunk(void *ctx, int ci, int thread)
 
 void gi_vlinks_default_settings(gi_vlinks_settings *s)
 {
-    memset(s, 0, sizeof *s);
-    s->nside = 16;
-    s->bounces = 0;
-    s->feature_deg = 30.0;
+    *s = (gi_vlinks_settings){.nside = 16, .feature_deg = 30.0};
 }
 
 gi_vlinks *gi_vlinks_new(const gi_vlinks_settings *s)

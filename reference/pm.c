@@ -14,14 +14,7 @@
 
 void pm_common_defaults(pm_common *c)
 {
-    memset(c, 0, sizeof *c);
-    c->width = 320;
-    c->height = 240;
-    c->threads = 0;
-    c->seed = 0;
-    c->spp = 1;
-    c->jitter = 1;
-    c->image_interval = 10.0;
+    *c = (pm_common){.width = 320, .height = 240, .spp = 1, .jitter = 1, .image_interval = 10.0};
 }
 
 uint64_t pm_mix64(uint64_t z) { return pt_mix64(z + 0x9e3779b97f4a7c15ULL); }

@@ -495,10 +495,7 @@ static void cam_job(void *ctx, int y, int thread)
 
 void pm_detp_default_settings(pm_detp_settings *s)
 {
-    memset(s, 0, sizeof *s);
-    s->photons = PM_DETP_PHOTONS;
-    s->max_bounces = 256;
-    s->seed = 1;
+    *s = (pm_detp_settings){.photons = PM_DETP_PHOTONS, .max_bounces = 256, .seed = 1};
 }
 
 pm_detp *pm_detp_new(const pm_detp_settings *s)

@@ -34,7 +34,9 @@
 
 void pm_fg_default_settings(pm_fg_settings *s)
 {
-    memset(s, 0, sizeof *s);
+    *s = (pm_fg_settings){.photons = 1000000, .fg_rays = 4096, .k_global = 64, .k_caustic = 32, .irradiance_stride = 4,
+                          .caustics = -1, .area_samples = 4, .emitter_samples = 4, .max_eye_depth = 16,
+                          .max_gather_depth = 8, .max_photon_bounces = 256};
     pm_common_defaults(&s->c);
     /* 64 eye samples per pixel, the gather rays and light samples split over
      * them (4 area-light and 4 emitter samples each: 256 per pixel): with
@@ -43,17 +45,6 @@ void pm_fg_default_settings(pm_fg_settings *s)
      * tops of radiosity/cornell.pov against an antialiased path image); 16
      * still left pixels of thin lit strips at half of path's (balcony.pov) */
     s->c.spp = 64;
-    s->photons = 1000000;
-    s->fg_rays = 4096;
-    s->k_global = 64;
-    s->k_caustic = 32;
-    s->irradiance_stride = 4;
-    s->caustics = -1;
-    s->area_samples = 4;
-    s->emitter_samples = 4;
-    s->max_eye_depth = 16;
-    s->max_gather_depth = 8;
-    s->max_photon_bounces = 256;
 }
 
 typedef struct {

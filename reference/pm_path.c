@@ -25,13 +25,9 @@
 
 void pm_path_default_settings(pm_path_settings *s)
 {
-    memset(s, 0, sizeof *s);
+    *s = (pm_path_settings){.rr_depth = 3, .rr_threshold = 0.1, .area_samples = 1};
     pm_common_defaults(&s->c);
     s->c.spp = 64;
-    s->max_depth = 0;
-    s->rr_depth = 3;
-    s->rr_threshold = 0.1;
-    s->area_samples = 1;
 }
 
 typedef struct {

@@ -114,17 +114,9 @@ static double shade_colour_distance(rgb a, rgb b) { return fabs(a.r - b.r) + fab
 
 void shade_default_settings(shade_settings *s)
 {
-    memset(s, 0, sizeof *s);
-    s->width = 320;
-    s->height = 240;
-    s->threads = 0;
-    s->seed = 0;
-    s->antialias = 0;
-    s->aa_threshold = 0.3; /* POV-Ray's +A default threshold */
-    s->aa_depth = 3;       /* +R default 3 */
-    s->spp = 1;
-    s->use_ambient = 1;
-    s->quality = 9;
+    /* POV-Ray's defaults: +A threshold 0.3, +R3, +Q9 */
+    *s = (shade_settings){.width = 320, .height = 240, .aa_threshold = 0.3, .aa_depth = 3, .spp = 1, .use_ambient = 1,
+                          .quality = 9};
 }
 
 /* ------------------------------------------------------------------ lights */
