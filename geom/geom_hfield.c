@@ -3,9 +3,10 @@
  * Work happens in grid coordinates (X, Y, Z) = (x (W-1), y, z (H-1)), where
  * cells are unit squares; the ray parameter is the same in both. Node
  * (level l, ix, iz) of the quadtree covers cells [ix 2^l, (ix+1) 2^l) x
- * [iz 2^l, (iz+1) 2^l) and stores their height range; children are visited
- * in the order given by the signs of the ray direction, which is front to
- * back for a monotonic 2-D walk, so the search can stop at the first hit. */
+ * [iz 2^l, (iz+1) 2^l) and stores their height range. A ray walks the
+ * nodes along its path front to back (geom_hfield_hits), going down where
+ * its height meets a node's range and on to the next node where it does
+ * not, so the search can stop at the first hit. */
 #include "geom_hfield.h"
 #include <float.h>
 #include <math.h>
@@ -137,90 +138,112 @@ static void cell_tri(const hf_data *f, int i, int j, int k, vec3 *a, vec3 *b, ve
     }
 }
 
-typedef struct {
-    const hf_data *f;
-    vec3 o, d;      /* grid space */
-    double tmin;
-    geom_shape_hit *out;
-    int n, max;
-    double tmax;    /* shrinks once `max` hits are held */
-    double oa[3], inv[3]; /* o and 1/d by axis (inv 0 where d is 0), once per ray */
-} hf_walk;
-
-static int box_range(const hf_walk *w, double x0, double x1, double y0, double y1, double z0, double z1, double *ta,
-                     double *tb)
+/* The hits of one cell's two triangles with t in (tmin, tmax) go into out
+ * (n held so far, at most max). */
+static int cell_hits(const hf_data *f, int ix, int iz, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out,
+                     int n, int max)
 {
-    double lo[3] = {x0, y0, z0}, hi[3] = {x1, y1, z1};
-    const double *o = w->oa;
-    double a = w->tmin, b = w->tmax;
-    for (int k = 0; k < 3; k++) {
-        if (w->inv[k] == 0.0) {
-            if (o[k] < lo[k] || o[k] > hi[k]) return 0;
-            continue;
-        }
-        double p = (lo[k] - o[k]) * w->inv[k], q = (hi[k] - o[k]) * w->inv[k];
-        if (p > q) { double t = p; p = q; q = t; }
-        /* a hair of slack so grid lines do not leak */
-        double sl = 1e-12 * (fabs(p) + fabs(q)) + 1e-300;
-        if (p - sl > a) a = p - sl;
-        if (q + sl < b) b = q + sl;
-        if (!(a <= b)) return 0;
+    for (int tri = 0; tri < 2; tri++) {
+        vec3 a, b, c;
+        double t;
+        cell_tri(f, ix, iz, tri, &a, &b, &c);
+        if (tri_hit(o, d, a, b, c, &t) && t > tmin && t < tmax)
+            n = geom_shape_hit_put(out, n, max, t, (int)(2 * ((size_t)iz * f->nx + ix) + tri));
     }
-    *ta = a;
-    *tb = b;
-    return 1;
+    return n;
 }
 
-static void walk(hf_walk *w, int lev, int ix, int iz)
+/* Plain comparisons: libm's fmin and fmax are calls (NaN rules) and the
+ * walk's values are never NaN. */
+static inline double dmin(double a, double b) { return a < b ? a : b; }
+static inline double dmax(double a, double b) { return a > b ? a : b; }
+
+/* Node (lev, ix, iz)'s footprint on axis k (0: X, 1: Z): [*lo, *hi]. */
+static void node_span(const hf_data *f, int lev, int i, int k, double *lo, double *hi)
 {
-    const hf_data *f = w->f;
-    if (ix >= f->lw[lev] || iz >= f->lh[lev]) return;
-    int span = 1 << lev;
-    double x0 = (double)ix * span, z0 = (double)iz * span;
-    double x1 = fmin((double)(ix + 1) * span, f->nx), z1 = fmin((double)(iz + 1) * span, f->nz);
-    size_t k = (size_t)iz * f->lw[lev] + ix;
-    double ta, tb;
-    if (!box_range(w, x0, x1, f->mn[lev][k], f->mx[lev][k], z0, z1, &ta, &tb)) return;
-    if (w->n == w->max && ta > w->out[w->max - 1].t) return;
-    if (lev == 0) {
-        for (int tri = 0; tri < 2; tri++) {
-            vec3 a, b, c;
-            double t;
-            cell_tri(f, ix, iz, tri, &a, &b, &c);
-            if (tri_hit(w->o, w->d, a, b, c, &t) && t > w->tmin && t < w->tmax) {
-                w->n = geom_shape_hit_put(w->out, w->n, w->max, t, (int)(2 * ((size_t)iz * f->nx + ix) + tri));
-                if (w->n == w->max) w->tmax = fmin(w->tmax, w->out[w->max - 1].t);
-            }
-        }
-        return;
-    }
-    int fx = w->d.x < 0.0, fz = w->d.z < 0.0;
-    for (int c = 0; c < 4; c++) {
-        int cx = (c & 1) ^ fx, cz = ((c >> 1) & 1) ^ fz;
-        walk(w, lev - 1, 2 * ix + cx, 2 * iz + cz);
-    }
+    double s = (double)(1 << lev), n = k ? f->nz : f->nx;
+    *lo = (double)i * s;
+    *hi = dmin((double)(i + 1) * s, n);
+}
+
+/* The ray's parameter where it leaves [lo, hi] on an axis with origin o
+ * and inverse direction inv (0: parallel, never). */
+static double axis_exit(double o, double inv, double lo, double hi)
+{
+    if (inv == 0.0) return INFINITY;
+    return ((inv > 0.0 ? hi : lo) - o) * inv;
 }
 
 int geom_hfield_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     const hf_data *f = sh->data;
     if (!f || max <= 0) return 0;
-    hf_walk w;
-    w.f = f;
-    w.o = v3(o.x * f->nx, o.y, o.z * f->nz);
-    w.d = v3(d.x * f->nx, d.y, d.z * f->nz);
-    w.tmin = tmin;
-    w.tmax = tmax;
-    w.out = out;
-    w.n = 0;
-    w.max = max;
-    double dd[3] = {w.d.x, w.d.y, w.d.z};
-    w.oa[0] = w.o.x;
-    w.oa[1] = w.o.y;
-    w.oa[2] = w.o.z;
-    for (int k = 0; k < 3; k++) w.inv[k] = dd[k] != 0.0 ? 1.0 / dd[k] : 0.0;
-    walk(&w, f->nlev - 1, 0, 0);
-    return w.n;
+    /* grid space: cells are unit squares, t is unchanged */
+    vec3 go = v3(o.x * f->nx, o.y, o.z * f->nz), gd = v3(d.x * f->nx, d.y, d.z * f->nz);
+    double ta, tb;
+    /* the grid's box, a hair wider so its faces do not leak */
+    vec3 pad = v3(1e-9 * f->nx, 1e-9 * (f->yhi - f->ylo) + 1e-300, 1e-9 * f->nz);
+    if (!v3_slab(go, gd, v3_sub(v3(0.0, f->ylo, 0.0), pad), v3_add(v3(f->nx, f->yhi, f->nz), pad), &ta, &tb)) return 0;
+    ta = fmax(ta, tmin);
+    tb = fmin(tb, tmax);
+    if (!(ta <= tb)) return 0;
+    double inv_x = gd.x != 0.0 ? 1.0 / gd.x : 0.0, inv_z = gd.z != 0.0 ? 1.0 / gd.z : 0.0;
+    int sx = gd.x < 0.0 ? -1 : 1, sz = gd.z < 0.0 ? -1 : 1;
+    /* A front-to-back walk of the min/max quadtree along the ray, as a
+     * hierarchical grid traversal: the node the ray is in at t is entered
+     * when the ray's height over the node's stretch of it meets the node's
+     * height range (a leaf: its triangles are tested), else the ray moves
+     * on to the neighbouring node, up a level when it leaves the parent.
+     * Node indices change by whole steps, so the walk ends after at most
+     * one visit per node along the ray. */
+    int top = f->nlev - 1, lev = top, ix = 0, iz = 0, n = 0;
+    double t = ta;
+    for (;;) {
+        double x0, x1, z0, z1;
+        node_span(f, lev, ix, 0, &x0, &x1);
+        node_span(f, lev, iz, 1, &z0, &z1);
+        double ex = axis_exit(go.x, inv_x, x0, x1), ez = axis_exit(go.z, inv_z, z0, z1);
+        double te = dmin(dmin(ex, ez), tb);
+        if (te < t) te = t;
+        double y0 = go.y + t * gd.y, y1 = go.y + te * gd.y;
+        double ylo = dmin(y0, y1), yhi = dmax(y0, y1), sl = 1e-12 * (fabs(ylo) + fabs(yhi)) + 1e-300;
+        size_t k = (size_t)iz * f->lw[lev] + ix;
+        if (yhi + sl >= f->mn[lev][k] && ylo - sl <= f->mx[lev][k]) {
+            if (lev > 0) {
+                /* down to the child holding the ray at t (on a split line:
+                 * the one the ray goes on into; the lower one for a ray
+                 * along the line) */
+                double px = go.x + t * gd.x, pz = go.z + t * gd.z, mx = (ix * 2 + 1) * (double)(1 << (lev - 1)),
+                       mz = (iz * 2 + 1) * (double)(1 << (lev - 1));
+                lev--;
+                int cx = px > mx || (px == mx && gd.x > 0.0), cz = pz > mz || (pz == mz && gd.z > 0.0);
+                ix = 2 * ix + cx;
+                iz = 2 * iz + cz;
+                if (ix >= f->lw[lev]) ix = f->lw[lev] - 1;
+                if (iz >= f->lh[lev]) iz = f->lh[lev] - 1;
+                continue;
+            }
+            n = cell_hits(f, ix, iz, go, gd, tmin, tmax, out, n, max);
+        }
+        /* a cell's hits lie within its stretch of the ray: once `max` are
+         * held and the nearest `max` end before the next node, none can
+         * replace them */
+        if (te >= tb || (n == max && out[max - 1].t <= te)) break;
+        t = te;
+        int ox = ix, oz = iz;
+        if (ex <= ez) ix += sx;
+        else iz += sz;
+        if (ix < 0 || iz < 0 || ix >= f->lw[lev] || iz >= f->lh[lev]) break;
+        /* up while the step left the parent */
+        while (lev < top && ((ox >> 1) != (ix >> 1) || (oz >> 1) != (iz >> 1))) {
+            ox >>= 1;
+            oz >>= 1;
+            ix >>= 1;
+            iz >>= 1;
+            lev++;
+        }
+    }
+    return n;
 }
 
 /* Cell and local coordinates of a grid point (clamped into the grid). */
