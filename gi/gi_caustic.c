@@ -575,78 +575,126 @@ static void gbuf_row(void *ctx, int y, int thread)
 
 /* ------------------------------------------------------------ binning and splat */
 
-static int int_cmp(const void *a, const void *b) { return *(const int *)a - *(const int *)b; }
+
+/* Binning, photon by photon: the tiles' bounds (the valid G-buffer points
+ * of each GI_CAUS_TILE-pixel tile) sit in a hierarchy, tiles in blocks of
+ * BIN_FAN x BIN_FAN tiles, blocks in blocks of those, up to a top level of
+ * at most BIN_FAN x BIN_FAN boxes; a photon goes down into each box its
+ * kernel sphere reaches and is listed in each tile it reaches. The cost is the photons' overlap with
+ * the image plus a few box tests each, whatever the photons' spread in
+ * space (a walk over a grid of photons per tile visited every empty cell of
+ * a tile's bounds: a tile seeing far-off walls spans many). */
+#define BIN_FAN 4
+#define BIN_MAX_LEVELS 12
+#define BIN_CHUNK 4096
+
+typedef struct {
+    float lo[3], hi[3]; /* lo > hi: no valid point */
+} bin_box;
+
+typedef struct {
+    int nx, ny;   /* boxes in a row, rows */
+    bin_box *box;
+} bin_level;
 
 typedef struct {
     gi_caustic *c;
-    int **lists;
-    int *counts;
-    int *stamps;   /* threads x nph */
+    bin_level lv[BIN_MAX_LEVELS]; /* 0: tiles, then blocks of the level below */
+    int nlv;
+    int **pairs;      /* per chunk: (tile, photon) pairs, photons ascending */
+    long *npairs, *caps;
 } bin_job;
 
-static void bin_tile(void *ctx, int t, int thread)
+static int sphere_meets_box(const gi_caus_photon *p, const bin_box *b)
 {
-    bin_job *bj = ctx;
-    gi_caustic *c = bj->c;
-    int tx = t % c->tiles_x, ty = t / c->tiles_x;
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    int any = 0;
-    for (int y = ty * GI_CAUS_TILE; y < (ty + 1) * GI_CAUS_TILE && y < c->h; y++)
-        for (int x = tx * GI_CAUS_TILE; x < (tx + 1) * GI_CAUS_TILE && x < c->w; x++) {
+    if (!(b->lo[0] <= b->hi[0])) return 0;
+    float dd = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        float e = p->x[k] < b->lo[k] ? b->lo[k] - p->x[k] : (p->x[k] > b->hi[k] ? p->x[k] - b->hi[k] : 0.0f);
+        dd += e * e;
+    }
+    return dd <= p->r_xy * p->r_xy;
+}
+
+static void box_add(bin_box *b, const float *s)
+{
+    for (int k = 0; k < 3; k++) {
+        b->lo[k] = fminf(b->lo[k], s[k]);
+        b->hi[k] = fmaxf(b->hi[k], s[k]);
+    }
+}
+
+static int bin_levels(gi_caustic *c, bin_level *lv, int *nlv)
+{
+    lv[0].nx = c->tiles_x;
+    lv[0].ny = c->tiles_y;
+    int n = 1;
+    while (n < BIN_MAX_LEVELS && (lv[n - 1].nx > BIN_FAN || lv[n - 1].ny > BIN_FAN)) {
+        lv[n].nx = (lv[n - 1].nx + BIN_FAN - 1) / BIN_FAN;
+        lv[n].ny = (lv[n - 1].ny + BIN_FAN - 1) / BIN_FAN;
+        n++;
+    }
+    *nlv = n;
+    for (int l = 0; l < n; l++) {
+        lv[l].box = malloc(sizeof(bin_box) * (size_t)lv[l].nx * (size_t)lv[l].ny);
+        if (!lv[l].box) return 0;
+        for (long i = 0; i < (long)lv[l].nx * lv[l].ny; i++)
+            for (int k = 0; k < 3; k++) {
+                lv[l].box[i].lo[k] = INFINITY;
+                lv[l].box[i].hi[k] = -INFINITY;
+            }
+    }
+    for (int y = 0; y < c->h; y++)
+        for (int x = 0; x < c->w; x++) {
             const gi_caus_pixel *px = &c->gb[(size_t)y * c->w + x];
             if (!(px->valid > 0.0f)) continue;
-            any = 1;
-            for (int k = 0; k < 3; k++) {
-                lo[k] = fmin(lo[k], px->s[k]);
-                hi[k] = fmax(hi[k], px->s[k]);
+            int tx = x / GI_CAUS_TILE, ty = y / GI_CAUS_TILE;
+            for (int l = 0; l < *nlv; l++) {
+                box_add(&lv[l].box[(size_t)ty * lv[l].nx + tx], px->s);
+                tx /= BIN_FAN;
+                ty /= BIN_FAN;
             }
         }
-    bj->lists[t] = NULL;
-    bj->counts[t] = 0;
-    if (!any || c->nph == 0) return;
-    int *stamp = bj->stamps + (size_t)thread * (size_t)c->nph;
-    int n = 0, cap = 0;
-    int *list = NULL;
-    double cell = c->pgrid.cell;
-    long x0 = cidx(lo[0], cell), x1 = cidx(hi[0], cell), y0 = cidx(lo[1], cell), y1 = cidx(hi[1], cell);
-    long z0 = cidx(lo[2], cell), z1 = cidx(hi[2], cell);
-    double ncells = (double)(x1 - x0 + 1) * (double)(y1 - y0 + 1) * (double)(z1 - z0 + 1);
-    int brute = ncells > (double)c->nph;
-    /* candidates: every photon (brute), or the photons of the cells the box
-     * touches and the big ones; exact test: the kernel sphere meets the box */
-    for (int pass = 0; pass < 2; pass++) {
-        long nbig = pass == 0 ? c->pgrid.nbig : 0;
-        if (pass == 1 && brute) break;
-        for (long xi = pass ? x0 : 0; pass ? xi <= x1 : xi < 1; xi++)
-            for (long yi = pass ? y0 : 0; pass ? yi <= y1 : yi < 1; yi++)
-                for (long zi = pass ? z0 : 0; pass ? zi <= z1 : zi < 1; zi++) {
-                    long a = 0, b = 0;
-                    if (pass) hgrid_cell(&c->pgrid, xi, yi, zi, &a, &b);
-                    long m = pass ? b - a : (brute ? c->nph : nbig);
-                    for (long q = 0; q < m; q++) {
-                        int id = pass ? c->pgrid.e[a + q].id : (brute ? (int)q : c->pgrid.big[q]);
-                        if (stamp[id] == t + 1) continue;
-                        stamp[id] = t + 1;
-                        const gi_caus_photon *p = &c->ph[id];
-                        double dd = 0.0;
-                        for (int k = 0; k < 3; k++) {
-                            double e = p->x[k] < lo[k] ? lo[k] - p->x[k] : (p->x[k] > hi[k] ? p->x[k] - hi[k] : 0.0);
-                            dd += e * e;
-                        }
-                        if (dd > (double)p->r_xy * p->r_xy) continue;
-                        if (!grow_array_int((void **)&list, &cap, n + 1, sizeof *list)) {
-                            free(list);
-                            bj->counts[t] = -1;
-                            return;
-                        }
-                        list[n++] = id;
-                    }
+    return 1;
+}
+
+static int push_pair(bin_job *bj, int ci, int tile, int id)
+{
+    if (!grow_array_long((void **)&bj->pairs[ci], &bj->caps[ci], 2 * (bj->npairs[ci] + 1), sizeof(int))) return 0;
+    bj->pairs[ci][2 * bj->npairs[ci]] = tile;
+    bj->pairs[ci][2 * bj->npairs[ci] + 1] = id;
+    bj->npairs[ci]++;
+    return 1;
+}
+
+/* The children of box (x, y) of level l that photon p reaches, down to the
+ * tiles. 0: out of memory. */
+static int bin_descend(bin_job *bj, int ci, const gi_caus_photon *p, int id, int l, int x, int y)
+{
+    const bin_level *lv = &bj->lv[l];
+    if (!sphere_meets_box(p, &lv->box[(size_t)y * lv->nx + x])) return 1;
+    if (l == 0) return push_pair(bj, ci, y * lv->nx + x, id);
+    const bin_level *dn = &bj->lv[l - 1];
+    for (int j = y * BIN_FAN; j < (y + 1) * BIN_FAN && j < dn->ny; j++)
+        for (int i = x * BIN_FAN; i < (x + 1) * BIN_FAN && i < dn->nx; i++)
+            if (!bin_descend(bj, ci, p, id, l - 1, i, j)) return 0;
+    return 1;
+}
+
+static void bin_chunk(void *ctx, int ci, int thread)
+{
+    (void)thread;
+    bin_job *bj = ctx;
+    gi_caustic *c = bj->c;
+    long i0 = (long)ci * BIN_CHUNK, i1 = i0 + BIN_CHUNK < c->nph ? i0 + BIN_CHUNK : c->nph;
+    const bin_level *top = &bj->lv[bj->nlv - 1];
+    for (long i = i0; i < i1; i++)
+        for (int y = 0; y < top->ny; y++)
+            for (int x = 0; x < top->nx; x++)
+                if (!bin_descend(bj, ci, &c->ph[i], (int)i, bj->nlv - 1, x, y)) {
+                    bj->npairs[ci] = -1;
+                    return;
                 }
-    }
-    /* ascending photon order: the sums do not depend on the binning */
-    if (n > 1) qsort(list, (size_t)n, sizeof(int), int_cmp);
-    bj->lists[t] = list;
-    bj->counts[t] = n;
 }
 
 static pt_status bin_and_splat(gi_caustic *c, diag *d)
@@ -654,35 +702,48 @@ static pt_status bin_and_splat(gi_caustic *c, diag *d)
     double t0 = timer_now();
     int nt = c->tiles_x * c->tiles_y;
     int threads = c->s.threads > 0 ? c->s.threads : pool_default_threads();
-    bin_job bj = {c, calloc((size_t)nt, sizeof(int *)), calloc((size_t)nt, sizeof(int)),
-                  calloc((size_t)threads * (size_t)(c->nph > 0 ? c->nph : 1), sizeof(int))};
+    int nchunks = (int)((c->nph + BIN_CHUNK - 1) / BIN_CHUNK);
+    bin_job bj = {c, {{0}}, 0, calloc((size_t)(nchunks > 0 ? nchunks : 1), sizeof(int *)),
+                  calloc((size_t)(nchunks > 0 ? nchunks : 1), sizeof(long)),
+                  calloc((size_t)(nchunks > 0 ? nchunks : 1), sizeof(long))};
     free(c->tile_off);
     free(c->tile_idx);
-    c->tile_off = malloc(sizeof(int) * (size_t)(nt + 1));
+    c->tile_idx = NULL;
+    c->tile_off = calloc((size_t)nt + 1, sizeof(int));
     pt_status st = PT_OK;
-    if (!bj.lists || !bj.counts || !bj.stamps || !c->tile_off) st = PT_ERR_NOMEM;
+    if (!bj.pairs || !bj.npairs || !bj.caps || !c->tile_off || !bin_levels(c, bj.lv, &bj.nlv)) st = PT_ERR_NOMEM;
     if (st == PT_OK) {
-        pool_run(threads, nt, bin_tile, &bj);
+        pool_run(threads, nchunks, bin_chunk, &bj);
+        /* counting sort by tile; the chunks in order keep each tile's
+         * photons ascending, so the sums do not depend on the binning */
         long tot = 0;
-        for (int t = 0; t < nt; t++) {
-            if (bj.counts[t] < 0) st = PT_ERR_NOMEM;
-            c->tile_off[t] = (int)tot;
-            tot += bj.counts[t] > 0 ? bj.counts[t] : 0;
+        for (int ci = 0; ci < nchunks; ci++) {
+            if (bj.npairs[ci] < 0) st = PT_ERR_NOMEM;
+            for (long k = 0; k < bj.npairs[ci]; k++) c->tile_off[bj.pairs[ci][2 * k] + 1]++;
+            tot += bj.npairs[ci] > 0 ? bj.npairs[ci] : 0;
         }
-        c->tile_off[nt] = (int)tot;
+        if (tot > 0x7fffffffL) st = PT_ERR_NOMEM; /* tile_off is int (the kernel's) */
+        for (int t = 0; t < nt; t++) c->tile_off[t + 1] += c->tile_off[t];
         c->st.tile_entries = tot;
-        c->tile_idx = malloc(sizeof(int) * (size_t)(tot > 0 ? tot : 1));
+        if (st == PT_OK) c->tile_idx = malloc(sizeof(int) * (size_t)(tot > 0 ? tot : 1));
         if (!c->tile_idx) st = PT_ERR_NOMEM;
-        for (int t = 0; t < nt && st == PT_OK; t++)
-            if (bj.counts[t] > 0) memcpy(c->tile_idx + c->tile_off[t], bj.lists[t], sizeof(int) * (size_t)bj.counts[t]);
-    } else {
-        c->tile_idx = NULL;
+        if (st == PT_OK) {
+            int *fill = malloc(sizeof(int) * (size_t)(nt > 0 ? nt : 1));
+            if (!fill) st = PT_ERR_NOMEM;
+            else {
+                memcpy(fill, c->tile_off, sizeof(int) * (size_t)nt);
+                for (int ci = 0; ci < nchunks; ci++)
+                    for (long k = 0; k < bj.npairs[ci]; k++)
+                        c->tile_idx[fill[bj.pairs[ci][2 * k]]++] = bj.pairs[ci][2 * k + 1];
+                free(fill);
+            }
+        }
     }
-    if (bj.lists)
-        for (int t = 0; t < nt; t++) free(bj.lists[t]);
-    free(bj.lists);
-    free(bj.counts);
-    free(bj.stamps);
+    for (int ci = 0; bj.pairs && ci < nchunks; ci++) free(bj.pairs[ci]);
+    free(bj.pairs);
+    free(bj.npairs);
+    free(bj.caps);
+    for (int l = 0; l < BIN_MAX_LEVELS; l++) free(bj.lv[l].box);
     c->st.t_bin = timer_now() - t0;
     if (st != PT_OK) return st;
     t0 = timer_now();

@@ -6,7 +6,7 @@
  * atomic adds,
  * prefetch a write prefetch.
  * Math calls (pow, sqrt, fabs, rint) resolve to the C library's double
- * versions, so results can differ from the OpenCL build in the last float
+ * versions (native_exp2, native_log2 to exp2f, log2f), so results can differ from the OpenCL build in the last float
  * bits; tests compare the two with a tolerance. */
 #ifndef GI_SHIM_H
 #define GI_SHIM_H
@@ -31,5 +31,8 @@ static _Thread_local size_t gi_shim_gid;
 #define atom_add(p, v) __atomic_fetch_add((p), (v), __ATOMIC_RELAXED)
 #define atomic_add(p, v) __atomic_fetch_add((p), (v), __ATOMIC_RELAXED)
 #define prefetch(p, n) ((void)(n), __builtin_prefetch((p), 1))
+/* OpenCL's native exp2 and log2, in float as there */
+#define native_exp2(x) exp2f(x)
+#define native_log2(x) log2f(x)
 
 #endif

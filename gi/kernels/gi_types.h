@@ -237,7 +237,8 @@ typedef struct {
  * tile whose G-buffer bounds its kernel ellipsoid's sphere reaches. Smaller
  * tiles have tighter bounds (a tile of floor at grazing view spans a long
  * depth range), so fewer (photon, pixel) pairs miss; the binning grows with
- * the tiles' count (bench_caustics prints both). */
-#define GI_CAUS_TILE 8
+ * the tiles' count, which its two levels (gi_caustic.c, bin_block) keep
+ * small (bench_caustics prints both). */
+#define GI_CAUS_TILE 4
 
 #endif
