@@ -860,10 +860,8 @@ static void fill_triangle(const accel *a, const accel_leaf *l, unsigned local, d
                 smooth = 1;
             }
         }
-        if (m->tri_texture && (int)local < m->ntris) {
-            int ti = m->tri_texture[local];
-            if (ti >= 0 && ti < m->ntextures && m->textures && m->textures[ti]) tex = m->textures[ti];
-        }
+        const scene_texture *tt = scene_mesh_tri_texture(o, (int)local);
+        if (tt) tex = tt;
     } else {
         for (int k = 0; k < 3; k++) p[k] = o->u.triangle.v[k];
         if (o->kind == SHAPE_SMOOTH_TRIANGLE) {

@@ -378,11 +378,8 @@ static int add_leaf(accel_surf *as, const scene_object *o, const scene_texture *
             const int *v = m->tris[t];
             if (v[0] < 0 || v[0] >= m->nverts || v[1] < 0 || v[1] >= m->nverts || v[2] < 0 || v[2] >= m->nverts)
                 continue;
-            const scene_texture *tt = tex;
-            if (m->tri_texture) {
-                int ti = m->tri_texture[t];
-                if (ti >= 0 && ti < m->ntextures && m->textures && m->textures[ti]) tt = m->textures[ti];
-            }
+            const scene_texture *tt = scene_mesh_tri_texture(o, t);
+            if (!tt) tt = tex;
             double w = weight_of(as, o, tt, flags);
             if (w <= 0.0) continue;
             vec3 p[3];

@@ -112,6 +112,14 @@ scene_texture *scene_new_texture(scene *s)
 
 scene_mesh *scene_new_mesh(scene *s) { return arena_alloc(s->mem, sizeof(scene_mesh)); }
 
+const scene_texture *scene_mesh_tri_texture(const scene_object *o, int t)
+{
+    const scene_mesh *m = o->u.mesh.mesh;
+    if (!m || !m->tri_texture || t < 0 || t >= m->ntris || !o->u.mesh.textures) return NULL;
+    int ti = m->tri_texture[t];
+    return ti >= 0 && ti < m->ntextures ? o->u.mesh.textures[ti] : NULL;
+}
+
 pt_status scene_add_object(scene *s, scene_object *o)
 {
     if (!grow_array_int((void **)&s->objects, &s->cap_objects, s->nobjects + 1, sizeof *s->objects)) return PT_ERR_NOMEM;

@@ -199,7 +199,11 @@ struct scene_object {
         struct { vec3 c1, c2; } box;            /* c1 <= c2 component-wise */
         struct { vec3 normal; double offset; } plane; /* points p with n.p = offset */
         struct { vec3 v[3]; vec3 n[3]; } triangle;   /* n used for smooth_triangle */
-        struct { const scene_mesh *mesh; int inside_vector_set; vec3 inside_vector; } mesh;
+        /* textures: this object's copies of the mesh's texture_list
+         * (mesh->ntextures entries, NULL without a list), moved by the
+         * object's own transforms as POV-Ray moves a mesh's textures with
+         * it; read them through scene_mesh_tri_texture */
+        struct { const scene_mesh *mesh; int inside_vector_set; vec3 inside_vector; const scene_texture **textures; } mesh;
         struct { scene_object **kids; int nkids; } csg;
         struct { vec3 base, cap; double base_radius, cap_radius; } cone; /* cylinder: equal radii */
         struct { vec3 centre, normal; double radius, hole_radius; } disc;
@@ -244,5 +248,9 @@ struct scene_object {
      * copied by the parser to its members that have none */
     const scene_obj_photons *photons;
 };
+
+/* The texture_list entry of triangle t of mesh object o (its per-object
+ * copy), NULL when the triangle names none: the object's texture applies. */
+const scene_texture *scene_mesh_tri_texture(const scene_object *o, int t);
 
 #endif

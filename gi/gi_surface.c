@@ -477,11 +477,8 @@ pt_status gi_surface_add_leaf(gi_surface *g, const scene_object *o, const scene_
             const int *tv = m->tris[t];
             int ok = tv[0] >= 0 && tv[0] < m->nverts && tv[1] >= 0 && tv[1] < m->nverts && tv[2] >= 0 &&
                      tv[2] < m->nverts;
-            const scene_texture *tt = tex;
-            if (m->tri_texture) {
-                int ti = m->tri_texture[t];
-                if (ti >= 0 && ti < m->ntextures && m->textures && m->textures[ti]) tt = m->textures[ti];
-            }
+            const scene_texture *tt = scene_mesh_tri_texture(o, t);
+            if (!tt) tt = tex;
             vec3 v[3];
             for (int k = 0; k < 3; k++) {
                 int vi = ok ? tv[k] : 0;

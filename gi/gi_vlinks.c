@@ -200,8 +200,8 @@ static void mesh_rho(gi_vlinks *v, const scene *sc, const scene_object *o, const
     for (int i = 0; i < m->nverts; i++) {
         const scene_texture *tex = o->texture ? o->texture : &sc->default_texture;
         int t = first[i];
-        if (t >= 0 && sm->tri_texture && sm->tri_texture[t] >= 0 && sm->tri_texture[t] < sm->ntextures)
-            tex = sm->textures[sm->tri_texture[t]];
+        const scene_texture *tt = t >= 0 ? scene_mesh_tri_texture(o, t) : NULL;
+        if (tt) tex = tt;
         accel_hit h;
         memset(&h, 0, sizeof h);
         long g = m->vbase + i;

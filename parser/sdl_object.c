@@ -86,6 +86,10 @@ static void node_transform(scene_object *o, const xform *x)
     if (o->uv_mapping != 1) { /* uv-mapped textures stay on the surface (POV-Ray's UV_FLAG) */
         sdl_transform_texture_outer(own_texture(o->texture), x);
         sdl_transform_texture_outer(own_texture(o->interior_texture), x);
+        /* and a mesh's texture_list moves with it (each object holds its
+         * own copies, own_mesh_textures) */
+        if (o->kind == SHAPE_MESH && o->u.mesh.mesh && o->u.mesh.textures)
+            for (int i = 0; i < o->u.mesh.mesh->ntextures; i++) sdl_transform_texture_outer(own_texture(o->u.mesh.textures[i]), x);
     }
     if (scene_object_is_csg(o))
         for (int i = 0; i < o->u.csg.nkids; i++) node_transform(o->u.csg.kids[i], x);
@@ -107,6 +111,18 @@ void sdl_obj_transform(sdl_obj *o, const xform *x)
     for (int i = 0; i < o->nlights; i++) sdl_light_transform(&o->lights[i], x);
 }
 
+/* Object o's own copies of the n textures src (a mesh's texture_list),
+ * so that its transforms move them and no other object's. */
+static void own_mesh_textures(sdl_parser *p, scene_object *o, const scene_texture *const *src, int n)
+{
+    o->u.mesh.textures = NULL;
+    if (!src || n <= 0) return;
+    const scene_texture **t = sdl_alloc(p, sizeof *t * (size_t)n);
+    if (!t) return;
+    for (int i = 0; i < n; i++) t[i] = src[i] ? sdl_copy_texture(p, src[i]) : NULL;
+    o->u.mesh.textures = t;
+}
+
 static scene_object *copy_node(sdl_parser *p, const scene_object *o)
 {
     scene_object *c = sdl_alloc(p, sizeof *c);
@@ -114,6 +130,8 @@ static scene_object *copy_node(sdl_parser *p, const scene_object *o)
     *c = *o;
     c->texture = sdl_copy_texture(p, o->texture);
     c->interior_texture = sdl_copy_texture(p, o->interior_texture);
+    if (o->kind == SHAPE_MESH && o->u.mesh.mesh)
+        own_mesh_textures(p, c, o->u.mesh.textures, o->u.mesh.mesh->ntextures);
     if (scene_object_is_csg(o) && o->u.csg.nkids > 0) {
         c->u.csg.kids = sdl_alloc(p, sizeof(scene_object *) * (size_t)o->u.csg.nkids);
         if (!c->u.csg.kids) return NULL;
@@ -779,6 +797,8 @@ static void mesh_body(sdl_parser *p, sdl_obj *so, src_loc loc)
     if (sdl_ok(p) && b.nt == 0) sdl_error(p, loc, PT_ERR_SYNTAX, "mesh has no triangles");
     if (!b.any_uv) b.nuv = 0; /* every uv <0,0>: keep none */
     if (sdl_ok(p)) so->obj->u.mesh.mesh = finish_mesh(p, &b, loc);
+    if (sdl_ok(p) && so->obj->u.mesh.mesh)
+        own_mesh_textures(p, so->obj, so->obj->u.mesh.mesh->textures, so->obj->u.mesh.mesh->ntextures);
     mesh_build_free(&b);
 }
 
@@ -957,6 +977,8 @@ static void mesh2_body(sdl_parser *p, sdl_obj *so, src_loc loc)
     }
     if (sdl_ok(p) && b.uv_indices && b.nuv == 0) sdl_error(p, loc, PT_ERR_SYNTAX, "mesh2 uv_indices without uv_vectors");
     if (sdl_ok(p)) so->obj->u.mesh.mesh = finish_mesh(p, &b, loc);
+    if (sdl_ok(p) && so->obj->u.mesh.mesh)
+        own_mesh_textures(p, so->obj, so->obj->u.mesh.mesh->textures, so->obj->u.mesh.mesh->ntextures);
     mesh_build_free(&b);
 }
 

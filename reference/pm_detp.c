@@ -121,9 +121,9 @@ static int obj_emits(const scene *sc, const scene_object *o)
     const scene_texture *t = o->texture ? o->texture : &sc->default_texture;
     rgb e = shade_mat_texture_emission(sc, t);
     if (e.r > 0.0 || e.g > 0.0 || e.b > 0.0) return 1;
-    if (o->kind == SHAPE_MESH && o->u.mesh.mesh)
+    if (o->kind == SHAPE_MESH && o->u.mesh.mesh && o->u.mesh.textures)
         for (int i = 0; i < o->u.mesh.mesh->ntextures; i++) {
-            rgb m = shade_mat_texture_emission(sc, o->u.mesh.mesh->textures[i]);
+            rgb m = shade_mat_texture_emission(sc, o->u.mesh.textures[i]);
             if (m.r > 0.0 || m.g > 0.0 || m.b > 0.0) return 1;
         }
     return 0;

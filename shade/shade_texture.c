@@ -701,9 +701,9 @@ static int object_transparent(const scene_object *o, int depth)
             if (object_transparent(o->u.csg.kids[i], depth + 1)) return 1;
         return 0;
     case SHAPE_MESH:
-        if (o->u.mesh.mesh)
+        if (o->u.mesh.mesh && o->u.mesh.textures)
             for (int i = 0; i < o->u.mesh.mesh->ntextures; i++)
-                if (o->u.mesh.mesh->textures[i] && tex_transparent(o->u.mesh.mesh->textures[i])) return 1;
+                if (o->u.mesh.textures[i] && tex_transparent(o->u.mesh.textures[i])) return 1;
         return 0;
     default:
         return 0;

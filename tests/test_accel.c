@@ -341,6 +341,7 @@ static scene_object *mesh_obj(scene *s, const scene_mesh *m, xform x)
     scene_object *o = add_obj(s, SHAPE_MESH);
     o->name = "mesh";
     o->u.mesh.mesh = m;
+    o->u.mesh.textures = m->textures; /* the object's texture_list (the parser gives it copies) */
     o->transform = x;
     ((scene_mesh *)m)->uses++;
     return o;

@@ -640,6 +640,28 @@ static void test_mesh2(void **st)
     assert_int_equal(c.meshes, 1);
     scene_free(s);
 
+    /* a texture_list moves with each object that uses the mesh, as
+     * POV-Ray moves a mesh's textures with it: both objects show the
+     * pattern at the same place on their triangles */
+    s = parse_ok("#declare M = mesh2 {\n"
+                 "  vertex_vectors { 3, <0,0,0>, <1,0,0>, <0,1,0> }\n"
+                 "  texture_list { 1, texture { pigment { agate } } }\n"
+                 "  face_indices { 1, <0,1,2>, 0 }\n"
+                 "}\n"
+                 "object { M scale 2 }\n"
+                 "object { M translate x }\n");
+    const scene_object *a = s->objects[0], *b = s->objects[1];
+    assert_ptr_equal(a->u.mesh.mesh, b->u.mesh.mesh);
+    assert_ptr_not_equal(a->u.mesh.textures[0], b->u.mesh.textures[0]);
+    assert_ptr_equal(scene_mesh_tri_texture(a, 0), a->u.mesh.textures[0]);
+    vec3 pa = xform_point(&a->u.mesh.textures[0]->transform, v3(1, 1, 1));
+    vec3 pb = xform_point(&b->u.mesh.textures[0]->transform, v3(1, 1, 1));
+    assert_near(pa.x, 2, 1e-12);
+    assert_near(pa.y, 2, 1e-12);
+    assert_near(pb.x, 2, 1e-12);
+    assert_near(pb.y, 1, 1e-12);
+    scene_free(s);
+
     char *e = parse_err("mesh2 {\n vertex_vectors { 2, 0, x }\n face_indices { 1, <0,1,2> }\n}", PT_ERR_SYNTAX);
     assert_prefix(e, "test.pov:3:20: error: vertex index 2 out of range");
     free(e);
