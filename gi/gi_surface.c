@@ -426,18 +426,8 @@ pt_status gi_surface_add_leaf(gi_surface *g, const scene_object *o, const scene_
         }
         int obj = gi_surface_add_obj(g, o);
         if (obj < 0) return PT_ERR_NOMEM;
-        patch p;
-        memset(&p, 0, sizeof p);
-        p.kind = PATCH_PIECE;
-        p.obj = obj;
-        p.piece = first;
-        p.npieces = count;
-        p.cdf0 = c0;
-        p.area = area;
-        p.tex = tex;
-        p.nsides = (unsigned char)piece_sides(g, o);
-        p.mask = 3;
-        p.cnode = -1;
+        patch p = {.kind = PATCH_PIECE, .obj = obj, .piece = first, .npieces = count, .cdf0 = c0, .area = area,
+                   .tex = tex, .nsides = (unsigned char)piece_sides(g, o), .mask = 3, .cnode = -1};
         if (gi_surface_has_grid(o->kind)) {
             p.sh = malloc(sizeof *p.sh);
             if (!p.sh) return PT_ERR_NOMEM;

@@ -790,24 +790,9 @@ pt_status pm_detp_frame(pm_detp *dp, const scene *sc, const accel *a, int width,
         aps[t].sign = t < nthreads ? -1 : 1;
         aps[t].stamp = stamps + (size_t)t * (size_t)(np > 0 ? np : 1);
     }
-    frame_ctx fc;
-    memset(&fc, 0, sizeof fc);
-    fc.dp = dp;
-    fc.sc = sc;
-    fc.a = a;
-    fc.mob = mob;
-    fc.mob_boxed = mob_boxed;
-    fc.mob_lo = mob_lo;
-    fc.mob_hi = mob_hi;
-    fc.wk = wk;
-    fc.lv = lv;
-    fc.moving = moving;
-    fc.incremental = dp->have;
-    fc.ginc = &ginc;
-    fc.nthreads = nthreads;
-    fc.ap_minus = aps;
-    fc.ap_plus = aps + nthreads;
-    fc.scratch = scratch;
+    frame_ctx fc = {.dp = dp, .sc = sc, .a = a, .mob = mob, .mob_boxed = mob_boxed, .mob_lo = mob_lo, .mob_hi = mob_hi,
+                    .wk = wk, .lv = lv, .moving = moving, .incremental = dp->have, .ginc = &ginc,
+                    .nthreads = nthreads, .ap_minus = aps, .ap_plus = aps + nthreads, .scratch = scratch};
     dp->npaths = npaths;
     progress_stage(dp->s.progress, "detp: photon paths", nchunks);
     pool_run_counted(nthreads, (int)nchunks, path_job, &fc, dp->s.cancel, dp->s.progress);

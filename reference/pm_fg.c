@@ -483,16 +483,9 @@ static pt_status fg_run(const pm_job *j, const void *settings)
     int threads = pm_threads(s->c.threads);
     pt_status status = PT_OK;
 
-    fg_ctx c;
-    memset(&c, 0, sizeof c);
-    c.sc = sc;
-    c.a = a;
-    c.s = s;
-    c.L = L;
-    c.eps = pm_lights_eps(L);
-    c.rr = radrules_of(sc, 1);
+    fg_ctx c = {.sc = sc, .a = a, .s = s, .L = L, .eps = pm_lights_eps(L), .rr = radrules_of(sc, 1),
+                .eye_levels = radrules_level_limit(sc, 0)};
     c.gathers = pm_gathers(&c.rr);
-    c.eye_levels = radrules_level_limit(sc, 0);
     /* a gather ray is at level g1, its hit's specular rays at g1 + 1, ... */
     const int g1 = radrules_gather_level(1);
     c.gather_specular = radrules_level_limit(sc, g1) - g1 - 1;

@@ -369,14 +369,7 @@ static void chunk_job(void *ctx, int ci, int thread)
 static pt_status setup(trace_ctx *cp, const scene *sc, const accel *a, const pm_lights *L, const pm_photon_settings *s,
                        const vec3 *bounds, int *sources, int *targets)
 {
-    trace_ctx c;
-    memset(&c, 0, sizeof c);
-    c.sc = sc;
-    c.a = a;
-    c.L = L;
-    c.s = s;
-    c.eps = pm_lights_eps(L);
-    c.rr = radrules_of(sc, 1);
+    trace_ctx c = {.sc = sc, .a = a, .L = L, .s = s, .eps = pm_lights_eps(L), .rr = radrules_of(sc, 1)};
     c.gathers = pm_gathers(&c.rr);
     for (int i = 0; i < sc->nobjects && !c.targets; i++) c.targets = scene_object_any(sc->objects[i], is_target);
     *targets = c.targets;

@@ -620,18 +620,9 @@ rgb shade_media_segment(const shade_media_env *e, int which, const shade_media_i
     }
     if (niv == 0) return c;
 
-    sampler s;
-    s.e = e;
-    s.refs = refs;
-    s.nrefs = nrefs;
-    s.org = org;
-    s.dir = dir;
-    s.shadow = shadow;
-    s.use_scattering = use_scat;
-    s.lights = lights;
-    s.nlights = nl;
-    s.in = in;
-    s.pc = shade_pattern_ctx_plain(e->sc);
+    sampler s = {.e = e, .refs = refs, .nrefs = nrefs, .org = org, .dir = dir, .shadow = shadow,
+                 .use_scattering = use_scat, .lights = lights, .nlights = nl, .in = in,
+                 .pc = shade_pattern_ctx_plain(e->sc)};
 
     int nmin = im->min_samples > 0 ? im->min_samples : 1;
     for (int i = 0; i < niv; i++) {

@@ -488,15 +488,8 @@ static void ior_setup(hit_info *hi, const shade_media_inside *in, const scene_ob
 
 rgb shade_tex_shade(const shade_tex_env *e, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip, float wavelength)
 {
-    hit_info hi;
-    memset(&hi, 0, sizeof hi);
-    hi.e = e;
-    hi.h = h;
-    hi.dir = dir;
-    hi.level = level;
-    hi.skip = skip;
-    hi.wavelength = wavelength;
-    hi.version = scene_version(e->sc);
+    hit_info hi = {.e = e, .h = h, .dir = dir, .level = level, .skip = skip, .wavelength = wavelength,
+                   .version = scene_version(e->sc)};
     vec3 ng = h->ng, n = h->ns;
     hi.entering = v3_dot(dir, ng) < 0.0;
     if (v3_dot(dir, n) > 0.0) n = v3_neg(n);
