@@ -104,9 +104,7 @@ static void point_of(const shade_mat_bsdf *b, double lift, gpoint *g)
     float *dst[3] = {g->dev.p, g->dev.n, g->dev.wo};
     vec3 src[3] = {p, b->n, wo};
     for (int k = 0; k < 3; k++) {
-        dst[k][0] = (float)src[k].x;
-        dst[k][1] = (float)src[k].y;
-        dst[k][2] = (float)src[k].z;
+        v3_store_f(dst[k], src[k]);
     }
     rgb kd = b->k[SHADE_MAT_LOBE_DIFFUSE];
     g->dev.kd[0] = (float)kd.r;
@@ -387,9 +385,7 @@ static gi_dev_vpl_point *vpl_points(const vpl_set *vs, double lift)
     if (!p) return NULL;
     for (int i = 0; i < vs->n; i++) {
         vec3 q = v3_madd(vs->v[i].p, vs->v[i].n, lift);
-        p[i].p[0] = (float)q.x;
-        p[i].p[1] = (float)q.y;
-        p[i].p[2] = (float)q.z;
+        v3_store_f(p[i].p, q);
         p[i].n[0] = p[i].wo[0] = (float)vs->v[i].n.x;
         p[i].n[1] = p[i].wo[1] = (float)vs->v[i].n.y;
         p[i].n[2] = p[i].wo[2] = (float)vs->v[i].n.z;

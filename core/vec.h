@@ -29,6 +29,13 @@ static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fmin(a.x, b.x), fmin(a.y, 
 static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z)); }
 static inline double v3_maxc(vec3 a) { return fmax(a.x, fmax(a.y, a.z)); }
 static inline double v3_idx(vec3 a, int i) { return i == 0 ? a.x : (i == 1 ? a.y : a.z); }
+/* a in single precision, into f[0..2] (device records, photon and mesh arrays) */
+static inline void v3_store_f(float f[3], vec3 a)
+{
+    f[0] = (float)a.x;
+    f[1] = (float)a.y;
+    f[2] = (float)a.z;
+}
 static inline int v3_finite(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 /* Ray o + t d against the box [lo, hi] (slab method): the parameter interval
  * [*t0, *t1] inside the box; 0 if the ray misses it. */

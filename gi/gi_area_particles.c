@@ -261,12 +261,8 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
                     continue;
                 }
                 gi_dev_particle p = mat;
-                p.p[0] = (float)pos.x;
-                p.p[1] = (float)pos.y;
-                p.p[2] = (float)pos.z;
-                p.n[0] = (float)nn.x;
-                p.n[1] = (float)nn.y;
-                p.n[2] = (float)nn.z;
+                v3_store_f(p.p, pos);
+                v3_store_f(p.n, nn);
                 if (!push(&b, &p, i, s)) {
                     if (have_ush) geom_shape_release(&ush);
                     free(inclip);

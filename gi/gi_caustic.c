@@ -555,13 +555,9 @@ static void gbuf_row(void *ctx, int y, int thread)
             if (ph && !ph->collect) continue;
             if (!(c->hk.surface(c->hk.ctx, &h, d, &r, NULL) & GI_CAUSTIC_RECEIVES)) continue;
             vec3 n = v3_dot(h.ng, d) < 0.0 ? h.ng : v3_neg(h.ng);
-            px->s[0] = (float)h.p.x;
-            px->s[1] = (float)h.p.y;
-            px->s[2] = (float)h.p.z;
+            v3_store_f(px->s, h.p);
             px->valid = 1.0f;
-            px->n[0] = (float)n.x;
-            px->n[1] = (float)n.y;
-            px->n[2] = (float)n.z;
+            v3_store_f(px->n, n);
             px->brilliance = c->hk.brilliance ? (float)c->hk.brilliance(c->hk.ctx, &h, d) : 1.0f;
             c->gobj[k] = h.obj;
             /* footprint: the neighbouring pixels' rays at the same distance */

@@ -313,12 +313,8 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
         const view_rec *r = &gp->vrec[i];
         vec3 nv = gp->vg_nrm[i];
         gi_dev_particle *q = &cp[n + k];
-        q->p[0] = (float)r->h.p.x;
-        q->p[1] = (float)r->h.p.y;
-        q->p[2] = (float)r->h.p.z;
-        q->n[0] = (float)nv.x;
-        q->n[1] = (float)nv.y;
-        q->n[2] = (float)nv.z;
+        v3_store_f(q->p, r->h.p);
+        v3_store_f(q->n, nv);
         q->area = 0.0f;
         const scene_object *o = r->h.obj;
         /* its radius: stride pixels' footprint on the surface (the angle

@@ -21,9 +21,7 @@
 void gi_light_pack(const scene_light *l, gi_dev_light *o)
 {
     memset(o, 0, sizeof *o);
-    o->pos[0] = (float)l->position.x;
-    o->pos[1] = (float)l->position.y;
-    o->pos[2] = (float)l->position.z;
+    v3_store_f(o->pos, l->position);
     o->kind = l->kind == LIGHT_SPOT ? GI_LIGHT_SPOT
               : l->kind == LIGHT_CYLINDER ? GI_LIGHT_CYLINDER
               : l->kind == LIGHT_PARALLEL ? GI_LIGHT_PARALLEL
@@ -32,9 +30,7 @@ void gi_light_pack(const scene_light *l, gi_dev_light *o)
     o->colour[1] = (float)l->colour.g;
     o->colour[2] = (float)l->colour.b;
     o->parallel = l->parallel;
-    o->point_at[0] = (float)l->point_at.x;
-    o->point_at[1] = (float)l->point_at.y;
-    o->point_at[2] = (float)l->point_at.z;
+    v3_store_f(o->point_at, l->point_at);
     o->tightness = (float)l->tightness;
     o->cos_radius = (float)cos(l->radius * M_PI / 180.0);
     o->cos_falloff = (float)cos(l->falloff * M_PI / 180.0);

@@ -157,9 +157,7 @@ static int share_add(rp_share *S, int obj, vec3 p, vec3 n, const int64_t home[3]
     size_t b = share_bucket(S, obj, home);
     share_entry *e = &S->e[S->n];
     e->pos = p;
-    e->n[0] = (float)n.x;
-    e->n[1] = (float)n.y;
-    e->n[2] = (float)n.z;
+    v3_store_f(e->n, n);
     e->obj = obj;
     e->rp = rp;
     e->next = S->head[b];

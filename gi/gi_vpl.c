@@ -153,13 +153,9 @@ static void filter(gi_vpl_tree *t, hnode *h, int spread)
     vec3 cp = v3_scale(sp, 1.0 / m);
     double nlen = v3_len(sn) / m;
     vec3 cn = nlen > 0.0 ? v3_norm(sn) : v3(0, 0, 1);
-    d->p[0] = (float)cp.x;
-    d->p[1] = (float)cp.y;
-    d->p[2] = (float)cp.z;
+    v3_store_f(d->p, cp);
     d->p[3] = (float)area;
-    d->n[0] = (float)cn.x;
-    d->n[1] = (float)cn.y;
-    d->n[2] = (float)cn.z;
+    v3_store_f(d->n, cn);
     d->n[3] = (float)nlen;
     d->ld[0] = (float)(sld.r / m);
     d->ld[1] = (float)(sld.g / m);
@@ -174,9 +170,7 @@ static void filter(gi_vpl_tree *t, hnode *h, int spread)
             d->ls[1] = (float)(sls.g / m);
             d->ls[2] = (float)(sls.b / m);
             d->ls[3] = (float)kappa;
-            d->d[0] = (float)axis.x;
-            d->d[1] = (float)axis.y;
-            d->d[2] = (float)axis.z;
+            v3_store_f(d->d, axis);
         }
     }
     if (spread) {

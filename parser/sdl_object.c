@@ -632,9 +632,7 @@ static int add_vec(sdl_parser *p, mesh_build *b, float (**arr)[3], int *n, int *
         sdl_error(p, none, PT_ERR_NOMEM, "out of memory");
         return -1;
     }
-    (*arr)[*n][0] = (float)v.x;
-    (*arr)[*n][1] = (float)v.y;
-    (*arr)[*n][2] = (float)v.z;
+    v3_store_f((*arr)[*n], v);
     return (*n)++;
 }
 

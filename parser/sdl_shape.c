@@ -1000,13 +1000,9 @@ static void bicubic_args(sdl_parser *p, sdl_obj *so, src_loc loc)
                 nrm = v3_cross(e2, e1);
             }
             int k = a * (nu + 1) + b;
-            m->verts[k][0] = (float)pt.x;
-            m->verts[k][1] = (float)pt.y;
-            m->verts[k][2] = (float)pt.z;
+            v3_store_f(m->verts[k], pt);
             vec3 un = v3_norm(nrm);
-            m->normals[k][0] = (float)un.x;
-            m->normals[k][1] = (float)un.y;
-            m->normals[k][2] = (float)un.z;
+            v3_store_f(m->normals[k], un);
             /* BicubicPatch::Compute_Texture_UV of the patch point (s, t) =
              * (parameter along the second control-point index, along the
              * first): bilinear in the four ST corners */
@@ -1213,12 +1209,8 @@ static void parametric_args(sdl_parser *p, sdl_obj *so, src_loc loc)
             int k = j * (N + 1) + i;
             if (!v3_finite(pt)) pt = v3s(0.0);
             if (!v3_finite(nn)) nn = v3(0, 1, 0);
-            m->verts[k][0] = (float)pt.x;
-            m->verts[k][1] = (float)pt.y;
-            m->verts[k][2] = (float)pt.z;
-            m->normals[k][0] = (float)nn.x;
-            m->normals[k][1] = (float)nn.y;
-            m->normals[k][2] = (float)nn.z;
+            v3_store_f(m->verts[k], pt);
+            v3_store_f(m->normals[k], nn);
             m->uvs[k][0] = (float)u;
             m->uvs[k][1] = (float)v;
         }

@@ -36,9 +36,7 @@ uint32_t pm_surface_key(const void *object, int outside)
 
 void pm_photon_set(pm_photon *ph, vec3 p, rgb power, vec3 n, uint32_t surf)
 {
-    ph->p[0] = (float)p.x;
-    ph->p[1] = (float)p.y;
-    ph->p[2] = (float)p.z;
+    v3_store_f(ph->p, p);
     ph->power[0] = (float)power.r;
     ph->power[1] = (float)power.g;
     ph->power[2] = (float)power.b;
@@ -270,12 +268,8 @@ int pm_kdtree_knn(const pm_kdtree *t, vec3 p, vec3 n, uint32_t surf, double min_
     if (!t || t->n <= 0 || k < 1) return 0;
     knn_state s;
     s.ph = t->ph;
-    s.q[0] = (float)p.x;
-    s.q[1] = (float)p.y;
-    s.q[2] = (float)p.z;
-    s.nq[0] = (float)n.x;
-    s.nq[1] = (float)n.y;
-    s.nq[2] = (float)n.z;
+    v3_store_f(s.q, p);
+    v3_store_f(s.nq, n);
     s.min_dot = (float)min_dot;
     s.surf = surf;
     s.k = k;
