@@ -20,10 +20,17 @@
  *    corner values differ by more than 0.1 or the level is below `adaptive`),
  *    each grid point jittered by up to half a cell when `jitter` is set.
  *    `area_illumination on` evaluates the shading per grid point instead.
- *  - antialiasing (+A, method 1): one ray through each pixel centre; a pixel
- *    whose gamma-encoded colour differs from its left or upper neighbour by
- *    at least the threshold is supersampled with depth x depth jittered rays,
- *    averaged with the first sample.
+ *  - antialiasing (+A, method 1): one ray through each pixel centre; then,
+ *    in POV-Ray's 32 x 32 render blocks and its order within a block
+ *    (tracetask.cpp, NonAdaptiveSupersamplingM1), each pixel is compared
+ *    with its left and upper neighbours after the Antialias_Gamma curve:
+ *    a pair that differs by at least the threshold supersamples the
+ *    neighbour (unless done already) and the pixel, with depth x depth
+ *    jittered rays averaged with the first sample. Comparisons read the
+ *    neighbours as they are by then (supersampled or not); across a block's
+ *    left and upper edges they read the neighbours' first samples, and
+ *    those neighbours are left to their own block (at the image's edges
+ *    the neighbour is a ray through the pixel centre outside the image).
  */
 #include "shade.h"
 #include "hash.h"
@@ -68,7 +75,7 @@ typedef struct {
     int max_level;
     thread_stats *ts;
     framebuffer *fb;
-    unsigned char *flag; /* per pixel: needs supersampling */
+    float *first;        /* +A: the first pass's colours (rgb per pixel) */
     int tiles_x, tiles_y;
     int transparent;     /* some surface lets light through: filtered shadows */
     shade_light_projection *proj; /* projected_through lights (shade_project.c), NULL = none */
@@ -80,7 +87,7 @@ typedef struct {
     const struct hit_frame *frame[SHADE_MAX_THREADS];
     int primary_on;      /* s->primary holds this render's centre rays (shade_primary_begin_fn) */
     int win[4];          /* the pixels rendered (shade_settings.window) */
-    int first_win[4];    /* the first pass's: win and, with +A, a one-pixel apron */
+    int first_win[4];    /* the first pass's: win and, with +A, the AA blocks it meets and a one-pixel apron */
     shade_focal focal;   /* focal blur's budget (camera_focal_blur) */
 } render_ctx;
 
@@ -623,38 +630,98 @@ static rgb aa_encode(const scene *sc, const float *px)
     return c;
 }
 
-static void tile_supersample(void *ctx, int tile, int thread)
+/* POV-Ray 3.7's default Render_Block_Size (view.cpp): its +A method 1
+ * decides per block of this many pixels square, from the image's corner. */
+#define AA_BLOCK 32
+
+/* Pixel (x, y) supersampled: depth x depth jittered rays averaged with its
+ * first sample `px`, which it replaces. */
+static void supersample_pixel(render_ctx *c, int thread, int x, int y, float *px)
+{
+    int d = c->s->aa_depth > 0 ? c->s->aa_depth : 3;
+    double step = 1.0 / d;
+    rng r;
+    pixel_rng(&r, c->s->seed, x, y, 1);
+    rgb acc = {px[0], px[1], px[2]};
+    for (int j = 0; j < d; j++) {
+        for (int i = 0; i < d; i++) {
+            /* jittered grid: POV-Ray's default jitter 1.0 scaled by 1/depth */
+            double sx = x + (i + 0.5) * step + (rng_f64(&r) - 0.5) * step;
+            double sy = y + (j + 0.5) * step + (rng_f64(&r) - 0.5) * step;
+            acc = rgb_add(acc, sample(c, thread, sx, sy, &r));
+        }
+    }
+    acc = rgb_scale(acc, 1.0 / (d * d + 1));
+    px[0] = (float)acc.r;
+    px[1] = (float)acc.g;
+    px[2] = (float)acc.b;
+}
+
+/* The first sample of (x, y), which may lie one pixel outside the image
+ * (left of column 0 or above row 0): traced there, as POV-Ray does for a
+ * block's neighbours. */
+static void first_sample(render_ctx *c, int thread, int x, int y, float *out)
+{
+    if (x >= 0 && y >= 0) {
+        const float *f = c->first + 3 * ((size_t)y * c->s->width + x);
+        out[0] = f[0];
+        out[1] = f[1];
+        out[2] = f[2];
+        return;
+    }
+    rng r;
+    /* a stream of its own: (width, y) or (x, height) is no pixel */
+    pixel_rng(&r, c->s->seed, x < 0 ? c->s->width : x, y < 0 ? c->s->height : y, 0);
+    rgb v = sample(c, thread, x + 0.5, y + 0.5, &r);
+    out[0] = (float)v.r;
+    out[1] = (float)v.g;
+    out[2] = (float)v.b;
+}
+
+static int aa_differ(const render_ctx *c, const float *a, const float *b)
+{
+    return shade_colour_distance(aa_encode(c->sc, a), aa_encode(c->sc, b)) >= c->s->aa_threshold;
+}
+
+/* Pass 2 of +A: block `block` of the AA_BLOCK grid, in POV-Ray's order. */
+static void block_supersample(void *ctx, int block, int thread)
 {
     render_ctx *c = ctx;
     if (c->s->cancel && *c->s->cancel) return;
-    int x0, y0, x1, y1;
-    tile_bounds(c, tile, c->win, &x0, &y0, &x1, &y1);
-    int d = c->s->aa_depth > 0 ? c->s->aa_depth : 3;
-    double step = 1.0 / d;
-    for (int y = y0; y < y1; y++) {
+    int bw = (c->s->width + AA_BLOCK - 1) / AA_BLOCK;
+    int X0 = block % bw * AA_BLOCK, Y0 = block / bw * AA_BLOCK;
+    int X1 = X0 + AA_BLOCK < c->s->width ? X0 + AA_BLOCK : c->s->width;
+    int Y1 = Y0 + AA_BLOCK < c->s->height ? Y0 + AA_BLOCK : c->s->height;
+    /* blocks outside the window are not rendered; those it meets are
+     * decided whole, as in the whole image */
+    if (X1 <= c->win[0] || X0 >= c->win[2] || Y1 <= c->win[1] || Y0 >= c->win[3]) return;
+    unsigned char done[AA_BLOCK][AA_BLOCK];
+    memset(done, 0, sizeof done);
+    float above[AA_BLOCK][3], left[3];
+    for (int x = X0; x < X1; x++) first_sample(c, thread, x, Y0 - 1, above[x - X0]);
+    for (int y = Y0; y < Y1; y++) {
         if (c->s->cancel && *c->s->cancel) return;
-        int nflag = 0;
-        for (int x = x0; x < x1; x++) nflag += c->flag[(size_t)y * c->s->width + x];
-        for (int x = x0; x < x1; x++) {
-            if (!c->flag[(size_t)y * c->s->width + x]) continue;
-            rng r;
-            pixel_rng(&r, c->s->seed, x, y, 1);
-            float *px = fb_px(c->fb, x, y);
-            rgb acc = {px[0], px[1], px[2]};
-            for (int j = 0; j < d; j++) {
-                for (int i = 0; i < d; i++) {
-                    /* jittered grid: POV-Ray's default jitter 1.0 scaled by 1/depth */
-                    double sx = x + (i + 0.5) * step + (rng_f64(&r) - 0.5) * step;
-                    double sy = y + (j + 0.5) * step + (rng_f64(&r) - 0.5) * step;
-                    acc = rgb_add(acc, sample(c, thread, sx, sy, &r));
-                }
+        first_sample(c, thread, X0 - 1, y, left);
+        for (int x = X0; x < X1; x++) {
+            int i = x - X0, j = y - Y0;
+            float *cur = fb_px(c->fb, x, y);
+            float *lp = i > 0 ? fb_px(c->fb, x - 1, y) : left, *tp = j > 0 ? fb_px(c->fb, x, y - 1) : above[i];
+            int ldiff = aa_differ(c, lp, cur), tdiff = aa_differ(c, tp, cur);
+            /* the block's neighbours count as done (POV-Ray's SetFlag) */
+            if (ldiff && i > 0 && !done[j][i - 1]) {
+                supersample_pixel(c, thread, x - 1, y, lp);
+                done[j][i - 1] = 1;
             }
-            acc = rgb_scale(acc, 1.0 / (d * d + 1));
-            px[0] = (float)acc.r;
-            px[1] = (float)acc.g;
-            px[2] = (float)acc.b;
+            if (tdiff && j > 0 && !done[j - 1][i]) {
+                supersample_pixel(c, thread, x, y - 1, tp);
+                done[j - 1][i] = 1;
+            }
+            if (ldiff || tdiff) {
+                supersample_pixel(c, thread, x, y, cur);
+                done[j][i] = 1;
+            }
         }
-        progress_add(c->s->progress, nflag);
+        progress_add(c->s->progress, X1 - X0);
     }
 }
 
@@ -699,11 +766,17 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
         return PT_ERR_INTERNAL;
     }
     for (int i = 0; i < 4; i++) c.win[i] = whole ? (i == 2 ? s->width : i == 3 ? s->height : 0) : sw[i];
-    int apron = s->antialias == 1 ? 1 : 0;
-    c.first_win[0] = c.win[0] - apron > 0 ? c.win[0] - apron : 0;
-    c.first_win[1] = c.win[1] - apron > 0 ? c.win[1] - apron : 0;
-    c.first_win[2] = c.win[2] + apron < s->width ? c.win[2] + apron : s->width;
-    c.first_win[3] = c.win[3] + apron < s->height ? c.win[3] + apron : s->height;
+    for (int i = 0; i < 4; i++) c.first_win[i] = c.win[i];
+    if (s->antialias == 1) {
+        /* the AA blocks the window meets, and the pixel left of and above
+         * each: their decisions read those first samples */
+        int bx0 = c.win[0] / AA_BLOCK * AA_BLOCK, by0 = c.win[1] / AA_BLOCK * AA_BLOCK;
+        int bx1 = (c.win[2] + AA_BLOCK - 1) / AA_BLOCK * AA_BLOCK, by1 = (c.win[3] + AA_BLOCK - 1) / AA_BLOCK * AA_BLOCK;
+        c.first_win[0] = bx0 > 0 ? bx0 - 1 : 0;
+        c.first_win[1] = by0 > 0 ? by0 - 1 : 0;
+        c.first_win[2] = bx1 < s->width ? bx1 : s->width;
+        c.first_win[3] = by1 < s->height ? by1 : s->height;
+    }
     /* hits found before the render serve the centre rays of plain cameras
      * (primary_ray perturbs a camera normal's rays, sample() blurs) */
     const scene_camera *cam = &sc->camera;
@@ -715,25 +788,16 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     pool_run(threads, ntiles, tile_first_pass, &c);
 
     if (s->antialias == 1 && !(s->cancel && *s->cancel)) {
-        c.flag = calloc((size_t)s->width * (size_t)s->height, 1);
-        if (!c.flag) { shade_projection_free(c.proj); shade_focal_release(&c.focal); free(ts); return PT_ERR_NOMEM; }
-        /* the pairs inside the first pass's rectangle: every pair a window
-         * pixel belongs to, as in the whole image */
-        for (int y = c.first_win[1]; y < c.first_win[3]; y++) {
-            for (int x = c.first_win[0]; x < c.first_win[2]; x++) {
-                rgb cur = aa_encode(sc, fb_px(fb, x, y));
-                if (x > c.first_win[0] && shade_colour_distance(aa_encode(sc, fb_px(fb, x - 1, y)), cur) >= s->aa_threshold)
-                    c.flag[(size_t)y * s->width + x] = c.flag[(size_t)y * s->width + x - 1] = 1;
-                if (y > c.first_win[1] && shade_colour_distance(aa_encode(sc, fb_px(fb, x, y - 1)), cur) >= s->aa_threshold)
-                    c.flag[(size_t)y * s->width + x] = c.flag[(size_t)(y - 1) * s->width + x] = 1;
-            }
-        }
-        long long nflag = 0;
-        for (int y = c.win[1]; y < c.win[3]; y++)
-            for (int x = c.win[0]; x < c.win[2]; x++) nflag += c.flag[(size_t)y * s->width + x];
-        progress_stage(s->progress, "antialias", nflag);
-        pool_run(threads, ntiles, tile_supersample, &c);
-        free(c.flag);
+        size_t nv = (size_t)s->width * (size_t)s->height * 3u;
+        c.first = malloc(sizeof *c.first * nv);
+        if (!c.first) { shade_projection_free(c.proj); shade_focal_release(&c.focal); free(ts); return PT_ERR_NOMEM; }
+        memcpy(c.first, fb->rgb, sizeof *c.first * nv);
+        int bw = (s->width + AA_BLOCK - 1) / AA_BLOCK, bh = (s->height + AA_BLOCK - 1) / AA_BLOCK;
+        /* the pixels of the blocks the window meets (block_supersample) */
+        int ax0 = c.win[0] / AA_BLOCK * AA_BLOCK, ay0 = c.win[1] / AA_BLOCK * AA_BLOCK;
+        progress_stage(s->progress, "antialias", (long long)(c.first_win[2] - ax0) * (long long)(c.first_win[3] - ay0));
+        pool_run(threads, bw * bh, block_supersample, &c);
+        free(c.first);
     }
 
     if (!whole) /* the apron is not part of the window */
