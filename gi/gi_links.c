@@ -40,6 +40,7 @@ typedef struct {
     float far_bounce;     /* brightness when the far field reflects the sky, else 0 */
     gi_dev_light *lights; /* the scene's, for the far field's direct light */
     int nlights;
+    int exact;            /* view points with no bounce after the hit: every hit takes far_field */
 } link_job;
 
 /* The material where ray h hit object o: rho and le at the pigment there
@@ -241,7 +242,7 @@ static void job(void *ctx, int index, int thread)
     long *cell = J->cell[thread], *tcell = J->tcell[thread];
     /* hits on a triangle gi_trilook lists take its list (cell -3: no grid
      * cell, unless the list cannot decide) */
-    const gi_trilook *tl = J->tl && J->grid && J->links && J->pobj ? J->tl : NULL;
+    const gi_trilook *tl = J->tl && J->grid && J->links && J->pobj && !J->exact ? J->tl : NULL;
     for (int t = 0; t < m; t++) {
         const struct RTCRayHit *h = &rh[t];
         int hit = h->hit.geomID != RTC_INVALID_GEOMETRY_ID && isfinite(h->ray.tfar);
@@ -262,7 +263,7 @@ static void job(void *ctx, int index, int thread)
         for (int st = 1; st <= 2; st++)
             for (int t = 0; t < m; t++)
                 if (tcell[t] >= 0) gi_trilook_prefetch(tl, tcell[t], st);
-    if (J->grid && J->links) gi_lookup_cells(J->grid, m, hp, cell);
+    if (J->grid && J->links && !J->exact) gi_lookup_cells(J->grid, m, hp, cell);
     m = 0;
     const void *last_obj = NULL;
     int last_hid = -1;
@@ -284,6 +285,18 @@ static void job(void *ctx, int index, int thread)
             }
             if (!J->links) continue;
             int target = -1;
+            if (J->exact) {
+                /* no bounce after this hit (POV-Ray's recursion_limit 1, or
+                 * brightness 0): what the ray sees there is the hit's
+                 * emission and the direct light it reflects, computed at
+                 * the hit itself (far_field, a shadow ray a light from its
+                 * centre, as POV-Ray's radiosity rays take area lights)
+                 * rather than read from the nearest particle, whose value
+                 * blurs shadow edges over a particle spacing */
+                if (hit) far_field(J, &rh[m], sky);
+                J->links[(size_t)(i - J->first) * J->k + J->order[j]] = -1;
+                continue;
+            }
             /* a hit on an object that carries no particles (unsupported
              * shapes, CSG results whose members are not sampled) has no
              * answer: the checks below would only accept a particle on that
@@ -550,6 +563,7 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
         for (int l = 0; J.lights && l < sc->nlights; l++) gi_light_pack(&sc->lights[l], &J.lights[l]);
         J.nlights = J.lights ? sc->nlights : 0;
     }
+    J.exact = J.esky && J.first > 0 && !(J.far_bounce > 0.0f);
     size_t rays = (size_t)J.per_job * (size_t)J.k;
     size_t bytes = rays * sizeof(struct RTCRayHit);
     for (int t = 0; rc == PT_OK && t < threads; t++) {

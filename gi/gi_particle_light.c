@@ -302,7 +302,15 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
     S->flux_scattered = sums.scattered;
     reset_view(gp);
     gp->lit = 1;
-    gi_particle_view_regather(gp); /* the final gather's values for this light */
+    /* the final gather's values for this light: its rays took the direct
+     * light where no particle answers (and everywhere when no bounce
+     * follows), so with lights they are traced again */
+    if (gp->vg_n > 0 && gp->nlights > 0) {
+        st = gi_particle_view_gather(gp, d);
+        if (st != PT_OK) return st;
+    } else {
+        gi_particle_view_regather(gp);
+    }
     S->t_lighting = timer_now() - t0;
     return PT_OK;
 }
