@@ -13,8 +13,13 @@
 #include "timer.h"
 
 /* A photon ray passes no_shadow objects (POV-Ray trace.cpp: a photon ray
- * skips NO_SHADOW objects) and pass_through objects (unchanged). */
-#define PHOTON_SKIP (OBJ_NO_SHADOW | ACCEL_SKIP_PASS_THROUGH)
+ * skips NO_SHADOW objects) and, on its way to the target, pass_through
+ * objects (unchanged). Past the target a pass_through object is like any
+ * other (photons.cpp, PhotonTrace::TraceRay tests the flag only for the
+ * first ray and after a pass-through): a lemon slice hanging over a
+ * glass's rim shadows the glass's caustic. */
+#define PHOTON_SKIP_FIRST (OBJ_NO_SHADOW | ACCEL_SKIP_PASS_THROUGH)
+#define PHOTON_SKIP_LATER OBJ_NO_SHADOW
 #define GBUF_LAYERS 8
 /* k of r_xy = k s_D / sqrt(rho_p): 6 unfocused spacings, about 110
  * photons of an unfocused beam within r_xy. The paper gives no constant;
@@ -326,7 +331,8 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
     while (ns > 0) {
         branch br = stack[--ns];
         accel_hit h;
-        if (accel_intersect_past(c->a, br.has_from ? &br.from : NULL, br.o, br.w, c->eps, PHOTON_SKIP, &h, &out->rays) <= 0)
+        if (accel_intersect_past(c->a, br.has_from ? &br.from : NULL, br.o, br.w, c->eps,
+                                 br.level == 0 ? PHOTON_SKIP_FIRST : PHOTON_SKIP_LATER, &h, &out->rays) <= 0)
             continue;
         int level = br.level;
         double depth = br.depth + h.t;

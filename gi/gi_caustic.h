@@ -6,7 +6,8 @@
  * photons { target } for which their merged flags allow reflection or
  * refraction (scene_photon_shoots); a photon's first hit must be that
  * target (pass_through objects and no_shadow objects are passed; any other
- * object ends it), later hits reflect or refract where scene_photon_lobe
+ * object ends it; past the target only no_shadow objects are passed),
+ * later hits reflect or refract where scene_photon_lobe
  * allows, and every hit after the first on a surface with a Lambertian
  * term and `collect` on stores a photon. Photon count: the global spacing
  * (times the target's multiplier) is the distance between neighbouring
