@@ -148,7 +148,20 @@ static double se_dg(const im_data *m, vec3 o, vec3 d, double t) { return v3_dot(
  * (Kelley's cutting planes), so the search either finds a point with
  * g < 0 (two crossings, bracketed on both sides), proves the minimum
  * positive (no crossing) or closes in on a touching point (grazing). */
-static int se_piece(const im_data *m, vec3 o, vec3 d, double a, double b, double *roots, int nr)
+/* The caller's view of the crossings: distance tau along the unit ray is
+ * t = t0 + tau / s, kept when tmin < t < tmax; `max` are wanted. */
+typedef struct {
+    double t0, s, tmin, tmax;
+    int max;
+} se_range;
+
+static int se_kept(const se_range *r, double tau)
+{
+    double t = r->t0 + tau / r->s;
+    return t > r->tmin && t < r->tmax;
+}
+
+static int se_piece(const im_data *m, vec3 o, vec3 d, double a, double b, double *roots, int nr, const se_range *rg)
 {
     double ga = se_g(m, o, d, a), gb = se_g(m, o, d, b);
     if ((ga < 0.0) != (gb < 0.0)) {
@@ -167,7 +180,8 @@ static int se_piece(const im_data *m, vec3 o, vec3 d, double a, double b, double
         double gt = se_g(m, o, d, t);
         if (gt < 0.0) {
             roots[nr++] = se_root(m, o, d, a0, t, ga0, gt);
-            roots[nr++] = se_root(m, o, d, t, b0, gt, gb0);
+            /* the far crossing only when the caller wants more than one */
+            if (rg->max > 1 || !se_kept(rg, roots[nr - 1])) roots[nr++] = se_root(m, o, d, t, b0, gt, gb0);
             return nr;
         }
         if (b - a <= 1e-13 * (fabs(a) + fabs(b)) + 1e-300 || gt - lower <= 1e-15) {
@@ -212,18 +226,26 @@ static int se_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, g
     cuts[nc++] = L;
     double roots[64];
     int nr = 0;
+    /* Crossings are found in ascending order: the search stops once `max`
+     * lie strictly inside the range (the caller's interval is open, so a
+     * crossing at its very start does not count). */
+    se_range rg = {t0, s, tmin, tmax, max};
     if (m->convex) {
         /* convex along the ray: at most two crossings; a norm is smooth
          * enough across the kinks for the bracket search on the whole range */
-        nr = se_piece(m, p, e, 0.0, L, roots, nr);
+        nr = se_piece(m, p, e, 0.0, L, roots, nr, &rg);
     } else {
-        for (int c = 0; c + 1 < nc && nr < 56; c++) {
+        int kept = 0;
+        for (int c = 0; c + 1 < nc && nr < 56 && kept < max; c++) {
             const int N = 24;
             double a = cuts[c], b = cuts[c + 1];
             double prev = a, gprev = se_g(m, p, e, a);
-            for (int k = 1; k <= N && nr < 56; k++) {
+            for (int k = 1; k <= N && nr < 56 && kept < max; k++) {
                 double x = a + (b - a) * k / N, gx = se_g(m, p, e, x);
-                if ((gprev < 0.0) != (gx < 0.0)) roots[nr++] = se_root(m, p, e, prev, x, gprev, gx);
+                if ((gprev < 0.0) != (gx < 0.0)) {
+                    roots[nr++] = se_root(m, p, e, prev, x, gprev, gx);
+                    kept += se_kept(&rg, roots[nr - 1]);
+                }
                 prev = x;
                 gprev = gx;
             }
