@@ -21,12 +21,13 @@
 #define PHOTON_SKIP_FIRST (OBJ_NO_SHADOW | ACCEL_SKIP_PASS_THROUGH)
 #define PHOTON_SKIP_LATER OBJ_NO_SHADOW
 #define GBUF_LAYERS 8
-/* k of r_xy = k s_D / sqrt(rho_p): 6 unfocused spacings, about 110
+/* k of r_xy = k s_D / sqrt(rho_p): 9 unfocused spacings, about 250
  * photons of an unfocused beam within r_xy. The paper gives no constant;
- * this one was chosen on phot_met_glass and glassthing at 160x120 against
- * POV-Ray (bench/caustics.sh: k = 2.5, POV-Ray's minimum gather count of 20
- * photons, left visible speckle; 6 and 8 measured alike, 12 blurred) */
-#define RADIUS_K 6.0
+ * this one was chosen on phot_met_glass, glassthing and grenadine at
+ * 160x120 against POV-Ray (bench/caustics.sh: k = 2.5, POV-Ray's minimum
+ * gather count of 20 photons, left visible speckle; 9 came closer to
+ * POV-Ray's images than 6 on all three, 12 blurred phot_met_glass) */
+#define RADIUS_K 9.0
 #define CHUNK 2048
 /* most photons shot in all (memory and time stay bounded whatever the scene asks) */
 #define MAX_CELLS 4194304.0

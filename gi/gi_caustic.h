@@ -39,7 +39,7 @@
  *     over the lobes would give each lobe), sets the photon volume's
  *     radius: r_xy = k s_D / sqrt(rho_p), with s_D the spacing of the
  *     photon's direction cell at its path length (the distance to its
- *     neighbours had nothing focused it) and k = 6 (gi_caustic.c says
+ *     neighbours had nothing focused it) and k = 9 (gi_caustic.c says
  *     why); r_z = r_xy / 4;
  *  4. eye G-buffer (paper step 2): the first receiving surface through each
  *     pixel centre (non-receiving surfaces, e.g. clear glass, are passed
