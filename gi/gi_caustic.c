@@ -358,10 +358,10 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
                                 {(float)np.x, (float)np.y, (float)np.z},
                                 (float)(0.25 * rxy),
                                 {(float)-br.w.x, (float)-br.w.y, (float)-br.w.z},
-                                0.0f,
+                                (float)(1.0 / (rxy * rxy)),
                                 {(float)(cb->phi0.r * br.tr.r * k), (float)(cb->phi0.g * br.tr.g * k),
                                  (float)(cb->phi0.b * br.tr.b * k)},
-                                0.0f};
+                                (float)(16.0 / (rxy * rxy))};
             if (rxy > 0.0 && isfinite(q.phi[0] + q.phi[1] + q.phi[2]) && cmax3(crgb(q.phi[0], q.phi[1], q.phi[2])) > 0.0)
                 if (!push_photon(out, &q)) {
                     out->oom = 1;

@@ -37,7 +37,8 @@ _Static_assert(offsetof(gi_dev_light, shadowless) == 72, "shadowless");
 _Static_assert(sizeof(gi_walk_entry) == 16 && offsetof(gi_walk_entry, w) == 4, "gi_walk_entry is 16 bytes");
 _Static_assert(sizeof(gi_caus_photon) == 64 && offsetof(gi_caus_photon, r_xy) == 12 && offsetof(gi_caus_photon, n) == 16 &&
                    offsetof(gi_caus_photon, r_z) == 28 && offsetof(gi_caus_photon, w) == 32 &&
-                   offsetof(gi_caus_photon, phi) == 48,
+                   offsetof(gi_caus_photon, inv_rxy2) == 44 && offsetof(gi_caus_photon, phi) == 48 &&
+                   offsetof(gi_caus_photon, inv_rz2) == 60,
                "gi_caus_photon is 64 bytes");
 _Static_assert(sizeof(gi_caus_pixel) == 32 && offsetof(gi_caus_pixel, valid) == 12 && offsetof(gi_caus_pixel, n) == 16,
                "gi_caus_pixel is 32 bytes");

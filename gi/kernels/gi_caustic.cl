@@ -29,10 +29,9 @@ static inline float gi_caus_kappa(GI_GLOBAL const gi_caus_photon *q, float sx, f
     float d2 = dx * dx + dy * dy + dz * dz;
     float dp2 = d2 - dn * dn;
     if (dp2 < 0.0f) dp2 = 0.0f;
-    float rxy = q->r_xy, rz = q->r_z;
-    float t2 = dp2 / (rxy * rxy) + dn * dn / (rz * rz);
+    float t2 = dp2 * q->inv_rxy2 + dn * dn * q->inv_rz2;
     if (!(t2 < 1.0f)) return 0.0f;
-    return 3.0f * (1.0f - sqrt(t2)) / (GI_PI_F * rxy * rxy);
+    return (3.0f / GI_PI_F) * (1.0f - sqrt(t2)) * q->inv_rxy2;
 }
 
 /* Equation 1 without the BSDF: what photon q adds to the receiver's

@@ -217,9 +217,9 @@ typedef struct {
     float n[3];
     float r_z;
     float w[3];
-    float pad0;
+    float inv_rxy2; /* 1 / r_xy^2, 1 / r_z^2: the kernel's divisions, made once */
     float phi[3];
-    float pad1;
+    float inv_rz2;
 } gi_caus_photon;
 
 /* One eye G-buffer texel (paper step 2): the world position s and normal n
