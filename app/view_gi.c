@@ -70,6 +70,23 @@ static void whitted_settings(shade_settings *ss, const view_gi_pass *p)
     ss->cancel = p->cancel;
 }
 
+/* A Whitted pass of the scene (shade_render, timed into t->render); for a
+ * GI method's pass (gi) the ambient follows the radiosity rules as in
+ * render_gi.c and fn, when given, answers the indirect light. */
+static pt_status whitted_render(const scene *sc, const accel *a, const view_gi_pass *p, int gi, shade_indirect_fn fn,
+                                void *fn_ctx, framebuffer *fb, shade_stats *st, view_gi_times *t, diag *d)
+{
+    shade_settings ss;
+    whitted_settings(&ss, p);
+    if (gi) ss.use_ambient = radrules_of(sc, 1).ambient;
+    ss.indirect = fn;
+    ss.indirect_ctx = fn_ctx;
+    double t0 = timer_now();
+    pt_status s = shade_render(sc, a, &ss, fb, st, d);
+    t->render = timer_now() - t0;
+    return s;
+}
+
 static int whitted_last_level(const view_gi_opts *o) { (void)o; return 2; }
 
 static pt_status none_open(void **ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
@@ -87,12 +104,8 @@ static pt_status none_relight(void *ctx, volatile int *cancel, view_gi_times *t,
 static pt_status none_render(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
 {
     none_ctx *c = ctx;
-    shade_settings ss;
-    whitted_settings(&ss, p);
     shade_stats st;
-    double t0 = timer_now();
-    pt_status s = shade_render(c->sc, c->a, &ss, fb, &st, d);
-    t->render = timer_now() - t0;
+    pt_status s = whitted_render(c->sc, c->a, p, 0, NULL, NULL, fb, &st, t, d);
     c->rays = st.primary_rays + st.shadow_rays + st.secondary_rays;
     return s;
 }
@@ -205,15 +218,7 @@ static pt_status particle_render(void *ctx, const view_gi_pass *p, framebuffer *
     pt_status st = gi_particle_prepare_view(gp, &c->sc->camera, p->width, p->height, d);
     t->view = gi_particle_get_stats(gp)->t_view;
     if (st != PT_OK) return st;
-    shade_settings ss;
-    whitted_settings(&ss, p);
-    ss.use_ambient = radrules_of(c->sc, 1).ambient; /* as render_gi.c */
-    ss.indirect = gi_particle_indirect;
-    ss.indirect_ctx = gp;
-    double t0 = timer_now();
-    st = shade_render(c->sc, c->a, &ss, fb, NULL, d);
-    t->render = timer_now() - t0;
-    return st;
+    return whitted_render(c->sc, c->a, p, 1, gi_particle_indirect, gp, fb, NULL, t, d);
 }
 
 static void particle_describe(void *ctx, char *buf, int n)
@@ -333,17 +338,7 @@ static void links_adopt(void *ctx)
 static pt_status links_render(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
 {
     links_ctx *c = ctx;
-    shade_settings ss;
-    whitted_settings(&ss, p);
-    ss.use_ambient = radrules_of(c->sc, 1).ambient; /* as render_gi.c */
-    if (c->shot) {
-        ss.indirect = gi_vlinks_shot_indirect;
-        ss.indirect_ctx = c->shot;
-    }
-    double t0 = timer_now();
-    pt_status st = shade_render(c->sc, c->a, &ss, fb, NULL, d);
-    t->render = timer_now() - t0;
-    return st;
+    return whitted_render(c->sc, c->a, p, 1, c->shot ? gi_vlinks_shot_indirect : NULL, c->shot, fb, NULL, t, d);
 }
 
 static void links_describe(void *ctx, char *buf, int n)
