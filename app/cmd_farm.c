@@ -527,12 +527,7 @@ int cmd_farm(int argc, char **argv)
         fputs(farm_help, stdout);
         return 0;
     }
-    farm_plan p;
-    memset(&p, 0, sizeof p);
-    p.tiles = 1;
-    p.jobs = 2;
-    p.retries = 2;
-    p.max_rounds = 3;
+    farm_plan p = {.tiles = 1, .jobs = 2, .retries = 2, .max_rounds = 3};
     snprintf(p.engine, sizeof p.engine, "parallel");
     const char *dir = "farm", *out = NULL, *sshlogin = NULL, *fault = NULL;
     char **rest = calloc((size_t)argc + 1, sizeof *rest);

@@ -534,38 +534,16 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
         return status_exit(st == PT_OK ? PT_ERR_DEVICE : st);
     }
 
-    render_gi_opts ss;
-    memset(&ss, 0, sizeof ss);
-    ss.mode = gi;
-    ss.width = o->width > 0 ? o->width : 320;
-    ss.height = o->height > 0 ? o->height : 240;
-    ss.threads = threads;
-    ss.seed = o->seed;
-    ss.antialias = o->antialias ? 1 : (o->spp > 1 ? 2 : 0);
-    ss.aa_threshold = o->aa_threshold;
-    ss.aa_depth = o->aa_depth;
-    ss.quality = o->quality;
-    ss.spp = o->spp;
-    ss.particles = o->particles;
-    ss.gi_quality = o->gi_quality;
-    ss.photon_scale = o->photon_scale;
-    ss.bounces = o->bounces;
-    ss.fg_rays = o->fg_rays;
-    ss.photons = o->photons;
-    ss.max_depth = o->max_depth;
-    ss.cl_device = o->cl_device;
-    ss.cl_max_bytes = o->cl_max_memory_mib > 0 ? (size_t)o->cl_max_memory_mib << 20 : 0;
-    ss.progress = prog;
-    ss.notes = d;
-    ss.cancel = &g_cancel;
-    ss.reuse = reuse ? run->keep.gp : NULL;
-    ss.relight = relight;
-    ss.keep = keep_gi;
-    ss.detp_radius = o->detp_radius;
-    ss.detp_full = o->detp_full;
-    ss.vpls = o->vpls;
-    ss.vpl_cut = o->vpl_cut;
-    ss.vpl_adaptive = o->vpl_adaptive;
+    render_gi_opts ss = {.mode = gi, .width = o->width > 0 ? o->width : 320, .height = o->height > 0 ? o->height : 240,
+                         .threads = threads, .seed = o->seed, .antialias = o->antialias ? 1 : (o->spp > 1 ? 2 : 0),
+                         .aa_threshold = o->aa_threshold, .aa_depth = o->aa_depth, .quality = o->quality, .spp = o->spp,
+                         .particles = o->particles, .gi_quality = o->gi_quality, .photon_scale = o->photon_scale,
+                         .bounces = o->bounces, .fg_rays = o->fg_rays, .photons = o->photons, .max_depth = o->max_depth,
+                         .cl_device = o->cl_device,
+                         .cl_max_bytes = o->cl_max_memory_mib > 0 ? (size_t)o->cl_max_memory_mib << 20 : 0,
+                         .progress = prog, .notes = d, .cancel = &g_cancel, .reuse = reuse ? run->keep.gp : NULL,
+                         .relight = relight, .keep = keep_gi, .detp_radius = o->detp_radius, .detp_full = o->detp_full,
+                         .vpls = o->vpls, .vpl_cut = o->vpl_cut, .vpl_adaptive = o->vpl_adaptive};
     if (gi == GI_DETP && plan->animated) {
         /* the paths kept across frames: the pieces that changed are traced
          * again (pm_detp.h); the IR's stage hashes say whether the lights

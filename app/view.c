@@ -914,15 +914,9 @@ int cmd_view(int argc, char **argv)
         }
     }
 
-    viewer v;
-    memset(&v, 0, sizeof v);
-    v.t_start = timer_now();
-    v.verbose = verbose;
-    v.overlay = 1;
-    v.scene_path = o.scene;
-    v.width = o.width > 0 ? o.width : 512;
-    v.height = o.height > 0 ? o.height : (o.width > 0 ? o.width : 512);
-    v.threads = o.threads > 0 ? o.threads : pool_default_threads();
+    viewer v = {.t_start = timer_now(), .verbose = verbose, .overlay = 1, .scene_path = o.scene,
+                .width = o.width > 0 ? o.width : 512, .height = o.height > 0 ? o.height : (o.width > 0 ? o.width : 512),
+                .threads = o.threads > 0 ? o.threads : pool_default_threads()};
     v.last_gen_first = v.last_gen_full = v.last_gen_relit = v.last_gen_relit_full = -1;
     scene_stem(o.scene, v.stem, sizeof v.stem);
 

@@ -137,14 +137,8 @@ static void copy_messages(diag *dst, const diag *src)
 
 static view_gi_opts gi_opts(const view_render *vr)
 {
-    view_gi_opts go;
-    memset(&go, 0, sizeof go);
-    go.preview_particles = vr->o.preview_particles;
-    go.threads = vr->o.threads;
-    go.ref_spp = vr->o.ref_spp;
-    go.particles = vr->o.particles;
-    go.bounces = vr->o.bounces;
-    go.cl_device = vr->o.cl_device;
+    view_gi_opts go = {.preview_particles = vr->o.preview_particles, .threads = vr->o.threads, .ref_spp = vr->o.ref_spp,
+                       .particles = vr->o.particles, .bounces = vr->o.bounces, .cl_device = vr->o.cl_device};
     return go;
 }
 

@@ -479,14 +479,8 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
                          const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce)
 {
     if (threads <= 0) threads = pool_default_threads();
-    link_job J;
-    memset(&J, 0, sizeof J);
-    J.a = a;
-    J.sky = sky;
-    J.esky = sky && sc ? esky : NULL;
-    J.sc = sc;
-    J.pig = pig;
-    J.far_bounce = isfinite(far_bounce) && far_bounce > 0.0 ? (float)far_bounce : 0.0f;
+    link_job J = {.a = a, .sky = sky, .esky = sky && sc ? esky : NULL, .sc = sc, .pig = pig,
+                  .far_bounce = isfinite(far_bounce) && far_bounce > 0.0 ? (float)far_bounce : 0.0f};
     /* the link scene (accel.h): without the main scene's robust mode and
      * filters it is cheaper per link ray; the main scene is the fallback */
     void *lscene = rtc_scene ? NULL : accel_rtc_link_scene(a);

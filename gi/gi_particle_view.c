@@ -310,14 +310,8 @@ static void fill_row(void *ctx, int y, int thread)
             /* on a triangle of one cell, seen from b's side (the hit takes
              * b's ng and n): locate would give b's 3, marked already */
             if (b->diffuse && !(b->located && b->whole)) {
-                accel_hit hh;
-                memset(&hh, 0, sizeof hh);
-                hh.t = t;
-                hh.p = v3_madd(org, dir, t);
-                hh.ng = b->ng;
-                hh.ns = b->ng;
-                hh.obj = b->obj;
-                hh.prim = b->prim;
+                accel_hit hh = {.t = t, .p = v3_madd(org, dir, t), .ng = b->ng, .ns = b->ng, .obj = b->obj,
+                                .prim = b->prim};
                 long rp[3];
                 double w[3];
                 mark_hit(gp, &hh, b->n, rp, w);

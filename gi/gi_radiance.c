@@ -167,15 +167,9 @@ pt_status gi_radiance_lists(gi_lists *L, const gi_surface *g, const gi_particles
 {
     memset(L, 0, sizeof *L);
     L->nrp = gi_surface_nrp(g);
-    list_job J;
-    memset(&J, 0, sizeof J);
-    J.g = g;
-    J.ps = ps;
-    J.a = a;
-    J.eps = 1e-6 * (accel_eps_scale(a) > 0.0 && isfinite(accel_eps_scale(a)) ? accel_eps_scale(a) : 1.0);
-    J.r = r;
-    J.cos_thr = cos_thr;
-    J.nrp = L->nrp;
+    list_job J = {.g = g, .ps = ps, .a = a,
+                  .eps = 1e-6 * (accel_eps_scale(a) > 0.0 && isfinite(accel_eps_scale(a)) ? accel_eps_scale(a) : 1.0),
+                  .r = r, .cos_thr = cos_thr, .nrp = L->nrp};
     atomic_init(&J.widened, 0);
     atomic_init(&J.empty, 0);
     atomic_init(&J.dead, 0);

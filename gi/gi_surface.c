@@ -89,12 +89,7 @@ static void member_sides(const gi_surface *g, patch *p)
 static int add_tri(gi_surface *g, int obj, vec3 a, vec3 b, vec3 c, vec3 front, int nsides, int probe,
                    const scene_texture *tex)
 {
-    patch p;
-    memset(&p, 0, sizeof p);
-    p.kind = PATCH_TRI;
-    p.v0 = a;
-    p.e1 = v3_sub(b, a);
-    p.e2 = v3_sub(c, a);
+    patch p = {.kind = PATCH_TRI, .v0 = a, .e1 = v3_sub(b, a), .e2 = v3_sub(c, a)};
     vec3 cr = v3_cross(p.e1, p.e2);
     double l = v3_len(cr);
     if (!(l > 0.0) || !isfinite(l)) return 0;
@@ -478,15 +473,7 @@ pt_status gi_surface_add_leaf(gi_surface *g, const scene_object *o, const scene_
             int r = ok ? add_tri(g, obj, v[0], v[1], v[2], v3(0, 0, 0), two, probe, tt) : 0;
             if (r < 0) return PT_ERR_NOMEM;
             if (r == 0) {
-                patch p;
-                memset(&p, 0, sizeof p);
-                p.kind = PATCH_TRI;
-                p.obj = obj;
-                p.k = 1;
-                p.nsides = 0;
-                p.tex = tt;
-                p.cnode = -1;
-                p.mask = 3;
+                patch p = {.kind = PATCH_TRI, .obj = obj, .k = 1, .nsides = 0, .tex = tt, .cnode = -1, .mask = 3};
                 if (gi_surface_add_patch(g, &p) < 0) return PT_ERR_NOMEM;
                 g->o[obj].count++;
             }
@@ -498,11 +485,7 @@ pt_status gi_surface_add_leaf(gi_surface *g, const scene_object *o, const scene_
         pt_status st = add_box(g, obj, o, probe, tex);
         if (st != PT_OK) return st;
     } else {
-        patch p;
-        memset(&p, 0, sizeof p);
-        p.obj = obj;
-        p.probe = (unsigned char)probe;
-        p.tex = tex;
+        patch p = {.obj = obj, .probe = (unsigned char)probe, .tex = tex};
         if (o->kind == SHAPE_SPHERE) {
             p.kind = PATCH_SPHERE;
             p.c = o->u.sphere.centre;

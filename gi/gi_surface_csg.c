@@ -51,14 +51,7 @@ pt_status gi_surface_csg_add_piece(gi_surface *g, const scene_object *o, const s
     assert(g->cur_node >= 0 && g->cur_node < g->ncm);
     const csg_member *m = &g->cm[g->cur_node];
     const geom_shape *nsh = &g->ct[m->tree].shapes[m->shape];
-    patch p;
-    memset(&p, 0, sizeof p);
-    p.kind = PATCH_PIECE;
-    p.piece = -1;
-    p.tex = tex;
-    p.nsides = 2;
-    p.mask = g->cur_mask;
-    p.cnode = g->cur_node;
+    patch p = {.kind = PATCH_PIECE, .piece = -1, .tex = tex, .nsides = 2, .mask = g->cur_mask, .cnode = g->cur_node};
     /* a copy of the node's shape (which keeps serving the inside tests)
      * that may be clipped; its data stays the node's */
     p.sh = malloc(sizeof *p.sh);

@@ -299,11 +299,7 @@ static rand_streams *streams_of(sdl_parser *p)
     static const char key[] = " rand streams";
     const sdl_value *v = sdl_symtab_find(p->sym, key, sizeof key - 1);
     if (v) return v->ptr;
-    sdl_value nv;
-    memset(&nv, 0, sizeof nv);
-    nv.kind = VAL_OPAQUE;
-    nv.str = "rand";
-    nv.ptr = sdl_alloc(p, sizeof(rand_streams));
+    sdl_value nv = {.kind = VAL_OPAQUE, .str = "rand", .ptr = sdl_alloc(p, sizeof(rand_streams))};
     if (!nv.ptr) return NULL;
     /* global scope, whatever the current depth */
     sdl_symtab_declare(p->sym, key, sizeof key - 1, &nv);

@@ -197,11 +197,7 @@ void sdl_fopen_directive(sdl_parser *p, src_loc loc)
         f->out = out;
     }
     f->open = 1;
-    sdl_value v;
-    memset(&v, 0, sizeof v);
-    v.kind = VAL_FILE;
-    v.ptr = f;
-    v.str = f->name;
+    sdl_value v = {.kind = VAL_FILE, .ptr = f, .str = f->name};
     if (!sdl_symtab_declare(p->sym, id.tk.text, (size_t)id.tk.len, &v)) sdl_error(p, loc, PT_ERR_NOMEM, "out of memory");
 }
 

@@ -76,26 +76,14 @@ static scene_pattern *new_pattern(sdl_parser *p, const scene_pattern *from)
 static target target_new(sdl_parser *p, tgt_kind kind, const scene_pattern *pat, const scene_blend_map **map,
                          xform *outer, int uv)
 {
-    target tg;
-    memset(&tg, 0, sizeof tg);
-    tg.kind = kind;
-    tg.pat = pat ? new_pattern(p, pat) : NULL;
-    tg.map = map;
-    tg.outer = outer;
-    tg.uv = uv;
+    target tg = {.kind = kind, .pat = pat ? new_pattern(p, pat) : NULL, .map = map, .outer = outer, .uv = uv};
     if (uv && tg.pat) tg.pat->uv_mapping = 1;
     return tg;
 }
 
 static scene_warp default_turb(void)
 {
-    scene_warp w;
-    memset(&w, 0, sizeof w);
-    w.kind = WARP_TURBULENCE;
-    w.octaves = 6;
-    w.omega = 0.5;
-    w.lambda = 2.0;
-    w.transform = xform_identity();
+    scene_warp w = {.kind = WARP_TURBULENCE, .octaves = 6, .omega = 0.5, .lambda = 2.0, .transform = xform_identity()};
     return w;
 }
 
@@ -458,11 +446,7 @@ static void warp_block(sdl_parser *p, target *tg)
 {
     src_loc loc = sdl_peek(p)->tk.loc;
     if (!sdl_begin_block(p, "warp")) return;
-    scene_warp w;
-    memset(&w, 0, sizeof w);
-    w.transform = xform_identity();
-    w.orientation = v3(0, 0, 1);
-    w.major_radius = 1.0;
+    scene_warp w = {.transform = xform_identity(), .orientation = v3(0, 0, 1), .major_radius = 1.0};
     sdl_tok t = sdl_next(p);
     sdl_kw k = t.tk.kind == TOK_KEYWORD ? t.tk.kw : KW_NONE;
     switch (k) {

@@ -150,16 +150,9 @@ pt_status pm_image_render(const scene *sc, const pm_common *c, int max_pass, fra
     int threads = pm_threads(c->threads);
     int spp = c->spp > 0 ? c->spp : 1;
     if (max_pass < 1) max_pass = 1;
-    loop_ctx L;
-    memset(&L, 0, sizeof L);
-    L.sc = sc;
-    L.c = c;
-    L.fn = fn;
-    L.ctx = ctx;
-    L.cnt = calloc((size_t)threads, sizeof(pm_counts));
-    L.acc = calloc((size_t)c->width * (size_t)c->height * 3, sizeof(double));
-    L.tiles_x = (c->width + TILE - 1) / TILE;
-    L.tiles_y = (c->height + TILE - 1) / TILE;
+    loop_ctx L = {.sc = sc, .c = c, .fn = fn, .ctx = ctx, .cnt = calloc((size_t)threads, sizeof(pm_counts)),
+                  .acc = calloc((size_t)c->width * (size_t)c->height * 3, sizeof(double)),
+                  .tiles_x = (c->width + TILE - 1) / TILE, .tiles_y = (c->height + TILE - 1) / TILE};
     L.tile_spp = calloc((size_t)L.tiles_x * (size_t)L.tiles_y, sizeof(int));
     if (!L.cnt || !L.acc || !L.tile_spp) {
         free(L.cnt);

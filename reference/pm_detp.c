@@ -352,13 +352,9 @@ static void on_seg(void *ctx, long index, const pm_photon_launch *l, const accel
 {
     (void)index;
     walk_sink *ws = ctx;
-    seg s;
-    memset(&s, 0, sizeof s);
-    s.l = *l;
-    s.t = h ? h->t : INFINITY;
-    s.carried = carried;
-    s.hit_leaf = h ? scene_leaves_find(ws->fc->lv, h->obj) : -1;
-    s.from_leaf = l->from.obj ? scene_leaves_find(ws->fc->lv, l->from.obj) : -1;
+    seg s = {.l = *l, .t = h ? h->t : INFINITY, .carried = carried,
+             .hit_leaf = h ? scene_leaves_find(ws->fc->lv, h->obj) : -1,
+             .from_leaf = l->from.obj ? scene_leaves_find(ws->fc->lv, l->from.obj) : -1};
     segvec_push(ws->out, &s);
     ws->count++;
     if (ws->plus) apply_seg(ws->plus, ws->fc->ginc, &s);

@@ -736,13 +736,8 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     if (!ts) return PT_ERR_NOMEM;
     int threads = s->threads > 0 ? s->threads : pool_default_threads();
     if (threads > SHADE_MAX_THREADS) threads = SHADE_MAX_THREADS;
-    render_ctx c;
-    memset(&c, 0, sizeof c);
-    c.sc = sc;
-    c.a = a;
-    c.s = s;
-    c.eps = scene_eps(a);
-    c.max_level = s->max_trace_level > 0 ? s->max_trace_level : sc->global.max_trace_level;
+    render_ctx c = {.sc = sc, .a = a, .s = s, .eps = scene_eps(a),
+                    .max_level = s->max_trace_level > 0 ? s->max_trace_level : sc->global.max_trace_level};
     if (c.max_level < 1) c.max_level = 1;
     c.ts = ts;
     c.fb = fb;
@@ -836,14 +831,7 @@ rgb shade_direct(const scene *sc, const accel *a, const shade_light_surface *s, 
     memset(ts, 0, sizeof ts);
     shade_settings ss;
     shade_default_settings(&ss);
-    render_ctx c;
-    memset(&c, 0, sizeof c);
-    c.sc = sc;
-    c.a = a;
-    c.s = &ss;
-    c.eps = scene_eps(a);
-    c.max_level = 1;
-    c.ts = ts;
+    render_ctx c = {.sc = sc, .a = a, .s = &ss, .eps = scene_eps(a), .max_level = 1, .ts = ts};
     c.transparent = 1; /* filtered shadows, as shade_trace: exact for opaque surfaces too */
     return direct_light(&c, 0, s, h, p, r);
 }

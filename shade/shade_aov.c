@@ -155,12 +155,7 @@ pt_status shade_aov_render(const scene *sc, const accel *a, const shade_settings
         diag_error(d, "shade_aov_render: bad arguments");
         return PT_ERR_INTERNAL;
     }
-    aov_ctx c;
-    memset(&c, 0, sizeof c);
-    c.sc = sc;
-    c.a = a;
-    c.s = s;
-    c.out = out;
+    aov_ctx c = {.sc = sc, .a = a, .s = s, .out = out};
     /* shade.c's distance epsilon: a fixed fraction of the scene's extent */
     double scale = accel_scale(a);
     if (!(scale > 0.0) || !isfinite(scale)) scale = 1.0;
