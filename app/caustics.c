@@ -31,6 +31,11 @@ static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, rng *r, gi_caus
         /* reflected inside an object, the photon has crossed it: its fade
          * over the way (the refracted branch's filter below has it too) */
         rgb fa = shade_tex_leaving_fade(h, dir), k = b.k[SHADE_MAT_LOBE_REFLECT];
+        /* total internal reflection keeps the whole photon: POV-Ray's
+         * photon refraction reflects the unfiltered photon instead and
+         * skips the surface's own reflection (photons.cpp,
+         * TraceRefractionRayForPhotons) */
+        if (b.tir) k = (rgb){1, 1, 1};
         step[n] = (gi_caustic_step){b.p_out, b.refl_dir, {fa.r * k.r / p, fa.g * k.g / p, fa.b * k.b / p}, p, 0, b.from};
         n++;
     }

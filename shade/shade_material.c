@@ -326,6 +326,7 @@ void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec
             double k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
             if (k < 0.0) {
                 /* total internal reflection: the transmitted part reflects */
+                b->tir = 1;
                 refl = mrgb(refl.r + trans.r, refl.g + trans.g, refl.b + trans.b);
                 trans = mrgb(0, 0, 0);
             } else {
