@@ -15,8 +15,13 @@
  * would choose one of them; a kept photon goes on along each specular
  * lobe the surface has, weighted by the lobe over p. Each branch carries
  * p as its path-density factor (rho): split branches are as dense as the
- * photons arriving, only the roulette thins them. */
-static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, rng *r, gi_caustic_step *step)
+ * photons arriving, only the roulette thins them. A refraction bends by
+ * the ior ratio of POV-Ray's interior list (the photon's containers `in`,
+ * shade_tex_refraction_eta), as POV-Ray's photons do (photons.cpp,
+ * ComputeRefractionForPhotons): a liquid in a glass refracts against the
+ * glass, not against air. */
+static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, const gi_caustic_inside *in, rng *r,
+                        gi_caustic_step *step)
 {
     const caustics *c = ctx;
     shade_mat_bsdf b;
@@ -26,39 +31,59 @@ static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, rng *r, gi_caus
     double mr = b.m[SHADE_MAT_LOBE_REFLECT], mt = b.m[SHADE_MAT_LOBE_TRANSMIT];
     double p = (mr + mt) / (b.msum > 1.0 ? b.msum : 1.0);
     if (!(p > 0.0) || rng_f64(r) >= p) return out;
+    /* the surface's own reflectivity (shade_material folds a transmitted
+     * part it totally reflects into k[REFLECT]) */
+    rgb kr = b.k[SHADE_MAT_LOBE_REFLECT];
+    if (b.tir) kr = (rgb){fmax(0.0, kr.r - b.tir_trans.r), fmax(0.0, kr.g - b.tir_trans.g), fmax(0.0, kr.b - b.tir_trans.b)};
+    int transmits = mt > 0.0 || b.tir, tir = b.tir;
+    vec3 tdir = b.trans_dir;
+    shade_media_inside si = {0, {0}};
+    if (in) {
+        si.n = in->n < SHADE_MEDIA_MAX_INSIDE ? in->n : SHADE_MEDIA_MAX_INSIDE;
+        for (int i = 0; i < si.n; i++) si.obj[i] = in->obj[i];
+    }
+    if (transmits && in) {
+        double eta = shade_tex_refraction_eta(&si, h->obj, b.entering);
+        double cos_i = -v3_dot(dir, b.n), k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+        tir = k < 0.0;
+        if (!tir) tdir = v3_norm(v3_add(v3_scale(dir, eta), v3_scale(b.n, eta * cos_i - sqrt(k))));
+    }
+    gi_caustic_inside same = {0, {0}};
+    if (in) same = *in;
+    /* reflected inside an object, the photon has crossed it: its fade over
+     * the way (the refracted branch's filter below has it too) */
+    rgb fa = shade_tex_leaving_fade(h, dir);
     int n = 0;
-    if (mr > 0.0) {
-        /* reflected inside an object, the photon has crossed it: its fade
-         * over the way (the refracted branch's filter below has it too) */
-        rgb fa = shade_tex_leaving_fade(h, dir), k = b.k[SHADE_MAT_LOBE_REFLECT];
+    if (tir) {
         /* total internal reflection keeps the whole photon: POV-Ray's
          * photon refraction reflects the unfiltered photon instead and
-         * skips the surface's own reflection (photons.cpp,
-         * TraceRefractionRayForPhotons) */
-        if (b.tir) k = (rgb){1, 1, 1};
-        step[n] = (gi_caustic_step){b.p_out, b.refl_dir, {fa.r * k.r / p, fa.g * k.g / p, fa.b * k.b / p}, p, 0, b.from};
-        n++;
-    }
-    if (mt > 0.0) {
-        /* what a refracted photon keeps: the layers' filter and transmit
-         * and, leaving an object, the interior's fade over h->t, the
-         * straight path inside (shade_tex_shadow_filter), times 1 - the
-         * top layer's reflectivity under conserve_energy (POV-Ray 3.7's
-         * photons.cpp, PhotonTrace::ComputeLightedTexture: FilCol *= 1 -
-         * reflec, the photon carrying LightCol * FilCol) */
-        rgb f = shade_tex_shadow_filter(c->sc, h, dir);
-        if (b.ls.f && b.ls.f->conserve_energy) {
-            rgb kr = b.k[SHADE_MAT_LOBE_REFLECT];
-            f = (rgb){f.r * fmin(1.0, 1.0 - kr.r), f.g * fmin(1.0, 1.0 - kr.g), f.b * fmin(1.0, 1.0 - kr.b)};
+         * skips the surface's own reflection (TraceRefractionRayForPhotons) */
+        step[n++] = (gi_caustic_step){b.p_out, b.refl_dir, {fa.r / p, fa.g / p, fa.b / p}, p, 0, b.from, same};
+    } else {
+        if (fmax(kr.r, fmax(kr.g, kr.b)) > 0.0)
+            step[n++] = (gi_caustic_step){b.p_out, b.refl_dir, {fa.r * kr.r / p, fa.g * kr.g / p, fa.b * kr.b / p}, p, 0,
+                                          b.from, same};
+        if (transmits) {
+            /* what a refracted photon keeps: the layers' filter and
+             * transmit and, leaving an object, the interior's fade over
+             * h->t, the straight path inside (shade_tex_shadow_filter),
+             * times 1 - the top layer's reflectivity under conserve_energy
+             * (POV-Ray 3.7's photons.cpp, ComputeLightedTexture: FilCol *=
+             * 1 - reflec, the photon carrying LightCol * FilCol). No
+             * (eta_i/eta_t)^2 (b.eta2, the path tracer's adjoint rule):
+             * POV-Ray's photon keeps LightCol x FilCol through a
+             * refraction, so a surface inside a refracting object (a floor
+             * that a glass sinks into) gets the photons' full power;
+             * through a whole object the two factors cancel anyway */
+            rgb f = shade_tex_shadow_filter(c->sc, h, dir);
+            if (b.ls.f && b.ls.f->conserve_energy)
+                f = (rgb){f.r * fmin(1.0, 1.0 - kr.r), f.g * fmin(1.0, 1.0 - kr.g), f.b * fmin(1.0, 1.0 - kr.b)};
+            shade_media_inside_cross(&si, h->obj);
+            gi_caustic_inside after = {0, {0}};
+            after.n = si.n < GI_CAUSTIC_MAX_INSIDE ? si.n : GI_CAUSTIC_MAX_INSIDE;
+            for (int i = 0; i < after.n; i++) after.obj[i] = si.obj[i];
+            step[n++] = (gi_caustic_step){b.p_in, tdir, {f.r / p, f.g / p, f.b / p}, p, 1, b.from, after};
         }
-        /* no (eta_i/eta_t)^2 (b.eta2, the path tracer's adjoint rule):
-         * POV-Ray's photon keeps LightCol x FilCol through a refraction,
-         * so a surface inside a refracting object (a floor that a glass
-         * sinks into) gets the photons' full power; through a whole
-         * object the two factors cancel anyway */
-        double k = 1.0 / p;
-        step[n] = (gi_caustic_step){b.p_in, b.trans_dir, {f.r * k, f.g * k, f.b * k}, p, 1, b.from};
-        n++;
     }
     return out | GI_CAUSTIC_CONTINUES | (n == 2 ? GI_CAUSTIC_SPLIT : 0);
 }

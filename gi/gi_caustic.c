@@ -324,10 +324,11 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
         int has_from, level;
         double depth, rho_p;
         rgb tr;
+        gi_caustic_inside in;
     } branch;
     branch stack[2 * GI_CAUSTIC_MAX_BOUNCES + 4];
     int ns = 0;
-    stack[ns++] = (branch){o, w, {0}, 0, 0, 0.0, 1.0, {1, 1, 1}};
+    stack[ns++] = (branch){o, w, {0}, 0, 0, 0.0, 1.0, {1, 1, 1}, {0, {0}}};
     vec3 p_first = o;
     while (ns > 0) {
         branch br = stack[--ns];
@@ -344,7 +345,7 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
             p_first = h.p;
         }
         gi_caustic_step step[2];
-        int sf = c->hk.surface(c->hk.ctx, &h, br.w, &r, step);
+        int sf = c->hk.surface(c->hk.ctx, &h, br.w, &br.in, &r, step);
         const scene_obj_photons *ph = h.obj ? h.obj->photons : NULL;
         if (level >= 1 && (sf & GI_CAUSTIC_RECEIVES) && !(ph && !ph->collect) && scene_light_reaches(l, h.obj)) {
             /* store the photon before this bounce (paper, step 1(d)) */
@@ -382,7 +383,7 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
             if (!(cmax3(tr) >= c->adc) || !isfinite(tr.r + tr.g + tr.b)) continue;
             if (ns >= (int)(sizeof stack / sizeof stack[0])) continue;
             stack[ns++] = (branch){st->org, st->dir, st->from, 1, level + 1, depth,
-                                   br.rho_p * fmin(1.0, fmax(st->rho, 1e-6)), tr};
+                                   br.rho_p * fmin(1.0, fmax(st->rho, 1e-6)), tr, st->inside};
             went = 1;
         }
         if (went) out->alive[level + 1]++;
@@ -560,7 +561,7 @@ static void gbuf_row(void *ctx, int y, int thread)
             if (h.flags & OBJ_NO_IMAGE) continue;
             const scene_obj_photons *ph = h.obj ? h.obj->photons : NULL;
             if (ph && !ph->collect) continue;
-            if (!(c->hk.surface(c->hk.ctx, &h, d, &r, NULL) & GI_CAUSTIC_RECEIVES)) continue;
+            if (!(c->hk.surface(c->hk.ctx, &h, d, NULL, &r, NULL) & GI_CAUSTIC_RECEIVES)) continue;
             vec3 n = v3_dot(h.ng, d) < 0.0 ? h.ng : v3_neg(h.ng);
             v3_store_f(px->s, h.p);
             px->valid = 1.0f;

@@ -70,6 +70,15 @@
 
 typedef struct gi_caustic gi_caustic;
 
+/* The objects a photon is inside, innermost last (POV-Ray's interior list:
+ * it sets the ior ratio of each refraction); filled by the hooks, which
+ * know when two objects share an interior. */
+#define GI_CAUSTIC_MAX_INSIDE 16
+typedef struct {
+    int n;
+    const scene_object *obj[GI_CAUSTIC_MAX_INSIDE];
+} gi_caustic_inside;
+
 /* A specular bounce that the photon continues along. */
 typedef struct {
     vec3 org, dir;   /* continuation ray, origin off the right side */
@@ -78,6 +87,7 @@ typedef struct {
                         the path density */
     int refract;     /* 1 refraction, 0 reflection */
     accel_from from; /* the surface left */
+    gi_caustic_inside inside; /* the containers after the bounce */
 } gi_caustic_step;
 
 /* GI_CAUSTIC_CONTINUES: step[0] holds the bounce; GI_CAUSTIC_SPLIT as well:
@@ -86,7 +96,8 @@ enum { GI_CAUSTIC_RECEIVES = 1, GI_CAUSTIC_CONTINUES = 2, GI_CAUSTIC_SPLIT = 4 }
 
 /* The material and light model, from app/ (gi/ cannot reach shade/). */
 typedef struct {
-    /* The surface at h for a photon or eye ray arriving along unit dir:
+    /* The surface at h for a photon or eye ray arriving along unit dir
+     * inside the objects `in` (NULL: the atmosphere):
      * GI_CAUSTIC_RECEIVES when it has a Lambertian term (photons light it);
      * with step non-NULL (room for 2), Russian roulette (seed 002 appendix
      * A) between going on, with probability the specular lobes' share of
@@ -95,7 +106,8 @@ typedef struct {
      * mirror reflection and its refraction where the surface has both, as
      * POV-Ray's photon tracer traces both (photons.cpp): a split has no
      * roulette noise between the lobes. */
-    int (*surface)(void *ctx, const accel_hit *h, vec3 dir, rng *r, gi_caustic_step *step);
+    int (*surface)(void *ctx, const accel_hit *h, vec3 dir, const gi_caustic_inside *in, rng *r,
+                   gi_caustic_step *step);
     /* Light l's angle and distance attenuation at point p (first hit of a
      * photon) for path length depth (shade_light_attenuation). */
     double (*attenuation)(void *ctx, const scene_light *l, vec3 p, double depth);

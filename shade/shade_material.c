@@ -327,6 +327,7 @@ void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec
             if (k < 0.0) {
                 /* total internal reflection: the transmitted part reflects */
                 b->tir = 1;
+                b->tir_trans = trans;
                 refl = mrgb(refl.r + trans.r, refl.g + trans.g, refl.b + trans.b);
                 trans = mrgb(0, 0, 0);
             } else {

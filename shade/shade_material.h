@@ -105,7 +105,8 @@ typedef struct {
     rgb k[SHADE_MAT_NLOBES]; /* kd, kb, kr, kt, kg (kg: the glossy weights' sum, untinted) */
     vec3 refl_dir, trans_dir;
     double eta2;       /* (eta_i/eta_t)^2 of the refraction, 1 without */
-    int tir;           /* total internal reflection: the transmitted part is in k[REFLECT] */
+    int tir;           /* total internal reflection: the transmitted part, tir_trans, is in k[REFLECT] */
+    rgb tir_trans;
     double m[SHADE_MAT_NLOBES]; /* lobe sizes: max channel of k (>= 0) */
     double msum;
     int nglossy;       /* glossy sub-lobes of the top layer: blurred reflection (first, when there

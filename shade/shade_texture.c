@@ -486,6 +486,16 @@ static void ior_setup(hit_info *hi, const shade_media_inside *in, const scene_ob
     }
 }
 
+double shade_tex_refraction_eta(const shade_media_inside *in, const scene_object *o, int entering)
+{
+    hit_info hi;
+    memset(&hi, 0, sizeof hi);
+    hi.entering = entering;
+    hi.interior = o ? o->interior : NULL;
+    ior_setup(&hi, in, o);
+    return hi.eta;
+}
+
 rgb shade_tex_shade(const shade_tex_env *e, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip, float wavelength)
 {
     hit_info hi = {.e = e, .h = h, .dir = dir, .level = level, .skip = skip, .wavelength = wavelength,

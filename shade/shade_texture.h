@@ -72,6 +72,13 @@ rgb shade_tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir);
  * object's fade whenever it travelled inside that object, before it is
  * reflected or refracted). */
 rgb shade_tex_leaving_fade(const accel_hit *h, vec3 dir);
+/* The ior ratio eta = n_incident / n_transmitted of a refraction through
+ * object o's surface (entering: the ray hits its outside) by a ray whose
+ * containers are `in`, POV-Ray 3.7's interior-list rule (the one the eye
+ * rays follow, trace.cpp ComputeRefraction; photons.cpp
+ * ComputeRefractionForPhotons has the same): nested objects refract
+ * against their container, leaving an overlap does not refract. */
+double shade_tex_refraction_eta(const shade_media_inside *in, const scene_object *o, int entering);
 
 /* Light left along a shadow ray from p (unit dir) over (tmin, tmax): 0 when
  * an opaque surface blocks it, else the product of the filter colours of the
