@@ -40,7 +40,7 @@ typedef struct {
     float far_bounce;     /* brightness when the far field reflects the sky, else 0 */
     gi_dev_light *lights; /* the scene's, for the far field's direct light */
     int nlights;
-    int exact;            /* view points with no bounce after the hit: every hit takes far_field */
+    int exact;            /* view points with no bounce after the hit: every hit takes hit_light */
 } link_job;
 
 /* The material where ray h hit object o: rho and le at the pigment there
@@ -89,33 +89,21 @@ static const scene_object *hit_leaf(const link_job *J, const struct RTCRayHit *h
     return o;
 }
 
-/* The emission where ray h hit, added to out: links from view points
- * (gi_links_build's first > 0) take it at the hit, not from the particle
- * they end on. */
-static void hit_emission(const link_job *J, const struct RTCRayHit *h, float out[3])
-{
-    const scene_texture *tex;
-    const scene_object *o = hit_leaf(J, h, &tex);
-    if (!o) return;
-    float rho[3], le[3];
-    const colour5 white = {1.0, 1.0, 1.0, 0.0, 0.0};
-    gi_particles_material(J->sc, tex, &white, rho, le);
-    if (!(le[0] > 0.0f || le[1] > 0.0f || le[2] > 0.0f)) return; /* its finish emits nothing */
-    vec3 p, n;
-    hit_material(J, h, o, tex, rho, le, &p, &n);
-    for (int c = 0; c < 3; c++)
-        if (isfinite(le[c]) && le[c] > 0.0f) out[c] += le[c];
-}
-
-/* The far field (beyond the paper, which leaves open scenes out): a link
+/* The light at the hit of link ray h that does not come from particles,
+ * added to out (nothing without esky): the surface's emission; for the
+ * final gather's links (J->lights) the direct light it reflects; and with
+ * sky_bounce, the far field's sky term below.
+ *
+ * The far field (beyond the paper, which leaves open scenes out): a link
  * ray that hits a surface where no particle answers (an infinite plane
  * beyond the geometry stage's clip box, a shape without particles) sees
  * that surface's emission, plus, when the light has a bounce to spare
  * (far_bounce > 0), the sky it reflects, taken as unoccluded: rho * b *
  * E_sky(n)/pi about the hit's normal turned to the ray, at the texture's
  * base colour. In a closed room under a black sky this is the emission
- * alone. Adds it to out (nothing without esky). */
-static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3])
+ * alone. Where a particle answers (sky_bounce 0) the particle's reflected
+ * indirect light is added by the caller (gi_particle_view_regather). */
+static void hit_light(const link_job *J, const struct RTCRayHit *h, int sky_bounce, float out[3])
 {
     if (!J->esky) return;
     const scene_texture *tex;
@@ -125,7 +113,7 @@ static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3]
     vec3 p, n;
     hit_material(J, h, o, tex, rho, le, &p, &n);
     float irr[3] = {0.0f, 0.0f, 0.0f};
-    if (J->far_bounce > 0.0f) gi_sky_irradiance(J->sky, n, irr);
+    if (sky_bounce && J->far_bounce > 0.0f) gi_sky_irradiance(J->sky, n, irr);
     /* and, for the final gather's links (J->lights), the direct light it
      * reflects (the particles' edir at the hit, gi_k_emit's sum, a shadow
      * ray each; area lights from their centre): sunlit ground beyond the
@@ -134,7 +122,12 @@ static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3]
      * recursion_limit. */
     float dir[3] = {0.0f, 0.0f, 0.0f};
     if (J->nlights > 0 && (rho[0] > 0.0f || rho[1] > 0.0f || rho[2] > 0.0f)) {
+        /* the shadow ray starts eps off the surface and ends short of the
+         * light as the particles' do (gi_particle_light.c shadow_ray), its
+         * length measured from where it starts: a light in a surface's
+         * plane (cornell.pov's, in its ceiling) is not shadowed by it */
         double eps = accel_epsilon(J->a, p, n);
+        vec3 org = v3_madd(p, n, eps);
         for (int l = 0; l < J->nlights; l++) {
             const gi_dev_light *lt = &J->lights[l];
             float dl[3];
@@ -143,9 +136,12 @@ static void far_field(const link_job *J, const struct RTCRayHit *h, float out[3]
             if (!(ci > 0.0)) continue;
             float att = gi_light_attenuation(lt, (float)p.x, (float)p.y, (float)p.z, dl, depth);
             if (!(att > 0.0f)) continue;
-            if (!lt->shadowless &&
-                accel_occluded(J->a, v3_madd(p, n, eps), v3(dl[0], dl[1], dl[2]), eps, depth > 0.0f ? depth : INFINITY))
-                continue;
+            if (!lt->shadowless) {
+                float ds[3];
+                double dep = gi_light_ray(lt, lt->pos[0], lt->pos[1], lt->pos[2], (float)org.x, (float)org.y, (float)org.z, ds);
+                double tmax = dep > 0.0 ? dep - fmax(eps, dep * 1e-5) : INFINITY;
+                if (tmax > eps && accel_occluded(J->a, org, v3(ds[0], ds[1], ds[2]), 0.0, tmax)) continue;
+            }
             for (int c = 0; c < 3; c++) dir[c] += lt->colour[c] * att * (float)ci;
         }
     }
@@ -289,11 +285,11 @@ static void job(void *ctx, int index, int thread)
                 /* no bounce after this hit (POV-Ray's recursion_limit 1, or
                  * brightness 0): what the ray sees there is the hit's
                  * emission and the direct light it reflects, computed at
-                 * the hit itself (far_field, a shadow ray a light from its
+                 * the hit itself (hit_light, a shadow ray a light from its
                  * centre, as POV-Ray's radiosity rays take area lights)
                  * rather than read from the nearest particle, whose value
                  * blurs shadow edges over a particle spacing */
-                if (hit) far_field(J, &rh[m], sky);
+                if (hit) hit_light(J, &rh[m], 1, sky);
                 J->links[(size_t)(i - J->first) * J->k + J->order[j]] = -1;
                 continue;
             }
@@ -318,7 +314,7 @@ static void job(void *ctx, int index, int thread)
             int hid = hobj ? last_hid : -1;
             if (hobj && hid < 0) {
                 unres++;
-                far_field(J, &rh[m], sky);
+                hit_light(J, &rh[m], 1, sky);
             } else if (hit && J->grid) {
                 const struct RTCRayHit *h = &rh[m];
                 vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
@@ -417,9 +413,9 @@ static void job(void *ctx, int index, int thread)
                 }
                 if (target < 0) {
                     unres++;
-                    if (hit) far_field(J, &rh[m], sky);
+                    if (hit) hit_light(J, &rh[m], 1, sky);
                 } else if (J->first > 0 && J->esky) {
-                    hit_emission(J, &rh[m], sky);
+                    hit_light(J, &rh[m], 0, sky);
                 }
             }
             J->links[(size_t)(i - J->first) * J->k + J->order[j]] = target;
