@@ -75,9 +75,8 @@ void sdl_array_set(sdl_parser *p, sdl_array *a, long i, const sdl_value *v, src_
 
 sdl_array *sdl_array_copy(sdl_parser *p, const sdl_array *a)
 {
-    sdl_array *c = sdl_alloc(p, sizeof *c);
+    sdl_array *c = sdl_dup(p, a, sizeof *c);
     if (!c) return NULL;
-    *c = *a;
     c->elems = sdl_alloc(p, sizeof(sdl_value) * (size_t)a->total);
     if (!c->elems) return NULL;
     for (long i = 0; i < a->total; i++) c->elems[i] = stored_value(p, &a->elems[i]);

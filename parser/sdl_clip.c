@@ -70,9 +70,8 @@ static scene_object *clip_objects(sdl_parser *p, src_loc loc)
 static scene_object *copy_tree(sdl_parser *p, const scene_object *o, int depth)
 {
     if (!o || depth > 1000) return NULL;
-    scene_object *c = sdl_alloc(p, sizeof *c);
+    scene_object *c = sdl_dup(p, o, sizeof *c);
     if (!c) return NULL;
-    *c = *o;
     if (scene_object_is_csg(o)) {
         c->u.csg.kids = o->u.csg.nkids ? sdl_alloc(p, sizeof *c->u.csg.kids * (size_t)o->u.csg.nkids) : NULL;
         for (int i = 0; i < o->u.csg.nkids && c->u.csg.kids; i++) c->u.csg.kids[i] = copy_tree(p, o->u.csg.kids[i], depth + 1);

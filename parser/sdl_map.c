@@ -146,9 +146,8 @@ const scene_blend_map *sdl_map_blend(sdl_parser *p, map_kind k, int average)
         sdl_accept(p, TOK_COMMA);
         switch (k) {
         case MAP_PIGMENT: {
-            scene_pigment *pg = sdl_alloc(p, sizeof *pg);
+            scene_pigment *pg = sdl_dup(p, &p->s->default_texture.pigment, sizeof *pg);
             if (!pg) return NULL;
-            *pg = p->s->default_texture.pigment;
             sdl_pattern_pigment_body(p, pg);
             e[n].pigment = pg;
             break;

@@ -95,9 +95,8 @@ scene_texture *sdl_copy_texture(sdl_parser *p, const scene_texture *t)
 {
     scene_texture *head = NULL, **tail = &head;
     for (; t; t = t->next) {
-        scene_texture *c = sdl_alloc(p, sizeof *c);
+        scene_texture *c = sdl_dup(p, t, sizeof *c);
         if (!c) return head;
-        *c = *t;
         c->next = NULL;
         *tail = c;
         tail = &c->next;
@@ -129,9 +128,8 @@ void sdl_parse_pigment(sdl_parser *p, scene_pigment *pg)
 
 scene_pigment *sdl_parse_pigment_new(sdl_parser *p)
 {
-    scene_pigment *pg = sdl_alloc(p, sizeof *pg);
+    scene_pigment *pg = sdl_dup(p, &p->s->default_texture.pigment, sizeof *pg);
     if (!pg) return NULL;
-    *pg = p->s->default_texture.pigment;
     sdl_parse_pigment(p, pg);
     return pg;
 }
@@ -288,9 +286,8 @@ void sdl_parse_finish(sdl_parser *p, scene_finish *f)
 
 scene_finish *sdl_parse_finish_new(sdl_parser *p)
 {
-    scene_finish *f = sdl_alloc(p, sizeof *f);
+    scene_finish *f = sdl_dup(p, &p->s->default_texture.finish, sizeof *f);
     if (!f) return NULL;
-    *f = p->s->default_texture.finish;
     sdl_parse_finish(p, f);
     return f;
 }
@@ -373,9 +370,8 @@ scene_interior *sdl_parse_interior_new(sdl_parser *p)
 
 static scene_texture *new_texture(sdl_parser *p)
 {
-    scene_texture *t = sdl_alloc(p, sizeof *t);
+    scene_texture *t = sdl_dup(p, &p->s->default_texture, sizeof *t);
     if (!t) return NULL;
-    *t = p->s->default_texture;
     t->next = NULL;
     t->transform = xform_identity();
     return t;

@@ -194,9 +194,8 @@ void sdl_media_attach(sdl_parser *p, scene_interior *in, const scene_interior *b
     for (int i = 0; i < in->nmedia; i++) {
         a[i] = in->media[i];
         if (in_list(before, in->media[i])) continue;
-        scene_media *c = sdl_alloc(p, sizeof *c);
+        scene_media *c = sdl_dup(p, in->media[i], sizeof *c);
         if (!c) return;
-        *c = *in->media[i];
         c->transform = xform_then(c->transform, back);
         a[i] = c;
     }

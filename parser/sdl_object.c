@@ -125,9 +125,8 @@ static void own_mesh_textures(sdl_parser *p, scene_object *o, const scene_textur
 
 static scene_object *copy_node(sdl_parser *p, const scene_object *o)
 {
-    scene_object *c = sdl_alloc(p, sizeof *c);
+    scene_object *c = sdl_dup(p, o, sizeof *c);
     if (!c) return NULL;
-    *c = *o;
     c->texture = sdl_copy_texture(p, o->texture);
     c->interior_texture = sdl_copy_texture(p, o->interior_texture);
     if (o->kind == SHAPE_MESH && o->u.mesh.mesh)
@@ -185,9 +184,8 @@ enum { INHERITED_FLAGS = OBJ_NO_REFLECTION | OBJ_NO_RADIOSITY | OBJ_NO_IMAGE | O
 static void own_interior(sdl_parser *p, scene_object *o)
 {
     if (!o->interior) return;
-    scene_interior *in = sdl_alloc(p, sizeof *in);
+    scene_interior *in = sdl_dup(p, o->interior, sizeof *in);
     if (!in) return;
-    *in = *o->interior;
     o->interior = in;
 }
 
@@ -213,9 +211,8 @@ static void post_process(sdl_parser *p, scene_object *o, const scene_object *par
                     in->media = NULL;
                     xform rebase = xform_then(parent->transform, xform_inverse(o->transform));
                     for (int i = 0; i < parent->interior->nmedia; i++) {
-                        scene_media *c = sdl_alloc(p, sizeof *c);
+                        scene_media *c = sdl_dup(p, parent->interior->media[i], sizeof *c);
                         if (!c) break;
-                        *c = *parent->interior->media[i];
                         c->transform = xform_then(c->transform, rebase);
                         sdl_media_append(p, &in->media, &in->nmedia, c);
                     }
@@ -268,9 +265,8 @@ static void link_texture(scene_object *o, scene_texture *t)
 static scene_texture *top_texture(sdl_parser *p, scene_object *o)
 {
     if (!o->texture) {
-        scene_texture *t = sdl_alloc(p, sizeof *t);
+        scene_texture *t = sdl_dup(p, &p->s->default_texture, sizeof *t);
         if (!t) return NULL;
-        *t = p->s->default_texture;
         t->next = NULL;
         t->transform = xform_identity();
         t->loc = o->loc;
@@ -358,9 +354,8 @@ static int material_mod(sdl_parser *p, scene_object *o, sdl_kw k)
         o->texture = m.texture;
         o->interior_texture = m.interior_texture;
         if (m.interior && m.interior != before && m.interior->nmedia) {
-            scene_interior *in = sdl_alloc(p, sizeof *in);
+            scene_interior *in = sdl_dup(p, m.interior, sizeof *in);
             if (!in) return 1;
-            *in = *m.interior;
             sdl_media_attach(p, in, before, &o->transform);
             m.interior = in;
         }

@@ -280,6 +280,13 @@ void *sdl_alloc(sdl_parser *p, size_t n)
     return m;
 }
 
+void *sdl_dup(sdl_parser *p, const void *src, size_t n)
+{
+    void *m = sdl_alloc(p, n);
+    if (m) memcpy(m, src, n);
+    return m;
+}
+
 char *sdl_strndup(sdl_parser *p, const char *s, size_t n)
 {
     char *r = sdl_alloc(p, n + 1);

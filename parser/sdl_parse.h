@@ -206,6 +206,8 @@ void sdl_skip_item(sdl_parser *p);
 
 /* --- memory --- */
 void *sdl_alloc(sdl_parser *p, size_t n);
+/* sdl_alloc of n bytes holding a copy of src (a record copied into the scene's arena). */
+void *sdl_dup(sdl_parser *p, const void *src, size_t n);
 /* Room for `extra` more bytes of work memory within opt.max_memory? If not,
  * a located limit error naming `what` is recorded and 0 returned. */
 int sdl_memory_ok(sdl_parser *p, size_t extra, src_loc loc, const char *what);

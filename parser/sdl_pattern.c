@@ -375,9 +375,8 @@ static void blend_list(sdl_parser *p, target *tg, int count)
             const sdl_tok *t = sdl_peek(p);
             if (mk == MAP_PIGMENT) {
                 if (!sdl_accept_kw(p, KW_PIGMENT)) break;
-                scene_pigment *pg = sdl_alloc(p, sizeof *pg);
+                scene_pigment *pg = sdl_dup(p, &p->s->default_texture.pigment, sizeof *pg);
                 if (!pg) return;
-                *pg = p->s->default_texture.pigment;
                 if (sdl_begin_block(p, "pigment")) {
                     sdl_pattern_pigment_body(p, pg);
                     sdl_end_block(p);

@@ -504,9 +504,8 @@ static void component_mods(sdl_parser *p, scene_blob_component *c)
         if (pk->tk.kind == TOK_KEYWORD && (pk->tk.kw == KW_PIGMENT || pk->tk.kw == KW_FINISH || pk->tk.kw == KW_NORMAL)) {
             sdl_kw k = sdl_next(p).tk.kw;
             if (!tex) {
-                tex = sdl_alloc(p, sizeof *tex);
+                tex = sdl_dup(p, &p->s->default_texture, sizeof *tex);
                 if (!tex) return;
-                *tex = p->s->default_texture;
                 tex->next = NULL;
                 tex->transform = xform_identity();
                 tex->loc = p->last_loc;
