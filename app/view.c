@@ -279,6 +279,13 @@ static int light_index(viewer *v, int number)
     return number - 1;
 }
 
+/* A script's input event, queued as if the user had made it. */
+static void push_input(viewer *v, SDL_Event *e)
+{
+    SDL_PushEvent(e);
+    v->raw_input = 1;
+}
+
 static void apply(viewer *v, const view_action *a)
 {
     int li;
@@ -341,43 +348,27 @@ static void apply(viewer *v, const view_action *a)
             fprintf(stderr, "partray view: unknown key '%s'\n", a->text);
             break;
         }
-        SDL_Event e;
-        memset(&e, 0, sizeof e);
-        e.type = SDL_KEYDOWN;
-        e.key.state = SDL_PRESSED;
-        e.key.keysym.sym = k;
-        e.key.keysym.scancode = SDL_GetScancodeFromKey(k);
-        SDL_PushEvent(&e);
+        SDL_Event e = {.key = {.type = SDL_KEYDOWN, .state = SDL_PRESSED,
+                               .keysym = {.sym = k, .scancode = SDL_GetScancodeFromKey(k)}}};
+        push_input(v, &e);
         if (v->nrelease < (int)(sizeof v->release / sizeof v->release[0])) {
             v->release[v->nrelease].at = timer_now() + a->v[0];
             v->release[v->nrelease].key = k;
             v->release[v->nrelease].code = e.key.keysym.scancode;
             v->nrelease++;
         }
-        v->raw_input = 1;
         break;
     }
     case VIEW_ACT_DRAG: {
-        SDL_Event e;
-        memset(&e, 0, sizeof e);
-        e.type = SDL_MOUSEMOTION;
-        e.motion.state = a->mode == 1 ? SDL_BUTTON_LMASK : SDL_BUTTON_RMASK;
-        e.motion.xrel = (Sint32)lround(a->v[0]);
-        e.motion.yrel = (Sint32)lround(a->v[1]);
-        e.motion.x = v->width / 2;
-        e.motion.y = v->height / 2;
-        SDL_PushEvent(&e);
-        v->raw_input = 1;
+        SDL_Event e = {.motion = {.type = SDL_MOUSEMOTION, .state = a->mode == 1 ? SDL_BUTTON_LMASK : SDL_BUTTON_RMASK,
+                                  .x = v->width / 2, .y = v->height / 2, .xrel = (Sint32)lround(a->v[0]),
+                                  .yrel = (Sint32)lround(a->v[1])}};
+        push_input(v, &e);
         break;
     }
     case VIEW_ACT_WHEEL: {
-        SDL_Event e;
-        memset(&e, 0, sizeof e);
-        e.type = SDL_MOUSEWHEEL;
-        e.wheel.y = (Sint32)lround(a->v[0]);
-        e.wheel.direction = SDL_MOUSEWHEEL_NORMAL;
-        SDL_PushEvent(&e);
-        v->raw_input = 1;
+        SDL_Event e = {.wheel = {.type = SDL_MOUSEWHEEL, .y = (Sint32)lround(a->v[0]), .direction = SDL_MOUSEWHEEL_NORMAL}};
+        push_input(v, &e);
         break;
     }
     case VIEW_ACT_CLOCK:
