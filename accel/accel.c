@@ -929,14 +929,8 @@ static void fill_triangle(const accel *a, const accel_leaf *l, unsigned local, d
  * callbacks read through accel_tls_query), with no user-geometry hit yet. */
 static void query_init(accel_query *q, vec3 org, vec3 dir, double t0)
 {
+    *q = (accel_query){.org = org, .dir = dir, .tmin = t0};
     rtcInitIntersectContext(&q->rtc);
-    q->org = org;
-    q->dir = dir;
-    q->tmin = t0;
-    q->uhit = 0;
-    q->ut = 0.0;
-    q->upart = 0;
-    q->uprim = 0;
 }
 
 /* accel_intersect with the effective tmin t0 as given. */
