@@ -1233,8 +1233,14 @@ const scene_object *accel_rtc_leaf(const accel *a, unsigned geom, unsigned prim,
         return NULL;
     }
     if (li >= (unsigned)a->nleaves) return NULL;
+    const scene_object *o = a->leaves[li].obj;
     *tex = a->leaves[li].texture;
-    return a->leaves[li].obj;
+    if (o && o->kind == SHAPE_MESH) { /* the triangle's own texture_list entry */
+        unsigned local = inst != RTC_INVALID_GEOMETRY_ID ? prim : a->tri[a->ginfo[geom].idx].refs[prim].local;
+        const scene_texture *tt = scene_mesh_tri_texture(o, (int)local);
+        if (tt) *tex = tt;
+    }
+    return o;
 }
 
 unsigned accel_rtc_ngeoms(const accel *a) { return a ? a->nginfo : 0; }
