@@ -195,6 +195,47 @@ static int se_piece(const im_data *m, vec3 o, vec3 d, double a, double b, double
     return nr;
 }
 
+/* The stretch [*c0, *c1] of the unit ray p + tau e (tau in [0, L]) that
+ * can hold the surface of a non-convex superellipsoid; 0 when there is
+ * none. With exponent p <= 1 the inner norm (|x|^p + |y|^p)^(1/p) is at
+ * least |x| + |y| (and always at least max(|x|, |y|)); with q <= 1 the
+ * outer one is at least the sum of its two parts: where the bound exceeds
+ * 1 so does the norm, so the solid lies in the polytope
+ * {|x| + |y| + |z| <= 1} (p, q <= 1), {max(|x|, |y|) + |z| <= 1} (q <= 1)
+ * or {|x| + |y| <= 1} (p <= 1), each an intersection of half-spaces
+ * s . v <= 1. The planes are padded by 1e-9 so that rounding in the norm
+ * cannot put a crossing outside. */
+static int se_polytope(const im_data *m, vec3 p, vec3 e, double L, double *c0, double *c1)
+{
+    int pl = m->p <= 1.0, ql = m->q <= 1.0;
+    double a = 0.0, b = L;
+    for (int k = 0; k < 8; k++) {
+        double sx = k & 1 ? -1.0 : 1.0, sy = k & 2 ? -1.0 : 1.0, sz = k & 4 ? -1.0 : 1.0;
+        /* the normals of this case; the last one is tried in both halves */
+        vec3 ns[2];
+        int nn = 0;
+        if (pl && ql) ns[nn++] = v3(sx, sy, sz);
+        else if (ql) {
+            ns[nn++] = v3(sx, 0.0, sz);
+            ns[nn++] = v3(0.0, sy, sz);
+        } else if (k < 4) ns[nn++] = v3(sx, sy, 0.0);
+        for (int i = 0; i < nn; i++) {
+            double np = v3_dot(ns[i], p), ne = v3_dot(ns[i], e), lim = 1.0 + 1e-9;
+            if (ne == 0.0) {
+                if (np > lim) return 0;
+                continue;
+            }
+            double t = (lim - np) / ne;
+            if (ne > 0.0) b = t < b ? t : b;
+            else a = t > a ? t : a;
+        }
+    }
+    if (!(a <= b)) return 0;
+    *c0 = a;
+    *c1 = b;
+    return 1;
+}
+
 static int se_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     double t0, t1;
@@ -235,13 +276,31 @@ static int se_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, g
          * enough across the kinks for the bracket search on the whole range */
         nr = se_piece(m, p, e, 0.0, L, roots, nr, &rg);
     } else {
+        /* Sample steps wholly outside the polytope's stretch have the
+         * function positive at both ends: they are passed over without
+         * evaluating it (the samples are where they would be, so the
+         * crossings found are the same). */
+        double c0, c1;
+        if (!se_polytope(m, p, e, L, &c0, &c1)) return 0;
         int kept = 0;
         for (int c = 0; c + 1 < nc && nr < 56 && kept < max; c++) {
             const int N = 24;
             double a = cuts[c], b = cuts[c + 1];
-            double prev = a, gprev = se_g(m, p, e, a);
+            if (a > c1) break;
+            double prev = a, gprev = 0.0;
+            int have_prev = 0;
             for (int k = 1; k <= N && nr < 56 && kept < max; k++) {
-                double x = a + (b - a) * k / N, gx = se_g(m, p, e, x);
+                double x = a + (b - a) * k / N;
+                if (x < c0) {
+                    prev = x;
+                    continue;
+                }
+                if (prev > c1) break;
+                if (!have_prev) {
+                    gprev = se_g(m, p, e, prev);
+                    have_prev = 1;
+                }
+                double gx = se_g(m, p, e, x);
                 if ((gprev < 0.0) != (gx < 0.0)) {
                     roots[nr++] = se_root(m, p, e, prev, x, gprev, gx);
                     kept += se_kept(&rg, roots[nr - 1]);
