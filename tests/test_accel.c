@@ -427,6 +427,29 @@ static void test_mesh_textures_normals(void **st)
     expect_hit(a, v3(10.25, 0.75, 0), v3(0, 0, 1), 5.0, v3(0, 0, 1), 1e-6, 1e-6, &h);
     assert_ptr_equal(h.texture, to);
     assert_int_equal(accel_get_stats(a).instances, 2);
+    /* the bare Embree hits the GI's link rays make: accel_rtc_leaf gives the
+     * same per-triangle textures (instanced and single-use meshes) */
+    const struct { double x, y; const scene_texture *tex; } probe[] = {
+        {0.75, 0.25, t0}, {0.25, 0.75, t1}, {5.25, 0.75, t1}, {10.75, 0.25, t0}, {10.25, 0.75, to}};
+    for (int i = 0; i < 5; i++) {
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        struct RTCRayHit rh;
+        memset(&rh, 0, sizeof rh);
+        rh.ray.org_x = (float)probe[i].x;
+        rh.ray.org_y = (float)probe[i].y;
+        rh.ray.dir_z = 1.0f;
+        rh.ray.tfar = INFINITY;
+        rh.ray.mask = 0xFFFFFFFFu;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1((RTCScene)accel_rtc_scene(a), &ctx, &rh);
+        const scene_texture *lt = NULL;
+        const scene_object *lo = accel_rtc_leaf(a, rh.hit.geomID, rh.hit.primID, rh.hit.instID[0], v3(probe[i].x, probe[i].y, 0),
+                                                v3(0, 0, 1), rh.ray.tfar, &lt);
+        assert_non_null(lo);
+        assert_ptr_equal(lt, probe[i].tex);
+    }
     accel_free(a);
     diag_free(d);
     scene_free(s);
