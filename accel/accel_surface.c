@@ -618,7 +618,7 @@ void accel_surf_free(accel_surf *as)
     if (!as) return;
     free(as->pieces);
     free(as->tris);
-    for (int i = 0; i < as->nshapes; i++) geom_shape_release(&as->shapes[i].sh); /* issue-4 shapes' data */
+    for (int i = 0; i < as->nshapes; i++) geom_shape_release(&as->shapes[i].sh); /* the geom/ shapes' data */
     free(as->shapes);
     free(as->cdf);
     free(as->tab);

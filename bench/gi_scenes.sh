@@ -11,9 +11,8 @@
 #          (/tmp/gi_scenes_refs; an existing file is reused), timed.
 # scenes   bench_gi on each scene at SIZE (512), THREADS (2) threads, n_b
 #          NB (8), REPS (3) repetitions (median), with 50,000 particles on
-#          cbox and cornell and 200,000 on maze and conference (the issue's
-#          "200,000-particle scenes"): geometry stage time and breakdown
-#          (wall; CPU of all threads), memory, lighting stage time, frame
+#          cbox and cornell and 200,000 on maze and conference: geometry
+#          stage time and breakdown (wall; CPU of all threads), memory, lighting stage time, frame
 #          --gi particle against --gi none (wall and CPU); then, with the
 #          same particles, a QSIZE frame with FRAME_SPP (16) stratified eye
 #          samples per pixel (the reference is antialiased too) against the

@@ -1,7 +1,7 @@
 #!/bin/sh
 # Shapes benchmark: ray throughput of partray on (a) 10,000 spheres and
 # (b) a CSG-heavy scene (differences and intersections of analytic shapes and
-# issue-4 shapes: lathes, prisms, superellipsoids, blobs), beside POV-Ray
+# swept and implicit ones: lathes, prisms, superellipsoids, blobs), beside POV-Ray
 # 3.7's wall time for the same scene and size. Prints figures; not a test.
 # usage: bench/shapes_vs_povray.sh [SIZE] [THREADS]
 set -eu

@@ -98,8 +98,8 @@ const scene_texture *geom_shape_texture(const geom_shape *sh, vec3 p);
 int geom_shape_intersect(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
                           geom_shape_hit *h);
 /* All crossings with t in (tmin, tmax), ascending, at most `max` of them
- * (the `max` nearest; a torus has up to 4, the quadrics up to 2, the issue-4
- * shapes any number). */
+ * (the `max` nearest; a torus has up to 4, the quadrics up to 2, swept,
+ * implicit and mesh shapes any number). */
 int geom_shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
                      int max);
 /* The crossings a traced ray gets (CSG members, geom_shape_intersect):
@@ -128,8 +128,8 @@ vec3 geom_shape_pov_normal(const geom_shape *sh, vec3 p, int part);
  * world x and y (ObjectBase::UVCoord). Always finite. */
 void geom_shape_uv(const geom_shape *sh, vec3 p, int part, double uv[2]);
 
-/* Parametric grid for radiance particles (DESIGN.md) on the issue-4
- * shapes: object-space triangles whose vertices lie on the exact surface,
+/* Parametric grid for radiance particles (DESIGN.md) on the shapes that
+ * are not triangles or Embree's: object-space triangles whose vertices lie on the exact surface,
  * with the exact outward normals there, about n x n per part (polygon and
  * height_field: their own triangles; quadric, poly, blob, isosurface and
  * julia_fractal: marching tetrahedra on n cells along the longest side of

@@ -47,7 +47,7 @@ rm -f /tmp/test_docs.$$
 # history: dates, clock times, hashes, issue numbers, sessions, periods
 pat_date='(19|20)[0-9]{2}-[01][0-9]-[0-3][0-9]|(^|[^0-9.])[0-9]{1,2} (Jan|Feb|Mar|Apr|Jun|Jul|Aug|Sep|Oct|Nov|Dec)([^a-z]|$)|[0-9]{1,2} (Jan|Feb|Mar|Apr|May|Jun|Jul|Aug|Sep|Oct|Nov|Dec)[a-z]* (19|20)[0-9]{2}|(Jan|Feb|Mar|Apr|May|Jun|Jul|Aug|Sep|Oct|Nov|Dec)[a-z]* [0-9]{1,2},? (19|20)[0-9]{2}'
 pat_time='[0-2][0-9]:[0-5][0-9](-[0-2][0-9]:[0-5][0-9])? UTC'
-pat_issue='[Ii]ssues? #?[0-9]+|[Ss]ession [0-9]+|[Ww]ork period|\(branch [a-z0-9_-]+'
+pat_issue='[Ii]ssues?[ -]#?[0-9]+|[Ss]ession [0-9]+|[Ww]ork period|\(branch [a-z0-9_-]+'
 for f in $files; do
     grep -n -E "$pat_date" "$f" | sed "s|^|$f:|; s|$| <- a date|"
     grep -n -E "$pat_time" "$f" | sed "s|^|$f:|; s|$| <- a clock time|"
