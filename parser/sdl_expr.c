@@ -29,6 +29,20 @@ static long utf8_len(const char *s);
 
 int sdl_true(double x) { return fabs(x) > SDL_EPSILON; }
 
+/* A built-in function's next argument after its ',' (the comma optional,
+ * as everywhere in POV-Ray's argument lists): an integer / a string. */
+static int next_int_arg(sdl_parser *p)
+{
+    sdl_accept(p, TOK_COMMA);
+    return sdl_to_int(sdl_float(p));
+}
+
+static const char *next_string_arg(sdl_parser *p)
+{
+    sdl_accept(p, TOK_COMMA);
+    return string_expr(p);
+}
+
 static void ex_float(ex_val *e, double x)
 {
     memset(e, 0, sizeof *e);
@@ -246,8 +260,7 @@ static double dimension_fn(sdl_parser *p, sdl_kw k)
     const sdl_array *a = array_param(p);
     double v = 0;
     if (k == KW_DIMENSION_SIZE) {
-        sdl_accept(p, TOK_COMMA);
-        int d = sdl_to_int(sdl_float(p)) - 1;
+        int d = next_int_arg(p) - 1;
         if (a && d >= 0 && d < a->ndims) v = a->sizes[d];
     } else if (a) {
         v = a->ndims;
@@ -313,8 +326,7 @@ static double string_float_fn(sdl_parser *p, sdl_kw k)
     const char *a = string_expr(p);
     double v = 0;
     if (k == KW_STRCMP) {
-        sdl_accept(p, TOK_COMMA);
-        const char *b = string_expr(p);
+        const char *b = next_string_arg(p);
         /* POV-Ray's UCS2_strcmp: the difference of the first differing codes */
         unsigned ca, cb;
         do {
@@ -477,8 +489,7 @@ static vec3 vturbulence_fn(sdl_parser *p, src_loc loc)
     double lambda = sdl_float(p);
     sdl_accept(p, TOK_COMMA);
     double omega = sdl_float(p);
-    sdl_accept(p, TOK_COMMA);
-    int octaves = sdl_to_int(sdl_float(p));
+    int octaves = next_int_arg(p);
     sdl_accept(p, TOK_COMMA);
     vec3 v = sdl_vector(p);
     sdl_accept(p, TOK_COMMA);
@@ -977,10 +988,8 @@ static const char *str_fn(sdl_parser *p)
 {
     sdl_expect(p, TOK_LPAREN, "'('");
     double v = sdl_float(p);
-    sdl_accept(p, TOK_COMMA);
-    int w = sdl_to_int(sdl_float(p));
-    sdl_accept(p, TOK_COMMA);
-    int prec = sdl_to_int(sdl_float(p));
+    int w = next_int_arg(p);
+    int prec = next_int_arg(p);
     sdl_expect(p, TOK_RPAREN, "')'");
     char buf[256];
     pov_number(buf, sizeof buf, v, w, prec);
@@ -999,12 +1008,9 @@ static const char *vstr_fn(sdl_parser *p)
     if (n > 5) n = 5;
     ex_val e;
     sum(p, &e);
-    sdl_accept(p, TOK_COMMA);
-    const char *sep = string_expr(p);
-    sdl_accept(p, TOK_COMMA);
-    int w = sdl_to_int(sdl_float(p));
-    sdl_accept(p, TOK_COMMA);
-    int prec = sdl_to_int(sdl_float(p));
+    const char *sep = next_string_arg(p);
+    int w = next_int_arg(p);
+    int prec = next_int_arg(p);
     sdl_expect(p, TOK_RPAREN, "')'");
     if (!sdl_ok(p)) return "";
     const char *out = "";
@@ -1052,10 +1058,8 @@ static const char *substr_fn(sdl_parser *p, src_loc loc)
 {
     sdl_expect(p, TOK_LPAREN, "'('");
     const char *s = string_expr(p);
-    sdl_accept(p, TOK_COMMA);
-    int start = sdl_to_int(sdl_float(p));
-    sdl_accept(p, TOK_COMMA);
-    int len = sdl_to_int(sdl_float(p));
+    int start = next_int_arg(p);
+    int len = next_int_arg(p);
     sdl_expect(p, TOK_RPAREN, "')'");
     if (!sdl_ok(p)) return "";
     long n = utf8_len(s);
