@@ -105,26 +105,53 @@ int geom_bvh_build(geom_bvh *b, int n, const vec3 *lo, const vec3 *hi, int leaf)
     return 0;
 }
 
-/* Whether the node's box meets the query: the ray stretch (pad: 1e-9 of
- * the box's size) when `ray`, else the point o. */
-static int node_meets(const geom_bvh_node *nd, int ray, vec3 o, vec3 d, double tmin, double tmax)
+/* A query: the ray o + t d over [tmin, tmax] with 1/d per axis (flat
+ * axes, d = 0, flagged), or the point o when !ray. */
+typedef struct {
+    int ray;
+    vec3 o;
+    double inv[3];
+    int flat[3];
+    double tmin, tmax;
+} bvh_query;
+
+/* Whether the node's box meets the query: the ray stretch (the box padded
+ * by 1e-9 of its size, so that a crossing on a face is not lost to
+ * rounding) or the point. */
+static int node_meets(const geom_bvh_node *nd, const bvh_query *q)
 {
-    if (!ray)
-        return !(o.x < nd->lo.x || o.x > nd->hi.x || o.y < nd->lo.y || o.y > nd->hi.y || o.z < nd->lo.z ||
-                 o.z > nd->hi.z);
-    vec3 pad = v3s(1e-9 * v3_maxc(v3_sub(nd->hi, nd->lo)) + 1e-300);
-    double t0, t1;
-    return v3_slab(o, d, v3_sub(nd->lo, pad), v3_add(nd->hi, pad), &t0, &t1) && t1 >= tmin && t0 <= tmax;
+    if (!q->ray)
+        return !(q->o.x < nd->lo.x || q->o.x > nd->hi.x || q->o.y < nd->lo.y || q->o.y > nd->hi.y ||
+                 q->o.z < nd->lo.z || q->o.z > nd->hi.z);
+    double pad = 1e-9 * v3_maxc(v3_sub(nd->hi, nd->lo)) + 1e-300;
+    double a = q->tmin, b = q->tmax;
+    for (int k = 0; k < 3; k++) {
+        double o = v3_idx(q->o, k), lo = v3_idx(nd->lo, k) - pad, hi = v3_idx(nd->hi, k) + pad;
+        if (q->flat[k]) {
+            if (o < lo || o > hi) return 0;
+            continue;
+        }
+        double t0 = (lo - o) * q->inv[k], t1 = (hi - o) * q->inv[k];
+        if (t0 > t1) {
+            double t = t0;
+            t0 = t1;
+            t1 = t;
+        }
+        if (t0 > a) a = t0;
+        if (t1 < b) b = t1;
+        if (!(a <= b)) return 0;
+    }
+    return 1;
 }
 
-static void walk(const geom_bvh *b, int ray, vec3 o, vec3 d, double tmin, double tmax, geom_bvh_visit fn, void *ctx)
+static void walk(const geom_bvh *b, const bvh_query *q, geom_bvh_visit fn, void *ctx)
 {
     if (b->nnodes == 0) return;
     int stack[BVH_STACK], sp = 0;
     stack[sp++] = 0;
     while (sp > 0) {
         const geom_bvh_node *nd = &b->nodes[stack[--sp]];
-        if (!node_meets(nd, ray, o, d, tmin, tmax)) continue;
+        if (!node_meets(nd, q)) continue;
         if (nd->left < 0) {
             for (int i = nd->first; i < nd->first + nd->count; i++) fn(ctx, b->order[i]);
             continue;
@@ -137,10 +164,17 @@ static void walk(const geom_bvh *b, int ray, vec3 o, vec3 d, double tmin, double
 
 void geom_bvh_ray(const geom_bvh *b, vec3 o, vec3 d, double tmin, double tmax, geom_bvh_visit fn, void *ctx)
 {
-    walk(b, 1, o, d, tmin, tmax, fn, ctx);
+    bvh_query q = {1, o, {0, 0, 0}, {0, 0, 0}, tmin, tmax};
+    for (int k = 0; k < 3; k++) {
+        double dk = v3_idx(d, k);
+        q.flat[k] = dk == 0.0;
+        q.inv[k] = q.flat[k] ? 0.0 : 1.0 / dk;
+    }
+    walk(b, &q, fn, ctx);
 }
 
 void geom_bvh_point(const geom_bvh *b, vec3 q, geom_bvh_visit fn, void *ctx)
 {
-    walk(b, 0, q, v3s(0.0), 0.0, 0.0, fn, ctx);
+    bvh_query pq = {0, q, {0, 0, 0}, {0, 0, 0}, 0.0, 0.0};
+    walk(b, &pq, fn, ctx);
 }
