@@ -90,9 +90,9 @@ static const scene_object *hit_leaf(const link_job *J, const struct RTCRayHit *h
 }
 
 /* The light at the hit of link ray h that does not come from particles,
- * added to out (nothing without esky): the surface's emission; for the
- * final gather's links (J->lights) the direct light it reflects; and with
- * sky_bounce, the far field's sky term below.
+ * added to out (nothing without esky): the surface's emission; with
+ * direct, for the final gather's links (J->lights), the direct light it
+ * reflects; and with far, the far field's sky term below.
  *
  * The far field (beyond the paper, which leaves open scenes out): a link
  * ray that hits a surface where no particle answers (an infinite plane
@@ -101,19 +101,24 @@ static const scene_object *hit_leaf(const link_job *J, const struct RTCRayHit *h
  * (far_bounce > 0), the sky it reflects, taken as unoccluded: rho * b *
  * E_sky(n)/pi about the hit's normal turned to the ray, at the texture's
  * base colour. In a closed room under a black sky this is the emission
- * alone. Where a particle answers (sky_bounce 0) the particle's reflected
- * indirect light is added by the caller (gi_particle_view_regather). */
-static void hit_light(const link_job *J, const struct RTCRayHit *h, int sky_bounce, float out[3])
+ * alone. Where a particle answers (far 0, direct 0) the particle's
+ * reflected light is added by the caller (gi_particle_view_regather). */
+static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int direct, float out[3])
 {
     if (!J->esky) return;
     const scene_texture *tex;
     const scene_object *o = hit_leaf(J, h, &tex);
     if (!o) return;
     float rho[3], le[3];
+    if (!far && !direct) { /* the emission alone: none where the finish emits nothing */
+        const colour5 white = {1.0, 1.0, 1.0, 0.0, 0.0};
+        gi_particles_material(J->sc, tex, &white, rho, le);
+        if (!(le[0] > 0.0f || le[1] > 0.0f || le[2] > 0.0f)) return;
+    }
     vec3 p, n;
     hit_material(J, h, o, tex, rho, le, &p, &n);
     float irr[3] = {0.0f, 0.0f, 0.0f};
-    if (sky_bounce && J->far_bounce > 0.0f) gi_sky_irradiance(J->sky, n, irr);
+    if (far && J->far_bounce > 0.0f) gi_sky_irradiance(J->sky, n, irr);
     /* and, for the final gather's links (J->lights), the direct light it
      * reflects (the particles' edir at the hit, gi_k_emit's sum, a shadow
      * ray each; area lights from their centre): sunlit ground beyond the
@@ -121,7 +126,7 @@ static void hit_light(const link_job *J, const struct RTCRayHit *h, int sky_boun
      * radiosity rays see the direct light of what they hit at every
      * recursion_limit. */
     float dir[3] = {0.0f, 0.0f, 0.0f};
-    if (J->nlights > 0 && (rho[0] > 0.0f || rho[1] > 0.0f || rho[2] > 0.0f)) {
+    if (direct && J->nlights > 0 && (rho[0] > 0.0f || rho[1] > 0.0f || rho[2] > 0.0f)) {
         /* the shadow ray starts eps off the surface and ends short of the
          * light as the particles' do (gi_particle_light.c shadow_ray), its
          * length measured from where it starts: a light in a surface's
@@ -289,7 +294,7 @@ static void job(void *ctx, int index, int thread)
                  * centre, as POV-Ray's radiosity rays take area lights)
                  * rather than read from the nearest particle, whose value
                  * blurs shadow edges over a particle spacing */
-                if (hit) hit_light(J, &rh[m], 1, sky);
+                if (hit) hit_light(J, &rh[m], 1, 1, sky);
                 J->links[(size_t)(i - J->first) * J->k + J->order[j]] = -1;
                 continue;
             }
@@ -314,7 +319,7 @@ static void job(void *ctx, int index, int thread)
             int hid = hobj ? last_hid : -1;
             if (hobj && hid < 0) {
                 unres++;
-                hit_light(J, &rh[m], 1, sky);
+                hit_light(J, &rh[m], 1, 1, sky);
             } else if (hit && J->grid) {
                 const struct RTCRayHit *h = &rh[m];
                 vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
@@ -413,9 +418,11 @@ static void job(void *ctx, int index, int thread)
                 }
                 if (target < 0) {
                     unres++;
-                    if (hit) hit_light(J, &rh[m], 1, sky);
+                    if (hit) hit_light(J, &rh[m], 1, 1, sky);
                 } else if (J->first > 0 && J->esky) {
-                    hit_light(J, &rh[m], 0, sky);
+                    /* the emission where it hit; the particle's reflected
+                     * light, direct and indirect, follows in the regather */
+                    hit_light(J, &rh[m], 0, 0, sky);
                 }
             }
             J->links[(size_t)(i - J->first) * J->k + J->order[j]] = target;

@@ -45,11 +45,11 @@ typedef struct {
  * only particles [first, n) send rays (all n are targets); links, anyhit
  * and esky are then indexed i - first. first > 0 means those are points
  * to gather at, not particles: a link that ends on a particle adds the
- * emission where its ray hit, and the direct light of sc's lights it
- * reflects there (a shadow ray a light, from the light's centre), to esky,
- * so its gather must take the particle's reflected indirect radiance
- * (lout - le - rho edir), not lout. When no bounce follows (far_bounce 0)
- * no link ends on a particle: every hit takes that light alone. */
+ * emission where its ray hit to esky, so its gather must take the
+ * particle's reflected radiance (lout - le), not lout. When no bounce
+ * follows (far_bounce 0) no link ends on a particle: every hit takes its
+ * emission and the direct light of sc's lights it reflects (a shadow ray
+ * a light, from the light's centre), computed there. */
 /* sky, esky and sc (all or none; NULL: none): esky receives 4 floats a
  * particle (the fourth 0): the radiance its rays that leave the scene see
  * (sky), plus the far field of those that hit where no particle answers

@@ -468,8 +468,8 @@ void gi_particle_view_regather(gi_particle *gp)
         return;
     }
     for (int i = 0; i < gp->vg_n; i++) idx[i] = i;
-    /* the particles' reflected indirect radiance: the emission and the
-     * direct light were taken where each ray hit (gi_links.h, first > 0) */
+    /* the particles' reflected radiance: the emission was taken where each
+     * ray hit (gi_links.h, first > 0) */
     float *lrefl = malloc((size_t)gp->ps.n * 4 * sizeof *lrefl);
     if (!lrefl) {
         free(idx);
@@ -478,12 +478,9 @@ void gi_particle_view_regather(gi_particle *gp)
         gi_particle_view_gather_free(gp);
         return;
     }
-    const int took_direct = gp->sky && gp->sc->nlights > 0; /* gi_links_build gave the gathers the lights */
-    if (took_direct) gi_dev_fetch(gp->dev, NULL); /* edir, kept on the device until asked */
     for (int t = 0; t < gp->ps.n; t++) {
         for (int c = 0; c < 3; c++) {
             float v = gp->lout[4 * (size_t)t + c] - gp->ps.p[t].le[c];
-            if (took_direct) v -= gp->ps.p[t].rho[c] * gp->edir[4 * (size_t)t + c];
             lrefl[4 * (size_t)t + c] = v > 0.0f ? v : 0.0f;
         }
         lrefl[4 * (size_t)t + 3] = 0.0f;
