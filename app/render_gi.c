@@ -53,6 +53,18 @@ static pt_status render_aovs(const scene *sc, const accel *a, const render_gi_op
     return st;
 }
 
+/* render_aovs for a mode that renders without shade_render (path, pmfg,
+ * vpl): direct, albedo, normal, depth and illuminance as for none, from the
+ * Whitted settings of the render's options; no indirect AOV (0). */
+static pt_status render_whitted_aovs(const scene *sc, const accel *a, const render_gi_opts *o, render_gi_result *r,
+                                     diag *d)
+{
+    if (!o->aov) return PT_OK;
+    shade_settings ss;
+    fill_shade(&ss, o);
+    return render_aovs(sc, a, o, &ss, r, d);
+}
+
 static pt_status render_none(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
                              render_gi_result *r, diag *d)
 {
@@ -320,13 +332,7 @@ static pt_status render_reference(const scene *sc, const accel *a, const render_
     r->secondary_rays = r->pm.bsdf_rays + r->pm.gather_rays;
     r->other_rays = r->pm.photon_rays;
     r->discarded = r->pm.discarded_samples;
-    if (st == PT_OK && o->aov) {
-        /* direct, albedo, normal, depth, illuminance as for none; the
-         * reference modes do not split off their indirect light (AOV 0) */
-        shade_settings ss;
-        fill_shade(&ss, o);
-        st = render_aovs(sc, a, o, &ss, r, d);
-    }
+    if (st == PT_OK) st = render_whitted_aovs(sc, a, o, r, d);
     return st;
 }
 
@@ -355,11 +361,7 @@ static pt_status render_vpl_mode(const scene *sc, const accel *a, const render_g
     r->primary_rays = r->vpl.camera_rays;
     r->shadow_rays = r->vpl.shadow_rays;
     r->secondary_rays = r->vpl.secondary_rays;
-    if (st == PT_OK && o->aov) {
-        shade_settings ss;
-        fill_shade(&ss, o);
-        st = render_aovs(sc, a, o, &ss, r, d);
-    }
+    if (st == PT_OK) st = render_whitted_aovs(sc, a, o, r, d);
     return st;
 }
 
