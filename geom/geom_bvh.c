@@ -131,12 +131,8 @@ static int node_meets(const geom_bvh_node *nd, const bvh_query *q)
             if (o < lo || o > hi) return 0;
             continue;
         }
-        double t0 = (lo - o) * q->inv[k], t1 = (hi - o) * q->inv[k];
-        if (t0 > t1) {
-            double t = t0;
-            t0 = t1;
-            t1 = t;
-        }
+        /* the face the ray enters by, then the one it leaves by */
+        double inv = q->inv[k], t0 = ((inv > 0.0 ? lo : hi) - o) * inv, t1 = ((inv > 0.0 ? hi : lo) - o) * inv;
         if (t0 > a) a = t0;
         if (t1 < b) b = t1;
         if (!(a <= b)) return 0;
