@@ -42,9 +42,13 @@ void gi_particle_settings_from_scene(gi_particle_settings *s, const scene *sc)
     }
     if (r->brightness > 0.0) s->brightness = r->brightness;
     /* the final gather's rays: about the scene's count, as POV-Ray's
-     * radiosity samples take count rays each */
-    int side = (int)lround(sqrt((double)(r->count > 0 ? r->count : 35)));
-    s->view_gather_side = side < 6 ? 6 : (side > 16 ? 16 : side);
+     * radiosity samples take count rays each; 1.7 times as many with
+     * further bounces, where a ray costs a particle lookup, not a shadow
+     * ray a light, and ends on a particle whose own estimate is noisy
+     * (docs/gi.md: cornell.pov's figures) */
+    double want = (double)(r->count > 0 ? r->count : 35) * (s->bounces >= 1 ? 1.7 : 1.0);
+    int side = (int)lround(sqrt(want));
+    s->view_gather_side = side < 6 ? 6 : (side > 20 ? 20 : side);
     s->view_gather_stride = 2;
     /* the area particles' own gathers then feed only further bounces and
      * the hits the final gather does not answer: a quarter of the rays,
