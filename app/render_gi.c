@@ -174,11 +174,14 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     return st;
 }
 
-/* The Whitted pass with a GI mode's indirect hook under radiosity's rule
- * for ambient (as particle), then the AOVs. */
+/* After a GI mode's frame ended with st (detp, links): the Whitted pass
+ * with the mode's indirect hook under radiosity's rule for ambient (as
+ * particle), then the AOVs; skipped when the frame failed or the render was
+ * cancelled. Cancelling is not an error: PT_CANCELLED comes back as PT_OK. */
 static pt_status render_with_hook(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
-                                  render_gi_result *r, diag *d, shade_indirect_fn fn, void *ctx)
+                                  render_gi_result *r, diag *d, pt_status st, shade_indirect_fn fn, void *ctx)
 {
+    if (st != PT_OK || (o->cancel && *o->cancel)) return st == PT_CANCELLED ? PT_OK : st;
     shade_settings ss;
     fill_shade(&ss, o);
     ss.use_ambient = radrules_of(sc, 1).ambient;
@@ -186,10 +189,10 @@ static pt_status render_with_hook(const scene *sc, const accel *a, const render_
     ss.indirect_ctx = ctx;
     double t0 = timer_now();
     r->image_begun = 1;
-    pt_status st = shade_render(sc, a, &ss, fb, &r->shade, d);
+    st = shade_render(sc, a, &ss, fb, &r->shade, d);
     r->t_render = timer_now() - t0;
     if (st == PT_OK) st = render_aovs(sc, a, o, &ss, r, d);
-    return st;
+    return st == PT_CANCELLED ? PT_OK : st;
 }
 
 pm_detp *render_gi_detp_new(const render_gi_opts *o)
@@ -215,11 +218,11 @@ static pt_status render_detp(const scene *sc, const accel *a, const render_gi_op
     pt_status st = pm_detp_frame(dp, sc, a, o->width, o->height, &o->detp_frame, &r->detp, d);
     r->t_gi_geometry = r->detp.t_trace;
     r->t_gi_lighting = r->detp.t_estimate;
-    if (st == PT_OK && !(o->cancel && *o->cancel)) st = render_with_hook(sc, a, o, fb, r, d, pm_detp_indirect, dp);
+    st = render_with_hook(sc, a, o, fb, r, d, st, pm_detp_indirect, dp);
     pm_detp_lookups(dp, &r->detp.lookups, &r->detp.lookups_none);
     pm_detp_set_progress(dp, NULL);
     if (!o->detp) pm_detp_free(dp);
-    return st == PT_CANCELLED ? PT_OK : st;
+    return st;
 }
 
 gi_vlinks *render_gi_links_new(const render_gi_opts *o)
@@ -247,11 +250,11 @@ static pt_status render_links(const scene *sc, const accel *a, const render_gi_o
                     r->links.other_objects);
     r->t_gi_geometry = r->links.t_links;
     r->t_gi_lighting = r->links.t_light + r->links.t_bounces + r->links.t_smooth;
-    if (st == PT_OK && !(o->cancel && *o->cancel)) st = render_with_hook(sc, a, o, fb, r, d, gi_vlinks_indirect, v);
+    st = render_with_hook(sc, a, o, fb, r, d, st, gi_vlinks_indirect, v);
     r->links.lookups_other = gi_vlinks_lookups_other(v);
     gi_vlinks_set_progress(v, NULL);
     if (!o->links) gi_vlinks_free(v);
-    return st == PT_CANCELLED ? PT_OK : st;
+    return st;
 }
 
 typedef struct {
