@@ -142,6 +142,102 @@ static double node_value(const scene_function *f, int i, double *slots, eval_ctx
     return 0;
 }
 
+/* Whether an op can run on the value stack (no control flow, no calls,
+ * cannot fail). */
+static int post_op(func_op op)
+{
+    switch (op) {
+    case FN_CONST: case FN_ARG: case FN_NEG: case FN_ADD: case FN_SUB: case FN_MUL: case FN_DIV:
+    case FN_LT: case FN_LE: case FN_EQ: case FN_NE: case FN_GE: case FN_GT: case FN_AND: case FN_OR:
+    case FN_MATH: case FN_ATAN2: case FN_POW: case FN_MOD: case FN_IDIV: case FN_MIN: case FN_MAX:
+        return 1;
+    default:
+        return 0;
+    }
+}
+
+/* Post order below node i into out[*n]; the stack depth it needs in *depth.
+ * 0 when a node does not qualify or out is full. */
+static int post_walk(const scene_function *f, int i, int *out, int max, int *n, int *depth, int level)
+{
+    if (level > FUNC_POST_STACK || i < 0 || i >= f->nnodes) return 0;
+    const func_node *nd = &f->nodes[i];
+    if (!post_op((func_op)nd->op)) return 0;
+    if ((nd->op == FN_MIN || nd->op == FN_MAX) && nd->nkids < 1) return 0;
+    int need = 1;
+    for (int j = 0; j < nd->nkids; j++) {
+        int d;
+        if (!post_walk(f, f->kids[nd->kid + j], out, max, n, &d, level + 1)) return 0;
+        /* kid j is computed with j values already on the stack */
+        if (j + d > need) need = j + d;
+    }
+    if (*n >= max) return 0;
+    out[(*n)++] = i;
+    *depth = need;
+    return 1;
+}
+
+int func_postorder(const scene_function *f, int *out, int max)
+{
+    if (!f || f->kind != FUNC_FLOAT || !f->nodes) return -1;
+    int n = 0, depth = 0;
+    if (!post_walk(f, f->root, out, max, &n, &depth, 0) || depth > FUNC_POST_STACK) return -1;
+    return n;
+}
+
+/* The body of f as its post-order list (scene_function.post): the same
+ * operations on the same values as node_value, so the same result. */
+static double post_value(const scene_function *f, const double *slots)
+{
+    double st[FUNC_POST_STACK];
+    int sp = 0;
+    /* a binary node: its two kids' values, the first below, give one */
+#define BIN(expr)                                                                                              \
+    do {                                                                                                       \
+        double y = st[--sp], x = st[sp - 1];                                                                   \
+        st[sp - 1] = (expr);                                                                                   \
+    } while (0)
+    for (int i = 0; i < f->npost; i++) {
+        const func_node *n = &f->nodes[f->post[i]];
+        switch ((func_op)n->op) {
+        case FN_CONST: st[sp++] = n->k; break;
+        case FN_ARG: st[sp++] = slots[n->slot]; break;
+        case FN_NEG: st[sp - 1] = -st[sp - 1]; break;
+        case FN_MATH: st[sp - 1] = math1((func_math)n->sub, st[sp - 1]); break;
+        case FN_ADD: BIN(x + y); break;
+        case FN_SUB: BIN(x - y); break;
+        case FN_MUL: BIN(x * y); break;
+        case FN_DIV: BIN(x / y); break;
+        case FN_LT: BIN(x < y); break;
+        case FN_LE: BIN(x <= y); break;
+        case FN_EQ: BIN(x == y); break;
+        case FN_NE: BIN(x != y); break;
+        case FN_GE: BIN(x >= y); break;
+        case FN_GT: BIN(x > y); break;
+        case FN_AND: BIN(truth(x) && truth(y)); break;
+        case FN_OR: BIN(truth(x) || truth(y)); break;
+        case FN_ATAN2: BIN(atan2(x, y)); break;
+        case FN_POW: BIN(pow(x, y)); break;
+        case FN_MOD: BIN(fmod(x, y)); break;
+        case FN_IDIV: BIN(trunc(x / y)); break;
+        case FN_MIN: case FN_MAX: {
+            int k = n->nkids;
+            double v = st[sp - k];
+            for (int j = 1; j < k; j++) {
+                double w = st[sp - k + j];
+                if (n->op == FN_MIN ? w < v : w > v) v = w;
+            }
+            sp -= k - 1;
+            st[sp - 1] = v;
+            break;
+        }
+        default: return 0.0; /* func_postorder admits none other */
+        }
+    }
+#undef BIN
+    return st[0];
+}
+
 static pt_status eval_function(const scene_function *f, const double *args, double *out, eval_ctx *c)
 {
     for (int i = 0; i < (f->nterms > 0 ? f->nterms : 1); i++) out[i] = 0;
@@ -162,7 +258,7 @@ static pt_status eval_function(const scene_function *f, const double *args, doub
         /* loops, not memcpy/memset: a handful of slots, per evaluation */
         for (int i = 0; i < np; i++) slots[i] = args[i];
         for (int i = np; i < ns; i++) slots[i] = 0.0;
-        out[0] = node_value(f, f->root, slots, c);
+        out[0] = f->post ? post_value(f, slots) : node_value(f, f->root, slots, c);
         break;
     }
     case FUNC_TRANSFORM: {

@@ -71,6 +71,12 @@ typedef struct scene_function {
     const func_node *nodes;
     const int *kids;
     int root;                  /* FUNC_FLOAT: the body's node */
+    /* FUNC_FLOAT whose body is arithmetic, comparisons, min/max and the
+     * math built-ins only (no select, sum/prod, calls or internals): its
+     * nodes in post order (func_postorder), evaluated on a value stack
+     * instead of by walking the tree; NULL: walked. */
+    const int *post;
+    int npost;
     xform transform;           /* FUNC_TRANSFORM */
     const struct user_spline *spline; /* FUNC_SPLINE */
     const void *pigment;       /* FUNC_PIGMENT / FUNC_PATTERN: the pigment IR (opaque here) */
@@ -92,6 +98,13 @@ typedef struct func_env {
  * or PT_ERR_UNSUPPORTED when something needs an evaluator env lacks (then
  * *why, if not NULL, names it: "internal(76) (noise)", "pigment function"). */
 pt_status func_eval(const scene_function *f, const double *args, double *out, const func_env *env, const char **why);
+
+/* FUNC_POST_STACK bounds the value stack of a post-order body. */
+#define FUNC_POST_STACK 64
+/* The nodes of f's body in post order into out (at most max), when the body
+ * qualifies for scene_function.post and its stack stays within
+ * FUNC_POST_STACK: their number; else -1. */
+int func_postorder(const scene_function *f, int *out, int max);
 
 /* The float result (out[0]); NaN when unsupported. */
 double func_eval_float(const scene_function *f, const double *args, const func_env *env);

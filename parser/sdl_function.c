@@ -542,6 +542,16 @@ scene_function *sdl_parse_function(sdl_parser *p, src_loc loc, const char *name)
         f->nnodes = b.nnodes;
         f->nodes = arena_memdup(p->s->mem, b.nodes, sizeof *b.nodes * (size_t)b.nnodes);
         f->kids = b.nkids ? arena_memdup(p->s->mem, b.kids, sizeof *b.kids * (size_t)b.nkids) : NULL;
+        if (f->kind == FUNC_FLOAT) {
+            /* a plain arithmetic body runs as a post-order list (func.h) */
+            int *post = malloc(sizeof *post * (size_t)b.nnodes);
+            int np = post ? func_postorder(f, post, b.nnodes) : -1;
+            if (np > 0) {
+                f->post = arena_memdup(p->s->mem, post, sizeof *post * (size_t)np);
+                f->npost = f->post ? np : 0;
+            }
+            free(post);
+        }
     }
     free(b.nodes);
     free(b.kids);

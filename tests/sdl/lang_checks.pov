@@ -34,6 +34,9 @@ Fill(D)
 #declare G = function { f_sphere(x, y, z, 1) * 2 + f_r(x, y, z) }
 #declare H = function(x, u) { x * 10 + y + u }
 #debug concat("fn2 ", str(G(0.3, 0.4, 1.2),0,9), " ", str(H(2, 3),0,9), "\n")
+// arithmetic, comparisons, min/max and math only: evaluated in post order
+#declare Fpost = function(a, b) { min(a, b, 3) * 2 - max(a, 1) + atan2(a, b) + pow(b, 2) / (a + 1) + (a < b) + (a >= b) * 3 - (a != b) + abs(-a) * sqrt(abs(b)) - (a > 1 & b > 1) + (a < 0 | b < 0) * 5 }
+#debug concat("fnq ", str(Fpost(1.5, 2),0,9), " ", str(Fpost(3, -2),0,9), " ", str(Fpost(-0.5, 0.25),0,9), "\n")
 #declare T = function { transform { rotate <10, 20, 30> translate <1, 2, 3> scale 2 } }
 #declare TV = T(1, -1, 0.5);
 #debug concat("fnt ", vstr(3, TV, " ", 0, 9), " ", str(T(0, 1, 0).y,0,9), "\n")
