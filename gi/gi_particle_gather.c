@@ -400,14 +400,15 @@ static int raw_value(const gi_particle *gp, size_t i, float out[3])
 }
 
 /* The edge-aware filter over the pixels' raw values: a Gaussian of
- * FILTER_SIGMA pixels over the pixels that lie on the same object and
+ * view_gather_filter pixels (default FILTER_SIGMA), to 2 sigma, over the
+ * pixels that lie on the same object and
  * side, face the same way and lie in the same plane (compatible, and the
  * offset along the normal within DEPTH_TOL of the depth). It averages the
  * gathers' noise over about (2 sigma / stride)^2 gathers, as an irradiance
  * cache reuses a record over its radius, and stops at edges, creases and
  * depth steps, where the light may change. */
 #define FILTER_SIGMA 2.0
-#define FILTER_RADIUS 4
+#define FILTER_RADIUS_MAX 8
 
 typedef struct {
     gi_particle *gp;
@@ -421,8 +422,12 @@ static void filter_row(void *ctx, int y, int thread)
     filter_job *F = ctx;
     gi_particle *gp = F->gp;
     int w = gp->vw, h = gp->vh;
-    double g[FILTER_RADIUS + 1];
-    for (int d = 0; d <= FILTER_RADIUS; d++) g[d] = exp(-0.5 * d * d / (FILTER_SIGMA * FILTER_SIGMA));
+    /* sigma from the settings (default FILTER_SIGMA), the taps to 2 sigma */
+    const double sigma = gp->set.view_gather_filter > 0.0 ? gp->set.view_gather_filter : FILTER_SIGMA;
+    int R = (int)ceil(2.0 * sigma);
+    if (R > FILTER_RADIUS_MAX) R = FILTER_RADIUS_MAX;
+    double g[FILTER_RADIUS_MAX + 1];
+    for (int d = 0; d <= R; d++) g[d] = exp(-0.5 * d * d / (sigma * sigma));
     for (int x = 0; x < w; x++) {
         size_t i = (size_t)y * w + x;
         float *o = &gp->vg_pixval[4 * i];
@@ -431,10 +436,10 @@ static void filter_row(void *ctx, int y, int thread)
         const view_rec *r = &gp->vrec[i];
         vec3 nr = gp->vg_nrm[i];
         double s[3] = {0.0, 0.0, 0.0}, ws = 0.0;
-        for (int dy = -FILTER_RADIUS; dy <= FILTER_RADIUS; dy++) {
+        for (int dy = -R; dy <= R; dy++) {
             int yy = y + dy;
             if (yy < 0 || yy >= h) continue;
-            for (int dx = -FILTER_RADIUS; dx <= FILTER_RADIUS; dx++) {
+            for (int dx = -R; dx <= R; dx++) {
                 int xx = x + dx;
                 if (xx < 0 || xx >= w) continue;
                 size_t j = (size_t)yy * w + xx;
