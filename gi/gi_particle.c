@@ -51,12 +51,11 @@ void gi_particle_settings_from_scene(gi_particle_settings *s, const scene *sc)
     s->view_gather_side = side < 6 ? 6 : (side > 20 ? 20 : side);
     /* POV-Ray's error_bound sets how densely its cache samples where the
      * light changes; below 0.1 (stackernight.pov's 0.01: blocks lit by the
-     * glowing letters on their faces) every pixel gathers and the filter
-     * narrows to 1 pixel, interpolation across a face blurring contact
-     * light that such a scene asks for (docs/gi.md) */
-    const int fine = r->error_bound > 0.0 && r->error_bound < 0.1;
-    s->view_gather_stride = fine ? 1 : 2;
-    s->view_gather_filter = fine ? 1.0 : 2.0;
+     * glowing letters on their faces) every pixel gathers, interpolation
+     * across a face blurring contact light that such a scene asks for
+     * (docs/gi.md) */
+    s->view_gather_stride = r->error_bound > 0.0 && r->error_bound < 0.1 ? 1 : 2;
+    s->view_gather_filter = 1.0;
     /* the area particles' own gathers then feed only further bounces and
      * the hits the final gather does not answer: a quarter of the rays,
      * a sixteenth without further bounces */

@@ -122,7 +122,7 @@ typedef struct {
     int view_gather_stride; /* gathers at every Nth pixel in x and y, and where the pixels between
                               find no matching one (default 2) */
     double view_gather_filter; /* the edge-aware filter's Gaussian sigma over the gathers, in
-                                  pixels (0: the default, 2) */
+                                  pixels (0: the default, 1) */
     int keep_hits;       /* 1: the pre-pass keeps each traced pixel's first hit, and the radiance
                             particles it located there, for the render: gi_particle_primary_begin
                             and _hit as shade_settings.primary_begin and .primary give the render

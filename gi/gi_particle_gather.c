@@ -241,13 +241,116 @@ static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int
     return 1;
 }
 
+static int gather_values(gi_particle *gp);
+
+/* Gather point k (kept pixel i) as a link source at slot cp[t], its
+ * object and inside flag at cobj[t], cpin[t], and its record vg_pt[k]. */
+static void put_point(gi_particle *gp, gi_dev_particle *cp, const void **cobj, unsigned char *cpin, long t, int k,
+                      size_t i, int s)
+{
+    int w = gp->vw, h = gp->vh;
+    const view_rec *r = &gp->vrec[i];
+    vec3 nv = gp->vg_nrm[i];
+    gi_dev_particle *q = &cp[t];
+    v3_store_f(q->p, r->h.p);
+    v3_store_f(q->n, nv);
+    q->area = 0.0f;
+    const scene_object *o = r->h.obj;
+    /* its radius: stride pixels' footprint on the surface (the angle
+     * between neighbouring camera rays, at its depth, over the cosine) */
+    size_t x = i % (size_t)w, y = i / (size_t)w;
+    const view_rec *nb = &gp->vrec[x + 1 < (size_t)w ? i + 1 : (y + 1 < (size_t)h ? i + (size_t)w : i)];
+    double ang = nb != r && nb->kind ? v3_len(v3_sub(v3_norm(nb->dir), v3_norm(r->dir))) : 0.0;
+    double cs = fabs(v3_dot(v3_norm(r->dir), nv));
+    vg_point *vp = &gp->vg_pt[k];
+    vp->p = r->h.p;
+    vp->n = nv;
+    vp->obj = o;
+    vp->side = r->side;
+    vp->r = (float)(s * r->h.t * ang / (cs > 0.25 ? cs : 0.25));
+    cobj[t] = o;
+    /* on the inside of a closed sphere or box (as gi_particle_objects
+     * marks particles): its rays end inside it */
+    if ((o->kind == SHAPE_SPHERE || o->kind == SHAPE_BOX) && !(o->flags & OBJ_INVERSE)) {
+        vec3 p = r->h.p;
+        double lift = 1e-5 * (1.0 + fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
+        cpin[t] = (unsigned char)gi_surface_inside_solid(o, v3_madd(p, nv, lift));
+    }
+}
+
+/* Traces the links of gather points [k0, k1) (the pixels vg_pix names)
+ * into vg_link and vg_esky from point k0 on: gi_links_build with the area
+ * particles as targets and the points as its sources [n, n + k1 - k0). */
+static pt_status trace_points(gi_particle *gp, const void **pobj, const unsigned char *pin, const gi_lookup *grid,
+                              int k0, int k1, int side, int s, uint64_t seed, long *rays)
+{
+    int n = gp->ps.n;
+    long N = (long)n + (k1 - k0);
+    size_t npix = (size_t)gp->vw * (size_t)gp->vh;
+    gi_dev_particle *cp = calloc((size_t)N, sizeof *cp);
+    const void **cobj = calloc(2 * (size_t)N, sizeof *cobj);
+    unsigned char *cpin = calloc(2 * (size_t)N, 1);
+    pt_status st = PT_OK;
+    if (!cp || !cobj || !cpin) {
+        st = PT_ERR_NOMEM;
+        goto done;
+    }
+    memcpy(cp, gp->ps.p, (size_t)n * sizeof *cp);
+    for (int t = 0; t < n; t++) {
+        cobj[t] = pobj[t];
+        cobj[N + t] = pobj[n + t];
+        cpin[t] = pin[t];
+        cpin[N + t] = pin[n + t];
+    }
+    for (size_t i = 0; i < npix; i++) {
+        int k = gp->vg_pix[i];
+        if (k >= k0 && k < k1) put_point(gp, cp, cobj, cpin, n + (k - k0), k, i, s);
+    }
+    double spacing = gp->ps.spacing > 0.0 ? gp->ps.spacing : 1.0;
+    gi_link_stats ls = {0};
+    st = gi_links_build(gp->a, gp->lscene, cp, cobj, cpin, (int)N, n, side, seed, grid, NULL, 3.0 * spacing, gp->threads,
+                        gp->vg_link + (size_t)k0 * side * side, NULL, &ls, gp->set.cancel, NULL, gp->sky,
+                        gp->vg_esky + 4 * (size_t)k0, gp->sc, gp->set.pigment,
+                        gp->set.bounces >= 1 ? gp->set.brightness : 0.0);
+    *rays += ls.rays;
+done:
+    free(cp);
+    free(cobj);
+    free(cpin);
+    return st;
+}
+
+/* Whether kept pixel i, which takes its block's corners, should gather
+ * itself instead: the corners that match it differ in luminance by more
+ * than REFINE (interpolation would guess across a change of the light,
+ * where an irradiance cache would place a record of its own). */
+#define REFINE 0.15
+static int needs_own(const gi_particle *gp, size_t i)
+{
+    int x = (int)(i % (size_t)gp->vw), y = (int)(i / (size_t)gp->vw);
+    int cx[4], cy[4];
+    double cw[4], lo = INFINITY, hi = 0.0;
+    int nc = corners(x, y, gp->vw, gp->vh, gp->vg_s, cx, cy, cw), m = 0;
+    for (int c = 0; c < nc; c++) {
+        size_t j = (size_t)cy[c] * gp->vw + cx[c];
+        int kc = gp->vg_pix[j];
+        if (kc < 0 || !compatible(gp, j, i)) continue;
+        const float *v = &gp->vg_val[4 * (size_t)kc];
+        double l = 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
+        lo = fmin(lo, l);
+        hi = fmax(hi, l);
+        m++;
+    }
+    return m > 1 && hi > (1.0 + REFINE) * lo;
+}
+
 pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
 {
     (void)d;
     gi_particle_view_gather_free(gp);
     int side = gp->set.view_gather_side, s = gp->set.view_gather_stride > 0 ? gp->set.view_gather_stride : 2;
     if (side <= 0 || !gp->vrec || gp->vw <= 0 || gp->vh <= 0 || !gp->lout || gp->ps.n <= 0) return PT_OK;
-    int w = gp->vw, h = gp->vh, n = gp->ps.n;
+    int w = gp->vw, h = gp->vh;
     size_t npix = (size_t)w * (size_t)h;
     pt_status st = PT_OK;
     /* vg_pix: the gather point of a pixel, -1 none (it interpolates or
@@ -259,12 +362,14 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
         return PT_ERR_NOMEM;
     }
     for (size_t i = 0; i < npix; i++) gp->vg_nrm[i] = gp->vrec[i].kind == 2 ? view_normal(&gp->vrec[i]) : v3s(0.0);
-    int m = 0;
+    int m = 0, mmax = 0;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
             gp->vg_pix[i] = -1;
-            if (x % s == 0 && y % s == 0 && gathers(gp, &gp->vrec[i])) gp->vg_pix[i] = m++;
+            if (!gathers(gp, &gp->vrec[i])) continue;
+            mmax++;
+            if (x % s == 0 && y % s == 0) gp->vg_pix[i] = m++;
         }
     /* pixels no corner answers gather themselves */
     for (int y = 0; y < h; y++)
@@ -281,62 +386,18 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
             if (!ok) gp->vg_pix[i] = m++;
         }
     if (m == 0) return PT_OK;
-    /* the area particles, then the gather points (gi_links_build's sources
-     * [n, n + m), its targets the area particles) */
-    long N = (long)n + m;
-    gi_dev_particle *cp = calloc((size_t)N, sizeof *cp);
-    const void **cobj = NULL;
-    unsigned char *cpin = NULL, *pin = NULL;
-    const void **pobj = gi_particle_objects(gp, &gp->ps, &pin, &st);
-    cobj = calloc(2 * (size_t)N, sizeof *cobj);
-    cpin = calloc(2 * (size_t)N, 1);
-    gp->vg_link = malloc((size_t)m * side * side * sizeof *gp->vg_link);
-    gp->vg_esky = calloc((size_t)m * 4, sizeof *gp->vg_esky);
-    gp->vg_val = calloc((size_t)m * 4, sizeof *gp->vg_val);
-    gp->vg_pt = calloc((size_t)m, sizeof *gp->vg_pt);
+    /* room for every gathering pixel: the refinement below adds points */
+    const void **pobj = NULL;
+    unsigned char *pin = NULL;
+    pobj = gi_particle_objects(gp, &gp->ps, &pin, &st);
+    gp->vg_link = malloc((size_t)mmax * side * side * sizeof *gp->vg_link);
+    gp->vg_esky = calloc((size_t)mmax * 4, sizeof *gp->vg_esky);
+    gp->vg_val = calloc((size_t)mmax * 4, sizeof *gp->vg_val);
+    gp->vg_pt = calloc((size_t)mmax, sizeof *gp->vg_pt);
     gi_lookup *grid = NULL;
-    if (!cp || !pobj || !pin || !cobj || !cpin || !gp->vg_link || !gp->vg_esky || !gp->vg_val || !gp->vg_pt ||
-        st != PT_OK) {
+    if (!pobj || !pin || !gp->vg_link || !gp->vg_esky || !gp->vg_val || !gp->vg_pt || st != PT_OK) {
         st = PT_ERR_NOMEM;
         goto done;
-    }
-    memcpy(cp, gp->ps.p, (size_t)n * sizeof *cp);
-    for (int t = 0; t < n; t++) {
-        cobj[t] = pobj[t];
-        cobj[N + t] = pobj[n + t];
-        cpin[t] = pin[t];
-        cpin[N + t] = pin[n + t];
-    }
-    for (size_t i = 0; i < npix; i++) {
-        int k = gp->vg_pix[i];
-        if (k < 0) continue;
-        const view_rec *r = &gp->vrec[i];
-        vec3 nv = gp->vg_nrm[i];
-        gi_dev_particle *q = &cp[n + k];
-        v3_store_f(q->p, r->h.p);
-        v3_store_f(q->n, nv);
-        q->area = 0.0f;
-        const scene_object *o = r->h.obj;
-        /* its radius: stride pixels' footprint on the surface (the angle
-         * between neighbouring camera rays, at its depth, over the cosine) */
-        size_t x = i % (size_t)w, y = i / (size_t)w;
-        const view_rec *nb = &gp->vrec[x + 1 < (size_t)w ? i + 1 : (y + 1 < (size_t)h ? i + (size_t)w : i)];
-        double ang = nb != r && nb->kind ? v3_len(v3_sub(v3_norm(nb->dir), v3_norm(r->dir))) : 0.0;
-        double cs = fabs(v3_dot(v3_norm(r->dir), nv));
-        vg_point *vp = &gp->vg_pt[k];
-        vp->p = r->h.p;
-        vp->n = nv;
-        vp->obj = o;
-        vp->side = r->side;
-        vp->r = (float)(s * r->h.t * ang / (cs > 0.25 ? cs : 0.25));
-        cobj[n + k] = o;
-        /* on the inside of a closed sphere or box (as gi_particle_objects
-         * marks particles): its rays end inside it */
-        if ((o->kind == SHAPE_SPHERE || o->kind == SHAPE_BOX) && !(o->flags & OBJ_INVERSE)) {
-            vec3 p = r->h.p;
-            double lift = 1e-5 * (1.0 + fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
-            cpin[n + k] = (unsigned char)gi_surface_inside_solid(o, v3_madd(p, nv, lift));
-        }
     }
     double spacing = gp->ps.spacing > 0.0 ? gp->ps.spacing : 1.0;
     grid = gi_lookup_build(&gp->ps, 2.0 * spacing);
@@ -345,27 +406,31 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
         goto done;
     }
     st = gi_lookup_set_objects(grid, (const void *const *)pobj);
-    gi_link_stats ls = {0};
-    if (st == PT_OK)
-        st = gi_links_build(gp->a, gp->lscene, cp, cobj, cpin, (int)N, n, side, gp->set.seed ^ 0x7a9e7ULL, grid, NULL,
-                            3.0 * spacing, gp->threads, gp->vg_link, NULL, &ls, gp->set.cancel, NULL, gp->sky,
-                            gp->vg_esky, gp->sc, gp->set.pigment, gp->set.bounces >= 1 ? gp->set.brightness : 0.0);
+    gp->vg_k = side * side;
+    gp->vg_w = w;
+    gp->vg_h = h;
+    gp->vg_s = s;
+    long rays = 0;
+    if (st == PT_OK) st = trace_points(gp, pobj, pin, grid, 0, m, side, s, gp->set.seed ^ 0x7a9e7ULL, &rays);
+    /* refinement (an irradiance cache's adaptive placement): pixels whose
+     * matching corners disagree gather themselves, traced as a second set */
+    if (st == PT_OK && s > 1) {
+        gp->vg_n = m;
+        gather_values(gp);
+        int m1 = m;
+        for (size_t i = 0; i < npix; i++)
+            if (gp->vg_pix[i] < 0 && gathers(gp, &gp->vrec[i]) && needs_own(gp, i)) gp->vg_pix[i] = m++;
+        if (m > m1) st = trace_points(gp, pobj, pin, grid, m1, m, side, s, gp->set.seed ^ 0x3c5b1ULL, &rays);
+    }
     if (st == PT_OK) {
         gp->vg_n = m;
-        gp->vg_k = side * side;
-        gp->vg_w = w;
-        gp->vg_h = h;
-        gp->vg_s = s;
         gp->st.view_gathers = m;
-        gp->st.view_gather_rays = ls.rays;
+        gp->st.view_gather_rays = rays;
         gi_particle_view_regather(gp);
         st = build_index(gp);
     }
 done:
     gi_lookup_free(grid);
-    free(cp);
-    free(cobj);
-    free(cpin);
     free(pobj);
     free(pin);
     if (st != PT_OK) gi_particle_view_gather_free(gp);
@@ -407,7 +472,7 @@ static int raw_value(const gi_particle *gp, size_t i, float out[3])
  * gathers' noise over about (2 sigma / stride)^2 gathers, as an irradiance
  * cache reuses a record over its radius, and stops at edges, creases and
  * depth steps, where the light may change. */
-#define FILTER_SIGMA 2.0
+#define FILTER_SIGMA 1.0
 #define FILTER_RADIUS_MAX 8
 
 typedef struct {
@@ -457,32 +522,21 @@ static void filter_row(void *ctx, int y, int thread)
     }
 }
 
-void gi_particle_view_regather(gi_particle *gp)
+/* The raw E/pi of the vg_n gather points into vg_val from their links and
+ * esky (the gathering kernel's C build: equation 5 at the pixels). 0: out
+ * of memory. */
+static int gather_values(gi_particle *gp)
 {
-    if (gp->vg_n <= 0 || !gp->lout) return;
-    size_t npix = (size_t)gp->vw * (size_t)gp->vh;
     int *idx = malloc((size_t)gp->vg_n * sizeof *idx);
-    float *raw = malloc(npix * 3 * sizeof *raw);
-    unsigned char *ok = malloc(npix);
-    if (!gp->vg_pixval) gp->vg_pixval = malloc(npix * 4 * sizeof *gp->vg_pixval);
-    if (!idx || !raw || !ok || !gp->vg_pixval) {
-        free(idx);
-        free(raw);
-        free(ok);
-        gi_particle_view_gather_free(gp);
-        return;
-    }
-    for (int i = 0; i < gp->vg_n; i++) idx[i] = i;
     /* the particles' reflected radiance: the emission was taken where each
      * ray hit (gi_links.h, first > 0) */
     float *lrefl = malloc((size_t)gp->ps.n * 4 * sizeof *lrefl);
-    if (!lrefl) {
+    if (!idx || !lrefl) {
         free(idx);
-        free(raw);
-        free(ok);
-        gi_particle_view_gather_free(gp);
-        return;
+        free(lrefl);
+        return 0;
     }
+    for (int i = 0; i < gp->vg_n; i++) idx[i] = i;
     for (int t = 0; t < gp->ps.n; t++) {
         for (int c = 0; c < 3; c++) {
             float v = gp->lout[4 * (size_t)t + c] - gp->ps.p[t].le[c];
@@ -490,9 +544,25 @@ void gi_particle_view_regather(gi_particle *gp)
         }
         lrefl[4 * (size_t)t + 3] = 0.0f;
     }
-    /* the gathering kernel's C build (equation 5 at the pixels) */
     gi_c_gather(gp->threads, gp->vg_link, gp->vg_k, lrefl, idx, gp->vg_n, gp->vg_esky, gp->vg_val);
+    free(idx);
     free(lrefl);
+    return 1;
+}
+
+void gi_particle_view_regather(gi_particle *gp)
+{
+    if (gp->vg_n <= 0 || !gp->lout) return;
+    size_t npix = (size_t)gp->vw * (size_t)gp->vh;
+    float *raw = malloc(npix * 3 * sizeof *raw);
+    unsigned char *ok = malloc(npix);
+    if (!gp->vg_pixval) gp->vg_pixval = malloc(npix * 4 * sizeof *gp->vg_pixval);
+    if (!raw || !ok || !gp->vg_pixval || !gather_values(gp)) {
+        free(raw);
+        free(ok);
+        gi_particle_view_gather_free(gp);
+        return;
+    }
     for (size_t i = 0; i < npix; i++) ok[i] = (unsigned char)raw_value(gp, i, &raw[3 * i]);
     filter_job F = {gp, raw, ok};
     pool_run(gp->threads, gp->vh, filter_row, &F);
@@ -503,7 +573,6 @@ void gi_particle_view_regather(gi_particle *gp)
         if (k >= 0 && gp->vg_pixval[4 * i + 3] > 0.0f)
             for (int c = 0; c < 3; c++) gp->vg_val[4 * (size_t)k + c] = gp->vg_pixval[4 * i + c];
     }
-    free(idx);
     free(raw);
     free(ok);
 }
