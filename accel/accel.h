@@ -161,8 +161,10 @@ const scene_object *accel_rtc_object_tri(const accel *a, unsigned geom, unsigned
 /* The leaf object a hit of ray org + t dir lies on, and its effective
  * texture (*tex; the CSG parents' when the leaf has none), for every hit
  * accel_rtc_object answers and for hits on CSG results too (their member
- * is found by intersecting the CSG again about t); a mesh triangle's own
- * texture_list entry where it names one. NULL: invalid ids. */
+ * is found by intersecting the CSG again about t; where every member has
+ * the same effective texture and flags, the first member without that); a
+ * mesh triangle's own texture_list entry where it names one. NULL: invalid
+ * ids. */
 const scene_object *accel_rtc_leaf(const accel *a, unsigned geom, unsigned prim, unsigned inst, vec3 org, vec3 dir,
                                    double t, const scene_texture **tex);
 /* Embree geometry ids run over [0, accel_rtc_ngeoms). For a geometry of
