@@ -9,7 +9,9 @@
  *    + extinction_factor * scattering.
  *  - Lit intervals: every light with media_interaction lights the part of
  *    the segment inside its cone (spotlight: the cone of its falloff angle),
- *    cylinder (falloff radius) or all of it (point and area lights). The
+ *    cylinder (falloff radius) or all of it (point and area lights); a
+ *    shadowless light lights no media (its type is FILL_LIGHT_SOURCE, which
+ *    ComputeOneMediaLightInterval's switch leaves out of the list). The
  *    interval starts and ends are sorted separately and merged into lit
  *    and unlit intervals.
  *  - Sampling intervals: max(intervals, number of lit intervals) of them;
@@ -509,7 +511,7 @@ static int collect_refs(const shade_media_env *e, int which, const shade_media_i
 
 static int light_acts(const scene_light *l, const scene_object *hit)
 {
-    if (!l->media_interaction) return 0;
+    if (!l->media_interaction || l->shadowless) return 0;
     return scene_light_reaches(l, hit);
 }
 

@@ -10,7 +10,11 @@
  *    transparent sphere of diameter D in the way: e (d - D) when the sphere
  *    is not hollow (POV-Ray applies no atmosphere inside it), e d when it is;
  *  - a shadow ray through an absorbing box dims a diffuse floor by
- *    exp(-sigma_a L) of its path inside the box.
+ *    exp(-sigma_a L) of its path inside the box;
+ *  - isotropic scattering s without extinction over L in front of a black
+ *    background, lit by a point light of colour 1: s L; lit only by a
+ *    shadowless light: 0 (POV-Ray 3.7's media.cpp lights media only with
+ *    point, spot and cylinder lights; shadowless makes a fill light).
  * Cross-checks against POV-Ray 3.7 (as test_look: 160x120, +A0.3, sRGB,
  * 4x4 downsample, mean |difference| <= 0.02 and a regression bound): an
  * emitting sphere with a density pattern, an absorbing box (method 2, a
@@ -146,6 +150,28 @@ static void test_shadow_through_media(void **st)
     done(&w);
 }
 
+static void test_shadowless_lights_no_media(void **st)
+{
+    (void)st;
+    for (int fill = 0; fill < 2; fill++) {
+        char src[512];
+        snprintf(src, sizeof src,
+                 "light_source { <0, 50, 0> color rgb 1 %s }\n"
+                 "box { <-1, -1, -1>, <1, 1, 1> pigment { rgbf 1 } finish { ambient 0 diffuse 0 } hollow\n"
+                 "  interior { media { scattering { 1, 0.3 extinction 0 } } } scale <1, 1, 1.5> }\n",
+                 fill ? "shadowless" : "");
+        world w = build(src);
+        rgb c = trace(&w, v3(0.1, 0.2, -10), v3(0, 0, 1));
+        if (fill) {
+            printf("media %-34s got %.12f expected 0\n", "shadowless light scattering", c.g);
+            assert_true(fabs(c.g) <= 1e-12);
+        } else {
+            expect_rel(c.g, 0.3 * 3.0, TOL, "point light scattering");
+        }
+        done(&w);
+    }
+}
+
 /* Bad media are located errors (POV-Ray's messages), declared media and
  * densities are reused, defaults follow #version. */
 static void test_media_parse(void **st)
@@ -225,6 +251,7 @@ int main(void)
         cmocka_unit_test(test_emission_absorption),
         cmocka_unit_test(test_atmosphere_hollow),
         cmocka_unit_test(test_shadow_through_media),
+        cmocka_unit_test(test_shadowless_lights_no_media),
         cmocka_unit_test(test_media_parse),
         cmocka_unit_test(test_xc_emit),
         cmocka_unit_test(test_xc_absorb),
