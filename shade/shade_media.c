@@ -21,16 +21,20 @@
  *    parts each (w = ratio for lit, 1 - ratio for unlit), bounded so the
  *    later ones still get one. The media with the most intervals decides
  *    (and its method, samples, jitter, ratio); aa_threshold is the smallest.
- *  - Method 3 (adaptive, POV-Ray 3.5+'s default): an interval is cut into
- *    (min_samples + 1) / 2 sub-intervals; samples at their ends (moved by
+ *  - Method 3 (adaptive, POV-Ray 3.5+'s default): an interval gets
+ *    count = floor(min_samples / 2) + 1 sub-intervals of 1 / (count + 1)
+ *    of it from its start (the samples leave its last 1 / (count + 1)
+ *    out, as POV-Ray's); samples at their ends (moved by
  *    jitter * (rand - 0.5) of a sub-interval); between two samples whose
  *    colours differ by more than aa_threshold (sum of |channel
  *    differences|) a middle sample is taken recursively, aa_level - 1
  *    levels deep; at the last level the three samples average 1:1:1,
  *    otherwise each half weighs its outer sample 1/3 and the middle one
- *    1/6. A sub-interval's emitted light is attenuated by the optical depth
- *    of the sub-intervals before it and by (1 - exp(-od)) / od of its own
- *    (od = its optical depth).
+ *    1/6. A sub-interval's emitted light (a sample's coefficients times
+ *    the whole interval's length, averaged over the count) is attenuated
+ *    by the optical depth of the sub-intervals before it only, not within
+ *    itself, so thick media emit more than the closed form (a left
+ *    Riemann sum of it).
  *  - Methods 1 and 2: min_samples samples per interval at a random place
  *    (1) or stratified (j + 0.5) / n + jitter * rand / n (2); each sample's
  *    emitted light is ds * exp(-extinction * d) (d = its distance into the
@@ -448,9 +452,15 @@ static void recursive_sample(const sampler *s, interval *iv, double d1, double d
 
 static void adaptive(const sampler *s, interval *iv, const scene_media *im, double aa)
 {
-    int sub = (im->min_samples + 1) / 2;
-    if (sub < 1) sub = 1;
-    double dd = 1.0 / sub;
+    /* POV-Ray 3.7's ComputeMediaAdaptiveSampling: min_samples / 2 + 1
+     * sub-intervals, their ends 1 / (count + 1) apart from the interval's
+     * start (so the samples span count / (count + 1) of it); each
+     * sub-interval's light is attenuated by the optical depth before it
+     * only, not within itself. */
+    int sub = im->min_samples / 2 + 1;
+    if (sub < 2) sub = 2;
+    double dd = 1.0 / (sub + 1);
+    double n = 1.0 / sub;
     rgb c0, od0, c1, od1, res, odres;
     double j0 = im->jitter != 0.0 ? dd * im->jitter * (rnd(s->e) - 0.5) : 0.0;
     one_sample(s, iv, j0, 3, &c0, &od0);
@@ -462,14 +472,7 @@ static void adaptive(const sampler *s, interval *iv, const scene_media *im, doub
         double jj = im->jitter != 0.0 ? dd * im->jitter * (rnd(s->e) - 0.5) : 0.0;
         one_sample(s, iv, d1 + jj, 3, &c1, &od1);
         recursive_sample(s, iv, d0, d1, c0, c1, od0, od1, im->aa_level - 1, im->jitter, aa, &res, &odres);
-        /* attenuation by the sub-intervals before this one, then within it
-         * (exact for a constant emission / extinction ratio) */
-        res = mul(res, expn(scl(iv->od, dd)));
-        double odc[3] = {odres.r * dd, odres.g * dd, odres.b * dd};
-        double *rc[3] = {&res.r, &res.g, &res.b};
-        for (int k = 0; k < 3; k++)
-            if (odc[k] != 0.0) *rc[k] *= (1.0 - exp(-odc[k])) / odc[k];
-        iv->te = add(iv->te, res);
+        iv->te = add(iv->te, mul(res, expn(scl(iv->od, n))));
         iv->od = add(iv->od, odres);
         c0 = c1;
         od0 = od1;
