@@ -124,6 +124,39 @@ static const accel_hit *kept_hit(gi_particle *gp, int i, int w, vec3 *dir)
     return h;
 }
 
+/* The kept pixels of gp's w x h view for which expect(h, n, ctx) gives an
+ * expected E/pi (> 0; n the hit's normal turned to the camera): how many,
+ * and the mean and worst of the hook's E/pi (green) over it. */
+typedef double (*expect_fn)(const accel_hit *h, vec3 n, const void *ctx);
+static int kept_ratios(gi_particle *gp, int w, int h, expect_fn expect, const void *ctx, double *mean, double *worst)
+{
+    double sum = 0.0;
+    int m = 0;
+    *worst = 0.0;
+    for (int i = 0; i < w * h; i++) {
+        vec3 dir;
+        const accel_hit *hit = kept_hit(gp, i, w, &dir);
+        if (!hit) continue;
+        vec3 n = v3_dot(dir, hit->ns) > 0.0 ? v3_neg(hit->ns) : hit->ns;
+        double x = expect(hit, n, ctx);
+        if (!(x > 0.0)) continue;
+        rgb e = gi_particle_indirect(gp, hit, n, 0);
+        assert_true(isfinite(e.r) && isfinite(e.g) && isfinite(e.b));
+        sum += e.g / x;
+        *worst = fmax(*worst, fabs(e.g / x - 1.0));
+        m++;
+    }
+    *mean = m > 0 ? sum / m : 0.0;
+    return m;
+}
+
+/* expected E/pi: ctx's L, or with ctx NULL the gradient sky's 1 + n.y/3 */
+static double expect_sky(const accel_hit *h, vec3 n, const void *ctx)
+{
+    (void)h;
+    return ctx ? *(const double *)ctx : 1.0 + (1.0 / 3.0) * n.y;
+}
+
 /* The final gather at the camera's hits (gi_particle_gather.c) in the same
  * furnaces: every kept pixel on the sphere gathers (or interpolates, or
  * takes the edge-aware filter of) side x side rays of its own, so under the
@@ -140,26 +173,14 @@ static void gather_case(const char *what, int background, double L, gi_sky_fn fn
     tg_load(&f, tu_sky_furnace(text, sizeof text, L, background, 1));
     const int W = 32, H = 32;
     gi_particle *gp = gather_state(&f, 2000, 5, fn, W, H, NULL);
-    double sum = 0.0, worst = 0.0;
-    int m = 0;
-    for (int i = 0; i < W * H; i++) {
-        vec3 dir;
-        const accel_hit *h = kept_hit(gp, i, W, &dir);
-        if (!h) continue;
-        vec3 n = v3_dot(dir, h->ns) > 0.0 ? v3_neg(h->ns) : h->ns;
-        rgb e = gi_particle_indirect(gp, h, n, 0);
-        assert_true(isfinite(e.r) && isfinite(e.g) && isfinite(e.b));
-        double expect = gradient ? 1.0 + (1.0 / 3.0) * n.y : L;
-        sum += e.g / expect;
-        worst = fmax(worst, fabs(e.g / expect - 1.0));
-        m++;
-    }
+    double mean, worst;
+    int m = kept_ratios(gp, W, H, expect_sky, gradient ? NULL : &L, &mean, &worst);
     const gi_particle_stats *st = gi_particle_get_stats(gp);
     printf("  final gather %-20s: %3d pixels (%ld gathers, %ld rays), mean E/pi over expected %.5f, worst %.4f\n", what,
-           m, st->view_gathers, st->view_gather_rays, sum / m, worst);
+           m, st->view_gathers, st->view_gather_rays, mean, worst);
     assert_true(m > 100);
     assert_true(st->view_gathers > 0);
-    assert_true(fabs(sum / m - 1.0) <= 0.01);
+    assert_true(fabs(mean - 1.0) <= 0.01);
     assert_true(worst <= 0.05);
     gi_particle_free(gp);
     tg_unload(&f);
@@ -171,6 +192,12 @@ static void gather_case(const char *what, int background, double L, gi_sky_fn fn
  * (shade_tex_pigment_at) composites the layers as the camera sees them, so
  * every kept pixel on the white sphere inside gathers E/pi = L (mean within
  * 1%, worst 5%); taking the top layer alone made it 0. */
+/* L on the white sphere's pixels (not the dome's) */
+static double expect_dome_inside(const accel_hit *h, vec3 n, const void *ctx)
+{
+    return v3_len(h->p) > 2.0 ? 0.0 : expect_sky(h, n, ctx);
+}
+
 static void layered_dome_case(double L)
 {
     fixture f;
@@ -187,22 +214,11 @@ static void layered_dome_case(double L)
     tg_load(&f, text);
     const int W = 32, H = 32;
     gi_particle *gp = gather_state(&f, 2000, 9, NULL, W, H, shade_tex_pigment_at);
-    double sum = 0.0, worst = 0.0;
-    int m = 0;
-    for (int i = 0; i < W * H; i++) {
-        vec3 dir;
-        const accel_hit *h = kept_hit(gp, i, W, &dir);
-        if (!h || v3_len(h->p) > 2.0) continue; /* the sphere's pixels, not the dome's */
-        vec3 n = v3_dot(dir, h->ns) > 0.0 ? v3_neg(h->ns) : h->ns;
-        rgb e = gi_particle_indirect(gp, h, n, 0);
-        assert_true(isfinite(e.r) && isfinite(e.g) && isfinite(e.b));
-        sum += e.g / L;
-        worst = fmax(worst, fabs(e.g / L - 1.0));
-        m++;
-    }
-    printf("  final gather layered dome L %.2f: %3d pixels, mean E/pi over L %.5f, worst %.4f\n", L, m, sum / m, worst);
+    double mean, worst;
+    int m = kept_ratios(gp, W, H, expect_dome_inside, &L, &mean, &worst);
+    printf("  final gather layered dome L %.2f: %3d pixels, mean E/pi over L %.5f, worst %.4f\n", L, m, mean, worst);
     assert_true(m > 100);
-    assert_true(fabs(sum / m - 1.0) <= 0.01);
+    assert_true(fabs(mean - 1.0) <= 0.01);
     assert_true(worst <= 0.05);
     gi_particle_free(gp);
     tg_unload(&f);
@@ -234,6 +250,17 @@ static double corner_ff(double a, double b)
     return (X / sx * atan(Y / sx) + Y / sy * atan(X / sy)) / (2.0 * M_PI);
 }
 
+/* Le F under the slab (Le 2), floor pixels within 0.3 of its centre */
+static double expect_slab(const accel_hit *h, vec3 n, const void *ctx)
+{
+    (void)n;
+    (void)ctx;
+    double px = h->p.x, pz = h->p.z;
+    if (fabs(h->p.y) > 1e-6 || fabs(px) > 0.3 || fabs(pz) > 0.3) return 0.0;
+    return 2.0 * (corner_ff(1.0 - px, 1.0 - pz) + corner_ff(1.0 + px, 1.0 - pz) + corner_ff(1.0 - px, 1.0 + pz) +
+                  corner_ff(1.0 + px, 1.0 + pz));
+}
+
 void test_csg_emitter_gather(void **state)
 {
     (void)state;
@@ -247,26 +274,11 @@ void test_csg_emitter_gather(void **state)
     tg_load(&f, text);
     const int W = 40, H = 40;
     gi_particle *gp = gather_state(&f, 3000, 7, NULL, W, H, NULL);
-    double sum = 0.0, worst = 0.0;
-    int m = 0;
-    for (int i = 0; i < W * H; i++) {
-        vec3 dir;
-        const accel_hit *h = kept_hit(gp, i, W, &dir);
-        if (!h) continue;
-        if (fabs(h->p.y) > 1e-6 || fabs(h->p.x) > 0.3 || fabs(h->p.z) > 0.3) continue;
-        rgb e = gi_particle_indirect(gp, h, v3(0, 1, 0), 0);
-        double px = h->p.x, pz = h->p.z;
-        double F = corner_ff(1.0 - px, 1.0 - pz) + corner_ff(1.0 + px, 1.0 - pz) + corner_ff(1.0 - px, 1.0 + pz) +
-                   corner_ff(1.0 + px, 1.0 + pz);
-        double expect = 2.0 * F;
-        sum += e.g / expect;
-        worst = fmax(worst, fabs(e.g / expect - 1.0));
-        m++;
-    }
-    printf("  CSG emitter over a floor: %d pixels, mean E/pi over the form factor's %.5f, worst %.4f\n", m, sum / m,
-           worst);
+    double mean, worst;
+    int m = kept_ratios(gp, W, H, expect_slab, NULL, &mean, &worst);
+    printf("  CSG emitter over a floor: %d pixels, mean E/pi over the form factor's %.5f, worst %.4f\n", m, mean, worst);
     assert_true(m > 30);
-    assert_true(fabs(sum / m - 1.0) <= 0.02);
+    assert_true(fabs(mean - 1.0) <= 0.02);
     assert_true(worst <= 0.06);
     gi_particle_free(gp);
     tg_unload(&f);
