@@ -46,7 +46,7 @@ typedef struct {
     rgb reflection_min;   /* reflection {min, max}; plain "reflection c" sets both */
     rgb reflection_max;
     double reflection_falloff;  /* default 1 */
-    double reflection_exponent; /* default 1 */
+    double reflection_exponent; /* as written, default 1 (never 0) */
     double reflection_metallic; /* default 0 */
     int fresnel;                /* reflection { fresnel on } */
     int conserve_energy;

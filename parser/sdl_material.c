@@ -138,6 +138,20 @@ scene_pigment *sdl_parse_pigment_new(sdl_parser *p)
 
 /* reflection := 'reflection' ( colour | '{' colour [','] [colour]
  *               { fresnel [bool] | falloff f | exponent f | metallic [f] } '}' ) */
+/* reflection's exponent e (in the block or as reflection_exponent), as
+ * written; shading raises the reflected colour to 1 / e, which POV-Ray 3.7
+ * divides by without a check (parstxtr.cpp, Reflect_Exp), so 0 is an error. */
+static double reflection_exponent(sdl_parser *p)
+{
+    src_loc loc = sdl_peek(p)->tk.loc;
+    double v = sdl_float(p);
+    if (v == 0.0) {
+        sdl_error(p, loc, PT_ERR_SYNTAX, "reflection exponent must not be 0");
+        return 1.0;
+    }
+    return v;
+}
+
 static void reflection(sdl_parser *p, scene_finish *f)
 {
     if (!sdl_is(sdl_peek(p), TOK_LBRACE)) {
@@ -165,7 +179,7 @@ static void reflection(sdl_parser *p, scene_finish *f)
         } else if (sdl_is_kw(&t, KW_FALLOFF)) {
             f->reflection_falloff = sdl_float(p);
         } else if (sdl_is_kw(&t, KW_EXPONENT)) {
-            f->reflection_exponent = sdl_float(p);
+            f->reflection_exponent = reflection_exponent(p);
         } else if (sdl_is_kw(&t, KW_METALLIC)) {
             f->reflection_metallic = sdl_allow_float(p, 1.0);
         } else {
@@ -243,7 +257,7 @@ static void finish_item(sdl_parser *p, scene_finish *f, albedo_flags *a)
     case KW_METALLIC: f->metallic = sdl_starts_float(sdl_peek(p)) ? sdl_float(p) : 1.0; break;
     case KW_CRAND: f->crand = sdl_float(p); break;
     case KW_REFLECTION: reflection(p, f); break;
-    case KW_REFLECTION_EXPONENT: f->reflection_exponent = sdl_float(p); break;
+    case KW_REFLECTION_EXPONENT: f->reflection_exponent = reflection_exponent(p); break;
     case KW_CONSERVE_ENERGY: f->conserve_energy = 1; break;
     case KW_IRID: irid(p, f); break;
     case KW_SUBSURFACE: skip_sub_block(p, &t); break;

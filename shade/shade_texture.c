@@ -33,7 +33,9 @@
  *    dispersive surface instead of splitting again.
  *  - Reflection per layer along the layer's normal (POV-Ray's fix when the
  *    mirrored ray goes below the raw surface), weighted by its
- *    reflectivity, raised to reflection_exponent.
+ *    reflectivity times the reflected colour raised to 1 / reflection_exponent
+ *    (POV-Ray 3.7 stores that reciprocal as Reflect_Exp, parstxtr.cpp, and
+ *    trace.cpp raises the colour to it).
  *
  * uv_mapping (object, texture, pigment and normal level) evaluates at the
  * hit's POV-Ray UV coordinates (accel_hit.uv).
@@ -303,7 +305,7 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
         layer_refl *L = &lr[nl++];
         L->weight = new_weight;
         L->normal = ln;
-        L->exponent = f->reflection_exponent;
+        L->exponent = f->reflection_exponent != 0.0 ? 1.0 / f->reflection_exponent : 1.0;
         L->f = f;
         double cos_i = -v3_dot(hi->dir, ln);
         L->reflec = reflectivity(hi, f, cos_i, &L->weight);

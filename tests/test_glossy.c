@@ -23,7 +23,12 @@
  *  - where only direct light exists (one glossy metallic sphere, a point
  *    light and a spotlight, black sky), the path tracer at full depth and
  *    pmfg show --gi none's highlights exactly (POV-Ray's own formula for
- *    light from light sources; the glossy lobe finds only the black sky). */
+ *    light from light sources; the glossy lobe finds only the black sky);
+ *  - reflection's exponent e (--gi none): a black mirror plane with
+ *    reflection { r exponent e } under a sky of radiance L shows
+ *    r L^(1/e) in every pixel (POV-Ray 3.7 raises the reflected colour to
+ *    1 / e: parstxtr.cpp stores Reflect_Exp = 1 / e, trace.cpp applies it),
+ *    within 1e-6. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -379,6 +384,31 @@ static void test_blurred_reflection(void **state)
     tu_world_free(&ws);
 }
 
+static void test_reflection_exponent(void **state)
+{
+    (void)state;
+    static const double es[] = {0.5, 0.8, 1.0, 2.0};
+    for (int i = 0; i < 4; i++) {
+        char text[1024];
+        snprintf(text, sizeof text,
+                 "#version 3.7;\n"
+                 "global_settings { assumed_gamma 1.0 }\n"
+                 "camera { location <0, 1, 0> look_at <0, 0, 0> angle 40 }\n"
+                 "sky_sphere { pigment { rgb 0.25 } }\n"
+                 "plane { y, 0 pigment { rgb 0 } finish { ambient 0 diffuse 0 reflection { 0.7 exponent %g } } }\n",
+                 es[i]);
+        tu_world w = tu_world_build("glossy_reflexp.pov", text);
+        framebuffer *fb = fb_new(8, 8);
+        render_none(&w, 8, 8, 0, fb);
+        double want = 0.7 * pow(0.25, 1.0 / es[i]), maxdev = 0.0;
+        for (int k = 0; k < 3 * 8 * 8; k++) maxdev = fmax(maxdev, fabs(fb->rgb[k] - want));
+        printf("reflection exponent %.1f: expect %.6f, max pixel dev %.2e (tol 1e-6)\n", es[i], want, maxdev);
+        assert_true(maxdev <= 1e-6);
+        fb_free(fb);
+        tu_world_free(&w);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -389,6 +419,7 @@ int main(void)
         cmocka_unit_test(test_furnace_pmfg),
         cmocka_unit_test(test_highlights_direct),
         cmocka_unit_test(test_blurred_reflection),
+        cmocka_unit_test(test_reflection_exponent),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -524,7 +524,7 @@ static void test_textures(void **st)
                         "sphere { 0, 1 texture { T } translate x }\n"
                         "sphere { 0, 1 translate x texture { T } }\n"
                         "sphere { 0, 1 finish { F diffuse 0.8 } }\n"
-                        "sphere { 0, 1 pigment { rgbft <1, 1, 1, 0.5, 0.25> } finish { reflection { 0.1, 0.5 falloff 2 } } }\n"
+                        "sphere { 0, 1 pigment { rgbft <1, 1, 1, 0.5, 0.25> } finish { reflection { 0.1, 0.5 falloff 2 exponent 0.8 } } }\n"
                         "sphere { 0, 1 pigment { checker rgb x, rgb y } }\n"
                         "sphere { 0, 1 pigment { colour 1 } finish { ambient 0.5 specular albedo 0.5 roughness 0.1 } }\n");
     const scene_object *u = s->objects[0];
@@ -555,6 +555,7 @@ static void test_textures(void **st)
     assert_near(t5->finish.reflection_min.g, 0.1, 0);
     assert_near(t5->finish.reflection_max.g, 0.5, 0);
     assert_near(t5->finish.reflection_falloff, 2, 0);
+    assert_near(t5->finish.reflection_exponent, 0.8, 0); /* as written */
     const scene_texture *t6 = s->objects[5]->texture;
     assert_int_equal(t6->pigment.kind, PIGMENT_PATTERN); /* evaluated by shade_pattern */
     assert_string_equal(t6->pigment.pattern, "checker");
@@ -746,6 +747,10 @@ static void test_photons_language(void **st)
     free(m);
     m = parse_err("global_settings { photons { bogus 1 } }\n", PT_ERR_SYNTAX);
     assert_prefix(m, "test.pov:1:");
+    free(m);
+    m = parse_err("sphere { 0, 1 finish {\n reflection { 0.5 exponent 0 } } }\n", PT_ERR_SYNTAX);
+    assert_prefix(m, "test.pov:2:");
+    assert_non_null(strstr(m, "reflection exponent"));
     free(m);
     m = parse_err("light_source { 0, 1 photons { target } }\n", PT_ERR_SYNTAX);
     assert_prefix(m, "test.pov:1:");
