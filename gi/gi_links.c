@@ -128,9 +128,7 @@ static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int
     float dir[3] = {0.0f, 0.0f, 0.0f};
     if (direct && J->nlights > 0 && (rho[0] > 0.0f || rho[1] > 0.0f || rho[2] > 0.0f)) {
         /* the shadow ray starts eps off the surface and ends short of the
-         * light as the particles' do (gi_particle_light.c shadow_ray), its
-         * length measured from where it starts: a light in a surface's
-         * plane (cornell.pov's, in its ceiling) is not shadowed by it */
+         * light (gi_shadow_tmax), its length measured from where it starts */
         double eps = accel_epsilon(J->a, p, n);
         vec3 org = v3_madd(p, n, eps);
         for (int l = 0; l < J->nlights; l++) {
@@ -144,7 +142,7 @@ static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int
             if (!lt->shadowless) {
                 float ds[3];
                 double dep = gi_light_ray(lt, lt->pos[0], lt->pos[1], lt->pos[2], (float)org.x, (float)org.y, (float)org.z, ds);
-                double tmax = dep > 0.0 ? dep - fmax(eps, dep * 1e-5) : INFINITY;
+                double tmax = dep > 0.0 ? gi_shadow_tmax(dep, eps) : INFINITY;
                 if (tmax > eps && accel_occluded(J->a, org, v3(ds[0], ds[1], ds[2]), 0.0, tmax)) continue;
             }
             for (int c = 0; c < 3; c++) dir[c] += lt->colour[c] * att * (float)ci;

@@ -7,6 +7,7 @@
  * its hit, gives -1. Internal to gi/. */
 #ifndef PT_GI_LINKS_H
 #define PT_GI_LINKS_H
+#include <math.h>
 #include <stdint.h>
 #include "accel.h"
 #include "scene.h"
@@ -71,5 +72,13 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
  * target t's sources are src[off[t] .. off[t + 1] - 1] (off[0..n]). */
 size_t gi_links_reverse_count(const int *links, int n, int k, const unsigned *mask, int *off);
 void gi_links_reverse_fill(const int *links, int n, int k, const unsigned *mask, int *off, int *src);
+
+/* How far a shadow ray from a surface point runs towards a light `depth`
+ * away (eps the ray's epsilon): it stops 1e-5 x depth short of the light
+ * (as the path tracer's pm_nee.c), so that a light lying in a surface's
+ * plane (cornell.pov's lights in its ceiling) is not shadowed by that
+ * surface: Embree's single-precision t there is off by ~2e-6 x depth. The
+ * particles' visibility and the final gather's direct light both use it. */
+static inline double gi_shadow_tmax(double depth, double eps) { return depth - fmax(eps, depth * 1e-5); }
 
 #endif

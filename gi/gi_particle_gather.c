@@ -241,7 +241,33 @@ static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int
     return 1;
 }
 
-static int gather_values(gi_particle *gp);
+/* The raw E/pi of the vg_n gather points into vg_val from their links and
+ * esky (the gathering kernel's C build: equation 5 at the pixels). 0: out
+ * of memory. */
+static int gather_values(gi_particle *gp)
+{
+    int *idx = malloc((size_t)gp->vg_n * sizeof *idx);
+    /* the particles' reflected radiance: the emission was taken where each
+     * ray hit (gi_links.h, first > 0) */
+    float *lrefl = malloc((size_t)gp->ps.n * 4 * sizeof *lrefl);
+    if (!idx || !lrefl) {
+        free(idx);
+        free(lrefl);
+        return 0;
+    }
+    for (int i = 0; i < gp->vg_n; i++) idx[i] = i;
+    for (int t = 0; t < gp->ps.n; t++) {
+        for (int c = 0; c < 3; c++) {
+            float v = gp->lout[4 * (size_t)t + c] - gp->ps.p[t].le[c];
+            lrefl[4 * (size_t)t + c] = v > 0.0f ? v : 0.0f;
+        }
+        lrefl[4 * (size_t)t + 3] = 0.0f;
+    }
+    gi_c_gather(gp->threads, gp->vg_link, gp->vg_k, lrefl, idx, gp->vg_n, gp->vg_esky, gp->vg_val);
+    free(idx);
+    free(lrefl);
+    return 1;
+}
 
 /* Gather point k (kept pixel i) as a link source at slot cp[t], its
  * object and inside flag at cobj[t], cpin[t], and its record vg_pt[k]. */
@@ -387,9 +413,8 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
         }
     if (m == 0) return PT_OK;
     /* room for every gathering pixel: the refinement below adds points */
-    const void **pobj = NULL;
     unsigned char *pin = NULL;
-    pobj = gi_particle_objects(gp, &gp->ps, &pin, &st);
+    const void **pobj = gi_particle_objects(gp, &gp->ps, &pin, &st);
     gp->vg_link = malloc((size_t)mmax * side * side * sizeof *gp->vg_link);
     gp->vg_esky = calloc((size_t)mmax * 4, sizeof *gp->vg_esky);
     gp->vg_val = calloc((size_t)mmax * 4, sizeof *gp->vg_val);
@@ -520,34 +545,6 @@ static void filter_row(void *ctx, int y, int thread)
         for (int c = 0; c < 3; c++) o[c] = (float)(s[c] / ws);
         o[3] = 1.0f;
     }
-}
-
-/* The raw E/pi of the vg_n gather points into vg_val from their links and
- * esky (the gathering kernel's C build: equation 5 at the pixels). 0: out
- * of memory. */
-static int gather_values(gi_particle *gp)
-{
-    int *idx = malloc((size_t)gp->vg_n * sizeof *idx);
-    /* the particles' reflected radiance: the emission was taken where each
-     * ray hit (gi_links.h, first > 0) */
-    float *lrefl = malloc((size_t)gp->ps.n * 4 * sizeof *lrefl);
-    if (!idx || !lrefl) {
-        free(idx);
-        free(lrefl);
-        return 0;
-    }
-    for (int i = 0; i < gp->vg_n; i++) idx[i] = i;
-    for (int t = 0; t < gp->ps.n; t++) {
-        for (int c = 0; c < 3; c++) {
-            float v = gp->lout[4 * (size_t)t + c] - gp->ps.p[t].le[c];
-            lrefl[4 * (size_t)t + c] = v > 0.0f ? v : 0.0f;
-        }
-        lrefl[4 * (size_t)t + 3] = 0.0f;
-    }
-    gi_c_gather(gp->threads, gp->vg_link, gp->vg_k, lrefl, idx, gp->vg_n, gp->vg_esky, gp->vg_val);
-    free(idx);
-    free(lrefl);
-    return 1;
 }
 
 void gi_particle_view_regather(gi_particle *gp)

@@ -98,14 +98,11 @@ static void batch_free(ray_batch *b)
 }
 
 /* A shadow ray from p towards a light point at `depth` along dir: 1 (seen,
- * no ray needed: the point is within eps) or queued (0). The ray stops
- * 1e-5 x depth short of the light (as the path tracer's pm_nee.c): a light
- * lying in a surface's plane (cornell.pov's lights in its ceiling) must not
- * be shadowed by that surface, and Embree's single-precision t there is
- * off by ~2e-6 x depth, more than the 1e-6 x depth this used to leave. */
+ * no ray needed: the point is within eps) or queued (0); its length is
+ * gi_shadow_tmax's. */
 static int shadow_ray(ray_batch *b, vec3 p, vec3 dir, double depth, double eps, int owner, const accel *a)
 {
-    double tmax = depth - fmax(eps, depth * 1e-5);
+    double tmax = gi_shadow_tmax(depth, eps);
     if (tmax <= eps) return 1;
     if (!batch_add(b, p, dir, eps, tmax, owner)) return accel_occluded(a, p, dir, eps, tmax) ? 0 : 1;
     return 0;
