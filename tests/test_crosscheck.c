@@ -88,11 +88,12 @@ static void test_spot_specular(void **st) { (void)st; scene_test("xc_spot_specul
 static void test_parallel_reflect(void **st) { (void)st; scene_test("xc_parallel_reflect"); }
 static void test_area_fade(void **st) { (void)st; scene_test("xc_area_fade"); }
 /* glass seen from inside a closed room, glass in glass, overlapping glass:
- * the ior ratios from the ray's list of containers (before they were
- * taken from the surface's side alone the difference was 0.0101) */
+ * the ior ratios come from the ray's list of containers, not from the
+ * surface's side alone */
 static void test_glass_room(void **st) { (void)st; scene_test("xc_glass_room"); }
-/* the camera inside a glass intersection: before the leaving-an-unlisted-
- * object rule, FLIP 0.47 against POV-Ray's image at 120x90 */
+/* the camera inside a glass intersection: a ray leaving an object its
+ * list of containers does not hold (it started inside) is not put inside
+ * it (shade.c) */
 static void test_glass_inside_csg(void **st) { (void)st; scene_test("xc_glass_inside_csg"); }
 
 int main(void)
