@@ -165,8 +165,22 @@ static int pov_switch(const char *arg, cli_render *o, char *err, int errlen)
         }
         if (v[0] && !v[1] && strchr("DdLlVvRrOo", v[0])) return 0;
         break;
-    case 'D': case 'P': case 'V': case 'J': case 'X': case 'G': case 'B': case 'C':
-        return 0; /* display, pause, verbose, jitter...: ignored */
+    case 'J': /* +J[n.n] jitter on (amount n.n, clipped to [0, 1]), -J off: POV-Ray's view.cpp */
+        if (!on) {
+            o->aa_jitter = 0.0;
+            return 0;
+        }
+        if (!*v) {
+            o->aa_jitter = 1.0;
+            return 0;
+        }
+        if (parse_double(v, &o->aa_jitter)) {
+            o->aa_jitter = o->aa_jitter < 0.0 ? 0.0 : o->aa_jitter > 1.0 ? 1.0 : o->aa_jitter;
+            return 0;
+        }
+        break;
+    case 'D': case 'P': case 'V': case 'X': case 'G': case 'B': case 'C':
+        return 0; /* display, pause, verbose...: ignored */
     default:
         break;
     }
@@ -200,7 +214,7 @@ static int parse_size(const char *v, cli_render *o)
 int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen)
 {
     /* POV-Ray's Initial_Frame, Final_Frame, Initial_Clock, Final_Clock, +A threshold, +R, +Q */
-    *o = (cli_render){.kfi = 1, .kff = 1, .kf = 1, .aa_threshold = 0.3, .aa_depth = 3, .quality = 9, .spp = 1,
+    *o = (cli_render){.kfi = 1, .kff = 1, .kf = 1, .aa_threshold = 0.3, .aa_depth = 3, .aa_jitter = 1.0, .quality = 9, .spp = 1,
                       .exr_compression = -1};
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];

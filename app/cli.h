@@ -57,6 +57,7 @@ typedef struct {
     int antialias;          /* 0 off, 1 +A adaptive */
     double aa_threshold;
     int aa_depth;
+    double aa_jitter;       /* +J amount, default 1; -J: 0 */
     int exr_float;
     int quiet;
     long max_loop;

@@ -536,7 +536,8 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
 
     render_gi_opts ss = {.mode = gi, .width = o->width > 0 ? o->width : 320, .height = o->height > 0 ? o->height : 240,
                          .threads = threads, .seed = o->seed, .antialias = o->antialias ? 1 : (o->spp > 1 ? 2 : 0),
-                         .aa_threshold = o->aa_threshold, .aa_depth = o->aa_depth, .quality = o->quality, .spp = o->spp,
+                         .aa_threshold = o->aa_threshold, .aa_depth = o->aa_depth,
+                         .aa_jitter = o->aa_jitter, .quality = o->quality, .spp = o->spp,
                          .particles = o->particles, .gi_quality = o->gi_quality, .photon_scale = o->photon_scale,
                          .bounces = o->bounces, .fg_rays = o->fg_rays, .photons = o->photons, .max_depth = o->max_depth,
                          .cl_device = o->cl_device,

@@ -34,6 +34,7 @@ static void fill_shade(shade_settings *ss, const render_gi_opts *o)
     ss->antialias = o->antialias;
     ss->aa_threshold = o->aa_threshold;
     ss->aa_depth = o->aa_depth;
+    ss->aa_jitter = o->aa_jitter;
     ss->spp = o->spp;
     ss->cancel = o->cancel;
     memcpy(ss->window, o->window, sizeof ss->window);

@@ -25,6 +25,7 @@ typedef struct {
     int antialias;            /* Whitted-based modes: 0 off, 1 +A adaptive, 2 fixed spp */
     double aa_threshold;
     int aa_depth;
+    double aa_jitter;         /* +J amount (shade_settings.aa_jitter) */
     int quality;              /* none, particle: POV-Ray's +Q level 0..9 (shade_settings.quality) */
     int spp;                  /* path: samples per pixel; pmfg: eye samples; none/particle: fixed AA */
     long particles;           /* particle: area particles (0 = from the scene/default) */

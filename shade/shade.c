@@ -45,6 +45,7 @@
 #include "shade_gamma.h"
 #include "shade_light.h"
 #include "shade_media.h"
+#include "shade_noise.h"
 #include "shade_normal.h"
 #include "shade_project.h"
 #include "shade_texture.h"
@@ -123,8 +124,8 @@ static double shade_colour_distance(rgb a, rgb b) { return fabs(a.r - b.r) + fab
 void shade_default_settings(shade_settings *s)
 {
     /* POV-Ray's defaults: +A threshold 0.3, +R3, +Q9 */
-    *s = (shade_settings){.width = 320, .height = 240, .aa_threshold = 0.3, .aa_depth = 3, .spp = 1, .use_ambient = 1,
-                          .quality = 9};
+    *s = (shade_settings){.width = 320, .height = 240, .aa_threshold = 0.3, .aa_depth = 3, .aa_jitter = 1.0, .spp = 1,
+                          .use_ambient = 1, .quality = 9};
 }
 
 /* ------------------------------------------------------------------ lights */
@@ -636,19 +637,26 @@ static rgb aa_encode(const scene *sc, const float *px)
 #define AA_BLOCK 32
 
 /* Pixel (x, y) supersampled: depth x depth jittered rays averaged with its
- * first sample `px`, which it replaces. */
+ * first sample `px`, which it replaces. As POV-Ray's tracetask.cpp
+ * (SupersampleOnePixel): grid offsets run from -(1/2 - step/2) by step,
+ * accumulated by addition, rows outer; each sample moves by POV-Ray's
+ * jitter at (x + offset, y + offset) times the jitter amount over depth.
+ * The jitter is a fixed function of position (shade_noise_jitter2d), so
+ * two renders of a scene take the same subsamples. */
 static void supersample_pixel(render_ctx *c, int thread, int x, int y, float *px)
 {
     int d = c->s->aa_depth > 0 ? c->s->aa_depth : 3;
-    double step = 1.0 / d;
+    double step = 1.0 / d, range = 0.5 - step * 0.5, js = c->s->aa_jitter / d;
     rng r;
     pixel_rng(&r, c->s->seed, x, y, 1);
     rgb acc = {px[0], px[1], px[2]};
-    for (int j = 0; j < d; j++) {
-        for (int i = 0; i < d; i++) {
-            /* jittered grid: POV-Ray's default jitter 1.0 scaled by 1/depth */
-            double sx = x + (i + 0.5) * step + (rng_f64(&r) - 0.5) * step;
-            double sy = y + (j + 0.5) * step + (rng_f64(&r) - 0.5) * step;
+    double yy = -range;
+    for (int j = 0; j < d; j++, yy += step) {
+        double xx = -range;
+        for (int i = 0; i < d; i++, xx += step) {
+            double jx = 0.0, jy = 0.0;
+            if (js > 0.0) shade_noise_jitter2d(x + xx, y + yy, &jx, &jy);
+            double sx = x + 0.5 + xx + jx * js, sy = y + 0.5 + yy + jy * js;
             acc = rgb_add(acc, sample(c, thread, sx, sy, &r));
         }
     }

@@ -40,6 +40,7 @@ typedef struct {
     int antialias;          /* 0 off, 1 POV-Ray +A adaptive (method 1), 2 fixed supersampling */
     double aa_threshold;    /* +A0.3 -> 0.3 */
     int aa_depth;           /* +R, default 3 */
+    double aa_jitter;       /* +J amount (POV-Ray's Jitter_Amount), default 1; 0: no jitter */
     int spp;                /* fixed supersampling: samples per pixel (n x n grid rounded) */
     int max_trace_level;    /* 0 = scene's global_settings value */
     int use_ambient;        /* 1: add finish ambient * ambient_light (no GI); 0: GI supplies it */

@@ -413,6 +413,31 @@ int shade_noise_hash3d(int a, int b, int c)
     return hash_table[hash_table[hash_table[a & 0xfff] ^ (b & 0xfff)] ^ (c & 0xfff)];
 }
 
+/* Entry k of POV-Ray's 256-entry jitter table (core/math/jitter.cpp). The
+ * table is a closed form: with m = (k << 1) ^ (k << 2) (ten bits) and p the
+ * parity of k's bits, the entry is m/1024 - 1/2 when p is even and
+ * m/1024 + 2^-15 when p is odd, wrapped into [-1/2, 1/2); POV-Ray stores
+ * it printed with six decimals, so it is rounded the same way. */
+static double jitter_entry(int k)
+{
+    int m = ((k << 1) ^ (k << 2)) & 0x3ff, p = __builtin_parity((unsigned)k);
+    double v = m / 1024.0 + (p ? 1.0 / 32768.0 : -0.5);
+    if (v >= 0.5) v -= 1.0;
+    return round(v * 1e6) / 1e6;
+}
+
+/* Jitter2d of POV-Ray's jitter.h for real coordinates: each axis's offset
+ * is the table entry at a double lattice hash of the coordinates scaled by
+ * the primes 1021 and 1019 (truncated toward zero, masked to 12 bits). */
+void shade_noise_jitter2d(double x, double y, double *jx, double *jy)
+{
+    noise_init();
+    int ax = (int)(x * 1021.0), bx = (int)(y * 1019.0);
+    int ay = (int)(x * 1019.0), by = (int)(y * 1021.0);
+    *jx = jitter_entry(hash_table[(hash_table[ax & 0xfff] ^ bx) & 0xfff] & 0xff);
+    *jy = jitter_entry(hash_table[(hash_table[ay & 0xfff] ^ by) & 0xfff] & 0xff);
+}
+
 double shade_noise_pattern_rand(unsigned long i)
 {
     noise_init();

@@ -40,6 +40,10 @@ double shade_noise_triangle_wave(double x);
 
 /* POV-Ray's Hash3d lattice hash (each argument masked to 12 bits): 0..4095. */
 int shade_noise_hash3d(int a, int b, int c);
+/* POV-Ray's antialiasing jitter of the subsample at pixel coordinates
+ * (x, y): a fixed offset pair in [-0.5, 0.5], a function of the position
+ * only, so every render of a scene jitters alike. */
+void shade_noise_jitter2d(double x, double y, double *jx, double *jy);
 /* POV-Ray's PatternRands(i): 32768 uniform doubles in [0,1) (mt19937 with its
  * default seed, divided by 2^32), index taken modulo 32768. */
 double shade_noise_pattern_rand(unsigned long i);

@@ -96,7 +96,7 @@ int tu_finish(int rc, const char *dir)
 
 /* Mean absolute difference over all channels of the `f`x`f`
  * box-downsampled images (same size, sRGB-encoded values in 0..1). */
-static double tu_downsampled_mad(const framebuffer *a, const framebuffer *b, int f)
+double tu_downsampled_mad(const framebuffer *a, const framebuffer *b, int f)
 {
     int w = a->width / f, h = a->height / f;
     double sum = 0.0;

@@ -35,6 +35,10 @@ int tu_finish(int rc, const char *dir);
  * none. */
 double tu_luminance_mean(const framebuffer *fb, const unsigned char *mask);
 
+/* Mean absolute difference over all channels of a and b (same size) after
+ * an f x f box downsample of each. */
+double tu_downsampled_mad(const framebuffer *a, const framebuffer *b, int f);
+
 /* Copy `scene_path` into `dir`, render it there with Debian's povray and
  * with `partray_bin` at w x h, +A0.3, both to sRGB PNG; `decl` is NAME=VALUE
  * (passed as Declare= / -D) or NULL. Returns the 4x4-downsampled mean
