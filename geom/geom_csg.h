@@ -26,9 +26,14 @@
 
 /* Deepest CSG nesting an object may have (an error beyond it). */
 #define GEOM_CSG_MAX_DEPTH 512
-/* A merge with more leaves is rendered as a union (accel.c): each member's
- * inside tests would cost more than the internal surfaces they remove. */
-#define GEOM_CSG_MAX_MERGE 64
+/* A merge with more leaves is rendered as a union (accel.c, warned): a ray
+ * through a CSG tries every member whose keep box it crosses, and each
+ * crossing of a merge member tests the inside of its siblings, so the cost
+ * per ray grows with the leaves as in POV-Ray's own CSG. Merges of a few
+ * hundred leaves occur (grenadine.pov's liquid, 243: as a union its bubbles'
+ * and cylinders' internal surfaces band the liquid), so the bound only
+ * keeps a generated merge of many thousands from being traced leaf by leaf. */
+#define GEOM_CSG_MAX_MERGE 4096
 
 /* o, or a member of it at any level, is a mesh (depth: o's nesting level;
  * nothing deeper than GEOM_CSG_MAX_DEPTH counts). */

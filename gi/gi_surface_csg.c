@@ -177,8 +177,8 @@ static pt_status walk_tree(gi_surface *g, const scene_object *o, const scene_tex
 
 int gi_surface_csg_walk(gi_surface *g, const scene_object *o, const scene_texture *tex, pt_status *status)
 {
-    /* accel renders CSG with a mesh member, and merges of more than 64
-     * members, as unions (accel.c) */
+    /* accel renders CSG with a mesh member, and merges of more than
+     * GEOM_CSG_MAX_MERGE leaves, as unions (accel.c) */
     if (o->kind == SHAPE_UNION || geom_csg_has_mesh(o, 0) || (o->kind == SHAPE_MERGE && geom_csg_leaf_count(o, 0) > GEOM_CSG_MAX_MERGE))
         return 0;
     *status = walk_tree(g, o, tex);

@@ -1041,9 +1041,18 @@ static void test_csg(void **st)
     m8->kind = SHAPE_MERGE;
     m8->u.csg.kids[0] = msphere(s, v3(70, 0, 5), 1);
     m8->u.csg.kids[1] = msphere(s, v3(70, 0, 6), 1);
+    /* 9. a merge of 300 spheres (more leaves than grenadine.pov's liquid,
+     * 243) is one CSG too: along the row of centres only its first
+     * member's front and its last member's back are surfaces */
+    scene_object *m9 = csg(s, SHAPE_UNION, 300, 1);
+    m9->kind = SHAPE_MERGE;
+    for (int k = 0; k < 300; k++) m9->u.csg.kids[k] = msphere(s, v3(65, 0, 5 + 0.003 * k), 0.5);
     accel *a = build(s, d);
     assert_int_equal(diag_count(d), 0);
-    assert_int_equal(accel_get_stats(a).user_prims, 8);
+    assert_int_equal(accel_get_stats(a).user_prims, 9);
+    expect_hit(a, v3(65, 0, 0), v3(0, 0, 1), 4.5, v3(0, 0, -1), 1e-12, 1e-12, NULL);
+    assert_true(accel_intersect(a, v3(65, 0, 0), v3(0, 0, 1), 4.6, INFINITY, &h));
+    assert_near(h.t, 5.0 + 0.003 * 299 + 0.5, 1e-9);
     expect_hit(a, v3(70, 0, 0), v3(0, 0, 1), 4.0, v3(0, 0, -1), 1e-12, 1e-12, NULL);
     assert_true(accel_intersect(a, v3(70, 0, 0), v3(0, 0, 1), 4.5, INFINITY, &h));
     assert_near(h.t, 7.0, 1e-12);
