@@ -18,12 +18,13 @@
  * 3 none).
  *
  * Which polyform and which arrangement `pattern N` names is POV-Ray's own
- * numbering, a fact we must match: the per-cell codes (tables in
- * shade_pavement_tables.h, one row per pattern number) are measured from
+ * numbering, a fact we must match: the per-cell codes (shade/pavement_cells.txt,
+ * one row per pattern number, made into C tables at build time by
+ * shade/pavement_tables.cmake) are measured from
  * POV-Ray 3.7.0's renders of every paving by scripts/gen_pavement.py
  * (borders and corners read off 16-bit renders at several interior /
  * exterior / form settings, each code checked against the renders through
- * a copy of the cell functions below); rerun it to remake the header.
+ * a copy of the cell functions below); rerun it to remake the data file.
  * Code bits, squares: 1 top, 2 right, 4 bottom, 8 left edge is a border;
  * 0x10 top-left, 0x20 top-right, 0x40 bottom-right, 0x80 bottom-left
  * concave corner. Triangles (folded to point up, vertices L (0,0),
