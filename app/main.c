@@ -364,10 +364,8 @@ typedef struct {
     gi_keep keep;           /* particle GI of the previous frame */
     scene_camera geo_cam;   /* an animation's initial frame's camera, pointers cleared (geometry_camera) */
     int have_geo_cam;
-    pm_detp *detp;          /* --gi detp: the photon paths of the previous frame */
-    gi_vlinks *links;       /* --gi links: the vertex links of the previous frame */
-    uint64_t links_h_geom;  /* and its geometry stage hash (stage_hashes) */
-    uint64_t detp_h_geom, detp_l; /* and the stage hashes (stage_hashes) of that frame */
+    render_gi_kept *kept;   /* --gi detp, links: the work of the previous frame */
+    uint64_t kept_h_geom, kept_l; /* and the stage hashes (stage_hashes) of that frame */
 } render_run;
 
 /* A copy of fb with straight alpha: colour / alpha where alpha > 0. */
@@ -545,30 +543,20 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
                          .progress = prog, .notes = d, .cancel = &g_cancel, .reuse = reuse ? run->keep.gp : NULL,
                          .relight = relight, .keep = keep_gi, .detp_radius = o->detp_radius, .detp_full = o->detp_full,
                          .vpls = o->vpls, .vpl_cut = o->vpl_cut, .vpl_adaptive = o->vpl_adaptive};
-    if (gi == GI_DETP && plan->animated) {
-        /* the paths kept across frames: the pieces that changed are traced
-         * again (pm_detp.h); the IR's stage hashes say whether the lights
-         * changed and whether objects may have */
+    if ((gi == GI_DETP || gi == GI_LINKS) && plan->animated) {
+        /* the work kept across frames: detp traces again the pieces of its
+         * paths that changed (pm_detp.h), links links again only what
+         * moved (gi_vlinks.h); the IR's stage hashes say whether the
+         * lights changed and whether objects may have */
         uint64_t hg, hl;
         stage_hashes(sc, frame_dependent, frame, &hg, &hl);
-        int had = run->detp != NULL;
-        if (!run->detp) run->detp = render_gi_detp_new(&ss);
-        ss.detp = run->detp;
-        ss.detp_frame.lights_changed = had && (hl ^ hg) != run->detp_l;
-        ss.detp_frame.objects_may_change = !had || hg != run->detp_h_geom;
-        run->detp_h_geom = hg;
-        run->detp_l = hl ^ hg;
-    }
-    if (gi == GI_LINKS && plan->animated) {
-        /* the links kept across frames: only what moved is linked again
-         * (gi_vlinks.h) */
-        uint64_t hg, hl;
-        stage_hashes(sc, frame_dependent, frame, &hg, &hl);
-        int had = run->links != NULL;
-        if (!run->links) run->links = render_gi_links_new(&ss);
-        ss.links = run->links;
-        ss.links_objects_may_change = !had || hg != run->links_h_geom;
-        run->links_h_geom = hg;
+        int had = run->kept != NULL;
+        if (!run->kept) run->kept = render_gi_kept_new(&ss);
+        ss.kept = run->kept;
+        ss.lights_changed = had && (hl ^ hg) != run->kept_l;
+        ss.objects_may_change = !had || hg != run->kept_h_geom;
+        run->kept_h_geom = hg;
+        run->kept_l = hl ^ hg;
     }
     ss.gi_cache = gi_cache;
     ss.gi_cache_load = gi_cache && access(gi_cache, F_OK) == 0;
@@ -908,8 +896,7 @@ static int cmd_render(int argc, char **argv)
         fprintf(stderr, "partray: %d frames in %.3f s\n", nframes, timer_now() - t_start);
     for (int i = 0; i < nbases; i++) free(bases[i]);
     gi_keep_free(&run.keep);
-    pm_detp_free(run.detp);
-    gi_vlinks_free(run.links);
+    render_gi_kept_free(run.kept);
     lighting_free(&ls);
     img_ocio_close(oc);
     ini_free(ia);

@@ -12,6 +12,7 @@
  *            (reference/pm_detp.h) as the indirect hook of the Whitted pass. */
 #include "render_gi.h"
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 #include "gi.h"
@@ -24,22 +25,19 @@
 #include "shade_texture.h"
 #include "timer.h"
 
+/* The Whitted pass's settings that render_gi_opts carries under
+ * shade_settings' own names; the rest keep shade_default_settings'. */
+#define WHITTED_FIELDS(X) \
+    X(width) X(height) X(threads) X(seed) X(antialias) X(aa_threshold) X(aa_depth) X(aa_jitter) X(spp) X(cancel) \
+    X(progress) X(quality)
+
 static void fill_shade(shade_settings *ss, const render_gi_opts *o)
 {
     shade_default_settings(ss);
-    ss->width = o->width;
-    ss->height = o->height;
-    ss->threads = o->threads;
-    ss->seed = o->seed;
-    ss->antialias = o->antialias;
-    ss->aa_threshold = o->aa_threshold;
-    ss->aa_depth = o->aa_depth;
-    ss->aa_jitter = o->aa_jitter;
-    ss->spp = o->spp;
-    ss->cancel = o->cancel;
+#define COPY_FIELD(f) ss->f = o->f;
+    WHITTED_FIELDS(COPY_FIELD)
+#undef COPY_FIELD
     memcpy(ss->window, o->window, sizeof ss->window);
-    ss->progress = o->progress;
-    ss->quality = o->quality;
 }
 
 /* The AOV pass (shade_aov.h) with the Whitted settings of the render and,
@@ -196,7 +194,40 @@ static pt_status render_with_hook(const scene *sc, const accel *a, const render_
     return st == PT_CANCELLED ? PT_OK : st;
 }
 
-pm_detp *render_gi_detp_new(const render_gi_opts *o)
+/* A mode whose work may outlive the frame and lights the Whitted pass
+ * through a hook (detp, links): how to make, drive and free its state. */
+typedef struct {
+    void *(*make)(const render_gi_opts *o);
+    void (*set_progress)(void *g, progress *p);
+    /* the mode's own frame, its figures into r (before the Whitted pass) */
+    pt_status (*frame)(void *g, const scene *sc, const accel *a, const render_gi_opts *o, render_gi_result *r, diag *d);
+    shade_indirect_fn indirect;
+    void (*after)(void *g, render_gi_result *r); /* figures of the pass (lookups) */
+    void (*free)(void *g);
+} hook_mode;
+
+struct render_gi_kept {
+    const hook_mode *m;
+    void *g;
+};
+
+/* One frame of a hook mode: with the caller's state (kept, from the
+ * previous frame; the caller frees it) or one made and freed here. */
+static pt_status render_hook_mode(const hook_mode *m, const scene *sc, const accel *a, const render_gi_opts *o,
+                                  framebuffer *fb, render_gi_result *r, diag *d)
+{
+    void *g = o->kept ? o->kept->g : m->make(o);
+    if (!g) return PT_ERR_NOMEM;
+    m->set_progress(g, o->progress);
+    pt_status st = m->frame(g, sc, a, o, r, d);
+    st = render_with_hook(sc, a, o, fb, r, d, st, m->indirect, g);
+    m->after(g, r);
+    m->set_progress(g, NULL); /* o->progress ends with this render */
+    if (!o->kept) m->free(g);
+    return st;
+}
+
+static void *detp_make(const render_gi_opts *o)
 {
     pm_detp_settings s;
     pm_detp_default_settings(&s);
@@ -209,53 +240,77 @@ pm_detp *render_gi_detp_new(const render_gi_opts *o)
     return pm_detp_new(&s);
 }
 
-static pt_status render_detp(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
-                             render_gi_result *r, diag *d)
+static pt_status detp_frame(void *g, const scene *sc, const accel *a, const render_gi_opts *o, render_gi_result *r,
+                            diag *d)
 {
-    pm_detp *dp = o->detp ? o->detp : render_gi_detp_new(o);
-    if (!dp) return PT_ERR_NOMEM;
-    pm_detp_set_progress(dp, o->progress);
     r->has_detp = 1;
-    pt_status st = pm_detp_frame(dp, sc, a, o->width, o->height, &o->detp_frame, &r->detp, d);
+    const pm_detp_frame_info fi = {.lights_changed = o->lights_changed, .objects_may_change = o->objects_may_change};
+    pt_status st = pm_detp_frame(g, sc, a, o->width, o->height, &fi, &r->detp, d);
     r->t_gi_geometry = r->detp.t_trace;
     r->t_gi_lighting = r->detp.t_estimate;
-    st = render_with_hook(sc, a, o, fb, r, d, st, pm_detp_indirect, dp);
-    pm_detp_lookups(dp, &r->detp.lookups, &r->detp.lookups_none);
-    pm_detp_set_progress(dp, NULL);
-    if (!o->detp) pm_detp_free(dp);
     return st;
 }
 
-gi_vlinks *render_gi_links_new(const render_gi_opts *o)
+static void detp_progress(void *g, progress *p) { pm_detp_set_progress(g, p); }
+static void detp_after(void *g, render_gi_result *r) { pm_detp_lookups(g, &r->detp.lookups, &r->detp.lookups_none); }
+static void detp_free(void *g) { pm_detp_free(g); }
+static const hook_mode detp_mode = {detp_make, detp_progress, detp_frame, pm_detp_indirect, detp_after, detp_free};
+
+void render_gi_links_settings(gi_vlinks_settings *s, int threads, int bounces)
+{
+    gi_vlinks_default_settings(s);
+    s->pigment = shade_tex_pigment_at;
+    s->threads = threads;
+    if (bounces > 0) s->bounces = bounces;
+}
+
+static void *links_make(const render_gi_opts *o)
 {
     gi_vlinks_settings s;
-    gi_vlinks_default_settings(&s);
-    if (o->bounces > 0) s.bounces = o->bounces;
-    s.threads = o->threads;
+    render_gi_links_settings(&s, o->threads, o->bounces);
     s.cancel = o->cancel;
-    s.pigment = shade_tex_pigment_at; /* vertices reflect the pigment where they are */
     return gi_vlinks_new(&s);
 }
 
-static pt_status render_links(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
-                              render_gi_result *r, diag *d)
+static pt_status links_frame(void *g, const scene *sc, const accel *a, const render_gi_opts *o, render_gi_result *r,
+                             diag *d)
 {
-    gi_vlinks *v = o->links ? o->links : render_gi_links_new(o);
-    if (!v) return PT_ERR_NOMEM;
-    gi_vlinks_set_progress(v, o->progress);
     r->has_links = 1;
-    pt_status st = gi_vlinks_frame(v, sc, a, o->links ? o->links_objects_may_change : 1, &r->links, d);
+    pt_status st = gi_vlinks_frame(g, sc, a, o->kept ? o->objects_may_change : 1, &r->links, d);
     if (st == PT_OK && r->links.other_objects > 0)
         diag_report(d, DIAG_WARNING, (src_loc){0}, NULL,
                     "--gi links: %ld objects are not meshes: they block light but neither receive nor pass on indirect light",
                     r->links.other_objects);
     r->t_gi_geometry = r->links.t_links;
     r->t_gi_lighting = r->links.t_light + r->links.t_bounces + r->links.t_smooth;
-    st = render_with_hook(sc, a, o, fb, r, d, st, gi_vlinks_indirect, v);
-    r->links.lookups_other = gi_vlinks_lookups_other(v);
-    gi_vlinks_set_progress(v, NULL);
-    if (!o->links) gi_vlinks_free(v);
     return st;
+}
+
+static void links_progress(void *g, progress *p) { gi_vlinks_set_progress(g, p); }
+static void links_after(void *g, render_gi_result *r) { r->links.lookups_other = gi_vlinks_lookups_other(g); }
+static void links_free(void *g) { gi_vlinks_free(g); }
+static const hook_mode links_mode = {links_make, links_progress, links_frame, gi_vlinks_indirect, links_after,
+                                     links_free};
+
+render_gi_kept *render_gi_kept_new(const render_gi_opts *o)
+{
+    const hook_mode *m = o->mode == GI_DETP ? &detp_mode : o->mode == GI_LINKS ? &links_mode : NULL;
+    render_gi_kept *k = m ? malloc(sizeof *k) : NULL;
+    if (!k) return NULL;
+    k->m = m;
+    k->g = m->make(o);
+    if (!k->g) {
+        free(k);
+        return NULL;
+    }
+    return k;
+}
+
+void render_gi_kept_free(render_gi_kept *k)
+{
+    if (!k) return;
+    k->m->free(k->g);
+    free(k);
 }
 
 typedef struct {
@@ -414,9 +469,9 @@ pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, fr
     pt_status st;
     switch (o->mode) {
     case GI_PARTICLE: st = render_particle(sc, a, o, fb, r, d); break;
-    case GI_DETP: st = render_detp(sc, a, o, fb, r, d); break;
+    case GI_DETP: st = render_hook_mode(&detp_mode, sc, a, o, fb, r, d); break;
     case GI_VPL: return render_vpl_mode(sc, a, o, fb, r, d);
-    case GI_LINKS: st = render_links(sc, a, o, fb, r, d); break;
+    case GI_LINKS: st = render_hook_mode(&links_mode, sc, a, o, fb, r, d); break;
     case GI_PMFG:
     case GI_PATH: return render_reference(sc, a, o, fb, r, d);
     default: st = render_none(sc, a, o, fb, r, d); break;

@@ -18,6 +18,8 @@
 #include "shade_aov.h"
 #include "stats_json.h"
 
+typedef struct render_gi_kept render_gi_kept;
+
 typedef struct {
     int mode;                 /* gi_mode */
     int width, height, threads;
@@ -49,15 +51,13 @@ typedef struct {
     gi_particle *reuse;
     int relight;
     int keep;
-    /* detp: the photon paths kept from the previous frame (render_gi_detp_new;
-     * NULL: a still, made and freed here) and what changed since */
-    pm_detp *detp;
-    pm_detp_frame_info detp_frame;
+    /* detp, links: the mode's work kept from the previous frame
+     * (render_gi_kept_new; NULL: a still, made and freed here) and what
+     * changed since (links relights every frame: it reads only
+     * objects_may_change, and takes every object as moved without kept) */
+    render_gi_kept *kept;
+    int lights_changed, objects_may_change;
     double detp_radius;       /* detp: disc radius (0 = default) */
-    /* links: the vertex links kept from the previous frame (render_gi_links_new;
-     * NULL: a still, made and freed here); objects may have changed since */
-    gi_vlinks *links;
-    int links_objects_may_change;
     int detp_full;            /* detp: recompute every frame */
     /* particle: the geometry stage's file (gi_particle_save/_load), NULL:
      * none. gi_cache_load: read it (a mismatch or a bad file is the
@@ -114,12 +114,15 @@ typedef struct {
 
 pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb, render_gi_result *r,
                     diag *d);
-/* The DETP state for the frames of one animation, with o's settings
- * (photons, radius, seed, threads, full); NULL on no memory. */
-pm_detp *render_gi_detp_new(const render_gi_opts *o);
-/* The vertex links' state for the frames of one animation, with o's
- * settings (bounces, threads); NULL on no memory. */
-gi_vlinks *render_gi_links_new(const render_gi_opts *o);
+/* The work of o->mode kept for the frames of one animation, with o's
+ * settings (detp: its photon paths, from photons, radius, seed, threads,
+ * full; links: its vertex links, from bounces, threads); NULL for another
+ * mode or on no memory. */
+render_gi_kept *render_gi_kept_new(const render_gi_opts *o);
+void render_gi_kept_free(render_gi_kept *k);
+/* The vertex links' settings of a render or a viewer session (bounces 0:
+ * the default): vertices reflect the pigment where they are. */
+void render_gi_links_settings(gi_vlinks_settings *s, int threads, int bounces);
 /* Adds the method-specific object ("particle": {...}, "reference": {...}). */
 void render_gi_json(const render_gi_result *r, int mode, stats_json *js);
 

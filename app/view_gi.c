@@ -13,12 +13,17 @@
 #include "pm_fg.h"
 #include "radrules.h"
 #include "pm_path.h"
+#include "render_gi.h"
 
+/* A mode's state (ctx) is ctx_size bytes that view_gi_open allocates
+ * zeroed and view_gi_close frees: open fills it (and may leave it half
+ * filled when it fails), close (NULL: nothing to do) frees what it holds. */
 typedef struct {
     int mode;
     int slow_light;   /* the lighting stage is slow: a pass with the new lights and the old GI first */
+    size_t ctx_size;
     int (*last_level)(const view_gi_opts *o);
-    pt_status (*open)(void **ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d);
+    pt_status (*open)(void *ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d);
     pt_status (*relight)(void *ctx, volatile int *cancel, view_gi_times *t, diag *d);
     int (*has_preview)(void *ctx); /* NULL: no preview lighting */
     pt_status (*relight_preview)(void *ctx, volatile int *cancel, view_gi_times *t, diag *d);
@@ -89,13 +94,11 @@ static pt_status whitted_render(const scene *sc, const accel *a, const view_gi_p
 
 static int whitted_last_level(const view_gi_opts *o) { (void)o; return 2; }
 
-static pt_status none_open(void **ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
+static pt_status none_open(void *ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
 {
-    none_ctx *c = calloc(1, sizeof *c);
-    if (!c) return PT_ERR_NOMEM;
+    none_ctx *c = ctx;
     c->sc = sc;
     c->a = a;
-    *ctx = c;
     return PT_OK;
 }
 
@@ -116,8 +119,6 @@ static void none_describe(void *ctx, char *buf, int n)
     snprintf(buf, (size_t)n, "%.2f Mrays", c->rays * 1e-6);
 }
 
-static void none_close(void *ctx) { free(ctx); }
-
 /* -------------------------------------------------------------- particle */
 /* Two instances on the same scene copy: the mode's own (the scene's or
  * --particles count) and a preview one with 1/8 of the particles and at
@@ -134,10 +135,9 @@ typedef struct {
     double t_light_q;      /* its last lighting stage */
 } particle_ctx;
 
-static pt_status particle_open(void **ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
+static pt_status particle_open(void *ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
 {
-    particle_ctx *c = calloc(1, sizeof *c);
-    if (!c) return PT_ERR_NOMEM;
+    particle_ctx *c = ctx;
     c->sc = sc;
     c->a = a;
     gi_particle_settings s;
@@ -150,16 +150,11 @@ static pt_status particle_open(void **ctx, const scene *sc, const accel *a, cons
     if (o->cl_device) s.cl_device = o->cl_device;
     pt_status st = PT_OK;
     c->gp = gi_particle_build(sc, a, &s, &c->stats, d, &st);
-    if (!c->gp || st != PT_OK) {
-        gi_particle_free(c->gp);
-        free(c);
-        return st != PT_OK ? st : PT_ERR_INTERNAL;
-    }
+    if (!c->gp || st != PT_OK) return st != PT_OK ? st : PT_ERR_INTERNAL;
     st = gi_particle_light(c->gp, d);
     const gi_particle_stats *gs = gi_particle_get_stats(c->gp);
     t->build = gs->t_geometry;
     t->light = gs->t_lighting;
-    *ctx = c;
     if (st != PT_OK) return st;
     long nq = o->preview_particles > 0 ? o->preview_particles : s.count / 8;
     if (o->preview_particles >= 0 && nq >= 500 && nq <= s.count / 2) {
@@ -236,10 +231,8 @@ static void particle_describe(void *ctx, char *buf, int n)
 static void particle_close(void *ctx)
 {
     particle_ctx *c = ctx;
-    if (!c) return;
     gi_particle_free(c->gp);
     gi_particle_free(c->gpq);
-    free(c);
 }
 
 /* ----------------------------------------------------------------- links */
@@ -289,23 +282,15 @@ static pt_status links_run(links_ctx *c, int objects_may_change, volatile int *c
     return s == PT_CANCELLED ? PT_OK : s;
 }
 
-static pt_status links_open(void **ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
+static pt_status links_open(void *ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
 {
-    links_ctx *c = calloc(1, sizeof *c);
-    if (!c) return PT_ERR_NOMEM;
+    links_ctx *c = ctx;
     c->sc = sc;
     c->a = a;
     gi_vlinks_settings s;
-    gi_vlinks_default_settings(&s);
-    s.threads = o->threads;
-    if (o->bounces > 0) s.bounces = o->bounces;
-    s.pigment = shade_tex_pigment_at; /* vertices reflect the pigment where they are */
+    render_gi_links_settings(&s, o->threads, o->bounces);
     c->v = gi_vlinks_new(&s);
-    if (!c->v) {
-        free(c);
-        return PT_ERR_NOMEM;
-    }
-    *ctx = c;
+    if (!c->v) return PT_ERR_NOMEM;
     return links_run(c, 1, NULL, t, d);
 }
 
@@ -353,11 +338,9 @@ static void links_describe(void *ctx, char *buf, int n)
 static void links_close(void *ctx)
 {
     links_ctx *c = ctx;
-    if (!c) return;
     gi_vlinks_shot_free(c->shot);
     gi_vlinks_shot_free(c->next_shot);
     gi_vlinks_free(c->v);
-    free(c);
 }
 
 /* ------------------------------------------------- reference previews */
@@ -385,24 +368,22 @@ static int ref_last_level(const view_gi_opts *o)
     return L;
 }
 
-static pt_status ref_open(void **ctx, const scene *sc, const accel *a, int mode, const view_gi_opts *o)
+static pt_status ref_open(void *ctx, const scene *sc, const accel *a, int mode, const view_gi_opts *o)
 {
-    ref_ctx *c = calloc(1, sizeof *c);
-    if (!c) return PT_ERR_NOMEM;
+    ref_ctx *c = ctx;
     c->sc = sc;
     c->a = a;
     c->mode = mode;
     c->photons = o->ref_photons > 0 ? o->ref_photons : 50000;
-    *ctx = c;
     return PT_OK;
 }
 
-static pt_status path_open(void **ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
+static pt_status path_open(void *ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
 {
     return ref_open(ctx, sc, a, GI_PATH, o);
 }
 
-static pt_status pmfg_open(void **ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
+static pt_status pmfg_open(void *ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
 {
     return ref_open(ctx, sc, a, GI_PMFG, o);
 }
@@ -479,24 +460,19 @@ static void ref_describe(void *ctx, char *buf, int n)
         snprintf(buf, (size_t)n, "reference preview, %d spp", c->spp);
 }
 
-static void ref_close(void *ctx)
-{
-    ref_ctx *c = ctx;
-    if (!c) return;
-    fb_free(c->sum);
-    free(c);
-}
+static void ref_close(void *ctx) { fb_free(((ref_ctx *)ctx)->sum); }
 
 /* ----------------------------------------------------------------- table */
 
 static const gi_backend backends[] = {
-    {GI_NONE, 0, whitted_last_level, none_open, none_relight, NULL, NULL, none_render, none_describe, none_close},
-    {GI_PARTICLE, 1, whitted_last_level, particle_open, particle_relight, particle_has_preview, particle_relight_preview,
-     particle_render, particle_describe, particle_close},
-    {GI_LINKS, 0, whitted_last_level, links_open, links_relight, NULL, NULL, links_render, links_describe, links_close,
-     links_reframe, links_adopt},
-    {GI_PATH, 0, ref_last_level, path_open, ref_relight, NULL, NULL, ref_render, ref_describe, ref_close},
-    {GI_PMFG, 0, ref_last_level, pmfg_open, ref_relight, NULL, NULL, ref_render, ref_describe, ref_close},
+    {GI_NONE, 0, sizeof(none_ctx), whitted_last_level, none_open, none_relight, NULL, NULL, none_render, none_describe,
+     NULL},
+    {GI_PARTICLE, 1, sizeof(particle_ctx), whitted_last_level, particle_open, particle_relight, particle_has_preview,
+     particle_relight_preview, particle_render, particle_describe, particle_close},
+    {GI_LINKS, 0, sizeof(links_ctx), whitted_last_level, links_open, links_relight, NULL, NULL, links_render,
+     links_describe, links_close, links_reframe, links_adopt},
+    {GI_PATH, 0, sizeof(ref_ctx), ref_last_level, path_open, ref_relight, NULL, NULL, ref_render, ref_describe, ref_close},
+    {GI_PMFG, 0, sizeof(ref_ctx), ref_last_level, pmfg_open, ref_relight, NULL, NULL, ref_render, ref_describe, ref_close},
 };
 enum { NBACKENDS = (int)(sizeof backends / sizeof backends[0]) };
 
@@ -542,14 +518,18 @@ pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a,
     if (sc->nlights > 0) memcpy(g->lights, sc->lights, (size_t)sc->nlights * sizeof *g->lights);
     g->sc.lights = g->lights;
     g->sc.cap_lights = sc->nlights;
+    g->ctx = calloc(1, b->ctx_size);
+    if (!g->ctx) {
+        free(g->lights);
+        free(g);
+        return PT_ERR_NOMEM;
+    }
     double t0 = timer_now();
-    pt_status st = b->open(&g->ctx, &g->sc, a, o, t, d);
+    pt_status st = b->open(g->ctx, &g->sc, a, o, t, d);
     if (t->build == 0 && t->light == 0) t->build = timer_now() - t0;
     g->t_light = t->light;
     if (st != PT_OK) {
-        if (g->ctx) b->close(g->ctx);
-        free(g->lights);
-        free(g);
+        view_gi_close(g);
         return st;
     }
     *out = g;
@@ -650,7 +630,8 @@ void view_gi_adopt(view_gi *g)
 void view_gi_close(view_gi *g)
 {
     if (!g) return;
-    g->b->close(g->ctx);
+    if (g->b->close) g->b->close(g->ctx);
+    free(g->ctx);
     free(g->lights);
     free(g->next_lights);
     free(g);
