@@ -20,10 +20,38 @@ xform xform_matrix(const double v[12]);
 xform xform_then(xform a, xform b);
 xform xform_inverse(xform a);
 int xform_is_identity(const xform *a);
-vec3 xform_point(const xform *a, vec3 p);
-vec3 xform_vector(const xform *a, vec3 v);
-vec3 xform_normal(const xform *a, vec3 n); /* inverse-transpose, not normalised */
-vec3 xform_inv_point(const xform *a, vec3 p);
-vec3 xform_inv_vector(const xform *a, vec3 v);
+/* inline: they run per ray and per inside test of every transformed shape */
+static inline vec3 xform_point(const xform *a, vec3 p)
+{
+    return v3(a->m[0][0] * p.x + a->m[0][1] * p.y + a->m[0][2] * p.z + a->m[0][3],
+              a->m[1][0] * p.x + a->m[1][1] * p.y + a->m[1][2] * p.z + a->m[1][3],
+              a->m[2][0] * p.x + a->m[2][1] * p.y + a->m[2][2] * p.z + a->m[2][3]);
+}
+static inline vec3 xform_vector(const xform *a, vec3 v)
+{
+    return v3(a->m[0][0] * v.x + a->m[0][1] * v.y + a->m[0][2] * v.z,
+              a->m[1][0] * v.x + a->m[1][1] * v.y + a->m[1][2] * v.z,
+              a->m[2][0] * v.x + a->m[2][1] * v.y + a->m[2][2] * v.z);
+}
+/* inverse-transpose, not normalised */
+static inline vec3 xform_normal(const xform *a, vec3 n)
+{
+    /* (M^-1)^T n */
+    return v3(a->inv[0][0] * n.x + a->inv[1][0] * n.y + a->inv[2][0] * n.z,
+              a->inv[0][1] * n.x + a->inv[1][1] * n.y + a->inv[2][1] * n.z,
+              a->inv[0][2] * n.x + a->inv[1][2] * n.y + a->inv[2][2] * n.z);
+}
+static inline vec3 xform_inv_point(const xform *a, vec3 p)
+{
+    return v3(a->inv[0][0] * p.x + a->inv[0][1] * p.y + a->inv[0][2] * p.z + a->inv[0][3],
+              a->inv[1][0] * p.x + a->inv[1][1] * p.y + a->inv[1][2] * p.z + a->inv[1][3],
+              a->inv[2][0] * p.x + a->inv[2][1] * p.y + a->inv[2][2] * p.z + a->inv[2][3]);
+}
+static inline vec3 xform_inv_vector(const xform *a, vec3 v)
+{
+    return v3(a->inv[0][0] * v.x + a->inv[0][1] * v.y + a->inv[0][2] * v.z,
+              a->inv[1][0] * v.x + a->inv[1][1] * v.y + a->inv[1][2] * v.z,
+              a->inv[2][0] * v.x + a->inv[2][1] * v.y + a->inv[2][2] * v.z);
+}
 
 #endif

@@ -119,6 +119,13 @@ static int init_shape(geom_shape *sh, const scene_object *o, int meshes)
         if (!(l > 0.0) || !finite_d(l) || !finite_d(o->u.plane.offset)) return -1;
         sh->g.plane.n = v3_scale(n, 1.0 / l);
         sh->g.plane.d = o->u.plane.offset / l;
+        /* object q = inv (p) + inv_t: n.q = (M^-T n).p + n.inv_t */
+        vec3 on = sh->g.plane.n;
+        sh->g.plane.wn = sh->identity ? on : xform_normal(&sh->x, on);
+        sh->g.plane.wd = sh->identity ? sh->g.plane.d
+                                      : sh->g.plane.d - (on.x * sh->x.inv[0][3] + on.y * sh->x.inv[1][3] +
+                                                         on.z * sh->x.inv[2][3]);
+        if (!(v3_len2(sh->g.plane.wn) > 0.0) || !v3_finite(sh->g.plane.wn) || !finite_d(sh->g.plane.wd)) return -1;
         /* bounds come from geom_shape_clip_plane */
         sh->lo = v3s(-1.0);
         sh->hi = v3s(1.0);
@@ -395,12 +402,13 @@ static int in_box(vec3 p, vec3 lo, vec3 hi)
     return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
 }
 
-static int hits_plane(const geom_shape *sh, vec3 o, vec3 d, vec3 worg, vec3 wdir, double tmin, double tmax,
-                      geom_shape_hit *out, int max)
+/* In world space (the ray's parameter is the same in object space). */
+static int hits_plane(const geom_shape *sh, vec3 worg, vec3 wdir, double tmin, double tmax, geom_shape_hit *out,
+                      int max)
 {
-    double den = v3_dot(sh->g.plane.n, d);
+    double den = v3_dot(sh->g.plane.wn, wdir);
     if (den == 0.0) return 0;
-    double t = (sh->g.plane.d - v3_dot(sh->g.plane.n, o)) / den;
+    double t = (sh->g.plane.wd - v3_dot(sh->g.plane.wn, worg)) / den;
     if (!in_range(t, tmin, tmax)) return 0;
     if (sh->clipped && !in_box(v3_madd(worg, wdir, t), sh->clip_lo, sh->clip_hi)) return 0;
     return geom_shape_hit_put(out, 0, max, t, 0);
@@ -594,6 +602,7 @@ static int shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, dou
                       int max, int traced)
 {
     if (max <= 0) return 0;
+    if (sh->kind == SHAPE_PLANE) return v3_len2(dir) == 0.0 ? 0 : hits_plane(sh, org, dir, tmin, tmax, out, max);
     vec3 o = org, d = dir;
     if (!sh->identity) {
         o = xform_inv_point(&sh->x, org);
@@ -603,7 +612,6 @@ static int shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, dou
     switch (sh->kind) {
     case SHAPE_SPHERE: return hits_sphere(sh, o, d, tmin, tmax, out, max);
     case SHAPE_BOX: return hits_box(sh, o, d, tmin, tmax, out, max);
-    case SHAPE_PLANE: return hits_plane(sh, o, d, org, dir, tmin, tmax, out, max);
     case SHAPE_CYLINDER:
     case SHAPE_CONE: return hits_cone(sh, o, d, tmin, tmax, out, max);
     case SHAPE_DISC: return hits_disc(sh, o, d, tmin, tmax, out, max);
@@ -726,6 +734,7 @@ int geom_shape_intersect(const geom_shape *sh, vec3 org, vec3 dir, double tmin, 
 
 int geom_shape_inside(const geom_shape *sh, vec3 p)
 {
+    if (sh->kind == SHAPE_PLANE) return v3_dot(sh->g.plane.wn, p) < sh->g.plane.wd;
     vec3 q = sh->identity ? p : xform_inv_point(&sh->x, p);
     switch (sh->kind) {
     case SHAPE_SPHERE:
@@ -733,8 +742,6 @@ int geom_shape_inside(const geom_shape *sh, vec3 p)
     case SHAPE_BOX:
         return q.x > sh->g.box.lo.x && q.x < sh->g.box.hi.x && q.y > sh->g.box.lo.y && q.y < sh->g.box.hi.y &&
                q.z > sh->g.box.lo.z && q.z < sh->g.box.hi.z;
-    case SHAPE_PLANE:
-        return v3_dot(sh->g.plane.n, q) < sh->g.plane.d;
     case SHAPE_CYLINDER:
     case SHAPE_CONE: {
         /* the closed solid, also for `open` ones */

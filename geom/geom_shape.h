@@ -29,7 +29,11 @@ typedef struct {
     union {
         struct { vec3 c; double r; } sphere;
         struct { vec3 lo, hi; } box;
-        struct { vec3 n; double d; } plane;      /* unit n, n.p = d */
+        /* unit n, n.p = d in object space; the same plane in world space
+         * is wn.p = wd (wn = M^-T n, not unit), which rays and inside
+         * tests use without carrying the point to object space, as
+         * POV-Ray's Plane::Transform folds the transform into the plane */
+        struct { vec3 n; double d; vec3 wn; double wd; } plane;
         struct { vec3 base, u, v, w; double h, r0, r1, k; } cone; /* frame: w along the axis */
         struct { vec3 c, n; double r2, h2; } disc; /* unit n, squared radii */
         struct { double R, r; } torus;           /* in the xz plane, axis y */
