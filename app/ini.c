@@ -39,43 +39,46 @@ struct ini_args {
 
 typedef enum { K_INT, K_FLOAT, K_BOOL, K_STR, K_DECLARE, K_FTYPE, K_INPUT, K_IGNORED } key_kind;
 
-/* `fmt` makes the switch from the value (%d, %.17g, %s); bools use `fmt`
- * when true and `off` when false. */
+/* A key and the switch it becomes. The kind says how: K_INT sw then the
+ * value (%d), K_FLOAT sw then %.17g, K_BOOL +sw when true and -sw when
+ * false, K_STR and K_INPUT sw then the text; K_FTYPE (+F) and K_DECLARE
+ * (-D) check and rewrite the value. */
 typedef struct {
-    const char *key;
     key_kind kind;
-    const char *fmt, *off;
+    const char *sw;
 } ini_key;
 
-static const ini_key keys[] = {
-    {"Width", K_INT, "+W%d", NULL},
-    {"Height", K_INT, "+H%d", NULL},
-    {"Antialias", K_BOOL, "+A", "-A"},
-    {"Antialias_Threshold", K_FLOAT, "--aa-threshold=%.17g", NULL},
-    {"Antialias_Depth", K_INT, "+R%d", NULL},
-    {"Jitter", K_BOOL, "+J", "-J"},
-    {"Jitter_Amount", K_FLOAT, "+J%.17g", NULL},
-    {"Clock", K_FLOAT, "+K%.17g", NULL},
-    {"Initial_Frame", K_INT, "+KFI%d", NULL},
-    {"Final_Frame", K_INT, "+KFF%d", NULL},
-    {"Initial_Clock", K_FLOAT, "+KI%.17g", NULL},
-    {"Final_Clock", K_FLOAT, "+KF%.17g", NULL},
-    {"Subset_Start_Frame", K_FLOAT, "+SF%.17g", NULL},
-    {"Subset_End_Frame", K_FLOAT, "+EF%.17g", NULL},
-    {"Cyclic_Animation", K_BOOL, "+KC", "-KC"},
-    {"Start_Column", K_FLOAT, "+SC%.17g", NULL},
-    {"End_Column", K_FLOAT, "+EC%.17g", NULL},
-    {"Start_Row", K_FLOAT, "+SR%.17g", NULL},
-    {"End_Row", K_FLOAT, "+ER%.17g", NULL},
-    {"Library_Path", K_STR, "+L%s", NULL},
-    {"Input_File_Name", K_INPUT, "+I%s", NULL},
-    {"Output_File_Name", K_STR, "+O%s", NULL},
-    {"Output_File_Type", K_FTYPE, "+F%s", NULL},
-    {"Declare", K_DECLARE, "-D%s", NULL},
-    {"Quality", K_INT, "+Q%d", NULL},
-    {"Output_Alpha", K_BOOL, "+UA", "-UA"},
-    {"Work_Threads", K_INT, "+WT%d", NULL},
+typedef struct {
+    const char *key, *sw;
+} key_switch;
+
+static const key_switch int_keys[] = {
+    {"Width", "+W"}, {"Height", "+H"}, {"Antialias_Depth", "+R"}, {"Initial_Frame", "+KFI"}, {"Final_Frame", "+KFF"},
+    {"Quality", "+Q"}, {"Work_Threads", "+WT"},
 };
+static const key_switch float_keys[] = {
+    {"Antialias_Threshold", "--aa-threshold="}, {"Jitter_Amount", "+J"}, {"Clock", "+K"}, {"Initial_Clock", "+KI"},
+    {"Final_Clock", "+KF"}, {"Subset_Start_Frame", "+SF"}, {"Subset_End_Frame", "+EF"}, {"Start_Column", "+SC"},
+    {"End_Column", "+EC"}, {"Start_Row", "+SR"}, {"End_Row", "+ER"},
+};
+static const key_switch bool_keys[] = {
+    {"Antialias", "A"}, {"Jitter", "J"}, {"Cyclic_Animation", "KC"}, {"Output_Alpha", "UA"},
+};
+static const key_switch str_keys[] = {{"Library_Path", "+L"}, {"Output_File_Name", "+O"}};
+static const key_switch input_keys[] = {{"Input_File_Name", "+I"}};
+static const key_switch ftype_keys[] = {{"Output_File_Type", "+F"}};
+static const key_switch declare_keys[] = {{"Declare", "-D"}};
+
+#define KEYS_OF(kind, t) {kind, t, sizeof t / sizeof t[0]}
+static const struct {
+    key_kind kind;
+    const key_switch *keys;
+    size_t n;
+} key_tables[] = {
+    KEYS_OF(K_INT, int_keys), KEYS_OF(K_FLOAT, float_keys), KEYS_OF(K_BOOL, bool_keys), KEYS_OF(K_STR, str_keys),
+    KEYS_OF(K_INPUT, input_keys), KEYS_OF(K_FTYPE, ftype_keys), KEYS_OF(K_DECLARE, declare_keys),
+};
+#undef KEYS_OF
 
 /* POV-Ray 3.7's other INI keys: accepted, warned about as not used. */
 static const char *const pov_keys[] = {
@@ -98,14 +101,26 @@ static const char *const pov_keys[] = {
     "Warning_Level",
 };
 
-static const ini_key *find_key(const char *k, size_t n)
+static int key_is(const char *name, const char *k, size_t n)
 {
-    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
-        if (strlen(keys[i].key) == n && strncasecmp(keys[i].key, k, n) == 0) return &keys[i];
-    static const ini_key ignored = {NULL, K_IGNORED, NULL, NULL};
+    return strlen(name) == n && strncasecmp(name, k, n) == 0;
+}
+
+/* The key k (n bytes); 0 when partray does not know it. */
+static int find_key(const char *k, size_t n, ini_key *out)
+{
+    for (size_t t = 0; t < sizeof key_tables / sizeof key_tables[0]; t++)
+        for (size_t i = 0; i < key_tables[t].n; i++)
+            if (key_is(key_tables[t].keys[i].key, k, n)) {
+                *out = (ini_key){key_tables[t].kind, key_tables[t].keys[i].sw};
+                return 1;
+            }
     for (size_t i = 0; i < sizeof pov_keys / sizeof pov_keys[0]; i++)
-        if (strlen(pov_keys[i]) == n && strncasecmp(pov_keys[i], k, n) == 0) return &ignored;
-    return NULL;
+        if (key_is(pov_keys[i], k, n)) {
+            *out = (ini_key){K_IGNORED, NULL};
+            return 1;
+        }
+    return 0;
 }
 
 ini_args *ini_args_new(void) { return calloc(1, sizeof(ini_args)); }
@@ -165,7 +180,8 @@ static int parse_bool(const char *v, int *out)
 /* One option `key` = `val` (val starts at column vcol). */
 static pt_status option(reader *r, const char *k, size_t kn, int kcol, const char *val, int vcol)
 {
-    const ini_key *key = find_key(k, kn);
+    ini_key keyv;
+    const ini_key *key = find_key(k, kn, &keyv) ? &keyv : NULL;
     char name[64];
     snprintf(name, sizeof name, "%.*s", (int)(kn < 60 ? kn : 60), k);
     if (!key) {
@@ -187,7 +203,7 @@ static pt_status option(reader *r, const char *k, size_t kn, int kcol, const cha
             err_at(r, vcol, "'%s' wants an integer", name);
             return PT_ERR_USAGE;
         }
-        snprintf(sw, sizeof sw, key->fmt, (int)v);
+        snprintf(sw, sizeof sw, "%s%d", key->sw, (int)v);
         break;
     }
     case K_FLOAT: {
@@ -196,7 +212,7 @@ static pt_status option(reader *r, const char *k, size_t kn, int kcol, const cha
             err_at(r, vcol, "'%s' wants a number", name);
             return PT_ERR_USAGE;
         }
-        snprintf(sw, sizeof sw, key->fmt, v);
+        snprintf(sw, sizeof sw, "%s%.17g", key->sw, v);
         break;
     }
     case K_BOOL: {
@@ -205,7 +221,7 @@ static pt_status option(reader *r, const char *k, size_t kn, int kcol, const cha
             err_at(r, vcol, "'%s' wants on/off, true/false, yes/no or 1/0", name);
             return PT_ERR_USAGE;
         }
-        snprintf(sw, sizeof sw, "%s", b ? key->fmt : key->off);
+        snprintf(sw, sizeof sw, "%c%s", b ? '+' : '-', key->sw);
         break;
     }
     case K_STR:
@@ -214,7 +230,7 @@ static pt_status option(reader *r, const char *k, size_t kn, int kcol, const cha
             err_at(r, vcol, "'%s' wants a value", name);
             return PT_ERR_USAGE;
         }
-        snprintf(sw, sizeof sw, key->fmt, key->kind == K_INPUT ? beside(r, val, buf, sizeof buf) : val);
+        snprintf(sw, sizeof sw, "%s%s", key->sw, key->kind == K_INPUT ? beside(r, val, buf, sizeof buf) : val);
         break;
     case K_FTYPE: {
         /* N png, E exr; POV-Ray's other types (T, C, P, J, B, H, S) are
@@ -229,7 +245,7 @@ static pt_status option(reader *r, const char *k, size_t kn, int kcol, const cha
                         "Output_File_Type %c: partray writes PNG (N), OpenEXR (E) or PFM; PNG used", t);
             t = 'N';
         }
-        snprintf(sw, sizeof sw, "+F%c", t);
+        snprintf(sw, sizeof sw, "%s%c", key->sw, t);
         break;
     }
     case K_DECLARE: {
@@ -244,14 +260,14 @@ static pt_status option(reader *r, const char *k, size_t kn, int kcol, const cha
         if (q) {
             const char *q2 = strchr(q + 1, '"');
             int len = q2 ? (int)(q2 - q - 1) : (int)strlen(q + 1);
-            snprintf(sw, sizeof sw, "-D%.*s=\"%.*s\"", (int)(eq - val), val, len, q + 1);
+            snprintf(sw, sizeof sw, "%s%.*s=\"%.*s\"", key->sw, (int)(eq - val), val, len, q + 1);
         } else {
             double v = strtod(eq + 1, &end);
             if (!eq[1] || *end || errno) {
                 err_at(r, vcol + (int)(eq + 1 - val), "'%s' wants a number or a quoted string after '='", name);
                 return PT_ERR_USAGE;
             }
-            snprintf(sw, sizeof sw, "-D%.*s=%.17g", (int)(eq - val), val, v);
+            snprintf(sw, sizeof sw, "%s%.*s=%.17g", key->sw, (int)(eq - val), val, v);
         }
         break;
     }
@@ -463,7 +479,8 @@ static int is_ini_option(const char *s)
     if (!eq || s[0] == '+' || s[0] == '-') return 0;
     for (const char *p = s; p < eq; p++)
         if (!isalnum((unsigned char)*p) && *p != '_') return 0;
-    return find_key(s, (size_t)(eq - s)) != NULL;
+    ini_key key;
+    return find_key(s, (size_t)(eq - s), &key);
 }
 
 pt_status ini_expand(int argc, char **argv, ini_args **out, diag *d)
