@@ -565,10 +565,26 @@ int sdl_pattern_is_type(sdl_kw k)
     }
 }
 
+/* Kinds whose value frequency does not scale (their value picks a list
+ * entry, or is an image's, an object's or quilted's own): POV-Ray 3.7's
+ * Parse_Pattern (parstxtr.cpp) sets their Frequency to 0 when the kind is
+ * named, before any `frequency` modifier. */
+static int kind_without_frequency(pattern_kind k)
+{
+    switch (k) {
+    case PAT_QUILTED: case PAT_CHECKER: case PAT_HEXAGON: case PAT_SQUARE: case PAT_TRIANGULAR: case PAT_CUBIC:
+    case PAT_BRICK: case PAT_IMAGE: case PAT_OBJECT:
+        return 1;
+    default:
+        return 0;
+    }
+}
+
 static void set_kind(target *tg, pattern_kind k, const char *name)
 {
     tg->pat->kind = k;
     tg->pat->name = name;
+    if (kind_without_frequency(k)) tg->pat->frequency = 0.0;
 }
 
 static void unsupported_pattern(sdl_parser *p, target *tg, const sdl_tok *t)
@@ -686,7 +702,6 @@ static int pattern_type(sdl_parser *p, target *tg)
         set_kind(tg, PAT_QUILTED, name);
         pt->control0 = 1.0;
         pt->control1 = 1.0;
-        pt->frequency = 0.0;
         break;
     case KW_FACETS:
         set_kind(tg, PAT_FACETS, name);
@@ -703,24 +718,20 @@ static int pattern_type(sdl_parser *p, target *tg)
             pt->mortar = 0.5 - PAT_EPS * 2.0;
         }
         set_kind(tg, pk2, name);
-        pt->frequency = 0.0;
         blend_list(p, tg, count);
         break;
     }
     case KW_IMAGE_MAP:
         set_kind(tg, PAT_IMAGE, name);
-        pt->frequency = 0.0;
         if (tg->kind != TGT_PIGMENT) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "image_map can only be used in pigment");
         image_block(p, &pt->image, 0, NULL);
         break;
     case KW_IMAGE_PATTERN:
         set_kind(tg, PAT_IMAGE, name);
-        pt->frequency = 0.0;
         image_block(p, &pt->image, 1, NULL);
         break;
     case KW_BUMP_MAP:
         set_kind(tg, PAT_IMAGE, name);
-        pt->frequency = 0.0;
         if (tg->kind != TGT_NORMAL) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "bump_map can only be used in normal");
         image_block(p, &pt->image, 2, tg->nm ? &tg->nm->amount : NULL);
         break;
@@ -778,7 +789,6 @@ static int pattern_type(sdl_parser *p, target *tg)
          * outside (POV-Ray 3.7's object pattern; the two listed entries
          * stand inside the braces) */
         set_kind(tg, PAT_OBJECT, name);
-        pt->frequency = 0.0;
         pt->object = NULL;
         if (!sdl_begin_block(p, "object")) break;
         sdl_obj *so = sdl_parse_object_body(p);
