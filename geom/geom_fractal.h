@@ -15,10 +15,8 @@
 #define PT_GEOM_FRACTAL_H
 #include "geom_shape.h"
 
-int geom_fractal_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
-void geom_fractal_free(void *data);
-int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max);
-int geom_fractal_inside(const geom_shape *sh, vec3 q);
+/* geom_fractal_init, _free, _hits, _inside (geom_shape.h) */
+GEOM_FAMILY(fractal)
 vec3 geom_fractal_normal(const geom_shape *sh, vec3 q);
 
 #endif

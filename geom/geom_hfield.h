@@ -15,10 +15,8 @@
 #define PT_GEOM_HFIELD_H
 #include "geom_shape.h"
 
-int geom_hfield_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
-void geom_hfield_free(void *data);
-int geom_hfield_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max);
-int geom_hfield_inside(const geom_shape *sh, vec3 q);
+/* geom_hfield_init, _free, _hits, _inside (geom_shape.h) */
+GEOM_FAMILY(hfield)
 /* Object-space geometric normal of the triangle `part` and (u, v) = (x, z). */
 void geom_hfield_surface(const geom_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v);
 /* Object-space smooth shading normal at q (0 when the field is not smooth). */

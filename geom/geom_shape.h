@@ -75,6 +75,22 @@ static inline int geom_shape_hit_put(geom_shape_hit *out, int n, int max, double
     return n;
 }
 
+/* The entry points of a shape family module FAM that geom_shape.c calls
+ * for its kinds, one contract for all (geom_sweep, geom_hfield,
+ * geom_fractal):
+ *   geom_FAM_init   set up sh from o: object-space bounds in lo/hi, may
+ *                   allocate sh->data; -1 when degenerate;
+ *   geom_FAM_free   free sh->data;
+ *   geom_FAM_hits   object-space ray o + t d: crossings with t in
+ *                   (tmin, tmax), ascending, at most max;
+ *   geom_FAM_inside whether the object-space point q is inside. */
+#define GEOM_FAMILY(fam)                                                                                               \
+    int geom_##fam##_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);                                  \
+    void geom_##fam##_free(void *data);                                                                                \
+    int geom_##fam##_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out,         \
+                          int max);                                                                                    \
+    int geom_##fam##_inside(const geom_shape *sh, vec3 q);
+
 /* Fill `sh` from a leaf object of an analytic kind (triangles and smooth
  * triangles too: they are intersected here when they belong to a CSG
  * intersection/difference; otherwise Embree handles them). Returns 0 on success, -1

@@ -21,13 +21,9 @@
 #include "geom_shape.h"
 #include "rng.h"
 
-/* Set up sh (kind SHAPE_LATHE, SOR, PRISM, TEXT or POLYGON) from o; object
- * space bounds in lo/hi. Allocates sh->data. -1 when degenerate. */
-int geom_sweep_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
-void geom_sweep_free(void *data);
-/* Object-space ray o + t d; crossings with t in (tmin, tmax), ascending. */
-int geom_sweep_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max);
-int geom_sweep_inside(const geom_shape *sh, vec3 q);
+/* geom_sweep_init (kinds SHAPE_LATHE, SOR, PRISM, TEXT and POLYGON;
+ * allocates sh->data), _free, _hits, _inside (geom_shape.h) */
+GEOM_FAMILY(sweep)
 /* Object-space outward normal (not unit) and surface parameters at q. */
 void geom_sweep_surface(const geom_shape *sh, vec3 q, int part, vec3 *n, double *u, double *v);
 /* POV-Ray's UV coordinates (uv_mapping) of a lathe or sor at q. */
