@@ -20,6 +20,30 @@
  * shade_tex_refraction_eta), as POV-Ray's photons do (photons.cpp,
  * ComputeRefractionForPhotons): a liquid in a glass refracts against the
  * glass, not against air. */
+/* A photon going on through the surface at h along tdir: what it keeps is
+ * the layers' filter and transmit and, leaving an object, the interior's
+ * fade over h->t, the straight path inside (shade_tex_shadow_filter),
+ * times 1 - the top layer's reflectivity kr under conserve_energy
+ * (POV-Ray 3.7's photons.cpp, ComputeLightedTexture: FilCol *= 1 - reflec,
+ * the photon carrying LightCol * FilCol). No (eta_i/eta_t)^2 (b.eta2, the
+ * path tracer's adjoint rule): POV-Ray's photon keeps LightCol x FilCol
+ * through a refraction, so a surface inside a refracting object (a floor
+ * that a glass sinks into) gets the photons' full power; through a whole
+ * object the two factors cancel anyway. `si` (the containers before) is
+ * crossed into the step's. */
+static gi_caustic_step through(const caustics *c, const accel_hit *h, vec3 dir, const shade_mat_bsdf *b, rgb kr,
+                               shade_media_inside *si, vec3 tdir)
+{
+    rgb f = shade_tex_shadow_filter(c->sc, h, dir);
+    if (b->ls.f && b->ls.f->conserve_energy)
+        f = (rgb){f.r * fmin(1.0, 1.0 - kr.r), f.g * fmin(1.0, 1.0 - kr.g), f.b * fmin(1.0, 1.0 - kr.b)};
+    shade_media_inside_cross(si, h->obj);
+    gi_caustic_inside after = {0, {0}};
+    after.n = si->n < GI_CAUSTIC_MAX_INSIDE ? si->n : GI_CAUSTIC_MAX_INSIDE;
+    for (int i = 0; i < after.n; i++) after.obj[i] = si->obj[i];
+    return (gi_caustic_step){b->p_in, tdir, f, 1.0, 1, b->from, after};
+}
+
 static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, const gi_caustic_inside *in, rng *r,
                         gi_caustic_step *step)
 {
@@ -64,28 +88,31 @@ static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, const gi_causti
             step[n++] = (gi_caustic_step){b.p_out, b.refl_dir, {fa.r * kr.r / p, fa.g * kr.g / p, fa.b * kr.b / p}, p, 0,
                                           b.from, same};
         if (transmits) {
-            /* what a refracted photon keeps: the layers' filter and
-             * transmit and, leaving an object, the interior's fade over
-             * h->t, the straight path inside (shade_tex_shadow_filter),
-             * times 1 - the top layer's reflectivity under conserve_energy
-             * (POV-Ray 3.7's photons.cpp, ComputeLightedTexture: FilCol *=
-             * 1 - reflec, the photon carrying LightCol * FilCol). No
-             * (eta_i/eta_t)^2 (b.eta2, the path tracer's adjoint rule):
-             * POV-Ray's photon keeps LightCol x FilCol through a
-             * refraction, so a surface inside a refracting object (a floor
-             * that a glass sinks into) gets the photons' full power;
-             * through a whole object the two factors cancel anyway */
-            rgb f = shade_tex_shadow_filter(c->sc, h, dir);
-            if (b.ls.f && b.ls.f->conserve_energy)
-                f = (rgb){f.r * fmin(1.0, 1.0 - kr.r), f.g * fmin(1.0, 1.0 - kr.g), f.b * fmin(1.0, 1.0 - kr.b)};
-            shade_media_inside_cross(&si, h->obj);
-            gi_caustic_inside after = {0, {0}};
-            after.n = si.n < GI_CAUSTIC_MAX_INSIDE ? si.n : GI_CAUSTIC_MAX_INSIDE;
-            for (int i = 0; i < after.n; i++) after.obj[i] = si.obj[i];
-            step[n++] = (gi_caustic_step){b.p_in, tdir, {f.r / p, f.g / p, f.b / p}, p, 1, b.from, after};
+            step[n] = through(c, h, dir, &b, kr, &si, tdir);
+            step[n].weight = (rgb){step[n].weight.r / p, step[n].weight.g / p, step[n].weight.b / p};
+            step[n++].rho = p;
         }
     }
     return out | GI_CAUSTIC_CONTINUES | (n == 2 ? GI_CAUSTIC_SPLIT : 0);
+}
+
+/* The caustic layer's pass hook: a pass_through object before the target
+ * lets the photon on along its way with what a refraction through it
+ * would keep (through above; POV-Ray 3.7's photons.cpp filters such a
+ * photon by the layers' filter and transmit, FilCol, and crosses the
+ * object's interior, without bending it). */
+static int hook_pass(void *ctx, const accel_hit *h, vec3 dir, const gi_caustic_inside *in, gi_caustic_step *step)
+{
+    const caustics *c = ctx;
+    shade_mat_bsdf b;
+    shade_mat_setup(&b, c->sc, h, dir, c->eps, NULL);
+    shade_media_inside si = {0, {0}};
+    if (in) {
+        si.n = in->n < SHADE_MEDIA_MAX_INSIDE ? in->n : SHADE_MEDIA_MAX_INSIDE;
+        for (int i = 0; i < si.n; i++) si.obj[i] = in->obj[i];
+    }
+    *step = through(c, h, dir, &b, b.k[SHADE_MAT_LOBE_REFLECT], &si, dir);
+    return fmax(step->weight.r, fmax(step->weight.g, step->weight.b)) > 0.0;
 }
 
 /* The brilliance of the top layer's finish at the hit (POV-Ray shades each
@@ -173,7 +200,7 @@ pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width
     not_modelled(c, sc, d);
     c->sc = sc;
     c->eps = accel_scale(a) * 1e-6;
-    gi_caustic_hooks hk = {hook_surface, hook_attenuation, c, hook_brilliance};
+    gi_caustic_hooks hk = {hook_surface, hook_attenuation, c, hook_brilliance, hook_pass};
     gi_caustic_settings s = {width, height, threads, seed, cl_device, cl_max_bytes, count_scale, cancel};
     pt_status st = PT_OK;
     c->layer = gi_caustic_build(sc, a, &s, &hk, d, &st);

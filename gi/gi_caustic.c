@@ -13,13 +13,15 @@
 #include "timer.h"
 
 /* A photon ray passes no_shadow objects (POV-Ray trace.cpp: a photon ray
- * skips NO_SHADOW objects) and, on its way to the target, pass_through
- * objects (unchanged). Past the target a pass_through object is like any
- * other (photons.cpp, PhotonTrace::TraceRay tests the flag only for the
- * first ray and after a pass-through): a lemon slice hanging over a
- * glass's rim shadows the glass's caustic. */
-#define PHOTON_SKIP_FIRST (OBJ_NO_SHADOW | ACCEL_SKIP_PASS_THROUGH)
-#define PHOTON_SKIP_LATER OBJ_NO_SHADOW
+ * skips NO_SHADOW objects). On its way to the target it goes straight on
+ * through pass_through objects, filtered by them (the hooks' pass: POV-Ray
+ * 3.7 builds photons.cpp with PT_FILTER_BEFORE_TARGET, "pass_through
+ * objects encountered before target do affect photons color"); a lemon
+ * slice hanging over grenadine's glass tints, or with its opaque peel
+ * stops, the photons that cross it before the glass. Past the target a
+ * pass_through object is like any other (PhotonTrace::TraceRay tests the
+ * flag only for the first ray and after a pass-through). */
+#define PHOTON_SKIP OBJ_NO_SHADOW
 #define GBUF_LAYERS 8
 /* k of r_xy = k s_D / sqrt(rho_p): 9 unfocused spacings, about 250
  * photons of an unfocused beam within r_xy. The paper gives no constant;
@@ -330,17 +332,28 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
     int ns = 0;
     stack[ns++] = (branch){o, w, {0}, 0, 0, 0.0, 1.0, {1, 1, 1}, {0, {0}}};
     vec3 p_first = o;
+    int passes = 0;
     while (ns > 0) {
         branch br = stack[--ns];
         accel_hit h;
-        if (accel_intersect_past(c->a, br.has_from ? &br.from : NULL, br.o, br.w, c->eps,
-                                 br.level == 0 ? PHOTON_SKIP_FIRST : PHOTON_SKIP_LATER, &h, &out->rays) <= 0)
+        if (accel_intersect_past(c->a, br.has_from ? &br.from : NULL, br.o, br.w, c->eps, PHOTON_SKIP, &h,
+                                 &out->rays) <= 0)
             continue;
         int level = br.level;
         double depth = br.depth + h.t;
         if (level == 0) {
-            /* the first hit must be the target (POV-Ray's PhotonTrace) */
-            if (!in_target(cb, h.obj)) return;
+            /* the first hit must be the target, or a pass_through object
+             * that the photon crosses towards it (POV-Ray's PhotonTrace) */
+            if (!in_target(cb, h.obj)) {
+                gi_caustic_step st;
+                if (!(h.obj && h.obj->photons && h.obj->photons->pass_through) || !c->hk.pass ||
+                    ++passes > ACCEL_PASS_MAX || !c->hk.pass(c->hk.ctx, &h, br.w, &br.in, &st))
+                    return;
+                rgb tr = crgb(br.tr.r * st.weight.r, br.tr.g * st.weight.g, br.tr.b * st.weight.b);
+                if (!(cmax3(tr) >= c->adc) || !isfinite(tr.r + tr.g + tr.b)) return;
+                stack[ns++] = (branch){st.org, st.dir, st.from, 1, 0, depth, br.rho_p, tr, st.inside};
+                continue;
+            }
             out->first_hits++;
             p_first = h.p;
         }

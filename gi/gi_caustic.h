@@ -115,6 +115,11 @@ typedef struct {
     /* The brilliance of the receiving finish at h seen along unit dir (the
      * photons' weight, gi_caus_add); NULL: 1. */
     double (*brilliance)(void *ctx, const accel_hit *h, vec3 dir);
+    /* A pass_through object met before the target: *step goes on along
+     * dir from its far side, weighted by what the surface lets through,
+     * with the containers crossed; 0 when nothing passes. NULL: the
+     * photon ends there. */
+    int (*pass)(void *ctx, const accel_hit *h, vec3 dir, const gi_caustic_inside *in, gi_caustic_step *step);
 } gi_caustic_hooks;
 
 typedef struct {
