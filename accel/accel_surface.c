@@ -16,6 +16,7 @@
 #include <string.h>
 #include "geom_shape.h"
 #include "geom_tess.h"
+#include "pool.h"
 
 enum { INHERITED = OBJ_NO_SHADOW | OBJ_NO_IMAGE | OBJ_NO_REFLECTION | OBJ_NO_RADIOSITY };
 #define MAX_DEPTH 256
@@ -500,22 +501,49 @@ static int collect(accel_surf *as, const scene_object *o, const scene_texture *p
     }
 }
 
-/* Area estimates of the shapes sampled by lines, within the scene's budget. */
-static void finish_crofton(accel_surf *as)
+/* Area estimates of the shapes sampled by lines, within the scene's budget.
+ * Each shape's estimate depends only on its shape and the line count (its
+ * lines are a fixed quasi-random sequence), so the shapes are estimated in
+ * parallel and the result is the same for any thread count. */
+typedef struct {
+    accel_surf *as;
+    const int *piece; /* the pieces sampled by lines */
+    double *area;     /* their estimates */
+    int lines;
+} crofton_job;
+
+static void crofton_one(void *ctx, int k, int thread)
+{
+    (void)thread;
+    crofton_job *J = ctx;
+    shape_geo *g = &J->as->shapes[J->as->pieces[J->piece[k]].idx];
+    J->area[k] = geom_tess_sampler_init(&g->cro, &g->sh, NULL, NULL, CROFTON_REL_ERR, J->lines);
+}
+
+static int finish_crofton(accel_surf *as, int threads)
 {
     int n = 0;
     for (int i = 0; i < as->nshapes; i++) n += as->shapes[i].crofton;
-    if (n == 0) return;
+    if (n == 0) return 1;
     int lines = CROFTON_BUDGET / n;
     if (lines > CROFTON_MAX_LINES) lines = CROFTON_MAX_LINES;
     if (lines < CROFTON_MIN_LINES) lines = CROFTON_MIN_LINES;
-    for (int i = 0; i < as->npieces; i++) {
-        piece_rec *p = &as->pieces[i];
-        if (!p->is_shape) continue;
+    int *piece = malloc((size_t)as->npieces * sizeof *piece);
+    double *area = malloc((size_t)as->npieces * sizeof *area);
+    if (!piece || !area) {
+        free(piece);
+        free(area);
+        return 0;
+    }
+    int m = 0;
+    for (int i = 0; i < as->npieces; i++)
+        if (as->pieces[i].is_shape && as->shapes[as->pieces[i].idx].crofton) piece[m++] = i;
+    crofton_job J = {as, piece, area, lines};
+    pool_run(threads > 0 ? threads : 1, m, crofton_one, &J);
+    for (int k = 0; k < m; k++) {
+        piece_rec *p = &as->pieces[piece[k]];
         shape_geo *g = &as->shapes[p->idx];
-        if (!g->crofton) continue;
-        double area = geom_tess_sampler_init(&g->cro, &g->sh, NULL, NULL, CROFTON_REL_ERR, lines);
-        if (!(area > 0.0) || !isfinite(area)) {
+        if (!(area[k] > 0.0) || !isfinite(area[k])) {
             /* no surface found: never chosen, pdf 0 */
             p->pub.area = 0.0;
             p->pub.weight = 0.0;
@@ -523,8 +551,11 @@ static void finish_crofton(accel_surf *as)
             g->cro.area = 0.0;
             continue;
         }
-        p->pub.area = area;
+        p->pub.area = area[k];
     }
+    free(piece);
+    free(area);
+    return 1;
 }
 
 static uint64_t hash_key(const scene_object *o, unsigned prim)
@@ -558,11 +589,11 @@ static int build_table(accel_surf *as)
 accel_surf *accel_surf_build(const scene *s, const accel *a, accel_surf_weight_fn weight, void *ctx, diag *d,
                              pt_status *st)
 {
-    return accel_surf_build_in(s, a, NULL, NULL, weight, ctx, d, st);
+    return accel_surf_build_in(s, a, NULL, NULL, weight, ctx, 1, d, st);
 }
 
 accel_surf *accel_surf_build_in(const scene *s, const accel *a, const vec3 *lo, const vec3 *hi,
-                                accel_surf_weight_fn weight, void *ctx, diag *d, pt_status *st)
+                                accel_surf_weight_fn weight, void *ctx, int threads, diag *d, pt_status *st)
 {
     (void)d;
     *st = PT_OK;
@@ -589,7 +620,7 @@ accel_surf *accel_surf_build_in(const scene *s, const accel *a, const vec3 *lo, 
     }
     int ok = 1;
     for (int i = 0; i < s->nobjects && ok; i++) ok = collect(as, s->objects[i], &s->default_texture, 0u, 0);
-    if (ok) finish_crofton(as);
+    if (ok) ok = finish_crofton(as, threads);
     if (ok && as->npieces > 0) {
         as->cdf = malloc(sizeof(double) * (size_t)as->npieces);
         ok = as->cdf != NULL;

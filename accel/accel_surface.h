@@ -78,9 +78,11 @@ accel_surf *accel_surf_build(const scene *s, const accel *a, accel_surf_weight_f
                              pt_status *st);
 /* The same with infinite planes (and quadrics, polys) clipped to the box
  * [*lo, *hi] instead of the scene's finite bounds (lo or hi NULL: those):
- * for sets that must cover what the camera sees of a plane. */
+ * for sets that must cover what the camera sees of a plane; the areas of
+ * shapes sampled by random lines are estimated on `threads` threads
+ * (accel_surf_build: 1), the same set for any count. */
 accel_surf *accel_surf_build_in(const scene *s, const accel *a, const vec3 *lo, const vec3 *hi,
-                                accel_surf_weight_fn weight, void *ctx, diag *d, pt_status *st);
+                                accel_surf_weight_fn weight, void *ctx, int threads, diag *d, pt_status *st);
 void accel_surf_free(accel_surf *as);
 
 int accel_surf_count(const accel_surf *as);

@@ -332,7 +332,7 @@ static pt_status make_vpls(const scene *sc, const accel *a, const pm_lights *L, 
                 hi = v3_max(hi, h.p);
             }
         }
-    accel_surf *S = accel_surf_build_in(sc, a, &lo, &hi, vpl_weight, NULL, d, &st);
+    accel_surf *S = accel_surf_build_in(sc, a, &lo, &hi, vpl_weight, NULL, threads > 0 ? threads : pool_default_threads(), d, &st);
     if (!S) return st;
     memset(out, 0, sizeof *out);
     if (accel_surf_count(S) == 0 || want < 1) {

@@ -519,7 +519,7 @@ gi_particle *gi_particle_begin(const scene *sc, const accel *a, const gi_particl
 
     progress_stage(set->progress, "gi geometry: surfaces", 0);
     double tg = timer_now();
-    gp->surf = gi_surface_build(set->camera ? &gp->gsc : sc, a, 1e30, d, &st);
+    gp->surf = gi_surface_build(set->camera ? &gp->gsc : sc, a, 1e30, gp->threads, d, &st);
     if (!gp->surf) {
         *status = st == PT_OK ? PT_ERR_INTERNAL : st;
         gi_particle_free(gp);

@@ -645,7 +645,7 @@ int gi_surface_nobjs(const gi_surface *g) { return g->no; }
 int gi_surface_obj_index(const gi_surface *g, int i) { return g->p[i].obj; }
 double gi_surface_view_share(const gi_surface *g, int k) { return g->view && k >= 0 && k < g->no ? g->view[k] : 0.0; }
 
-gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *d, pt_status *status)
+gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, int threads, diag *d, pt_status *status)
 {
     pt_status dummy;
     if (!status) status = &dummy;
@@ -683,7 +683,7 @@ gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *
     const scene_object **seen = calloc((size_t)VIEW_W * VIEW_H, sizeof *seen);
     view_clip(s, a, &g->lo, &g->hi, seen);
     pt_status ast = PT_OK;
-    g->as = accel_surf_build(s, a, NULL, NULL, d, &ast);
+    g->as = accel_surf_build_in(s, a, NULL, NULL, NULL, NULL, threads, d, &ast);
     if (!g->as) {
         free(seen);
         gi_surface_free(g);
@@ -700,10 +700,12 @@ gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *
             return NULL;
         }
     }
-    if (!build_hash(g)) {
+    /* the CSG members' areas, all at once */
+    pt_status cst = gi_surface_csg_finish(g, threads);
+    if (cst != PT_OK || !build_hash(g)) {
         free(seen);
         gi_surface_free(g);
-        *status = PT_ERR_NOMEM;
+        *status = cst != PT_OK ? cst : PT_ERR_NOMEM;
         return NULL;
     }
     for (int i = 0; i < g->np; i++) g->total_area += g->p[i].area;

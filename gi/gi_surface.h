@@ -73,8 +73,10 @@
 
 typedef struct gi_surface gi_surface;
 
-/* tess: bound on sub-triangle edges and grid cell size (world units). */
-gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, diag *d, pt_status *status);
+/* tess: bound on sub-triangle edges and grid cell size (world units);
+ * threads: for the area estimates of shapes sampled by lines (the same
+ * surfaces for any count). */
+gi_surface *gi_surface_build(const scene *s, const accel *a, double tess, int threads, diag *d, pt_status *status);
 void gi_surface_free(gi_surface *g);
 /* Change the tessellation bound (radiance particles are laid out anew). */
 void gi_surface_retess(gi_surface *g, double tess);

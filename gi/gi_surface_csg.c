@@ -12,6 +12,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include "pool.h"
 
 /* ------------------------------------------------------------ CSG members
  *
@@ -45,7 +46,11 @@ static int keep_fn(void *ctx, vec3 p)
 }
 
 /* A PIECE-kind member of CSG (cur_node): sampled by Crofton lines over its
- * own shape, keeping the crossings on the result's surface. */
+ * own shape, keeping the crossings on the result's surface. Its sampler
+ * and area are made later, for all such members at once
+ * (gi_surface_csg_finish): the patch and its object record stand with the
+ * area PENDING until then. */
+#define PENDING (-1.0)
 pt_status gi_surface_csg_add_piece(gi_surface *g, const scene_object *o, const scene_texture *tex)
 {
     assert(g->cur_node >= 0 && g->cur_node < g->ncm);
@@ -66,18 +71,7 @@ pt_status gi_surface_csg_add_piece(gi_surface *g, const scene_object *o, const s
     if (p.sh->infinite) geom_shape_clip_plane(p.sh, g->lo, g->hi);
     p.ks->g = g;
     p.ks->node = g->cur_node;
-    /* The area only shares the particles out among the patches (each
-     * particle stands for the same dA whatever its patch's area), so 1%
-     * does: at accel_surface's 0.1% (65536 lines) a scene of a few hundred
-     * CSG members (patio-radio's arcades) spent most of its geometry stage
-     * here. */
-    double area = geom_tess_sampler_init(&p.ks->cs, p.sh, keep_fn, p.ks, 1e-2, 8192);
-    if (!(area > 0.0) || !isfinite(area)) {
-        /* nothing of it is on the result's surface */
-        gi_surface_free_patch(&p);
-        return PT_OK;
-    }
-    p.area = area;
+    p.area = PENDING;
     int obj = gi_surface_add_obj(g, o);
     if (obj < 0) {
         gi_surface_free_patch(&p);
@@ -92,6 +86,73 @@ pt_status gi_surface_csg_add_piece(gi_surface *g, const scene_object *o, const s
     return PT_OK;
 }
 
+typedef struct {
+    gi_surface *g;
+    const int *patch; /* the pending patches */
+} piece_job;
+
+static void piece_area(void *ctx, int k, int thread)
+{
+    (void)thread;
+    piece_job *J = ctx;
+    patch *p = &J->g->p[J->patch[k]];
+    /* The area only shares the particles out among the patches (each
+     * particle stands for the same dA whatever its patch's area), so 1%
+     * does: at accel_surface's 0.1% (65536 lines) a scene of a few hundred
+     * CSG members (patio-radio's arcades) spent most of its geometry stage
+     * here. The estimate depends on the member alone (a fixed
+     * quasi-random set of lines), so the members are estimated in
+     * parallel, the same for any thread count. */
+    p->area = geom_tess_sampler_init(&p->ks->cs, p->sh, keep_fn, p->ks, 1e-2, 8192);
+}
+
+pt_status gi_surface_csg_finish(gi_surface *g, int threads)
+{
+    int *pend = malloc(((size_t)g->np + 1) * sizeof *pend);
+    int *newo = malloc(((size_t)g->no + 1) * sizeof *newo);
+    if (!pend || !newo) {
+        free(pend);
+        free(newo);
+        return PT_ERR_NOMEM;
+    }
+    int m = 0;
+    for (int i = 0; i < g->np; i++)
+        if (g->p[i].kind == PATCH_PIECE && g->p[i].cnode >= 0 && g->p[i].area == PENDING) pend[m++] = i;
+    piece_job J = {g, pend};
+    pool_run(threads > 0 ? threads : 1, m, piece_area, &J);
+    /* a member with nothing of it on the result's surface has no patch and
+     * no object record (each member's record is its own, of one patch):
+     * both go, and the records after them move up */
+    int removed = 0;
+    for (int k = 0; k < m; k++) {
+        patch *p = &g->p[pend[k]];
+        if (p->area > 0.0 && isfinite(p->area)) continue;
+        g->o[p->obj].count = -1; /* marks the record for removal */
+        gi_surface_free_patch(p);
+        p->obj = -1;
+        removed++;
+    }
+    if (removed) {
+        int no = 0;
+        for (int j = 0; j < g->no; j++) newo[j] = g->o[j].count < 0 ? -1 : no++;
+        /* a record's first patch: the patches kept before its old first */
+        int np = 0, jo = 0;
+        for (int i = 0; i <= g->np; i++) {
+            for (; jo < g->no && g->o[jo].first <= i; jo++)
+                if (newo[jo] >= 0) g->o[jo].first = np;
+            if (i == g->np || g->p[i].obj < 0) continue;
+            g->p[i].obj = newo[g->p[i].obj];
+            g->p[np++] = g->p[i];
+        }
+        for (int j = 0; j < g->no; j++)
+            if (newo[j] >= 0) g->o[newo[j]] = g->o[j];
+        g->np = np;
+        g->no = no;
+    }
+    free(pend);
+    free(newo);
+    return PT_OK;
+}
 
 /* geom_csg_build's leaf callback: the members in the order they are added. */
 typedef struct {

@@ -154,8 +154,13 @@ int gi_surface_has_grid(shape_kind k);
  * (the result in *status); 0 when o is to be walked as a union. */
 int gi_surface_csg_walk(gi_surface *g, const scene_object *o, const scene_texture *tex, pt_status *status);
 /* A PIECE-kind member of CSG (g->cur_node): sampled by Crofton lines over
- * its own shape, keeping the crossings on the result's surface. */
+ * its own shape, keeping the crossings on the result's surface; its area
+ * is estimated by gi_surface_csg_finish. */
 pt_status gi_surface_csg_add_piece(gi_surface *g, const scene_object *o, const scene_texture *tex);
+/* After the walk: the areas of those members on `threads` threads (the
+ * same for any count); members with none on the result's surface are
+ * removed with their object records, as if never added. */
+pt_status gi_surface_csg_finish(gi_surface *g, int threads);
 /* Is world point p (on the surface of member `node`) on the CSG result's surface? */
 int gi_surface_csg_keep(const gi_surface *g, int node, vec3 p);
 /* Frees the trees. */

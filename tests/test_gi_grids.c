@@ -114,7 +114,7 @@ static void render_particle(tu_world *w, gi_particle *gp, framebuffer *fb)
 static long shape_rp(tu_world *w, double tess, shape_kind k)
 {
     pt_status st;
-    gi_surface *g = gi_surface_build(w->s, w->a, tess, w->d, &st);
+    gi_surface *g = gi_surface_build(w->s, w->a, tess, 1, w->d, &st);
     assert_non_null(g);
     long n = 0, nrp = gi_surface_nrp(g);
     for (long r = 0; r < nrp; r++) n += gi_surface_object(g, gi_surface_rp_patch(g, r))->kind == k;
