@@ -194,9 +194,6 @@ static pt_status build_csg(accel *a, diag *d, const scene_object *o, const scene
         int *n1 = realloc(a->csg_bn, cap * sizeof *n1);
         if (!n1) return PT_ERR_NOMEM;
         a->csg_bn = n1;
-        int *n2 = realloc(a->csg_one_leaf, cap * sizeof *n2);
-        if (!n2) return PT_ERR_NOMEM;
-        a->csg_one_leaf = n2;
         a->csg_b0[a->ncsgs] = cb0;
         a->csg_bn[a->ncsgs] = cbn;
     }
@@ -211,12 +208,6 @@ static pt_status build_csg(accel *a, diag *d, const scene_object *o, const scene
         geom_csg_free(c);
         return PT_OK;
     }
-    int one = c->nshapes > 0 ? (int)c->shape_leaf[0] : -1;
-    for (int k = 1; k < c->nshapes && one >= 0; k++) {
-        const accel_leaf *l0 = &a->leaves[c->shape_leaf[0]], *lk = &a->leaves[c->shape_leaf[k]];
-        if (lk->texture != l0->texture || lk->flags != l0->flags) one = -1;
-    }
-    a->csg_one_leaf[a->ncsgs] = one;
     a->ncsgs++;
     if (v3_finite(c->lo) && v3_finite(c->hi)) {
         a->lo = v3_min(a->lo, c->lo);
@@ -807,7 +798,7 @@ void accel_free(accel *a)
     for (int i = 0; i < a->nshapes; i++) geom_shape_release(&a->shapes[i]);
     for (int i = 0; i < a->ncsgs; i++) geom_csg_free(&a->csgs[i]);
     for (int i = 0; i < a->nbshapes; i++) geom_shape_release(&a->bshapes[i]);
-    GROW_FREE_ALL(a->leaves, a->shapes, a->shape_leaf, a->diags, a->groups, a->csgs, a->bshapes, a->csg_b0, a->csg_bn, a->csg_one_leaf,
+    GROW_FREE_ALL(a->leaves, a->shapes, a->shape_leaf, a->diags, a->groups, a->csgs, a->bshapes, a->csg_b0, a->csg_bn,
                   a->ubox, a->ginfo, a);
 }
 
@@ -1214,8 +1205,8 @@ const scene_object *accel_rtc_object_tri(const accel *a, unsigned geom, unsigned
     return o;
 }
 
-const scene_object *accel_rtc_leaf(const accel *a, unsigned geom, unsigned prim, unsigned inst, vec3 org, vec3 dir,
-                                   double t, const scene_texture **tex)
+const scene_object *accel_rtc_leaf(const accel *a, unsigned geom, unsigned prim, unsigned inst, float u,
+                                   const scene_texture **tex)
 {
     *tex = NULL;
     if (!a || geom == RTC_INVALID_GEOMETRY_ID) return NULL;
@@ -1232,17 +1223,11 @@ const scene_object *accel_rtc_leaf(const accel *a, unsigned geom, unsigned prim,
     } else if (a->ginfo[geom].kind == GEOM_USER && prim < (unsigned)a->nshapes) {
         li = a->shape_leaf[prim];
     } else if (a->ginfo[geom].kind == GEOM_USER && prim < (unsigned)(a->nshapes + a->ncsgs)) {
-        /* which member of the CSG: its hit again, about t (the record does
-         * not keep it), unless every member looks the same */
-        int one = a->csg_one_leaf[prim - (unsigned)a->nshapes];
-        if (one >= 0) {
-            li = (unsigned)one;
-        } else {
-            geom_csg_hit h;
-            double slack = 1e-4 * (fabs(t) + a->eps_scale);
-            if (!accel_prim_hit(a, prim, org, dir, t - slack > 0.0 ? t - slack : 0.0, t + slack, &h)) return NULL;
-            li = a->csgs[prim - (unsigned)a->nshapes].shape_leaf[h.shape];
-        }
+        /* the member the intersect callback found, from the record's u
+         * (accel_user_intersect) */
+        const geom_csg *c = &a->csgs[prim - (unsigned)a->nshapes];
+        if (!(u >= 0.0f && u < (float)c->nshapes)) return NULL;
+        li = c->shape_leaf[(int)u];
     } else {
         return NULL;
     }

@@ -158,15 +158,14 @@ const scene_object *accel_rtc_object(const accel *a, unsigned geom, unsigned pri
  * for other hits). Embree's u, v of such a hit weight the triangle's second
  * and third vertices, as accel_hit's do. */
 const scene_object *accel_rtc_object_tri(const accel *a, unsigned geom, unsigned prim, unsigned inst, unsigned *local);
-/* The leaf object a hit of ray org + t dir lies on, and its effective
- * texture (*tex; the CSG parents' when the leaf has none), for every hit
- * accel_rtc_object answers and for hits on CSG results too (their member
- * is found by intersecting the CSG again about t; where every member has
- * the same effective texture and flags, the first member without that); a
- * mesh triangle's own texture_list entry where it names one. NULL: invalid
+/* The leaf object a bare Embree hit lies on (geomID, primID, instID[0]
+ * and u of its RTCHit), and its effective texture (*tex; the CSG parents'
+ * when the leaf has none), for every hit accel_rtc_object answers and for
+ * hits on CSG results too (their record's u names the member hit); a mesh
+ * triangle's own texture_list entry where it names one. NULL: invalid
  * ids. */
-const scene_object *accel_rtc_leaf(const accel *a, unsigned geom, unsigned prim, unsigned inst, vec3 org, vec3 dir,
-                                   double t, const scene_texture **tex);
+const scene_object *accel_rtc_leaf(const accel *a, unsigned geom, unsigned prim, unsigned inst, float u,
+                                   const scene_texture **tex);
 /* Embree geometry ids run over [0, accel_rtc_ngeoms). For a geometry of
  * world-space triangles (the ids rtcIntersect on accel_rtc_scene or
  * accel_rtc_link_scene reports with an invalid instID), its triangle count,

@@ -86,8 +86,6 @@ struct accel {
     geom_shape *bshapes;         /* bounding objects (bounded_by), world space */
     int nbshapes, capbshapes;
     int *csg_b0, *csg_bn;         /* per CSG primitive, as accel_leaf.b0/bn */
-    int *csg_one_leaf;            /* per CSG primitive: its first member's leaf when every member
-                                     has the same effective texture and flags, else -1 */
     const bound_chain *cur_chain; /* during collect(): the bounds above the current object */
     accel_stats stats;
     atomic_int err;

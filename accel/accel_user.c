@@ -332,7 +332,10 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
         SOA_F(hit, N, i, 0) = (float)ng.x;
         SOA_F(hit, N, i, 1) = (float)ng.y;
         SOA_F(hit, N, i, 2) = (float)ng.z;
-        SOA_F(hit, N, i, 3) = (float)u;
+        /* a CSG result's record carries the member hit in u (exact in a
+         * float: members are counted in ints far below 2^24), which
+         * accel_rtc_leaf reads instead of intersecting the CSG again */
+        SOA_F(hit, N, i, 3) = args->primID < (unsigned)a->nshapes ? (float)u : (float)h.shape;
         SOA_F(hit, N, i, 4) = (float)v;
         SOA_U(hit, N, i, 5) = args->primID;
         SOA_U(hit, N, i, 6) = args->geomID;

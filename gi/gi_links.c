@@ -82,9 +82,7 @@ static void hit_material(const link_job *J, const struct RTCRayHit *h, const sce
  * leaf is found), CSG members included. */
 static const scene_object *hit_leaf(const link_job *J, const struct RTCRayHit *h, const scene_texture **tex)
 {
-    const scene_object *o =
-        accel_rtc_leaf(J->a, h->hit.geomID, h->hit.primID, h->hit.instID[0], v3(h->ray.org_x, h->ray.org_y, h->ray.org_z),
-                       v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z), h->ray.tfar, tex);
+    const scene_object *o = accel_rtc_leaf(J->a, h->hit.geomID, h->hit.primID, h->hit.instID[0], h->hit.u, tex);
     if (o && !*tex) *tex = o->texture ? o->texture : &J->sc->default_texture;
     return o;
 }

@@ -445,8 +445,7 @@ static void test_mesh_textures_normals(void **st)
         rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1((RTCScene)accel_rtc_scene(a), &ctx, &rh);
         const scene_texture *lt = NULL;
-        const scene_object *lo = accel_rtc_leaf(a, rh.hit.geomID, rh.hit.primID, rh.hit.instID[0], v3(probe[i].x, probe[i].y, 0),
-                                                v3(0, 0, 1), rh.ray.tfar, &lt);
+        const scene_object *lo = accel_rtc_leaf(a, rh.hit.geomID, rh.hit.primID, rh.hit.instID[0], rh.hit.u, &lt);
         assert_non_null(lo);
         assert_ptr_equal(lt, probe[i].tex);
     }
