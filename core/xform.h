@@ -20,19 +20,21 @@ xform xform_matrix(const double v[12]);
 xform xform_then(xform a, xform b);
 xform xform_inverse(xform a);
 int xform_is_identity(const xform *a);
-/* inline: they run per ray and per inside test of every transformed shape */
-static inline vec3 xform_point(const xform *a, vec3 p)
+/* inline: they run per ray and per inside test of every transformed shape.
+ * M's 3x3 part times v, and with column 3 added (the sums in the same order,
+ * so either form rounds as one written-out expression would). */
+static inline vec3 xform_mat3(const double M[3][4], vec3 v)
 {
-    return v3(a->m[0][0] * p.x + a->m[0][1] * p.y + a->m[0][2] * p.z + a->m[0][3],
-              a->m[1][0] * p.x + a->m[1][1] * p.y + a->m[1][2] * p.z + a->m[1][3],
-              a->m[2][0] * p.x + a->m[2][1] * p.y + a->m[2][2] * p.z + a->m[2][3]);
+    return v3(M[0][0] * v.x + M[0][1] * v.y + M[0][2] * v.z, M[1][0] * v.x + M[1][1] * v.y + M[1][2] * v.z,
+              M[2][0] * v.x + M[2][1] * v.y + M[2][2] * v.z);
 }
-static inline vec3 xform_vector(const xform *a, vec3 v)
+static inline vec3 xform_mat34(const double M[3][4], vec3 p)
 {
-    return v3(a->m[0][0] * v.x + a->m[0][1] * v.y + a->m[0][2] * v.z,
-              a->m[1][0] * v.x + a->m[1][1] * v.y + a->m[1][2] * v.z,
-              a->m[2][0] * v.x + a->m[2][1] * v.y + a->m[2][2] * v.z);
+    vec3 l = xform_mat3(M, p);
+    return v3(l.x + M[0][3], l.y + M[1][3], l.z + M[2][3]);
 }
+static inline vec3 xform_point(const xform *a, vec3 p) { return xform_mat34(a->m, p); }
+static inline vec3 xform_vector(const xform *a, vec3 v) { return xform_mat3(a->m, v); }
 /* inverse-transpose, not normalised */
 static inline vec3 xform_normal(const xform *a, vec3 n)
 {
@@ -41,17 +43,7 @@ static inline vec3 xform_normal(const xform *a, vec3 n)
               a->inv[0][1] * n.x + a->inv[1][1] * n.y + a->inv[2][1] * n.z,
               a->inv[0][2] * n.x + a->inv[1][2] * n.y + a->inv[2][2] * n.z);
 }
-static inline vec3 xform_inv_point(const xform *a, vec3 p)
-{
-    return v3(a->inv[0][0] * p.x + a->inv[0][1] * p.y + a->inv[0][2] * p.z + a->inv[0][3],
-              a->inv[1][0] * p.x + a->inv[1][1] * p.y + a->inv[1][2] * p.z + a->inv[1][3],
-              a->inv[2][0] * p.x + a->inv[2][1] * p.y + a->inv[2][2] * p.z + a->inv[2][3]);
-}
-static inline vec3 xform_inv_vector(const xform *a, vec3 v)
-{
-    return v3(a->inv[0][0] * v.x + a->inv[0][1] * v.y + a->inv[0][2] * v.z,
-              a->inv[1][0] * v.x + a->inv[1][1] * v.y + a->inv[1][2] * v.z,
-              a->inv[2][0] * v.x + a->inv[2][1] * v.y + a->inv[2][2] * v.z);
-}
+static inline vec3 xform_inv_point(const xform *a, vec3 p) { return xform_mat34(a->inv, p); }
+static inline vec3 xform_inv_vector(const xform *a, vec3 v) { return xform_mat3(a->inv, v); }
 
 #endif
