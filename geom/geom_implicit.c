@@ -117,6 +117,21 @@ static vec3 se_grad(const im_data *m, vec3 v)
 
 static double se_g(const im_data *m, vec3 o, vec3 d, double t) { return se_norm(m, v3_madd(o, d, t), NULL) - 1.0; }
 
+/* Whether N < 1 at tau, for the sample scan: N^q < 1 with the powers of
+ * the coordinates themselves, without se_norm's largest-term factoring or
+ * its final root (the scan is within the box |v| <= 1 + 1e-9, where no
+ * power overflows and an underflow only rounds a sum that is below 1
+ * anyway). The sign can differ from se_g's only where g is within
+ * rounding of 0; the scan takes se_g's values at a bracket's ends. */
+static int se_inside(const im_data *m, vec3 o, vec3 d, double t)
+{
+    vec3 v = v3_madd(o, d, t);
+    double ax = fabs(v.x), ay = fabs(v.y), az = fabs(v.z);
+    if (m->p == m->q) return se_pow(ax, m->p, m->pint) + se_pow(ay, m->p, m->pint) + se_pow(az, m->p, m->pint) < 1.0;
+    double sxy = se_pow(ax, m->p, m->pint) + se_pow(ay, m->p, m->pint);
+    return pow(sxy, m->q / m->p) + se_pow(az, m->q, m->qint) < 1.0;
+}
+
 /* Root of g in [a, b] with g(a), g(b) of opposite signs (Illinois regula falsi). */
 static double se_root(const im_data *m, vec3 o, vec3 d, double a, double b, double ga, double gb)
 {
@@ -142,7 +157,61 @@ static double se_root(const im_data *m, vec3 o, vec3 d, double a, double b, doub
     return 0.5 * (a + b);
 }
 
-static double se_dg(const im_data *m, vec3 o, vec3 d, double t) { return v3_dot(se_grad(m, v3_madd(o, d, t)), d); }
+/* g at tau and its derivative along the ray, d/dtau N = grad N . d, from
+ * one evaluation: g as se_g computes it, and se_grad's gradient from the
+ * same powers, (|x|/N)^(p-1) = (|x|/mm)^p / S * N / |x| (p = q; with
+ * p != q the chain through a = (|x|^p + |y|^p)^(1/p) likewise), with no
+ * pow of its own. At a coordinate 0 (the pieces' ends) the factor is
+ * se_grad's pow(0, p - 1): 1 for p = 1, else 0 (p < 1 gives an infinity
+ * there, which se_grad drops). */
+static double se_gd(const im_data *m, vec3 o, vec3 d, double t, double *dg)
+{
+    vec3 v = v3_madd(o, d, t);
+    double ax = fabs(v.x), ay = fabs(v.y), az = fabs(v.z), gx = 0.0, gy = 0.0, gz = 0.0, N;
+    if (m->p == m->q) {
+        double mm = fmax(fmax(ax, ay), az);
+        if (!(mm > 0.0)) {
+            /* se_grad's fallback for a zero gradient */
+            *dg = copysign(1.0, v.x) * d.x + copysign(1.0, v.y) * d.y + copysign(1.0, v.z) * d.z;
+            return -1.0;
+        }
+        double tx = se_pow(ax / mm, m->p, m->pint), ty = se_pow(ay / mm, m->p, m->pint),
+               tz = se_pow(az / mm, m->p, m->pint), S = tx + ty + tz;
+        N = mm * pow(S, 1.0 / m->p);
+        /* se_grad takes x and y through a, which is 0 on the z axis */
+        double k = N / S, at0 = m->p == 1.0 && (ax > 0.0 || ay > 0.0) ? 1.0 : 0.0;
+        gx = ax > 0.0 ? tx * k / ax : at0;
+        gy = ay > 0.0 ? ty * k / ay : at0;
+        gz = az > 0.0 ? tz * k / az : m->p == 1.0 ? 1.0 : 0.0;
+    } else {
+        double mxy = fmax(ax, ay), a = 0.0, tx = 0.0, ty = 0.0, Sxy = 0.0;
+        if (mxy > 0.0) {
+            tx = se_pow(ax / mxy, m->p, m->pint);
+            ty = se_pow(ay / mxy, m->p, m->pint);
+            Sxy = tx + ty;
+            a = mxy * pow(Sxy, 1.0 / m->p);
+        }
+        double mm = fmax(a, az);
+        if (!(mm > 0.0)) {
+            *dg = copysign(1.0, v.x) * d.x + copysign(1.0, v.y) * d.y + copysign(1.0, v.z) * d.z;
+            return -1.0;
+        }
+        double ua = se_pow(a / mm, m->q, m->qint), uz = se_pow(az / mm, m->q, m->qint), So = ua + uz;
+        N = mm * pow(So, 1.0 / m->q);
+        if (a > 0.0) {
+            double gxy = ua * N / (So * a), at0 = m->p == 1.0 ? gxy : 0.0;
+            gx = ax > 0.0 ? gxy * tx * a / (Sxy * ax) : at0;
+            gy = ay > 0.0 ? gxy * ty * a / (Sxy * ay) : at0;
+        }
+        gz = az > 0.0 ? uz * N / (So * az) : (m->q == 1.0 ? 1.0 : 0.0);
+    }
+    if (!isfinite(gx)) gx = 0.0;
+    if (!isfinite(gy)) gy = 0.0;
+    if (!isfinite(gz)) gz = 0.0;
+    if (!(gx * gx + gy * gy + gz * gz > 0.0)) gx = gy = gz = 1.0;
+    *dg = copysign(gx, v.x) * d.x + copysign(gy, v.y) * d.y + copysign(gz, v.z) * d.z;
+    return N - 1.0;
+}
 
 /* Crossings on [a, b] of g, convex there: tangent lines bound g from below
  * (Kelley's cutting planes), so the search either finds a point with
@@ -163,13 +232,12 @@ static int se_kept(const se_range *r, double tau)
 
 static int se_piece(const im_data *m, vec3 o, vec3 d, double a, double b, double *roots, int nr, const se_range *rg)
 {
-    double ga = se_g(m, o, d, a), gb = se_g(m, o, d, b);
+    double da, db, ga = se_gd(m, o, d, a, &da), gb = se_gd(m, o, d, b, &db);
     if ((ga < 0.0) != (gb < 0.0)) {
         roots[nr++] = se_root(m, o, d, a, b, ga, gb);
         return nr;
     }
     if (ga < 0.0) return nr; /* inside at both ends of a convex piece: no crossing */
-    double da = se_dg(m, o, d, a), db = se_dg(m, o, d, b);
     double a0 = a, b0 = b, ga0 = ga, gb0 = gb;
     for (int it = 0; it < 100; it++) {
         if (da >= 0.0 || db <= 0.0) return nr; /* the minimum is at an end, where g >= 0 */
@@ -177,7 +245,7 @@ static int se_piece(const im_data *m, vec3 o, vec3 d, double a, double b, double
         if (!(t > a && t < b)) t = 0.5 * (a + b);
         double lower = ga + da * (t - a);
         if (lower > 0.0) return nr;
-        double gt = se_g(m, o, d, t);
+        double dt, gt = se_gd(m, o, d, t, &dt);
         if (gt < 0.0) {
             roots[nr++] = se_root(m, o, d, a0, t, ga0, gt);
             /* the far crossing only when the caller wants more than one */
@@ -188,7 +256,6 @@ static int se_piece(const im_data *m, vec3 o, vec3 d, double a, double b, double
             if (gt <= 1e-12) roots[nr++] = t; /* grazing */
             return nr;
         }
-        double dt = se_dg(m, o, d, t);
         if (dt < 0.0) { a = t; ga = gt; da = dt; }
         else { b = t; gb = gt; db = dt; }
     }
@@ -287,8 +354,8 @@ static int se_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, g
             const int N = 24;
             double a = cuts[c], b = cuts[c + 1];
             if (a > c1) break;
-            double prev = a, gprev = 0.0;
-            int have_prev = 0;
+            double prev = a;
+            int have_prev = 0, iprev = 0;
             for (int k = 1; k <= N && nr < 56 && kept < max; k++) {
                 double x = a + (b - a) * k / N;
                 if (x < c0) {
@@ -297,16 +364,19 @@ static int se_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, g
                 }
                 if (prev > c1) break;
                 if (!have_prev) {
-                    gprev = se_g(m, p, e, prev);
+                    iprev = se_inside(m, p, e, prev);
                     have_prev = 1;
                 }
-                double gx = se_g(m, p, e, x);
-                if ((gprev < 0.0) != (gx < 0.0)) {
-                    roots[nr++] = se_root(m, p, e, prev, x, gprev, gx);
-                    kept += se_kept(&rg, roots[nr - 1]);
+                int ix = se_inside(m, p, e, x);
+                if (iprev != ix) {
+                    double gprev = se_g(m, p, e, prev), gx = se_g(m, p, e, x);
+                    if ((gprev < 0.0) != (gx < 0.0)) {
+                        roots[nr++] = se_root(m, p, e, prev, x, gprev, gx);
+                        kept += se_kept(&rg, roots[nr - 1]);
+                    }
                 }
                 prev = x;
-                gprev = gx;
+                iprev = ix;
             }
         }
     }
