@@ -974,7 +974,11 @@ static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tm
         const accel_leaf *l = &a->leaves[li];
         hit->t = h.t;
         hit->p = v3_madd(org, dir, h.t);
-        geom_shape_surface(sh, hit->p, h.part, &hit->ng, &hit->u, &hit->v);
+        /* the surface parameters only for triangles (their barycentrics,
+         * which the GI links read); no shading reads them for round shapes */
+        int tri = sh->kind == SHAPE_TRIANGLE || sh->kind == SHAPE_SMOOTH_TRIANGLE;
+        hit->u = hit->v = 0.0;
+        geom_shape_surface(sh, hit->p, h.part, &hit->ng, tri ? &hit->u : NULL, tri ? &hit->v : NULL);
         if (l->want_uv) {
             geom_shape_uv(sh, hit->p, h.part, hit->uv);
         } else {

@@ -842,8 +842,7 @@ void geom_shape_shading(const geom_shape *sh, vec3 p, vec3 ng, vec3 *ns)
 vec3 geom_shape_pov_normal(const geom_shape *sh, vec3 p, int part)
 {
     vec3 ng, ns;
-    double u, v;
-    geom_shape_surface(sh, p, part, &ng, &u, &v);
+    geom_shape_surface(sh, p, part, &ng, NULL, NULL);
     if (sh->kind == SHAPE_TRIANGLE || sh->kind == SHAPE_SMOOTH_TRIANGLE) {
         /* POV-Ray's (P1 - P2) x (P3 - P2) is against the winding normal
          * (accel.c's pov_flip) */
@@ -873,12 +872,15 @@ void geom_shape_surface(const geom_shape *sh, vec3 p, int part, vec3 *ng, double
     vec3 po = sh->identity ? p : xform_inv_point(&sh->x, p);
     vec3 n = v3(0, 1, 0);
     double su = 0.0, sv = 0.0;
+    int uv = u && v;
     switch (sh->kind) {
     case SHAPE_SPHERE: {
         n = v3_sub(po, sh->g.sphere.c);
-        vec3 un = v3_norm(n);
-        su = wrap01(atan2(un.z, un.x));
-        sv = clamp01(1.0 - acos(fmax(-1.0, fmin(1.0, un.y))) / (TWO_PI * 0.5));
+        if (uv) {
+            vec3 un = v3_norm(n);
+            su = wrap01(atan2(un.z, un.x));
+            sv = clamp01(1.0 - acos(fmax(-1.0, fmin(1.0, un.y))) / (TWO_PI * 0.5));
+        }
         break;
     }
     case SHAPE_BOX: {
@@ -899,13 +901,13 @@ void geom_shape_surface(const geom_shape *sh, vec3 p, int part, vec3 *ng, double
     case SHAPE_CONE: {
         vec3 rel = v3_sub(po, sh->g.cone.base);
         double x = v3_dot(rel, sh->g.cone.u), y = v3_dot(rel, sh->g.cone.v), z = v3_dot(rel, sh->g.cone.w);
-        su = wrap01(atan2(y, x));
+        if (uv) su = wrap01(atan2(y, x));
         if (part == GEOM_PART_CONE_BASE) {
             n = v3_neg(sh->g.cone.w);
-            sv = sh->g.cone.r0 > 0 ? clamp01(sqrt(x * x + y * y) / sh->g.cone.r0) : 0.0;
+            if (uv) sv = sh->g.cone.r0 > 0 ? clamp01(sqrt(x * x + y * y) / sh->g.cone.r0) : 0.0;
         } else if (part == GEOM_PART_CONE_CAP) {
             n = sh->g.cone.w;
-            sv = sh->g.cone.r1 > 0 ? clamp01(sqrt(x * x + y * y) / sh->g.cone.r1) : 0.0;
+            if (uv) sv = sh->g.cone.r1 > 0 ? clamp01(sqrt(x * x + y * y) / sh->g.cone.r1) : 0.0;
         } else {
             double k = sh->g.cone.k, rz = sh->g.cone.r0 + k * z;
             n = v3_add(v3_add(v3_scale(sh->g.cone.u, x), v3_scale(sh->g.cone.v, y)), v3_scale(sh->g.cone.w, -k * rz));
@@ -916,10 +918,12 @@ void geom_shape_surface(const geom_shape *sh, vec3 p, int part, vec3 *ng, double
     }
     case SHAPE_DISC: {
         n = sh->g.disc.n;
-        vec3 t, b, rel = v3_sub(po, sh->g.disc.c);
-        v3_basis(n, &t, &b);
-        su = wrap01(atan2(v3_dot(rel, b), v3_dot(rel, t)));
-        sv = clamp01(sqrt(v3_len2(rel) / sh->g.disc.r2));
+        if (uv) {
+            vec3 t, b, rel = v3_sub(po, sh->g.disc.c);
+            v3_basis(n, &t, &b);
+            su = wrap01(atan2(v3_dot(rel, b), v3_dot(rel, t)));
+            sv = clamp01(sqrt(v3_len2(rel) / sh->g.disc.r2));
+        }
         break;
     }
     case SHAPE_TORUS: {
@@ -931,14 +935,16 @@ void geom_shape_surface(const geom_shape *sh, vec3 p, int part, vec3 *ng, double
         } else {
             n = v3(0.0, po.y >= 0.0 ? 1.0 : -1.0, 0.0);
         }
-        su = wrap01(atan2(po.z, po.x));
-        sv = wrap01(atan2(po.y, rho - R));
+        if (uv) {
+            su = wrap01(atan2(po.z, po.x));
+            sv = wrap01(atan2(po.y, rho - R));
+        }
         break;
     }
     case SHAPE_TRIANGLE:
     case SHAPE_SMOOTH_TRIANGLE:
         n = v3_scale(v3_cross(sh->g.tri.e1, sh->g.tri.e2), sh->g.tri.wind);
-        tri_bary(sh, po, &su, &sv);
+        if (uv) tri_bary(sh, po, &su, &sv);
         break;
     case SHAPE_OVUS: {
         if (part == GEOM_PART_OVUS_BOTTOM) {
@@ -951,8 +957,10 @@ void geom_shape_surface(const geom_shape *sh, vec3 p, int part, vec3 *ng, double
             double f = hh > 0.0 ? 1.0 + sh->g.ovus.h / hh : 1.0;
             n = hh > 0.0 ? v3(po.x * f, po.y - sh->g.ovus.v, po.z * f) : v3(0.0, po.y > sh->g.ovus.v ? 1.0 : -1.0, 0.0);
         }
-        su = wrap01(atan2(po.z, po.x));
-        sv = clamp01((po.y + sh->g.ovus.rb) / (sh->g.ovus.rb + sh->g.ovus.rt));
+        if (uv) {
+            su = wrap01(atan2(po.z, po.x));
+            sv = clamp01((po.y + sh->g.ovus.rb) / (sh->g.ovus.rb + sh->g.ovus.rt));
+        }
         break;
     }
     case SHAPE_POLYGON: case SHAPE_LATHE: case SHAPE_SOR: case SHAPE_PRISM: case SHAPE_TEXT:
@@ -978,8 +986,10 @@ void geom_shape_surface(const geom_shape *sh, vec3 p, int part, vec3 *ng, double
     if (l > 0.0 && isfinite(l)) nw = v3_scale(nw, 1.0 / l);
     else nw = v3(0.0, 1.0, 0.0);
     *ng = nw;
-    *u = su;
-    *v = sv;
+    if (uv) {
+        *u = su;
+        *v = sv;
+    }
 }
 
 /* POV-Ray 3.7's angle of (x, z) from +x around y over 2 pi, 0..1, and 0 at

@@ -135,7 +135,9 @@ int geom_shape_inside(const geom_shape *sh, vec3 p);
 /* Surface data at world point p (on the shape, `part` from the hit): unit
  * outward world normal and natural surface parameters in [0,1] (triangles:
  * barycentrics, normal by world winding; `ns` gets the interpolated normal
- * of smooth triangles, else the geometric one; it may be NULL). */
+ * of smooth triangles, else the geometric one; it may be NULL). u and v
+ * may be NULL: the parameters are then not computed (they cost an atan2
+ * and more per hit on round shapes, and only triangles' are read). */
 void geom_shape_surface(const geom_shape *sh, vec3 p, int part, vec3 *ng, double *u, double *v);
 void geom_shape_shading(const geom_shape *sh, vec3 p, vec3 ng, vec3 *ns);
 /* POV-Ray's own unit normal at p (its Normal(): what trace() reports): the

@@ -126,8 +126,7 @@ static void find_crossing(const tess *t, vec3 a, vec3 b, int a_inside, vec3 *p, 
         part = np > 0 ? h[0].part : 0;
     }
     vec3 ng;
-    double u, v;
-    geom_shape_surface(sh, wp, part, &ng, &u, &v);
+    geom_shape_surface(sh, wp, part, &ng, NULL, NULL);
     *p = to_object(t, wp);
     *n = normal_to_object(sh, ng);
 }
@@ -392,8 +391,7 @@ int geom_tess_sample(const geom_tess_sampler *cs, double u1, double u2, rng *r, 
             int j = (int)(rng_f64(r) * k);
             if (j >= k) j = k - 1;
             *p = v3_madd(org, dir, h[j].t);
-            double u, v;
-            geom_shape_surface(cs->sh, *p, h[j].part, n, &u, &v);
+            geom_shape_surface(cs->sh, *p, h[j].part, n, NULL, NULL);
             *part = (unsigned)h[j].part;
             return 1;
         }
