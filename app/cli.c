@@ -214,7 +214,7 @@ static int parse_size(const char *v, cli_render *o)
 int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen)
 {
     /* POV-Ray's Initial_Frame, Final_Frame, Initial_Clock, Final_Clock, +A threshold, +R, +Q */
-    *o = (cli_render){.kfi = 1, .kff = 1, .kf = 1, .aa_threshold = 0.3, .aa_depth = 3, .aa_jitter = 1.0, .quality = 9, .spp = 1,
+    *o = (cli_render){.kfi = 1, .kff = 1, .kf = 1, .aa_threshold = 0.3, .aa_depth = 3, .aa_jitter = 1.0, .quality = 9,
                       .exr_compression = -1};
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
@@ -616,7 +616,8 @@ const char cli_render_help[] =
     "                         2-3 no shadows, 4 shadows (area lights as points), 5 area\n"
     "                         lights, 6-7 refraction, 8 reflection and normals, 9-11 media\n"
     "                         and radiosity (10, 11 are 9); quick colours are not modelled\n"
-    "  --spp N                samples per pixel (fixed supersampling; path/pmfg: per pixel)\n"
+    "  --spp N                samples per pixel: fixed supersampling (default 1: none);\n"
+    "                         path 1; pmfg eye samples (default 64); vpl (default 16)\n"
     "  --seed N               random seed (renders are repeatable for a seed)\n"
     "  --threads N, +WTn      worker threads (default: every CPU)\n"
     "\n"

@@ -46,7 +46,7 @@ typedef struct {
     int noutputs;
     int width, height;      /* 0 = default (POV-Ray's 320x240 unless the scene says) */
     const char *gi;         /* NULL = from the scene */
-    int spp;
+    int spp;                /* 0 = not given: the mode's default (render_gi_opts.spp) */
     int threads;
     uint64_t seed;
     const char *stats;

@@ -621,7 +621,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
     snprintf(settings, sizeof settings,
              "size %dx%d, antialias %s threshold %.17g depth %d, spp %d, seed %llu, gi %s, particles %ld, bounces %d",
              ss.width, ss.height, ss.antialias == 1 ? "adaptive" : (ss.antialias == 2 ? "fixed" : "off"), ss.aa_threshold,
-             ss.aa_depth, ss.spp, (unsigned long long)ss.seed, gi_used, o->particles, o->bounces);
+             ss.aa_depth, ss.spp > 0 ? ss.spp : 1, (unsigned long long)ss.seed, gi_used, o->particles, o->bounces);
     snprintf(hash, sizeof hash, "%016llx", (unsigned long long)scene_hash);
     snprintf(framestr, sizeof framestr, "%d clock %.17g", frame, so.clock);
     snprintf(window, sizeof window, "%d %d %d %d", run->win[0], run->win[1], run->win[2], run->win[3]);

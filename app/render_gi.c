@@ -28,8 +28,8 @@
 /* The Whitted pass's settings that render_gi_opts carries under
  * shade_settings' own names; the rest keep shade_default_settings'. */
 #define WHITTED_FIELDS(X) \
-    X(width) X(height) X(threads) X(seed) X(antialias) X(aa_threshold) X(aa_depth) X(aa_jitter) X(spp) X(cancel) \
-    X(progress) X(quality)
+    X(width) X(height) X(threads) X(seed) X(antialias) X(aa_threshold) X(aa_depth) X(aa_jitter) X(cancel) X(progress) \
+    X(quality)
 
 static void fill_shade(shade_settings *ss, const render_gi_opts *o)
 {
@@ -37,6 +37,7 @@ static void fill_shade(shade_settings *ss, const render_gi_opts *o)
 #define COPY_FIELD(f) ss->f = o->f;
     WHITTED_FIELDS(COPY_FIELD)
 #undef COPY_FIELD
+    if (o->spp > 0) ss->spp = o->spp;
     memcpy(ss->window, o->window, sizeof ss->window);
 }
 
@@ -378,7 +379,7 @@ static pt_status render_reference(const scene *sc, const accel *a, const render_
         pm_fg_default_settings(&fs);
         const int eye_spp = fs.c.spp;
         fill_common(&fs.c, o, &pc);
-        if (o->spp <= 1) fs.c.spp = eye_spp; /* --spp 1 (the CLI's default): pmfg's own (pm_fg.h) */
+        if (o->spp <= 0) fs.c.spp = eye_spp; /* no --spp: pmfg's own (pm_fg.h) */
         if (o->fg_rays > 0) fs.fg_rays = o->fg_rays;
         if (o->photons > 0) fs.photons = o->photons;
         st = pm_fg_render(sc, a, &fs, fb, &r->pm, d);
@@ -404,7 +405,7 @@ static pt_status render_vpl_mode(const scene *sc, const accel *a, const render_g
     vs.height = o->height;
     vs.threads = o->threads;
     vs.seed = o->seed;
-    if (o->spp > 1) vs.spp = o->spp; /* --spp 1 (the CLI's default): vpl's own */
+    if (o->spp > 0) vs.spp = o->spp; /* no --spp: vpl's own */
     if (o->vpls > 0) vs.vpls = o->vpls;
     if (o->bounces > 0) vs.bounces = o->bounces;
     vs.cut = o->vpl_cut;

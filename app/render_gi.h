@@ -29,7 +29,8 @@ typedef struct {
     int aa_depth;
     double aa_jitter;         /* +J amount (shade_settings.aa_jitter) */
     int quality;              /* none, particle: POV-Ray's +Q level 0..9 (shade_settings.quality) */
-    int spp;                  /* path: samples per pixel; pmfg: eye samples; none/particle: fixed AA */
+    int spp;                  /* path: samples per pixel; pmfg: eye samples; none/particle: fixed AA; vpl: per
+                                 pixel; 0: the mode's default (1; pmfg's and vpl's own) */
     long particles;           /* particle: area particles (0 = from the scene/default) */
     double photon_scale;      /* none, particle: the caustic layer's photons times this (0 = 1) */
     double gi_quality;        /* particle: multiplies the scene's particle count (0 = 1); --particles wins */

@@ -21,13 +21,13 @@
 #   cbox_particle   scenes/cbox.pov  128x128 --gi particle
 #   maze_particle   scenes/maze.pov  128x128 --gi particle
 #   cbox_path       scenes/cbox.pov  48x48 --gi path --spp 4
-#   cbox_pmfg       scenes/cbox.pov  32x32 --gi pmfg --fg-rays 64 --photons 20000 --spp 1
+#   cbox_pmfg       scenes/cbox.pov  32x32 --gi pmfg --fg-rays 64 --photons 20000
 #   cbox_vpl        scenes/cbox.pov  48x48 --gi vpl
 #   cbox_links      scenes/cbox.pov  48x48 --gi links
 #   photons_none    the distribution's lights/phot_met_glass.pov 64x48 --gi
 #                   none (its photons{} block: the caustic layer)
 #   photons_pmfg    the same, 32x24 --gi pmfg --fg-rays 64 --photons 20000
-#                   --spp 1 (the photon map's caustic photons)
+#                   (the photon map's caustic photons)
 # Every render uses --seed 1. Scenes are copied to OUTDIR first (scenes may
 # write files beside themselves). Exit status of compare (and of the two-binary
 # form): 0 when every file is identical, 1 otherwise (each differing or
@@ -85,11 +85,11 @@ render_set() { # BIN DIR
     render_one "$bin" "$dir" cbox_particle cbox.pov --size 128x128 --gi particle
     render_one "$bin" "$dir" maze_particle maze.pov --size 128x128 --gi particle
     render_one "$bin" "$dir" cbox_path cbox.pov --size 48x48 --gi path --spp 4
-    render_one "$bin" "$dir" cbox_pmfg cbox.pov --size 32x32 --gi pmfg --fg-rays 64 --photons 20000 --spp 1
+    render_one "$bin" "$dir" cbox_pmfg cbox.pov --size 32x32 --gi pmfg --fg-rays 64 --photons 20000
     render_one "$bin" "$dir" cbox_vpl cbox.pov --size 48x48 --gi vpl
     render_one "$bin" "$dir" cbox_links cbox.pov --size 48x48 --gi links
     render_one "$bin" "$dir" photons_none phot_met_glass.pov --size 64x48 --gi none
-    render_one "$bin" "$dir" photons_pmfg phot_met_glass.pov --size 32x24 --gi pmfg --fg-rays 64 --photons 20000 --spp 1
+    render_one "$bin" "$dir" photons_pmfg phot_met_glass.pov --size 32x24 --gi pmfg --fg-rays 64 --photons 20000
 }
 
 compare_sets() { # DIR_A DIR_B
