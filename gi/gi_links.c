@@ -101,7 +101,15 @@ static const scene_object *hit_leaf(const link_job *J, const struct RTCRayHit *h
  * base colour. In a closed room under a black sky this is the emission
  * alone. Where a particle answers (far 0, direct 0) the particle's
  * reflected light is added by the caller (gi_particle_view_regather). */
-static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int direct, float out[3])
+/* Whether a texture emits at all (its finish's emission under a white
+ * pigment), for the last texture asked: consecutive link rays mostly hit
+ * one object. */
+typedef struct {
+    const scene_texture *tex;
+    int emits;
+} emit_memo;
+
+static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int direct, emit_memo *memo, float out[3])
 {
     if (!J->esky) return;
     const scene_texture *tex;
@@ -109,9 +117,13 @@ static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int
     if (!o) return;
     float rho[3], le[3];
     if (!far && !direct) { /* the emission alone: none where the finish emits nothing */
-        const colour5 white = {1.0, 1.0, 1.0, 0.0, 0.0};
-        gi_particles_material(J->sc, tex, &white, rho, le);
-        if (!(le[0] > 0.0f || le[1] > 0.0f || le[2] > 0.0f)) return;
+        if (memo->tex != tex) {
+            const colour5 white = {1.0, 1.0, 1.0, 0.0, 0.0};
+            gi_particles_material(J->sc, tex, &white, rho, le);
+            memo->tex = tex;
+            memo->emits = le[0] > 0.0f || le[1] > 0.0f || le[2] > 0.0f;
+        }
+        if (!memo->emits) return;
     }
     vec3 p, n;
     hit_material(J, h, o, tex, rho, le, &p, &n);
@@ -264,6 +276,7 @@ static void job(void *ctx, int index, int thread)
     m = 0;
     const void *last_obj = NULL;
     int last_hid = -1;
+    emit_memo memo = {NULL, 0};
     for (int i = i0; i < i1; i++) {
         int any = 0;
         float sky[3] = {0.0f, 0.0f, 0.0f};
@@ -290,7 +303,7 @@ static void job(void *ctx, int index, int thread)
                  * centre, as POV-Ray's radiosity rays take area lights)
                  * rather than read from the nearest particle, whose value
                  * blurs shadow edges over a particle spacing */
-                if (hit) hit_light(J, &rh[m], 1, 1, sky);
+                if (hit) hit_light(J, &rh[m], 1, 1, &memo, sky);
                 J->links[(size_t)(i - J->first) * J->k + J->order[j]] = -1;
                 continue;
             }
@@ -315,7 +328,7 @@ static void job(void *ctx, int index, int thread)
             int hid = hobj ? last_hid : -1;
             if (hobj && hid < 0) {
                 unres++;
-                hit_light(J, &rh[m], 1, 1, sky);
+                hit_light(J, &rh[m], 1, 1, &memo, sky);
             } else if (hit && J->grid) {
                 const struct RTCRayHit *h = &rh[m];
                 vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
@@ -414,11 +427,11 @@ static void job(void *ctx, int index, int thread)
                 }
                 if (target < 0) {
                     unres++;
-                    if (hit) hit_light(J, &rh[m], 1, 1, sky);
+                    if (hit) hit_light(J, &rh[m], 1, 1, &memo, sky);
                 } else if (J->first > 0 && J->esky) {
                     /* the emission where it hit; the particle's reflected
                      * light, direct and indirect, follows in the regather */
-                    hit_light(J, &rh[m], 0, 0, sky);
+                    hit_light(J, &rh[m], 0, 0, &memo, sky);
                 }
             }
             J->links[(size_t)(i - J->first) * J->k + J->order[j]] = target;
