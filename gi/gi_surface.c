@@ -751,8 +751,31 @@ int gi_surface_in_clip(const gi_surface *g, vec3 p)
  * CLIP_PROBES points of its own sampler: 1 and 0 exactly when all or none
  * are in (a patch far from what the camera sees gets no particles). */
 #define CLIP_PROBES 16
+
+/* World bounds of patch p where they are known without sampling (a
+ * triangle's corners, a finite shape's box); 0 otherwise. */
+static int patch_bounds(const patch *p, vec3 *lo, vec3 *hi)
+{
+    if (p->kind == PATCH_TRI) {
+        vec3 b = v3_add(p->v0, p->e1), c = v3_add(p->v0, p->e2);
+        *lo = v3_min(p->v0, v3_min(b, c));
+        *hi = v3_max(p->v0, v3_max(b, c));
+    } else if (p->sh && !p->sh->infinite && !p->sh->clipped) {
+        *lo = p->sh->lo;
+        *hi = p->sh->hi;
+    } else {
+        return 0;
+    }
+    return v3_finite(*lo) && v3_finite(*hi) && lo->x <= hi->x && lo->y <= hi->y && lo->z <= hi->z;
+}
+
 float gi_surface_clip_fraction(const gi_surface *g, int i, uint64_t seed)
 {
+    /* a patch whose bounds lie in the box: every probe would be in */
+    vec3 lo, hi;
+    if (patch_bounds(&g->p[i], &lo, &hi) && lo.x >= g->lo.x && lo.y >= g->lo.y && lo.z >= g->lo.z &&
+        hi.x <= g->hi.x && hi.y <= g->hi.y && hi.z <= g->hi.z)
+        return 1.0f;
     rng r;
     rng_seed(&r, seed ^ 0xc11bULL, (uint64_t)i);
     int in = 0, n = 0;
