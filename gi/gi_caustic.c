@@ -327,17 +327,18 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
         double depth, rho_p;
         rgb tr;
         gi_caustic_inside in;
+        double t0; /* hits from here on (0: the self-intersection distance) */
     } branch;
     branch stack[2 * GI_CAUSTIC_MAX_BOUNCES + 4];
     int ns = 0;
-    stack[ns++] = (branch){o, w, {0}, 0, 0, 0.0, 1.0, {1, 1, 1}, {0, {0}}};
+    stack[ns++] = (branch){o, w, {0}, 0, 0, 0.0, 1.0, {1, 1, 1}, {0, {0}}, 0.0};
     vec3 p_first = o;
     int passes = 0;
     while (ns > 0) {
         branch br = stack[--ns];
         accel_hit h;
-        if (accel_intersect_past(c->a, br.has_from ? &br.from : NULL, br.o, br.w, c->eps, PHOTON_SKIP, &h,
-                                 &out->rays) <= 0)
+        if (accel_intersect_past(c->a, br.has_from ? &br.from : NULL, br.o, br.w, fmax(c->eps, br.t0), PHOTON_SKIP,
+                                 &h, &out->rays) <= 0)
             continue;
         int level = br.level;
         double depth = br.depth + h.t;
@@ -351,7 +352,11 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
                     return;
                 rgb tr = crgb(br.tr.r * st.weight.r, br.tr.g * st.weight.g, br.tr.b * st.weight.b);
                 if (!(cmax3(tr) >= c->adc) || !isfinite(tr.r + tr.g + tr.b)) return;
-                stack[ns++] = (branch){st.org, st.dir, st.from, 1, 0, depth, br.rho_p, tr, st.inside};
+                /* on along the same ray from the same origin, past the
+                 * hit as accel_intersect_past steps (an isosurface's
+                 * crossings, found from the ray's start, stay the same) */
+                stack[ns++] = (branch){br.o, br.w, br.from, br.has_from, 0, br.depth, br.rho_p, tr, st.inside,
+                                       h.t + fmax(c->eps, h.t * 1e-7)};
                 continue;
             }
             out->first_hits++;
@@ -396,7 +401,7 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
             if (!(cmax3(tr) >= c->adc) || !isfinite(tr.r + tr.g + tr.b)) continue;
             if (ns >= (int)(sizeof stack / sizeof stack[0])) continue;
             stack[ns++] = (branch){st->org, st->dir, st->from, 1, level + 1, depth,
-                                   br.rho_p * fmin(1.0, fmax(st->rho, 1e-6)), tr, st->inside};
+                                   br.rho_p * fmin(1.0, fmax(st->rho, 1e-6)), tr, st->inside, 0.0};
             went = 1;
         }
         if (went) out->alive[level + 1]++;

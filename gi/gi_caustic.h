@@ -115,10 +115,10 @@ typedef struct {
     /* The brilliance of the receiving finish at h seen along unit dir (the
      * photons' weight, gi_caus_add); NULL: 1. */
     double (*brilliance)(void *ctx, const accel_hit *h, vec3 dir);
-    /* A pass_through object met before the target: *step goes on along
-     * dir from its far side, weighted by what the surface lets through,
-     * with the containers crossed; 0 when nothing passes. NULL: the
-     * photon ends there. */
+    /* A pass_through object met before the target: step->weight is what
+     * the surface lets through and step->inside the containers crossed
+     * (the photon goes on along the same ray); 0 when nothing passes.
+     * NULL: the photon ends there. */
     int (*pass)(void *ctx, const accel_hit *h, vec3 dir, const gi_caustic_inside *in, gi_caustic_step *step);
 } gi_caustic_hooks;
 
