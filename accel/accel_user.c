@@ -217,7 +217,8 @@ void accel_user_bounds_link(const struct RTCBoundsFunctionArguments *args)
  * rays, 9% of the particle GI geometry stage's instructions). Conservative:
  * a NaN slab (a zero direction component starting on a face) constrains
  * nothing, and the interval must be empty by more than float rounding. */
-static int user_box_missed(const accel *a, unsigned prim, void *ray, unsigned N, unsigned i)
+__attribute__((always_inline)) static inline int user_box_missed(const accel *a, unsigned prim, void *ray,
+                                                                  unsigned N, unsigned i)
 {
     if (!a->ubox) return 0;
     const float *b = a->ubox + 6 * (size_t)prim;
@@ -234,6 +235,13 @@ static int user_box_missed(const accel *a, unsigned prim, void *ray, unsigned N,
         if (t1 < tf) tf = t1;
     }
     return tn > tf + 1e-5f * fabsf(tf) + 1e-30f;
+}
+
+/* user_box_missed with the single ray's offsets folded (N = 1: a query's
+ * ray, by far the most common) or for lane i of a packet. */
+static int box_missed(const accel *a, unsigned prim, void *ray, unsigned N, unsigned i)
+{
+    return N == 1 ? user_box_missed(a, prim, ray, 1, 0) : user_box_missed(a, prim, ray, N, i);
 }
 
 /* One user primitive against a ray: an analytic shape or a CSG tree. */
@@ -301,7 +309,7 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
     float *hit = (float *)args->rayhit + 12 * (size_t)N;
     if (args->primID >= (unsigned)(a->nshapes + a->ncsgs)) return; /* the link scene's empty primitive */
     for (unsigned i = 0; i < N; i++) {
-        if (args->valid[i] != -1 || user_box_missed(a, args->primID, ray, N, i)) continue;
+        if (args->valid[i] != -1 || box_missed(a, args->primID, ray, N, i)) continue;
         float tfar = SOA_F(ray, N, i, 8);
         vec3 o, d;
         double tmin;
@@ -353,7 +361,7 @@ void accel_user_occluded(const struct RTCOccludedFunctionNArguments *args)
     int exact = q && (void *)q == (void *)args->context && N == 1;
     void *ray = args->ray;
     for (unsigned i = 0; i < N; i++) {
-        if (args->valid[i] != -1 || user_box_missed(a, args->primID, ray, N, i)) continue;
+        if (args->valid[i] != -1 || box_missed(a, args->primID, ray, N, i)) continue;
         vec3 o, d;
         double tmin;
         user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);

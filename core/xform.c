@@ -125,11 +125,4 @@ xform xform_inverse(xform a)
     return r;
 }
 
-int xform_is_identity(const xform *a)
-{
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 4; j++)
-            if (a->m[i][j] != (i == j ? 1.0 : 0.0)) return 0;
-    return 1;
-}
 

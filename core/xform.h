@@ -19,7 +19,13 @@ xform xform_matrix(const double v[12]);
 /* Apply a, then b. */
 xform xform_then(xform a, xform b);
 xform xform_inverse(xform a);
-int xform_is_identity(const xform *a);
+/* inline and unrolled: shading asks it of every texture layer at every hit */
+static inline int xform_is_identity(const xform *a)
+{
+    return a->m[0][0] == 1.0 && a->m[1][1] == 1.0 && a->m[2][2] == 1.0 && a->m[0][1] == 0.0 && a->m[0][2] == 0.0 &&
+           a->m[0][3] == 0.0 && a->m[1][0] == 0.0 && a->m[1][2] == 0.0 && a->m[1][3] == 0.0 && a->m[2][0] == 0.0 &&
+           a->m[2][1] == 0.0 && a->m[2][3] == 0.0;
+}
 /* inline: they run per ray and per inside test of every transformed shape.
  * M's 3x3 part times v, and with column 3 added (the sums in the same order,
  * so either form rounds as one written-out expression would). */
