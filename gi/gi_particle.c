@@ -434,8 +434,9 @@ static pt_status catchment_areas(gi_particles *ps, const int *glink, int ng)
 
 /* Sky light in the lighting stage (beyond the paper, which leaves open
  * scenes out): what a particle's gathering links that left the scene saw
- * (and the far field of those no particle answered) is light arriving at
- * it, E/pi = esky (gi_links.h), which it reflects as rho * E / pi like
+ * (and the far field of those no particle answered: an emitting dome
+ * beyond the clip box, under a black sky too) is light arriving at it,
+ * E/pi = esky (gi_links.h), which it reflects as rho * E / pi like
  * light from a light_source. That reflected radiance is added to the
  * particle's emitted radiance le, so emission (gi_k_emit) sends it along
  * the scattering links and the gathering step reads it, with no further
@@ -444,17 +445,23 @@ static pt_status catchment_areas(gi_particles *ps, const int *glink, int ng)
  * gathered light: with no scattering bounce (recursion_limit 1) the sky
  * reaches a surface only through its own gathering (gi_k_gather), not by
  * way of another surface. */
+static float sky_reflected(const gi_particle *gp, int i, int c)
+{
+    if (gp->set.bounces < 1 || !gp->esky) return 0.0f;
+    float v = gp->ps.p[i].rho[c] * (float)gp->set.brightness * gp->esky[4 * (size_t)i + c];
+    return isfinite(v) ? v : 0.0f;
+}
+
 static void sky_as_emission(gi_particle *gp)
 {
-    if (gp->set.bounces < 1 || !gp->esky || gi_sky_black(gp->sky)) return;
-    float b = (float)gp->set.brightness;
-    for (int i = 0; i < gp->ps.n; i++) {
-        gi_dev_particle *p = &gp->ps.p[i];
-        for (int c = 0; c < 3; c++) {
-            float le = p->le[c] + p->rho[c] * b * gp->esky[4 * (size_t)i + c];
-            if (isfinite(le)) p->le[c] = le;
-        }
-    }
+    for (int i = 0; i < gp->ps.n; i++)
+        for (int c = 0; c < 3; c++) gp->ps.p[i].le[c] += sky_reflected(gp, i, c);
+}
+
+float gi_particle_own_emission(const gi_particle *gp, int i, int c)
+{
+    float v = gp->ps.p[i].le[c] - sky_reflected(gp, i, c);
+    return v > 0.0f ? v : 0.0f;
 }
 
 gi_particle *gi_particle_begin(const scene *sc, const accel *a, const gi_particle_settings *s, diag *d,

@@ -247,8 +247,9 @@ static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int
 static int gather_values(gi_particle *gp)
 {
     int *idx = malloc((size_t)gp->vg_n * sizeof *idx);
-    /* the particles' reflected radiance: the emission was taken where each
-     * ray hit (gi_links.h, first > 0) */
+    /* the particles' reflected radiance, the sky light they reflect
+     * included: their own emission was taken where each ray hit
+     * (gi_links.h, first > 0) */
     float *lrefl = malloc((size_t)gp->ps.n * 4 * sizeof *lrefl);
     if (!idx || !lrefl) {
         free(idx);
@@ -258,7 +259,7 @@ static int gather_values(gi_particle *gp)
     for (int i = 0; i < gp->vg_n; i++) idx[i] = i;
     for (int t = 0; t < gp->ps.n; t++) {
         for (int c = 0; c < 3; c++) {
-            float v = gp->lout[4 * (size_t)t + c] - gp->ps.p[t].le[c];
+            float v = gp->lout[4 * (size_t)t + c] - gi_particle_own_emission(gp, t, c);
             lrefl[4 * (size_t)t + c] = v > 0.0f ? v : 0.0f;
         }
         lrefl[4 * (size_t)t + 3] = 0.0f;

@@ -160,6 +160,11 @@ void gi_particle_fill_stats(gi_particle *gp, gi_particle_stats *out);
 const void **gi_particle_objects(const gi_particle *gp, const gi_particles *ps, unsigned char **pin,
                                  pt_status *st);
 
+/* Particle i's own emission in channel c: its le without the sky light
+ * it reflects, which the geometry stage adds to le (sky_as_emission,
+ * gi_particle.c). */
+float gi_particle_own_emission(const gi_particle *gp, int i, int c);
+
 /* Geometry stage helpers the lighting stage uses (gi_particle.c). */
 /* calloc of n (at least 1) elements; sets *st to PT_ERR_NOMEM on failure. */
 void *gi_particle_calloc(size_t n, size_t size, pt_status *st);
