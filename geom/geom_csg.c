@@ -258,6 +258,97 @@ static int quadric_box_local(const geom_csg *c, int leaf, const bbox *V, bbox *o
     return 1;
 }
 
+/* ------------------------------------------------------------ members' hierarchy */
+
+#define CSG_BVH_LEAF 4
+
+static double keep_centre(const geom_csg *c, int s, int axis)
+{
+    return 0.5 * (v3_idx(c->keep_box[2 * s], axis) + v3_idx(c->keep_box[2 * s + 1], axis));
+}
+
+/* Reorders it[0 .. n) so that it[k] has the k-th smallest keep-box centre
+ * along axis, the smaller ones before it (Hoare's selection). */
+static void select_kth(const geom_csg *c, int *it, int n, int k, int axis)
+{
+    int lo = 0, hi = n - 1;
+    while (lo < hi) {
+        double piv = keep_centre(c, it[(lo + hi) / 2], axis);
+        int i = lo, j = hi;
+        while (i <= j) {
+            while (keep_centre(c, it[i], axis) < piv) i++;
+            while (keep_centre(c, it[j], axis) > piv) j--;
+            if (i <= j) {
+                int tmp = it[i];
+                it[i++] = it[j];
+                it[j--] = tmp;
+            }
+        }
+        if (k <= j) hi = j;
+        else if (k >= i) lo = i;
+        else break;
+    }
+}
+
+/* Node over bvh_items[first .. first + n): median split along the longest
+ * axis of the boxes' centres; returns its index (*nn nodes so far). */
+static int bvh_node(geom_csg *c, int first, int n, int *nn)
+{
+    int me = (*nn)++;
+    bbox box = bb_empty(), cen = bb_empty();
+    for (int i = first; i < first + n; i++) {
+        int s = c->bvh_items[i];
+        bbox b = {c->keep_box[2 * s], c->keep_box[2 * s + 1]};
+        vec3 m = v3_scale(v3_add(b.lo, b.hi), 0.5);
+        box = bb_union(box, b);
+        cen = bb_union(cen, (bbox){m, m});
+    }
+    c->bvh[me].lo = box.lo;
+    c->bvh[me].hi = box.hi;
+    if (n <= CSG_BVH_LEAF) {
+        c->bvh[me].first = first;
+        c->bvh[me].count = n;
+        return me;
+    }
+    vec3 ext = v3_sub(cen.hi, cen.lo);
+    int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : ext.y >= ext.z ? 1 : 2;
+    select_kth(c, c->bvh_items + first, n, n / 2, axis);
+    bvh_node(c, first, n / 2, nn);
+    c->bvh[me].first = bvh_node(c, first + n / 2, n - n / 2, nn);
+    c->bvh[me].count = 0;
+    return me;
+}
+
+/* The hierarchy over the members with a finite keep box (those with an
+ * empty one are never tried, nor surfaceless ones); without memory for
+ * it, rays try every member as below it. */
+static void build_bvh(geom_csg *c)
+{
+    int n = 0, nu = 0;
+    c->bvh_items = malloc((size_t)c->nshapes * sizeof(int));
+    c->unbounded = malloc((size_t)c->nshapes * sizeof(int));
+    c->bvh = malloc((size_t)(2 * c->nshapes) * sizeof(geom_csg_bvh));
+    if (!c->bvh_items || !c->unbounded || !c->bvh) goto fail;
+    for (int s = 0; s < c->nshapes; s++) {
+        const vec3 *kb = c->keep_box + 2 * s;
+        if (c->nodes[c->shape_node[s]].nosurf || !(kb[0].x <= kb[1].x)) continue;
+        if (v3_finite(kb[0]) && v3_finite(kb[1])) c->bvh_items[n++] = s;
+        else c->unbounded[nu++] = s;
+    }
+    c->nunbounded = nu;
+    if (n == 0) goto fail;
+    int nn = 0;
+    bvh_node(c, 0, n, &nn);
+    return;
+fail:
+    free(c->bvh_items);
+    free(c->unbounded);
+    free(c->bvh);
+    c->bvh_items = c->unbounded = NULL;
+    c->bvh = NULL;
+    c->nunbounded = 0;
+}
+
 int geom_csg_finish(geom_csg *c)
 {
     if (c->nnodes == 0) return 0;
@@ -398,6 +489,7 @@ int geom_csg_finish(geom_csg *c)
             c->keep_box[2 * sh] = kb.lo;
             c->keep_box[2 * sh + 1] = kb.hi;
         }
+        if (c->nshapes > GEOM_CSG_BVH_MIN) build_bvh(c);
     } else {
         free(c->keep_box);
         free(c->inside_box);
@@ -428,6 +520,9 @@ void geom_csg_free(geom_csg *c)
     free(c->shape_node);
     free(c->keep_box);
     free(c->inside_box);
+    free(c->bvh);
+    free(c->bvh_items);
+    free(c->unbounded);
     memset(c, 0, sizeof *c);
 }
 
@@ -495,46 +590,77 @@ int geom_csg_kept(const geom_csg *c, int node, vec3 p)
  * nearest kept crossing over all members is the answer. */
 #define CSG_CHUNK 8
 
+/* Member s's nearest kept crossing in (tmin, *best): into *h, *best
+ * lowered, 1 returned. */
+static int try_member(const geom_csg *c, int s, vec3 org, vec3 dir, double tmin, double *bestp, geom_csg_hit *h)
+{
+    int found = 0;
+    double best = *bestp;
+    int node = c->shape_node[s];
+    if (c->nodes[node].nosurf) return 0;
+    double from = tmin, upto = INFINITY;
+    if (c->keep_box) {
+        /* the ray must cross where this member's crossings can be kept,
+         * and only that stretch is searched (a clipped quartic's root
+         * finder then works on the clip box's chord, not the whole
+         * ray); an isosurface's crossings count from the ray's start
+         * (max_trace), so its search starts there */
+        const vec3 *kb = c->keep_box + 2 * s;
+        double t0, t1;
+        if (!(kb[0].x <= kb[1].x) || !v3_slab(org, dir, kb[0], kb[1], &t0, &t1) || t1 < tmin || t0 > best) return 0;
+        double pad = 1e-9 * (fabs(t0) + fabs(t1)) + 1e-300;
+        upto = t1 + pad;
+        if (c->shapes[s].kind != SHAPE_ISOSURFACE && t0 - pad > tmin) from = t0 - pad;
+    }
+    for (int guard = 0; guard < 1000; guard++) {
+        geom_shape_hit tmp[CSG_CHUNK];
+        int k = geom_shape_ray_hits(&c->shapes[s], org, dir, from, fmin(best, upto), tmp, CSG_CHUNK);
+        int kept_one = 0;
+        for (int j = 0; j < k; j++) {
+            if (geom_csg_kept(c, node, v3_madd(org, dir, tmp[j].t))) {
+                best = tmp[j].t;
+                h->t = tmp[j].t;
+                h->shape = s;
+                h->part = tmp[j].part;
+                h->flip = c->nodes[node].flip;
+                found = 1;
+                kept_one = 1;
+                break;
+            }
+        }
+        if (kept_one || k < CSG_CHUNK) break;
+        if (!(tmp[k - 1].t > from)) break;
+        from = tmp[k - 1].t;
+    }
+    *bestp = best;
+    return found;
+}
+
 int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, geom_csg_hit *h)
 {
     int found = 0;
     double best = tmax;
-    for (int s = 0; s < c->nshapes; s++) {
-        int node = c->shape_node[s];
-        if (c->nodes[node].nosurf) continue;
-        double from = tmin, upto = INFINITY;
-        if (c->keep_box) {
-            /* the ray must cross where this member's crossings can be kept,
-             * and only that stretch is searched (a clipped quartic's root
-             * finder then works on the clip box's chord, not the whole
-             * ray); an isosurface's crossings count from the ray's start
-             * (max_trace), so its search starts there */
-            const vec3 *kb = c->keep_box + 2 * s;
+    if (!c->bvh) {
+        for (int s = 0; s < c->nshapes; s++) found |= try_member(c, s, org, dir, tmin, &best, h);
+    } else {
+        for (int i = 0; i < c->nunbounded; i++) found |= try_member(c, c->unbounded[i], org, dir, tmin, &best, h);
+        /* a node's box holds its members' keep boxes, so skipping a node
+         * whose interval lies outside (tmin, best) skips only members that
+         * try_member would skip; depth is log2 of the members */
+        int stack[64], sp = 0;
+        stack[sp++] = 0;
+        while (sp > 0) {
+            int ni = stack[--sp];
+            const geom_csg_bvh *nd = &c->bvh[ni];
             double t0, t1;
-            if (!(kb[0].x <= kb[1].x) || !v3_slab(org, dir, kb[0], kb[1], &t0, &t1) || t1 < tmin || t0 > best) continue;
-            double pad = 1e-9 * (fabs(t0) + fabs(t1)) + 1e-300;
-            upto = t1 + pad;
-            if (c->shapes[s].kind != SHAPE_ISOSURFACE && t0 - pad > tmin) from = t0 - pad;
-        }
-        for (int guard = 0; guard < 1000; guard++) {
-            geom_shape_hit tmp[CSG_CHUNK];
-            int k = geom_shape_ray_hits(&c->shapes[s], org, dir, from, fmin(best, upto), tmp, CSG_CHUNK);
-            int kept_one = 0;
-            for (int j = 0; j < k; j++) {
-                if (geom_csg_kept(c, node, v3_madd(org, dir, tmp[j].t))) {
-                    best = tmp[j].t;
-                    h->t = tmp[j].t;
-                    h->shape = s;
-                    h->part = tmp[j].part;
-                    h->flip = c->nodes[node].flip;
-                    found = 1;
-                    kept_one = 1;
-                    break;
-                }
+            if (!v3_slab(org, dir, nd->lo, nd->hi, &t0, &t1) || t1 < tmin || t0 > best) continue;
+            if (nd->count > 0) {
+                for (int k = 0; k < nd->count; k++)
+                    found |= try_member(c, c->bvh_items[nd->first + k], org, dir, tmin, &best, h);
+            } else if (sp + 2 <= 64) {
+                stack[sp++] = nd->first;
+                stack[sp++] = ni + 1;
             }
-            if (kept_one || k < CSG_CHUNK) break;
-            if (!(tmp[k - 1].t > from)) break;
-            from = tmp[k - 1].t;
         }
     }
     assert(!found || (h->t > tmin && h->t < tmax && h->shape >= 0 && h->shape < c->nshapes));

@@ -34,6 +34,8 @@
  * and cylinders' internal surfaces band the liquid), so the bound only
  * keeps a generated merge of many thousands from being traced leaf by leaf. */
 #define GEOM_CSG_MAX_MERGE 4096
+/* Members beyond which geom_csg_finish builds the keep boxes' hierarchy. */
+#define GEOM_CSG_BVH_MIN 32
 
 /* o, or a member of it at any level, is a mesh (depth: o's nesting level;
  * nothing deeper than GEOM_CSG_MAX_DEPTH counts). */
@@ -57,6 +59,14 @@ typedef struct {
                          counting as one (set by geom_csg_finish) */
 } geom_csg_node;
 
+/* A node of the members' bounding volume hierarchy (geom_csg.bvh): a leaf
+ * (count > 0) holds bvh_items[first .. first + count); an inner node's
+ * children are the next node and node `first`. */
+typedef struct {
+    vec3 lo, hi;
+    int first, count;
+} geom_csg_bvh;
+
 typedef struct {
     geom_csg_node *nodes;
     int nnodes, capnodes;
@@ -72,6 +82,13 @@ typedef struct {
      * siblings that must contain it, up to the root), and per node the box
      * of its inside; rays and inside tests skip what lies outside them. */
     vec3 *keep_box, *inside_box;
+    /* From geom_csg_finish, for a CSG of more than GEOM_CSG_BVH_MIN members
+     * (NULL otherwise): a hierarchy over the finite keep boxes, so that a
+     * ray tries the members whose boxes it crosses, not every member; the
+     * members with an unbounded keep box are tried always. */
+    geom_csg_bvh *bvh;
+    int *bvh_items, *unbounded;
+    int nunbounded;
     unsigned flags;        /* caller's tag (accel.c: effective object flags of the root) */
 } geom_csg;
 
