@@ -87,7 +87,7 @@ typedef struct {
 static const gi_mode modes[] = {
     {"none", "", 1e-3, 1e-4, 1e-4, 0, NULL},
     {"path", "--spp 2", 0.02, 1e-3, 0, 1, NULL},
-    {"pmfg", "--photons 2000 --fg-rays 16 --spp 2", 0.02, 1e-3, 0, 1, NULL},
+    {"pmfg", "--photons 2000 --fg-rays 16 --spp 1", 0.02, 1e-3, 0, 1, NULL},
     {"particle", "--particles 500", 0.02, 1e-3, 0, 1, NULL},
 };
 #define NMODES (sizeof modes / sizeof modes[0])
