@@ -11,6 +11,7 @@
  *  detp      incremental photon paths and the fixed-radius estimate
  *            (reference/pm_detp.h) as the indirect hook of the Whitted pass. */
 #include "render_gi.h"
+#include "shade_gamma.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -384,6 +385,10 @@ static pt_status render_reference(const scene *sc, const accel *a, const render_
         if (o->photons > 0) fs.photons = o->photons;
         st = pm_fg_render(sc, a, &fs, fb, &r->pm, d);
     }
+    /* The references shade in the scene's working space as the Whitted
+     * renderer does (POV-Ray's assumed_gamma: the scene's colours and the
+     * arithmetic on them), so their image leaves it the same way. */
+    if (st == PT_OK) shade_gamma_fb_to_linear(sc, fb);
     double total = timer_now() - t0;
     r->t_gi_lighting = r->pm.t_lights + r->pm.t_photons + r->pm.t_maps + r->pm.t_irradiance;
     r->t_render = r->pm.t_render > 0 ? r->pm.t_render : total - r->t_gi_lighting;
