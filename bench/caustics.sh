@@ -12,7 +12,10 @@
 # render meets the bounds (luminance within 5%, FLIP no worse than POV-Ray's
 # default, time no longer); then, per scene, bench_caustics' splat-versus-
 # kd-tree-gather times and Russian-roulette attrition. Prints figures; not
-# a test.
+# a test. With CAUSTICS_FLOOR=1, each row is followed by the floor without
+# caustics: the scene with its global photons block removed, rendered by
+# both, partray's FLIP against POV-Ray's (how much of the row's FLIP is not
+# the caustics).
 #
 # usage: bench/caustics.sh [SIZE] [THREADS] [REF_TIMEOUT] [SCENE...]
 #   SIZE default 160x120, THREADS 2, REF_TIMEOUT 1200 s (a 4x render that
@@ -47,13 +50,14 @@ t = time.time(); subprocess.call(sys.argv[1:], stdout=subprocess.DEVNULL, stderr
 print("%.3f" % (time.time() - t))' "$@"
 }
 
-# The scene with its global photons block at 4x the photons: count x4, or
-# spacing / 2 (POV-Ray's photon count goes as 1 / spacing^2); a block with
-# neither gets spacing 0.5 (the default spacing 1, halved).
-photons4x() {
-    python3 - "$1" "$2" <<'EOF'
+# The scene with its global photons block edited. MODE 4x: at 4x the
+# photons: count x4, or spacing / 2 (POV-Ray's photon count goes as
+# 1 / spacing^2); a block with neither gets spacing 0.5 (the default spacing
+# 1, halved). MODE off: the block removed (no photons at all).
+photons_edit() {
+    python3 - "$1" "$2" "$3" <<'EOF'
 import re, sys
-src, dst = sys.argv[1], sys.argv[2]
+mode, src, dst = sys.argv[1], sys.argv[2], sys.argv[3]
 text = open(src, encoding='latin-1').read()
 out, i, done = [], 0, False
 for m in re.finditer(r'\bphotons\s*\{', text):
@@ -68,6 +72,9 @@ for m in re.finditer(r'\bphotons\s*\{', text):
     def count4(c): return c.group(1) + str(4 * int(float(c.group(2))))
     def spacing2(c): return c.group(1) + repr(float(c.group(2)) / 2)
     new = code
+    if mode == 'off':
+        out.append(text[i:m.start()]); out.append('/* photons removed */'); i = j; done = True
+        continue
     if re.search(r'\bcount\b', code):
         new = re.sub(r'(\bcount\s+)([0-9.eE+]+)', count4, code)
     elif re.search(r'\bspacing\b', code):
@@ -89,7 +96,7 @@ for rel in "$@"; do
     ref="$CACHE/${stem}_${key}_${W}x${H}_4x.png"
     note=""
     if [ ! -f "$ref" ] && [ ! -f "$ref.timedout" ]; then
-        if [ "$(photons4x "$work/$base" "$work/${stem}_4x.pov")" = ok ]; then
+        if [ "$(photons_edit 4x "$work/$base" "$work/${stem}_4x.pov")" = ok ]; then
             (cd "$work" && timeout "$RTIMEOUT" povray +I"${stem}_4x.pov" +O"${stem}_4x.png" $POVOPTS +L"$work" >/dev/null 2>&1)
             if [ -f "$work/${stem}_4x.png" ]; then cp "$work/${stem}_4x.png" "$ref"; else touch "$ref.timedout"; fi
         fi
@@ -144,6 +151,14 @@ print("%-34s %7.4f %8.4f %8.4f %8s %8.2f %8.2f %6.3f  %s %s %s%s" % (rel, lum, f
       ok(abs(lum - 1) <= 0.05), ok(fpt <= fpov) if fpov > 0 else "--", ok(tt <= tp), note))
 print("RATIO %.6f" % (tt / tp if tp > 0 else 1), file=sys.stderr)
 ' "$rel" "$fpov" "$mad" "$t_pov" "$t_pt" "$note" 2>>"$TMP/ratios"
+    if [ "${CAUSTICS_FLOOR:-0}" = 1 ] && [ "$(photons_edit off "$work/$base" "$work/${stem}_off.pov")" = ok ]; then
+        (cd "$work" && povray +I"${stem}_off.pov" +O"${stem}_off_pov.png" $POVOPTS +L"$work" >/dev/null 2>&1)
+        (cd "$work" && "$PARTRAY" render "${stem}_off.pov" --size "$SIZE" +A0.3 --threads "$THREADS" -o "${stem}_off_pt.png" \
+             --quiet >/dev/null 2>&1)
+        "$PARTRAY" compare "$work/${stem}_off_pov.png" "$work/${stem}_off_pt.png" --json 2>/dev/null | python3 -c '
+import json, sys
+print("  without photons (both renderers): FLIP partray vs POV-Ray %.4f" % json.load(sys.stdin)["flip"]["mean"])'
+    fi
     (cd "$work" && "$BENCH" "$base" --size "$SIZE" --threads "$THREADS" --reps 3 > "$TMP/${stem}.bench" 2>&1)
 done
 awk '/^RATIO/ { n++; s += log($2) } END { if (n) printf "geometric mean of partray/POV-Ray wall time over %d scenes: %.3f\n", n, exp(s / n) }' "$TMP/ratios"
