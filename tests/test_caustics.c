@@ -40,6 +40,14 @@ static double centre_mean(const float *img, int stride, int w, int h, int cw, in
     return s / (cw * ch);
 }
 
+/* Mean of channel k over the n pixels of a layer image (4 floats a pixel). */
+static double channel_mean(const float *img, int n, int k)
+{
+    double s = 0.0;
+    for (int i = 0; i < n; i++) s += img[4 * i + k];
+    return s / n;
+}
+
 /* A glass sphere (radius 0.5, ior 1.5) 0.8 above a white floor under a
  * point light 10 above the floor that falls off as 1/d^2 (colour 50,
  * fade_distance 0.1, fade_power 2: 2/(1 + (d/0.1)^2) = 0.02/d^2 within
@@ -240,9 +248,7 @@ static void test_pass_through_filter(void **state)
     const float *img = gi_caustic_image(c.layer);
     const double f[3] = {0.8, 0.5, 0.35};
     for (int k = 0; k < 3; k++) {
-        double e = 0.0;
-        for (int i = 0; i < 32 * 32; i++) e += img[4 * i + k] / (32.0 * 32.0);
-        double want = f[k] * f[k] * 5.0 / sqrt(41.0);
+        double e = channel_mean(img, 32 * 32, k), want = f[k] * f[k] * 5.0 / sqrt(41.0);
         printf("pass_through pane, channel %d: caustic layer %.5f, closed form %.5f (rel err %+.4f, tol 0.02)\n", k, e,
                want, e / want - 1.0);
         assert_true(fabs(e / want - 1.0) <= 0.02);
@@ -281,8 +287,7 @@ static void test_slab_transmission(void **state)
     const float *img = gi_caustic_image(c.layer);
     const double col[3] = {0.35, 0.65, 0.85};
     for (int k = 0; k < 3; k++) {
-        double e = 0.0;
-        for (int i = 0; i < 256; i++) e += img[4 * i + k] / 256.0;
+        double e = channel_mean(img, 256, k);
         double a = exp(-(1.0 - col[k]) / 2.0), want = 0.81 * a / (1.0 - 0.01 * a * a);
         printf("slab channel %d: caustic layer %.4f, closed form %.4f (rel err %+.4f, tol 0.03)\n", k, e, want,
                e / want - 1.0);
