@@ -933,6 +933,42 @@ static void query_init(accel_query *q, vec3 org, vec3 dir, double t0)
     rtcInitIntersectContext(&q->rtc);
 }
 
+/* The hit record of user primitive prim's crossing h of org + t dir. */
+static void fill_user(const accel *a, unsigned prim, const geom_csg_hit *h, vec3 org, vec3 dir, accel_hit *hit)
+{
+    const geom_shape *sh = accel_prim_shape(a, prim, h->shape);
+    unsigned li = prim < (unsigned)a->nshapes ? a->shape_leaf[prim]
+                                              : a->csgs[prim - (unsigned)a->nshapes].shape_leaf[h->shape];
+    assert(li < (unsigned)a->nleaves);
+    const accel_leaf *l = &a->leaves[li];
+    hit->t = h->t;
+    hit->p = v3_madd(org, dir, h->t);
+    /* the surface parameters only for triangles (their barycentrics,
+     * which the GI links read); no shading reads them for round shapes */
+    int tri = sh->kind == SHAPE_TRIANGLE || sh->kind == SHAPE_SMOOTH_TRIANGLE;
+    hit->u = hit->v = 0.0;
+    geom_shape_surface(sh, hit->p, h->part, &hit->ng, tri ? &hit->u : NULL, tri ? &hit->v : NULL);
+    if (l->want_uv) {
+        geom_shape_uv(sh, hit->p, h->part, hit->uv);
+    } else {
+        hit->uv[0] = hit->p.x;
+        hit->uv[1] = hit->p.y;
+    }
+    if (h->flip) hit->ng = v3_neg(hit->ng);
+    /* triangles intersected here (CSG members): POV-Ray's normal as in fill_triangle */
+    hit->pov_flip = (sh->kind == SHAPE_TRIANGLE || sh->kind == SHAPE_SMOOTH_TRIANGLE) && sh->g.tri.wind > 0.0;
+    if (h->flip) hit->pov_flip = !hit->pov_flip;
+    geom_shape_shading(sh, hit->p, hit->ng, &hit->ns);
+    hit->obj = l->obj;
+    hit->texture = l->texture;
+    if (sh->kind == SHAPE_BLOB) {
+        const scene_texture *bt = geom_shape_texture(sh, hit->p);
+        if (bt) hit->texture = bt;
+    }
+    hit->prim = (unsigned)h->part;
+    hit->flags = l->flags;
+}
+
 /* accel_intersect with the effective tmin t0 as given. */
 static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tmax, accel_hit *hit)
 {
@@ -967,37 +1003,7 @@ static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tm
         } else if (!accel_prim_hit(a, prim, org, dir, t0, tmax, &h)) {
             return 0;
         }
-        const geom_shape *sh = accel_prim_shape(a, prim, h.shape);
-        unsigned li = prim < (unsigned)a->nshapes ? a->shape_leaf[prim]
-                                                  : a->csgs[prim - (unsigned)a->nshapes].shape_leaf[h.shape];
-        assert(li < (unsigned)a->nleaves);
-        const accel_leaf *l = &a->leaves[li];
-        hit->t = h.t;
-        hit->p = v3_madd(org, dir, h.t);
-        /* the surface parameters only for triangles (their barycentrics,
-         * which the GI links read); no shading reads them for round shapes */
-        int tri = sh->kind == SHAPE_TRIANGLE || sh->kind == SHAPE_SMOOTH_TRIANGLE;
-        hit->u = hit->v = 0.0;
-        geom_shape_surface(sh, hit->p, h.part, &hit->ng, tri ? &hit->u : NULL, tri ? &hit->v : NULL);
-        if (l->want_uv) {
-            geom_shape_uv(sh, hit->p, h.part, hit->uv);
-        } else {
-            hit->uv[0] = hit->p.x;
-            hit->uv[1] = hit->p.y;
-        }
-        if (h.flip) hit->ng = v3_neg(hit->ng);
-        /* triangles intersected here (CSG members): POV-Ray's normal as in fill_triangle */
-        hit->pov_flip = (sh->kind == SHAPE_TRIANGLE || sh->kind == SHAPE_SMOOTH_TRIANGLE) && sh->g.tri.wind > 0.0;
-        if (h.flip) hit->pov_flip = !hit->pov_flip;
-        geom_shape_shading(sh, hit->p, hit->ng, &hit->ns);
-        hit->obj = l->obj;
-        hit->texture = l->texture;
-        if (sh->kind == SHAPE_BLOB) {
-            const scene_texture *bt = geom_shape_texture(sh, hit->p);
-            if (bt) hit->texture = bt;
-        }
-        hit->prim = (unsigned)h.part;
-        hit->flags = l->flags;
+        fill_user(a, prim, &h, org, dir, hit);
     } else {
         return 0;
     }
@@ -1020,6 +1026,71 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
     if (tmin > t0) t0 = tmin;
     if (!(tmax > t0)) return 0;
     return intersect_at(a, org, dir, t0, tmax, hit);
+}
+
+/* accel_crossings in one traversal: possible when every geometry is user
+ * geometry (the callback collects; triangles would need a filter). */
+#define CROSS_MAX 256
+static int crossings_collected(const accel *a, vec3 org, vec3 dir, double t0, double tmax, double step,
+                               accel_crossing *cr)
+{
+    for (unsigned g = 0; g < a->nginfo; g++)
+        if (a->ginfo[g].kind == GEOM_TRI || a->ginfo[g].kind == GEOM_INSTANCE) return -1;
+    accel_query q;
+    query_init(&q, org, dir, t0);
+    q.cross = cr;
+    q.maxcross = CROSS_MAX;
+    q.ctmax = tmax;
+    q.cstep = step;
+    struct RTCRayHit rh;
+    fill_rtc_ray(&rh.ray, org, dir, t0, tmax);
+    rh.hit.geomID = rh.hit.primID = rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    accel_query *saved = accel_tls_query;
+    accel_tls_query = &q;
+    rtcIntersect1(a->root, &q.rtc, &rh);
+    accel_tls_query = saved;
+    if (q.overflow) return -1;
+    /* nearest first (insertion: a handful) */
+    for (int i = 1; i < q.ncross; i++) {
+        accel_crossing c = cr[i];
+        int j = i;
+        for (; j > 0 && (cr[j - 1].t > c.t || (cr[j - 1].t == c.t && cr[j - 1].prim > c.prim)); j--) cr[j] = cr[j - 1];
+        cr[j] = c;
+    }
+    return q.ncross;
+}
+
+int accel_crossings(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, accel_crossing_fn fn,
+                    void *ctx)
+{
+    if (!a || !ray_ok(org, dir)) return 0;
+    double t0 = eps_rule(a->eps_scale, org, v3_len(dir));
+    if (tmin > t0) t0 = tmin;
+    if (!(tmax > t0)) return 0;
+    accel_crossing cr[CROSS_MAX];
+    int n = crossings_collected(a, org, dir, t0, tmax, step, cr), visited = 0;
+    accel_hit h;
+    if (n >= 0) {
+        /* the same crossings as the loop below: each the nearest past the
+         * one before by the stepping rule */
+        for (int i = 0; i < n; i++) {
+            if (!(cr[i].t > t0) || !(cr[i].t < tmax)) continue;
+            geom_csg_hit g = {.t = cr[i].t, .part = cr[i].part, .shape = cr[i].shape, .flip = cr[i].flip};
+            fill_user(a, cr[i].prim, &g, org, dir, &h);
+            if (!isfinite(h.t) || !v3_finite(h.p)) continue;
+            visited++;
+            if (!fn(ctx, &h)) break;
+            t0 = h.t + fmax(step, h.t * 1e-7);
+        }
+        return visited;
+    }
+    for (int k = 0; k < CROSS_MAX && t0 < tmax; k++) {
+        if (!intersect_at(a, org, dir, t0, tmax, &h)) break;
+        visited++;
+        if (!fn(ctx, &h)) break;
+        t0 = h.t + fmax(step, h.t * 1e-7);
+    }
+    return visited;
 }
 
 /* Contacts (accel_intersect_from): inside the self-intersection distance

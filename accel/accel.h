@@ -63,6 +63,17 @@ void accel_free(accel *a);
 /* Nearest hit with t in (tmin, tmax); returns 1 on hit. (no_image and
  * no_reflection are not applied here yet: callers see them in hit->obj->flags.) */
 int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, accel_hit *hit);
+/* Every surface the ray crosses with t in (tmin, tmax) (tmin as for
+ * accel_intersect), nearest first, each the nearest at least
+ * max(step, 1e-7 t) past the one before (at most 256): fn gets each and
+ * returns 0 to stop. A scene of analytic shapes and CSG alone is walked in
+ * one traversal that collects every primitive's crossings (a shadow ray
+ * through glass asks each primitive once, not once per surface crossed);
+ * with triangles, one accel_intersect per crossing. Returns the number of
+ * crossings fn got. */
+typedef int (*accel_crossing_fn)(void *ctx, const accel_hit *h);
+int accel_crossings(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, accel_crossing_fn fn,
+                    void *ctx);
 /* Mutual visibility of two surface points for density estimates: 1 when
  * the segment from x + lift*nx to y + lift*ny (lift = 16 eps) crosses no
  * object for which same(obj, ctx) is 0; crossings of "same" objects are

@@ -92,6 +92,13 @@ struct accel {
     char errmsg[512];
 };
 
+/* One crossing found in collect mode. */
+typedef struct {
+    double t;
+    unsigned prim;
+    int part, shape, flip;
+} accel_crossing;
+
 /* Our intersect context: Embree passes the context pointer unchanged to the
  * user-geometry callbacks (documented for RTCIntersectContext), which lets
  * them use the caller's double ray. The callbacks recognise it by comparing
@@ -105,6 +112,13 @@ typedef struct {
     int upart, ushape, uflip; /* ushape, uflip: CSG member */
     unsigned uprim;
     int uhit;
+    /* collect mode (accel_crossings): the user-geometry callback records
+     * every crossing of each primitive it is asked about, stepping past
+     * each by max(cstep, 1e-7 t), and reports none, so the traversal
+     * visits every primitive the ray's interval meets */
+    accel_crossing *cross;
+    int ncross, maxcross, overflow;
+    double ctmax, cstep;
 } accel_query;
 
 /* The query of this thread (the callbacks tell our context from a plain

@@ -314,6 +314,19 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
         vec3 o, d;
         double tmin;
         user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
+        if (exact && q->cross) {
+            for (double from = tmin; from < q->ctmax;) {
+                geom_csg_hit h;
+                if (!accel_prim_hit(a, args->primID, o, d, from, q->ctmax, &h)) break;
+                if (q->ncross == q->maxcross) {
+                    q->overflow = 1;
+                    break;
+                }
+                q->cross[q->ncross++] = (accel_crossing){h.t, args->primID, h.part, h.shape, h.flip};
+                from = h.t + fmax(q->cstep, h.t * 1e-7);
+            }
+            continue;
+        }
         /* the nearest hit so far is the exact one of the query: a float
          * tfar rounded up past a second surface within an ulp (a liquid
          * 1e-8 inside its glass) would let that farther surface win, and

@@ -723,25 +723,40 @@ int shade_tex_scene_transparent(const scene *sc)
     return 0;
 }
 
+typedef struct {
+    const scene *sc;
+    const scene_light *photon_light;
+    vec3 dir;
+    double tmin, t0; /* t0: just past the last crossing (accel_crossings' step), tmin before the first */
+    rgb c;
+} shadow_walk;
+
+static int shadow_crossing(void *ctx, const accel_hit *h)
+{
+    shadow_walk *w = ctx;
+    double t0 = w->t0;
+    w->t0 = h->t + fmax(w->tmin, h->t * 1e-7);
+    if (h->flags & OBJ_NO_SHADOW) return 1;
+    const scene_obj_photons *ph = h->obj ? h->obj->photons : NULL;
+    if (w->photon_light && ph && ph->target && scene_photon_lobe(w->photon_light, ph, 1)) {
+        w->c = trgb(0, 0, 0);
+        return 0;
+    }
+    /* distance inside the object: from the previous crossing */
+    accel_hit hh = *h;
+    hh.t = h->t - (t0 > w->tmin ? t0 - fmax(w->tmin, t0 * 1e-7) : 0.0);
+    w->c = tmul(w->c, shade_tex_shadow_filter(w->sc, &hh, w->dir));
+    if (fabs(w->c.r) < TEX_EPSILON && fabs(w->c.g) < TEX_EPSILON && fabs(w->c.b) < TEX_EPSILON) {
+        w->c = trgb(0, 0, 0);
+        return 0;
+    }
+    return 1;
+}
+
 rgb shade_tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, double tmin, double tmax,
                          const scene_light *photon_light)
 {
-    rgb c = {1, 1, 1};
-    accel_hit h;
-    double t0 = tmin;
-    for (int k = 0; k < 256 && t0 < tmax; k++) {
-        if (!accel_intersect(a, p, dir, t0, tmax, &h)) return c;
-        double next = h.t + fmax(tmin, h.t * 1e-7);
-        if (!(h.flags & OBJ_NO_SHADOW)) {
-            const scene_obj_photons *ph = h.obj ? h.obj->photons : NULL;
-            if (photon_light && ph && ph->target && scene_photon_lobe(photon_light, ph, 1)) return trgb(0, 0, 0);
-            /* distance inside the object: from the previous crossing */
-            accel_hit hh = h;
-            hh.t = h.t - (t0 > tmin ? t0 - fmax(tmin, t0 * 1e-7) : 0.0);
-            c = tmul(c, shade_tex_shadow_filter(sc, &hh, dir));
-            if (fabs(c.r) < TEX_EPSILON && fabs(c.g) < TEX_EPSILON && fabs(c.b) < TEX_EPSILON) return trgb(0, 0, 0);
-        }
-        t0 = next;
-    }
-    return c;
+    shadow_walk w = {sc, photon_light, dir, tmin, tmin, {1, 1, 1}};
+    accel_crossings(a, p, dir, tmin, tmax, tmin, shadow_crossing, &w);
+    return w.c;
 }

@@ -975,6 +975,64 @@ static void test_warnings_csg(void **st)
     scene_free(s);
 }
 
+/* accel_crossings: every crossing in order, the same from the one-traversal
+ * walk (analytic shapes only) and from the per-crossing loop (a triangle in
+ * the scene); closed-form distances along +z. */
+typedef struct {
+    double t[16];
+    int n, stop_after;
+} crossing_log;
+
+static int log_crossing(void *ctx, const accel_hit *h)
+{
+    crossing_log *l = ctx;
+    assert_hit_sane(h);
+    if (l->n < 16) l->t[l->n] = h->t;
+    l->n++;
+    return l->stop_after <= 0 || l->n < l->stop_after;
+}
+
+static void test_crossings(void **st)
+{
+    (void)st;
+    for (int with_tri = 0; with_tri < 2; with_tri++) {
+        scene *s = scene_new();
+        diag *d = diag_new();
+        sphere(s, v3(0, 0, 5), 1);                 /* 4, 6 */
+        box(s, v3(-1, -1, 8), v3(1, 1, 9));        /* 8, 9 */
+        sphere(s, v3(0, 0, 12), 0.5);              /* 11.5, 12.5 */
+        if (with_tri) triangle(s, v3(-1, -1, 7), v3(3, -1, 7), v3(-1, 3, 7)); /* 7 */
+        accel *a = build(s, d);
+        const double all[2][7] = {{4, 6, 8, 9, 11.5, 12.5}, {4, 6, 7, 8, 9, 11.5, 12.5}};
+        int n = with_tri ? 7 : 6;
+        crossing_log l = {{0}, 0, 0};
+        assert_int_equal(accel_crossings(a, v3(0, 0, 0), v3(0, 0, 1), 0.0, INFINITY, 1e-6, log_crossing, &l), n);
+        assert_int_equal(l.n, n);
+        for (int i = 0; i < n; i++) assert_near(l.t[i], all[with_tri][i], 1e-9);
+        /* the interval: (5, 11.5) leaves 6 (7) 8 9 */
+        l = (crossing_log){{0}, 0, 0};
+        accel_crossings(a, v3(0, 0, 0), v3(0, 0, 1), 5.0, 11.5, 1e-6, log_crossing, &l);
+        assert_int_equal(l.n, with_tri ? 4 : 3);
+        assert_near(l.t[0], 6.0, 1e-9);
+        assert_near(l.t[l.n - 1], 9.0, 1e-9);
+        /* stopping: fn's 0 ends the walk */
+        l = (crossing_log){{0}, 0, 2};
+        assert_int_equal(accel_crossings(a, v3(0, 0, 0), v3(0, 0, 1), 0.0, INFINITY, 1e-6, log_crossing, &l), 2);
+        assert_near(l.t[1], 6.0, 1e-9);
+        /* a step longer than a gap passes the crossing inside it: each
+         * next crossing is at least 1.5 further, so 9 (after 8) and 12.5
+         * (after 11.5) are passed */
+        l = (crossing_log){{0}, 0, 0};
+        accel_crossings(a, v3(0, 0, 0), v3(0, 0, 1), 7.5, INFINITY, 1.5, log_crossing, &l);
+        assert_int_equal(l.n, 2);
+        assert_near(l.t[0], 8.0, 1e-9);
+        assert_near(l.t[1], 11.5, 1e-9);
+        accel_free(a);
+        diag_free(d);
+        scene_free(s);
+    }
+}
+
 static void test_csg(void **st)
 {
     (void)st;
@@ -1415,6 +1473,7 @@ int main(void)
         cmocka_unit_test(test_scales),
         cmocka_unit_test(test_no_shadow),
         cmocka_unit_test(test_warnings_csg),
+        cmocka_unit_test(test_crossings),
         cmocka_unit_test(test_csg),
         cmocka_unit_test(test_csg_inverse_union),
         cmocka_unit_test(test_csg_brute),
