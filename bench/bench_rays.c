@@ -17,6 +17,7 @@
 #include <string.h>
 #include "accel.h"
 #include "bench_util.h"
+#include "pipeline.h"
 #include "pool.h"
 #include "scene.h"
 #include "timer.h"
@@ -288,7 +289,7 @@ int main(int argc, char **argv)
     if (!s) { fprintf(stderr, "bench_rays: out of memory\n"); return 1; }
     diag *d = diag_new();
     pt_status st;
-    accel *a = accel_build(s, op.threads, d, &st);
+    accel *a = pipeline_accel(s, op.threads, d, &st, NULL);
     for (int i = 0; i < diag_count(d); i++) {
         char *m = diag_format(diag_get(d, i));
         fprintf(stderr, "%s\n", m);
