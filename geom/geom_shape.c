@@ -744,12 +744,18 @@ int geom_shape_inside(const geom_shape *sh, vec3 p)
                q.z > sh->g.box.lo.z && q.z < sh->g.box.hi.z;
     case SHAPE_CYLINDER:
     case SHAPE_CONE: {
-        /* the closed solid, also for `open` ones */
+        /* the closed solid, also for `open` ones, less a skin of 1e-10 of
+         * its size (POV-Ray's cone.cpp Inside: EPSILON in the unit
+         * cylinder's space): a point on the surface is outside, so where
+         * a merge's members share a surface (shapes.inc's
+         * Round_Cylinder_Merge inside a cylinder of its radius) each
+         * member's crossing there is kept, not dropped by rounding */
+        const double skin = 1e-10;
         vec3 rel = v3_sub(q, sh->g.cone.base);
         double x = v3_dot(rel, sh->g.cone.u), y = v3_dot(rel, sh->g.cone.v), z = v3_dot(rel, sh->g.cone.w);
-        if (!(z > 0.0 && z < sh->g.cone.h)) return 0;
+        if (!(z > skin * sh->g.cone.h && z < (1.0 - skin) * sh->g.cone.h)) return 0;
         double rz = sh->g.cone.r0 + sh->g.cone.k * z;
-        return x * x + y * y < rz * rz;
+        return x * x + y * y < (1.0 - skin) * rz * rz;
     }
     case SHAPE_DISC:
         /* POV-Ray: the half-space behind the disc (against its normal) */
