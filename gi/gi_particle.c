@@ -605,7 +605,10 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
     S->spacing = spacing;
     S->tess = set->tess > 0.0 ? set->tess : set->tess_factor * spacing;
     S->radius = set->radius > 0.0 ? set->radius : set->radius_factor * spacing;
-    gi_surface_retess(gp->surf, S->tess);
+    /* the radiance particles' layout at the particles' spacing, unless the
+     * final gather answers the kept hits: then no radiance particle is
+     * built (no_rp below) and the layout would go unread */
+    if (!(set->view_gather_side > 0 && set->keep_hits)) gi_surface_retess(gp->surf, S->tess);
     S->t_sampling = timer_now() - tg;
 
     /* scattering links (and the final pruning), then gathering links.
@@ -718,7 +721,7 @@ pt_status gi_particle_finish(gi_particle *gp, diag *d)
 {
     pt_status st = PT_OK;
     gi_particle_stats *S = &gp->st;
-    S->radiance_slots = gi_surface_rp_slots(gp->surf);
+    S->radiance_slots = gp->no_rp ? 0 : gi_surface_rp_slots(gp->surf); /* none laid out for the final gather */
     double tg = timer_now();
     gp->rgrid = gi_grid_build(gp->ps.p, gp->ps.n, S->radius);
     if (!gp->rgrid) return PT_ERR_NOMEM;

@@ -331,9 +331,12 @@ gi_particle *gi_particle_load(const scene *sc, const accel *a, const gi_particle
             S->list_entries = k.entries;
             S->lists_widened = k.widened;
             S->lists_empty = k.empty;
-            gi_surface_retess(gp->surf, S->tess);
-            /* (a cache made for the final gather has none: cs.no_rp, compared above) */
-            if (!cs.no_rp && gi_surface_nrp(gp->surf) != k.nrp) why = "radiance particles do not match this scene's surfaces";
+            /* the radiance particles' layout (a cache made for the final
+             * gather has none: cs.no_rp, compared above, and needs none) */
+            if (!cs.no_rp) {
+                gi_surface_retess(gp->surf, S->tess);
+                if (gi_surface_nrp(gp->surf) != k.nrp) why = "radiance particles do not match this scene's surfaces";
+            }
         }
     }
     free(bytes);
