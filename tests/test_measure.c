@@ -19,17 +19,6 @@
 #include "test_util.h"
 
 static char tmpdir[256];
-static char *read_file(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    static char buf[1 << 18];
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    buf[n] = 0;
-    fclose(f);
-    return buf;
-}
-
 static int exists(const char *path)
 {
     struct stat sb;
@@ -107,7 +96,7 @@ static void test_sweep_spp(void **st)
 
     /* CSV: a header and one row per setting, in order. */
     snprintf(path, sizeof path, "%s/sweep.csv", dir);
-    char *csv = read_file(path);
+    char *csv = tu_read_file(path);
     assert_non_null(csv);
     printf("%s", csv ? csv : "");
     char *lines[8];
@@ -176,7 +165,7 @@ static void test_sweep_spp(void **st)
 
     /* The page and everything it links to. */
     snprintf(path, sizeof path, "%s/index.html", dir);
-    char *html = read_file(path);
+    char *html = tu_read_file(path);
     assert_non_null(html);
     assert_non_null(strstr(html, "plot.png"));
     assert_non_null(strstr(html, "_flip.png"));
@@ -206,7 +195,7 @@ static void test_sweep_size_and_usage(void **st)
     printf("%s", tu_out);
     assert_int_equal(rc, 0);
     snprintf(path, sizeof path, "%s/sweep.csv", dir);
-    char *csv = read_file(path);
+    char *csv = tu_read_file(path);
     assert_non_null(csv);
     printf("%s", csv ? csv : "");
     assert_non_null(strstr(csv, "none,size=32x32;D:Power=1,"));

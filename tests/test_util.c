@@ -57,6 +57,17 @@ void tu_write_file(const char *path, const char *text)
     assert_int_equal(fclose(f), 0);
 }
 
+char *tu_read_file(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    static char buf[1 << 18];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    buf[n] = 0;
+    fclose(f);
+    return buf;
+}
+
 int tu_exists(const char *path)
 {
     struct stat sb;

@@ -19,6 +19,9 @@ int tu_run_stdout(const char *cmd);
 
 /* Write `text` to `path` (fails the test when it cannot). */
 void tu_write_file(const char *path, const char *text);
+/* The text of `path` (its first 256 KiB) in a buffer of the test library,
+ * valid until the next call; NULL when it cannot be read. */
+char *tu_read_file(const char *path);
 /* 1 when `path` exists. */
 int tu_exists(const char *path);
 

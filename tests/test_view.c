@@ -43,6 +43,7 @@
 #include "sdl.h"
 #include "shade.h"
 #include "shade_texture.h"
+#include "test_util.h"
 #include "timer.h"
 #include "view_camera.h"
 #include "view_gi.h"
@@ -78,17 +79,6 @@ static void write_file(const char *path, const char *text)
     assert_non_null(f);
     fputs(text, f);
     fclose(f);
-}
-
-static char *read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    static char buf[8192];
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    buf[n] = 0;
-    fclose(f);
-    return buf;
 }
 
 static int have_program(const char *name)
@@ -379,7 +369,7 @@ static void test_viewer_script(void **st)
      * view met the plane (the origin), the location turned 30 degrees
      * towards screen right (+x) around it. */
     snprintf(path, sizeof path, "%s/cam.inc", tmpdir);
-    char *block = read_text(path);
+    char *block = tu_read_file(path);
     assert_non_null(block);
     char src[9000];
     snprintf(src, sizeof src, "#version 3.7;\n%s", block);
@@ -403,7 +393,7 @@ static void test_viewer_script(void **st)
      * the distance; P saved both files under the counter name */
     for (int k = 1; k <= 2; k++) {
         snprintf(path, sizeof path, "%s/two-camera-%04d.inc", tmpdir, k);
-        block = read_text(path);
+        block = tu_read_file(path);
         assert_non_null(block);
         snprintf(src, sizeof src, "#version 3.7;\n%s", block);
         sc = NULL;
