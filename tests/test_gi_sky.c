@@ -94,13 +94,14 @@ void test_sky_furnace(void **state)
 
 
 /* A particle GI state of f's scene with the final gather on (256 rays a
- * point, every 2nd pixel), no further bounce, its view prepared at w x h. */
-static gi_particle *gather_state(fixture *f, long count, uint64_t seed, gi_sky_fn fn, int w, int h, gi_pigment_fn pig)
+ * point, every 2nd pixel), nb further bounces, its view prepared at w x h. */
+static gi_particle *gather_state(fixture *f, long count, uint64_t seed, gi_sky_fn fn, int w, int h, gi_pigment_fn pig,
+                                 int nb)
 {
     gi_particle_settings s;
     gi_particle_settings_from_scene(&s, f->sc);
     s.count = count;
-    s.bounces = 0;
+    s.bounces = nb;
     s.threads = 2;
     s.seed = seed;
     s.cl_device = tg_device_c;
@@ -172,7 +173,7 @@ static void gather_case(const char *what, int background, double L, gi_sky_fn fn
     char text[1024];
     tg_load(&f, tu_sky_furnace(text, sizeof text, L, background, 1));
     const int W = 32, H = 32;
-    gi_particle *gp = gather_state(&f, 2000, 5, fn, W, H, NULL);
+    gi_particle *gp = gather_state(&f, 2000, 5, fn, W, H, NULL, 0);
     double mean, worst;
     int m = kept_ratios(gp, W, H, expect_sky, gradient ? NULL : &L, &mean, &worst);
     const gi_particle_stats *st = gi_particle_get_stats(gp);
@@ -213,7 +214,7 @@ static void layered_dome_case(double L)
              L);
     tg_load(&f, text);
     const int W = 32, H = 32;
-    gi_particle *gp = gather_state(&f, 2000, 9, NULL, W, H, shade_tex_pigment_at);
+    gi_particle *gp = gather_state(&f, 2000, 9, NULL, W, H, shade_tex_pigment_at, 0);
     double mean, worst;
     int m = kept_ratios(gp, W, H, expect_dome_inside, &L, &mean, &worst);
     printf("  final gather layered dome L %.2f: %3d pixels, mean E/pi over L %.5f, worst %.4f\n", L, m, mean, worst);
@@ -273,7 +274,7 @@ void test_csg_emitter_gather(void **state)
                        "plane { y, 0 pigment { rgb 1 } finish { diffuse 1 } }\n";
     tg_load(&f, text);
     const int W = 40, H = 40;
-    gi_particle *gp = gather_state(&f, 3000, 7, NULL, W, H, NULL);
+    gi_particle *gp = gather_state(&f, 3000, 7, NULL, W, H, NULL, 0);
     double mean, worst;
     int m = kept_ratios(gp, W, H, expect_slab, NULL, &mean, &worst);
     printf("  CSG emitter over a floor: %d pixels, mean E/pi over the form factor's %.5f, worst %.4f\n", m, mean, worst);
@@ -340,20 +341,8 @@ static void two_bounce_case(double L)
              "box { <-4, -0.1, -4>, <4, 0, 4> pigment { rgb 0.5 } finish { ambient 0 diffuse 1 } }\n",
              L);
     tg_load(&f, text);
-    gi_particle_settings s;
-    gi_particle_settings_from_scene(&s, f.sc);
-    s.count = 4000;
-    s.bounces = 1;
-    s.threads = 2;
-    s.seed = 11;
-    s.cl_device = tg_device_c;
-    s.keep_hits = 1;
-    s.view_gather_side = 16;
-    s.view_gather_stride = 2;
-    s.pigment = shade_tex_pigment_at;
-    gi_particle *gp = tg_build_with(&f, &s);
     const int W = 48, H = 48;
-    assert_int_equal(gi_particle_prepare_view(gp, &f.sc->camera, W, H, f.d), PT_OK);
+    gi_particle *gp = gather_state(&f, 4000, 11, NULL, W, H, shade_tex_pigment_at, 1);
     double mean, worst;
     int m = kept_ratios(gp, W, H, expect_two_bounce, &L, &mean, &worst);
     printf("  sky's second bounce, L %.2f: %3d pixels, mean E/pi over expected %.5f, worst %.4f\n", L, m, mean, worst);
