@@ -82,6 +82,30 @@ static void seg_set(sw_seg *s, const double a[2], const double b[2], const doubl
     s->nk++;
     s->tk[s->nk] = 1.0;
     s->yk[s->nk] = e1[1];
+    double xc[2];
+    int nx = 0;
+    if (deg > 1) {
+        double dc[3] = {c[0], 2.0 * b[0], 3.0 * a[0]};
+        nx = geom_poly_solve(dc, 2, 0.0, 1.0, xc, 0);
+    }
+    for (int j = 0; j < s->nk; j++) {
+        double p0[2], p1[2];
+        seg_eval(s, s->tk[j], p0, NULL);
+        seg_eval(s, s->tk[j + 1], p1, NULL);
+        double lo = fmin(p0[0], p1[0]), hi = fmax(p0[0], p1[0]);
+        for (int i = 0; i < nx; i++)
+            if (xc[i] > s->tk[j] && xc[i] < s->tk[j + 1]) {
+                double p[2];
+                seg_eval(s, xc[i], p, NULL);
+                lo = fmin(lo, p[0]);
+                hi = fmax(hi, p[0]);
+            }
+        /* the bisection's point is evaluated as these are: rounding apart,
+         * it lies in [lo, hi] */
+        double pad = 1e-9 * (1.0 + fabs(lo) + fabs(hi));
+        s->xk_lo[j] = lo - pad;
+        s->xk_hi[j] = hi + pad;
+    }
     s->out = 1.0;
 }
 
@@ -152,8 +176,10 @@ static int seg_crossings(const sw_seg *s, double u, double v)
     double pv[4];
     for (int j = 0; j < s->nk; j++) {
         if ((s->yk[j] >= v) == (s->yk[j + 1] >= v)) continue;
-        /* the crossing lies on the segment, so at u' >= lo[0] */
-        if (u <= s->lo[0]) { count++; continue; }
+        /* the crossing lies on the segment, so at u' >= lo[0]; on this
+         * piece, within [xk_lo, xk_hi] */
+        if (u <= s->lo[0] || u < s->xk_lo[j]) { count++; continue; }
+        if (u > s->xk_hi[j]) continue;
         if (!have_pv) {
             seg_poly(s, 1, pv);
             pv[0] -= v;

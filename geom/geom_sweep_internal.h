@@ -22,6 +22,10 @@ typedef struct {
      * at 0 and 1). Independent of the query, so set once. */
     double tk[4], yk[4];
     int nk;
+    /* p_u's range over each piece, padded beyond rounding: a crossing of
+     * the line v on piece j lies at u' in [xk_lo[j], xk_hi[j]], so a
+     * query u outside it is decided without finding the crossing */
+    double xk_lo[3], xk_hi[3];
     double out;                    /* outward 2-D normal = out * (p1', -p0') */
 } sw_seg;
 
