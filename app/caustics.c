@@ -31,17 +31,41 @@
  * that a glass sinks into) gets the photons' full power; through a whole
  * object the two factors cancel anyway. `si` (the containers before) is
  * crossed into the step's. */
+/* The step's trace_w is POV-Ray's photon weight factor through a
+ * refraction: the largest channel of that filter before the fade (photons.cpp,
+ * ComputeLightedTexture: New_Weight = weight * max3(FilCol); the fade dims
+ * the photon's colour only). */
 static gi_caustic_step through(const caustics *c, const accel_hit *h, vec3 dir, const shade_mat_bsdf *b, rgb kr,
                                shade_media_inside *si, vec3 tdir)
 {
-    rgb f = shade_tex_shadow_filter(c->sc, h, dir);
+    rgb f = shade_tex_shadow_filter(c->sc, h, dir), fa = shade_tex_leaving_fade(h, dir);
     if (b->ls.f && b->ls.f->conserve_energy)
         f = (rgb){f.r * fmin(1.0, 1.0 - kr.r), f.g * fmin(1.0, 1.0 - kr.g), f.b * fmin(1.0, 1.0 - kr.b)};
+    double tw = fmax(fa.r > 0.0 ? f.r / fa.r : 0.0, fmax(fa.g > 0.0 ? f.g / fa.g : 0.0, fa.b > 0.0 ? f.b / fa.b : 0.0));
     shade_media_inside_cross(si, h->obj);
     gi_caustic_inside after = {0, {0}};
     after.n = si->n < GI_CAUSTIC_MAX_INSIDE ? si->n : GI_CAUSTIC_MAX_INSIDE;
     for (int i = 0; i < after.n; i++) after.obj[i] = si->obj[i];
-    return (gi_caustic_step){b->p_in, tdir, f, 1.0, 1, b->from, after};
+    return (gi_caustic_step){b->p_in, tdir, f, 1.0, 1, b->from, after, tw};
+}
+
+/* POV-Ray's photon weight factor through a reflection off the top layer of
+ * reflectivity kr: its ComputeReflectivity scales the weight by the
+ * reflectivity's largest channel (fresnel) or by the larger of reflection
+ * min and max (otherwise), and the reflected photon is traced with that
+ * weight times kr's largest channel again (photons.cpp,
+ * ComputeLightedTexture). A reflection so weighs kr squared: with the
+ * default adc_bailout of 1/255 a photon reflected twice inside a glass of
+ * reflectivity 0.27 ends there, under conserve_energy (0.73 x 0.07 x 0.07
+ * x 0.73 < 1/255) as in POV-Ray. The fresnel factor is taken after the
+ * metallic tint (POV-Ray: before it). */
+static double reflect_weight(const shade_mat_bsdf *b, rgb kr)
+{
+    const scene_finish *f = b->ls.f;
+    double m = fmax(kr.r, fmax(kr.g, kr.b));
+    if (!f || f->fresnel) return m * m;
+    rgb a = f->reflection_max, z = f->reflection_min;
+    return fmax(fmax(a.r, fmax(a.g, a.b)), fmax(z.r, fmax(z.g, z.b))) * m;
 }
 
 static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, const gi_caustic_inside *in, rng *r,
@@ -81,12 +105,15 @@ static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, const gi_causti
     if (tir) {
         /* total internal reflection keeps the whole photon: POV-Ray's
          * photon refraction reflects the unfiltered photon instead and
-         * skips the surface's own reflection (TraceRefractionRayForPhotons) */
-        step[n++] = (gi_caustic_step){b.p_out, b.refl_dir, {fa.r / p, fa.g / p, fa.b / p}, p, 0, b.from, same};
+         * skips the surface's own reflection (TraceRefractionRayForPhotons),
+         * weighted as the refraction it replaces (through's trace_w) */
+        shade_media_inside unused = si;
+        step[n++] = (gi_caustic_step){b.p_out, b.refl_dir, {fa.r / p, fa.g / p, fa.b / p}, p, 0, b.from, same,
+                                      through(c, h, dir, &b, kr, &unused, tdir).trace_w};
     } else {
         if (fmax(kr.r, fmax(kr.g, kr.b)) > 0.0)
             step[n++] = (gi_caustic_step){b.p_out, b.refl_dir, {fa.r * kr.r / p, fa.g * kr.g / p, fa.b * kr.b / p}, p, 0,
-                                          b.from, same};
+                                          b.from, same, reflect_weight(&b, kr)};
         if (transmits) {
             step[n] = through(c, h, dir, &b, kr, &si, tdir);
             step[n].weight = (rgb){step[n].weight.r / p, step[n].weight.g / p, step[n].weight.b / p};

@@ -326,12 +326,14 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
         int has_from, level;
         double depth, rho_p;
         rgb tr;
+        double tw; /* POV-Ray's ray weight (gi_caustic_step.trace_w): the photon goes on while it is at least
+                      adc_bailout (photons.cpp, TraceRay) */
         gi_caustic_inside in;
         double t0; /* hits from here on (0: the self-intersection distance) */
     } branch;
     branch stack[2 * GI_CAUSTIC_MAX_BOUNCES + 4];
     int ns = 0;
-    stack[ns++] = (branch){o, w, {0}, 0, 0, 0.0, 1.0, {1, 1, 1}, {0, {0}}, 0.0};
+    stack[ns++] = (branch){o, w, {0}, 0, 0, 0.0, 1.0, {1, 1, 1}, 1.0, {0, {0}}, 0.0};
     vec3 p_first = o;
     int passes = 0;
     while (ns > 0) {
@@ -351,11 +353,12 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
                     ++passes > ACCEL_PASS_MAX || !c->hk.pass(c->hk.ctx, &h, br.w, &br.in, &st))
                     return;
                 rgb tr = crgb(br.tr.r * st.weight.r, br.tr.g * st.weight.g, br.tr.b * st.weight.b);
-                if (!(cmax3(tr) >= c->adc) || !isfinite(tr.r + tr.g + tr.b)) return;
+                double tw = br.tw * st.trace_w;
+                if (!(tw >= c->adc) || !(cmax3(tr) > 0.0) || !isfinite(tr.r + tr.g + tr.b)) return;
                 /* on along the same ray from the same origin, past the
                  * hit as accel_intersect_past steps (an isosurface's
                  * crossings, found from the ray's start, stay the same) */
-                stack[ns++] = (branch){br.o, br.w, br.from, br.has_from, 0, br.depth, br.rho_p, tr, st.inside,
+                stack[ns++] = (branch){br.o, br.w, br.from, br.has_from, 0, br.depth, br.rho_p, tr, tw, st.inside,
                                        h.t + fmax(c->eps, h.t * 1e-7)};
                 continue;
             }
@@ -398,10 +401,11 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
             const gi_caustic_step *st = &step[k];
             if (!scene_photon_lobe(l, ph, st->refract)) continue;
             rgb tr = crgb(br.tr.r * st->weight.r, br.tr.g * st->weight.g, br.tr.b * st->weight.b);
-            if (!(cmax3(tr) >= c->adc) || !isfinite(tr.r + tr.g + tr.b)) continue;
+            double tw = br.tw * st->trace_w;
+            if (!(tw >= c->adc) || !(cmax3(tr) > 0.0) || !isfinite(tr.r + tr.g + tr.b)) continue;
             if (ns >= (int)(sizeof stack / sizeof stack[0])) continue;
             stack[ns++] = (branch){st->org, st->dir, st->from, 1, level + 1, depth,
-                                   br.rho_p * fmin(1.0, fmax(st->rho, 1e-6)), tr, st->inside, 0.0};
+                                   br.rho_p * fmin(1.0, fmax(st->rho, 1e-6)), tr, tw, st->inside, 0.0};
             went = 1;
         }
         if (went) out->alive[level + 1]++;

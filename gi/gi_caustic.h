@@ -88,6 +88,8 @@ typedef struct {
     int refract;     /* 1 refraction, 0 reflection */
     accel_from from; /* the surface left */
     gi_caustic_inside inside; /* the containers after the bounce */
+    double trace_w;  /* the factor of POV-Ray's photon ray weight over this bounce (not the flux: the photon
+                        ends when the product falls under adc_bailout) */
 } gi_caustic_step;
 
 /* GI_CAUSTIC_CONTINUES: step[0] holds the bounce; GI_CAUSTIC_SPLIT as well:
