@@ -320,18 +320,27 @@ typedef struct {
     double last;
     diag *notes;
     int *image_begun;
+    const scene *sc;
 } progressive_ctx;
 
 static void on_image(void *ctx, const framebuffer *fb, int done, int total)
 {
     progressive_ctx *p = ctx;
     if (!p->path) return;
+    /* the image leaves the working space as the final one does */
+    framebuffer *out = fb_new(fb->width, fb->height);
+    if (!out) return;
+    memcpy(out->rgb, fb->rgb, (size_t)fb->width * (size_t)fb->height * 3 * sizeof *out->rgb);
+    shade_gamma_fb_to_linear(p->sc, out);
+    out->alpha = fb->alpha; /* borrowed for the write */
     diag *d = diag_new();
     img_write_opts wo;
     img_default_write_opts(&wo);
-    if (img_write(p->path, fb, &wo, d) == PT_OK && p->notes)
+    if (img_write(p->path, out, &wo, d) == PT_OK && p->notes)
         diag_report(p->notes, DIAG_NOTE, (src_loc){0}, NULL, "%d/%d samples per pixel written to %s", done, total, p->path);
     diag_free(d);
+    out->alpha = NULL;
+    fb_free(out);
 }
 
 /* the reference renderers report the fraction of their image loop done:
@@ -365,7 +374,7 @@ static void fill_common(pm_common *c, const render_gi_opts *o, progressive_ctx *
 static pt_status render_reference(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
                                   render_gi_result *r, diag *d)
 {
-    progressive_ctx pc = {o->progressive_path, 0.0, o->notes, &r->image_begun};
+    progressive_ctx pc = {o->progressive_path, 0.0, o->notes, &r->image_begun, sc};
     pt_status st;
     r->has_pm = 1;
     double t0 = timer_now();
