@@ -199,7 +199,7 @@ static void test_empty_scene_and_defaults(void **st)
  * sphere in a uniform background of working value 0.5 reflects 0.5 there
  * (the furnace), so every pixel on it is 0.5^2.2 = 0.2176 in the linear
  * PFM, within 2% of the mean: the Whitted modes and the references alike
- * (before, the references wrote the working value, 0.5). */
+ * (a mode that wrote the working value would give 0.5). */
 static void test_working_gamma_all_modes(void **st)
 {
     (void)st;

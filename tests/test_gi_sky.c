@@ -298,8 +298,8 @@ void test_csg_emitter_gather(void **state)
  * sky's share in it. Pixels on the sphere's lower half (n.y < 0): mean
  * within 2%, each within 15% (near the silhouette the stride-2
  * interpolation and the filter mix normals up to 25.8 degrees apart, where
- * F changes fast); without the sky's share the floor reflects nothing: the
- * mean falls to about 0.72. */
+ * F changes fast); without the sky's share the floor reflects nothing and
+ * the mean falls far below 1. */
 static double floor_share(vec3 p, vec3 n)
 {
     vec3 t = fabs(n.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0);
