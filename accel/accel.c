@@ -1442,6 +1442,13 @@ void accel_bounds(const accel *a, vec3 *lo, vec3 *hi)
 double accel_scale(const accel *a) { return a ? a->scale : 1.0; }
 double accel_eps_scale(const accel *a) { return a ? a->eps_scale : 1.0; }
 
+double accel_surface_eps(const accel *a)
+{
+    double s = accel_eps_scale(a);
+    if (!(s > 0.0) || !isfinite(s)) s = 1.0;
+    return s * 1e-6;
+}
+
 accel_stats accel_get_stats(const accel *a)
 {
     accel_stats s;

@@ -226,7 +226,7 @@ pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width
     if (!c->asked) return PT_OK;
     not_modelled(c, sc, d);
     c->sc = sc;
-    c->eps = accel_scale(a) * 1e-6;
+    c->eps = accel_surface_eps(a); /* the shader's offsets: photons cross thin walls as eye rays do */
     gi_caustic_hooks hk = {hook_surface, hook_attenuation, c, hook_brilliance, hook_pass};
     gi_caustic_settings s = {width, height, threads, seed, cl_device, cl_max_bytes, count_scale, cancel};
     pt_status st = PT_OK;

@@ -818,7 +818,7 @@ gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_s
     c->a = a;
     c->s = *s;
     c->hk = *hk;
-    c->eps = accel_scale(a) * 1e-6;
+    c->eps = accel_surface_eps(a); /* the shader's, so photons cross thin walls as eye rays do */
     c->r_max = 0.05 * accel_scale(a);
     const scene_photons *ps = &sc->global.photons;
     c->max_level = ps->max_trace_level >= 0 ? ps->max_trace_level : sc->global.max_trace_level;

@@ -53,9 +53,7 @@ pm_lights *pm_lights_new(const scene *sc, const accel *a, diag *d, pt_status *st
     }
     L->sc = sc;
     L->a = a;
-    double s = accel_eps_scale(a); /* median object size: a far object does not grow it */
-    if (!(s > 0.0) || !isfinite(s)) s = 1.0;
-    L->eps = s * 1e-6;
+    L->eps = accel_surface_eps(a); /* median object size: a far object does not grow it */
     L->emit = accel_surf_build(sc, a, emit_weight, (void *)sc, d, st);
     if (!L->emit) {
         free(L);

@@ -440,15 +440,10 @@ static rgb trace_ray(render_ctx *c, int thread, vec3 org, vec3 dir, int level, d
     return along_ray(c, thread, org, dir, INFINITY, shade_atmos_sky(c->sc, dir), r, in, NULL);
 }
 
-static double scene_eps(const accel *a)
-{
-    /* Distance epsilon: a fixed fraction of the scene's extent, so that tiny
-     * and huge scenes behave alike (single-precision Embree hits carry a
-     * relative error near 1e-7 of the coordinates). */
-    double s = accel_eps_scale(a); /* median object size: a far object does not grow it */
-    if (!(s > 0.0) || !isfinite(s)) s = 1.0;
-    return s * 1e-6;
-}
+/* Distance epsilon: a fixed fraction of the median object size, so that
+ * tiny and huge scenes behave alike (single-precision Embree hits carry a
+ * relative error near 1e-7 of the coordinates). */
+static double scene_eps(const accel *a) { return accel_surface_eps(a); }
 
 rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 org, vec3 dir, int thread, rng *r)
 {

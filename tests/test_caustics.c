@@ -275,19 +275,25 @@ static void test_pass_through_filter(void **state)
  * the photon reflected twice inside (weight 0.75 x 0.25^2 x 0.25^2 x 0.75
  * = 0.0022 < 1/255) ends as in POV-Ray. Ending photons on their flux
  * (0.75 x 0.25 x 0.25 x 0.75 = 0.035) instead adds the series
- * 1 / (1 - 0.25^2): E = 0.600, 6.7% above (tolerance 2%). */
-static void slab_case(const char *box, const double want[3], double tol)
+ * 1 / (1 - 0.25^2): E = 0.600, 6.7% above (tolerance 2%).
+ * Then that slab 0.002 thick inside a sphere of radius 1e6 (a sky dome):
+ * the same E = 0.75^2. The photons' surface offsets follow the median
+ * object size, as the shader's do; offsets of 1e-6 of the scene's extent
+ * (3.5 here) carried each photon past the slab's lower face, and it never
+ * left the slab (a drinking glass's wall in `balcony` so dropped its
+ * caustic). */
+static void slab_case(double y0, double y1, const char *extra, const char *box, const double want[3], double tol)
 {
-    char text[1200];
+    char text[1400];
     snprintf(text, sizeof text,
              "#version 3.7;\n"
              "global_settings { assumed_gamma 1.0 max_trace_level 25 photons { spacing 0.02 } }\n"
              "camera { orthographic location <0, 5, 0> look_at <0, 0, 0> sky z right x*2 up z*2 }\n"
              "light_source { <0, 10, 0> color rgb 1 photons { reflection on refraction on } }\n"
-             "box { <-3, 0.5, -3>, <3, 1.5, 3> pigment { rgbf 1 } %s "
+             "box { <-3, %g, -3>, <3, %g, 3> pigment { rgbf 1 } %s "
              "photons { target reflection on refraction on collect off } }\n"
-             "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 1 } }\n",
-             box);
+             "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 1 } }\n%s\n",
+             y0, y1, box, extra);
     tu_world w = tu_world_build("test.pov", text);
     diag *d = diag_new();
     caustics c;
@@ -310,11 +316,13 @@ static void test_slab_transmission(void **state)
     const double col[3] = {0.35, 0.65, 0.85};
     double fresnel[3], flat[3] = {0.5625, 0.5625, 0.5625};
     for (int k = 0; k < 3; k++) fresnel[k] = 0.81 * exp(-(1.0 - col[k]) / 2.0);
-    slab_case("finish { specular 0.6 roughness 0.002 ambient 0 diffuse 0.1 brilliance 5 "
+    slab_case(0.5, 1.5, "", "finish { specular 0.6 roughness 0.002 ambient 0 diffuse 0.1 brilliance 5 "
               "reflection { 0.1, 1.0 fresnel on } conserve_energy } "
               "interior { ior 1 fade_distance 2 fade_power 1001 fade_color rgb <0.35, 0.65, 0.85> }",
               fresnel, 0.03);
-    slab_case("finish { ambient 0 diffuse 0 reflection { 0.25 } conserve_energy } interior { ior 1 }", flat, 0.02);
+    const char *flat_box = "finish { ambient 0 diffuse 0 reflection { 0.25 } conserve_energy } interior { ior 1 }";
+    slab_case(0.5, 1.5, "", flat_box, flat, 0.02);
+    slab_case(1.0, 1.002, "sphere { 0, 1e6 hollow pigment { rgb 1 } finish { ambient 0 diffuse 0 } }", flat_box, flat, 0.02);
 }
 
 static const char *ball =
