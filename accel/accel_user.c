@@ -269,6 +269,19 @@ int accel_prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, d
     return 1;
 }
 
+/* Whether prim has a crossing in (tmin, tmax): accel_prim_hit's answer
+ * without the search for the nearest crossing of a CSG (shadow rays). */
+static int prim_occludes(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, double tmax)
+{
+    if (prim < (unsigned)a->nshapes) {
+        geom_csg_hit h;
+        return accel_prim_hit(a, prim, o, d, tmin, tmax, &h);
+    }
+    unsigned ci = prim - (unsigned)a->nshapes;
+    if (a->csg_bn[ci] && !ray_in_bound(a, a->csg_b0[ci], a->csg_bn[ci], o, d, tmin)) return 0;
+    return geom_csg_occludes(&a->csgs[ci], o, d, tmin, tmax);
+}
+
 const geom_shape *accel_prim_shape(const accel *a, unsigned prim, int member)
 {
     assert(prim < (unsigned)(a->nshapes + a->ncsgs));
@@ -338,7 +351,6 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
         /* rounded up: a nearer candidate within the ulp is still tried */
         SOA_F(ray, N, i, 8) = exact ? nextafterf((float)h.t, INFINITY) : (float)h.t;
         vec3 ng = v3(0, 0, 0);
-        double u = 0, v = 0;
         if (exact) {
             q->ut = h.t;
             q->upart = h.part;
@@ -347,7 +359,11 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
             q->uprim = args->primID;
             q->uhit = 1;
         } else {
-            geom_shape_surface(accel_prim_shape(a, args->primID, h.shape), v3_madd(o, d, h.t), h.part, &ng, &u, &v);
+            /* the normal only: the surface's (u, v) (a sphere's two
+             * inverse trigonometric calls) has no reader in a packet's or
+             * stream's record, where u and v hold Embree's barycentrics
+             * for triangles only */
+            geom_shape_surface(accel_prim_shape(a, args->primID, h.shape), v3_madd(o, d, h.t), h.part, &ng, NULL, NULL);
             if (h.flip) ng = v3_neg(ng);
         }
         SOA_F(hit, N, i, 0) = (float)ng.x;
@@ -356,8 +372,8 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
         /* a CSG result's record carries the member hit in u (exact in a
          * float: members are counted in ints far below 2^24), which
          * accel_rtc_leaf reads instead of intersecting the CSG again */
-        SOA_F(hit, N, i, 3) = args->primID < (unsigned)a->nshapes ? (float)u : (float)h.shape;
-        SOA_F(hit, N, i, 4) = (float)v;
+        SOA_F(hit, N, i, 3) = args->primID < (unsigned)a->nshapes ? 0.0f : (float)h.shape;
+        SOA_F(hit, N, i, 4) = 0.0f;
         SOA_U(hit, N, i, 5) = args->primID;
         SOA_U(hit, N, i, 6) = args->geomID;
         SOA_U(hit, N, i, 7) = args->context->instID[0];
@@ -378,8 +394,7 @@ void accel_user_occluded(const struct RTCOccludedFunctionNArguments *args)
         vec3 o, d;
         double tmin;
         user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
-        geom_csg_hit h;
-        if (accel_prim_hit(a, args->primID, o, d, tmin, (double)SOA_F(ray, N, i, 8), &h)) SOA_F(ray, N, i, 8) = -INFINITY;
+        if (prim_occludes(a, args->primID, o, d, tmin, (double)SOA_F(ray, N, i, 8))) SOA_F(ray, N, i, 8) = -INFINITY;
     }
 }
 

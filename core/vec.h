@@ -58,6 +58,29 @@ static inline int v3_slab(vec3 o, vec3 d, vec3 lo, vec3 hi, double *t0, double *
     *t1 = b;
     return 1;
 }
+/* v3_slab with inv = 1 / d precomputed per component (for one ray tested
+ * against many boxes): a product in place of each division, so t0 and t1
+ * may differ from v3_slab's by an ulp; a zero component of d (or one so
+ * small that its inverse overflows) is handled as v3_slab's zero. */
+static inline int v3_slab_inv(vec3 o, vec3 d, vec3 inv, vec3 lo, vec3 hi, double *t0, double *t1)
+{
+    double a = -INFINITY, b = INFINITY;
+    for (int i = 0; i < 3; i++) {
+        double oi = v3_idx(o, i), di = v3_idx(d, i), l = v3_idx(lo, i), u = v3_idx(hi, i), r = v3_idx(inv, i);
+        if (di == 0.0 || !isfinite(r)) {
+            if (oi < l || oi > u) return 0;
+            continue;
+        }
+        double x = (l - oi) * r, y = (u - oi) * r;
+        if (x > y) { double t = x; x = y; y = t; }
+        if (x > a) a = x;
+        if (y < b) b = y;
+    }
+    if (!(a <= b)) return 0;
+    *t0 = a;
+    *t1 = b;
+    return 1;
+}
 /* Whether the segment o + t d, t in [0, tmax], meets the box [lo, hi]. */
 static inline int v3_segment_meets_box(vec3 o, vec3 d, vec3 lo, vec3 hi, double tmax)
 {

@@ -590,12 +590,23 @@ int geom_csg_kept(const geom_csg *c, int node, vec3 p)
  * nearest kept crossing over all members is the answer. */
 #define CSG_CHUNK 8
 
+/* A ray as the members are searched: inv = 1 / dir per component for the
+ * keep boxes' slab tests (one ray meets many boxes), and whether any kept
+ * crossing will do (an occlusion query) rather than the nearest. */
+typedef struct {
+    vec3 org, dir, inv;
+    double tmin;
+    int any;
+} csg_ray;
+
 /* Member s's nearest kept crossing in (tmin, *best): into *h, *best
  * lowered, 1 returned. */
-static int try_member(const geom_csg *c, int s, vec3 org, vec3 dir, double tmin, double *bestp, geom_csg_hit *h)
+static int try_member(const geom_csg *c, int s, const csg_ray *R, double *bestp, geom_csg_hit *h)
 {
     int found = 0;
     double best = *bestp;
+    vec3 org = R->org, dir = R->dir;
+    double tmin = R->tmin;
     int node = c->shape_node[s];
     if (c->nodes[node].nosurf) return 0;
     double from = tmin, upto = INFINITY;
@@ -604,11 +615,14 @@ static int try_member(const geom_csg *c, int s, vec3 org, vec3 dir, double tmin,
          * and only that stretch is searched (a clipped quartic's root
          * finder then works on the clip box's chord, not the whole
          * ray); an isosurface's crossings count from the ray's start
-         * (max_trace), so its search starts there */
+         * (max_trace), so its search starts there. The stretch is padded
+         * by 1e-9 of its distances, far above the ulp by which the
+         * product with inv may move its ends. */
         const vec3 *kb = c->keep_box + 2 * s;
         double t0, t1;
-        if (!(kb[0].x <= kb[1].x) || !v3_slab(org, dir, kb[0], kb[1], &t0, &t1) || t1 < tmin || t0 > best) return 0;
+        if (!(kb[0].x <= kb[1].x) || !v3_slab_inv(org, dir, R->inv, kb[0], kb[1], &t0, &t1)) return 0;
         double pad = 1e-9 * (fabs(t0) + fabs(t1)) + 1e-300;
+        if (t1 + pad < tmin || t0 - pad > best) return 0;
         upto = t1 + pad;
         if (c->shapes[s].kind != SHAPE_ISOSURFACE && t0 - pad > tmin) from = t0 - pad;
     }
@@ -636,35 +650,61 @@ static int try_member(const geom_csg *c, int s, vec3 org, vec3 dir, double tmin,
     return found;
 }
 
-int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, geom_csg_hit *h)
+/* The nearest kept crossing in (tmin, tmax), or with R->any the first one
+ * met in the members' order: both find one exactly when one exists, since
+ * before a member answers every search runs to tmax. */
+static int csg_search(const geom_csg *c, const csg_ray *R, double tmax, geom_csg_hit *h)
 {
     int found = 0;
     double best = tmax;
     if (!c->bvh) {
-        for (int s = 0; s < c->nshapes; s++) found |= try_member(c, s, org, dir, tmin, &best, h);
+        for (int s = 0; s < c->nshapes && !(found && R->any); s++) found |= try_member(c, s, R, &best, h);
     } else {
-        for (int i = 0; i < c->nunbounded; i++) found |= try_member(c, c->unbounded[i], org, dir, tmin, &best, h);
+        for (int i = 0; i < c->nunbounded && !(found && R->any); i++)
+            found |= try_member(c, c->unbounded[i], R, &best, h);
         /* a node's box holds its members' keep boxes, so skipping a node
          * whose interval lies outside (tmin, best) skips only members that
-         * try_member would skip; depth is log2 of the members */
+         * try_member would skip (both pad the interval alike); depth is
+         * log2 of the members */
         int stack[64], sp = 0;
         stack[sp++] = 0;
-        while (sp > 0) {
+        while (sp > 0 && !(found && R->any)) {
             int ni = stack[--sp];
             const geom_csg_bvh *nd = &c->bvh[ni];
             double t0, t1;
-            if (!v3_slab(org, dir, nd->lo, nd->hi, &t0, &t1) || t1 < tmin || t0 > best) continue;
+            if (!v3_slab_inv(R->org, R->dir, R->inv, nd->lo, nd->hi, &t0, &t1)) continue;
+            double pad = 1e-9 * (fabs(t0) + fabs(t1)) + 1e-300;
+            if (t1 + pad < R->tmin || t0 - pad > best) continue;
             if (nd->count > 0) {
-                for (int k = 0; k < nd->count; k++)
-                    found |= try_member(c, c->bvh_items[nd->first + k], org, dir, tmin, &best, h);
+                for (int k = 0; k < nd->count && !(found && R->any); k++)
+                    found |= try_member(c, c->bvh_items[nd->first + k], R, &best, h);
             } else if (sp + 2 <= 64) {
                 stack[sp++] = nd->first;
                 stack[sp++] = ni + 1;
             }
         }
     }
-    assert(!found || (h->t > tmin && h->t < tmax && h->shape >= 0 && h->shape < c->nshapes));
+    assert(!found || (h->t > R->tmin && h->t < tmax && h->shape >= 0 && h->shape < c->nshapes));
     return found;
+}
+
+static csg_ray make_ray(vec3 org, vec3 dir, double tmin, int any)
+{
+    csg_ray R = {org, dir, v3(1.0 / dir.x, 1.0 / dir.y, 1.0 / dir.z), tmin, any};
+    return R;
+}
+
+int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, geom_csg_hit *h)
+{
+    csg_ray R = make_ray(org, dir, tmin, 0);
+    return csg_search(c, &R, tmax, h);
+}
+
+int geom_csg_occludes(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax)
+{
+    csg_ray R = make_ray(org, dir, tmin, 1);
+    geom_csg_hit h;
+    return csg_search(c, &R, tmax, &h);
 }
 
 /* ------------------------------------------------------------ building */

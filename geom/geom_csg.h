@@ -135,6 +135,10 @@ pt_status geom_csg_build(geom_csg *c, const scene_object *o, const scene_texture
 
 /* Nearest crossing of the result with t in (tmin, tmax). */
 int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, geom_csg_hit *h);
+/* Whether some crossing of the result lies in (tmin, tmax): what
+ * geom_csg_intersect finds, without searching on for the nearest (shadow
+ * rays). */
+int geom_csg_occludes(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax);
 int geom_csg_inside(const geom_csg *c, int node, vec3 p);
 /* Does a point p on the surface of leaf `node` belong to the result's
  * surface (the member rules at every level up to the root)? */
