@@ -117,15 +117,15 @@ static int corners(int x, int y, int w, int h, int s, int cx[4], int cy[4], doub
  * cells of each level nearest to p (those overlapping the box p +- size/2).
  * The cells are a hash table (open addressing) of runs in vg_ids. */
 
-#define VG_LEVELS 24
+#define VG_LEVELS GI_VG_LEVELS
+
+/* A cell's key: the level, then its x, y and z indices, chained (a query
+ * shares the chain's first links between the cells it looks in). */
+static uint64_t hash_step(uint64_t h, int64_t i) { return pt_mix64(h ^ (uint64_t)i); }
 
 static uint64_t cell_hash(int level, int64_t ix, int64_t iy, int64_t iz)
 {
-    uint64_t h = pt_mix64((uint64_t)level);
-    h = pt_mix64(h ^ (uint64_t)ix);
-    h = pt_mix64(h ^ (uint64_t)iy);
-    h = pt_mix64(h ^ (uint64_t)iz);
-    return h | 1; /* 0 marks an empty slot */
+    return hash_step(hash_step(hash_step(pt_mix64((uint64_t)level), ix), iy), iz) | 1; /* 0 marks an empty slot */
 }
 
 static int point_level(const gi_particle *gp, double r)
@@ -168,6 +168,9 @@ static pt_status build_index(gi_particle *gp)
     for (int k = 0; k < m; k++) {
         const vg_point *pt = &gp->vg_pt[k];
         int L = point_level(gp, pt->r);
+        vec3 *box = gp->vg_lvl_box + 2 * L;
+        box[0] = used >> L & 1u ? v3_min(box[0], pt->p) : pt->p;
+        box[1] = used >> L & 1u ? v3_max(box[1], pt->p) : pt->p;
         used |= 1u << L;
         double c = gp->vg_c0 * (double)(1u << L);
         kk[k].key = cell_hash(L, (int64_t)floor(pt->p.x / c), (int64_t)floor(pt->p.y / c), (int64_t)floor(pt->p.z / c));
@@ -206,15 +209,27 @@ static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int
     for (int L = 0; L < VG_LEVELS; L++) {
         if (!(gp->vg_levels >> L & 1u)) continue;
         double c = gp->vg_c0 * (double)(1u << L);
+        /* a point of this level answers within r <= c/2 (relaxed 2r <= c;
+         * the last level's may be larger): none does from farther than c
+         * outside the box of its points */
+        const vec3 *box = gp->vg_lvl_box + 2 * L;
+        if (L < VG_LEVELS - 1 &&
+            (hit->p.x < box[0].x - c || hit->p.y < box[0].y - c || hit->p.z < box[0].z - c ||
+             hit->p.x > box[1].x + c || hit->p.y > box[1].y + c || hit->p.z > box[1].z + c))
+            continue;
         /* the 2 cells per axis overlapping p +- c/2 (relaxed: the 3 around
-         * p's, which hold every point within c) */
+         * p's, which hold every point within c); cell_hash's chain over
+         * the x and y indices is shared by the cells that have them */
         int64_t i0[3];
         int span = relaxed ? 3 : 2, ncell = span * span * span;
         const double sh = relaxed ? 0.0 : 0.5;
         const double pc[3] = {hit->p.x / c - sh, hit->p.y / c - sh, hit->p.z / c - sh};
         for (int a = 0; a < 3; a++) i0[a] = (int64_t)floor(pc[a]) - (relaxed ? 1 : 0);
+        uint64_t hl = pt_mix64((uint64_t)L), hx[3], hxy[9];
+        for (int a = 0; a < span; a++) hx[a] = hash_step(hl, i0[0] + a);
+        for (int a = 0; a < span * span; a++) hxy[a] = hash_step(hx[a % span], i0[1] + a / span);
         for (int corner = 0; corner < ncell; corner++) {
-            uint64_t key = cell_hash(L, i0[0] + corner % span, i0[1] + corner / span % span, i0[2] + corner / (span * span));
+            uint64_t key = hash_step(hxy[corner % (span * span)], i0[2] + corner / (span * span)) | 1;
             size_t slot = (size_t)key & gp->vg_tab_mask;
             while (gp->vg_tab[slot].key && gp->vg_tab[slot].key != key) slot = (slot + 1) & gp->vg_tab_mask;
             if (!gp->vg_tab[slot].key) continue;

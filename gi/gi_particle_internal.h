@@ -28,6 +28,9 @@ typedef struct {
     struct cell_batch *cb; /* the pre-pass's cell tests waiting for the row's end (cell_batch) */
 } thread_count;
 
+/* Levels of the final gather's cells of points (gi_particle_gather.c). */
+#define GI_VG_LEVELS 24
+
 struct gi_particle {
     const scene *sc;
     scene gsc;          /* settings.camera given: *sc with that camera, for the geometry stage */
@@ -91,6 +94,7 @@ struct gi_particle {
     size_t vg_tab_mask;
     double vg_c0;     /* level 0's cell size */
     unsigned vg_levels; /* bit L: level L has points */
+    vec3 vg_lvl_box[2 * GI_VG_LEVELS]; /* per level, the box (lo, hi) of its points */
     thread_count tc[GI_MAX_THREADS];
     gi_particle_stats st;
 };
