@@ -174,6 +174,19 @@ static double axis_exit(double o, double inv, double lo, double hi)
     return ((inv > 0.0 ? hi : lo) - o) * inv;
 }
 
+/* The cell index along one axis of a point at grid coordinate p on a ray
+ * with direction component d, as the walk's descent picks children: on a
+ * cell line the one the ray goes on into (the lower one for d <= 0), then
+ * clamped to [0, n - 1]. */
+static int leaf_index(double p, double d, int n)
+{
+    if (!(p > 0.0)) return 0;
+    if (p >= (double)n) return n - 1;
+    int i = (int)p; /* p in (0, n): truncation is floor */
+    if ((double)i == p && !(d > 0.0)) i--;
+    return i < 0 ? 0 : i;
+}
+
 int geom_hfield_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     const hf_data *f = sh->data;
@@ -195,9 +208,19 @@ int geom_hfield_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double t
      * height range (a leaf: its triangles are tested), else the ray moves
      * on to the neighbouring node, up a level when it leaves the parent.
      * Node indices change by whole steps, so the walk ends after at most
-     * one visit per node along the ray. */
-    int top = f->nlev - 1, lev = top, ix = 0, iz = 0, n = 0;
+     * one visit per node along the ray.
+     *
+     * The walk starts at the cell holding the ray at ta (on a cell line:
+     * the one the ray goes on into, the lower one for a ray along the
+     * line; clamped into the grid as the box's padding may reach past
+     * it), the cell a descent from the root would reach: the descent's
+     * tests of the cell's ancestors could only skip stretches where the
+     * cell itself is not met, and they made up most of the walk's steps
+     * for the shadow rays that leave a height field's surface (every
+     * ancestor of the cell under a surface point meets the ray there). */
+    int top = f->nlev - 1, lev = 0, n = 0;
     double t = ta;
+    int ix = leaf_index(go.x + t * gd.x, gd.x, f->nx), iz = leaf_index(go.z + t * gd.z, gd.z, f->nz);
     for (;;) {
         double x0, x1, z0, z1;
         node_span(f, lev, ix, 0, &x0, &x1);
