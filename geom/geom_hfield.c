@@ -10,6 +10,7 @@
 #include "geom_hfield.h"
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -31,6 +32,21 @@ static double H_at(const hf_data *f, int i, int j)
 {
     double v = f->h[(size_t)j * (size_t)f->W + (size_t)i];
     return v > f->water ? v : f->water;
+}
+
+/* nextafterf(x, dir * INFINITY) without the library call for a finite,
+ * non-zero x (the next float's bit pattern is one away in the direction
+ * of its magnitude); the call for the rest. The node ranges of a large
+ * field take a million of these. */
+static float float_step(float x, int dir)
+{
+    if (x == 0.0f || !isfinite(x)) return nextafterf(x, dir * INFINITY);
+    uint32_t b;
+    memcpy(&b, &x, sizeof b);
+    if ((x > 0.0f) == (dir > 0)) b++;
+    else b--;
+    memcpy(&x, &b, sizeof b);
+    return x;
 }
 
 int geom_hfield_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
@@ -65,8 +81,8 @@ int geom_hfield_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
                     for (int dj = 0; dj < 2; dj++)
                         for (int di = 0; di < 2; di++) {
                             double v = H_at(f, i + di, j + dj);
-                            a = fmin(a, v);
-                            b = fmax(b, v);
+                            a = v < a ? v : a;
+                            b = v > b ? v : b;
                         }
                 } else {
                     int pw = f->lw[lev - 1], ph = f->lh[lev - 1];
@@ -74,13 +90,14 @@ int geom_hfield_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
                         for (int di = 0; di < 2; di++) {
                             int ci = 2 * i + di, cj = 2 * j + dj;
                             if (ci >= pw || cj >= ph) continue;
-                            a = fmin(a, f->mn[lev - 1][(size_t)cj * pw + ci]);
-                            b = fmax(b, f->mx[lev - 1][(size_t)cj * pw + ci]);
+                            double cmn = f->mn[lev - 1][(size_t)cj * pw + ci], cmx = f->mx[lev - 1][(size_t)cj * pw + ci];
+                            a = cmn < a ? cmn : a;
+                            b = cmx > b ? cmx : b;
                         }
                 }
                 /* float storage: round outwards */
-                f->mn[lev][(size_t)j * lw + i] = nextafterf((float)a, -INFINITY);
-                f->mx[lev][(size_t)j * lw + i] = nextafterf((float)b, INFINITY);
+                f->mn[lev][(size_t)j * lw + i] = float_step((float)a, -1);
+                f->mx[lev][(size_t)j * lw + i] = float_step((float)b, 1);
             }
         lev++;
         if ((lw == 1 && lh == 1) || lev == MAX_LEVELS) break;
