@@ -56,6 +56,21 @@
 
 static unsigned short hash_table[8192];
 static double rtab[267];
+
+/* The gradient table rearranged for the lattice sums, which index it at
+ * k = hash & 0xFF: ntab[k] holds R[k]/2, R[k+1], R[k+2], R[k+3] (one Noise
+ * term), drow[k] the same four for R[k..], R[k+4..], R[k+8..] in lanes 0,
+ * 1, 2 (the x, y, z terms of one DNoise corner; lane 3 unused). Halving is
+ * exact and every lane does the scalar term's operations in its order, so
+ * the sums are bit for bit the scalar ones (the compiler contracts nothing
+ * into fused multiply-adds on the baseline instruction set). */
+typedef double nv2 __attribute__((vector_size(16)));
+static double ntab[256][4];
+typedef struct {
+    nv2 h, a, b, c;       /* x and y terms */
+    double hz, az, bz, cz; /* z term */
+} noise_drow;
+static noise_drow dtab[256];
 static int solid_perm[2 * (SOLID_N + 1)];
 static vec3 solid_grad[2 * (SOLID_N + 1)];
 static double pattern_rands[RANDS_N];
@@ -108,6 +123,22 @@ static void init_rtable(void)
         char buf[64];
         snprintf(buf, sizeof buf, "%g", val); /* POV-Ray's literal table precision */
         rtab[i] = strtod(buf, NULL);
+    }
+    for (int k = 0; k < 256; k++) {
+        ntab[k][0] = rtab[k] * 0.5;
+        ntab[k][1] = rtab[k + 1];
+        ntab[k][2] = rtab[k + 2];
+        ntab[k][3] = rtab[k + 3];
+        for (int j = 0; j < 2; j++) {
+            dtab[k].h[j] = rtab[k + 4 * j] * 0.5;
+            dtab[k].a[j] = rtab[k + 4 * j + 1];
+            dtab[k].b[j] = rtab[k + 4 * j + 2];
+            dtab[k].c[j] = rtab[k + 4 * j + 3];
+        }
+        dtab[k].hz = rtab[k + 8] * 0.5;
+        dtab[k].az = rtab[k + 9];
+        dtab[k].bz = rtab[k + 10];
+        dtab[k].cz = rtab[k + 11];
     }
 }
 
@@ -206,10 +237,30 @@ static inline void lattice(double x, int *i, double *f)
 static inline int hash2(int a, int b) { return hash_table[hash_table[a] ^ b]; }
 static inline int rindex_of(int h, int c) { return hash_table[h ^ c] & 0xFF; }
 
-/* One lattice term: s * (R[k]/2 + R[k+1] x + R[k+2] y + R[k+3] z). */
-static inline double term(int k, double s, double x, double y, double z)
+/* Two lattice terms s * (R[k]/2 + R[k+1] x + R[k+2] y + R[k+3] z), for
+ * k = ka in lane 0 and kb in lane 1. */
+static inline nv2 term2(int ka, int kb, nv2 s, nv2 x, nv2 y, nv2 z)
 {
-    return s * ((rtab[k] * 0.5) + rtab[k + 1] * x + rtab[k + 2] * y + rtab[k + 3] * z);
+    const double *a = ntab[ka], *b = ntab[kb];
+    nv2 h = {a[0], b[0]}, r1 = {a[1], b[1]}, r2 = {a[2], b[2]}, r3 = {a[3], b[3]};
+    return s * (((h + r1 * x) + r2 * y) + r3 * z);
+}
+
+/* The x, y, z terms of one DNoise corner: x and y in the lanes of *xy, z
+ * in *z; stored by the first corner, added by the rest. */
+static inline void dterm(nv2 *xy, double *z, int first, int k, double s, double x, double y, double zz)
+{
+    const noise_drow *r = &dtab[k];
+    nv2 vs = {s, s}, vx = {x, x}, vy = {y, y}, vz = {zz, zz};
+    nv2 t = vs * (((r->h + r->a * vx) + r->b * vy) + r->c * vz);
+    double tz = s * (((r->hz + r->az * x) + r->bz * y) + r->cz * zz);
+    if (first) {
+        *xy = t;
+        *z = tz;
+    } else {
+        *xy += t;
+        *z += tz;
+    }
 }
 
 /* The lattice cell of p as POV-Ray's Noise and DNoise set it up: p's
@@ -259,14 +310,22 @@ double shade_noise_value(vec3 p, int generator)
     }
     noise_cell c;
     cell_at(p, &c);
-    double sum = term(rindex_of(c.h00, c.iz), c.txty * c.tz, c.x0, c.y0, c.z0);
-    sum += term(rindex_of(c.h10, c.iz), c.sxty * c.tz, c.x1, c.y0, c.z0);
-    sum += term(rindex_of(c.h01, c.iz), c.txsy * c.tz, c.x0, c.y1, c.z0);
-    sum += term(rindex_of(c.h11, c.iz), c.sxsy * c.tz, c.x1, c.y1, c.z0);
-    sum += term(rindex_of(c.h00, c.iz + 1), c.txty * c.sz, c.x0, c.y0, c.z1);
-    sum += term(rindex_of(c.h10, c.iz + 1), c.sxty * c.sz, c.x1, c.y0, c.z1);
-    sum += term(rindex_of(c.h01, c.iz + 1), c.txsy * c.sz, c.x0, c.y1, c.z1);
-    sum += term(rindex_of(c.h11, c.iz + 1), c.sxsy * c.sz, c.x1, c.y1, c.z1);
+    /* corners in POV-Ray's order, two to a vector: (000, 100), (010, 110),
+     * (001, 101), (011, 111); summed one by one in that order */
+    nv2 x = {c.x0, c.x1}, y0 = {c.y0, c.y0}, y1 = {c.y1, c.y1}, z0 = {c.z0, c.z0}, z1 = {c.z1, c.z1};
+    nv2 sy0 = {c.txty, c.sxty}, sy1 = {c.txsy, c.sxsy}, tz = {c.tz, c.tz}, sz = {c.sz, c.sz};
+    nv2 t0 = term2(rindex_of(c.h00, c.iz), rindex_of(c.h10, c.iz), sy0 * tz, x, y0, z0);
+    nv2 t1 = term2(rindex_of(c.h01, c.iz), rindex_of(c.h11, c.iz), sy1 * tz, x, y1, z0);
+    nv2 t2 = term2(rindex_of(c.h00, c.iz + 1), rindex_of(c.h10, c.iz + 1), sy0 * sz, x, y0, z1);
+    nv2 t3 = term2(rindex_of(c.h01, c.iz + 1), rindex_of(c.h11, c.iz + 1), sy1 * sz, x, y1, z1);
+    double sum = t0[0];
+    sum += t0[1];
+    sum += t1[0];
+    sum += t1[1];
+    sum += t2[0];
+    sum += t2[1];
+    sum += t3[0];
+    sum += t3[1];
     if (generator == 2) {
         sum += 1.05242;
         sum *= 0.48985582;
@@ -274,13 +333,6 @@ double shade_noise_value(vec3 p, int generator)
         sum = sum + 0.5;
     }
     return sum < 0.0 ? 0.0 : (sum > 1.0 ? 1.0 : sum);
-}
-
-static inline void dterm(vec3 *r, int k, double s, double x, double y, double z)
-{
-    r->x += term(k, s, x, y, z);
-    r->y += term(k + 4, s, x, y, z);
-    r->z += term(k + 8, s, x, y, z);
 }
 
 vec3 shade_noise_dvector(vec3 p)
@@ -294,17 +346,17 @@ static vec3 dnoise(vec3 p)
     noise_cell c;
     cell_at(p, &c);
     /* The first corner initialises, the rest add (POV-Ray's corner order). */
-    int k = rindex_of(c.h00, c.iz);
-    double s = c.txty * c.tz;
-    vec3 r = v3(term(k, s, c.x0, c.y0, c.z0), term(k + 4, s, c.x0, c.y0, c.z0), term(k + 8, s, c.x0, c.y0, c.z0));
-    dterm(&r, rindex_of(c.h10, c.iz), c.sxty * c.tz, c.x1, c.y0, c.z0);
-    dterm(&r, rindex_of(c.h11, c.iz), c.sxsy * c.tz, c.x1, c.y1, c.z0);
-    dterm(&r, rindex_of(c.h01, c.iz), c.txsy * c.tz, c.x0, c.y1, c.z0);
-    dterm(&r, rindex_of(c.h01, c.iz + 1), c.txsy * c.sz, c.x0, c.y1, c.z1);
-    dterm(&r, rindex_of(c.h11, c.iz + 1), c.sxsy * c.sz, c.x1, c.y1, c.z1);
-    dterm(&r, rindex_of(c.h10, c.iz + 1), c.sxty * c.sz, c.x1, c.y0, c.z1);
-    dterm(&r, rindex_of(c.h00, c.iz + 1), c.txty * c.sz, c.x0, c.y0, c.z1);
-    return r;
+    nv2 xy;
+    double z;
+    dterm(&xy, &z, 1, rindex_of(c.h00, c.iz), c.txty * c.tz, c.x0, c.y0, c.z0);
+    dterm(&xy, &z, 0, rindex_of(c.h10, c.iz), c.sxty * c.tz, c.x1, c.y0, c.z0);
+    dterm(&xy, &z, 0, rindex_of(c.h11, c.iz), c.sxsy * c.tz, c.x1, c.y1, c.z0);
+    dterm(&xy, &z, 0, rindex_of(c.h01, c.iz), c.txsy * c.tz, c.x0, c.y1, c.z0);
+    dterm(&xy, &z, 0, rindex_of(c.h01, c.iz + 1), c.txsy * c.sz, c.x0, c.y1, c.z1);
+    dterm(&xy, &z, 0, rindex_of(c.h11, c.iz + 1), c.sxsy * c.sz, c.x1, c.y1, c.z1);
+    dterm(&xy, &z, 0, rindex_of(c.h10, c.iz + 1), c.sxty * c.sz, c.x1, c.y0, c.z1);
+    dterm(&xy, &z, 0, rindex_of(c.h00, c.iz + 1), c.txty * c.sz, c.x0, c.y0, c.z1);
+    return v3(xy[0], xy[1], z);
 }
 
 /* ------------------------------------------------------------ gradient noise */
