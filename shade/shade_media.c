@@ -395,6 +395,11 @@ static void one_sample(const sampler *s, interval *iv, double d, int method, rgb
     coeffs c = coeffs_at(s->refs, s->nrefs, h, s->shadow, &s->pc);
     *od = scl(c.ext, iv->ds);
     if (method != 3) iv->od = add(iv->od, *od);
+    if (s->shadow) { /* extinction only: no light to add up */
+        *col = mk(0, 0, 0);
+        iv->samples++;
+        return;
+    }
     rgb emit = c.emit;
     if (!s->shadow && s->use_scattering && iv->lit && s->e->light && !is_zero(c.scat)) {
         for (int i = 0; i < s->nlights; i++) {
@@ -472,7 +477,7 @@ static void adaptive(const sampler *s, interval *iv, const scene_media *im, doub
         double jj = im->jitter != 0.0 ? dd * im->jitter * (rnd(s->e) - 0.5) : 0.0;
         one_sample(s, iv, d1 + jj, 3, &c1, &od1);
         recursive_sample(s, iv, d0, d1, c0, c1, od0, od1, im->aa_level - 1, im->jitter, aa, &res, &odres);
-        iv->te = add(iv->te, mul(res, expn(scl(iv->od, n))));
+        if (!s->shadow) iv->te = add(iv->te, mul(res, expn(scl(iv->od, n))));
         iv->od = add(iv->od, odres);
         c0 = c1;
         od0 = od1;
@@ -526,18 +531,28 @@ rgb shade_media_segment(const shade_media_env *e, int which, const shade_media_i
     if (nrefs == 0 || !(depth > 0.0)) return c;
     const scene_media *im = refs[0].m;
     double aa = HUGE_VAL;
-    int use_ext = 0, use_scat = 0, all_constant = shadow;
+    int use_ext = 0, use_scat = 0, all_constant = shadow, no_density = 1;
     for (int i = 0; i < nrefs; i++) {
         const scene_media *m = refs[i].m;
         if (m->intervals > im->intervals) im = m;
         if (m->aa_threshold < aa) aa = m->aa_threshold;
         if (!is_zero(m->absorption) || !is_zero(m->scattering)) use_ext = 1;
         if (!is_zero(m->scattering)) use_scat = 1;
+        if (m->ndensity > 0) no_density = 0;
         /* a density counts as constant when it is a plain colour */
         for (int k = 0; k < m->ndensity; k++)
             if (m->density[k]->kind == PIGMENT_PATTERN) all_constant = 0;
     }
     if (shadow && !use_ext) return c;
+    if (shadow && no_density) {
+        /* a shadow ray through media without densities: one interval of
+         * one sample (see below), whose light is 0; what that sample
+         * computes, the sum of the extinctions times the depth, without
+         * the emission's exponentials */
+        rgb ext = {0, 0, 0};
+        for (int i = 0; i < nrefs; i++) ext = add(ext, add(refs[i].m->absorption, scl(refs[i].m->scattering, refs[i].m->extinction)));
+        return mul(c, expn(scl(ext, depth)));
+    }
 
     /* lit intervals */
     lit_light lights[MAX_LIGHTS];
@@ -666,7 +681,7 @@ rgb shade_media_segment(const shade_media_env *e, int which, const shade_media_i
     rgb od = {0, 0, 0}, te = {0, 0, 0};
     for (int i = 0; i < niv; i++) {
         double n = ivs[i].samples > 0 ? 1.0 / ivs[i].samples : 0.0;
-        te = add(te, mul(scl(ivs[i].te, n), expn(od)));
+        if (!shadow) te = add(te, mul(scl(ivs[i].te, n), expn(od)));
         od = add(od, scl(ivs[i].od, n));
     }
     return add(mul(c, expn(od)), te);
