@@ -211,14 +211,56 @@ typedef struct {
     rgb ext, emit, scat;
 } coeffs;
 
+/* A density that costs a few operations to evaluate: a plain colour, or a
+ * pattern that is a closed form of the point (no noise, cells or
+ * functions) through a colour map, without turbulence. */
+static int density_cheap(const scene_pigment *pg)
+{
+    if (pg->kind != PIGMENT_PATTERN) return 1;
+    const scene_pattern *pat = pg->pat;
+    if (!pat || (pg->map && pg->map->kind != MAP_COLOUR)) return 0;
+    switch (pat->kind) {
+    case PAT_SPHERICAL: case PAT_GRADIENT: case PAT_PLANAR: case PAT_BOXED: case PAT_CYLINDRICAL:
+    case PAT_ONION: case PAT_RADIAL: case PAT_CHECKER:
+        break;
+    default:
+        return 0;
+    }
+    for (int i = 0; i < pat->nwarps; i++)
+        if (pat->warps[i].kind == WARP_TURBULENCE) return 0;
+    return 1;
+}
+
+#define MAX_DENSITIES 16
 static rgb density_at(const media_ref *r, vec3 p, const shade_pattern_ctx *pc)
 {
     const scene_media *m = r->m;
     if (m->ndensity == 0) return mk(1, 1, 1);
     vec3 q = r->obj ? xform_inv_point(r->obj, p) : p;
     if (!xform_is_identity(&m->transform)) q = xform_inv_point(&m->transform, q);
+    /* The densities multiply, so one that is 0 in every channel makes the
+     * product 0 (their colours are finite): the cheap ones are evaluated
+     * first, and an expensive one (crackle, noise) is not where a cheap
+     * one is 0 (micro: a crackle density times a spherical one that is 0
+     * outside the unit sphere). Otherwise the product is formed in the
+     * written order, as before. */
+    rgb v[MAX_DENSITIES];
+    unsigned have = 0;
+    int n = m->ndensity <= MAX_DENSITIES ? m->ndensity : 0;
+    for (int i = 0; n > 1 && i < n; i++) {
+        if (!density_cheap(m->density[i])) continue;
+        colour5 c = {0, 0, 0, 0, 0};
+        shade_pigment_eval(m->density[i], q, pc, &c);
+        v[i] = mk(c.r, c.g, c.b);
+        have |= 1u << i;
+        if (is_zero(v[i])) return mk(0, 0, 0);
+    }
     rgb d = {1, 1, 1};
     for (int i = 0; i < m->ndensity; i++) {
+        if (i < n && (have & (1u << i))) {
+            d = mul(d, v[i]);
+            continue;
+        }
         colour5 c = {0, 0, 0, 0, 0};
         shade_pigment_eval(m->density[i], q, pc, &c);
         d = mul(d, mk(c.r, c.g, c.b));
