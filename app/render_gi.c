@@ -518,7 +518,7 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
         STATS_INTS(js, p, particles, radiance_particles, radiance_slots, list_entries, link_rays, link_misses,
                    visibility_rays, sources, bounces, found, used);
         /* the hook's lookups: all, without particles, estimated at the hit */
-        STATS_INTS(js, p, lookups, lookups_none, lookups_gathered, view_gathers, view_gather_rays, lookups_onthefly, skipped_objects, discarded);
+        STATS_INTS(js, p, lookups, lookups_none, lookups_gathered, lookups_gathered_here, view_gathers, view_gather_rays, lookups_onthefly, skipped_objects, discarded);
         STATS_NUMS(js, p, spacing, radius);
         STATS_INTS(js, p, bytes_total);
         stats_obj_begin(js, "timings");

@@ -41,6 +41,9 @@ typedef struct {
     gi_dev_light *lights; /* the scene's, for the far field's direct light */
     int nlights;
     int exact;            /* view points with no bounce after the hit: every hit takes hit_light */
+    float *reach;         /* per source (i - first): the harmonic mean of its rays' hit distances */
+    void *lscene;         /* the link scene built here, or NULL */
+    int threads;          /* buffers */
 } link_job;
 
 /* The material where ray h hit object o: rho and le at the pigment there
@@ -116,7 +119,9 @@ static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int
     const scene_object *o = hit_leaf(J, h, &tex);
     if (!o) return;
     float rho[3], le[3];
-    if (!far && !direct) { /* the emission alone: none where the finish emits nothing */
+    /* with no far-field sky and no lights to reflect, only the emission
+     * counts: none where the finish emits nothing */
+    if ((!far || !(J->far_bounce > 0.0f)) && (!direct || J->nlights <= 0)) {
         if (memo->tex != tex) {
             const colour5 white = {1.0, 1.0, 1.0, 0.0, 0.0};
             gi_particles_material(J->sc, tex, &white, rho, le);
@@ -208,6 +213,71 @@ static int inside_lifted(const scene_object *o, const gi_dev_particle *t)
     return gi_surface_inside_solid(o, v3_madd(p, v3(t->n[0], t->n[1], t->n[2]), lift));
 }
 
+/* The k = nside^2 rays of one source at pos with unit normal nrm into rh:
+ * the stratified cosine-weighted set (direction_f) from random stream
+ * `stream` of the job's seed, from a point lifted off the surface by the
+ * job's offset. */
+static void source_rays(const link_job *J, vec3 pos, vec3 nrm, uint64_t stream, struct RTCRayHit *rh)
+{
+    double off = J->off * (J->scale + fmax(fabs(pos.x), fmax(fabs(pos.y), fabs(pos.z))));
+    vec3 org = v3_madd(pos, nrm, off);
+    /* per source: the frame and the ray epsilon (unit directions) */
+    vec3 tv, bv;
+    v3_basis(nrm, &tv, &bv);
+    float t[3] = {(float)tv.x, (float)tv.y, (float)tv.z}, bb[3] = {(float)bv.x, (float)bv.y, (float)bv.z};
+    float nf[3] = {(float)nrm.x, (float)nrm.y, (float)nrm.z};
+    float tnear = (float)accel_epsilon(J->a, org, nrm);
+    const float of[3] = {(float)org.x, (float)org.y, (float)org.z};
+    rng r;
+    rng_seed(&r, J->seed, stream);
+    for (int j = 0; j < J->k; j++) {
+        float u1 = (float)rng_f64(&r), u2 = (float)rng_f64(&r);
+        float d[3];
+        direction_f(t, bb, nf, J->su0[j], J->sv0[j], J->sw, u1, u2, d);
+        accel_rtc_rayhit_init(&rh[j], of, tnear, d);
+    }
+}
+
+static void trace_rays(const link_job *J, struct RTCRayHit *rh, int m)
+{
+    struct RTCIntersectContext c;
+    rtcInitIntersectContext(&c);
+    /* incoherent: a batch's rays start at many particles and spread over
+     * the hemisphere, so Embree's stream mode for incoherent rays beats
+     * coherent packets (per 4x4 block of strata) and single rays on them
+     * (docs/gi.md; bench/bench_gi prints the link stage's time). */
+    c.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    rtcIntersect1M(J->scene, &c, rh, (unsigned)m, sizeof *rh);
+}
+
+static int ray_hit(const struct RTCRayHit *h)
+{
+    return h->hit.geomID != RTC_INVALID_GEOMETRY_ID && isfinite(h->ray.tfar);
+}
+
+/* How far one source's k rays reach: k over the sum of 1/distance of
+ * those that hit (a miss adds nothing), INFINITY when none hit. This is
+ * the harmonic mean distance an irradiance cache sizes a record's reach
+ * by (Ward, Rubinstein and Clear 1988; POV-Ray's radiosity.cpp takes the
+ * same mean of its sample rays' depths, a miss's depth infinite). */
+static float harmonic_reach(const struct RTCRayHit *rh, int k)
+{
+    double inv = 0.0;
+    for (int j = 0; j < k; j++)
+        if (ray_hit(&rh[j]) && rh[j].ray.tfar > 0.0f) inv += 1.0 / rh[j].ray.tfar;
+    return inv > 0.0 ? (float)(k / inv) : INFINITY;
+}
+
+/* What a ray that leaves the scene adds: the sky's radiance in its
+ * direction. */
+static void ray_sky(const link_job *J, const struct RTCRayHit *h, float sky[3])
+{
+    const float d[3] = {h->ray.dir_x, h->ray.dir_y, h->ray.dir_z};
+    float L[3];
+    gi_sky_radiance(J->sky, d, L);
+    for (int c = 0; c < 3; c++) sky[c] += L[c];
+}
+
 static void job(void *ctx, int index, int thread)
 {
     link_job *J = ctx;
@@ -217,34 +287,12 @@ static void job(void *ctx, int index, int thread)
     long miss = 0, unres = 0, other = 0, tri_ok = 0, tri_fb = 0;
     for (int i = i0; i < i1; i++) {
         const gi_dev_particle *pt = &J->p[i];
-        vec3 pos = v3(pt->p[0], pt->p[1], pt->p[2]);
-        vec3 nrm = v3(pt->n[0], pt->n[1], pt->n[2]);
-        double off = J->off * (J->scale + fmax(fabs(pos.x), fmax(fabs(pos.y), fabs(pos.z))));
-        vec3 org = v3_madd(pos, nrm, off);
-        /* per particle: the frame and the ray epsilon (unit directions) */
-        vec3 tv, bv;
-        v3_basis(nrm, &tv, &bv);
-        float t[3] = {(float)tv.x, (float)tv.y, (float)tv.z}, bb[3] = {(float)bv.x, (float)bv.y, (float)bv.z};
-        float nf[3] = {(float)nrm.x, (float)nrm.y, (float)nrm.z};
-        float tnear = (float)accel_epsilon(J->a, org, nrm);
-        const float of[3] = {(float)org.x, (float)org.y, (float)org.z};
-        rng r;
-        rng_seed(&r, J->seed, (uint64_t)i);
-        for (int j = 0; j < J->k; j++) {
-            float u1 = (float)rng_f64(&r), u2 = (float)rng_f64(&r);
-            float d[3];
-            direction_f(t, bb, nf, J->su0[j], J->sv0[j], J->sw, u1, u2, d);
-            accel_rtc_rayhit_init(&rh[m++], of, tnear, d);
-        }
+        source_rays(J, v3(pt->p[0], pt->p[1], pt->p[2]), v3(pt->n[0], pt->n[1], pt->n[2]), (uint64_t)i, rh + m);
+        m += J->k;
     }
-    struct RTCIntersectContext c;
-    rtcInitIntersectContext(&c);
-    /* incoherent: a batch's rays start at many particles and spread over
-     * the hemisphere, so Embree's stream mode for incoherent rays beats
-     * coherent packets (per 4x4 block of strata) and single rays on them
-     * (docs/gi.md; bench/bench_gi prints the link stage's time). */
-    c.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-    rtcIntersect1M(J->scene, &c, rh, (unsigned)m, sizeof *rh);
+    trace_rays(J, rh, m);
+    if (J->reach)
+        for (int i = i0; i < i1; i++) J->reach[i - J->first] = harmonic_reach(rh + (size_t)(i - i0) * J->k, J->k);
     /* hit points and their lookup cells; the lookups are bound by memory
      * latency, so the whole batch prefetches first (gi_area_particles.h) */
     vec3 *hp = J->hp[thread];
@@ -254,7 +302,7 @@ static void job(void *ctx, int index, int thread)
     const gi_trilook *tl = J->tl && J->grid && J->links && J->pobj && !J->exact ? J->tl : NULL;
     for (int t = 0; t < m; t++) {
         const struct RTCRayHit *h = &rh[t];
-        int hit = h->hit.geomID != RTC_INVALID_GEOMETRY_ID && isfinite(h->ray.tfar);
+        int hit = ray_hit(h);
         hp[t] = v3(h->ray.org_x + h->ray.tfar * h->ray.dir_x, h->ray.org_y + h->ray.tfar * h->ray.dir_y,
                    h->ray.org_z + h->ray.tfar * h->ray.dir_z);
         cell[t] = hit ? -1 : -2;
@@ -286,12 +334,7 @@ static void job(void *ctx, int index, int thread)
             any |= hit;
             if (!hit) {
                 miss++;
-                if (J->esky) {
-                    const float d[3] = {rh[m].ray.dir_x, rh[m].ray.dir_y, rh[m].ray.dir_z};
-                    float L[3];
-                    gi_sky_radiance(J->sky, d, L);
-                    for (int c = 0; c < 3; c++) sky[c] += L[c];
-                }
+                if (J->esky) ray_sky(J, &rh[m], sky);
             }
             if (!J->links) continue;
             int target = -1;
@@ -484,119 +527,135 @@ void gi_links_reverse_fill(const int *links, int n, int k, const unsigned *mask,
     }
 }
 
+/* The set-up gi_links_build and the gatherer share: the scene to trace,
+ * the strata, the offsets and `threads` buffers of `rays` rays (with
+ * cells: the lookup's per-ray arrays too). Undone by job_close. */
+static pt_status job_open(link_job *J, const accel *a, void *rtc_scene, int nside, int threads, size_t rays, int cells)
+{
+    J->a = a;
+    /* the link scene (accel.h): without the main scene's robust mode and
+     * filters it is cheaper per link ray; the main scene is the fallback */
+    J->lscene = rtc_scene ? NULL : accel_rtc_link_scene(a);
+    J->scene = rtc_scene ? (RTCScene)rtc_scene : J->lscene ? (RTCScene)J->lscene : (RTCScene)accel_rtc_scene(a);
+    if (!J->scene) return PT_ERR_INTERNAL;
+    J->nside = nside;
+    J->k = nside * nside;
+    J->threads = threads;
+    /* rays in 4x4 blocks of strata (a narrow cone each) when the side
+     * divides by 4 (the order fixes which random numbers each stratum
+     * gets, so it stays although the rays are traced as incoherent) */
+    J->order = malloc((size_t)J->k * sizeof *J->order);
+    J->su0 = malloc((size_t)J->k * sizeof *J->su0);
+    J->sv0 = malloc((size_t)J->k * sizeof *J->sv0);
+    J->buf = calloc((size_t)threads, sizeof *J->buf);
+    if (cells) {
+        J->hp = calloc((size_t)threads, sizeof *J->hp);
+        J->cell = calloc((size_t)threads, sizeof *J->cell);
+        J->tcell = calloc((size_t)threads, sizeof *J->tcell);
+    }
+    if (!J->order || !J->su0 || !J->sv0 || !J->buf || (cells && (!J->hp || !J->cell || !J->tcell))) return PT_ERR_NOMEM;
+    for (int j = 0; j < J->k; j++) {
+        if (nside % 4 == 0) {
+            int blk = j / 16, w = j % 16, bpr = nside / 4;
+            J->order[j] = ((blk / bpr) * 4 + w / 4) * nside + (blk % bpr) * 4 + w % 4;
+        } else {
+            J->order[j] = j;
+        }
+    }
+    /* su = 2 (jx + u1) / nside - 1 = su0 + sw u1, as direction_f takes it */
+    J->sw = 2.0f / (float)nside;
+    for (int j = 0; j < J->k; j++) {
+        J->su0[j] = 2.0f * (float)(J->order[j] % nside) / (float)nside - 1.0f;
+        J->sv0[j] = 2.0f * (float)(J->order[j] / nside) / (float)nside - 1.0f;
+    }
+    /* origins leave the surface by 1e-6 of the working scale (the median
+     * object size, accel_eps_scale) plus the point's magnitude: the scene's
+     * diagonal would let one far object (a sky sphere of radius 1e6 around
+     * a room) lift every origin past the room's walls */
+    J->off = 1e-6;
+    J->scale = accel_eps_scale(a);
+    size_t bytes = rays * sizeof(struct RTCRayHit);
+    for (int t = 0; rays > 0 && t < threads; t++) {
+        J->buf[t] = aligned_alloc(64, (bytes + 63) / 64 * 64);
+        if (!J->buf[t]) return PT_ERR_NOMEM;
+        if (!cells) continue;
+        J->hp[t] = malloc(rays * sizeof(vec3));
+        J->cell[t] = malloc(rays * sizeof(long));
+        J->tcell[t] = malloc(rays * sizeof(long));
+        if (!J->hp[t] || !J->cell[t] || !J->tcell[t]) return PT_ERR_NOMEM;
+    }
+    return PT_OK;
+}
+
+/* The direct light of sc's lights at what the rays hit (hit_light). */
+static pt_status job_lights(link_job *J, const scene *sc)
+{
+    if (sc->nlights <= 0) return PT_OK;
+    J->lights = malloc((size_t)sc->nlights * sizeof *J->lights);
+    if (!J->lights) return PT_ERR_NOMEM;
+    for (int l = 0; l < sc->nlights; l++) gi_light_pack(&sc->lights[l], &J->lights[l]);
+    J->nlights = sc->nlights;
+    return PT_OK;
+}
+
+static void job_close(link_job *J)
+{
+    for (int t = 0; t < J->threads; t++) {
+        if (J->buf) free(J->buf[t]);
+        if (J->hp) free(J->hp[t]);
+        if (J->cell) free(J->cell[t]);
+        if (J->tcell) free(J->tcell[t]);
+    }
+    free(J->buf);
+    free(J->hp);
+    free(J->cell);
+    free(J->tcell);
+    free(J->order);
+    free(J->su0);
+    free(J->sv0);
+    free(J->lights);
+    accel_rtc_link_scene_free(J->lscene);
+}
+
 pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle *p, const void *const *pobj,
                          const unsigned char *pin, int n, int first, int nside, uint64_t seed, const gi_lookup *grid,
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
                          gi_link_stats *st, volatile int *cancel, progress *prog,
-                         const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce)
+                         const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce,
+                         float *reach)
 {
     if (threads <= 0) threads = pool_default_threads();
-    link_job J = {.a = a, .sky = sky, .esky = sky && sc ? esky : NULL, .sc = sc, .pig = pig,
+    link_job J = {.sky = sky, .esky = sky && sc ? esky : NULL, .sc = sc, .pig = pig,
                   .far_bounce = isfinite(far_bounce) && far_bounce > 0.0 ? (float)far_bounce : 0.0f};
-    /* the link scene (accel.h): without the main scene's robust mode and
-     * filters it is cheaper per link ray; the main scene is the fallback */
-    void *lscene = rtc_scene ? NULL : accel_rtc_link_scene(a);
-    J.scene = rtc_scene ? (RTCScene)rtc_scene : lscene ? (RTCScene)lscene : (RTCScene)accel_rtc_scene(a);
     J.p = p;
     J.pobj = pobj;
     J.pin = pobj ? pin : NULL;
     J.n = n;
     J.first = first > 0 && first <= n ? first : 0;
-    J.nside = nside;
-    J.k = nside * nside;
-    /* rays in 4x4 blocks of strata (a narrow cone each) when the side
-     * divides by 4 (the order fixes which random numbers each stratum
-     * gets, so it stays although the rays are traced as incoherent) */
-    if (!J.scene) return PT_ERR_INTERNAL;
-    J.order = malloc((size_t)J.k * sizeof *J.order);
-    if (!J.order) {
-        accel_rtc_link_scene_free(lscene);
-        return PT_ERR_NOMEM;
-    }
-    for (int j = 0; j < J.k; j++) {
-        if (nside % 4 == 0) {
-            int blk = j / 16, w = j % 16, bpr = nside / 4;
-            J.order[j] = ((blk / bpr) * 4 + w / 4) * nside + (blk % bpr) * 4 + w % 4;
-        } else {
-            J.order[j] = j;
-        }
-    }
-    J.su0 = malloc((size_t)J.k * sizeof *J.su0);
-    J.sv0 = malloc((size_t)J.k * sizeof *J.sv0);
-    if (!J.su0 || !J.sv0) {
-        free(J.su0);
-        free(J.sv0);
-        free(J.order);
-        accel_rtc_link_scene_free(lscene);
-        return PT_ERR_NOMEM;
-    }
-    /* su = 2 (jx + u1) / nside - 1 = su0 + sw u1, as direction_f takes it */
-    J.sw = 2.0f / (float)nside;
-    for (int j = 0; j < J.k; j++) {
-        J.su0[j] = 2.0f * (float)(J.order[j] % nside) / (float)nside - 1.0f;
-        J.sv0[j] = 2.0f * (float)(J.order[j] / nside) / (float)nside - 1.0f;
-    }
-    J.per_job = J.k >= RAYS_PER_CALL ? 1 : RAYS_PER_CALL / J.k;
+    J.reach = J.first > 0 ? reach : NULL;
+    int k = nside * nside;
+    J.per_job = k >= RAYS_PER_CALL ? 1 : RAYS_PER_CALL / k;
     J.seed = seed;
     J.grid = grid;
     J.tl = tl;
     J.maxdist = maxdist;
     J.links = links;
     J.anyhit = anyhit;
-    /* origins leave the surface by 1e-6 of the working scale (the median
-     * object size, accel_eps_scale) plus the point's magnitude: the scene's
-     * diagonal would let one far object (a sky sphere of radius 1e6 around
-     * a room) lift every origin past the room's walls */
-    J.off = 1e-6;
-    J.scale = accel_eps_scale(a);
     atomic_init(&J.misses, 0);
     atomic_init(&J.unresolved, 0);
     atomic_init(&J.other, 0);
     atomic_init(&J.tri_ok, 0);
     atomic_init(&J.tri_fb, 0);
-    J.buf = calloc((size_t)threads, sizeof *J.buf);
-    J.hp = calloc((size_t)threads, sizeof *J.hp);
-    J.cell = calloc((size_t)threads, sizeof *J.cell);
-    J.tcell = calloc((size_t)threads, sizeof *J.tcell);
-    pt_status rc = PT_OK;
-    if (!J.buf || !J.hp || !J.cell || !J.tcell) rc = PT_ERR_NOMEM;
+    pt_status rc = job_open(&J, a, rtc_scene, nside, threads, (size_t)J.per_job * (size_t)k, 1);
     /* the far field's direct light: only for the final gather's points,
      * whose links are traced again for every view; the particles' links
      * are geometry and outlive a change of the lights (relighting) */
-    if (J.esky && J.first > 0 && sc->nlights > 0) {
-        J.lights = malloc((size_t)sc->nlights * sizeof *J.lights);
-        if (!J.lights) rc = PT_ERR_NOMEM;
-        for (int l = 0; J.lights && l < sc->nlights; l++) gi_light_pack(&sc->lights[l], &J.lights[l]);
-        J.nlights = J.lights ? sc->nlights : 0;
-    }
+    if (rc == PT_OK && J.esky && J.first > 0) rc = job_lights(&J, sc);
     J.exact = J.esky && J.first > 0 && !(J.far_bounce > 0.0f);
-    size_t rays = (size_t)J.per_job * (size_t)J.k;
-    size_t bytes = rays * sizeof(struct RTCRayHit);
-    for (int t = 0; rc == PT_OK && t < threads; t++) {
-        J.buf[t] = aligned_alloc(64, (bytes + 63) / 64 * 64);
-        J.hp[t] = malloc(rays * sizeof(vec3));
-        J.cell[t] = malloc(rays * sizeof(long));
-        J.tcell[t] = malloc(rays * sizeof(long));
-        if (!J.buf[t] || !J.hp[t] || !J.cell[t] || !J.tcell[t]) rc = PT_ERR_NOMEM;
-    }
     if (rc == PT_OK && n > 0 && !pool_run_counted(threads, (n - J.first + J.per_job - 1) / J.per_job, job, &J, cancel, prog))
         rc = PT_CANCELLED;
-    for (int t = 0; t < threads; t++) {
-        if (J.buf) free(J.buf[t]);
-        if (J.hp) free(J.hp[t]);
-        if (J.cell) free(J.cell[t]);
-        if (J.tcell) free(J.tcell[t]);
-    }
-    free(J.buf);
-    free(J.hp);
-    free(J.cell);
-    free(J.tcell);
-    free(J.order);
-    free(J.su0);
-    free(J.sv0);
-    free(J.lights);
-    accel_rtc_link_scene_free(lscene);
-    if (st) {
+    job_close(&J);
+    if (st && rc == PT_OK) {
         st->rays += (long)(n - J.first) * J.k;
         st->misses += atomic_load(&J.misses);
         st->unresolved += atomic_load(&J.unresolved);
@@ -605,4 +664,58 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
         st->tri_fallback += atomic_load(&J.tri_fb);
     }
     return rc;
+}
+
+/* ---- the gatherer: gi_links_build's exact gather at one point at a time */
+
+struct gi_gatherer {
+    link_job J;
+    float want; /* J.esky points here: hit_light takes it as the flag that light is wanted */
+};
+
+gi_gatherer *gi_gatherer_new(const accel *a, void *rtc_scene, int nside, uint64_t seed,
+                             const gi_sky *sky, const scene *sc, gi_pigment_fn pig)
+{
+    gi_gatherer *g = calloc(1, sizeof *g);
+    if (!g) return NULL;
+    link_job *J = &g->J;
+    *J = (link_job){.sky = sky, .esky = &g->want, .sc = sc, .pig = pig, .seed = seed, .exact = 1};
+    /* a buffer per thread, made by the thread on its first point */
+    if (job_open(J, a, rtc_scene, nside, GI_MAX_THREADS, 0, 0) != PT_OK || job_lights(J, sc) != PT_OK) {
+        gi_gatherer_free(g);
+        return NULL;
+    }
+    return g;
+}
+
+int gi_gatherer_point(gi_gatherer *g, int thread, vec3 p, vec3 n, uint64_t stream, float e[3], float *reach)
+{
+    const link_job *J = &g->J;
+    if ((unsigned)thread >= (unsigned)J->threads) return 0;
+    struct RTCRayHit *rh = J->buf[thread];
+    if (!rh) {
+        size_t bytes = (size_t)J->k * sizeof *rh;
+        rh = J->buf[thread] = aligned_alloc(64, (bytes + 63) / 64 * 64);
+        if (!rh) return 0;
+    }
+    source_rays(J, p, n, stream, rh);
+    trace_rays(J, rh, J->k);
+    float sky[3] = {0.0f, 0.0f, 0.0f};
+    emit_memo memo = {NULL, 0};
+    for (int j = 0; j < J->k; j++) {
+        if (ray_hit(&rh[j]))
+            hit_light(J, &rh[j], 1, 1, &memo, sky);
+        else
+            ray_sky(J, &rh[j], sky);
+    }
+    for (int c = 0; c < 3; c++) e[c] = sky[c] / (float)J->k;
+    if (reach) *reach = harmonic_reach(rh, J->k);
+    return 1;
+}
+
+void gi_gatherer_free(gi_gatherer *g)
+{
+    if (!g) return;
+    job_close(&g->J);
+    free(g);
 }

@@ -63,7 +63,28 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
                          const unsigned char *pin, int n, int first, int nside, uint64_t seed, const gi_lookup *grid,
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
                          gi_link_stats *st, volatile int *cancel, progress *prog,
-                         const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce);
+                         const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce,
+                         float *reach);
+
+/* reach (may be NULL; with first > 0): a float per point (i - first), the
+ * harmonic mean distance of its rays' hits (INFINITY when none hit), how
+ * far its gather may be reused (gi_particle_gather.c). */
+
+/* The gatherer: the final gather's exact form (no bounce after the hit,
+ * as gi_links_build's points with far_bounce 0) at one point at a time,
+ * for hits that arise while the image renders (antialiasing rays, a
+ * reflection of a seen surface) where no gathered point may answer. The
+ * same rays as gi_links_build's (nside^2 stratified cosine-weighted ones
+ * from random stream `stream` of seed); each that leaves the scene takes
+ * the sky, each that hits takes the emission and the direct light of sc's
+ * lights there (hit_light). e: E/pi at p about the unit normal n; reach
+ * (may be NULL): the rays' harmonic mean hit distance. thread: the
+ * caller's thread index, below GI_MAX_THREADS; 0: no answer. */
+typedef struct gi_gatherer gi_gatherer;
+gi_gatherer *gi_gatherer_new(const accel *a, void *rtc_scene, int nside, uint64_t seed,
+                             const gi_sky *sky, const scene *sc, gi_pigment_fn pig);
+int gi_gatherer_point(gi_gatherer *g, int thread, vec3 p, vec3 n, uint64_t stream, float e[3], float *reach);
+void gi_gatherer_free(gi_gatherer *g);
 
 /* Incoming links, a counting sort by target: the sources i < n in mask
  * (bit i of word i / 32; NULL: all) whose links[i * k + j] are >= 0, per

@@ -56,6 +56,11 @@ void gi_particle_settings_from_scene(gi_particle_settings *s, const scene *sc)
      * (docs/gi.md) */
     s->view_gather_stride = r->error_bound > 0.0 && r->error_bound < 0.1 ? 1 : 2;
     s->view_gather_filter = 1.0;
+    /* what POV-Ray's cache reuses where the antialiasing and secondary
+     * rays hit (gi_particle_gather.c, gi_particle_reuse) */
+    s->reuse_error = r->error_bound > 0.0 ? r->error_bound : 1.8;
+    s->reuse_min = r->minimum_reuse;
+    s->reuse_max = r->maximum_reuse;
     /* the area particles' own gathers then feed only further bounces and
      * the hits the final gather does not answer: a quarter of the rays,
      * a sixteenth without further bounces */
@@ -104,7 +109,7 @@ static void fill_stats(gi_particle *gp, gi_particle_stats *out)
 {
     update_bytes(gp);
     long look = 0, late = 0, none = 0, disc = 0, otf = 0, vis = gp->lists.vis_rays;
-    long lrp = 0, larea = 0, cells = 0, cclear = 0, clear = 0, kept = 0, gathered = 0;
+    long lrp = 0, larea = 0, cells = 0, cclear = 0, clear = 0, kept = 0, gathered = 0, here = 0;
     for (int t = 0; t < GI_MAX_THREADS; t++) {
         lrp += gp->tc[t].late_rp;
         larea += gp->tc[t].late_area;
@@ -113,6 +118,7 @@ static void fill_stats(gi_particle *gp, gi_particle_stats *out)
         clear += gp->tc[t].clear;
         kept += gp->tc[t].kept;
         gathered += gp->tc[t].gathered;
+        here += gp->tc[t].gathered_here;
         vis += gp->tc[t].vis_rays;
         otf += gp->tc[t].onthefly;
         look += gp->tc[t].lookups;
@@ -133,6 +139,7 @@ static void fill_stats(gi_particle *gp, gi_particle_stats *out)
     gp->st.lookups_clear = clear;
     gp->st.lookups_kept = kept;
     gp->st.lookups_gathered = gathered;
+    gp->st.lookups_gathered_here = here;
     if (out && out != &gp->st) *out = gp->st;
 }
 
@@ -220,7 +227,7 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
     if (st == PT_OK)
         st = gi_links_build(gp->a, gp->lscene, ps->p, pobj, pin, n, 0, gp->set.scatter_side, seed, grid, gp->tl,
                             3.0 * ps->spacing, gp->threads, links, keep, ls, gp->set.cancel, gp->set.progress, NULL,
-                            NULL, NULL, NULL, 0.0);
+                            NULL, NULL, NULL, 0.0, NULL);
     gi_lookup_free(grid);
     free(pobj);
     free(pin);
@@ -648,7 +655,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
             st = gi_links_build(a, gp->lscene, gp->ps.p, pobj, pin, n, 0, set->gather_side, set->seed ^ 0x6a7ULL, grid,
                                 gp->tl, 3.0 * spacing, gp->threads, gp->glink, NULL, &ls, set->cancel, set->progress,
                                 gp->sky, gp->esky, sc, set->pigment,
-                                set->bounces >= 1 ? set->brightness : 0.0);
+                                set->bounces >= 1 ? set->brightness : 0.0, NULL);
         S->t_gather_links = timer_now() - tg;
         S->c_gather_links = timer_cpu_now() - cg;
         gi_lookup_free(grid);

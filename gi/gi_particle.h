@@ -123,6 +123,13 @@ typedef struct {
                               find no matching one (default 2) */
     double view_gather_filter; /* the edge-aware filter's Gaussian sigma over the gathers, in
                                   pixels (0: the default, 1) */
+    double reuse_error;  /* > 0: with no bounce after the final gather's hits, a hit that is not a
+                            kept pixel takes a gathered point's value only where POV-Ray's
+                            irradiance cache would reuse it (its error_bound; gi_particle_gather.c),
+                            and gathers itself elsewhere. 0 (default): the nearest points answer */
+    double reuse_min, reuse_max; /* a point's reach (harmonic mean distance of its rays) is kept
+                            within these fractions of its distance from the camera (POV-Ray's
+                            minimum_reuse and maximum_reuse) */
     int keep_hits;       /* 1: the pre-pass keeps each traced pixel's first hit, and the radiance
                             particles it located there, for the render: gi_particle_primary_begin
                             and _hit as shade_settings.primary_begin and .primary give the render
@@ -191,6 +198,8 @@ typedef struct {
     long prepass_kept;      /* last prepare_view: pixels whose first hit was kept (keep_hits) */
     long lookups_kept;      /* hook lookups that took their cell from a kept hit (no locate) */
     long lookups_gathered;  /* lookups the final gather at the kept hits answered */
+    long lookups_gathered_here; /* of them, hits no gathered point could answer (antialiasing rays,
+                                   reflections) that gathered themselves (reuse_error) */
     size_t bytes_view;      /* keep_hits: the kept hits' records (not in bytes_total) */
     long skipped_objects;
     double flux_direct, flux_emitted, flux_scattered; /* sums over particles (grey) */

@@ -43,19 +43,21 @@
 /* The normal the gather at this kept hit uses: the smooth normal turned to
  * the side the camera sees (the hook's n has that side), unless it leans
  * away from the geometric normal of that side (then the geometric one). */
-static vec3 view_normal(const view_rec *r)
+static vec3 hit_normal(const accel_hit *h, int side)
 {
-    vec3 ng = r->side ? r->h.ng : v3_neg(r->h.ng);
+    vec3 ng = side ? h->ng : v3_neg(h->ng);
     double l = v3_len(ng);
     if (!(l > 0.0)) return ng;
     ng = v3_scale(ng, 1.0 / l);
-    vec3 ns = r->h.ns;
+    vec3 ns = h->ns;
     double ls = v3_len(ns);
     if (!(ls > 0.0) || !isfinite(ls)) return ng;
     ns = v3_scale(ns, 1.0 / ls);
     if (v3_dot(ns, ng) < 0.0) ns = v3_neg(ns);
     return v3_dot(ns, ng) > 0.5 ? ns : ng;
 }
+
+static vec3 view_normal(const view_rec *r) { return hit_normal(&r->h, r->side); }
 
 /* A kept hit that takes diffuse light from the hook. */
 static int gathers(const gi_particle *gp, const view_rec *r)
@@ -78,6 +80,8 @@ void gi_particle_view_gather_free(gi_particle *gp)
 {
     GROW_FREE_ALL(gp->vg_pt, gp->vg_ids, gp->vg_tab, gp->vg_link, gp->vg_esky, gp->vg_val, gp->vg_pix, gp->vg_pixval,
                   gp->vg_nrm);
+    gi_gatherer_free(gp->vg_gatherer);
+    gp->vg_gatherer = NULL;
     gp->vg_pt = NULL;
     gp->vg_tab = NULL;
     gp->vg_nrm = NULL;
@@ -195,6 +199,28 @@ static pt_status build_index(gi_particle *gp)
     return PT_OK;
 }
 
+/* Whether gather point pt may answer a hit at p with normal ng (length
+ * lg) that is not kept, by POV-Ray's test for reusing an irradiance cache
+ * record (radiosity.cpp, Ward's error measure): with a the scene's
+ * error_bound and R the point's reach, its distance d < a R and
+ * d / R + 2 sqrt(1 - n . n_pt) < a, and the point does not lie in front
+ * of p (the direction from it to p makes an angle of at most about 93
+ * degrees with the mean of the two normals; POV-Ray's in-front limit
+ * -0.05). A hit in a recess thus does not take the light of the rim
+ * above it, nor a hit beside a wall the light of a point farther out. */
+static int reusable(const gi_particle *gp, const vg_point *pt, vec3 p, vec3 ng, double lg)
+{
+    const double a = gp->set.reuse_error;
+    vec3 dv = v3_sub(p, pt->p);
+    double d = v3_len(dv), R = pt->reach;
+    if (!(d < a * R)) return 0;
+    double c = v3_dot(pt->n, ng) / lg;
+    if (!(d / R + 2.0 * sqrt(fmax(0.0, 1.0 - c)) < a)) return 0;
+    vec3 half = v3_add(pt->n, v3_scale(ng, 1.0 / lg));
+    double hl = v3_len(half);
+    return !(d > 0.0 && hl > 0.0) || v3_dot(dv, half) / (d * hl) > -0.05;
+}
+
 /* E/pi at a hit that is not kept, from the gather points around it on its
  * object and side that face its way: weights 1 - d/r. relaxed: any
  * object's points that face its way, within twice their radius (an
@@ -242,6 +268,7 @@ static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int
                 double d = v3_len(dv);
                 if (!(d < r) || (!relaxed && fabs(v3_dot(dv, pt->n)) > 0.25 * r)) continue;
                 if (v3_dot(pt->n, ng) < NORMAL_COS * lg) continue;
+                if (gp->vg_gatherer && !reusable(gp, pt, hit->p, ng, lg)) continue;
                 double w = 1.0 - d / r;
                 const float *v = &gp->vg_val[4 * (size_t)id];
                 for (int q = 0; q < 3; q++) s[q] += w * v[q];
@@ -332,6 +359,7 @@ static pt_status trace_points(gi_particle *gp, const void **pobj, const unsigned
     gi_dev_particle *cp = calloc((size_t)N, sizeof *cp);
     const void **cobj = calloc(2 * (size_t)N, sizeof *cobj);
     unsigned char *cpin = calloc(2 * (size_t)N, 1);
+    float *reach = NULL;
     pt_status st = PT_OK;
     if (!cp || !cobj || !cpin) {
         st = PT_ERR_NOMEM;
@@ -350,15 +378,32 @@ static pt_status trace_points(gi_particle *gp, const void **pobj, const unsigned
     }
     double spacing = gp->ps.spacing > 0.0 ? gp->ps.spacing : 1.0;
     gi_link_stats ls = {0};
+    reach = malloc((size_t)(k1 - k0) * sizeof *reach);
+    if (!reach) {
+        st = PT_ERR_NOMEM;
+        goto done;
+    }
     st = gi_links_build(gp->a, gp->lscene, cp, cobj, cpin, (int)N, n, side, seed, grid, NULL, 3.0 * spacing, gp->threads,
                         gp->vg_link + (size_t)k0 * side * side, NULL, &ls, gp->set.cancel, NULL, gp->sky,
                         gp->vg_esky + 4 * (size_t)k0, gp->sc, gp->set.pigment,
-                        gp->set.bounces >= 1 ? gp->set.brightness : 0.0);
+                        gp->set.bounces >= 1 ? gp->set.brightness : 0.0, reach);
     *rays += ls.rays;
+    /* each point's reach within POV-Ray's minimum_reuse and maximum_reuse
+     * of its distance from the camera (radiosity.cpp clamps its records'
+     * harmonic mean distance so) */
+    for (size_t i = 0; st == PT_OK && i < npix; i++) {
+        int k = gp->vg_pix[i];
+        if (k < k0 || k >= k1) continue;
+        double t = gp->vrec[i].h.t, R = reach[k - k0];
+        if (gp->set.reuse_min > 0.0 && R < gp->set.reuse_min * t) R = gp->set.reuse_min * t;
+        if (gp->set.reuse_max > 0.0 && R > gp->set.reuse_max * t) R = gp->set.reuse_max * t;
+        gp->vg_pt[k].reach = (float)R;
+    }
 done:
     free(cp);
     free(cobj);
     free(cpin);
+    free(reach);
     return st;
 }
 
@@ -462,6 +507,18 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
         for (size_t i = 0; i < npix; i++)
             if (gp->vg_pix[i] < 0 && gathers(gp, &gp->vrec[i]) && needs_own(gp, i)) gp->vg_pix[i] = m++;
         if (m > m1) st = trace_points(gp, pobj, pin, grid, m1, m, side, s, gp->set.seed ^ 0x3c5b1ULL, &rays);
+    }
+    /* with no bounce after the gather's hits (the exact gather, gi_links.h)
+     * a hit no point may answer gathers itself, as POV-Ray's cache adds a
+     * record where none can be reused */
+    if (st == PT_OK && gp->set.reuse_error > 0.0 && !(gp->set.bounces >= 1 && gp->set.brightness > 0.0)) {
+        /* a third of the side: such hits are mostly antialiasing rays,
+         * each one of the (depth^2 + 1) samples a pixel averages, so a
+         * pixel's 9 subsamples together still take about a gather's rays */
+        int hs = (side + 2) / 3 < 4 ? 4 : (side + 2) / 3;
+        gp->vg_gatherer = gi_gatherer_new(gp->a, gp->lscene, hs, gp->set.seed ^ 0x51d3ULL, gp->sky, gp->sc,
+                                          gp->set.pigment);
+        if (!gp->vg_gatherer) st = PT_ERR_NOMEM;
     }
     if (st == PT_OK) {
         gp->vg_n = m;
@@ -593,12 +650,36 @@ void gi_particle_view_regather(gi_particle *gp)
 int gi_particle_view_value(const gi_particle *gp, const accel_hit *hit, const view_rec *r, vec3 n, rgb *out)
 {
     if (gp->vg_n <= 0 || gp->vg_w != gp->vw || gp->vg_h != gp->vh) return 0;
-    if (!r) return nearby_value(gp, hit, n, 0, out) || nearby_value(gp, hit, n, 1, out);
+    /* with a gatherer, a hit no point may answer gathers itself
+     * (gi_particle_gather_here) instead of taking a looser neighbour */
+    const int relax = !gp->vg_gatherer;
+    if (!r) return nearby_value(gp, hit, n, 0, out) || (relax && nearby_value(gp, hit, n, 1, out));
     if ((v3_dot(n, r->h.ng) >= 0.0) != r->side) return 0; /* the other side (diffuse_back) */
     const float *v = &gp->vg_pixval[4 * (size_t)(r - gp->vrec)];
-    if (!(v[3] > 0.0f)) return nearby_value(gp, hit, n, 0, out) || nearby_value(gp, hit, n, 1, out);
+    if (!(v[3] > 0.0f)) return nearby_value(gp, hit, n, 0, out) || (relax && nearby_value(gp, hit, n, 1, out));
     out->r = v[0];
     out->g = v[1];
     out->b = v[2];
+    return 1;
+}
+
+int gi_particle_gather_here(gi_particle *gp, const accel_hit *hit, vec3 n, int thread, rgb *out)
+{
+    if (!gp->vg_gatherer || !hit->obj) return 0;
+    int side = v3_dot(n, hit->ng) >= 0.0;
+    vec3 nv = hit_normal(hit, side);
+    if (!(v3_len(nv) > 0.0)) return 0;
+    /* its rays' random stream from where it lies, so that a render gives
+     * the same image on any number of threads */
+    uint64_t bits[3];
+    memcpy(&bits[0], &hit->p.x, 8);
+    memcpy(&bits[1], &hit->p.y, 8);
+    memcpy(&bits[2], &hit->p.z, 8);
+    uint64_t stream = pt_mix64(pt_mix64(pt_mix64(bits[0]) ^ bits[1]) ^ bits[2]);
+    float e[3];
+    if (!gi_gatherer_point(gp->vg_gatherer, thread, hit->p, nv, stream, e, NULL)) return 0;
+    out->r = e[0];
+    out->g = e[1];
+    out->b = e[2];
     return 1;
 }

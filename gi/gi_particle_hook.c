@@ -242,6 +242,9 @@ rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
     int far = !gi_sky_black(gp->sky) && !gi_surface_in_clip(gp->surf, hit->p);
     if (gi_particle_view_value(gp, hit, kept_rec(gp, hit), n, &out)) {
         tc->gathered++;
+    } else if (gi_particle_gather_here(gp, hit, n, thread, &out)) {
+        tc->gathered++;
+        tc->gathered_here++;
     } else if (far || !side_value(gp, hit, n, tc, &out)) {
         /* No particle answers here: a surface the geometry stage left out
          * (beyond the clip box, an object far from what the camera sees, a

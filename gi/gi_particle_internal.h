@@ -23,6 +23,7 @@ typedef struct {
     long cells, cells_clear, clear; /* cells tested, of them clear; lookups in clear cells */
     long kept;                      /* lookups whose cell came from a kept hit (view_rec) */
     long gathered;                  /* lookups the final gather answered */
+    long gathered_here;             /* of them, hits that gathered themselves (gi_gatherer) */
     int *buf; /* on-the-fly estimation list */
     long len, cap;
     struct cell_batch *cb; /* the pre-pass's cell tests waiting for the row's end (cell_batch) */
@@ -95,6 +96,8 @@ struct gi_particle {
     double vg_c0;     /* level 0's cell size */
     unsigned vg_levels; /* bit L: level L has points */
     vec3 vg_lvl_box[2 * GI_VG_LEVELS]; /* per level, the box (lo, hi) of its points */
+    struct gi_gatherer *vg_gatherer; /* gathers where no point may answer (reuse_error > 0, no bounce
+                                        after the gather's hits); NULL: none */
     thread_count tc[GI_MAX_THREADS];
     gi_particle_stats st;
 };
@@ -189,6 +192,8 @@ typedef struct vg_point {
     vec3 p, n;                /* the hit and the normal gathered about */
     const scene_object *obj;
     float r;                  /* it answers hits within r on its object and side */
+    float reach;              /* its rays' harmonic mean hit distance, within the reuse bounds
+                                 (gi_particle_settings reuse_min/max); INFINITY: unknown */
     int side;
 } vg_point;
 pt_status gi_particle_view_gather(gi_particle *gp, diag *d);
@@ -198,4 +203,7 @@ void gi_particle_view_gather_free(gi_particle *gp);
  * of its block's corners that match it; elsewhere (r NULL) the gather
  * points around it (gi_particle_gather.c); 0 when none answers. */
 int gi_particle_view_value(const gi_particle *gp, const accel_hit *hit, const view_rec *r, vec3 n, rgb *out);
+/* E/pi gathered at a hit no point may answer (the gatherer's exact
+ * gather, gi_links.h); 0: no gatherer (or no memory). */
+int gi_particle_gather_here(gi_particle *gp, const accel_hit *hit, vec3 n, int thread, rgb *out);
 #endif
