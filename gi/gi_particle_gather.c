@@ -199,6 +199,14 @@ static pt_status build_index(gi_particle *gp)
     return PT_OK;
 }
 
+/* Whether the final gather takes POV-Ray's reuse test (reusable): with a
+ * scene's error_bound and no bounce after the gather's hits, where a hit
+ * that no point may answer can gather itself (the gatherer). */
+static int reuse_test(const gi_particle *gp)
+{
+    return gp->set.reuse_error > 0.0 && !(gp->set.bounces >= 1 && gp->set.brightness > 0.0);
+}
+
 /* Whether gather point pt may answer a hit at p with normal ng (length
  * lg) that is not kept, by POV-Ray's test for reusing an irradiance cache
  * record (radiosity.cpp, Ward's error measure): with a the scene's
@@ -422,6 +430,8 @@ static int needs_own(const gi_particle *gp, size_t i)
         size_t j = (size_t)cy[c] * gp->vw + cx[c];
         int kc = gp->vg_pix[j];
         if (kc < 0 || !compatible(gp, j, i)) continue;
+        /* a corner whose record POV-Ray's cache would not reuse here */
+        if (reuse_test(gp) && !reusable(gp, &gp->vg_pt[kc], gp->vrec[i].h.p, gp->vg_nrm[i], 1.0)) return 1;
         const float *v = &gp->vg_val[4 * (size_t)kc];
         double l = 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
         lo = fmin(lo, l);
@@ -511,7 +521,7 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
     /* with no bounce after the gather's hits (the exact gather, gi_links.h)
      * a hit no point may answer gathers itself, as POV-Ray's cache adds a
      * record where none can be reused */
-    if (st == PT_OK && gp->set.reuse_error > 0.0 && !(gp->set.bounces >= 1 && gp->set.brightness > 0.0)) {
+    if (st == PT_OK && reuse_test(gp)) {
         /* a third of the side: such hits are mostly antialiasing rays,
          * each one of the (depth^2 + 1) samples a pixel averages, so a
          * pixel's 9 subsamples together still take about a gather's rays */
