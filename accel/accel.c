@@ -360,6 +360,7 @@ static int set_ginfo(accel *a, unsigned id, int kind, unsigned idx)
     }
     a->ginfo[id].kind = kind;
     a->ginfo[id].idx = idx;
+    if (kind == GEOM_TRI || kind == GEOM_INSTANCE) a->has_tri_geoms = 1;
     return 1;
 }
 
@@ -1034,8 +1035,7 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
 static int crossings_collected(const accel *a, vec3 org, vec3 dir, double t0, double tmax, double step,
                                accel_crossing *cr)
 {
-    for (unsigned g = 0; g < a->nginfo; g++)
-        if (a->ginfo[g].kind == GEOM_TRI || a->ginfo[g].kind == GEOM_INSTANCE) return -1;
+    if (a->has_tri_geoms) return -1;
     accel_query q;
     query_init(&q, org, dir, t0);
     q.cross = cr;

@@ -78,6 +78,7 @@ struct accel {
     float *ubox;                  /* 6 floats per user primitive: its box as accel_user_bounds gives it */
     geom_info *ginfo;
     unsigned nginfo;
+    int has_tri_geoms; /* a geometry of triangles or instances: accel_crossings walks crossing by crossing */
     vec3 lo, hi;
     double scale;
     double eps_scale;  /* working scale of the epsilon rule (see the top) */

@@ -312,6 +312,41 @@ static inline void user_ray(const accel_query *q, const void *ray, unsigned N, u
     }
 }
 
+/* A crossing query (accel_crossings) on a leaf whose crossings are the
+ * closed-form roots of its surface filtered by the interval (sphere, box,
+ * cylinder, cone, disc, plane, triangle; no bounded_by, whose test takes
+ * the interval's start): all of them from one solve, stepped over by the
+ * rule of the loop in accel_user_intersect, which asks the shape again from
+ * just past each crossing and so gets the same roots. 0 when the loop must
+ * do it (other shapes, CSG, more crossings than the buffer holds). */
+static int cross_leaf_once(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, accel_query *q)
+{
+    if (prim >= (unsigned)a->nshapes || a->leaves[a->shape_leaf[prim]].bn) return 0;
+    const geom_shape *sh = &a->shapes[prim];
+    switch (sh->kind) {
+    case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC: case SHAPE_PLANE:
+    case SHAPE_TRIANGLE: case SHAPE_SMOOTH_TRIANGLE:
+        break;
+    default:
+        return 0;
+    }
+    enum { MAX_LEAF_CROSSINGS = 8 };
+    geom_shape_hit hs[MAX_LEAF_CROSSINGS];
+    int k = geom_shape_ray_hits(sh, o, d, tmin, q->ctmax, hs, MAX_LEAF_CROSSINGS);
+    if (k == MAX_LEAF_CROSSINGS) return 0;
+    double from = tmin;
+    for (int j = 0; j < k; j++) {
+        if (!(hs[j].t > from)) continue;
+        if (q->ncross == q->maxcross) {
+            q->overflow = 1;
+            break;
+        }
+        q->cross[q->ncross++] = (accel_crossing){hs[j].t, prim, hs[j].part, 0, 0};
+        from = hs[j].t + fmax(q->cstep, hs[j].t * 1e-7);
+    }
+    return 1;
+}
+
 void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
 {
     const accel *a = args->geometryUserPtr;
@@ -328,6 +363,7 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
         double tmin;
         user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
         if (exact && q->cross) {
+            if (cross_leaf_once(a, args->primID, o, d, tmin, q)) continue;
             for (double from = tmin; from < q->ctmax;) {
                 geom_csg_hit h;
                 if (!accel_prim_hit(a, args->primID, o, d, from, q->ctmax, &h)) break;
