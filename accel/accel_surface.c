@@ -522,6 +522,8 @@ typedef struct {
     const int *piece; /* the pieces sampled by lines */
     double *area;     /* their estimates */
     int lines;
+    int inner;        /* threads each estimate counts its lines on: the
+                         render's threads when there are fewer shapes */
 } crofton_job;
 
 static void crofton_one(void *ctx, int k, int thread)
@@ -529,7 +531,7 @@ static void crofton_one(void *ctx, int k, int thread)
     (void)thread;
     crofton_job *J = ctx;
     shape_geo *g = &J->as->shapes[J->as->pieces[J->piece[k]].idx];
-    J->area[k] = geom_tess_sampler_init(&g->cro, &g->sh, NULL, NULL, CROFTON_REL_ERR, J->lines);
+    J->area[k] = geom_tess_sampler_init(&g->cro, &g->sh, NULL, NULL, CROFTON_REL_ERR, J->lines, J->inner);
 }
 
 static int finish_crofton(accel_surf *as, int threads)
@@ -550,8 +552,9 @@ static int finish_crofton(accel_surf *as, int threads)
     int m = 0;
     for (int i = 0; i < as->npieces; i++)
         if (as->pieces[i].is_shape && as->shapes[as->pieces[i].idx].crofton) piece[m++] = i;
-    crofton_job J = {as, piece, area, lines};
-    pool_run(threads > 0 ? threads : 1, m, crofton_one, &J);
+    if (threads <= 0) threads = 1;
+    crofton_job J = {as, piece, area, lines, m > 0 && m < threads ? threads / m : 1};
+    pool_run(threads, m, crofton_one, &J);
     for (int k = 0; k < m; k++) {
         piece_rec *p = &as->pieces[piece[k]];
         shape_geo *g = &as->shapes[p->idx];

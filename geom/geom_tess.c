@@ -22,6 +22,7 @@
  * a point whose density is uniform by area. */
 #include "geom_tess.h"
 #include "hash.h"
+#include "pool.h"
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -309,8 +310,46 @@ static double radical_inverse(uint64_t i, unsigned b)
     return r;
 }
 
+/* Crofton lines are cast in batches of TESS_BATCH; a batch's crossings
+ * are counted in integers, so its mean (the count over a power of two) is
+ * exact whichever thread counted it. */
+enum { TESS_BATCH = 1024 };
+
+enum { TESS_SLOTS = 64 }; /* batches counted at once, at most */
+
+typedef struct {
+    const geom_tess_sampler *cs;
+    int first;                 /* the first batch of this round */
+    long count[TESS_SLOTS];    /* batch b's crossings in slot b % TESS_SLOTS */
+    int kmax[TESS_SLOTS];      /* and the most on one of its lines */
+} batch_job;
+
+/* Batch first + j: lines TESS_BATCH b + 1 .. TESS_BATCH (b + 1) of the
+ * Halton sequence (bases 2, 3, 5, 7). */
+static void batch_run(void *ctx, int j, int thread)
+{
+    (void)thread;
+    batch_job *J = ctx;
+    const geom_tess_sampler *cs = J->cs;
+    int b = J->first + j;
+    geom_shape_hit h[TESS_MAX_HITS];
+    uint64_t idx = 1 + (uint64_t)b * TESS_BATCH;
+    long sum = 0;
+    int kmax = 0;
+    for (int i = 0; i < TESS_BATCH; i++, idx++) {
+        vec3 org, dir;
+        random_line(cs->c, cs->R, radical_inverse(idx, 2), radical_inverse(idx, 3), radical_inverse(idx, 5),
+                    radical_inverse(idx, 7), &org, &dir);
+        int k = line_hits(cs, org, dir, h);
+        if (k > kmax) kmax = k;
+        sum += k;
+    }
+    J->count[b % TESS_SLOTS] = sum;
+    J->kmax[b % TESS_SLOTS] = kmax;
+}
+
 double geom_tess_sampler_init(geom_tess_sampler *cs, const geom_shape *sh, geom_tess_keep_fn keep,
-                               void *keep_ctx, double rel_err, int max_lines)
+                               void *keep_ctx, double rel_err, int max_lines, int threads)
 {
     memset(cs, 0, sizeof *cs);
     cs->sh = sh;
@@ -338,25 +377,33 @@ double geom_tess_sampler_init(geom_tess_sampler *cs, const geom_shape *sh, geom_
     if (!(R > 0.0) || !isfinite(R) || !v3_finite(c)) return 0.0;
     cs->c = c;
     cs->R = R;
-    /* E[k] by quasi-Monte Carlo lines (Halton bases 2, 3, 5, 7), in batches
-     * until the standard error of the batch means is below rel_err */
+    /* E[k] by quasi-Monte Carlo lines, in batches until the standard error
+     * of the batch means is below rel_err. The stopping rule reads the
+     * batches in order from the 8th on; with threads, the first 8 are
+     * counted together and then `threads` at a time (a batch counted past
+     * the stop is not read), so the estimate is the same for any count. */
     if (max_lines < 1024) max_lines = 1024;
-    enum { BATCH = 1024 };
+    enum { FIRST = 8 };
+    if (threads < 1) threads = 1;
+    if (threads > TESS_SLOTS) threads = TESS_SLOTS;
+    int total = (max_lines + TESS_BATCH - 1) / TESS_BATCH;
+    batch_job *J = malloc(sizeof *J);
+    if (!J) return 0.0;
+    J->cs = cs;
     double sum = 0.0, sum2 = 0.0;
-    int nb = 0, kmax = 0;
-    uint64_t idx = 1;
-    geom_shape_hit h[TESS_MAX_HITS];
-    for (int lines = 0; lines < max_lines; lines += BATCH) {
-        double bs = 0.0;
-        for (int i = 0; i < BATCH; i++, idx++) {
-            vec3 org, dir;
-            random_line(c, R, radical_inverse(idx, 2), radical_inverse(idx, 3), radical_inverse(idx, 5),
-                        radical_inverse(idx, 7), &org, &dir);
-            int k = line_hits(cs, org, dir, h);
-            if (k > kmax) kmax = k;
-            bs += k;
+    int nb = 0, kmax = 0, done = 0;
+    while (nb < total) {
+        if (nb == done) {
+            int n = nb < FIRST ? FIRST - nb : threads;
+            if (n > total - done) n = total - done;
+            J->first = done;
+            if (threads > 1 && n > 1) pool_run(threads, n, batch_run, J);
+            else
+                for (int j = 0; j < n; j++) batch_run(J, j, 0);
+            done += n;
         }
-        bs /= BATCH;
+        double bs = (double)J->count[nb % TESS_SLOTS] / TESS_BATCH;
+        if (J->kmax[nb % TESS_SLOTS] > kmax) kmax = J->kmax[nb % TESS_SLOTS];
         sum += bs;
         sum2 += bs * bs;
         nb++;
@@ -366,6 +413,7 @@ double geom_tess_sampler_init(geom_tess_sampler *cs, const geom_shape *sh, geom_
             if (mean == 0.0 && nb >= 16) break;
         }
     }
+    free(J);
     double mean = sum / nb;
     cs->kmax = kmax;
     cs->area = 2.0 * M_PI * R * R * mean;

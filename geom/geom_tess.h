@@ -38,9 +38,11 @@ typedef struct {
 
 /* Estimate the area with quasi-random lines, in batches of 1024 until the
  * standard error of the batch means is below rel_err (relative) or
- * max_lines were cast. Returns the area (0: no surface found). */
+ * max_lines were cast. Returns the area (0: no surface found). With
+ * threads > 1 the batches are counted on that many threads (keep must then
+ * be safe to call from several); the estimate is the same for any count. */
 double geom_tess_sampler_init(geom_tess_sampler *cs, const geom_shape *sh, geom_tess_keep_fn keep,
-                               void *keep_ctx, double rel_err, int max_lines);
+                               void *keep_ctx, double rel_err, int max_lines, int threads);
 /* A world point uniform by area with its unit outward world normal and the
  * part (as geom_shape_hit.part). (u1, u2) choose the first line's direction;
  * r supplies the rest (NULL: a generator seeded from u1, u2). 0 on failure. */

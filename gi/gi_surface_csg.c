@@ -89,6 +89,7 @@ pt_status gi_surface_csg_add_piece(gi_surface *g, const scene_object *o, const s
 typedef struct {
     gi_surface *g;
     const int *patch; /* the pending patches */
+    int inner;        /* threads each estimate counts its lines on (fewer patches than threads) */
 } piece_job;
 
 static void piece_area(void *ctx, int k, int thread)
@@ -103,7 +104,7 @@ static void piece_area(void *ctx, int k, int thread)
      * here. The estimate depends on the member alone (a fixed
      * quasi-random set of lines), so the members are estimated in
      * parallel, the same for any thread count. */
-    p->area = geom_tess_sampler_init(&p->ks->cs, p->sh, keep_fn, p->ks, 1e-2, 8192);
+    p->area = geom_tess_sampler_init(&p->ks->cs, p->sh, keep_fn, p->ks, 1e-2, 8192, J->inner);
 }
 
 pt_status gi_surface_csg_finish(gi_surface *g, int threads)
@@ -118,8 +119,9 @@ pt_status gi_surface_csg_finish(gi_surface *g, int threads)
     int m = 0;
     for (int i = 0; i < g->np; i++)
         if (g->p[i].kind == PATCH_PIECE && g->p[i].cnode >= 0 && g->p[i].area == PENDING) pend[m++] = i;
-    piece_job J = {g, pend};
-    pool_run(threads > 0 ? threads : 1, m, piece_area, &J);
+    if (threads <= 0) threads = 1;
+    piece_job J = {g, pend, m > 0 && m < threads ? threads / m : 1};
+    pool_run(threads, m, piece_area, &J);
     /* a member with nothing of it on the result's surface has no patch and
      * no object record (each member's record is its own, of one patch):
      * both go, and the records after them move up */
