@@ -349,6 +349,51 @@ fail:
     c->nunbounded = 0;
 }
 
+/* c->keep_lo/hi and the holes (geom_csg.h), from the keep boxes. */
+static void find_holes(geom_csg *c)
+{
+    c->nholes = 0;
+    bbox u = bb_empty();
+    for (int sh = 0; sh < c->nshapes; sh++) {
+        vec3 lo = c->keep_box[2 * sh], hi = c->keep_box[2 * sh + 1];
+        if (!(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z)) continue; /* never searched */
+        /* an unbounded keep box, or a member searched from the ray's start
+         * (try_member: isosurfaces), leaves no stretch to test */
+        if (!v3_finite(lo) || !v3_finite(hi) || c->shapes[sh].kind == SHAPE_ISOSURFACE) return;
+        u = bb_union(u, (bbox){lo, hi});
+    }
+    if (bb_empty_p(u)) return;
+    c->keep_lo = u.lo;
+    c->keep_hi = u.hi;
+    const geom_csg_node *root = &c->nodes[0];
+    if (root->op != GEOM_CSG_DIFFERENCE || root->inverse) return;
+    const int *k = c->kids + root->first;
+    for (int j = 1; j < root->nkids && c->nholes < GEOM_CSG_MAX_HOLES; j++) {
+        const geom_csg_node *nd = &c->nodes[k[j]];
+        if (nd->op != GEOM_CSG_LEAF || nd->inverse) continue;
+        const geom_shape *sh = &c->shapes[nd->shape];
+        if (sh->kind != SHAPE_BOX || !sh->identity) continue;
+        /* geom_shape_inside's box is open: a point is inside it when
+         * strictly within its faces; the margin (1e-9 of its size, 1e-12
+         * of the coordinates) keeps the points tested, and the crossings
+         * computed between them on the same line, strictly within */
+        vec3 lo = sh->g.box.lo, hi = sh->g.box.hi, m;
+        for (int a = 0; a < 3; a++) {
+            double l = v3_idx(lo, a), h = v3_idx(hi, a);
+            double mm = 1e-9 * (h - l) + 1e-12 * fmax(fabs(l), fabs(h)) + 1e-300;
+            if (a == 0) m.x = mm;
+            else if (a == 1) m.y = mm;
+            else m.z = mm;
+        }
+        lo = v3_add(lo, m);
+        hi = v3_sub(hi, m);
+        if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z) || !v3_finite(lo) || !v3_finite(hi)) continue;
+        c->hole_lo[c->nholes] = lo;
+        c->hole_hi[c->nholes] = hi;
+        c->nholes++;
+    }
+}
+
 int geom_csg_finish(geom_csg *c)
 {
     if (c->nnodes == 0) return 0;
@@ -490,10 +535,12 @@ int geom_csg_finish(geom_csg *c)
             c->keep_box[2 * sh + 1] = kb.hi;
         }
         if (c->nshapes > GEOM_CSG_BVH_MIN) build_bvh(c);
+        find_holes(c);
     } else {
         free(c->keep_box);
         free(c->inside_box);
         c->keep_box = c->inside_box = NULL;
+        c->nholes = 0;
     }
     free(count);
     free(S);
@@ -650,11 +697,34 @@ static int try_member(const geom_csg *c, int s, const csg_ray *R, double *bestp,
     return found;
 }
 
+/* Whether the ray's stretch in (tmin, tmax) through the keep boxes' box
+ * lies strictly inside one hole (geom_csg.h): then no crossing is kept.
+ * A member is searched only on its keep box's stretch padded by 1e-9 of
+ * its distances (try_member); the stretch tested here is padded by 4e-9 of
+ * the wider box's, which covers it. */
+static int in_hole(const geom_csg *c, const csg_ray *R, double tmax)
+{
+    double t0, t1;
+    if (!v3_slab_inv(R->org, R->dir, R->inv, c->keep_lo, c->keep_hi, &t0, &t1)) return 0;
+    double pad = 4e-9 * (fabs(t0) + fabs(t1)) + 1e-300;
+    double a = fmax(t0 - pad, R->tmin), b = fmin(t1 + pad, tmax);
+    if (!(a <= b)) return 0;
+    vec3 pa = v3_madd(R->org, R->dir, a), pb = v3_madd(R->org, R->dir, b);
+    for (int i = 0; i < c->nholes; i++) {
+        vec3 lo = c->hole_lo[i], hi = c->hole_hi[i];
+        if (pa.x > lo.x && pa.x < hi.x && pa.y > lo.y && pa.y < hi.y && pa.z > lo.z && pa.z < hi.z && pb.x > lo.x &&
+            pb.x < hi.x && pb.y > lo.y && pb.y < hi.y && pb.z > lo.z && pb.z < hi.z)
+            return 1;
+    }
+    return 0;
+}
+
 /* The nearest kept crossing in (tmin, tmax), or with R->any the first one
  * met in the members' order: both find one exactly when one exists, since
  * before a member answers every search runs to tmax. */
 static int csg_search(const geom_csg *c, const csg_ray *R, double tmax, geom_csg_hit *h)
 {
+    if (c->nholes > 0 && in_hole(c, R, tmax)) return 0;
     int found = 0;
     double best = tmax;
     if (!c->bvh) {

@@ -36,6 +36,8 @@
 #define GEOM_CSG_MAX_MERGE 4096
 /* Members beyond which geom_csg_finish builds the keep boxes' hierarchy. */
 #define GEOM_CSG_BVH_MIN 32
+/* Subtracted boxes a ray is tested against before the members (geom_csg.nholes). */
+#define GEOM_CSG_MAX_HOLES 4
 
 /* o, or a member of it at any level, is a mesh (depth: o's nesting level;
  * nothing deeper than GEOM_CSG_MAX_DEPTH counts). */
@@ -89,6 +91,16 @@ typedef struct {
     geom_csg_bvh *bvh;
     int *bvh_items, *unbounded;
     int nunbounded;
+    /* From geom_csg_finish: the box holding every member's keep box
+     * (keep_lo, keep_hi) and, where the root is a difference, the boxes of
+     * its subtracted members that are untransformed boxes, shrunk by a
+     * margin (nholes of them, 0 when a keep box is unbounded or a member is
+     * searched from the ray's start): a ray whose whole stretch through
+     * keep_lo..keep_hi lies inside one has no crossing, as every crossing
+     * but the hole's own is kept only outside it. */
+    vec3 keep_lo, keep_hi;
+    vec3 hole_lo[GEOM_CSG_MAX_HOLES], hole_hi[GEOM_CSG_MAX_HOLES];
+    int nholes;
     unsigned flags;        /* caller's tag (accel.c: effective object flags of the root) */
 } geom_csg;
 
