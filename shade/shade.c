@@ -157,8 +157,11 @@ static int media_shadows(const render_ctx *c, const scene_light *l)
 
 /* Light reaching p along a shadow ray: 0 or 1 in scenes without transparent
  * surfaces or media, else filtered by the surfaces crossed
- * (shade_texture.c) and attenuated by the media on the way. */
-static rgb shadow_rgb(render_ctx *c, int thread, vec3 p, vec3 dir, double depth, const scene_light *l, const shade_media_inside *in)
+ * (shade_texture.c) and attenuated by the media on the way. rest non-NULL
+ * (an area light's sample): the atmosphere after the last surface crossed
+ * is left to the caller, *rest its length (shade_media_shadow_ray). */
+static rgb shadow_rgb(render_ctx *c, int thread, vec3 p, vec3 dir, double depth, const scene_light *l, const shade_media_inside *in,
+                      double *rest)
 {
     int media = media_shadows(c, l);
     if (!media && !c->transparent)
@@ -168,7 +171,7 @@ static rgb shadow_rgb(render_ctx *c, int thread, vec3 p, vec3 dir, double depth,
     if (tmax <= c->eps) return rgb_make(1, 1, 1);
     if (media) {
         shade_media_env me = {c->sc, c, thread, NULL, media_light, NULL};
-        return shade_media_shadow_ray(c->sc, c->a, &me, l, p, dir, c->eps, tmax, in ? in : &no_containers);
+        return shade_media_shadow_ray(c->sc, c->a, &me, l, p, dir, c->eps, tmax, in ? in : &no_containers, rest);
     }
     const scene_light *pl = c->s->photon_shadows ? l : NULL;
     const accel_hit *lit = c->frame[thread] ? c->frame[thread]->h : NULL;
@@ -185,6 +188,8 @@ typedef struct {
     rng *r;
     int thread;
     const shade_media_inside *in;
+    double depth; /* to the light's centre */
+    double rest;  /* the atmosphere's part of the way (POV-Ray's lightsourcedepth, area_visibility) */
 } area_job;
 
 static rgb area_sample(area_job *j, int u, int v)
@@ -195,7 +200,7 @@ static rgb area_sample(area_job *j, int u, int v)
     vec3 dir;
     double depth;
     shade_light_ray(j->l, centre, j->p, &dir, &depth);
-    *g = shadow_rgb(j->c, j->thread, j->p, dir, depth, j->l, j->in);
+    *g = shadow_rgb(j->c, j->thread, j->p, dir, depth, j->l, j->in, &j->rest);
     return *g;
 }
 
@@ -209,9 +214,14 @@ static rgb area_subset(area_job *j, int u1, int v1, int u2, int v2, int level)
         if (level < j->l->adaptive || differ) {
             int um0 = (int)floor((u1 + u2) / 2.0), um1 = (int)ceil((u1 + u2) / 2.0);
             int vm0 = (int)floor((v1 + v2) / 2.0), vm1 = (int)ceil((v1 + v2) / 2.0);
+            /* POV-Ray re-aims at the centre (its whole depth) before each part */
+            j->rest = j->depth;
             s[0] = area_subset(j, u1, v1, um0, vm0, level + 1);
+            j->rest = j->depth;
             s[1] = area_subset(j, um1, v1, u2, vm0, level + 1);
+            j->rest = j->depth;
             s[2] = area_subset(j, u1, vm1, um0, v2, level + 1);
+            j->rest = j->depth;
             s[3] = area_subset(j, um1, vm1, u2, v2, level + 1);
         }
     }
@@ -225,10 +235,19 @@ static rgb area_visibility(render_ctx *c, int thread, const scene_light *l, vec3
     rgb *grid = n <= 256 ? stack_grid : malloc(sizeof(rgb) * (size_t)n);
     if (!grid) return rgb_make(1, 1, 1);
     for (int i = 0; i < n; i++) grid[i].r = -1.0;
-    area_job j = {c, l, p, l->axis1, l->axis2, grid, r, thread, in};
+    vec3 dir;
+    double depth;
+    shade_light_ray(l, l->position, p, &dir, &depth);
+    area_job j = {c, l, p, l->axis1, l->axis2, grid, r, thread, in, depth, depth};
     shade_light_area_axes(l, p, &j.ax1, &j.ax2);
     rgb vis = area_subset(&j, 0, 0, l->size1 - 1, l->size2 - 1, 0);
     if (grid != stack_grid) free(grid);
+    /* the atmosphere once, from p over what the last sample traced left of
+     * its way (POV-Ray 3.7's TraceShadowRay; shade_media_shadow_rest) */
+    if (media_shadows(c, l) && !rgb_near_zero(vis)) {
+        shade_media_env me = {c->sc, c, thread, NULL, media_light, NULL};
+        vis = shade_media_shadow_rest(c->sc, &me, l, in ? in : &no_containers, p, dir, fmin(j.rest, shadow_tmax(c, depth)), vis);
+    }
     return vis;
 }
 
@@ -259,7 +278,7 @@ static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, cons
         rng_seed(&r, k ^ (k2 * 0x9e3779b97f4a7c15ULL) ^ (k3 * 0xbf58476d1ce4e5b9ULL), (uint64_t)thread);
         vis = area_visibility(c, thread, l, p, &r, in);
     } else {
-        vis = shadow_rgb(c, thread, p, dir, sdepth, l, in);
+        vis = shadow_rgb(c, thread, p, dir, sdepth, l, in, NULL);
     }
     return rgb_mul(lc, vis);
 }
@@ -313,7 +332,7 @@ static rgb direct_light(render_ctx *c, int thread, const shade_light_surface *s,
                         else continue;
                     }
                     if (!l->shadowless && shadows_on) {
-                        slc = rgb_mul(slc, shadow_rgb(c, thread, p, d2, dep2, l, in));
+                        slc = rgb_mul(slc, shadow_rgb(c, thread, p, d2, dep2, l, in, NULL));
                         if (rgb_near_zero(slc)) continue;
                     }
                     total = rgb_add(total, shade_light_terms(s, d2, slc, back2));
@@ -329,7 +348,7 @@ static rgb direct_light(render_ctx *c, int thread, const shade_light_surface *s,
                 if (area_on && l->area && l->size1 * l->size2 > 1)
                     vis = area_visibility(c, thread, l, p, r, in);
                 else
-                    vis = shadow_rgb(c, thread, p, dir, sdepth, l, in);
+                    vis = shadow_rgb(c, thread, p, dir, sdepth, l, in, NULL);
                 if (i < LIGHT_CACHE) {
                     ts->lc_vis[i] = vis;
                     ts->lc_valid |= 1u << i;

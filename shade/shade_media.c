@@ -731,14 +731,24 @@ rgb shade_media_segment(const shade_media_env *e, int which, const shade_media_i
 
 /* ------------------------------------------------------------ shadow rays */
 
+rgb shade_media_shadow_rest(const scene *sc, const shade_media_env *e, const scene_light *l, const shade_media_inside *in,
+                            vec3 p, vec3 dir, double len, rgb c)
+{
+    if (!(l && l->media_interaction && l->media_attenuation) || !shade_media_inside_hollow(in) || !(len > 0.0)) return c;
+    if (sc->natmosphere) c = shade_media_segment(e, SHADE_MEDIA_ATMOSPHERE, in, p, dir, len, c, 1);
+    if (sc->fogs) c = mul(c, shade_atmos_fog_attenuation(sc, p, dir, len));
+    return c;
+}
+
 rgb shade_media_shadow_ray(const scene *sc, const accel *a, const shade_media_env *e, const scene_light *l, vec3 p, vec3 dir,
-                     double tmin, double tmax, const shade_media_inside *in0)
+                     double tmin, double tmax, const shade_media_inside *in0, double *rest)
 {
     rgb c = {1, 1, 1};
     shade_media_inside in = *in0;
     int atmos = l && l->media_interaction && l->media_attenuation;
     accel_hit h;
     double t0 = tmin, prev = 0.0; /* prev: where the current segment starts */
+    if (rest) *rest = tmax;
     for (int k = 0; k < 256 && t0 < tmax; k++) {
         if (!accel_intersect(a, p, dir, t0, tmax, &h)) break;
         double next = h.t + fmax(tmin, h.t * 1e-7);
@@ -762,14 +772,11 @@ rgb shade_media_shadow_ray(const scene *sc, const accel *a, const shade_media_en
             if (fabs(c.r) < MEDIA_EPSILON && fabs(c.g) < MEDIA_EPSILON && fabs(c.b) < MEDIA_EPSILON) return mk(0, 0, 0);
             shade_media_inside_cross(&in, h.obj);
             prev = h.t;
+            if (rest) *rest = tmax - prev;
         }
         t0 = next;
     }
     /* the rest of the way to the light: the atmosphere (a hollow ray) */
-    if (atmos && shade_media_inside_hollow(&in) && tmax > prev) {
-        vec3 q = v3_madd(p, dir, prev);
-        if (sc->natmosphere) c = shade_media_segment(e, SHADE_MEDIA_ATMOSPHERE, &in, q, dir, tmax - prev, c, 1);
-        if (sc->fogs) c = mul(c, shade_atmos_fog_attenuation(sc, q, dir, tmax - prev));
-    }
+    if (!rest && tmax > prev) c = shade_media_shadow_rest(sc, e, l, &in, v3_madd(p, dir, prev), dir, tmax - prev, c);
     return c;
 }

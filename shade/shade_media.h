@@ -71,8 +71,21 @@ rgb shade_media_segment(const shade_media_env *e, int which, const shade_media_i
  * interior media of the containers over the segment before it (a hollow
  * ray) and, for a light with media_interaction and media_attenuation, the
  * atmospheric media (and fog on hollow segments); after the last surface
- * the atmosphere and fog alone. no_shadow objects are passed through. */
+ * the atmosphere and fog alone. no_shadow objects are passed through.
+ * rest non-NULL: that last part is left out and *rest is its length (tmax
+ * less the last surface crossed), for an area light's samples
+ * (shade_media_shadow_rest). */
 rgb shade_media_shadow_ray(const scene *sc, const accel *a, const shade_media_env *e, const scene_light *l, vec3 p, vec3 dir,
-                     double tmin, double tmax, const shade_media_inside *in);
+                     double tmin, double tmax, const shade_media_inside *in, double *rest);
+/* c after the atmosphere and fog over len along p + t dir, for light l
+ * with media_interaction and media_attenuation, on a hollow ray starting
+ * inside `in` (else c unchanged): the last part of a shadow ray. POV-Ray
+ * 3.7 (trace.cpp, TraceShadowRay) adds it once after an area light's
+ * samples are averaged, from the shaded point itself over what the last
+ * sample traced left of its way after its last transparent surface: so
+ * fog near the ground dims an area light twice where that sample crossed a
+ * transparent object (benchmark.pov's cloud shell), once otherwise. */
+rgb shade_media_shadow_rest(const scene *sc, const shade_media_env *e, const scene_light *l, const shade_media_inside *in,
+                            vec3 p, vec3 dir, double len, rgb c);
 
 #endif
