@@ -859,6 +859,11 @@ static int blob_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax,
             }
             int na = 0;
             for (int k = 0; k + 1 < 2 * ns; k++) {
+                /* the roots of this stretch and the ones after it are at
+                 * tau >= ev[k].t (the solver returns roots inside its
+                 * interval): once `max` hits are held and the farthest is
+                 * no farther, none of them can enter */
+                if (n == max && out[max - 1].t <= t0 + ev[k].t / s) break;
                 if (ev[k].enter) active[na++] = ev[k].span;
                 else
                     for (int j = 0; j < na; j++)
