@@ -629,21 +629,21 @@ static void finish_bounds(accel *a)
         geom_shape *sh = &a->shapes[i];
         if (sh->kind != SHAPE_PLANE && !sh->infinite) continue;
         double dist = sh->kind == SHAPE_PLANE ? plane_distance(sh, c) : 0.0;
-        double hsz = PLANE_EXTENT_FACTOR * fmax(diag_e, dist);
+        double hsz = PLANE_EXTENT_FACTOR * fmax_inline(diag_e, dist);
         if (!(hsz > 0.0)) hsz = PLANE_EXTENT_FACTOR;
         geom_shape_clip_plane(sh, v3_sub(c, v3s(hsz)), v3_add(c, v3s(hsz)));
-        far_plane = fmax(far_plane, dist);
+        far_plane = fmax_inline(far_plane, dist);
     }
     /* CSG primitives: one cube for all their planes, the largest one needs */
     for (int i = 0; i < a->ncsgs; i++) {
         geom_csg *cs = &a->csgs[i];
         double dist = 0.0;
         for (int k = 0; k < cs->nshapes; k++)
-            if (cs->shapes[k].kind == SHAPE_PLANE) dist = fmax(dist, plane_distance(&cs->shapes[k], c));
-        double hsz = PLANE_EXTENT_FACTOR * fmax(diag_e, dist);
+            if (cs->shapes[k].kind == SHAPE_PLANE) dist = fmax_inline(dist, plane_distance(&cs->shapes[k], c));
+        double hsz = PLANE_EXTENT_FACTOR * fmax_inline(diag_e, dist);
         if (!(hsz > 0.0)) hsz = PLANE_EXTENT_FACTOR;
         geom_csg_clip(cs, v3_sub(c, v3s(hsz)), v3_add(c, v3s(hsz)));
-        far_plane = fmax(far_plane, dist);
+        far_plane = fmax_inline(far_plane, dist);
     }
     if (a->lo.x <= a->hi.x) {
         a->scale = v3_len(v3_sub(a->hi, a->lo));
@@ -1080,7 +1080,7 @@ int accel_crossings(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
             if (!isfinite(h.t) || !v3_finite(h.p)) continue;
             visited++;
             if (!fn(ctx, &h)) break;
-            t0 = h.t + fmax(step, h.t * 1e-7);
+            t0 = h.t + fmax_inline(step, h.t * 1e-7);
         }
         return visited;
     }
@@ -1088,7 +1088,7 @@ int accel_crossings(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
         if (!intersect_at(a, org, dir, t0, tmax, &h)) break;
         visited++;
         if (!fn(ctx, &h)) break;
-        t0 = h.t + fmax(step, h.t * 1e-7);
+        t0 = h.t + fmax_inline(step, h.t * 1e-7);
     }
     return visited;
 }
@@ -1112,7 +1112,7 @@ static int contact_hit(const accel *a, const accel_from *f, vec3 org, vec3 dir, 
         double nn = v3_len(hit->ng) * v3_len(f->ng);
         int parallel = nn > 0.0 && fabs(c) > CONTACT_COS * nn;
         if (!own && !parallel && !(hit->flags & skip)) return 1;
-        lo = hit->t + fmax(lo, hit->t * 1e-7);
+        lo = hit->t + fmax_inline(lo, hit->t * 1e-7);
     }
     return 0;
 }
@@ -1130,7 +1130,7 @@ int accel_intersect_from(const accel *a, const accel_from *f, vec3 org, vec3 dir
     if (!a || !ray_ok(org, dir)) return 0;
     double t0 = eps_rule(a->eps_scale, org, v3_len(dir));
     if (tmin > t0) t0 = tmin;
-    if (f && contact_hit(a, f, org, dir, fmin(t0, tmax), 0u, hit)) return 1;
+    if (f && contact_hit(a, f, org, dir, fmin_inline(t0, tmax), 0u, hit)) return 1;
     return accel_intersect(a, org, dir, tmin, tmax, hit);
 }
 
@@ -1146,7 +1146,7 @@ int accel_intersect_past(const accel *a, const accel_from *f, vec3 org, vec3 dir
         int pass = (hit->flags & skip) ||
                    ((skip & ACCEL_SKIP_PASS_THROUGH) && hit->obj && hit->obj->photons && hit->obj->photons->pass_through);
         if (!pass) return 1;
-        tmin = hit->t + fmax(eps, hit->t * 1e-7);
+        tmin = hit->t + fmax_inline(eps, hit->t * 1e-7);
     }
     return -1;
 }
@@ -1157,7 +1157,7 @@ int accel_occluded_from(const accel *a, const accel_from *f, vec3 org, vec3 dir,
     double t0 = eps_rule(a->eps_scale, org, v3_len(dir));
     if (tmin > t0) t0 = tmin;
     accel_hit h;
-    if (f && contact_hit(a, f, org, dir, fmin(t0, tmax), OBJ_NO_SHADOW, &h)) return 1;
+    if (f && contact_hit(a, f, org, dir, fmin_inline(t0, tmax), OBJ_NO_SHADOW, &h)) return 1;
     return accel_occluded(a, org, dir, tmin, tmax);
 }
 
@@ -1173,20 +1173,20 @@ int accel_mutually_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, 
     /* within the self-intersection distance of p: an object that is not
      * "same" blocks unless it lies parallel to x's surface (contacts, as
      * accel_intersect_from) */
-    double t_eps = fmin(eps_rule(a->eps_scale, p, 1.0), len);
+    double t_eps = fmin_inline(eps_rule(a->eps_scale, p, 1.0), len);
     for (double lo = CONTACT_REL * t_eps; lo < t_eps;) {
         accel_hit h;
         if (!intersect_at(a, p, d, lo, t_eps, &h)) break;
         double c = v3_dot(h.ng, nx), nn = v3_len(h.ng) * v3_len(nx);
         if (!same(h.obj, ctx) && !(nn > 0.0 && fabs(c) > CONTACT_COS * nn)) return 0;
-        lo = h.t + fmax(lo, h.t * 1e-7);
+        lo = h.t + fmax_inline(lo, h.t * 1e-7);
     }
     double tmin = 0.0;
     for (int k = 0; k < 8; k++) {
         accel_hit h;
         if (!accel_intersect(a, p, d, tmin, len, &h)) return 1;
         if (!same(h.obj, ctx)) return 0;
-        tmin = h.t + fmax(eps, h.t * 1e-7);
+        tmin = h.t + fmax_inline(eps, h.t * 1e-7);
     }
     return 1;
 }

@@ -372,7 +372,7 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
                     break;
                 }
                 q->cross[q->ncross++] = (accel_crossing){h.t, args->primID, h.part, h.shape, h.flip};
-                from = h.t + fmax(q->cstep, h.t * 1e-7);
+                from = h.t + fmax_inline(q->cstep, h.t * 1e-7);
             }
             continue;
         }

@@ -25,9 +25,16 @@ static inline vec3 v3_norm(vec3 a)
     double l = v3_len(a);
     return l > 0.0 ? v3_scale(a, 1.0 / l) : a;
 }
-static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fmin(a.x, b.x), fmin(a.y, b.y), fmin(a.z, b.z)); }
-static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z)); }
-static inline double v3_maxc(vec3 a) { return fmax(a.x, fmax(a.y, a.z)); }
+/* fmin and fmax inline, with the values glibc's x86-64 versions return
+ * (minsd/maxsd on ordered arguments: the second one when the two compare
+ * equal, so also for +0 and -0; the number when one is a NaN): libm's are
+ * calls, which the compiler may not replace under IEEE NaN rules, and the
+ * box and interval tests of a render make millions of them. */
+static inline double fmin_inline(double a, double b) { return (a < b || b != b) ? a : b; }
+static inline double fmax_inline(double a, double b) { return (a > b || b != b) ? a : b; }
+static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fmin_inline(a.x, b.x), fmin_inline(a.y, b.y), fmin_inline(a.z, b.z)); }
+static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fmax_inline(a.x, b.x), fmax_inline(a.y, b.y), fmax_inline(a.z, b.z)); }
+static inline double v3_maxc(vec3 a) { return fmax_inline(a.x, fmax_inline(a.y, a.z)); }
 static inline double v3_idx(vec3 a, int i) { return i == 0 ? a.x : (i == 1 ? a.y : a.z); }
 /* a in single precision, into f[0..2] (device records, photon and mesh arrays) */
 static inline void v3_store_f(float f[3], vec3 a)

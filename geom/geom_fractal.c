@@ -270,7 +270,7 @@ int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
     double disc = B * B - A * C;
     if (!(disc > 0.0)) return 0;
     double sq = sqrt(disc), t0 = (-B - sq) / A, t1 = (-B + sq) / A;
-    double a = fmax(t0, tmin), b = fmin(t1, tmax);
+    double a = fmax_inline(t0, tmin), b = fmin_inline(t1, tmax);
     if (!(a < b)) return 0;
     double s = sqrt(A);
     vec3 e = v3_scale(d, 1.0 / s), p0 = v3_madd(o, d, a);
@@ -278,8 +278,8 @@ int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
     int cur = jf_inside(f, p0, e, &de), n = 0;
     for (long guard = 0; tau < len && guard < 10000000; guard++) {
         if (n == max && a + tau / s > out[max - 1].t) break;
-        double step = cur ? f->step : fmax(de, f->step);
-        double tn = fmin(tau + step, len);
+        double step = cur ? f->step : fmax_inline(de, f->step);
+        double tn = fmin_inline(tau + step, len);
         double den;
         int next = jf_inside(f, v3_madd(p0, e, tn), e, &den);
         if (next != cur) {

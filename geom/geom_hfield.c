@@ -170,17 +170,12 @@ static int cell_hits(const hf_data *f, int ix, int iz, vec3 o, vec3 d, double tm
     return n;
 }
 
-/* Plain comparisons: libm's fmin and fmax are calls (NaN rules) and the
- * walk's values are never NaN. */
-static inline double dmin(double a, double b) { return a < b ? a : b; }
-static inline double dmax(double a, double b) { return a > b ? a : b; }
-
 /* Node (lev, ix, iz)'s footprint on axis k (0: X, 1: Z): [*lo, *hi]. */
 static void node_span(const hf_data *f, int lev, int i, int k, double *lo, double *hi)
 {
     double s = (double)(1 << lev), n = k ? f->nz : f->nx;
     *lo = (double)i * s;
-    *hi = dmin((double)(i + 1) * s, n);
+    *hi = fmin_inline((double)(i + 1) * s, n);
 }
 
 /* The ray's parameter where it leaves [lo, hi] on an axis with origin o
@@ -214,8 +209,8 @@ int geom_hfield_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double t
     /* the grid's box, a hair wider so its faces do not leak */
     vec3 pad = v3(1e-9 * f->nx, 1e-9 * (f->yhi - f->ylo) + 1e-300, 1e-9 * f->nz);
     if (!v3_slab(go, gd, v3_sub(v3(0.0, f->ylo, 0.0), pad), v3_add(v3(f->nx, f->yhi, f->nz), pad), &ta, &tb)) return 0;
-    ta = fmax(ta, tmin);
-    tb = fmin(tb, tmax);
+    ta = fmax_inline(ta, tmin);
+    tb = fmin_inline(tb, tmax);
     if (!(ta <= tb)) return 0;
     double inv_x = gd.x != 0.0 ? 1.0 / gd.x : 0.0, inv_z = gd.z != 0.0 ? 1.0 / gd.z : 0.0;
     int sx = gd.x < 0.0 ? -1 : 1, sz = gd.z < 0.0 ? -1 : 1;
@@ -243,10 +238,10 @@ int geom_hfield_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double t
         node_span(f, lev, ix, 0, &x0, &x1);
         node_span(f, lev, iz, 1, &z0, &z1);
         double ex = axis_exit(go.x, inv_x, x0, x1), ez = axis_exit(go.z, inv_z, z0, z1);
-        double te = dmin(dmin(ex, ez), tb);
+        double te = fmin_inline(fmin_inline(ex, ez), tb);
         if (te < t) te = t;
         double y0 = go.y + t * gd.y, y1 = go.y + te * gd.y;
-        double ylo = dmin(y0, y1), yhi = dmax(y0, y1), sl = 1e-12 * (fabs(ylo) + fabs(yhi)) + 1e-300;
+        double ylo = fmin_inline(y0, y1), yhi = fmax_inline(y0, y1), sl = 1e-12 * (fabs(ylo) + fabs(yhi)) + 1e-300;
         size_t k = (size_t)iz * f->lw[lev] + ix;
         if (yhi + sl >= f->mn[lev][k] && ylo - sl <= f->mx[lev][k]) {
             if (lev > 0) {
@@ -354,8 +349,8 @@ vec3 geom_hfield_shading(const geom_shape *sh, vec3 q)
     int i, j;
     double fx, fz;
     locate(f, q.x * f->nx, q.z * f->nz, &i, &j, &fx, &fz);
-    fx = fmin(1.0, fmax(0.0, fx));
-    fz = fmin(1.0, fmax(0.0, fz));
+    fx = fmin_inline(1.0, fmax_inline(0.0, fx));
+    fz = fmin_inline(1.0, fmax_inline(0.0, fz));
     vec3 n;
     if (fx + fz < 1.0) {
         double w0 = 1.0 - fx - fz;

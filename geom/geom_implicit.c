@@ -85,15 +85,15 @@ static double se_norm(const im_data *m, vec3 v, double *pa)
 {
     double ax = fabs(v.x), ay = fabs(v.y), az = fabs(v.z);
     if (!pa && m->p == m->q) {
-        double mm = fmax(fmax(ax, ay), az);
+        double mm = fmax_inline(fmax_inline(ax, ay), az);
         if (!(mm > 0.0)) return 0.0;
         double s = se_pow(ax / mm, m->p, m->pint) + se_pow(ay / mm, m->p, m->pint) + se_pow(az / mm, m->p, m->pint);
         return mm * pow(s, 1.0 / m->p);
     }
-    double mxy = fmax(ax, ay), a = 0.0;
+    double mxy = fmax_inline(ax, ay), a = 0.0;
     if (mxy > 0.0) a = mxy * pow(se_pow(ax / mxy, m->p, m->pint) + se_pow(ay / mxy, m->p, m->pint), 1.0 / m->p);
     if (pa) *pa = a;
-    double mm = fmax(a, az);
+    double mm = fmax_inline(a, az);
     if (!(mm > 0.0)) return 0.0;
     return mm * pow(se_pow(a / mm, m->q, m->qint) + se_pow(az / mm, m->q, m->qint), 1.0 / m->q);
 }
@@ -169,7 +169,7 @@ static double se_gd(const im_data *m, vec3 o, vec3 d, double t, double *dg)
     vec3 v = v3_madd(o, d, t);
     double ax = fabs(v.x), ay = fabs(v.y), az = fabs(v.z), gx = 0.0, gy = 0.0, gz = 0.0, N;
     if (m->p == m->q) {
-        double mm = fmax(fmax(ax, ay), az);
+        double mm = fmax_inline(fmax_inline(ax, ay), az);
         if (!(mm > 0.0)) {
             /* se_grad's fallback for a zero gradient */
             *dg = copysign(1.0, v.x) * d.x + copysign(1.0, v.y) * d.y + copysign(1.0, v.z) * d.z;
@@ -184,14 +184,14 @@ static double se_gd(const im_data *m, vec3 o, vec3 d, double t, double *dg)
         gy = ay > 0.0 ? ty * k / ay : at0;
         gz = az > 0.0 ? tz * k / az : m->p == 1.0 ? 1.0 : 0.0;
     } else {
-        double mxy = fmax(ax, ay), a = 0.0, tx = 0.0, ty = 0.0, Sxy = 0.0;
+        double mxy = fmax_inline(ax, ay), a = 0.0, tx = 0.0, ty = 0.0, Sxy = 0.0;
         if (mxy > 0.0) {
             tx = se_pow(ax / mxy, m->p, m->pint);
             ty = se_pow(ay / mxy, m->p, m->pint);
             Sxy = tx + ty;
             a = mxy * pow(Sxy, 1.0 / m->p);
         }
-        double mm = fmax(a, az);
+        double mm = fmax_inline(a, az);
         if (!(mm > 0.0)) {
             *dg = copysign(1.0, v.x) * d.x + copysign(1.0, v.y) * d.y + copysign(1.0, v.z) * d.z;
             return -1.0;
@@ -307,8 +307,8 @@ static int se_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, g
 {
     double t0, t1;
     if (!v3_slab(o, d, v3s(-1.0 - 1e-9), v3s(1.0 + 1e-9), &t0, &t1)) return 0;
-    t0 = fmax(t0, tmin);
-    t1 = fmin(t1, tmax);
+    t0 = fmax_inline(t0, tmin);
+    t1 = fmin_inline(t1, tmax);
     if (!(t0 < t1)) return 0;
     /* move the origin into the box, unit direction */
     double s = v3_len(d);
@@ -465,11 +465,11 @@ static double quad_min(double A, double B, double l, double h)
     if (A < 0.0 || (A == 0.0 && B < 0.0)) {
         if (!isfinite(h)) return -INFINITY;
     }
-    if (isfinite(l)) m = fmin(m, A * l * l + B * l);
-    if (isfinite(h)) m = fmin(m, A * h * h + B * h);
+    if (isfinite(l)) m = fmin_inline(m, A * l * l + B * l);
+    if (isfinite(h)) m = fmin_inline(m, A * h * h + B * h);
     if (A > 0.0) {
         double v = -B / (2.0 * A);
-        if (v >= l && v <= h) m = fmin(m, A * v * v + B * v);
+        if (v >= l && v <= h) m = fmin_inline(m, A * v * v + B * v);
     }
     if (A == 0.0 && B == 0.0) m = 0.0;
     return m;
@@ -481,23 +481,23 @@ static int quad_below(double A, double B, double R, double l, double h, double *
     if (R == INFINITY) { *lo = l; *hi = h; return l <= h; }
     double a = l, b = h;
     if (A == 0.0) {
-        if (B > 0.0) b = fmin(h, R / B);
-        else if (B < 0.0) a = fmax(l, R / B);
+        if (B > 0.0) b = fmin_inline(h, R / B);
+        else if (B < 0.0) a = fmax_inline(l, R / B);
         else if (!(0.0 < R)) return 0;
     } else {
         double disc = B * B + 4.0 * A * R;
         if (A > 0.0) {
             if (!(disc > 0.0)) return 0;
             double sq = sqrt(disc);
-            a = fmax(l, (-B - sq) / (2.0 * A));
-            b = fmin(h, (-B + sq) / (2.0 * A));
+            a = fmax_inline(l, (-B - sq) / (2.0 * A));
+            b = fmin_inline(h, (-B + sq) / (2.0 * A));
         } else if (disc > 0.0) {
             /* outside the two roots: the hull within [l, h] */
             double sq = sqrt(disc), r1 = (-B + sq) / (2.0 * A), r2 = (-B - sq) / (2.0 * A); /* r1 < r2 */
             int left = l < r1, right = h > r2;
             if (!left && !right) return 0;
-            if (!left) a = fmax(l, r2);
-            if (!right) b = fmin(h, r1);
+            if (!left) a = fmax_inline(l, r2);
+            if (!right) b = fmin_inline(h, r1);
         }
     }
     *lo = a;
@@ -531,7 +531,7 @@ int geom_quadric_solid_box(const geom_shape *sh, int local, vec3 clo, vec3 chi, 
         for (int k = 0; k < 3; k++) w[i] += L[k][i] * (2.0 * Qc[k] + b[k]);
         for (int j = 0; j < 3; j++) {
             W[i][j] = L[0][i] * QL[0][j] + L[1][i] * QL[1][j] + L[2][i] * QL[2][j];
-            big = fmax(big, fabs(W[i][j]));
+            big = fmax_inline(big, fabs(W[i][j]));
         }
     }
     if (!(big > 0.0) || !isfinite(big) || !isfinite(J)) return 0;
@@ -685,14 +685,14 @@ static int blob_spans(const blob_comp *c, vec3 p, vec3 e, double ta, double tb, 
             if (w1 != 0.0) {
                 double tw = -w0 / w1;
                 int below_after = end == 0 ? (w1 < 0.0) : (w1 > 0.0); /* the cap side is reached after tw */
-                if (below_after) a = fmax(a, tw);
-                else b = fmin(b, tw);
+                if (below_after) a = fmax_inline(a, tw);
+                else b = fmin_inline(b, tw);
             } else if ((end == 0 && w0 >= 0.0) || (end == 1 && w0 <= 0.0)) {
                 continue;
             }
         }
-        a = fmax(a, ta);
-        b = fmin(b, tb);
+        a = fmax_inline(a, ta);
+        b = fmin_inline(b, tb);
         if (!(a < b)) continue;
         sp[n++] = span_of(c, a, b, q0, q1, q2);
     }
@@ -716,13 +716,13 @@ static int blob_spans(const blob_comp *c, vec3 p, vec3 e, double ta, double tb, 
         if (w1 != 0.0) {
             double x = -w0 / w1, y = (c->len - w0) / w1;
             if (x > y) { double t = x; x = y; y = t; }
-            a = fmax(a, x);
-            b = fmin(b, y);
+            a = fmax_inline(a, x);
+            b = fmin_inline(b, y);
         } else if (w0 < 0.0 || w0 > c->len) {
             return n;
         }
-        a = fmax(a, ta);
-        b = fmin(b, tb);
+        a = fmax_inline(a, ta);
+        b = fmin_inline(b, tb);
         if (a < b) {
             sp[n++] = span_of(c, a, b, q0, q1, q2);
         }
@@ -806,7 +806,7 @@ static int blob_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax,
 {
     double b0, b1;
     if (!v3_slab(o, d, m->blo, m->bhi, &b0, &b1)) return 0;
-    double t0 = fmax(tmin, b0), t1 = fmin(tmax, b1);
+    double t0 = fmax_inline(tmin, b0), t1 = fmin_inline(tmax, b1);
     if (!(t0 < t1)) return 0;
     double s = v3_len(d);
     vec3 e = v3_scale(d, 1.0 / s), p = v3_madd(o, d, t0);
@@ -1132,7 +1132,7 @@ static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, 
 {
     double ca, cb;
     if (!iso_container(m, o, d, &ca, &cb)) return 0;
-    double a = fmax(ca, tmin), b = fmin(cb, tmax);
+    double a = fmax_inline(ca, tmin), b = fmin_inline(cb, tmax);
     if (!(a < b)) return 0;
     double s = v3_len(d);
     vec3 e = v3_scale(d, 1.0 / s), p0 = v3_madd(o, d, a);
@@ -1157,7 +1157,7 @@ static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, 
         }
     }
     if (budget <= 0) return n;
-    double minstep = fmax(m->acc, 1e-9 * m->size);
+    double minstep = fmax_inline(m->acc, 1e-9 * m->size);
     if (!traced) {
         iso_walk w = {m, p0, e, a, s, tmin, tmax, minstep, out, n, max};
         iso_split(&w, 0.0, iso_f(m, p0), len, iso_f(m, v3_madd(p0, e, len)), 0);

@@ -76,8 +76,8 @@ static void world_bounds(geom_shape *sh, vec3 lo, vec3 hi)
 /* Half extents of a disc of radius r with unit axis n, per coordinate. */
 static vec3 disc_extent(vec3 n, double r)
 {
-    return v3(r * sqrt(fmax(0.0, 1.0 - n.x * n.x)), r * sqrt(fmax(0.0, 1.0 - n.y * n.y)),
-              r * sqrt(fmax(0.0, 1.0 - n.z * n.z)));
+    return v3(r * sqrt(fmax_inline(0.0, 1.0 - n.x * n.x)), r * sqrt(fmax_inline(0.0, 1.0 - n.y * n.y)),
+              r * sqrt(fmax_inline(0.0, 1.0 - n.z * n.z)));
 }
 
 static int finite_d(double x) { return isfinite(x); }
@@ -206,7 +206,7 @@ static int init_shape(geom_shape *sh, const scene_object *o, int meshes)
          * the tangent points are at yb and yt */
         double rb = o->u.ovus.bottom, rt = o->u.ovus.top;
         if (!(rb > 0.0) || !(rt > 0.0) || !(rt < 2.0 * rb) || !finite_d(rb) || !finite_d(rt)) return -1;
-        double rc = 2.0 * fmax(rb, rt);
+        double rc = 2.0 * fmax_inline(rb, rt);
         double v = (rb * rb + (rc - rb) * (rc - rb) - (rc - rt) * (rc - rt)) / (2.0 * rb);
         double h2 = (rc - rb) * (rc - rb) - v * v;
         if (!(h2 > 0.0)) return -1;
@@ -217,7 +217,7 @@ static int init_shape(geom_shape *sh, const scene_object *o, int meshes)
         sh->g.ovus.v = v;
         sh->g.ovus.yb = -v * rb / (rc - rb);
         sh->g.ovus.yt = (rc * rb - v * rt) / (rc - rt);
-        double wide = fmax(rc - sh->g.ovus.h, fmax(rb, rt));
+        double wide = fmax_inline(rc - sh->g.ovus.h, fmax_inline(rb, rt));
         lo = v3(-wide, -rb, -wide);
         hi = v3(wide, rb + rt, wide);
         break;
@@ -513,7 +513,7 @@ static int hits_torus(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
     const double pad = 0.01;
     if (!slabs(o1, e, v3(-1.0 - pad, -r1 - pad, -1.0 - pad), v3(1.0 + pad, r1 + pad, 1.0 + pad), &b0, &f0, &b1, &f1))
         return 0;
-    double lo = fmax(ta, b0), hi = fmin(tb, b1);
+    double lo = fmax_inline(ta, b0), hi = fmin_inline(tb, b1);
     if (!(lo < hi)) return 0;
     vec3 q = v3_madd(o1, e, lo);
     double c[5];
@@ -541,12 +541,12 @@ static int hits_ovus(const geom_shape *sh, vec3 o, vec3 d, double tmin, double t
     double rb = sh->g.ovus.rb * k, rt = sh->g.ovus.rt * k, rc = sh->g.ovus.rc * k, H = sh->g.ovus.h * k;
     double V = sh->g.ovus.v * k, yb = sh->g.ovus.yb * k, yt = sh->g.ovus.yt * k;
     vec3 e = v3_scale(d, 1.0 / s), o1 = v3_scale(o, k);
-    double wide = fmax(rc - H, fmax(rb, rt)) + 0.01;
+    double wide = fmax_inline(rc - H, fmax_inline(rb, rt)) + 0.01;
     double b0, b1;
     int f0, f1;
     if (!slabs(o1, e, v3(-wide, -rb - 0.01, -wide), v3(wide, 1.01, wide), &b0, &f0, &b1, &f1)) return 0;
     double ta = tmin * sk, tb = tmax * sk;
-    double lo = fmax(ta, b0), hi = fmin(tb, b1);
+    double lo = fmax_inline(ta, b0), hi = fmin_inline(tb, b1);
     if (!(lo < hi)) return 0;
     vec3 q = v3_madd(o1, e, lo);
     double cand[8];
@@ -885,7 +885,7 @@ void geom_shape_surface(const geom_shape *sh, vec3 p, int part, vec3 *ng, double
         if (uv) {
             vec3 un = v3_norm(n);
             su = wrap01(atan2(un.z, un.x));
-            sv = clamp01(1.0 - acos(fmax(-1.0, fmin(1.0, un.y))) / (TWO_PI * 0.5));
+            sv = clamp01(1.0 - acos(fmax_inline(-1.0, fmin_inline(1.0, un.y))) / (TWO_PI * 0.5));
         }
         break;
     }
@@ -1008,7 +1008,7 @@ static double pov_theta(double x, double z)
     double th;
     if (z == 0.0) th = x > 0.0 ? 0.0 : M_PI;
     else {
-        th = acos(fmax(-1.0, fmin(1.0, x / len)));
+        th = acos(fmax_inline(-1.0, fmin_inline(1.0, x / len)));
         if (z < 0.0) th = TWO_PI - th;
     }
     return th / TWO_PI;
@@ -1022,7 +1022,7 @@ static int pov_sphere_uv(vec3 d, double uv[2])
     double len = v3_len(d);
     if (!(len > 0.0) || !isfinite(len)) return 0;
     d = v3_scale(d, 1.0 / len);
-    uv[1] = 0.5 + asin(fmax(-1.0, fmin(1.0, d.y))) / M_PI;
+    uv[1] = 0.5 + asin(fmax_inline(-1.0, fmin_inline(1.0, d.y))) / M_PI;
     uv[0] = pov_theta(d.x, d.z);
     return 1;
 }

@@ -221,9 +221,9 @@ vec3 shade_pattern_warp(const scene_pattern *pat, vec3 p)
         case WARP_CUBIC: p = warp_cubic(p); break;
         }
     }
-    p.x = fmin(fmax(p.x, -COORD_LIMIT), COORD_LIMIT);
-    p.y = fmin(fmax(p.y, -COORD_LIMIT), COORD_LIMIT);
-    p.z = fmin(fmax(p.z, -COORD_LIMIT), COORD_LIMIT);
+    p.x = fmin_inline(fmax_inline(p.x, -COORD_LIMIT), COORD_LIMIT);
+    p.y = fmin_inline(fmax_inline(p.y, -COORD_LIMIT), COORD_LIMIT);
+    p.z = fmin_inline(fmax_inline(p.z, -COORD_LIMIT), COORD_LIMIT);
     return p;
 }
 
@@ -251,7 +251,7 @@ static double agate(const scene_pattern *pat, vec3 p, int gen)
                                      : shade_noise_turbulence(p, 6, 0.5, 2.0, gen));
     double n = 0.5 * (shade_noise_cycloidal(1.3 * tv + 1.1 * p.z) + 1.0);
     if (n < 0.0) return 0.0;
-    n = fmin(1.0, n);
+    n = fmin_inline(1.0, n);
     return pow(n, 0.77);
 }
 
@@ -294,7 +294,7 @@ static double cells(vec3 p)
 {
     int h = shade_noise_hash3d(shade_noise_to_int(floor(p.x + PAT_EPSILON)), shade_noise_to_int(floor(p.y + PAT_EPSILON)),
                          shade_noise_to_int(floor(p.z + PAT_EPSILON)));
-    return fmin(shade_noise_pattern_rand((unsigned long)h), 1.0);
+    return fmin_inline(shade_noise_pattern_rand((unsigned long)h), 1.0);
 }
 
 static double checker(vec3 p)
@@ -384,7 +384,7 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
     }
     for (int i = 3; metric != 2 && i < 81; i++) {
         vec3 d = v3_sub(pts[i], p);
-        if (general && fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))) > bound) continue;
+        if (general && fmax_inline(fabs(d.x), fmax_inline(fabs(d.y), fabs(d.z))) > bound) continue;
         double s = metric_sum(d, metric);
         if (s < m3) {
             nearest3_put(s, i, &m1, &m2, &m3, &mi);
@@ -403,7 +403,7 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
     else if (metric == 2) t = f.x * sqrt(m1) + f.y * sqrt(m2) + f.z * sqrt(m3);
     else if (metric == 1) t = f.x * m1 + f.y * m2 + f.z * m3;
     else t = f.x * pow(m1, 1.0 / metric) + f.y * pow(m2, 1.0 / metric) + f.z * pow(m3, 1.0 / metric);
-    return fmax(fmin(t, 1.0), 0.0);
+    return fmax_inline(fmin_inline(t, 1.0), 0.0);
 }
 
 static double granite(vec3 p, int gen)
@@ -578,11 +578,11 @@ static double wood(const scene_pattern *pat, vec3 p)
 static double wrinkles(vec3 p, int gen)
 {
     double lambda = 2.0, omega = 0.5, value;
-    if (gen > 1) value = fmin(fmax(shade_noise_value(p, gen) * 2.0 - 0.5, 0.0), 1.0);
+    if (gen > 1) value = fmin_inline(fmax_inline(shade_noise_value(p, gen) * 2.0 - 0.5, 0.0), 1.0);
     else value = shade_noise_value(p, gen);
     for (int i = 1; i < 10; i++) {
         vec3 t = v3_scale(p, lambda);
-        if (gen > 1) value += omega * fmin(fmax(shade_noise_value(t, gen) * 2.0 - 0.5, 0.0), 1.0);
+        if (gen > 1) value += omega * fmin_inline(fmax_inline(shade_noise_value(t, gen) * 2.0 - 0.5, 0.0), 1.0);
         else value += omega * shade_noise_value(t, gen);
         lambda *= 2.0;
         omega *= 0.5;
@@ -744,7 +744,7 @@ static double aoi(const shade_pattern_ctx *c)
 {
     if (!c->has_hit) return 0.0;
     double ca = v3_dot(v3_norm(c->normal), v3_norm(c->dir));
-    ca = fmin(1.0, fmax(-1.0, ca));
+    ca = fmin_inline(1.0, fmax_inline(-1.0, ca));
     return acos(ca) / PI_;
 }
 
@@ -956,7 +956,7 @@ static double raw_value(const scene_pattern *pat, vec3 p, const shade_pattern_ct
     }
     case PAT_QUILTED: return quilted(pat, p);
     case PAT_PLANAR: return clip_density(fabs(p.y));
-    case PAT_BOXED: return clip_density(fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
+    case PAT_BOXED: return clip_density(fmax_inline(fabs(p.x), fmax_inline(fabs(p.y), fabs(p.z))));
     case PAT_SPHERICAL: return clip_density(v3_len(p));
     case PAT_CYLINDRICAL: return clip_density(sqrt(p.x * p.x + p.z * p.z));
     case PAT_PIGMENT: {

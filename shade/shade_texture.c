@@ -58,7 +58,7 @@ static inline rgb trgb(double r, double g, double b) { rgb c = {r, g, b}; return
 static inline rgb tadd(rgb a, rgb b) { return trgb(a.r + b.r, a.g + b.g, a.b + b.b); }
 static inline rgb tmul(rgb a, rgb b) { return trgb(a.r * b.r, a.g * b.g, a.b * b.b); }
 static inline rgb tscale(rgb a, double s) { return trgb(a.r * s, a.g * s, a.b * s); }
-static inline double tmax3(rgb a) { return fmax(a.r, fmax(a.g, a.b)); }
+static inline double tmax3(rgb a) { return fmax_inline(a.r, fmax_inline(a.g, a.b)); }
 
 /* A parent patterned texture whose transforms apply to normals below it. */
 typedef struct {
@@ -183,7 +183,7 @@ static rgb reflectivity(const hit_info *hi, const scene_finish *f, double cos_i,
             double fr = 0.5 * ((g - cos_i) * (g - cos_i) / ((g + cos_i) * (g + cos_i)));
             double a = cos_i * (g + cos_i) - 1.0, b = cos_i * (g - cos_i) + 1.0;
             fr = fr * (1.0 + a * a / (b * b));
-            fr = fmin(1.0, fmax(0.0, fr));
+            fr = fmin_inline(1.0, fmax_inline(0.0, fr));
             refl = tadd(tscale(rmax, fr), tscale(rmin, 1.0 - fr));
         } else {
             refl = rmax;
@@ -191,7 +191,7 @@ static rgb reflectivity(const hit_info *hi, const scene_finish *f, double cos_i,
         *weight *= tmax3(refl);
         return refl;
     }
-    *weight *= fmax(tmax3(rmax), tmax3(rmin));
+    *weight *= fmax_inline(tmax3(rmax), tmax3(rmin));
     double frac = fabs(f->reflection_falloff - 1.0) > TEX_EPSILON ? pow(1.0 - cos_i, f->reflection_falloff) : 1.0 - cos_i;
     if (fabs(frac) < TEX_EPSILON) return rmin;
     if (fabs(frac - 1.0) < TEX_EPSILON) return rmax;
@@ -317,7 +317,7 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
              * opaque (POV-Ray 3.7 trace.cpp, ComputeLightedTexture) */
             result = pig;
             if (found) filcol = tmul(filcol, trgb(lc.r * lc.f + lc.t, lc.g * lc.f + lc.t, lc.b * lc.f + lc.t));
-            trans = fmin(1.0, fabs(GREY(filcol)));
+            trans = fmin_inline(1.0, fabs(GREY(filcol)));
             continue;
         }
         rgb tmp = {0, 0, 0};
@@ -333,14 +333,14 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
         if (found) {
             filcol = tmul(filcol, trgb(lc.r * lc.f + lc.t, lc.g * lc.f + lc.t, lc.b * lc.f + lc.t));
             if (f->conserve_energy)
-                filcol = tmul(filcol, trgb(fmin(1.0, 1.0 - L->reflec.r), fmin(1.0, 1.0 - L->reflec.g), fmin(1.0, 1.0 - L->reflec.b)));
+                filcol = tmul(filcol, trgb(fmin_inline(1.0, 1.0 - L->reflec.r), fmin_inline(1.0, 1.0 - L->reflec.g), fmin_inline(1.0, 1.0 - L->reflec.b)));
         }
-        trans = fmin(1.0, fabs(GREY(filcol)));
+        trans = fmin_inline(1.0, fabs(GREY(filcol)));
     }
 
     int tir = 0;
     if (trans > bail && e->quality >= 6) { /* +Q: refraction and transmission from level 6 (Q_REFRACT) */
-        double w1 = fmax(fabs(filcol.r), fmax(fabs(filcol.g), fabs(filcol.b)));
+        double w1 = fmax_inline(fabs(filcol.r), fmax_inline(fabs(filcol.g), fabs(filcol.b)));
         rgb rfr;
         tir = refraction(hi, top, weight * w1, &rfr);
         rgb att = {1, 1, 1};
@@ -357,7 +357,7 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
         if (rf.r == 0.0 && rf.g == 0.0 && rf.b == 0.0) continue;
         rgb rc = trace_reflection(hi, lr[i].normal, lr[i].weight, lr[i].f);
         if (lr[i].exponent != 1.0)
-            rc = trgb(pow(fmax(rc.r, 0.0), lr[i].exponent), pow(fmax(rc.g, 0.0), lr[i].exponent), pow(fmax(rc.b, 0.0), lr[i].exponent));
+            rc = trgb(pow(fmax_inline(rc.r, 0.0), lr[i].exponent), pow(fmax_inline(rc.g, 0.0), lr[i].exponent), pow(fmax_inline(rc.b, 0.0), lr[i].exponent));
         result = tadd(result, tmul(rf, rc));
     }
     return result;
@@ -577,14 +577,14 @@ int shade_tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_
         if (!texture_colour(l, p, &pc, &c, 0)) continue;
         found = 1;
         const double pig[3] = {c.r, c.g, c.b};
-        double att = version < 3.7 ? 1.0 - (c.f * fmax(c.r, fmax(c.g, c.b)) + c.t) : 1.0 - c.f - c.t;
+        double att = version < 3.7 ? 1.0 - (c.f * fmax_inline(c.r, fmax_inline(c.g, c.b)) + c.t) : 1.0 - c.f - c.t;
         for (int k = 0; k < 3; k++) {
             S[k] += F[k] * att * pig[k];
             F[k] *= pig[k] * c.f + c.t;
         }
     }
     if (!found) return 0;
-    double t = fmin(1.0, fmax(0.0, GREY(trgb(F[0], F[1], F[2])))), o = 1.0 - t;
+    double t = fmin_inline(1.0, fmax_inline(0.0, GREY(trgb(F[0], F[1], F[2])))), o = 1.0 - t;
     out->r = o > 1e-9 ? S[0] / o : 0.0;
     out->g = o > 1e-9 ? S[1] / o : 0.0;
     out->b = o > 1e-9 ? S[2] / o : 0.0;
@@ -735,7 +735,7 @@ static int shadow_crossing(void *ctx, const accel_hit *h)
 {
     shadow_walk *w = ctx;
     double t0 = w->t0;
-    w->t0 = h->t + fmax(w->tmin, h->t * 1e-7);
+    w->t0 = h->t + fmax_inline(w->tmin, h->t * 1e-7);
     if (h->flags & OBJ_NO_SHADOW) return 1;
     const scene_obj_photons *ph = h->obj ? h->obj->photons : NULL;
     if (w->photon_light && ph && ph->target && scene_photon_lobe(w->photon_light, ph, 1)) {
@@ -744,7 +744,7 @@ static int shadow_crossing(void *ctx, const accel_hit *h)
     }
     /* distance inside the object: from the previous crossing */
     accel_hit hh = *h;
-    hh.t = h->t - (t0 > w->tmin ? t0 - fmax(w->tmin, t0 * 1e-7) : 0.0);
+    hh.t = h->t - (t0 > w->tmin ? t0 - fmax_inline(w->tmin, t0 * 1e-7) : 0.0);
     w->c = tmul(w->c, shade_tex_shadow_filter(w->sc, &hh, w->dir));
     if (fabs(w->c.r) < TEX_EPSILON && fabs(w->c.g) < TEX_EPSILON && fabs(w->c.b) < TEX_EPSILON) {
         w->c = trgb(0, 0, 0);
