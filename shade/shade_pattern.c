@@ -338,6 +338,8 @@ static inline void nearest3_put(double s, int i, double *m1, double *m2, double 
 }
 
 #define CRACKLE_SLOTS 64u /* per thread, 81 points each: 124 KiB */
+#define CRACKLE_N 81      /* the points; 82 stored, the last a copy of the first */
+typedef double crackle_v2 __attribute__((vector_size(16)));
 static double crackle(const scene_pattern *pat, vec3 p, int gen)
 {
     int fx = shade_noise_to_int(floor(p.x - PAT_EPSILON)), fy = shade_noise_to_int(floor(p.y - PAT_EPSILON)),
@@ -347,48 +349,91 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
      * coordinate of magnitude 2), in POV-Ray's table order; kept per thread
      * for the last few cubes visited (they depend on the cube alone), as
      * POV-Ray's crackle cache does: a ray marching an isosurface or a
-     * pixel's neighbours stay in one cube for many evaluations. */
-    static _Thread_local struct { int valid, fx, fy, fz; vec3 pts[81]; } cache[CRACKLE_SLOTS];
+     * pixel's neighbours stay in one cube for many evaluations. The points
+     * are kept by coordinate (x[], y[], z[]) so that the default metric's
+     * squared distances are taken two at a time. */
+    static _Thread_local struct {
+        int valid, fx, fy, fz;
+        _Alignas(16) double x[CRACKLE_N + 1];
+        _Alignas(16) double y[CRACKLE_N + 1];
+        _Alignas(16) double z[CRACKLE_N + 1];
+    } cache[CRACKLE_SLOTS];
     unsigned slot = ((unsigned)fx * 73856093u ^ (unsigned)fy * 19349663u ^ (unsigned)fz * 83492791u) % CRACKLE_SLOTS;
-    vec3 *pts = cache[slot].pts;
+    const double *X = cache[slot].x, *Y = cache[slot].y, *Z = cache[slot].z;
     if (!cache[slot].valid || cache[slot].fx != fx || cache[slot].fy != fy || cache[slot].fz != fz) {
         int n = 0;
         for (int ax = -2; ax <= 2; ax++)
             for (int ay = -2; ay <= 2; ay++)
                 for (int az = -2; az <= 2; az++)
-                    if ((abs(ax) == 2) + (abs(ay) == 2) + (abs(az) == 2) <= 1) pts[n++] = cube_point(fx + ax, fy + ay, fz + az);
+                    if ((abs(ax) == 2) + (abs(ay) == 2) + (abs(az) == 2) <= 1) {
+                        vec3 q = cube_point(fx + ax, fy + ay, fz + az);
+                        cache[slot].x[n] = q.x;
+                        cache[slot].y[n] = q.y;
+                        cache[slot].z[n] = q.z;
+                        n++;
+                    }
+        cache[slot].x[CRACKLE_N] = cache[slot].x[0];
+        cache[slot].y[CRACKLE_N] = cache[slot].y[0];
+        cache[slot].z[CRACKLE_N] = cache[slot].z[0];
         cache[slot].valid = 1;
         cache[slot].fx = fx;
         cache[slot].fy = fy;
         cache[slot].fz = fz;
     }
-    double m1 = metric_sum(v3_sub(pts[0], p), metric);
-    double m2 = metric_sum(v3_sub(pts[1], p), metric);
-    double m3 = metric_sum(v3_sub(pts[2], p), metric);
+    double m1, m2, m3, t;
     int mi = 0;
-    double t;
-    if (m2 < m1) { t = m1; m1 = m2; m2 = t; mi = 1; }
-    if (m3 < m1) { t = m1; m1 = m3; m3 = t; mi = 2; }
-    if (m3 < m2) { t = m2; m2 = m3; m3 = t; }
-    /* other metrics: each term is at least the largest coordinate's, so a
-     * point whose largest |coordinate| exceeds m3^(1/metric) cannot be
-     * among the three nearest; that bound skips most of the pow()s */
-    int general = metric > 0.0 && metric != 2 && metric != 1;
-    double bound = general ? pow(m3, 1.0 / metric) * (1.0 + 1e-12) : INFINITY;
-    /* the common metric 2 (the default) in a loop of its own: a squared
-     * distance and, for most points, one comparison with m3 */
-    for (int i = 3; metric == 2 && i < 81; i++) {
-        double dx = pts[i].x - p.x, dy = pts[i].y - p.y, dz = pts[i].z - p.z;
-        double s = dx * dx + dy * dy + dz * dz;
-        if (s < m3) nearest3_put(s, i, &m1, &m2, &m3, &mi);
-    }
-    for (int i = 3; metric != 2 && i < 81; i++) {
-        vec3 d = v3_sub(pts[i], p);
-        if (general && fmax_inline(fabs(d.x), fmax_inline(fabs(d.y), fabs(d.z))) > bound) continue;
-        double s = metric_sum(d, metric);
-        if (s < m3) {
-            nearest3_put(s, i, &m1, &m2, &m3, &mi);
-            if (general) bound = pow(m3, 1.0 / metric) * (1.0 + 1e-12);
+    if (metric == 2) {
+        /* the common metric 2 (the default): the squared distances two at
+         * a time (each lane the scalar sum dx dx + dy dy + dz dz), then
+         * one comparison with m3 for most points */
+        double sq[CRACKLE_N + 1];
+        crackle_v2 px = {p.x, p.x}, py = {p.y, p.y}, pz = {p.z, p.z};
+        for (int i = 0; i < CRACKLE_N + 1; i += 2) {
+            crackle_v2 dx = *(const crackle_v2 *)(X + i) - px, dy = *(const crackle_v2 *)(Y + i) - py,
+                       dz = *(const crackle_v2 *)(Z + i) - pz;
+            crackle_v2 s2 = dx * dx + dy * dy + dz * dz;
+            sq[i] = s2[0];
+            sq[i + 1] = s2[1];
+        }
+        /* The cube's own point and its six face neighbours (table
+         * indices) bound the third-nearest square from above by their own
+         * third-smallest, u; a point beyond u cannot be among the three
+         * nearest, so the scan in table order compares only the few within
+         * u with the running three and its branches stay predictable (an
+         * insertion at every new minimum mispredicts). The result is the
+         * unbounded scan's: the three smallest values and the first index
+         * of the smallest. */
+        static const int near7[7] = {40, 19, 61, 35, 45, 39, 41};
+        double a = INFINITY, b = INFINITY, u = INFINITY;
+        for (int k = 0; k < 7; k++) {
+            double v = sq[near7[k]], ab = a > v ? a : v, bb = b > v ? b : v;
+            u = u < bb ? u : bb;
+            b = b < ab ? b : ab;
+            a = a < v ? a : v;
+        }
+        m1 = m2 = m3 = INFINITY;
+        for (int i = 0; i < CRACKLE_N; i++)
+            if (sq[i] <= u && sq[i] < m3) nearest3_put(sq[i], i, &m1, &m2, &m3, &mi);
+    } else {
+        m1 = metric_sum(v3(X[0] - p.x, Y[0] - p.y, Z[0] - p.z), metric);
+        m2 = metric_sum(v3(X[1] - p.x, Y[1] - p.y, Z[1] - p.z), metric);
+        m3 = metric_sum(v3(X[2] - p.x, Y[2] - p.y, Z[2] - p.z), metric);
+        if (m2 < m1) { t = m1; m1 = m2; m2 = t; mi = 1; }
+        if (m3 < m1) { t = m1; m1 = m3; m3 = t; mi = 2; }
+        if (m3 < m2) { t = m2; m2 = m3; m3 = t; }
+        /* other metrics: each term is at least the largest coordinate's, so
+         * a point whose largest |coordinate| exceeds m3^(1/metric) cannot be
+         * among the three nearest; that bound skips most of the pow()s */
+        int general = metric > 0.0 && metric != 1;
+        double bound = general ? pow(m3, 1.0 / metric) * (1.0 + 1e-12) : INFINITY;
+        for (int i = 3; i < CRACKLE_N; i++) {
+            vec3 d = v3(X[i] - p.x, Y[i] - p.y, Z[i] - p.z);
+            if (general && fmax_inline(fabs(d.x), fmax_inline(fabs(d.y), fabs(d.z))) > bound) continue;
+            double s = metric_sum(d, metric);
+            if (s < m3) {
+                nearest3_put(s, i, &m1, &m2, &m3, &mi);
+                if (general) bound = pow(m3, 1.0 / metric) * (1.0 + 1e-12);
+            }
         }
     }
     double off = pat->crackle_offset;
@@ -399,7 +444,7 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
         m3 += a;
     }
     vec3 f = pat->crackle_form;
-    if (pat->crackle_solid) t = shade_noise_value(pts[mi], gen);
+    if (pat->crackle_solid) t = shade_noise_value(v3(X[mi], Y[mi], Z[mi]), gen);
     else if (metric == 2) t = f.x * sqrt(m1) + f.y * sqrt(m2) + f.z * sqrt(m3);
     else if (metric == 1) t = f.x * m1 + f.y * m2 + f.z * m3;
     else t = f.x * pow(m1, 1.0 / metric) + f.y * pow(m2, 1.0 / metric) + f.z * pow(m3, 1.0 / metric);
