@@ -317,11 +317,30 @@ static inline void user_ray(const accel_query *q, const void *ray, unsigned N, u
  * cylinder, cone, disc, plane, triangle; no bounded_by, whose test takes
  * the interval's start): all of them from one solve, stepped over by the
  * rule of the loop in accel_user_intersect, which asks the shape again from
- * just past each crossing and so gets the same roots. 0 when the loop must
- * do it (other shapes, CSG, more crossings than the buffer holds). */
+ * just past each crossing and so gets the same roots; on a CSG without
+ * bounded_by, geom_csg_crossings. 0 when the loop must do it (other
+ * shapes, isosurface members, more crossings than the buffer holds). */
 static int cross_leaf_once(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, accel_query *q)
 {
-    if (prim >= (unsigned)a->nshapes || a->leaves[a->shape_leaf[prim]].bn) return 0;
+    if (prim >= (unsigned)a->nshapes) {
+        /* a CSG: geom_csg_crossings searches each member once over the
+         * whole interval (not once per crossing) */
+        unsigned ci = prim - (unsigned)a->nshapes;
+        if (a->csg_bn[ci]) return 0;
+        enum { MAX_CSG_CROSSINGS = 32 };
+        geom_csg_hit hs[MAX_CSG_CROSSINGS];
+        int k = geom_csg_crossings(&a->csgs[ci], o, d, tmin, q->ctmax, q->cstep, hs, MAX_CSG_CROSSINGS);
+        if (k < 0) return 0;
+        for (int j = 0; j < k; j++) {
+            if (q->ncross == q->maxcross) {
+                q->overflow = 1;
+                break;
+            }
+            q->cross[q->ncross++] = (accel_crossing){hs[j].t, prim, hs[j].part, hs[j].shape, hs[j].flip};
+        }
+        return 1;
+    }
+    if (a->leaves[a->shape_leaf[prim]].bn) return 0;
     const geom_shape *sh = &a->shapes[prim];
     switch (sh->kind) {
     case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC: case SHAPE_PLANE:

@@ -777,6 +777,86 @@ int geom_csg_occludes(const geom_csg *c, vec3 org, vec3 dir, double tmin, double
     return csg_search(c, &R, tmax, &h);
 }
 
+/* Member s's kept crossings in (R->tmin, tmax) appended to out[*n..max):
+ * 0, or -1 when out is full or s is an isosurface. */
+static int member_crossings(const geom_csg *c, int s, const csg_ray *R, double tmax, geom_csg_hit *out, int *n, int max)
+{
+    int node = c->shape_node[s];
+    if (c->nodes[node].nosurf) return 0;
+    if (c->shapes[s].kind == SHAPE_ISOSURFACE) return -1;
+    double from = R->tmin, upto = tmax;
+    if (c->keep_box) {
+        /* try_member's stretch, with the whole interval for *best */
+        const vec3 *kb = c->keep_box + 2 * s;
+        double t0, t1;
+        if (!(kb[0].x <= kb[1].x) || !v3_slab_inv(R->org, R->dir, R->inv, kb[0], kb[1], &t0, &t1)) return 0;
+        double pad = 1e-9 * (fabs(t0) + fabs(t1)) + 1e-300;
+        if (t1 + pad < R->tmin || t0 - pad > tmax) return 0;
+        upto = fmin(tmax, t1 + pad);
+        if (t0 - pad > R->tmin) from = t0 - pad;
+    }
+    for (int guard = 0; guard < 1000; guard++) {
+        geom_shape_hit tmp[CSG_CHUNK];
+        int k = geom_shape_ray_hits(&c->shapes[s], R->org, R->dir, from, upto, tmp, CSG_CHUNK);
+        for (int j = 0; j < k; j++) {
+            if (!geom_csg_kept(c, node, v3_madd(R->org, R->dir, tmp[j].t))) continue;
+            if (*n == max) return -1;
+            out[(*n)++] = (geom_csg_hit){tmp[j].t, s, tmp[j].part, c->nodes[node].flip};
+        }
+        if (k < CSG_CHUNK || !(tmp[k - 1].t > from)) break;
+        from = tmp[k - 1].t;
+    }
+    return 0;
+}
+
+int geom_csg_crossings(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, double step, geom_csg_hit *out,
+                       int max)
+{
+    csg_ray R = make_ray(org, dir, tmin, 0);
+    int n = 0;
+    if (!c->bvh) {
+        for (int s = 0; s < c->nshapes; s++)
+            if (member_crossings(c, s, &R, tmax, out, &n, max) < 0) return -1;
+    } else {
+        for (int i = 0; i < c->nunbounded; i++)
+            if (member_crossings(c, c->unbounded[i], &R, tmax, out, &n, max) < 0) return -1;
+        /* csg_search's walk with the whole interval */
+        int stack[64], sp = 0;
+        stack[sp++] = 0;
+        while (sp > 0) {
+            int ni = stack[--sp];
+            const geom_csg_bvh *nd = &c->bvh[ni];
+            double t0, t1;
+            if (!v3_slab_inv(R.org, R.dir, R.inv, nd->lo, nd->hi, &t0, &t1)) continue;
+            double pad = 1e-9 * (fabs(t0) + fabs(t1)) + 1e-300;
+            if (t1 + pad < R.tmin || t0 - pad > tmax) continue;
+            if (nd->count > 0) {
+                for (int k = 0; k < nd->count; k++)
+                    if (member_crossings(c, c->bvh_items[nd->first + k], &R, tmax, out, &n, max) < 0) return -1;
+            } else if (sp + 2 <= 64) {
+                stack[sp++] = nd->first;
+                stack[sp++] = ni + 1;
+            }
+        }
+    }
+    /* nearest first; of equal ones the lower member, as the search keeps
+     * the first member's crossing when another's is not nearer */
+    for (int i = 1; i < n; i++) {
+        geom_csg_hit h = out[i];
+        int j = i;
+        for (; j > 0 && (out[j - 1].t > h.t || (out[j - 1].t == h.t && out[j - 1].shape > h.shape)); j--) out[j] = out[j - 1];
+        out[j] = h;
+    }
+    int m = 0;
+    double from = tmin;
+    for (int i = 0; i < n; i++) {
+        if (!(out[i].t > from) || !(out[i].t < tmax)) continue;
+        out[m++] = out[i];
+        from = out[i].t + fmax(step, out[i].t * 1e-7);
+    }
+    return m;
+}
+
 /* ------------------------------------------------------------ building */
 
 int geom_csg_has_mesh(const scene_object *o, int depth)

@@ -151,6 +151,16 @@ int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, doubl
  * geom_csg_intersect finds, without searching on for the nearest (shadow
  * rays). */
 int geom_csg_occludes(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax);
+/* Every kept crossing in (tmin, tmax), nearest first, each the nearest at
+ * least max(step, 1e-7 t) past the one before: what geom_csg_intersect
+ * called again from just past each crossing gives, from one search of
+ * each member over the whole interval (members whose root finders work on
+ * the interval they are given may place a root an ulp apart). Returns how
+ * many (at most max), or -1 when the caller must step itself: an
+ * isosurface member (its max_trace counts from the search's start) or
+ * more kept crossings than max. */
+int geom_csg_crossings(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, double step, geom_csg_hit *out,
+                       int max);
 int geom_csg_inside(const geom_csg *c, int node, vec3 p);
 /* Does a point p on the surface of leaf `node` belong to the result's
  * surface (the member rules at every level up to the root)? */

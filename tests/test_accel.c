@@ -1001,10 +1001,15 @@ static void test_crossings(void **st)
         sphere(s, v3(0, 0, 5), 1);                 /* 4, 6 */
         box(s, v3(-1, -1, 8), v3(1, 1, 9));        /* 8, 9 */
         sphere(s, v3(0, 0, 12), 0.5);              /* 11.5, 12.5 */
+        /* a hollow ball (geom_csg_crossings' one search per member): 14, 14.5, 15.5, 16 */
+        scene_object *hb = csg(s, SHAPE_DIFFERENCE, 2, 1);
+        hb->u.csg.kids[0] = msphere(s, v3(0, 0, 15), 1);
+        hb->u.csg.kids[1] = msphere(s, v3(0, 0, 15), 0.5);
         if (with_tri) triangle(s, v3(-1, -1, 7), v3(3, -1, 7), v3(-1, 3, 7)); /* 7 */
         accel *a = build(s, d);
-        const double all[2][7] = {{4, 6, 8, 9, 11.5, 12.5}, {4, 6, 7, 8, 9, 11.5, 12.5}};
-        int n = with_tri ? 7 : 6;
+        const double all[2][11] = {{4, 6, 8, 9, 11.5, 12.5, 14, 14.5, 15.5, 16},
+                                   {4, 6, 7, 8, 9, 11.5, 12.5, 14, 14.5, 15.5, 16}};
+        int n = with_tri ? 11 : 10;
         crossing_log l = {{0}, 0, 0};
         assert_int_equal(accel_crossings(a, v3(0, 0, 0), v3(0, 0, 1), 0.0, INFINITY, 1e-6, log_crossing, &l), n);
         assert_int_equal(l.n, n);
@@ -1020,13 +1025,15 @@ static void test_crossings(void **st)
         assert_int_equal(accel_crossings(a, v3(0, 0, 0), v3(0, 0, 1), 0.0, INFINITY, 1e-6, log_crossing, &l), 2);
         assert_near(l.t[1], 6.0, 1e-9);
         /* a step longer than a gap passes the crossing inside it: each
-         * next crossing is at least 1.5 further, so 9 (after 8) and 12.5
-         * (after 11.5) are passed */
+         * next crossing is at least 1.5 further, so 9 (after 8), 12.5
+         * (after 11.5), 14.5 and 15.5 (after 14) are passed */
         l = (crossing_log){{0}, 0, 0};
         accel_crossings(a, v3(0, 0, 0), v3(0, 0, 1), 7.5, INFINITY, 1.5, log_crossing, &l);
-        assert_int_equal(l.n, 2);
+        assert_int_equal(l.n, 4);
         assert_near(l.t[0], 8.0, 1e-9);
         assert_near(l.t[1], 11.5, 1e-9);
+        assert_near(l.t[2], 14.0, 1e-9);
+        assert_near(l.t[3], 16.0, 1e-9);
         accel_free(a);
         diag_free(d);
         scene_free(s);
