@@ -550,15 +550,17 @@ static double f_ridged_mf(const double *a, const func_env *e, int *ok)
     int gen = (int)P(5) & 3;
     double signal = P(3) - fabs(noise_at(e, p, gen, ok) * 2 - 1);
     signal *= signal;
-    double result = signal, freq = 1.0;
+    /* octave i weighs freq^-H = (lacunarity^-H)^i: one pow, then a
+     * product per octave */
+    double result = signal, step = P(2) > 1 ? pow(P(1), -P(0)) : 1.0, w = 1.0;
     for (int i = 1; i < P(2) && *ok; i++) {
-        freq *= P(1);
+        w *= step;
         p = v3_scale(p, P(1));
         double weight = signal * P(4);
         weight = weight > 1 ? 1 : (weight < 0 ? 0 : weight);
         signal = P(3) - fabs(noise_at(e, p, gen, ok) * 2 - 1);
         signal = signal * signal * weight;
-        result += signal * pow(freq, -P(0));
+        result += signal * w;
     }
     return result;
 }

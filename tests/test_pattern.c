@@ -99,6 +99,7 @@ static const pattern_case cases[] = {
     {"pigment_pattern", "pigment_pattern { checker rgb 0, rgb 1 scale 0.5 } " GREY " turbulence 0.3"},
     {"old_colour_map", "granite color_map { [0.0 0.4 color rgb 0 color rgb 0.5] [0.4 1.0 color rgb 0.5 color rgb 1] }"},
     {"function", "function { 0.3 * x * y + 0.5 * sin(2 * x) } " GREY},
+    {"ridged_mf", "function { f_ridged_mf(x, y, z, 0.07, 2.2, 7, 0.6, 0.9, 1) * 0.5 } scale 0.6 " GREY},
     {"mandel", "mandel 40 scale 0.8 translate -x*0.5 " GREY},
     {"mandel5", "mandel 30 exponent 5 exterior 6, 0.3 interior 1, 2 scale 0.7 " GREY},
     {"julia3", "julia <0.35, 0.2>, 30 exponent 3 interior 2, 1 scale 0.6 " GREY},
@@ -150,7 +151,7 @@ static int run_tiles(const pattern_case *cs, int ncases, const char *tag)
     char *src = malloc(cap);
     assert_non_null(src);
     len += (size_t)snprintf(src + len, cap - len,
-                            "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+                            "#version 3.7;\n#include \"functions.inc\"\nglobal_settings { assumed_gamma 1.0 }\n"
                             "camera { orthographic location <%g, %g, -10> direction z right x*%g up y*%g }\n",
                             ww / 2, -wh / 2, ww, wh);
     for (int i = 0; i < ncases; i++) {
