@@ -21,27 +21,21 @@
  * ComputeRefractionForPhotons): a liquid in a glass refracts against the
  * glass, not against air. */
 /* A photon going on through the surface at h along tdir: what it keeps is
- * the layers' filter and transmit and, leaving an object, the interior's
- * fade over h->t, the straight path inside (shade_tex_shadow_filter),
- * times 1 - the top layer's reflectivity kr under conserve_energy
- * (POV-Ray 3.7's photons.cpp, ComputeLightedTexture: FilCol *= 1 - reflec,
- * the photon carrying LightCol * FilCol). No (eta_i/eta_t)^2 (b.eta2, the
+ * shade_mat_photon_filter's (POV-Ray 3.7's photons.cpp, ComputeLightedTexture:
+ * the filter colour times 1 - reflectivity under conserve_energy, the
+ * photon carrying LightCol * FilCol). No (eta_i/eta_t)^2 (b.eta2, the
  * path tracer's adjoint rule): POV-Ray's photon keeps LightCol x FilCol
  * through a refraction, so a surface inside a refracting object (a floor
  * that a glass sinks into) gets the photons' full power; through a whole
  * object the two factors cancel anyway. `si` (the containers before) is
  * crossed into the step's. */
 /* The step's trace_w is POV-Ray's photon weight factor through a
- * refraction: the largest channel of that filter before the fade (photons.cpp,
- * ComputeLightedTexture: New_Weight = weight * max3(FilCol); the fade dims
- * the photon's colour only). */
+ * refraction (shade_mat_photon_filter's). */
 static gi_caustic_step through(const caustics *c, const accel_hit *h, vec3 dir, const shade_mat_bsdf *b, rgb kr,
                                shade_media_inside *si, vec3 tdir)
 {
-    rgb f = shade_tex_shadow_filter(c->sc, h, dir), fa = shade_tex_leaving_fade(h, dir);
-    if (b->ls.f && b->ls.f->conserve_energy)
-        f = (rgb){f.r * fmin(1.0, 1.0 - kr.r), f.g * fmin(1.0, 1.0 - kr.g), f.b * fmin(1.0, 1.0 - kr.b)};
-    double tw = fmax(fa.r > 0.0 ? f.r / fa.r : 0.0, fmax(fa.g > 0.0 ? f.g / fa.g : 0.0, fa.b > 0.0 ? f.b / fa.b : 0.0));
+    double tw;
+    rgb f = shade_mat_photon_filter(c->sc, h, dir, b, kr, &tw);
     shade_media_inside_cross(si, h->obj);
     gi_caustic_inside after = {0, {0}};
     after.n = si->n < GI_CAUSTIC_MAX_INSIDE ? si->n : GI_CAUSTIC_MAX_INSIDE;

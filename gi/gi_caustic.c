@@ -330,10 +330,11 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
                       adc_bailout (photons.cpp, TraceRay) */
         gi_caustic_inside in;
         double t0; /* hits from here on (0: the self-intersection distance) */
+        double tp; /* the last pass_through surface crossed along this ray (0: none) */
     } branch;
     branch stack[2 * GI_CAUSTIC_MAX_BOUNCES + 4];
     int ns = 0;
-    stack[ns++] = (branch){o, w, {0}, 0, 0, 0.0, 1.0, {1, 1, 1}, 1.0, {0, {0}}, 0.0};
+    stack[ns++] = (branch){o, w, {0}, 0, 0, 0.0, 1.0, {1, 1, 1}, 1.0, {0, {0}}, 0.0, 0.0};
     vec3 p_first = o;
     int passes = 0;
     while (ns > 0) {
@@ -349,8 +350,10 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
              * that the photon crosses towards it (POV-Ray's PhotonTrace) */
             if (!in_target(cb, h.obj)) {
                 gi_caustic_step st;
+                accel_hit hp = h; /* its fade over the way since the surface before */
+                hp.t = h.t - br.tp;
                 if (!(h.obj && h.obj->photons && h.obj->photons->pass_through) || !c->hk.pass ||
-                    ++passes > ACCEL_PASS_MAX || !c->hk.pass(c->hk.ctx, &h, br.w, &br.in, &st))
+                    ++passes > ACCEL_PASS_MAX || !c->hk.pass(c->hk.ctx, &hp, br.w, &br.in, &st))
                     return;
                 rgb tr = crgb(br.tr.r * st.weight.r, br.tr.g * st.weight.g, br.tr.b * st.weight.b);
                 double tw = br.tw * st.trace_w;
@@ -359,7 +362,7 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
                  * hit as accel_intersect_past steps (an isosurface's
                  * crossings, found from the ray's start, stay the same) */
                 stack[ns++] = (branch){br.o, br.w, br.from, br.has_from, 0, br.depth, br.rho_p, tr, tw, st.inside,
-                                       h.t + fmax(c->eps, h.t * 1e-7)};
+                                       h.t + fmax(c->eps, h.t * 1e-7), h.t};
                 continue;
             }
             out->first_hits++;
@@ -405,7 +408,7 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
             if (!(tw >= c->adc) || !(cmax3(tr) > 0.0) || !isfinite(tr.r + tr.g + tr.b)) continue;
             if (ns >= (int)(sizeof stack / sizeof stack[0])) continue;
             stack[ns++] = (branch){st->org, st->dir, st->from, 1, level + 1, depth,
-                                   br.rho_p * fmin(1.0, fmax(st->rho, 1e-6)), tr, tw, st->inside, 0.0};
+                                   br.rho_p * fmin(1.0, fmax(st->rho, 1e-6)), tr, tw, st->inside, 0.0, 0.0};
             went = 1;
         }
         if (went) out->alive[level + 1]++;

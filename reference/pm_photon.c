@@ -35,11 +35,16 @@
 #include "shade_material.h"
 
 #define CHUNK 1024
-/* Photon rays pass photons { pass_through } objects (photons go through
- * them unchanged); first hits seen from a POV-Ray light pass no_shadow
- * objects too, as shade.c's shadow rays do. */
+/* photons { pass_through } is POV-Ray's rule for its lights' photons: a
+ * light's photon goes straight through such objects before its first hit,
+ * filtered by each surface (POV-Ray 3.7 builds photons.cpp with
+ * PT_FILTER_BEFORE_TARGET; shade_mat_photon_filter, as the caustic layer
+ * does), and meets them as any other object afterwards. Emitted and sky
+ * photons, which stand for gathered (radiosity) light, pass them unchanged.
+ * First hits seen from a POV-Ray light pass no_shadow objects too, as
+ * shade.c's shadow rays do. */
 #define PHOTON_SKIP ACCEL_SKIP_PASS_THROUGH
-#define LIGHT_SKIP (OBJ_NO_SHADOW | ACCEL_SKIP_PASS_THROUGH)
+#define LIGHT_SKIP OBJ_NO_SHADOW
 /* Termination that does not depend on the albedo: from bounce RR_BOUNCES on,
  * a path survives each further bounce with probability RR_SURVIVE and its
  * power is divided by it (unbiased); with albedo 1 the material's roulette
@@ -131,6 +136,30 @@ static int caustic_bounce_ok(const scene_light *l, const accel_hit *h, int lobe)
 
 static int is_target(const scene_object *o) { return o->photons && o->photons->target; }
 
+/* The first hit of a light's photon from o along unit w (LIGHT_SKIP), its
+ * power *phi filtered by the pass_through objects crossed on the way (the
+ * rule above; each surface's fade over the way since the one before, the
+ * ray kept from o). Returns 1 on a hit, 0 when the photon left the scene
+ * or was filtered out. */
+static int light_first_hit(const trace_ctx *c, vec3 o, vec3 w, accel_hit *h, rgb *phi, long *rays)
+{
+    double tmin = c->eps, tprev = 0.0;
+    for (int k = 0; k < ACCEL_PASS_MAX; k++) {
+        if (accel_intersect_past(c->a, NULL, o, w, tmin, LIGHT_SKIP, h, rays) <= 0) return 0;
+        if (!(h->obj && h->obj->photons && h->obj->photons->pass_through)) return 1;
+        accel_hit hp = *h;
+        hp.t = h->t - tprev;
+        shade_mat_bsdf b;
+        shade_mat_setup(&b, c->sc, &hp, w, c->eps, NULL);
+        rgb f = shade_mat_photon_filter(c->sc, &hp, w, &b, b.k[SHADE_MAT_LOBE_REFLECT], NULL);
+        *phi = crgb(phi->r * f.r, phi->g * f.g, phi->b * f.b);
+        if (!(cmax(*phi) > 0.0) || !isfinite(phi->r + phi->g + phi->b)) return 0;
+        tprev = h->t;
+        tmin = h->t + fmax(c->eps, h->t * 1e-7);
+    }
+    return 0;
+}
+
 /* A photon of a beam (a cylinder light, or a parallel light over the
  * scene): from a uniform point of the disc of radius R about `centre`
  * across `axis`, along `dir`; its first hit and its power (one of n over
@@ -141,13 +170,14 @@ static int beam_photon(const trace_ctx *c, const scene_light *l, vec3 centre, ve
     double u1 = rng_f64(r), u2 = rng_f64(r);
     *o = disc_point(centre, axis, R, u1, u2);
     *w = dir;
-    if (accel_intersect_past(c->a, NULL, *o, dir, c->eps, LIGHT_SKIP, h, rays) <= 0) return 0;
+    rgb f = {1.0, 1.0, 1.0};
+    if (!light_first_hit(c, *o, dir, h, &f, rays)) return 0;
     vec3 dl;
     double depth;
     shade_light_ray(l, l->position, h->p, &dl, &depth);
     double att = shade_light_attenuation(l, h->p, dl, depth);
     double k = M_PI * att * M_PI * R * R / n;
-    *phi = crgb(l->colour.r * k, l->colour.g * k, l->colour.b * k);
+    *phi = crgb(l->colour.r * k * f.r, l->colour.g * k * f.g, l->colour.b * k * f.b);
     return 1;
 }
 
@@ -180,14 +210,15 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         *w = cone_dir(axis, cos_max, u1, u2);
         double pdf = 1.0 / (2.0 * M_PI * (1.0 - cos_max));
         *o = q;
-        if (accel_intersect_past(c->a, NULL, q, *w, c->eps, LIGHT_SKIP, h, rays) <= 0) return 0;
+        rgb f = {1.0, 1.0, 1.0};
+        if (!light_first_hit(c, q, *w, h, &f, rays)) return 0;
         vec3 dl;
         double depth;
         shade_light_ray(l, q, h->p, &dl, &depth);
         double att = shade_light_attenuation(l, h->p, dl, depth);
         double d = v3_len(v3_sub(h->p, q));
         double k = M_PI * att * d * d / (n * pdf);
-        *phi = crgb(C.r * k, C.g * k, C.b * k);
+        *phi = crgb(C.r * k * f.r, C.g * k * f.g, C.b * k * f.b);
         return 1;
     }
     if (src->kind == SRC_EMIT) {
@@ -263,7 +294,8 @@ static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume,
     } else {
         L = *resume;
         r = L.r;
-        if (accel_intersect_past(c->a, L.from.obj ? &L.from : NULL, L.o, L.w, c->eps, L.skip | PHOTON_SKIP, &h, rays) <= 0) {
+        unsigned pass = c->src[L.source].kind == SRC_LIGHT ? 0u : PHOTON_SKIP;
+        if (accel_intersect_past(c->a, L.from.obj ? &L.from : NULL, L.o, L.w, c->eps, L.skip | pass, &h, rays) <= 0) {
             if (fn) fn(fctx, index, &L, NULL, none);
             return;
         }
@@ -272,6 +304,7 @@ static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume,
     vec3 w = L.w;
     rgb phi = L.phi;
     int from_light = src->kind == SRC_LIGHT;
+    unsigned pass = from_light ? 0u : PHOTON_SKIP; /* the pass_through rule above */
     int store_first = src->kind == SRC_ENV || (src->kind == SRC_EMIT && c->s->emitters_first);
     int spec_only = L.spec_only;
     int nd = L.nd;
@@ -345,7 +378,7 @@ static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume,
         L.bounce = bounce + 1;
         L.nd = nd;
         L.spec_only = spec_only;
-        if (accel_intersect_past(c->a, &b.from, s.org, w, c->eps, L.skip | PHOTON_SKIP, &h, rays) <= 0) {
+        if (accel_intersect_past(c->a, &b.from, s.org, w, c->eps, L.skip | pass, &h, rays) <= 0) {
             if (fn) fn(fctx, index, &L, NULL, none);
             return;
         }

@@ -536,3 +536,13 @@ rgb shade_mat_light_nee(const shade_mat_bsdf *b, const shade_light_ctx *c, const
     }
     return total;
 }
+
+rgb shade_mat_photon_filter(const scene *sc, const accel_hit *h, vec3 dir, const shade_mat_bsdf *b, rgb kr, double *trace_w)
+{
+    rgb f = shade_tex_shadow_filter(sc, h, dir), fa = shade_tex_leaving_fade(h, dir);
+    if (b->ls.f && b->ls.f->conserve_energy)
+        f = (rgb){f.r * fmin(1.0, 1.0 - kr.r), f.g * fmin(1.0, 1.0 - kr.g), f.b * fmin(1.0, 1.0 - kr.b)};
+    if (trace_w)
+        *trace_w = fmax(fa.r > 0.0 ? f.r / fa.r : 0.0, fmax(fa.g > 0.0 ? f.g / fa.g : 0.0, fa.b > 0.0 ? f.b / fa.b : 0.0));
+    return f;
+}

@@ -168,6 +168,20 @@ int shade_mat_sample_glossy(const shade_mat_bsdf *b, double u0, double u1, doubl
 
 int shade_mat_sample(const shade_mat_bsdf *b, rng *r, int absorb, shade_mat_scatter *s);
 
+/* What a POV-Ray photon keeps going on through the surface of b (set up at
+ * h for dir) without reflecting: the layers' filter and transmit and,
+ * leaving an object, the interior's fade over h->t, the way inside
+ * (shade_tex_shadow_filter), times 1 - kr per channel under the top
+ * layer's conserve_energy (POV-Ray 3.7's photons.cpp,
+ * ComputeLightedTexture: the photon carries LightCol x FilCol, FilCol
+ * scaled by 1 - reflectivity). kr: the reflectivity the surface's
+ * reflection takes. *trace_w (NULL: not wanted): POV-Ray's ray-weight
+ * factor, the filter's largest channel before the fade (New_Weight =
+ * weight x max3(FilCol); the fade dims the colour only). The caustic
+ * layer's refractions and pass_through crossings and pmfg's photons
+ * through pass_through objects use it. */
+rgb shade_mat_photon_filter(const scene *sc, const accel_hit *h, vec3 dir, const shade_mat_bsdf *b, rgb kr, double *trace_w);
+
 /* Cosine-weighted direction about unit n for (u1, u2) in [0,1)^2 (Malley:
  * uniform on the disc, projected up); pdf cos/pi. */
 vec3 shade_mat_cosine_dir(vec3 n, double u1, double u2);
