@@ -740,43 +740,66 @@ rgb shade_media_shadow_rest(const scene *sc, const shade_media_env *e, const sce
     return c;
 }
 
+typedef struct {
+    const scene *sc;
+    const shade_media_env *e;
+    vec3 p, dir;
+    double tmin, t0; /* t0: just past the last crossing (accel_crossings' step), tmin before the first */
+    double prev;     /* where the current segment starts */
+    int atmos;
+    shade_media_inside in;
+    rgb c;
+} media_shadow_walk;
+
+static int media_shadow_crossing(void *ctx, const accel_hit *h)
+{
+    media_shadow_walk *w = ctx;
+    double t0 = w->t0;
+    w->t0 = h->t + fmax(w->tmin, h->t * 1e-7);
+    if (h->flags & OBJ_NO_SHADOW) return 1;
+    const scene *sc = w->sc;
+    accel_hit hh = *h;
+    hh.t = h->t - (t0 > w->tmin ? t0 - fmax(w->tmin, t0 * 1e-7) : 0.0);
+    rgb f = shade_tex_shadow_filter(sc, &hh, w->dir);
+    if (fabs(f.r) < MEDIA_EPSILON && fabs(f.g) < MEDIA_EPSILON && fabs(f.b) < MEDIA_EPSILON) {
+        w->c = mk(0, 0, 0);
+        return 0;
+    }
+    vec3 q = v3_madd(w->p, w->dir, w->prev);
+    double len = h->t - w->prev;
+    int hollow = shade_media_inside_hollow(&w->in);
+    /* the containers' media over the segment (a hollow ray) */
+    if (w->in.n > 0 && hollow && shade_media_inside_has_media(&w->in))
+        f = shade_media_segment(w->e, SHADE_MEDIA_INTERIOR, &w->in, q, w->dir, len, f, 1);
+    w->c = mul(w->c, f);
+    /* POV-Ray applies the atmosphere before every surface crossed (each
+     * object has an interior there); fog only while hollow */
+    if (w->atmos && !is_zero(w->c)) {
+        if (sc->natmosphere) w->c = shade_media_segment(w->e, SHADE_MEDIA_ATMOSPHERE, &w->in, q, w->dir, len, w->c, 1);
+        if (sc->fogs && hollow) w->c = mul(w->c, shade_atmos_fog_attenuation(sc, q, w->dir, len));
+    }
+    if (fabs(w->c.r) < MEDIA_EPSILON && fabs(w->c.g) < MEDIA_EPSILON && fabs(w->c.b) < MEDIA_EPSILON) {
+        w->c = mk(0, 0, 0);
+        return 0;
+    }
+    shade_media_inside_cross(&w->in, h->obj);
+    w->prev = h->t;
+    return 1;
+}
+
 rgb shade_media_shadow_ray(const scene *sc, const accel *a, const shade_media_env *e, const scene_light *l, vec3 p, vec3 dir,
                      double tmin, double tmax, const shade_media_inside *in0, double *rest)
 {
-    rgb c = {1, 1, 1};
-    shade_media_inside in = *in0;
-    int atmos = l && l->media_interaction && l->media_attenuation;
-    accel_hit h;
-    double t0 = tmin, prev = 0.0; /* prev: where the current segment starts */
-    if (rest) *rest = tmax;
-    for (int k = 0; k < 256 && t0 < tmax; k++) {
-        if (!accel_intersect(a, p, dir, t0, tmax, &h)) break;
-        double next = h.t + fmax(tmin, h.t * 1e-7);
-        if (!(h.flags & OBJ_NO_SHADOW)) {
-            accel_hit hh = h;
-            hh.t = h.t - (t0 > tmin ? t0 - fmax(tmin, t0 * 1e-7) : 0.0);
-            rgb f = shade_tex_shadow_filter(sc, &hh, dir);
-            if (fabs(f.r) < MEDIA_EPSILON && fabs(f.g) < MEDIA_EPSILON && fabs(f.b) < MEDIA_EPSILON) return mk(0, 0, 0);
-            vec3 q = v3_madd(p, dir, prev);
-            double len = h.t - prev;
-            int hollow = shade_media_inside_hollow(&in);
-            /* the containers' media over the segment (a hollow ray) */
-            if (in.n > 0 && hollow && shade_media_inside_has_media(&in)) f = shade_media_segment(e, SHADE_MEDIA_INTERIOR, &in, q, dir, len, f, 1);
-            c = mul(c, f);
-            /* POV-Ray applies the atmosphere before every surface crossed
-             * (each object has an interior there); fog only while hollow */
-            if (atmos && !is_zero(c)) {
-                if (sc->natmosphere) c = shade_media_segment(e, SHADE_MEDIA_ATMOSPHERE, &in, q, dir, len, c, 1);
-                if (sc->fogs && hollow) c = mul(c, shade_atmos_fog_attenuation(sc, q, dir, len));
-            }
-            if (fabs(c.r) < MEDIA_EPSILON && fabs(c.g) < MEDIA_EPSILON && fabs(c.b) < MEDIA_EPSILON) return mk(0, 0, 0);
-            shade_media_inside_cross(&in, h.obj);
-            prev = h.t;
-            if (rest) *rest = tmax - prev;
-        }
-        t0 = next;
-    }
+    media_shadow_walk w = {sc, e, p, dir, tmin, tmin, 0.0, l && l->media_interaction && l->media_attenuation, *in0,
+                           {1, 1, 1}};
+    /* every surface crossed, each the nearest just past the one before,
+     * from one traversal where the scene allows (accel_crossings) */
+    accel_crossings(a, p, dir, tmin, tmax, tmin, media_shadow_crossing, &w);
+    /* past the last surface that let light through (a blocked sample's
+     * too: its way is what an area light's last sample leaves) */
+    if (rest) *rest = tmax - w.prev;
+    if (is_zero(w.c)) return w.c;
     /* the rest of the way to the light: the atmosphere (a hollow ray) */
-    if (!rest && tmax > prev) c = shade_media_shadow_rest(sc, e, l, &in, v3_madd(p, dir, prev), dir, tmax - prev, c);
-    return c;
+    if (!rest && tmax > w.prev) return shade_media_shadow_rest(sc, e, l, &w.in, v3_madd(p, dir, w.prev), dir, tmax - w.prev, w.c);
+    return w.c;
 }
