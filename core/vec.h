@@ -29,9 +29,12 @@ static inline vec3 v3_norm(vec3 a)
  * (minsd/maxsd on ordered arguments: the second one when the two compare
  * equal, so also for +0 and -0; the number when one is a NaN): libm's are
  * calls, which the compiler may not replace under IEEE NaN rules, and the
- * box and interval tests of a render make millions of them. */
-static inline double fmin_inline(double a, double b) { return (a < b || b != b) ? a : b; }
-static inline double fmax_inline(double a, double b) { return (a > b || b != b) ? a : b; }
+ * box and interval tests of a render make millions of them. Written so
+ * that the compiler emits one minsd/maxsd after a NaN test that is never
+ * taken in practice (a select of a or b on a < b || b != b became two
+ * branches, one of them unpredictable). */
+static inline double fmin_inline(double a, double b) { return b != b ? a : (a < b ? a : b); }
+static inline double fmax_inline(double a, double b) { return b != b ? a : (a > b ? a : b); }
 static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fmin_inline(a.x, b.x), fmin_inline(a.y, b.y), fmin_inline(a.z, b.z)); }
 static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fmax_inline(a.x, b.x), fmax_inline(a.y, b.y), fmax_inline(a.z, b.z)); }
 static inline double v3_maxc(vec3 a) { return fmax_inline(a.x, fmax_inline(a.y, a.z)); }
