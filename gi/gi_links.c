@@ -42,6 +42,7 @@ typedef struct {
     int nlights;
     int exact;            /* view points with no bounce after the hit: every hit takes hit_light */
     float *reach;         /* per source (i - first): the harmonic mean of its rays' hit distances */
+    int points;           /* the sources are the final gather's points, not particles */
     void *lscene;         /* the link scene built here, or NULL */
     int threads;          /* buffers */
 } link_job;
@@ -471,7 +472,7 @@ static void job(void *ctx, int index, int thread)
                 if (target < 0) {
                     unres++;
                     if (hit) hit_light(J, &rh[m], 1, 1, &memo, sky);
-                } else if (J->first > 0 && J->esky) {
+                } else if (J->points && J->esky) {
                     /* the emission where it hit; the particle's reflected
                      * light, direct and indirect, follows in the regather */
                     hit_light(J, &rh[m], 0, 0, &memo, sky);
@@ -632,7 +633,10 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
     J.pin = pobj ? pin : NULL;
     J.n = n;
     J.first = first > 0 && first <= n ? first : 0;
-    J.reach = J.first > 0 ? reach : NULL;
+    /* points: sources after the particles, or a reach wanted for each
+     * (the final gather's points, when there are no particles at all) */
+    J.points = J.first > 0 || reach;
+    J.reach = J.points ? reach : NULL;
     int k = nside * nside;
     J.per_job = k >= RAYS_PER_CALL ? 1 : RAYS_PER_CALL / k;
     J.seed = seed;
@@ -650,8 +654,8 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
     /* the far field's direct light: only for the final gather's points,
      * whose links are traced again for every view; the particles' links
      * are geometry and outlive a change of the lights (relighting) */
-    if (rc == PT_OK && J.esky && J.first > 0) rc = job_lights(&J, sc);
-    J.exact = J.esky && J.first > 0 && !(J.far_bounce > 0.0f);
+    if (rc == PT_OK && J.esky && J.points) rc = job_lights(&J, sc);
+    J.exact = J.esky && J.points && !(J.far_bounce > 0.0f);
     if (rc == PT_OK && n > 0 && !pool_run_counted(threads, (n - J.first + J.per_job - 1) / J.per_job, job, &J, cancel, prog))
         rc = PT_CANCELLED;
     job_close(&J);

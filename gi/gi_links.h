@@ -66,9 +66,10 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
                          const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce,
                          float *reach);
 
-/* reach (may be NULL; with first > 0): a float per point (i - first), the
- * harmonic mean distance of its rays' hits (INFINITY when none hit), how
- * far its gather may be reused (gi_particle_gather.c). */
+/* reach (may be NULL): a float per point (i - first), the harmonic mean
+ * distance of its rays' hits (INFINITY when none hit), how far its gather
+ * may be reused (gi_particle_gather.c); given, the sources are points to
+ * gather at (as with first > 0) even when first is 0 (no particles). */
 
 /* The gatherer: the final gather's exact form (no bounce after the hit,
  * as gi_links_build's points with far_bounce 0) at one point at a time,

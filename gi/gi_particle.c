@@ -519,8 +519,9 @@ gi_particle *gi_particle_begin(const scene *sc, const accel *a, const gi_particl
      * that size the driver's start-up and program build cost more than
      * the kernels themselves (bench/gi_vs_povray.sh's small scenes; the
      * stats' kernel_build), and a GPU would not pay back its transfers. */
-    if ((!o.spec || !*o.spec || !strcmp(o.spec, "auto")) && set->count < GI_CL_AUTO_MIN_PARTICLES && !set->cl_source &&
-        !set->cl_max_bytes)
+    gp->final_only = gi_particle_final_only(set);
+    if ((!o.spec || !*o.spec || !strcmp(o.spec, "auto")) &&
+        (set->count < GI_CL_AUTO_MIN_PARTICLES || gp->final_only) && !set->cl_source && !set->cl_max_bytes)
         o.spec = "c";
     gp->dev = gi_dev_open(&o, d, &st);
     if (!gp->dev) {
@@ -533,7 +534,14 @@ gi_particle *gi_particle_begin(const scene *sc, const accel *a, const gi_particl
 
     progress_stage(set->progress, "gi geometry: surfaces", 0);
     double tg = timer_now();
-    gp->surf = gi_surface_build(set->camera ? &gp->gsc : sc, a, 1e30, gp->threads, d, &st);
+    /* final_only: the surfaces of no object (the clip box, which the
+     * hook's far field asks, comes from the scene's bounds), so no
+     * particle is placed */
+    if (gp->final_only) {
+        if (!set->camera) gp->gsc = *sc;
+        gp->gsc.nobjects = 0;
+    }
+    gp->surf = gi_surface_build(set->camera || gp->final_only ? &gp->gsc : sc, a, 1e30, gp->threads, d, &st);
     if (!gp->surf) {
         *status = st == PT_OK ? PT_ERR_INTERNAL : st;
         gi_particle_free(gp);

@@ -41,7 +41,8 @@ typedef struct {
     int32_t scatter_side, gather_side, bounces, scatter;
     double tess, tess_factor, radius, radius_factor, normal_cos, brightness;
     uint64_t seed;
-    int32_t no_rp, pad; /* made without radiance particles (the final gather's runs) */
+    int32_t no_rp;      /* made without radiance particles (the final gather's runs) */
+    int32_t final_only; /* made without particles at all (gi_particle_final_only) */
 } cache_settings;
 
 typedef struct {
@@ -71,6 +72,7 @@ static cache_settings settings_of(const gi_particle_settings *s)
     c.brightness = s->brightness;
     c.seed = s->seed;
     c.no_rp = s->view_gather_side > 0 && s->keep_hits;
+    c.final_only = gi_particle_final_only(s);
     return c;
 }
 
@@ -193,6 +195,7 @@ static const char *settings_differ(const cache_settings *a, const cache_settings
     if (a->scatter != b->scatter) return "scattering mode";
     if (a->seed != b->seed) return "seed";
     if (a->no_rp != b->no_rp) return "final gather (radiance particles)";
+    if (a->final_only != b->final_only) return "final gather (no particles)";
     if (memcmp(a, b, sizeof *a) != 0) return "tessellation, list radius, normal threshold or brightness";
     return NULL;
 }

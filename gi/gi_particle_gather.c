@@ -202,10 +202,7 @@ static pt_status build_index(gi_particle *gp)
 /* Whether the final gather takes POV-Ray's reuse test (reusable): with a
  * scene's error_bound and no bounce after the gather's hits, where a hit
  * that no point may answer can gather itself (the gatherer). */
-static int reuse_test(const gi_particle *gp)
-{
-    return gp->set.reuse_error > 0.0 && !(gp->set.bounces >= 1 && gp->set.brightness > 0.0);
-}
+static int reuse_test(const gi_particle *gp) { return gi_particle_exact_gather(&gp->set); }
 
 /* Whether gather point pt may answer a hit at p with normal ng (length
  * lg) that is not kept, by POV-Ray's test for reusing an irradiance cache
@@ -446,7 +443,8 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
     (void)d;
     gi_particle_view_gather_free(gp);
     int side = gp->set.view_gather_side, s = gp->set.view_gather_stride > 0 ? gp->set.view_gather_stride : 2;
-    if (side <= 0 || !gp->vrec || gp->vw <= 0 || gp->vh <= 0 || !gp->lout || gp->ps.n <= 0) return PT_OK;
+    if (side <= 0 || !gp->vrec || gp->vw <= 0 || gp->vh <= 0 || !gp->lout || (gp->ps.n <= 0 && !gp->final_only))
+        return PT_OK;
     int w = gp->vw, h = gp->vh;
     size_t npix = (size_t)w * (size_t)h;
     pt_status st = PT_OK;

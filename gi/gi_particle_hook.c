@@ -268,7 +268,8 @@ rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
     const scene_finish *f = &tex->finish;
     if (f->diffuse_back != 0.0 && f->diffuse > 0.0) {
         rgb back;
-        if (side_value(gp, hit, v3_neg(n), tc, &back)) {
+        if (gp->final_only ? gi_particle_gather_here(gp, hit, v3_neg(n), thread, &back)
+                           : side_value(gp, hit, v3_neg(n), tc, &back)) {
             double k = f->diffuse_back / f->diffuse;
             out.r += k * back.r;
             out.g += k * back.g;

@@ -53,6 +53,7 @@ struct gi_particle {
     int nwalk;
     gi_lists lists;
     int no_rp;      /* no radiance particles (the final gather answers the kept hits): lists empty */
+    int final_only; /* gi_particle_final_only: no particles at all, the final gather answers every hit */
     gi_grid *rgrid; /* particles by list radius: estimates on surfaces without radiance particles */
     gi_dev *dev;
     /* lighting */
@@ -182,6 +183,23 @@ void gi_particle_rp_far_field(gi_particle *gp, long l);
 /* A scene light as the kernels read it (gi_types.h: gi_light_ray,
  * gi_light_attenuation); the vertex links (gi_vlinks.c) light with it too. */
 void gi_light_pack(const scene_light *l, gi_dev_light *o);
+
+/* Whether the final gather is exact (no bounce after its hits: POV-Ray's
+ * recursion_limit 1) and takes POV-Ray's reuse test, so that a hit no
+ * gathered point may answer gathers itself (gi_particle_gather.c). */
+static inline int gi_particle_exact_gather(const gi_particle_settings *s)
+{
+    return s->reuse_error > 0.0 && !(s->bounces >= 1 && s->brightness > 0.0);
+}
+
+/* Whether the geometry stage builds no particles: the gather is exact and
+ * answers the kept hits (keep_hits) and every other hit (the gatherer),
+ * so no particle's light would reach the image; the particles' surfaces,
+ * links and lighting would be work for nothing. */
+static inline int gi_particle_final_only(const gi_particle_settings *s)
+{
+    return gi_particle_exact_gather(s) && s->view_gather_side > 0 && s->keep_hits;
+}
 
 /* gi_particle_gather.c: the final gather at the kept hits */
 typedef struct vg_cell {
