@@ -1032,7 +1032,7 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
 /* accel_crossings in one traversal: possible when every geometry is user
  * geometry (the callback collects; triangles would need a filter). */
 #define CROSS_MAX 256
-static int crossings_collected(const accel *a, vec3 org, vec3 dir, double t0, double tmax, double step,
+static int crossings_collected(const accel *a, vec3 org, vec3 dir, double t0, double tmax, double step, unsigned skip,
                                accel_crossing *cr)
 {
     if (a->has_tri_geoms) return -1;
@@ -1042,6 +1042,7 @@ static int crossings_collected(const accel *a, vec3 org, vec3 dir, double t0, do
     q.maxcross = CROSS_MAX;
     q.ctmax = tmax;
     q.cstep = step;
+    q.cskip = skip;
     struct RTCRayHit rh;
     fill_rtc_ray(&rh.ray, org, dir, t0, tmax);
     rh.hit.geomID = rh.hit.primID = rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
@@ -1060,15 +1061,15 @@ static int crossings_collected(const accel *a, vec3 org, vec3 dir, double t0, do
     return q.ncross;
 }
 
-int accel_crossings(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, accel_crossing_fn fn,
-                    void *ctx)
+int accel_crossings_skip(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, unsigned skip,
+                         accel_crossing_fn fn, void *ctx)
 {
     if (!a || !ray_ok(org, dir)) return 0;
     double t0 = eps_rule(a->eps_scale, org, v3_len(dir));
     if (tmin > t0) t0 = tmin;
     if (!(tmax > t0)) return 0;
     accel_crossing cr[CROSS_MAX];
-    int n = crossings_collected(a, org, dir, t0, tmax, step, cr), visited = 0;
+    int n = crossings_collected(a, org, dir, t0, tmax, step, skip, cr), visited = 0;
     accel_hit h;
     if (n >= 0) {
         /* the same crossings as the loop below: each the nearest past the
@@ -1078,19 +1079,27 @@ int accel_crossings(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
             geom_csg_hit g = {.t = cr[i].t, .part = cr[i].part, .shape = cr[i].shape, .flip = cr[i].flip};
             fill_user(a, cr[i].prim, &g, org, dir, &h);
             if (!isfinite(h.t) || !v3_finite(h.p)) continue;
+            t0 = h.t + fmax(step, h.t * 1e-7);
+            if (h.flags & skip) continue; /* a member's own flag */
             visited++;
             if (!fn(ctx, &h)) break;
-            t0 = h.t + fmax_inline(step, h.t * 1e-7);
         }
         return visited;
     }
     for (int k = 0; k < CROSS_MAX && t0 < tmax; k++) {
         if (!intersect_at(a, org, dir, t0, tmax, &h)) break;
+        t0 = h.t + fmax(step, h.t * 1e-7);
+        if (h.flags & skip) continue;
         visited++;
         if (!fn(ctx, &h)) break;
-        t0 = h.t + fmax_inline(step, h.t * 1e-7);
     }
     return visited;
+}
+
+int accel_crossings(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, accel_crossing_fn fn,
+                    void *ctx)
+{
+    return accel_crossings_skip(a, org, dir, tmin, tmax, step, 0u, fn, ctx);
 }
 
 /* Contacts (accel_intersect_from): inside the self-intersection distance

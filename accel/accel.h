@@ -74,6 +74,13 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
 typedef int (*accel_crossing_fn)(void *ctx, const accel_hit *h);
 int accel_crossings(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, accel_crossing_fn fn,
                     void *ctx);
+/* accel_crossings without the crossings of objects whose effective flags
+ * carry one of `skip` (OBJ_NO_SHADOW for shadow rays: POV-Ray's shadow
+ * rays do not test such objects, trace.cpp's NoShadowFlagRayObjectCondition,
+ * so the next crossing's distance counts from the last one reported); in
+ * the one-traversal walk such primitives are not asked at all. */
+int accel_crossings_skip(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, unsigned skip,
+                         accel_crossing_fn fn, void *ctx);
 /* Mutual visibility of two surface points for density estimates: 1 when
  * the segment from x + lift*nx to y + lift*ny (lift = 16 eps) crosses no
  * object for which same(obj, ctx) is 0; crossings of "same" objects are

@@ -120,6 +120,7 @@ typedef struct {
     accel_crossing *cross;
     int ncross, maxcross, overflow;
     double ctmax, cstep;
+    unsigned cskip; /* primitives whose effective flags carry one of these are not asked */
 } accel_query;
 
 /* The query of this thread (the callbacks tell our context from a plain

@@ -382,6 +382,7 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
         double tmin;
         user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
         if (exact && q->cross) {
+            if (q->cskip && (prim_flags(a, args->primID) & q->cskip)) continue;
             if (cross_leaf_once(a, args->primID, o, d, tmin, q)) continue;
             for (double from = tmin; from < q->ctmax;) {
                 geom_csg_hit h;

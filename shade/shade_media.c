@@ -794,7 +794,7 @@ rgb shade_media_shadow_ray(const scene *sc, const accel *a, const shade_media_en
                            {1, 1, 1}};
     /* every surface crossed, each the nearest just past the one before,
      * from one traversal where the scene allows (accel_crossings) */
-    accel_crossings(a, p, dir, tmin, tmax, tmin, media_shadow_crossing, &w);
+    accel_crossings_skip(a, p, dir, tmin, tmax, tmin, OBJ_NO_SHADOW, media_shadow_crossing, &w);
     /* past the last surface that let light through (a blocked sample's
      * too: its way is what an area light's last sample leaves) */
     if (rest) *rest = tmax - w.prev;

@@ -757,6 +757,6 @@ rgb shade_tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, doub
                          const scene_light *photon_light)
 {
     shadow_walk w = {sc, photon_light, dir, tmin, tmin, {1, 1, 1}};
-    accel_crossings(a, p, dir, tmin, tmax, tmin, shadow_crossing, &w);
+    accel_crossings_skip(a, p, dir, tmin, tmax, tmin, OBJ_NO_SHADOW, shadow_crossing, &w);
     return w.c;
 }

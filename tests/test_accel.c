@@ -1000,7 +1000,8 @@ static void test_crossings(void **st)
         diag *d = diag_new();
         sphere(s, v3(0, 0, 5), 1);                 /* 4, 6 */
         box(s, v3(-1, -1, 8), v3(1, 1, 9));        /* 8, 9 */
-        sphere(s, v3(0, 0, 12), 0.5);              /* 11.5, 12.5 */
+        scene_object *ns = sphere(s, v3(0, 0, 12), 0.5); /* 11.5, 12.5; no_shadow */
+        ns->flags |= OBJ_NO_SHADOW;
         /* a hollow ball (geom_csg_crossings' one search per member): 14, 14.5, 15.5, 16 */
         scene_object *hb = csg(s, SHAPE_DIFFERENCE, 2, 1);
         hb->u.csg.kids[0] = msphere(s, v3(0, 0, 15), 1);
@@ -1034,6 +1035,19 @@ static void test_crossings(void **st)
         assert_near(l.t[1], 11.5, 1e-9);
         assert_near(l.t[2], 14.0, 1e-9);
         assert_near(l.t[3], 16.0, 1e-9);
+        /* skipping no_shadow objects: 11.5 and 12.5 are not reported, and
+         * with a step of 1.5 the crossing after 9 is 14 */
+        l = (crossing_log){{0}, 0, 0};
+        assert_int_equal(accel_crossings_skip(a, v3(0, 0, 0), v3(0, 0, 1), 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW,
+                                              log_crossing, &l), n - 2);
+        for (int i = 0, j = 0; i < n; i++)
+            if (all[with_tri][i] != 11.5 && all[with_tri][i] != 12.5) assert_near(l.t[j++], all[with_tri][i], 1e-9);
+        l = (crossing_log){{0}, 0, 0};
+        accel_crossings_skip(a, v3(0, 0, 0), v3(0, 0, 1), 8.5, INFINITY, 1.5, OBJ_NO_SHADOW, log_crossing, &l);
+        assert_int_equal(l.n, 3);
+        assert_near(l.t[0], 9.0, 1e-9);
+        assert_near(l.t[1], 14.0, 1e-9);
+        assert_near(l.t[2], 16.0, 1e-9);
         accel_free(a);
         diag_free(d);
         scene_free(s);
