@@ -754,12 +754,11 @@ typedef struct {
 static int media_shadow_crossing(void *ctx, const accel_hit *h)
 {
     media_shadow_walk *w = ctx;
-    double t0 = w->t0;
-    w->t0 = h->t + fmax(w->tmin, h->t * 1e-7);
+    double depth = shade_tex_crossing_depth(&w->t0, w->tmin, h->t);
     if (h->flags & OBJ_NO_SHADOW) return 1;
     const scene *sc = w->sc;
     accel_hit hh = *h;
-    hh.t = h->t - (t0 > w->tmin ? t0 - fmax(w->tmin, t0 * 1e-7) : 0.0);
+    hh.t = depth;
     rgb f = shade_tex_shadow_filter(sc, &hh, w->dir);
     if (fabs(f.r) < MEDIA_EPSILON && fabs(f.g) < MEDIA_EPSILON && fabs(f.b) < MEDIA_EPSILON) {
         w->c = mk(0, 0, 0);

@@ -731,11 +731,17 @@ typedef struct {
     rgb c;
 } shadow_walk;
 
+double shade_tex_crossing_depth(double *t0, double tmin, double t)
+{
+    double prev = *t0;
+    *t0 = t + fmax_inline(tmin, t * 1e-7);
+    return t - (prev > tmin ? prev - fmax_inline(tmin, prev * 1e-7) : 0.0);
+}
+
 static int shadow_crossing(void *ctx, const accel_hit *h)
 {
     shadow_walk *w = ctx;
-    double t0 = w->t0;
-    w->t0 = h->t + fmax_inline(w->tmin, h->t * 1e-7);
+    double depth = shade_tex_crossing_depth(&w->t0, w->tmin, h->t);
     if (h->flags & OBJ_NO_SHADOW) return 1;
     const scene_obj_photons *ph = h->obj ? h->obj->photons : NULL;
     if (w->photon_light && ph && ph->target && scene_photon_lobe(w->photon_light, ph, 1)) {
@@ -744,7 +750,7 @@ static int shadow_crossing(void *ctx, const accel_hit *h)
     }
     /* distance inside the object: from the previous crossing */
     accel_hit hh = *h;
-    hh.t = h->t - (t0 > w->tmin ? t0 - fmax_inline(w->tmin, t0 * 1e-7) : 0.0);
+    hh.t = depth;
     w->c = tmul(w->c, shade_tex_shadow_filter(w->sc, &hh, w->dir));
     if (fabs(w->c.r) < TEX_EPSILON && fabs(w->c.g) < TEX_EPSILON && fabs(w->c.b) < TEX_EPSILON) {
         w->c = trgb(0, 0, 0);

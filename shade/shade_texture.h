@@ -64,6 +64,12 @@ int shade_tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_
  * h->t is taken as the distance travelled inside the object when the ray
  * leaves it. */
 rgb shade_tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir);
+/* A shadow ray's walk over its crossings (accel_crossings with step tmin):
+ * *t0 is just past the previous crossing (tmin before the first) and is
+ * moved past the crossing at t; returns the distance from the previous
+ * crossing (from the ray's start for the first), the h->t that
+ * shade_tex_shadow_filter takes. */
+double shade_tex_crossing_depth(double *t0, double tmin, double t);
 /* The interior's fade over h->t for a ray along dir that leaves h's object
  * there (dir along the geometric normal); 1 for a ray entering it. The
  * fade shade_tex_shadow_filter applies, alone: a photon reflected inside
