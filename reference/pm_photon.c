@@ -304,6 +304,17 @@ static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume,
     vec3 w = L.w;
     rgb phi = L.phi;
     int from_light = src->kind == SRC_LIGHT;
+    /* POV-Ray's photon power (photons.cpp, addSurfacePhoton): the light's
+     * colour times the photon's spread squared times D^2 (not for parallel
+     * lights), faded at D, D the photon's whole path; emit() gives the
+     * power at the first hit's distance d1, so a photon on a specular path
+     * from a light is stored with (D / d1)^2 fade(D) / fade(d1) of it (a
+     * mirrored POV-Ray light does not fall off, as its direct light does
+     * not). */
+    double d1 = L.d1, plen = L.plen;
+    if (!resume || resume->bounce == 0) d1 = plen = v3_len(v3_sub(h.p, L.o));
+    else plen += h.t;
+    int beam = from_light && (src->l->parallel || src->l->kind == LIGHT_PARALLEL || src->l->kind == LIGHT_CYLINDER);
     unsigned pass = from_light ? 0u : PHOTON_SKIP; /* the pass_through rule above */
     int store_first = src->kind == SRC_ENV || (src->kind == SRC_EMIT && c->s->emitters_first);
     int spec_only = L.spec_only;
@@ -330,10 +341,16 @@ static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume,
         int collect = !(h.obj && h.obj->photons && !h.obj->photons->collect); /* photons { collect off } */
         int g = from_light ? nd : nd + 1;
         rgb pg = none;
-        int eligible = (bounce >= 1 || store_first) && g + 1 <= c->gathers && cmax(phi) > 0.0;
+        rgb phs = phi; /* the power stored here (the rule above) */
+        if (from_light && spec_only && bounce >= 1 && d1 > 0.0) {
+            double kd = shade_light_fade(src->l, plen) / fmax(shade_light_fade(src->l, d1), 1e-300);
+            if (!beam) kd *= (plen / d1) * (plen / d1);
+            phs = crgb(phi.r * kd, phi.g * kd, phi.b * kd);
+        }
+        int eligible = (bounce >= 1 || store_first) && g + 1 <= c->gathers && cmax(phs) > 0.0;
         if (eligible) {
             double bk = g > 0 ? pow(c->rr.brightness, g) : 1.0;
-            pg = crgb(phi.r * bk, phi.g * bk, phi.b * bk);
+            pg = crgb(phs.r * bk, phs.g * bk, phs.b * bk);
         }
         if (fn) fn(fctx, index, &L, &h, pg);
         if (out && lambert && collect && eligible) {
@@ -342,7 +359,7 @@ static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume,
             if (out->ng + out->nc >= out->cap) { out->dropped++; return; }
             if (!push(&out->g, &out->ng, &out->cg, h.p, pg, b.ng, key)) { out->oom = 1; return; }
             if (c->s->caustics && from_light && spec_only && bounce >= 1)
-                if (!push(&out->c, &out->nc, &out->cc, h.p, phi, b.ng, key)) { out->oom = 1; return; }
+                if (!push(&out->c, &out->nc, &out->cc, h.p, phs, b.ng, key)) { out->oom = 1; return; }
         }
         if (bounce >= c->s->max_bounces) return;
         shade_mat_scatter s;
@@ -350,6 +367,7 @@ static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume,
         if (s.specular && bounce == 0 && from_light && !c->s->caustics) return;
         if (s.specular && from_light && spec_only && c->targets && !caustic_bounce_ok(src->l, &h, s.lobe)) return;
         if (!s.specular) {
+            if (spec_only) phi = phs; /* diffusely reflected: the power it arrived with */
             spec_only = 0;
             nd++;
             if ((from_light ? nd : nd + 1) + 1 > c->gathers) return; /* never stored again */
@@ -378,10 +396,13 @@ static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume,
         L.bounce = bounce + 1;
         L.nd = nd;
         L.spec_only = spec_only;
+        L.d1 = d1;
+        L.plen = plen;
         if (accel_intersect_past(c->a, &b.from, s.org, w, c->eps, L.skip | pass, &h, rays) <= 0) {
             if (fn) fn(fctx, index, &L, NULL, none);
             return;
         }
+        plen += h.t;
     }
 }
 

@@ -92,6 +92,7 @@ typedef struct {
     int bounce;       /* surfaces the path met before (0: emission) */
     int nd;           /* diffuse bounces before */
     int spec_only;    /* only specular bounces so far */
+    double d1, plen;  /* a light's path: its first hit's distance, its length to where the segment starts */
 } pm_photon_launch;
 /* One segment traced: its launch, its hit (NULL: left the scene) and the
  * power a receiver it crosses takes: the power the global map would store
