@@ -45,8 +45,13 @@ void gi_particle_settings_from_scene(gi_particle_settings *s, const scene *sc)
      * radiosity samples take count rays each; 1.7 times as many with
      * further bounces, where a ray costs a particle lookup, not a shadow
      * ray a light, and ends on a particle whose own estimate is noisy
-     * (docs/gi.md: cornell.pov's figures) */
-    double want = (double)(r->count > 0 ? r->count : 35) * (s->bounces >= 1 ? 1.7 : 1.0);
+     * (docs/gi.md: cornell.pov's figures). Without them, nearest_count / 2.5
+     * times as many, within 1 and 2: POV-Ray blends up to nearest_count
+     * records (default 5) at a point, each of count rays, where a pixel
+     * here blends its gather with its filtered neighbours' (docs/gi.md:
+     * patio-radio and baking_demo) */
+    double nc = r->nearest_count > 0 ? r->nearest_count / 2.5 : 2.0;
+    double want = (double)(r->count > 0 ? r->count : 35) * (s->bounces >= 1 ? 1.7 : (nc < 1.0 ? 1.0 : (nc > 2.0 ? 2.0 : nc)));
     int side = (int)lround(sqrt(want));
     s->view_gather_side = side < 6 ? 6 : (side > 20 ? 20 : side);
     /* POV-Ray's error_bound sets how densely its cache samples where the
