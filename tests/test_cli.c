@@ -230,6 +230,40 @@ static void test_working_gamma_all_modes(void **st)
     }
 }
 
+/* A white furnace lit by radiosity alone with no bounce after the gather
+ * (recursion_limit 1), antialiased: a diffuse white sphere under a
+ * uniform sky of 0.5 reflects 0.5 everywhere, so every pixel, edges and
+ * their antialiasing rays included, is 0.5; and since the final gather
+ * answers every hit, the geometry stage places no particles
+ * (gi_particle_final_only). */
+static void test_exact_gather_furnace(void **st)
+{
+    (void)st;
+    char scene[512], cmd[2048], out[512], stats[512];
+    snprintf(scene, sizeof scene, "%s/exact_furnace.pov", tmpdir);
+    snprintf(out, sizeof out, "%s/exact_furnace.pfm", tmpdir);
+    snprintf(stats, sizeof stats, "%s/exact_furnace.json", tmpdir);
+    tu_write_file(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1 radiosity { count 100 recursion_limit 1 "
+                         "error_bound 0.3 } }\ncamera { location -4*z look_at 0 angle 30 }\nsky_sphere { pigment { rgb 0.5 } }\n"
+                         "sphere { 0, 1 pigment { rgb 1 } finish { ambient 0 diffuse 1 } }\n");
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' -o '%s' --size 24x24 +A0.05 --threads 2 --quiet --stats '%s'", PARTRAY_BIN,
+             scene, out, stats);
+    assert_int_equal(tu_run_capture(cmd), 0);
+    framebuffer *fb = NULL;
+    assert_int_equal(img_read(out, 0, &fb, NULL), PT_OK);
+    double worst = 0.0;
+    for (int i = 0; i < fb->width * fb->height * 3; i++) worst = fmax(worst, fabs(fb->rgb[i] / 0.5 - 1.0));
+    fb_free(fb);
+    const char *js = tu_read_file(stats); /* a static buffer */
+    assert_non_null(js);
+    printf("  recursion_limit 1 furnace +A: worst pixel off by %.4f (bound 0.01); stats %s %s\n", worst,
+           strstr(js, "\"particles\": 0,") ? "0 particles" : "particles placed",
+           strstr(js, "\"lookups_gathered_here\": 0,") ? "no hit gathered itself" : "hits gathered themselves");
+    assert_true(worst <= 0.01);
+    assert_non_null(strstr(js, "\"particles\": 0,"));
+    assert_null(strstr(js, "\"lookups_gathered_here\": 0,"));
+}
+
 /* --clock, +K and the animation switches: the predeclared identifiers as
  * POV-Ray 3.7.0 gives them (each expected pair printed by
  * `povray +Ik.pov -F -D +W8 +H6 OPTIONS` with the same scene). */
@@ -715,6 +749,7 @@ int main(void)
         cmocka_unit_test(test_exit_codes),
         cmocka_unit_test(test_empty_scene_and_defaults),
         cmocka_unit_test(test_working_gamma_all_modes),
+        cmocka_unit_test(test_exact_gather_furnace),
         cmocka_unit_test(test_animation),
         cmocka_unit_test(test_mesh_camera),
         cmocka_unit_test(test_render_outputs_and_stats),
