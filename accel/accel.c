@@ -574,6 +574,10 @@ static pt_status build_shapes(accel *a, diag *d)
         shape_kind k = a->leaves[i].obj->kind;
         if (k != SHAPE_TRIANGLE && k != SHAPE_SMOOTH_TRIANGLE && k != SHAPE_MESH && !a->leaves[i].in_csg) n++;
     }
+    for (int i = 0; i < a->nleaves; i++) {
+        shape_kind k = a->leaves[i].obj->kind;
+        if (k == SHAPE_ISOSURFACE || k == SHAPE_JULIA) a->has_costly_crossings = 1;
+    }
     if (n == 0) return PT_OK;
     a->shapes = malloc((size_t)n * sizeof *a->shapes);
     a->shape_leaf = malloc((size_t)n * sizeof *a->shape_leaf);
@@ -1035,7 +1039,7 @@ int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
 static int crossings_collected(const accel *a, vec3 org, vec3 dir, double t0, double tmax, double step, unsigned skip,
                                accel_crossing *cr)
 {
-    if (a->has_tri_geoms) return -1;
+    if (a->has_tri_geoms || a->has_costly_crossings) return -1;
     accel_query q;
     query_init(&q, org, dir, t0);
     q.cross = cr;

@@ -79,6 +79,10 @@ struct accel {
     geom_info *ginfo;
     unsigned nginfo;
     int has_tri_geoms; /* a geometry of triangles or instances: accel_crossings walks crossing by crossing */
+    int has_costly_crossings; /* an isosurface or julia_fractal (CSG members too), whose crossings are
+                                 found by searching the interval: collecting all of them along a
+                                 shadow ray costs more than the walk, which stops at the first opaque
+                                 one, so accel_crossings walks crossing by crossing */
     vec3 lo, hi;
     double scale;
     double eps_scale;  /* working scale of the epsilon rule (see the top) */
