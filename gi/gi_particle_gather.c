@@ -370,7 +370,7 @@ static pt_status trace_points(gi_particle *gp, const void **pobj, const unsigned
         st = PT_ERR_NOMEM;
         goto done;
     }
-    memcpy(cp, gp->ps.p, (size_t)n * sizeof *cp);
+    if (n > 0) memcpy(cp, gp->ps.p, (size_t)n * sizeof *cp);
     for (int t = 0; t < n; t++) {
         cobj[t] = pobj[t];
         cobj[N + t] = pobj[n + t];
