@@ -62,7 +62,7 @@ void gi_particle_settings_from_scene(gi_particle_settings *s, const scene *sc)
     s->view_gather_stride = r->error_bound > 0.0 && r->error_bound < 0.1 ? 1 : 2;
     s->view_gather_filter = 1.0;
     /* what POV-Ray's cache reuses where the antialiasing and secondary
-     * rays hit (gi_particle_gather.c, gi_particle_reuse) */
+     * rays hit (gi_particle_gather.c, reusable) */
     s->reuse_error = r->error_bound > 0.0 ? r->error_bound : 1.8;
     s->reuse_min = r->minimum_reuse;
     s->reuse_max = r->maximum_reuse;

@@ -199,11 +199,6 @@ static pt_status build_index(gi_particle *gp)
     return PT_OK;
 }
 
-/* Whether the final gather takes POV-Ray's reuse test (reusable): with a
- * scene's error_bound and no bounce after the gather's hits, where a hit
- * that no point may answer can gather itself (the gatherer). */
-static int reuse_test(const gi_particle *gp) { return gi_particle_exact_gather(&gp->set); }
-
 /* Whether gather point pt may answer a hit at p with normal ng (length
  * lg) that is not kept, by POV-Ray's test for reusing an irradiance cache
  * record (radiosity.cpp, Ward's error measure): with a the scene's
@@ -428,7 +423,8 @@ static int needs_own(const gi_particle *gp, size_t i)
         int kc = gp->vg_pix[j];
         if (kc < 0 || !compatible(gp, j, i)) continue;
         /* a corner whose record POV-Ray's cache would not reuse here */
-        if (reuse_test(gp) && !reusable(gp, &gp->vg_pt[kc], gp->vrec[i].h.p, gp->vg_nrm[i], 1.0)) return 1;
+        if (gi_particle_exact_gather(&gp->set) && !reusable(gp, &gp->vg_pt[kc], gp->vrec[i].h.p, gp->vg_nrm[i], 1.0))
+            return 1;
         const float *v = &gp->vg_val[4 * (size_t)kc];
         double l = 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
         lo = fmin(lo, l);
@@ -519,7 +515,7 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
     /* with no bounce after the gather's hits (the exact gather, gi_links.h)
      * a hit no point may answer gathers itself, as POV-Ray's cache adds a
      * record where none can be reused */
-    if (st == PT_OK && reuse_test(gp)) {
+    if (st == PT_OK && gi_particle_exact_gather(&gp->set)) {
         /* a third of the side: such hits are mostly antialiasing rays,
          * each one of the (depth^2 + 1) samples a pixel averages, so a
          * pixel's 9 subsamples together still take about a gather's rays */
@@ -680,10 +676,8 @@ int gi_particle_gather_here(gi_particle *gp, const accel_hit *hit, vec3 n, int t
     /* its rays' random stream from where it lies, so that a render gives
      * the same image on any number of threads */
     uint64_t bits[3];
-    memcpy(&bits[0], &hit->p.x, 8);
-    memcpy(&bits[1], &hit->p.y, 8);
-    memcpy(&bits[2], &hit->p.z, 8);
-    uint64_t stream = pt_mix64(pt_mix64(pt_mix64(bits[0]) ^ bits[1]) ^ bits[2]);
+    memcpy(bits, &hit->p, sizeof bits);
+    uint64_t stream = hash_step(hash_step(pt_mix64(bits[0]), (int64_t)bits[1]), (int64_t)bits[2]);
     float e[3];
     if (!gi_gatherer_point(gp->vg_gatherer, thread, hit->p, nv, stream, e, NULL)) return 0;
     out->r = e[0];
