@@ -697,26 +697,74 @@ static int try_member(const geom_csg *c, int s, const csg_ray *R, double *bestp,
     return found;
 }
 
-/* Whether the ray's stretch in (tmin, tmax) through the keep boxes' box
- * lies strictly inside one hole (geom_csg.h): then no crossing is kept.
- * A member is searched only on its keep box's stretch padded by 1e-9 of
- * its distances (try_member); the stretch tested here is padded by 4e-9 of
- * the wider box's, which covers it. */
-static int in_hole(const geom_csg *c, const csg_ray *R, double tmax)
+static int in_hole_box(const geom_csg *c, int i, vec3 p)
+{
+    vec3 lo = c->hole_lo[i], hi = c->hole_hi[i];
+    return p.x > lo.x && p.x < hi.x && p.y > lo.y && p.y < hi.y && p.z > lo.z && p.z < hi.z;
+}
+
+/* Where the ray's kept crossings can start: the holes (geom_csg.h) no
+ * crossing is kept in, chained along the ray from where it enters the
+ * keep boxes' box (keep_lo..keep_hi) or from tmin, whichever is later.
+ * Returns R->tmin when that point lies in no hole (or the ray misses that
+ * box within (tmin, tmax): the members' own tests answer), INFINITY when the
+ * whole stretch through the keep boxes' box lies inside the chain of
+ * holes (no crossing), else a distance t (> R->tmin) such that no
+ * crossing in (R->tmin, t] is kept: each point there lies before that box
+ * or strictly inside some hole.
+ *
+ * Each link is a stretch between two points strictly inside one shrunk
+ * hole (boxes are convex, so the points between are too): from the start
+ * to a point inside this hole and the next one (halfway through their
+ * common stretch), and so on; the last hole's stretch is cut back by the
+ * pad, 4e-9 of the wider box's distances. A member is searched only on
+ * its keep box's stretch padded by 1e-9 of its distances (try_member),
+ * which the same pad covers. Every crossing but a hole's own is kept only
+ * outside it, and a hole's own crossings lie on its faces, outside its
+ * shrunk box: so none in the chain is kept. A ray from a courtyard's
+ * floor out through an arcade or a column ring (radiosity_37.pov's
+ * courtyard: the walls' and the column base's subtracted boxes) crosses
+ * two holes before any surface. */
+static double hole_clear(const geom_csg *c, const csg_ray *R, double tmax)
 {
     double t0, t1;
-    if (!v3_slab_inv(R->org, R->dir, R->inv, c->keep_lo, c->keep_hi, &t0, &t1)) return 0;
+    if (!v3_slab_inv(R->org, R->dir, R->inv, c->keep_lo, c->keep_hi, &t0, &t1)) return R->tmin;
     double pad = 4e-9 * (fabs(t0) + fabs(t1)) + 1e-300;
-    double a = fmax(t0 - pad, R->tmin), b = fmin(t1 + pad, tmax);
-    if (!(a <= b)) return 0;
+    double a = fmax_inline(t0 - pad, R->tmin), b = fmin_inline(t1 + pad, tmax);
+    if (!(a <= b)) return R->tmin;
     vec3 pa = v3_madd(R->org, R->dir, a), pb = v3_madd(R->org, R->dir, b);
-    for (int i = 0; i < c->nholes; i++) {
-        vec3 lo = c->hole_lo[i], hi = c->hole_hi[i];
-        if (pa.x > lo.x && pa.x < hi.x && pa.y > lo.y && pa.y < hi.y && pa.z > lo.z && pa.z < hi.z && pb.x > lo.x &&
-            pb.x < hi.x && pb.y > lo.y && pb.y < hi.y && pb.z > lo.z && pb.z < hi.z)
-            return 1;
+    int cur = -1;
+    for (int i = 0; i < c->nholes && cur < 0; i++)
+        if (in_hole_box(c, i, pa)) cur = i;
+    if (cur < 0) return R->tmin;
+    unsigned used = 1u << cur;
+    double at = a; /* a point strictly inside hole cur */
+    for (;;) {
+        if (in_hole_box(c, cur, pb)) return INFINITY;
+        double e0, e1;
+        if (!v3_slab_inv(R->org, R->dir, R->inv, c->hole_lo[cur], c->hole_hi[cur], &e0, &e1)) break;
+        int next = -1;
+        double next_at = 0.0, next_end = e1;
+        for (int j = 0; j < c->nholes; j++) {
+            double f0, f1;
+            if (used >> j & 1u || !v3_slab_inv(R->org, R->dir, R->inv, c->hole_lo[j], c->hole_hi[j], &f0, &f1)) continue;
+            if (!(f1 > next_end)) continue;
+            double m = 0.5 * (fmax_inline(f0, at) + e1);
+            vec3 pm = v3_madd(R->org, R->dir, m);
+            if (!(m > at) || !in_hole_box(c, cur, pm) || !in_hole_box(c, j, pm)) continue;
+            next = j;
+            next_at = m;
+            next_end = f1;
+        }
+        if (next < 0) {
+            double t = e1 - pad;
+            return t > at ? t : at;
+        }
+        used |= 1u << next;
+        cur = next;
+        at = next_at;
     }
-    return 0;
+    return at;
 }
 
 /* The nearest kept crossing in (tmin, tmax), or with R->any the first one
@@ -724,7 +772,16 @@ static int in_hole(const geom_csg *c, const csg_ray *R, double tmax)
  * before a member answers every search runs to tmax. */
 static int csg_search(const geom_csg *c, const csg_ray *R, double tmax, geom_csg_hit *h)
 {
-    if (c->nholes > 0 && in_hole(c, R, tmax)) return 0;
+    csg_ray Rh;
+    if (c->nholes > 0) {
+        double clear = hole_clear(c, R, tmax);
+        if (!(clear < tmax)) return 0;
+        if (clear > R->tmin) {
+            Rh = *R;
+            Rh.tmin = clear;
+            R = &Rh;
+        }
+    }
     int found = 0;
     double best = tmax;
     if (!c->bvh) {

@@ -95,9 +95,11 @@ typedef struct {
      * (keep_lo, keep_hi) and, where the root is a difference, the boxes of
      * its subtracted members that are untransformed boxes, shrunk by a
      * margin (nholes of them, 0 when a keep box is unbounded or a member is
-     * searched from the ray's start): a ray whose whole stretch through
-     * keep_lo..keep_hi lies inside one has no crossing, as every crossing
-     * but the hole's own is kept only outside it. */
+     * searched from the ray's start): every crossing but a hole's own is
+     * kept only outside it, so a ray whose stretch through keep_lo..keep_hi
+     * runs inside one hole, or a chain of overlapping ones, has no
+     * crossing, and one that starts so is searched from where the chain
+     * ends. */
     vec3 keep_lo, keep_hi;
     vec3 hole_lo[GEOM_CSG_MAX_HOLES], hole_hi[GEOM_CSG_MAX_HOLES];
     int nholes;

@@ -737,6 +737,29 @@ static void test_clipped_by(void **st)
     assert_true(accel_occluded(w.a, v3(0, 1, 0), v3(1, 0.74, 0), 0.0, INFINITY));
     assert_false(accel_occluded(w.a, v3(0, 1, 0), v3(1, 0.74, 0), 0.0, 3.9));
     done(&w);
+    /* two cuts a ray crosses one after the other (geom_csg.c hole_clear):
+     * a column base, a ring cut through by a band, and a courtyard with an
+     * arcade round it; each answer against the faces' closed form, where
+     * the cuts chain to the box's far side, where the ray meets a face in
+     * the second cut, and where solid lies between the two */
+    w = build("difference { box { <-4.7,0,-4.7>, <4.7,3.6,4.7> } box { <-4.1,-0.1,-4.1>, <4.1,4,4.1> } "
+              "box { <-5,0.5,-5>, <5,3.3,5> } }");
+    expect_miss(&w, v3(0, 1, 0), v3(1, 0, 0));                                     /* both cuts, then out */
+    expect_miss(&w, v3(10, 1, 0), v3(-1, 0, 0));                                   /* through the band from outside */
+    expect_hit(&w, v3(0, 1, 0), v3(1, 0.5, 0), 4.6, v3(0, -1, 0), 1e-12, 1e-12);   /* the top ring's underside */
+    expect_hit(&w, v3(0, 0.2, 0), v3(1, 0, 0), 4.1, v3(-1, 0, 0), 1e-12, 1e-12);   /* the bottom ring, below the band */
+    expect_hit(&w, v3(10, 3.4, 0), v3(-1, 0, 0), 5.3, v3(1, 0, 0), 1e-12, 1e-12); /* the top ring from outside */
+    assert_false(accel_occluded(w.a, v3(0, 1, 0), v3(1, 0, 0), 0.0, INFINITY));
+    assert_true(accel_occluded(w.a, v3(0, 1, 0), v3(1, 0.5, 0), 0.0, INFINITY));
+    assert_false(accel_occluded(w.a, v3(0, 1, 0), v3(1, 0.5, 0), 0.0, 4.59));
+    done(&w);
+    w = build("difference { box { <-10,-0.1,-10>, <10,4,10> } box { <-9,0.3,-9>, <9,3.5,9> } "
+              "box { <-4,0.1,-4>, <4,5,4> } }");
+    expect_hit(&w, v3(0, 1, 0), v3(1, 0, 0), 9.0, v3(-1, 0, 0), 1e-12, 1e-12);  /* across the arcade to its wall */
+    expect_hit(&w, v3(0, 0.2, 0), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12); /* the step between the floors */
+    expect_hit(&w, v3(0, 1, 0), v3(1, 0.4, 0), 6.25, v3(0, -1, 0), 1e-12, 1e-12); /* the arcade's ceiling */
+    expect_hit(&w, v3(0, 1, 0), v3(1, -0.1, 0), 7.0, v3(0, 1, 0), 1e-12, 1e-12); /* the arcade's floor */
+    done(&w);
 }
 
 /* isosurface: user functions (core/func.h) against closed forms */
