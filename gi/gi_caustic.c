@@ -285,6 +285,30 @@ static int push_photon(chunk_out *o, const gi_caus_photon *q)
     return 1;
 }
 
+/* The direction a photon came from (unit d) as POV-Ray 3.7 stores and
+ * reads it: two signed bytes, its elevation above the world's xz plane and
+ * its azimuth about the y axis, each angle * 127 / pi truncated towards
+ * zero (photons.cpp, addSurfacePhoton), decoded as angle = byte * pi / 127
+ * (SinCosOptimizations) when the gather shades the photon
+ * (trace.cpp, ComputePhotonDiffuseLight). The truncation tilts a photon
+ * up to 1.4 degrees towards the xz plane and about y; a receiver of
+ * brilliance b sees the tilt in its weight c^b / c (brilliance 1 does not:
+ * the cosines cancel), most at low elevations (docs/caustics.md,
+ * Receivers). The side test (c > 0) sees it too, as POV-Ray's does. */
+static vec3 pov_photon_dir(vec3 d)
+{
+    double l = v3_len(d);
+    if (!(l > 0.0)) return d;
+    d = v3_scale(d, 1.0 / l);
+    double dl = sqrt(d.x * d.x + d.z * d.z);
+    double phi = dl > 0.0 ? acos(fmax(-1.0, fmin(1.0, d.x / dl))) : 0.0;
+    if (d.z < 0.0) phi = -phi;
+    double theta = acos(fmin(1.0, dl));
+    if (d.y < 0.0) theta = -theta;
+    double tq = (double)(int)(theta * 127.0 / M_PI) * M_PI / 127.0;
+    double pq = (double)(int)(phi * 127.0 / M_PI) * M_PI / 127.0;
+    return v3(cos(tq) * cos(pq), sin(tq), cos(tq) * sin(pq));
+}
 /* One bounce-map cell: the photon's direction (and origin), then its path. */
 static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_out *out)
 {
@@ -377,12 +401,12 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
             double k = att * (cb->parallel ? 1.0 : depth * depth);
             double sd = cb->parallel ? sqrt(cb->cell) : depth * sqrt(cb->cell);
             double rxy = fmin(RADIUS_K * sd / sqrt(br.rho_p), c->r_max);
-            vec3 np = v3_dot(h.ng, br.w) < 0.0 ? h.ng : v3_neg(h.ng);
+            vec3 np = v3_dot(h.ng, br.w) < 0.0 ? h.ng : v3_neg(h.ng), wq = pov_photon_dir(v3_neg(br.w));
             gi_caus_photon q = {{(float)h.p.x, (float)h.p.y, (float)h.p.z},
                                 (float)rxy,
                                 {(float)np.x, (float)np.y, (float)np.z},
                                 (float)(0.25 * rxy),
-                                {(float)-br.w.x, (float)-br.w.y, (float)-br.w.z},
+                                {(float)wq.x, (float)wq.y, (float)wq.z},
                                 (float)(1.0 / (rxy * rxy)),
                                 {(float)(cb->phi0.r * br.tr.r * k), (float)(cb->phi0.g * br.tr.g * k),
                                  (float)(cb->phi0.b * br.tr.b * k)},

@@ -7,6 +7,7 @@
 #ifndef (Slab) #declare Slab = 1; #end
 #ifndef (Conserve) #declare Conserve = 1; #end
 #ifndef (Angle) #declare Angle = 71; #end
+#ifndef (Bril) #declare Bril = 1; #end
 global_settings {
   assumed_gamma 1.0
   max_trace_level 25
@@ -18,7 +19,7 @@ light_source {
   <100 * sin(radians(Angle)), 100 * cos(radians(Angle)), 0> color rgb 1
   photons { reflection on refraction on }
 }
-plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 1 } }
+plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 1 brilliance Bril } }
 #if (Slab)
 box {
   <-30, 3, -15>, <15, 3.5, 15>

@@ -208,7 +208,9 @@ static inline gi_u32 gi_hash(gi_u32 v)
  * position x, hit normal n_p, incoming direction w_i, power Phi) with the
  * kernel's two radii beside them: r_xy, the major radii in the plane of the
  * photon's surface, and r_z <= r_xy along n_p (section 2.5 of the digest,
- * Fig. 4). w points back towards where the light came from. phi is in the
+ * Fig. 4). w points back towards where the light came from, as POV-Ray
+ * stores it (gi_caustic.c, pov_photon_dir: its two angles truncated to
+ * steps of pi/127). phi is in the
  * "E/pi units" above times area: sum phi * kappa is a POV-Ray light colour
  * (E/pi) that the diffuse term multiplies by diffuse * pigment. 64 bytes. */
 typedef struct {
