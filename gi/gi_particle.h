@@ -122,7 +122,10 @@ typedef struct {
     int view_gather_stride; /* gathers at every Nth pixel in x and y, and where the pixels between
                               find no matching one (default 2) */
     double view_gather_filter; /* the edge-aware filter's Gaussian sigma over the gathers, in
-                                  pixels (0: the default, 1) */
+                                  pixels (0: the default, 1; below 0: no filter) */
+    double here_side_frac; /* a hit that gathers itself (reuse_error) takes this fraction of
+                            view_gather_side a side, at least 4 (0: the default, a third: such
+                            hits are mostly antialiasing samples, which a pixel averages) */
     double reuse_error;  /* > 0: with no bounce after the final gather's hits, a hit that is not a
                             kept pixel takes a gathered point's value only where POV-Ray's
                             irradiance cache would reuse it (its error_bound; gi_particle_gather.c),

@@ -516,10 +516,14 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
      * a hit no point may answer gathers itself, as POV-Ray's cache adds a
      * record where none can be reused */
     if (st == PT_OK && gi_particle_exact_gather(&gp->set)) {
-        /* a third of the side: such hits are mostly antialiasing rays,
-         * each one of the (depth^2 + 1) samples a pixel averages, so a
-         * pixel's 9 subsamples together still take about a gather's rays */
-        int hs = (side + 2) / 3 < 4 ? 4 : (side + 2) / 3;
+        /* by default a third of the side: such hits are mostly
+         * antialiasing rays, each one of the (depth^2 + 1) samples a pixel
+         * averages, so a pixel's 9 subsamples together still take about a
+         * gather's rays (more where POV-Ray's cache reuses nearly nothing:
+         * gi_particle_settings_from_scene) */
+        double frac = gp->set.here_side_frac > 0.0 ? gp->set.here_side_frac : 1.0 / 3.0;
+        int hs = (int)ceil(side * frac - 1e-9);
+        if (hs < 4) hs = 4;
         gp->vg_gatherer = gi_gatherer_new(gp->a, gp->lscene, hs, gp->set.seed ^ 0x51d3ULL, gp->sky, gp->sc,
                                           gp->set.pigment);
         if (!gp->vg_gatherer) st = PT_ERR_NOMEM;
@@ -567,7 +571,7 @@ static int raw_value(const gi_particle *gp, size_t i, float out[3])
 }
 
 /* The edge-aware filter over the pixels' raw values: a Gaussian of
- * view_gather_filter pixels (default FILTER_SIGMA), to 2 sigma, over the
+ * view_gather_filter pixels (default FILTER_SIGMA; none below 0), to 2 sigma, over the
  * pixels that lie on the same object and
  * side, face the same way and lie in the same plane (compatible, and the
  * offset along the normal within DEPTH_TOL of the depth). It averages the
@@ -590,11 +594,12 @@ static void filter_row(void *ctx, int y, int thread)
     gi_particle *gp = F->gp;
     int w = gp->vw, h = gp->vh;
     /* sigma from the settings (default FILTER_SIGMA), the taps to 2 sigma */
-    const double sigma = gp->set.view_gather_filter > 0.0 ? gp->set.view_gather_filter : FILTER_SIGMA;
-    int R = (int)ceil(2.0 * sigma);
+    const double sigma = gp->set.view_gather_filter != 0.0 ? gp->set.view_gather_filter : FILTER_SIGMA;
+    int R = sigma > 0.0 ? (int)ceil(2.0 * sigma) : 0; /* below 0: no filter, the pixel's own value */
     if (R > FILTER_RADIUS_MAX) R = FILTER_RADIUS_MAX;
     double g[FILTER_RADIUS_MAX + 1];
-    for (int d = 0; d <= R; d++) g[d] = exp(-0.5 * d * d / (sigma * sigma));
+    g[0] = 1.0;
+    for (int d = 1; d <= R; d++) g[d] = exp(-0.5 * d * d / (sigma * sigma));
     for (int x = 0; x < w; x++) {
         size_t i = (size_t)y * w + x;
         float *o = &gp->vg_pixval[4 * i];

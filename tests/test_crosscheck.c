@@ -150,13 +150,16 @@ static void test_merge_coincident_walls(void **st)
  * error_bound and the record's harmonic mean distance), and gathers
  * itself elsewhere; when the nearest pixels on the same object answered,
  * the rays in a recess took the rim's light and the mean difference was
- * above the bound. Full resolution, the scene's own count. */
+ * 0.0092. At this error_bound POV-Ray reuses nearly no record, so no
+ * filter blends the pixels' gathers and a hit that gathers itself takes
+ * 0.6 of the side (with the filter and a third of the side: 0.0063).
+ * Full resolution, the scene's own count. */
 static void test_gi_antialias_reuse(void **st)
 {
     (void)st;
     double mad = full_resolution_mad("xc_gi_recess", 96);
-    printf("crosscheck xc_gi_recess (particle GI) full-resolution mean |diff| = %.5f (tolerance 0.0075)\n", mad);
-    assert_true(mad <= 0.0075);
+    printf("crosscheck xc_gi_recess (particle GI) full-resolution mean |diff| = %.5f (tolerance 0.005)\n", mad);
+    assert_true(mad <= 0.005);
 }
 
 int main(void)
