@@ -697,7 +697,7 @@ static int try_member(const geom_csg *c, int s, const csg_ray *R, double *bestp,
     return found;
 }
 
-static int in_hole_box(const geom_csg *c, int i, vec3 p)
+static inline int in_hole_box(const geom_csg *c, int i, vec3 p)
 {
     vec3 lo = c->hole_lo[i], hi = c->hole_hi[i];
     return p.x > lo.x && p.x < hi.x && p.y > lo.y && p.y < hi.y && p.z > lo.z && p.z < hi.z;

@@ -355,33 +355,39 @@ static int hits_sphere(const geom_shape *sh, vec3 o, vec3 d, double tmin, double
     return n;
 }
 
-/* Slab test; entry/exit with the face each happens on. */
+/* One axis of slabs: the interval [*t0, *t1] and the faces it is
+ * bounded by (*f0, *f1) narrowed to slab i, [l, u]; 0 when the ray runs
+ * parallel to it outside it. */
+static inline int slab_face(int i, double oi, double di, double l, double u, double *t0, int *f0, double *t1, int *f1)
+{
+    double inv = 1.0 / di;
+    if (di == 0.0 || !isfinite(inv)) return !(oi < l || oi > u);
+    double ta = (l - oi) * inv, tb = (u - oi) * inv;
+    int fa = 2 * i, fb = 2 * i + 1;
+    /* a zero-thickness slab (l == u) is entered through the face that
+     * opposes the ray, so that the hit reads as entering: POV-Ray reports
+     * the other face of such a box (Box::Intersect's Side2 at the same
+     * depth, the last pushed and first popped in Find_Intersection) but
+     * refracts by the ray's interior list, which a ray from outside
+     * always enters (textures/finishes/var_reflection.pov) */
+    if (ta > tb || (ta == tb && di < 0.0)) {
+        double t = ta; ta = tb; tb = t;
+        int f = fa; fa = fb; fb = f;
+    }
+    if (ta > *t0) { *t0 = ta; *f0 = fa; }
+    if (tb < *t1) { *t1 = tb; *f1 = fb; }
+    return 1;
+}
+
+/* Slab test; entry/exit with the face each happens on (the axes written
+ * out: a loop over v3_idx is not unrolled). */
 static int slabs(vec3 o, vec3 d, vec3 lo, vec3 hi, double *tn, int *fn, double *tf, int *ff)
 {
     double t0 = -INFINITY, t1 = INFINITY;
     int f0 = -1, f1 = -1;
-    for (int i = 0; i < 3; i++) {
-        double oi = v3_idx(o, i), di = v3_idx(d, i), l = v3_idx(lo, i), u = v3_idx(hi, i);
-        double inv = 1.0 / di;
-        if (di == 0.0 || !isfinite(inv)) {
-            if (oi < l || oi > u) return 0;
-            continue;
-        }
-        double ta = (l - oi) * inv, tb = (u - oi) * inv;
-        int fa = 2 * i, fb = 2 * i + 1;
-        /* a zero-thickness slab (l == u) is entered through the face that
-         * opposes the ray, so that the hit reads as entering: POV-Ray reports
-         * the other face of such a box (Box::Intersect's Side2 at the same
-         * depth, the last pushed and first popped in Find_Intersection) but
-         * refracts by the ray's interior list, which a ray from outside
-         * always enters (textures/finishes/var_reflection.pov) */
-        if (ta > tb || (ta == tb && di < 0.0)) {
-            double t = ta; ta = tb; tb = t;
-            int f = fa; fa = fb; fb = f;
-        }
-        if (ta > t0) { t0 = ta; f0 = fa; }
-        if (tb < t1) { t1 = tb; f1 = fb; }
-    }
+    if (!slab_face(0, o.x, d.x, lo.x, hi.x, &t0, &f0, &t1, &f1) || !slab_face(1, o.y, d.y, lo.y, hi.y, &t0, &f0, &t1, &f1) ||
+        !slab_face(2, o.z, d.z, lo.z, hi.z, &t0, &f0, &t1, &f1))
+        return 0;
     if (!(t0 <= t1) || f0 < 0) return 0;
     *tn = t0; *fn = f0; *tf = t1; *ff = f1;
     return 1;
