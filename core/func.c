@@ -1,6 +1,7 @@
 /* func.c - evaluation of compiled POV-Ray functions. */
 #include "func.h"
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "func_internal.h"
 
@@ -46,196 +47,340 @@ static double math1(func_math m, double x)
     }
 }
 
-static double node_value(const scene_function *f, int i, double *slots, eval_ctx *c);
+/* ------------------------------------------------------------ compiler */
 
-/* A kid's value: constants and arguments (about half the nodes of a
- * typical body) without a call. */
-static inline double kid_value(const scene_function *f, int i, double *slots, eval_ctx *c)
+/* A compiled body is three-address code on a register file: registers
+ * 0..nslots-1 are the function's parameters and loop variables, the rest
+ * temporaries, allocated as a stack (a node at depth d leaves its value in
+ * temporary d; its kid j works from temporary d + j). A constant operand
+ * sits in the instruction (the _K and K_ forms), a parameter is read from
+ * its register: the leaves of the tree (about half its nodes) cost no
+ * instruction. */
+enum {
+    FI_MOV,      /* dst = a */
+    FI_LOADK,    /* dst = k */
+    FI_NEG, FI_MATH,                             /* dst = op a */
+    FI_ADD, FI_SUB, FI_MUL, FI_DIV,              /* dst = a op b */
+    FI_ADD_K, FI_SUB_K, FI_MUL_K, FI_DIV_K,      /* dst = a op k */
+    FI_K_ADD, FI_K_SUB, FI_K_MUL, FI_K_DIV,      /* dst = k op b */
+    FI_LT, FI_LE, FI_EQ, FI_NE, FI_GE, FI_GT, FI_AND, FI_OR,
+    FI_ATAN2, FI_POW, FI_MOD, FI_IDIV,           /* dst = op(a, b) */
+    FI_MIN, FI_MAX, /* dst = min/max of registers a .. a + n - 1, in order */
+    FI_JNLT,     /* unless a < 0 jump to dst (select's first test) */
+    FI_SEL4,     /* a < 0: next; a == 0: jump to dst; else jump to b */
+    FI_JMP,      /* jump to dst */
+    FI_LOOP,     /* registers a, a+1 hold from, to; a+2 = k (the sum's or
+                    product's start), a+3 = from; unless from <= to jump
+                    to b (the FI_END); else slot dst = from */
+    FI_NEXT,     /* registers as FI_LOOP, the body's value in a+4;
+                    a+2 op= it, a+3 += 1; while a+3 <= to:
+                    slot dst = a+3, jump to b (the body); sub: 1 sum */
+    FI_END,      /* a = a+2 (the loop's value into its register) */
+    FI_CALL,     /* dst = fn's result term sub (5: gray) of the n
+                    registers from a */
+    FI_CALL_INT, /* dst = internal(b) of the n registers from a (a call of
+                    a function whose body is one built-in) */
+    FI_INTERNAL  /* dst = internal(b) of this function's own registers */
+};
+
+/* An operand: register r, or the constant k when r < 0. */
+typedef struct {
+    int r;
+    double k;
+} operand;
+
+typedef struct {
+    const scene_function *f;
+    func_insn *out;
+    int n, max, bad, t0, top;
+} compiler;
+
+static int emit(compiler *cp, int op, int dst, int a, int b)
 {
-    const func_node *n = &f->nodes[i];
-    if (n->op == FN_CONST) return c->failed ? 0 : n->k;
-    if (n->op == FN_ARG) return c->failed ? 0 : slots[n->slot];
-    return node_value(f, i, slots, c);
+    if (cp->n >= cp->max) {
+        cp->bad = 1;
+        return 0;
+    }
+    func_insn *in = &cp->out[cp->n];
+    memset(in, 0, sizeof *in);
+    in->op = (unsigned char)op;
+    in->dst = dst;
+    in->a = a;
+    in->b = b;
+    return cp->n++;
 }
 
-/* One node's value; slots holds the parameters and loop variables. */
-static double node_value(const scene_function *f, int i, double *slots, eval_ctx *c)
+static int node_ok(const scene_function *f, int i) { return i >= 0 && i < f->nnodes; }
+
+/* Register `reg` made to hold operand v. */
+static void place(compiler *cp, operand v, int reg)
 {
-    const func_node *n = &f->nodes[i];
-    const int *k = f->kids ? f->kids + n->kid : NULL; /* no kids: no NULL + 0 */
-    if (c->failed) return 0;
-#define KID(j) kid_value(f, k[j], slots, c)
-    switch ((func_op)n->op) {
-    case FN_CONST: return n->k;
-    case FN_ARG: return slots[n->slot];
-    case FN_NEG: return -KID(0);
-    case FN_ADD: return KID(0) + KID(1);
-    case FN_SUB: return KID(0) - KID(1);
-    case FN_MUL: return KID(0) * KID(1);
-    case FN_DIV: return KID(0) / KID(1);
-    case FN_LT: return KID(0) < KID(1);
-    case FN_LE: return KID(0) <= KID(1);
-    case FN_EQ: return KID(0) == KID(1);
-    case FN_NE: return KID(0) != KID(1);
-    case FN_GE: return KID(0) >= KID(1);
-    case FN_GT: return KID(0) > KID(1);
-    case FN_AND: { double a = KID(0); double b = KID(1); return truth(a) && truth(b); }
-    case FN_OR: { double a = KID(0); double b = KID(1); return truth(a) || truth(b); }
-    case FN_MATH: return math1((func_math)n->sub, KID(0));
-    case FN_ATAN2: { double a = KID(0); return atan2(a, KID(1)); }
-    case FN_POW: { double a = KID(0); return pow(a, KID(1)); }
-    case FN_MOD: { double a = KID(0); return fmod(a, KID(1)); }
-    case FN_IDIV: { double a = KID(0); return trunc(a / KID(1)); }
+    if (v.r == reg) return;
+    if (v.r >= 0) {
+        emit(cp, FI_MOV, reg, v.r, 0);
+    } else {
+        int at = emit(cp, FI_LOADK, reg, 0, 0);
+        if (!cp->bad) cp->out[at].k = v.k;
+    }
+}
+
+static operand compile_node(compiler *cp, int i, int depth, int level);
+
+/* Node i's value in temporary `depth` (copied there if it is a leaf). */
+static void compile_to(compiler *cp, int i, int depth, int level)
+{
+    place(cp, compile_node(cp, i, depth, level), cp->t0 + depth);
+}
+
+/* Code for node i, working from temporary `depth` up; returns where its
+ * value is: a parameter's register, a constant, or temporary `depth`.
+ * The tree evaluates kids first to last, each op once its kids are known;
+ * so does the code, with the same operations on the same values. */
+static operand compile_node(compiler *cp, int i, int depth, int level)
+{
+    const scene_function *f = cp->f;
+    operand res = {cp->t0 + depth, 0.0};
+    if (!node_ok(f, i) || level > 4096) {
+        cp->bad = 1;
+        return res;
+    }
+    if (depth + 1 > cp->top) cp->top = depth + 1;
+    const func_node *nd = &f->nodes[i];
+    const int *k = f->kids ? f->kids + nd->kid : NULL;
+    int dst = cp->t0 + depth;
+    switch ((func_op)nd->op) {
+    case FN_CONST: return (operand){-1, nd->k};
+    case FN_ARG: return (operand){nd->slot, 0.0};
+    case FN_NEG: case FN_MATH: {
+        operand x = compile_node(cp, k[0], depth, level + 1);
+        if (x.r < 0) place(cp, x, dst), x.r = dst;
+        int at = emit(cp, nd->op == FN_NEG ? FI_NEG : FI_MATH, dst, x.r, 0);
+        if (!cp->bad) cp->out[at].sub = nd->sub;
+        return res;
+    }
+    case FN_ADD: case FN_SUB: case FN_MUL: case FN_DIV: {
+        int o = nd->op - FN_ADD;
+        operand x = compile_node(cp, k[0], depth, level + 1);
+        operand y = compile_node(cp, k[1], depth + 1, level + 1);
+        if (x.r < 0 && y.r < 0) place(cp, x, dst), x.r = dst;
+        int at = x.r < 0 ? emit(cp, FI_K_ADD + o, dst, 0, y.r)
+               : y.r < 0 ? emit(cp, FI_ADD_K + o, dst, x.r, 0)
+                         : emit(cp, FI_ADD + o, dst, x.r, y.r);
+        if (!cp->bad) cp->out[at].k = x.r < 0 ? x.k : y.k;
+        return res;
+    }
+    case FN_LT: case FN_LE: case FN_EQ: case FN_NE: case FN_GE: case FN_GT: case FN_AND: case FN_OR:
+    case FN_ATAN2: case FN_POW: case FN_MOD: case FN_IDIV: {
+        static const unsigned char ops[] = {[FN_LT] = FI_LT, [FN_LE] = FI_LE, [FN_EQ] = FI_EQ, [FN_NE] = FI_NE,
+                                            [FN_GE] = FI_GE, [FN_GT] = FI_GT, [FN_AND] = FI_AND, [FN_OR] = FI_OR,
+                                            [FN_ATAN2] = FI_ATAN2, [FN_POW] = FI_POW, [FN_MOD] = FI_MOD,
+                                            [FN_IDIV] = FI_IDIV};
+        operand x = compile_node(cp, k[0], depth, level + 1);
+        if (x.r < 0) place(cp, x, dst), x.r = dst;
+        operand y = compile_node(cp, k[1], depth + 1, level + 1);
+        if (y.r < 0) place(cp, y, dst + 1), y.r = dst + 1;
+        if (depth + 2 > cp->top) cp->top = depth + 2;
+        emit(cp, ops[nd->op], dst, x.r, y.r);
+        return res;
+    }
     case FN_MIN: case FN_MAX: {
-        double v = KID(0);
-        for (int j = 1; j < n->nkids; j++) {
-            double w = KID(j);
-            if (n->op == FN_MIN ? w < v : w > v) v = w;
-        }
-        return v;
+        if (nd->nkids < 1) break;
+        for (int j = 0; j < nd->nkids; j++) compile_to(cp, k[j], depth + j, level + 1);
+        if (depth + nd->nkids > cp->top) cp->top = depth + nd->nkids;
+        int at = emit(cp, nd->op == FN_MIN ? FI_MIN : FI_MAX, dst, dst, 0);
+        if (!cp->bad) cp->out[at].n = nd->nkids;
+        return res;
     }
     case FN_SELECT: {
-        double a = KID(0);
-        if (a < 0) return KID(1);
-        if (n->nkids == 3 || a == 0) return KID(2);
-        return KID(3);
+        /* select(a, lt, ge) or select(a, lt, eq, gt): only the branch
+         * taken is evaluated, as in the tree */
+        if (nd->nkids != 3 && nd->nkids != 4) break;
+        operand a = compile_node(cp, k[0], depth, level + 1);
+        if (a.r < 0) place(cp, a, dst), a.r = dst;
+        int test = emit(cp, nd->nkids == 3 ? FI_JNLT : FI_SEL4, 0, a.r, 0), jumps[2], nj = 0;
+        for (int j = 1; j < nd->nkids; j++) {
+            if (j > 1 && !cp->bad) {
+                if (j == 2) cp->out[test].dst = cp->n;
+                else cp->out[test].b = cp->n;
+            }
+            compile_to(cp, k[j], depth, level + 1);
+            if (j + 1 < nd->nkids) jumps[nj++] = emit(cp, FI_JMP, 0, 0, 0);
+        }
+        for (int j = 0; j < nj && !cp->bad; j++) cp->out[jumps[j]].dst = cp->n;
+        return res;
     }
     case FN_SUM: case FN_PROD: {
-        double from = KID(0), to = KID(1), acc = n->op == FN_SUM ? 0.0 : 1.0;
-        for (double v = from; v <= to && !c->failed; v += 1.0) {
-            slots[n->slot] = v;
-            double b = KID(2);
-            acc = n->op == FN_SUM ? acc + b : acc * b;
+        compile_to(cp, k[0], depth, level + 1);
+        compile_to(cp, k[1], depth + 1, level + 1);
+        if (depth + 5 > cp->top) cp->top = depth + 5;
+        int loop = emit(cp, FI_LOOP, nd->slot, dst, 0), body = cp->n;
+        compile_to(cp, k[2], depth + 4, level + 1);
+        int next = emit(cp, FI_NEXT, nd->slot, dst, body);
+        int end = emit(cp, FI_END, 0, dst, 0);
+        if (!cp->bad) {
+            cp->out[loop].k = nd->op == FN_SUM ? 0.0 : 1.0;
+            cp->out[loop].b = end;
+            cp->out[next].sub = nd->op == FN_SUM;
         }
-        return acc;
+        return res;
     }
     case FN_CALL: {
-        double a[FUNC_MAX_SLOTS], r[5];
-        for (int j = 0; j < n->nkids && j < FUNC_MAX_SLOTS; j++) a[j] = KID(j);
-        const scene_function *g = n->fn;
-        if (g->kind == FUNC_FLOAT && g->nodes[g->root].op == FN_INTERNAL && n->sub == 0) {
+        const scene_function *g = nd->fn;
+        for (int j = 0; j < nd->nkids; j++) compile_to(cp, k[j], depth + j, level + 1);
+        if (depth + nd->nkids > cp->top) cp->top = depth + nd->nkids;
+        int direct = 0, in = 0;
+        if (g && g->kind == FUNC_FLOAT && g->nodes && node_ok(g, g->root) && g->nodes[g->root].op == FN_INTERNAL &&
+            nd->sub == 0) {
             /* a body that is one built-in (functions.inc's f_rounded_box and
              * the rest): the built-in reads the call's arguments directly,
              * when the call gives it all of them */
-            int in = g->nodes[g->root].slot, np = func_internal_params(in);
-            if (np >= 0 && np <= n->nkids && np <= g->nparams) {
-                double v;
-                if (func_internal_eval(in, a, c->env, &v)) return v;
-                c->failed = 1;
-                c->why = func_internal_name(in);
-                return 0;
-            }
+            in = g->nodes[g->root].slot;
+            int np = func_internal_params(in);
+            direct = np >= 0 && np <= nd->nkids && np <= g->nparams;
         }
-        if (eval_function(n->fn, a, r, c) != PT_OK) return 0;
-        if (n->sub == 5) return 0.297 * r[0] + 0.589 * r[1] + 0.114 * r[2]; /* gray */
-        return n->sub < n->fn->nterms ? r[n->sub] : 0.0;
+        int at = emit(cp, direct ? FI_CALL_INT : FI_CALL, dst, dst, in);
+        if (!cp->bad) {
+            cp->out[at].n = nd->nkids;
+            cp->out[at].sub = nd->sub;
+            cp->out[at].fn = g;
+        }
+        return res;
     }
-    case FN_INTERNAL: {
-        double v;
-        if (func_internal_eval(n->slot, slots, c->env, &v)) return v;
-        c->failed = 1;
-        c->why = func_internal_name(n->slot);
-        return 0;
+    case FN_INTERNAL: emit(cp, FI_INTERNAL, dst, 0, nd->slot); return res;
     }
-    }
-#undef KID
-    return 0;
+    cp->bad = 1;
+    return res;
 }
 
-/* Whether an op can run on the value stack (no control flow, no calls,
- * cannot fail). */
-static int post_op(func_op op)
+/* The registers before the temporaries: every slot eval_function fills. */
+static int first_temp(const scene_function *f)
 {
-    switch (op) {
-    case FN_CONST: case FN_ARG: case FN_NEG: case FN_ADD: case FN_SUB: case FN_MUL: case FN_DIV:
-    case FN_LT: case FN_LE: case FN_EQ: case FN_NE: case FN_GE: case FN_GT: case FN_AND: case FN_OR:
-    case FN_MATH: case FN_ATAN2: case FN_POW: case FN_MOD: case FN_IDIV: case FN_MIN: case FN_MAX:
-        return 1;
-    default:
-        return 0;
-    }
+    int np = f->nparams < FUNC_MAX_SLOTS ? f->nparams : FUNC_MAX_SLOTS;
+    return f->nslots > np ? (f->nslots < FUNC_MAX_SLOTS ? f->nslots : FUNC_MAX_SLOTS) : np;
 }
 
-/* Post order below node i into out[*n]; the stack depth it needs in *depth.
- * 0 when a node does not qualify or out is full. */
-static int post_walk(const scene_function *f, int i, int *out, int max, int *n, int *depth, int level)
+int func_compile(const scene_function *f, func_insn *out, int max, int *stack)
 {
-    if (level > FUNC_POST_STACK || i < 0 || i >= f->nnodes) return 0;
-    const func_node *nd = &f->nodes[i];
-    if (!post_op((func_op)nd->op)) return 0;
-    if ((nd->op == FN_MIN || nd->op == FN_MAX) && nd->nkids < 1) return 0;
-    int need = 1;
-    for (int j = 0; j < nd->nkids; j++) {
-        int d;
-        if (!post_walk(f, f->kids[nd->kid + j], out, max, n, &d, level + 1)) return 0;
-        /* kid j is computed with j values already on the stack */
-        if (j + d > need) need = j + d;
-    }
-    if (*n >= max) return 0;
-    out[(*n)++] = i;
-    *depth = need;
-    return 1;
+    if (!f || f->kind != FUNC_FLOAT || !f->nodes || !out) return -1;
+    compiler cp = {f, out, 0, max, 0, first_temp(f), 0};
+    /* the result in temporary 0 (a leaf body is copied there) */
+    compile_to(&cp, f->root, 0, 0);
+    if (cp.bad) return -1;
+    if (stack) *stack = cp.top;
+    return cp.n;
 }
 
-int func_postorder(const scene_function *f, int *out, int max)
-{
-    if (!f || f->kind != FUNC_FLOAT || !f->nodes) return -1;
-    int n = 0, depth = 0;
-    if (!post_walk(f, f->root, out, max, &n, &depth, 0) || depth > FUNC_POST_STACK) return -1;
-    return n;
-}
+/* ------------------------------------------------------------ evaluation */
 
-/* The body of f as its post-order list (scene_function.post): the same
- * operations on the same values as node_value, so the same result. */
-static double post_value(const scene_function *f, const double *slots)
+/* FUNC_RUN_TEMPS temporaries live on the C stack; a program that needs
+ * more takes its registers from the heap for the evaluation. */
+#define FUNC_RUN_TEMPS 64
+
+/* Run f's program on registers r (its slots filled, then f->stack
+ * temporaries); the result is in the first temporary. */
+static double run(const scene_function *f, double *r, eval_ctx *c)
 {
-    double st[FUNC_POST_STACK];
-    int sp = 0;
-    /* a binary node: its two kids' values, the first below, give one */
-#define BIN(expr)                                                                                              \
-    do {                                                                                                       \
-        double y = st[--sp], x = st[sp - 1];                                                                   \
-        st[sp - 1] = (expr);                                                                                   \
-    } while (0)
-    for (int i = 0; i < f->npost; i++) {
-        const func_node *n = &f->nodes[f->post[i]];
-        switch ((func_op)n->op) {
-        case FN_CONST: st[sp++] = n->k; break;
-        case FN_ARG: st[sp++] = slots[n->slot]; break;
-        case FN_NEG: st[sp - 1] = -st[sp - 1]; break;
-        case FN_MATH: st[sp - 1] = math1((func_math)n->sub, st[sp - 1]); break;
-        case FN_ADD: BIN(x + y); break;
-        case FN_SUB: BIN(x - y); break;
-        case FN_MUL: BIN(x * y); break;
-        case FN_DIV: BIN(x / y); break;
-        case FN_LT: BIN(x < y); break;
-        case FN_LE: BIN(x <= y); break;
-        case FN_EQ: BIN(x == y); break;
-        case FN_NE: BIN(x != y); break;
-        case FN_GE: BIN(x >= y); break;
-        case FN_GT: BIN(x > y); break;
-        case FN_AND: BIN(truth(x) && truth(y)); break;
-        case FN_OR: BIN(truth(x) || truth(y)); break;
-        case FN_ATAN2: BIN(atan2(x, y)); break;
-        case FN_POW: BIN(pow(x, y)); break;
-        case FN_MOD: BIN(fmod(x, y)); break;
-        case FN_IDIV: BIN(trunc(x / y)); break;
-        case FN_MIN: case FN_MAX: {
-            int k = n->nkids;
-            double v = st[sp - k];
-            for (int j = 1; j < k; j++) {
-                double w = st[sp - k + j];
-                if (n->op == FN_MIN ? w < v : w > v) v = w;
-            }
-            sp -= k - 1;
-            st[sp - 1] = v;
+    const func_insn *code = f->code;
+    int pc = 0, n = f->ncode;
+    while (pc < n) {
+        const func_insn *in = &code[pc++];
+        double *d = r + in->dst;
+        switch (in->op) {
+        case FI_MOV: *d = r[in->a]; break;
+        case FI_LOADK: *d = in->k; break;
+        case FI_NEG: *d = -r[in->a]; break;
+        case FI_MATH: *d = math1((func_math)in->sub, r[in->a]); break;
+        case FI_ADD: *d = r[in->a] + r[in->b]; break;
+        case FI_SUB: *d = r[in->a] - r[in->b]; break;
+        case FI_MUL: *d = r[in->a] * r[in->b]; break;
+        case FI_DIV: *d = r[in->a] / r[in->b]; break;
+        case FI_ADD_K: *d = r[in->a] + in->k; break;
+        case FI_SUB_K: *d = r[in->a] - in->k; break;
+        case FI_MUL_K: *d = r[in->a] * in->k; break;
+        case FI_DIV_K: *d = r[in->a] / in->k; break;
+        case FI_K_ADD: *d = in->k + r[in->b]; break;
+        case FI_K_SUB: *d = in->k - r[in->b]; break;
+        case FI_K_MUL: *d = in->k * r[in->b]; break;
+        case FI_K_DIV: *d = in->k / r[in->b]; break;
+        case FI_LT: *d = r[in->a] < r[in->b]; break;
+        case FI_LE: *d = r[in->a] <= r[in->b]; break;
+        case FI_EQ: *d = r[in->a] == r[in->b]; break;
+        case FI_NE: *d = r[in->a] != r[in->b]; break;
+        case FI_GE: *d = r[in->a] >= r[in->b]; break;
+        case FI_GT: *d = r[in->a] > r[in->b]; break;
+        case FI_AND: *d = truth(r[in->a]) && truth(r[in->b]); break;
+        case FI_OR: *d = truth(r[in->a]) || truth(r[in->b]); break;
+        case FI_ATAN2: *d = atan2(r[in->a], r[in->b]); break;
+        case FI_POW: *d = pow(r[in->a], r[in->b]); break;
+        case FI_MOD: *d = fmod(r[in->a], r[in->b]); break;
+        case FI_IDIV: *d = trunc(r[in->a] / r[in->b]); break;
+        case FI_MIN: case FI_MAX: {
+            const double *v = r + in->a;
+            double m = v[0];
+            for (int j = 1; j < in->n; j++)
+                if (in->op == FI_MIN ? v[j] < m : v[j] > m) m = v[j];
+            *d = m;
             break;
         }
-        default: return 0.0; /* func_postorder admits none other */
+        case FI_JNLT:
+            if (!(r[in->a] < 0)) pc = in->dst;
+            break;
+        case FI_SEL4: {
+            double v = r[in->a];
+            if (!(v < 0)) pc = v == 0 ? in->dst : in->b;
+            break;
+        }
+        case FI_JMP: pc = in->dst; break;
+        case FI_LOOP: {
+            double *l = r + in->a;
+            l[2] = in->k;
+            l[3] = l[0];
+            if (l[0] <= l[1]) *d = l[0];
+            else pc = in->b;
+            break;
+        }
+        case FI_NEXT: {
+            double *l = r + in->a, b = l[4];
+            l[2] = in->sub ? l[2] + b : l[2] * b;
+            l[3] += 1.0;
+            if (l[3] <= l[1]) {
+                *d = l[3];
+                pc = in->b;
+            }
+            break;
+        }
+        case FI_END: r[in->a] = r[in->a + 2]; break;
+        case FI_CALL_INT: {
+            double v; /* not into *d: that is the first argument's register */
+            if (!func_internal_eval(in->b, r + in->a, c->env, &v)) {
+                c->failed = 1;
+                c->why = func_internal_name(in->b);
+                return 0;
+            }
+            *d = v;
+            break;
+        }
+        case FI_CALL: {
+            double v[5];
+            if (eval_function(in->fn, r + in->a, v, c) != PT_OK) return 0;
+            if (in->sub == 5) *d = 0.297 * v[0] + 0.589 * v[1] + 0.114 * v[2]; /* gray */
+            else *d = in->sub < in->fn->nterms ? v[in->sub] : 0.0;
+            break;
+        }
+        case FI_INTERNAL:
+            if (!func_internal_eval(in->b, r, c->env, d)) {
+                c->failed = 1;
+                c->why = func_internal_name(in->b);
+                return 0;
+            }
+            break;
+        default:
+            c->failed = 1;
+            c->why = "bad program";
+            return 0;
         }
     }
-#undef BIN
-    return st[0];
+    return r[first_temp(f)];
 }
 
 static pt_status eval_function(const scene_function *f, const double *args, double *out, eval_ctx *c)
@@ -250,15 +395,26 @@ static pt_status eval_function(const scene_function *f, const double *args, doub
     c->depth++;
     switch (f->kind) {
     case FUNC_FLOAT: {
-        double slots[FUNC_MAX_SLOTS];
-        int np = f->nparams < FUNC_MAX_SLOTS ? f->nparams : FUNC_MAX_SLOTS;
-        /* only the slots the body uses (parameters, loop variables) are
-         * cleared: a call is evaluated per isosurface sample */
-        int ns = f->nslots > np ? (f->nslots < FUNC_MAX_SLOTS ? f->nslots : FUNC_MAX_SLOTS) : np;
-        /* loops, not memcpy/memset: a handful of slots, per evaluation */
-        for (int i = 0; i < np; i++) slots[i] = args[i];
-        for (int i = np; i < ns; i++) slots[i] = 0.0;
-        out[0] = f->post ? post_value(f, slots) : node_value(f, f->root, slots, c);
+        if (!f->code) {
+            c->failed = 1;
+            c->why = "function not compiled";
+            break;
+        }
+        /* the registers: slots (parameters, loop variables), then the
+         * program's temporaries */
+        double local[FUNC_MAX_SLOTS + FUNC_RUN_TEMPS], *r = local;
+        int ns = first_temp(f), np = f->nparams < ns ? f->nparams : ns;
+        if (f->stack > FUNC_RUN_TEMPS && !(r = malloc(sizeof *r * (size_t)(ns + f->stack)))) {
+            c->failed = 1;
+            c->why = "out of memory";
+            break;
+        }
+        /* only the slots the body uses are cleared: a call is evaluated
+         * per isosurface sample (loops, not memcpy/memset: a handful) */
+        for (int i = 0; i < np; i++) r[i] = args[i];
+        for (int i = np; i < ns; i++) r[i] = 0.0;
+        out[0] = run(f, r, c);
+        if (r != local) free(r);
         break;
     }
     case FUNC_TRANSFORM: {

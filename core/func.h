@@ -71,12 +71,12 @@ typedef struct scene_function {
     const func_node *nodes;
     const int *kids;
     int root;                  /* FUNC_FLOAT: the body's node */
-    /* FUNC_FLOAT whose body is arithmetic, comparisons, min/max and the
-     * math built-ins only (no select, sum/prod, calls or internals): its
-     * nodes in post order (func_postorder), evaluated on a value stack
-     * instead of by walking the tree; NULL: walked. */
-    const int *post;
-    int npost;
+    /* FUNC_FLOAT: the body compiled to a flat program (func_compile, at
+     * declaration), run in a loop on registers; a float function without
+     * one cannot be evaluated (func_eval says so). */
+    const struct func_insn *code;
+    int ncode;
+    int stack;                 /* the temporaries the program needs */
     xform transform;           /* FUNC_TRANSFORM */
     const struct user_spline *spline; /* FUNC_SPLINE */
     const void *pigment;       /* FUNC_PIGMENT / FUNC_PATTERN: the pigment IR (opaque here) */
@@ -99,12 +99,26 @@ typedef struct func_env {
  * *why, if not NULL, names it: "internal(76) (noise)", "pigment function"). */
 pt_status func_eval(const scene_function *f, const double *args, double *out, const func_env *env, const char **why);
 
-/* FUNC_POST_STACK bounds the value stack of a post-order body. */
-#define FUNC_POST_STACK 64
-/* The nodes of f's body in post order into out (at most max), when the body
- * qualifies for scene_function.post and its stack stays within
- * FUNC_POST_STACK: their number; else -1. */
-int func_postorder(const scene_function *f, int *out, int max);
+/* One instruction of a compiled body (func_compile): three-address code
+ * on registers (the function's slots, then temporaries). Ops are FI_*
+ * (func.c); dst is the register written or a jump target, a and b the
+ * registers read (or a second jump target, an internal's number), k a
+ * constant operand, fn a called function. */
+typedef struct func_insn {
+    unsigned char op;
+    unsigned char sub;         /* FN_MATH: func_math; a call: result term */
+    unsigned short n;          /* arguments of a call, operands of min/max */
+    int dst, a, b;
+    double k;
+    const struct scene_function *fn;
+} func_insn;
+
+/* f's body (FUNC_FLOAT) compiled into out (room for max instructions;
+ * 4 per node always suffices): the same operations on the same values in
+ * the same order as the tree, so the same result to the bit. Returns the
+ * number of instructions and sets *stack to the temporaries it needs; -1
+ * when f is no float function or out is too small. */
+int func_compile(const scene_function *f, func_insn *out, int max, int *stack);
 
 /* The float result (out[0]); NaN when unsupported. */
 double func_eval_float(const scene_function *f, const double *args, const func_env *env);

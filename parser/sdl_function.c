@@ -543,14 +543,17 @@ scene_function *sdl_parse_function(sdl_parser *p, src_loc loc, const char *name)
         f->nodes = arena_memdup(p->s->mem, b.nodes, sizeof *b.nodes * (size_t)b.nnodes);
         f->kids = b.nkids ? arena_memdup(p->s->mem, b.kids, sizeof *b.kids * (size_t)b.nkids) : NULL;
         if (f->kind == FUNC_FLOAT) {
-            /* a plain arithmetic body runs as a post-order list (func.h) */
-            int *post = malloc(sizeof *post * (size_t)b.nnodes);
-            int np = post ? func_postorder(f, post, b.nnodes) : -1;
-            if (np > 0) {
-                f->post = arena_memdup(p->s->mem, post, sizeof *post * (size_t)np);
-                f->npost = f->post ? np : 0;
-            }
-            free(post);
+            /* the body runs as a flat program (func.h); 4 instructions per
+             * node always suffice */
+            int max = 4 * b.nnodes + 1, stack = 0;
+            func_insn *code = malloc(sizeof *code * (size_t)max);
+            int nc = code ? func_compile(f, code, max, &stack) : -1;
+            if (nc > 0) f->code = arena_memdup(p->s->mem, code, sizeof *code * (size_t)nc);
+            if (code && nc <= 0) sdl_error(p, loc, PT_ERR_INTERNAL, "function body could not be compiled");
+            else if (!f->code) sdl_error(p, loc, PT_ERR_NOMEM, "out of memory compiling a function");
+            free(code);
+            f->ncode = nc;
+            f->stack = stack;
         }
     }
     free(b.nodes);

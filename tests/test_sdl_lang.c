@@ -282,6 +282,65 @@ static void test_functions_ir(void **st)
     diag_free(d);
 }
 
+/* Compiled function bodies (func_compile): every op, each branch of
+ * select, loops (nested, one variable twice), calls of user, vector and
+ * built-in functions, and a body deeper than the on-stack registers,
+ * against the same expressions in C at the point (0.3, -0.7, 1.1). */
+static void test_functions_compiled(void **st)
+{
+    (void)st;
+    const double x = 0.3, y = -0.7, z = 1.1;
+    char deep[2048] = "#declare Deep = function { x";
+    /* x*2 + (x*2 + (... x)): 90 temporaries deep, past the on-stack ones */
+    for (int i = 0; i < 90; i++) strcat(deep, " * 2 + (x");
+    for (int i = 0; i < 90; i++) strcat(deep, ")");
+    strcat(deep, " }\n");
+    double dv = x;
+    for (int i = 0; i < 90; i++) dv = x * 2 + dv; /* innermost first: the same sums */
+    char text[8192];
+    snprintf(text, sizeof text,
+             "#include \"functions.inc\"\n"
+             "#declare S = function(a) { (sin(a) + 1) / 2 }\n"
+             "#declare T = function { transform { translate <1, 2, 3> } }\n"
+             "#declare F0 = function { sqrt(x*x + pow(y - sqrt((x*x/4) + (z*z/4))*1.5, 2) + z*z) - 1 - "
+             "(sin(atan2(x, z)*40)*0.5*0.075) }\n"
+             "#declare F1 = function { f_r(x, y*0.35, z) - 1 - S(atan2(x, z)*40)*0.075 }\n"
+             "#declare F2 = function { select(x, 1, 2, 3) + 10*select(y, 4, 5) + 100*select(z - 1.1, 6, 7, 8) + "
+             "1000*select(x - 0.3, 9, 10) }\n"
+             "#declare F3 = function { sum(i, 1, 4, i*x + sum(i, 0, 1, i)) + prod(j, 2, 3, j + y) + sum(k, 2, 1, k) }\n"
+             "#declare F4 = function { max(x, y, z) - min(z, 1) + 3/x - 2 - x + (x < y) + 2*(x <= y) + 4*(x = x) + "
+             "8*(x != y) + 16*(y >= x) + 32*(z > y) + 64*(x & 0) + 128*(0 | y) }\n"
+             "#declare F5 = function { -x + abs(y) + mod(z, x) + div(z, x) + T(x, y, z).y + 2 }\n"
+             "#declare F6 = function { 2 }\n"
+             "#declare F7 = function { y }\n"
+             "%s"
+             "#declare P = <0.3, -0.7, 1.1>;\n"
+             "#debug str(F0(P.x, P.y, P.z), 0, 17)\n#debug str(F1(P.x, P.y, P.z), 0, 17)\n"
+             "#debug str(F2(P.x, P.y, P.z), 0, 17)\n#debug str(F3(P.x, P.y, P.z), 0, 17)\n"
+             "#debug str(F4(P.x, P.y, P.z), 0, 17)\n#debug str(F5(P.x, P.y, P.z), 0, 17)\n"
+             "#debug str(F6(P.x, P.y, P.z), 0, 17)\n#debug str(F7(P.x, P.y, P.z), 0, 17)\n"
+             "#debug str(Deep(P.x, P.y, P.z), 0, 17)\n",
+             deep);
+    double want[9];
+    want[0] = sqrt(x * x + pow(y - sqrt((x * x / 4) + (z * z / 4)) * 1.5, 2) + z * z) - 1 - (sin(atan2(x, z) * 40) * 0.5 * 0.075);
+    want[1] = sqrt(x * x + (y * 0.35) * (y * 0.35) + z * z) - 1 - (sin(atan2(x, z) * 40) + 1) / 2 * 0.075;
+    want[2] = 3 + 10 * 4 + 100 * 7 + 1000 * 10; /* x > 0, y < 0, z - 1.1 == 0, x - 0.3 == 0 */
+    want[3] = (1 * x + 1) + (2 * x + 1) + (3 * x + 1) + (4 * x + 1) + (2 + y) * (3 + y) + 0;
+    want[4] = z - 1 + 3 / x - 2 - x + 0 + 0 + 4 + 8 + 0 + 32 + 0 + 128;
+    want[5] = -x + fabs(y) + fmod(z, x) + trunc(z / x) + (y + 2) + 2;
+    want[6] = 2;
+    want[7] = y;
+    want[8] = dv;
+    diag *d = parse_text(text, NULL, PT_OK, NULL);
+    for (int i = 0; i < 9; i++) {
+        const char *v = note(d, i);
+        assert_non_null(v);
+        /* 17 decimals printed: within 1e-14 of the same arithmetic in C */
+        if (!(fabs(strtod(v, NULL) - want[i]) <= 1e-14 * (1 + fabs(want[i])))) fail_msg("F%d: %s, want %.17f", i, v, want[i]);
+    }
+    diag_free(d);
+}
+
 /* ------------------------------------------------------------ files, cameras */
 
 static void test_file_io(void **st)
@@ -570,6 +629,7 @@ int main(void)
         cmocka_unit_test(test_arrays_ir),
         cmocka_unit_test(test_macros),
         cmocka_unit_test(test_functions_ir),
+        cmocka_unit_test(test_functions_compiled),
         cmocka_unit_test(test_file_io),
         cmocka_unit_test(test_render_statistics_mesh_camera),
         cmocka_unit_test(test_error_corpus),
