@@ -191,7 +191,7 @@ static void init_rands(void)
     }
 }
 
-static vec3 dnoise(vec3 p);
+static inline vec3 dnoise(vec3 p);
 
 static void init_waves(void)
 {
@@ -301,13 +301,10 @@ __attribute__((always_inline)) static inline void cell_at(vec3 p, noise_cell *c)
 
 static double solid_noise(vec3 p);
 
-double shade_noise_value(vec3 p, int generator)
+/* Generators 1 and 2 at one point; forced inline so that the octave loops
+ * (shade_noise_octaves) run it without a call per octave. */
+__attribute__((always_inline)) static inline double lattice_noise(vec3 p, int generator)
 {
-    noise_init();
-    if (generator == 3) {
-        double sum = 0.5 * (1.59 * solid_noise(p) + 0.985);
-        return sum < 0.0 ? 0.0 : (sum > 1.0 ? 1.0 : sum);
-    }
     noise_cell c;
     cell_at(p, &c);
     /* corners in POV-Ray's order, two to a vector: (000, 100), (010, 110),
@@ -335,13 +332,78 @@ double shade_noise_value(vec3 p, int generator)
     return sum < 0.0 ? 0.0 : (sum > 1.0 ? 1.0 : sum);
 }
 
+/* Generators 1 and 2 at two points at once, a and b in lanes 0 and 1: the
+ * eight corners of each are summed in POV-Ray's order down the lanes, each
+ * lane doing lattice_noise's operations in its order (bit for bit its
+ * result), so the two sums' additions, which run one after the other in
+ * a single noise value, share their instructions. */
+__attribute__((always_inline)) static inline nv2 lattice_noise2(vec3 a, vec3 b, int generator)
+{
+    noise_cell c, d;
+    cell_at(a, &c);
+    cell_at(b, &d);
+    nv2 x0 = {c.x0, d.x0}, x1 = {c.x1, d.x1}, y0 = {c.y0, d.y0}, y1 = {c.y1, d.y1}, z0 = {c.z0, d.z0}, z1 = {c.z1, d.z1};
+    nv2 tz = {c.tz, d.tz}, sz = {c.sz, d.sz};
+    nv2 txty = {c.txty, d.txty}, sxty = {c.sxty, d.sxty}, txsy = {c.txsy, d.txsy}, sxsy = {c.sxsy, d.sxsy};
+    nv2 sum = term2(rindex_of(c.h00, c.iz), rindex_of(d.h00, d.iz), txty * tz, x0, y0, z0);
+    sum += term2(rindex_of(c.h10, c.iz), rindex_of(d.h10, d.iz), sxty * tz, x1, y0, z0);
+    sum += term2(rindex_of(c.h01, c.iz), rindex_of(d.h01, d.iz), txsy * tz, x0, y1, z0);
+    sum += term2(rindex_of(c.h11, c.iz), rindex_of(d.h11, d.iz), sxsy * tz, x1, y1, z0);
+    sum += term2(rindex_of(c.h00, c.iz + 1), rindex_of(d.h00, d.iz + 1), txty * sz, x0, y0, z1);
+    sum += term2(rindex_of(c.h10, c.iz + 1), rindex_of(d.h10, d.iz + 1), sxty * sz, x1, y0, z1);
+    sum += term2(rindex_of(c.h01, c.iz + 1), rindex_of(d.h01, d.iz + 1), txsy * sz, x0, y1, z1);
+    sum += term2(rindex_of(c.h11, c.iz + 1), rindex_of(d.h11, d.iz + 1), sxsy * sz, x1, y1, z1);
+    if (generator == 2) {
+        sum += (nv2){1.05242, 1.05242};
+        sum *= (nv2){0.48985582, 0.48985582};
+    } else {
+        sum = sum + (nv2){0.5, 0.5};
+    }
+    /* the scalar clamp per lane (a NaN stays NaN, as there) */
+    for (int k = 0; k < 2; k++) sum[k] = sum[k] < 0.0 ? 0.0 : (sum[k] > 1.0 ? 1.0 : sum[k]);
+    return sum;
+}
+
+double shade_noise_value(vec3 p, int generator)
+{
+    noise_init();
+    if (generator == 3) {
+        double sum = 0.5 * (1.59 * solid_noise(p) + 0.985);
+        return sum < 0.0 ? 0.0 : (sum > 1.0 ? 1.0 : sum);
+    }
+    return lattice_noise(p, generator);
+}
+
+void shade_noise_octaves(vec3 p, int n, double lambda, int generator, double *out)
+{
+    noise_init();
+    double l = 1.0;
+    int i = 0;
+    if (generator != 3) {
+        /* two octaves at a time; the scale is the running product, as
+         * Turbulence forms it */
+        for (; i + 1 < n; i += 2) {
+            vec3 a = i ? v3_scale(p, l) : p;
+            double l2 = l * lambda;
+            nv2 v = lattice_noise2(a, v3_scale(p, l2), generator);
+            out[i] = v[0];
+            out[i + 1] = v[1];
+            l = l2 * lambda;
+        }
+    }
+    for (; i < n; i++) {
+        out[i] = shade_noise_value(i ? v3_scale(p, l) : p, generator);
+        l *= lambda;
+    }
+}
+
 vec3 shade_noise_dvector(vec3 p)
 {
     noise_init();
     return dnoise(p);
 }
 
-static vec3 dnoise(vec3 p)
+__attribute__((always_inline)) static inline vec3 dnoise(vec3 p)
 {
     noise_cell c;
     cell_at(p, &c);
@@ -406,20 +468,30 @@ static double solid_noise(vec3 p)
 
 /* ------------------------------------------------------------ fractal sums */
 
+/* The octaves' noise values come from shade_noise_octaves / the inlined
+ * DNoise loop below (the same scales, l *= lambda per octave); the sums
+ * are formed in POV-Ray's order. Octaves are at most 10 in a scene (the
+ * parser clamps them as POV-Ray does); more are taken in the same way, a
+ * call per octave. */
+#define OCTAVES_AT_ONCE 16
+
 double shade_noise_turbulence(vec3 p, int octaves, double omega, double lambda, int generator)
 {
+    double v[OCTAVES_AT_ONCE];
+    int n = octaves < 1 ? 1 : (octaves > OCTAVES_AT_ONCE ? OCTAVES_AT_ONCE : octaves);
+    shade_noise_octaves(p, n, lambda, generator, v);
     double value;
     if (generator > 1) {
-        value = 2.0 * shade_noise_value(p, generator) - 0.5;
+        value = 2.0 * v[0] - 0.5;
         value = fmin(fmax(value, 0.0), 1.0);
     } else {
-        value = shade_noise_value(p, generator);
+        value = v[0];
     }
     double l = lambda, o = omega;
     for (int i = 2; i <= octaves; i++) {
-        vec3 t = v3_scale(p, l);
-        if (generator > 1) value += o * (2.0 * shade_noise_value(t, generator) - 0.5);
-        else value += o * shade_noise_value(t, generator);
+        double nv = i <= n ? v[i - 1] : shade_noise_value(v3_scale(p, l), generator);
+        if (generator > 1) value += o * (2.0 * nv - 0.5);
+        else value += o * nv;
         if (i < octaves) {
             l *= lambda;
             o *= omega;
@@ -430,10 +502,11 @@ double shade_noise_turbulence(vec3 p, int octaves, double omega, double lambda, 
 
 vec3 shade_noise_dturbulence(vec3 p, int octaves, double omega, double lambda)
 {
-    vec3 r = shade_noise_dvector(p);
+    noise_init();
+    vec3 r = dnoise(p);
     double l = lambda, o = omega;
     for (int i = 2; i <= octaves; i++) {
-        vec3 v = shade_noise_dvector(v3_scale(p, l));
+        vec3 v = dnoise(v3_scale(p, l));
         r.x += o * v.x;
         r.y += o * v.y;
         r.z += o * v.z;

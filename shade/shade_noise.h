@@ -25,6 +25,11 @@ static inline int shade_noise_to_int(double x)
 
 /* POV-Ray's Noise(p, generator): a value in [0, 1]. generator 1..3. */
 double shade_noise_value(vec3 p, int generator);
+/* Noise(p * l_i, generator) for i = 0 .. n-1 into out, l_0 = 1 and
+ * l_i = l_(i-1) * lambda (the octave scales Turbulence and wrinkles use,
+ * formed the same way): each value bit for bit shade_noise_value's,
+ * evaluated together (two octaves at a time, no call per octave). */
+void shade_noise_octaves(vec3 p, int n, double lambda, int generator, double *out);
 /* POV-Ray's DNoise(p): vector noise, components roughly in [-1, 1]. */
 vec3 shade_noise_dvector(vec3 p);
 

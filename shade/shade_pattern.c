@@ -622,14 +622,14 @@ static double wood(const scene_pattern *pat, vec3 p)
 
 static double wrinkles(vec3 p, int gen)
 {
-    double lambda = 2.0, omega = 0.5, value;
-    if (gen > 1) value = fmin_inline(fmax_inline(shade_noise_value(p, gen) * 2.0 - 0.5, 0.0), 1.0);
-    else value = shade_noise_value(p, gen);
+    /* the noise at p scaled by 1, 2, 4, ... 512 */
+    double n[10], omega = 0.5, value;
+    shade_noise_octaves(p, 10, 2.0, gen, n);
+    if (gen > 1) value = fmin_inline(fmax_inline(n[0] * 2.0 - 0.5, 0.0), 1.0);
+    else value = n[0];
     for (int i = 1; i < 10; i++) {
-        vec3 t = v3_scale(p, lambda);
-        if (gen > 1) value += omega * fmin_inline(fmax_inline(shade_noise_value(t, gen) * 2.0 - 0.5, 0.0), 1.0);
-        else value += omega * shade_noise_value(t, gen);
-        lambda *= 2.0;
+        if (gen > 1) value += omega * fmin_inline(fmax_inline(n[i] * 2.0 - 0.5, 0.0), 1.0);
+        else value += omega * n[i];
         omega *= 0.5;
     }
     return value / 2.0;

@@ -442,6 +442,37 @@ static void test_image_options(void **st)
     assert_int_equal(run_tiles(image_cases, NIMAGE, "images"), 0);
 }
 
+/* The octave batch (two lattice noises per pass, down the lanes) gives
+ * each octave's value bit for bit as one shade_noise_value at the same
+ * scaled point, and Turbulence built on it the sum POV-Ray forms octave by
+ * octave; points on both sides of zero and just off lattice planes. */
+static void test_noise_octaves_exact(void **st)
+{
+    (void)st;
+    const double lambdas[3] = {2.0, 1.7, 3.1};
+    for (int g = 1; g <= 3; g++)
+        for (int li = 0; li < 3; li++)
+            for (int i = 0; i < 3000; i++) {
+                double off = (i % 7 == 0) ? 1e-11 : 0.0;
+                vec3 p = v3(i * 0.173 - 250.0 + off, 40.0 - i * 0.0311 - off, (i % 13) * 0.5 - 3.0 + i * 1e-4);
+                int n = 1 + i % 11;
+                double v[11];
+                shade_noise_octaves(p, n, lambdas[li], g, v);
+                double l = 1.0, turb = 0.0, o = 0.5;
+                for (int k = 0; k < n; k++) {
+                    double ref = shade_noise_value(k ? v3_scale(p, l) : p, g);
+                    if (v[k] != ref) fail_msg("gen %d lambda %g octave %d at point %d: %.17g != %.17g", g, lambdas[li], k, i, v[k], ref);
+                    if (k == 0) turb = g > 1 ? fmin(fmax(2.0 * ref - 0.5, 0.0), 1.0) : ref;
+                    else {
+                        turb += o * (g > 1 ? 2.0 * ref - 0.5 : ref);
+                        if (k < n - 1) o *= 0.5;
+                    }
+                    l *= lambdas[li];
+                }
+                assert_true(shade_noise_turbulence(p, n, 0.5, lambdas[li], g) == turb);
+            }
+}
+
 /* Closed forms: ranges and the blend-map search. */
 static void test_noise_closed_form(void **st)
 {
@@ -492,6 +523,7 @@ int main(void)
     if (!mkdtemp(tmpdir)) return 1;
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_noise_closed_form),
+        cmocka_unit_test(test_noise_octaves_exact),
         cmocka_unit_test(test_patterns),
         cmocka_unit_test(test_pavement),
         cmocka_unit_test(test_pavement_errors),
