@@ -47,12 +47,9 @@ typedef struct {
     int threads;          /* buffers */
 } link_job;
 
-/* The material where ray h hit object o: rho and le at the pigment there
- * (a sky dome's gradient, a terrain's colours; the texture's base colour
- * without a pigment function), the hit point and its normal turned to the
- * ray. */
-static void hit_material(const link_job *J, const struct RTCRayHit *h, const scene_object *o,
-                         const scene_texture *tex, float rho[3], float le[3], vec3 *pt, vec3 *nrm)
+/* Where ray h hit: the point and the normal turned to the ray (the
+ * geometric one; minus the ray's direction in an instance). */
+static void hit_point(const struct RTCRayHit *h, vec3 *pt, vec3 *nrm)
 {
     vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z), n = v3_neg(d);
     if (h->hit.instID[0] == RTC_INVALID_GEOMETRY_ID) {
@@ -60,13 +57,21 @@ static void hit_material(const link_job *J, const struct RTCRayHit *h, const sce
         double l = v3_len(ng);
         if (l > 0.0 && isfinite(l)) n = v3_dot(ng, d) > 0.0 ? v3_scale(ng, -1.0 / l) : v3_scale(ng, 1.0 / l);
     }
-    /* the pigment where the ray hit (a sky dome's gradient, a terrain's
-     * colours), else the texture's base colour */
+    *pt = v3(h->ray.org_x + h->ray.tfar * d.x, h->ray.org_y + h->ray.tfar * d.y, h->ray.org_z + h->ray.tfar * d.z);
+    *nrm = n;
+}
+
+/* The material of object o at p (hit_point's, normal n): rho and le at
+ * the pigment there (a sky dome's gradient, a terrain's colours; the
+ * texture's base colour without a pigment function). */
+static void hit_material(const link_job *J, const scene_object *o, const scene_texture *tex, vec3 p, vec3 n,
+                         float rho[3], float le[3])
+{
     colour5 c, *cp = NULL;
     if (J->pig) {
         accel_hit ah;
         memset(&ah, 0, sizeof ah);
-        ah.p = v3(h->ray.org_x + h->ray.tfar * d.x, h->ray.org_y + h->ray.tfar * d.y, h->ray.org_z + h->ray.tfar * d.z);
+        ah.p = p;
         ah.ng = ah.ns = n;
         ah.obj = o;
         ah.texture = tex;
@@ -78,8 +83,6 @@ static void hit_material(const link_job *J, const struct RTCRayHit *h, const sce
             cp = &c;
     }
     gi_particles_material(J->sc, tex, cp, rho, le);
-    *pt = v3(h->ray.org_x + h->ray.tfar * d.x, h->ray.org_y + h->ray.tfar * d.y, h->ray.org_z + h->ray.tfar * d.z);
-    *nrm = n;
 }
 
 /* The leaf a link ray hit and its effective texture (never NULL when the
@@ -111,7 +114,34 @@ static const scene_object *hit_leaf(const link_job *J, const struct RTCRayHit *h
 typedef struct {
     const scene_texture *tex;
     int emits;
+    /* under some pigment: it emits (its emission is not 0), it reflects
+     * (diffuse is not 0); where neither, no pigment gives light */
+    int glows, reflects;
+} emit_memo_entry;
+
+/* The last few textures asked (a gather's rays alternate between a few
+ * objects: the sky dome, a wall, the floor), replaced in turn. */
+#define EMIT_MEMO 4
+typedef struct {
+    emit_memo_entry e[EMIT_MEMO];
+    int next;
 } emit_memo;
+
+static const emit_memo_entry *memo_of(const link_job *J, emit_memo *memo, const scene_texture *tex)
+{
+    for (int i = 0; i < EMIT_MEMO; i++)
+        if (memo->e[i].tex == tex) return &memo->e[i];
+    emit_memo_entry *m = &memo->e[memo->next];
+    memo->next = (memo->next + 1) % EMIT_MEMO;
+    const colour5 white = {1.0, 1.0, 1.0, 0.0, 0.0};
+    float rho[3], le[3];
+    gi_particles_material(J->sc, tex, &white, rho, le);
+    m->tex = tex;
+    m->emits = le[0] > 0.0f || le[1] > 0.0f || le[2] > 0.0f;
+    m->glows = le[0] != 0.0f || le[1] != 0.0f || le[2] != 0.0f;
+    m->reflects = rho[0] != 0.0f || rho[1] != 0.0f || rho[2] != 0.0f;
+    return m;
+}
 
 static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int direct, emit_memo *memo, float out[3])
 {
@@ -120,29 +150,24 @@ static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int
     const scene_object *o = hit_leaf(J, h, &tex);
     if (!o) return;
     float rho[3], le[3];
+    const emit_memo_entry *mt = memo_of(J, memo, tex);
+    const int sky_term = far && J->far_bounce > 0.0f, lit = direct && J->nlights > 0;
     /* with no far-field sky and no lights to reflect, only the emission
      * counts: none where the finish emits nothing */
-    if ((!far || !(J->far_bounce > 0.0f)) && (!direct || J->nlights <= 0)) {
-        if (memo->tex != tex) {
-            const colour5 white = {1.0, 1.0, 1.0, 0.0, 0.0};
-            gi_particles_material(J->sc, tex, &white, rho, le);
-            memo->tex = tex;
-            memo->emits = le[0] > 0.0f || le[1] > 0.0f || le[2] > 0.0f;
-        }
-        if (!memo->emits) return;
-    }
+    if (!sky_term && !lit && !mt->emits) return;
     vec3 p, n;
-    hit_material(J, h, o, tex, rho, le, &p, &n);
-    float irr[3] = {0.0f, 0.0f, 0.0f};
-    if (far && J->far_bounce > 0.0f) gi_sky_irradiance(J->sky, n, irr);
+    hit_point(h, &p, &n);
     /* and, for the final gather's links (J->lights), the direct light it
      * reflects (the particles' edir at the hit, gi_k_emit's sum, a shadow
      * ray each; area lights from their centre): sunlit ground beyond the
      * clip box is bright, not black. This is no further bounce: POV-Ray's
      * radiosity rays see the direct light of what they hit at every
-     * recursion_limit. */
+     * recursion_limit. It comes before the pigment: a hit in shadow that
+     * neither emits nor sees the far field's sky adds nothing, whatever
+     * its pigment (a turbulent pigment's noise is most of a textured
+     * scene's gather). */
     float dir[3] = {0.0f, 0.0f, 0.0f};
-    if (direct && J->nlights > 0 && (rho[0] > 0.0f || rho[1] > 0.0f || rho[2] > 0.0f)) {
+    if (lit && mt->reflects) {
         /* the shadow ray starts eps off the surface and ends short of the
          * light (gi_shadow_tmax), its length measured from where it starts */
         double eps = accel_epsilon(J->a, p, n);
@@ -164,6 +189,12 @@ static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int
             for (int c = 0; c < 3; c++) dir[c] += lt->colour[c] * att * (float)ci;
         }
     }
+    if (!sky_term && !mt->glows && dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) return;
+    hit_material(J, o, tex, p, n, rho, le);
+    /* no direct light where this pigment reflects nothing */
+    if (!(rho[0] > 0.0f || rho[1] > 0.0f || rho[2] > 0.0f)) dir[0] = dir[1] = dir[2] = 0.0f;
+    float irr[3] = {0.0f, 0.0f, 0.0f};
+    if (sky_term) gi_sky_irradiance(J->sky, n, irr);
     for (int c = 0; c < 3; c++) {
         float v = le[c] + rho[c] * (J->far_bounce * irr[c] + dir[c]);
         if (isfinite(v) && v > 0.0f) out[c] += v;
@@ -325,7 +356,7 @@ static void job(void *ctx, int index, int thread)
     m = 0;
     const void *last_obj = NULL;
     int last_hid = -1;
-    emit_memo memo = {NULL, 0};
+    emit_memo memo = {0};
     for (int i = i0; i < i1; i++) {
         int any = 0;
         float sky[3] = {0.0f, 0.0f, 0.0f};
@@ -705,7 +736,7 @@ int gi_gatherer_point(gi_gatherer *g, int thread, vec3 p, vec3 n, uint64_t strea
     source_rays(J, p, n, stream, rh);
     trace_rays(J, rh, J->k);
     float sky[3] = {0.0f, 0.0f, 0.0f};
-    emit_memo memo = {NULL, 0};
+    emit_memo memo = {0};
     for (int j = 0; j < J->k; j++) {
         if (ray_hit(&rh[j]))
             hit_light(J, &rh[j], 1, 1, &memo, sky);
