@@ -47,6 +47,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #define NOISE_EPSILON 1.0e-10
 #define LATTICE_MIN (-10000)
@@ -226,10 +229,19 @@ static inline void noise_init(void)
 
 static inline double scurve(double a) { return a * a * (3.0 - 2.0 * a); }
 
+#if defined(__SSE2__)
+/* shade_noise_to_int's rule is what cvttsd2si does (INT_MIN for NaN and
+ * out-of-range values): the instruction alone, without the two range
+ * tests a portable C cast needs, in the noise's innermost step. */
+static inline int trunc_int(double x) { return _mm_cvttsd_si32(_mm_set_sd(x)); }
+#else
+static inline int trunc_int(double x) { return shade_noise_to_int(x); }
+#endif
+
 /* Cell index (12 bits) and fraction along one axis, POV-Ray's way. */
 static inline void lattice(double x, int *i, double *f)
 {
-    int t = x >= 0 ? shade_noise_to_int(x) : shade_noise_to_int(x - (1 - NOISE_EPSILON));
+    int t = trunc_int(x >= 0 ? x : x - (1 - NOISE_EPSILON));
     *i = (t - LATTICE_MIN) & 0xFFF;
     *f = x - t;
 }
