@@ -1,5 +1,6 @@
 /* func.c - evaluation of compiled POV-Ray functions. */
 #include "func.h"
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -80,7 +81,9 @@ enum {
                     registers from a */
     FI_CALL_INT, /* dst = internal(b) of the n registers from a (a call of
                     a function whose body is one built-in) */
-    FI_INTERNAL  /* dst = internal(b) of this function's own registers */
+    FI_INTERNAL, /* dst = internal(b) of the function's slots, from
+                    register a (0, or an inlined callee's first) */
+    FI_RET       /* the end: the value is in the first temporary */
 };
 
 /* An operand: register r, or the constant k when r < 0. */
@@ -90,7 +93,8 @@ typedef struct {
 } operand;
 
 typedef struct {
-    const scene_function *f;
+    const scene_function *f; /* the function whose nodes are compiled */
+    int base;                /* the register of its slot 0 */
     func_insn *out;
     int n, max, bad, t0, top;
 } compiler;
@@ -126,6 +130,25 @@ static void place(compiler *cp, operand v, int reg)
 
 static operand compile_node(compiler *cp, int i, int depth, int level);
 
+/* The registers before the temporaries: every slot eval_function fills. */
+static int first_temp(const scene_function *f)
+{
+    int np = f->nparams < FUNC_MAX_SLOTS ? f->nparams : FUNC_MAX_SLOTS;
+    return f->nslots > np ? (f->nslots < FUNC_MAX_SLOTS ? f->nslots : FUNC_MAX_SLOTS) : np;
+}
+
+/* FUNC_INLINE_MAX: the longest callee (in instructions) compiled into its
+ * callers; each call site then adds at most that much code. */
+#define FUNC_INLINE_MAX 48
+
+/* Whether call node nd of a float function g is compiled in place: its
+ * float result (not a colour's gray) with every parameter given. */
+static int inline_ok(const scene_function *g, const func_node *nd)
+{
+    return g && g->kind == FUNC_FLOAT && g->code && g->ncode <= FUNC_INLINE_MAX && nd->sub == 0 &&
+           nd->nkids == g->nparams && g->nodes;
+}
+
 /* Node i's value in temporary `depth` (copied there if it is a leaf). */
 static void compile_to(compiler *cp, int i, int depth, int level)
 {
@@ -150,7 +173,7 @@ static operand compile_node(compiler *cp, int i, int depth, int level)
     int dst = cp->t0 + depth;
     switch ((func_op)nd->op) {
     case FN_CONST: return (operand){-1, nd->k};
-    case FN_ARG: return (operand){nd->slot, 0.0};
+    case FN_ARG: return (operand){cp->base + nd->slot, 0.0};
     case FN_NEG: case FN_MATH: {
         operand x = compile_node(cp, k[0], depth, level + 1);
         if (x.r < 0) place(cp, x, dst), x.r = dst;
@@ -213,9 +236,9 @@ static operand compile_node(compiler *cp, int i, int depth, int level)
         compile_to(cp, k[0], depth, level + 1);
         compile_to(cp, k[1], depth + 1, level + 1);
         if (depth + 5 > cp->top) cp->top = depth + 5;
-        int loop = emit(cp, FI_LOOP, nd->slot, dst, 0), body = cp->n;
+        int loop = emit(cp, FI_LOOP, cp->base + nd->slot, dst, 0), body = cp->n;
         compile_to(cp, k[2], depth + 4, level + 1);
-        int next = emit(cp, FI_NEXT, nd->slot, dst, body);
+        int next = emit(cp, FI_NEXT, cp->base + nd->slot, dst, body);
         int end = emit(cp, FI_END, 0, dst, 0);
         if (!cp->bad) {
             cp->out[loop].k = nd->op == FN_SUM ? 0.0 : 1.0;
@@ -238,6 +261,23 @@ static operand compile_node(compiler *cp, int i, int depth, int level)
             int np = func_internal_params(in);
             direct = np >= 0 && np <= nd->nkids && np <= g->nparams;
         }
+        if (!direct && inline_ok(g, nd)) {
+            /* the callee's body in place: its slots are the registers of
+             * the arguments (then its loop variables, cleared as
+             * eval_function clears them), its temporaries above */
+            int ns = first_temp(g);
+            for (int j = nd->nkids; j < ns; j++) place(cp, (operand){-1, 0.0}, dst + j);
+            if (depth + ns > cp->top) cp->top = depth + ns;
+            const scene_function *f0 = cp->f;
+            int base0 = cp->base;
+            cp->f = g;
+            cp->base = dst;
+            operand v = compile_node(cp, g->root, depth + ns, level + 1);
+            cp->f = f0;
+            cp->base = base0;
+            place(cp, v, dst);
+            return res;
+        }
         int at = emit(cp, direct ? FI_CALL_INT : FI_CALL, dst, dst, in);
         if (!cp->bad) {
             cp->out[at].n = nd->nkids;
@@ -246,25 +286,31 @@ static operand compile_node(compiler *cp, int i, int depth, int level)
         }
         return res;
     }
-    case FN_INTERNAL: emit(cp, FI_INTERNAL, dst, 0, nd->slot); return res;
+    case FN_INTERNAL: emit(cp, FI_INTERNAL, dst, cp->base, nd->slot); return res;
     }
     cp->bad = 1;
     return res;
 }
 
-/* The registers before the temporaries: every slot eval_function fills. */
-static int first_temp(const scene_function *f)
+
+int func_code_bound(const scene_function *f)
 {
-    int np = f->nparams < FUNC_MAX_SLOTS ? f->nparams : FUNC_MAX_SLOTS;
-    return f->nslots > np ? (f->nslots < FUNC_MAX_SLOTS ? f->nslots : FUNC_MAX_SLOTS) : np;
+    if (!f || !f->nodes) return 1;
+    long n = 4L * f->nnodes + 2;
+    for (int i = 0; i < f->nnodes; i++) {
+        const func_node *nd = &f->nodes[i];
+        if (nd->op == FN_CALL && inline_ok(nd->fn, nd)) n += nd->fn->ncode + first_temp(nd->fn) + 1;
+    }
+    return n < INT_MAX / 2 ? (int)n : INT_MAX / 2;
 }
 
 int func_compile(const scene_function *f, func_insn *out, int max, int *stack)
 {
     if (!f || f->kind != FUNC_FLOAT || !f->nodes || !out) return -1;
-    compiler cp = {f, out, 0, max, 0, first_temp(f), 0};
+    compiler cp = {f, 0, out, 0, max, 0, first_temp(f), 0};
     /* the result in temporary 0 (a leaf body is copied there) */
     compile_to(&cp, f->root, 0, 0);
+    emit(&cp, FI_RET, 0, 0, 0);
     if (cp.bad) return -1;
     if (stack) *stack = cp.top;
     return cp.n;
@@ -277,12 +323,12 @@ int func_compile(const scene_function *f, func_insn *out, int max, int *stack)
 #define FUNC_RUN_TEMPS 64
 
 /* Run f's program on registers r (its slots filled, then f->stack
- * temporaries); the result is in the first temporary. */
-static double run(const scene_function *f, double *r, eval_ctx *c)
+ * temporaries from register t0) to its FI_RET. */
+static double run(const scene_function *f, double *r, int t0, eval_ctx *c)
 {
     const func_insn *code = f->code;
-    int pc = 0, n = f->ncode;
-    while (pc < n) {
+    int pc = 0;
+    for (;;) {
         const func_insn *in = &code[pc++];
         double *d = r + in->dst;
         switch (in->op) {
@@ -367,20 +413,23 @@ static double run(const scene_function *f, double *r, eval_ctx *c)
             else *d = in->sub < in->fn->nterms ? v[in->sub] : 0.0;
             break;
         }
-        case FI_INTERNAL:
-            if (!func_internal_eval(in->b, r, c->env, d)) {
+        case FI_INTERNAL: {
+            double v;
+            if (!func_internal_eval(in->b, r + in->a, c->env, &v)) {
                 c->failed = 1;
                 c->why = func_internal_name(in->b);
                 return 0;
             }
+            *d = v;
             break;
+        }
+        case FI_RET: return r[t0];
         default:
             c->failed = 1;
             c->why = "bad program";
             return 0;
         }
     }
-    return r[first_temp(f)];
 }
 
 static pt_status eval_function(const scene_function *f, const double *args, double *out, eval_ctx *c)
@@ -413,7 +462,7 @@ static pt_status eval_function(const scene_function *f, const double *args, doub
          * per isosurface sample (loops, not memcpy/memset: a handful) */
         for (int i = 0; i < np; i++) r[i] = args[i];
         for (int i = np; i < ns; i++) r[i] = 0.0;
-        out[0] = run(f, r, c);
+        out[0] = run(f, r, ns, c);
         if (r != local) free(r);
         break;
     }

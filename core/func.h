@@ -114,11 +114,14 @@ typedef struct func_insn {
 } func_insn;
 
 /* f's body (FUNC_FLOAT) compiled into out (room for max instructions;
- * 4 per node always suffices): the same operations on the same values in
- * the same order as the tree, so the same result to the bit. Returns the
- * number of instructions and sets *stack to the temporaries it needs; -1
- * when f is no float function or out is too small. */
+ * func_code_bound(f) suffices): the same operations on the same values in
+ * the same order as the tree, so the same result to the bit. Calls of
+ * short float functions are compiled in place. Returns the number of
+ * instructions and sets *stack to the temporaries it needs; -1 when f is
+ * no float function or out is too small. */
 int func_compile(const scene_function *f, func_insn *out, int max, int *stack);
+/* Room enough for func_compile(f). */
+int func_code_bound(const scene_function *f);
 
 /* The float result (out[0]); NaN when unsupported. */
 double func_eval_float(const scene_function *f, const double *args, const func_env *env);

@@ -543,9 +543,8 @@ scene_function *sdl_parse_function(sdl_parser *p, src_loc loc, const char *name)
         f->nodes = arena_memdup(p->s->mem, b.nodes, sizeof *b.nodes * (size_t)b.nnodes);
         f->kids = b.nkids ? arena_memdup(p->s->mem, b.kids, sizeof *b.kids * (size_t)b.nkids) : NULL;
         if (f->kind == FUNC_FLOAT) {
-            /* the body runs as a flat program (func.h); 4 instructions per
-             * node always suffice */
-            int max = 4 * b.nnodes + 1, stack = 0;
+            /* the body runs as a flat program (func.h) */
+            int max = func_code_bound(f), stack = 0;
             func_insn *code = malloc(sizeof *code * (size_t)max);
             int nc = code ? func_compile(f, code, max, &stack) : -1;
             if (nc > 0) f->code = arena_memdup(p->s->mem, code, sizeof *code * (size_t)nc);

@@ -285,7 +285,8 @@ static void test_functions_ir(void **st)
 /* Compiled function bodies (func_compile): every op, each branch of
  * select, loops (nested, one variable twice), calls of user, vector and
  * built-in functions, and a body deeper than the on-stack registers,
- * against the same expressions in C at the point (0.3, -0.7, 1.1). */
+ * short callees compiled in place, against the same expressions in C at
+ * the point (0.3, -0.7, 1.1). */
 static void test_functions_compiled(void **st)
 {
     (void)st;
@@ -313,15 +314,17 @@ static void test_functions_compiled(void **st)
              "#declare F5 = function { -x + abs(y) + mod(z, x) + div(z, x) + T(x, y, z).y + 2 }\n"
              "#declare F6 = function { 2 }\n"
              "#declare F7 = function { y }\n"
+             "#declare L = function(a, b) { sum(i, 1, 2, i*a) - b }\n"
+             "#declare F8 = function { L(x*2, y) + L(z, 1) + S(L(x, z)) }\n"
              "%s"
              "#declare P = <0.3, -0.7, 1.1>;\n"
              "#debug str(F0(P.x, P.y, P.z), 0, 17)\n#debug str(F1(P.x, P.y, P.z), 0, 17)\n"
              "#debug str(F2(P.x, P.y, P.z), 0, 17)\n#debug str(F3(P.x, P.y, P.z), 0, 17)\n"
              "#debug str(F4(P.x, P.y, P.z), 0, 17)\n#debug str(F5(P.x, P.y, P.z), 0, 17)\n"
              "#debug str(F6(P.x, P.y, P.z), 0, 17)\n#debug str(F7(P.x, P.y, P.z), 0, 17)\n"
-             "#debug str(Deep(P.x, P.y, P.z), 0, 17)\n",
+             "#debug str(Deep(P.x, P.y, P.z), 0, 17)\n#debug str(F8(P.x, P.y, P.z), 0, 17)\n",
              deep);
-    double want[9];
+    double want[10];
     want[0] = sqrt(x * x + pow(y - sqrt((x * x / 4) + (z * z / 4)) * 1.5, 2) + z * z) - 1 - (sin(atan2(x, z) * 40) * 0.5 * 0.075);
     want[1] = sqrt(x * x + (y * 0.35) * (y * 0.35) + z * z) - 1 - (sin(atan2(x, z) * 40) + 1) / 2 * 0.075;
     want[2] = 3 + 10 * 4 + 100 * 7 + 1000 * 10; /* x > 0, y < 0, z - 1.1 == 0, x - 0.3 == 0 */
@@ -331,8 +334,11 @@ static void test_functions_compiled(void **st)
     want[6] = 2;
     want[7] = y;
     want[8] = dv;
+    /* calls compiled in place: a callee with a loop variable, twice */
+    double l1 = ((0.0 + 1 * (x * 2)) + 2 * (x * 2)) - y, l2 = ((0.0 + 1 * z) + 2 * z) - 1, l3 = ((0.0 + 1 * x) + 2 * x) - z;
+    want[9] = l1 + l2 + (sin(l3) + 1) / 2;
     diag *d = parse_text(text, NULL, PT_OK, NULL);
-    for (int i = 0; i < 9; i++) {
+    for (int i = 0; i < 10; i++) {
         const char *v = note(d, i);
         assert_non_null(v);
         /* 17 decimals printed: within 1e-14 of the same arithmetic in C */
