@@ -14,6 +14,7 @@ void pipeline_sdl_options(sdl_options *so, const cli_render *o, int width, int h
      * isosurfaces' functions (they keep the evaluators: scene_isosurface.env) */
     so->func_env = shade_func_env();
     if (!o) return;
+    so->threads = o->threads; /* as the render's */
     so->lib_paths = o->libs;
     so->nlib_paths = o->nlibs;
     so->defines = o->defines;

@@ -41,6 +41,8 @@ typedef struct {
     const struct func_env *func_env; /* evaluators for pigment/pattern functions, noise and
                                      vturbulence at parse time (core/func.h); NULL: such
                                      calls are located PT_ERR_UNSUPPORTED errors */
+    int threads;                  /* parse-time work split over threads (a height_field
+                                     function's rows); 0: the machine's cores */
     progress *progress;           /* stage "parse": bytes of the scene file read (its
                                      position outside includes and macro bodies); NULL: none */
     /* Out (NULL = not wanted): set to 1 when a value that changes from

@@ -6,11 +6,13 @@
 #include "sdl_shape.h"
 #include "grow.h"
 #include <math.h>
+#include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include "pool.h"
 #include "sdl_directive.h"
 #include "sdl_expr.h"
 #include "sdl_font.h"
@@ -598,6 +600,40 @@ static void blob_args(sdl_parser *p, scene_object *o, src_loc loc)
  * y = i / (H - 1), z = 0 into row i, column j of a 16-bit grey image (a
  * pigment function: its colour's grey value), which the height field then
  * reads as it reads a file (row 0 = the top of the image). */
+typedef struct {
+    const scene_function *fn;
+    const func_env *env;
+    unsigned short *v;
+    const char **why; /* per row: why it could not be evaluated, or NULL */
+    int w, h;
+    atomic_int failed;
+} hf_rows;
+
+/* Row i of a height field's function image (pool job: the rows are
+ * independent, and the evaluators keep no state between calls). */
+static void hf_row(void *ctx, int i, int thread)
+{
+    (void)thread;
+    hf_rows *r = ctx;
+    if (atomic_load_explicit(&r->failed, memory_order_relaxed)) return; /* the error is known */
+    int w = r->w;
+    for (int j = 0; j < w; j++) {
+        double args[FUNC_MAX_PARAMS] = {0}, out[8] = {0};
+        args[0] = (double)j / (w - 1);
+        args[1] = (double)i / (r->h - 1);
+        const char *why = NULL;
+        if (func_eval(r->fn, args, out, r->env, &why) != PT_OK) {
+            r->why[i] = why ? why : "the function";
+            atomic_store(&r->failed, 1);
+            return;
+        }
+        double g = r->fn->nterms >= 3 ? 0.297 * out[0] + 0.589 * out[1] + 0.114 * out[2] : out[0];
+        if (!(g > 0.0)) g = 0.0; /* NaN too */
+        if (g > 1.0) g = 1.0;
+        r->v[(size_t)i * w + j] = (unsigned short)(g * 65535.0 + 0.5);
+    }
+}
+
 static unsigned short *function_heights(sdl_parser *p, src_loc loc, int *wp, int *hp)
 {
     double fw = sdl_float(p);
@@ -616,23 +652,22 @@ static unsigned short *function_heights(sdl_parser *p, src_loc loc, int *wp, int
         sdl_error(p, loc, PT_ERR_NOMEM, "out of memory for a %dx%d height_field function", w, h);
         return NULL;
     }
+    const char **why = calloc((size_t)h, sizeof *why);
+    if (!why) {
+        free(v);
+        sdl_error(p, loc, PT_ERR_NOMEM, "out of memory for a %dx%d height_field function", w, h);
+        return NULL;
+    }
+    hf_rows job = {fn, p->opt.func_env, v, why, w, h, 0};
+    pool_run(p->opt.threads, h, hf_row, &job);
     for (int i = 0; i < h; i++)
-        for (int j = 0; j < w; j++) {
-            double args[FUNC_MAX_PARAMS] = {0}, out[8] = {0};
-            args[0] = (double)j / (w - 1);
-            args[1] = (double)i / (h - 1);
-            const char *why = NULL;
-            if (func_eval(fn, args, out, p->opt.func_env, &why) != PT_OK) {
-                free(v);
-                sdl_error(p, loc, PT_ERR_UNSUPPORTED, "height_field function: %s cannot be evaluated at parse time",
-                          why ? why : "the function");
-                return NULL;
-            }
-            double g = fn->nterms >= 3 ? 0.297 * out[0] + 0.589 * out[1] + 0.114 * out[2] : out[0];
-            if (!(g > 0.0)) g = 0.0; /* NaN too */
-            if (g > 1.0) g = 1.0;
-            v[(size_t)i * w + j] = (unsigned short)(g * 65535.0 + 0.5);
+        if (why[i]) { /* the first row that failed (its reason is the function's) */
+            sdl_error(p, loc, PT_ERR_UNSUPPORTED, "height_field function: %s cannot be evaluated at parse time", why[i]);
+            free(why);
+            free(v);
+            return NULL;
         }
+    free(why);
     *wp = w;
     *hp = h;
     return v;

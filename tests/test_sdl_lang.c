@@ -280,6 +280,15 @@ static void test_functions_ir(void **st)
     d = parse_text("#include \"functions.inc\"\n#declare V = f_noise3d(1, 2, 3);\n", NULL, PT_ERR_UNSUPPORTED, NULL);
     assert_string_equal(first_error(d), "calling function 'f_noise3d' at parse time needs f_noise3d, which the parser cannot evaluate");
     diag_free(d);
+    /* nor in a height field's function, whose rows are split over threads:
+     * one located error, the function's reason, no height field */
+    o.func_env = NULL;
+    o.threads = 3;
+    d = parse_text("#include \"functions.inc\"\nheight_field { function 40, 30 { 0.5 + x * f_noise3d(x, y, z) } }\n", &o,
+                   PT_ERR_UNSUPPORTED, &s);
+    assert_null(s);
+    assert_string_equal(first_error(d), "height_field function: f_noise3d cannot be evaluated at parse time");
+    diag_free(d);
 }
 
 /* Compiled function bodies (func_compile): every op, each branch of
