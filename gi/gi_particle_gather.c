@@ -265,7 +265,12 @@ static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int
                 if (!relaxed && (pt->obj != hit->obj || pt->side != side)) continue;
                 double r = relaxed ? 2.0 * pt->r : pt->r;
                 vec3 dv = v3_sub(hit->p, pt->p);
-                double d = v3_len(dv);
+                /* most points lie out of reach: known from the squared
+                 * distance (a margin far above its rounding) before the
+                 * square root, whose latency the test below waited on */
+                double d2 = v3_dot(dv, dv);
+                if (d2 > r * r * (1.0 + 1e-9)) continue;
+                double d = sqrt(d2);
                 if (!(d < r) || (!relaxed && fabs(v3_dot(dv, pt->n)) > 0.25 * r)) continue;
                 if (v3_dot(pt->n, ng) < NORMAL_COS * lg) continue;
                 if (gp->vg_gatherer && !reusable(gp, pt, hit->p, ng, lg)) continue;
