@@ -344,6 +344,32 @@ __attribute__((always_inline)) static inline double lattice_noise(vec3 p, int ge
     return sum < 0.0 ? 0.0 : (sum > 1.0 ? 1.0 : sum);
 }
 
+/* The cells of two points side by side, point a in lane 0 and b in lane
+ * 1 of each vector, for the two-point sums below. */
+typedef struct {
+    noise_cell c, d;
+    nv2 x0, x1, y0, y1, z0, z1, tz, sz, txty, sxty, txsy, sxsy;
+} cell_pair;
+
+__attribute__((always_inline)) static inline void cells_at(vec3 a, vec3 b, cell_pair *q)
+{
+    cell_at(a, &q->c);
+    cell_at(b, &q->d);
+    const noise_cell *c = &q->c, *d = &q->d;
+    q->x0 = (nv2){c->x0, d->x0};
+    q->x1 = (nv2){c->x1, d->x1};
+    q->y0 = (nv2){c->y0, d->y0};
+    q->y1 = (nv2){c->y1, d->y1};
+    q->z0 = (nv2){c->z0, d->z0};
+    q->z1 = (nv2){c->z1, d->z1};
+    q->tz = (nv2){c->tz, d->tz};
+    q->sz = (nv2){c->sz, d->sz};
+    q->txty = (nv2){c->txty, d->txty};
+    q->sxty = (nv2){c->sxty, d->sxty};
+    q->txsy = (nv2){c->txsy, d->txsy};
+    q->sxsy = (nv2){c->sxsy, d->sxsy};
+}
+
 /* Generators 1 and 2 at two points at once, a and b in lanes 0 and 1: the
  * eight corners of each are summed in POV-Ray's order down the lanes, each
  * lane doing lattice_noise's operations in its order (bit for bit its
@@ -351,12 +377,11 @@ __attribute__((always_inline)) static inline double lattice_noise(vec3 p, int ge
  * a single noise value, share their instructions. */
 __attribute__((always_inline)) static inline nv2 lattice_noise2(vec3 a, vec3 b, int generator)
 {
-    noise_cell c, d;
-    cell_at(a, &c);
-    cell_at(b, &d);
-    nv2 x0 = {c.x0, d.x0}, x1 = {c.x1, d.x1}, y0 = {c.y0, d.y0}, y1 = {c.y1, d.y1}, z0 = {c.z0, d.z0}, z1 = {c.z1, d.z1};
-    nv2 tz = {c.tz, d.tz}, sz = {c.sz, d.sz};
-    nv2 txty = {c.txty, d.txty}, sxty = {c.sxty, d.sxty}, txsy = {c.txsy, d.txsy}, sxsy = {c.sxsy, d.sxsy};
+    cell_pair q;
+    cells_at(a, b, &q);
+    const noise_cell c = q.c, d = q.d;
+    nv2 x0 = q.x0, x1 = q.x1, y0 = q.y0, y1 = q.y1, z0 = q.z0, z1 = q.z1, tz = q.tz, sz = q.sz;
+    nv2 txty = q.txty, sxty = q.sxty, txsy = q.txsy, sxsy = q.sxsy;
     nv2 sum = term2(rindex_of(c.h00, c.iz), rindex_of(d.h00, d.iz), txty * tz, x0, y0, z0);
     sum += term2(rindex_of(c.h10, c.iz), rindex_of(d.h10, d.iz), sxty * tz, x1, y0, z0);
     sum += term2(rindex_of(c.h01, c.iz), rindex_of(d.h01, d.iz), txsy * tz, x0, y1, z0);
@@ -431,6 +456,48 @@ __attribute__((always_inline)) static inline vec3 dnoise(vec3 p)
     dterm(&xy, &z, 0, rindex_of(c.h10, c.iz + 1), c.sxty * c.sz, c.x1, c.y0, c.z1);
     dterm(&xy, &z, 0, rindex_of(c.h00, c.iz + 1), c.txty * c.sz, c.x0, c.y0, c.z1);
     return v3(xy[0], xy[1], z);
+}
+
+/* One DNoise corner of two points c and d at once: each point's x and y
+ * terms in the lanes of its own vector (as dterm), the two z terms in the
+ * lanes of a third; every lane does dterm's operations in its order. */
+static inline void dterm2(nv2 *xyc, nv2 *xyd, nv2 *z, int first, int kc, int kd, nv2 s, nv2 x, nv2 y, nv2 zz)
+{
+    const noise_drow *r = &dtab[kc], *q = &dtab[kd];
+    nv2 sc = {s[0], s[0]}, sd = {s[1], s[1]};
+    nv2 tc = sc * (((r->h + r->a * (nv2){x[0], x[0]}) + r->b * (nv2){y[0], y[0]}) + r->c * (nv2){zz[0], zz[0]});
+    nv2 td = sd * (((q->h + q->a * (nv2){x[1], x[1]}) + q->b * (nv2){y[1], y[1]}) + q->c * (nv2){zz[1], zz[1]});
+    nv2 tz = s * ((((nv2){r->hz, q->hz} + (nv2){r->az, q->az} * x) + (nv2){r->bz, q->bz} * y) + (nv2){r->cz, q->cz} * zz);
+    if (first) {
+        *xyc = tc;
+        *xyd = td;
+        *z = tz;
+    } else {
+        *xyc += tc;
+        *xyd += td;
+        *z += tz;
+    }
+}
+
+/* DNoise at a and b (bit for bit dnoise's), the two interleaved. */
+__attribute__((always_inline)) static inline void dnoise2(vec3 a, vec3 b, vec3 *ra, vec3 *rb)
+{
+    cell_pair q;
+    cells_at(a, b, &q);
+    const noise_cell c = q.c, d = q.d;
+    nv2 x0 = q.x0, x1 = q.x1, y0 = q.y0, y1 = q.y1, z0 = q.z0, z1 = q.z1, tz = q.tz, sz = q.sz;
+    nv2 txty = q.txty, sxty = q.sxty, txsy = q.txsy, sxsy = q.sxsy;
+    nv2 xyc, xyd, z;
+    dterm2(&xyc, &xyd, &z, 1, rindex_of(c.h00, c.iz), rindex_of(d.h00, d.iz), txty * tz, x0, y0, z0);
+    dterm2(&xyc, &xyd, &z, 0, rindex_of(c.h10, c.iz), rindex_of(d.h10, d.iz), sxty * tz, x1, y0, z0);
+    dterm2(&xyc, &xyd, &z, 0, rindex_of(c.h11, c.iz), rindex_of(d.h11, d.iz), sxsy * tz, x1, y1, z0);
+    dterm2(&xyc, &xyd, &z, 0, rindex_of(c.h01, c.iz), rindex_of(d.h01, d.iz), txsy * tz, x0, y1, z0);
+    dterm2(&xyc, &xyd, &z, 0, rindex_of(c.h01, c.iz + 1), rindex_of(d.h01, d.iz + 1), txsy * sz, x0, y1, z1);
+    dterm2(&xyc, &xyd, &z, 0, rindex_of(c.h11, c.iz + 1), rindex_of(d.h11, d.iz + 1), sxsy * sz, x1, y1, z1);
+    dterm2(&xyc, &xyd, &z, 0, rindex_of(c.h10, c.iz + 1), rindex_of(d.h10, d.iz + 1), sxty * sz, x1, y0, z1);
+    dterm2(&xyc, &xyd, &z, 0, rindex_of(c.h00, c.iz + 1), rindex_of(d.h00, d.iz + 1), txty * sz, x0, y0, z1);
+    *ra = v3(xyc[0], xyc[1], z[0]);
+    *rb = v3(xyd[0], xyd[1], z[1]);
 }
 
 /* ------------------------------------------------------------ gradient noise */
@@ -515,14 +582,27 @@ double shade_noise_turbulence(vec3 p, int octaves, double omega, double lambda, 
 vec3 shade_noise_dturbulence(vec3 p, int octaves, double omega, double lambda)
 {
     noise_init();
-    vec3 r = dnoise(p);
-    double l = lambda, o = omega;
-    for (int i = 2; i <= octaves; i++) {
-        vec3 v = dnoise(v3_scale(p, l));
-        r.x += o * v.x;
-        r.y += o * v.y;
-        r.z += o * v.z;
-        if (i < octaves) {
+    /* the octaves' DNoise two at a time (the scales as Turbulence forms
+     * them), then summed in POV-Ray's order */
+    vec3 v[OCTAVES_AT_ONCE];
+    int n = octaves < 1 ? 1 : (octaves > OCTAVES_AT_ONCE ? OCTAVES_AT_ONCE : octaves);
+    double l = 1.0;
+    int i = 0;
+    for (; i + 1 < n; i += 2) {
+        double l2 = l * lambda;
+        dnoise2(i ? v3_scale(p, l) : p, v3_scale(p, l2), &v[i], &v[i + 1]);
+        l = l2 * lambda;
+    }
+    if (i < n) v[i] = dnoise(i ? v3_scale(p, l) : p);
+    vec3 r = v[0];
+    double o = omega;
+    l = lambda;
+    for (int k = 2; k <= octaves; k++) {
+        vec3 w = k <= n ? v[k - 1] : dnoise(v3_scale(p, l));
+        r.x += o * w.x;
+        r.y += o * w.y;
+        r.z += o * w.z;
+        if (k < octaves) {
             l *= lambda;
             o *= omega;
         }

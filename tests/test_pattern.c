@@ -444,8 +444,8 @@ static void test_image_options(void **st)
 
 /* The octave batch (two lattice noises per pass, down the lanes) gives
  * each octave's value bit for bit as one shade_noise_value at the same
- * scaled point, and Turbulence built on it the sum POV-Ray forms octave by
- * octave; points on both sides of zero and just off lattice planes. */
+ * scaled point, and Turbulence built on it (and DTurbulence, two DNoise at
+ * a time) the sum POV-Ray forms octave by octave; points on both sides of zero and just off lattice planes. */
 static void test_noise_octaves_exact(void **st)
 {
     (void)st;
@@ -470,6 +470,21 @@ static void test_noise_octaves_exact(void **st)
                     l *= lambdas[li];
                 }
                 assert_true(shade_noise_turbulence(p, n, 0.5, lambdas[li], g) == turb);
+                if (g == 1) { /* DTurbulence (two octaves at a time) against DNoise octave by octave */
+                    vec3 d = shade_noise_dvector(p), dt = shade_noise_dturbulence(p, n, 0.5, lambdas[li]);
+                    double dl = lambdas[li], dO = 0.5;
+                    for (int k = 2; k <= n; k++) {
+                        vec3 w = shade_noise_dvector(v3_scale(p, dl));
+                        d.x += dO * w.x;
+                        d.y += dO * w.y;
+                        d.z += dO * w.z;
+                        if (k < n) {
+                            dl *= lambdas[li];
+                            dO *= 0.5;
+                        }
+                    }
+                    if (d.x != dt.x || d.y != dt.y || d.z != dt.z) fail_msg("dturbulence %d octaves at point %d", n, i);
+                }
             }
 }
 
