@@ -432,6 +432,31 @@ static double run(const scene_function *f, double *r, int t0, eval_ctx *c)
     }
 }
 
+/* A float function's value at args: its program on a register file
+ * (slots, then temporaries). */
+static double eval_float(const scene_function *f, const double *args, eval_ctx *c)
+{
+    if (!f->code) {
+        c->failed = 1;
+        c->why = "function not compiled";
+        return 0;
+    }
+    double local[FUNC_MAX_SLOTS + FUNC_RUN_TEMPS], *r = local;
+    int ns = first_temp(f), np = f->nparams < ns ? f->nparams : ns;
+    if (f->stack > FUNC_RUN_TEMPS && !(r = malloc(sizeof *r * (size_t)(ns + f->stack)))) {
+        c->failed = 1;
+        c->why = "out of memory";
+        return 0;
+    }
+    /* only the slots the body uses are cleared: a call is evaluated per
+     * isosurface sample (loops, not memcpy/memset: a handful) */
+    for (int i = 0; i < np; i++) r[i] = args[i];
+    for (int i = np; i < ns; i++) r[i] = 0.0;
+    double v = run(f, r, ns, c);
+    if (r != local) free(r);
+    return v;
+}
+
 static pt_status eval_function(const scene_function *f, const double *args, double *out, eval_ctx *c)
 {
     for (int i = 0; i < (f->nterms > 0 ? f->nterms : 1); i++) out[i] = 0;
@@ -443,29 +468,7 @@ static pt_status eval_function(const scene_function *f, const double *args, doub
     }
     c->depth++;
     switch (f->kind) {
-    case FUNC_FLOAT: {
-        if (!f->code) {
-            c->failed = 1;
-            c->why = "function not compiled";
-            break;
-        }
-        /* the registers: slots (parameters, loop variables), then the
-         * program's temporaries */
-        double local[FUNC_MAX_SLOTS + FUNC_RUN_TEMPS], *r = local;
-        int ns = first_temp(f), np = f->nparams < ns ? f->nparams : ns;
-        if (f->stack > FUNC_RUN_TEMPS && !(r = malloc(sizeof *r * (size_t)(ns + f->stack)))) {
-            c->failed = 1;
-            c->why = "out of memory";
-            break;
-        }
-        /* only the slots the body uses are cleared: a call is evaluated
-         * per isosurface sample (loops, not memcpy/memset: a handful) */
-        for (int i = 0; i < np; i++) r[i] = args[i];
-        for (int i = np; i < ns; i++) r[i] = 0.0;
-        out[0] = run(f, r, ns, c);
-        if (r != local) free(r);
-        break;
-    }
+    case FUNC_FLOAT: out[0] = eval_float(f, args, c); break;
     case FUNC_TRANSFORM: {
         vec3 p = xform_point(&f->transform, v3(args[0], args[1], args[2]));
         out[0] = p.x;
@@ -504,6 +507,13 @@ pt_status func_eval(const scene_function *f, const double *args, double *out, co
 
 double func_eval_float(const scene_function *f, const double *args, const func_env *env)
 {
+    if (f->kind == FUNC_FLOAT) {
+        /* eval_function's float case without its result terms (an
+         * isosurface's samples come here) */
+        eval_ctx c = {env, NULL, 1, 0};
+        double v = eval_float(f, args, &c);
+        return c.failed ? NAN : v;
+    }
     double out[5];
     if (func_eval(f, args, out, env, NULL) != PT_OK) return NAN;
     return out[0];
