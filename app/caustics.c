@@ -62,12 +62,37 @@ static double reflect_weight(const shade_mat_bsdf *b, rgb kr)
     return fmax(fmax(a.r, fmax(a.g, a.b)), fmax(z.r, fmax(z.g, z.b))) * m;
 }
 
+/* The photon's containers as the shader's list. */
+static shade_media_inside photon_inside(const gi_caustic_inside *in)
+{
+    shade_media_inside si = {0, {0}};
+    if (in) {
+        si.n = in->n < SHADE_MEDIA_MAX_INSIDE ? in->n : SHADE_MEDIA_MAX_INSIDE;
+        for (int i = 0; i < si.n; i++) si.obj[i] = in->obj[i];
+    }
+    return si;
+}
+
+/* The BSDF at h for a photon inside the containers si (NULL: the eye
+ * G-buffer's rays, which keep no list): its fresnel reflectivity takes
+ * the relative ior from the list, as POV-Ray's photons do (photons.cpp,
+ * ComputeLightedTexture calls ComputeReflectivity with the photon ray's
+ * interiors), so a photon leaving a glass inside a closed room reflects
+ * only the glass's reflection_min, as the eye rays do there. */
+static void setup(const caustics *c, shade_mat_bsdf *b, const accel_hit *h, vec3 dir, const shade_media_inside *si,
+                  rng *r)
+{
+    double fi = si ? shade_tex_fresnel_ior(si, h->obj, v3_dot(dir, h->ng) < 0.0) : 0.0;
+    shade_mat_setup_fresnel(b, c->sc, h, dir, c->eps, r, fi);
+}
+
 static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, const gi_caustic_inside *in, rng *r,
                         gi_caustic_step *step)
 {
     const caustics *c = ctx;
+    shade_media_inside si = photon_inside(in);
     shade_mat_bsdf b;
-    shade_mat_setup(&b, c->sc, h, dir, c->eps, r);
+    setup(c, &b, h, dir, in ? &si : NULL, r);
     int out = b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 ? GI_CAUSTIC_RECEIVES : 0;
     if (!step) return out;
     double mr = b.m[SHADE_MAT_LOBE_REFLECT], mt = b.m[SHADE_MAT_LOBE_TRANSMIT];
@@ -79,11 +104,6 @@ static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, const gi_causti
     if (b.tir) kr = (rgb){fmax(0.0, kr.r - b.tir_trans.r), fmax(0.0, kr.g - b.tir_trans.g), fmax(0.0, kr.b - b.tir_trans.b)};
     int transmits = mt > 0.0 || b.tir, tir = b.tir;
     vec3 tdir = b.trans_dir;
-    shade_media_inside si = {0, {0}};
-    if (in) {
-        si.n = in->n < SHADE_MEDIA_MAX_INSIDE ? in->n : SHADE_MEDIA_MAX_INSIDE;
-        for (int i = 0; i < si.n; i++) si.obj[i] = in->obj[i];
-    }
     if (transmits && in) {
         double eta = shade_tex_refraction_eta(&si, h->obj, b.entering);
         double cos_i = -v3_dot(dir, b.n), k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
@@ -117,6 +137,17 @@ static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, const gi_causti
     return out | GI_CAUSTIC_CONTINUES | (n == 2 ? GI_CAUSTIC_SPLIT : 0);
 }
 
+/* The caustic layer's containers hook: shade_media_inside_at's list (the
+ * camera's rule: every object holding p, hollow or not). */
+static void hook_containers(void *ctx, vec3 p, gi_caustic_inside *in)
+{
+    const caustics *c = ctx;
+    shade_media_inside si;
+    shade_media_inside_at(c->sc, p, &si);
+    in->n = si.n < GI_CAUSTIC_MAX_INSIDE ? si.n : GI_CAUSTIC_MAX_INSIDE;
+    for (int i = 0; i < in->n; i++) in->obj[i] = si.obj[i];
+}
+
 /* The caustic layer's pass hook: a pass_through object before the target
  * lets the photon on along its way with what a refraction through it
  * would keep (through above; POV-Ray 3.7's photons.cpp filters such a
@@ -125,13 +156,9 @@ static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, const gi_causti
 static int hook_pass(void *ctx, const accel_hit *h, vec3 dir, const gi_caustic_inside *in, gi_caustic_step *step)
 {
     const caustics *c = ctx;
+    shade_media_inside si = photon_inside(in);
     shade_mat_bsdf b;
-    shade_mat_setup(&b, c->sc, h, dir, c->eps, NULL);
-    shade_media_inside si = {0, {0}};
-    if (in) {
-        si.n = in->n < SHADE_MEDIA_MAX_INSIDE ? in->n : SHADE_MEDIA_MAX_INSIDE;
-        for (int i = 0; i < si.n; i++) si.obj[i] = in->obj[i];
-    }
+    setup(c, &b, h, dir, in ? &si : NULL, NULL);
     *step = through(c, h, dir, &b, b.k[SHADE_MAT_LOBE_REFLECT], &si, dir);
     return fmax(step->weight.r, fmax(step->weight.g, step->weight.b)) > 0.0;
 }
@@ -221,7 +248,7 @@ pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width
     not_modelled(c, sc, d);
     c->sc = sc;
     c->eps = accel_surface_eps(a); /* the shader's offsets: photons cross thin walls as eye rays do */
-    gi_caustic_hooks hk = {hook_surface, hook_attenuation, c, hook_brilliance, hook_pass};
+    gi_caustic_hooks hk = {hook_surface, hook_attenuation, c, hook_brilliance, hook_pass, hook_containers};
     gi_caustic_settings s = {width, height, threads, seed, cl_device, cl_max_bytes, count_scale, cancel};
     pt_status st = PT_OK;
     c->layer = gi_caustic_build(sc, a, &s, &hk, d, &st);

@@ -156,6 +156,7 @@ typedef struct {
     double cell;       /* solid angle (point-like) or area (parallel) of a cell */
     rgb phi0;          /* colour x cell */
     long first;        /* index of its first cell among all */
+    gi_caustic_inside in0; /* the objects holding the light (hooks.containers), where its photons start */
 } combo;
 
 struct gi_caustic {
@@ -358,7 +359,7 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
     } branch;
     branch stack[2 * GI_CAUSTIC_MAX_BOUNCES + 4];
     int ns = 0;
-    stack[ns++] = (branch){o, w, {0}, 0, 0, 0.0, 1.0, {1, 1, 1}, 1.0, {0, {0}}, 0.0, 0.0};
+    stack[ns++] = (branch){o, w, {0}, 0, 0, 0.0, 1.0, {1, 1, 1}, 1.0, cb->in0, 0.0, 0.0};
     vec3 p_first = o;
     int passes = 0;
     while (ns > 0) {
@@ -504,6 +505,11 @@ static pt_status make_combos(gi_caustic *c, diag *d)
             }
             add_leaves(t, cb->leaves, &cb->nleaves);
             qsort(cb->leaves, (size_t)cb->nleaves, sizeof *cb->leaves, ptr_cmp);
+            /* POV-Ray starts each photon inside every object holding the
+             * light (photonshootingtask.cpp: the interiors of the objects
+             * Inside the ray's origin); the light's position stands for
+             * the points of an area light and a parallel light's plane */
+            if (c->hk.containers) c->hk.containers(c->hk.ctx, l->position, &cb->in0);
             c->ncb++;
         }
     }

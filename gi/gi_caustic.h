@@ -122,6 +122,9 @@ typedef struct {
      * (the photon goes on along the same ray); 0 when nothing passes.
      * NULL: the photon ends there. */
     int (*pass)(void *ctx, const accel_hit *h, vec3 dir, const gi_caustic_inside *in, gi_caustic_step *step);
+    /* The objects holding point p (the light's position), innermost last:
+     * the list a photon starts with. NULL: none. */
+    void (*containers)(void *ctx, vec3 p, gi_caustic_inside *in);
 } gi_caustic_hooks;
 
 typedef struct {

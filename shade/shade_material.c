@@ -239,6 +239,12 @@ static void setup_glossy(shade_mat_bsdf *b, const scene *sc, const scene_texture
 
 void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r)
 {
+    shade_mat_setup_fresnel(b, sc, h, dir, eps, r, 0.0);
+}
+
+void shade_mat_setup_fresnel(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r,
+                             double fresnel_ior)
+{
     memset(b, 0, sizeof *b);
     const scene_texture *tex = h->texture ? h->texture : &sc->default_texture;
     const scene_finish *f = &tex->finish;
@@ -300,7 +306,7 @@ void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec
     rgb refl = {0, 0, 0};
     if (mrgb_max(rmax) > 0.0 || mrgb_max(rmin) > 0.0) {
         if (f->fresnel) {
-            double fr = shade_light_fresnel(cos_i, rel_ior);
+            double fr = shade_light_fresnel(cos_i, fresnel_ior > 0.0 ? fresnel_ior : rel_ior);
             refl = mrgb(rmax.r * fr + rmin.r * (1.0 - fr), rmax.g * fr + rmin.g * (1.0 - fr),
                         rmax.b * fr + rmin.b * (1.0 - fr));
         } else {

@@ -152,6 +152,12 @@ int shade_mat_texture_varies(const scene_texture *tex);
  * distance the origins are moved off the surface (shade.c's rule: accel_scale
  * * 1e-6). `r` feeds crand in shade_light_terms. */
 void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r);
+/* shade_mat_setup with the fresnel reflectivity's relative ior given
+ * (fresnel_ior > 0; POV-Ray's ComputeRelativeIOR from the ray's interior
+ * list, shade_tex_fresnel_ior) instead of the hit object's own across its
+ * surface; refraction keeps the object's own. */
+void shade_mat_setup_fresnel(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r,
+                             double fresnel_ior);
 
 /* Lambertian part of f (no cosine) for unit wi (towards where light comes
  * from); 0 where wi and the geometric normal disagree about the side. */

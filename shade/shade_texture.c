@@ -488,14 +488,25 @@ static void ior_setup(hit_info *hi, const shade_media_inside *in, const scene_ob
     }
 }
 
-double shade_tex_refraction_eta(const shade_media_inside *in, const scene_object *o, int entering)
+/* ior_setup for a ray crossing o's surface with the containers `in`. */
+static hit_info ior_query(const shade_media_inside *in, const scene_object *o, int entering)
 {
     hit_info hi;
     memset(&hi, 0, sizeof hi);
     hi.entering = entering;
     hi.interior = o ? o->interior : NULL;
     ior_setup(&hi, in, o);
-    return hi.eta;
+    return hi;
+}
+
+double shade_tex_refraction_eta(const shade_media_inside *in, const scene_object *o, int entering)
+{
+    return ior_query(in, o, entering).eta;
+}
+
+double shade_tex_fresnel_ior(const shade_media_inside *in, const scene_object *o, int entering)
+{
+    return ior_query(in, o, entering).rel_ior;
 }
 
 rgb shade_tex_shade(const shade_tex_env *e, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip, float wavelength)

@@ -85,6 +85,11 @@ rgb shade_tex_leaving_fade(const accel_hit *h, vec3 dir);
  * ComputeRefractionForPhotons has the same): nested objects refract
  * against their container, leaving an overlap does not refract. */
 double shade_tex_refraction_eta(const shade_media_inside *in, const scene_object *o, int entering);
+/* The relative ior of the fresnel reflectivity there (ComputeRelativeIOR,
+ * ior_setup's rule): 1 when the ray leaves the innermost of two or more
+ * containers (a glass in a closed room reflects only its reflection_min
+ * from inside). */
+double shade_tex_fresnel_ior(const shade_media_inside *in, const scene_object *o, int entering);
 
 /* Light left along a shadow ray from p (unit dir) over (tmin, tmax): 0 when
  * an opaque surface blocks it, else the product of the filter colours of the
