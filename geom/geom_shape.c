@@ -522,6 +522,22 @@ static int hits_torus(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
     double lo = fmax_inline(ta, b0), hi = fmin_inline(tb, b1);
     if (!(lo < hi)) return 0;
     vec3 q = v3_madd(o1, e, lo);
+    /* The tube lies at distances rho from the axis within [R1 - r1,
+     * R1 + r1]: a stretch of the ray (within the padded box, so within
+     * the slab around the ring's plane) whose rho stays a quarter of the
+     * tube's radius inside that annulus's hole or outside it has no root,
+     * and the quartic is not solved (a thin ring's box holds mostly its
+     * hole: patio-radio's arches). rho^2 along the stretch is a convex
+     * parabola in tau: its largest value at an end, its least at the
+     * vertex or an end. */
+    {
+        double A = e.x * e.x + e.z * e.z, B = q.x * e.x + q.z * e.z, C = q.x * q.x + q.z * q.z, L = hi - lo;
+        double at_end = (A * L + 2.0 * B) * L + C, v = A > 0.0 ? -B / A : 0.0;
+        v = v < 0.0 ? 0.0 : (v > L ? L : v);
+        double most = fmax_inline(C, at_end), least = (A * v + 2.0 * B) * v + C;
+        double m = 0.25 * r1 + 1e-9, inner = R1 - r1 - m, outer = R1 + r1 + m;
+        if ((inner > 0.0 && most < inner * inner) || least > outer * outer) return 0;
+    }
     double c[5];
     torus_quartic(q, e, R1, r1, c);
     double roots[4];

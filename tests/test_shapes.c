@@ -1120,6 +1120,26 @@ static void test_grid(void **st)
  * closed-form hits, inside, the sphere substitute for rt >= 2 rb, area by
  * zones: 2 pi rb (yb + rb) + 2 pi rt (rb + rt - yt) + 2 pi rc [u - h asin(u / rc)]
  * between u = yb - v and yt - v */
+/* A thin ring (torus 130, 2: its box is mostly its hole; hits_torus
+ * leaves out the stretches whose distance from the axis stays clear of the
+ * tube): hits against the circle's closed form, in the tube near its inner
+ * and outer edges, and misses just beside it. */
+static void test_thin_torus(void **st)
+{
+    (void)st;
+    world w = build("torus { 130, 2 }");
+    /* down through the tube at rho = 128.5: y = sqrt(4 - 1.5^2) */
+    double y = sqrt(1.75);
+    expect_hit(&w, v3(128.5, 10, 0), v3(0, -1, 0), 10.0 - y, v3(-0.75, y / 2.0, 0), 1e-7, 1e-6);
+    expect_hit(&w, v3(0, 10, -131.5), v3(0, -1, 0), 10.0 - y, v3(0, y / 2.0, -0.75), 1e-7, 1e-6);
+    expect_miss(&w, v3(127.95, 10, 0), v3(0, -1, 0));  /* in the hole, 0.05 from the tube */
+    expect_miss(&w, v3(0, 10, 132.05), v3(0, -1, 0));  /* outside it */
+    expect_hit(&w, v3(0, 0, 0), v3(1, 0, 0), 128.0, v3(-1, 0, 0), 1e-7, 1e-6); /* across the hole */
+    expect_hit(&w, v3(0, 1, 0), v3(0, 0, 1), 130.0 - sqrt(3.0), v3(0, 0.5, -sqrt(3.0) / 2.0), 1e-7, 1e-6);
+    expect_miss(&w, v3(0, 2.05, 0), v3(1, 0, 0)); /* over it */
+    done(&w);
+}
+
 static void test_ovus(void **st)
 {
     (void)st;
@@ -1344,6 +1364,7 @@ int main(void)
         cmocka_unit_test(test_sweep_sampling),
         cmocka_unit_test(test_implicit_sampling),
         cmocka_unit_test(test_grid),
+        cmocka_unit_test(test_thin_torus),
         cmocka_unit_test(test_ovus),
         cmocka_unit_test(test_bounded_by),
         cmocka_unit_test(test_bad_input),
