@@ -22,11 +22,11 @@ static double light_cubic_step(double low, double high, double x)
     return (3.0 - 2.0 * t) * t * t;
 }
 
-/* The cosines of a spotlight's radius and falloff angles, kept for the
- * last angles this thread asked about: they are asked per light sample
- * (per media sample in a lit medium), and two cos() calls there were a
- * tenth of media2's render. */
-static void spot_cosines(const scene_light *l, double *cos_radius, double *cos_falloff)
+/* Kept for the last angles this thread asked about: they are asked per
+ * light sample (per media sample in a lit medium) and per lit interval of
+ * a media segment, and two cos() calls there were a tenth of media2's
+ * render. */
+void shade_light_spot_cosines(const scene_light *l, double *cos_radius, double *cos_falloff)
 {
     static _Thread_local double radius = NAN, falloff = NAN, cr, cf;
     if (!(l->radius == radius && l->falloff == falloff)) {
@@ -47,7 +47,7 @@ double shade_light_attenuation(const scene_light *l, vec3 p, vec3 dir, double de
         double c = -v3_dot(dir, axis);
         if (c <= 0.0) return 0.0;
         double cos_radius, cos_falloff;
-        spot_cosines(l, &cos_radius, &cos_falloff);
+        shade_light_spot_cosines(l, &cos_radius, &cos_falloff);
         att = l->tightness != 0.0 ? pow(c, l->tightness) : 1.0;
         if (cos_radius > 0.0 && c < cos_radius) att *= light_cubic_step(cos_falloff, cos_radius, c);
     } else if (l->kind == LIGHT_CYLINDER) {

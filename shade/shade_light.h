@@ -29,6 +29,9 @@
  * and falloff are distances from the axis), fade 2/(1+(d/fade_distance)^fade_power)
  * (or d^-fade_power with fade_distance 0). */
 double shade_light_attenuation(const scene_light *l, vec3 p, vec3 dir, double depth);
+/* cos(radius) and cos(falloff) of a spotlight, its angles in degrees (the
+ * values cos() gives, kept per thread). */
+void shade_light_spot_cosines(const scene_light *l, double *cos_radius, double *cos_falloff);
 /* The light's fade at distance depth: 2 / (1 + (depth / fade_distance)^
  * fade_power), depth^-fade_power with fade_distance 0, 1 without
  * fade_power (POV-Ray 3.7's Attenuate_Light). */

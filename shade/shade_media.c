@@ -66,6 +66,7 @@
 #include "geom_shape.h"
 #include "scene_leaves.h"
 #include "shade_atmos.h"
+#include "shade_light.h"
 #include "shade_pattern.h"
 #include "shade_texture.h"
 
@@ -330,7 +331,8 @@ static int axial_roots(double a, double b, double d, double k1, double k2, doubl
 static int spot_interval(vec3 org, vec3 dir, const scene_light *l, double *d1, double *d2)
 {
     vec3 axis = v3_norm(v3_sub(l->point_at, l->position));
-    double cf = cos(l->falloff * M_PI / 180.0);
+    double cr, cf;
+    shade_light_spot_cosines(l, &cr, &cf);
     double m = 1.0 / (cf * cf);
     vec3 v1 = v3_sub(org, l->position);
     double k1 = v3_dot(dir, axis), k2 = v3_dot(v1, axis), len = v3_len(v1);
