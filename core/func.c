@@ -96,7 +96,7 @@ typedef struct {
     const scene_function *f; /* the function whose nodes are compiled */
     int base;                /* the register of its slot 0 */
     func_insn *out;
-    int n, max, bad, t0, top;
+    int n, max, bad, deep, t0, top;
 } compiler;
 
 static int emit(compiler *cp, int op, int dst, int a, int b)
@@ -163,8 +163,9 @@ static operand compile_node(compiler *cp, int i, int depth, int level)
 {
     const scene_function *f = cp->f;
     operand res = {cp->t0 + depth, 0.0};
-    if (!node_ok(f, i) || level > 4096) {
+    if (!node_ok(f, i) || level > FUNC_MAX_NESTING) {
         cp->bad = 1;
+        cp->deep |= level > FUNC_MAX_NESTING;
         return res;
     }
     if (depth + 1 > cp->top) cp->top = depth + 1;
@@ -307,11 +308,11 @@ int func_code_bound(const scene_function *f)
 int func_compile(const scene_function *f, func_insn *out, int max, int *stack)
 {
     if (!f || f->kind != FUNC_FLOAT || !f->nodes || !out) return -1;
-    compiler cp = {f, 0, out, 0, max, 0, first_temp(f), 0};
+    compiler cp = {f, 0, out, 0, max, 0, 0, first_temp(f), 0};
     /* the result in temporary 0 (a leaf body is copied there) */
     compile_to(&cp, f->root, 0, 0);
     emit(&cp, FI_RET, 0, 0, 0);
-    if (cp.bad) return -1;
+    if (cp.bad) return cp.deep ? -2 : -1;
     if (stack) *stack = cp.top;
     return cp.n;
 }

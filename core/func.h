@@ -113,12 +113,16 @@ typedef struct func_insn {
     const struct scene_function *fn;
 } func_insn;
 
+/* FUNC_MAX_NESTING bounds a compiled body's nesting (calls compiled in
+ * place count with their callers). */
+#define FUNC_MAX_NESTING 4096
 /* f's body (FUNC_FLOAT) compiled into out (room for max instructions;
  * func_code_bound(f) suffices): the same operations on the same values in
  * the same order as the tree, so the same result to the bit. Calls of
  * short float functions are compiled in place. Returns the number of
- * instructions and sets *stack to the temporaries it needs; -1 when f is
- * no float function or out is too small. */
+ * instructions and sets *stack to the temporaries it needs; -2 when the
+ * body is nested deeper than FUNC_MAX_NESTING, -1 when f is no float
+ * function or out is too small. */
 int func_compile(const scene_function *f, func_insn *out, int max, int *stack);
 /* Room enough for func_compile(f). */
 int func_code_bound(const scene_function *f);

@@ -548,7 +548,8 @@ scene_function *sdl_parse_function(sdl_parser *p, src_loc loc, const char *name)
             func_insn *code = malloc(sizeof *code * (size_t)max);
             int nc = code ? func_compile(f, code, max, &stack) : -1;
             if (nc > 0) f->code = arena_memdup(p->s->mem, code, sizeof *code * (size_t)nc);
-            if (code && nc <= 0) sdl_error(p, loc, PT_ERR_INTERNAL, "function body could not be compiled");
+            if (nc == -2) sdl_error(p, loc, PT_ERR_LIMIT, "function body nested more than %d deep", FUNC_MAX_NESTING);
+            else if (code && nc <= 0) sdl_error(p, loc, PT_ERR_INTERNAL, "function body could not be compiled");
             else if (!f->code) sdl_error(p, loc, PT_ERR_NOMEM, "out of memory compiling a function");
             free(code);
             f->ncode = nc;
