@@ -351,6 +351,52 @@ typedef struct {
     nv2 x0, x1, y0, y1, z0, z1, tz, sz, txty, sxty, txsy, sxsy;
 } cell_pair;
 
+#if defined(__SSE2__)
+/* lattice() along one axis for two coordinates (lanes 0 and 1): the same
+ * operations lane by lane (x - 0.0 is x, -0.0 included; cvttpd2dq
+ * truncates as cvttsd2si does), the cell indices back as ints. */
+__attribute__((always_inline)) static inline nv2 lattice2(nv2 v, int *ia, int *ib)
+{
+    __m128d x = (__m128d)v;
+    __m128d ge = _mm_cmpge_pd(x, _mm_setzero_pd());
+    __m128i t = _mm_cvttpd_epi32(_mm_sub_pd(x, _mm_andnot_pd(ge, _mm_set1_pd(1 - NOISE_EPSILON))));
+    __m128i i = _mm_and_si128(_mm_sub_epi32(t, _mm_set1_epi32(LATTICE_MIN)), _mm_set1_epi32(0xFFF));
+    *ia = _mm_cvtsi128_si32(i);
+    *ib = _mm_cvtsi128_si32(_mm_shuffle_epi32(i, 1));
+    return (nv2)_mm_sub_pd(x, _mm_cvtepi32_pd(t));
+}
+
+/* cell_at for two points at once: the fractions, s-curves and weights in
+ * the lanes (each lane cell_at's operations in its order), the hashes per
+ * point; only the integer fields of q->c and q->d are set. */
+__attribute__((always_inline)) static inline void cells_at(vec3 a, vec3 b, cell_pair *q)
+{
+    int ixa, ixb, iya, iyb;
+    q->x0 = lattice2((nv2){a.x, b.x}, &ixa, &ixb);
+    q->y0 = lattice2((nv2){a.y, b.y}, &iya, &iyb);
+    q->z0 = lattice2((nv2){a.z, b.z}, &q->c.iz, &q->d.iz);
+    nv2 one = {1.0, 1.0}, three = {3.0, 3.0}, two = {2.0, 2.0};
+    q->x1 = q->x0 - one;
+    q->y1 = q->y0 - one;
+    q->z1 = q->z0 - one;
+    nv2 sx = q->x0 * q->x0 * (three - two * q->x0), sy = q->y0 * q->y0 * (three - two * q->y0);
+    q->sz = q->z0 * q->z0 * (three - two * q->z0);
+    nv2 tx = one - sx, ty = one - sy;
+    q->tz = one - q->sz;
+    q->txty = tx * ty;
+    q->sxty = sx * ty;
+    q->txsy = tx * sy;
+    q->sxsy = sx * sy;
+    q->c.h00 = hash2(ixa, iya);
+    q->c.h10 = hash2(ixa + 1, iya);
+    q->c.h01 = hash2(ixa, iya + 1);
+    q->c.h11 = hash2(ixa + 1, iya + 1);
+    q->d.h00 = hash2(ixb, iyb);
+    q->d.h10 = hash2(ixb + 1, iyb);
+    q->d.h01 = hash2(ixb, iyb + 1);
+    q->d.h11 = hash2(ixb + 1, iyb + 1);
+}
+#else
 __attribute__((always_inline)) static inline void cells_at(vec3 a, vec3 b, cell_pair *q)
 {
     cell_at(a, &q->c);
@@ -369,6 +415,7 @@ __attribute__((always_inline)) static inline void cells_at(vec3 a, vec3 b, cell_
     q->txsy = (nv2){c->txsy, d->txsy};
     q->sxsy = (nv2){c->sxsy, d->sxsy};
 }
+#endif
 
 /* Generators 1 and 2 at two points at once, a and b in lanes 0 and 1: the
  * eight corners of each are summed in POV-Ray's order down the lanes, each
@@ -379,17 +426,17 @@ __attribute__((always_inline)) static inline nv2 lattice_noise2(vec3 a, vec3 b, 
 {
     cell_pair q;
     cells_at(a, b, &q);
-    const noise_cell c = q.c, d = q.d;
+    const noise_cell *c = &q.c, *d = &q.d;
     nv2 x0 = q.x0, x1 = q.x1, y0 = q.y0, y1 = q.y1, z0 = q.z0, z1 = q.z1, tz = q.tz, sz = q.sz;
     nv2 txty = q.txty, sxty = q.sxty, txsy = q.txsy, sxsy = q.sxsy;
-    nv2 sum = term2(rindex_of(c.h00, c.iz), rindex_of(d.h00, d.iz), txty * tz, x0, y0, z0);
-    sum += term2(rindex_of(c.h10, c.iz), rindex_of(d.h10, d.iz), sxty * tz, x1, y0, z0);
-    sum += term2(rindex_of(c.h01, c.iz), rindex_of(d.h01, d.iz), txsy * tz, x0, y1, z0);
-    sum += term2(rindex_of(c.h11, c.iz), rindex_of(d.h11, d.iz), sxsy * tz, x1, y1, z0);
-    sum += term2(rindex_of(c.h00, c.iz + 1), rindex_of(d.h00, d.iz + 1), txty * sz, x0, y0, z1);
-    sum += term2(rindex_of(c.h10, c.iz + 1), rindex_of(d.h10, d.iz + 1), sxty * sz, x1, y0, z1);
-    sum += term2(rindex_of(c.h01, c.iz + 1), rindex_of(d.h01, d.iz + 1), txsy * sz, x0, y1, z1);
-    sum += term2(rindex_of(c.h11, c.iz + 1), rindex_of(d.h11, d.iz + 1), sxsy * sz, x1, y1, z1);
+    nv2 sum = term2(rindex_of(c->h00, c->iz), rindex_of(d->h00, d->iz), txty * tz, x0, y0, z0);
+    sum += term2(rindex_of(c->h10, c->iz), rindex_of(d->h10, d->iz), sxty * tz, x1, y0, z0);
+    sum += term2(rindex_of(c->h01, c->iz), rindex_of(d->h01, d->iz), txsy * tz, x0, y1, z0);
+    sum += term2(rindex_of(c->h11, c->iz), rindex_of(d->h11, d->iz), sxsy * tz, x1, y1, z0);
+    sum += term2(rindex_of(c->h00, c->iz + 1), rindex_of(d->h00, d->iz + 1), txty * sz, x0, y0, z1);
+    sum += term2(rindex_of(c->h10, c->iz + 1), rindex_of(d->h10, d->iz + 1), sxty * sz, x1, y0, z1);
+    sum += term2(rindex_of(c->h01, c->iz + 1), rindex_of(d->h01, d->iz + 1), txsy * sz, x0, y1, z1);
+    sum += term2(rindex_of(c->h11, c->iz + 1), rindex_of(d->h11, d->iz + 1), sxsy * sz, x1, y1, z1);
     if (generator == 2) {
         sum += (nv2){1.05242, 1.05242};
         sum *= (nv2){0.48985582, 0.48985582};
@@ -484,18 +531,18 @@ __attribute__((always_inline)) static inline void dnoise2(vec3 a, vec3 b, vec3 *
 {
     cell_pair q;
     cells_at(a, b, &q);
-    const noise_cell c = q.c, d = q.d;
+    const noise_cell *c = &q.c, *d = &q.d;
     nv2 x0 = q.x0, x1 = q.x1, y0 = q.y0, y1 = q.y1, z0 = q.z0, z1 = q.z1, tz = q.tz, sz = q.sz;
     nv2 txty = q.txty, sxty = q.sxty, txsy = q.txsy, sxsy = q.sxsy;
     nv2 xyc, xyd, z;
-    dterm2(&xyc, &xyd, &z, 1, rindex_of(c.h00, c.iz), rindex_of(d.h00, d.iz), txty * tz, x0, y0, z0);
-    dterm2(&xyc, &xyd, &z, 0, rindex_of(c.h10, c.iz), rindex_of(d.h10, d.iz), sxty * tz, x1, y0, z0);
-    dterm2(&xyc, &xyd, &z, 0, rindex_of(c.h11, c.iz), rindex_of(d.h11, d.iz), sxsy * tz, x1, y1, z0);
-    dterm2(&xyc, &xyd, &z, 0, rindex_of(c.h01, c.iz), rindex_of(d.h01, d.iz), txsy * tz, x0, y1, z0);
-    dterm2(&xyc, &xyd, &z, 0, rindex_of(c.h01, c.iz + 1), rindex_of(d.h01, d.iz + 1), txsy * sz, x0, y1, z1);
-    dterm2(&xyc, &xyd, &z, 0, rindex_of(c.h11, c.iz + 1), rindex_of(d.h11, d.iz + 1), sxsy * sz, x1, y1, z1);
-    dterm2(&xyc, &xyd, &z, 0, rindex_of(c.h10, c.iz + 1), rindex_of(d.h10, d.iz + 1), sxty * sz, x1, y0, z1);
-    dterm2(&xyc, &xyd, &z, 0, rindex_of(c.h00, c.iz + 1), rindex_of(d.h00, d.iz + 1), txty * sz, x0, y0, z1);
+    dterm2(&xyc, &xyd, &z, 1, rindex_of(c->h00, c->iz), rindex_of(d->h00, d->iz), txty * tz, x0, y0, z0);
+    dterm2(&xyc, &xyd, &z, 0, rindex_of(c->h10, c->iz), rindex_of(d->h10, d->iz), sxty * tz, x1, y0, z0);
+    dterm2(&xyc, &xyd, &z, 0, rindex_of(c->h11, c->iz), rindex_of(d->h11, d->iz), sxsy * tz, x1, y1, z0);
+    dterm2(&xyc, &xyd, &z, 0, rindex_of(c->h01, c->iz), rindex_of(d->h01, d->iz), txsy * tz, x0, y1, z0);
+    dterm2(&xyc, &xyd, &z, 0, rindex_of(c->h01, c->iz + 1), rindex_of(d->h01, d->iz + 1), txsy * sz, x0, y1, z1);
+    dterm2(&xyc, &xyd, &z, 0, rindex_of(c->h11, c->iz + 1), rindex_of(d->h11, d->iz + 1), sxsy * sz, x1, y1, z1);
+    dterm2(&xyc, &xyd, &z, 0, rindex_of(c->h10, c->iz + 1), rindex_of(d->h10, d->iz + 1), sxty * sz, x1, y0, z1);
+    dterm2(&xyc, &xyd, &z, 0, rindex_of(c->h00, c->iz + 1), rindex_of(d->h00, d->iz + 1), txty * sz, x0, y0, z1);
     *ra = v3(xyc[0], xyc[1], z[0]);
     *rb = v3(xyd[0], xyd[1], z[1]);
 }
