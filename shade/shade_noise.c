@@ -626,26 +626,29 @@ double shade_noise_turbulence(vec3 p, int octaves, double omega, double lambda, 
     return value;
 }
 
-vec3 shade_noise_dturbulence(vec3 p, int octaves, double omega, double lambda)
+void shade_noise_dvector_octaves(vec3 p, int n, double lambda, vec3 *out)
 {
     noise_init();
-    /* the octaves' DNoise two at a time (the scales as Turbulence forms
-     * them), then summed in POV-Ray's order */
-    vec3 v[OCTAVES_AT_ONCE];
-    int n = octaves < 1 ? 1 : (octaves > OCTAVES_AT_ONCE ? OCTAVES_AT_ONCE : octaves);
     double l = 1.0;
     int i = 0;
     for (; i + 1 < n; i += 2) {
         double l2 = l * lambda;
-        dnoise2(i ? v3_scale(p, l) : p, v3_scale(p, l2), &v[i], &v[i + 1]);
+        dnoise2(i ? v3_scale(p, l) : p, v3_scale(p, l2), &out[i], &out[i + 1]);
         l = l2 * lambda;
     }
-    if (i < n) v[i] = dnoise(i ? v3_scale(p, l) : p);
+    if (i < n) out[i] = dnoise(i ? v3_scale(p, l) : p);
+}
+
+vec3 shade_noise_dturbulence(vec3 p, int octaves, double omega, double lambda)
+{
+    /* the octaves' DNoise two at a time, then summed in POV-Ray's order */
+    vec3 v[OCTAVES_AT_ONCE];
+    int n = octaves < 1 ? 1 : (octaves > OCTAVES_AT_ONCE ? OCTAVES_AT_ONCE : octaves);
+    shade_noise_dvector_octaves(p, n, lambda, v);
     vec3 r = v[0];
-    double o = omega;
-    l = lambda;
+    double o = omega, l = lambda;
     for (int k = 2; k <= octaves; k++) {
-        vec3 w = k <= n ? v[k - 1] : dnoise(v3_scale(p, l));
+        vec3 w = k <= n ? v[k - 1] : shade_noise_dvector(v3_scale(p, l));
         r.x += o * w.x;
         r.y += o * w.y;
         r.z += o * w.z;

@@ -32,6 +32,9 @@ double shade_noise_value(vec3 p, int generator);
 void shade_noise_octaves(vec3 p, int n, double lambda, int generator, double *out);
 /* POV-Ray's DNoise(p): vector noise, components roughly in [-1, 1]. */
 vec3 shade_noise_dvector(vec3 p);
+/* DNoise(p * l_i) for i = 0 .. n-1, the scales as shade_noise_octaves's
+ * (each bit for bit shade_noise_dvector's, two at a time). */
+void shade_noise_dvector_octaves(vec3 p, int n, double lambda, vec3 *out);
 
 /* Fractal sums (POV-Ray's Turbulence and DTurbulence) with the given
  * octaves, omega and lambda. */

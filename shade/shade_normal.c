@@ -193,10 +193,12 @@ static vec3 bump_pattern(const scene_normal *nm, vec3 n, vec3 tp, const shade_pa
     case PAT_RIPPLES: return waves_normal(nm, tp, n, 1, c->nwaves > 0 ? c->nwaves : SHADE_NOISE_WAVES);
     case PAT_WAVES: return waves_normal(nm, tp, n, 0, c->nwaves > 0 ? c->nwaves : SHADE_NOISE_WAVES);
     case PAT_WRINKLES: {
-        vec3 r = v3(0, 0, 0);
+        /* DNoise at tp scaled by 1, 2, 4, ... 512 */
+        vec3 r = v3(0, 0, 0), d[10];
         double scale = 1.0;
+        shade_noise_dvector_octaves(tp, 10, 2.0, d);
         for (int i = 0; i < 10; scale *= 2.0, i++) {
-            vec3 v = shade_noise_dvector(v3_scale(tp, scale));
+            vec3 v = d[i];
             r.x += fabs(v.x / scale);
             r.y += fabs(v.y / scale);
             r.z += fabs(v.z / scale);

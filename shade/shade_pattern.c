@@ -453,15 +453,15 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
 
 static double granite(vec3 p, int gen)
 {
-    double noise = 0.0, freq = 1.0;
-    vec3 tv1 = v3_scale(p, 4.0);
+    /* the noise at 4 p scaled by 1, 2, 4, ... 32 */
+    double noise = 0.0, freq = 1.0, n[6];
+    shade_noise_octaves(v3_scale(p, 4.0), 6, 2.0, gen, n);
     for (int i = 0; i < 6; freq *= 2.0, i++) {
-        vec3 tv2 = v3_scale(tv1, freq);
         double t;
         if (gen == 1) {
-            t = fabs(0.5 - shade_noise_value(tv2, gen));
+            t = fabs(0.5 - n[i]);
         } else {
-            t = fabs(1.0 - 2.0 * shade_noise_value(tv2, gen));
+            t = fabs(1.0 - 2.0 * n[i]);
             if (t > 0.5) t = 0.5;
         }
         noise += t / freq;

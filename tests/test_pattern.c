@@ -470,6 +470,16 @@ static void test_noise_octaves_exact(void **st)
                     l *= lambdas[li];
                 }
                 assert_true(shade_noise_turbulence(p, n, 0.5, lambdas[li], g) == turb);
+                if (g == 1) { /* DNoise's octaves (two at a time) against one DNoise each */
+                    vec3 dv[11];
+                    shade_noise_dvector_octaves(p, n, lambdas[li], dv);
+                    double dl2 = 1.0;
+                    for (int k = 0; k < n; k++) {
+                        vec3 w = shade_noise_dvector(k ? v3_scale(p, dl2) : p);
+                        if (w.x != dv[k].x || w.y != dv[k].y || w.z != dv[k].z) fail_msg("dnoise octave %d at point %d", k, i);
+                        dl2 *= lambdas[li];
+                    }
+                }
                 if (g == 1) { /* DTurbulence (two octaves at a time) against DNoise octave by octave */
                     vec3 d = shade_noise_dvector(p), dt = shade_noise_dturbulence(p, n, 0.5, lambdas[li]);
                     double dl = lambdas[li], dO = 0.5;
