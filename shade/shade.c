@@ -701,10 +701,11 @@ static void first_sample(render_ctx *c, int thread, int x, int y, float *out)
     out[2] = (float)v.b;
 }
 
-static int aa_differ(const render_ctx *c, const float *a, const float *b)
-{
-    return shade_colour_distance(aa_encode(c->sc, a), aa_encode(c->sc, b)) >= c->s->aa_threshold;
-}
+/* Whether two pixels' encoded colours (aa_encode) differ enough to
+ * supersample. Each pixel is encoded once where it is compared several
+ * times (with its left and upper neighbours, as either): the encoding is
+ * three powers. */
+static int aa_differ(const render_ctx *c, rgb a, rgb b) { return shade_colour_distance(a, b) >= c->s->aa_threshold; }
 
 /* Pass 2 of +A: block `block` of the AA_BLOCK grid, in POV-Ray's order. */
 static void block_supersample(void *ctx, int k, int thread)
@@ -722,27 +723,40 @@ static void block_supersample(void *ctx, int k, int thread)
     unsigned char done[AA_BLOCK][AA_BLOCK];
     memset(done, 0, sizeof done);
     float above[AA_BLOCK][3], left[3];
-    for (int x = X0; x < X1; x++) first_sample(c, thread, x, Y0 - 1, above[x - X0]);
+    /* the encodings of the block's pixels as they are now (first samples
+     * until supersampled) and of the neighbours above */
+    rgb enc[AA_BLOCK][AA_BLOCK], above_e[AA_BLOCK];
+    for (int y = Y0; y < Y1; y++)
+        for (int x = X0; x < X1; x++) enc[y - Y0][x - X0] = aa_encode(c->sc, fb_px(c->fb, x, y));
+    for (int x = X0; x < X1; x++) {
+        first_sample(c, thread, x, Y0 - 1, above[x - X0]);
+        above_e[x - X0] = aa_encode(c->sc, above[x - X0]);
+    }
     for (int y = Y0; y < Y1; y++) {
         if (c->s->cancel && *c->s->cancel) return;
         first_sample(c, thread, X0 - 1, y, left);
+        rgb left_e = aa_encode(c->sc, left);
         for (int x = X0; x < X1; x++) {
             int i = x - X0, j = y - Y0;
             float *cur = fb_px(c->fb, x, y);
             float *lp = i > 0 ? fb_px(c->fb, x - 1, y) : left, *tp = j > 0 ? fb_px(c->fb, x, y - 1) : above[i];
-            int ldiff = aa_differ(c, lp, cur), tdiff = aa_differ(c, tp, cur);
+            int ldiff = aa_differ(c, i > 0 ? enc[j][i - 1] : left_e, enc[j][i]);
+            int tdiff = aa_differ(c, j > 0 ? enc[j - 1][i] : above_e[i], enc[j][i]);
             /* the block's neighbours count as done (POV-Ray's SetFlag) */
             if (ldiff && i > 0 && !done[j][i - 1]) {
                 supersample_pixel(c, thread, x - 1, y, lp);
                 done[j][i - 1] = 1;
+                enc[j][i - 1] = aa_encode(c->sc, lp); /* the next row compares with it */
             }
             if (tdiff && j > 0 && !done[j - 1][i]) {
                 supersample_pixel(c, thread, x, y - 1, tp);
                 done[j - 1][i] = 1;
+                enc[j - 1][i] = aa_encode(c->sc, tp);
             }
             if (ldiff || tdiff) {
                 supersample_pixel(c, thread, x, y, cur);
                 done[j][i] = 1;
+                enc[j][i] = aa_encode(c->sc, cur);
             }
         }
         progress_add(c->s->progress, X1 - X0);
@@ -776,12 +790,28 @@ static int *aa_block_order(const render_ctx *c, int bw, int bh)
         return NULL;
     }
     for (int b = 0; b < nb; b++) bc[b] = (block_cost){0, b};
-    for (int y = c->first_win[1]; y < c->first_win[3]; y++)
-        for (int x = c->first_win[0]; x < c->first_win[2]; x++) {
-            const float *f = c->first + 3 * ((size_t)y * w + x);
-            int differ = (x > 0 && aa_differ(c, f - 3, f)) || (y > 0 && aa_differ(c, f - 3 * (size_t)w, f));
+    /* the encoded first samples of the row and of the row above, from the
+     * column left of the window on */
+    int x0 = c->first_win[0] > 0 ? c->first_win[0] - 1 : 0, x1 = c->first_win[2], y0 = c->first_win[1];
+    rgb *rows = malloc(sizeof *rows * (size_t)w * 2), *row = rows, *up = rows ? rows + w : NULL;
+    if (!rows) {
+        free(bc);
+        free(order);
+        return NULL;
+    }
+    if (y0 > 0)
+        for (int x = x0; x < x1; x++) up[x] = aa_encode(c->sc, c->first + 3 * ((size_t)(y0 - 1) * w + x));
+    for (int y = y0; y < c->first_win[3]; y++) {
+        for (int x = x0; x < x1; x++) row[x] = aa_encode(c->sc, c->first + 3 * ((size_t)y * w + x));
+        for (int x = c->first_win[0]; x < x1; x++) {
+            int differ = (x > 0 && aa_differ(c, row[x - 1], row[x])) || (y > 0 && aa_differ(c, up[x], row[x]));
             if (differ) bc[y / AA_BLOCK * bw + x / AA_BLOCK].cost++;
         }
+        rgb *t = up;
+        up = row;
+        row = t;
+    }
+    free(rows);
     qsort(bc, (size_t)nb, sizeof *bc, cmp_block_cost);
     for (int b = 0; b < nb; b++) order[b] = bc[b].block;
     free(bc);
