@@ -81,7 +81,16 @@ static inline rgb mk(double r, double g, double b) { rgb c = {r, g, b}; return c
 static inline rgb add(rgb a, rgb b) { return mk(a.r + b.r, a.g + b.g, a.b + b.b); }
 static inline rgb mul(rgb a, rgb b) { return mk(a.r * b.r, a.g * b.g, a.b * b.b); }
 static inline rgb scl(rgb a, double s) { return mk(a.r * s, a.g * s, a.b * s); }
-static inline rgb expn(rgb a) { return mk(exp(-a.r), exp(-a.g), exp(-a.b)); }
+/* exp(-a) per channel; one exp() where the channels are equal (grey
+ * media, the usual case), the same value three times. */
+static inline rgb expn(rgb a)
+{
+    if (a.r == a.g && a.g == a.b) {
+        double e = exp(-a.r);
+        return mk(e, e, e);
+    }
+    return mk(exp(-a.r), exp(-a.g), exp(-a.b));
+}
 static inline int is_zero(rgb a) { return a.r == 0.0 && a.g == 0.0 && a.b == 0.0; }
 static inline double dist3(rgb a, rgb b) { return fabs(a.r - b.r) + fabs(a.g - b.g) + fabs(a.b - b.b); }
 
