@@ -268,14 +268,16 @@ static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, cons
     if (rgb_near_zero(lc) || l->shadowless) return lc;
     rgb vis;
     if (l->area && l->size1 * l->size2 > 1) {
-        rng r; /* jittered area lights: a stream of the sample's own */
+        rng r; /* jittered area lights: a stream of the sample's own, from
+                * where it lies alone (never the thread: an image is the
+                * same on any thread count, and a tile equals the frame) */
         uint64_t k;
         double coords[3] = {p.x, p.y, p.z};
         memcpy(&k, &coords[0], sizeof k);
         uint64_t k2, k3;
         memcpy(&k2, &coords[1], sizeof k2);
         memcpy(&k3, &coords[2], sizeof k3);
-        rng_seed(&r, k ^ (k2 * 0x9e3779b97f4a7c15ULL) ^ (k3 * 0xbf58476d1ce4e5b9ULL), (uint64_t)thread);
+        rng_seed(&r, k ^ (k2 * 0x9e3779b97f4a7c15ULL) ^ (k3 * 0xbf58476d1ce4e5b9ULL), 0);
         vis = area_visibility(c, thread, l, p, &r, in);
     } else {
         vis = shadow_rgb(c, thread, p, dir, sdepth, l, in, NULL);
