@@ -93,7 +93,10 @@ static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, const gi_causti
     shade_media_inside si = photon_inside(in);
     shade_mat_bsdf b;
     setup(c, &b, h, dir, in ? &si : NULL, r);
-    int out = b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 ? GI_CAUSTIC_RECEIVES : 0;
+    const scene_finish *tf = b.ls.f;
+    int out = b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0                      ? GI_CAUSTIC_RECEIVES
+              : tf && (tf->specular > 0.0 || tf->phong > 0.0) ? GI_CAUSTIC_HIGHLIGHTS
+                                                               : 0;
     if (!step) return out;
     double mr = b.m[SHADE_MAT_LOBE_REFLECT], mt = b.m[SHADE_MAT_LOBE_TRANSMIT];
     double p = (mr + mt) / (b.msum > 1.0 ? b.msum : 1.0);
@@ -273,6 +276,37 @@ static rgb chained(void *ctx, const accel_hit *h, vec3 n, int thread)
     return e;
 }
 
+/* One photon through the highlights of the surface (caustics_highlights). */
+typedef struct {
+    shade_light_surface s;
+    rgb sum;
+} highlight_acc;
+
+static void highlight_one(void *ctx, vec3 w, rgb e)
+{
+    highlight_acc *a = ctx;
+    rgb t = shade_light_terms(&a->s, w, e, 0);
+    a->sum.r += t.r;
+    a->sum.g += t.g;
+    a->sum.b += t.b;
+}
+
+rgb caustics_highlights(void *ctx, const accel_hit *h, const shade_light_surface *s, int thread)
+{
+    (void)thread;
+    caustics *c = ctx;
+    highlight_acc a = {*s, {0, 0, 0}};
+    if (!c->layer || !s->f || (s->f->specular <= 0.0 && s->f->phong <= 0.0)) return a.sum;
+    /* the highlights alone: the Lambertian share of the same photons is
+     * gi_caustic_at's, added through the indirect hook */
+    scene_finish f = *s->f;
+    f.diffuse = 0.0;
+    f.diffuse_back = 0.0;
+    a.s.f = &f;
+    gi_caustic_visit(c->layer, h, s->n, highlight_one, &a);
+    return a.sum;
+}
+
 void caustics_attach(caustics *c, shade_settings *ss)
 {
     if (!c->layer) return;
@@ -280,6 +314,8 @@ void caustics_attach(caustics *c, shade_settings *ss)
     c->next_ctx = ss->indirect_ctx;
     ss->indirect = chained;
     ss->indirect_ctx = c;
+    ss->highlights = caustics_highlights;
+    ss->highlights_ctx = c;
     ss->photon_shadows = 1;
 }
 
@@ -308,7 +344,7 @@ void caustics_json(caustics *c, stats_json *js)
         stats_int(js, k, s->alive[b]);
     }
     stats_obj_end(js);
-    STATS_INTS(js, s, stored);
+    STATS_INTS(js, s, stored, stored_highlights);
     STATS_NUMS(js, s, flux, r_median);
     STATS_INTS(js, s, rays, tile_entries, lookups_gbuffer, lookups_photons);
     stats_obj_begin(js, "seconds");

@@ -44,6 +44,11 @@ pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width
 /* Puts the layer into shade settings: its indirect hook (after whatever
  * hook ss has: that one is kept and summed) and POV-Ray's photon shadows. */
 void caustics_attach(caustics *c, shade_settings *ss);
+/* The highlights (specular, phong) that the photons near h give the layer
+ * surface s, each photon shaded as a light (POV-Ray's gather, trace.cpp
+ * ComputePhotonDiffuseLight; the Lambertian share comes through the
+ * indirect hook); shade_highlight_fn-compatible with c as the context. */
+rgb caustics_highlights(void *c, const accel_hit *h, const shade_light_surface *s, int thread);
 void caustics_free(caustics *c);
 /* "caustics": {...} in the stats (nothing when the scene asked for none). */
 void caustics_json(caustics *c, stats_json *js);

@@ -175,6 +175,11 @@ struct gi_caustic {
     gi_caus_photon *ph;
     long nph;
     hgrid pgrid;
+    /* photons on highlight-only surfaces (GI_CAUSTIC_HIGHLIGHTS): never
+     * splatted, only visited */
+    gi_caus_photon *hl;
+    long nhl;
+    hgrid hlgrid;
     /* G-buffer */
     int w, h;
     gi_caus_pixel *gb;
@@ -274,15 +279,19 @@ static void concentric(double u, double v, double *rho, double *phi)
 typedef struct {
     gi_caus_photon *p;
     long n, cap;
+    gi_caus_photon *hl; /* highlight-only surfaces' photons */
+    long nhl, caphl;
     long rays, first_hits, absorbed_first;
     long alive[GI_CAUSTIC_MAX_BOUNCES + 1];
     int oom;
 } chunk_out;
 
-static int push_photon(chunk_out *o, const gi_caus_photon *q)
+static int push_photon(chunk_out *o, const gi_caus_photon *q, int highlight_only)
 {
-    if (!grow_array_long((void **)&o->p, &o->cap, o->n + 1, sizeof *o->p)) return 0;
-    o->p[o->n++] = *q;
+    gi_caus_photon **p = highlight_only ? &o->hl : &o->p;
+    long *n = highlight_only ? &o->nhl : &o->n, *cap = highlight_only ? &o->caphl : &o->cap;
+    if (!grow_array_long((void **)p, cap, *n + 1, sizeof **p)) return 0;
+    (*p)[(*n)++] = *q;
     return 1;
 }
 
@@ -396,7 +405,8 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
         gi_caustic_step step[2];
         int sf = c->hk.surface(c->hk.ctx, &h, br.w, &br.in, &r, step);
         const scene_obj_photons *ph = h.obj ? h.obj->photons : NULL;
-        if (level >= 1 && (sf & GI_CAUSTIC_RECEIVES) && !(ph && !ph->collect) && scene_light_reaches(l, h.obj)) {
+        if (level >= 1 && (sf & (GI_CAUSTIC_RECEIVES | GI_CAUSTIC_HIGHLIGHTS)) && !(ph && !ph->collect) &&
+            scene_light_reaches(l, h.obj)) {
             /* store the photon before this bounce (paper, step 1(d)) */
             double att = c->hk.attenuation(c->hk.ctx, l, p_first, depth);
             double k = att * (cb->parallel ? 1.0 : depth * depth);
@@ -413,7 +423,7 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
                                  (float)(cb->phi0.b * br.tr.b * k)},
                                 (float)(16.0 / (rxy * rxy))};
             if (rxy > 0.0 && isfinite(q.phi[0] + q.phi[1] + q.phi[2]) && cmax3(crgb(q.phi[0], q.phi[1], q.phi[2])) > 0.0)
-                if (!push_photon(out, &q)) {
+                if (!push_photon(out, &q, !(sf & GI_CAUSTIC_RECEIVES))) {
                     out->oom = 1;
                     return;
                 }
@@ -873,10 +883,11 @@ gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_s
     trace_job tj = {c, calloc((size_t)(nchunks > 0 ? nchunks : 1), sizeof(chunk_out))};
     if (!tj.outs) st = PT_ERR_NOMEM;
     if (st == PT_OK) pool_run(threads, nchunks, trace_chunk, &tj);
-    long nph = 0;
+    long nph = 0, nhl = 0;
     for (int i = 0; tj.outs && i < nchunks; i++) {
         if (tj.outs[i].oom) st = PT_ERR_NOMEM;
         nph += tj.outs[i].n;
+        nhl += tj.outs[i].nhl;
         c->st.rays += tj.outs[i].rays;
         c->st.first_hits += tj.outs[i].first_hits;
         c->st.absorbed_first += tj.outs[i].absorbed_first;
@@ -884,17 +895,25 @@ gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_s
     }
     if (st == PT_OK) {
         c->ph = malloc(sizeof *c->ph * (size_t)(nph > 0 ? nph : 1));
-        if (!c->ph) st = PT_ERR_NOMEM;
+        c->hl = malloc(sizeof *c->hl * (size_t)(nhl > 0 ? nhl : 1));
+        if (!c->ph || !c->hl) st = PT_ERR_NOMEM;
     }
     for (int i = 0; tj.outs && i < nchunks; i++) {
         if (st == PT_OK && tj.outs[i].n) memcpy(c->ph + c->nph, tj.outs[i].p, sizeof *c->ph * (size_t)tj.outs[i].n);
-        if (st == PT_OK) c->nph += tj.outs[i].n;
+        if (st == PT_OK && tj.outs[i].nhl)
+            memcpy(c->hl + c->nhl, tj.outs[i].hl, sizeof *c->hl * (size_t)tj.outs[i].nhl);
+        if (st == PT_OK) {
+            c->nph += tj.outs[i].n;
+            c->nhl += tj.outs[i].nhl;
+        }
         free(tj.outs[i].p);
+        free(tj.outs[i].hl);
     }
     free(tj.outs);
     for (int b = 1; b <= GI_CAUSTIC_MAX_BOUNCES; b++)
         if (c->st.alive[b] > 0) c->st.max_bounce = b;
     c->st.stored = c->nph;
+    c->st.stored_highlights = c->nhl;
     for (long i = 0; i < c->nph; i++) c->st.flux += (c->ph[i].phi[0] + c->ph[i].phi[1] + c->ph[i].phi[2]) / 3.0;
     c->st.t_trace = timer_now() - t0;
     if (st != PT_OK || (s->cancel && *s->cancel)) {
@@ -905,6 +924,8 @@ gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_s
     c->st.r_median = median_of(&c->ph[0].r_xy, c->nph, sizeof(gi_caus_photon) / sizeof(float));
     double pcell = 2.0 * (c->st.r_median > 0.0 ? c->st.r_median : accel_scale(a) * 1e-3);
     if (!hgrid_build(&c->pgrid, pcell, c->nph, c->ph[0].x, sizeof(gi_caus_photon) / sizeof(float), &c->ph[0].r_xy,
+                     sizeof(gi_caus_photon) / sizeof(float)) ||
+        !hgrid_build(&c->hlgrid, pcell, c->nhl, c->hl[0].x, sizeof(gi_caus_photon) / sizeof(float), &c->hl[0].r_xy,
                      sizeof(gi_caus_photon) / sizeof(float))) {
         gi_caustic_free(c);
         *status = PT_ERR_NOMEM;
@@ -966,6 +987,8 @@ void gi_caustic_free(gi_caustic *c)
     free(c->cb);
     free(c->ph);
     hgrid_free(&c->pgrid);
+    free(c->hl);
+    hgrid_free(&c->hlgrid);
     hgrid_free(&c->ggrid);
     free(c->gb);
     free(c->gobj);
@@ -1049,4 +1072,34 @@ rgb gi_caustic_at(void *ctx, const accel_hit *h, vec3 n, int thread)
         acc[2] += one[2];
     }
     return crgb(acc[0], acc[1], acc[2]);
+}
+
+/* gi_caustic_visit's photon q at s (normal n facing the viewer). */
+static void visit_one(const gi_caus_photon *q, const float s[3], vec3 n, gi_caustic_visit_fn fn, void *ctx)
+{
+    vec3 w = {q->w[0], q->w[1], q->w[2]};
+    double c = v3_dot(w, n);
+    if (c <= 0.0) return;
+    double k = gi_c_caustic_kappa(q, s);
+    if (k <= 0.0) return;
+    k /= fmax(fmin(c, 1.0), 0.1);
+    fn(ctx, w, crgb(q->phi[0] * k, q->phi[1] * k, q->phi[2] * k));
+}
+
+static void visit_grid(const hgrid *g, const gi_caus_photon *ph, vec3 p, vec3 n, gi_caustic_visit_fn fn, void *ctx)
+{
+    if (!ph) return;
+    float s[3] = {(float)p.x, (float)p.y, (float)p.z};
+    long lo, hi;
+    double cell = g->cell;
+    hgrid_cell(g, cidx(p.x, cell), cidx(p.y, cell), cidx(p.z, cell), &lo, &hi);
+    for (long q = lo; q < hi; q++) visit_one(&ph[g->e[q].id], s, n, fn, ctx);
+    for (long q = 0; q < g->nbig; q++) visit_one(&ph[g->big[q]], s, n, fn, ctx);
+}
+
+void gi_caustic_visit(const gi_caustic *c, const accel_hit *h, vec3 n, gi_caustic_visit_fn fn, void *ctx)
+{
+    if (!c || !h || !h->obj || (h->obj->photons && !h->obj->photons->collect)) return;
+    visit_grid(&c->pgrid, c->ph, h->p, n, fn, ctx);
+    visit_grid(&c->hlgrid, c->hl, h->p, n, fn, ctx);
 }

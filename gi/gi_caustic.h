@@ -94,13 +94,20 @@ typedef struct {
 
 /* GI_CAUSTIC_CONTINUES: step[0] holds the bounce; GI_CAUSTIC_SPLIT as well:
  * step[1] holds a second one (reflection and refraction both). */
-enum { GI_CAUSTIC_RECEIVES = 1, GI_CAUSTIC_CONTINUES = 2, GI_CAUSTIC_SPLIT = 4 };
+/* GI_CAUSTIC_HIGHLIGHTS: the surface has no Lambertian term but a
+ * specular or phong highlight (clear glass): a photon arriving there is
+ * stored for gi_caustic_visit only (POV-Ray gathers the photons at every
+ * surface with diffuse, specular or phong and shades each through the
+ * highlight as a light: trace.cpp, ComputePhotonDiffuseLight), never
+ * splatted or summed as irradiance. */
+enum { GI_CAUSTIC_RECEIVES = 1, GI_CAUSTIC_CONTINUES = 2, GI_CAUSTIC_SPLIT = 4, GI_CAUSTIC_HIGHLIGHTS = 8 };
 
 /* The material and light model, from app/ (gi/ cannot reach shade/). */
 typedef struct {
     /* The surface at h for a photon or eye ray arriving along unit dir
      * inside the objects `in` (NULL: the atmosphere):
-     * GI_CAUSTIC_RECEIVES when it has a Lambertian term (photons light it);
+     * GI_CAUSTIC_RECEIVES when it has a Lambertian term (photons light it),
+     * GI_CAUSTIC_HIGHLIGHTS when it has only a highlight;
      * with step non-NULL (room for 2), Russian roulette (seed 002 appendix
      * A) between going on, with probability the specular lobes' share of
      * the surface's albedo, and ending the photon (absorbed, or taken by a
@@ -146,7 +153,8 @@ typedef struct {
     long alive[GI_CAUSTIC_MAX_BOUNCES + 1]; /* branches going on after bounce b (b = 1: the bounce map; a
                                                split counts once, so later bounces can exceed the first) */
     int max_bounce;         /* highest b with alive[b] > 0 */
-    long stored;            /* photon volumes */
+    long stored;            /* photon volumes (splatted) */
+    long stored_highlights; /* photons on surfaces with only a highlight (gi_caustic_visit's alone) */
     double flux;            /* their power, summed (grey: mean of the channels) */
     long rays;
     double spacing;         /* the global spacing used (count and count_scale applied) */
@@ -168,7 +176,18 @@ void gi_caustic_get_stats(const gi_caustic *c, gi_caustic_stats *st);
  * layer at hit h, n facing the viewer; shade_indirect_fn-compatible with c
  * as the context. Thread-safe. */
 rgb gi_caustic_at(void *c, const accel_hit *h, vec3 n, int thread);
-/* The stored photon volumes. */
+/* Every stored photon (on receivers and on highlight-only surfaces alike)
+ * whose volume holds hit h's point and that arrives on the side of n (n
+ * facing the viewer), unless h's object has photons { collect off }: fn
+ * gets w, the unit direction back towards where the photon came from (as
+ * stored), and e = Phi kappa / max(w.n, 0.1), the photon as a light of
+ * colour e along w (POV-Ray's gather: a photon's colour over the gather
+ * disc's area, times 1 / cos at most tenfold; trace.cpp,
+ * ComputePhotonDiffuseLight). Summed through a Lambertian term e c gives
+ * gi_caustic_at's irradiance; the caller adds the highlights. Thread-safe. */
+typedef void (*gi_caustic_visit_fn)(void *ctx, vec3 w, rgb e);
+void gi_caustic_visit(const gi_caustic *c, const accel_hit *h, vec3 n, gi_caustic_visit_fn fn, void *ctx);
+/* The stored photon volumes (those splatted). */
 const gi_caus_photon *gi_caustic_photons(const gi_caustic *c, long *n);
 /* The splat's result: 4 floats per G-buffer pixel (row-major, y down), and
  * the G-buffer. */

@@ -176,3 +176,5 @@ void gi_c_caustic_at(const gi_caus_photon *ph, const int *idx, int n, const floa
     e[0] = e[1] = e[2] = 0.0f;
     for (int k = 0; k < n; k++) gi_caus_add(&ph[idx ? idx[k] : k], s[0], s[1], s[2], nrm[0], nrm[1], nrm[2], brilliance, e);
 }
+
+float gi_c_caustic_kappa(const gi_caus_photon *q, const float s[3]) { return gi_caus_kappa(q, s[0], s[1], s[2]); }

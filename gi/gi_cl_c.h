@@ -42,4 +42,7 @@ void gi_c_caustic_splat(int threads, const gi_caus_photon *ph, const int *tile_o
 void gi_c_caustic_at(const gi_caus_photon *ph, const int *idx, int n, const float s[3], const float nrm[3], float brilliance,
                      float e[3]);
 
+/* gi_caus_kappa (gi_caustic.cl): photon q's filter kernel at s. */
+float gi_c_caustic_kappa(const gi_caus_photon *q, const float s[3]);
+
 #endif

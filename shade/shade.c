@@ -416,11 +416,18 @@ static rgb tex_cb_indirect(void *ctx, int thread, const accel_hit *h, vec3 n)
     return c->s->indirect(c->s->indirect_ctx, h, n, thread);
 }
 
+static rgb tex_cb_highlights(void *ctx, int thread, const accel_hit *h, const shade_light_surface *s)
+{
+    render_ctx *c = ctx;
+    return c->s->highlights(c->s->highlights_ctx, h, s, thread);
+}
+
 static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip,
                      float wavelength, rng *r, const shade_media_inside *in)
 {
     shade_tex_env e = {c->sc, c->eps, c->s->use_ambient, c->max_level, c, thread, r, tex_cb_trace, tex_cb_direct,
-                 c->s->indirect ? tex_cb_indirect : NULL, &c->ts[thread].unsupported, c->s->quality, in};
+                 c->s->indirect ? tex_cb_indirect : NULL, &c->ts[thread].unsupported, c->s->quality, in,
+                 c->s->highlights ? tex_cb_highlights : NULL};
     hit_frame f = {h, dir, in};
     const hit_frame *outer = c->frame[thread];
     c->frame[thread] = &f;

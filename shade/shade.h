@@ -17,6 +17,10 @@
  * indirect radiance weighting that multiplies pigment*diffuse (POV-Ray's
  * radiosity "ambient" replacement). `n` faces the viewer. */
 typedef rgb (*shade_indirect_fn)(void *ctx, const accel_hit *hit, vec3 n, int thread);
+/* Highlights (specular, phong) from light the indirect hook carries as
+ * directed samples (the caustic layer's photons) on the layer surface s at
+ * hit; the Lambertian share stays the indirect hook's. */
+typedef rgb (*shade_highlight_fn)(void *ctx, const accel_hit *hit, const shade_light_surface *s, int thread);
 
 /* Primary hits found before the render (the particle GI's view pre-pass
  * traces the same camera rays). primary_begin is asked once per render:
@@ -46,6 +50,8 @@ typedef struct {
     int use_ambient;        /* 1: add finish ambient * ambient_light (no GI); 0: GI supplies it */
     shade_indirect_fn indirect;
     void *indirect_ctx;
+    shade_highlight_fn highlights; /* NULL: none */
+    void *highlights_ctx;
     shade_primary_begin_fn primary_begin; /* both NULL: every camera ray is traced */
     shade_primary_fn primary;
     void *primary_ctx;

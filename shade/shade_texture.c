@@ -327,6 +327,8 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
         if (f->diffuse != 0.0 || f->diffuse_back != 0.0 || f->specular != 0.0 || f->phong != 0.0) {
             shade_light_surface s = {f, pig, ln, hi->dir, att, e->r, hi->pc.ipoint, &sc->global};
             tmp = tadd(tmp, e->direct(e->ctx, e->thread, &s, hi->h, hi->p_out, e->r));
+            if (e->highlights && (f->specular > 0.0 || f->phong > 0.0))
+                tmp = tadd(tmp, e->highlights(e->ctx, e->thread, hi->h, &s));
         }
         result = tadd(result, tmul(tmp, filcol));
 

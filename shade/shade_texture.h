@@ -46,6 +46,10 @@ typedef struct {
      * NULL: the ray's side of the surface decides (a ray from the
      * atmosphere). */
     const shade_media_inside *inside;
+    /* Highlights of directed indirect light (the caustic layer's photons)
+     * on the layer surface s at every layer with specular or phong (NULL =
+     * none). */
+    rgb (*highlights)(void *ctx, int thread, const accel_hit *h, const shade_light_surface *s);
 } shade_tex_env;
 
 /* Colour seen along unit `dir` at hit h (the ray's level and weight as in

@@ -246,6 +246,57 @@ static void test_mirror_brilliance(void **state)
     }
 }
 
+/* The mirror above over a floor with no Lambertian term but a specular
+ * highlight (diffuse 0, specular 1, roughness 0.5: POV-Ray's exponent
+ * 1 / roughness = 2), as clear glass is: the photons stored there light it
+ * through the highlight alone, each as a light (trace.cpp,
+ * ComputePhotonDiffuseLight). Seen straight down (eye -y, normal y), a
+ * light along unit l gives the half-vector cosine^2 = (1 + l_y) / 2; the
+ * photons around a point sum to the mirrored light's colour 1 (their
+ * density carries the cosine c that each photon's 1 / c takes away), from
+ * the mirrored light at <4, 5, 0>. So the highlight at floor point
+ * (x, 0, z) is (1 + 5 / |(4 - x, 5, -z)|) / 2, about 0.89; the mean over
+ * a 9 x 9 grid of the view's points must match within 2% (POV-Ray's
+ * stored direction, truncated to pi/127 steps, moves it by under 1%).
+ * The floor stores no photon for the splat, and a floor of specular 0
+ * gets no highlight. */
+static void test_highlight_photons(void **state)
+{
+    (void)state;
+    for (int spec = 1; spec >= 0; spec--) {
+        char text[1024], floor[96];
+        snprintf(floor, sizeof floor, "diffuse 0 specular %d roughness 0.5", spec);
+        snprintf(text, sizeof text, mirror_fmt, "photons { spacing 0.01 }", "light_source { <-2, 5, 0> color rgb 1 }",
+                 "photons { target reflection on }", floor);
+        tu_world w = tu_world_build("test.pov", text);
+        diag *d = diag_new();
+        caustics c;
+        layer(&c, w.s, w.a, 32, 32, NULL, THREADS, d);
+        assert_int_equal(c.st.stored, 0);
+        if (spec) assert_true(c.st.stored_highlights > 1000);
+        else assert_int_equal(c.st.stored_highlights, 0);
+        double got = 0.0, want = 0.0;
+        for (int i = 0; i < 9; i++)
+            for (int j = 0; j < 9; j++) {
+                double x = -0.18 + 0.045 * i, z = -0.18 + 0.045 * j;
+                accel_hit h;
+                assert_true(accel_intersect(w.a, v3(x, 5, z), v3(0, -1, 0), 0.0, INFINITY, &h));
+                const scene_finish *f = &h.obj->texture->finish;
+                shade_light_surface s = {f, {1, 1, 1}, v3(0, 1, 0), v3(0, -1, 0), 1.0, NULL, h.p, &w.s->global};
+                rgb e = caustics_highlights(&c, &h, &s, 0);
+                got += e.g / 81.0;
+                want += spec * 0.5 * (1.0 + 5.0 / sqrt((4.0 - x) * (4.0 - x) + 25.0 + z * z)) / 81.0;
+            }
+        printf("highlight-only floor, specular %d: photons' highlight %.5f, closed form %.5f (%ld photons)\n", spec, got,
+               want, c.st.stored_highlights);
+        if (spec) assert_true(fabs(got / want - 1.0) <= 0.02);
+        else assert_true(got == 0.0);
+        caustics_free(&c);
+        diag_free(d);
+        tu_world_free(&w);
+    }
+}
+
 /* The mirror above with a pass_through pane (rgbft <1, 0.5, 0.25, 0.6,
  * 0.2>, no ior) across the photons' way from the light to the mirror:
  * POV-Ray 3.7 (photons.cpp, built with PT_FILTER_BEFORE_TARGET) lets a
@@ -633,6 +684,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_mirror_closed_form),
         cmocka_unit_test(test_mirror_brilliance),
+        cmocka_unit_test(test_highlight_photons),
         cmocka_unit_test(test_photons_in_room),
         cmocka_unit_test(test_pass_through_filter),
         cmocka_unit_test(test_path_mirror_closed_form),
