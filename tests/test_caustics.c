@@ -222,16 +222,24 @@ static double mirror_brilliance_want(double b)
     return sum / (32.0 * 32.0);
 }
 
+/* The mirror scene lit by the point light <-2, 5, 0> of colour 1 shooting
+ * photons at the mirror (spacing 0.01), its floor's finish items `floor`. */
+static tu_world mirror_lit(const char *floor)
+{
+    char text[1024];
+    snprintf(text, sizeof text, mirror_fmt, "photons { spacing 0.01 }", "light_source { <-2, 5, 0> color rgb 1 }",
+             "photons { target reflection on }", floor);
+    return tu_world_build("test.pov", text);
+}
+
 static void test_mirror_brilliance(void **state)
 {
     (void)state;
     const double bs[2] = {0.5, 3.0};
     for (int i = 0; i < 2; i++) {
-        char text[1024], floor[64];
+        char floor[64];
         snprintf(floor, sizeof floor, "brilliance %g", bs[i]);
-        snprintf(text, sizeof text, mirror_fmt, "photons { spacing 0.01 }", "light_source { <-2, 5, 0> color rgb 1 }",
-                 "photons { target reflection on }", floor);
-        tu_world w = tu_world_build("test.pov", text);
+        tu_world w = mirror_lit(floor);
         diag *d = diag_new();
         caustics c;
         layer(&c, w.s, w.a, 32, 32, NULL, THREADS, d);
@@ -264,11 +272,9 @@ static void test_highlight_photons(void **state)
 {
     (void)state;
     for (int spec = 1; spec >= 0; spec--) {
-        char text[1024], floor[96];
+        char floor[96];
         snprintf(floor, sizeof floor, "diffuse 0 specular %d roughness 0.5", spec);
-        snprintf(text, sizeof text, mirror_fmt, "photons { spacing 0.01 }", "light_source { <-2, 5, 0> color rgb 1 }",
-                 "photons { target reflection on }", floor);
-        tu_world w = tu_world_build("test.pov", text);
+        tu_world w = mirror_lit(floor);
         diag *d = diag_new();
         caustics c;
         layer(&c, w.s, w.a, 32, 32, NULL, THREADS, d);
