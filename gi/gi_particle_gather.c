@@ -603,8 +603,7 @@ static void filter_row(void *ctx, int y, int thread)
     int R = sigma > 0.0 ? (int)ceil(2.0 * sigma) : 0; /* below 0: no filter, the pixel's own value */
     if (R > FILTER_RADIUS_MAX) R = FILTER_RADIUS_MAX;
     double g[FILTER_RADIUS_MAX + 1];
-    g[0] = 1.0;
-    for (int d = 1; d <= R; d++) g[d] = exp(-0.5 * d * d / (sigma * sigma));
+    for (int d = 0; d <= R; d++) g[d] = exp(-0.5 * d * d / (sigma * sigma));
     for (int x = 0; x < w; x++) {
         size_t i = (size_t)y * w + x;
         float *o = &gp->vg_pixval[4 * i];
