@@ -149,10 +149,11 @@ static void test_merge_coincident_walls(void **st)
  * pixel's light only where POV-Ray's cache would reuse that record (its
  * error_bound and the record's harmonic mean distance), and gathers
  * itself elsewhere; when the nearest pixels on the same object answered,
- * the rays in a recess took the rim's light and the mean difference was
- * 0.0092. At this error_bound POV-Ray reuses nearly no record, so no
- * filter blends the pixels' gathers and a hit that gathers itself takes
- * 0.6 of the side (with the filter and a third of the side: 0.0063).
+ * the rays in a recess took the rim's light, and the mean difference was
+ * far above the bound. At this error_bound POV-Ray reuses nearly no
+ * record, so no filter blends the pixels' gathers and a hit that gathers
+ * itself takes 0.6 of the side; with the filter and a third of the side
+ * the difference is above the bound too.
  * Full resolution, the scene's own count. */
 static void test_gi_antialias_reuse(void **st)
 {
