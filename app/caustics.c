@@ -187,7 +187,36 @@ static double hook_attenuation(void *ctx, const scene_light *l, vec3 p, double d
     return shade_light_attenuation(l, p, dir, depth);
 }
 
-static int has_media(const scene_object *o) { return o->interior && o->interior->nmedia > 0; }
+/* The caustic layer's media hook: the containers' media over a photon's
+ * segment, as POV-Ray's photon rays meet them (photons.cpp,
+ * ComputeLightedTexture): only on a hollow ray, dimmed by their extinction
+ * (shade_media_segment's shadow mode: extinction alone); photons are left
+ * there when some media scatters and collects photons (`collect`, the
+ * opposite of POV-Ray's ignore_photons; the media list takes photons when
+ * any of them does) and some absorbs or scatters (POV-Ray deposits nothing
+ * without extinction: ComputeMediaAndDepositPhotons returns first). */
+static int hook_media(void *ctx, const gi_caustic_inside *in, vec3 org, vec3 dir, double len, rgb *tr)
+{
+    const caustics *c = ctx;
+    shade_media_inside si = photon_inside(in);
+    *tr = (rgb){1, 1, 1};
+    if (si.n == 0 || !shade_media_inside_hollow(&si) || !shade_media_inside_has_media(&si)) return 0;
+    int scatters = 0, collects = 0, extinction = 0;
+    for (int k = 0; k < si.n; k++) {
+        const scene_interior *it = si.obj[k]->interior;
+        for (int i = 0; it && i < it->nmedia; i++) {
+            const scene_media *m = it->media[i];
+            int sc = m->scattering.r != 0.0 || m->scattering.g != 0.0 || m->scattering.b != 0.0;
+            int ab = m->absorption.r != 0.0 || m->absorption.g != 0.0 || m->absorption.b != 0.0;
+            scatters |= sc;
+            collects |= m->collect;
+            extinction |= sc || ab;
+        }
+    }
+    shade_media_env me = {c->sc, NULL, 0, NULL, NULL, NULL};
+    *tr = shade_media_segment(&me, SHADE_MEDIA_INTERIOR, &si, org, dir, len, *tr, 1);
+    return scatters && collects && extinction;
+}
 
 static int disperses(const scene_object *o)
 {
@@ -203,7 +232,8 @@ static int lit_from_behind(const scene_object *o)
     return 0;
 }
 
-/* What the scene's photon settings ask that the layer leaves out. */
+/* What the scene's photon settings ask that the layer leaves out (media
+ * photons are modelled: hook_media and caustics_media_photons). */
 static void not_modelled(caustics *c, const scene *sc, diag *d)
 {
     const scene_photons *p = &sc->global.photons;
@@ -212,12 +242,10 @@ static void not_modelled(caustics *c, const scene *sc, diag *d)
     nm->radius = (p->given & SCENE_PH_RADIUS) != 0;
     nm->expand_thresholds = (p->given & SCENE_PH_EXPAND) != 0;
     nm->autostop = (p->given & SCENE_PH_AUTOSTOP) != 0 && p->autostop > 0.0;
-    nm->media = p->media_steps > 0;
     nm->save_file = (p->given & SCENE_PH_SAVE_FILE) != 0 && p->file && !p->load;
     nm->load_file = (p->given & SCENE_PH_LOAD_FILE) != 0 && p->file && p->load;
     for (int i = 0; i < sc->nobjects; i++) {
         nm->dispersion |= scene_object_any(sc->objects[i], disperses);
-        nm->media_objects |= scene_object_any(sc->objects[i], has_media);
         nm->diffuse_back |= scene_object_any(sc->objects[i], lit_from_behind);
     }
     src_loc nowhere = {0};
@@ -227,7 +255,6 @@ static void not_modelled(caustics *c, const scene *sc, diag *d)
     if (nm->expand_thresholds) diag_warn_once(d, nowhere, "photons: expand_thresholds is not modelled: %s", why);
     if (nm->autostop)
         diag_warn_once(d, nowhere, "photons: autostop is not modelled: every direction towards a target is shot");
-    if (nm->media) diag_warn_once(d, nowhere, "photons: media photons are not modelled; media get no caustic light");
     if (nm->save_file) diag_warn_once(d, nowhere, "photons: save_file is not modelled: no photon file is written");
     if (nm->load_file)
         diag_warn_once(d, nowhere, "photons: load_file is not modelled: the photons are shot again, not read");
@@ -237,8 +264,6 @@ static void not_modelled(caustics *c, const scene *sc, diag *d)
         diag_warn_once(d, nowhere,
                        "photons: diffuse_back is not modelled in the caustic layer: photons arriving at the back of a "
                        "surface do not light it");
-    if (nm->media_objects)
-        diag_warn_once(d, nowhere, "photons: media inside objects neither take nor dim photons in the caustic layer");
 }
 
 pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width, int height, int threads,
@@ -251,7 +276,7 @@ pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width
     not_modelled(c, sc, d);
     c->sc = sc;
     c->eps = accel_surface_eps(a); /* the shader's offsets: photons cross thin walls as eye rays do */
-    gi_caustic_hooks hk = {hook_surface, hook_attenuation, c, hook_brilliance, hook_pass, hook_containers};
+    gi_caustic_hooks hk = {hook_surface, hook_attenuation, c, hook_brilliance, hook_pass, hook_containers, hook_media};
     gi_caustic_settings s = {width, height, threads, seed, cl_device, cl_max_bytes, count_scale, cancel};
     pt_status st = PT_OK;
     c->layer = gi_caustic_build(sc, a, &s, &hk, d, &st);
@@ -307,6 +332,12 @@ rgb caustics_highlights(void *ctx, const accel_hit *h, const shade_light_surface
     return a.sum;
 }
 
+void caustics_media_photons(void *ctx, vec3 p, shade_media_photon_fn each, void *each_ctx)
+{
+    const caustics *c = ctx;
+    gi_caustic_media_visit(c->layer, p, each, each_ctx);
+}
+
 void caustics_attach(caustics *c, shade_settings *ss)
 {
     if (!c->layer) return;
@@ -317,6 +348,10 @@ void caustics_attach(caustics *c, shade_settings *ss)
     ss->highlights = caustics_highlights;
     ss->highlights_ctx = c;
     ss->photon_shadows = 1;
+    if (c->st.stored_media > 0) {
+        ss->media_photons = caustics_media_photons;
+        ss->media_photons_ctx = c;
+    }
 }
 
 void caustics_free(caustics *c)
@@ -344,15 +379,15 @@ void caustics_json(caustics *c, stats_json *js)
         stats_int(js, k, s->alive[b]);
     }
     stats_obj_end(js);
-    STATS_INTS(js, s, stored, stored_highlights);
-    STATS_NUMS(js, s, flux, r_median);
+    STATS_INTS(js, s, stored, stored_highlights, stored_media);
+    STATS_NUMS(js, s, flux, r_median, r_media_median);
     STATS_INTS(js, s, rays, tile_entries, lookups_gbuffer, lookups_photons);
     stats_obj_begin(js, "seconds");
     STATS_NUMS_PRE(js, s, t_, trace, gbuffer, bin, splat);
     stats_obj_end(js);
     stats_obj_begin(js, "not_modelled");
-    STATS_INTS(js, &c->nm, gather, radius, expand_thresholds, autostop, media, save_file, load_file, dispersion,
-               media_objects, diffuse_back);
+    STATS_INTS(js, &c->nm, gather, radius, expand_thresholds, autostop, save_file, load_file, dispersion,
+               diffuse_back);
     stats_obj_end(js);
     stats_obj_end(js);
 }

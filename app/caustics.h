@@ -15,9 +15,8 @@
 /* Photon settings a scene uses that the caustic layer does not model: 1
  * where used (each also warned once by caustics_build). */
 typedef struct {
-    int gather, radius, expand_thresholds, autostop, media, save_file, load_file;
+    int gather, radius, expand_thresholds, autostop, save_file, load_file;
     int dispersion;     /* a target's interior has dispersion (photons carry no wavelength) */
-    int media_objects;  /* photons would cross media in objects (not deposited or attenuated) */
     int diffuse_back;   /* a surface with diffuse_back: photons arriving at its back are not shown (POV-Ray
                            lights it through diffuse_back) */
 } caustics_not_modelled;
@@ -41,8 +40,13 @@ typedef struct {
 pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width, int height, int threads,
                          uint64_t seed, const char *cl_device, size_t cl_max_bytes, double count_scale,
                          volatile int *cancel, diag *d);
+/* The media photons around p, each as a light through each (the layer's
+ * gi_caustic_media_visit); shade_media_photons_fn-compatible with c as the
+ * context. */
+void caustics_media_photons(void *c, vec3 p, shade_media_photon_fn each, void *each_ctx);
 /* Puts the layer into shade settings: its indirect hook (after whatever
- * hook ss has: that one is kept and summed) and POV-Ray's photon shadows. */
+ * hook ss has: that one is kept and summed), POV-Ray's photon shadows and,
+ * when the layer holds media photons, the media's photon hook. */
 void caustics_attach(caustics *c, shade_settings *ss);
 /* The highlights (specular, phong) that the photons near h give the layer
  * surface s, each photon shaded as a light (POV-Ray's gather, trace.cpp

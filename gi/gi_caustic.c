@@ -30,6 +30,13 @@
  * gather count of 20 photons, left visible speckle; 9 came closer to
  * POV-Ray's images than 6 on all three, 12 blurred phot_met_glass) */
 #define RADIUS_K 9.0
+/* k of a media photon's sphere radius r = k (s_l^2 s_a)^(1/3), s_l its
+ * lateral spacing (s_D / sqrt(rho_p)) and s_a its step along the way: the
+ * sphere holds about 4 pi k^3 / 3 = 113 photons of an unfocused beam, as
+ * POV-Ray's media gather, which takes up to its gather maximum (100 by
+ * default) within a radius sized from the map's mean density
+ * (photons.cpp, setGatherOptions) */
+#define MEDIA_RADIUS_K 3.0
 #define CHUNK 2048
 /* most photons shot in all (memory and time stay bounded whatever the scene asks) */
 #define MAX_CELLS 4194304.0
@@ -180,6 +187,10 @@ struct gi_caustic {
     gi_caus_photon *hl;
     long nhl;
     hgrid hlgrid;
+    /* media photons (spheres: r_xy = r_z = their radius, n unused) */
+    gi_caus_photon *mp;
+    long nmp;
+    hgrid mgrid;
     /* G-buffer */
     int w, h;
     gi_caus_pixel *gb;
@@ -281,15 +292,19 @@ typedef struct {
     long n, cap;
     gi_caus_photon *hl; /* highlight-only surfaces' photons */
     long nhl, caphl;
+    gi_caus_photon *mp; /* media photons */
+    long nmp, capmp;
     long rays, first_hits, absorbed_first;
     long alive[GI_CAUSTIC_MAX_BOUNCES + 1];
     int oom;
 } chunk_out;
 
-static int push_photon(chunk_out *o, const gi_caus_photon *q, int highlight_only)
+enum { STORE_SPLAT, STORE_HIGHLIGHT, STORE_MEDIA };
+static int push_photon(chunk_out *o, const gi_caus_photon *q, int kind)
 {
-    gi_caus_photon **p = highlight_only ? &o->hl : &o->p;
-    long *n = highlight_only ? &o->nhl : &o->n, *cap = highlight_only ? &o->caphl : &o->cap;
+    gi_caus_photon **p = kind == STORE_MEDIA ? &o->mp : kind == STORE_HIGHLIGHT ? &o->hl : &o->p;
+    long *n = kind == STORE_MEDIA ? &o->nmp : kind == STORE_HIGHLIGHT ? &o->nhl : &o->n;
+    long *cap = kind == STORE_MEDIA ? &o->capmp : kind == STORE_HIGHLIGHT ? &o->caphl : &o->cap;
     if (!grow_array_long((void **)p, cap, *n + 1, sizeof **p)) return 0;
     (*p)[(*n)++] = *q;
     return 1;
@@ -319,6 +334,58 @@ static vec3 pov_photon_dir(vec3 d)
     double pq = (double)(int)(phi * 127.0 / M_PI) * M_PI / 127.0;
     return v3(cos(tq) * cos(pq), sin(tq), cos(tq) * sin(pq));
 }
+/* Media photons along one straight segment of a photon's path, org + t w
+ * for 0 <= t <= len, that starts at path length D (POV-Ray 3.7's
+ * photons.cpp, DepositMediaPhotons and addMediaPhoton, for semantics):
+ *  - spacing: u = s D (point lights; s = the cell's angular spacing,
+ *    sqrt of its solid angle) or u = s (parallel lights; s = the cell's
+ *    edge), the distance to the photon's neighbours at the segment's start;
+ *  - count: n = floor(len / (f u)), f the media spacing factor; when n
+ *    exceeds max_steps, n = max_steps and f = len / (u n) (the steps grow);
+ *    n = 0 leaves no photon (POV-Ray's integer truncation);
+ *  - place j: t = (j + 1/2 + jitter (xi - 1/2)) / n len;
+ *  - colour: the photon's light (tr x the cell's colour) times the cell's
+ *    cross-section at D + t times its step f s (D + t) (point: f s^3
+ *    (D + t)^3; parallel: f s^3, phi0 holding s^2), times the light's
+ *    fade and spot attenuation at D + t: a light colour once summed over a
+ *    volume (gi_caustic_media_visit's kernel), as a surface photon is once
+ *    summed over an area. tr is the photon's colour at the segment's start:
+ *    POV-Ray deposits before the segment's extinction and fade. */
+static int deposit_media(const gi_caustic *c, const combo *cb, vec3 org, vec3 w, double len, double D, rgb tr,
+                         double rho_p, vec3 p_first, rng *r, chunk_out *out)
+{
+    const scene_photons *ps = &c->sc->global.photons;
+    double s = sqrt(cb->cell), u = cb->parallel ? s : s * D, f = ps->media_factor > 0.0 ? ps->media_factor : 1.0;
+    if (!(u > 0.0) || !(len > 0.0)) return 1;
+    double nd = floor(len / (f * u));
+    long n = nd > (double)ps->media_steps ? ps->media_steps : (long)nd;
+    if (n <= 0) return 1;
+    if (nd > (double)ps->media_steps) f = len / (u * (double)n);
+    double jit = ps->jitter, sa = len / (double)n;
+    vec3 wq = pov_photon_dir(v3_neg(w));
+    for (long j = 0; j < n; j++) {
+        double t = (j + 0.5 + jit * (rng_f64(r) - 0.5)) / (double)n * len, Dt = D + t;
+        double att = c->hk.attenuation(c->hk.ctx, cb->l, p_first, Dt);
+        double k = att * f * s * (cb->parallel ? 1.0 : Dt * Dt * Dt);
+        double sl = (cb->parallel ? s : s * Dt) / sqrt(rho_p);
+        double rad = fmin(MEDIA_RADIUS_K * cbrt(sl * sl * sa), c->r_max);
+        vec3 x = v3_madd(org, w, t);
+        float ir2 = (float)(1.0 / (rad * rad));
+        gi_caus_photon q = {{(float)x.x, (float)x.y, (float)x.z},
+                            (float)rad,
+                            {0, 0, 0},
+                            (float)rad,
+                            {(float)wq.x, (float)wq.y, (float)wq.z},
+                            ir2,
+                            {(float)(cb->phi0.r * tr.r * k), (float)(cb->phi0.g * tr.g * k), (float)(cb->phi0.b * tr.b * k)},
+                            ir2};
+        if (!(rad > 0.0) || !isfinite(q.phi[0] + q.phi[1] + q.phi[2]) || !(cmax3(crgb(q.phi[0], q.phi[1], q.phi[2])) > 0.0))
+            continue;
+        if (!push_photon(out, &q, STORE_MEDIA)) return 0;
+    }
+    return 1;
+}
+
 /* One bounce-map cell: the photon's direction (and origin), then its path. */
 static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_out *out)
 {
@@ -402,6 +469,18 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
             out->first_hits++;
             p_first = h.p;
         }
+        if (level >= 1 && c->hk.media && br.in.n > 0) {
+            /* the media of the containers over the way here: photons left
+             * in them (after the first surface, POV-Ray's traceLevel > 1),
+             * then the photon dimmed by their extinction */
+            rgb trm = {1, 1, 1};
+            if (c->hk.media(c->hk.ctx, &br.in, br.o, br.w, h.t, &trm) && c->sc->global.photons.media_steps > 0 &&
+                !deposit_media(c, cb, br.o, br.w, h.t, br.depth, br.tr, br.rho_p, p_first, &r, out)) {
+                out->oom = 1;
+                return;
+            }
+            br.tr = crgb(br.tr.r * trm.r, br.tr.g * trm.g, br.tr.b * trm.b);
+        }
         gi_caustic_step step[2];
         int sf = c->hk.surface(c->hk.ctx, &h, br.w, &br.in, &r, step);
         const scene_obj_photons *ph = h.obj ? h.obj->photons : NULL;
@@ -423,7 +502,7 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
                                  (float)(cb->phi0.b * br.tr.b * k)},
                                 (float)(16.0 / (rxy * rxy))};
             if (rxy > 0.0 && isfinite(q.phi[0] + q.phi[1] + q.phi[2]) && cmax3(crgb(q.phi[0], q.phi[1], q.phi[2])) > 0.0)
-                if (!push_photon(out, &q, !(sf & GI_CAUSTIC_RECEIVES))) {
+                if (!push_photon(out, &q, sf & GI_CAUSTIC_RECEIVES ? STORE_SPLAT : STORE_HIGHLIGHT)) {
                     out->oom = 1;
                     return;
                 }
@@ -883,11 +962,12 @@ gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_s
     trace_job tj = {c, calloc((size_t)(nchunks > 0 ? nchunks : 1), sizeof(chunk_out))};
     if (!tj.outs) st = PT_ERR_NOMEM;
     if (st == PT_OK) pool_run(threads, nchunks, trace_chunk, &tj);
-    long nph = 0, nhl = 0;
+    long nph = 0, nhl = 0, nmp = 0;
     for (int i = 0; tj.outs && i < nchunks; i++) {
         if (tj.outs[i].oom) st = PT_ERR_NOMEM;
         nph += tj.outs[i].n;
         nhl += tj.outs[i].nhl;
+        nmp += tj.outs[i].nmp;
         c->st.rays += tj.outs[i].rays;
         c->st.first_hits += tj.outs[i].first_hits;
         c->st.absorbed_first += tj.outs[i].absorbed_first;
@@ -896,24 +976,30 @@ gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_s
     if (st == PT_OK) {
         c->ph = malloc(sizeof *c->ph * (size_t)(nph > 0 ? nph : 1));
         c->hl = malloc(sizeof *c->hl * (size_t)(nhl > 0 ? nhl : 1));
-        if (!c->ph || !c->hl) st = PT_ERR_NOMEM;
+        c->mp = malloc(sizeof *c->mp * (size_t)(nmp > 0 ? nmp : 1));
+        if (!c->ph || !c->hl || !c->mp) st = PT_ERR_NOMEM;
     }
     for (int i = 0; tj.outs && i < nchunks; i++) {
         if (st == PT_OK && tj.outs[i].n) memcpy(c->ph + c->nph, tj.outs[i].p, sizeof *c->ph * (size_t)tj.outs[i].n);
         if (st == PT_OK && tj.outs[i].nhl)
             memcpy(c->hl + c->nhl, tj.outs[i].hl, sizeof *c->hl * (size_t)tj.outs[i].nhl);
+        if (st == PT_OK && tj.outs[i].nmp)
+            memcpy(c->mp + c->nmp, tj.outs[i].mp, sizeof *c->mp * (size_t)tj.outs[i].nmp);
         if (st == PT_OK) {
             c->nph += tj.outs[i].n;
             c->nhl += tj.outs[i].nhl;
+            c->nmp += tj.outs[i].nmp;
         }
         free(tj.outs[i].p);
         free(tj.outs[i].hl);
+        free(tj.outs[i].mp);
     }
     free(tj.outs);
     for (int b = 1; b <= GI_CAUSTIC_MAX_BOUNCES; b++)
         if (c->st.alive[b] > 0) c->st.max_bounce = b;
     c->st.stored = c->nph;
     c->st.stored_highlights = c->nhl;
+    c->st.stored_media = c->nmp;
     for (long i = 0; i < c->nph; i++) c->st.flux += (c->ph[i].phi[0] + c->ph[i].phi[1] + c->ph[i].phi[2]) / 3.0;
     c->st.t_trace = timer_now() - t0;
     if (st != PT_OK || (s->cancel && *s->cancel)) {
@@ -930,6 +1016,15 @@ gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_s
         gi_caustic_free(c);
         *status = PT_ERR_NOMEM;
         return NULL;
+    }
+    if (c->nmp > 0) {
+        const size_t fs = sizeof(gi_caus_photon) / sizeof(float);
+        c->st.r_media_median = median_of(&c->mp[0].r_xy, c->nmp, fs);
+        if (!hgrid_build(&c->mgrid, 2.0 * c->st.r_media_median, c->nmp, c->mp[0].x, fs, &c->mp[0].r_xy, fs)) {
+            gi_caustic_free(c);
+            *status = PT_ERR_NOMEM;
+            return NULL;
+        }
     }
 
     /* step 2 of the paper's frame: the eye G-buffer */
@@ -989,6 +1084,8 @@ void gi_caustic_free(gi_caustic *c)
     hgrid_free(&c->pgrid);
     free(c->hl);
     hgrid_free(&c->hlgrid);
+    free(c->mp);
+    hgrid_free(&c->mgrid);
     hgrid_free(&c->ggrid);
     free(c->gb);
     free(c->gobj);
@@ -1011,6 +1108,11 @@ const gi_caus_photon *gi_caustic_photons(const gi_caustic *c, long *n)
 {
     *n = c->nph;
     return c->ph;
+}
+const gi_caus_photon *gi_caustic_media_photons(const gi_caustic *c, long *n)
+{
+    *n = c ? c->nmp : 0;
+    return c && c->nmp > 0 ? c->mp : NULL;
 }
 const float *gi_caustic_image(const gi_caustic *c) { return c->img; }
 const gi_caus_pixel *gi_caustic_gbuffer(const gi_caustic *c) { return c->gb; }
@@ -1102,4 +1204,26 @@ void gi_caustic_visit(const gi_caustic *c, const accel_hit *h, vec3 n, gi_causti
     if (!c || !h || !h->obj || (h->obj->photons && !h->obj->photons->collect)) return;
     visit_grid(&c->pgrid, c->ph, h->p, n, fn, ctx);
     visit_grid(&c->hlgrid, c->hl, h->p, n, fn, ctx);
+}
+
+/* One media photon q at p: Phi kappa with kappa the cone 3 (1 - d/r) /
+ * (pi r^3) over its sphere (normalised: its integral over the sphere is 1). */
+static void media_one(const gi_caus_photon *q, vec3 p, gi_caustic_visit_fn fn, void *ctx)
+{
+    double dx = p.x - q->x[0], dy = p.y - q->x[1], dz = p.z - q->x[2], r = q->r_xy;
+    double d2 = dx * dx + dy * dy + dz * dz;
+    if (!(d2 < r * r)) return;
+    double k = 3.0 * (1.0 - sqrt(d2) / r) / (M_PI * r * r * r);
+    fn(ctx, v3(q->w[0], q->w[1], q->w[2]), crgb(q->phi[0] * k, q->phi[1] * k, q->phi[2] * k));
+}
+
+void gi_caustic_media_visit(const gi_caustic *c, vec3 p, gi_caustic_visit_fn fn, void *ctx)
+{
+    if (!c || c->nmp <= 0) return;
+    const hgrid *g = &c->mgrid;
+    long lo, hi;
+    double cell = g->cell;
+    hgrid_cell(g, cidx(p.x, cell), cidx(p.y, cell), cidx(p.z, cell), &lo, &hi);
+    for (long q = lo; q < hi; q++) media_one(&c->mp[g->e[q].id], p, fn, ctx);
+    for (long q = 0; q < g->nbig; q++) media_one(&c->mp[g->big[q]], p, fn, ctx);
 }

@@ -54,7 +54,18 @@
  * same photon volume sum is evaluated at the hit from the photon grid.
  * Both counts are in the stats.
  *
- * Not modelled (the caller reports what the scene uses): photons in media,
+ * Media photons (global photons { media max_steps [, factor] }, POV-Ray
+ * 3.7's photons.cpp DepositMediaPhotons): along every straight segment of
+ * a photon's path after its first surface, inside hollow containers whose
+ * media take photons (hooks.media), photons are left at n evenly jittered
+ * places, n = floor(len / (factor s_D)) at most max_steps (s_D the
+ * photon's spacing at the segment's start; beyond max_steps the step
+ * grows to len / n), each carrying the photon's colour times its cell's
+ * cross-section and its step along the way; the media sum them over a
+ * sphere (gi_caustic_media_visit). Photons are dimmed by the media's
+ * extinction over every segment.
+ *
+ * Not modelled (the caller reports what the scene uses):
  * dispersion, the gather/radius/expand_thresholds/autostop settings (the
  * radius comes from the heuristic above; the bounce map covers the whole
  * cone, so autostop has nothing to cut short), save_file/load_file, light
@@ -132,6 +143,15 @@ typedef struct {
     /* The objects holding point p (the light's position), innermost last:
      * the list a photon starts with. NULL: none. */
     void (*containers)(void *ctx, vec3 p, gi_caustic_inside *in);
+    /* The participating media of the containers `in` over the photon's
+     * segment org + t dir, 0 <= t <= len (unit dir): *tr the light left
+     * after their extinction over it (POV-Ray's photon rays are dimmed by
+     * the media of the interiors they cross, photons.cpp,
+     * ComputeLightedTexture); returns 1 when the segment is hollow and its
+     * media take photons (some media scatters and has collect on, and
+     * some absorbs or scatters: POV-Ray's ComputeMediaAndDepositPhotons
+     * returns early without extinction). NULL: no media. */
+    int (*media)(void *ctx, const gi_caustic_inside *in, vec3 org, vec3 dir, double len, rgb *tr);
 } gi_caustic_hooks;
 
 typedef struct {
@@ -155,6 +175,8 @@ typedef struct {
     int max_bounce;         /* highest b with alive[b] > 0 */
     long stored;            /* photon volumes (splatted) */
     long stored_highlights; /* photons on surfaces with only a highlight (gi_caustic_visit's alone) */
+    long stored_media;      /* media photons (global photons { media steps }) */
+    double r_media_median;  /* median radius of the media photons' spheres */
     double flux;            /* their power, summed (grey: mean of the channels) */
     long rays;
     double spacing;         /* the global spacing used (count and count_scale applied) */
@@ -187,6 +209,18 @@ rgb gi_caustic_at(void *c, const accel_hit *h, vec3 n, int thread);
  * gi_caustic_at's irradiance; the caller adds the highlights. Thread-safe. */
 typedef void (*gi_caustic_visit_fn)(void *ctx, vec3 w, rgb e);
 void gi_caustic_visit(const gi_caustic *c, const accel_hit *h, vec3 n, gi_caustic_visit_fn fn, void *ctx);
+/* Media photons (POV-Ray 3.7's global photons { media max_steps, factor }):
+ * every media photon whose sphere holds p. fn gets w, the unit direction
+ * back towards where the photon came from (as stored), and e = Phi kappa,
+ * kappa = 3 (1 - d/r) / (pi r^3) the normalised cone over the photon's
+ * sphere of radius r at distance d: the photon as a light of colour e
+ * along w at p. The media shade each through its scattering and phase
+ * function as a light (POV-Ray's media.cpp, ComputeMediaPhotons: the
+ * photons' colours over the gather sphere's volume, each through
+ * ComputeMediaScatteringAttenuation). Thread-safe. */
+void gi_caustic_media_visit(const gi_caustic *c, vec3 p, gi_caustic_visit_fn fn, void *ctx);
+/* The media photons stored (NULL and 0 when none). */
+const gi_caus_photon *gi_caustic_media_photons(const gi_caustic *c, long *n);
 /* The stored photon volumes (those splatted). */
 const gi_caus_photon *gi_caustic_photons(const gi_caustic *c, long *n);
 /* The splat's result: 4 floats per G-buffer pixel (row-major, y down), and

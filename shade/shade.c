@@ -65,6 +65,10 @@ typedef struct {
     vec3 lc_p;
     unsigned lc_valid;
     rgb lc_vis[LIGHT_CACHE];
+    /* while a media sample's light is traced: 1 its media take photons, 2
+     * they do not; 0 a surface's light (the photon shadow rule asks the
+     * lit surface's collect, photon_light) */
+    int media_lit;
     char pad[64];
 } thread_stats;
 
@@ -146,7 +150,22 @@ static int shadow_blocked(render_ctx *c, int thread, vec3 p, vec3 dir, double de
     return accel_occluded(c->a, p, dir, c->eps, tmax);
 }
 
-static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, const shade_media_inside *in, vec3 *to_light);
+static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, const shade_media_inside *in, int collect,
+                       vec3 *to_light);
+
+/* The light whose photons a caustic layer carries, where the shadow ray's
+ * lit thing takes photons (POV-Ray 3.7's trace.cpp, ComputeShadowColour:
+ * not when the lit object has collect off, or the lit media all ignore
+ * photons): shadow rays then stop at photon targets that refract it. */
+static const scene_light *photon_light(const render_ctx *c, int thread, const scene_light *l)
+{
+    if (!c->s->photon_shadows) return NULL;
+    int m = c->ts[thread].media_lit;
+    if (m) return m == 1 ? l : NULL;
+    const accel_hit *lit = c->frame[thread] ? c->frame[thread]->h : NULL;
+    if (lit && lit->obj && lit->obj->photons && !lit->obj->photons->collect) return NULL;
+    return l;
+}
 
 /* Media along shadow rays (shade_media.c): the light's media_attenuation
  * through the atmosphere and fog, the containers' media on the way. */
@@ -169,13 +188,11 @@ static rgb shadow_rgb(render_ctx *c, int thread, vec3 p, vec3 dir, double depth,
     c->ts[thread].shadow++;
     double tmax = shadow_tmax(c, depth);
     if (tmax <= c->eps) return rgb_make(1, 1, 1);
+    const scene_light *pl = photon_light(c, thread, l);
     if (media) {
-        shade_media_env me = {c->sc, c, thread, NULL, media_light, NULL};
-        return shade_media_shadow_ray(c->sc, c->a, &me, l, p, dir, c->eps, tmax, in ? in : &no_containers, rest);
+        shade_media_env me = {c->sc, c, thread, NULL, media_light, NULL, NULL, NULL};
+        return shade_media_shadow_ray(c->sc, c->a, &me, l, p, dir, c->eps, tmax, in ? in : &no_containers, rest, pl);
     }
-    const scene_light *pl = c->s->photon_shadows ? l : NULL;
-    const accel_hit *lit = c->frame[thread] ? c->frame[thread]->h : NULL;
-    if (lit && lit->obj && lit->obj->photons && !lit->obj->photons->collect) pl = NULL;
     return shade_tex_shadow_ray(c->sc, c->a, p, dir, c->eps, tmax, pl);
 }
 
@@ -245,7 +262,7 @@ static rgb area_visibility(render_ctx *c, int thread, const scene_light *l, vec3
     /* the atmosphere once, from p over what the last sample traced left of
      * its way (POV-Ray 3.7's TraceShadowRay; shade_media_shadow_rest) */
     if (media_shadows(c, l) && !rgb_near_zero(vis)) {
-        shade_media_env me = {c->sc, c, thread, NULL, media_light, NULL};
+        shade_media_env me = {c->sc, c, thread, NULL, media_light, NULL, NULL, NULL};
         vis = shade_media_shadow_rest(c->sc, &me, l, in ? in : &no_containers, p, dir, fmin(j.rest, shadow_tmax(c, depth)), vis);
     }
     return vis;
@@ -254,7 +271,8 @@ static rgb area_visibility(render_ctx *c, int thread, const scene_light *l, vec3
 /* Light of l reaching a media sample at p (POV-Ray's TestShadow): its
  * attenuation there, then unless shadowless the shadow ray (area grid
  * included) from the sampled ray's containers. */
-static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, const shade_media_inside *in, vec3 *to_light)
+static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, const shade_media_inside *in, int collect,
+                       vec3 *to_light)
 {
     render_ctx *c = ctx;
     vec3 dir;
@@ -267,6 +285,8 @@ static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, cons
     rgb lc = rgb_scale(l->colour, shade_light_attenuation(l, p, dir, depth));
     if (rgb_near_zero(lc) || l->shadowless) return lc;
     rgb vis;
+    int outer = c->ts[thread].media_lit;
+    c->ts[thread].media_lit = collect ? 1 : 2;
     if (l->area && l->size1 * l->size2 > 1) {
         rng r; /* jittered area lights: a stream of the sample's own, from
                 * where it lies alone (never the thread: an image is the
@@ -282,6 +302,7 @@ static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, cons
     } else {
         vis = shadow_rgb(c, thread, p, dir, sdepth, l, in, NULL);
     }
+    c->ts[thread].media_lit = outer;
     return rgb_mul(lc, vis);
 }
 
@@ -445,7 +466,7 @@ static rgb along_ray(render_ctx *c, int thread, vec3 org, vec3 dir, double depth
     int hollow = shade_media_inside_hollow(in);
     if (!hollow) return col;
     if (c->media && c->s->quality >= 9) { /* +Q: media from level 9 (Q_VOLUME) */
-        shade_media_env me = {c->sc, c, thread, r, media_light, hit};
+        shade_media_env me = {c->sc, c, thread, r, media_light, hit, c->s->media_photons, c->s->media_photons_ctx};
         if (isfinite(depth) && in->n > 0 && shade_media_inside_has_media(in))
             col = shade_media_segment(&me, SHADE_MEDIA_INTERIOR, in, org, dir, depth, col, 0);
         if (c->sc->natmosphere > 0)

@@ -12,6 +12,7 @@
 #include "rng.h"
 #include "scene.h"
 #include "shade_light.h"
+#include "shade_media.h"
 
 /* Irradiance-like indirect term at a diffuse hit: returns the incoming
  * indirect radiance weighting that multiplies pigment*diffuse (POV-Ray's
@@ -76,6 +77,10 @@ typedef struct {
      * rule (shade_tex_shadow_ray's photon_light), except for surfaces with
      * photons { collect off }, which take no photons */
     int photon_shadows;
+    /* a caustic layer's media photons, added at every sample of the media
+     * on view rays (shade_media_env.photons); NULL: none */
+    shade_media_photons_fn media_photons;
+    void *media_photons_ctx;
 } shade_settings;
 
 typedef struct {

@@ -57,7 +57,12 @@
  *  - Intervals in order: colour * exp(-sum od) + sum te * exp(-od before).
  *  - Shadow rays: extinction only; media whose densities are all constant
  *    take a single sample per interval.
- *  - Photons in media are not modelled. */
+ *  - Media photons (a caustic layer's, shade_media_env.photons): at every
+ *    sample of a view ray, lit or not, each photon around the sample adds
+ *    scattering x phase x its light, as a light would (POV-Ray's
+ *    ComputeMediaPhotons). A photon target that refracts a light's photons
+ *    shadows that light fully at samples whose media collect photons
+ *    (shade_media_light_fn). */
 #include "shade_media.h"
 #include "shade_chi2.h"
 #include <math.h>
@@ -436,7 +441,21 @@ typedef struct {
     int nlights;
     const shade_media_inside *in;
     shade_pattern_ctx pc;
+    int collect; /* some media acting takes photons */
 } sampler;
+
+/* The media photons around a sample, each through the phase function. */
+typedef struct {
+    const sampler *s;
+    rgb sum;
+} photon_acc;
+
+static void photon_one(void *ctx, vec3 to_light, rgb light)
+{
+    photon_acc *a = ctx;
+    double k = phase(a->s->refs, a->s->nrefs, v3_dot(to_light, a->s->dir));
+    a->sum = add(a->sum, scl(light, k));
+}
 
 /* One sample at fraction d of interval iv: its emitted (and in-scattered)
  * light times ds in *col, its optical depth over ds in *od. Methods 1/2
@@ -458,11 +477,16 @@ static void one_sample(const sampler *s, interval *iv, double d, int method, rgb
         for (int i = 0; i < s->nlights; i++) {
             if (d1 < s->lights[i].s0 || d1 > s->lights[i].s1) continue;
             vec3 to;
-            rgb lc = s->e->light(s->e->ctx, s->e->thread, s->lights[i].l, h, s->in, &to);
+            rgb lc = s->e->light(s->e->ctx, s->e->thread, s->lights[i].l, h, s->in, s->collect, &to);
             if (is_zero(lc)) continue;
             double k = phase(s->refs, s->nrefs, v3_dot(to, s->dir));
             emit = add(emit, scl(mul(c.scat, lc), k));
         }
+    }
+    if (s->use_scattering && s->e->photons && !is_zero(c.scat)) {
+        photon_acc pa = {s, {0, 0, 0}};
+        s->e->photons(s->e->photons_ctx, h, photon_one, &pa);
+        emit = add(emit, mul(c.scat, pa.sum));
     }
     if (method == 3) {
         emit = scl(emit, iv->ds);
@@ -584,13 +608,14 @@ rgb shade_media_segment(const shade_media_env *e, int which, const shade_media_i
     if (nrefs == 0 || !(depth > 0.0)) return c;
     const scene_media *im = refs[0].m;
     double aa = HUGE_VAL;
-    int use_ext = 0, use_scat = 0, all_constant = shadow, no_density = 1;
+    int use_ext = 0, use_scat = 0, all_constant = shadow, no_density = 1, collect = 0;
     for (int i = 0; i < nrefs; i++) {
         const scene_media *m = refs[i].m;
         if (m->intervals > im->intervals) im = m;
         if (m->aa_threshold < aa) aa = m->aa_threshold;
         if (!is_zero(m->absorption) || !is_zero(m->scattering)) use_ext = 1;
         if (!is_zero(m->scattering)) use_scat = 1;
+        if (m->collect) collect = 1;
         if (m->ndensity > 0) no_density = 0;
         /* a density counts as constant when it is a plain colour */
         for (int k = 0; k < m->ndensity; k++)
@@ -695,7 +720,7 @@ rgb shade_media_segment(const shade_media_env *e, int which, const shade_media_i
 
     sampler s = {.e = e, .refs = refs, .nrefs = nrefs, .org = org, .dir = dir, .shadow = shadow,
                  .use_scattering = use_scat, .lights = lights, .nlights = nl, .in = in,
-                 .pc = shade_pattern_ctx_plain(e->sc)};
+                 .pc = shade_pattern_ctx_plain(e->sc), .collect = collect};
 
     int nmin = im->min_samples > 0 ? im->min_samples : 1;
     for (int i = 0; i < niv; i++) {
@@ -754,6 +779,7 @@ rgb shade_media_shadow_rest(const scene *sc, const shade_media_env *e, const sce
 typedef struct {
     const scene *sc;
     const shade_media_env *e;
+    const scene_light *photon_light;
     vec3 p, dir;
     double tmin, t0; /* t0: just past the last crossing (accel_crossings' step), tmin before the first */
     double prev;     /* where the current segment starts */
@@ -767,6 +793,11 @@ static int media_shadow_crossing(void *ctx, const accel_hit *h)
     media_shadow_walk *w = ctx;
     double depth = shade_tex_crossing_depth(&w->t0, w->tmin, h->t);
     if (h->flags & OBJ_NO_SHADOW) return 1;
+    const scene_obj_photons *ph = h->obj ? h->obj->photons : NULL;
+    if (w->photon_light && ph && ph->target && scene_photon_lobe(w->photon_light, ph, 1)) {
+        w->c = mk(0, 0, 0); /* shade_tex_shadow_ray's photon rule */
+        return 0;
+    }
     const scene *sc = w->sc;
     accel_hit hh = *h;
     hh.t = depth;
@@ -798,9 +829,10 @@ static int media_shadow_crossing(void *ctx, const accel_hit *h)
 }
 
 rgb shade_media_shadow_ray(const scene *sc, const accel *a, const shade_media_env *e, const scene_light *l, vec3 p, vec3 dir,
-                     double tmin, double tmax, const shade_media_inside *in0, double *rest)
+                           double tmin, double tmax, const shade_media_inside *in0, double *rest,
+                           const scene_light *photon_light)
 {
-    media_shadow_walk w = {sc, e, p, dir, tmin, tmin, 0.0, l && l->media_interaction && l->media_attenuation, *in0,
+    media_shadow_walk w = {sc, e, photon_light, p, dir, tmin, tmin, 0.0, l && l->media_interaction && l->media_attenuation, *in0,
                            {1, 1, 1}};
     /* every surface crossed, each the nearest just past the one before,
      * from one traversal where the scene allows (accel_crossings) */

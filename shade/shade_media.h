@@ -43,9 +43,19 @@ void shade_media_inside_at(const scene *sc, vec3 p, shade_media_inside *in);
 
 /* Light of l reaching p (attenuated, shadowed, filtered) and the unit
  * direction from p towards it; 0 when none. `in` = the sampled ray's
- * containers (the shadow ray starts inside them). */
+ * containers (the shadow ray starts inside them). collect: the sample's
+ * media take photons (some has `collect` on): then, where a caustic layer
+ * carries l's photons, a photon target that refracts them casts a full
+ * shadow (POV-Ray 3.7's trace.cpp, ComputeShadowColour, whose
+ * litObjectIgnoresPhotons media.cpp sets from the media's ignore_photons:
+ * the light through the target arrives as media photons). */
 typedef rgb (*shade_media_light_fn)(void *ctx, int thread, const scene_light *l, vec3 p, const shade_media_inside *in,
-                              vec3 *to_light);
+                                    int collect, vec3 *to_light);
+/* Media photons (a caustic layer's): each photon around p as a light of
+ * colour `light` arriving from the unit direction to_light, already over
+ * the gather volume (gi/gi_caustic.h, gi_caustic_media_visit). */
+typedef void (*shade_media_photon_fn)(void *ctx, vec3 to_light, rgb light);
+typedef void (*shade_media_photons_fn)(void *ctx, vec3 p, shade_media_photon_fn each, void *each_ctx);
 
 typedef struct {
     const scene *sc;
@@ -54,6 +64,12 @@ typedef struct {
     rng *r;
     shade_media_light_fn light;   /* scattering's light (NULL: no in-scattering) */
     const scene_object *hit; /* the surface ending the segment (its light group), NULL = none */
+    /* media photons: every sample of a view ray's scattering media adds
+     * the photons around it, through its scattering and phase function as
+     * lights, lit interval or not (POV-Ray's media.cpp, ComputeOneMediaSample
+     * and ComputeMediaPhotons). NULL: none. */
+    shade_media_photons_fn photons;
+    void *photons_ctx;
 } shade_media_env;
 
 enum { SHADE_MEDIA_INTERIOR = 0, SHADE_MEDIA_ATMOSPHERE = 1 };
@@ -75,8 +91,12 @@ rgb shade_media_segment(const shade_media_env *e, int which, const shade_media_i
  * rest non-NULL: that last part is left out and *rest is its length (tmax
  * less the last surface crossed), for an area light's samples
  * (shade_media_shadow_rest). */
+/* photon_light: NULL, or l where a caustic layer carries its photons and
+ * the lit surface or media take them: a photon target that refracts them
+ * casts a full shadow (shade_tex_shadow_ray's rule). */
 rgb shade_media_shadow_ray(const scene *sc, const accel *a, const shade_media_env *e, const scene_light *l, vec3 p, vec3 dir,
-                     double tmin, double tmax, const shade_media_inside *in, double *rest);
+                           double tmin, double tmax, const shade_media_inside *in, double *rest,
+                           const scene_light *photon_light);
 /* c after the atmosphere and fog over len along p + t dir, for light l
  * with media_interaction and media_attenuation, on a hollow ray starting
  * inside `in` (else c unchanged): the last part of a shadow ray. POV-Ray
