@@ -332,7 +332,9 @@ rgb caustics_highlights(void *ctx, const accel_hit *h, const shade_light_surface
     return a.sum;
 }
 
-void caustics_media_photons(void *ctx, vec3 p, shade_media_photon_fn each, void *each_ctx)
+/* The media photons around p, each as a light through each (the layer's
+ * gi_caustic_media_visit): the shader's media photon hook. */
+static void caustics_media_photons(void *ctx, vec3 p, shade_media_photon_fn each, void *each_ctx)
 {
     const caustics *c = ctx;
     gi_caustic_media_visit(c->layer, p, each, each_ctx);

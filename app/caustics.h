@@ -40,10 +40,6 @@ typedef struct {
 pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width, int height, int threads,
                          uint64_t seed, const char *cl_device, size_t cl_max_bytes, double count_scale,
                          volatile int *cancel, diag *d);
-/* The media photons around p, each as a light through each (the layer's
- * gi_caustic_media_visit); shade_media_photons_fn-compatible with c as the
- * context. */
-void caustics_media_photons(void *c, vec3 p, shade_media_photon_fn each, void *each_ctx);
 /* Puts the layer into shade settings: its indirect hook (after whatever
  * hook ss has: that one is kept and summed), POV-Ray's photon shadows and,
  * when the layer holds media photons, the media's photon hook. */

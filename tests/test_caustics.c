@@ -1,7 +1,8 @@
 /* test_caustics.c - the caustic layer (gi/gi_caustic.h, app/caustics.h):
  * its irradiance against the path tracer in a glass sphere's focus, against
  * the closed form behind a mirror, the splat against the brute-force sum of
- * the same photon volumes, OpenCL against the C build, determinism, and the
+ * the same photon volumes, OpenCL against the C build, determinism, media
+ * photons in a lit box against the closed form, and the
  * photon settings that are counted and warned about as not modelled. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -617,6 +618,91 @@ static void test_devices_and_threads(void **state)
     tu_world_free(&w);
 }
 
+
+/* gi_caustic_media_visit's callback: the photons' light summed. */
+static void media_sum(void *ctx, vec3 w, rgb e)
+{
+    (void)w;
+    rgb *s = ctx;
+    s->r += e.r;
+    s->g += e.g;
+    s->b += e.b;
+}
+
+/* Media photons through a box of scattering media (scattering 0.5 grey,
+ * extinction 0, isotropic), the box a photon target lit along x by a point
+ * light of colour 1 at distance 100, global photons { media 100 }. A
+ * POV-Ray light does not fall off, so the box is lit by L = 1 throughout:
+ *  - the media photons summed at points inside (away from the walls by
+ *    more than a photon sphere's radius) give L = 1. Tolerance 4%: POV-Ray's
+ *    step rule weighs a photon t along its segment by (D + t) / D (here at
+ *    most +1.5%), and the integer count of steps per segment loses up to
+ *    one step of the 2 units (-2.5% at spacing 0.05);
+ *  - the radiance of a view ray across the box (length 4, along z, through
+ *    its centre) is scattering x L x length = 2 (POV-Ray's media
+ *    in-scattering, no 1/(4 pi)), the box's photon shadow keeping the
+ *    light's direct part out (POV-Ray's rule for photon targets); the
+ *    photons' spheres reach past the two walls the ray crosses, so within
+ *    a radius of each the sum falls towards half (a loss of under a
+ *    radius's worth, 0.15 of the 4 units at most): tolerance 5%. */
+static const char *media_box_fmt =
+    "#version 3.7;\n"
+    "global_settings { %s }\n"
+    "camera { location <0, 0, -10> look_at 0 }\n"
+    "light_source { <-101, 0, 0> color rgb 1 }\n"
+    "box { <-1, -1, -2>, <1, 1, 2> hollow pigment { rgbf 1 } "
+    "interior { media { scattering { 1, rgb 0.5 extinction 0 } method 3 intervals 1 samples 4 } } "
+    "photons { target refraction on } }\n";
+
+static void test_media_photons(void **state)
+{
+    (void)state;
+    char text[1024];
+    snprintf(text, sizeof text, media_box_fmt, "photons { spacing 0.05 media 100 }");
+    tu_world w = tu_world_build("test.pov", text);
+    diag *d = diag_new();
+    caustics c;
+    layer(&c, w.s, w.a, 8, 8, NULL, THREADS, d);
+    long n = 0;
+    assert_non_null(gi_caustic_media_photons(c.layer, &n));
+    assert_int_equal(n, c.st.stored_media);
+    double sum = 0.0, lo = 1e9, hi = 0.0;
+    int np = 0;
+    for (int i = 0; i < 5; i++)
+        for (int j = 0; j < 5; j++)
+            for (int k = 0; k < 5; k++) {
+                rgb e = {0, 0, 0};
+                vec3 p = v3(-0.5 + 0.25 * i, -0.5 + 0.25 * j, -1.5 + 0.75 * k);
+                gi_caustic_media_visit(c.layer, p, media_sum, &e);
+                sum += e.g;
+                lo = fmin(lo, e.g);
+                hi = fmax(hi, e.g);
+                np++;
+            }
+    double mean = sum / np;
+    printf("media photons: %ld stored (sphere radius median %.4f); light at 125 inside points: mean %.5f (%.5f..%.5f), "
+           "closed form 1 (rel err %+.4f, tol 0.04)\n",
+           n, c.st.r_media_median, mean, lo, hi, mean - 1.0);
+    assert_true(fabs(mean - 1.0) <= 0.04);
+
+    shade_settings ss;
+    shade_default_settings(&ss);
+    caustics_attach(&c, &ss);
+    assert_non_null(ss.media_photons);
+    double ray = 0.0;
+    for (int i = 0; i < 16; i++) {
+        rng r;
+        rng_seed(&r, 7, (uint64_t)i);
+        rgb col = shade_trace(w.s, w.a, &ss, v3(0.02 * (i - 8), 0.02 * (i % 4), -10), v3(0, 0, 1), 0, &r);
+        ray += col.g / 16.0;
+    }
+    printf("media photons: radiance across the box %.5f, closed form 2 (rel err %+.4f, tol 0.05)\n", ray, ray / 2.0 - 1.0);
+    assert_true(fabs(ray / 2.0 - 1.0) <= 0.05);
+    caustics_free(&c);
+    diag_free(d);
+    tu_world_free(&w);
+}
+
 /* Photon settings the layer does not model are counted and warned about,
  * each once; a scene without any target warns that nothing shoots. */
 static void test_not_modelled(void **state)
@@ -699,6 +785,7 @@ int main(void)
         cmocka_unit_test(test_splat_equals_sum),
         cmocka_unit_test(test_devices_and_threads),
         cmocka_unit_test(test_not_modelled),
+        cmocka_unit_test(test_media_photons),
         cmocka_unit_test(test_focus_vs_path),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
