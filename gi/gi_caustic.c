@@ -32,11 +32,12 @@
 #define RADIUS_K 9.0
 /* k of a media photon's sphere radius r = k (s_l^2 s_a)^(1/3), s_l its
  * lateral spacing (s_D / sqrt(rho_p)) and s_a its step along the way: the
- * sphere holds about 4 pi k^3 / 3 = 113 photons of an unfocused beam, as
- * POV-Ray's media gather, which takes up to its gather maximum (100 by
- * default) within a radius sized from the map's mean density
- * (photons.cpp, setGatherOptions) */
-#define MEDIA_RADIUS_K 3.0
+ * sphere holds about 4 pi k^3 / 3 = 65 photons of an unfocused beam, of
+ * the order of POV-Ray's media gather, which takes up to its gather
+ * maximum (100 by default) within a radius sized from the map's mean
+ * density (photons.cpp, setGatherOptions). Chosen on optics.pov against
+ * POV-Ray's render at 4x its photons (docs/caustics.md, step 8). */
+#define MEDIA_RADIUS_K 2.5
 #define CHUNK 2048
 /* most photons shot in all (memory and time stay bounded whatever the scene asks) */
 #define MAX_CELLS 4194304.0
