@@ -45,6 +45,7 @@
 #include "accel_surface.h"
 #include "gi_cl.h"
 #include "gi_vpl.h"
+#include "mirror.h"
 #include "glossy.h"
 #include "pm_nee.h"
 #include "pool.h"
@@ -114,7 +115,7 @@ static void point_of(const shade_mat_bsdf *b, double lift, gpoint *g)
     for (int j = 0; j < b->nglossy && j < 2; j++) { /* the two first (blurred mirror, phong) */
         rgb c = mk(b->gl_w[j] * b->gl_c[j].r, b->gl_w[j] * b->gl_c[j].g, b->gl_w[j] * b->gl_c[j].b);
         if (b->gl_tint[j] && b->gl_metallic != 0.0)
-            shade_light_metallic_tint(&c, b->gl_metallic, b->pigment, v3_dot(wo, b->n));
+            mirror_metallic_tint(&c, b->gl_metallic, b->pigment, v3_dot(wo, b->n));
         g->dev.kg[j][0] = (float)c.r;
         g->dev.kg[j][1] = (float)c.g;
         g->dev.kg[j][2] = (float)c.b;

@@ -6,7 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include "gi_particle_internal.h"
+#include "mirror.h"
 #include "pool.h"
+#include "radrules.h"
 #include "rng.h"
 
 /* particles per job: about 256 rays per rtcIntersect1M call */
@@ -43,6 +45,12 @@ typedef struct {
     int exact;            /* view points with no bounce after the hit: every hit takes hit_light */
     float *reach;         /* per source (i - first): the harmonic mean of its rays' hit distances */
     int points;           /* the sources are the final gather's points, not particles */
+    /* mirror reflections at the hits (the final gather's points and the
+     * gatherer, job_mirror): the gather rays' trace level and weight, the
+     * level at which a ray returns black and the radiosity block's
+     * adc_bailout (radrules.h rule 7); mirror 0: not followed */
+    int mirror, mlevel, mlimit;
+    double mweight, madc;
     void *lscene;         /* the link scene built here, or NULL */
     int threads;          /* buffers */
 } link_job;
@@ -65,7 +73,7 @@ static void hit_point(const struct RTCRayHit *h, vec3 *pt, vec3 *nrm)
  * the pigment there (a sky dome's gradient, a terrain's colours; the
  * texture's base colour without a pigment function). */
 static void hit_material(const link_job *J, const scene_object *o, const scene_texture *tex, vec3 p, vec3 n,
-                         float rho[3], float le[3])
+                         float rho[3], float le[3], rgb *pigment)
 {
     colour5 c, *cp = NULL;
     if (J->pig) {
@@ -83,6 +91,10 @@ static void hit_material(const link_job *J, const scene_object *o, const scene_t
             cp = &c;
     }
     gi_particles_material(J->sc, tex, cp, rho, le);
+    if (pigment) {
+        const colour5 *u = cp ? cp : &tex->pigment.colour;
+        *pigment = (rgb){u->r, u->g, u->b};
+    }
 }
 
 /* The leaf a link ray hit and its effective texture (never NULL when the
@@ -117,6 +129,7 @@ typedef struct {
     /* under some pigment: it emits (its emission is not 0), it reflects
      * (diffuse is not 0); where neither, no pigment gives light */
     int glows, reflects;
+    int mirrors; /* its finish reflects as a mirror (mirror_reflects) */
 } emit_memo_entry;
 
 /* The last few textures asked (a gather's rays alternate between a few
@@ -140,10 +153,15 @@ static const emit_memo_entry *memo_of(const link_job *J, emit_memo *memo, const 
     m->emits = le[0] > 0.0f || le[1] > 0.0f || le[2] > 0.0f;
     m->glows = le[0] != 0.0f || le[1] != 0.0f || le[2] != 0.0f;
     m->reflects = rho[0] != 0.0f || rho[1] != 0.0f || rho[2] != 0.0f;
+    m->mirrors = mirror_reflects(&tex->finish);
     return m;
 }
 
-static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int direct, emit_memo *memo, float out[3])
+static void hit_mirror(const link_job *J, const struct RTCRayHit *h, const scene_object *o, const scene_texture *tex,
+                       vec3 p, vec3 n, rgb pigment, int level, double weight, emit_memo *memo, float out[3]);
+
+static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, int direct, emit_memo *memo, float out[3],
+                         int level, double weight)
 {
     if (!J->esky) return;
     const scene_texture *tex;
@@ -152,9 +170,11 @@ static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int
     float rho[3], le[3];
     const emit_memo_entry *mt = memo_of(J, memo, tex);
     const int sky_term = far && J->far_bounce > 0.0f, lit = direct && J->nlights > 0;
-    /* with no far-field sky and no lights to reflect, only the emission
-     * counts: none where the finish emits nothing */
-    if (!sky_term && !lit && !mt->emits) return;
+    /* a mirror's reflection (hit_mirror), where followed */
+    const int mir = J->mirror && mt->mirrors;
+    /* with no far-field sky, no lights and no mirror to reflect, only the
+     * emission counts: none where the finish emits nothing */
+    if (!sky_term && !lit && !mt->emits && !mir) return;
     vec3 p, n;
     hit_point(h, &p, &n);
     /* and, for the final gather's links (J->lights), the direct light it
@@ -189,8 +209,9 @@ static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int
             for (int c = 0; c < 3; c++) dir[c] += lt->colour[c] * att * (float)ci;
         }
     }
-    if (!sky_term && !mt->glows && dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) return;
-    hit_material(J, o, tex, p, n, rho, le);
+    if (!sky_term && !mt->glows && !mir && dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) return;
+    rgb pigment;
+    hit_material(J, o, tex, p, n, rho, le, &pigment);
     /* no direct light where this pigment reflects nothing */
     if (!(rho[0] > 0.0f || rho[1] > 0.0f || rho[2] > 0.0f)) dir[0] = dir[1] = dir[2] = 0.0f;
     float irr[3] = {0.0f, 0.0f, 0.0f};
@@ -198,6 +219,76 @@ static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int
     for (int c = 0; c < 3; c++) {
         float v = le[c] + rho[c] * (J->far_bounce * irr[c] + dir[c]);
         if (isfinite(v) && v > 0.0f) out[c] += v;
+    }
+    if (mir) hit_mirror(J, h, o, tex, p, n, pigment, level, weight, memo, out);
+}
+
+static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int direct, emit_memo *memo, float out[3])
+{
+    hit_light_at(J, h, far, direct, memo, out, J->mlevel, J->mweight);
+}
+
+/* The mirror reflection at the hit of ray h (at trace level `level`, of
+ * weight `weight`) on object o with texture tex, at p with the normal n
+ * turned to the ray and the pigment there, added to out. POV-Ray traces
+ * its radiosity rays in full (radiosity.cpp GatherLight calls TraceRay),
+ * so one that meets a mirror (balcony.pov's sea: no diffuse, a fresnel
+ * reflection up to 0.95) brings back what the mirror reflects; the
+ * reflected ray is traced here and takes what a gather ray takes where it
+ * hits (hit_light_at: emission, direct light, the far field's sky, and a
+ * mirror there in turn) or the sky where it leaves. The reflectivity is
+ * POV-Ray's (mirror.h: fresnel at the interior's ior, falloff, metallic;
+ * reflection_exponent applied to what comes back), of the texture's top
+ * finish as the rest of the GI takes it, about the geometric normal: a
+ * normal pattern's ripples are not followed. The reflected ray goes one
+ * trace level up and is not traced at or past the level limit nor below
+ * the radiosity block's adc_bailout (trace.cpp ComputeReflection;
+ * radrules.h rule 7). Transmission through the mirror is not followed. */
+static void hit_mirror(const link_job *J, const struct RTCRayHit *h, const scene_object *o, const scene_texture *tex,
+                       vec3 p, vec3 n, rgb pigment, int level, double weight, emit_memo *memo, float out[3])
+{
+    if (level + 1 >= J->mlimit) return;
+    const scene_finish *f = &tex->finish;
+    vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
+    double dl = v3_len(d);
+    if (!(dl > 0.0)) return;
+    d = v3_scale(d, 1.0 / dl);
+    double cos_i = -v3_dot(d, n);
+    if (!(cos_i > 0.0)) return;
+    /* the relative ior of a ray entering the object (it meets the outer
+     * side of the raw geometric normal), else leaving it; in an instance
+     * the ray is taken as entering */
+    double rel_ior = 1.0;
+    if (o->interior && o->interior->ior > 0.0) {
+        int entering = 1;
+        if (h->hit.instID[0] == RTC_INVALID_GEOMETRY_ID)
+            entering = h->hit.Ng_x * d.x + h->hit.Ng_y * d.y + h->hit.Ng_z * d.z <= 0.0;
+        rel_ior = entering ? o->interior->ior : 1.0 / o->interior->ior;
+    }
+    double w = weight;
+    rgb refl = mirror_reflectivity(f, cos_i, rel_ior, &w);
+    mirror_metallic_tint(&refl, f->reflection_metallic, pigment, cos_i);
+    if (w < J->madc || !(refl.r > 0.0 || refl.g > 0.0 || refl.b > 0.0)) return;
+    vec3 rd = v3_madd(d, n, 2.0 * cos_i);
+    double off = J->off * (J->scale + fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
+    vec3 org = v3_madd(p, n, off);
+    const float of[3] = {(float)org.x, (float)org.y, (float)org.z}, df[3] = {(float)rd.x, (float)rd.y, (float)rd.z};
+    struct RTCRayHit rh;
+    accel_rtc_rayhit_init(&rh, of, (float)accel_epsilon(J->a, org, rd), df);
+    struct RTCIntersectContext c;
+    rtcInitIntersectContext(&c);
+    rtcIntersect1(J->scene, &c, &rh);
+    float sub[3] = {0.0f, 0.0f, 0.0f};
+    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID && isfinite(rh.ray.tfar))
+        hit_light_at(J, &rh, 1, 1, memo, sub, level + 1, w);
+    else
+        gi_sky_radiance(J->sky, df, sub);
+    double ex = f->reflection_exponent != 0.0 ? 1.0 / f->reflection_exponent : 1.0;
+    const double rc[3] = {refl.r, refl.g, refl.b};
+    for (int k = 0; k < 3; k++) {
+        double v = ex != 1.0 ? pow(fmax(sub[k], 0.0), ex) : sub[k];
+        v *= rc[k];
+        if (isfinite(v) && v > 0.0) out[k] += (float)v;
     }
 }
 
@@ -630,6 +721,22 @@ static pt_status job_lights(link_job *J, const scene *sc)
     return PT_OK;
 }
 
+/* Mirror reflections at the hits, with POV-Ray's trace level and weight
+ * for the rays of the first gathering step (radiosity.cpp
+ * GetRecursionSettings: level int(1.5), weight 0.5 brightness, at least
+ * the block's adc_bailout; GatherLight raises the level limit to one
+ * above the rays' level). */
+static void job_mirror(link_job *J, const scene *sc)
+{
+    const radrules rr = radrules_of(sc, 1);
+    const scene_radiosity *rs = &sc->global.radiosity;
+    J->mirror = 1;
+    J->mlevel = radrules_gather_level(1);
+    J->mlimit = radrules_level_limit(sc, J->mlevel);
+    J->madc = isfinite(rs->adc_bailout) && rs->adc_bailout > 0.0 ? rs->adc_bailout : 0.0;
+    J->mweight = fmax(J->madc + 1e-10, 0.5 * (isfinite(rr.brightness) ? rr.brightness : 1.0));
+}
+
 static void job_close(link_job *J)
 {
     for (int t = 0; t < J->threads; t++) {
@@ -685,7 +792,10 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
     /* the far field's direct light: only for the final gather's points,
      * whose links are traced again for every view; the particles' links
      * are geometry and outlive a change of the lights (relighting) */
-    if (rc == PT_OK && J.esky && J.points) rc = job_lights(&J, sc);
+    if (rc == PT_OK && J.esky && J.points) {
+        rc = job_lights(&J, sc);
+        job_mirror(&J, sc);
+    }
     J.exact = J.esky && J.points && !(J.far_bounce > 0.0f);
     if (rc == PT_OK && n > 0 && !pool_run_counted(threads, (n - J.first + J.per_job - 1) / J.per_job, job, &J, cancel, prog))
         rc = PT_CANCELLED;
@@ -720,6 +830,7 @@ gi_gatherer *gi_gatherer_new(const accel *a, void *rtc_scene, int nside, uint64_
         gi_gatherer_free(g);
         return NULL;
     }
+    job_mirror(J, sc);
     return g;
 }
 

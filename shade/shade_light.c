@@ -5,6 +5,7 @@
 #include "shade_light.h"
 #include <math.h>
 #include <stdlib.h>
+#include "mirror.h"
 #include "shade_noise.h"
 
 static inline rgb lrgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
@@ -105,30 +106,6 @@ void shade_light_area_axes(const scene_light *l, vec3 p, vec3 *ax1, vec3 *ax2)
     }
 }
 
-void shade_light_metallic_tint(rgb *cs, double metallic, rgb pigment, double cos_angle)
-{
-    if (metallic == 0.0) return;
-    double x = fabs(acos(fmax(-1.0, fmin(1.0, cos_angle)))) / (M_PI / 2.0);
-    double f = 0.014567225 / ((x - 1.12) * (x - 1.12)) - 0.011612903;
-    f = fmin(1.0, fmax(0.0, f));
-    double k = metallic * (1.0 - f);
-    cs->r *= 1.0 + k * (pigment.r - 1.0);
-    cs->g *= 1.0 + k * (pigment.g - 1.0);
-    cs->b *= 1.0 + k * (pigment.b - 1.0);
-}
-
-/* The standard dielectric formula in the form POV-Ray documents for `fresnel`. */
-double shade_light_fresnel(double cos_i, double n)
-{
-    double g2 = n * n + cos_i * cos_i - 1.0;
-    if (g2 <= 0.0) return 1.0;
-    double g = sqrt(g2);
-    double q1 = (g - cos_i) / (g + cos_i);
-    double q2 = (cos_i * (g + cos_i) - 1.0) / (cos_i * (g - cos_i) + 1.0);
-    double f = 0.5 * q1 * q1 * (1.0 + q2 * q2);
-    return fmin(1.0, fmax(0.0, f));
-}
-
 static rgb light_terms_plain(const shade_light_surface *s, vec3 l, rgb lc, int backside);
 
 rgb shade_light_irid(const scene_finish *f, vec3 l, vec3 e, vec3 n, vec3 ipoint, const scene_global *g)
@@ -174,7 +151,7 @@ static rgb light_terms_plain(const shade_light_surface *s, vec3 l, rgb lc, int b
         if (ca > 0.0 && (f->phong_size < 60 || ca > 0.0008)) {
             double intensity = f->phong * pow(ca, f->phong_size);
             rgb cs = {1, 1, 1};
-            shade_light_metallic_tint(&cs, f->metallic, s->pigment, v3_dot(s->n, l));
+            mirror_metallic_tint(&cs, f->metallic, s->pigment, v3_dot(s->n, l));
             out = lrgb_add(out, lrgb_scale(lrgb_mul(lc, cs), intensity));
         }
     }
@@ -188,7 +165,7 @@ static rgb light_terms_plain(const shade_light_surface *s, vec3 l, rgb lc, int b
                 double rough = f->roughness > 0.0 ? f->roughness : 0.05;
                 double intensity = f->specular * pow(ca, 1.0 / rough);
                 rgb cs = {1, 1, 1};
-                shade_light_metallic_tint(&cs, f->metallic, s->pigment, v3_dot(h, l) / hl);
+                mirror_metallic_tint(&cs, f->metallic, s->pigment, v3_dot(h, l) / hl);
                 out = lrgb_add(out, lrgb_scale(lrgb_mul(lc, cs), intensity));
             }
         }

@@ -49,13 +49,6 @@ void shade_light_ray(const scene_light *l, vec3 centre, vec3 p, vec3 *dir, doubl
  * the same lengths turned to face p (POV-Ray's rule, scene_light_orient_axes). */
 void shade_light_area_axes(const scene_light *l, vec3 p, vec3 *ax1, vec3 *ax2);
 
-/* POV-Ray's empirical metallic tint of a highlight or reflection colour:
- * F(x) = 0.014567225/(x-1.12)^2 - 0.011612903 with x = angle/(pi/2). */
-void shade_light_metallic_tint(rgb *cs, double metallic, rgb pigment, double cos_angle);
-
-/* Fresnel reflectance for unpolarised light at relative ior n. */
-double shade_light_fresnel(double cos_i, double n);
-
 /* The surface a light shines on. */
 typedef struct {
     const scene_finish *f;

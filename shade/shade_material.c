@@ -11,6 +11,7 @@
  * 1.5 a photon keeps 1/2.25 of kt, leaving it gets 2.25: a round trip is kt^2,
  * and surfaces inside a medium receive what the camera-side transport sees. */
 #include "shade_material.h"
+#include "mirror.h"
 #include "radrules.h"
 #include <math.h>
 #include <stdatomic.h>
@@ -301,20 +302,12 @@ void shade_mat_setup_fresnel(shade_mat_bsdf *b, const scene *sc, const accel_hit
     b->refl_dir = v3_madd(dir, n, 2.0 * cos_i);
     b->eta2 = 1.0;
 
-    /* Reflection (shade.c: falloff blend or fresnel, metallic tint). */
-    rgb rmax = f->reflection_max, rmin = f->reflection_min;
+    /* Reflection (mirror.h: falloff blend or fresnel, metallic tint). */
     rgb refl = {0, 0, 0};
-    if (mrgb_max(rmax) > 0.0 || mrgb_max(rmin) > 0.0) {
-        if (f->fresnel) {
-            double fr = shade_light_fresnel(cos_i, fresnel_ior > 0.0 ? fresnel_ior : rel_ior);
-            refl = mrgb(rmax.r * fr + rmin.r * (1.0 - fr), rmax.g * fr + rmin.g * (1.0 - fr),
-                        rmax.b * fr + rmin.b * (1.0 - fr));
-        } else {
-            double frac = fabs(f->reflection_falloff - 1.0) > 1e-10 ? pow(1.0 - cos_i, f->reflection_falloff) : 1.0 - cos_i;
-            refl = mrgb(rmax.r * frac + rmin.r * (1.0 - frac), rmax.g * frac + rmin.g * (1.0 - frac),
-                        rmax.b * frac + rmin.b * (1.0 - frac));
-        }
-        shade_light_metallic_tint(&refl, f->reflection_metallic, pig, cos_i);
+    if (mirror_reflects(f)) {
+        double wdummy = 1.0;
+        refl = mirror_reflectivity(f, cos_i, fresnel_ior > 0.0 ? fresnel_ior : rel_ior, &wdummy);
+        mirror_metallic_tint(&refl, f->reflection_metallic, pig, cos_i);
     }
     /* conserve_energy: what the reflection takes is not transmitted
      * (trace.cpp: filCol *= min(1, 1 - reflectivity), as shade_texture.c);
@@ -362,7 +355,7 @@ rgb shade_mat_eval(const shade_mat_bsdf *b, vec3 wi)
     return mrgb(0, 0, 0);
 }
 
-/* The glossy sub-lobes' sum, tinted by metallic (shade_light_metallic_tint, at
+/* The glossy sub-lobes' sum, tinted by metallic (mirror_metallic_tint, at
  * the mean cosine of wi and wo: symmetric); 0 unless wi is on the viewer's
  * side by both normals. */
 rgb shade_mat_eval_glossy(const shade_mat_bsdf *b, vec3 wi)
@@ -379,7 +372,7 @@ rgb shade_mat_eval_glossy(const shade_mat_bsdf *b, vec3 wi)
         else out = mrgb(out.r + c.r, out.g + c.g, out.b + c.b);
     }
     if (b->gl_metallic != 0.0)
-        shade_light_metallic_tint(&tinted, b->gl_metallic, b->pigment, 0.5 * (v3_dot(wi, b->n) + v3_dot(wo, b->n)));
+        mirror_metallic_tint(&tinted, b->gl_metallic, b->pigment, 0.5 * (v3_dot(wi, b->n) + v3_dot(wo, b->n)));
     return mrgb(out.r + tinted.r, out.g + tinted.g, out.b + tinted.b);
 }
 

@@ -44,6 +44,7 @@
 #include "shade_texture.h"
 #include <math.h>
 #include <string.h>
+#include "mirror.h"
 #include "shade_noise.h"
 #include "shade_normal.h"
 #include "shade_pattern.h"
@@ -170,34 +171,6 @@ static rgb trace_reflection(const hit_info *hi, vec3 n, double weight, const sce
 
 static double interior_ior(const scene_interior *in) { return in && in->ior > 0.0 ? in->ior : 1.0; }
 
-/* Reflectivity of a layer (POV-Ray's ComputeReflectivity) and the weight of
- * its reflected ray. */
-static rgb reflectivity(const hit_info *hi, const scene_finish *f, double cos_i, double *weight)
-{
-    rgb rmax = f->reflection_max, rmin = f->reflection_min, refl;
-    if (f->fresnel) {
-        double ior = hi->rel_ior;
-        double sqx = ior * ior + cos_i * cos_i - 1.0;
-        if (sqx > 0.0) {
-            double g = sqrt(sqx);
-            double fr = 0.5 * ((g - cos_i) * (g - cos_i) / ((g + cos_i) * (g + cos_i)));
-            double a = cos_i * (g + cos_i) - 1.0, b = cos_i * (g - cos_i) + 1.0;
-            fr = fr * (1.0 + a * a / (b * b));
-            fr = fmin_inline(1.0, fmax_inline(0.0, fr));
-            refl = tadd(tscale(rmax, fr), tscale(rmin, 1.0 - fr));
-        } else {
-            refl = rmax;
-        }
-        *weight *= tmax3(refl);
-        return refl;
-    }
-    *weight *= fmax_inline(tmax3(rmax), tmax3(rmin));
-    double frac = fabs(f->reflection_falloff - 1.0) > TEX_EPSILON ? pow(1.0 - cos_i, f->reflection_falloff) : 1.0 - cos_i;
-    if (fabs(frac) < TEX_EPSILON) return rmin;
-    if (fabs(frac - 1.0) < TEX_EPSILON) return rmax;
-    return tadd(tscale(rmax, frac), tscale(rmin, 1.0 - frac));
-}
-
 /* One refracted ray with the ior ratio eta (POV-Ray's TraceRefractionRay,
  * Heckbert's method), of band `wavelength`; returns 1 on total internal
  * reflection, when colour holds the reflected ray's radiance (traced with
@@ -308,8 +281,8 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
         L->exponent = f->reflection_exponent != 0.0 ? 1.0 / f->reflection_exponent : 1.0;
         L->f = f;
         double cos_i = -v3_dot(hi->dir, ln);
-        L->reflec = reflectivity(hi, f, cos_i, &L->weight);
-        shade_light_metallic_tint(&L->reflec, f->reflection_metallic, pig, cos_i);
+        L->reflec = mirror_reflectivity(f, cos_i, hi->rel_ior, &L->weight);
+        mirror_metallic_tint(&L->reflec, f->reflection_metallic, pig, cos_i);
 
         double att = hi->version < 3.7 ? 1.0 - (lc.f * tmax3(pig) + lc.t) : 1.0 - lc.f - lc.t;
         if (e->quality <= 1) {
