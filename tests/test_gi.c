@@ -1448,6 +1448,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_sky_furnace),
         cmocka_unit_test(test_sky_final_gather),
         cmocka_unit_test(test_csg_emitter_gather),
+        cmocka_unit_test(test_mirror_gather),
         cmocka_unit_test(test_sky_second_bounce),
         cmocka_unit_test(test_direct_matches_whitted),
         cmocka_unit_test(test_determinism),

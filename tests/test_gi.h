@@ -35,6 +35,7 @@ void test_kept_hits(void **state);
 void test_sky_furnace(void **state);
 void test_sky_final_gather(void **state);
 void test_csg_emitter_gather(void **state);
+void test_mirror_gather(void **state);
 void test_sky_second_bounce(void **state);
 
 #endif
