@@ -41,6 +41,10 @@
 #define CHUNK 2048
 /* most photons shot in all (memory and time stay bounded whatever the scene asks) */
 #define MAX_CELLS 4194304.0
+/* most media photons kept in all (64 bytes each, and up to 8 grid entries):
+ * each chunk of bounce-map cells keeps at most its share, thinning its own
+ * (deposit_media) */
+#define MAX_MEDIA_PHOTONS 2097152L
 
 static inline rgb crgb(double r, double g, double b)
 {
@@ -295,6 +299,8 @@ typedef struct {
     long nhl, caphl;
     gi_caus_photon *mp; /* media photons */
     long nmp, capmp;
+    long mquota;        /* most media photons this chunk keeps (MAX_MEDIA_PHOTONS shared out) */
+    long mstride, mseen; /* every mstride-th media photon left is kept (1 until the quota is met) */
     long rays, first_hits, absorbed_first;
     long alive[GI_CAUSTIC_MAX_BOUNCES + 1];
     int oom;
@@ -366,10 +372,14 @@ static int deposit_media(const gi_caustic *c, const combo *cb, vec3 org, vec3 w,
     vec3 wq = pov_photon_dir(v3_neg(w));
     for (long j = 0; j < n; j++) {
         double t = (j + 0.5 + jit * (rng_f64(r) - 0.5)) / (double)n * len, Dt = D + t;
+        /* past the chunk's quota only every mstride-th photon is kept, with
+         * mstride times the power and a sphere holding as many of them */
+        if (out->mseen++ % out->mstride) continue;
+        double thin = (double)out->mstride;
         double att = c->hk.attenuation(c->hk.ctx, cb->l, p_first, Dt);
-        double k = att * f * s * (cb->parallel ? 1.0 : Dt * Dt * Dt);
+        double k = att * f * s * (cb->parallel ? 1.0 : Dt * Dt * Dt) * thin;
         double sl = (cb->parallel ? s : s * Dt) / sqrt(rho_p);
-        double rad = fmin(MEDIA_RADIUS_K * cbrt(sl * sl * sa), c->r_max);
+        double rad = fmin(MEDIA_RADIUS_K * cbrt(sl * sl * sa * thin), c->r_max);
         vec3 x = v3_madd(org, w, t);
         float ir2 = (float)(1.0 / (rad * rad));
         gi_caus_photon q = {{(float)x.x, (float)x.y, (float)x.z},
@@ -383,6 +393,22 @@ static int deposit_media(const gi_caustic *c, const combo *cb, vec3 org, vec3 w,
         if (!(rad > 0.0) || !isfinite(q.phi[0] + q.phi[1] + q.phi[2]) || !(cmax3(crgb(q.phi[0], q.phi[1], q.phi[2])) > 0.0))
             continue;
         if (!push_photon(out, &q, STORE_MEDIA)) return 0;
+        if (out->nmp >= out->mquota) {
+            /* the quota met: every other photon kept so far goes, the rest
+             * take their power and a sphere as wide as theirs and their
+             * neighbour's together (deterministic: one chunk, in order) */
+            long m = 0;
+            for (long i = 0; i < out->nmp; i += 2) {
+                gi_caus_photon p = out->mp[i];
+                for (int ch = 0; ch < 3; ch++) p.phi[ch] *= 2.0f;
+                double r2 = fmin(p.r_xy * cbrt(2.0), c->r_max);
+                p.r_xy = p.r_z = (float)r2;
+                p.inv_rxy2 = p.inv_rz2 = (float)(1.0 / (r2 * r2));
+                out->mp[m++] = p;
+            }
+            out->nmp = m;
+            out->mstride *= 2;
+        }
     }
     return 1;
 }
@@ -962,10 +988,17 @@ gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_s
     int nchunks = (int)((c->total + CHUNK - 1) / CHUNK);
     trace_job tj = {c, calloc((size_t)(nchunks > 0 ? nchunks : 1), sizeof(chunk_out))};
     if (!tj.outs) st = PT_ERR_NOMEM;
+    for (int i = 0; tj.outs && i < nchunks; i++) {
+        long q = MAX_MEDIA_PHOTONS / nchunks;
+        tj.outs[i].mquota = q > 1024 ? q : 1024;
+        tj.outs[i].mstride = 1;
+    }
     if (st == PT_OK) pool_run(threads, nchunks, trace_chunk, &tj);
     long nph = 0, nhl = 0, nmp = 0;
+    long thinned = 1;
     for (int i = 0; tj.outs && i < nchunks; i++) {
         if (tj.outs[i].oom) st = PT_ERR_NOMEM;
+        if (tj.outs[i].mstride > thinned) thinned = tj.outs[i].mstride;
         nph += tj.outs[i].n;
         nhl += tj.outs[i].nhl;
         nmp += tj.outs[i].nmp;
@@ -1001,6 +1034,12 @@ gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_s
     c->st.stored = c->nph;
     c->st.stored_highlights = c->nhl;
     c->st.stored_media = c->nmp;
+    c->st.media_thinned = thinned;
+    if (thinned > 1)
+        diag_warn_once(d, sc->global.photons.loc,
+                       "photons: more media photons than the caustic layer keeps (%ld); some were kept at up to %ld "
+                       "times the power in wider spheres",
+                       MAX_MEDIA_PHOTONS, thinned);
     for (long i = 0; i < c->nph; i++) c->st.flux += (c->ph[i].phi[0] + c->ph[i].phi[1] + c->ph[i].phi[2]) / 3.0;
     c->st.t_trace = timer_now() - t0;
     if (st != PT_OK || (s->cancel && *s->cancel)) {

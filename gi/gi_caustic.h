@@ -177,6 +177,8 @@ typedef struct {
     long stored_highlights; /* photons on surfaces with only a highlight (gi_caustic_visit's alone) */
     long stored_media;      /* media photons (global photons { media steps }) */
     double r_media_median;  /* median radius of the media photons' spheres */
+    long media_thinned;     /* 1, or the largest factor by which a chunk of photons thinned its media photons to
+                               stay within the layer's limit (each kept one carrying that many's power) */
     double flux;            /* their power, summed (grey: mean of the channels) */
     long rays;
     double spacing;         /* the global spacing used (count and count_scale applied) */
