@@ -638,41 +638,81 @@ int geom_csg_kept(const geom_csg *c, int node, vec3 p)
 #define CSG_CHUNK 8
 
 /* A ray as the members are searched: inv = 1 / dir per component for the
- * keep boxes' slab tests (one ray meets many boxes), and whether any kept
+ * keep boxes' slab tests (one ray meets many boxes), whether every
+ * component of dir is non-zero with a finite inverse (regular: the slab
+ * tests need no case for a ray parallel to a face), and whether any kept
  * crossing will do (an occlusion query) rather than the nearest. */
 typedef struct {
     vec3 org, dir, inv;
     double tmin;
-    int any;
+    int any, regular;
 } csg_ray;
 
-/* Member s's nearest kept crossing in (tmin, *best): into *h, *best
- * lowered, 1 returned. */
-static int try_member(const geom_csg *c, int s, const csg_ray *R, double *bestp, geom_csg_hit *h)
+/* One axis of keep_slab: v3_slab_axis's arithmetic for a ray that is not
+ * parallel to the slab, so that the interval is the same to the bit. */
+#define KEEP_SLAB_AXIS(c)                                                                                              \
+    do {                                                                                                               \
+        double x_ = (lo.c - R->org.c) * R->inv.c, y_ = (hi.c - R->org.c) * R->inv.c;                                   \
+        if (x_ > y_) {                                                                                                 \
+            double t_ = x_;                                                                                            \
+            x_ = y_;                                                                                                   \
+            y_ = t_;                                                                                                   \
+        }                                                                                                              \
+        if (x_ > a) a = x_;                                                                                            \
+        if (y_ < b) b = y_;                                                                                            \
+    } while (0)
+
+/* v3_slab_inv of the ray against the box [lo, hi], the same interval;
+ * inline and without the parallel cases for a regular ray, which is most
+ * of them (a ray meets most of a CSG's keep boxes only to be turned away
+ * by this test). */
+__attribute__((always_inline)) static inline int keep_slab(const csg_ray *R, vec3 lo, vec3 hi, double *t0, double *t1)
+{
+    if (!R->regular) return v3_slab_inv(R->org, R->dir, R->inv, lo, hi, t0, t1);
+    double a = -INFINITY, b = INFINITY;
+    KEEP_SLAB_AXIS(x);
+    KEEP_SLAB_AXIS(y);
+    KEEP_SLAB_AXIS(z);
+    if (!(a <= b)) return 0;
+    *t0 = a;
+    *t1 = b;
+    return 1;
+}
+
+/* The stretch [*from, *upto] of the ray where member s's crossings can be
+ * kept, within (tmin, best): 0 when there is none. The ray must cross
+ * where this member's crossings can be kept, and only that stretch is
+ * searched (a clipped quartic's root finder then works on the clip box's
+ * chord, not the whole ray); an isosurface's crossings count from the
+ * ray's start (max_trace), so its search starts there. The stretch is
+ * padded by 1e-9 of its distances, far above the ulp by which the product
+ * with inv may move its ends. Inline: the search loops turn most members
+ * away here, before a call. */
+__attribute__((always_inline)) static inline int member_stretch(const geom_csg *c, int s, const csg_ray *R, double best, double *from, double *upto)
+{
+    *from = R->tmin;
+    *upto = INFINITY;
+    if (c->keep_box) {
+        const vec3 *kb = c->keep_box + 2 * s;
+        double t0, t1;
+        if (!(kb[0].x <= kb[1].x) || !keep_slab(R, kb[0], kb[1], &t0, &t1)) return 0;
+        double pad = 1e-9 * (fabs(t0) + fabs(t1)) + 1e-300;
+        if (t1 + pad < R->tmin || t0 - pad > best) return 0;
+        *upto = t1 + pad;
+        if (c->shapes[s].kind != SHAPE_ISOSURFACE && t0 - pad > R->tmin) *from = t0 - pad;
+    }
+    return !c->nodes[c->shape_node[s]].nosurf;
+}
+
+/* Member s's nearest kept crossing in (from, min(*best, upto)), its stretch
+ * from member_stretch: into *h, *best lowered, 1 returned. */
+static int search_member(const geom_csg *c, int s, const csg_ray *R, double from, double upto, double *bestp,
+                         geom_csg_hit *h)
 {
     int found = 0;
     double best = *bestp;
     vec3 org = R->org, dir = R->dir;
-    double tmin = R->tmin;
     int node = c->shape_node[s];
-    if (c->nodes[node].nosurf) return 0;
-    double from = tmin, upto = INFINITY;
-    if (c->keep_box) {
-        /* the ray must cross where this member's crossings can be kept,
-         * and only that stretch is searched (a clipped quartic's root
-         * finder then works on the clip box's chord, not the whole
-         * ray); an isosurface's crossings count from the ray's start
-         * (max_trace), so its search starts there. The stretch is padded
-         * by 1e-9 of its distances, far above the ulp by which the
-         * product with inv may move its ends. */
-        const vec3 *kb = c->keep_box + 2 * s;
-        double t0, t1;
-        if (!(kb[0].x <= kb[1].x) || !v3_slab_inv(org, dir, R->inv, kb[0], kb[1], &t0, &t1)) return 0;
-        double pad = 1e-9 * (fabs(t0) + fabs(t1)) + 1e-300;
-        if (t1 + pad < tmin || t0 - pad > best) return 0;
-        upto = t1 + pad;
-        if (c->shapes[s].kind != SHAPE_ISOSURFACE && t0 - pad > tmin) from = t0 - pad;
-    }
     for (int guard = 0; guard < 1000; guard++) {
         geom_shape_hit tmp[CSG_CHUNK];
         int k = geom_shape_ray_hits(&c->shapes[s], org, dir, from, fmin(best, upto), tmp, CSG_CHUNK);
@@ -695,6 +735,15 @@ static int try_member(const geom_csg *c, int s, const csg_ray *R, double *bestp,
     }
     *bestp = best;
     return found;
+}
+
+/* Member s's nearest kept crossing in (tmin, *best): into *h, *best
+ * lowered, 1 returned. */
+static inline int try_member(const geom_csg *c, int s, const csg_ray *R, double *bestp, geom_csg_hit *h)
+{
+    double from, upto;
+    if (!member_stretch(c, s, R, *bestp, &from, &upto)) return 0;
+    return search_member(c, s, R, from, upto, bestp, h);
 }
 
 static inline int in_hole_box(const geom_csg *c, int i, vec3 p)
@@ -728,7 +777,7 @@ static inline int in_hole_box(const geom_csg *c, int i, vec3 p)
 static double hole_clear(const geom_csg *c, const csg_ray *R, double tmax)
 {
     double t0, t1;
-    if (!v3_slab_inv(R->org, R->dir, R->inv, c->keep_lo, c->keep_hi, &t0, &t1)) return R->tmin;
+    if (!keep_slab(R, c->keep_lo, c->keep_hi, &t0, &t1)) return R->tmin;
     double pad = 4e-9 * (fabs(t0) + fabs(t1)) + 1e-300;
     double a = fmax_inline(t0 - pad, R->tmin), b = fmin_inline(t1 + pad, tmax);
     if (!(a <= b)) return R->tmin;
@@ -742,12 +791,12 @@ static double hole_clear(const geom_csg *c, const csg_ray *R, double tmax)
     for (;;) {
         if (in_hole_box(c, cur, pb)) return INFINITY;
         double e0, e1;
-        if (!v3_slab_inv(R->org, R->dir, R->inv, c->hole_lo[cur], c->hole_hi[cur], &e0, &e1)) break;
+        if (!keep_slab(R, c->hole_lo[cur], c->hole_hi[cur], &e0, &e1)) break;
         int next = -1;
         double next_at = 0.0, next_end = e1;
         for (int j = 0; j < c->nholes; j++) {
             double f0, f1;
-            if (used >> j & 1u || !v3_slab_inv(R->org, R->dir, R->inv, c->hole_lo[j], c->hole_hi[j], &f0, &f1)) continue;
+            if (used >> j & 1u || !keep_slab(R, c->hole_lo[j], c->hole_hi[j], &f0, &f1)) continue;
             if (!(f1 > next_end)) continue;
             double m = 0.5 * (fmax_inline(f0, at) + e1);
             vec3 pm = v3_madd(R->org, R->dir, m);
@@ -799,7 +848,7 @@ static int csg_search(const geom_csg *c, const csg_ray *R, double tmax, geom_csg
             int ni = stack[--sp];
             const geom_csg_bvh *nd = &c->bvh[ni];
             double t0, t1;
-            if (!v3_slab_inv(R->org, R->dir, R->inv, nd->lo, nd->hi, &t0, &t1)) continue;
+            if (!keep_slab(R, nd->lo, nd->hi, &t0, &t1)) continue;
             double pad = 1e-9 * (fabs(t0) + fabs(t1)) + 1e-300;
             if (t1 + pad < R->tmin || t0 - pad > best) continue;
             if (nd->count > 0) {
@@ -817,7 +866,9 @@ static int csg_search(const geom_csg *c, const csg_ray *R, double tmax, geom_csg
 
 static csg_ray make_ray(vec3 org, vec3 dir, double tmin, int any)
 {
-    csg_ray R = {org, dir, v3(1.0 / dir.x, 1.0 / dir.y, 1.0 / dir.z), tmin, any};
+    csg_ray R = {org, dir, v3(1.0 / dir.x, 1.0 / dir.y, 1.0 / dir.z), tmin, any, 0};
+    R.regular = dir.x != 0.0 && dir.y != 0.0 && dir.z != 0.0 && isfinite(R.inv.x) && isfinite(R.inv.y) &&
+                isfinite(R.inv.z);
     return R;
 }
 
@@ -846,7 +897,7 @@ static int member_crossings(const geom_csg *c, int s, const csg_ray *R, double t
         /* try_member's stretch, with the whole interval for *best */
         const vec3 *kb = c->keep_box + 2 * s;
         double t0, t1;
-        if (!(kb[0].x <= kb[1].x) || !v3_slab_inv(R->org, R->dir, R->inv, kb[0], kb[1], &t0, &t1)) return 0;
+        if (!(kb[0].x <= kb[1].x) || !keep_slab(R, kb[0], kb[1], &t0, &t1)) return 0;
         double pad = 1e-9 * (fabs(t0) + fabs(t1)) + 1e-300;
         if (t1 + pad < R->tmin || t0 - pad > tmax) return 0;
         upto = fmin(tmax, t1 + pad);
@@ -884,7 +935,7 @@ int geom_csg_crossings(const geom_csg *c, vec3 org, vec3 dir, double tmin, doubl
             int ni = stack[--sp];
             const geom_csg_bvh *nd = &c->bvh[ni];
             double t0, t1;
-            if (!v3_slab_inv(R.org, R.dir, R.inv, nd->lo, nd->hi, &t0, &t1)) continue;
+            if (!keep_slab(&R, nd->lo, nd->hi, &t0, &t1)) continue;
             double pad = 1e-9 * (fabs(t0) + fabs(t1)) + 1e-300;
             if (t1 + pad < R.tmin || t0 - pad > tmax) continue;
             if (nd->count > 0) {
