@@ -680,8 +680,12 @@ static pt_status build_user_geometry(accel *a)
     if (!g) return PT_ERR_DEVICE;
     unsigned np = (unsigned)(a->nshapes + a->ncsgs);
     a->ubox = malloc((size_t)np * 6 * sizeof *a->ubox);
-    if (!a->ubox) return PT_ERR_NOMEM;
-    for (unsigned p = 0; p < np; p++) accel_user_box(a, p, a->ubox + 6 * (size_t)p);
+    a->ubox_test = malloc(np);
+    if (!a->ubox || !a->ubox_test) return PT_ERR_NOMEM;
+    for (unsigned p = 0; p < np; p++) {
+        accel_user_box(a, p, a->ubox + 6 * (size_t)p);
+        a->ubox_test[p] = (unsigned char)accel_user_box_test(a, p, np);
+    }
     rtcSetGeometryUserPrimitiveCount(g, (unsigned)(a->nshapes + a->ncsgs));
     rtcSetGeometryUserData(g, a);
     rtcSetGeometryBoundsFunction(g, accel_user_bounds, a);
@@ -804,7 +808,7 @@ void accel_free(accel *a)
     for (int i = 0; i < a->ncsgs; i++) geom_csg_free(&a->csgs[i]);
     for (int i = 0; i < a->nbshapes; i++) geom_shape_release(&a->bshapes[i]);
     GROW_FREE_ALL(a->leaves, a->shapes, a->shape_leaf, a->diags, a->groups, a->csgs, a->bshapes, a->csg_b0, a->csg_bn,
-                  a->ubox, a->ginfo, a);
+                  a->ubox, a->ubox_test, a->ginfo, a);
 }
 
 static inline double eps_rule(double scale, vec3 org, double dirlen)

@@ -76,6 +76,8 @@ struct accel {
     geom_csg *csgs;              /* user primitives nshapes .. nshapes + ncsgs - 1 */
     int ncsgs, capcsgs;
     float *ubox;                  /* 6 floats per user primitive: its box as accel_user_bounds gives it */
+    unsigned char *ubox_test;     /* per user primitive: whether the callbacks test a ray against ubox
+                                     before intersecting it (accel_user_box_test) */
     geom_info *ginfo;
     unsigned nginfo;
     int has_tri_geoms; /* a geometry of triangles or instances: accel_crossings walks crossing by crossing */
@@ -148,6 +150,7 @@ int accel_collect_bounds(accel *a, diag *d, const scene_object *o, int own, int 
 
 /* The user geometry's primitives and Embree callbacks (accel_user.c). */
 void accel_user_box(const accel *a, unsigned prim, float out[6]);
+int accel_user_box_test(const accel *a, unsigned prim, unsigned np);
 void accel_user_bounds(const struct RTCBoundsFunctionArguments *args);
 void accel_user_bounds_link(const struct RTCBoundsFunctionArguments *args);
 /* Primitive prim's nearest hit in (tmin, tmax) of the double ray o + t d. */

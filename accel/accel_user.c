@@ -210,17 +210,40 @@ void accel_user_bounds_link(const struct RTCBoundsFunctionArguments *args)
     b->upper_x = out[3]; b->upper_y = out[4]; b->upper_z = out[5];
 }
 
+/* Whether the callbacks test a ray against user primitive prim's box
+ * (ubox) before intersecting it, of np primitives. Embree's BVH over the
+ * user geometry has one primitive per leaf (Embree 3's device setting
+ * object_accel_max_leaf_size defaults to 1, kernels/common/state.cpp), and
+ * a ray reaches a leaf only through the test of that leaf's box in the node
+ * above: the test here turns away only the rays whose nearest hit moved
+ * closer since (few: docs/gi.md, "Where the time goes"), at the cost of a
+ * slab test in float on every call. It pays where the intersection costs
+ * far more: a CSG's search over its members, a bounded_by's tests, the
+ * shapes without a closed-form solution (quartics, sweeps, isosurfaces);
+ * and where no node lies above the leaf: a user geometry of one primitive
+ * is a lone leaf whose box Embree never tests (cbox's light patch, asked
+ * by every link ray). The other shapes' own tests are a few products and a
+ * root, about the slab test's cost. */
+int accel_user_box_test(const accel *a, unsigned prim, unsigned np)
+{
+    if (np <= 1 || prim >= (unsigned)a->nshapes) return 1;
+    if (a->leaves[a->shape_leaf[prim]].bn) return 1;
+    switch (a->shapes[prim].kind) {
+    case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_PLANE: case SHAPE_DISC: case SHAPE_CYLINDER: case SHAPE_CONE:
+    case SHAPE_TRIANGLE: case SHAPE_SMOOTH_TRIANGLE:
+        return 0;
+    default:
+        return 1;
+    }
+}
+
 /* Does lane i of an SOA ray miss user primitive prim's box within its
- * [tnear, tfar]? Embree tests a primitive's box only from a BVH node
- * above it, and a user geometry of one primitive is a lone leaf: every ray
- * then called accel_prim_hit (cbox's light patch: 2.07 M calls for 1.85 M link
- * rays, 9% of the particle GI geometry stage's instructions). Conservative:
- * a NaN slab (a zero direction component starting on a face) constrains
- * nothing, and the interval must be empty by more than float rounding. */
+ * [tnear, tfar]? (Asked where accel_user_box_test says so.) Conservative: a NaN slab (a zero direction component starting on a
+ * face) constrains nothing, and the interval must be empty by more than
+ * float rounding. */
 __attribute__((always_inline)) static inline int user_box_missed(const accel *a, unsigned prim, void *ray,
                                                                   unsigned N, unsigned i)
 {
-    if (!a->ubox) return 0;
     const float *b = a->ubox + 6 * (size_t)prim;
     float tn = SOA_F(ray, N, i, 3), tf = SOA_F(ray, N, i, 8);
     for (int k = 0; k < 3; k++) {
@@ -375,8 +398,9 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
     void *ray = args->rayhit;
     float *hit = (float *)args->rayhit + 12 * (size_t)N;
     if (args->primID >= (unsigned)(a->nshapes + a->ncsgs)) return; /* the link scene's empty primitive */
+    const int box_test = a->ubox && a->ubox_test[args->primID];
     for (unsigned i = 0; i < N; i++) {
-        if (args->valid[i] != -1 || box_missed(a, args->primID, ray, N, i)) continue;
+        if (args->valid[i] != -1 || (box_test && box_missed(a, args->primID, ray, N, i))) continue;
         float tfar = SOA_F(ray, N, i, 8);
         vec3 o, d;
         double tmin;
@@ -445,8 +469,9 @@ void accel_user_occluded(const struct RTCOccludedFunctionNArguments *args)
     unsigned N = args->N;
     int exact = q && (void *)q == (void *)args->context && N == 1;
     void *ray = args->ray;
+    const int box_test = a->ubox && a->ubox_test[args->primID];
     for (unsigned i = 0; i < N; i++) {
-        if (args->valid[i] != -1 || box_missed(a, args->primID, ray, N, i)) continue;
+        if (args->valid[i] != -1 || (box_test && box_missed(a, args->primID, ray, N, i))) continue;
         vec3 o, d;
         double tmin;
         user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
