@@ -116,6 +116,9 @@ int main(int argc, char **argv)
     for (int b = 1; b <= s.max_bounce; b++)
         printf("  going on after bounce %2d: %9ld  (%.1f%% of those at their target; a split counts once)\n", b, s.alive[b],
                s.first_hits ? 100.0 * s.alive[b] / s.first_hits : 0.0);
+    if (s.stored_media > 0)
+        printf("media photons: %ld stored (sphere radius median %.4g, thinned %ldx at most)\n", s.stored_media,
+               s.r_media_median, s.media_thinned);
     printf("stages: trace %.3f s, G-buffer %.3f s\n", s.t_trace, s.t_gbuffer);
 
     double tb[16], ts[16], tk[16], tg[16];
