@@ -28,6 +28,7 @@ typedef struct {
     int n;                /* max_iteration */
     double step;          /* 1 / precision */
     double slice[4], sdist;
+    double inv_s3;        /* 1 / slice[3] where that is exact (a power of two), else 0 */
     double R, exit;       /* bounding radius, bailout on |z|^2 */
     double complex ca, cb; /* c as the complex pair (hypercomplex) */
 } jf_data;
@@ -38,7 +39,11 @@ static void lift(const jf_data *f, vec3 p, double q[4])
     q[0] = p.x;
     q[1] = p.y;
     q[2] = p.z;
-    q[3] = (f->sdist - f->slice[0] * p.x - f->slice[1] * p.y - f->slice[2] * p.z) / f->slice[3];
+    double w = f->sdist - f->slice[0] * p.x - f->slice[1] * p.y - f->slice[2] * p.z;
+    /* the quotient by a power of two is the product by its reciprocal, bit
+     * for bit, and a division is the longest step of a test's first
+     * iteration (the default slice's w component is 1) */
+    q[3] = f->inv_s3 != 0.0 ? w * f->inv_s3 : w / f->slice[3];
 }
 
 static void qmul(const double a[4], const double b[4], double r[4])
@@ -244,6 +249,8 @@ int geom_fractal_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
         free(f);
         return -1;
     }
+    int ex;
+    f->inv_s3 = fabs(frexp(f->slice[3], &ex)) == 0.5 && isfinite(1.0 / f->slice[3]) ? 1.0 / f->slice[3] : 0.0;
     if (!f->hyper) {
         double R = 1.0 + sqrt(f->c[0] * f->c[0] + f->c[1] * f->c[1] + f->c[2] * f->c[2] + f->c[3] * f->c[3]) + 1e-7;
         f->R = R > 2.0 ? 2.0 : R;
