@@ -500,7 +500,7 @@ static void torus_quartic(vec3 q, vec3 e, double R, double r, double c[5])
     c[0] = G * G - 4.0 * R * R * C;
 }
 
-static int hits_torus(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
+__attribute__((noinline)) static int hits_torus(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     double s = v3_len(d);
     if (!(s > 0.0) || !isfinite(s)) return 0;
@@ -555,7 +555,7 @@ static int hits_torus(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
  * padded box; each sphere's roots where that sphere is the surface, the
  * spindle torus' quartic (the torus equation with major radius h, tube rc,
  * centred at y = v) where the lemon is, on the lemon's branch. */
-static int hits_ovus(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
+__attribute__((noinline)) static int hits_ovus(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     double s = v3_len(d);
     if (!(s > 0.0) || !isfinite(s)) return 0;
@@ -619,30 +619,13 @@ static int hits_ovus(const geom_shape *sh, vec3 o, vec3 d, double tmin, double t
     return n;
 }
 
-/* Parameter interval of a ray inside a box. */
-static int shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
-                      int max, int traced)
+/* The shapes searched within their bounds (shape_hits' other kinds; o, d:
+ * the ray in object space, org, dir: in world space). Apart from
+ * shape_hits, as are the torus and ovus solves: their scratch would
+ * otherwise make every sphere's or box's test set up their stack frame. */
+__attribute__((noinline)) static int hits_bounded(const geom_shape *sh, vec3 org, vec3 dir, vec3 o, vec3 d, double tmin,
+                                                  double tmax, geom_shape_hit *out, int max, int traced)
 {
-    if (max <= 0) return 0;
-    if (sh->kind == SHAPE_PLANE) return v3_len2(dir) == 0.0 ? 0 : hits_plane(sh, org, dir, tmin, tmax, out, max);
-    vec3 o = org, d = dir;
-    if (!sh->identity) {
-        o = xform_inv_point(&sh->x, org);
-        d = xform_inv_vector(&sh->x, dir);
-    }
-    if (v3_len2(d) == 0.0) return 0;
-    switch (sh->kind) {
-    case SHAPE_SPHERE: return hits_sphere(sh, o, d, tmin, tmax, out, max);
-    case SHAPE_BOX: return hits_box(sh, o, d, tmin, tmax, out, max);
-    case SHAPE_CYLINDER:
-    case SHAPE_CONE: return hits_cone(sh, o, d, tmin, tmax, out, max);
-    case SHAPE_DISC: return hits_disc(sh, o, d, tmin, tmax, out, max);
-    case SHAPE_TORUS: return hits_torus(sh, o, d, tmin, tmax, out, max);
-    case SHAPE_OVUS: return hits_ovus(sh, o, d, tmin, tmax, out, max);
-    case SHAPE_TRIANGLE:
-    case SHAPE_SMOOTH_TRIANGLE: return hits_triangle(sh, o, d, tmin, tmax, out, max);
-    default: break;
-    }
     /* the other shapes: the interval narrowed to the clip box (unbounded
      * shapes: hits outside it are rejected, as for planes) or to the
      * object-space bounds, padded */
@@ -681,6 +664,32 @@ static int shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, dou
     for (int i = 0; i < n; i++)
         if (out[i].t > tmin && out[i].t < tmax && isfinite(out[i].t)) out[k++] = out[i];
     return k;
+}
+
+/* Parameter interval of a ray inside a box. */
+static int shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
+                      int max, int traced)
+{
+    if (max <= 0) return 0;
+    if (sh->kind == SHAPE_PLANE) return v3_len2(dir) == 0.0 ? 0 : hits_plane(sh, org, dir, tmin, tmax, out, max);
+    vec3 o = org, d = dir;
+    if (!sh->identity) {
+        o = xform_inv_point(&sh->x, org);
+        d = xform_inv_vector(&sh->x, dir);
+    }
+    if (v3_len2(d) == 0.0) return 0;
+    switch (sh->kind) {
+    case SHAPE_SPHERE: return hits_sphere(sh, o, d, tmin, tmax, out, max);
+    case SHAPE_BOX: return hits_box(sh, o, d, tmin, tmax, out, max);
+    case SHAPE_CYLINDER:
+    case SHAPE_CONE: return hits_cone(sh, o, d, tmin, tmax, out, max);
+    case SHAPE_DISC: return hits_disc(sh, o, d, tmin, tmax, out, max);
+    case SHAPE_TORUS: return hits_torus(sh, o, d, tmin, tmax, out, max);
+    case SHAPE_OVUS: return hits_ovus(sh, o, d, tmin, tmax, out, max);
+    case SHAPE_TRIANGLE:
+    case SHAPE_SMOOTH_TRIANGLE: return hits_triangle(sh, o, d, tmin, tmax, out, max);
+    default: return hits_bounded(sh, org, dir, o, d, tmin, tmax, out, max, traced);
+    }
 }
 
 int geom_shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
