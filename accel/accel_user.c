@@ -261,17 +261,9 @@ __attribute__((always_inline)) static inline int user_box_missed(const accel *a,
 }
 
 /* user_box_missed with the single ray's offsets folded (N = 1: a query's
- * ray, by far the most common) or for lane i of a packet; asked only where
- * the user geometry holds a single primitive (the scene's own counts its
- * shapes and CSGs; the link scene's has one more, empty). With two or more
- * the BVH root is an inner node: Embree has tested the box of the leaf
- * holding the primitive before calling back, which is the primitive's own
- * box or close to it, so a second test here would hardly ever reject and
- * costs more than the rare exact test it saves (the exact intersection
- * decides either way). */
-static inline int box_missed(const accel *a, unsigned prim, void *ray, unsigned N, unsigned i)
+ * ray, by far the most common) or for lane i of a packet. */
+static int box_missed(const accel *a, unsigned prim, void *ray, unsigned N, unsigned i)
 {
-    if (a->nshapes + a->ncsgs > 1) return 0;
     return N == 1 ? user_box_missed(a, prim, ray, 1, 0) : user_box_missed(a, prim, ray, N, i);
 }
 
