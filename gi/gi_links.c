@@ -240,14 +240,17 @@ static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int
  * POV-Ray's (mirror.h: fresnel at the interior's ior, falloff, metallic;
  * reflection_exponent applied to what comes back), of the texture's top
  * finish as the rest of the GI takes it, about the geometric normal: a
- * normal pattern's ripples are not followed. The reflected ray goes one
+ * normal pattern's ripples are not followed, nor a mirror in an instance
+ * (its hit carries no normal here). The reflected ray goes one
  * trace level up and is not traced at or past the level limit nor below
  * the radiosity block's adc_bailout (trace.cpp ComputeReflection;
  * radrules.h rule 7). Transmission through the mirror is not followed. */
 static void hit_mirror(const link_job *J, const struct RTCRayHit *h, const scene_object *o, const scene_texture *tex,
                        vec3 p, vec3 n, rgb pigment, int level, double weight, emit_memo *memo, float out[3])
 {
-    if (level + 1 >= J->mlimit) return;
+    /* in an instance the hit's normal is not known here (hit_point takes
+     * minus the ray's direction): no mirror direction to follow */
+    if (level + 1 >= J->mlimit || h->hit.instID[0] != RTC_INVALID_GEOMETRY_ID) return;
     const scene_finish *f = &tex->finish;
     vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
     double dl = v3_len(d);
@@ -256,13 +259,10 @@ static void hit_mirror(const link_job *J, const struct RTCRayHit *h, const scene
     double cos_i = -v3_dot(d, n);
     if (!(cos_i > 0.0)) return;
     /* the relative ior of a ray entering the object (it meets the outer
-     * side of the raw geometric normal), else leaving it; in an instance
-     * the ray is taken as entering */
+     * side of the raw geometric normal), else leaving it */
     double rel_ior = 1.0;
     if (o->interior && o->interior->ior > 0.0) {
-        int entering = 1;
-        if (h->hit.instID[0] == RTC_INVALID_GEOMETRY_ID)
-            entering = h->hit.Ng_x * d.x + h->hit.Ng_y * d.y + h->hit.Ng_z * d.z <= 0.0;
+        int entering = h->hit.Ng_x * d.x + h->hit.Ng_y * d.y + h->hit.Ng_z * d.z <= 0.0;
         rel_ior = entering ? o->interior->ior : 1.0 / o->interior->ior;
     }
     double w = weight;
