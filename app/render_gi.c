@@ -453,7 +453,12 @@ static void light_not_modelled(const scene *sc, int mode, render_gi_result *r, d
         r->nm_fog = fog;
         r->nm_rainbow = rainbow;
     }
+    if (mode == GI_PARTICLE) r->nm_normal = radrules_of(sc, 1).normal;
     src_loc nowhere = {0};
+    if (r->nm_normal)
+        diag_report(d, DIAG_WARNING, nowhere, NULL,
+                    "--gi particle: radiosity normal on is not modelled: light is gathered about the unperturbed "
+                    "normal, so a normal pattern does not shade the gathered light");
     if (sc->global.photons.enabled && mode != GI_NONE && mode != GI_PARTICLE) {
         r->nm_photons = mode != GI_PMFG;
         r->nm_photon_count = mode == GI_PMFG;
@@ -509,7 +514,7 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
 {
     caustics_json((caustics *)&r->caus, js);
     stats_obj_begin(js, "light_not_modelled");
-    STATS_INTS_PRE(js, r, nm_, media, fog, rainbow, photons, photon_count);
+    STATS_INTS_PRE(js, r, nm_, media, fog, rainbow, normal, photons, photon_count);
     stats_obj_end(js);
     if (r->has_particle) {
         const gi_particle_stats *p = &r->particle;

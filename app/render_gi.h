@@ -103,6 +103,9 @@ typedef struct {
      * (atmospheric or in objects) and rainbows on every ray; particle: with
      * radiosity's `media on`, media, fog and rainbows along gathering rays. */
     int nm_media, nm_fog, nm_rainbow;
+    /* particle: radiosity's `normal on` (POV-Ray gathers about the
+     * perturbed normal; the final gather takes the unperturbed one) */
+    int nm_normal;
     /* The scene's photons{}: nm_photons 1 where the mode shows no caustics
      * of POV-Ray's lights (every mode but none, particle and pmfg);
      * nm_photon_count 1 for pmfg, whose caustic map shoots --photons from

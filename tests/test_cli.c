@@ -264,6 +264,44 @@ static void test_exact_gather_furnace(void **st)
     assert_null(strstr(js, "\"lookups_gathered_here\": 0,"));
 }
 
+/* radiosity's `normal on` is not modelled by the particle mode (it gathers
+ * about the unperturbed normal): warned once and counted in --stats
+ * (light_not_modelled.normal 1); the same scene with `normal off` is
+ * neither warned about nor counted. */
+static void test_radiosity_normal_warned(void **st)
+{
+    (void)st;
+    char scene[512], cmd[2048], out[512], stats[512];
+    snprintf(out, sizeof out, "%s/rnormal.pfm", tmpdir);
+    snprintf(stats, sizeof stats, "%s/rnormal.json", tmpdir);
+    for (int on = 0; on <= 1; on++) {
+        snprintf(scene, sizeof scene, "%s/rnormal%d.pov", tmpdir, on);
+        char text[1024];
+        snprintf(text, sizeof text,
+                 "#version 3.7;\nglobal_settings { assumed_gamma 1 radiosity { count 20 recursion_limit 1 normal %s } }\n"
+                 "camera { location -4*z look_at 0 angle 30 }\nsky_sphere { pigment { rgb 0.5 } }\n"
+                 "sphere { 0, 1 pigment { rgb 1 } normal { bumps 0.5 scale 0.2 } finish { ambient 0 diffuse 1 } }\n",
+                 on ? "on" : "off");
+        tu_write_file(scene, text);
+        snprintf(cmd, sizeof cmd, "'%s' render '%s' -o '%s' --size 8x8 --threads 2 --stats '%s'", PARTRAY_BIN, scene,
+                 out, stats);
+        assert_int_equal(tu_run_capture(cmd), 0);
+        const char *w = strstr(tu_out, "radiosity normal on is not modelled");
+        const char *js = tu_read_file(stats); /* a static buffer */
+        assert_non_null(js);
+        const char *k = strstr(js, "\"normal\": 1");
+        printf("  radiosity normal %s: warned %s, counted %s\n", on ? "on" : "off", w ? "yes" : "no", k ? "yes" : "no");
+        if (on) {
+            assert_non_null(w);
+            assert_null(strstr(w + 1, "radiosity normal on is not modelled")); /* once */
+            assert_non_null(k);
+        } else {
+            assert_null(w);
+            assert_null(k);
+        }
+    }
+}
+
 /* --clock, +K and the animation switches: the predeclared identifiers as
  * POV-Ray 3.7.0 gives them (each expected pair printed by
  * `povray +Ik.pov -F -D +W8 +H6 OPTIONS` with the same scene). */
@@ -758,6 +796,7 @@ int main(void)
         cmocka_unit_test(test_progress_plain_and_quiet),
         cmocka_unit_test(test_sigint_during_gi),
         cmocka_unit_test(test_quality_levels),
+        cmocka_unit_test(test_radiosity_normal_warned),
         cmocka_unit_test(test_alpha_output),
         cmocka_unit_test(test_output_names_and_types),
     };
