@@ -40,6 +40,14 @@ void shade_light_spot_cosines(const scene_light *l, double *cos_radius, double *
     *cos_falloff = cf;
 }
 
+/* x^tightness, 1 for tightness 0; pow(x, 1) is x exactly (the exact
+ * result is a double), and tightness 1 is common in spotlit media scenes,
+ * where this is asked per media sample and light */
+static double tightness_power(double x, double tightness)
+{
+    return tightness == 0.0 ? 1.0 : tightness == 1.0 ? x : pow(x, tightness);
+}
+
 double shade_light_attenuation(const scene_light *l, vec3 p, vec3 dir, double depth)
 {
     double att = 1.0;
@@ -49,7 +57,7 @@ double shade_light_attenuation(const scene_light *l, vec3 p, vec3 dir, double de
         if (c <= 0.0) return 0.0;
         double cos_radius, cos_falloff;
         shade_light_spot_cosines(l, &cos_radius, &cos_falloff);
-        att = l->tightness != 0.0 ? pow(c, l->tightness) : 1.0;
+        att = tightness_power(c, l->tightness);
         if (cos_radius > 0.0 && c < cos_radius) att *= light_cubic_step(cos_falloff, cos_radius, c);
     } else if (l->kind == LIGHT_CYLINDER) {
         /* radius and falloff are distances from the axis for cylinder lights */
@@ -60,7 +68,7 @@ double shade_light_attenuation(const scene_light *l, vec3 p, vec3 dir, double de
         double len = v3_len(v3_sub(v1, v3_scale(axis, k)));
         if (len >= l->falloff) return 0.0;
         double d = 1.0 - len / l->falloff;
-        att = l->tightness != 0.0 ? pow(d, l->tightness) : 1.0;
+        att = tightness_power(d, l->tightness);
         if (l->radius > 0.0 && len > l->radius) att *= light_cubic_step(0.0, 1.0 - l->radius / l->falloff, d);
     }
     if (att > 0.0) att *= shade_light_fade(l, depth);
