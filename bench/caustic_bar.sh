@@ -11,12 +11,8 @@
 # Prints figures; not a test (docs/caustics.md).
 # usage: bench/caustic_bar.sh [SIZE] [THREADS]   (80x60 2)
 set -eu
-SIZE=${1:-80x60} THREADS=${2:-2}
-W=${SIZE%x*} H=${SIZE#*x}
-ROOT=$(cd "$(dirname "$0")/.." && pwd)
-SCENE=$ROOT/bench/scenes/caustic_bar.pov PARTRAY=${PARTRAY:-$ROOT/build/partray}
-TMP=$(mktemp -d /tmp/caustic_bar.XXXXXX)
-trap 'rm -rf "$TMP"' EXIT
+BENCH_SCENE=caustic_bar BENCH_SIZE=80x60
+. "$(dirname "$0")/scene_bench.sh"
 # render NAME VIEW BLOCK: both renderers into $TMP/pt_NAME.exr, $TMP/pov_NAME.exr
 render() {
     "$PARTRAY" render "$SCENE" -o "$TMP/pt_$1.exr" --size "$SIZE" --threads "$THREADS" --quiet \

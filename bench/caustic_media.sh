@@ -9,14 +9,8 @@
 # not a test (docs/caustics.md).
 # usage: bench/caustic_media.sh [SIZE] [THREADS]   (40x40 2)
 set -eu
-ROOT=$(cd "$(dirname "$0")/.." && pwd)
-PARTRAY=${PARTRAY:-$ROOT/build/partray}
-SCENE=$ROOT/bench/scenes/caustic_media_box.pov
-SIZE=${1:-40x40}
-THREADS=${2:-2}
-W=${SIZE%x*}; H=${SIZE#*x}
-TMP=$(mktemp -d /tmp/caustic_media.XXXXXX)
-trap 'rm -rf "$TMP"' EXIT
+BENCH_SCENE=caustic_media_box BENCH_SIZE=40x40
+. "$(dirname "$0")/scene_bench.sh"
 # mean luminance of B (partray compare A B prints both images' means)
 lum() { "$PARTRAY" compare "$1" "$1" | awk '/^mean luminance/ { sub(",", "", $4); print $4 }'; }
 printf "media box at %s, %s threads: mean luminance (the box's centre sees 0.4)\n" "$SIZE" "$THREADS"

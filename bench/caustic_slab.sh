@@ -10,15 +10,9 @@
 # EXR). Prints figures; not a test (docs/caustics.md).
 # usage: bench/caustic_slab.sh [SIZE] [THREADS] [ANGLE...]   (80x60 2 0 45 71)
 set -eu
-ROOT=$(cd "$(dirname "$0")/.." && pwd)
-PARTRAY=${PARTRAY:-$ROOT/build/partray}
-SCENE=$ROOT/bench/scenes/caustic_slab.pov
-SIZE=${1:-80x60}
-THREADS=${2:-2}
+BENCH_SCENE=caustic_slab BENCH_SIZE=80x60
+. "$(dirname "$0")/scene_bench.sh"
 [ $# -gt 2 ] && shift 2 || set -- 0 45 71
-W=${SIZE%x*}; H=${SIZE#*x}
-TMP=$(mktemp -d /tmp/caustic_slab.XXXXXX)
-trap 'rm -rf "$TMP"' EXIT
 lum() { "$PARTRAY" compare "$1" "$2" | awk '/^mean luminance/ { print $6 / $4 }'; }
 row() { # ANGLE CONSERVE [BRILLIANCE]
     b=${3:-1}
