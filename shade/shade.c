@@ -103,6 +103,7 @@ typedef struct hit_frame {
     const accel_hit *h;
     vec3 dir;
     const shade_media_inside *in;
+    int depth;   /* hits on the stack, this one included (shade_tex_env.depth) */
 } hit_frame;
 
 static const shade_media_inside no_containers = {0, {0}};
@@ -446,11 +447,11 @@ static rgb tex_cb_highlights(void *ctx, int thread, const accel_hit *h, const sh
 static rgb shade_hit(render_ctx *c, int thread, const accel_hit *h, vec3 dir, int level, double weight, unsigned skip,
                      float wavelength, rng *r, const shade_media_inside *in)
 {
+    const hit_frame *outer = c->frame[thread];
+    hit_frame f = {h, dir, in, outer ? outer->depth + 1 : 1};
     shade_tex_env e = {c->sc, c->eps, c->s->use_ambient, c->max_level, c, thread, r, tex_cb_trace, tex_cb_direct,
                  c->s->indirect ? tex_cb_indirect : NULL, &c->ts[thread].unsupported, c->s->quality, in,
-                 c->s->highlights ? tex_cb_highlights : NULL};
-    hit_frame f = {h, dir, in};
-    const hit_frame *outer = c->frame[thread];
+                 c->s->highlights ? tex_cb_highlights : NULL, f.depth};
     c->frame[thread] = &f;
     rgb col = shade_tex_shade(&e, h, dir, level, weight, skip, wavelength);
     c->frame[thread] = outer;

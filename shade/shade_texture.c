@@ -202,7 +202,14 @@ static int refraction(const hit_info *hi, vec3 top, double weight, rgb *colour)
     *colour = trgb(0, 0, 0);
     if (weight < e->sc->global.adc_bailout) return 0;
     if (fabs(eta - 1.0) < TEX_EPSILON && fabs(dr - 1.0) < TEX_EPSILON) {
-        *colour = e->trace(e->ctx, e->thread, hi->p_in, hi->dir, hi->level + 1, weight, hi->skip, hi->wavelength, e->r);
+        /* a continued ray (SHADE_TEX_MAX_CONTINUED): POV-Ray still ends it
+         * at the level limit, where a raised level would end */
+        int level = hi->level + 1;
+        if (e->depth > 0 && e->depth - hi->level < SHADE_TEX_MAX_CONTINUED) {
+            if (level > e->max_level) return 0;
+            level = hi->level;
+        }
+        *colour = e->trace(e->ctx, e->thread, hi->p_in, hi->dir, level, weight, hi->skip, hi->wavelength, e->r);
         return 0;
     }
     double n = v3_dot(hi->dir, top);

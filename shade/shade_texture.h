@@ -50,7 +50,19 @@ typedef struct {
      * on the layer surface s at every layer with specular or phong (NULL =
      * none). */
     rgb (*highlights)(void *ctx, int thread, const accel_hit *h, const shade_light_surface *s);
+    /* Hits being shaded on this ray tree's stack, this one included (1 at
+     * a camera ray's first hit): depth - level is the number of straight
+     * rays (below) on the way here. 0: unknown, every ray counts a level. */
+    int depth;
 } shade_tex_env;
+
+/* A ray that goes on unbent through a surface between equal iors (an
+ * object without ior, the overlap of two objects) keeps its trace level,
+ * as POV-Ray 3.7's ComputeRefraction traces it as a continued ray
+ * (trace.cpp: TraceRay checks the level but does not raise it). At most
+ * this many such rays in a chain keep it, so that a stack of transparent
+ * surfaces cannot recurse without bound; past that each counts a level. */
+#define SHADE_TEX_MAX_CONTINUED 64
 
 /* Colour seen along unit `dir` at hit h (the ray's level and weight as in
  * POV-Ray's TraceRay; skip and wavelength as for trace). */

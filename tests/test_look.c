@@ -19,8 +19,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include "img_io.h"
+#include "shade.h"
 #include "shade_spectral.h"
 #include "test_util.h"
+#include "test_world.h"
 
 #define W 160
 #define H 120
@@ -162,6 +164,53 @@ static void test_spectral(void **st)
     assert_true(fabs(1.0 / shade_spectral_ior(405.0f, 1.0 / 1.5, 1.0 / 1.3) - 1.5 * pow(1.3, 150.0 / 350.0)) < 1e-9);
 }
 
+/* Trace levels of straight rays (closed forms along the view axis, to
+ * 1e-6): a ray that goes on unbent through a surface between equal iors
+ * keeps its level (POV-Ray 3.7's ComputeRefraction traces it as a continued
+ * ray), and still ends where its level is at the limit. Four transparent
+ * planes without ior (transmit 0.8, no light of their own) in front of a
+ * wall of ambient 0.5: 0.5 * 0.8^4 = 0.2048 with max_trace_level 2, black
+ * with 1. Two overlapping boxes of ior 1.5 (filter 1) crossed at normal
+ * incidence: entering the second inside the first and leaving the first
+ * inside the second bend nothing, so the wall is the third level: 0.5 with
+ * max_trace_level 3, black with 2. povray renders the same four cases as
+ * sRGB 125, 0, 188, 0 (0.2051, 0, 0.5029, 0); with every surface counting
+ * a level all four were black. */
+static double straight_ray(const char *objects, int max_level)
+{
+    char src[1024];
+    snprintf(src, sizeof src,
+             "#version 3.7;\n"
+             "global_settings { assumed_gamma 1.0 max_trace_level %d }\n"
+             "background { rgb 0 }\n"
+             "#default { finish { ambient 0 diffuse 0 } }\n"
+             "plane { z, 10 pigment { rgb 0.5 } finish { ambient 1 } }\n%s",
+             max_level, objects);
+    tu_world w = tu_world_build("levels.pov", src);
+    shade_settings ss;
+    shade_default_settings(&ss);
+    rng r;
+    rng_seed(&r, 1, 2);
+    rgb c = shade_trace(w.s, w.a, &ss, v3(0, 0, -5), v3(0, 0, 1), 0, &r);
+    tu_world_free(&w);
+    printf("look straight rays, max_trace_level %d: %.6f %.6f %.6f\n", max_level, c.r, c.g, c.b);
+    assert_true(fabs(c.r - c.g) < 1e-9 && fabs(c.g - c.b) < 1e-9);
+    return c.r;
+}
+
+static void test_straight_ray_levels(void **st)
+{
+    (void)st;
+    static const char panes[] = "#declare I = 0;\n"
+                                "#while (I < 4) plane { z, I pigment { rgbt <1, 1, 1, 0.8> } } #declare I = I + 1; #end\n";
+    static const char boxes[] = "box { <-5, -5, 0>, <5, 5, 2> pigment { rgbf 1 } interior { ior 1.5 } }\n"
+                                "box { <-5, -5, 1>, <5, 5, 3> pigment { rgbf 1 } interior { ior 1.5 } }\n";
+    assert_true(fabs(straight_ray(panes, 2) - 0.2048) < 1e-6);
+    assert_true(fabs(straight_ray(panes, 1)) < 1e-6);
+    assert_true(fabs(straight_ray(boxes, 3) - 0.5) < 1e-6);
+    assert_true(fabs(straight_ray(boxes, 2)) < 1e-6);
+}
+
 int main(void)
 {
     if (tu_mkdtemp(tmpdir, sizeof tmpdir, "partray-look") != 0) return 1;
@@ -184,6 +233,7 @@ int main(void)
         cmocka_unit_test(test_dispersion),
         cmocka_unit_test(test_dispersion_chain),
         cmocka_unit_test(test_spectral),
+        cmocka_unit_test(test_straight_ray_levels),
     };
     return tu_finish(cmocka_run_group_tests(tests, NULL, NULL), tmpdir);
 }
