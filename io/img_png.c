@@ -96,6 +96,70 @@ static unsigned encode_code(float v, double maxcode)
     return (unsigned)floor(e * maxcode + 0.5);
 }
 
+/* encode_code's 8-bit codes without a power per sample. encode_code is
+ * non-decreasing over the floats (the transfer function increases, each
+ * rounding keeps order, and neighbouring floats lie far more than the
+ * power's error apart), and non-negative floats order as their bit
+ * patterns do. So code c is taken from the least float whose code is c
+ * (thr[c], found by bisection over the bit patterns: 255 searches of 31
+ * steps, once per image) up to the next one's; start[] holds the code at
+ * the first float of each run of 2^15 bit patterns, from which a sample
+ * steps up over the thresholds in its run (a run is narrower than one
+ * code's floats everywhere in [0, 1], so one step at most). The codes are
+ * encode_code's, to the bit (checked over every float in [0, 1]). */
+#define SRGB8_RUN_SHIFT 15
+typedef struct {
+    uint32_t thr[257];                          /* thr[c]: bits of the least float of code c; thr[256] past all */
+    unsigned char start[1u << (32 - SRGB8_RUN_SHIFT)];
+} srgb8_table;
+
+static uint32_t float_bits(float v)
+{
+    uint32_t b;
+    memcpy(&b, &v, sizeof b);
+    return b;
+}
+
+static float bits_float(uint32_t b)
+{
+    float v;
+    memcpy(&v, &b, sizeof v);
+    return v;
+}
+
+static void srgb8_build(srgb8_table *t)
+{
+    const uint32_t one = float_bits(1.0f); /* encode_code(1) = 255 */
+    t->thr[0] = 0;
+    for (unsigned c = 1; c <= 255; c++) {
+        uint32_t lo = t->thr[c - 1], hi = one; /* every float below lo has a code below c; hi's is c or more */
+        while (lo < hi) {
+            uint32_t mid = lo + (hi - lo) / 2;
+            if (encode_code(bits_float(mid), 255.0) >= c) hi = mid;
+            else lo = mid + 1;
+        }
+        t->thr[c] = lo;
+    }
+    t->thr[256] = UINT32_MAX;
+    unsigned c = 0;
+    for (uint32_t k = 0; k < (1u << (32 - SRGB8_RUN_SHIFT)); k++) {
+        uint32_t b = k << SRGB8_RUN_SHIFT;
+        while (c < 255 && b >= t->thr[c + 1]) c++;
+        t->start[k] = (unsigned char)c;
+    }
+}
+
+/* encode_code(v, 255) from the table (non-finite and negative values as
+ * there: 0; sign bit set: 0). */
+static unsigned srgb8_code(const srgb8_table *t, float v)
+{
+    if (!isfinite(v) || v <= 0.0f) return 0;
+    uint32_t b = float_bits(v);
+    unsigned c = t->start[b >> SRGB8_RUN_SHIFT];
+    while (c < 255 && b >= t->thr[c + 1]) c++;
+    return c;
+}
+
 /* Display-encoded value -> code: clamp to [0,1], round to nearest. */
 static unsigned display_code(float v, double maxcode)
 {
@@ -135,17 +199,21 @@ static pt_status write_png(int fd, const char *name, const framebuffer *fb, cons
     const int ch = fb->alpha ? 4 : 3;
     const double maxcode = bits == 16 ? 65535.0 : 255.0;
     const size_t rowbytes = (size_t)fb->width * (size_t)ch * (size_t)(bits / 8);
-    unsigned char *row = malloc(rowbytes);
+    /* volatile: freed on the longjmp path (C11 7.13.2.1) */
+    unsigned char *volatile row = malloc(rowbytes);
+    srgb8_table *volatile t8 = !encoded && bits == 8 ? malloc(sizeof(srgb8_table)) : NULL; /* NULL: encode_code per sample */
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &ctx, on_error, on_warning);
     png_infop info = png ? png_create_info_struct(png) : NULL;
     if (!row || !png || !info) {
         if (png) png_destroy_write_struct(&png, info ? &info : NULL);
+        free(t8);
         free(row);
         diag_error(d, "cannot write '%s': out of memory", name);
         return PT_ERR_NOMEM;
     }
     if (setjmp(png_jmpbuf(png))) {
         png_destroy_write_struct(&png, &info);
+        free(t8);
         free(row);
         if (ctx.err)
             diag_error(d, "cannot write '%s': %s", name, strerror(ctx.err));
@@ -170,6 +238,8 @@ static pt_status write_png(int fd, const char *name, const framebuffer *fb, cons
         png_set_cHRM_fixed(png, info, 31270, 32900, 64000, 33000, 30000, 60000, 15000, 6000);
     }
     png_write_info(png, info);
+    srgb8_table *tab = t8;
+    if (tab) srgb8_build(tab);
     for (int y = 0; y < fb->height; y++) {
         const float *src = fb->rgb + (size_t)y * (size_t)fb->width * 3u;
         const float *asrc = fb->alpha ? fb->alpha + (size_t)y * (size_t)fb->width : NULL;
@@ -177,7 +247,9 @@ static pt_status write_png(int fd, const char *name, const framebuffer *fb, cons
         for (int x = 0; x < fb->width; x++) {
             unsigned codes[4];
             for (int k = 0; k < 3; k++)
-                codes[k] = encoded ? display_code(src[x * 3 + k], maxcode) : encode_code(src[x * 3 + k], maxcode);
+                codes[k] = encoded ? display_code(src[x * 3 + k], maxcode)
+                           : tab   ? srgb8_code(tab, src[x * 3 + k])
+                                   : encode_code(src[x * 3 + k], maxcode);
             if (asrc) codes[3] = alpha_code(asrc[x], maxcode);
             for (int k = 0; k < ch; k++) {
                 if (bits == 16) {
@@ -192,6 +264,7 @@ static pt_status write_png(int fd, const char *name, const framebuffer *fb, cons
     }
     png_write_end(png, info);
     png_destroy_write_struct(&png, &info);
+    free(t8);
     free(row);
     return PT_OK;
 }

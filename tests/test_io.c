@@ -570,6 +570,43 @@ static void test_png_codes(void **state)
     fb_free(fb);
 }
 
+/* 8-bit codes over a sweep of the floats in [0, 1.01] (every 2^13-th bit
+ * pattern, plus the exact 2^-k steps near 0): each the nearest code to
+ * the sRGB encoding, as the transfer function says (the writer takes
+ * them from a table of the codes' first floats; any float it misplaced
+ * would be a code off here). */
+static void test_png_codes_sweep(void **state)
+{
+    tmpdir *t = *state;
+    const int w = 512, h = 256;
+    framebuffer *fb = fb_new(w, h);
+    uint32_t top;
+    float one = 1.01f;
+    memcpy(&top, &one, sizeof top);
+    int n = 0;
+    for (uint32_t b = 0; b <= top && n < w * h * 3; b += 1u << 13) {
+        float v;
+        memcpy(&v, &b, sizeof v);
+        fb->rgb[n++] = v;
+    }
+    assert_true(n > 3 * 40000); /* the sweep covers (0, 1.01] */
+    for (; n < w * h * 3; n++) fb->rgb[n] = ldexpf(1.0f, -(n % 40)); /* 1 down to 2^-39 */
+    diag *d = diag_new();
+    const char *p = tpath(t, "sweep.png");
+    assert_int_equal(img_write(p, fb, NULL, d), PT_OK);
+    framebuffer *in = NULL;
+    assert_int_equal(img_read(p, 1, &in, d), PT_OK); /* raw: code / 255 */
+    for (int i = 0; i < w * h * 3; i++) {
+        double v = fb->rgb[i], e = v > 0.0 ? img_srgb_encode(v) : 0.0;
+        int want = e >= 1.0 ? 255 : (int)floor(e * 255.0 + 0.5);
+        int got = (int)lround(in->rgb[i] * 255.0);
+        if (got != want) fail_msg("linear %.9g: code %d, want %d", v, got, want);
+    }
+    fb_free(in);
+    diag_free(d);
+    fb_free(fb);
+}
+
 static void test_png_roundtrip(void **state)
 {
     tmpdir *t = *state;
@@ -900,6 +937,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_exr_read_tiled, setup_dir, teardown_dir),
         cmocka_unit_test_setup_teardown(test_exr_truncated, setup_dir, teardown_dir),
         cmocka_unit_test_setup_teardown(test_png_codes, setup_dir, teardown_dir),
+        cmocka_unit_test_setup_teardown(test_png_codes_sweep, setup_dir, teardown_dir),
         cmocka_unit_test_setup_teardown(test_png_roundtrip, setup_dir, teardown_dir),
         cmocka_unit_test_setup_teardown(test_png_read_other_layouts, setup_dir, teardown_dir),
         cmocka_unit_test_setup_teardown(test_png_truncated, setup_dir, teardown_dir),
