@@ -301,7 +301,14 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
             continue;
         }
         rgb tmp = {0, 0, 0};
-        if (e->indirect && f->diffuse > 0.0) tmp = tadd(tmp, tscale(tmul(pig, e->indirect(e->ctx, e->thread, hi->h, ln)), f->diffuse * att));
+        /* no gather where its light is multiplied by 0 (a clear glass's
+         * opacity, a black pigment): POV-Ray gathers only where the most it
+         * can add, (filter x pigment) grey x opacity x diffuse, passes
+         * adc_bailout (trace.cpp ComputeLightedTexture); this takes only the
+         * exact zeros, so no image changes. A gather point inside a glass
+         * wall otherwise sends rays that reflect inside it up to
+         * max_trace_level (total internal reflection keeps their weight). */
+        if (e->indirect && f->diffuse > 0.0 && att != 0.0 && (pig.r != 0.0 || pig.g != 0.0 || pig.b != 0.0)) tmp = tadd(tmp, tscale(tmul(pig, e->indirect(e->ctx, e->thread, hi->h, ln)), f->diffuse * att));
         if (e->use_ambient) tmp = tadd(tmp, tscale(tmul(pig, tmul(f->ambient, sc->global.ambient_light)), att));
         tmp = tadd(tmp, tscale(tmul(pig, f->emission), att));
         if (f->diffuse != 0.0 || f->diffuse_back != 0.0 || f->specular != 0.0 || f->phong != 0.0) {
