@@ -45,6 +45,7 @@
 #include <math.h>
 #include <string.h>
 #include "mirror.h"
+#include "transmit.h"
 #include "shade_noise.h"
 #include "shade_normal.h"
 #include "shade_pattern.h"
@@ -53,7 +54,7 @@
 #define TEX_EPSILON 1.0e-10
 #define MAX_PARENTS 32
 #define MAX_LAYERS 64
-#define GREY(c) (0.297 * (c).r + 0.589 * (c).g + 0.114 * (c).b)
+#define GREY(c) transmit_grey(c)
 
 static inline rgb trgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
 static inline rgb tadd(rgb a, rgb b) { return trgb(a.r + b.r, a.g + b.g, a.b + b.b); }
@@ -180,13 +181,11 @@ static int refract_one(const hit_info *hi, vec3 top, double eta, double n, vec3 
                        rgb *colour)
 {
     const shade_tex_env *e = hi->e;
-    double t = 1.0 + eta * eta * (n * n - 1.0);
-    if (t < 0.0) {
+    vec3 td;
+    if (transmit_refract(hi->dir, local, n, eta, &td)) {
         *colour = trace_reflection(hi, top, weight, NULL);
         return 1;
     }
-    t = eta * n - sqrt(t);
-    vec3 td = v3_norm(v3_add(v3_scale(hi->dir, eta), v3_scale(local, t)));
     *colour = e->trace(e->ctx, e->thread, hi->p_in, td, hi->level + 1, weight, hi->skip, wavelength, e->r);
     return 0;
 }
@@ -233,22 +232,6 @@ static int refraction(const hit_info *hi, vec3 top, double weight, rgb *colour)
     }
     *colour = tscale(sum, 1.0 / nb);
     return 0;
-}
-
-/* Interior fade of a ray segment of length d inside the object (POV-Ray
- * tests fade_distance only for lit surfaces, fade_power > 0 as well for
- * shadows: `shadow`). */
-static rgb fade(const scene_interior *in, double d, int shadow)
-{
-    rgb one = {1, 1, 1};
-    if (!in || fabs(in->fade_distance) <= TEX_EPSILON || (shadow && in->fade_power <= 0.0)) return one;
-    rgb fc = in->fade_colour;
-    if (in->fade_power >= 1000) {
-        double k = d / in->fade_distance;
-        return trgb(exp(-(1.0 - fc.r) * k), exp(-(1.0 - fc.g) * k), exp(-(1.0 - fc.b) * k));
-    }
-    double a = 1.0 + pow(d / in->fade_distance, in->fade_power);
-    return trgb(fc.r + (1.0 - fc.r) / a, fc.g + (1.0 - fc.g) / a, fc.b + (1.0 - fc.b) / a);
 }
 
 typedef struct {
@@ -320,9 +303,7 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
         result = tadd(result, tmul(tmp, filcol));
 
         if (found) {
-            filcol = tmul(filcol, trgb(lc.r * lc.f + lc.t, lc.g * lc.f + lc.t, lc.b * lc.f + lc.t));
-            if (f->conserve_energy)
-                filcol = tmul(filcol, trgb(fmin_inline(1.0, 1.0 - L->reflec.r), fmin_inline(1.0, 1.0 - L->reflec.g), fmin_inline(1.0, 1.0 - L->reflec.b)));
+            filcol = transmit_layer_filter(filcol, &lc, f, L->reflec);
         }
         trans = fmin_inline(1.0, fabs(GREY(filcol)));
     }
@@ -333,7 +314,7 @@ static rgb lighted(const hit_info *hi, const scene_texture *tex, vec3 point, con
         rgb rfr;
         tir = refraction(hi, top, weight * w1, &rfr);
         rgb att = {1, 1, 1};
-        if (hi->inside_interior) att = fade(hi->interior, hi->h->t, 0);
+        if (hi->inside_interior) att = transmit_fade(hi->interior, hi->h->t, 0);
         if (tir || !one_colour_found) result = tadd(result, tmul(att, rfr));
         else result = tadd(result, tmul(tmul(att, rfr), filcol));
     }
@@ -651,55 +632,16 @@ rgb shade_tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir)
 rgb shade_tex_leaving_fade(const accel_hit *h, vec3 dir)
 {
     if (v3_dot(dir, h->ng) < 0.0) return trgb(1, 1, 1);
-    return fade(h->obj ? h->obj->interior : NULL, h->t, 1);
+    return transmit_fade(h->obj ? h->obj->interior : NULL, h->t, 1);
 }
 
 /* ------------------------------------------------------------ shadows */
 
-static int pigment_transparent(const scene_pigment *pg, int depth);
-static int tex_transparent(const scene_texture *t);
-
-static int map_transparent(const scene_blend_map *m, int depth)
-{
-    if (!m || depth > MAX_PARENTS) return 0;
-    for (int i = 0; i < m->n; i++) {
-        const scene_map_entry *e = &m->e[i];
-        if (m->kind == MAP_COLOUR && (e->c[3] != 0.0 || e->c[4] != 0.0)) return 1;
-        if (m->kind == MAP_PIGMENT && e->pigment && pigment_transparent(e->pigment, depth + 1)) return 1;
-        if (m->kind == MAP_TEXTURE && e->texture && tex_transparent(e->texture)) return 1;
-    }
-    return 0;
-}
-
-static int pigment_transparent(const scene_pigment *pg, int depth)
-{
-    if (pg->colour.f != 0.0 || pg->colour.t != 0.0) return 1;
-    if (pg->kind != PIGMENT_PATTERN || !pg->pat) return 0;
-    const scene_pattern *pat = pg->pat;
-    if (pat->kind == PAT_IMAGE && !pg->map) {
-        const scene_image_map *im = &pat->image;
-        return im->once || im->filter_all_set || im->transmit_all_set || !im->image || im->image->has_alpha;
-    }
-    return map_transparent(pg->map, depth);
-}
-
-static int tex_transparent(const scene_texture *t)
-{
-    for (; t; t = t->next) {
-        if (t->pat && t->map) {
-            if (map_transparent(t->map, 0)) return 1;
-        } else if (pigment_transparent(&t->pigment, 0)) {
-            return 1;
-        }
-    }
-    return 0;
-}
-
 static int object_transparent(const scene_object *o, int depth)
 {
     if (depth > 64) return 1;
-    if (o->texture && tex_transparent(o->texture)) return 1;
-    if (o->interior_texture && tex_transparent(o->interior_texture)) return 1;
+    if (o->texture && transmit_texture_may(o->texture)) return 1;
+    if (o->interior_texture && transmit_texture_may(o->interior_texture)) return 1;
     switch (o->kind) {
     case SHAPE_UNION: case SHAPE_MERGE: case SHAPE_INTERSECTION: case SHAPE_DIFFERENCE:
         for (int i = 0; i < o->u.csg.nkids; i++)
@@ -708,7 +650,7 @@ static int object_transparent(const scene_object *o, int depth)
     case SHAPE_MESH:
         if (o->u.mesh.mesh && o->u.mesh.textures)
             for (int i = 0; i < o->u.mesh.mesh->ntextures; i++)
-                if (o->u.mesh.textures[i] && tex_transparent(o->u.mesh.textures[i])) return 1;
+                if (o->u.mesh.textures[i] && transmit_texture_may(o->u.mesh.textures[i])) return 1;
         return 0;
     default:
         return 0;
@@ -717,7 +659,7 @@ static int object_transparent(const scene_object *o, int depth)
 
 int shade_tex_scene_transparent(const scene *sc)
 {
-    if (tex_transparent(&sc->default_texture)) return 1;
+    if (transmit_texture_may(&sc->default_texture)) return 1;
     for (int i = 0; i < sc->nobjects; i++)
         if (object_transparent(sc->objects[i], 0)) return 1;
     return 0;
