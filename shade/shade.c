@@ -806,13 +806,57 @@ static int cmp_block_cost(const void *x, const void *y)
     return (a->block > b->block) - (a->block < b->block);
 }
 
+/* The cost count of one row of blocks (aa_block_order): jobs write the
+ * costs of their own row of blocks only. */
+typedef struct {
+    const render_ctx *c;
+    block_cost *bc;
+    int bw;
+    volatile int failed; /* a job's scratch could not be allocated */
+} order_job;
+
+static void aa_order_band(void *ctx, int br, int thread)
+{
+    (void)thread;
+    order_job *j = ctx;
+    const render_ctx *c = j->c;
+    int w = c->s->width;
+    /* the encoded first samples of the row and of the row above, from the
+     * column left of the window on */
+    int x0 = c->first_win[0] > 0 ? c->first_win[0] - 1 : 0, x1 = c->first_win[2];
+    int y0 = br * AA_BLOCK > c->first_win[1] ? br * AA_BLOCK : c->first_win[1];
+    int y1 = (br + 1) * AA_BLOCK < c->first_win[3] ? (br + 1) * AA_BLOCK : c->first_win[3];
+    if (y0 >= y1) return;
+    rgb *rows = malloc(sizeof *rows * (size_t)w * 2), *row = rows, *up = rows ? rows + w : NULL;
+    if (!rows) {
+        j->failed = 1;
+        return;
+    }
+    if (y0 > 0)
+        for (int x = x0; x < x1; x++) up[x] = aa_encode(c->sc, c->first + 3 * ((size_t)(y0 - 1) * w + x));
+    for (int y = y0; y < y1; y++) {
+        for (int x = x0; x < x1; x++) row[x] = aa_encode(c->sc, c->first + 3 * ((size_t)y * w + x));
+        for (int x = c->first_win[0]; x < x1; x++) {
+            int differ = (x > 0 && aa_differ(c, row[x - 1], row[x])) || (y > 0 && aa_differ(c, up[x], row[x]));
+            if (differ) j->bc[y / AA_BLOCK * j->bw + x / AA_BLOCK].cost++;
+        }
+        rgb *t = up;
+        up = row;
+        row = t;
+    }
+    free(rows);
+}
+
 /* The blocks in the order the threads take them: by the number of pixels
  * whose first sample differs from a neighbour's (about the rays the block
  * will trace), most first, so that no costly block is left to one thread
- * at the end. The order changes no pixel: blocks are independent. */
-static int *aa_block_order(const render_ctx *c, int bw, int bh)
+ * at the end. The order changes no pixel: blocks are independent. The
+ * count runs on the render's threads, a row of blocks per job (each
+ * encodes the row above its own first: the encodings are three powers a
+ * pixel, which one thread took a while over at the end of the first pass). */
+static int *aa_block_order(const render_ctx *c, int threads, int bw, int bh)
 {
-    int nb = bw * bh, w = c->s->width;
+    int nb = bw * bh;
     block_cost *bc = malloc(sizeof *bc * (size_t)nb);
     int *order = malloc(sizeof *order * (size_t)nb);
     if (!bc || !order) {
@@ -821,28 +865,13 @@ static int *aa_block_order(const render_ctx *c, int bw, int bh)
         return NULL;
     }
     for (int b = 0; b < nb; b++) bc[b] = (block_cost){0, b};
-    /* the encoded first samples of the row and of the row above, from the
-     * column left of the window on */
-    int x0 = c->first_win[0] > 0 ? c->first_win[0] - 1 : 0, x1 = c->first_win[2], y0 = c->first_win[1];
-    rgb *rows = malloc(sizeof *rows * (size_t)w * 2), *row = rows, *up = rows ? rows + w : NULL;
-    if (!rows) {
+    order_job j = {c, bc, bw, 0};
+    pool_run(threads, bh, aa_order_band, &j);
+    if (j.failed) {
         free(bc);
         free(order);
         return NULL;
     }
-    if (y0 > 0)
-        for (int x = x0; x < x1; x++) up[x] = aa_encode(c->sc, c->first + 3 * ((size_t)(y0 - 1) * w + x));
-    for (int y = y0; y < c->first_win[3]; y++) {
-        for (int x = x0; x < x1; x++) row[x] = aa_encode(c->sc, c->first + 3 * ((size_t)y * w + x));
-        for (int x = c->first_win[0]; x < x1; x++) {
-            int differ = (x > 0 && aa_differ(c, row[x - 1], row[x])) || (y > 0 && aa_differ(c, up[x], row[x]));
-            if (differ) bc[y / AA_BLOCK * bw + x / AA_BLOCK].cost++;
-        }
-        rgb *t = up;
-        up = row;
-        row = t;
-    }
-    free(rows);
     qsort(bc, (size_t)nb, sizeof *bc, cmp_block_cost);
     for (int b = 0; b < nb; b++) order[b] = bc[b].block;
     free(bc);
@@ -915,7 +944,7 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
         /* the pixels of the blocks the window meets (block_supersample) */
         int ax0 = c.win[0] / AA_BLOCK * AA_BLOCK, ay0 = c.win[1] / AA_BLOCK * AA_BLOCK;
         progress_stage(s->progress, "antialias", (long long)(c.first_win[2] - ax0) * (long long)(c.first_win[3] - ay0));
-        c.block_order = aa_block_order(&c, bw, bh);
+        c.block_order = aa_block_order(&c, threads, bw, bh);
         if (!c.block_order) { free(c.first); shade_projection_free(c.proj); shade_focal_release(&c.focal); free(ts); return PT_ERR_NOMEM; }
         pool_run(threads, bw * bh, block_supersample, &c);
         free(c.block_order);
