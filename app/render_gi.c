@@ -331,7 +331,7 @@ static void on_image(void *ctx, const framebuffer *fb, int done, int total)
     framebuffer *out = fb_new(fb->width, fb->height);
     if (!out) return;
     memcpy(out->rgb, fb->rgb, (size_t)fb->width * (size_t)fb->height * 3 * sizeof *out->rgb);
-    shade_gamma_fb_to_linear(p->sc, out);
+    shade_gamma_fb_to_linear(p->sc, out, 0);
     out->alpha = fb->alpha; /* borrowed for the write */
     diag *d = diag_new();
     img_write_opts wo;
@@ -397,7 +397,7 @@ static pt_status render_reference(const scene *sc, const accel *a, const render_
     /* The references shade in the scene's working space as the Whitted
      * renderer does (POV-Ray's assumed_gamma: the scene's colours and the
      * arithmetic on them), so their image leaves it the same way. */
-    if (st == PT_OK) shade_gamma_fb_to_linear(sc, fb);
+    if (st == PT_OK) shade_gamma_fb_to_linear(sc, fb, o->threads);
     double total = timer_now() - t0;
     r->t_gi_lighting = r->pm.t_lights + r->pm.t_photons + r->pm.t_maps + r->pm.t_irradiance;
     r->t_render = r->pm.t_render > 0 ? r->pm.t_render : total - r->t_gi_lighting;

@@ -958,7 +958,7 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
                     float *px = fb_px(fb, x, y);
                     px[0] = px[1] = px[2] = 0.0f;
                 }
-    shade_gamma_fb_to_linear(sc, fb); /* assumed_gamma: working space -> linear (shade_gamma.c) */
+    shade_gamma_fb_to_linear(sc, fb, threads); /* assumed_gamma: working space -> linear (shade_gamma.c) */
     long fixed = fb_sanitize(fb);
     assert(fb_all_finite(fb)); /* no NaN or Inf reaches a framebuffer */
     if (st) {

@@ -4,6 +4,7 @@
  * with gamma handling off (values written as computed). */
 #include "shade_gamma.h"
 #include <math.h>
+#include "pool.h"
 
 /* assumed_gamma when given; 1 for #version 3.7 scenes without it; 0 for
  * older scenes without it (POV-Ray then turns gamma handling off: computed
@@ -29,14 +30,29 @@ double shade_gamma_aa_value(const scene *sc, double v)
     return pow(v, (g > 0.0 ? g : 1.0) / 2.5);
 }
 
-void shade_gamma_fb_to_linear(const scene *sc, framebuffer *fb)
+typedef struct {
+    framebuffer *fb;
+    double g;
+} to_linear_job;
+
+static void to_linear_row(void *ctx, int y, int thread)
+{
+    (void)thread;
+    const to_linear_job *j = ctx;
+    float *row = j->fb->rgb + (size_t)y * (size_t)j->fb->width * 3;
+    for (size_t i = 0; i < (size_t)j->fb->width * 3; i++) {
+        float v = row[i];
+        if (!isfinite(v)) continue;
+        row[i] = j->g == 0.0 ? srgb_decode(v) : (v > 0.0f ? (float)pow(v, j->g) : v);
+    }
+}
+
+/* A power per channel, a row per job: on one thread it was a serial tail
+ * of every render with a working gamma other than 1. */
+void shade_gamma_fb_to_linear(const scene *sc, framebuffer *fb, int threads)
 {
     double g = gamma_working(sc);
     if (g == 1.0) return;
-    size_t n = (size_t)fb->width * fb->height * 3;
-    for (size_t i = 0; i < n; i++) {
-        float v = fb->rgb[i];
-        if (!isfinite(v)) continue;
-        fb->rgb[i] = g == 0.0 ? srgb_decode(v) : (v > 0.0f ? (float)pow(v, g) : v);
-    }
+    to_linear_job j = {fb, g};
+    pool_run(threads > 0 ? threads : pool_default_threads(), fb->height, to_linear_row, &j);
 }

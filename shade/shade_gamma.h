@@ -8,9 +8,9 @@
 
 /* Convert a rendered framebuffer from the working space to linear values
  * (v^gamma; for gamma handling off, the sRGB decoding, so that the usual
- * sRGB encoding of a PNG writes the computed values unchanged). No-op for
- * gamma 1. */
-void shade_gamma_fb_to_linear(const scene *sc, framebuffer *fb);
+ * sRGB encoding of a PNG writes the computed values unchanged), on
+ * `threads` threads (0 or less: pool_default_threads). No-op for gamma 1. */
+void shade_gamma_fb_to_linear(const scene *sc, framebuffer *fb, int threads);
 
 /* A working-space channel value as POV-Ray 3.7's adaptive antialiasing
  * compares it (tracetask.cpp with view.cpp's Antialias_Gamma default 2.5):
