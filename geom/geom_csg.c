@@ -705,8 +705,10 @@ __attribute__((always_inline)) static inline int member_stretch(const geom_csg *
 }
 
 /* Member s's nearest kept crossing in (from, min(*best, upto)), its stretch
- * from member_stretch: into *h, *best lowered, 1 returned. */
-static int search_member(const geom_csg *c, int s, const csg_ray *R, double from, double upto, double *bestp,
+ * from member_stretch: into *h, *best lowered, 1 returned. Not inlined: the
+ * loops over the members call it only for those member_stretch lets
+ * through, and inline it would make every member's test pay its set-up. */
+__attribute__((noinline)) static int search_member(const geom_csg *c, int s, const csg_ray *R, double from, double upto, double *bestp,
                          geom_csg_hit *h)
 {
     int found = 0;
@@ -739,7 +741,7 @@ static int search_member(const geom_csg *c, int s, const csg_ray *R, double from
 
 /* Member s's nearest kept crossing in (tmin, *best): into *h, *best
  * lowered, 1 returned. */
-static inline int try_member(const geom_csg *c, int s, const csg_ray *R, double *bestp, geom_csg_hit *h)
+__attribute__((always_inline)) static inline int try_member(const geom_csg *c, int s, const csg_ray *R, double *bestp, geom_csg_hit *h)
 {
     double from, upto;
     if (!member_stretch(c, s, R, *bestp, &from, &upto)) return 0;
