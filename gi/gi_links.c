@@ -10,6 +10,7 @@
 #include "pool.h"
 #include "radrules.h"
 #include "rng.h"
+#include "transmit.h"
 
 /* particles per job: about 256 rays per rtcIntersect1M call */
 #define RAYS_PER_CALL 256
@@ -71,9 +72,10 @@ static void hit_point(const struct RTCRayHit *h, vec3 *pt, vec3 *nrm)
 
 /* The material of object o at p (hit_point's, normal n): rho and le at
  * the pigment there (a sky dome's gradient, a terrain's colours; the
- * texture's base colour without a pigment function). */
+ * texture's base colour without a pigment function), and that pigment
+ * with its filter and transmit. */
 static void hit_material(const link_job *J, const scene_object *o, const scene_texture *tex, vec3 p, vec3 n,
-                         float rho[3], float le[3], rgb *pigment)
+                         float rho[3], float le[3], colour5 *pigment)
 {
     colour5 c, *cp = NULL;
     if (J->pig) {
@@ -91,10 +93,7 @@ static void hit_material(const link_job *J, const scene_object *o, const scene_t
             cp = &c;
     }
     gi_particles_material(J->sc, tex, cp, rho, le);
-    if (pigment) {
-        const colour5 *u = cp ? cp : &tex->pigment.colour;
-        *pigment = (rgb){u->r, u->g, u->b};
-    }
+    if (pigment) *pigment = cp ? *cp : tex->pigment.colour;
 }
 
 /* The leaf a link ray hit and its effective texture (never NULL when the
@@ -130,6 +129,7 @@ typedef struct {
      * (diffuse is not 0); where neither, no pigment gives light */
     int glows, reflects;
     int mirrors; /* its finish reflects as a mirror (mirror_reflects) */
+    int clear;   /* its pigment can let light through (transmit_texture_may) */
 } emit_memo_entry;
 
 /* The last few textures asked (a gather's rays alternate between a few
@@ -154,11 +154,12 @@ static const emit_memo_entry *memo_of(const link_job *J, emit_memo *memo, const 
     m->glows = le[0] != 0.0f || le[1] != 0.0f || le[2] != 0.0f;
     m->reflects = rho[0] != 0.0f || rho[1] != 0.0f || rho[2] != 0.0f;
     m->mirrors = mirror_reflects(&tex->finish);
+    m->clear = transmit_texture_may(tex);
     return m;
 }
 
-static void hit_mirror(const link_job *J, const struct RTCRayHit *h, const scene_object *o, const scene_texture *tex,
-                       vec3 p, vec3 n, rgb pigment, int level, double weight, emit_memo *memo, float out[3]);
+static void hit_specular(const link_job *J, const struct RTCRayHit *h, const scene_object *o, const scene_texture *tex,
+                         vec3 p, vec3 n, const colour5 *pigment, int level, double weight, emit_memo *memo, float out[3]);
 
 static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, int direct, emit_memo *memo, float out[3],
                          int level, double weight)
@@ -170,8 +171,9 @@ static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, 
     float rho[3], le[3];
     const emit_memo_entry *mt = memo_of(J, memo, tex);
     const int sky_term = far && J->far_bounce > 0.0f, lit = direct && J->nlights > 0;
-    /* a mirror's reflection (hit_mirror), where followed */
-    const int mir = J->mirror && mt->mirrors;
+    /* a mirror's reflection and a clear surface's transmission
+     * (hit_specular), where followed */
+    const int mir = J->mirror && (mt->mirrors || mt->clear);
     /* with no far-field sky, no lights and no mirror to reflect, only the
      * emission counts: none where the finish emits nothing */
     if (!sky_term && !lit && !mt->emits && !mir) return;
@@ -210,7 +212,7 @@ static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, 
         }
     }
     if (!sky_term && !mt->glows && !mir && dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) return;
-    rgb pigment;
+    colour5 pigment;
     hit_material(J, o, tex, p, n, rho, le, &pigment);
     /* no direct light where this pigment reflects nothing */
     if (!(rho[0] > 0.0f || rho[1] > 0.0f || rho[2] > 0.0f)) dir[0] = dir[1] = dir[2] = 0.0f;
@@ -220,7 +222,7 @@ static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, 
         float v = le[c] + rho[c] * (J->far_bounce * irr[c] + dir[c]);
         if (isfinite(v) && v > 0.0f) out[c] += v;
     }
-    if (mir) hit_mirror(J, h, o, tex, p, n, pigment, level, weight, memo, out);
+    if (mir) hit_specular(J, h, o, tex, p, n, &pigment, level, weight, memo, out);
 }
 
 static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int direct, emit_memo *memo, float out[3])
@@ -228,28 +230,62 @@ static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int
     hit_light_at(J, h, far, direct, memo, out, J->mlevel, J->mweight);
 }
 
-/* The mirror reflection at the hit of ray h (at trace level `level`, of
- * weight `weight`) on object o with texture tex, at p with the normal n
- * turned to the ray and the pigment there, added to out. POV-Ray traces
- * its radiosity rays in full (radiosity.cpp GatherLight calls TraceRay),
- * so one that meets a mirror (balcony.pov's sea: no diffuse, a fresnel
- * reflection up to 0.95) brings back what the mirror reflects; the
- * reflected ray is traced here and takes what a gather ray takes where it
- * hits (hit_light_at: emission, direct light, the far field's sky, and a
- * mirror there in turn) or the sky where it leaves. The reflectivity is
- * POV-Ray's (mirror.h: fresnel at the interior's ior, falloff, metallic;
- * reflection_exponent applied to what comes back), of the texture's top
- * finish as the rest of the GI takes it, about the geometric normal: a
- * normal pattern's ripples are not followed, nor a mirror in an instance
- * (its hit carries no normal here). The reflected ray goes one
- * trace level up and is not traced at or past the level limit nor below
- * the radiosity block's adc_bailout (trace.cpp ComputeReflection;
- * radrules.h rule 7). Transmission through the mirror is not followed. */
-static void hit_mirror(const link_job *J, const struct RTCRayHit *h, const scene_object *o, const scene_texture *tex,
-                       vec3 p, vec3 n, rgb pigment, int level, double weight, emit_memo *memo, float out[3])
+/* Trace one continuation of a gather ray (a mirror's reflection, a
+ * transmission) from org along unit d at trace level `level` with weight
+ * w, and add scale times what it brings back to out: what a gather ray
+ * takes where it hits (hit_light_at: emission, direct light, the far
+ * field's sky, and its own continuations) or the sky where it leaves; ex
+ * (reflection_exponent's reciprocal) raises that to a power first. */
+static void continue_ray(const link_job *J, vec3 org, vec3 d, int level, double w, emit_memo *memo, rgb scale,
+                         double ex, float out[3])
+{
+    const float of[3] = {(float)org.x, (float)org.y, (float)org.z}, df[3] = {(float)d.x, (float)d.y, (float)d.z};
+    struct RTCRayHit rh;
+    accel_rtc_rayhit_init(&rh, of, (float)accel_epsilon(J->a, org, d), df);
+    struct RTCIntersectContext c;
+    rtcInitIntersectContext(&c);
+    rtcIntersect1(J->scene, &c, &rh);
+    float sub[3] = {0.0f, 0.0f, 0.0f};
+    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID && isfinite(rh.ray.tfar))
+        hit_light_at(J, &rh, 1, 1, memo, sub, level, w);
+    else
+        gi_sky_radiance(J->sky, df, sub);
+    const double sc[3] = {scale.r, scale.g, scale.b};
+    for (int k = 0; k < 3; k++) {
+        double v = ex != 1.0 ? pow(fmax(sub[k], 0.0), ex) : sub[k];
+        v *= sc[k];
+        if (isfinite(v) && v > 0.0) out[k] += (float)v;
+    }
+}
+
+/* The mirror reflection and the transmission at the hit of ray h (at
+ * trace level `level`, of weight `weight`) on object o with texture tex,
+ * at p with the normal n turned to the ray and the pigment there, added to
+ * out. POV-Ray traces its radiosity rays in full (radiosity.cpp
+ * GatherLight calls TraceRay), so one that meets a mirror (balcony.pov's
+ * sea: no diffuse, a fresnel reflection up to 0.95) brings back what the
+ * mirror reflects, and one that meets glass what lies behind it. Both
+ * follow the Whitted pass's rules (trace.cpp ComputeLightedTexture): the
+ * reflectivity of mirror.h (fresnel at the interior's ior, falloff,
+ * metallic; reflection_exponent on what comes back), and transmit.h's
+ * filter (filter and transmit, less the reflectivity under
+ * conserve_energy), refraction at the interior's ior (total internal
+ * reflection: the reflected ray alone, unfiltered, in place of the
+ * mirror's) and fade over the way inside for a ray that leaves the
+ * interior. They are taken for the texture's top finish and its composite
+ * pigment, as the rest of the GI takes them, about the geometric normal
+ * (a normal pattern's ripples are not followed, nor dispersion, nor a
+ * mirror or glass in an instance, whose hit carries no normal here), and
+ * from the geometric side alone (no list of the interiors the ray is
+ * in: overlapping glass takes each object's own ior against air). Each
+ * continuation goes one trace level up and is not traced at or past the
+ * level limit nor below the radiosity block's adc_bailout (trace.cpp
+ * TraceRay, ComputeRefraction; radrules.h rule 7). */
+static void hit_specular(const link_job *J, const struct RTCRayHit *h, const scene_object *o, const scene_texture *tex,
+                         vec3 p, vec3 n, const colour5 *pigment, int level, double weight, emit_memo *memo, float out[3])
 {
     /* in an instance the hit's normal is not known here (hit_point takes
-     * minus the ray's direction): no mirror direction to follow */
+     * minus the ray's direction): no direction to follow */
     if (level + 1 >= J->mlimit || h->hit.instID[0] != RTC_INVALID_GEOMETRY_ID) return;
     const scene_finish *f = &tex->finish;
     vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
@@ -258,38 +294,36 @@ static void hit_mirror(const link_job *J, const struct RTCRayHit *h, const scene
     d = v3_scale(d, 1.0 / dl);
     double cos_i = -v3_dot(d, n);
     if (!(cos_i > 0.0)) return;
-    /* the relative ior of a ray entering the object (it meets the outer
-     * side of the raw geometric normal), else leaving it */
-    double rel_ior = 1.0;
-    if (o->interior && o->interior->ior > 0.0) {
-        int entering = h->hit.Ng_x * d.x + h->hit.Ng_y * d.y + h->hit.Ng_z * d.z <= 0.0;
-        rel_ior = entering ? o->interior->ior : 1.0 / o->interior->ior;
-    }
+    /* a ray entering the object meets the outer side of the raw geometric
+     * normal; the relative ior is outside over inside for it */
+    const int entering = h->hit.Ng_x * d.x + h->hit.Ng_y * d.y + h->hit.Ng_z * d.z <= 0.0;
+    const double ior = o->interior && o->interior->ior > 0.0 ? o->interior->ior : 1.0;
+    const double rel_ior = entering ? ior : 1.0 / ior;
     double w = weight;
-    rgb refl = mirror_reflectivity(f, cos_i, rel_ior, &w);
-    mirror_metallic_tint(&refl, f->reflection_metallic, pigment, cos_i);
-    if (w < J->madc || !(refl.r > 0.0 || refl.g > 0.0 || refl.b > 0.0)) return;
-    vec3 rd = v3_madd(d, n, 2.0 * cos_i);
-    double off = J->off * (J->scale + fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
-    vec3 org = v3_madd(p, n, off);
-    const float of[3] = {(float)org.x, (float)org.y, (float)org.z}, df[3] = {(float)rd.x, (float)rd.y, (float)rd.z};
-    struct RTCRayHit rh;
-    accel_rtc_rayhit_init(&rh, of, (float)accel_epsilon(J->a, org, rd), df);
-    struct RTCIntersectContext c;
-    rtcInitIntersectContext(&c);
-    rtcIntersect1(J->scene, &c, &rh);
-    float sub[3] = {0.0f, 0.0f, 0.0f};
-    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID && isfinite(rh.ray.tfar))
-        hit_light_at(J, &rh, 1, 1, memo, sub, level + 1, w);
-    else
-        gi_sky_radiance(J->sky, df, sub);
-    double ex = f->reflection_exponent != 0.0 ? 1.0 / f->reflection_exponent : 1.0;
-    const double rc[3] = {refl.r, refl.g, refl.b};
-    for (int k = 0; k < 3; k++) {
-        double v = ex != 1.0 ? pow(fmax(sub[k], 0.0), ex) : sub[k];
-        v *= rc[k];
-        if (isfinite(v) && v > 0.0) out[k] += (float)v;
+    rgb refl = {0.0, 0.0, 0.0};
+    if (memo_of(J, memo, tex)->mirrors) {
+        refl = mirror_reflectivity(f, cos_i, rel_ior, &w);
+        mirror_metallic_tint(&refl, f->reflection_metallic, (rgb){pigment->r, pigment->g, pigment->b}, cos_i);
     }
+    double off = J->off * (J->scale + fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
+    const double ex = f->reflection_exponent != 0.0 ? 1.0 / f->reflection_exponent : 1.0;
+    int tir = 0;
+    const rgb filcol = transmit_layer_filter((rgb){1.0, 1.0, 1.0}, pigment, f, refl);
+    const double trans = fmin(1.0, fabs(transmit_grey(filcol)));
+    const double tw = weight * fmax(fabs(filcol.r), fmax(fabs(filcol.g), fabs(filcol.b)));
+    if (trans > J->madc && tw >= J->madc) {
+        /* the fade over the way this ray came inside the object it leaves */
+        const rgb att = entering ? (rgb){1.0, 1.0, 1.0} : transmit_fade(o->interior, h->ray.tfar * dl, 0);
+        vec3 td = d;
+        if (fabs(1.0 / rel_ior - 1.0) >= 1e-10) tir = transmit_refract(d, n, cos_i, 1.0 / rel_ior, &td);
+        if (tir)
+            continue_ray(J, v3_madd(p, n, off), v3_madd(d, n, 2.0 * cos_i), level + 1, tw, memo, att, 1.0, out);
+        else
+            continue_ray(J, v3_madd(p, n, -off), td, level + 1, tw, memo,
+                         (rgb){att.r * filcol.r, att.g * filcol.g, att.b * filcol.b}, 1.0, out);
+    }
+    if (tir || w < J->madc || !(refl.r > 0.0 || refl.g > 0.0 || refl.b > 0.0)) return;
+    continue_ray(J, v3_madd(p, n, off), v3_madd(d, n, 2.0 * cos_i), level + 1, w, memo, refl, ex, out);
 }
 
 /* sin and cos of a = (pi/4) t for t in [-1, 1] (the concentric map's

@@ -170,6 +170,12 @@ static void test_gi_antialias_reuse(void **st)
  * mirror rays partray's floor is a fifth darker and the mean difference
  * is five times the tolerance. */
 static void test_gi_mirror(void **st) { (void)st; scene_test("xc_gi_mirror"); }
+/* Particle GI against POV-Ray's radiosity where a gathering ray meets
+ * glass: a white floor under a clear slab (transmit 0.7, ior 1.5, a fade)
+ * under a uniform sky, the camera between them. POV-Ray traces its
+ * radiosity rays through the slab; without the final gather's transmitted
+ * rays partray's floor is black. */
+static void test_gi_glass(void **st) { (void)st; scene_test("xc_gi_glass"); }
 
 int main(void)
 {
@@ -186,6 +192,7 @@ int main(void)
         cmocka_unit_test(test_merge_coincident_walls),
         cmocka_unit_test(test_gi_antialias_reuse),
         cmocka_unit_test(test_gi_mirror),
+        cmocka_unit_test(test_gi_glass),
     };
     return tu_finish(cmocka_run_group_tests(tests, NULL, NULL), tmpdir);
 }

@@ -36,6 +36,7 @@ void test_sky_furnace(void **state);
 void test_sky_final_gather(void **state);
 void test_csg_emitter_gather(void **state);
 void test_mirror_gather(void **state);
+void test_transmit_gather(void **state);
 void test_sky_second_bounce(void **state);
 
 #endif
