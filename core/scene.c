@@ -38,9 +38,11 @@ void scene_default_camera(scene_camera *c)
 void scene_default_light(scene_light *l)
 {
     /* spotlight defaults: radius 30, falloff 45, tightness 0 (3.7 docs);
-     * adaptive -1: not given. */
+     * adaptive 100, POV-Ray 3.7's Adaptive_Level without the keyword
+     * (lighting/point.cpp, the LightSource constructor): every point of an
+     * area grid is sampled. */
     *l = (scene_light){.kind = LIGHT_POINT, .colour = {1, 1, 1}, .point_at = {0, 0, 1}, .radius = 30.0,
-                       .falloff = 45.0, .adaptive = -1, .media_interaction = 1};
+                       .falloff = 45.0, .adaptive = 100, .media_interaction = 1};
 }
 
 void scene_default_photons(scene_photons *p)

@@ -19,7 +19,7 @@ typedef struct {
     int area;
     vec3 axis1, axis2;
     int size1, size2;
-    int adaptive;           /* adaptive level, -1 if not given */
+    int adaptive;           /* adaptive level (default 100: the whole grid) */
     int jitter, circular, orient;
     int area_illumination;
     /* attenuation */

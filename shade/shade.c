@@ -17,7 +17,8 @@
  *  - area lights: the intensity (spot, fade, cosine) is taken from the light's
  *    centre; shadows are the average visibility over the size1 x size2 grid,
  *    sampled adaptively as POV-Ray does (corners first, subdivide while the
- *    corner values differ by more than 0.1 or the level is below `adaptive`),
+ *    corner values differ by more than 0.1 or the level is below `adaptive`,
+ *    100 unless given: the whole grid),
  *    each grid point jittered by up to half a cell when `jitter` is set.
  *    `area_illumination on` evaluates the shading per grid point instead.
  *  - antialiasing (+A, method 1): one ray through each pixel centre; then,

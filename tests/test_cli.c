@@ -479,10 +479,12 @@ static void test_sigint_partial(void **st)
     fb_free(fb);
 }
 
+/* adaptive 0: the grid from its corners, subdivided where they differ (a
+ * render of a second or two, whose bar fits the captured output) */
 static const char progress_scene[] =
     "#debug \"debug text from the parse\\n\"\n"
     "camera { location <0, 3, -6> look_at 0 }\n"
-    "light_source { <0, 5, 0> rgb 1 area_light 2*x, 2*z, 16, 16 jitter }\n"
+    "light_source { <0, 5, 0> rgb 1 area_light 2*x, 2*z, 16, 16 jitter adaptive 0 }\n"
     "plane { y, 0 pigment { rgb 1 } }\n"
     "sphere { <0, 1, 0>, 1 pigment { rgb 0.5 } }\n";
 

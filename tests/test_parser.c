@@ -790,7 +790,7 @@ static void test_lights(void **st)
     assert_vec(l[4].axis1, v3(0, 2, 0), 1e-12);
     assert_non_null(l[5].looks_like);
     assert_vec(xform_point(&l[5].looks_like->transform, v3(0, 0, 0)), v3(1, 0, 0), 0);
-    assert_int_equal(l[0].adaptive, -1);
+    assert_int_equal(l[0].adaptive, 100);
     scene_free(s);
 
     char *e = parse_err("light_source { 0, 1\n  radius 5 }", PT_ERR_SYNTAX);
