@@ -1183,11 +1183,16 @@ static vec3 iso_normal(const im_data *m, vec3 q, int part)
         }
         return n;
     }
-    double h = 1e-6 * m->size;
-    vec3 g = v3(iso_f(m, v3_add(q, v3(h, 0, 0))) - iso_f(m, v3_sub(q, v3(h, 0, 0))),
-                iso_f(m, v3_add(q, v3(0, h, 0))) - iso_f(m, v3_sub(q, v3(0, h, 0))),
-                iso_f(m, v3_add(q, v3(0, 0, h))) - iso_f(m, v3_sub(q, v3(0, 0, h))));
-    return v3_finite(g) && v3_len2(g) > 0.0 ? g : v3(0, 1, 0);
+    /* POV-Ray 3.7's rule (isosurf.cpp, IsoSurface::Normal): the forward
+     * difference of f over `accuracy` along each axis, so that detail of f
+     * finer than accuracy is smoothed out of the shading as in its images
+     * (a noise-displaced surface's shading follows it); a zero difference
+     * is +x, as there. */
+    double h = m->acc, f0 = iso_f(m, q);
+    vec3 g = v3(iso_f(m, v3_add(q, v3(h, 0, 0))) - f0, iso_f(m, v3_add(q, v3(0, h, 0))) - f0,
+                iso_f(m, v3_add(q, v3(0, 0, h))) - f0);
+    if (!v3_finite(g)) return v3(0, 1, 0);
+    return v3_len2(g) > 0.0 ? g : v3(1, 0, 0);
 }
 
 /* ------------------------------------------------------------ public */

@@ -762,7 +762,9 @@ static void test_clipped_by(void **st)
     done(&w);
 }
 
-/* isosurface: user functions (core/func.h) against closed forms */
+/* isosurface: user functions (core/func.h) against closed forms; the
+ * normal is POV-Ray's forward difference over accuracy (isosurf.cpp),
+ * within 1.5 accuracy / radius of the sphere's. */
 static void test_isosurface(void **st)
 {
     (void)st;
@@ -771,7 +773,7 @@ static void test_isosurface(void **st)
     assert_int_equal(w.s->objects[0]->kind, SHAPE_ISOSURFACE);
     for (int i = 0; i < 6; i++) {
         double y = 0.08 * i, x = sqrt(0.25 - y * y);
-        expect_hit(&w, v3(-5, y, 3), v3(1, 0, 0), 5 - x, v3(-x, y, 0), 1e-10, 1e-6);
+        expect_hit(&w, v3(-5, y, 3), v3(1, 0, 0), 5 - x, v3(-x, y, 0), 1e-10, 3e-4);
     }
     expect_miss(&w, v3(-5, 0.6, 3), v3(1, 0, 0));
     done(&w);
