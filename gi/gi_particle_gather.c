@@ -352,9 +352,11 @@ static void put_point(gi_particle *gp, gi_dev_particle *cp, const void **cobj, u
     }
 }
 
-/* Traces the links of gather points [k0, k1) (the pixels vg_pix names)
- * into vg_link and vg_esky from point k0 on: gi_links_build with the area
- * particles as targets and the points as its sources [n, n + k1 - k0). */
+/* Traces the links of gather points [k0, k1) (the pixels vg_pix names),
+ * side x side rays each, into vg_link from row k0 on (rows of vg_k
+ * links; a side below the rows' leaves their rows packed from there, for
+ * the caller to mark) and vg_esky: gi_links_build with the area particles
+ * as targets and the points as its sources [n, n + k1 - k0). */
 static pt_status trace_points(gi_particle *gp, const void **pobj, const unsigned char *pin, const gi_lookup *grid,
                               int k0, int k1, int side, int s, uint64_t seed, long *rays)
 {
@@ -389,7 +391,7 @@ static pt_status trace_points(gi_particle *gp, const void **pobj, const unsigned
         goto done;
     }
     st = gi_links_build(gp->a, gp->lscene, cp, cobj, cpin, (int)N, n, side, seed, grid, NULL, 3.0 * spacing, gp->threads,
-                        gp->vg_link + (size_t)k0 * side * side, NULL, &ls, gp->set.cancel, NULL, gp->sky,
+                        gp->vg_link + (size_t)k0 * gp->vg_k, NULL, &ls, gp->set.cancel, NULL, gp->sky,
                         gp->vg_esky + 4 * (size_t)k0, gp->sc, gp->set.pigment,
                         gp->set.bounces >= 1 ? gp->set.brightness : 0.0, reach);
     *rays += ls.rays;
@@ -417,6 +419,9 @@ done:
  * than REFINE (interpolation would guess across a change of the light,
  * where an irradiance cache would place a record of its own). */
 #define REFINE 0.15
+/* the side of a refinement gather over the corners' side (particle-free
+ * gathers only: gi_particle_view_gather) */
+#define REFINE_SIDE_FRAC 0.71
 static int needs_own(const gi_particle *gp, size_t i)
 {
     int x = (int)(i % (size_t)gp->vw), y = (int)(i / (size_t)gp->vw);
@@ -515,7 +520,24 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
         int m1 = m;
         for (size_t i = 0; i < npix; i++)
             if (gp->vg_pix[i] < 0 && gathers(gp, &gp->vrec[i]) && needs_own(gp, i)) gp->vg_pix[i] = m++;
-        if (m > m1) st = trace_points(gp, pobj, pin, grid, m1, m, side, s, gp->set.seed ^ 0x3c5b1ULL, &rays);
+        if (m > m1) {
+            /* without particles (no bounce after the gather's hits) a
+             * refinement point takes REFINE_SIDE_FRAC of the side: such
+             * points sit where the light changes across a block, where
+             * that change rather than the gather's noise is what shows
+             * (docs/gi.md gives the trade against POV-Ray's own render).
+             * Their links all miss (there is nothing to link to), so the
+             * shorter rows need only be marked empty */
+            int rs = side;
+            if (gp->final_only) {
+                rs = (int)lround(side * REFINE_SIDE_FRAC);
+                if (rs < 4) rs = 4;
+                if (rs > side) rs = side;
+            }
+            st = trace_points(gp, pobj, pin, grid, m1, m, rs, s, gp->set.seed ^ 0x3c5b1ULL, &rays);
+            if (rs != side)
+                for (size_t j = (size_t)m1 * side * side; j < (size_t)m * side * side; j++) gp->vg_link[j] = -1;
+        }
     }
     /* with no bounce after the gather's hits (the exact gather, gi_links.h)
      * a hit no point may answer gathers itself, as POV-Ray's cache adds a
