@@ -324,124 +324,113 @@ int func_compile(const scene_function *f, func_insn *out, int max, int *stack)
 #define FUNC_RUN_TEMPS 64
 
 /* Run f's program on registers r (its slots filled, then f->stack
- * temporaries from register t0) to its FI_RET. Dispatch jumps through a
- * table of labels after each instruction (labels as values, a GNU C
- * extension that GCC and Clang both take): one indirect branch per place
- * in the loop, which the processor predicts by the instruction before it,
- * where a switch's single branch mispredicts whenever the kind changes. */
+ * temporaries from register t0) to its FI_RET. */
 static double run(const scene_function *f, double *r, int t0, eval_ctx *c)
 {
-    static const void *const go[FI_RET + 1] = {
-        [FI_MOV] = &&mov, [FI_LOADK] = &&loadk, [FI_NEG] = &&neg, [FI_MATH] = &&math,
-        [FI_ADD] = &&add, [FI_SUB] = &&sub, [FI_MUL] = &&mul, [FI_DIV] = &&div,
-        [FI_ADD_K] = &&add_k, [FI_SUB_K] = &&sub_k, [FI_MUL_K] = &&mul_k, [FI_DIV_K] = &&div_k,
-        [FI_K_ADD] = &&k_add, [FI_K_SUB] = &&k_sub, [FI_K_MUL] = &&k_mul, [FI_K_DIV] = &&k_div,
-        [FI_LT] = &&lt, [FI_LE] = &&le, [FI_EQ] = &&eq, [FI_NE] = &&ne, [FI_GE] = &&ge, [FI_GT] = &&gt,
-        [FI_AND] = &&and, [FI_OR] = &&or, [FI_ATAN2] = &&atan2_, [FI_POW] = &&pow_, [FI_MOD] = &&mod,
-        [FI_IDIV] = &&idiv, [FI_MIN] = &&minmax, [FI_MAX] = &&minmax, [FI_JNLT] = &&jnlt, [FI_SEL4] = &&sel4,
-        [FI_JMP] = &&jmp, [FI_LOOP] = &&loop, [FI_NEXT] = &&next, [FI_END] = &&end, [FI_CALL] = &&call,
-        [FI_CALL_INT] = &&call_int, [FI_INTERNAL] = &&internal, [FI_RET] = &&ret,
-    };
-    const func_insn *code = f->code, *in;
+    const func_insn *code = f->code;
     int pc = 0;
-    double *d;
-#define NEXT                                       \
-    do {                                           \
-        in = &code[pc++];                          \
-        d = r + in->dst;                           \
-        if (in->op > FI_RET) goto bad;             \
-        goto *go[in->op];                          \
-    } while (0)
-    NEXT;
-mov: *d = r[in->a]; NEXT;
-loadk: *d = in->k; NEXT;
-neg: *d = -r[in->a]; NEXT;
-math: *d = math1((func_math)in->sub, r[in->a]); NEXT;
-add: *d = r[in->a] + r[in->b]; NEXT;
-sub: *d = r[in->a] - r[in->b]; NEXT;
-mul: *d = r[in->a] * r[in->b]; NEXT;
-div: *d = r[in->a] / r[in->b]; NEXT;
-add_k: *d = r[in->a] + in->k; NEXT;
-sub_k: *d = r[in->a] - in->k; NEXT;
-mul_k: *d = r[in->a] * in->k; NEXT;
-div_k: *d = r[in->a] / in->k; NEXT;
-k_add: *d = in->k + r[in->b]; NEXT;
-k_sub: *d = in->k - r[in->b]; NEXT;
-k_mul: *d = in->k * r[in->b]; NEXT;
-k_div: *d = in->k / r[in->b]; NEXT;
-lt: *d = r[in->a] < r[in->b]; NEXT;
-le: *d = r[in->a] <= r[in->b]; NEXT;
-eq: *d = r[in->a] == r[in->b]; NEXT;
-ne: *d = r[in->a] != r[in->b]; NEXT;
-ge: *d = r[in->a] >= r[in->b]; NEXT;
-gt: *d = r[in->a] > r[in->b]; NEXT;
-and: *d = truth(r[in->a]) && truth(r[in->b]); NEXT;
-or: *d = truth(r[in->a]) || truth(r[in->b]); NEXT;
-atan2_: *d = atan2(r[in->a], r[in->b]); NEXT;
-pow_: *d = pow(r[in->a], r[in->b]); NEXT;
-mod: *d = fmod(r[in->a], r[in->b]); NEXT;
-idiv: *d = trunc(r[in->a] / r[in->b]); NEXT;
-minmax: {
-        const double *v = r + in->a;
-        double m = v[0];
-        for (int j = 1; j < in->n; j++)
-            if (in->op == FI_MIN ? v[j] < m : v[j] > m) m = v[j];
-        *d = m;
-        NEXT;
-    }
-jnlt:
-    if (!(r[in->a] < 0)) pc = in->dst;
-    NEXT;
-sel4: {
-        double v = r[in->a];
-        if (!(v < 0)) pc = v == 0 ? in->dst : in->b;
-        NEXT;
-    }
-jmp: pc = in->dst; NEXT;
-loop: {
-        double *l = r + in->a;
-        l[2] = in->k;
-        l[3] = l[0];
-        if (l[0] <= l[1]) *d = l[0];
-        else pc = in->b;
-        NEXT;
-    }
-next: {
-        double *l = r + in->a, b = l[4];
-        l[2] = in->sub ? l[2] + b : l[2] * b;
-        l[3] += 1.0;
-        if (l[3] <= l[1]) {
-            *d = l[3];
-            pc = in->b;
+    for (;;) {
+        const func_insn *in = &code[pc++];
+        double *d = r + in->dst;
+        switch (in->op) {
+        case FI_MOV: *d = r[in->a]; break;
+        case FI_LOADK: *d = in->k; break;
+        case FI_NEG: *d = -r[in->a]; break;
+        case FI_MATH: *d = math1((func_math)in->sub, r[in->a]); break;
+        case FI_ADD: *d = r[in->a] + r[in->b]; break;
+        case FI_SUB: *d = r[in->a] - r[in->b]; break;
+        case FI_MUL: *d = r[in->a] * r[in->b]; break;
+        case FI_DIV: *d = r[in->a] / r[in->b]; break;
+        case FI_ADD_K: *d = r[in->a] + in->k; break;
+        case FI_SUB_K: *d = r[in->a] - in->k; break;
+        case FI_MUL_K: *d = r[in->a] * in->k; break;
+        case FI_DIV_K: *d = r[in->a] / in->k; break;
+        case FI_K_ADD: *d = in->k + r[in->b]; break;
+        case FI_K_SUB: *d = in->k - r[in->b]; break;
+        case FI_K_MUL: *d = in->k * r[in->b]; break;
+        case FI_K_DIV: *d = in->k / r[in->b]; break;
+        case FI_LT: *d = r[in->a] < r[in->b]; break;
+        case FI_LE: *d = r[in->a] <= r[in->b]; break;
+        case FI_EQ: *d = r[in->a] == r[in->b]; break;
+        case FI_NE: *d = r[in->a] != r[in->b]; break;
+        case FI_GE: *d = r[in->a] >= r[in->b]; break;
+        case FI_GT: *d = r[in->a] > r[in->b]; break;
+        case FI_AND: *d = truth(r[in->a]) && truth(r[in->b]); break;
+        case FI_OR: *d = truth(r[in->a]) || truth(r[in->b]); break;
+        case FI_ATAN2: *d = atan2(r[in->a], r[in->b]); break;
+        case FI_POW: *d = pow(r[in->a], r[in->b]); break;
+        case FI_MOD: *d = fmod(r[in->a], r[in->b]); break;
+        case FI_IDIV: *d = trunc(r[in->a] / r[in->b]); break;
+        case FI_MIN: case FI_MAX: {
+            const double *v = r + in->a;
+            double m = v[0];
+            for (int j = 1; j < in->n; j++)
+                if (in->op == FI_MIN ? v[j] < m : v[j] > m) m = v[j];
+            *d = m;
+            break;
         }
-        NEXT;
-    }
-end: r[in->a] = r[in->a + 2]; NEXT;
-call_int:
-internal: {
-        double v; /* not into *d: that is the first argument's register */
-        if (!func_internal_eval(in->b, r + in->a, c->env, &v)) {
+        case FI_JNLT:
+            if (!(r[in->a] < 0)) pc = in->dst;
+            break;
+        case FI_SEL4: {
+            double v = r[in->a];
+            if (!(v < 0)) pc = v == 0 ? in->dst : in->b;
+            break;
+        }
+        case FI_JMP: pc = in->dst; break;
+        case FI_LOOP: {
+            double *l = r + in->a;
+            l[2] = in->k;
+            l[3] = l[0];
+            if (l[0] <= l[1]) *d = l[0];
+            else pc = in->b;
+            break;
+        }
+        case FI_NEXT: {
+            double *l = r + in->a, b = l[4];
+            l[2] = in->sub ? l[2] + b : l[2] * b;
+            l[3] += 1.0;
+            if (l[3] <= l[1]) {
+                *d = l[3];
+                pc = in->b;
+            }
+            break;
+        }
+        case FI_END: r[in->a] = r[in->a + 2]; break;
+        case FI_CALL_INT: {
+            double v; /* not into *d: that is the first argument's register */
+            if (!func_internal_eval(in->b, r + in->a, c->env, &v)) {
+                c->failed = 1;
+                c->why = func_internal_name(in->b);
+                return 0;
+            }
+            *d = v;
+            break;
+        }
+        case FI_CALL: {
+            double v[5];
+            if (eval_function(in->fn, r + in->a, v, c) != PT_OK) return 0;
+            if (in->sub == 5) *d = 0.297 * v[0] + 0.589 * v[1] + 0.114 * v[2]; /* gray */
+            else *d = in->sub < in->fn->nterms ? v[in->sub] : 0.0;
+            break;
+        }
+        case FI_INTERNAL: {
+            double v;
+            if (!func_internal_eval(in->b, r + in->a, c->env, &v)) {
+                c->failed = 1;
+                c->why = func_internal_name(in->b);
+                return 0;
+            }
+            *d = v;
+            break;
+        }
+        case FI_RET: return r[t0];
+        default:
             c->failed = 1;
-            c->why = func_internal_name(in->b);
+            c->why = "bad program";
             return 0;
         }
-        *d = v;
-        NEXT;
     }
-call: {
-        double v[5];
-        if (eval_function(in->fn, r + in->a, v, c) != PT_OK) return 0;
-        if (in->sub == 5) *d = 0.297 * v[0] + 0.589 * v[1] + 0.114 * v[2]; /* gray */
-        else *d = in->sub < in->fn->nterms ? v[in->sub] : 0.0;
-        NEXT;
-    }
-ret:
-    return r[t0];
-bad:
-    c->failed = 1;
-    c->why = "bad program";
-    return 0;
-#undef NEXT
 }
 
 /* A float function's value at args: its program on a register file
