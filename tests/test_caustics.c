@@ -428,10 +428,9 @@ static double slab_mean(double y0, double y1, const char *extra, const char *box
  * the slab's exit face so grows by 0.9 / 0.864 = 1.04167 in the room;
  * the entry face, the beam's narrowing and the faded reflections inside
  * (ended by adc_bailout, as in POV-Ray) are the same in both, so the
- * layer's ratio must be that (tolerance 0.5%; 1 before photons kept the
- * list). povray's own image of the floor behind a tall wall of
- * glassthing's glass, lit from inside glassthing's room (a hollow
- * cylinder), is 3.3% brighter than with the room replaced by a plane. */
+ * layer's ratio must be that (tolerance 0.5%; photons that start with no
+ * list give 1; docs/caustics.md, Transport, compares glassthing's room
+ * with povray's image). */
 static void test_photons_in_room(void **state)
 {
     (void)state;
