@@ -390,7 +390,7 @@ static pt_status trace_points(gi_particle *gp, const void **pobj, const unsigned
         st = PT_ERR_NOMEM;
         goto done;
     }
-    st = gi_links_build(gp->a, gp->lscene, cp, cobj, cpin, (int)N, n, side, seed, grid, NULL, 3.0 * spacing, gp->threads,
+    st = gi_links_build(gp->a, gp->lscene, cp, cobj, cpin, (int)N, n, side, seed, grid, gp->tl, 3.0 * spacing, gp->threads,
                         gp->vg_link + (size_t)k0 * gp->vg_k, NULL, &ls, gp->set.cancel, NULL, gp->sky,
                         gp->vg_esky + 4 * (size_t)k0, gp->sc, gp->set.pigment,
                         gp->set.bounces >= 1 ? gp->set.brightness : 0.0, reach);
