@@ -88,7 +88,7 @@ void gi_particle_view_gather_free(gi_particle *gp)
     gp->vg_ids = gp->vg_link = gp->vg_pix = NULL;
     gp->vg_esky = gp->vg_val = gp->vg_pixval = NULL;
     gp->vg_levels = 0;
-    gp->vg_n = 0;
+    gp->vg_n = gp->vg_m1 = gp->vg_rk = 0;
     gp->vg_w = gp->vg_h = 0;
 }
 
@@ -311,7 +311,14 @@ static int gather_values(gi_particle *gp)
         }
         lrefl[4 * (size_t)t + 3] = 0.0f;
     }
-    gi_c_gather(gp->threads, gp->vg_link, gp->vg_k, lrefl, idx, gp->vg_n, gp->vg_esky, gp->vg_val);
+    /* points [0, m1) take vg_k rays; the refinement points [m1, vg_n)
+     * vg_rk, their rows packed from row m1: the kernel reads point i's
+     * row at i times its k from the pointer it is given */
+    int m1 = gp->vg_m1 > 0 && gp->vg_m1 < gp->vg_n && gp->vg_rk > 0 ? gp->vg_m1 : gp->vg_n;
+    gi_c_gather(gp->threads, gp->vg_link, gp->vg_k, lrefl, idx, m1, gp->vg_esky, gp->vg_val);
+    if (m1 < gp->vg_n)
+        gi_c_gather(gp->threads, gp->vg_link + (size_t)m1 * (size_t)(gp->vg_k - gp->vg_rk), gp->vg_rk, lrefl, idx + m1,
+                    gp->vg_n - m1, gp->vg_esky, gp->vg_val);
     free(idx);
     free(lrefl);
     return 1;
@@ -354,8 +361,8 @@ static void put_point(gi_particle *gp, gi_dev_particle *cp, const void **cobj, u
 
 /* Traces the links of gather points [k0, k1) (the pixels vg_pix names),
  * side x side rays each, into vg_link from row k0 on (rows of vg_k
- * links; a side below the rows' leaves their rows packed from there, for
- * the caller to mark) and vg_esky: gi_links_build with the area particles
+ * links; a side below the rows' packs side^2 links a row from there, as
+ * gather_values reads the refinement points' rows) and vg_esky: gi_links_build with the area particles
  * as targets and the points as its sources [n, n + k1 - k0). */
 static pt_status trace_points(gi_particle *gp, const void **pobj, const unsigned char *pin, const gi_lookup *grid,
                               int k0, int k1, int side, int s, uint64_t seed, long *rays)
@@ -419,8 +426,8 @@ done:
  * than REFINE (interpolation would guess across a change of the light,
  * where an irradiance cache would place a record of its own). */
 #define REFINE 0.15
-/* the side of a refinement gather over the corners' side (particle-free
- * gathers only: gi_particle_view_gather) */
+/* the side of a refinement gather over the corners' side
+ * (gi_particle_view_gather) */
 #define REFINE_SIDE_FRAC 0.71
 static int needs_own(const gi_particle *gp, size_t i)
 {
@@ -521,22 +528,18 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
         for (size_t i = 0; i < npix; i++)
             if (gp->vg_pix[i] < 0 && gathers(gp, &gp->vrec[i]) && needs_own(gp, i)) gp->vg_pix[i] = m++;
         if (m > m1) {
-            /* without particles (no bounce after the gather's hits) a
-             * refinement point takes REFINE_SIDE_FRAC of the side: such
+            /* a refinement point takes REFINE_SIDE_FRAC of the side: such
              * points sit where the light changes across a block, where
              * that change rather than the gather's noise is what shows
              * (docs/gi.md gives the trade against POV-Ray's own render).
-             * Their links all miss (there is nothing to link to), so the
-             * shorter rows need only be marked empty */
-            int rs = side;
-            if (gp->final_only) {
-                rs = (int)lround(side * REFINE_SIDE_FRAC);
-                if (rs < 4) rs = 4;
-                if (rs > side) rs = side;
-            }
+             * Their rows are packed from row m1 on, rs^2 links each, and
+             * the regather takes them so (vg_m1, vg_rk) */
+            int rs = (int)lround(side * REFINE_SIDE_FRAC);
+            if (rs < 4) rs = 4;
+            if (rs > side) rs = side;
             st = trace_points(gp, pobj, pin, grid, m1, m, rs, s, gp->set.seed ^ 0x3c5b1ULL, &rays);
-            if (rs != side)
-                for (size_t j = (size_t)m1 * side * side; j < (size_t)m * side * side; j++) gp->vg_link[j] = -1;
+            gp->vg_m1 = m1;
+            gp->vg_rk = rs * rs;
         }
     }
     /* with no bounce after the gather's hits (the exact gather, gi_links.h)

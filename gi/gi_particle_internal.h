@@ -83,6 +83,7 @@ struct gi_particle {
     double vis_eps; /* gi_visible's eps: 1e-6 x accel_eps_scale */
     /* the final gather at the kept hits (gi_particle_gather.c) */
     int vg_n, vg_k;   /* gather points, rays each */
+    int vg_m1, vg_rk; /* points from vg_m1 on take vg_rk rays, their rows packed from row vg_m1 (gi_particle_gather.c) */
     int vg_w, vg_h, vg_s; /* for the pre-pass of this size, every vg_s-th pixel */
     int *vg_link;     /* vg_n x vg_k: the area particle each ray ends on, -1 none */
     float *vg_esky;   /* vg_n x 4: the sky's and far field's share (gi_links.h) */
