@@ -457,6 +457,9 @@ static void job(void *ctx, int index, int thread)
     /* hits on a triangle gi_trilook lists take its list (cell -3: no grid
      * cell, unless the list cannot decide) */
     const gi_trilook *tl = J->tl && J->grid && J->links && J->pobj && !J->exact ? J->tl : NULL;
+    /* the final gather's points: the answer at the centre of the hit's
+     * cell where it has one (gi_links.h); only the others scan a list */
+    const int *rep = tl && J->points ? gi_trilook_centre_table(tl) : NULL;
     for (int t = 0; t < m; t++) {
         const struct RTCRayHit *h = &rh[t];
         int hit = ray_hit(h);
@@ -469,14 +472,18 @@ static void job(void *ctx, int index, int thread)
             tcell[t] = gi_trilook_cell(tl, h->hit.geomID, h->hit.primID, h->hit.u, h->hit.v, d);
             if (tcell[t] >= 0) {
                 cell[t] = -3;
-                gi_trilook_prefetch(tl, tcell[t], 0);
+                if (rep) __builtin_prefetch(&rep[tcell[t]]);
+                else gi_trilook_prefetch(tl, tcell[t], 0);
             }
         }
     }
+    if (tl && rep)
+        for (int t = 0; t < m; t++)
+            if (tcell[t] >= 0 && rep[tcell[t]] < 0) gi_trilook_prefetch(tl, tcell[t], 0);
     if (tl)
         for (int st = 1; st <= 2; st++)
             for (int t = 0; t < m; t++)
-                if (tcell[t] >= 0) gi_trilook_prefetch(tl, tcell[t], st);
+                if (tcell[t] >= 0 && !(rep && rep[tcell[t]] >= 0)) gi_trilook_prefetch(tl, tcell[t], st);
     if (J->grid && J->links && !J->exact) gi_lookup_cells(J->grid, m, hp, cell);
     m = 0;
     const void *last_obj = NULL;
@@ -541,7 +548,7 @@ static void job(void *ctx, int index, int thread)
                     const float qf[3] = {(float)hp[m].x, (float)hp[m].y, (float)hp[m].z};
                     const float df[3] = {h->ray.dir_x, h->ray.dir_y, h->ray.dir_z};
                     const float of[3] = {h->ray.org_x, h->ray.org_y, h->ray.org_z};
-                    target = gi_trilook_nearest(tl, tcell[m], qf, df, of);
+                    target = rep && rep[tcell[m]] >= 0 ? rep[tcell[m]] : gi_trilook_nearest(tl, tcell[m], qf, df, of);
                     if (target >= -1) {
                         fast = 1;
                         tri_ok++;

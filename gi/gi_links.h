@@ -39,7 +39,12 @@ typedef struct {
  * solid end on them). tl (may be NULL; needs grid and pobj, built with
  * the same particles, pobj, pin + n as buried flags, GI_LINKS_AGREE and
  * maxdist): hits on its triangles take its answer when it has one (the
- * same answer, gi_trilook.h), else the grid path. scene (may be NULL):
+ * same answer, gi_trilook.h), else the grid path; the points' rays
+ * (first > 0, or reach given), when gi_trilook_centres has been made,
+ * take the answer at the centre of the hit's cell where it has one (a
+ * cell's edge is at most a particle spacing: the particles' light,
+ * constant over each particle's own cell of the surface, sampled at the
+ * cells' centres instead of at the hit; no list is scanned). scene (may be NULL):
  * the RTCScene to trace (accel_rtc_link_scene's, built once by the
  * caller); NULL: the link scene is built and freed here. prog (may be
  * NULL): its current stage counts the chunks of particles traced. first:

@@ -518,6 +518,9 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
     gp->vg_h = h;
     gp->vg_s = s;
     long rays = 0;
+    /* a ray that hits a triangle the lists cover takes the particle at the
+     * centre of its cell (gi_links.h) */
+    if (gp->tl && !gi_trilook_centres(gp->tl, gp->threads)) st = PT_ERR_NOMEM;
     if (st == PT_OK) st = trace_points(gp, pobj, pin, grid, 0, m, side, s, gp->set.seed ^ 0x7a9e7ULL, &rays);
     /* refinement (an irradiance cache's adaptive placement): pixels whose
      * matching corners disagree gather themselves, traced as a second set */

@@ -61,6 +61,9 @@ struct gi_trilook {
     tl_pp *pp; /* the particles */
     int n;
     float start2; /* scan radius squared: maxdist (1 + REL), squared */
+    float lift;   /* the centre query's origin above the surface (a spacing) */
+    float *cc;    /* per cell (ncell / 2): its centre and its triangle's unit normal, 6 floats */
+    int *rep;     /* per list (NULL: not made): the answer at its cell's centre (gi_trilook_centre) */
 };
 
 /* ------------------------------------------------------------------ build */
@@ -333,6 +336,11 @@ static void build_job(void *ctx, int ch, int thread)
                             cv[q][a] = v[0][a] + uv[q][0] / k * e1[a] + uv[q][1] / k * e2[a];
                             c[a] += cv[q][a] / nv;
                         }
+                    float *cc = t->cc + 6 * cell;
+                    for (int a = 0; a < 3; a++) {
+                        cc[a] = (float)c[a];
+                        cc[3 + a] = (float)nrm[a];
+                    }
                     vec3 cw[4]; /* the corners as vectors (geom_tri_closest) */
                     for (int q = 0; q < nv; q++) cw[q] = v3(cv[q][0], cv[q][1], cv[q][2]);
                     double rc = 0.0;
@@ -471,6 +479,8 @@ void gi_trilook_free(gi_trilook *t)
     free(t->loff);
     free(t->e);
     free(t->pp);
+    free(t->cc);
+    free(t->rep);
     free(t);
 }
 
@@ -570,6 +580,8 @@ gi_trilook *gi_trilook_build(const accel *a, const gi_dev_particle *p, int n, co
     }
     t->ncell = 2 * ncell;
     t->loff = calloc((size_t)t->ncell, sizeof *t->loff);
+    t->cc = malloc((size_t)ncell * 6 * sizeof *t->cc);
+    if (!t->cc) goto nomem;
     t->pp = aligned_alloc(64, (((size_t)n + 1) * sizeof *t->pp + 63) / 64 * 64); /* (a multiple of the alignment, as C11 asks) */
     if (!t->loff || !t->pp) goto nomem;
     t->n = n;
@@ -588,6 +600,7 @@ gi_trilook *gi_trilook_build(const accel *a, const gi_dev_particle *p, int n, co
     B.ngeo = ngeo;
     B.ntris = ntris;
     B.spacing = spacing;
+    t->lift = (float)spacing;
     B.agree = agree;
     B.maxdist = maxdist;
     /* the hit point's distance to its cell: float rounding of Embree's
@@ -690,6 +703,8 @@ void gi_trilook_compact(gi_trilook *t, const int *remap, const gi_dev_particle *
         entries += w;
     }
     t->entries = entries;
+    free(t->rep);
+    t->rep = NULL;
     /* the particles, renumbered */
     if (n <= t->n) {
         for (int i = 0; i < n; i++)
@@ -837,3 +852,47 @@ int gi_trilook_nearest(const gi_trilook *t, long cell, const float q[3], const f
     if (bestd > cert2 || (win & UNCERTAIN)) return -2;
     return (int)win;
 }
+
+/* ------------------------------------------------------------ centres */
+
+typedef struct {
+    gi_trilook *t;
+    long per;
+} rep_job;
+
+static void rep_chunk(void *ctx, int ch, int thread)
+{
+    (void)thread;
+    rep_job *R = ctx;
+    gi_trilook *t = R->t;
+    long c0 = (long)ch * R->per, c1 = c0 + R->per < t->ncell ? c0 + R->per : t->ncell;
+    for (long l = c0; l < c1; l++) {
+        const float *cc = t->cc + 6 * (l / 2);
+        /* a ray along the side's normal onto the centre, from a spacing
+         * above it (the scan's filters: the particle faces the ray, the
+         * origin lies in front of it, the centre near its plane) */
+        float sg = (l & 1) ? -1.0f : 1.0f, q[3], dir[3], org[3];
+        for (int a = 0; a < 3; a++) {
+            q[a] = cc[a];
+            dir[a] = -sg * cc[3 + a];
+            org[a] = cc[a] + sg * cc[3 + a] * t->lift;
+        }
+        int r = t->loff[l] == EMPTY_OPEN ? -2 : gi_trilook_nearest(t, l, q, dir, org);
+        t->rep[l] = r >= 0 ? r : -2;
+    }
+}
+
+int gi_trilook_centres(gi_trilook *t, int threads)
+{
+    if (!t || !t->cc) return 0;
+    if (t->rep) return 1;
+    t->rep = malloc((size_t)t->ncell * sizeof *t->rep);
+    if (!t->rep) return 0;
+    rep_job R = {t, 4096};
+    pool_run(threads > 0 ? threads : pool_default_threads(), (int)((t->ncell + R.per - 1) / R.per), rep_chunk, &R);
+    return 1;
+}
+
+int gi_trilook_centre(const gi_trilook *t, long cell) { return t->rep[cell]; }
+
+const int *gi_trilook_centre_table(const gi_trilook *t) { return t ? t->rep : NULL; }

@@ -56,4 +56,13 @@ void gi_trilook_prefetch(const gi_trilook *t, long cell, int stage);
  * >= 0 the particle, -1 none, -2 not decided here (take the grid path). */
 int gi_trilook_nearest(const gi_trilook *t, long cell, const float q[3], const float dir[3], const float org[3]);
 
+/* The answer at each list's cell centre (gi_trilook_nearest's for a ray
+ * along the side's normal onto the centre): made once by
+ * gi_trilook_centres (0: out of memory; undone by gi_trilook_compact),
+ * then gi_trilook_centre gives a list's answer, >= 0 a particle, -2 none
+ * decided (take gi_trilook_nearest). */
+int gi_trilook_centres(gi_trilook *t, int threads);
+int gi_trilook_centre(const gi_trilook *t, long cell);
+const int *gi_trilook_centre_table(const gi_trilook *t);
+
 #endif
