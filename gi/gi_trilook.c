@@ -63,7 +63,7 @@ struct gi_trilook {
     float start2; /* scan radius squared: maxdist (1 + REL), squared */
     float lift;   /* the centre query's origin above the surface (a spacing) */
     float *cc;    /* per cell (ncell / 2): its centre and its triangle's unit normal, 6 floats */
-    int *rep;     /* per list (NULL: not made): the answer at its cell's centre (gi_trilook_centre) */
+    int *rep;     /* per list (NULL: not made): the answer at its cell's centre (gi_trilook_centres) */
 };
 
 /* ------------------------------------------------------------------ build */
@@ -892,7 +892,5 @@ int gi_trilook_centres(gi_trilook *t, int threads)
     pool_run(threads > 0 ? threads : pool_default_threads(), (int)((t->ncell + R.per - 1) / R.per), rep_chunk, &R);
     return 1;
 }
-
-int gi_trilook_centre(const gi_trilook *t, long cell) { return t->rep[cell]; }
 
 const int *gi_trilook_centre_table(const gi_trilook *t) { return t ? t->rep : NULL; }

@@ -58,11 +58,11 @@ int gi_trilook_nearest(const gi_trilook *t, long cell, const float q[3], const f
 
 /* The answer at each list's cell centre (gi_trilook_nearest's for a ray
  * along the side's normal onto the centre): made once by
- * gi_trilook_centres (0: out of memory; undone by gi_trilook_compact),
- * then gi_trilook_centre gives a list's answer, >= 0 a particle, -2 none
- * decided (take gi_trilook_nearest). */
+ * gi_trilook_centres (0: out of memory; undone by gi_trilook_compact);
+ * gi_trilook_centre_table then gives them by list (gi_trilook_cell's
+ * index), >= 0 a particle, -2 none decided (take gi_trilook_nearest), and
+ * NULL before they are made. */
 int gi_trilook_centres(gi_trilook *t, int threads);
-int gi_trilook_centre(const gi_trilook *t, long cell);
 const int *gi_trilook_centre_table(const gi_trilook *t);
 
 #endif
