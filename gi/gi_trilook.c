@@ -18,6 +18,9 @@
  * among 0.7, 1.0 and 1.4 (bench_gi's link pass timings). */
 #define CELL_FAC 1.0
 #define MAX_K 64
+/* cells per edge of a block that gathers its candidates together
+ * (build_block) */
+#define BLOCK 4
 /* particles whose n . N lies within AGREE_SLACK of the threshold are
  * "uncertain" (gi_links compares Embree's Ng, not this N) */
 #define AGREE_SLACK 1e-3
@@ -284,6 +287,156 @@ static unsigned *chunk_words(tl_build *B, int ch, long more)
     return B->ce[ch] + B->cne[ch];
 }
 
+/* The lists of triangle T's cells (i, j) with bi <= i < ie, bj <= j < je
+ * (v: its vertices, e1, e2 its edges from v[0], nrm its unit normal),
+ * from candidates gathered around ct within rt of every point of those
+ * cells; written to chunk ch. 0: out of memory. */
+static int build_block(tl_build *B, tl_scratch *s, int ch, const tl_tri *T, int oid, const double v[3][3],
+                       const double e1[3], const double e2[3], const double nrm[3], int bi, int ie, int bj, int je,
+                       const double ct[3], double rt)
+{
+    gi_trilook *t = B->t;
+    const int k = T->k;
+    const double full = B->maxdist * (1.0 + REL) + B->delta;
+    /* the candidates cover every point within rg - rt of the block;
+     * gathered again wider when a cell's list needs more */
+    double rg = rt + fmin(1.5 * B->spacing, full);
+    long blk_start = B->cne[ch];
+    for (int pass = 0; pass < 2; pass++) {
+        if (!gather(B, s, oid, ct, rg, nrm)) return 0;
+        double needed = 0.0;
+        for (int i = bi; i < ie; i++)
+            for (int j = bj; j < je && j + i < k; j++) {
+                long cell = T->cell0 + (long)i * k - (long)i * (i - 1) / 2 + j;
+                /* corners (i, j), (i+1, j), (i, j+1) [, (i+1, j+1)] in units of 1/k */
+                double uv[4][2] = {{i, j}, {i + 1, j}, {i, j + 1}, {i + 1, j + 1}};
+                int nv = i + j < k - 1 ? 4 : 3;
+                double cv[4][3], c[3] = {0, 0, 0};
+                for (int q = 0; q < nv; q++)
+                    for (int a = 0; a < 3; a++) {
+                        cv[q][a] = v[0][a] + uv[q][0] / k * e1[a] + uv[q][1] / k * e2[a];
+                        c[a] += cv[q][a] / nv;
+                    }
+                float *cc = t->cc + 6 * cell;
+                for (int a = 0; a < 3; a++) {
+                    cc[a] = (float)c[a];
+                    cc[3 + a] = (float)nrm[a];
+                }
+                vec3 cw[4]; /* the corners as vectors (geom_tri_closest) */
+                for (int q = 0; q < nv; q++) cw[q] = v3(cv[q][0], cv[q][1], cv[q][2]);
+                double rc = 0.0;
+                for (int q = 0; q < nv; q++) {
+                    double e = 0.0;
+                    for (int a = 0; a < 3; a++) e += (cv[q][a] - c[a]) * (cv[q][a] - c[a]);
+                    rc = fmax(rc, sqrt(e));
+                }
+                /* R: the least max corner distance of a certain
+                 * candidate; the one nearest the centre first (its
+                 * bound prunes the rest: max corner distance >= pc - rc) */
+                double R[2] = {INFINITY, INFINITY}, pmin[2] = {INFINITY, INFINITY};
+                long first[2] = {-1, -1};
+                centre_distances(s, c);
+                for (long m = 0; m < s->n; m++) {
+                    int sd = s->side[m];
+                    if (!s->unc[m] && s->pc[m] < pmin[sd]) {
+                        pmin[sd] = s->pc[m];
+                        first[sd] = m;
+                    }
+                }
+                for (int pass2 = 0; pass2 < 2; pass2++)
+                    for (long m = 0; m < s->n; m++) {
+                        int sd = s->side[m];
+                        if (pass2 == 0 ? m != first[sd] : (s->unc[m] || m == first[sd] || s->pc[m] - rc >= R[sd]))
+                            continue;
+                        const float *px = &s->px[3 * m];
+                        double mx = 0.0;
+                        for (int q = 0; q < nv; q++) {
+                            double e2q = 0.0;
+                            for (int a = 0; a < 3; a++) e2q += (px[a] - cv[q][a]) * (px[a] - cv[q][a]);
+                            if (e2q > mx) mx = e2q;
+                        }
+                        mx = sqrt(mx);
+                        if (mx < R[sd]) R[sd] = mx;
+                    }
+                /* a side without a certain particle near the triangle
+                 * (a side facing the void, the inside of a closed
+                 * mesh) is left to the grid path: its list would have
+                 * to reach maxdist, and few rays hit it (cbox 50K: 5,993
+                 * of 8,180 triangles gathered again out to maxdist for
+                 * such a side; 4x4 links with the build 0.78 -> 0.73 s
+                 * CPU, two runs each) */
+                int cov[2];
+                for (int sd = 0; sd < 2; sd++) {
+                    cov[sd] = R[sd] < INFINITY;
+                    if (R[sd] > B->maxdist) R[sd] = B->maxdist;
+                }
+                double rl[2] = {R[0] * (1.0 + REL) + B->delta, R[1] * (1.0 + REL) + B->delta};
+                for (int sd = 0; sd < 2; sd++) {
+                    if (cov[sd] && pass == 0) needed = fmax(needed, rl[sd]);
+                    /* (the second pass gathered every need the first one saw) */
+                    if (pass == 1 && rl[sd] > rg - rt) cov[sd] = 0;
+                }
+                if (pass == 0 && needed > rg - rt) continue; /* gathered again */
+                for (int sd = 0; sd < 2; sd++) {
+                    if (!cov[sd]) {
+                        t->loff[2 * cell + sd] = EMPTY_OPEN;
+                        continue;
+                    }
+                    double rl2 = rl[sd] * rl[sd];
+                    /* membership: dist(p, cell) <= rl; the centre distance
+                     * bounds it: pc - rc <= dist <= pc */
+                    long cnt = 0;
+                    for (long m = 0; m < s->n; m++) {
+                        s->cd[m] = -1.0;
+                        if (s->side[m] != sd || s->pc[m] - rc > rl[sd]) continue;
+                        if (s->pc[m] > rl[sd]) {
+                            vec3 px = v3(s->px[3 * m], s->px[3 * m + 1], s->px[3 * m + 2]);
+                            double w[3];
+                            double d2 = geom_tri_closest(px, cw[0], cw[1], cw[2], w);
+                            if (nv == 4 && d2 > rl2) d2 = fmin(d2, geom_tri_closest(px, cw[1], cw[3], cw[2], w));
+                            if (d2 > rl2) continue;
+                        }
+                        s->cd[m] = 1.0;
+                        cnt++;
+                    }
+                    int complete = R[sd] >= B->maxdist;
+                    double cert = complete ? B->maxdist * (1.0 - REL) : R[sd];
+                    float cert2 = (float)(cert * cert * (1.0 - 1e-6));
+                    if (cnt == 0) {
+                        /* a shared header (offsets below the chunks') */
+                        t->loff[2 * cell + sd] = complete ? EMPTY_COMPLETE : EMPTY_OPEN;
+                        continue;
+                    }
+                    unsigned *w = chunk_words(B, ch, cnt + 2);
+                    if (!w) return 0;
+                    t->loff[2 * cell + sd] = (unsigned)B->cne[ch] | LOCAL;
+                    w[0] = (unsigned)cnt | (complete ? COMPLETE : 0u);
+                    memcpy(&w[1], &cert2, sizeof cert2);
+                    long q = 2;
+                    for (long m = 0; m < s->n; m++) {
+                        if (s->cd[m] < 0.0) continue;
+                        /* ascending particle index (insertion: lists are short) */
+                        unsigned id = (unsigned)s->ix[m] | (s->unc[m] ? UNCERTAIN : 0u);
+                        long b = q++;
+                        while (b > 2 && (w[b - 1] & ~UNCERTAIN) > (id & ~UNCERTAIN)) {
+                            w[b] = w[b - 1];
+                            b--;
+                        }
+                        w[b] = id;
+                    }
+                    B->cne[ch] += cnt + 2;
+                }
+            }
+        if (pass == 0 && needed <= rg - rt) break; /* every cell written */
+        if (pass == 1) break;
+        /* some cell needs more: drop this block's lists written so far
+         * (the chunk's last words) and gather wider */
+        B->cne[ch] = blk_start;
+        rg = rt + needed * (1.0 + 1e-9);
+    }
+    return 1;
+}
+
 static void build_job(void *ctx, int ch, int thread)
 {
     (void)thread;
@@ -292,7 +445,6 @@ static void build_job(void *ctx, int ch, int thread)
     long t0 = B->ntris * ch / B->chunks, t1 = B->ntris * (ch + 1) / B->chunks;
     tl_scratch s = {0};
     unsigned gi = 0;
-    const double full = B->maxdist * (1.0 + REL) + B->delta;
     for (long ft = t0; ft < t1; ft++) {
         while (gi + 1 < B->ngeo && B->gbase[gi + 1] <= ft) gi++;
         const tl_geo *G = &B->geo[gi];
@@ -303,159 +455,41 @@ static void build_job(void *ctx, int ch, int thread)
         double v[3][3];
         for (int q = 0; q < 3; q++)
             for (int c = 0; c < 3; c++) v[q][c] = G->v[3 * G->idx[3 * prim + q] + c];
-        double e1[3], e2[3], nrm[3] = {T->n[0], T->n[1], T->n[2]}, ct[3], rt = 0.0;
+        double e1[3], e2[3], nrm[3] = {T->n[0], T->n[1], T->n[2]};
         for (int c = 0; c < 3; c++) {
             e1[c] = v[1][c] - v[0][c];
             e2[c] = v[2][c] - v[0][c];
-            ct[c] = (v[0][c] + v[1][c] + v[2][c]) / 3.0;
         }
-        for (int q = 0; q < 3; q++) {
-            double e = 0.0;
-            for (int c = 0; c < 3; c++) e += (v[q][c] - ct[c]) * (v[q][c] - ct[c]);
-            rt = fmax(rt, sqrt(e));
-        }
-        /* the candidates cover every point within rg - rt of the triangle;
-         * gathered again wider when a cell's list needs more */
-        double rg = rt + fmin(1.5 * B->spacing, full);
-        long tri_start = B->cne[ch];
-        for (int pass = 0; pass < 2; pass++) {
-            if (!gather(B, &s, oid, ct, rg, nrm)) {
-                B->fail[ch] = 1;
-                goto out;
-            }
-            double needed = 0.0;
-            long cell = T->cell0;
-            for (int i = 0; i < k; i++)
-                for (int j = 0; j + i < k; j++, cell++) {
-                    /* corners (i, j), (i+1, j), (i, j+1) [, (i+1, j+1)] in units of 1/k */
-                    double uv[4][2] = {{i, j}, {i + 1, j}, {i, j + 1}, {i + 1, j + 1}};
-                    int nv = i + j < k - 1 ? 4 : 3;
-                    double cv[4][3], c[3] = {0, 0, 0};
-                    for (int q = 0; q < nv; q++)
-                        for (int a = 0; a < 3; a++) {
-                            cv[q][a] = v[0][a] + uv[q][0] / k * e1[a] + uv[q][1] / k * e2[a];
-                            c[a] += cv[q][a] / nv;
-                        }
-                    float *cc = t->cc + 6 * cell;
-                    for (int a = 0; a < 3; a++) {
-                        cc[a] = (float)c[a];
-                        cc[3 + a] = (float)nrm[a];
-                    }
-                    vec3 cw[4]; /* the corners as vectors (geom_tri_closest) */
-                    for (int q = 0; q < nv; q++) cw[q] = v3(cv[q][0], cv[q][1], cv[q][2]);
-                    double rc = 0.0;
-                    for (int q = 0; q < nv; q++) {
-                        double e = 0.0;
-                        for (int a = 0; a < 3; a++) e += (cv[q][a] - c[a]) * (cv[q][a] - c[a]);
-                        rc = fmax(rc, sqrt(e));
-                    }
-                    /* R: the least max corner distance of a certain
-                     * candidate; the one nearest the centre first (its
-                     * bound prunes the rest: max corner distance >= pc - rc) */
-                    double R[2] = {INFINITY, INFINITY}, pmin[2] = {INFINITY, INFINITY};
-                    long first[2] = {-1, -1};
-                    centre_distances(&s, c);
-                    for (long m = 0; m < s.n; m++) {
-                        int sd = s.side[m];
-                        if (!s.unc[m] && s.pc[m] < pmin[sd]) {
-                            pmin[sd] = s.pc[m];
-                            first[sd] = m;
-                        }
-                    }
-                    for (int pass2 = 0; pass2 < 2; pass2++)
-                        for (long m = 0; m < s.n; m++) {
-                            int sd = s.side[m];
-                            if (pass2 == 0 ? m != first[sd] : (s.unc[m] || m == first[sd] || s.pc[m] - rc >= R[sd]))
-                                continue;
-                            const float *px = &s.px[3 * m];
-                            double mx = 0.0;
-                            for (int q = 0; q < nv; q++) {
-                                double e2q = 0.0;
-                                for (int a = 0; a < 3; a++) e2q += (px[a] - cv[q][a]) * (px[a] - cv[q][a]);
-                                if (e2q > mx) mx = e2q;
-                            }
-                            mx = sqrt(mx);
-                            if (mx < R[sd]) R[sd] = mx;
-                        }
-                    /* a side without a certain particle near the triangle
-                     * (a side facing the void, the inside of a closed
-                     * mesh) is left to the grid path: its list would have
-                     * to reach maxdist, and few rays hit it (cbox 50K: 5,993
-                     * of 8,180 triangles gathered again out to maxdist for
-                     * such a side; 4x4 links with the build 0.78 -> 0.73 s
-                     * CPU, two runs each) */
-                    int cov[2];
-                    for (int sd = 0; sd < 2; sd++) {
-                        cov[sd] = R[sd] < INFINITY;
-                        if (R[sd] > B->maxdist) R[sd] = B->maxdist;
-                    }
-                    double rl[2] = {R[0] * (1.0 + REL) + B->delta, R[1] * (1.0 + REL) + B->delta};
-                    for (int sd = 0; sd < 2; sd++) {
-                        if (cov[sd] && pass == 0) needed = fmax(needed, rl[sd]);
-                        /* (the second pass gathered every need the first one saw) */
-                        if (pass == 1 && rl[sd] > rg - rt) cov[sd] = 0;
-                    }
-                    if (pass == 0 && needed > rg - rt) continue; /* gathered again */
-                    for (int sd = 0; sd < 2; sd++) {
-                        if (!cov[sd]) {
-                            t->loff[2 * cell + sd] = EMPTY_OPEN;
-                            continue;
-                        }
-                        double rl2 = rl[sd] * rl[sd];
-                        /* membership: dist(p, cell) <= rl; the centre distance
-                         * bounds it: pc - rc <= dist <= pc */
-                        long cnt = 0;
-                        for (long m = 0; m < s.n; m++) {
-                            s.cd[m] = -1.0;
-                            if (s.side[m] != sd || s.pc[m] - rc > rl[sd]) continue;
-                            if (s.pc[m] > rl[sd]) {
-                                vec3 px = v3(s.px[3 * m], s.px[3 * m + 1], s.px[3 * m + 2]);
-                                double w[3];
-                                double d2 = geom_tri_closest(px, cw[0], cw[1], cw[2], w);
-                                if (nv == 4 && d2 > rl2) d2 = fmin(d2, geom_tri_closest(px, cw[1], cw[3], cw[2], w));
-                                if (d2 > rl2) continue;
-                            }
-                            s.cd[m] = 1.0;
-                            cnt++;
-                        }
-                        int complete = R[sd] >= B->maxdist;
-                        double cert = complete ? B->maxdist * (1.0 - REL) : R[sd];
-                        float cert2 = (float)(cert * cert * (1.0 - 1e-6));
-                        if (cnt == 0) {
-                            /* a shared header (offsets below the chunks') */
-                            t->loff[2 * cell + sd] = complete ? EMPTY_COMPLETE : EMPTY_OPEN;
-                            continue;
-                        }
-                        unsigned *w = chunk_words(B, ch, cnt + 2);
-                        if (!w) {
-                            B->fail[ch] = 1;
-                            goto out;
-                        }
-                        t->loff[2 * cell + sd] = (unsigned)B->cne[ch] | LOCAL;
-                        w[0] = (unsigned)cnt | (complete ? COMPLETE : 0u);
-                        memcpy(&w[1], &cert2, sizeof cert2);
-                        long q = 2;
-                        for (long m = 0; m < s.n; m++) {
-                            if (s.cd[m] < 0.0) continue;
-                            /* ascending particle index (insertion: lists are short) */
-                            unsigned id = (unsigned)s.ix[m] | (s.unc[m] ? UNCERTAIN : 0u);
-                            long b = q++;
-                            while (b > 2 && (w[b - 1] & ~UNCERTAIN) > (id & ~UNCERTAIN)) {
-                                w[b] = w[b - 1];
-                                b--;
-                            }
-                            w[b] = id;
-                        }
-                        B->cne[ch] += cnt + 2;
-                    }
+        /* the cells in blocks of BLOCK x BLOCK, each with candidates of its
+         * own: one set for a whole large triangle made every cell measure
+         * its distance to every particle on it (cornell.pov's floor: 1,378
+         * cells by some 1,700 particles). A triangle of at most BLOCK cells
+         * an edge is one block, about its centroid; a larger one's block
+         * about the centre of the parallelogram [bi, ie] x [bj, je] (in
+         * 1/k of the edges) that holds its cells. */
+        for (int bi = 0; bi < k; bi += BLOCK)
+            for (int bj = 0; bj + bi < k; bj += BLOCK) {
+                int ie = bi + BLOCK < k ? bi + BLOCK : k, je = bj + BLOCK < k - bi ? bj + BLOCK : k - bi;
+                double cb[3], rb = 0.0, pv[4][3];
+                int np = k <= BLOCK ? 3 : 4;
+                for (int q = 0; q < np; q++)
+                    for (int c = 0; c < 3; c++)
+                        pv[q][c] = np == 3 ? v[q][c]
+                                           : v[0][c] + (double)(q & 1 ? ie : bi) / k * e1[c] +
+                                                 (double)(q & 2 ? je : bj) / k * e2[c];
+                for (int c = 0; c < 3; c++)
+                    cb[c] = np == 3 ? (v[0][c] + v[1][c] + v[2][c]) / 3.0
+                                    : (pv[0][c] + pv[1][c] + pv[2][c] + pv[3][c]) / 4.0;
+                for (int q = 0; q < np; q++) {
+                    double e = 0.0;
+                    for (int c = 0; c < 3; c++) e += (pv[q][c] - cb[c]) * (pv[q][c] - cb[c]);
+                    rb = fmax(rb, sqrt(e));
                 }
-            if (pass == 0 && needed <= rg - rt) break; /* every cell written */
-            if (pass == 1) break;
-            /* some cell needs more: drop this triangle's lists written so
-             * far (the chunk's last words) and gather wider */
-            B->cne[ch] = tri_start;
-            rg = rt + needed * (1.0 + 1e-9);
-        }
+                if (!build_block(B, &s, ch, T, oid, (const double(*)[3])v, e1, e2, nrm, bi, ie, bj, je, cb, rb)) {
+                    B->fail[ch] = 1;
+                    goto out;
+                }
+            }
     }
 out:
     free(s.ix);
