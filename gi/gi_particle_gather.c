@@ -78,11 +78,11 @@ static int compatible(const gi_particle *gp, size_t i, size_t j)
 
 void gi_particle_view_gather_free(gi_particle *gp)
 {
-    GROW_FREE_ALL(gp->vg_pt, gp->vg_ids, gp->vg_tab, gp->vg_link, gp->vg_esky, gp->vg_val, gp->vg_pix, gp->vg_pixval,
-                  gp->vg_nrm);
+    GROW_FREE_ALL(gp->vg_pt, gp->vg_cpt, gp->vg_ids, gp->vg_tab, gp->vg_link, gp->vg_esky, gp->vg_val, gp->vg_pix,
+                  gp->vg_pixval, gp->vg_nrm);
     gi_gatherer_free(gp->vg_gatherer);
     gp->vg_gatherer = NULL;
-    gp->vg_pt = NULL;
+    gp->vg_pt = gp->vg_cpt = NULL;
     gp->vg_tab = NULL;
     gp->vg_nrm = NULL;
     gp->vg_ids = gp->vg_link = gp->vg_pix = NULL;
@@ -162,8 +162,9 @@ static pt_status build_index(gi_particle *gp)
     size_t cap = 64;
     while (cap < 2 * (size_t)m) cap *= 2;
     gp->vg_ids = malloc((size_t)m * sizeof *gp->vg_ids);
+    gp->vg_cpt = malloc((size_t)m * sizeof *gp->vg_cpt);
     gp->vg_tab = calloc(cap, sizeof *gp->vg_tab);
-    if (!kk || !gp->vg_ids || !gp->vg_tab) {
+    if (!kk || !gp->vg_ids || !gp->vg_cpt || !gp->vg_tab) {
         free(kk);
         return PT_ERR_NOMEM;
     }
@@ -186,6 +187,7 @@ static pt_status build_index(gi_particle *gp)
         int f = e;
         while (f < m && kk[f].key == kk[e].key) {
             gp->vg_ids[f] = kk[f].id;
+            gp->vg_cpt[f] = gp->vg_pt[kk[f].id];
             f++;
         }
         size_t slot = (size_t)kk[e].key & gp->vg_tab_mask;
@@ -260,8 +262,7 @@ static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int
             while (gp->vg_tab[slot].key && gp->vg_tab[slot].key != key) slot = (slot + 1) & gp->vg_tab_mask;
             if (!gp->vg_tab[slot].key) continue;
             for (int e = gp->vg_tab[slot].start, end = e + gp->vg_tab[slot].count; e < end; e++) {
-                int id = gp->vg_ids[e];
-                const vg_point *pt = &gp->vg_pt[id];
+                const vg_point *pt = &gp->vg_cpt[e];
                 if (!relaxed && (pt->obj != hit->obj || pt->side != side)) continue;
                 double r = relaxed ? 2.0 * pt->r : pt->r;
                 vec3 dv = v3_sub(hit->p, pt->p);
@@ -275,7 +276,7 @@ static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int
                 if (v3_dot(pt->n, ng) < NORMAL_COS * lg) continue;
                 if (gp->vg_gatherer && !reusable(gp, pt, hit->p, ng, lg)) continue;
                 double w = 1.0 - d / r;
-                const float *v = &gp->vg_val[4 * (size_t)id];
+                const float *v = &gp->vg_val[4 * (size_t)gp->vg_ids[e]];
                 for (int q = 0; q < 3; q++) s[q] += w * v[q];
                 ws += w;
             }

@@ -93,6 +93,7 @@ struct gi_particle {
     vec3 *vg_nrm;     /* vg_w x vg_h: each kept hit's normal the gather takes (gi_particle_gather.c view_normal) */
     struct vg_point *vg_pt; /* vg_n: where each gathered (for hits that are not kept) */
     int *vg_ids;      /* vg_n: the points, by cell */
+    struct vg_point *vg_cpt; /* vg_n: vg_pt[vg_ids[e]] at e (a cell's points read in a row) */
     struct vg_cell *vg_tab; /* cells (hash table): runs of vg_ids */
     size_t vg_tab_mask;
     double vg_c0;     /* level 0's cell size */
