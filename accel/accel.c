@@ -35,7 +35,9 @@
  * down to about 0.3 degrees (a relative 1e-6 is too small: float hit points
  * then shadow themselves at grazing angles of a few degrees) while losing only contacts
  * closer than 1e-5 of the scene size, and it scales with the scene, so the
- * same scene scaled by 1e-4 or 1e5 behaves identically. Analytic shapes are
+ * same scene scaled by 1e-4 or 1e5 behaves identically. A scene of
+ * closed-form shapes only takes 1e-3 of the working scale in the scale term
+ * (ACCEL_EXACT_EPS_FACTOR, at build below). Analytic shapes are
  * intersected in double precision from the caller's double ray (passed to
  * the callbacks through an extended intersect context), triangle hit
  * distances are refined in double against the triangle's plane.
@@ -135,6 +137,20 @@ static int texture_uses_uv(const scene_texture *t, int depth)
     return 0;
 }
 
+/* Whether a shape's hits are found in closed form in double precision
+ * (quadratic or linear equations, no float vertices, no iteration): such a
+ * hit point lies on its surface to double rounding. Containers hold no
+ * surface of their own. */
+static int shape_closed_form(shape_kind k)
+{
+    switch (k) {
+    case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_PLANE: case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC:
+    case SHAPE_QUADRIC: case SHAPE_POLYGON: case SHAPE_UNION: case SHAPE_MERGE: case SHAPE_INTERSECTION:
+    case SHAPE_DIFFERENCE: return 1;
+    default: return 0;
+    }
+}
+
 static int add_leaf(accel *a, const scene_object *o, const scene_texture *tex, unsigned flags)
 {
     if (a->nleaves == a->capleaves) {
@@ -152,6 +168,7 @@ static int add_leaf(accel *a, const scene_object *o, const scene_texture *tex, u
     l->wind = det < 0.0 ? -1.0 : 1.0;
     l->identity = xform_is_identity(&o->transform);
     l->in_csg = 0;
+    if (!shape_closed_form(o->kind)) a->inexact_leaves++;
     l->group = -1;
     l->b0 = l->bn = 0;
     l->want_uv = o->uv_mapping || texture_uses_uv(l->texture, 0) || (o->interior_texture && texture_uses_uv(o->interior_texture, 0));
@@ -668,6 +685,14 @@ static void finish_bounds(accel *a)
         double med = a->diags[(a->ndiags - 1) / 2];
         if (med < a->eps_scale) a->eps_scale = med;
     }
+    /* A scene made only of closed-form shapes (solved in double from the
+     * double ray) needs no float margin: its rays' scale term shrinks by
+     * ACCEL_EXACT_EPS_FACTOR, so surfaces a far smaller distance apart than
+     * the objects' size stay apart (shells of a planet-sized sky 1 unit
+     * apart, as POV-Ray's own absolute depth tolerances of 1e-6 to 1e-4 keep
+     * them). Any triangle, mesh or iteratively solved shape keeps the rule
+     * at its size. The |org| term is unchanged. */
+    a->ray_eps_scale = a->inexact_leaves > 0 ? a->eps_scale : a->eps_scale * ACCEL_EXACT_EPS_FACTOR;
     free(a->diags);
     a->diags = NULL;
     a->ndiags = a->capdiags = 0;
@@ -824,7 +849,7 @@ double accel_epsilon(const accel *a, vec3 org, vec3 dir)
 {
     double l = v3_len(dir);
     if (!(l > 0.0) || !v3_finite(org)) return INFINITY;
-    double e = eps_rule(a ? a->eps_scale : 1.0, org, l);
+    double e = eps_rule(a ? a->ray_eps_scale : 1.0, org, l);
     assert(e >= 0.0 && isfinite(e)); /* a finite origin, a non-zero direction */
     return e;
 }
@@ -1020,8 +1045,8 @@ static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tm
      * to the epsilon rule's distance: triangle distances are refined in
      * double from Embree's float hit), unit normals on one side, the leaf
      * and its effective texture */
-    assert(!(hit->t < t0 - eps_rule(a->eps_scale, org, v3_len(dir))) &&
-           !(hit->t > tmax + eps_rule(a->eps_scale, org, v3_len(dir))));
+    assert(!(hit->t < t0 - eps_rule(a->ray_eps_scale, org, v3_len(dir))) &&
+           !(hit->t > tmax + eps_rule(a->ray_eps_scale, org, v3_len(dir))));
     assert(fabs(v3_len2(hit->ng) - 1.0) < 1e-6 && fabs(v3_len2(hit->ns) - 1.0) < 1e-6);
     assert(v3_dot(hit->ng, hit->ns) >= 0.0);
     assert(hit->obj && hit->texture);
@@ -1031,7 +1056,7 @@ static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tm
 int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, accel_hit *hit)
 {
     if (!a || !ray_ok(org, dir)) return 0;
-    double t0 = eps_rule(a->eps_scale, org, v3_len(dir));
+    double t0 = eps_rule(a->ray_eps_scale, org, v3_len(dir));
     if (tmin > t0) t0 = tmin;
     if (!(tmax > t0)) return 0;
     return intersect_at(a, org, dir, t0, tmax, hit);
@@ -1073,7 +1098,7 @@ int accel_crossings_skip(const accel *a, vec3 org, vec3 dir, double tmin, double
                          accel_crossing_fn fn, void *ctx)
 {
     if (!a || !ray_ok(org, dir)) return 0;
-    double t0 = eps_rule(a->eps_scale, org, v3_len(dir));
+    double t0 = eps_rule(a->ray_eps_scale, org, v3_len(dir));
     if (tmin > t0) t0 = tmin;
     if (!(tmax > t0)) return 0;
     accel_crossing cr[CROSS_MAX];
@@ -1145,7 +1170,7 @@ int accel_intersect_from(const accel *a, const accel_from *f, vec3 org, vec3 dir
                          accel_hit *hit)
 {
     if (!a || !ray_ok(org, dir)) return 0;
-    double t0 = eps_rule(a->eps_scale, org, v3_len(dir));
+    double t0 = eps_rule(a->ray_eps_scale, org, v3_len(dir));
     if (tmin > t0) t0 = tmin;
     if (f && contact_hit(a, f, org, dir, fmin_inline(t0, tmax), 0u, hit)) return 1;
     return accel_intersect(a, org, dir, tmin, tmax, hit);
@@ -1171,7 +1196,7 @@ int accel_intersect_past(const accel *a, const accel_from *f, vec3 org, vec3 dir
 int accel_occluded_from(const accel *a, const accel_from *f, vec3 org, vec3 dir, double tmin, double tmax)
 {
     if (!a || !ray_ok(org, dir)) return 0;
-    double t0 = eps_rule(a->eps_scale, org, v3_len(dir));
+    double t0 = eps_rule(a->ray_eps_scale, org, v3_len(dir));
     if (tmin > t0) t0 = tmin;
     accel_hit h;
     if (f && contact_hit(a, f, org, dir, fmin_inline(t0, tmax), OBJ_NO_SHADOW, &h)) return 1;
@@ -1190,7 +1215,7 @@ int accel_mutually_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, 
     /* within the self-intersection distance of p: an object that is not
      * "same" blocks unless it lies parallel to x's surface (contacts, as
      * accel_intersect_from) */
-    double t_eps = fmin_inline(eps_rule(a->eps_scale, p, 1.0), len);
+    double t_eps = fmin_inline(eps_rule(a->ray_eps_scale, p, 1.0), len);
     for (double lo = CONTACT_REL * t_eps; lo < t_eps;) {
         accel_hit h;
         if (!intersect_at(a, p, d, lo, t_eps, &h)) break;
@@ -1350,7 +1375,7 @@ long accel_rtc_triangles(const accel *a, unsigned geom, const float **v, const u
 int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax)
 {
     if (!a || !ray_ok(org, dir)) return 0;
-    double t0 = eps_rule(a->eps_scale, org, v3_len(dir));
+    double t0 = eps_rule(a->ray_eps_scale, org, v3_len(dir));
     if (tmin > t0) t0 = tmin;
     if (!(tmax > t0)) return 0;
     accel_query q;
@@ -1387,7 +1412,7 @@ static int fill_packet16(const accel *a, int k0, int m, const vec3 *org, const v
         int i = k0 + k;
         out[i] = 0;
         if (!a || !ray_ok(org[i], dir[i])) continue;
-        double t0 = eps_rule(a->eps_scale, org[i], v3_len(dir[i]));
+        double t0 = eps_rule(a->ray_eps_scale, org[i], v3_len(dir[i]));
         if (tmin[i] > t0) t0 = tmin[i];
         if (!(tmax[i] > t0)) continue;
         struct RTCRay one;

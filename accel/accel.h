@@ -55,9 +55,12 @@ void accel_free(accel *a);
  *
  * Self-intersection rule: every query uses an effective tmin of
  * max(tmin, accel_epsilon(a, org, dir)), i.e.
- * ACCEL_EPS_REL * (accel_eps_scale + max|org_i|) / |dir|, so a ray leaving a
- * surface does not hit it again at t ~ 0 (reasoning in accel.c). */
+ * ACCEL_EPS_REL * (s + max|org_i|) / |dir|, so a ray leaving a surface does
+ * not hit it again at t ~ 0, with s = accel_eps_scale, times
+ * ACCEL_EXACT_EPS_FACTOR when every shape is closed-form (reasoning in
+ * accel.c). */
 #define ACCEL_EPS_REL 1e-5
+#define ACCEL_EXACT_EPS_FACTOR 1e-3
 /* Thread-safe: any number of threads may query one accel concurrently. */
 
 /* Nearest hit with t in (tmin, tmax); returns 1 on hit. (no_image and

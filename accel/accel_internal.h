@@ -88,6 +88,9 @@ struct accel {
     vec3 lo, hi;
     double scale;
     double eps_scale;  /* working scale of the epsilon rule (see the top) */
+    double ray_eps_scale; /* the scale the rays' rule takes: eps_scale, times
+                             ACCEL_EXACT_EPS_FACTOR when every leaf is closed-form */
+    int inexact_leaves;   /* leaves whose hits are not closed-form in double */
     double *diags;     /* leaf bounding-box diagonals, during the build */
     int ndiags, capdiags;
     geom_shape *bshapes;         /* bounding objects (bounded_by), world space */

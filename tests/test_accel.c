@@ -182,6 +182,43 @@ static void test_epsilon_small_beside_huge(void **st)
     scene_free(s);
 }
 
+/* Shells of a planet-sized sky (advanced/mediasky.pov): spheres of radius
+ * 5e4 and 5e4 + 1 about one centre, with a sun sphere of radius 7.5e4.
+ * Every object is closed-form, so the rays' scale term is 1e-3 of the
+ * median size and a ray leaving the inner shell meets the outer one 1 unit
+ * on (1e-5 of the working scale alone would be about 1.5, past it). One
+ * triangle anywhere puts the float margin back (the median size again),
+ * and the same ray then skips the gap: the rule is per scene, stated in
+ * accel.c. */
+static void test_epsilon_closed_form_shells(void **st)
+{
+    (void)st;
+    for (int with_triangle = 0; with_triangle < 2; with_triangle++) {
+        scene *s = scene_new();
+        diag *d = diag_new();
+        sphere(s, v3(0, -5e4, 0), 5e4);
+        scene_object *outer = sphere(s, v3(0, -5e4, 0), 5e4 + 1.0);
+        sphere(s, v3(1e6, 0, 0), 7.5e4);
+        if (with_triangle) triangle(s, v3(1e6, 1e6, 1e6), v3(1e6 + 1, 1e6, 1e6), v3(1e6, 1e6 + 1, 1e6));
+        accel *a = build(s, d);
+        /* leaving the inner shell's top (y = 0) upwards */
+        double e = accel_epsilon(a, v3(0, 0, 0), v3(0, 1, 0));
+        accel_hit h;
+        int hit = accel_intersect(a, v3(0, 0, 0), v3(0, 1, 0), 0.0, INFINITY, &h);
+        if (!with_triangle) {
+            assert_true(e < 0.01); /* 1e-5 * 1e-3 * (median diagonal ~1.7e5) */
+            assert_true(hit);
+            assert_ptr_equal(h.obj, outer);
+            assert_true(fabs(h.t - 1.0) < 1e-9);
+        } else {
+            assert_true(e > 1.0); /* the median diagonal's 1e-5 */
+        }
+        accel_free(a);
+        diag_free(d);
+        scene_free(s);
+    }
+}
+
 static void test_box_faces(void **st)
 {
     (void)st;
@@ -1504,6 +1541,7 @@ int main(void)
         cmocka_unit_test(test_bare_embree),
         cmocka_unit_test(test_threads),
         cmocka_unit_test(test_epsilon_small_beside_huge),
+        cmocka_unit_test(test_epsilon_closed_form_shells),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
