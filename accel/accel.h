@@ -193,6 +193,12 @@ const scene_object *accel_rtc_object_tri(const accel *a, unsigned geom, unsigned
  * ids. */
 const scene_object *accel_rtc_leaf(const accel *a, unsigned geom, unsigned prim, unsigned inst, float u,
                                    const scene_texture **tex);
+/* Every leaf accel_rtc_leaf can name: leaf i of [0, accel_leaf_count) and
+ * its texture as accel_rtc_leaf gives it (*tex; NULL where the leaf and
+ * its CSG parents have none; a mesh's texture_list entries are read
+ * through scene_mesh_tri_texture). */
+int accel_leaf_count(const accel *a);
+const scene_object *accel_leaf_at(const accel *a, int i, const scene_texture **tex);
 /* Embree geometry ids run over [0, accel_rtc_ngeoms). For a geometry of
  * world-space triangles (the ids rtcIntersect on accel_rtc_scene or
  * accel_rtc_link_scene reports with an invalid instID), its triangle count,

@@ -45,6 +45,7 @@ typedef struct {
     int nlights;
     int exact;            /* view points with no bounce after the hit: every hit takes hit_light */
     float *reach;         /* per source (i - first): the harmonic mean of its rays' hit distances */
+    int occlude;          /* the gatherer's rays where a hit brings nothing (hits_dark): occlusion tests */
     int points;           /* the sources are the final gather's points, not particles */
     /* mirror reflections at the hits (the final gather's points and the
      * gatherer, job_mirror): the gather rays' trace level and weight, the
@@ -778,6 +779,39 @@ static void job_mirror(link_job *J, const scene *sc)
     J->mweight = fmax(J->madc + 1e-10, 0.5 * (isfinite(rr.brightness) ? rr.brightness : 1.0));
 }
 
+/* Whether texture t, where an exact gather's ray hits it, can bring light
+ * back without a light to reflect: its emission, or (where followed) a
+ * mirror's reflection or a transmission (hit_light_at's cases). */
+static int tex_dark(const link_job *J, emit_memo *memo, const scene_texture *t)
+{
+    const emit_memo_entry *m = memo_of(J, memo, t);
+    return !m->emits && !(J->mirror && (m->mirrors || m->clear));
+}
+
+/* Whether every ray of J's exact gather that hits something brings
+ * nothing back: no light to reflect there, no far-field sky, and no leaf
+ * texture (hit_leaf's choice where a leaf has none, a mesh's texture_list
+ * entries too) that emits, mirrors or lets light through. A sky-lit scene
+ * of diffuse surfaces under recursion_limit 1 is one (stackerday.pov):
+ * what reaches a point is the sky its rays see, so an occlusion test
+ * answers each ray. */
+static int hits_dark(const link_job *J)
+{
+    if (!J->esky || !J->exact || J->nlights > 0 || J->far_bounce > 0.0f || !J->sc) return 0;
+    emit_memo memo = {0};
+    if (!tex_dark(J, &memo, &J->sc->default_texture)) return 0;
+    for (int i = 0, n = accel_leaf_count(J->a); i < n; i++) {
+        const scene_texture *t;
+        const scene_object *o = accel_leaf_at(J->a, i, &t);
+        if (!o) continue;
+        if (!tex_dark(J, &memo, t ? t : o->texture ? o->texture : &J->sc->default_texture)) return 0;
+        if (o->kind == SHAPE_MESH && o->u.mesh.mesh && o->u.mesh.textures)
+            for (int k = 0; k < o->u.mesh.mesh->ntextures; k++)
+                if (o->u.mesh.textures[k] && !tex_dark(J, &memo, o->u.mesh.textures[k])) return 0;
+    }
+    return 1;
+}
+
 static void job_close(link_job *J)
 {
     for (int t = 0; t < J->threads; t++) {
@@ -872,8 +906,11 @@ gi_gatherer *gi_gatherer_new(const accel *a, void *rtc_scene, int nside, uint64_
         return NULL;
     }
     job_mirror(J, sc);
+    J->occlude = hits_dark(J);
     return g;
 }
+
+int gi_gatherer_dark(const gi_gatherer *g) { return g && g->J.occlude; }
 
 int gi_gatherer_point(gi_gatherer *g, int thread, vec3 p, vec3 n, uint64_t stream, float e[3], float *reach)
 {
@@ -886,8 +923,21 @@ int gi_gatherer_point(gi_gatherer *g, int thread, vec3 p, vec3 n, uint64_t strea
         if (!rh) return 0;
     }
     source_rays(J, p, n, stream, rh);
-    trace_rays(J, rh, J->k);
     float sky[3] = {0.0f, 0.0f, 0.0f};
+    if (J->occlude && !reach) {
+        /* a hit brings nothing (hits_dark): a ray that leaves the scene
+         * takes the sky, found by an occlusion test (Embree stops at any
+         * hit, a CSG at its first kept crossing: geom_csg_occludes) */
+        struct RTCIntersectContext c;
+        rtcInitIntersectContext(&c);
+        c.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+        rtcOccluded1M(J->scene, &c, &rh[0].ray, (unsigned)J->k, sizeof *rh);
+        for (int j = 0; j < J->k; j++)
+            if (rh[j].ray.tfar >= 0.0f) ray_sky(J, &rh[j], sky); /* an occluded ray's tfar is -inf */
+        for (int c3 = 0; c3 < 3; c3++) e[c3] = sky[c3] / (float)J->k;
+        return 1;
+    }
+    trace_rays(J, rh, J->k);
     emit_memo memo = {0};
     for (int j = 0; j < J->k; j++) {
         if (ray_hit(&rh[j]))

@@ -90,6 +90,11 @@ typedef struct gi_gatherer gi_gatherer;
 gi_gatherer *gi_gatherer_new(const accel *a, void *rtc_scene, int nside, uint64_t seed,
                              const gi_sky *sky, const scene *sc, gi_pigment_fn pig);
 int gi_gatherer_point(gi_gatherer *g, int thread, vec3 p, vec3 n, uint64_t stream, float e[3], float *reach);
+/* 1 when no ray of g that hits something can bring light back (no light
+ * to reflect, no texture that emits, mirrors or lets light through: a
+ * sky-lit scene of diffuse surfaces): its points without a reach are then
+ * answered by occlusion tests alone, the same answer for less time. */
+int gi_gatherer_dark(const gi_gatherer *g);
 void gi_gatherer_free(gi_gatherer *g);
 
 /* Incoming links, a counting sort by target: the sources i < n in mask

@@ -430,6 +430,11 @@ done:
 /* the side of a refinement gather over the corners' side
  * (gi_particle_view_gather) */
 #define REFINE_SIDE_FRAC 0.71
+/* the self-gathering hits' side where their rays are occlusion tests
+ * (gi_gatherer_dark) over the side otherwise: chosen so that the render's
+ * CPU time is about that of nearest-hit rays at the smaller side
+ * (docs/gi.md, "Gather rays that only need the sky") */
+#define DARK_SIDE_GAIN (4.0 / 3.0)
 static int needs_own(const gi_particle *gp, size_t i)
 {
     int x = (int)(i % (size_t)gp->vw), y = (int)(i / (size_t)gp->vw);
@@ -560,6 +565,15 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
         if (hs < 4) hs = 4;
         gp->vg_gatherer = gi_gatherer_new(gp->a, gp->lscene, hs, gp->set.seed ^ 0x51d3ULL, gp->sky, gp->sc,
                                           gp->set.pigment);
+        /* where its rays need only occlusion tests (gi_gatherer_dark), the
+         * time of hs^2 nearest-hit rays buys about DARK_SIDE_GAIN^2 times
+         * as many: less noise for the same time */
+        int hd = (int)ceil(hs * DARK_SIDE_GAIN - 1e-9);
+        if (gp->vg_gatherer && gi_gatherer_dark(gp->vg_gatherer) && hd > hs) {
+            gi_gatherer_free(gp->vg_gatherer);
+            gp->vg_gatherer = gi_gatherer_new(gp->a, gp->lscene, hd, gp->set.seed ^ 0x51d3ULL, gp->sky, gp->sc,
+                                              gp->set.pigment);
+        }
         if (!gp->vg_gatherer) st = PT_ERR_NOMEM;
     }
     if (st == PT_OK) {

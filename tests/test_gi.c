@@ -1450,6 +1450,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_csg_emitter_gather),
         cmocka_unit_test(test_mirror_gather),
         cmocka_unit_test(test_transmit_gather),
+        cmocka_unit_test(test_dark_gather),
         cmocka_unit_test(test_sky_second_bounce),
         cmocka_unit_test(test_direct_matches_whitted),
         cmocka_unit_test(test_determinism),

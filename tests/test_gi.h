@@ -37,6 +37,7 @@ void test_sky_final_gather(void **state);
 void test_csg_emitter_gather(void **state);
 void test_mirror_gather(void **state);
 void test_transmit_gather(void **state);
+void test_dark_gather(void **state);
 void test_sky_second_bounce(void **state);
 
 #endif
