@@ -963,7 +963,13 @@ static void fill_triangle(const accel *a, const accel_leaf *l, unsigned local, d
  * callbacks read through accel_tls_query), with no user-geometry hit yet. */
 static void query_init(accel_query *q, vec3 org, vec3 dir, double t0)
 {
-    *q = (accel_query){.org = org, .dir = dir, .tmin = t0};
+    /* the fields every callback reads; the hit's (ut .. uprim) are read
+     * only once uhit is set, the collect mode's only with cross set */
+    q->org = org;
+    q->dir = dir;
+    q->tmin = t0;
+    q->uhit = 0;
+    q->cross = NULL;
     rtcInitIntersectContext(&q->rtc);
 }
 
@@ -1072,6 +1078,8 @@ static int crossings_collected(const accel *a, vec3 org, vec3 dir, double t0, do
     accel_query q;
     query_init(&q, org, dir, t0);
     q.cross = cr;
+    q.ncross = 0;
+    q.overflow = 0;
     q.maxcross = CROSS_MAX;
     q.ctmax = tmax;
     q.cstep = step;
@@ -1112,7 +1120,7 @@ int accel_crossings_skip(const accel *a, vec3 org, vec3 dir, double tmin, double
             geom_csg_hit g = {.t = cr[i].t, .part = cr[i].part, .shape = cr[i].shape, .flip = cr[i].flip};
             fill_user(a, cr[i].prim, &g, org, dir, &h);
             if (!isfinite(h.t) || !v3_finite(h.p)) continue;
-            t0 = h.t + fmax(step, h.t * 1e-7);
+            t0 = h.t + fmax_inline(step, h.t * 1e-7);
             if (h.flags & skip) continue; /* a member's own flag */
             visited++;
             if (!fn(ctx, &h)) break;
@@ -1121,7 +1129,7 @@ int accel_crossings_skip(const accel *a, vec3 org, vec3 dir, double tmin, double
     }
     for (int k = 0; k < CROSS_MAX && t0 < tmax; k++) {
         if (!intersect_at(a, org, dir, t0, tmax, &h)) break;
-        t0 = h.t + fmax(step, h.t * 1e-7);
+        t0 = h.t + fmax_inline(step, h.t * 1e-7);
         if (h.flags & skip) continue;
         visited++;
         if (!fn(ctx, &h)) break;

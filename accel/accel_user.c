@@ -384,7 +384,7 @@ static int cross_leaf_once(const accel *a, unsigned prim, vec3 o, vec3 d, double
             break;
         }
         q->cross[q->ncross++] = (accel_crossing){hs[j].t, prim, hs[j].part, 0, 0};
-        from = hs[j].t + fmax(q->cstep, hs[j].t * 1e-7);
+        from = hs[j].t + fmax_inline(q->cstep, hs[j].t * 1e-7);
     }
     return 1;
 }

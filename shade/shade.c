@@ -141,7 +141,7 @@ void shade_default_settings(shade_settings *s)
  * larger; at most c->eps means the light touches p (nothing in between). */
 static double shadow_tmax(const render_ctx *c, double depth)
 {
-    return depth - fmax(c->eps, depth * 1e-6);
+    return depth - fmax_inline(c->eps, depth * 1e-6);
 }
 
 static int shadow_blocked(render_ctx *c, int thread, vec3 p, vec3 dir, double depth)
