@@ -1504,7 +1504,7 @@ double accel_eps_scale(const accel *a) { return a ? a->eps_scale : 1.0; }
 
 double accel_surface_eps(const accel *a)
 {
-    double s = accel_eps_scale(a);
+    double s = a ? a->ray_eps_scale : 1.0;
     if (!(s > 0.0) || !isfinite(s)) s = 1.0;
     return s * 1e-6;
 }

@@ -151,8 +151,9 @@ double accel_scale(const accel *a);
  * coarsen the epsilons of the rest; scales with the scene. */
 double accel_eps_scale(const accel *a);
 /* The distance a secondary ray's origin is moved off the surface it leaves
- * (shading offsets, photon and eye-ray tmin): 1e-6 of accel_eps_scale (1e-6
- * where that is not a positive number). One rule for the shader, the
+ * (shading offsets, photon and eye-ray tmin): 1e-6 of the rays' working
+ * scale (accel_eps_scale, times ACCEL_EXACT_EPS_FACTOR in a scene of
+ * closed-form shapes only; 1e-6 where that is not a positive number). One rule for the shader, the
  * caustic layer and the references, so a thin shell (a drinking glass's
  * wall in a scene with a sky sphere of radius 1e6) is crossed alike by all. */
 double accel_surface_eps(const accel *a);

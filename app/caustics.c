@@ -83,7 +83,7 @@ static void setup(const caustics *c, shade_mat_bsdf *b, const accel_hit *h, vec3
                   rng *r)
 {
     double fi = si ? shade_tex_fresnel_ior(si, h->obj, v3_dot(dir, h->ng) < 0.0) : 0.0;
-    shade_mat_setup_fresnel(b, c->sc, h, dir, c->eps, r, fi);
+    shade_mat_setup_fresnel(b, c->sc, h, dir, c->eps, c->scale, r, fi);
 }
 
 static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, const gi_caustic_inside *in, rng *r,
@@ -172,7 +172,7 @@ static double hook_brilliance(void *ctx, const accel_hit *h, vec3 dir)
 {
     const caustics *c = ctx;
     shade_mat_bsdf b;
-    shade_mat_setup(&b, c->sc, h, dir, c->eps, NULL);
+    shade_mat_setup(&b, c->sc, h, dir, c->eps, c->scale, NULL);
     return b.ls.f ? b.ls.f->brilliance : 1.0;
 }
 
@@ -276,6 +276,7 @@ pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width
     not_modelled(c, sc, d);
     c->sc = sc;
     c->eps = accel_surface_eps(a); /* the shader's offsets: photons cross thin walls as eye rays do */
+    c->scale = accel_eps_scale(a);
     gi_caustic_hooks hk = {hook_surface, hook_attenuation, c, hook_brilliance, hook_pass, hook_containers, hook_media};
     gi_caustic_settings s = {width, height, threads, seed, cl_device, cl_max_bytes, count_scale, cancel};
     pt_status st = PT_OK;

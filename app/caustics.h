@@ -31,6 +31,7 @@ typedef struct {
     void *next_ctx;
     const scene *sc;    /* the hooks' scene and offset epsilon (shade.c's rule) */
     double eps;
+    double scale;       /* the scene's working scale (accel_eps_scale) */
 } caustics;
 
 /* Builds the layer (c must stay where it is while the layer is used: it

@@ -239,7 +239,7 @@ static int make_one(const vpl_job *j, int i, rng *r, long *shadow)
     for (int side = 0; side < 2; side++) {
         vec3 ns = side ? v3_neg(s.n) : s.n;
         shade_mat_bsdf b;
-        shade_mat_setup(&b, sc, &h, v3_neg(ns), eps, r);
+        shade_mat_setup(&b, sc, &h, v3_neg(ns), eps, accel_eps_scale(j->a), r);
         b.gathered = 1; /* what a gathering ray sees: no highlights, area lights at their centre */
         rgb e = pm_direct_lights(L, &b, 1, r, shadow);
         shade_mat_bsdf bl = b; /* emitters through the Lambertian lobes only */
@@ -462,7 +462,7 @@ static void eye_trace(eye_ctx *c, int y, int pixel, const accel_from *from, vec3
         return;
     }
     shade_mat_bsdf b;
-    shade_mat_setup(&b, c->sc, &h, dir, c->eps, r);
+    shade_mat_setup(&b, c->sc, &h, dir, c->eps, accel_eps_scale(c->a), r);
     rgb e = b.emission;
     if (b.nee) {
         rgb dl = pm_direct_lights(c->L, &b, 1, r, &c->shadow[y]);
@@ -562,7 +562,7 @@ static void eye_row(void *ctx, int y, int thread)
         }
         if (hit) {
             shade_mat_bsdf b;
-            shade_mat_setup(&b, c->sc, &h, dir, c->eps, &r);
+            shade_mat_setup(&b, c->sc, &h, dir, c->eps, accel_eps_scale(c->a), &r);
             if (b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 || b.m[SHADE_MAT_LOBE_GLOSSY] > 0.0) {
                 point_of(&b, c->lift, &c->centre[pixel]);
                 c->centre[pixel].pixel = pixel;

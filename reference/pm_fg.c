@@ -252,7 +252,7 @@ static rgb gather_hit(const fg_ctx *c, const shade_mat_bsdf *b, uint32_t surf, i
             acc_add(&L, w, pm_sky(c->sc, dir));
         } else {
             shade_mat_bsdf b2;
-            shade_mat_setup(&b2, c->sc, &h, dir, c->eps, r);
+            shade_mat_setup(&b2, c->sc, &h, dir, c->eps, accel_eps_scale(c->a), r);
             b2.gathered = 1;
             double we = lobe == SHADE_MAT_LOBE_GLOSSY ? pm_mis(pg * pdf, pm_emitter_density(c->L, &h, org, 1)) : 1.0;
             acc_add(&L, w, frgb(b2.emission.r * we, b2.emission.g * we, b2.emission.b * we));
@@ -286,7 +286,7 @@ static rgb gather_ray(const fg_ctx *c, const shade_mat_bsdf *b, vec3 org, vec3 w
         return sum;
     }
     shade_mat_bsdf b2;
-    shade_mat_setup(&b2, c->sc, &h, w, c->eps, r);
+    shade_mat_setup(&b2, c->sc, &h, w, c->eps, accel_eps_scale(c->a), r);
     b2.gathered = 1;
     rgb le = b2.emission;
     if (le.r != 0.0 || le.g != 0.0 || le.b != 0.0) {
@@ -367,7 +367,7 @@ static void eye_trace(const fg_ctx *c, const accel_from *from, vec3 org, vec3 di
         return;
     }
     shade_mat_bsdf b;
-    shade_mat_setup(&b, c->sc, &h, dir, c->eps, r);
+    shade_mat_setup(&b, c->sc, &h, dir, c->eps, accel_eps_scale(c->a), r);
     if (b.unsupported) cnt->unsupported++;
     acc_add(L, T, b.emission);
     if (b.nee) acc_add(L, T, pm_direct_lights(c->L, &b, c->s->area_samples, r, &cnt->shadow));

@@ -86,7 +86,7 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
             break;
         }
         shade_mat_bsdf b;
-        shade_mat_setup(&b, sc, &h, dir, c->eps, r);
+        shade_mat_setup(&b, sc, &h, dir, c->eps, accel_eps_scale(c->a), r);
         b.gathered = nd > 0;
         if (b.unsupported) cnt->unsupported++;
         rgb le = b.emission;

@@ -150,7 +150,7 @@ static int light_first_hit(const trace_ctx *c, vec3 o, vec3 w, accel_hit *h, rgb
         accel_hit hp = *h;
         hp.t = h->t - tprev;
         shade_mat_bsdf b;
-        shade_mat_setup(&b, c->sc, &hp, w, c->eps, NULL);
+        shade_mat_setup(&b, c->sc, &hp, w, c->eps, accel_eps_scale(c->a), NULL);
         rgb f = shade_mat_photon_filter(c->sc, &hp, w, &b, b.k[SHADE_MAT_LOBE_REFLECT], NULL);
         *phi = crgb(phi->r * f.r, phi->g * f.g, phi->b * f.b);
         if (!(cmax(*phi) > 0.0) || !isfinite(phi->r + phi->g + phi->b)) return 0;
@@ -336,7 +336,7 @@ static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume,
     }
     for (int bounce = L.bounce;; bounce++) {
         shade_mat_bsdf b;
-        shade_mat_setup(&b, c->sc, &h, w, c->eps, &r);
+        shade_mat_setup(&b, c->sc, &h, w, c->eps, accel_eps_scale(c->a), &r);
         int lambert = b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 || b.m[SHADE_MAT_LOBE_BACK] > 0.0;
         int collect = !(h.obj && h.obj->photons && !h.obj->photons->collect); /* photons { collect off } */
         int g = from_light ? nd : nd + 1;

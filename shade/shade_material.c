@@ -238,12 +238,14 @@ static void setup_glossy(shade_mat_bsdf *b, const scene *sc, const scene_texture
     b->k[SHADE_MAT_LOBE_GLOSSY] = kg;
 }
 
-void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r)
+void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, double scale,
+                     rng *r)
 {
-    shade_mat_setup_fresnel(b, sc, h, dir, eps, r, 0.0);
+    shade_mat_setup_fresnel(b, sc, h, dir, eps, scale, r, 0.0);
 }
 
-void shade_mat_setup_fresnel(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r,
+void shade_mat_setup_fresnel(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps,
+                             double scale, rng *r,
                              double fresnel_ior)
 {
     memset(b, 0, sizeof *b);
@@ -337,7 +339,7 @@ void shade_mat_setup_fresnel(shade_mat_bsdf *b, const scene *sc, const accel_hit
     }
     b->k[SHADE_MAT_LOBE_REFLECT] = refl;
     b->k[SHADE_MAT_LOBE_TRANSMIT] = trans;
-    setup_glossy(b, sc, tex, f, eps * 1e6); /* eps is the scene size * 1e-6 */
+    setup_glossy(b, sc, tex, f, scale);
     b->msum = 0.0;
     for (int i = 0; i < SHADE_MAT_NLOBES; i++) {
         double m = mrgb_max(b->k[i]);

@@ -149,14 +149,18 @@ rgb shade_mat_texture_emission(const scene *sc, const scene_texture *tex);
 int shade_mat_texture_varies(const scene_texture *tex);
 
 /* Set up the BSDF at hit `h` for a ray of unit direction `dir`. `eps` is the
- * distance the origins are moved off the surface (shade.c's rule: accel_scale
- * * 1e-6). `r` feeds crand in shade_light_terms. */
-void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r);
+ * distance the origins are moved off the surface (accel_surface_eps);
+ * `scale` the scene's working scale (accel_eps_scale), against which the
+ * glossy blur's test decides that a normal pattern is micro-scale. `r`
+ * feeds crand in shade_light_terms. */
+void shade_mat_setup(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, double scale,
+                     rng *r);
 /* shade_mat_setup with the fresnel reflectivity's relative ior given
  * (fresnel_ior > 0; POV-Ray's ComputeRelativeIOR from the ray's interior
  * list, shade_tex_fresnel_ior) instead of the hit object's own across its
  * surface; refraction keeps the object's own. */
-void shade_mat_setup_fresnel(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps, rng *r,
+void shade_mat_setup_fresnel(shade_mat_bsdf *b, const scene *sc, const accel_hit *h, vec3 dir, double eps,
+                             double scale, rng *r,
                              double fresnel_ior);
 
 /* Lambertian part of f (no cosine) for unit wi (towards where light comes
