@@ -959,9 +959,13 @@ static void fill_triangle(const accel *a, const accel_leaf *l, unsigned local, d
     hit->flags = l->flags;
 }
 
+_Static_assert((int)ACCEL_RAY_POV == (int)GEOM_RAY_POV && (int)ACCEL_RAY_EXACT == (int)GEOM_RAY_EXACT,
+               "accel's ray rules are geom's");
+
 /* The intersect context of a ray org + t dir from t0 (what the user-geometry
- * callbacks read through accel_tls_query), with no user-geometry hit yet. */
-static void query_init(accel_query *q, vec3 org, vec3 dir, double t0)
+ * callbacks read through accel_tls_query), with no user-geometry hit yet,
+ * under `rule`. */
+static void query_init(accel_query *q, vec3 org, vec3 dir, double t0, accel_ray_rule rule)
 {
     /* the fields every callback reads; the hit's (ut .. uprim) are read
      * only once uhit is set, the collect mode's only with cross set */
@@ -970,6 +974,8 @@ static void query_init(accel_query *q, vec3 org, vec3 dir, double t0)
     q->tmin = t0;
     q->uhit = 0;
     q->cross = NULL;
+    q->rule = (geom_ray_rule)rule;
+    q->packet = 0;
     rtcInitIntersectContext(&q->rtc);
 }
 
@@ -1009,11 +1015,12 @@ static void fill_user(const accel *a, unsigned prim, const geom_csg_hit *h, vec3
     hit->flags = l->flags;
 }
 
-/* accel_intersect with the effective tmin t0 as given. */
-static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tmax, accel_hit *hit)
+/* accel_intersect_rule with the effective tmin t0 as given. */
+static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tmax, accel_hit *hit,
+                        accel_ray_rule rule)
 {
     accel_query q;
-    query_init(&q, org, dir, t0);
+    query_init(&q, org, dir, t0, rule);
     struct RTCRayHit rh;
     fill_rtc_ray(&rh.ray, org, dir, t0, tmax);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -1040,7 +1047,7 @@ static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tm
             h.part = q.upart;
             h.shape = q.ushape;
             h.flip = q.uflip;
-        } else if (!accel_prim_hit(a, prim, org, dir, t0, tmax, &h)) {
+        } else if (!accel_prim_hit(a, prim, org, dir, t0, tmax, &h, q.rule)) {
             return 0;
         }
         fill_user(a, prim, &h, org, dir, hit);
@@ -1059,13 +1066,28 @@ static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tm
     return isfinite(hit->t) && v3_finite(hit->p);
 }
 
-int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, accel_hit *hit)
+int accel_intersect_rule(const accel *a, accel_ray_rule rule, vec3 org, vec3 dir, double tmin, double tmax,
+                         accel_hit *hit)
 {
     if (!a || !ray_ok(org, dir)) return 0;
     double t0 = eps_rule(a->ray_eps_scale, org, v3_len(dir));
     if (tmin > t0) t0 = tmin;
     if (!(tmax > t0)) return 0;
-    return intersect_at(a, org, dir, t0, tmax, hit);
+    return intersect_at(a, org, dir, t0, tmax, hit, rule);
+}
+
+int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, accel_hit *hit)
+{
+    return accel_intersect_rule(a, ACCEL_RAY_POV, org, dir, tmin, tmax, hit);
+}
+
+double accel_hit_placement(const scene_object *o)
+{
+    /* the far end of a halving piece shorter than accuracy (geom_shape.h,
+     * GEOM_RAY_POV): within accuracy of the root along the ray, so within
+     * accuracy of the surface; the parser gives every isosurface a
+     * positive accuracy */
+    return o && o->kind == SHAPE_ISOSURFACE && o->u.isosurface ? o->u.isosurface->accuracy : 0.0;
 }
 
 /* accel_crossings in one traversal: possible when every geometry is user
@@ -1076,7 +1098,7 @@ static int crossings_collected(const accel *a, vec3 org, vec3 dir, double t0, do
 {
     if (a->has_tri_geoms || a->has_costly_crossings) return -1;
     accel_query q;
-    query_init(&q, org, dir, t0);
+    query_init(&q, org, dir, t0, ACCEL_RAY_POV);
     q.cross = cr;
     q.ncross = 0;
     q.overflow = 0;
@@ -1128,7 +1150,7 @@ int accel_crossings_skip(const accel *a, vec3 org, vec3 dir, double tmin, double
         return visited;
     }
     for (int k = 0; k < CROSS_MAX && t0 < tmax; k++) {
-        if (!intersect_at(a, org, dir, t0, tmax, &h)) break;
+        if (!intersect_at(a, org, dir, t0, tmax, &h, ACCEL_RAY_POV)) break;
         t0 = h.t + fmax_inline(step, h.t * 1e-7);
         if (h.flags & skip) continue;
         visited++;
@@ -1156,7 +1178,7 @@ static int contact_hit(const accel *a, const accel_from *f, vec3 org, vec3 dir, 
 {
     double lo = CONTACT_REL * t_eps;
     for (int k = 0; k < 8 && lo < t_eps; k++) {
-        if (!intersect_at(a, org, dir, lo, t_eps, hit)) return 0;
+        if (!intersect_at(a, org, dir, lo, t_eps, hit, ACCEL_RAY_POV)) return 0;
         int own = hit->obj == f->obj && hit->prim == f->prim;
         double c = v3_dot(hit->ng, f->ng);
         double nn = v3_len(hit->ng) * v3_len(f->ng);
@@ -1226,7 +1248,7 @@ int accel_mutually_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, 
     double t_eps = fmin_inline(eps_rule(a->ray_eps_scale, p, 1.0), len);
     for (double lo = CONTACT_REL * t_eps; lo < t_eps;) {
         accel_hit h;
-        if (!intersect_at(a, p, d, lo, t_eps, &h)) break;
+        if (!intersect_at(a, p, d, lo, t_eps, &h, ACCEL_RAY_EXACT)) break;
         double c = v3_dot(h.ng, nx), nn = v3_len(h.ng) * v3_len(nx);
         if (!same(h.obj, ctx) && !(nn > 0.0 && fabs(c) > CONTACT_COS * nn)) return 0;
         lo = h.t + fmax_inline(lo, h.t * 1e-7);
@@ -1234,7 +1256,7 @@ int accel_mutually_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, 
     double tmin = 0.0;
     for (int k = 0; k < 8; k++) {
         accel_hit h;
-        if (!accel_intersect(a, p, d, tmin, len, &h)) return 1;
+        if (!accel_intersect_rule(a, ACCEL_RAY_EXACT, p, d, tmin, len, &h)) return 1;
         if (!same(h.obj, ctx)) return 0;
         tmin = h.t + fmax_inline(eps, h.t * 1e-7);
     }
@@ -1397,7 +1419,7 @@ int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax)
     if (tmin > t0) t0 = tmin;
     if (!(tmax > t0)) return 0;
     accel_query q;
-    query_init(&q, org, dir, t0);
+    query_init(&q, org, dir, t0, ACCEL_RAY_POV);
     struct RTCRay r;
     fill_rtc_ray(&r, org, dir, t0, tmax);
     accel_query *saved = accel_tls_query;
@@ -1454,7 +1476,7 @@ static int fill_packet16(const accel *a, int k0, int m, const vec3 *org, const v
  * query's skipping of no_shadow objects would get wrong: they block the
  * cells' segments too), in packets of 16. */
 static void query_n(const accel *a, int n, const vec3 *org, const vec3 *dir, const double *tmin, const double *tmax,
-                    unsigned char *out, int nearest)
+                    unsigned char *out, int nearest, accel_ray_rule rule)
 {
     for (int k0 = 0; k0 < n; k0 += 16) {
         int m = n - k0 < 16 ? n - k0 : 16;
@@ -1467,14 +1489,15 @@ static void query_n(const accel *a, int n, const vec3 *org, const vec3 *dir, con
                 r.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
                 r.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
             }
-        struct RTCIntersectContext c;
-        rtcInitIntersectContext(&c);
-        c.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-        /* no accel_query: user geometry takes the packet's float rays */
+        /* a packet's context: user geometry takes the packet's float
+         * rays (no double ray), under the query's rule */
+        accel_query q = {.rule = (geom_ray_rule)rule, .packet = 1};
+        rtcInitIntersectContext(&q.rtc);
+        q.rtc.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
         accel_query *saved = accel_tls_query;
-        accel_tls_query = NULL;
-        if (nearest) rtcIntersect16(valid, a->root, &c, &r);
-        else rtcOccluded16(valid, a->root, &c, &r.ray);
+        accel_tls_query = &q;
+        if (nearest) rtcIntersect16(valid, a->root, &q.rtc, &r);
+        else rtcOccluded16(valid, a->root, &q.rtc, &r.ray);
         accel_tls_query = saved;
         for (int k = 0; k < m; k++)
             if (valid[k]) out[k0 + k] = nearest ? r.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID : r.ray.tfar[k] == -INFINITY;
@@ -1484,13 +1507,13 @@ static void query_n(const accel *a, int n, const vec3 *org, const vec3 *dir, con
 void accel_occluded_n(const accel *a, int n, const vec3 *org, const vec3 *dir, const double *tmin,
                       const double *tmax, unsigned char *out)
 {
-    query_n(a, n, org, dir, tmin, tmax, out, 0);
+    query_n(a, n, org, dir, tmin, tmax, out, 0, ACCEL_RAY_POV);
 }
 
-void accel_hit_any_n(const accel *a, int n, const vec3 *org, const vec3 *dir, const double *tmin,
-                     const double *tmax, unsigned char *out)
+void accel_hit_any_n(const accel *a, accel_ray_rule rule, int n, const vec3 *org, const vec3 *dir,
+                     const double *tmin, const double *tmax, unsigned char *out)
 {
-    query_n(a, n, org, dir, tmin, tmax, out, 1);
+    query_n(a, n, org, dir, tmin, tmax, out, 1, rule);
 }
 
 void accel_bounds(const accel *a, vec3 *lo, vec3 *hi)

@@ -63,9 +63,35 @@ void accel_free(accel *a);
 #define ACCEL_EXACT_EPS_FACTOR 1e-3
 /* Thread-safe: any number of threads may query one accel concurrently. */
 
+/* How a query's ray meets the surfaces whose crossings are searched for
+ * along it (isosurfaces; every other shape is met at its exact crossings
+ * under both rules; geom_shape.h's rules):
+ * ACCEL_RAY_POV: POV-Ray 3.7's rules for its rays: the hit is placed at
+ *   the far end of the halving piece shorter than `accuracy` that holds
+ *   the crossing (up to accuracy beyond the surface: accel_hit_placement),
+ *   and a ray that starts on the surface searches from 5 accuracy on (a
+ *   shadow ray from a noise-displaced surface under a grazing light meets
+ *   the next fold, as in POV-Ray's images). Every query below that does
+ *   not name its rule uses it: they trace the renderer's rays (camera,
+ *   reflected, refracted, shadow, photon and GI rays).
+ * ACCEL_RAY_EXACT: every crossing at its root, from tmin on: queries
+ *   between two points on surfaces that count or step over the crossings
+ *   between them (visibility for density estimates), which a hit placed
+ *   inside a surface or a search that starts 5 accuracy on would
+ *   miscount. */
+typedef enum { ACCEL_RAY_POV = 0, ACCEL_RAY_EXACT = 1 } accel_ray_rule;
+
 /* Nearest hit with t in (tmin, tmax); returns 1 on hit. (no_image and
- * no_reflection are not applied here yet: callers see them in hit->obj->flags.) */
+ * no_reflection are not applied here yet: callers see them in hit->obj->flags.)
+ * accel_intersect is accel_intersect_rule under ACCEL_RAY_POV. */
 int accel_intersect(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, accel_hit *hit);
+int accel_intersect_rule(const accel *a, accel_ray_rule rule, vec3 org, vec3 dir, double tmin, double tmax,
+                         accel_hit *hit);
+/* How far from its exact surface an ACCEL_RAY_POV hit on leaf object o may
+ * lie (world length): an isosurface's accuracy, 0 for every other shape. A
+ * visibility test from such a hit lifts it by more than this, so that it
+ * starts on the outer side of the surface it lies on. */
+double accel_hit_placement(const scene_object *o);
 /* Every surface the ray crosses with t in (tmin, tmax) (tmin as for
  * accel_intersect), nearest first, each the nearest at least
  * max(step, 1e-7 t) past the one before (at most 256): fn gets each and
@@ -84,7 +110,8 @@ int accel_crossings(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
  * the one-traversal walk such primitives are not asked at all. */
 int accel_crossings_skip(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, unsigned skip,
                          accel_crossing_fn fn, void *ctx);
-/* Mutual visibility of two surface points for density estimates: 1 when
+/* Mutual visibility of two surface points for density estimates
+ * (ACCEL_RAY_EXACT: it steps over crossings between the points): 1 when
  * the segment from x + lift*nx to y + lift*ny (lift = 16 eps) crosses no
  * object for which same(obj, ctx) is 0; crossings of "same" objects are
  * stepped over (at most 8); inside the self-intersection distance only
@@ -140,8 +167,8 @@ void accel_occluded_n(const accel *a, int n, const vec3 *org, const vec3 *dir, c
  * something (then accel_intersect tells what). Triangles see the same float
  * ray as accel_intersect's; analytic shapes see the packet's float rays
  * where accel_intersect gives them its double ray. */
-void accel_hit_any_n(const accel *a, int n, const vec3 *org, const vec3 *dir, const double *tmin,
-                     const double *tmax, unsigned char *out);
+void accel_hit_any_n(const accel *a, accel_ray_rule rule, int n, const vec3 *org, const vec3 *dir,
+                     const double *tmin, const double *tmax, unsigned char *out);
 /* World bounds of finite geometry (infinite planes excluded) and a scene
  * scale (bounding-box diagonal) for epsilons. */
 void accel_bounds(const accel *a, vec3 *lo, vec3 *hi);

@@ -130,6 +130,8 @@ typedef struct {
     int ncross, maxcross, overflow;
     double ctmax, cstep;
     unsigned cskip; /* primitives whose effective flags carry one of these are not asked */
+    geom_ray_rule rule; /* how searched-for surfaces are met (accel_ray_rule) */
+    int packet;         /* a packet query's context: no double ray (org, dir, tmin unset) */
 } accel_query;
 
 /* The query of this thread (the callbacks tell our context from a plain
@@ -156,8 +158,10 @@ void accel_user_box(const accel *a, unsigned prim, float out[6]);
 int accel_user_box_test(const accel *a, unsigned prim, unsigned np);
 void accel_user_bounds(const struct RTCBoundsFunctionArguments *args);
 void accel_user_bounds_link(const struct RTCBoundsFunctionArguments *args);
-/* Primitive prim's nearest hit in (tmin, tmax) of the double ray o + t d. */
-int accel_prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, double tmax, geom_csg_hit *h);
+/* Primitive prim's nearest hit in (tmin, tmax) of the double ray o + t d,
+ * placed by `rule`. */
+int accel_prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, double tmax, geom_csg_hit *h,
+                   geom_ray_rule rule);
 /* The shape of primitive prim (member: its CSG member, else -1). */
 const geom_shape *accel_prim_shape(const accel *a, unsigned prim, int member);
 void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args);

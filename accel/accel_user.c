@@ -115,13 +115,13 @@ int accel_collect_bounds(accel *a, diag *d, const scene_object *o, int own, int 
 
 /* POV-Ray's Ray_In_Bound: the ray meets every bound ahead of its origin or
  * starts inside it. */
-static int ray_in_bound(const accel *a, int b0, int bn, vec3 o, vec3 d, double tmin)
+static int ray_in_bound(const accel *a, int b0, int bn, vec3 o, vec3 d, double tmin, geom_ray_rule rule)
 {
     for (int i = 0; i < bn; i++) {
         const geom_shape *b = &a->bshapes[b0 + i];
         geom_shape_hit h;
         if (geom_shape_inside(b, o)) continue;
-        if (!geom_shape_intersect(b, o, d, tmin, INFINITY, &h)) return 0;
+        if (!geom_shape_intersect(b, o, d, tmin, INFINITY, &h, rule)) return 0;
     }
     return 1;
 }
@@ -268,16 +268,17 @@ static int box_missed(const accel *a, unsigned prim, void *ray, unsigned N, unsi
 }
 
 /* One user primitive against a ray: an analytic shape or a CSG tree. */
-int accel_prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, double tmax, geom_csg_hit *h)
+int accel_prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, double tmax, geom_csg_hit *h,
+                   geom_ray_rule rule)
 {
     assert(prim < (unsigned)(a->nshapes + a->ncsgs));
     if (prim < (unsigned)a->nshapes) {
         /* the bound first: it is the cheaper test, and both must pass */
         assert(a->shape_leaf[prim] < (unsigned)a->nleaves);
         const accel_leaf *l = &a->leaves[a->shape_leaf[prim]];
-        if (l->bn && !ray_in_bound(a, l->b0, l->bn, o, d, tmin)) return 0;
+        if (l->bn && !ray_in_bound(a, l->b0, l->bn, o, d, tmin, rule)) return 0;
         geom_shape_hit sh;
-        if (!geom_shape_intersect(&a->shapes[prim], o, d, tmin, tmax, &sh)) return 0;
+        if (!geom_shape_intersect(&a->shapes[prim], o, d, tmin, tmax, &sh, rule)) return 0;
         assert(sh.t > tmin && sh.t < tmax);
         h->t = sh.t;
         h->part = sh.part;
@@ -286,23 +287,23 @@ int accel_prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, d
         return 1;
     }
     unsigned ci = prim - (unsigned)a->nshapes;
-    if (a->csg_bn[ci] && !ray_in_bound(a, a->csg_b0[ci], a->csg_bn[ci], o, d, tmin)) return 0;
-    if (!geom_csg_intersect(&a->csgs[ci], o, d, tmin, tmax, h)) return 0;
+    if (a->csg_bn[ci] && !ray_in_bound(a, a->csg_b0[ci], a->csg_bn[ci], o, d, tmin, rule)) return 0;
+    if (!geom_csg_intersect(&a->csgs[ci], o, d, tmin, tmax, h, rule)) return 0;
     assert(h->t > tmin && h->t < tmax && h->shape >= 0 && h->shape < a->csgs[ci].nshapes);
     return 1;
 }
 
 /* Whether prim has a crossing in (tmin, tmax): accel_prim_hit's answer
  * without the search for the nearest crossing of a CSG (shadow rays). */
-static int prim_occludes(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, double tmax)
+static int prim_occludes(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, double tmax, geom_ray_rule rule)
 {
     if (prim < (unsigned)a->nshapes) {
         geom_csg_hit h;
-        return accel_prim_hit(a, prim, o, d, tmin, tmax, &h);
+        return accel_prim_hit(a, prim, o, d, tmin, tmax, &h, rule);
     }
     unsigned ci = prim - (unsigned)a->nshapes;
-    if (a->csg_bn[ci] && !ray_in_bound(a, a->csg_b0[ci], a->csg_bn[ci], o, d, tmin)) return 0;
-    return geom_csg_occludes(&a->csgs[ci], o, d, tmin, tmax);
+    if (a->csg_bn[ci] && !ray_in_bound(a, a->csg_b0[ci], a->csg_bn[ci], o, d, tmin, rule)) return 0;
+    return geom_csg_occludes(&a->csgs[ci], o, d, tmin, tmax, rule);
 }
 
 const geom_shape *accel_prim_shape(const accel *a, unsigned prim, int member)
@@ -316,6 +317,15 @@ static unsigned prim_flags(const accel *a, unsigned prim)
 {
     return prim < (unsigned)a->nshapes ? a->leaves[a->shape_leaf[prim]].flags
                                        : a->csgs[prim - (unsigned)a->nshapes].flags;
+}
+
+/* The rule a query's rays meet searched-for surfaces by (accel_ray_rule):
+ * its own, or for a ray traced without our context (a benchmark's bare
+ * Embree calls, the particle GI's link rays, which carry light between
+ * surfaces as the renderer's rays do) POV-Ray's. */
+static inline geom_ray_rule query_rule(const accel_query *q)
+{
+    return q ? q->rule : GEOM_RAY_POV;
 }
 
 /* Ray i of an Embree packet of N (SoA) as the user callbacks read it: the
@@ -352,7 +362,7 @@ static int cross_leaf_once(const accel *a, unsigned prim, vec3 o, vec3 d, double
         if (a->csg_bn[ci]) return 0;
         enum { MAX_CSG_CROSSINGS = 32 };
         geom_csg_hit hs[MAX_CSG_CROSSINGS];
-        int k = geom_csg_crossings(&a->csgs[ci], o, d, tmin, q->ctmax, q->cstep, hs, MAX_CSG_CROSSINGS);
+        int k = geom_csg_crossings(&a->csgs[ci], o, d, tmin, q->ctmax, q->cstep, hs, MAX_CSG_CROSSINGS, q->rule);
         if (k < 0) return 0;
         for (int j = 0; j < k; j++) {
             if (q->ncross == q->maxcross) {
@@ -374,7 +384,7 @@ static int cross_leaf_once(const accel *a, unsigned prim, vec3 o, vec3 d, double
     }
     enum { MAX_LEAF_CROSSINGS = 8 };
     geom_shape_hit hs[MAX_LEAF_CROSSINGS];
-    int k = geom_shape_ray_hits(sh, o, d, tmin, q->ctmax, hs, MAX_LEAF_CROSSINGS);
+    int k = geom_shape_ray_hits(sh, o, d, tmin, q->ctmax, hs, MAX_LEAF_CROSSINGS, q->rule);
     if (k == MAX_LEAF_CROSSINGS) return 0;
     double from = tmin;
     for (int j = 0; j < k; j++) {
@@ -394,7 +404,9 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
     const accel *a = args->geometryUserPtr;
     accel_query *q = accel_tls_query;
     unsigned N = args->N;
-    int exact = q && (void *)q == (void *)args->context && N == 1;
+    int ours = q && (void *)q == (void *)args->context;
+    int exact = ours && !q->packet && N == 1;
+    geom_ray_rule rule = query_rule(ours ? q : NULL);
     void *ray = args->rayhit;
     float *hit = (float *)args->rayhit + 12 * (size_t)N;
     if (args->primID >= (unsigned)(a->nshapes + a->ncsgs)) return; /* the link scene's empty primitive */
@@ -410,7 +422,7 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
             if (cross_leaf_once(a, args->primID, o, d, tmin, q)) continue;
             for (double from = tmin; from < q->ctmax;) {
                 geom_csg_hit h;
-                if (!accel_prim_hit(a, args->primID, o, d, from, q->ctmax, &h)) break;
+                if (!accel_prim_hit(a, args->primID, o, d, from, q->ctmax, &h, rule)) break;
                 if (q->ncross == q->maxcross) {
                     q->overflow = 1;
                     break;
@@ -427,7 +439,7 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
         double tmax = (double)tfar;
         if (exact && q->uhit && q->ut < tmax) tmax = q->ut;
         geom_csg_hit h;
-        if (!accel_prim_hit(a, args->primID, o, d, tmin, tmax, &h)) continue;
+        if (!accel_prim_hit(a, args->primID, o, d, tmin, tmax, &h, rule)) continue;
         /* rounded up: a nearer candidate within the ulp is still tried */
         SOA_F(ray, N, i, 8) = exact ? nextafterf((float)h.t, INFINITY) : (float)h.t;
         vec3 ng = v3(0, 0, 0);
@@ -467,7 +479,9 @@ void accel_user_occluded(const struct RTCOccludedFunctionNArguments *args)
     if (prim_flags(a, args->primID) & OBJ_NO_SHADOW) return;
     accel_query *q = accel_tls_query;
     unsigned N = args->N;
-    int exact = q && (void *)q == (void *)args->context && N == 1;
+    int ours = q && (void *)q == (void *)args->context;
+    int exact = ours && !q->packet && N == 1;
+    geom_ray_rule rule = query_rule(ours ? q : NULL);
     void *ray = args->ray;
     const int box_test = a->ubox && a->ubox_test[args->primID];
     for (unsigned i = 0; i < N; i++) {
@@ -475,7 +489,7 @@ void accel_user_occluded(const struct RTCOccludedFunctionNArguments *args)
         vec3 o, d;
         double tmin;
         user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
-        if (prim_occludes(a, args->primID, o, d, tmin, (double)SOA_F(ray, N, i, 8))) SOA_F(ray, N, i, 8) = -INFINITY;
+        if (prim_occludes(a, args->primID, o, d, tmin, (double)SOA_F(ray, N, i, 8), rule)) SOA_F(ray, N, i, 8) = -INFINITY;
     }
 }
 

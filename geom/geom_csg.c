@@ -641,11 +641,13 @@ int geom_csg_kept(const geom_csg *c, int node, vec3 p)
  * keep boxes' slab tests (one ray meets many boxes), whether every
  * component of dir is non-zero with a finite inverse (regular: the slab
  * tests need no case for a ray parallel to a face), and whether any kept
- * crossing will do (an occlusion query) rather than the nearest. */
+ * crossing will do (an occlusion query) rather than the nearest; the
+ * rule the members' crossings are placed by. */
 typedef struct {
     vec3 org, dir, inv;
     double tmin;
     int any, regular;
+    geom_ray_rule rule;
 } csg_ray;
 
 /* One axis of keep_slab: v3_slab_axis's arithmetic for a ray that is not
@@ -717,7 +719,7 @@ __attribute__((noinline)) static int search_member(const geom_csg *c, int s, con
     int node = c->shape_node[s];
     for (int guard = 0; guard < 1000; guard++) {
         geom_shape_hit tmp[CSG_CHUNK];
-        int k = geom_shape_ray_hits(&c->shapes[s], org, dir, from, fmin(best, upto), tmp, CSG_CHUNK);
+        int k = geom_shape_ray_hits(&c->shapes[s], org, dir, from, fmin(best, upto), tmp, CSG_CHUNK, R->rule);
         int kept_one = 0;
         for (int j = 0; j < k; j++) {
             if (geom_csg_kept(c, node, v3_madd(org, dir, tmp[j].t))) {
@@ -866,23 +868,24 @@ static int csg_search(const geom_csg *c, const csg_ray *R, double tmax, geom_csg
     return found;
 }
 
-static csg_ray make_ray(vec3 org, vec3 dir, double tmin, int any)
+static csg_ray make_ray(vec3 org, vec3 dir, double tmin, int any, geom_ray_rule rule)
 {
-    csg_ray R = {org, dir, v3(1.0 / dir.x, 1.0 / dir.y, 1.0 / dir.z), tmin, any, 0};
+    csg_ray R = {org, dir, v3(1.0 / dir.x, 1.0 / dir.y, 1.0 / dir.z), tmin, any, 0, rule};
     R.regular = dir.x != 0.0 && dir.y != 0.0 && dir.z != 0.0 && isfinite(R.inv.x) && isfinite(R.inv.y) &&
                 isfinite(R.inv.z);
     return R;
 }
 
-int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, geom_csg_hit *h)
+int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, geom_csg_hit *h,
+                       geom_ray_rule rule)
 {
-    csg_ray R = make_ray(org, dir, tmin, 0);
+    csg_ray R = make_ray(org, dir, tmin, 0, rule);
     return csg_search(c, &R, tmax, h);
 }
 
-int geom_csg_occludes(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax)
+int geom_csg_occludes(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, geom_ray_rule rule)
 {
-    csg_ray R = make_ray(org, dir, tmin, 1);
+    csg_ray R = make_ray(org, dir, tmin, 1, rule);
     geom_csg_hit h;
     return csg_search(c, &R, tmax, &h);
 }
@@ -907,7 +910,7 @@ static int member_crossings(const geom_csg *c, int s, const csg_ray *R, double t
     }
     for (int guard = 0; guard < 1000; guard++) {
         geom_shape_hit tmp[CSG_CHUNK];
-        int k = geom_shape_ray_hits(&c->shapes[s], R->org, R->dir, from, upto, tmp, CSG_CHUNK);
+        int k = geom_shape_ray_hits(&c->shapes[s], R->org, R->dir, from, upto, tmp, CSG_CHUNK, R->rule);
         for (int j = 0; j < k; j++) {
             if (!geom_csg_kept(c, node, v3_madd(R->org, R->dir, tmp[j].t))) continue;
             if (*n == max) return -1;
@@ -920,9 +923,9 @@ static int member_crossings(const geom_csg *c, int s, const csg_ray *R, double t
 }
 
 int geom_csg_crossings(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, double step, geom_csg_hit *out,
-                       int max)
+                       int max, geom_ray_rule rule)
 {
-    csg_ray R = make_ray(org, dir, tmin, 0);
+    csg_ray R = make_ray(org, dir, tmin, 0, rule);
     int n = 0;
     if (!c->bvh) {
         for (int s = 0; s < c->nshapes; s++)

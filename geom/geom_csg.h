@@ -147,12 +147,14 @@ typedef struct {
 pt_status geom_csg_build(geom_csg *c, const scene_object *o, const scene_texture *tex, unsigned flags, int parent,
                          int depth, geom_csg_builder *b);
 
-/* Nearest crossing of the result with t in (tmin, tmax). */
-int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, geom_csg_hit *h);
+/* Nearest crossing of the result with t in (tmin, tmax), the members'
+ * crossings placed by `rule` (geom_shape.h). */
+int geom_csg_intersect(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, geom_csg_hit *h,
+                       geom_ray_rule rule);
 /* Whether some crossing of the result lies in (tmin, tmax): what
  * geom_csg_intersect finds, without searching on for the nearest (shadow
  * rays). */
-int geom_csg_occludes(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax);
+int geom_csg_occludes(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, geom_ray_rule rule);
 /* Every kept crossing in (tmin, tmax), nearest first, each the nearest at
  * least max(step, 1e-7 t) past the one before: what geom_csg_intersect
  * called again from just past each crossing gives, from one search of
@@ -162,7 +164,7 @@ int geom_csg_occludes(const geom_csg *c, vec3 org, vec3 dir, double tmin, double
  * isosurface member (its max_trace counts from the search's start) or
  * more kept crossings than max. */
 int geom_csg_crossings(const geom_csg *c, vec3 org, vec3 dir, double tmin, double tmax, double step, geom_csg_hit *out,
-                       int max);
+                       int max, geom_ray_rule rule);
 int geom_csg_inside(const geom_csg *c, int node, vec3 p);
 /* Does a point p on the surface of leaf `node` belong to the result's
  * surface (the member rules at every level up to the root)? */

@@ -1098,23 +1098,35 @@ static double iso_root(const im_data *m, vec3 p0, vec3 e, double lo, double hi, 
  * after its two ends; others are halved down to `accuracy`. A piece whose
  * ends differ in sign holds exactly one crossing once L (t2 - t1) <=
  * |f1| + |f2| (a second and third would need more variation than L allows);
- * that crossing is polished by iso_root. */
+ * that crossing is polished by iso_root. Under POV-Ray's placement
+ * (`pov`), a piece whose ends differ in sign is halved on until it is
+ * shorter than `accuracy` along the world ray, and the crossing is its far
+ * end (Function_Find_Root_R returns the end of the first such piece beyond
+ * the crossing, up to accuracy past the surface), not the root. */
 typedef struct {
     const im_data *m;
     vec3 p0, e;
     double a, s, tmin, tmax, minstep;
     geom_shape_hit *out;
     int n, max;
+    int pov; /* POV-Ray's placement: minstep is accuracy in object length along this ray */
 } iso_walk;
 
 static void iso_split(iso_walk *w, double t1, double f1, double t2, double f2, int depth)
 {
     if (w->n == w->max && w->a + t1 / w->s > w->out[w->max - 1].t) return; /* nothing nearer can follow */
     double len = t2 - t1, reach = w->m->grad * len;
-    int fine = len <= w->minstep || depth >= 60;
+    /* POV-Ray's leaf is a piece strictly shorter than accuracy */
+    int fine = (w->pov ? len < w->minstep : len <= w->minstep) || depth >= 60;
     if (isfinite(f1) && isfinite(f2)) {
         if ((f1 < 0.0) == (f2 < 0.0)) {
             if (fabs(f1) + fabs(f2) > reach || fine) return;
+        } else if (w->pov) {
+            if (fine) {
+                double t = w->a + t2 / w->s;
+                if (t > w->tmin && t < w->tmax) w->n = geom_shape_hit_put(w->out, w->n, w->max, t, 0);
+                return;
+            }
         } else if (fabs(f1) + fabs(f2) >= reach || fine) {
             double t = w->a + iso_root(w->m, w->p0, w->e, t1, t2, f1, f2, 1e-15 * (fabs(t2) + len)) / w->s;
             if (t > w->tmin && t < w->tmax) w->n = geom_shape_hit_put(w->out, w->n, w->max, t, 0);
@@ -1128,13 +1140,33 @@ static void iso_split(iso_walk *w, double t1, double f1, double t2, double f2, i
     iso_split(w, mid, fm, t2, f2, depth + 1);
 }
 
-static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max, int traced)
+/* wl: the world length of d (the ray's t counts world length wl per unit,
+ * which POV-Ray's accuracy rules measure). */
+static int iso_hits(const im_data *m, vec3 o, vec3 d, double wl, double tmin, double tmax, geom_shape_hit *out,
+                    int max, int traced, geom_ray_rule rule)
 {
     double ca, cb;
     if (!iso_container(m, o, d, &ca, &cb)) return 0;
+    double s = v3_len(d);
+    int pov = traced && rule == GEOM_RAY_POV && wl > 0.0 && isfinite(wl);
+    if (pov && ca * wl < m->acc) {
+        /* POV-Ray's start (isosurface.cpp All_Intersections): a ray that
+         * starts within accuracy of the container's entry or inside it, at
+         * a point where f is within 4 max_gradient accuracy of the
+         * threshold (below it when closed: any point inside), starts
+         * its search 5 accuracy on; a ray leaving the surface does not
+         * find the surface it leaves, but on a noise-displaced surface
+         * it may meet the next fold within a few accuracies (the
+         * terminator of a grazing light shadows itself there) */
+        double t0 = ca > 0.0 ? ca : 0.0, f0 = iso_f(m, v3_madd(o, d, t0));
+        double near = 4.0 * m->grad * m->acc;
+        if (m->open ? fabs(f0) < near : f0 < near) {
+            double t5 = 5.0 * m->acc / wl;
+            if (t5 > tmin) tmin = t5;
+        }
+    }
     double a = fmax_inline(ca, tmin), b = fmin_inline(cb, tmax);
     if (!(a < b)) return 0;
-    double s = v3_len(d);
     vec3 e = v3_scale(d, 1.0 / s), p0 = v3_madd(o, d, a);
     double len = (b - a) * s;
     /* A traced ray: POV-Ray's max_trace (isosurface.cpp All_Intersections):
@@ -1157,14 +1189,16 @@ static int iso_hits(const im_data *m, vec3 o, vec3 d, double tmin, double tmax, 
         }
     }
     if (budget <= 0) return n;
-    double minstep = fmax_inline(m->acc, 1e-9 * m->size);
+    /* accuracy in object length along this ray: POV-Ray measures it along
+     * the world ray (its t), the exact search in object space */
+    double minstep = pov ? m->acc * s / wl : fmax_inline(m->acc, 1e-9 * m->size);
     if (!traced) {
-        iso_walk w = {m, p0, e, a, s, tmin, tmax, minstep, out, n, max};
+        iso_walk w = {m, p0, e, a, s, tmin, tmax, minstep, out, n, max, 0};
         iso_split(&w, 0.0, iso_f(m, p0), len, iso_f(m, v3_madd(p0, e, len)), 0);
         return w.n;
     }
     geom_shape_hit roots[ISO_MAX_TRACE];
-    iso_walk w = {m, p0, e, a, s, tmin, tmax, minstep, roots, 0, budget < max ? budget : max};
+    iso_walk w = {m, p0, e, a, s, tmin, tmax, minstep, roots, 0, budget < max ? budget : max, pov};
     iso_split(&w, 0.0, iso_f(m, p0), len, iso_f(m, v3_madd(p0, e, len)), 0);
     for (int i = 0; i < w.n; i++) n = geom_shape_hit_put(out, n, max, roots[i].t, roots[i].part);
     return n;
@@ -1337,8 +1371,8 @@ void geom_implicit_free(void *data)
     free(m);
 }
 
-int geom_implicit_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out,
-                        int max, int traced)
+int geom_implicit_hits(const geom_shape *sh, vec3 o, vec3 d, double wl, double tmin, double tmax,
+                        geom_shape_hit *out, int max, int traced, geom_ray_rule rule)
 {
     const im_data *m = sh->data;
     if (!m || max <= 0) return 0;
@@ -1346,7 +1380,7 @@ int geom_implicit_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double
     case IM_SUPER: return se_hits(m, o, d, tmin, tmax, out, max);
     case IM_QUADRIC: return quadric_hits(m, o, d, tmin, tmax, out, max);
     case IM_POLY: return poly_hits(m, o, d, tmin, tmax, out, max);
-    case IM_ISO: return iso_hits(m, o, d, tmin, tmax, out, max, traced);
+    case IM_ISO: return iso_hits(m, o, d, wl, tmin, tmax, out, max, traced, rule);
     default: return blob_hits(m, o, d, tmin, tmax, out, max);
     }
 }

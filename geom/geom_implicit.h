@@ -29,10 +29,11 @@
 int geom_implicit_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi);
 void geom_implicit_free(void *data);
 /* Object-space ray o + t d, crossings with t in (tmin, tmax), ascending;
- * `traced`: under POV-Ray's per-ray limits (an isosurface's max_trace),
- * else all of them. */
-int geom_implicit_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out,
-                        int max, int traced);
+ * `traced`: under POV-Ray's per-ray limits (an isosurface's max_trace) and
+ * `rule` (geom_ray_rule), else all of them at their roots. wl: the length
+ * of the world ray's direction (what one unit of t is in world length). */
+int geom_implicit_hits(const geom_shape *sh, vec3 o, vec3 d, double wl, double tmin, double tmax,
+                        geom_shape_hit *out, int max, int traced, geom_ray_rule rule);
 int geom_implicit_inside(const geom_shape *sh, vec3 q);
 /* Object-space gradient (outward normal, not unit); part 1 of an
  * isosurface is its container's surface. */

@@ -624,7 +624,8 @@ __attribute__((noinline)) static int hits_ovus(const geom_shape *sh, vec3 o, vec
  * shape_hits, as are the torus and ovus solves: their scratch would
  * otherwise make every sphere's or box's test set up their stack frame. */
 __attribute__((noinline)) static int hits_bounded(const geom_shape *sh, vec3 org, vec3 dir, vec3 o, vec3 d, double tmin,
-                                                  double tmax, geom_shape_hit *out, int max, int traced)
+                                                  double tmax, geom_shape_hit *out, int max, int traced,
+                                                  geom_ray_rule rule)
 {
     /* the other shapes: the interval narrowed to the clip box (unbounded
      * shapes: hits outside it are rejected, as for planes) or to the
@@ -645,7 +646,7 @@ __attribute__((noinline)) static int hits_bounded(const geom_shape *sh, vec3 org
         n = geom_sweep_hits(sh, o, d, a, b, out, max);
         break;
     case SHAPE_SUPERELLIPSOID: case SHAPE_QUADRIC: case SHAPE_POLY: case SHAPE_BLOB: case SHAPE_ISOSURFACE:
-        n = geom_implicit_hits(sh, o, d, a, b, out, max, traced);
+        n = geom_implicit_hits(sh, o, d, v3_len(dir), a, b, out, max, traced, rule);
         break;
     case SHAPE_HEIGHT_FIELD:
         n = geom_hfield_hits(sh, o, d, a, b, out, max);
@@ -668,7 +669,7 @@ __attribute__((noinline)) static int hits_bounded(const geom_shape *sh, vec3 org
 
 /* Parameter interval of a ray inside a box. */
 static int shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
-                      int max, int traced)
+                      int max, int traced, geom_ray_rule rule)
 {
     if (max <= 0) return 0;
     if (sh->kind == SHAPE_PLANE) return v3_len2(dir) == 0.0 ? 0 : hits_plane(sh, org, dir, tmin, tmax, out, max);
@@ -688,20 +689,20 @@ static int shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, dou
     case SHAPE_OVUS: return hits_ovus(sh, o, d, tmin, tmax, out, max);
     case SHAPE_TRIANGLE:
     case SHAPE_SMOOTH_TRIANGLE: return hits_triangle(sh, o, d, tmin, tmax, out, max);
-    default: return hits_bounded(sh, org, dir, o, d, tmin, tmax, out, max, traced);
+    default: return hits_bounded(sh, org, dir, o, d, tmin, tmax, out, max, traced, rule);
     }
 }
 
 int geom_shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
                      int max)
 {
-    return shape_hits(sh, org, dir, tmin, tmax, out, max, 0);
+    return shape_hits(sh, org, dir, tmin, tmax, out, max, 0, GEOM_RAY_EXACT);
 }
 
 int geom_shape_ray_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
-                         int max)
+                         int max, geom_ray_rule rule)
 {
-    return shape_hits(sh, org, dir, tmin, tmax, out, max, 1);
+    return shape_hits(sh, org, dir, tmin, tmax, out, max, 1, rule);
 }
 
 typedef struct {
@@ -757,10 +758,10 @@ int geom_shape_grid(const geom_shape *sh, int n, geom_grid_fn fn, void *ctx)
     }
 }
 
-int geom_shape_intersect(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
-                          geom_shape_hit *h)
+int geom_shape_intersect(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *h,
+                          geom_ray_rule rule)
 {
-    return geom_shape_ray_hits(sh, org, dir, tmin, tmax, h, 1);
+    return geom_shape_ray_hits(sh, org, dir, tmin, tmax, h, 1, rule);
 }
 
 int geom_shape_inside(const geom_shape *sh, vec3 p)

@@ -113,21 +113,40 @@ int geom_shape_solid_bounded(const geom_shape *sh);
 /* Blob components with their own textures: the one that dominates at the
  * world point p; NULL otherwise. */
 const scene_texture *geom_shape_texture(const geom_shape *sh, vec3 p);
-/* Nearest intersection with t in (tmin, tmax) of the world ray org + t*dir.
- * Returns 1 and fills `h` on a hit. Never produces NaN for finite input. */
-int geom_shape_intersect(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax,
-                          geom_shape_hit *h);
+/* How a traced ray meets the surfaces whose crossings are searched for
+ * along it (isosurfaces; every other shape's crossings are its roots under
+ * either rule):
+ * GEOM_RAY_POV: POV-Ray 3.7's rules for its rays (isosurface.cpp
+ *   All_Intersections, Function_Find_Root_R): a crossing is placed at the
+ *   far end of the halving piece shorter than `accuracy` (world length)
+ *   that holds it, up to accuracy beyond the surface; a ray that starts on
+ *   the surface (within 4 max_gradient accuracy of the threshold) searches
+ *   from 5 accuracy on. The renderer's rays, whose images are compared with
+ *   POV-Ray's: the shading of a noise-displaced surface depends on both.
+ * GEOM_RAY_EXACT: every crossing at its root, searched from tmin on: for
+ *   queries that count the crossings between two points on surfaces
+ *   (visibility for density estimates), which a ray starting up to
+ *   accuracy inside a surface or skipping the first 5 accuracies would
+ *   miscount. */
+typedef enum { GEOM_RAY_POV = 0, GEOM_RAY_EXACT = 1 } geom_ray_rule;
+
+/* Nearest intersection with t in (tmin, tmax) of the world ray org + t*dir,
+ * a traced ray under `rule`. Returns 1 and fills `h` on a hit. Never
+ * produces NaN for finite input. */
+int geom_shape_intersect(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *h,
+                          geom_ray_rule rule);
 /* All crossings with t in (tmin, tmax), ascending, at most `max` of them
  * (the `max` nearest; a torus has up to 4, the quadrics up to 2, swept,
- * implicit and mesh shapes any number). */
+ * implicit and mesh shapes any number), each at its root. */
 int geom_shape_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
                      int max);
 /* The crossings a traced ray gets (CSG members, geom_shape_intersect):
  * geom_shape_hits under the scene's per-ray limits, as POV-Ray reports
- * them: an isosurface gives at most its max_trace crossings (default 1).
- * geom_shape_hits is the geometry's full set (tessellation, sampling). */
+ * them: an isosurface gives at most its max_trace crossings (default 1),
+ * placed by `rule`. geom_shape_hits is the geometry's full set
+ * (tessellation, sampling). */
 int geom_shape_ray_hits(const geom_shape *sh, vec3 org, vec3 dir, double tmin, double tmax, geom_shape_hit *out,
-                         int max);
+                         int max, geom_ray_rule rule);
 /* Whether the world point p is strictly inside the solid, as POV-Ray defines
  * it for CSG: planes and discs are half-spaces (the side against the normal),
  * open cylinders and cones are their closed solids, triangles have no inside. */

@@ -304,8 +304,9 @@ void gi_particle_batch_test(gi_particle *gp, struct cell_batch *b, thread_count 
             for (int k = 0; k < 3; k++) {
                 int j = k + 1 < 3 ? k + 1 : 0;
                 /* cell_clear's order: the edge from q[k], the spoke to q[k] */
-                if (gi_visible_segment(gp->a, gp->vis_eps, q[k], nq[k], q[j], nq[j], &b->sg[nr])) b->owner[nr++] = c;
-                if (gi_visible_segment(gp->a, gp->vis_eps, ctr, nc, q[k], nq[k], &b->sg[nr])) b->owner[nr++] = c;
+                const scene_object *own = b->cell[c].own;
+                if (gi_visible_segment(gp->a, gp->vis_eps, q[k], nq[k], q[j], nq[j], own, &b->sg[nr])) b->owner[nr++] = c;
+                if (gi_visible_segment(gp->a, gp->vis_eps, ctr, nc, q[k], nq[k], own, &b->sg[nr])) b->owner[nr++] = c;
             }
         }
         for (int r = 0; r < nr; r++) {
@@ -314,7 +315,9 @@ void gi_particle_batch_test(gi_particle *gp, struct cell_batch *b, thread_count 
             b->tmin[r] = 0.0;
             b->tmax[r] = b->sg[r].len;
         }
-        accel_hit_any_n(gp->a, nr, b->org, b->dir, b->tmin, b->tmax, b->hit);
+        /* gi_visible's exact crossings (ACCEL_RAY_EXACT): a segment along
+         * an isosurface cell must see the surface where it dips under it */
+        accel_hit_any_n(gp->a, ACCEL_RAY_EXACT, nr, b->org, b->dir, b->tmin, b->tmax, b->hit);
         for (int r = 0; r < nr; r++) {
             batch_cell_t *bc = &b->cell[b->owner[r]];
             if (!b->hit[r] || bc->verdict != GI_CELL_CLEAR) continue;

@@ -25,12 +25,17 @@ typedef struct {
     atomic_int oom;
 } list_job;
 
-int gi_visible_segment(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, gi_segment *sg)
+int gi_visible_segment(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, const scene_object *own,
+                       gi_segment *sg)
 {
     /* both ends lifted off their surfaces by more than accel's
      * self-intersection epsilon at x (accel.h), so that a segment leaving
-     * x's surface downwards meets that surface where it crosses it */
-    double lift = fmax(16.0 * eps, 2.0 * accel_epsilon(a, x, nx));
+     * x's surface downwards meets that surface where it crosses it; and by
+     * more than twice how far a traced hit on `own` may lie inside it
+     * (accel_hit_placement: an isosurface's hit up to accuracy past its
+     * surface), so that x starts outside the surface it lies on and the
+     * crossings counted below are the exact surface's */
+    double lift = fmax(fmax(16.0 * eps, 2.0 * accel_epsilon(a, x, nx)), 2.0 * accel_hit_placement(own));
     vec3 p = v3_madd(x, nx, lift), q = v3_madd(y, ny, lift);
     vec3 d = v3_sub(q, p);
     double len = v3_len(d);
@@ -48,7 +53,8 @@ int gi_visible_along(const accel *a, double eps, const gi_segment *sg, const sce
     int crossings = 0;
     for (int k = 0; k < 8; k++) {
         accel_hit h;
-        if (!accel_intersect(a, sg->p, sg->d, tmin, len, &h)) break;
+        /* the exact crossings: their parity is the test (ACCEL_RAY_EXACT) */
+        if (!accel_intersect_rule(a, ACCEL_RAY_EXACT, sg->p, sg->d, tmin, len, &h)) break;
         if (h.obj != own) return 0;
         /* not where the segment ends: a radiance particle on an edge,
          * lifted, lies in the plane of the face across the edge */
@@ -67,7 +73,7 @@ int gi_visible_along(const accel *a, double eps, const gi_segment *sg, const sce
 int gi_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, const scene_object *own)
 {
     gi_segment sg;
-    return !gi_visible_segment(a, eps, x, nx, y, ny, &sg) || gi_visible_along(a, eps, &sg, own);
+    return !gi_visible_segment(a, eps, x, nx, y, ny, own, &sg) || gi_visible_along(a, eps, &sg, own);
 }
 
 static int visible(const list_job *J, vec3 q, vec3 nq, int i, const scene_object *obj)

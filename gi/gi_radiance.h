@@ -28,7 +28,8 @@ typedef struct {
 
 /* Whether a sample at y (normal ny) may stand for light at x (normal nx) on
  * object `own`: the segment between the two, lifted off the surface by
- * 16 eps along their normals (accel_mutually_visible), crosses no other object, and
+ * 16 eps along their normals (and past accel_hit_placement(own)), crosses
+ * no other object (exact crossings, ACCEL_RAY_EXACT), and
  * `own` an even number of times (a chord of a curved surface dips under it
  * and out again; one crossing puts y behind a sheet of `own`: the inside of
  * a thin closed slab's other face). Without it
@@ -42,13 +43,15 @@ int gi_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, con
  * (gi_particle_cells.c's cell tests, accel_hit_any_n): the lifted segment from x
  * to y (0 when the points are closer than twice the lift: visible, no ray),
  * then gi_visible's rule along it. gi_visible = !segment || along. A segment
- * whose ray from p along d over [0, len] meets nothing is visible. */
+ * whose ray from p along d over [0, len] meets nothing (ACCEL_RAY_EXACT) is
+ * visible. */
 typedef struct {
     vec3 p, d;   /* from the lifted x along the unit direction to the lifted y */
     double len;  /* its length */
     double lift; /* how far both ends were lifted */
 } gi_segment;
-int gi_visible_segment(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, gi_segment *sg);
+int gi_visible_segment(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, vec3 ny, const scene_object *own,
+                       gi_segment *sg);
 int gi_visible_along(const accel *a, double eps, const gi_segment *sg, const scene_object *own);
 
 /* prog (may be NULL): its current stage counts the chunks of radiance

@@ -106,14 +106,18 @@ static query *query_get(sdl_parser *p, const scene_object *o)
     return q;
 }
 
-/* Nearest crossing of the world ray with t > tmin (dir unit). */
+/* Nearest crossing of the world ray with t > tmin (dir unit), under
+ * POV-Ray's rules for its rays (GEOM_RAY_POV): trace() answers with the
+ * object's own intersection routine (POV-Ray 3.7 parser_expressions.cpp
+ * Parse_Trace, through Find_Intersection), so an isosurface's point is
+ * placed as its rays' are. */
 static int query_hit(const query *q, vec3 org, vec3 dir, double tmin, geom_csg_hit *h)
 {
     if (q->empty) return 0;
-    if (!q->infinite) return geom_csg_intersect(&q->c, org, dir, tmin, INFINITY, h);
+    if (!q->infinite) return geom_csg_intersect(&q->c, org, dir, tmin, INFINITY, h, GEOM_RAY_POV);
     double a = tmin > 0.0 ? tmin : 0.0, w = QUERY_WINDOW, reach = 4.0 * QUERY_EXTENT;
     while (a < reach) {
-        if (geom_csg_intersect(&q->c, org, dir, a, a + w, h)) return 1;
+        if (geom_csg_intersect(&q->c, org, dir, a, a + w, h, GEOM_RAY_POV)) return 1;
         a += w;
         w *= 4.0;
     }

@@ -765,21 +765,35 @@ static void test_clipped_by(void **st)
 /* isosurface: user functions (core/func.h) against closed forms; the
  * normal is POV-Ray's forward difference over accuracy (isosurf.cpp),
  * within 1.5 accuracy / radius of the sphere's. */
+/* An isosurface hit under both ray rules (accel.h): ACCEL_RAY_EXACT at the
+ * root t to 1e-10, ACCEL_RAY_POV (accel_intersect) at the far end of
+ * POV-Ray's halving piece holding it: in [t, t + accuracy]. */
+static void expect_iso_hit(const world *w, vec3 o, vec3 d, double t, double acc)
+{
+    accel_hit h;
+    if (!accel_intersect_rule(w->a, ACCEL_RAY_EXACT, o, d, 0.0, INFINITY, &h)) fail_msg("expected a hit at t = %.17g", t);
+    assert_near(h.t, t, 1e-10);
+    if (!hit(w, o, d, &h)) fail_msg("expected a hit at t = %.17g", t);
+    if (!(h.t >= t - 1e-12 && h.t <= t + acc)) fail_msg("POV-Ray's placement: t = %.17g, not in [%.17g, +%g]", h.t, t, acc);
+}
+
 static void test_isosurface(void **st)
 {
     (void)st;
     world w = build("isosurface { function { sqrt(x*x + y*y + z*z) - 0.5 } contained_by { box { -1, 1 } } "
                     "max_gradient 1.01 accuracy 1e-4 translate <0,0,3> }");
     assert_int_equal(w.s->objects[0]->kind, SHAPE_ISOSURFACE);
+    assert_near(accel_hit_placement(w.s->objects[0]), 1e-4, 0.0);
     for (int i = 0; i < 6; i++) {
         double y = 0.08 * i, x = sqrt(0.25 - y * y);
-        expect_hit(&w, v3(-5, y, 3), v3(1, 0, 0), 5 - x, v3(-x, y, 0), 1e-10, 3e-4);
+        expect_iso_hit(&w, v3(-5, y, 3), v3(1, 0, 0), 5 - x, 1e-4);
+        expect_hit(&w, v3(-5, y, 3), v3(1, 0, 0), 5 - x, v3(-x, y, 0), 1e-4, 3e-4);
     }
     expect_miss(&w, v3(-5, 0.6, 3), v3(1, 0, 0));
     done(&w);
     /* the half-space y < 0 in a box: the box's faces show where they are inside */
     w = build("isosurface { function { y } }");
-    expect_hit(&w, v3(0.3, 5, 0.2), v3(0, -1, 0), 5.0, v3(0, 1, 0), 1e-10, 1e-6);
+    expect_iso_hit(&w, v3(0.3, 5, 0.2), v3(0, -1, 0), 5.0, 1e-3);
     expect_hit(&w, v3(-5, -0.5, 0.2), v3(1, 0, 0), 4.0, v3(-1, 0, 0), 1e-12, 1e-12);
     expect_miss(&w, v3(-5, 0.5, 0.2), v3(1, 0, 0));
     geom_shape sh = shape_of(&w);
@@ -788,9 +802,27 @@ static void test_isosurface(void **st)
     assert_false(geom_shape_inside(&sh, v3(0.2, -1.3, 0.1)));
     geom_shape_release(&sh);
     done(&w);
+    /* a ray that starts on the surface (f within 4 max_gradient accuracy =
+     * 0.044 of the threshold) searches from 5 accuracy (0.05) on under
+     * POV-Ray's rule: from 0.004 below the plane y = 0 upwards it does not
+     * find the plane it leaves (the exact rule does, at 0.004); one that
+     * starts 0.1 below it does (f = -0.1 is not near) */
+    w = build("isosurface { function { y } accuracy 0.01 }");
+    accel_hit h;
+    assert_true(accel_intersect_rule(w.a, ACCEL_RAY_EXACT, v3(0.2, -0.004, 0.1), v3(0, 1, 0), 0.0, INFINITY, &h));
+    assert_near(h.t, 0.004, 1e-10);
+    expect_miss(&w, v3(0.2, -0.004, 0.1), v3(0, 1, 0));
+    expect_hit(&w, v3(0.2, -0.1, 0.1), v3(0, 1, 0), 0.1, v3(0, 1, 0), 0.01, 1e-6);
+    /* downwards from just above the plane: 5 accuracy on it is inside, so
+     * the search is for the way out: the box's bottom face, where the
+     * inside reaches it (t = 1.004); the exact rule meets the plane */
+    expect_hit(&w, v3(0.2, 0.004, 0.1), v3(0, -1, 0), 1.004, v3(0, -1, 0), 1e-9, 1e-9);
+    assert_true(accel_intersect_rule(w.a, ACCEL_RAY_EXACT, v3(0.2, 0.004, 0.1), v3(0, -1, 0), 0.0, INFINITY, &h));
+    assert_near(h.t, 0.004, 1e-10);
+    done(&w);
     w = build("isosurface { function { y } open contained_by { sphere { 0, 1 } } threshold 0.25 }");
     expect_miss(&w, v3(-5, -0.5, 0.0), v3(1, 0, 0));
-    expect_hit(&w, v3(0.3, 5, 0.2), v3(0, -1, 0), 4.75, v3(0, 1, 0), 1e-10, 1e-6);
+    expect_iso_hit(&w, v3(0.3, 5, 0.2), v3(0, -1, 0), 4.75, 1e-3);
     done(&w);
 }
 
@@ -1052,13 +1084,14 @@ static int grid_cb(void *ctx, const vec3 p[3], const vec3 n[3])
             if (!geom_shape_inside(g->sh, v3_madd(p[k], n[k], -g->tol)) || geom_shape_inside(g->sh, v3_madd(p[k], n[k], g->tol)))
                 g->bad++;
         } else if (g->inside_checks) {
-            /* back along the normal from just outside: the surface at the vertex */
+            /* back along the normal from just outside: the surface at the
+             * vertex, at its exact root (GEOM_RAY_EXACT) */
             /* nudged towards the triangle's centre, off edges and corners */
             vec3 c = v3_scale(v3_add(v3_add(p[0], p[1]), p[2]), 1.0 / 3.0);
             vec3 q = v3_madd(p[k], v3_sub(c, p[k]), 1e-6);
             double e = 1e-3;
             geom_shape_hit h;
-            if (!geom_shape_intersect(g->sh, v3_madd(q, n[k], e), v3_neg(n[k]), 0.0, 1.0, &h) || fabs(h.t - e) > 1e-8)
+            if (!geom_shape_intersect(g->sh, v3_madd(q, n[k], e), v3_neg(n[k]), 0.0, 1.0, &h, GEOM_RAY_EXACT) || fabs(h.t - e) > 1e-8)
                 g->bad++;
         }
     }
