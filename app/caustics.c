@@ -382,7 +382,7 @@ void caustics_json(caustics *c, stats_json *js)
         stats_int(js, k, s->alive[b]);
     }
     stats_obj_end(js);
-    STATS_INTS(js, s, stored, stored_highlights, stored_media, media_thinned);
+    STATS_INTS(js, s, stored, stored_highlights, stored_media, media_thinned, widened);
     STATS_NUMS(js, s, flux, r_median, r_media_median);
     STATS_INTS(js, s, rays, tile_entries, lookups_gbuffer, lookups_photons);
     stats_obj_begin(js, "seconds");

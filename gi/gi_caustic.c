@@ -3,6 +3,7 @@
 #include "grow.h"
 #include "scene_leaves.h"
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -953,6 +954,153 @@ static double median_of(const float *v, long n, size_t stride)
     return r;
 }
 
+/* POV-Ray's gather minimum for the photon volumes. Its gather
+ * (photons.cpp, PhotonGatherer::gatherPhotonsAdaptive) widens a search that
+ * finds fewer than the minimum count (`gather min, max`, 20 by default) by
+ * a step of twice its starting radius, once by default (gatherNumSteps
+ * 2): up to three times the radius (WIDEN_MAX). The photon volumes are the
+ * scatter form of the same estimate: a photon whose volume holds fewer
+ * than the scene's gather minimum m of photon positions (its own included, of photons on the same side of the same
+ * surface: normals within 60 degrees, by the volume's own ellipsoidal
+ * distance) is widened to hold m, at most WIDEN_MAX times its radius and
+ * r_max. A volume integrates to its photon's power
+ * whatever its radius, so this spreads, not adds, light: where the path
+ * density rho_p over-states the real density (a beam spread by a convex
+ * reflector, whose divergence rho_p does not see) the sparse photons
+ * were each a speckle. Each photon's new radius depends on the old radii
+ * and positions alone (any thread count gives the same layer). */
+#define WIDEN_MAX 3.0
+#define WIDEN_CHUNK 1024
+
+typedef struct {
+    gi_caustic *c;
+    int m;         /* the gather minimum */
+    hgrid g;       /* photon positions (zero radius) */
+    float *r;      /* the new radii */
+    atomic_long widened;
+    atomic_int oom;
+} widen_job;
+
+/* The k-th smallest (0-based) of v[0..n), v reordered (Hoare's select). */
+static double kth_smallest(double *v, long n, long k)
+{
+    long lo = 0, hi = n - 1;
+    while (lo < hi) {
+        double pivot = v[lo + (hi - lo) / 2];
+        long i = lo, j = hi;
+        while (i <= j) {
+            while (v[i] < pivot) i++;
+            while (v[j] > pivot) j--;
+            if (i <= j) {
+                double t = v[i];
+                v[i++] = v[j];
+                v[j--] = t;
+            }
+        }
+        if (k <= j) hi = j;
+        else if (k >= i) lo = i;
+        else return v[k];
+    }
+    return v[k];
+}
+
+/* The distances (the volume's own: sqrt(d_plane^2 + (d_n r_xy / r_z)^2))
+ * of the photons within `reach` of photon q on the same side of the same
+ * surface, appended to *buf (NULL: only counted); how many, -1 out of
+ * memory. Stops counting at `enough` when buf is NULL. */
+static long widen_scan(const widen_job *wj, const gi_caus_photon *q, double reach, long enough, double **buf,
+                       long *cap)
+{
+    const gi_caustic *c = wj->c;
+    double cell = wj->g.cell;
+    long n = 0;
+    long x0 = cidx(q->x[0] - reach, cell), x1 = cidx(q->x[0] + reach, cell);
+    long y0 = cidx(q->x[1] - reach, cell), y1 = cidx(q->x[1] + reach, cell);
+    long z0 = cidx(q->x[2] - reach, cell), z1 = cidx(q->x[2] + reach, cell);
+    for (long x = x0; x <= x1; x++)
+        for (long y = y0; y <= y1; y++)
+            for (long z = z0; z <= z1; z++) {
+                long lo, hi;
+                hgrid_cell(&wj->g, x, y, z, &lo, &hi);
+                for (long e = lo; e < hi; e++) {
+                    const gi_caus_photon *o = &c->ph[wj->g.e[e].id];
+                    if (o->n[0] * q->n[0] + o->n[1] * q->n[1] + o->n[2] * q->n[2] < 0.5f) continue;
+                    double dx = o->x[0] - q->x[0], dy = o->x[1] - q->x[1], dz = o->x[2] - q->x[2];
+                    double dn = dx * q->n[0] + dy * q->n[1] + dz * q->n[2];
+                    double dp2 = fmax(dx * dx + dy * dy + dz * dz - dn * dn, 0.0);
+                    double t = sqrt(dp2 + dn * dn * (double)q->r_xy * q->r_xy * q->inv_rz2);
+                    if (!(t < reach)) continue;
+                    if (buf) {
+                        if (!grow_array_long((void **)buf, cap, n + 1, sizeof(double))) return -1;
+                        (*buf)[n] = t;
+                    }
+                    if (++n >= enough && !buf) return n;
+                }
+            }
+    return n;
+}
+
+static void widen_chunk(void *ctx, int ci, int thread)
+{
+    (void)thread;
+    widen_job *wj = ctx;
+    const gi_caustic *c = wj->c;
+    long i0 = (long)ci * WIDEN_CHUNK, i1 = i0 + WIDEN_CHUNK < c->nph ? i0 + WIDEN_CHUNK : c->nph;
+    double *buf = NULL;
+    long cap = 0;
+    for (long i = i0; i < i1; i++) {
+        const gi_caus_photon *q = &c->ph[i];
+        double r = q->r_xy, R = fmin(WIDEN_MAX * r, c->r_max);
+        wj->r[i] = (float)r;
+        if (!(R > r) || widen_scan(wj, q, r, wj->m, NULL, NULL) >= wj->m) continue;
+        long n = widen_scan(wj, q, R, 0, &buf, &cap);
+        if (n < 0) {
+            atomic_store(&wj->oom, 1);
+            break;
+        }
+        double w = n >= wj->m ? kth_smallest(buf, n, wj->m - 1) : R;
+        if (w > r) {
+            wj->r[i] = (float)fmin(w, R);
+            atomic_fetch_add(&wj->widened, 1);
+        }
+    }
+    free(buf);
+}
+
+/* widens the splatted photons' volumes to the gather minimum; 0 out of memory */
+static int widen_sparse(gi_caustic *c, int threads)
+{
+    int m = c->sc->global.photons.gather_min;
+    if (c->nph <= 0 || m <= 1) return 1;
+    widen_job wj = {c, m, {0}, malloc(sizeof(float) * (size_t)c->nph), 0, 0};
+    float zero = 0.0f;
+    double cell = c->st.r_median > 0.0 ? c->st.r_median : 1.0;
+    if (!wj.r || !hgrid_build(&wj.g, cell, c->nph, c->ph[0].x, sizeof(gi_caus_photon) / sizeof(float), &zero, 0)) {
+        free(wj.r);
+        hgrid_free(&wj.g);
+        return 0;
+    }
+    int nchunks = (int)((c->nph + WIDEN_CHUNK - 1) / WIDEN_CHUNK);
+    pool_run(threads, nchunks, widen_chunk, &wj);
+    if (atomic_load(&wj.oom)) {
+        free(wj.r);
+        hgrid_free(&wj.g);
+        return 0;
+    }
+    for (long i = 0; i < c->nph; i++) {
+        gi_caus_photon *q = &c->ph[i];
+        double r = wj.r[i];
+        q->r_xy = (float)r;
+        q->r_z = (float)(0.25 * r);
+        q->inv_rxy2 = (float)(1.0 / (r * r));
+        q->inv_rz2 = (float)(16.0 / (r * r));
+    }
+    c->st.widened = atomic_load(&wj.widened);
+    free(wj.r);
+    hgrid_free(&wj.g);
+    return 1;
+}
+
 gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_settings *s, const gi_caustic_hooks *hk,
                              diag *d, pt_status *status)
 {
@@ -1045,6 +1193,12 @@ gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_s
     if (st != PT_OK || (s->cancel && *s->cancel)) {
         gi_caustic_free(c);
         *status = st;
+        return NULL;
+    }
+    c->st.r_median = median_of(&c->ph[0].r_xy, c->nph, sizeof(gi_caus_photon) / sizeof(float));
+    if (!widen_sparse(c, threads)) {
+        gi_caustic_free(c);
+        *status = PT_ERR_NOMEM;
         return NULL;
     }
     c->st.r_median = median_of(&c->ph[0].r_xy, c->nph, sizeof(gi_caus_photon) / sizeof(float));

@@ -182,7 +182,8 @@ typedef struct {
     double flux;            /* their power, summed (grey: mean of the channels) */
     long rays;
     double spacing;         /* the global spacing used (count and count_scale applied) */
-    double r_median;        /* median r_xy */
+    double r_median;        /* median r_xy (after the widening) */
+    long widened;           /* photon volumes widened to hold the gather minimum (gi_caustic.c, GATHER_MIN) */
     long tile_entries;      /* (photon, tile) pairs the splat visits */
     long lookups_gbuffer, lookups_photons; /* gi_caustic_at answers from the G-buffer / from the photons */
     double t_trace, t_gbuffer, t_bin, t_splat; /* seconds */

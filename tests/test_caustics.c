@@ -198,6 +198,77 @@ static void test_mirror_closed_form(void **state)
     tu_world_free(&w);
 }
 
+/* POV-Ray's gather minimum (gi_caustic.c, widen_sparse): a photon volume
+ * holding fewer than `gather`'s minimum m of photon positions is widened
+ * to hold m (up to 3 times its radius), spreading its power, not adding
+ * to it. Under the mirror the floor's photons are an unfocused beam whose
+ * volumes hold some 170 photons each: the default m = 20 widens none but
+ * the odd one at the beam's edge, m = 300 nearly all. Checked by brute
+ * force on every 500th photon: each holds m as it was, or its radius is
+ * the distance of its m-th nearest position (m within 1.001 of it, fewer
+ * within 0.999), or it holds fewer than m at 3 times the radius it had
+ * (the beam's edge); at m = 300 at least 80% are at their m-th nearest,
+ * at m = 20 99% hold m as they were; the irradiance keeps the closed form
+ * (2%). */
+static long positions_within(const gi_caus_photon *ph, long n, const gi_caus_photon *q, double r)
+{
+    long k = 0;
+    for (long j = 0; j < n; j++) {
+        const gi_caus_photon *o = &ph[j];
+        if (o->n[0] * q->n[0] + o->n[1] * q->n[1] + o->n[2] * q->n[2] < 0.5f) continue;
+        double dx = o->x[0] - q->x[0], dy = o->x[1] - q->x[1], dz = o->x[2] - q->x[2];
+        double dn = dx * q->n[0] + dy * q->n[1] + dz * q->n[2];
+        double dp2 = fmax(dx * dx + dy * dy + dz * dz - dn * dn, 0.0);
+        k += sqrt(dp2 + 16.0 * dn * dn) < r;
+    }
+    return k;
+}
+
+static void test_gather_minimum(void **state)
+{
+    (void)state;
+    long widened[2], stored[2];
+    for (int k = 0; k < 2; k++) {
+        const long m = k ? 300 : 20;
+        char text[1024];
+        snprintf(text, sizeof text, mirror_fmt, k ? "photons { spacing 0.01 gather 300, 400 }" : "photons { spacing 0.01 }",
+                 "light_source { <-2, 5, 0> color rgb 1 }", "photons { target reflection on }", "");
+        tu_world w = tu_world_build("test.pov", text);
+        diag *d = diag_new();
+        caustics c;
+        layer(&c, w.s, w.a, 32, 32, NULL, THREADS, d);
+        gi_caustic_stats st;
+        gi_caustic_get_stats(c.layer, &st);
+        double e = centre_mean(gi_caustic_image(c.layer), 4, 32, 32, 32, 32), want = 5.0 / sqrt(41.0);
+        widened[k] = st.widened;
+        stored[k] = st.stored;
+        long n, checked = 0, at_mth = 0, held = 0, capped = 0;
+        const gi_caus_photon *ph = gi_caustic_photons(c.layer, &n);
+        assert_int_equal(n, st.stored);
+        for (long i = 0; i < n; i += 500) {
+            long less = positions_within(ph, n, &ph[i], 0.999 * ph[i].r_xy);
+            long more = positions_within(ph, n, &ph[i], 1.001 * ph[i].r_xy);
+            at_mth += less < m && more >= m; /* widened to the m-th nearest */
+            held += less >= m;               /* held m already: as it was */
+            capped += more < m;              /* fewer than m within 3 times its radius */
+            checked++;
+        }
+        printf("gather minimum %ld: %ld of %ld volumes widened, median radius %.5f; of %ld checked, %ld at their "
+               "m-th nearest, %ld at 3 times their radius, %ld holding m as they were; caustic layer %.5f, closed "
+               "form %.5f (rel err %+.4f, tol 0.02)\n",
+               m, st.widened, st.stored, st.r_median, checked, at_mth, capped, held, e, want, e / want - 1.0);
+        assert_int_equal(at_mth + capped + held, checked);
+        if (k) assert_true(at_mth >= checked * 8 / 10);
+        else assert_true(held >= checked * 99 / 100);
+        assert_true(fabs(e / want - 1.0) <= 0.02);
+        caustics_free(&c);
+        diag_free(d);
+        tu_world_free(&w);
+    }
+    assert_true(widened[0] < stored[0] / 100);
+    assert_true(widened[1] > stored[1] * 9 / 10);
+}
+
 /* The mirror above with a floor of finish brilliance b: POV-Ray shades
  * each photon as a light through the diffuse term cos^b after dividing by
  * the cosine (trace.cpp's ComputePhotonDiffuseLight), with the direction
@@ -775,6 +846,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_mirror_closed_form),
         cmocka_unit_test(test_mirror_brilliance),
+        cmocka_unit_test(test_gather_minimum),
         cmocka_unit_test(test_highlight_photons),
         cmocka_unit_test(test_photons_in_room),
         cmocka_unit_test(test_pass_through_filter),
