@@ -640,8 +640,11 @@ gi_trilook *gi_trilook_build(const accel *a, const gi_dev_particle *p, int n, co
     /* the hit point's distance to its cell: float rounding of Embree's
      * (u, v) and of org + t dir, a few ulps of the coordinates */
     B.delta = 1e-3 * spacing + 1e-5 * tmag;
-    B.chunks = (int)(ntris / 64 + 1);
-    if (B.chunks > 4096) B.chunks = 4096;
+    /* a chunk a triangle up to 4096 (a few large triangles, as in a
+     * room of quads, are then shared out among the threads; 64 a chunk
+     * left cornell.pov's 30 on one thread), then runs of them */
+    B.chunks = (int)(ntris < 4096 ? ntris : 4096);
+    if (B.chunks < 1) B.chunks = 1;
     B.ce = calloc((size_t)B.chunks, sizeof *B.ce);
     B.cne = calloc((size_t)B.chunks, sizeof *B.cne);
     B.ccap = calloc((size_t)B.chunks, sizeof *B.ccap);
