@@ -46,6 +46,7 @@ typedef struct {
     int exact;            /* view points with no bounce after the hit: every hit takes hit_light */
     float *reach;         /* per source (i - first): the harmonic mean of its rays' hit distances */
     int occlude;          /* the gatherer's rays where a hit brings nothing (hits_dark): occlusion tests */
+    int lone;             /* points' rays that end on a particle: no emission or mirror there to add (leaves_dark) */
     int points;           /* the sources are the final gather's points, not particles */
     /* mirror reflections at the hits (the final gather's points and the
      * gatherer, job_mirror): the gather rays' trace level and weight, the
@@ -636,7 +637,7 @@ static void job(void *ctx, int index, int thread)
                 if (target < 0) {
                     unres++;
                     if (hit) hit_light(J, &rh[m], 1, 1, &memo, sky);
-                } else if (J->points && J->esky) {
+                } else if (J->points && J->esky && !J->lone) {
                     /* the emission where it hit; the particle's reflected
                      * light, direct and indirect, follows in the regather */
                     hit_light(J, &rh[m], 0, 0, &memo, sky);
@@ -788,16 +789,13 @@ static int tex_dark(const link_job *J, emit_memo *memo, const scene_texture *t)
     return !m->emits && !(J->mirror && (m->mirrors || m->clear));
 }
 
-/* Whether every ray of J's exact gather that hits something brings
- * nothing back: no light to reflect there, no far-field sky, and no leaf
- * texture (hit_leaf's choice where a leaf has none, a mesh's texture_list
- * entries too) that emits, mirrors or lets light through. A sky-lit scene
- * of diffuse surfaces under recursion_limit 1 is one (stackerday.pov):
- * what reaches a point is the sky its rays see, so an occlusion test
- * answers each ray. */
-static int hits_dark(const link_job *J)
+/* Whether no leaf texture (hit_leaf's choice where a leaf has none, a
+ * mesh's texture_list entries too) emits, mirrors or lets light through
+ * (tex_dark): then a hit's emission and its mirror and glass rays
+ * (hit_light_at without the far field and direct light) add nothing. */
+static int leaves_dark(const link_job *J)
 {
-    if (!J->esky || !J->exact || J->nlights > 0 || J->far_bounce > 0.0f || !J->sc) return 0;
+    if (!J->sc) return 0;
     emit_memo memo = {0};
     if (!tex_dark(J, &memo, &J->sc->default_texture)) return 0;
     for (int i = 0, n = accel_leaf_count(J->a); i < n; i++) {
@@ -810,6 +808,18 @@ static int hits_dark(const link_job *J)
                 if (o->u.mesh.textures[k] && !tex_dark(J, &memo, o->u.mesh.textures[k])) return 0;
     }
     return 1;
+}
+
+/* Whether every ray of J's exact gather that hits something brings
+ * nothing back: no light to reflect there, no far-field sky, and no leaf
+ * texture that emits, mirrors or lets light through (leaves_dark). A sky-lit scene
+ * of diffuse surfaces under recursion_limit 1 is one (stackerday.pov):
+ * what reaches a point is the sky its rays see, so an occlusion test
+ * answers each ray. */
+static int hits_dark(const link_job *J)
+{
+    if (!J->esky || !J->exact || J->nlights > 0 || J->far_bounce > 0.0f || !J->sc) return 0;
+    return leaves_dark(J);
 }
 
 static void job_close(link_job *J)
@@ -872,6 +882,10 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
         job_mirror(&J, sc);
     }
     J.exact = J.esky && J.points && !(J.far_bounce > 0.0f);
+    /* with no texture that emits, mirrors or lets light through, a point's
+     * ray that ends on a particle takes that particle's light alone: its
+     * hit's texture is not looked up (cornell.pov) */
+    if (rc == PT_OK && J.esky && J.points && !J.exact) J.lone = leaves_dark(&J);
     if (rc == PT_OK && n > 0 && !pool_run_counted(threads, (n - J.first + J.per_job - 1) / J.per_job, job, &J, cancel, prog))
         rc = PT_CANCELLED;
     job_close(&J);
