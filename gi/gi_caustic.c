@@ -971,11 +971,19 @@ static double median_of(const float *v, long n, size_t stride)
  * and positions alone (any thread count gives the same layer). */
 #define WIDEN_MAX 3.0
 #define WIDEN_CHUNK 1024
+/* The photons' positions are binned at several cell sizes, r_median times
+ * 1, 4, 16, ...: a search of reach R reads the level whose cells are at
+ * least R / 2, so it visits at most 5^3 cells whatever R is (the volumes'
+ * radii span orders of magnitude: a dim caustic's photons are few and
+ * wide, and one level of cells r_median across made their searches visit
+ * up to (6 r / r_median)^3 cells each). */
+#define WIDEN_LEVELS 8
 
 typedef struct {
     gi_caustic *c;
     int m;         /* the gather minimum */
-    hgrid g;       /* photon positions (zero radius) */
+    int nlv;       /* levels of g in use */
+    hgrid g[WIDEN_LEVELS]; /* photon positions (zero radius), cells r_median 4^k */
     float *r;      /* the new radii */
     atomic_long widened;
     atomic_int oom;
@@ -1012,7 +1020,10 @@ static long widen_scan(const widen_job *wj, const gi_caus_photon *q, double reac
                        long *cap)
 {
     const gi_caustic *c = wj->c;
-    double cell = wj->g.cell;
+    int lv = 0;
+    while (lv + 1 < wj->nlv && wj->g[lv].cell < 0.5 * reach) lv++;
+    const hgrid *g = &wj->g[lv];
+    double cell = g->cell;
     long n = 0;
     long x0 = cidx(q->x[0] - reach, cell), x1 = cidx(q->x[0] + reach, cell);
     long y0 = cidx(q->x[1] - reach, cell), y1 = cidx(q->x[1] + reach, cell);
@@ -1021,9 +1032,9 @@ static long widen_scan(const widen_job *wj, const gi_caus_photon *q, double reac
         for (long y = y0; y <= y1; y++)
             for (long z = z0; z <= z1; z++) {
                 long lo, hi;
-                hgrid_cell(&wj->g, x, y, z, &lo, &hi);
+                hgrid_cell(g, x, y, z, &lo, &hi);
                 for (long e = lo; e < hi; e++) {
-                    const gi_caus_photon *o = &c->ph[wj->g.e[e].id];
+                    const gi_caus_photon *o = &c->ph[g->e[e].id];
                     if (o->n[0] * q->n[0] + o->n[1] * q->n[1] + o->n[2] * q->n[2] < 0.5f) continue;
                     double dx = o->x[0] - q->x[0], dy = o->x[1] - q->x[1], dz = o->x[2] - q->x[2];
                     double dn = dx * q->n[0] + dy * q->n[1] + dz * q->n[2];
@@ -1072,33 +1083,37 @@ static int widen_sparse(gi_caustic *c, int threads)
 {
     int m = c->sc->global.photons.gather_min;
     if (c->nph <= 0 || m <= 1) return 1;
-    widen_job wj = {c, m, {0}, malloc(sizeof(float) * (size_t)c->nph), 0, 0};
-    float zero = 0.0f;
+    widen_job wj = {c, m, 0, {{0}}, malloc(sizeof(float) * (size_t)c->nph), 0, 0};
+    float zero = 0.0f, rmax = 0.0f;
+    for (long i = 0; i < c->nph; i++) rmax = fmaxf(rmax, c->ph[i].r_xy);
     double cell = c->st.r_median > 0.0 ? c->st.r_median : 1.0;
-    if (!wj.r || !hgrid_build(&wj.g, cell, c->nph, c->ph[0].x, sizeof(gi_caus_photon) / sizeof(float), &zero, 0)) {
-        free(wj.r);
-        hgrid_free(&wj.g);
-        return 0;
+    /* levels up to cells of half the widest reach */
+    int ok = wj.r != NULL;
+    for (int k = 0; ok && k < WIDEN_LEVELS; k++) {
+        ok = hgrid_build(&wj.g[k], cell, c->nph, c->ph[0].x, sizeof(gi_caus_photon) / sizeof(float), &zero, 0);
+        wj.nlv = k + 1;
+        if (cell >= 0.5 * WIDEN_MAX * rmax) break;
+        cell *= 4.0;
     }
-    int nchunks = (int)((c->nph + WIDEN_CHUNK - 1) / WIDEN_CHUNK);
-    pool_run(threads, nchunks, widen_chunk, &wj);
-    if (atomic_load(&wj.oom)) {
-        free(wj.r);
-        hgrid_free(&wj.g);
-        return 0;
+    if (ok) {
+        int nchunks = (int)((c->nph + WIDEN_CHUNK - 1) / WIDEN_CHUNK);
+        pool_run(threads, nchunks, widen_chunk, &wj);
+        ok = !atomic_load(&wj.oom);
     }
-    for (long i = 0; i < c->nph; i++) {
-        gi_caus_photon *q = &c->ph[i];
-        double r = wj.r[i];
-        q->r_xy = (float)r;
-        q->r_z = (float)(0.25 * r);
-        q->inv_rxy2 = (float)(1.0 / (r * r));
-        q->inv_rz2 = (float)(16.0 / (r * r));
+    if (ok) {
+        for (long i = 0; i < c->nph; i++) {
+            gi_caus_photon *q = &c->ph[i];
+            double r = wj.r[i];
+            q->r_xy = (float)r;
+            q->r_z = (float)(0.25 * r);
+            q->inv_rxy2 = (float)(1.0 / (r * r));
+            q->inv_rz2 = (float)(16.0 / (r * r));
+        }
+        c->st.widened = atomic_load(&wj.widened);
     }
-    c->st.widened = atomic_load(&wj.widened);
     free(wj.r);
-    hgrid_free(&wj.g);
-    return 1;
+    for (int k = 0; k < WIDEN_LEVELS; k++) hgrid_free(&wj.g[k]);
+    return ok;
 }
 
 gi_caustic *gi_caustic_build(const scene *sc, const accel *a, const gi_caustic_settings *s, const gi_caustic_hooks *hk,
