@@ -57,20 +57,28 @@ static inline rgb cscale(rgb a, double k) { return crgb(a.r * k, a.g * k, a.b * 
 /* ------------------------------------------------------------ hash grid */
 
 /* Items (spheres) binned into cubic cells of edge `cell`: each item is
- * listed in every cell its sphere's box touches, or in `big` when that is
- * more than BIG_CELLS cells. Cells are found by hashing their integer
- * coordinates; a collision only adds candidates that the exact tests drop. */
+ * listed in every cell its sphere's box touches, or, when that is more
+ * than BIG_CELLS cells, in `up`, the same kind of grid with cells 4 times
+ * as large (up to HGRID_LEVELS levels; past the last, in `big`, which
+ * every lookup reads whole). Photon volumes' radii span orders of
+ * magnitude (the gather minimum widens the sparse ones up to threefold):
+ * one flat list of the wide ones made every lookup read thousands. A
+ * lookup reads its cell at each level. Cells are found by hashing their
+ * integer coordinates; a collision only adds candidates that the exact
+ * tests drop. */
 #define BIG_CELLS 64
+#define HGRID_LEVELS 6
 typedef struct {
     uint64_t key;
     int id;
 } cell_entry;
-typedef struct {
+typedef struct hgrid {
     double cell;
     cell_entry *e;
     long n;
     int *big;
     long nbig;
+    struct hgrid *up; /* the items too wide for these cells, or NULL */
 } hgrid;
 
 static uint64_t cell_key(long ix, long iy, long iz)
@@ -91,27 +99,31 @@ static int entry_cmp(const void *a, const void *b)
 
 static long cidx(double v, double cell) { return (long)floor(v / cell); }
 
-/* centres c (stride floats apart, 3 coordinates at c + i*stride) with radii r */
-static int hgrid_build(hgrid *g, double cell, long n, const float *c, size_t stride, const float *r, size_t rstride)
+static void hgrid_free(hgrid *g);
+
+/* The grid of items ids[0..n) (NULL: 0..n-1) at level `level`. */
+static int hgrid_build_at(hgrid *g, double cell, long n, const int *ids, const float *c, size_t stride, const float *r,
+                          size_t rstride, int level)
 {
     memset(g, 0, sizeof *g);
     g->cell = cell;
-    long cap = 0;
-    for (long i = 0; i < n; i++) {
+    long cap = 0, nwide = 0;
+    for (long j = 0; j < n; j++) {
+        long i = ids ? ids[j] : j;
         const float *p = c + (size_t)i * stride;
         double rad = r[(size_t)i * rstride];
         long nx = cidx(p[0] + rad, cell) - cidx(p[0] - rad, cell) + 1;
         long ny = cidx(p[1] + rad, cell) - cidx(p[1] - rad, cell) + 1;
         long nz = cidx(p[2] + rad, cell) - cidx(p[2] - rad, cell) + 1;
         long k = nx * ny * nz;
-        if (k > BIG_CELLS) g->nbig++;
+        if (k > BIG_CELLS) nwide++;
         else cap += k;
     }
     g->e = malloc(sizeof(cell_entry) * (size_t)(cap > 0 ? cap : 1));
-    g->big = malloc(sizeof(int) * (size_t)(g->nbig > 0 ? g->nbig : 1));
+    g->big = malloc(sizeof(int) * (size_t)(nwide > 0 ? nwide : 1));
     if (!g->e || !g->big) return 0;
-    g->nbig = 0;
-    for (long i = 0; i < n; i++) {
+    for (long j = 0; j < n; j++) {
+        long i = ids ? ids[j] : j;
         const float *p = c + (size_t)i * stride;
         double rad = r[(size_t)i * rstride];
         long x0 = cidx(p[0] - rad, cell), x1 = cidx(p[0] + rad, cell);
@@ -126,11 +138,28 @@ static int hgrid_build(hgrid *g, double cell, long n, const float *c, size_t str
                 for (long z = z0; z <= z1; z++) g->e[g->n++] = (cell_entry){cell_key(x, y, z), (int)i};
     }
     qsort(g->e, (size_t)g->n, sizeof *g->e, entry_cmp);
+    if (g->nbig > 0 && level + 1 < HGRID_LEVELS) {
+        g->up = malloc(sizeof *g->up);
+        if (!g->up) return 0;
+        int ok = hgrid_build_at(g->up, 4.0 * cell, g->nbig, g->big, c, stride, r, rstride, level + 1);
+        g->nbig = 0; /* they are up there */
+        if (!ok) return 0;
+    }
     return 1;
+}
+
+/* centres c (stride floats apart, 3 coordinates at c + i*stride) with radii r */
+static int hgrid_build(hgrid *g, double cell, long n, const float *c, size_t stride, const float *r, size_t rstride)
+{
+    return hgrid_build_at(g, cell, n, NULL, c, stride, r, rstride, 0);
 }
 
 static void hgrid_free(hgrid *g)
 {
+    if (g->up) {
+        hgrid_free(g->up);
+        free(g->up);
+    }
     free(g->e);
     free(g->big);
     memset(g, 0, sizeof *g);
@@ -1337,13 +1366,13 @@ rgb gi_caustic_at(void *ctx, const accel_hit *h, vec3 n, int thread)
     vec3 p = h->p;
     /* the G-buffer points of the same surface whose footprint holds p */
     long lo, hi;
-    double cell = c->ggrid.cell;
-    hgrid_cell(&c->ggrid, cidx(p.x, cell), cidx(p.y, cell), cidx(p.z, cell), &lo, &hi);
     double ws = 0.0;
+    for (const hgrid *gl = &c->ggrid; gl; gl = gl->up)
     for (int pass = 0; pass < 2; pass++) {
-        long m = pass ? c->ggrid.nbig : hi - lo;
+        hgrid_cell(gl, cidx(p.x, gl->cell), cidx(p.y, gl->cell), cidx(p.z, gl->cell), &lo, &hi);
+        long m = pass ? gl->nbig : hi - lo;
         for (long q = 0; q < m; q++) {
-            int i = pass ? c->ggrid.big[q] : c->ggrid.e[lo + q].id;
+            int i = pass ? gl->big[q] : gl->e[lo + q].id;
             if (c->gobj[i] != h->obj) continue;
             const gi_caus_pixel *px = &c->gb[i];
             if (px->n[0] * n.x + px->n[1] * n.y + px->n[2] * n.z < 0.7) continue;
@@ -1366,21 +1395,22 @@ rgb gi_caustic_at(void *ctx, const accel_hit *h, vec3 n, int thread)
     __atomic_fetch_add(&c->st.lookups_photons, 1, __ATOMIC_RELAXED);
     float s[3] = {(float)p.x, (float)p.y, (float)p.z}, nn[3] = {(float)n.x, (float)n.y, (float)n.z}, acc[3] = {0, 0, 0};
     float b = c->hk.brilliance ? (float)c->hk.brilliance(c->hk.ctx, h, v3_neg(n)) : 1.0f;
-    cell = c->pgrid.cell;
-    hgrid_cell(&c->pgrid, cidx(p.x, cell), cidx(p.y, cell), cidx(p.z, cell), &lo, &hi);
-    for (long q = lo; q < hi; q++) {
-        float one[3];
-        gi_c_caustic_at(c->ph, &c->pgrid.e[q].id, 1, s, nn, b, one);
-        acc[0] += one[0];
-        acc[1] += one[1];
-        acc[2] += one[2];
-    }
-    if (c->pgrid.nbig) {
-        float one[3];
-        gi_c_caustic_at(c->ph, c->pgrid.big, (int)c->pgrid.nbig, s, nn, b, one);
-        acc[0] += one[0];
-        acc[1] += one[1];
-        acc[2] += one[2];
+    for (const hgrid *gl = &c->pgrid; gl; gl = gl->up) {
+        hgrid_cell(gl, cidx(p.x, gl->cell), cidx(p.y, gl->cell), cidx(p.z, gl->cell), &lo, &hi);
+        for (long q = lo; q < hi; q++) {
+            float one[3];
+            gi_c_caustic_at(c->ph, &gl->e[q].id, 1, s, nn, b, one);
+            acc[0] += one[0];
+            acc[1] += one[1];
+            acc[2] += one[2];
+        }
+        if (gl->nbig) {
+            float one[3];
+            gi_c_caustic_at(c->ph, gl->big, (int)gl->nbig, s, nn, b, one);
+            acc[0] += one[0];
+            acc[1] += one[1];
+            acc[2] += one[2];
+        }
     }
     return crgb(acc[0], acc[1], acc[2]);
 }
@@ -1402,10 +1432,11 @@ static void visit_grid(const hgrid *g, const gi_caus_photon *ph, vec3 p, vec3 n,
     if (!ph) return;
     float s[3] = {(float)p.x, (float)p.y, (float)p.z};
     long lo, hi;
-    double cell = g->cell;
-    hgrid_cell(g, cidx(p.x, cell), cidx(p.y, cell), cidx(p.z, cell), &lo, &hi);
-    for (long q = lo; q < hi; q++) visit_one(&ph[g->e[q].id], s, n, fn, ctx);
-    for (long q = 0; q < g->nbig; q++) visit_one(&ph[g->big[q]], s, n, fn, ctx);
+    for (const hgrid *gl = g; gl; gl = gl->up) {
+        hgrid_cell(gl, cidx(p.x, gl->cell), cidx(p.y, gl->cell), cidx(p.z, gl->cell), &lo, &hi);
+        for (long q = lo; q < hi; q++) visit_one(&ph[gl->e[q].id], s, n, fn, ctx);
+        for (long q = 0; q < gl->nbig; q++) visit_one(&ph[gl->big[q]], s, n, fn, ctx);
+    }
 }
 
 void gi_caustic_visit(const gi_caustic *c, const accel_hit *h, vec3 n, gi_caustic_visit_fn fn, void *ctx)
@@ -1429,10 +1460,10 @@ static void media_one(const gi_caus_photon *q, vec3 p, gi_caustic_visit_fn fn, v
 void gi_caustic_media_visit(const gi_caustic *c, vec3 p, gi_caustic_visit_fn fn, void *ctx)
 {
     if (!c || c->nmp <= 0) return;
-    const hgrid *g = &c->mgrid;
     long lo, hi;
-    double cell = g->cell;
-    hgrid_cell(g, cidx(p.x, cell), cidx(p.y, cell), cidx(p.z, cell), &lo, &hi);
-    for (long q = lo; q < hi; q++) media_one(&c->mp[g->e[q].id], p, fn, ctx);
-    for (long q = 0; q < g->nbig; q++) media_one(&c->mp[g->big[q]], p, fn, ctx);
+    for (const hgrid *gl = &c->mgrid; gl; gl = gl->up) {
+        hgrid_cell(gl, cidx(p.x, gl->cell), cidx(p.y, gl->cell), cidx(p.z, gl->cell), &lo, &hi);
+        for (long q = lo; q < hi; q++) media_one(&c->mp[gl->e[q].id], p, fn, ctx);
+        for (long q = 0; q < gl->nbig; q++) media_one(&c->mp[gl->big[q]], p, fn, ctx);
+    }
 }
