@@ -684,12 +684,12 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         S->bytes_trilook = gi_trilook_bytes(gp->tl);
         S->trilook_entries = gi_trilook_entries(gp->tl);
         S->trilook_lists = gi_trilook_cells(gp->tl);
-        /* the final gather at the camera's hits traces the same scene and
-         * looks its rays' particles up in the same triangle lists (its
-         * rays end on these particles by the same rules) */
+        /* (the final gather builds lists of its own for the kept
+         * particles, gi_particle_gather.c) */
+        gi_trilook_free(gp->tl);
+        gp->tl = NULL;
+        /* the final gather at the camera's hits traces the same scene */
         if (set->view_gather_side <= 0 || !set->keep_hits) {
-            gi_trilook_free(gp->tl);
-            gp->tl = NULL;
             accel_rtc_link_scene_free(gp->lscene);
             gp->lscene = NULL;
         }

@@ -524,9 +524,15 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
     gp->vg_h = h;
     gp->vg_s = s;
     long rays = 0;
-    /* a ray that hits a triangle the lists cover takes the particle at the
-     * centre of its cell (gi_links.h) */
-    if (gp->tl && !gi_trilook_centres(gp->tl, gp->threads)) st = PT_ERR_NOMEM;
+    /* the triangle lists of the particles as they are now (built once for
+     * the views: the geometry stage's were built before the pruning, and
+     * a geometry stage read from a cache has none; so a render gives the
+     * same image with and without --gi-cache). A ray that hits a triangle
+     * they cover takes the particle at the centre of its cell (gi_links.h) */
+    if (st == PT_OK && !gp->tl && gp->ps.n > 0)
+        gp->tl = gi_trilook_build(gp->a, gp->ps.p, gp->ps.n, (const void *const *)pobj, grid, pin + gp->ps.n,
+                                  spacing, GI_LINKS_AGREE, 3.0 * spacing, gp->threads, gp->set.cancel, &st);
+    if (st == PT_OK && gp->tl && !gi_trilook_centres(gp->tl, gp->threads)) st = PT_ERR_NOMEM;
     if (st == PT_OK) st = trace_points(gp, pobj, pin, grid, 0, m, side, s, gp->set.seed ^ 0x7a9e7ULL, &rays);
     /* refinement (an irradiance cache's adaptive placement): pixels whose
      * matching corners disagree gather themselves, traced as a second set */

@@ -439,7 +439,11 @@ static void test_gi_cache(void **st)
     tu_write_file(scene, "#version 3.7;\nglobal_settings { radiosity { count 50 } }\n"
                          "camera { location <0.3, 1, -3.2> look_at <0, 0.8, 0> angle 60 }\n"
                          "light_source { <0, 1.8, -0.5> rgb 1 }\n#include \"cache_room.inc\"\n"
-                         "sphere { <-0.6, 0.4, -0.3>, 0.4 pigment { rgb <0.9, 0.3, 0.2> } finish { diffuse 0.8 ambient 0 } }\n");
+                         "sphere { <-0.6, 0.4, -0.3>, 0.4 pigment { rgb <0.9, 0.3, 0.2> } finish { diffuse 0.8 ambient 0 } }\n"
+                         /* a triangle: the final gather's rays look its
+                          * particles up in lists the cache does not hold */
+                         "triangle { <0.1, 0.001, -1>, <1.2, 0.001, -1>, <0.6, 0.001, 0.8> pigment { rgb <0.2, 0.5, 0.9> }"
+                         " finish { diffuse 0.8 ambient 0 } }\n");
     tu_write_file(inc, "box { <-1.5, 0, -4>, <1.5, 2, 1.5> hollow pigment { rgb 0.8 } finish { diffuse 0.8 ambient 0 } }\n");
     const char *opts = "--size 48x36 --particles 5000";
     snprintf(cmd, sizeof cmd, "'%s' render '%s' %s --threads 2 --gi-cache '%s' -o '%s'", PARTRAY_BIN, scene, opts, cache, a);
