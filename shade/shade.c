@@ -500,7 +500,9 @@ rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 o
 {
     thread_stats ts[1];
     memset(ts, 0, sizeof ts);
-    render_ctx c = {sc, a, s, scene_eps(a), s->max_trace_level > 0 ? s->max_trace_level : sc->global.max_trace_level, ts, NULL, NULL, 0, 0, 1};
+    render_ctx c = {.sc = sc, .a = a, .s = s, .eps = scene_eps(a),
+                    .max_level = s->max_trace_level > 0 ? s->max_trace_level : sc->global.max_trace_level, .ts = ts,
+                    .transparent = 1 /* filtered shadows: exact for opaque surfaces too */};
     c.media = shade_media_scene_has(sc);
     return trace_ray(&c, 0, org, v3_norm(dir), 1, 1.0, OBJ_NO_IMAGE, 0.0f, r, &no_containers);
 }

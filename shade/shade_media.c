@@ -781,8 +781,8 @@ typedef struct {
     const shade_media_env *e;
     const scene_light *photon_light;
     vec3 p, dir;
-    double tmin, t0; /* t0: just past the last crossing (accel_crossings' step), tmin before the first */
-    double prev;     /* where the current segment starts */
+    shade_tex_walk walk; /* POV-Ray's crossings taken */
+    double prev;         /* where the current segment starts: the last crossing that let light through */
     int atmos;
     shade_media_inside in;
     rgb c;
@@ -791,8 +791,9 @@ typedef struct {
 static int media_shadow_crossing(void *ctx, const accel_hit *h)
 {
     media_shadow_walk *w = ctx;
-    double depth = shade_tex_crossing_depth(&w->t0, w->tmin, h->t);
-    if (h->flags & OBJ_NO_SHADOW) return 1;
+    double depth;
+    int inside;
+    if (!shade_tex_walk_take(&w->walk, h, w->dir, &depth, &inside)) return 1;
     const scene_obj_photons *ph = h->obj ? h->obj->photons : NULL;
     if (w->photon_light && ph && ph->target && scene_photon_lobe(w->photon_light, ph, 1)) {
         w->c = mk(0, 0, 0); /* shade_tex_shadow_ray's photon rule */
@@ -801,7 +802,7 @@ static int media_shadow_crossing(void *ctx, const accel_hit *h)
     const scene *sc = w->sc;
     accel_hit hh = *h;
     hh.t = depth;
-    rgb f = shade_tex_shadow_filter(sc, &hh, w->dir);
+    rgb f = shade_tex_shadow_filter_inside(sc, &hh, w->dir, inside);
     if (fabs(f.r) < MEDIA_EPSILON && fabs(f.g) < MEDIA_EPSILON && fabs(f.b) < MEDIA_EPSILON) {
         w->c = mk(0, 0, 0);
         return 0;
@@ -832,8 +833,8 @@ rgb shade_media_shadow_ray(const scene *sc, const accel *a, const shade_media_en
                            double tmin, double tmax, const shade_media_inside *in0, double *rest,
                            const scene_light *photon_light)
 {
-    media_shadow_walk w = {sc, e, photon_light, p, dir, tmin, tmin, 0.0, l && l->media_interaction && l->media_attenuation, *in0,
-                           {1, 1, 1}};
+    media_shadow_walk w = {sc, e, photon_light, p, dir, {0.0, {0, {0}}}, 0.0, l && l->media_interaction && l->media_attenuation,
+                           *in0, {1, 1, 1}};
     /* every surface crossed, each the nearest just past the one before,
      * from one traversal where the scene allows (accel_crossings) */
     accel_crossings_skip(a, p, dir, tmin, tmax, tmin, OBJ_NO_SHADOW, media_shadow_crossing, &w);

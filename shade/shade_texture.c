@@ -614,7 +614,7 @@ static rgb shadow_layers(const scene_texture *tex, vec3 point, const shade_patte
     return c;
 }
 
-rgb shade_tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir)
+rgb shade_tex_shadow_filter_inside(const scene *sc, const accel_hit *h, vec3 dir, int inside)
 {
     int entering = v3_dot(dir, h->ng) < 0.0;
     const scene_texture *tex = hit_texture(sc, h, entering);
@@ -626,7 +626,12 @@ rgb shade_tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir)
     vec3 raw = h->ns;
     if (v3_dot(raw, dir) > 0.0) raw = v3_neg(raw);
     rgb c = shadow_layers(tex, texture_point(h), &pc, 0, in ? in->caustics : 0.0, raw, dir);
-    return tmul(c, shade_tex_leaving_fade(h, dir));
+    return inside ? tmul(c, transmit_fade(in, h->t, 1)) : c;
+}
+
+rgb shade_tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir)
+{
+    return shade_tex_shadow_filter_inside(sc, h, dir, v3_dot(dir, h->ng) >= 0.0);
 }
 
 rgb shade_tex_leaving_fade(const accel_hit *h, vec3 dir)
@@ -665,35 +670,42 @@ int shade_tex_scene_transparent(const scene *sc)
     return 0;
 }
 
+int shade_tex_walk_take(shade_tex_walk *w, const accel_hit *h, vec3 dir, double *depth, int *inside)
+{
+    if (h->flags & OBJ_NO_SHADOW) return 0;
+    if (!(h->t - w->last > SHADE_TEX_POV_SMALL_TOLERANCE)) {
+        shade_media_inside_cross(&w->unseen, h->obj);
+        return 0;
+    }
+    *depth = h->t - w->last;
+    w->last = h->t;
+    *inside = (v3_dot(dir, h->ng) >= 0.0) != (h->obj && shade_media_inside_find(&w->unseen, h->obj) >= 0);
+    return 1;
+}
+
 typedef struct {
     const scene *sc;
     const scene_light *photon_light;
     vec3 dir;
-    double tmin, t0; /* t0: just past the last crossing (accel_crossings' step), tmin before the first */
+    shade_tex_walk walk;
     rgb c;
 } shadow_walk;
-
-double shade_tex_crossing_depth(double *t0, double tmin, double t)
-{
-    double prev = *t0;
-    *t0 = t + fmax_inline(tmin, t * 1e-7);
-    return t - (prev > tmin ? prev - fmax_inline(tmin, prev * 1e-7) : 0.0);
-}
 
 static int shadow_crossing(void *ctx, const accel_hit *h)
 {
     shadow_walk *w = ctx;
-    double depth = shade_tex_crossing_depth(&w->t0, w->tmin, h->t);
-    if (h->flags & OBJ_NO_SHADOW) return 1;
+    double depth;
+    int inside;
+    if (!shade_tex_walk_take(&w->walk, h, w->dir, &depth, &inside)) return 1;
     const scene_obj_photons *ph = h->obj ? h->obj->photons : NULL;
     if (w->photon_light && ph && ph->target && scene_photon_lobe(w->photon_light, ph, 1)) {
         w->c = trgb(0, 0, 0);
         return 0;
     }
-    /* distance inside the object: from the previous crossing */
+    /* distance inside the object: from the previous crossing taken */
     accel_hit hh = *h;
     hh.t = depth;
-    w->c = tmul(w->c, shade_tex_shadow_filter(w->sc, &hh, w->dir));
+    w->c = tmul(w->c, shade_tex_shadow_filter_inside(w->sc, &hh, w->dir, inside));
     if (fabs(w->c.r) < TEX_EPSILON && fabs(w->c.g) < TEX_EPSILON && fabs(w->c.b) < TEX_EPSILON) {
         w->c = trgb(0, 0, 0);
         return 0;
@@ -704,7 +716,7 @@ static int shadow_crossing(void *ctx, const accel_hit *h)
 rgb shade_tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, double tmin, double tmax,
                          const scene_light *photon_light)
 {
-    shadow_walk w = {sc, photon_light, dir, tmin, tmin, {1, 1, 1}};
+    shadow_walk w = {sc, photon_light, dir, {0.0, {0, {0}}}, {1, 1, 1}};
     accel_crossings_skip(a, p, dir, tmin, tmax, tmin, OBJ_NO_SHADOW, shadow_crossing, &w);
     return w.c;
 }

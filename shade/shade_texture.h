@@ -80,12 +80,32 @@ int shade_tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_
  * h->t is taken as the distance travelled inside the object when the ray
  * leaves it. */
 rgb shade_tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir);
-/* A shadow ray's walk over its crossings (accel_crossings with step tmin):
- * *t0 is just past the previous crossing (tmin before the first) and is
- * moved past the crossing at t; returns the distance from the previous
- * crossing (from the ray's start for the first), the h->t that
- * shade_tex_shadow_filter takes. */
-double shade_tex_crossing_depth(double *t0, double tmin, double t);
+/* shade_tex_shadow_filter with the interior's fade over h->t taken when
+ * `inside` (and not otherwise), whichever way the ray crosses. */
+rgb shade_tex_shadow_filter_inside(const scene *sc, const accel_hit *h, vec3 dir, int inside);
+/* POV-Ray 3.7's walk of a shadow ray over the surfaces it crosses
+ * (trace.cpp, TracePointLightShadowRay): the ray's origin moves to each
+ * crossing it takes, and the next one it takes is the nearest more than
+ * SMALL_TOLERANCE beyond it (FindIntersection's postcondition,
+ * SmallToleranceRayObjectCondition; the first also more than
+ * SHADOW_TOLERANCE from the lit point; both 0.001, absolute lengths:
+ * configbackend.h, trace.cpp). A crossing nearer than that is not seen: no
+ * filter, and the ray's interior list is not updated (ComputeShadowMedia
+ * does that for the crossings taken), so the list's fade rule
+ * (ComputeShadowTexture: fade when the list holds the object's interior)
+ * counts that object from the wrong side until its next crossing taken: a
+ * drink 0.3 mm inside its glass casts no filtered shadow. */
+typedef struct {
+    double last;                /* t of the last crossing taken (0: the lit point) */
+    shade_media_inside unseen;  /* interiors crossed an odd number of times unseen */
+} shade_tex_walk;
+#define SHADE_TEX_POV_SMALL_TOLERANCE 1.0e-3
+/* 1 when the walk takes the crossing at h (not a no_shadow object's): then
+ * *depth is its distance from the last one taken (from the lit point for
+ * the first) and *inside whether POV-Ray's interior list holds h's object
+ * there (it leaves the object, or an odd number of its crossings went
+ * unseen, not both); 0 when it is not seen. */
+int shade_tex_walk_take(shade_tex_walk *w, const accel_hit *h, vec3 dir, double *depth, int *inside);
 /* The interior's fade over h->t for a ray along dir that leaves h's object
  * there (dir along the geometric normal); 1 for a ray entering it. The
  * fade shade_tex_shadow_filter applies, alone: a photon reflected inside

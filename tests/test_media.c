@@ -25,7 +25,18 @@
  *    area light also by the fog from the floor over the way left after the
  *    pane (POV-Ray 3.7's TraceShadowRay adds that part once for the
  *    averaged samples, from the shaded point, so fog near the ground counts
- *    twice: benchmark.pov's clouds and ground fog).
+ *    twice: benchmark.pov's clouds and ground fog);
+ *  - POV-Ray 3.7's shadow walk (trace.cpp): a glass sphere (fade to 0.5
+ *    over 1) holding a drink sphere (fade to 0 over 1) above a floor, the
+ *    light straight above: with a 0.1 gap between them the floor under
+ *    them gets exp(-1.8) exp(-0.5 x 0.1) (the drink's fade over its
+ *    chord, the glass's over the gap before it leaves); with a 0.0005 gap
+ *    (under SMALL_TOLERANCE, 0.001) the drink's entry and the glass's exit
+ *    are not seen and the drink's exit is taken for an entry: no fade at
+ *    all, 1 (balcony.pov's drinking glass); povray's own 16 x 16 render
+ *    of the scene (assumed_gamma 1) gives 111 of 255 (0.160) and 255 at
+ *    the centre. Without and with media in the scene (the two shadow
+ *    walks).
  * Cross-checks against POV-Ray 3.7 (as test_look: 160x120, +A0.3, sRGB,
  * 4x4 downsample, mean |difference| <= 0.02 and a regression bound): an
  * emitting sphere with a density pattern, an absorbing box (method 2, a
@@ -162,6 +173,31 @@ static void test_shadow_through_media(void **st)
     expect_rel(lit.g, 1.0, TOL, "unshadowed floor");
     expect_rel(shaded.g, exp(-0.4 * 2.0), TOL, "floor under the absorbing box");
     done(&w);
+}
+
+static void test_shadow_walk_tolerance(void **st)
+{
+    (void)st;
+    for (int media = 0; media < 2; media++)
+        for (int small = 0; small < 2; small++) {
+            char src[1024];
+            snprintf(src, sizeof src,
+                     "light_source { <0, 100, 0> color rgb 1 parallel point_at <0, 0, 0> }\n"
+                     "plane { y, -1 pigment { rgb 1 } finish { ambient 0 diffuse 1 } }\n"
+                     "sphere { <0, 1, 0>, 1 pigment { rgbt 1 } finish { ambient 0 diffuse 0 }\n"
+                     "  interior { fade_distance 1 fade_power 1001 fade_color rgb 0.5 } }\n"
+                     "sphere { <0, 1, 0>, %s pigment { rgbt 1 } finish { ambient 0 diffuse 0 }\n"
+                     "  interior { fade_distance 1 fade_power 1001 fade_color rgb 0 } }\n%s",
+                     small ? "0.9995" : "0.9",
+                     media ? "box { <10, -1, 10>, <11, 0, 11> pigment { rgbt 1 } hollow interior { media { absorption 0.1 } } }\n"
+                           : "");
+            world w = build(src);
+            rgb shaded = trace(&w, v3(0, -0.5, -5), v3_norm(v3(0, -0.5, 5))); /* the floor under the spheres */
+            char what[64];
+            snprintf(what, sizeof what, "%s gap, %s", small ? "0.0005" : "0.1", media ? "media walk" : "plain walk");
+            expect_rel(shaded.g, small ? 1.0 : exp(-1.8) * exp(-0.05), TOL, what);
+            done(&w);
+        }
 }
 
 static void test_shadowless_lights_no_media(void **st)
@@ -336,6 +372,7 @@ int main(void)
         cmocka_unit_test(test_emission_absorption),
         cmocka_unit_test(test_atmosphere_hollow),
         cmocka_unit_test(test_shadow_through_media),
+        cmocka_unit_test(test_shadow_walk_tolerance),
         cmocka_unit_test(test_shadowless_lights_no_media),
         cmocka_unit_test(test_area_light_ground_fog),
         cmocka_unit_test(test_media_area_jitter_threads),
