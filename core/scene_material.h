@@ -127,6 +127,15 @@ typedef struct scene_texture {
      * evaluated at the hit's <u, v, 0> (POV-Ray's UV_MAP_PATTERN), with its
      * own transforms only */
     int uv_mapping;
+    /* uv_mapping: the transforms applied to the texture from outside (its
+     * object's), which POV-Ray 3.7 composes into the UV_MAP_PATTERN's own
+     * warps (texture.cpp Transform_Textures): they move no point, but its
+     * layers' normals are warped by them around their perturbation
+     * (trace.cpp ComputeOneTextureColour pushes the texture on the warps
+     * list; ComputeLightedTexture's Warp_Normal / UnWarp_Normal), so a
+     * rotated uv-mapped object's bumps turn with it. uv_warped: any. */
+    xform uv_warp;
+    int uv_warped;
 } scene_texture;
 
 #endif

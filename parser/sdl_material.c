@@ -112,8 +112,14 @@ static void sdl_transform_texture(scene_texture *t, const xform *x)
 
 void sdl_transform_texture_outer(scene_texture *t, const xform *x)
 {
-    for (; t; t = t->next)
-        if (!t->uv_mapping && !(t->pat && t->pat->uv_mapping)) t->transform = xform_then(t->transform, *x);
+    for (; t; t = t->next) {
+        if (!t->uv_mapping && !(t->pat && t->pat->uv_mapping)) {
+            t->transform = xform_then(t->transform, *x);
+        } else {
+            t->uv_warp = t->uv_warped ? xform_then(t->uv_warp, *x) : *x;
+            t->uv_warped = 1;
+        }
+    }
 }
 
 /* ------------------------------------------------------------ pigments */

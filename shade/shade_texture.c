@@ -131,9 +131,12 @@ static vec3 layer_normal(const hit_info *hi, const scene_texture *layer, vec3 po
     vec3 n = hi->raw;
     if (!layer->normal || !layer->normal->pat || layer->normal->pat->kind == PAT_PLAIN) return n;
     for (int i = 0; i < npf; i++) n = shade_normal_warp(n, pf[i].xf, NULL, pf[i].pat, 0);
+    const xform *uvw = layer->uv_warped && !(layer->pat && layer->map) ? &layer->uv_warp : NULL;
+    if (uvw) n = shade_normal_warp(n, uvw, NULL, NULL, 0);
     vec3 tp = to_texture_space_at(layer, point, &hi->pc);
     n = shade_normal_perturb(layer->normal, n, tp, xform_is_identity(&layer->transform) ? NULL : &layer->transform, &hi->pc);
     if (layer->normal->no_bump_scale) n = v3_norm(n);
+    if (uvw) n = shade_normal_unwarp(n, uvw, NULL, NULL, 0);
     for (int i = npf - 1; i >= 0; i--) n = shade_normal_unwarp(n, pf[i].xf, NULL, pf[i].pat, 0);
     return v3_norm(n);
 }
@@ -362,6 +365,11 @@ static rgb one_texture(const hit_info *hi, const scene_texture *tex, vec3 point,
     const scene_pattern *pat = tex->pat;
     const scene_blend_map *m = tex->map;
     vec3 tp = shade_pattern_warp(pat, to_texture_space_at(tex, point, &hi->pc));
+    if (tex->uv_warped && npf + 1 < MAX_PARENTS) { /* the uv-mapped texture's outer warps, before its own */
+        pf[npf].xf = &tex->uv_warp;
+        pf[npf].pat = NULL;
+        npf++;
+    }
     pf[npf].xf = xform_is_identity(&tex->transform) ? NULL : &tex->transform;
     pf[npf].pat = pat;
     if (pat->kind == PAT_AVERAGE) {

@@ -66,6 +66,9 @@ static void test_uv_mapping(void **st) { (void)st; check("xl_uv", NULL, "uv_mapp
  * evaluated in 3D instead land above the bound; image_map gives no image) */
 static void test_uv_shapes(void **st) { (void)st; check("xl_uv_shapes", NULL, "uv_shapes", 0.003); }
 static void test_uv_mesh(void **st) { (void)st; check("xl_uv_mesh", NULL, "uv_mesh", 0.003); }
+/* a uv-mapped texture's normal on rotated meshes: its bumps turn with the
+ * object (without the uv texture's outer warps on the normal: 0.0101) */
+static void test_uv_normal(void **st) { (void)st; check("xl_uv_normal", NULL, "uv_normal", 0.001); }
 /* uv_mapping inherited by CSG members (keeping the member's own texture
  * from the union's transforms, or not uv-mapping that member, lands above
  * the bound) */
@@ -222,6 +225,7 @@ int main(void)
         cmocka_unit_test(test_irid),
         cmocka_unit_test(test_light_group),
         cmocka_unit_test(test_uv_mapping),
+        cmocka_unit_test(test_uv_normal),
         cmocka_unit_test(test_uv_shapes),
         cmocka_unit_test(test_uv_mesh),
         cmocka_unit_test(test_uv_levels),
