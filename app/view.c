@@ -1,7 +1,5 @@
 /* view.c - `partray view`: window, input, the event loop. */
 #include "view.h"
-#define SDL_MAIN_HANDLED
-#include <SDL.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -23,6 +21,7 @@
 #include "view_overlay.h"
 #include "view_render.h"
 #include "view_script.h"
+#include "view_sdl.h"
 
 enum { EXIT_OK = CLI_EXIT_OK, EXIT_SCENE = CLI_EXIT_SCENE, EXIT_USAGE = CLI_EXIT_USAGE, EXIT_IO = CLI_EXIT_IO };
 
@@ -703,6 +702,11 @@ static void present(viewer *v)
 
 static int open_window(viewer *v)
 {
+    char why[300];
+    if (!view_sdl_load(why, sizeof why)) {
+        fprintf(stderr, "partray view: cannot open a window: %s\n", why);
+        return 0;
+    }
     SDL_SetMainReady();
     if (SDL_Init(SDL_INIT_VIDEO) != 0) {
         fprintf(stderr, "partray view: cannot open a window: %s\n", SDL_GetError());
@@ -742,6 +746,7 @@ static int open_window(viewer *v)
 
 static void close_window(viewer *v)
 {
+    if (!view_sdl_load(NULL, 0)) return; /* no window was opened */
     if (v->tex) SDL_DestroyTexture(v->tex);
     if (v->otex) SDL_DestroyTexture(v->otex);
     free(v->orgba);
