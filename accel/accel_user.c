@@ -2,6 +2,9 @@
  * Embree callbacks of the user geometry over geom/ (bounds, intersect,
  * occluded, the no_shadow filters); see accel.c for the layout of the
  * Embree scene and the epsilon rule. */
+#include <stdint.h>
+#include <string.h>
+#include <math.h>
 #include "accel_internal.h"
 #include "scene_leaves.h"
 #include "grow.h"
@@ -399,6 +402,39 @@ static int cross_leaf_once(const accel *a, unsigned prim, vec3 o, vec3 d, double
     return 1;
 }
 
+/* Two crossings of different primitives closer than this at distance t
+ * are a tie. POV-Ray 3.7 computes each shape's distance in its own frame
+ * (a cylinder's cap through its axis transform, a box's face directly), so
+ * where two surfaces coincide, such as a glass box's bottom on a floor, the
+ * rounding picks the nearer one ray by ray and either wins about half the
+ * time (its image of the contact speckles). A fixed order would show one of
+ * them everywhere. The window is far below any modelled gap (a liquid 1e-8
+ * inside its glass, 1e-9 of the distance) and above the rounding of a
+ * double-precision distance (1e-15 of it, a few times over). */
+#define TIE_REL 1e-12
+static inline double tie_window(double t) { return fabs(t) * TIE_REL; }
+
+/* Whether primitive `cand` takes a tie from `cur` for the query's ray: a
+ * hash of the ray's origin, direction and the two primitives, symmetric in
+ * the order the traversal meets them, so the choice does not depend on it
+ * and is the same for the same ray. */
+static int tie_first(const accel_query *q, unsigned cand, unsigned cur)
+{
+    double v[6] = {q->org.x, q->org.y, q->org.z, q->dir.x, q->dir.y, q->dir.z};
+    uint64_t h = 0x9e3779b97f4a7c15ULL;
+    for (int k = 0; k < 6; k++) {
+        uint64_t b;
+        memcpy(&b, &v[k], sizeof b);
+        h = (h ^ b) * 0xbf58476d1ce4e5b9ULL;
+        h ^= h >> 31;
+    }
+    uint64_t ka = (h ^ ((uint64_t)cand * 0x94d049bb133111ebULL)) * 0x9e3779b97f4a7c15ULL;
+    uint64_t kb = (h ^ ((uint64_t)cur * 0x94d049bb133111ebULL)) * 0x9e3779b97f4a7c15ULL;
+    ka ^= ka >> 29;
+    kb ^= kb >> 29;
+    return ka < kb;
+}
+
 void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
 {
     const accel *a = args->geometryUserPtr;
@@ -437,9 +473,17 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
          * 1e-8 inside its glass) would let that farther surface win, and
          * which one did would depend on the traversal order */
         double tmax = (double)tfar;
-        if (exact && q->uhit && q->ut < tmax) tmax = q->ut;
+        double tie = exact && q->uhit ? tie_window(q->ut) : 0.0;
+        if (exact && q->uhit && q->ut + tie < tmax) tmax = q->ut + tie;
         geom_csg_hit h;
         if (!accel_prim_hit(a, args->primID, o, d, tmin, tmax, &h, rule)) continue;
+        /* two surfaces of different primitives at one distance within the
+         * rounding of their intersections (a box standing on a plane, seen
+         * through its bottom): the tie goes to one of them by the ray's
+         * hash, either about as often (tie_first) */
+        if (exact && q->uhit && h.t >= q->ut - tie &&
+            (q->uprim == args->primID || !tie_first(q, args->primID, q->uprim)))
+            continue;
         /* rounded up: a nearer candidate within the ulp is still tried */
         SOA_F(ray, N, i, 8) = exact ? nextafterf((float)h.t, INFINITY) : (float)h.t;
         vec3 ng = v3(0, 0, 0);

@@ -603,6 +603,61 @@ static scene_object *cone(scene *s, shape_kind k, vec3 b, double rb, vec3 c, dou
     return o;
 }
 
+/* Coincident surfaces of two objects (a box's bottom face on a plane, a
+ * floor cylinder's cap): rays from inside the box meet both at one
+ * distance, and the tie goes to each about half the time, as POV-Ray's
+ * rounding splits it; a gap of 1e-8 (a liquid inside its glass) is no tie.
+ * Tolerance: 2000 rays, each object's share within 0.5 +- 0.1 (about 9
+ * standard deviations of a fair split). */
+static double floor_share(double gap, int cylinder_floor)
+{
+    scene *s = scene_new();
+    diag *d = diag_new();
+    box(s, v3(-3, 0, -0.6), v3(3, 2.4, 0.6));
+    scene_object *fl;
+    if (cylinder_floor) {
+        fl = cone(s, SHAPE_CYLINDER, v3(0, gap, 0), 30, v3(0, 9, 0), 30);
+    } else {
+        fl = add_obj(s, SHAPE_PLANE);
+        fl->u.plane.normal = v3(0, 1, 0);
+        fl->u.plane.offset = gap;
+    }
+    accel *a = build(s, d);
+    rng r;
+    rng_seed(&r, 19, 5);
+    int on_floor = 0, n = 2000;
+    for (int k = 0; k < n; k++) {
+        vec3 org = v3(-2.5 + 5 * rng_f64(&r), 0.2 + 2 * rng_f64(&r), -0.5 + rng_f64(&r));
+        vec3 dir = v3_norm(v3(rng_f64(&r) - 0.5, -0.2 - rng_f64(&r), rng_f64(&r) - 0.5));
+        /* where the ray meets y = 0 inside the box's bottom face */
+        double t = -org.y / dir.y;
+        vec3 p = v3_madd(org, dir, t);
+        if (fabs(p.x) > 2.9 || fabs(p.z) > 0.5) {
+            k--;
+            continue;
+        }
+        accel_hit h;
+        assert_true(accel_intersect(a, org, dir, 0.0, INFINITY, &h));
+        assert_near(h.t, t, 1e-7 * t);
+        on_floor += h.obj == fl;
+    }
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+    return (double)on_floor / n;
+}
+
+static void test_coplanar_tie(void **st)
+{
+    (void)st;
+    assert_near(floor_share(0.0, 0), 0.5, 0.1);
+    assert_near(floor_share(0.0, 1), 0.5, 0.1);
+    /* the floor 1e-8 above the box's bottom: always the floor; below it: never */
+    assert_near(floor_share(1e-8, 0), 1.0, 0.0);
+    assert_near(floor_share(-1e-8, 0), 0.0, 0.0);
+    assert_near(floor_share(1e-8, 1), 1.0, 0.0);
+}
+
 static void test_cylinder_cone(void **st)
 {
     (void)st;
@@ -1523,6 +1578,7 @@ int main(void)
         cmocka_unit_test(test_mesh_textures_normals),
         cmocka_unit_test(test_uv),
         cmocka_unit_test(test_cylinder_cone),
+        cmocka_unit_test(test_coplanar_tie),
         cmocka_unit_test(test_disc),
         cmocka_unit_test(test_torus),
         cmocka_unit_test(test_poly_roots),
