@@ -231,6 +231,77 @@ static int jf_inside(const jf_data *f, vec3 p, vec3 e, double *de)
     return 1;
 }
 
+typedef double jf_v2 __attribute__((vector_size(16)));
+typedef long long jf_m2 __attribute__((vector_size(16))); /* a lane comparison: -1 or 0 */
+
+/* jf_inside without the step estimate at three points at once, for the
+ * fractals whose iteration is written out there (quaternion sqr and cube,
+ * hypercomplex sqr): p[0] on its own and p[1], p[2] in a two-lane vector,
+ * each doing jf_inside's operations in its order, so each answer is
+ * jf_inside's. A point that escapes answers 0 and runs on unread until all
+ * three have escaped or max_iteration is reached. Returns 0 (nothing
+ * written) for the other fractals. */
+static int jf_inside3(const jf_data *f, const vec3 p[3], int res[3])
+{
+    const int quat = !f->hyper && (f->func == JULIA_SQR || f->func == JULIA_CUBE), cube = f->func == JULIA_CUBE;
+    if (!quat && !(f->hyper && f->func == JULIA_SQR)) return 0;
+    double q[3][4];
+    for (int k = 0; k < 3; k++) lift(f, p[k], q[k]);
+    const jf_v2 ex = {f->exit, f->exit};
+    const double exit = f->exit;
+    jf_m2 e1 = {0, 0};
+    int e0 = 0;
+    if (quat) {
+        double x0 = q[0][0], y0 = q[0][1], z0 = q[0][2], w0 = q[0][3];
+        jf_v2 x1 = {q[1][0], q[2][0]}, y1 = {q[1][1], q[2][1]}, z1 = {q[1][2], q[2][2]}, w1 = {q[1][3], q[2][3]};
+        const jf_v2 c0 = {f->c[0], f->c[0]}, c1 = {f->c[1], f->c[1]}, c2 = {f->c[2], f->c[2]}, c3 = {f->c[3], f->c[3]};
+        for (int i = 1; i <= f->n; i++) {
+            double d0 = y0 * y0 + z0 * z0 + w0 * w0, x20 = x0 * x0, r20 = d0 + x20;
+            jf_v2 d1 = y1 * y1 + z1 * z1 + w1 * w1, x21 = x1 * x1, r21 = d1 + x21;
+            e0 |= r20 > exit;
+            e1 |= r21 > ex;
+            if (e0 && e1[0] && e1[1]) break;
+            double s0 = cube ? 3.0 * x20 - d0 : 2.0 * x0;
+            jf_v2 s1 = cube ? 3.0 * x21 - d1 : 2.0 * x1;
+            x0 = (cube ? x0 * (x20 - 3.0 * d0) : x20 - d0) + c0[0];
+            x1 = (cube ? x1 * (x21 - 3.0 * d1) : x21 - d1) + c0;
+            y0 = s0 * y0 + c1[0];
+            y1 = s1 * y1 + c1;
+            z0 = s0 * z0 + c2[0];
+            z1 = s1 * z1 + c2;
+            w0 = s0 * w0 + c3[0];
+            w1 = s1 * w1 + c3;
+        }
+    } else {
+        /* to_pair: a = (x - w) + i (y + z), b = (x + w) + i (y - z) */
+        double ar0 = q[0][0] - q[0][3], ai0 = q[0][1] + q[0][2], br0 = q[0][0] + q[0][3], bi0 = q[0][1] - q[0][2];
+        jf_v2 ar1 = {q[1][0] - q[1][3], q[2][0] - q[2][3]}, ai1 = {q[1][1] + q[1][2], q[2][1] + q[2][2]};
+        jf_v2 br1 = {q[1][0] + q[1][3], q[2][0] + q[2][3]}, bi1 = {q[1][1] - q[1][2], q[2][1] - q[2][2]};
+        const double car = creal(f->ca), cai = cimag(f->ca), cbr = creal(f->cb), cbi = cimag(f->cb);
+        for (int i = 1; i <= f->n; i++) {
+            double ar20 = ar0 * ar0, ai20 = ai0 * ai0, br20 = br0 * br0, bi20 = bi0 * bi0;
+            jf_v2 ar21 = ar1 * ar1, ai21 = ai1 * ai1, br21 = br1 * br1, bi21 = bi1 * bi1;
+            double r20 = 0.5 * (ar20 + ai20 + br20 + bi20);
+            jf_v2 r21 = 0.5 * (ar21 + ai21 + br21 + bi21);
+            e0 |= !(r20 <= exit);
+            e1 |= ~(r21 <= ex);
+            if (e0 && e1[0] && e1[1]) break;
+            ai0 = 2.0 * ar0 * ai0 + cai;
+            ai1 = 2.0 * ar1 * ai1 + cai;
+            ar0 = ar20 - ai20 + car;
+            ar1 = ar21 - ai21 + car;
+            bi0 = 2.0 * br0 * bi0 + cbi;
+            bi1 = 2.0 * br1 * bi1 + cbi;
+            br0 = br20 - bi20 + cbr;
+            br1 = br21 - bi21 + cbr;
+        }
+    }
+    res[0] = !e0;
+    res[1] = !e1[0];
+    res[2] = !e1[1];
+    return 1;
+}
+
 int geom_fractal_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
 {
     const scene_julia *j = o->u.julia;
@@ -293,11 +364,26 @@ int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
             double lo = tau, hi = tn;
             /* POV-Ray polishes the crossing by bisection to Fractal_Tolerance
              * (1e-7 in the fractal's space, fractal.cpp), far finer than the
-             * set's detail at any usable precision */
-            for (int it = 0; it < 200 && hi - lo > FRACTAL_TOLERANCE; it++) {
-                double m = 0.5 * (lo + hi);
-                if (jf_inside(f, v3_madd(p0, e, m), e, NULL) == cur) lo = m;
+             * set's detail at any usable precision. Two halvings at a time
+             * where jf_inside3 applies: the midpoint and both quarter points
+             * at once, the next midpoint being whichever quarter point the
+             * first answer leaves (the same value the halving computes from
+             * the new ends), so the points and answers are the one-at-a-time
+             * bisection's. */
+            for (int it = 0; it < 200 && hi - lo > FRACTAL_TOLERANCE;) {
+                double m = 0.5 * (lo + hi), ql = 0.5 * (lo + m), qh = 0.5 * (m + hi);
+                vec3 pts[3] = {v3_madd(p0, e, m), v3_madd(p0, e, ql), v3_madd(p0, e, qh)};
+                int r[3], lanes = jf_inside3(f, pts, r);
+                if (!lanes) r[0] = jf_inside(f, pts[0], e, NULL);
+                int in_m = r[0] == cur;
+                if (in_m) lo = m;
                 else hi = m;
+                if (++it >= 200 || !(hi - lo > FRACTAL_TOLERANCE)) break;
+                double m2 = 0.5 * (lo + hi); /* qh after lo = m, ql after hi = m */
+                int r2 = lanes && m2 == (in_m ? qh : ql) ? r[in_m ? 2 : 1] : jf_inside(f, v3_madd(p0, e, m2), e, NULL);
+                if (r2 == cur) lo = m2;
+                else hi = m2;
+                ++it;
             }
             double t = a + 0.5 * (lo + hi) / s;
             if (t > tmin && t < tmax) n = geom_shape_hit_put(out, n, max, t, 0);
