@@ -3,9 +3,10 @@
  * over the same photons (pmfg's reference/pm_kdtree.h, the k-nearest
  * search its caustic map uses: k = 32 within 0.02 x the scene size) at the
  * same G-buffer points, as the paper's Table 3 compares ISPM with Purcell's
- * gather; and the bounce map's Russian-roulette attrition per bounce (the
- * paper's Fig. 10): photons shot, reaching their target, and still
- * travelling after each bounce.
+ * gather; and the photons' attrition per bounce (the paper's Fig. 10, there
+ * by Russian roulette; here photons end where a surface has no specular
+ * lobe, by adc_bailout or by max_trace_level): photons shot, reaching their
+ * target, and still travelling after each bounce.
  *
  * The scene's photons{} as partray renders it (run from the scene's
  * directory). Median of --reps runs of each estimate. Prints figures; not a
@@ -110,8 +111,7 @@ int main(int argc, char **argv)
     printf("photons: %ld shot (bounce map cells, %d light-target pairs, spacing %.4g), %ld reached their target, "
            "%ld stored, %ld rays\n",
            s.emitted, s.combos, s.spacing, s.first_hits, s.stored, s.rays);
-    printf("Russian-roulette attrition (paper Fig. 10): of %ld photons at their target, %ld absorbed at the bounce "
-           "map (%.1f%%)\n",
+    printf("attrition (paper Fig. 10): of %ld photons at their target, %ld absorbed at the bounce map (%.1f%%)\n",
            s.first_hits, s.absorbed_first, s.first_hits ? 100.0 * s.absorbed_first / s.first_hits : 0.0);
     for (int b = 1; b <= s.max_bounce; b++)
         printf("  going on after bounce %2d: %9ld  (%.1f%% of those at their target; a split counts once)\n", b, s.alive[b],

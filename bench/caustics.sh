@@ -11,7 +11,7 @@
 # 4x4 box downsample, both wall times and their ratio, and whether the
 # render meets the bounds (luminance within 5%, FLIP no worse than POV-Ray's
 # default, time no longer); then, per scene, bench_caustics' splat-versus-
-# kd-tree-gather times and Russian-roulette attrition. Prints figures; not
+# kd-tree-gather times and photon attrition per bounce. Prints figures; not
 # a test. With CAUSTICS_FLOOR=1, each row is followed by the floor without
 # caustics: the scene with its global photons block removed, rendered by
 # both, partray's FLIP against POV-Ray's (how much of the row's FLIP is not
@@ -163,7 +163,7 @@ print("  without photons (both renderers): FLIP partray vs POV-Ray %.4f" % json.
 done
 awk '/^RATIO/ { n++; s += log($2) } END { if (n) printf "geometric mean of partray/POV-Ray wall time over %d scenes: %.3f\n", n, exp(s / n) }' "$TMP/ratios"
 echo
-echo "splat (photon volumes) vs pmfg's kd-tree gather over the same photons; Russian-roulette attrition:"
+echo "splat (photon volumes) vs pmfg's kd-tree gather over the same photons; attrition per bounce:"
 for f in "$TMP"/*.bench; do
     [ -f "$f" ] || continue
     echo "--- $(head -1 "$f")"

@@ -566,7 +566,7 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
         }
         if (level + 1 >= c->max_level || level >= GI_CAUSTIC_MAX_BOUNCES) continue;
         if (!(sf & GI_CAUSTIC_CONTINUES)) {
-            /* absorbed by the roulette, or only a Lambertian or glossy lobe */
+            /* no specular lobe: absorbed, or only a Lambertian or glossy lobe */
             if (level == 0) out->absorbed_first++;
             continue;
         }

@@ -24,20 +24,21 @@
  *     the cone of directions that holds the target's bounding sphere
  *     (POV-Ray's box, geom_extent), equal solid angle per cell (so no
  *     inverse-cosine correction is needed), jittered by the scene's
- *     `jitter`; Embree finds the first hit; Russian roulette keeps the
- *     photon with the specular lobes' share of the surface's albedo or
- *     absorbs it (appendix A, through the hooks: the one BSDF of
- *     shade_material.h; counted), and a kept photon splits into its
- *     reflection and refraction where the surface has both (POV-Ray's
- *     photon tracer traces both);
+ *     `jitter`; Embree finds the first hit; the photon goes on along each
+ *     specular lobe of the surface (its reflection and its refraction
+ *     where it has both, as POV-Ray's photon tracer traces both), weighted
+ *     by the lobe (through the hooks: the one BSDF of shade_material.h),
+ *     and ends where the surface has none (counted); what the surface
+ *     absorbs is lost as weight, as in POV-Ray, not by the paper's Russian
+ *     roulette (appendix A), whose survivors were noisier;
  *  2. world-space tracing of the further bounces, storing a photon before
  *     each bounce on a receiving surface (bounce-map photons are not
- *     stored), roulette and splitting at each, up to the photons'
- *     max_trace_level and adc_bailout;
- *  3. path density rho_p, the product over bounces of the roulette's
- *     survival probability (the paper's factor rho_S, which a roulette
- *     over the lobes would give each lobe), sets the photon volume's
- *     radius: r_xy = k s_D / sqrt(rho_p), with s_D the spacing of the
+ *     stored), splitting at each, up to the photons' max_trace_level and
+ *     adc_bailout;
+ *  3. path density rho_p, the product over bounces of the hook's density
+ *     factor (the paper's factor rho_S, which a roulette over the lobes
+ *     would give each lobe; 1 where every lobe is followed, as now), sets
+ *     the photon volume's radius: r_xy = k s_D / sqrt(rho_p), with s_D the spacing of the
  *     photon's direction cell at its path length (the distance to its
  *     neighbours had nothing focused it) and k = 9 (gi_caustic.c says
  *     why); r_z = r_xy / 4;
@@ -93,8 +94,8 @@ typedef struct {
 /* A specular bounce that the photon continues along. */
 typedef struct {
     vec3 org, dir;   /* continuation ray, origin off the right side */
-    rgb weight;      /* flux multiplier: the lobe's colour (and fade, filter) / the probability of going on */
-    double rho;      /* the photons' density factor of this bounce (the roulette's survival probability), for
+    rgb weight;      /* flux multiplier: the lobe's colour (and fade, filter) */
+    double rho;      /* the photons' density factor of this bounce (1: no photon of the bounce is dropped), for
                         the path density */
     int refract;     /* 1 refraction, 0 reflection */
     accel_from from; /* the surface left */
@@ -119,13 +120,12 @@ typedef struct {
      * inside the objects `in` (NULL: the atmosphere):
      * GI_CAUSTIC_RECEIVES when it has a Lambertian term (photons light it),
      * GI_CAUSTIC_HIGHLIGHTS when it has only a highlight;
-     * with step non-NULL (room for 2), Russian roulette (seed 002 appendix
-     * A) between going on, with probability the specular lobes' share of
-     * the surface's albedo, and ending the photon (absorbed, or taken by a
-     * Lambertian or glossy lobe); going on, the photon splits into its
-     * mirror reflection and its refraction where the surface has both, as
-     * POV-Ray's photon tracer traces both (photons.cpp): a split has no
-     * roulette noise between the lobes. */
+     * with step non-NULL (room for 2), the bounces the photon goes on
+     * along: its mirror reflection and its refraction where the surface
+     * has both, as POV-Ray's photon tracer traces both (photons.cpp), each
+     * weighted by its lobe (what is absorbed, or taken by a Lambertian or
+     * glossy lobe, is lost as weight: no roulette noise); none (no
+     * GI_CAUSTIC_CONTINUES) where the surface has no specular lobe. */
     int (*surface)(void *ctx, const accel_hit *h, vec3 dir, const gi_caustic_inside *in, rng *r,
                    gi_caustic_step *step);
     /* Light l's angle and distance attenuation at point p (first hit of a
@@ -169,7 +169,7 @@ typedef struct {
     int combos;             /* light-target pairs that shoot */
     long emitted;           /* bounce-map cells (photons shot) */
     long first_hits;        /* photons whose first hit was their target */
-    long absorbed_first;    /* of those, absorbed at the bounce map's roulette (power 0) */
+    long absorbed_first;    /* of those, ended at the bounce map (their target has no specular lobe there) */
     long alive[GI_CAUSTIC_MAX_BOUNCES + 1]; /* branches going on after bounce b (b = 1: the bounce map; a
                                                split counts once, so later bounces can exceed the first) */
     int max_bounce;         /* highest b with alive[b] > 0 */
