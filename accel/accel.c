@@ -976,6 +976,7 @@ static void query_init(accel_query *q, vec3 org, vec3 dir, double t0, accel_ray_
     q->cross = NULL;
     q->rule = (geom_ray_rule)rule;
     q->packet = 0;
+    q->oprim = 0;
     rtcInitIntersectContext(&q->rtc);
 }
 
@@ -1414,6 +1415,11 @@ long accel_rtc_triangles(const accel *a, unsigned geom, const float **v, const u
 
 int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax)
 {
+    return accel_occluded_cached(a, NULL, org, dir, tmin, tmax);
+}
+
+int accel_occluded_cached(const accel *a, unsigned *last, vec3 org, vec3 dir, double tmin, double tmax)
+{
     if (!a || !ray_ok(org, dir)) return 0;
     double t0 = eps_rule(a->ray_eps_scale, org, v3_len(dir));
     if (tmin > t0) t0 = tmin;
@@ -1422,11 +1428,14 @@ int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax)
     query_init(&q, org, dir, t0, ACCEL_RAY_POV);
     struct RTCRay r;
     fill_rtc_ray(&r, org, dir, t0, tmax);
+    if (last && *last && accel_user_blocks(a, &q, &r, *last - 1u)) return 1;
     accel_query *saved = accel_tls_query;
     accel_tls_query = &q;
     rtcOccluded1(a->root, &q.rtc, &r);
     accel_tls_query = saved;
-    return r.tfar == -INFINITY;
+    int blocked = r.tfar == -INFINITY;
+    if (last) *last = blocked ? q.oprim : 0u;
+    return blocked;
 }
 
 /* Rays k0 .. k0 + 15 of a batch (the first m of them real) as a packet of

@@ -123,6 +123,21 @@ int accel_mutually_visible(const accel *a, double eps, vec3 x, vec3 nx, vec3 y, 
                            const void *ctx);
 /* Any hit in (tmin, tmax) by an object that casts shadows (not no_shadow). */
 int accel_occluded(const accel *a, vec3 org, vec3 dir, double tmin, double tmax);
+/* accel_occluded with a shadow cache (as POV-Ray 3.7's trace.cpp, which
+ * keeps per light and thread the object that last blocked it,
+ * lightSourceLevel1ShadowCache, and tests it first): *last (0: none)
+ * names the primitive that last blocked a ray of this caller's; it is
+ * asked first, and a ray it blocks is answered without the scene's
+ * traversal. The answer is
+ * accel_occluded's: the primitive is asked as the traversal asks it (the
+ * same double ray, interval, box test and rule), and a blocked ray is
+ * blocked whichever primitive blocks it. After a ray the traversal
+ * answers, *last is the shape or CSG that blocked it, or 0 where nothing
+ * did or a triangle did (a ray after an unblocked one is seldom blocked,
+ * and the cached test would be paid for nothing). One cache per thread
+ * and light: consecutive shadow rays to one light mostly meet one
+ * blocker. */
+int accel_occluded_cached(const accel *a, unsigned *last, vec3 org, vec3 dir, double tmin, double tmax);
 
 /* The surface a ray leaves: the hit it starts from. */
 typedef struct {

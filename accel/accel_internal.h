@@ -132,6 +132,9 @@ typedef struct {
     unsigned cskip; /* primitives whose effective flags carry one of these are not asked */
     geom_ray_rule rule; /* how searched-for surfaces are met (accel_ray_rule) */
     int packet;         /* a packet query's context: no double ray (org, dir, tmin unset) */
+    /* an exact occlusion query: the top-level user primitive found to
+     * block it, plus 1 (0: none or not asked; accel_occluded_cached) */
+    unsigned oprim;
 } accel_query;
 
 /* The query of this thread (the callbacks tell our context from a plain
@@ -166,6 +169,10 @@ int accel_prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, d
 const geom_shape *accel_prim_shape(const accel *a, unsigned prim, int member);
 void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args);
 void accel_user_occluded(const struct RTCOccludedFunctionNArguments *args);
+/* Whether user primitive prim blocks the exact occlusion query q, whose
+ * Embree ray is r, as accel_user_occluded answers when the traversal asks
+ * it (accel_occluded_cached). */
+int accel_user_blocks(const accel *a, const accel_query *q, const struct RTCRay *r, unsigned prim);
 /* Occlusion filters of no_shadow geometry. */
 void accel_filter_reject_all(const struct RTCFilterFunctionNArguments *args);
 void accel_filter_instance_no_shadow(const struct RTCFilterFunctionNArguments *args);

@@ -533,8 +533,18 @@ void accel_user_occluded(const struct RTCOccludedFunctionNArguments *args)
         vec3 o, d;
         double tmin;
         user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
-        if (prim_occludes(a, args->primID, o, d, tmin, (double)SOA_F(ray, N, i, 8), rule)) SOA_F(ray, N, i, 8) = -INFINITY;
+        if (prim_occludes(a, args->primID, o, d, tmin, (double)SOA_F(ray, N, i, 8), rule)) {
+            SOA_F(ray, N, i, 8) = -INFINITY;
+            if (exact && args->context->instID[0] == RTC_INVALID_GEOMETRY_ID) q->oprim = args->primID + 1u;
+        }
     }
+}
+
+int accel_user_blocks(const accel *a, const accel_query *q, const struct RTCRay *r, unsigned prim)
+{
+    if (prim >= (unsigned)(a->nshapes + a->ncsgs) || (prim_flags(a, prim) & OBJ_NO_SHADOW)) return 0;
+    if (a->ubox && a->ubox_test[prim] && box_missed(a, prim, (void *)r, 1, 0)) return 0;
+    return prim_occludes(a, prim, q->org, q->dir, q->tmin, (double)r->tfar, q->rule);
 }
 
 /* Occlusion filter of the no_shadow triangle geometry: nothing there occludes. */

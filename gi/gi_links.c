@@ -137,9 +137,12 @@ typedef struct {
 /* The last few textures asked (a gather's rays alternate between a few
  * objects: the sky dome, a wall, the floor), replaced in turn. */
 #define EMIT_MEMO 4
+/* the lights whose shadow rays keep a shadow cache (accel_occluded_cached) */
+#define MEMO_LIGHTS 8
 typedef struct {
     emit_memo_entry e[EMIT_MEMO];
     int next;
+    unsigned blocker[MEMO_LIGHTS]; /* light l's last blocker (accel_occluded_cached's *last) */
 } emit_memo;
 
 static const emit_memo_entry *memo_of(const link_job *J, emit_memo *memo, const scene_texture *tex)
@@ -208,7 +211,8 @@ static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, 
                 float ds[3];
                 double dep = gi_light_ray(lt, lt->pos[0], lt->pos[1], lt->pos[2], (float)org.x, (float)org.y, (float)org.z, ds);
                 double tmax = dep > 0.0 ? gi_shadow_tmax(dep, eps) : INFINITY;
-                if (tmax > eps && accel_occluded(J->a, org, v3(ds[0], ds[1], ds[2]), 0.0, tmax)) continue;
+                unsigned *last = l < MEMO_LIGHTS ? &memo->blocker[l] : NULL;
+                if (tmax > eps && accel_occluded_cached(J->a, last, org, v3(ds[0], ds[1], ds[2]), 0.0, tmax)) continue;
             }
             for (int c = 0; c < 3; c++) dir[c] += lt->colour[c] * att * (float)ci;
         }

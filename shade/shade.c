@@ -38,6 +38,7 @@
 #include "camera.h"
 #include <assert.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include "pool.h"
@@ -66,6 +67,9 @@ typedef struct {
     vec3 lc_p;
     unsigned lc_valid;
     rgb lc_vis[LIGHT_CACHE];
+    /* per light, the primitive that last blocked one of this thread's
+     * shadow rays (accel_occluded_cached: POV-Ray's shadow cache) */
+    unsigned blocker[LIGHT_CACHE];
     /* while a media sample's light is traced: 1 its media take photons, 2
      * they do not; 0 a surface's light (the photon shadow rule asks the
      * lit surface's collect, photon_light) */
@@ -144,12 +148,14 @@ static double shadow_tmax(const render_ctx *c, double depth)
     return depth - fmax_inline(c->eps, depth * 1e-6);
 }
 
-static int shadow_blocked(render_ctx *c, int thread, vec3 p, vec3 dir, double depth)
+static int shadow_blocked(render_ctx *c, int thread, vec3 p, vec3 dir, double depth, const scene_light *l)
 {
     c->ts[thread].shadow++;
     double tmax = shadow_tmax(c, depth);
     if (tmax <= c->eps) return 0;
-    return accel_occluded(c->a, p, dir, c->eps, tmax);
+    ptrdiff_t li = l ? l - c->sc->lights : -1;
+    unsigned *last = li >= 0 && li < c->sc->nlights && li < LIGHT_CACHE ? &c->ts[thread].blocker[li] : NULL;
+    return accel_occluded_cached(c->a, last, p, dir, c->eps, tmax);
 }
 
 static rgb media_light(void *ctx, int thread, const scene_light *l, vec3 p, const shade_media_inside *in, int collect,
@@ -186,7 +192,7 @@ static rgb shadow_rgb(render_ctx *c, int thread, vec3 p, vec3 dir, double depth,
 {
     int media = media_shadows(c, l);
     if (!media && !c->transparent)
-        return shadow_blocked(c, thread, p, dir, depth) ? rgb_make(0, 0, 0) : rgb_make(1, 1, 1);
+        return shadow_blocked(c, thread, p, dir, depth, l) ? rgb_make(0, 0, 0) : rgb_make(1, 1, 1);
     c->ts[thread].shadow++;
     double tmax = shadow_tmax(c, depth);
     if (tmax <= c->eps) return rgb_make(1, 1, 1);

@@ -1427,6 +1427,60 @@ static void test_random_rays(void **st)
     scene_free(s);
 }
 
+/* The shadow cache (accel_occluded_cached) answers as accel_occluded does:
+ * over shadow rays from random points to a light, with the cache carried
+ * from ray to ray, with every primitive number (and numbers past the last)
+ * put in the cache by hand, with rays that end short of a blocker, and
+ * with a no_shadow primitive cached; and it
+ * learns a blocker (the cache is set once a ray was blocked). */
+static void test_occluded_cached(void **st)
+{
+    (void)st;
+    scene *s = scene_new();
+    diag *d = diag_new();
+    sphere(s, v3(0, 4, 0), 1);
+    box(s, v3(2, 3, -1), v3(4, 3.5, 1));
+    scene_object *ns = sphere(s, v3(-3, 4, 0), 1); /* casts no shadow */
+    ns->flags |= OBJ_NO_SHADOW;
+    /* a slab with a hole: rays through the hole pass */
+    scene_object *dif = csg(s, SHAPE_DIFFERENCE, 2, 1);
+    dif->u.csg.kids[0] = member(s, SHAPE_BOX);
+    dif->u.csg.kids[0]->u.box.c1 = v3(-2, 6, -2);
+    dif->u.csg.kids[0]->u.box.c2 = v3(2, 6.5, 2);
+    dif->u.csg.kids[1] = msphere(s, v3(0.5, 6.25, 0.5), 0.8);
+    triangle(s, v3(-6, 5, -2), v3(-4, 5, -2), v3(-5, 5, 2));
+    accel *a = build(s, d);
+    const unsigned nprim = 8; /* more than the scene's user primitives */
+    vec3 light = v3(0, 12, 0);
+    rng r;
+    rng_seed(&r, 7, 1);
+    unsigned last = 0;
+    int blocked = 0, learnt = 0;
+    for (int i = 0; i < 4000; i++) {
+        vec3 org = v3(16 * rng_f64(&r) - 8, 2 * rng_f64(&r), 8 * rng_f64(&r) - 4);
+        vec3 dir = v3_sub(light, org);
+        double tmax = 0.3 + 0.7 * rng_f64(&r); /* some rays end short of a blocker */
+        int want = accel_occluded(a, org, dir, 0.0, tmax);
+        assert_int_equal(accel_occluded_cached(a, &last, org, dir, 0.0, tmax), want);
+        blocked += want;
+        learnt += want && last != 0;
+        for (unsigned k = 0; k <= nprim + 1; k++) {
+            unsigned c = k;
+            assert_int_equal(accel_occluded_cached(a, &c, org, dir, 0.0, tmax), want);
+        }
+    }
+    assert_true(blocked > 400 && blocked < 3600); /* both answers were asked */
+    assert_true(learnt > blocked / 2);
+    /* straight through the no_shadow sphere only: not blocked, whatever is cached */
+    for (unsigned k = 0; k <= nprim + 1; k++) {
+        unsigned c = k;
+        assert_false(accel_occluded_cached(a, &c, v3(-3, 0, 0), v3(0, 12, 0), 0.0, 0.999));
+    }
+    accel_free(a);
+    diag_free(d);
+    scene_free(s);
+}
+
 /* Torus against brute force: signed distance to the tube sampled along the
  * ray; the reported hit must be on the surface and no sign change may come
  * before it. */
@@ -1571,6 +1625,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sphere),
+        cmocka_unit_test(test_occluded_cached),
         cmocka_unit_test(test_box_faces),
         cmocka_unit_test(test_plane),
         cmocka_unit_test(test_triangles),
