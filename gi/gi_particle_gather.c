@@ -360,6 +360,28 @@ static void put_point(gi_particle *gp, gi_dev_particle *cp, const void **cobj, u
     }
 }
 
+/* put_point for the points [k0, k1) on one row of pixels (each point
+ * writes its own slots: rows may run on any thread). */
+typedef struct {
+    gi_particle *gp;
+    gi_dev_particle *cp;
+    const void **cobj;
+    unsigned char *cpin;
+    int n, k0, k1, s;
+} put_job;
+
+static void put_row(void *ctx, int y, int thread)
+{
+    (void)thread;
+    put_job *P = ctx;
+    gi_particle *gp = P->gp;
+    size_t w = (size_t)gp->vw;
+    for (size_t i = (size_t)y * w; i < (size_t)(y + 1) * w; i++) {
+        int k = gp->vg_pix[i];
+        if (k >= P->k0 && k < P->k1) put_point(gp, P->cp, P->cobj, P->cpin, P->n + (k - P->k0), k, i, P->s);
+    }
+}
+
 /* Traces the links of gather points [k0, k1) (the pixels vg_pix names),
  * side x side rays each, into vg_link from row k0 on (rows of vg_k
  * links; a side below the rows' packs side^2 links a row from there, as
@@ -387,10 +409,8 @@ static pt_status trace_points(gi_particle *gp, const void **pobj, const unsigned
         cpin[t] = pin[t];
         cpin[N + t] = pin[n + t];
     }
-    for (size_t i = 0; i < npix; i++) {
-        int k = gp->vg_pix[i];
-        if (k >= k0 && k < k1) put_point(gp, cp, cobj, cpin, n + (k - k0), k, i, s);
-    }
+    put_job P = {gp, cp, cobj, cpin, n, k0, k1, s};
+    pool_run(gp->threads, gp->vh, put_row, &P);
     double spacing = gp->ps.spacing > 0.0 ? gp->ps.spacing : 1.0;
     gi_link_stats ls = {0};
     reach = malloc((size_t)(k1 - k0) * sizeof *reach);
@@ -457,6 +477,33 @@ static int needs_own(const gi_particle *gp, size_t i)
     return m > 1 && hi > (1.0 + REFINE) * lo;
 }
 
+/* vg_nrm of one row of pixels */
+static void normal_row(void *ctx, int y, int thread)
+{
+    (void)thread;
+    gi_particle *gp = ctx;
+    size_t w = (size_t)gp->vw;
+    for (size_t i = (size_t)y * w; i < (size_t)(y + 1) * w; i++)
+        gp->vg_nrm[i] = gp->vrec[i].kind == 2 ? view_normal(&gp->vrec[i]) : v3s(0.0);
+}
+
+/* own[i]: whether pixel i of the row, which takes its block's corners,
+ * gathers itself (needs_own) */
+typedef struct {
+    const gi_particle *gp;
+    unsigned char *own;
+} own_job;
+
+static void own_row(void *ctx, int y, int thread)
+{
+    (void)thread;
+    own_job *O = ctx;
+    const gi_particle *gp = O->gp;
+    size_t w = (size_t)gp->vw;
+    for (size_t i = (size_t)y * w; i < (size_t)(y + 1) * w; i++)
+        O->own[i] = (unsigned char)(gp->vg_pix[i] < 0 && gathers(gp, &gp->vrec[i]) && needs_own(gp, i));
+}
+
 pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
 {
     (void)d;
@@ -475,7 +522,7 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
         gi_particle_view_gather_free(gp);
         return PT_ERR_NOMEM;
     }
-    for (size_t i = 0; i < npix; i++) gp->vg_nrm[i] = gp->vrec[i].kind == 2 ? view_normal(&gp->vrec[i]) : v3s(0.0);
+    pool_run(gp->threads, h, normal_row, gp);
     int m = 0, mmax = 0;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
@@ -540,8 +587,19 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
         gp->vg_n = m;
         gather_values(gp);
         int m1 = m;
+        /* which pixels gather themselves (needs_own reads only the corner
+         * points, which this pass does not change), then their numbers in
+         * pixel order */
+        unsigned char *own = malloc(npix);
+        if (!own) {
+            st = PT_ERR_NOMEM;
+            goto done;
+        }
+        own_job O = {gp, own};
+        pool_run(gp->threads, h, own_row, &O);
         for (size_t i = 0; i < npix; i++)
-            if (gp->vg_pix[i] < 0 && gathers(gp, &gp->vrec[i]) && needs_own(gp, i)) gp->vg_pix[i] = m++;
+            if (own[i]) gp->vg_pix[i] = m++;
+        free(own);
         if (m > m1) {
             /* a refinement point takes REFINE_SIDE_FRAC of the side: such
              * points sit where the light changes across a block, where
@@ -682,6 +740,22 @@ static void filter_row(void *ctx, int y, int thread)
     }
 }
 
+/* The raw values (raw_value) of one row of pixels and whether each has one */
+typedef struct {
+    const gi_particle *gp;
+    float *raw;
+    unsigned char *ok;
+} raw_job;
+
+static void raw_row(void *ctx, int y, int thread)
+{
+    (void)thread;
+    raw_job *R = ctx;
+    size_t w = (size_t)R->gp->vw;
+    for (size_t i = (size_t)y * w; i < (size_t)(y + 1) * w; i++)
+        R->ok[i] = (unsigned char)raw_value(R->gp, i, &R->raw[3 * i]);
+}
+
 void gi_particle_view_regather(gi_particle *gp)
 {
     if (gp->vg_n <= 0 || !gp->lout) return;
@@ -695,7 +769,8 @@ void gi_particle_view_regather(gi_particle *gp)
         gi_particle_view_gather_free(gp);
         return;
     }
-    for (size_t i = 0; i < npix; i++) ok[i] = (unsigned char)raw_value(gp, i, &raw[3 * i]);
+    raw_job R = {gp, raw, ok};
+    pool_run(gp->threads, gp->vh, raw_row, &R);
     filter_job F = {gp, raw, ok};
     pool_run(gp->threads, gp->vh, filter_row, &F);
     /* the points answer hits that are not kept with the filtered value of
