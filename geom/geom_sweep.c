@@ -20,6 +20,7 @@
 #include <float.h>
 #include <limits.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 #include "geom_poly.h"
@@ -1000,9 +1001,28 @@ static void setup_areas(sw_data *w)
     w->total_area = isfinite(tot) ? tot * w->L * w->L : 0.0;
 }
 
+/* The areas on first use: most renders never sample a sweep's surface
+ * (the GI modes and area sampling do), and the integrals cost about two
+ * hundred density evaluations per segment, once per shape built. The
+ * first caller computes them under the lock; later ones see areas_done. */
+static pthread_mutex_t areas_lock = PTHREAD_MUTEX_INITIALIZER;
+
+static const sw_data *areas_ready(const geom_shape *sh)
+{
+    sw_data *w = sh->data;
+    if (!w || atomic_load_explicit(&w->areas_done, memory_order_acquire)) return w;
+    pthread_mutex_lock(&areas_lock);
+    if (!atomic_load_explicit(&w->areas_done, memory_order_relaxed)) {
+        setup_areas(w);
+        atomic_store_explicit(&w->areas_done, 1, memory_order_release);
+    }
+    pthread_mutex_unlock(&areas_lock);
+    return w;
+}
+
 double geom_sweep_area(const geom_shape *sh)
 {
-    const sw_data *w = sh->data;
+    const sw_data *w = areas_ready(sh);
     return w && w->nparts ? w->total_area : 0.0;
 }
 
@@ -1016,7 +1036,7 @@ static double next_rand(rng *r, int *k, double u)
 
 void geom_sweep_sample(const geom_shape *sh, double u1, double u2, rng *r, vec3 *p, vec3 *n, unsigned *part)
 {
-    const sw_data *w = sh->data;
+    const sw_data *w = areas_ready(sh);
     *p = v3s(0.0);
     *n = v3(0, 1, 0);
     *part = 0;
@@ -1104,7 +1124,6 @@ int geom_sweep_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
         *lo = v3_add(w->c, v3_scale(w->blo, w->L));
         *hi = v3_add(w->c, v3_scale(w->bhi, w->L));
     }
-    setup_areas(w);
     sh->data = w;
     return 0;
 }

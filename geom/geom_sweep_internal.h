@@ -4,6 +4,7 @@
  * grids). Not for use outside them. */
 #ifndef PT_GEOM_SWEEP_INTERNAL_H
 #define PT_GEOM_SWEEP_INTERNAL_H
+#include <stdatomic.h>
 #include "geom_sweep.h"
 
 #define TWO_PI 6.283185307179586476925
@@ -59,7 +60,10 @@ typedef struct {
     double base_r2, cap_r2;
     /* polygon: object-space plane and in-plane frame */
     vec3 pn, pu, pv, p0;
-    /* GI sampling: parts 0 base cap, 1 top cap, 2 + k segment k (local areas) */
+    /* GI sampling: parts 0 base cap, 1 top cap, 2 + k segment k (local
+     * areas), set up on the first geom_sweep_area or geom_sweep_sample
+     * (areas_done) */
+    atomic_int areas_done;
     int nparts;
     double *part_area, *part_cdf, *part_max;
     double total_area;       /* object space */
