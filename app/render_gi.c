@@ -93,6 +93,8 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     gi_particle_settings_from_scene(&gs, sc);
     gs.pigment = shade_tex_pigment_at; /* particles reflect the pigment where they are */
     gs.sky = shade_atmos_sky; /* what escaping rays see (shade_atmos.h) */
+    /* radiosity `normal on`: the final gather about the perturbed normal */
+    if (radrules_of(sc, 1).normal) gs.normal_at = shade_tex_normal_at;
     gi_particle_scale_quality(&gs, o->gi_quality);
     if (o->particles > 0) gs.count = o->particles;
     if (o->bounces > 0) gs.bounces = o->bounces;
@@ -440,7 +442,7 @@ static pt_status render_vpl_mode(const scene *sc, const accel *a, const render_g
 }
 
 /* What render_gi_result's nm_* say, counted and warned once. */
-static void light_not_modelled(const scene *sc, int mode, render_gi_result *r, diag *d)
+static void light_not_modelled(const scene *sc, int mode, int final_gather, render_gi_result *r, diag *d)
 {
     const int media = shade_media_scene_has(sc), fog = sc->fogs != NULL, rainbow = sc->rainbows != NULL;
     const char *who = mode == GI_PATH ? "path" : mode == GI_PMFG ? "pmfg" : "particle";
@@ -453,12 +455,14 @@ static void light_not_modelled(const scene *sc, int mode, render_gi_result *r, d
         r->nm_fog = fog;
         r->nm_rainbow = rainbow;
     }
-    if (mode == GI_PARTICLE) r->nm_normal = radrules_of(sc, 1).normal;
+    /* the final gather (keep_hits) gathers about the perturbed normal
+     * (gi_particle.h normal_at); the paper's estimate (--spp) cannot */
+    if (mode == GI_PARTICLE && !final_gather) r->nm_normal = radrules_of(sc, 1).normal;
     src_loc nowhere = {0};
     if (r->nm_normal)
         diag_report(d, DIAG_WARNING, nowhere, NULL,
-                    "--gi particle: radiosity normal on is not modelled: light is gathered about the unperturbed "
-                    "normal, so a normal pattern does not shade the gathered light");
+                    "--gi particle: radiosity normal on is not modelled without the final gather (--spp): light is "
+                    "gathered about the unperturbed normal, so a normal pattern does not shade the gathered light");
     if (sc->global.photons.enabled && mode != GI_NONE && mode != GI_PARTICLE) {
         r->nm_photons = mode != GI_PMFG;
         r->nm_photon_count = mode == GI_PMFG;
@@ -485,7 +489,7 @@ pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, fr
                     diag *d)
 {
     memset(r, 0, sizeof *r);
-    light_not_modelled(sc, o->mode, r, d);
+    light_not_modelled(sc, o->mode, o->antialias != 2, r, d);
     pt_status st;
     switch (o->mode) {
     case GI_PARTICLE: st = render_particle(sc, a, o, fb, r, d); break;

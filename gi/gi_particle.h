@@ -84,6 +84,11 @@ typedef struct gi_particle gi_particle;
  * was found. */
 typedef int (*gi_pigment_fn)(const scene *sc, const scene_texture *tex, const accel_hit *h, colour5 *out);
 
+/* The perturbed normal of the hit's texture for unit n, its raw normal on
+ * the side seen (the signature of shade_texture.h's shade_tex_normal_at):
+ * returns 0, *out = n, where it has none. */
+typedef int (*gi_normal_fn)(const scene *sc, const accel_hit *h, vec3 n, vec3 *out);
+
 /* gi_sky_fn (gi_sky.h): the sky's radiance for rays that leave the scene. */
 
 /* How flux is scattered after emission (gi_lighting.cl; every bounce a
@@ -157,6 +162,8 @@ typedef struct {
                               particles, lists of a chunk of radiance particles): gi_particle_build then returns
                               NULL with PT_CANCELLED. NULL (the default): never. */
     gi_pigment_fn pigment; /* particles' pigment at their position; NULL: each texture's base colour */
+    gi_normal_fn normal_at; /* radiosity `normal on` (core/radrules.h rule 5): the final gather (keep_hits) and
+                               the gatherer gather about the texture's perturbed normal; NULL: the raw one */
     gi_sky_fn sky;         /* radiance of rays leaving the scene; NULL: the background colour */
     progress *progress;    /* names each step of the geometry, lighting and view stages (NULL: none) */
 } gi_particle_settings;

@@ -335,7 +335,12 @@ static void put_point(gi_particle *gp, gi_dev_particle *cp, const void **cobj, u
     vec3 nv = gp->vg_nrm[i];
     gi_dev_particle *q = &cp[t];
     v3_store_f(q->p, r->h.p);
-    v3_store_f(q->n, nv);
+    /* its rays about the texture's perturbed normal under radiosity
+     * `normal on` (core/radrules.h rule 5); which pixels may take its
+     * value (vg_nrm, vp->n) still goes by the surface's own normal */
+    vec3 ngat = nv;
+    if (gp->set.normal_at) gp->set.normal_at(gp->sc, &r->h, nv, &ngat);
+    v3_store_f(q->n, ngat);
     q->area = 0.0f;
     const scene_object *o = r->h.obj;
     /* its radius: stride pixels' footprint on the surface (the angle
@@ -806,6 +811,8 @@ int gi_particle_gather_here(gi_particle *gp, const accel_hit *hit, vec3 n, int t
     int side = v3_dot(n, hit->ng) >= 0.0;
     vec3 nv = hit_normal(hit, side);
     if (!(v3_len(nv) > 0.0)) return 0;
+    /* under radiosity `normal on` about n, the shading's perturbed normal */
+    if (gp->set.normal_at && v3_dot(n, nv) > 0.0) nv = v3_norm(n);
     /* its rays' random stream from where it lies, so that a render gives
      * the same image on any number of threads */
     uint64_t bits[3];

@@ -582,6 +582,55 @@ int shade_tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_
     return 1;
 }
 
+int shade_tex_normal_at(const scene *sc, const accel_hit *h, vec3 n, vec3 *out)
+{
+    *out = n;
+    const scene_texture *tex = h->texture ? h->texture : &sc->default_texture;
+    hit_info hi = {.h = h, .raw = n, .version = scene_version(sc)};
+    hi.pc = shade_pattern_ctx_plain(sc);
+    ctx_from_hit(&hi.pc, h);
+    hi.pc.normal = n;
+    vec3 point = texture_point(h);
+    parent_frame pf[MAX_PARENTS];
+    int npf = 0;
+    /* down the texture maps as one_texture walks them, along the entry
+     * with the larger weight where two blend (a checker's one) */
+    while (tex->pat && tex->map && tex->map->n > 0 && npf + 2 < MAX_PARENTS) {
+        const scene_pattern *pat = tex->pat;
+        const scene_blend_map *m = tex->map;
+        vec3 tp = shade_pattern_warp(pat, to_texture_space_at(tex, point, &hi.pc));
+        if (tex->uv_warped) {
+            pf[npf].xf = &tex->uv_warp;
+            pf[npf].pat = NULL;
+            npf++;
+        }
+        pf[npf].xf = xform_is_identity(&tex->transform) ? NULL : &tex->transform;
+        pf[npf].pat = pat;
+        npf++;
+        const scene_texture *next;
+        if (pat->kind == PAT_AVERAGE) {
+            next = m->e[0].texture;
+        } else if (pat->kind == PAT_IMAGE && pat->image.material) {
+            next = m->e[material_index(&pat->image, tp, m->n)].texture;
+        } else {
+            shade_pattern_ctx pc = hi.pc;
+            double v = shade_pattern_value(pat, tp, &pc);
+            int ip, ic;
+            shade_blend_map_search(m, v, &ip, &ic);
+            double v1 = ip != ic ? (v - m->e[ip].value) / (m->e[ic].value - m->e[ip].value) : 1.0;
+            next = v1 >= 0.5 ? m->e[ic].texture : m->e[ip].texture;
+        }
+        if (!next) return 0;
+        tex = next;
+        point = tp;
+    }
+    if (!tex->normal || !tex->normal->pat || tex->normal->pat->kind == PAT_PLAIN) return 0;
+    vec3 p = layer_normal(&hi, tex, point, pf, npf);
+    if (!(v3_dot(p, n) > 0.0) || !isfinite(p.x)) return 0;
+    *out = p;
+    return 1;
+}
+
 static rgb shadow_layers(const scene_texture *tex, vec3 point, const shade_pattern_ctx *pc, int depth, double caustics, vec3 raw,
                          vec3 dir)
 {

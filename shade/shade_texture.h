@@ -74,6 +74,14 @@ rgb shade_tex_shade(const shade_tex_env *e, const accel_hit *h, vec3 dir, int le
  * image map used `once`). */
 int shade_tex_pigment_at(const scene *sc, const scene_texture *tex, const accel_hit *h, colour5 *out);
 
+/* The perturbed normal of the top layer of the hit's texture (its normal
+ * pattern, warped as the Whitted pass warps it; through texture maps along
+ * the entry of the larger weight), for unit n, the raw normal on the side
+ * seen, into *out: POV-Ray's radiosity `normal on` gathers about it
+ * (core/radrules.h rule 5). Returns 0, with *out = n, where the texture
+ * has no normal pattern or the perturbed normal leaves n's side. */
+int shade_tex_normal_at(const scene *sc, const accel_hit *h, vec3 n, vec3 *out);
+
 /* Filter colour of a surface for a shadow ray crossing it at h (POV-Ray's
  * ComputeShadowTexture: rgb*filter + transmit of the layers, multiplied,
  * with the interior's faked caustics and fade; 0 for opaque surfaces).
