@@ -68,6 +68,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "geom_extent.h"
 #include "geom_shape.h"
 #include "scene_leaves.h"
 #include "shade_atmos.h"
@@ -154,9 +155,24 @@ void shade_media_inside_cross(shade_media_inside *in, const scene_object *o)
     if (in->n < SHADE_MEDIA_MAX_INSIDE) in->obj[in->n++] = o;
 }
 
-/* A degenerate shape (the renderer skips it too) is never inside. */
+/* A degenerate shape (the renderer skips it too) is never inside. A
+ * blob's field is 0 outside its components' reach, so with a threshold of
+ * 0 or more a point outside the reach's box (geom_extent's, padded) is not
+ * inside: answered without building the blob's component hierarchy, which
+ * the camera's container test would otherwise build for every blob. */
 static int leaf_inside(const scene_object *o, vec3 p)
 {
+    if (o->kind == SHAPE_BLOB && o->u.blob && o->u.blob->threshold >= 0.0) {
+        vec3 lo, hi;
+        const char *what = NULL;
+        if (geom_extent(o, &lo, &hi, &what) == 0) {
+            vec3 pad = v3s(1e-9 * (v3_maxc(v3_sub(hi, lo)) + v3_maxc(v3_max(v3_neg(lo), hi))));
+            lo = v3_sub(lo, pad);
+            hi = v3_add(hi, pad);
+            if (!(p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z))
+                return (o->flags & OBJ_INVERSE) ? 1 : 0;
+        }
+    }
     geom_shape sh;
     if (geom_shape_init(&sh, o) != 0) return 0;
     int r = geom_shape_inside(&sh, p);

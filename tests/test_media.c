@@ -56,6 +56,7 @@
 #include "framebuffer.h"
 #include "sdl.h"
 #include "shade.h"
+#include "shade_media.h"
 #include "test_util.h"
 #include "test_world.h"
 
@@ -293,6 +294,44 @@ static void test_media_area_jitter_threads(void **st)
     done(&w);
 }
 
+/* The containers of a point (the camera's, shade_media_inside_at) with
+ * blobs, which a box test answers outside their components' reach: a
+ * point within the field's threshold is inside, one past the reach (just
+ * outside the box, and far off) is not, an inverse blob the other way
+ * round, a blob within a union too (strength 1, radius 2, threshold 0.5:
+ * inside within 1.08 of a lone component's centre). */
+static void test_inside_at_blobs(void **st)
+{
+    (void)st;
+    const char *src = "blob { threshold 0.5 sphere { <0, 0, 0>, 2, 1 } sphere { <3, 0, 0>, 1, 1 } hollow }\n"
+                      "blob { threshold 0.5 sphere { <0, 10, 0>, 2, 1 } inverse hollow }\n"
+                      "union { blob { threshold 0.5 sphere { <0, -10, 0>, 2, 1 } translate <2, 0, 0> } sphere { 100, 1 } }\n";
+    diag *d = diag_new();
+    scene *sc = NULL;
+    assert_int_equal(sdl_parse_string("blobs.pov", src, NULL, &sc, d), PT_OK);
+    static const struct { vec3 p; int n; } cases[] = {
+        {{0.1, 0.2, 0.0}, 2},    /* inside the first, outside the inverse one's reach */
+        {{3.5, 0.0, 0.0}, 2},    /* the first's second component */
+        {{4.0001, 0.0, 0.0}, 1}, /* just past the first's reach: only the inverse one */
+        {{0.0, 10.2, 0.0}, 0},   /* inside the inverse one's field */
+        {{-1.0, 0.0, 0.0}, 2},   /* 1 from the first's centre on each axis: inside */
+        {{0.0, 1.0, 0.0}, 2},
+        {{0.0, -1.0, 0.0}, 2},
+        {{0.0, 0.0, 1.0}, 2},
+        {{0.0, 0.0, -1.0}, 2},
+        {{3.0, -10.0, 0.0}, 2},  /* the union's blob, moved by the translate */
+        {{0.5, -10.0, 0.0}, 1},  /* 1.5 from its centre: a field below the threshold */
+        {{50.0, 50.0, 50.0}, 1},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        shade_media_inside in;
+        shade_media_inside_at(sc, cases[i].p, &in);
+        if (in.n != cases[i].n) fail_msg("point %zu: %d containers, %d expected", i, in.n, cases[i].n);
+    }
+    scene_free(sc);
+    diag_free(d);
+}
+
 /* Bad media are located errors (POV-Ray's messages), declared media and
  * densities are reused, defaults follow #version. */
 static void test_media_parse(void **st)
@@ -377,6 +416,7 @@ int main(void)
         cmocka_unit_test(test_area_light_ground_fog),
         cmocka_unit_test(test_media_area_jitter_threads),
         cmocka_unit_test(test_media_parse),
+        cmocka_unit_test(test_inside_at_blobs),
         cmocka_unit_test(test_xc_emit),
         cmocka_unit_test(test_xc_absorb),
         cmocka_unit_test(test_xc_scatter),
