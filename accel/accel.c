@@ -977,6 +977,7 @@ static void query_init(accel_query *q, vec3 org, vec3 dir, double t0, accel_ray_
     q->rule = (geom_ray_rule)rule;
     q->packet = 0;
     q->oprim = 0;
+    q->tie_skip = 0u;
     rtcInitIntersectContext(&q->rtc);
 }
 
@@ -1016,12 +1017,16 @@ static void fill_user(const accel *a, unsigned prim, const geom_csg_hit *h, vec3
     hit->flags = l->flags;
 }
 
-/* accel_intersect_rule with the effective tmin t0 as given. */
-static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tmax, accel_hit *hit,
-                        accel_ray_rule rule)
+/* accel_intersect_rule with the effective tmin t0 as given; user
+ * primitives whose effective flags carry one of `skip` (the surfaces the
+ * caller passes over, accel_intersect_past) lose the ties of coincident
+ * surfaces (accel_user.c). */
+static int intersect_at_skip(const accel *a, vec3 org, vec3 dir, double t0, double tmax, accel_hit *hit,
+                             accel_ray_rule rule, unsigned skip)
 {
     accel_query q;
     query_init(&q, org, dir, t0, rule);
+    q.tie_skip = skip;
     struct RTCRayHit rh;
     fill_rtc_ray(&rh.ray, org, dir, t0, tmax);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -1065,6 +1070,12 @@ static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tm
     assert(v3_dot(hit->ng, hit->ns) >= 0.0);
     assert(hit->obj && hit->texture);
     return isfinite(hit->t) && v3_finite(hit->p);
+}
+
+static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tmax, accel_hit *hit,
+                        accel_ray_rule rule)
+{
+    return intersect_at_skip(a, org, dir, t0, tmax, hit, rule, 0u);
 }
 
 int accel_intersect_rule(const accel *a, accel_ray_rule rule, vec3 org, vec3 dir, double tmin, double tmax,
@@ -1209,13 +1220,28 @@ int accel_intersect_from(const accel *a, const accel_from *f, vec3 org, vec3 dir
 
 _Static_assert(OBJ_NO_RADIOSITY < ACCEL_SKIP_PASS_THROUGH, "ACCEL_SKIP_PASS_THROUGH lies above the OBJ_* flags");
 
+/* accel_intersect_from whose coincident-surface ties go against the
+ * primitives carrying one of `skip` (intersect_at_skip): a no_reflection
+ * box standing on a floor is passed over from a distance past its
+ * bottom face, which would pass over the floor too had the box won. */
+static int intersect_from_skip(const accel *a, const accel_from *f, vec3 org, vec3 dir, double tmin, double tmax,
+                               unsigned skip, accel_hit *hit)
+{
+    if (!a || !ray_ok(org, dir)) return 0;
+    double t0 = eps_rule(a->ray_eps_scale, org, v3_len(dir));
+    if (tmin > t0) t0 = tmin;
+    if (f && contact_hit(a, f, org, dir, fmin_inline(t0, tmax), 0u, hit)) return 1;
+    if (!(tmax > t0)) return 0;
+    return intersect_at_skip(a, org, dir, t0, tmax, hit, ACCEL_RAY_POV, skip & ~ACCEL_SKIP_PASS_THROUGH);
+}
+
 int accel_intersect_past(const accel *a, const accel_from *f, vec3 org, vec3 dir, double eps, unsigned skip,
                          accel_hit *hit, long *rays)
 {
     double tmin = eps;
     for (int k = 0; k < ACCEL_PASS_MAX; k++) {
         if (rays) (*rays)++;
-        if (!accel_intersect_from(a, k == 0 ? f : NULL, org, dir, tmin, INFINITY, hit)) return 0;
+        if (!intersect_from_skip(a, k == 0 ? f : NULL, org, dir, tmin, INFINITY, skip, hit)) return 0;
         int pass = (hit->flags & skip) ||
                    ((skip & ACCEL_SKIP_PASS_THROUGH) && hit->obj && hit->obj->photons && hit->obj->photons->pass_through);
         if (!pass) return 1;

@@ -135,6 +135,7 @@ typedef struct {
     /* an exact occlusion query: the top-level user primitive found to
      * block it, plus 1 (0: none or not asked; accel_occluded_cached) */
     unsigned oprim;
+    unsigned tie_skip; /* nearest mode: primitives whose effective flags carry one of these lose ties */
 } accel_query;
 
 /* The query of this thread (the callbacks tell our context from a plain

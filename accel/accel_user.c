@@ -435,6 +435,17 @@ static int tie_first(const accel_query *q, unsigned cand, unsigned cur)
     return ka < kb;
 }
 
+/* Whether primitive `cand` takes a tie from the query's hit: never from
+ * itself; a primitive the caller passes over (q->tie_skip) loses to one it
+ * does not; otherwise tie_first. */
+static int tie_takes(const accel *a, const accel_query *q, unsigned cand)
+{
+    if (cand == q->uprim) return 0;
+    int cs = (prim_flags(a, cand) & q->tie_skip) != 0, us = (prim_flags(a, q->uprim) & q->tie_skip) != 0;
+    if (cs != us) return us;
+    return tie_first(q, cand, q->uprim);
+}
+
 void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
 {
     const accel *a = args->geometryUserPtr;
@@ -481,9 +492,7 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
          * rounding of their intersections (a box standing on a plane, seen
          * through its bottom): the tie goes to one of them by the ray's
          * hash, either about as often (tie_first) */
-        if (exact && q->uhit && h.t >= q->ut - tie &&
-            (q->uprim == args->primID || !tie_first(q, args->primID, q->uprim)))
-            continue;
+        if (exact && q->uhit && h.t >= q->ut - tie && !tie_takes(a, q, args->primID)) continue;
         /* rounded up: a nearer candidate within the ulp is still tried */
         SOA_F(ray, N, i, 8) = exact ? nextafterf((float)h.t, INFINITY) : (float)h.t;
         vec3 ng = v3(0, 0, 0);
