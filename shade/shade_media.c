@@ -173,6 +173,17 @@ static int leaf_inside(const scene_object *o, vec3 p)
                 return (o->flags & OBJ_INVERSE) ? 1 : 0;
         }
     }
+    if (o->kind == SHAPE_HEIGHT_FIELD && o->u.height_field && o->u.height_field->heights) {
+        /* inside is below the surface over the unit square (object
+         * space), so never above the highest height or the water: a point
+         * there is answered without building the field's min/max tree */
+        const scene_height_field *h = o->u.height_field;
+        double top = h->water_level;
+        for (long i = 0; i < (long)h->width * h->height; i++) top = h->heights[i] > top ? h->heights[i] : top;
+        vec3 q = xform_inv_point(&o->transform, p);
+        if (q.y > top + 1e-6 * (fabs(top) + 1.0) || q.x < -1e-9 || q.x > 1.0 + 1e-9 || q.z < -1e-9 || q.z > 1.0 + 1e-9)
+            return (o->flags & OBJ_INVERSE) ? 1 : 0;
+    }
     geom_shape sh;
     if (geom_shape_init(&sh, o) != 0) return 0;
     int r = geom_shape_inside(&sh, p);

@@ -295,17 +295,20 @@ static void test_media_area_jitter_threads(void **st)
 }
 
 /* The containers of a point (the camera's, shade_media_inside_at) with
- * blobs, which a box test answers outside their components' reach: a
+ * blobs and a height field, which a box test answers away from them (a
+ * blob outside its components' reach, a height field above its highest
+ * point or off its square): a
  * point within the field's threshold is inside, one past the reach (just
  * outside the box, and far off) is not, an inverse blob the other way
  * round, a blob within a union too (strength 1, radius 2, threshold 0.5:
  * inside within 1.08 of a lone component's centre). */
-static void test_inside_at_blobs(void **st)
+static void test_inside_at_bounds(void **st)
 {
     (void)st;
     const char *src = "blob { threshold 0.5 sphere { <0, 0, 0>, 2, 1 } sphere { <3, 0, 0>, 1, 1 } hollow }\n"
                       "blob { threshold 0.5 sphere { <0, 10, 0>, 2, 1 } inverse hollow }\n"
-                      "union { blob { threshold 0.5 sphere { <0, -10, 0>, 2, 1 } translate <2, 0, 0> } sphere { 100, 1 } }\n";
+                      "union { blob { threshold 0.5 sphere { <0, -10, 0>, 2, 1 } translate <2, 0, 0> } sphere { 100, 1 } }\n"
+                      "height_field { function 8, 8 { 0.25 + 0.5 * x } scale <4, 2, 4> translate <20, 0, 0> }\n";
     diag *d = diag_new();
     scene *sc = NULL;
     assert_int_equal(sdl_parse_string("blobs.pov", src, NULL, &sc, d), PT_OK);
@@ -322,6 +325,11 @@ static void test_inside_at_blobs(void **st)
         {{3.0, -10.0, 0.0}, 2},  /* the union's blob, moved by the translate */
         {{0.5, -10.0, 0.0}, 1},  /* 1.5 from its centre: a field below the threshold */
         {{50.0, 50.0, 50.0}, 1},
+        {{21.0, 0.3, 2.0}, 2},   /* under the height field's surface (0.5 to 1.5 high there) */
+        {{21.0, 1.2, 2.0}, 1},   /* over it, below its highest point */
+        {{21.0, 2.5, 2.0}, 1},   /* above its highest point */
+        {{25.0, 0.3, 2.0}, 1},   /* past its square */
+        {{21.0, -5.0, 2.0}, 2},  /* far below: still under the surface */
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         shade_media_inside in;
@@ -416,7 +424,7 @@ int main(void)
         cmocka_unit_test(test_area_light_ground_fog),
         cmocka_unit_test(test_media_area_jitter_threads),
         cmocka_unit_test(test_media_parse),
-        cmocka_unit_test(test_inside_at_blobs),
+        cmocka_unit_test(test_inside_at_bounds),
         cmocka_unit_test(test_xc_emit),
         cmocka_unit_test(test_xc_absorb),
         cmocka_unit_test(test_xc_scatter),
