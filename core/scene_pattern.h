@@ -151,6 +151,10 @@ typedef struct scene_pattern {
     const struct scene_density *density; /* PAT_DENSITY (NULL: file not read, evaluates to 0) */
     int density_interpolate;       /* 0 none, 1 trilinear, 2 tricubic */
     const struct scene_object *object;   /* PAT_OBJECT: inside 1, outside 0 */
+    /* PAT_OBJECT: the serial of the scene that owns `object` (keys the
+     * renderer's cache of its shapes where the caller names no scene: a
+     * pigment function's evaluation) */
+    unsigned long object_serial;
     /* `pigment/normal { uv_mapping ... }`: evaluated at
      * the hit's <u, v, 0> instead of the point it is given (POV-Ray's
      * UV_MAP_PATTERN: the transforms of the enclosing texture and object

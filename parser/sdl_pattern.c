@@ -792,7 +792,10 @@ static int pattern_type(sdl_parser *p, target *tg)
         pt->object = NULL;
         if (!sdl_begin_block(p, "object")) break;
         sdl_obj *so = sdl_parse_object_body(p);
-        if (so && so->obj) pt->object = so->obj;
+        if (so && so->obj) {
+            pt->object = so->obj;
+            pt->object_serial = p->s->serial;
+        }
         else if (sdl_ok(p)) sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "object or object identifier expected");
         blend_list(p, tg, 2);
         sdl_end_block(p);

@@ -1086,7 +1086,13 @@ static double raw_value(const scene_pattern *pat, vec3 p, const shade_pattern_ct
         return shade_pavement_value(&pv, p);
     }
     case PAT_DENSITY: return density(pat, p);
-    case PAT_OBJECT: return pat->object && object_inside(pat->object, p, c->scene_serial, 0) ? 1.0 : 0.0;
+    case PAT_OBJECT:
+        /* a pigment function's context names no scene: the pattern's own
+         * (without a cached shape, each test would build the shapes anew:
+         * a text or lathe integrates its surface area when built) */
+        return pat->object && object_inside(pat->object, p, c->scene_serial ? c->scene_serial : pat->object_serial, 0)
+                   ? 1.0
+                   : 0.0;
     default: return 0.0;
     }
 }

@@ -1117,6 +1117,25 @@ static void test_scene_sweep(void **st)
     assert_int_equal(ok + located, n);
 }
 
+/* The object pattern records its scene's serial, which keys the
+ * renderer's cache of the object's shapes where an evaluation names no
+ * scene (a pigment function's). */
+static void test_object_pattern_serial(void **st)
+{
+    (void)st;
+    scene *s = parse_ok("sphere { 0, 1 pigment { object { sphere { 0, 0.5 } rgb 1 rgb 0 } } }\n");
+    assert_int_equal(s->nobjects, 1);
+    const scene_texture *t = s->objects[0]->texture;
+    assert_non_null(t);
+    assert_int_equal(t->pigment.kind, PIGMENT_PATTERN);
+    assert_non_null(t->pigment.pat);
+    assert_int_equal(t->pigment.pat->kind, PAT_OBJECT);
+    assert_non_null(t->pigment.pat->object);
+    assert_true(s->serial != 0);
+    assert_true(t->pigment.pat->object_serial == s->serial);
+    scene_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1145,6 +1164,7 @@ int main(void)
         cmocka_unit_test(test_photons_language),
         cmocka_unit_test_setup(test_input_hash, make_tmpdir),
         cmocka_unit_test(test_scene_sweep),
+        cmocka_unit_test(test_object_pattern_serial),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
