@@ -158,11 +158,13 @@ void shade_media_inside_cross(shade_media_inside *in, const scene_object *o)
 /* A degenerate shape (the renderer skips it too) is never inside. A
  * blob's field is 0 outside its components' reach, so with a threshold of
  * 0 or more a point outside the reach's box (geom_extent's, padded) is not
- * inside: answered without building the blob's component hierarchy, which
- * the camera's container test would otherwise build for every blob. */
+ * inside; nor is one outside a text's box (its glyphs' control points,
+ * which hold the curves, over the depth): answered without building the
+ * blob's component hierarchy or the text's outline, which the camera's
+ * container test would otherwise build for every such object. */
 static int leaf_inside(const scene_object *o, vec3 p)
 {
-    if (o->kind == SHAPE_BLOB && o->u.blob && o->u.blob->threshold >= 0.0) {
+    if ((o->kind == SHAPE_BLOB && o->u.blob && o->u.blob->threshold >= 0.0) || o->kind == SHAPE_TEXT) {
         vec3 lo, hi;
         const char *what = NULL;
         if (geom_extent(o, &lo, &hi, &what) == 0) {

@@ -52,6 +52,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "accel.h"
 #include "framebuffer.h"
 #include "sdl.h"
@@ -295,9 +296,9 @@ static void test_media_area_jitter_threads(void **st)
 }
 
 /* The containers of a point (the camera's, shade_media_inside_at) with
- * blobs and a height field, which a box test answers away from them (a
- * blob outside its components' reach, a height field above its highest
- * point or off its square): a
+ * blobs, a height field and a text, which a box test answers away from
+ * them (a blob outside its components' reach, a height field above its
+ * highest point or off its square, a text outside its glyphs' box): a
  * point within the field's threshold is inside, one past the reach (just
  * outside the box, and far off) is not, an inverse blob the other way
  * round, a blob within a union too (strength 1, radius 2, threshold 0.5:
@@ -305,10 +306,12 @@ static void test_media_area_jitter_threads(void **st)
 static void test_inside_at_bounds(void **st)
 {
     (void)st;
+    if (access("/usr/share/povray-3.7/include/timrom.ttf", R_OK) != 0) skip();
     const char *src = "blob { threshold 0.5 sphere { <0, 0, 0>, 2, 1 } sphere { <3, 0, 0>, 1, 1 } hollow }\n"
                       "blob { threshold 0.5 sphere { <0, 10, 0>, 2, 1 } inverse hollow }\n"
                       "union { blob { threshold 0.5 sphere { <0, -10, 0>, 2, 1 } translate <2, 0, 0> } sphere { 100, 1 } }\n"
-                      "height_field { function 8, 8 { 0.25 + 0.5 * x } scale <4, 2, 4> translate <20, 0, 0> }\n";
+                      "height_field { function 8, 8 { 0.25 + 0.5 * x } scale <4, 2, 4> translate <20, 0, 0> }\n"
+                      "text { ttf \"timrom.ttf\" \"I\" 1, 0 scale 4 translate <40, 0, 0> }\n";
     diag *d = diag_new();
     scene *sc = NULL;
     assert_int_equal(sdl_parse_string("blobs.pov", src, NULL, &sc, d), PT_OK);
@@ -330,6 +333,10 @@ static void test_inside_at_bounds(void **st)
         {{21.0, 2.5, 2.0}, 1},   /* above its highest point */
         {{25.0, 0.3, 2.0}, 1},   /* past its square */
         {{21.0, -5.0, 2.0}, 2},  /* far below: still under the surface */
+        {{40.6, 1.0, 2.0}, 2},   /* in the letter I's stem (40.5 to 40.75 in x, 4 deep) */
+        {{40.6, 1.0, 4.5}, 1},   /* behind it */
+        {{41.5, 1.0, 2.0}, 1},   /* beside it, within its box */
+        {{38.0, 1.0, 2.0}, 1},   /* outside its box */
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         shade_media_inside in;
