@@ -164,18 +164,20 @@ void shade_media_inside_cross(shade_media_inside *in, const scene_object *o)
  * container test would otherwise build for every such object. */
 static int leaf_inside(const scene_object *o, vec3 p)
 {
-    if ((o->kind == SHAPE_BLOB && o->u.blob && o->u.blob->threshold >= 0.0) || o->kind == SHAPE_TEXT) {
+    /* an inverse object is answered in full: a degenerate one is never
+     * inside, inverse or not */
+    int inverse = (o->flags & OBJ_INVERSE) != 0;
+    if (!inverse && ((o->kind == SHAPE_BLOB && o->u.blob && o->u.blob->threshold >= 0.0) || o->kind == SHAPE_TEXT)) {
         vec3 lo, hi;
         const char *what = NULL;
         if (geom_extent(o, &lo, &hi, &what) == 0) {
             vec3 pad = v3s(1e-9 * (v3_maxc(v3_sub(hi, lo)) + v3_maxc(v3_max(v3_neg(lo), hi))));
             lo = v3_sub(lo, pad);
             hi = v3_add(hi, pad);
-            if (!(p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z))
-                return (o->flags & OBJ_INVERSE) ? 1 : 0;
+            if (!(p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z)) return 0;
         }
     }
-    if (o->kind == SHAPE_HEIGHT_FIELD && o->u.height_field && o->u.height_field->heights) {
+    if (!inverse && o->kind == SHAPE_HEIGHT_FIELD && o->u.height_field && o->u.height_field->heights) {
         /* inside is below the surface over the unit square (object
          * space), so never above the highest height or the water: a point
          * there is answered without building the field's min/max tree */
@@ -183,8 +185,7 @@ static int leaf_inside(const scene_object *o, vec3 p)
         double top = h->water_level;
         for (long i = 0; i < (long)h->width * h->height; i++) top = h->heights[i] > top ? h->heights[i] : top;
         vec3 q = xform_inv_point(&o->transform, p);
-        if (q.y > top + 1e-6 * (fabs(top) + 1.0) || q.x < -1e-9 || q.x > 1.0 + 1e-9 || q.z < -1e-9 || q.z > 1.0 + 1e-9)
-            return (o->flags & OBJ_INVERSE) ? 1 : 0;
+        if (q.y > top + 1e-6 * (fabs(top) + 1.0) || q.x < -1e-9 || q.x > 1.0 + 1e-9 || q.z < -1e-9 || q.z > 1.0 + 1e-9) return 0;
     }
     geom_shape sh;
     if (geom_shape_init(&sh, o) != 0) return 0;
