@@ -71,12 +71,24 @@ static int pigment_may(const scene_pigment *pg, int depth)
 
 int transmit_texture_may(const scene_texture *t)
 {
-    for (; t; t = t->next) {
-        if (t->pat && t->map) {
-            if (map_may(t->map, 0)) return 1;
-        } else if (pigment_may(&t->pigment, 0)) {
-            return 1;
+    /* A layered texture's filters multiply (POV-Ray 3.7's trace.cpp,
+     * ComputeShadowTexture and ComputeLightedTexture: each layer's
+     * filter and transmit scale the light let through; shade_texture.c's
+     * shadow_layers), so one layer of a solid colour without filter or
+     * transmit (stones.inc's T_StoneN over their pigment{color Black})
+     * stops all light, whatever the layers over it let through. A texture
+     * map at the head stands for the whole texture there. */
+    const int layered = t && !(t->pat && t->map);
+    int may = 0;
+    for (const scene_texture *l = t; l; l = l->next) {
+        if (layered && (l->pigment.kind != PIGMENT_PATTERN || !l->pigment.pat) && l->pigment.colour.f == 0.0 &&
+            l->pigment.colour.t == 0.0)
+            return 0;
+        if (l->pat && l->map) {
+            if (map_may(l->map, 0)) may = 1;
+        } else if (pigment_may(&l->pigment, 0)) {
+            may = 1;
         }
     }
-    return 0;
+    return may;
 }

@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include "scene.h"
+#include "transmit.h"
 #include "sdl.h"
 #include "sdl_keywords.h"
 
@@ -1136,6 +1137,29 @@ static void test_object_pattern_serial(void **st)
     scene_free(s);
 }
 
+/* A layered texture lets light through only where every layer does (the
+ * layers' filters multiply): one solid layer without filter or transmit
+ * makes the whole texture opaque (transmit_texture_may), as stones.inc's
+ * T_StoneN over pigment { color Black }; layers that all may transmit, or
+ * a single transmitting one, may. */
+static void test_layered_transmit(void **st)
+{
+    (void)st;
+    scene *s = parse_ok("sphere { 0, 1 texture { pigment { color rgb 0 } } texture { pigment { rgbt <1, 1, 1, 0.5> } } }\n"
+                        "sphere { 0, 1 texture { pigment { rgbt <1, 1, 1, 0.5> } } texture { pigment { color rgb 1 } } }\n"
+                        "sphere { 0, 1 texture { pigment { rgbf <1, 1, 1, 0.5> } } texture { pigment { rgbt 0.5 } } }\n"
+                        "sphere { 0, 1 texture { pigment { rgbt 0.5 } } }\n"
+                        "sphere { 0, 1 texture { pigment { color rgb 1 } } }\n"
+                        "sphere { 0, 1 texture { pigment { checker rgb 0, rgbt 1 } } texture { pigment { rgbt 0.5 } } }\n");
+    assert_int_equal(s->nobjects, 6);
+    int want[6] = {0, 0, 1, 1, 0, 1};
+    for (int i = 0; i < 6; i++) {
+        assert_non_null(s->objects[i]->texture);
+        assert_int_equal(transmit_texture_may(s->objects[i]->texture), want[i]);
+    }
+    scene_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1165,6 +1189,7 @@ int main(void)
         cmocka_unit_test_setup(test_input_hash, make_tmpdir),
         cmocka_unit_test(test_scene_sweep),
         cmocka_unit_test(test_object_pattern_serial),
+        cmocka_unit_test(test_layered_transmit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
