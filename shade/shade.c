@@ -94,6 +94,9 @@ typedef struct {
      * containers of the camera's location, and per thread the hit being
      * shaded (its incoming ray's containers) for the rays it spawns. */
     int media;
+    /* shadow rays take the media's extinction: 0 where no media can dim
+     * light (emission only: shade_media_scene_attenuates) */
+    int media_shadow;
     shade_media_inside cam_in;
     const struct hit_frame *frame[SHADE_MAX_THREADS];
     int primary_on;      /* s->primary holds this render's centre rays (shade_primary_begin_fn) */
@@ -179,7 +182,7 @@ static const scene_light *photon_light(const render_ctx *c, int thread, const sc
  * through the atmosphere and fog, the containers' media on the way. */
 static int media_shadows(const render_ctx *c, const scene_light *l)
 {
-    return c->media || (l && c->sc->fogs && l->media_interaction && l->media_attenuation);
+    return c->media_shadow || (l && c->sc->fogs && l->media_interaction && l->media_attenuation);
 }
 
 /* Light reaching p along a shadow ray: 0 or 1 in scenes without transparent
@@ -510,6 +513,7 @@ rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 o
                     .max_level = s->max_trace_level > 0 ? s->max_trace_level : sc->global.max_trace_level, .ts = ts,
                     .transparent = 1 /* filtered shadows: exact for opaque surfaces too */};
     c.media = shade_media_scene_has(sc);
+    c.media_shadow = c.media;
     return trace_ray(&c, 0, org, v3_norm(dir), 1, 1.0, OBJ_NO_IMAGE, 0.0f, r, &no_containers);
 }
 
@@ -908,6 +912,7 @@ pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s,
     c.transparent = shade_tex_scene_transparent(sc);
     c.proj = shade_projection_build(sc, d);
     c.media = shade_media_scene_has(sc);
+    c.media_shadow = c.media && shade_media_scene_attenuates(sc);
     if (camera_focal_blur(&sc->camera)) shade_focal_init(&c.focal, &sc->camera);
     /* the camera's containers: they set the ior ratios at the surfaces its
      * rays meet, and media and fog act only in hollow ones */

@@ -110,6 +110,29 @@ static const void *key_of(const scene_object *o)
 
 static int has_interior_media(const scene_object *o) { return o->interior && o->interior->nmedia > 0; }
 
+static int media_attenuates(const scene_media *m)
+{
+    return m && (m->absorption.r != 0.0 || m->absorption.g != 0.0 || m->absorption.b != 0.0 || m->scattering.r != 0.0 ||
+                 m->scattering.g != 0.0 || m->scattering.b != 0.0);
+}
+
+static int has_attenuating_media(const scene_object *o)
+{
+    if (!o->interior) return 0;
+    for (int k = 0; k < o->interior->nmedia; k++)
+        if (media_attenuates(o->interior->media[k])) return 1;
+    return 0;
+}
+
+int shade_media_scene_attenuates(const scene *sc)
+{
+    for (int k = 0; k < sc->natmosphere; k++)
+        if (media_attenuates(sc->atmosphere[k])) return 1;
+    for (int i = 0; i < sc->nobjects; i++)
+        if (scene_object_any(sc->objects[i], has_attenuating_media)) return 1;
+    return 0;
+}
+
 int shade_media_scene_has(const scene *sc)
 {
     if (sc->natmosphere > 0) return 1;

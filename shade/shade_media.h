@@ -27,6 +27,11 @@ typedef struct {
 
 /* Any media in the scene (interior or atmospheric)? */
 int shade_media_scene_has(const scene *sc);
+/* Whether some media of sc (an object's interior or the atmosphere) can
+ * dim light: absorption or scattering above 0 in some channel. Without,
+ * a shadow ray crosses every media unchanged (POV-Ray's shadow rays take
+ * their media's extinction only, never their emission). */
+int shade_media_scene_attenuates(const scene *sc);
 /* Is the ray hollow (every container hollow)? */
 int shade_media_inside_hollow(const shade_media_inside *in);
 /* Do the containers hold any media? */

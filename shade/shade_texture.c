@@ -699,9 +699,13 @@ rgb shade_tex_leaving_fade(const accel_hit *h, vec3 dir)
 
 /* ------------------------------------------------------------ shadows */
 
+/* Whether o can filter a shadow ray: a no_shadow object (its members
+ * inherit the flag) never meets one (shade_tex_walk_take, accel's
+ * occlusion callbacks). */
 static int object_transparent(const scene_object *o, int depth)
 {
     if (depth > 64) return 1;
+    if (o->flags & OBJ_NO_SHADOW) return 0;
     if (o->texture && transmit_texture_may(o->texture)) return 1;
     if (o->interior_texture && transmit_texture_may(o->interior_texture)) return 1;
     switch (o->kind) {

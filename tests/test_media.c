@@ -58,6 +58,7 @@
 #include "sdl.h"
 #include "shade.h"
 #include "shade_media.h"
+#include "shade_texture.h"
 #include "test_util.h"
 #include "test_world.h"
 
@@ -418,11 +419,41 @@ static void test_xc_emit(void **st) { (void)st; check("xm_emit", 0.008); }
 static void test_xc_absorb(void **st) { (void)st; check("xm_absorb", 0.003); }
 static void test_xc_scatter(void **st) { (void)st; check("xm_scatter", 0.008); }
 
+/* What makes a render's shadow rays walk their crossings: media that can
+ * dim light (absorption or scattering; emission alone never does:
+ * shade_media_scene_attenuates), and surfaces that can filter them, of
+ * objects that cast shadows (shade_tex_scene_transparent: a no_shadow
+ * glowing bulb is neither, as in baking_demo.pov). */
+static void test_shadow_media_rules(void **st)
+{
+    (void)st;
+    const char *srcs[] = {
+        "sphere { 0, 1 pigment { rgbt 1 } hollow no_shadow interior { media { emission 1 } } }\n",
+        "sphere { 0, 1 pigment { rgbt 1 } hollow interior { media { emission 1 } } }\n",
+        "sphere { 0, 1 pigment { rgbt 1 } hollow no_shadow interior { media { absorption 0.1 } } }\n",
+        "sphere { 0, 1 pigment { rgbt 1 } hollow no_shadow interior { media { scattering { 1, 0.2 } } } }\n",
+        "sphere { 0, 1 pigment { rgb 1 } }\nmedia { emission 0.1 }\n",
+        "sphere { 0, 1 pigment { rgb 1 } }\nmedia { absorption 0.1 }\n",
+        "union { sphere { 0, 1 pigment { rgbf 0.5 } } sphere { x, 1 } no_shadow }\n",
+    };
+    const int has[] = {1, 1, 1, 1, 1, 1, 0}, dims[] = {0, 0, 1, 1, 0, 1, 0}, filters[] = {0, 1, 0, 0, 0, 0, 0};
+    for (int i = 0; i < (int)(sizeof srcs / sizeof srcs[0]); i++) {
+        world w = build(srcs[i]);
+        printf("scene %d: media %d, attenuates %d, transparent %d\n", i, shade_media_scene_has(w.s),
+               shade_media_scene_attenuates(w.s), shade_tex_scene_transparent(w.s));
+        assert_int_equal(shade_media_scene_has(w.s), has[i]);
+        assert_int_equal(shade_media_scene_attenuates(w.s), dims[i]);
+        assert_int_equal(shade_tex_scene_transparent(w.s), filters[i]);
+        done(&w);
+    }
+}
+
 int main(void)
 {
     if (tu_mkdtemp(tmpdir, sizeof tmpdir, "partray-media") != 0) return 1;
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_beer_lambert),
+        cmocka_unit_test(test_shadow_media_rules),
         cmocka_unit_test(test_emission_absorption),
         cmocka_unit_test(test_atmosphere_hollow),
         cmocka_unit_test(test_shadow_through_media),
