@@ -106,6 +106,17 @@ static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, const gi_causti
     if (!step) return out;
     double mr = b.m[SHADE_MAT_LOBE_REFLECT], mt = b.m[SHADE_MAT_LOBE_TRANSMIT];
     if (!(mr + mt > 0.0)) return out;
+    /* Seed 002's appendix A (with --photon-roulette): the photon goes on
+     * with probability p, the specular lobes' share of the surface's lobes
+     * (as shade_mat_sample(absorb = 1) would choose one of them), and a
+     * kept photon's branches carry 1/p of the weight and p as their density
+     * factor (rho, so the photon volumes widen where the roulette thins
+     * them). The expected flux is the weighted rule's. */
+    double p = 1.0;
+    if (c->roulette) {
+        p = (mr + mt) / (b.msum > 1.0 ? b.msum : 1.0);
+        if (!(p > 0.0) || rng_f64(r) >= p) return out;
+    }
     /* the surface's own reflectivity (shade_material folds a transmitted
      * part it totally reflects into k[REFLECT]) */
     rgb kr = b.k[SHADE_MAT_LOBE_REFLECT];
@@ -137,6 +148,10 @@ static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, const gi_causti
             step[n++] = (gi_caustic_step){b.p_out, b.refl_dir, {fa.r * kr.r, fa.g * kr.g, fa.b * kr.b}, 1.0, 0,
                                           b.from, same, reflect_weight(&b, kr)};
         if (transmits) step[n++] = through(c, h, dir, &b, kr, &si, tdir);
+    }
+    for (int k = 0; k < n && p < 1.0; k++) {
+        step[k].weight = (rgb){step[k].weight.r / p, step[k].weight.g / p, step[k].weight.b / p};
+        step[k].rho = p;
     }
     return out | GI_CAUSTIC_CONTINUES | (n == 2 ? GI_CAUSTIC_SPLIT : 0);
 }
@@ -269,9 +284,10 @@ static void not_modelled(caustics *c, const scene *sc, diag *d)
 
 pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width, int height, int threads,
                          uint64_t seed, const char *cl_device, size_t cl_max_bytes, double count_scale,
-                         volatile int *cancel, diag *d)
+                         int roulette, volatile int *cancel, diag *d)
 {
     memset(c, 0, sizeof *c);
+    c->roulette = roulette != 0;
     c->asked = sc->global.photons.enabled;
     if (!c->asked) return PT_OK;
     not_modelled(c, sc, d);

@@ -32,15 +32,18 @@ typedef struct {
     const scene *sc;    /* the hooks' scene and offset epsilon (shade.c's rule) */
     double eps;
     double scale;       /* the scene's working scale (accel_eps_scale) */
+    int roulette;       /* 1: seed 002's Russian roulette at each bounce instead of POV-Ray's weights */
 } caustics;
 
 /* Builds the layer (c must stay where it is while the layer is used: it
  * is the hooks' context) for a w x h image when the scene asks for photons;
  * fills c (c->layer NULL when nothing shoots). count_scale: photons times
- * this (0: the scene's). */
+ * this (0: the scene's). roulette: 1 ends photons by the paper's Russian
+ * roulette at each surface (appendix A) instead of POV-Ray's weights (see
+ * hook_surface in caustics.c); the same expected light, more noise. */
 pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width, int height, int threads,
                          uint64_t seed, const char *cl_device, size_t cl_max_bytes, double count_scale,
-                         volatile int *cancel, diag *d);
+                         int roulette, volatile int *cancel, diag *d);
 /* Puts the layer into shade settings: its indirect hook (after whatever
  * hook ss has: that one is kept and summed), POV-Ray's photon shadows and,
  * when the layer holds media photons, the media's photon hook. */

@@ -344,6 +344,8 @@ int cli_parse_render(int argc, char **argv, cli_render *o, char *err, int errlen
                 return 2;
             }
             i++;
+        } else if (strcmp(a, "--photon-roulette") == 0) {
+            o->photon_roulette = 1;
         } else if (strcmp(a, "--clock") == 0) {
             if (!has_value(a, next, err, errlen)) return 2;
             if (!parse_double(next, &o->clock)) { snprintf(err, (size_t)errlen, "--clock wants a number"); return 2; }
@@ -641,6 +643,8 @@ const char cli_render_help[] =
     "                         (16384), bounces at the VPLs (1), the cut walked per pixel, adaptive sampling\n"
     "  --photon-scale F       none, particle: F times the photons the scene's photons{} asks for\n"
     "                         (caustic layer, docs/caustics.md; default 1)\n"
+    "  --photon-roulette      none, particle: end photons by seed 002's Russian roulette instead of\n"
+    "                         POV-Ray's weights (same expected light, noisier; docs/caustics.md)\n"
     "\n"
     "Colour and light (docs/guide.md, docs/units.md)\n"
     "  --display NAME --view NAME --look NAME --exposure STOPS --working-space NAME\n"

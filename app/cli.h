@@ -76,6 +76,7 @@ typedef struct {
     /* GI settings (render_gi.h); 0 = the mode's default */
     long particles;
     double photon_scale;    /* --photon-scale: the caustic layer's photons times this (0 = 1) */
+    int photon_roulette;    /* --photon-roulette: the caustic layer's photons end by Russian roulette */
     double gi_quality;      /* --gi-quality: scales the GI method's effort from the scene's settings (0 = 1) */
     int bounces, fg_rays, max_depth;
     long photons;

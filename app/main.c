@@ -537,6 +537,7 @@ static int render_frame(render_run *run, const anim_plan *plan, int frame, char 
                          .aa_threshold = o->aa_threshold, .aa_depth = o->aa_depth,
                          .aa_jitter = o->aa_jitter, .quality = o->quality, .spp = o->spp,
                          .particles = o->particles, .gi_quality = o->gi_quality, .photon_scale = o->photon_scale,
+                         .photon_roulette = o->photon_roulette,
                          .bounces = o->bounces, .fg_rays = o->fg_rays, .photons = o->photons, .max_depth = o->max_depth,
                          .cl_device = o->cl_device,
                          .cl_max_bytes = o->cl_max_memory_mib > 0 ? (size_t)o->cl_max_memory_mib << 20 : 0,

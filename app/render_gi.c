@@ -74,7 +74,7 @@ static pt_status render_none(const scene *sc, const accel *a, const render_gi_op
     ss.use_ambient = radrules_of(sc, 0).ambient; /* radiosity off: always */
     double t0 = timer_now();
     pt_status st = caustics_build(&r->caus, sc, a, o->width, o->height, o->threads, o->seed, o->cl_device,
-                                  o->cl_max_bytes, o->photon_scale, o->cancel, d);
+                                  o->cl_max_bytes, o->photon_scale, o->photon_roulette, o->cancel, d);
     r->t_gi_lighting = timer_now() - t0;
     if (st != PT_OK) return st;
     caustics_attach(&r->caus, &ss);
@@ -139,7 +139,7 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
         /* the caustic layer of the scene's photons{} (caustics.h) */
         double tc = timer_now();
         st = caustics_build(&r->caus, sc, a, o->width, o->height, o->threads, o->seed, o->cl_device, o->cl_max_bytes,
-                            o->photon_scale, o->cancel, d);
+                            o->photon_scale, o->photon_roulette, o->cancel, d);
         r->t_gi_lighting += timer_now() - tc;
     }
     if (st == PT_OK) {

@@ -33,6 +33,7 @@ typedef struct {
                                  pixel; 0: the mode's default (1; pmfg's and vpl's own) */
     long particles;           /* particle: area particles (0 = from the scene/default) */
     double photon_scale;      /* none, particle: the caustic layer's photons times this (0 = 1) */
+    int photon_roulette;      /* none, particle: the caustic layer ends photons by Russian roulette */
     double gi_quality;        /* particle: multiplies the scene's particle count (0 = 1); --particles wins */
     int bounces;              /* particle: n_b (0 = default) */
     int fg_rays;              /* pmfg: final-gather rays per pixel (0 = default 4096) */

@@ -3,10 +3,13 @@
  * over the same photons (pmfg's reference/pm_kdtree.h, the k-nearest
  * search its caustic map uses: k = 32 within 0.02 x the scene size) at the
  * same G-buffer points, as the paper's Table 3 compares ISPM with Purcell's
- * gather; and the photons' attrition per bounce (the paper's Fig. 10, there
- * by Russian roulette; here photons end where a surface has no specular
- * lobe, by adc_bailout or by max_trace_level): photons shot, reaching their
- * target, and still travelling after each bounce.
+ * gather; and the photons' attrition per bounce (the paper's Fig. 10):
+ * photons shot, reaching their target, and still travelling after each
+ * bounce, twice: as partray renders them (POV-Ray's weights: photons end
+ * where a surface has no specular lobe, by adc_bailout or by
+ * max_trace_level) and with the paper's Russian roulette at each surface
+ * (appendix A, `--photon-roulette`), whose attrition Fig. 10 plots; the
+ * flux each way (the roulette's expected flux is the weights').
  *
  * The scene's photons{} as partray renders it (run from the scene's
  * directory). Median of --reps runs of each estimate. Prints figures; not a
@@ -35,6 +38,27 @@ typedef struct {
 } gather_job;
 
 #define GK 32
+
+/* Attrition per bounce of one build of the layer. */
+static void print_attrition(const char *what, const gi_caustic_stats *s, double flux)
+{
+    printf("attrition (paper Fig. 10), %s: of %ld photons at their target, %ld ended at the bounce map (%.1f%%); "
+           "stored flux %.6g\n",
+           what, s->first_hits, s->absorbed_first, s->first_hits ? 100.0 * s->absorbed_first / s->first_hits : 0.0, flux);
+    for (int b = 1; b <= s->max_bounce; b++)
+        printf("  going on after bounce %2d: %9ld  (%.1f%% of those at their target; a split counts once)\n", b,
+               s->alive[b], s->first_hits ? 100.0 * s->alive[b] / s->first_hits : 0.0);
+}
+
+/* Sum of the stored photons' power (all three channels). */
+static double stored_flux(const gi_caustic *layer)
+{
+    long n;
+    const gi_caus_photon *p = gi_caustic_photons(layer, &n);
+    double f = 0.0;
+    for (long i = 0; i < n; i++) f += (double)p[i].phi[0] + p[i].phi[1] + p[i].phi[2];
+    return f;
+}
 
 static void gather_rows(void *ctx, int chunk, int thread)
 {
@@ -97,7 +121,7 @@ int main(int argc, char **argv)
         return 1;
     }
     caustics c;
-    st = caustics_build(&c, pl.sc, pl.acc, w, h, threads, 1, device, 0, scale, NULL, d);
+    st = caustics_build(&c, pl.sc, pl.acc, w, h, threads, 1, device, 0, scale, 0, NULL, d);
     if (st != PT_OK || !c.layer) {
         bench_report_diag(d);
         fprintf(stderr, "bench_caustics: %s shoots no photons\n", path);
@@ -111,11 +135,18 @@ int main(int argc, char **argv)
     printf("photons: %ld shot (bounce map cells, %d light-target pairs, spacing %.4g), %ld reached their target, "
            "%ld stored, %ld rays\n",
            s.emitted, s.combos, s.spacing, s.first_hits, s.stored, s.rays);
-    printf("attrition (paper Fig. 10): of %ld photons at their target, %ld absorbed at the bounce map (%.1f%%)\n",
-           s.first_hits, s.absorbed_first, s.first_hits ? 100.0 * s.absorbed_first / s.first_hits : 0.0);
-    for (int b = 1; b <= s.max_bounce; b++)
-        printf("  going on after bounce %2d: %9ld  (%.1f%% of those at their target; a split counts once)\n", b, s.alive[b],
-               s.first_hits ? 100.0 * s.alive[b] / s.first_hits : 0.0);
+    print_attrition("POV-Ray's weights (partray's default)", &s, stored_flux(c.layer));
+    {
+        caustics cr;
+        if (caustics_build(&cr, pl.sc, pl.acc, w, h, threads, 1, device, 0, scale, 1, NULL, d) != PT_OK || !cr.layer) {
+            bench_report_diag(d);
+            return 1;
+        }
+        gi_caustic_stats sr;
+        gi_caustic_get_stats(cr.layer, &sr);
+        print_attrition("Russian roulette (seed 002 appendix A, --photon-roulette)", &sr, stored_flux(cr.layer));
+        caustics_free(&cr);
+    }
     if (s.stored_media > 0)
         printf("media photons: %ld stored (sphere radius median %.4g, thinned %ldx at most)\n", s.stored_media,
                s.r_media_median, s.media_thinned);

@@ -28,7 +28,7 @@
 /* The layer of scene `text` over a w x h G-buffer on device dev (NULL auto). */
 static void layer(caustics *c, const scene *sc, const accel *a, int w, int h, const char *dev, int threads, diag *d)
 {
-    assert_int_equal(caustics_build(c, sc, a, w, h, threads, 1, dev, 0, 0.0, NULL, d), PT_OK);
+    assert_int_equal(caustics_build(c, sc, a, w, h, threads, 1, dev, 0, 0.0, 0, NULL, d), PT_OK);
     assert_non_null(c->layer);
 }
 
@@ -195,6 +195,51 @@ static void test_mirror_closed_form(void **state)
     assert_true(fabs(e / want - 1.0) <= 0.02);
     caustics_free(&c);
     diag_free(d);
+    tu_world_free(&w);
+}
+
+/* The two ways a photon loses what a surface does not pass on: a grey
+ * mirror (diffuse 0.2, reflection 0.6) beside the light of
+ * test_mirror_closed_form. POV-Ray's weights (the default) send every
+ * photon on at 0.6 of its power; seed 002's Russian roulette
+ * (--photon-roulette) sends on a share p = 0.6 (the specular lobe's share
+ * of 0.8, under 1) at 1/p of 0.6 of its power. Both must give the closed
+ * form 0.6 x 5 / sqrt(41) = 0.46852 (2%: each photon volume holds some
+ * hundred photons, so the roulette's noise is a fraction of that), and the
+ * attrition after the bounce map must be the rule's: every photon at its
+ * target goes on under the weights, 0.6 of them under the roulette (+-0.02,
+ * many standard deviations of a binomial over the 10^5 photons at the
+ * mirror, far from the other rule's 1). */
+static void test_mirror_roulette(void **state)
+{
+    (void)state;
+    static const char *fmt = "#version 3.7;\n"
+                             "global_settings { assumed_gamma 1.0 photons { spacing 0.01 } }\n"
+                             "camera { orthographic location <0, 5, 0> look_at <0, 0, 0> sky z right x*0.4 up z*0.4 }\n"
+                             "light_source { <-2, 5, 0> color rgb 1 }\n"
+                             "box { <1, -1, -3>, <1.1, 3, 3> pigment { rgb 1 } finish { ambient 0 diffuse 0.2 "
+                             "reflection 0.6 } photons { target reflection on } }\n"
+                             "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 1 } }\n";
+    tu_world w = tu_world_build("test.pov", fmt);
+    double want = 0.6 * 5.0 / sqrt(41.0);
+    for (int rr = 0; rr <= 1; rr++) {
+        diag *d = diag_new();
+        caustics c;
+        assert_int_equal(caustics_build(&c, w.s, w.a, 32, 32, THREADS, 1, NULL, 0, 0.0, rr, NULL, d), PT_OK);
+        assert_non_null(c.layer);
+        double e = centre_mean(gi_caustic_image(c.layer), 4, 32, 32, 32, 32);
+        gi_caustic_stats st;
+        gi_caustic_get_stats(c.layer, &st);
+        double kept = st.first_hits ? (double)st.alive[1] / (double)st.first_hits : 0.0;
+        printf("grey mirror, %s: caustic layer %.5f, closed form %.5f (rel err %+.4f, tol 0.02); going on after the "
+               "bounce map %.4f of %ld (want %.1f)\n",
+               rr ? "roulette" : "weights", e, want, e / want - 1.0, kept, st.first_hits, rr ? 0.6 : 1.0);
+        assert_true(st.first_hits > 1000);
+        assert_true(fabs(e / want - 1.0) <= 0.02);
+        assert_true(fabs(kept - (rr ? 0.6 : 1.0)) <= 0.02);
+        caustics_free(&c);
+        diag_free(d);
+    }
     tu_world_free(&w);
 }
 
@@ -833,7 +878,7 @@ static void test_not_modelled(void **state)
     sc = w.s;
     a = w.a;
     d = diag_new();
-    assert_int_equal(caustics_build(&c, sc, a, 8, 8, THREADS, 1, NULL, 0, 0.0, NULL, d), PT_OK);
+    assert_int_equal(caustics_build(&c, sc, a, 8, 8, THREADS, 1, NULL, 0, 0.0, 0, NULL, d), PT_OK);
     assert_null(c.layer);
     assert_int_equal(diag_count(d), 1);
     caustics_free(&c);
@@ -846,6 +891,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_mirror_closed_form),
         cmocka_unit_test(test_mirror_brilliance),
+        cmocka_unit_test(test_mirror_roulette),
         cmocka_unit_test(test_gather_minimum),
         cmocka_unit_test(test_highlight_photons),
         cmocka_unit_test(test_photons_in_room),
