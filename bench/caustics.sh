@@ -110,35 +110,11 @@ for rel in "$@"; do
     if [ -f "$ref" ]; then refimg=$ref; else refimg="$work/${stem}_pov.png"; note=" [ref: POV-Ray default, 4x not made]"; fi
     fpov=$("$PARTRAY" compare "$refimg" "$work/${stem}_pov.png" --json 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin)["flip"]["mean"])')
     js=$("$PARTRAY" compare "$refimg" "$work/${stem}_pt.png" --json 2>/dev/null)
-    mad=$(python3 - "$work/${stem}_pov.png" "$work/${stem}_pt.png" <<'EOF'
-import struct, sys, zlib
-def read(path):
-    d = open(path, 'rb').read(); i = 8; idat = b''
-    while i < len(d):
-        n, = struct.unpack('>I', d[i:i + 4]); t = d[i + 4:i + 8]; c = d[i + 8:i + 8 + n]; i += 12 + n
-        if t == b'IHDR': w, h, bd, ct = struct.unpack('>IIBB', c[:10])
-        elif t == b'IDAT': idat += c
-    ch = {2: 3, 6: 4, 0: 1, 4: 2}[ct]; bpp = ch * (bd // 8); raw = zlib.decompress(idat); st = w * bpp
-    prev = [0] * st; p = 0; img = []
-    for y in range(h):
-        f = raw[p]; row = raw[p + 1:p + 1 + st]; p += 1 + st; r = [0] * st
-        for x in range(st):
-            a = r[x - bpp] if x >= bpp else 0; b = prev[x]; c = prev[x - bpp] if x >= bpp else 0
-            pr = 0 if f == 0 else a if f == 1 else b if f == 2 else (a + b) // 2 if f == 3 else \
-                (a if abs(b - c) <= abs(a - c) and abs(b - c) <= abs(a + b - 2 * c) else b if abs(a - c) <= abs(a + b - 2 * c) else c)
-            r[x] = (row[x] + pr) & 255
-        prev = r
-        img.append([[r[x * bpp + k * (bd // 8)] / 255.0 for k in range(3)] for x in range(w)])
-    return img, w, h
-a, w, h = read(sys.argv[1]); b, _, _ = read(sys.argv[2])
-s = n = 0
-for y in range(h // 4):
-    for x in range(w // 4):
-        for k in range(3):
-            va = sum(a[4 * y + j][4 * x + i][k] for j in range(4) for i in range(4)) / 16
-            vb = sum(b[4 * y + j][4 * x + i][k] for j in range(4) for i in range(4)) / 16
-            s += abs(va - vb); n += 1
-print("%.4f" % (s / n))
+    mad=$(python3 - "$ROOT/scripts" "$work/${stem}_pov.png" "$work/${stem}_pt.png" <<'EOF'
+import sys
+sys.path.insert(0, sys.argv[1])
+from pngread import mad4, read_png
+print("%.4f" % mad4(read_png(sys.argv[2]), read_png(sys.argv[3])))
 EOF
 )
     printf '%s\n' "$js" | python3 -c '

@@ -20,28 +20,14 @@ for view in 0 1; do
         povray +I"$SCENE" +O"$TMP/pov_${view}_$lift.png" +FN +W$W +H$H -A -D -V -P -UA +WT$THREADS \
             Declare=View=$view Declare=Lift=$lift >/dev/null 2>&1
     done
-    python3 - "$TMP/pt_$view.png" "$TMP/pov_${view}_0.png" "$TMP/pov_${view}_-0.001.png" "$view" <<'PY'
-import struct, sys, zlib
+    python3 - "$(dirname "$0")/../scripts" "$TMP/pt_$view.png" "$TMP/pov_${view}_0.png" "$TMP/pov_${view}_-0.001.png" "$view" <<'PY'
+import sys
+sys.path.insert(0, sys.argv.pop(1))
+from pngread import read_png
 def read(path):
-    d = open(path, 'rb').read(); i = 8; idat = b''
-    while i < len(d):
-        n, = struct.unpack('>I', d[i:i + 4]); t = d[i + 4:i + 8]; c = d[i + 8:i + 8 + n]; i += 12 + n
-        if t == b'IHDR': w, h, bd, ct = struct.unpack('>IIBB', c[:10])
-        elif t == b'IDAT': idat += c
-    ch = {2: 3, 6: 4}[ct]; bpp = ch * (bd // 8); raw = zlib.decompress(idat); st = w * bpp
-    prev = [0] * st; p = 0; img = []
-    for y in range(h):
-        f = raw[p]; row = raw[p + 1:p + 1 + st]; p += 1 + st; r = [0] * st
-        for x in range(st):
-            a = r[x - bpp] if x >= bpp else 0; b = prev[x]; c = prev[x - bpp] if x >= bpp else 0
-            pr = 0 if f == 0 else a if f == 1 else b if f == 2 else (a + b) // 2 if f == 3 else \
-                (a if abs(b - c) <= abs(a - c) and abs(b - c) <= abs(a + b - 2 * c) else b if abs(a - c) <= abs(a + b - 2 * c) else c)
-            r[x] = (row[x] + pr) & 255
-        prev = r
-        img.append([tuple(r[x * bpp + k * (bd // 8)] for k in range(3)) for x in range(w)])
-    return img
+    return read_png(path)[2]
 def cls(px):
-    r, g, b = px
+    r, g = px[0] * 255, px[1] * 255
     return 'R' if r > 128 and g < 64 else 'G' if g > 128 and r < 64 else 'K' if r < 64 and g < 64 else 'M'
 pt, pov, sunk, view = read(sys.argv[1]), read(sys.argv[2]), read(sys.argv[3]), sys.argv[4]
 h, w = len(pt), len(pt[0])
