@@ -350,11 +350,11 @@ static inline void user_ray(const accel_query *q, const void *ray, unsigned N, u
 
 /* A crossing query (accel_crossings) on a leaf whose crossings are the
  * closed-form roots of its surface filtered by the interval (sphere, box,
- * cylinder, cone, disc, plane, triangle, and a height field's triangles,
- * whose distances its walk takes from the ray's origin wherever the walk
- * starts; no bounded_by, whose test takes the interval's start): all of
- * them from one solve, stepped over by the
- * rule of the loop in accel_user_intersect, which asks the shape again from
+ * cylinder, cone, disc, plane, triangle, polygon, and a height field's
+ * triangles, whose distances its walk takes from the ray's origin
+ * wherever the walk starts; no bounded_by, whose test takes the
+ * interval's start): all of them from one solve, stepped over by the rule
+ * of the loop in accel_user_intersect, which asks the shape again from
  * just past each crossing and so gets the same roots; on a CSG without
  * bounded_by, geom_csg_crossings. 0 when the loop must do it (other
  * shapes, isosurface members, more crossings than the buffer holds). */
@@ -382,7 +382,7 @@ static int cross_leaf_once(const accel *a, unsigned prim, vec3 o, vec3 d, double
     const geom_shape *sh = &a->shapes[prim];
     switch (sh->kind) {
     case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_CYLINDER: case SHAPE_CONE: case SHAPE_DISC: case SHAPE_PLANE:
-    case SHAPE_TRIANGLE: case SHAPE_SMOOTH_TRIANGLE: case SHAPE_HEIGHT_FIELD:
+    case SHAPE_TRIANGLE: case SHAPE_SMOOTH_TRIANGLE: case SHAPE_HEIGHT_FIELD: case SHAPE_POLYGON:
         break;
     default:
         return 0;
