@@ -1105,6 +1105,10 @@ double accel_hit_placement(const scene_object *o)
 /* accel_crossings in one traversal: possible when every geometry is user
  * geometry (the callback collects; triangles would need a filter). */
 #define CROSS_MAX 256
+/* Up to this many user primitives (and no other geometry) the crossings
+ * are collected by a loop over the primitives' boxes instead of Embree's
+ * traversal, whose fixed cost per ray is then the larger part. */
+#define CROSS_DIRECT_MAX 4
 static int crossings_collected(const accel *a, vec3 org, vec3 dir, double t0, double tmax, double step, unsigned skip,
                                accel_crossing *cr)
 {
@@ -1123,7 +1127,10 @@ static int crossings_collected(const accel *a, vec3 org, vec3 dir, double t0, do
     rh.hit.geomID = rh.hit.primID = rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     accel_query *saved = accel_tls_query;
     accel_tls_query = &q;
-    rtcIntersect1(a->root, &q.rtc, &rh);
+    if (a->nshapes + a->ncsgs <= CROSS_DIRECT_MAX)
+        accel_user_cross_all(a, &q, &rh.ray);
+    else
+        rtcIntersect1(a->root, &q.rtc, &rh);
     accel_tls_query = saved;
     if (q.overflow) return -1;
     /* nearest first (insertion: a handful) */

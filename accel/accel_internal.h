@@ -170,6 +170,9 @@ int accel_prim_hit(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, d
 const geom_shape *accel_prim_shape(const accel *a, unsigned prim, int member);
 void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args);
 void accel_user_occluded(const struct RTCOccludedFunctionNArguments *args);
+/* A crossing query's collection over every user primitive whose box the
+ * ray meets, without Embree (scenes of user geometry only). */
+void accel_user_cross_all(const accel *a, accel_query *q, const struct RTCRay *r);
 /* Whether user primitive prim blocks the exact occlusion query q, whose
  * Embree ray is r, as accel_user_occluded answers when the traversal asks
  * it (accel_occluded_cached). */

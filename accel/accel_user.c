@@ -358,7 +358,8 @@ static inline void user_ray(const accel_query *q, const void *ray, unsigned N, u
  * just past each crossing and so gets the same roots; on a CSG without
  * bounded_by, geom_csg_crossings. 0 when the loop must do it (other
  * shapes, isosurface members, more crossings than the buffer holds). */
-static int cross_leaf_once(const accel *a, unsigned prim, vec3 o, vec3 d, double tmin, accel_query *q)
+__attribute__((always_inline)) static inline int cross_leaf_once(const accel *a, unsigned prim, vec3 o, vec3 d,
+                                                            double tmin, accel_query *q)
 {
     if (prim >= (unsigned)a->nshapes) {
         /* a CSG: geom_csg_crossings searches each member once over the
@@ -448,6 +449,25 @@ static int tie_takes(const accel *a, const accel_query *q, unsigned cand)
     return tie_first(q, cand, q->uprim);
 }
 
+/* A crossing query's collection on primitive prim: every crossing of it
+ * in (tmin, q->ctmax), each the nearest just past the one before. */
+__attribute__((always_inline)) static inline void cross_prim(const accel *a, accel_query *q, unsigned prim, vec3 o,
+                                                            vec3 d, double tmin)
+{
+    if (q->cskip && (prim_flags(a, prim) & q->cskip)) return;
+    if (cross_leaf_once(a, prim, o, d, tmin, q)) return;
+    for (double from = tmin; from < q->ctmax;) {
+        geom_csg_hit h;
+        if (!accel_prim_hit(a, prim, o, d, from, q->ctmax, &h, q->rule)) break;
+        if (q->ncross == q->maxcross) {
+            q->overflow = 1;
+            break;
+        }
+        q->cross[q->ncross++] = (accel_crossing){h.t, prim, h.part, h.shape, h.flip};
+        from = h.t + fmax_inline(q->cstep, h.t * 1e-7);
+    }
+}
+
 void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
 {
     const accel *a = args->geometryUserPtr;
@@ -467,18 +487,7 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
         double tmin;
         user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
         if (exact && q->cross) {
-            if (q->cskip && (prim_flags(a, args->primID) & q->cskip)) continue;
-            if (cross_leaf_once(a, args->primID, o, d, tmin, q)) continue;
-            for (double from = tmin; from < q->ctmax;) {
-                geom_csg_hit h;
-                if (!accel_prim_hit(a, args->primID, o, d, from, q->ctmax, &h, rule)) break;
-                if (q->ncross == q->maxcross) {
-                    q->overflow = 1;
-                    break;
-                }
-                q->cross[q->ncross++] = (accel_crossing){h.t, args->primID, h.part, h.shape, h.flip};
-                from = h.t + fmax_inline(q->cstep, h.t * 1e-7);
-            }
+            cross_prim(a, q, args->primID, o, d, tmin);
             continue;
         }
         /* the nearest hit so far is the exact one of the query: a float
@@ -524,6 +533,50 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
         SOA_U(hit, N, i, 5) = args->primID;
         SOA_U(hit, N, i, 6) = args->geomID;
         SOA_U(hit, N, i, 7) = args->context->instID[0];
+    }
+}
+
+/* A crossing query (q->cross set, ray r its Embree ray) on a scene whose
+ * only geometry is the user geometry, without Embree's traversal: each
+ * primitive whose box the ray's interval meets is asked as the traversal's
+ * leaf would ask it (accel_user_intersect, which in collect mode reports
+ * no hit, so the traversal visits every such leaf and prunes nothing by
+ * distance). The crossings are the same whatever the order; the caller
+ * sorts them. For a handful of primitives the loop costs less than the
+ * traversal's set-up and node tests. */
+/* Whether the ray from org with reciprocal direction inv misses box b (6
+ * floats) within [tn, tf]: user_box_missed's test where no slab end is
+ * NaN (every reciprocal finite), so that plain minima and maxima do. */
+static inline int box_missed_finite(const float *b, const float org[3], const float inv[3], float tn, float tf)
+{
+    float x0 = (b[0] - org[0]) * inv[0], x1 = (b[3] - org[0]) * inv[0];
+    float y0 = (b[1] - org[1]) * inv[1], y1 = (b[4] - org[1]) * inv[1];
+    float z0 = (b[2] - org[2]) * inv[2], z1 = (b[5] - org[2]) * inv[2];
+    float xl = x0 < x1 ? x0 : x1, xh = x0 < x1 ? x1 : x0;
+    float yl = y0 < y1 ? y0 : y1, yh = y0 < y1 ? y1 : y0;
+    float zl = z0 < z1 ? z0 : z1, zh = z0 < z1 ? z1 : z0;
+    tn = xl > tn ? xl : tn;
+    tn = yl > tn ? yl : tn;
+    tn = zl > tn ? zl : tn;
+    tf = xh < tf ? xh : tf;
+    tf = yh < tf ? yh : tf;
+    tf = zh < tf ? zh : tf;
+    return tn > tf + 1e-5f * fabsf(tf) + 1e-30f;
+}
+
+void accel_user_cross_all(const accel *a, accel_query *q, const struct RTCRay *r)
+{
+    unsigned np = (unsigned)(a->nshapes + a->ncsgs);
+    /* the reciprocals taken once; a ray along which one is not finite
+     * takes user_box_missed itself */
+    float org[3] = {r->org_x, r->org_y, r->org_z};
+    float inv[3] = {1.0f / r->dir_x, 1.0f / r->dir_y, 1.0f / r->dir_z};
+    int finite = fabsf(inv[0]) < INFINITY && fabsf(inv[1]) < INFINITY && fabsf(inv[2]) < INFINITY;
+    for (unsigned p = 0; p < np && !q->overflow; p++) {
+        if (a->ubox && (finite ? box_missed_finite(a->ubox + 6 * (size_t)p, org, inv, r->tnear, r->tfar)
+                               : user_box_missed(a, p, (void *)r, 1, 0)))
+            continue;
+        cross_prim(a, q, p, q->org, q->dir, q->tmin);
     }
 }
 
