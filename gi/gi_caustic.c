@@ -444,6 +444,32 @@ static int deposit_media(const gi_caustic *c, const combo *cb, vec3 org, vec3 w,
 }
 
 /* One bounce-map cell: the photon's direction (and origin), then its path. */
+/* r_z, a photon volume's reach along its surface normal, for in-plane
+ * radius r_xy: as far as POV-Ray's gather reaches off the surface. Its
+ * gather (photons.cpp, PhotonGatherer::gatherPhotonsRec with `flatten`)
+ * takes up to the gather maximum (`gather min, max`, 100 by default) within
+ * a sphere, and "flattens" it by adding 16 |n . d| d^2 to a photon's squared
+ * distance d^2, |n . d| the photon's distance off the surface in scene
+ * units (not a ratio): along the normal a photon is gathered within z of
+ * z^2 (1 + 16 z) = r^2, r the gather radius. The volume takes for r the
+ * radius that holds the gather maximum of its own photons' unfocused beam,
+ * r_xy sqrt(max / pi) / RADIUS_K. So on a glass wall thinner than that
+ * reach (balcony's drinking glass, 0.0022 thick under photons 0.002 apart)
+ * a point on one face takes the photons stored on the other face, as
+ * POV-Ray's gather does. Newton's method from z = r, where the cubic is
+ * above r^2, converges from above. */
+static double normal_reach(const gi_caustic *c, double rxy)
+{
+    int gmax = c->sc->global.photons.gather_max > 0 ? c->sc->global.photons.gather_max : 100;
+    double r = rxy * sqrt(gmax / M_PI) / RADIUS_K, z = r;
+    for (int i = 0; i < 40; i++) {
+        double f = z * z * (1.0 + 16.0 * z) - r * r, dz = f / (2.0 * z + 48.0 * z * z);
+        z -= dz;
+        if (!(dz > 1e-9 * z)) break;
+    }
+    return isfinite(z) && z > 0.0 ? fmin(z, rxy) : 0.25 * rxy;
+}
+
 static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_out *out)
 {
     const scene_light *l = cb->l;
@@ -548,16 +574,17 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
             double k = att * (cb->parallel ? 1.0 : depth * depth);
             double sd = cb->parallel ? sqrt(cb->cell) : depth * sqrt(cb->cell);
             double rxy = fmin(RADIUS_K * sd / sqrt(br.rho_p), c->r_max);
+            double rz = normal_reach(c, rxy);
             vec3 np = v3_dot(h.ng, br.w) < 0.0 ? h.ng : v3_neg(h.ng), wq = pov_photon_dir(v3_neg(br.w));
             gi_caus_photon q = {{(float)h.p.x, (float)h.p.y, (float)h.p.z},
                                 (float)rxy,
                                 {(float)np.x, (float)np.y, (float)np.z},
-                                (float)(0.25 * rxy),
+                                (float)rz,
                                 {(float)wq.x, (float)wq.y, (float)wq.z},
                                 (float)(1.0 / (rxy * rxy)),
                                 {(float)(cb->phi0.r * br.tr.r * k), (float)(cb->phi0.g * br.tr.g * k),
                                  (float)(cb->phi0.b * br.tr.b * k)},
-                                (float)(16.0 / (rxy * rxy))};
+                                (float)(1.0 / (rz * rz))};
             if (rxy > 0.0 && isfinite(q.phi[0] + q.phi[1] + q.phi[2]) && cmax3(crgb(q.phi[0], q.phi[1], q.phi[2])) > 0.0)
                 if (!push_photon(out, &q, sf & GI_CAUSTIC_RECEIVES ? STORE_SPLAT : STORE_HIGHLIGHT)) {
                     out->oom = 1;
@@ -1134,9 +1161,10 @@ static int widen_sparse(gi_caustic *c, int threads)
             gi_caus_photon *q = &c->ph[i];
             double r = wj.r[i];
             q->r_xy = (float)r;
-            q->r_z = (float)(0.25 * r);
+            double rz = normal_reach(c, r);
+            q->r_z = (float)rz;
             q->inv_rxy2 = (float)(1.0 / (r * r));
-            q->inv_rz2 = (float)(16.0 / (r * r));
+            q->inv_rz2 = (float)(1.0 / (rz * rz));
         }
         c->st.widened = atomic_load(&wj.widened);
     }

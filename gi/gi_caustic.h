@@ -41,7 +41,8 @@
  *     the photon volume's radius: r_xy = k s_D / sqrt(rho_p), with s_D the spacing of the
  *     photon's direction cell at its path length (the distance to its
  *     neighbours had nothing focused it) and k = 9 (gi_caustic.c says
- *     why); r_z = r_xy / 4;
+ *     why); r_z, along the normal, is as far as POV-Ray's flattened
+ *     gather sphere reaches off the surface (gi_caustic.c, normal_reach);
  *  4. eye G-buffer (paper step 2): the first receiving surface through each
  *     pixel centre (non-receiving surfaces, e.g. clear glass, are passed
  *     straight, so what lies behind them is in the buffer too);
