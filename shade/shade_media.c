@@ -300,11 +300,12 @@ static int density_cheap(const scene_pigment *pg)
 }
 
 #define MAX_DENSITIES 16
-static rgb density_at(const media_ref *r, vec3 p, const shade_pattern_ctx *pc)
+/* The density of media r at po, the point in its object's space. */
+static rgb density_at(const media_ref *r, vec3 po, const shade_pattern_ctx *pc)
 {
     const scene_media *m = r->m;
     if (m->ndensity == 0) return mk(1, 1, 1);
-    vec3 q = r->obj ? xform_inv_point(r->obj, p) : p;
+    vec3 q = po;
     if (!xform_is_identity(&m->transform)) q = xform_inv_point(&m->transform, q);
     /* The densities multiply, so one that is 0 in every channel makes the
      * product 0 (their colours are finite): the cheap ones are evaluated
@@ -339,9 +340,16 @@ static rgb density_at(const media_ref *r, vec3 p, const shade_pattern_ctx *pc)
 static coeffs coeffs_at(const media_ref *refs, int n, vec3 p, int shadow, const shade_pattern_ctx *pc)
 {
     coeffs c = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    /* the point in each object's space, once for the media of one object */
+    const xform *obj = NULL;
+    vec3 po = p;
     for (int i = 0; i < n; i++) {
         const scene_media *m = refs[i].m;
-        rgb d = density_at(&refs[i], p, pc);
+        if (refs[i].obj != obj) {
+            obj = refs[i].obj;
+            po = obj ? xform_inv_point(obj, p) : p;
+        }
+        rgb d = density_at(&refs[i], po, pc);
         rgb ext = add(m->absorption, scl(m->scattering, m->extinction));
         c.ext = add(c.ext, mul(d, ext));
         if (!shadow) {

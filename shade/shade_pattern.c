@@ -1100,7 +1100,13 @@ static double raw_value(const scene_pattern *pat, vec3 p, const shade_pattern_ct
 double shade_pattern_value(const scene_pattern *pat, vec3 tp, const shade_pattern_ctx *c)
 {
     double v = raw_value(pat, tp, c);
-    if (pat->frequency != 0.0) v = fmod(v * pat->frequency + pat->phase, 1.00001);
+    if (pat->frequency != 0.0) {
+        /* fmod is exact, so a value already in [0, 1.00001) is its own
+         * remainder (most are: raw values lie in [0, 1] and the default
+         * frequency is 1, phase 0); the call only for the others */
+        double x = v * pat->frequency + pat->phase;
+        v = x >= 0.0 && x < 1.00001 ? x : fmod(x, 1.00001);
+    }
     if (v < 0.0) v -= floor(v);
     switch (pat->wave) {
     case WAVE_RAMP: break;
@@ -1245,8 +1251,12 @@ int shade_pigment_eval(const scene_pigment *pg, vec3 p, const shade_pattern_ctx 
         } else {
             prev = entry_colour(&m->e[ip]);
         }
-        double f = (v - m->e[ip].value) / (m->e[ic].value - m->e[ip].value);
-        col = c5_lerp(prev, col, f);
+        /* between two entries of one colour the blend is that colour (a
+         * finite fraction times a zero difference): no division there */
+        if (prev.r != col.r || prev.g != col.g || prev.b != col.b || prev.f != col.f || prev.t != col.t) {
+            double f = (v - m->e[ip].value) / (m->e[ic].value - m->e[ip].value);
+            col = c5_lerp(prev, col, f);
+        }
     }
     *out = col;
     return found;
