@@ -114,25 +114,94 @@ static FT_UInt glyph_for(FT_Face face, unsigned long c)
     return g;
 }
 
-pt_status sdl_font_text(const char *path, const char *text, vec3 offset, sdl_font_outline *out, char *why, size_t whycap)
-{
-    memset(out, 0, sizeof *out);
-    FT_Library lib;
-    if (FT_Init_FreeType(&lib)) {
-        snprintf(why, whycap, "FreeType could not be initialised");
-        return PT_ERR_IO;
-    }
+typedef struct font_entry {
+    char *path;
     FT_Face face;
-    if (FT_New_Face(lib, path, 0, &face)) {
-        FT_Done_FreeType(lib);
+    struct font_entry *next;
+} font_entry;
+
+struct sdl_font_cache {
+    FT_Library lib;
+    font_entry *fonts;
+};
+
+void sdl_font_cache_free(sdl_font_cache *cache)
+{
+    if (!cache) return;
+    font_entry *f = cache->fonts;
+    while (f) {
+        font_entry *n = f->next;
+        FT_Done_Face(f->face);
+        free(f->path);
+        free(f);
+        f = n;
+    }
+    if (cache->lib) FT_Done_FreeType(cache->lib);
+    free(cache);
+}
+
+/* The face of `path` in the cache into *face, opened (and its Unicode
+ * charmap chosen) on first use. */
+static pt_status cache_face(sdl_font_cache *cache, const char *path, FT_Face *face, char *why, size_t whycap)
+{
+    for (font_entry *f = cache->fonts; f; f = f->next)
+        if (strcmp(f->path, path) == 0) {
+            *face = f->face;
+            return PT_OK;
+        }
+    font_entry *f = calloc(1, sizeof *f);
+    if (f) f->path = strdup(path);
+    if (!f || !f->path) {
+        free(f);
+        snprintf(why, whycap, "out of memory");
+        return PT_ERR_NOMEM;
+    }
+    if (FT_New_Face(cache->lib, path, 0, &f->face)) {
+        free(f->path);
+        free(f);
         snprintf(why, whycap, "not a font FreeType can read");
         return PT_ERR_IO;
     }
-    if (!face->charmap && face->num_charmaps > 0) FT_Set_Charmap(face, face->charmaps[0]);
-    if (face->charmap && face->charmap->encoding != FT_ENCODING_UNICODE) {
-        for (int i = 0; i < face->num_charmaps; i++)
-            if (face->charmaps[i]->encoding == FT_ENCODING_UNICODE) FT_Set_Charmap(face, face->charmaps[i]);
+    FT_Face fc = f->face;
+    if (!fc->charmap && fc->num_charmaps > 0) FT_Set_Charmap(fc, fc->charmaps[0]);
+    if (fc->charmap && fc->charmap->encoding != FT_ENCODING_UNICODE) {
+        for (int i = 0; i < fc->num_charmaps; i++)
+            if (fc->charmaps[i]->encoding == FT_ENCODING_UNICODE) FT_Set_Charmap(fc, fc->charmaps[i]);
     }
+    f->next = cache->fonts;
+    cache->fonts = f;
+    *face = fc;
+    return PT_OK;
+}
+
+static pt_status outline_text(FT_Face face, const char *text, vec3 offset, sdl_font_outline *out, char *why,
+                              size_t whycap);
+
+pt_status sdl_font_text(sdl_font_cache **cache, const char *path, const char *text, vec3 offset,
+                        sdl_font_outline *out, char *why, size_t whycap)
+{
+    memset(out, 0, sizeof *out);
+    if (!*cache) {
+        sdl_font_cache *c = calloc(1, sizeof *c);
+        if (!c) {
+            snprintf(why, whycap, "out of memory");
+            return PT_ERR_NOMEM;
+        }
+        if (FT_Init_FreeType(&c->lib)) {
+            free(c);
+            snprintf(why, whycap, "FreeType could not be initialised");
+            return PT_ERR_IO;
+        }
+        *cache = c;
+    }
+    FT_Face face;
+    pt_status st = cache_face(*cache, path, &face, why, whycap);
+    return st == PT_OK ? outline_text(face, text, offset, out, why, whycap) : st;
+}
+
+static pt_status outline_text(FT_Face face, const char *text, vec3 offset, sdl_font_outline *out, char *why,
+                              size_t whycap)
+{
     double units = face->units_per_EM > 0 ? face->units_per_EM : 1000.0;
     outline_sink s;
     memset(&s, 0, sizeof s);
@@ -192,8 +261,6 @@ pt_status sdl_font_text(const char *path, const char *text, vec3 offset, sdl_fon
         last = g;
         first = 0;
     }
-    FT_Done_Face(face);
-    FT_Done_FreeType(lib);
     if (s.oom && st == PT_OK) {
         snprintf(why, whycap, "out of memory");
         st = PT_ERR_NOMEM;

@@ -19,8 +19,19 @@ typedef struct {
     double z_offset;       /* offset.z summed over the string (ignored: POV-Ray moves glyphs in z, rarely used) */
 } sdl_font_outline;
 
-/* Outline of the UTF-8 string `text` in the font file at `path`. On error
+/* The font files one parse has opened, each kept open until the parse ends
+ * (a scene may set thousands of texts in one font). Starts as NULL. */
+typedef struct sdl_font_cache sdl_font_cache;
+
+/* Outline of the UTF-8 string `text` in the font file at `path`, opened
+ * through `*cache` (created on first use). The outline depends only on the
+ * file and the arguments, not on what the face was used for before (each
+ * glyph is loaded anew, the charmap is chosen once at opening). On error
  * returns PT_ERR_IO or PT_ERR_NOMEM with a reason in `why`. */
-pt_status sdl_font_text(const char *path, const char *text, vec3 offset, sdl_font_outline *out, char *why, size_t whycap);
+pt_status sdl_font_text(sdl_font_cache **cache, const char *path, const char *text, vec3 offset,
+                        sdl_font_outline *out, char *why, size_t whycap);
+
+/* Closes every font of the cache and frees it (NULL is a no-op). */
+void sdl_font_cache_free(sdl_font_cache *cache);
 
 #endif

@@ -1,5 +1,6 @@
 /* sdl_parse.c - public entry points (sdl.h), errors, token helpers. */
 #include "sdl_parse.h"
+#include "sdl_font.h"
 #include "grow.h"
 #include <stdarg.h>
 #include <stdio.h>
@@ -441,6 +442,7 @@ static pt_status run(const char *name, const char *text, const sdl_options *opt,
     sdl_close_inputs(&p);
     sdl_geom_free(&p);
     sdl_files_close(&p);
+    sdl_font_cache_free(p.fonts);
     sdl_symtab_free(p.sym);
     free(p.blocks);
     if (p.status != PT_OK) {

@@ -127,6 +127,7 @@ typedef struct sdl_parser {
     void *geom_cache;     /* sdl_geom: the objects' trees prepared for trace/inside */
     int nlight_groups;    /* light_group ids handed out */
     void *files;          /* sdl_file: every #fopen'ed file (closed at the end) */
+    void *fonts;          /* sdl_font_cache: the font files text{} opened (closed at the end) */
     long long ntokens;    /* tokens read so far (opt.max_tokens) */
     size_t build_bytes;   /* malloc'd work memory outside the arena (meshes being
                              built), counted against opt.max_memory */

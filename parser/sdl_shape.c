@@ -787,7 +787,7 @@ static void text_args(sdl_parser *p, scene_object *o, src_loc loc)
     }
     sdl_font_outline out;
     char why[256] = "";
-    pt_status st = sdl_font_text(path, str, offset, &out, why, sizeof why);
+    pt_status st = sdl_font_text((sdl_font_cache **)&p->fonts, path, str, offset, &out, why, sizeof why);
     free(path);
     if (st != PT_OK) {
         sdl_error(p, loc, st, "text: font '%s': %s", font, why);

@@ -406,6 +406,25 @@ static void test_text(void **st)
     assert_int_equal(w.s->objects[0]->kind, SHAPE_TEXT);
     assert_int_equal(w.s->objects[0]->u.text->nsegments, nseg);
     done(&w);
+    /* one parse keeps each font file open for all its texts: the outlines
+     * are those of separate parses, whatever the face set before */
+    if (access("/usr/share/povray-3.7/include/cyrvetic.ttf", R_OK) != 0) return;
+    world a = build("text { ttf \"timrom.ttf\" \"AVA\" 0.25, 0 }");
+    world b = build("text { ttf \"cyrvetic.ttf\" \"Wo\" 0.5, <0.1,0,0> }");
+    w = build("text { ttf \"timrom.ttf\" \"I-I\" 0.25, 0 }"
+              "text { ttf \"cyrvetic.ttf\" \"Wo\" 0.5, <0.1,0,0> }"
+              "text { ttf \"timrom.ttf\" \"AVA\" 0.25, 0 }");
+    assert_int_equal(w.s->nobjects, 3);
+    const scene_text *want[3] = {NULL, b.s->objects[0]->u.text, a.s->objects[0]->u.text};
+    for (int i = 1; i < 3; i++) {
+        const scene_text *got = w.s->objects[i]->u.text;
+        assert_int_equal(got->nsegments, want[i]->nsegments);
+        assert_true(memcmp(got->segments, want[i]->segments, sizeof *got->segments * (size_t)got->nsegments) == 0);
+    }
+    assert_int_equal(w.s->objects[0]->u.text->nsegments, nseg);
+    done(&w);
+    done(&a);
+    done(&b);
 }
 
 /* ------------------------------------------------------------ superellipsoid */
