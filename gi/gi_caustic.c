@@ -796,10 +796,14 @@ static void gbuf_row(void *ctx, int y, int thread)
             v3_store_f(px->n, n);
             px->brilliance = c->hk.brilliance ? (float)c->hk.brilliance(c->hk.ctx, &h, d) : 1.0f;
             c->gobj[k] = h.obj;
-            /* footprint: the neighbouring pixels' rays at the same distance */
+            /* footprint: the distance to the neighbouring pixels' rays at
+             * the same distance, so a lookup at this point takes its own
+             * splatted value alone and one between points a tent mix of
+             * the nearest (gi_caustic_at); a wider footprint blurred
+             * every pixel's caustic with its neighbours' */
             double t = h.t;
             double f1 = v3_len(v3_sub(v3_madd(o1, d1, t), h.p)), f2 = v3_len(v3_sub(v3_madd(o2, d2, t), h.p));
-            c->grad[k] = (float)fmax(1.5 * fmax(f1, f2), 1e-6 * (t + 1.0));
+            c->grad[k] = (float)fmax(fmax(f1, f2), 1e-6 * (t + 1.0));
             break;
         }
     }
