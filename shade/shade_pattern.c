@@ -350,9 +350,8 @@ static inline void nearest3_put(double s, int i, double *m1, double *m2, double 
     }
 }
 
-#define CRACKLE_SLOTS 64u /* per thread, 81 points each: 124 KiB */
-#define CRACKLE_N 81      /* the points; 82 stored, the last a copy of the first */
-typedef double crackle_v2 __attribute__((vector_size(16)));
+#define CRACKLE_SLOTS 64u /* per thread, 81 points each: about 122 KiB */
+#define CRACKLE_N 81      /* the points */
 static double crackle(const scene_pattern *pat, vec3 p, int gen)
 {
     int fx = shade_noise_to_int(floor(p.x - PAT_EPSILON)), fy = shade_noise_to_int(floor(p.y - PAT_EPSILON)),
@@ -363,13 +362,12 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
      * for the last few cubes visited (they depend on the cube alone), as
      * POV-Ray's crackle cache does: a ray marching an isosurface or a
      * pixel's neighbours stay in one cube for many evaluations. The points
-     * are kept by coordinate (x[], y[], z[]) so that the default metric's
-     * squared distances are taken two at a time. */
+     * are kept by coordinate (x[], y[], z[]). */
     static _Thread_local struct {
         int valid, fx, fy, fz;
-        _Alignas(16) double x[CRACKLE_N + 1];
-        _Alignas(16) double y[CRACKLE_N + 1];
-        _Alignas(16) double z[CRACKLE_N + 1];
+        double x[CRACKLE_N];
+        double y[CRACKLE_N];
+        double z[CRACKLE_N];
     } cache[CRACKLE_SLOTS];
     unsigned slot = ((unsigned)fx * 73856093u ^ (unsigned)fy * 19349663u ^ (unsigned)fz * 83492791u) % CRACKLE_SLOTS;
     const double *X = cache[slot].x, *Y = cache[slot].y, *Z = cache[slot].z;
@@ -385,9 +383,6 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
                         cache[slot].z[n] = q.z;
                         n++;
                     }
-        cache[slot].x[CRACKLE_N] = cache[slot].x[0];
-        cache[slot].y[CRACKLE_N] = cache[slot].y[0];
-        cache[slot].z[CRACKLE_N] = cache[slot].z[0];
         cache[slot].valid = 1;
         cache[slot].fx = fx;
         cache[slot].fy = fy;
@@ -396,18 +391,7 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
     double m1, m2, m3, t;
     int mi = 0;
     if (metric == 2) {
-        /* the common metric 2 (the default): the squared distances two at
-         * a time (each lane the scalar sum dx dx + dy dy + dz dz), then
-         * one comparison with m3 for most points */
-        double sq[CRACKLE_N + 1];
-        crackle_v2 px = {p.x, p.x}, py = {p.y, p.y}, pz = {p.z, p.z};
-        for (int i = 0; i < CRACKLE_N + 1; i += 2) {
-            crackle_v2 dx = *(const crackle_v2 *)(X + i) - px, dy = *(const crackle_v2 *)(Y + i) - py,
-                       dz = *(const crackle_v2 *)(Z + i) - pz;
-            crackle_v2 s2 = dx * dx + dy * dy + dz * dz;
-            sq[i] = s2[0];
-            sq[i + 1] = s2[1];
-        }
+        /* the common metric 2 (the default) */
         /* The cube's own point and its six face neighbours (table
          * indices) bound the third-nearest square from above by their own
          * third-smallest, u; a point beyond u cannot be among the three
@@ -419,14 +403,36 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
         static const int near7[7] = {40, 19, 61, 35, 45, 39, 41};
         double a = INFINITY, b = INFINITY, u = INFINITY;
         for (int k = 0; k < 7; k++) {
-            double v = sq[near7[k]], ab = a > v ? a : v, bb = b > v ? b : v;
+            int i = near7[k];
+            double dx = X[i] - p.x, dy = Y[i] - p.y, dz = Z[i] - p.z;
+            double v = dx * dx + dy * dy + dz * dz, ab = a > v ? a : v, bb = b > v ? b : v;
             u = u < bb ? u : bb;
             b = b < ab ? b : ab;
             a = a < v ? a : v;
         }
+        /* The 54 points of the cubes two away along an axis (side bits:
+         * x -2, +2, y -2, +2, z -2, +2) lie beyond that cube's near face,
+         * whose distance g from p bounds their coordinate difference; the
+         * rounded differences, squares and sums are monotone, so each such
+         * point's square is at least the rounded g^2 (a cube's point lies
+         * in [c, c + 1]: pattern_rands are in [0, 1)). A side whose g^2
+         * exceeds u has no point within u: its squares are not taken. */
+        static const unsigned char side[CRACKLE_N] = {
+            1, 1, 1, 1, 1, 1, 1, 1, 1, 4, 4, 4, 16, 0, 0, 0, 32, 16, 0, 0, 0, 32, 16, 0, 0, 0, 32,
+            8, 8, 8, 4, 4, 4, 16, 0, 0, 0, 32, 16, 0, 0, 0, 32, 16, 0, 0, 0, 32, 8, 8, 8, 4, 4, 4,
+            16, 0, 0, 0, 32, 16, 0, 0, 0, 32, 16, 0, 0, 0, 32, 8, 8, 8, 2, 2, 2, 2, 2, 2, 2, 2, 2};
+        double gxm = p.x - (double)(fx - 1), gxp = (double)(fx + 2) - p.x;
+        double gym = p.y - (double)(fy - 1), gyp = (double)(fy + 2) - p.y;
+        double gzm = p.z - (double)(fz - 1), gzp = (double)(fz + 2) - p.z;
+        unsigned skip = (unsigned)(gxm * gxm > u) | (unsigned)(gxp * gxp > u) << 1 | (unsigned)(gym * gym > u) << 2 |
+                        (unsigned)(gyp * gyp > u) << 3 | (unsigned)(gzm * gzm > u) << 4 | (unsigned)(gzp * gzp > u) << 5;
         m1 = m2 = m3 = INFINITY;
-        for (int i = 0; i < CRACKLE_N; i++)
-            if (sq[i] <= u && sq[i] < m3) nearest3_put(sq[i], i, &m1, &m2, &m3, &mi);
+        for (int i = 0; i < CRACKLE_N; i++) {
+            if (side[i] & skip) continue;
+            double dx = X[i] - p.x, dy = Y[i] - p.y, dz = Z[i] - p.z;
+            double sq = dx * dx + dy * dy + dz * dz;
+            if (sq <= u && sq < m3) nearest3_put(sq, i, &m1, &m2, &m3, &mi);
+        }
     } else if (metric > 0.0 && metric <= 32.0 && metric != 1 && metric != 3 && 2.0 * metric == floor(2.0 * metric)) {
         /* A metric of halves (2.5, 4, 6): each point's sum is first taken
          * with pow_half, whose relative error is far below 1e-12. The
