@@ -118,12 +118,23 @@ static double complex cderiv(const jf_data *f, double complex z)
     }
 }
 
+/* The direction e of a ray in the slice, as the complex pair: a step
+ * along e moves w by -(slice . e) / slice_w (lift). The same for every
+ * point of the ray, so taken once per ray. */
+static void jf_dir_pair(const jf_data *f, vec3 e, double complex dp[2])
+{
+    double dq[4] = {e.x, e.y, e.z, -(f->slice[0] * e.x + f->slice[1] * e.y + f->slice[2] * e.z) / f->slice[3]};
+    to_pair(dq, &dp[0], &dp[1]);
+}
+
 /* Inside test; when outside and `de` is given, a step estimate: for
  * quaternions POV-Ray's distance estimate |z| ln|z|^2 / (k^i prod |z_j|)
  * (k = 2 or 3); for hypercomplex numbers POV-Ray's rule F / (2 |dF/dt|)
- * along the ray direction e (F = |z|^2 at the escape, used only while the
- * ray approaches and the step stays within 1 to 30 precision steps), else 0. */
-static int jf_inside(const jf_data *f, vec3 p, vec3 e, double *de)
+ * along the ray direction (F = |z|^2 at the escape, used only while the
+ * ray approaches and the step stays within 1 to 30 precision steps), else 0.
+ * For hypercomplex numbers (da0, db0) is that direction lifted to the slice
+ * as the complex pair (jf_dir_pair), read only when `de` is given. */
+static int jf_inside(const jf_data *f, vec3 p, double complex da0, double complex db0, double *de)
 {
     double q[4];
     lift(f, p, q);
@@ -173,8 +184,8 @@ static int jf_inside(const jf_data *f, vec3 p, vec3 e, double *de)
     double complex a, b, da = 0, db = 0;
     to_pair(q, &a, &b);
     if (de) {
-        double dq[4] = {e.x, e.y, e.z, -(f->slice[0] * e.x + f->slice[1] * e.y + f->slice[2] * e.z) / f->slice[3]};
-        to_pair(dq, &da, &db);
+        da = da0;
+        db = db0;
     }
     if (f->func == JULIA_SQR) {
         /* the same iteration with the squares written out (no call per step) */
@@ -353,13 +364,15 @@ int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
     double s = sqrt(A);
     vec3 e = v3_scale(d, 1.0 / s), p0 = v3_madd(o, d, a);
     double len = (b - a) * s, tau = 0.0, de;
-    int cur = jf_inside(f, p0, e, &de), n = 0;
+    double complex dp[2] = {0, 0};
+    if (f->hyper) jf_dir_pair(f, e, dp);
+    int cur = jf_inside(f, p0, dp[0], dp[1], &de), n = 0;
     for (long guard = 0; tau < len && guard < 10000000; guard++) {
         if (n == max && a + tau / s > out[max - 1].t) break;
         double step = cur ? f->step : fmax_inline(de, f->step);
         double tn = fmin_inline(tau + step, len);
         double den;
-        int next = jf_inside(f, v3_madd(p0, e, tn), e, &den);
+        int next = jf_inside(f, v3_madd(p0, e, tn), dp[0], dp[1], &den);
         if (next != cur) {
             double lo = tau, hi = tn;
             /* POV-Ray polishes the crossing by bisection to Fractal_Tolerance
@@ -374,13 +387,13 @@ int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
                 double m = 0.5 * (lo + hi), ql = 0.5 * (lo + m), qh = 0.5 * (m + hi);
                 vec3 pts[3] = {v3_madd(p0, e, m), v3_madd(p0, e, ql), v3_madd(p0, e, qh)};
                 int r[3], lanes = jf_inside3(f, pts, r);
-                if (!lanes) r[0] = jf_inside(f, pts[0], e, NULL);
+                if (!lanes) r[0] = jf_inside(f, pts[0], 0, 0, NULL);
                 int in_m = r[0] == cur;
                 if (in_m) lo = m;
                 else hi = m;
                 if (++it >= 200 || !(hi - lo > FRACTAL_TOLERANCE)) break;
                 double m2 = 0.5 * (lo + hi); /* qh after lo = m, ql after hi = m */
-                int r2 = lanes && m2 == (in_m ? qh : ql) ? r[in_m ? 2 : 1] : jf_inside(f, v3_madd(p0, e, m2), e, NULL);
+                int r2 = lanes && m2 == (in_m ? qh : ql) ? r[in_m ? 2 : 1] : jf_inside(f, v3_madd(p0, e, m2), 0, 0, NULL);
                 if (r2 == cur) lo = m2;
                 else hi = m2;
                 ++it;
@@ -399,7 +412,7 @@ int geom_fractal_inside(const geom_shape *sh, vec3 q)
 {
     const jf_data *f = sh->data;
     if (!f || v3_len2(q) > f->R * f->R) return 0;
-    return jf_inside(f, q, v3(0, 0, 1), NULL);
+    return jf_inside(f, q, 0, 0, NULL);
 }
 
 /* Gradient of |z_N|^2 with respect to (x, y, z): z0 moves along the slice. */
