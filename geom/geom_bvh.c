@@ -38,6 +38,7 @@ static int split(builder *bd, int first, int count, int depth)
     }
     b->nodes[id].lo = lo;
     b->nodes[id].hi = hi;
+    b->nodes[id].pad = 1e-9 * v3_maxc(v3_sub(hi, lo)) + 1e-300;
     b->nodes[id].left = b->nodes[id].right = -1;
     b->nodes[id].first = first;
     b->nodes[id].count = count;
@@ -117,13 +118,13 @@ typedef struct {
 
 /* Whether the node's box meets the query: the ray stretch (the box padded
  * by 1e-9 of its size, so that a crossing on a face is not lost to
- * rounding) or the point. */
+ * rounding; the padding taken once, when the node is built) or the point. */
 static int node_meets(const geom_bvh_node *nd, const bvh_query *q)
 {
     if (!q->ray)
         return !(q->o.x < nd->lo.x || q->o.x > nd->hi.x || q->o.y < nd->lo.y || q->o.y > nd->hi.y ||
                  q->o.z < nd->lo.z || q->o.z > nd->hi.z);
-    double pad = 1e-9 * v3_maxc(v3_sub(nd->hi, nd->lo)) + 1e-300;
+    double pad = nd->pad;
     double a = q->tmin, b = q->tmax;
     for (int k = 0; k < 3; k++) {
         double o = v3_idx(q->o, k), lo = v3_idx(nd->lo, k) - pad, hi = v3_idx(nd->hi, k) + pad;

@@ -12,6 +12,7 @@ typedef struct {
     vec3 lo, hi;
     int left, right;  /* children; -1 for a leaf */
     int first, count; /* leaf: its items are order[first .. first + count) */
+    double pad;       /* a ray query's padding of the box (geom_bvh.c, node_meets) */
 } geom_bvh_node;
 
 typedef struct {
