@@ -1306,6 +1306,29 @@ static void test_settings_from_radiosity(void **state)
     assert_true(fabs(s.radius_factor - 2.0) < 1e-12);
     assert_true(fabs(s.brightness - 1.5) < 1e-12);
     tg_unload(&f);
+    /* the final gather's side: sqrt(count x nearest_count / 2.5) within
+     * [6, 20] without further bounces; below error_bound 0.1 every pixel
+     * gathers unfiltered at 1.8 times that side, at most GI_DENSE_SIDE_MAX
+     * (stackerday.pov's block: count 400, nearest_count 1, 0.05; count 100 with
+     * nearest_count 5: 14 -> 25) */
+    static const struct { double eb; int nc, side, stride; } want[] = {{0.1, 1, 20, 2}, {0.05, 1, 36, 1},
+                                                                       {0.05, 5, 25, 1}, {0.5, 5, 20, 2}};
+    for (size_t k = 0; k < sizeof want / sizeof want[0]; k++) {
+        char text[512];
+        snprintf(text, sizeof text,
+                 "#version 3.7;\nglobal_settings { radiosity { count %d recursion_limit 1 nearest_count %d "
+                 "error_bound %g } }\ncamera { location <0,0,-3> look_at 0 }\nsphere { 0, 1 }\n",
+                 k == 2 ? 100 : 400, want[k].nc, want[k].eb);
+        tg_load(&f, text);
+        gi_particle_settings_from_scene(&s, f.sc);
+        printf("  error_bound %g, nearest_count %d: gather side %d (want %d), stride %d\n", want[k].eb, want[k].nc,
+               s.view_gather_side, want[k].side, s.view_gather_stride);
+        assert_int_equal(s.view_gather_side, want[k].side);
+        assert_int_equal(s.view_gather_stride, want[k].stride);
+        gi_particle_scale_quality(&s, 4.0); /* the quality knob still raises a dense side */
+        assert_true(s.view_gather_side >= want[k].side);
+        tg_unload(&f);
+    }
 }
 
 /* ------------------------------------------------------------------ shared radiance particles */
