@@ -536,14 +536,6 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
     }
 }
 
-/* A crossing query (q->cross set, ray r its Embree ray) on a scene whose
- * only geometry is the user geometry, without Embree's traversal: each
- * primitive whose box the ray's interval meets is asked as the traversal's
- * leaf would ask it (accel_user_intersect, which in collect mode reports
- * no hit, so the traversal visits every such leaf and prunes nothing by
- * distance). The crossings are the same whatever the order; the caller
- * sorts them. For a handful of primitives the loop costs less than the
- * traversal's set-up and node tests. */
 /* Whether the ray from org with reciprocal direction inv misses box b (6
  * floats) within [tn, tf]: user_box_missed's test where no slab end is
  * NaN (every reciprocal finite), so that plain minima and maxima do. */
@@ -564,6 +556,14 @@ static inline int box_missed_finite(const float *b, const float org[3], const fl
     return tn > tf + 1e-5f * fabsf(tf) + 1e-30f;
 }
 
+/* A crossing query (q->cross set, ray r its Embree ray) on a scene whose
+ * only geometry is the user geometry, without Embree's traversal: each
+ * primitive whose box the ray's interval meets is asked as the traversal's
+ * leaf would ask it (accel_user_intersect, which in collect mode reports
+ * no hit, so the traversal visits every such leaf and prunes nothing by
+ * distance). The crossings are the same whatever the order; the caller
+ * sorts them. For a handful of primitives the loop costs less than the
+ * traversal's set-up and node tests. */
 void accel_user_cross_all(const accel *a, accel_query *q, const struct RTCRay *r)
 {
     unsigned np = (unsigned)(a->nshapes + a->ncsgs);

@@ -470,6 +470,17 @@ static double normal_reach(const gi_caustic *c, double rxy)
     return isfinite(z) && z > 0.0 ? fmin(z, rxy) : 0.25 * rxy;
 }
 
+/* A photon volume's radii from its in-plane radius: r_xy, the reach off
+ * its surface (normal_reach) and their inverse squares. */
+static void set_radii(const gi_caustic *c, gi_caus_photon *q, double rxy)
+{
+    double rz = normal_reach(c, rxy);
+    q->r_xy = (float)rxy;
+    q->r_z = (float)rz;
+    q->inv_rxy2 = (float)(1.0 / (rxy * rxy));
+    q->inv_rz2 = (float)(1.0 / (rz * rz));
+}
+
 static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_out *out)
 {
     const scene_light *l = cb->l;
@@ -574,17 +585,13 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
             double k = att * (cb->parallel ? 1.0 : depth * depth);
             double sd = cb->parallel ? sqrt(cb->cell) : depth * sqrt(cb->cell);
             double rxy = fmin(RADIUS_K * sd / sqrt(br.rho_p), c->r_max);
-            double rz = normal_reach(c, rxy);
             vec3 np = v3_dot(h.ng, br.w) < 0.0 ? h.ng : v3_neg(h.ng), wq = pov_photon_dir(v3_neg(br.w));
-            gi_caus_photon q = {{(float)h.p.x, (float)h.p.y, (float)h.p.z},
-                                (float)rxy,
-                                {(float)np.x, (float)np.y, (float)np.z},
-                                (float)rz,
-                                {(float)wq.x, (float)wq.y, (float)wq.z},
-                                (float)(1.0 / (rxy * rxy)),
-                                {(float)(cb->phi0.r * br.tr.r * k), (float)(cb->phi0.g * br.tr.g * k),
-                                 (float)(cb->phi0.b * br.tr.b * k)},
-                                (float)(1.0 / (rz * rz))};
+            gi_caus_photon q = {.x = {(float)h.p.x, (float)h.p.y, (float)h.p.z},
+                                .n = {(float)np.x, (float)np.y, (float)np.z},
+                                .w = {(float)wq.x, (float)wq.y, (float)wq.z},
+                                .phi = {(float)(cb->phi0.r * br.tr.r * k), (float)(cb->phi0.g * br.tr.g * k),
+                                        (float)(cb->phi0.b * br.tr.b * k)}};
+            set_radii(c, &q, rxy);
             if (rxy > 0.0 && isfinite(q.phi[0] + q.phi[1] + q.phi[2]) && cmax3(crgb(q.phi[0], q.phi[1], q.phi[2])) > 0.0)
                 if (!push_photon(out, &q, sf & GI_CAUSTIC_RECEIVES ? STORE_SPLAT : STORE_HIGHLIGHT)) {
                     out->oom = 1;
@@ -1162,13 +1169,7 @@ static int widen_sparse(gi_caustic *c, int threads)
     }
     if (ok) {
         for (long i = 0; i < c->nph; i++) {
-            gi_caus_photon *q = &c->ph[i];
-            double r = wj.r[i];
-            q->r_xy = (float)r;
-            double rz = normal_reach(c, r);
-            q->r_z = (float)rz;
-            q->inv_rxy2 = (float)(1.0 / (r * r));
-            q->inv_rz2 = (float)(1.0 / (rz * rz));
+            set_radii(c, &c->ph[i], wj.r[i]);
         }
         c->st.widened = atomic_load(&wj.widened);
     }
