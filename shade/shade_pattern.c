@@ -321,6 +321,21 @@ static double metric_sum(vec3 d, double metric)
     return pow(fabs(d.x), metric) + pow(fabs(d.y), metric) + pow(fabs(d.z), metric);
 }
 
+/* Crackle's candidate points (CRACKLE_N, in table order): the indices of
+ * the cube's own point and its six face neighbours', whose third-nearest
+ * distance bounds the full scan's. */
+static const int near7[7] = {40, 19, 61, 35, 45, 39, 41};
+
+/* a <= b <= u: the three smallest of the values given so far, without
+ * branches (a sorted insertion mispredicts at every new minimum). */
+static inline void keep3(double v, double *a, double *b, double *u)
+{
+    double ab = *a > v ? *a : v, bb = *b > v ? *b : v;
+    *u = *u < bb ? *u : bb;
+    *b = *b < ab ? *b : ab;
+    *a = *a < v ? *a : v;
+}
+
 /* x^(k/2) for a whole k in [1, 64], by products and at most one root: a
  * cheap stand-in for pow(x, k / 2.0) within a few units of rounding (at
  * most about a dozen roundings), used only to rule points out */
@@ -400,15 +415,11 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
          * insertion at every new minimum mispredicts). The result is the
          * unbounded scan's: the three smallest values and the first index
          * of the smallest. */
-        static const int near7[7] = {40, 19, 61, 35, 45, 39, 41};
         double a = INFINITY, b = INFINITY, u = INFINITY;
         for (int k = 0; k < 7; k++) {
             int i = near7[k];
             double dx = X[i] - p.x, dy = Y[i] - p.y, dz = Z[i] - p.z;
-            double v = dx * dx + dy * dy + dz * dz, ab = a > v ? a : v, bb = b > v ? b : v;
-            u = u < bb ? u : bb;
-            b = b < ab ? b : ab;
-            a = a < v ? a : v;
+            keep3(dx * dx + dy * dy + dz * dz, &a, &b, &u);
         }
         /* The 54 points of the cubes two away along an axis (side bits:
          * x -2, +2, y -2, +2, z -2, +2) lie beyond that cube's near face,
@@ -444,16 +455,12 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
          * full scan keeps them (the three smallest values, the first index
          * of the smallest); the 1e-300 covers subnormal terms. */
         int k = (int)(2.0 * metric);
-        static const int near7[7] = {40, 19, 61, 35, 45, 39, 41};
         double a = INFINITY, b = INFINITY, u = INFINITY;
         for (int j = 0; j < 7; j++) {
             int i = near7[j];
             double v = (pow_half(fabs(X[i] - p.x), k) + pow_half(fabs(Y[i] - p.y), k) + pow_half(fabs(Z[i] - p.z), k)) *
                            (1.0 + 1e-12) + 1e-300;
-            double ab = a > v ? a : v, bb = b > v ? b : v;
-            u = u < bb ? u : bb;
-            b = b < ab ? b : ab;
-            a = a < v ? a : v;
+            keep3(v, &a, &b, &u);
         }
         /* a coordinate beyond u^(1/metric) alone puts a point past u */
         double cu = pow(u, 1.0 / metric) * (1.0 + 1e-12);
