@@ -468,13 +468,60 @@ __attribute__((always_inline)) static inline void cross_prim(const accel *a, acc
     }
 }
 
-void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
+/* accel_user_intersect on a query's single exact ray (N = 1, the query
+ * its context): its crossings (q->cross) or its nearest hit in q. */
+__attribute__((always_inline)) static inline void intersect_one(const struct RTCIntersectFunctionNArguments *args,
+                                                               const accel *a, accel_query *q)
+{
+    unsigned prim = args->primID;
+    if (prim >= (unsigned)(a->nshapes + a->ncsgs) || args->valid[0] != -1) return;
+    float *ray = (float *)args->rayhit, *hit = ray + 12;
+    if (a->ubox && a->ubox_test[prim] && user_box_missed(a, prim, ray, 1, 0)) return;
+    if (q->cross) {
+        cross_prim(a, q, prim, q->org, q->dir, q->tmin);
+        return;
+    }
+    /* the nearest hit so far is the exact one of the query: a float tfar
+     * rounded up past a second surface within an ulp (a liquid 1e-8 inside
+     * its glass) would let that farther surface win, and which one did
+     * would depend on the traversal order */
+    double tmax = (double)ray[8];
+    double tie = q->uhit ? tie_window(q->ut) : 0.0;
+    if (q->uhit && q->ut + tie < tmax) tmax = q->ut + tie;
+    geom_csg_hit h;
+    if (!accel_prim_hit(a, prim, q->org, q->dir, q->tmin, tmax, &h, q->rule)) return;
+    /* two surfaces of different primitives at one distance within the
+     * rounding of their intersections (a box standing on a plane, seen
+     * through its bottom): the tie goes to one of them by the ray's hash,
+     * either about as often (tie_first) */
+    if (q->uhit && h.t >= q->ut - tie && !tie_takes(a, q, prim)) return;
+    /* rounded up: a nearer candidate within the ulp is still tried */
+    ray[8] = nextafterf((float)h.t, INFINITY);
+    q->ut = h.t;
+    q->upart = h.part;
+    q->ushape = h.shape;
+    q->uflip = h.flip;
+    q->uprim = prim;
+    q->uhit = 1;
+    /* the record as intersect_lanes writes it; the query's reader takes
+     * the hit from q */
+    hit[0] = hit[1] = hit[2] = 0.0f;
+    hit[3] = prim < (unsigned)a->nshapes ? 0.0f : (float)h.shape;
+    hit[4] = 0.0f;
+    ((unsigned *)hit)[5] = prim;
+    ((unsigned *)hit)[6] = args->geomID;
+    ((unsigned *)hit)[7] = args->context->instID[0];
+}
+
+/* accel_user_intersect on a packet or stream of N rays, or a ray traced
+ * without our query (a benchmark's bare Embree calls, the particle GI's
+ * link rays): the rays' floats. */
+static __attribute__((noinline)) void intersect_lanes(const struct RTCIntersectFunctionNArguments *args)
 {
     const accel *a = args->geometryUserPtr;
     accel_query *q = accel_tls_query;
     unsigned N = args->N;
     int ours = q && (void *)q == (void *)args->context;
-    int exact = ours && !q->packet && N == 1;
     geom_ray_rule rule = query_rule(ours ? q : NULL);
     void *ray = args->rayhit;
     float *hit = (float *)args->rayhit + 12 * (size_t)N;
@@ -482,46 +529,19 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
     const int box_test = a->ubox && a->ubox_test[args->primID];
     for (unsigned i = 0; i < N; i++) {
         if (args->valid[i] != -1 || (box_test && box_missed(a, args->primID, ray, N, i))) continue;
-        float tfar = SOA_F(ray, N, i, 8);
         vec3 o, d;
         double tmin;
-        user_ray(exact ? q : NULL, ray, N, i, &o, &d, &tmin);
-        if (exact && q->cross) {
-            cross_prim(a, q, args->primID, o, d, tmin);
-            continue;
-        }
-        /* the nearest hit so far is the exact one of the query: a float
-         * tfar rounded up past a second surface within an ulp (a liquid
-         * 1e-8 inside its glass) would let that farther surface win, and
-         * which one did would depend on the traversal order */
-        double tmax = (double)tfar;
-        double tie = exact && q->uhit ? tie_window(q->ut) : 0.0;
-        if (exact && q->uhit && q->ut + tie < tmax) tmax = q->ut + tie;
+        user_ray(NULL, ray, N, i, &o, &d, &tmin);
         geom_csg_hit h;
-        if (!accel_prim_hit(a, args->primID, o, d, tmin, tmax, &h, rule)) continue;
-        /* two surfaces of different primitives at one distance within the
-         * rounding of their intersections (a box standing on a plane, seen
-         * through its bottom): the tie goes to one of them by the ray's
-         * hash, either about as often (tie_first) */
-        if (exact && q->uhit && h.t >= q->ut - tie && !tie_takes(a, q, args->primID)) continue;
-        /* rounded up: a nearer candidate within the ulp is still tried */
-        SOA_F(ray, N, i, 8) = exact ? nextafterf((float)h.t, INFINITY) : (float)h.t;
-        vec3 ng = v3(0, 0, 0);
-        if (exact) {
-            q->ut = h.t;
-            q->upart = h.part;
-            q->ushape = h.shape;
-            q->uflip = h.flip;
-            q->uprim = args->primID;
-            q->uhit = 1;
-        } else {
-            /* the normal only: the surface's (u, v) (a sphere's two
-             * inverse trigonometric calls) has no reader in a packet's or
-             * stream's record, where u and v hold Embree's barycentrics
-             * for triangles only */
-            geom_shape_surface(accel_prim_shape(a, args->primID, h.shape), v3_madd(o, d, h.t), h.part, &ng, NULL, NULL);
-            if (h.flip) ng = v3_neg(ng);
-        }
+        if (!accel_prim_hit(a, args->primID, o, d, tmin, (double)SOA_F(ray, N, i, 8), &h, rule)) continue;
+        SOA_F(ray, N, i, 8) = (float)h.t;
+        /* the normal only: the surface's (u, v) (a sphere's two inverse
+         * trigonometric calls) has no reader in a packet's or stream's
+         * record, where u and v hold Embree's barycentrics for triangles
+         * only */
+        vec3 ng;
+        geom_shape_surface(accel_prim_shape(a, args->primID, h.shape), v3_madd(o, d, h.t), h.part, &ng, NULL, NULL);
+        if (h.flip) ng = v3_neg(ng);
         SOA_F(hit, N, i, 0) = (float)ng.x;
         SOA_F(hit, N, i, 1) = (float)ng.y;
         SOA_F(hit, N, i, 2) = (float)ng.z;
@@ -534,6 +554,19 @@ void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
         SOA_U(hit, N, i, 6) = args->geomID;
         SOA_U(hit, N, i, 7) = args->context->instID[0];
     }
+}
+
+void accel_user_intersect(const struct RTCIntersectFunctionNArguments *args)
+{
+    const accel *a = args->geometryUserPtr;
+    accel_query *q = accel_tls_query;
+    /* a query's single ray (every traced ray's nearest hit, every
+     * filtered shadow ray's walk) */
+    if (args->N == 1 && q && (void *)q == (void *)args->context && !q->packet) {
+        intersect_one(args, a, q);
+        return;
+    }
+    intersect_lanes(args);
 }
 
 /* Whether the ray from org with reciprocal direction inv misses box b (6

@@ -48,6 +48,23 @@ static double tightness_power(double x, double tightness)
     return tightness == 0.0 ? 1.0 : tightness == 1.0 ? x : pow(x, tightness);
 }
 
+/* x^e of a highlight (x in (0, 1], e > 0): pow's value, without the call
+ * where that value is 0. At or below 2^(-1100 / e), x^e is at most 2^-1100,
+ * far below half the smallest subnormal (2^-1075), which glibc's pow rounds
+ * to 0 (its results are within about half an ulp, also where they
+ * underflow). A tight highlight (specular's 1/roughness of 1000) has
+ * x^e = 0 over half the directions; the bound is kept for the last
+ * exponent this thread asked about. */
+static double highlight_power(double x, double e)
+{
+    static _Thread_local double last = NAN, below = 0.0;
+    if (!(e == last)) {
+        below = e > 0.0 && isfinite(e) ? exp2(-1100.0 / e) : 0.0;
+        last = e;
+    }
+    return x <= below ? 0.0 : pow(x, e);
+}
+
 double shade_light_attenuation(const scene_light *l, vec3 p, vec3 dir, double depth)
 {
     double att = 1.0;
@@ -157,7 +174,7 @@ static rgb light_terms_plain(const shade_light_surface *s, vec3 l, rgb lc, int b
         vec3 refl = v3_madd(s->eye, s->n, -2.0 * v3_dot(s->eye, s->n));
         double ca = v3_dot(refl, l);
         if (ca > 0.0 && (f->phong_size < 60 || ca > 0.0008)) {
-            double intensity = f->phong * pow(ca, f->phong_size);
+            double intensity = f->phong * highlight_power(ca, f->phong_size);
             rgb cs = {1, 1, 1};
             mirror_metallic_tint(&cs, f->metallic, s->pigment, v3_dot(s->n, l));
             out = lrgb_add(out, lrgb_scale(lrgb_mul(lc, cs), intensity));
@@ -171,7 +188,7 @@ static rgb light_terms_plain(const shade_light_surface *s, vec3 l, rgb lc, int b
             if (ca > 0.0) {
                 /* POV-Ray stores 1/roughness as the exponent. */
                 double rough = f->roughness > 0.0 ? f->roughness : 0.05;
-                double intensity = f->specular * pow(ca, 1.0 / rough);
+                double intensity = f->specular * highlight_power(ca, 1.0 / rough);
                 rgb cs = {1, 1, 1};
                 mirror_metallic_tint(&cs, f->metallic, s->pigment, v3_dot(h, l) / hl);
                 out = lrgb_add(out, lrgb_scale(lrgb_mul(lc, cs), intensity));

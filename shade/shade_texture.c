@@ -671,15 +671,35 @@ static rgb shadow_layers(const scene_texture *tex, vec3 point, const shade_patte
     return c;
 }
 
+/* Whether shadow_layers(tex, ..) with no faked caustics is a constant: no
+ * blend map at the top and every layer's pigment a plain colour. */
+static int shadow_layers_plain(const scene_texture *tex)
+{
+    if (tex->pat && tex->map && tex->map->n > 0) return 0;
+    for (const scene_texture *l = tex; l; l = l->next)
+        if (l->pigment.kind == PIGMENT_PATTERN && l->pigment.pat) return 0;
+    return 1;
+}
+
 rgb shade_tex_shadow_filter_inside(const scene *sc, const accel_hit *h, vec3 dir, int inside)
 {
     int entering = v3_dot(dir, h->ng) < 0.0;
     const scene_texture *tex = hit_texture(sc, h, entering);
+    const scene_interior *in = h->obj ? h->obj->interior : NULL;
+    if (!(in && in->caustics != 0.0) && shadow_layers_plain(tex)) {
+        /* shadow_layers' products over the layers' colours, without the
+         * pattern context no plain colour reads */
+        rgb c = {1, 1, 1};
+        for (const scene_texture *l = tex; l; l = l->next) {
+            colour5 lc = l->pigment.colour;
+            c = tmul(c, trgb(lc.r * lc.f + lc.t, lc.g * lc.f + lc.t, lc.b * lc.f + lc.t));
+        }
+        return inside ? tmul(c, transmit_fade(in, h->t, 1)) : c;
+    }
     shade_pattern_ctx pc = shade_pattern_ctx_plain(sc);
     ctx_from_hit(&pc, h);
     pc.normal = h->ns;
     pc.dir = dir;
-    const scene_interior *in = h->obj ? h->obj->interior : NULL;
     vec3 raw = h->ns;
     if (v3_dot(raw, dir) > 0.0) raw = v3_neg(raw);
     rgb c = shadow_layers(tex, texture_point(h), &pc, 0, in ? in->caustics : 0.0, raw, dir);
