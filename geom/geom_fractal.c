@@ -31,6 +31,7 @@ typedef struct {
     double inv_s3;        /* 1 / slice[3] where that is exact (a power of two), else 0 */
     double R, exit;       /* bounding radius, bailout on |z|^2 */
     double complex ca, cb; /* c as the complex pair (hypercomplex) */
+    double rho;           /* every point farther from the centre escapes (jf_escape_radius); 0: none known */
 } jf_data;
 
 /* The slice: z0 = (x, y, z, w(x, y, z)). */
@@ -313,6 +314,37 @@ static int jf_inside3(const jf_data *f, const vec3 p[3], int res[3])
     return 1;
 }
 
+/* A radius beyond which every point escapes within max_iteration, for the
+ * iterations z -> z^k + c (k = 2, 3) whose norm grows as |z|^k:
+ * |z^k + c| >= |z|^k - |c|, and g(r) = r^k - |c| is increasing, so a start
+ * with |z_0| > g^-(n-1)(E) has |z_(n-1)| > E. Quaternions: the norm is
+ * multiplicative, E^2 the bailout. Hypercomplex numbers: the complex pair
+ * (a, b) iterates a -> a^k + ca and b -> b^k + cb apart, with
+ * |z|^2 = (|a|^2 + |b|^2) / 2, so the larger of |a|, |b| is at least |z|
+ * and alone exceeds the bailout once its square passes twice it. The
+ * lifted point's norm is at least the 3-D point's (lift adds w). The
+ * radius is widened by a relative 1e-6, far beyond the rounding of the
+ * iteration, so a point past it escapes in floating point as well. Returns
+ * 0 for the other functions or where the radius is not below R. */
+static double jf_escape_radius(const jf_data *f)
+{
+    const int cube = f->func == JULIA_CUBE;
+    if (f->hyper && f->func != JULIA_SQR && !cube) return 0.0;
+    double c, E;
+    if (f->hyper) {
+        c = fmax(cabs(f->ca), cabs(f->cb));
+        E = sqrt(2.0 * f->exit);
+    } else {
+        /* jf_inside iterates the square for every quaternion function but the cube */
+        c = sqrt(f->c[0] * f->c[0] + f->c[1] * f->c[1] + f->c[2] * f->c[2] + f->c[3] * f->c[3]);
+        E = sqrt(f->exit);
+    }
+    double r = E;
+    for (int i = 1; i < f->n; i++) r = cube ? cbrt(r + c) : sqrt(r + c);
+    r *= 1.0 + 1e-6;
+    return isfinite(r) && r < f->R ? r : 0.0;
+}
+
 int geom_fractal_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
 {
     const scene_julia *j = o->u.julia;
@@ -342,6 +374,7 @@ int geom_fractal_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
         f->exit = 16.0;
         to_pair(f->c, &f->ca, &f->cb);
     }
+    f->rho = jf_escape_radius(f);
     *lo = v3s(-f->R);
     *hi = v3s(f->R);
     sh->data = f;
@@ -364,10 +397,21 @@ int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
     double s = sqrt(A);
     vec3 e = v3_scale(d, 1.0 / s), p0 = v3_madd(o, d, a);
     double len = (b - a) * s, tau = 0.0, de;
+    /* the march's points follow POV-Ray's from the bounding sphere on, but
+     * it ends where the ray leaves the ball every point beyond which
+     * escapes: past it every answer is outside and no crossing follows */
+    double end = len;
+    if (f->rho > 0.0) {
+        double pb = v3_dot(p0, e), pd = pb * pb - (v3_dot(p0, p0) - f->rho * f->rho);
+        if (!(pd > 0.0)) return 0;
+        double sd = sqrt(pd);
+        if (!(-pb + sd > 0.0) || !(-pb - sd < len)) return 0;
+        end = fmin_inline(len, -pb + sd);
+    }
     double complex dp[2] = {0, 0};
     if (f->hyper) jf_dir_pair(f, e, dp);
     int cur = jf_inside(f, p0, dp[0], dp[1], &de), n = 0;
-    for (long guard = 0; tau < len && guard < 10000000; guard++) {
+    for (long guard = 0; tau < end && guard < 10000000; guard++) {
         if (n == max && a + tau / s > out[max - 1].t) break;
         double step = cur ? f->step : fmax_inline(de, f->step);
         double tn = fmin_inline(tau + step, len);
@@ -411,7 +455,7 @@ int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
 int geom_fractal_inside(const geom_shape *sh, vec3 q)
 {
     const jf_data *f = sh->data;
-    if (!f || v3_len2(q) > f->R * f->R) return 0;
+    if (!f || v3_len2(q) > f->R * f->R || (f->rho > 0.0 && v3_len2(q) > f->rho * f->rho)) return 0;
     return jf_inside(f, q, 0, 0, NULL);
 }
 
