@@ -135,10 +135,14 @@ static void jf_dir_pair(const jf_data *f, vec3 e, double complex dp[2])
  * ray approaches and the step stays within 1 to 30 precision steps), else 0.
  * For hypercomplex numbers (da0, db0) is that direction lifted to the slice
  * as the complex pair (jf_dir_pair), read only when `de` is given. */
-static int jf_inside(const jf_data *f, vec3 p, double complex da0, double complex db0, double *de)
+static int jf_inside(const jf_data *f, double px, double py, double pz, double complex da0, double complex db0,
+                     double *de)
 {
+    /* the point as three numbers, not a vec3: a structure of three is
+     * passed through memory, and the march's caller stored it in pieces
+     * just before the callee loaded it whole, a stalled store forwarding */
     double q[4];
-    lift(f, p, q);
+    lift(f, v3(px, py, pz), q);
     if (de) *de = 0.0;
     if (!f->hyper && (f->func == JULIA_SQR || f->func == JULIA_CUBE)) {
         /* q^2 + c and q^3 + c written out as POV-Ray's Iteration_Julia and
@@ -242,6 +246,9 @@ static int jf_inside(const jf_data *f, vec3 p, double complex da0, double comple
     }
     return 1;
 }
+
+/* jf_inside without the step estimate */
+static int jf_at(const jf_data *f, vec3 p) { return jf_inside(f, p.x, p.y, p.z, 0, 0, NULL); }
 
 typedef double jf_v2 __attribute__((vector_size(16)));
 typedef long long jf_m2 __attribute__((vector_size(16))); /* a lane comparison: -1 or 0 */
@@ -410,13 +417,14 @@ int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
     }
     double complex dp[2] = {0, 0};
     if (f->hyper) jf_dir_pair(f, e, dp);
-    int cur = jf_inside(f, p0, dp[0], dp[1], &de), n = 0;
+    int cur = jf_inside(f, p0.x, p0.y, p0.z, dp[0], dp[1], &de), n = 0;
     for (long guard = 0; tau < end && guard < 10000000; guard++) {
         if (n == max && a + tau / s > out[max - 1].t) break;
         double step = cur ? f->step : fmax_inline(de, f->step);
         double tn = fmin_inline(tau + step, len);
         double den;
-        int next = jf_inside(f, v3_madd(p0, e, tn), dp[0], dp[1], &den);
+        vec3 pn = v3_madd(p0, e, tn);
+        int next = jf_inside(f, pn.x, pn.y, pn.z, dp[0], dp[1], &den);
         if (next != cur) {
             double lo = tau, hi = tn;
             /* POV-Ray polishes the crossing by bisection to Fractal_Tolerance
@@ -431,13 +439,13 @@ int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
                 double m = 0.5 * (lo + hi), ql = 0.5 * (lo + m), qh = 0.5 * (m + hi);
                 vec3 pts[3] = {v3_madd(p0, e, m), v3_madd(p0, e, ql), v3_madd(p0, e, qh)};
                 int r[3], lanes = jf_inside3(f, pts, r);
-                if (!lanes) r[0] = jf_inside(f, pts[0], 0, 0, NULL);
+                if (!lanes) r[0] = jf_at(f, pts[0]);
                 int in_m = r[0] == cur;
                 if (in_m) lo = m;
                 else hi = m;
                 if (++it >= 200 || !(hi - lo > FRACTAL_TOLERANCE)) break;
                 double m2 = 0.5 * (lo + hi); /* qh after lo = m, ql after hi = m */
-                int r2 = lanes && m2 == (in_m ? qh : ql) ? r[in_m ? 2 : 1] : jf_inside(f, v3_madd(p0, e, m2), 0, 0, NULL);
+                int r2 = lanes && m2 == (in_m ? qh : ql) ? r[in_m ? 2 : 1] : jf_at(f, v3_madd(p0, e, m2));
                 if (r2 == cur) lo = m2;
                 else hi = m2;
                 ++it;
@@ -456,7 +464,7 @@ int geom_fractal_inside(const geom_shape *sh, vec3 q)
 {
     const jf_data *f = sh->data;
     if (!f || v3_len2(q) > f->R * f->R || (f->rho > 0.0 && v3_len2(q) > f->rho * f->rho)) return 0;
-    return jf_inside(f, q, 0, 0, NULL);
+    return jf_at(f, q);
 }
 
 /* Gradient of |z_N|^2 with respect to (x, y, z): z0 moves along the slice. */
