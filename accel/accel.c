@@ -872,6 +872,20 @@ static void fill_rtc_ray(struct RTCRay *r, vec3 org, vec3 dir, double tmin, doub
     r->flags = 0;
 }
 
+
+void accel_mesh_uv(const scene_object *o, unsigned local, double bu, double bv, double uv[2])
+{
+    const scene_mesh *m = o->u.mesh.mesh;
+    uv[0] = uv[1] = 0.0;
+    if (!m || !m->uvs || !m->tri_uvs || (int)local >= m->ntris) return;
+    const int *ti = m->tri_uvs[local];
+    double w = 1.0 - bu - bv;
+    if (ti[0] >= 0 && ti[0] < m->nuvs && ti[1] >= 0 && ti[1] < m->nuvs && ti[2] >= 0 && ti[2] < m->nuvs) {
+        uv[0] = w * m->uvs[ti[0]][0] + bu * m->uvs[ti[1]][0] + bv * m->uvs[ti[2]][0];
+        uv[1] = w * m->uvs[ti[0]][1] + bu * m->uvs[ti[1]][1] + bv * m->uvs[ti[2]][1];
+    }
+}
+
 /* Triangle data in object space for a hit on leaf `l`, triangle `local`. */
 static void fill_triangle(const accel *a, const accel_leaf *l, unsigned local, double bu, double bv, double t_emb,
                           vec3 org, vec3 dir, accel_hit *hit)
@@ -941,18 +955,7 @@ static void fill_triangle(const accel *a, const accel_leaf *l, unsigned local, d
      * has ObjectBase::UVCoord's world x, y */
     hit->uv[0] = hit->p.x;
     hit->uv[1] = hit->p.y;
-    if (o->kind == SHAPE_MESH) {
-        const scene_mesh *m = o->u.mesh.mesh;
-        hit->uv[0] = hit->uv[1] = 0.0;
-        if (m->uvs && m->tri_uvs && (int)local < m->ntris) {
-            const int *ti = m->tri_uvs[local];
-            double w = 1.0 - bu - bv;
-            if (ti[0] >= 0 && ti[0] < m->nuvs && ti[1] >= 0 && ti[1] < m->nuvs && ti[2] >= 0 && ti[2] < m->nuvs) {
-                hit->uv[0] = w * m->uvs[ti[0]][0] + bu * m->uvs[ti[1]][0] + bv * m->uvs[ti[2]][0];
-                hit->uv[1] = w * m->uvs[ti[0]][1] + bu * m->uvs[ti[1]][1] + bv * m->uvs[ti[2]][1];
-            }
-        }
-    }
+    if (o->kind == SHAPE_MESH) accel_mesh_uv(o, local, bu, bv, hit->uv);
     hit->obj = o;
     hit->texture = tex;
     hit->prim = local;

@@ -228,6 +228,12 @@ const scene_object *accel_rtc_object(const accel *a, unsigned geom, unsigned pri
  * for other hits). Embree's u, v of such a hit weight the triangle's second
  * and third vertices, as accel_hit's do. */
 const scene_object *accel_rtc_object_tri(const accel *a, unsigned geom, unsigned prim, unsigned inst, unsigned *local);
+/* The (u, v) of mesh o's triangle `local` (its index among the mesh's own,
+ * as accel_rtc_object_tri gives it) at barycentrics bu, bv (weights of its
+ * second and third vertices): Mesh::UVCoord interpolates the corners'
+ * uv_vectors (mesh.cpp; <0,0> without uv_vectors). What a uv-mapped
+ * texture reads where a ray hits the mesh. */
+void accel_mesh_uv(const scene_object *o, unsigned local, double bu, double bv, double uv[2]);
 /* The leaf object a bare Embree hit lies on (geomID, primID, instID[0]
  * and u of its RTCHit), and its effective texture (*tex; the CSG parents'
  * when the leaf has none), for every hit accel_rtc_object answers and for

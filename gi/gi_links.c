@@ -72,12 +72,12 @@ static void hit_point(const struct RTCRayHit *h, vec3 *pt, vec3 *nrm)
     *nrm = n;
 }
 
-/* The material of object o at p (hit_point's, normal n): rho and le at
- * the pigment there (a sky dome's gradient, a terrain's colours; the
- * texture's base colour without a pigment function), and that pigment
+/* The material of object o at p (hit_point's, normal n, of ray h): rho
+ * and le at the pigment there (a sky dome's gradient, a terrain's colours;
+ * the texture's base colour without a pigment function), and that pigment
  * with its filter and transmit. */
-static void hit_material(const link_job *J, const scene_object *o, const scene_texture *tex, vec3 p, vec3 n,
-                         float rho[3], float le[3], colour5 *pigment)
+static void hit_material(const link_job *J, const struct RTCRayHit *h, const scene_object *o,
+                         const scene_texture *tex, vec3 p, vec3 n, float rho[3], float le[3], colour5 *pigment)
 {
     colour5 c, *cp = NULL;
     if (J->pig) {
@@ -90,6 +90,14 @@ static void hit_material(const link_job *J, const scene_object *o, const scene_t
         ah.flags = o->flags;
         ah.uv[0] = ah.p.x;
         ah.uv[1] = ah.p.y;
+        /* a mesh's uv_vectors where a uv-mapped texture reads them, as
+         * POV-Ray's radiosity rays shade their hits in full (a cloth's
+         * hem stripes, not the world's x and y) */
+        if (o->kind == SHAPE_MESH) {
+            unsigned local;
+            if (accel_rtc_object_tri(J->a, h->hit.geomID, h->hit.primID, h->hit.instID[0], &local) == o)
+                accel_mesh_uv(o, local, h->hit.u, h->hit.v, ah.uv);
+        }
         if (J->pig(J->sc, tex, &ah, &c) && isfinite(c.r) &&
             isfinite(c.g) && isfinite(c.b) && isfinite(c.f) && isfinite(c.t))
             cp = &c;
@@ -219,7 +227,7 @@ static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, 
     }
     if (!sky_term && !mt->glows && !mir && dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) return;
     colour5 pigment;
-    hit_material(J, o, tex, p, n, rho, le, &pigment);
+    hit_material(J, h, o, tex, p, n, rho, le, &pigment);
     /* no direct light where this pigment reflects nothing */
     if (!(rho[0] > 0.0f || rho[1] > 0.0f || rho[2] > 0.0f)) dir[0] = dir[1] = dir[2] = 0.0f;
     float irr[3] = {0.0f, 0.0f, 0.0f};
