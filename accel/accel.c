@@ -706,10 +706,13 @@ static pt_status build_user_geometry(accel *a)
     unsigned np = (unsigned)(a->nshapes + a->ncsgs);
     a->ubox = malloc((size_t)np * 6 * sizeof *a->ubox);
     a->ubox_test = malloc(np);
-    if (!a->ubox || !a->ubox_test) return PT_ERR_NOMEM;
+    a->ucut = malloc(np);
+    if (!a->ubox || !a->ubox_test || !a->ucut) return PT_ERR_NOMEM;
     for (unsigned p = 0; p < np; p++) {
         accel_user_box(a, p, a->ubox + 6 * (size_t)p);
         a->ubox_test[p] = (unsigned char)accel_user_box_test(a, p, np);
+        a->ucut[p] = (unsigned char)accel_user_cut(a, p);
+        a->has_ucut |= a->ucut[p];
     }
     rtcSetGeometryUserPrimitiveCount(g, (unsigned)(a->nshapes + a->ncsgs));
     rtcSetGeometryUserData(g, a);
@@ -833,7 +836,7 @@ void accel_free(accel *a)
     for (int i = 0; i < a->ncsgs; i++) geom_csg_free(&a->csgs[i]);
     for (int i = 0; i < a->nbshapes; i++) geom_shape_release(&a->bshapes[i]);
     GROW_FREE_ALL(a->leaves, a->shapes, a->shape_leaf, a->diags, a->groups, a->csgs, a->bshapes, a->csg_b0, a->csg_bn,
-                  a->ubox, a->ubox_test, a->ginfo, a);
+                  a->ubox, a->ubox_test, a->ucut, a->ginfo, a);
 }
 
 static inline double eps_rule(double scale, vec3 org, double dirlen)
@@ -1113,7 +1116,7 @@ double accel_hit_placement(const scene_object *o)
  * traversal, whose fixed cost per ray is then the larger part. */
 #define CROSS_DIRECT_MAX 4
 static int crossings_collected(const accel *a, vec3 org, vec3 dir, double t0, double tmax, double step, unsigned skip,
-                               accel_crossing *cr)
+                               int cut, accel_crossing *cr)
 {
     if (a->has_tri_geoms || a->has_costly_crossings) return -1;
     accel_query q;
@@ -1125,6 +1128,7 @@ static int crossings_collected(const accel *a, vec3 org, vec3 dir, double t0, do
     q.ctmax = tmax;
     q.cstep = step;
     q.cskip = skip;
+    q.ccut = cut;
     struct RTCRayHit rh;
     fill_rtc_ray(&rh.ray, org, dir, t0, tmax);
     rh.hit.geomID = rh.hit.primID = rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
@@ -1146,20 +1150,26 @@ static int crossings_collected(const accel *a, vec3 org, vec3 dir, double t0, do
     return q.ncross;
 }
 
-int accel_crossings_skip(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, unsigned skip,
-                         accel_crossing_fn fn, void *ctx)
+/* accel_crossings_skip; with `cut`, accel_crossings_cut's walk (-1 when
+ * it must be walked again without the cut). */
+static int crossings_walk(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, unsigned skip,
+                          int cut, accel_crossing_fn fn, void *ctx)
 {
     if (!a || !ray_ok(org, dir)) return 0;
     double t0 = eps_rule(a->ray_eps_scale, org, v3_len(dir));
     if (tmin > t0) t0 = tmin;
     if (!(tmax > t0)) return 0;
+    cut = cut && a->has_ucut;
     accel_crossing cr[CROSS_MAX];
-    int n = crossings_collected(a, org, dir, t0, tmax, step, skip, cr), visited = 0;
+    int n = crossings_collected(a, org, dir, t0, tmax, step, skip, cut, cr), visited = 0;
     accel_hit h;
     if (n >= 0) {
         /* the same crossings as the loop below: each the nearest past the
          * one before by the stepping rule */
         for (int i = 0; i < n; i++) {
+            /* past a crossing whose primitive's later ones were left out,
+             * the walk would miss them */
+            if (cut && i > 0 && cr[i - 1].cut) return -1;
             if (!(cr[i].t > t0) || !(cr[i].t < tmax)) continue;
             geom_csg_hit g = {.t = cr[i].t, .part = cr[i].part, .shape = cr[i].shape, .flip = cr[i].flip};
             fill_user(a, cr[i].prim, &g, org, dir, &h);
@@ -1167,9 +1177,9 @@ int accel_crossings_skip(const accel *a, vec3 org, vec3 dir, double tmin, double
             t0 = h.t + fmax_inline(step, h.t * 1e-7);
             if (h.flags & skip) continue; /* a member's own flag */
             visited++;
-            if (!fn(ctx, &h)) break;
+            if (!fn(ctx, &h)) return visited;
         }
-        return visited;
+        return cut && n > 0 && cr[n - 1].cut ? -1 : visited;
     }
     for (int k = 0; k < CROSS_MAX && t0 < tmax; k++) {
         if (!intersect_at(a, org, dir, t0, tmax, &h, ACCEL_RAY_POV)) break;
@@ -1179,6 +1189,18 @@ int accel_crossings_skip(const accel *a, vec3 org, vec3 dir, double tmin, double
         if (!fn(ctx, &h)) break;
     }
     return visited;
+}
+
+int accel_crossings_skip(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, unsigned skip,
+                         accel_crossing_fn fn, void *ctx)
+{
+    return crossings_walk(a, org, dir, tmin, tmax, step, skip, 0, fn, ctx);
+}
+
+int accel_crossings_cut(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, unsigned skip,
+                        accel_crossing_fn fn, void *ctx)
+{
+    return crossings_walk(a, org, dir, tmin, tmax, step, skip, 1, fn, ctx);
 }
 
 int accel_crossings(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, accel_crossing_fn fn,

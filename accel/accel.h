@@ -110,6 +110,17 @@ int accel_crossings(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
  * the one-traversal walk such primitives are not asked at all. */
 int accel_crossings_skip(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, unsigned skip,
                          accel_crossing_fn fn, void *ctx);
+/* accel_crossings_skip for a walk that stops (fn returns 0) at the first
+ * crossing of an object none of whose textures can let light through
+ * (transmit_texture_may: a shadow ray's filter is 0 there): of such a
+ * height field only the nearest crossing is collected, not its crossings
+ * behind it (its walk over the cells along the rest of the ray).
+ * The crossings fn gets are accel_crossings_skip's. Returns -1 when fn
+ * went on past such a crossing (the walk's own rule passed it over), so
+ * that the crossings after it may be missing: the caller walks again with
+ * accel_crossings_skip. */
+int accel_crossings_cut(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, unsigned skip,
+                        accel_crossing_fn fn, void *ctx);
 /* Mutual visibility of two surface points for density estimates
  * (ACCEL_RAY_EXACT: it steps over crossings between the points): 1 when
  * the segment from x + lift*nx to y + lift*ny (lift = 16 eps) crosses no

@@ -78,6 +78,8 @@ struct accel {
     float *ubox;                  /* 6 floats per user primitive: its box as accel_user_bounds gives it */
     unsigned char *ubox_test;     /* per user primitive: whether the callbacks test a ray against ubox
                                      before intersecting it (accel_user_box_test) */
+    unsigned char *ucut;          /* per user primitive: accel_user_cut */
+    int has_ucut;                 /* some primitive's ucut is set */
     geom_info *ginfo;
     unsigned nginfo;
     int has_tri_geoms; /* a geometry of triangles or instances: accel_crossings walks crossing by crossing */
@@ -102,11 +104,13 @@ struct accel {
     char errmsg[512];
 };
 
-/* One crossing found in collect mode. */
+/* One crossing found in collect mode; `cut`: its primitive's crossings
+ * past this one were not collected (accel_crossings_cut). */
 typedef struct {
     double t;
     unsigned prim;
-    int part, shape, flip;
+    int part, shape;
+    unsigned char flip, cut;
 } accel_crossing;
 
 /* Our intersect context: Embree passes the context pointer unchanged to the
@@ -130,6 +134,7 @@ typedef struct {
     int ncross, maxcross, overflow;
     double ctmax, cstep;
     unsigned cskip; /* primitives whose effective flags carry one of these are not asked */
+    int ccut;       /* a primitive whose ucut is set gives only its nearest crossing */
     geom_ray_rule rule; /* how searched-for surfaces are met (accel_ray_rule) */
     int packet;         /* a packet query's context: no double ray (org, dir, tmin unset) */
     /* an exact occlusion query: the top-level user primitive found to
@@ -160,6 +165,11 @@ int accel_collect_bounds(accel *a, diag *d, const scene_object *o, int own, int 
 /* The user geometry's primitives and Embree callbacks (accel_user.c). */
 void accel_user_box(const accel *a, unsigned prim, float out[6]);
 int accel_user_box_test(const accel *a, unsigned prim, unsigned np);
+/* Whether a walk that stops at opaque surfaces (accel_crossings_cut) takes
+ * only the nearest crossing of user primitive prim: a height field whose
+ * every surface stops a shadow ray's light (its filter there is 0: no
+ * texture of it can let light through). */
+int accel_user_cut(const accel *a, unsigned prim);
 void accel_user_bounds(const struct RTCBoundsFunctionArguments *args);
 void accel_user_bounds_link(const struct RTCBoundsFunctionArguments *args);
 /* Primitive prim's nearest hit in (tmin, tmax) of the double ray o + t d,

@@ -8,6 +8,7 @@
 #include "accel_internal.h"
 #include "scene_leaves.h"
 #include "grow.h"
+#include "transmit.h"
 
 /* ------------------------------------------------------------ bounded_by */
 
@@ -240,6 +241,26 @@ int accel_user_box_test(const accel *a, unsigned prim, unsigned np)
     }
 }
 
+/* Whether a shadow ray's filter is 0 at every surface of leaf l: its
+ * texture and interior texture cannot let light through
+ * (transmit_texture_may), and it is not a blob, whose components carry
+ * textures of their own. */
+static int leaf_opaque(const accel_leaf *l)
+{
+    const scene_object *o = l->obj;
+    if (!o || o->kind == SHAPE_BLOB || !l->texture || transmit_texture_may(l->texture)) return 0;
+    return !(o->interior_texture && transmit_texture_may(o->interior_texture));
+}
+
+int accel_user_cut(const accel *a, unsigned prim)
+{
+    /* a height field's crossings come from a walk over its cells along the
+     * ray, which its nearest crossing ends; the other closed-form shapes
+     * give all theirs from one solve, at the cost of the nearest */
+    if (prim >= (unsigned)a->nshapes || a->shapes[prim].kind != SHAPE_HEIGHT_FIELD) return 0;
+    return leaf_opaque(&a->leaves[a->shape_leaf[prim]]);
+}
+
 /* Does lane i of an SOA ray miss user primitive prim's box within its
  * [tnear, tfar]? (Asked where accel_user_box_test says so.) Conservative: a NaN slab (a zero direction component starting on a
  * face) constrains nothing, and the interval must be empty by more than
@@ -375,7 +396,7 @@ __attribute__((always_inline)) static inline int cross_leaf_once(const accel *a,
                 q->overflow = 1;
                 break;
             }
-            q->cross[q->ncross++] = (accel_crossing){hs[j].t, prim, hs[j].part, hs[j].shape, hs[j].flip};
+            q->cross[q->ncross++] = (accel_crossing){hs[j].t, prim, hs[j].part, hs[j].shape, hs[j].flip, 0};
         }
         return 1;
     }
@@ -390,8 +411,11 @@ __attribute__((always_inline)) static inline int cross_leaf_once(const accel *a,
     }
     enum { MAX_LEAF_CROSSINGS = 8 };
     geom_shape_hit hs[MAX_LEAF_CROSSINGS];
-    int k = geom_shape_ray_hits(sh, o, d, tmin, q->ctmax, hs, MAX_LEAF_CROSSINGS, q->rule);
-    if (k == MAX_LEAF_CROSSINGS) return 0;
+    /* a cut primitive's nearest crossing is its first one here (the roots
+     * do not depend on how many are asked for) */
+    int cut = q->ccut && a->ucut[prim];
+    int k = geom_shape_ray_hits(sh, o, d, tmin, q->ctmax, hs, cut ? 1 : MAX_LEAF_CROSSINGS, q->rule);
+    if (cut ? k == 1 && !(hs[0].t > tmin) : k == MAX_LEAF_CROSSINGS) return 0;
     double from = tmin;
     for (int j = 0; j < k; j++) {
         if (!(hs[j].t > from)) continue;
@@ -399,7 +423,7 @@ __attribute__((always_inline)) static inline int cross_leaf_once(const accel *a,
             q->overflow = 1;
             break;
         }
-        q->cross[q->ncross++] = (accel_crossing){hs[j].t, prim, hs[j].part, 0, 0};
+        q->cross[q->ncross++] = (accel_crossing){hs[j].t, prim, hs[j].part, 0, 0, cut};
         from = hs[j].t + fmax_inline(q->cstep, hs[j].t * 1e-7);
     }
     return 1;
@@ -463,7 +487,7 @@ __attribute__((always_inline)) static inline void cross_prim(const accel *a, acc
             q->overflow = 1;
             break;
         }
-        q->cross[q->ncross++] = (accel_crossing){h.t, prim, h.part, h.shape, h.flip};
+        q->cross[q->ncross++] = (accel_crossing){h.t, prim, h.part, h.shape, h.flip, 0};
         from = h.t + fmax_inline(q->cstep, h.t * 1e-7);
     }
 }

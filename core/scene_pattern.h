@@ -88,6 +88,8 @@ typedef struct scene_image {
     float *pixels;          /* width*height*5: r g b filter transmit, row 0 = top; NULL until
                                loaded (io/img_scene.h fills it after parsing) */
     int has_alpha;
+    int clear;              /* some pixel has a filter or transmit other than 0
+                               (sdl_image_note_clear; set with the pixels) */
     struct scene_image *next; /* the scene's list of images (scene.images) */
     unsigned char *indices; /* palette images: width*height palette indices, else NULL */
 } scene_image;

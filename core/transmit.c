@@ -64,7 +64,10 @@ static int pigment_may(const scene_pigment *pg, int depth)
     const scene_pattern *pat = pg->pat;
     if (pat->kind == PAT_IMAGE && !pg->map) {
         const scene_image_map *im = &pat->image;
-        return im->once || im->filter_all_set || im->transmit_all_set || !im->image || im->image->has_alpha;
+        /* an image whose every pixel is opaque (a palette with a
+         * transparent entry no pixel uses) stops all light */
+        return im->once || im->filter_all_set || im->transmit_all_set || !im->image ||
+               (im->image->pixels ? im->image->clear : im->image->has_alpha);
     }
     return map_may(pg->map, depth);
 }

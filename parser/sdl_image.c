@@ -82,5 +82,14 @@ int sdl_image_load(scene_image *img, arena *mem, double working_gamma, unsigned 
     img->height = (int)h;
     img->pixels = px;
     if (idx) img->indices = idx;
+    sdl_image_note_clear(img);
     return 0;
+}
+
+void sdl_image_note_clear(scene_image *img)
+{
+    size_t n = img->pixels ? (size_t)img->width * (size_t)img->height : 0;
+    img->clear = 0;
+    for (size_t i = 0; i < n && !img->clear; i++)
+        img->clear = img->pixels[i * 5 + 3] != 0.0f || img->pixels[i * 5 + 4] != 0.0f;
 }

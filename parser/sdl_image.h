@@ -19,6 +19,10 @@
  * Returns 0 on success, else a reason in `why`. */
 int sdl_image_load(scene_image *img, arena *mem, double working_gamma, unsigned long long max_pixels, char *why,
                    size_t whycap);
+/* Set img->clear from its pixels: whether any has a filter or transmit
+ * other than 0 (what transmit_texture_may asks of an image_map); again
+ * after a palette entry's filter or transmit changed. */
+void sdl_image_note_clear(scene_image *img);
 /* The sRGB transfer function decoded to linear as POV-Ray 3.7 decodes it
  * (SRGBGammaCurve: knee at 0.04045), for images and srgb colours. */
 double sdl_srgb_decode(double v);

@@ -255,6 +255,7 @@ static void palette_set(scene_image *img, int reg, int ch, double v)
     size_t n = (size_t)img->width * (size_t)img->height;
     for (size_t i = 0; i < n; i++)
         if (reg < 0 || img->indices[i] == reg) img->pixels[i * 5 + (size_t)ch] = (float)v;
+    sdl_image_note_clear(img);
 }
 
 /* image_map { image_spec { once | interpolate n | map_type n | use_colour |

@@ -794,10 +794,29 @@ static int shadow_crossing(void *ctx, const accel_hit *h)
     return 1;
 }
 
+/* A walk from the lit point: no crossing taken, no interior passed unseen
+ * (the list's entries from n on are not read), all light let through. */
+static void shadow_walk_start(shadow_walk *w, const scene *sc, const scene_light *photon_light, vec3 dir)
+{
+    w->sc = sc;
+    w->photon_light = photon_light;
+    w->dir = dir;
+    w->walk.last = 0.0;
+    w->walk.unseen.n = 0;
+    w->c = trgb(1, 1, 1);
+}
+
 rgb shade_tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, double tmin, double tmax,
                          const scene_light *photon_light)
 {
-    shadow_walk w = {sc, photon_light, dir, {0.0, {0, {0}}}, {1, 1, 1}};
-    accel_crossings_skip(a, p, dir, tmin, tmax, tmin, OBJ_NO_SHADOW, shadow_crossing, &w);
+    /* a crossing of an opaque object ends the walk (its filter is 0), so
+     * its crossings behind it are not needed, unless the walk's tolerance
+     * passed it over */
+    shadow_walk w;
+    shadow_walk_start(&w, sc, photon_light, dir);
+    if (accel_crossings_cut(a, p, dir, tmin, tmax, tmin, OBJ_NO_SHADOW, shadow_crossing, &w) < 0) {
+        shadow_walk_start(&w, sc, photon_light, dir);
+        accel_crossings_skip(a, p, dir, tmin, tmax, tmin, OBJ_NO_SHADOW, shadow_crossing, &w);
+    }
     return w.c;
 }

@@ -1160,6 +1160,34 @@ static void test_layered_transmit(void **st)
     scene_free(s);
 }
 
+/* An image_map lets light through only where a pixel has a filter or
+ * transmit above 0 (transmit_texture_may reads the image's pixels, not its
+ * format): fract003.png's palette has a transparent entry (tRNS, index 0)
+ * that no pixel uses, so the image stops all light; a transmit given to a
+ * used entry (index 1), or to all of them, lets light through, one given
+ * to the unused entry does not. */
+static void test_image_map_transmit(void **st)
+{
+    (void)st;
+    if (access("/usr/share/povray-3.7/include/fract003.png", R_OK) != 0) skip();
+    scene *s = parse_ok("#declare F = \"/usr/share/povray-3.7/include/fract003.png\";\n"
+                        "plane { y, 0 pigment { image_map { png F } } }\n"
+                        "plane { y, 0 pigment { image_map { png F transmit 1, 0.5 } } }\n"
+                        "plane { y, 0 pigment { image_map { png F transmit 0, 0.5 } } }\n"
+                        "plane { y, 0 pigment { image_map { png F transmit all 0.3 } } }\n");
+    assert_int_equal(s->nobjects, 4);
+    int want[4] = {0, 1, 0, 1};
+    for (int i = 0; i < 4; i++) {
+        const scene_texture *t = s->objects[i]->texture;
+        assert_non_null(t);
+        assert_non_null(t->pigment.pat);
+        assert_non_null(t->pigment.pat->image.image);
+        assert_int_equal(t->pigment.pat->image.image->has_alpha, 1);
+        assert_int_equal(transmit_texture_may(t), want[i]);
+    }
+    scene_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1190,6 +1218,7 @@ int main(void)
         cmocka_unit_test(test_scene_sweep),
         cmocka_unit_test(test_object_pattern_serial),
         cmocka_unit_test(test_layered_transmit),
+        cmocka_unit_test(test_image_map_transmit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

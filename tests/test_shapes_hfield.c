@@ -48,6 +48,59 @@ void test_height_field(void **st)
     unlink(path);
 }
 
+/* accel_crossings_cut: an opaque height field (a ridge along z, rising
+ * from x = 0 to 0.5 and falling to x = 1, heights 0, 254/255, 0) gives
+ * only its nearest crossing. A ray along +x at height 0.5 crosses it at
+ * x = 0.25 and 0.75, then a glass sphere at 2.5 and 3.5: a walk that
+ * stops on the height field gets what accel_crossings_skip gives it; one
+ * that goes on past it is told to walk again (-1), and the full walk has
+ * all four crossings. */
+typedef struct {
+    double t[8];
+    int n;
+    int stop_at_field; /* stop on the height field's crossing */
+} cut_log;
+
+static int log_cut(void *ctx, const accel_hit *h)
+{
+    cut_log *l = ctx;
+    if (l->n < 8) l->t[l->n] = h->t;
+    l->n++;
+    return !(l->stop_at_field && h->obj && h->obj->kind == SHAPE_HEIGHT_FIELD);
+}
+
+void test_height_field_cut(void **st)
+{
+    (void)st;
+    char path[] = "/tmp/test_shapes_hfcutXXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    unsigned char v[9] = {0, 254, 0, 0, 254, 0, 0, 254, 0};
+    write_pgm(path, 3, 3, v);
+    char src[768];
+    snprintf(src, sizeof src,
+             "height_field { pgm \"%s\" pigment { rgb 1 } }\n"
+             "sphere { <3, 0.5, 0.5>, 0.5 pigment { rgbt <1, 1, 1, 0.5> } }\n",
+             path);
+    world w = build(src);
+    double top = 254 * 257 / 65536.0, x0 = 0.5 * 0.5 / top;
+    const double all[4] = {1 + x0, 2 - x0, 3.5, 4.5}; /* from x = -1 */
+    vec3 o = v3(-1, 0.5, 0.5), d = v3(1, 0, 0);
+    cut_log l = {{0}, 0, 1}, m = {{0}, 0, 1};
+    assert_int_equal(accel_crossings_cut(w.a, o, d, 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW, log_cut, &l), 1);
+    assert_int_equal(accel_crossings_skip(w.a, o, d, 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW, log_cut, &m), 1);
+    assert_near(l.t[0], m.t[0], 0.0);
+    assert_near(l.t[0], all[0], 1e-6);
+    l = (cut_log){{0}, 0, 0};
+    assert_int_equal(accel_crossings_cut(w.a, o, d, 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW, log_cut, &l), -1);
+    m = (cut_log){{0}, 0, 0};
+    assert_int_equal(accel_crossings_skip(w.a, o, d, 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW, log_cut, &m), 4);
+    for (int i = 0; i < 4; i++) assert_near(m.t[i], all[i], 1e-6);
+    done(&w);
+    unlink(path);
+}
+
 /* A minimal GIF (no palette, 8-bit LZW codes written as literals of 9 bits). */
 static void write_gif(const char *path, int w, int h, const unsigned char *px)
 {
