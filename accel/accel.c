@@ -857,7 +857,12 @@ double accel_epsilon(const accel *a, vec3 org, vec3 dir)
     return e;
 }
 
-static int ray_ok(vec3 org, vec3 dir) { return v3_finite(org) && v3_finite(dir) && v3_len2(dir) > 0.0; }
+/* inline at every query: called out of line, its two vectors went through
+ * the stack on every shadow ray */
+__attribute__((always_inline)) static inline int ray_ok(vec3 org, vec3 dir)
+{
+    return v3_finite(org) && v3_finite(dir) && v3_len2(dir) > 0.0;
+}
 
 static void fill_rtc_ray(struct RTCRay *r, vec3 org, vec3 dir, double tmin, double tmax)
 {
