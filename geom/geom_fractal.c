@@ -253,74 +253,6 @@ static int jf_at(const jf_data *f, vec3 p) { return jf_inside(f, p.x, p.y, p.z, 
 typedef double jf_v2 __attribute__((vector_size(16)));
 typedef long long jf_m2 __attribute__((vector_size(16))); /* a lane comparison: -1 or 0 */
 
-/* jf_inside without the step estimate at three points at once, for the
- * fractals whose iteration is written out there (quaternion sqr and cube,
- * hypercomplex sqr): p[0] on its own and p[1], p[2] in a two-lane vector,
- * each doing jf_inside's operations in its order, so each answer is
- * jf_inside's. A point that escapes answers 0 and runs on unread until all
- * three have escaped or max_iteration is reached. Returns 0 (nothing
- * written) for the other fractals. */
-static int jf_inside3(const jf_data *f, const vec3 p[3], int res[3])
-{
-    const int quat = !f->hyper && (f->func == JULIA_SQR || f->func == JULIA_CUBE), cube = f->func == JULIA_CUBE;
-    if (!quat && !(f->hyper && f->func == JULIA_SQR)) return 0;
-    double q[3][4];
-    for (int k = 0; k < 3; k++) lift(f, p[k], q[k]);
-    const jf_v2 ex = {f->exit, f->exit};
-    const double exit = f->exit;
-    jf_m2 e1 = {0, 0};
-    int e0 = 0;
-    if (quat) {
-        double x0 = q[0][0], y0 = q[0][1], z0 = q[0][2], w0 = q[0][3];
-        jf_v2 x1 = {q[1][0], q[2][0]}, y1 = {q[1][1], q[2][1]}, z1 = {q[1][2], q[2][2]}, w1 = {q[1][3], q[2][3]};
-        const jf_v2 c0 = {f->c[0], f->c[0]}, c1 = {f->c[1], f->c[1]}, c2 = {f->c[2], f->c[2]}, c3 = {f->c[3], f->c[3]};
-        for (int i = 1; i <= f->n; i++) {
-            double d0 = y0 * y0 + z0 * z0 + w0 * w0, x20 = x0 * x0, r20 = d0 + x20;
-            jf_v2 d1 = y1 * y1 + z1 * z1 + w1 * w1, x21 = x1 * x1, r21 = d1 + x21;
-            e0 |= r20 > exit;
-            e1 |= r21 > ex;
-            if (e0 && e1[0] && e1[1]) break;
-            double s0 = cube ? 3.0 * x20 - d0 : 2.0 * x0;
-            jf_v2 s1 = cube ? 3.0 * x21 - d1 : 2.0 * x1;
-            x0 = (cube ? x0 * (x20 - 3.0 * d0) : x20 - d0) + c0[0];
-            x1 = (cube ? x1 * (x21 - 3.0 * d1) : x21 - d1) + c0;
-            y0 = s0 * y0 + c1[0];
-            y1 = s1 * y1 + c1;
-            z0 = s0 * z0 + c2[0];
-            z1 = s1 * z1 + c2;
-            w0 = s0 * w0 + c3[0];
-            w1 = s1 * w1 + c3;
-        }
-    } else {
-        /* to_pair: a = (x - w) + i (y + z), b = (x + w) + i (y - z) */
-        double ar0 = q[0][0] - q[0][3], ai0 = q[0][1] + q[0][2], br0 = q[0][0] + q[0][3], bi0 = q[0][1] - q[0][2];
-        jf_v2 ar1 = {q[1][0] - q[1][3], q[2][0] - q[2][3]}, ai1 = {q[1][1] + q[1][2], q[2][1] + q[2][2]};
-        jf_v2 br1 = {q[1][0] + q[1][3], q[2][0] + q[2][3]}, bi1 = {q[1][1] - q[1][2], q[2][1] - q[2][2]};
-        const double car = creal(f->ca), cai = cimag(f->ca), cbr = creal(f->cb), cbi = cimag(f->cb);
-        for (int i = 1; i <= f->n; i++) {
-            double ar20 = ar0 * ar0, ai20 = ai0 * ai0, br20 = br0 * br0, bi20 = bi0 * bi0;
-            jf_v2 ar21 = ar1 * ar1, ai21 = ai1 * ai1, br21 = br1 * br1, bi21 = bi1 * bi1;
-            double r20 = 0.5 * (ar20 + ai20 + br20 + bi20);
-            jf_v2 r21 = 0.5 * (ar21 + ai21 + br21 + bi21);
-            e0 |= !(r20 <= exit);
-            e1 |= ~(r21 <= ex);
-            if (e0 && e1[0] && e1[1]) break;
-            ai0 = 2.0 * ar0 * ai0 + cai;
-            ai1 = 2.0 * ar1 * ai1 + cai;
-            ar0 = ar20 - ai20 + car;
-            ar1 = ar21 - ai21 + car;
-            bi0 = 2.0 * br0 * bi0 + cbi;
-            bi1 = 2.0 * br1 * bi1 + cbi;
-            br0 = br20 - bi20 + cbr;
-            br1 = br21 - bi21 + cbr;
-        }
-    }
-    res[0] = !e0;
-    res[1] = !e1[0];
-    res[2] = !e1[1];
-    return 1;
-}
-
 /* A radius beyond which every point escapes within max_iteration, for the
  * iterations z -> z^k + c (k = 2, 3) whose norm grows as |z|^k:
  * |z^k + c| >= |z|^k - |c|, and g(r) = r^k - |c| is increasing, so a start
@@ -390,6 +322,159 @@ int geom_fractal_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
 
 void geom_fractal_free(void *data) { free(data); }
 
+/* The crossing between lo (answer `cur`) and hi (the other answer) by
+ * POV-Ray's bisection (jf_polish), one test per halving: for the fractals
+ * without jf_level3. */
+static double jf_bisect(const jf_data *f, vec3 p0, vec3 e, double lo, double hi, int cur)
+{
+    for (int it = 0; it < 200 && hi - lo > FRACTAL_TOLERANCE; it++) {
+        double m = 0.5 * (lo + hi);
+        if (jf_at(f, v3_madd(p0, e, m)) == cur) lo = m;
+        else hi = m;
+    }
+    return 0.5 * (lo + hi);
+}
+
+/* jf_inside's answers at three points at once, for the fractals whose
+ * iteration is written out there (quaternion sqr and cube, hypercomplex
+ * sqr): p[0] on its own and p[1], p[2] in a two-lane vector, each doing
+ * jf_inside's operations in its order up to its escape, so each answer is
+ * jf_inside's. In F[k] a smooth function of p[k] whose sign is nearly
+ * always the answer's: (u - 1) / (u + 1) with u = |z_(n-1)|^2 over the
+ * bailout, the iteration run on past the escape (past the bailout
+ * |z^k + c| >= |z|^k - |c| exceeds |z|: the iterates do not come back), 1
+ * where they grow past 1e100. Returns 0 (nothing written) for the other
+ * fractals. */
+static int jf_level3(const jf_data *f, const vec3 p[3], int res[3], double F[3])
+{
+    const int quat = !f->hyper && (f->func == JULIA_SQR || f->func == JULIA_CUBE), cube = f->func == JULIA_CUBE;
+    if (!quat && !(f->hyper && f->func == JULIA_SQR)) return 0;
+    double q[3][4];
+    for (int k = 0; k < 3; k++) lift(f, p[k], q[k]);
+    const double exit = f->exit, big = 1e100;
+    const jf_v2 ex = {exit, exit}, bg = {big, big};
+    jf_m2 e1 = {0, 0}, g1 = {0, 0};
+    jf_v2 r21 = {0, 0};
+    int e0 = 0, g0 = 0;
+    double r20 = 0.0;
+    if (quat) {
+        double x0 = q[0][0], y0 = q[0][1], z0 = q[0][2], w0 = q[0][3];
+        jf_v2 x1 = {q[1][0], q[2][0]}, y1 = {q[1][1], q[2][1]}, z1 = {q[1][2], q[2][2]}, w1 = {q[1][3], q[2][3]};
+        const jf_v2 c0 = {f->c[0], f->c[0]}, c1 = {f->c[1], f->c[1]}, c2 = {f->c[2], f->c[2]}, c3 = {f->c[3], f->c[3]};
+        for (int i = 1; i <= f->n; i++) {
+            double d0 = y0 * y0 + z0 * z0 + w0 * w0, x20 = x0 * x0;
+            jf_v2 d1 = y1 * y1 + z1 * z1 + w1 * w1, x21 = x1 * x1;
+            r20 = d0 + x20;
+            r21 = d1 + x21;
+            e0 |= r20 > exit;
+            e1 |= r21 > ex;
+            g0 = !(r20 <= big);
+            g1 = ~(r21 <= bg);
+            if (g0 && g1[0] && g1[1]) break;
+            double s0 = cube ? 3.0 * x20 - d0 : 2.0 * x0;
+            jf_v2 s1 = cube ? 3.0 * x21 - d1 : 2.0 * x1;
+            x0 = (cube ? x0 * (x20 - 3.0 * d0) : x20 - d0) + c0[0];
+            x1 = (cube ? x1 * (x21 - 3.0 * d1) : x21 - d1) + c0;
+            y0 = s0 * y0 + c1[0];
+            y1 = s1 * y1 + c1;
+            z0 = s0 * z0 + c2[0];
+            z1 = s1 * z1 + c2;
+            w0 = s0 * w0 + c3[0];
+            w1 = s1 * w1 + c3;
+        }
+    } else {
+        /* to_pair: a = (x - w) + i (y + z), b = (x + w) + i (y - z) */
+        double ar0 = q[0][0] - q[0][3], ai0 = q[0][1] + q[0][2], br0 = q[0][0] + q[0][3], bi0 = q[0][1] - q[0][2];
+        jf_v2 ar1 = {q[1][0] - q[1][3], q[2][0] - q[2][3]}, ai1 = {q[1][1] + q[1][2], q[2][1] + q[2][2]};
+        jf_v2 br1 = {q[1][0] + q[1][3], q[2][0] + q[2][3]}, bi1 = {q[1][1] - q[1][2], q[2][1] - q[2][2]};
+        const double car = creal(f->ca), cai = cimag(f->ca), cbr = creal(f->cb), cbi = cimag(f->cb);
+        for (int i = 1; i <= f->n; i++) {
+            double ar20 = ar0 * ar0, ai20 = ai0 * ai0, br20 = br0 * br0, bi20 = bi0 * bi0;
+            jf_v2 ar21 = ar1 * ar1, ai21 = ai1 * ai1, br21 = br1 * br1, bi21 = bi1 * bi1;
+            r20 = 0.5 * (ar20 + ai20 + br20 + bi20);
+            r21 = 0.5 * (ar21 + ai21 + br21 + bi21);
+            e0 |= !(r20 <= exit);
+            e1 |= ~(r21 <= ex);
+            g0 = !(r20 <= big);
+            g1 = ~(r21 <= bg);
+            if (g0 && g1[0] && g1[1]) break;
+            ai0 = 2.0 * ar0 * ai0 + cai;
+            ai1 = 2.0 * ar1 * ai1 + cai;
+            ar0 = ar20 - ai20 + car;
+            ar1 = ar21 - ai21 + car;
+            bi0 = 2.0 * br0 * bi0 + cbi;
+            bi1 = 2.0 * br1 * bi1 + cbi;
+            br0 = br20 - bi20 + cbr;
+            br1 = br21 - bi21 + cbr;
+        }
+    }
+    res[0] = !e0;
+    res[1] = !e1[0];
+    res[2] = !e1[1];
+    const double u[3] = {r20 / exit, r21[0] / exit, r21[1] / exit};
+    const int g[3] = {g0, g1[0] != 0, g1[1] != 0};
+    for (int j = 0; j < 3; j++) F[j] = g[j] ? 1.0 : (u[j] - 1.0) / (u[j] + 1.0);
+    return 1;
+}
+
+/* The crossing between the march's points lo (answer `cur`) and hi (the
+ * other answer), in the ray's length from p0 along the unit e, placed as
+ * POV-Ray places it: by bisection to Fractal_Tolerance (1e-7 in the
+ * fractal's space, fractal.cpp), halving [lo, hi] and keeping the half
+ * whose ends' answers differ until it is shorter than that, at the last
+ * piece's middle. Far finer than the set's detail at any usable
+ * precision, so the halvings are taken three at a time: jf_level3 tests
+ * the next three midpoints of the path the crossing's estimate predicts
+ * (regula falsi on jf_level3's smooth function at the ends, or the secant
+ * through an end's last two places), and the halvings follow the answers
+ * while each midpoint is the one the halving itself computes from its
+ * ends. Every point and answer is the one-at-a-time bisection's; a wrong
+ * prediction only wastes the lanes after it. The first call takes the
+ * midpoint and both quarter points, two halvings, whichever way they go. */
+static double jf_polish(const jf_data *f, vec3 p0, vec3 e, double lo, double hi, int cur)
+{
+    double m = 0.5 * (lo + hi), x[3] = {m, 0.5 * (lo + m), 0.5 * (m + hi)}, F[3];
+    int r[3];
+    vec3 pts[3] = {v3_madd(p0, e, x[0]), v3_madd(p0, e, x[1]), v3_madd(p0, e, x[2])};
+    if (!(hi - lo > FRACTAL_TOLERANCE)) return m;
+    if (!jf_level3(f, pts, r, F)) return jf_bisect(f, p0, e, lo, hi, cur);
+    /* each end's smooth value where known, and the end's place and value before it last moved */
+    double Flo = NAN, Fhi = NAN, plo = NAN, Fplo = NAN, phi = NAN, Fphi = NAN;
+    int it = 0, first = 1;
+    for (;;) {
+        for (int j = 0; j < 3 && it < 200 && hi - lo > FRACTAL_TOLERANCE; j++) {
+            double mj = 0.5 * (lo + hi);
+            /* the first call's lanes: the midpoint, then a quarter point */
+            int k = first ? (j == 0 ? 0 : (r[0] == cur ? 2 : 1)) : j;
+            if (mj != x[k] || (first && j > 1)) break;
+            if (r[k] == cur) {
+                plo = lo, Fplo = Flo;
+                lo = mj, Flo = F[k];
+            } else {
+                phi = hi, Fphi = Fhi;
+                hi = mj, Fhi = F[k];
+            }
+            it++;
+        }
+        first = 0;
+        if (!(it < 200 && hi - lo > FRACTAL_TOLERANCE)) break;
+        double est = NAN;
+        if (Flo * Fhi < 0.0) est = lo + (hi - lo) * (Flo / (Flo - Fhi));
+        else if (isfinite(Flo) && isfinite(Fplo)) est = lo - Flo * ((lo - plo) / (Flo - Fplo));
+        else if (isfinite(Fhi) && isfinite(Fphi)) est = hi - Fhi * ((hi - phi) / (Fhi - Fphi));
+        /* the path to the estimate (a point at or below it has lo's answer) */
+        double a = lo, b = hi;
+        for (int j = 0; j < 3; j++) {
+            x[j] = 0.5 * (a + b);
+            if (x[j] <= est) a = x[j];
+            else b = x[j];
+            pts[j] = v3_madd(p0, e, x[j]);
+        }
+        jf_level3(f, pts, r, F);
+    }
+    return 0.5 * (lo + hi);
+}
+
 int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     const jf_data *f = sh->data;
@@ -426,31 +511,7 @@ int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
         vec3 pn = v3_madd(p0, e, tn);
         int next = jf_inside(f, pn.x, pn.y, pn.z, dp[0], dp[1], &den);
         if (next != cur) {
-            double lo = tau, hi = tn;
-            /* POV-Ray polishes the crossing by bisection to Fractal_Tolerance
-             * (1e-7 in the fractal's space, fractal.cpp), far finer than the
-             * set's detail at any usable precision. Two halvings at a time
-             * where jf_inside3 applies: the midpoint and both quarter points
-             * at once, the next midpoint being whichever quarter point the
-             * first answer leaves (the same value the halving computes from
-             * the new ends), so the points and answers are the one-at-a-time
-             * bisection's. */
-            for (int it = 0; it < 200 && hi - lo > FRACTAL_TOLERANCE;) {
-                double m = 0.5 * (lo + hi), ql = 0.5 * (lo + m), qh = 0.5 * (m + hi);
-                vec3 pts[3] = {v3_madd(p0, e, m), v3_madd(p0, e, ql), v3_madd(p0, e, qh)};
-                int r[3], lanes = jf_inside3(f, pts, r);
-                if (!lanes) r[0] = jf_at(f, pts[0]);
-                int in_m = r[0] == cur;
-                if (in_m) lo = m;
-                else hi = m;
-                if (++it >= 200 || !(hi - lo > FRACTAL_TOLERANCE)) break;
-                double m2 = 0.5 * (lo + hi); /* qh after lo = m, ql after hi = m */
-                int r2 = lanes && m2 == (in_m ? qh : ql) ? r[in_m ? 2 : 1] : jf_at(f, v3_madd(p0, e, m2));
-                if (r2 == cur) lo = m2;
-                else hi = m2;
-                ++it;
-            }
-            double t = a + 0.5 * (lo + hi) / s;
+            double t = a + jf_polish(f, p0, e, tau, tn, cur) / s;
             if (t > tmin && t < tmax) n = geom_shape_hit_put(out, n, max, t, 0);
         }
         tau = tn;
