@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include "func_internal.h"
 #include "gi.h"
 #include "img_io.h"
 #include "pm_fg.h"
@@ -490,17 +491,28 @@ pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, fr
 {
     memset(r, 0, sizeof *r);
     light_not_modelled(sc, o->mode, o->antialias != 2, r, d);
+    /* f_ridged_mf's weights as POV-Ray's render fixes them, before any pass
+     * (photons, GI, the image) calls it; the whole image's order, so that a
+     * window (a farm's tile) takes the frame's */
+    shade_ridged_mf_first(sc, a, o->width, o->height);
     pt_status st;
     switch (o->mode) {
     case GI_PARTICLE: st = render_particle(sc, a, o, fb, r, d); break;
     case GI_DETP: st = render_hook_mode(&detp_mode, sc, a, o, fb, r, d); break;
-    case GI_VPL: return render_vpl_mode(sc, a, o, fb, r, d);
+    case GI_VPL:
+        st = render_vpl_mode(sc, a, o, fb, r, d);
+        func_ridged_mf_reset();
+        return st;
     case GI_LINKS: st = render_hook_mode(&links_mode, sc, a, o, fb, r, d); break;
     case GI_PMFG:
-    case GI_PATH: return render_reference(sc, a, o, fb, r, d);
+    case GI_PATH:
+        st = render_reference(sc, a, o, fb, r, d);
+        func_ridged_mf_reset();
+        return st;
     default: st = render_none(sc, a, o, fb, r, d); break;
     }
     caustics_free(&r->caus);
+    func_ridged_mf_reset(); /* a later scene's calls take their own */
     r->primary_rays = r->shade.primary_rays;
     r->shadow_rays = r->shade.shadow_rays;
     r->secondary_rays = r->shade.secondary_rays;

@@ -544,15 +544,44 @@ static double f_ridge(const double *a, const func_env *e, int *ok)
     return value * scale / total;
 }
 
+enum { RIDGED_OWN, RIDGED_RECORD, RIDGED_FIXED };
+static struct {
+    int state;
+    double h, lacunarity;
+} ridged; /* func_internal.h: written by one thread between renders */
+
+void func_ridged_mf_reset(void) { ridged.state = RIDGED_OWN; }
+void func_ridged_mf_record(void) { ridged.state = RIDGED_RECORD; }
+
+int func_ridged_mf_fixed(double *h, double *lacunarity)
+{
+    if (ridged.state != RIDGED_FIXED) return 0;
+    if (h) *h = ridged.h;
+    if (lacunarity) *lacunarity = ridged.lacunarity;
+    return 1;
+}
+
 static double f_ridged_mf(const double *a, const func_env *e, int *ok)
 {
     vec3 p = v3(X, Y, Z);
     int gen = (int)P(5) & 3;
     double signal = P(3) - fabs(noise_at(e, p, gen, ok) * 2 - 1);
     signal *= signal;
+    /* the weights' H and lacunarity: the first call's once recorded
+     * (func_internal.h); past the first call's octaves POV-Ray reads beyond
+     * its array, the same sequence goes on here */
+    double h = P(0), lac = P(1);
+    if (ridged.state == RIDGED_RECORD) {
+        ridged.h = h;
+        ridged.lacunarity = lac;
+        ridged.state = RIDGED_FIXED;
+    } else if (ridged.state == RIDGED_FIXED) {
+        h = ridged.h;
+        lac = ridged.lacunarity;
+    }
     /* octave i weighs freq^-H = (lacunarity^-H)^i: one pow, then a
      * product per octave */
-    double result = signal, step = P(2) > 1 ? pow(P(1), -P(0)) : 1.0, w = 1.0;
+    double result = signal, step = P(2) > 1 ? pow(lac, -h) : 1.0, w = 1.0;
     for (int i = 1; i < P(2) && *ok; i++) {
         w *= step;
         p = v3_scale(p, P(1));

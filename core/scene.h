@@ -41,6 +41,9 @@ typedef struct {
                                files, each as its length then its bytes (sdl_hash_input); what the GI
                                cache and a tile's header name the scene by */
     double clock;
+    /* the functions whose bodies call a function that is internal(59),
+     * f_ridged_mf (its weights come from one call: func_internal.h) */
+    int ridged_mf_callers;
     /* atmosphere (scene_pattern.h) */
     const scene_fog *fogs;  /* linked through `next`; NULL = none */
     const scene_sky_sphere *sky_sphere; /* NULL = none */

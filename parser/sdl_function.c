@@ -498,6 +498,19 @@ static void special_body(fn_build *b, scene_function *f, const sdl_tok *k)
     }
 }
 
+/* 1 when f's body calls a function whose body is internal(59), f_ridged_mf
+ * (scene.ridged_mf_callers) */
+static int calls_ridged_mf(const scene_function *f)
+{
+    for (int i = 0; i < f->nnodes; i++) {
+        const scene_function *g = f->nodes[i].op == FN_CALL ? f->nodes[i].fn : NULL;
+        if (g && g->kind == FUNC_FLOAT && g->nodes && g->root >= 0 && g->root < g->nnodes &&
+            g->nodes[g->root].op == FN_INTERNAL && g->nodes[g->root].slot == FUNC_INTERNAL_RIDGED_MF)
+            return 1;
+    }
+    return 0;
+}
+
 scene_function *sdl_parse_function(sdl_parser *p, src_loc loc, const char *name)
 {
     fn_build b;
@@ -555,6 +568,7 @@ scene_function *sdl_parse_function(sdl_parser *p, src_loc loc, const char *name)
             f->ncode = nc;
             f->stack = stack;
         }
+        if (calls_ridged_mf(f)) p->s->ridged_mf_callers++;
     }
     free(b.nodes);
     free(b.kids);

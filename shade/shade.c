@@ -36,6 +36,7 @@
 #include "shade.h"
 #include "hash.h"
 #include "camera.h"
+#include "func_internal.h"
 #include <assert.h>
 #include <math.h>
 #include <stddef.h>
@@ -515,6 +516,32 @@ rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 o
     c.media = shade_media_scene_has(sc);
     c.media_shadow = c.media;
     return trace_ray(&c, 0, org, v3_norm(dir), 1, 1.0, OBJ_NO_IMAGE, 0.0f, r, &no_containers);
+}
+
+#define POV_BLOCK 32 /* POV-Ray 3.7's render block (view.cpp, Render_Block_Size) */
+
+void shade_ridged_mf_first(const scene *sc, const accel *a, int width, int height)
+{
+    func_ridged_mf_reset();
+    if (!sc || sc->ridged_mf_callers < 2 || width < 1 || height < 1) return;
+    shade_settings s;
+    shade_default_settings(&s);
+    s.width = width;
+    s.height = height;
+    s.quality = 8; /* shade.h */
+    rng r;
+    rng_seed(&r, 0, 0);
+    func_ridged_mf_record();
+    for (int by = 0; by < height; by += POV_BLOCK)
+        for (int bx = 0; bx < width; bx += POV_BLOCK)
+            for (int y = by; y < by + POV_BLOCK && y < height; y++)
+                for (int x = bx; x < bx + POV_BLOCK && x < width; x++) {
+                    vec3 org, dir;
+                    if (camera_ray(&sc->camera, x + 0.5, y + 0.5, width, height, 0.0, 0.0, &org, &dir))
+                        (void)shade_trace(sc, a, &s, org, dir, 0, &r);
+                    if (func_ridged_mf_fixed(NULL, NULL)) return;
+                }
+    func_ridged_mf_reset();
 }
 
 /* --------------------------------------------------------------- the image */

@@ -94,6 +94,15 @@ void shade_default_settings(shade_settings *s);
 pt_status shade_render(const scene *sc, const accel *a, const shade_settings *s, framebuffer *fb, shade_stats *st, diag *d);
 /* Radiance along one ray (for tests and other integrators). */
 rgb shade_trace(const scene *sc, const accel *a, const shade_settings *s, vec3 org, vec3 dir, int thread, rng *r);
+/* POV-Ray's first call of f_ridged_mf (func_internal.h), in a scene with two
+ * or more functions calling it: the camera's rays through the pixel centres
+ * of a width x height image in POV-Ray 3.7's render order (its 32 x 32
+ * blocks, row by row; view.cpp's default Render_Block_Size), one thread,
+ * shaded at +Q8 (no media: a sky's media cost the most and seldom call it)
+ * until one calls it, whose H and lacunarity then weigh every call of the
+ * render. None calling it: each call its own. Does nothing in other
+ * scenes. */
+void shade_ridged_mf_first(const scene *sc, const accel *a, int width, int height);
 /* The Whitted direct term (every light, its attenuation, area grid and
  * shadows: what shade_tex_shade's direct callback gets) of surface s at hit h,
  * shaded from p (off the surface on the viewer's side). For shade_aov.c. */

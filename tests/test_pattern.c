@@ -22,12 +22,15 @@
 #include <string.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include "func_internal.h"
 #include "img_io.h"
 #include "sdl.h"
+#include "shade.h"
 #include "shade_noise.h"
 #include "shade_pattern.h"
 #include "shade_pavement.h"
 #include "shade_tiling.h"
+#include "test_world.h"
 
 #define TILE 24        /* pixels per pattern tile */
 #define COLS 8
@@ -217,6 +220,78 @@ static int run_tiles(const pattern_case *cs, int ncases, const char *tag)
     fb_free(fb);
     free(src);
     return failed;
+}
+
+/* f_ridged_mf's weights from its first call (func_internal.h): one declared
+ * f_ridged_mf called by two tiles with different H and lacunarity, the top
+ * tile first in POV-Ray's order (one thread: its 32-pixel blocks row by row).
+ * partray finds that call (shade_ridged_mf_first) and evaluates both tiles
+ * with its weights; each tile agrees with POV-Ray as run_tiles asks
+ * (measured: every pixel). With every call's own weights over a fifth of the
+ * second tile's pixels disagree (measured 32%). */
+static void test_ridged_mf_first_call(void **st)
+{
+    (void)st;
+    const char *fn[2] = {"R(x, y, z, 0.5, 2.0, 6, 0.6, 0.9, 1) * 0.5", "R(x, y, z, 0.07, 2.2, 7, 0.6, 0.9, 1) * 0.5"};
+    int w = TILE, h = 2 * TILE;
+    double span = TSPAN;
+    char src[2048];
+    int len = snprintf(src, sizeof src,
+                       "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+                       "#declare R = function { internal(59) }\n"
+                       "camera { orthographic location <%g, %g, -10> direction z right x*%g up y*%g }\n",
+                       span / 2, -span, span, 2 * span);
+    for (int i = 0; i < 2; i++)
+        len += snprintf(src + len, sizeof src - (size_t)len,
+                        "polygon { 4, <0, %g, 0>, <%g, %g, 0>, <%g, %g, 0>, <0, %g, 0> pigment { function { %s } " GREY
+                        " } finish { ambient 1 diffuse 0 } }\n",
+                        -(i + 1) * span, span, -(i + 1) * span, span, -i * span, -i * span, fn[i]);
+    assert_true(len < (int)sizeof src);
+    char path[512], cmd[2048];
+    snprintf(path, sizeof path, "%s/ridged.pov", tmpdir);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(src, f);
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "cd '%s' && povray +Iridged.pov +Oridged.png +W%d +H%d -A -D -V -GA +FN16 +WT1 >ridged.log 2>&1",
+             tmpdir, w, h);
+    if (run(cmd) != 0) fail_msg("povray failed (see %s/ridged.log)", tmpdir);
+    snprintf(path, sizeof path, "%s/ridged.png", tmpdir);
+    framebuffer *fb = NULL;
+    assert_int_equal(img_read(path, 0, &fb, NULL), PT_OK);
+
+    tu_world wd = tu_world_build("ridged.pov", src);
+    assert_int_equal(wd.s->ridged_mf_callers, 2);
+    double fh = 0.0, flac = 0.0;
+    for (int pass = 0; pass < 2; pass++) {
+        /* pass 0: the render's rule; pass 1: each call its own weights */
+        if (pass == 0) {
+            shade_ridged_mf_first(wd.s, wd.a, w, h);
+            assert_true(func_ridged_mf_fixed(&fh, &flac));
+            assert_true(fh == 0.5 && flac == 2.0); /* the top tile's, exactly */
+        } else {
+            func_ridged_mf_reset();
+            assert_false(func_ridged_mf_fixed(NULL, NULL));
+        }
+        shade_pattern_ctx pc = shade_pattern_ctx_plain(wd.s);
+        for (int i = 0; i < 2; i++) {
+            const scene_texture *tex = wd.s->objects[i]->texture;
+            int bad = 0, n = 0;
+            for (int y = i * TILE + 1; y < (i + 1) * TILE - 1; y++)
+                for (int x = 1; x < TILE - 1; x++) {
+                    vec3 p = v3((x + 0.5) / w * span, -(y + 0.5) / h * 2 * span, 0.0);
+                    colour5 c;
+                    shade_pigment_eval(&tex->pigment, xform_inv_point(&tex->transform, p), &pc, &c);
+                    if (fabs(clamp01(c.r) - fb_px(fb, x, y)[0]) > 2e-3) bad++;
+                    n++;
+                }
+            printf("ridged_mf tile %d, %s: %6.2f%% of pixels differ\n", i, pass ? "own weights" : "first call's", 100.0 * bad / n);
+            if (pass == 0 || i == 0) assert_true(bad <= MAX_BAD * n);
+            else assert_true(bad > n / 5);
+        }
+    }
+    tu_world_free(&wd);
+    fb_free(fb);
 }
 
 static void test_patterns(void **st)
@@ -596,6 +671,7 @@ int main(void)
         cmocka_unit_test(test_noise_octaves_exact),
         cmocka_unit_test(test_crackle_half_metrics),
         cmocka_unit_test(test_patterns),
+        cmocka_unit_test(test_ridged_mf_first_call),
         cmocka_unit_test(test_pavement),
         cmocka_unit_test(test_pavement_errors),
         cmocka_unit_test(test_image_options),
