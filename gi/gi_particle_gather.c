@@ -79,12 +79,12 @@ static int compatible(const gi_particle *gp, size_t i, size_t j)
 void gi_particle_view_gather_free(gi_particle *gp)
 {
     GROW_FREE_ALL(gp->vg_pt, gp->vg_cpt, gp->vg_ids, gp->vg_tab, gp->vg_link, gp->vg_esky, gp->vg_val, gp->vg_pix,
-                  gp->vg_pixval, gp->vg_nrm);
+                  gp->vg_pixval, gp->vg_nrm, gp->vg_pnrm);
     gi_gatherer_free(gp->vg_gatherer);
     gp->vg_gatherer = NULL;
     gp->vg_pt = gp->vg_cpt = NULL;
     gp->vg_tab = NULL;
-    gp->vg_nrm = NULL;
+    gp->vg_nrm = gp->vg_pnrm = NULL;
     gp->vg_ids = gp->vg_link = gp->vg_pix = NULL;
     gp->vg_esky = gp->vg_val = gp->vg_pixval = NULL;
     gp->vg_levels = 0;
@@ -203,7 +203,10 @@ static pt_status build_index(gi_particle *gp)
 
 /* Whether gather point pt may answer a hit at p with normal ng (length
  * lg) that is not kept, by POV-Ray's test for reusing an irradiance cache
- * record (radiosity.cpp, Ward's error measure): with a the scene's
+ * record (radiosity.cpp, Ward's error measure). Under radiosity `normal
+ * on` POV-Ray files a record under the perturbed normal it gathered about
+ * and compares the hit's perturbed normal (ComputeAmbient's
+ * effectiveNormal): n_pt is then pt->pn and ng the hit's. With a the scene's
  * error_bound and R the point's reach, its distance d < a R and
  * d / R + 2 sqrt(1 - n . n_pt) < a, and the point does not lie in front
  * of p (the direction from it to p makes an angle of at most about 93
@@ -216,9 +219,9 @@ static int reusable(const gi_particle *gp, const vg_point *pt, vec3 p, vec3 ng, 
     vec3 dv = v3_sub(p, pt->p);
     double d = v3_len(dv), R = pt->reach;
     if (!(d < a * R)) return 0;
-    double c = v3_dot(pt->n, ng) / lg;
+    double c = v3_dot(pt->pn, ng) / lg;
     if (!(d / R + 2.0 * sqrt(fmax(0.0, 1.0 - c)) < a)) return 0;
-    vec3 half = v3_add(pt->n, v3_scale(ng, 1.0 / lg));
+    vec3 half = v3_add(pt->pn, v3_scale(ng, 1.0 / lg));
     double hl = v3_len(half);
     return !(d > 0.0 && hl > 0.0) || v3_dot(dv, half) / (d * hl) > -0.05;
 }
@@ -234,6 +237,9 @@ static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int
     int side = v3_dot(n, hit->ng) >= 0.0;
     vec3 ng = side ? hit->ng : v3_neg(hit->ng);
     double lg = v3_len(ng), s[3] = {0.0, 0.0, 0.0}, ws = 0.0;
+    /* the normal POV-Ray's cache compares: under radiosity `normal on` the
+     * shading's perturbed n (core/radrules.h rule 5) */
+    vec3 qn = gp->set.normal_at && v3_dot(n, ng) > 0.0 ? v3_norm(n) : v3_scale(ng, 1.0 / lg);
     for (int L = 0; L < VG_LEVELS; L++) {
         if (!(gp->vg_levels >> L & 1u)) continue;
         double c = gp->vg_c0 * (double)(1u << L);
@@ -274,7 +280,7 @@ static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int
                 double d = sqrt(d2);
                 if (!(d < r) || (!relaxed && fabs(v3_dot(dv, pt->n)) > 0.25 * r)) continue;
                 if (v3_dot(pt->n, ng) < NORMAL_COS * lg) continue;
-                if (gp->vg_gatherer && !reusable(gp, pt, hit->p, ng, lg)) continue;
+                if (gp->vg_gatherer && !reusable(gp, pt, hit->p, qn, 1.0)) continue;
                 double w = 1.0 - d / r;
                 const float *v = &gp->vg_val[4 * (size_t)gp->vg_ids[e]];
                 for (int q = 0; q < 3; q++) s[q] += w * v[q];
@@ -336,10 +342,8 @@ static void put_point(gi_particle *gp, gi_dev_particle *cp, const void **cobj, u
     gi_dev_particle *q = &cp[t];
     v3_store_f(q->p, r->h.p);
     /* its rays about the texture's perturbed normal under radiosity
-     * `normal on` (core/radrules.h rule 5); which pixels may take its
-     * value (vg_nrm, vp->n) still goes by the surface's own normal */
-    vec3 ngat = nv;
-    if (gp->set.normal_at) gp->set.normal_at(gp->sc, &r->h, nv, &ngat);
+     * `normal on` (core/radrules.h rule 5, vg_pnrm) */
+    vec3 ngat = gp->vg_pnrm[i];
     v3_store_f(q->n, ngat);
     q->area = 0.0f;
     const scene_object *o = r->h.obj;
@@ -352,6 +356,7 @@ static void put_point(gi_particle *gp, gi_dev_particle *cp, const void **cobj, u
     vg_point *vp = &gp->vg_pt[k];
     vp->p = r->h.p;
     vp->n = nv;
+    vp->pn = ngat;
     vp->obj = o;
     vp->side = r->side;
     vp->r = (float)(s * r->h.t * ang / (cs > 0.25 ? cs : 0.25));
@@ -471,7 +476,7 @@ static int needs_own(const gi_particle *gp, size_t i)
         int kc = gp->vg_pix[j];
         if (kc < 0 || !compatible(gp, j, i)) continue;
         /* a corner whose record POV-Ray's cache would not reuse here */
-        if (gi_particle_exact_gather(&gp->set) && !reusable(gp, &gp->vg_pt[kc], gp->vrec[i].h.p, gp->vg_nrm[i], 1.0))
+        if (gi_particle_exact_gather(&gp->set) && !reusable(gp, &gp->vg_pt[kc], gp->vrec[i].h.p, gp->vg_pnrm[i], 1.0))
             return 1;
         const float *v = &gp->vg_val[4 * (size_t)kc];
         double l = 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
@@ -482,14 +487,17 @@ static int needs_own(const gi_particle *gp, size_t i)
     return m > 1 && hi > (1.0 + REFINE) * lo;
 }
 
-/* vg_nrm of one row of pixels */
+/* vg_nrm and vg_pnrm of one row of pixels */
 static void normal_row(void *ctx, int y, int thread)
 {
     (void)thread;
     gi_particle *gp = ctx;
     size_t w = (size_t)gp->vw;
-    for (size_t i = (size_t)y * w; i < (size_t)(y + 1) * w; i++)
-        gp->vg_nrm[i] = gp->vrec[i].kind == 2 ? view_normal(&gp->vrec[i]) : v3s(0.0);
+    for (size_t i = (size_t)y * w; i < (size_t)(y + 1) * w; i++) {
+        vec3 n = gp->vrec[i].kind == 2 ? view_normal(&gp->vrec[i]) : v3s(0.0);
+        gp->vg_nrm[i] = gp->vg_pnrm[i] = n;
+        if (gp->set.normal_at && gathers(gp, &gp->vrec[i])) gp->set.normal_at(gp->sc, &gp->vrec[i].h, n, &gp->vg_pnrm[i]);
+    }
 }
 
 /* own[i]: whether pixel i of the row, which takes its block's corners,
@@ -523,7 +531,8 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
      * takes the old estimate) */
     gp->vg_pix = malloc(npix * sizeof *gp->vg_pix);
     gp->vg_nrm = malloc(npix * sizeof *gp->vg_nrm);
-    if (!gp->vg_pix || !gp->vg_nrm) {
+    gp->vg_pnrm = malloc(npix * sizeof *gp->vg_pnrm);
+    if (!gp->vg_pix || !gp->vg_nrm || !gp->vg_pnrm) {
         gi_particle_view_gather_free(gp);
         return PT_ERR_NOMEM;
     }
@@ -716,13 +725,18 @@ static void filter_row(void *ctx, int y, int thread)
     if (R > FILTER_RADIUS_MAX) R = FILTER_RADIUS_MAX;
     double g[FILTER_RADIUS_MAX + 1];
     for (int d = 0; d <= R; d++) g[d] = exp(-0.5 * d * d / (sigma * sigma));
+    /* under radiosity `normal on` a tap whose gather's perturbed normal
+     * differs from the pixel's by more than POV-Ray's cache lets a record
+     * be reused over (Ward's normal term, 2 sqrt(1 - cos) below the error
+     * bound: reusable) is left out, as the bumps' light is the pixel's own */
+    const double a = gp->set.normal_at && gi_particle_exact_gather(&gp->set) ? gp->set.reuse_error : 0.0;
     for (int x = 0; x < w; x++) {
         size_t i = (size_t)y * w + x;
         float *o = &gp->vg_pixval[4 * i];
         o[3] = 0.0f;
         if (!F->ok[i]) continue;
         const view_rec *r = &gp->vrec[i];
-        vec3 nr = gp->vg_nrm[i];
+        vec3 nr = gp->vg_nrm[i], pn = gp->vg_pnrm[i];
         double s[3] = {0.0, 0.0, 0.0}, ws = 0.0;
         for (int dy = -R; dy <= R; dy++) {
             int yy = y + dy;
@@ -735,6 +749,7 @@ static void filter_row(void *ctx, int y, int thread)
                 const view_rec *q = &gp->vrec[j];
                 if (j != i && (!compatible(gp, j, i) || fabs(v3_dot(v3_sub(q->h.p, r->h.p), nr)) > DEPTH_TOL * r->h.t))
                     continue;
+                if (j != i && a > 0.0 && !(2.0 * sqrt(fmax(0.0, 1.0 - v3_dot(gp->vg_pnrm[j], pn))) < a)) continue;
                 double wt = g[dx < 0 ? -dx : dx] * g[dy < 0 ? -dy : dy];
                 for (int c = 0; c < 3; c++) s[c] += wt * F->raw[3 * j + c];
                 ws += wt;

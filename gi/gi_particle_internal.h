@@ -90,7 +90,9 @@ struct gi_particle {
     float *vg_val;    /* vg_n x 4: gathered E/pi */
     int *vg_pix;      /* vg_w x vg_h: a pixel's gather point, -1 none */
     float *vg_pixval; /* vg_w x vg_h x 4: each kept pixel's filtered E/pi, [3] 1 where it has one */
-    vec3 *vg_nrm;     /* vg_w x vg_h: each kept hit's normal the gather takes (gi_particle_gather.c view_normal) */
+    vec3 *vg_nrm;     /* vg_w x vg_h: each kept hit's own normal on its side (gi_particle_gather.c view_normal) */
+    vec3 *vg_pnrm;    /* vg_w x vg_h: the normal its gather takes and its reuse test compares: under radiosity
+                         `normal on` the texture's perturbed one (normal_at), else vg_nrm's */
     struct vg_point *vg_pt; /* vg_n: where each gathered (for hits that are not kept) */
     int *vg_ids;      /* vg_n: the points, by cell */
     struct vg_point *vg_cpt; /* vg_n: vg_pt[vg_ids[e]] at e (a cell's points read in a row) */
@@ -209,7 +211,8 @@ typedef struct vg_cell {
     int start, count;
 } vg_cell;
 typedef struct vg_point {
-    vec3 p, n;                /* the hit and the normal gathered about */
+    vec3 p, n;                /* the hit and its own normal on its side */
+    vec3 pn;                  /* the normal gathered about (vg_pnrm) */
     const scene_object *obj;
     float r;                  /* it answers hits within r on its object and side */
     float reach;              /* its rays' harmonic mean hit distance, within the reuse bounds

@@ -1470,6 +1470,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_integrating_sphere),
         cmocka_unit_test(test_sky_furnace),
         cmocka_unit_test(test_sky_final_gather),
+        cmocka_unit_test(test_normal_on_gather),
         cmocka_unit_test(test_csg_emitter_gather),
         cmocka_unit_test(test_mirror_gather),
         cmocka_unit_test(test_transmit_gather),

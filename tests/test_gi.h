@@ -34,6 +34,7 @@ void test_kept_hits(void **state);
 /* test_gi_sky.c */
 void test_sky_furnace(void **state);
 void test_sky_final_gather(void **state);
+void test_normal_on_gather(void **state);
 void test_csg_emitter_gather(void **state);
 void test_mirror_gather(void **state);
 void test_transmit_gather(void **state);
