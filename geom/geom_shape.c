@@ -907,10 +907,15 @@ vec3 geom_shape_pov_normal(const geom_shape *sh, vec3 p, int part)
 
 void geom_shape_surface(const geom_shape *sh, vec3 p, int part, vec3 *ng, double *u, double *v)
 {
-    vec3 po = sh->identity ? p : xform_inv_point(&sh->x, p);
+    int uv = u && v;
+    /* the point in the shape's frame; a box's, plane's, disc's or
+     * triangle's normal does not depend on it (a box's is its face's), only
+     * their (u, v) */
+    int flat = sh->kind == SHAPE_BOX || sh->kind == SHAPE_PLANE || sh->kind == SHAPE_DISC ||
+               sh->kind == SHAPE_TRIANGLE || sh->kind == SHAPE_SMOOTH_TRIANGLE;
+    vec3 po = sh->identity || (flat && !uv) ? p : xform_inv_point(&sh->x, p);
     vec3 n = v3(0, 1, 0);
     double su = 0.0, sv = 0.0;
-    int uv = u && v;
     switch (sh->kind) {
     case SHAPE_SPHERE: {
         n = v3_sub(po, sh->g.sphere.c);
@@ -925,11 +930,13 @@ void geom_shape_surface(const geom_shape *sh, vec3 p, int part, vec3 *ng, double
         int axis = part / 2;
         double s = (part & 1) ? 1.0 : -1.0;
         n = v3(axis == 0 ? s : 0.0, axis == 1 ? s : 0.0, axis == 2 ? s : 0.0);
-        vec3 ext = v3_sub(sh->g.box.hi, sh->g.box.lo);
-        vec3 f = v3_sub(po, sh->g.box.lo);
-        double fx = ext.x > 0 ? f.x / ext.x : 0, fy = ext.y > 0 ? f.y / ext.y : 0, fz = ext.z > 0 ? f.z / ext.z : 0;
-        su = clamp01(axis == 0 ? fz : fx);
-        sv = clamp01(axis == 1 ? fz : fy);
+        if (uv) {
+            vec3 ext = v3_sub(sh->g.box.hi, sh->g.box.lo);
+            vec3 f = v3_sub(po, sh->g.box.lo);
+            double fx = ext.x > 0 ? f.x / ext.x : 0, fy = ext.y > 0 ? f.y / ext.y : 0, fz = ext.z > 0 ? f.z / ext.z : 0;
+            su = clamp01(axis == 0 ? fz : fx);
+            sv = clamp01(axis == 1 ? fz : fy);
+        }
         break;
     }
     case SHAPE_PLANE:
