@@ -1028,6 +1028,25 @@ static void fill_user(const accel *a, unsigned prim, const geom_csg_hit *h, vec3
     hit->flags = l->flags;
 }
 
+/* fill_user's record without the surface (accel_crossings_cut's
+ * `surface` said it is not read): no normals, no uv. */
+static void fill_user_bare(const accel *a, unsigned prim, const geom_csg_hit *h, const accel_leaf *l,
+                           const geom_shape *sh, vec3 org, vec3 dir, accel_hit *hit)
+{
+    hit->t = h->t;
+    hit->p = v3_madd(org, dir, h->t);
+    hit->u = hit->v = 0.0;
+    hit->uv[0] = hit->uv[1] = 0.0;
+    hit->ng = hit->ns = v3(0.0, 0.0, 0.0);
+    hit->pov_flip = (sh->kind == SHAPE_TRIANGLE || sh->kind == SHAPE_SMOOTH_TRIANGLE) && sh->g.tri.wind > 0.0;
+    if (h->flip) hit->pov_flip = !hit->pov_flip;
+    hit->obj = l->obj;
+    hit->texture = l->texture;
+    hit->prim = (unsigned)h->part;
+    hit->flags = l->flags;
+    (void)prim;
+}
+
 /* accel_intersect_rule with the effective tmin t0 as given; user
  * primitives whose effective flags carry one of `skip` (the surfaces the
  * caller passes over, accel_intersect_past) lose the ties of coincident
@@ -1158,7 +1177,7 @@ static int crossings_collected(const accel *a, vec3 org, vec3 dir, double t0, do
 /* accel_crossings_skip; with `cut`, accel_crossings_cut's walk (-1 when
  * it must be walked again without the cut). */
 static int crossings_walk(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, unsigned skip,
-                          int cut, accel_crossing_fn fn, void *ctx)
+                          int cut, accel_surface_fn surface, accel_crossing_fn fn, void *ctx)
 {
     if (!a || !ray_ok(org, dir)) return 0;
     double t0 = eps_rule(a->ray_eps_scale, org, v3_len(dir));
@@ -1177,7 +1196,20 @@ static int crossings_walk(const accel *a, vec3 org, vec3 dir, double tmin, doubl
             if (cut && i > 0 && cr[i - 1].cut) return -1;
             if (!(cr[i].t > t0) || !(cr[i].t < tmax)) continue;
             geom_csg_hit g = {.t = cr[i].t, .part = cr[i].part, .shape = cr[i].shape, .flip = cr[i].flip};
-            fill_user(a, cr[i].prim, &g, org, dir, &h);
+            if (surface) {
+                /* a blob's texture depends on the point (fill_user) */
+                const geom_shape *sh = accel_prim_shape(a, cr[i].prim, g.shape);
+                unsigned li = cr[i].prim < (unsigned)a->nshapes
+                                  ? a->shape_leaf[cr[i].prim]
+                                  : a->csgs[cr[i].prim - (unsigned)a->nshapes].shape_leaf[g.shape];
+                const accel_leaf *l = &a->leaves[li];
+                if (sh->kind != SHAPE_BLOB && !surface(ctx, l->obj, l->texture))
+                    fill_user_bare(a, cr[i].prim, &g, l, sh, org, dir, &h);
+                else
+                    fill_user(a, cr[i].prim, &g, org, dir, &h);
+            } else {
+                fill_user(a, cr[i].prim, &g, org, dir, &h);
+            }
             if (!isfinite(h.t) || !v3_finite(h.p)) continue;
             t0 = h.t + fmax_inline(step, h.t * 1e-7);
             if (h.flags & skip) continue; /* a member's own flag */
@@ -1199,13 +1231,13 @@ static int crossings_walk(const accel *a, vec3 org, vec3 dir, double tmin, doubl
 int accel_crossings_skip(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, unsigned skip,
                          accel_crossing_fn fn, void *ctx)
 {
-    return crossings_walk(a, org, dir, tmin, tmax, step, skip, 0, fn, ctx);
+    return crossings_walk(a, org, dir, tmin, tmax, step, skip, 0, NULL, fn, ctx);
 }
 
 int accel_crossings_cut(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, unsigned skip,
-                        accel_crossing_fn fn, void *ctx)
+                        accel_surface_fn surface, accel_crossing_fn fn, void *ctx)
 {
-    return crossings_walk(a, org, dir, tmin, tmax, step, skip, 1, fn, ctx);
+    return crossings_walk(a, org, dir, tmin, tmax, step, skip, 1, surface, fn, ctx);
 }
 
 int accel_crossings(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, accel_crossing_fn fn,

@@ -110,17 +110,24 @@ int accel_crossings(const accel *a, vec3 org, vec3 dir, double tmin, double tmax
  * the one-traversal walk such primitives are not asked at all. */
 int accel_crossings_skip(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, unsigned skip,
                          accel_crossing_fn fn, void *ctx);
+/* Whether a crossing walk's fn reads the surface of a crossing of leaf
+ * object obj with effective texture tex (accel_crossings_cut). */
+typedef int (*accel_surface_fn)(void *ctx, const scene_object *obj, const scene_texture *tex);
 /* accel_crossings_skip for a walk that stops (fn returns 0) at the first
  * crossing of an object none of whose textures can let light through
  * (transmit_texture_may: a shadow ray's filter is 0 there): of such a
  * height field only the nearest crossing is collected, not its crossings
  * behind it (its walk over the cells along the rest of the ray).
- * The crossings fn gets are accel_crossings_skip's. Returns -1 when fn
- * went on past such a crossing (the walk's own rule passed it over), so
+ * The crossings fn gets are accel_crossings_skip's; where `surface` (if
+ * not NULL) says fn does not read the surface of a crossing found in the
+ * one-traversal walk (not of a blob, whose texture depends on the point),
+ * its record has t, p, obj, texture, flags, prim and pov_flip but no
+ * normals (ng and ns 0) and no uv. Returns -1 when fn
+ * went on past a cut crossing (the walk's own rule passed it over), so
  * that the crossings after it may be missing: the caller walks again with
  * accel_crossings_skip. */
 int accel_crossings_cut(const accel *a, vec3 org, vec3 dir, double tmin, double tmax, double step, unsigned skip,
-                        accel_crossing_fn fn, void *ctx);
+                        accel_surface_fn surface, accel_crossing_fn fn, void *ctx);
 /* Mutual visibility of two surface points for density estimates
  * (ACCEL_RAY_EXACT: it steps over crossings between the points): 1 when
  * the segment from x + lift*nx to y + lift*ny (lift = 16 eps) crosses no

@@ -28,10 +28,15 @@ int transmit_refract(vec3 d, vec3 local, double cos_n, double eta, vec3 *out)
     return 0;
 }
 
+int transmit_fade_none(const scene_interior *in, int shadow)
+{
+    return !in || fabs(in->fade_distance) <= TRANSMIT_EPSILON || (shadow && in->fade_power <= 0.0);
+}
+
 rgb transmit_fade(const scene_interior *in, double d, int shadow)
 {
     rgb one = {1, 1, 1};
-    if (!in || fabs(in->fade_distance) <= TRANSMIT_EPSILON || (shadow && in->fade_power <= 0.0)) return one;
+    if (transmit_fade_none(in, shadow)) return one;
     rgb fc = in->fade_colour;
     if (in->fade_power >= 1000) {
         double k = d / in->fade_distance;

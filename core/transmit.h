@@ -36,6 +36,8 @@ int transmit_refract(vec3 d, vec3 local, double cos_n, double eta, vec3 *out);
  * fade_distance, and for a shadow ray (`shadow`) also without a
  * fade_power above 0 (POV-Ray tests it for shadows only). */
 rgb transmit_fade(const scene_interior *in, double d, int shadow);
+/* Whether transmit_fade(in, d, shadow) is 1 in every channel whatever d. */
+int transmit_fade_none(const scene_interior *in, int shadow);
 
 /* 1 when texture t (its layers, maps and image maps) can let light
  * through somewhere: a filter or transmit above 0 in some colour, a

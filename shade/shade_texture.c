@@ -794,6 +794,22 @@ static int shadow_crossing(void *ctx, const accel_hit *h)
     return 1;
 }
 
+/* Whether shadow_crossing reads the surface of a crossing of obj with
+ * texture tex (accel_crossings_cut's `surface`): only for the side it is
+ * crossed from (the interior texture's choice; the fade of the stretch
+ * inside) and for textures other than plain colours or with faked
+ * caustics (the filter's point and normal). Without these its filter is
+ * shade_tex_shadow_filter_inside's product of the layers' colours, and
+ * the fade it would take inside is 1 (transmit_fade_none). */
+static int shadow_surface(void *ctx, const scene_object *obj, const scene_texture *tex)
+{
+    (void)ctx;
+    if (!obj || obj->interior_texture || !tex) return 1;
+    const scene_interior *in = obj->interior;
+    if ((in && in->caustics != 0.0) || !transmit_fade_none(in, 1)) return 1;
+    return !shadow_layers_plain(tex);
+}
+
 /* A walk from the lit point: no crossing taken, no interior passed unseen
  * (the list's entries from n on are not read), all light let through. */
 static void shadow_walk_start(shadow_walk *w, const scene *sc, const scene_light *photon_light, vec3 dir)
@@ -814,7 +830,7 @@ rgb shade_tex_shadow_ray(const scene *sc, const accel *a, vec3 p, vec3 dir, doub
      * passed it over */
     shadow_walk w;
     shadow_walk_start(&w, sc, photon_light, dir);
-    if (accel_crossings_cut(a, p, dir, tmin, tmax, tmin, OBJ_NO_SHADOW, shadow_crossing, &w) < 0) {
+    if (accel_crossings_cut(a, p, dir, tmin, tmax, tmin, OBJ_NO_SHADOW, shadow_surface, shadow_crossing, &w) < 0) {
         shadow_walk_start(&w, sc, photon_light, dir);
         accel_crossings_skip(a, p, dir, tmin, tmax, tmin, OBJ_NO_SHADOW, shadow_crossing, &w);
     }

@@ -54,7 +54,8 @@ void test_height_field(void **st)
  * x = 0.25 and 0.75, then a glass sphere at 2.5 and 3.5: a walk that
  * stops on the height field gets what accel_crossings_skip gives it; one
  * that goes on past it is told to walk again (-1), and the full walk has
- * all four crossings. */
+ * all four crossings. A walk whose `surface` says it reads no surface gets
+ * the crossings without normals. */
 typedef struct {
     double t[8];
     int n;
@@ -67,6 +68,30 @@ static int log_cut(void *ctx, const accel_hit *h)
     if (l->n < 8) l->t[l->n] = h->t;
     l->n++;
     return !(l->stop_at_field && h->obj && h->obj->kind == SHAPE_HEIGHT_FIELD);
+}
+
+typedef struct {
+    double t[8], len[8];
+    int n, go_on;
+} surface_log;
+
+static int no_surface(void *ctx, const scene_object *obj, const scene_texture *tex)
+{
+    (void)ctx;
+    (void)tex;
+    assert_non_null(obj);
+    return 0;
+}
+
+static int log_surface(void *ctx, const accel_hit *h)
+{
+    surface_log *l = ctx;
+    if (l->n < 8) {
+        l->t[l->n] = h->t;
+        l->len[l->n] = v3_len(h->ng);
+    }
+    l->n++;
+    return l->go_on;
 }
 
 void test_height_field_cut(void **st)
@@ -88,15 +113,32 @@ void test_height_field_cut(void **st)
     const double all[4] = {1 + x0, 2 - x0, 3.5, 4.5}; /* from x = -1 */
     vec3 o = v3(-1, 0.5, 0.5), d = v3(1, 0, 0);
     cut_log l = {{0}, 0, 1}, m = {{0}, 0, 1};
-    assert_int_equal(accel_crossings_cut(w.a, o, d, 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW, log_cut, &l), 1);
+    assert_int_equal(accel_crossings_cut(w.a, o, d, 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW, NULL, log_cut, &l), 1);
     assert_int_equal(accel_crossings_skip(w.a, o, d, 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW, log_cut, &m), 1);
     assert_near(l.t[0], m.t[0], 0.0);
     assert_near(l.t[0], all[0], 1e-6);
     l = (cut_log){{0}, 0, 0};
-    assert_int_equal(accel_crossings_cut(w.a, o, d, 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW, log_cut, &l), -1);
+    assert_int_equal(accel_crossings_cut(w.a, o, d, 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW, NULL, log_cut, &l), -1);
     m = (cut_log){{0}, 0, 0};
     assert_int_equal(accel_crossings_skip(w.a, o, d, 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW, log_cut, &m), 4);
     for (int i = 0; i < 4; i++) assert_near(m.t[i], all[i], 1e-6);
+    /* a walk that does not read the surfaces gets the same crossings
+     * without their normals; one that does gets unit normals */
+    surface_log sl = {{0}, {0}, 0, 0};
+    assert_int_equal(accel_crossings_cut(w.a, o, d, 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW, no_surface, log_surface, &sl), 1);
+    assert_near(sl.t[0], all[0], 1e-6);
+    assert_near(sl.len[0], 0.0, 0.0);
+    sl = (surface_log){{0}, {0}, 0, 1};
+    o = v3(2, 0.5, 0.5);
+    assert_int_equal(accel_crossings_cut(w.a, o, d, 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW, no_surface, log_surface, &sl), 2);
+    assert_near(sl.t[0], 0.5, 1e-9);
+    assert_near(sl.t[1], 1.5, 1e-9);
+    assert_near(sl.len[0], 0.0, 0.0);
+    assert_near(sl.len[1], 0.0, 0.0);
+    sl = (surface_log){{0}, {0}, 0, 1};
+    assert_int_equal(accel_crossings_cut(w.a, o, d, 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW, NULL, log_surface, &sl), 2);
+    assert_near(sl.len[0], 1.0, 1e-12);
+    assert_near(sl.len[1], 1.0, 1e-12);
     done(&w);
     unlink(path);
 }
