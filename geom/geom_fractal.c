@@ -32,6 +32,7 @@ typedef struct {
     double R, exit;       /* bounding radius, bailout on |z|^2 */
     double complex ca, cb; /* c as the complex pair (hypercomplex) */
     double rho;           /* every point farther from the centre escapes (jf_escape_radius); 0: none known */
+    double rho_a, rho_b;  /* hypercomplex: the same for either number of the pair alone; 0: none */
 } jf_data;
 
 /* The slice: z0 = (x, y, z, w(x, y, z)). */
@@ -253,35 +254,46 @@ static int jf_at(const jf_data *f, vec3 p) { return jf_inside(f, p.x, p.y, p.z, 
 typedef double jf_v2 __attribute__((vector_size(16)));
 typedef long long jf_m2 __attribute__((vector_size(16))); /* a lane comparison: -1 or 0 */
 
+/* g^-(n-1)(E) for g(r) = r^k - c (k = 2, 3), widened by a relative 1e-6,
+ * far beyond the rounding of the iteration: a start with |z_0| beyond it
+ * has |z_(n-1)| > E, as |z^k + c| >= |z|^k - |c| and g is increasing. */
+static double jf_back_radius(const jf_data *f, double c, double E)
+{
+    double r = E;
+    for (int i = 1; i < f->n; i++) r = f->func == JULIA_CUBE ? cbrt(r + c) : sqrt(r + c);
+    return r * (1.0 + 1e-6);
+}
+
 /* A radius beyond which every point escapes within max_iteration, for the
- * iterations z -> z^k + c (k = 2, 3) whose norm grows as |z|^k:
- * |z^k + c| >= |z|^k - |c|, and g(r) = r^k - |c| is increasing, so a start
- * with |z_0| > g^-(n-1)(E) has |z_(n-1)| > E. Quaternions: the norm is
- * multiplicative, E^2 the bailout. Hypercomplex numbers: the complex pair
- * (a, b) iterates a -> a^k + ca and b -> b^k + cb apart, with
- * |z|^2 = (|a|^2 + |b|^2) / 2, so the larger of |a|, |b| is at least |z|
- * and alone exceeds the bailout once its square passes twice it. The
- * lifted point's norm is at least the 3-D point's (lift adds w). The
- * radius is widened by a relative 1e-6, far beyond the rounding of the
- * iteration, so a point past it escapes in floating point as well. Returns
- * 0 for the other functions or where the radius is not below R. */
-static double jf_escape_radius(const jf_data *f)
+ * iterations z -> z^k + c (k = 2, 3) whose norm grows as |z|^k
+ * (jf_back_radius). Quaternions: the norm is multiplicative, E^2 the
+ * bailout. Hypercomplex numbers: the complex pair (a, b) iterates
+ * a -> a^k + ca and b -> b^k + cb apart, with |z|^2 = (|a|^2 + |b|^2) / 2,
+ * so either of |a|, |b| alone exceeds the bailout once its square passes
+ * twice it: ra and rb get the radii for a and b apart (the larger of
+ * |a|, |b| is at least |z|, so the larger radius holds for |z|). The
+ * lifted point's norm is at least the 3-D point's (lift adds w). Returns
+ * 0 for the other functions or where the radius is not below R (then ra
+ * and rb are 0 too). */
+static double jf_escape_radius(const jf_data *f, double *ra, double *rb)
 {
     const int cube = f->func == JULIA_CUBE;
+    *ra = *rb = 0.0;
     if (f->hyper && f->func != JULIA_SQR && !cube) return 0.0;
-    double c, E;
+    double r;
     if (f->hyper) {
-        c = fmax(cabs(f->ca), cabs(f->cb));
-        E = sqrt(2.0 * f->exit);
+        const double E = sqrt(2.0 * f->exit);
+        *ra = jf_back_radius(f, cabs(f->ca), E);
+        *rb = jf_back_radius(f, cabs(f->cb), E);
+        r = fmax(*ra, *rb);
     } else {
         /* jf_inside iterates the square for every quaternion function but the cube */
-        c = sqrt(f->c[0] * f->c[0] + f->c[1] * f->c[1] + f->c[2] * f->c[2] + f->c[3] * f->c[3]);
-        E = sqrt(f->exit);
+        r = jf_back_radius(f, sqrt(f->c[0] * f->c[0] + f->c[1] * f->c[1] + f->c[2] * f->c[2] + f->c[3] * f->c[3]),
+                           sqrt(f->exit));
     }
-    double r = E;
-    for (int i = 1; i < f->n; i++) r = cube ? cbrt(r + c) : sqrt(r + c);
-    r *= 1.0 + 1e-6;
-    return isfinite(r) && r < f->R ? r : 0.0;
+    if (isfinite(r) && r < f->R && isfinite(*ra) && isfinite(*rb)) return r;
+    *ra = *rb = 0.0;
+    return 0.0;
 }
 
 int geom_fractal_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
@@ -313,7 +325,7 @@ int geom_fractal_init(geom_shape *sh, const scene_object *o, vec3 *lo, vec3 *hi)
         f->exit = 16.0;
         to_pair(f->c, &f->ca, &f->cb);
     }
-    f->rho = jf_escape_radius(f);
+    f->rho = jf_escape_radius(f, &f->rho_a, &f->rho_b);
     *lo = v3s(-f->R);
     *hi = v3s(f->R);
     sh->data = f;
@@ -502,6 +514,29 @@ int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
     }
     double complex dp[2] = {0, 0};
     if (f->hyper) jf_dir_pair(f, e, dp);
+    if (f->rho_a > 0.0) {
+        /* the same for the pair's numbers apart: the ray's a and b are
+         * a0 + t da and b0 + t db (the direction's pair, jf_dir_pair) */
+        double q[4];
+        double complex pa[2];
+        lift(f, p0, q);
+        to_pair(q, &pa[0], &pa[1]);
+        const double rr[2] = {f->rho_a, f->rho_b};
+        for (int k = 0; k < 2; k++) {
+            double A2 = creal(dp[k]) * creal(dp[k]) + cimag(dp[k]) * cimag(dp[k]);
+            double B2 = creal(pa[k]) * creal(dp[k]) + cimag(pa[k]) * cimag(dp[k]);
+            double C2 = creal(pa[k]) * creal(pa[k]) + cimag(pa[k]) * cimag(pa[k]) - rr[k] * rr[k];
+            if (!(A2 > 0.0)) {
+                if (C2 > 0.0) return 0;
+                continue;
+            }
+            double D2 = B2 * B2 - A2 * C2;
+            if (!(D2 > 0.0)) return 0;
+            double sd = sqrt(D2), t2 = (-B2 + sd) / A2;
+            if (!(t2 > 0.0) || !((-B2 - sd) / A2 < len)) return 0;
+            end = fmin_inline(end, t2);
+        }
+    }
     int cur = jf_inside(f, p0.x, p0.y, p0.z, dp[0], dp[1], &de), n = 0;
     for (long guard = 0; tau < end && guard < 10000000; guard++) {
         if (n == max && a + tau / s > out[max - 1].t) break;
