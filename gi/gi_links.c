@@ -98,6 +98,23 @@ static void hit_material(const link_job *J, const struct RTCRayHit *h, const sce
             if (accel_rtc_object_tri(J->a, h->hit.geomID, h->hit.primID, h->hit.instID[0], &local) == o)
                 accel_mesh_uv(o, local, h->hit.u, h->hit.v, ah.uv);
         }
+        /* on a flat shape, the texture read where the hit lies in double
+         * precision: POV-Ray intersects its radiosity rays so, and its
+         * patterns' 1e-10 offsets (checker, brick, cells: pattern.cpp)
+         * put a face lying in a cell boundary wholly in one cell
+         * (balcony.pov's floor at z = 0 in a checker of textures).
+         * Embree's float hit lies up to about 1e-7 of its coordinates off
+         * the face on either side, and took either cell at random. Found
+         * again by accel_intersect over a short stretch of the same ray.
+         * Only a planar face can lie in a boundary as a whole; on other
+         * surfaces the float error moves a cell's edge by as little,
+         * which no gather sees. */
+        if (o->kind == SHAPE_BOX || o->kind == SHAPE_PLANE || o->kind == SHAPE_DISC || o->kind == SHAPE_POLYGON) {
+            vec3 org = v3(h->ray.org_x, h->ray.org_y, h->ray.org_z), d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
+            double t = h->ray.tfar, dt = 1e-4 * t + 1e-6;
+            accel_hit dh;
+            if (accel_intersect(J->a, org, d, t - dt, t + dt, &dh) && dh.obj == o) ah.p = dh.p;
+        }
         if (J->pig(J->sc, tex, &ah, &c) && isfinite(c.r) &&
             isfinite(c.g) && isfinite(c.b) && isfinite(c.f) && isfinite(c.t))
             cp = &c;
