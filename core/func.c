@@ -19,35 +19,6 @@ static int truth(double v) { return v != 0.0; }
 
 static pt_status eval_function(const scene_function *f, const double *args, double *out, eval_ctx *c);
 
-static double math1(func_math m, double x)
-{
-    switch (m) {
-    case FM_SIN: return sin(x);
-    case FM_COS: return cos(x);
-    case FM_TAN: return tan(x);
-    case FM_ASIN: return asin(x);
-    case FM_ACOS: return acos(x);
-    case FM_ATAN: return atan(x);
-    case FM_SINH: return sinh(x);
-    case FM_COSH: return cosh(x);
-    case FM_TANH: return tanh(x);
-    case FM_ASINH: return asinh(x);
-    case FM_ACOSH: return acosh(x);
-    case FM_ATANH: return atanh(x);
-    case FM_ABS: return fabs(x);
-    case FM_RADIANS: return x * (M_PI / 180.0);
-    case FM_DEGREES: return x * (180.0 / M_PI);
-    case FM_FLOOR: return floor(x);
-    case FM_INT: return trunc(x);
-    case FM_CEIL: return ceil(x);
-    case FM_SQRT: return sqrt(x);
-    case FM_EXP: return exp(x);
-    case FM_LN: return log(x);
-    case FM_LOG: return log10(x);
-    default: return x * x; /* FM_SQR */
-    }
-}
-
 /* ------------------------------------------------------------ compiler */
 
 /* A compiled body is three-address code on a register file: registers
@@ -57,16 +28,41 @@ static double math1(func_math m, double x)
  * sits in the instruction (the _K and K_ forms), a parameter is read from
  * its register: the leaves of the tree (about half its nodes) cost no
  * instruction. */
+/* The maths functions, in func_math's order, as f(x). */
+#define FI_MATHS(X) \
+    X(SIN, sin(x)) X(COS, cos(x)) X(TAN, tan(x)) X(ASIN, asin(x)) X(ACOS, acos(x)) X(ATAN, atan(x)) \
+    X(SINH, sinh(x)) X(COSH, cosh(x)) X(TANH, tanh(x)) X(ASINH, asinh(x)) X(ACOSH, acosh(x)) X(ATANH, atanh(x)) \
+    X(ABS, fabs(x)) X(RADIANS, x * (M_PI / 180.0)) X(DEGREES, x * (180.0 / M_PI)) X(FLOOR, floor(x)) \
+    X(INT, trunc(x)) X(CEIL, ceil(x)) X(SQRT, sqrt(x)) X(EXP, exp(x)) X(LN, log(x)) X(LOG, log10(x)) X(SQR, x * x)
+/* Ops of one register operand x (register a) and the constant k. */
+#define FI_UNARY(X) \
+    X(NEG, -x) FI_MATHS(X) \
+    X(ADD_K, x + k) X(SUB_K, x - k) X(MUL_K, x * k) X(DIV_K, x / k) \
+    X(K_ADD, k + x) X(K_SUB, k - x) X(K_MUL, k * x) X(K_DIV, k / x) X(POW_K, pow(x, k))
+/* Ops of two register operands x (register a) and y (register b). */
+#define FI_BINARY(X) \
+    X(ADD, x + y) X(SUB, x - y) X(MUL, x * y) X(DIV, x / y) \
+    X(LT, x < y) X(LE, x <= y) X(EQ, x == y) X(NE, x != y) X(GE, x >= y) X(GT, x > y) \
+    X(AND, truth(x) && truth(y)) X(OR, truth(x) || truth(y)) \
+    X(ATAN2, atan2(x, y)) X(POW, pow(x, y)) X(MOD, fmod(x, y)) X(IDIV, trunc(x / y))
+/* Each unary op has an _A form whose x is the previous instruction's
+ * result, kept in a local (func_compile's last pass picks them); each
+ * binary op an _A form (x is it) and a _B form (y is it). */
+#define FI_ENUM_U(N, E) FI_##N, FI_##N##_A,
+#define FI_ENUM_B(N, E) FI_##N, FI_##N##_A, FI_##N##_B,
 enum {
     FI_MOV,      /* dst = a */
     FI_LOADK,    /* dst = k */
-    FI_NEG, FI_MATH,                             /* dst = op a */
-    FI_ADD, FI_SUB, FI_MUL, FI_DIV,              /* dst = a op b */
-    FI_ADD_K, FI_SUB_K, FI_MUL_K, FI_DIV_K,      /* dst = a op k */
-    FI_K_ADD, FI_K_SUB, FI_K_MUL, FI_K_DIV,      /* dst = k op b */
-    FI_LT, FI_LE, FI_EQ, FI_NE, FI_GE, FI_GT, FI_AND, FI_OR,
-    FI_ATAN2, FI_POW, FI_MOD, FI_IDIV,           /* dst = op(a, b) */
+    FI_UNARY(FI_ENUM_U)                          /* dst = op a (and k) */
+    FI_BINARY(FI_ENUM_B)                         /* dst = a op b */
     FI_MIN, FI_MAX, /* dst = min/max of registers a .. a + n - 1, in order */
+    FI_CALL,     /* dst = fn's result term sub (5: gray) of the n
+                    registers from a */
+    FI_CALL_INT, /* dst = internal(b) of the n registers from a (a call of
+                    a function whose body is one built-in) */
+    FI_INTERNAL, /* dst = internal(b) of the function's slots, from
+                    register a (0, or an inlined callee's first) */
+    /* the ops above write register dst; those below are control */
     FI_JNLT,     /* unless a < 0 jump to dst (select's first test) */
     FI_SEL4,     /* a < 0: next; a == 0: jump to dst; else jump to b */
     FI_JMP,      /* jump to dst */
@@ -77,14 +73,11 @@ enum {
                     a+2 op= it, a+3 += 1; while a+3 <= to:
                     slot dst = a+3, jump to b (the body); sub: 1 sum */
     FI_END,      /* a = a+2 (the loop's value into its register) */
-    FI_CALL,     /* dst = fn's result term sub (5: gray) of the n
-                    registers from a */
-    FI_CALL_INT, /* dst = internal(b) of the n registers from a (a call of
-                    a function whose body is one built-in) */
-    FI_INTERNAL, /* dst = internal(b) of the function's slots, from
-                    register a (0, or an inlined callee's first) */
     FI_RET       /* the end: the value is in the first temporary */
 };
+
+#define FI_MATH_OP(N, E) [FM_##N] = FI_##N,
+static const unsigned char math_op[] = {FI_MATHS(FI_MATH_OP)};
 
 /* An operand: register r, or the constant k when r < 0. */
 typedef struct {
@@ -178,8 +171,8 @@ static operand compile_node(compiler *cp, int i, int depth, int level)
     case FN_NEG: case FN_MATH: {
         operand x = compile_node(cp, k[0], depth, level + 1);
         if (x.r < 0) place(cp, x, dst), x.r = dst;
-        int at = emit(cp, nd->op == FN_NEG ? FI_NEG : FI_MATH, dst, x.r, 0);
-        if (!cp->bad) cp->out[at].sub = nd->sub;
+        if (nd->op == FN_MATH && nd->sub >= sizeof math_op) break;
+        emit(cp, nd->op == FN_NEG ? FI_NEG : math_op[nd->sub], dst, x.r, 0);
         return res;
     }
     case FN_ADD: case FN_SUB: case FN_MUL: case FN_DIV: {
@@ -187,9 +180,13 @@ static operand compile_node(compiler *cp, int i, int depth, int level)
         operand x = compile_node(cp, k[0], depth, level + 1);
         operand y = compile_node(cp, k[1], depth + 1, level + 1);
         if (x.r < 0 && y.r < 0) place(cp, x, dst), x.r = dst;
-        int at = x.r < 0 ? emit(cp, FI_K_ADD + o, dst, 0, y.r)
-               : y.r < 0 ? emit(cp, FI_ADD_K + o, dst, x.r, 0)
-                         : emit(cp, FI_ADD + o, dst, x.r, y.r);
+        static const unsigned char rr[] = {FI_ADD, FI_SUB, FI_MUL, FI_DIV};
+        static const unsigned char rk[] = {FI_ADD_K, FI_SUB_K, FI_MUL_K, FI_DIV_K};
+        static const unsigned char kr[] = {FI_K_ADD, FI_K_SUB, FI_K_MUL, FI_K_DIV};
+        /* the register operand of a k-op form is a */
+        int at = x.r < 0 ? emit(cp, kr[o], dst, y.r, 0)
+               : y.r < 0 ? emit(cp, rk[o], dst, x.r, 0)
+                         : emit(cp, rr[o], dst, x.r, y.r);
         if (!cp->bad) cp->out[at].k = x.r < 0 ? x.k : y.k;
         return res;
     }
@@ -202,6 +199,12 @@ static operand compile_node(compiler *cp, int i, int depth, int level)
         operand x = compile_node(cp, k[0], depth, level + 1);
         if (x.r < 0) place(cp, x, dst), x.r = dst;
         operand y = compile_node(cp, k[1], depth + 1, level + 1);
+        if (y.r < 0 && nd->op == FN_POW) {
+            /* pow(x, k): the same pow of the same values */
+            int at = emit(cp, FI_POW_K, dst, x.r, 0);
+            if (!cp->bad) cp->out[at].k = y.k;
+            return res;
+        }
         if (y.r < 0) place(cp, y, dst + 1), y.r = dst + 1;
         if (depth + 2 > cp->top) cp->top = depth + 2;
         emit(cp, ops[nd->op], dst, x.r, y.r);
@@ -305,6 +308,41 @@ int func_code_bound(const scene_function *f)
     return n < INT_MAX / 2 ? (int)n : INT_MAX / 2;
 }
 
+#define FI_TO_A(N, E) [FI_##N] = FI_##N##_A,
+#define FI_TO_B(N, E) [FI_##N] = FI_##N##_B,
+static const unsigned char form_a[FI_RET + 1] = {FI_UNARY(FI_TO_A) FI_BINARY(FI_TO_A)};
+static const unsigned char form_b[FI_RET + 1] = {FI_BINARY(FI_TO_B)};
+
+/* The last pass: an op that reads the register the instruction before it
+ * wrote takes that value from run's local instead (its _A or _B form),
+ * unless something jumps to it (then the instruction before is not the
+ * one that ran). Every op before FI_JNLT leaves its result in the local;
+ * the register is written too, so any later reader still finds it. */
+static void chain_results(func_insn *code, int n)
+{
+    unsigned char *target = calloc((size_t)n + 1, 1);
+    if (!target) return; /* the plain forms compute the same */
+    for (int i = 0; i < n; i++) {
+        const func_insn *in = &code[i];
+        int t1 = -1, t2 = -1;
+        switch (in->op) {
+        case FI_JNLT: case FI_JMP: t1 = in->dst; break;
+        case FI_SEL4: t1 = in->dst, t2 = in->b; break;
+        case FI_LOOP: case FI_NEXT: t1 = in->b; break;
+        }
+        if (t1 >= 0 && t1 <= n) target[t1] = 1;
+        if (t2 >= 0 && t2 <= n) target[t2] = 1;
+    }
+    for (int i = 1; i < n; i++) {
+        func_insn *in = &code[i];
+        const func_insn *prev = &code[i - 1];
+        if (target[i] || prev->op >= FI_JNLT || in->op > FI_RET) continue;
+        if (form_a[in->op] && in->a == prev->dst) in->op = form_a[in->op];
+        else if (form_b[in->op] && in->b == prev->dst) in->op = form_b[in->op];
+    }
+    free(target);
+}
+
 int func_compile(const scene_function *f, func_insn *out, int max, int *stack)
 {
     if (!f || f->kind != FUNC_FLOAT || !f->nodes || !out) return -1;
@@ -314,6 +352,7 @@ int func_compile(const scene_function *f, func_insn *out, int max, int *stack)
     emit(&cp, FI_RET, 0, 0, 0);
     if (cp.bad) return cp.deep ? -2 : -1;
     if (stack) *stack = cp.top;
+    chain_results(out, cp.n);
     return cp.n;
 }
 
@@ -327,109 +366,104 @@ int func_compile(const scene_function *f, func_insn *out, int max, int *stack)
  * temporaries from register t0) to its FI_RET. */
 static double run(const scene_function *f, double *r, int t0, eval_ctx *c)
 {
-    const func_insn *code = f->code;
-    int pc = 0;
+    const func_insn *code = f->code, *pc = code;
+    double acc = 0.0; /* the last value op's result */
     for (;;) {
-        const func_insn *in = &code[pc++];
-        double *d = r + in->dst;
+        const func_insn *in = pc++;
         switch (in->op) {
-        case FI_MOV: *d = r[in->a]; break;
-        case FI_LOADK: *d = in->k; break;
-        case FI_NEG: *d = -r[in->a]; break;
-        case FI_MATH: *d = math1((func_math)in->sub, r[in->a]); break;
-        case FI_ADD: *d = r[in->a] + r[in->b]; break;
-        case FI_SUB: *d = r[in->a] - r[in->b]; break;
-        case FI_MUL: *d = r[in->a] * r[in->b]; break;
-        case FI_DIV: *d = r[in->a] / r[in->b]; break;
-        case FI_ADD_K: *d = r[in->a] + in->k; break;
-        case FI_SUB_K: *d = r[in->a] - in->k; break;
-        case FI_MUL_K: *d = r[in->a] * in->k; break;
-        case FI_DIV_K: *d = r[in->a] / in->k; break;
-        case FI_K_ADD: *d = in->k + r[in->b]; break;
-        case FI_K_SUB: *d = in->k - r[in->b]; break;
-        case FI_K_MUL: *d = in->k * r[in->b]; break;
-        case FI_K_DIV: *d = in->k / r[in->b]; break;
-        case FI_LT: *d = r[in->a] < r[in->b]; break;
-        case FI_LE: *d = r[in->a] <= r[in->b]; break;
-        case FI_EQ: *d = r[in->a] == r[in->b]; break;
-        case FI_NE: *d = r[in->a] != r[in->b]; break;
-        case FI_GE: *d = r[in->a] >= r[in->b]; break;
-        case FI_GT: *d = r[in->a] > r[in->b]; break;
-        case FI_AND: *d = truth(r[in->a]) && truth(r[in->b]); break;
-        case FI_OR: *d = truth(r[in->a]) || truth(r[in->b]); break;
-        case FI_ATAN2: *d = atan2(r[in->a], r[in->b]); break;
-        case FI_POW: *d = pow(r[in->a], r[in->b]); break;
-        case FI_MOD: *d = fmod(r[in->a], r[in->b]); break;
-        case FI_IDIV: *d = trunc(r[in->a] / r[in->b]); break;
+        case FI_MOV: acc = r[in->a]; break;
+        case FI_LOADK: acc = in->k; break;
+#define FI_RUN_U(N, E)                                                                                                 \
+        case FI_##N: {                                                                                                 \
+            double x = r[in->a], k = in->k;                                                                            \
+            (void)k;                                                                                                   \
+            acc = E;                                                                                                   \
+            break;                                                                                                     \
+        }                                                                                                              \
+        case FI_##N##_A: {                                                                                             \
+            double x = acc, k = in->k;                                                                                 \
+            (void)k;                                                                                                   \
+            acc = E;                                                                                                   \
+            break;                                                                                                     \
+        }
+        FI_UNARY(FI_RUN_U)
+#define FI_RUN_B(N, E)                                                                                                 \
+        case FI_##N: {                                                                                                 \
+            double x = r[in->a], y = r[in->b];                                                                         \
+            acc = E;                                                                                                   \
+            break;                                                                                                     \
+        }                                                                                                              \
+        case FI_##N##_A: {                                                                                             \
+            double x = acc, y = r[in->b];                                                                              \
+            acc = E;                                                                                                   \
+            break;                                                                                                     \
+        }                                                                                                              \
+        case FI_##N##_B: {                                                                                             \
+            double x = r[in->a], y = acc;                                                                              \
+            acc = E;                                                                                                   \
+            break;                                                                                                     \
+        }
+        FI_BINARY(FI_RUN_B)
         case FI_MIN: case FI_MAX: {
             const double *v = r + in->a;
             double m = v[0];
             for (int j = 1; j < in->n; j++)
                 if (in->op == FI_MIN ? v[j] < m : v[j] > m) m = v[j];
-            *d = m;
+            acc = m;
+            break;
+        }
+        case FI_CALL_INT: case FI_INTERNAL: {
+            double v; /* not acc's address: acc stays in a register */
+            if (!func_internal_eval(in->b, r + in->a, c->env, &v)) {
+                c->failed = 1;
+                c->why = func_internal_name(in->b);
+                return 0;
+            }
+            acc = v;
+            break;
+        }
+        case FI_CALL: {
+            double v[5];
+            if (eval_function(in->fn, r + in->a, v, c) != PT_OK) return 0;
+            if (in->sub == 5) acc = 0.297 * v[0] + 0.589 * v[1] + 0.114 * v[2]; /* gray */
+            else acc = in->sub < in->fn->nterms ? v[in->sub] : 0.0;
             break;
         }
         case FI_JNLT:
-            if (!(r[in->a] < 0)) pc = in->dst;
-            break;
+            if (!(r[in->a] < 0)) pc = code + in->dst;
+            continue;
         case FI_SEL4: {
             double v = r[in->a];
-            if (!(v < 0)) pc = v == 0 ? in->dst : in->b;
-            break;
+            if (!(v < 0)) pc = code + (v == 0 ? in->dst : in->b);
+            continue;
         }
-        case FI_JMP: pc = in->dst; break;
+        case FI_JMP: pc = code + in->dst; continue;
         case FI_LOOP: {
             double *l = r + in->a;
             l[2] = in->k;
             l[3] = l[0];
-            if (l[0] <= l[1]) *d = l[0];
-            else pc = in->b;
-            break;
+            if (l[0] <= l[1]) r[in->dst] = l[0];
+            else pc = code + in->b;
+            continue;
         }
         case FI_NEXT: {
             double *l = r + in->a, b = l[4];
             l[2] = in->sub ? l[2] + b : l[2] * b;
             l[3] += 1.0;
             if (l[3] <= l[1]) {
-                *d = l[3];
-                pc = in->b;
+                r[in->dst] = l[3];
+                pc = code + in->b;
             }
-            break;
+            continue;
         }
-        case FI_END: r[in->a] = r[in->a + 2]; break;
-        case FI_CALL_INT: {
-            double v; /* not into *d: that is the first argument's register */
-            if (!func_internal_eval(in->b, r + in->a, c->env, &v)) {
-                c->failed = 1;
-                c->why = func_internal_name(in->b);
-                return 0;
-            }
-            *d = v;
-            break;
-        }
-        case FI_CALL: {
-            double v[5];
-            if (eval_function(in->fn, r + in->a, v, c) != PT_OK) return 0;
-            if (in->sub == 5) *d = 0.297 * v[0] + 0.589 * v[1] + 0.114 * v[2]; /* gray */
-            else *d = in->sub < in->fn->nterms ? v[in->sub] : 0.0;
-            break;
-        }
-        case FI_INTERNAL: {
-            double v;
-            if (!func_internal_eval(in->b, r + in->a, c->env, &v)) {
-                c->failed = 1;
-                c->why = func_internal_name(in->b);
-                return 0;
-            }
-            *d = v;
-            break;
-        }
+        case FI_END: r[in->a] = r[in->a + 2]; continue;
         case FI_RET: return r[t0];
         default:
             c->failed = 1;
             c->why = "bad program";
             return 0;
         }
+        r[in->dst] = acc;
     }
 }
 
