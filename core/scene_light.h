@@ -40,13 +40,17 @@ typedef struct {
 /* POV-Ray 3.7's photon rules for light l and a target's block o (NULL:
  * none), photons.cpp and photonshootingtask.cpp:
  *  - scene_photon_shoots: whether l shoots photons at target o at all: the
- *    light's and target's flags merged, some lobe on and not off;
+ *    light's and target's flags merged, some lobe on and not off; never a
+ *    `shadowless` light nor one in a light_group (photonstrategytask.cpp
+ *    walks the scene's global lights and skips FILL_LIGHT_SOURCE, the type
+ *    `shadowless` sets: reswords.cpp, parse.cpp; its light_group loop is
+ *    left out there);
  *  - scene_photon_lobe: whether a photon of l is reflected (refract 0) or
  *    refracted (1) where it hits an object with block o: the object says
  *    on and the light not off, or the light says on and the object not off. */
 static inline int scene_photon_shoots(const scene_light *l, const scene_obj_photons *o)
 {
-    if (!o || !o->target) return 0;
+    if (!o || !o->target || l->shadowless || l->group) return 0;
     int rfr_on = l->ph_refraction || o->refraction, rfr_off = l->ph_refraction_off || o->refraction_off;
     int rfl_on = l->ph_reflection || o->reflection, rfl_off = l->ph_reflection_off || o->reflection_off;
     return (rfr_on && !rfr_off) || (rfl_on && !rfl_off);

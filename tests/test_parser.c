@@ -720,6 +720,13 @@ static void test_photons_language(void **st)
     assert_true(scene_photon_lobe(l0, b, 1) && !scene_photon_lobe(l0, b, 0));
     assert_true(!scene_photon_lobe(l1, b, 1) && scene_photon_lobe(l1, a, 1) && !scene_photon_lobe(l1, a, 0));
     assert_true(!scene_photon_lobe(l0, NULL, 0) && scene_photon_lobe(l0, NULL, 1));
+    /* POV-Ray shoots no photons from a shadowless light nor from one in a
+     * light_group (photonstrategytask.cpp); shadows keep the lobe rule */
+    scene_light ls = *l0, lg = *l0;
+    ls.shadowless = 1;
+    lg.group = 1;
+    assert_true(!scene_photon_shoots(&ls, a) && !scene_photon_shoots(&lg, a));
+    assert_true(scene_photon_lobe(&ls, b, 1) && scene_photon_lobe(&lg, b, 1));
     scene_free(s);
 
     /* defaults of a bare block; spacing alone */
