@@ -681,19 +681,26 @@ static int shadow_layers_plain(const scene_texture *tex)
     return 1;
 }
 
+/* shadow_layers of a texture that shadow_layers_plain accepts: the
+ * products over the layers' colours, without the pattern context no plain
+ * colour reads. */
+static rgb shadow_layers_colours(const scene_texture *tex)
+{
+    rgb c = {1, 1, 1};
+    for (const scene_texture *l = tex; l; l = l->next) {
+        colour5 lc = l->pigment.colour;
+        c = tmul(c, trgb(lc.r * lc.f + lc.t, lc.g * lc.f + lc.t, lc.b * lc.f + lc.t));
+    }
+    return c;
+}
+
 rgb shade_tex_shadow_filter_inside(const scene *sc, const accel_hit *h, vec3 dir, int inside)
 {
     int entering = v3_dot(dir, h->ng) < 0.0;
     const scene_texture *tex = hit_texture(sc, h, entering);
     const scene_interior *in = h->obj ? h->obj->interior : NULL;
     if (!(in && in->caustics != 0.0) && shadow_layers_plain(tex)) {
-        /* shadow_layers' products over the layers' colours, without the
-         * pattern context no plain colour reads */
-        rgb c = {1, 1, 1};
-        for (const scene_texture *l = tex; l; l = l->next) {
-            colour5 lc = l->pigment.colour;
-            c = tmul(c, trgb(lc.r * lc.f + lc.t, lc.g * lc.f + lc.t, lc.b * lc.f + lc.t));
-        }
+        rgb c = shadow_layers_colours(tex);
         return inside ? tmul(c, transmit_fade(in, h->t, 1)) : c;
     }
     shade_pattern_ctx pc = shade_pattern_ctx_plain(sc);
@@ -783,10 +790,17 @@ static int shadow_crossing(void *ctx, const accel_hit *h)
         w->c = trgb(0, 0, 0);
         return 0;
     }
-    /* distance inside the object: from the previous crossing taken */
-    accel_hit hh = *h;
-    hh.t = depth;
-    w->c = tmul(w->c, shade_tex_shadow_filter_inside(w->sc, &hh, w->dir, inside));
+    if (h->ng.x == 0.0 && h->ng.y == 0.0 && h->ng.z == 0.0) {
+        /* a record without its surface (shadow_surface said so: no
+         * interior texture, no fade, plain colours): the filter is
+         * shade_tex_shadow_filter_inside's product of the colours */
+        w->c = tmul(w->c, shadow_layers_colours(h->texture));
+    } else {
+        /* distance inside the object: from the previous crossing taken */
+        accel_hit hh = *h;
+        hh.t = depth;
+        w->c = tmul(w->c, shade_tex_shadow_filter_inside(w->sc, &hh, w->dir, inside));
+    }
     if (fabs(w->c.r) < TEX_EPSILON && fabs(w->c.g) < TEX_EPSILON && fabs(w->c.b) < TEX_EPSILON) {
         w->c = trgb(0, 0, 0);
         return 0;
