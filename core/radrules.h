@@ -35,7 +35,9 @@
  * 5. `media on` lets gathering rays see media, and with them fog and
  *    rainbows (default off: GetRadiosityQualityFlags drops the media
  *    quality flag, which TraceRay asks before all three); `normal on`
- *    gathers about the perturbed normal (default off: the raw normal).
+ *    gathers about the perturbed normal and reuses a gather only where
+ *    the perturbed normals agree (ComputeAmbient's effectiveNormal;
+ *    default off: the raw normal).
  * 6. `recursion_limit` is how many bounces of gathered light POV-Ray
  *    follows; `count`, `error_bound`, `pretrace_*`, `nearest_count`,
  *    `minimum_reuse`, `maximum_reuse`, `low_error_factor`,

@@ -163,7 +163,8 @@ typedef struct {
                               NULL with PT_CANCELLED. NULL (the default): never. */
     gi_pigment_fn pigment; /* particles' pigment at their position; NULL: each texture's base colour */
     gi_normal_fn normal_at; /* radiosity `normal on` (core/radrules.h rule 5): the final gather (keep_hits) and
-                               the gatherer gather about the texture's perturbed normal; NULL: the raw one */
+                               the gatherer gather about the texture's perturbed normal, and the reuse test and
+                               the filter compare perturbed normals; NULL: the raw one */
     gi_sky_fn sky;         /* radiance of rays leaving the scene; NULL: the background colour */
     progress *progress;    /* names each step of the geometry, lighting and view stages (NULL: none) */
 } gi_particle_settings;
