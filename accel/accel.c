@@ -1047,12 +1047,11 @@ static void fill_user_bare(const accel *a, unsigned prim, const geom_csg_hit *h,
     (void)prim;
 }
 
-/* accel_intersect_rule with the effective tmin t0 as given; user
- * primitives whose effective flags carry one of `skip` (the surfaces the
- * caller passes over, accel_intersect_past) lose the ties of coincident
- * surfaces (accel_user.c). */
-static int intersect_at_skip(const accel *a, vec3 org, vec3 dir, double t0, double tmax, accel_hit *hit,
-                             accel_ray_rule rule, unsigned skip)
+/* intersect_at_skip; with `surface`, a user primitive's hit for which
+ * it says its surface is not read gets fill_user_bare's record (a blob's
+ * always the full one: its texture depends on the point). */
+static int intersect_at_surface(const accel *a, vec3 org, vec3 dir, double t0, double tmax, accel_hit *hit,
+                                accel_ray_rule rule, unsigned skip, accel_surface_fn surface, void *ctx)
 {
     accel_query q;
     query_init(&q, org, dir, t0, rule);
@@ -1086,6 +1085,18 @@ static int intersect_at_skip(const accel *a, vec3 org, vec3 dir, double t0, doub
         } else if (!accel_prim_hit(a, prim, org, dir, t0, tmax, &h, q.rule)) {
             return 0;
         }
+        /* a blob's texture depends on the point (fill_user) */
+        const geom_shape *sh = surface ? accel_prim_shape(a, prim, h.shape) : NULL;
+        if (sh && sh->kind != SHAPE_BLOB) {
+            unsigned li = prim < (unsigned)a->nshapes ? a->shape_leaf[prim]
+                                                       : a->csgs[prim - (unsigned)a->nshapes].shape_leaf[h.shape];
+            const accel_leaf *l = &a->leaves[li];
+            if (!surface(ctx, l->obj, l->texture)) {
+                fill_user_bare(a, prim, &h, l, sh, org, dir, hit);
+                assert(hit->obj && hit->texture);
+                return isfinite(hit->t) && v3_finite(hit->p);
+            }
+        }
         fill_user(a, prim, &h, org, dir, hit);
     } else {
         return 0;
@@ -1100,6 +1111,16 @@ static int intersect_at_skip(const accel *a, vec3 org, vec3 dir, double t0, doub
     assert(v3_dot(hit->ng, hit->ns) >= 0.0);
     assert(hit->obj && hit->texture);
     return isfinite(hit->t) && v3_finite(hit->p);
+}
+
+/* accel_intersect_rule with the effective tmin t0 as given; user
+ * primitives whose effective flags carry one of `skip` (the surfaces the
+ * caller passes over, accel_intersect_past) lose the ties of coincident
+ * surfaces (accel_user.c). */
+static int intersect_at_skip(const accel *a, vec3 org, vec3 dir, double t0, double tmax, accel_hit *hit,
+                             accel_ray_rule rule, unsigned skip)
+{
+    return intersect_at_surface(a, org, dir, t0, tmax, hit, rule, skip, NULL, NULL);
 }
 
 static int intersect_at(const accel *a, vec3 org, vec3 dir, double t0, double tmax, accel_hit *hit,
@@ -1219,7 +1240,7 @@ static int crossings_walk(const accel *a, vec3 org, vec3 dir, double tmin, doubl
         return cut && n > 0 && cr[n - 1].cut ? -1 : visited;
     }
     for (int k = 0; k < CROSS_MAX && t0 < tmax; k++) {
-        if (!intersect_at(a, org, dir, t0, tmax, &h, ACCEL_RAY_POV)) break;
+        if (!intersect_at_surface(a, org, dir, t0, tmax, &h, ACCEL_RAY_POV, 0u, surface, ctx)) break;
         t0 = h.t + fmax_inline(step, h.t * 1e-7);
         if (h.flags & skip) continue;
         visited++;

@@ -119,9 +119,9 @@ typedef int (*accel_surface_fn)(void *ctx, const scene_object *obj, const scene_
  * height field only the nearest crossing is collected, not its crossings
  * behind it (its walk over the cells along the rest of the ray).
  * The crossings fn gets are accel_crossings_skip's; where `surface` (if
- * not NULL) says fn does not read the surface of a crossing found in the
- * one-traversal walk (not of a blob, whose texture depends on the point),
- * its record has t, p, obj, texture, flags, prim and pov_flip but no
+ * not NULL) says fn does not read the surface of a crossing of a user
+ * primitive (not of a blob, whose texture depends on the point), its
+ * record has t, p, obj, texture, flags, prim and pov_flip but no
  * normals (ng and ns 0) and no uv. Returns -1 when fn
  * went on past a cut crossing (the walk's own rule passed it over), so
  * that the crossings after it may be missing: the caller walks again with

@@ -1405,6 +1405,7 @@ int main(void)
         cmocka_unit_test(test_blob),
         cmocka_unit_test(test_height_field),
         cmocka_unit_test(test_height_field_cut),
+        cmocka_unit_test(test_crossings_walk_surface),
         cmocka_unit_test(test_height_field_png),
         cmocka_unit_test(test_height_field_gif),
         cmocka_unit_test(test_height_field_formats),

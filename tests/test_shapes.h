@@ -107,6 +107,7 @@ static inline void write_pgm(const char *path, int w, int h, const unsigned char
 /* test_shapes_hfield.c */
 void test_height_field(void **st);
 void test_height_field_cut(void **st);
+void test_crossings_walk_surface(void **st);
 void test_height_field_png(void **st);
 void test_height_field_gif(void **st);
 void test_height_field_formats(void **st);

@@ -143,6 +143,34 @@ void test_height_field_cut(void **st)
     unlink(path);
 }
 
+/* The crossing-by-crossing walk (a scene with an isosurface, whose
+ * crossings are not collected in one traversal) honours `surface` too: an
+ * isosurface sphere of radius 0.5 at the origin and a sphere of radius
+ * 0.5 at x = 5, crossed along +x from x = -2 at 1.5, 2.5 (within the
+ * isosurface's accuracy), 6.5 and 7.5. */
+void test_crossings_walk_surface(void **st)
+{
+    (void)st;
+    world w = build("isosurface { function { sqrt(x*x + y*y + z*z) - 0.5 } contained_by { box { -1, 1 } } "
+                    "accuracy 1e-6 pigment { rgbf 0.5 } }\n"
+                    "sphere { <5, 0, 0>, 0.5 pigment { rgbt <1, 1, 1, 0.5> } }\n");
+    const double all[4] = {1.5, 2.5, 6.5, 7.5};
+    vec3 o = v3(-2, 0, 0), d = v3(1, 0, 0);
+    surface_log sl = {{0}, {0}, 0, 1};
+    assert_int_equal(accel_crossings_cut(w.a, o, d, 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW, no_surface, log_surface, &sl), 4);
+    for (int i = 0; i < 4; i++) {
+        assert_near(sl.t[i], all[i], 1e-5);
+        assert_near(sl.len[i], 0.0, 0.0);
+    }
+    surface_log full = {{0}, {0}, 0, 1};
+    assert_int_equal(accel_crossings_cut(w.a, o, d, 0.0, INFINITY, 1e-6, OBJ_NO_SHADOW, NULL, log_surface, &full), 4);
+    for (int i = 0; i < 4; i++) {
+        assert_near(full.t[i], sl.t[i], 0.0);
+        assert_near(full.len[i], 1.0, 1e-12);
+    }
+    done(&w);
+}
+
 /* A minimal GIF (no palette, 8-bit LZW codes written as literals of 9 bits). */
 static void write_gif(const char *path, int w, int h, const unsigned char *px)
 {
