@@ -365,6 +365,23 @@ static inline void nearest3_put(double s, int i, double *m1, double *m2, double 
     }
 }
 
+/* nearest3_put where the points come in any order: a tie with the
+ * smallest goes to the lower index i (the table order's first) */
+static inline void nearest3_put_first(double s, int i, double *m1, double *m2, double *m3, int *mi)
+{
+    if (s < *m1 || (s == *m1 && i < *mi)) {
+        *m3 = *m2;
+        *m2 = *m1;
+        *m1 = s;
+        *mi = i;
+    } else if (s < *m2) {
+        *m3 = *m2;
+        *m2 = s;
+    } else {
+        *m3 = s;
+    }
+}
+
 #define CRACKLE_SLOTS 64u /* per thread, 81 points each: about 122 KiB */
 #define CRACKLE_N 81      /* the points */
 static double crackle(const scene_pattern *pat, vec3 p, int gen)
@@ -408,41 +425,54 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
     if (metric == 2) {
         /* the common metric 2 (the default) */
         /* The cube's own point and its six face neighbours (table
-         * indices) bound the third-nearest square from above by their own
-         * third-smallest, u; a point beyond u cannot be among the three
-         * nearest, so the scan in table order compares only the few within
-         * u with the running three and its branches stay predictable (an
-         * insertion at every new minimum mispredicts). The result is the
-         * unbounded scan's: the three smallest values and the first index
-         * of the smallest. */
-        double a = INFINITY, b = INFINITY, u = INFINITY;
-        for (int k = 0; k < 7; k++) {
-            int i = near7[k];
-            double dx = X[i] - p.x, dy = Y[i] - p.y, dz = Z[i] - p.z;
-            keep3(dx * dx + dy * dy + dz * dz, &a, &b, &u);
-        }
-        /* The 54 points of the cubes two away along an axis (side bits:
-         * x -2, +2, y -2, +2, z -2, +2) lie beyond that cube's near face,
-         * whose distance g from p bounds their coordinate difference; the
+         * indices) are taken first, without branches (an insertion at
+         * every new minimum mispredicts): their three smallest squares
+         * start m1 <= m2 <= m3 and mi. The other 20 points of the 27
+         * cubes around p's follow, each compared with m3 only (few are
+         * within it, so the branch stays predictable). The 54 points of
+         * the cubes two away along an axis (nine per side: x -2, +2,
+         * y -2, +2, z -2, +2) lie beyond that cube's near face, whose
+         * distance g from p bounds their coordinate difference; the
          * rounded differences, squares and sums are monotone, so each such
          * point's square is at least the rounded g^2 (a cube's point lies
          * in [c, c + 1]: pattern_rands are in [0, 1)). A side whose g^2
-         * exceeds u has no point within u: its squares are not taken. */
-        static const unsigned char side[CRACKLE_N] = {
-            1, 1, 1, 1, 1, 1, 1, 1, 1, 4, 4, 4, 16, 0, 0, 0, 32, 16, 0, 0, 0, 32, 16, 0, 0, 0, 32,
-            8, 8, 8, 4, 4, 4, 16, 0, 0, 0, 32, 16, 0, 0, 0, 32, 16, 0, 0, 0, 32, 8, 8, 8, 4, 4, 4,
-            16, 0, 0, 0, 32, 16, 0, 0, 0, 32, 16, 0, 0, 0, 32, 8, 8, 8, 2, 2, 2, 2, 2, 2, 2, 2, 2};
-        double gxm = p.x - (double)(fx - 1), gxp = (double)(fx + 2) - p.x;
-        double gym = p.y - (double)(fy - 1), gyp = (double)(fy + 2) - p.y;
-        double gzm = p.z - (double)(fz - 1), gzp = (double)(fz + 2) - p.z;
-        unsigned skip = (unsigned)(gxm * gxm > u) | (unsigned)(gxp * gxp > u) << 1 | (unsigned)(gym * gym > u) << 2 |
-                        (unsigned)(gyp * gyp > u) << 3 | (unsigned)(gzm * gzm > u) << 4 | (unsigned)(gzp * gzp > u) << 5;
+         * exceeds m3 has no point that could enter the three: its squares
+         * are not taken. The three values do not depend on the order the
+         * points are taken in; mi is kept as the table's first index of
+         * the smallest (a tie goes to the lower index), so the result is
+         * the full scan's in table order. */
         m1 = m2 = m3 = INFINITY;
-        for (int i = 0; i < CRACKLE_N; i++) {
-            if (side[i] & skip) continue;
+        mi = CRACKLE_N;
+        for (int k = 0; k < 7; k++) {
+            int i = near7[k];
             double dx = X[i] - p.x, dy = Y[i] - p.y, dz = Z[i] - p.z;
             double sq = dx * dx + dy * dy + dz * dz;
-            if (sq <= u && sq < m3) nearest3_put(sq, i, &m1, &m2, &m3, &mi);
+            int first = (sq < m1) | ((sq == m1) & (i < mi));
+            mi = first ? i : mi;
+            keep3(sq, &m1, &m2, &m3);
+        }
+        static const unsigned char around[20] = {13, 14, 15, 18, 20, 23, 24, 25, 34, 36,
+                                                 44, 46, 55, 56, 57, 60, 62, 65, 66, 67};
+        for (int k = 0; k < 20; k++) {
+            int i = around[k];
+            double dx = X[i] - p.x, dy = Y[i] - p.y, dz = Z[i] - p.z;
+            double sq = dx * dx + dy * dy + dz * dz;
+            if (sq < m3) nearest3_put_first(sq, i, &m1, &m2, &m3, &mi);
+        }
+        static const unsigned char sides[6][9] = {
+            {0, 1, 2, 3, 4, 5, 6, 7, 8},           {72, 73, 74, 75, 76, 77, 78, 79, 80},
+            {9, 10, 11, 30, 31, 32, 51, 52, 53},   {27, 28, 29, 48, 49, 50, 69, 70, 71},
+            {12, 17, 22, 33, 38, 43, 54, 59, 64},  {16, 21, 26, 37, 42, 47, 58, 63, 68}};
+        double g[6] = {p.x - (double)(fx - 1), (double)(fx + 2) - p.x, p.y - (double)(fy - 1),
+                       (double)(fy + 2) - p.y, p.z - (double)(fz - 1), (double)(fz + 2) - p.z};
+        for (int sd = 0; sd < 6; sd++) {
+            if (g[sd] * g[sd] > m3) continue;
+            for (int k = 0; k < 9; k++) {
+                int i = sides[sd][k];
+                double dx = X[i] - p.x, dy = Y[i] - p.y, dz = Z[i] - p.z;
+                double sq = dx * dx + dy * dy + dz * dz;
+                if (sq < m3) nearest3_put_first(sq, i, &m1, &m2, &m3, &mi);
+            }
         }
     } else if (metric > 0.0 && metric <= 32.0 && metric != 1 && metric != 3 && 2.0 * metric == floor(2.0 * metric)) {
         /* A metric of halves (2.5, 4, 6): each point's sum is first taken

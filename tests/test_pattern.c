@@ -574,7 +574,8 @@ static void test_noise_octaves_exact(void **st)
 }
 
 /* Crackle with a metric of halves (1.5, 2.5, 4, 6) rules points out by a
- * product-and-root sum before taking pow's; the values are the full scan's.
+ * product-and-root sum before taking pow's, and metric 2 rules whole sides
+ * of the scan out by their distance; the values are the full scan's.
  * The same pattern with the metric moved by 1e-9 takes the scan that asks
  * pow of every point within the largest-coordinate bound: its three
  * distances move by about 1e-9 (they are continuous in the metric), while
@@ -584,8 +585,8 @@ static void test_noise_octaves_exact(void **st)
 static void test_crackle_half_metrics(void **st)
 {
     (void)st;
-    static const double metrics[4] = {1.5, 2.5, 4.0, 6.0};
-    for (int mi = 0; mi < 4; mi++) {
+    static const double metrics[5] = {1.5, 2.0, 2.5, 4.0, 6.0};
+    for (int mi = 0; mi < 5; mi++) {
         char src[1024];
         double m = metrics[mi], m2 = m + 1e-9;
         snprintf(src, sizeof src,
