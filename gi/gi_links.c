@@ -44,7 +44,8 @@ typedef struct {
     gi_dev_light *lights; /* the scene's, for the far field's direct light */
     int nlights;
     int exact;            /* view points with no bounce after the hit: every hit takes hit_light */
-    float *reach;         /* per source (i - first): the harmonic mean of its rays' hit distances */
+    float *reach;         /* per source (i - first), 4 floats: the harmonic mean of its rays' hit
+                             distances, the vector to their nearest hit */
     int occlude;          /* the gatherer's rays where a hit brings nothing (hits_dark): occlusion tests */
     int lone;             /* points' rays that end on a particle: no emission or mirror there to add (leaves_dark) */
     int points;           /* the sources are the final gather's points, not particles */
@@ -456,6 +457,25 @@ static float harmonic_reach(const struct RTCRayHit *rh, int k)
     return inv > 0.0 ? (float)(k / inv) : INFINITY;
 }
 
+/* The vector from the source to the nearest hit of its k rays (zero when
+ * none hit): POV-Ray's record keeps it (radiosity.cpp, To_Nearest_Surface
+ * and Nearest_Distance) to shrink the record's reach toward that surface. */
+static void nearest_hit(const struct RTCRayHit *rh, int k, float v[3])
+{
+    float best = INFINITY;
+    v[0] = v[1] = v[2] = 0.0f;
+    for (int j = 0; j < k; j++) {
+        if (!ray_hit(&rh[j]) || !(rh[j].ray.tfar > 0.0f)) continue;
+        float dx = rh[j].ray.dir_x, dy = rh[j].ray.dir_y, dz = rh[j].ray.dir_z;
+        float l = sqrtf(dx * dx + dy * dy + dz * dz), d = rh[j].ray.tfar * l;
+        if (!(d < best) || !(l > 0.0f)) continue;
+        best = d;
+        v[0] = dx * rh[j].ray.tfar;
+        v[1] = dy * rh[j].ray.tfar;
+        v[2] = dz * rh[j].ray.tfar;
+    }
+}
+
 /* What a ray that leaves the scene adds: the sky's radiance in its
  * direction. */
 static void ray_sky(const link_job *J, const struct RTCRayHit *h, float sky[3])
@@ -480,7 +500,12 @@ static void job(void *ctx, int index, int thread)
     }
     trace_rays(J, rh, m);
     if (J->reach)
-        for (int i = i0; i < i1; i++) J->reach[i - J->first] = harmonic_reach(rh + (size_t)(i - i0) * J->k, J->k);
+        for (int i = i0; i < i1; i++) {
+            const struct RTCRayHit *r0 = rh + (size_t)(i - i0) * J->k;
+            float *o = &J->reach[4 * (size_t)(i - J->first)];
+            o[0] = harmonic_reach(r0, J->k);
+            nearest_hit(r0, J->k, o + 1);
+        }
     /* hit points and their lookup cells; the lookups are bound by memory
      * latency, so the whole batch prefetches first (gi_area_particles.h) */
     vec3 *hp = J->hp[thread];

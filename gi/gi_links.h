@@ -71,9 +71,10 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
                          const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce,
                          float *reach);
 
-/* reach (may be NULL): a float per point (i - first), the harmonic mean
- * distance of its rays' hits (INFINITY when none hit), how far its gather
- * may be reused (gi_particle_gather.c); given, the sources are points to
+/* reach (may be NULL): four floats per point (i - first): the harmonic
+ * mean distance of its rays' hits (INFINITY when none hit), how far its
+ * gather may be reused (gi_particle_gather.c), then the vector from the
+ * point to its rays' nearest hit (zero when none hit); given, the sources are points to
  * gather at (as with first > 0) even when first is 0 (no particles). */
 
 /* The gatherer: the final gather's exact form (no bounce after the hit,

@@ -219,6 +219,18 @@ static int reusable(const gi_particle *gp, const vg_point *pt, vec3 p, vec3 ng, 
     vec3 dv = v3_sub(p, pt->p);
     double d = v3_len(dv), R = pt->reach;
     if (!(d < a * R)) return 0;
+    /* toward the nearest surface its rays found, the reach shrinks to that
+     * surface's distance (POV-Ray's radiosity.cpp, AverageNearBlock: ri = c
+     * Nearest_Distance + (1 - c) ri, c the cosine between the offset and the
+     * direction to that surface, where positive): at a contact a record
+     * does not answer the hits between it and the other surface */
+    double nd = sqrt((double)pt->nearest[0] * pt->nearest[0] + (double)pt->nearest[1] * pt->nearest[1] +
+                     (double)pt->nearest[2] * pt->nearest[2]);
+    if (d > 0.0 && nd > 0.0) {
+        double cn = (dv.x * pt->nearest[0] + dv.y * pt->nearest[1] + dv.z * pt->nearest[2]) / (d * nd);
+        if (cn > 0.0) R = cn * nd + (1.0 - cn) * R;
+        if (!(d < a * R)) return 0;
+    }
     double c = v3_dot(pt->pn, ng) / lg;
     if (!(d / R + 2.0 * sqrt(fmax(0.0, 1.0 - c)) < a)) return 0;
     vec3 half = v3_add(pt->pn, v3_scale(ng, 1.0 / lg));
@@ -423,7 +435,7 @@ static pt_status trace_points(gi_particle *gp, const void **pobj, const unsigned
     pool_run(gp->threads, gp->vh, put_row, &P);
     double spacing = gp->ps.spacing > 0.0 ? gp->ps.spacing : 1.0;
     gi_link_stats ls = {0};
-    reach = malloc((size_t)(k1 - k0) * sizeof *reach);
+    reach = malloc((size_t)(k1 - k0) * 4 * sizeof *reach);
     if (!reach) {
         st = PT_ERR_NOMEM;
         goto done;
@@ -439,7 +451,8 @@ static pt_status trace_points(gi_particle *gp, const void **pobj, const unsigned
     for (size_t i = 0; st == PT_OK && i < npix; i++) {
         int k = gp->vg_pix[i];
         if (k < k0 || k >= k1) continue;
-        double t = gp->vrec[i].h.t, R = reach[k - k0];
+        double t = gp->vrec[i].h.t, R = reach[4 * (size_t)(k - k0)];
+        for (int c = 0; c < 3; c++) gp->vg_pt[k].nearest[c] = reach[4 * (size_t)(k - k0) + 1 + c];
         if (gp->set.reuse_min > 0.0 && R < gp->set.reuse_min * t) R = gp->set.reuse_min * t;
         if (gp->set.reuse_max > 0.0 && R > gp->set.reuse_max * t) R = gp->set.reuse_max * t;
         gp->vg_pt[k].reach = (float)R;

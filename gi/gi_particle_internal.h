@@ -217,6 +217,8 @@ typedef struct vg_point {
     float r;                  /* it answers hits within r on its object and side */
     float reach;              /* its rays' harmonic mean hit distance, within the reuse bounds
                                  (gi_particle_settings reuse_min/max); INFINITY: unknown */
+    float nearest[3];         /* the vector to its rays' nearest hit (POV-Ray's To_Nearest_Surface
+                                 times Nearest_Distance); zero: none */
     int side;
 } vg_point;
 pt_status gi_particle_view_gather(gi_particle *gp, diag *d);
