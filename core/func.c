@@ -55,6 +55,9 @@ enum {
     FI_LOADK,    /* dst = k */
     FI_UNARY(FI_ENUM_U)                          /* dst = op a (and k) */
     FI_BINARY(FI_ENUM_B)                         /* dst = a op b */
+    FI_MUL_ADD, FI_MUL_SUB, /* an FI_MUL and the FI_ADD_B or FI_SUB_B after
+                    it (which reads its result) in one dispatch; the
+                    second stays as it was, skipped */
     FI_MIN, FI_MAX, /* dst = min/max of registers a .. a + n - 1, in order */
     FI_CALL,     /* dst = fn's result term sub (5: gray) of the n
                     registers from a */
@@ -340,6 +343,10 @@ static void chain_results(func_insn *code, int n)
         if (form_a[in->op] && in->a == prev->dst) in->op = form_a[in->op];
         else if (form_b[in->op] && in->b == prev->dst) in->op = form_b[in->op];
     }
+    /* a product added to or taken from a sum before it (x*x + y*y + z*z) */
+    for (int i = 0; i + 1 < n; i++)
+        if (code[i].op == FI_MUL && (code[i + 1].op == FI_ADD_B || code[i + 1].op == FI_SUB_B))
+            code[i].op = code[i + 1].op == FI_ADD_B ? FI_MUL_ADD : FI_MUL_SUB;
     free(target);
 }
 
@@ -404,6 +411,16 @@ static double run(const scene_function *f, double *r, int t0, eval_ctx *c)
             break;                                                                                                     \
         }
         FI_BINARY(FI_RUN_B)
+        case FI_MUL_ADD: case FI_MUL_SUB: {
+            /* the two ops as they are, each into its register */
+            double y = r[in->a] * r[in->b];
+            r[in->dst] = y;
+            double x = r[in[1].a];
+            acc = in->op == FI_MUL_ADD ? x + y : x - y;
+            r[in[1].dst] = acc;
+            pc = in + 2;
+            continue;
+        }
         case FI_MIN: case FI_MAX: {
             const double *v = r + in->a;
             double m = v[0];
