@@ -234,6 +234,14 @@ static int hook_media(void *ctx, const gi_caustic_inside *in, vec3 org, vec3 dir
     return scatters && collects && extinction;
 }
 
+/* The caustic layer's fade hook: shade_tex_leaving_fade, the fade the
+ * bounces' weights carry (hook_surface), for the photon stored at h. */
+static rgb hook_fade(void *ctx, const accel_hit *h, vec3 dir)
+{
+    (void)ctx;
+    return shade_tex_leaving_fade(h, dir);
+}
+
 static int disperses(const scene_object *o)
 {
     return o->photons && o->photons->target && o->interior && o->interior->dispersion != 1.0;
@@ -294,7 +302,8 @@ pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width
     c->sc = sc;
     c->eps = accel_surface_eps(a); /* the shader's offsets: photons cross thin walls as eye rays do */
     c->scale = accel_eps_scale(a);
-    gi_caustic_hooks hk = {hook_surface, hook_attenuation, c, hook_brilliance, hook_pass, hook_containers, hook_media};
+    gi_caustic_hooks hk = {hook_surface, hook_attenuation, c,          hook_brilliance,
+                           hook_pass,    hook_containers,  hook_media, hook_fade};
     gi_caustic_settings s = {width, height, threads, seed, cl_device, cl_max_bytes, count_scale, cancel};
     pt_status st = PT_OK;
     c->layer = gi_caustic_build(sc, a, &s, &hk, d, &st);

@@ -583,14 +583,15 @@ static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_ou
             /* store the photon before this bounce (paper, step 1(d)) */
             double att = c->hk.attenuation(c->hk.ctx, l, p_first, depth);
             double k = att * (cb->parallel ? 1.0 : depth * depth);
+            rgb fd = c->hk.fade ? c->hk.fade(c->hk.ctx, &h, br.w) : (rgb){1, 1, 1};
             double sd = cb->parallel ? sqrt(cb->cell) : depth * sqrt(cb->cell);
             double rxy = fmin(RADIUS_K * sd / sqrt(br.rho_p), c->r_max);
             vec3 np = v3_dot(h.ng, br.w) < 0.0 ? h.ng : v3_neg(h.ng), wq = pov_photon_dir(v3_neg(br.w));
             gi_caus_photon q = {.x = {(float)h.p.x, (float)h.p.y, (float)h.p.z},
                                 .n = {(float)np.x, (float)np.y, (float)np.z},
                                 .w = {(float)wq.x, (float)wq.y, (float)wq.z},
-                                .phi = {(float)(cb->phi0.r * br.tr.r * k), (float)(cb->phi0.g * br.tr.g * k),
-                                        (float)(cb->phi0.b * br.tr.b * k)}};
+                                .phi = {(float)(cb->phi0.r * br.tr.r * fd.r * k), (float)(cb->phi0.g * br.tr.g * fd.g * k),
+                                        (float)(cb->phi0.b * br.tr.b * fd.b * k)}};
             set_radii(c, &q, rxy);
             if (rxy > 0.0 && isfinite(q.phi[0] + q.phi[1] + q.phi[2]) && cmax3(crgb(q.phi[0], q.phi[1], q.phi[2])) > 0.0)
                 if (!push_photon(out, &q, sf & GI_CAUSTIC_RECEIVES ? STORE_SPLAT : STORE_HIGHLIGHT)) {

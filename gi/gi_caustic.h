@@ -153,6 +153,13 @@ typedef struct {
      * some absorbs or scatters: POV-Ray's ComputeMediaAndDepositPhotons
      * returns early without extinction). NULL: no media. */
     int (*media)(void *ctx, const gi_caustic_inside *in, vec3 org, vec3 dir, double len, rgb *tr);
+    /* The fade of h's interior over h->t for a photon arriving along unit
+     * dir from inside h's object (1 from outside): the colour the photon
+     * is stored with at h, before it bounces (POV-Ray 3.7's photons.cpp,
+     * PhotonTrace::ComputeLightedTexture fades LightCol by the hit
+     * object's interior, then adds the surface photon). The bounces'
+     * weights carry the same fade. NULL: none. */
+    rgb (*fade)(void *ctx, const accel_hit *h, vec3 dir);
 } gi_caustic_hooks;
 
 typedef struct {

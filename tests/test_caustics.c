@@ -420,6 +420,49 @@ static void test_highlight_photons(void **state)
     }
 }
 
+/* A photon is stored faded by the interior it arrives from: a box of
+ * half-transparent white (rgbt 0.5, diffuse 1, ior 1) lit straight down by
+ * a parallel light; each photon enters the top face (its target, not
+ * stored) and meets the bottom face 1 below from inside, where it is
+ * stored. POV-Ray 3.7 (photons.cpp, PhotonTrace::ComputeLightedTexture)
+ * fades the photon by the hit object's interior over its way there before
+ * it adds the surface photon, so with fade_distance 1, fade_power 1001 and
+ * fade_color 0 the stored flux is exp(-1) of the unfaded box's (tolerance
+ * 0.5%: every photon crosses the same 1 unit), with as many photons. */
+static void test_stored_fade(void **state)
+{
+    (void)state;
+    static const char *fmt =
+        "#version 3.7;\n"
+        "global_settings { assumed_gamma 1.0 photons { spacing 0.02 } }\n"
+        "camera { orthographic location <0, 5, 0> look_at <0, 0, 0> right x*2 up z*2 }\n"
+        "light_source { <0, 10, 0> color rgb 1 parallel point_at <0, 0, 0> }\n"
+        "box { <-0.5, 0.5, -0.5>, <0.5, 1.5, 0.5> pigment { rgbt <1, 1, 1, 0.5> } finish { ambient 0 diffuse 1 }\n"
+        "      interior { ior 1 %s } photons { target refraction on } }\n";
+    double flux[2];
+    long stored[2];
+    for (int faded = 0; faded < 2; faded++) {
+        char text[1024];
+        snprintf(text, sizeof text, fmt, faded ? "fade_distance 1 fade_power 1001 fade_color rgb 0" : "");
+        tu_world w = tu_world_build("test.pov", text);
+        diag *d = diag_new();
+        caustics c;
+        layer(&c, w.s, w.a, 16, 16, NULL, THREADS, d);
+        gi_caustic_stats st;
+        gi_caustic_get_stats(c.layer, &st);
+        flux[faded] = st.flux;
+        stored[faded] = st.stored;
+        caustics_free(&c);
+        diag_free(d);
+        tu_world_free(&w);
+    }
+    printf("photons stored leaving a faded box: %ld and %ld, flux %.6g faded over %.6g (ratio %.5f, exp(-1) %.5f)\n",
+           stored[1], stored[0], flux[1], flux[0], flux[1] / flux[0], exp(-1.0));
+    assert_true(stored[0] > 1000);
+    assert_int_equal(stored[1], stored[0]);
+    assert_true(fabs(flux[1] / flux[0] / exp(-1.0) - 1.0) <= 0.005);
+}
+
 /* The mirror above with a pass_through pane (rgbft <1, 0.5, 0.25, 0.6,
  * 0.2>, no ior) across the photons' way from the light to the mirror:
  * POV-Ray 3.7 (photons.cpp, built with PT_FILTER_BEFORE_TARGET) lets a
@@ -896,6 +939,7 @@ int main(void)
         cmocka_unit_test(test_highlight_photons),
         cmocka_unit_test(test_photons_in_room),
         cmocka_unit_test(test_pass_through_filter),
+        cmocka_unit_test(test_stored_fade),
         cmocka_unit_test(test_path_mirror_closed_form),
         cmocka_unit_test(test_slab_transmission),
         cmocka_unit_test(test_pmfg_pass_through_filter),
