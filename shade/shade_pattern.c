@@ -197,6 +197,15 @@ static vec3 warp_black_hole(const scene_warp *w, vec3 p)
     return v3_add(p, v3_scale(d, w->inverted ? -s : s));
 }
 
+/* shade_pattern_warp's last step, the coordinates held within COORD_LIMIT */
+static inline vec3 coord_clamp(vec3 p)
+{
+    p.x = fmin_inline(fmax_inline(p.x, -COORD_LIMIT), COORD_LIMIT);
+    p.y = fmin_inline(fmax_inline(p.y, -COORD_LIMIT), COORD_LIMIT);
+    p.z = fmin_inline(fmax_inline(p.z, -COORD_LIMIT), COORD_LIMIT);
+    return p;
+}
+
 vec3 shade_pattern_warp(const scene_pattern *pat, vec3 p)
 {
     for (int i = 0; i < pat->nwarps; i++) {
@@ -221,10 +230,7 @@ vec3 shade_pattern_warp(const scene_pattern *pat, vec3 p)
         case WARP_CUBIC: p = warp_cubic(p); break;
         }
     }
-    p.x = fmin_inline(fmax_inline(p.x, -COORD_LIMIT), COORD_LIMIT);
-    p.y = fmin_inline(fmax_inline(p.y, -COORD_LIMIT), COORD_LIMIT);
-    p.z = fmin_inline(fmax_inline(p.z, -COORD_LIMIT), COORD_LIMIT);
-    return p;
+    return coord_clamp(p);
 }
 
 /* The classic turbulence warp of a pattern (the last warp), or NULL. */
@@ -443,13 +449,22 @@ static double crackle(const scene_pattern *pat, vec3 p, int gen)
          * the full scan's in table order. */
         m1 = m2 = m3 = INFINITY;
         mi = CRACKLE_N;
-        for (int k = 0; k < 7; k++) {
-            int i = near7[k];
-            double dx = X[i] - p.x, dy = Y[i] - p.y, dz = Z[i] - p.z;
-            double sq = dx * dx + dy * dy + dz * dz;
-            int first = (sq < m1) | ((sq == m1) & (i < mi));
-            mi = first ? i : mi;
-            keep3(sq, &m1, &m2, &m3);
+        if (pat->crackle_solid) {
+            for (int k = 0; k < 7; k++) {
+                int i = near7[k];
+                double dx = X[i] - p.x, dy = Y[i] - p.y, dz = Z[i] - p.z;
+                double sq = dx * dx + dy * dy + dz * dz;
+                int first = (sq < m1) | ((sq == m1) & (i < mi));
+                mi = first ? i : mi;
+                keep3(sq, &m1, &m2, &m3);
+            }
+        } else {
+            /* mi is read by `solid` alone */
+            for (int k = 0; k < 7; k++) {
+                int i = near7[k];
+                double dx = X[i] - p.x, dy = Y[i] - p.y, dz = Z[i] - p.z;
+                keep3(dx * dx + dy * dy + dz * dz, &m1, &m2, &m3);
+            }
         }
         static const unsigned char around[20] = {13, 14, 15, 18, 20, 23, 24, 25, 34, 36,
                                                  44, 46, 55, 56, 57, 60, 62, 65, 66, 67};
@@ -1256,7 +1271,8 @@ int shade_pigment_eval(const scene_pigment *pg, vec3 p, const shade_pattern_ctx 
      * pigment at the hit's <u, v, 0> (pigment.cpp), its own transforms only */
     if (pat->uv_mapping && c && c->has_uv) p = v3(c->uv[0], c->uv[1], 0.0);
     vec3 q = xform_is_identity(&pg->transform) ? p : xform_inv_point(&pg->transform, p);
-    vec3 tp = shade_pattern_warp(pat, q);
+    /* without warps, shade_pattern_warp is the clamp alone (no call) */
+    vec3 tp = pat->nwarps ? shade_pattern_warp(pat, q) : coord_clamp(q);
     if (pat->kind == PAT_IMAGE && !pg->map) return pattern_image_colour(&pat->image, tp, out);
     const scene_blend_map *m = pg->map ? pg->map : pattern_default_map(pat->kind);
     if (!pg->map && pat->kind == PAT_MANDEL && (pat->magnet || pat->fractal_exponent != 2)) m = &grey_map;
