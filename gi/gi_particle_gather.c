@@ -743,6 +743,11 @@ static void filter_row(void *ctx, int y, int thread)
      * be reused over (Ward's normal term, 2 sqrt(1 - cos) below the error
      * bound: reusable) is left out, as the bumps' light is the pixel's own */
     const double a = gp->set.normal_at && gi_particle_exact_gather(&gp->set) ? gp->set.reuse_error : 0.0;
+    /* with no bounce after the gathers' hits, a tap that gathered itself
+     * is left out where POV-Ray's cache would not reuse its record at the
+     * pixel (reusable: near a contact its reach shrinks toward the other
+     * surface, so the brighter light of the taps farther out stays there) */
+    const int exact = gi_particle_exact_gather(&gp->set);
     for (int x = 0; x < w; x++) {
         size_t i = (size_t)y * w + x;
         float *o = &gp->vg_pixval[4 * i];
@@ -761,6 +766,8 @@ static void filter_row(void *ctx, int y, int thread)
                 if (!F->ok[j]) continue;
                 const view_rec *q = &gp->vrec[j];
                 if (j != i && (!compatible(gp, j, i) || fabs(v3_dot(v3_sub(q->h.p, r->h.p), nr)) > DEPTH_TOL * r->h.t))
+                    continue;
+                if (j != i && exact && gp->vg_pix[j] >= 0 && !reusable(gp, &gp->vg_pt[gp->vg_pix[j]], r->h.p, pn, 1.0))
                     continue;
                 if (j != i && a > 0.0 && !(2.0 * sqrt(fmax(0.0, 1.0 - v3_dot(gp->vg_pnrm[j], pn))) < a)) continue;
                 double wt = g[dx < 0 ? -dx : dx] * g[dy < 0 ? -dy : dy];
