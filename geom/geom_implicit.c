@@ -1175,12 +1175,18 @@ static int iso_hits(const im_data *m, vec3 o, vec3 d, double wl, double tmin, do
      * only for a ray that starts inside the container. Otherwise every
      * crossing and both faces where the inside reaches them. */
     int n = 0, budget = traced ? m->max_trace : max;
+    /* f at the container's entry, when the face test below asks for it:
+     * a walk that starts at that point (bit for bit) takes it rather than
+     * evaluating f there again (f is a function of the point alone) */
+    vec3 pca = v3_madd(o, d, ca);
+    double fca = NAN;
+    int have_fca = 0;
     if (!m->open) {
         if (!traced) {
-            if (ca > tmin && ca < tmax && iso_f(m, v3_madd(o, d, ca)) < 0.0) n = geom_shape_hit_put(out, n, max, ca, 1);
+            if (ca > tmin && ca < tmax && (have_fca = 1, fca = iso_f(m, pca)) < 0.0) n = geom_shape_hit_put(out, n, max, ca, 1);
             if (cb > tmin && cb < tmax && iso_f(m, v3_madd(o, d, cb)) < 0.0) n = geom_shape_hit_put(out, n, max, cb, 1);
         } else if (ca > tmin) {
-            if (ca < tmax && iso_f(m, v3_madd(o, d, ca)) < 0.0) {
+            if (ca < tmax && (have_fca = 1, fca = iso_f(m, pca)) < 0.0) {
                 n = geom_shape_hit_put(out, n, max, ca, 1);
                 budget--;
             }
@@ -1192,14 +1198,15 @@ static int iso_hits(const im_data *m, vec3 o, vec3 d, double wl, double tmin, do
     /* accuracy in object length along this ray: POV-Ray measures it along
      * the world ray (its t), the exact search in object space */
     double minstep = pov ? m->acc * s / wl : fmax_inline(m->acc, 1e-9 * m->size);
+    double fa = have_fca && memcmp(&pca, &p0, sizeof p0) == 0 ? fca : iso_f(m, p0);
     if (!traced) {
         iso_walk w = {m, p0, e, a, s, tmin, tmax, minstep, out, n, max, 0};
-        iso_split(&w, 0.0, iso_f(m, p0), len, iso_f(m, v3_madd(p0, e, len)), 0);
+        iso_split(&w, 0.0, fa, len, iso_f(m, v3_madd(p0, e, len)), 0);
         return w.n;
     }
     geom_shape_hit roots[ISO_MAX_TRACE];
     iso_walk w = {m, p0, e, a, s, tmin, tmax, minstep, roots, 0, budget < max ? budget : max, pov};
-    iso_split(&w, 0.0, iso_f(m, p0), len, iso_f(m, v3_madd(p0, e, len)), 0);
+    iso_split(&w, 0.0, fa, len, iso_f(m, v3_madd(p0, e, len)), 0);
     for (int i = 0; i < w.n; i++) n = geom_shape_hit_put(out, n, max, roots[i].t, roots[i].part);
     return n;
 }
