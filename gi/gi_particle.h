@@ -228,6 +228,8 @@ void gi_particle_default_settings(gi_particle_settings *s);
 #define GI_PARTICLES_MAX 200000L
 /* the final gather's side under an error_bound below 0.1 (gi_particle.c) */
 #define GI_DENSE_SIDE_MAX 36
+/* the final gather's side gain under radiosity's `normal on` (gi_particle.c) */
+#define GI_NORMAL_ON_SIDE_GAIN 1.45
 /* --cl-device auto below this many particles: the C build of the kernels */
 #define GI_CL_AUTO_MIN_PARTICLES 20000L
 void gi_particle_settings_from_scene(gi_particle_settings *s, const scene *sc);

@@ -1310,15 +1310,18 @@ static void test_settings_from_radiosity(void **state)
      * [6, 20] without further bounces; below error_bound 0.1 every pixel
      * gathers unfiltered at 1.8 times that side, at most GI_DENSE_SIDE_MAX
      * (stackerday.pov's block: count 400, nearest_count 1, 0.05; count 100 with
-     * nearest_count 5: 14 -> 25) */
-    static const struct { double eb; int nc, side, stride; } want[] = {{0.1, 1, 20, 2}, {0.05, 1, 36, 1},
-                                                                       {0.05, 5, 25, 1}, {0.5, 5, 20, 2}};
+     * nearest_count 5: 14 -> 25); under `normal on` every pixel gathers at
+     * GI_NORMAL_ON_SIDE_GAIN times the side (balcony.pov's block: count 130,
+     * nearest_count 5, error_bound 0.3: 16 -> 23) */
+    static const struct { double eb; int nc, side, stride, normal_on, count; } want[] = {
+        {0.1, 1, 20, 2, 0, 400}, {0.05, 1, 36, 1, 0, 400}, {0.05, 5, 25, 1, 0, 100},
+        {0.5, 5, 20, 2, 0, 400}, {0.3, 5, 23, 1, 1, 130}, {0.3, 5, 16, 2, 0, 130}};
     for (size_t k = 0; k < sizeof want / sizeof want[0]; k++) {
         char text[512];
         snprintf(text, sizeof text,
                  "#version 3.7;\nglobal_settings { radiosity { count %d recursion_limit 1 nearest_count %d "
-                 "error_bound %g } }\ncamera { location <0,0,-3> look_at 0 }\nsphere { 0, 1 }\n",
-                 k == 2 ? 100 : 400, want[k].nc, want[k].eb);
+                 "error_bound %g %s } }\ncamera { location <0,0,-3> look_at 0 }\nsphere { 0, 1 }\n",
+                 want[k].count, want[k].nc, want[k].eb, want[k].normal_on ? "normal on" : "");
         tg_load(&f, text);
         gi_particle_settings_from_scene(&s, f.sc);
         printf("  error_bound %g, nearest_count %d: gather side %d (want %d), stride %d\n", want[k].eb, want[k].nc,
