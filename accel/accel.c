@@ -1028,28 +1028,39 @@ static void fill_user(const accel *a, unsigned prim, const geom_csg_hit *h, vec3
     hit->flags = l->flags;
 }
 
-/* fill_user's record without the surface (accel_crossings_cut's
- * `surface` said it is not read): no normals, no uv. */
-static void fill_user_bare(const accel *a, unsigned prim, const geom_csg_hit *h, const accel_leaf *l,
-                           const geom_shape *sh, vec3 org, vec3 dir, accel_hit *hit)
+/* fill_user's record, or without the surface where `surface` (given)
+ * says it is not read (accel_crossings_cut's walk): no normals, no uv.
+ * A blob's is always the full one: its texture depends on the point.
+ * Returns whether the record is the bare one (its normals are zero). */
+static int fill_user_for(const accel *a, unsigned prim, const geom_csg_hit *h, vec3 org, vec3 dir,
+                         accel_surface_fn surface, void *ctx, accel_hit *hit)
 {
-    hit->t = h->t;
-    hit->p = v3_madd(org, dir, h->t);
-    hit->u = hit->v = 0.0;
-    hit->uv[0] = hit->uv[1] = 0.0;
-    hit->ng = hit->ns = v3(0.0, 0.0, 0.0);
-    hit->pov_flip = (sh->kind == SHAPE_TRIANGLE || sh->kind == SHAPE_SMOOTH_TRIANGLE) && sh->g.tri.wind > 0.0;
-    if (h->flip) hit->pov_flip = !hit->pov_flip;
-    hit->obj = l->obj;
-    hit->texture = l->texture;
-    hit->prim = (unsigned)h->part;
-    hit->flags = l->flags;
-    (void)prim;
+    const geom_shape *sh = surface ? accel_prim_shape(a, prim, h->shape) : NULL;
+    if (sh && sh->kind != SHAPE_BLOB) {
+        unsigned li = prim < (unsigned)a->nshapes ? a->shape_leaf[prim]
+                                                   : a->csgs[prim - (unsigned)a->nshapes].shape_leaf[h->shape];
+        const accel_leaf *l = &a->leaves[li];
+        if (!surface(ctx, l->obj, l->texture)) {
+            hit->t = h->t;
+            hit->p = v3_madd(org, dir, h->t);
+            hit->u = hit->v = 0.0;
+            hit->uv[0] = hit->uv[1] = 0.0;
+            hit->ng = hit->ns = v3(0.0, 0.0, 0.0);
+            hit->pov_flip = (sh->kind == SHAPE_TRIANGLE || sh->kind == SHAPE_SMOOTH_TRIANGLE) && sh->g.tri.wind > 0.0;
+            if (h->flip) hit->pov_flip = !hit->pov_flip;
+            hit->obj = l->obj;
+            hit->texture = l->texture;
+            hit->prim = (unsigned)h->part;
+            hit->flags = l->flags;
+            return 1;
+        }
+    }
+    fill_user(a, prim, h, org, dir, hit);
+    return 0;
 }
 
 /* intersect_at_skip; with `surface`, a user primitive's hit for which
- * it says its surface is not read gets fill_user_bare's record (a blob's
- * always the full one: its texture depends on the point). */
+ * it says its surface is not read gets fill_user_for's bare record. */
 static int intersect_at_surface(const accel *a, vec3 org, vec3 dir, double t0, double tmax, accel_hit *hit,
                                 accel_ray_rule rule, unsigned skip, accel_surface_fn surface, void *ctx)
 {
@@ -1085,19 +1096,10 @@ static int intersect_at_surface(const accel *a, vec3 org, vec3 dir, double t0, d
         } else if (!accel_prim_hit(a, prim, org, dir, t0, tmax, &h, q.rule)) {
             return 0;
         }
-        /* a blob's texture depends on the point (fill_user) */
-        const geom_shape *sh = surface ? accel_prim_shape(a, prim, h.shape) : NULL;
-        if (sh && sh->kind != SHAPE_BLOB) {
-            unsigned li = prim < (unsigned)a->nshapes ? a->shape_leaf[prim]
-                                                       : a->csgs[prim - (unsigned)a->nshapes].shape_leaf[h.shape];
-            const accel_leaf *l = &a->leaves[li];
-            if (!surface(ctx, l->obj, l->texture)) {
-                fill_user_bare(a, prim, &h, l, sh, org, dir, hit);
-                assert(hit->obj && hit->texture);
-                return isfinite(hit->t) && v3_finite(hit->p);
-            }
+        if (fill_user_for(a, prim, &h, org, dir, surface, ctx, hit)) {
+            assert(hit->obj && hit->texture);
+            return isfinite(hit->t) && v3_finite(hit->p);
         }
-        fill_user(a, prim, &h, org, dir, hit);
     } else {
         return 0;
     }
@@ -1217,20 +1219,7 @@ static int crossings_walk(const accel *a, vec3 org, vec3 dir, double tmin, doubl
             if (cut && i > 0 && cr[i - 1].cut) return -1;
             if (!(cr[i].t > t0) || !(cr[i].t < tmax)) continue;
             geom_csg_hit g = {.t = cr[i].t, .part = cr[i].part, .shape = cr[i].shape, .flip = cr[i].flip};
-            if (surface) {
-                /* a blob's texture depends on the point (fill_user) */
-                const geom_shape *sh = accel_prim_shape(a, cr[i].prim, g.shape);
-                unsigned li = cr[i].prim < (unsigned)a->nshapes
-                                  ? a->shape_leaf[cr[i].prim]
-                                  : a->csgs[cr[i].prim - (unsigned)a->nshapes].shape_leaf[g.shape];
-                const accel_leaf *l = &a->leaves[li];
-                if (sh->kind != SHAPE_BLOB && !surface(ctx, l->obj, l->texture))
-                    fill_user_bare(a, cr[i].prim, &g, l, sh, org, dir, &h);
-                else
-                    fill_user(a, cr[i].prim, &g, org, dir, &h);
-            } else {
-                fill_user(a, cr[i].prim, &g, org, dir, &h);
-            }
+            fill_user_for(a, cr[i].prim, &g, org, dir, surface, ctx, &h);
             if (!isfinite(h.t) || !v3_finite(h.p)) continue;
             t0 = h.t + fmax_inline(step, h.t * 1e-7);
             if (h.flags & skip) continue; /* a member's own flag */
