@@ -443,7 +443,6 @@ static int deposit_media(const gi_caustic *c, const combo *cb, vec3 org, vec3 w,
     return 1;
 }
 
-/* One bounce-map cell: the photon's direction (and origin), then its path. */
 /* r_z, a photon volume's reach along its surface normal, for in-plane
  * radius r_xy: as far as POV-Ray's gather reaches off the surface. Its
  * gather (photons.cpp, PhotonGatherer::gatherPhotonsRec with `flatten`)
@@ -481,6 +480,7 @@ static void set_radii(const gi_caustic *c, gi_caus_photon *q, double rxy)
     q->inv_rz2 = (float)(1.0 / (rz * rz));
 }
 
+/* One bounce-map cell: the photon's direction (and origin), then its path. */
 static void trace_cell(const gi_caustic *c, const combo *cb, long cell, chunk_out *out)
 {
     const scene_light *l = cb->l;
