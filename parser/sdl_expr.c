@@ -434,9 +434,11 @@ static double float_function(sdl_parser *p, sdl_kw k, src_loc loc)
     case KW_VERSION: return p->version;
     case KW_NOW: {
         p->frame_dependent = 1; /* the time of day, anywhere */
-        /* days since 2000-01-01 00:00 UTC, to the microsecond (POV-Ray 3.7) */
-        struct timespec ts;
-        timespec_get(&ts, TIME_UTC);
+        /* days since 2000-01-01 00:00 UTC, to the microsecond (POV-Ray 3.7).
+         * CLOCK_REALTIME, the clock time() and the rest of the program read,
+         * so a scene and its log agree on the date; time() if it fails. */
+        struct timespec ts = { 0, 0 };
+        if (clock_gettime(CLOCK_REALTIME, &ts) != 0) ts.tv_sec = time(NULL);
         return ((double)ts.tv_sec - 946684800.0 + (double)(ts.tv_nsec / 1000) * 1e-6) / 86400.0;
     }
     case KW_MIN: case KW_MAX: case KW_BITWISE_AND: case KW_BITWISE_OR: case KW_BITWISE_XOR:
