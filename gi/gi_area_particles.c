@@ -44,6 +44,12 @@ static void material(const scene *sc, const scene_texture *tex, const colour5 *c
         p->le[k] = isfinite(le) ? (float)le : 0.0f;
     }
     p->brilliance = isfinite(f->brilliance) && f->brilliance > 0.0 ? (float)f->brilliance : 1.0f;
+    /* diffuse_back as a fraction of diffuse (gi_types.h); with diffuse 0
+     * rho is 0 and so is rho_b: not modelled (the render's last bounce,
+     * gi_particle_hook.c, takes the same rule) */
+    double back = f->diffuse > 0.0 && f->diffuse_back > 0.0 ? f->diffuse_back / f->diffuse : 0.0;
+    p->back = isfinite(back) ? (float)back : 0.0f;
+    p->twin = -1;
 }
 
 void gi_particles_material(const scene *sc, const scene_texture *tex, const colour5 *c, float rho[3], float le[3])
@@ -292,6 +298,21 @@ pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel
     ps->patch = b.patch;
     ps->side = b.side;
     return PT_OK;
+}
+
+int gi_particles_twin(const gi_particles *ps, int i)
+{
+    /* gi_particles_sample pushes a point's sides in a row, side 0 first;
+     * compaction keeps the order */
+    int j = ps->side[i] == 0 ? i + 1 : i - 1;
+    if (j < 0 || j >= ps->n || ps->patch[j] != ps->patch[i] || ps->side[j] == ps->side[i]) return -1;
+    const float *a = ps->p[i].p, *b = ps->p[j].p;
+    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2] ? j : -1;
+}
+
+void gi_particles_set_twins(gi_particles *ps)
+{
+    for (int i = 0; i < ps->n; i++) ps->p[i].twin = ps->p[i].back > 0.0f ? gi_particles_twin(ps, i) : -1;
 }
 
 pt_status gi_particles_compact(gi_particles *ps, const unsigned char *keep)

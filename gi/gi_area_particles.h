@@ -36,6 +36,12 @@ typedef struct {
  * or with pig NULL the texture's base colour. */
 pt_status gi_particles_sample(gi_particles *ps, const gi_surface *g, const accel *a, const scene *sc, long count,
                               uint64_t seed, const float *side_frac, gi_pigment_fn pig, diag *d);
+/* The particle of the other side at particle i's point (its twin), -1
+ * none (a one-sided surface, or that side was not sampled or was pruned). */
+int gi_particles_twin(const gi_particles *ps, int i);
+/* Every particle's twin field: gi_particles_twin for those with a
+ * diffuse_back lobe (back > 0), -1 for the others (gi_types.h). */
+void gi_particles_set_twins(gi_particles *ps);
 /* Keep the particles with keep[i] != 0, in order. */
 pt_status gi_particles_compact(gi_particles *ps, const unsigned char *keep);
 void gi_particles_free(gi_particles *ps);

@@ -19,7 +19,9 @@ _Static_assert(offsetof(gi_dev_particle, area) == 12, "area");
 _Static_assert(offsetof(gi_dev_particle, n) == 16, "n");
 _Static_assert(offsetof(gi_dev_particle, brilliance) == 28, "brilliance");
 _Static_assert(offsetof(gi_dev_particle, rho) == 32, "rho");
+_Static_assert(offsetof(gi_dev_particle, back) == 44, "back");
 _Static_assert(offsetof(gi_dev_particle, le) == 48, "le");
+_Static_assert(offsetof(gi_dev_particle, twin) == 60, "twin");
 _Static_assert(sizeof(gi_dev_light) == 80, "gi_dev_light is 80 bytes");
 _Static_assert(offsetof(gi_dev_light, pos) == 0, "pos");
 _Static_assert(offsetof(gi_dev_light, kind) == 12, "kind");
@@ -59,7 +61,7 @@ extern const int gi_kernel_nfiles;
 /* gi_k_bounce work-items (GI_BOUNCE_CHUNK particles each) per work-group */
 #define GI_BOUNCE_LOCAL 4
 
-enum { KE_EMIT, KE_BOUNCE, KE_WALK, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_VPL, KE_CAUSTIC, KE_COUNT };
+enum { KE_EMIT, KE_BOUNCE, KE_WALK, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_VPL, KE_CAUSTIC, KE_BACK, KE_COUNT };
 
 struct gi_dev {
     int is_cl;
@@ -92,6 +94,7 @@ struct gi_dev {
     float *dsum;   /* gi_k_emit's direct flux per work-item (read back) */
     unsigned *srcmask_host; /* gi_k_emit's source mask (OpenCL: read back) */
     double emitted; /* grey emitted flux (gi_dev_sums), fixed by the particles */
+    int has_back;   /* some particle has a diffuse_back lobe and a twin (gi_k_back runs) */
     /* edir and phi of the last completed stage go to these when asked
      * (gi_dev_fetch); stale: not written yet */
     float *edir_host, *phi_host;
@@ -353,7 +356,7 @@ static pt_status cl_open(gi_dev *dv, const gi_dev_options *o, diag *d)
     }
     static const char *const names[KE_COUNT] = {"gi_k_emit", "gi_k_bounce", "gi_k_walk", "gi_k_resolve",
                                                 "gi_k_gather", "gi_k_estimate", "gi_k_vpl_gather",
-                                                "gi_k_caustic_splat"};
+                                                "gi_k_caustic_splat", "gi_k_back"};
     for (int k = 0; k < KE_COUNT; k++) {
         dv->k[k] = clCreateKernel(dv->prog, names[k], &e);
         if (!dv->k[k]) return cl_fail(d, names[k], e);
@@ -609,8 +612,14 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     if (!dv->emits || !dv->cand || !dv->cand_new || !dv->cin_off || !dv->dsum || !dv->srcmask_host)
         return PT_ERR_NOMEM;
     dv->emitted = 0.0;
+    dv->has_back = 0;
     for (int i = 0; i < n; i++) {
-        if (part[i].le[0] != 0.0f || part[i].le[1] != 0.0f || part[i].le[2] != 0.0f) dv->emits[i >> 5] |= 1u << (i & 31);
+        /* emits: particles gi_k_emit must read without a light on them, the
+         * emitters and the diffuse_back particles (their twin's light) */
+        int back = part[i].back > 0.0f && part[i].twin >= 0;
+        dv->has_back |= back;
+        if (back || part[i].le[0] != 0.0f || part[i].le[1] != 0.0f || part[i].le[2] != 0.0f)
+            dv->emits[i >> 5] |= 1u << (i & 31);
         for (int c = 0; c < 3; c++) dv->emitted += 3.14159265358979323846 * part[i].le[c] * part[i].area / 3.0;
     }
     dv->stale = 0;
@@ -911,6 +920,7 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
                       dv->tally, (int)items);
         else
             gi_c_resolve(dv->threads, dv->part, n, dv->edir, nb > 0, dv->total, lout, phi);
+        if (dv->has_back) gi_c_back(dv->threads, dv->part, n, phi, lout);
         memcpy(edir, dv->edir, nn * 4 * sizeof(float));
         memcpy(dv->srcmask_host, dv->mask_src, eitems * sizeof(unsigned));
         sum_bounces(dv->tally, items, nb, bounce_flux);
@@ -975,6 +985,10 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
         karg r[] = {KMEM(dv->b_part), KINT(n),          KMEM(dv->b_enew), KINT(scattered), KMEM(dv->b_total),
                     KMEM(dv->b_lout), KMEM(dv->b_phi)};
         if ((st = run_kernel(dv, KE_RESOLVE, nn, r, 7, d)) != PT_OK) return st;
+    }
+    if (dv->has_back) {
+        karg bk[] = {KMEM(dv->b_part), KINT(n), KMEM(dv->b_phi), KMEM(dv->b_lout)};
+        if ((st = run_kernel(dv, KE_BACK, nn, bk, 4, d)) != PT_OK) return st;
     }
     cl_mem te = dv->b_edir;
     dv->b_edir = dv->b_enew;

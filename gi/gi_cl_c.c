@@ -49,7 +49,7 @@ typedef struct {
     int *visits;
 } c_launch;
 
-enum { K_EMIT, K_BOUNCE, K_WALK, K_RESOLVE, K_GATHER, K_ESTIMATE, K_VPL, K_CAUSTIC };
+enum { K_EMIT, K_BOUNCE, K_WALK, K_RESOLVE, K_GATHER, K_ESTIMATE, K_VPL, K_CAUSTIC, K_BACK };
 
 static void run_chunk(void *ctx, int chunk, int thread)
 {
@@ -73,6 +73,7 @@ static void run_chunk(void *ctx, int chunk, int thread)
                       a->tally, a->items);
             break;
         case K_RESOLVE: gi_k_resolve(a->part, a->np, a->edir, a->scattered, a->total, a->fout, a->fout2); break;
+        case K_BACK: gi_k_back(a->part, a->np, a->total, a->fout); break;
         case K_GATHER:
             gi_k_gather(a->glink, a->ng, a->lout, a->idx, (int)a->n, a->esky, a->fout);
             break;
@@ -136,6 +137,12 @@ void gi_c_resolve(int threads, const gi_dev_particle *part, int n, const float *
 {
     c_launch a = {.kernel = K_RESOLVE, .n = (size_t)n, .part = part, .np = n, .edir = edir, .scattered = scattered,
                   .total = total, .fout = lout, .fout2 = phi};
+    launch(threads, &a);
+}
+
+void gi_c_back(int threads, const gi_dev_particle *part, int n, const float *phi, float *lout)
+{
+    c_launch a = {.kernel = K_BACK, .n = (size_t)n, .part = part, .np = n, .total = phi, .fout = lout};
     launch(threads, &a);
 }
 

@@ -24,6 +24,8 @@ void gi_c_walk(int threads, const gi_dev_particle *part, int n, const float *edi
                float *tally, int items);
 void gi_c_resolve(int threads, const gi_dev_particle *part, int n, const float *edir, int scattered,
                   const float *total, float *lout, float *phi);
+/* gi_k_back: n work-items, after gi_c_resolve or gi_c_walk. */
+void gi_c_back(int threads, const gi_dev_particle *part, int n, const float *phi, float *lout);
 void gi_c_gather(int threads, const int *glink, int ng, const float *lout, const int *used, int nused,
                  const float *esky, float *eind);
 void gi_c_estimate(int threads, const gi_dev_particle *part, const int *list_off, const int *list_idx,

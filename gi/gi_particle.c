@@ -289,6 +289,13 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
             memset(keep, 1, (size_t)n);
         }
         for (int i = 0; i < n; i++) keep[i] |= linked[i];
+        /* a diffuse_back particle reflects what its twin receives (the
+         * sunlit outer face of a curtain lights the room through it): the
+         * two are kept together */
+        for (int i = 0; i < n; i++) {
+            int j = ps->p[i].back > 0.0f ? gi_particles_twin(ps, i) : -1;
+            if (j >= 0 && (keep[i] || keep[j])) keep[i] = keep[j] = 1;
+        }
         int m = 0;
         for (int i = 0; i < n; i++) remap[i] = keep[i] ? m++ : -1;
         for (int i = 0; i < n; i++) {
@@ -488,7 +495,11 @@ static pt_status catchment_areas(gi_particles *ps, const int *glink, int ng)
 static float sky_reflected(const gi_particle *gp, int i, int c)
 {
     if (gp->set.bounces < 1 || !gp->esky) return 0.0f;
-    float v = gp->ps.p[i].rho[c] * (float)gp->set.brightness * gp->esky[4 * (size_t)i + c];
+    const gi_dev_particle *p = &gp->ps.p[i];
+    float e = gp->esky[4 * (size_t)i + c];
+    /* diffuse_back: the sky its twin sees, too (gi_types.h) */
+    if (p->back > 0.0f && p->twin >= 0) e += p->back * gp->esky[4 * (size_t)p->twin + c];
+    float v = p->rho[c] * (float)gp->set.brightness * e;
     return isfinite(v) ? v : 0.0f;
 }
 
@@ -676,6 +687,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
         tg = timer_now();
         cg = timer_cpu_now();
         st = trace_and_prune(gp, &gp->ps, set->seed ^ 0x51ULL, &gp->slink, &ls, 1);
+        if (st == PT_OK) gi_particles_set_twins(&gp->ps);
         S->t_scatter_links = timer_now() - tg;
         S->c_scatter_links = timer_cpu_now() - cg;
         if (st != PT_OK) goto fail;

@@ -297,7 +297,7 @@ void gi_particle_free(gi_particle *gp);
  * geometry settings (count, links, bounces, seed, radii), or whose
  * particles do not fit this scene's surfaces; an unreadable file is
  * PT_ERR_IO. */
-#define GI_PARTICLE_CACHE_VERSION 7
+#define GI_PARTICLE_CACHE_VERSION 8
 pt_status gi_particle_save(gi_particle *gp, const char *path, uint64_t scene_key, diag *d);
 gi_particle *gi_particle_load(const scene *sc, const accel *a, const gi_particle_settings *s, const char *path,
                               uint64_t scene_key, gi_particle_stats *stats, diag *d, pt_status *status);

@@ -518,6 +518,8 @@ static pt_status walk(gi_surface *g, const scene_object *o, const scene_texture 
 {
     if (o->texture) tex = o->texture;
     if (o->flags & OBJ_NO_RADIOSITY) return PT_OK;
+    pt_status cst;
+    if (o->clip && gi_surface_csg_walk(g, o, tex, &cst)) return cst; /* clipped_by: a CSG tree */
     switch (o->kind) {
     case SHAPE_UNION:
     case SHAPE_MERGE:

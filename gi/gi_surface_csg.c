@@ -230,7 +230,12 @@ static pt_status walk_tree(gi_surface *g, const scene_object *o, const scene_tex
         g->cm[g->ncm].node = node;
         g->cm[g->ncm].shape = k;
         g->cur_node = g->ncm++;
-        g->cur_mask = both ? 3 : (unsigned char)(1u << c->nodes[node].flip);
+        /* sheets (polygons, discs, open cylinders and cones; triangles
+         * and meshes, member_sides) show both sides where the result keeps
+         * them: a clipped open cylinder is seen from within */
+        shape_kind k = lr->o->kind;
+        int sheet = k == SHAPE_POLYGON || k == SHAPE_DISC || (lr->o->flags & OBJ_OPEN);
+        g->cur_mask = both || sheet ? 3 : (unsigned char)(1u << c->nodes[node].flip);
         st = gi_surface_add_leaf(g, lr->o, lr->tex, 1);
         g->cur_node = -1;
     }
@@ -240,9 +245,14 @@ static pt_status walk_tree(gi_surface *g, const scene_object *o, const scene_tex
 
 int gi_surface_csg_walk(gi_surface *g, const scene_object *o, const scene_texture *tex, pt_status *status)
 {
+    /* clipped_by (any shape, a union too): one CSG tree whose clipping
+     * solids have no surface, as accel renders it, unless meshes are
+     * involved (then accel renders it unclipped: so do the particles) */
+    int clipped = o->clip && o->kind != SHAPE_UNSUPPORTED && !geom_csg_has_mesh(o, 0) && !geom_csg_has_mesh(o->clip, 0);
     /* accel renders CSG with a mesh member, and merges of more than
      * GEOM_CSG_MAX_MERGE leaves, as unions (accel.c) */
-    if (o->kind == SHAPE_UNION || geom_csg_has_mesh(o, 0) || (o->kind == SHAPE_MERGE && geom_csg_leaf_count(o, 0) > GEOM_CSG_MAX_MERGE))
+    if (!clipped && (o->kind == SHAPE_UNION || geom_csg_has_mesh(o, 0) ||
+                     (o->kind == SHAPE_MERGE && geom_csg_leaf_count(o, 0) > GEOM_CSG_MAX_MERGE)))
         return 0;
     *status = walk_tree(g, o, tex);
     return 1;

@@ -29,6 +29,33 @@
  * marks the particles with emission: a particle no light reaches (every vis
  * 0) and without it gets zeros without reading its record. dsum[g]: the
  * direct flux of the work-item's particles, summed over colours (stats). */
+/* Direct E/pi at particle i into e (added), from its row of vis; whether
+ * any light reaches it (its record is read only then). */
+static inline int gi_direct(__global const gi_dev_particle *part, int i, __global const gi_dev_light *lights,
+                            int nlights, __global const float *vis, float *e)
+{
+    __global const gi_dev_particle *pt = &part[i];
+    int lit = 0;
+    for (int l = 0; l < nlights; l++) {
+        float v = vis[(long)i * nlights + l];
+        if (!(v > 0.0f)) continue;
+        lit = 1;
+        __global const gi_dev_light *lt = &lights[l];
+        float d[3];
+        gi_light_ray(lt, lt->pos[0], lt->pos[1], lt->pos[2], pt->p[0], pt->p[1], pt->p[2], d);
+        float ci = pt->n[0] * d[0] + pt->n[1] * d[1] + pt->n[2] * d[2];
+        if (ci < 1e-10f) continue; /* the other side's particle takes it (shade.c: backside rule) */
+        float intensity = pt->brilliance != 1.0f ? pow(ci, pt->brilliance) : ci;
+        float w = intensity * v; /* v = att * V */
+        for (int c = 0; c < 3; c++) e[c] += lt->colour[c] * w;
+    }
+    return lit;
+}
+
+/* diffuse_back (gi_types.h): a particle with a twin also sends
+ *   rho_b * phi_d(twin) (dA / dA_twin) = back * rho * pi * (E_twin/pi) * dA,
+ * the direct light on the other side that its back lobe reflects; the
+ * host marks such particles in emits, so they are always read. */
 __kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global const gi_dev_light *lights, int nlights,
                         __global const float *vis, __global const uint *emits, __global float *edir,
                         __global float *src, __global uint *srcmask, __global float *dsum)
@@ -40,24 +67,9 @@ __kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global co
     uint em = emits[g], bits = 0u;
     float ds = 0.0f;
     for (int i = i0; i < i1; i++) {
-        /* one pass over the particle's row of vis: its record is read only
-         * once a light reaches it (lit) */
         __global const gi_dev_particle *pt = &part[i];
         float e[3] = {0.0f, 0.0f, 0.0f};
-        int lit = 0;
-        for (int l = 0; l < nlights; l++) {
-            float v = vis[(long)i * nlights + l];
-            if (!(v > 0.0f)) continue;
-            lit = 1;
-            __global const gi_dev_light *lt = &lights[l];
-            float d[3];
-            gi_light_ray(lt, lt->pos[0], lt->pos[1], lt->pos[2], pt->p[0], pt->p[1], pt->p[2], d);
-            float ci = pt->n[0] * d[0] + pt->n[1] * d[1] + pt->n[2] * d[2];
-            if (ci < 1e-10f) continue; /* the other side's particle takes it (shade.c: backside rule) */
-            float intensity = pt->brilliance != 1.0f ? pow(ci, pt->brilliance) : ci;
-            float w = intensity * v; /* v = att * V */
-            for (int c = 0; c < 3; c++) e[c] += lt->colour[c] * w;
-        }
+        int lit = gi_direct(part, i, lights, nlights, vis, e);
         if (!lit && !((em >> (i - i0)) & 1u)) {
             for (int c = 0; c < 4; c++) {
                 edir[4 * i + c] = 0.0f;
@@ -65,11 +77,14 @@ __kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global co
             }
             continue;
         }
+        float eb[3] = {0.0f, 0.0f, 0.0f};
+        if (pt->back > 0.0f && pt->twin >= 0) gi_direct(part, pt->twin, lights, nlights, vis, eb);
         int any = 0;
         for (int c = 0; c < 3; c++) {
             if (!isfinite(e[c])) e[c] = 0.0f;
+            if (!isfinite(eb[c])) eb[c] = 0.0f;
             float phid = GI_PI_F * e[c] * pt->area;
-            float sv = pt->rho[c] * phid + GI_PI_F * pt->le[c] * pt->area;
+            float sv = pt->rho[c] * (phid + pt->back * GI_PI_F * eb[c] * pt->area) + GI_PI_F * pt->le[c] * pt->area;
             ds += phid;
             edir[4 * i + c] = e[c];
             src[4 * i + c] = sv;
@@ -247,6 +262,29 @@ __kernel void gi_k_walk(__global const gi_dev_particle *part, int n, __global co
     }
     for (int b = 0; b < nwalk; b++)
         for (int c = 0; c < 3; c++) tally[3 * (b + 1) * items + 3 * g + c] = tb[3 * b + c];
+}
+
+/* diffuse_back's share of the reflected radiance (gi_types.h), after
+ * gi_k_resolve or gi_k_walk: a particle with a twin t adds
+ *   rho_b phi^(t) / (pi dA^(t)) = back * rho * phi^(t) / (pi dA^(t)),
+ * the back lobe of the paper's L^(i) = f_rd phi / dA (section 4.2.2) over
+ * the flux its twin received (direct and scattered; the sky its twin sees
+ * is in le, gi_particle.c). phi is read, lout written: no particle reads
+ * what another writes. */
+__kernel void gi_k_back(__global const gi_dev_particle *part, int n, __global const float *phi,
+                        __global float *lout)
+{
+    int i = (int)get_global_id(0);
+    if (i >= n) return;
+    __global const gi_dev_particle *pt = &part[i];
+    int t = pt->twin;
+    if (!(pt->back > 0.0f) || t < 0) return;
+    float a = part[t].area;
+    if (!(a > 0.0f)) return;
+    for (int c = 0; c < 3; c++) {
+        float l = lout[4 * i + c] + pt->back * pt->rho[c] * phi[4 * t + c] / (GI_PI_F * a);
+        if (isfinite(l)) lout[4 * i + c] = l;
+    }
 }
 
 /* gi_resolve_one for every particle, the scattered flux from total

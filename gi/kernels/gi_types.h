@@ -60,16 +60,22 @@ typedef struct {
  * diffuse reflectance rho_d; the BRDF is rho_d/pi). `n` is the normal of the
  * side the particle stands for (two-sided surfaces get one particle per
  * side). `le` is the emitted radiance (finish emission, and ambient when
- * radiosity{} makes it a light source). 64 bytes. */
+ * radiosity{} makes it a light source).
+ * finish { diffuse A, B } (POV-Ray 3.7's diffuse_back) adds to the paper's
+ * BRDF a second lobe, rho_b/pi for light arriving from the other side, with
+ * rho_b = B * pigment * opacity = back * rho (back = B / A): the particle
+ * reflects towards its side what its twin, the particle of the other side
+ * at the same point, receives. twin is that particle's index, -1 none
+ * (back 0: unused). 64 bytes. */
 typedef struct {
     float p[3];
     float area;
     float n[3];
     float brilliance;
     float rho[3];
-    float pad0;
+    float back;
     float le[3];
-    float pad1;
+    int twin;
 } gi_dev_particle;
 
 enum { GI_LIGHT_POINT = 0, GI_LIGHT_SPOT = 1, GI_LIGHT_CYLINDER = 2, GI_LIGHT_PARALLEL = 3 };
