@@ -61,7 +61,7 @@ extern const int gi_kernel_nfiles;
 /* gi_k_bounce work-items (GI_BOUNCE_CHUNK particles each) per work-group */
 #define GI_BOUNCE_LOCAL 4
 
-enum { KE_EMIT, KE_BOUNCE, KE_WALK, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_VPL, KE_CAUSTIC, KE_BACK, KE_COUNT };
+enum { KE_EMIT, KE_BOUNCE, KE_WALK, KE_RESOLVE, KE_GATHER, KE_ESTIMATE, KE_VPL, KE_CAUSTIC, KE_BACK, KE_BACK_SEND, KE_COUNT };
 
 struct gi_dev {
     int is_cl;
@@ -356,7 +356,7 @@ static pt_status cl_open(gi_dev *dv, const gi_dev_options *o, diag *d)
     }
     static const char *const names[KE_COUNT] = {"gi_k_emit", "gi_k_bounce", "gi_k_walk", "gi_k_resolve",
                                                 "gi_k_gather", "gi_k_estimate", "gi_k_vpl_gather",
-                                                "gi_k_caustic_splat", "gi_k_back"};
+                                                "gi_k_caustic_splat", "gi_k_back", "gi_k_back_send"};
     for (int k = 0; k < KE_COUNT; k++) {
         dv->k[k] = clCreateKernel(dv->prog, names[k], &e);
         if (!dv->k[k]) return cl_fail(d, names[k], e);
@@ -912,6 +912,19 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
             dv->mask_b = dv->mask_a;
             dv->mask_a = tm;
             min = dv->mask_b;
+            if (dv->has_back && b + 1 < nbounce) {
+                /* the back lobes' share of what this bounce sends on
+                 * (gi_k_back_send), into the free pair, then swapped in */
+                gi_c_back_send(dv->threads, dv->part, n, dv->rho4, dv->bin, dv->bout, dv->mask_a);
+                t = dv->bin;
+                dv->bin = dv->bout;
+                dv->bout = t;
+                bin = dv->bin;
+                tm = dv->mask_b;
+                dv->mask_b = dv->mask_a;
+                dv->mask_a = tm;
+                min = dv->mask_b;
+            }
         }
         if (cancelled(cancel)) return PT_OK;
         /* from here on the results are written: not cancelled any more */
@@ -971,6 +984,21 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
         dv->b_mask_b = dv->b_mask_a;
         dv->b_mask_a = t;
         min = dv->b_mask_b;
+        if (dv->has_back && b + 1 < nbounce) {
+            /* the back lobes' share of what this bounce sends on
+             * (gi_k_back_send), into the free pair, then swapped in */
+            karg bs[] = {KMEM(dv->b_part), KINT(n), KMEM(dv->b_rho), KMEM(dv->b_bin), KMEM(dv->b_bout),
+                         KMEM(dv->b_mask_a)};
+            if ((st = run_kernel(dv, KE_BACK_SEND, eitems, bs, 6, d)) != PT_OK) return st;
+            t = dv->b_bin;
+            dv->b_bin = dv->b_bout;
+            dv->b_bout = t;
+            bin = dv->b_bin;
+            t = dv->b_mask_b;
+            dv->b_mask_b = dv->b_mask_a;
+            dv->b_mask_a = t;
+            min = dv->b_mask_b;
+        }
     }
     if (cancelled(cancel)) return PT_OK;
     /* from here on the results are written: not cancelled any more */

@@ -49,7 +49,7 @@ typedef struct {
     int *visits;
 } c_launch;
 
-enum { K_EMIT, K_BOUNCE, K_WALK, K_RESOLVE, K_GATHER, K_ESTIMATE, K_VPL, K_CAUSTIC, K_BACK };
+enum { K_EMIT, K_BOUNCE, K_WALK, K_RESOLVE, K_GATHER, K_ESTIMATE, K_VPL, K_CAUSTIC, K_BACK, K_BACK_SEND };
 
 static void run_chunk(void *ctx, int chunk, int thread)
 {
@@ -74,6 +74,7 @@ static void run_chunk(void *ctx, int chunk, int thread)
             break;
         case K_RESOLVE: gi_k_resolve(a->part, a->np, a->edir, a->scattered, a->total, a->fout, a->fout2); break;
         case K_BACK: gi_k_back(a->part, a->np, a->total, a->fout); break;
+        case K_BACK_SEND: gi_k_back_send(a->part, a->np, a->rho4, a->src, a->fout, a->mask_out); break;
         case K_GATHER:
             gi_k_gather(a->glink, a->ng, a->lout, a->idx, (int)a->n, a->esky, a->fout);
             break;
@@ -143,6 +144,15 @@ void gi_c_resolve(int threads, const gi_dev_particle *part, int n, const float *
 void gi_c_back(int threads, const gi_dev_particle *part, int n, const float *phi, float *lout)
 {
     c_launch a = {.kernel = K_BACK, .n = (size_t)n, .part = part, .np = n, .total = phi, .fout = lout};
+    launch(threads, &a);
+}
+
+void gi_c_back_send(int threads, const gi_dev_particle *part, int n, const float *rho4, const float *bin, float *bout,
+                    unsigned *mask)
+{
+    size_t items = ((size_t)n + GI_EMIT_CHUNK - 1) / GI_EMIT_CHUNK;
+    c_launch a = {.kernel = K_BACK_SEND, .n = items, .part = part, .np = n, .rho4 = rho4, .src = bin, .fout = bout,
+                  .mask_out = mask, .chunk = 16};
     launch(threads, &a);
 }
 

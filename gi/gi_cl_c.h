@@ -26,6 +26,9 @@ void gi_c_resolve(int threads, const gi_dev_particle *part, int n, const float *
                   const float *total, float *lout, float *phi);
 /* gi_k_back: n work-items, after gi_c_resolve or gi_c_walk. */
 void gi_c_back(int threads, const gi_dev_particle *part, int n, const float *phi, float *lout);
+/* gi_k_back_send: ceil(n / GI_EMIT_CHUNK) work-items, one mask word each. */
+void gi_c_back_send(int threads, const gi_dev_particle *part, int n, const float *rho4, const float *bin, float *bout,
+                    unsigned *mask);
 void gi_c_gather(int threads, const int *glink, int ng, const float *lout, const int *used, int nused,
                  const float *esky, float *eind);
 void gi_c_estimate(int threads, const gi_dev_particle *part, const int *list_off, const int *list_idx,

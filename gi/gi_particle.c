@@ -326,7 +326,8 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
  * lose the flux, as a packet leaving the scene). So what particle j
  * received in bounce 0 follows a fixed path, P_0 = j, P_b = c(P_(b-1), b),
  * and reaches P_b in bounce b times w_b = rho(P_0) rho(P_1) ... rho(P_(b-1))
- * (per colour, float products in that order). The table lists per target k
+ * (per colour, float products in that order; at a particle with a
+ * diffuse_back twin the link may be the twin's, below). The table lists per target k
  * the entries (j, b, w_b) with P_b(j) = k, sorted by b, then j (a fixed
  * summation order for gi_k_walk); a path ends at a -1 link or where w_b is
  * 0 in every colour (it carries nothing on). 16 bytes per entry, at most n
@@ -371,9 +372,28 @@ pt_status gi_particle_build_walk(gi_particle *gp, int nwalk, diag *d)
                 int p = pos[j];
                 if (p < 0) continue;
                 gi_u32 h = gi_hash(seed ^ gi_hash((gi_u32)p ^ hb));
-                int t = gp->slink[(size_t)p * (size_t)k + (size_t)(h % (gi_u32)k)];
                 float *wj = &w[3 * (size_t)j];
-                for (int c = 0; c < 3; c++) wj[c] *= gp->ps.p[p].rho[c];
+                /* diffuse_back (gi_types.h): what p received leaves by p's
+                 * own lobe (rho_p) and by its twin's back lobe (back_t
+                 * rho_t, along the twin's links); the walk takes the twin's
+                 * way with probability q = back_t / (1 + back_t) and
+                 * divides by the probability taken: the same expectation,
+                 * rho_p own + back_t rho_t twin */
+                int from = p, tw = gp->ps.p[p].twin;
+                float scale = 1.0f;
+                const float *rho = gp->ps.p[p].rho;
+                if (tw >= 0 && gp->ps.p[tw].back > 0.0f) {
+                    float bt = gp->ps.p[tw].back, q = bt / (1.0f + bt);
+                    if ((float)(gi_hash(h ^ 0x9e3779b9u) >> 8) * (1.0f / 16777216.0f) < q) {
+                        from = tw;
+                        rho = gp->ps.p[tw].rho;
+                        scale = bt / q;
+                    } else {
+                        scale = 1.0f / (1.0f - q);
+                    }
+                }
+                int t = gp->slink[(size_t)from * (size_t)k + (size_t)(h % (gi_u32)k)];
+                for (int c = 0; c < 3; c++) wj[c] *= rho[c] * scale;
                 if (t < 0 || (wj[0] == 0.0f && wj[1] == 0.0f && wj[2] == 0.0f)) {
                     pos[j] = -1;
                     continue;

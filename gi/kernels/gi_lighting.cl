@@ -287,6 +287,40 @@ __kernel void gi_k_back(__global const gi_dev_particle *part, int n, __global co
     }
 }
 
+/* diffuse_back between the FULL mode's bounces (gi_types.h): what a
+ * particle sends on is rho_i recv_i (gi_k_bounce's bout), and with a twin t
+ * also back_i rho_i recv_t, its back lobe's share of what the twin
+ * received, recv_t = bin_t / rho_t. bout_i = bin_i + that, and mask word g
+ * (particles [32 g, 32 g + 32), GI_EMIT_CHUNK) says which send something.
+ * Reads bin, writes bout: the caller swaps them. */
+__kernel void gi_k_back_send(__global const gi_dev_particle *part, int n, __global const float *rho4,
+                             __global const float *bin, __global float *bout, __global uint *mask)
+{
+    int g = (int)get_global_id(0);
+    int i0 = g * GI_EMIT_CHUNK;
+    if (i0 >= n) return;
+    int i1 = n - i0 < GI_EMIT_CHUNK ? n : i0 + GI_EMIT_CHUNK;
+    uint bits = 0u;
+    for (int i = i0; i < i1; i++) {
+        __global const gi_dev_particle *pt = &part[i];
+        int t = pt->twin;
+        int any = 0;
+        for (int c = 0; c < 3; c++) {
+            float v = bin[4 * i + c];
+            float rt = t >= 0 ? rho4[4 * t + c] : 0.0f;
+            if (pt->back > 0.0f && rt > 0.0f) {
+                float u = v + pt->back * pt->rho[c] * bin[4 * t + c] / rt;
+                if (isfinite(u)) v = u;
+            }
+            bout[4 * i + c] = v;
+            any |= v != 0.0f;
+        }
+        bout[4 * i + 3] = 0.0f;
+        if (any) bits |= 1u << (i - i0);
+    }
+    mask[g] = bits;
+}
+
 /* gi_resolve_one for every particle, the scattered flux from total
  * (gi_k_bounce): after the FULL mode's bounces, or with no bounce. */
 __kernel void gi_k_resolve(__global const gi_dev_particle *part, int n, __global const float *edir, int scattered,
