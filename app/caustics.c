@@ -183,13 +183,20 @@ static int hook_pass(void *ctx, const accel_hit *h, vec3 dir, const gi_caustic_i
 }
 
 /* The brilliance of the top layer's finish at the hit (POV-Ray shades each
- * photon through it; the caustic layer weights its photons so). */
-static double hook_brilliance(void *ctx, const accel_hit *h, vec3 dir)
+ * photon through it; the caustic layer weights its photons so), and its
+ * diffuse_back over its diffuse: photons arriving from behind light it
+ * through diffuse_back (trace.cpp, ComputePhotonDiffuseLight shades a
+ * photon as a light, and a light behind the surface takes diffuse_back). */
+static double hook_brilliance(void *ctx, const accel_hit *h, vec3 dir, double *back)
 {
     const caustics *c = ctx;
     shade_mat_bsdf b;
     shade_mat_setup(&b, c->sc, h, dir, c->eps, c->scale, NULL);
-    return b.ls.f ? b.ls.f->brilliance : 1.0;
+    const scene_finish *f = b.ls.f;
+    *back = f && f->diffuse > 0.0 && f->diffuse_back > 0.0 && isfinite(f->diffuse_back / f->diffuse)
+                ? f->diffuse_back / f->diffuse
+                : 0.0;
+    return f ? f->brilliance : 1.0;
 }
 
 /* Spot and cylinder attenuation seen from the photon's first hit p, fade at
@@ -247,15 +254,6 @@ static int disperses(const scene_object *o)
     return o->photons && o->photons->target && o->interior && o->interior->dispersion != 1.0;
 }
 
-/* A layer of the object's own texture has a diffuse_back term (texture
- * maps are not looked into). */
-static int lit_from_behind(const scene_object *o)
-{
-    for (const scene_texture *t = o->texture; t; t = t->next)
-        if (t->finish.diffuse_back > 0.0) return 1;
-    return 0;
-}
-
 /* What the scene's photon settings ask that the layer leaves out (media
  * photons are modelled: hook_media and caustics_media_photons). */
 static void not_modelled(caustics *c, const scene *sc, diag *d)
@@ -268,10 +266,7 @@ static void not_modelled(caustics *c, const scene *sc, diag *d)
     nm->autostop = (p->given & SCENE_PH_AUTOSTOP) != 0 && p->autostop > 0.0;
     nm->save_file = (p->given & SCENE_PH_SAVE_FILE) != 0 && p->file && !p->load;
     nm->load_file = (p->given & SCENE_PH_LOAD_FILE) != 0 && p->file && p->load;
-    for (int i = 0; i < sc->nobjects; i++) {
-        nm->dispersion |= scene_object_any(sc->objects[i], disperses);
-        nm->diffuse_back |= scene_object_any(sc->objects[i], lit_from_behind);
-    }
+    for (int i = 0; i < sc->nobjects; i++) nm->dispersion |= scene_object_any(sc->objects[i], disperses);
     src_loc nowhere = {0};
     const char *why = "the caustic layer sizes its photon volumes itself (docs/caustics.md)";
     if (nm->gather) diag_warn_once(d, nowhere, "photons: gather is not modelled: %s", why);
@@ -284,10 +279,6 @@ static void not_modelled(caustics *c, const scene *sc, diag *d)
         diag_warn_once(d, nowhere, "photons: load_file is not modelled: the photons are shot again, not read");
     if (nm->dispersion)
         diag_warn_once(d, nowhere, "photons: dispersion is not modelled: photons through a dispersive target are white");
-    if (nm->diffuse_back)
-        diag_warn_once(d, nowhere,
-                       "photons: diffuse_back is not modelled in the caustic layer: photons arriving at the back of a "
-                       "surface do not light it");
 }
 
 pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width, int height, int threads,
@@ -415,8 +406,7 @@ void caustics_json(caustics *c, stats_json *js)
     STATS_NUMS_PRE(js, s, t_, trace, gbuffer, bin, splat);
     stats_obj_end(js);
     stats_obj_begin(js, "not_modelled");
-    STATS_INTS(js, &c->nm, gather, radius, expand_thresholds, autostop, save_file, load_file, dispersion,
-               diffuse_back);
+    STATS_INTS(js, &c->nm, gather, radius, expand_thresholds, autostop, save_file, load_file, dispersion);
     stats_obj_end(js);
     stats_obj_end(js);
 }

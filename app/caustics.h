@@ -17,8 +17,6 @@
 typedef struct {
     int gather, radius, expand_thresholds, autostop, save_file, load_file;
     int dispersion;     /* a target's interior has dispersion (photons carry no wavelength) */
-    int diffuse_back;   /* a surface with diffuse_back: photons arriving at its back are not shown (POV-Ray
-                           lights it through diffuse_back) */
 } caustics_not_modelled;
 
 typedef struct {

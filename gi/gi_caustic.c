@@ -802,7 +802,9 @@ static void gbuf_row(void *ctx, int y, int thread)
             v3_store_f(px->s, h.p);
             px->valid = 1.0f;
             v3_store_f(px->n, n);
-            px->brilliance = c->hk.brilliance ? (float)c->hk.brilliance(c->hk.ctx, &h, d) : 1.0f;
+            double back = 0.0;
+            px->brilliance = c->hk.brilliance ? (float)c->hk.brilliance(c->hk.ctx, &h, d, &back) : 1.0f;
+            px->back = (float)back;
             c->gobj[k] = h.obj;
             /* footprint: the distance to the neighbouring pixels' rays at
              * the same distance, so a lookup at this point takes its own
@@ -1428,19 +1430,20 @@ rgb gi_caustic_at(void *ctx, const accel_hit *h, vec3 n, int thread)
     /* elsewhere: the same photon volumes, summed at p */
     __atomic_fetch_add(&c->st.lookups_photons, 1, __ATOMIC_RELAXED);
     float s[3] = {(float)p.x, (float)p.y, (float)p.z}, nn[3] = {(float)n.x, (float)n.y, (float)n.z}, acc[3] = {0, 0, 0};
-    float b = c->hk.brilliance ? (float)c->hk.brilliance(c->hk.ctx, h, v3_neg(n)) : 1.0f;
+    double back = 0.0;
+    float b = c->hk.brilliance ? (float)c->hk.brilliance(c->hk.ctx, h, v3_neg(n), &back) : 1.0f;
     for (const hgrid *gl = &c->pgrid; gl; gl = gl->up) {
         hgrid_cell(gl, cidx(p.x, gl->cell), cidx(p.y, gl->cell), cidx(p.z, gl->cell), &lo, &hi);
         for (long q = lo; q < hi; q++) {
             float one[3];
-            gi_c_caustic_at(c->ph, &gl->e[q].id, 1, s, nn, b, one);
+            gi_c_caustic_at(c->ph, &gl->e[q].id, 1, s, nn, b, (float)back, one);
             acc[0] += one[0];
             acc[1] += one[1];
             acc[2] += one[2];
         }
         if (gl->nbig) {
             float one[3];
-            gi_c_caustic_at(c->ph, gl->big, (int)gl->nbig, s, nn, b, one);
+            gi_c_caustic_at(c->ph, gl->big, (int)gl->nbig, s, nn, b, (float)back, one);
             acc[0] += one[0];
             acc[1] += one[1];
             acc[2] += one[2];

@@ -134,8 +134,10 @@ typedef struct {
     double (*attenuation)(void *ctx, const scene_light *l, vec3 p, double depth);
     void *ctx;
     /* The brilliance of the receiving finish at h seen along unit dir (the
-     * photons' weight, gi_caus_add); NULL: 1. */
-    double (*brilliance)(void *ctx, const accel_hit *h, vec3 dir);
+     * photons' weight, gi_caus_add), and in *back its diffuse_back as a
+     * fraction of its diffuse (0: none; photons arriving on the other side
+     * light it times that); NULL: brilliance 1, back 0. */
+    double (*brilliance)(void *ctx, const accel_hit *h, vec3 dir, double *back);
     /* A pass_through object met before the target: step->weight is what
      * the surface lets through and step->inside the containers crossed
      * (the photon goes on along the same ray); 0 when nothing passes.

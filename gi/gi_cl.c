@@ -42,8 +42,9 @@ _Static_assert(sizeof(gi_caus_photon) == 64 && offsetof(gi_caus_photon, r_xy) ==
                    offsetof(gi_caus_photon, inv_rxy2) == 44 && offsetof(gi_caus_photon, phi) == 48 &&
                    offsetof(gi_caus_photon, inv_rz2) == 60,
                "gi_caus_photon is 64 bytes");
-_Static_assert(sizeof(gi_caus_pixel) == 32 && offsetof(gi_caus_pixel, valid) == 12 && offsetof(gi_caus_pixel, n) == 16,
-               "gi_caus_pixel is 32 bytes");
+_Static_assert(sizeof(gi_caus_pixel) == 48 && offsetof(gi_caus_pixel, valid) == 12 && offsetof(gi_caus_pixel, n) == 16 &&
+                   offsetof(gi_caus_pixel, brilliance) == 28 && offsetof(gi_caus_pixel, back) == 32,
+               "gi_caus_pixel is 48 bytes");
 _Static_assert(GI_BOUNCE_CHUNK % 32 == 0, "gi_k_bounce writes whole mask words");
 _Static_assert(sizeof(gi_i64) == 8 && sizeof(gi_u32) == 4 && sizeof(float) == 4 && sizeof(int) == 4,
                "scalar sizes match OpenCL C");

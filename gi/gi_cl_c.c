@@ -188,10 +188,11 @@ void gi_c_caustic_splat(int threads, const gi_caus_photon *ph, const int *tile_o
 }
 
 void gi_c_caustic_at(const gi_caus_photon *ph, const int *idx, int n, const float s[3], const float nrm[3], float brilliance,
-                     float e[3])
+                     float back, float e[3])
 {
     e[0] = e[1] = e[2] = 0.0f;
-    for (int k = 0; k < n; k++) gi_caus_add(&ph[idx ? idx[k] : k], s[0], s[1], s[2], nrm[0], nrm[1], nrm[2], brilliance, e);
+    for (int k = 0; k < n; k++)
+        gi_caus_add(&ph[idx ? idx[k] : k], s[0], s[1], s[2], nrm[0], nrm[1], nrm[2], brilliance, back, e);
 }
 
 float gi_c_caustic_kappa(const gi_caus_photon *q, const float s[3]) { return gi_caus_kappa(q, s[0], s[1], s[2]); }

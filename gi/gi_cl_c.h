@@ -41,11 +41,11 @@ void gi_c_vpl_gather(int threads, const gi_dev_vpl_point *pts, int npts, const g
 void gi_c_caustic_splat(int threads, const gi_caus_photon *ph, const int *tile_off, const int *tile_idx,
                         const gi_caus_pixel *gbuf, int w, int h, int tiles_x, float *e);
 /* The same photon volume sum (gi_caus_add) at one receiver point s with
- * normal nrm and finish brilliance, over photons idx[0 .. n) (idx NULL:
+ * normal nrm, finish brilliance and diffuse_back fraction back, over photons idx[0 .. n) (idx NULL:
  * photons 0 .. n), on the calling thread: the caustic layer's lookups away
  * from the G-buffer. */
 void gi_c_caustic_at(const gi_caus_photon *ph, const int *idx, int n, const float s[3], const float nrm[3], float brilliance,
-                     float e[3]);
+                     float back, float e[3]);
 
 /* gi_caus_kappa (gi_caustic.cl): photon q's filter kernel at s. */
 float gi_c_caustic_kappa(const gi_caus_photon *q, const float s[3]);

@@ -44,19 +44,27 @@ static inline float gi_caus_kappa(GI_GLOBAL const gi_caus_photon *q, float sx, f
  * light through the finish's diffuse term, cos^brilliance, after dividing
  * by the cosine, at most tenfold (trace.cpp, ComputePhotonDiffuseLight and
  * ComputeDiffuseColour). g is 1 for brilliance 1 above c = 0.1. The BSDF's
- * diffuse * pigment is applied by the shader. */
+ * diffuse * pigment is applied by the shader. A photon arriving on the
+ * other side (c < 0) lights a finish with diffuse_back through it, as
+ * POV-Ray's gather shades it as a light from behind: weight back = B / A
+ * (the shader's diffuse A times it gives B) at |c|; back 0: not at all. */
 static inline void gi_caus_add(GI_GLOBAL const gi_caus_photon *q, float sx, float sy, float sz, float nx, float ny,
-                               float nz, float b, float *e)
+                               float nz, float b, float back, float *e)
 {
     float c = q->w[0] * nx + q->w[1] * ny + q->w[2] * nz;
-    if (c <= 0.0f) return;
+    float side = 1.0f;
+    if (c <= 0.0f) {
+        if (!(back > 0.0f) || c == 0.0f) return;
+        c = -c;
+        side = back;
+    }
     float k = gi_caus_kappa(q, sx, sy, sz);
     if (k <= 0.0f) return;
     if (c > 1.0f) c = 1.0f;
     /* c^b as exp2(b log2 c), c > 0 here: the native pair, where pow cost
      * PoCL as much as the rest of the sum (bench_caustics on glassthing,
      * whose walls have brilliance 0.6) */
-    k *= (b == 1.0f ? c : native_exp2(b * native_log2(c))) / (c > 0.1f ? c : 0.1f);
+    k *= side * (b == 1.0f ? c : native_exp2(b * native_log2(c))) / (c > 0.1f ? c : 0.1f);
     e[0] += q->phi[0] * k;
     e[1] += q->phi[1] * k;
     e[2] += q->phi[2] * k;
@@ -76,7 +84,8 @@ __kernel void gi_k_caustic_splat(__global const gi_caus_photon *ph, __global con
     if (px->valid > 0.0f) {
         int t = (g / w) / GI_CAUS_TILE * tiles_x + (g % w) / GI_CAUS_TILE;
         for (int k = tile_off[t]; k < tile_off[t + 1]; k++)
-            gi_caus_add(&ph[tile_idx[k]], px->s[0], px->s[1], px->s[2], px->n[0], px->n[1], px->n[2], px->brilliance, acc);
+            gi_caus_add(&ph[tile_idx[k]], px->s[0], px->s[1], px->s[2], px->n[0], px->n[1], px->n[2], px->brilliance,
+                        px->back, acc);
     }
     for (int c = 0; c < 3; c++) e[4 * g + c] = isfinite(acc[c]) ? acc[c] : 0.0f;
     e[4 * g + 3] = 0.0f;

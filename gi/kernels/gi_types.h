@@ -232,13 +232,16 @@ typedef struct {
 
 /* One eye G-buffer texel (paper step 2): the world position s and normal n
  * of the camera's first receiving hit through the pixel's centre, n turned
- * towards the camera, and the brilliance of its finish (gi_caus_add);
- * valid 0 where the pixel sees no receiver. 32 bytes. */
+ * towards the camera, and the brilliance of its finish and its diffuse_back
+ * as a fraction of diffuse (back, gi_caus_add); valid 0 where the pixel
+ * sees no receiver. 48 bytes. */
 typedef struct {
     float s[3];
     float valid;
     float n[3];
     float brilliance;
+    float back;
+    float pad[3];
 } gi_caus_pixel;
 
 /* Tile edge (pixels) of the splat's binning: a photon is listed in every
