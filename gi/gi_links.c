@@ -112,7 +112,7 @@ static void hit_material(const link_job *J, const struct RTCRayHit *h, const sce
          * which no gather sees. */
         if (o->kind == SHAPE_BOX || o->kind == SHAPE_PLANE || o->kind == SHAPE_DISC || o->kind == SHAPE_POLYGON) {
             vec3 org = v3(h->ray.org_x, h->ray.org_y, h->ray.org_z), d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
-            double t = h->ray.tfar, dt = 1e-4 * t + 1e-6;
+            double t = h->ray.tfar, dt = 1e-4 * t + 1e-6 * J->scale; /* relative, and the working scale's */
             accel_hit dh;
             if (accel_intersect(J->a, org, d, t - dt, t + dt, &dh) && dh.obj == o) ah.p = dh.p;
         }
