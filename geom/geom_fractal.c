@@ -487,15 +487,26 @@ static double jf_polish(const jf_data *f, vec3 p0, vec3 e, double lo, double hi,
     return 0.5 * (lo + hi);
 }
 
+/* The parameters t0 <= t1 where a line x + t v meets a ball, from
+ * A = v.v, B = x.v, C = x.x - r^2 (x relative to the centre): 0 when it
+ * misses or only grazes it. */
+static int ball_chord(double A, double B, double C, double *t0, double *t1)
+{
+    double disc = B * B - A * C;
+    if (!(disc > 0.0)) return 0;
+    double sq = sqrt(disc);
+    *t0 = (-B - sq) / A;
+    *t1 = (-B + sq) / A;
+    return 1;
+}
+
 int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double tmax, geom_shape_hit *out, int max)
 {
     const jf_data *f = sh->data;
     if (!f || max <= 0) return 0;
     /* the bounding sphere */
-    double A = v3_dot(d, d), B = v3_dot(o, d), C = v3_dot(o, o) - f->R * f->R;
-    double disc = B * B - A * C;
-    if (!(disc > 0.0)) return 0;
-    double sq = sqrt(disc), t0 = (-B - sq) / A, t1 = (-B + sq) / A;
+    double A = v3_dot(d, d), t0, t1;
+    if (!ball_chord(A, v3_dot(o, d), v3_dot(o, o) - f->R * f->R, &t0, &t1)) return 0;
     double a = fmax_inline(t0, tmin), b = fmin_inline(t1, tmax);
     if (!(a < b)) return 0;
     double s = sqrt(A);
@@ -506,11 +517,10 @@ int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
      * escapes: past it every answer is outside and no crossing follows */
     double end = len;
     if (f->rho > 0.0) {
-        double pb = v3_dot(p0, e), pd = pb * pb - (v3_dot(p0, p0) - f->rho * f->rho);
-        if (!(pd > 0.0)) return 0;
-        double sd = sqrt(pd);
-        if (!(-pb + sd > 0.0) || !(-pb - sd < len)) return 0;
-        end = fmin_inline(len, -pb + sd);
+        double r0, r1;
+        if (!ball_chord(1.0, v3_dot(p0, e), v3_dot(p0, p0) - f->rho * f->rho, &r0, &r1)) return 0;
+        if (!(r1 > 0.0) || !(r0 < len)) return 0;
+        end = fmin_inline(len, r1);
     }
     double complex dp[2] = {0, 0};
     if (f->hyper) jf_dir_pair(f, e, dp);
@@ -530,11 +540,10 @@ int geom_fractal_hits(const geom_shape *sh, vec3 o, vec3 d, double tmin, double 
                 if (C2 > 0.0) return 0;
                 continue;
             }
-            double D2 = B2 * B2 - A2 * C2;
-            if (!(D2 > 0.0)) return 0;
-            double sd = sqrt(D2), t2 = (-B2 + sd) / A2;
-            if (!(t2 > 0.0) || !((-B2 - sd) / A2 < len)) return 0;
-            end = fmin_inline(end, t2);
+            double r0, r1;
+            if (!ball_chord(A2, B2, C2, &r0, &r1)) return 0;
+            if (!(r1 > 0.0) || !(r0 < len)) return 0;
+            end = fmin_inline(end, r1);
         }
     }
     int cur = jf_inside(f, p0.x, p0.y, p0.z, dp[0], dp[1], &de), n = 0;
