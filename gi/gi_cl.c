@@ -835,6 +835,30 @@ static void sum_bounces(const float *tally, size_t items, int nb, double *bounce
 }
 
 static int cancelled(volatile int *cancel) { return cancel && *cancel; }
+
+/* After a bounce (or gi_k_back_send): what it wrote (bout, mask_a) becomes
+ * the next one's input (bin, mask_b), and the old input the free pair. */
+static void swap_c_pairs(gi_dev *dv)
+{
+    float *t = dv->bin;
+    dv->bin = dv->bout;
+    dv->bout = t;
+    unsigned *m = dv->mask_b;
+    dv->mask_b = dv->mask_a;
+    dv->mask_a = m;
+}
+
+#ifdef PARTRAY_HAVE_OPENCL
+static void swap_cl_pairs(gi_dev *dv)
+{
+    cl_mem t = dv->b_bin;
+    dv->b_bin = dv->b_bout;
+    dv->b_bout = t;
+    t = dv->b_mask_b;
+    dv->b_mask_b = dv->b_mask_a;
+    dv->b_mask_a = t;
+}
+#endif
 /* What gi_dev_sums reports, from the per-work-item sums and masks. */
 static void fill_sums(const gi_dev *dv, size_t eitems, int nb, const double *bounce_flux, gi_dev_sums *sums)
 {
@@ -905,27 +929,15 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
             gi_c_bounce(dv->threads, n, c0 ? dv->cin_off : dv->rin_off, 0, c0 ? dv->cin_src : dv->rin_src, 0,
                         w_fan, bin, min, dv->rho4, b == 0, dv->bout, dv->mask_a, dv->total, dv->tally,
                         b * 3 * (int)items);
-            float *t = dv->bin;
-            dv->bin = dv->bout;
-            dv->bout = t;
-            bin = dv->bin;
-            unsigned *tm = dv->mask_b;
-            dv->mask_b = dv->mask_a;
-            dv->mask_a = tm;
-            min = dv->mask_b;
+            swap_c_pairs(dv);
             if (dv->has_back && b + 1 < nbounce) {
                 /* the back lobes' share of what this bounce sends on
                  * (gi_k_back_send), into the free pair, then swapped in */
                 gi_c_back_send(dv->threads, dv->part, n, dv->rho4, dv->bin, dv->bout, dv->mask_a);
-                t = dv->bin;
-                dv->bin = dv->bout;
-                dv->bout = t;
-                bin = dv->bin;
-                tm = dv->mask_b;
-                dv->mask_b = dv->mask_a;
-                dv->mask_a = tm;
-                min = dv->mask_b;
+                swap_c_pairs(dv);
             }
+            bin = dv->bin;
+            min = dv->mask_b;
         }
         if (cancelled(cancel)) return PT_OK;
         /* from here on the results are written: not cancelled any more */
@@ -977,29 +989,17 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
                     KF(w_fan),       KMEM(bin),           KMEM(min),           KMEM(dv->b_rho),     KINT(first),
                     KMEM(dv->b_bout), KMEM(dv->b_mask_a), KMEM(dv->b_total),   KMEM(dv->b_tally),   KINT(tbase)};
         if ((st = run_kernel_local(dv, KE_BOUNCE, items, GI_BOUNCE_LOCAL, k, 15, d)) != PT_OK) return st;
-        cl_mem t = dv->b_bin;
-        dv->b_bin = dv->b_bout;
-        dv->b_bout = t;
-        bin = dv->b_bin;
-        t = dv->b_mask_b;
-        dv->b_mask_b = dv->b_mask_a;
-        dv->b_mask_a = t;
-        min = dv->b_mask_b;
+        swap_cl_pairs(dv);
         if (dv->has_back && b + 1 < nbounce) {
             /* the back lobes' share of what this bounce sends on
              * (gi_k_back_send), into the free pair, then swapped in */
             karg bs[] = {KMEM(dv->b_part), KINT(n), KMEM(dv->b_rho), KMEM(dv->b_bin), KMEM(dv->b_bout),
                          KMEM(dv->b_mask_a)};
             if ((st = run_kernel(dv, KE_BACK_SEND, eitems, bs, 6, d)) != PT_OK) return st;
-            t = dv->b_bin;
-            dv->b_bin = dv->b_bout;
-            dv->b_bout = t;
-            bin = dv->b_bin;
-            t = dv->b_mask_b;
-            dv->b_mask_b = dv->b_mask_a;
-            dv->b_mask_a = t;
-            min = dv->b_mask_b;
+            swap_cl_pairs(dv);
         }
+        bin = dv->b_bin;
+        min = dv->b_mask_b;
     }
     if (cancelled(cancel)) return PT_OK;
     /* from here on the results are written: not cancelled any more */
