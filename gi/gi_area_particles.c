@@ -577,6 +577,16 @@ struct gi_lookup {
     int omask;
 };
 
+int gi_lookup_covers(const gi_lookup *g, vec3 q)
+{
+    if (!g || g->n == 0) return 0;
+    const double lo[3] = {g->origin.x - g->cell, g->origin.y - g->cell, g->origin.z - g->cell};
+    const double qq[3] = {q.x, q.y, q.z};
+    for (int k = 0; k < 3; k++)
+        if (!(qq[k] >= lo[k] && qq[k] <= lo[k] + (double)(g->dim[k] + 2) * g->cell)) return 0;
+    return 1;
+}
+
 int gi_lookup_object_id(const gi_lookup *g, const void *obj)
 {
     if (!g->okey || !obj) return -1;

@@ -83,6 +83,9 @@ long gi_lookup_cell(const gi_lookup *g, vec3 q);
 void gi_lookup_cells(const gi_lookup *g, int n, const vec3 *q, long *cell);
 /* Object ids for the answers (pobj: the object of each particle). */
 pt_status gi_lookup_set_objects(gi_lookup *g, const void *const *pobj);
+/* Whether q lies in the box the particles stand in (within a cell): a
+ * hit outside it is in the far field (gi_links.c). */
+int gi_lookup_covers(const gi_lookup *g, vec3 q);
 /* The id of an object (-1: no particle of the lookup lies on it). */
 int gi_lookup_object_id(const gi_lookup *g, const void *obj);
 /* Nearest particle to q by gi_grid_nearest's rules, from q's block `cell`;

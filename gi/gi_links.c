@@ -57,6 +57,7 @@ typedef struct {
     double mweight, madc;
     void *lscene;         /* the link scene built here, or NULL */
     int threads;          /* buffers */
+    gi_link_conts *cont;  /* per thread: the continuations ending on particles (gi_links_build's conts), or NULL */
 } link_job;
 
 /* Where ray h hit: the point and the normal turned to the ray (the
@@ -169,6 +170,14 @@ typedef struct {
     emit_memo_entry e[EMIT_MEMO];
     int next;
     unsigned blocker[MEMO_LIGHTS]; /* light l's last blocker (accel_occluded_cached's *last) */
+    /* the continuations' particles (J->cont): this thread's list, the
+     * source (i - first) whose ray is followed, the weight its
+     * continuation carries so far (products of continue_ray's scales, over
+     * the ray count), and 0 once a reflection_exponent made it nonlinear */
+    gi_link_conts *cb;
+    int src;
+    float acc[3];
+    int linear;
 } emit_memo;
 
 static const emit_memo_entry *memo_of(const link_job *J, emit_memo *memo, const scene_texture *tex)
@@ -192,6 +201,31 @@ static const emit_memo_entry *memo_of(const link_job *J, emit_memo *memo, const 
 static void hit_specular(const link_job *J, const struct RTCRayHit *h, const scene_object *o, const scene_texture *tex,
                          vec3 p, vec3 n, const colour5 *pigment, int level, double weight, emit_memo *memo, float out[3]);
 
+/* E/pi of the sky at p about unit n, estimated by one cosine-weighted
+ * shadow ray (its radiance where it leaves the scene, 0 where it is
+ * blocked: the estimator of (1/pi) * integral of L cos over the
+ * hemisphere). The direction comes from a hash of the point and the
+ * arriving ray's direction d: the same hit gives the same answer. */
+static void sky_traced(const link_job *J, vec3 p, vec3 n, vec3 d, float out[3])
+{
+    union { float f; gi_u32 u; } b0 = {(float)p.x}, b1 = {(float)p.y}, b2 = {(float)p.z}, b3 = {(float)(d.x + 2.0 * d.y + 4.0 * d.z)};
+    gi_u32 h1 = gi_hash(b0.u ^ gi_hash(b1.u ^ gi_hash(b2.u ^ gi_hash(b3.u)))), h2 = gi_hash(h1 ^ 0x9e3779b9u);
+    double u1 = (double)(h1 >> 8) / 16777216.0, u2 = (double)(h2 >> 8) / 16777216.0;
+    double r = sqrt(u1), ph = 2.0 * M_PI * u2, z = sqrt(fmax(0.0, 1.0 - u1));
+    vec3 tv, bv;
+    v3_basis(n, &tv, &bv);
+    vec3 dir = v3_add(v3_add(v3_scale(tv, r * cos(ph)), v3_scale(bv, r * sin(ph))), v3_scale(n, z));
+    double eps = accel_epsilon(J->a, p, n);
+    out[0] = out[1] = out[2] = 0.0f;
+    if (accel_occluded(J->a, v3_madd(p, n, eps), dir, 0.0, INFINITY)) return;
+    const float df[3] = {(float)dir.x, (float)dir.y, (float)dir.z};
+    gi_sky_radiance(J->sky, df, out);
+}
+
+/* far: 0 no sky term; 1 the far field's, the sky taken as unoccluded (a
+ * hit beyond the particles' box); 2 the sky as one traced ray sees it
+ * (sky_traced: a hit within the box where no particle answers, which may
+ * lie in a closed room) */
 static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, int direct, emit_memo *memo, float out[3],
                          int level, double weight)
 {
@@ -249,7 +283,10 @@ static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, 
     /* no direct light where this pigment reflects nothing */
     if (!(rho[0] > 0.0f || rho[1] > 0.0f || rho[2] > 0.0f)) dir[0] = dir[1] = dir[2] = 0.0f;
     float irr[3] = {0.0f, 0.0f, 0.0f};
-    if (sky_term) gi_sky_irradiance(J->sky, n, irr);
+    if (sky_term && far == 2)
+        sky_traced(J, p, n, v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z), irr);
+    else if (sky_term)
+        gi_sky_irradiance(J->sky, n, irr);
     for (int c = 0; c < 3; c++) {
         float v = le[c] + rho[c] * (J->far_bounce * irr[c] + dir[c]);
         if (isfinite(v) && v > 0.0f) out[c] += v;
@@ -260,6 +297,82 @@ static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, 
 static void hit_light(const link_job *J, const struct RTCRayHit *h, int far, int direct, emit_memo *memo, float out[3])
 {
     hit_light_at(J, h, far, direct, memo, out, J->mlevel, J->mweight);
+}
+
+/* The sky term of a hit where no particle answers (hit_light_at's far):
+ * beyond the particles' box, the far field's unoccluded sky (an infinite
+ * plane past the clip box); within it, where walls may close the sky off
+ * (a thin post in a closed room), the sky one traced ray sees. */
+static int unanswered_far(const link_job *J, const struct RTCRayHit *h)
+{
+    vec3 p, n;
+    hit_point(h, &p, &n);
+    return J->grid && gi_lookup_covers(J->grid, p) ? 2 : 1;
+}
+
+/* The particle a continuation's hit h takes (the nearest on the object
+ * and side hit, as a point's own ray's), -1 none. */
+static int cont_target(const link_job *J, const struct RTCRayHit *h)
+{
+    if (!J->grid || !J->pobj || h->hit.instID[0] != RTC_INVALID_GEOMETRY_ID) return -1;
+    const void *ho = accel_rtc_object(J->a, h->hit.geomID, h->hit.primID, h->hit.instID[0]);
+    if (!ho) return -1;
+    vec3 p, n;
+    hit_point(h, &p, &n);
+    vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z), o = v3(h->ray.org_x, h->ray.org_y, h->ray.org_z);
+    return gi_lookup_nearest_on(J->grid, p, d, o, J->maxdist, J->pobj, ho, n, GI_LINKS_AGREE, J->pin ? J->pin + J->n : NULL);
+}
+
+static int cont_push(gi_link_conts *c, int src, int t, const float w[3])
+{
+    if (c->n == c->cap) {
+        long cap = c->cap ? 2 * c->cap : 256;
+        gi_link_cont *e = realloc(c->e, (size_t)cap * sizeof *e);
+        if (!e) return 0;
+        c->e = e;
+        c->cap = cap;
+    }
+    gi_link_cont *e = &c->e[c->n++];
+    e->src = src;
+    e->t = t;
+    for (int k = 0; k < 3; k++) e->w[k] = w[k];
+    return 1;
+}
+
+void gi_link_conts_free(gi_link_conts *c)
+{
+    if (!c) return;
+    free(c->e);
+    c->e = NULL;
+    c->n = c->cap = 0;
+}
+
+/* The threads' lists appended to out in the order of their sources (a
+ * counting sort: a source's entries all come from one job, in the order
+ * its rays were followed), so that their sums come out the same for any
+ * thread count and schedule. nsrc: the sources' count. */
+static pt_status conts_gather(const gi_link_conts *per, int threads, int nsrc, gi_link_conts *out)
+{
+    long total = 0;
+    for (int t = 0; t < threads; t++) total += per[t].n;
+    if (total == 0) return PT_OK;
+    long *off = calloc((size_t)nsrc + 1, sizeof *off);
+    gi_link_cont *e = realloc(out->e, (size_t)(out->n + total) * sizeof *e);
+    if (!off || !e) {
+        free(off);
+        if (e) out->e = e;
+        return PT_ERR_NOMEM;
+    }
+    out->e = e;
+    out->cap = out->n + total;
+    for (int t = 0; t < threads; t++)
+        for (long q = 0; q < per[t].n; q++) off[per[t].e[q].src + 1]++;
+    for (int s = 0; s < nsrc; s++) off[s + 1] += off[s];
+    for (int t = 0; t < threads; t++)
+        for (long q = 0; q < per[t].n; q++) out->e[out->n + off[per[t].e[q].src]++] = per[t].e[q];
+    out->n += total;
+    free(off);
+    return PT_OK;
 }
 
 /* Trace one continuation of a gather ray (a mirror's reflection, a
@@ -278,11 +391,23 @@ static void continue_ray(const link_job *J, vec3 org, vec3 d, int level, double 
     rtcInitIntersectContext(&c);
     rtcIntersect1(J->scene, &c, &rh);
     float sub[3] = {0.0f, 0.0f, 0.0f};
-    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID && isfinite(rh.ray.tfar))
-        hit_light_at(J, &rh, 1, 1, memo, sub, level, w);
-    else
-        gi_sky_radiance(J->sky, df, sub);
     const double sc[3] = {scale.r, scale.g, scale.b};
+    /* the weight down the chain, for a particle where it ends */
+    float acc[3] = {memo->acc[0], memo->acc[1], memo->acc[2]};
+    int linear = memo->linear;
+    for (int k = 0; k < 3; k++) memo->acc[k] = (float)(acc[k] * sc[k]);
+    memo->linear = linear && ex == 1.0;
+    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID && isfinite(rh.ray.tfar)) {
+        int t = memo->cb && memo->linear ? cont_target(J, &rh) : -1;
+        if (t >= 0 && cont_push(memo->cb, memo->src, t, memo->acc))
+            hit_light_at(J, &rh, 0, 0, memo, sub, level, w); /* the particle's light through gi_link_cont */
+        else
+            hit_light_at(J, &rh, 2, 1, memo, sub, level, w);
+    } else {
+        gi_sky_radiance(J->sky, df, sub);
+    }
+    for (int k = 0; k < 3; k++) memo->acc[k] = acc[k];
+    memo->linear = linear;
     for (int k = 0; k < 3; k++) {
         double v = ex != 1.0 ? pow(fmax(sub[k], 0.0), ex) : sub[k];
         v *= sc[k];
@@ -545,9 +670,13 @@ static void job(void *ctx, int index, int thread)
     const void *last_obj = NULL;
     int last_hid = -1;
     emit_memo memo = {0};
+    memo.cb = J->cont ? &J->cont[thread] : NULL;
     for (int i = i0; i < i1; i++) {
         int any = 0;
         float sky[3] = {0.0f, 0.0f, 0.0f};
+        memo.src = i - J->first;
+        memo.linear = 1;
+        memo.acc[0] = memo.acc[1] = memo.acc[2] = 1.0f / (float)J->k;
         const gi_dev_particle *pt_i = &J->p[i];
         for (int j = 0; j < J->k; j++, m++) {
             int hit = cell[m] != -2;
@@ -591,7 +720,7 @@ static void job(void *ctx, int index, int thread)
             int hid = hobj ? last_hid : -1;
             if (hobj && hid < 0) {
                 unres++;
-                hit_light(J, &rh[m], 1, 1, &memo, sky);
+                hit_light(J, &rh[m], unanswered_far(J, &rh[m]), 1, &memo, sky);
             } else if (hit && J->grid) {
                 const struct RTCRayHit *h = &rh[m];
                 vec3 d = v3(h->ray.dir_x, h->ray.dir_y, h->ray.dir_z);
@@ -690,7 +819,7 @@ static void job(void *ctx, int index, int thread)
                 }
                 if (target < 0) {
                     unres++;
-                    if (hit) hit_light(J, &rh[m], 1, 1, &memo, sky);
+                    if (hit) hit_light(J, &rh[m], unanswered_far(J, &rh[m]), 1, &memo, sky);
                 } else if (J->points && J->esky && !J->lone) {
                     /* the emission where it hit; the particle's reflected
                      * light, direct and indirect, follows in the regather */
@@ -900,7 +1029,7 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
                          gi_link_stats *st, volatile int *cancel, progress *prog,
                          const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce,
-                         float *reach)
+                         float *reach, gi_link_conts *conts)
 {
     if (threads <= 0) threads = pool_default_threads();
     link_job J = {.sky = sky, .esky = sky && sc ? esky : NULL, .sc = sc, .pig = pig,
@@ -940,8 +1069,18 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
      * ray that ends on a particle takes that particle's light alone: its
      * hit's texture is not looked up (cornell.pov) */
     if (rc == PT_OK && J.esky && J.points && !J.exact) J.lone = leaves_dark(&J);
+    /* continuations that end on particles, where the points follow mirrors */
+    if (rc == PT_OK && conts && J.points && J.mirror && !J.exact && J.grid && J.links) {
+        J.cont = calloc((size_t)threads, sizeof *J.cont);
+        if (!J.cont) rc = PT_ERR_NOMEM;
+    }
     if (rc == PT_OK && n > 0 && !pool_run_counted(threads, (n - J.first + J.per_job - 1) / J.per_job, job, &J, cancel, prog))
         rc = PT_CANCELLED;
+    if (J.cont) {
+        if (rc == PT_OK) rc = conts_gather(J.cont, threads, n - J.first, conts);
+        for (int t = 0; t < threads; t++) gi_link_conts_free(&J.cont[t]);
+        free(J.cont);
+    }
     job_close(&J);
     if (st && rc == PT_OK) {
         st->rays += (long)(n - J.first) * J.k;

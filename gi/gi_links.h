@@ -64,13 +64,34 @@ typedef struct {
  * divided by nside^2: their share of the cosine-weighted mean incoming
  * radiance, in E/pi units. */
 #define GI_LINKS_AGREE 0.3
+/* A final-gather ray's continuation (a mirror's reflection, a clear
+ * surface's transmission) that ends on particle t: point src (i - first)
+ * gathers w times t's reflected radiance besides its rays' own (w: the
+ * reflectivity and filter along the way, over the point's ray count). */
+typedef struct {
+    int src, t;
+    float w[3];
+} gi_link_cont;
+typedef struct {
+    gi_link_cont *e;
+    long n, cap;
+} gi_link_conts;
+void gi_link_conts_free(gi_link_conts *c);
+
 pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle *p, const void *const *pobj,
                          const unsigned char *pin, int n, int first, int nside, uint64_t seed, const gi_lookup *grid,
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
                          gi_link_stats *st, volatile int *cancel, progress *prog,
                          const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce,
-                         float *reach);
+                         float *reach, gi_link_conts *conts);
 
+/* conts (may be NULL; the final gather's points): where a continuation
+ * of a point's ray ends on a surface with particles, the particle it ends
+ * on is appended there, and that hit adds only its emission to esky (the
+ * particle's reflected light, direct and indirect, is the caller's to
+ * add, as for the rays' own targets); without it, or where no particle
+ * answers, the hit takes the far field (its direct light, and the sky it
+ * reflects as one traced ray sees it). */
 /* reach (may be NULL): four floats per point (i - first): the harmonic
  * mean distance of its rays' hits (INFINITY when none hit), how far its
  * gather may be reused (gi_particle_gather.c), then the vector from the

@@ -82,6 +82,7 @@ void gi_particle_view_gather_free(gi_particle *gp)
                   gp->vg_pixval, gp->vg_nrm, gp->vg_pnrm);
     gi_gatherer_free(gp->vg_gatherer);
     gp->vg_gatherer = NULL;
+    gi_link_conts_free(&gp->vg_cont);
     gp->vg_pt = gp->vg_cpt = NULL;
     gp->vg_tab = NULL;
     gp->vg_nrm = gp->vg_pnrm = NULL;
@@ -338,6 +339,13 @@ static int gather_values(gi_particle *gp)
     if (m1 < gp->vg_n)
         gi_c_gather(gp->threads, gp->vg_link + (size_t)m1 * (size_t)(gp->vg_k - gp->vg_rk), gp->vg_rk, lrefl, idx + m1,
                     gp->vg_n - m1, gp->vg_esky, gp->vg_val);
+    /* the continuations that ended on particles (mirrors, glass): their
+     * weight times that particle's reflected light, in the points' order */
+    for (long q = 0; q < gp->vg_cont.n; q++) {
+        const gi_link_cont *e = &gp->vg_cont.e[q];
+        if (e->src >= gp->vg_n) continue;
+        for (int c = 0; c < 3; c++) gp->vg_val[4 * (size_t)e->src + c] += e->w[c] * lrefl[4 * (size_t)e->t + c];
+    }
     free(idx);
     free(lrefl);
     return 1;
@@ -440,10 +448,12 @@ static pt_status trace_points(gi_particle *gp, const void **pobj, const unsigned
         st = PT_ERR_NOMEM;
         goto done;
     }
+    long c0 = gp->vg_cont.n;
     st = gi_links_build(gp->a, gp->lscene, cp, cobj, cpin, (int)N, n, side, seed, grid, gp->tl, 3.0 * spacing, gp->threads,
                         gp->vg_link + (size_t)k0 * gp->vg_k, NULL, &ls, gp->set.cancel, NULL, gp->sky,
                         gp->vg_esky + 4 * (size_t)k0, gp->sc, gp->set.pigment,
-                        gp->set.bounces >= 1 ? gp->set.brightness : 0.0, reach);
+                        gp->set.bounces >= 1 ? gp->set.brightness : 0.0, reach, &gp->vg_cont);
+    for (long q = c0; q < gp->vg_cont.n; q++) gp->vg_cont.e[q].src += k0; /* the points' own numbers */
     *rays += ls.rays;
     /* each point's reach within POV-Ray's minimum_reuse and maximum_reuse
      * of its distance from the camera (radiosity.cpp clamps its records'

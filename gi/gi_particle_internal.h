@@ -87,6 +87,7 @@ struct gi_particle {
     int vg_w, vg_h, vg_s; /* for the pre-pass of this size, every vg_s-th pixel */
     int *vg_link;     /* vg_n x vg_k: the area particle each ray ends on, -1 none */
     float *vg_esky;   /* vg_n x 4: the sky's and far field's share (gi_links.h) */
+    gi_link_conts vg_cont; /* the rays' continuations that end on particles, by point (gi_links.h) */
     float *vg_val;    /* vg_n x 4: gathered E/pi */
     int *vg_pix;      /* vg_w x vg_h: a pixel's gather point, -1 none */
     float *vg_pixval; /* vg_w x vg_h x 4: each kept pixel's filtered E/pi, [3] 1 where it has one */

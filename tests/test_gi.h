@@ -38,6 +38,7 @@ void test_normal_on_gather(void **state);
 void test_csg_emitter_gather(void **state);
 void test_mirror_gather(void **state);
 void test_transmit_gather(void **state);
+void test_closed_room_gather(void **state);
 void test_dark_gather(void **state);
 void test_sky_second_bounce(void **state);
 

@@ -664,6 +664,49 @@ void test_transmit_gather(void **state)
     slab_case("transmit 0.9, ior 1.5, fade", 2.0, 0.9, 1.5, 0.5);
 }
 
+/* A closed room under a bright sky (background rgb 6), no light and
+ * nothing that emits inside, recursion_limit 2 (the gather's hits take
+ * the particles' light): no light reaches any surface inside, so every
+ * kept pixel's E/pi is exactly 0. The room holds a mirror panel, a clear
+ * glass sphere and a white post that reflects 0.2: the final gather's rays
+ * follow the mirror and the glass (hit_specular), and where such a
+ * continuation ends on a wall the wall's particle answers (gi_link_cont);
+ * they once took the sky there as if nothing occluded it (E/pi up to 0.4
+ * at 48 x 48). */
+static double expect_zero(const accel_hit *h, vec3 n, const void *ctx)
+{
+    (void)h;
+    (void)n;
+    (void)ctx;
+    return 1.0; /* every kept pixel, and the ratio is E/pi itself */
+}
+
+void test_closed_room_gather(void **state)
+{
+    (void)state;
+    fixture f;
+    tg_load(&f, "#version 3.7;\n"
+                "global_settings { assumed_gamma 1.0 radiosity { count 200 recursion_limit 2 } }\n"
+                "background { rgb 6 }\n"
+                "camera { location <0.5, 0.5, 0.05> look_at <0.5, 0.45, 1> angle 90 }\n"
+                "box { <0,0,0>, <1,1,1> inverse pigment { rgb 1 } finish { ambient 0 diffuse 0.7 } }\n"
+                "box { <0.25, 0.2, 0.98>, <0.75, 0.8, 0.999> pigment { rgb 0 } "
+                "finish { ambient 0 diffuse 0 reflection 0.9 } }\n"
+                "sphere { <0.5, 0.3, 0.6>, 0.15 pigment { rgbf 1 } finish { ambient 0 diffuse 0 } "
+                "interior { ior 1.5 } }\n"
+                "cylinder { <0.2, 0, 0.7>, <0.2, 0.6, 0.7>, 0.05 pigment { rgb 1 } "
+                "finish { ambient 0 diffuse 0.8 reflection 0.2 } }\n");
+    const int W = 32, H = 32;
+    gi_particle *gp = gather_state(&f, 4000, 13, NULL, W, H, NULL, 1);
+    double mean, worst;
+    int m = kept_ratios(gp, W, H, expect_zero, NULL, &mean, &worst);
+    printf("  closed room, sky rgb 6 outside, no light: %d kept pixels, E/pi mean %.3g\n", m, mean);
+    assert_true(m > 500);
+    assert_true(mean == 0.0);
+    gi_particle_free(gp);
+    tg_unload(&f);
+}
+
 /* A sky-lit scene of diffuse surfaces: a white floor (y = 0) beside a
  * white wall (a box from x = 1 to 1.2, height h = 0.8, 200 long in z)
  * under a uniform sky of radiance L (a background), recursion_limit 1, no
