@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "gi_particle_internal.h"
+#include "grow.h"
 #include "mirror.h"
 #include "pool.h"
 #include "radrules.h"
@@ -325,13 +326,7 @@ static int cont_target(const link_job *J, const struct RTCRayHit *h)
 
 static int cont_push(gi_link_conts *c, int src, int t, const float w[3])
 {
-    if (c->n == c->cap) {
-        long cap = c->cap ? 2 * c->cap : 256;
-        gi_link_cont *e = realloc(c->e, (size_t)cap * sizeof *e);
-        if (!e) return 0;
-        c->e = e;
-        c->cap = cap;
-    }
+    if (!grow_array_long((void **)&c->e, &c->cap, c->n + 1, sizeof *c->e)) return 0;
     gi_link_cont *e = &c->e[c->n++];
     e->src = src;
     e->t = t;
