@@ -253,7 +253,7 @@ static int make_one(const vpl_job *j, int i, rng *r, long *shadow)
              * area samples above, as the path tracer does) */
             rgb acc = {0, 0, 0};
             for (int j = 0; j < SKY_RAYS; j++) {
-                vec3 w = shade_mat_cosine_dir(b.n, (j + rng_f64(r)) / SKY_RAYS, rng_f64(r));
+                vec3 w = v3_cosine_dir(b.n, (j + rng_f64(r)) / SKY_RAYS, rng_f64(r));
                 if (v3_dot(w, b.ng) <= 0.0) continue;
                 accel_hit gh;
                 rgb c = {0, 0, 0};

@@ -214,7 +214,7 @@ int main(int argc, char **argv)
         accel_surf_sample_point(all_s, rng_f64(&rg), rng_f64(&rg), rng_f64(&rg), &rg, &s);
         vec3 nn = rng_f64(&rg) < 0.5 ? s.n : v3_neg(s.n);
         org[i] = v3_madd(s.p, nn, 1e-4 * accel_scale(a));
-        dir[i] = shade_mat_cosine_dir(nn, rng_f64(&rg), rng_f64(&rg));
+        dir[i] = v3_cosine_dir(nn, rng_f64(&rg), rng_f64(&rg));
     }
     double tr[2];
     long hc[2];

@@ -108,5 +108,16 @@ static inline void v3_basis(vec3 n, vec3 *t, vec3 *b)
     *t = v3(1.0 + s * n.x * n.x * a, s * c, -s * n.x);
     *b = v3(c, s + n.y * n.y * a, -n.y);
 }
+/* The cosine-weighted direction about unit n for uniforms u1, u2 in [0, 1)
+ * (Malley's method: a uniform point of the unit disc lifted to the
+ * hemisphere; pdf cos / pi). */
+static inline vec3 v3_cosine_dir(vec3 n, double u1, double u2)
+{
+    double r = sqrt(u1), phi = 2.0 * M_PI * u2;
+    double x = r * cos(phi), y = r * sin(phi), z = sqrt(fmax(0.0, 1.0 - u1));
+    vec3 t, bt;
+    v3_basis(n, &t, &bt);
+    return v3_add(v3_add(v3_scale(t, x), v3_scale(bt, y)), v3_scale(n, z));
+}
 
 #endif

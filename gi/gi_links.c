@@ -211,11 +211,7 @@ static void sky_traced(const link_job *J, vec3 p, vec3 n, vec3 d, float out[3])
 {
     union { float f; gi_u32 u; } b0 = {(float)p.x}, b1 = {(float)p.y}, b2 = {(float)p.z}, b3 = {(float)(d.x + 2.0 * d.y + 4.0 * d.z)};
     gi_u32 h1 = gi_hash(b0.u ^ gi_hash(b1.u ^ gi_hash(b2.u ^ gi_hash(b3.u)))), h2 = gi_hash(h1 ^ 0x9e3779b9u);
-    double u1 = (double)(h1 >> 8) / 16777216.0, u2 = (double)(h2 >> 8) / 16777216.0;
-    double r = sqrt(u1), ph = 2.0 * M_PI * u2, z = sqrt(fmax(0.0, 1.0 - u1));
-    vec3 tv, bv;
-    v3_basis(n, &tv, &bv);
-    vec3 dir = v3_add(v3_add(v3_scale(tv, r * cos(ph)), v3_scale(bv, r * sin(ph))), v3_scale(n, z));
+    vec3 dir = v3_cosine_dir(n, (double)(h1 >> 8) / 16777216.0, (double)(h2 >> 8) / 16777216.0);
     double eps = accel_epsilon(J->a, p, n);
     out[0] = out[1] = out[2] = 0.0f;
     if (accel_occluded(J->a, v3_madd(p, n, eps), dir, 0.0, INFINITY)) return;

@@ -321,7 +321,7 @@ static rgb gather_lobe(const fg_ctx *c, const shade_mat_bsdf *b, vec3 axis, vec3
     for (int i = 0; i < n; i++) {
         double u1, u2;
         gather_stratum(i, n, r, &u1, &u2);
-        vec3 w = shade_mat_cosine_dir(axis, u1, u2);
+        vec3 w = v3_cosine_dir(axis, u1, u2);
         double cg = v3_dot(w, b->ng);
         if (front ? cg <= 0.0 : cg >= 0.0) continue;
         double cb = (front ? nf : nb) * fabs(v3_dot(w, b->n)) / M_PI;

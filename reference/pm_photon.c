@@ -228,7 +228,7 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         if (!accel_surf_sample_point(es, u1, u2, u3, r, &s)) return -1;
         vec3 ns = rng_f64(r) < 0.5 ? s.n : v3_neg(s.n);
         double u4 = rng_f64(r), u5 = rng_f64(r);
-        *w = shade_mat_cosine_dir(ns, u4, u5);
+        *w = v3_cosine_dir(ns, u4, u5);
         *o = v3_madd(s.p, ns, c->eps);
         if (accel_intersect_past(c->a, NULL, *o, *w, c->eps, OBJ_NO_RADIOSITY | PHOTON_SKIP, h, rays) <= 0) return 0;
         rgb le = pm_lights_piece_emission(c->L, &s);

@@ -422,15 +422,6 @@ int shade_mat_sample_glossy(const shade_mat_bsdf *b, double u0, double u1, doubl
     return isfinite(k) && k > 0.0;
 }
 
-vec3 shade_mat_cosine_dir(vec3 n, double u1, double u2)
-{
-    double r = sqrt(u1), phi = 2.0 * M_PI * u2;
-    double x = r * cos(phi), y = r * sin(phi), z = sqrt(fmax(0.0, 1.0 - u1));
-    vec3 t, bt;
-    v3_basis(n, &t, &bt);
-    return v3_add(v3_add(v3_scale(t, x), v3_scale(bt, y)), v3_scale(n, z));
-}
-
 /* Sample a lobe and a direction. absorb = 0: a lobe is always chosen, with
  * probability m_k / sum m (path tracer; Russian roulette is separate).
  * absorb = 1: probability m_k (scaled down when sum m > 1), else the particle
@@ -474,13 +465,13 @@ static int mat_sample_lobe(const shade_mat_bsdf *b, double u_lobe, double u1, do
     s->weight = mrgb_scale(b->k[lobe], 1.0 / p);
     switch (lobe) {
     case SHADE_MAT_LOBE_DIFFUSE:
-        s->dir = shade_mat_cosine_dir(b->n, u1, u2);
+        s->dir = v3_cosine_dir(b->n, u1, u2);
         if (v3_dot(s->dir, b->ng) <= 0.0) return 0;
         s->org = b->p_out;
         s->pdf = p * v3_dot(s->dir, b->n) / M_PI;
         break;
     case SHADE_MAT_LOBE_BACK:
-        s->dir = shade_mat_cosine_dir(v3_neg(b->n), u1, u2);
+        s->dir = v3_cosine_dir(v3_neg(b->n), u1, u2);
         if (v3_dot(s->dir, b->ng) >= 0.0) return 0;
         s->org = b->p_in;
         s->pdf = p * -v3_dot(s->dir, b->n) / M_PI;

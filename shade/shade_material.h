@@ -192,10 +192,6 @@ int shade_mat_sample(const shade_mat_bsdf *b, rng *r, int absorb, shade_mat_scat
  * through pass_through objects use it. */
 rgb shade_mat_photon_filter(const scene *sc, const accel_hit *h, vec3 dir, const shade_mat_bsdf *b, rgb kr, double *trace_w);
 
-/* Cosine-weighted direction about unit n for (u1, u2) in [0,1)^2 (Malley:
- * uniform on the disc, projected up); pdf cos/pi. */
-vec3 shade_mat_cosine_dir(vec3 n, double u1, double u2);
-
 /* Direct light of one POV-Ray light at the hit (shade_light_nee at p_out; see
  * `gathered`). */
 rgb shade_mat_light_nee(const shade_mat_bsdf *b, const shade_light_ctx *c, const scene_light *l, int nsamples, rng *r);

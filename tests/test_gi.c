@@ -1116,8 +1116,8 @@ static void test_diffuse_back(void **state)
  * (gi_k_back_send); WALK's paths take the twin's way with probability
  * back / (1 + back), weighted to the same expectation
  * (gi_particle_build_walk): the scattered flux (received minus direct) of
- * the two within 1% (WALK's noise; without the back lobes' sends FULL is
- * 2.7% lower), and the OpenCL build's FULL within 1e-4 of the C build's
+ * the two within 1% (WALK's noise; well below the back lobes' share of the
+ * later bounces), and the OpenCL build's FULL within 1e-4 of the C build's
  * (float sums in another order). */
 static double scattered_flux(gi_particle *gp)
 {

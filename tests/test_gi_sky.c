@@ -671,8 +671,7 @@ void test_transmit_gather(void **state)
  * glass sphere and a white post that reflects 0.2: the final gather's rays
  * follow the mirror and the glass (hit_specular), and where such a
  * continuation ends on a wall the wall's particle answers (gi_link_cont);
- * they once took the sky there as if nothing occluded it (E/pi up to 0.4
- * at 48 x 48). */
+ * taking the sky there as if nothing occluded it would light the room. */
 static double expect_zero(const accel_hit *h, vec3 n, const void *ctx)
 {
     (void)h;
