@@ -442,7 +442,7 @@ static void internal_body(fn_build *b, scene_function *f)
     double v = sdl_float(p);
     sdl_expect(p, TOK_RPAREN, "')'");
     if (!sdl_ok(p)) return;
-    int n = (int)v, count = func_internal_params(n);
+    int n = sdl_to_int(v), count = func_internal_params(n);
     if (v != floor(v) || count < 0 || n == 77) {
         sdl_error(p, at, PT_ERR_SYNTAX, "unknown internal function %g (POV-Ray 3.7 has internal(0) to internal(78), 77 being reserved)", v);
         return;

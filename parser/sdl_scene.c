@@ -147,7 +147,7 @@ static int camera_item(sdl_parser *p, scene_camera *c, camera_said *said)
             double mx = sdl_allow_float(p, 0.0);
             if (mx > 0) {
                 c->blur_samples_min = c->blur_samples;
-                c->blur_samples = (int)mx;
+                c->blur_samples = sdl_to_int(mx);
                 if (c->blur_samples_min > c->blur_samples)
                     sdl_error(p, t.tk.loc, PT_ERR_SYNTAX, "focal blur samples minimum must not be larger than maximum");
             }
@@ -481,11 +481,11 @@ static void radiosity_counts(sdl_parser *p, scene_radiosity *r, sdl_kw k, src_lo
     int n = sdl_to_int(sdl_float(p));
     sdl_accept(p, TOK_COMMA);
     if (k == KW_COUNT) {
-        r->count = (int)checked(p, loc, n, n > 0, "count must be a positive number");
+        r->count = sdl_to_int(checked(p, loc, n, n > 0, "count must be a positive number"));
         r->direction_pool = sdl_to_int(sdl_allow_float(p, n > 1600 ? n : 1600));
         checked(p, loc, 0, r->direction_pool >= n, "count can not be more than the direction pool size (count's 2nd value)");
     } else {
-        r->nearest_count = (int)checked(p, loc, n, n >= 1 && n <= 20, "nearest_count must be from 1 to 20");
+        r->nearest_count = sdl_to_int(checked(p, loc, n, n >= 1 && n <= 20, "nearest_count must be from 1 to 20"));
         r->nearest_count_pretrace = sdl_to_int(sdl_allow_float(p, 0.0));
         checked(p, loc, 0, r->nearest_count_pretrace >= 0 && r->nearest_count_pretrace < n,
                 "nearest_count for adaptive pretrace must be non-negative and smaller than nearest_count");
@@ -519,7 +519,7 @@ static int radiosity_item(sdl_parser *p, scene_radiosity *r)
     case KW_SUBSURFACE: r->subsurface = sdl_to_int(sdl_float(p)) != 0; break;
     case KW_PRETRACE_START: v = sdl_float(p); r->pretrace_start = checked(p, at, v, v > 0 && v <= 1, "pretrace_start must be greater than 0 and at most 1"); break;
     case KW_PRETRACE_END: v = sdl_float(p); r->pretrace_end = checked(p, at, v, v > 0 && v <= 1, "pretrace_end must be greater than 0 and at most 1"); break;
-    case KW_RECURSION_LIMIT: v = sdl_float(p); r->recursion_limit = (int)checked(p, at, v, v >= 1 && v <= 20, "recursion_limit must be from 1 to 20"); break;
+    case KW_RECURSION_LIMIT: v = sdl_float(p); r->recursion_limit = sdl_to_int(checked(p, at, v, v >= 1 && v <= 20, "recursion_limit must be from 1 to 20")); break;
     case KW_LOAD_FILE: case KW_SAVE_FILE:
         sdl_warn_once(p, at, "radiosity %s is ignored (POV-Ray 3.7 takes it from the command line)", sdl_kw_text(t.tk.kw));
         sdl_string(p);

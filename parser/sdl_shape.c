@@ -765,7 +765,7 @@ static void text_args(sdl_parser *p, scene_object *o, src_loc loc)
 {
     const char *font = NULL;
     if (sdl_accept_kw(p, KW_INTERNAL)) {
-        int id = (int)sdl_float(p);
+        int id = sdl_to_int(sdl_float(p));
         font = id == 1 ? "timrom.ttf" : id == 2 ? "cyrvetic.ttf" : id == 3 ? "crystal.ttf" : "povlogo.ttf";
     } else if (!sdl_accept_kw(p, KW_TTF)) {
         sdl_tok t = sdl_next(p);
