@@ -133,7 +133,7 @@ static int hook_surface(void *ctx, const accel_hit *h, vec3 dir, const gi_causti
     if (in) same = *in;
     /* reflected inside an object, the photon has crossed it: its fade over
      * the way (the refracted branch's filter below has it too) */
-    rgb fa = shade_tex_leaving_fade(h, dir);
+    rgb fa = shade_tex_leaving_fade(h, dir, 1);
     int n = 0;
     if (tir) {
         /* total internal reflection keeps the whole photon: POV-Ray's
@@ -246,7 +246,7 @@ static int hook_media(void *ctx, const gi_caustic_inside *in, vec3 org, vec3 dir
 static rgb hook_fade(void *ctx, const accel_hit *h, vec3 dir)
 {
     (void)ctx;
-    return shade_tex_leaving_fade(h, dir);
+    return shade_tex_leaving_fade(h, dir, 1);
 }
 
 static int disperses(const scene_object *o)

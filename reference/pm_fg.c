@@ -26,6 +26,7 @@
 #include "radrules.h"
 #include "shade_atmos.h"
 #include "shade_material.h"
+#include "shade_texture.h"
 #include "timer.h"
 
 #define KMAX 1024
@@ -251,6 +252,8 @@ static rgb gather_hit(const fg_ctx *c, const shade_mat_bsdf *b, uint32_t surf, i
         if (accel_intersect_past(c->a, &b->from, org, dir, c->eps, skip, &h, NULL) <= 0) {
             acc_add(&L, w, pm_sky(c->sc, dir));
         } else {
+            rgb fa = shade_tex_leaving_fade(&h, dir, 0); /* as pm_path.c */
+            w = frgb(w.r * fa.r, w.g * fa.g, w.b * fa.b);
             shade_mat_bsdf b2;
             shade_mat_setup(&b2, c->sc, &h, dir, c->eps, accel_eps_scale(c->a), r);
             b2.gathered = 1;
@@ -285,6 +288,8 @@ static rgb gather_ray(const fg_ctx *c, const shade_mat_bsdf *b, vec3 org, vec3 w
         acc_add(&sum, fa, pm_sky(c->sc, w));
         return sum;
     }
+    rgb ff = shade_tex_leaving_fade(&h, w, 0); /* as pm_path.c */
+    fa = frgb(fa.r * ff.r, fa.g * ff.g, fa.b * ff.b);
     shade_mat_bsdf b2;
     shade_mat_setup(&b2, c->sc, &h, w, c->eps, accel_eps_scale(c->a), r);
     b2.gathered = 1;
@@ -366,6 +371,8 @@ static void eye_trace(const fg_ctx *c, const accel_from *from, vec3 org, vec3 di
         acc_add(L, T, pm_sky(c->sc, dir));
         return;
     }
+    rgb fa = shade_tex_leaving_fade(&h, dir, 0); /* as pm_path.c */
+    T = frgb(T.r * fa.r, T.g * fa.g, T.b * fa.b);
     shade_mat_bsdf b;
     shade_mat_setup(&b, c->sc, &h, dir, c->eps, accel_eps_scale(c->a), r);
     if (b.unsupported) cnt->unsupported++;

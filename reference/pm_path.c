@@ -19,6 +19,7 @@
 #include "radrules.h"
 #include "shade_atmos.h"
 #include "shade_material.h"
+#include "shade_texture.h"
 #include "timer.h"
 
 #define HARD_DEPTH 1024
@@ -85,6 +86,12 @@ static rgb path_sample(void *ctx, double px, double py, int thread, rng *r, pm_c
             L.b += T.b * sky.b;
             break;
         }
+        /* a segment inside an object fades where it leaves it (the Whitted
+         * pass's rule): all the hit returns came through that interior */
+        rgb fa = shade_tex_leaving_fade(&h, dir, 0);
+        T.r *= fa.r;
+        T.g *= fa.g;
+        T.b *= fa.b;
         shade_mat_bsdf b;
         shade_mat_setup(&b, sc, &h, dir, c->eps, accel_eps_scale(c->a), r);
         b.gathered = nd > 0;

@@ -33,6 +33,7 @@
 #include "radrules.h"
 #include "shade_light.h"
 #include "shade_material.h"
+#include "shade_texture.h"
 
 #define CHUNK 1024
 /* photons { pass_through } is POV-Ray's rule for its lights' photons: a
@@ -335,6 +336,11 @@ static void walk(const trace_ctx *c, long index, const pm_photon_launch *resume,
         return;
     }
     for (int bounce = L.bounce;; bounce++) {
+        /* a photon that crossed an object fades where it leaves it, by the
+         * shadow rule, as the caustic layer's (shade_mat_photon_filter) */
+        rgb fa = shade_tex_leaving_fade(&h, w, 1);
+        phi = crgb(phi.r * fa.r, phi.g * fa.g, phi.b * fa.b);
+        if (!(cmax(phi) > 0.0)) return;
         shade_mat_bsdf b;
         shade_mat_setup(&b, c->sc, &h, w, c->eps, accel_eps_scale(c->a), &r);
         int lambert = b.m[SHADE_MAT_LOBE_DIFFUSE] > 0.0 || b.m[SHADE_MAT_LOBE_BACK] > 0.0;

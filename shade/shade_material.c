@@ -531,7 +531,7 @@ rgb shade_mat_light_nee(const shade_mat_bsdf *b, const shade_light_ctx *c, const
 
 rgb shade_mat_photon_filter(const scene *sc, const accel_hit *h, vec3 dir, const shade_mat_bsdf *b, rgb kr, double *trace_w)
 {
-    rgb f = shade_tex_shadow_filter(sc, h, dir), fa = shade_tex_leaving_fade(h, dir);
+    rgb f = shade_tex_shadow_filter(sc, h, dir), fa = shade_tex_leaving_fade(h, dir, 1);
     if (b->ls.f && b->ls.f->conserve_energy)
         f = (rgb){f.r * fmin(1.0, 1.0 - kr.r), f.g * fmin(1.0, 1.0 - kr.g), f.b * fmin(1.0, 1.0 - kr.b)};
     if (trace_w)

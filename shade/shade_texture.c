@@ -718,10 +718,10 @@ rgb shade_tex_shadow_filter(const scene *sc, const accel_hit *h, vec3 dir)
     return shade_tex_shadow_filter_inside(sc, h, dir, v3_dot(dir, h->ng) >= 0.0);
 }
 
-rgb shade_tex_leaving_fade(const accel_hit *h, vec3 dir)
+rgb shade_tex_leaving_fade(const accel_hit *h, vec3 dir, int shadow)
 {
     if (v3_dot(dir, h->ng) < 0.0) return trgb(1, 1, 1);
-    return transmit_fade(h->obj ? h->obj->interior : NULL, h->t, 1);
+    return transmit_fade(h->obj ? h->obj->interior : NULL, h->t, shadow);
 }
 
 /* ------------------------------------------------------------ shadows */

@@ -115,13 +115,16 @@ typedef struct {
  * unseen, not both); 0 when it is not seen. */
 int shade_tex_walk_take(shade_tex_walk *w, const accel_hit *h, vec3 dir, double *depth, int *inside);
 /* The interior's fade over h->t for a ray along dir that leaves h's object
- * there (dir along the geometric normal); 1 for a ray entering it. The
- * fade shade_tex_shadow_filter applies, alone: a photon reflected inside
- * an object has crossed it as well (POV-Ray 3.7 photons.cpp,
- * PhotonTrace::ComputeLightedTexture attenuates the photon by the hit
- * object's fade whenever it travelled inside that object, before it is
- * reflected or refracted). */
-rgb shade_tex_leaving_fade(const accel_hit *h, vec3 dir);
+ * there (dir along the geometric normal); 1 for a ray entering it: the
+ * Whitted pass's rule without an interior list (the object left fades
+ * what came through it, shade_tex_shade). `shadow` 1: transmit_fade's
+ * shadow rule, the fade shade_tex_shadow_filter applies, alone: a photon
+ * reflected inside an object has crossed it as well (POV-Ray 3.7
+ * photons.cpp, PhotonTrace::ComputeLightedTexture attenuates the photon
+ * by the hit object's fade whenever it travelled inside that object,
+ * before it is reflected or refracted); 0: a view ray's (the reference
+ * renderers' paths). */
+rgb shade_tex_leaving_fade(const accel_hit *h, vec3 dir, int shadow);
 /* The ior ratio eta = n_incident / n_transmitted of a refraction through
  * object o's surface (entering: the ray hits its outside) by a ray whose
  * containers are `in`, POV-Ray 3.7's interior-list rule (the one the eye

@@ -689,6 +689,63 @@ static void test_light_group(void **state)
     assert_true(fabs(mean[1][1] / mean[0][1] - 1.0) < LG_TOL);
 }
 
+/* ------------------------------------------------------------ interior fade */
+
+/* A view ray through a clear box with an interior fade, in both reference
+ * modes: the centre pixel (the ray along the box's normal, 2 units inside
+ * it, in front of a white background) shows the fade's closed form
+ * (transmit.h): exp(-(1 - c) d / fade_distance) for fade_power 1001, c +
+ * (1 - c) / (1 + (d / fade_distance)^2) for fade_power 2; within 1e-4.
+ * Before, the references ignored the fade: the pixel was 1. */
+static void test_interior_fade(void **state)
+{
+    (void)state;
+    static const char *power[2] = {"1001", "2"};
+    const double c[3] = {0.5, 0.8, 0.6}, d = 2.0, fd = 1.0;
+    for (int k = 0; k < 2; k++) {
+        char text[1024];
+        snprintf(text, sizeof text,
+                 "#version 3.7;\n"
+                 "global_settings { assumed_gamma 1 }\n"
+                 "camera { location <0, 0, -5> look_at 0 angle 30 }\n"
+                 "background { rgb 1 }\n"
+                 "box { -1, 1 pigment { rgbt 1 } finish { ambient 0 diffuse 0 }\n"
+                 "  interior { ior 1.5 fade_power %s fade_distance %g fade_color <%g, %g, %g> } }\n",
+                 power[k], fd, c[0], c[1], c[2]);
+        scene *sc = parse(text);
+        accel *a = build(sc);
+        enum { S = 33 };
+        framebuffer *fb[2] = {fb_new(S, S), fb_new(S, S)};
+        pm_stats st;
+        pm_path_settings ps;
+        pm_path_default_settings(&ps);
+        ps.c.width = ps.c.height = S;
+        ps.c.threads = THREADS;
+        ps.c.spp = 1;
+        assert_int_equal(pm_path_render(sc, a, &ps, fb[0], &st, NULL), PT_OK);
+        pm_fg_settings fs;
+        pm_fg_default_settings(&fs);
+        fs.c.width = fs.c.height = S;
+        fs.c.threads = THREADS;
+        fs.c.spp = 1;
+        fs.photons = 1000;
+        assert_int_equal(pm_fg_render(sc, a, &fs, fb[1], &st, NULL), PT_OK);
+        for (int ch = 0; ch < 3; ch++) {
+            double want = k == 0 ? exp(-(1.0 - c[ch]) * d / fd) : c[ch] + (1.0 - c[ch]) / (1.0 + (d / fd) * (d / fd));
+            for (int m = 0; m < 2; m++) {
+                double got = fb[m]->rgb[((S / 2) * S + S / 2) * 3 + ch];
+                printf("interior fade, fade_power %s, channel %d: %s %.6f, closed form %.6f (tol 1e-4)\n", power[k], ch,
+                       m ? "pmfg" : "path", got, want);
+                assert_true(fabs(got - want) <= 1e-4);
+            }
+        }
+        fb_free(fb[0]);
+        fb_free(fb[1]);
+        accel_free(a);
+        scene_free(sc);
+    }
+}
+
 /* ------------------------------------------------------------ determinism */
 
 static const char *small_scene =
@@ -1048,6 +1105,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_surface_uniform),
         cmocka_unit_test(test_direct_equivalence),
         cmocka_unit_test(test_light_group),
+        cmocka_unit_test(test_interior_fade),
         cmocka_unit_test(test_determinism),
         cmocka_unit_test(test_progressive),
         cmocka_unit_test(test_no_nan),
