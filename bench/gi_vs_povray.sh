@@ -16,12 +16,19 @@
 #   the reference and the line says so). Scenes: relative to the examples
 #   directory, default all 18 with radiosity{}. PARTRAY, XC_CACHE override
 #   the binary and the reference cache.
+# Where no converged render is made and partray's render uses GI, a second
+# line compares both default renders with partray's path tracer, which
+# follows POV-Ray's rules for radiosity light (diffuse bounces up to
+# recursion_limit, mirrors and glass up to max_trace_level; no photons):
+# `--gi path --spp PATH_SPP` (env, default 1024; 0 leaves the line out).
+# It tells which of the two unconverged renders is nearer a converged one.
 set -u
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 PARTRAY=${PARTRAY:-$ROOT/build/partray}
 SIZE=${1:-160x120}
 THREADS=${2:-2}
 CTIMEOUT=${3:-1800}
+PATH_SPP=${PATH_SPP:-1024}
 [ $# -gt 3 ] && shift 3 || set --
 EX=/usr/share/doc/povray/examples
 CACHE=${XC_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/partray/crosscheck}
@@ -35,7 +42,7 @@ for rel in "$@"; do
     dir=$(dirname "$rel"); base=$(basename "$rel")
     mkdir -p "$TMP/$dir" && cp -r "$EX/$dir/." "$TMP/$dir/"
     js=$(cd "$TMP/$dir" && "$PARTRAY" crosscheck "$base" --size "$SIZE" +A0.3 --threads "$THREADS" \
-         --converged --cache "$CACHE" --converged-timeout "$CTIMEOUT" --json --quiet 2>"$TMP/err")
+         --converged --cache "$CACHE" --converged-timeout "$CTIMEOUT" --json --quiet --out "$TMP/xc" 2>"$TMP/err")
     if [ $? -ne 0 ] || [ -z "$js" ]; then
         printf '%-36s failed: %s\n' "$rel" "$(tail -1 "$TMP/err")"
         continue
@@ -53,5 +60,19 @@ print("%-36s %7.4f %7.4f %7.4f %8.2f %8.2f %6.3f  %s %s %s%s" % (rel, lum, fpov,
       ok(abs(lum - 1) <= 0.03), ok(fpt <= fpov) if c.get("made") else "--", ok(tt <= tp), note))
 print("RATIO %.6f" % (tt / tp if tp > 0 else 1), file=sys.stderr)
 ' "$rel" 2>>"$TMP/ratios"
+    made=$(printf '%s\n' "$js" | python3 -c 'import json, sys; j = json.load(sys.stdin); print(int(bool(j.get("converged", {}).get("made")) or j["partray"].get("gi", "none") == "none"))')
+    if [ "$made" = 0 ] && [ "$PATH_SPP" -gt 0 ]; then
+        (cd "$TMP/$dir" && "$PARTRAY" render "$base" --size "$SIZE" --gi path --spp "$PATH_SPP" --threads "$THREADS" \
+            -o "$TMP/path.png" --quiet 2>/dev/null)
+        line=""
+        for who in povray partray; do
+            line="$line $("$PARTRAY" compare "$TMP/path.png" "$TMP/xc/$who.png" --json 2>/dev/null | python3 -c '
+import json, sys
+j = json.load(sys.stdin); r = j["luminance"]["reference"]
+print("%s lum %+.2f%% FLIP %.4f;" % (sys.argv[1], 100 * (j["luminance"]["test"] / r - 1) if r > 0 else 0, j["flip"]["mean"]))' "$who")"
+        done
+        printf '  against --gi path --spp %s (POV-Ray'"'"'s radiosity rules, no photons):%s\n' "$PATH_SPP" "${line%;}"
+    fi
+    rm -rf "$TMP/xc" "$TMP/path.png"
 done
 awk '/^RATIO/ { n++; s += log($2) } END { if (n) printf "geometric mean of partray/POV-Ray wall time over %d scenes: %.3f\n", n, exp(s / n) }' "$TMP/ratios"
