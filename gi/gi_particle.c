@@ -544,6 +544,8 @@ gi_particle *gi_particle_begin(const scene *sc, const accel *a, const gi_particl
         *status = PT_ERR_NOMEM;
         return NULL;
     }
+    gp->vg = &gp->vgs[0];
+    gp->vgs[1].back = 1;
     gp->sc = sc;
     gp->a = a;
     gp->vis_eps = 1e-6 * (accel_eps_scale(a) > 0.0 && isfinite(accel_eps_scale(a)) ? accel_eps_scale(a) : 1.0);

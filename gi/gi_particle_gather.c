@@ -57,14 +57,23 @@ static vec3 hit_normal(const accel_hit *h, int side)
     return v3_dot(ns, ng) > 0.5 ? ns : ng;
 }
 
-static vec3 view_normal(const view_rec *r) { return hit_normal(&r->h, r->side); }
+/* The side of kept hit r that the gather being built takes: the one the
+ * camera sees, or for the other side's gather (back) the one behind. */
+static int gather_side(const gi_particle *gp, const view_rec *r) { return gp->vg->back ? !r->side : r->side; }
 
-/* A kept hit that takes diffuse light from the hook. */
+static vec3 view_normal(const gi_particle *gp, const view_rec *r) { return hit_normal(&r->h, gather_side(gp, r)); }
+
+/* A kept hit that takes diffuse light from the hook: on the side seen
+ * where its finish has diffuse, and for the other side's gather where it
+ * also has diffuse_back (the hook adds that side's light times B / A:
+ * POV-Ray gathers a surface's back side for its diffuse_back as it
+ * gathers the front, trace.cpp ComputeLightedTexture's second
+ * ComputeAmbient about the reversed normal). */
 static int gathers(const gi_particle *gp, const view_rec *r)
 {
     if (r->kind != 2 || !r->h.obj) return 0;
     const scene_texture *t = r->h.texture ? r->h.texture : &gp->sc->default_texture;
-    return t->finish.diffuse > 0.0;
+    return t->finish.diffuse > 0.0 && (!gp->vg->back || t->finish.diffuse_back != 0.0);
 }
 
 /* May pixel j take pixel i's gather? (vg_nrm: their view_normal) */
@@ -73,24 +82,29 @@ static int compatible(const gi_particle *gp, size_t i, size_t j)
     const view_rec *a = &gp->vrec[i], *b = &gp->vrec[j];
     if (a->h.obj != b->h.obj || a->side != b->side) return 0;
     if (!(fabs(a->h.t - b->h.t) <= DEPTH_TOL * b->h.t)) return 0;
-    return v3_dot(gp->vg_nrm[i], gp->vg_nrm[j]) > NORMAL_COS;
+    return v3_dot(gp->vg->nrm[i], gp->vg->nrm[j]) > NORMAL_COS;
+}
+
+static void view_gather_free_side(gi_view_gather *g)
+{
+    GROW_FREE_ALL(g->pt, g->cpt, g->ids, g->tab, g->link, g->esky, g->val, g->pix, g->pixval, g->nrm, g->pnrm);
+    gi_gatherer_free(g->gatherer);
+    g->gatherer = NULL;
+    gi_link_conts_free(&g->cont);
+    g->pt = g->cpt = NULL;
+    g->tab = NULL;
+    g->nrm = g->pnrm = NULL;
+    g->ids = g->link = g->pix = NULL;
+    g->esky = g->val = g->pixval = NULL;
+    g->levels = 0;
+    g->n = g->m1 = g->rk = 0;
+    g->w = g->h = 0;
 }
 
 void gi_particle_view_gather_free(gi_particle *gp)
 {
-    GROW_FREE_ALL(gp->vg_pt, gp->vg_cpt, gp->vg_ids, gp->vg_tab, gp->vg_link, gp->vg_esky, gp->vg_val, gp->vg_pix,
-                  gp->vg_pixval, gp->vg_nrm, gp->vg_pnrm);
-    gi_gatherer_free(gp->vg_gatherer);
-    gp->vg_gatherer = NULL;
-    gi_link_conts_free(&gp->vg_cont);
-    gp->vg_pt = gp->vg_cpt = NULL;
-    gp->vg_tab = NULL;
-    gp->vg_nrm = gp->vg_pnrm = NULL;
-    gp->vg_ids = gp->vg_link = gp->vg_pix = NULL;
-    gp->vg_esky = gp->vg_val = gp->vg_pixval = NULL;
-    gp->vg_levels = 0;
-    gp->vg_n = gp->vg_m1 = gp->vg_rk = 0;
-    gp->vg_w = gp->vg_h = 0;
+    view_gather_free_side(&gp->vgs[0]);
+    view_gather_free_side(&gp->vgs[1]);
 }
 
 /* The corners of pixel (x, y)'s block and their bilinear weights (fewer
@@ -136,7 +150,7 @@ static uint64_t cell_hash(int level, int64_t ix, int64_t iy, int64_t iz)
 static int point_level(const gi_particle *gp, double r)
 {
     int L = 0;
-    while (L < VG_LEVELS - 1 && gp->vg_c0 * (double)(1u << L) < 2.0 * r) L++;
+    while (L < VG_LEVELS - 1 && gp->vg->c0 * (double)(1u << L) < 2.0 * r) L++;
     return L;
 }
 
@@ -153,49 +167,49 @@ static int cmp_keyed(const void *a, const void *b)
 
 static pt_status build_index(gi_particle *gp)
 {
-    int m = gp->vg_n;
+    int m = gp->vg->n;
     double rmin = INFINITY;
     for (int k = 0; k < m; k++)
-        if (gp->vg_pt[k].r > 0.0f && gp->vg_pt[k].r < rmin) rmin = gp->vg_pt[k].r;
+        if (gp->vg->pt[k].r > 0.0f && gp->vg->pt[k].r < rmin) rmin = gp->vg->pt[k].r;
     if (!isfinite(rmin)) return PT_OK; /* no radii: kept hits only */
-    gp->vg_c0 = 2.0 * rmin;
+    gp->vg->c0 = 2.0 * rmin;
     keyed *kk = malloc((size_t)m * sizeof *kk);
     size_t cap = 64;
     while (cap < 2 * (size_t)m) cap *= 2;
-    gp->vg_ids = malloc((size_t)m * sizeof *gp->vg_ids);
-    gp->vg_cpt = malloc((size_t)m * sizeof *gp->vg_cpt);
-    gp->vg_tab = calloc(cap, sizeof *gp->vg_tab);
-    if (!kk || !gp->vg_ids || !gp->vg_cpt || !gp->vg_tab) {
+    gp->vg->ids = malloc((size_t)m * sizeof *gp->vg->ids);
+    gp->vg->cpt = malloc((size_t)m * sizeof *gp->vg->cpt);
+    gp->vg->tab = calloc(cap, sizeof *gp->vg->tab);
+    if (!kk || !gp->vg->ids || !gp->vg->cpt || !gp->vg->tab) {
         free(kk);
         return PT_ERR_NOMEM;
     }
-    gp->vg_tab_mask = cap - 1;
+    gp->vg->tab_mask = cap - 1;
     unsigned used = 0;
     for (int k = 0; k < m; k++) {
-        const vg_point *pt = &gp->vg_pt[k];
+        const vg_point *pt = &gp->vg->pt[k];
         int L = point_level(gp, pt->r);
-        vec3 *box = gp->vg_lvl_box + 2 * L;
+        vec3 *box = gp->vg->lvl_box + 2 * L;
         box[0] = used >> L & 1u ? v3_min(box[0], pt->p) : pt->p;
         box[1] = used >> L & 1u ? v3_max(box[1], pt->p) : pt->p;
         used |= 1u << L;
-        double c = gp->vg_c0 * (double)(1u << L);
+        double c = gp->vg->c0 * (double)(1u << L);
         kk[k].key = cell_hash(L, (int64_t)floor(pt->p.x / c), (int64_t)floor(pt->p.y / c), (int64_t)floor(pt->p.z / c));
         kk[k].id = k;
     }
-    gp->vg_levels = used;
+    gp->vg->levels = used;
     qsort(kk, (size_t)m, sizeof *kk, cmp_keyed);
     for (int e = 0; e < m;) {
         int f = e;
         while (f < m && kk[f].key == kk[e].key) {
-            gp->vg_ids[f] = kk[f].id;
-            gp->vg_cpt[f] = gp->vg_pt[kk[f].id];
+            gp->vg->ids[f] = kk[f].id;
+            gp->vg->cpt[f] = gp->vg->pt[kk[f].id];
             f++;
         }
-        size_t slot = (size_t)kk[e].key & gp->vg_tab_mask;
-        while (gp->vg_tab[slot].key) slot = (slot + 1) & gp->vg_tab_mask;
-        gp->vg_tab[slot].key = kk[e].key;
-        gp->vg_tab[slot].start = e;
-        gp->vg_tab[slot].count = f - e;
+        size_t slot = (size_t)kk[e].key & gp->vg->tab_mask;
+        while (gp->vg->tab[slot].key) slot = (slot + 1) & gp->vg->tab_mask;
+        gp->vg->tab[slot].key = kk[e].key;
+        gp->vg->tab[slot].start = e;
+        gp->vg->tab[slot].count = f - e;
         e = f;
     }
     free(kk);
@@ -244,9 +258,10 @@ static int reusable(const gi_particle *gp, const vg_point *pt, vec3 p, vec3 ng, 
  * object's points that face its way, within twice their radius (an
  * antialiasing ray on a part too thin for a kept pixel of its own: the
  * light of its neighbours, not the unoccluded sky). 0: none. */
-static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int relaxed, rgb *out)
+static int nearby_value(const gi_particle *gp, const gi_view_gather *g, const accel_hit *hit, vec3 n, int relaxed,
+                        rgb *out)
 {
-    if (!gp->vg_tab || !hit->obj) return 0;
+    if (!g->tab || !hit->obj) return 0;
     int side = v3_dot(n, hit->ng) >= 0.0;
     vec3 ng = side ? hit->ng : v3_neg(hit->ng);
     double lg = v3_len(ng), s[3] = {0.0, 0.0, 0.0}, ws = 0.0;
@@ -254,12 +269,12 @@ static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int
      * shading's perturbed n (core/radrules.h rule 5) */
     vec3 qn = gp->set.normal_at && v3_dot(n, ng) > 0.0 ? v3_norm(n) : v3_scale(ng, 1.0 / lg);
     for (int L = 0; L < VG_LEVELS; L++) {
-        if (!(gp->vg_levels >> L & 1u)) continue;
-        double c = gp->vg_c0 * (double)(1u << L);
+        if (!(g->levels >> L & 1u)) continue;
+        double c = g->c0 * (double)(1u << L);
         /* a point of this level answers within r <= c/2 (relaxed 2r <= c;
          * the last level's may be larger): none does from farther than c
          * outside the box of its points */
-        const vec3 *box = gp->vg_lvl_box + 2 * L;
+        const vec3 *box = g->lvl_box + 2 * L;
         if (L < VG_LEVELS - 1 &&
             (hit->p.x < box[0].x - c || hit->p.y < box[0].y - c || hit->p.z < box[0].z - c ||
              hit->p.x > box[1].x + c || hit->p.y > box[1].y + c || hit->p.z > box[1].z + c))
@@ -277,11 +292,11 @@ static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int
         for (int a = 0; a < span * span; a++) hxy[a] = hash_step(hx[a % span], i0[1] + a / span);
         for (int corner = 0; corner < ncell; corner++) {
             uint64_t key = hash_step(hxy[corner % (span * span)], i0[2] + corner / (span * span)) | 1;
-            size_t slot = (size_t)key & gp->vg_tab_mask;
-            while (gp->vg_tab[slot].key && gp->vg_tab[slot].key != key) slot = (slot + 1) & gp->vg_tab_mask;
-            if (!gp->vg_tab[slot].key) continue;
-            for (int e = gp->vg_tab[slot].start, end = e + gp->vg_tab[slot].count; e < end; e++) {
-                const vg_point *pt = &gp->vg_cpt[e];
+            size_t slot = (size_t)key & g->tab_mask;
+            while (g->tab[slot].key && g->tab[slot].key != key) slot = (slot + 1) & g->tab_mask;
+            if (!g->tab[slot].key) continue;
+            for (int e = g->tab[slot].start, end = e + g->tab[slot].count; e < end; e++) {
+                const vg_point *pt = &g->cpt[e];
                 if (!relaxed && (pt->obj != hit->obj || pt->side != side)) continue;
                 double r = relaxed ? 2.0 * pt->r : pt->r;
                 vec3 dv = v3_sub(hit->p, pt->p);
@@ -293,9 +308,9 @@ static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int
                 double d = sqrt(d2);
                 if (!(d < r) || (!relaxed && fabs(v3_dot(dv, pt->n)) > 0.25 * r)) continue;
                 if (v3_dot(pt->n, ng) < NORMAL_COS * lg) continue;
-                if (gp->vg_gatherer && !reusable(gp, pt, hit->p, qn, 1.0)) continue;
+                if (gp->vgs[0].gatherer && !reusable(gp, pt, hit->p, qn, 1.0)) continue;
                 double w = 1.0 - d / r;
-                const float *v = &gp->vg_val[4 * (size_t)gp->vg_ids[e]];
+                const float *v = &g->val[4 * (size_t)g->ids[e]];
                 for (int q = 0; q < 3; q++) s[q] += w * v[q];
                 ws += w;
             }
@@ -313,7 +328,7 @@ static int nearby_value(const gi_particle *gp, const accel_hit *hit, vec3 n, int
  * of memory. */
 static int gather_values(gi_particle *gp)
 {
-    int *idx = malloc((size_t)gp->vg_n * sizeof *idx);
+    int *idx = malloc((size_t)gp->vg->n * sizeof *idx);
     /* the particles' reflected radiance, the sky light they reflect
      * included: their own emission was taken where each ray hit
      * (gi_links.h, first > 0) */
@@ -323,7 +338,7 @@ static int gather_values(gi_particle *gp)
         free(lrefl);
         return 0;
     }
-    for (int i = 0; i < gp->vg_n; i++) idx[i] = i;
+    for (int i = 0; i < gp->vg->n; i++) idx[i] = i;
     for (int t = 0; t < gp->ps.n; t++) {
         for (int c = 0; c < 3; c++) {
             float v = gp->lout[4 * (size_t)t + c] - gi_particle_own_emission(gp, t, c);
@@ -334,17 +349,17 @@ static int gather_values(gi_particle *gp)
     /* points [0, m1) take vg_k rays; the refinement points [m1, vg_n)
      * vg_rk, their rows packed from row m1: the kernel reads point i's
      * row at i times its k from the pointer it is given */
-    int m1 = gp->vg_m1 > 0 && gp->vg_m1 < gp->vg_n && gp->vg_rk > 0 ? gp->vg_m1 : gp->vg_n;
-    gi_c_gather(gp->threads, gp->vg_link, gp->vg_k, lrefl, idx, m1, gp->vg_esky, gp->vg_val);
-    if (m1 < gp->vg_n)
-        gi_c_gather(gp->threads, gp->vg_link + (size_t)m1 * (size_t)(gp->vg_k - gp->vg_rk), gp->vg_rk, lrefl, idx + m1,
-                    gp->vg_n - m1, gp->vg_esky, gp->vg_val);
+    int m1 = gp->vg->m1 > 0 && gp->vg->m1 < gp->vg->n && gp->vg->rk > 0 ? gp->vg->m1 : gp->vg->n;
+    gi_c_gather(gp->threads, gp->vg->link, gp->vg->k, lrefl, idx, m1, gp->vg->esky, gp->vg->val);
+    if (m1 < gp->vg->n)
+        gi_c_gather(gp->threads, gp->vg->link + (size_t)m1 * (size_t)(gp->vg->k - gp->vg->rk), gp->vg->rk, lrefl, idx + m1,
+                    gp->vg->n - m1, gp->vg->esky, gp->vg->val);
     /* the continuations that ended on particles (mirrors, glass): their
      * weight times that particle's reflected light, in the points' order */
-    for (long q = 0; q < gp->vg_cont.n; q++) {
-        const gi_link_cont *e = &gp->vg_cont.e[q];
-        if (e->src >= gp->vg_n) continue;
-        for (int c = 0; c < 3; c++) gp->vg_val[4 * (size_t)e->src + c] += e->w[c] * lrefl[4 * (size_t)e->t + c];
+    for (long q = 0; q < gp->vg->cont.n; q++) {
+        const gi_link_cont *e = &gp->vg->cont.e[q];
+        if (e->src >= gp->vg->n) continue;
+        for (int c = 0; c < 3; c++) gp->vg->val[4 * (size_t)e->src + c] += e->w[c] * lrefl[4 * (size_t)e->t + c];
     }
     free(idx);
     free(lrefl);
@@ -358,12 +373,12 @@ static void put_point(gi_particle *gp, gi_dev_particle *cp, const void **cobj, u
 {
     int w = gp->vw, h = gp->vh;
     const view_rec *r = &gp->vrec[i];
-    vec3 nv = gp->vg_nrm[i];
+    vec3 nv = gp->vg->nrm[i];
     gi_dev_particle *q = &cp[t];
     v3_store_f(q->p, r->h.p);
     /* its rays about the texture's perturbed normal under radiosity
      * `normal on` (core/radrules.h rule 5, vg_pnrm) */
-    vec3 ngat = gp->vg_pnrm[i];
+    vec3 ngat = gp->vg->pnrm[i];
     v3_store_f(q->n, ngat);
     q->area = 0.0f;
     const scene_object *o = r->h.obj;
@@ -373,12 +388,12 @@ static void put_point(gi_particle *gp, gi_dev_particle *cp, const void **cobj, u
     const view_rec *nb = &gp->vrec[x + 1 < (size_t)w ? i + 1 : (y + 1 < (size_t)h ? i + (size_t)w : i)];
     double ang = nb != r && nb->kind ? v3_len(v3_sub(v3_norm(nb->dir), v3_norm(r->dir))) : 0.0;
     double cs = fabs(v3_dot(v3_norm(r->dir), nv));
-    vg_point *vp = &gp->vg_pt[k];
+    vg_point *vp = &gp->vg->pt[k];
     vp->p = r->h.p;
     vp->n = nv;
     vp->pn = ngat;
     vp->obj = o;
-    vp->side = r->side;
+    vp->side = gather_side(gp, r);
     vp->r = (float)(s * r->h.t * ang / (cs > 0.25 ? cs : 0.25));
     cobj[t] = o;
     /* on the inside of a closed sphere or box (as gi_particle_objects
@@ -407,7 +422,7 @@ static void put_row(void *ctx, int y, int thread)
     gi_particle *gp = P->gp;
     size_t w = (size_t)gp->vw;
     for (size_t i = (size_t)y * w; i < (size_t)(y + 1) * w; i++) {
-        int k = gp->vg_pix[i];
+        int k = gp->vg->pix[i];
         if (k >= P->k0 && k < P->k1) put_point(gp, P->cp, P->cobj, P->cpin, P->n + (k - P->k0), k, i, P->s);
     }
 }
@@ -448,24 +463,24 @@ static pt_status trace_points(gi_particle *gp, const void **pobj, const unsigned
         st = PT_ERR_NOMEM;
         goto done;
     }
-    long c0 = gp->vg_cont.n;
+    long c0 = gp->vg->cont.n;
     st = gi_links_build(gp->a, gp->lscene, cp, cobj, cpin, (int)N, n, side, seed, grid, gp->tl, 3.0 * spacing, gp->threads,
-                        gp->vg_link + (size_t)k0 * gp->vg_k, NULL, &ls, gp->set.cancel, NULL, gp->sky,
-                        gp->vg_esky + 4 * (size_t)k0, gp->sc, gp->set.pigment,
-                        gp->set.bounces >= 1 ? gp->set.brightness : 0.0, reach, &gp->vg_cont);
-    for (long q = c0; q < gp->vg_cont.n; q++) gp->vg_cont.e[q].src += k0; /* the points' own numbers */
+                        gp->vg->link + (size_t)k0 * gp->vg->k, NULL, &ls, gp->set.cancel, NULL, gp->sky,
+                        gp->vg->esky + 4 * (size_t)k0, gp->sc, gp->set.pigment,
+                        gp->set.bounces >= 1 ? gp->set.brightness : 0.0, reach, &gp->vg->cont);
+    for (long q = c0; q < gp->vg->cont.n; q++) gp->vg->cont.e[q].src += k0; /* the points' own numbers */
     *rays += ls.rays;
     /* each point's reach within POV-Ray's minimum_reuse and maximum_reuse
      * of its distance from the camera (radiosity.cpp clamps its records'
      * harmonic mean distance so) */
     for (size_t i = 0; st == PT_OK && i < npix; i++) {
-        int k = gp->vg_pix[i];
+        int k = gp->vg->pix[i];
         if (k < k0 || k >= k1) continue;
         double t = gp->vrec[i].h.t, R = reach[4 * (size_t)(k - k0)];
-        for (int c = 0; c < 3; c++) gp->vg_pt[k].nearest[c] = reach[4 * (size_t)(k - k0) + 1 + c];
+        for (int c = 0; c < 3; c++) gp->vg->pt[k].nearest[c] = reach[4 * (size_t)(k - k0) + 1 + c];
         if (gp->set.reuse_min > 0.0 && R < gp->set.reuse_min * t) R = gp->set.reuse_min * t;
         if (gp->set.reuse_max > 0.0 && R > gp->set.reuse_max * t) R = gp->set.reuse_max * t;
-        gp->vg_pt[k].reach = (float)R;
+        gp->vg->pt[k].reach = (float)R;
     }
 done:
     free(cp);
@@ -493,15 +508,15 @@ static int needs_own(const gi_particle *gp, size_t i)
     int x = (int)(i % (size_t)gp->vw), y = (int)(i / (size_t)gp->vw);
     int cx[4], cy[4];
     double cw[4], lo = INFINITY, hi = 0.0;
-    int nc = corners(x, y, gp->vw, gp->vh, gp->vg_s, cx, cy, cw), m = 0;
+    int nc = corners(x, y, gp->vw, gp->vh, gp->vg->s, cx, cy, cw), m = 0;
     for (int c = 0; c < nc; c++) {
         size_t j = (size_t)cy[c] * gp->vw + cx[c];
-        int kc = gp->vg_pix[j];
+        int kc = gp->vg->pix[j];
         if (kc < 0 || !compatible(gp, j, i)) continue;
         /* a corner whose record POV-Ray's cache would not reuse here */
-        if (gi_particle_exact_gather(&gp->set) && !reusable(gp, &gp->vg_pt[kc], gp->vrec[i].h.p, gp->vg_pnrm[i], 1.0))
+        if (gi_particle_exact_gather(&gp->set) && !reusable(gp, &gp->vg->pt[kc], gp->vrec[i].h.p, gp->vg->pnrm[i], 1.0))
             return 1;
-        const float *v = &gp->vg_val[4 * (size_t)kc];
+        const float *v = &gp->vg->val[4 * (size_t)kc];
         double l = 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
         lo = fmin(lo, l);
         hi = fmax(hi, l);
@@ -517,9 +532,9 @@ static void normal_row(void *ctx, int y, int thread)
     gi_particle *gp = ctx;
     size_t w = (size_t)gp->vw;
     for (size_t i = (size_t)y * w; i < (size_t)(y + 1) * w; i++) {
-        vec3 n = gp->vrec[i].kind == 2 ? view_normal(&gp->vrec[i]) : v3s(0.0);
-        gp->vg_nrm[i] = gp->vg_pnrm[i] = n;
-        if (gp->set.normal_at && gathers(gp, &gp->vrec[i])) gp->set.normal_at(gp->sc, &gp->vrec[i].h, n, &gp->vg_pnrm[i]);
+        vec3 n = gp->vrec[i].kind == 2 ? view_normal(gp, &gp->vrec[i]) : v3s(0.0);
+        gp->vg->nrm[i] = gp->vg->pnrm[i] = n;
+        if (gp->set.normal_at && gathers(gp, &gp->vrec[i])) gp->set.normal_at(gp->sc, &gp->vrec[i].h, n, &gp->vg->pnrm[i]);
     }
 }
 
@@ -537,13 +552,14 @@ static void own_row(void *ctx, int y, int thread)
     const gi_particle *gp = O->gp;
     size_t w = (size_t)gp->vw;
     for (size_t i = (size_t)y * w; i < (size_t)(y + 1) * w; i++)
-        O->own[i] = (unsigned char)(gp->vg_pix[i] < 0 && gathers(gp, &gp->vrec[i]) && needs_own(gp, i));
+        O->own[i] = (unsigned char)(gp->vg->pix[i] < 0 && gathers(gp, &gp->vrec[i]) && needs_own(gp, i));
 }
 
-pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
+static void regather_side(gi_particle *gp);
+
+/* The final gather of the side gp->vg takes (gi_particle_view_gather). */
+static pt_status view_gather_side(gi_particle *gp)
 {
-    (void)d;
-    gi_particle_view_gather_free(gp);
     int side = gp->set.view_gather_side, s = gp->set.view_gather_stride > 0 ? gp->set.view_gather_stride : 2;
     if (side <= 0 || !gp->vrec || gp->vw <= 0 || gp->vh <= 0 || !gp->lout || (gp->ps.n <= 0 && !gp->final_only))
         return PT_OK;
@@ -552,11 +568,11 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
     pt_status st = PT_OK;
     /* vg_pix: the gather point of a pixel, -1 none (it interpolates or
      * takes the old estimate) */
-    gp->vg_pix = malloc(npix * sizeof *gp->vg_pix);
-    gp->vg_nrm = malloc(npix * sizeof *gp->vg_nrm);
-    gp->vg_pnrm = malloc(npix * sizeof *gp->vg_pnrm);
-    if (!gp->vg_pix || !gp->vg_nrm || !gp->vg_pnrm) {
-        gi_particle_view_gather_free(gp);
+    gp->vg->pix = malloc(npix * sizeof *gp->vg->pix);
+    gp->vg->nrm = malloc(npix * sizeof *gp->vg->nrm);
+    gp->vg->pnrm = malloc(npix * sizeof *gp->vg->pnrm);
+    if (!gp->vg->pix || !gp->vg->nrm || !gp->vg->pnrm) {
+        view_gather_free_side(gp->vg);
         return PT_ERR_NOMEM;
     }
     pool_run(gp->threads, h, normal_row, gp);
@@ -564,35 +580,35 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
-            gp->vg_pix[i] = -1;
+            gp->vg->pix[i] = -1;
             if (!gathers(gp, &gp->vrec[i])) continue;
             mmax++;
-            if (x % s == 0 && y % s == 0) gp->vg_pix[i] = m++;
+            if (x % s == 0 && y % s == 0) gp->vg->pix[i] = m++;
         }
     /* pixels no corner answers gather themselves */
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
-            if (gp->vg_pix[i] >= 0 || !gathers(gp, &gp->vrec[i])) continue;
+            if (gp->vg->pix[i] >= 0 || !gathers(gp, &gp->vrec[i])) continue;
             int cx[4], cy[4];
             double cw[4];
             int nc = corners(x, y, w, h, s, cx, cy, cw), ok = 0;
             for (int k = 0; k < nc && !ok; k++) {
                 size_t c = (size_t)cy[k] * w + cx[k];
-                ok = gp->vg_pix[c] >= 0 && compatible(gp, c, i);
+                ok = gp->vg->pix[c] >= 0 && compatible(gp, c, i);
             }
-            if (!ok) gp->vg_pix[i] = m++;
+            if (!ok) gp->vg->pix[i] = m++;
         }
     if (m == 0) return PT_OK;
     /* room for every gathering pixel: the refinement below adds points */
     unsigned char *pin = NULL;
     const void **pobj = gi_particle_objects(gp, &gp->ps, &pin, &st);
-    gp->vg_link = malloc((size_t)mmax * side * side * sizeof *gp->vg_link);
-    gp->vg_esky = calloc((size_t)mmax * 4, sizeof *gp->vg_esky);
-    gp->vg_val = calloc((size_t)mmax * 4, sizeof *gp->vg_val);
-    gp->vg_pt = calloc((size_t)mmax, sizeof *gp->vg_pt);
+    gp->vg->link = malloc((size_t)mmax * side * side * sizeof *gp->vg->link);
+    gp->vg->esky = calloc((size_t)mmax * 4, sizeof *gp->vg->esky);
+    gp->vg->val = calloc((size_t)mmax * 4, sizeof *gp->vg->val);
+    gp->vg->pt = calloc((size_t)mmax, sizeof *gp->vg->pt);
     gi_lookup *grid = NULL;
-    if (!pobj || !pin || !gp->vg_link || !gp->vg_esky || !gp->vg_val || !gp->vg_pt || st != PT_OK) {
+    if (!pobj || !pin || !gp->vg->link || !gp->vg->esky || !gp->vg->val || !gp->vg->pt || st != PT_OK) {
         st = PT_ERR_NOMEM;
         goto done;
     }
@@ -603,10 +619,10 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
         goto done;
     }
     st = gi_lookup_set_objects(grid, (const void *const *)pobj);
-    gp->vg_k = side * side;
-    gp->vg_w = w;
-    gp->vg_h = h;
-    gp->vg_s = s;
+    gp->vg->k = side * side;
+    gp->vg->w = w;
+    gp->vg->h = h;
+    gp->vg->s = s;
     long rays = 0;
     /* the triangle lists of the particles as they are now (built once for
      * the views: the geometry stage's were built before the pruning, and
@@ -621,7 +637,7 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
     /* refinement (an irradiance cache's adaptive placement): pixels whose
      * matching corners disagree gather themselves, traced as a second set */
     if (st == PT_OK && s > 1) {
-        gp->vg_n = m;
+        gp->vg->n = m;
         gather_values(gp);
         int m1 = m;
         /* which pixels gather themselves (needs_own reads only the corner
@@ -635,7 +651,7 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
         own_job O = {gp, own};
         pool_run(gp->threads, h, own_row, &O);
         for (size_t i = 0; i < npix; i++)
-            if (own[i]) gp->vg_pix[i] = m++;
+            if (own[i]) gp->vg->pix[i] = m++;
         free(own);
         if (m > m1) {
             /* a refinement point takes REFINE_SIDE_FRAC of the side: such
@@ -648,14 +664,14 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
             if (rs < 4) rs = 4;
             if (rs > side) rs = side;
             st = trace_points(gp, pobj, pin, grid, m1, m, rs, s, gp->set.seed ^ 0x3c5b1ULL, &rays);
-            gp->vg_m1 = m1;
-            gp->vg_rk = rs * rs;
+            gp->vg->m1 = m1;
+            gp->vg->rk = rs * rs;
         }
     }
     /* with no bounce after the gather's hits (the exact gather, gi_links.h)
      * a hit no point may answer gathers itself, as POV-Ray's cache adds a
      * record where none can be reused */
-    if (st == PT_OK && gi_particle_exact_gather(&gp->set)) {
+    if (st == PT_OK && gi_particle_exact_gather(&gp->set) && !gp->vg->back) {
         /* by default a third of the side: such hits are mostly
          * antialiasing rays, each one of the (depth^2 + 1) samples a pixel
          * averages, so a pixel's 9 subsamples together still take about a
@@ -664,30 +680,58 @@ pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
         double frac = gp->set.here_side_frac > 0.0 ? gp->set.here_side_frac : 1.0 / 3.0;
         int hs = (int)ceil(side * frac - 1e-9);
         if (hs < 4) hs = 4;
-        gp->vg_gatherer = gi_gatherer_new(gp->a, gp->lscene, hs, gp->set.seed ^ 0x51d3ULL, gp->sky, gp->sc,
+        gp->vg->gatherer = gi_gatherer_new(gp->a, gp->lscene, hs, gp->set.seed ^ 0x51d3ULL, gp->sky, gp->sc,
                                           gp->set.pigment);
         /* where its rays need only occlusion tests (gi_gatherer_dark), the
          * time of hs^2 nearest-hit rays buys about DARK_SIDE_GAIN^2 times
          * as many: less noise for the same time */
         int hd = (int)ceil(hs * DARK_SIDE_GAIN - 1e-9);
-        if (gp->vg_gatherer && gi_gatherer_dark(gp->vg_gatherer) && hd > hs) {
-            gi_gatherer_free(gp->vg_gatherer);
-            gp->vg_gatherer = gi_gatherer_new(gp->a, gp->lscene, hd, gp->set.seed ^ 0x51d3ULL, gp->sky, gp->sc,
+        if (gp->vg->gatherer && gi_gatherer_dark(gp->vg->gatherer) && hd > hs) {
+            gi_gatherer_free(gp->vg->gatherer);
+            gp->vg->gatherer = gi_gatherer_new(gp->a, gp->lscene, hd, gp->set.seed ^ 0x51d3ULL, gp->sky, gp->sc,
                                               gp->set.pigment);
         }
-        if (!gp->vg_gatherer) st = PT_ERR_NOMEM;
+        if (!gp->vg->gatherer) st = PT_ERR_NOMEM;
     }
     if (st == PT_OK) {
-        gp->vg_n = m;
-        gp->st.view_gathers = m;
-        gp->st.view_gather_rays = rays;
-        gi_particle_view_regather(gp);
+        gp->vg->n = m;
+        gp->st.view_gathers = (gp->vg->back ? gp->st.view_gathers : 0) + m;
+        gp->st.view_gather_rays = (gp->vg->back ? gp->st.view_gather_rays : 0) + rays;
+        regather_side(gp);
         st = build_index(gp);
     }
 done:
     gi_lookup_free(grid);
     free(pobj);
     free(pin);
+    if (st != PT_OK) view_gather_free_side(gp->vg);
+    return st;
+}
+
+/* Whether some kept hit's finish has diffuse_back: then the other side of
+ * those hits is gathered too (gathers). */
+static int any_back(const gi_particle *gp)
+{
+    for (size_t i = 0, npix = (size_t)gp->vw * (size_t)gp->vh; i < npix; i++) {
+        const view_rec *r = &gp->vrec[i];
+        if (r->kind != 2 || !r->h.obj) continue;
+        const scene_texture *t = r->h.texture ? r->h.texture : &gp->sc->default_texture;
+        if (t->finish.diffuse > 0.0 && t->finish.diffuse_back != 0.0) return 1;
+    }
+    return 0;
+}
+
+pt_status gi_particle_view_gather(gi_particle *gp, diag *d)
+{
+    (void)d;
+    gi_particle_view_gather_free(gp);
+    gp->vg = &gp->vgs[0];
+    pt_status st = view_gather_side(gp);
+    if (st == PT_OK && gp->vrec && any_back(gp)) {
+        gp->vg = &gp->vgs[1];
+        st = view_gather_side(gp);
+        gp->vg = &gp->vgs[0];
+    }
     if (st != PT_OK) gi_particle_view_gather_free(gp);
     return st;
 }
@@ -696,9 +740,9 @@ done:
  * mean of its block's corners that match it. 0: neither. */
 static int raw_value(const gi_particle *gp, size_t i, float out[3])
 {
-    int k = gp->vg_pix[i];
+    int k = gp->vg->pix[i];
     if (k >= 0) {
-        for (int c = 0; c < 3; c++) out[c] = gp->vg_val[4 * (size_t)k + c];
+        for (int c = 0; c < 3; c++) out[c] = gp->vg->val[4 * (size_t)k + c];
         return 1;
     }
     const view_rec *r = &gp->vrec[i];
@@ -706,12 +750,12 @@ static int raw_value(const gi_particle *gp, size_t i, float out[3])
     int x = (int)(i % (size_t)gp->vw), y = (int)(i / (size_t)gp->vw);
     int cx[4], cy[4];
     double cw[4], s[3] = {0.0, 0.0, 0.0}, ws = 0.0;
-    int nc = corners(x, y, gp->vw, gp->vh, gp->vg_s, cx, cy, cw);
+    int nc = corners(x, y, gp->vw, gp->vh, gp->vg->s, cx, cy, cw);
     for (int c = 0; c < nc; c++) {
         size_t j = (size_t)cy[c] * gp->vw + cx[c];
-        int kc = gp->vg_pix[j];
+        int kc = gp->vg->pix[j];
         if (kc < 0 || !compatible(gp, j, i)) continue;
-        for (int q = 0; q < 3; q++) s[q] += cw[c] * gp->vg_val[4 * (size_t)kc + q];
+        for (int q = 0; q < 3; q++) s[q] += cw[c] * gp->vg->val[4 * (size_t)kc + q];
         ws += cw[c];
     }
     if (!(ws > 0.0)) return 0;
@@ -760,11 +804,11 @@ static void filter_row(void *ctx, int y, int thread)
     const int exact = gi_particle_exact_gather(&gp->set);
     for (int x = 0; x < w; x++) {
         size_t i = (size_t)y * w + x;
-        float *o = &gp->vg_pixval[4 * i];
+        float *o = &gp->vg->pixval[4 * i];
         o[3] = 0.0f;
         if (!F->ok[i]) continue;
         const view_rec *r = &gp->vrec[i];
-        vec3 nr = gp->vg_nrm[i], pn = gp->vg_pnrm[i];
+        vec3 nr = gp->vg->nrm[i], pn = gp->vg->pnrm[i];
         double s[3] = {0.0, 0.0, 0.0}, ws = 0.0;
         for (int dy = -R; dy <= R; dy++) {
             int yy = y + dy;
@@ -777,9 +821,9 @@ static void filter_row(void *ctx, int y, int thread)
                 const view_rec *q = &gp->vrec[j];
                 if (j != i && (!compatible(gp, j, i) || fabs(v3_dot(v3_sub(q->h.p, r->h.p), nr)) > DEPTH_TOL * r->h.t))
                     continue;
-                if (j != i && exact && gp->vg_pix[j] >= 0 && !reusable(gp, &gp->vg_pt[gp->vg_pix[j]], r->h.p, pn, 1.0))
+                if (j != i && exact && gp->vg->pix[j] >= 0 && !reusable(gp, &gp->vg->pt[gp->vg->pix[j]], r->h.p, pn, 1.0))
                     continue;
-                if (j != i && a > 0.0 && !(2.0 * sqrt(fmax(0.0, 1.0 - v3_dot(gp->vg_pnrm[j], pn))) < a)) continue;
+                if (j != i && a > 0.0 && !(2.0 * sqrt(fmax(0.0, 1.0 - v3_dot(gp->vg->pnrm[j], pn))) < a)) continue;
                 double wt = g[dx < 0 ? -dx : dx] * g[dy < 0 ? -dy : dy];
                 for (int c = 0; c < 3; c++) s[c] += wt * F->raw[3 * j + c];
                 ws += wt;
@@ -806,17 +850,17 @@ static void raw_row(void *ctx, int y, int thread)
         R->ok[i] = (unsigned char)raw_value(R->gp, i, &R->raw[3 * i]);
 }
 
-void gi_particle_view_regather(gi_particle *gp)
+static void regather_side(gi_particle *gp)
 {
-    if (gp->vg_n <= 0 || !gp->lout) return;
+    if (gp->vg->n <= 0 || !gp->lout) return;
     size_t npix = (size_t)gp->vw * (size_t)gp->vh;
     float *raw = malloc(npix * 3 * sizeof *raw);
     unsigned char *ok = malloc(npix);
-    if (!gp->vg_pixval) gp->vg_pixval = malloc(npix * 4 * sizeof *gp->vg_pixval);
-    if (!raw || !ok || !gp->vg_pixval || !gather_values(gp)) {
+    if (!gp->vg->pixval) gp->vg->pixval = malloc(npix * 4 * sizeof *gp->vg->pixval);
+    if (!raw || !ok || !gp->vg->pixval || !gather_values(gp)) {
         free(raw);
         free(ok);
-        gi_particle_view_gather_free(gp);
+        view_gather_free_side(gp->vg);
         return;
     }
     raw_job R = {gp, raw, ok};
@@ -826,24 +870,47 @@ void gi_particle_view_regather(gi_particle *gp)
     /* the points answer hits that are not kept with the filtered value of
      * their pixel too */
     for (size_t i = 0; i < npix; i++) {
-        int k = gp->vg_pix[i];
-        if (k >= 0 && gp->vg_pixval[4 * i + 3] > 0.0f)
-            for (int c = 0; c < 3; c++) gp->vg_val[4 * (size_t)k + c] = gp->vg_pixval[4 * i + c];
+        int k = gp->vg->pix[i];
+        if (k >= 0 && gp->vg->pixval[4 * i + 3] > 0.0f)
+            for (int c = 0; c < 3; c++) gp->vg->val[4 * (size_t)k + c] = gp->vg->pixval[4 * i + c];
     }
     free(raw);
     free(ok);
 }
 
-int gi_particle_view_value(const gi_particle *gp, const accel_hit *hit, const view_rec *r, vec3 n, rgb *out)
+void gi_particle_view_regather(gi_particle *gp)
 {
-    if (gp->vg_n <= 0 || gp->vg_w != gp->vw || gp->vg_h != gp->vh) return 0;
+    for (int b = 0; b < 2; b++) {
+        gp->vg = &gp->vgs[b];
+        regather_side(gp);
+    }
+    gp->vg = &gp->vgs[0];
+}
+
+/* The points of either gather near a hit that is not kept: each side's
+ * points hold E/pi on the side they face, whichever gather made them. */
+static int nearby_either(const gi_particle *gp, const accel_hit *hit, vec3 n, rgb *out)
+{
     /* with a gatherer, a hit no point may answer gathers itself
      * (gi_particle_gather_here) instead of taking a looser neighbour */
-    const int relax = !gp->vg_gatherer;
-    if (!r) return nearby_value(gp, hit, n, 0, out) || (relax && nearby_value(gp, hit, n, 1, out));
-    if ((v3_dot(n, r->h.ng) >= 0.0) != r->side) return 0; /* the other side (diffuse_back) */
-    const float *v = &gp->vg_pixval[4 * (size_t)(r - gp->vrec)];
-    if (!(v[3] > 0.0f)) return nearby_value(gp, hit, n, 0, out) || (relax && nearby_value(gp, hit, n, 1, out));
+    const int relax = !gp->vgs[0].gatherer;
+    for (int relaxed = 0; relaxed <= relax; relaxed++)
+        for (int b = 0; b < 2; b++) {
+            const gi_view_gather *g = &gp->vgs[b];
+            if (g->n > 0 && g->w == gp->vw && g->h == gp->vh && nearby_value(gp, g, hit, n, relaxed, out)) return 1;
+        }
+    return 0;
+}
+
+int gi_particle_view_value(const gi_particle *gp, const accel_hit *hit, const view_rec *r, vec3 n, rgb *out)
+{
+    if (!r) return nearby_either(gp, hit, n, out);
+    /* a kept hit: its pixel's value on the side seen, or on the other side
+     * (diffuse_back) from the other side's gather */
+    const gi_view_gather *g = &gp->vgs[(v3_dot(n, r->h.ng) >= 0.0) != r->side];
+    if (g->n <= 0 || g->w != gp->vw || g->h != gp->vh || !g->pixval) return 0;
+    const float *v = &g->pixval[4 * (size_t)(r - gp->vrec)];
+    if (!(v[3] > 0.0f)) return nearby_either(gp, hit, n, out);
     out->r = v[0];
     out->g = v[1];
     out->b = v[2];
@@ -852,7 +919,7 @@ int gi_particle_view_value(const gi_particle *gp, const accel_hit *hit, const vi
 
 int gi_particle_gather_here(gi_particle *gp, const accel_hit *hit, vec3 n, int thread, rgb *out)
 {
-    if (!gp->vg_gatherer || !hit->obj) return 0;
+    if (!gp->vgs[0].gatherer || !hit->obj) return 0;
     int side = v3_dot(n, hit->ng) >= 0.0;
     vec3 nv = hit_normal(hit, side);
     if (!(v3_len(nv) > 0.0)) return 0;
@@ -864,7 +931,7 @@ int gi_particle_gather_here(gi_particle *gp, const accel_hit *hit, vec3 n, int t
     memcpy(bits, &hit->p, sizeof bits);
     uint64_t stream = hash_step(hash_step(pt_mix64(bits[0]), (int64_t)bits[1]), (int64_t)bits[2]);
     float e[3];
-    if (!gi_gatherer_point(gp->vg_gatherer, thread, hit->p, nv, stream, e, NULL)) return 0;
+    if (!gi_gatherer_point(gp->vgs[0].gatherer, thread, hit->p, nv, stream, e, NULL)) return 0;
     out->r = e[0];
     out->g = e[1];
     out->b = e[2];

@@ -261,15 +261,17 @@ rgb gi_particle_indirect(void *ctx, const accel_hit *hit, vec3 n, int thread)
     }
     /* finish { diffuse A, B } (3.7's backside diffuse, shade_material.h:
      * kb/pi for light arriving from the other side): shade.c multiplies the
-     * hook by diffuse, so the other side's E/pi enters scaled by B / A.
-     * Only at this last bounce: the particles themselves reflect with
-     * diffuse alone (the lighting kernels keep the sides apart). */
+     * hook by diffuse, so the other side's E/pi enters scaled by B / A:
+     * the final gather's value on that side where it has one (gathered
+     * like the side seen, as POV-Ray gathers both), else the particles'
+     * estimate there. */
     const scene_texture *tex = hit->texture ? hit->texture : &gp->sc->default_texture;
     const scene_finish *f = &tex->finish;
     if (f->diffuse_back != 0.0 && f->diffuse > 0.0) {
         rgb back;
-        if (gp->final_only ? gi_particle_gather_here(gp, hit, v3_neg(n), thread, &back)
-                           : side_value(gp, hit, v3_neg(n), tc, &back)) {
+        const vec3 nb = v3_neg(n);
+        if (gi_particle_view_value(gp, hit, kept_rec(gp, hit), nb, &back) ||
+            (gp->final_only ? gi_particle_gather_here(gp, hit, nb, thread, &back) : side_value(gp, hit, nb, tc, &back))) {
             double k = f->diffuse_back / f->diffuse;
             out.r += k * back.r;
             out.g += k * back.g;

@@ -32,6 +32,34 @@ typedef struct {
 /* Levels of the final gather's cells of points (gi_particle_gather.c). */
 #define GI_VG_LEVELS 24
 
+/* The final gather at the kept hits for one side of them
+ * (gi_particle_gather.c). */
+typedef struct gi_view_gather {
+    int back;         /* 1: about the other side of the kept hits whose finish has diffuse_back */
+    int n, k;         /* gather points, rays each */
+    int m1, rk;       /* points from m1 on take rk rays, their rows packed from row m1 */
+    int w, h, s;      /* for the pre-pass of this size, every s-th pixel */
+    int *link;        /* n x k: the area particle each ray ends on, -1 none */
+    float *esky;      /* n x 4: the sky's and far field's share (gi_links.h) */
+    gi_link_conts cont; /* the rays' continuations that end on particles, by point (gi_links.h) */
+    float *val;       /* n x 4: gathered E/pi */
+    int *pix;         /* w x h: a pixel's gather point, -1 none */
+    float *pixval;    /* w x h x 4: each kept pixel's filtered E/pi, [3] 1 where it has one */
+    vec3 *nrm;        /* w x h: each kept hit's own normal on the side gathered (view_normal) */
+    vec3 *pnrm;       /* w x h: the normal its gather takes and its reuse test compares: under radiosity
+                         `normal on` the texture's perturbed one (normal_at), else nrm's */
+    struct vg_point *pt; /* n: where each gathered (for hits that are not kept) */
+    int *ids;         /* n: the points, by cell */
+    struct vg_point *cpt; /* n: pt[ids[e]] at e (a cell's points read in a row) */
+    struct vg_cell *tab; /* cells (hash table): runs of ids */
+    size_t tab_mask;
+    double c0;        /* level 0's cell size */
+    unsigned levels;  /* bit L: level L has points */
+    vec3 lvl_box[2 * GI_VG_LEVELS]; /* per level, the box (lo, hi) of its points */
+    struct gi_gatherer *gatherer; /* gathers where no point may answer (reuse_error > 0, no bounce
+                                     after the gather's hits); NULL: none */
+} gi_view_gather;
+
 struct gi_particle {
     const scene *sc;
     scene gsc;          /* settings.camera given: *sc with that camera, for the geometry stage */
@@ -81,29 +109,12 @@ struct gi_particle {
     int vw, vh;
     double veps;           /* the pre-pass's tmin */
     double vis_eps; /* gi_visible's eps: 1e-6 x accel_eps_scale */
-    /* the final gather at the kept hits (gi_particle_gather.c) */
-    int vg_n, vg_k;   /* gather points, rays each */
-    int vg_m1, vg_rk; /* points from vg_m1 on take vg_rk rays, their rows packed from row vg_m1 (gi_particle_gather.c) */
-    int vg_w, vg_h, vg_s; /* for the pre-pass of this size, every vg_s-th pixel */
-    int *vg_link;     /* vg_n x vg_k: the area particle each ray ends on, -1 none */
-    float *vg_esky;   /* vg_n x 4: the sky's and far field's share (gi_links.h) */
-    gi_link_conts vg_cont; /* the rays' continuations that end on particles, by point (gi_links.h) */
-    float *vg_val;    /* vg_n x 4: gathered E/pi */
-    int *vg_pix;      /* vg_w x vg_h: a pixel's gather point, -1 none */
-    float *vg_pixval; /* vg_w x vg_h x 4: each kept pixel's filtered E/pi, [3] 1 where it has one */
-    vec3 *vg_nrm;     /* vg_w x vg_h: each kept hit's own normal on its side (gi_particle_gather.c view_normal) */
-    vec3 *vg_pnrm;    /* vg_w x vg_h: the normal its gather takes and its reuse test compares: under radiosity
-                         `normal on` the texture's perturbed one (normal_at), else vg_nrm's */
-    struct vg_point *vg_pt; /* vg_n: where each gathered (for hits that are not kept) */
-    int *vg_ids;      /* vg_n: the points, by cell */
-    struct vg_point *vg_cpt; /* vg_n: vg_pt[vg_ids[e]] at e (a cell's points read in a row) */
-    struct vg_cell *vg_tab; /* cells (hash table): runs of vg_ids */
-    size_t vg_tab_mask;
-    double vg_c0;     /* level 0's cell size */
-    unsigned vg_levels; /* bit L: level L has points */
-    vec3 vg_lvl_box[2 * GI_VG_LEVELS]; /* per level, the box (lo, hi) of its points */
-    struct gi_gatherer *vg_gatherer; /* gathers where no point may answer (reuse_error > 0, no bounce
-                                        after the gather's hits); NULL: none */
+    /* the final gather at the kept hits (gi_particle_gather.c): vgs[0]
+     * about the side the camera sees, vgs[1] about the other side of the
+     * kept hits on diffuse_back surfaces; vg the one being built or
+     * regathered (vgs[0] outside gi_particle_gather.c's build) */
+    gi_view_gather vgs[2];
+    gi_view_gather *vg;
     thread_count tc[GI_MAX_THREADS];
     gi_particle_stats st;
 };

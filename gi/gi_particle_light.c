@@ -302,7 +302,7 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
     /* the final gather's values for this light: its rays took the direct
      * light where no particle answers (and everywhere when no bounce
      * follows), so with lights they are traced again */
-    if (gp->vg_n > 0 && gp->nlights > 0) {
+    if ((gp->vgs[0].n > 0 || gp->vgs[1].n > 0) && gp->nlights > 0) {
         st = gi_particle_view_gather(gp, d);
         if (st != PT_OK) return st;
     } else {

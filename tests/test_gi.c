@@ -1624,6 +1624,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_mirror_gather),
         cmocka_unit_test(test_transmit_gather),
         cmocka_unit_test(test_closed_room_gather),
+        cmocka_unit_test(test_diffuse_back_gather),
         cmocka_unit_test(test_dark_gather),
         cmocka_unit_test(test_sky_second_bounce),
         cmocka_unit_test(test_direct_matches_whitted),

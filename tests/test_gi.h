@@ -39,6 +39,7 @@ void test_csg_emitter_gather(void **state);
 void test_mirror_gather(void **state);
 void test_transmit_gather(void **state);
 void test_closed_room_gather(void **state);
+void test_diffuse_back_gather(void **state);
 void test_dark_gather(void **state);
 void test_sky_second_bounce(void **state);
 
