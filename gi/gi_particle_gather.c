@@ -382,11 +382,20 @@ static void put_point(gi_particle *gp, gi_dev_particle *cp, const void **cobj, u
     v3_store_f(q->n, ngat);
     q->area = 0.0f;
     const scene_object *o = r->h.obj;
-    /* its radius: stride pixels' footprint on the surface (the angle
-     * between neighbouring camera rays, at its depth, over the cosine) */
+    /* its radius: stride pixels' footprint on the surface (the distance
+     * between neighbouring camera rays at its depth, over the cosine: the
+     * angle between them times the depth from one eye point, the distance
+     * between their origins for an orthographic camera's parallel rays) */
     size_t x = i % (size_t)w, y = i / (size_t)w;
     const view_rec *nb = &gp->vrec[x + 1 < (size_t)w ? i + 1 : (y + 1 < (size_t)h ? i + (size_t)w : i)];
-    double ang = nb != r && nb->kind ? v3_len(v3_sub(v3_norm(nb->dir), v3_norm(r->dir))) : 0.0;
+    double foot = 0.0;
+    if (nb != r && nb->kind) {
+        vec3 d0 = v3_norm(r->dir), d1 = v3_norm(nb->dir);
+        if (r->org.x == nb->org.x && r->org.y == nb->org.y && r->org.z == nb->org.z)
+            foot = s * r->h.t * v3_len(v3_sub(d1, d0));
+        else
+            foot = s * v3_len(v3_sub(v3_madd(nb->org, d1, r->h.t), v3_madd(r->org, d0, r->h.t)));
+    }
     double cs = fabs(v3_dot(v3_norm(r->dir), nv));
     vg_point *vp = &gp->vg->pt[k];
     vp->p = r->h.p;
@@ -394,7 +403,7 @@ static void put_point(gi_particle *gp, gi_dev_particle *cp, const void **cobj, u
     vp->pn = ngat;
     vp->obj = o;
     vp->side = gather_side(gp, r);
-    vp->r = (float)(s * r->h.t * ang / (cs > 0.25 ? cs : 0.25));
+    vp->r = (float)(foot / (cs > 0.25 ? cs : 0.25));
     cobj[t] = o;
     /* on the inside of a closed sphere or box (as gi_particle_objects
      * marks particles): its rays end inside it */

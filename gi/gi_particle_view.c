@@ -360,8 +360,9 @@ pt_status gi_particle_prepare_view(gi_particle *gp, const scene_camera *c, int w
     J.h = h;
     J.max_level = gp->set.max_trace_level > 0 ? gp->set.max_trace_level : gp->sc->global.max_trace_level;
     if (J.max_level < 1) J.max_level = 1;
-    double sc = accel_eps_scale(gp->a);
-    J.eps = (sc > 0.0 && isfinite(sc) ? sc : 1.0) * 1e-6;
+    /* the render's tmin for camera rays (shade.c's scene_eps), so that its
+     * rays are these (gi_particle_primary_begin compares the two) */
+    J.eps = accel_surface_eps(gp->a);
     double c0 = timer_cpu_now();
     J.ch = NULL;
     J.rec = NULL;
