@@ -63,6 +63,8 @@ typedef struct {
     int gathers;           /* recursion_limit: gathering steps from the eye */
     int eye_levels;        /* eye rays: levels 0 .. eye_levels - 1 (max_trace_level, radrules.h rule 7) */
     int gather_specular;   /* specular bounces after a gather hit within the level limit */
+    vec3 pcentre;          /* the sphere the photons of parallel lights and the sky are aimed across */
+    double pradius;        /* (pm_photon.c setup: the finite geometry's bounds) */
 } fg_ctx;
 
 static inline rgb frgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
@@ -186,6 +188,37 @@ static rgb global_irradiance(const fg_ctx *c, vec3 p, vec3 n, uint32_t surf, int
     return e;
 }
 
+static rgb gather_hit(const fg_ctx *c, const shade_mat_bsdf *b, uint32_t surf, int level, int ng, int thread, rng *r,
+                      pm_counts *cnt);
+
+/* Irradiance at a gather hit beyond the photons' sphere (an infinite
+ * ground far from the finite objects), where the sky's and parallel
+ * lights' photons never land: one cosine-weighted ray about axis from org
+ * estimates what the map would hold there, pi times the sky's radiance
+ * where it leaves the scene, else the reflected radiance of what it hits
+ * (its direct light, and its own gathering within recursion_limit;
+ * emitters are sampled at the hit itself, so their emission is not
+ * counted), times brightness for the gathering at the hit, as the map's
+ * photons carry it (pm_photon.c). */
+static rgb far_irradiance(const fg_ctx *c, const shade_mat_bsdf *b, vec3 axis, vec3 org, int ng, int thread, rng *r,
+                          pm_counts *cnt)
+{
+    vec3 w = v3_cosine_dir(axis, rng_f64(r), rng_f64(r));
+    const double k = M_PI * c->rr.brightness;
+    cnt->bsdf++;
+    accel_hit h;
+    if (accel_intersect_past(c->a, &b->from, org, w, c->eps, OBJ_NO_RADIOSITY, &h, NULL) <= 0) {
+        rgb sky = pm_sky(c->sc, w);
+        return frgb(k * sky.r, k * sky.g, k * sky.b);
+    }
+    rgb fa = shade_tex_leaving_fade(&h, w, 0);
+    shade_mat_bsdf b2;
+    shade_mat_setup(&b2, c->sc, &h, w, c->eps, accel_eps_scale(c->a), r);
+    b2.gathered = 1;
+    rgb v = gather_hit(c, &b2, pm_surface_key(h.obj, b2.entering), 0, ng + 1, thread, r, cnt);
+    return frgb(k * fa.r * v.r, k * fa.g * v.g, k * fa.b * v.b);
+}
+
 /* Reflected radiance at a gather hit (not its emission); surf: the key of
  * the side the gather ray arrived at (pm_surface_key); ng: the gathering
  * steps taken to reach it (1 for the hit of a gather ray from the eye). */
@@ -217,12 +250,15 @@ static rgb gather_hit(const fg_ctx *c, const shade_mat_bsdf *b, uint32_t surf, i
         L.r += d.r * br;
         L.g += d.g * br;
         L.b += d.b * br;
+        const int beyond = v3_len(v3_sub(b->p, c->pcentre)) > c->pradius;
         if (b->m[SHADE_MAT_LOBE_DIFFUSE] > 0.0) {
-            rgb e = global_irradiance(c, b->p, b->n, surf, thread, &cnt->shadow);
+            rgb e = beyond ? far_irradiance(c, b, b->n, b->p_out, ng, thread, r, cnt)
+                           : global_irradiance(c, b->p, b->n, surf, thread, &cnt->shadow);
             acc_add(&L, b->k[SHADE_MAT_LOBE_DIFFUSE], frgb(e.r / M_PI, e.g / M_PI, e.b / M_PI));
         }
         if (b->m[SHADE_MAT_LOBE_BACK] > 0.0) {
-            rgb e = global_irradiance(c, b->p, v3_neg(b->n), surf ^ 1u, thread, &cnt->shadow);
+            rgb e = beyond ? far_irradiance(c, b, v3_neg(b->n), b->p_in, ng, thread, r, cnt)
+                           : global_irradiance(c, b->p, v3_neg(b->n), surf ^ 1u, thread, &cnt->shadow);
             acc_add(&L, b->k[SHADE_MAT_LOBE_BACK], frgb(e.r / M_PI, e.g / M_PI, e.b / M_PI));
         }
     }
@@ -493,6 +529,13 @@ static pt_status fg_run(const pm_job *j, const void *settings)
     fg_ctx c = {.sc = sc, .a = a, .s = s, .L = L, .eps = pm_lights_eps(L), .rr = radrules_of(sc, 1),
                 .eye_levels = radrules_level_limit(sc, 0)};
     c.gathers = pm_gathers(&c.rr);
+    {
+        /* the photons' sphere, as pm_photon.c's setup takes it */
+        vec3 lo, hi;
+        accel_bounds(a, &lo, &hi);
+        c.pcentre = v3_scale(v3_add(lo, hi), 0.5);
+        c.pradius = 0.5 * v3_len(v3_sub(hi, lo)) * 1.01 + 1e-9;
+    }
     /* a gather ray is at level g1, its hit's specular rays at g1 + 1, ... */
     const int g1 = radrules_gather_level(1);
     c.gather_specular = radrules_level_limit(sc, g1) - g1 - 1;
