@@ -617,6 +617,33 @@ static double fb_avg(const framebuffer *fb)
     return s / (fb->width * fb->height * 3);
 }
 
+/* Path (pspp samples a pixel, seed pseed) into fp and pmfg (fspp samples,
+ * seed fseed, `photons` photon paths, fg_rays gather rays, 0 its default)
+ * into fg, both fp's size. */
+static void render_path_fg(const scene *sc, const accel *a, framebuffer *fp, int pspp, uint64_t pseed, framebuffer *fg,
+                           int fspp, uint64_t fseed, long photons, int fg_rays)
+{
+    pm_stats st;
+    pm_path_settings ps;
+    pm_path_default_settings(&ps);
+    ps.c.width = fp->width;
+    ps.c.height = fp->height;
+    ps.c.threads = THREADS;
+    ps.c.spp = pspp;
+    ps.c.seed = pseed;
+    assert_int_equal(pm_path_render(sc, a, &ps, fp, &st, NULL), PT_OK);
+    pm_fg_settings fs;
+    pm_fg_default_settings(&fs);
+    fs.c.width = fg->width;
+    fs.c.height = fg->height;
+    fs.c.threads = THREADS;
+    fs.c.spp = fspp;
+    fs.c.seed = fseed;
+    fs.photons = photons;
+    if (fg_rays > 0) fs.fg_rays = fg_rays;
+    assert_int_equal(pm_fg_render(sc, a, &fs, fg, &st, NULL), PT_OK);
+}
+
 static void test_light_group(void **state)
 {
     (void)state;
@@ -632,8 +659,6 @@ static void test_light_group(void **state)
     int w = 32, h = 24;
     framebuffer *ref = fb_new(w, h), *fb = fb_new(w, h);
     render_direct_pair(sc, a, w, h, ref, fb);
-    pm_path_settings ps;
-    pm_stats st;
     double maxdiff = 0.0, maxval = 0.0;
     for (int i = 0; i < w * h * 3; i++) {
         maxdiff = fmax(maxdiff, fabs(fb->rgb[i] - ref->rgb[i]));
@@ -658,21 +683,7 @@ static void test_light_group(void **state)
         a = build(sc);
         enum { S = 16 };
         framebuffer *f0 = fb_new(S, S), *f1 = fb_new(S, S);
-        pm_path_default_settings(&ps);
-        ps.c.width = ps.c.height = S;
-        ps.c.threads = THREADS;
-        ps.c.spp = 16;
-        ps.c.seed = 5;
-        assert_int_equal(pm_path_render(sc, a, &ps, f0, &st, NULL), PT_OK);
-        pm_fg_settings fs;
-        pm_fg_default_settings(&fs);
-        fs.c.width = fs.c.height = S;
-        fs.c.threads = THREADS;
-        fs.c.spp = 4;
-        fs.c.seed = 11;
-        fs.photons = 60000;
-        fs.fg_rays = 512;
-        assert_int_equal(pm_fg_render(sc, a, &fs, f1, &st, NULL), PT_OK);
+        render_path_fg(sc, a, f0, 16, 5, f1, 4, 11, 60000, 512);
         mean[with][0] = fb_avg(f0);
         mean[with][1] = fb_avg(f1);
         fb_free(f0);
@@ -716,20 +727,7 @@ static void test_interior_fade(void **state)
         accel *a = build(sc);
         enum { S = 33 };
         framebuffer *fb[2] = {fb_new(S, S), fb_new(S, S)};
-        pm_stats st;
-        pm_path_settings ps;
-        pm_path_default_settings(&ps);
-        ps.c.width = ps.c.height = S;
-        ps.c.threads = THREADS;
-        ps.c.spp = 1;
-        assert_int_equal(pm_path_render(sc, a, &ps, fb[0], &st, NULL), PT_OK);
-        pm_fg_settings fs;
-        pm_fg_default_settings(&fs);
-        fs.c.width = fs.c.height = S;
-        fs.c.threads = THREADS;
-        fs.c.spp = 1;
-        fs.photons = 1000;
-        assert_int_equal(pm_fg_render(sc, a, &fs, fb[1], &st, NULL), PT_OK);
+        render_path_fg(sc, a, fb[0], 1, 1, fb[1], 1, 1, 1000, 0);
         for (int ch = 0; ch < 3; ch++) {
             double want = k == 0 ? exp(-(1.0 - c[ch]) * d / fd) : c[ch] + (1.0 - c[ch]) / (1.0 + (d / fd) * (d / fd));
             for (int m = 0; m < 2; m++) {
@@ -766,22 +764,7 @@ static void test_beyond_photons(void **state)
     accel *a = build(sc);
     enum { S = 16 };
     framebuffer *fp = fb_new(S, S), *fg = fb_new(S, S);
-    pm_stats st;
-    pm_path_settings ps;
-    pm_path_default_settings(&ps);
-    ps.c.width = ps.c.height = S;
-    ps.c.threads = THREADS;
-    ps.c.spp = 1024;
-    ps.c.seed = 3;
-    assert_int_equal(pm_path_render(sc, a, &ps, fp, &st, NULL), PT_OK);
-    pm_fg_settings fs;
-    pm_fg_default_settings(&fs);
-    fs.c.width = fs.c.height = S;
-    fs.c.threads = THREADS;
-    fs.c.spp = 4;
-    fs.c.seed = 7;
-    fs.photons = 100000;
-    assert_int_equal(pm_fg_render(sc, a, &fs, fg, &st, NULL), PT_OK);
+    render_path_fg(sc, a, fp, 1024, 3, fg, 4, 7, 100000, 0);
     double mp = fb_avg(fp), mg = fb_avg(fg);
     printf("wall on an infinite floor under a sky: pmfg mean %.5f, path %.5f (%+.2f%%, tol 2%%)\n", mg, mp,
            100.0 * (mg / mp - 1.0));
