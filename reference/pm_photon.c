@@ -244,6 +244,12 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
     double u3 = rng_f64(r), u4 = rng_f64(r);
     *o = disc_point(v3_madd(c->centre, wd, -R * 1.001), wd, R, u3, u4);
     *w = wd;
+    /* The disc lies at a finite distance, within reach of infinite objects
+     * (above a ground plane that the sky below the horizon lies behind): a
+     * photon whose way back towards the sky meets something carries no sky
+     * light (counted, not traced), as a path's ray towards it sees that
+     * object and not the sky. */
+    if (accel_intersect_past(c->a, NULL, *o, v3_neg(wd), c->eps, OBJ_NO_RADIOSITY | PHOTON_SKIP, h, rays) > 0) return 0;
     if (accel_intersect_past(c->a, NULL, *o, wd, c->eps, OBJ_NO_RADIOSITY | PHOTON_SKIP, h, rays) <= 0) return 0;
     /* it arrives from the sky in direction -wd */
     rgb bg = pm_sky(c->sc, v3_neg(wd));
