@@ -69,11 +69,16 @@ static vec3 view_normal(const gi_particle *gp, const view_rec *r) { return hit_n
  * POV-Ray gathers a surface's back side for its diffuse_back as it
  * gathers the front, trace.cpp ComputeLightedTexture's second
  * ComputeAmbient about the reversed normal). */
+static const scene_finish *kept_finish(const gi_particle *gp, const view_rec *r)
+{
+    if (r->kind != 2 || !r->h.obj) return NULL;
+    return r->h.texture ? &r->h.texture->finish : &gp->sc->default_texture.finish;
+}
+
 static int gathers(const gi_particle *gp, const view_rec *r)
 {
-    if (r->kind != 2 || !r->h.obj) return 0;
-    const scene_texture *t = r->h.texture ? r->h.texture : &gp->sc->default_texture;
-    return t->finish.diffuse > 0.0 && (!gp->vg->back || t->finish.diffuse_back != 0.0);
+    const scene_finish *f = kept_finish(gp, r);
+    return f && f->diffuse > 0.0 && (!gp->vg->back || f->diffuse_back != 0.0);
 }
 
 /* May pixel j take pixel i's gather? (vg_nrm: their view_normal) */
@@ -722,10 +727,8 @@ done:
 static int any_back(const gi_particle *gp)
 {
     for (size_t i = 0, npix = (size_t)gp->vw * (size_t)gp->vh; i < npix; i++) {
-        const view_rec *r = &gp->vrec[i];
-        if (r->kind != 2 || !r->h.obj) continue;
-        const scene_texture *t = r->h.texture ? r->h.texture : &gp->sc->default_texture;
-        if (t->finish.diffuse > 0.0 && t->finish.diffuse_back != 0.0) return 1;
+        const scene_finish *f = kept_finish(gp, &gp->vrec[i]);
+        if (f && f->diffuse > 0.0 && f->diffuse_back != 0.0) return 1;
     }
     return 0;
 }

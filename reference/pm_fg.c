@@ -63,8 +63,8 @@ typedef struct {
     int gathers;           /* recursion_limit: gathering steps from the eye */
     int eye_levels;        /* eye rays: levels 0 .. eye_levels - 1 (max_trace_level, radrules.h rule 7) */
     int gather_specular;   /* specular bounces after a gather hit within the level limit */
-    vec3 pcentre;          /* the sphere the photons of parallel lights and the sky are aimed across */
-    double pradius;        /* (pm_photon.c setup: the finite geometry's bounds) */
+    vec3 pcentre;          /* the photons' sphere (pm_photon_result's centre, radius) */
+    double pradius;
 } fg_ctx;
 
 static inline rgb frgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
@@ -529,13 +529,6 @@ static pt_status fg_run(const pm_job *j, const void *settings)
     fg_ctx c = {.sc = sc, .a = a, .s = s, .L = L, .eps = pm_lights_eps(L), .rr = radrules_of(sc, 1),
                 .eye_levels = radrules_level_limit(sc, 0)};
     c.gathers = pm_gathers(&c.rr);
-    {
-        /* the photons' sphere, as pm_photon.c's setup takes it */
-        vec3 lo, hi;
-        accel_bounds(a, &lo, &hi);
-        c.pcentre = v3_scale(v3_add(lo, hi), 0.5);
-        c.pradius = 0.5 * v3_len(v3_sub(hi, lo)) * 1.01 + 1e-9;
-    }
     /* a gather ray is at level g1, its hit's specular rays at g1 + 1, ... */
     const int g1 = radrules_gather_level(1);
     c.gather_specular = radrules_level_limit(sc, g1) - g1 - 1;
@@ -568,6 +561,8 @@ static pt_status fg_run(const pm_job *j, const void *settings)
         free(c.scratch);
         return status;
     }
+    c.pcentre = pr.centre;
+    c.pradius = pr.radius;
     st->photons_emitted = pr.emitted;
     st->photons_global = pr.nglobal;
     st->photons_caustic = pr.ncaustic;

@@ -526,7 +526,10 @@ pt_status pm_photons_trace(const scene *sc, const accel *a, const pm_lights *L, 
     memset(out, 0, sizeof *out);
     trace_ctx c;
     pt_status st = setup(&c, sc, a, L, s, NULL, &out->sources, &out->targets);
-    if (st != PT_OK || !c.src) return st;
+    if (st != PT_OK) return st;
+    out->centre = c.centre;
+    out->radius = c.radius;
+    if (!c.src) return st;
     source *src = c.src;
     long total = c.total;
     c.nchunks = (int)((total + CHUNK - 1) / CHUNK);

@@ -70,6 +70,8 @@ typedef struct {
     long dropped;        /* photons not stored: the memory cap on stored photons was reached */
     int sources;
     int targets;         /* some object has photons { target } */
+    vec3 centre;         /* the sphere the background's and parallel lights' photons are aimed across */
+    double radius;       /* (the finite geometry's bounds): beyond it they never land */
 } pm_photon_result;
 
 /* Trace. The arrays in `out` are malloc'd (ownership passes to the caller,
