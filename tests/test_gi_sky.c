@@ -714,8 +714,8 @@ void test_closed_room_gather(void **state)
  * view factor of the half-plane from a point u = -x in from its edge,
  * 1/2 + u / (2 sqrt(u^2 + h^2)) (a differential area to a parallel
  * half-plane). Pixels 0.25 or more from the shadow's edge: mean within 1%,
- * every one within 3%. The back side's light once came from the particles
- * there, smoothed over their spacing: mean 1.8% high, up to 30% off. */
+ * every one within 3%. Taken from the particles there, the back side's
+ * light is smoothed over their spacing and fails both bounds. */
 static double expect_back_sheet(const accel_hit *h, vec3 n, const void *ctx)
 {
     (void)n;
@@ -784,7 +784,7 @@ static void back_sheet_case(const char *what, const char *camera)
 /* The same under a perspective and an orthographic camera (whose rays are
  * parallel: the points' reach is the distance between neighbouring rays,
  * not the angle between them, which is 0; with that reach no hit between
- * the kept ones met a point, and they were 30% off). */
+ * the kept ones meets a point). */
 void test_diffuse_back_gather(void **state)
 {
     (void)state;

@@ -707,7 +707,7 @@ static void test_light_group(void **state)
  * it, in front of a white background) shows the fade's closed form
  * (transmit.h): exp(-(1 - c) d / fade_distance) for fade_power 1001, c +
  * (1 - c) / (1 + (d / fade_distance)^2) for fade_power 2; within 1e-4.
- * Before, the references ignored the fade: the pixel was 1. */
+ * Without the fade the pixel is the background's 1. */
 static void test_interior_fade(void **state)
 {
     (void)state;
@@ -751,7 +751,7 @@ static void test_interior_fade(void **state)
  * holds none. A white wall (1 x 1) standing on such a floor under a
  * uniform sky, recursion_limit 2, seen face on: half its light is the
  * floor's, gathered there. pmfg's image mean within 2% of the path
- * tracer's (1024 spp); reading the empty map there made it 32% dark. */
+ * tracer's (1024 spp); reading the empty map there leaves that light out. */
 static void test_beyond_photons(void **state)
 {
     (void)state;
@@ -782,8 +782,8 @@ static void test_beyond_photons(void **state)
  * floating over a white floor under a uniform sky, recursion_limit 2, the
  * camera low: the floor's bottom quarter of the image (where the panel's
  * underside is in view) within 2% between pmfg and the path tracer (256
- * spp). Before, those photons lit the panel's underside from below and
- * that floor read 9% bright. */
+ * spp). Those photons, if traced, light the panel's underside from below
+ * and that floor reads bright. */
 static void test_sky_below_horizon(void **state)
 {
     (void)state;
