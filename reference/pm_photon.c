@@ -67,7 +67,8 @@ typedef struct {
     const scene_light *l;
     double power;      /* allocation proxy only */
     long n, first;     /* photons of this source: [first, first + n) */
-    double cos_max;    /* cone of directions (point-like lights) */
+    double cos_max;    /* cone of directions (point-like lights) about axis */
+    vec3 axis;
 } source;
 
 typedef struct {
@@ -204,9 +205,8 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
          * (photons.cpp: the area only with the light's photons { area_light }),
          * and so does the direct light its gathering rays see (radrules.h) */
         vec3 q = l->position;
-        vec3 axis = v3(0, 0, 1);
+        vec3 axis = src->axis;
         double cos_max = src->cos_max;
-        if (l->kind == LIGHT_SPOT) axis = v3_norm(v3_sub(l->point_at, l->position));
         double u1 = rng_f64(r), u2 = rng_f64(r);
         *w = cone_dir(axis, cos_max, u1, u2);
         double pdf = 1.0 / (2.0 * M_PI * (1.0 - cos_max));
@@ -460,6 +460,7 @@ static pt_status setup(trace_ctx *cp, const scene *sc, const accel *a, const pm_
         q->kind = SRC_LIGHT;
         q->l = l;
         q->cos_max = -1.0;
+        q->axis = v3(0, 0, 1);
         double cm = cmax(l->colour);
         if (l->kind == LIGHT_CYLINDER) {
             q->power = cm * M_PI * M_PI * l->falloff * l->falloff;
@@ -469,8 +470,35 @@ static pt_status setup(trace_ctx *cp, const scene *sc, const accel *a, const pm_
             if (l->kind == LIGHT_SPOT) {
                 double cr = cos(l->radius * M_PI / 180.0), cf = cos(l->falloff * M_PI / 180.0);
                 q->cos_max = cr > 0.0 ? fmax(0.0, fmin(cf, cr)) : 0.0;
+                q->axis = v3_norm(v3_sub(l->point_at, l->position));
             }
-            q->power = cm * M_PI * 2.0 * M_PI * (1.0 - q->cos_max) * D * D * shade_light_fade(l, D);
+            /* A light outside the sphere around the finite objects (a sun
+             * placed far away, as POV-Ray scenes do) reaches them only
+             * within the cone that subtends the sphere: shot over all
+             * directions, nearly every photon would miss (a room lit
+             * through its window by such a light got almost none, and its
+             * second bounce was lost). Photons go into that cone when it is
+             * narrower than the spot's; directions outside it meet only
+             * infinite objects beyond the sphere, whose gather hits do not
+             * read the map (pm_fg.c, far_irradiance), as for parallel
+             * lights. Either cone holds every direction that matters, so
+             * the estimate stays unbiased inside the sphere. */
+            vec3 to = v3_sub(c.centre, l->position);
+            double dl = v3_len(to);
+            int aimed = 0;
+            if (dl > c.radius) {
+                double cs = sqrt(fmax(0.0, 1.0 - (c.radius / dl) * (c.radius / dl)));
+                if (cs > q->cos_max) {
+                    q->cos_max = cs;
+                    q->axis = v3_scale(to, 1.0 / dl);
+                    aimed = 1;
+                }
+            }
+            /* allocation proxy: the flux across the sphere's disc for an
+             * aimed light (E = pi C att over pi R^2), else over a sphere of
+             * radius D about the light */
+            q->power = aimed ? cm * M_PI * M_PI * c.radius * c.radius * shade_light_fade(l, dl)
+                             : cm * M_PI * 2.0 * M_PI * (1.0 - q->cos_max) * D * D * shade_light_fade(l, D);
         }
         if (q->power > 0.0 && isfinite(q->power)) ns++;
     }
