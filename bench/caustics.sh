@@ -17,12 +17,22 @@
 # both, partray's FLIP against POV-Ray's (how much of the row's FLIP is not
 # the caustics).
 #
+# In a scene with radiosity{} POV-Ray's default render and its 4x render
+# share their radiosity solution (same samples, same positions), so their
+# FLIP measures the photons alone while partray's also holds every
+# difference of its GI from that unconverged solution. Such a row is
+# followed by a second comparison against POV-Ray at 4x the photons and
+# with converged radiosity (the 4x scene through `partray crosscheck
+# --converged`: its radiosity block at 4x the count and 0.4x the
+# error_bound, cached in XC_CACHE as gi_vs_povray.sh's are; a render over
+# REF_TIMEOUT is not made and the line says so).
+#
 # usage: bench/caustics.sh [SIZE] [THREADS] [REF_TIMEOUT] [SCENE...]
 #   SIZE default 160x120, THREADS 2, REF_TIMEOUT 1200 s (a 4x render that
 #   takes longer is not made; the line says so and POV-Ray's default render
 #   is the reference). Scenes relative to the examples directory, default
-#   the 7 with photons{}. PARTRAY, BENCH_CAUSTICS, CAUSTICS_CACHE override
-#   the binaries and the reference cache.
+#   the 7 with photons{}. PARTRAY, BENCH_CAUSTICS, CAUSTICS_CACHE, XC_CACHE
+#   override the binaries and the reference caches.
 set -u
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 PARTRAY=${PARTRAY:-$ROOT/build/partray}
@@ -33,6 +43,7 @@ RTIMEOUT=${3:-1200}
 [ $# -gt 3 ] && shift 3 || set --
 EX=/usr/share/doc/povray/examples
 CACHE=${CAUSTICS_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/partray/caustics}
+XC_CACHE=${XC_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/partray/crosscheck}
 W=${SIZE%x*}; H=${SIZE#*x}
 if [ $# -eq 0 ]; then
     set -- lights/phot_met_glass.pov lights/glassthing.pov advanced/optics.pov advanced/grenadine/grenadine.pov \
@@ -134,6 +145,28 @@ print("RATIO %.6f" % (tt / tp if tp > 0 else 1), file=sys.stderr)
         "$PARTRAY" compare "$work/${stem}_off_pov.png" "$work/${stem}_off_pt.png" --json 2>/dev/null | python3 -c '
 import json, sys
 print("  without photons (both renderers): FLIP partray vs POV-Ray %.4f" % json.load(sys.stdin)["flip"]["mean"])'
+    fi
+    # partray's default mode is particle GI exactly when the scene has radiosity{}
+    gi=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1])).get("gi", ""))' "$work/${stem}.json" 2>/dev/null)
+    if [ "$gi" = particle ] && [ "$(photons_edit 4x "$work/$base" "$work/${stem}_4x.pov")" = ok ]; then
+        xj=$(cd "$work" && "$PARTRAY" crosscheck "${stem}_4x.pov" --size "$SIZE" +A0.3 --threads "$THREADS" --converged \
+             --cache "$XC_CACHE" --converged-timeout "$RTIMEOUT" --json --quiet 2>/dev/null)
+        conv=$(printf '%s\n' "$xj" | python3 -c 'import json, sys
+try: c = json.load(sys.stdin).get("converged", {})
+except Exception: c = {}
+print(c.get("image", "") if c.get("made") else "")')
+        if [ -n "$conv" ]; then
+            fpc=$("$PARTRAY" compare "$conv" "$work/${stem}_pov.png" --json 2>/dev/null)
+            ftc=$("$PARTRAY" compare "$conv" "$work/${stem}_pt.png" --json 2>/dev/null)
+            python3 -c '
+import json, sys
+p, t = json.loads(sys.argv[1]), json.loads(sys.argv[2])
+lum = lambda j: j["luminance"]["test"] / j["luminance"]["reference"] if j["luminance"]["reference"] > 0 else 0
+print("  vs POV-Ray at 4x photons, converged radiosity: lum POV-Ray %.4f partray %.4f, FLIP POV-Ray %.4f partray %.4f  %s" %
+      (lum(p), lum(t), p["flip"]["mean"], t["flip"]["mean"], "ok" if t["flip"]["mean"] <= p["flip"]["mean"] else "NO"))' "$fpc" "$ftc"
+        else
+            echo "  vs POV-Ray at 4x photons, converged radiosity: not made (over ${RTIMEOUT} s)"
+        fi
     fi
     (cd "$work" && "$BENCH" "$base" --size "$SIZE" --threads "$THREADS" --reps 3 > "$TMP/${stem}.bench" 2>&1)
 done
