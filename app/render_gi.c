@@ -130,18 +130,21 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     r->has_particle = 1;
     gi_particle_set_cancel(gp, o->cancel);
     gi_particle_set_progress(gp, o->progress);
-    if (!o->reuse || o->relight) {
+    /* the caustic layer of the scene's photons{} (caustics.h), first: the
+     * lighting stage takes its photons as light at the particles (POV-Ray's
+     * radiosity sees photons), and the render shows it */
+    t0 = timer_now();
+    st = caustics_build(&r->caus, sc, a, o->width, o->height, o->threads, o->seed, o->cl_device, o->cl_max_bytes,
+                        o->photon_scale, o->photon_roulette, o->cancel, d);
+    r->t_gi_lighting = timer_now() - t0;
+    /* this frame's layer: the lighting stage and the view's gathers read
+     * its photons until the render ends (cleared below) */
+    gi_particle_set_caustic(gp, r->caus.layer);
+    if (st == PT_OK && (!o->reuse || o->relight)) {
         t0 = timer_now();
         st = o->reuse ? gi_particle_relight(gp, d) : gi_particle_light(gp, d);
-        r->t_gi_lighting = timer_now() - t0;
+        r->t_gi_lighting += timer_now() - t0;
         r->ran_lighting = 1;
-    }
-    if (st == PT_OK) {
-        /* the caustic layer of the scene's photons{} (caustics.h) */
-        double tc = timer_now();
-        st = caustics_build(&r->caus, sc, a, o->width, o->height, o->threads, o->seed, o->cl_device, o->cl_max_bytes,
-                            o->photon_scale, o->photon_roulette, o->cancel, d);
-        r->t_gi_lighting += timer_now() - tc;
     }
     if (st == PT_OK) {
         shade_settings ss;
@@ -173,6 +176,7 @@ static pt_status render_particle(const scene *sc, const accel *a, const render_g
     }
     r->particle = *gi_particle_get_stats(gp);
     gi_particle_set_progress(gp, NULL); /* o->progress ends with this render */
+    gi_particle_set_caustic(gp, NULL);  /* and the caustic layer (freed with the result) */
     if (o->keep && st == PT_OK) r->kept = gp;
     else if (!o->reuse) gi_particle_free(gp);
     return st;
@@ -541,6 +545,8 @@ void render_gi_json(const render_gi_result *r, int mode, stats_json *js)
         /* the hook's lookups: all, without particles, estimated at the hit */
         STATS_INTS(js, p, lookups, lookups_none, lookups_gathered, lookups_gathered_here, view_gathers, view_gather_rays, lookups_onthefly, skipped_objects, discarded);
         STATS_NUMS(js, p, spacing, radius);
+        /* flux into the particles (grey): from the lights and the caustic photons, of it the photons' */
+        STATS_NUMS(js, p, flux_direct, flux_caustic);
         STATS_INTS(js, p, bytes_total);
         stats_obj_begin(js, "timings");
         STATS_NUMS_PRE(js, p, t_, kernel_build, surfaces, sampling, scatter_links, gather_links, lists, visibility,

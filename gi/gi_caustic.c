@@ -1429,9 +1429,17 @@ rgb gi_caustic_at(void *ctx, const accel_hit *h, vec3 n, int thread)
     }
     /* elsewhere: the same photon volumes, summed at p */
     __atomic_fetch_add(&c->st.lookups_photons, 1, __ATOMIC_RELAXED);
-    float s[3] = {(float)p.x, (float)p.y, (float)p.z}, nn[3] = {(float)n.x, (float)n.y, (float)n.z}, acc[3] = {0, 0, 0};
     double back = 0.0;
     float b = c->hk.brilliance ? (float)c->hk.brilliance(c->hk.ctx, h, v3_neg(n), &back) : 1.0f;
+    return gi_caustic_world_at(c, p, n, b, back);
+}
+
+rgb gi_caustic_world_at(const gi_caustic *c, vec3 p, vec3 n, double brilliance, double back)
+{
+    if (!c) return crgb(0, 0, 0);
+    long lo, hi;
+    float s[3] = {(float)p.x, (float)p.y, (float)p.z}, nn[3] = {(float)n.x, (float)n.y, (float)n.z}, acc[3] = {0, 0, 0};
+    float b = (float)brilliance;
     for (const hgrid *gl = &c->pgrid; gl; gl = gl->up) {
         hgrid_cell(gl, cidx(p.x, gl->cell), cidx(p.y, gl->cell), cidx(p.z, gl->cell), &lo, &hi);
         for (long q = lo; q < hi; q++) {

@@ -211,6 +211,13 @@ void gi_caustic_get_stats(const gi_caustic *c, gi_caustic_stats *st);
  * layer at hit h, n facing the viewer; shade_indirect_fn-compatible with c
  * as the context. Thread-safe. */
 rgb gi_caustic_at(void *c, const accel_hit *h, vec3 n, int thread);
+/* The photon volumes' sum at point p alone (gi_caustic_at's answer away
+ * from the G-buffer), n the side's normal, brilliance and back (B / A of
+ * diffuse_back: the weight of photons arriving on the other side) of the
+ * surface there; E/pi. Any point, not only one the camera sees: the
+ * particle GI takes the caustics' light into its bounces with it. The
+ * caller checks photons { collect off }. Thread-safe. */
+rgb gi_caustic_world_at(const gi_caustic *c, vec3 p, vec3 n, double brilliance, double back);
 /* Every stored photon (on receivers and on highlight-only surfaces alike)
  * whose volume holds hit h's point and that arrives on the side of n (n
  * facing the viewer), unless h's object has photons { collect off }: fn

@@ -101,6 +101,7 @@ struct gi_dev {
     float *edir_host, *phi_host;
     int stale;
     int vis_ok; /* the device's vis holds the last call's (OpenCL) */
+    int had_extra; /* the last lighting stage had extra light (gi_dev_lighting) */
     /* C build scratch */
     float *edir, *src, *bin, *bout, *total;
     unsigned *mask_src, *mask_a, *mask_b; /* source masks (gi_k_emit, gi_k_bounce) */
@@ -116,8 +117,10 @@ struct gi_dev {
     cl_mem b_rin_off, b_rin_src, b_bin, b_bout, b_total, b_woff, b_went;
     cl_mem b_emits, b_mask_src, b_mask_a, b_mask_b, b_cin_off, b_cin_src;
     cl_mem b_enew, b_dsum; /* gi_k_emit's edir (swapped with b_edir when a stage completes), direct sums */
+    cl_mem b_extra;        /* gi_k_emit's extra E/pi (caustic photons), 4 floats per particle */
     cl_mem b_cph, b_ctoff, b_ctidx, b_cpix, b_ce; /* gi_k_caustic_splat's photons, tile lists, G-buffer, output */
     size_t sz_cph, sz_ctoff, sz_ctidx, sz_cpix, sz_ce;
+    size_t sz_extra;
     size_t sz_lights, sz_vis, sz_tally, sz_list, sz_vout, sz_woff, sz_went, sz_cin_off, sz_cin_src;
     cl_mem b_vpts, b_vnodes, b_vtabs, b_vres, b_visits; /* gi_dev_vpl_gather */
     size_t sz_vpts, sz_vnodes, sz_vtabs, sz_vres, sz_visits;
@@ -380,7 +383,7 @@ static void release_buffers(gi_dev *dv)
                     &dv->b_eind, &dv->b_list, &dv->b_vout, &dv->b_rin_off, &dv->b_rin_src, &dv->b_bin,
                     &dv->b_bout, &dv->b_total, &dv->b_woff, &dv->b_went,
                     &dv->b_emits, &dv->b_mask_src, &dv->b_mask_a, &dv->b_mask_b, &dv->b_cin_off,
-                    &dv->b_cin_src, &dv->b_enew, &dv->b_dsum, &dv->b_vpts, &dv->b_vnodes, &dv->b_vtabs,
+                    &dv->b_cin_src, &dv->b_enew, &dv->b_dsum, &dv->b_extra, &dv->b_vpts, &dv->b_vnodes, &dv->b_vtabs,
                     &dv->b_vres, &dv->b_visits, &dv->b_cph, &dv->b_ctoff, &dv->b_ctidx, &dv->b_cpix, &dv->b_ce};
     for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) rel(ms[i]);
 }
@@ -647,7 +650,7 @@ pt_status gi_dev_set_particles(gi_dev *dv, const gi_dev_particle *part, int n, c
     /* a new geometry: drop every buffer and start the byte count again */
     release_buffers(dv);
     dv->sz_lights = dv->sz_vis = dv->sz_tally = dv->sz_list = dv->sz_vout = dv->sz_woff = dv->sz_went = 0;
-    dv->sz_cin_off = dv->sz_cin_src = 0;
+    dv->sz_cin_off = dv->sz_cin_src = dv->sz_extra = 0;
     dv->bytes = 0;
     /* the real count: with no particles the arrays may be NULL (buffers get a
      * minimal size, nothing is written) */
@@ -777,7 +780,8 @@ pt_status gi_dev_set_walk(gi_dev *dv, const int *woff, const gi_walk_entry *went
  * change, a frame relit with nothing moved) and reused while it stays. The
  * first stage after gi_dev_set_particles (every light traced, the sort a
  * small part of it) builds them at once. */
-static pt_status compact_sources(gi_dev *dv, const float *vis, int nlights, int vis_changed, diag *d)
+static pt_status compact_sources(gi_dev *dv, const float *vis, int nlights, int vis_changed, const float *extra,
+                                 diag *d)
 {
     int n = dv->n, ns2 = dv->ns2;
     size_t words = ((size_t)n + 31) / 32;
@@ -790,6 +794,9 @@ static pt_status compact_sources(gi_dev *dv, const float *vis, int nlights, int 
         for (int l = 0; l < nlights; l++) lit |= v[l] > 0.0f;
         if (lit) dv->cand_new[i >> 5] |= 1u << (i & 31);
     }
+    for (int i = 0; extra && i < n; i++)
+        if (extra[4 * (size_t)i] > 0.0f || extra[4 * (size_t)i + 1] > 0.0f || extra[4 * (size_t)i + 2] > 0.0f)
+            dv->cand_new[i >> 5] |= 1u << (i & 31);
     unsigned *t = dv->cand;
     dv->cand = dv->cand_new;
     dv->cand_new = t;
@@ -878,7 +885,7 @@ static void fill_sums(const gi_dev *dv, size_t eitems, int nb, const double *bou
 }
 
 pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, const float *vis, int vis_changed,
-                          int mode, int nb, volatile int *cancel, float *edir, float *lout, float *phi,
+                          const float *extra, int mode, int nb, volatile int *cancel, float *edir, float *lout, float *phi,
                           double *bounce_flux, gi_dev_sums *sums, int *done, double times[2], diag *d)
 {
     double t0 = timer_now(), t1 = t0;
@@ -912,14 +919,18 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
     /* the device's vis is the last call's only if that one uploaded it */
     if (dv->is_cl && !dv->vis_ok) vis_changed = 1;
 #endif
+    /* the extra light may differ from the last stage's: the sources' set
+     * is found again (compact_sources keeps its lists when it is the same) */
+    if (extra || dv->had_extra) vis_changed = 1;
+    dv->had_extra = extra != NULL;
     if (nb > 0) {
-        pt_status cs = compact_sources(dv, vis, nlights, vis_changed, d);
+        pt_status cs = compact_sources(dv, vis, nlights, vis_changed, extra, d);
         if (cs != PT_OK) return cs;
     }
     if (!dv->is_cl) {
         if (cancelled(cancel)) return PT_OK;
         gi_c_emit(dv->threads, dv->part, n, lights, nlights, vis, dv->emits, dv->edir, dv->src, dv->mask_src,
-                  dv->dsum);
+                  dv->dsum, extra);
         t1 = timer_now();
         const float *bin = dv->src;
         const unsigned *min = dv->mask_src;
@@ -974,9 +985,15 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
     }
     if ((st = ensure(dv, &dv->b_tally, &dv->sz_tally, tcount * sizeof(float), d)) != PT_OK) return st;
     /* emission into b_enew: b_edir keeps the last completed stage's (gi_dev_fetch) */
+    /* no extra light: a minimal buffer the kernel does not read */
+    if ((st = extra ? upload(dv, &dv->b_extra, &dv->sz_extra, extra, f4, d)
+                    : ensure(dv, &dv->b_extra, &dv->sz_extra, 16, d)) != PT_OK)
+        return st;
+    int has_extra = extra != NULL;
     karg a[] = {KMEM(dv->b_part),  KINT(n),          KMEM(dv->b_lights), KINT(nlights),        KMEM(dv->b_vis),
-                KMEM(dv->b_emits), KMEM(dv->b_enew), KMEM(dv->b_src),    KMEM(dv->b_mask_src), KMEM(dv->b_dsum)};
-    if ((st = run_kernel(dv, KE_EMIT, eitems, a, 10, d)) != PT_OK) return st;
+                KMEM(dv->b_emits), KMEM(dv->b_enew), KMEM(dv->b_src),    KMEM(dv->b_mask_src), KMEM(dv->b_dsum),
+                KMEM(dv->b_extra), KINT(has_extra)};
+    if ((st = run_kernel(dv, KE_EMIT, eitems, a, 12, d)) != PT_OK) return st;
     t1 = timer_now();
     cl_mem bin = dv->b_src, min = dv->b_mask_src;
     for (int b = 0; b < nbounce; b++) {

@@ -67,7 +67,9 @@ pt_status gi_dev_set_walk(gi_dev *dv, const int *woff, const gi_walk_entry *went
 
 /* Lighting stage (gi_lighting.cl): emission from the lights with vis
  * (n x nlights: attenuation times visibility fraction; vis_changed 0: the
- * same values as the previous call's, not uploaded again), nb scattering
+ * same values as the previous call's, not uploaded again) and extra (NULL
+ * or n*4 floats: E/pi arriving besides the lights', the caustic photons',
+ * treated as direct light), nb scattering
  * bounces (mode GI_SCATTER_WALK: the first along all links, then the walk
  * table; GI_SCATTER_FULL: all along all links), then the reflected
  * radiance. The host array lout (radiance, n*4 floats), bounce_flux (nb grey
@@ -88,7 +90,7 @@ typedef struct {
     long sources;     /* particles sending light in the first bounce */
 } gi_dev_sums;
 pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, const float *vis, int vis_changed,
-                          int mode, int nb, volatile int *cancel, float *edir, float *lout, float *phi,
+                          const float *extra, int mode, int nb, volatile int *cancel, float *edir, float *lout, float *phi,
                           double *bounce_flux, gi_dev_sums *sums, int *done, double times[2], diag *d);
 /* Writes the last completed lighting stage's edir and phi into the arrays
  * it was given (nothing when they are written already). d may be NULL. */

@@ -47,6 +47,8 @@ typedef struct {
     const float *vtabs;
     float vthr;
     int *visits;
+    const float *extra; /* gi_k_emit */
+    int has_extra;
 } c_launch;
 
 enum { K_EMIT, K_BOUNCE, K_WALK, K_RESOLVE, K_GATHER, K_ESTIMATE, K_VPL, K_CAUSTIC, K_BACK, K_BACK_SEND };
@@ -62,7 +64,7 @@ static void run_chunk(void *ctx, int chunk, int thread)
         switch (a->kernel) {
         case K_EMIT:
             gi_k_emit(a->part, a->np, a->lights, a->nlights, a->vis, a->emits, a->fout, a->fout2, a->mask_out,
-                      a->tally);
+                      a->tally, a->extra, a->has_extra);
             break;
         case K_BOUNCE:
             gi_k_bounce(a->np, a->off, a->obase, a->from, a->sbase, a->w_in, a->src, a->mask_in, a->rho4, a->first,
@@ -100,13 +102,14 @@ static void launch(int threads, c_launch *a)
 }
 
 void gi_c_emit(int threads, const gi_dev_particle *part, int n, const gi_dev_light *lights, int nlights,
-               const float *vis, const unsigned *emits, float *edir, float *src, unsigned *srcmask, float *dsum)
+               const float *vis, const unsigned *emits, float *edir, float *src, unsigned *srcmask, float *dsum,
+               const float *extra)
 {
     /* one work-item per GI_EMIT_CHUNK particles, 16 work-items per pool job */
     size_t items = ((size_t)n + GI_EMIT_CHUNK - 1) / GI_EMIT_CHUNK;
     c_launch a = {.kernel = K_EMIT, .n = items, .part = part, .np = n, .lights = lights, .nlights = nlights,
                   .vis = vis, .emits = emits, .fout = edir, .fout2 = src, .mask_out = srcmask, .tally = dsum,
-                  .chunk = 16};
+                  .extra = extra, .has_extra = extra != NULL, .chunk = 16};
     launch(threads, &a);
 }
 

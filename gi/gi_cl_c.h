@@ -9,9 +9,11 @@
 #include "kernels/gi_types.h"
 #include "kernels/gi_vpl_types.h"
 
-/* gi_k_emit: ceil(n / GI_EMIT_CHUNK) work-items, one srcmask word and dsum float each. */
+/* gi_k_emit: ceil(n / GI_EMIT_CHUNK) work-items, one srcmask word and dsum
+ * float each; extra: E/pi besides the lights', 4 floats per particle (NULL: none). */
 void gi_c_emit(int threads, const gi_dev_particle *part, int n, const gi_dev_light *lights, int nlights,
-               const float *vis, const unsigned *emits, float *edir, float *src, unsigned *srcmask, float *dsum);
+               const float *vis, const unsigned *emits, float *edir, float *src, unsigned *srcmask, float *dsum,
+               const float *extra);
 /* gi_k_bounce: ceil(n / GI_BOUNCE_CHUNK) work-items; tally gets 3 floats
  * per work-item from tbase. */
 void gi_c_bounce(int threads, int n, const int *off, int obase, const int *from, int sbase, float w_in,

@@ -5,6 +5,7 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
+#include "gi_caustic.h"
 #include "gi_particle_internal.h"
 #include "grow.h"
 #include "mirror.h"
@@ -44,6 +45,7 @@ typedef struct {
     float far_bounce;     /* brightness when the far field reflects the sky, else 0 */
     gi_dev_light *lights; /* the scene's, for the far field's direct light */
     int nlights;
+    const gi_caustic *caus; /* its photons' light at the hits, with the lights' (NULL: none) */
     int exact;            /* view points with no bounce after the hit: every hit takes hit_light */
     float *reach;         /* per source (i - first), 4 floats: the harmonic mean of its rays' hit
                              distances, the vector to their nearest hit */
@@ -272,6 +274,16 @@ static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, 
                 if (tmax > eps && accel_occluded_cached(J->a, last, org, v3(ds[0], ds[1], ds[2]), 0.0, tmax)) continue;
             }
             for (int c = 0; c < 3; c++) dir[c] += lt->colour[c] * att * (float)ci;
+        }
+        /* and the caustic photons there: POV-Ray's radiosity rays see
+         * photons at every hit (trace.cpp, ComputeLightedTexture) */
+        if (J->caus && !(o->photons && !o->photons->collect)) {
+            rgb e = gi_caustic_world_at(J->caus, p, n, 1.0, 0.0);
+            if (isfinite(e.r + e.g + e.b)) {
+                dir[0] += (float)e.r;
+                dir[1] += (float)e.g;
+                dir[2] += (float)e.b;
+            }
         }
     }
     if (!sky_term && !mt->glows && !mir && dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) return;
@@ -1020,10 +1032,10 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
                          gi_link_stats *st, volatile int *cancel, progress *prog,
                          const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce,
-                         float *reach, gi_link_conts *conts)
+                         float *reach, gi_link_conts *conts, const gi_caustic *caus)
 {
     if (threads <= 0) threads = pool_default_threads();
-    link_job J = {.sky = sky, .esky = sky && sc ? esky : NULL, .sc = sc, .pig = pig,
+    link_job J = {.sky = sky, .esky = sky && sc ? esky : NULL, .sc = sc, .pig = pig, .caus = caus,
                   .far_bounce = isfinite(far_bounce) && far_bounce > 0.0 ? (float)far_bounce : 0.0f};
     J.p = p;
     J.pobj = pobj;
@@ -1146,6 +1158,11 @@ int gi_gatherer_point(gi_gatherer *g, int thread, vec3 p, vec3 n, uint64_t strea
     for (int c = 0; c < 3; c++) e[c] = sky[c] / (float)J->k;
     if (reach) *reach = harmonic_reach(rh, J->k);
     return 1;
+}
+
+void gi_gatherer_set_caustic(gi_gatherer *g, const gi_caustic *caus)
+{
+    if (g) g->J.caus = caus;
 }
 
 void gi_gatherer_free(gi_gatherer *g)

@@ -78,12 +78,16 @@ typedef struct {
 } gi_link_conts;
 void gi_link_conts_free(gi_link_conts *c);
 
+/* caus (may be NULL): the caustic layer whose photons the final gather's
+ * hits add to the lights' direct light they reflect (POV-Ray's radiosity
+ * rays see photons). */
+struct gi_caustic;
 pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle *p, const void *const *pobj,
                          const unsigned char *pin, int n, int first, int nside, uint64_t seed, const gi_lookup *grid,
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
                          gi_link_stats *st, volatile int *cancel, progress *prog,
                          const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce,
-                         float *reach, gi_link_conts *conts);
+                         float *reach, gi_link_conts *conts, const struct gi_caustic *caus);
 
 /* conts (may be NULL; the final gather's points): where a continuation
  * of a point's ray ends on a surface with particles, the particle it ends
@@ -117,6 +121,9 @@ int gi_gatherer_point(gi_gatherer *g, int thread, vec3 p, vec3 n, uint64_t strea
  * sky-lit scene of diffuse surfaces): its points without a reach are then
  * answered by occlusion tests alone, the same answer for less time. */
 int gi_gatherer_dark(const gi_gatherer *g);
+/* The caustic layer whose photons its hits add to the lights' direct
+ * light (NULL: none); it must outlive the gatherer's use of it. */
+void gi_gatherer_set_caustic(gi_gatherer *g, const struct gi_caustic *caus);
 void gi_gatherer_free(gi_gatherer *g);
 
 /* Incoming links, a counting sort by target: the sources i < n in mask

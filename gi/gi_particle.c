@@ -260,7 +260,7 @@ static pt_status trace_and_prune(gi_particle *gp, gi_particles *ps, uint64_t see
     if (st == PT_OK)
         st = gi_links_build(gp->a, gp->lscene, ps->p, pobj, pin, n, 0, gp->set.scatter_side, seed, grid, gp->tl,
                             3.0 * ps->spacing, gp->threads, links, keep, ls, gp->set.cancel, gp->set.progress, NULL,
-                            NULL, NULL, NULL, 0.0, NULL, NULL);
+                            NULL, NULL, NULL, 0.0, NULL, NULL, NULL);
     gi_lookup_free(grid);
     free(pobj);
     free(pin);
@@ -730,7 +730,7 @@ gi_particle *gi_particle_build(const scene *sc, const accel *a, const gi_particl
             st = gi_links_build(a, gp->lscene, gp->ps.p, pobj, pin, n, 0, set->gather_side, set->seed ^ 0x6a7ULL, grid,
                                 gp->tl, 3.0 * spacing, gp->threads, gp->glink, NULL, &ls, set->cancel, set->progress,
                                 gp->sky, gp->esky, sc, set->pigment,
-                                set->bounces >= 1 ? set->brightness : 0.0, NULL, NULL);
+                                set->bounces >= 1 ? set->brightness : 0.0, NULL, NULL, NULL);
         S->t_gather_links = timer_now() - tg;
         S->c_gather_links = timer_cpu_now() - cg;
         gi_lookup_free(grid);
@@ -882,6 +882,7 @@ void gi_particle_free(gi_particle *gp)
     free(gp->vis_lights);
     free(gp->dirty);
     free(gp->edir);
+    free(gp->extra);
     free(gp->phi);
     free(gp->lout);
     free(gp->eind);

@@ -214,6 +214,7 @@ typedef struct {
     size_t bytes_view;      /* keep_hits: the kept hits' records (not in bytes_total) */
     long skipped_objects;
     double flux_direct, flux_emitted, flux_scattered; /* sums over particles (grey) */
+    double flux_caustic;    /* of flux_direct, what the caustic photons brought (gi_particle_set_caustic) */
     /* memory, bytes */
     size_t bytes_particles, bytes_links, bytes_lists, bytes_surfaces, bytes_device, bytes_cells, bytes_total;
     double spacing, tess, radius;
@@ -263,6 +264,12 @@ void gi_particle_set_cancel(gi_particle *gp, volatile int *cancel);
  * (settings.progress is the build's); NULL: nowhere. A GI kept across an
  * animation's frames reports to each frame's own. */
 void gi_particle_set_progress(gi_particle *gp, progress *p);
+/* The caustic layer whose photons the next lighting stages take as light
+ * arriving at the particles (NULL: none): POV-Ray's radiosity rays see the
+ * photons at every hit (trace.cpp, ComputeLightedTexture), so a caustic's
+ * light is bounced on as direct light is. It must outlive those stages. */
+struct gi_caustic;
+void gi_particle_set_caustic(gi_particle *gp, const struct gi_caustic *layer);
 /* Change n_b and the scattering mode; takes effect at the next
  * gi_particle_relight (no geometry work). */
 void gi_particle_set_scattering(gi_particle *gp, int bounces, int scatter);

@@ -95,6 +95,8 @@ struct gi_particle {
     int nbounce_flux;
     int lit;
     volatile int *cancel; /* gi_particle_set_cancel: non-zero stops the lighting stage */
+    const struct gi_caustic *caus; /* gi_particle_set_caustic: its photons are light at the particles */
+    float *extra;         /* their E/pi per particle (4 floats), filled by each lighting stage */
     /* view */
     float *eind;                 /* n*4: gathered E~/pi */
     atomic_uchar *e_state;       /* 0 none, 1 being computed, 2 done */

@@ -12,6 +12,7 @@
 #include "gi_cl_c.h"
 #include "gi_links.h"
 #include "gi_area_particles.h"
+#include "gi_caustic.h"
 #include "gi_radiance.h"
 #include "gi_surface.h"
 #include "pool.h"
@@ -202,6 +203,54 @@ static int same_geometry(const scene_light *a, const scene_light *b)
            a->fade_distance == b->fade_distance && a->fade_power == b->fade_power && a->shadowless == b->shadowless;
 }
 
+/* The caustic photons' E/pi at each particle (gi_caustic_world_at: the
+ * photon volumes that hold its point, arriving on its side; its twin's
+ * side is its twin's, gi_k_emit adds it through the back lobe), none on
+ * objects with photons { collect off }. */
+typedef struct {
+    gi_particle *gp;
+} caus_job;
+
+#define CAUS_CHUNK 1024
+
+static void caus_chunk(void *ctx, int ci, int thread)
+{
+    (void)thread;
+    caus_job *J = ctx;
+    gi_particle *gp = J->gp;
+    int i0 = ci * CAUS_CHUNK, i1 = i0 + CAUS_CHUNK < gp->ps.n ? i0 + CAUS_CHUNK : gp->ps.n;
+    for (int i = i0; i < i1; i++) {
+        const gi_dev_particle *p = &gp->ps.p[i];
+        const scene_object *o = gi_surface_object(gp->surf, gp->ps.patch[i]);
+        rgb e = {0, 0, 0};
+        if (o && !(o->photons && !o->photons->collect))
+            e = gi_caustic_world_at(gp->caus, v3(p->p[0], p->p[1], p->p[2]), v3(p->n[0], p->n[1], p->n[2]),
+                                    p->brilliance, 0.0);
+        float *x = &gp->extra[4 * (size_t)i];
+        x[0] = isfinite(e.r) && e.r > 0.0 ? (float)e.r : 0.0f;
+        x[1] = isfinite(e.g) && e.g > 0.0 ? (float)e.g : 0.0f;
+        x[2] = isfinite(e.b) && e.b > 0.0 ? (float)e.b : 0.0f;
+        x[3] = 0.0f;
+    }
+}
+
+/* Fills gp->extra from the caustic layer; NULL when there is none (or no
+ * photon reaches a particle). *flux: the light it brings (grey). */
+static const float *caustic_extra(gi_particle *gp, double *flux, pt_status *st)
+{
+    *flux = 0.0;
+    int n = gp->ps.n;
+    if (!gp->caus || n <= 0) return NULL;
+    if (!gp->extra && !(gp->extra = gi_particle_calloc((size_t)n * 4, sizeof(float), st))) return NULL;
+    caus_job J = {gp};
+    pool_run(gp->threads, (n + CAUS_CHUNK - 1) / CAUS_CHUNK, caus_chunk, &J);
+    double f = 0.0;
+    for (int i = 0; i < n; i++)
+        f += M_PI * gp->ps.p[i].area * (gp->extra[4 * (size_t)i] + gp->extra[4 * (size_t)i + 1] + gp->extra[4 * (size_t)i + 2]) / 3.0;
+    *flux = f;
+    return f > 0.0 ? gp->extra : NULL;
+}
+
 static void reset_view(gi_particle *gp)
 {
     /* no hook runs now (the stages are not run during a render): relaxed
@@ -284,8 +333,11 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
      * sums: no pass over the particles here. The device keeps edir and phi
      * until gi_particle_debug asks (gi_dev_fetch). */
     gi_dev_sums sums;
+    double fcaus = 0.0;
+    const float *extra = caustic_extra(gp, &fcaus, &st);
+    if (st != PT_OK) return st;
     progress_stage(gp->set.progress, "gi lighting: emit and scatter", 0);
-    st = gi_dev_lighting(gp->dev, gp->lights, gp->nlights, gp->vis, ndirty > 0,
+    st = gi_dev_lighting(gp->dev, gp->lights, gp->nlights, gp->vis, ndirty > 0, extra,
                          full ? GI_SCATTER_FULL : GI_SCATTER_WALK, nb, gp->cancel, gp->edir, gp->lout, gp->phi,
                          gp->bounce_flux, &sums, &done, kt, d);
     if (st != PT_OK) return st;
@@ -295,6 +347,7 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
     gp->nbounce_flux = nb;
     S->sources = sums.sources;
     S->flux_direct = sums.direct;
+    S->flux_caustic = fcaus;
     S->flux_emitted = sums.emitted;
     S->flux_scattered = sums.scattered;
     reset_view(gp);
@@ -317,6 +370,13 @@ pt_status gi_particle_relight(gi_particle *gp, diag *d) { return gi_particle_lig
 void gi_particle_set_cancel(gi_particle *gp, volatile int *cancel) { gp->cancel = cancel; }
 
 void gi_particle_set_progress(gi_particle *gp, progress *p) { gp->set.progress = p; }
+
+void gi_particle_set_caustic(gi_particle *gp, const gi_caustic *layer)
+{
+    gp->caus = layer;
+    /* the view's gatherers (hits no gathered point answers) see it too */
+    for (int v = 0; v < 2; v++) gi_gatherer_set_caustic(gp->vgs[v].gatherer, layer);
+}
 
 void gi_particle_set_scattering(gi_particle *gp, int bounces, int scatter)
 {

@@ -20,6 +20,8 @@
 #include "gi_cl_c.h"
 #include "pm_fg.h"
 #include "pm_path.h"
+#include "render_gi.h"
+#include "gi.h"
 #include "sdl.h"
 #include "test_world.h"
 
@@ -647,6 +649,75 @@ static double slab_mean(double y0, double y1, const char *extra, const char *box
  * layer's ratio must be that (tolerance 0.5%; photons that start with no
  * list give 1; docs/caustics.md, Transport, compares glassthing's room
  * with povray's image). */
+/* The caustics' light in particle GI's bounces (POV-Ray's radiosity rays
+ * see photons). A point light above a clear slab (ior 1, transmit 1, a
+ * photon target) over a white floor; a wall standing on the floor under
+ * the slab faces away from the light, so it is lit only by the floor. The
+ * camera sees the wall alone. The slab casts a full shadow (photons on)
+ * and its photons carry the light through it, unchanged: the wall must
+ * look as in the same scene without slab and photons, within 3% (the
+ * photon volumes' density estimate), with particles (recursion_limit 2)
+ * and with the final gather alone (recursion_limit 1). Without the
+ * photons' light at the particles, or at the gather's hits, the wall is
+ * black. */
+static const char *caustic_bounce_fmt =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1 radiosity { recursion_limit %d } %s }\n"
+    "camera { location <0, 1, 0> look_at <2, 1, 0> angle 40 }\n"
+    "light_source { <3, 10, 0> color rgb 1 }\n"
+    "box { <-2, -0.1, -2>, <3.5, 0, 2> pigment { rgb 1 } finish { ambient 0 diffuse 0.8 } }\n"
+    "box { <2, 0, -2>, <2.1, 1.9, 2> pigment { rgb 1 } finish { ambient 0 diffuse 0.8 } }\n"
+    "%s\n";
+
+/* Mean of partray's default particle render of the scene (32 x 24). */
+static double particle_mean(int rl, const char *photons, const char *slab, long *caustic_photons)
+{
+    char text[2048];
+    snprintf(text, sizeof text, caustic_bounce_fmt, rl, photons, slab);
+    tu_world w = tu_world_build("test.pov", text);
+    render_gi_opts o;
+    memset(&o, 0, sizeof o);
+    o.mode = GI_PARTICLE;
+    o.width = 32;
+    o.height = 24;
+    o.threads = THREADS;
+    o.seed = 1;
+    o.quality = 9;
+    o.cl_device = "c";
+    framebuffer *fb = fb_new(o.width, o.height);
+    render_gi_result r;
+    memset(&r, 0, sizeof r);
+    assert_int_equal(render_gi(w.s, w.a, &o, fb, &r, w.d), PT_OK);
+    *caustic_photons = r.caus.st.stored;
+    double m = 0.0;
+    for (int i = 0; i < o.width * o.height * 3; i++) m += fb->rgb[i];
+    m /= o.width * o.height * 3;
+    fb_free(fb);
+    tu_world_free(&w);
+    return m;
+}
+
+static void test_caustic_bounce(void **state)
+{
+    (void)state;
+    /* recursion_limit 2: the particles carry it; 1: no particles, the
+     * final gather's hits take it */
+    for (int rl = 2; rl >= 1; rl--) {
+        long n0 = 0, n1 = 0;
+        double open = particle_mean(rl, "", "", &n0);
+        double slab = particle_mean(rl, "photons { count 400000 }",
+                                    "box { <-2, 2, -2>, <3.5, 2.1, 2> pigment { rgbt <1, 1, 1, 1> } "
+                                    "finish { ambient 0 diffuse 0 } interior { ior 1 } photons { target refraction on } }",
+                                    &n1);
+        printf("recursion_limit %d: wall lit by a floor that photons through a slab light: %.5f, without the slab %.5f "
+               "(rel err %+.4f, tol 0.03; %ld photons stored)\n",
+               rl, slab, open, slab / open - 1.0, n1);
+        assert_true(n0 == 0 && n1 > 0);
+        assert_true(open > 0.01);
+        assert_true(fabs(slab / open - 1.0) <= 0.03);
+    }
+}
+
 static void test_photons_in_room(void **state)
 {
     (void)state;
@@ -1006,6 +1077,7 @@ int main(void)
         cmocka_unit_test(test_not_modelled),
         cmocka_unit_test(test_media_photons),
         cmocka_unit_test(test_focus_vs_path),
+        cmocka_unit_test(test_caustic_bounce),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -51,7 +51,7 @@ static double compare_links(gi_particle *gp, void *lscene, const void *const *po
     double maxdist = 3.0 * ps->spacing;
     for (int k = 0; k < 2; k++)
         assert_int_equal(gi_links_build(gp->a, lscene, ps->p, pobj, pin, n, 0, nside, seed, grid, k == 0 ? tl : NULL,
-                                        maxdist, 2, links[k], NULL, &st[k], NULL, NULL, NULL, NULL, NULL, NULL, 0.0, NULL, NULL),
+                                        maxdist, 2, links[k], NULL, &st[k], NULL, NULL, NULL, NULL, NULL, NULL, 0.0, NULL, NULL, NULL),
                          PT_OK);
     long diff = 0;
     for (size_t i = 0; i < nl; i++) diff += links[0][i] != links[1][i];

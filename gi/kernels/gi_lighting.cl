@@ -55,10 +55,29 @@ static inline int gi_direct(__global const gi_dev_particle *part, int i, __globa
 /* diffuse_back (gi_types.h): a particle with a twin also sends
  *   rho_b * phi_d(twin) (dA / dA_twin) = back * rho * pi * (E_twin/pi) * dA,
  * the direct light on the other side that its back lobe reflects; the
- * host marks such particles in emits, so they are always read. */
+ * host marks such particles in emits, so they are always read.
+ * extra (4 floats per particle, read when has_extra): E/pi that arrives
+ * like direct light but not from a light_source ray, the caustic photons'
+ * (beyond the paper: POV-Ray's radiosity rays see photons, trace.cpp
+ * ComputeLightedTexture adds ComputePhotonDiffuseLight at every hit); it
+ * joins e, so it is sent, scattered and reflected as direct light is. */
+static inline int gi_extra(__global const float *extra, int i, float *e)
+{
+    int any = 0;
+    for (int c = 0; c < 3; c++) {
+        float v = extra[4 * (long)i + c];
+        if (v > 0.0f) {
+            e[c] += v;
+            any = 1;
+        }
+    }
+    return any;
+}
+
 __kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global const gi_dev_light *lights, int nlights,
                         __global const float *vis, __global const uint *emits, __global float *edir,
-                        __global float *src, __global uint *srcmask, __global float *dsum)
+                        __global float *src, __global uint *srcmask, __global float *dsum,
+                        __global const float *extra, int has_extra)
 {
     int g = (int)get_global_id(0);
     int i0 = g * GI_EMIT_CHUNK;
@@ -70,6 +89,7 @@ __kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global co
         __global const gi_dev_particle *pt = &part[i];
         float e[3] = {0.0f, 0.0f, 0.0f};
         int lit = gi_direct(part, i, lights, nlights, vis, e);
+        if (has_extra) lit |= gi_extra(extra, i, e);
         if (!lit && !((em >> (i - i0)) & 1u)) {
             for (int c = 0; c < 4; c++) {
                 edir[4 * i + c] = 0.0f;
@@ -78,7 +98,10 @@ __kernel void gi_k_emit(__global const gi_dev_particle *part, int n, __global co
             continue;
         }
         float eb[3] = {0.0f, 0.0f, 0.0f};
-        if (pt->back > 0.0f && pt->twin >= 0) gi_direct(part, pt->twin, lights, nlights, vis, eb);
+        if (pt->back > 0.0f && pt->twin >= 0) {
+            gi_direct(part, pt->twin, lights, nlights, vis, eb);
+            if (has_extra) gi_extra(extra, pt->twin, eb);
+        }
         int any = 0;
         for (int c = 0; c < 3; c++) {
             if (!isfinite(e[c])) e[c] = 0.0f;
