@@ -8,11 +8,13 @@
  * weighted by the power heuristic (Veach & Guibas 1995, eq. for beta = 2)
  * against the BSDF strategy. */
 #include "pm_nee.h"
+#include "shade_texture.h"
 #include "shade_atmos.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include "radrules.h"
+#include "scene_leaves.h"
 #include "shade_light.h"
 #include "timer.h"
 
@@ -20,6 +22,7 @@ struct pm_lights {
     const scene *sc;
     const accel *a;
     double eps;
+    int transparent; /* filtered shadows (shade_light_ctx) */
     accel_surf *emit;
     rgb *le;          /* emission per piece (its fallback colour when it varies) */
     unsigned char *varies; /* the piece's colour varies: evaluate Le at the sampled point */
@@ -43,6 +46,15 @@ static double emit_weight(void *ctx, const scene_object *leaf, const scene_textu
     return w;
 }
 
+static int is_target(const scene_object *o) { return o->photons && o->photons->target; }
+
+int pm_any_target(const scene *sc)
+{
+    for (int i = 0; i < sc->nobjects; i++)
+        if (scene_object_any(sc->objects[i], is_target)) return 1;
+    return 0;
+}
+
 pm_lights *pm_lights_new(const scene *sc, const accel *a, diag *d, pt_status *st)
 {
     *st = PT_OK;
@@ -54,6 +66,9 @@ pm_lights *pm_lights_new(const scene *sc, const accel *a, diag *d, pt_status *st
     L->sc = sc;
     L->a = a;
     L->eps = accel_surface_eps(a); /* median object size: a far object does not grow it */
+    /* filtered shadows, but full ones in a scene with photons{} and no
+     * target, where every specular surface makes caustics (pm_photon.c) */
+    L->transparent = shade_tex_scene_transparent(sc) && !(sc->global.photons.enabled && !pm_any_target(sc));
     L->emit = accel_surf_build(sc, a, emit_weight, (void *)sc, d, st);
     if (!L->emit) {
         free(L);
@@ -138,7 +153,7 @@ rgb pm_direct_lights(const pm_lights *L, const shade_mat_bsdf *b, int area_sampl
 {
     rgb total = {0, 0, 0};
     if (!b->nee) return total;
-    shade_light_ctx c = {L->a, L->eps, shadow_rays};
+    shade_light_ctx c = {L->a, L->eps, shadow_rays, NULL, L->sc, L->transparent, L->sc->global.photons.enabled};
     for (int i = 0; i < L->sc->nlights; i++) {
         if (!scene_light_reaches(&L->sc->lights[i], b->obj)) continue; /* light_group, as shade.c */
         rgb v = shade_mat_light_nee(b, &c, &L->sc->lights[i], area_samples, r);
@@ -179,7 +194,7 @@ rgb pm_direct_one_light(const pm_lights *L, const shade_mat_bsdf *b, rng *r, lon
         }
         while (pick > 0 && w[pick] <= 0.0) pick--;
         double p = w[pick] / wsum;
-        shade_light_ctx c = {L->a, L->eps, shadow_rays};
+        shade_light_ctx c = {L->a, L->eps, shadow_rays, NULL, L->sc, L->transparent, L->sc->global.photons.enabled};
         rgb v = shade_mat_light_nee(b, &c, &L->sc->lights[pick], 1, r);
         out.r = v.r / p;
         out.g = v.g / p;

@@ -53,6 +53,9 @@ double pm_lights_eps(const pm_lights *L);                  /* distance epsilon (
 rgb pm_sky(const scene *sc, vec3 dir);
 /* 1 when pm_sky can be non-zero (a background colour or a sky_sphere). */
 int pm_sky_any(const scene *sc);
+/* Whether some object has photons { target } (a CSG's block reaches its
+ * members). */
+int pm_any_target(const scene *sc);
 
 /* Direct light of all POV-Ray light sources at b (diffuse, diffuse_back,
  * phong, specular), area lights with `area_samples` stratified samples. */

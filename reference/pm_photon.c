@@ -96,6 +96,7 @@ typedef struct {
     double radius;
     radrules rr;       /* POV-Ray's rules for gathered light (core/radrules.h) */
     int gathers;       /* recursion_limit: gathering steps light may take to the eye */
+    int transparent;   /* some surface lets light through: filtered shadows (shade_tex_scene_transparent) */
 } trace_ctx;
 
 static inline rgb crgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
@@ -136,19 +137,56 @@ static int caustic_bounce_ok(const scene_light *l, const accel_hit *h, int lobe)
     return scene_photon_lobe(l, ph, lobe != SHADE_MAT_LOBE_REFLECT);
 }
 
-static int is_target(const scene_object *o) { return o->photons && o->photons->target; }
+/* Whether a POV-Ray light's photon passes the transparent surface at h
+ * straight, filtered, as the direct light's shadow ray does (pm_nee's
+ * filtered shadows, shade_tex_shadow_ray): not where that surface is a
+ * photon target refracting this light's photons under the scene's
+ * photons{} (a full shadow: the light through it is the caustic's; with
+ * photons{} and no target every surface acts as one, and the NEE's shadows
+ * are full, pm_nee.c), and
+ * only with probability q, the filter's largest channel (at most 1): the
+ * rest of the photons meet the surface and bounce on it as any first hit
+ * (its diffuse part; its specular lobes are caustic paths), each weight
+ * divided by its branch's probability. Then the NEE's filtered direct
+ * light behind the surface and the map's photons that carry it on agree. */
+static int filtered_pass(const trace_ctx *c, const scene_light *l, const accel_hit *h, vec3 w, double tprev, rng *r,
+                         rgb *phi)
+{
+    if (!c->transparent || !l || !r) return 0;
+    const scene_obj_photons *ph = h->obj ? h->obj->photons : NULL;
+    if (c->sc->global.photons.enabled && (!c->targets || (ph && ph->target && scene_photon_lobe(l, ph, 1)))) return 0;
+    accel_hit hp = *h;
+    hp.t = h->t - tprev;
+    rgb f = shade_tex_shadow_filter(c->sc, &hp, w);
+    double q = fmin(1.0, fmax(f.r, fmax(f.g, f.b)));
+    if (!(q > 0.0) || !isfinite(f.r + f.g + f.b)) return 0;
+    if (rng_f64(r) >= q) {
+        *phi = crgb(phi->r / (1.0 - q), phi->g / (1.0 - q), phi->b / (1.0 - q));
+        return 0;
+    }
+    *phi = crgb(phi->r * fmax(f.r, 0.0) / q, phi->g * fmax(f.g, 0.0) / q, phi->b * fmax(f.b, 0.0) / q);
+    return 1;
+}
 
 /* The first hit of a light's photon from o along unit w (LIGHT_SKIP), its
  * power *phi filtered by the pass_through objects crossed on the way (the
  * rule above; each surface's fade over the way since the one before, the
- * ray kept from o). Returns 1 on a hit, 0 when the photon left the scene
- * or was filtered out. */
-static int light_first_hit(const trace_ctx *c, vec3 o, vec3 w, accel_hit *h, rgb *phi, long *rays)
+ * ray kept from o) and by the transparent surfaces it passes as a filtered
+ * shadow (filtered_pass). Returns 1 on a hit, 0 when the photon left the
+ * scene or was filtered out. */
+static int light_first_hit(const trace_ctx *c, const scene_light *l, vec3 o, vec3 w, accel_hit *h, rgb *phi, rng *r,
+                           long *rays)
 {
     double tmin = c->eps, tprev = 0.0;
     for (int k = 0; k < ACCEL_PASS_MAX; k++) {
         if (accel_intersect_past(c->a, NULL, o, w, tmin, LIGHT_SKIP, h, rays) <= 0) return 0;
-        if (!(h->obj && h->obj->photons && h->obj->photons->pass_through)) return 1;
+        if (!(h->obj && h->obj->photons && h->obj->photons->pass_through)) {
+            if (!filtered_pass(c, l, h, w, tprev, r, phi)) return 1;
+            if (!(cmax(*phi) > 0.0) || !isfinite(phi->r + phi->g + phi->b)) return 0;
+            tprev = h->t;
+            tmin = h->t + fmax(c->eps, h->t * 1e-7);
+            continue;
+        }
         accel_hit hp = *h;
         hp.t = h->t - tprev;
         shade_mat_bsdf b;
@@ -173,7 +211,7 @@ static int beam_photon(const trace_ctx *c, const scene_light *l, vec3 centre, ve
     *o = disc_point(centre, axis, R, u1, u2);
     *w = dir;
     rgb f = {1.0, 1.0, 1.0};
-    if (!light_first_hit(c, *o, dir, h, &f, rays)) return 0;
+    if (!light_first_hit(c, l, *o, dir, h, &f, r, rays)) return 0;
     vec3 dl;
     double depth;
     shade_light_ray(l, l->position, h->p, &dl, &depth);
@@ -212,7 +250,7 @@ static int emit(const trace_ctx *c, const source *src, rng *r, accel_hit *h, vec
         double pdf = 1.0 / (2.0 * M_PI * (1.0 - cos_max));
         *o = q;
         rgb f = {1.0, 1.0, 1.0};
-        if (!light_first_hit(c, q, *w, h, &f, rays)) return 0;
+        if (!light_first_hit(c, l, q, *w, h, &f, r, rays)) return 0;
         vec3 dl;
         double depth;
         shade_light_ray(l, q, h->p, &dl, &depth);
@@ -437,7 +475,8 @@ static pt_status setup(trace_ctx *cp, const scene *sc, const accel *a, const pm_
 {
     trace_ctx c = {.sc = sc, .a = a, .L = L, .s = s, .eps = pm_lights_eps(L), .rr = radrules_of(sc, 1)};
     c.gathers = pm_gathers(&c.rr);
-    for (int i = 0; i < sc->nobjects && !c.targets; i++) c.targets = scene_object_any(sc->objects[i], is_target);
+    c.transparent = shade_tex_scene_transparent(sc);
+    c.targets = pm_any_target(sc);
     *targets = c.targets;
     vec3 lo, hi;
     if (bounds) {

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include "mirror.h"
 #include "shade_noise.h"
+#include "shade_texture.h"
 
 static inline rgb lrgb(double r, double g, double b) { rgb c = {r, g, b}; return c; }
 static inline rgb lrgb_add(rgb a, rgb b) { return lrgb(a.r + b.r, a.g + b.g, a.b + b.b); }
@@ -200,14 +201,21 @@ static rgb light_terms_plain(const shade_light_surface *s, vec3 l, rgb lc, int b
 
 /* ------------------------------------------------------------ GI direct light */
 
-/* shade.c's shadow_blocked, and contacts: the ray leaves c->from
- * (accel_occluded_from). */
-static int blocked(const shade_light_ctx *c, vec3 p, vec3 dir, double depth)
+/* The light of l that reaches p along dir: shade.c's shadow_blocked, and
+ * contacts: the ray leaves c->from (accel_occluded_from); a blocked ray in
+ * a scene with transparent surfaces passes their filters (shade.c's
+ * filtered shadows, shade_tex_shadow_ray). */
+static rgb pass_light(const shade_light_ctx *c, const scene_light *l, vec3 p, vec3 dir, double depth)
 {
+    const rgb one = {1, 1, 1}, zero = {0, 0, 0};
     if (c->shadow_rays) (*c->shadow_rays)++;
     double tmax = depth - fmax(c->eps, depth * 1e-6);
-    if (tmax <= c->eps) return 0;
-    return accel_occluded_from(c->a, c->from, p, dir, c->eps, tmax);
+    if (tmax <= c->eps) return one;
+    if (!accel_occluded_from(c->a, c->from, p, dir, c->eps, tmax)) return one;
+    if (!c->sc || !c->transparent) return zero;
+    rgb t = shade_tex_shadow_ray(c->sc, c->a, p, dir, c->eps, tmax, c->photon_shadows ? l : NULL);
+    if (!(t.r > 0.0 || t.g > 0.0 || t.b > 0.0) || !isfinite(t.r + t.g + t.b)) return zero;
+    return lrgb(fmax(t.r, 0.0), fmax(t.g, 0.0), fmax(t.b, 0.0));
 }
 
 /* 1 when l is an area light whose points do not all coincide: an axis with
@@ -277,7 +285,11 @@ rgb shade_light_nee(const shade_light_ctx *c, const scene_light *l, const shade_
                 if (s->f->diffuse_back != 0.0) back2 = 1;
                 else continue;
             }
-            if (!l->shadowless && blocked(c, p, d2, dep2)) continue;
+            if (!l->shadowless) {
+                rgb t = pass_light(c, l, p, d2, dep2);
+                if (lrgb_near_zero(t)) continue;
+                slc = lrgb(slc.r * t.r, slc.g * t.g, slc.b * t.b);
+            }
             total = lrgb_add(total, shade_light_terms(s, d2, slc, back2));
         }
         return lrgb_scale(total, 1.0 / nsamples);
@@ -290,11 +302,10 @@ rgb shade_light_nee(const shade_light_ctx *c, const scene_light *l, const shade_
         else return zero;
     }
     if (!l->shadowless) {
-        double vis;
+        rgb vis = zero;
         if (light_extended(l)) {
             vec3 ax1, ax2;
             shade_light_area_axes(l, p, &ax1, &ax2);
-            int seen = 0;
             for (int k = 0; k < nsamples; k++) {
                 double u, v;
                 stratum(k, nsamples, r, &u, &v);
@@ -302,14 +313,14 @@ rgb shade_light_nee(const shade_light_ctx *c, const scene_light *l, const shade_
                 vec3 d2;
                 double dep2;
                 shade_light_ray(l, q, p, &d2, &dep2);
-                if (!blocked(c, p, d2, dep2)) seen++;
+                vis = lrgb_add(vis, pass_light(c, l, p, d2, dep2));
             }
-            vis = (double)seen / nsamples;
+            vis = lrgb_scale(vis, 1.0 / nsamples);
         } else {
-            vis = blocked(c, p, dir, depth) ? 0.0 : 1.0;
+            vis = pass_light(c, l, p, dir, depth);
         }
-        if (vis <= 0.0) return zero;
-        lc = lrgb_scale(lc, vis);
+        if (lrgb_near_zero(vis)) return zero;
+        lc = lrgb(lc.r * vis.r, lc.g * vis.g, lc.b * vis.b);
     }
     return shade_light_terms(s, dir, lc, backside);
 }

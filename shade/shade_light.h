@@ -81,6 +81,14 @@ typedef struct {
     double eps;          /* scene distance epsilon (shade.c's: accel_scale * 1e-6) */
     long *shadow_rays;   /* incremented per shadow ray; may be NULL */
     const accel_from *from; /* the surface the shadow rays leave (accel_occluded_from); NULL: none */
+    /* Filtered shadows (POV-Ray's, shade_tex_shadow_ray): sc non-NULL and
+     * transparent set (shade_tex_scene_transparent) make a blocked shadow
+     * ray walk the surfaces it crosses and pass their filter colours;
+     * photon_shadows (the scene's photons{} is on): a photon target that
+     * refracts the light's photons shadows it fully. Else every object but
+     * no_shadow ones is opaque. */
+    const scene *sc;
+    int transparent, photon_shadows;
 } shade_light_ctx;
 
 /* Direct light from one POV-Ray light source at the surface point p (already
@@ -94,8 +102,9 @@ typedef struct {
  * intensity (spot, fade, cosine) comes from the light's centre unless
  * area_illumination is on, as in shade.c. `double_illum` is the object's
  * double_illuminate flag. Shadows: accel_occluded (no_shadow objects do not
- * block; every other object is opaque, as in shade.c). Unbiased for the
- * continuous light. */
+ * block), then, where c asks for filtered shadows, POV-Ray's filter of the
+ * transparent surfaces crossed, as shade.c's. Unbiased for the continuous
+ * light. */
 rgb shade_light_nee(const shade_light_ctx *c, const scene_light *l, const shade_light_surface *s, vec3 p, int double_illum,
               int nsamples, rng *r);
 
