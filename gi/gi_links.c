@@ -45,7 +45,7 @@ typedef struct {
     float far_bounce;     /* brightness when the far field reflects the sky, else 0 */
     gi_dev_light *lights; /* the scene's, for the far field's direct light */
     int nlights;
-    const gi_caustic *caus; /* its photons' light at the hits, with the lights' (NULL: none) */
+    gi_hit_light hl;      /* the caustics' light and filtered shadows at the hits (gi_links.h) */
     int exact;            /* view points with no bounce after the hit: every hit takes hit_light */
     float *reach;         /* per source (i - first), 4 floats: the harmonic mean of its rays' hit
                              distances, the vector to their nearest hit */
@@ -271,14 +271,24 @@ static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, 
                 double dep = gi_light_ray(lt, lt->pos[0], lt->pos[1], lt->pos[2], (float)org.x, (float)org.y, (float)org.z, ds);
                 double tmax = dep > 0.0 ? gi_shadow_tmax(dep, eps) : INFINITY;
                 unsigned *last = l < MEMO_LIGHTS ? &memo->blocker[l] : NULL;
-                if (tmax > eps && accel_occluded_cached(J->a, last, org, v3(ds[0], ds[1], ds[2]), 0.0, tmax)) continue;
+                if (tmax > eps && accel_occluded_cached(J->a, last, org, v3(ds[0], ds[1], ds[2]), 0.0, tmax)) {
+                    /* POV-Ray's filtered shadow through transparent surfaces */
+                    if (!J->hl.shadow) continue;
+                    rgb t = J->hl.shadow(J->sc, J->a, org, v3(ds[0], ds[1], ds[2]), 0.0, tmax,
+                                         J->hl.photon_shadows ? &J->sc->lights[l] : NULL);
+                    if (!(t.r > 0.0 || t.g > 0.0 || t.b > 0.0) || !isfinite(t.r + t.g + t.b)) continue;
+                    dir[0] += lt->colour[0] * att * (float)ci * (float)t.r;
+                    dir[1] += lt->colour[1] * att * (float)ci * (float)t.g;
+                    dir[2] += lt->colour[2] * att * (float)ci * (float)t.b;
+                    continue;
+                }
             }
             for (int c = 0; c < 3; c++) dir[c] += lt->colour[c] * att * (float)ci;
         }
         /* and the caustic photons there: POV-Ray's radiosity rays see
          * photons at every hit (trace.cpp, ComputeLightedTexture) */
-        if (J->caus && !(o->photons && !o->photons->collect)) {
-            rgb e = gi_caustic_world_at(J->caus, p, n, 1.0, 0.0);
+        if (J->hl.caus && !(o->photons && !o->photons->collect)) {
+            rgb e = gi_caustic_world_at(J->hl.caus, p, n, 1.0, 0.0);
             if (isfinite(e.r + e.g + e.b)) {
                 dir[0] += (float)e.r;
                 dir[1] += (float)e.g;
@@ -1032,10 +1042,10 @@ pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle 
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
                          gi_link_stats *st, volatile int *cancel, progress *prog,
                          const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce,
-                         float *reach, gi_link_conts *conts, const gi_caustic *caus)
+                         float *reach, gi_link_conts *conts, const gi_hit_light *hl)
 {
     if (threads <= 0) threads = pool_default_threads();
-    link_job J = {.sky = sky, .esky = sky && sc ? esky : NULL, .sc = sc, .pig = pig, .caus = caus,
+    link_job J = {.sky = sky, .esky = sky && sc ? esky : NULL, .sc = sc, .pig = pig, .hl = hl ? *hl : (gi_hit_light){0},
                   .far_bounce = isfinite(far_bounce) && far_bounce > 0.0 ? (float)far_bounce : 0.0f};
     J.p = p;
     J.pobj = pobj;
@@ -1160,9 +1170,9 @@ int gi_gatherer_point(gi_gatherer *g, int thread, vec3 p, vec3 n, uint64_t strea
     return 1;
 }
 
-void gi_gatherer_set_caustic(gi_gatherer *g, const gi_caustic *caus)
+void gi_gatherer_set_light(gi_gatherer *g, const gi_hit_light *hl)
 {
-    if (g) g->J.caus = caus;
+    if (g) g->J.hl = hl ? *hl : (gi_hit_light){0};
 }
 
 void gi_gatherer_free(gi_gatherer *g)

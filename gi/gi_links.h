@@ -12,6 +12,7 @@
 #include "accel.h"
 #include "scene.h"
 #include "gi_area_particles.h"
+#include "gi_shadow.h"
 #include "gi_sky.h"
 #include "gi_surface.h"
 #include "gi_trilook.h"
@@ -78,16 +79,23 @@ typedef struct {
 } gi_link_conts;
 void gi_link_conts_free(gi_link_conts *c);
 
-/* caus (may be NULL): the caustic layer whose photons the final gather's
- * hits add to the lights' direct light they reflect (POV-Ray's radiosity
- * rays see photons). */
+/* What the hits of the final gather's rays add to the lights' direct
+ * light they reflect, as POV-Ray's radiosity rays see light: the caustic
+ * layer's photons there (caus, NULL: none) and filtered shadows (shadow,
+ * NULL: full ones; photon_shadows: the scene's photons{} is on). */
 struct gi_caustic;
+typedef struct {
+    const struct gi_caustic *caus;
+    gi_shadow_fn shadow;
+    int photon_shadows;
+} gi_hit_light;
+/* hl (may be NULL: none of it): gi_hit_light. */
 pt_status gi_links_build(const accel *a, void *rtc_scene, const gi_dev_particle *p, const void *const *pobj,
                          const unsigned char *pin, int n, int first, int nside, uint64_t seed, const gi_lookup *grid,
                          const gi_trilook *tl, double maxdist, int threads, int *links, unsigned char *anyhit,
                          gi_link_stats *st, volatile int *cancel, progress *prog,
                          const gi_sky *sky, float *esky, const scene *sc, gi_pigment_fn pig, double far_bounce,
-                         float *reach, gi_link_conts *conts, const struct gi_caustic *caus);
+                         float *reach, gi_link_conts *conts, const gi_hit_light *hl);
 
 /* conts (may be NULL; the final gather's points): where a continuation
  * of a point's ray ends on a surface with particles, the particle it ends
@@ -121,9 +129,9 @@ int gi_gatherer_point(gi_gatherer *g, int thread, vec3 p, vec3 n, uint64_t strea
  * sky-lit scene of diffuse surfaces): its points without a reach are then
  * answered by occlusion tests alone, the same answer for less time. */
 int gi_gatherer_dark(const gi_gatherer *g);
-/* The caustic layer whose photons its hits add to the lights' direct
- * light (NULL: none); it must outlive the gatherer's use of it. */
-void gi_gatherer_set_caustic(gi_gatherer *g, const struct gi_caustic *caus);
+/* What its hits add to the lights' direct light (gi_hit_light, copied;
+ * NULL: none); the layer must outlive the gatherer's use of it. */
+void gi_gatherer_set_light(gi_gatherer *g, const gi_hit_light *hl);
 void gi_gatherer_free(gi_gatherer *g);
 
 /* Incoming links, a counting sort by target: the sources i < n in mask

@@ -879,6 +879,7 @@ void gi_particle_free(gi_particle *gp)
     free(gp->rin_src);
     free(gp->lights);
     free(gp->vis);
+    free(gp->visf);
     free(gp->vis_lights);
     free(gp->dirty);
     free(gp->edir);

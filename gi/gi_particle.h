@@ -73,6 +73,7 @@
 #include "accel.h"
 #include "diag.h"
 #include "progress.h"
+#include "gi_shadow.h"
 #include "gi_sky.h"
 #include "scene.h"
 
@@ -166,6 +167,9 @@ typedef struct {
                                the gatherer gather about the texture's perturbed normal, and the reuse test and
                                the filter compare perturbed normals; NULL: the raw one */
     gi_sky_fn sky;         /* radiance of rays leaving the scene; NULL: the background colour */
+    gi_shadow_fn shadow;   /* filtered shadows at the particles (the scene has transparent surfaces); NULL:
+                              every surface shadows fully */
+    int photon_shadows;    /* the scene's photons{} is on: gi_shadow_fn's photon_light is the light */
     progress *progress;    /* names each step of the geometry, lighting and view stages (NULL: none) */
 } gi_particle_settings;
 

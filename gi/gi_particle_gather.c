@@ -478,10 +478,11 @@ static pt_status trace_points(gi_particle *gp, const void **pobj, const unsigned
         goto done;
     }
     long c0 = gp->vg->cont.n;
+    gi_hit_light hl = gi_particle_hit_light(gp);
     st = gi_links_build(gp->a, gp->lscene, cp, cobj, cpin, (int)N, n, side, seed, grid, gp->tl, 3.0 * spacing, gp->threads,
                         gp->vg->link + (size_t)k0 * gp->vg->k, NULL, &ls, gp->set.cancel, NULL, gp->sky,
                         gp->vg->esky + 4 * (size_t)k0, gp->sc, gp->set.pigment,
-                        gp->set.bounces >= 1 ? gp->set.brightness : 0.0, reach, &gp->vg->cont, gp->caus);
+                        gp->set.bounces >= 1 ? gp->set.brightness : 0.0, reach, &gp->vg->cont, &hl);
     for (long q = c0; q < gp->vg->cont.n; q++) gp->vg->cont.e[q].src += k0; /* the points' own numbers */
     *rays += ls.rays;
     /* each point's reach within POV-Ray's minimum_reuse and maximum_reuse
@@ -696,7 +697,8 @@ static pt_status view_gather_side(gi_particle *gp)
         if (hs < 4) hs = 4;
         gp->vg->gatherer = gi_gatherer_new(gp->a, gp->lscene, hs, gp->set.seed ^ 0x51d3ULL, gp->sky, gp->sc,
                                           gp->set.pigment);
-        gi_gatherer_set_caustic(gp->vg->gatherer, gp->caus);
+        gi_hit_light hl = gi_particle_hit_light(gp);
+        gi_gatherer_set_light(gp->vg->gatherer, &hl);
         /* where its rays need only occlusion tests (gi_gatherer_dark), the
          * time of hs^2 nearest-hit rays buys about DARK_SIDE_GAIN^2 times
          * as many: less noise for the same time */
@@ -705,7 +707,7 @@ static pt_status view_gather_side(gi_particle *gp)
             gi_gatherer_free(gp->vg->gatherer);
             gp->vg->gatherer = gi_gatherer_new(gp->a, gp->lscene, hd, gp->set.seed ^ 0x51d3ULL, gp->sky, gp->sc,
                                               gp->set.pigment);
-            gi_gatherer_set_caustic(gp->vg->gatherer, gp->caus);
+            gi_gatherer_set_light(gp->vg->gatherer, &hl);
         }
         if (!gp->vg->gatherer) st = PT_ERR_NOMEM;
     }

@@ -97,6 +97,8 @@ struct gi_particle {
     volatile int *cancel; /* gi_particle_set_cancel: non-zero stops the lighting stage */
     const struct gi_caustic *caus; /* gi_particle_set_caustic: its photons are light at the particles */
     float *extra;         /* their E/pi per particle (4 floats), filled by each lighting stage */
+    float *visf;          /* set.shadow: the light through transparent surfaces, n x nlights x 4 floats
+                             (att times the mean filter over the shadow rays an opaque test blocked) */
     /* view */
     float *eind;                 /* n*4: gathered E~/pi */
     atomic_uchar *e_state;       /* 0 none, 1 being computed, 2 done */
@@ -190,6 +192,9 @@ const void **gi_particle_objects(const gi_particle *gp, const gi_particles *ps, 
  * it reflects, which the geometry stage adds to le (sky_as_emission,
  * gi_particle.c). */
 float gi_particle_own_emission(const gi_particle *gp, int i, int c);
+/* What the final gather's hits add to the lights' direct light: the
+ * caustic layer set now and the settings' filtered shadows (gi_links.h). */
+gi_hit_light gi_particle_hit_light(const gi_particle *gp);
 
 /* Geometry stage helpers the lighting stage uses (gi_particle.c). */
 /* calloc of n (at least 1) elements; sets *st to PT_ERR_NOMEM on failure. */

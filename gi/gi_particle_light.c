@@ -119,7 +119,7 @@ static void vis_chunk(void *ctx, int chunk, int thread)
     int n = gp->ps.n, nl = gp->nlights;
     int i0 = chunk * VIS_CHUNK, i1 = i0 + VIS_CHUNK < n ? i0 + VIS_CHUNK : n;
     long rays = 0;
-    float att[VIS_CHUNK], seen[VIS_CHUNK];
+    float att[VIS_CHUNK], seen[VIS_CHUNK], tf[VIS_CHUNK][3];
     int m_of[VIS_CHUNK];
     ray_batch B = {0};
     for (int li = 0; li < nl; li++) {
@@ -180,6 +180,27 @@ static void vis_chunk(void *ctx, int chunk, int thread)
         if (B.n > 0) accel_occluded_n(gp->a, B.n, B.org, B.dir, B.tmin, B.tmax, B.hit);
         for (int k = 0; k < B.n; k++)
             if (!B.hit[k]) seen[B.owner[k]] += 1.0f;
+        /* POV-Ray's filtered shadows: a blocked ray walks the surfaces it
+         * crosses and passes their filters (gi_shadow_fn); the light through
+         * them joins the particle's direct light (gi_particle_extra) */
+        if (gp->visf) {
+            memset(tf, 0, sizeof tf);
+            const scene_light *pl = gp->set.photon_shadows ? l : NULL;
+            for (int k = 0; k < B.n; k++) {
+                if (!B.hit[k]) continue;
+                rgb t = gp->set.shadow(sc, gp->a, B.org[k], B.dir[k], B.tmin[k], B.tmax[k], pl);
+                if (!isfinite(t.r + t.g + t.b)) continue;
+                tf[B.owner[k]][0] += (float)fmax(t.r, 0.0);
+                tf[B.owner[k]][1] += (float)fmax(t.g, 0.0);
+                tf[B.owner[k]][2] += (float)fmax(t.b, 0.0);
+            }
+            for (int i = i0; i < i1; i++) {
+                int o = i - i0;
+                float *v = &gp->visf[((size_t)i * nl + li) * 4];
+                for (int c = 0; c < 3; c++) v[c] = att[o] > 0.0f ? att[o] * tf[o][c] / (float)m_of[o] : 0.0f;
+                v[3] = 0.0f;
+            }
+        }
         /* gi_k_emit reads att * V, V the fraction of the light seen */
         for (int i = i0; i < i1; i++) {
             int o = i - i0;
@@ -234,21 +255,55 @@ static void caus_chunk(void *ctx, int ci, int thread)
     }
 }
 
-/* Fills gp->extra from the caustic layer; NULL when there is none (or no
- * photon reaches a particle). *flux: the light it brings (grey). */
-static const float *caustic_extra(gi_particle *gp, double *flux, pt_status *st)
+/* The light through transparent surfaces (visf) at particle i, E/pi
+ * added to e: each light's colour times the cosine term gi_k_emit's
+ * gi_direct gives it (brilliance; none from behind). */
+static void filtered_direct(const gi_particle *gp, int i, float e[3])
 {
-    *flux = 0.0;
+    const gi_dev_particle *pt = &gp->ps.p[i];
+    for (int l = 0; l < gp->nlights; l++) {
+        const float *v = &gp->visf[((size_t)i * gp->nlights + l) * 4];
+        if (!(v[0] > 0.0f || v[1] > 0.0f || v[2] > 0.0f)) continue;
+        const gi_dev_light *lt = &gp->lights[l];
+        float d[3];
+        gi_light_ray(lt, lt->pos[0], lt->pos[1], lt->pos[2], pt->p[0], pt->p[1], pt->p[2], d);
+        float ci = pt->n[0] * d[0] + pt->n[1] * d[1] + pt->n[2] * d[2];
+        if (ci < 1e-10f) continue;
+        float in = pt->brilliance != 1.0f ? powf(ci, pt->brilliance) : ci;
+        for (int c = 0; c < 3; c++) e[c] += lt->colour[c] * in * v[c];
+    }
+}
+
+/* Fills gp->extra from the caustic layer and the light through transparent
+ * surfaces; NULL when there is neither (or it reaches no particle).
+ * *fcaus: the light the photons bring (grey). */
+static const float *particle_extra(gi_particle *gp, double *fcaus, pt_status *st)
+{
+    *fcaus = 0.0;
     int n = gp->ps.n;
-    if (!gp->caus || n <= 0) return NULL;
+    if ((!gp->caus && !gp->visf) || n <= 0) return NULL;
     if (!gp->extra && !(gp->extra = gi_particle_calloc((size_t)n * 4, sizeof(float), st))) return NULL;
-    caus_job J = {gp};
-    pool_run(gp->threads, (n + CAUS_CHUNK - 1) / CAUS_CHUNK, caus_chunk, &J);
+    if (gp->caus) {
+        caus_job J = {gp};
+        pool_run(gp->threads, (n + CAUS_CHUNK - 1) / CAUS_CHUNK, caus_chunk, &J);
+    } else {
+        memset(gp->extra, 0, (size_t)n * 4 * sizeof(float));
+    }
     double f = 0.0;
-    for (int i = 0; i < n; i++)
-        f += M_PI * gp->ps.p[i].area * (gp->extra[4 * (size_t)i] + gp->extra[4 * (size_t)i + 1] + gp->extra[4 * (size_t)i + 2]) / 3.0;
-    *flux = f;
-    return f > 0.0 ? gp->extra : NULL;
+    int any = 0;
+    for (int i = 0; i < n; i++) {
+        float *x = &gp->extra[4 * (size_t)i];
+        f += M_PI * gp->ps.p[i].area * (x[0] + x[1] + x[2]) / 3.0;
+        if (gp->visf) {
+            float e[3] = {0.0f, 0.0f, 0.0f};
+            filtered_direct(gp, i, e);
+            for (int c = 0; c < 3; c++)
+                if (isfinite(e[c]) && e[c] > 0.0f) x[c] += e[c];
+        }
+        any |= x[0] > 0.0f || x[1] > 0.0f || x[2] > 0.0f;
+    }
+    *fcaus = f;
+    return any ? gp->extra : NULL;
 }
 
 static void reset_view(gi_particle *gp)
@@ -278,10 +333,14 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
     if (nl != gp->nlights) {
         free(gp->lights);
         free(gp->vis);
+        free(gp->visf);
+        gp->visf = NULL;
         free(gp->vis_lights);
         free(gp->dirty);
         gp->lights = gi_particle_calloc((size_t)nl, sizeof *gp->lights, &st);
         gp->vis = gi_particle_calloc((size_t)n * (size_t)(nl > 0 ? nl : 1), sizeof(float), &st);
+        if (gp->set.shadow && nl > 0)
+            gp->visf = gi_particle_calloc((size_t)n * (size_t)nl * 4, sizeof(float), &st);
         gp->vis_lights = gi_particle_calloc((size_t)nl, sizeof *gp->vis_lights, &st);
         gp->dirty = gi_particle_calloc((size_t)nl, 1, &st);
         if (st != PT_OK) {
@@ -334,7 +393,7 @@ pt_status gi_particle_light(gi_particle *gp, diag *d)
      * until gi_particle_debug asks (gi_dev_fetch). */
     gi_dev_sums sums;
     double fcaus = 0.0;
-    const float *extra = caustic_extra(gp, &fcaus, &st);
+    const float *extra = particle_extra(gp, &fcaus, &st);
     if (st != PT_OK) return st;
     progress_stage(gp->set.progress, "gi lighting: emit and scatter", 0);
     st = gi_dev_lighting(gp->dev, gp->lights, gp->nlights, gp->vis, ndirty > 0, extra,
@@ -371,11 +430,17 @@ void gi_particle_set_cancel(gi_particle *gp, volatile int *cancel) { gp->cancel 
 
 void gi_particle_set_progress(gi_particle *gp, progress *p) { gp->set.progress = p; }
 
+gi_hit_light gi_particle_hit_light(const gi_particle *gp)
+{
+    return (gi_hit_light){gp->caus, gp->set.shadow, gp->set.photon_shadows};
+}
+
 void gi_particle_set_caustic(gi_particle *gp, const gi_caustic *layer)
 {
     gp->caus = layer;
     /* the view's gatherers (hits no gathered point answers) see it too */
-    for (int v = 0; v < 2; v++) gi_gatherer_set_caustic(gp->vgs[v].gatherer, layer);
+    gi_hit_light hl = gi_particle_hit_light(gp);
+    for (int v = 0; v < 2; v++) gi_gatherer_set_light(gp->vgs[v].gatherer, &hl);
 }
 
 void gi_particle_set_scattering(gi_particle *gp, int bounces, int scatter)
