@@ -725,7 +725,7 @@ static void test_caustic_bounce(void **state)
  * 0.7, no photons), the camera inside. partray's default render within 3%
  * of the path tracer (1024 spp, which takes filtered shadows too), with
  * particles (recursion_limit 2) and with the final gather alone (1). With
- * the pane shadowing fully the room was nearly black (-98%). */
+ * the pane shadowing fully the room is nearly black. */
 static const char *pane_fmt =
     "#version 3.7;\n"
     "global_settings { assumed_gamma 1 radiosity { recursion_limit %d } }\n"
