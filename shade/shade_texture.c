@@ -779,6 +779,15 @@ typedef struct {
     rgb c;
 } shadow_walk;
 
+/* A crossing of a texture that lets no light through anywhere
+ * (transmit_texture_may), on an object without an interior texture that
+ * might: its filter is 0 wherever it is crossed, so the walk ends there
+ * without reading its surface (its pattern pigments). */
+static int opaque_crossing(const scene_object *obj, const scene_texture *tex)
+{
+    return obj && tex && !obj->interior_texture && !transmit_texture_may(tex);
+}
+
 static int shadow_crossing(void *ctx, const accel_hit *h)
 {
     shadow_walk *w = ctx;
@@ -786,7 +795,8 @@ static int shadow_crossing(void *ctx, const accel_hit *h)
     int inside;
     if (!shade_tex_walk_take(&w->walk, h, w->dir, &depth, &inside)) return 1;
     const scene_obj_photons *ph = h->obj ? h->obj->photons : NULL;
-    if (w->photon_light && ph && ph->target && scene_photon_lobe(w->photon_light, ph, 1)) {
+    if ((w->photon_light && ph && ph->target && scene_photon_lobe(w->photon_light, ph, 1)) ||
+        opaque_crossing(h->obj, h->texture)) {
         w->c = trgb(0, 0, 0);
         return 0;
     }
@@ -818,6 +828,7 @@ static int shadow_crossing(void *ctx, const accel_hit *h)
 static int shadow_surface(void *ctx, const scene_object *obj, const scene_texture *tex)
 {
     (void)ctx;
+    if (opaque_crossing(obj, tex)) return 0;
     if (!obj || obj->interior_texture || !tex) return 1;
     const scene_interior *in = obj->interior;
     if ((in && in->caustics != 0.0) || !transmit_fade_none(in, 1)) return 1;
