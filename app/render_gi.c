@@ -87,17 +87,22 @@ static pt_status render_none(const scene *sc, const accel *a, const render_gi_op
     return st;
 }
 
+void render_gi_particle_settings(gi_particle_settings *gs, const scene *sc)
+{
+    gi_particle_settings_from_scene(gs, sc);
+    gs->pigment = shade_tex_pigment_at; /* particles reflect the pigment where they are */
+    gs->sky = shade_atmos_sky; /* what escaping rays see (shade_atmos.h) */
+    /* POV-Ray's filtered shadows reach the particles too (its radiosity
+     * sees them), with its photon targets' full shadows */
+    if (shade_tex_scene_transparent(sc)) gs->shadow = shade_tex_shadow_ray;
+    gs->photon_shadows = sc->global.photons.enabled;
+}
+
 static pt_status render_particle(const scene *sc, const accel *a, const render_gi_opts *o, framebuffer *fb,
                                  render_gi_result *r, diag *d)
 {
     gi_particle_settings gs;
-    gi_particle_settings_from_scene(&gs, sc);
-    gs.pigment = shade_tex_pigment_at; /* particles reflect the pigment where they are */
-    gs.sky = shade_atmos_sky; /* what escaping rays see (shade_atmos.h) */
-    /* POV-Ray's filtered shadows reach the particles too (its radiosity
-     * sees them), with its photon targets' full shadows */
-    if (shade_tex_scene_transparent(sc)) gs.shadow = shade_tex_shadow_ray;
-    gs.photon_shadows = sc->global.photons.enabled;
+    render_gi_particle_settings(&gs, sc);
     /* radiosity `normal on`: the final gather about the perturbed normal */
     if (radrules_of(sc, 1).normal) gs.normal_at = shade_tex_normal_at;
     gi_particle_scale_quality(&gs, o->gi_quality);

@@ -125,6 +125,10 @@ pt_status render_gi(const scene *sc, const accel *a, const render_gi_opts *o, fr
  * mode or on no memory. */
 render_gi_kept *render_gi_kept_new(const render_gi_opts *o);
 void render_gi_kept_free(render_gi_kept *k);
+/* Particle GI's settings for scene sc, a render's or a viewer session's:
+ * the scene's (gi_particle_settings_from_scene) with shade/'s hooks (the
+ * pigment at a particle, the sky, POV-Ray's filtered shadows). */
+void render_gi_particle_settings(gi_particle_settings *gs, const scene *sc);
 /* The vertex links' settings of a render or a viewer session (bounces 0:
  * the default): vertices reflect the pigment where they are. */
 void render_gi_links_settings(gi_vlinks_settings *s, int threads, int bounces);

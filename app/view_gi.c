@@ -141,9 +141,7 @@ static pt_status particle_open(void *ctx, const scene *sc, const accel *a, const
     c->sc = sc;
     c->a = a;
     gi_particle_settings s;
-    gi_particle_settings_from_scene(&s, sc);
-    s.pigment = shade_tex_pigment_at; /* particles reflect the pigment where they are */
-    s.sky = shade_atmos_sky; /* what escaping rays see (shade_atmos.h) */
+    render_gi_particle_settings(&s, sc);
     s.threads = o->threads;
     if (o->particles > 0) s.count = o->particles;
     if (o->bounces > 0) s.bounces = o->bounces;
