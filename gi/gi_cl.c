@@ -767,12 +767,12 @@ pt_status gi_dev_set_walk(gi_dev *dv, const int *woff, const gi_walk_entry *went
 /* The first bounce reads only particles that send light (gi_k_emit's source
  * mask), but a gather over every incoming link (rin) still reads every link
  * and tests its source's bit. cin holds the incoming links of the candidate
- * sources only: particles with emission or some vis > 0, the ones gi_k_emit
+ * sources only: particles with emission, some vis > 0 or extra light, the ones gi_k_emit
  * may give a non-zero src (the others get 0, and adding a 0 changes no
  * float sum: the same sums as over rin, bit for bit). It is a counting sort
  * of the candidates' own scattering links (slink) by target, candidates
  * ascending: per target the same entries in the same order as rin's. The
- * set changes only with the visibility (vis_changed: a light moved). The
+ * set changes only with the visibility and the extra light (changed). The
  * sort costs about what it saves in one bounce (more when most particles
  * are candidates; bench/bench_gi prints the lighting stage), so a stage whose
  * set differs from the previous stage's gathers over rin with the mask, and
@@ -780,12 +780,12 @@ pt_status gi_dev_set_walk(gi_dev *dv, const int *woff, const gi_walk_entry *went
  * change, a frame relit with nothing moved) and reused while it stays. The
  * first stage after gi_dev_set_particles (every light traced, the sort a
  * small part of it) builds them at once. */
-static pt_status compact_sources(gi_dev *dv, const float *vis, int nlights, int vis_changed, const float *extra,
+static pt_status compact_sources(gi_dev *dv, const float *vis, int nlights, int changed, const float *extra,
                                  diag *d)
 {
     int n = dv->n, ns2 = dv->ns2;
     size_t words = ((size_t)n + 31) / 32;
-    if (!vis_changed && dv->cand_seen) goto same; /* the same vis: the same set */
+    if (!changed && dv->cand_seen) goto same; /* the same vis and extra light: the same set */
     memcpy(dv->cand_new, dv->emits, words * sizeof(unsigned));
     /* no lights: vis may be NULL (no offset from it, C11 6.5.6) */
     for (int i = 0; nlights > 0 && i < n; i++) {
@@ -920,11 +920,12 @@ pt_status gi_dev_lighting(gi_dev *dv, const gi_dev_light *lights, int nlights, c
     if (dv->is_cl && !dv->vis_ok) vis_changed = 1;
 #endif
     /* the extra light may differ from the last stage's: the sources' set
-     * is found again (compact_sources keeps its lists when it is the same) */
-    if (extra || dv->had_extra) vis_changed = 1;
+     * is found again (compact_sources keeps its lists when it is the same);
+     * vis itself is uploaded only when it changed */
+    int sources_changed = vis_changed || extra || dv->had_extra;
     dv->had_extra = extra != NULL;
     if (nb > 0) {
-        pt_status cs = compact_sources(dv, vis, nlights, vis_changed, extra, d);
+        pt_status cs = compact_sources(dv, vis, nlights, sources_changed, extra, d);
         if (cs != PT_OK) return cs;
     }
     if (!dv->is_cl) {

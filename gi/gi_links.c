@@ -266,24 +266,25 @@ static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, 
             if (!(ci > 0.0)) continue;
             float att = gi_light_attenuation(lt, (float)p.x, (float)p.y, (float)p.z, dl, depth);
             if (!(att > 0.0f)) continue;
+            /* the light let through: all, or POV-Ray's filtered shadow of
+             * the transparent surfaces that block it */
+            float tr[3] = {1.0f, 1.0f, 1.0f};
             if (!lt->shadowless) {
                 float ds[3];
                 double dep = gi_light_ray(lt, lt->pos[0], lt->pos[1], lt->pos[2], (float)org.x, (float)org.y, (float)org.z, ds);
                 double tmax = dep > 0.0 ? gi_shadow_tmax(dep, eps) : INFINITY;
                 unsigned *last = l < MEMO_LIGHTS ? &memo->blocker[l] : NULL;
                 if (tmax > eps && accel_occluded_cached(J->a, last, org, v3(ds[0], ds[1], ds[2]), 0.0, tmax)) {
-                    /* POV-Ray's filtered shadow through transparent surfaces */
                     if (!J->hl.shadow) continue;
                     rgb t = J->hl.shadow(J->sc, J->a, org, v3(ds[0], ds[1], ds[2]), 0.0, tmax,
                                          J->hl.photon_shadows ? &J->sc->lights[l] : NULL);
                     if (!(t.r > 0.0 || t.g > 0.0 || t.b > 0.0) || !isfinite(t.r + t.g + t.b)) continue;
-                    dir[0] += lt->colour[0] * att * (float)ci * (float)t.r;
-                    dir[1] += lt->colour[1] * att * (float)ci * (float)t.g;
-                    dir[2] += lt->colour[2] * att * (float)ci * (float)t.b;
-                    continue;
+                    tr[0] = (float)t.r;
+                    tr[1] = (float)t.g;
+                    tr[2] = (float)t.b;
                 }
             }
-            for (int c = 0; c < 3; c++) dir[c] += lt->colour[c] * att * (float)ci;
+            for (int c = 0; c < 3; c++) dir[c] += lt->colour[c] * att * (float)ci * tr[c];
         }
         /* and the caustic photons there: POV-Ray's radiosity rays see
          * photons at every hit (trace.cpp, ComputeLightedTexture) */

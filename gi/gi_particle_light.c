@@ -182,7 +182,7 @@ static void vis_chunk(void *ctx, int chunk, int thread)
             if (!B.hit[k]) seen[B.owner[k]] += 1.0f;
         /* POV-Ray's filtered shadows: a blocked ray walks the surfaces it
          * crosses and passes their filters (gi_shadow_fn); the light through
-         * them joins the particle's direct light (gi_particle_extra) */
+         * them joins the particle's direct light (particle_extra) */
         if (gp->visf) {
             memset(tf, 0, sizeof tf);
             const scene_light *pl = gp->set.photon_shadows ? l : NULL;

@@ -779,15 +779,6 @@ typedef struct {
     rgb c;
 } shadow_walk;
 
-/* A crossing of a texture that lets no light through anywhere
- * (transmit_texture_may), on an object without an interior texture that
- * might: its filter is 0 wherever it is crossed, so the walk ends there
- * without reading its surface (its pattern pigments). */
-static int opaque_crossing(const scene_object *obj, const scene_texture *tex)
-{
-    return obj && tex && !obj->interior_texture && !transmit_texture_may(tex);
-}
-
 static int shadow_crossing(void *ctx, const accel_hit *h)
 {
     shadow_walk *w = ctx;
@@ -795,16 +786,17 @@ static int shadow_crossing(void *ctx, const accel_hit *h)
     int inside;
     if (!shade_tex_walk_take(&w->walk, h, w->dir, &depth, &inside)) return 1;
     const scene_obj_photons *ph = h->obj ? h->obj->photons : NULL;
-    if ((w->photon_light && ph && ph->target && scene_photon_lobe(w->photon_light, ph, 1)) ||
-        opaque_crossing(h->obj, h->texture)) {
+    if (w->photon_light && ph && ph->target && scene_photon_lobe(w->photon_light, ph, 1)) {
         w->c = trgb(0, 0, 0);
         return 0;
     }
     if (h->ng.x == 0.0 && h->ng.y == 0.0 && h->ng.z == 0.0) {
-        /* a record without its surface (shadow_surface said so: no
-         * interior texture, no fade, plain colours): the filter is
-         * shade_tex_shadow_filter_inside's product of the colours */
-        w->c = tmul(w->c, shadow_layers_colours(h->texture));
+        /* a record without its surface (shadow_surface said so): plain
+         * colours without interior texture or fade, whose filter is
+         * shade_tex_shadow_filter_inside's product of the colours, or an
+         * opaque_crossing, whose filter is 0 */
+        const scene_texture *tex = h->texture;
+        w->c = tex && !shadow_layers_plain(tex) ? trgb(0, 0, 0) : tmul(w->c, shadow_layers_colours(tex));
     } else {
         /* distance inside the object: from the previous crossing taken */
         accel_hit hh = *h;
@@ -816,6 +808,15 @@ static int shadow_crossing(void *ctx, const accel_hit *h)
         return 0;
     }
     return 1;
+}
+
+/* A crossing of a texture that lets no light through anywhere
+ * (transmit_texture_may), on an object without an interior texture that
+ * might: its filter is 0 wherever it is crossed, so the walk ends there
+ * without reading its surface (its pattern pigments). */
+static int opaque_crossing(const scene_object *obj, const scene_texture *tex)
+{
+    return obj && tex && !obj->interior_texture && !transmit_texture_may(tex);
 }
 
 /* Whether shadow_crossing reads the surface of a crossing of obj with

@@ -671,17 +671,17 @@ static const char *caustic_bounce_fmt =
     "box { <2, 0, -2>, <2.1, 1.9, 2> pigment { rgb 1 } finish { ambient 0 diffuse 0.8 } }\n"
     "%s\n";
 
-/* Mean of partray's default particle render of the scene (32 x 24). */
-static double particle_mean(int rl, const char *photons, const char *slab, long *caustic_photons)
+enum { GI_W = 32, GI_H = 24 };
+
+/* Mean of partray's default particle render of w (GI_W x GI_H, the C
+ * build); *caustic_photons: the caustic layer's stored photons. */
+static double particle_mean_of(const tu_world *w, long *caustic_photons)
 {
-    char text[2048];
-    snprintf(text, sizeof text, caustic_bounce_fmt, rl, photons, slab);
-    tu_world w = tu_world_build("test.pov", text);
     render_gi_opts o;
     memset(&o, 0, sizeof o);
     o.mode = GI_PARTICLE;
-    o.width = 32;
-    o.height = 24;
+    o.width = GI_W;
+    o.height = GI_H;
     o.threads = THREADS;
     o.seed = 1;
     o.quality = 9;
@@ -689,12 +689,38 @@ static double particle_mean(int rl, const char *photons, const char *slab, long 
     framebuffer *fb = fb_new(o.width, o.height);
     render_gi_result r;
     memset(&r, 0, sizeof r);
-    assert_int_equal(render_gi(w.s, w.a, &o, fb, &r, w.d), PT_OK);
+    assert_int_equal(render_gi(w->s, w->a, &o, fb, &r, w->d), PT_OK);
     *caustic_photons = r.caus.st.stored;
-    double m = 0.0;
-    for (int i = 0; i < o.width * o.height * 3; i++) m += fb->rgb[i];
-    m /= o.width * o.height * 3;
+    double m = fb_mean(fb, -1);
     fb_free(fb);
+    return m;
+}
+
+/* Mean of the path tracer's render of w (GI_W x GI_H, spp samples). */
+static double path_mean_of(const tu_world *w, int spp)
+{
+    pm_path_settings ps;
+    pm_path_default_settings(&ps);
+    ps.c.width = GI_W;
+    ps.c.height = GI_H;
+    ps.c.threads = THREADS;
+    ps.c.spp = spp;
+    ps.c.seed = 3;
+    framebuffer *fb = fb_new(GI_W, GI_H);
+    pm_stats st;
+    assert_int_equal(pm_path_render(w->s, w->a, &ps, fb, &st, NULL), PT_OK);
+    double m = fb_mean(fb, -1);
+    fb_free(fb);
+    return m;
+}
+
+/* particle_mean_of the caustic bounce scene. */
+static double particle_mean(int rl, const char *photons, const char *slab, long *caustic_photons)
+{
+    char text[2048];
+    snprintf(text, sizeof text, caustic_bounce_fmt, rl, photons, slab);
+    tu_world w = tu_world_build("test.pov", text);
+    double m = particle_mean_of(&w, caustic_photons);
     tu_world_free(&w);
     return m;
 }
@@ -743,40 +769,13 @@ static void test_filtered_shadow_gi(void **state)
         char text[2048];
         snprintf(text, sizeof text, pane_fmt, rl);
         tu_world w = tu_world_build("test.pov", text);
-        render_gi_opts o;
-        memset(&o, 0, sizeof o);
-        o.mode = GI_PARTICLE;
-        o.width = 32;
-        o.height = 24;
-        o.threads = THREADS;
-        o.seed = 1;
-        o.quality = 9;
-        o.cl_device = "c";
-        framebuffer *fb = fb_new(o.width, o.height), *fp = fb_new(o.width, o.height);
-        render_gi_result r;
-        memset(&r, 0, sizeof r);
-        assert_int_equal(render_gi(w.s, w.a, &o, fb, &r, w.d), PT_OK);
-        pm_path_settings ps;
-        pm_path_default_settings(&ps);
-        ps.c.width = o.width;
-        ps.c.height = o.height;
-        ps.c.threads = THREADS;
-        ps.c.spp = 1024;
-        ps.c.seed = 3;
-        pm_stats st;
-        assert_int_equal(pm_path_render(w.s, w.a, &ps, fp, &st, NULL), PT_OK);
-        double mg = 0.0, mp = 0.0;
-        for (int i = 0; i < o.width * o.height * 3; i++) {
-            mg += fb->rgb[i];
-            mp += fp->rgb[i];
-        }
+        long nc = 0;
+        double mg = particle_mean_of(&w, &nc), mp = path_mean_of(&w, 1024);
         printf("recursion_limit %d: room lit through a transparent pane: particle %.5f, path %.5f (rel err %+.4f, "
                "tol 0.03)\n",
                rl, mg, mp, mg / mp - 1.0);
         assert_true(mp > 0.0);
         assert_true(fabs(mg / mp - 1.0) <= 0.03);
-        fb_free(fb);
-        fb_free(fp);
         tu_world_free(&w);
     }
 }

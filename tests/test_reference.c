@@ -761,6 +761,23 @@ static void test_interior_fade(void **state)
 
 /* ------------------------------------------------------------ beyond the photons */
 
+/* Means of path (pspp samples a pixel, seed 3) into *mp and pmfg (fspp
+ * samples, seed 7, `photons` photon paths, its default gather rays) into
+ * *mg over a w x h image of scene src. */
+static void path_fg_means(const char *src, int w, int h, int pspp, int fspp, long photons, double *mp, double *mg)
+{
+    scene *sc = parse(src);
+    accel *a = build(sc);
+    framebuffer *fp = fb_new(w, h), *fg = fb_new(w, h);
+    render_path_fg(sc, a, fp, pspp, 3, fg, fspp, 7, photons, 0);
+    *mp = fb_avg(fp);
+    *mg = fb_avg(fg);
+    fb_free(fp);
+    fb_free(fg);
+    accel_free(a);
+    scene_free(sc);
+}
+
 /* pmfg where the photons do not land: the sky's photons are aimed across
  * the sphere around the finite objects, so an infinite floor beyond it
  * holds none. A white wall (1 x 1) standing on such a floor under a
@@ -770,25 +787,18 @@ static void test_interior_fade(void **state)
 static void test_beyond_photons(void **state)
 {
     (void)state;
-    scene *sc = parse("#version 3.7;\n"
-                      "global_settings { assumed_gamma 1 radiosity { recursion_limit 2 } }\n"
-                      "camera { location <0, 0.5, -3> look_at <0, 0.5, 0> angle 15 }\n"
-                      "sky_sphere { pigment { rgb 1 } }\n"
-                      "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 0.8 } }\n"
-                      "box { <-0.5, 0, 0>, <0.5, 1, 0.1> pigment { rgb 1 } finish { ambient 0 diffuse 0.8 } }\n");
-    accel *a = build(sc);
-    enum { S = 16 };
-    framebuffer *fp = fb_new(S, S), *fg = fb_new(S, S);
-    render_path_fg(sc, a, fp, 1024, 3, fg, 4, 7, 100000, 0);
-    double mp = fb_avg(fp), mg = fb_avg(fg);
+    double mp, mg;
+    path_fg_means("#version 3.7;\n"
+                  "global_settings { assumed_gamma 1 radiosity { recursion_limit 2 } }\n"
+                  "camera { location <0, 0.5, -3> look_at <0, 0.5, 0> angle 15 }\n"
+                  "sky_sphere { pigment { rgb 1 } }\n"
+                  "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 0.8 } }\n"
+                  "box { <-0.5, 0, 0>, <0.5, 1, 0.1> pigment { rgb 1 } finish { ambient 0 diffuse 0.8 } }\n",
+                  16, 16, 1024, 4, 100000, &mp, &mg);
     printf("wall on an infinite floor under a sky: pmfg mean %.5f, path %.5f (%+.2f%%, tol 2%%)\n", mg, mp,
            100.0 * (mg / mp - 1.0));
     assert_true(mp > 0.5);
     assert_true(fabs(mg / mp - 1.0) <= 0.02);
-    fb_free(fp);
-    fb_free(fg);
-    accel_free(a);
-    scene_free(sc);
 }
 
 /* A point light far outside the objects (a sun placed far away) lights a
@@ -801,26 +811,19 @@ static void test_beyond_photons(void **state)
 static void test_far_light_photons(void **state)
 {
     (void)state;
-    scene *sc = parse("#version 3.7;\n"
-                      "global_settings { assumed_gamma 1 radiosity { recursion_limit 2 } }\n"
-                      "camera { location <0, 1, -0.9> look_at <0, 1.2, 1> angle 90 }\n"
-                      "light_source { <1e4, 2e4, 3e3> color rgb 1 }\n"
-                      "difference { box { <-1.1, -0.1, -1.1>, <1.1, 2.1, 1.1> } box { <-1, 0, -1>, <1, 2, 1> }\n"
-                      "  box { <0.9, 0.5, -0.5>, <1.2, 1.5, 0.5> }\n"
-                      "  pigment { rgb 0.9 } finish { ambient 0 diffuse 1 } }\n");
-    accel *a = build(sc);
-    const int W = 32, H = 24;
-    framebuffer *fp = fb_new(W, H), *fg = fb_new(W, H);
-    render_path_fg(sc, a, fp, 1024, 3, fg, 16, 7, 2000000, 0);
-    double mp = fb_avg(fp), mg = fb_avg(fg);
+    double mp, mg;
+    path_fg_means("#version 3.7;\n"
+                  "global_settings { assumed_gamma 1 radiosity { recursion_limit 2 } }\n"
+                  "camera { location <0, 1, -0.9> look_at <0, 1.2, 1> angle 90 }\n"
+                  "light_source { <1e4, 2e4, 3e3> color rgb 1 }\n"
+                  "difference { box { <-1.1, -0.1, -1.1>, <1.1, 2.1, 1.1> } box { <-1, 0, -1>, <1, 2, 1> }\n"
+                  "  box { <0.9, 0.5, -0.5>, <1.2, 1.5, 0.5> }\n"
+                  "  pigment { rgb 0.9 } finish { ambient 0 diffuse 1 } }\n",
+                  32, 24, 1024, 16, 2000000, &mp, &mg);
     printf("room lit through a window by a far point light: pmfg mean %.5f, path %.5f (%+.2f%%, tol 2%%)\n", mg, mp,
            100.0 * (mg / mp - 1.0));
     assert_true(mp > 0.0);
     assert_true(fabs(mg / mp - 1.0) <= 0.02);
-    fb_free(fp);
-    fb_free(fg);
-    accel_free(a);
-    scene_free(sc);
 }
 
 /* A white room lit by a light outside through a window closed by a
@@ -833,28 +836,21 @@ static void test_far_light_photons(void **state)
 static void test_filtered_window(void **state)
 {
     (void)state;
-    scene *sc = parse("#version 3.7;\n"
-                      "global_settings { assumed_gamma 1 radiosity { recursion_limit 2 } }\n"
-                      "camera { location <0, 1, -0.9> look_at <0, 1.2, 1> angle 90 }\n"
-                      "light_source { <6, 5, 0.5> color rgb 1 }\n"
-                      "difference { box { <-1.1, -0.1, -1.1>, <1.1, 2.1, 1.1> } box { <-1, 0, -1>, <1, 2, 1> }\n"
-                      "  box { <0.9, 0.5, -0.5>, <1.2, 1.5, 0.5> }\n"
-                      "  pigment { rgb 0.9 } finish { ambient 0 diffuse 1 } }\n"
-                      "box { <1.02, 0.45, -0.55>, <1.05, 1.55, 0.55> pigment { rgbt <1, 1, 1, 0.7> }\n"
-                      "  finish { ambient 0 diffuse 0.1 } interior { ior 1.5 } }\n");
-    accel *a = build(sc);
-    const int W = 32, H = 24;
-    framebuffer *fp = fb_new(W, H), *fg = fb_new(W, H);
-    render_path_fg(sc, a, fp, 1024, 3, fg, 16, 7, 2000000, 0);
-    double mp = fb_avg(fp), mg = fb_avg(fg);
+    double mp, mg;
+    path_fg_means("#version 3.7;\n"
+                  "global_settings { assumed_gamma 1 radiosity { recursion_limit 2 } }\n"
+                  "camera { location <0, 1, -0.9> look_at <0, 1.2, 1> angle 90 }\n"
+                  "light_source { <6, 5, 0.5> color rgb 1 }\n"
+                  "difference { box { <-1.1, -0.1, -1.1>, <1.1, 2.1, 1.1> } box { <-1, 0, -1>, <1, 2, 1> }\n"
+                  "  box { <0.9, 0.5, -0.5>, <1.2, 1.5, 0.5> }\n"
+                  "  pigment { rgb 0.9 } finish { ambient 0 diffuse 1 } }\n"
+                  "box { <1.02, 0.45, -0.55>, <1.05, 1.55, 0.55> pigment { rgbt <1, 1, 1, 0.7> }\n"
+                  "  finish { ambient 0 diffuse 0.1 } interior { ior 1.5 } }\n",
+                  32, 24, 1024, 16, 2000000, &mp, &mg);
     printf("room lit through a transparent pane (filtered shadow): pmfg mean %.5f, path %.5f (%+.2f%%, tol 2%%)\n", mg,
            mp, 100.0 * (mg / mp - 1.0));
     assert_true(mp > 0.005);
     assert_true(fabs(mg / mp - 1.0) <= 0.02);
-    fb_free(fp);
-    fb_free(fg);
-    accel_free(a);
-    scene_free(sc);
 }
 
 /* The sky below the horizon lies behind an infinite ground: a background
