@@ -299,7 +299,7 @@ pt_status caustics_build(caustics *c, const scene *sc, const accel *a, int width
     pt_status st = PT_OK;
     c->layer = gi_caustic_build(sc, a, &s, &hk, d, &st);
     if (c->layer) gi_caustic_get_stats(c->layer, &c->st);
-    else if (st == PT_OK) {
+    else if (st == PT_OK && !(cancel && *cancel)) {
         src_loc nowhere = {0};
         diag_warn_once(d, nowhere, "photons: no light shoots photons at a photons { target } object: no caustics");
     }

@@ -14,13 +14,17 @@
 #include "radrules.h"
 #include "pm_path.h"
 #include "render_gi.h"
+#include "caustics.h"
 
 /* A mode's state (ctx) is ctx_size bytes that view_gi_open allocates
  * zeroed and view_gi_close frees: open fills it (and may leave it half
  * filled when it fails), close (NULL: nothing to do) frees what it holds. */
 typedef struct {
     int mode;
-    int slow_light;   /* the lighting stage is slow: a pass with the new lights and the old GI first */
+    /* the lighting stage can be slow (none: the caustic layer's photons;
+     * particle: its lighting stage): a pass with the new lights and the
+     * old GI first, when the last stage took longer than a preview */
+    int slow_light;
     size_t ctx_size;
     int (*last_level)(const view_gi_opts *o);
     pt_status (*open)(void *ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d);
@@ -52,11 +56,81 @@ struct view_gi {
     int reframed;
 };
 
+/* --------------------------------------------------------- caustic layer */
+/* The scene's photons{} in the none and particle modes, as `partray
+ * render` has them (caustics.h): shot when the mode opens, and again by a
+ * relight when the lights differ from those the layer was shot from. A
+ * camera move needs nothing: the layer's G-buffer is the opening camera's,
+ * and a lookup away from it is answered from the photons themselves
+ * (gi_caustic_at). A new layer is built in the free slot and takes over
+ * only when complete, so a cancelled relight keeps the old one; a slot is
+ * its layer's hook context, so slots never move. */
+typedef struct {
+    caustics slot[2];
+    int cur;
+    scene_light *lights;   /* the lights the current layer was shot from */
+    int nlights;
+} view_caus;
+
+static caustics *caus_cur(view_caus *v) { return v->slot[v->cur].layer ? &v->slot[v->cur] : NULL; }
+
+/* The lights differ from the current layer's (or there is none yet). */
+static int caus_stale(const view_caus *v, const scene *sc)
+{
+    if (!sc->global.photons.enabled) return 0;
+    return !v->lights || v->nlights != sc->nlights ||
+           (sc->nlights > 0 && memcmp(v->lights, sc->lights, (size_t)sc->nlights * sizeof *sc->lights) != 0);
+}
+
+/* Shoots the layer for the scene's lights unless it is up to date. The
+ * scene's photon warnings go to d when the mode opens (first), not again
+ * at each relight. */
+static pt_status caus_update(view_caus *v, const scene *sc, const accel *a, const view_gi_opts *o,
+                             volatile int *cancel, diag *d)
+{
+    if (!caus_stale(v, sc)) return PT_OK;
+    int first = v->lights == NULL, nxt = 1 - v->cur;
+    diag *dl = first ? d : diag_new();
+    if (!dl) return PT_ERR_NOMEM;
+    int w = o->width > 0 ? o->width : 160, h = o->height > 0 ? o->height : 120;
+    pt_status st = caustics_build(&v->slot[nxt], sc, a, w, h, o->threads, o->seed, o->cl_device, 0, 0.0, 0, cancel, dl);
+    if (!first) {
+        if (st != PT_OK) diag_error(d, "caustic layer: %s", pt_status_name(st));
+        diag_free(dl);
+    }
+    if (st != PT_OK || (cancel && *cancel)) {
+        caustics_free(&v->slot[nxt]);
+        return st;
+    }
+    scene_light *l = malloc((size_t)(sc->nlights > 0 ? sc->nlights : 1) * sizeof *l);
+    if (!l) {
+        caustics_free(&v->slot[nxt]);
+        return PT_ERR_NOMEM;
+    }
+    if (sc->nlights > 0) memcpy(l, sc->lights, (size_t)sc->nlights * sizeof *l);
+    caustics_free(&v->slot[v->cur]);
+    v->cur = nxt;
+    free(v->lights);
+    v->lights = l;
+    v->nlights = sc->nlights;
+    return PT_OK;
+}
+
+static void caus_free(view_caus *v)
+{
+    caustics_free(&v->slot[0]);
+    caustics_free(&v->slot[1]);
+    free(v->lights);
+    v->lights = NULL;
+}
+
 /* ------------------------------------------------------------------ none */
 
 typedef struct {
     const scene *sc;
     const accel *a;
+    view_gi_opts o;
+    view_caus caus;
     long rays;
 } none_ctx;
 
@@ -79,13 +153,15 @@ static void whitted_settings(shade_settings *ss, const view_gi_pass *p)
  * GI method's pass (gi) the ambient follows the radiosity rules as in
  * render_gi.c and fn, when given, answers the indirect light. */
 static pt_status whitted_render(const scene *sc, const accel *a, const view_gi_pass *p, int gi, shade_indirect_fn fn,
-                                void *fn_ctx, framebuffer *fb, shade_stats *st, view_gi_times *t, diag *d)
+                                void *fn_ctx, caustics *caus, framebuffer *fb, shade_stats *st, view_gi_times *t,
+                                diag *d)
 {
     shade_settings ss;
     whitted_settings(&ss, p);
     if (gi) ss.use_ambient = radrules_of(sc, 1).ambient;
     ss.indirect = fn;
     ss.indirect_ctx = fn_ctx;
+    if (caus) caustics_attach(caus, &ss); /* after the mode's hook, which it keeps */
     double t0 = timer_now();
     pt_status s = shade_render(sc, a, &ss, fb, st, d);
     t->render = timer_now() - t0;
@@ -99,16 +175,27 @@ static pt_status none_open(void *ctx, const scene *sc, const accel *a, const vie
     none_ctx *c = ctx;
     c->sc = sc;
     c->a = a;
-    return PT_OK;
+    c->o = *o;
+    double t0 = timer_now();
+    pt_status st = caus_update(&c->caus, sc, a, o, NULL, d);
+    t->light = timer_now() - t0;
+    return st;
 }
 
-static pt_status none_relight(void *ctx, volatile int *cancel, view_gi_times *t, diag *d) { return PT_OK; }
+static pt_status none_relight(void *ctx, volatile int *cancel, view_gi_times *t, diag *d)
+{
+    none_ctx *c = ctx;
+    double t0 = timer_now();
+    pt_status st = caus_update(&c->caus, c->sc, c->a, &c->o, cancel, d);
+    t->light = timer_now() - t0;
+    return st;
+}
 
 static pt_status none_render(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
 {
     none_ctx *c = ctx;
     shade_stats st;
-    pt_status s = whitted_render(c->sc, c->a, p, 0, NULL, NULL, fb, &st, t, d);
+    pt_status s = whitted_render(c->sc, c->a, p, 0, NULL, NULL, caus_cur(&c->caus), fb, &st, t, d);
     c->rays = st.primary_rays + st.shadow_rays + st.secondary_rays;
     return s;
 }
@@ -116,8 +203,14 @@ static pt_status none_render(void *ctx, const view_gi_pass *p, framebuffer *fb, 
 static void none_describe(void *ctx, char *buf, int n)
 {
     none_ctx *c = ctx;
-    snprintf(buf, (size_t)n, "%.2f Mrays", c->rays * 1e-6);
+    caustics *k = caus_cur(&c->caus);
+    if (k)
+        snprintf(buf, (size_t)n, "%.2f Mrays, %ld caustic photons", c->rays * 1e-6, k->st.stored);
+    else
+        snprintf(buf, (size_t)n, "%.2f Mrays", c->rays * 1e-6);
 }
+
+static void none_close(void *ctx) { caus_free(&((none_ctx *)ctx)->caus); }
 
 /* -------------------------------------------------------------- particle */
 /* Two instances on the same scene copy: the mode's own (the scene's or
@@ -133,13 +226,28 @@ typedef struct {
     gi_particle *gpq;      /* preview instance, NULL when the count is too small for one */
     gi_particle_stats stats, statsq;
     double t_light_q;      /* its last lighting stage */
+    view_gi_opts o;
+    view_caus caus;        /* both instances' caustic photons (their light, and the passes') */
 } particle_ctx;
+
+/* The caustic layer for the lights of the scene, given to both instances:
+ * their lighting stages take its photons as light (POV-Ray's radiosity
+ * sees photons), as render_gi.c's particle mode does. */
+static pt_status particle_caustics(particle_ctx *c, volatile int *cancel, diag *d)
+{
+    pt_status st = caus_update(&c->caus, c->sc, c->a, &c->o, cancel, d);
+    caustics *k = caus_cur(&c->caus);
+    if (c->gp) gi_particle_set_caustic(c->gp, k ? k->layer : NULL);
+    if (c->gpq) gi_particle_set_caustic(c->gpq, k ? k->layer : NULL);
+    return st;
+}
 
 static pt_status particle_open(void *ctx, const scene *sc, const accel *a, const view_gi_opts *o, view_gi_times *t, diag *d)
 {
     particle_ctx *c = ctx;
     c->sc = sc;
     c->a = a;
+    c->o = *o;
     gi_particle_settings s;
     render_gi_particle_settings(&s, sc);
     s.threads = o->threads;
@@ -149,10 +257,13 @@ static pt_status particle_open(void *ctx, const scene *sc, const accel *a, const
     pt_status st = PT_OK;
     c->gp = gi_particle_build(sc, a, &s, &c->stats, d, &st);
     if (!c->gp || st != PT_OK) return st != PT_OK ? st : PT_ERR_INTERNAL;
+    double t0 = timer_now();
+    if ((st = particle_caustics(c, NULL, d)) != PT_OK) return st;
+    double t_caus = timer_now() - t0;
     st = gi_particle_light(c->gp, d);
     const gi_particle_stats *gs = gi_particle_get_stats(c->gp);
     t->build = gs->t_geometry;
-    t->light = gs->t_lighting;
+    t->light = gs->t_lighting + t_caus;
     if (st != PT_OK) return st;
     long nq = o->preview_particles > 0 ? o->preview_particles : s.count / 8;
     if (o->preview_particles >= 0 && nq >= 500 && nq <= s.count / 2) {
@@ -162,6 +273,8 @@ static pt_status particle_open(void *ctx, const scene *sc, const accel *a, const
         pt_status stq = PT_OK;
         diag *dq = diag_new();
         c->gpq = gi_particle_build(sc, a, &sq, &c->statsq, dq, &stq);
+        caustics *k = caus_cur(&c->caus);
+        if (c->gpq && k) gi_particle_set_caustic(c->gpq, k->layer);
         if (c->gpq && stq == PT_OK) stq = gi_particle_light(c->gpq, dq);
         if (!c->gpq || stq != PT_OK) {
             /* the mode works without it: its messages are dropped */
@@ -177,11 +290,19 @@ static pt_status particle_open(void *ctx, const scene *sc, const accel *a, const
     return PT_OK;
 }
 
-static pt_status relight_one(gi_particle *gp, volatile int *cancel, double *seconds, diag *d)
+/* The caustic layer for the new lights first (whichever instance is relit
+ * first shoots it; a cancelled shot keeps the old layer and the old
+ * lighting), then the instance's lighting stage. */
+static pt_status relight_one(particle_ctx *c, gi_particle *gp, volatile int *cancel, double *seconds, diag *d)
 {
     double t0 = timer_now();
+    pt_status st = particle_caustics(c, cancel, d);
+    if (st != PT_OK || (cancel && *cancel)) {
+        *seconds = timer_now() - t0;
+        return st;
+    }
     gi_particle_set_cancel(gp, cancel); /* stops in the visibility pass, old lighting kept */
-    pt_status st = gi_particle_relight(gp, d);
+    st = gi_particle_relight(gp, d);
     gi_particle_set_cancel(gp, NULL);
     *seconds = timer_now() - t0;
     return st;
@@ -190,7 +311,7 @@ static pt_status relight_one(gi_particle *gp, volatile int *cancel, double *seco
 static pt_status particle_relight(void *ctx, volatile int *cancel, view_gi_times *t, diag *d)
 {
     particle_ctx *c = ctx;
-    return relight_one(c->gp, cancel, &t->light, d);
+    return relight_one(c, c->gp, cancel, &t->light, d);
 }
 
 static int particle_has_preview(void *ctx) { return ((particle_ctx *)ctx)->gpq != NULL; }
@@ -199,7 +320,7 @@ static pt_status particle_relight_preview(void *ctx, volatile int *cancel, view_
 {
     particle_ctx *c = ctx;
     if (!c->gpq) return PT_ERR_UNSUPPORTED;
-    pt_status st = relight_one(c->gpq, cancel, &t->light, d);
+    pt_status st = relight_one(c, c->gpq, cancel, &t->light, d);
     if (st == PT_OK && !(cancel && *cancel)) c->t_light_q = t->light;
     return st;
 }
@@ -211,7 +332,7 @@ static pt_status particle_render(void *ctx, const view_gi_pass *p, framebuffer *
     pt_status st = gi_particle_prepare_view(gp, &c->sc->camera, p->width, p->height, d);
     t->view = gi_particle_get_stats(gp)->t_view;
     if (st != PT_OK) return st;
-    return whitted_render(c->sc, c->a, p, 1, gi_particle_indirect, gp, fb, NULL, t, d);
+    return whitted_render(c->sc, c->a, p, 1, gi_particle_indirect, gp, caus_cur(&c->caus), fb, NULL, t, d);
 }
 
 static void particle_describe(void *ctx, char *buf, int n)
@@ -221,9 +342,12 @@ static void particle_describe(void *ctx, char *buf, int n)
     char q[48] = "";
     if (c->gpq)
         snprintf(q, sizeof q, " (preview %ld, %.0f ms)", gi_particle_get_stats(c->gpq)->particles, c->t_light_q * 1e3);
-    snprintf(buf, (size_t)n, "%ld particles%s, %d bounces, lighting %.0f ms (visibility %.0f, emit %.0f, scatter %.0f)",
+    caustics *k = caus_cur(&c->caus);
+    char cp[48] = "";
+    if (k) snprintf(cp, sizeof cp, ", %ld caustic photons", k->st.stored);
+    snprintf(buf, (size_t)n, "%ld particles%s, %d bounces, lighting %.0f ms (visibility %.0f, emit %.0f, scatter %.0f)%s",
              s->particles, q, s->bounces, s->t_lighting * 1e3, s->t_visibility * 1e3, s->t_emit * 1e3,
-             s->t_scatter * 1e3);
+             s->t_scatter * 1e3, cp);
 }
 
 static void particle_close(void *ctx)
@@ -231,6 +355,7 @@ static void particle_close(void *ctx)
     particle_ctx *c = ctx;
     gi_particle_free(c->gp);
     gi_particle_free(c->gpq);
+    caus_free(&c->caus);
 }
 
 /* ----------------------------------------------------------------- links */
@@ -321,7 +446,7 @@ static void links_adopt(void *ctx)
 static pt_status links_render(void *ctx, const view_gi_pass *p, framebuffer *fb, view_gi_times *t, diag *d)
 {
     links_ctx *c = ctx;
-    return whitted_render(c->sc, c->a, p, 1, c->shot ? gi_vlinks_shot_indirect : NULL, c->shot, fb, NULL, t, d);
+    return whitted_render(c->sc, c->a, p, 1, c->shot ? gi_vlinks_shot_indirect : NULL, c->shot, NULL, fb, NULL, t, d);
 }
 
 static void links_describe(void *ctx, char *buf, int n)
@@ -463,8 +588,8 @@ static void ref_close(void *ctx) { fb_free(((ref_ctx *)ctx)->sum); }
 /* ----------------------------------------------------------------- table */
 
 static const gi_backend backends[] = {
-    {GI_NONE, 0, sizeof(none_ctx), whitted_last_level, none_open, none_relight, NULL, NULL, none_render, none_describe,
-     NULL},
+    {GI_NONE, 1, sizeof(none_ctx), whitted_last_level, none_open, none_relight, NULL, NULL, none_render, none_describe,
+     none_close},
     {GI_PARTICLE, 1, sizeof(particle_ctx), whitted_last_level, particle_open, particle_relight, particle_has_preview,
      particle_relight_preview, particle_render, particle_describe, particle_close},
     {GI_LINKS, 0, sizeof(links_ctx), whitted_last_level, links_open, links_relight, NULL, NULL, links_render,

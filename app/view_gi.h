@@ -5,7 +5,10 @@
  *
  *   none      shade_render: direct light + Whitted (+ POV-Ray's ambient).
  *             Levels: 0 preview, 1 full resolution, 2 adaptive antialiasing
- *             (+A0.3 +R3).
+ *             (+A0.3 +R3). A scene with photons{} gets its caustic layer
+ *             (caustics.h) in this mode and in particle, as `partray
+ *             render` does: shot when the mode opens and again by a
+ *             relight when the lights moved.
  *   particle  gi_particle (seed 000): open = geometry + lighting stage,
  *             relight = lighting stage only, every pass = prepare_view +
  *             shade_render with the indirect hook. Levels as `none`.
@@ -54,6 +57,10 @@ typedef struct {
     int bounces;            /* particle: n_b (<= 0: from the scene) */
     const char *cl_device;  /* particle: OpenCL device (NULL: auto) */
     long preview_particles; /* particle: the preview instance's count (0: 1/8 of the mode's, < 0: none) */
+    /* none, particle: the caustic layer of the scene's photons{}: its
+     * G-buffer's size (the image's; <= 0: 160 x 120) and its jitter's seed */
+    int width, height;
+    uint64_t seed;
 } view_gi_opts;
 
 typedef struct {

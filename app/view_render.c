@@ -138,7 +138,8 @@ static void copy_messages(diag *dst, const diag *src)
 static view_gi_opts gi_opts(const view_render *vr)
 {
     view_gi_opts go = {.preview_particles = vr->o.preview_particles, .threads = vr->o.threads, .ref_spp = vr->o.ref_spp,
-                       .particles = vr->o.particles, .bounces = vr->o.bounces, .cl_device = vr->o.cl_device};
+                       .particles = vr->o.particles, .bounces = vr->o.bounces, .cl_device = vr->o.cl_device,
+                       .width = vr->o.width, .height = vr->o.height, .seed = vr->o.seed};
     return go;
 }
 

@@ -39,6 +39,7 @@
 #include "gi_vlinks.h"
 #include "img_io.h"
 #include "radrules.h"
+#include "render_gi.h"
 #include "scene.h"
 #include "sdl.h"
 #include "shade.h"
@@ -842,6 +843,161 @@ static void test_particle_relight_cancel(void **st)
     diag_free(d);
 }
 
+/* ------------------------------------- caustic layer, no display */
+
+/* A glass sphere over a floor under a point light, photons{} on it; the
+ * camera looks straight down at the caustic (the sphere is no_image). %s:
+ * the global photons block, the light's x. */
+static const char *caustic_view_fmt =
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 max_trace_level 10 %s radiosity { count 20 recursion_limit 2 } }\n"
+    "camera { orthographic location <0, 5, 0> look_at <0, 0, 0> sky z right x*0.6 up z*0.6 }\n"
+    "light_source { <%g, 10, 0> color rgb 1 }\n"
+    "sphere { <0, 0.8, 0>, 0.5 pigment { rgbf 1 } finish { ambient 0 diffuse 0 } interior { ior 1.5 } no_image\n"
+    "         photons { target refraction on reflection off } }\n"
+    "plane { y, 0 pigment { rgb 1 } finish { ambient 0 diffuse 0.8 } }\n"
+    "box { <0.4, 0, -1>, <0.5, 1, 1> pigment { rgb 1 } finish { ambient 0 diffuse 0.8 } }\n";
+
+static void caustic_world(double lx, int photons, scene **sc, accel **a)
+{
+    char text[1024];
+    snprintf(text, sizeof text, caustic_view_fmt, photons ? "photons { spacing 0.004 }" : "", lx);
+    sdl_options so;
+    sdl_default_options(&so);
+    diag *d = diag_new();
+    assert_int_equal(sdl_parse_string("caustic.pov", text, &so, sc, d), PT_OK);
+    pt_status ps = PT_OK;
+    *a = accel_build(*sc, 2, d, &ps);
+    assert_non_null(*a);
+    diag_free(d);
+}
+
+/* Mean green over the central c x c pixels of a w x w image. */
+static double centre_green(const framebuffer *fb, int c)
+{
+    double s = 0;
+    int w = fb->width;
+    for (int y = (w - c) / 2; y < (w + c) / 2; y++)
+        for (int x = (w - c) / 2; x < (w + c) / 2; x++) s += fb->rgb[((size_t)y * w + x) * 3 + 1];
+    return s / (c * c);
+}
+
+static view_gi *caustic_mode(int mode, const scene *sc, const accel *a, int w)
+{
+    view_gi_opts go;
+    memset(&go, 0, sizeof go);
+    go.threads = 2;
+    go.width = go.height = w;
+    go.seed = 1;
+    go.cl_device = "c";
+    go.particles = 1200;
+    go.preview_particles = -1;
+    view_gi_times t;
+    view_gi *g = NULL;
+    diag *d = diag_new();
+    assert_int_equal(view_gi_open(&g, mode, sc, a, &go, &t, d), PT_OK);
+    diag_free(d);
+    return g;
+}
+
+/* The viewer's none and particle modes show the scene's caustics, as
+ * `partray render` does: none's first full-resolution pass equals
+ * render_gi's --gi none image of the same size and seed exactly (one
+ * caustic layer, same G-buffer), and the caustic is there (the focus
+ * region at least 3 times as bright as without photons). A light edit: a
+ * cancelled relight keeps the old layer (the pass does not change), the
+ * relight that completes gives exactly the image of a mode opened with the
+ * light already there, in none and in particle (whose lighting stage takes
+ * the new layer's photons). */
+static void test_viewer_caustics(void **st)
+{
+    (void)st;
+    const int w = 40, c = 8;
+    scene *sc = NULL, *sc_b = NULL, *sc_off = NULL;
+    accel *a = NULL, *a_b = NULL, *a_off = NULL;
+    caustic_world(0.0, 1, &sc, &a);
+    caustic_world(1.0, 1, &sc_b, &a_b);
+    caustic_world(0.0, 0, &sc_off, &a_off);
+
+    view_gi *g = caustic_mode(GI_NONE, sc, a, w);
+    framebuffer *v = gi_pass(g, w, w);
+    render_gi_opts o;
+    memset(&o, 0, sizeof o);
+    o.mode = GI_NONE;
+    o.width = o.height = w;
+    o.threads = 2;
+    o.seed = 1;
+    o.quality = 9;
+    o.cl_device = "c";
+    framebuffer *r = fb_new(w, w);
+    render_gi_result rr;
+    memset(&rr, 0, sizeof rr);
+    diag *d = diag_new();
+    assert_int_equal(render_gi(sc, a, &o, r, &rr, d), PT_OK);
+    assert_true(rr.caus.st.stored > 1000);
+    view_gi *goff = caustic_mode(GI_NONE, sc_off, a_off, w);
+    framebuffer *voff = gi_pass(goff, w, w);
+    double e_render = max_diff(v, r), focus = centre_green(v, c), focus_off = centre_green(voff, c);
+    char desc[256];
+    view_gi_describe(g, desc, sizeof desc);
+    printf("none: view against render %.3g; focus %.4f, without photons %.4f (%s)\n", e_render, focus, focus_off, desc);
+    assert_true(e_render < 1e-6);
+    assert_true(focus > 3.0 * focus_off);
+
+    /* the light moves to x = 1 */
+    view_gi_scene(g)->lights[0].position = sc_b->lights[0].position;
+    view_gi_lights_changed(g);
+    framebuffer *q = gi_pass(g, w, w); /* new direct light, old caustics */
+    volatile int cancel = 1;
+    view_gi_times t;
+    assert_int_equal(view_gi_relight(g, &cancel, &t, d), PT_OK);
+    assert_true(view_gi_stale(g));
+    framebuffer *q2 = gi_pass(g, w, w);
+    cancel = 0;
+    assert_int_equal(view_gi_relight(g, &cancel, &t, d), PT_OK);
+    assert_false(view_gi_stale(g));
+    framebuffer *rl = gi_pass(g, w, w);
+    view_gi *gb = caustic_mode(GI_NONE, sc_b, a_b, w);
+    framebuffer *fresh = gi_pass(gb, w, w);
+    double e_cancel = max_diff(q, q2), e_fresh = max_diff(rl, fresh), e_moved = max_diff(q, rl);
+    printf("none: cancelled relight changed %.3g, relit vs opened there %.3g, caustic moved %.3g\n", e_cancel, e_fresh,
+           e_moved);
+    assert_true(e_cancel == 0);
+    assert_true(e_fresh < 1e-6);
+    assert_true(e_moved > 0.05);
+
+    /* particle: the same light edit */
+    view_gi *gp = caustic_mode(GI_PARTICLE, sc, a, w);
+    view_gi *gpoff = caustic_mode(GI_PARTICLE, sc_off, a_off, w);
+    framebuffer *p0 = gi_pass(gp, w, w), *poff = gi_pass(gpoff, w, w);
+    double pfocus = centre_green(p0, c), pfocus_off = centre_green(poff, c);
+    view_gi_scene(gp)->lights[0].position = sc_b->lights[0].position;
+    view_gi_lights_changed(gp);
+    assert_int_equal(view_gi_relight(gp, &cancel, &t, d), PT_OK);
+    framebuffer *prl = gi_pass(gp, w, w);
+    view_gi *gpb = caustic_mode(GI_PARTICLE, sc_b, a_b, w);
+    framebuffer *pfresh = gi_pass(gpb, w, w);
+    double pe_fresh = max_diff(prl, pfresh), pe_moved = max_diff(p0, prl);
+    view_gi_describe(gp, desc, sizeof desc);
+    printf("particle: focus %.4f, without photons %.4f; relit vs opened there %.3g, moved %.3g (%s)\n", pfocus,
+           pfocus_off, pe_fresh, pe_moved, desc);
+    assert_true(pfocus > 3.0 * pfocus_off);
+    assert_true(pe_fresh < 1e-5);
+    assert_true(pe_moved > 0.05);
+
+    framebuffer *fbs[] = {v, r, voff, q, q2, rl, fresh, p0, poff, prl, pfresh};
+    for (size_t i = 0; i < sizeof fbs / sizeof fbs[0]; i++) fb_free(fbs[i]);
+    view_gi *gs[] = {g, goff, gb, gp, gpoff, gpb};
+    for (size_t i = 0; i < sizeof gs / sizeof gs[0]; i++) view_gi_close(gs[i]);
+    accel_free(a);
+    accel_free(a_b);
+    accel_free(a_off);
+    scene_free(sc);
+    scene_free(sc_b);
+    scene_free(sc_off);
+    diag_free(d);
+}
+
 /* ------------------------------------------------- overlay, no display */
 
 static void test_overlay_font(void **st)
@@ -1328,6 +1484,7 @@ int main(void)
         cmocka_unit_test(test_render_thread_clock),
         cmocka_unit_test(test_overlay_font),
         cmocka_unit_test(test_particle_relight_cancel),
+        cmocka_unit_test(test_viewer_caustics),
         cmocka_unit_test(test_viewer_script),
         cmocka_unit_test(test_viewer_overlay_reference),
         cmocka_unit_test(test_viewer_functions),
