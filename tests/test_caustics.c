@@ -554,9 +554,13 @@ static void test_pass_through_filter(void **state)
  * lights it through diffuse_back): a glass sphere's caustic on a plane of
  * diffuse 0.6, 0.3, the camera below the plane. Every G-buffer pixel on the
  * plane has back = B / A = 0.5; its splatted value equals the sum over the
- * photons at its point with the normal turned down and back 0.5, which is
- * 0.5 x the sum seen from above (relative 1e-5); without B the underside
- * gets none. */
+ * photons at its point with the normal turned down and back 0.5. POV-Ray
+ * divides a photon from behind by 0.1 (its cosine against the normal
+ * turned to the viewer is negative, and the clamp makes it 0.1), not by
+ * its cosine c, so each photon weighs 0.5 x c / 0.1 from below against
+ * c / c seen from above: the sum from below is 5 x the sum seen from above
+ * at brilliance 2 (c^2 / c; every photon here arrives at c > 0.1),
+ * relative 1e-5. Without B the underside gets none. */
 static void test_diffuse_back_photons(void **state)
 {
     (void)state;
@@ -582,12 +586,14 @@ static void test_diffuse_back_photons(void **state)
             on++;
             assert_true(gb[i].n[1] < 0.0f);
             assert_true(fabsf(gb[i].back - (k ? 0.5f : 0.0f)) < 1e-6f);
-            float up[3] = {-gb[i].n[0], -gb[i].n[1], -gb[i].n[2]}, e[3], t[3];
-            gi_c_caustic_at(ph, NULL, (int)n, gb[i].s, up, gb[i].brilliance, 0.0f, t);
-            gi_c_caustic_at(ph, NULL, (int)n, gb[i].s, gb[i].n, gb[i].brilliance, gb[i].back, e);
+            float up[3] = {-gb[i].n[0], -gb[i].n[1], -gb[i].n[2]}, e[3], t[3], t2[3];
+            assert_true(gb[i].brilliance == 1.0f);
+            gi_c_caustic_at(ph, NULL, (int)n, gb[i].s, up, 1.0f, 0.0f, t);
+            gi_c_caustic_at(ph, NULL, (int)n, gb[i].s, up, 2.0f, 0.0f, t2);
+            gi_c_caustic_at(ph, NULL, (int)n, gb[i].s, gb[i].n, 1.0f, gb[i].back, e);
             lit += t[1] > 0.0f;
             for (int c3 = 0; c3 < 3; c3++) {
-                double want = (k ? 0.5 : 0.0) * t[c3];
+                double want = (k ? 5.0 : 0.0) * t2[c3];
                 worst = fmax(worst, fabs(e[c3] - want) / fmax(t[c3], 1e-30));
                 worst = fmax(worst, fabs(img[4 * i + c3] - e[c3]) / fmax(t[c3], 1e-30));
             }

@@ -47,16 +47,24 @@ static inline float gi_caus_kappa(GI_GLOBAL const gi_caus_photon *q, float sx, f
  * diffuse * pigment is applied by the shader. A photon arriving on the
  * other side (c < 0) lights a finish with diffuse_back through it, as
  * POV-Ray's gather shades it as a light from behind: weight back = B / A
- * (the shader's diffuse A times it gives B) at |c|; back 0: not at all. */
+ * (the shader's diffuse A times it gives B) at |c|^b; back 0: not at all.
+ * Such a photon is divided by 0.1, not by |c|: POV-Ray takes the cosine
+ * against the normal turned to the viewer, negative from behind, and its
+ * clamp to at least 0.1 makes the division tenfold whatever the angle
+ * (ComputePhotonDiffuseLight; ComputeDiffuseColour then takes |c|^b
+ * times diffuse_back). */
 static inline void gi_caus_add(GI_GLOBAL const gi_caus_photon *q, float sx, float sy, float sz, float nx, float ny,
                                float nz, float b, float back, float *e)
 {
     float c = q->w[0] * nx + q->w[1] * ny + q->w[2] * nz;
-    float side = 1.0f;
+    float side = 1.0f, div;
     if (c <= 0.0f) {
         if (!(back > 0.0f) || c == 0.0f) return;
         c = -c;
         side = back;
+        div = 0.1f;
+    } else {
+        div = c > 0.1f ? c : 0.1f;
     }
     float k = gi_caus_kappa(q, sx, sy, sz);
     if (k <= 0.0f) return;
@@ -64,7 +72,7 @@ static inline void gi_caus_add(GI_GLOBAL const gi_caus_photon *q, float sx, floa
     /* c^b as exp2(b log2 c), c > 0 here: the native pair, where pow cost
      * PoCL as much as the rest of the sum (bench_caustics on glassthing,
      * whose walls have brilliance 0.6) */
-    k *= side * (b == 1.0f ? c : native_exp2(b * native_log2(c))) / (c > 0.1f ? c : 0.1f);
+    k *= side * (b == 1.0f ? c : native_exp2(b * native_log2(c))) / (div < 1.0f ? div : 1.0f);
     e[0] += q->phi[0] * k;
     e[1] += q->phi[1] * k;
     e[2] += q->phi[2] * k;
