@@ -225,6 +225,9 @@ static void sky_traced(const link_job *J, vec3 p, vec3 n, vec3 d, float out[3])
  * hit beyond the particles' box); 2 the sky as one traced ray sees it
  * (sky_traced: a hit within the box where no particle answers, which may
  * lie in a closed room) */
+/* org lies on n's side of p (the memo's last blocker is for that side). */
+static int org_front(vec3 p, vec3 org, vec3 n) { return v3_dot(v3_sub(org, p), n) > 0.0; }
+
 static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, int direct, emit_memo *memo, float out[3],
                          int level, double weight)
 {
@@ -254,16 +257,24 @@ static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, 
      * scene's gather). */
     float dir[3] = {0.0f, 0.0f, 0.0f};
     if (lit && mt->reflects) {
-        /* the shadow ray starts eps off the surface and ends short of the
-         * light (gi_shadow_tmax), its length measured from where it starts */
+        /* finish { diffuse A, B }: a light behind the hit lights it
+         * through diffuse_back, B / A of what the same light would give
+         * in front (POV-Ray's radiosity rays shade what they hit as the
+         * camera's rays do, trace.cpp ComputeDiffuseLight's backside) */
+        const scene_finish *fin = tex ? &tex->finish : NULL;
+        double bk = fin && fin->diffuse > 0.0 && fin->diffuse_back > 0.0 ? fin->diffuse_back / fin->diffuse : 0.0;
+        /* the shadow ray starts eps off the surface, on the light's side,
+         * and ends short of the light (gi_shadow_tmax), its length
+         * measured from where it starts */
         double eps = accel_epsilon(J->a, p, n);
-        vec3 org = v3_madd(p, n, eps);
         for (int l = 0; l < J->nlights; l++) {
             const gi_dev_light *lt = &J->lights[l];
             float dl[3];
             float depth = gi_light_ray(lt, lt->pos[0], lt->pos[1], lt->pos[2], (float)p.x, (float)p.y, (float)p.z, dl);
             double ci = n.x * dl[0] + n.y * dl[1] + n.z * dl[2];
-            if (!(ci > 0.0)) continue;
+            if (!(ci > 0.0) && !(ci < 0.0 && bk > 0.0)) continue;
+            vec3 org = v3_madd(p, n, ci > 0.0 ? eps : -eps);
+            if (ci < 0.0) ci = -ci * bk;
             float att = gi_light_attenuation(lt, (float)p.x, (float)p.y, (float)p.z, dl, depth);
             if (!(att > 0.0f)) continue;
             /* the light let through: all, or POV-Ray's filtered shadow of
@@ -273,7 +284,7 @@ static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, 
                 float ds[3];
                 double dep = gi_light_ray(lt, lt->pos[0], lt->pos[1], lt->pos[2], (float)org.x, (float)org.y, (float)org.z, ds);
                 double tmax = dep > 0.0 ? gi_shadow_tmax(dep, eps) : INFINITY;
-                unsigned *last = l < MEMO_LIGHTS ? &memo->blocker[l] : NULL;
+                unsigned *last = l < MEMO_LIGHTS && org_front(p, org, n) ? &memo->blocker[l] : NULL;
                 if (tmax > eps && accel_occluded_cached(J->a, last, org, v3(ds[0], ds[1], ds[2]), 0.0, tmax)) {
                     if (!J->hl.shadow) continue;
                     rgb t = J->hl.shadow(J->sc, J->a, org, v3(ds[0], ds[1], ds[2]), 0.0, tmax,
@@ -289,7 +300,7 @@ static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, 
         /* and the caustic photons there: POV-Ray's radiosity rays see
          * photons at every hit (trace.cpp, ComputeLightedTexture) */
         if (J->hl.caus && !(o->photons && !o->photons->collect)) {
-            rgb e = gi_caustic_world_at(J->hl.caus, p, n, 1.0, 0.0);
+            rgb e = gi_caustic_world_at(J->hl.caus, p, n, 1.0, bk);
             if (isfinite(e.r + e.g + e.b)) {
                 dir[0] += (float)e.r;
                 dir[1] += (float)e.g;

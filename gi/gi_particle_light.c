@@ -227,9 +227,18 @@ static int same_geometry(const scene_light *a, const scene_light *b)
 /* The caustic photons' E/pi at each particle (gi_caustic_world_at: the
  * photon volumes that hold its point, arriving on its side; its twin's
  * side is its twin's, gi_k_emit adds it through the back lobe), none on
- * objects with photons { collect off }. */
+ * objects with photons { collect off }.
+ * The back lobe (diffuse_back) takes the twin's photons as the twin sees
+ * them, each divided by its cosine; POV-Ray's radiosity rays see such a
+ * photon divided by 0.1 instead (the caustic layer's rule, gi_caustic.cl
+ * gi_caus_add), tenfold whatever its angle. back_over[i] is the photons
+ * from behind particle i weighted so (gi_caustic_world_at with back 1,
+ * less its front part), and particle_extra adds back x (that - the
+ * twin's own sum) to particle i's extra: its back lobe then sends what
+ * POV-Ray's would. */
 typedef struct {
     gi_particle *gp;
+    float *back_over; /* 3 floats per particle; NULL: no diffuse_back particle */
 } caus_job;
 
 #define CAUS_CHUNK 1024
@@ -244,9 +253,18 @@ static void caus_chunk(void *ctx, int ci, int thread)
         const gi_dev_particle *p = &gp->ps.p[i];
         const scene_object *o = gi_surface_object(gp->surf, gp->ps.patch[i]);
         rgb e = {0, 0, 0};
-        if (o && !(o->photons && !o->photons->collect))
-            e = gi_caustic_world_at(gp->caus, v3(p->p[0], p->p[1], p->p[2]), v3(p->n[0], p->n[1], p->n[2]),
-                                    p->brilliance, 0.0);
+        int collects = o && !(o->photons && !o->photons->collect);
+        vec3 pp = v3(p->p[0], p->p[1], p->p[2]), pn = v3(p->n[0], p->n[1], p->n[2]);
+        if (collects) e = gi_caustic_world_at(gp->caus, pp, pn, p->brilliance, 0.0);
+        if (J->back_over) {
+            float *b = &J->back_over[3 * (size_t)i];
+            b[0] = b[1] = b[2] = 0.0f;
+            if (collects && p->back > 0.0f && p->twin >= 0) {
+                rgb t = gi_caustic_world_at(gp->caus, pp, pn, p->brilliance, 1.0);
+                double v[3] = {t.r - e.r, t.g - e.g, t.b - e.b};
+                for (int c = 0; c < 3; c++) b[c] = isfinite(v[c]) && v[c] > 0.0 ? (float)v[c] : 0.0f;
+            }
+        }
         float *x = &gp->extra[4 * (size_t)i];
         x[0] = isfinite(e.r) && e.r > 0.0 ? (float)e.r : 0.0f;
         x[1] = isfinite(e.g) && e.g > 0.0 ? (float)e.g : 0.0f;
@@ -284,8 +302,23 @@ static const float *particle_extra(gi_particle *gp, double *fcaus, pt_status *st
     if ((!gp->caus && !gp->visf) || n <= 0) return NULL;
     if (!gp->extra && !(gp->extra = gi_particle_calloc((size_t)n * 4, sizeof(float), st))) return NULL;
     if (gp->caus) {
-        caus_job J = {gp};
+        caus_job J = {gp, NULL};
+        int backs = 0;
+        for (int i = 0; i < n && !backs; i++) backs = gp->ps.p[i].back > 0.0f && gp->ps.p[i].twin >= 0;
+        if (backs && !(J.back_over = gi_particle_calloc((size_t)n * 3, sizeof(float), st))) return NULL;
         pool_run(gp->threads, (n + CAUS_CHUNK - 1) / CAUS_CHUNK, caus_chunk, &J);
+        if (J.back_over) {
+            /* less what the twin's own sum brings through gi_k_emit's
+             * back lobe (all twins' sums read before any is changed) */
+            for (int i = 0; i < n; i++) {
+                int t = gp->ps.p[i].twin;
+                float *b = &J.back_over[3 * (size_t)i];
+                for (int c = 0; c < 3; c++) b[c] = t >= 0 ? fmaxf(b[c] - gp->extra[4 * (size_t)t + c], 0.0f) : 0.0f;
+            }
+            for (int i = 0; i < n; i++)
+                for (int c = 0; c < 3; c++) gp->extra[4 * (size_t)i + c] += gp->ps.p[i].back * J.back_over[3 * (size_t)i + c];
+            free(J.back_over);
+        }
     } else {
         memset(gp->extra, 0, (size_t)n * 4 * sizeof(float));
     }

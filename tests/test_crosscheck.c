@@ -108,6 +108,47 @@ static void test_photon_backlit(void **st)
     assert_true(crosscheck(path, "xc_photon_backlit") <= TOLERANCE);
 }
 
+/* The same under radiosity{}, seen from the room (partray's default
+ * there: particle GI): the floor, lit only by the curtain's room side,
+ * has a mean within 5% of POV-Ray's, and so has the image; with
+ * recursion_limit 2 (the particles light the floor) and 1 (the final
+ * gather's hits alone). */
+static void backlit_gi(int rl)
+{
+    char path[512], pov[512], pt[512], name[64], decl[16];
+    snprintf(name, sizeof name, "xc_photon_backlit_gi_rl%d", rl);
+    snprintf(decl, sizeof decl, "RL=%d", rl);
+    snprintf(path, sizeof path, "%s/scenes/xc_photon_backlit_gi.pov", TESTS_DIR);
+    const int w = 96, h = 72;
+    tu_crosscheck(PARTRAY_BIN, tmpdir, path, name, w, h, decl);
+    snprintf(pov, sizeof pov, "%s/%s_pov.png", tmpdir, name);
+    snprintf(pt, sizeof pt, "%s/%s_pt.png", tmpdir, name);
+    framebuffer *a = NULL, *b = NULL;
+    assert_int_equal(img_read(pov, 1, &a, NULL), PT_OK);
+    assert_int_equal(img_read(pt, 1, &b, NULL), PT_OK);
+    /* the floor: the lower middle of the image */
+    unsigned char *floor = calloc((size_t)w * h, 1);
+    assert_non_null(floor);
+    for (int y = 50; y < 72; y++)
+        for (int x = 35; x < 80; x++) floor[y * w + x] = 1;
+    double fa = tu_luminance_mean(a, floor), fb = tu_luminance_mean(b, floor);
+    double ia = tu_luminance_mean(a, NULL), ib = tu_luminance_mean(b, NULL);
+    printf("%s: floor POV-Ray %.5f partray %.5f (%+.2f%%), image %.5f %.5f (%+.2f%%); tolerance 5%%\n", name, fa, fb,
+           100.0 * (fb / fa - 1.0), ia, ib, 100.0 * (ib / ia - 1.0));
+    assert_true(fa > 0.0 && fabs(fb / fa - 1.0) <= 0.05);
+    assert_true(ia > 0.0 && fabs(ib / ia - 1.0) <= 0.05);
+    free(floor);
+    fb_free(a);
+    fb_free(b);
+}
+
+static void test_photon_backlit_gi(void **st)
+{
+    (void)st;
+    backlit_gi(2);
+    backlit_gi(1);
+}
+
 /* +A's subsamples: POV-Ray jitters them by a fixed function of position
  * (its jitter table under a lattice hash), so partray, taking the same
  * positions, reproduces its antialiased edges pixel for pixel. Compared at
@@ -201,6 +242,7 @@ int main(void)
         cmocka_unit_test(test_glass_room),
         cmocka_unit_test(test_glass_inside_csg),
         cmocka_unit_test(test_photon_backlit),
+        cmocka_unit_test(test_photon_backlit_gi),
         cmocka_unit_test(test_antialias_subsamples),
         cmocka_unit_test(test_merge_coincident_walls),
         cmocka_unit_test(test_gi_antialias_reuse),
