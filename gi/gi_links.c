@@ -221,13 +221,13 @@ static void sky_traced(const link_job *J, vec3 p, vec3 n, vec3 d, float out[3])
     gi_sky_radiance(J->sky, df, out);
 }
 
+/* org lies on n's side of p (the memo's last blocker is for that side). */
+static int org_front(vec3 p, vec3 org, vec3 n) { return v3_dot(v3_sub(org, p), n) > 0.0; }
+
 /* far: 0 no sky term; 1 the far field's, the sky taken as unoccluded (a
  * hit beyond the particles' box); 2 the sky as one traced ray sees it
  * (sky_traced: a hit within the box where no particle answers, which may
  * lie in a closed room) */
-/* org lies on n's side of p (the memo's last blocker is for that side). */
-static int org_front(vec3 p, vec3 org, vec3 n) { return v3_dot(v3_sub(org, p), n) > 0.0; }
-
 static void hit_light_at(const link_job *J, const struct RTCRayHit *h, int far, int direct, emit_memo *memo, float out[3],
                          int level, double weight)
 {
