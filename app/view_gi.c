@@ -37,6 +37,9 @@ typedef struct {
     /* NULL: the mode cannot follow a new scene (view_gi_reframe) */
     pt_status (*reframe)(void *ctx, const scene *sc, const accel *a, volatile int *cancel, view_gi_times *t, diag *d);
     void (*adopt)(void *ctx);
+    /* NULL or 0: open ran the lighting stage; 1: open left it to the
+     * first relight (the mode opens stale) */
+    int (*pending)(void *ctx);
 } gi_backend;
 
 struct view_gi {
@@ -58,8 +61,9 @@ struct view_gi {
 
 /* --------------------------------------------------------- caustic layer */
 /* The scene's photons{} in the none and particle modes, as `partray
- * render` has them (caustics.h): shot when the mode opens, and again by a
- * relight when the lights differ from those the layer was shot from. A
+ * render` has them (caustics.h): shot when particle opens and by none's
+ * first relight (none opens stale), and again by a relight when the
+ * lights differ from those the layer was shot from. A
  * camera move needs nothing: the layer's G-buffer is the opening camera's,
  * and a lookup away from it is answered from the photons themselves
  * (gi_caustic_at). A new layer is built in the free slot and takes over
@@ -176,10 +180,15 @@ static pt_status none_open(void *ctx, const scene *sc, const accel *a, const vie
     c->sc = sc;
     c->a = a;
     c->o = *o;
-    double t0 = timer_now();
-    pt_status st = caus_update(&c->caus, sc, a, o, NULL, d);
-    t->light = timer_now() - t0;
-    return st;
+    /* the caustic layer is left to the first relight: `none` opens on the
+     * render thread, whose first image should not wait for the photons */
+    return PT_OK;
+}
+
+static int none_pending(void *ctx)
+{
+    none_ctx *c = ctx;
+    return caus_stale(&c->caus, c->sc);
 }
 
 static pt_status none_relight(void *ctx, volatile int *cancel, view_gi_times *t, diag *d)
@@ -589,7 +598,7 @@ static void ref_close(void *ctx) { fb_free(((ref_ctx *)ctx)->sum); }
 
 static const gi_backend backends[] = {
     {GI_NONE, 1, sizeof(none_ctx), whitted_last_level, none_open, none_relight, NULL, NULL, none_render, none_describe,
-     none_close},
+     none_close, NULL, NULL, none_pending},
     {GI_PARTICLE, 1, sizeof(particle_ctx), whitted_last_level, particle_open, particle_relight, particle_has_preview,
      particle_relight_preview, particle_render, particle_describe, particle_close},
     {GI_LINKS, 0, sizeof(links_ctx), whitted_last_level, links_open, links_relight, NULL, NULL, links_render,
@@ -651,6 +660,7 @@ pt_status view_gi_open(view_gi **out, int mode, const scene *sc, const accel *a,
     pt_status st = b->open(g->ctx, &g->sc, a, o, t, d);
     if (t->build == 0 && t->light == 0) t->build = timer_now() - t0;
     g->t_light = t->light;
+    if (st == PT_OK && b->pending && b->pending(g->ctx)) g->stale = 1;
     if (st != PT_OK) {
         view_gi_close(g);
         return st;

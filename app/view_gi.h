@@ -7,7 +7,9 @@
  *             Levels: 0 preview, 1 full resolution, 2 adaptive antialiasing
  *             (+A0.3 +R3). A scene with photons{} gets its caustic layer
  *             (caustics.h) in this mode and in particle, as `partray
- *             render` does: shot when the mode opens and again by a
+ *             render` does: shot by the first relight (none opens stale,
+ *             view_gi_stale, so that its first image does not wait for
+ *             the photons; particle shoots it as it opens) and again by a
  *             relight when the lights moved.
  *   particle  gi_particle (seed 000): open = geometry + lighting stage,
  *             relight = lighting stage only, every pass = prepare_view +

@@ -496,6 +496,9 @@ static void *render_main(void *arg)
             view_gi_opts go = gi_opts(vr);
             st = view_gi_open(&vr->opened[use], use, vr->sc, vr->a, &go, &t, d);
             acc.build += t.build;
+            /* opened stale (the caustic layer not shot yet): a preview
+             * without it first, the lighting stage in the next pass */
+            if (st == PT_OK && view_gi_stale(vr->opened[use])) quick_pending = 1;
         }
         view_gi *g = vr->opened[use];
         int quick = 0, stale = 0, coarse = 0;

@@ -882,7 +882,10 @@ static double centre_green(const framebuffer *fb, int c)
     return s / (c * c);
 }
 
-static view_gi *caustic_mode(int mode, const scene *sc, const accel *a, int w)
+/* Opens mode on sc; a mode that opens stale (none with photons: its
+ * caustic layer is the first relight's) is relit at once. *opened_stale
+ * (NULL: not wanted) says whether it was. */
+static view_gi *caustic_mode(int mode, const scene *sc, const accel *a, int w, int *opened_stale)
 {
     view_gi_opts go;
     memset(&go, 0, sizeof go);
@@ -896,12 +899,17 @@ static view_gi *caustic_mode(int mode, const scene *sc, const accel *a, int w)
     view_gi *g = NULL;
     diag *d = diag_new();
     assert_int_equal(view_gi_open(&g, mode, sc, a, &go, &t, d), PT_OK);
+    int stale = view_gi_stale(g);
+    if (opened_stale) *opened_stale = stale;
+    if (stale) assert_int_equal(view_gi_relight(g, NULL, &t, d), PT_OK);
+    assert_false(view_gi_stale(g));
     diag_free(d);
     return g;
 }
 
 /* The viewer's none and particle modes show the scene's caustics, as
- * `partray render` does: none's first full-resolution pass equals
+ * `partray render` does: none opens stale where there are photons (its
+ * first relight shoots them), and its first full-resolution pass then equals
  * render_gi's --gi none image of the same size and seed exactly (one
  * caustic layer, same G-buffer), and the caustic is there (the focus
  * region at least 3 times as bright as without photons). A light edit: a
@@ -919,7 +927,8 @@ static void test_viewer_caustics(void **st)
     caustic_world(1.0, 1, &sc_b, &a_b);
     caustic_world(0.0, 0, &sc_off, &a_off);
 
-    view_gi *g = caustic_mode(GI_NONE, sc, a, w);
+    int stale_photons = 0, stale_none = 1, stale_particle = 1;
+    view_gi *g = caustic_mode(GI_NONE, sc, a, w, &stale_photons);
     framebuffer *v = gi_pass(g, w, w);
     render_gi_opts o;
     memset(&o, 0, sizeof o);
@@ -935,7 +944,11 @@ static void test_viewer_caustics(void **st)
     diag *d = diag_new();
     assert_int_equal(render_gi(sc, a, &o, r, &rr, d), PT_OK);
     assert_true(rr.caus.st.stored > 1000);
-    view_gi *goff = caustic_mode(GI_NONE, sc_off, a_off, w);
+    view_gi *goff = caustic_mode(GI_NONE, sc_off, a_off, w, &stale_none);
+    /* none opens stale where there are photons to shoot, so that the
+     * viewer's first image does not wait for them */
+    assert_true(stale_photons);
+    assert_false(stale_none);
     framebuffer *voff = gi_pass(goff, w, w);
     double e_render = max_diff(v, r), focus = centre_green(v, c), focus_off = centre_green(voff, c);
     char desc[256];
@@ -957,7 +970,7 @@ static void test_viewer_caustics(void **st)
     assert_int_equal(view_gi_relight(g, &cancel, &t, d), PT_OK);
     assert_false(view_gi_stale(g));
     framebuffer *rl = gi_pass(g, w, w);
-    view_gi *gb = caustic_mode(GI_NONE, sc_b, a_b, w);
+    view_gi *gb = caustic_mode(GI_NONE, sc_b, a_b, w, NULL);
     framebuffer *fresh = gi_pass(gb, w, w);
     double e_cancel = max_diff(q, q2), e_fresh = max_diff(rl, fresh), e_moved = max_diff(q, rl);
     printf("none: cancelled relight changed %.3g, relit vs opened there %.3g, caustic moved %.3g\n", e_cancel, e_fresh,
@@ -967,15 +980,16 @@ static void test_viewer_caustics(void **st)
     assert_true(e_moved > 0.05);
 
     /* particle: the same light edit */
-    view_gi *gp = caustic_mode(GI_PARTICLE, sc, a, w);
-    view_gi *gpoff = caustic_mode(GI_PARTICLE, sc_off, a_off, w);
+    view_gi *gp = caustic_mode(GI_PARTICLE, sc, a, w, &stale_particle);
+    assert_false(stale_particle); /* particle shoots its layer as it opens */
+    view_gi *gpoff = caustic_mode(GI_PARTICLE, sc_off, a_off, w, NULL);
     framebuffer *p0 = gi_pass(gp, w, w), *poff = gi_pass(gpoff, w, w);
     double pfocus = centre_green(p0, c), pfocus_off = centre_green(poff, c);
     view_gi_scene(gp)->lights[0].position = sc_b->lights[0].position;
     view_gi_lights_changed(gp);
     assert_int_equal(view_gi_relight(gp, &cancel, &t, d), PT_OK);
     framebuffer *prl = gi_pass(gp, w, w);
-    view_gi *gpb = caustic_mode(GI_PARTICLE, sc_b, a_b, w);
+    view_gi *gpb = caustic_mode(GI_PARTICLE, sc_b, a_b, w, NULL);
     framebuffer *pfresh = gi_pass(gpb, w, w);
     double pe_fresh = max_diff(prl, pfresh), pe_moved = max_diff(p0, prl);
     view_gi_describe(gp, desc, sizeof desc);
