@@ -63,6 +63,19 @@ static double crosscheck(const char *scene_path, const char *name)
     return mad;
 }
 
+/* tu_crosscheck's two renders of scene_path (tag name, w x h, decl as
+ * there), read back linear: *pov POV-Ray's, *pt partray's. */
+static void crosscheck_images(const char *scene_path, const char *name, int w, int h, const char *decl,
+                              framebuffer **pov, framebuffer **pt)
+{
+    char a[512], b[512];
+    tu_crosscheck(PARTRAY_BIN, tmpdir, scene_path, name, w, h, decl);
+    snprintf(a, sizeof a, "%s/%s_pov.png", tmpdir, name);
+    snprintf(b, sizeof b, "%s/%s_pt.png", tmpdir, name);
+    assert_int_equal(img_read(a, 1, pov, NULL), PT_OK);
+    assert_int_equal(img_read(b, 1, pt, NULL), PT_OK);
+}
+
 static void test_cornell_direct(void **st)
 {
     (void)st;
@@ -115,17 +128,13 @@ static void test_photon_backlit(void **st)
  * gather's hits alone). */
 static void backlit_gi(int rl)
 {
-    char path[512], pov[512], pt[512], name[64], decl[16];
+    char path[512], name[64], decl[16];
     snprintf(name, sizeof name, "xc_photon_backlit_gi_rl%d", rl);
     snprintf(decl, sizeof decl, "RL=%d", rl);
     snprintf(path, sizeof path, "%s/scenes/xc_photon_backlit_gi.pov", TESTS_DIR);
     const int w = 96, h = 72;
-    tu_crosscheck(PARTRAY_BIN, tmpdir, path, name, w, h, decl);
-    snprintf(pov, sizeof pov, "%s/%s_pov.png", tmpdir, name);
-    snprintf(pt, sizeof pt, "%s/%s_pt.png", tmpdir, name);
     framebuffer *a = NULL, *b = NULL;
-    assert_int_equal(img_read(pov, 1, &a, NULL), PT_OK);
-    assert_int_equal(img_read(pt, 1, &b, NULL), PT_OK);
+    crosscheck_images(path, name, w, h, decl, &a, &b);
     /* the floor: the lower middle of the image */
     unsigned char *floor = calloc((size_t)w * h, 1);
     assert_non_null(floor);
@@ -156,14 +165,10 @@ static void test_photon_backlit_gi(void **st)
  * the mean difference on this scene of edges is ten times the bound. */
 static double full_resolution_mad(const char *name, int size)
 {
-    char path[512], pov[512], pt[512];
+    char path[512];
     snprintf(path, sizeof path, "%s/scenes/%s.pov", TESTS_DIR, name);
-    tu_crosscheck(PARTRAY_BIN, tmpdir, path, name, size, size, NULL);
-    snprintf(pov, sizeof pov, "%s/%s_pov.png", tmpdir, name);
-    snprintf(pt, sizeof pt, "%s/%s_pt.png", tmpdir, name);
     framebuffer *a = NULL, *b = NULL;
-    assert_int_equal(img_read(pov, 1, &a, NULL), PT_OK);
-    assert_int_equal(img_read(pt, 1, &b, NULL), PT_OK);
+    crosscheck_images(path, name, size, size, NULL, &a, &b);
     double mad = tu_downsampled_mad(a, b, 1);
     fb_free(a);
     fb_free(b);
